@@ -1,0 +1,48 @@
+"""Benchmark helpers: lots written outside the timed region, the whole command timed as a process.
+
+Run with ``python -m pytest benchmarks`` (add ``-k 1e5`` for one size). Each benchmark reports terminals
+per second and the child's peak RSS in ``extra_info`` (shown by ``--benchmark-json`` and in the table's
+name column); times are wall-clock for the whole ``grammarc build`` process, start-up included.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import resource
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+HERE = Path(__file__).parent
+
+
+def grid_lots(path: Path, n: int, width: float = 20.0, depth: float = 15.0) -> Path:
+    """n rectangular lots on a grid, as GeoJSON (deterministic)."""
+    side = int(n ** 0.5 + 0.999)
+    features = []
+    for i in range(n):
+        x, y = (i % side) * (width + 10), (i // side) * (depth + 10)
+        ring = [[x, y], [x + width, y], [x + width, y + depth], [x, y + depth], [x, y]]
+        features.append({"type": "Feature", "id": f"lot{i}", "properties": {},
+                         "geometry": {"type": "Polygon", "coordinates": [ring]}})
+    path.write_text(json.dumps({"type": "FeatureCollection", "features": features}))
+    return path
+
+
+def run_build(args: list[str], env: dict | None = None) -> dict:
+    """Run ``grammarc build`` in a child process; returns its stderr summary and peak RSS (KiB)."""
+    before = resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss
+    proc = subprocess.run([sys.executable, "-m", "grammarc.cli", "build", *args], check=False,
+                          capture_output=True, text=True, env={**os.environ, **(env or {})})
+    if proc.returncode != 0:
+        raise RuntimeError(proc.stderr)
+    peak = resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss
+    return {"stderr": proc.stderr, "peak_rss_kib": max(peak, before)}
+
+
+@pytest.fixture(scope="session")
+def lots_dir(tmp_path_factory):
+    return tmp_path_factory.mktemp("lots")

@@ -1,0 +1,71 @@
+"""The state of deriving one chunk of lots: frame table, polygon store, lot columns, outputs, counters.
+
+Everything a chunk creates lives here and is dropped with it, so memory is bounded by the chunk.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from grammarc.geometry.polygons import PolygonStore
+
+
+class Frames:
+    """Growable table of scope axes (F, 3, 3) float64; row j of a frame is scope axis j in world."""
+
+    def __init__(self, capacity: int = 256) -> None:
+        self.data = np.empty((capacity, 3, 3))
+        self.count = 0
+
+    def add(self, axes: np.ndarray) -> np.ndarray:
+        """Append frames (m, 3, 3); returns their ids (m,) int32."""
+        m = len(axes)
+        if self.count + m > len(self.data):
+            grown = np.empty((max(2 * len(self.data), self.count + m), 3, 3))
+            grown[: self.count] = self.data[: self.count]
+            self.data = grown
+        self.data[self.count: self.count + m] = axes
+        ids = np.arange(self.count, self.count + m, dtype=np.int32)
+        self.count += m
+        return ids
+
+    def __getitem__(self, ids: np.ndarray) -> np.ndarray:
+        return self.data[ids]
+
+
+@dataclass
+class Outputs:
+    """Terminal rows and leaf meshes of a chunk, as lists of arrays concatenated at the end."""
+
+    asset: list = field(default_factory=list)
+    xform: list = field(default_factory=list)
+    lot: list = field(default_factory=list)
+    symbol: list = field(default_factory=list)
+    meshes: list = field(default_factory=list)
+
+
+@dataclass
+class Chunk:
+    """One chunk of lots being derived.
+
+    ``lot_index`` (L,) int64 numbers the lots in the input (for records and random keys), ``lot_ids``
+    (L,) their identifiers, ``attrs`` the per-lot attribute columns (L,) after overrides, ``lot_origin``
+    (L, 3) and ``lot_axes`` (L, 3, 3) the lots' own scopes (``Scope.tx`` is relative to them).
+    """
+
+    lot_index: np.ndarray
+    lot_ids: np.ndarray
+    attrs: dict[str, np.ndarray]
+    lot_origin: np.ndarray
+    lot_axes: np.ndarray
+    frames: Frames
+    polygons: PolygonStore
+    outputs: Outputs = field(default_factory=Outputs)
+    #: Shapes created so far per lot, for the ``max_shapes`` limit.
+    shape_count: np.ndarray | None = None
+
+    def __post_init__(self) -> None:
+        if self.shape_count is None:
+            self.shape_count = np.zeros(len(self.lot_index), dtype=np.int64)

@@ -1,0 +1,106 @@
+"""Derive one chunk of lots: initial shapes, attributes, the staged worklist, sorted records.
+
+The schedule (paper section 2, "Production process"): stages follow the rules' priorities from the lowest;
+within a stage, rounds visit the symbols in a fixed order (their ids) and apply each symbol's rules to all
+of its pending shapes at once, until no shape of the stage is pending. Because the schedule is the same for
+every lot and each operation is elementwise, the records of a lot do not depend on which other lots share
+its chunk; sorting the chunk's records by lot (stably) makes the output independent of the chunking.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from grammarc.backend.attributes import attribute_columns
+from grammarc.backend.chunk import Chunk, Frames
+from grammarc.backend.evaluate import Env
+from grammarc.backend.execute import Executor
+from grammarc.backend.kernels.order import group_by, scatter_rows
+from grammarc.backend.plan import Plan
+from grammarc.backend.random import lot_keys
+from grammarc.backend.shapes import Shapes
+from grammarc.constants import Limits
+from grammarc.geometry.footprint import footprint_polygons, lot_scopes
+from grammarc.geometry.polygons import PolygonStore
+from grammarc.io.lots import Lots
+from grammarc.io.npz import MeshChunk, TerminalChunk
+from grammarc.ragged import ragged_take
+
+
+def initial_chunk(lots: Lots) -> tuple[Chunk, Shapes]:
+    """The chunk state and initial shapes (one per lot) of ``lots``."""
+    origin, axes, size, local = lot_scopes(lots)
+    is_rect, coords, ring_offsets, poly_offsets = footprint_polygons(lots, size, local)
+    frames = Frames(capacity=max(256, 4 * len(lots)))
+    polygons = PolygonStore()
+    geom = np.full(len(lots), -1, dtype=np.int32)
+    geom[~is_rect] = polygons.add(coords, ring_offsets, poly_offsets,
+                                  np.ones(int((~is_rect).sum()), dtype=np.int8))
+    chunk = Chunk(lot_index=lots.index, lot_ids=lots.ids, attrs={}, lot_origin=origin, lot_axes=axes,
+                  frames=frames, polygons=polygons)
+    n = len(lots)
+    shapes = Shapes(origin, size, frames.add(axes), geom, np.arange(n, dtype=np.int32),
+                    np.zeros(n, dtype=np.uint64), np.zeros(n, dtype=np.int32))
+    return chunk, shapes
+
+
+def derive_chunk(plan: Plan, lots: Lots, *, seed: int, limits: Limits, overrides: dict,
+                 chunk_budget: int) -> TerminalChunk:
+    """Derive ``lots``; raises ``LotFailure`` naming lots to skip, ``ChunkTooLarge``, or ``LimitError``."""
+    chunk, shapes = initial_chunk(lots)
+    shapes = Shapes(shapes.origin, shapes.size, shapes.frame, shapes.geom, shapes.lot,
+                    lot_keys(seed, lots.index), shapes.depth)
+    attribute_columns(plan.grammar.module, Env(shapes, chunk, plan.strings.ids), lots.attrs, overrides,
+                      plan.strings)
+    executor = Executor(plan, chunk, limits, chunk_budget)
+    executor.pending[plan.start].append(shapes)
+    for stage in plan.stages:
+        # A fixed visiting order per round: whether a lot's shapes are processed in a round depends only
+        # on that lot, never on which other lots have shapes pending (see the module docstring).
+        order = [s.id for s in plan.symbols if s.rules and s.priority <= stage]
+        while any(executor.pending.get(s) for s in order):
+            for sym_id in order:
+                batches = executor.pending.pop(sym_id, None)
+                if batches:
+                    executor.apply(plan.symbols[sym_id], Shapes.concat(batches))
+    return collect(chunk)
+
+
+def collect(chunk: Chunk) -> TerminalChunk:
+    """The chunk's records, sorted stably by lot, with lots numbered as in the input.
+
+    Rows are scattered straight from the pieces the operations emitted into their sorted places, so each
+    column is copied once.
+    """
+    out = chunk.outputs
+    n_lots = len(chunk.lot_index)
+    lot = np.concatenate(out.lot) if out.lot else np.zeros(0, dtype=np.int32)
+    order, _ = group_by(lot.astype(np.int64), n_lots)
+    dest = np.empty_like(order)
+    dest[order] = np.arange(len(order))
+    columns = {}
+    for name, row_shape, dtype in (("asset", (), np.int32), ("xform", (3, 4), np.float32),
+                                   ("symbol", (), np.int32)):
+        column = np.empty((len(lot), *row_shape), dtype=dtype)
+        flat = column.reshape(len(lot), -1)
+        start = 0
+        for piece in getattr(out, name):
+            stop = start + len(piece)
+            scatter_rows(np.ascontiguousarray(piece).reshape(len(piece), -1), dest[start:stop], flat)
+            start = stop
+        columns[name] = column
+    index = chunk.lot_index.astype(np.int32)
+    mesh = MeshChunk.concat(out.meshes) if out.meshes else MeshChunk.empty()
+    if len(mesh.lot):
+        mesh = _sort_mesh(mesh)
+    mesh = MeshChunk(mesh.vertices, mesh.ring_offsets, mesh.face_offsets, index[mesh.lot], mesh.symbol)
+    return TerminalChunk(asset=columns["asset"], xform=columns["xform"], lot=index[lot[order]],
+                         symbol=columns["symbol"], mesh=mesh)
+
+
+def _sort_mesh(mesh: MeshChunk) -> MeshChunk:
+    order = np.argsort(mesh.lot, kind="stable")
+    rings, face_offsets = ragged_take(mesh.face_offsets, order)
+    vertices, ring_offsets = ragged_take(mesh.ring_offsets, rings)
+    return MeshChunk(mesh.vertices[vertices], ring_offsets, face_offsets, mesh.lot[order],
+                     mesh.symbol[order])

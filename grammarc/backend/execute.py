@@ -1,0 +1,409 @@
+"""Rules and successor bodies executed on whole batches of shapes.
+
+``Executor.apply`` takes every pending shape of one symbol: guards partition the batch (the first rule
+whose guard holds applies, in source order), one uniform draw per shape picks a stochastic alternative,
+and each alternative's body runs on its shapes at once. A body is a sequence of operations on a *cursor*:
+a ``Shapes`` batch whose scope columns the operations replace as they go (``T``, ``S``, ``R``, ``[ ]``).
+Successor symbols are queued for later rounds; splits run their parts' bodies on the children at once,
+one call per part. Python cost is per operation and batch, never per shape.
+"""
+
+from __future__ import annotations
+
+from collections import defaultdict
+from dataclasses import dataclass
+
+import numpy as np
+
+from grammarc.backend import terminals
+from grammarc.backend.chunk import Chunk
+from grammarc.backend.evaluate import Env, elementwise, evaluate, evaluate_array
+from grammarc.backend.kernels import scope as scope_kernels
+from grammarc.backend.kernels import split as split_kernels
+from grammarc.backend.kernels.order import group_by
+from grammarc.backend.plan import Plan, SymbolPlan
+from grammarc.backend.random import child_keys, uniform
+from grammarc.backend.shapes import Shapes
+from grammarc.constants import TOL, Limits
+from grammarc.errors import ChunkTooLarge, LimitError, LotFailure
+from grammarc.geometry import components as comp_kernels
+from grammarc.ir import nodes as ir
+
+
+@dataclass(frozen=True)
+class Where:
+    """The rule being applied, for messages and records."""
+
+    symbol: int
+    rule: ir.Rule
+
+
+class Executor:
+    """Derives one chunk: a worklist of pending batches per symbol, and the operations."""
+
+    def __init__(self, plan: Plan, chunk: Chunk, limits: Limits, chunk_budget: int):
+        self.plan = plan
+        self.chunk = chunk
+        self.limits = limits
+        self.chunk_budget = chunk_budget
+        self.pending: dict[int, list[Shapes]] = defaultdict(list)
+
+    # ------------------------------------------------------------------------------------------ helpers
+    def env(self, shapes: Shapes) -> Env:
+        return Env(shapes, self.chunk, self.plan.strings.ids)
+
+    def fail(self, shapes: Shapes, bad: np.ndarray, message: str, where: Where, span) -> None:
+        """Report the lots of shapes ``bad`` (bool mask) as failed: raises ``LotFailure``."""
+        lots = np.unique(shapes.lot[bad])
+        rule = self.plan.symbols[where.symbol].name
+        raise LotFailure(f"{message} in rule `{rule}` at {span}", lots)
+
+    def count(self, shapes: Shapes, where: Where, span) -> None:
+        """Add new shapes to the per-lot counters and enforce the shape limits."""
+        if not len(shapes):
+            return
+        counts = self.chunk.shape_count
+        counts += np.bincount(shapes.lot, minlength=len(counts))
+        worst = int(np.argmax(counts))
+        if counts[worst] > self.limits.max_shapes:
+            rule = self.plan.symbols[where.symbol].name
+            raise LimitError(
+                f"lot {self.chunk.lot_ids[worst]} made more than {self.limits.max_shapes:,} shapes; the "
+                f"last were made by rule `{rule}` at {span}: a runaway grammar? "
+                "Raise the limit with --max-shapes N."
+            )
+        if counts.sum() > self.chunk_budget and len(counts) > 1:
+            raise ChunkTooLarge()
+
+    # ---------------------------------------------------------------------------------- rule application
+    def apply(self, sym: SymbolPlan, shapes: Shapes) -> None:
+        """Apply the rules of ``sym`` to all of ``shapes``; shapes no rule applies to become leaves."""
+        deepest = int(np.argmax(shapes.depth))
+        if shapes.depth[deepest] >= self.limits.max_depth:
+            rule = sym.rules[0]
+            raise LimitError(
+                f"derivation of lot {self.chunk.lot_ids[shapes.lot[deepest]]} reached --max-depth "
+                f"{self.limits.max_depth} at rule `{sym.name}` ({rule.span}): runaway recursion? "
+                "Raise the limit with --max-depth N."
+            )
+        remaining = shapes
+        for rule in sym.rules:
+            if not len(remaining):
+                break
+            if rule.guard is None:
+                chosen, remaining = remaining, remaining.take(np.zeros(0, dtype=np.int64))
+            else:
+                holds = evaluate_array(rule.guard, self.env(remaining), dtype=bool)
+                chosen, remaining = remaining.take(holds), remaining.take(~holds)
+            if len(chosen):
+                self.apply_rule(sym, rule, chosen)
+        if len(remaining):
+            terminals.emit_leaves(self.chunk, remaining, sym.id)
+
+    def apply_rule(self, sym: SymbolPlan, rule: ir.Rule, shapes: Shapes) -> None:
+        where = Where(sym.id, rule)
+        alts = rule.alternatives
+        if len(alts) == 1:
+            self.run(alts[0].body, shapes, where)
+            return
+        env = self.env(shapes)
+        probs = np.stack([evaluate_array(a.prob, env) for a in alts], axis=1)
+        bad = (np.abs(probs.sum(axis=1) - 1.0) > TOL.probability) | (probs < 0).any(axis=1)
+        if bad.any():
+            self.fail(shapes, bad, "probabilities do not sum to 1", where, rule.span)
+        cumulative = np.cumsum(probs, axis=1)
+        draw = uniform(shapes.key, rule.site)
+        choice = np.minimum((draw[:, None] >= cumulative).sum(axis=1), len(alts) - 1)
+        for i, alt in enumerate(alts):
+            picked = shapes.take(choice == i)
+            if len(picked):
+                self.run(alt.body, picked, where)
+
+    # ------------------------------------------------------------------------------------------- bodies
+    def run(self, body: ir.Body, cursor: Shapes, where: Where) -> None:
+        """Execute ``body`` on ``cursor``; operations replace its scope columns as they go."""
+        stack: list[tuple] = []
+        for op in body:
+            if not len(cursor):
+                return
+            if isinstance(op, ir.Symbol):
+                self.successor(op, cursor, where)
+            elif isinstance(op, ir.Translate):
+                cursor = self.translate(op, cursor)
+            elif isinstance(op, ir.Scale):
+                cursor = self.scale(op, cursor, where)
+            elif isinstance(op, ir.Rotate):
+                cursor = self.rotate(op, cursor)
+            elif isinstance(op, ir.Push):
+                stack.append((cursor.origin, cursor.size, cursor.frame, cursor.geom))
+            elif isinstance(op, ir.Pop):
+                if stack:
+                    cursor = cursor.with_scope(*stack.pop())
+            elif isinstance(op, ir.Insert):
+                asset = self.plan.grammar.asset_ids[op.asset]
+                terminals.emit_instances(self.chunk, cursor, asset, where.symbol)
+            elif isinstance(op, ir.Split):
+                self.split(op, cursor, where)
+            elif isinstance(op, ir.Repeat):
+                self.repeat(op, cursor, where)
+            elif isinstance(op, ir.Comp):
+                self.comp(op, cursor, where)
+            elif isinstance(op, ir.Empty):
+                pass
+            else:
+                raise TypeError(f"unknown operation {op!r}")
+
+    def successor(self, op: ir.Symbol, cursor: Shapes, where: Where) -> None:
+        sym = self.plan.symbols[self.plan.symbol_ids[op.name]]
+        env = self.env(cursor)
+        params = tuple(
+            evaluate_array(arg, env, dtype=np.int32 if t is ir.Type.STR else np.float64)
+            for arg, t in zip(op.args, sym.param_types)
+        )
+        shapes = Shapes(cursor.origin, cursor.size, cursor.frame, cursor.geom, cursor.lot,
+                        child_keys(cursor.key, op.site), cursor.depth + 1, params)
+        self.count(shapes, where, op.span)
+        if sym.terminal:
+            terminals.emit_leaves(self.chunk, shapes, sym.id)
+        else:
+            self.pending[sym.id].append(shapes)
+
+    def translate(self, op: ir.Translate, cursor: Shapes) -> Shapes:
+        env = self.env(cursor)
+        local = np.stack([evaluate_array(e, env) for e in op.vector], axis=1)
+        delta = np.einsum("ni,nij->nj", local, self.chunk.frames[cursor.frame])
+        return cursor.with_scope(cursor.origin + delta, cursor.size, cursor.frame, cursor.geom)
+
+    def scale(self, op: ir.Scale, cursor: Shapes, where: Where) -> Shapes:
+        env = self.env(cursor)
+        size = np.empty_like(cursor.size)
+        for axis, s in enumerate(op.sizes):
+            value = evaluate_array(s.value, env)
+            size[:, axis] = value * cursor.size[:, axis] if s.kind is ir.SizeKind.RELATIVE else value
+        bad = ~(size >= 0).all(axis=1)
+        if bad.any():
+            self.fail(cursor, bad, f"`S` gives a negative or NaN size ({_example(size, bad)})", where,
+                      op.span)
+        return cursor.with_scope(cursor.origin, size, cursor.frame, cursor.geom)
+
+    def rotate(self, op: ir.Rotate, cursor: Shapes) -> Shapes:
+        env = self.env(cursor)
+        angles = [evaluate(e, env) for e in op.angles]
+        frames = self.chunk.frames
+        if all(np.ndim(a) == 0 for a in angles):
+            # One rotation for all: rotate each distinct frame once.
+            unique, inverse = np.unique(cursor.frame, return_inverse=True)
+            matrix = _rotation(*(np.full(1, a, dtype=np.float64) for a in angles))[0]
+            new = frames.add(np.einsum("ij,fjk->fik", matrix, frames[unique]))
+            frame = new[inverse.reshape(-1)]
+        else:
+            n = len(cursor)
+            matrices = _rotation(*(np.broadcast_to(np.asarray(a, np.float64), (n,)) for a in angles))
+            frame = frames.add(np.einsum("nij,njk->nik", matrices, frames[cursor.frame]))
+        return cursor.with_scope(cursor.origin, cursor.size, frame, cursor.geom)
+
+    # ------------------------------------------------------------------------------------------- splits
+    def split(self, op: ir.Split, cursor: Shapes, where: Where) -> None:
+        env = self.env(cursor)
+        values = _size_matrix([evaluate(s.value, env) for s in op.sizes], len(cursor))
+        bad = ~(values >= 0).all(axis=1)
+        if bad.any():
+            self.fail(cursor, bad, f"`Subdiv` has a negative or NaN size ({_example(values, bad)})", where,
+                      op.span)
+        relative = np.array([s.kind is ir.SizeKind.RELATIVE for s in op.sizes])
+        cell = np.zeros(len(cursor), dtype=np.int64)
+        shapes = cursor
+        last = len(op.axes) - 1
+        for level, axis in enumerate(op.axes):
+            self.check_splittable(shapes, axis, where, op.span)
+            parent, part, pos, length = split_kernels.subdiv(
+                np.ascontiguousarray(shapes.size[:, axis]), values, relative, TOL.zero
+            )
+            cell = cell[parent] + part * len(op.sizes) ** level
+            if values.shape[0] > 1:
+                values = values[parent]
+            if level == last:
+                shapes, offsets = self.grouped_children(shapes, axis, parent, cell, pos, length, op.site,
+                                                        len(op.parts))
+            else:
+                shapes = self.children(shapes, axis, parent, cell, pos, length, op.site)
+        self.count(shapes, where, op.span)
+        self.run_parts(op.parts, shapes, offsets, where)
+
+    def repeat(self, op: ir.Repeat, cursor: Shapes, where: Where) -> None:
+        env = self.env(cursor)
+        sizes = [evaluate_array(e, env) for e in op.sizes]
+        shapes = cursor
+        cell = np.zeros(len(cursor), dtype=np.int64)
+        stride = np.ones(len(cursor), dtype=np.int64)
+        last = len(op.axes) - 1
+        for level, axis in enumerate(op.axes):
+            size = sizes[level]
+            bad = ~(size > 0)
+            if bad.any():
+                self.fail(shapes, bad, f"`Repeat` needs a positive size, got {size[bad][0]:g}", where,
+                          op.span)
+            self.check_splittable(shapes, axis, where, op.span)
+            extent = np.ascontiguousarray(shapes.size[:, axis])
+            counts = split_kernels.repeat_counts(extent, size, TOL.zero)
+            self.check_fan_out(shapes, counts, where, op.span)
+            parent, part, pos, length = split_kernels.repeat(extent, counts)
+            cell = cell[parent] + part * stride[parent]
+            stride = stride[parent] * counts[parent]
+            sizes = [s[parent] for s in sizes]  # the next axes' sizes follow the children
+            if level == last:
+                shapes, offsets = self.grouped_children(shapes, axis, parent, cell, pos, length, op.site,
+                                                        len(op.parts))
+            else:
+                shapes = self.children(shapes, axis, parent, cell, pos, length, op.site)
+        self.count(shapes, where, op.span)
+        self.run_parts(op.parts, shapes, offsets, where)
+
+    def check_fan_out(self, shapes: Shapes, counts: np.ndarray, where: Where, span) -> None:
+        """Refuse a repeat that would exceed --max-shapes before allocating its children."""
+        per_lot = np.bincount(shapes.lot, weights=counts, minlength=len(self.chunk.shape_count))
+        total = per_lot + self.chunk.shape_count
+        worst = int(np.argmax(total))
+        if total[worst] > self.limits.max_shapes:
+            rule = self.plan.symbols[where.symbol].name
+            raise LimitError(
+                f"`Repeat` at {span} in rule `{rule}` would make {int(total[worst]):,} shapes on lot "
+                f"{self.chunk.lot_ids[worst]} (--max-shapes {self.limits.max_shapes:,}); raise the limit "
+                "with --max-shapes N"
+            )
+
+    def check_splittable(self, shapes: Shapes, axis: int, where: Where, span) -> None:
+        """Polygons split only along their extrusion axis until the polygon geometry issue lands."""
+        poly = shapes.geom >= 0
+        if not poly.any():
+            return
+        plane = self.chunk.polygons.plane[shapes.geom[poly]]
+        bad = np.zeros(len(shapes), dtype=bool)
+        bad[np.flatnonzero(poly)[plane != axis]] = True
+        if bad.any():
+            self.fail(shapes, bad, f"splitting a non-rectangular polygon along {'XYZ'[axis]} is not "
+                      "supported yet (only along its extrusion axis)", where, span)
+
+    def children(self, shapes: Shapes, axis: int, parent, index, pos, length, site: int) -> Shapes:
+        """Children of a split along ``axis``: the parent's scope moved by ``pos`` and cut to ``length``."""
+        origin, size, key = scope_kernels.place_children(
+            shapes.origin, shapes.size, shapes.key, shapes.frame, self.chunk.frames.data, axis, parent,
+            pos, length, site, index,
+        )
+        return Shapes(origin, size, shapes.frame[parent], shapes.geom[parent], shapes.lot[parent], key,
+                      shapes.depth[parent], tuple(p[parent] for p in shapes.params))
+
+    def grouped_children(self, shapes, axis, parent, cell, pos, length, site, n_parts):
+        """``children`` ordered by body part (cell mod parts): each part's batch is then a slice."""
+        order, offsets = group_by(cell % n_parts, n_parts)
+        children = self.children(shapes, axis, parent[order], cell[order], pos[order], length[order], site)
+        return children, offsets
+
+    def run_parts(self, parts: tuple[ir.Body, ...], shapes: Shapes, offsets: np.ndarray, where) -> None:
+        for i, body in enumerate(parts):
+            if offsets[i + 1] > offsets[i]:
+                self.run(body, shapes.take(slice(offsets[i], offsets[i + 1])), where)
+
+    # ------------------------------------------------------------------------------------------- comp
+    def comp(self, op: ir.Comp, cursor: Shapes, where: Where) -> None:
+        chunk = self.chunk
+        coords, ring_offsets, shape_offsets, plane = self.polygons_of(cursor)
+        parent, index, origin, axes, size, poly = comp_kernels.components(
+            comp_kernels.KIND_CODES[op.kind], coords, ring_offsets, shape_offsets, plane, cursor.size,
+            TOL.zero,
+        )
+        if op.index is not None:
+            wanted = evaluate_array(op.index, self.env(cursor))[parent]
+            keep = index == np.round(wanted)
+            parent, index, origin, axes, size, poly = (a[keep] for a in
+                                                       (parent, index, origin, axes, size, poly))
+        child = cursor.take(parent)
+        parent_axes = chunk.frames[child.frame]
+        world_origin = child.origin + np.einsum("ni,nij->nj", origin, parent_axes)
+        frame = chunk.frames.add(np.einsum("nij,njk->nik", axes, parent_axes))
+        geom = np.full(len(parent), -1, dtype=np.int32)
+        same = poly == comp_kernels.SAME_POLY
+        geom[same] = child.geom[same]
+        for code, flip_when in ((comp_kernels.BOTTOM_POLY, "bottom"), (comp_kernels.TOP_POLY, "top")):
+            sel = (poly == code) & (child.geom >= 0)
+            if sel.any():
+                geom[sel] = self.cap_polygons(child.geom[sel], flip_when)
+        shapes = Shapes(world_origin, size, frame, geom, child.lot, child_keys(child.key, op.site, index),
+                        child.depth, child.params)
+        self.count(shapes, where, op.span)
+        order, offsets = group_by(index % len(op.parts), len(op.parts))
+        self.run_parts(op.parts, shapes.take(order), offsets, where)
+
+    def polygons_of(self, shapes: Shapes):
+        """Each shape's polygon as batch-local ragged arrays (implicit rectangles for scope shapes)."""
+        polygons = self.chunk.polygons
+        n = len(shapes)
+        plane = comp_kernels.rect_plane(shapes.size, TOL.zero)
+        is_poly = shapes.geom >= 0
+        plane[is_poly] = polygons.plane[shapes.geom[is_poly]]
+        if not is_poly.any():
+            coords = np.concatenate([comp_kernels.RECT_RINGS[p] for p in plane]) if n else np.empty((0, 2))
+            return (coords, np.arange(0, 4 * n + 1, 4, dtype=np.int64), np.arange(n + 1, dtype=np.int64),
+                    plane)
+        # Mixed batch: give scope shapes a stored rectangle so one gather serves all.
+        geom = shapes.geom.copy()
+        rects = np.flatnonzero(~is_poly)
+        if len(rects):
+            rect_coords = np.concatenate([comp_kernels.RECT_RINGS[p] for p in plane[rects]])
+            geom[rects] = polygons.add(rect_coords, np.arange(0, 4 * len(rects) + 1, 4, dtype=np.int64),
+                                       np.arange(len(rects) + 1, dtype=np.int64), plane[rects])
+        coords, ring_offsets, shape_offsets = polygons.gather(geom)
+        return coords, ring_offsets, shape_offsets, plane
+
+    def cap_polygons(self, geom: np.ndarray, which: str) -> np.ndarray:
+        """New store polygons for the bottom or top faces of prisms ``geom`` (in the face's own plane).
+
+        The face's x is the polygon's first axis; its y runs along the second axis or against it, and
+        the bottom face sees the rings from below, so they are reversed (see components.py).
+        """
+        polygons = self.chunk.polygons
+        coords, ring_offsets, poly_offsets = polygons.gather(geom)
+        plane = polygons.plane[geom]
+        flip = (plane == 1) if which == "top" else (plane != 1)
+        vertex_poly = np.repeat(np.repeat(np.arange(len(geom)), np.diff(poly_offsets)),
+                                np.diff(ring_offsets))
+        coords = coords.copy()
+        coords[:, 1] = np.where(flip[vertex_poly], 1.0 - coords[:, 1], coords[:, 1])
+        if which == "bottom":
+            coords = comp_kernels.reverse_rings(coords, ring_offsets)
+        return polygons.add(coords, ring_offsets, poly_offsets, np.full(len(geom), 2, dtype=np.int8))
+
+
+def _rotation(ax: np.ndarray, ay: np.ndarray, az: np.ndarray) -> np.ndarray:
+    """(n, 3, 3) matrices M with new axes = M @ axes: about x, then the new y, then the new z (degrees)."""
+    n = len(ax)
+    out = np.empty((n, 3, 3))
+    cx, sx = _cos_sin(ax)
+    cy, sy = _cos_sin(ay)
+    cz, sz = _cos_sin(az)
+    one, zero = np.ones(n), np.zeros(n)
+    mx = np.stack([np.stack([one, zero, zero], 1), np.stack([zero, cx, sx], 1),
+                   np.stack([zero, -sx, cx], 1)], 1)
+    my = np.stack([np.stack([cy, zero, -sy], 1), np.stack([zero, one, zero], 1),
+                   np.stack([sy, zero, cy], 1)], 1)
+    mz = np.stack([np.stack([cz, sz, zero], 1), np.stack([-sz, cz, zero], 1),
+                   np.stack([zero, zero, one], 1)], 1)
+    np.matmul(mz, np.matmul(my, mx), out=out)
+    return out
+
+
+def _cos_sin(degrees: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    d = np.ascontiguousarray(degrees, dtype=np.float64)
+    return elementwise(1, d), elementwise(0, d)
+
+
+def _example(values: np.ndarray, bad: np.ndarray) -> str:
+    row = values[np.flatnonzero(bad)[0]]
+    return ", ".join(f"{v:g}" for v in np.atleast_1d(row))
+
+
+def _size_matrix(values: list, n: int) -> np.ndarray:
+    """Split sizes as (n, P) float64, or (1, P) when every size is the same for all shapes."""
+    if all(np.ndim(v) == 0 for v in values):
+        return np.array([values], dtype=np.float64)
+    return np.stack([np.broadcast_to(np.asarray(v, np.float64), (n,)) for v in values], axis=1)

@@ -1,0 +1,36 @@
+"""Stable orderings of rows by a small integer key (a body part, a lot): counting sorts in numba."""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+
+@njit(cache=True)
+def group_by(group, k):
+    """Stable counting sort of children by body part: ``order`` (m,) int64 and ``offsets`` (k+1,) int64.
+
+    group [1, 0, 1, 0], k 2 -> order [1, 3, 0, 2], offsets [0, 2, 4]: the children of part g are
+    ``order[offsets[g]:offsets[g + 1]]``, so each part's batch is a contiguous slice.
+    """
+    offsets = np.zeros(k + 1, np.int64)
+    for g in group:
+        offsets[g + 1] += 1
+    for g in range(k):
+        offsets[g + 1] += offsets[g]
+    fill = offsets[:-1].copy()
+    order = np.empty(len(group), np.int64)
+    for i in range(len(group)):
+        g = group[i]
+        order[fill[g]] = i
+        fill[g] += 1
+    return order, offsets
+
+
+@njit(cache=True)
+def scatter_rows(src, dest, out):
+    """out[dest[i]] = src[i] for rows of 2-D arrays: src (k, w), dest (k,) int64, out (N, w)."""
+    for i in range(len(dest)):
+        d = dest[i]
+        for j in range(src.shape[1]):
+            out[d, j] = src[i, j]

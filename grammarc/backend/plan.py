@@ -1,0 +1,84 @@
+"""The executable form of a grammar: symbols numbered, rules grouped per symbol, strings interned.
+
+The derivation looks everything up here by symbol id; nothing in it refers to syntax.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from grammarc.compiler import Grammar
+from grammarc.ir import nodes as ir
+from grammarc.ir.traverse import iter_exprs, iter_ops, op_exprs
+
+
+class Strings:
+    """Interned strings: a string value in a column is an int32 id, compared by equality."""
+
+    def __init__(self) -> None:
+        self.ids: dict[str, int] = {}
+
+    def intern(self, text: str) -> int:
+        return self.ids.setdefault(text, len(self.ids))
+
+
+@dataclass(frozen=True)
+class SymbolPlan:
+    id: int
+    name: str
+    #: The symbol's rules in source order (empty for a terminal symbol).
+    rules: tuple[ir.Rule, ...]
+    #: The stage at which shapes of this symbol are derived: the lowest priority of its rules.
+    priority: int
+    param_types: tuple[ir.Type, ...]
+
+    @property
+    def terminal(self) -> bool:
+        return not self.rules
+
+
+@dataclass(frozen=True)
+class Plan:
+    grammar: Grammar
+    symbols: tuple[SymbolPlan, ...]
+    symbol_ids: dict[str, int]
+    start: int
+    strings: Strings
+    #: Distinct priorities in derivation order (lowest first).
+    stages: tuple[int, ...]
+
+    @property
+    def symbol_names(self) -> tuple[str, ...]:
+        return tuple(s.name for s in self.symbols)
+
+
+def make_plan(grammar: Grammar) -> Plan:
+    module = grammar.module
+    names = list(grammar.graph.nonterminals) + list(grammar.graph.terminals)
+    ids = {name: i for i, name in enumerate(names)}
+    param_types = dict(module.param_types)
+    symbols = []
+    for i, name in enumerate(names):
+        rules = tuple(r for r in module.rules if r.symbol == name)
+        priority = min((r.priority for r in rules), default=0)
+        symbols.append(SymbolPlan(i, name, rules, priority, param_types.get(name, ())))
+    strings = Strings()
+    for expr in _all_exprs(module):
+        if isinstance(expr, ir.Str):
+            strings.intern(expr.value)
+    stages = tuple(sorted({s.priority for s in symbols if s.rules}))
+    return Plan(grammar, tuple(symbols), ids, ids[grammar.graph.start], strings, stages)
+
+
+def _all_exprs(module: ir.Module):
+    roots = [a.default for a in module.attrs]
+    for rule in module.rules:
+        if rule.guard is not None:
+            roots.append(rule.guard)
+        for alt in rule.alternatives:
+            if alt.prob is not None:
+                roots.append(alt.prob)
+            for op in iter_ops(alt.body):
+                roots.extend(op_exprs(op))
+    for root in roots:
+        yield from iter_exprs(root)

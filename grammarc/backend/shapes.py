@@ -1,0 +1,57 @@
+"""Shapes as columns: a batch of n shapes is a set of arrays, never a list of objects.
+
+A ``Shapes`` batch holds, per shape:
+
+- ``origin`` (n, 3) float64: the scope's position P in world coordinates;
+- ``size`` (n, 3) float64: the scope's size S along its own axes;
+- ``frame`` (n,) int32: the scope's axes, as an index into the chunk's frame table (``Frames``) - most
+  operations keep the axes, so shapes share frames instead of copying 3x3 matrices;
+- ``geom`` (n,) int32: -1 when the shape's geometry is its scope box or rectangle, else a polygon in the
+  chunk's ``PolygonStore``;
+- ``lot`` (n,) int32: the lot, as an index into the chunk's lots;
+- ``key`` (n,) uint64: the random-stream key (``backend.random``);
+- ``depth`` (n,) int32: rule applications on the path from the lot;
+- ``params`` tuple of (n,) arrays: the values of the symbol's parameters (float64, or int32 string ids).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, replace
+
+import numpy as np
+
+
+@dataclass(frozen=True, eq=False)
+class Shapes:
+    origin: np.ndarray
+    size: np.ndarray
+    frame: np.ndarray
+    geom: np.ndarray
+    lot: np.ndarray
+    key: np.ndarray
+    depth: np.ndarray
+    params: tuple[np.ndarray, ...] = ()
+
+    def __len__(self) -> int:
+        return len(self.lot)
+
+    def take(self, index: np.ndarray) -> Shapes:
+        """The shapes at ``index`` (integer or boolean array), in that order."""
+        return Shapes(
+            self.origin[index], self.size[index], self.frame[index], self.geom[index], self.lot[index],
+            self.key[index], self.depth[index], tuple(p[index] for p in self.params),
+        )
+
+    def with_scope(self, origin, size, frame, geom) -> Shapes:
+        return replace(self, origin=origin, size=size, frame=frame, geom=geom)
+
+    @staticmethod
+    def concat(batches: list[Shapes]) -> Shapes:
+        if len(batches) == 1:
+            return batches[0]
+        first = batches[0]
+        return Shapes(
+            *(np.concatenate([getattr(b, f) for b in batches]) for f in
+              ("origin", "size", "frame", "geom", "lot", "key", "depth")),
+            params=tuple(np.concatenate([b.params[i] for b in batches]) for i in range(len(first.params))),
+        )

@@ -1,0 +1,134 @@
+"""Terminal records: instances mapping an asset's unit box onto a scope, and leaf geometry.
+
+``instance_xform`` builds the (n, 3, 4) record transform of DESIGN.md: column j is scope axis j times
+scope size j, column 3 the scope origin. ``emit_leaves`` turns shapes whose symbol has no rule (or to which
+no rule applied) into output, as CityEngine emits leaf geometry:
+
+- a box scope -> ``builtin:cube``;
+- a flat rectangle (one zero axis k) -> ``builtin:quad``, the unit square z = 0 with normal +z. Its
+  columns are scope axes (k+1, k+2) mod 3 and a zero column, a cyclic permutation chosen so that the
+  quad's normal is the scope's axis k (a footprint faces up, a facade out);
+- an edge or a vertex (two or three zero axes) -> nothing: it has no surface;
+- a polygon -> faces of the mesh table (with holes); a prism -> its bottom, top and side faces.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from grammarc.backend.chunk import Chunk
+from grammarc.backend.kernels.scope import xforms
+from grammarc.backend.shapes import Shapes
+from grammarc.constants import TOL
+from grammarc.geometry.components import reverse_rings
+from grammarc.geometry.polygons import PLANE_AXES
+from grammarc.io.npz import MeshChunk
+from grammarc.ragged import offsets_from_counts, segment_of
+
+CUBE, QUAD = 0, 1  # asset ids of the leaf built-ins (see compiler._assets)
+
+
+def instance_xform(axes: np.ndarray, size: np.ndarray, origin: np.ndarray) -> np.ndarray:
+    """(n, 3, 4) float32 transforms from axes (n, 3, 3) (rows), size (n, 3) and origin (n, 3)."""
+    xform = np.empty((len(size), 3, 4), dtype=np.float32)
+    xform[:, :, :3] = (axes * size[:, :, None]).transpose(0, 2, 1)
+    xform[:, :, 3] = origin
+    return xform
+
+
+def emit_instances(chunk: Chunk, shapes: Shapes, asset: int, symbol: int) -> None:
+    if not len(shapes):
+        return
+    out = chunk.outputs
+    out.xform.append(xforms(chunk.frames.data, shapes.frame, shapes.size, shapes.origin))
+    out.asset.append(np.full(len(shapes), asset, dtype=np.int32))
+    out.lot.append(shapes.lot.astype(np.int32))
+    out.symbol.append(np.full(len(shapes), symbol, dtype=np.int32))
+
+
+def emit_leaves(chunk: Chunk, shapes: Shapes, symbol: int) -> None:
+    """Emit the geometry of leaf shapes: instances for scope boxes and rectangles, meshes for polygons."""
+    if not len(shapes):
+        return
+    box = shapes.geom < 0
+    flat = shapes.size <= TOL.zero
+    zeros = flat.sum(axis=1)
+    emit_instances(chunk, shapes.take(box & (zeros == 0)), CUBE, symbol)
+    quads = shapes.take(box & (zeros == 1))
+    if len(quads):
+        k = np.argmax(flat[box & (zeros == 1)], axis=1)
+        axes = chunk.frames[quads.frame]
+        cols = np.stack([(k + 1) % 3, (k + 2) % 3, k], axis=1)
+        rows = np.arange(len(quads))[:, None]
+        permuted_axes = axes[rows, cols]
+        permuted_size = quads.size[rows, cols]
+        permuted_size[:, 2] = 0.0
+        out = chunk.outputs
+        out.xform.append(instance_xform(permuted_axes, permuted_size, quads.origin))
+        out.asset.append(np.full(len(quads), QUAD, dtype=np.int32))
+        out.lot.append(quads.lot.astype(np.int32))
+        out.symbol.append(np.full(len(quads), symbol, dtype=np.int32))
+    polygons = shapes.take(~box)
+    if len(polygons):
+        chunk.outputs.meshes.append(polygon_meshes(chunk, polygons, symbol))
+
+
+def polygon_meshes(chunk: Chunk, shapes: Shapes, symbol: int) -> MeshChunk:
+    """Faces of polygon shapes in world coordinates: the polygon, or a prism's bottom, top and sides."""
+    coords, ring_offsets, poly_offsets = chunk.polygons.gather(shapes.geom)
+    plane = chunk.polygons.plane[shapes.geom]
+    a_axis = np.array([PLANE_AXES[p][0] for p in range(3)])[plane]
+    b_axis = np.array([PLANE_AXES[p][1] for p in range(3)])[plane]
+    rows = np.arange(len(shapes))
+    axes = chunk.frames[shapes.frame]
+    height = shapes.size[rows, plane]
+    vertex_shape = segment_of(ring_offsets)
+    vertex_shape = segment_of(poly_offsets)[vertex_shape]
+    s = vertex_shape
+    base = (shapes.origin[s]
+            + (coords[:, 0] * shapes.size[s, a_axis[s]])[:, None] * axes[s, a_axis[s]]
+            + (coords[:, 1] * shapes.size[s, b_axis[s]])[:, None] * axes[s, b_axis[s]])
+    lift = height[s, None] * axes[s, plane[s]]
+    solid = height > TOL.zero
+
+    faces_v, faces_rings, faces_shape = [], [], []
+    # Flat polygons: one face each, as stored. Solids: the bottom reversed, then the top.
+    n_rings = np.diff(poly_offsets)
+    ring_shape = np.repeat(rows, n_rings)
+    ring_counts = np.diff(ring_offsets)
+    reversed_base = base[_reversed_order(ring_offsets)]
+    for verts, which in ((np.where(solid[s, None], reversed_base, base), rows),
+                         (base + lift, np.flatnonzero(solid))):
+        keep_ring = np.isin(ring_shape, which)
+        keep_vertex = keep_ring[segment_of(ring_offsets)]
+        faces_v.append(verts[keep_vertex])
+        faces_rings.append(ring_counts[keep_ring])
+        faces_shape.append(n_rings[which])
+    # Side quads of solids: vertex j, its successor, both lifted.
+    side = solid[s]
+    at = np.arange(len(coords))
+    ring = segment_of(ring_offsets)
+    nxt = np.where(at + 1 < ring_offsets[1:][ring], at + 1, ring_offsets[:-1][ring])
+    j = at[side]
+    quads = np.stack([base[j], base[nxt[j]], base[nxt[j]] + lift[j], base[j] + lift[j]], axis=1)
+    faces_v.append(quads.reshape(-1, 3))
+    faces_rings.append(np.full(len(j), 4, dtype=np.int64))
+    faces_shape.append(np.ones(len(j), dtype=np.int64))
+
+    vertices = np.concatenate(faces_v).astype(np.float32)
+    ring_sizes = np.concatenate(faces_rings)
+    rings_per_face = np.concatenate(faces_shape)
+    face_owner = np.concatenate([rows, np.flatnonzero(solid), s[j]])
+    return MeshChunk(
+        vertices=vertices,
+        ring_offsets=offsets_from_counts(ring_sizes),
+        face_offsets=offsets_from_counts(rings_per_face),
+        lot=shapes.lot[face_owner].astype(np.int32),
+        symbol=np.full(len(face_owner), symbol, dtype=np.int32),
+    )
+
+
+def _reversed_order(ring_offsets: np.ndarray) -> np.ndarray:
+    """Index that reverses every ring keeping its first vertex: ring [0,1,2,3] -> [0,3,2,1]."""
+    index = np.arange(ring_offsets[-1], dtype=np.float64)[:, None]
+    return reverse_rings(index, ring_offsets)[:, 0].astype(np.int64)

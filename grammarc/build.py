@@ -1,0 +1,164 @@
+"""``grammarc build``: grammar and lots in, instance records out, chunk by chunk.
+
+Lots are derived in chunks of ``chunk_size`` and each chunk's records are streamed to the writer, so memory
+is bounded by a chunk (DESIGN.md, invariant 3). A chunk that cannot be derived whole is not lost:
+
+- lots that fail (a negative size, an unsupported geometry) are reported by id and skipped, and the chunk
+  is derived again without them;
+- a chunk that makes more shapes than its memory budget is split in halves, derived one after the other.
+
+Neither changes the output of the other lots, because a lot's records do not depend on its chunk. A
+``LimitError`` (runaway recursion or shape explosion) stops the build: it names the rule, and nothing is
+written.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from grammarc import __version__
+from grammarc.backend.attributes import check_overrides
+from grammarc.backend.derive import derive_chunk
+from grammarc.backend.plan import make_plan
+from grammarc.compiler import Grammar, compile_grammar
+from grammarc.constants import LIMITS, Limits
+from grammarc.errors import ChunkTooLarge, LotFailure
+from grammarc.io import writer_for
+from grammarc.io.lots import BadLot, Lots, default_lot, read_lots
+from grammarc.io.npz import MeshChunk
+
+#: Shapes plus records one chunk may make before it is split: ~100 bytes each, so about 2 GB.
+CHUNK_BUDGET = 20_000_000
+
+
+@dataclass(frozen=True)
+class BuildOptions:
+    seed: int = 0
+    attrs: dict = field(default_factory=dict)
+    start: str | None = None
+    chunk_size: int = 2048
+    limits: Limits = LIMITS
+    asset_roots: tuple[Path, ...] = ()
+    chunk_budget: int = CHUNK_BUDGET
+
+
+@dataclass(frozen=True)
+class BuildResult:
+    output: Path
+    lots: int
+    derived: int
+    bad: tuple[BadLot, ...]
+    counts: dict
+    seconds: float
+    grammar: Grammar
+
+
+def find_lots(grammar_path: Path) -> Path | None:
+    """The example's own lots: ``<grammar stem>.geojson`` or ``lots.geojson`` beside the grammar."""
+    for name in (grammar_path.with_suffix(".geojson").name, "lots.geojson"):
+        candidate = grammar_path.parent / name
+        if candidate.is_file():
+            return candidate
+    return None
+
+
+def load_lots(grammar_path: Path, lots_path: Path | None) -> Lots:
+    path = lots_path or find_lots(grammar_path)
+    return read_lots(path) if path is not None else default_lot()
+
+
+def build(grammar_path, output, *, lots_path=None, options: BuildOptions = BuildOptions(),
+          progress=None) -> BuildResult:
+    """Derive the lots with the grammar and write the records to ``output`` (atomically).
+
+    ``progress`` is called with the number of lots finished after each chunk.
+    """
+    started = time.perf_counter()
+    grammar_path = Path(grammar_path)
+    grammar = compile_grammar(grammar_path, start=options.start, asset_roots=options.asset_roots)
+    plan = make_plan(grammar)
+    check_overrides(grammar.module, options.attrs)
+    writer_class = writer_for(output)
+    Path(output).parent.mkdir(parents=True, exist_ok=True)
+    lots = load_lots(grammar_path, Path(lots_path) if lots_path else None)
+    meta = {
+        "grammar": str(grammar_path),
+        "grammar_sha256": grammar.digest,
+        "grammarc": __version__,
+        "seed": options.seed,
+        "start": plan.symbols[plan.start].name,
+        "attrs": {k: v for k, v in sorted(options.attrs.items())},
+        "lots_source": lots.source,
+    }
+    failed: list[BadLot] = []
+    derived = 0
+    with writer_class(output, assets=grammar.assets, symbols=plan.symbol_names, meta=meta) as writer:
+        for first in range(0, len(lots), options.chunk_size):
+            part = lots.take(slice(first, first + options.chunk_size))
+            derived += _derive(plan, part, options, writer, failed)
+            if progress is not None:
+                progress(len(part))
+        counts = writer.close()
+    bad = tuple(sorted((*lots.bad, *failed), key=lambda b: b.index))
+    return BuildResult(Path(output), len(lots) + len(lots.bad), derived, bad, counts,
+                       time.perf_counter() - started, grammar)
+
+
+def derive(grammar: Grammar, lots: Lots, options: BuildOptions = BuildOptions()) -> dict:
+    """Derive ``lots`` in memory: the record's columns as one dict (the same rows ``build`` writes).
+
+    For tests and for callers that want arrays rather than a file. Bad lots are listed under ``"bad"``.
+    """
+    plan = make_plan(grammar)
+    check_overrides(grammar.module, options.attrs)
+    chunks: list = []
+    failed: list[BadLot] = []
+
+    class Collect:
+        write = staticmethod(chunks.append)
+
+    for first in range(0, len(lots), options.chunk_size):
+        _derive(plan, lots.take(slice(first, first + options.chunk_size)), options, Collect, failed)
+    mesh = MeshChunk.concat([c.mesh for c in chunks]) if chunks else MeshChunk.empty()
+    columns = {
+        name: (np.concatenate([getattr(c, name) for c in chunks]) if chunks else
+               np.zeros((0, 3, 4) if name == "xform" else 0, dtype=np.float32 if name == "xform"
+                        else np.int32))
+        for name in ("asset", "xform", "lot", "symbol")
+    }
+    columns.update(
+        assets=np.array(grammar.assets), symbols=np.array(plan.symbol_names), mesh=mesh,
+        bad=tuple(sorted((*lots.bad, *failed), key=lambda b: b.index)),
+    )
+    return columns
+
+
+def _derive(plan, lots: Lots, options: BuildOptions, writer, failed: list[BadLot]) -> int:
+    """Derive ``lots`` into ``writer``, skipping failing lots and splitting oversized chunks."""
+    queue = [lots]
+    derived = 0
+    while queue:
+        part = queue.pop(0)
+        if not len(part):
+            continue
+        try:
+            records = derive_chunk(plan, part, seed=options.seed, limits=options.limits,
+                                   overrides=options.attrs, chunk_budget=options.chunk_budget)
+        except LotFailure as failure:
+            skip = np.zeros(len(part), dtype=bool)
+            skip[failure.lots] = True
+            failed.extend(BadLot(int(part.index[i]), str(part.ids[i]), str(failure))
+                          for i in np.flatnonzero(skip))
+            queue.insert(0, part.take(~skip))
+            continue
+        except ChunkTooLarge:
+            half = len(part) // 2
+            queue[:0] = [part.take(slice(0, half)), part.take(slice(half, None))]
+            continue
+        writer.write(records)
+        derived += len(part)
+    return derived

@@ -1,0 +1,49 @@
+"""Tolerances and limits, each with the reason for its value.
+
+``Tol`` holds geometric epsilons; ``Limits`` holds the defaults that stop runaway grammars. A user raises
+the limits with ``--max-depth`` and ``--max-shapes``; the tolerances are not user settings.
+"""
+
+from __future__ import annotations
+
+import os
+from dataclasses import dataclass
+
+
+@dataclass(frozen=True)
+class Tol:
+    #: Lengths below this are zero: a scope axis of this size is a flat axis (a face or an edge).
+    #: Footprints come in metres; 1e-9 m is far below any modelled feature and above float64 noise
+    #: of coordinates up to ~1e6 m.
+    zero: float = 1e-9
+    #: Split sizes may overshoot the scope by this relative amount before the last part is clipped:
+    #: sums of floats like 0.1 + 0.2 must not create a sliver part.
+    split: float = 1e-9
+    #: Lot rings: consecutive vertices closer than this are merged (duplicate points in GIS data).
+    merge: float = 1e-7
+    #: Lots with a smaller area (m^2) are reported as bad lots: they cannot carry a building.
+    area_floor: float = 1e-6
+    #: A footprint is its own scope rectangle when its area differs from sx*sz by less than this
+    #: relative amount; such lots take the box fast path.
+    rect: float = 1e-9
+    #: Probabilities of a stochastic rule must sum to 1 within this.
+    probability: float = 1e-6
+
+
+@dataclass(frozen=True)
+class Limits:
+    #: Rule applications along one derivation path. Real grammars nest a few dozen levels (the Puuc
+    #: moldings are ~12); a non-branching runaway recursion reaches this in well under a second.
+    max_depth: int = 256
+    #: Shapes created from one lot. The largest buildings of the example grammars make ~10^5
+    #: shapes; a doubling runaway (`grow ~> grow grow`) reaches this after 21 rounds, long
+    #: before memory is at risk (a shape costs ~100 bytes).
+    max_shapes: int = 2_000_000
+
+
+TOL = Tol()
+LIMITS = Limits()
+
+#: Invariant checks too slow to ship (axes orthonormal, offsets monotone, child counts). The test suite
+#: sets GRAMMARC_STRICT=1.
+STRICT = os.environ.get("GRAMMARC_STRICT", "") not in ("", "0")

@@ -1,0 +1,96 @@
+"""Spans and diagnostics: errors are data, rendered by one function.
+
+Every IR node carries a ``Span``; every problem found in a grammar becomes a ``Diagnostic`` appended to
+a list, so that all of them are reported at once. ``render`` prints the CGA-style message::
+
+    city.cga:12:12: error: unknown operation `Subdv` (did you mean `Subdiv`?)
+       12 | facade ~> Subdv("Y", 3){ floor }
+          |           ^^^^^
+"""
+
+from __future__ import annotations
+
+import difflib
+from dataclasses import dataclass
+from enum import Enum
+
+
+@dataclass(frozen=True, slots=True)
+class Span:
+    """Where a construct is in its source: 1-based line and column, end exclusive."""
+
+    file: str
+    line: int
+    col: int
+    end_line: int
+    end_col: int
+
+    def __str__(self) -> str:
+        return f"{self.file}:{self.line}:{self.col}"
+
+
+NO_SPAN = Span("<builtin>", 0, 0, 0, 0)
+
+
+class Severity(Enum):
+    ERROR = "error"
+    WARNING = "warning"
+
+
+@dataclass(frozen=True, slots=True)
+class Diagnostic:
+    code: str
+    severity: Severity
+    message: str
+    span: Span
+    hint: str = ""
+
+    @property
+    def is_error(self) -> bool:
+        return self.severity is Severity.ERROR
+
+
+class Diagnostics(list):
+    """A list of ``Diagnostic`` with helpers to add errors and warnings."""
+
+    def error(self, code: str, message: str, span: Span, hint: str = "") -> None:
+        self.append(Diagnostic(code, Severity.ERROR, message, span, hint))
+
+    def warning(self, code: str, message: str, span: Span, hint: str = "") -> None:
+        self.append(Diagnostic(code, Severity.WARNING, message, span, hint))
+
+    @property
+    def has_errors(self) -> bool:
+        return any(d.is_error for d in self)
+
+
+def render(diag: Diagnostic, sources: dict[str, str]) -> str:
+    """Render one diagnostic with the offending line and a caret under the span."""
+    head = f"{diag.span}: {diag.severity.value}: {diag.message}"
+    text = sources.get(diag.span.file)
+    lines = [head]
+    if text is not None and diag.span.line > 0:
+        src_lines = text.splitlines()
+        if diag.span.line <= len(src_lines):
+            src = src_lines[diag.span.line - 1].expandtabs(1)
+            width = 1
+            if diag.span.end_line == diag.span.line and diag.span.end_col > diag.span.col:
+                width = diag.span.end_col - diag.span.col
+            num = str(diag.span.line)
+            pad = " " * len(num)
+            lines.append(f" {num} | {src}")
+            lines.append(f" {pad} | {' ' * (diag.span.col - 1)}{'^' * width}")
+    if diag.hint:
+        lines.append(f"  hint: {diag.hint}")
+    return "\n".join(lines)
+
+
+def render_all(diags: list[Diagnostic], sources: dict[str, str]) -> str:
+    ordered = sorted(diags, key=lambda d: (d.span.file, d.span.line, d.span.col))
+    return "\n".join(render(d, sources) for d in ordered)
+
+
+def suggest(name: str, candidates) -> str:
+    """`` (did you mean `x`?)`` for the closest candidate, or an empty string."""
+    close = difflib.get_close_matches(name, list(candidates), n=1, cutoff=0.6)
+    return f" (did you mean `{close[0]}`?)" if close else ""

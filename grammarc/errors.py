@@ -1,0 +1,60 @@
+"""The exceptions of grammarc: one base class, a few flat subclasses."""
+
+from __future__ import annotations
+
+
+class GrammarcError(Exception):
+    """Base class of every error grammarc raises on purpose."""
+
+    exit_code = 1
+
+
+class GrammarError(GrammarcError):
+    """The grammar has errors; ``diagnostics`` holds all of them, ``sources`` the texts to render them."""
+
+    exit_code = 2
+
+    def __init__(self, diagnostics, sources):
+        from grammarc.diagnostics import render_all
+
+        self.diagnostics = list(diagnostics)
+        self.sources = dict(sources)
+        super().__init__(render_all([d for d in self.diagnostics], self.sources))
+
+
+class UsageError(GrammarcError):
+    """A command-line option or argument is wrong (bad --attr, missing file)."""
+
+    exit_code = 2
+
+
+class LotsError(GrammarcError):
+    """The lots file cannot be read at all (missing, not GeoJSON/OBJ, no polygon)."""
+
+
+class LimitError(GrammarcError):
+    """A derivation limit was reached: runaway recursion or a shape explosion."""
+
+
+class DerivationError(GrammarcError):
+    """A rule cannot be applied to a shape (NaN or negative size, an unsupported geometry)."""
+
+
+class AssetError(GrammarcError):
+    """An asset cannot be resolved, or its path escapes the asset roots."""
+
+
+class LotFailure(DerivationError):
+    """Some lots of a chunk cannot be derived (a negative size, an unsupported geometry).
+
+    ``lots`` holds their chunk-local indices: the build reports them as bad lots and derives the chunk
+    again without them, so the other lots are not lost.
+    """
+
+    def __init__(self, message: str, lots):
+        super().__init__(message)
+        self.lots = lots
+
+
+class ChunkTooLarge(GrammarcError):
+    """A chunk made more shapes than its memory budget; the build splits it and derives the halves."""

@@ -1,0 +1,141 @@
+"""Parse grammar text into IR with every syntax error reported, not just the first.
+
+The lark grammar (``grammars/cga2006.lark``) is loaded once per process (LALR, positions on). The text is
+cut into statements (``statements.py``); each is parsed on its own, with leading newlines so that lark's
+line numbers are the file's, and lowered to IR by ``lower_cga2006.Lowering``.
+"""
+
+from __future__ import annotations
+
+import itertools
+import re
+from functools import cache
+from importlib import resources
+
+from lark import Lark
+from lark.exceptions import UnexpectedCharacters, UnexpectedEOF, UnexpectedInput, UnexpectedToken
+
+from grammarc.diagnostics import Diagnostics, Span
+from grammarc.frontend.lower_cga2006 import Lowering, assemble
+from grammarc.frontend.statements import split_statements
+from grammarc.ir import nodes as ir
+
+#: How terminals are named in messages.
+_TERMINALS = {
+    "ARROW": "`~>`", "NAME": "a name", "NUMBER": "a number", "INT": "an integer", "STRING": "a string",
+    "RELATIVE": "a relative size", "EMPTY": "`ε`", "LPAR": "`(`", "RPAR": "`)`", "LBRACE": "`{`",
+    "RBRACE": "`}`", "LSQB": "`[`", "RSQB": "`]`", "VBAR": "`|`", "COMMA": "`,`", "COLON": "`:`",
+    "COMPARE": "a comparison", "ADD": "`+` or `-`", "MUL": "`*`, `/` or `%`", "EQUAL": "`=`",
+    "DOT": "`.`", "MINUS": "`-`", "PLUS": "`+`", "BANG": "`!`", "TRUE": "`true`", "FALSE": "`false`",
+    "AND": "`&&`", "OR": "`||`", "NOT": "`not`", "PRIORITY": "`PRIORITY`", "ATTR": "`attr`",
+    "$END": "the end of the statement",
+}
+
+
+@cache
+def _parser() -> Lark:
+    grammar = resources.files("grammarc.frontend").joinpath("grammars/cga2006.lark").read_text("utf-8")
+    return Lark(grammar, start="statement", parser="lalr", propagate_positions=True,
+                maybe_placeholders=True)
+
+
+def parse_source(text: str, file: str, diags: Diagnostics) -> ir.Module:
+    """Parse and lower ``text`` (named ``file`` in diagnostics); problems go to ``diags``."""
+    parser = _parser()
+    sites = itertools.count(1)
+    lowered = []
+    for statement in split_statements(text):
+        try:
+            tree = parser.parse("\n" * (statement.line - 1) + statement.text)
+        except UnexpectedInput as error:
+            _syntax_error(error, file, statement.text, statement.line, diags)
+            continue
+        lowered.append(Lowering(file, diags, sites).transform(tree))
+    return assemble(file, lowered, diags)
+
+
+def _syntax_error(error: UnexpectedInput, file: str, text: str, first_line: int, diags: Diagnostics):
+    if isinstance(error, UnexpectedCharacters):
+        span = Span(file, error.line, error.column, error.line, error.column + 1)
+        char = error.char if hasattr(error, "char") else "?"
+        diags.error("syntax", f"unexpected character `{char}`", span)
+        return
+    expected = sorted(
+        _TERMINALS.get(t, f"`{t}`") for t in getattr(error, "expected", ()) or () if not t.startswith("__")
+    )
+    if isinstance(error, UnexpectedEOF) or (
+        isinstance(error, UnexpectedToken) and error.token.type == "$END"
+    ):
+        if getattr(error, "line", -1) > 0 and getattr(error, "column", -1) > 0:
+            # lark places the end at the last token: the caret goes under it, not under a comment after it
+            span = Span(file, error.line, error.column, error.line, error.column + 1)
+        else:
+            lines = text.splitlines() or [""]
+            line = first_line + len(lines) - 1
+            col = len(lines[-1]) + 1
+            span = Span(file, line, max(col - 1, 1), line, col)
+        message = "unexpected end of statement"
+        unclosed = _unclosed(text)
+        if unclosed:
+            # Point at the bracket left open, not at the end: it may be lines above.
+            bracket, row, column = unclosed
+            message = f"unclosed `{bracket}`"
+            span = Span(file, first_line + row, column, first_line + row, column + 1)
+        elif "`~>`" in expected:
+            message = "a rule needs an arrow `~>` and a successor"
+        diags.error("syntax", message, span, hint=_expected_hint(expected))
+        return
+    token = error.token
+    end_col = token.end_column if token.end_column else token.column + len(str(token))
+    span = Span(file, token.line, token.column, token.line, end_col)
+    message = f"unexpected `{token}`"
+    before = text[: max(token.start_pos - (first_line - 1), 0)] if token.start_pos is not None else text
+    starts_successor = token.type in ("NAME", "EMPTY", "LSQB", "RSQB")
+    if starts_successor and "`~>`" in expected \
+            and not _ARROW.search(_BRACKET_SCAN.sub(_blank_strings, before)):
+        message = f"a rule needs an arrow `~>` before `{token}`"
+    elif expected:
+        message += f", expected {_expected_hint(expected, prefix='')}"
+    hint = ""
+    if token.column == 1 and token.line > first_line:
+        opened = _unclosed("\n".join(text.splitlines()[: token.line - first_line]))
+        if opened:
+            hint = f"a `{opened[0]}` on line {first_line + opened[1]} of this rule is not closed"
+    diags.error("syntax", message, span, hint=hint)
+
+
+def _expected_hint(expected: list[str], prefix: str = "expected ") -> str:
+    if not expected:
+        return ""
+    if len(expected) > 6:
+        expected = expected[:6] + ["..."]
+    return prefix + (expected[0] if len(expected) == 1 else "one of " + ", ".join(expected))
+
+
+def _unclosed(text: str) -> tuple[str, int, int] | None:
+    """The innermost bracket left open at the end of ``text`` with its 0-based line and 1-based column,
+    ignoring strings (straight or typographic quotes) and comments."""
+    stack = []
+    for match in _BRACKET_SCAN.finditer(text):
+        c = match.group()
+        if c in ("(", "[", "{"):
+            row = text.count("\n", 0, match.start())
+            col = match.start() - (text.rfind("\n", 0, match.start()) + 1) + 1
+            stack.append((c, row, col))
+        elif c in (")", "]", "}") and stack:
+            stack.pop()
+    return stack[-1] if stack else None
+
+
+#: The rule arrows of cga2006.lark.
+_ARROW = re.compile("~>|-->|->|;|\u2192|\u21dd")
+
+
+def _blank_strings(match: re.Match) -> str:
+    """Strings and comments become blanks (an arrow inside them is not an arrow); brackets stay."""
+    return match.group() if len(match.group()) == 1 else " "
+
+
+#: Brackets, and the strings and comments whose brackets do not count.
+_BRACKET_SCAN = re.compile(r'"[^"\n]*"?|[\u201c\u201d][^\u201c\u201d"\n]*[\u201c\u201d]?|//[^\n]*|#[^\n]*'
+                           r"|/\*.*?(\*/|$)|[()\[\]{}]", re.DOTALL)

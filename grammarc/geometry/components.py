@@ -1,0 +1,272 @@
+"""Component splits (``Comp``): faces, edges and vertices of many shapes in one numba pass.
+
+Every shape is seen as a polygon (with holes) in one plane of its scope, extruded along the plane's
+normal axis by the scope size on that axis: a box is its implicit rectangle in the scope's x-z plane
+extruded along y, a footprint prism is its stored polygon extruded along y, a flat face is its polygon
+not extruded. So one kernel serves boxes, prisms and faces.
+
+Component scopes follow the paper (section 2, "Component split") and CityEngine:
+
+- side face of ring edge p -> q: x along the edge, y along the extrusion axis, z = x cross y pointing
+  out of the solid, origin at p on the base, size (|q - p|, height, 0);
+- top face: z along the extrusion axis, x along the polygon's first axis; bottom face: z against it;
+- ring edge: x along the edge, y the polygon's normal, z outward in the polygon's plane, size (|q-p|, 0, 0);
+- side edge at a ring vertex: x along the extrusion axis, z the outward normal of the side face that
+  starts there; vertex: the frame of the ring edge that starts there, size 0.
+
+Order: faces are bottom, side faces in ring order (exterior ring first, then holes), top; edges are
+bottom ring, top ring, side edges; vertices are bottom ring, then top ring.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+#: Component kinds of the kernel; the indexed selectors of the grammar map onto these.
+KIND_CODES = {
+    "faces": 0, "sidefaces": 1, "top": 2, "bottom": 3, "edges": 4, "sideedges": 5, "topedges": 6,
+    "bottomedges": 7, "vertices": 8,
+    "face": 0, "sideface": 1, "edge": 4, "vertex": 8,
+}
+
+#: ``poly`` codes of the kernel output: what geometry a component has.
+RECT, BOTTOM_POLY, TOP_POLY, SAME_POLY = 0, 1, 2, 3
+
+
+@njit(cache=True)
+def _axes_of(plane):
+    """(a, b) in-plane axes and the normal axis n of a polygon plane code."""
+    if plane == 0:
+        return 1, 2, 0
+    if plane == 1:
+        return 0, 2, 1
+    return 0, 1, 2
+
+
+@njit(cache=True)
+def _cross(a, b):
+    return np.array([a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]])
+
+
+@njit(cache=True)
+def _count(kind, n_edges, volume):
+    if volume:
+        if kind == 0:
+            return n_edges + 2
+        if kind == 1 or kind == 5 or kind == 6 or kind == 7:
+            return n_edges
+        if kind == 2 or kind == 3:
+            return 1
+        if kind == 4:
+            return 3 * n_edges
+        return 2 * n_edges
+    if kind == 0:
+        return 1
+    if kind == 4 or kind == 8:
+        return n_edges
+    return 0
+
+
+@njit(cache=True)
+def components(kind, coords, ring_offsets, shape_offsets, plane, size, tol):
+    """Component scopes of n shapes, in each shape's local frame.
+
+    kind : int, a value of KIND_CODES.
+    coords : (V, 2) float64 normalized polygon vertices; ring_offsets : (R+1,) int64 into coords;
+    shape_offsets : (n+1,) int64 into rings (one polygon per shape); plane : (n,) int8 normal axis;
+    size : (n, 3) float64 scope sizes; tol : lengths at or below it are zero.
+
+    Returns parent (m,) int64, index (m,) int64 (position among the shape's components), origin (m, 3)
+    and axes (m, 3, 3) in the parent's local frame (rows are unit axes), csize (m, 3), and poly (m,) int8
+    (RECT, BOTTOM_POLY, TOP_POLY or SAME_POLY). Zero-length edges are skipped. All allocated here.
+    """
+    n = len(plane)
+    total = 0
+    for i in range(n):
+        a, b, nrm = _axes_of(plane[i])
+        volume = size[i, nrm] > tol
+        n_edges = ring_offsets[shape_offsets[i + 1]] - ring_offsets[shape_offsets[i]]
+        total += _count(kind, n_edges, volume)
+    parent = np.empty(total, np.int64)
+    index = np.empty(total, np.int64)
+    origin = np.zeros((total, 3))
+    axes = np.zeros((total, 3, 3))
+    csize = np.zeros((total, 3))
+    poly = np.zeros(total, np.int8)
+    m = 0
+    for i in range(n):
+        a, b, nrm = _axes_of(plane[i])
+        h = size[i, nrm]
+        volume = h > tol
+        nvec = np.zeros(3)
+        nvec[nrm] = 1.0
+        avec = np.zeros(3)
+        avec[a] = 1.0
+        bvec = np.zeros(3)
+        bvec[b] = 1.0
+        first = m
+        # Faces: bottom, sides, top (volumes) or the face itself (flat shapes).
+        if kind == 0 and not volume:
+            axes[m] = np.eye(3)
+            csize[m] = size[i]
+            poly[m] = SAME_POLY
+            parent[m] = i
+            m += 1
+        if volume and (kind == 0 or kind == 3):
+            # bottom: z = -n, x = a, y = z cross x
+            z = -nvec
+            y = _cross(z, avec)
+            axes[m, 0] = avec
+            axes[m, 1] = y
+            axes[m, 2] = z
+            if y[b] < 0:
+                origin[m] = bvec * size[i, b]
+            csize[m, 0] = size[i, a]
+            csize[m, 1] = size[i, b]
+            poly[m] = BOTTOM_POLY
+            parent[m] = i
+            m += 1
+        for ring in range(shape_offsets[i], shape_offsets[i + 1]):
+            r0 = ring_offsets[ring]
+            r1 = ring_offsets[ring + 1]
+            count = r1 - r0
+            for j in range(r0, r1):
+                k = r0 + (j - r0 + 1) % count
+                p = np.zeros(3)
+                q = np.zeros(3)
+                p[a] = coords[j, 0] * size[i, a]
+                p[b] = coords[j, 1] * size[i, b]
+                q[a] = coords[k, 0] * size[i, a]
+                q[b] = coords[k, 1] * size[i, b]
+                d = q - p
+                length = np.sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2])
+                if length <= tol:
+                    continue
+                d = d / length
+                out = _cross(d, nvec)
+                if volume and (kind == 0 or kind == 1):
+                    axes[m, 0] = d
+                    axes[m, 1] = nvec
+                    axes[m, 2] = out
+                    origin[m] = p
+                    csize[m, 0] = length
+                    csize[m, 1] = h
+                    parent[m] = i
+                    m += 1
+                if kind == 4 or (kind == 7 and volume):
+                    axes[m, 0] = d
+                    axes[m, 1] = nvec
+                    axes[m, 2] = out
+                    origin[m] = p
+                    csize[m, 0] = length
+                    parent[m] = i
+                    m += 1
+                if kind == 8:
+                    axes[m, 0] = d
+                    axes[m, 1] = nvec
+                    axes[m, 2] = out
+                    origin[m] = p
+                    parent[m] = i
+                    m += 1
+        if volume and (kind == 4 or kind == 6 or kind == 8):
+            # The top ring: ring edges (or vertices) lifted by the extrusion height.
+            for ring in range(shape_offsets[i], shape_offsets[i + 1]):
+                r0 = ring_offsets[ring]
+                r1 = ring_offsets[ring + 1]
+                count = r1 - r0
+                for j in range(r0, r1):
+                    k = r0 + (j - r0 + 1) % count
+                    p = np.zeros(3)
+                    q = np.zeros(3)
+                    p[a] = coords[j, 0] * size[i, a]
+                    p[b] = coords[j, 1] * size[i, b]
+                    q[a] = coords[k, 0] * size[i, a]
+                    q[b] = coords[k, 1] * size[i, b]
+                    d = q - p
+                    length = np.sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2])
+                    if length <= tol:
+                        continue
+                    d = d / length
+                    axes[m, 0] = d
+                    axes[m, 1] = nvec
+                    axes[m, 2] = _cross(d, nvec)
+                    origin[m] = p + nvec * h
+                    if kind != 8:
+                        csize[m, 0] = length
+                    parent[m] = i
+                    m += 1
+        if volume and (kind == 4 or kind == 5):
+            for ring in range(shape_offsets[i], shape_offsets[i + 1]):
+                r0 = ring_offsets[ring]
+                r1 = ring_offsets[ring + 1]
+                count = r1 - r0
+                for j in range(r0, r1):
+                    k = r0 + (j - r0 + 1) % count
+                    p = np.zeros(3)
+                    q = np.zeros(3)
+                    p[a] = coords[j, 0] * size[i, a]
+                    p[b] = coords[j, 1] * size[i, b]
+                    q[a] = coords[k, 0] * size[i, a]
+                    q[b] = coords[k, 1] * size[i, b]
+                    d = q - p
+                    length = np.sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2])
+                    if length <= tol:
+                        continue
+                    out = _cross(d / length, nvec)
+                    axes[m, 0] = nvec
+                    axes[m, 1] = _cross(out, nvec)
+                    axes[m, 2] = out
+                    origin[m] = p
+                    csize[m, 0] = h
+                    parent[m] = i
+                    m += 1
+        if volume and (kind == 0 or kind == 2):
+            # top: z = n, x = a, y = z cross x; origin keeps the polygon in the positive quadrant.
+            y = _cross(nvec, avec)
+            axes[m, 0] = avec
+            axes[m, 1] = y
+            axes[m, 2] = nvec
+            origin[m] = nvec * h
+            if y[b] < 0:
+                origin[m] += bvec * size[i, b]
+            csize[m, 0] = size[i, a]
+            csize[m, 1] = size[i, b]
+            poly[m] = TOP_POLY
+            parent[m] = i
+            m += 1
+        for c in range(first, m):
+            index[c] = c - first
+    return parent[:m], index[:m], origin[:m], axes[:m], csize[:m], poly[:m]
+
+
+#: Implicit rectangles of shapes whose geometry is their scope, per plane code: counter-clockwise
+#: around the +normal axis, the first edge along the in-plane x (or y) axis. For a box (plane 1) the
+#: first side face is the one facing +z.
+RECT_RINGS = {
+    0: np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]]),
+    1: np.array([[0.0, 1.0], [1.0, 1.0], [1.0, 0.0], [0.0, 0.0]]),
+    2: np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]]),
+}
+
+
+def rect_plane(size: np.ndarray, tol: float) -> np.ndarray:
+    """Plane code of scope rectangles (n,) int8: the flat axis of a face, y for volumes."""
+    flat = size <= tol
+    plane = np.ones(len(size), dtype=np.int8)
+    plane[flat[:, 2]] = 2
+    plane[flat[:, 0] & ~flat[:, 2]] = 0
+    return plane
+
+
+@njit(cache=True)
+def reverse_rings(coords, ring_offsets):
+    """Each ring in reverse order, keeping its first vertex first: (V, 2) float64, a new array."""
+    out = np.empty_like(coords)
+    for r in range(len(ring_offsets) - 1):
+        s = ring_offsets[r]
+        e = ring_offsets[r + 1]
+        count = e - s
+        for q in range(count):
+            out[s + q] = coords[s + (count - q) % count]
+    return out

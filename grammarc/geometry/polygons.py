@@ -1,0 +1,84 @@
+"""The ragged polygon store: the geometry of shapes that are not simply their scope.
+
+A polygon (with holes) is stored in its shape's scope, normalized: a vertex is (u, v) in [0, 1]^2, the
+fractions of the scope size along the two axes of the polygon's plane. Because coordinates are relative to
+the scope, ``T``, ``R`` and ``S`` never touch the store; only operations that make new geometry append
+to it. ``plane`` is the scope axis normal to the polygon: 1 (y) for footprints, whose (u, v) run along
+scope (x, z); 2 (z) for faces, along (x, y); 0 (x) along (y, z). Exterior rings wind counter-clockwise
+around the +normal axis, holes clockwise.
+
+Layout (Arrow-style offsets, each starting at 0):
+
+- ``coords`` (V, 2) float64, ``ring_offsets`` (R+1,) int64 into coords,
+- ``poly_offsets`` (G+1,) int64 into rings (exterior ring first), ``plane`` (G,) int8.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+#: Scope axes spanned by (u, v) for each normal axis.
+PLANE_AXES = {0: (1, 2), 1: (0, 2), 2: (0, 1)}
+
+
+class PolygonStore:
+    """Append-only ragged storage of normalized polygons for one chunk of lots."""
+
+    def __init__(self) -> None:
+        self.coords = np.empty((0, 2))
+        self.ring_offsets = np.zeros(1, dtype=np.int64)
+        self.poly_offsets = np.zeros(1, dtype=np.int64)
+        self.plane = np.empty(0, dtype=np.int8)
+
+    def __len__(self) -> int:
+        return len(self.plane)
+
+    def add(self, coords: np.ndarray, ring_offsets: np.ndarray, poly_offsets: np.ndarray,
+            plane: np.ndarray) -> np.ndarray:
+        """Append polygons given as ragged arrays (offsets from 0); returns their ids (k,) int32."""
+        first = len(self.plane)
+        self.ring_offsets = np.concatenate([self.ring_offsets, ring_offsets[1:] + len(self.coords)])
+        self.poly_offsets = np.concatenate(
+            [self.poly_offsets, poly_offsets[1:] + (len(self.ring_offsets) - len(ring_offsets))]
+        )
+        self.coords = np.concatenate([self.coords, coords])
+        self.plane = np.concatenate([self.plane, np.asarray(plane, dtype=np.int8)])
+        return np.arange(first, len(self.plane), dtype=np.int32)
+
+    def gather(self, ids: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Polygons ``ids`` as new ragged arrays: (coords, ring_offsets, poly_offsets)."""
+        return _gather(self.coords, self.ring_offsets, self.poly_offsets, np.asarray(ids, np.int64))
+
+
+@njit(cache=True)
+def _gather(coords, ring_offsets, poly_offsets, ids):
+    """Copy polygons ``ids`` out of a ragged store.
+
+    coords : (V, 2) float64; ring_offsets : (R+1,) int64; poly_offsets : (G+1,) int64; ids : (k,) int64.
+    Returns coords (V', 2), ring_offsets (R'+1,), poly_offsets (k+1,), all allocated here.
+    """
+    k = len(ids)
+    out_poly = np.zeros(k + 1, np.int64)
+    n_rings = 0
+    n_verts = 0
+    for i in range(k):
+        g = ids[i]
+        r0, r1 = poly_offsets[g], poly_offsets[g + 1]
+        n_rings += r1 - r0
+        n_verts += ring_offsets[r1] - ring_offsets[r0]
+        out_poly[i + 1] = n_rings
+    out_ring = np.zeros(n_rings + 1, np.int64)
+    out_coords = np.empty((n_verts, 2))
+    r = 0
+    v = 0
+    for i in range(k):
+        g = ids[i]
+        for ring in range(poly_offsets[g], poly_offsets[g + 1]):
+            for j in range(ring_offsets[ring], ring_offsets[ring + 1]):
+                out_coords[v, 0] = coords[j, 0]
+                out_coords[v, 1] = coords[j, 1]
+                v += 1
+            r += 1
+            out_ring[r] = v
+    return out_coords, out_ring, out_poly

@@ -1,0 +1,531 @@
+"""Lots in: footprints from GeoJSON or OBJ, cleaned, validated and oriented as CityEngine takes them.
+
+Every lot becomes an initial shape, and the backend derives shapes in batches of arrays, so lots are read
+once into flat ragged arrays (Arrow-style offsets that start at 0, as in shapely's ``from_ragged_array``)
+rather than into one object per lot. Cleanup, orientation and validation then run over all lots at once:
+numpy over the ragged arrays, and shapely's vectorized predicates on the whole array of polygons. Python
+loops only where parsing needs them (over JSON features and OBJ lines) and over the bad lots' messages.
+
+A bad lot (self-intersecting, zero area, not a polygon, a wall) is data, not an exception (DESIGN.md,
+invariant 5): it is listed in ``Lots.bad`` with its id and a reason, and the other lots load. Only a file
+that cannot be read at all raises :class:`~grammarc.errors.LotsError`.
+
+Conventions, those of CityEngine and Esri PRT:
+
+- Map to world: world x = map x, world y = 0, world z = -map y (north is -z). Coordinates are taken as
+  metres as they are: longitude/latitude is not reprojected (project the file first, e.g. to UTM).
+- The exterior ring of a lot has a +Y Newell normal (counter-clockwise on the map, as RFC 7946 wants),
+  holes a -Y normal. A ring wound the other way is reversed keeping its first vertex first
+  (v0, v_{n-1}, ..., v1): the first edge v0 -> v1 is the lot's scope x axis downstream.
+- Rings are open (the first vertex is not repeated); consecutive vertices closer than ``TOL.merge`` are
+  merged, and lots with less area than ``TOL.area_floor`` are bad.
+"""
+
+from __future__ import annotations
+
+import json
+import numbers
+import os
+import re
+from dataclasses import dataclass, replace
+from pathlib import Path
+
+import numpy as np
+import shapely
+
+from grammarc.constants import TOL
+from grammarc.errors import LotsError
+from grammarc.ragged import offsets_from_counts, ragged_take, segment_reduce
+
+__all__ = ["BadLot", "Lots", "default_lot", "lots_from_polygons", "read_lots"]
+
+# GEOS reasons end with the offending point, e.g. "Self-intersection[3 4.5]".
+_GEOS_REASON = re.compile(r"^(?P<what>.*)\[(?P<x>\S+) (?P<y>\S+)\]$")
+
+
+@dataclass(frozen=True)
+class BadLot:
+    """A lot that was skipped: its number in the input, its id and why."""
+
+    index: int
+    id: str
+    reason: str
+
+
+@dataclass(frozen=True, eq=False)
+class Lots:
+    """Footprints in world coordinates (y up), rings as Arrow-style ragged arrays (offsets start at 0).
+
+    Attributes
+    ----------
+    ids : (L,) object
+      Lot identifiers, ``str``.
+    index : (L,) int64
+      Each lot's number in the input; bad lots keep theirs, so the good lots' numbers are stable.
+    vertices : (V, 3) float64
+      Ring vertices in world coordinates.
+    ring_offsets : (R + 1,) int64
+      Ring ``r`` is ``vertices[ring_offsets[r]:ring_offsets[r + 1]]``, open (first vertex not repeated),
+      at least 3 vertices. Exterior rings have a +Y Newell normal, holes a -Y one.
+    lot_offsets : (L + 1,) int64
+      Lot ``i`` is rings ``lot_offsets[i]:lot_offsets[i + 1]``, the exterior ring first, then its holes.
+    attrs : dict of str to (L,) float64 or object
+      Per-lot property columns: float64 with nan for missing values, or object with ``str`` values and
+      None for missing ones.
+    bad : tuple of BadLot
+      Lots of the input that were skipped, ordered by ``index``.
+    source : str
+      The path read, or ``"<memory>"``.
+    """
+
+    ids: np.ndarray
+    index: np.ndarray
+    vertices: np.ndarray
+    ring_offsets: np.ndarray
+    lot_offsets: np.ndarray
+    attrs: dict[str, np.ndarray]
+    bad: tuple[BadLot, ...]
+    source: str
+
+    def __len__(self) -> int:
+        return len(self.ids)
+
+    def take(self, sel: np.ndarray | slice) -> Lots:
+        """A subset of the lots, in the order of ``sel``.
+
+        Parameters
+        ----------
+        sel : (k,) int, (L,) bool or slice
+          The lots to keep.
+
+        Returns
+        -------
+        lots : Lots
+          The selected lots with rebased offsets and sliced attrs; ``bad`` and ``source`` are kept as is.
+        """
+        lot = np.atleast_1d(np.arange(len(self))[sel])
+        ring, lot_offsets = ragged_take(self.lot_offsets, lot)
+        vertex, ring_offsets = ragged_take(self.ring_offsets, ring)
+        return Lots(
+            ids=self.ids[lot],
+            index=self.index[lot],
+            vertices=self.vertices[vertex],
+            ring_offsets=ring_offsets,
+            lot_offsets=lot_offsets,
+            attrs={name: column[lot] for name, column in self.attrs.items()},
+            bad=self.bad,
+            source=self.source,
+        )
+
+
+def read_lots(path: str | os.PathLike) -> Lots:
+    """Read lots from a GeoJSON (``.geojson``, ``.json``) or OBJ (``.obj``) file.
+
+    GeoJSON may be a FeatureCollection, a single Feature or a bare Polygon / MultiPolygon geometry,
+    in map coordinates taken as metres (longitude/latitude is not reprojected). A Polygon is one lot
+    and a MultiPolygon one lot per polygon (ids ``"<feature id>:<k>"``, each with the feature's
+    properties); other geometries are bad lots. A lot's id is the feature's ``id``, else its property
+    ``id``, else ``name``, else its index; ``index`` numbers polygons in file order. Properties become
+    ``attrs`` columns, typed over all polygon lots of the file. A ``.json`` file holding a PRT initial
+    shape (``vertices``, ``face_indices``, ``face_counts``, ``holes`` in world coordinates, as the PRT
+    kit's ``courtyard_40x40.json``) is read too: one lot per face that is not a hole, ids ``"face<k>"``.
+
+    In OBJ, each face is one lot without holes, ids ``"face<k>"``, index the face number; vertices are
+    world coordinates. A face whose normal is not roughly vertical (a wall) is a bad lot.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+      The lots file.
+
+    Returns
+    -------
+    lots : Lots
+      The good lots, oriented and validated; the bad ones in ``lots.bad``.
+
+    Raises
+    ------
+    LotsError
+      The file is missing, unreadable, not valid JSON, of an unknown suffix, or holds no polygon.
+    """
+    path = Path(path)
+    if not path.is_file():
+        raise LotsError(f"lots file not found: {path}")
+    suffix = path.suffix.lower()
+    if suffix not in (".geojson", ".json", ".obj"):
+        raise LotsError(f"unknown lots file type {suffix!r} (expected .geojson, .json or .obj): {path}")
+    try:
+        text = path.read_text(encoding="utf-8")
+    except (OSError, UnicodeDecodeError) as error:
+        raise LotsError(f"cannot read lots file {path}: {error}") from error
+    if suffix == ".obj":
+        builder = _parse_obj(text, path)
+    else:
+        try:
+            data = json.loads(text)
+        except json.JSONDecodeError as error:
+            where = f"{path}:{error.lineno}:{error.colno}"
+            raise LotsError(f"{where}: not valid JSON: {error.msg}") from error
+        if isinstance(data, dict) and "face_counts" in data and "type" not in data:
+            builder = _parse_prt_shape(data, path)
+        else:
+            builder = _parse_geojson(data)
+    if builder.polygons == 0:
+        raise LotsError(f"no polygon in lots file {path}")
+    return builder.finish(_columns(builder.props), str(path))
+
+
+def lots_from_polygons(
+    polygons: list[list[np.ndarray]],
+    *,
+    ids=None,
+    attrs=None,
+    source: str = "<memory>",
+) -> Lots:
+    """Make lots in memory from map-coordinate polygons, cleaned and validated as GeoJSON lots are.
+
+    Parameters
+    ----------
+    polygons : list of list of (k, 2) float
+      Per lot, the exterior ring then its holes, in map coordinates (x, y); any winding, closed or not.
+    ids : sequence of str, optional
+      One id per lot; default ``"0"``, ``"1"``, ...
+    attrs : dict of str to sequence, optional
+      Per-lot property columns of length ``len(polygons)``; typed as GeoJSON properties are (numbers and
+      None become float64 with nan, anything else ``str`` with None).
+    source : str
+      Recorded in ``Lots.source``.
+
+    Returns
+    -------
+    lots : Lots
+      The good lots; bad ones (lot numbers = positions in ``polygons``) in ``lots.bad``.
+
+    Examples
+    --------
+    >>> lots = lots_from_polygons([[np.array([[0, 0], [4, 0], [4, 3], [0, 3]])]], ids=["a"])
+    >>> lots.vertices[:2].tolist()
+    [[0.0, 0.0, 0.0], [4.0, 0.0, 0.0]]
+    >>> lots_from_polygons([[np.array([[0, 0], [1, 1], [2, 2]])]]).bad
+    (BadLot(index=0, id='0', reason='zero area'),)
+    """
+    ids = [str(i) for i in range(len(polygons))] if ids is None else [str(i) for i in ids]
+    attrs = {} if attrs is None else dict(attrs)
+    lengths = {"ids": len(ids), **{f"attrs[{name!r}]": len(values) for name, values in attrs.items()}}
+    for name, length in lengths.items():
+        if length != len(polygons):
+            raise ValueError(f"{name} has {length} entries for {len(polygons)} polygons")
+    builder = _Builder(world=False)
+    for index, (lot_id, rings) in enumerate(zip(ids, polygons)):
+        builder.add_positions(index, lot_id, rings, {})
+    return builder.finish({name: _column(list(values)) for name, values in attrs.items()}, source)
+
+
+def default_lot() -> Lots:
+    """One 30 x 20 m rectangle, id ``"default"``: map corners (0, 0), (30, 0), (30, 20), (0, 20).
+
+    Returns
+    -------
+    lots : Lots
+      A single lot whose first edge runs 30 m along world +x.
+    """
+    rectangle = np.array([[0.0, 0.0], [30.0, 0.0], [30.0, 20.0], [0.0, 20.0]])
+    return lots_from_polygons([[rectangle]], ids=["default"])
+
+
+# ---------------------------------------------------------------------------------------------- parsing
+
+
+class _Builder:
+    """Collects lots while a file is parsed; ``finish`` cleans, orients and validates them all at once.
+
+    Rings are (k, 3) float64 world coordinates if ``world``, else (k, 2) float64 map coordinates.
+    """
+
+    def __init__(self, world: bool):
+        self.world = world
+        self.rings: list[np.ndarray] = []
+        self.ring_counts: list[int] = []  # rings per lot
+        self.index: list[int] = []
+        self.ids: list[str] = []
+        self.props: list[dict] = []
+        self.bad: list[BadLot] = []
+        self.polygons = 0  # lots added or rejected; a file without any has "no polygon"
+
+    def reject(self, index: int, lot_id: str, reason: str) -> None:
+        """A polygon that is bad before any geometry check (malformed, empty)."""
+        self.polygons += 1
+        self.bad.append(BadLot(index, lot_id, reason))
+
+    def add(self, index: int, lot_id: str, rings: list[np.ndarray], props: dict) -> None:
+        """Add a lot: its exterior ring, then its holes."""
+        if not rings:
+            self.reject(index, lot_id, "empty polygon")
+            return
+        self.polygons += 1
+        self.rings.extend(rings)
+        self.ring_counts.append(len(rings))
+        self.index.append(index)
+        self.ids.append(lot_id)
+        self.props.append(props)
+
+    def add_positions(self, index: int, lot_id: str, rings, props: dict) -> None:
+        """Add a lot given as lists of map positions (GeoJSON); extra components are ignored."""
+        try:
+            xy = [_ring_xy(ring) for ring in rings]
+        except (TypeError, ValueError, IndexError):
+            self.reject(index, lot_id, "malformed coordinates")
+            return
+        self.add(index, lot_id, xy, props)
+
+    def finish(self, attrs: dict[str, np.ndarray], source: str) -> Lots:
+        """Clean, orient and validate every lot at once; ``attrs`` are columns over all added lots."""
+        counts = np.array([len(ring) for ring in self.rings], dtype=np.int64)
+        vertices = np.concatenate([np.zeros((0, 3 if self.world else 2)), *self.rings])
+        if not self.world:
+            # world (x, 0, -y); 0.0 - y keeps z = +0.0 where y = 0
+            x, y = vertices.T
+            vertices = np.column_stack([x, np.zeros_like(x), np.subtract(0.0, y)])
+        vertices, ring_offsets = _clean(vertices, offsets_from_counts(counts))
+        lot_offsets = offsets_from_counts(np.array(self.ring_counts, dtype=np.int64))
+        normals = _newell(vertices, ring_offsets)
+        exterior = np.zeros(len(normals), dtype=bool)
+        exterior[lot_offsets[:-1]] = True
+        vertices = _orient(vertices, ring_offsets, exterior, normals[:, 1])
+        lots = Lots(
+            ids=np.array(self.ids, dtype=object),
+            index=np.array(self.index, dtype=np.int64),
+            vertices=vertices,
+            ring_offsets=ring_offsets,
+            lot_offsets=lot_offsets,
+            attrs=attrs,
+            bad=(),
+            source=source,
+        )
+        reasons = _validate(lots, normals, self.world)
+        rejected = np.flatnonzero(reasons != "")
+        bad = self.bad + [BadLot(int(lots.index[i]), lots.ids[i], reasons[i]) for i in rejected]
+        good = lots.take(np.flatnonzero(reasons == ""))
+        return replace(good, bad=tuple(sorted(bad, key=lambda b: b.index)))
+
+
+def _ring_xy(ring) -> np.ndarray:
+    """A ring's positions as (k, 2) float64; a third component (elevation) is dropped."""
+    try:
+        array = np.asarray(ring, dtype=np.float64)
+    except ValueError:  # positions of mixed length, e.g. some with an elevation
+        array = np.array([position[:2] for position in ring], dtype=np.float64)
+    if array.size == 0:
+        return np.zeros((0, 2))
+    if array.ndim != 2 or array.shape[1] < 2:
+        raise ValueError("a ring is a list of positions")
+    return array[:, :2]
+
+
+def _feature_id(feature: dict, props: dict, index: int) -> str:
+    for value in (feature.get("id"), props.get("id"), props.get("name")):
+        if value is not None:
+            return str(value)
+    return str(index)
+
+
+def _parse_geojson(data) -> _Builder:
+    """Lots of a FeatureCollection, a Feature or a bare geometry; ``index`` counts polygons in order."""
+    if isinstance(data, dict) and data.get("type") == "FeatureCollection":
+        features = data.get("features") or []
+    elif isinstance(data, dict) and data.get("type") == "Feature":
+        features = [data]
+    elif isinstance(data, dict):
+        features = [{"type": "Feature", "geometry": data}]
+    else:
+        features = []
+    builder = _Builder(world=False)
+    index = 0
+    for feature in features:
+        if not isinstance(feature, dict):
+            continue
+        props = feature.get("properties") if isinstance(feature.get("properties"), dict) else {}
+        geometry = feature.get("geometry") if isinstance(feature.get("geometry"), dict) else {}
+        kind = geometry.get("type")
+        lot_id = _feature_id(feature, props, index)
+        if kind == "Polygon":
+            builder.add_positions(index, lot_id, geometry.get("coordinates") or [], props)
+            index += 1
+        elif kind == "MultiPolygon" and not geometry.get("coordinates"):
+            builder.reject(index, lot_id, "empty polygon")
+            index += 1
+        elif kind == "MultiPolygon":
+            for k, rings in enumerate(geometry["coordinates"]):
+                builder.add_positions(index, f"{lot_id}:{k}", rings or [], props)
+                index += 1
+        else:
+            builder.bad.append(BadLot(index, lot_id, f"not a polygon ({kind or 'null geometry'})"))
+            index += 1
+    return builder
+
+
+def _parse_obj(text: str, path: Path) -> _Builder:
+    """One lot per ``f`` line; ``v`` lines are world coordinates, every other line is ignored."""
+    points: list[list[float]] = []
+    faces: list[list[int]] = []
+    for number, line in enumerate(text.splitlines(), start=1):
+        fields = line.split()
+        if not fields or fields[0] not in ("v", "f"):
+            continue
+        try:
+            if fields[0] == "v":
+                point = [float(value) for value in fields[1:4]]
+                if len(point) != 3:
+                    raise ValueError("a vertex needs x y z")
+                points.append(point)
+            else:
+                # "i", "i/t", "i//n" or "i/t/n"; a negative i counts back from the last vertex read
+                indices = [int(token.split("/")[0]) for token in fields[1:]]
+                faces.append([i - 1 if i > 0 else len(points) + i for i in indices])
+        except ValueError as error:
+            message = f"{path}:{number}: bad {fields[0]!r} line: {line.strip()!r} ({error})"
+            raise LotsError(message) from error
+    vertices = np.array(points, dtype=np.float64).reshape(-1, 3)
+    builder = _Builder(world=True)
+    for k, face in enumerate(faces):
+        face = np.array(face, dtype=np.int64)
+        if np.any((face < 0) | (face >= len(vertices))):
+            builder.reject(k, f"face{k}", "vertex index out of range")
+        else:
+            builder.add(k, f"face{k}", [vertices[face]], {})
+    return builder
+
+
+def _parse_prt_shape(data: dict, path: Path) -> _Builder:
+    """A PRT initial shape as JSON: the arguments of ``pyprt.InitialShape`` (vertices, indices, counts,
+    holes), in world coordinates; a hole face is listed after its face in ``holes``."""
+    try:
+        vertices = np.asarray(data["vertices"], dtype=np.float64).reshape(-1, 3)
+        indices = np.asarray(data["face_indices"], dtype=np.int64)
+        faces = np.split(indices, np.cumsum(data["face_counts"])[:-1])
+        holes = {int(group[0]): [int(h) for h in group[1:]] for group in data.get("holes") or []}
+        is_hole = {h for group in holes.values() for h in group}
+        builder = _Builder(world=True)
+        lots = [k for k in range(len(faces)) if k not in is_hole]
+        for index, k in enumerate(lots):
+            builder.add(index, f"face{k}", [vertices[faces[f]] for f in [k, *holes.get(k, [])]], {})
+    except (KeyError, TypeError, ValueError, IndexError) as error:
+        raise LotsError(f"{path}: not a PRT initial shape ({error!r})") from error
+    return builder
+
+
+def _column(values: list) -> np.ndarray:
+    """One property column: all numbers (bools too) or None -> float64 with nan, else object str/None."""
+    if all(v is None or isinstance(v, (numbers.Real, np.bool_)) for v in values):
+        return np.array([np.nan if v is None else float(v) for v in values], dtype=np.float64)
+    column = np.empty(len(values), dtype=object)
+    column[:] = [v if v is None or isinstance(v, str) else json.dumps(v) for v in values]
+    return column
+
+
+def _columns(props: list[dict]) -> dict[str, np.ndarray]:
+    names = dict.fromkeys(name for p in props for name in p)  # first-seen order
+    return {name: _column([p.get(name) for p in props]) for name in names}
+
+
+# ------------------------------------------------------------------------------------- ragged kernels
+
+
+def _ring_positions(ring_offsets: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Per vertex: its ring, its ring's start and its ring's vertex count, each (V,) int64."""
+    counts = np.diff(ring_offsets)
+    ring = np.repeat(np.arange(len(counts)), counts)
+    return ring, ring_offsets[:-1][ring], counts[ring]
+
+
+def _successor(start: np.ndarray, count: np.ndarray) -> np.ndarray:
+    """(V,) int64 index of each vertex's successor in its ring; the last vertex wraps to the first."""
+    at = np.arange(len(start))
+    return np.where(at + 1 < start + count, at + 1, start)
+
+
+def _clean(vertices: np.ndarray, ring_offsets: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Merge consecutive vertices closer than ``TOL.merge``, keeping the first of each run.
+
+    A run may wrap around the ring's end (a closing vertex equal to the first, or a duplicated last
+    vertex): it belongs to the first vertex, which always stays first.
+    """
+    ring, start, count = _ring_positions(ring_offsets)
+    at = np.arange(len(vertices))
+    close_next = np.linalg.norm(vertices[_successor(start, count)] - vertices, axis=1) < TOL.merge
+    close_prev = np.zeros(len(vertices), dtype=bool)
+    close_prev[1:] = close_next[:-1]
+    first = at == start
+    # the last vertex of each ring that is not close to its successor: vertices after it chain into v0
+    last_far = np.full(len(ring_offsets) - 1, -1, dtype=np.int64)
+    np.maximum.at(last_far, ring, np.where(close_next, -1, at))
+    keep = first | (~close_prev & (at <= last_far[ring]))
+    kept = segment_reduce(np.add, keep.astype(np.int64), ring_offsets, 0)
+    return vertices[keep], offsets_from_counts(kept)
+
+
+def _newell(vertices: np.ndarray, ring_offsets: np.ndarray) -> np.ndarray:
+    """(R, 3) float64 Newell normals, twice the vector area; ``normal[:, 1]`` = 2 x the map signed area.
+
+    The ring's first vertex is subtracted first, so large world coordinates lose no precision.
+    """
+    _, start, count = _ring_positions(ring_offsets)
+    local = vertices - vertices[start]
+    return segment_reduce(np.add, np.cross(local, local[_successor(start, count)]), ring_offsets, 0.0)
+
+
+def _orient(vertices, ring_offsets, exterior, normal_y) -> np.ndarray:
+    """Reverse exterior rings with a -Y normal and holes with a +Y one, keeping each ring's first vertex.
+
+    A reversed ring of n vertices takes position p from position (n - p) % n: v0, v_{n-1}, ..., v1.
+    """
+    ring, start, count = _ring_positions(ring_offsets)
+    flip = np.where(exterior, normal_y < 0, normal_y > 0)[ring]
+    position = np.arange(len(vertices)) - start
+    return vertices[start + np.where(flip, (count - position) % count, position)]
+
+
+def _validate(lots: Lots, normals: np.ndarray, world: bool) -> np.ndarray:
+    """(L,) object: why each lot is bad, "" for a good lot; the first failed check gives the reason."""
+    reasons = np.full(len(lots), "", dtype=object)
+    short_ring = (np.diff(lots.ring_offsets) < 3).astype(np.int64)
+    short = segment_reduce(np.add, short_ring, lots.lot_offsets, 0) > 0
+    reasons[short] = "fewer than 3 distinct vertices"
+    norm = np.linalg.norm(normals, axis=1)
+    wall_ring = (norm >= 2 * TOL.area_floor) & (np.abs(normals[:, 1]) < 0.5 * norm)
+    wall = segment_reduce(np.add, wall_ring.astype(np.int64), lots.lot_offsets, 0) > 0
+    reasons[wall & (reasons == "")] = "not a footprint: face normal is not vertical"
+
+    todo = np.flatnonzero(reasons == "")
+    polygons = _map_polygons(lots.take(todo))
+    why = shapely.is_valid_reason(polygons)
+    valid = why == "Valid Geometry"
+    area = shapely.area(polygons)
+    # a symmetric bowtie has zero area too; only a polygon whose convex hull is flat is "zero area"
+    small = area < TOL.area_floor
+    flat = np.zeros(len(todo), dtype=bool)
+    flat[small] = shapely.area(shapely.convex_hull(polygons[small])) < TOL.area_floor
+    zero = flat | (small & valid)
+    reasons[todo[zero]] = "zero area"
+    invalid = ~valid & ~zero
+    reasons[todo[invalid]] = [_geos_reason(text, world) for text in why[invalid]]
+    return reasons
+
+
+def _map_polygons(lots: Lots) -> np.ndarray:
+    """(L,) shapely Polygons in map coordinates (x, -z), rings closed as GeoArrow requires."""
+    xy = np.column_stack([lots.vertices[:, 0], -lots.vertices[:, 2]])
+    closed = np.insert(xy, lots.ring_offsets[1:], xy[lots.ring_offsets[:-1]], axis=0)
+    ring_offsets = lots.ring_offsets + np.arange(len(lots.ring_offsets))
+    offsets = (ring_offsets, lots.lot_offsets)
+    return shapely.from_ragged_array(shapely.GeometryType.POLYGON, closed, offsets)
+
+
+def _geos_reason(text: str, world: bool) -> str:
+    """'Self-intersection[3 4.5]' -> 'self-intersection at (3.0, 4.5)' in the input's coordinates."""
+    match = _GEOS_REASON.match(text)
+    if match is None:
+        return text[:1].lower() + text[1:]
+    what, x, y = match["what"], float(match["x"]), float(match["y"])
+    where = f"x={x}, z={0.0 - y}" if world else f"({x}, {y})"
+    return f"{what[:1].lower()}{what[1:]} at {where}"

@@ -1,0 +1,322 @@
+"""IR nodes: frozen, slotted dataclasses, one class per construct, each with its source span.
+
+A ``Module`` holds attribute declarations and rules. A ``Rule`` rewrites a symbol: an optional guard and
+one or more stochastic ``Alternative``s, each a ``Body`` (a tuple of operations executed in order on the
+current scope). Expressions are typed trees (``Type``); names are resolved by ``passes.resolve`` from
+``Name`` into ``Param`` or ``AttrRef``.
+
+Geometry conventions (shared with the backend): a scope has an origin, three orthonormal axes (rows of a
+3x3 matrix, right-handed) and a size. Angles are in degrees. Axis indices are 0, 1, 2 for x, y, z.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from enum import Enum
+
+from grammarc.diagnostics import NO_SPAN, Span
+
+
+class Type(Enum):
+    NUM = "num"
+    BOOL = "bool"
+    STR = "str"
+    UNKNOWN = "unknown"
+
+
+class SizeKind(Enum):
+    ABSOLUTE = "abs"
+    RELATIVE = "rel"
+    #: CityEngine's `~` sizes; the paper notation has none, the CityEngine frontend will lower to it.
+    FLOATING = "float"
+
+
+# ----------------------------------------------------------------------------------------------- expressions
+
+
+@dataclass(frozen=True, slots=True)
+class Num:
+    value: float
+    span: Span = NO_SPAN
+
+
+@dataclass(frozen=True, slots=True)
+class Str:
+    value: str
+    span: Span = NO_SPAN
+
+
+@dataclass(frozen=True, slots=True)
+class Bool:
+    value: bool
+    span: Span = NO_SPAN
+
+
+@dataclass(frozen=True, slots=True)
+class Name:
+    """An identifier before name resolution."""
+
+    name: str
+    span: Span = NO_SPAN
+
+
+@dataclass(frozen=True, slots=True)
+class Param:
+    """The ``index``-th parameter of the rule being applied."""
+
+    index: int
+    name: str
+    span: Span = NO_SPAN
+
+
+@dataclass(frozen=True, slots=True)
+class AttrRef:
+    """A control parameter: its default, overridden per lot or by ``--attr``."""
+
+    name: str
+    span: Span = NO_SPAN
+
+
+#: The attribute name of ``placeholder``: no declaration can have it.
+PLACEHOLDER = "<error>"
+
+
+def placeholder(span: Span = NO_SPAN) -> AttrRef:
+    """A stand-in for an expression whose error is already reported.
+
+    It names no declared attribute, so its type is unknown and no second error cascades from it (a
+    typed stand-in such as ``0`` would make ``Shape.occ("all") == "none"`` a type error too). Only
+    modules with errors hold one, and those are never derived.
+    """
+    return AttrRef(PLACEHOLDER, span)
+
+
+#: Scope fields readable from expressions: size and translation (origin) per axis.
+SCOPE_FIELDS = ("sx", "sy", "sz", "tx", "ty", "tz")
+
+
+@dataclass(frozen=True, slots=True)
+class ScopeRef:
+    field: str
+    span: Span = NO_SPAN
+
+
+@dataclass(frozen=True, slots=True)
+class Unary:
+    op: str  # "-", "!"
+    operand: Expr
+    span: Span = NO_SPAN
+
+
+#: Binary operators by category; the category decides the result type.
+ARITH_OPS = frozenset({"+", "-", "*", "/", "%"})
+COMPARE_OPS = frozenset({"<", "<=", ">", ">=", "==", "!="})
+LOGIC_OPS = frozenset({"&&", "||"})
+
+
+@dataclass(frozen=True, slots=True)
+class Binary:
+    op: str
+    left: Expr
+    right: Expr
+    span: Span = NO_SPAN
+
+
+@dataclass(frozen=True, slots=True)
+class Call:
+    """A built-in function. ``site`` numbers the call so that ``rand`` draws differ per call site."""
+
+    func: str
+    args: tuple[Expr, ...]
+    span: Span = NO_SPAN
+    site: int = 0
+
+
+Expr = Num | Str | Bool | Name | Param | AttrRef | ScopeRef | Unary | Binary | Call
+
+#: Built-in functions: name -> (min args, max args, result type). Argument types are numbers.
+FUNCTIONS: dict[str, tuple[int, int, Type]] = {
+    "rand": (0, 2, Type.NUM),
+    "floor": (1, 1, Type.NUM),
+    "ceil": (1, 1, Type.NUM),
+    "round": (1, 1, Type.NUM),
+    "abs": (1, 1, Type.NUM),
+    "sqrt": (1, 1, Type.NUM),
+    "sin": (1, 1, Type.NUM),
+    "cos": (1, 1, Type.NUM),
+    "tan": (1, 1, Type.NUM),
+    "asin": (1, 1, Type.NUM),
+    "acos": (1, 1, Type.NUM),
+    "atan": (1, 1, Type.NUM),
+    "atan2": (2, 2, Type.NUM),
+    "exp": (1, 1, Type.NUM),
+    "log": (1, 1, Type.NUM),
+    "pow": (2, 2, Type.NUM),
+    "min": (2, 2, Type.NUM),
+    "max": (2, 2, Type.NUM),
+}
+
+
+# ------------------------------------------------------------------------------------------------ operations
+
+
+@dataclass(frozen=True, slots=True)
+class Size:
+    """One size of ``S`` or ``Subdiv``: an expression and whether it is absolute or relative (``1r``)."""
+
+    kind: SizeKind
+    value: Expr
+    span: Span = NO_SPAN
+
+
+@dataclass(frozen=True, slots=True)
+class Symbol:
+    """Create a shape with this symbol on the current scope (a successor shape)."""
+
+    name: str
+    args: tuple[Expr, ...]
+    span: Span = NO_SPAN
+    site: int = 0
+
+
+@dataclass(frozen=True, slots=True)
+class Empty:
+    """The empty shape (``ε``, ``epsilon``, ``null``): nothing is created."""
+
+    span: Span = NO_SPAN
+
+
+@dataclass(frozen=True, slots=True)
+class Translate:
+    """``T(x,y,z)``: move the scope origin along its own axes."""
+
+    vector: tuple[Expr, Expr, Expr]
+    span: Span = NO_SPAN
+
+
+@dataclass(frozen=True, slots=True)
+class Scale:
+    """``S(x,y,z)``: set the scope size; relative sizes scale the current size."""
+
+    sizes: tuple[Size, Size, Size]
+    span: Span = NO_SPAN
+
+
+@dataclass(frozen=True, slots=True)
+class Rotate:
+    """Rotate the scope axes about its own x, then y, then z axis (degrees), around the origin."""
+
+    angles: tuple[Expr, Expr, Expr]
+    span: Span = NO_SPAN
+
+
+@dataclass(frozen=True, slots=True)
+class Push:
+    span: Span = NO_SPAN
+
+
+@dataclass(frozen=True, slots=True)
+class Pop:
+    span: Span = NO_SPAN
+
+
+@dataclass(frozen=True, slots=True)
+class Insert:
+    """``I("name")``: an instance of an asset mapped onto the scope box."""
+
+    asset: str
+    span: Span = NO_SPAN
+
+
+@dataclass(frozen=True, slots=True)
+class Split:
+    """``Subdiv(axes, sizes...){parts}``: split the scope along one or more axes.
+
+    With several axes, the scope is split along the first axis, then every part along the next axis,
+    with the same sizes; cells are numbered with the first axis varying fastest. Part ``i`` of the body
+    applies to cell ``i`` modulo the number of parts.
+    """
+
+    axes: tuple[int, ...]
+    sizes: tuple[Size, ...]
+    parts: tuple[Body, ...]
+    span: Span = NO_SPAN
+    site: int = 0
+
+
+@dataclass(frozen=True, slots=True)
+class Repeat:
+    """``Repeat(axes, size per axis){parts}``: ceil(scope size / size) elements per axis, sizes adjusted."""
+
+    axes: tuple[int, ...]
+    sizes: tuple[Expr, ...]
+    parts: tuple[Body, ...]
+    span: Span = NO_SPAN
+    site: int = 0
+
+
+#: Component selectors of ``Comp``; those in COMP_INDEXED take an index argument.
+COMP_KINDS = frozenset({
+    "faces", "sidefaces", "top", "bottom", "edges", "sideedges", "topedges", "bottomedges", "vertices",
+    "face", "sideface", "edge", "vertex",
+})
+COMP_INDEXED = frozenset({"face", "sideface", "edge", "vertex"})
+
+
+@dataclass(frozen=True, slots=True)
+class Comp:
+    """``Comp(kind[, index]){parts}``: split into faces, edges or vertices; component i takes part i mod k."""
+
+    kind: str
+    index: Expr | None
+    parts: tuple[Body, ...]
+    span: Span = NO_SPAN
+    site: int = 0
+
+
+Op = Symbol | Empty | Translate | Scale | Rotate | Push | Pop | Insert | Split | Repeat | Comp
+Body = tuple[Op, ...]
+
+
+# -------------------------------------------------------------------------------------------------- top level
+
+
+@dataclass(frozen=True, slots=True)
+class Alternative:
+    body: Body
+    prob: Expr | None
+    span: Span = NO_SPAN
+
+
+@dataclass(frozen=True, slots=True)
+class Rule:
+    """``[label:] symbol(params) : guard ~> alternatives``; the first rule of a symbol whose guard holds applies."""
+
+    symbol: str
+    params: tuple[str, ...]
+    guard: Expr | None
+    alternatives: tuple[Alternative, ...]
+    priority: int
+    label: str | None = None
+    span: Span = NO_SPAN
+    site: int = 0
+
+
+@dataclass(frozen=True, slots=True)
+class AttrDecl:
+    name: str
+    default: Expr
+    span: Span = NO_SPAN
+    type: Type = Type.UNKNOWN
+
+
+@dataclass(frozen=True, slots=True)
+class Module:
+    """A whole grammar: its file, attributes, rules in source order, and the start symbol."""
+
+    file: str
+    attrs: tuple[AttrDecl, ...]
+    rules: tuple[Rule, ...]
+    start: str | None
+    #: Parameter types per symbol, filled by ``passes.types``.
+    param_types: tuple[tuple[str, tuple[Type, ...]], ...] = ()

@@ -1,0 +1,63 @@
+"""Name resolution: every ``Name`` becomes a rule ``Param`` or an ``AttrRef``.
+
+Assumes: a lowered module. Guarantees: no ``Name`` is left; an identifier that is neither a parameter of
+its rule nor a declared attribute is an error that names it (attribute defaults may only use attributes
+declared before them).
+"""
+
+from __future__ import annotations
+
+from dataclasses import replace
+
+from grammarc.diagnostics import Diagnostics, suggest
+from grammarc.ir import nodes as ir
+from grammarc.ir.traverse import rewrite_expr, rewrite_rule
+
+
+def resolve_names(module: ir.Module, diags: Diagnostics) -> ir.Module:
+    declared: list[str] = []
+    all_attrs = [a.name for a in module.attrs]
+    attrs = []
+    for attr in module.attrs:
+        where = f"attribute `{attr.name}`"
+        default = rewrite_expr(attr.default, _resolver({}, declared, diags, where, later=all_attrs))
+        attrs.append(attr if default is attr.default else replace(attr, default=default))
+        declared.append(attr.name)
+    rules = []
+    for rule in module.rules:
+        params = {name: i for i, name in enumerate(rule.params)}
+        for name in rule.params:
+            if name in all_attrs:
+                diags.warning("shadow", f"parameter `{name}` of `{rule.symbol}` hides the attribute `{name}`",
+                              rule.span)
+        rules.append(rewrite_rule(rule, _resolver(params, all_attrs, diags, f"rule `{rule.symbol}`")))
+    if all(a is b for a, b in zip(attrs, module.attrs)) and all(a is b for a, b in zip(rules, module.rules)):
+        return module
+    return replace(module, attrs=tuple(attrs), rules=tuple(rules))
+
+
+def _resolver(params: dict[str, int], attrs: list[str], diags: Diagnostics, where: str,
+              later: list[str] | tuple[str, ...] = ()):
+    """Name -> Param or AttrRef; ``later`` are attributes declared after the one being resolved."""
+
+    def resolve(expr: ir.Expr) -> ir.Expr:
+        if not isinstance(expr, ir.Name):
+            return expr
+        if expr.name in params:
+            return ir.Param(params[expr.name], expr.name, expr.span)
+        if expr.name in attrs:
+            return ir.AttrRef(expr.name, expr.span)
+        if expr.name in later:
+            diags.error("attr-order", f"attribute `{expr.name}` is used in {where} before its declaration",
+                        expr.span, hint=f"declare `{expr.name}` above the attributes that use it")
+            return ir.placeholder(expr.span)
+        known = list(params) + list(attrs)
+        diags.error(
+            "unknown-name",
+            f"unknown identifier `{expr.name}` in {where}{suggest(expr.name, known)}",
+            expr.span,
+            hint="declare it with `attr name = value`, or make it a parameter of the rule",
+        )
+        return ir.placeholder(expr.span)
+
+    return resolve

@@ -1,0 +1,103 @@
+"""The rule graph: which symbols a start symbol reaches, which recurse, which are terminals.
+
+An analysis, not a rewrite: it returns a ``RuleGraph`` and warns about rules the start symbol never
+reaches. Recursion is found as strongly connected components of the symbol graph (Tarjan).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from grammarc.diagnostics import Diagnostics
+from grammarc.ir import nodes as ir
+from grammarc.ir.traverse import iter_ops
+
+
+@dataclass(frozen=True)
+class RuleGraph:
+    start: str
+    #: Symbols with rules, in order of first definition.
+    nonterminals: tuple[str, ...]
+    #: Symbols used in successors that have no rule: their shapes are leaves.
+    terminals: tuple[str, ...]
+    reachable: frozenset[str]
+    #: Symbols on a cycle of the graph (directly or mutually recursive).
+    recursive: frozenset[str]
+    edges: dict[str, tuple[str, ...]]
+
+
+def analyze_rules(module: ir.Module, start: str, diags: Diagnostics) -> RuleGraph:
+    nonterminals = tuple(dict.fromkeys(r.symbol for r in module.rules))
+    edges: dict[str, list[str]] = {s: [] for s in nonterminals}
+    used: dict[str, None] = {}
+    for rule in module.rules:
+        for alt in rule.alternatives:
+            for op in iter_ops(alt.body):
+                if isinstance(op, ir.Symbol):
+                    edges[rule.symbol].append(op.name)
+                    used[op.name] = None
+    terminals = tuple(s for s in used if s not in edges)
+    reachable = _reach(start, edges)
+    for rule in module.rules:
+        if rule.symbol not in reachable:
+            diags.warning("unreachable", f"rule for `{rule.symbol}` is never reached from `{start}`",
+                          rule.span)
+    frozen = {s: tuple(dict.fromkeys(t)) for s, t in edges.items()}
+    return RuleGraph(start, nonterminals, terminals, frozenset(reachable), _recursive(frozen), frozen)
+
+
+def _reach(start: str, edges) -> set[str]:
+    seen, stack = {start}, [start]
+    while stack:
+        for t in edges.get(stack.pop(), ()):
+            if t not in seen:
+                seen.add(t)
+                stack.append(t)
+    return seen
+
+
+def _recursive(edges: dict[str, tuple[str, ...]]) -> frozenset[str]:
+    """Symbols in a strongly connected component with a cycle (Tarjan, iterative)."""
+    index: dict[str, int] = {}
+    low: dict[str, int] = {}
+    on_stack: set[str] = set()
+    stack: list[str] = []
+    result: set[str] = set()
+    counter = 0
+    for root, targets in edges.items():
+        if root in index:
+            continue
+        work = [(root, iter(targets))]
+        index[root] = low[root] = counter
+        counter += 1
+        stack.append(root)
+        on_stack.add(root)
+        while work:
+            node, children = work[-1]
+            for child in children:
+                if child not in edges:
+                    continue
+                if child not in index:
+                    index[child] = low[child] = counter
+                    counter += 1
+                    stack.append(child)
+                    on_stack.add(child)
+                    work.append((child, iter(edges[child])))
+                    break
+                if child in on_stack:
+                    low[node] = min(low[node], index[child])
+            else:
+                work.pop()
+                if work:
+                    low[work[-1][0]] = min(low[work[-1][0]], low[node])
+                if low[node] == index[node]:
+                    component = []
+                    while True:
+                        w = stack.pop()
+                        on_stack.discard(w)
+                        component.append(w)
+                        if w == node:
+                            break
+                    if len(component) > 1 or node in edges[node]:
+                        result.update(component)
+    return frozenset(result)

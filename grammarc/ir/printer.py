@@ -1,0 +1,101 @@
+"""IR as compact canonical text: what tests compare and what ``grammarc check --dump-ir`` shows.
+
+The text is the paper notation with every binary expression parenthesized, resolved names marked
+(``$h`` is a rule parameter, ``@height`` an attribute) and one rule per line.
+"""
+
+from __future__ import annotations
+
+from grammarc.ir import nodes as ir
+
+_AXES = "XYZ"
+
+
+def print_expr(e: ir.Expr) -> str:
+    if isinstance(e, ir.Num):
+        return f"{e.value:g}"
+    if isinstance(e, ir.Str):
+        return f'"{e.value}"'
+    if isinstance(e, ir.Bool):
+        return "true" if e.value else "false"
+    if isinstance(e, ir.Name):
+        return e.name
+    if isinstance(e, ir.Param):
+        return f"${e.name}"
+    if isinstance(e, ir.AttrRef):
+        return f"@{e.name}"
+    if isinstance(e, ir.ScopeRef):
+        return f"Scope.{e.field}"
+    if isinstance(e, ir.Unary):
+        return f"{e.op}{print_expr(e.operand)}"
+    if isinstance(e, ir.Binary):
+        return f"({print_expr(e.left)} {e.op} {print_expr(e.right)})"
+    if isinstance(e, ir.Call):
+        return f"{e.func}({', '.join(print_expr(a) for a in e.args)})"
+    raise TypeError(f"not an expression: {e!r}")
+
+
+def _size(s: ir.Size) -> str:
+    text = print_expr(s.value)
+    return f"{text}r" if s.kind is ir.SizeKind.RELATIVE else text
+
+
+def _axes(axes: tuple[int, ...]) -> str:
+    return '"' + "".join(_AXES[a] for a in axes) + '"'
+
+
+def _parts(parts) -> str:
+    return "{ " + " | ".join(print_body(p) or "ε" for p in parts) + " }"
+
+
+def print_op(op: ir.Op) -> str:
+    if isinstance(op, ir.Symbol):
+        return op.name + (f"({', '.join(print_expr(a) for a in op.args)})" if op.args else "")
+    if isinstance(op, ir.Empty):
+        return "ε"
+    if isinstance(op, ir.Translate):
+        return f"T({', '.join(print_expr(e) for e in op.vector)})"
+    if isinstance(op, ir.Scale):
+        return f"S({', '.join(_size(s) for s in op.sizes)})"
+    if isinstance(op, ir.Rotate):
+        return f"R({', '.join(print_expr(e) for e in op.angles)})"
+    if isinstance(op, ir.Push):
+        return "["
+    if isinstance(op, ir.Pop):
+        return "]"
+    if isinstance(op, ir.Insert):
+        return f'I("{op.asset}")'
+    if isinstance(op, ir.Split):
+        return f"Subdiv({_axes(op.axes)}, {', '.join(_size(s) for s in op.sizes)}){_parts(op.parts)}"
+    if isinstance(op, ir.Repeat):
+        return f"Repeat({_axes(op.axes)}, {', '.join(print_expr(e) for e in op.sizes)}){_parts(op.parts)}"
+    if isinstance(op, ir.Comp):
+        index = f", {print_expr(op.index)}" if op.index is not None else ""
+        return f'Comp("{op.kind}"{index}){_parts(op.parts)}'
+    raise TypeError(f"not an operation: {op!r}")
+
+
+def print_body(body: ir.Body) -> str:
+    return " ".join(print_op(op) for op in body)
+
+
+def print_rule(rule: ir.Rule) -> str:
+    head = rule.symbol + (f"({', '.join(rule.params)})" if rule.params else "")
+    if rule.guard is not None:
+        head += f" : {print_expr(rule.guard)}"
+    alts = []
+    for alt in rule.alternatives:
+        prob = f" : {print_expr(alt.prob)}" if alt.prob is not None else ""
+        alts.append(f"~> {print_body(alt.body) or 'ε'}{prob}")
+    return f"{head} " + " ".join(alts)
+
+
+def print_module(module: ir.Module) -> str:
+    lines = [f"attr {a.name} = {print_expr(a.default)}" for a in module.attrs]
+    priority = None
+    for rule in module.rules:
+        if rule.priority != priority:
+            priority = rule.priority
+            lines.append(f"PRIORITY {priority}:")
+        lines.append(print_rule(rule))
+    return "\n".join(lines)

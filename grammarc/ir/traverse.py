@@ -1,0 +1,144 @@
+"""Walk and rebuild IR: the one place that knows which fields of which node hold expressions and bodies.
+
+``rewrite_expr`` applies a function bottom-up and returns the same object when nothing changed, so a pass
+can tell whether it did anything by identity; ``rewrite_body``, ``rewrite_rule`` and ``rewrite_module``
+apply an expression rewrite to every expression of a body (descending into split parts), rule or module;
+``iter_ops`` and ``iter_exprs`` visit without rebuilding.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Iterator
+from dataclasses import replace
+
+from grammarc.ir import nodes as ir
+
+ExprFn = Callable[[ir.Expr], ir.Expr]
+
+
+def rewrite_expr(expr: ir.Expr, fn: ExprFn) -> ir.Expr:
+    """Rebuild ``expr`` bottom-up with ``fn`` applied to every node (children first)."""
+    if isinstance(expr, ir.Unary):
+        operand = rewrite_expr(expr.operand, fn)
+        if operand is not expr.operand:
+            expr = replace(expr, operand=operand)
+    elif isinstance(expr, ir.Binary):
+        left, right = rewrite_expr(expr.left, fn), rewrite_expr(expr.right, fn)
+        if left is not expr.left or right is not expr.right:
+            expr = replace(expr, left=left, right=right)
+    elif isinstance(expr, ir.Call):
+        args = _tuple(expr.args, lambda a: rewrite_expr(a, fn))
+        if args is not expr.args:
+            expr = replace(expr, args=args)
+    return fn(expr)
+
+
+def _tuple(items: tuple, fn) -> tuple:
+    new = tuple(fn(i) for i in items)
+    return items if all(a is b for a, b in zip(new, items)) else new
+
+
+def _size(size: ir.Size, fn: ExprFn) -> ir.Size:
+    value = rewrite_expr(size.value, fn)
+    return size if value is size.value else replace(size, value=value)
+
+
+def rewrite_op(op: ir.Op, fn: ExprFn) -> ir.Op:
+    """``op`` with ``fn`` applied to each of its expressions, and to the bodies of its parts."""
+    ex = lambda e: rewrite_expr(e, fn)
+    if isinstance(op, ir.Symbol):
+        args = _tuple(op.args, ex)
+        return op if args is op.args else replace(op, args=args)
+    if isinstance(op, ir.Translate):
+        vec = _tuple(op.vector, ex)
+        return op if vec is op.vector else replace(op, vector=vec)
+    if isinstance(op, ir.Rotate):
+        angles = _tuple(op.angles, ex)
+        return op if angles is op.angles else replace(op, angles=angles)
+    if isinstance(op, ir.Scale):
+        sizes = _tuple(op.sizes, lambda s: _size(s, fn))
+        return op if sizes is op.sizes else replace(op, sizes=sizes)
+    if isinstance(op, ir.Split):
+        sizes = _tuple(op.sizes, lambda s: _size(s, fn))
+        parts = _tuple(op.parts, lambda b: rewrite_body(b, fn))
+        return op if sizes is op.sizes and parts is op.parts else replace(op, sizes=sizes, parts=parts)
+    if isinstance(op, ir.Repeat):
+        sizes = _tuple(op.sizes, ex)
+        parts = _tuple(op.parts, lambda b: rewrite_body(b, fn))
+        return op if sizes is op.sizes and parts is op.parts else replace(op, sizes=sizes, parts=parts)
+    if isinstance(op, ir.Comp):
+        index = ex(op.index) if op.index is not None else None
+        parts = _tuple(op.parts, lambda b: rewrite_body(b, fn))
+        return op if index is op.index and parts is op.parts else replace(op, index=index, parts=parts)
+    return op
+
+
+def rewrite_body(body: ir.Body, fn: ExprFn) -> ir.Body:
+    return _tuple(body, lambda op: rewrite_op(op, fn))
+
+
+def rewrite_rule(rule: ir.Rule, fn: ExprFn) -> ir.Rule:
+    """``rule`` with ``fn`` applied to its guard, probabilities and bodies."""
+    guard = rewrite_expr(rule.guard, fn) if rule.guard is not None else None
+
+    def alt(a: ir.Alternative) -> ir.Alternative:
+        body = rewrite_body(a.body, fn)
+        prob = rewrite_expr(a.prob, fn) if a.prob is not None else None
+        return a if body is a.body and prob is a.prob else replace(a, body=body, prob=prob)
+
+    alts = _tuple(rule.alternatives, alt)
+    if guard is rule.guard and alts is rule.alternatives:
+        return rule
+    return replace(rule, guard=guard, alternatives=alts)
+
+
+def rewrite_module(module: ir.Module, fn: ExprFn) -> ir.Module:
+    """``module`` with ``fn`` applied to every attribute default and rule; the same object if unchanged."""
+
+    def attr(a: ir.AttrDecl) -> ir.AttrDecl:
+        default = rewrite_expr(a.default, fn)
+        return a if default is a.default else replace(a, default=default)
+
+    attrs = _tuple(module.attrs, attr)
+    rules = _tuple(module.rules, lambda r: rewrite_rule(r, fn))
+    if attrs is module.attrs and rules is module.rules:
+        return module
+    return replace(module, attrs=attrs, rules=rules)
+
+
+def iter_ops(body: ir.Body) -> Iterator[ir.Op]:
+    """Every operation of ``body``, including those inside split parts, in source order."""
+    for op in body:
+        yield op
+        if isinstance(op, (ir.Split, ir.Repeat, ir.Comp)):
+            for part in op.parts:
+                yield from iter_ops(part)
+
+
+def op_exprs(op: ir.Op) -> Iterator[ir.Expr]:
+    """The expressions directly held by ``op`` (not those of its parts)."""
+    if isinstance(op, ir.Symbol):
+        yield from op.args
+    elif isinstance(op, ir.Translate):
+        yield from op.vector
+    elif isinstance(op, ir.Rotate):
+        yield from op.angles
+    elif isinstance(op, (ir.Scale, ir.Split)):
+        yield from (s.value for s in op.sizes)
+    elif isinstance(op, ir.Repeat):
+        yield from op.sizes
+    elif isinstance(op, ir.Comp) and op.index is not None:
+        yield op.index
+
+
+def iter_exprs(expr: ir.Expr) -> Iterator[ir.Expr]:
+    """``expr`` and all its sub-expressions."""
+    yield expr
+    if isinstance(expr, ir.Unary):
+        yield from iter_exprs(expr.operand)
+    elif isinstance(expr, ir.Binary):
+        yield from iter_exprs(expr.left)
+        yield from iter_exprs(expr.right)
+    elif isinstance(expr, ir.Call):
+        for a in expr.args:
+            yield from iter_exprs(a)

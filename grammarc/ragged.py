@@ -1,0 +1,63 @@
+"""The one ragged-array convention of grammarc, and its helpers.
+
+A ragged array is flat items plus ``offsets`` (n+1,) int64 starting at 0 (Arrow, as in shapely's
+``from_ragged_array``): segment i is ``items[offsets[i]:offsets[i + 1]]``. Fan-outs return
+``(children, parent)`` like shapely's ``get_parts(return_index=True)``.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+
+def offsets_from_counts(counts: np.ndarray) -> np.ndarray:
+    """(n + 1,) int64 offsets from (n,) counts: [2, 3] -> [0, 2, 5]."""
+    offsets = np.zeros(len(counts) + 1, dtype=np.int64)
+    np.cumsum(counts, out=offsets[1:])
+    return offsets
+
+
+def ragged_take(offsets: np.ndarray, sel: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Flat item indices of segments ``sel`` and their packed offsets.
+
+    offsets [0, 2, 5, 6], sel [2, 0] -> items [5, 0, 1], offsets [0, 1, 3].
+    """
+    starts = offsets[sel]
+    counts = offsets[sel + 1] - starts
+    packed = offsets_from_counts(counts)
+    # each item's flat index = its position in the packed output + (old start - new start) of its segment
+    items = np.arange(packed[-1], dtype=np.int64) + np.repeat(starts - packed[:-1], counts)
+    return items, packed
+
+
+def segment_of(offsets: np.ndarray) -> np.ndarray:
+    """(N,) int64: the segment of each item. offsets [0, 2, 3] -> [0, 0, 1]."""
+    return np.repeat(np.arange(len(offsets) - 1), np.diff(offsets))
+
+
+def segment_reduce(ufunc: np.ufunc, values: np.ndarray, offsets: np.ndarray, empty) -> np.ndarray:
+    """``ufunc.reduce`` over each segment (sum with np.add, min with np.minimum, ...).
+
+    Empty segments get ``empty``, which ``reduceat`` alone gets wrong.
+    """
+    counts = np.diff(offsets)
+    out = np.full((len(counts), *values.shape[1:]), empty, dtype=values.dtype)
+    nonempty = counts > 0
+    if nonempty.any():
+        # Only the starts of non-empty segments: each then runs to the next such start (the empty
+        # segments between have zero length), the last to the end. offsets [0, 2, 2] -> starts [0].
+        out[nonempty] = ufunc.reduceat(values, offsets[:-1][nonempty], axis=0)
+    return out
+
+
+def fan_out(counts: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Children of a ragged fan-out: (parent, index within parent), each (sum(counts),) int64.
+
+    counts [2, 0, 3] -> parent [0, 0, 2, 2, 2], index [0, 1, 0, 1, 2].
+    """
+    counts = np.asarray(counts, dtype=np.int64)
+    offsets = offsets_from_counts(counts)
+    parent = np.repeat(np.arange(len(counts)), counts)
+    # position of each child minus the offset of its parent's first child
+    index = np.arange(offsets[-1], dtype=np.int64) - offsets[:-1][parent]
+    return parent, index

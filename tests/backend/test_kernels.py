@@ -1,0 +1,243 @@
+"""The numba kernels of grammarc.backend.kernels against plain Python/numpy references on random batches."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from grammarc.backend.kernels.order import group_by, scatter_rows
+from grammarc.backend.kernels.scope import place_children, xforms
+from grammarc.backend.kernels.split import repeat, repeat_counts, subdiv
+from grammarc.backend.random import child_keys
+
+SIZES = [0, 1, 2, 50]
+TOL = 1e-9
+
+
+def random_frames(rng, f):
+    """(f, 3, 3) random rotations, rows the axes."""
+    q, _ = np.linalg.qr(rng.normal(size=(f, 3, 3)))
+    q[np.linalg.det(q) < 0, 2] *= -1
+    return np.ascontiguousarray(q)
+
+
+# --------------------------------------------------------------------------------------------- split.subdiv
+
+
+def subdiv_reference(extent, values, relative, tol):
+    """Paper section 2: relative sizes share what the absolute ones leave; parts past the scope are cut."""
+    out = []
+    for i, e in enumerate(extent):
+        row = values[0] if len(values) == 1 else values[i]
+        absolute = sum(v for v, r in zip(row, relative) if not r)
+        rel = sum(v for v, r in zip(row, relative) if r)
+        free = max(e - absolute, 0.0)
+        at = 0.0
+        for j, (v, r) in enumerate(zip(row, relative)):
+            size = (v * free / rel if rel > 0 else 0.0) if r else v
+            length = min(at + size, e) - at
+            if length > tol:
+                out.append((i, j, at, length))
+            at += size
+    return out
+
+
+def check_subdiv(extent, values, relative, tol=TOL):
+    parent, part, pos, length = subdiv(extent, values, relative, tol)
+    want = subdiv_reference(extent, values, relative, tol)
+    assert parent.dtype == np.int64 and part.dtype == np.int64
+    assert list(zip(parent.tolist(), part.tolist())) == [(i, j) for i, j, _, _ in want]
+    np.testing.assert_allclose(pos, [w[2] for w in want], rtol=1e-12, atol=1e-12)
+    np.testing.assert_allclose(length, [w[3] for w in want], rtol=1e-12, atol=1e-12)
+    return parent, part, pos, length
+
+
+@pytest.mark.parametrize("n", SIZES)
+@pytest.mark.parametrize("shared", [False, True])
+def test_subdiv_random(n, shared):
+    rng = np.random.default_rng(n + 100 * shared)
+    p = 5
+    extent = rng.uniform(0, 20, n)
+    extent[rng.random(n) < 0.1] = 0.0
+    values = rng.uniform(0.1, 6, (1 if shared else n, p))
+    relative = rng.random(p) < 0.4
+    parent, _, pos, length = check_subdiv(extent, values, relative)
+    # Children tile their parent from 0 and never leave it.
+    assert np.all(length > TOL)
+    assert np.all(pos + length <= extent[parent] + 1e-12)
+
+
+def test_subdiv_paper_example():
+    """Subdiv("X", 2, 1r, 1r, 2): 2, 4, 4, 2 on width 12 and 2, 3, 3, 2 on width 10."""
+    values = np.array([[2.0, 1.0, 1.0, 2.0]])
+    relative = np.array([False, True, True, False])
+    _, part, pos, length = check_subdiv(np.array([12.0, 10.0]), values, relative)
+    assert part.tolist() == [0, 1, 2, 3] * 2
+    assert length.tolist() == [2, 4, 4, 2, 2, 3, 3, 2]
+    assert pos.tolist() == [0, 2, 6, 10, 0, 2, 5, 8]
+
+
+def test_subdiv_overflow_cuts_last_and_drops_beyond():
+    """Absolute sizes 4, 4, 4 on 10: the third part is cut to 2; 4, 8, 4 drops the third."""
+    relative = np.zeros(3, bool)
+    _, part, _, length = check_subdiv(np.array([10.0]), np.array([[4.0, 4.0, 4.0]]), relative)
+    assert part.tolist() == [0, 1, 2] and length.tolist() == [4, 4, 2]
+    _, part, _, length = check_subdiv(np.array([10.0]), np.array([[4.0, 8.0, 4.0]]), relative)
+    assert part.tolist() == [0, 1] and length.tolist() == [4, 6]
+
+
+def test_subdiv_relative_parts_vanish_when_absolutes_fill():
+    relative = np.array([False, True, False])
+    _, part, _, _ = check_subdiv(np.array([6.0]), np.array([[3.0, 1.0, 3.0]]), relative)
+    assert part.tolist() == [0, 2]
+
+
+def test_subdiv_drops_parts_at_or_below_tol():
+    relative = np.zeros(3, bool)
+    _, part, _, _ = check_subdiv(np.array([10.0]), np.array([[1.0, 0.5, 2.0]]), relative, tol=0.5)
+    assert part.tolist() == [0, 2]
+
+
+def test_subdiv_float_sum_makes_no_sliver():
+    """0.1 + 0.2 overshoots 0.3 in float64: the last part is cut, not followed by a sliver."""
+    _, part, _, length = check_subdiv(np.array([0.3]), np.array([[0.1, 0.2]]), np.zeros(2, bool))
+    assert part.tolist() == [0, 1]
+    assert length.sum() == pytest.approx(0.3)
+
+
+# --------------------------------------------------------------------------------------------- split.repeat
+
+
+def repeat_counts_reference(extent, size, tol):
+    return [0 if e <= tol else max(math.ceil(e / s - 1e-9), 1) for e, s in zip(extent, size)]
+
+
+@pytest.mark.parametrize("n", SIZES)
+def test_repeat_counts_random(n):
+    rng = np.random.default_rng(n)
+    extent = rng.uniform(0, 30, n)
+    extent[rng.random(n) < 0.2] = 0.0
+    size = rng.uniform(0.5, 5, n)
+    counts = repeat_counts(extent, size, TOL)
+    assert counts.dtype == np.int64
+    assert counts.tolist() == repeat_counts_reference(extent, size, TOL)
+
+
+@pytest.mark.parametrize("extent, size, want", [
+    (10.0, 2.0, 5),      # exact fit
+    (10.5, 2.0, 6),      # ceil
+    (0.6, 0.2, 3),       # 0.6 / 0.2 = 2.9999999999999996
+    (0.3, 0.1, 3),       # 0.3 / 0.1 = 2.9999999999999996
+    (0.7, 0.1, 7),
+    (1.0, 5.0, 1),       # smaller than one element: one, stretched
+    (0.0, 1.0, 0),       # zero extent: none
+])
+def test_repeat_counts_cases(extent, size, want):
+    assert repeat_counts(np.array([extent]), np.array([size]), TOL).tolist() == [want]
+
+
+@pytest.mark.parametrize("n", SIZES)
+def test_repeat_random(n):
+    rng = np.random.default_rng(n)
+    extent = rng.uniform(0, 30, n)
+    counts = rng.integers(0, 5, n)
+    parent, part, pos, length = repeat(extent, counts)
+    want = [(i, j, j * e / c, e / c) for i, (e, c) in enumerate(zip(extent, counts)) for j in range(c)]
+    assert parent.tolist() == [w[0] for w in want]
+    assert part.tolist() == [w[1] for w in want]
+    np.testing.assert_allclose(pos, [w[2] for w in want], rtol=1e-12, atol=1e-12)
+    np.testing.assert_allclose(length, [w[3] for w in want], rtol=1e-12)
+
+
+# -------------------------------------------------------------------------------------------------- order
+
+
+@pytest.mark.parametrize("n", SIZES)
+@pytest.mark.parametrize("k", [1, 3, 8])
+def test_group_by_is_stable_counting_sort(n, k):
+    group = np.random.default_rng(n * k).integers(0, k, n).astype(np.int64)
+    order, offsets = group_by(group, k)
+    assert order.tolist() == np.argsort(group, kind="stable").tolist()
+    assert offsets.tolist() == [0, *np.cumsum(np.bincount(group, minlength=k)).tolist()]
+    for g in range(k):
+        assert np.all(group[order[offsets[g]:offsets[g + 1]]] == g)
+
+
+def test_group_by_docstring_example():
+    order, offsets = group_by(np.array([1, 0, 1, 0]), 2)
+    assert order.tolist() == [1, 3, 0, 2]
+    assert offsets.tolist() == [0, 2, 4]
+
+
+@pytest.mark.parametrize("n", SIZES)
+def test_scatter_rows(n):
+    rng = np.random.default_rng(n)
+    big = n + 3
+    src = rng.normal(size=(n, 12))
+    dest = rng.permutation(big)[:n].astype(np.int64)
+    out = np.zeros((big, 12))
+    want = out.copy()
+    want[dest] = src
+    scatter_rows(src, dest, out)
+    assert np.array_equal(out, want)
+
+
+# -------------------------------------------------------------------------------------------------- scope
+
+
+@pytest.mark.parametrize("n", SIZES)
+@pytest.mark.parametrize("axis", [0, 1, 2])
+def test_place_children(n, axis):
+    rng = np.random.default_rng(n + 10 * axis)
+    frames = random_frames(rng, 4)
+    origin = rng.normal(size=(n, 3)) * 10
+    size = rng.uniform(1, 10, (n, 3))
+    key = rng.integers(0, 2**63, n, dtype=np.uint64) * np.uint64(2) + np.uint64(1)
+    frame = rng.integers(0, 4, n).astype(np.int32)
+    m = 3 * n
+    parent = np.sort(rng.integers(0, max(n, 1), m)) if n else np.zeros(0, np.int64)
+    pos = rng.uniform(0, 5, m)
+    length = rng.uniform(0.1, 5, m)
+    index = rng.integers(0, 9, m).astype(np.int64)
+    site = 7
+    out_origin, out_size, out_key = place_children(origin, size, key, frame, frames, axis, parent, pos,
+                                                   length, site, index)
+    want_origin = origin[parent] + pos[:, None] * frames[frame[parent], axis]
+    want_size = size[parent].copy()
+    want_size[:, axis] = length
+    np.testing.assert_allclose(out_origin, want_origin, rtol=1e-14, atol=1e-12)
+    assert np.array_equal(out_size, want_size)
+    assert out_key.dtype == np.uint64
+    assert np.array_equal(out_key, child_keys(key[parent], site, index))
+
+
+@pytest.mark.parametrize("n", SIZES)
+def test_xforms(n):
+    rng = np.random.default_rng(n)
+    frames = random_frames(rng, 5)
+    frame = rng.integers(0, 5, n).astype(np.int32)
+    size = rng.uniform(0, 10, (n, 3))
+    size[rng.random((n, 3)) < 0.2] = 0.0
+    origin = rng.normal(size=(n, 3)) * 100
+    out = xforms(frames, frame, size, origin)
+    assert out.dtype == np.float32 and out.shape == (n, 3, 4)
+    want = np.empty((n, 3, 4))
+    for i in range(n):
+        for j in range(3):
+            want[i, :, j] = frames[frame[i], j] * size[i, j]  # column j = scope axis j * size j
+        want[i, :, 3] = origin[i]
+    assert np.array_equal(out, want.astype(np.float32))
+
+
+def test_xforms_maps_unit_box_corners_to_scope_corners():
+    rng = np.random.default_rng(3)
+    frames = random_frames(rng, 1)
+    size = np.array([[2.0, 3.0, 4.0]])
+    origin = np.array([[1.0, -2.0, 5.0]])
+    x = xforms(frames, np.zeros(1, np.int32), size, origin)[0].astype(np.float64)
+    for corner in np.ndindex(2, 2, 2):
+        c = np.array(corner, float)
+        world = x[:, :3] @ c + x[:, 3]
+        np.testing.assert_allclose(world, origin[0] + (c * size[0]) @ frames[0], atol=1e-5)

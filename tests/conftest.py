@@ -1,0 +1,49 @@
+"""Shared fixtures: strict invariant checks on, a zoo of small grammars and lots.
+
+The zoo holds named inputs that tests parametrize over (shapely's ``tests/common.py`` habit): lots that are
+square, concave, with a hole, a sliver, and grammars in the paper notation.
+"""
+
+from __future__ import annotations
+
+import os
+
+os.environ.setdefault("GRAMMARC_STRICT", "1")
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from grammarc.io.lots import lots_from_polygons
+
+PRT_KIT = Path(__file__).resolve().parents[1].parent / "shared" / "prt"
+
+#: Footprints in map coordinates (x east, y north), exterior counter-clockwise, holes clockwise.
+LOT_ZOO = {
+    "square": [np.array([[0, 0], [10, 0], [10, 10], [0, 10]], float)],
+    "rect_12x8": [np.array([[0, 0], [12, 0], [12, 8], [0, 8]], float)],
+    "concave_L": [np.array([[0, 0], [30, 0], [30, 10], [10, 10], [10, 20], [0, 20]], float)],
+    "courtyard": [
+        np.array([[0, 0], [40, 0], [40, 40], [0, 40]], float),
+        np.array([[10, 10], [10, 30], [30, 30], [30, 10]], float),
+    ],
+    "sliver": [np.array([[0, 0], [50, 0], [50, 0.05], [0, 0.05]], float)],
+}
+
+
+def make_lots(*names: str, attrs: dict | None = None):
+    """Lots from the zoo by name, ids equal to the names."""
+    return lots_from_polygons([LOT_ZOO[n] for n in names], ids=list(names), attrs=attrs)
+
+
+@pytest.fixture
+def write(tmp_path):
+    """Write a text file under tmp_path and return its path: ``write("g.cga", text)``."""
+
+    def _write(name: str, text: str) -> Path:
+        path = tmp_path / name
+        path.write_text(text, encoding="utf-8")
+        return path
+
+    return _write

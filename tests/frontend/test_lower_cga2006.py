@@ -1,0 +1,133 @@
+"""frontend/lower_cga2006.py: operations, their arities and the constructs that are not supported yet.
+
+Each case is a one-rule grammar and the exact errors (line, column, message) that lowering and the IR
+passes report for it: no error may hide another, and none may cascade from one already reported.
+"""
+
+from __future__ import annotations
+
+import pytest
+
+from grammarc.diagnostics import Diagnostics, render
+from grammarc.frontend.parse import parse_source
+from grammarc.ir.pipeline import run_passes
+
+FILE = "g.cga"
+
+
+def diagnose(text: str) -> Diagnostics:
+    diags = Diagnostics()
+    run_passes(parse_source(text, FILE, diags), diags, check=True)
+    return diags
+
+
+def errors(text: str) -> list[tuple[int, int, str]]:
+    return sorted((d.span.line, d.span.col, d.message) for d in diagnose(text) if d.is_error)
+
+
+@pytest.mark.parametrize("text, expected", [
+    # unknown operations, functions and names
+    ('a ~> Subdv("Y", 1){ b }', [(1, 6, "unknown operation `Subdv` (did you mean `Subdiv`?)")]),
+    ('a ~> Repaet("X", 1){ b }', [(1, 6, "unknown operation `Repaet` (did you mean `Repeat`?)")]),
+    ("a ~> T(sqr(4), 0, 0)", [(1, 8, "unknown function `sqr` (did you mean `sqrt`?)")]),
+    ("a ~> T(frobnicate(4), 0, 0)", [(1, 8, "unknown function `frobnicate`")]),
+    ("a ~> T(Scope.foo, 0, 0)", [(1, 8, "unknown scope attribute `Scope.foo`")]),
+    ("a ~> T(Scope.szz, 0, 0)", [(1, 8, "unknown scope attribute `Scope.szz` (did you mean `sz`?)")]),
+    ("a ~> T(Lot.area, 0, 0)", [(1, 8, "unknown name `Lot.area`")]),
+    ("a ~> T(Lot.area(), 0, 0)", [(1, 8, "unknown function `Lot.area`")]),
+    # arities of operations
+    ("a ~> T(1, 2)", [(1, 6, "`T` takes 3 arguments, got 2")]),
+    ("a ~> S(1, 2, 3, 4)", [(1, 6, "`S` takes 3 arguments, got 4")]),
+    ("a ~> R(1, 2)", [(1, 6, "`R` takes 3 arguments, got 2")]),
+    ("a ~> Rx(1, 2)", [(1, 6, "`Rx` takes 1 argument, got 2")]),
+    ('a ~> I("cube", 2)', [(1, 6, "`I` takes 1 argument, got 2")]),
+    ("a ~> I(cube)", [(1, 8, "`I` expects an asset name as a string literal")]),
+    ("a ~> floor(1, 2)", []),  # a successor symbol, not the function: it has no rule, see the warning test
+    ("a ~> T(floor(1, 2), 0, 0)", [(1, 8, "`floor` takes 1 argument, got 2")]),
+    ("a ~> T(rand(1, 2, 3), 0, 0)", [(1, 8, "`rand` takes 0 to 2 arguments, got 3")]),
+    # splits
+    ('a ~> Subdiv("Y", 1, 2){ b }', [(1, 6, "`Subdiv` has 2 parts but 1 successor in its body")]),
+    ('a ~> Subdiv("Y", 1){ b | c }', [(1, 6, "`Subdiv` has 1 parts but 2 successors in its body")]),
+    ('a ~> Subdiv("XY", 1, 2){ b | c }', [(1, 6, "`Subdiv` has 4 cells but 2 successors in its body")]),
+    ('a ~> Subdiv("Y"){ b }', [(1, 6, "`Subdiv` takes an axis and at least one size, got 1 argument")]),
+    ('a ~> Subdiv("Y", 1)', [(1, 6, "`Subdiv` needs a body `{ A | B | ... }`")]),
+    ('a ~> Repeat("XY", 1){ b }', [(1, 6, '`Repeat("XY", ...)` takes 2 sizes, got 1')]),
+    ('a ~> Repeat("X", 1, 2){ b }', [(1, 6, '`Repeat("X", ...)` takes 1 size, got 2')]),
+    ('a ~> Repeat("X"){ b }', [(1, 6, "`Repeat` takes an axis and a size per axis, got 1 argument")]),
+    ('a ~> Repeat("X", 1r){ b }', [(1, 18, "a relative size like `1r` is only allowed in `S` and `Subdiv`")]),
+    ('a ~> Subdiv("Q", 1){ b }',
+     [(1, 13, 'unknown split axis "Q", expected one of X, Y, Z, XY, XZ, YZ, XYZ')]),
+    ("a ~> Subdiv(Y, 1){ b }", [(1, 13, "`Subdiv` expects an axis as a string literal")]),
+    ("a ~> T(1, 2, 3){ b }", [(1, 6, "`T` takes no `{...}` body")]),
+    # component splits
+    ('a ~> Comp("edge"){ b }', [(1, 6, '`Comp("edge")` takes 2 arguments, got 1')]),
+    ('a ~> Comp("faces", 2){ b }', [(1, 6, '`Comp("faces")` takes 1 argument, got 2')]),
+    ('a ~> Comp("facez"){ b }', [(1, 11, 'unknown component type "facez" (did you mean `face`?)')]),
+    ('a ~> Comp("wibble"){ b }', [(1, 11, 'unknown component type "wibble"')]),
+    ("a ~> Comp(){ b }", [(1, 6, "`Comp` takes a component type, got no arguments")]),
+    ('a ~> Comp("edge", "x"){ b }', [(1, 19, 'a component index must be a num, got a str')]),
+    # relative sizes are for S and Subdiv only
+    ("a ~> T(1r, 0, 0)", [(1, 8, "a relative size like `1r` is only allowed in `S` and `Subdiv`")]),
+    ("a ~> R(0, 0.5r, 0)", [(1, 11, "a relative size like `1r` is only allowed in `S` and `Subdiv`")]),
+    ("a ~> b(1r)", [(1, 8, "a relative size like `1r` is only allowed in `S` and `Subdiv`")]),
+    # parameters
+    ("a(x, x) ~> b", [(1, 6, "parameter `x` appears twice")]),
+])
+def test_lowering_errors(text, expected):
+    assert errors(text) == expected
+
+
+@pytest.mark.parametrize("text, col, what", [
+    ('a : Shape.occ("all") == "none" ~> b', 5, "`Shape.occ` is not supported yet"),
+    ('a : Scope.occ("noparent") != "none" ~> b', 5, "`Scope.occ` is not supported yet"),
+    ('a : Shape.visible("front") ~> b', 5, "`Shape.visible` is not supported yet"),
+    ('a ~> b Snap("XZ")', 8, "`Snap` is not supported yet"),
+    ('a ~> Snap("Y", "entrancesnap") b', 6, "`Snap` is not supported yet"),
+    ('a ~> b SnapLines("y")', 8, "`SnapLines` is not supported yet"),
+    ("a ~> b Snap", 8, "`Snap` is not supported yet"),
+    ('a ~> Roof("hipped", 30){ r }', 6, "`Roof` is not supported yet"),
+    ('a ~> Repeat("XS", 2){ b }', 13, '`Repeat("XS")` is not supported yet'),
+    ('a ~> Subdiv("YS", 1r){ b }', 13, '`Subdiv("YS")` is not supported yet'),
+])
+def test_not_supported_yet_each_with_its_line_and_nothing_else(text, col, what):
+    # the second line proves the position is this construct's, and that nothing cascades from it
+    diags = diagnose("z ~> a\n" + text)
+    assert [(d.span.line, d.span.col) for d in diags if d.is_error] == [(2, col)]
+    [d] = [d for d in diags if d.is_error]
+    assert d.message.startswith(what) and d.code == "not-supported"
+
+
+def test_errors_inside_nested_bodies_are_found():
+    text = 'a ~> Subdiv("Y", 1, 1r){ Subdiv("X", 1r){ Subdv("Z", 1){ c } } | Comp("edge"){ d } }'
+    assert errors(text) == [
+        (1, 43, "unknown operation `Subdv` (did you mean `Subdiv`?)"),
+        (1, 66, '`Comp("edge")` takes 2 arguments, got 1'),
+    ]
+
+
+def test_all_errors_of_a_file_are_reported():
+    text = (
+        'a ~> Subdv("Y", 1){ b } T(1r, 0, 0)\n'
+        "b ~> T(1, 2) c(1, 2)\n"
+        'c(x) ~> I("cube")\n'
+        'd ~> Comp("edge"){ e } Roof("hipped", 30){ r }'
+    )
+    positions = [(line, col) for line, col, _ in errors(text)]
+    assert positions == [(1, 6), (1, 27), (2, 6), (2, 14), (4, 6), (4, 24)]
+
+
+def test_unknown_operation_renders_with_a_caret_under_the_name():
+    text = 'facade ~> Subdv("Y", 3){ floor }\n'
+    [d] = [d for d in diagnose(text) if d.is_error]
+    assert render(d, {FILE: text}) == (
+        "g.cga:1:11: error: unknown operation `Subdv` (did you mean `Subdiv`?)\n"
+        ' 1 | facade ~> Subdv("Y", 3){ floor }\n'
+        "   |           ^^^^^"
+    )
+
+
+def test_arguments_of_a_symbol_without_rules_are_a_warning():
+    diags = diagnose("a ~> floor(1, 2)")
+    [d] = diags
+    assert (d.severity.value, d.span.col, d.message) == (
+        "warning", 6, "`floor` has no rule, so its arguments are not used")

@@ -1,0 +1,97 @@
+"""ir/passes/rulegraph.py: terminals, reachable symbols, recursion and unreachable rules."""
+
+from __future__ import annotations
+
+import random
+
+import pytest
+
+from grammarc.diagnostics import Diagnostics
+from grammarc.frontend.parse import parse_source
+from grammarc.ir.passes.rulegraph import RuleGraph, analyze_rules
+from grammarc.ir.pipeline import run_passes
+
+FILE = "g.cga"
+
+
+def graph(text: str, start: str | None = None) -> tuple[RuleGraph, Diagnostics]:
+    diags = Diagnostics()
+    module = run_passes(parse_source(text, FILE, diags), diags, check=True)
+    assert not diags.has_errors
+    return analyze_rules(module, start or module.start, diags), diags
+
+
+def test_terminals_nonterminals_and_edges():
+    g, diags = graph('a ~> b x [ y ]\nb ~> Subdiv("X", 1r, 1r){ c | z }\nc ~> Comp("faces"){ w | x }\nb ~> v')
+    assert not diags
+    assert g.start == "a"
+    assert g.nonterminals == ("a", "b", "c")
+    assert g.terminals == ("x", "y", "z", "w", "v")
+    assert g.edges == {"a": ("b", "x", "y"), "b": ("c", "z", "v"), "c": ("w", "x")}
+    assert g.reachable == frozenset("abcxyzwv")
+    assert g.recursive == frozenset()
+
+
+def test_symbols_in_nested_bodies_and_all_alternatives_count():
+    g, _ = graph('a ~> Subdiv("Y", 1r){ Repeat("X", 1){ Comp("edges"){ deep } } } : 0.5 ~> other : 0.5')
+    assert g.edges["a"] == ("deep", "other")
+
+
+@pytest.mark.parametrize("text, recursive", [
+    ("a ~> a", {"a"}),
+    ("a ~> b\nb ~> b c", {"b"}),
+    ("a ~> b\nb ~> c\nc ~> a", {"a", "b", "c"}),
+    ("a ~> b\nb ~> c\nc ~> b", {"b", "c"}),
+    ('a ~> Subdiv("X", 1r){ b }\nb : Scope.sx > 1 ~> a\nb ~> leaf', {"a", "b"}),
+    ("a ~> b c\nb ~> d\nc ~> d\nd ~> leaf", set()),  # a diamond is not a cycle
+    ("a ~> b\nb ~> a\nc ~> d\nd ~> c\nc ~> e", {"a", "b", "c", "d"}),
+])
+def test_recursion_direct_and_mutual(text, recursive):
+    g, _ = graph(text)
+    assert g.recursive == frozenset(recursive)
+
+
+def test_unreachable_rules_warn():
+    g, diags = graph("lot ~> a\na ~> b\nc ~> d\nd ~> c\nd ~> e")
+    assert g.reachable == frozenset({"lot", "a", "b"})
+    assert [(d.severity.value, d.span.line, d.message) for d in diags] == [
+        ("warning", 3, "rule for `c` is never reached from `lot`"),
+        ("warning", 4, "rule for `d` is never reached from `lot`"),
+        ("warning", 5, "rule for `d` is never reached from `lot`"),
+    ]
+
+
+def test_another_start_symbol():
+    g, diags = graph("lot ~> a\na ~> b", start="a")
+    assert g.reachable == frozenset({"a", "b"})
+    assert [d.message for d in diags] == ["rule for `lot` is never reached from `a`"]
+
+
+def _reaches(edges: dict[str, set[str]], src: str, dst: str) -> bool:
+    """Whether ``dst`` is reachable from ``src`` in one or more steps."""
+    seen, stack = set(), list(edges.get(src, ()))
+    while stack:
+        x = stack.pop()
+        if x == dst:
+            return True
+        if x not in seen:
+            seen.add(x)
+            stack.extend(edges.get(x, ()))
+    return False
+
+
+def test_recursion_and_reachability_match_a_brute_force_reference():
+    # a symbol is recursive iff it reaches itself in one or more steps
+    rng = random.Random(7)
+    for _ in range(40):
+        names = [f"s{i}" for i in range(rng.randint(1, 9))]
+        lines = []
+        for name in names:
+            targets = [t for t in names if rng.random() < 0.2] + ["leaf"]
+            lines.append(f"{name} ~> {' '.join(targets)}")
+        text = "\n".join(lines)
+        g, _ = graph(text, start="s0")
+        edges = {s: set(t) for s, t in g.edges.items()}
+        assert g.recursive == frozenset(s for s in names if _reaches(edges, s, s)), text
+        reached = {s for s in [*names, "leaf"] if _reaches(edges, "s0", s)}
+        assert g.reachable == frozenset({"s0"} | reached), text

@@ -1,0 +1,135 @@
+"""ir/passes/types.py: expression types, successor arities and parameter types from call sites."""
+
+from __future__ import annotations
+
+import pytest
+
+from grammarc.diagnostics import Diagnostics
+from grammarc.frontend.parse import parse_source
+from grammarc.ir import nodes as ir
+from grammarc.ir.passes.types import infer_types
+from grammarc.ir.pipeline import run_passes
+
+FILE = "g.cga"
+T = ir.Type
+
+
+def typed(text: str) -> tuple[ir.Module, Diagnostics]:
+    diags = Diagnostics()
+    module = run_passes(parse_source(text, FILE, diags), diags, check=True, stop_after="types")
+    return module, diags
+
+
+def errors(text: str) -> list[tuple[int, int, str]]:
+    return [(d.span.line, d.span.col, d.message) for d in typed(text)[1] if d.is_error]
+
+
+@pytest.mark.parametrize("text, expected", [
+    # guards are bool
+    ("a : 3 ~> b", [(1, 5, "a guard must be a bool, got a num")]),
+    ('attr s = "x"\na : s ~> b', [(2, 5, "a guard must be a bool, got a str")]),
+    ("a(x) : x + 1 ~> b", [(1, 10, "a guard must be a bool, got a num")]),
+    # operators
+    ('a ~> T("a" + 1, 0, 0)', [(1, 12, "`+` cannot combine a str and a num")]),
+    ('a ~> T(2 * "b", 0, 0)', [(1, 10, "`*` cannot combine a num and a str")]),
+    ('a : 1 == "x" ~> b', [(1, 7, "`==` cannot combine a num and a str")]),
+    ('a : "x" != 1 ~> b', [(1, 9, "`!=` cannot combine a str and a num")]),
+    ('a : "a" < "b" ~> b', [(1, 9, "`<` cannot combine a str and a str")]),
+    ("a : true + 1 > 0 ~> b", [(1, 10, "`+` cannot combine a bool and a num")]),
+    ("a : 1 && true ~> b", [(1, 5, "`&&` cannot combine a num and a bool")]),
+    ("a : !1 ~> b", [(1, 6, "the operand of `!` must be a bool, got a num")]),
+    ("a ~> T(-true, 0, 0)", [(1, 9, "the operand of `-` must be a num, got a bool")]),
+    ('a ~> T(sin("x"), 0, 0)', [(1, 12, "an argument of `sin` must be a num, got a str")]),
+    # operations take numbers
+    ('a ~> T("x", 0, 0)', [(1, 8, "a translation must be a num, got a str")]),
+    ("a ~> S(1r, true, 1)", [(1, 12, "a size must be a num, got a bool")]),
+    ('a ~> R(0, "x", 0)', [(1, 11, "an angle must be a num, got a str")]),
+    ('a ~> Subdiv("X", "x", 1r){ b | c }', [(1, 18, "a size must be a num, got a str")]),
+    ('a ~> Repeat("X", true){ b }', [(1, 18, "a size must be a num, got a bool")]),
+    ('a ~> b : "p" ~> c : 0.5', [(1, 10, "a probability must be a num, got a str")]),
+    # attribute defaults are checked too
+    ('attr a = "x" + 1\nb ~> c', [(1, 14, "`+` cannot combine a str and a num")]),
+    # well-typed: equality on any one type, logic on bools
+    ('a : "x" == "x" && true != false || !(1 >= 2) ~> b', []),
+])
+def test_type_errors(text, expected):
+    assert errors(text) == expected
+
+
+@pytest.mark.parametrize("text, expected", [
+    ("a ~> b(1, 2)\nb(x) ~> c", [(1, 6, "`b` takes 1 argument, got 2")]),
+    ("a ~> b\nb(x) ~> c", [(1, 6, "`b` takes 1 argument, got 0")]),
+    ("a ~> b(1)\nb ~> c", [(1, 6, "`b` takes 0 arguments, got 1")]),
+    ("a ~> b(1, 2)\nb(x, y, z) ~> c", [(1, 6, "`b` takes 3 arguments, got 2")]),
+    ('a ~> Subdiv("X", 1r){ b(1, 2) }\nb(x) ~> c', [(1, 23, "`b` takes 1 argument, got 2")]),
+    ("b(x) ~> c\nb ~> d",
+     [(2, 1, "rules of `b` disagree: this one takes 0 parameters, the one at line 1 takes 1")]),
+    ("b(x) ~> c\nb(x, y) : y > 0 ~> d",
+     [(2, 1, "rules of `b` disagree: this one takes 2 parameters, the one at line 1 takes 1")]),
+    ("b(x) ~> c\nb(y) : y > 0 ~> d", []),
+])
+def test_successor_arity(text, expected):
+    assert errors(text) == expected
+
+
+def test_symbol_without_rules_may_take_arguments_with_a_warning():
+    _, diags = typed("a ~> leaf(1, 2)")
+    [d] = diags
+    assert (d.severity.value, d.code) == ("warning", "terminal-args")
+
+
+def test_parameter_types_from_call_sites_including_strings():
+    module, diags = typed('a ~> b("x", 1, true)\nb(s, n, f) : f && s == "x" ~> T(n, 0, 0)')
+    assert not diags
+    assert dict(module.param_types) == {"a": (), "b": (T.STR, T.NUM, T.BOOL)}
+
+
+def test_parameter_types_flow_through_parameters():
+    # c's parameter is a string because b passes on the string it got from a
+    module, diags = typed('a ~> b("x")\nb(s) ~> c(s)\nc(t) ~> T(t, 0, 0)')
+    assert dict(module.param_types)["c"] == (T.STR,)
+    assert [(d.span.line, d.span.col, d.message) for d in diags] == [
+        (3, 11, "a translation must be a num, got a str")]
+
+
+def test_parameter_types_flow_through_a_long_chain_in_reverse_order():
+    # the rules come in the reverse of the call order, so inference needs one round per link
+    chain = [f"s{i}(p) ~> s{i + 1}(p)" for i in range(6, 0, -1)]
+    text = "\n".join([*chain, 's0 ~> s1("x")', 's7(p) : p == "x" ~> z'])
+    module, diags = typed(text)
+    assert not diags
+    assert dict(module.param_types)["s7"] == (T.STR,)
+
+
+def test_parameter_types_from_attributes_and_expressions():
+    module, _ = typed(
+        'attr name = "n"\nattr big = 1 > 0\na ~> b(name, big, 1 + 2, Scope.sx < 1)\nb(p, q, r, s) ~> c')
+    assert dict(module.param_types)["b"] == (T.STR, T.BOOL, T.NUM, T.BOOL)
+
+
+def test_a_parameter_never_passed_a_value_is_a_number():
+    module, _ = typed("a ~> c\nb(x) ~> T(x, 0, 0)")
+    assert dict(module.param_types)["b"] == (T.NUM,)
+
+
+def test_conflicting_call_sites_report_the_later_one():
+    # the first call site decides the type; later ones are checked against it
+    module, diags = typed('a ~> b(1) b("x")\nb(x) ~> c')
+    assert dict(module.param_types)["b"] == (T.NUM,)
+    assert [(d.span.col, d.message) for d in diags] == [(13, 'argument 1 of `b` must be a num, got a str')]
+
+
+def test_attribute_types():
+    module, diags = typed('attr a = 1\nattr b = a > 0\nattr c = "s"\nattr d = -a * 2\nattr e = !b\nx ~> y')
+    assert not diags
+    assert [(a.name, a.type) for a in module.attrs] == [
+        ("a", T.NUM), ("b", T.BOOL), ("c", T.STR), ("d", T.NUM), ("e", T.BOOL)]
+
+
+def test_types_pass_fills_param_types_for_every_symbol():
+    diags = Diagnostics()
+    module = parse_source("a ~> b(1)\nb(x) ~> c\nc ~> d", FILE, diags)
+    from grammarc.ir.passes.resolve import resolve_names
+
+    module = infer_types(resolve_names(module, diags), diags)
+    assert module.param_types == (("a", ()), ("b", (T.NUM,)), ("c", ()))

@@ -1,0 +1,160 @@
+"""The command line: every error kind gets its message and exit code, and a failed build writes nothing."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+
+from grammarc.cli import main
+from grammarc.io.npz import read_instances
+
+GOOD = 'attr height = 9\nlot ~> S(1r, height, 1r) Comp("sidefaces"){ wall }\n'
+
+
+def geojson(path, polygons, props=None):
+    features = [
+        {"type": "Feature", "id": f"lot{i}", "properties": (props or [{}] * len(polygons))[i],
+         "geometry": {"type": "Polygon", "coordinates": [ring + [ring[0]] for ring in rings]}}
+        for i, rings in enumerate(polygons)
+    ]
+    path.write_text(json.dumps({"type": "FeatureCollection", "features": features}))
+    return path
+
+
+SQUARE = [[[0, 0], [10, 0], [10, 10], [0, 10]]]
+BOWTIE = [[[0, 0], [10, 10], [10, 0], [0, 10]]]
+FLAT = [[[0, 0], [10, 0], [20, 0]]]
+
+
+def test_build_writes_the_record(write, tmp_path, capsys):
+    grammar = write("g.cga", GOOD)
+    lots = geojson(tmp_path / "lots.geojson", [SQUARE, SQUARE])
+    out = tmp_path / "out.npz"
+    assert main(["build", str(grammar), "--lots", str(lots), "--emit", str(out)]) == 0
+    record = read_instances(out)
+    assert len(record["asset"]) == 8 and list(np.unique(record["lot"])) == [0, 1]
+    np.testing.assert_allclose(record["xform"][:, 1, 1], 9)
+    assert "8 instances" in capsys.readouterr().err
+
+
+def test_build_uses_lots_beside_the_grammar_and_attr_override(write, tmp_path):
+    grammar = write("city.cga", GOOD)
+    geojson(tmp_path / "city.geojson", [SQUARE])
+    out = tmp_path / "out.npz"
+    assert main(["build", str(grammar), "--emit", str(out), "--attr", "height=4", "--quiet"]) == 0
+    record = read_instances(out)
+    np.testing.assert_allclose(record["xform"][:, 1, 1], 4)
+    assert record["meta"]["attrs"] == {"height": 4.0}
+
+
+def test_syntax_errors_all_reported_with_caret_exit_2(write, tmp_path, capsys):
+    grammar = write("bad.cga", "a ~> S(1, 2, 3 b\nc ~> T(1, 2, 3)\nd ~> Subdv(\"X\", 1){ e }\n")
+    out = tmp_path / "out.npz"
+    assert main(["build", str(grammar), "--emit", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert f"{grammar}:1:16: error: unexpected `b`" in err
+    assert f"{grammar}:3:6: error: unknown operation `Subdv` (did you mean `Subdiv`?)" in err
+    assert " 3 | d ~> Subdv" in err and "   |      ^^^^^" in err
+    assert "2 errors; nothing was written" in err
+    assert not out.exists()
+
+
+@pytest.mark.parametrize("text, message", [
+    ("lot ~> S(1r, heigth, 1r) x\n", "unknown identifier `heigth`"),
+    ("lot ~> f(1, 2)\nf(a) ~> x\n", "`f` takes 1 argument, got 2"),
+    ("lot ~> a : 0.5\n    ~> b : 0.4\n", "probabilities of `lot` sum to 0.9"),
+    ("lot ~> Shape.occ(\"all\")\n", "unexpected"),
+    ("lot : Shape.occ(\"all\") == \"none\" ~> x\n", "`Shape.occ` is not supported yet"),
+])
+def test_grammar_errors_exit_2(write, tmp_path, capsys, text, message):
+    out = tmp_path / "out.npz"
+    assert main(["build", str(write("g.cga", text)), "--emit", str(out)]) == 2
+    assert message in capsys.readouterr().err
+    assert not out.exists()
+
+
+def test_bad_lots_reported_and_skipped(write, tmp_path, capsys):
+    lots = geojson(tmp_path / "lots.geojson", [SQUARE, BOWTIE, SQUARE, FLAT])
+    out = tmp_path / "out.npz"
+    assert main(["build", str(write("g.cga", GOOD)), "--lots", str(lots), "--emit", str(out)]) == 0
+    err = capsys.readouterr().err
+    assert "lot lot1 (#1) skipped: self-intersection" in err
+    assert "lot lot3 (#3) skipped" in err
+    assert list(np.unique(read_instances(out)["lot"])) == [0, 2]
+
+
+def test_negative_size_lot_skipped_by_id(write, tmp_path, capsys):
+    grammar = write("g.cga", "lot ~> S(Scope.sx - 10.5, 3, 1r) I(\"cube\")\n")
+    lots = geojson(tmp_path / "lots.geojson", [SQUARE, [[[0, 0], [12, 0], [12, 5], [0, 5]]]])
+    out = tmp_path / "out.npz"
+    assert main(["build", str(grammar), "--lots", str(lots), "--emit", str(out)]) == 0
+    assert "lot lot0 (#0) skipped: `S` gives a negative or NaN size" in capsys.readouterr().err
+    assert list(read_instances(out)["lot"]) == [1]
+
+
+def test_runaway_recursion_fails_and_leaves_existing_output(write, tmp_path, capsys):
+    out = tmp_path / "out.npz"
+    out.write_bytes(b"previous")
+    grammar = write("g.cga", "grow ~> T(0, 1, 0) grow grow\n")
+    assert main(["build", str(grammar), "--emit", str(out), "--max-shapes", "100000"]) == 1
+    err = capsys.readouterr().err
+    assert "rule `grow`" in err and "--max-shapes" in err
+    assert out.read_bytes() == b"previous"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["g.cga", "out.npz"]
+
+
+def test_depth_limit_can_be_raised(write, tmp_path):
+    grammar = write("g.cga", "lot ~> S(1r, 1, 1r) grow(300)\ngrow(n) : n > 0 ~> T(0, 1, 0) grow(n - 1)\n"
+                             "grow(n) ~> I(\"cube\")\n")
+    out = tmp_path / "out.npz"
+    assert main(["build", str(grammar), "--emit", str(out), "--quiet"]) == 1
+    assert main(["build", str(grammar), "--emit", str(out), "--quiet", "--max-depth", "400"]) == 0
+    np.testing.assert_allclose(read_instances(out)["xform"][0, 1, 3], 300)
+
+
+@pytest.mark.parametrize("content, message", [
+    (None, "lots file not found"),
+    ("{not json", "lots.geojson"),
+    ('{"type": "FeatureCollection", "features": []}', "no polygon"),
+])
+def test_unreadable_lots_exit_1(write, tmp_path, capsys, content, message):
+    lots = tmp_path / "lots.geojson"
+    if content is not None:
+        lots.write_text(content)
+    out = tmp_path / "out.npz"
+    assert main(["build", str(write("g.cga", GOOD)), "--lots", str(lots), "--emit", str(out)]) == 1
+    assert message in capsys.readouterr().err
+    assert not out.exists()
+
+
+@pytest.mark.parametrize("args, message", [
+    (["--emit", "out.usd"], "output format `.usd` is not supported"),
+    (["--emit", "out.npz", "--attr", "nope=1"], "declares no attribute `nope`"),
+    (["--emit", "out.npz", "--attr", "height=tall"], "`height` is a num, not a str"),
+    (["--emit", "out.npz", "--start", "missing"], "start symbol `missing` has no rule"),
+])
+def test_usage_errors_exit_2(write, tmp_path, capsys, args, message):
+    args = [a if not a.startswith("out.") else str(tmp_path / a) for a in args]
+    assert main(["build", str(write("g.cga", GOOD)), *args]) == 2
+    assert message in capsys.readouterr().err
+
+
+def test_check_prints_a_summary(write, capsys):
+    grammar = write("g.cga", "lot ~> S(1r, 3, 1r) grow(2)\ngrow(n) : n > 0 ~> grow(n - 1) leaf\n"
+                             "grow(n) ~> ε\n")
+    assert main(["check", str(grammar)]) == 0
+    out = capsys.readouterr().out
+    assert "rules:     3 (2 symbols with rules)" in out
+    assert "terminals: leaf" in out and "recursive: grow" in out
+
+
+def test_check_dump_ir(write, capsys):
+    assert main(["check", "--dump-ir", str(write("g.cga", "attr h = 2 * 3\nlot ~> S(1r, h, 1r) x\n"))]) == 0
+    assert "lot ~> S(1r, @h, 1r) x" in capsys.readouterr().out
+
+
+def test_check_reports_errors_exit_2(write, capsys):
+    assert main(["check", str(write("g.cga", "lot ~> T(1, 2)\n"))]) == 2
+    assert "`T` takes 3 arguments, got 2" in capsys.readouterr().err

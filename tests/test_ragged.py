@@ -1,0 +1,103 @@
+"""grammarc.ragged against plain-Python references on random ragged arrays, empty segments included."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from grammarc.ragged import fan_out, offsets_from_counts, ragged_take, segment_of, segment_reduce
+
+
+def random_counts(rng, n):
+    """Counts with many zeros, so empty segments occur first, in the middle and last."""
+    return rng.integers(0, 4, n) * (rng.random(n) < 0.7)
+
+
+def segments(counts):
+    """Python reference: [(start, stop)] of each segment."""
+    out, at = [], 0
+    for c in counts:
+        out.append((at, at + int(c)))
+        at += int(c)
+    return out
+
+
+@pytest.mark.parametrize("n", [0, 1, 2, 17])
+def test_offsets_from_counts(n):
+    counts = random_counts(np.random.default_rng(n), n)
+    offsets = offsets_from_counts(counts)
+    assert offsets.dtype == np.int64
+    assert offsets.tolist() == [0] + [b for _, b in segments(counts)]
+
+
+def test_offsets_docstring_example():
+    assert offsets_from_counts(np.array([2, 3])).tolist() == [0, 2, 5]
+
+
+@pytest.mark.parametrize("n", [0, 1, 2, 17])
+def test_ragged_take(n):
+    rng = np.random.default_rng(n)
+    counts = random_counts(rng, n)
+    offsets = offsets_from_counts(counts)
+    for sel in (np.arange(n), rng.permutation(n), rng.integers(0, max(n, 1), 3 * n) if n else np.arange(0),
+                np.zeros(0, np.int64)):
+        items, packed = ragged_take(offsets, sel)
+        want = [i for s in sel for i in range(*segments(counts)[s])]
+        assert items.tolist() == want
+        assert packed.tolist() == offsets_from_counts(counts[sel]).tolist()
+
+
+def test_ragged_take_docstring_example():
+    items, packed = ragged_take(np.array([0, 2, 5, 6]), np.array([2, 0]))
+    assert items.tolist() == [5, 0, 1]
+    assert packed.tolist() == [0, 1, 3]
+
+
+@pytest.mark.parametrize("n", [0, 1, 2, 17])
+def test_segment_of(n):
+    counts = random_counts(np.random.default_rng(n), n)
+    want = [s for s, c in enumerate(counts) for _ in range(c)]
+    assert segment_of(offsets_from_counts(counts)).tolist() == want
+
+
+@pytest.mark.parametrize("ufunc, empty, ref", [
+    (np.add, 0.0, sum), (np.minimum, np.inf, min), (np.maximum, -np.inf, max),
+])
+@pytest.mark.parametrize("n", [0, 1, 2, 17, 40])
+def test_segment_reduce(ufunc, empty, ref, n):
+    rng = np.random.default_rng(n)
+    counts = random_counts(rng, n)
+    offsets = offsets_from_counts(counts)
+    values = rng.normal(size=(offsets[-1], 3))
+    out = segment_reduce(ufunc, values, offsets, empty)
+    assert out.shape == (n, 3)
+    for s, (a, b) in enumerate(segments(counts)):
+        for j in range(3):
+            want = ref(values[a:b, j].tolist()) if b > a else empty
+            assert out[s, j] == pytest.approx(want, rel=1e-12)
+
+
+@pytest.mark.parametrize("offsets, want", [
+    ([0, 2, 2], [3.0, 0.0]),  # regression: trailing empty segments cut the last non-empty one short
+    ([0, 0, 2, 3, 3, 3], [0.0, 3.0, 4.0, 0.0, 0.0]),
+    ([0, 0], [0.0]),
+    ([0], []),
+])
+def test_segment_reduce_empty_segments(offsets, want):
+    values = np.array([1.0, 2.0, 4.0])[: offsets[-1]]
+    assert segment_reduce(np.add, values, np.array(offsets), 0.0).tolist() == want
+
+
+@pytest.mark.parametrize("n", [0, 1, 2, 17])
+def test_fan_out(n):
+    counts = random_counts(np.random.default_rng(n), n)
+    parent, index = fan_out(counts)
+    assert parent.dtype == np.int64 and index.dtype == np.int64
+    assert parent.tolist() == [p for p, c in enumerate(counts) for _ in range(c)]
+    assert index.tolist() == [i for c in counts for i in range(c)]
+
+
+def test_fan_out_docstring_example():
+    parent, index = fan_out([2, 0, 3])
+    assert parent.tolist() == [0, 0, 2, 2, 2]
+    assert index.tolist() == [0, 1, 0, 1, 2]
