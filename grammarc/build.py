@@ -40,7 +40,7 @@ class BuildOptions:
     seed: int = 0
     attrs: dict = field(default_factory=dict)
     start: str | None = None
-    chunk_size: int = 2048
+    chunk_size: int = 256
     limits: Limits = LIMITS
     asset_roots: tuple[Path, ...] = ()
     chunk_budget: int = CHUNK_BUDGET
@@ -75,7 +75,7 @@ def build(grammar_path, output, *, lots_path=None, options: BuildOptions = Build
           progress=None) -> BuildResult:
     """Derive the lots with the grammar and write the records to ``output`` (atomically).
 
-    ``progress`` is called with the number of lots finished after each chunk.
+    ``progress(done, total)`` is called with the number of lots finished after each chunk.
     """
     started = time.perf_counter()
     grammar_path = Path(grammar_path)
@@ -101,7 +101,7 @@ def build(grammar_path, output, *, lots_path=None, options: BuildOptions = Build
             part = lots.take(slice(first, first + options.chunk_size))
             derived += _derive(plan, part, options, writer, failed)
             if progress is not None:
-                progress(len(part))
+                progress(first + len(part), len(lots))
         counts = writer.close()
     bad = tuple(sorted((*lots.bad, *failed), key=lambda b: b.index))
     return BuildResult(Path(output), len(lots) + len(lots.bad), derived, bad, counts,

@@ -50,8 +50,8 @@ def _parser() -> argparse.ArgumentParser:
     build.add_argument("--attr", action="append", default=[], metavar="NAME=VALUE",
                        help="override an attribute for every lot (repeatable)")
     build.add_argument("--start", metavar="SYMBOL", help="start symbol (default: the first rule's)")
-    build.add_argument("--chunk-size", type=_positive, default=2048, metavar="N",
-                       help="lots derived together (default 2048); the output does not depend on it")
+    build.add_argument("--chunk-size", type=_positive, default=256, metavar="N",
+                       help="lots derived together (default 256); the output does not depend on it")
     build.add_argument("--max-depth", type=_positive, default=LIMITS.max_depth, metavar="N",
                        help=f"rule applications along one path (default {LIMITS.max_depth})")
     build.add_argument("--max-shapes", type=_positive, default=LIMITS.max_shapes, metavar="N",
@@ -100,6 +100,25 @@ def _check(args) -> int:
     return 0
 
 
+class _ProgressBar:
+    """A tqdm bar of lots (with lots/s), made when the number of lots is known; silent off a terminal."""
+
+    def __init__(self) -> None:
+        self.bar = None
+
+    def __call__(self, done: int, total: int) -> None:
+        if self.bar is None:
+            from tqdm import tqdm
+
+            self.bar = tqdm(total=total, unit=" lots", desc="deriving", disable=None, dynamic_ncols=True,
+                            leave=False)
+        self.bar.update(done - self.bar.n)
+
+    def close(self) -> None:
+        if self.bar is not None:
+            self.bar.close()
+
+
 def _build(args) -> int:
     from grammarc.backend.attributes import parse_override
     from grammarc.build import BuildOptions, build
@@ -112,14 +131,9 @@ def _build(args) -> int:
         limits=replace(LIMITS, max_depth=args.max_depth, max_shapes=args.max_shapes),
         asset_roots=tuple(args.assets),
     )
-    bar = None
-    if not args.quiet:
-        from tqdm import tqdm
-
-        bar = tqdm(unit=" lots", desc="deriving", disable=None, dynamic_ncols=True, leave=False)
+    bar = _ProgressBar() if not args.quiet else None
     try:
-        result = build(args.grammar, args.emit, lots_path=args.lots, options=options,
-                       progress=bar.update if bar is not None else None)
+        result = build(args.grammar, args.emit, lots_path=args.lots, options=options, progress=bar)
     finally:
         if bar is not None:
             bar.close()

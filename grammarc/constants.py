@@ -16,16 +16,14 @@ class Tol:
     #: Footprints come in metres; 1e-9 m is far below any modelled feature and above float64 noise
     #: of coordinates up to ~1e6 m.
     zero: float = 1e-9
-    #: Split sizes may overshoot the scope by this relative amount before the last part is clipped:
-    #: sums of floats like 0.1 + 0.2 must not create a sliver part.
-    split: float = 1e-9
     #: Lot rings: consecutive vertices closer than this are merged (duplicate points in GIS data).
     merge: float = 1e-7
     #: Lots with a smaller area (m^2) are reported as bad lots: they cannot carry a building.
     area_floor: float = 1e-6
     #: A footprint is its own scope rectangle when its area differs from sx*sz by less than this
-    #: relative amount; such lots take the box fast path.
-    rect: float = 1e-9
+    #: relative amount; such lots take the box fast path. Map coordinates far from the origin carry
+    #: ~1e-11 relative rounding, which a long thin lot's lever arm multiplies by its aspect ratio.
+    rect: float = 1e-7
     #: Probabilities of a stochastic rule must sum to 1 within this.
     probability: float = 1e-6
 

@@ -64,14 +64,7 @@ class Executor:
             return
         counts = self.chunk.shape_count
         counts += np.bincount(shapes.lot, minlength=len(counts))
-        worst = int(np.argmax(counts))
-        if counts[worst] > self.limits.max_shapes:
-            rule = self.plan.symbols[where.symbol].name
-            raise LimitError(
-                f"lot {self.chunk.lot_ids[worst]} made more than {self.limits.max_shapes:,} shapes; the "
-                f"last were made by rule `{rule}` at {span}: a runaway grammar? "
-                "Raise the limit with --max-shapes N."
-            )
+        self.check_shape_limit(counts, where, span)
         if counts.sum() > self.chunk_budget and len(counts) > 1:
             raise ChunkTooLarge()
 
@@ -211,47 +204,54 @@ class Executor:
             self.fail(cursor, bad, f"`Subdiv` has a negative or NaN size ({_example(values, bad)})", where,
                       op.span)
         relative = np.array([s.kind is ir.SizeKind.RELATIVE for s in op.sizes])
-        cell = np.zeros(len(cursor), dtype=np.int64)
-        shapes = cursor
-        last = len(op.axes) - 1
-        for level, axis in enumerate(op.axes):
-            self.check_splittable(shapes, axis, where, op.span)
+
+        def cut(shapes: Shapes, level: int, axis: int):
+            nonlocal values
             parent, part, pos, length = split_kernels.subdiv(
                 np.ascontiguousarray(shapes.size[:, axis]), values, relative, TOL.zero
             )
-            cell = cell[parent] + part * len(op.sizes) ** level
             if values.shape[0] > 1:
-                values = values[parent]
-            if level == last:
-                shapes, offsets = self.grouped_children(shapes, axis, parent, cell, pos, length, op.site,
-                                                        len(op.parts))
-            else:
-                shapes = self.children(shapes, axis, parent, cell, pos, length, op.site)
-        self.count(shapes, where, op.span)
-        self.run_parts(op.parts, shapes, offsets, where)
+                values = values[parent]  # the next axis' sizes follow the children
+            return parent, part * len(op.sizes) ** level, pos, length
+
+        self.fan_out(op, cursor, where, cut)
 
     def repeat(self, op: ir.Repeat, cursor: Shapes, where: Where) -> None:
         env = self.env(cursor)
         sizes = [evaluate_array(e, env) for e in op.sizes]
-        shapes = cursor
-        cell = np.zeros(len(cursor), dtype=np.int64)
         stride = np.ones(len(cursor), dtype=np.int64)
-        last = len(op.axes) - 1
-        for level, axis in enumerate(op.axes):
+
+        def cut(shapes: Shapes, level: int, axis: int):
+            nonlocal sizes, stride
             size = sizes[level]
             bad = ~(size > 0)
             if bad.any():
                 self.fail(shapes, bad, f"`Repeat` needs a positive size, got {size[bad][0]:g}", where,
                           op.span)
-            self.check_splittable(shapes, axis, where, op.span)
             extent = np.ascontiguousarray(shapes.size[:, axis])
             counts = split_kernels.repeat_counts(extent, size, TOL.zero)
             self.check_fan_out(shapes, counts, where, op.span)
             parent, part, pos, length = split_kernels.repeat(extent, counts)
-            cell = cell[parent] + part * stride[parent]
+            step = part * stride[parent]
             stride = stride[parent] * counts[parent]
             sizes = [s[parent] for s in sizes]  # the next axes' sizes follow the children
-            if level == last:
+            return parent, step, pos, length
+
+        self.fan_out(op, cursor, where, cut)
+
+    def fan_out(self, op: ir.Split | ir.Repeat, cursor: Shapes, where: Where, cut) -> None:
+        """Split ``cursor`` along each of ``op.axes`` in turn and run the parts on the cells.
+
+        ``cut(shapes, level, axis)`` returns the children of one axis as (parent, cell step, position,
+        length); a cell's number adds up the steps, the first axis varying fastest.
+        """
+        shapes = cursor
+        cell = np.zeros(len(cursor), dtype=np.int64)
+        for level, axis in enumerate(op.axes):
+            self.check_splittable(shapes, axis, where, op.span)
+            parent, step, pos, length = cut(shapes, level, axis)
+            cell = cell[parent] + step
+            if level == len(op.axes) - 1:
                 shapes, offsets = self.grouped_children(shapes, axis, parent, cell, pos, length, op.site,
                                                         len(op.parts))
             else:
@@ -262,14 +262,17 @@ class Executor:
     def check_fan_out(self, shapes: Shapes, counts: np.ndarray, where: Where, span) -> None:
         """Refuse a repeat that would exceed --max-shapes before allocating its children."""
         per_lot = np.bincount(shapes.lot, weights=counts, minlength=len(self.chunk.shape_count))
-        total = per_lot + self.chunk.shape_count
-        worst = int(np.argmax(total))
-        if total[worst] > self.limits.max_shapes:
+        self.check_shape_limit(per_lot + self.chunk.shape_count, where, span)
+
+    def check_shape_limit(self, counts: np.ndarray, where: Where, span) -> None:
+        """LimitError naming the rule if a lot's shape count (made or about to be) exceeds --max-shapes."""
+        worst = int(np.argmax(counts))
+        if counts[worst] > self.limits.max_shapes:
             rule = self.plan.symbols[where.symbol].name
             raise LimitError(
-                f"`Repeat` at {span} in rule `{rule}` would make {int(total[worst]):,} shapes on lot "
-                f"{self.chunk.lot_ids[worst]} (--max-shapes {self.limits.max_shapes:,}); raise the limit "
-                "with --max-shapes N"
+                f"lot {self.chunk.lot_ids[worst]} makes more than {self.limits.max_shapes:,} shapes "
+                f"({int(counts[worst]):,}) in rule `{rule}` at {span}: a runaway grammar? "
+                "Raise the limit with --max-shapes N."
             )
 
     def check_splittable(self, shapes: Shapes, axis: int, where: Where, span) -> None:
@@ -284,20 +287,24 @@ class Executor:
             self.fail(shapes, bad, f"splitting a non-rectangular polygon along {'XYZ'[axis]} is not "
                       "supported yet (only along its extrusion axis)", where, span)
 
-    def children(self, shapes: Shapes, axis: int, parent, index, pos, length, site: int) -> Shapes:
-        """Children of a split along ``axis``: the parent's scope moved by ``pos`` and cut to ``length``."""
-        origin, size, key = scope_kernels.place_children(
-            shapes.origin, shapes.size, shapes.key, shapes.frame, self.chunk.frames.data, axis, parent,
-            pos, length, site, index,
+    def children(self, shapes: Shapes, axis: int, parent, index, pos, length, site: int,
+                 order=None) -> Shapes:
+        """Children of a split along ``axis``: the parent's scope moved by ``pos`` and cut to ``length``.
+
+        ``order`` (default: as given) picks and orders the children.
+        """
+        if order is None:
+            order = np.arange(len(parent))
+        origin, size, key, frame, geom, lot, depth, parents = scope_kernels.place_children(
+            shapes.origin, shapes.size, shapes.key, shapes.frame, shapes.geom, shapes.lot, shapes.depth,
+            self.chunk.frames.data, axis, order, parent, pos, length, site, index,
         )
-        return Shapes(origin, size, shapes.frame[parent], shapes.geom[parent], shapes.lot[parent], key,
-                      shapes.depth[parent], tuple(p[parent] for p in shapes.params))
+        return Shapes(origin, size, frame, geom, lot, key, depth, tuple(p[parents] for p in shapes.params))
 
     def grouped_children(self, shapes, axis, parent, cell, pos, length, site, n_parts):
         """``children`` ordered by body part (cell mod parts): each part's batch is then a slice."""
-        order, offsets = group_by(cell % n_parts, n_parts)
-        children = self.children(shapes, axis, parent[order], cell[order], pos[order], length[order], site)
-        return children, offsets
+        order, offsets = group_by(cell % n_parts if n_parts > 1 else np.zeros_like(cell), n_parts)
+        return self.children(shapes, axis, parent, cell, pos, length, site, order), offsets
 
     def run_parts(self, parts: tuple[ir.Body, ...], shapes: Shapes, offsets: np.ndarray, where) -> None:
         for i, body in enumerate(parts):

@@ -50,6 +50,51 @@ def _cross(a, b):
 
 
 @njit(cache=True)
+def _edge(coords, j, r0, count, a, b, size_row):
+    """Ring edge from vertex j to its successor in local coordinates: start p (3,), unit direction and
+    length (the direction is zero for a zero-length edge)."""
+    k = r0 + (j - r0 + 1) % count
+    p = np.zeros(3)
+    d = np.zeros(3)
+    p[a] = coords[j, 0] * size_row[a]
+    p[b] = coords[j, 1] * size_row[b]
+    d[a] = coords[k, 0] * size_row[a] - p[a]
+    d[b] = coords[k, 1] * size_row[b] - p[b]
+    length = np.sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2])
+    if length > 0.0:
+        d = d / length
+    return p, d, length
+
+
+@njit(cache=True)
+def _put(out, m, i, o, x, y, z, s, code):
+    """Write component m: parent i, origin o, axes x, y, z (rows), size s (3,), geometry code."""
+    parent, origin, axes, csize, poly = out
+    parent[m] = i
+    origin[m] = o
+    axes[m, 0] = x
+    axes[m, 1] = y
+    axes[m, 2] = z
+    csize[m] = s
+    poly[m] = code
+    return m + 1
+
+
+@njit(cache=True)
+def _sizes(sx, sy):
+    s = np.zeros(3)
+    s[0] = sx
+    s[1] = sy
+    return s
+
+
+@njit(cache=True)
+def _cap_size(size_row, a, b):
+    """Size of a top or bottom face: the polygon's two in-plane extents."""
+    return _sizes(size_row[a], size_row[b])
+
+
+@njit(cache=True)
 def _count(kind, n_edges, volume):
     if volume:
         if kind == 0:
@@ -94,6 +139,7 @@ def components(kind, coords, ring_offsets, shape_offsets, plane, size, tol):
     axes = np.zeros((total, 3, 3))
     csize = np.zeros((total, 3))
     poly = np.zeros(total, np.int8)
+    out = (parent, origin, axes, csize, poly)
     m = 0
     for i in range(n):
         a, b, nrm = _axes_of(plane[i])
@@ -106,135 +152,57 @@ def components(kind, coords, ring_offsets, shape_offsets, plane, size, tol):
         bvec = np.zeros(3)
         bvec[b] = 1.0
         first = m
-        # Faces: bottom, sides, top (volumes) or the face itself (flat shapes).
         if kind == 0 and not volume:
-            axes[m] = np.eye(3)
-            csize[m] = size[i]
-            poly[m] = SAME_POLY
-            parent[m] = i
-            m += 1
+            # a flat shape's only face is itself
+            e = np.eye(3)
+            m = _put(out, m, i, np.zeros(3), e[0], e[1], e[2], size[i], SAME_POLY)
         if volume and (kind == 0 or kind == 3):
-            # bottom: z = -n, x = a, y = z cross x
-            z = -nvec
-            y = _cross(z, avec)
-            axes[m, 0] = avec
-            axes[m, 1] = y
-            axes[m, 2] = z
-            if y[b] < 0:
-                origin[m] = bvec * size[i, b]
-            csize[m, 0] = size[i, a]
-            csize[m, 1] = size[i, b]
-            poly[m] = BOTTOM_POLY
-            parent[m] = i
-            m += 1
+            # bottom: z = -n, x = a, y = z cross x; origin keeps the polygon in the positive quadrant
+            y = _cross(-nvec, avec)
+            o = bvec * size[i, b] if y[b] < 0 else np.zeros(3)
+            m = _put(out, m, i, o, avec, y, -nvec, _cap_size(size[i], a, b), BOTTOM_POLY)
         for ring in range(shape_offsets[i], shape_offsets[i + 1]):
             r0 = ring_offsets[ring]
-            r1 = ring_offsets[ring + 1]
-            count = r1 - r0
-            for j in range(r0, r1):
-                k = r0 + (j - r0 + 1) % count
-                p = np.zeros(3)
-                q = np.zeros(3)
-                p[a] = coords[j, 0] * size[i, a]
-                p[b] = coords[j, 1] * size[i, b]
-                q[a] = coords[k, 0] * size[i, a]
-                q[b] = coords[k, 1] * size[i, b]
-                d = q - p
-                length = np.sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2])
+            count = ring_offsets[ring + 1] - r0
+            for j in range(r0, r0 + count):
+                p, d, length = _edge(coords, j, r0, count, a, b, size[i])
                 if length <= tol:
                     continue
-                d = d / length
-                out = _cross(d, nvec)
+                outward = _cross(d, nvec)
                 if volume and (kind == 0 or kind == 1):
-                    axes[m, 0] = d
-                    axes[m, 1] = nvec
-                    axes[m, 2] = out
-                    origin[m] = p
-                    csize[m, 0] = length
-                    csize[m, 1] = h
-                    parent[m] = i
-                    m += 1
+                    m = _put(out, m, i, p, d, nvec, outward, _sizes(length, h), RECT)
                 if kind == 4 or (kind == 7 and volume):
-                    axes[m, 0] = d
-                    axes[m, 1] = nvec
-                    axes[m, 2] = out
-                    origin[m] = p
-                    csize[m, 0] = length
-                    parent[m] = i
-                    m += 1
+                    m = _put(out, m, i, p, d, nvec, outward, _sizes(length, 0.0), RECT)
                 if kind == 8:
-                    axes[m, 0] = d
-                    axes[m, 1] = nvec
-                    axes[m, 2] = out
-                    origin[m] = p
-                    parent[m] = i
-                    m += 1
+                    m = _put(out, m, i, p, d, nvec, outward, _sizes(0.0, 0.0), RECT)
         if volume and (kind == 4 or kind == 6 or kind == 8):
-            # The top ring: ring edges (or vertices) lifted by the extrusion height.
+            # the top ring: ring edges (or vertices) lifted by the extrusion height
             for ring in range(shape_offsets[i], shape_offsets[i + 1]):
                 r0 = ring_offsets[ring]
-                r1 = ring_offsets[ring + 1]
-                count = r1 - r0
-                for j in range(r0, r1):
-                    k = r0 + (j - r0 + 1) % count
-                    p = np.zeros(3)
-                    q = np.zeros(3)
-                    p[a] = coords[j, 0] * size[i, a]
-                    p[b] = coords[j, 1] * size[i, b]
-                    q[a] = coords[k, 0] * size[i, a]
-                    q[b] = coords[k, 1] * size[i, b]
-                    d = q - p
-                    length = np.sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2])
+                count = ring_offsets[ring + 1] - r0
+                for j in range(r0, r0 + count):
+                    p, d, length = _edge(coords, j, r0, count, a, b, size[i])
                     if length <= tol:
                         continue
-                    d = d / length
-                    axes[m, 0] = d
-                    axes[m, 1] = nvec
-                    axes[m, 2] = _cross(d, nvec)
-                    origin[m] = p + nvec * h
-                    if kind != 8:
-                        csize[m, 0] = length
-                    parent[m] = i
-                    m += 1
+                    edge_length = length if kind != 8 else 0.0
+                    m = _put(out, m, i, p + nvec * h, d, nvec, _cross(d, nvec), _sizes(edge_length, 0.0),
+                             RECT)
         if volume and (kind == 4 or kind == 5):
+            # side edges: x up the extrusion, z the outward normal of the side face starting there
             for ring in range(shape_offsets[i], shape_offsets[i + 1]):
                 r0 = ring_offsets[ring]
-                r1 = ring_offsets[ring + 1]
-                count = r1 - r0
-                for j in range(r0, r1):
-                    k = r0 + (j - r0 + 1) % count
-                    p = np.zeros(3)
-                    q = np.zeros(3)
-                    p[a] = coords[j, 0] * size[i, a]
-                    p[b] = coords[j, 1] * size[i, b]
-                    q[a] = coords[k, 0] * size[i, a]
-                    q[b] = coords[k, 1] * size[i, b]
-                    d = q - p
-                    length = np.sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2])
+                count = ring_offsets[ring + 1] - r0
+                for j in range(r0, r0 + count):
+                    p, d, length = _edge(coords, j, r0, count, a, b, size[i])
                     if length <= tol:
                         continue
-                    out = _cross(d / length, nvec)
-                    axes[m, 0] = nvec
-                    axes[m, 1] = _cross(out, nvec)
-                    axes[m, 2] = out
-                    origin[m] = p
-                    csize[m, 0] = h
-                    parent[m] = i
-                    m += 1
+                    outward = _cross(d, nvec)
+                    m = _put(out, m, i, p, nvec, _cross(outward, nvec), outward, _sizes(h, 0.0), RECT)
         if volume and (kind == 0 or kind == 2):
-            # top: z = n, x = a, y = z cross x; origin keeps the polygon in the positive quadrant.
+            # top: z = n, x = a, y = z cross x
             y = _cross(nvec, avec)
-            axes[m, 0] = avec
-            axes[m, 1] = y
-            axes[m, 2] = nvec
-            origin[m] = nvec * h
-            if y[b] < 0:
-                origin[m] += bvec * size[i, b]
-            csize[m, 0] = size[i, a]
-            csize[m, 1] = size[i, b]
-            poly[m] = TOP_POLY
-            parent[m] = i
-            m += 1
+            o = nvec * h + (bvec * size[i, b] if y[b] < 0 else np.zeros(3))
+            m = _put(out, m, i, o, avec, y, nvec, _cap_size(size[i], a, b), TOP_POLY)
         for c in range(first, m):
             index[c] = c - first
     return parent[:m], index[:m], origin[:m], axes[:m], csize[:m], poly[:m]

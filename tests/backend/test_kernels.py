@@ -194,23 +194,29 @@ def test_place_children(n, axis):
     frames = random_frames(rng, 4)
     origin = rng.normal(size=(n, 3)) * 10
     size = rng.uniform(1, 10, (n, 3))
-    key = rng.integers(0, 2**63, n, dtype=np.uint64) * np.uint64(2) + np.uint64(1)
-    frame = rng.integers(0, 4, n).astype(np.int32)
+    key = rng.integers(0, 2**64, n, dtype=np.uint64)
+    frame, geom, lot, depth = (rng.integers(lo, 4, n).astype(np.int32) for lo in (0, -1, 0, 0))
     m = 3 * n
     parent = np.sort(rng.integers(0, max(n, 1), m)) if n else np.zeros(0, np.int64)
     pos = rng.uniform(0, 5, m)
     length = rng.uniform(0.1, 5, m)
     index = rng.integers(0, 9, m).astype(np.int64)
+    order = rng.permutation(m).astype(np.int64)
     site = 7
-    out_origin, out_size, out_key = place_children(origin, size, key, frame, frames, axis, parent, pos,
-                                                   length, site, index)
-    want_origin = origin[parent] + pos[:, None] * frames[frame[parent], axis]
-    want_size = size[parent].copy()
-    want_size[:, axis] = length
+    out = place_children(origin, size, key, frame, geom, lot, depth, frames, axis, order, parent, pos,
+                         length, site, index)
+    out_origin, out_size, out_key, out_frame, out_geom, out_lot, out_depth, out_parent = out
+    p = parent[order]
+    want_origin = origin[p] + pos[order, None] * frames[frame[p], axis]
+    want_size = size[p].copy()
+    want_size[:, axis] = length[order]
     np.testing.assert_allclose(out_origin, want_origin, rtol=1e-14, atol=1e-12)
     assert np.array_equal(out_size, want_size)
     assert out_key.dtype == np.uint64
-    assert np.array_equal(out_key, child_keys(key[parent], site, index))
+    assert np.array_equal(out_key, child_keys(key[p], site, index[order]))
+    assert out_parent.dtype == np.int64 and np.array_equal(out_parent, p)
+    for got, column in ((out_frame, frame), (out_geom, geom), (out_lot, lot), (out_depth, depth)):
+        assert got.dtype == np.int32 and np.array_equal(got, column[p])
 
 
 @pytest.mark.parametrize("n", SIZES)

@@ -9,6 +9,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 from conftest import LOT_ZOO
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from grammarc.geometry.footprint import footprint_polygons, lot_scopes
 from grammarc.io.lots import lots_from_polygons
@@ -180,3 +182,18 @@ def test_one_lot(name):
     i = ZOO.index(name)
     for a, b in zip(alone[:3], together[:3]):
         np.testing.assert_allclose(a[0], b[i], atol=1e-12)
+
+
+@settings(max_examples=40, deadline=None)
+@given(w=st.floats(0.5, 200), h=st.floats(0.5, 200), degrees=st.floats(-180, 180),
+       sx=st.floats(-1e5, 1e5), sy=st.floats(-1e5, 1e5))
+def test_any_rotated_rectangle_is_a_rect_of_its_size(w, h, degrees, sx, sy):
+    ring = np.array([[0, 0], [w, 0], [w, h], [0, h]], float)
+    lots = lots_from_polygons([rotated([ring], degrees, (sx, sy))])
+    _, axes, size, local = lot_scopes(lots)
+    # rounding of coordinates near 1e5 m (ulp ~1.5e-11), times the lever arm of a 0.5 x 200 lot
+    np.testing.assert_allclose(size[0], [w, 0, h], rtol=1e-9, atol=1e-8)
+    np.testing.assert_allclose(axes[0] @ axes[0].T, np.eye(3), atol=1e-12)
+    assert np.linalg.det(axes[0]) == pytest.approx(1.0)
+    assert footprint_polygons(lots, size, local)[0].tolist() == [True]
+    assert np.all(local[:, [0, 2]] >= -1e-9 * max(w, h))

@@ -13,27 +13,41 @@ from grammarc.backend.random import mix1
 
 
 @njit(cache=True)
-def place_children(origin, size, key, frame, frames, axis, parent, pos, length, site, index):
-    """Scopes and keys of split children.
+def place_children(origin, size, key, frame, geom, lot, depth, frames, axis, order, parent, pos, length,
+                   site, index):
+    """Columns of split children, in the order ``order`` (children grouped by body part).
 
-    origin, size : (n, 3) float64 parents' scopes; key : (n,) uint64; frame : (n,) int32 into
-    frames : (F, 3, 3) float64; axis : int; parent : (m,) int64; pos, length : (m,) float64 the
-    children's offset and size along ``axis``; site : int; index : (m,) int64 the child's number.
-    Returns child origin (m, 3), size (m, 3) and key (m,) uint64, allocated here.
+    Parents: origin, size (n, 3) float64; key (n,) uint64; frame, geom, lot, depth (n,) int32; frames
+    (F, 3, 3) float64 the frame table; axis: int. Children, as the split kernel made them: parent (m,)
+    int64, pos and length (m,) float64 (offset and size along ``axis``), index (m,) int64 (the child's
+    number, for its key); order (m,) int64 picks them. site: int.
+    Returns origin (m, 3), size (m, 3), key (m,) uint64, frame, geom, lot, depth (m,) int32 and the
+    parent of each placed child (m,) int64, all allocated here.
     """
-    m = len(parent)
+    m = len(order)
     out_origin = np.empty((m, 3))
     out_size = np.empty((m, 3))
     out_key = np.empty(m, np.uint64)
+    out_frame = np.empty(m, np.int32)
+    out_geom = np.empty(m, np.int32)
+    out_lot = np.empty(m, np.int32)
+    out_depth = np.empty(m, np.int32)
+    out_parent = np.empty(m, np.int64)
     for c in range(m):
-        p = parent[c]
+        k = order[c]
+        p = parent[k]
         f = frame[p]
         for j in range(3):
-            out_origin[c, j] = origin[p, j] + pos[c] * frames[f, axis, j]
+            out_origin[c, j] = origin[p, j] + pos[k] * frames[f, axis, j]
             out_size[c, j] = size[p, j]
-        out_size[c, axis] = length[c]
-        out_key[c] = mix1(mix1(key[p], site), index[c])
-    return out_origin, out_size, out_key
+        out_size[c, axis] = length[k]
+        out_key[c] = mix1(mix1(key[p], site), index[k])
+        out_frame[c] = f
+        out_geom[c] = geom[p]
+        out_lot[c] = lot[p]
+        out_depth[c] = depth[p]
+        out_parent[c] = p
+    return out_origin, out_size, out_key, out_frame, out_geom, out_lot, out_depth, out_parent
 
 
 @njit(cache=True)
