@@ -50,8 +50,9 @@ def _parser() -> argparse.ArgumentParser:
     build.add_argument("--attr", action="append", default=[], metavar="NAME=VALUE",
                        help="override an attribute for every lot (repeatable)")
     build.add_argument("--start", metavar="SYMBOL", help="start symbol (default: the first rule's)")
-    build.add_argument("--chunk-size", type=_positive, default=256, metavar="N",
-                       help="lots derived together (default 256); the output does not depend on it")
+    build.add_argument("--chunk-size", type=_positive, default=4096, metavar="N",
+                       help="at most N lots derived together (default 4096; fewer when lots make many "
+                            "records); the output does not depend on it")
     build.add_argument("--max-depth", type=_positive, default=LIMITS.max_depth, metavar="N",
                        help=f"rule applications along one path (default {LIMITS.max_depth})")
     build.add_argument("--max-shapes", type=_positive, default=LIMITS.max_shapes, metavar="N",

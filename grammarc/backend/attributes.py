@@ -65,31 +65,45 @@ def attribute_columns(module: ir.Module, env: Env, lot_attrs: dict[str, np.ndarr
 
 
 def _from_lots(attr: ir.AttrDecl, values: np.ndarray, column: np.ndarray, strings, env) -> np.ndarray:
+    """``column`` with the lots' own values where they have one; text is converted once per distinct
+    value, not once per lot."""
     if values.dtype != object:
         given = ~np.isnan(values)
         if attr.type is T.STR:
-            column[given] = [strings.intern(f"{v:g}") for v in values[given]]
+            column[given] = _per_distinct(values[given], lambda v: strings.intern(f"{v:g}"))
         else:
             column[given] = values[given] if attr.type is T.NUM else values[given] != 0
         return column
-    given = np.array([v is not None for v in values], dtype=bool)
+    given = values != None  # noqa: E711 - elementwise comparison on an object array
     if attr.type is T.STR:
-        column[given] = [strings.intern(v) for v in values[given]]
+        column[given] = _per_distinct(values[given], strings.intern)
         return column
     parsed = np.full(len(values), np.nan)
-    bad = np.zeros(len(values), dtype=bool)
-    for i in np.flatnonzero(given):
-        text = values[i].strip()
-        if attr.type is T.BOOL and text in ("true", "false"):
-            parsed[i] = text == "true"
-            continue
-        try:
-            parsed[i] = float(text)
-        except ValueError:
-            bad[i] = True
+    parsed[given] = _per_distinct(values[given], lambda text: _number(text, attr.type))
+    bad = given & np.isnan(parsed)
     if bad.any():
         first = np.flatnonzero(bad)[0]
         raise LotFailure(f"attribute `{attr.name}` is \"{values[first]}\", not a {attr.type.value}",
                          np.flatnonzero(bad))
     column[given] = parsed[given] if attr.type is T.NUM else parsed[given] != 0
     return column
+
+
+def _number(text: str, want: ir.Type) -> float:
+    """A lot's text value as a number (``true``/``false`` for booleans); NaN when it is not one."""
+    text = text.strip()
+    if want is T.BOOL and text in ("true", "false"):
+        return float(text == "true")
+    try:
+        return float(text)
+    except ValueError:
+        return float("nan")
+
+
+def _per_distinct(values: np.ndarray, convert) -> np.ndarray:
+    """``convert`` applied to each distinct value of ``values`` (k,), spread back to all k."""
+    if not len(values):
+        return np.zeros(0)
+    distinct, inverse = np.unique(values.astype(str) if values.dtype == object else values,
+                                  return_inverse=True)
+    return np.array([convert(v) for v in distinct])[inverse.reshape(-1)]

@@ -9,6 +9,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from grammarc.constants import STRICT
 from grammarc.geometry.polygons import PolygonStore
 
 
@@ -22,6 +23,11 @@ class Frames:
     def add(self, axes: np.ndarray) -> np.ndarray:
         """Append frames (m, 3, 3); returns their ids (m,) int32."""
         m = len(axes)
+        if STRICT and m:
+            # frames stay orthonormal and right-handed through rotations and component splits
+            gram = np.einsum("mij,mkj->mik", axes, axes)
+            assert np.allclose(gram, np.eye(3), atol=1e-9), "a scope frame is not orthonormal"
+            assert np.allclose(np.linalg.det(axes), 1.0, atol=1e-9), "a scope frame is left-handed"
         if self.count + m > len(self.data):
             grown = np.empty((max(2 * len(self.data), self.count + m), 3, 3))
             grown[: self.count] = self.data[: self.count]

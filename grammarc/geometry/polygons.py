@@ -18,6 +18,8 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
+from grammarc.constants import STRICT
+
 #: Scope axes spanned by (u, v) for each normal axis.
 PLANE_AXES = {0: (1, 2), 1: (0, 2), 2: (0, 1)}
 
@@ -37,6 +39,11 @@ class PolygonStore:
     def add(self, coords: np.ndarray, ring_offsets: np.ndarray, poly_offsets: np.ndarray,
             plane: np.ndarray) -> np.ndarray:
         """Append polygons given as ragged arrays (offsets from 0); returns their ids (k,) int32."""
+        if STRICT:
+            assert ring_offsets[0] == 0 and poly_offsets[0] == 0, "offsets must start at 0"
+            assert (np.diff(ring_offsets) >= 3).all(), "a ring has fewer than 3 vertices"
+            assert (np.diff(poly_offsets) >= 1).all(), "a polygon has no ring"
+            assert ring_offsets[-1] == len(coords) and poly_offsets[-1] == len(ring_offsets) - 1
         first = len(self.plane)
         self.ring_offsets = np.concatenate([self.ring_offsets, ring_offsets[1:] + len(self.coords)])
         self.poly_offsets = np.concatenate(

@@ -1,36 +1,57 @@
 """The terminal record ``instances.npz``: a streaming, atomic writer and its reader.
 
 A city's terminals (10^7-10^8 rows, gigabytes) arrive chunk by chunk from the derivation, and the writer must
-hold no more than one chunk in memory (DESIGN.md, invariant 3). ``np.savez`` needs every array whole, so the
-writer appends each column's raw bytes to a spool file instead and, on ``close()``, writes the npz member by
-member: the ``.npy`` header with the final shape, then the spooled bytes copied in fixed-size blocks.
+hold no more than a few chunks in memory (DESIGN.md, invariant 3). ``np.savez`` needs every array whole, so the
+writer builds the zip itself, as the rows arrive:
 
-The result is what ``np.savez`` writes (uncompressed, loadable by ``np.load(path)`` without pickles), except
-that it is reproducible: zip entries carry a fixed date and mode, and the bytes depend only on the rows, not on
-how they were chunked, so example cities can keep hashes of their output (STYLE.md, "Replay before you
-refactor").
+* ``xform`` (48 of the 60 bytes of a row) is written once, straight into the output: it is the first member of
+  the file, its local header and ``.npy`` header are written up front with a placeholder shape and sizes of fixed
+  width, each chunk's bytes are appended behind them, and ``close()`` patches the headers in place. Its CRC is
+  kept running over the data and combined with the CRC of the final ``.npy`` header (``_crc32_combine``).
+* The other columns (12 bytes a row, and the mesh table) are appended to spool files, their CRCs kept running,
+  and ``close()`` copies each spool behind the others in the kernel (``os.copy_file_range``) and unlinks it.
+* ``write()`` validates the chunk and hands its columns to one background thread that does the file I/O
+  (through a queue two chunks deep, so the derivation overlaps the writes and memory stays bounded). The
+  arrays are not copied: the caller must not modify them after ``write()``.
+* Where it can (Linux), the thread starts the writeback of the streamed data as it goes and drops the pages
+  already written back (``posix_fadvise(DONTNEED)``), so the final fsync has little left to write and the
+  output does not fill the page cache.
+
+Zip readers find members through the central directory, which lists them in the order of the record's table
+(``_KEYS``), whatever their order in the file. Members are stored (no compression) with zip64 local headers,
+as ``np.savez`` writes them, so ``np.load(path)`` reads the file without pickles. The bytes are reproducible:
+entries carry a fixed date and mode, and the bytes depend only on the rows, not on how they were chunked, so
+example cities can keep hashes of their output (STYLE.md, "Replay before you refactor"). Outputs of the writer
+before xform was streamed (which went through ``zipfile``, members in key order) hold the same arrays, but
+their bytes differ: xform now comes first in the file.
 
 An output is complete or absent (invariant 5). Everything is written under a temporary directory next to the
-output (``.<name>.tmp*``, so on the same filesystem), fsynced, and moved into place with ``os.replace``.
-``abort()``, an exception inside ``with``, a failed write or a writer dropped without ``close()`` removes the
-temporaries and leaves a file already at the output path untouched.
+output (``.<name>.tmp*``, so on the same filesystem), the output is fsynced and moved into place with
+``os.replace``. ``abort()``, an exception inside ``with``, a failed write (also one that fails later, in the
+background thread) or a writer dropped without ``close()`` stops the thread, removes the temporaries and leaves
+a file already at the output path untouched.
 """
 
 from __future__ import annotations
 
+import contextlib
+import errno
+import functools
 import json
 import os
+import queue
 import shutil
+import struct
 import tempfile
+import threading
 import weakref
-import zipfile
+import zlib
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING
 
 import numpy as np
-from numpy.lib import format as npy_format
 
 if TYPE_CHECKING:
     from typing_extensions import Self
@@ -38,11 +59,13 @@ if TYPE_CHECKING:
 __all__ = ["InstanceWriter", "MeshChunk", "TerminalChunk", "read_instances"]
 
 _FORMAT = "grammarc.instances/1"
-_BLOCK = 16 << 20  # bytes per copy from a spool file into the npz: bounds the memory of close()
+_FADVISE = hasattr(os, "posix_fadvise")  # Linux: DONTNEED starts the writeback of a range, drops clean pages
+_QUEUE_DEPTH = 2  # chunks waiting for the background thread: bounds the memory of write()
+_BLOCK = 16 << 20  # bytes per copy call from a spool into the npz (and the buffer of the fallback copy)
 _ZIP_DATE = (1980, 1, 1, 0, 0, 0)  # the earliest date zip can store; fixed so that runs are byte-identical
 
-# Columns spooled to disk: npz key -> (dtype, shape of one row). Offsets are spooled without their leading 0
-# and already rebased, so each has one row per ring or face and the member gets the 0 written in front.
+# Columns written by the background thread: npz key -> (dtype, shape of one row). Offsets are written without
+# their leading 0 and already rebased, so each has one row per ring or face and the member gets the 0 in front.
 _SPOOLED = {
     "asset": ("<i4", ()),
     "xform": ("<f4", (3, 4)),
@@ -55,7 +78,10 @@ _SPOOLED = {
     "mesh_symbol": ("<i4", ()),
 }
 _OFFSETS = ("mesh_ring_offsets", "mesh_face_offsets")
-# Member order in the file: the record's table in DESIGN.md, then the mesh table.
+# The column written straight into the output, as its first member; the others are spooled.
+_STREAMED = "xform"
+# Central directory order, the order of np.load(path).files: the record's table in DESIGN.md, then the mesh
+# table. In the file, xform comes first and the others follow in this order.
 _KEYS = (
     "assets", "asset", "xform", "lot", "symbols", "symbol", "meta",
     "mesh_vertices", "mesh_ring_offsets", "mesh_face_offsets", "mesh_lot", "mesh_symbol",
@@ -152,6 +178,10 @@ class TerminalChunk:
 class InstanceWriter:
     """Streams TerminalChunks into an .npz; the output appears complete on close() or not at all.
 
+    The file I/O runs in a background thread, so the caller derives the next chunk while the last ones are
+    written. ``write()`` does not copy the chunk's arrays: it keeps them until they are written, so the caller
+    must not modify them after ``write()`` (``derive_chunk`` allocates fresh arrays for every chunk).
+
     Parameters
     ----------
     path : str or os.PathLike
@@ -194,20 +224,16 @@ class InstanceWriter:
         self._rows = dict.fromkeys(_SPOOLED, 0)
         self._counts: dict[str, int] = {}
         self._state = "open"
-        self._tmpdir = tempfile.mkdtemp(prefix=f".{self.path.name}.tmp", dir=self.path.parent)
-        self._spools: dict = {}
-        # Removes the temporaries on abort(), after close(), or when a writer is dropped unclosed.
-        self._cleanup = weakref.finalize(self, _remove_temporaries, self._spools, self._tmpdir)
-        try:
-            for key in _SPOOLED:
-                # Open until close() or abort(), which close them through self._cleanup.
-                self._spools[key] = open(os.path.join(self._tmpdir, key), "wb")  # noqa: SIM115
-        except BaseException:
-            self._cleanup()
-            raise
+        tmpdir = tempfile.mkdtemp(prefix=f".{self.path.name}.tmp", dir=self.path.parent)
+        self._sink = _Sink(tmpdir, self.path.name)  # removes tmpdir itself if it fails
+        # Stops the thread and removes the temporaries on abort(), after close(), or when a writer is dropped
+        # unclosed. Neither the sink nor its thread refers to the writer, so a dropped writer is collected.
+        self._cleanup = weakref.finalize(self, self._sink.discard)
 
     def write(self, chunk: TerminalChunk) -> None:
         """Append a chunk's rows; its mesh offsets are rebased onto the rows written before.
+
+        The rows are written in the background: keep the chunk's arrays unmodified after the call.
 
         Raises
         ------
@@ -215,6 +241,8 @@ class InstanceWriter:
             If the writer is closed or aborted, or a field of ``chunk`` has the wrong dtype or shape,
             inconsistent lengths, bad offsets or an asset or symbol index out of range. The writer is
             unchanged by a rejected chunk.
+        OSError
+            If writing an earlier chunk failed in the background; the writer has aborted.
         """
         if self._state != "open":
             raise ValueError(f"write to an InstanceWriter that is {self._state}")
@@ -222,23 +250,30 @@ class InstanceWriter:
         columns["mesh_ring_offsets"] = columns["mesh_ring_offsets"] + self._rows["mesh_vertices"]
         columns["mesh_face_offsets"] = columns["mesh_face_offsets"] + self._rows["mesh_ring_offsets"]
         try:
-            for key, column in columns.items():
-                # A byte view of the contiguous column: no copy on the way to the file.
-                self._spools[key].write(column.reshape(-1).view(np.uint8))
-                self._rows[key] += len(column)
+            self._sink.put(columns)
         except BaseException:
-            # The spools may now disagree on the rows written: this output cannot be completed.
+            # A failed or interrupted append: the columns may disagree on the rows written, so this output
+            # cannot be completed.
             self.abort()
             raise
+        for key, column in columns.items():
+            self._rows[key] += len(column)
 
     def close(self) -> dict:
-        """Write the npz next to the output, fsync it, and rename it onto ``path``.
+        """Finish the npz next to the output, fsync it, and rename it onto ``path``.
 
         Returns
         -------
         counts : dict
             ``{"instances": N, "mesh_faces": F, "mesh_vertices": V}``, as stored in ``meta["counts"]``.
             Closing again returns the same counts.
+
+        Raises
+        ------
+        ValueError
+            If the writer is aborted.
+        OSError
+            If a write failed, in the background or now; the writer has aborted and left ``path`` untouched.
         """
         if self._state == "closed":
             return dict(self._counts)
@@ -250,14 +285,7 @@ class InstanceWriter:
             "mesh_vertices": self._rows["mesh_vertices"],
         }
         try:
-            for spool in self._spools.values():
-                spool.close()
-            # Inside the temporary directory, so abort() removes it; created with the umask's permissions.
-            tmp = os.path.join(self._tmpdir, self.path.name)
-            with open(tmp, "xb") as out:
-                self._write_npz(out, counts)
-                out.flush()
-                os.fsync(out.fileno())
+            tmp = self._sink.finish(self._members(counts))
             os.replace(tmp, self.path)
         except BaseException:
             self.abort()
@@ -269,7 +297,10 @@ class InstanceWriter:
         return dict(counts)
 
     def abort(self) -> None:
-        """Remove every temporary; a file already at ``path`` is left untouched. No-op once closed."""
+        """Stop writing and remove every temporary; a file already at ``path`` is left untouched.
+
+        No-op once closed.
+        """
         if self._state == "open":
             self._state = "aborted"
             self._cleanup()
@@ -283,21 +314,23 @@ class InstanceWriter:
         else:
             self.abort()
 
-    def _write_npz(self, out, counts: dict) -> None:
-        """Write the record to the binary file ``out``, member by member, in the order of ``_KEYS``."""
+    def _members(self, counts: dict) -> dict[str, tuple[str, tuple, bytes]]:
+        """Each key, in ``_KEYS`` order, to its array's descr and shape and the bytes of its member that the
+        background thread did not write: all of them for an array in memory, the offsets' leading 0."""
         # Sorted keys: the bytes must not depend on the order in which meta was built.
         meta = json.dumps({**self._meta, "counts": counts, "format": _FORMAT}, sort_keys=True)
-        in_memory = {"assets": self._assets, "symbols": self._symbols, "meta": np.array(meta)}
-        with zipfile.ZipFile(out, "w", zipfile.ZIP_STORED, allowZip64=True) as zf:
-            for key in _KEYS:
-                if key in in_memory:
-                    array = in_memory[key]
-                    _write_member(zf, key, array.dtype, array.shape, array.tobytes())
-                    continue
+        arrays = {"assets": self._assets, "symbols": self._symbols, "meta": np.array(meta)}
+        members = {}
+        for key in _KEYS:
+            if key in arrays:
+                array = arrays[key]
+                members[key] = (_descr(array.dtype), array.shape, array.tobytes())
+            else:
                 dtype, row_shape = _SPOOLED[key]
                 rows = self._rows[key] + (key in _OFFSETS)
                 head = np.zeros(1, np.int64).tobytes() if key in _OFFSETS else b""
-                _write_member(zf, key, dtype, (rows, *row_shape), head, self._spools[key].name)
+                members[key] = (_descr(dtype), (rows, *row_shape), head)
+        return members
 
 
 def read_instances(path: str | os.PathLike) -> dict[str, np.ndarray | dict]:
@@ -401,33 +434,319 @@ def _check_index(field: str, index: np.ndarray, size: int) -> None:
         raise ValueError(f"{field}: index out of range [0, {size})")
 
 
-def _write_member(zf: zipfile.ZipFile, key: str, dtype, shape: tuple, head: bytes, spool: str = "") -> None:
-    """Write ``key.npy``: the .npy header of an array ``shape`` of ``dtype``, ``head``, the ``spool`` file."""
-    info = zipfile.ZipInfo(f"{key}.npy", date_time=_ZIP_DATE)
-    info.create_system = 3  # Unix, whatever the platform, so the bytes do not depend on it
-    info.external_attr = 0o644 << 16
-    header = {"descr": npy_format.dtype_to_descr(np.dtype(dtype)), "fortran_order": False, "shape": shape}
-    # force_zip64 as np.savez does: the size is not known to zipfile before the member is written.
-    with zf.open(info, "w", force_zip64=True) as member:
-        npy_format.write_array_header_1_0(member, header)
-        member.write(head)
-        if spool:
-            with open(spool, "rb") as source:
-                _copy(source, member)
+class _Sink:
+    """The files of one output and the thread that appends the chunks' columns to them.
+
+    A temporary directory holds the output (named as the final file) and a spool file per column but
+    ``_STREAMED``, whose bytes go straight into the output behind placeholder headers. ``put()`` queues a chunk's
+    columns and the thread writes them, keeping each column's byte count and CRC-32; ``finish()`` completes the
+    zip and ``discard()`` stops the thread and removes the directory. Nothing here refers to the writer, so a
+    writer dropped unclosed is collected and its finalizer calls ``discard()``.
+    """
+
+    def __init__(self, tmpdir: str, name: str):
+        self.tmpdir = tmpdir
+        self.path = os.path.join(tmpdir, name)
+        self._fds: dict[str, int] = {}  # open files: "" the output, a column's key its spool
+        self._crc = dict.fromkeys(_SPOOLED, 0)  # CRC-32 of each column's bytes so far
+        self._size = dict.fromkeys(_SPOOLED, 0)  # and their number
+        self._queue: queue.Queue = queue.Queue(_QUEUE_DEPTH)
+        self._error: BaseException | None = None  # the thread's failure, raised by put() or finish()
+        self._stop = False  # set by discard(): the thread drops what is queued and ends
+        self._remove_on_exit = False  # set by discard() run in the thread itself (by the garbage collector)
+        self._thread: threading.Thread | None = None
+        try:
+            self._fds[""] = _create(self.path)
+            for key in _SPOOLED:
+                if key != _STREAMED:
+                    self._fds[key] = _create(os.path.join(tmpdir, key))
+            # The streamed member's headers, for 0 rows: as wide as the final ones, which finish() writes over.
+            dtype, row_shape = _SPOOLED[_STREAMED]
+            header = _npy_header(_descr(dtype), (0, *row_shape))
+            head = _local_header(f"{_STREAMED}.npy".encode(), 0, 0) + header
+            _write_all(self._fds[""], head)
+            self._head_size = len(head)
+            # For _FADVISE: the output before _dropped is on disk, before _written on its way there.
+            self._dropped = self._written = 0
+            self._thread = threading.Thread(target=self._run, name=f"InstanceWriter {name}", daemon=True)
+            self._thread.start()
+        except BaseException:
+            self.discard()
+            raise
+
+    def put(self, columns: dict[str, np.ndarray]) -> None:
+        """Queue a chunk's columns for the thread, after raising its failure on an earlier chunk, if any.
+
+        Blocks while ``_QUEUE_DEPTH`` chunks wait. The arrays are written later, as they are then.
+        """
+        self._raise_error()
+        self._queue.put(columns)
+
+    def finish(self, members: dict[str, tuple[str, tuple, bytes]]) -> str:
+        """Write the rest of the zip after the streamed column, fsync it, and return its path.
+
+        ``members`` maps every key, in central directory order, to the ``.npy`` descr and shape of its array
+        and the bytes of the member before those written by the thread (all of them for an array held in
+        memory). Each spool is copied into the output in the kernel and unlinked.
+        """
+        self._join()
+        self._raise_error()
+        out = self._fds[""]
+        position = self._head_size + self._size[_STREAMED]  # where the file ends: after the streamed data
+        entries = []  # (name, crc, size, offset of the local header) of each member, in central order
+        for key, (descr, shape, body) in members.items():
+            header = _npy_header(descr, shape)
+            written = self._size.get(key, 0)
+            if len(body) + written != np.dtype(descr).itemsize * int(np.prod(shape)):
+                raise RuntimeError(f"{key}: {len(body) + written} bytes for an array {descr} {shape}")
+            size = len(header) + len(body) + written
+            crc = _crc32_combine(zlib.crc32(body, zlib.crc32(header)), self._crc.get(key, 0), written)
+            name = f"{key}.npy".encode()
+            local = _local_header(name, crc, size)
+            if key == _STREAMED:
+                head = local + header
+                if len(head) != self._head_size:
+                    raise RuntimeError(f"{key}: the final headers do not fit the space left for them")
+                entries.append((name, crc, size, 0))
+                continue
+            entries.append((name, crc, size, position))
+            _write_all(out, local + header + body)
+            if key in self._fds:
+                _copy_file(self._fds[key], out, written)
+                # Unlinked at once: its pages are freed, and if not written back yet, never will be.
+                os.close(self._fds.pop(key))
+                os.unlink(os.path.join(self.tmpdir, key))
+            position += len(local) + size
+        directory = b"".join(_central_header(*entry) for entry in entries)
+        _write_all(out, directory + _end_records(len(entries), position, len(directory)))
+        os.lseek(out, 0, os.SEEK_SET)
+        _write_all(out, head)
+        os.fsync(out)
+        os.close(self._fds.pop(""))
+        return self.path
+
+    def discard(self) -> None:
+        """Stop the thread, dropping what is queued, close the files and remove the directory."""
+        self._stop = True
+        if threading.current_thread() is self._thread:
+            # The garbage collector dropped the writer inside the thread: it removes the files as it ends.
+            self._remove_on_exit = True
+            with contextlib.suppress(queue.Full):
+                self._queue.put_nowait(None)  # in case it waits for a chunk: no writer will send one
+            return
+        if self._thread is not None and self._thread.is_alive():
+            while True:  # make room for the wake-up call, which must not block
+                try:
+                    self._queue.get_nowait()
+                except queue.Empty:
+                    break
+        self._join()
+        self._remove()
+
+    def _run(self) -> None:
+        """The thread: append queued columns until None (finish) or _stop (discard); keep its first error."""
+        while not self._stop:
+            columns = self._queue.get()
+            if columns is None or self._stop:
+                break
+            if self._error is None:  # after a failure, keep taking chunks so that put() never blocks
+                try:
+                    self._append(columns)
+                except BaseException as error:  # noqa: BLE001 - raised in the caller's thread by put(), finish()
+                    self._error = error
+            del columns  # hold no chunk while waiting for the next
+        if self._remove_on_exit:
+            self._remove()
+
+    def _append(self, columns: dict[str, np.ndarray]) -> None:
+        for key, column in columns.items():
+            data = column.reshape(-1).view(np.uint8)  # the bytes of the contiguous column, not a copy
+            if len(data):
+                self._crc[key] = zlib.crc32(data, self._crc[key])
+                _write_all(self._fds["" if key == _STREAMED else key], data)
+                self._size[key] += len(data)
+        end = self._head_size + self._size[_STREAMED]
+        if _FADVISE and end > self._written:
+            # Start writing the new streamed data to disk now, while the caller derives, rather than in the
+            # final fsync, and drop the pages of the previous chunk, written back by now: the output need not
+            # stay in memory, and new pages cost more system time than reused ones.
+            try:
+                os.posix_fadvise(self._fds[""], self._dropped, end - self._dropped, os.POSIX_FADV_DONTNEED)
+            except OSError:
+                pass  # advice only: this filesystem does not take it
+            self._dropped, self._written = self._written, end
+
+    def _join(self) -> None:
+        """Tell the thread to end once the queue is empty, and wait for it."""
+        if self._thread is not None and self._thread.is_alive():
+            self._queue.put(None)
+            self._thread.join()
+
+    def _raise_error(self) -> None:
+        if self._error is not None:
+            raise self._error
+
+    def _remove(self) -> None:
+        while self._fds:
+            os.close(self._fds.popitem()[1])
+        shutil.rmtree(self.tmpdir, ignore_errors=True)
 
 
-def _copy(source, target) -> None:
-    """Copy ``source`` to ``target`` through one reused buffer of ``_BLOCK`` bytes."""
-    buffer = memoryview(bytearray(_BLOCK))
-    while n := source.readinto(buffer):
-        target.write(buffer[:n])
+def _create(path: str) -> int:
+    """A new file at ``path``, open for reading and writing, with the umask's permissions."""
+    return os.open(path, os.O_RDWR | os.O_CREAT | os.O_EXCL | getattr(os, "O_BINARY", 0), 0o666)
 
 
-def _remove_temporaries(spools: dict, tmpdir: str) -> None:
-    """Close the spool files and delete the temporary directory with everything in it."""
-    for spool in spools.values():
-        spool.close()
-    shutil.rmtree(tmpdir, ignore_errors=True)
+def _write_all(fd: int, data) -> None:
+    """Write the bytes of the buffer ``data`` at the position of ``fd`` (os.write may write fewer)."""
+    view = memoryview(data).cast("B")
+    while view:
+        view = view[os.write(fd, view) :]
+
+
+# Errors of os.copy_file_range that mean "not between these files": copy through a buffer instead.
+_NO_COPY_RANGE = {errno.EXDEV, errno.ENOSYS, errno.EINVAL, errno.EPERM, errno.ETXTBSY, errno.EOPNOTSUPP}
+_NO_COPY_RANGE.add(getattr(errno, "ENOTSUP", errno.EOPNOTSUPP))
+
+
+def _copy_file(source: int, target: int, size: int) -> None:
+    """Append the first ``size`` bytes of file ``source`` at the position of ``target``.
+
+    In the kernel with ``os.copy_file_range`` (Linux): the bytes do not pass through Python. Elsewhere, or where
+    the filesystem refuses, through a buffer of ``_BLOCK`` bytes.
+    """
+    done = 0
+    copy_range = getattr(os, "copy_file_range", None)
+    while copy_range is not None and done < size:
+        try:
+            n = copy_range(source, target, min(size - done, _BLOCK), done)
+        except OSError as error:
+            if error.errno not in _NO_COPY_RANGE:
+                raise
+            n = 0
+        if n == 0:  # refused, or a source shorter than size (the loop below raises then)
+            break
+        done += n
+    if done < size:
+        os.lseek(source, done, os.SEEK_SET)
+    while done < size:
+        data = os.read(source, min(size - done, _BLOCK))
+        if not data:
+            raise OSError(errno.EIO, f"spool file ended after {done} of {size} bytes")
+        _write_all(target, data)
+        done += len(data)
+
+
+def _descr(dtype) -> str:
+    """The ``.npy`` descr of a dtype without fields ('<f4', '<U12'): its string."""
+    return np.dtype(dtype).str
+
+
+def _npy_header(descr: str, shape: tuple) -> bytes:
+    """The ``.npy`` 1.0 header of a C-order array, as numpy writes it.
+
+    The text is padded so that the data starts at a multiple of 64 bytes, with room for 21 digits of
+    ``shape[0]``: the header's length does not depend on the number of rows, so it can be written before the
+    rows are known and replaced afterwards.
+    """
+    shape = tuple(int(n) for n in shape)  # numpy integers would print as np.int64(...)
+    text = f"{{'descr': {descr!r}, 'fortran_order': False, 'shape': {shape!r}, }}"
+    if shape:
+        text += " " * (21 - len(repr(shape[0])))
+    pad = 64 - (10 + len(text) + 1) % 64  # magic, version and length take 10 bytes; 64, not 0, when aligned
+    body = text.encode("latin1") + b" " * pad + b"\n"
+    return b"\x93NUMPY\x01\x00" + struct.pack("<H", len(body)) + body
+
+
+# Zip records, written as zipfile writes a stored member with force_zip64 (as np.savez does): made by Unix,
+# version 4.5 (zip64), mode 0644, the date _ZIP_DATE, no flags and no compression.
+_ZIP_VERSION = 45
+_ZIP_UNIX = 3
+_ZIP_MODE = 0o644 << 16
+_DOS_DATE = (_ZIP_DATE[0] - 1980) << 9 | _ZIP_DATE[1] << 5 | _ZIP_DATE[2]
+_DOS_TIME = _ZIP_DATE[3] << 11 | _ZIP_DATE[4] << 5 | _ZIP_DATE[5] // 2
+_ZIP64_LIMIT = (1 << 31) - 1  # as zipfile: beyond this, a size or offset goes into a zip64 field
+_FULL32 = 0xFFFFFFFF  # a 32-bit size or offset whose value is in the zip64 extra field
+
+
+def _local_header(name: bytes, crc: int, size: int) -> bytes:
+    """The local header of a stored member of ``size`` bytes; always zip64, so its width does not depend on size."""
+    extra = struct.pack("<HHQQ", 1, 16, size, size)
+    fixed = struct.pack(
+        "<4s2B4HL2L2H", b"PK\x03\x04", _ZIP_VERSION, 0, 0, 0, _DOS_TIME, _DOS_DATE,
+        crc, _FULL32, _FULL32, len(name), len(extra),
+    )  # fmt: skip
+    return fixed + name + extra
+
+
+def _central_header(name: bytes, crc: int, size: int, offset: int) -> bytes:
+    """The central directory entry of a stored member; zip64 fields only for what does not fit 32 bits."""
+    zip64 = []
+    if size > _ZIP64_LIMIT:
+        zip64 += [size, size]
+        size = _FULL32
+    if offset > _ZIP64_LIMIT:
+        zip64.append(offset)
+        offset = _FULL32
+    extra = struct.pack(f"<HH{len(zip64)}Q", 1, 8 * len(zip64), *zip64) if zip64 else b""
+    fixed = struct.pack(
+        "<4s4B4HL2L5HLL", b"PK\x01\x02", _ZIP_VERSION, _ZIP_UNIX, _ZIP_VERSION, 0, 0, 0, _DOS_TIME, _DOS_DATE,
+        crc, size, size, len(name), len(extra), 0, 0, 0, _ZIP_MODE, offset,
+    )  # fmt: skip
+    return fixed + name + extra
+
+
+def _end_records(count: int, offset: int, size: int) -> bytes:
+    """The end of central directory record, after the zip64 end record and locator if they are needed."""
+    records = b""
+    if count > 0xFFFF or offset > _ZIP64_LIMIT or size > _ZIP64_LIMIT:
+        records += struct.pack(
+            "<4sQ2H2L4Q", b"PK\x06\x06", 44, _ZIP_VERSION, _ZIP_VERSION, 0, 0, count, count, size, offset
+        )
+        records += struct.pack("<4sLQL", b"PK\x06\x07", 0, offset + size, 1)
+        count, offset, size = min(count, 0xFFFF), min(offset, _FULL32), min(size, _FULL32)
+    return records + struct.pack("<4s4H2LH", b"PK\x05\x06", 0, 0, count, count, size, offset, 0)
+
+
+def _crc32_combine(crc1: int, crc2: int, size2: int) -> int:
+    """The CRC-32 of ``a + b`` from ``crc1 = crc32(a)``, ``crc2 = crc32(b)`` and ``size2 = len(b)``.
+
+    zlib's ``crc32_combine``, which Python does not expose: appending a zero byte to the message maps the CRC
+    register through a linear operator over GF(2), a 32x32 bit matrix; ``_zeros_operator(k)`` is the one for
+    2**k zero bytes, and ``crc1`` goes through those of the bits of ``size2``, then ``crc2`` is added.
+    """
+    k = 0
+    while size2:
+        if size2 & 1:
+            crc1 = _gf2_times(_zeros_operator(k), crc1)
+        size2 >>= 1
+        k += 1
+    return crc1 ^ crc2
+
+
+@functools.cache
+def _zeros_operator(k: int) -> tuple[int, ...]:
+    """The operator appending 2**k zero bytes to a CRC-32 message: 32 columns, each a 32-bit int."""
+    if k:
+        return _gf2_square(_zeros_operator(k - 1))
+    # One zero bit: shift right, folding the reflected polynomial back in when the low bit falls off.
+    one_bit = (0xEDB88320, *(1 << n for n in range(31)))
+    return _gf2_square(_gf2_square(_gf2_square(one_bit)))  # 2, 4, then 8 zero bits
+
+
+def _gf2_times(matrix: tuple[int, ...], vector: int) -> int:
+    total = 0
+    for column in matrix:
+        if not vector:
+            break
+        if vector & 1:
+            total ^= column
+        vector >>= 1
+    return total
+
+
+def _gf2_square(matrix: tuple[int, ...]) -> tuple[int, ...]:
+    return tuple(_gf2_times(matrix, column) for column in matrix)
 
 
 def _fsync_dir(path: Path) -> None:

@@ -294,3 +294,11 @@ def test_zoo_lots_all_derive(write):
     grammar = compile_grammar(write("g.cga", SECTION_4))
     r = derive(grammar, lots)
     assert set(np.unique(r["lot"])) == {0, 1, 2, 3, 4}
+
+
+def test_lot_attribute_of_the_wrong_type_makes_its_lot_bad(write):
+    text = 'attr height = 10\nlot ~> S(1r, height, 1r) I("cube")\n'
+    r = run(write, text, [rect(5, 5)] * 3, lot_attrs={"height": ["12", "tall", None]})
+    np.testing.assert_allclose(r["xform"][:, 1, 1], [12, 10])
+    assert [b.index for b in r["bad"]] == [1]
+    assert 'attribute `height` is "tall", not a num' in r["bad"][0].reason

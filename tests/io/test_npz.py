@@ -1,15 +1,22 @@
 """instances.npz: round trips, rebased mesh offsets, reproducible bytes, atomicity, bounded memory."""
 
 import dataclasses
+import errno
 import gc
+import io
 import json
 import os
+import struct
+import threading
+import time
 import tracemalloc
 import zipfile
+import zlib
 
 import numpy as np
 import pytest
 
+from grammarc.io import npz
 from grammarc.io.npz import InstanceWriter, MeshChunk, TerminalChunk, read_instances
 
 ASSETS = ["builtin:cube", "builtin:quad", "facade/window.obj"]
@@ -392,3 +399,212 @@ def test_read_instances_refuses_other_npz(tmp_path):
     np.savez(tmp_path / "other.npz", meta=np.array(json.dumps({"format": "grammarc.instances/9"})))
     with pytest.raises(ValueError, match="grammarc.instances/9"):
         read_instances(tmp_path / "other.npz")
+
+
+# The writer's internals: the zip and .npy records it writes by hand, and its background thread.
+
+
+def writer_threads():
+    return [t for t in threading.enumerate() if t.name.startswith("InstanceWriter") and t.is_alive()]
+
+
+@pytest.mark.parametrize(
+    ("n1", "n2"), [(0, 0), (0, 7), (7, 0), (1, 1), (3, 1000), (1000, 3), (4096, 65537), (1 << 20, 12345)]
+)
+def test_crc32_combine_matches_zlib(n1, n2):
+    rng = np.random.default_rng(n1 + n2)
+    a, b = rng.bytes(n1), rng.bytes(n2)
+    assert npz._crc32_combine(zlib.crc32(a), zlib.crc32(b), len(b)) == zlib.crc32(a + b)
+
+
+def test_crc32_combine_over_pieces_and_long_lengths():
+    rng = np.random.default_rng(4)
+    pieces = [rng.bytes(int(n)) for n in rng.integers(0, 300, 20)] + [b"", bytes(1 << 16)]
+    crc = 0
+    for piece in pieces:
+        crc = npz._crc32_combine(crc, zlib.crc32(piece), len(piece))
+    assert crc == zlib.crc32(b"".join(pieces))
+    # Lengths of gigabytes: combining is associative, (a + b) + c == a + (b + c), for any CRCs and lengths.
+    c1, c2, c3 = (int(x) for x in rng.integers(0, 1 << 32, 3))
+    n2, n3 = (1 << 33) + 5, 3_600_000_123
+    left = npz._crc32_combine(npz._crc32_combine(c1, c2, n2), c3, n3)
+    assert left == npz._crc32_combine(c1, npz._crc32_combine(c2, c3, n3), n2 + n3)
+
+
+def test_npy_header_width_does_not_depend_on_rows():
+    headers = {rows: npz._npy_header("<f4", (rows, 3, 4)) for rows in (0, 1, 59, 10**9, 10**20)}
+    assert len({len(header) for header in headers.values()}) == 1
+    for rows, header in headers.items():
+        assert len(header) % 64 == 0
+        stream = io.BytesIO(header)
+        assert np.lib.format.read_magic(stream) == (1, 0)
+        assert np.lib.format.read_array_header_1_0(stream) == ((rows, 3, 4), False, np.dtype("<f4"))
+        assert stream.tell() == len(header)
+    scalar = io.BytesIO(npz._npy_header("<U5", ()))
+    np.lib.format.read_magic(scalar)
+    assert np.lib.format.read_array_header_1_0(scalar) == ((), False, np.dtype("<U5"))
+
+
+def test_zip_records(tmp_path, chunks):
+    path = tmp_path / "city.npz"
+    write(path, chunks)
+    with zipfile.ZipFile(path) as zf:
+        assert zf.testzip() is None  # every member's CRC and size
+        infos = zf.infolist()
+    # The central directory lists the record's table in order, whatever the members' order in the file.
+    assert [info.filename for info in infos] == [f"{key}.npy" for key in npz._KEYS]
+    unix_0644 = {(info.create_system, info.external_attr, info.flag_bits) for info in infos}
+    assert unix_0644 == {(3, 0o644 << 16, 0)}
+    # xform is streamed into the file first; the members do not overlap and leave no gaps.
+    spans = sorted((info.header_offset, info) for info in infos)
+    assert spans[0][1].filename == "xform.npy" and spans[0][0] == 0
+    data = path.read_bytes()
+    for (offset, info), (next_offset, _) in zip(spans, [*spans[1:], (data.index(b"PK\x01\x02"), None)]):
+        name_size, extra_size = struct.unpack("<HH", data[offset + 26 : offset + 30])
+        assert offset + 30 + name_size + extra_size + info.compress_size == next_offset
+        # The local header agrees with the central directory (zip64 sizes in its extra field).
+        crc, size32, _ = struct.unpack("<LLL", data[offset + 14 : offset + 26])
+        assert crc == info.CRC and size32 == 0xFFFFFFFF
+        sizes = struct.unpack("<HHQQ", data[offset + 30 + name_size : offset + 30 + name_size + 20])
+        assert sizes == (1, 16, info.file_size, info.file_size)
+
+
+def test_zip64_records_load(tmp_path, chunks, monkeypatch):
+    # A record of more than 2 GB needs zip64 fields in the central directory and a zip64 end record; with the
+    # limit at 0, a small record takes them all.
+    write(tmp_path / "small.npz", chunks)
+    monkeypatch.setattr(npz, "_ZIP64_LIMIT", 0)
+    path = tmp_path / "city.npz"
+    write(path, chunks)
+    data = path.read_bytes()
+    assert b"PK\x06\x06" in data and b"PK\x06\x07" in data
+    with zipfile.ZipFile(path) as zf:
+        assert zf.testzip() is None
+        assert all(info.extra.startswith(b"\x01\x00") for info in zf.infolist())
+    got, expected = read_instances(path), read_instances(tmp_path / "small.npz")
+    assert got["meta"] == expected["meta"]
+    for key in KEYS - {"meta"}:
+        np.testing.assert_array_equal(got[key], expected[key])
+
+
+def test_bytes_do_not_depend_on_how_spools_are_copied(tmp_path, chunks, monkeypatch):
+    write(tmp_path / "kernel.npz", chunks)
+
+    def refused(*args, **kwargs):
+        raise OSError(errno.EXDEV, "cross-device")
+
+    monkeypatch.setattr(npz, "_FADVISE", False)
+    monkeypatch.setattr(os, "copy_file_range", refused, raising=False)
+    write(tmp_path / "refused.npz", chunks)
+    monkeypatch.delattr(os, "copy_file_range", raising=False)
+    write(tmp_path / "absent.npz", chunks)
+    data = {name: (tmp_path / name).read_bytes() for name in ("kernel.npz", "refused.npz", "absent.npz")}
+    assert len(set(data.values())) == 1
+
+
+def failing_writes(monkeypatch, after=0):
+    """Make the writer's file writes fail with a full disk after ``after`` more of them."""
+    write_all = npz._write_all
+    calls = []
+
+    def full_disk(fd, data):
+        calls.append(len(memoryview(data)))
+        if len(calls) > after:
+            raise OSError(errno.ENOSPC, "No space left on device")
+        write_all(fd, data)
+
+    monkeypatch.setattr(npz, "_write_all", full_disk)
+    return calls
+
+
+def test_error_in_background_surfaces_at_a_later_write(tmp_path, chunks, monkeypatch):
+    path = tmp_path / "city.npz"
+    path.write_bytes(b"the previous city")
+    out = InstanceWriter(path, assets=ASSETS, symbols=SYMBOLS, meta={})
+    failing_writes(monkeypatch)
+    # The first chunk fails in the thread; at most the queue's depth of later writes go through before the
+    # failure is raised.
+    with pytest.raises(OSError, match="No space left"):
+        for _ in range(npz._QUEUE_DEPTH + 3):
+            out.write(chunks[0])
+    assert path.read_bytes() == b"the previous city"
+    assert os.listdir(tmp_path) == ["city.npz"]
+    assert writer_threads() == []
+    with pytest.raises(ValueError, match="aborted"):
+        out.close()
+
+
+def test_error_in_background_surfaces_at_close(tmp_path, chunks, monkeypatch):
+    path = tmp_path / "city.npz"
+    path.write_bytes(b"the previous city")
+    out = InstanceWriter(path, assets=ASSETS, symbols=SYMBOLS, meta={})
+    failing_writes(monkeypatch)
+    out.write(chunks[0])
+    with pytest.raises(OSError, match="No space left"):
+        out.close()
+    assert path.read_bytes() == b"the previous city"
+    assert os.listdir(tmp_path) == ["city.npz"]
+    assert writer_threads() == []
+
+
+def test_error_while_finishing_removes_temporaries(tmp_path, chunks, monkeypatch):
+    out = InstanceWriter(tmp_path / "city.npz", assets=ASSETS, symbols=SYMBOLS, meta={})
+    for chunk in chunks:
+        out.write(chunk)
+    out._sink._join()  # the chunks are written; the next write is close() copying the first member
+    failing_writes(monkeypatch)
+    with pytest.raises(OSError, match="No space left"):
+        out.close()
+    assert os.listdir(tmp_path) == []
+
+
+def test_abort_stops_the_thread_with_chunks_queued(tmp_path, chunks, monkeypatch):
+    write_all = npz._write_all
+
+    def slow(fd, data):
+        time.sleep(0.02)
+        write_all(fd, data)
+
+    out = InstanceWriter(tmp_path / "city.npz", assets=ASSETS, symbols=SYMBOLS, meta={})
+    monkeypatch.setattr(npz, "_write_all", slow)
+    for _ in range(npz._QUEUE_DEPTH + 2):
+        out.write(chunks[0])
+    assert len(writer_threads()) == 1
+    out.abort()
+    assert writer_threads() == []
+    assert os.listdir(tmp_path) == []
+
+
+def test_close_and_drop_stop_the_thread(tmp_path, chunks):
+    write(tmp_path / "city.npz", chunks)
+    assert writer_threads() == []
+    out = InstanceWriter(tmp_path / "dropped.npz", assets=ASSETS, symbols=SYMBOLS, meta={})
+    out.write(chunks[0])
+    del out
+    gc.collect()
+    assert writer_threads() == []
+    assert os.listdir(tmp_path) == ["city.npz"]
+
+
+def test_memory_stays_bounded_with_fresh_chunks(tmp_path):
+    # As the derivation does: a new chunk for every write. The writer holds the queued chunks, not the rows.
+    rows, n_chunks = 50_000, 40  # 2e6 instances, 120 MB of columns, 3 MB a chunk
+    template = random_chunk(np.random.default_rng(5), rows, 0)
+    chunk_bytes = rows * (4 + 48 + 4 + 4)
+    path = tmp_path / "big.npz"
+
+    tracemalloc.start()
+    try:
+        with InstanceWriter(path, assets=ASSETS, symbols=SYMBOLS, meta={}) as out:
+            for i in range(n_chunks):
+                lot = np.full(rows, i, np.int32)
+                out.write(dataclasses.replace(template, xform=template.xform + i, lot=lot))
+        _, peak = tracemalloc.get_traced_memory()
+    finally:
+        tracemalloc.stop()
+
+    assert peak < (npz._QUEUE_DEPTH + 5) * chunk_bytes, f"peak {peak / 1e6:.0f} MB"
+    with np.load(path) as record:
+        assert record["xform"].shape == (n_chunks * rows, 3, 4)
+        np.testing.assert_array_equal(record["xform"][-rows:], template.xform + n_chunks - 1)
+        np.testing.assert_array_equal(record["lot"][::rows], np.arange(n_chunks))
