@@ -74,7 +74,7 @@ def _from_lots(attr: ir.AttrDecl, values: np.ndarray, column: np.ndarray, string
         else:
             column[given] = values[given] if attr.type is T.NUM else values[given] != 0
         return column
-    given = values != None
+    given = values != None  # elementwise on an object array: `is not None` would compare the array
     if attr.type is T.STR:
         column[given] = _per_distinct(values[given], strings.intern)
         return column

@@ -11,7 +11,6 @@ one call per part. Python cost is per operation and batch, never per shape.
 from __future__ import annotations
 
 from collections import defaultdict
-from dataclasses import dataclass
 
 import numpy as np
 
@@ -30,14 +29,6 @@ from grammarc.geometry import components as comp_kernels
 from grammarc.ir import nodes as ir
 
 
-@dataclass(frozen=True)
-class Where:
-    """The rule being applied, for messages and records."""
-
-    symbol: int
-    rule: ir.Rule
-
-
 class Executor:
     """Derives one chunk: a worklist of pending batches per symbol, and the operations."""
 
@@ -52,19 +43,19 @@ class Executor:
     def env(self, shapes: Shapes) -> Env:
         return Env(shapes, self.chunk, self.plan.strings.ids)
 
-    def fail(self, shapes: Shapes, bad: np.ndarray, message: str, where: Where, span) -> None:
+    def fail(self, shapes: Shapes, bad: np.ndarray, message: str, symbol: int, span) -> None:
         """Report the lots of shapes ``bad`` (bool mask) as failed: raises ``LotFailure``."""
         lots = np.unique(shapes.lot[bad])
-        rule = self.plan.symbols[where.symbol].name
+        rule = self.plan.symbols[symbol].name
         raise LotFailure(f"{message} in rule `{rule}` at {span}", lots)
 
-    def count(self, shapes: Shapes, where: Where, span) -> None:
+    def count(self, shapes: Shapes, symbol: int, span) -> None:
         """Add new shapes to the per-lot counters and enforce the shape limits."""
         if not len(shapes):
             return
         counts = self.chunk.shape_count
         counts += np.bincount(shapes.lot, minlength=len(counts))
-        self.check_shape_limit(counts, where, span)
+        self.check_shape_limit(counts, symbol, span)
         if counts.sum() > self.chunk_budget and len(counts) > 1:
             raise ChunkTooLarge()
 
@@ -94,37 +85,37 @@ class Executor:
             terminals.emit_leaves(self.chunk, remaining, sym.id)
 
     def apply_rule(self, sym: SymbolPlan, rule: ir.Rule, shapes: Shapes) -> None:
-        where = Where(sym.id, rule)
+        symbol = sym.id
         alts = rule.alternatives
         if len(alts) == 1:
-            self.run(alts[0].body, shapes, where)
+            self.run(alts[0].body, shapes, symbol)
             return
         env = self.env(shapes)
         probs = np.stack([evaluate_array(a.prob, env) for a in alts], axis=1)
         bad = (np.abs(probs.sum(axis=1) - 1.0) > TOL.probability) | (probs < 0).any(axis=1)
         if bad.any():
-            self.fail(shapes, bad, "probabilities do not sum to 1", where, rule.span)
+            self.fail(shapes, bad, "probabilities do not sum to 1", symbol, rule.span)
         cumulative = np.cumsum(probs, axis=1)
         draw = uniform(shapes.key, rule.site)
         choice = np.minimum((draw[:, None] >= cumulative).sum(axis=1), len(alts) - 1)
         for i, alt in enumerate(alts):
             picked = shapes.take(choice == i)
             if len(picked):
-                self.run(alt.body, picked, where)
+                self.run(alt.body, picked, symbol)
 
     # ------------------------------------------------------------------------------------------- bodies
-    def run(self, body: ir.Body, cursor: Shapes, where: Where) -> None:
+    def run(self, body: ir.Body, cursor: Shapes, symbol: int) -> None:
         """Execute ``body`` on ``cursor``; operations replace its scope columns as they go."""
         stack: list[tuple] = []
         for op in body:
             if not len(cursor):
                 return
             if isinstance(op, ir.Symbol):
-                self.successor(op, cursor, where)
+                self.successor(op, cursor, symbol)
             elif isinstance(op, ir.Translate):
                 cursor = self.translate(op, cursor)
             elif isinstance(op, ir.Scale):
-                cursor = self.scale(op, cursor, where)
+                cursor = self.scale(op, cursor, symbol)
             elif isinstance(op, ir.Rotate):
                 cursor = self.rotate(op, cursor)
             elif isinstance(op, ir.Push):
@@ -134,19 +125,19 @@ class Executor:
                     cursor = cursor.with_scope(*stack.pop())
             elif isinstance(op, ir.Insert):
                 asset = self.plan.grammar.asset_ids[op.asset]
-                terminals.emit_instances(self.chunk, cursor, asset, where.symbol)
+                terminals.emit_instances(self.chunk, cursor, asset, symbol)
             elif isinstance(op, ir.Split):
-                self.split(op, cursor, where)
+                self.split(op, cursor, symbol)
             elif isinstance(op, ir.Repeat):
-                self.repeat(op, cursor, where)
+                self.repeat(op, cursor, symbol)
             elif isinstance(op, ir.Comp):
-                self.comp(op, cursor, where)
+                self.comp(op, cursor, symbol)
             elif isinstance(op, ir.Empty):
                 pass
             else:
                 raise TypeError(f"unknown operation {op!r}")
 
-    def successor(self, op: ir.Symbol, cursor: Shapes, where: Where) -> None:
+    def successor(self, op: ir.Symbol, cursor: Shapes, symbol: int) -> None:
         sym = self.plan.symbols[self.plan.symbol_ids[op.name]]
         env = self.env(cursor)
         params = tuple(
@@ -155,7 +146,7 @@ class Executor:
         )
         shapes = Shapes(cursor.origin, cursor.size, cursor.frame, cursor.geom, cursor.lot,
                         child_keys(cursor.key, op.site), cursor.depth + 1, params)
-        self.count(shapes, where, op.span)
+        self.count(shapes, symbol, op.span)
         if sym.terminal:
             terminals.emit_leaves(self.chunk, shapes, sym.id)
         else:
@@ -167,7 +158,7 @@ class Executor:
         delta = np.einsum("ni,nij->nj", local, self.chunk.frames[cursor.frame])
         return cursor.with_scope(cursor.origin + delta, cursor.size, cursor.frame, cursor.geom)
 
-    def scale(self, op: ir.Scale, cursor: Shapes, where: Where) -> Shapes:
+    def scale(self, op: ir.Scale, cursor: Shapes, symbol: int) -> Shapes:
         env = self.env(cursor)
         size = np.empty_like(cursor.size)
         for axis, s in enumerate(op.sizes):
@@ -175,7 +166,7 @@ class Executor:
             size[:, axis] = value * cursor.size[:, axis] if s.kind is ir.SizeKind.RELATIVE else value
         bad = ~(size >= 0).all(axis=1)
         if bad.any():
-            self.fail(cursor, bad, f"`S` gives a negative or NaN size ({_example(size, bad)})", where,
+            self.fail(cursor, bad, f"`S` gives a negative or NaN size ({_example(size, bad)})", symbol,
                       op.span)
         return cursor.with_scope(cursor.origin, size, cursor.frame, cursor.geom)
 
@@ -196,12 +187,12 @@ class Executor:
         return cursor.with_scope(cursor.origin, cursor.size, frame, cursor.geom)
 
     # ------------------------------------------------------------------------------------------- splits
-    def split(self, op: ir.Split, cursor: Shapes, where: Where) -> None:
+    def split(self, op: ir.Split, cursor: Shapes, symbol: int) -> None:
         env = self.env(cursor)
         values = _size_matrix([evaluate(s.value, env) for s in op.sizes], len(cursor))
         bad = ~(values >= 0).all(axis=1)
         if bad.any():
-            self.fail(cursor, bad, f"`Subdiv` has a negative or NaN size ({_example(values, bad)})", where,
+            self.fail(cursor, bad, f"`Subdiv` has a negative or NaN size ({_example(values, bad)})", symbol,
                       op.span)
         relative = np.array([s.kind is ir.SizeKind.RELATIVE for s in op.sizes])
 
@@ -214,9 +205,9 @@ class Executor:
                 values = values[parent]  # the next axis' sizes follow the children
             return parent, part * len(op.sizes) ** level, pos, length
 
-        self.fan_out(op, cursor, where, cut)
+        self.fan_out(op, cursor, symbol, cut)
 
-    def repeat(self, op: ir.Repeat, cursor: Shapes, where: Where) -> None:
+    def repeat(self, op: ir.Repeat, cursor: Shapes, symbol: int) -> None:
         env = self.env(cursor)
         sizes = [evaluate_array(e, env) for e in op.sizes]
         stride = np.ones(len(cursor), dtype=np.int64)
@@ -226,20 +217,20 @@ class Executor:
             size = sizes[level]
             bad = ~(size > 0)
             if bad.any():
-                self.fail(shapes, bad, f"`Repeat` needs a positive size, got {size[bad][0]:g}", where,
+                self.fail(shapes, bad, f"`Repeat` needs a positive size, got {size[bad][0]:g}", symbol,
                           op.span)
             extent = np.ascontiguousarray(shapes.size[:, axis])
             counts = split_kernels.repeat_counts(extent, size, TOL.zero)
-            self.check_fan_out(shapes, counts, where, op.span)
+            self.check_fan_out(shapes, counts, symbol, op.span)
             parent, part, pos, length = split_kernels.repeat(extent, counts)
             step = part * stride[parent]
             stride = stride[parent] * counts[parent]
             sizes = [s[parent] for s in sizes]  # the next axes' sizes follow the children
             return parent, step, pos, length
 
-        self.fan_out(op, cursor, where, cut)
+        self.fan_out(op, cursor, symbol, cut)
 
-    def fan_out(self, op: ir.Split | ir.Repeat, cursor: Shapes, where: Where, cut) -> None:
+    def fan_out(self, op: ir.Split | ir.Repeat, cursor: Shapes, symbol: int, cut) -> None:
         """Split ``cursor`` along each of ``op.axes`` in turn and run the parts on the cells.
 
         ``cut(shapes, level, axis)`` returns the children of one axis as (parent, cell step, position,
@@ -248,7 +239,7 @@ class Executor:
         shapes = cursor
         cell = np.zeros(len(cursor), dtype=np.int64)
         for level, axis in enumerate(op.axes):
-            self.check_splittable(shapes, axis, where, op.span)
+            self.check_splittable(shapes, axis, symbol, op.span)
             parent, step, pos, length = cut(shapes, level, axis)
             cell = cell[parent] + step
             if level == len(op.axes) - 1:
@@ -256,26 +247,26 @@ class Executor:
                                                         len(op.parts))
             else:
                 shapes = self.children(shapes, axis, parent, cell, pos, length, op.site)
-        self.count(shapes, where, op.span)
-        self.run_parts(op.parts, shapes, offsets, where)
+        self.count(shapes, symbol, op.span)
+        self.run_parts(op.parts, shapes, offsets, symbol)
 
-    def check_fan_out(self, shapes: Shapes, counts: np.ndarray, where: Where, span) -> None:
+    def check_fan_out(self, shapes: Shapes, counts: np.ndarray, symbol: int, span) -> None:
         """Refuse a repeat that would exceed --max-shapes before allocating its children."""
         per_lot = np.bincount(shapes.lot, weights=counts, minlength=len(self.chunk.shape_count))
-        self.check_shape_limit(per_lot + self.chunk.shape_count, where, span)
+        self.check_shape_limit(per_lot + self.chunk.shape_count, symbol, span)
 
-    def check_shape_limit(self, counts: np.ndarray, where: Where, span) -> None:
+    def check_shape_limit(self, counts: np.ndarray, symbol: int, span) -> None:
         """LimitError naming the rule if a lot's shape count (made or about to be) exceeds --max-shapes."""
         worst = int(np.argmax(counts))
         if counts[worst] > self.limits.max_shapes:
-            rule = self.plan.symbols[where.symbol].name
+            rule = self.plan.symbols[symbol].name
             raise LimitError(
                 f"lot {self.chunk.lot_ids[worst]} makes more than {self.limits.max_shapes:,} shapes "
                 f"({int(counts[worst]):,}) in rule `{rule}` at {span}: a runaway grammar? "
                 "Raise the limit with --max-shapes N."
             )
 
-    def check_splittable(self, shapes: Shapes, axis: int, where: Where, span) -> None:
+    def check_splittable(self, shapes: Shapes, axis: int, symbol: int, span) -> None:
         """Polygons split only along their extrusion axis until the polygon geometry issue lands."""
         poly = shapes.geom >= 0
         if not poly.any():
@@ -285,7 +276,7 @@ class Executor:
         bad[np.flatnonzero(poly)[plane != axis]] = True
         if bad.any():
             self.fail(shapes, bad, f"splitting a non-rectangular polygon along {'XYZ'[axis]} is not "
-                      "supported yet (only along its extrusion axis)", where, span)
+                      "supported yet (only along its extrusion axis)", symbol, span)
 
     def children(self, shapes: Shapes, axis: int, parent, index, pos, length, site: int,
                  order=None) -> Shapes:
@@ -306,13 +297,13 @@ class Executor:
         order, offsets = group_by(cell % n_parts if n_parts > 1 else np.zeros_like(cell), n_parts)
         return self.children(shapes, axis, parent, cell, pos, length, site, order), offsets
 
-    def run_parts(self, parts: tuple[ir.Body, ...], shapes: Shapes, offsets: np.ndarray, where) -> None:
+    def run_parts(self, parts: tuple[ir.Body, ...], shapes: Shapes, offsets: np.ndarray, symbol) -> None:
         for i, body in enumerate(parts):
             if offsets[i + 1] > offsets[i]:
-                self.run(body, shapes.take(slice(offsets[i], offsets[i + 1])), where)
+                self.run(body, shapes.take(slice(offsets[i], offsets[i + 1])), symbol)
 
     # ------------------------------------------------------------------------------------------- comp
-    def comp(self, op: ir.Comp, cursor: Shapes, where: Where) -> None:
+    def comp(self, op: ir.Comp, cursor: Shapes, symbol: int) -> None:
         chunk = self.chunk
         coords, ring_offsets, shape_offsets, plane = self.polygons_of(cursor)
         parent, index, origin, axes, size, poly = comp_kernels.components(
@@ -337,9 +328,9 @@ class Executor:
                 geom[sel] = self.cap_polygons(child.geom[sel], flip_when)
         shapes = Shapes(world_origin, size, frame, geom, child.lot, child_keys(child.key, op.site, index),
                         child.depth, child.params)
-        self.count(shapes, where, op.span)
+        self.count(shapes, symbol, op.span)
         order, offsets = group_by(index % len(op.parts), len(op.parts))
-        self.run_parts(op.parts, shapes.take(order), offsets, where)
+        self.run_parts(op.parts, shapes.take(order), offsets, symbol)
 
     def polygons_of(self, shapes: Shapes):
         """Each shape's polygon as batch-local ragged arrays (implicit rectangles for scope shapes)."""
@@ -375,7 +366,7 @@ class Executor:
         vertex_poly = np.repeat(np.repeat(np.arange(len(geom)), np.diff(poly_offsets)),
                                 np.diff(ring_offsets))
         coords = coords.copy()
-        coords[:, 1] = np.where(flip[vertex_poly], 1.0 - coords[:, 1], coords[:, 1])
+        coords[:, 1] = np.symbol(flip[vertex_poly], 1.0 - coords[:, 1], coords[:, 1])
         if which == "bottom":
             coords = comp_kernels.reverse_rings(coords, ring_offsets)
         return polygons.add(coords, ring_offsets, poly_offsets, np.full(len(geom), 2, dtype=np.int8))
