@@ -82,11 +82,12 @@ def collect(chunk: Chunk) -> TerminalChunk:
     for name, row_shape, dtype in (("asset", (), np.int32), ("xform", (3, 4), np.float32),
                                    ("symbol", (), np.int32)):
         column = np.empty((len(lot), *row_shape), dtype=dtype)
-        flat = column.reshape(len(lot), -1)
+        width = int(np.prod(row_shape))
+        flat = column.reshape(len(lot), width)
         start = 0
         for piece in getattr(out, name):
             stop = start + len(piece)
-            scatter_rows(np.ascontiguousarray(piece).reshape(len(piece), -1), dest[start:stop], flat)
+            scatter_rows(np.ascontiguousarray(piece).reshape(len(piece), width), dest[start:stop], flat)
             start = stop
         columns[name] = column
     index = chunk.lot_index.astype(np.int32)

@@ -366,7 +366,7 @@ class Executor:
         vertex_poly = np.repeat(np.repeat(np.arange(len(geom)), np.diff(poly_offsets)),
                                 np.diff(ring_offsets))
         coords = coords.copy()
-        coords[:, 1] = np.symbol(flip[vertex_poly], 1.0 - coords[:, 1], coords[:, 1])
+        coords[:, 1] = np.where(flip[vertex_poly], 1.0 - coords[:, 1], coords[:, 1])
         if which == "bottom":
             coords = comp_kernels.reverse_rings(coords, ring_offsets)
         return polygons.add(coords, ring_offsets, poly_offsets, np.full(len(geom), 2, dtype=np.int8))

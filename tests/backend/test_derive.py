@@ -302,3 +302,38 @@ def test_lot_attribute_of_the_wrong_type_makes_its_lot_bad(write):
     np.testing.assert_allclose(r["xform"][:, 1, 1], [12, 10])
     assert [b.index for b in r["bad"]] == [1]
     assert 'attribute `height` is "tall", not a num' in r["bad"][0].reason
+
+
+def _face_area_normal(mesh, face):
+    """Signed area vector (Newell) of a mesh face: its outline minus its holes."""
+    total = np.zeros(3)
+    for ring in range(mesh.face_offsets[face], mesh.face_offsets[face + 1]):
+        p = mesh.vertices[mesh.ring_offsets[ring]:mesh.ring_offsets[ring + 1]].astype(np.float64)
+        total += np.cross(p, np.roll(p, -1, axis=0)).sum(axis=0) / 2
+    return total
+
+
+@pytest.mark.parametrize("lot, area", [("concave_L", 400.0), ("courtyard", 1200.0)])
+def test_polygon_top_and_bottom_faces(write, lot, area):
+    """Comp("top"/"bottom") of a prism on a concave or holed lot: polygon faces at the right height,
+    with the footprint's area, facing up and down."""
+    r = run(write, 'lot ~> S(1r, 7, 1r) Comp("top"){ roof } Comp("bottom"){ floor }\n', make_lots_polys(lot))
+    mesh = r["mesh"]
+    names = r["symbols"][mesh.symbol]
+    assert sorted(names) == ["floor", "roof"] and len(r["asset"]) == 0
+    for face, name in enumerate(names):
+        vector = _face_area_normal(mesh, face)
+        np.testing.assert_allclose(np.linalg.norm(vector), area, rtol=1e-6)
+        y = mesh.vertices[mesh.ring_offsets[mesh.face_offsets[face]]:
+                          mesh.ring_offsets[mesh.face_offsets[face + 1]], 1]
+        np.testing.assert_allclose(y, 7.0 if name == "roof" else 0.0, atol=1e-5)
+        assert np.sign(vector[1]) == (1 if name == "roof" else -1)
+
+
+def test_comp_faces_of_a_courtyard_prism(write):
+    r = run(write, 'lot ~> S(1r, 5, 1r) Comp("faces"){ f }\n', make_lots_polys("courtyard"))
+    # 8 side faces (4 outer, 4 facing the hole) are quads; top and bottom are polygons with a hole
+    assert len(r["asset"]) == 8 and len(r["mesh"].lot) == 2
+    assert list(np.diff(r["mesh"].face_offsets)) == [2, 2]
+    quad_area = np.linalg.norm(np.cross(r["xform"][:, :, 0], r["xform"][:, :, 1]), axis=1).sum()
+    np.testing.assert_allclose(quad_area, (160 + 80) * 5, rtol=1e-6)
