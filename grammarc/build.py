@@ -24,6 +24,7 @@ from grammarc import __version__
 from grammarc.backend.attributes import check_overrides
 from grammarc.backend.derive import derive_chunk
 from grammarc.backend.plan import make_plan
+from grammarc.backend.reports import Reports
 from grammarc.compiler import Grammar, compile_grammar
 from grammarc.constants import LIMITS, Limits
 from grammarc.errors import ChunkTooLarge, LotFailure
@@ -47,6 +48,8 @@ class BuildOptions:
     limits: Limits = LIMITS
     asset_roots: tuple[Path, ...] = ()
     chunk_budget: int = CHUNK_BUDGET
+    #: ``cga2006`` or ``cityengine``; detected from the grammar's text when None.
+    dialect: str | None = None
 
 
 @dataclass(frozen=True)
@@ -82,7 +85,8 @@ def build(grammar_path, output, *, lots_path=None, options: BuildOptions = Build
     """
     started = time.perf_counter()
     grammar_path = Path(grammar_path)
-    grammar = compile_grammar(grammar_path, start=options.start, asset_roots=options.asset_roots)
+    grammar = compile_grammar(grammar_path, start=options.start, asset_roots=options.asset_roots,
+                              dialect=options.dialect)
     plan = make_plan(grammar)
     check_overrides(grammar.module, options.attrs)
     writer_class = writer_for(output)
@@ -96,11 +100,17 @@ def build(grammar_path, output, *, lots_path=None, options: BuildOptions = Build
         "start": plan.symbols[plan.start].name,
         "attrs": {k: v for k, v in sorted(options.attrs.items())},
         "lots_source": lots.source,
+        "dialect": grammar.module.dialect,
+        # operations accepted without effect on the record (material, texture, UV, print)
+        "not_applied": list(plan.not_applied),
     }
     failed: list[BadLot] = []
+    reports = Reports()
     with writer_class(output, assets=grammar.assets, symbols=plan.symbol_names, meta=meta) as writer:
-        derived = _derive_all(plan, lots, options, writer, failed, progress)
+        derived = _derive_all(plan, lots, options, writer, failed, reports, progress)
         counts = writer.close()
+    if reports:
+        reports.write(reports_path(Path(output)))
     bad = tuple(sorted((*lots.bad, *failed), key=lambda b: b.index))
     return BuildResult(Path(output), len(lots) + len(lots.bad), derived, bad, counts,
                        time.perf_counter() - started, grammar)
@@ -119,7 +129,8 @@ def derive(grammar: Grammar, lots: Lots, options: BuildOptions = BuildOptions())
     class Collect:
         write = staticmethod(chunks.append)
 
-    _derive_all(plan, lots, options, Collect, failed)
+    reports = Reports()
+    _derive_all(plan, lots, options, Collect, failed, reports)
     mesh = MeshChunk.concat([c.mesh for c in chunks]) if chunks else MeshChunk.empty()
     columns = {
         name: (np.concatenate([getattr(c, name) for c in chunks]) if chunks else
@@ -129,12 +140,18 @@ def derive(grammar: Grammar, lots: Lots, options: BuildOptions = BuildOptions())
     }
     columns.update(
         assets=np.array(grammar.assets), symbols=np.array(plan.symbol_names), mesh=mesh,
-        bad=tuple(sorted((*lots.bad, *failed), key=lambda b: b.index)),
+        bad=tuple(sorted((*lots.bad, *failed), key=lambda b: b.index)), reports=reports,
     )
     return columns
 
 
-def _derive_all(plan, lots: Lots, options: BuildOptions, writer, failed: list[BadLot], progress=None) -> int:
+def reports_path(output: Path) -> Path:
+    """Where the reports of ``output`` go: ``city.npz`` -> ``city.reports.json``."""
+    return output.with_name(output.stem + ".reports.json")
+
+
+def _derive_all(plan, lots: Lots, options: BuildOptions, writer, failed: list[BadLot], reports: Reports,
+                progress=None) -> int:
     """Derive all ``lots`` chunk by chunk into ``writer``; returns the number of lots derived.
 
     A chunk holds at most ``options.chunk_size`` lots, and fewer when the lots so far made many records:
@@ -147,7 +164,7 @@ def _derive_all(plan, lots: Lots, options: BuildOptions, writer, failed: list[Ba
     rows = 0
     while first < len(lots):
         part = lots.take(slice(first, first + size))
-        derived_now, made = _derive(plan, part, options, writer, failed)
+        derived_now, made = _derive(plan, part, options, writer, failed, reports)
         derived += derived_now
         rows += made
         first += len(part)
@@ -158,7 +175,8 @@ def _derive_all(plan, lots: Lots, options: BuildOptions, writer, failed: list[Ba
     return derived
 
 
-def _derive(plan, lots: Lots, options: BuildOptions, writer, failed: list[BadLot]) -> tuple[int, int]:
+def _derive(plan, lots: Lots, options: BuildOptions, writer, failed: list[BadLot],
+            reports: Reports) -> tuple[int, int]:
     """Derive ``lots`` into ``writer``, skipping failing lots and splitting oversized chunks.
 
     Returns the number of lots derived and of records made.
@@ -171,8 +189,8 @@ def _derive(plan, lots: Lots, options: BuildOptions, writer, failed: list[BadLot
         if not len(part):
             continue
         try:
-            records = derive_chunk(plan, part, seed=options.seed, limits=options.limits,
-                                   overrides=options.attrs, chunk_budget=options.chunk_budget)
+            records, per_lot = derive_chunk(plan, part, seed=options.seed, limits=options.limits,
+                                            overrides=options.attrs, chunk_budget=options.chunk_budget)
         except LotFailure as failure:
             skip = np.zeros(len(part), dtype=bool)
             skip[failure.lots] = True
@@ -185,6 +203,7 @@ def _derive(plan, lots: Lots, options: BuildOptions, writer, failed: list[BadLot
             queue[:0] = [part.take(slice(0, half)), part.take(slice(half, None))]
             continue
         writer.write(records)
+        reports.add(per_lot)
         derived += len(part)
         rows += len(records.asset) + len(records.mesh.lot)
     return derived, rows

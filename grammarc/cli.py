@@ -59,6 +59,8 @@ def _parser() -> argparse.ArgumentParser:
                        help=f"shapes made from one lot (default {LIMITS.max_shapes:,})")
     build.add_argument("--assets", type=Path, action="append", default=[], metavar="DIR",
                        help="a further folder for I() assets (the grammar's folder comes first)")
+    build.add_argument("--dialect", choices=("cga2006", "cityengine"),
+                       help="the grammar's notation (default: detected from its text)")
     build.add_argument("--quiet", "-q", action="store_true", help="no progress bar and no summary")
     build.set_defaults(run=_build)
 
@@ -66,6 +68,8 @@ def _parser() -> argparse.ArgumentParser:
     check.add_argument("grammar", type=Path)
     check.add_argument("--start", metavar="SYMBOL")
     check.add_argument("--dump-ir", action="store_true", help="print the IR after the passes")
+    check.add_argument("--dialect", choices=("cga2006", "cityengine"),
+                       help="the grammar's notation (default: detected from its text)")
     check.set_defaults(run=_check)
     return parser
 
@@ -86,7 +90,7 @@ def _check(args) -> int:
     from grammarc.compiler import compile_grammar
     from grammarc.ir.printer import print_module
 
-    grammar = compile_grammar(args.grammar, start=args.start)
+    grammar = compile_grammar(args.grammar, start=args.start, dialect=args.dialect)
     _warn(grammar)
     graph = grammar.graph
     if args.dump_ir:
@@ -131,6 +135,7 @@ def _build(args) -> int:
         chunk_size=args.chunk_size,
         limits=replace(LIMITS, max_depth=args.max_depth, max_shapes=args.max_shapes),
         asset_roots=tuple(args.assets),
+        dialect=args.dialect,
     )
     bar = _ProgressBar() if not args.quiet else None
     try:

@@ -36,7 +36,7 @@ class Grammar:
 
 
 def compile_grammar(path: str | Path, *, text: str | None = None, start: str | None = None,
-                    asset_roots: tuple[Path, ...] = ()) -> Grammar:
+                    asset_roots: tuple[Path, ...] = (), dialect: str | None = None) -> Grammar:
     """Parse, check and analyse a grammar file; raise ``GrammarError`` listing every error."""
     path = Path(path)
     if text is None:
@@ -46,7 +46,7 @@ def compile_grammar(path: str | Path, *, text: str | None = None, start: str | N
             raise UsageError(f"cannot read grammar {path}: {error}") from None
     file = str(path)
     diags = Diagnostics()
-    module = parse_source(text, file, diags)
+    module = parse_source(text, file, diags, dialect)
     module = run_passes(module, diags)
     if not module.rules and not diags.has_errors:  # rules that failed to parse are not "no rules"
         diags.error("empty", "the grammar has no rules", Span(file, 1, 1, 1, 1))
@@ -87,7 +87,7 @@ def _assets(module: ir.Module, roots, diags: Diagnostics) -> tuple[tuple[str, ..
     for rule in module.rules:
         for alt in rule.alternatives:
             for op in iter_ops(alt.body):
-                if not isinstance(op, ir.Insert) or op.asset in ids:
+                if not isinstance(op, (ir.Insert, ir.UseAsset)) or op.asset in ids:
                     continue
                 resolved = resolve_asset(op.asset, roots)
                 if resolved.problem:

@@ -14,6 +14,7 @@ import numpy as np
 from grammarc.backend.evaluate import Env, evaluate_array
 from grammarc.errors import LotFailure, UsageError
 from grammarc.ir import nodes as ir
+from grammarc.ir.traverse import iter_exprs
 
 T = ir.Type
 
@@ -34,7 +35,10 @@ def parse_override(text: str) -> tuple[str, object]:
 
 def check_overrides(module: ir.Module, overrides: dict[str, object]) -> None:
     types = {a.name: a.type for a in module.attrs}
+    consts = {a.name for a in module.attrs if a.const}
     for name, value in overrides.items():
+        if name in consts:
+            raise UsageError(f"--attr {name}: `{name}` is a constant, which cannot be overridden")
         if name not in types:
             known = ", ".join(types) or "none"
             raise UsageError(f"--attr {name}: the grammar declares no attribute `{name}` (attributes: {known})")
@@ -49,19 +53,42 @@ def attribute_columns(module: ir.Module, env: Env, lot_attrs: dict[str, np.ndarr
     """Fill ``env.chunk.attrs`` with one (L,) column per attribute; ``env.shapes`` are the lots' shapes."""
     columns = env.chunk.attrs
     n = len(env.shapes)
-    for attr in module.attrs:
+    for attr in dependency_order(module.attrs):
         dtype = np.int32 if attr.type is T.STR else bool if attr.type is T.BOOL else np.float64
-        if attr.name in overrides:
+        if attr.name in overrides and not attr.const:
             value = overrides[attr.name]
             value = strings.intern(value) if attr.type is T.STR else value
             columns[attr.name] = np.full(n, value, dtype=dtype)
             continue
         column = evaluate_array(attr.default, env, dtype=dtype) if attr.type is not T.STR else \
             np.asarray(evaluate_array(attr.default, env, dtype=np.int32))
-        if attr.name in lot_attrs:
+        if attr.name in lot_attrs and not attr.const:
             column = _from_lots(attr, lot_attrs[attr.name], column.copy(), strings, env)
         columns[attr.name] = column
     return columns
+
+
+def dependency_order(attrs: tuple[ir.AttrDecl, ...]) -> list[ir.AttrDecl]:
+    """Attributes ordered so that each comes after those its default uses (CityEngine lets a default use
+    an attribute declared further down); declaration order otherwise. A cycle keeps declaration order
+    for the attributes on it (their defaults then see the other's default as not yet set)."""
+    by_name = {a.name: a for a in attrs}
+    done: dict[str, ir.AttrDecl] = {}
+    visiting: set[str] = set()
+
+    def visit(attr: ir.AttrDecl) -> None:
+        if attr.name in done or attr.name in visiting:
+            return
+        visiting.add(attr.name)
+        for e in iter_exprs(attr.default):
+            if isinstance(e, ir.AttrRef) and e.name in by_name:
+                visit(by_name[e.name])
+        visiting.discard(attr.name)
+        done[attr.name] = attr
+
+    for attr in attrs:
+        visit(attr)
+    return list(done.values())
 
 
 def _from_lots(attr: ir.AttrDecl, values: np.ndarray, column: np.ndarray, strings, env) -> np.ndarray:

@@ -50,6 +50,8 @@ class Outputs:
     lot: list = field(default_factory=list)
     symbol: list = field(default_factory=list)
     meshes: list = field(default_factory=list)
+    #: ``report`` rows: (lot, key ids, values, kind) per call.
+    reports: list = field(default_factory=list)
 
 
 @dataclass

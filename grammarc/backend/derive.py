@@ -9,6 +9,8 @@ its chunk; sorting the chunk's records by lot (stably) makes the output independ
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 
 from grammarc.backend.attributes import attribute_columns
@@ -18,6 +20,7 @@ from grammarc.backend.execute import Executor
 from grammarc.backend.kernels.order import group_by, scatter_rows
 from grammarc.backend.plan import Plan
 from grammarc.backend.random import lot_keys
+from grammarc.backend.reports import aggregate_chunk
 from grammarc.backend.shapes import Shapes
 from grammarc.constants import Limits
 from grammarc.geometry.footprint import footprint_polygons, lot_scopes
@@ -45,13 +48,15 @@ def initial_chunk(lots: Lots) -> tuple[Chunk, Shapes]:
 
 
 def derive_chunk(plan: Plan, lots: Lots, *, seed: int, limits: Limits, overrides: dict,
-                 chunk_budget: int) -> TerminalChunk:
-    """Derive ``lots``; raises ``LotFailure`` naming lots to skip, ``ChunkTooLarge``, or ``LimitError``."""
+                 chunk_budget: int) -> tuple[TerminalChunk, dict]:
+    """Derive ``lots``: their records and their reports per lot (``reports.aggregate_chunk``).
+
+    Raises ``LotFailure`` naming lots to skip, ``ChunkTooLarge``, or ``LimitError``.
+    """
     chunk, shapes = initial_chunk(lots)
-    shapes = Shapes(shapes.origin, shapes.size, shapes.frame, shapes.geom, shapes.lot,
-                    lot_keys(seed, lots.index), shapes.depth)
-    attribute_columns(plan.grammar.module, Env(shapes, chunk, plan.strings.ids), lots.attrs, overrides,
-                      plan.strings)
+    shapes = replace(shapes, key=lot_keys(seed, lots.index))
+    attribute_columns(plan.grammar.module, Env(shapes, chunk, plan), lots.attrs, overrides, plan.strings)
+    shapes = replace(shapes, dynamic=tuple(chunk.attrs[name][shapes.lot] for name in plan.dynamic))
     executor = Executor(plan, chunk, limits, chunk_budget)
     executor.pending[plan.start].append(shapes)
     for stage in plan.stages:
@@ -63,7 +68,8 @@ def derive_chunk(plan: Plan, lots: Lots, *, seed: int, limits: Limits, overrides
                 batches = executor.pending.pop(sym_id, None)
                 if batches:
                     executor.apply(plan.symbols[sym_id], Shapes.concat(batches))
-    return collect(chunk)
+    reports = aggregate_chunk(chunk.outputs.reports, chunk.lot_index, list(plan.strings.ids))
+    return collect(chunk), reports
 
 
 def collect(chunk: Chunk) -> TerminalChunk:

@@ -9,6 +9,7 @@ a numba loop rather than numpy's SIMD kernels, so a value never depends on its p
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 from numba import njit
@@ -16,16 +17,25 @@ from numba import njit
 from grammarc.backend.chunk import Chunk
 from grammarc.backend.random import uniform
 from grammarc.backend.shapes import Shapes
+from grammarc.geometry.measure import area_and_volume
 from grammarc.ir import nodes as ir
+
+if TYPE_CHECKING:
+    from grammarc.backend.plan import Plan
 
 
 @dataclass(frozen=True, eq=False)
 class Env:
-    """What an expression can read: the shapes (scope, params, keys) and their chunk (attributes)."""
+    """What an expression can read: the shapes (scope, params, keys, set attributes), their chunk (lot
+    attributes, geometry) and the plan (interned strings, which attributes are set per shape)."""
 
     shapes: Shapes
     chunk: Chunk
-    strings: dict[str, int]
+    plan: Plan
+
+    @property
+    def strings(self) -> dict[str, int]:
+        return self.plan.strings.ids
 
 
 _ARITH = {"+": np.add, "-": np.subtract, "*": np.multiply, "/": np.divide, "%": np.fmod}
@@ -43,8 +53,14 @@ def evaluate(expr: ir.Expr, env: Env):
     if isinstance(expr, ir.Param):
         return env.shapes.params[expr.index]
     if isinstance(expr, ir.AttrRef):
+        index = env.plan.dynamic.get(expr.name)
+        if index is not None and env.shapes.dynamic:
+            return env.shapes.dynamic[index]
         column = env.chunk.attrs[expr.name]
         return column[env.shapes.lot]
+    if isinstance(expr, ir.Select):
+        cond = evaluate(expr.cond, env)
+        return np.where(cond, evaluate(expr.then, env), evaluate(expr.other, env))
     if isinstance(expr, ir.ScopeRef):
         return _scope_field(expr.field, env)
     if isinstance(expr, ir.Unary):
@@ -58,11 +74,44 @@ def evaluate(expr: ir.Expr, env: Env):
             return np.logical_or(left, right)
         if expr.op in _COMPARE:
             return _COMPARE[expr.op](left, right)
+        if expr.op == "+" and (_is_string(left) or _is_string(right)):
+            return concatenate(left, right, env.plan.strings)
         with np.errstate(divide="ignore", invalid="ignore"):
             return _ARITH[expr.op](np.asarray(left, dtype=np.float64), right)
     if isinstance(expr, ir.Call):
         return _call(expr, env)
     raise TypeError(f"cannot evaluate {expr!r}")
+
+
+def _is_string(value) -> bool:
+    """String values are interned ids: Python ints or int32 arrays (numbers are float, flags bool)."""
+    return isinstance(value, (int, np.integer)) and not isinstance(value, (bool, np.bool_)) or (
+        isinstance(value, np.ndarray) and value.dtype == np.int32)
+
+
+def format_value(value, is_string: bool, names: list[str]) -> str:
+    """A value as CityEngine prints it in strings: 3.0 -> "3", 2.5 -> "2.5", True -> "true"."""
+    if is_string:
+        return names[int(value)]
+    if isinstance(value, (bool, np.bool_)):
+        return "true" if value else "false"
+    value = float(value)
+    return str(int(value)) if value.is_integer() and abs(value) < 1e15 else repr(value)
+
+
+def concatenate(left, right, strings) -> np.ndarray | int:
+    """CityEngine's ``+`` on strings, per shape: once per distinct pair of operands, then spread."""
+    names = list(strings.ids)
+    left_str, right_str = _is_string(left), _is_string(right)
+    a, b = np.broadcast_arrays(np.asarray(left), np.asarray(right))
+    if a.ndim == 0:
+        text = format_value(a[()], left_str, names) + format_value(b[()], right_str, names)
+        return strings.intern(text)
+    pairs = np.stack([a.astype(np.float64), b.astype(np.float64)], axis=1)
+    distinct, inverse = np.unique(pairs, axis=0, return_inverse=True)
+    ids = np.array([strings.intern(format_value(x, left_str, names) + format_value(y, right_str, names))
+                    for x, y in distinct], dtype=np.int32)
+    return ids[inverse.reshape(-1)]
 
 
 def evaluate_array(expr: ir.Expr, env: Env, dtype=np.float64) -> np.ndarray:
@@ -93,6 +142,22 @@ def _call(expr: ir.Call, env: Env):
             return u
         low, high = (0.0, args[0]) if len(args) == 1 else args
         return low + (np.subtract(high, low)) * u
+    if f == "p":
+        return uniform(env.shapes.key, expr.site) < np.asarray(args[0], dtype=np.float64)
+    if f in ("geometry.area", "geometry.volume"):
+        area, volume = area_and_volume(env.shapes.size, env.shapes.geom, env.chunk.polygons)
+        return area if f == "geometry.area" else volume
+    if f == "isnan":
+        return np.isnan(np.asarray(args[0], dtype=np.float64))
+    if f == "log10":
+        with np.errstate(divide="ignore", invalid="ignore"):
+            return np.log10(np.asarray(args[0], dtype=np.float64))
+    if f == "str":
+        return concatenate(env.plan.strings.intern(""), args[0], env.plan.strings)
+    if f == "float":
+        return _to_float(args[0], env)
+    if f == "bool":
+        return np.asarray(args[0]) != 0
     if f in ("floor", "ceil", "abs"):
         return getattr(np, f)(args[0])
     if f == "round":
@@ -109,6 +174,23 @@ def _call(expr: ir.Call, env: Env):
     x = np.atleast_1d(np.asarray(args[0], dtype=np.float64))
     out = elementwise(_MATH[f], np.ascontiguousarray(x))
     return out if np.ndim(args[0]) else float(out[0])
+
+
+def _to_float(value, env: Env):
+    """``float(x)``: numbers stay, booleans become 0/1, strings are parsed (NaN when not a number)."""
+    if not _is_string(value):
+        return np.asarray(value, dtype=np.float64)
+    names = list(env.plan.strings.ids)
+    ids = np.atleast_1d(np.asarray(value))
+    distinct, inverse = np.unique(ids, return_inverse=True)
+    parsed = []
+    for i in distinct:
+        try:
+            parsed.append(float(names[int(i)]))
+        except ValueError:
+            parsed.append(np.nan)
+    out = np.array(parsed)[inverse.reshape(-1)]
+    return out if np.ndim(value) else float(out[0])
 
 
 @njit(cache=True)

@@ -20,7 +20,7 @@ from grammarc.backend.evaluate import Env, elementwise, evaluate, evaluate_array
 from grammarc.backend.kernels import scope as scope_kernels
 from grammarc.backend.kernels import split as split_kernels
 from grammarc.backend.kernels.order import group_by
-from grammarc.backend.plan import Plan, SymbolPlan
+from grammarc.backend.plan import Plan, SymbolPlan, consumes
 from grammarc.backend.random import child_keys, uniform
 from grammarc.backend.shapes import Shapes
 from grammarc.constants import TOL, Limits
@@ -41,7 +41,7 @@ class Executor:
 
     # ------------------------------------------------------------------------------------------ helpers
     def env(self, shapes: Shapes) -> Env:
-        return Env(shapes, self.chunk, self.plan.strings.ids)
+        return Env(shapes, self.chunk, self.plan)
 
     def fail(self, shapes: Shapes, bad: np.ndarray, message: str, symbol: int, span) -> None:
         """Report the lots of shapes ``bad`` (bool mask) as failed: raises ``LotFailure``."""
@@ -88,7 +88,7 @@ class Executor:
         symbol = sym.id
         alts = rule.alternatives
         if len(alts) == 1:
-            self.run(alts[0].body, shapes, symbol)
+            self.run(alts[0].body, shapes, symbol, leaf_at_end=True)
             return
         env = self.env(shapes)
         probs = np.stack([evaluate_array(a.prob, env) for a in alts], axis=1)
@@ -101,12 +101,17 @@ class Executor:
         for i, alt in enumerate(alts):
             picked = shapes.take(choice == i)
             if len(picked):
-                self.run(alt.body, picked, symbol)
+                self.run(alt.body, picked, symbol, leaf_at_end=True)
 
     # ------------------------------------------------------------------------------------------- bodies
-    def run(self, body: ir.Body, cursor: Shapes, symbol: int) -> None:
-        """Execute ``body`` on ``cursor``; operations replace its scope columns as they go."""
+    def run(self, body: ir.Body, cursor: Shapes, symbol: int, leaf_at_end: bool = False) -> None:
+        """Execute ``body`` on ``cursor``; operations replace its scope columns as they go.
+
+        With CityEngine semantics and ``leaf_at_end`` (a rule's body, a split part, a case branch), a
+        body that makes no successor leaves its shape as a leaf of ``symbol``.
+        """
         stack: list[tuple] = []
+        base = (cursor.origin, cursor.size, cursor.frame)  # what `center` centres on
         for op in body:
             if not len(cursor):
                 return
@@ -119,10 +124,12 @@ class Executor:
             elif isinstance(op, ir.Rotate):
                 cursor = self.rotate(op, cursor)
             elif isinstance(op, ir.Push):
-                stack.append((cursor.origin, cursor.size, cursor.frame, cursor.geom))
+                stack.append((cursor.origin, cursor.size, cursor.frame, cursor.geom, base))
+                base = (cursor.origin, cursor.size, cursor.frame)
             elif isinstance(op, ir.Pop):
                 if stack:
-                    cursor = cursor.with_scope(*stack.pop())
+                    *scope, base = stack.pop()
+                    cursor = cursor.with_scope(*scope)
             elif isinstance(op, ir.Insert):
                 asset = self.plan.grammar.asset_ids[op.asset]
                 terminals.emit_instances(self.chunk, cursor, asset, symbol)
@@ -132,10 +139,28 @@ class Executor:
                 self.repeat(op, cursor, symbol)
             elif isinstance(op, ir.Comp):
                 self.comp(op, cursor, symbol)
-            elif isinstance(op, ir.Empty):
+            elif isinstance(op, ir.Extrude):
+                cursor = self.extrude(op, cursor, symbol)
+            elif isinstance(op, ir.Center):
+                cursor = self.center(op, cursor, base)
+            elif isinstance(op, ir.UseAsset):
+                cursor = self.use_asset(op, cursor)
+            elif isinstance(op, ir.SetAttr):
+                cursor = self.set_attr(op, cursor)
+            elif isinstance(op, ir.Report):
+                self.report(op, cursor)
+            elif isinstance(op, (ir.Case, ir.Stochastic)):
+                self.branch(op, cursor, symbol)
+            elif isinstance(op, ir.GroupSplit):
+                self.group_split(op, cursor, symbol)
+            elif isinstance(op, ir.CompFaces):
+                self.comp_faces(op, cursor, symbol)
+            elif isinstance(op, (ir.Empty, ir.NotApplied)):
                 pass
             else:
                 raise TypeError(f"unknown operation {op!r}")
+        if leaf_at_end and self.plan.leaf_bodies and len(cursor) and not consumes(body):
+            terminals.emit_leaves(self.chunk, cursor, symbol)
 
     def successor(self, op: ir.Symbol, cursor: Shapes, symbol: int) -> None:
         sym = self.plan.symbols[self.plan.symbol_ids[op.name]]
@@ -145,9 +170,9 @@ class Executor:
             for arg, t in zip(op.args, sym.param_types)
         )
         shapes = Shapes(cursor.origin, cursor.size, cursor.frame, cursor.geom, cursor.lot,
-                        child_keys(cursor.key, op.site), cursor.depth + 1, params)
+                        child_keys(cursor.key, op.site), cursor.depth + 1, params, cursor.dynamic)
         self.count(shapes, symbol, op.span)
-        if sym.terminal:
+        if sym.terminal or op.leaf:
             terminals.emit_leaves(self.chunk, shapes, sym.id)
         else:
             self.pending[sym.id].append(shapes)
@@ -290,7 +315,8 @@ class Executor:
             shapes.origin, shapes.size, shapes.key, shapes.frame, shapes.geom, shapes.lot, shapes.depth,
             self.chunk.frames.data, axis, order, parent, pos, length, site, index,
         )
-        return Shapes(origin, size, frame, geom, lot, key, depth, tuple(p[parents] for p in shapes.params))
+        return Shapes(origin, size, frame, geom, lot, key, depth, tuple(p[parents] for p in shapes.params),
+                      tuple(d[parents] for d in shapes.dynamic))
 
     def grouped_children(self, shapes, axis, parent, cell, pos, length, site, n_parts):
         """``children`` ordered by body part (cell mod parts): each part's batch is then a slice."""
@@ -300,19 +326,27 @@ class Executor:
     def run_parts(self, parts: tuple[ir.Body, ...], shapes: Shapes, offsets: np.ndarray, symbol) -> None:
         for i, body in enumerate(parts):
             if offsets[i + 1] > offsets[i]:
-                self.run(body, shapes.take(slice(offsets[i], offsets[i + 1])), symbol)
+                self.run(body, shapes.take(slice(offsets[i], offsets[i + 1])), symbol, leaf_at_end=True)
 
     # ------------------------------------------------------------------------------------------- comp
     def comp(self, op: ir.Comp, cursor: Shapes, symbol: int) -> None:
+        index_of = None
+        if op.index is not None:
+            index_of = evaluate_array(op.index, self.env(cursor))
+        shapes, _, index = self.components(comp_kernels.KIND_CODES[op.kind], cursor, op.site, index_of)
+        self.count(shapes, symbol, op.span)
+        order, offsets = group_by(index % len(op.parts), len(op.parts))
+        self.run_parts(op.parts, shapes.take(order), offsets, symbol)
+
+    def components(self, kind: int, cursor: Shapes, site: int, wanted=None):
+        """Component shapes of ``cursor``, their normals in the parents' frames (m, 3) and their indices
+        among their parent's components (m,); ``wanted`` (n,) keeps, per shape, only that index."""
         chunk = self.chunk
         coords, ring_offsets, shape_offsets, plane = self.polygons_of(cursor)
         parent, index, origin, axes, size, poly = comp_kernels.components(
-            comp_kernels.KIND_CODES[op.kind], coords, ring_offsets, shape_offsets, plane, cursor.size,
-            TOL.zero,
-        )
-        if op.index is not None:
-            wanted = evaluate_array(op.index, self.env(cursor))[parent]
-            keep = index == np.round(wanted)
+            kind, coords, ring_offsets, shape_offsets, plane, cursor.size, TOL.zero)
+        if wanted is not None:
+            keep = index == np.round(wanted[parent])
             parent, index, origin, axes, size, poly = (a[keep] for a in
                                                        (parent, index, origin, axes, size, poly))
         child = cursor.take(parent)
@@ -322,15 +356,16 @@ class Executor:
         geom = np.full(len(parent), -1, dtype=np.int32)
         same = poly == comp_kernels.SAME_POLY
         geom[same] = child.geom[same]
-        for code, flip_when in ((comp_kernels.BOTTOM_POLY, "bottom"), (comp_kernels.TOP_POLY, "top")):
+        for code, which in ((comp_kernels.BOTTOM_POLY, "bottom"), (comp_kernels.TOP_POLY, "top")):
             sel = (poly == code) & (child.geom >= 0)
             if sel.any():
-                geom[sel] = self.cap_polygons(child.geom[sel], flip_when)
-        shapes = Shapes(world_origin, size, frame, geom, child.lot, child_keys(child.key, op.site, index),
-                        child.depth, child.params)
-        self.count(shapes, symbol, op.span)
-        order, offsets = group_by(index % len(op.parts), len(op.parts))
-        self.run_parts(op.parts, shapes.take(order), offsets, symbol)
+                geom[sel] = self.cap_polygons(child.geom[sel], which)
+        # a flat shape's only face is itself: its normal is its plane's axis, not its frame's z
+        normal = axes[:, 2].copy()
+        normal[same] = np.eye(3)[plane[parent[same]]]
+        shapes = Shapes(world_origin, size, frame, geom, child.lot, child_keys(child.key, site, index),
+                        child.depth, child.params, child.dynamic)
+        return shapes, normal, index
 
     def polygons_of(self, shapes: Shapes):
         """Each shape's polygon as batch-local ragged arrays (implicit rectangles for scope shapes)."""
@@ -372,6 +407,118 @@ class Executor:
         return polygons.add(coords, ring_offsets, poly_offsets, np.full(len(geom), 2, dtype=np.int8))
 
 
+    # ------------------------------------------------------------------------------ CityEngine operations
+    def flat_axis(self, cursor: Shapes) -> np.ndarray:
+        """The axis each shape is flat along (its face normal), -1 for solids, edges and assets."""
+        flat = cursor.size <= TOL.zero
+        axis = np.where(flat.sum(axis=1) == 1, np.argmax(flat, axis=1), -1)
+        poly = cursor.geom >= 0
+        axis[poly] = np.where(flat[poly].sum(axis=1) >= 1, self.chunk.polygons.plane[cursor.geom[poly]], -1)
+        axis[cursor.geom < -1] = -1
+        return axis
+
+    def extrude(self, op: ir.Extrude, cursor: Shapes, symbol: int) -> Shapes:
+        """A face becomes a solid along its normal; a negative height extrudes behind the face."""
+        height = evaluate_array(op.height, self.env(cursor))
+        axis = self.flat_axis(cursor)
+        bad = (axis < 0) | ~np.isfinite(height)
+        if bad.any():
+            self.fail(cursor, bad, "`extrude` needs a face (a flat shape) and a finite height", symbol,
+                      op.span)
+        rows = np.arange(len(cursor))
+        size = cursor.size.copy()
+        size[rows, axis] = np.abs(height)
+        normal = self.chunk.frames[cursor.frame][rows, axis]
+        origin = cursor.origin + np.minimum(height, 0.0)[:, None] * normal
+        return cursor.with_scope(origin, size, cursor.frame, cursor.geom)
+
+    def center(self, op: ir.Center, cursor: Shapes, base) -> Shapes:
+        """Centre the scope on ``base`` (the body's first scope or the last push) along ``op.axes``."""
+        base_origin, base_size, base_frame = base
+        frames = self.chunk.frames
+        base_axes = frames[base_frame]
+        axes = frames[cursor.frame]
+        base_center = base_origin + np.einsum("ni,nij->nj", base_size / 2, base_axes)
+        center = cursor.origin + np.einsum("ni,nij->nj", cursor.size / 2, axes)
+        offset = base_center - center
+        origin = cursor.origin.copy()
+        for k in op.axes:
+            origin += np.einsum("nj,nj->n", offset, axes[:, k])[:, None] * axes[:, k]
+        return cursor.with_scope(origin, cursor.size, cursor.frame, cursor.geom)
+
+    def use_asset(self, op: ir.UseAsset, cursor: Shapes) -> Shapes:
+        """The geometry becomes the asset fitted to the scope (a cube is the scope box itself)."""
+        if op.asset == "builtin:cube":
+            geom = np.full(len(cursor), -1, dtype=np.int32)
+        else:
+            geom = np.full(len(cursor), -2 - self.plan.grammar.asset_ids[op.asset], dtype=np.int32)
+        return cursor.with_scope(cursor.origin, cursor.size, cursor.frame, geom)
+
+    def set_attr(self, op: ir.SetAttr, cursor: Shapes) -> Shapes:
+        index = self.plan.dynamic[op.name]
+        column = cursor.dynamic[index]
+        value = evaluate_array(op.value, self.env(cursor), dtype=column.dtype)
+        dynamic = cursor.dynamic[:index] + (value,) + cursor.dynamic[index + 1:]
+        return Shapes(cursor.origin, cursor.size, cursor.frame, cursor.geom, cursor.lot, cursor.key,
+                      cursor.depth, cursor.params, dynamic)
+
+    def report(self, op: ir.Report, cursor: Shapes) -> None:
+        env = self.env(cursor)
+        key = evaluate_array(op.key, env, dtype=np.int32)
+        value = evaluate(op.value, env)
+        self.chunk.outputs.reports.append(report_rows(cursor.lot, key, value, len(cursor)))
+
+    def branch(self, op: ir.Case | ir.Stochastic, cursor: Shapes, symbol: int) -> None:
+        """``case`` and ``p%`` blocks: each shape runs one branch, the default when none is taken."""
+        env = self.env(cursor)
+        n = len(cursor)
+        taken = np.full(n, len(op.branches), dtype=np.int64)
+        if isinstance(op, ir.Case):
+            for i in range(len(op.branches) - 1, -1, -1):
+                holds = evaluate_array(op.branches[i][0], env, dtype=bool)
+                taken[holds] = i
+        else:
+            percent = np.stack([evaluate_array(c, env) for c, _ in op.branches], axis=1)
+            cumulative = np.cumsum(percent, axis=1) / 100.0
+            draw = uniform(cursor.key, op.site)
+            taken = (draw[:, None] >= cumulative).sum(axis=1)
+        bodies = [body for _, body in op.branches] + [op.default]
+        order, offsets = group_by(taken, len(bodies))
+        self.run_parts(tuple(bodies), cursor.take(order), offsets, symbol)
+
+    def group_split(self, op: ir.GroupSplit, cursor: Shapes, symbol: int) -> None:
+        env = self.env(cursor)
+        values = _size_matrix([evaluate(s.value, env) for s in op.sizes], len(cursor))
+        bad = ~(values >= 0).all(axis=1)
+        if bad.any():
+            self.fail(cursor, bad, f"`split` has a negative or NaN size ({_example(values, bad)})", symbol,
+                      op.span)
+        self.check_splittable(cursor, op.axis, symbol, op.span)
+        kind = np.array([_SIZE_KIND[s.kind] for s in op.sizes], dtype=np.int64)
+        groups = np.array(op.groups, dtype=np.int64)
+        if op.repeat:
+            groups = np.zeros_like(groups)
+        n_groups = int(groups.max()) + 1 if len(groups) else 0
+        parent, part, pos, length, index = split_kernels.group_split(
+            np.ascontiguousarray(cursor.size[:, op.axis]), values, kind, groups, n_groups, TOL.zero)
+        order, offsets = group_by(part, len(op.parts))
+        children = self.children(cursor, op.axis, parent, index, pos, length, op.site, order)
+        self.count(children, symbol, op.span)
+        self.run_parts(op.parts, children, offsets, symbol)
+
+    def comp_faces(self, op: ir.CompFaces, cursor: Shapes, symbol: int) -> None:
+        """CityEngine ``comp(f)``: faces to the first selector they match, by their normal."""
+        bad = cursor.geom < -1
+        if bad.any():
+            self.fail(cursor, bad, "`comp` of an inserted asset is not supported yet", symbol, op.span)
+        shapes, normal, _ = self.components(comp_kernels.KIND_CODES["faces"], cursor, op.site)
+        which = classify_faces(normal, op.selectors)
+        keep = which < len(op.selectors)
+        shapes, which = shapes.take(keep), which[keep]
+        self.count(shapes, symbol, op.span)
+        order, offsets = group_by(which, len(op.parts))
+        self.run_parts(op.parts, shapes.take(order), offsets, symbol)
+
 def _rotation(ax: np.ndarray, ay: np.ndarray, az: np.ndarray) -> np.ndarray:
     """(n, 3, 3) matrices M with new axes = M @ axes: about x, then the new y, then the new z (degrees)."""
     n = len(ax)
@@ -405,3 +552,48 @@ def _size_matrix(values: list, n: int) -> np.ndarray:
     if all(np.ndim(v) == 0 for v in values):
         return np.array([values], dtype=np.float64)
     return np.stack([np.broadcast_to(np.asarray(v, np.float64), (n,)) for v in values], axis=1)
+
+
+#: GroupSplit size kinds for the kernel.
+_SIZE_KIND = {ir.SizeKind.ABSOLUTE: 0, ir.SizeKind.RELATIVE: 1, ir.SizeKind.FLOATING: 2}
+#: A face is "top" or "bottom" when its normal is within 45 degrees of the scope's y axis; "horizontal"
+#: and "vertical" within this tolerance of exactly so.
+_FLAT_TOLERANCE = 1e-6
+
+
+def classify_faces(normal: np.ndarray, selectors: tuple[str, ...]) -> np.ndarray:
+    """Index of the first selector each face matches (len(selectors) for none), from normals (m, 3) in
+    the parent's scope frame: front +z, back -z, right +x, left -x, top +y, bottom -y."""
+    x, y, z = normal[:, 0], normal[:, 1], normal[:, 2]
+    top, bottom = y > np.sqrt(0.5), y < -np.sqrt(0.5)
+    side = ~top & ~bottom
+    front = side & (z >= np.abs(x))
+    back = side & (-z >= np.abs(x)) & ~front
+    right = side & (x > np.abs(z))
+    left = side & (-x > np.abs(z))
+    vertical = np.abs(y) <= _FLAT_TOLERANCE
+    horizontal = np.abs(y) >= 1 - _FLAT_TOLERANCE
+    masks = {
+        "front": front, "back": back, "left": left, "right": right, "top": top, "bottom": bottom,
+        "side": side, "vertical": vertical, "horizontal": horizontal,
+        "aslant": ~vertical & ~horizontal & (y > 0), "nutant": ~vertical & ~horizontal & (y < 0),
+        "all": np.ones(len(normal), dtype=bool),
+    }
+    which = np.full(len(normal), len(selectors), dtype=np.int64)
+    for i in range(len(selectors) - 1, -1, -1):
+        which[masks[selectors[i]]] = i
+    return which
+
+
+def report_rows(lot: np.ndarray, key, value, n: int) -> tuple:
+    """One ``report`` call's rows: lot (n,), key ids (n,), values (n,) float64 and the value kind
+    ("num", "bool" or "str"; strings as their ids)."""
+    key = np.broadcast_to(np.asarray(key, dtype=np.int32), (n,))
+    if isinstance(value, (bool, np.bool_)) or (isinstance(value, np.ndarray) and value.dtype == bool):
+        kind = "bool"
+    elif isinstance(value, (int, np.integer)) or (isinstance(value, np.ndarray) and value.dtype == np.int32):
+        kind = "str"
+    else:
+        kind = "num"
+    values = np.broadcast_to(np.asarray(value, dtype=np.float64), (n,))
+    return lot, key, values, kind

@@ -46,6 +46,12 @@ class Plan:
     strings: Strings
     #: Distinct priorities in derivation order (lowest first).
     stages: tuple[int, ...]
+    #: Attributes that rules ``set``: name -> index into ``Shapes.dynamic``.
+    dynamic: dict[str, int]
+    #: CityEngine semantics: a body that makes no successor leaves its shape as a leaf.
+    leaf_bodies: bool
+    #: Names of operations accepted without effect on the record (material, UV, print).
+    not_applied: tuple[str, ...]
 
     @property
     def symbol_names(self) -> tuple[str, ...]:
@@ -67,7 +73,23 @@ def make_plan(grammar: Grammar) -> Plan:
         if isinstance(expr, ir.Str):
             strings.intern(expr.value)
     stages = tuple(sorted({s.priority for s in symbols if s.rules}))
-    return Plan(grammar, tuple(symbols), ids, ids[grammar.graph.start], strings, stages)
+    ops = [op for rule in module.rules for alt in rule.alternatives for op in iter_ops(alt.body)]
+    dynamic = {name: i for i, name in enumerate(dict.fromkeys(
+        op.name for op in ops if isinstance(op, ir.SetAttr)))}
+    not_applied = tuple(sorted({op.name for op in ops if isinstance(op, ir.NotApplied)}))
+    return Plan(grammar, tuple(symbols), ids, ids[grammar.graph.start], strings, stages, dynamic,
+                module.dialect == "cityengine", not_applied)
+
+
+#: Operations after which a body's shape is not the body's to emit: it was replaced by successors, split
+#: into parts, deleted, or handed to case branches (which emit their own leaves).
+_CONSUMING = (ir.Symbol, ir.Empty, ir.Split, ir.Repeat, ir.Comp, ir.GroupSplit, ir.CompFaces, ir.Insert,
+              ir.Case, ir.Stochastic)
+
+
+def consumes(body: ir.Body) -> bool:
+    """Whether ``body`` replaces its shape (CityEngine: a body that does not leaves a leaf)."""
+    return any(isinstance(op, _CONSUMING) for op in body)
 
 
 def _all_exprs(module: ir.Module):

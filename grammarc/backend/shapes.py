@@ -11,7 +11,12 @@ A ``Shapes`` batch holds, per shape:
 - ``lot`` (n,) int32: the lot, as an index into the chunk's lots;
 - ``key`` (n,) uint64: the random-stream key (``backend.random``);
 - ``depth`` (n,) int32: rule applications on the path from the lot;
-- ``params`` tuple of (n,) arrays: the values of the symbol's parameters (float64, or int32 string ids).
+- ``params`` tuple of (n,) arrays: the values of the symbol's parameters (float64, or int32 string ids);
+- ``dynamic`` tuple of (n,) arrays: the attributes that rules ``set`` (``Plan.dynamic`` numbers them),
+  inherited by children.
+
+``geom`` < -1 means the shape's geometry is an inserted asset fitted to its scope (CityEngine's ``i()``):
+asset id = -2 - geom.
 """
 
 from __future__ import annotations
@@ -31,6 +36,7 @@ class Shapes:
     key: np.ndarray
     depth: np.ndarray
     params: tuple[np.ndarray, ...] = ()
+    dynamic: tuple[np.ndarray, ...] = ()
 
     def __len__(self) -> int:
         return len(self.lot)
@@ -40,6 +46,7 @@ class Shapes:
         return Shapes(
             self.origin[index], self.size[index], self.frame[index], self.geom[index], self.lot[index],
             self.key[index], self.depth[index], tuple(p[index] for p in self.params),
+            tuple(d[index] for d in self.dynamic),
         )
 
     def with_scope(self, origin, size, frame, geom) -> Shapes:
@@ -54,4 +61,5 @@ class Shapes:
             *(np.concatenate([getattr(b, f) for b in batches]) for f in
               ("origin", "size", "frame", "geom", "lot", "key", "depth")),
             params=tuple(np.concatenate([b.params[i] for b in batches]) for i in range(len(first.params))),
+            dynamic=tuple(np.concatenate([b.dynamic[i] for b in batches]) for i in range(len(first.dynamic))),
         )

@@ -9,6 +9,7 @@ no rule applied) into output, as CityEngine emits leaf geometry:
   columns are scope axes (k+1, k+2) mod 3 and a zero column, a cyclic permutation chosen so that the
   quad's normal is the scope's axis k (a footprint faces up, a facade out);
 - an edge or a vertex (two or three zero axes) -> nothing: it has no surface;
+- an inserted asset (CityEngine's ``i()``) -> an instance of that asset;
 - a polygon -> faces of the mesh table (with holes); a prism -> its bottom, top and side faces.
 """
 
@@ -50,7 +51,11 @@ def emit_leaves(chunk: Chunk, shapes: Shapes, symbol: int) -> None:
     """Emit the geometry of leaf shapes: instances for scope boxes and rectangles, meshes for polygons."""
     if not len(shapes):
         return
-    box = shapes.geom < 0
+    assets = shapes.geom < -1
+    if assets.any():
+        for asset in np.unique(-2 - shapes.geom[assets]):
+            emit_instances(chunk, shapes.take(shapes.geom == -2 - asset), int(asset), symbol)
+    box = shapes.geom == -1
     flat = shapes.size <= TOL.zero
     zeros = flat.sum(axis=1)
     emit_instances(chunk, shapes.take(box & (zeros == 0)), CUBE, symbol)
@@ -68,7 +73,7 @@ def emit_leaves(chunk: Chunk, shapes: Shapes, symbol: int) -> None:
         out.asset.append(np.full(len(quads), QUAD, dtype=np.int32))
         out.lot.append(quads.lot.astype(np.int32))
         out.symbol.append(np.full(len(quads), symbol, dtype=np.int32))
-    polygons = shapes.take(~box)
+    polygons = shapes.take(shapes.geom >= 0)
     if len(polygons):
         chunk.outputs.meshes.append(polygon_meshes(chunk, polygons, symbol))
 

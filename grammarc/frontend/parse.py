@@ -1,8 +1,9 @@
 """Parse grammar text into IR with every syntax error reported, not just the first.
 
-The lark grammar (``grammars/cga2006.lark``) is loaded once per process (LALR, positions on). The text is
-cut into statements (``statements.py``); each is parsed on its own, with leading newlines so that lark's
-line numbers are the file's, and lowered to IR by ``lower_cga2006.Lowering``.
+Two dialects, one IR: the paper notation (``grammars/cga2006.lark``, ``lower_cga2006``) and CityEngine CGA
+(``grammars/cityengine.lark``, ``lower_cityengine``). Each lark grammar is loaded once per process (LALR,
+positions on). The text is cut into statements (``statements.py``, with the dialect's layout); each is
+parsed on its own, with leading newlines so that lark's line numbers are the file's, and lowered to IR.
 """
 
 from __future__ import annotations
@@ -16,9 +17,23 @@ from lark import Lark
 from lark.exceptions import UnexpectedCharacters, UnexpectedEOF, UnexpectedInput, UnexpectedToken
 
 from grammarc.diagnostics import Diagnostics, Span
-from grammarc.frontend.lower_cga2006 import Lowering, assemble
-from grammarc.frontend.statements import split_statements
+from grammarc.frontend import lower_cga2006, lower_cityengine
+from grammarc.frontend.statements import CITYENGINE, PAPER, split_statements
 from grammarc.ir import nodes as ir
+
+#: Dialect name -> (grammar file, statement layout, lowering module).
+DIALECTS = {
+    "cga2006": ("grammars/cga2006.lark", PAPER, lower_cga2006),
+    "cityengine": ("grammars/cityengine.lark", CITYENGINE, lower_cityengine),
+}
+#: Text that only CityEngine CGA has: its version line, annotations, lower-case operations, const.
+_CITYENGINE_MARKS = re.compile(r'^\s*(version\s+"|@StartRule|const\s)|\b(extrude|split|comp)\s*\(|-->\s*$',
+                               re.MULTILINE)
+
+
+def detect_dialect(text: str) -> str:
+    """``cityengine`` for CityEngine CGA, ``cga2006`` for the paper notation."""
+    return "cityengine" if _CITYENGINE_MARKS.search(text) else "cga2006"
 
 #: How terminals are named in messages.
 _TERMINALS = {
@@ -33,26 +48,30 @@ _TERMINALS = {
 
 
 @cache
-def _parser() -> Lark:
-    grammar = resources.files("grammarc.frontend").joinpath("grammars/cga2006.lark").read_text("utf-8")
+def _parser(grammar_file: str = "grammars/cga2006.lark") -> Lark:
+    grammar = resources.files("grammarc.frontend").joinpath(grammar_file).read_text("utf-8")
     # cache=True keeps the LALR tables in the temp folder, keyed by the grammar's hash: saves ~0.2 s a run
     return Lark(grammar, start="statement", parser="lalr", propagate_positions=True,
                 maybe_placeholders=True, cache=True)
 
 
-def parse_source(text: str, file: str, diags: Diagnostics) -> ir.Module:
-    """Parse and lower ``text`` (named ``file`` in diagnostics); problems go to ``diags``."""
-    parser = _parser()
+def parse_source(text: str, file: str, diags: Diagnostics, dialect: str | None = None) -> ir.Module:
+    """Parse and lower ``text`` (named ``file`` in diagnostics); problems go to ``diags``.
+
+    ``dialect`` is ``cga2006`` or ``cityengine``; by default it is detected from the text.
+    """
+    grammar_file, layout, lowering = DIALECTS[dialect or detect_dialect(text)]
+    parser = _parser(grammar_file)
     sites = itertools.count(1)
     lowered = []
-    for statement in split_statements(text):
+    for statement in split_statements(text, layout):
         try:
             tree = parser.parse("\n" * (statement.line - 1) + statement.text)
         except UnexpectedInput as error:
             _syntax_error(error, file, statement.text, statement.line, diags)
             continue
-        lowered.append(Lowering(file, diags, sites).transform(tree))
-    return assemble(file, lowered, diags)
+        lowered.append(lowering.Lowering(file, diags, sites).transform(tree))
+    return lowering.assemble(file, lowered, diags)
 
 
 def _syntax_error(error: UnexpectedInput, file: str, text: str, first_line: int, diags: Diagnostics):

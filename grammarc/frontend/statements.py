@@ -23,6 +23,30 @@ _OBVIOUS_START = re.compile(
 
 
 @dataclass(frozen=True, slots=True)
+class Layout:
+    """How a dialect lays statements out.
+
+    ``obvious_start`` matches a line that begins a statement even inside an open bracket; lines starting
+    with one of ``continuation_words`` continue the statement before them; with ``glue_annotations``, a
+    statement made only of annotation lines (``@Range(...)``) continues into the declaration after it.
+    """
+
+    obvious_start: re.Pattern
+    continuation_words: tuple[str, ...] = ()
+    glue_annotations: bool = False
+
+
+#: The paper notation: rules start in column 1 with an optional integer label.
+PAPER = Layout(_OBVIOUS_START)
+#: CityEngine CGA: declarations and rules start in column 1, annotations glue to what follows.
+CITYENGINE = Layout(
+    re.compile(r"^(@\w|attr\s|const\s|version\s|import\s|[A-Za-z_$][\w$]*\s*(\([^()]*\))?\s*-->)"),
+    continuation_words=("case", "else"),
+    glue_annotations=True,
+)
+
+
+@dataclass(frozen=True, slots=True)
 class Statement:
     """One statement's text and its first line (1-based); the text starts in column 1."""
 
@@ -30,7 +54,7 @@ class Statement:
     line: int
 
 
-def split_statements(text: str) -> list[Statement]:
+def split_statements(text: str, layout: Layout = PAPER) -> list[Statement]:
     """Split ``text`` into statements, skipping blank and comment-only lines between them."""
     statements: list[Statement] = []
     current: list[str] = []
@@ -45,8 +69,10 @@ def split_statements(text: str) -> list[Statement]:
             and line[:1] not in ("", " ", "\t")
             and line[0] not in _CONTINUATION_START
             and not line.startswith(("//", "#", "/*"))
+            and not _starts_with_word(line, layout.continuation_words)
+            and not (layout.glue_annotations and current and _only_annotations(current[:kept]))
         )
-        if not begins and depth > 0 and not in_block_comment and _OBVIOUS_START.match(line):
+        if not begins and depth > 0 and not in_block_comment and layout.obvious_start.match(line):
             begins, depth = True, 0
         after, in_comment_after, has_code = _scan(line, depth, in_block_comment)
         if not begins and not current and has_code:
@@ -64,6 +90,15 @@ def split_statements(text: str) -> list[Statement]:
     if current:
         statements.append(Statement("\n".join(current[:kept]), start))
     return statements
+
+
+def _starts_with_word(line: str, words: tuple[str, ...]) -> bool:
+    return any(line.startswith(w) and not line[len(w):len(w) + 1].isalnum() for w in words)
+
+
+def _only_annotations(lines: list[str]) -> bool:
+    code = [s.strip() for s in lines if s.strip() and not s.strip().startswith(("#", "//"))]
+    return bool(code) and all(s.startswith("@") for s in code)
 
 
 def _scan(line: str, depth: int, in_block_comment: bool) -> tuple[int, bool, bool]:

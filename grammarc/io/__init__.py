@@ -12,6 +12,10 @@ from grammarc.errors import UsageError
 
 #: Output extension -> writer class name in its module. Later formats (USD, glTF, OBJ) add a line each.
 WRITERS = {".npz": ("grammarc.io.npz", "InstanceWriter")}
+WRITERS[".obj"] = ("grammarc.io.bake", "BakedWriter")  # meshes: the record baked on close (io/bake.py)
+WRITERS[".ply"] = ("grammarc.io.bake", "BakedWriter")
+WRITERS[".stl"] = ("grammarc.io.bake", "BakedWriter")
+WRITERS[".glb"] = ("grammarc.io.bake", "BakedWriter")
 
 
 def writer_for(path: str | Path):

@@ -132,7 +132,17 @@ class Call:
     site: int = 0
 
 
-Expr = Num | Str | Bool | Name | Param | AttrRef | ScopeRef | Unary | Binary | Call
+@dataclass(frozen=True, slots=True)
+class Select:
+    """``cond ? then : other`` per shape: CityEngine's ``case`` and ``p% :`` expressions lower to it."""
+
+    cond: Expr
+    then: Expr
+    other: Expr
+    span: Span = NO_SPAN
+
+
+Expr = Num | Str | Bool | Name | Param | AttrRef | ScopeRef | Unary | Binary | Call | Select
 
 #: Built-in functions: name -> (min args, max args, result type). Argument types are numbers.
 FUNCTIONS: dict[str, tuple[int, int, Type]] = {
@@ -154,7 +164,15 @@ FUNCTIONS: dict[str, tuple[int, int, Type]] = {
     "pow": (2, 2, Type.NUM),
     "min": (2, 2, Type.NUM),
     "max": (2, 2, Type.NUM),
+    # CityEngine built-ins
+    "p": (1, 1, Type.BOOL),
+    "log10": (1, 1, Type.NUM),
+    "isnan": (1, 1, Type.BOOL),
+    "geometry.area": (0, 0, Type.NUM),
+    "geometry.volume": (0, 0, Type.NUM),
 }
+#: Functions that take strings or any type (their argument types are checked by ``passes.types``).
+CONVERSIONS: dict[str, Type] = {"str": Type.STR, "float": Type.NUM, "bool": Type.BOOL}
 
 
 # ------------------------------------------------------------------------------------------------ operations
@@ -171,12 +189,16 @@ class Size:
 
 @dataclass(frozen=True, slots=True)
 class Symbol:
-    """Create a shape with this symbol on the current scope (a successor shape)."""
+    """Create a shape with this symbol on the current scope (a successor shape).
+
+    ``leaf`` (CityEngine's ``X.``): the shape is a leaf named ``name`` even if ``name`` has rules.
+    """
 
     name: str
     args: tuple[Expr, ...]
     span: Span = NO_SPAN
     site: int = 0
+    leaf: bool = False
 
 
 @dataclass(frozen=True, slots=True)
@@ -274,7 +296,116 @@ class Comp:
     site: int = 0
 
 
-Op = Symbol | Empty | Translate | Scale | Rotate | Push | Pop | Insert | Split | Repeat | Comp
+@dataclass(frozen=True, slots=True)
+class Extrude:
+    """CityEngine ``extrude(h)``: a flat shape becomes a solid along its normal (its flat scope axis);
+    a negative height extrudes against the normal."""
+
+    height: Expr
+    span: Span = NO_SPAN
+
+
+@dataclass(frozen=True, slots=True)
+class Center:
+    """CityEngine ``center(axes)``: centre the scope on the scope the body started with (or the last
+    ``[``) along the given axes."""
+
+    axes: tuple[int, ...]
+    span: Span = NO_SPAN
+
+
+@dataclass(frozen=True, slots=True)
+class UseAsset:
+    """CityEngine ``i(asset)`` and ``primitiveCube()``: the shape's geometry becomes the asset fitted to
+    its scope; the shape goes on (a leaf emits the asset as an instance)."""
+
+    asset: str
+    span: Span = NO_SPAN
+
+
+@dataclass(frozen=True, slots=True)
+class Case:
+    """``case c1: B1 case c2: B2 else: B`` inside a body: each shape runs the first branch that holds."""
+
+    branches: tuple[tuple[Expr, Body], ...]
+    default: Body
+    span: Span = NO_SPAN
+
+
+@dataclass(frozen=True, slots=True)
+class Stochastic:
+    """``30% : B1 20% : B2 else: B``: each shape draws one branch (percentages, ``else`` the rest)."""
+
+    branches: tuple[tuple[Expr, Body], ...]
+    default: Body
+    span: Span = NO_SPAN
+    site: int = 0
+
+
+@dataclass(frozen=True, slots=True)
+class SetAttr:
+    """CityEngine ``set(attr, value)``: the attribute's value for this shape and its descendants."""
+
+    name: str
+    value: Expr
+    span: Span = NO_SPAN
+
+
+@dataclass(frozen=True, slots=True)
+class Report:
+    """CityEngine ``report(key, value)``: summed per lot (count, sum, mean, min, max) beside the output."""
+
+    key: Expr
+    value: Expr
+    span: Span = NO_SPAN
+
+
+@dataclass(frozen=True, slots=True)
+class NotApplied:
+    """An operation that is accepted but has no effect on the record (material, texture and UV
+    operations, ``reverseNormals``, ``print``); the output's meta lists it."""
+
+    name: str
+    span: Span = NO_SPAN
+
+
+@dataclass(frozen=True, slots=True)
+class GroupSplit:
+    """CityEngine ``split(axis){ size: A | 'rel: B | ~float: C | { ... }* }[*]``.
+
+    Sizes: absolute, relative to the scope (``'``) or floating (``~``, adjusted so the parts fill the
+    scope). ``groups[i]`` is the repeat group of part ``i`` (-1 outside any group); a group repeats as
+    often as it fits, rounded when it holds floating sizes. ``repeat``: the whole split is one group.
+    """
+
+    axis: int
+    sizes: tuple[Size, ...]
+    groups: tuple[int, ...]
+    parts: tuple[Body, ...]
+    repeat: bool
+    span: Span = NO_SPAN
+    site: int = 0
+
+
+#: Face selectors of CityEngine's ``comp(f)``, relative to the shape's scope.
+FACE_SELECTORS = frozenset({
+    "front", "back", "left", "right", "top", "bottom", "side", "vertical", "horizontal", "aslant",
+    "nutant", "all",
+})
+
+
+@dataclass(frozen=True, slots=True)
+class CompFaces:
+    """CityEngine ``comp(f){ sel: A | sel: B }``: each face goes to the first selector it matches."""
+
+    selectors: tuple[str, ...]
+    parts: tuple[Body, ...]
+    span: Span = NO_SPAN
+    site: int = 0
+
+
+Op = (Symbol | Empty | Translate | Scale | Rotate | Push | Pop | Insert | Split | Repeat | Comp | Extrude
+      | Center | UseAsset | Case | Stochastic | SetAttr | Report | NotApplied | GroupSplit | CompFaces)
 Body = tuple[Op, ...]
 
 
@@ -304,10 +435,17 @@ class Rule:
 
 @dataclass(frozen=True, slots=True)
 class AttrDecl:
+    """``attr name = default``; a ``const`` is an attribute that lots and ``--attr`` cannot override.
+
+    ``annotations`` keeps CityEngine's ``@Range(...)``, ``@Enum(...)``, ... as (name, argument texts).
+    """
+
     name: str
     default: Expr
     span: Span = NO_SPAN
     type: Type = Type.UNKNOWN
+    const: bool = False
+    annotations: tuple[tuple[str, tuple[str, ...]], ...] = ()
 
 
 @dataclass(frozen=True, slots=True)
@@ -320,3 +458,6 @@ class Module:
     start: str | None
     #: Parameter types per symbol, filled by ``passes.types``.
     param_types: tuple[tuple[str, tuple[Type, ...]], ...] = ()
+    #: ``cga2006`` or ``cityengine``. In CityEngine CGA a body that makes no successor leaves its shape
+    #: as a leaf (``Lot --> extrude(10)`` is a mass); in the paper notation such a body emits nothing.
+    dialect: str = "cga2006"

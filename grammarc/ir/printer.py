@@ -32,12 +32,22 @@ def print_expr(e: ir.Expr) -> str:
         return f"({print_expr(e.left)} {e.op} {print_expr(e.right)})"
     if isinstance(e, ir.Call):
         return f"{e.func}({', '.join(print_expr(a) for a in e.args)})"
+    if isinstance(e, ir.Select):
+        return f"({print_expr(e.cond)} ? {print_expr(e.then)} : {print_expr(e.other)})"
     raise TypeError(f"not an expression: {e!r}")
 
 
 def _size(s: ir.Size) -> str:
     text = print_expr(s.value)
+    if s.kind is ir.SizeKind.FLOATING:
+        return f"~{text}"
     return f"{text}r" if s.kind is ir.SizeKind.RELATIVE else text
+
+
+def _branches(op) -> str:
+    head = "case" if isinstance(op, ir.Case) else "%"
+    parts = [f"{head} {print_expr(c)}: {print_body(b) or 'ε'}" for c, b in op.branches]
+    return "{ " + " ".join(parts) + f" else: {print_body(op.default) or 'ε'} }}"
 
 
 def _axes(axes: tuple[int, ...]) -> str:
@@ -50,7 +60,8 @@ def _parts(parts) -> str:
 
 def print_op(op: ir.Op) -> str:
     if isinstance(op, ir.Symbol):
-        return op.name + (f"({', '.join(print_expr(a) for a in op.args)})" if op.args else "")
+        args = f"({', '.join(print_expr(a) for a in op.args)})" if op.args else ""
+        return op.name + args + ("." if op.leaf else "")
     if isinstance(op, ir.Empty):
         return "ε"
     if isinstance(op, ir.Translate):
@@ -72,6 +83,31 @@ def print_op(op: ir.Op) -> str:
     if isinstance(op, ir.Comp):
         index = f", {print_expr(op.index)}" if op.index is not None else ""
         return f'Comp("{op.kind}"{index}){_parts(op.parts)}'
+    if isinstance(op, ir.GroupSplit):
+        items = []
+        for g in sorted(set(op.groups)):
+            members = [f"{_size(s)}: {print_body(b) or 'ε'}"
+                       for s, b, grp in zip(op.sizes, op.parts, op.groups) if grp == g]
+            items.append(" | ".join(members) if g < 0 else "{ " + " | ".join(members) + " }*")
+        star = "*" if op.repeat else ""
+        return f"split({'xyz'[op.axis]}){{ {' | '.join(items)} }}{star}"
+    if isinstance(op, ir.CompFaces):
+        return "comp(f){ " + " | ".join(f"{s}: {print_body(b) or 'ε'}"
+                                         for s, b in zip(op.selectors, op.parts)) + " }"
+    if isinstance(op, (ir.Case, ir.Stochastic)):
+        return _branches(op)
+    if isinstance(op, ir.Extrude):
+        return f"extrude({print_expr(op.height)})"
+    if isinstance(op, ir.Center):
+        return f"center({''.join('xyz'[a] for a in op.axes)})"
+    if isinstance(op, ir.UseAsset):
+        return f'i("{op.asset}")'
+    if isinstance(op, ir.SetAttr):
+        return f"set({op.name}, {print_expr(op.value)})"
+    if isinstance(op, ir.Report):
+        return f"report({print_expr(op.key)}, {print_expr(op.value)})"
+    if isinstance(op, ir.NotApplied):
+        return f"{op.name}(...)"
     raise TypeError(f"not an operation: {op!r}")
 
 

@@ -30,6 +30,11 @@ def rewrite_expr(expr: ir.Expr, fn: ExprFn) -> ir.Expr:
         args = _tuple(expr.args, lambda a: rewrite_expr(a, fn))
         if args is not expr.args:
             expr = replace(expr, args=args)
+    elif isinstance(expr, ir.Select):
+        parts = _tuple((expr.cond, expr.then, expr.other), lambda a: rewrite_expr(a, fn))
+        if parts is not (expr.cond, expr.then, expr.other) and any(
+                a is not b for a, b in zip(parts, (expr.cond, expr.then, expr.other))):
+            expr = replace(expr, cond=parts[0], then=parts[1], other=parts[2])
     return fn(expr)
 
 
@@ -70,7 +75,35 @@ def rewrite_op(op: ir.Op, fn: ExprFn) -> ir.Op:
         index = ex(op.index) if op.index is not None else None
         parts = _tuple(op.parts, lambda b: rewrite_body(b, fn))
         return op if index is op.index and parts is op.parts else replace(op, index=index, parts=parts)
+    if isinstance(op, ir.GroupSplit):
+        sizes = _tuple(op.sizes, lambda s: _size(s, fn))
+        parts = _tuple(op.parts, lambda b: rewrite_body(b, fn))
+        return op if sizes is op.sizes and parts is op.parts else replace(op, sizes=sizes, parts=parts)
+    if isinstance(op, ir.CompFaces):
+        parts = _tuple(op.parts, lambda b: rewrite_body(b, fn))
+        return op if parts is op.parts else replace(op, parts=parts)
+    if isinstance(op, (ir.Case, ir.Stochastic)):
+        branches = _tuple(op.branches, lambda br: _branch(br, fn))
+        default = rewrite_body(op.default, fn)
+        if branches is op.branches and default is op.default:
+            return op
+        return replace(op, branches=branches, default=default)
+    if isinstance(op, ir.Extrude):
+        height = ex(op.height)
+        return op if height is op.height else replace(op, height=height)
+    if isinstance(op, ir.SetAttr):
+        value = ex(op.value)
+        return op if value is op.value else replace(op, value=value)
+    if isinstance(op, ir.Report):
+        key, value = ex(op.key), ex(op.value)
+        return op if key is op.key and value is op.value else replace(op, key=key, value=value)
     return op
+
+
+def _branch(branch: tuple, fn: ExprFn) -> tuple:
+    cond, body = branch
+    new_cond, new_body = rewrite_expr(cond, fn), rewrite_body(body, fn)
+    return branch if new_cond is cond and new_body is body else (new_cond, new_body)
 
 
 def rewrite_body(body: ir.Body, fn: ExprFn) -> ir.Body:
@@ -110,9 +143,17 @@ def iter_ops(body: ir.Body) -> Iterator[ir.Op]:
     """Every operation of ``body``, including those inside split parts, in source order."""
     for op in body:
         yield op
-        if isinstance(op, (ir.Split, ir.Repeat, ir.Comp)):
-            for part in op.parts:
-                yield from iter_ops(part)
+        for part in sub_bodies(op):
+            yield from iter_ops(part)
+
+
+def sub_bodies(op: ir.Op) -> tuple[ir.Body, ...]:
+    """The bodies nested in ``op``: split parts, case and stochastic branches."""
+    if isinstance(op, (ir.Split, ir.Repeat, ir.Comp, ir.GroupSplit, ir.CompFaces)):
+        return op.parts
+    if isinstance(op, (ir.Case, ir.Stochastic)):
+        return (*(body for _, body in op.branches), op.default)
+    return ()
 
 
 def op_exprs(op: ir.Op) -> Iterator[ir.Expr]:
@@ -129,6 +170,17 @@ def op_exprs(op: ir.Op) -> Iterator[ir.Expr]:
         yield from op.sizes
     elif isinstance(op, ir.Comp) and op.index is not None:
         yield op.index
+    elif isinstance(op, ir.GroupSplit):
+        yield from (s.value for s in op.sizes)
+    elif isinstance(op, (ir.Case, ir.Stochastic)):
+        yield from (cond for cond, _ in op.branches)
+    elif isinstance(op, ir.Extrude):
+        yield op.height
+    elif isinstance(op, ir.SetAttr):
+        yield op.value
+    elif isinstance(op, ir.Report):
+        yield op.key
+        yield op.value
 
 
 def iter_exprs(expr: ir.Expr) -> Iterator[ir.Expr]:
@@ -141,4 +193,7 @@ def iter_exprs(expr: ir.Expr) -> Iterator[ir.Expr]:
         yield from iter_exprs(expr.right)
     elif isinstance(expr, ir.Call):
         for a in expr.args:
+            yield from iter_exprs(a)
+    elif isinstance(expr, ir.Select):
+        for a in (expr.cond, expr.then, expr.other):
             yield from iter_exprs(a)

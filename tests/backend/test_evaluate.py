@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import replace
+from types import SimpleNamespace
 
 import numpy as np
 import pytest
@@ -11,6 +12,7 @@ from conftest import make_lots
 
 from grammarc.backend.derive import initial_chunk
 from grammarc.backend.evaluate import _MATH, Env, elementwise, evaluate, evaluate_array
+from grammarc.backend.plan import Strings
 from grammarc.backend.random import lot_keys, mix
 from grammarc.ir import nodes as ir
 
@@ -88,7 +90,10 @@ def env():
     shapes = replace(shapes, key=mix(lot_keys(9, chunk.lot_index)[lot], np.arange(N)),
                      params=(rng.uniform(-10, 10, N),))
     chunk.attrs = {"h": np.array([1.0, 2.0, 3.0, 4.0, 5.0])}
-    return Env(shapes, chunk, {"a": 0, "b": 1})
+    strings = Strings()
+    strings.intern("a")
+    strings.intern("b")
+    return Env(shapes, chunk, SimpleNamespace(strings=strings, dynamic={}))
 
 
 def num(v):
@@ -200,7 +205,7 @@ def test_rand_does_not_depend_on_batch(env):
     """A shape draws the same number alone or in a batch (DESIGN.md invariant 2)."""
     whole = evaluate(call("rand", num(2), num(9), site=3), env)
     sel = np.random.default_rng(0).permutation(N)[:50]
-    part = Env(env.shapes.take(sel), env.chunk, env.strings)
+    part = Env(env.shapes.take(sel), env.chunk, env.plan)
     assert np.array_equal(evaluate(call("rand", num(2), num(9), site=3), part), whole[sel])
 
 
@@ -247,7 +252,7 @@ def test_scope_fields(env):
     for field in ("tx", "ty", "tz"):
         assert np.allclose(evaluate(ir.ScopeRef(field), env), 0.0)
     d = np.random.default_rng(2).normal(size=(N, 3))
-    moved = Env(replace(shapes, origin=shapes.origin + d), env.chunk, env.strings)
+    moved = Env(replace(shapes, origin=shapes.origin + d), env.chunk, env.plan)
     axes = env.chunk.lot_axes[shapes.lot]
     for k, field in enumerate(("tx", "ty", "tz")):
         np.testing.assert_allclose(evaluate(ir.ScopeRef(field), moved), np.einsum("nj,nj->n", d, axes[:, k]),
@@ -255,7 +260,7 @@ def test_scope_fields(env):
 
 
 def test_empty_batch(env):
-    empty = Env(env.shapes.take(np.zeros(0, np.int64)), env.chunk, env.strings)
+    empty = Env(env.shapes.take(np.zeros(0, np.int64)), env.chunk, env.plan)
     for expr in (call("rand", site=1), call("sin", P0), ir.Binary("*", P0, num(2)), ir.ScopeRef("tx")):
         assert evaluate(expr, empty).shape == (0,)
     assert evaluate_array(num(1), empty).shape == (0,)

@@ -30,7 +30,7 @@ def errors(text: str) -> list[tuple[int, int, str]]:
     ('attr s = "x"\na : s ~> b', [(2, 5, "a guard must be a bool, got a str")]),
     ("a(x) : x + 1 ~> b", [(1, 10, "a guard must be a bool, got a num")]),
     # operators
-    ('a ~> T("a" + 1, 0, 0)', [(1, 12, "`+` cannot combine a str and a num")]),
+    ('a ~> T("a" * 1, 0, 0)', [(1, 12, "`*` cannot combine a str and a num")]),
     ('a ~> T(2 * "b", 0, 0)', [(1, 10, "`*` cannot combine a num and a str")]),
     ('a : 1 == "x" ~> b', [(1, 7, "`==` cannot combine a num and a str")]),
     ('a : "x" != 1 ~> b', [(1, 9, "`!=` cannot combine a str and a num")]),
@@ -48,7 +48,7 @@ def errors(text: str) -> list[tuple[int, int, str]]:
     ('a ~> Repeat("X", true){ b }', [(1, 18, "a size must be a num, got a bool")]),
     ('a ~> b : "p" ~> c : 0.5', [(1, 10, "a probability must be a num, got a str")]),
     # attribute defaults are checked too
-    ('attr a = "x" + 1\nb ~> c', [(1, 14, "`+` cannot combine a str and a num")]),
+    ('attr a = "x" - 1\nb ~> c', [(1, 14, "`-` cannot combine a str and a num")]),
     # well-typed: equality on any one type, logic on bools
     ('a : "x" == "x" && true != false || !(1 >= 2) ~> b', []),
 ])

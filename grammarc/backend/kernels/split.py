@@ -114,3 +114,129 @@ def repeat(extent, counts):
             m += 1
     return parent, part, pos, length
 
+
+
+@njit(cache=True)
+def group_split(extent, values, kind, group, n_groups, tol):
+    """Parts of CityEngine's ``split`` with absolute, relative and floating sizes and repeat groups.
+
+    extent : (n,) float64; values : (n, P) or (1, P) float64 the sizes as written; kind : (P,) int64,
+    0 absolute, 1 relative (a fraction of the extent), 2 floating (``~``); group : (P,) int64 the repeat
+    group of each part, -1 for none; n_groups : int.
+
+    The rule (grammarc's reading of CityEngine's): the extent minus the fixed parts outside groups is
+    shared by the floating parts outside groups and the groups, in proportion to their nominal sizes (a
+    group's nominal size is one repetition). A group repeats round(share / nominal) times (at least once)
+    if it holds floating parts, whose sizes then stretch to fill its share exactly; otherwise
+    floor(share / nominal) times, the rest of its share left empty. Parts are laid end to end; parts
+    beyond the extent are dropped, the last one cut; parts of length <= tol are dropped.
+
+    Returns parent, part (index into the P parts), position, length (m,) and index (m,) int64, the
+    child's number within its parent.
+    """
+    n = len(extent)
+    count = values.shape[1]
+    shared = values.shape[0] == 1
+    reps = np.zeros((n, max(n_groups, 1)), np.int64)
+    stretch = np.ones((n, max(n_groups, 1)))
+    gap = np.zeros((n, max(n_groups, 1)))
+    float_scale = np.ones(n)
+    total = 0
+    for i in range(n):
+        row = 0 if shared else i
+        fixed = 0.0
+        float_weight = 0.0
+        nominal = np.zeros(max(n_groups, 1))
+        group_fixed = np.zeros(max(n_groups, 1))
+        group_float = np.zeros(max(n_groups, 1))
+        for j in range(count):
+            size = values[row, j] * extent[i] if kind[j] == 1 else values[row, j]
+            g = group[j]
+            if g < 0:
+                if kind[j] == 2:
+                    float_weight += size
+                else:
+                    fixed += size
+            else:
+                nominal[g] += size
+                if kind[j] == 2:
+                    group_float[g] += size
+                else:
+                    group_fixed[g] += size
+        rest = max(extent[i] - fixed, 0.0)
+        weight = float_weight
+        for g in range(n_groups):
+            weight += nominal[g]
+        used_by_groups = 0.0
+        for g in range(n_groups):
+            share = rest * nominal[g] / weight if weight > 0.0 else 0.0
+            if nominal[g] <= tol:
+                continue
+            if group_float[g] > 0.0:
+                r = max(int(np.floor(share / nominal[g] + 0.5)), 1) if share > tol else 0
+                if r > 0:
+                    stretch[i, g] = max(share / r - group_fixed[g], 0.0) / group_float[g]
+            else:
+                r = int(np.floor(share / nominal[g] + 1e-9))
+                gap[i, g] = share - r * nominal[g]
+            reps[i, g] = r
+            used_by_groups += share
+        if float_weight > 0.0:
+            float_scale[i] = (rest - used_by_groups) / float_weight if weight > 0.0 else 0.0
+        for j in range(count):
+            g = group[j]
+            total += 1 if g < 0 else reps[i, g]
+    parent = np.empty(total, np.int64)
+    part = np.empty(total, np.int64)
+    pos = np.empty(total)
+    length = np.empty(total)
+    index = np.empty(total, np.int64)
+    m = 0
+    for i in range(n):
+        row = 0 if shared else i
+        at = 0.0
+        child = 0
+        j = 0
+        while j < count:
+            g = group[j]
+            if g < 0:
+                size = _part_size(values[row, j], kind[j], extent[i], float_scale[i])
+                m, at, child = _place(parent, part, pos, length, index, m, i, j, at, size, extent[i], tol,
+                                      child)
+                j += 1
+                continue
+            end = j
+            while end < count and group[end] == g:
+                end += 1
+            for _ in range(reps[i, g]):
+                for k in range(j, end):
+                    size = _part_size(values[row, k], kind[k], extent[i], stretch[i, g])
+                    m, at, child = _place(parent, part, pos, length, index, m, i, k, at, size, extent[i],
+                                          tol, child)
+            at += gap[i, g]
+            j = end
+    return parent[:m], part[:m], pos[:m], length[:m], index[:m]
+
+
+@njit(cache=True)
+def _part_size(value, kind, extent, scale):
+    if kind == 1:
+        return value * extent
+    if kind == 2:
+        return value * scale
+    return value
+
+
+@njit(cache=True)
+def _place(parent, part, pos, length, index, m, i, j, at, size, extent, tol, child):
+    """Lay one part at ``at``; cut at the extent, drop if empty. Returns (m, next position, child)."""
+    end = min(at + size, extent)
+    if end - at > tol:
+        parent[m] = i
+        part[m] = j
+        pos[m] = at
+        length[m] = end - at
+        index[m] = child
+        m += 1
+        child += 1
+    return m, at + size, child

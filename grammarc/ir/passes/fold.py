@@ -26,8 +26,10 @@ PURE = {
     "tan": lambda d: math.tan(math.radians(d)),
     "asin": lambda x: math.degrees(math.asin(x)), "acos": lambda x: math.degrees(math.acos(x)),
     "atan": lambda x: math.degrees(math.atan(x)), "atan2": lambda y, x: math.degrees(math.atan2(y, x)),
-    "pow": math.pow, "min": min, "max": max,
+    "pow": math.pow, "min": min, "max": max, "log10": math.log10, "isnan": math.isnan,
 }
+#: Functions that read the shape or draw random numbers: never folded.
+SHAPE_DEPENDENT = frozenset({"rand", "p", "geometry.area", "geometry.volume"})
 _CONSTANT = (ir.Num, ir.Str, ir.Bool)
 
 
@@ -58,10 +60,15 @@ def _folder(diags: Diagnostics):
                 return ir.Bool(bool(a and b), expr.span)
             if expr.op == "||":
                 return ir.Bool(bool(a or b), expr.span)
+        if isinstance(expr, ir.Select) and isinstance(expr.cond, ir.Bool):
+            return expr.then if expr.cond.value else expr.other
         if isinstance(expr, ir.Call) and expr.func in PURE \
                 and all(isinstance(a, ir.Num) for a in expr.args):
             try:
-                return ir.Num(float(PURE[expr.func](*(a.value for a in expr.args))), expr.span)
+                value = PURE[expr.func](*(a.value for a in expr.args))
+                if isinstance(value, bool):
+                    return ir.Bool(value, expr.span)
+                return ir.Num(float(value), expr.span)
             except (ValueError, OverflowError):
                 diags.error("domain", f"`{expr.func}` is undefined for these arguments", expr.span)
         return expr

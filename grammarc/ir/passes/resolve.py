@@ -11,16 +11,20 @@ from dataclasses import replace
 
 from grammarc.diagnostics import Diagnostics, suggest
 from grammarc.ir import nodes as ir
-from grammarc.ir.traverse import rewrite_expr, rewrite_rule
+from grammarc.ir.traverse import iter_ops, rewrite_expr, rewrite_rule
 
 
 def resolve_names(module: ir.Module, diags: Diagnostics) -> ir.Module:
     declared: list[str] = []
     all_attrs = [a.name for a in module.attrs]
     attrs = []
+    # CityEngine evaluates attributes lazily, so a default may use an attribute declared after it (the
+    # backend evaluates them in dependency order); the paper notation reads top to bottom.
+    lazy = module.dialect == "cityengine"
     for attr in module.attrs:
         where = f"attribute `{attr.name}`"
-        default = rewrite_expr(attr.default, _resolver({}, declared, diags, where, later=all_attrs))
+        visible = all_attrs if lazy else declared
+        default = rewrite_expr(attr.default, _resolver({}, visible, diags, where, later=all_attrs))
         attrs.append(attr if default is attr.default else replace(attr, default=default))
         declared.append(attr.name)
     rules = []
@@ -31,6 +35,7 @@ def resolve_names(module: ir.Module, diags: Diagnostics) -> ir.Module:
                 diags.warning("shadow", f"parameter `{name}` of `{rule.symbol}` hides the attribute `{name}`",
                               rule.span)
         rules.append(rewrite_rule(rule, _resolver(params, all_attrs, diags, f"rule `{rule.symbol}`")))
+        _check_set_targets(rule, module, diags)
     if all(a is b for a, b in zip(attrs, module.attrs)) and all(a is b for a, b in zip(rules, module.rules)):
         return module
     return replace(module, attrs=tuple(attrs), rules=tuple(rules))
@@ -61,3 +66,18 @@ def _resolver(params: dict[str, int], attrs: list[str], diags: Diagnostics, wher
         return ir.placeholder(expr.span)
 
     return resolve
+
+
+def _check_set_targets(rule: ir.Rule, module: ir.Module, diags: Diagnostics) -> None:
+    """``set(name, v)`` needs an attribute (not a constant) called ``name``."""
+    attrs = {a.name: a for a in module.attrs}
+    for alt in rule.alternatives:
+        for op in iter_ops(alt.body):
+            if not isinstance(op, ir.SetAttr):
+                continue
+            attr = attrs.get(op.name)
+            if attr is None:
+                diags.error("unknown-name", f"`set` of `{op.name}`, which is not an attribute"
+                            f"{suggest(op.name, attrs)}", op.span)
+            elif attr.const:
+                diags.error("const", f"`set` of the constant `{op.name}`", op.span)

@@ -68,6 +68,21 @@ def _check_op(op, check, param_types, diags) -> None:
             check(e, T.NUM, "a size")
     elif isinstance(op, ir.Comp) and op.index is not None:
         check(op.index, T.NUM, "a component index")
+    elif isinstance(op, ir.GroupSplit):
+        for s in op.sizes:
+            check(s.value, T.NUM, "a size")
+    elif isinstance(op, ir.Extrude):
+        check(op.height, T.NUM, "a height")
+    elif isinstance(op, ir.Case):
+        for cond, _ in op.branches:
+            check(cond, T.BOOL, "a case condition")
+    elif isinstance(op, ir.Stochastic):
+        for chance, _ in op.branches:
+            check(chance, T.NUM, "a percentage")
+    elif isinstance(op, ir.SetAttr):
+        want = check.keywords["attrs"].get(op.name)
+        if want is not None and want is not T.UNKNOWN:
+            check(op.value, want, f"the value of `{op.name}`")
 
 
 def _check_arity(module: ir.Module, diags: Diagnostics) -> dict[str, int]:
@@ -142,6 +157,18 @@ def type_of(expr: ir.Expr, attrs: dict, params: tuple, diags: Diagnostics) -> ir
         return attrs.get(expr.name, T.UNKNOWN)
     if isinstance(expr, ir.Param):
         return params[expr.index] if expr.index < len(params) else T.UNKNOWN
+    if isinstance(expr, ir.Select):
+        _expect(expr.cond, T.BOOL, "a condition", attrs, params, diags)
+        then = type_of(expr.then, attrs, params, diags)
+        other = type_of(expr.other, attrs, params, diags)
+        if T.UNKNOWN not in (then, other) and then is not other:
+            diags.error("type", f"the branches give a {then.value} and a {other.value}", expr.span)
+            return T.UNKNOWN
+        return then if then is not T.UNKNOWN else other
+    if isinstance(expr, ir.Call) and expr.func in ir.CONVERSIONS:
+        for a in expr.args:
+            type_of(a, attrs, params, diags)
+        return ir.CONVERSIONS[expr.func]
     if isinstance(expr, ir.Call):
         for a in expr.args:
             _expect(a, T.NUM, f"an argument of `{expr.func}`", attrs, params, diags)
@@ -161,6 +188,9 @@ def type_of(expr: ir.Expr, attrs: dict, params: tuple, diags: Diagnostics) -> ir
             ok, result = left is right, T.BOOL
         elif expr.op in ir.COMPARE_OPS:
             ok, result = left is T.NUM and right is T.NUM, T.BOOL
+        elif expr.op == "+" and T.STR in (left, right):
+            # CityEngine's string concatenation: "Height." + 3 is "Height.3"
+            ok, result = True, T.STR
         else:
             ok, result = left is T.NUM and right is T.NUM, T.NUM
         if not ok:

@@ -1,0 +1,619 @@
+"""Lower CityEngine CGA (cityengine.lark) to the IR, one statement at a time.
+
+The same IR as the paper notation: CityEngine's ``split`` becomes ``GroupSplit`` (absolute, ``'`` relative
+and ``~`` floating sizes, repeat groups), ``comp(f)`` with selectors ``CompFaces``, ``case`` and ``p%``
+blocks ``Case`` and ``Stochastic`` operations, ``case`` and ``p%`` expressions ``Select``. Functions and
+constants-as-functions are inlined by ``assemble``; rules overloaded by arity get one symbol per arity
+(``Pipe/1``, ``Pipe/3``). An operation or construct that grammarc does not implement is an error
+``unsupported: NAME`` at its span, never skipped.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, replace
+
+from lark import Token, Transformer, v_args
+
+from grammarc.diagnostics import Diagnostics, Span, suggest
+from grammarc.ir import nodes as ir
+from grammarc.ir.traverse import rewrite_body, rewrite_expr, sub_bodies
+
+#: Operations that are parsed and accepted but do not change the record (listed in its meta).
+NOT_APPLIED = frozenset({
+    "color", "texture", "setupProjection", "projectUV", "tileUV", "translateUV", "scaleUV", "rotateUV",
+    "normalizeUV", "deleteUV", "reverseNormals", "print", "setNormals", "softenNormals", "label",
+})
+#: CityEngine operations grammarc does not implement yet (the geometry and context issues bring most).
+UNSUPPORTED_OPS = frozenset({
+    "offset", "setback", "shapeL", "shapeU", "shapeO", "innerRectangle", "innerPolygon", "convexify",
+    "cleanupGeometry", "trim", "envelope", "roofGable", "roofHip", "roofShed", "roofPyramid",
+    "alignScopeToAxes", "alignScopeToGeometry", "rotateScope", "mirror", "mirrorScope", "setPivot",
+    "insertAlongUV", "scatter", "footprint", "tileUV", "splitArea", "inline", "resetGeometry", "taper",
+    "primitiveCylinder", "primitiveSphere", "primitiveDisk", "primitiveCone", "primitiveQuad",
+    "deleteHoles", "reduceGeometry", "rectify", "semiPolygon",
+} - NOT_APPLIED)
+#: CityEngine built-in functions mapped onto the IR's.
+FUNCTION_NAMES = {"rint": "round", "ln": "log"}
+AXIS_NAMES = {"x": (0,), "y": (1,), "z": (2,), "xy": (0, 1), "xz": (0, 2), "yz": (1, 2), "xyz": (0, 1, 2)}
+SCOPE_MEMBERS = {"scope.sx": "sx", "scope.sy": "sy", "scope.sz": "sz", "scope.tx": "tx", "scope.ty": "ty",
+                 "scope.tz": "tz"}
+
+
+@dataclass(frozen=True, slots=True)
+class Annotated:
+    annotations: tuple[tuple[str, tuple[str, ...]], ...]
+    declaration: object
+
+
+@dataclass(frozen=True, slots=True)
+class RuleDef:
+    name: str
+    params: tuple[str, ...]
+    body: ir.Body
+    span: Span
+    site: int
+
+
+@dataclass(frozen=True, slots=True)
+class FunctionDef:
+    name: str
+    params: tuple[str, ...]
+    value: ir.Expr
+    span: Span
+
+
+@dataclass(frozen=True, slots=True)
+class Sized:
+    """A split part's size or an argument with its kind (absolute, ``'`` relative, ``~`` floating)."""
+
+    kind: ir.SizeKind
+    value: ir.Expr
+    span: Span
+
+
+@dataclass(frozen=True, slots=True)
+class Part:
+    size: Sized
+    body: ir.Body
+    merged: bool
+    span: Span
+
+
+@dataclass(frozen=True, slots=True)
+class Group:
+    parts: tuple
+    span: Span
+
+
+@v_args(inline=True, meta=True)
+class Lowering(Transformer):
+    """One CityEngine statement's parse tree -> IR pieces (``Annotated`` declarations)."""
+
+    def __init__(self, file: str, diags: Diagnostics, sites):
+        super().__init__()
+        self.file = file
+        self.diags = diags
+        self.sites = sites
+        self.fallback = Span(file, 0, 0, 0, 0)
+
+    # ------------------------------------------------------------------------------------------ helpers
+    def span(self, meta) -> Span:
+        if getattr(meta, "empty", True):
+            return self.fallback
+        return Span(self.file, meta.line, meta.column, meta.end_line, meta.end_column)
+
+    def tspan(self, tok: Token) -> Span:
+        return Span(self.file, tok.line, tok.column, tok.end_line, tok.end_column)
+
+    def site(self) -> int:
+        return next(self.sites)
+
+    def unsupported(self, name: str, span: Span, why: str = ""):
+        self.diags.error("unsupported", f"unsupported: {name}" + (f" ({why})" if why else ""), span)
+        return ir.Empty(span)
+
+    def __default__(self, data, children, meta):
+        return self.unsupported(str(data), self.span(meta))
+
+    def expr(self, value) -> ir.Expr:
+        """An argument that must be a plain expression."""
+        if isinstance(value, Sized):
+            if value.kind is not ir.SizeKind.ABSOLUTE:
+                self.unsupported("relative or floating value here", value.span)
+            return value.value
+        return value
+
+    # ------------------------------------------------------------------------------------- declarations
+    def statement(self, meta, *children):
+        *annotations, declaration = children
+        return Annotated(tuple(annotations), declaration)
+
+    def annotation(self, meta, name, args):
+        return (str(name), tuple(args or ()))
+
+    def annotation_args(self, meta, *args):
+        from grammarc.ir.printer import print_expr
+
+        return tuple(a if isinstance(a, str) else print_expr(self.expr(a)) for a in args)
+
+    def keyword_arg(self, meta, name, value):
+        from grammarc.ir.printer import print_expr
+
+        return f"{name}={print_expr(self.expr(value))}"
+
+    def version(self, meta, text):
+        return None
+
+    def style(self, meta, name):
+        return self.unsupported("style", self.tspan(name))
+
+    def import_prefixed(self, meta, prefix, path, *names):
+        return self.unsupported("import", self.span(meta), "rule files are compiled alone for now")
+
+    def import_plain(self, meta, path):
+        return self.unsupported("import", self.span(meta), "rule files are compiled alone for now")
+
+    def attr_decl(self, meta, name, value):
+        return ir.AttrDecl(str(name), value, self.tspan(name))
+
+    def const_decl(self, meta, name, value):
+        return ir.AttrDecl(str(name), value, self.tspan(name), const=True)
+
+    def function_def(self, meta, name, params, value):
+        return FunctionDef(str(name), params or (), value, self.tspan(name))
+
+    def rule_def(self, meta, name, params, arrow, body):
+        return RuleDef(str(name), params or (), _as_body(body), self.tspan(name), self.site())
+
+    def params(self, meta, *names):
+        return tuple(str(n) for n in names if n is not None)
+
+    # ------------------------------------------------------------------------------------------ bodies
+    def body(self, meta, *items):
+        return tuple(items)
+
+    def case_block(self, meta, *branches):
+        *cases, default = branches
+        return (ir.Case(tuple(cases), default, self.span(meta)),)
+
+    def case_branch(self, meta, cond, body):
+        return (cond, _as_body(body))
+
+    def else_branch(self, meta, body):
+        return _as_body(body)
+
+    def stochastic_block(self, meta, *branches):
+        *chances, default = branches
+        return (ir.Stochastic(tuple(chances), default if default is not None else (), self.span(meta),
+                              self.site()),)
+
+    def stochastic_branch(self, meta, probability, percent, body):
+        return (probability, _as_body(body))
+
+    def symbol(self, meta, name):
+        text, span = str(name), self.tspan(name)
+        if text == "NIL":
+            return ir.Empty(span)
+        if text == "primitiveCube":
+            return ir.UseAsset("builtin:cube", span)
+        if text in NOT_APPLIED:
+            return ir.NotApplied(text, span)
+        if text in UNSUPPORTED_OPS:
+            return self.unsupported(text, span)
+        return ir.Symbol(text, (), span, self.site())
+
+    def leaf(self, meta, name, dot):
+        return ir.Symbol(str(name), (), self.tspan(name), self.site(), leaf=True)
+
+    def imported_symbol(self, meta, prefix, name):
+        return self.unsupported(f"{prefix}.{name}", self.tspan(prefix), "import")
+
+    def imported_call(self, meta, prefix, name, args):
+        return self.unsupported(f"{prefix}.{name}", self.tspan(prefix), "import")
+
+    def push(self, meta, tok):
+        return ir.Push(self.tspan(tok))
+
+    def pop(self, meta, tok):
+        return ir.Pop(self.tspan(tok))
+
+    def args(self, meta, *args):
+        return tuple(args)
+
+    def relative(self, meta, prime, value):
+        return Sized(ir.SizeKind.RELATIVE, value, self.tspan(prime))
+
+    def floating(self, meta, tilde, value):
+        return Sized(ir.SizeKind.FLOATING, value, self.tspan(tilde))
+
+    def selector_function(self, meta, name, args, parts):
+        return self.unsupported(f"{name}(...){{...}} as an argument", self.tspan(name))
+
+    def size_prefix(self, meta, prefix):
+        if prefix is None:
+            return ir.SizeKind.ABSOLUTE
+        return ir.SizeKind.RELATIVE if str(prefix) == "'" else ir.SizeKind.FLOATING
+
+    def part(self, meta, kind, value, body):
+        return Part(Sized(kind, value, getattr(value, "span", self.span(meta))), _as_body(body), False,
+                    self.span(meta))
+
+    def merged_part(self, meta, kind, value, body):
+        return Part(Sized(kind, value, getattr(value, "span", self.span(meta))), _as_body(body), True,
+                    self.span(meta))
+
+    def repeat_group(self, meta, parts, star):
+        return Group(parts, self.span(meta))
+
+    def parts(self, meta, *parts):
+        return tuple(parts)
+
+    # -------------------------------------------------------------------------------------- operations
+    def call(self, meta, name, args):
+        op, span, args = str(name), self.tspan(name), args or ()
+        handler = _OPS.get(op)
+        if handler is not None:
+            return handler(self, op, args, span)
+        if op in NOT_APPLIED:
+            return ir.NotApplied(op, span)
+        if op in UNSUPPORTED_OPS or op in _SPLIT_OPS:
+            return self.unsupported(op, span)
+        return ir.Symbol(op, tuple(self.expr(a) for a in args), span, self.site())
+
+    def split_call(self, meta, name, args, parts, star):
+        op, span, args = str(name), self.tspan(name), args or ()
+        if op == "split":
+            return self.op_split(args, parts, star is not None, span)
+        if op == "comp":
+            return self.op_comp(args, parts, span)
+        return self.unsupported(op, span)
+
+    def arity(self, op, args, counts, span) -> bool:
+        if len(args) in counts:
+            return True
+        want = " or ".join(str(c) for c in counts)
+        self.diags.error("arity", f"`{op}` takes {want} arguments, got {len(args)}", span)
+        return False
+
+    def op_extrude(self, op, args, span):
+        if len(args) != 1:
+            return self.unsupported(f"extrude with {len(args)} arguments", span, "only extrude(height)")
+        return ir.Extrude(self.expr(args[0]), span)
+
+    def op_translate(self, op, args, span):
+        if not self.arity(op, args, (3,), span):
+            return ir.Empty(span)
+        return ir.Translate(tuple(self.scoped(a, axis) for axis, a in enumerate(args)), span)
+
+    def scoped(self, arg, axis: int) -> ir.Expr:
+        """``'v`` in ``t``: v times the scope size on that axis."""
+        if isinstance(arg, Sized) and arg.kind is ir.SizeKind.RELATIVE:
+            return ir.Binary("*", arg.value, ir.ScopeRef("s" + "xyz"[axis], arg.span), arg.span)
+        return self.expr(arg)
+
+    def op_scale(self, op, args, span):
+        if not self.arity(op, args, (3,), span):
+            return ir.Empty(span)
+        sizes = []
+        for a in args:
+            if isinstance(a, Sized) and a.kind is ir.SizeKind.RELATIVE:
+                sizes.append(ir.Size(ir.SizeKind.RELATIVE, a.value, a.span))
+            else:
+                value = self.expr(a)
+                sizes.append(ir.Size(ir.SizeKind.ABSOLUTE, value, getattr(value, "span", span)))
+        return ir.Scale(tuple(sizes), span)
+
+    def op_rotate(self, op, args, span):
+        if len(args) != 3:
+            return self.unsupported(f"r with {len(args)} arguments", span, "only r(x, y, z)")
+        return ir.Rotate(tuple(self.expr(a) for a in args), span)
+
+    def op_center(self, op, args, span):
+        axes = self.axis_argument(op, args, span)
+        return ir.Center(axes, span) if axes else ir.Empty(span)
+
+    def axis_argument(self, op, args, span) -> tuple[int, ...]:
+        if len(args) == 1 and isinstance(args[0], ir.Name) and args[0].name in AXIS_NAMES:
+            return AXIS_NAMES[args[0].name]
+        self.diags.error("axis", f"`{op}` expects an axis selector (x, y, z, xy, xz, yz, xyz)", span)
+        return ()
+
+    def op_insert(self, op, args, span):
+        if len(args) != 1 or not isinstance(args[0], ir.Str):
+            return self.unsupported(f"i with {len(args)} arguments or a computed asset", span,
+                                    "only i(\"path\")")
+        return ir.UseAsset(args[0].value, span)
+
+    def op_cube(self, op, args, span):
+        if args:
+            return self.unsupported("primitiveCube with arguments", span)
+        return ir.UseAsset("builtin:cube", span)
+
+    def op_nil(self, op, args, span):
+        return ir.Empty(span)
+
+    def op_set(self, op, args, span):
+        if not self.arity(op, args, (2,), span):
+            return ir.Empty(span)
+        target = args[0]
+        if isinstance(target, ir.Name) and target.name.startswith("material."):
+            return ir.NotApplied(f"set({target.name})", span)
+        if not isinstance(target, ir.Name):
+            return self.unsupported("set of this target", span, "set(attribute, value)")
+        return ir.SetAttr(target.name, self.expr(args[1]), span)
+
+    def op_report(self, op, args, span):
+        if not self.arity(op, args, (2,), span):
+            return ir.Empty(span)
+        return ir.Report(self.expr(args[0]), self.expr(args[1]), span)
+
+    def op_split(self, args, parts, repeat, span):
+        if not args or not isinstance(args[0], ir.Name) or args[0].name not in ("x", "y", "z"):
+            self.diags.error("axis", "`split` expects an axis x, y or z", span)
+            return ir.Empty(span)
+        for extra in args[1:]:
+            if not (isinstance(extra, ir.Name) and extra.name in ("adjust", "noAdjust")):
+                return self.unsupported("this split option", getattr(extra, "span", span))
+            if extra.name == "noAdjust":
+                return self.unsupported("split(..., noAdjust)", extra.span)
+        sizes, groups, bodies = [], [], []
+        n_groups = 0
+        for item in parts:
+            if isinstance(item, Group):
+                for inner in item.parts:
+                    if isinstance(inner, Group):
+                        return self.unsupported("nested repeat groups", inner.span)
+                    sizes.append(self.size_of(inner))
+                    groups.append(n_groups)
+                    bodies.append(inner.body)
+                n_groups += 1
+            else:
+                sizes.append(self.size_of(item))
+                groups.append(-1)
+                bodies.append(item.body)
+        return ir.GroupSplit("xyz".index(args[0].name), tuple(sizes), tuple(groups), tuple(bodies), repeat,
+                             span, self.site())
+
+    def size_of(self, part: Part) -> ir.Size:
+        if part.merged:
+            self.unsupported("`=` in split", part.span)
+        return ir.Size(part.size.kind, part.size.value, part.size.span)
+
+    def op_comp(self, args, parts, span):
+        if len(args) != 1 or not isinstance(args[0], ir.Name) or args[0].name != "f":
+            kind = args[0].name if args and isinstance(args[0], ir.Name) else "?"
+            return self.unsupported(f"comp({kind})", span, "only comp(f)")
+        selectors, bodies = [], []
+        for part in parts:
+            if isinstance(part, Group):
+                return self.unsupported("repeat group in comp", part.span)
+            value = part.size.value
+            if part.size.kind is not ir.SizeKind.ABSOLUTE or not isinstance(value, ir.Name):
+                return self.unsupported("this comp selector", part.span)
+            if value.name not in ir.FACE_SELECTORS:
+                return self.unsupported(f"comp selector `{value.name}`", value.span,
+                                        "street, object and world selectors are not supported yet"
+                                        + suggest(value.name, ir.FACE_SELECTORS))
+            if part.merged:
+                return self.unsupported(f"`{value.name}=` (one shape for all selected faces)", part.span)
+            selectors.append(value.name)
+            bodies.append(part.body)
+        return ir.CompFaces(tuple(selectors), tuple(bodies), span, self.site())
+
+    # ------------------------------------------------------------------------------------- expressions
+    def value_case(self, meta, *items):
+        *pairs, default = items
+        result = default
+        for i in range(len(pairs) - 2, -1, -2):
+            result = ir.Select(self.expr(pairs[i]), pairs[i + 1], result, self.span(meta))
+        return result
+
+    def value_stochastic(self, meta, *items):
+        *pairs, default = [i for i in items if not (isinstance(i, Token) and i.type == "PERCENT_COLON")]
+        # p% : a  q% : b  else : c  ->  draw u once; u < p -> a, u < p + q -> b, else c
+        site = self.site()
+        u = ir.Call("rand", (), self.span(meta), site)
+        result, bounds, total = default, [], None
+        for i in range(0, len(pairs), 2):
+            share = ir.Binary("/", pairs[i], ir.Num(100.0), pairs[i].span)
+            total = share if total is None else ir.Binary("+", total, share, share.span)
+            bounds.append((total, pairs[i + 1]))
+        for bound, value in reversed(bounds):
+            result = ir.Select(ir.Binary("<", u, bound, self.span(meta)), value, result, self.span(meta))
+        return result
+
+    def or_(self, meta, left, right):
+        return ir.Binary("||", self.expr(left), self.expr(right), self.span(meta))
+
+    def and_(self, meta, left, right):
+        return ir.Binary("&&", self.expr(left), self.expr(right), self.span(meta))
+
+    def not_(self, meta, operand):
+        return ir.Unary("!", self.expr(operand), self.span(meta))
+
+    def binary(self, meta, left, op, right):
+        return ir.Binary(str(op), self.expr(left), self.expr(right), self.tspan(op))
+
+    def neg(self, meta, operand):
+        return ir.Unary("-", self.expr(operand), self.span(meta))
+
+    def number(self, meta, tok):
+        return ir.Num(float(tok), self.tspan(tok))
+
+    def string(self, meta, tok):
+        text = str(tok)[1:-1].replace('\\"', '"').replace("\\\\", "\\")
+        return ir.Str(text, self.tspan(tok))
+
+    def true(self, meta, tok):
+        return ir.Bool(True, self.tspan(tok))
+
+    def false(self, meta, tok):
+        return ir.Bool(False, self.tspan(tok))
+
+    def name(self, meta, tok):
+        return ir.Name(str(tok), self.tspan(tok))
+
+    def dotted_name(self, meta, *names):
+        return tuple(str(n) for n in names), Span(self.file, names[0].line, names[0].column,
+                                                  names[-1].end_line, names[-1].end_column)
+
+    def member(self, meta, dotted):
+        names, span = dotted
+        text = ".".join(names)
+        if text in SCOPE_MEMBERS:
+            return ir.ScopeRef(SCOPE_MEMBERS[text], span)
+        if text in ("geometry.area", "geometry.volume"):
+            return ir.Call(text, (), span, self.site())
+        if names[0] == "material":
+            return ir.Name(text, span)  # only set(material.*, ...) takes it
+        self.unsupported(text, span)
+        return ir.placeholder(span)
+
+    def member_function(self, meta, dotted, args):
+        names, span = dotted
+        text = ".".join(names)
+        if text in ("geometry.area", "geometry.volume") and not args:
+            return ir.Call(text, (), span, self.site())
+        self.unsupported(f"{text}()", span)
+        return ir.placeholder(span)
+
+    def function(self, meta, name, args):
+        span = self.tspan(name)
+        func = FUNCTION_NAMES.get(str(name), str(name))
+        args = tuple(self.expr(a) for a in (args or ()))
+        if func == "p" and len(args) == 1:
+            return ir.Call("p", args, span, self.site())
+        return ir.Call(func, args, span, self.site())
+
+    def array(self, meta, *items):
+        self.unsupported("arrays", self.span(meta))
+        return ir.placeholder(self.span(meta))
+
+    def index(self, meta, array, index):
+        self.unsupported("array indexing", self.span(meta))
+        return ir.placeholder(self.span(meta))
+
+
+_OPS = {
+    "extrude": Lowering.op_extrude,
+    "t": Lowering.op_translate,
+    "s": Lowering.op_scale,
+    "r": Lowering.op_rotate,
+    "center": Lowering.op_center,
+    "i": Lowering.op_insert,
+    "primitiveCube": Lowering.op_cube,
+    "NIL": Lowering.op_nil,
+    "set": Lowering.op_set,
+    "report": Lowering.op_report,
+}
+_SPLIT_OPS = frozenset({"split", "comp"})
+
+
+def _as_body(value) -> ir.Body:
+    return value if isinstance(value, tuple) else (value,)
+
+
+# ---------------------------------------------------------------------------------------------- assembly
+
+
+def assemble(file: str, statements: list, diags: Diagnostics) -> ir.Module:
+    """Declarations in source order -> Module: start rule, overloads by arity, functions inlined."""
+    attrs: list[ir.AttrDecl] = []
+    functions: dict[str, FunctionDef] = {}
+    rules: list[tuple[RuleDef, tuple]] = []
+    for st in statements:
+        if not isinstance(st, Annotated):
+            st = Annotated((), st)  # a declaration without annotations comes bare from the parser
+        decl = st.declaration
+        if isinstance(decl, ir.AttrDecl):
+            if any(a.name == decl.name for a in attrs):
+                diags.error("duplicate-attr", f"attribute `{decl.name}` is declared twice", decl.span)
+            attrs.append(replace(decl, annotations=st.annotations))
+        elif isinstance(decl, FunctionDef):
+            functions[decl.name] = decl
+        elif isinstance(decl, RuleDef):
+            rules.append((decl, st.annotations))
+    arities: dict[str, set[int]] = {}
+    for rule, _ in rules:
+        arities.setdefault(rule.name, set()).add(len(rule.params))
+
+    def symbol_name(name: str, arity: int) -> str:
+        return f"{name}/{arity}" if len(arities.get(name, ())) > 1 else name
+
+    inline = _Inliner(functions, {a.name for a in attrs}, diags)
+    attrs = [replace(a, default=inline.expr(a.default, frozenset())) for a in attrs]
+    start = None
+    lowered: list[ir.Rule] = []
+    for rule, notes in rules:
+        name = symbol_name(rule.name, len(rule.params))
+        if any(a[0] == "StartRule" for a in notes) and start is None:
+            start = name
+        params = frozenset(rule.params)
+        body = _map_symbols(rule.body, lambda op: replace(op, name=symbol_name(op.name, len(op.args)))
+                            if op.name in arities else op)
+        body = rewrite_body(body, lambda e, p=params: inline.expr(e, p))
+        lowered.append(ir.Rule(symbol=name, params=rule.params, guard=None,
+                               alternatives=(ir.Alternative(body, None, rule.span),), priority=0,
+                               span=rule.span, site=rule.site))
+    if start is None and lowered:
+        start = lowered[0].symbol
+    return ir.Module(file=file, attrs=tuple(attrs), rules=tuple(lowered), start=start, dialect="cityengine")
+
+
+def _map_symbols(body: ir.Body, fn) -> ir.Body:
+    """``body`` with ``fn`` applied to every successor symbol, nested bodies included."""
+    out = []
+    for op in body:
+        if isinstance(op, ir.Symbol):
+            op = fn(op)
+        elif isinstance(op, (ir.Case, ir.Stochastic)):
+            op = replace(op, branches=tuple((c, _map_symbols(b, fn)) for c, b in op.branches),
+                         default=_map_symbols(op.default, fn))
+        elif sub_bodies(op):
+            op = replace(op, parts=tuple(_map_symbols(b, fn) for b in op.parts))
+        out.append(op)
+    return tuple(out)
+
+
+class _Inliner:
+    """Replaces calls of user functions (and bare names of parameterless ones) by their bodies."""
+
+    MAX_DEPTH = 32
+
+    def __init__(self, functions: dict[str, FunctionDef], attrs: set[str], diags: Diagnostics):
+        self.functions = functions
+        self.attrs = attrs
+        self.diags = diags
+
+    def expr(self, expr: ir.Expr, params: frozenset, depth: int = 0) -> ir.Expr:
+        def visit(e: ir.Expr) -> ir.Expr:
+            if isinstance(e, ir.Name) and e.name not in params and e.name not in self.attrs \
+                    and e.name in self.functions and not self.functions[e.name].params:
+                return self.call(self.functions[e.name], (), e.span, depth)
+            if isinstance(e, ir.Call) and e.func not in ir.FUNCTIONS and e.func not in ir.CONVERSIONS:
+                fn = self.functions.get(e.func)
+                if fn is None:
+                    self.diags.error("unknown-function", f"unknown function `{e.func}`"
+                                     f"{suggest(e.func, [*ir.FUNCTIONS, *self.functions])}", e.span)
+                    return ir.placeholder(e.span)
+                if len(fn.params) != len(e.args):
+                    self.diags.error("arity", f"`{e.func}` takes {len(fn.params)} arguments, got "
+                                     f"{len(e.args)}", e.span)
+                    return ir.placeholder(e.span)
+                return self.call(fn, e.args, e.span, depth)
+            return e
+
+        return rewrite_expr(expr, visit)
+
+    def call(self, fn: FunctionDef, args: tuple, span: Span, depth: int) -> ir.Expr:
+        if depth >= self.MAX_DEPTH:
+            self.diags.error("unsupported", f"unsupported: recursive function `{fn.name}`", span)
+            return ir.placeholder(span)
+        bound = dict(zip(fn.params, args))
+
+        def substitute(e: ir.Expr) -> ir.Expr:
+            return bound.get(e.name, e) if isinstance(e, ir.Name) else e
+
+        body = rewrite_expr(fn.value, substitute)
+        return self.expr(body, frozenset(), depth=depth + 1)
+

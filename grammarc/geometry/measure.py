@@ -1,0 +1,49 @@
+"""Areas and volumes of shapes, for CityEngine's ``geometry.area`` and ``geometry.volume``.
+
+A flat shape's area is its face's; a solid's area is its surface (as CityEngine reports it), its volume
+the prism's. Boxes and inserted assets measure as their scope box; polygons from the store, scaled by
+the scope, for all shapes at once.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from grammarc.constants import TOL
+from grammarc.geometry.polygons import PLANE_AXES, PolygonStore
+from grammarc.ragged import segment_of, segment_reduce
+
+
+def area_and_volume(size: np.ndarray, geom: np.ndarray, store: PolygonStore) -> tuple[np.ndarray, np.ndarray]:
+    """Per shape: area (n,) and volume (n,) float64, from scope sizes (n, 3) and geometry ids (n,)."""
+    flat = size <= TOL.zero
+    n_flat = flat.sum(axis=1)
+    sx, sy, sz = size[:, 0], size[:, 1], size[:, 2]
+    box_area = np.where(n_flat == 0, 2 * (sx * sy + sy * sz + sx * sz),
+                        np.where(n_flat == 1, np.prod(np.where(flat, 1.0, size), axis=1), 0.0))
+    area = box_area
+    volume = sx * sy * sz
+    poly = np.flatnonzero(geom >= 0)
+    if len(poly):
+        ids = geom[poly]
+        coords, ring_offsets, poly_offsets = store.gather(ids)
+        plane = store.plane[ids]
+        a_axis = np.array([PLANE_AXES[p][0] for p in range(3)])[plane]
+        b_axis = np.array([PLANE_AXES[p][1] for p in range(3)])[plane]
+        sa, sb, h = size[poly, a_axis], size[poly, b_axis], size[poly, plane]
+        vertex_ring = segment_of(ring_offsets)
+        vertex_poly = segment_of(poly_offsets)[vertex_ring]
+        at = np.arange(len(coords))
+        nxt = np.where(at + 1 < ring_offsets[1:][vertex_ring], at + 1, ring_offsets[:-1][vertex_ring])
+        u = coords[:, 0] * sa[vertex_poly]
+        v = coords[:, 1] * sb[vertex_poly]
+        cross = u * v[nxt] - u[nxt] * v
+        vertex_offsets = ring_offsets[poly_offsets]
+        face = np.abs(segment_reduce(np.add, cross, vertex_offsets, 0.0)) / 2
+        perimeter = segment_reduce(np.add, np.hypot(u[nxt] - u, v[nxt] - v), vertex_offsets, 0.0)
+        solid = h > TOL.zero
+        area = area.copy()
+        volume = volume.copy()
+        area[poly] = np.where(solid, 2 * face + perimeter * h, face)
+        volume[poly] = np.where(solid, face * h, 0.0)
+    return area, volume

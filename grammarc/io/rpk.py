@@ -1,0 +1,225 @@
+"""CityEngine rule packages (``.rpk``): the CGA sources, the start rule and the assets of a package.
+
+A rule package is a 7-zip archive as CityEngine exports it::
+
+    rules/Candler Building.cga      CGA sources (may be absent: a package needs only its compiled rules)
+    bin/Candler Building.cgb        compiled rules; the main one carries the start rule
+    assets/facade/windows/x.obj     assets and textures (absent in packages without any)
+    .resolvemap.xml                 workspace path -> path in the package
+
+``open_rpk`` extracts the archive to a temporary directory that lives as long as the returned
+``RulePackage`` (use it as a context manager, or call ``close()``), so rule files and assets are plain
+paths the compiler and the baker read as they read any other.
+
+Assets are resolved as CityEngine resolves a relative ``i("facade/windows/x.obj")`` of a rule file: first
+in the ``assets`` folder of the project the rule file is in, then in that project's root
+(CityEngine manual, "Asset and texture search"). ``RulePackage.asset_roots`` lists those folders in that
+order; a package is one project.
+
+py7zr is an optional dependency (the ``rpk`` extra), imported when a package is opened.
+"""
+
+from __future__ import annotations
+
+import os
+import re
+import shutil
+import tempfile
+import weakref
+from pathlib import Path, PurePosixPath
+from typing import TYPE_CHECKING
+from xml.etree import ElementTree
+
+from grammarc.errors import UsageError
+
+if TYPE_CHECKING:
+    from typing_extensions import Self
+
+__all__ = ["RulePackage", "open_rpk", "start_rule_of"]
+
+_INSTALL_HINT = "pip install 'grammarc[rpk]' (or pip install py7zr)"
+
+# A string literal, or a comment: comments are dropped, strings kept (a "//" inside a string is text).
+_STRING_OR_COMMENT = re.compile(r'("(?:[^"\\\n]|\\.)*"|\'(?:[^\'\\\n]|\\.)*\')|//[^\n]*|/\*.*?\*/', re.DOTALL)
+# @StartRule, then any further annotations (@Hidden, @Description("...")), then the rule's name. Strings
+# inside annotation arguments are blanked by _strip_comments, so `[^)]*` cannot stop inside one.
+_START_RULE = re.compile(r"@StartRule\b\s*(?:@\w+\s*(?:\([^)]*\))?\s*)*([A-Za-z_][\w.]*)")
+
+
+class RulePackage:
+    """An extracted rule package; its files exist until ``close()`` (or the end of a ``with`` block).
+
+    Attributes
+    ----------
+    path : Path
+        The ``.rpk`` file.
+    root : Path
+        The temporary directory holding the extracted package.
+    rules : dict of str to Path
+        Every CGA source, by its POSIX path in the package (``"rules/Candler Building.cga"``), sorted.
+    compiled : list of str
+        The compiled rule files (``"bin/Candler Building.cgb"``), sorted.
+    assets_root : Path
+        The package's ``assets`` folder, or ``root`` when it has none: where ``i("facade/x.obj")``
+        is looked up first.
+    main_rule_file : Path or None
+        The CGA source of the compiled main rule file: the ``.cga`` named as a ``bin/*.cgb``, else the
+        only ``.cga``, else the one with a ``@StartRule``; None for a package without sources.
+    start_rule : str or None
+        The rule after ``@StartRule`` in ``main_rule_file`` (``"Footprint"``); None if it has none.
+        PRT names it with its style, ``"Default$Footprint"``.
+    resolve_map : dict of str to str
+        ``.resolvemap.xml``: workspace paths (``"/Project/assets/x.obj"``, ``"assets/x.obj"``) to
+        paths in the package; empty when the package has no resolve map.
+
+    Examples
+    --------
+    >>> with open_rpk("candler.rpk") as rpk:                                      # doctest: +SKIP
+    ...     rpk.start_rule, rpk.main_rule_file.name
+    ('Footprint', 'Candler Building.cga')
+    """
+
+    def __init__(self, path: Path, root: Path):
+        self.path = path
+        self.root = root
+        # Removes the extracted files on close(), or when the package is dropped unclosed.
+        self._cleanup = weakref.finalize(self, shutil.rmtree, str(root), ignore_errors=True)
+        files = sorted(p for p in root.rglob("*") if p.is_file())
+        relative = {p.relative_to(root).as_posix(): p for p in files}
+        self.rules = {name: p for name, p in relative.items() if name.lower().endswith(".cga")}
+        self.compiled = [name for name in relative if name.lower().endswith(".cgb")]
+        self.assets_root = root / "assets" if (root / "assets").is_dir() else root
+        self.main_rule_file = _main_rule_file(self.rules, self.compiled)
+        self.start_rule = start_rule_of(self.main_rule_file) if self.main_rule_file is not None else None
+        self.resolve_map = _resolve_map(root / ".resolvemap.xml")
+
+    @property
+    def asset_roots(self) -> tuple[Path, ...]:
+        """Folders to resolve asset names in, in CityEngine's order: ``assets``, then the package root."""
+        return (self.assets_root,) if self.assets_root == self.root else (self.assets_root, self.root)
+
+    @property
+    def closed(self) -> bool:
+        """True once the extracted files are removed."""
+        return not self._cleanup.alive
+
+    def close(self) -> None:
+        """Remove the extracted files; the paths of this package are invalid afterwards. Idempotent."""
+        self._cleanup()
+
+    def __enter__(self) -> Self:
+        return self
+
+    def __exit__(self, exc_type, exc, tb) -> None:
+        self.close()
+
+    def __repr__(self) -> str:
+        state = "closed" if self.closed else str(self.root)
+        main = self.main_rule_file.relative_to(self.root).as_posix() if self.main_rule_file else None
+        return f"RulePackage({self.path.name!r}, main={main!r}, start={self.start_rule!r}, {state})"
+
+
+def open_rpk(path: str | os.PathLike, *, tmpdir: str | os.PathLike | None = None) -> RulePackage:
+    """Extract a CityEngine rule package and describe it.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The ``.rpk`` file (a 7-zip archive).
+    tmpdir : str or os.PathLike, optional
+        Where to create the extraction directory; the system's temporary folder by default.
+
+    Returns
+    -------
+    RulePackage
+        Its files live until ``close()``; use it as a context manager.
+
+    Raises
+    ------
+    UsageError
+        If py7zr is missing (naming the ``rpk`` extra), the file is missing or not a 7-zip archive, or a
+        member's path is absolute, leaves the package or is a link.
+    """
+    try:
+        import py7zr
+    except ImportError as error:
+        raise UsageError(f"reading rule packages (.rpk) needs py7zr: {_INSTALL_HINT}") from error
+    path = Path(path)
+    if not path.is_file():
+        raise UsageError(f"rule package `{path}` does not exist")
+    root = Path(tempfile.mkdtemp(prefix=f"grammarc-rpk-{path.stem}-", dir=tmpdir))
+    try:
+        with py7zr.SevenZipFile(path, mode="r") as archive:
+            for info in archive.list():
+                _check_member(path, info)
+            archive.extractall(path=root)
+        return RulePackage(path, root)
+    except (py7zr.exceptions.ArchiveError, EOFError) as error:
+        shutil.rmtree(root, ignore_errors=True)
+        raise UsageError(f"cannot read rule package `{path}`: {error}") from error
+    except BaseException:
+        shutil.rmtree(root, ignore_errors=True)
+        raise
+
+
+def start_rule_of(cga: str | os.PathLike) -> str | None:
+    """The name of the rule after the first ``@StartRule`` annotation of a CGA file, or None.
+
+    Comments are ignored (a commented-out ``// @StartRule`` does not count); further annotations between
+    ``@StartRule`` and the rule are skipped.
+    """
+    text = Path(cga).read_text(encoding="utf-8", errors="replace")
+    match = _START_RULE.search(_strip_comments(text))
+    return match.group(1) if match else None
+
+
+def _strip_comments(text: str) -> str:
+    """CGA text without comments, and string literals blanked to ``""`` (their quotes kept)."""
+
+    def keep(match: re.Match) -> str:
+        string = match.group(1)
+        if string is None:
+            return " "
+        return string[0] * 2  # "" or '': an annotation's argument, not text to search
+
+    return _STRING_OR_COMMENT.sub(keep, text)
+
+
+def _check_member(archive: Path, info) -> None:
+    """Refuse members that would land outside the extraction directory (absolute, ``..``, links)."""
+    name = info.filename.replace("\\", "/")
+    pure = PurePosixPath(name)
+    if pure.is_absolute() or ".." in pure.parts or (len(name) > 1 and name[1] == ":"):
+        raise UsageError(f"rule package `{archive}`: member `{info.filename}` leaves the package")
+    if getattr(info, "is_symlink", False):
+        raise UsageError(f"rule package `{archive}`: member `{info.filename}` is a link")
+
+
+def _main_rule_file(rules: dict[str, Path], compiled: list[str]) -> Path | None:
+    """The CGA source of the main compiled rule file (see ``RulePackage.main_rule_file``)."""
+    if not rules:
+        return None
+    compiled_stems = {PurePosixPath(name).stem for name in compiled}
+    matching = [p for p in rules.values() if p.stem in compiled_stems]
+    if len(matching) == 1:
+        return matching[0]
+    candidates = matching or list(rules.values())
+    if len(candidates) == 1:
+        return candidates[0]
+    with_start = [p for p in candidates if start_rule_of(p) is not None]
+    return with_start[0] if with_start else candidates[0]
+
+
+def _resolve_map(path: Path) -> dict[str, str]:
+    """``.resolvemap.xml`` entries, key -> value; empty if the file is absent or unreadable."""
+    if not path.is_file():
+        return {}
+    try:
+        tree = ElementTree.parse(path)
+    except ElementTree.ParseError:
+        return {}
+    return {
+        entry.get("key", ""): entry.get("value", "")
+        for entry in tree.getroot().iter("entry")
+        if entry.get("key") is not None
+    }
