@@ -15,7 +15,8 @@ written.
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass, field
+from contextlib import contextmanager
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 import numpy as np
@@ -27,7 +28,7 @@ from grammarc.backend.plan import make_plan
 from grammarc.backend.reports import Reports
 from grammarc.compiler import Grammar, compile_grammar
 from grammarc.constants import LIMITS, Limits
-from grammarc.errors import ChunkTooLarge, LotFailure
+from grammarc.errors import ChunkTooLarge, LotFailure, UsageError
 from grammarc.io import writer_for
 from grammarc.io.lots import BadLot, Lots, default_lot, read_lots
 from grammarc.io.npz import MeshChunk
@@ -84,9 +85,32 @@ def build(grammar_path, output, *, lots_path=None, options: BuildOptions = Build
     ``progress(done, total)`` is called with the number of lots finished after each chunk.
     """
     started = time.perf_counter()
-    grammar_path = Path(grammar_path)
-    grammar = compile_grammar(grammar_path, start=options.start, asset_roots=options.asset_roots,
-                              dialect=options.dialect)
+    with grammar_source(Path(grammar_path), options) as (source, display, options):
+        return _build(source, display, Path(grammar_path), output, lots_path, options, progress, started)
+
+
+@contextmanager
+def grammar_source(path: Path, options: BuildOptions):
+    """The rule file to compile and the options to use: a ``.rpk`` package is extracted for the
+    duration of the build, its main rule file compiled, its assets and start rule used."""
+    if path.suffix.lower() != ".rpk":
+        yield path, None, options
+        return
+    from grammarc.io.rpk import open_rpk
+
+    with open_rpk(path) as package:
+        if package.main_rule_file is None:
+            raise UsageError(f"{path}: the rule package holds no CGA rule file")
+        inside = package.main_rule_file.relative_to(package.root).as_posix()
+        yield package.main_rule_file, f"{path.name}/{inside}", replace(
+            options, asset_roots=(*package.asset_roots, *options.asset_roots),
+            start=options.start or package.start_rule)
+
+
+def _build(source: Path, display: str | None, grammar_path: Path, output, lots_path,
+           options: BuildOptions, progress, started: float) -> BuildResult:
+    grammar = compile_grammar(source, start=options.start, asset_roots=options.asset_roots,
+                              dialect=options.dialect, display=display)
     plan = make_plan(grammar)
     check_overrides(grammar.module, options.attrs)
     writer_class = writer_for(output)

@@ -18,7 +18,7 @@ from grammarc.io.assets import LEAF_CUBE, LEAF_QUAD, resolve_asset
 from grammarc.ir import nodes as ir
 from grammarc.ir.passes.rulegraph import RuleGraph, analyze_rules
 from grammarc.ir.pipeline import run_passes
-from grammarc.ir.traverse import iter_ops
+from grammarc.ir.traverse import iter_exprs, iter_ops, op_exprs
 
 
 @dataclass(frozen=True)
@@ -36,15 +36,19 @@ class Grammar:
 
 
 def compile_grammar(path: str | Path, *, text: str | None = None, start: str | None = None,
-                    asset_roots: tuple[Path, ...] = (), dialect: str | None = None) -> Grammar:
-    """Parse, check and analyse a grammar file; raise ``GrammarError`` listing every error."""
+                    asset_roots: tuple[Path, ...] = (), dialect: str | None = None,
+                    display: str | None = None) -> Grammar:
+    """Parse, check and analyse a grammar file; raise ``GrammarError`` listing every error.
+
+    ``display`` names the file in diagnostics (a rule file inside a package: ``candler.rpk/rules/x.cga``).
+    """
     path = Path(path)
     if text is None:
         try:
             text = path.read_text(encoding="utf-8")
         except (OSError, UnicodeDecodeError) as error:
             raise UsageError(f"cannot read grammar {path}: {error}") from None
-    file = str(path)
+    file = display or str(path)
     diags = Diagnostics()
     module = parse_source(text, file, diags, dialect)
     module = run_passes(module, diags)
@@ -81,22 +85,45 @@ def compile_grammar(path: str | Path, *, text: str | None = None, start: str | N
     )
 
 
+#: File endings of assets that a computed ``i(name)`` may name: string constants ending so are resolved.
+ASSET_SUFFIXES = (".obj",)
+
+
 def _assets(module: ir.Module, roots, diags: Diagnostics) -> tuple[tuple[str, ...], dict[str, int]]:
     names = [LEAF_CUBE, LEAF_QUAD]
     ids: dict[str, int] = {}
+    named = []
+    for rule in module.rules:
+        for alt in rule.alternatives:
+            named.extend(op for op in iter_ops(alt.body) if isinstance(op, (ir.Insert, ir.UseAsset))
+                         and op.asset)
+    if any(isinstance(op, ir.UseAsset) and op.name is not None for rule in module.rules
+           for alt in rule.alternatives for op in iter_ops(alt.body)):
+        # a computed asset name: every string constant that looks like an asset may be one
+        named.extend(ir.UseAsset(e.value, e.span) for e in _strings(module)
+                     if e.value.lower().endswith(ASSET_SUFFIXES))
+    for op in named:
+        if op.asset in ids:
+            continue
+        resolved = resolve_asset(op.asset, roots)
+        if resolved.problem:
+            diags.error("asset", resolved.problem, op.span)
+            continue
+        if resolved.missing:
+            diags.warning("asset", f"asset `{op.asset}` not found in "
+                          f"{', '.join(str(r) for r in roots)}; the record keeps its name", op.span)
+        if resolved.name not in names:
+            names.append(resolved.name)
+        ids[op.asset] = names.index(resolved.name)
+    return tuple(names), ids
+
+
+def _strings(module: ir.Module):
+    """Every string constant of the module (attribute defaults, arguments, conditions)."""
+    roots = [a.default for a in module.attrs]
     for rule in module.rules:
         for alt in rule.alternatives:
             for op in iter_ops(alt.body):
-                if not isinstance(op, (ir.Insert, ir.UseAsset)) or op.asset in ids:
-                    continue
-                resolved = resolve_asset(op.asset, roots)
-                if resolved.problem:
-                    diags.error("asset", resolved.problem, op.span)
-                    continue
-                if resolved.missing:
-                    diags.warning("asset", f"asset `{op.asset}` not found in "
-                                  f"{', '.join(str(r) for r in roots)}; the record keeps its name", op.span)
-                if resolved.name not in names:
-                    names.append(resolved.name)
-                ids[op.asset] = names.index(resolved.name)
-    return tuple(names), ids
+                roots.extend(op_exprs(op))
+    for root in roots:
+        yield from (e for e in iter_exprs(root) if isinstance(e, ir.Str))

@@ -56,7 +56,7 @@ def derive_chunk(plan: Plan, lots: Lots, *, seed: int, limits: Limits, overrides
     chunk, shapes = initial_chunk(lots)
     shapes = replace(shapes, key=lot_keys(seed, lots.index))
     attribute_columns(plan.grammar.module, Env(shapes, chunk, plan), lots.attrs, overrides, plan.strings)
-    shapes = replace(shapes, dynamic=tuple(chunk.attrs[name][shapes.lot] for name in plan.dynamic))
+    shapes = replace(shapes, dynamic=tuple(initial_dynamic(plan, name, chunk, shapes) for name in plan.dynamic))
     executor = Executor(plan, chunk, limits, chunk_budget)
     executor.pending[plan.start].append(shapes)
     for stage in plan.stages:
@@ -70,6 +70,18 @@ def derive_chunk(plan: Plan, lots: Lots, *, seed: int, limits: Limits, overrides
                     executor.apply(plan.symbols[sym_id], Shapes.concat(batches))
     reports = aggregate_chunk(chunk.outputs.reports, chunk.lot_index, list(plan.strings.ids))
     return collect(chunk), reports
+
+
+def initial_dynamic(plan: Plan, name: str, chunk: Chunk, shapes: Shapes) -> np.ndarray:
+    """A lot's starting value of a per-shape column: its attribute, or the context of no split yet."""
+    n = len(shapes)
+    if name == "comp.sel":
+        return np.full(n, plan.strings.intern(""), dtype=np.int32)
+    if name in ("split.total", "comp.total"):
+        return np.ones(n)
+    if name in ("split.index", "comp.index"):
+        return np.zeros(n)
+    return chunk.attrs[name][shapes.lot]
 
 
 def collect(chunk: Chunk) -> TerminalChunk:

@@ -58,6 +58,8 @@ def evaluate(expr: ir.Expr, env: Env):
             return env.shapes.dynamic[index]
         column = env.chunk.attrs[expr.name]
         return column[env.shapes.lot]
+    if isinstance(expr, ir.ContextRef):
+        return env.shapes.dynamic[env.plan.dynamic[expr.name]]
     if isinstance(expr, ir.Select):
         cond = evaluate(expr.cond, env)
         return np.where(cond, evaluate(expr.then, env), evaluate(expr.other, env))

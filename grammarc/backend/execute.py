@@ -11,6 +11,7 @@ one call per part. Python cost is per operation and batch, never per shape.
 from __future__ import annotations
 
 from collections import defaultdict
+from dataclasses import replace
 
 import numpy as np
 
@@ -144,7 +145,7 @@ class Executor:
             elif isinstance(op, ir.Center):
                 cursor = self.center(op, cursor, base)
             elif isinstance(op, ir.UseAsset):
-                cursor = self.use_asset(op, cursor)
+                cursor = self.use_asset(op, cursor, symbol)
             elif isinstance(op, ir.SetAttr):
                 cursor = self.set_attr(op, cursor)
             elif isinstance(op, ir.Report):
@@ -315,8 +316,24 @@ class Executor:
             shapes.origin, shapes.size, shapes.key, shapes.frame, shapes.geom, shapes.lot, shapes.depth,
             self.chunk.frames.data, axis, order, parent, pos, length, site, index,
         )
-        return Shapes(origin, size, frame, geom, lot, key, depth, tuple(p[parents] for p in shapes.params),
-                      tuple(d[parents] for d in shapes.dynamic))
+        children = Shapes(origin, size, frame, geom, lot, key, depth,
+                          tuple(p[parents] for p in shapes.params), tuple(d[parents] for d in shapes.dynamic))
+        return self.with_context(children, "split", index[order], parents, len(shapes))
+
+    def with_context(self, shapes: Shapes, kind: str, index, parents, n_parents: int,
+                     selector=None) -> Shapes:
+        """Set ``split.index``/``split.total`` (or ``comp.*``) of new children, where the grammar reads
+        them: the child's number and its parent's number of children."""
+        dynamic = list(shapes.dynamic)
+        slots = self.plan.dynamic
+        if f"{kind}.index" in slots:
+            dynamic[slots[f"{kind}.index"]] = index.astype(np.float64)
+        if f"{kind}.total" in slots:
+            dynamic[slots[f"{kind}.total"]] = np.bincount(parents, minlength=n_parents)[parents].astype(
+                np.float64)
+        if selector is not None and "comp.sel" in slots:
+            dynamic[slots["comp.sel"]] = selector
+        return replace(shapes, dynamic=tuple(dynamic))
 
     def grouped_children(self, shapes, axis, parent, cell, pos, length, site, n_parts):
         """``children`` ordered by body part (cell mod parts): each part's batch is then a slice."""
@@ -365,7 +382,7 @@ class Executor:
         normal[same] = np.eye(3)[plane[parent[same]]]
         shapes = Shapes(world_origin, size, frame, geom, child.lot, child_keys(child.key, site, index),
                         child.depth, child.params, child.dynamic)
-        return shapes, normal, index
+        return self.with_context(shapes, "comp", index, parent, len(cursor)), normal, index
 
     def polygons_of(self, shapes: Shapes):
         """Each shape's polygon as batch-local ragged arrays (implicit rectangles for scope shapes)."""
@@ -446,12 +463,21 @@ class Executor:
             origin += np.einsum("nj,nj->n", offset, axes[:, k])[:, None] * axes[:, k]
         return cursor.with_scope(origin, cursor.size, cursor.frame, cursor.geom)
 
-    def use_asset(self, op: ir.UseAsset, cursor: Shapes) -> Shapes:
+    def use_asset(self, op: ir.UseAsset, cursor: Shapes, symbol: int) -> Shapes:
         """The geometry becomes the asset fitted to the scope (a cube is the scope box itself)."""
-        if op.asset == "builtin:cube":
-            geom = np.full(len(cursor), -1, dtype=np.int32)
+        if op.name is None:
+            asset = np.full(len(cursor), self.plan.grammar.asset_ids[op.asset], dtype=np.int32)
         else:
-            geom = np.full(len(cursor), -2 - self.plan.grammar.asset_ids[op.asset], dtype=np.int32)
+            names = evaluate_array(op.name, self.env(cursor), dtype=np.int32)
+            lookup = self.plan.asset_of_string
+            asset = np.array([lookup.get(int(s), -1) for s in np.unique(names)], dtype=np.int32)[
+                np.unique(names, return_inverse=True)[1].reshape(-1)]
+            bad = asset < 0
+            if bad.any():
+                name = list(self.plan.strings.ids)[int(names[np.flatnonzero(bad)[0]])]
+                self.fail(cursor, bad, f"`i` of `{name}`, which is not an asset of the grammar", symbol,
+                          op.span)
+        geom = np.where(asset == 0, -1, -2 - asset).astype(np.int32)  # asset 0 is builtin:cube: a box
         return cursor.with_scope(cursor.origin, cursor.size, cursor.frame, geom)
 
     def set_attr(self, op: ir.SetAttr, cursor: Shapes) -> Shapes:
@@ -515,6 +541,9 @@ class Executor:
         which = classify_faces(normal, op.selectors)
         keep = which < len(op.selectors)
         shapes, which = shapes.take(keep), which[keep]
+        if "comp.sel" in self.plan.dynamic:
+            ids = np.array([self.plan.strings.ids[s] for s in op.selectors], dtype=np.int32)
+            shapes = self.with_context(shapes, "sel", None, None, 0, selector=ids[which])
         self.count(shapes, symbol, op.span)
         order, offsets = group_by(which, len(op.parts))
         self.run_parts(op.parts, shapes.take(order), offsets, symbol)

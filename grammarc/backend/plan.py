@@ -46,12 +46,15 @@ class Plan:
     strings: Strings
     #: Distinct priorities in derivation order (lowest first).
     stages: tuple[int, ...]
-    #: Attributes that rules ``set``: name -> index into ``Shapes.dynamic``.
+    #: Per-shape values: attributes that rules ``set`` and the split/comp context the grammar reads
+    #: (``split.index``...): name -> index into ``Shapes.dynamic``.
     dynamic: dict[str, int]
     #: CityEngine semantics: a body that makes no successor leaves its shape as a leaf.
     leaf_bodies: bool
     #: Names of operations accepted without effect on the record (material, UV, print).
     not_applied: tuple[str, ...]
+    #: Interned string id -> asset id, for assets named by computed strings (``i(asset)``); -1: none.
+    asset_of_string: dict[int, int]
 
     @property
     def symbol_names(self) -> tuple[str, ...]:
@@ -74,11 +77,16 @@ def make_plan(grammar: Grammar) -> Plan:
             strings.intern(expr.value)
     stages = tuple(sorted({s.priority for s in symbols if s.rules}))
     ops = [op for rule in module.rules for alt in rule.alternatives for op in iter_ops(alt.body)]
+    context = [e.name for e in _all_exprs(module) if isinstance(e, ir.ContextRef)]
     dynamic = {name: i for i, name in enumerate(dict.fromkeys(
-        op.name for op in ops if isinstance(op, ir.SetAttr)))}
+        [op.name for op in ops if isinstance(op, ir.SetAttr)] + sorted(set(context))))}
     not_applied = tuple(sorted({op.name for op in ops if isinstance(op, ir.NotApplied)}))
+    strings.intern("")
+    for selector in ir.FACE_SELECTORS:
+        strings.intern(selector)
+    asset_of_string = {strings.intern(raw): asset for raw, asset in grammar.asset_ids.items()}
     return Plan(grammar, tuple(symbols), ids, ids[grammar.graph.start], strings, stages, dynamic,
-                module.dialect == "cityengine", not_applied)
+                module.dialect == "cityengine", not_applied, asset_of_string)
 
 
 #: Operations after which a body's shape is not the body's to emit: it was replaced by successors, split

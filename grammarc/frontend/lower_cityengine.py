@@ -63,6 +63,14 @@ class FunctionDef:
 
 
 @dataclass(frozen=True, slots=True)
+class Style:
+    """``style Name``: the attributes after it redefine the defaults for that style."""
+
+    name: str
+    span: Span
+
+
+@dataclass(frozen=True, slots=True)
 class Sized:
     """A split part's size or an argument with its kind (absolute, ``'`` relative, ``~`` floating)."""
 
@@ -145,7 +153,7 @@ class Lowering(Transformer):
         return None
 
     def style(self, meta, name):
-        return self.unsupported("style", self.tspan(name))
+        return Style(str(name), self.tspan(name))
 
     def import_prefixed(self, meta, prefix, path, *names):
         return self.unsupported("import", self.span(meta), "rule files are compiled alone for now")
@@ -319,10 +327,11 @@ class Lowering(Transformer):
         return ()
 
     def op_insert(self, op, args, span):
-        if len(args) != 1 or not isinstance(args[0], ir.Str):
-            return self.unsupported(f"i with {len(args)} arguments or a computed asset", span,
-                                    "only i(\"path\")")
-        return ir.UseAsset(args[0].value, span)
+        if len(args) != 1:
+            return self.unsupported(f"i with {len(args)} arguments", span, "only i(asset)")
+        if isinstance(args[0], ir.Str):
+            return ir.UseAsset(args[0].value, span)
+        return ir.UseAsset("", span, name=self.expr(args[0]))
 
     def op_cube(self, op, args, span):
         if args:
@@ -336,7 +345,7 @@ class Lowering(Transformer):
         if not self.arity(op, args, (2,), span):
             return ir.Empty(span)
         target = args[0]
-        if isinstance(target, ir.Name) and target.name.startswith("material."):
+        if isinstance(target, ir.Name) and target.name.startswith(("material.", "trim.")):
             return ir.NotApplied(f"set({target.name})", span)
         if not isinstance(target, ir.Name):
             return self.unsupported("set of this target", span, "set(attribute, value)")
@@ -464,10 +473,14 @@ class Lowering(Transformer):
             return ir.ScopeRef(SCOPE_MEMBERS[text], span)
         if text in ("geometry.area", "geometry.volume"):
             return ir.Call(text, (), span, self.site())
-        if names[0] == "material":
-            return ir.Name(text, span)  # only set(material.*, ...) takes it
-        self.unsupported(text, span)
-        return ir.placeholder(span)
+        if text in ir.CONTEXT_FIELDS:
+            return ir.ContextRef(text, span)
+        if names[0] in _UNSUPPORTED_MEMBERS:
+            self.unsupported(text, span)
+            return ir.placeholder(span)
+        # material.*, scope.xy, world.xyz...: arguments of set, setupProjection, alignScopeToAxes; as a
+        # value anywhere else, name resolution reports them
+        return ir.Name(text, span)
 
     def member_function(self, meta, dotted, args):
         names, span = dotted
@@ -507,6 +520,8 @@ _OPS = {
     "report": Lowering.op_report,
 }
 _SPLIT_OPS = frozenset({"split", "comp"})
+#: Shape attributes that grammarc does not provide yet: comp.index, split.index, initialShape.origin...
+_UNSUPPORTED_MEMBERS = frozenset({"comp", "split", "initialShape", "geometry"})
 
 
 def _as_body(value) -> ir.Body:
@@ -521,10 +536,19 @@ def assemble(file: str, statements: list, diags: Diagnostics) -> ir.Module:
     attrs: list[ir.AttrDecl] = []
     functions: dict[str, FunctionDef] = {}
     rules: list[tuple[RuleDef, tuple]] = []
+    style = None
     for st in statements:
         if not isinstance(st, Annotated):
             st = Annotated((), st)  # a declaration without annotations comes bare from the parser
         decl = st.declaration
+        if isinstance(decl, Style):
+            if style is None:
+                diags.warning("style", f"style `{decl.name}` is not derived: grammarc derives the Default "
+                              "style (PRT's Default$...)", decl.span)
+            style = decl
+            continue
+        if style is not None and isinstance(decl, ir.AttrDecl):
+            continue  # a redefinition for the style
         if isinstance(decl, ir.AttrDecl):
             if any(a.name == decl.name for a in attrs):
                 diags.error("duplicate-attr", f"attribute `{decl.name}` is declared twice", decl.span)

@@ -41,6 +41,7 @@ triangles before it allocates anything and refuses a record beyond ``max_triangl
 from __future__ import annotations
 
 import os
+import shutil
 import tempfile
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
@@ -652,7 +653,7 @@ class BakedWriter:
             return dict(self._counts)
         if self._state == "aborted":
             raise ValueError("close of a BakedWriter that is aborted")
-        tmp = None
+        tmpdir = None
         try:
             chunks, self._chunks = self._chunks, []
             mesh_table = MeshChunk.concat([c[2] for c in chunks])
@@ -662,21 +663,24 @@ class BakedWriter:
             mesh = _bake(self._library, asset.astype(np.int64, copy=False), xform, mesh_table,
                          self.max_triangles)
             del asset, xform
-            fd, tmp = tempfile.mkstemp(prefix=f".{self.path.name}.tmp", suffix=self.path.suffix,
-                                       dir=self.path.parent)
             n_polygons = int(mesh.metadata["n_polygons"])
-            with os.fdopen(fd, "wb") as out:
-                out.write(self._export(mesh))
+            data = self._export(mesh)
+            # A private directory next to the output (same filesystem, for the rename); the file in it
+            # gets the umask's permissions, as the npz writer's output does (mkstemp would give 0600).
+            tmpdir = tempfile.mkdtemp(prefix=f".{self.path.name}.tmp", dir=self.path.parent)
+            tmp = os.path.join(tmpdir, self.path.name)
+            with open(tmp, "xb") as out:
+                out.write(data)
                 out.flush()
                 os.fsync(out.fileno())
+            del data
             os.replace(tmp, self.path)
-            tmp = None
         except BaseException:
             self.abort()
             raise
         finally:
-            if tmp is not None:
-                Path(tmp).unlink(missing_ok=True)
+            if tmpdir is not None:
+                shutil.rmtree(tmpdir, ignore_errors=True)
         self._state = "closed"
         self._counts = {
             "instances": self._rows,

@@ -132,6 +132,19 @@ class Call:
     site: int = 0
 
 
+#: What a shape knows of the split or component split that made it (CityEngine's ``split.index``...).
+CONTEXT_FIELDS = {"split.index": Type.NUM, "split.total": Type.NUM, "comp.index": Type.NUM,
+                  "comp.total": Type.NUM, "comp.sel": Type.STR}
+
+
+@dataclass(frozen=True, slots=True)
+class ContextRef:
+    """``split.index``, ``split.total``, ``comp.index``, ``comp.total``, ``comp.sel`` of the shape."""
+
+    name: str
+    span: Span = NO_SPAN
+
+
 @dataclass(frozen=True, slots=True)
 class Select:
     """``cond ? then : other`` per shape: CityEngine's ``case`` and ``p% :`` expressions lower to it."""
@@ -142,7 +155,7 @@ class Select:
     span: Span = NO_SPAN
 
 
-Expr = Num | Str | Bool | Name | Param | AttrRef | ScopeRef | Unary | Binary | Call | Select
+Expr = Num | Str | Bool | Name | Param | AttrRef | ScopeRef | Unary | Binary | Call | Select | ContextRef
 
 #: Built-in functions: name -> (min args, max args, result type). Argument types are numbers.
 FUNCTIONS: dict[str, tuple[int, int, Type]] = {
@@ -317,10 +330,15 @@ class Center:
 @dataclass(frozen=True, slots=True)
 class UseAsset:
     """CityEngine ``i(asset)`` and ``primitiveCube()``: the shape's geometry becomes the asset fitted to
-    its scope; the shape goes on (a leaf emits the asset as an instance)."""
+    its scope; the shape goes on (a leaf emits the asset as an instance).
+
+    ``asset`` is the name when it is written as a string; otherwise ``name`` computes it per shape (a
+    parameter or constant holding an asset path).
+    """
 
     asset: str
     span: Span = NO_SPAN
+    name: Expr | None = None
 
 
 @dataclass(frozen=True, slots=True)

@@ -32,6 +32,8 @@ def print_expr(e: ir.Expr) -> str:
         return f"({print_expr(e.left)} {e.op} {print_expr(e.right)})"
     if isinstance(e, ir.Call):
         return f"{e.func}({', '.join(print_expr(a) for a in e.args)})"
+    if isinstance(e, ir.ContextRef):
+        return e.name
     if isinstance(e, ir.Select):
         return f"({print_expr(e.cond)} ? {print_expr(e.then)} : {print_expr(e.other)})"
     raise TypeError(f"not an expression: {e!r}")
@@ -101,7 +103,7 @@ def print_op(op: ir.Op) -> str:
     if isinstance(op, ir.Center):
         return f"center({''.join('xyz'[a] for a in op.axes)})"
     if isinstance(op, ir.UseAsset):
-        return f'i("{op.asset}")'
+        return f"i({print_expr(op.name)})" if op.name is not None else f'i("{op.asset}")'
     if isinstance(op, ir.SetAttr):
         return f"set({op.name}, {print_expr(op.value)})"
     if isinstance(op, ir.Report):

@@ -91,6 +91,9 @@ def rewrite_op(op: ir.Op, fn: ExprFn) -> ir.Op:
     if isinstance(op, ir.Extrude):
         height = ex(op.height)
         return op if height is op.height else replace(op, height=height)
+    if isinstance(op, ir.UseAsset) and op.name is not None:
+        name = ex(op.name)
+        return op if name is op.name else replace(op, name=name)
     if isinstance(op, ir.SetAttr):
         value = ex(op.value)
         return op if value is op.value else replace(op, value=value)
@@ -176,6 +179,8 @@ def op_exprs(op: ir.Op) -> Iterator[ir.Expr]:
         yield from (cond for cond, _ in op.branches)
     elif isinstance(op, ir.Extrude):
         yield op.height
+    elif isinstance(op, ir.UseAsset) and op.name is not None:
+        yield op.name
     elif isinstance(op, ir.SetAttr):
         yield op.value
     elif isinstance(op, ir.Report):

@@ -73,6 +73,8 @@ def _check_op(op, check, param_types, diags) -> None:
             check(s.value, T.NUM, "a size")
     elif isinstance(op, ir.Extrude):
         check(op.height, T.NUM, "a height")
+    elif isinstance(op, ir.UseAsset) and op.name is not None:
+        check(op.name, T.STR, "an asset name")
     elif isinstance(op, ir.Case):
         for cond, _ in op.branches:
             check(cond, T.BOOL, "a case condition")
@@ -153,6 +155,8 @@ def type_of(expr: ir.Expr, attrs: dict, params: tuple, diags: Diagnostics) -> ir
         return T.BOOL
     if isinstance(expr, ir.ScopeRef):
         return T.NUM
+    if isinstance(expr, ir.ContextRef):
+        return ir.CONTEXT_FIELDS[expr.name]
     if isinstance(expr, ir.AttrRef):
         return attrs.get(expr.name, T.UNKNOWN)
     if isinstance(expr, ir.Param):
