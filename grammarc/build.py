@@ -85,8 +85,8 @@ def build(grammar_path, output, *, lots_path=None, options: BuildOptions = Build
     ``progress(done, total)`` is called with the number of lots finished after each chunk.
     """
     started = time.perf_counter()
-    with grammar_source(Path(grammar_path), options) as (source, display, options):
-        return _build(source, display, Path(grammar_path), output, lots_path, options, progress, started)
+    with grammar_source(Path(grammar_path), options) as (source, display, resolved):
+        return _build(source, display, Path(grammar_path), output, lots_path, resolved, progress, started)
 
 
 @contextmanager
