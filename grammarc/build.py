@@ -125,6 +125,8 @@ def _build(source: Path, display: str | None, grammar_path: Path, output, lots_p
         "attrs": {k: v for k, v in sorted(options.attrs.items())},
         "lots_source": lots.source,
         "dialect": grammar.module.dialect,
+        # where the record's assets are (baking, conformance); a package's are temporary
+        "asset_roots": [str(r) for r in options.asset_roots],
         # operations accepted without effect on the record (material, texture, UV, print)
         "not_applied": list(plan.not_applied),
     }

@@ -64,6 +64,15 @@ def _parser() -> argparse.ArgumentParser:
     build.add_argument("--quiet", "-q", action="store_true", help="no progress bar and no summary")
     build.set_defaults(run=_build)
 
+    conform = sub.add_parser("conform", help="compare grammarc with Esri's PRT on the conformance kit")
+    conform.add_argument("rpk", type=Path, nargs="?", help="a rule package of the kit (.rpk)")
+    conform.add_argument("footprint", nargs="?", help="a kit footprint name (rect_30x20) or a lots file")
+    conform.add_argument("--attr", action="append", default=[], metavar="NAME=VALUE")
+    conform.add_argument("--seed", type=int, default=0)
+    conform.add_argument("--all", action="store_true",
+                         help="every record of the kit's reference.json, as a table")
+    conform.set_defaults(run=_conform)
+
     check = sub.add_parser("check", help="report every problem of a grammar, and a summary")
     check.add_argument("grammar", type=Path)
     check.add_argument("--start", metavar="SYMBOL")
@@ -122,6 +131,31 @@ class _ProgressBar:
     def close(self) -> None:
         if self.bar is not None:
             self.bar.close()
+
+
+def _conform(args) -> int:
+    from grammarc.backend.attributes import parse_override
+    from grammarc.conform import kit_dir, load_reference, run_conformance
+    from grammarc.errors import UsageError
+
+    reference = load_reference()
+    if args.all:
+        runs = [(kit_dir() / "rpk" / f"{r['rpk']}.rpk", r["footprint"], r.get("attrs", {}))
+                for r in reference["records"]]
+    elif args.rpk is None or args.footprint is None:
+        raise UsageError("conform takes RPK FOOTPRINT, or --all")
+    else:
+        runs = [(args.rpk, args.footprint, dict(parse_override(a) for a in args.attr))]
+    print("| rpk | footprint | attrs | verdict |")
+    print("|---|---|---|---|")
+    passed = 0
+    for rpk, footprint, attrs in runs:
+        result = run_conformance(rpk, footprint, attrs, seed=args.seed, reference=reference)
+        passed += result.passed
+        shown = ", ".join(f"{k}={v:g}" if isinstance(v, float) else f"{k}={v}" for k, v in attrs.items())
+        print(f"| {result.rpk} | {result.footprint} | {shown or '-'} | {result.summary} |", flush=True)
+    print(f"{passed} of {len(runs)} pass")
+    return 0 if passed == len(runs) else 1
 
 
 def _build(args) -> int:

@@ -40,6 +40,7 @@ import numpy as np
 from grammarc.errors import UsageError
 
 __all__ = [
+    "Conformance",
     "Verdict",
     "compare",
     "find_record",
@@ -47,6 +48,7 @@ __all__ = [
     "kit_dir",
     "load_reference",
     "measure",
+    "run_conformance",
     "surface_distance",
 ]
 
@@ -417,3 +419,102 @@ def footprint_geojson(name: str, kit: str | os.PathLike | None = None) -> dict:
         names = ", ".join(f.get("properties", {}).get("name", "?") for f in collection["features"])
         raise UsageError(f"no footprint `{name}` in {path} (footprints: {names})")
     return {"type": "FeatureCollection", "features": features}
+
+
+# ------------------------------------------------------------------------------------------ the runner
+
+#: The issue's targets: rule packages with simple geometry must match to the README's tolerances; the
+#: large facade packages to 2 cm and 1 % of the area.
+TOLERANCES = {"candler": (0.02, 0.01), "complexpatterns": (0.02, 0.01)}
+#: Record fields of a report that are compared: numbers to a relative 1e-9, the rest exactly.
+_REPORT_REL_TOL = 1e-9
+
+
+@dataclass(frozen=True)
+class Conformance:
+    """grammarc against PRT on one (rule package, footprint, attributes): geometry and reports."""
+
+    rpk: str
+    footprint: str
+    attrs: dict
+    verdict: Verdict | None
+    reports_ok: bool | None
+    report_differences: tuple[str, ...]
+    error: str = ""
+
+    @property
+    def passed(self) -> bool:
+        return self.verdict is not None and self.verdict.passed and self.reports_ok is not False
+
+    @property
+    def summary(self) -> str:
+        if self.error:
+            return f"ERROR {self.error}"
+        text = self.verdict.summary if self.verdict is not None else "no reference record"
+        if self.reports_ok is not None:
+            text += ", reports " + ("equal" if self.reports_ok else
+                                    "differ: " + "; ".join(self.report_differences[:3]))
+        return text
+
+
+def footprint_path(name: str, kit: Path | None = None) -> Path:
+    """A kit footprint by name (``rect_30x20``; the courtyard is its PRT JSON), or a path as given."""
+    path = Path(name)
+    if path.suffix:
+        return path
+    folder = (kit or kit_dir()) / "footprints"
+    for suffix in (".obj", ".json"):
+        candidate = folder / f"{name}{suffix}"
+        if candidate.is_file():
+            return candidate
+    raise UsageError(f"no footprint `{name}` in {folder}")
+
+
+def compare_reports(ours: Mapping, theirs: Mapping) -> tuple[bool, tuple[str, ...]]:
+    """PRT's flat report (``key_n``, ``key_sum``...) against grammarc's totals for the same model."""
+    differences = []
+    for key in sorted(set(ours) | set(theirs)):
+        a, b = ours.get(key), theirs.get(key)
+        if a is None or b is None:
+            differences.append(f"{key}: {'missing' if a is None else a} vs {'missing' if b is None else b}")
+        elif isinstance(b, (int, float)) and not isinstance(b, bool) and not isinstance(a, (bool, str)):
+            if not math.isclose(float(a), float(b), rel_tol=_REPORT_REL_TOL, abs_tol=1e-12):
+                differences.append(f"{key}: {a} vs {b}")
+        elif a != b:
+            differences.append(f"{key}: {a} vs {b}")
+    return not differences, tuple(differences)
+
+
+def run_conformance(rpk: str | os.PathLike, footprint: str, attrs: Mapping | None = None, *,
+                    seed: int = 0, reference: Mapping | None = None) -> Conformance:
+    """Derive ``rpk`` on a kit footprint with grammarc, bake it, and compare with PRT's record."""
+    from grammarc.build import BuildOptions, derive, grammar_source
+    from grammarc.compiler import compile_grammar
+    from grammarc.errors import GrammarcError
+    from grammarc.io.bake import bake
+    from grammarc.io.lots import read_lots
+
+    rpk = Path(rpk)
+    attrs = dict(attrs or {})
+    reference = reference if reference is not None else load_reference()
+    expected = find_record(reference, rpk.stem, footprint, attrs, seed=seed)
+    options = BuildOptions(seed=seed, attrs={k: float(v) if isinstance(v, int) else v
+                                             for k, v in attrs.items()})
+    try:
+        with grammar_source(rpk, options) as (source, display, resolved):
+            grammar = compile_grammar(source, start=resolved.start, asset_roots=resolved.asset_roots,
+                                      display=display)
+            record = derive(grammar, read_lots(footprint_path(footprint)), resolved)
+            mesh = bake(record, resolved.asset_roots)
+    except GrammarcError as error:
+        first = str(error).splitlines()[0]
+        return Conformance(rpk.stem, footprint, attrs, None, None, (), error=first)
+    if expected is None:
+        return Conformance(rpk.stem, footprint, attrs, None, None, ())
+    bbox_tol, area_tol = TOLERANCES.get(rpk.stem, (BBOX_TOL, AREA_REL_TOL))
+    verdict = compare(measure(mesh), expected, bbox_tol=bbox_tol, area_rel_tol=area_tol)
+    reports_ok, differences = None, ()
+    if expected.get("report") or record["reports"]:
+        ours = record["reports"].table(record["reports"].totals())
+        reports_ok, differences = compare_reports(ours, expected.get("report") or {})
+    return Conformance(rpk.stem, footprint, attrs, verdict, reports_ok, differences)

@@ -39,7 +39,8 @@ __all__ = ["RulePackage", "open_rpk", "start_rule_of"]
 
 _INSTALL_HINT = "pip install 'grammarc[rpk]' (or pip install py7zr)"
 
-# A string literal, or a comment: comments are dropped, strings kept (a "//" inside a string is text).
+# A string literal (group 1) or a comment; _strip_comments blanks the one and drops the other, so a "//"
+# inside a string is not taken for a comment.
 _STRING_OR_COMMENT = re.compile(r'("(?:[^"\\\n]|\\.)*"|\'(?:[^\'\\\n]|\\.)*\')|//[^\n]*|/\*.*?\*/', re.DOTALL)
 # @StartRule, then any further annotations (@Hidden, @Description("...")), then the rule's name. Strings
 # inside annotation arguments are blanked by _strip_comments, so `[^)]*` cannot stop inside one.

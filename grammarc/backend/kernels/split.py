@@ -124,12 +124,13 @@ def group_split(extent, values, kind, group, n_groups, tol):
     0 absolute, 1 relative (a fraction of the extent), 2 floating (``~``); group : (P,) int64 the repeat
     group of each part, -1 for none; n_groups : int.
 
-    The rule (grammarc's reading of CityEngine's): the extent minus the fixed parts outside groups is
-    shared by the floating parts outside groups and the groups, in proportion to their nominal sizes (a
-    group's nominal size is one repetition). A group repeats round(share / nominal) times (at least once)
-    if it holds floating parts, whose sizes then stretch to fill its share exactly; otherwise
-    floor(share / nominal) times, the rest of its share left empty. Parts are laid end to end; parts
-    beyond the extent are dropped, the last one cut; parts of length <= tol are dropped.
+    The rule (grammarc's reading of CityEngine's): what the fixed parts and the floating parts outside
+    groups leave at their written sizes is shared by the groups in proportion to one repetition's size.
+    A group with floating parts repeats round(share / repetition) times (at least once when there is
+    room); a group of fixed sizes floor(share / repetition) times, the rest of its share left empty at
+    its end. Then every floating size, in groups or not, is scaled by one factor so that the parts fill
+    the extent. Parts are laid end to end; parts beyond the extent are dropped, the last one cut; parts
+    of length <= tol are dropped.
 
     Returns parent, part (index into the P parts), position, length (m,) and index (m,) int64, the
     child's number within its parent.
@@ -137,24 +138,24 @@ def group_split(extent, values, kind, group, n_groups, tol):
     n = len(extent)
     count = values.shape[1]
     shared = values.shape[0] == 1
-    reps = np.zeros((n, max(n_groups, 1)), np.int64)
-    stretch = np.ones((n, max(n_groups, 1)))
-    gap = np.zeros((n, max(n_groups, 1)))
-    float_scale = np.ones(n)
+    slots = max(n_groups, 1)
+    reps = np.zeros((n, slots), np.int64)
+    gap = np.zeros((n, slots))
+    scale = np.ones(n)
     total = 0
     for i in range(n):
         row = 0 if shared else i
         fixed = 0.0
-        float_weight = 0.0
-        nominal = np.zeros(max(n_groups, 1))
-        group_fixed = np.zeros(max(n_groups, 1))
-        group_float = np.zeros(max(n_groups, 1))
+        floating = 0.0
+        nominal = np.zeros(slots)
+        group_fixed = np.zeros(slots)
+        group_float = np.zeros(slots)
         for j in range(count):
             size = values[row, j] * extent[i] if kind[j] == 1 else values[row, j]
             g = group[j]
             if g < 0:
                 if kind[j] == 2:
-                    float_weight += size
+                    floating += size
                 else:
                     fixed += size
             else:
@@ -163,26 +164,27 @@ def group_split(extent, values, kind, group, n_groups, tol):
                     group_float[g] += size
                 else:
                     group_fixed[g] += size
-        rest = max(extent[i] - fixed, 0.0)
-        weight = float_weight
+        room = extent[i] - fixed
+        avail = room - floating
+        all_nominal = 0.0
         for g in range(n_groups):
-            weight += nominal[g]
-        used_by_groups = 0.0
+            all_nominal += nominal[g]
         for g in range(n_groups):
-            share = rest * nominal[g] / weight if weight > 0.0 else 0.0
             if nominal[g] <= tol:
                 continue
+            share = max(avail, 0.0) * nominal[g] / all_nominal
             if group_float[g] > 0.0:
-                r = max(int(np.floor(share / nominal[g] + 0.5)), 1) if share > tol else 0
-                if r > 0:
-                    stretch[i, g] = max(share / r - group_fixed[g], 0.0) / group_float[g]
+                r = int(np.floor(share / nominal[g] + 0.5))
+                if r == 0 and room > tol:
+                    r = 1
             else:
                 r = int(np.floor(share / nominal[g] + 1e-9))
                 gap[i, g] = share - r * nominal[g]
             reps[i, g] = r
-            used_by_groups += share
-        if float_weight > 0.0:
-            float_scale[i] = (rest - used_by_groups) / float_weight if weight > 0.0 else 0.0
+            fixed += r * group_fixed[g] + gap[i, g]
+            floating += r * group_float[g]
+        if floating > 0.0:
+            scale[i] = max(extent[i] - fixed, 0.0) / floating
         for j in range(count):
             g = group[j]
             total += 1 if g < 0 else reps[i, g]
@@ -200,7 +202,7 @@ def group_split(extent, values, kind, group, n_groups, tol):
         while j < count:
             g = group[j]
             if g < 0:
-                size = _part_size(values[row, j], kind[j], extent[i], float_scale[i])
+                size = _part_size(values[row, j], kind[j], extent[i], scale[i])
                 m, at, child = _place(parent, part, pos, length, index, m, i, j, at, size, extent[i], tol,
                                       child)
                 j += 1
@@ -210,7 +212,7 @@ def group_split(extent, values, kind, group, n_groups, tol):
                 end += 1
             for _ in range(reps[i, g]):
                 for k in range(j, end):
-                    size = _part_size(values[row, k], kind[k], extent[i], stretch[i, g])
+                    size = _part_size(values[row, k], kind[k], extent[i], scale[i])
                     m, at, child = _place(parent, part, pos, length, index, m, i, k, at, size, extent[i],
                                           tol, child)
             at += gap[i, g]

@@ -1,0 +1,134 @@
+"""Rule packages: the kit's eight .rpk files opened, their start rules, assets, and the temporary files."""
+
+import gc
+import json
+import sys
+from pathlib import Path
+
+import pytest
+
+from grammarc.errors import UsageError
+from grammarc.io.assets import resolve_asset
+from grammarc.io.rpk import open_rpk, start_rule_of
+
+py7zr = pytest.importorskip("py7zr")
+
+KIT = Path(__file__).resolve().parents[2].parent / "shared" / "prt"
+needs_kit = pytest.mark.skipif(not (KIT / "rpk").is_dir(), reason="PRT kit (../shared/prt) absent")
+
+#: Start rules as read from the CGA sources; PRT names them "Default$" + the rule (reference.json).
+START_RULES = {
+    "candler": "Footprint",
+    "extrusion_rule": "Footprint",
+    "extrude_color": "Init",
+    "translateModel": "Lot",
+    "reporting": "Lot",
+    "genattrs": "Init",
+    "massing": "Lot",
+    "complexpatterns": "Lot",
+}
+
+
+@pytest.fixture(scope="module")
+def reference():
+    return json.loads((KIT / "reference.json").read_text(encoding="utf-8"))
+
+
+@needs_kit
+@pytest.mark.parametrize("name", sorted(START_RULES))
+def test_kit_package(name, reference):
+    info = reference["rpks"][name]
+    with open_rpk(KIT / "rpk" / f"{name}.rpk") as rpk:
+        assert list(rpk.rules) == sorted(info["cga_sources"])
+        assert rpk.start_rule == START_RULES[name]
+        assert info["start_rules"] == [f"Default${rpk.start_rule}"]
+        assert rpk.main_rule_file.stem == Path(info["main_cgb"]).stem
+        assert rpk.compiled == [info["main_cgb"]]
+        assert all(path.is_file() for path in rpk.rules.values())
+        lines = sum(len(p.read_text(encoding="utf-8").splitlines()) for p in rpk.rules.values())
+        assert lines == info["cga_lines"]
+        has_assets = (rpk.root / "assets").is_dir()
+        assert rpk.assets_root == (rpk.root / "assets" if has_assets else rpk.root)
+        assert rpk.asset_roots[-1] == rpk.root
+        assert rpk.resolve_map  # every kit package has a .resolvemap.xml
+
+
+@needs_kit
+def test_candler_assets_resolve_in_assets_folder():
+    # Candler inserts i("facade/windows/win.single.05.sashwindow.obj"): CityEngine finds it in assets/.
+    with open_rpk(KIT / "rpk" / "candler.rpk") as rpk:
+        resolved = resolve_asset("facade/windows/win.single.05.sashwindow.obj", list(rpk.asset_roots))
+        assert resolved.path == rpk.root / "assets" / "facade" / "windows" / "win.single.05.sashwindow.obj"
+        assert rpk.resolve_map["assets/primitives/cylinder.hor.obj"] == "assets/primitives/cylinder.hor.obj"
+        assert rpk.rules["rules/Candler Building.cga"] == rpk.main_rule_file
+
+
+@needs_kit
+def test_temporary_files_removed(tmp_path):
+    with open_rpk(KIT / "rpk" / "extrude_color.rpk", tmpdir=tmp_path) as rpk:
+        root = rpk.root
+        assert root.parent == tmp_path and root.is_dir() and not rpk.closed
+    assert rpk.closed and not root.exists()
+    rpk.close()  # idempotent
+
+    dropped = open_rpk(KIT / "rpk" / "extrude_color.rpk", tmpdir=tmp_path)
+    root = dropped.root
+    del dropped
+    gc.collect()
+    assert not root.exists()
+    assert list(tmp_path.iterdir()) == []
+
+
+def make_rpk(path: Path, files: dict[str, str]) -> Path:
+    """A 7-zip archive holding ``files`` (name in the archive -> text)."""
+    with py7zr.SevenZipFile(path, "w") as archive:
+        for name, text in files.items():
+            archive.writestr(text.encode(), name)
+    return path
+
+
+def test_main_rule_file_choice(tmp_path):
+    # No compiled rules: the one .cga with a @StartRule is the main file.
+    package = make_rpk(tmp_path / "two.rpk", {
+        "rules/lib.cga": "Helper --> X\n",
+        "rules/main.cga": '/* @StartRule Fake --> */\n@StartRule\n@Description("a) b")\nLot(h) -->\n X\n',
+    })  # fmt: skip
+    with open_rpk(package) as rpk:
+        assert rpk.main_rule_file.name == "main.cga"
+        assert rpk.start_rule == "Lot"
+        assert rpk.assets_root == rpk.root and rpk.resolve_map == {}
+    # The .cga named as the compiled rule file wins, even without @StartRule.
+    package = make_rpk(tmp_path / "cgb.rpk", {
+        "rules/a.cga": "@StartRule\nA --> X\n", "rules/b.cga": "B --> X\n", "bin/b.cgb": "",
+    })  # fmt: skip
+    with open_rpk(package) as rpk:
+        assert rpk.main_rule_file.name == "b.cga" and rpk.start_rule is None
+    # No sources at all.
+    with open_rpk(make_rpk(tmp_path / "bin.rpk", {"bin/x.cgb": ""})) as rpk:
+        assert rpk.rules == {} and rpk.main_rule_file is None and rpk.start_rule is None
+
+
+def test_start_rule_of(write):
+    text = "// @StartRule\nA --> X\n@StartRule Footprint --> B\n"
+    assert start_rule_of(write("a.cga", text)) == "Footprint"
+    assert start_rule_of(write("b.cga", 'attr s = "// @StartRule"\nA --> X\n')) is None
+    assert start_rule_of(write("c.cga", "@StartRule\n@Hidden\n\n  Init -->\n")) == "Init"
+
+
+def test_errors(tmp_path, monkeypatch):
+    with pytest.raises(UsageError, match="does not exist"):
+        open_rpk(tmp_path / "missing.rpk")
+    (tmp_path / "text.rpk").write_text("not an archive")
+    with pytest.raises(UsageError, match="cannot read rule package"):
+        open_rpk(tmp_path / "text.rpk")
+    (tmp_path / "evil.cga").write_text("A --> X\n")
+    with py7zr.SevenZipFile(tmp_path / "evil.rpk", "w") as archive:
+        archive.write(tmp_path / "evil.cga", arcname="../evil.cga")  # writestr refuses this name
+    (tmp_path / "evil.cga").unlink()
+    (tmp_path / "out").mkdir()
+    with pytest.raises(UsageError, match="leaves the package"):
+        open_rpk(tmp_path / "evil.rpk", tmpdir=tmp_path / "out")
+    assert not (tmp_path / "evil.cga").exists() and list((tmp_path / "out").iterdir()) == []
+    monkeypatch.setitem(sys.modules, "py7zr", None)  # import py7zr now raises ImportError
+    with pytest.raises(UsageError, match=r"grammarc\[rpk\]"):
+        open_rpk(tmp_path / "text.rpk")
