@@ -507,8 +507,12 @@ def run_conformance(rpk: str | os.PathLike, footprint: str, attrs: Mapping | Non
             record = derive(grammar, read_lots(footprint_path(footprint)), resolved)
             mesh = bake(record, resolved.asset_roots)
     except GrammarcError as error:
-        first = str(error).splitlines()[0]
-        return Conformance(rpk.stem, footprint, attrs, None, None, (), error=first)
+        diagnostics = [d for d in getattr(error, "diagnostics", ()) if d.is_error]
+        first = f"{diagnostics[0].span}: {diagnostics[0].message}" if diagnostics else str(error)
+        return Conformance(rpk.stem, footprint, attrs, None, None, (), error=first.splitlines()[0])
+    if record["bad"]:
+        return Conformance(rpk.stem, footprint, attrs, None, None, (),
+                           error=f"lot skipped: {record['bad'][0].reason}")
     if expected is None:
         return Conformance(rpk.stem, footprint, attrs, None, None, ())
     bbox_tol, area_tol = TOLERANCES.get(rpk.stem, (BBOX_TOL, AREA_REL_TOL))

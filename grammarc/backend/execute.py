@@ -27,7 +27,9 @@ from grammarc.backend.shapes import Shapes
 from grammarc.constants import TOL, Limits
 from grammarc.errors import ChunkTooLarge, LimitError, LotFailure
 from grammarc.geometry import components as comp_kernels
+from grammarc.geometry.reframe import reframe
 from grammarc.ir import nodes as ir
+from grammarc.ragged import ragged_take
 
 
 class Executor:
@@ -144,6 +146,8 @@ class Executor:
                 cursor = self.extrude(op, cursor, symbol)
             elif isinstance(op, ir.Center):
                 cursor = self.center(op, cursor, base)
+            elif isinstance(op, ir.AlignScope):
+                cursor = self.align_scope(op, cursor, symbol)
             elif isinstance(op, ir.UseAsset):
                 cursor = self.use_asset(op, cursor, symbol)
             elif isinstance(op, ir.SetAttr):
@@ -462,6 +466,43 @@ class Executor:
         for k in op.axes:
             origin += np.einsum("nj,nj->n", offset, axes[:, k])[:, None] * axes[:, k]
         return cursor.with_scope(origin, cursor.size, cursor.frame, cursor.geom)
+
+    def align_scope(self, op: ir.AlignScope, cursor: Shapes, symbol: int) -> Shapes:
+        """New scope axes around unchanged geometry (``geometry.reframe``)."""
+        frames = self.chunk.frames
+        axes = frames[cursor.frame]
+        n = len(cursor)
+        if op.mode == "world":
+            new_axes = np.broadcast_to(np.eye(3), (n, 3, 3))
+        elif op.mode == "y":
+            up = np.array([0.0, 1.0, 0.0])
+            x = axes[:, 0] - axes[:, 0, 1:2] * up
+            flat = np.linalg.norm(x, axis=1) < 1e-9
+            x[flat] = axes[flat, 2] - axes[flat, 2, 1:2] * up
+            x /= np.linalg.norm(x, axis=1, keepdims=True)
+            new_axes = np.stack([x, np.broadcast_to(up, x.shape), np.cross(x, up)], axis=1)
+        else:
+            env = self.env(cursor)
+            angles = [np.broadcast_to(evaluate_array(e, env), (n,)) for e in op.angles]
+            new_axes = np.einsum("nij,njk->nik", _rotation(*angles), axes)
+        bad = cursor.geom < -1
+        if bad.any():
+            self.fail(cursor, bad, "aligning the scope of an inserted asset is not supported yet", symbol,
+                      op.span)
+        coords, ring_offsets, shape_offsets, plane = self.polygons_of(cursor)
+        ok, origin, size, is_rect, new_coords = reframe(
+            cursor.origin, cursor.size, axes, coords, ring_offsets, shape_offsets, plane, new_axes)
+        if not ok.all():
+            self.fail(cursor, ~ok, "turning a scope out of its geometry's plane is not supported yet",
+                      symbol, op.span)
+        geom = np.full(n, -1, dtype=np.int32)
+        poly = np.flatnonzero(~is_rect)
+        if len(poly):
+            rings, packed_shapes = ragged_take(shape_offsets, poly)
+            vertices, packed_rings = ragged_take(ring_offsets, rings)
+            geom[poly] = self.chunk.polygons.add(new_coords[vertices], packed_rings, packed_shapes,
+                                                 plane[poly])
+        return cursor.with_scope(origin, size, frames.add(np.ascontiguousarray(new_axes)), geom)
 
     def use_asset(self, op: ir.UseAsset, cursor: Shapes, symbol: int) -> Shapes:
         """The geometry becomes the asset fitted to the scope (a cube is the scope box itself)."""

@@ -27,7 +27,7 @@ NOT_APPLIED = frozenset({
 UNSUPPORTED_OPS = frozenset({
     "offset", "setback", "shapeL", "shapeU", "shapeO", "innerRectangle", "innerPolygon", "convexify",
     "cleanupGeometry", "trim", "envelope", "roofGable", "roofHip", "roofShed", "roofPyramid",
-    "alignScopeToAxes", "alignScopeToGeometry", "rotateScope", "mirror", "mirrorScope", "setPivot",
+    "alignScopeToGeometry", "mirror", "mirrorScope", "setPivot",
     "insertAlongUV", "scatter", "footprint", "tileUV", "splitArea", "inline", "resetGeometry", "taper",
     "primitiveCylinder", "primitiveSphere", "primitiveDisk", "primitiveCone", "primitiveQuad",
     "deleteHoles", "reduceGeometry", "rectify", "semiPolygon",
@@ -316,6 +316,19 @@ class Lowering(Transformer):
             return self.unsupported(f"r with {len(args)} arguments", span, "only r(x, y, z)")
         return ir.Rotate(tuple(self.expr(a) for a in args), span)
 
+    def op_align(self, op, args, span):
+        if not args or (len(args) == 1 and isinstance(args[0], ir.Name) and args[0].name == "world.xyz"):
+            return ir.AlignScope("world", None, span)
+        if len(args) == 1 and isinstance(args[0], ir.Name) and args[0].name in ("y", "world.y"):
+            return ir.AlignScope("y", None, span)
+        return self.unsupported("alignScopeToAxes with this axis", span,
+                                "alignScopeToAxes(), alignScopeToAxes(world.xyz) and alignScopeToAxes(y)")
+
+    def op_rotate_scope(self, op, args, span):
+        if len(args) != 3:
+            return self.unsupported(f"rotateScope with {len(args)} arguments", span)
+        return ir.AlignScope("rotate", tuple(self.expr(a) for a in args), span)
+
     def op_center(self, op, args, span):
         axes = self.axis_argument(op, args, span)
         return ir.Center(axes, span) if axes else ir.Empty(span)
@@ -508,6 +521,8 @@ class Lowering(Transformer):
 
 
 _OPS = {
+    "alignScopeToAxes": Lowering.op_align,
+    "rotateScope": Lowering.op_rotate_scope,
     "extrude": Lowering.op_extrude,
     "t": Lowering.op_translate,
     "s": Lowering.op_scale,

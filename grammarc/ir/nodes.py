@@ -342,6 +342,16 @@ class UseAsset:
 
 
 @dataclass(frozen=True, slots=True)
+class AlignScope:
+    """CityEngine ``alignScopeToAxes()`` (``mode`` "world"), ``alignScopeToAxes(y)`` ("y") and
+    ``rotateScope(x, y, z)`` ("rotate", ``angles``): new scope axes, the geometry unchanged."""
+
+    mode: str
+    angles: tuple[Expr, Expr, Expr] | None = None
+    span: Span = NO_SPAN
+
+
+@dataclass(frozen=True, slots=True)
 class Case:
     """``case c1: B1 case c2: B2 else: B`` inside a body: each shape runs the first branch that holds."""
 
@@ -423,7 +433,8 @@ class CompFaces:
 
 
 Op = (Symbol | Empty | Translate | Scale | Rotate | Push | Pop | Insert | Split | Repeat | Comp | Extrude
-      | Center | UseAsset | Case | Stochastic | SetAttr | Report | NotApplied | GroupSplit | CompFaces)
+      | Center | UseAsset | Case | Stochastic | SetAttr | Report | NotApplied | GroupSplit | CompFaces
+      | AlignScope)
 Body = tuple[Op, ...]
 
 

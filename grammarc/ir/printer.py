@@ -108,6 +108,10 @@ def print_op(op: ir.Op) -> str:
         return f"set({op.name}, {print_expr(op.value)})"
     if isinstance(op, ir.Report):
         return f"report({print_expr(op.key)}, {print_expr(op.value)})"
+    if isinstance(op, ir.AlignScope):
+        if op.angles is not None:
+            return f"rotateScope({', '.join(print_expr(a) for a in op.angles)})"
+        return "alignScopeToAxes()" if op.mode == "world" else f"alignScopeToAxes({op.mode})"
     if isinstance(op, ir.NotApplied):
         return f"{op.name}(...)"
     raise TypeError(f"not an operation: {op!r}")

@@ -73,6 +73,9 @@ def _check_op(op, check, param_types, diags) -> None:
             check(s.value, T.NUM, "a size")
     elif isinstance(op, ir.Extrude):
         check(op.height, T.NUM, "a height")
+    elif isinstance(op, ir.AlignScope) and op.angles is not None:
+        for e in op.angles:
+            check(e, T.NUM, "an angle")
     elif isinstance(op, ir.UseAsset) and op.name is not None:
         check(op.name, T.STR, "an asset name")
     elif isinstance(op, ir.Case):

@@ -1,0 +1,65 @@
+"""A new scope for unchanged geometry: CityEngine's ``alignScopeToAxes`` and ``rotateScope``.
+
+The geometry stays where it is in the world; the scope turns to the new axes and becomes the geometry's
+bounding box in them. grammarc keeps a shape's geometry relative to its scope, so the polygon is
+expressed anew in the new scope (a rectangle that lines up with the new axes takes the box fast path
+again). The new axes must keep the polygon's plane: its normal axis keeps its direction (turning a
+footprint about the vertical, say); other turns need the general geometry of the polygon issue.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from grammarc.constants import TOL
+from grammarc.geometry.polygons import PLANE_AXES
+from grammarc.ragged import segment_of, segment_reduce
+
+_A = np.array([PLANE_AXES[p][0] for p in range(3)])
+_B = np.array([PLANE_AXES[p][1] for p in range(3)])
+
+
+def reframe(origin, size, axes, coords, ring_offsets, shape_offsets, plane, new_axes):
+    """Scopes of the same polygons in new axes.
+
+    origin, size (n, 3), axes, new_axes (n, 3, 3) (rows are the scope axes); the shapes' polygons as
+    normalized ragged arrays (coords (V, 2), ring_offsets, shape_offsets (n+1,)) with plane (n,) codes.
+
+    Returns ``ok`` (n,) bool (the new axes keep the plane), new origin and size (n, 3), ``is_rect`` (n,)
+    bool, and the new normalized coords (V, 2) (meaningful where ``ok``).
+    """
+    n = len(plane)
+    rows = np.arange(n)
+    a, b = _A[plane], _B[plane]
+    normal_old = axes[rows, plane]
+    normal_new = new_axes[rows, plane]
+    ok = np.einsum("ij,ij->i", normal_old, normal_new) > 1 - 1e-9
+    vertex_shape = segment_of(shape_offsets)[segment_of(ring_offsets)]
+    s = vertex_shape
+    world = ((coords[:, 0] * size[s, a[s]])[:, None] * axes[s, a[s]]
+             + (coords[:, 1] * size[s, b[s]])[:, None] * axes[s, b[s]])  # relative to the old origin
+    local = np.einsum("vj,vij->vi", world, new_axes[s])
+    vertex_offsets = ring_offsets[shape_offsets]
+    low = segment_reduce(np.minimum, local, vertex_offsets, 0.0)
+    high = segment_reduce(np.maximum, local, vertex_offsets, 0.0)
+    new_size = size.copy()
+    new_size[rows, a] = (high - low)[rows, a]
+    new_size[rows, b] = (high - low)[rows, b]
+    shift = low.copy()
+    shift[rows, plane] = 0.0
+    new_origin = origin + np.einsum("ni,nij->nj", shift, new_axes)
+    u = local[np.arange(len(s)), a[s]] - low[s, a[s]]
+    v = local[np.arange(len(s)), b[s]] - low[s, b[s]]
+    extent_a = np.where(new_size[rows, a] > TOL.zero, new_size[rows, a], 1.0)
+    extent_b = np.where(new_size[rows, b] > TOL.zero, new_size[rows, b], 1.0)
+    new_coords = np.stack([u / extent_a[s], v / extent_b[s]], axis=1)
+    # a rectangle lined up with the new axes: one ring of 4 vertices filling its box
+    at = np.arange(len(coords))
+    ring = segment_of(ring_offsets)
+    nxt = np.where(at + 1 < ring_offsets[1:][ring], at + 1, ring_offsets[:-1][ring])
+    cross = new_coords[:, 0] * new_coords[nxt, 1] - new_coords[nxt, 0] * new_coords[:, 1]
+    area = np.abs(segment_reduce(np.add, cross, vertex_offsets, 0.0)) / 2
+    one_ring = np.diff(shape_offsets) == 1
+    four = np.diff(vertex_offsets) == 4
+    is_rect = one_ring & four & (np.abs(area - 1.0) <= TOL.rect)
+    return ok, new_origin, new_size, is_rect, new_coords
