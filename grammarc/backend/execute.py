@@ -578,8 +578,13 @@ class Executor:
         bad = cursor.geom < -1
         if bad.any():
             self.fail(cursor, bad, "`comp` of an inserted asset is not supported yet", symbol, op.span)
-        shapes, normal, _ = self.components(comp_kernels.KIND_CODES["faces"], cursor, op.site)
-        which = classify_faces(normal, op.selectors)
+        kind = {"f": "faces", "e": "edges", "v": "vertices"}[op.kind]
+        shapes, normal, _ = self.components(comp_kernels.KIND_CODES[kind], cursor, op.site)
+        if op.kind == "f":
+            which = classify_faces(normal, op.selectors)
+        else:
+            direction = self.chunk.frames[shapes.frame][:, 0] if op.kind == "e" else None
+            which = classify_edges(direction, op.selectors, len(shapes))
         keep = which < len(op.selectors)
         shapes, which = shapes.take(keep), which[keep]
         if "comp.sel" in self.plan.dynamic:
@@ -650,6 +655,20 @@ def classify_faces(normal: np.ndarray, selectors: tuple[str, ...]) -> np.ndarray
         "all": np.ones(len(normal), dtype=bool),
     }
     which = np.full(len(normal), len(selectors), dtype=np.int64)
+    for i in range(len(selectors) - 1, -1, -1):
+        which[masks[selectors[i]]] = i
+    return which
+
+
+def classify_edges(direction: np.ndarray | None, selectors: tuple[str, ...], n: int) -> np.ndarray:
+    """Index of the first selector each edge (or vertex, ``direction`` None) matches: an edge is
+    vertical along the world's y axis, horizontal across it, aslant otherwise."""
+    masks = {"all": np.ones(n, dtype=bool)}
+    if direction is not None:
+        y = np.abs(direction[:, 1])
+        masks.update(vertical=y >= 1 - _FLAT_TOLERANCE, horizontal=y <= _FLAT_TOLERANCE,
+                     aslant=(y > _FLAT_TOLERANCE) & (y < 1 - _FLAT_TOLERANCE))
+    which = np.full(n, len(selectors), dtype=np.int64)
     for i in range(len(selectors) - 1, -1, -1):
         which[masks[selectors[i]]] = i
     return which

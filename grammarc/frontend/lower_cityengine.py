@@ -402,9 +402,11 @@ class Lowering(Transformer):
         return ir.Size(part.size.kind, part.size.value, part.size.span)
 
     def op_comp(self, args, parts, span):
-        if len(args) != 1 or not isinstance(args[0], ir.Name) or args[0].name != "f":
+        if len(args) != 1 or not isinstance(args[0], ir.Name) or args[0].name not in _COMP_SELECTORS:
             kind = args[0].name if args and isinstance(args[0], ir.Name) else "?"
-            return self.unsupported(f"comp({kind})", span, "only comp(f)")
+            return self.unsupported(f"comp({kind})", span, "comp(f), comp(e) and comp(v)")
+        kind = args[0].name
+        known = _COMP_SELECTORS[kind]
         selectors, bodies = [], []
         for part in parts:
             if isinstance(part, Group):
@@ -412,15 +414,15 @@ class Lowering(Transformer):
             value = part.size.value
             if part.size.kind is not ir.SizeKind.ABSOLUTE or not isinstance(value, ir.Name):
                 return self.unsupported("this comp selector", part.span)
-            if value.name not in ir.FACE_SELECTORS:
-                return self.unsupported(f"comp selector `{value.name}`", value.span,
+            if value.name not in known:
+                return self.unsupported(f"comp({kind}) selector `{value.name}`", value.span,
                                         "street, object and world selectors are not supported yet"
-                                        + suggest(value.name, ir.FACE_SELECTORS))
+                                        + suggest(value.name, known))
             if part.merged:
                 return self.unsupported(f"`{value.name}=` (one shape for all selected faces)", part.span)
             selectors.append(value.name)
             bodies.append(part.body)
-        return ir.CompFaces(tuple(selectors), tuple(bodies), span, self.site())
+        return ir.CompFaces(tuple(selectors), tuple(bodies), span, self.site(), kind)
 
     # ------------------------------------------------------------------------------------- expressions
     def value_case(self, meta, *items):
@@ -535,6 +537,7 @@ _OPS = {
     "report": Lowering.op_report,
 }
 _SPLIT_OPS = frozenset({"split", "comp"})
+_COMP_SELECTORS = {"f": ir.FACE_SELECTORS, "e": ir.EDGE_SELECTORS, "v": ir.VERTEX_SELECTORS}
 #: Shape attributes that grammarc does not provide yet: comp.index, split.index, initialShape.origin...
 _UNSUPPORTED_MEMBERS = frozenset({"comp", "split", "initialShape", "geometry"})
 

@@ -422,14 +422,21 @@ FACE_SELECTORS = frozenset({
 })
 
 
+#: Edge and vertex selectors of ``comp(e)`` and ``comp(v)``.
+EDGE_SELECTORS = frozenset({"vertical", "horizontal", "aslant", "all"})
+VERTEX_SELECTORS = frozenset({"all"})
+
+
 @dataclass(frozen=True, slots=True)
 class CompFaces:
-    """CityEngine ``comp(f){ sel: A | sel: B }``: each face goes to the first selector it matches."""
+    """CityEngine ``comp(f|e|v){ sel: A | sel: B }``: each face (edge, vertex) goes to the first selector
+    it matches; ``kind`` is "f", "e" or "v"."""
 
     selectors: tuple[str, ...]
     parts: tuple[Body, ...]
     span: Span = NO_SPAN
     site: int = 0
+    kind: str = "f"
 
 
 Op = (Symbol | Empty | Translate | Scale | Rotate | Push | Pop | Insert | Split | Repeat | Comp | Extrude

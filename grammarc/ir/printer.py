@@ -94,7 +94,7 @@ def print_op(op: ir.Op) -> str:
         star = "*" if op.repeat else ""
         return f"split({'xyz'[op.axis]}){{ {' | '.join(items)} }}{star}"
     if isinstance(op, ir.CompFaces):
-        return "comp(f){ " + " | ".join(f"{s}: {print_body(b) or 'ε'}"
+        return f"comp({op.kind}){{ " + " | ".join(f"{s}: {print_body(b) or 'ε'}"
                                          for s, b in zip(op.selectors, op.parts)) + " }"
     if isinstance(op, (ir.Case, ir.Stochastic)):
         return _branches(op)
