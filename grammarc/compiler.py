@@ -50,7 +50,8 @@ def compile_grammar(path: str | Path, *, text: str | None = None, start: str | N
             raise UsageError(f"cannot read grammar {path}: {error}") from None
     file = display or str(path)
     diags = Diagnostics()
-    module = parse_source(text, file, diags, dialect)
+    sources = {file: text}
+    module = parse_source(text, file, diags, dialect, path=path, sources=sources)
     module = run_passes(module, diags)
     if not module.rules and not diags.has_errors:  # rules that failed to parse are not "no rules"
         diags.error("empty", "the grammar has no rules", Span(file, 1, 1, 1, 1))

@@ -63,6 +63,16 @@ class FunctionDef:
 
 
 @dataclass(frozen=True, slots=True)
+class Import:
+    """``import prefix : "file.cga"`` (or without a prefix): the file's rules and attributes, named
+    ``prefix.Name``; an attribute the importing file declares too takes the importing file's value."""
+
+    prefix: str | None
+    path: str
+    span: Span
+
+
+@dataclass(frozen=True, slots=True)
 class Style:
     """``style Name``: the attributes after it redefine the defaults for that style."""
 
@@ -156,10 +166,12 @@ class Lowering(Transformer):
         return Style(str(name), self.tspan(name))
 
     def import_prefixed(self, meta, prefix, path, *names):
-        return self.unsupported("import", self.span(meta), "rule files are compiled alone for now")
+        if any(n is not None for n in names):
+            return self.unsupported("import with a list of names", self.span(meta))
+        return Import(str(prefix), str(path)[1:-1], self.span(meta))
 
     def import_plain(self, meta, path):
-        return self.unsupported("import", self.span(meta), "rule files are compiled alone for now")
+        return Import(None, str(path)[1:-1], self.span(meta))
 
     def attr_decl(self, meta, name, value):
         return ir.AttrDecl(str(name), value, self.tspan(name))
@@ -214,10 +226,11 @@ class Lowering(Transformer):
         return ir.Symbol(str(name), (), self.tspan(name), self.site(), leaf=True)
 
     def imported_symbol(self, meta, prefix, name):
-        return self.unsupported(f"{prefix}.{name}", self.tspan(prefix), "import")
+        return ir.Symbol(f"{prefix}.{name}", (), self.tspan(prefix), self.site())
 
     def imported_call(self, meta, prefix, name, args):
-        return self.unsupported(f"{prefix}.{name}", self.tspan(prefix), "import")
+        return ir.Symbol(f"{prefix}.{name}", tuple(self.expr(a) for a in (args or ())), self.tspan(prefix),
+                         self.site())
 
     def push(self, meta, tok):
         return ir.Push(self.tspan(tok))
@@ -549,8 +562,9 @@ def _as_body(value) -> ir.Body:
 # ---------------------------------------------------------------------------------------------- assembly
 
 
-def assemble(file: str, statements: list, diags: Diagnostics) -> ir.Module:
-    """Declarations in source order -> Module: start rule, overloads by arity, functions inlined."""
+def assemble(file: str, statements: list, diags: Diagnostics, imports=()) -> ir.Module:
+    """Declarations in source order -> Module: start rule, overloads by arity, functions inlined, the
+    imported modules' rules and attributes merged under their prefixes."""
     attrs: list[ir.AttrDecl] = []
     functions: dict[str, FunctionDef] = {}
     rules: list[tuple[RuleDef, tuple]] = []
@@ -599,7 +613,37 @@ def assemble(file: str, statements: list, diags: Diagnostics) -> ir.Module:
                                span=rule.span, site=rule.site))
     if start is None and lowered:
         start = lowered[0].symbol
+    for statement, module in imports:
+        more_attrs, more_rules = _prefixed(module, statement.prefix, {a.name for a in attrs})
+        attrs.extend(more_attrs)
+        lowered.extend(more_rules)
     return ir.Module(file=file, attrs=tuple(attrs), rules=tuple(lowered), start=start, dialect="cityengine")
+
+
+def _prefixed(module: ir.Module, prefix: str | None, forwarded: set[str]):
+    """An imported module's attributes and rules under ``prefix.``; its attributes that the importing
+    file declares too are dropped, so that their names resolve to the importer's (forwarding)."""
+    if prefix is None:
+        return [a for a in module.attrs if a.name not in forwarded], list(module.rules)
+    own_attrs = {a.name for a in module.attrs} - forwarded
+
+    def rename(params):
+        def visit(e):
+            if isinstance(e, ir.Name) and e.name in own_attrs and e.name not in params:
+                return replace(e, name=f"{prefix}.{e.name}")
+            return e
+        return visit
+
+    attrs = [replace(a, name=f"{prefix}.{a.name}", default=rewrite_expr(a.default, rename(())))
+             for a in module.attrs if a.name in own_attrs]
+    rules = []
+    for rule in module.rules:
+        bodies = []
+        for alt in rule.alternatives:
+            body = _map_symbols(alt.body, lambda op: replace(op, name=f"{prefix}.{op.name}"))
+            bodies.append(replace(alt, body=rewrite_body(body, rename(set(rule.params)))))
+        rules.append(replace(rule, symbol=f"{prefix}.{rule.symbol}", alternatives=tuple(bodies)))
+    return attrs, rules
 
 
 def _map_symbols(body: ir.Body, fn) -> ir.Body:

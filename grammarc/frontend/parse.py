@@ -12,6 +12,7 @@ import itertools
 import re
 from functools import cache
 from importlib import resources
+from pathlib import Path
 
 from lark import Lark
 from lark.exceptions import UnexpectedCharacters, UnexpectedEOF, UnexpectedInput, UnexpectedToken
@@ -55,14 +56,18 @@ def _parser(grammar_file: str = "grammars/cga2006.lark") -> Lark:
                 maybe_placeholders=True, cache=True)
 
 
-def parse_source(text: str, file: str, diags: Diagnostics, dialect: str | None = None) -> ir.Module:
+def parse_source(text: str, file: str, diags: Diagnostics, dialect: str | None = None, *,
+                 path: Path | None = None, sources: dict[str, str] | None = None, sites=None,
+                 importing: tuple[Path, ...] = ()) -> ir.Module:
     """Parse and lower ``text`` (named ``file`` in diagnostics); problems go to ``diags``.
 
-    ``dialect`` is ``cga2006`` or ``cityengine``; by default it is detected from the text.
+    ``dialect`` is ``cga2006`` or ``cityengine``; by default it is detected from the text. ``path`` is
+    the file on disk, from which CityEngine ``import``s are resolved; the texts of imported files are
+    added to ``sources`` (for diagnostics); ``sites`` numbers random-stream sites across imported files.
     """
     grammar_file, layout, lowering = DIALECTS[dialect or detect_dialect(text)]
     parser = _parser(grammar_file)
-    sites = itertools.count(1)
+    sites = sites if sites is not None else itertools.count(1)
     lowered = []
     for statement in split_statements(text, layout):
         try:
@@ -71,7 +76,40 @@ def parse_source(text: str, file: str, diags: Diagnostics, dialect: str | None =
             _syntax_error(error, file, statement.text, statement.line, diags)
             continue
         lowered.append(lowering.Lowering(file, diags, sites).transform(tree))
-    return lowering.assemble(file, lowered, diags)
+    if lowering is not lower_cityengine:
+        return lowering.assemble(file, lowered, diags)
+    imports = []
+    for st in lowered:
+        declaration = getattr(st, "declaration", st)
+        if isinstance(declaration, lower_cityengine.Import):
+            module = _import(declaration, file, path, diags, sources, sites, importing)
+            if module is not None:
+                imports.append((declaration, module))
+    return lowering.assemble(file, lowered, diags, imports)
+
+
+def _import(statement, file: str, path: Path | None, diags: Diagnostics, sources, sites, importing):
+    """Parse the file an ``import`` names, relative to the importing file."""
+    if path is None:
+        diags.error("import", "`import` needs the grammar's folder (the text was given without a file)",
+                    statement.span)
+        return None
+    target = (path.parent / statement.path).resolve()
+    if target in importing or target == path.resolve():
+        diags.error("import", f"`{statement.path}` imports itself (through {len(importing)} files)",
+                    statement.span)
+        return None
+    try:
+        text = target.read_text(encoding="utf-8")
+    except (OSError, UnicodeDecodeError) as error:
+        diags.error("import", f"cannot read imported file `{statement.path}`: {error.strerror or error}",
+                    statement.span)
+        return None
+    display = str(Path(file).parent / statement.path)
+    if sources is not None:
+        sources[display] = text
+    return parse_source(text, display, diags, "cityengine", path=target, sources=sources, sites=sites,
+                        importing=(*importing, path.resolve()))
 
 
 def _syntax_error(error: UnexpectedInput, file: str, text: str, first_line: int, diags: Diagnostics):

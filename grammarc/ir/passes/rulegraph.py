@@ -34,8 +34,9 @@ def analyze_rules(module: ir.Module, start: str, diags: Diagnostics) -> RuleGrap
         for alt in rule.alternatives:
             for op in iter_ops(alt.body):
                 if isinstance(op, ir.Symbol):
-                    edges[rule.symbol].append(op.name)
                     used[op.name] = None
+                    if not op.leaf:  # `X.` ends the derivation: no edge to X's rules
+                        edges[rule.symbol].append(op.name)
     terminals = tuple(s for s in used if s not in edges)
     reachable = _reach(start, edges)
     for rule in module.rules:
