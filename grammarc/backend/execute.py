@@ -481,16 +481,18 @@ class Executor:
             x[flat] = axes[flat, 2] - axes[flat, 2, 1:2] * up
             x /= np.linalg.norm(x, axis=1, keepdims=True)
             new_axes = np.stack([x, np.broadcast_to(up, x.shape), np.cross(x, up)], axis=1)
-        else:
+        elif op.mode == "rotate":
             env = self.env(cursor)
             angles = [np.broadcast_to(evaluate_array(e, env), (n,)) for e in op.angles]
             new_axes = np.einsum("nij,njk->nik", _rotation(*angles), axes)
+        else:
+            new_axes = self.geometry_axes(op, cursor, axes, symbol)
         bad = cursor.geom < -1
         if bad.any():
             self.fail(cursor, bad, "aligning the scope of an inserted asset is not supported yet", symbol,
                       op.span)
         coords, ring_offsets, shape_offsets, plane = self.polygons_of(cursor)
-        ok, origin, size, is_rect, new_coords = reframe(
+        ok, plane, origin, size, is_rect, new_coords = reframe(
             cursor.origin, cursor.size, axes, coords, ring_offsets, shape_offsets, plane, new_axes)
         if not ok.all():
             self.fail(cursor, ~ok, "turning a scope out of its geometry's plane is not supported yet",
@@ -503,6 +505,34 @@ class Executor:
             geom[poly] = self.chunk.polygons.add(new_coords[vertices], packed_rings, packed_shapes,
                                                  plane[poly])
         return cursor.with_scope(origin, size, frames.add(np.ascontiguousarray(new_axes)), geom)
+
+    def geometry_axes(self, op: ir.AlignScope, cursor: Shapes, axes: np.ndarray, symbol: int):
+        """Axes of ``alignScopeToGeometry``: up along the face's normal, x along its edge ``k``."""
+        flat = cursor.size <= TOL.zero
+        bad = flat.sum(axis=1) != 1
+        if bad.any():
+            self.fail(cursor, bad, "alignScopeToGeometry of a solid is not supported yet (only faces)",
+                      symbol, op.span)
+        coords, ring_offsets, shape_offsets, plane = self.polygons_of(cursor)
+        rows = np.arange(len(cursor))
+        edge = np.round(evaluate_array(op.angles[0], self.env(cursor))).astype(np.int64)
+        start = ring_offsets[shape_offsets[:-1]]
+        count = ring_offsets[shape_offsets[:-1] + 1] - start
+        j = start + np.mod(edge, count)
+        k = start + np.mod(edge + 1, count)
+        a = np.where(plane == 0, 1, 0)  # the plane's in-plane axes (polygons.PLANE_AXES)
+        b = np.where(plane == 2, 1, 2)
+
+        def world(v):
+            return ((coords[v, 0] * cursor.size[rows, a])[:, None] * axes[rows, a]
+                    + (coords[v, 1] * cursor.size[rows, b])[:, None] * axes[rows, b])
+
+        x = world(k) - world(j)
+        x /= np.linalg.norm(x, axis=1, keepdims=True)
+        normal = axes[rows, plane]
+        if op.mode == "geometry-y":
+            return np.stack([x, normal, np.cross(x, normal)], axis=1)
+        return np.stack([x, np.cross(normal, x), normal], axis=1)
 
     def use_asset(self, op: ir.UseAsset, cursor: Shapes, symbol: int) -> Shapes:
         """The geometry becomes the asset fitted to the scope (a cube is the scope box itself)."""

@@ -27,7 +27,7 @@ NOT_APPLIED = frozenset({
 UNSUPPORTED_OPS = frozenset({
     "offset", "setback", "shapeL", "shapeU", "shapeO", "innerRectangle", "innerPolygon", "convexify",
     "cleanupGeometry", "trim", "envelope", "roofGable", "roofHip", "roofShed", "roofPyramid",
-    "alignScopeToGeometry", "mirror", "mirrorScope", "setPivot",
+    "mirror", "mirrorScope", "setPivot",
     "insertAlongUV", "scatter", "footprint", "tileUV", "splitArea", "inline", "resetGeometry", "taper",
     "primitiveCylinder", "primitiveSphere", "primitiveDisk", "primitiveCone", "primitiveQuad",
     "deleteHoles", "reduceGeometry", "rectify", "semiPolygon",
@@ -337,6 +337,16 @@ class Lowering(Transformer):
         return self.unsupported("alignScopeToAxes with this axis", span,
                                 "alignScopeToAxes(), alignScopeToAxes(world.xyz) and alignScopeToAxes(y)")
 
+    def op_align_geometry(self, op, args, span):
+        if len(args) not in (2, 3) or not isinstance(args[0], ir.Name) or args[0].name not in ("yUp", "zUp"):
+            return self.unsupported("alignScopeToGeometry with these arguments", span,
+                                    "alignScopeToGeometry(yUp|zUp, 0[, edgeIndex])")
+        face = self.expr(args[1])
+        if not (isinstance(face, ir.Num) and face.value == 0):
+            return self.unsupported("alignScopeToGeometry on a face other than 0", getattr(face, "span", span))
+        edge = self.expr(args[2]) if len(args) == 3 else ir.Num(0.0, span)
+        return ir.AlignScope("geometry-" + args[0].name[0], (edge, ir.Num(0.0), ir.Num(0.0)), span)
+
     def op_rotate_scope(self, op, args, span):
         if len(args) != 3:
             return self.unsupported(f"rotateScope with {len(args)} arguments", span)
@@ -537,6 +547,7 @@ class Lowering(Transformer):
 
 _OPS = {
     "alignScopeToAxes": Lowering.op_align,
+    "alignScopeToGeometry": Lowering.op_align_geometry,
     "rotateScope": Lowering.op_rotate_scope,
     "extrude": Lowering.op_extrude,
     "t": Lowering.op_translate,

@@ -3,8 +3,9 @@
 The geometry stays where it is in the world; the scope turns to the new axes and becomes the geometry's
 bounding box in them. grammarc keeps a shape's geometry relative to its scope, so the polygon is
 expressed anew in the new scope (a rectangle that lines up with the new axes takes the box fast path
-again). The new axes must keep the polygon's plane: its normal axis keeps its direction (turning a
-footprint about the vertical, say); other turns need the general geometry of the polygon issue.
+again). One of the new axes must be the polygon's normal (turning a footprint about the vertical,
+putting z up with ``alignScopeToGeometry(zUp, ...)``); other turns need the general geometry of the
+polygon issue.
 """
 
 from __future__ import annotations
@@ -25,15 +26,17 @@ def reframe(origin, size, axes, coords, ring_offsets, shape_offsets, plane, new_
     origin, size (n, 3), axes, new_axes (n, 3, 3) (rows are the scope axes); the shapes' polygons as
     normalized ragged arrays (coords (V, 2), ring_offsets, shape_offsets (n+1,)) with plane (n,) codes.
 
-    Returns ``ok`` (n,) bool (the new axes keep the plane), new origin and size (n, 3), ``is_rect`` (n,)
-    bool, and the new normalized coords (V, 2) (meaningful where ``ok``).
+    Returns ``ok`` (n,) bool (a new axis is the polygon's normal), the new plane codes (n,), origin and
+    size (n, 3), ``is_rect`` (n,) bool, and the new normalized coords (V, 2) (meaningful where ``ok``).
     """
     n = len(plane)
     rows = np.arange(n)
     a, b = _A[plane], _B[plane]
     normal_old = axes[rows, plane]
-    normal_new = new_axes[rows, plane]
-    ok = np.einsum("ij,ij->i", normal_old, normal_new) > 1 - 1e-9
+    alignment = np.einsum("nj,nkj->nk", normal_old, new_axes)
+    new_plane = np.argmax(alignment, axis=1)
+    ok = alignment[rows, new_plane] > 1 - 1e-9
+    height = size[rows, plane]
     vertex_shape = segment_of(shape_offsets)[segment_of(ring_offsets)]
     s = vertex_shape
     world = ((coords[:, 0] * size[s, a[s]])[:, None] * axes[s, a[s]]
@@ -42,9 +45,10 @@ def reframe(origin, size, axes, coords, ring_offsets, shape_offsets, plane, new_
     vertex_offsets = ring_offsets[shape_offsets]
     low = segment_reduce(np.minimum, local, vertex_offsets, 0.0)
     high = segment_reduce(np.maximum, local, vertex_offsets, 0.0)
-    new_size = size.copy()
-    new_size[rows, a] = (high - low)[rows, a]
-    new_size[rows, b] = (high - low)[rows, b]
+    plane = new_plane
+    a, b = _A[plane], _B[plane]
+    new_size = high - low
+    new_size[rows, plane] = height
     shift = low.copy()
     shift[rows, plane] = 0.0
     new_origin = origin + np.einsum("ni,nij->nj", shift, new_axes)
@@ -62,4 +66,4 @@ def reframe(origin, size, axes, coords, ring_offsets, shape_offsets, plane, new_
     one_ring = np.diff(shape_offsets) == 1
     four = np.diff(vertex_offsets) == 4
     is_rect = one_ring & four & (np.abs(area - 1.0) <= TOL.rect)
-    return ok, new_origin, new_size, is_rect, new_coords
+    return ok, new_plane.astype(np.int8), new_origin, new_size, is_rect, new_coords

@@ -343,8 +343,10 @@ class UseAsset:
 
 @dataclass(frozen=True, slots=True)
 class AlignScope:
-    """CityEngine ``alignScopeToAxes()`` (``mode`` "world"), ``alignScopeToAxes(y)`` ("y") and
-    ``rotateScope(x, y, z)`` ("rotate", ``angles``): new scope axes, the geometry unchanged."""
+    """New scope axes, the geometry unchanged: CityEngine ``alignScopeToAxes()`` (``mode`` "world"),
+    ``alignScopeToAxes(y)`` ("y"), ``rotateScope(x, y, z)`` ("rotate", ``angles``) and
+    ``alignScopeToGeometry(yUp|zUp, 0, edge)`` ("geometry-y"/"geometry-z", the edge index first in
+    ``angles``)."""
 
     mode: str
     angles: tuple[Expr, Expr, Expr] | None = None

@@ -109,6 +109,8 @@ def print_op(op: ir.Op) -> str:
     if isinstance(op, ir.Report):
         return f"report({print_expr(op.key)}, {print_expr(op.value)})"
     if isinstance(op, ir.AlignScope):
+        if op.mode.startswith("geometry"):
+            return f"alignScopeToGeometry({op.mode[-1]}Up, 0, {print_expr(op.angles[0])})"
         if op.angles is not None:
             return f"rotateScope({', '.join(print_expr(a) for a in op.angles)})"
         return "alignScopeToAxes()" if op.mode == "world" else f"alignScopeToAxes({op.mode})"
