@@ -99,7 +99,12 @@ def _check(args) -> int:
     from grammarc.compiler import compile_grammar
     from grammarc.ir.printer import print_module
 
-    grammar = compile_grammar(args.grammar, start=args.start, dialect=args.dialect)
+    from grammarc.build import BuildOptions, grammar_source
+
+    options = BuildOptions(start=args.start, dialect=args.dialect)
+    with grammar_source(args.grammar, options) as (source, display, resolved):
+        grammar = compile_grammar(source, start=resolved.start, dialect=resolved.dialect, display=display,
+                                  asset_roots=resolved.asset_roots)
     _warn(grammar)
     graph = grammar.graph
     if args.dump_ir:

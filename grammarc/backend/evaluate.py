@@ -17,7 +17,7 @@ from numba import njit
 from grammarc.backend.chunk import Chunk
 from grammarc.backend.random import uniform
 from grammarc.backend.shapes import Shapes
-from grammarc.geometry.measure import area_and_volume
+from grammarc.geometry.measure import area_and_volume, is_rectangular
 from grammarc.ir import nodes as ir
 
 if TYPE_CHECKING:
@@ -146,6 +146,9 @@ def _call(expr: ir.Call, env: Env):
         return low + (np.subtract(high, low)) * u
     if f == "p":
         return uniform(env.shapes.key, expr.site) < np.asarray(args[0], dtype=np.float64)
+    if f == "geometry.isRectangular":
+        return is_rectangular(env.shapes.size, env.shapes.geom, env.chunk.polygons,
+                              float(np.max(args[0])) if np.size(args[0]) else 0.0)
     if f in ("geometry.area", "geometry.volume"):
         area, volume = area_and_volume(env.shapes.size, env.shapes.geom, env.chunk.polygons)
         return area if f == "geometry.area" else volume

@@ -438,11 +438,15 @@ class Lowering(Transformer):
             if part.size.kind is not ir.SizeKind.ABSOLUTE or not isinstance(value, ir.Name):
                 return self.unsupported("this comp selector", part.span)
             if value.name not in known:
-                return self.unsupported(f"comp({kind}) selector `{value.name}`", value.span,
-                                        "street, object and world selectors are not supported yet"
-                                        + suggest(value.name, known))
+                why = ("the faces `offset` makes: the polygon geometry issue"
+                       if value.name in ("inside", "border") else
+                       "street, object and world selectors are not supported yet" + suggest(value.name, known))
+                return self.unsupported(f"comp({kind}) selector `{value.name}`", value.span, why)
             if part.merged:
-                return self.unsupported(f"`{value.name}=` (one shape for all selected faces)", part.span)
+                self.diags.warning(
+                    "merged", f"`{value.name}=` gives one shape for all its faces in CityEngine; grammarc "
+                    "derives them one by one (the same leaves; operations that read the scope differ)",
+                    part.span)
             selectors.append(value.name)
             bodies.append(part.body)
         return ir.CompFaces(tuple(selectors), tuple(bodies), span, self.site(), kind)
@@ -525,6 +529,9 @@ class Lowering(Transformer):
         text = ".".join(names)
         if text in ("geometry.area", "geometry.volume") and not args:
             return ir.Call(text, (), span, self.site())
+        if text == "geometry.isRectangular" and len(args or ()) <= 1:
+            tolerance = self.expr(args[0]) if args else ir.Num(0.0, span)
+            return ir.Call(text, (tolerance,), span, self.site())
         self.unsupported(f"{text}()", span)
         return ir.placeholder(span)
 

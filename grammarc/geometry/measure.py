@@ -47,3 +47,35 @@ def area_and_volume(size: np.ndarray, geom: np.ndarray, store: PolygonStore) -> 
         area[poly] = np.where(solid, 2 * face + perimeter * h, face)
         volume[poly] = np.where(solid, face * h, 0.0)
     return area, volume
+
+
+def is_rectangular(size: np.ndarray, geom: np.ndarray, store: PolygonStore, degrees: float) -> np.ndarray:
+    """CityEngine's ``geometry.isRectangular(tolerance)``: a face or solid whose polygon is a rectangle,
+    its corners right angles within ``degrees``. Scope boxes and rectangles are; assets are not."""
+    result = geom == -1
+    poly = np.flatnonzero(geom >= 0)
+    if not len(poly):
+        return result
+    ids = geom[poly]
+    coords, ring_offsets, poly_offsets = store.gather(ids)
+    plane = store.plane[ids]
+    a_axis = np.array([PLANE_AXES[p][0] for p in range(3)])[plane]
+    b_axis = np.array([PLANE_AXES[p][1] for p in range(3)])[plane]
+    vertex_ring = segment_of(ring_offsets)
+    vertex_poly = segment_of(poly_offsets)[vertex_ring]
+    at = np.arange(len(coords))
+    start, end = ring_offsets[:-1][vertex_ring], ring_offsets[1:][vertex_ring]
+    nxt = np.where(at + 1 < end, at + 1, start)
+    prv = np.where(at > start, at - 1, end - 1)
+    u = coords[:, 0] * size[poly, a_axis][vertex_poly]
+    v = coords[:, 1] * size[poly, b_axis][vertex_poly]
+    d1 = np.stack([u[nxt] - u, v[nxt] - v], axis=1)
+    d0 = np.stack([u - u[prv], v - v[prv]], axis=1)
+    cos = np.abs(np.einsum("ij,ij->i", d0, d1)) / np.maximum(
+        np.linalg.norm(d0, axis=1) * np.linalg.norm(d1, axis=1), 1e-300)
+    square = cos <= np.sin(np.radians(degrees)) + 1e-9
+    corners_ok = segment_reduce(np.minimum, square.astype(np.int64), ring_offsets[poly_offsets], 1) > 0
+    four = (np.diff(poly_offsets) == 1) & (np.diff(ring_offsets[poly_offsets]) == 4)
+    result = result.copy()
+    result[poly] = four & corners_ok
+    return result

@@ -183,6 +183,7 @@ FUNCTIONS: dict[str, tuple[int, int, Type]] = {
     "isnan": (1, 1, Type.BOOL),
     "geometry.area": (0, 0, Type.NUM),
     "geometry.volume": (0, 0, Type.NUM),
+    "geometry.isRectangular": (1, 1, Type.BOOL),
 }
 #: Functions that take strings or any type (their argument types are checked by ``passes.types``).
 CONVERSIONS: dict[str, Type] = {"str": Type.STR, "float": Type.NUM, "bool": Type.BOOL}

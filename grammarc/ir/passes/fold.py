@@ -29,7 +29,7 @@ PURE = {
     "pow": math.pow, "min": min, "max": max, "log10": math.log10, "isnan": math.isnan,
 }
 #: Functions that read the shape or draw random numbers: never folded.
-SHAPE_DEPENDENT = frozenset({"rand", "p", "geometry.area", "geometry.volume"})
+SHAPE_DEPENDENT = frozenset({"rand", "p", "geometry.area", "geometry.volume", "geometry.isRectangular"})
 _CONSTANT = (ir.Num, ir.Str, ir.Bool)
 
 
