@@ -96,10 +96,9 @@ def _warn(grammar) -> None:
 
 
 def _check(args) -> int:
+    from grammarc.build import BuildOptions, grammar_source
     from grammarc.compiler import compile_grammar
     from grammarc.ir.printer import print_module
-
-    from grammarc.build import BuildOptions, grammar_source
 
     options = BuildOptions(start=args.start, dialect=args.dialect)
     with grammar_source(args.grammar, options) as (source, display, resolved):
