@@ -9,9 +9,10 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from lark import Token, Transformer, v_args
+from lark import v_args
 
 from grammarc.diagnostics import Diagnostics, Span, suggest
+from grammarc.frontend.lowering import LoweringBase
 from grammarc.ir import nodes as ir
 
 #: Split axes of Subdiv and Repeat (paper section 2, "Basic split rule").
@@ -75,27 +76,8 @@ Statement = RuleStatement | ContinuationStatement | PriorityStatement | ir.AttrD
 
 
 @v_args(inline=True, meta=True)
-class Lowering(Transformer):
+class Lowering(LoweringBase):
     """Parse tree of one statement -> IR pieces. ``sites`` numbers random-stream sites in source order."""
-
-    def __init__(self, file: str, diags: Diagnostics, sites):
-        super().__init__()
-        self.file = file
-        self.diags = diags
-        self.sites = sites
-        self.fallback = Span(file, 0, 0, 0, 0)
-
-    # ------------------------------------------------------------------------------------------ helpers
-    def span(self, meta) -> Span:
-        if getattr(meta, "empty", True):
-            return self.fallback
-        return Span(self.file, meta.line, meta.column, meta.end_line, meta.end_column)
-
-    def token_span(self, tok: Token) -> Span:
-        return Span(self.file, tok.line, tok.column, tok.end_line, tok.end_column)
-
-    def site(self) -> int:
-        return next(self.sites)
 
     def __default__(self, data, children, meta):
         span = self.span(meta)
@@ -335,35 +317,8 @@ class Lowering(Transformer):
         return ir.Comp(kind, index, parts, span, self.site())
 
     # ------------------------------------------------------------------------------------- expressions
-    def or_(self, meta, left, right):
-        return ir.Binary("||", self.expr(left), self.expr(right), self.span(meta))
-
-    def and_(self, meta, left, right):
-        return ir.Binary("&&", self.expr(left), self.expr(right), self.span(meta))
-
-    def not_(self, meta, operand):
-        return ir.Unary("!", self.expr(operand), self.span(meta))
-
-    def binary(self, meta, left, op, right):
-        return ir.Binary(str(op), self.expr(left), self.expr(right), self.token_span(op))
-
-    def neg(self, meta, operand):
-        return ir.Unary("-", self.expr(operand), self.span(meta))
-
-    def number(self, meta, tok):
-        return ir.Num(float(tok), self.token_span(tok))
-
     def string(self, meta, tok):
         return ir.Str(str(tok)[1:-1], self.token_span(tok))
-
-    def true(self, meta, tok):
-        return ir.Bool(True, self.token_span(tok))
-
-    def false(self, meta, tok):
-        return ir.Bool(False, self.token_span(tok))
-
-    def name(self, meta, tok):
-        return ir.Name(str(tok), self.token_span(tok))
 
     def dotted(self, meta, head, field):
         span = Span(self.file, head.line, head.column, field.end_line, field.end_column)

@@ -12,9 +12,10 @@ from __future__ import annotations
 
 from dataclasses import dataclass, replace
 
-from lark import Token, Transformer, v_args
+from lark import Token, v_args
 
 from grammarc.diagnostics import Diagnostics, Span, suggest
+from grammarc.frontend.lowering import LoweringBase
 from grammarc.ir import nodes as ir
 from grammarc.ir.traverse import rewrite_body, rewrite_expr, sub_bodies
 
@@ -104,27 +105,8 @@ class Group:
 
 
 @v_args(inline=True, meta=True)
-class Lowering(Transformer):
+class Lowering(LoweringBase):
     """One CityEngine statement's parse tree -> IR pieces (``Annotated`` declarations)."""
-
-    def __init__(self, file: str, diags: Diagnostics, sites):
-        super().__init__()
-        self.file = file
-        self.diags = diags
-        self.sites = sites
-        self.fallback = Span(file, 0, 0, 0, 0)
-
-    # ------------------------------------------------------------------------------------------ helpers
-    def span(self, meta) -> Span:
-        if getattr(meta, "empty", True):
-            return self.fallback
-        return Span(self.file, meta.line, meta.column, meta.end_line, meta.end_column)
-
-    def tspan(self, tok: Token) -> Span:
-        return Span(self.file, tok.line, tok.column, tok.end_line, tok.end_column)
-
-    def site(self) -> int:
-        return next(self.sites)
 
     def unsupported(self, name: str, span: Span, why: str = ""):
         self.diags.error("unsupported", f"unsupported: {name}" + (f" ({why})" if why else ""), span)
@@ -163,7 +145,7 @@ class Lowering(Transformer):
         return None
 
     def style(self, meta, name):
-        return Style(str(name), self.tspan(name))
+        return Style(str(name), self.token_span(name))
 
     def import_prefixed(self, meta, prefix, path, *names):
         if any(n is not None for n in names):
@@ -174,16 +156,16 @@ class Lowering(Transformer):
         return Import(None, str(path)[1:-1], self.span(meta))
 
     def attr_decl(self, meta, name, value):
-        return ir.AttrDecl(str(name), value, self.tspan(name))
+        return ir.AttrDecl(str(name), value, self.token_span(name))
 
     def const_decl(self, meta, name, value):
-        return ir.AttrDecl(str(name), value, self.tspan(name), const=True)
+        return ir.AttrDecl(str(name), value, self.token_span(name), const=True)
 
     def function_def(self, meta, name, params, value):
-        return FunctionDef(str(name), params or (), value, self.tspan(name))
+        return FunctionDef(str(name), params or (), value, self.token_span(name))
 
     def rule_def(self, meta, name, params, arrow, body):
-        return RuleDef(str(name), params or (), _as_body(body), self.tspan(name), self.site())
+        return RuleDef(str(name), params or (), _as_body(body), self.token_span(name), self.site())
 
     def params(self, meta, *names):
         return tuple(str(n) for n in names if n is not None)
@@ -211,7 +193,7 @@ class Lowering(Transformer):
         return (probability, _as_body(body))
 
     def symbol(self, meta, name):
-        text, span = str(name), self.tspan(name)
+        text, span = str(name), self.token_span(name)
         if text == "NIL":
             return ir.Empty(span)
         if text == "primitiveCube":
@@ -223,32 +205,32 @@ class Lowering(Transformer):
         return ir.Symbol(text, (), span, self.site())
 
     def leaf(self, meta, name, dot):
-        return ir.Symbol(str(name), (), self.tspan(name), self.site(), leaf=True)
+        return ir.Symbol(str(name), (), self.token_span(name), self.site(), leaf=True)
 
     def imported_symbol(self, meta, prefix, name):
-        return ir.Symbol(f"{prefix}.{name}", (), self.tspan(prefix), self.site())
+        return ir.Symbol(f"{prefix}.{name}", (), self.token_span(prefix), self.site())
 
     def imported_call(self, meta, prefix, name, args):
-        return ir.Symbol(f"{prefix}.{name}", tuple(self.expr(a) for a in (args or ())), self.tspan(prefix),
+        return ir.Symbol(f"{prefix}.{name}", tuple(self.expr(a) for a in (args or ())), self.token_span(prefix),
                          self.site())
 
     def push(self, meta, tok):
-        return ir.Push(self.tspan(tok))
+        return ir.Push(self.token_span(tok))
 
     def pop(self, meta, tok):
-        return ir.Pop(self.tspan(tok))
+        return ir.Pop(self.token_span(tok))
 
     def args(self, meta, *args):
         return tuple(args)
 
     def relative(self, meta, prime, value):
-        return Sized(ir.SizeKind.RELATIVE, value, self.tspan(prime))
+        return Sized(ir.SizeKind.RELATIVE, value, self.token_span(prime))
 
     def floating(self, meta, tilde, value):
-        return Sized(ir.SizeKind.FLOATING, value, self.tspan(tilde))
+        return Sized(ir.SizeKind.FLOATING, value, self.token_span(tilde))
 
     def selector_function(self, meta, name, args, parts):
-        return self.unsupported(f"{name}(...){{...}} as an argument", self.tspan(name))
+        return self.unsupported(f"{name}(...){{...}} as an argument", self.token_span(name))
 
     def size_prefix(self, meta, prefix):
         if prefix is None:
@@ -271,7 +253,7 @@ class Lowering(Transformer):
 
     # -------------------------------------------------------------------------------------- operations
     def call(self, meta, name, args):
-        op, span, args = str(name), self.tspan(name), args or ()
+        op, span, args = str(name), self.token_span(name), args or ()
         handler = _OPS.get(op)
         if handler is not None:
             return handler(self, op, args, span)
@@ -282,7 +264,7 @@ class Lowering(Transformer):
         return ir.Symbol(op, tuple(self.expr(a) for a in args), span, self.site())
 
     def split_call(self, meta, name, args, parts, star):
-        op, span, args = str(name), self.tspan(name), args or ()
+        op, span, args = str(name), self.token_span(name), args or ()
         if op == "split":
             return self.op_split(args, parts, star is not None, span)
         if op == "comp":
@@ -473,36 +455,9 @@ class Lowering(Transformer):
             result = ir.Select(ir.Binary("<", u, bound, self.span(meta)), value, result, self.span(meta))
         return result
 
-    def or_(self, meta, left, right):
-        return ir.Binary("||", self.expr(left), self.expr(right), self.span(meta))
-
-    def and_(self, meta, left, right):
-        return ir.Binary("&&", self.expr(left), self.expr(right), self.span(meta))
-
-    def not_(self, meta, operand):
-        return ir.Unary("!", self.expr(operand), self.span(meta))
-
-    def binary(self, meta, left, op, right):
-        return ir.Binary(str(op), self.expr(left), self.expr(right), self.tspan(op))
-
-    def neg(self, meta, operand):
-        return ir.Unary("-", self.expr(operand), self.span(meta))
-
-    def number(self, meta, tok):
-        return ir.Num(float(tok), self.tspan(tok))
-
     def string(self, meta, tok):
         text = str(tok)[1:-1].replace('\\"', '"').replace("\\\\", "\\")
-        return ir.Str(text, self.tspan(tok))
-
-    def true(self, meta, tok):
-        return ir.Bool(True, self.tspan(tok))
-
-    def false(self, meta, tok):
-        return ir.Bool(False, self.tspan(tok))
-
-    def name(self, meta, tok):
-        return ir.Name(str(tok), self.tspan(tok))
+        return ir.Str(text, self.token_span(tok))
 
     def dotted_name(self, meta, *names):
         return tuple(str(n) for n in names), Span(self.file, names[0].line, names[0].column,
@@ -536,7 +491,7 @@ class Lowering(Transformer):
         return ir.placeholder(span)
 
     def function(self, meta, name, args):
-        span = self.tspan(name)
+        span = self.token_span(name)
         func = FUNCTION_NAMES.get(str(name), str(name))
         args = tuple(self.expr(a) for a in (args or ()))
         if func == "p" and len(args) == 1:
