@@ -127,12 +127,12 @@ class Executor:
             elif isinstance(op, ir.Rotate):
                 cursor = self.rotate(op, cursor)
             elif isinstance(op, ir.Push):
-                stack.append((cursor.origin, cursor.size, cursor.frame, cursor.geom, base))
+                # the whole shape: its scope, its geometry and the attributes `set` gives it
+                stack.append((cursor, base))
                 base = (cursor.origin, cursor.size, cursor.frame)
             elif isinstance(op, ir.Pop):
                 if stack:
-                    *scope, base = stack.pop()
-                    cursor = cursor.with_scope(*scope)
+                    cursor, base = stack.pop()
             elif isinstance(op, ir.Insert):
                 asset = self.plan.grammar.asset_ids[op.asset]
                 terminals.emit_instances(self.chunk, cursor, asset, symbol)
@@ -354,14 +354,15 @@ class Executor:
         index_of = None
         if op.index is not None:
             index_of = evaluate_array(op.index, self.env(cursor))
-        shapes, _, index = self.components(comp_kernels.KIND_CODES[op.kind], cursor, op.site, index_of)
+        shapes, _, index, _ = self.components(comp_kernels.KIND_CODES[op.kind], cursor, op.site, index_of)
         self.count(shapes, symbol, op.span)
         order, offsets = group_by(index % len(op.parts), len(op.parts))
         self.run_parts(op.parts, shapes.take(order), offsets, symbol)
 
     def components(self, kind: int, cursor: Shapes, site: int, wanted=None):
-        """Component shapes of ``cursor``, their normals in the parents' frames (m, 3) and their indices
-        among their parent's components (m,); ``wanted`` (n,) keeps, per shape, only that index."""
+        """Component shapes of ``cursor``, their normals in the parents' frames (m, 3), their indices
+        among their parent's components (m,) and their parents (m,); ``wanted`` (n,) keeps, per shape,
+        only that index."""
         chunk = self.chunk
         coords, ring_offsets, shape_offsets, plane = self.polygons_of(cursor)
         parent, index, origin, axes, size, poly = comp_kernels.components(
@@ -386,7 +387,7 @@ class Executor:
         normal[same] = np.eye(3)[plane[parent[same]]]
         shapes = Shapes(world_origin, size, frame, geom, child.lot, child_keys(child.key, site, index),
                         child.depth, child.params, child.dynamic)
-        return self.with_context(shapes, "comp", index, parent, len(cursor)), normal, index
+        return self.with_context(shapes, "comp", index, parent, len(cursor)), normal, index, parent
 
     def polygons_of(self, shapes: Shapes):
         """Each shape's polygon as batch-local ragged arrays (implicit rectangles for scope shapes)."""
@@ -604,25 +605,41 @@ class Executor:
         self.run_parts(op.parts, children, offsets, symbol)
 
     def comp_faces(self, op: ir.CompFaces, cursor: Shapes, symbol: int) -> None:
-        """CityEngine ``comp(f)``: faces to the first selector they match, by their normal."""
+        """CityEngine ``comp(f|e|v)``: components to the first selector they match."""
         bad = cursor.geom < -1
         if bad.any():
             self.fail(cursor, bad, "`comp` of an inserted asset is not supported yet", symbol, op.span)
         kind = {"f": "faces", "e": "edges", "v": "vertices"}[op.kind]
-        shapes, normal, _ = self.components(comp_kernels.KIND_CODES[kind], cursor, op.site)
+        shapes, normal, _, parent = self.components(comp_kernels.KIND_CODES[kind], cursor, op.site)
         if op.kind == "f":
             which = classify_faces(normal, op.selectors)
         else:
             direction = self.chunk.frames[shapes.frame][:, 0] if op.kind == "e" else None
             which = classify_edges(direction, op.selectors, len(shapes))
         keep = which < len(op.selectors)
-        shapes, which = shapes.take(keep), which[keep]
-        if "comp.sel" in self.plan.dynamic:
+        shapes, which, parent = shapes.take(keep), which[keep], parent[keep]
+        if {"comp.index", "comp.total", "comp.sel"} & set(self.plan.dynamic):
+            # CityEngine numbers the components of each selector: the front face is 0 of 1
+            group = parent * (len(op.selectors) + 1) + which
+            rank = _rank_within(group)
             ids = np.array([self.plan.strings.ids[s] for s in op.selectors], dtype=np.int32)
-            shapes = self.with_context(shapes, "sel", None, None, 0, selector=ids[which])
+            shapes = self.with_context(shapes, "comp", rank, group, int(group.max(initial=0)) + 1,
+                                       selector=ids[which])
         self.count(shapes, symbol, op.span)
         order, offsets = group_by(which, len(op.parts))
         self.run_parts(op.parts, shapes.take(order), offsets, symbol)
+
+
+def _rank_within(group: np.ndarray) -> np.ndarray:
+    """Each item's number among the items of its group, in order: [5, 3, 5, 5] -> [0, 0, 1, 2]."""
+    order = np.argsort(group, kind="stable")
+    sorted_group = group[order]
+    first = np.r_[True, sorted_group[1:] != sorted_group[:-1]] if len(group) else np.zeros(0, bool)
+    starts = np.maximum.accumulate(np.where(first, np.arange(len(group)), 0)) if len(group) else first
+    rank = np.empty(len(group), dtype=np.int64)
+    rank[order] = np.arange(len(group)) - starts
+    return rank
+
 
 def _rotation(ax: np.ndarray, ay: np.ndarray, az: np.ndarray) -> np.ndarray:
     """(n, 3, 3) matrices M with new axes = M @ axes: about x, then the new y, then the new z (degrees)."""

@@ -268,6 +268,8 @@ class Lowering(LoweringBase):
         if op == "split":
             return self.op_split(args, parts, star is not None, span)
         if op == "comp":
+            if star is not None:
+                return self.unsupported("`*` after comp", self.token_span(star), "only split repeats")
             return self.op_comp(args, parts, span)
         return self.unsupported(op, span)
 
@@ -420,9 +422,12 @@ class Lowering(LoweringBase):
             if part.size.kind is not ir.SizeKind.ABSOLUTE or not isinstance(value, ir.Name):
                 return self.unsupported("this comp selector", part.span)
             if value.name not in known:
-                why = ("the faces `offset` makes: the polygon geometry issue"
-                       if value.name in ("inside", "border") else
-                       "street, object and world selectors are not supported yet" + suggest(value.name, known))
+                if value.name in ("inside", "border"):
+                    why = "the faces `offset` makes: the polygon geometry issue"
+                elif kind == "f":
+                    why = "street, object and world selectors are not supported yet" + suggest(value.name, known)
+                else:
+                    why = f"comp({kind}) selects {', '.join(sorted(known))}"
                 return self.unsupported(f"comp({kind}) selector `{value.name}`", value.span, why)
             if part.merged:
                 self.diags.warning(
@@ -578,19 +583,23 @@ def assemble(file: str, statements: list, diags: Diagnostics, imports=()) -> ir.
         if any(a[0] == "StartRule" for a in notes) and start is None:
             start = name
         params = frozenset(rule.params)
+        # a leaf `X.` names a shape, not a rule: it keeps its name when rules `X` are overloaded
         body = _map_symbols(rule.body, lambda op: replace(op, name=symbol_name(op.name, len(op.args)))
-                            if op.name in arities else op)
+                            if op.name in arities and not op.leaf else op)
         body = rewrite_body(body, lambda e, p=params: inline.expr(e, p))
         lowered.append(ir.Rule(symbol=name, params=rule.params, guard=None,
                                alternatives=(ir.Alternative(body, None, rule.span),), priority=0,
                                span=rule.span, site=rule.site))
     if start is None and lowered:
         start = lowered[0].symbol
+    imported = []
     for statement, module in imports:
         more_attrs, more_rules = _prefixed(module, statement.prefix, {a.name for a in attrs})
         attrs.extend(more_attrs)
         lowered.extend(more_rules)
-    return ir.Module(file=file, attrs=tuple(attrs), rules=tuple(lowered), start=start, dialect="cityengine")
+        imported.extend((module.file, *module.imported))
+    return ir.Module(file=file, attrs=tuple(attrs), rules=tuple(lowered), start=start, dialect="cityengine",
+                     imported=tuple(dict.fromkeys(imported)))
 
 
 def _prefixed(module: ir.Module, prefix: str | None, forwarded: set[str]):
@@ -603,6 +612,8 @@ def _prefixed(module: ir.Module, prefix: str | None, forwarded: set[str]):
     def rename(params):
         def visit(e):
             if isinstance(e, ir.Name) and e.name in own_attrs and e.name not in params:
+                return replace(e, name=f"{prefix}.{e.name}")
+            if isinstance(e, ir.AttrRef) and e.name in own_attrs:  # from an inlined function
                 return replace(e, name=f"{prefix}.{e.name}")
             return e
         return visit
@@ -635,20 +646,25 @@ def _map_symbols(body: ir.Body, fn) -> ir.Body:
 
 
 class _Inliner:
-    """Replaces calls of user functions (and bare names of parameterless ones) by their bodies."""
+    """Replaces calls of user functions (and bare names of parameterless ones) by their bodies.
 
-    MAX_DEPTH = 32
+    A function's body is inlined in its own scope (its parameters, then the attributes) before the
+    caller's arguments are bound, so that its names never see the parameters of the rule that calls it.
+    """
 
     def __init__(self, functions: dict[str, FunctionDef], attrs: set[str], diags: Diagnostics):
         self.functions = functions
         self.attrs = attrs
         self.diags = diags
+        #: Function name -> its body with the functions it calls inlined (computed once per function).
+        self.bodies: dict[str, ir.Expr] = {}
 
-    def expr(self, expr: ir.Expr, params: frozenset, depth: int = 0) -> ir.Expr:
+    def expr(self, expr: ir.Expr, params: frozenset, calling: tuple[str, ...] = ()) -> ir.Expr:
+        """``expr`` with user functions inlined; ``calling`` are the functions being inlined around it."""
         def visit(e: ir.Expr) -> ir.Expr:
             if isinstance(e, ir.Name) and e.name not in params and e.name not in self.attrs \
                     and e.name in self.functions and not self.functions[e.name].params:
-                return self.call(self.functions[e.name], (), e.span, depth)
+                return self.call(self.functions[e.name], (), e.span, calling)
             if isinstance(e, ir.Call) and e.func not in ir.FUNCTIONS and e.func not in ir.CONVERSIONS:
                 fn = self.functions.get(e.func)
                 if fn is None:
@@ -659,20 +675,25 @@ class _Inliner:
                     self.diags.error("arity", f"`{e.func}` takes {len(fn.params)} arguments, got "
                                      f"{len(e.args)}", e.span)
                     return ir.placeholder(e.span)
-                return self.call(fn, e.args, e.span, depth)
+                return self.call(fn, e.args, e.span, calling)
             return e
 
         return rewrite_expr(expr, visit)
 
-    def call(self, fn: FunctionDef, args: tuple, span: Span, depth: int) -> ir.Expr:
-        if depth >= self.MAX_DEPTH:
+    def call(self, fn: FunctionDef, args: tuple, span: Span, calling: tuple[str, ...]) -> ir.Expr:
+        if fn.name in calling:
+            # reported where the function calls itself, once (its body is inlined once)
             self.diags.error("unsupported", f"unsupported: recursive function `{fn.name}`", span)
             return ir.placeholder(span)
+        if fn.name not in self.bodies:
+            self.bodies[fn.name] = self.expr(fn.value, frozenset(fn.params), (*calling, fn.name))
         bound = dict(zip(fn.params, args))
 
         def substitute(e: ir.Expr) -> ir.Expr:
-            return bound.get(e.name, e) if isinstance(e, ir.Name) else e
+            if not isinstance(e, ir.Name):
+                return e
+            if e.name in bound:
+                return bound[e.name]  # the caller's expression, already inlined in the caller's scope
+            return ir.AttrRef(e.name, e.span) if e.name in self.attrs else e
 
-        body = rewrite_expr(fn.value, substitute)
-        return self.expr(body, frozenset(), depth=depth + 1)
-
+        return rewrite_expr(self.bodies[fn.name], substitute)

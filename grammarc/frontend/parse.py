@@ -28,13 +28,21 @@ DIALECTS = {
     "cityengine": ("grammars/cityengine.lark", CITYENGINE, lower_cityengine),
 }
 #: Text that only CityEngine CGA has: its version line, annotations, lower-case operations, const.
-_CITYENGINE_MARKS = re.compile(r'^\s*(version\s+"|@StartRule|const\s)|\b(extrude|split|comp)\s*\(|-->\s*$',
+_CITYENGINE_MARKS = re.compile(r'^\s*(version\s+"|@StartRule|const\s)|\b(extrude|split|comp)\s*\(',
                                re.MULTILINE)
+#: Text that only the paper notation has: its arrows, PRIORITY blocks, capitalised operations.
+_PAPER_MARKS = re.compile(r"~>|\u2192|\u21dd|^\s*(PRIORITY\b|\d+\s*:)|\b(Subdiv|Repeat|Comp|I|S|T)\s*\(",
+                          re.MULTILINE)
 
 
 def detect_dialect(text: str) -> str:
-    """``cityengine`` for CityEngine CGA, ``cga2006`` for the paper notation."""
-    return "cityengine" if _CITYENGINE_MARKS.search(text) else "cga2006"
+    """``cityengine`` for CityEngine CGA, ``cga2006`` for the paper notation.
+
+    A rule arrow ``-->`` is CityEngine's unless the text has the paper notation's own marks.
+    """
+    if _CITYENGINE_MARKS.search(text):
+        return "cityengine"
+    return "cityengine" if "-->" in text and not _PAPER_MARKS.search(text) else "cga2006"
 
 #: How terminals are named in messages.
 _TERMINALS = {

@@ -96,9 +96,14 @@ def _starts_with_word(line: str, words: tuple[str, ...]) -> bool:
     return any(line.startswith(w) and not line[len(w):len(w) + 1].isalnum() for w in words)
 
 
+_ANNOTATION = re.compile(r"@\w+\s*(\([^()]*\))?\s*")
+
+
 def _only_annotations(lines: list[str]) -> bool:
+    """Whether ``lines`` hold annotations and nothing else (``@Range(1, 5)`` yes, ``@Hidden attr x = 1``
+    no: that line declares)."""
     code = [s.strip() for s in lines if s.strip() and not s.strip().startswith(("#", "//"))]
-    return bool(code) and all(s.startswith("@") for s in code)
+    return bool(code) and all(s.startswith("@") and not _ANNOTATION.sub("", s).strip() for s in code)
 
 
 def _scan(line: str, depth: int, in_block_comment: bool) -> tuple[int, bool, bool]:

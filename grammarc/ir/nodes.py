@@ -500,3 +500,5 @@ class Module:
     #: ``cga2006`` or ``cityengine``. In CityEngine CGA a body that makes no successor leaves its shape
     #: as a leaf (``Lot --> extrude(10)`` is a mass); in the paper notation such a body emits nothing.
     dialect: str = "cga2006"
+    #: Files whose rules and attributes were imported into this module (CityEngine ``import``).
+    imported: tuple[str, ...] = ()

@@ -86,13 +86,16 @@ def print_op(op: ir.Op) -> str:
         index = f", {print_expr(op.index)}" if op.index is not None else ""
         return f'Comp("{op.kind}"{index}){_parts(op.parts)}'
     if isinstance(op, ir.GroupSplit):
-        items = []
-        for g in sorted(set(op.groups)):
-            members = [f"{_size(s)}: {print_body(b) or 'ε'}"
-                       for s, b, grp in zip(op.sizes, op.parts, op.groups) if grp == g]
-            items.append(" | ".join(members) if g < 0 else "{ " + " | ".join(members) + " }*")
-        star = "*" if op.repeat else ""
-        return f"split({'xyz'[op.axis]}){{ {' | '.join(items)} }}{star}"
+        items, group = [], None
+        for size, body, g in zip(op.sizes, op.parts, op.groups):
+            text = f"{_size(size)}: {print_body(body) or 'ε'}"
+            if g >= 0 and g == group:
+                items[-1].append(text)
+            else:
+                items.append([text] if g < 0 else ["{", text])
+            group = g
+        shown = [" | ".join(i) if i[0] != "{" else "{ " + " | ".join(i[1:]) + " }*" for i in items]
+        return f"split({'xyz'[op.axis]}){{ {' | '.join(shown)} }}{'*' if op.repeat else ''}"
     if isinstance(op, ir.CompFaces):
         return f"comp({op.kind}){{ " + " | ".join(f"{s}: {print_body(b) or 'ε'}"
                                          for s, b in zip(op.selectors, op.parts)) + " }"

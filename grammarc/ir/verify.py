@@ -47,6 +47,6 @@ def verify(module: ir.Module, stage: str) -> list[str]:
                     problems.append(f"{where}: undeclared attribute `{sub.name}`")
                 if isinstance(sub, ir.Param) and sub.index >= len(rule.params):
                     problems.append(f"{where}: parameter index {sub.index} out of range")
-                if sub.span.file != module.file and sub.span.line != 0:
+                if sub.span.file not in (module.file, *module.imported) and sub.span.line != 0:
                     problems.append(f"{where}: span from another file {sub.span}")
     return problems

@@ -1,0 +1,290 @@
+"""backend/kernels/split.py ``group_split``: CityEngine's split with ``'``, ``~`` sizes and repeat groups.
+
+Layouts are computed by hand from the kernel's rule (its docstring): fixed parts and floating parts outside
+groups keep their written sizes while the groups share what is left in proportion to one repetition's
+size; a group with floating parts repeats round(share / repetition) times (at least once when there is
+room), a group of fixed sizes floor(share / repetition) times with the rest of its share left empty; then
+one factor scales every floating size so that the parts fill the extent. A plain Python reference of the
+same rule checks random batches.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from grammarc.backend.kernels.split import group_split
+
+ABS, REL, FLT = 0, 1, 2
+TOL = 1e-9
+
+
+def layout(extent, sizes, groups=None, kinds=None, rows=None):
+    """Run the kernel on one shape of ``extent``: [(part, position, length, index), ...].
+
+    ``sizes`` are written as CityEngine does: a number is absolute, ``"'0.5"`` relative, ``"~3"``
+    floating; ``groups`` gives each part's repeat group (-1 or None: none).
+    """
+    values, kind = _parse(sizes)
+    if kinds is not None:
+        kind = np.array(kinds, np.int64)
+    group = np.array([-1 if g is None else g for g in (groups or [-1] * len(sizes))], np.int64)
+    n_groups = int(group.max()) + 1 if len(group) else 0
+    parent, part, pos, length, index = group_split(np.array([extent], float), values[None, :], kind,
+                                                   group, n_groups, TOL)
+    assert (parent == 0).all()
+    return list(zip(part.tolist(), pos.tolist(), length.tolist(), index.tolist()))
+
+
+def _parse(sizes):
+    values, kind = [], []
+    for s in sizes:
+        if isinstance(s, str) and s[0] in "'~":
+            values.append(float(s[1:]))
+            kind.append(REL if s[0] == "'" else FLT)
+        else:
+            values.append(float(s))
+            kind.append(ABS)
+    return np.array(values, float), np.array(kind, np.int64)
+
+
+def assert_layout(got, want):
+    """``want``: [(part, length), ...] laid end to end from 0, or (part, position, length) triples."""
+    assert [g[0] for g in got] == [w[0] for w in want], got
+    assert [g[3] for g in got] == list(range(len(want)))
+    at = 0.0
+    for g, w in zip(got, want):
+        pos, length = (w[1], w[2]) if len(w) == 3 else (at, w[1])
+        assert g[1] == pytest.approx(pos, abs=1e-9), got
+        assert g[2] == pytest.approx(length, abs=1e-9), got
+        at = pos + length
+
+
+# --------------------------------------------------------------------------------------- absolute and '
+
+
+def test_absolute_sizes_end_to_end():
+    assert_layout(layout(12, [3, 4, 5]), [(0, 3), (1, 4), (2, 5)])
+
+
+def test_absolute_sizes_beyond_the_extent_are_cut_then_dropped():
+    # 3 | 4 | 5 | 2 on 10: the third part is cut at 10, the fourth starts beyond the extent
+    assert_layout(layout(10, [3, 4, 5, 2]), [(0, 3), (1, 4), (2, 3)])
+    # a first part longer than the extent is cut, the rest dropped
+    assert_layout(layout(2.5, [3, 4]), [(0, 2.5)])
+
+
+def test_absolute_sizes_short_of_the_extent_leave_the_rest_empty():
+    assert_layout(layout(10, [2, 3]), [(0, 2), (1, 3)])
+
+
+def test_relative_sizes_are_fractions_of_the_extent():
+    # '0.25 | 2 | '0.5 on 12: 3, 2, 6 (one metre left empty)
+    assert_layout(layout(12, ["'0.25", 2, "'0.5"]), [(0, 3), (1, 2), (2, 6)])
+
+
+def test_parts_of_zero_length_are_dropped_and_not_numbered():
+    got = layout(10, [5, 0, 5])
+    assert_layout(got, [(0, 0, 5), (2, 5, 5)])
+
+
+# ------------------------------------------------------------------------------------------------ ~ sizes
+
+
+def test_floating_sizes_share_the_rest_in_proportion():
+    # 2 | ~1 | ~3 on 10: the floating parts take the 8 left, 1:3
+    assert_layout(layout(10, [2, "~1", "~3"]), [(0, 2), (1, 2), (2, 6)])
+
+
+def test_floating_sizes_shrink_to_fill_the_extent():
+    # ~6 | ~6 | 2 on 8: the two floating parts shrink to 3 each
+    assert_layout(layout(8, ["~6", "~6", 2]), [(0, 3), (1, 3), (2, 2)])
+
+
+def test_floating_sizes_vanish_when_the_fixed_parts_fill_the_extent():
+    # 8 | ~1 | 8 on 10: nothing left for the floating part; the last fixed part is cut
+    assert_layout(layout(10, [8, "~1", 8]), [(0, 0, 8), (2, 8, 2)])
+
+
+# ------------------------------------------------------------------------------------------ repeat groups
+
+
+@pytest.mark.parametrize("extent, reps", [(10, 3), (11, 4), (9, 3), (4.4, 1), (1, 1)])
+def test_floating_repeat_group_rounds_and_fills(extent, reps):
+    """{ ~3 : A }*: round(extent / 3) repetitions (at least one), stretched to fill the extent."""
+    got = layout(extent, ["~3"], groups=[0])
+    assert_layout(got, [(0, extent / reps)] * reps)
+
+
+def test_floating_repeat_group_without_room_makes_nothing():
+    # 8 | { ~3 }* on 8: no room for a repetition
+    assert_layout(layout(8, [8, "~3"], groups=[-1, 0]), [(0, 8)])
+    # on 8.5 there is room for one, shrunk to 0.5
+    assert_layout(layout(8.5, [8, "~3"], groups=[-1, 0]), [(0, 8), (1, 0.5)])
+
+
+def test_absolute_repeat_group_floors_and_leaves_the_rest_empty():
+    # { 3 }* on 10: three parts, one metre empty at the end
+    assert_layout(layout(10, [3], groups=[0]), [(0, 3)] * 3)
+    # 1 | { 3 }* | 1 on 10: two repetitions; the group's rest (2) stays empty before the last part
+    assert_layout(layout(10, [1, 3, 1], groups=[-1, 0, -1]),
+                  [(0, 0, 1), (1, 1, 3), (1, 4, 3), (2, 9, 1)])
+
+
+def test_absolute_repeat_group_too_long_for_the_extent_makes_nothing():
+    assert_layout(layout(2, [3], groups=[0]), [])
+
+
+def test_mixed_repeat_group_scales_only_its_floating_sizes():
+    """{ ~1 : A | 0.2 : B }* on 10: round(10 / 1.2) = 8 repetitions; A takes (10 - 8 * 0.2) / 8."""
+    a = (10 - 8 * 0.2) / 8
+    assert_layout(layout(10, ["~1", 0.2], groups=[0, 0]), [(0, a), (1, 0.2)] * 8)
+
+
+def test_floating_parts_outside_a_group_keep_their_written_size_for_the_count():
+    """~2 | { ~3 }* on 21: the group gets 19, round(19 / 3) = 6; one factor 21 / 20 for all ~ sizes."""
+    f = 21 / 20
+    assert_layout(layout(21, ["~2", "~3"], groups=[-1, 0]), [(0, 2 * f)] + [(1, 3 * f)] * 6)
+
+
+def test_relative_sizes_inside_a_group_are_fixed():
+    # { '0.1 }* on 10: ten parts of 1
+    assert_layout(layout(10, ["'0.1"], groups=[0]), [(0, 1)] * 10)
+
+
+def test_candler_floor_two_groups_share_the_rest():
+    """candler's Floor: 1 | 3.55 | {~3.55}* | 3.55 | {~3.55}* | 3.55 | 1 on 30 m.
+
+    Fixed 12.65; the groups share 17.35 equally, 8.675 each: round(8.675 / 3.55) = 2 repetitions each;
+    four floating parts fill the 17.35, 4.3375 each.
+    """
+    sizes = [1, 3.55, "~3.55", 3.55, "~3.55", 3.55, 1]
+    groups = [-1, -1, 0, -1, 1, -1, -1]
+    w = 17.35 / 4
+    got = layout(30, sizes, groups=groups)
+    assert_layout(got, [(0, 1), (1, 3.55), (2, w), (2, w), (3, 3.55), (4, w), (4, w), (5, 3.55), (6, 1)])
+    assert got[-1][1] + got[-1][2] == pytest.approx(30)
+
+
+def test_whole_split_repeat_is_one_group():
+    """split(x){ 2 : A | ~1 : B }* on 10 is one group around all parts: round(10 / 3) = 3 repetitions."""
+    b = (10 - 3 * 2) / 3
+    assert_layout(layout(10, [2, "~1"], groups=[0, 0]), [(0, 2), (1, b)] * 3)
+
+
+# ------------------------------------------------------------------------------------------- batches
+
+
+def test_no_shapes():
+    out = group_split(np.zeros(0), np.ones((1, 2)), np.array([ABS, FLT], np.int64),
+                      np.array([-1, 0], np.int64), 1, TOL)
+    assert [len(a) for a in out] == [0] * 5
+    assert out[0].dtype == np.int64 and out[2].dtype == np.float64 and out[4].dtype == np.int64
+
+
+def test_one_shape_and_no_parts():
+    out = group_split(np.array([10.0]), np.zeros((1, 0)), np.zeros(0, np.int64), np.zeros(0, np.int64), 0,
+                      TOL)
+    assert [len(a) for a in out] == [0] * 5
+
+
+def test_one_row_of_values_serves_every_shape_like_one_row_each():
+    extent = np.array([10.0, 11.0, 4.4, 0.0, 30.0])
+    kind = np.array([ABS, FLT, ABS], np.int64)
+    group = np.array([-1, 0, -1], np.int64)
+    shared = group_split(extent, np.array([[1.0, 3.0, 1.0]]), kind, group, 1, TOL)
+    per_shape = group_split(extent, np.tile([1.0, 3.0, 1.0], (5, 1)), kind, group, 1, TOL)
+    for a, b in zip(shared, per_shape):
+        np.testing.assert_array_equal(a, b)
+    # the shape of zero extent makes nothing; the others are in parent order
+    assert 3 not in shared[0] and (np.diff(shared[0]) >= 0).all()
+
+
+def test_values_per_shape_are_read_per_row():
+    extent = np.array([10.0, 10.0])
+    values = np.array([[2.0, 1.0], [5.0, 1.0]])
+    parent, _, pos, length, index = group_split(extent, values, np.array([ABS, FLT], np.int64),
+                                                np.array([-1, -1], np.int64), 0, TOL)
+    np.testing.assert_array_equal(parent, [0, 0, 1, 1])
+    np.testing.assert_allclose(length, [2, 8, 5, 5])
+    np.testing.assert_allclose(pos, [0, 2, 0, 5])
+    np.testing.assert_array_equal(index, [0, 1, 0, 1])
+
+
+def reference(extent, values, kind, group, n_groups, tol):
+    """The docstring's rule in plain Python, one shape at a time."""
+    out = []
+    for i, e in enumerate(extent):
+        row = values[0 if len(values) == 1 else i]
+        size = [v * e if k == REL else v for v, k in zip(row, kind)]
+        fixed = sum(s for s, k, g in zip(size, kind, group) if g < 0 and k != FLT)
+        floating = sum(s for s, k, g in zip(size, kind, group) if g < 0 and k == FLT)
+        nominal = [sum(s for s, g in zip(size, group) if g == gi) for gi in range(n_groups)]
+        room = e - fixed
+        avail = max(room - floating, 0.0)
+        reps, gaps = [0] * n_groups, [0.0] * n_groups
+        for gi in range(n_groups):
+            if nominal[gi] <= tol:
+                continue
+            share = avail * nominal[gi] / sum(nominal)
+            has_float = any(k == FLT for k, g in zip(kind, group) if g == gi)
+            if has_float:
+                reps[gi] = int(np.floor(share / nominal[gi] + 0.5))
+                if reps[gi] == 0 and room > tol:
+                    reps[gi] = 1
+            else:
+                reps[gi] = int(np.floor(share / nominal[gi] + 1e-9))
+                gaps[gi] = share - reps[gi] * nominal[gi]
+            members = [(s, k) for s, k, g in zip(size, kind, group) if g == gi]
+            fixed += reps[gi] * sum(s for s, k in members if k != FLT) + gaps[gi]
+            floating += reps[gi] * sum(s for s, k in members if k == FLT)
+        scale = max(e - fixed, 0.0) / floating if floating > 0 else 1.0
+        sequence = []
+        j = 0
+        while j < len(size):
+            if group[j] < 0:
+                sequence.append((j, size[j] * (scale if kind[j] == FLT else 1.0)))
+                j += 1
+                continue
+            end = j
+            while end < len(size) and group[end] == group[j]:
+                end += 1
+            for _ in range(reps[group[j]]):
+                sequence.extend((k, size[k] * (scale if kind[k] == FLT else 1.0)) for k in range(j, end))
+            sequence.append((None, gaps[group[j]]))
+            j = end
+        at, child = 0.0, 0
+        for part, length in sequence:
+            end = min(at + length, e)
+            if part is not None and end - at > tol:
+                out.append((i, part, at, end - at, child))
+                child += 1
+            at += length
+    return out
+
+
+@pytest.mark.parametrize("seed", range(5))
+def test_random_batches_match_the_reference(seed):
+    rng = np.random.default_rng(seed)
+    n = int(rng.integers(1, 40))
+    count = int(rng.integers(1, 7))
+    kind = rng.integers(0, 3, count).astype(np.int64)
+    # groups are contiguous runs: [-1, 0, 0, -1, 1, ...]
+    group = np.full(count, -1, np.int64)
+    at, g = 0, 0
+    while at < count:
+        run = int(rng.integers(1, 3))
+        if rng.random() < 0.5:
+            group[at:at + run] = g
+            g += 1
+        at += run
+    values = np.where(kind == REL, rng.uniform(0.05, 0.4, (n, count)), rng.uniform(0.2, 5, (n, count)))
+    if rng.random() < 0.5:
+        values = values[:1]
+    extent = rng.uniform(0, 30, n)
+    extent[0] = 0.0
+    got = group_split(extent, values, kind, group, g, TOL)
+    want = reference(extent, values, kind, group, g, TOL)
+    assert len(got[0]) == len(want)
+    for column, expected in zip(got, zip(*want)):
+        np.testing.assert_allclose(column, expected, atol=1e-9)
