@@ -73,6 +73,8 @@ class Chunk:
     outputs: Outputs = field(default_factory=Outputs)
     #: Shapes created so far per lot, for the ``max_shapes`` limit.
     shape_count: np.ndarray | None = None
+    #: The lots' root random keys (``fileRandom`` draws from them).
+    lot_key: np.ndarray | None = None
 
     def __post_init__(self) -> None:
         if self.shape_count is None:

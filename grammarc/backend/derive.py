@@ -55,6 +55,7 @@ def derive_chunk(plan: Plan, lots: Lots, *, seed: int, limits: Limits, overrides
     """
     chunk, shapes = initial_chunk(lots)
     shapes = replace(shapes, key=lot_keys(seed, lots.index))
+    chunk.lot_key = shapes.key
     attribute_columns(plan.grammar.module, Env(shapes, chunk, plan), lots.attrs, overrides, plan.strings)
     shapes = replace(shapes, dynamic=tuple(initial_dynamic(plan, name, chunk, shapes) for name in plan.dynamic))
     executor = Executor(plan, chunk, limits, chunk_budget)

@@ -17,7 +17,7 @@ from numba import njit
 from grammarc.backend.chunk import Chunk
 from grammarc.backend.random import uniform
 from grammarc.backend.shapes import Shapes
-from grammarc.geometry.measure import area_and_volume, is_rectangular
+from grammarc.geometry.measure import area_and_volume, is_rectangular, vertex_and_face_counts
 from grammarc.ir import nodes as ir
 
 if TYPE_CHECKING:
@@ -129,10 +129,26 @@ def _scope_field(name: str, env: Env):
     shapes = env.shapes
     if name[0] == "s":
         return shapes.size[:, axis]
+    if name[0] == "o":
+        return env.chunk.lot_origin[shapes.lot, axis]
+    if name[0] == "r":
+        return _scope_angles(env)[:, axis]
     # Translation relative to the lot's own scope, along the lot's axes (CityEngine's object coordinates).
     lot = shapes.lot
     offset = shapes.origin - env.chunk.lot_origin[lot]
     return np.einsum("nj,nj->n", offset, env.chunk.lot_axes[lot, axis])
+
+
+def _scope_angles(env: Env) -> np.ndarray:
+    """The scope's rotation relative to its lot's scope, as angles (n, 3) in degrees about x, then y,
+    then z (the order of ``R``): the inverse of ``execute._rotation``."""
+    relative = np.einsum("nij,nkj->nik", env.chunk.frames[env.shapes.frame],
+                         env.chunk.lot_axes[env.shapes.lot])  # rows: new axes in the lot's frame
+    # relative = Rz @ Ry @ Rx with rows as in execute._rotation; read the angles off its entries
+    ry = np.degrees(np.arcsin(np.clip(-relative[:, 0, 2], -1.0, 1.0)))
+    rx = np.degrees(np.arctan2(relative[:, 1, 2], relative[:, 2, 2]))
+    rz = np.degrees(np.arctan2(relative[:, 0, 1], relative[:, 0, 0]))
+    return np.stack([rx, ry, rz], axis=1)
 
 
 def _call(expr: ir.Call, env: Env):
@@ -146,6 +162,17 @@ def _call(expr: ir.Call, env: Env):
         return low + (np.subtract(high, low)) * u
     if f == "p":
         return uniform(env.shapes.key, expr.site) < np.asarray(args[0], dtype=np.float64)
+    if f == "fileRandom":
+        return uniform(env.chunk.lot_key[env.shapes.lot], 0x5F11E)
+    if f in ("geometry.nVertices", "geometry.nFaces"):
+        vertices, faces = vertex_and_face_counts(env.shapes.size, env.shapes.geom, env.chunk.polygons)
+        return vertices if f == "geometry.nVertices" else faces
+    if f == "len":
+        names = list(env.plan.strings.ids)
+        ids = np.asarray(args[0])
+        distinct, inverse = np.unique(np.atleast_1d(ids), return_inverse=True)
+        lengths = np.array([len(names[int(i)]) for i in distinct], dtype=np.float64)[inverse.reshape(-1)]
+        return lengths if ids.ndim else float(lengths[0])
     if f == "geometry.isRectangular":
         return is_rectangular(env.shapes.size, env.shapes.geom, env.chunk.polygons,
                               float(np.max(args[0])) if np.size(args[0]) else 0.0)

@@ -612,7 +612,12 @@ class Executor:
         kind = {"f": "faces", "e": "edges", "v": "vertices"}[op.kind]
         shapes, normal, _, parent = self.components(comp_kernels.KIND_CODES[kind], cursor, op.site)
         if op.kind == "f":
-            which = classify_faces(normal, op.selectors)
+            frames = None
+            if any("." in s for s in op.selectors):
+                world = np.einsum("mi,mij->mj", normal, self.chunk.frames[cursor.frame][parent])
+                lot = np.einsum("mj,mij->mi", world, self.chunk.lot_axes[cursor.lot[parent]])
+                frames = {"world": world, "object": lot}
+            which = classify_faces(normal, op.selectors, frames)
         else:
             direction = self.chunk.frames[shapes.frame][:, 0] if op.kind == "e" else None
             which = classify_edges(direction, op.selectors, len(shapes))
@@ -683,9 +688,18 @@ _SIZE_KIND = {ir.SizeKind.ABSOLUTE: 0, ir.SizeKind.RELATIVE: 1, ir.SizeKind.FLOA
 _FLAT_TOLERANCE = 1e-6
 
 
-def classify_faces(normal: np.ndarray, selectors: tuple[str, ...]) -> np.ndarray:
+def classify_faces(normal: np.ndarray, selectors: tuple[str, ...], frames: dict | None = None) -> np.ndarray:
     """Index of the first selector each face matches (len(selectors) for none), from normals (m, 3) in
-    the parent's scope frame: front +z, back -z, right +x, left -x, top +y, bottom -y."""
+    the parent's scope frame: front +z, back -z, right +x, left -x, top +y, bottom -y. ``frames`` gives
+    the normals in the lot's frame (``object.`` selectors) and the world's (``world.``)."""
+    which = np.full(len(normal), len(selectors), dtype=np.int64)
+    for i in range(len(selectors) - 1, -1, -1):
+        prefix, _, name = selectors[i].rpartition(".")
+        which[_face_masks((frames or {}).get(prefix, normal))[name]] = i
+    return which
+
+
+def _face_masks(normal: np.ndarray) -> dict[str, np.ndarray]:
     x, y, z = normal[:, 0], normal[:, 1], normal[:, 2]
     top, bottom = y > np.sqrt(0.5), y < -np.sqrt(0.5)
     side = ~top & ~bottom
@@ -701,10 +715,7 @@ def classify_faces(normal: np.ndarray, selectors: tuple[str, ...]) -> np.ndarray
         "aslant": ~vertical & ~horizontal & (y > 0), "nutant": ~vertical & ~horizontal & (y < 0),
         "all": np.ones(len(normal), dtype=bool),
     }
-    which = np.full(len(normal), len(selectors), dtype=np.int64)
-    for i in range(len(selectors) - 1, -1, -1):
-        which[masks[selectors[i]]] = i
-    return which
+    return masks
 
 
 def classify_edges(direction: np.ndarray | None, selectors: tuple[str, ...], n: int) -> np.ndarray:

@@ -36,8 +36,12 @@ UNSUPPORTED_OPS = frozenset({
 #: CityEngine built-in functions mapped onto the IR's.
 FUNCTION_NAMES = {"rint": "round", "ln": "log"}
 AXIS_NAMES = {"x": (0,), "y": (1,), "z": (2,), "xy": (0, 1), "xz": (0, 2), "yz": (1, 2), "xyz": (0, 1, 2)}
-SCOPE_MEMBERS = {"scope.sx": "sx", "scope.sy": "sy", "scope.sz": "sz", "scope.tx": "tx", "scope.ty": "ty",
-                 "scope.tz": "tz"}
+SCOPE_MEMBERS = {
+    **{f"scope.{f}": f for f in ("sx", "sy", "sz", "tx", "ty", "tz", "rx", "ry", "rz")},
+    "initialShape.origin.px": "ox", "initialShape.origin.py": "oy", "initialShape.origin.pz": "oz",
+}
+#: Shape queries without arguments, written as members (``geometry.area``) or calls (``geometry.area()``).
+GEOMETRY_QUERIES = ("geometry.area", "geometry.volume", "geometry.nVertices", "geometry.nFaces")
 
 
 @dataclass(frozen=True, slots=True)
@@ -425,7 +429,7 @@ class Lowering(LoweringBase):
                 if value.name in ("inside", "border"):
                     why = "the faces `offset` makes: the polygon geometry issue"
                 elif kind == "f":
-                    why = "street, object and world selectors are not supported yet" + suggest(value.name, known)
+                    why = "street selectors come with the context issue" + suggest(value.name, known)
                 else:
                     why = f"comp({kind}) selects {', '.join(sorted(known))}"
                 return self.unsupported(f"comp({kind}) selector `{value.name}`", value.span, why)
@@ -468,12 +472,17 @@ class Lowering(LoweringBase):
         return tuple(str(n) for n in names), Span(self.file, names[0].line, names[0].column,
                                                   names[-1].end_line, names[-1].end_column)
 
+    def name(self, meta, tok):
+        if str(tok) == "fileRandom":
+            return ir.Call("fileRandom", (), self.token_span(tok), 0)
+        return ir.Name(str(tok), self.token_span(tok))
+
     def member(self, meta, dotted):
         names, span = dotted
         text = ".".join(names)
         if text in SCOPE_MEMBERS:
             return ir.ScopeRef(SCOPE_MEMBERS[text], span)
-        if text in ("geometry.area", "geometry.volume"):
+        if text in GEOMETRY_QUERIES:
             return ir.Call(text, (), span, self.site())
         if text in ir.CONTEXT_FIELDS:
             return ir.ContextRef(text, span)
@@ -487,7 +496,7 @@ class Lowering(LoweringBase):
     def member_function(self, meta, dotted, args):
         names, span = dotted
         text = ".".join(names)
-        if text in ("geometry.area", "geometry.volume") and not args:
+        if text in GEOMETRY_QUERIES and not args:
             return ir.Call(text, (), span, self.site())
         if text == "geometry.isRectangular" and len(args or ()) <= 1:
             tolerance = self.expr(args[0]) if args else ir.Num(0.0, span)
@@ -501,6 +510,8 @@ class Lowering(LoweringBase):
         args = tuple(self.expr(a) for a in (args or ()))
         if func == "p" and len(args) == 1:
             return ir.Call("p", args, span, self.site())
+        if func == "fileRandom" and not args:
+            return ir.Call("fileRandom", (), span, 0)  # one draw per lot for the whole file
         return ir.Call(func, args, span, self.site())
 
     def array(self, meta, *items):
@@ -528,7 +539,11 @@ _OPS = {
     "report": Lowering.op_report,
 }
 _SPLIT_OPS = frozenset({"split", "comp"})
-_COMP_SELECTORS = {"f": ir.FACE_SELECTORS, "e": ir.EDGE_SELECTORS, "v": ir.VERTEX_SELECTORS}
+_COMP_SELECTORS = {
+    "f": ir.FACE_SELECTORS | {f"{frame}.{s}" for frame in ("object", "world") for s in ir.FACE_SELECTORS},
+    "e": ir.EDGE_SELECTORS,
+    "v": ir.VERTEX_SELECTORS,
+}
 #: Shape attributes that grammarc does not provide yet: comp.index, split.index, initialShape.origin...
 _UNSUPPORTED_MEMBERS = frozenset({"comp", "split", "initialShape", "geometry"})
 

@@ -79,3 +79,23 @@ def is_rectangular(size: np.ndarray, geom: np.ndarray, store: PolygonStore, degr
     result = result.copy()
     result[poly] = four & corners_ok
     return result
+
+
+def vertex_and_face_counts(size: np.ndarray, geom: np.ndarray, store: PolygonStore):
+    """CityEngine's ``geometry.nVertices`` and ``geometry.nFaces`` per shape, (n,) float64 each: a box
+    has 8 and 6, a rectangle 4 and 1, a polygon its vertices and 1 face, a prism twice its vertices and
+    its edges plus 2 faces; an inserted asset counts as its box."""
+    flat = (size <= TOL.zero).sum(axis=1)
+    vertices = np.where(flat == 0, 8.0, np.where(flat == 1, 4.0, np.where(flat == 2, 2.0, 1.0)))
+    faces = np.where(flat == 0, 6.0, np.where(flat == 1, 1.0, 0.0))
+    poly = np.flatnonzero(geom >= 0)
+    if len(poly):
+        ids = geom[poly]
+        counts = np.diff(store.ring_offsets)[segment_of(store.poly_offsets)]
+        per_poly = segment_reduce(np.add, counts, store.poly_offsets, 0)[ids].astype(np.float64)
+        solid = size[poly, store.plane[ids]] > TOL.zero
+        vertices = vertices.copy()
+        faces = faces.copy()
+        vertices[poly] = np.where(solid, 2 * per_poly, per_poly)
+        faces[poly] = np.where(solid, per_poly + 2, 1.0)
+    return vertices, faces

@@ -91,8 +91,9 @@ def placeholder(span: Span = NO_SPAN) -> AttrRef:
     return AttrRef(PLACEHOLDER, span)
 
 
-#: Scope fields readable from expressions: size and translation (origin) per axis.
-SCOPE_FIELDS = ("sx", "sy", "sz", "tx", "ty", "tz")
+#: Scope fields readable from expressions: size, translation (origin) and rotation (degrees, x then y
+#: then z, relative to the lot's scope) per axis; ``ox oy oz``: the lot's scope origin in the world.
+SCOPE_FIELDS = ("sx", "sy", "sz", "tx", "ty", "tz", "rx", "ry", "rz", "ox", "oy", "oz")
 
 
 @dataclass(frozen=True, slots=True)
@@ -184,9 +185,12 @@ FUNCTIONS: dict[str, tuple[int, int, Type]] = {
     "geometry.area": (0, 0, Type.NUM),
     "geometry.volume": (0, 0, Type.NUM),
     "geometry.isRectangular": (1, 1, Type.BOOL),
+    "geometry.nVertices": (0, 0, Type.NUM),
+    "geometry.nFaces": (0, 0, Type.NUM),
+    "fileRandom": (0, 0, Type.NUM),
 }
 #: Functions that take strings or any type (their argument types are checked by ``passes.types``).
-CONVERSIONS: dict[str, Type] = {"str": Type.STR, "float": Type.NUM, "bool": Type.BOOL}
+CONVERSIONS: dict[str, Type] = {"str": Type.STR, "float": Type.NUM, "bool": Type.BOOL, "len": Type.NUM}
 
 
 # ------------------------------------------------------------------------------------------------ operations

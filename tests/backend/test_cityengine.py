@@ -502,3 +502,24 @@ def test_records_do_not_depend_on_the_chunk_size_and_repeat_with_the_seed(write)
 def test_a_function_with_rand_draws_at_each_use(write):
     r = run(write, 'h = rand(0, 100)\nLot --> report("d", h - h)\n', [rect(1, 1)] * 20)
     assert totals(r)["d_max"] > 0
+
+
+def test_world_and_object_face_selectors(write):
+    """world.* classifies by the world's axes, object.* by the lot's scope (x along the first edge)."""
+    r = run(write, "Lot --> extrude(4) comp(f){ world.front : WF | object.front : OF | world.top : T }\n",
+            [rect(12, 8)])
+    normals = quad_normals(r)
+    np.testing.assert_allclose(normals[rows(r, "WF")], [[0, 0, 1]], atol=1e-6)
+    np.testing.assert_allclose(normals[rows(r, "T")], [[0, 1, 0]], atol=1e-6)
+    assert Counter(names(r)) == {"WF": 1, "T": 1}  # map rectangles: the lot's front is the world's front
+
+
+def test_shape_queries(write):
+    r = run(write, 'Lot --> report("nv", geometry.nVertices) report("nf", geometry.nFaces) extrude(3) A\n'
+                   'A --> report("nv3", geometry.nVertices) report("nf3", geometry.nFaces) r(0, 30, 0) '
+                   'report("ry", scope.ry) report("ox", initialShape.origin.px) report("len", len("abcd")) '
+                   'report("fr", fileRandom) report("fr2", fileRandom) X.\n', [LOT_ZOO["concave_L"]])
+    t = totals(r)
+    assert (t["nv_sum"], t["nf_sum"], t["nv3_sum"], t["nf3_sum"]) == (6, 1, 12, 8)
+    assert t["ry_sum"] == pytest.approx(30) and t["len_sum"] == 4 and t["ox_sum"] == 0
+    assert t["fr_sum"] == t["fr2_sum"] and 0 <= t["fr_sum"] < 1

@@ -29,7 +29,8 @@ PURE = {
     "pow": math.pow, "min": min, "max": max, "log10": math.log10, "isnan": math.isnan,
 }
 #: Functions that read the shape or draw random numbers: never folded.
-SHAPE_DEPENDENT = frozenset({"rand", "p", "geometry.area", "geometry.volume", "geometry.isRectangular"})
+SHAPE_DEPENDENT = frozenset({"rand", "p", "geometry.area", "geometry.volume", "geometry.isRectangular",
+                             "geometry.nVertices", "geometry.nFaces", "fileRandom"})
 _CONSTANT = (ir.Num, ir.Str, ir.Bool)
 
 
