@@ -459,7 +459,6 @@ def test_comp_faces_selectors(selectors):
     ("Lot --> taper(4) A", "taper", "taper"),
     ("Lot --> comp(x){ all : A }", "comp(x)", "comp"),
     ("Lot --> comp(f){ street.front : A }", "comp(f) selector `street.front`", "street"),
-    ("Lot --> comp(f){ street.front : A }", "comp(f) selector `street.front`", "street"),
     ("Lot --> comp(f){ fornt : A }", "comp(f) selector `fornt`", "fornt"),
     ("Lot --> comp(f){ inside : A }", "comp(f) selector `inside`", "inside"),
     ("Lot --> comp(e){ front : A }", "comp(e) selector `front`", "front"),
