@@ -23,7 +23,7 @@ from grammarc.backend.kernels import split as split_kernels
 from grammarc.backend.kernels.order import group_by
 from grammarc.backend.plan import Plan, SymbolPlan, consumes
 from grammarc.backend.random import child_keys, uniform
-from grammarc.backend.shapes import Shapes
+from grammarc.backend.shapes import Shapes, asset_geom, asset_of
 from grammarc.constants import TOL, Limits
 from grammarc.errors import ChunkTooLarge, LimitError, LotFailure
 from grammarc.geometry import components as comp_kernels
@@ -148,6 +148,8 @@ class Executor:
                 cursor = self.center(op, cursor, base)
             elif isinstance(op, ir.AlignScope):
                 cursor = self.align_scope(op, cursor, symbol)
+            elif isinstance(op, ir.Mirror):
+                cursor = self.mirror(op, cursor)
             elif isinstance(op, ir.UseAsset):
                 cursor = self.use_asset(op, cursor, symbol)
             elif isinstance(op, ir.SetAttr):
@@ -535,6 +537,38 @@ class Executor:
             return np.stack([x, normal, np.cross(x, normal)], axis=1)
         return np.stack([x, np.cross(normal, x), normal], axis=1)
 
+    def mirror(self, op: ir.Mirror, cursor: Shapes) -> Shapes:
+        """Mirror the geometry inside its scope: assets flip (a bit of their geometry code), polygons
+        are stored flipped with their rings reversed (so they still wind around their normal); a scope
+        box is its own mirror image."""
+        env = self.env(cursor)
+        flips = [np.broadcast_to(evaluate_array(f, env, dtype=bool), (len(cursor),)) for f in op.axes]
+        bits = flips[0] * 1 + flips[1] * 2 + flips[2] * 4
+        geom = cursor.geom.copy()
+        assets = (geom < -1) & (bits > 0)
+        if assets.any():
+            asset, mirrored = asset_of(geom[assets])
+            geom[assets] = asset_geom(asset, mirrored ^ bits[assets])
+        poly = np.flatnonzero((geom >= 0) & (bits > 0))
+        if len(poly):
+            store = self.chunk.polygons
+            coords, ring_offsets, poly_offsets = store.gather(geom[poly])
+            plane = store.plane[geom[poly]]
+            vertex_poly = np.repeat(np.repeat(np.arange(len(poly)), np.diff(poly_offsets)),
+                                    np.diff(ring_offsets))
+            a = np.where(plane == 0, 1, 0)[vertex_poly]  # the plane's in-plane axes
+            b = np.where(plane == 2, 1, 2)[vertex_poly]
+            shape_bits = bits[poly][vertex_poly]
+            flip_u = (shape_bits >> a) & 1
+            flip_v = (shape_bits >> b) & 1
+            coords = coords.copy()
+            coords[:, 0] = np.where(flip_u, 1.0 - coords[:, 0], coords[:, 0])
+            coords[:, 1] = np.where(flip_v, 1.0 - coords[:, 1], coords[:, 1])
+            once = (flip_u ^ flip_v).astype(bool)  # one flip turns the winding round
+            coords = np.where(once[:, None], comp_kernels.reverse_rings(coords, ring_offsets), coords)
+            geom[poly] = store.add(coords, ring_offsets, poly_offsets, plane)
+        return cursor.with_scope(cursor.origin, cursor.size, cursor.frame, geom)
+
     def use_asset(self, op: ir.UseAsset, cursor: Shapes, symbol: int) -> Shapes:
         """The geometry becomes the asset fitted to the scope (a cube is the scope box itself)."""
         if op.name is None:
@@ -549,7 +583,7 @@ class Executor:
                 name = list(self.plan.strings.ids)[int(names[np.flatnonzero(bad)[0]])]
                 self.fail(cursor, bad, f"`i` of `{name}`, which is not an asset of the grammar", symbol,
                           op.span)
-        geom = np.where(asset == 0, -1, -2 - asset).astype(np.int32)  # asset 0 is builtin:cube: a box
+        geom = np.where(asset == 0, -1, asset_geom(asset)).astype(np.int32)  # asset 0 is builtin:cube
         return cursor.with_scope(cursor.origin, cursor.size, cursor.frame, geom)
 
     def set_attr(self, op: ir.SetAttr, cursor: Shapes) -> Shapes:

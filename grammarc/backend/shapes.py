@@ -15,8 +15,8 @@ A ``Shapes`` batch holds, per shape:
 - ``dynamic`` tuple of (n,) arrays: the attributes that rules ``set`` (``Plan.dynamic`` numbers them),
   inherited by children.
 
-``geom`` < -1 means the shape's geometry is an inserted asset fitted to its scope (CityEngine's ``i()``):
-asset id = -2 - geom.
+``geom`` < -1 means the shape's geometry is an inserted asset fitted to its scope (CityEngine's ``i()``),
+possibly mirrored along scope axes (``mirror``): ``asset_geom`` and ``asset_of`` encode and decode it.
 """
 
 from __future__ import annotations
@@ -24,6 +24,17 @@ from __future__ import annotations
 from dataclasses import dataclass, replace
 
 import numpy as np
+
+
+def asset_geom(asset: np.ndarray, mirrored: np.ndarray | int = 0) -> np.ndarray:
+    """The ``geom`` code (int32) of asset ids, with mirror bits (1: x, 2: y, 4: z)."""
+    return (-2 - (np.asarray(asset, dtype=np.int64) * 8 + mirrored)).astype(np.int32)
+
+
+def asset_of(geom: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Asset ids and mirror bits of asset ``geom`` codes (< -1)."""
+    code = -2 - geom.astype(np.int64)
+    return code // 8, code % 8
 
 
 @dataclass(frozen=True, eq=False)

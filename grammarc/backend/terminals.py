@@ -19,7 +19,7 @@ import numpy as np
 
 from grammarc.backend.chunk import Chunk
 from grammarc.backend.kernels.scope import xforms
-from grammarc.backend.shapes import Shapes
+from grammarc.backend.shapes import Shapes, asset_of
 from grammarc.constants import TOL
 from grammarc.geometry.components import reverse_rings
 from grammarc.geometry.polygons import PLANE_AXES
@@ -37,11 +37,18 @@ def instance_xform(axes: np.ndarray, size: np.ndarray, origin: np.ndarray) -> np
     return xform
 
 
-def emit_instances(chunk: Chunk, shapes: Shapes, asset: int, symbol: int) -> None:
+def emit_instances(chunk: Chunk, shapes: Shapes, asset: int, symbol: int, mirrored: int = 0) -> None:
+    """Instances of ``asset`` on the scopes of ``shapes``; ``mirrored`` bits (1 x, 2 y, 4 z) flip the
+    asset along those scope axes (the column is negated and the origin moved to the far side)."""
     if not len(shapes):
         return
     out = chunk.outputs
-    out.xform.append(xforms(chunk.frames.data, shapes.frame, shapes.size, shapes.origin))
+    xform = xforms(chunk.frames.data, shapes.frame, shapes.size, shapes.origin)
+    for axis in range(3):
+        if mirrored >> axis & 1:
+            xform[:, :, 3] += xform[:, :, axis]
+            xform[:, :, axis] *= -1
+    out.xform.append(xform)
     out.asset.append(np.full(len(shapes), asset, dtype=np.int32))
     out.lot.append(shapes.lot.astype(np.int32))
     out.symbol.append(np.full(len(shapes), symbol, dtype=np.int32))
@@ -53,8 +60,9 @@ def emit_leaves(chunk: Chunk, shapes: Shapes, symbol: int) -> None:
         return
     assets = shapes.geom < -1
     if assets.any():
-        for asset in np.unique(-2 - shapes.geom[assets]):
-            emit_instances(chunk, shapes.take(shapes.geom == -2 - asset), int(asset), symbol)
+        for code in np.unique(shapes.geom[assets]):
+            asset, mirrored = asset_of(np.array([code]))
+            emit_instances(chunk, shapes.take(shapes.geom == code), int(asset[0]), symbol, int(mirrored[0]))
     box = shapes.geom == -1
     flat = shapes.size <= TOL.zero
     zeros = flat.sum(axis=1)

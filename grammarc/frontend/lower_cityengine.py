@@ -23,12 +23,14 @@ from grammarc.ir.traverse import rewrite_body, rewrite_expr, sub_bodies
 NOT_APPLIED = frozenset({
     "color", "texture", "setupProjection", "projectUV", "tileUV", "translateUV", "scaleUV", "rotateUV",
     "normalizeUV", "deleteUV", "reverseNormals", "print", "setNormals", "softenNormals", "label",
+    # the pivot only moves the model's own origin in an export; scope.t* stay relative to the lot
+    "setPivot",
 })
 #: CityEngine operations grammarc does not implement yet (the geometry and context issues bring most).
 UNSUPPORTED_OPS = frozenset({
     "offset", "setback", "shapeL", "shapeU", "shapeO", "innerRectangle", "innerPolygon", "convexify",
     "cleanupGeometry", "trim", "envelope", "roofGable", "roofHip", "roofShed", "roofPyramid",
-    "mirror", "mirrorScope", "setPivot",
+    "mirrorScope",
     "insertAlongUV", "scatter", "footprint", "tileUV", "splitArea", "inline", "resetGeometry", "taper",
     "primitiveCylinder", "primitiveSphere", "primitiveDisk", "primitiveCone", "primitiveQuad",
     "deleteHoles", "reduceGeometry", "rectify", "semiPolygon",
@@ -317,6 +319,11 @@ class Lowering(LoweringBase):
             return self.unsupported(f"r with {len(args)} arguments", span, "only r(x, y, z)")
         return ir.Rotate(tuple(self.expr(a) for a in args), span)
 
+    def op_mirror(self, op, args, span):
+        if not self.arity(op, args, (3,), span):
+            return ir.Empty(span)
+        return ir.Mirror(tuple(self.expr(a) for a in args), span)
+
     def op_align(self, op, args, span):
         if not args or (len(args) == 1 and isinstance(args[0], ir.Name) and args[0].name == "world.xyz"):
             return ir.AlignScope("world", None, span)
@@ -524,6 +531,7 @@ class Lowering(LoweringBase):
 
 
 _OPS = {
+    "mirror": Lowering.op_mirror,
     "alignScopeToAxes": Lowering.op_align,
     "alignScopeToGeometry": Lowering.op_align_geometry,
     "rotateScope": Lowering.op_rotate_scope,

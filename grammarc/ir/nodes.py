@@ -359,6 +359,14 @@ class AlignScope:
 
 
 @dataclass(frozen=True, slots=True)
+class Mirror:
+    """CityEngine ``mirror(x, y, z)``: mirror the geometry along the scope axes whose flag is true."""
+
+    axes: tuple[Expr, Expr, Expr]
+    span: Span = NO_SPAN
+
+
+@dataclass(frozen=True, slots=True)
 class Case:
     """``case c1: B1 case c2: B2 else: B`` inside a body: each shape runs the first branch that holds."""
 
@@ -448,7 +456,7 @@ class CompFaces:
 
 Op = (Symbol | Empty | Translate | Scale | Rotate | Push | Pop | Insert | Split | Repeat | Comp | Extrude
       | Center | UseAsset | Case | Stochastic | SetAttr | Report | NotApplied | GroupSplit | CompFaces
-      | AlignScope)
+      | AlignScope | Mirror)
 Body = tuple[Op, ...]
 
 

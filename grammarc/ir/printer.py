@@ -111,6 +111,8 @@ def print_op(op: ir.Op) -> str:
         return f"set({op.name}, {print_expr(op.value)})"
     if isinstance(op, ir.Report):
         return f"report({print_expr(op.key)}, {print_expr(op.value)})"
+    if isinstance(op, ir.Mirror):
+        return f"mirror({', '.join(print_expr(a) for a in op.axes)})"
     if isinstance(op, ir.AlignScope):
         if op.mode.startswith("geometry"):
             return f"alignScopeToGeometry({op.mode[-1]}Up, 0, {print_expr(op.angles[0])})"

@@ -91,6 +91,9 @@ def rewrite_op(op: ir.Op, fn: ExprFn) -> ir.Op:
     if isinstance(op, ir.Extrude):
         height = ex(op.height)
         return op if height is op.height else replace(op, height=height)
+    if isinstance(op, ir.Mirror):
+        axes = _tuple(op.axes, ex)
+        return op if axes is op.axes else replace(op, axes=axes)
     if isinstance(op, ir.AlignScope) and op.angles is not None:
         angles = _tuple(op.angles, ex)
         return op if angles is op.angles else replace(op, angles=angles)
@@ -186,6 +189,8 @@ def op_exprs(op: ir.Op) -> Iterator[ir.Expr]:
         yield op.name
     elif isinstance(op, ir.AlignScope) and op.angles is not None:
         yield from op.angles
+    elif isinstance(op, ir.Mirror):
+        yield from op.axes
     elif isinstance(op, ir.SetAttr):
         yield op.value
     elif isinstance(op, ir.Report):

@@ -455,7 +455,7 @@ def test_comp_faces_selectors(selectors):
     ("Lot --> shapeL(4, 4){ shape : A | remainder : NIL }", "shapeL", "shapeL"),
     ("Lot --> innerRectangle(scope){ shape : A | remainder : NIL }", "innerRectangle", "innerRectangle"),
     ("Lot --> primitiveCylinder(16, 1, 2)", "primitiveCylinder", "primitiveCylinder"),
-    ("Lot --> mirror(true, false, false) A", "mirror", "mirror"),
+    ("Lot --> mirrorScope(true, false, false) A", "mirrorScope", "mirrorScope"),
     ("Lot --> taper(4) A", "taper", "taper"),
     ("Lot --> comp(x){ all : A }", "comp(x)", "comp"),
     ("Lot --> comp(f){ street.front : A }", "comp(f) selector `street.front`", "street"),

@@ -73,6 +73,9 @@ def _check_op(op, check, param_types, diags) -> None:
             check(s.value, T.NUM, "a size")
     elif isinstance(op, ir.Extrude):
         check(op.height, T.NUM, "a height")
+    elif isinstance(op, ir.Mirror):
+        for e in op.axes:
+            check(e, T.BOOL, "a mirror flag")
     elif isinstance(op, ir.AlignScope) and op.angles is not None:
         for e in op.angles:
             check(e, T.NUM, "an angle")
