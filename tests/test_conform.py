@@ -200,15 +200,15 @@ def test_footprints_and_kit(tmp_path, monkeypatch):
 FOOTPRINTS = ["rect_30x20", "rect_12x8", "L_30x20", "U_40x30", "courtyard_40x40", "rotated_25x15",
               "triangle", "octagon"]
 #: The issue's targets that grammarc meets: (rpk, footprints, attributes). The records of the other
-#: combinations need operations of the geometry issue (offset, setback, polygon splits) or PRT's own
-#: random numbers (extrusion_rule with its default random height).
+#: combinations need operations of the geometry issue (offset, setback, envelope, convexify) or PRT's own
+#: random numbers (extrusion_rule with its default random height, reporting).
 PASSING = [
     ("extrude_color", FOOTPRINTS, {}),
     ("genattrs", FOOTPRINTS, {}),
     ("translateModel", FOOTPRINTS, {}),
     ("extrusion_rule", FOOTPRINTS, {"minBuildingHeight": 17, "maxBuildingHeight": 17}),
-    ("complexpatterns", ["rect_30x20", "rect_12x8", "rotated_25x15"], {}),
-    ("complexpatterns", ["rect_30x20", "rotated_25x15"], {"buildingH": 20}),
+    ("complexpatterns", FOOTPRINTS, {}),
+    ("complexpatterns", FOOTPRINTS, {"buildingH": 20}),
 ]
 
 

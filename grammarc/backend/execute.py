@@ -27,6 +27,7 @@ from grammarc.backend.shapes import Shapes, asset_geom, asset_of
 from grammarc.constants import TOL, Limits
 from grammarc.errors import ChunkTooLarge, LimitError, LotFailure
 from grammarc.geometry import components as comp_kernels
+from grammarc.geometry.clip import clip_to_slabs
 from grammarc.geometry.reframe import reframe
 from grammarc.ir import nodes as ir
 from grammarc.ragged import ragged_take
@@ -271,14 +272,16 @@ class Executor:
         shapes = cursor
         cell = np.zeros(len(cursor), dtype=np.int64)
         for level, axis in enumerate(op.axes):
-            self.check_splittable(shapes, axis, symbol, op.span)
             parent, step, pos, length = cut(shapes, level, axis)
+            parent, step, pos, length, _, geometry = self.clip(shapes, axis, parent, step, pos, length,
+                                                               np.zeros(len(parent), dtype=np.int64))
             cell = cell[parent] + step
             if level == len(op.axes) - 1:
                 shapes, offsets = self.grouped_children(shapes, axis, parent, cell, pos, length, op.site,
-                                                        len(op.parts))
+                                                        len(op.parts), geometry)
             else:
-                shapes = self.children(shapes, axis, parent, cell, pos, length, op.site)
+                shapes = self.children(shapes, axis, parent, cell, pos, length, op.site,
+                                       geometry=geometry)
         self.count(shapes, symbol, op.span)
         self.run_parts(op.parts, shapes, offsets, symbol)
 
@@ -298,23 +301,46 @@ class Executor:
                 "Raise the limit with --max-shapes N."
             )
 
-    def check_splittable(self, shapes: Shapes, axis: int, symbol: int, span) -> None:
-        """Polygons split only along their extrusion axis until the polygon geometry issue lands."""
-        poly = shapes.geom >= 0
-        if not poly.any():
-            return
-        plane = self.chunk.polygons.plane[shapes.geom[poly]]
-        bad = np.zeros(len(shapes), dtype=bool)
-        bad[np.flatnonzero(poly)[plane != axis]] = True
-        if bad.any():
-            self.fail(shapes, bad, f"splitting a non-rectangular polygon along {'XYZ'[axis]} is not "
-                      "supported yet (only along its extrusion axis)", symbol, span)
+    def clip(self, shapes: Shapes, axis: int, parent, step, pos, length, index):
+        """Children of polygons split across their plane become the pieces of the polygon in their slabs
+        (``geometry.clip``): empty ones go, a slab that cuts the polygon apart gives one child a piece.
+
+        Takes and returns the split's children as (parent, step, pos, length, index) arrays, and the
+        pieces' geometry for ``children`` (None when no child is a polygon split across its plane).
+        """
+        store = self.chunk.polygons
+        geom = shapes.geom[parent]
+        poly = np.flatnonzero(geom >= 0)
+        poly = poly[store.plane[geom[poly]] != axis]
+        if not len(poly):
+            return parent, step, pos, length, index, None
+        clipped = clip_to_slabs(store, geom[poly], shapes.size[parent[poly]], axis, pos[poly], length[poly])
+        whole = np.ones(len(parent), dtype=bool)
+        whole[poly] = False
+        rows = np.concatenate([np.flatnonzero(whole), poly[clipped.source]])
+        piece = np.concatenate([np.full(int(whole.sum()), -1), np.arange(len(clipped.source))])
+        order = np.lexsort((piece, rows))  # pieces take their child's place, in GEOS's order
+        rows, piece = rows[order], piece[order]
+        new_geom = np.full(len(clipped.source), -1, dtype=np.int32)
+        shaped = np.flatnonzero(~clipped.is_rect)
+        if len(shaped):
+            rings, poly_offsets = ragged_take(clipped.poly_offsets, shaped)
+            vertices, ring_offsets = ragged_take(clipped.ring_offsets, rings)
+            new_geom[shaped] = store.add(clipped.coords[vertices], ring_offsets, poly_offsets,
+                                         clipped.plane[shaped])
+        is_piece = piece >= 0
+        pos, length = pos[rows].copy(), length[rows].copy()
+        pos[is_piece] = clipped.low[piece[is_piece], axis]
+        length[is_piece] = clipped.extent[piece[is_piece], axis]
+        geometry = (is_piece, new_geom[piece], clipped.low[piece], clipped.extent[piece])
+        return parent[rows], step[rows], pos, length, index[rows], geometry
 
     def children(self, shapes: Shapes, axis: int, parent, index, pos, length, site: int,
-                 order=None) -> Shapes:
+                 order=None, geometry=None) -> Shapes:
         """Children of a split along ``axis``: the parent's scope moved by ``pos`` and cut to ``length``.
 
-        ``order`` (default: as given) picks and orders the children.
+        ``order`` (default: as given) picks and orders the children; ``geometry`` (from ``clip``) gives
+        the clipped pieces their own boxes and polygons.
         """
         if order is None:
             order = np.arange(len(parent))
@@ -322,6 +348,13 @@ class Executor:
             shapes.origin, shapes.size, shapes.key, shapes.frame, shapes.geom, shapes.lot, shapes.depth,
             self.chunk.frames.data, axis, order, parent, pos, length, site, index,
         )
+        if geometry is not None:
+            is_piece, piece_geom, low, extent = (g[order] for g in geometry)
+            rows = np.flatnonzero(is_piece)
+            axes = self.chunk.frames[frame[rows]]
+            origin[rows] = shapes.origin[parents[rows]] + np.einsum("ni,nij->nj", low[rows], axes)
+            size[rows] = extent[rows]
+            geom[rows] = piece_geom[rows]
         children = Shapes(origin, size, frame, geom, lot, key, depth,
                           tuple(p[parents] for p in shapes.params), tuple(d[parents] for d in shapes.dynamic))
         return self.with_context(children, "split", index[order], parents, len(shapes))
@@ -341,10 +374,10 @@ class Executor:
             dynamic[slots["comp.sel"]] = selector
         return replace(shapes, dynamic=tuple(dynamic))
 
-    def grouped_children(self, shapes, axis, parent, cell, pos, length, site, n_parts):
+    def grouped_children(self, shapes, axis, parent, cell, pos, length, site, n_parts, geometry=None):
         """``children`` ordered by body part (cell mod parts): each part's batch is then a slice."""
         order, offsets = group_by(cell % n_parts if n_parts > 1 else np.zeros_like(cell), n_parts)
-        return self.children(shapes, axis, parent, cell, pos, length, site, order), offsets
+        return self.children(shapes, axis, parent, cell, pos, length, site, order, geometry), offsets
 
     def run_parts(self, parts: tuple[ir.Body, ...], shapes: Shapes, offsets: np.ndarray, symbol) -> None:
         for i, body in enumerate(parts):
@@ -625,7 +658,6 @@ class Executor:
         if bad.any():
             self.fail(cursor, bad, f"`split` has a negative or NaN size ({_example(values, bad)})", symbol,
                       op.span)
-        self.check_splittable(cursor, op.axis, symbol, op.span)
         kind = np.array([_SIZE_KIND[s.kind] for s in op.sizes], dtype=np.int64)
         groups = np.array(op.groups, dtype=np.int64)
         if op.repeat:
@@ -633,8 +665,10 @@ class Executor:
         n_groups = int(groups.max()) + 1 if len(groups) else 0
         parent, part, pos, length, index = split_kernels.group_split(
             np.ascontiguousarray(cursor.size[:, op.axis]), values, kind, groups, n_groups, TOL.zero)
+        parent, part, pos, length, index, geometry = self.clip(cursor, op.axis, parent, part, pos, length,
+                                                               index)
         order, offsets = group_by(part, len(op.parts))
-        children = self.children(cursor, op.axis, parent, index, pos, length, op.site, order)
+        children = self.children(cursor, op.axis, parent, index, pos, length, op.site, order, geometry)
         self.count(children, symbol, op.span)
         self.run_parts(op.parts, children, offsets, symbol)
 
