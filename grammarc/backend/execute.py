@@ -14,6 +14,7 @@ from collections import defaultdict
 from dataclasses import replace
 
 import numpy as np
+import shapely
 
 from grammarc.backend import terminals
 from grammarc.backend.chunk import Chunk
@@ -27,7 +28,7 @@ from grammarc.backend.shapes import Shapes, asset_geom, asset_of
 from grammarc.constants import TOL, Limits
 from grammarc.errors import ChunkTooLarge, LimitError, LotFailure
 from grammarc.geometry import components as comp_kernels
-from grammarc.geometry.clip import clip_to_slabs
+from grammarc.geometry.clip import clip_to_slabs, fit_pieces, scope_polygons
 from grammarc.geometry.reframe import reframe
 from grammarc.ir import nodes as ir
 from grammarc.ragged import ragged_take
@@ -151,6 +152,8 @@ class Executor:
                 cursor = self.align_scope(op, cursor, symbol)
             elif isinstance(op, ir.Mirror):
                 cursor = self.mirror(op, cursor)
+            elif isinstance(op, ir.Offset):
+                cursor = self.offset(op, cursor, symbol)
             elif isinstance(op, ir.UseAsset):
                 cursor = self.use_asset(op, cursor, symbol)
             elif isinstance(op, ir.SetAttr):
@@ -672,8 +675,76 @@ class Executor:
         self.count(children, symbol, op.span)
         self.run_parts(op.parts, children, offsets, symbol)
 
+    def offset_pieces(self, distance: ir.Expr, cursor: Shapes, symbol: int, span):
+        """The inside and border pieces of each flat shape's polygon offset by ``distance``."""
+        bad = (cursor.size <= TOL.zero).sum(axis=1) != 1
+        if bad.any():
+            self.fail(cursor, bad, "`offset` of a solid is not supported yet (only of faces)", symbol, span)
+        store = self.chunk.polygons
+        geom = cursor.geom.copy()
+        rects = np.flatnonzero(geom < 0)
+        if len(rects):
+            plane = comp_kernels.rect_plane(cursor.size[rects], TOL.zero)
+            geom[rects] = store.add(np.concatenate([comp_kernels.RECT_RINGS[q] for q in plane]),
+                                    np.arange(0, 4 * len(rects) + 1, 4, dtype=np.int64),
+                                    np.arange(len(rects) + 1, dtype=np.int64), plane)
+        polygons = scope_polygons(store, geom, cursor.size)
+        d = evaluate_array(distance, self.env(cursor))
+        inset = shapely.buffer(polygons, d, join_style="mitre", mitre_limit=1e6)
+        border = shapely.difference(polygons, inset)
+        plane = store.plane[geom]
+        return fit_pieces(inset, plane, cursor.size), fit_pieces(border, plane, cursor.size)
+
+    def piece_shapes(self, cursor: Shapes, pieces, site: int) -> Shapes:
+        """Shapes of clipped or offset pieces: the parent's frame, the piece's box and polygon."""
+        child = cursor.take(pieces.source)
+        geom = np.full(len(pieces.source), -1, dtype=np.int32)
+        shaped = np.flatnonzero(~pieces.is_rect)
+        if len(shaped):
+            rings, poly_offsets = ragged_take(pieces.poly_offsets, shaped)
+            vertices, ring_offsets = ragged_take(pieces.ring_offsets, rings)
+            geom[shaped] = self.chunk.polygons.add(pieces.coords[vertices], ring_offsets, poly_offsets,
+                                                   pieces.plane[shaped])
+        origin = child.origin + np.einsum("ni,nij->nj", pieces.low, self.chunk.frames[child.frame])
+        index = _rank_within(pieces.source)
+        return Shapes(origin, pieces.extent, child.frame, geom, child.lot,
+                      child_keys(child.key, site, index), child.depth, child.params, child.dynamic)
+
+    def offset(self, op: ir.Offset, cursor: Shapes, symbol: int) -> Shapes:
+        """``offset(d, inside|border)``: the shape's face becomes its inset or the ring around it."""
+        inside, border = self.offset_pieces(op.distance, cursor, symbol, op.span)
+        pieces = inside if op.select == "inside" else border
+        several = np.bincount(pieces.source, minlength=len(cursor)) > 1
+        if several.any():
+            self.fail(cursor, several, "`offset` parts the face into pieces: several faces in one shape are "
+                      "not supported yet", symbol, op.span)
+        return self.piece_shapes(cursor, pieces, 0)
+
+    def offset_faces(self, op: ir.CompFaces, cursor: Shapes, symbol: int) -> None:
+        """``offset(d) comp(f){ inside: ... | border: ... }``: the offset's faces as components."""
+        inside, border = self.offset_pieces(op.offset, cursor, symbol, op.span)
+        shapes = Shapes.concat([self.piece_shapes(cursor, inside, op.site),
+                                self.piece_shapes(cursor, border, op.site + 1 << 20)])
+        kind = np.concatenate([np.zeros(len(inside.source), np.int64), np.ones(len(border.source), np.int64)])
+        parent = np.concatenate([inside.source, border.source])
+        order = np.argsort(parent, kind="stable")  # each parent's faces together: inside, then border
+        shapes, kind = shapes.take(order), kind[order]
+        names = ("inside", "border")
+        which = np.full(len(kind), len(op.selectors), dtype=np.int64)
+        for i in range(len(op.selectors) - 1, -1, -1):
+            selector = op.selectors[i]
+            which[(selector == "all") | (np.array(names)[kind] == selector)] = i
+        keep = which < len(op.selectors)
+        shapes, which = shapes.take(keep), which[keep]
+        self.count(shapes, symbol, op.span)
+        order, offsets = group_by(which, len(op.parts))
+        self.run_parts(op.parts, shapes.take(order), offsets, symbol)
+
     def comp_faces(self, op: ir.CompFaces, cursor: Shapes, symbol: int) -> None:
         """CityEngine ``comp(f|e|v)``: components to the first selector they match."""
+        if op.offset is not None:
+            self.offset_faces(op, cursor, symbol)
+            return
         bad = cursor.geom < -1
         if bad.any():
             self.fail(cursor, bad, "`comp` of an inserted asset is not supported yet", symbol, op.span)
@@ -782,6 +853,8 @@ def _face_masks(normal: np.ndarray) -> dict[str, np.ndarray]:
         "side": side, "vertical": vertical, "horizontal": horizontal,
         "aslant": ~vertical & ~horizontal & (y > 0), "nutant": ~vertical & ~horizontal & (y < 0),
         "all": np.ones(len(normal), dtype=bool),
+        # the faces an offset makes: a shape not offset has none
+        "inside": np.zeros(len(normal), dtype=bool), "border": np.zeros(len(normal), dtype=bool),
     }
     return masks
 

@@ -28,7 +28,7 @@ NOT_APPLIED = frozenset({
 })
 #: CityEngine operations grammarc does not implement yet (the geometry and context issues bring most).
 UNSUPPORTED_OPS = frozenset({
-    "offset", "setback", "shapeL", "shapeU", "shapeO", "innerRectangle", "innerPolygon", "convexify",
+    "setback", "shapeL", "shapeU", "shapeO", "innerRectangle", "innerPolygon", "convexify",
     "cleanupGeometry", "trim", "envelope", "roofGable", "roofHip", "roofShed", "roofPyramid",
     "mirrorScope",
     "insertAlongUV", "scatter", "footprint", "tileUV", "splitArea", "inline", "resetGeometry", "taper",
@@ -66,6 +66,14 @@ class FunctionDef:
     name: str
     params: tuple[str, ...]
     value: ir.Expr
+    span: Span
+
+
+@dataclass(frozen=True, slots=True)
+class PendingOffset:
+    """``offset(d)`` before the ``comp(f)`` that takes its inside and border faces."""
+
+    distance: ir.Expr
     span: Span
 
 
@@ -178,7 +186,33 @@ class Lowering(LoweringBase):
 
     # ------------------------------------------------------------------------------------------ bodies
     def body(self, meta, *items):
-        return tuple(items)
+        return self.fuse_offsets(items)
+
+    def fuse_offsets(self, items) -> ir.Body:
+        """``offset(d) comp(f){ inside: ... | border: ... }`` becomes one component split of the offset's
+        faces; an ``offset(d)`` that no such comp follows would need several faces in one shape."""
+        out: list = []
+        pending = None
+        for item in items:
+            if isinstance(item, PendingOffset):
+                pending = item
+                continue
+            if pending is not None and isinstance(item, ir.NotApplied):
+                out.append(item)
+                continue
+            if pending is not None:
+                if isinstance(item, ir.CompFaces) and item.kind == "f" and \
+                        set(item.selectors) <= ir.OFFSET_SELECTORS:
+                    item = replace(item, offset=pending.distance)
+                else:
+                    self.unsupported("offset(d) without comp(f){ inside | border } after it", pending.span,
+                                     "write offset(d, inside) or offset(d, border) for one face")
+                pending = None
+            out.append(item)
+        if pending is not None:
+            self.unsupported("offset(d) without comp(f){ inside | border } after it", pending.span,
+                             "write offset(d, inside) or offset(d, border) for one face")
+        return tuple(out)
 
     def case_block(self, meta, *branches):
         *cases, default = branches
@@ -319,6 +353,14 @@ class Lowering(LoweringBase):
             return self.unsupported(f"r with {len(args)} arguments", span, "only r(x, y, z)")
         return ir.Rotate(tuple(self.expr(a) for a in args), span)
 
+    def op_offset(self, op, args, span):
+        if len(args) == 1:
+            return PendingOffset(self.expr(args[0]), span)
+        if len(args) == 2 and isinstance(args[1], ir.Name) and args[1].name in ("inside", "border"):
+            return ir.Offset(self.expr(args[0]), args[1].name, span)
+        return self.unsupported("offset with these arguments", span,
+                                "offset(d), offset(d, inside), offset(d, border)")
+
     def op_mirror(self, op, args, span):
         if not self.arity(op, args, (3,), span):
             return ir.Empty(span)
@@ -433,9 +475,7 @@ class Lowering(LoweringBase):
             if part.size.kind is not ir.SizeKind.ABSOLUTE or not isinstance(value, ir.Name):
                 return self.unsupported("this comp selector", part.span)
             if value.name not in known:
-                if value.name in ("inside", "border"):
-                    why = "the faces `offset` makes: the polygon geometry issue"
-                elif kind == "f":
+                if kind == "f":
                     why = "street selectors come with the context issue" + suggest(value.name, known)
                 else:
                     why = f"comp({kind}) selects {', '.join(sorted(known))}"
@@ -531,6 +571,7 @@ class Lowering(LoweringBase):
 
 
 _OPS = {
+    "offset": Lowering.op_offset,
     "mirror": Lowering.op_mirror,
     "alignScopeToAxes": Lowering.op_align,
     "alignScopeToGeometry": Lowering.op_align_geometry,
@@ -548,7 +589,8 @@ _OPS = {
 }
 _SPLIT_OPS = frozenset({"split", "comp"})
 _COMP_SELECTORS = {
-    "f": ir.FACE_SELECTORS | {f"{frame}.{s}" for frame in ("object", "world") for s in ir.FACE_SELECTORS},
+    "f": ir.FACE_SELECTORS | ir.OFFSET_SELECTORS
+    | {f"{frame}.{s}" for frame in ("object", "world") for s in ir.FACE_SELECTORS},
     "e": ir.EDGE_SELECTORS,
     "v": ir.VERTEX_SELECTORS,
 }

@@ -42,6 +42,16 @@ class Clipped:
     plane: np.ndarray
 
 
+def scope_polygons(store: PolygonStore, geom: np.ndarray, size: np.ndarray) -> np.ndarray:
+    """Shapely polygons (m,) of store polygons ``geom`` in their scopes' units (u, v scaled by size)."""
+    plane = store.plane[geom]
+    rows = np.arange(len(geom))
+    coords, ring_offsets, poly_offsets = store.gather(geom)
+    vertex_poly = segment_of(poly_offsets)[segment_of(ring_offsets)]
+    scale = np.stack([size[rows, _A[plane]], size[rows, _B[plane]]], axis=1)
+    return _polygons(coords * scale[vertex_poly], ring_offsets, poly_offsets)
+
+
 def clip_to_slabs(store: PolygonStore, geom: np.ndarray, size: np.ndarray, axis: int, pos: np.ndarray,
                   length: np.ndarray) -> Clipped:
     """Clip the polygons ``geom`` (m,) of the children's parents to the children's slabs.
@@ -53,10 +63,7 @@ def clip_to_slabs(store: PolygonStore, geom: np.ndarray, size: np.ndarray, axis:
     a, b = _A[plane], _B[plane]
     rows = np.arange(len(geom))
     sa, sb = size[rows, a], size[rows, b]
-    coords, ring_offsets, poly_offsets = store.gather(geom)
-    vertex_poly = segment_of(poly_offsets)[segment_of(ring_offsets)]
-    scaled = coords * np.stack([sa, sb], axis=1)[vertex_poly]
-    polygons = _polygons(scaled, ring_offsets, poly_offsets)
+    polygons = scope_polygons(store, geom, size)
     along_a = axis == a
     big = np.maximum(sa, sb) + 1.0
     xmin = np.where(along_a, pos, -big)
@@ -64,10 +71,16 @@ def clip_to_slabs(store: PolygonStore, geom: np.ndarray, size: np.ndarray, axis:
     ymin = np.where(along_a, -big, pos)
     ymax = np.where(along_a, big, pos + length)
     pieces = shapely.intersection(polygons, shapely.box(xmin, ymin, xmax, ymax))
-    parts, source = shapely.get_parts(pieces, return_index=True)
+    return fit_pieces(pieces, plane, size)
+
+
+def fit_pieces(geometries: np.ndarray, plane: np.ndarray, size: np.ndarray) -> Clipped:
+    """Polygons (or multipolygons) in scope units, one per source row, as pieces with fitted boxes."""
+    parts, source = shapely.get_parts(geometries, return_index=True)
     keep = (shapely.get_type_id(parts) == shapely.GeometryType.POLYGON) & (
         shapely.area(parts) > TOL.area_floor)
     parts, source = parts[keep], source[keep]
+    a, b = _A[plane], _B[plane]
     part_plane = plane[source]
     # exteriors wind counter-clockwise around the plane's normal: clockwise in (u, v) for plane 1, whose
     # (x, z) axes make a left-handed pair with y

@@ -359,6 +359,16 @@ class AlignScope:
 
 
 @dataclass(frozen=True, slots=True)
+class Offset:
+    """CityEngine ``offset(d, inside|border)``: the face's polygon grown (d > 0) or shrunk (d < 0) with
+    mitred corners, keeping the inset (``inside``) or the ring around it (``border``)."""
+
+    distance: Expr
+    select: str
+    span: Span = NO_SPAN
+
+
+@dataclass(frozen=True, slots=True)
 class Mirror:
     """CityEngine ``mirror(x, y, z)``: mirror the geometry along the scope axes whose flag is true."""
 
@@ -437,6 +447,8 @@ FACE_SELECTORS = frozenset({
 })
 
 
+#: Selectors of the faces an ``offset`` makes.
+OFFSET_SELECTORS = frozenset({"inside", "border", "all"})
 #: Edge and vertex selectors of ``comp(e)`` and ``comp(v)``.
 EDGE_SELECTORS = frozenset({"vertical", "horizontal", "aslant", "all"})
 VERTEX_SELECTORS = frozenset({"all"})
@@ -452,11 +464,13 @@ class CompFaces:
     span: Span = NO_SPAN
     site: int = 0
     kind: str = "f"
+    #: ``offset(d) comp(f){ inside: ... | border: ... }``: the faces are the offset's inside and border.
+    offset: Expr | None = None
 
 
 Op = (Symbol | Empty | Translate | Scale | Rotate | Push | Pop | Insert | Split | Repeat | Comp | Extrude
       | Center | UseAsset | Case | Stochastic | SetAttr | Report | NotApplied | GroupSplit | CompFaces
-      | AlignScope | Mirror)
+      | AlignScope | Mirror | Offset)
 Body = tuple[Op, ...]
 
 

@@ -96,8 +96,11 @@ def print_op(op: ir.Op) -> str:
             group = g
         shown = [" | ".join(i) if i[0] != "{" else "{ " + " | ".join(i[1:]) + " }*" for i in items]
         return f"split({'xyz'[op.axis]}){{ {' | '.join(shown)} }}{'*' if op.repeat else ''}"
+    if isinstance(op, ir.Offset):
+        return f"offset({print_expr(op.distance)}, {op.select})"
     if isinstance(op, ir.CompFaces):
-        return f"comp({op.kind}){{ " + " | ".join(f"{s}: {print_body(b) or 'ε'}"
+        head = f"offset({print_expr(op.offset)}) " if op.offset is not None else ""
+        return head + f"comp({op.kind}){{ " + " | ".join(f"{s}: {print_body(b) or 'ε'}"
                                          for s, b in zip(op.selectors, op.parts)) + " }"
     if isinstance(op, (ir.Case, ir.Stochastic)):
         return _branches(op)

@@ -81,7 +81,11 @@ def rewrite_op(op: ir.Op, fn: ExprFn) -> ir.Op:
         return op if sizes is op.sizes and parts is op.parts else replace(op, sizes=sizes, parts=parts)
     if isinstance(op, ir.CompFaces):
         parts = _tuple(op.parts, lambda b: rewrite_body(b, fn))
-        return op if parts is op.parts else replace(op, parts=parts)
+        offset = ex(op.offset) if op.offset is not None else None
+        return op if parts is op.parts and offset is op.offset else replace(op, parts=parts, offset=offset)
+    if isinstance(op, ir.Offset):
+        distance = ex(op.distance)
+        return op if distance is op.distance else replace(op, distance=distance)
     if isinstance(op, (ir.Case, ir.Stochastic)):
         branches = _tuple(op.branches, lambda br: _branch(br, fn))
         default = rewrite_body(op.default, fn)
@@ -191,6 +195,10 @@ def op_exprs(op: ir.Op) -> Iterator[ir.Expr]:
         yield from op.angles
     elif isinstance(op, ir.Mirror):
         yield from op.axes
+    elif isinstance(op, ir.Offset):
+        yield op.distance
+    elif isinstance(op, ir.CompFaces) and op.offset is not None:
+        yield op.offset
     elif isinstance(op, ir.SetAttr):
         yield op.value
     elif isinstance(op, ir.Report):

@@ -18,7 +18,7 @@ from conftest import LOT_ZOO, make_lots
 
 from grammarc.build import BuildOptions, derive
 from grammarc.compiler import compile_grammar
-from grammarc.errors import UsageError
+from grammarc.errors import GrammarError, UsageError
 from grammarc.io.lots import lots_from_polygons
 
 VERSION = 'version "2022.0"\n'
@@ -523,3 +523,34 @@ def test_shape_queries(write):
     assert (t["nv_sum"], t["nf_sum"], t["nv3_sum"], t["nf3_sum"]) == (6, 1, 12, 8)
     assert t["ry_sum"] == pytest.approx(30) and t["len_sum"] == 4 and t["ox_sum"] == 0
     assert t["fr_sum"] == t["fr2_sum"] and 0 <= t["fr_sum"] < 1
+
+
+def test_offset_inside_and_border_faces(write):
+    """offset(-2) comp(f){ border | inside } on the L: a ring with an L-shaped hole and the inset L."""
+    r = run(write, "Lot --> offset(-2) comp(f){ border : B. | inside : I. }\n", [LOT_ZOO["concave_L"]])
+    mesh = r["mesh"]
+    names = list(r["symbols"][mesh.symbol])
+    assert sorted(zip(names, np.diff(mesh.face_offsets))) == [("B", 2), ("I", 1)]
+
+    def area(face):
+        import shapely
+
+        rings = [mesh.vertices[mesh.ring_offsets[k]:mesh.ring_offsets[k + 1]][:, [0, 2]]
+                 for k in range(mesh.face_offsets[face], mesh.face_offsets[face + 1])]
+        return shapely.Polygon(rings[0], rings[1:]).area
+
+    inside, border = area(names.index("I")), area(names.index("B"))
+    # the L of 400 m2 (arms 10 wide) shrunk by 2: arms 6 wide, 26 and 16 long
+    assert inside == pytest.approx(26 * 6 + 10 * 6, rel=1e-6)
+    assert inside + border == pytest.approx(400, rel=1e-6)
+
+
+def test_offset_inside_of_a_rectangle_stays_a_box_path_rectangle(write):
+    r = run(write, "Lot --> offset(-1, inside) extrude(2) X.\n", [rect(12, 8)])
+    np.testing.assert_allclose(np.diagonal(np.abs(r["xform"][0, :, :3])), [10, 2, 6])
+    np.testing.assert_allclose(r["xform"][0, :, 3], [1, 0, -7])
+
+
+def test_offset_without_its_comp_is_named(write):
+    with pytest.raises(GrammarError, match="offset\\(d\\) without comp"):
+        run(write, "Lot --> offset(-1) extrude(3)\n", [rect(12, 8)])

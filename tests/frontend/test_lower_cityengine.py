@@ -447,8 +447,8 @@ def test_comp_faces_selectors(selectors):
 
 
 @pytest.mark.parametrize("line, name, at", [
-    ("Lot --> offset(-2) Inner", "offset", "offset"),
-    ("Lot --> offset(-2, inside) Inner", "offset", "offset"),
+    ("Lot --> offset(-2) Inner", "offset(d) without comp(f){ inside | border } after it", "offset"),
+    ("Lot --> offset(-2, outside) Inner", "offset with these arguments", "offset"),
     ("Lot --> setback(3){ street.front : Garden | remainder : Building }", "setback", "setback"),
     ("Lot --> extrude(10) roofGable(30)", "roofGable", "roofGable"),
     ("Lot --> roofHip(30, 1) Roof", "roofHip", "roofHip"),
@@ -460,7 +460,6 @@ def test_comp_faces_selectors(selectors):
     ("Lot --> comp(x){ all : A }", "comp(x)", "comp"),
     ("Lot --> comp(f){ street.front : A }", "comp(f) selector `street.front`", "street"),
     ("Lot --> comp(f){ fornt : A }", "comp(f) selector `fornt`", "fornt"),
-    ("Lot --> comp(f){ inside : A }", "comp(f) selector `inside`", "inside"),
     ("Lot --> comp(e){ front : A }", "comp(e) selector `front`", "front"),
     ("Lot --> comp(f){ 0 : A }", "this comp selector", "0"),
     ("Lot --> comp(f){ { front : A }* }", "repeat group in comp", "{ front"),

@@ -73,6 +73,10 @@ def _check_op(op, check, param_types, diags) -> None:
             check(s.value, T.NUM, "a size")
     elif isinstance(op, ir.Extrude):
         check(op.height, T.NUM, "a height")
+    elif isinstance(op, ir.Offset):
+        check(op.distance, T.NUM, "an offset distance")
+    elif isinstance(op, ir.CompFaces) and op.offset is not None:
+        check(op.offset, T.NUM, "an offset distance")
     elif isinstance(op, ir.Mirror):
         for e in op.axes:
             check(e, T.BOOL, "a mirror flag")
