@@ -723,8 +723,9 @@ class Executor:
     def offset_faces(self, op: ir.CompFaces, cursor: Shapes, symbol: int) -> None:
         """``offset(d) comp(f){ inside: ... | border: ... }``: the offset's faces as components."""
         inside, border = self.offset_pieces(op.offset, cursor, symbol, op.span)
+        border_site = (op.site << 20) + 1  # another stream than the inside faces'
         shapes = Shapes.concat([self.piece_shapes(cursor, inside, op.site),
-                                self.piece_shapes(cursor, border, op.site + 1 << 20)])
+                                self.piece_shapes(cursor, border, border_site)])
         kind = np.concatenate([np.zeros(len(inside.source), np.int64), np.ones(len(border.source), np.int64)])
         parent = np.concatenate([inside.source, border.source])
         order = np.argsort(parent, kind="stable")  # each parent's faces together: inside, then border
