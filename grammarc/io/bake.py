@@ -54,6 +54,7 @@ import numpy as np
 from grammarc.errors import AssetError, UsageError
 from grammarc.io.assets import resolve_asset
 from grammarc.io.npz import MeshChunk, TerminalChunk
+from grammarc.io.obj import ObjError, read_obj
 from grammarc.ragged import fan_out, offsets_from_counts, segment_reduce
 
 if TYPE_CHECKING:
@@ -195,7 +196,21 @@ def load_asset(name: str, asset_roots: Sequence[str | os.PathLike] = ()) -> Asse
 
 @lru_cache(maxsize=64)
 def _load_file(path: Path, mtime_ns: int) -> AssetMesh:
-    """A file asset, cached by path and modification time (a city uses a few assets many times)."""
+    """A file asset, cached by path and modification time (a city uses a few assets many times).
+
+    OBJ files are read by ``io.obj`` (geometry only: their materials would need Pillow), their polygons
+    fanned into triangles; other formats go through trimesh.
+    """
+    if path.suffix.lower() == ".obj":
+        try:
+            vertices, polygons = read_obj(path.read_text(encoding="utf-8", errors="replace"), str(path))
+        except (OSError, ObjError) as error:
+            raise AssetError(f"cannot read asset `{path}`: {error}") from error
+        polygons = [f for f in polygons if len(f) >= 3 and (f >= 0).all() and (f < len(vertices)).all()]
+        sizes = np.array([len(f) for f in polygons], np.int64)
+        faces = np.concatenate([np.stack([np.full(len(f) - 2, f[0]), f[1:-1], f[2:]], axis=1)
+                                for f in polygons]) if polygons else np.zeros((0, 3), np.int64)
+        return _frozen(_fitted(vertices), faces, sizes)
     import trimesh
 
     try:
@@ -204,29 +219,19 @@ def _load_file(path: Path, mtime_ns: int) -> AssetMesh:
         raise AssetError(f"cannot read asset `{path}`: {error}") from error
     vertices = np.asarray(getattr(mesh, "vertices", np.zeros((0, 3))), np.float64).reshape(-1, 3)
     faces = np.asarray(getattr(mesh, "faces", np.zeros((0, 3))), np.int64).reshape(-1, 3)
-    if len(vertices):
-        low, high = vertices.min(axis=0), vertices.max(axis=0)
-        extent = high - low
-        flat = extent <= _FLAT * max(1.0, float(np.abs(vertices).max()))
-        scale = np.divide(1.0, extent, out=np.zeros(3), where=~flat)  # a flat axis maps to 0
-        vertices = (vertices - low) * scale
-    if path.suffix.lower() == ".obj":
-        sizes = _obj_polygon_sizes(path)
-    else:
-        sizes = np.full(len(faces), 3, np.int64)
-    return _frozen(vertices, faces, sizes)
+    return _frozen(_fitted(vertices), faces, np.full(len(faces), 3, np.int64))
 
 
-def _obj_polygon_sizes(path: Path) -> np.ndarray:
-    """(p,) int64: the vertex count of each ``f`` line of an OBJ file (faces of fewer than 3 skipped)."""
-    sizes = []
-    with open(path, encoding="utf-8", errors="replace") as lines:
-        for line in lines:
-            if line.startswith(("f ", "f\t")):
-                n = len(line.split()) - 1
-                if n >= 3:
-                    sizes.append(n)
-    return np.array(sizes, np.int64)
+def _fitted(vertices: np.ndarray) -> np.ndarray:
+    """Vertices mapped from their bounding box onto [0, 1]^3, as CityEngine fits an asset to a scope;
+    a flat axis maps to 0."""
+    if not len(vertices):
+        return vertices
+    low, high = vertices.min(axis=0), vertices.max(axis=0)
+    extent = high - low
+    flat = extent <= _FLAT * max(1.0, float(np.abs(vertices).max()))
+    scale = np.divide(1.0, extent, out=np.zeros(3), where=~flat)  # a flat axis maps to 0
+    return (vertices - low) * scale
 
 
 def _quads_to_triangles(quads: np.ndarray) -> np.ndarray:

@@ -35,6 +35,7 @@ import shapely
 
 from grammarc.constants import TOL
 from grammarc.errors import LotsError
+from grammarc.io.obj import ObjError, read_obj
 from grammarc.ragged import offsets_from_counts, ragged_take, segment_reduce
 
 __all__ = ["BadLot", "Lots", "default_lot", "lots_from_polygons", "read_lots"]
@@ -366,29 +367,12 @@ def _parse_geojson(data) -> _Builder:
 
 def _parse_obj(text: str, path: Path) -> _Builder:
     """One lot per ``f`` line; ``v`` lines are world coordinates, every other line is ignored."""
-    points: list[list[float]] = []
-    faces: list[list[int]] = []
-    for number, line in enumerate(text.splitlines(), start=1):
-        fields = line.split()
-        if not fields or fields[0] not in ("v", "f"):
-            continue
-        try:
-            if fields[0] == "v":
-                point = [float(value) for value in fields[1:4]]
-                if len(point) != 3:
-                    raise ValueError("a vertex needs x y z")
-                points.append(point)
-            else:
-                # "i", "i/t", "i//n" or "i/t/n"; a negative i counts back from the last vertex read
-                indices = [int(token.split("/")[0]) for token in fields[1:]]
-                faces.append([i - 1 if i > 0 else len(points) + i for i in indices])
-        except ValueError as error:
-            message = f"{path}:{number}: bad {fields[0]!r} line: {line.strip()!r} ({error})"
-            raise LotsError(message) from error
-    vertices = np.array(points, dtype=np.float64).reshape(-1, 3)
+    try:
+        vertices, faces = read_obj(text, str(path))
+    except ObjError as error:
+        raise LotsError(str(error)) from error
     builder = _Builder(world=True)
     for k, face in enumerate(faces):
-        face = np.array(face, dtype=np.int64)
         if np.any((face < 0) | (face >= len(vertices))):
             builder.reject(k, f"face{k}", "vertex index out of range")
         else:
