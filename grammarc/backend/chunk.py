@@ -50,6 +50,8 @@ class Outputs:
     lot: list = field(default_factory=list)
     symbol: list = field(default_factory=list)
     meshes: list = field(default_factory=list)
+    #: (n, 4) uint8 colours beside ``asset``, when the grammar sets colours.
+    color: list = field(default_factory=list)
     #: ``report`` rows: (lot, key ids, values, kind) per call.
     reports: list = field(default_factory=list)
 
@@ -75,6 +77,9 @@ class Chunk:
     shape_count: np.ndarray | None = None
     #: The lots' root random keys (``fileRandom`` draws from them).
     lot_key: np.ndarray | None = None
+    #: Index of the colour column in ``Shapes.dynamic`` when the grammar sets colours (else no colours
+    #: are recorded and the record's rows are white).
+    color_slot: int | None = None
 
     def __post_init__(self) -> None:
         if self.shape_count is None:

@@ -18,7 +18,7 @@ from grammarc.backend.chunk import Chunk, Frames
 from grammarc.backend.evaluate import Env
 from grammarc.backend.execute import Executor
 from grammarc.backend.kernels.order import group_by, scatter_rows
-from grammarc.backend.plan import Plan
+from grammarc.backend.plan import COLOR_SLOT, WHITE_RGB, Plan
 from grammarc.backend.random import lot_keys
 from grammarc.backend.reports import aggregate_chunk
 from grammarc.backend.shapes import Shapes
@@ -58,6 +58,7 @@ def derive_chunk(plan: Plan, lots: Lots, *, seed: int, limits: Limits, overrides
     chunk.lot_key = shapes.key
     attribute_columns(plan.grammar.module, Env(shapes, chunk, plan), lots.attrs, overrides, plan.strings)
     shapes = replace(shapes, dynamic=tuple(initial_dynamic(plan, name, chunk, shapes) for name in plan.dynamic))
+    chunk.color_slot = plan.dynamic.get(COLOR_SLOT)
     executor = Executor(plan, chunk, limits, chunk_budget)
     executor.pending[plan.start].append(shapes)
     for stage in plan.stages:
@@ -76,6 +77,8 @@ def derive_chunk(plan: Plan, lots: Lots, *, seed: int, limits: Limits, overrides
 def initial_dynamic(plan: Plan, name: str, chunk: Chunk, shapes: Shapes) -> np.ndarray:
     """A lot's starting value of a per-shape column: its attribute, or the context of no split yet."""
     n = len(shapes)
+    if name == COLOR_SLOT:
+        return np.full(n, WHITE_RGB)
     if name == "comp.sel":
         return np.full(n, plan.strings.intern(""), dtype=np.int32)
     if name in ("split.total", "comp.total"):
@@ -98,8 +101,10 @@ def collect(chunk: Chunk) -> TerminalChunk:
     dest = np.empty_like(order)
     dest[order] = np.arange(len(order))
     columns = {}
-    for name, row_shape, dtype in (("asset", (), np.int32), ("xform", (3, 4), np.float32),
-                                   ("symbol", (), np.int32)):
+    names = [("asset", (), np.int32), ("xform", (3, 4), np.float32), ("symbol", (), np.int32)]
+    if out.color:
+        names.append(("color", (4,), np.uint8))
+    for name, row_shape, dtype in names:
         column = np.empty((len(lot), *row_shape), dtype=dtype)
         width = int(np.prod(row_shape))
         flat = column.reshape(len(lot), width)
@@ -113,9 +118,10 @@ def collect(chunk: Chunk) -> TerminalChunk:
     mesh = MeshChunk.concat(out.meshes) if out.meshes else MeshChunk.empty()
     if len(mesh.lot):
         mesh = _sort_mesh(mesh)
-    mesh = MeshChunk(mesh.vertices, mesh.ring_offsets, mesh.face_offsets, index[mesh.lot], mesh.symbol)
+    mesh = MeshChunk(mesh.vertices, mesh.ring_offsets, mesh.face_offsets, index[mesh.lot], mesh.symbol,
+                     mesh.color)
     return TerminalChunk(asset=columns["asset"], xform=columns["xform"], lot=index[lot[order]],
-                         symbol=columns["symbol"], mesh=mesh)
+                         symbol=columns["symbol"], mesh=mesh, color=columns.get("color"))
 
 
 def _sort_mesh(mesh: MeshChunk) -> MeshChunk:
@@ -123,4 +129,4 @@ def _sort_mesh(mesh: MeshChunk) -> MeshChunk:
     rings, face_offsets = ragged_take(mesh.face_offsets, order)
     vertices, ring_offsets = ragged_take(mesh.ring_offsets, rings)
     return MeshChunk(mesh.vertices[vertices], ring_offsets, face_offsets, mesh.lot[order],
-                     mesh.symbol[order])
+                     mesh.symbol[order], mesh.color[order] if mesh.color is not None else None)

@@ -22,7 +22,7 @@ from grammarc.backend.evaluate import Env, elementwise, evaluate, evaluate_array
 from grammarc.backend.kernels import scope as scope_kernels
 from grammarc.backend.kernels import split as split_kernels
 from grammarc.backend.kernels.order import group_by
-from grammarc.backend.plan import Plan, SymbolPlan, consumes
+from grammarc.backend.plan import COLOR_SLOT, Plan, SymbolPlan, consumes
 from grammarc.backend.random import child_keys, uniform
 from grammarc.backend.shapes import Shapes, asset_geom, asset_of
 from grammarc.constants import TOL, Limits
@@ -154,6 +154,8 @@ class Executor:
                 cursor = self.mirror(op, cursor)
             elif isinstance(op, ir.Offset):
                 cursor = self.offset(op, cursor, symbol)
+            elif isinstance(op, ir.SetColor):
+                cursor = self.set_color(op, cursor, symbol)
             elif isinstance(op, ir.UseAsset):
                 cursor = self.use_asset(op, cursor, symbol)
             elif isinstance(op, ir.SetAttr):
@@ -622,6 +624,27 @@ class Executor:
         geom = np.where(asset == 0, -1, asset_geom(asset)).astype(np.int32)  # asset 0 is builtin:cube
         return cursor.with_scope(cursor.origin, cursor.size, cursor.frame, geom)
 
+    def set_color(self, op: ir.SetColor, cursor: Shapes, symbol: int) -> Shapes:
+        """The shape's colour as 0xRRGGBB: from components in [0, 1], or parsed from "#rrggbb"."""
+        env = self.env(cursor)
+        n = len(cursor)
+        if len(op.values) == 3:
+            parts = [np.clip(np.round(np.broadcast_to(evaluate_array(v, env), (n,)) * 255), 0, 255)
+                     for v in op.values]
+            packed = parts[0] * 65536 + parts[1] * 256 + parts[2]
+        else:
+            ids = np.broadcast_to(evaluate_array(op.values[0], env, dtype=np.int32), (n,))
+            names = list(self.plan.strings.ids)
+            distinct, inverse = np.unique(ids, return_inverse=True)
+            packed = np.array([_hex_color(names[int(i)]) for i in distinct])[inverse.reshape(-1)]
+            bad = np.isnan(packed)
+            if bad.any():
+                text = names[int(ids[np.flatnonzero(bad)[0]])]
+                self.fail(cursor, bad, f'color("{text}") is not a colour "#rrggbb"', symbol, op.span)
+        index = self.plan.dynamic[COLOR_SLOT]
+        dynamic = cursor.dynamic[:index] + (packed.astype(np.float64),) + cursor.dynamic[index + 1:]
+        return replace(cursor, dynamic=dynamic)
+
     def set_attr(self, op: ir.SetAttr, cursor: Shapes) -> Shapes:
         index = self.plan.dynamic[op.name]
         column = cursor.dynamic[index]
@@ -773,6 +796,17 @@ class Executor:
         self.count(shapes, symbol, op.span)
         order, offsets = group_by(which, len(op.parts))
         self.run_parts(op.parts, shapes.take(order), offsets, symbol)
+
+
+def _hex_color(text: str) -> float:
+    """0xRRGGBB of "#rrggbb" (or "#rgb"), NaN when the text is no such colour."""
+    digits = text.strip().lstrip("#")
+    if len(digits) == 3:
+        digits = "".join(c * 2 for c in digits)
+    try:
+        return float(int(digits, 16)) if len(digits) == 6 else float("nan")
+    except ValueError:
+        return float("nan")
 
 
 def _rank_within(group: np.ndarray) -> np.ndarray:

@@ -11,6 +11,10 @@ from grammarc.compiler import Grammar
 from grammarc.ir import nodes as ir
 from grammarc.ir.traverse import iter_exprs, iter_ops, op_exprs
 
+#: The per-shape column of the colour set by ``color()``: 0xRRGGBB as a float (white to begin with).
+COLOR_SLOT = "#color"
+WHITE_RGB = float(0xFFFFFF)
+
 
 class Strings:
     """Interned strings: a string value in a column is an int32 id, compared by equality."""
@@ -78,8 +82,9 @@ def make_plan(grammar: Grammar) -> Plan:
     stages = tuple(sorted({s.priority for s in symbols if s.rules}))
     ops = [op for rule in module.rules for alt in rule.alternatives for op in iter_ops(alt.body)]
     context = [e.name for e in _all_exprs(module) if isinstance(e, ir.ContextRef)]
+    colour = [COLOR_SLOT] if any(isinstance(op, ir.SetColor) for op in ops) else []
     dynamic = {name: i for i, name in enumerate(dict.fromkeys(
-        [op.name for op in ops if isinstance(op, ir.SetAttr)] + sorted(set(context))))}
+        [op.name for op in ops if isinstance(op, ir.SetAttr)] + sorted(set(context)) + colour))}
     not_applied = tuple(sorted({op.name for op in ops if isinstance(op, ir.NotApplied)}))
     strings.intern("")
     for selector in ir.FACE_SELECTORS:

@@ -42,16 +42,29 @@ def emit_instances(chunk: Chunk, shapes: Shapes, asset: int, symbol: int, mirror
     asset along those scope axes (the column is negated and the origin moved to the far side)."""
     if not len(shapes):
         return
-    out = chunk.outputs
     xform = xforms(chunk.frames.data, shapes.frame, shapes.size, shapes.origin)
     for axis in range(3):
         if mirrored >> axis & 1:
             xform[:, :, 3] += xform[:, :, axis]
             xform[:, :, axis] *= -1
+    _append(chunk, shapes, xform, asset, symbol)
+
+
+def _append(chunk: Chunk, shapes: Shapes, xform: np.ndarray, asset: int, symbol: int) -> None:
+    out = chunk.outputs
     out.xform.append(xform)
     out.asset.append(np.full(len(shapes), asset, dtype=np.int32))
     out.lot.append(shapes.lot.astype(np.int32))
     out.symbol.append(np.full(len(shapes), symbol, dtype=np.int32))
+    if chunk.color_slot is not None:
+        out.color.append(rgba(shapes.dynamic[chunk.color_slot]))
+
+
+def rgba(packed: np.ndarray) -> np.ndarray:
+    """(n, 4) uint8 opaque colours from 0xRRGGBB values (n,) stored as floats."""
+    value = packed.astype(np.int64)
+    return np.stack([value >> 16 & 255, value >> 8 & 255, value & 255, np.full_like(value, 255)],
+                    axis=1).astype(np.uint8)
 
 
 def emit_leaves(chunk: Chunk, shapes: Shapes, symbol: int) -> None:
@@ -76,11 +89,7 @@ def emit_leaves(chunk: Chunk, shapes: Shapes, symbol: int) -> None:
         permuted_axes = axes[rows, cols]
         permuted_size = quads.size[rows, cols]
         permuted_size[:, 2] = 0.0
-        out = chunk.outputs
-        out.xform.append(instance_xform(permuted_axes, permuted_size, quads.origin))
-        out.asset.append(np.full(len(quads), QUAD, dtype=np.int32))
-        out.lot.append(quads.lot.astype(np.int32))
-        out.symbol.append(np.full(len(quads), symbol, dtype=np.int32))
+        _append(chunk, quads, instance_xform(permuted_axes, permuted_size, quads.origin), QUAD, symbol)
     polygons = shapes.take(shapes.geom >= 0)
     if len(polygons):
         chunk.outputs.meshes.append(polygon_meshes(chunk, polygons, symbol))
@@ -138,6 +147,7 @@ def polygon_meshes(chunk: Chunk, shapes: Shapes, symbol: int) -> MeshChunk:
         face_offsets=offsets_from_counts(rings_per_face),
         lot=shapes.lot[face_owner].astype(np.int32),
         symbol=np.full(len(face_owner), symbol, dtype=np.int32),
+        color=rgba(shapes.dynamic[chunk.color_slot][face_owner]) if chunk.color_slot is not None else None,
     )
 
 

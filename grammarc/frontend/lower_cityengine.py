@@ -21,7 +21,7 @@ from grammarc.ir.traverse import rewrite_body, rewrite_expr, sub_bodies
 
 #: Operations that are parsed and accepted but do not change the record (listed in its meta).
 NOT_APPLIED = frozenset({
-    "color", "texture", "setupProjection", "projectUV", "tileUV", "translateUV", "scaleUV", "rotateUV",
+    "texture", "setupProjection", "projectUV", "tileUV", "translateUV", "scaleUV", "rotateUV",
     "normalizeUV", "deleteUV", "reverseNormals", "print", "setNormals", "softenNormals", "label",
     # the pivot only moves the model's own origin in an export; scope.t* stay relative to the lot
     "setPivot",
@@ -353,6 +353,12 @@ class Lowering(LoweringBase):
             return self.unsupported(f"r with {len(args)} arguments", span, "only r(x, y, z)")
         return ir.Rotate(tuple(self.expr(a) for a in args), span)
 
+    def op_color(self, op, args, span):
+        if len(args) not in (1, 3, 4):
+            return self.unsupported(f"color with {len(args)} arguments", span,
+                                    'color(r, g, b) or color("#rrggbb")')
+        return ir.SetColor(tuple(self.expr(a) for a in args[:3]), span)
+
     def op_offset(self, op, args, span):
         if len(args) == 1:
             return PendingOffset(self.expr(args[0]), span)
@@ -571,6 +577,7 @@ class Lowering(LoweringBase):
 
 
 _OPS = {
+    "color": Lowering.op_color,
     "offset": Lowering.op_offset,
     "mirror": Lowering.op_mirror,
     "alignScopeToAxes": Lowering.op_align,

@@ -71,11 +71,13 @@ _SPOOLED = {
     "xform": ("<f4", (3, 4)),
     "lot": ("<i4", ()),
     "symbol": ("<i4", ()),
+    "color": ("|u1", (4,)),
     "mesh_vertices": ("<f4", (3,)),
     "mesh_ring_offsets": ("<i8", ()),
     "mesh_face_offsets": ("<i8", ()),
     "mesh_lot": ("<i4", ()),
     "mesh_symbol": ("<i4", ()),
+    "mesh_color": ("|u1", (4,)),
 }
 _OFFSETS = ("mesh_ring_offsets", "mesh_face_offsets")
 # The column written straight into the output, as its first member; the others are spooled.
@@ -83,9 +85,11 @@ _STREAMED = "xform"
 # Central directory order, the order of np.load(path).files: the record's table in DESIGN.md, then the mesh
 # table. In the file, xform comes first and the others follow in this order.
 _KEYS = (
-    "assets", "asset", "xform", "lot", "symbols", "symbol", "meta",
-    "mesh_vertices", "mesh_ring_offsets", "mesh_face_offsets", "mesh_lot", "mesh_symbol",
+    "assets", "asset", "xform", "lot", "symbols", "symbol", "color", "meta",
+    "mesh_vertices", "mesh_ring_offsets", "mesh_face_offsets", "mesh_lot", "mesh_symbol", "mesh_color",
 )  # fmt: skip
+#: Colour of rows that carry none: opaque white (RGBA).
+WHITE = np.array([255, 255, 255, 255], np.uint8)
 
 
 # eq=False: the generated __eq__ would compare arrays elementwise and fail on truth testing.
@@ -105,6 +109,8 @@ class MeshChunk:
         Lot of each face.
     symbol : (F,) int32
         Symbol of each face, an index into the writer's ``symbols``.
+    color : (F, 4) uint8, optional
+        RGBA colour of each face (CityEngine's ``color``); None: white.
     """
 
     vertices: np.ndarray
@@ -112,6 +118,13 @@ class MeshChunk:
     face_offsets: np.ndarray
     lot: np.ndarray
     symbol: np.ndarray
+    color: np.ndarray | None = None
+
+    def colors(self) -> np.ndarray:
+        """(F, 4) uint8: the faces' colours, white where none was given."""
+        if self.color is not None:
+            return self.color
+        return np.broadcast_to(WHITE, (len(self.lot), 4))
 
     @staticmethod
     def empty() -> MeshChunk:
@@ -122,6 +135,7 @@ class MeshChunk:
             face_offsets=np.zeros(1, np.int64),
             lot=np.zeros(0, np.int32),
             symbol=np.zeros(0, np.int32),
+            color=np.zeros((0, 4), np.uint8),
         )
 
     @staticmethod
@@ -138,6 +152,7 @@ class MeshChunk:
             face_offsets=_join_offsets([c.face_offsets for c in chunks], n_rings, n_faces),
             lot=np.concatenate([c.lot for c in chunks]),
             symbol=np.concatenate([c.symbol for c in chunks]),
+            color=np.concatenate([c.colors() for c in chunks]),
         )
 
 
@@ -166,6 +181,8 @@ class TerminalChunk:
         Index into the writer's ``symbols``: the shape's symbol when it became a terminal.
     mesh : MeshChunk
         Faces of this batch that are not instances.
+    color : (n, 4) uint8, optional
+        RGBA colour of each instance (CityEngine's ``color``); None: white.
     """
 
     asset: np.ndarray
@@ -173,6 +190,7 @@ class TerminalChunk:
     lot: np.ndarray
     symbol: np.ndarray
     mesh: MeshChunk
+    color: np.ndarray | None = None
 
 
 class InstanceWriter:
@@ -376,15 +394,18 @@ def _validate(chunk: TerminalChunk, n_assets: int, n_symbols: int) -> dict[str, 
         ("xform", "TerminalChunk.xform", chunk.xform),
         ("lot", "TerminalChunk.lot", chunk.lot),
         ("symbol", "TerminalChunk.symbol", chunk.symbol),
+        ("color", "TerminalChunk.color",
+         chunk.color if chunk.color is not None else np.broadcast_to(WHITE, (len(chunk.asset), 4))),
         ("mesh_vertices", "MeshChunk.vertices", chunk.mesh.vertices),
         ("mesh_ring_offsets", "MeshChunk.ring_offsets", chunk.mesh.ring_offsets),
         ("mesh_face_offsets", "MeshChunk.face_offsets", chunk.mesh.face_offsets),
         ("mesh_lot", "MeshChunk.lot", chunk.mesh.lot),
         ("mesh_symbol", "MeshChunk.symbol", chunk.mesh.symbol),
+        ("mesh_color", "MeshChunk.color", chunk.mesh.colors()),
     ):
         columns[key] = _column(field, value, *_SPOOLED[key])
     n = len(columns["asset"])
-    for key in ("xform", "lot", "symbol"):
+    for key in ("xform", "lot", "symbol", "color"):
         if len(columns[key]) != n:
             raise ValueError(f"TerminalChunk.{key}: {len(columns[key])} rows, asset has {n}")
     _check_offsets("MeshChunk.ring_offsets", columns["mesh_ring_offsets"], len(columns["mesh_vertices"]), 0)
@@ -392,7 +413,7 @@ def _validate(chunk: TerminalChunk, n_assets: int, n_symbols: int) -> dict[str, 
         "MeshChunk.face_offsets", columns["mesh_face_offsets"], len(columns["mesh_ring_offsets"]) - 1, 1
     )
     n_faces = len(columns["mesh_face_offsets"]) - 1
-    for key in ("mesh_lot", "mesh_symbol"):
+    for key in ("mesh_lot", "mesh_symbol", "mesh_color"):
         if len(columns[key]) != n_faces:
             raise ValueError(
                 f"MeshChunk.{key[5:]}: {len(columns[key])} rows, face_offsets has {n_faces} faces"

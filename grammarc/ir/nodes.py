@@ -359,6 +359,15 @@ class AlignScope:
 
 
 @dataclass(frozen=True, slots=True)
+class SetColor:
+    """CityEngine ``color(r, g, b)`` (0 to 1 each) or ``color("#rrggbb")``: the shape's colour, which its
+    instances and faces carry into the record."""
+
+    values: tuple[Expr, ...]
+    span: Span = NO_SPAN
+
+
+@dataclass(frozen=True, slots=True)
 class Offset:
     """CityEngine ``offset(d, inside|border)``: the face's polygon grown (d > 0) or shrunk (d < 0) with
     mitred corners, keeping the inset (``inside``) or the ring around it (``border``)."""
@@ -470,7 +479,7 @@ class CompFaces:
 
 Op = (Symbol | Empty | Translate | Scale | Rotate | Push | Pop | Insert | Split | Repeat | Comp | Extrude
       | Center | UseAsset | Case | Stochastic | SetAttr | Report | NotApplied | GroupSplit | CompFaces
-      | AlignScope | Mirror | Offset)
+      | AlignScope | Mirror | Offset | SetColor)
 Body = tuple[Op, ...]
 
 

@@ -96,6 +96,8 @@ def print_op(op: ir.Op) -> str:
             group = g
         shown = [" | ".join(i) if i[0] != "{" else "{ " + " | ".join(i[1:]) + " }*" for i in items]
         return f"split({'xyz'[op.axis]}){{ {' | '.join(shown)} }}{'*' if op.repeat else ''}"
+    if isinstance(op, ir.SetColor):
+        return f"color({', '.join(print_expr(v) for v in op.values)})"
     if isinstance(op, ir.Offset):
         return f"offset({print_expr(op.distance)}, {op.select})"
     if isinstance(op, ir.CompFaces):

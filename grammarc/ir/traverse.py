@@ -83,6 +83,9 @@ def rewrite_op(op: ir.Op, fn: ExprFn) -> ir.Op:
         parts = _tuple(op.parts, lambda b: rewrite_body(b, fn))
         offset = ex(op.offset) if op.offset is not None else None
         return op if parts is op.parts and offset is op.offset else replace(op, parts=parts, offset=offset)
+    if isinstance(op, ir.SetColor):
+        values = _tuple(op.values, ex)
+        return op if values is op.values else replace(op, values=values)
     if isinstance(op, ir.Offset):
         distance = ex(op.distance)
         return op if distance is op.distance else replace(op, distance=distance)
@@ -197,6 +200,8 @@ def op_exprs(op: ir.Op) -> Iterator[ir.Expr]:
         yield from op.axes
     elif isinstance(op, ir.Offset):
         yield op.distance
+    elif isinstance(op, ir.SetColor):
+        yield from op.values
     elif isinstance(op, ir.CompFaces) and op.offset is not None:
         yield op.offset
     elif isinstance(op, ir.SetAttr):

@@ -125,7 +125,8 @@ def test_the_same_text_lowers_in_the_dialect_asked_for():
     ('report("volume", geometry.volume()) A', 'report("volume", geometry.volume()) A'),
     ("split(z){ 1 : A | ~1 : B }", "split(z){ 1: A | ~1: B }"),
     ("comp(f){ front : A | side : B. | top : NIL }", "comp(f){ front: A | side: B. | top: \u03b5 }"),
-    ('color("#ff0000") A', "color(...) A"),
+    ('color("#ff0000") A', 'color("#ff0000") A'),
+    ("color(1, 0.5, 0) A", "color(1, 0.5, 0) A"),
     ('texture("brick.jpg") A', "texture(...) A"),
     ("setupProjection(0, scope.xy, ~1.5, ~1) projectUV(0) A", "setupProjection(...) projectUV(...) A"),
     ('print("h = " + h) A', "print(...) A"),
@@ -145,9 +146,9 @@ def test_operations_lower_to_their_nodes():
     module = module_of(VERSION + 'Lot --> extrude(3) center(x) alignScopeToAxes() i("builtin:cube") '
                        'color("#fff") set(h, 2) report("k", 1) comp(f){ all : A } \nattr h = 1\n')
     ops = list(iter_ops(module.rules[0].alternatives[0].body))
-    assert [type(op) for op in ops] == [ir.Extrude, ir.Center, ir.AlignScope, ir.UseAsset, ir.NotApplied,
+    assert [type(op) for op in ops] == [ir.Extrude, ir.Center, ir.AlignScope, ir.UseAsset, ir.SetColor,
                                         ir.SetAttr, ir.Report, ir.CompFaces, ir.Symbol]
-    assert ops[4].name == "color" and ops[7].selectors == ("all",)
+    assert ops[7].selectors == ("all",)
 
 
 def test_not_applied_operations_are_listed_for_the_meta(tmp_path):
@@ -155,7 +156,7 @@ def test_not_applied_operations_are_listed_for_the_meta(tmp_path):
     path.write_text(VERSION + 'Lot --> color(1, 0, 0) extrude(3) texture("a.jpg") tileUV(0, 1, 1) '
                     'print(scope.sx) set(material.opacity, 0.5) Mass.\n')
     assert make_plan(compile_grammar(path)).not_applied == (
-        "color", "print", "set(material.opacity)", "texture", "tileUV")
+        "print", "set(material.opacity)", "texture", "tileUV")
 
 
 def test_context_attributes_lower_to_context_refs():
@@ -560,4 +561,4 @@ def test_building_fixture_lowers_every_construct():
     height = next(a for a in module.attrs if a.name == "height")
     assert ("Range", ("min=3", "max=30", "restricted=false")) in height.annotations
     assert grammar.assets == ("builtin:cube", "builtin:quad", "assets/window.obj")
-    assert make_plan(grammar).not_applied == ("color", "print", "projectUV", "setupProjection", "texture")
+    assert make_plan(grammar).not_applied == ("print", "projectUV", "setupProjection", "texture")

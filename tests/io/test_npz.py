@@ -22,8 +22,8 @@ from grammarc.io.npz import InstanceWriter, MeshChunk, TerminalChunk, read_insta
 ASSETS = ["builtin:cube", "builtin:quad", "facade/window.obj"]
 SYMBOLS = ["Wall", "Window", "Roof", "Ledge"]
 KEYS = {
-    "assets", "asset", "xform", "lot", "symbols", "symbol", "meta",
-    "mesh_vertices", "mesh_ring_offsets", "mesh_face_offsets", "mesh_lot", "mesh_symbol",
+    "assets", "asset", "xform", "lot", "symbols", "symbol", "color", "meta",
+    "mesh_vertices", "mesh_ring_offsets", "mesh_face_offsets", "mesh_lot", "mesh_symbol", "mesh_color",
 }  # fmt: skip
 
 
@@ -227,11 +227,13 @@ def test_zero_chunks_give_empty_arrays(tmp_path):
         "xform": (np.float32, (0, 3, 4)),
         "lot": (np.int32, (0,)),
         "symbol": (np.int32, (0,)),
+        "color": (np.uint8, (0, 4)),
         "mesh_vertices": (np.float32, (0, 3)),
         "mesh_ring_offsets": (np.int64, (1,)),
         "mesh_face_offsets": (np.int64, (1,)),
         "mesh_lot": (np.int32, (0,)),
         "mesh_symbol": (np.int32, (0,)),
+        "mesh_color": (np.uint8, (0, 4)),
     }
     for key, (dtype, shape) in expected.items():
         assert (record[key].dtype, record[key].shape) == (np.dtype(dtype), shape), key
@@ -608,3 +610,22 @@ def test_memory_stays_bounded_with_fresh_chunks(tmp_path):
         assert record["xform"].shape == (n_chunks * rows, 3, 4)
         np.testing.assert_array_equal(record["xform"][-rows:], template.xform + n_chunks - 1)
         np.testing.assert_array_equal(record["lot"][::rows], np.arange(n_chunks))
+
+
+
+def test_colours_default_to_white_and_round_trip(tmp_path):
+    rng = np.random.default_rng(5)
+    plain = random_chunk(rng, 4, 2)
+    coloured = TerminalChunk(plain.asset, plain.xform, plain.lot, plain.symbol,
+                             MeshChunk(*(getattr(plain.mesh, f) for f in ("vertices", "ring_offsets",
+                                                                          "face_offsets", "lot", "symbol")),
+                                       color=np.full((len(plain.mesh.lot), 4), 7, np.uint8)),
+                             color=np.tile(np.array([[1, 2, 3, 255]], np.uint8), (4, 1)))
+    with InstanceWriter(tmp_path / "c.npz", assets=ASSETS, symbols=SYMBOLS, meta={}) as writer:
+        writer.write(plain)
+        writer.write(coloured)
+    record = read_instances(tmp_path / "c.npz")
+    assert record["color"][:4].tolist() == [[255, 255, 255, 255]] * 4
+    assert record["color"][4:].tolist() == [[1, 2, 3, 255]] * 4
+    n = len(plain.mesh.lot)
+    assert (record["mesh_color"][:n] == 255).all() and (record["mesh_color"][n:] == 7).all()

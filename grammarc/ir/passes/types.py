@@ -75,6 +75,10 @@ def _check_op(op, check, param_types, diags) -> None:
         check(op.height, T.NUM, "a height")
     elif isinstance(op, ir.Offset):
         check(op.distance, T.NUM, "an offset distance")
+    elif isinstance(op, ir.SetColor):
+        want = T.STR if len(op.values) == 1 else T.NUM
+        for v in op.values:
+            check(v, want, "a colour" if want is T.STR else "a colour component")
     elif isinstance(op, ir.CompFaces) and op.offset is not None:
         check(op.offset, T.NUM, "an offset distance")
     elif isinstance(op, ir.Mirror):
