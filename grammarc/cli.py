@@ -1,4 +1,5 @@
-"""The ``grammarc`` command: ``build`` derives a city, ``check`` reports on a grammar.
+"""The ``grammarc`` command: ``build`` derives a city, ``check`` reports on a grammar, ``conform`` compares
+with Esri's PRT.
 
 Exit codes: 0 success; 1 a build failed (unreadable lots, a derivation limit reached); 2 the grammar has
 errors or the command line is wrong. Errors go to stderr; no output file is left by a failed build.
@@ -41,15 +42,18 @@ def _parser() -> argparse.ArgumentParser:
     sub = parser.add_subparsers(required=True, metavar="COMMAND")
 
     build = sub.add_parser("build", help="derive lots with a grammar and write instance records")
-    build.add_argument("grammar", type=Path, help="the grammar file (CGA shape, paper notation)")
-    build.add_argument("--emit", required=True, metavar="OUT", help="output file (.npz)")
+    build.add_argument("grammar", type=Path,
+                       help="the grammar: a .cga file (paper notation or CityEngine CGA) or a .rpk package")
+    build.add_argument("--emit", required=True, metavar="OUT",
+                       help="output file: .npz (instance record), or .obj/.ply/.stl/.glb (baked mesh)")
     build.add_argument("--lots", type=Path, metavar="PATH",
                        help="footprints: GeoJSON or OBJ (default: the lots beside the grammar, or one "
                             "30 x 20 m lot)")
     build.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
     build.add_argument("--attr", action="append", default=[], metavar="NAME=VALUE",
                        help="override an attribute for every lot (repeatable)")
-    build.add_argument("--start", metavar="SYMBOL", help="start symbol (default: the first rule's)")
+    build.add_argument("--start", metavar="SYMBOL",
+                       help="start symbol (default: @StartRule, else the first rule's)")
     build.add_argument("--chunk-size", type=_positive, default=4096, metavar="N",
                        help="at most N lots derived together (default 4096; fewer when lots make many "
                             "records); the output does not depend on it")
