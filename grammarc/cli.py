@@ -37,7 +37,7 @@ def main(argv: list[str] | None = None) -> int:
 
 
 def _parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(prog="grammarc", description=__doc__.splitlines()[0])
+    parser = argparse.ArgumentParser(prog="grammarc", description=" ".join(__doc__.split("\n\n")[0].split()))
     parser.add_argument("--version", action="version", version=f"grammarc {__version__}")
     sub = parser.add_subparsers(required=True, metavar="COMMAND")
 
