@@ -120,60 +120,29 @@ class Executor:
         for op in body:
             if not len(cursor):
                 return
-            if isinstance(op, ir.Symbol):
-                self.successor(op, cursor, symbol)
-            elif isinstance(op, ir.Translate):
-                cursor = self.translate(op, cursor)
-            elif isinstance(op, ir.Scale):
-                cursor = self.scale(op, cursor, symbol)
-            elif isinstance(op, ir.Rotate):
-                cursor = self.rotate(op, cursor)
-            elif isinstance(op, ir.Push):
+            if isinstance(op, ir.Push):
                 # the whole shape: its scope, its geometry and the attributes `set` gives it
                 stack.append((cursor, base))
                 base = (cursor.origin, cursor.size, cursor.frame)
             elif isinstance(op, ir.Pop):
                 if stack:
                     cursor, base = stack.pop()
-            elif isinstance(op, ir.Insert):
-                asset = self.plan.grammar.asset_ids[op.asset]
-                terminals.emit_instances(self.chunk, cursor, asset, symbol)
-            elif isinstance(op, ir.Split):
-                self.split(op, cursor, symbol)
-            elif isinstance(op, ir.Repeat):
-                self.repeat(op, cursor, symbol)
-            elif isinstance(op, ir.Comp):
-                self.comp(op, cursor, symbol)
-            elif isinstance(op, ir.Extrude):
-                cursor = self.extrude(op, cursor, symbol)
             elif isinstance(op, ir.Center):
                 cursor = self.center(op, cursor, base)
-            elif isinstance(op, ir.AlignScope):
-                cursor = self.align_scope(op, cursor, symbol)
-            elif isinstance(op, ir.Mirror):
-                cursor = self.mirror(op, cursor)
-            elif isinstance(op, ir.Offset):
-                cursor = self.offset(op, cursor, symbol)
-            elif isinstance(op, ir.SetColor):
-                cursor = self.set_color(op, cursor, symbol)
-            elif isinstance(op, ir.UseAsset):
-                cursor = self.use_asset(op, cursor, symbol)
-            elif isinstance(op, ir.SetAttr):
-                cursor = self.set_attr(op, cursor)
-            elif isinstance(op, ir.Report):
-                self.report(op, cursor)
-            elif isinstance(op, (ir.Case, ir.Stochastic)):
-                self.branch(op, cursor, symbol)
-            elif isinstance(op, ir.GroupSplit):
-                self.group_split(op, cursor, symbol)
-            elif isinstance(op, ir.CompFaces):
-                self.comp_faces(op, cursor, symbol)
-            elif isinstance(op, (ir.Empty, ir.NotApplied)):
-                pass
             else:
-                raise TypeError(f"unknown operation {op!r}")
+                # an operation either makes shapes (returns None) or changes the cursor (returns it)
+                changed = _OPERATIONS[type(op)](self, op, cursor, symbol)
+                if changed is not None:
+                    cursor = changed
         if leaf_at_end and self.plan.leaf_bodies and len(cursor) and not consumes(body):
             terminals.emit_leaves(self.chunk, cursor, symbol)
+
+    def insert(self, op: ir.Insert, cursor: Shapes, symbol: int) -> None:
+        """The paper's ``I(name)``: an instance of the asset on the scope."""
+        terminals.emit_instances(self.chunk, cursor, self.plan.grammar.asset_ids[op.asset], symbol)
+
+    def nothing(self, op: ir.Empty | ir.NotApplied, cursor: Shapes, symbol: int) -> None:
+        """``ε``, ``NIL``, and operations without effect on the record."""
 
     def successor(self, op: ir.Symbol, cursor: Shapes, symbol: int) -> None:
         sym = self.plan.symbols[self.plan.symbol_ids[op.name]]
@@ -190,7 +159,7 @@ class Executor:
         else:
             self.pending[sym.id].append(shapes)
 
-    def translate(self, op: ir.Translate, cursor: Shapes) -> Shapes:
+    def translate(self, op: ir.Translate, cursor: Shapes, symbol: int) -> Shapes:
         env = self.env(cursor)
         local = np.stack([evaluate_array(e, env) for e in op.vector], axis=1)
         delta = np.einsum("ni,nij->nj", local, self.chunk.frames[cursor.frame])
@@ -208,7 +177,7 @@ class Executor:
                       op.span)
         return cursor.with_scope(cursor.origin, size, cursor.frame, cursor.geom)
 
-    def rotate(self, op: ir.Rotate, cursor: Shapes) -> Shapes:
+    def rotate(self, op: ir.Rotate, cursor: Shapes, symbol: int) -> Shapes:
         env = self.env(cursor)
         angles = [evaluate(e, env) for e in op.angles]
         frames = self.chunk.frames
@@ -575,7 +544,7 @@ class Executor:
             return np.stack([x, normal, np.cross(x, normal)], axis=1)
         return np.stack([x, np.cross(normal, x), normal], axis=1)
 
-    def mirror(self, op: ir.Mirror, cursor: Shapes) -> Shapes:
+    def mirror(self, op: ir.Mirror, cursor: Shapes, symbol: int) -> Shapes:
         """Mirror the geometry inside its scope: assets flip (a bit of their geometry code), polygons
         are stored flipped with their rings reversed (so they still wind around their normal); a scope
         box is its own mirror image."""
@@ -645,7 +614,7 @@ class Executor:
         dynamic = cursor.dynamic[:index] + (packed.astype(np.float64),) + cursor.dynamic[index + 1:]
         return replace(cursor, dynamic=dynamic)
 
-    def set_attr(self, op: ir.SetAttr, cursor: Shapes) -> Shapes:
+    def set_attr(self, op: ir.SetAttr, cursor: Shapes, symbol: int) -> Shapes:
         index = self.plan.dynamic[op.name]
         column = cursor.dynamic[index]
         value = evaluate_array(op.value, self.env(cursor), dtype=column.dtype)
@@ -653,7 +622,7 @@ class Executor:
         return Shapes(cursor.origin, cursor.size, cursor.frame, cursor.geom, cursor.lot, cursor.key,
                       cursor.depth, cursor.params, dynamic)
 
-    def report(self, op: ir.Report, cursor: Shapes) -> None:
+    def report(self, op: ir.Report, cursor: Shapes, symbol: int) -> None:
         env = self.env(cursor)
         key = evaluate_array(op.key, env, dtype=np.int32)
         value = evaluate(op.value, env)
@@ -796,6 +765,19 @@ class Executor:
         self.count(shapes, symbol, op.span)
         order, offsets = group_by(which, len(op.parts))
         self.run_parts(op.parts, shapes.take(order), offsets, symbol)
+
+
+#: Operation type -> the Executor method that runs it (``[``, ``]`` and ``center`` are handled in ``run``).
+_OPERATIONS = {
+    ir.Symbol: Executor.successor, ir.Translate: Executor.translate, ir.Scale: Executor.scale,
+    ir.Rotate: Executor.rotate, ir.Insert: Executor.insert, ir.Split: Executor.split,
+    ir.Repeat: Executor.repeat, ir.Comp: Executor.comp, ir.Extrude: Executor.extrude,
+    ir.AlignScope: Executor.align_scope, ir.Mirror: Executor.mirror, ir.Offset: Executor.offset,
+    ir.SetColor: Executor.set_color, ir.UseAsset: Executor.use_asset, ir.SetAttr: Executor.set_attr,
+    ir.Report: Executor.report, ir.Case: Executor.branch, ir.Stochastic: Executor.branch,
+    ir.GroupSplit: Executor.group_split, ir.CompFaces: Executor.comp_faces, ir.Empty: Executor.nothing,
+    ir.NotApplied: Executor.nothing,
+}
 
 
 def _hex_color(text: str) -> float:
