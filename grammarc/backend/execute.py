@@ -29,7 +29,9 @@ from grammarc.constants import TOL, Limits
 from grammarc.errors import ChunkTooLarge, LimitError, LotFailure
 from grammarc.geometry import components as comp_kernels
 from grammarc.geometry.clip import clip_to_slabs, fit_pieces, scope_polygons
+from grammarc.geometry.polygons import PLANE_U, PLANE_V
 from grammarc.geometry.reframe import reframe
+from grammarc.geometry.setback import polygon_edges, setback_regions
 from grammarc.ir import nodes as ir
 from grammarc.ragged import ragged_take
 
@@ -667,11 +669,11 @@ class Executor:
         self.count(children, symbol, op.span)
         self.run_parts(op.parts, children, offsets, symbol)
 
-    def offset_pieces(self, distance: ir.Expr, cursor: Shapes, symbol: int, span):
-        """The inside and border pieces of each flat shape's polygon offset by ``distance``."""
+    def face_polygons(self, cursor: Shapes, what: str, symbol: int, span) -> tuple[np.ndarray, np.ndarray]:
+        """Shapely polygons (m,) of flat shapes in their scope units, and each one's plane (m,)."""
         bad = (cursor.size <= TOL.zero).sum(axis=1) != 1
         if bad.any():
-            self.fail(cursor, bad, "`offset` of a solid is not supported yet (only of faces)", symbol, span)
+            self.fail(cursor, bad, f"`{what}` of a solid is not supported yet (only of faces)", symbol, span)
         store = self.chunk.polygons
         geom = cursor.geom.copy()
         rects = np.flatnonzero(geom < 0)
@@ -680,11 +682,14 @@ class Executor:
             geom[rects] = store.add(np.concatenate([comp_kernels.RECT_RINGS[q] for q in plane]),
                                     np.arange(0, 4 * len(rects) + 1, 4, dtype=np.int64),
                                     np.arange(len(rects) + 1, dtype=np.int64), plane)
-        polygons = scope_polygons(store, geom, cursor.size)
+        return scope_polygons(store, geom, cursor.size), store.plane[geom]
+
+    def offset_pieces(self, distance: ir.Expr, cursor: Shapes, symbol: int, span):
+        """The inside and border pieces of each flat shape's polygon offset by ``distance``."""
+        polygons, plane = self.face_polygons(cursor, "offset", symbol, span)
         d = evaluate_array(distance, self.env(cursor))
         inset = shapely.buffer(polygons, d, join_style="mitre", mitre_limit=1e6)
         border = shapely.difference(polygons, inset)
-        plane = store.plane[geom]
         return fit_pieces(inset, plane, cursor.size), fit_pieces(border, plane, cursor.size)
 
     def piece_shapes(self, cursor: Shapes, pieces, site: int) -> Shapes:
@@ -711,6 +716,45 @@ class Executor:
             self.fail(cursor, several, "`offset` parts the face into pieces: several faces in one shape are "
                       "not supported yet", symbol, op.span)
         return self.piece_shapes(cursor, pieces, 0)
+
+    def setback(self, op: ir.Setback, cursor: Shapes, symbol: int) -> None:
+        """``setback`` and ``shapeL/U/O``: the face's edge strips and its remainder to their parts."""
+        polygons, plane = self.face_polygons(cursor, "setback", symbol, op.span)
+        edges = polygon_edges(polygons)
+        m = len(cursor)
+        normal = np.zeros((len(edges.poly), 3))
+        rows = np.arange(len(edges.poly))
+        normal[rows, PLANE_U[plane[edges.poly]]] = -edges.inward[:, 0]
+        normal[rows, PLANE_V[plane[edges.poly]]] = -edges.inward[:, 1]
+        frames = self.selector_frames(normal, cursor, edges.poly, (*op.selectors, *(s for s, _ in op.distances)))
+        env = self.env(cursor)
+        table = np.zeros((len(op.distances) + 1, m))
+        for k, (_, expr) in enumerate(op.distances):
+            table[k] = evaluate_array(expr, env)
+        distance = table[classify_faces(normal, tuple(s for s, _ in op.distances), frames), edges.poly]
+        owners = tuple(s for s in op.selectors if s != "remainder")
+        regions, remainder = setback_regions(polygons, edges, distance,
+                                             classify_faces(normal, owners, frames), len(owners))
+        by_owner = dict(zip(owners, regions))
+        pieces = [fit_pieces(by_owner[s] if s != "remainder" else remainder, plane, cursor.size)
+                  for s in op.selectors]
+        shapes = Shapes.concat([self.piece_shapes(cursor, p, (op.site << 20) + k) for k, p in enumerate(pieces)])
+        kind = np.concatenate([np.full(len(p.source), k, dtype=np.int64) for k, p in enumerate(pieces)])
+        parent = np.concatenate([p.source for p in pieces])
+        order = np.argsort(parent, kind="stable")  # each parent's pieces together, in selector order
+        shapes, kind = shapes.take(order), kind[order]
+        self.count(shapes, symbol, op.span)
+        order, offsets = group_by(kind, len(op.parts))
+        self.run_parts(op.parts, shapes.take(order), offsets, symbol)
+
+    def selector_frames(self, normal: np.ndarray, cursor: Shapes, parent: np.ndarray,
+                        selectors) -> dict | None:
+        """Normals (m, 3) in the world's and the lot's frames when a selector names them (``world.``)."""
+        if not any("." in s for s in selectors):
+            return None
+        world = np.einsum("mi,mij->mj", normal, self.chunk.frames[cursor.frame][parent])
+        lot = np.einsum("mj,mij->mi", world, self.chunk.lot_axes[cursor.lot[parent]])
+        return {"world": world, "object": lot}
 
     def offset_faces(self, op: ir.CompFaces, cursor: Shapes, symbol: int) -> None:
         """``offset(d) comp(f){ inside: ... | border: ... }``: the offset's faces as components."""
@@ -744,12 +788,8 @@ class Executor:
         kind = {"f": "faces", "e": "edges", "v": "vertices"}[op.kind]
         shapes, normal, _, parent = self.components(comp_kernels.KIND_CODES[kind], cursor, op.site)
         if op.kind == "f":
-            frames = None
-            if any("." in s for s in op.selectors):
-                world = np.einsum("mi,mij->mj", normal, self.chunk.frames[cursor.frame][parent])
-                lot = np.einsum("mj,mij->mi", world, self.chunk.lot_axes[cursor.lot[parent]])
-                frames = {"world": world, "object": lot}
-            which = classify_faces(normal, op.selectors, frames)
+            which = classify_faces(normal, op.selectors, self.selector_frames(normal, cursor, parent,
+                                                                                op.selectors))
         else:
             direction = self.chunk.frames[shapes.frame][:, 0] if op.kind == "e" else None
             which = classify_edges(direction, op.selectors, len(shapes))
@@ -776,7 +816,7 @@ _OPERATIONS = {
     ir.SetColor: Executor.set_color, ir.UseAsset: Executor.use_asset, ir.SetAttr: Executor.set_attr,
     ir.Report: Executor.report, ir.Case: Executor.branch, ir.Stochastic: Executor.branch,
     ir.GroupSplit: Executor.group_split, ir.CompFaces: Executor.comp_faces, ir.Empty: Executor.nothing,
-    ir.NotApplied: Executor.nothing,
+    ir.NotApplied: Executor.nothing, ir.Setback: Executor.setback,
 }
 
 

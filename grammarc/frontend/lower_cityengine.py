@@ -28,7 +28,7 @@ NOT_APPLIED = frozenset({
 })
 #: CityEngine operations grammarc does not implement yet (the geometry and context issues bring most).
 UNSUPPORTED_OPS = frozenset({
-    "setback", "shapeL", "shapeU", "shapeO", "innerRectangle", "innerPolygon", "convexify",
+    "innerRectangle", "innerPolygon", "convexify",
     "cleanupGeometry", "trim", "envelope", "roofGable", "roofHip", "roofShed", "roofPyramid",
     "mirrorScope",
     "insertAlongUV", "scatter", "footprint", "tileUV", "splitArea", "inline", "resetGeometry", "taper",
@@ -301,6 +301,9 @@ class Lowering(LoweringBase):
             return ir.NotApplied(op, span)
         if op in UNSUPPORTED_OPS or op in _SPLIT_OPS:
             return self.unsupported(op, span)
+        if op in _SETBACK_OPS:
+            return self.unsupported(f"{op} without selector parts", span,
+                                    f"write {op}(...) {{ ... | remainder: ... }}")
         return ir.Symbol(op, tuple(self.expr(a) for a in args), span, self.site())
 
     def split_call(self, meta, name, args, parts, star):
@@ -311,6 +314,10 @@ class Lowering(LoweringBase):
             if star is not None:
                 return self.unsupported("`*` after comp", self.token_span(star), "only split repeats")
             return self.op_comp(args, parts, span)
+        if op in _SETBACK_OPS:
+            if star is not None:
+                return self.unsupported(f"`*` after {op}", self.token_span(star), "only split repeats")
+            return self.op_setback(op, args, parts, span)
         return self.unsupported(op, span)
 
     def arity(self, op, args, counts, span) -> bool:
@@ -495,6 +502,38 @@ class Lowering(LoweringBase):
             bodies.append(part.body)
         return ir.CompFaces(tuple(selectors), tuple(bodies), span, self.site(), kind)
 
+    def op_setback(self, op, args, parts, span):
+        """``setback(d) { sel: A | remainder: B }``; ``shapeL/U/O(widths...) { shape: A | remainder: B }``."""
+        sides = _SETBACK_OPS[op]
+        if not self.arity(op, args, (len(sides) if sides else 1,), span):
+            return None
+        known = _SETBACK_SELECTORS if not sides else frozenset({"shape", "remainder"})
+        selectors, bodies = [], []
+        for part in parts:
+            if isinstance(part, Group):
+                return self.unsupported(f"repeat group in {op}", part.span)
+            value = part.size.value
+            if part.size.kind is not ir.SizeKind.ABSOLUTE or not isinstance(value, ir.Name):
+                return self.unsupported(f"this {op} selector", part.span)
+            if value.name not in known:
+                why = ("street selectors come with the context issue" if "treet" in value.name else
+                       f"{op} selects {', '.join(sorted(known - {'remainder'}))} and remainder")
+                return self.unsupported(f"{op} selector `{value.name}`", value.span,
+                                        why + suggest(value.name, known))
+            if part.merged:
+                self.diags.warning(
+                    "merged", f"`{value.name}=` gives one shape for all its polygons in CityEngine; grammarc "
+                    "derives them one by one (the same leaves; operations that read the scope differ)",
+                    part.span)
+            selectors.append("all" if value.name == "shape" else value.name)
+            bodies.append(part.body)
+        exprs = tuple(self.expr(a) for a in args)
+        if sides:
+            distances = tuple(zip(sides, exprs))
+        else:
+            distances = tuple((s, exprs[0]) for s in selectors if s != "remainder")
+        return ir.Setback(distances, tuple(selectors), tuple(bodies), span, self.site())
+
     # ------------------------------------------------------------------------------------- expressions
     def value_case(self, meta, *items):
         *pairs, default = items
@@ -601,6 +640,11 @@ _COMP_SELECTORS = {
     "e": ir.EDGE_SELECTORS,
     "v": ir.VERTEX_SELECTORS,
 }
+#: Setback operations and the edges their distances move (``setback`` moves those its parts select).
+_SETBACK_OPS = {"setback": (), "shapeL": ("front", "left"), "shapeU": ("front", "right", "left"),
+                "shapeO": ("front", "right", "back", "left")}
+#: Edge selectors of ``setback``: an edge is named as the face an extrusion of the polygon would make of it.
+_SETBACK_SELECTORS = (_COMP_SELECTORS["f"] - ir.OFFSET_SELECTORS) | {"all", "remainder"}
 #: Shape attributes that grammarc does not provide yet: comp.index, split.index, initialShape.origin...
 _UNSUPPORTED_MEMBERS = frozenset({"comp", "split", "initialShape", "geometry"})
 

@@ -15,11 +15,10 @@ import numpy as np
 import shapely
 
 from grammarc.constants import TOL
-from grammarc.geometry.polygons import PLANE_AXES, PolygonStore
+from grammarc.geometry.polygons import PLANE_U as _A
+from grammarc.geometry.polygons import PLANE_V as _B
+from grammarc.geometry.polygons import PolygonStore
 from grammarc.ragged import offsets_from_counts, segment_of, segment_reduce
-
-_A = np.array([PLANE_AXES[p][0] for p in range(3)])
-_B = np.array([PLANE_AXES[p][1] for p in range(3)])
 
 
 @dataclass(frozen=True)

@@ -22,6 +22,9 @@ from grammarc.constants import STRICT
 
 #: Scope axes spanned by (u, v) for each normal axis.
 PLANE_AXES = {0: (1, 2), 1: (0, 2), 2: (0, 1)}
+#: The scope axis of u (``PLANE_U``) and of v (``PLANE_V``), indexed by the normal axis.
+PLANE_U = np.array([PLANE_AXES[p][0] for p in range(3)])
+PLANE_V = np.array([PLANE_AXES[p][1] for p in range(3)])
 
 
 class PolygonStore:

@@ -456,6 +456,21 @@ FACE_SELECTORS = frozenset({
 })
 
 
+@dataclass(frozen=True, slots=True)
+class Setback:
+    """CityEngine ``setback(d) { sel: A | remainder: B }`` and ``shapeL/U/O(...) { shape: A | remainder: B }``:
+    the face's edges move in, each edge by the distance of the first selector of ``distances`` it
+    matches (selectors as comp(f) names the faces an extrusion would give the edges). A part takes the
+    strips of the edges whose first matching selector it is; ``remainder`` takes the rest of the face.
+    ``shapeL/U/O`` are setbacks of the front, right, back and left edges whose strips all go to ``all``."""
+
+    distances: tuple[tuple[str, Expr], ...]
+    selectors: tuple[str, ...]
+    parts: tuple[Body, ...]
+    span: Span = NO_SPAN
+    site: int = 0
+
+
 #: Selectors of the faces an ``offset`` makes.
 OFFSET_SELECTORS = frozenset({"inside", "border", "all"})
 #: Edge and vertex selectors of ``comp(e)`` and ``comp(v)``.
@@ -479,7 +494,7 @@ class CompFaces:
 
 Op = (Symbol | Empty | Translate | Scale | Rotate | Push | Pop | Insert | Split | Repeat | Comp | Extrude
       | Center | UseAsset | Case | Stochastic | SetAttr | Report | NotApplied | GroupSplit | CompFaces
-      | AlignScope | Mirror | Offset | SetColor)
+      | AlignScope | Mirror | Offset | SetColor | Setback)
 Body = tuple[Op, ...]
 
 

@@ -104,6 +104,10 @@ def print_op(op: ir.Op) -> str:
         head = f"offset({print_expr(op.offset)}) " if op.offset is not None else ""
         return head + f"comp({op.kind}){{ " + " | ".join(f"{s}: {print_body(b) or 'ε'}"
                                          for s, b in zip(op.selectors, op.parts)) + " }"
+    if isinstance(op, ir.Setback):
+        moves = ", ".join(f"{s}={print_expr(d)}" for s, d in op.distances)
+        return f"setback({moves}){{ " + " | ".join(f"{s}: {print_body(b) or 'ε'}"
+                                                  for s, b in zip(op.selectors, op.parts)) + " }"
     if isinstance(op, (ir.Case, ir.Stochastic)):
         return _branches(op)
     if isinstance(op, ir.Extrude):

@@ -83,6 +83,12 @@ def rewrite_op(op: ir.Op, fn: ExprFn) -> ir.Op:
         parts = _tuple(op.parts, lambda b: rewrite_body(b, fn))
         offset = ex(op.offset) if op.offset is not None else None
         return op if parts is op.parts and offset is op.offset else replace(op, parts=parts, offset=offset)
+    if isinstance(op, ir.Setback):
+        parts = _tuple(op.parts, lambda b: rewrite_body(b, fn))
+        distances = _tuple(op.distances, lambda sd: (sd[0], ex(sd[1])))
+        if parts is op.parts and all(a[1] is b[1] for a, b in zip(distances, op.distances)):
+            return op
+        return replace(op, parts=parts, distances=distances)
     if isinstance(op, ir.SetColor):
         values = _tuple(op.values, ex)
         return op if values is op.values else replace(op, values=values)
@@ -165,7 +171,7 @@ def iter_ops(body: ir.Body) -> Iterator[ir.Op]:
 
 def sub_bodies(op: ir.Op) -> tuple[ir.Body, ...]:
     """The bodies nested in ``op``: split parts, case and stochastic branches."""
-    if isinstance(op, (ir.Split, ir.Repeat, ir.Comp, ir.GroupSplit, ir.CompFaces)):
+    if isinstance(op, (ir.Split, ir.Repeat, ir.Comp, ir.GroupSplit, ir.CompFaces, ir.Setback)):
         return op.parts
     if isinstance(op, (ir.Case, ir.Stochastic)):
         return (*(body for _, body in op.branches), op.default)
@@ -204,6 +210,8 @@ def op_exprs(op: ir.Op) -> Iterator[ir.Expr]:
         yield from op.values
     elif isinstance(op, ir.CompFaces) and op.offset is not None:
         yield op.offset
+    elif isinstance(op, ir.Setback):
+        yield from (d for _, d in op.distances)
     elif isinstance(op, ir.SetAttr):
         yield op.value
     elif isinstance(op, ir.Report):

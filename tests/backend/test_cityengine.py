@@ -545,6 +545,44 @@ def test_offset_inside_and_border_faces(write):
     assert inside + border == pytest.approx(400, rel=1e-6)
 
 
+AREA_REPORTS = ('A --> report("a", geometry.area) A.\nB --> report("b", geometry.area) B.\n'
+                'R --> report("r", geometry.area) R.\n')
+
+
+@pytest.mark.parametrize("op, strips, remainder", [
+    # the front edge is the lot's first edge, 30 long; its strip is 5 deep, the left one 11 wide
+    ("shapeL(5, 11)", 30 * 5 + 11 * 15, 19 * 15),
+    ("shapeU(5, 3, 11)", 30 * 5 + 11 * 15 + 3 * 15, 16 * 15),
+    ("shapeO(2, 2, 2, 2)", 600 - 26 * 16, 26 * 16),
+])
+def test_shape_l_u_o_on_a_rectangle(write, op, strips, remainder):
+    r = run(write, f"Lot --> {op}{{ shape : A | remainder : R }}\n" + AREA_REPORTS, [rect(30, 20)])
+    t = totals(r)
+    assert (t["a_n"], t["r_n"]) == (1, 1)
+    assert (t["a_sum"], t["r_sum"]) == (pytest.approx(strips), pytest.approx(remainder))
+
+
+def test_setback_of_all_edges_on_concave_and_holed_lots(write):
+    """The L's strip is one piece; the courtyard's are two rings, around the lot and around the hole."""
+    r = run(write, "Lot --> setback(2){ all : A | remainder : R }\n" + AREA_REPORTS,
+            [LOT_ZOO["concave_L"], LOT_ZOO["courtyard"]])
+    lots = per_lot(r)
+    assert lots[0]["a_sum"] == pytest.approx(400 - 216) and lots[0]["r_sum"] == pytest.approx(216)
+    assert lots[1]["a_n"] == 2 and lots[1]["a_sum"] + lots[1]["r_sum"] == pytest.approx(1200)
+
+
+def test_setback_of_a_facade_selects_its_top_and_bottom_edges(write):
+    r = run(write, "Lot --> extrude(10) comp(f){ front : F }\n"
+                   "F --> setback(1){ top : A | bottom : B | remainder : R }\n" + AREA_REPORTS, [rect(30, 20)])
+    t = totals(r)
+    assert (t["a_sum"], t["b_sum"], t["r_sum"]) == (30, 30, 240)
+
+
+def test_setback_leaves_its_parts_to_cityengine_leaf_rules(write):
+    r = run(write, "Lot --> setback(3){ front : Yard | remainder : extrude(6) Mass }\n", [rect(30, 20)])
+    assert sorted(names(r)) == ["Mass", "Yard"]
+
+
 def test_offset_inside_of_a_rectangle_stays_a_box_path_rectangle(write):
     r = run(write, "Lot --> offset(-1, inside) extrude(2) X.\n", [rect(12, 8)])
     np.testing.assert_allclose(np.diagonal(np.abs(r["xform"][0, :, :3])), [10, 2, 6])

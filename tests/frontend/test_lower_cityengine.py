@@ -444,16 +444,35 @@ def test_comp_faces_selectors(selectors):
     assert [p[0].name for p in op.parts] == [s.capitalize() for s in selectors]
 
 
+def test_shape_u_moves_front_right_and_left_edges_into_its_shape_part():
+    op = module_of(f"{VERSION}Lot --> shapeU(5, 3, 11){{ shape : A | remainder = B }}\n"
+                   ).rules[0].alternatives[0].body[0]
+    assert isinstance(op, ir.Setback)
+    assert [s for s, _ in op.distances] == ["front", "right", "left"]
+    assert [d.value for _, d in op.distances] == [5, 3, 11]
+    assert op.selectors == ("all", "remainder")
+
+
+def test_setback_moves_the_edges_its_parts_select():
+    op = module_of(f"{VERSION}Lot --> setback(4){{ front : A | left : B | remainder : C }}\n"
+                   ).rules[0].alternatives[0].body[0]
+    assert [s for s, _ in op.distances] == ["front", "left"]
+    assert op.selectors == ("front", "left", "remainder")
+
+
 # ------------------------------------------------------------------------------------ the unsupported
 
 
 @pytest.mark.parametrize("line, name, at", [
     ("Lot --> offset(-2) Inner", "offset(d) without comp(f){ inside | border } after it", "offset"),
     ("Lot --> offset(-2, outside) Inner", "offset with these arguments", "offset"),
-    ("Lot --> setback(3){ street.front : Garden | remainder : Building }", "setback", "setback"),
+    ("Lot --> setback(3){ street.front : Garden | remainder : Building }", "setback selector `street.front`",
+     "street"),
+    ("Lot --> setback(3) Garden", "setback without selector parts", "setback"),
+    ("Lot --> setback(3){ 2 : Garden }", "this setback selector", "2"),
     ("Lot --> extrude(10) roofGable(30)", "roofGable", "roofGable"),
     ("Lot --> roofHip(30, 1) Roof", "roofHip", "roofHip"),
-    ("Lot --> shapeL(4, 4){ shape : A | remainder : NIL }", "shapeL", "shapeL"),
+    ("Lot --> shapeL(4, 4){ front : A | remainder : NIL }", "shapeL selector `front`", "front"),
     ("Lot --> innerRectangle(scope){ shape : A | remainder : NIL }", "innerRectangle", "innerRectangle"),
     ("Lot --> primitiveCylinder(16, 1, 2)", "primitiveCylinder", "primitiveCylinder"),
     ("Lot --> mirrorScope(true, false, false) A", "mirrorScope", "mirrorScope"),

@@ -81,6 +81,9 @@ def _check_op(op, check, param_types, diags) -> None:
             check(v, want, "a colour" if want is T.STR else "a colour component")
     elif isinstance(op, ir.CompFaces) and op.offset is not None:
         check(op.offset, T.NUM, "an offset distance")
+    elif isinstance(op, ir.Setback):
+        for _, d in op.distances:
+            check(d, T.NUM, "a setback distance")
     elif isinstance(op, ir.Mirror):
         for e in op.axes:
             check(e, T.BOOL, "a mirror flag")

@@ -1,0 +1,82 @@
+"""Setbacks of polygon edges: strips that meet in mitres, the remainder, holes, and a partition of the area."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+import shapely
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from grammarc.geometry.setback import polygon_edges, setback_regions
+
+L_SHAPE = shapely.Polygon([(0, 0), (30, 0), (30, 10), (10, 10), (10, 20), (0, 20)])
+COURTYARD = shapely.Polygon([(0, 0), (40, 0), (40, 40), (0, 40)], [[(10, 10), (10, 30), (30, 30), (30, 10)]])
+
+
+def setback(polygons, distance, owner=None, n_owners=1):
+    polygons = np.asarray(polygons, dtype=object)
+    edges = polygon_edges(polygons)
+    d = np.broadcast_to(np.asarray(distance, dtype=float), edges.poly.shape)
+    owner = np.zeros(len(edges.poly), dtype=np.int64) if owner is None else owner(edges)
+    return setback_regions(polygons, edges, d, owner, n_owners)
+
+
+def test_edges_point_inward_on_both_windings_and_on_holes():
+    edges = polygon_edges(np.array([shapely.box(0, 0, 2, 1), shapely.box(0, 0, 2, 1).reverse(), COURTYARD]))
+    mid = (edges.start + edges.end) / 2 + edges.inward * 0.01
+    polygons = np.array([shapely.box(0, 0, 2, 1)] * 8 + [COURTYARD] * 8)
+    assert shapely.contains_xy(polygons, mid[:, 0], mid[:, 1]).all()
+    assert list(edges.poly) == [0] * 4 + [1] * 4 + [2] * 8
+
+
+def test_all_edges_equal_the_mitred_inset():
+    (strips,), remainder = setback([shapely.box(0, 0, 30, 20), L_SHAPE, COURTYARD], 2.0)
+    np.testing.assert_allclose(shapely.area(remainder), [26 * 16, 26 * 6 + 10 * 6, 36 * 36 - 24 * 24])
+    np.testing.assert_allclose(shapely.area(strips) + shapely.area(remainder), [600, 400, 1200])
+
+
+def test_an_unmoved_neighbour_stops_the_strip():
+    """Only the edges facing -v move: on the courtyard the outer bottom edge and the hole's top edge."""
+    (strips,), remainder = setback([COURTYARD], 2.0, owner=lambda e: np.where(e.inward[:, 1] > 0.9, 0, 1))
+    assert shapely.area(strips[0]) == pytest.approx(40 * 2 + 20 * 2)
+    assert shapely.area(remainder[0]) == pytest.approx(1200 - 120)
+
+
+def test_moved_neighbours_share_their_corner_along_the_mitre():
+    (first, second), remainder = setback(
+        [shapely.box(0, 0, 30, 20)], 5.0, owner=lambda e: np.where(np.abs(e.inward[:, 1]) > 0.9, 0, 1),
+        n_owners=2)
+    # each corner square is cut along its diagonal: trapezoids of 5 * (30 + 20) / 2 and 5 * (20 + 10) / 2
+    assert shapely.area(first[0]) == pytest.approx(2 * 125)
+    assert shapely.area(second[0]) == pytest.approx(2 * 75)
+    assert shapely.area(remainder[0]) == pytest.approx(20 * 10)
+
+
+def random_polygon(seed):
+    rng = np.random.default_rng(seed)
+    n = int(rng.integers(5, 14))
+    angles = np.sort(rng.uniform(0, 2 * np.pi, n))
+    radius = rng.uniform(8, 20, n)
+    outer = shapely.Polygon(np.stack([np.cos(angles) * radius, np.sin(angles) * radius], axis=1)).buffer(0)
+    if rng.uniform() < 0.5:
+        outer = outer.difference(shapely.Point(rng.uniform(-2, 2, 2)).buffer(rng.uniform(1, 4), 3))
+    return outer if isinstance(outer, shapely.Polygon) else max(outer.geoms, key=lambda g: g.area)
+
+
+@settings(max_examples=40, deadline=None)
+@given(st.integers(0, 2**31 - 1), st.floats(0.1, 3.0))
+def test_strips_and_remainder_partition_the_polygon(seed, d):
+    polygon = random_polygon(seed)
+    (strips,), remainder = setback([polygon], d, owner=lambda e: (np.arange(len(e.poly)) % 2))
+    assert shapely.area(strips[0]) + shapely.area(remainder[0]) == pytest.approx(polygon.area, rel=1e-6)
+    assert shapely.area(shapely.intersection(strips[0], remainder[0])) <= 1e-6 * polygon.area
+
+
+@settings(max_examples=40, deadline=None)
+@given(st.integers(0, 2**31 - 1), st.floats(0.1, 2.0), st.floats(1.05, 2.0))
+def test_remainder_shrinks_as_the_distance_grows(seed, d, factor):
+    polygon = random_polygon(seed)
+    _, near = setback([polygon], d)
+    _, far = setback([polygon], d * factor)
+    assert shapely.area(far[0]) <= shapely.area(near[0]) + 1e-6 * polygon.area
