@@ -13,7 +13,9 @@ import subprocess
 import sys
 from pathlib import Path
 
+import numpy as np
 import pytest
+import shapely
 
 HERE = Path(__file__).parent
 
@@ -27,6 +29,30 @@ def grid_lots(path: Path, n: int, width: float = 20.0, depth: float = 15.0) -> P
         ring = [[x, y], [x + width, y], [x + width, y + depth], [x, y + depth], [x, y]]
         features.append({"type": "Feature", "id": f"lot{i}", "properties": {},
                          "geometry": {"type": "Polygon", "coordinates": [ring]}})
+    path.write_text(json.dumps({"type": "FeatureCollection", "features": features}))
+    return path
+
+
+def concave_lots(path: Path, n: int, seed: int = 7) -> Path:
+    """n random concave footprints of 8 to 40 vertices (star-shaped, radius 6 to 12 m), every fifth with
+    a round courtyard where it fits, on a 30 m grid, as GeoJSON (deterministic)."""
+    rng = np.random.default_rng(seed)
+    side = int(n ** 0.5 + 0.999)
+    features = []
+    for i in range(n):
+        k = int(rng.integers(8, 41))
+        angles = np.sort(rng.uniform(0, 2 * np.pi, k))
+        angles += (np.arange(k) * 2 * np.pi / k - angles) * 0.5  # spread out: no needle wedges
+        radius = rng.uniform(6, 12, k)
+        centre = np.array([(i % side) * 30.0, (i // side) * 30.0])
+        outer = centre + np.stack([np.cos(angles), np.sin(angles)], axis=1) * radius[:, None]
+        rings = [[*outer.tolist(), outer[0].tolist()]]
+        hole = centre + np.stack([np.cos(-np.arange(12) * np.pi / 6), np.sin(-np.arange(12) * np.pi / 6)],
+                                 axis=1) * 2.5
+        if i % 5 == 0 and shapely.Polygon(outer).contains(shapely.Polygon(hole).buffer(0.5)):
+            rings.append([*hole.tolist(), hole[0].tolist()])
+        features.append({"type": "Feature", "id": f"lot{i}", "properties": {},
+                         "geometry": {"type": "Polygon", "coordinates": rings}})
     path.write_text(json.dumps({"type": "FeatureCollection", "features": features}))
     return path
 
