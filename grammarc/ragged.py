@@ -30,6 +30,17 @@ def ragged_take(offsets: np.ndarray, sel: np.ndarray) -> tuple[np.ndarray, np.nd
     return items, packed
 
 
+def rank_within(group: np.ndarray) -> np.ndarray:
+    """Each item's number among the items of its group, in order: [5, 3, 5, 5] -> [0, 0, 1, 2]."""
+    order = np.argsort(group, kind="stable")
+    sorted_group = group[order]
+    first = np.r_[True, sorted_group[1:] != sorted_group[:-1]] if len(group) else np.zeros(0, bool)
+    starts = np.maximum.accumulate(np.where(first, np.arange(len(group)), 0)) if len(group) else first
+    rank = np.empty(len(group), dtype=np.int64)
+    rank[order] = np.arange(len(group)) - starts
+    return rank
+
+
 def segment_of(offsets: np.ndarray) -> np.ndarray:
     """(N,) int64: the segment of each item. offsets [0, 2, 3] -> [0, 0, 1]."""
     return np.repeat(np.arange(len(offsets) - 1), np.diff(offsets))

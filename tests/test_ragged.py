@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from grammarc.ragged import fan_out, offsets_from_counts, ragged_take, segment_of, segment_reduce
+from grammarc.ragged import fan_out, offsets_from_counts, ragged_take, rank_within, segment_of, segment_reduce
 
 
 def random_counts(rng, n):
@@ -51,6 +51,11 @@ def test_ragged_take_docstring_example():
     items, packed = ragged_take(np.array([0, 2, 5, 6]), np.array([2, 0]))
     assert items.tolist() == [5, 0, 1]
     assert packed.tolist() == [0, 1, 3]
+
+
+def test_rank_within():
+    np.testing.assert_array_equal(rank_within(np.array([5, 3, 5, 5])), [0, 0, 1, 2])
+    assert rank_within(np.zeros(0, np.int64)).shape == (0,)
 
 
 @pytest.mark.parametrize("n", [0, 1, 2, 17])

@@ -33,7 +33,7 @@ from grammarc.geometry.polygons import PLANE_U, PLANE_V
 from grammarc.geometry.reframe import reframe
 from grammarc.geometry.setback import polygon_edges, setback_regions
 from grammarc.ir import nodes as ir
-from grammarc.ragged import ragged_take
+from grammarc.ragged import ragged_take, rank_within
 
 
 class Executor:
@@ -703,7 +703,7 @@ class Executor:
             geom[shaped] = self.chunk.polygons.add(pieces.coords[vertices], ring_offsets, poly_offsets,
                                                    pieces.plane[shaped])
         origin = child.origin + np.einsum("ni,nij->nj", pieces.low, self.chunk.frames[child.frame])
-        index = _rank_within(pieces.source)
+        index = rank_within(pieces.source)
         return Shapes(origin, pieces.extent, child.frame, geom, child.lot,
                       child_keys(child.key, site, index), child.depth, child.params, child.dynamic)
 
@@ -798,7 +798,7 @@ class Executor:
         if {"comp.index", "comp.total", "comp.sel"} & set(self.plan.dynamic):
             # CityEngine numbers the components of each selector: the front face is 0 of 1
             group = parent * (len(op.selectors) + 1) + which
-            rank = _rank_within(group)
+            rank = rank_within(group)
             ids = np.array([self.plan.strings.ids[s] for s in op.selectors], dtype=np.int32)
             shapes = self.with_context(shapes, "comp", rank, group, int(group.max(initial=0)) + 1,
                                        selector=ids[which])
@@ -831,15 +831,6 @@ def _hex_color(text: str) -> float:
         return float("nan")
 
 
-def _rank_within(group: np.ndarray) -> np.ndarray:
-    """Each item's number among the items of its group, in order: [5, 3, 5, 5] -> [0, 0, 1, 2]."""
-    order = np.argsort(group, kind="stable")
-    sorted_group = group[order]
-    first = np.r_[True, sorted_group[1:] != sorted_group[:-1]] if len(group) else np.zeros(0, bool)
-    starts = np.maximum.accumulate(np.where(first, np.arange(len(group)), 0)) if len(group) else first
-    rank = np.empty(len(group), dtype=np.int64)
-    rank[order] = np.arange(len(group)) - starts
-    return rank
 
 
 def _rotation(ax: np.ndarray, ay: np.ndarray, az: np.ndarray) -> np.ndarray:

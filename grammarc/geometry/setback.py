@@ -17,7 +17,7 @@ import numpy as np
 import shapely
 
 from grammarc.constants import TOL
-from grammarc.ragged import offsets_from_counts
+from grammarc.ragged import offsets_from_counts, rank_within
 
 #: A mitre longer than this many setback distances (a near-reversal of the boundary) is cut to the
 #: edge's rectangle.
@@ -109,11 +109,8 @@ def _mitres(edges: Edges, d: np.ndarray) -> np.ndarray:
 
 def _union_by_group(geometries: np.ndarray, group: np.ndarray, n_groups: int) -> np.ndarray:
     """The union of the geometries of each group (n_groups,), empty where a group has none."""
-    order = np.argsort(group, kind="stable")
-    geometries, group = geometries[order], group[order]
-    counts = np.bincount(group, minlength=n_groups)
-    rank = np.arange(len(group)) - offsets_from_counts(counts)[group]
-    grid = np.full((n_groups, max(int(counts.max(initial=0)), 1)), None, dtype=object)
+    rank = rank_within(group)
+    grid = np.full((n_groups, int(rank.max(initial=0)) + 1), None, dtype=object)
     grid[group, rank] = geometries
     united = shapely.union_all(grid, axis=1)
     return np.where(shapely.is_empty(united), shapely.Polygon(), united)
