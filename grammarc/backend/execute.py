@@ -738,14 +738,18 @@ class Executor:
         by_owner = dict(zip(owners, regions))
         pieces = [fit_pieces(by_owner[s] if s != "remainder" else remainder, plane, cursor.size)
                   for s in op.selectors]
-        shapes = Shapes.concat([self.piece_shapes(cursor, p, (op.site << 20) + k) for k, p in enumerate(pieces)])
-        kind = np.concatenate([np.full(len(p.source), k, dtype=np.int64) for k, p in enumerate(pieces)])
-        parent = np.concatenate([p.source for p in pieces])
-        order = np.argsort(parent, kind="stable")  # each parent's pieces together, in selector order
-        shapes, kind = shapes.take(order), kind[order]
+        shapes, kind = self.pieces_by_parent(cursor, pieces, [(op.site << 20) + k for k in range(len(pieces))])
         self.count(shapes, symbol, op.span)
         order, offsets = group_by(kind, len(op.parts))
         self.run_parts(op.parts, shapes.take(order), offsets, symbol)
+
+    def pieces_by_parent(self, cursor: Shapes, pieces, sites) -> tuple[Shapes, np.ndarray]:
+        """Shapes of several kinds of pieces (kind k: ``pieces[k]``, numbered in stream ``sites[k]``),
+        each parent's pieces together in kind order, and each shape's kind."""
+        shapes = Shapes.concat([self.piece_shapes(cursor, p, site) for p, site in zip(pieces, sites)])
+        kind = np.concatenate([np.full(len(p.source), k, dtype=np.int64) for k, p in enumerate(pieces)])
+        order = np.argsort(np.concatenate([p.source for p in pieces]), kind="stable")
+        return shapes.take(order), kind[order]
 
     def selector_frames(self, normal: np.ndarray, cursor: Shapes, parent: np.ndarray,
                         selectors) -> dict | None:
@@ -758,14 +762,9 @@ class Executor:
 
     def offset_faces(self, op: ir.CompFaces, cursor: Shapes, symbol: int) -> None:
         """``offset(d) comp(f){ inside: ... | border: ... }``: the offset's faces as components."""
-        inside, border = self.offset_pieces(op.offset, cursor, symbol, op.span)
+        pieces = self.offset_pieces(op.offset, cursor, symbol, op.span)
         border_site = (op.site << 20) + 1  # another stream than the inside faces'
-        shapes = Shapes.concat([self.piece_shapes(cursor, inside, op.site),
-                                self.piece_shapes(cursor, border, border_site)])
-        kind = np.concatenate([np.zeros(len(inside.source), np.int64), np.ones(len(border.source), np.int64)])
-        parent = np.concatenate([inside.source, border.source])
-        order = np.argsort(parent, kind="stable")  # each parent's faces together: inside, then border
-        shapes, kind = shapes.take(order), kind[order]
+        shapes, kind = self.pieces_by_parent(cursor, pieces, [op.site, border_site])
         names = ("inside", "border")
         which = np.full(len(kind), len(op.selectors), dtype=np.int64)
         for i in range(len(op.selectors) - 1, -1, -1):
