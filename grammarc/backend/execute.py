@@ -196,13 +196,18 @@ class Executor:
         return cursor.with_scope(cursor.origin, cursor.size, frame, cursor.geom)
 
     # ------------------------------------------------------------------------------------------- splits
-    def split(self, op: ir.Split, cursor: Shapes, symbol: int) -> None:
+    def split_sizes(self, op: ir.Split | ir.GroupSplit, cursor: Shapes, symbol: int, what: str) -> np.ndarray:
+        """The parts' sizes, (n, P) or (1, P) when the same for all shapes; a negative or NaN one fails."""
         env = self.env(cursor)
         values = _size_matrix([evaluate(s.value, env) for s in op.sizes], len(cursor))
         bad = ~(values >= 0).all(axis=1)
         if bad.any():
-            self.fail(cursor, bad, f"`Subdiv` has a negative or NaN size ({_example(values, bad)})", symbol,
+            self.fail(cursor, bad, f"`{what}` has a negative or NaN size ({_example(values, bad)})", symbol,
                       op.span)
+        return values
+
+    def split(self, op: ir.Split, cursor: Shapes, symbol: int) -> None:
+        values = self.split_sizes(op, cursor, symbol, "Subdiv")
         relative = np.array([s.kind is ir.SizeKind.RELATIVE for s in op.sizes])
 
         def cut(shapes: Shapes, level: int, axis: int):
@@ -649,12 +654,7 @@ class Executor:
         self.run_parts(tuple(bodies), cursor.take(order), offsets, symbol)
 
     def group_split(self, op: ir.GroupSplit, cursor: Shapes, symbol: int) -> None:
-        env = self.env(cursor)
-        values = _size_matrix([evaluate(s.value, env) for s in op.sizes], len(cursor))
-        bad = ~(values >= 0).all(axis=1)
-        if bad.any():
-            self.fail(cursor, bad, f"`split` has a negative or NaN size ({_example(values, bad)})", symbol,
-                      op.span)
+        values = self.split_sizes(op, cursor, symbol, "split")
         kind = np.array([_SIZE_KIND[s.kind] for s in op.sizes], dtype=np.int64)
         groups = np.array(op.groups, dtype=np.int64)
         if op.repeat:
