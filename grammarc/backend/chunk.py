@@ -10,6 +10,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from grammarc.constants import STRICT
+from grammarc.geometry.meshes import MeshStore
 from grammarc.geometry.polygons import PolygonStore
 
 
@@ -73,6 +74,7 @@ class Chunk:
     frames: Frames
     polygons: PolygonStore
     outputs: Outputs = field(default_factory=Outputs)
+    meshes: MeshStore = field(default_factory=MeshStore)
     #: Shapes created so far per lot, for the ``max_shapes`` limit.
     shape_count: np.ndarray | None = None
     #: The lots' root random keys (``fileRandom`` draws from them).

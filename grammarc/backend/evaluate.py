@@ -165,7 +165,8 @@ def _call(expr: ir.Call, env: Env):
     if f == "fileRandom":
         return uniform(env.chunk.lot_key[env.shapes.lot], 0x5F11E)
     if f in ("geometry.nVertices", "geometry.nFaces"):
-        vertices, faces = vertex_and_face_counts(env.shapes.size, env.shapes.geom, env.chunk.polygons)
+        vertices, faces = vertex_and_face_counts(env.shapes.size, env.shapes.geom, env.chunk.polygons,
+                                                  env.chunk.meshes)
         return vertices if f == "geometry.nVertices" else faces
     if f == "len":
         names = list(env.plan.strings.ids)
@@ -177,7 +178,7 @@ def _call(expr: ir.Call, env: Env):
         return is_rectangular(env.shapes.size, env.shapes.geom, env.chunk.polygons,
                               float(np.max(args[0])) if np.size(args[0]) else 0.0)
     if f in ("geometry.area", "geometry.volume"):
-        area, volume = area_and_volume(env.shapes.size, env.shapes.geom, env.chunk.polygons)
+        area, volume = area_and_volume(env.shapes.size, env.shapes.geom, env.chunk.polygons, env.chunk.meshes)
         return area if f == "geometry.area" else volume
     if f == "isnan":
         return np.isnan(np.asarray(args[0], dtype=np.float64))

@@ -16,7 +16,7 @@ from dataclasses import replace
 import numpy as np
 import shapely
 
-from grammarc.backend import terminals
+from grammarc.backend import roofs, terminals
 from grammarc.backend.chunk import Chunk
 from grammarc.backend.evaluate import Env, elementwise, evaluate, evaluate_array
 from grammarc.backend.kernels import scope as scope_kernels
@@ -29,10 +29,12 @@ from grammarc.constants import TOL, Limits
 from grammarc.errors import ChunkTooLarge, LimitError, LotFailure
 from grammarc.geometry import components as comp_kernels
 from grammarc.geometry.clip import clip_to_slabs, fit_pieces, scope_polygons
+from grammarc.geometry.meshes import is_mesh, is_polygon
 from grammarc.geometry.polygons import PLANE_U, PLANE_V
 from grammarc.geometry.reframe import reframe
 from grammarc.geometry.setback import polygon_edges, setback_regions
 from grammarc.ir import nodes as ir
+from grammarc.ir.printer import print_op
 from grammarc.ragged import ragged_take, rank_within
 
 
@@ -132,12 +134,22 @@ class Executor:
             elif isinstance(op, ir.Center):
                 cursor = self.center(op, cursor, base)
             else:
+                if type(op) not in _MESH_OPERATIONS and len(self.chunk.meshes):
+                    self.refuse_meshes(op, cursor, symbol)
                 # an operation either makes shapes (returns None) or changes the cursor (returns it)
                 changed = _OPERATIONS[type(op)](self, op, cursor, symbol)
                 if changed is not None:
                     cursor = changed
         if leaf_at_end and self.plan.leaf_bodies and len(cursor) and not consumes(body):
             terminals.emit_leaves(self.chunk, cursor, symbol)
+
+    def refuse_meshes(self, op: ir.Op, cursor: Shapes, symbol: int) -> None:
+        """Roofs take component splits and scope operations; other operations on them are reported."""
+        mesh = is_mesh(cursor.geom)
+        if mesh.any():
+            name = print_op(op).split("(")[0]
+            self.fail(cursor, mesh, f"`{name}` of a roof is not supported yet (split the roof into faces "
+                      "with comp(f) first)", symbol, op.span)
 
     def insert(self, op: ir.Insert, cursor: Shapes, symbol: int) -> None:
         """The paper's ``I(name)``: an instance of the asset on the scope."""
@@ -291,7 +303,7 @@ class Executor:
         """
         store = self.chunk.polygons
         geom = shapes.geom[parent]
-        poly = np.flatnonzero(geom >= 0)
+        poly = np.flatnonzero(is_polygon(geom))
         poly = poly[store.plane[geom[poly]] != axis]
         if not len(poly):
             return parent, step, pos, length, index, None
@@ -367,6 +379,8 @@ class Executor:
 
     # ------------------------------------------------------------------------------------------- comp
     def comp(self, op: ir.Comp, cursor: Shapes, symbol: int) -> None:
+        if op.kind != "faces":
+            self.refuse_meshes(op, cursor, symbol)
         index_of = None
         if op.index is not None:
             index_of = evaluate_array(op.index, self.env(cursor))
@@ -378,39 +392,60 @@ class Executor:
     def components(self, kind: int, cursor: Shapes, site: int, wanted=None):
         """Component shapes of ``cursor``, their normals in the parents' frames (m, 3), their indices
         among their parent's components (m,) and their parents (m,); ``wanted`` (n,) keeps, per shape,
-        only that index."""
+        only that index. Roofs (meshes) have faces only (``comp_faces`` and ``comp`` check)."""
         chunk = self.chunk
-        coords, ring_offsets, shape_offsets, plane = self.polygons_of(cursor)
-        parent, index, origin, axes, size, poly = comp_kernels.components(
-            kind, coords, ring_offsets, shape_offsets, plane, cursor.size, TOL.zero)
+        mesh = is_mesh(cursor.geom)
+        pieces = []
+        if not mesh.all():
+            pieces.append(self.solid_components(kind, cursor, np.flatnonzero(~mesh)))
+        if mesh.any():
+            which = np.flatnonzero(mesh)
+            parent, index, origin, axes, size, geom = roofs.mesh_components(chunk, cursor.take(which))
+            pieces.append((which[parent], index, origin, axes, size, geom, axes[:, 2]))
+        parent, index, origin, axes, size, geom, normal = (
+            pieces[0] if len(pieces) == 1 else
+            (np.concatenate(columns) for columns in zip(*pieces)))
+        if len(pieces) > 1:
+            order = np.argsort(parent, kind="stable")
+            parent, index, origin, axes, size, geom, normal = (
+                a[order] for a in (parent, index, origin, axes, size, geom, normal))
         if wanted is not None:
             keep = index == np.round(wanted[parent])
-            parent, index, origin, axes, size, poly = (a[keep] for a in
-                                                       (parent, index, origin, axes, size, poly))
+            parent, index, origin, axes, size, geom, normal = (
+                a[keep] for a in (parent, index, origin, axes, size, geom, normal))
         child = cursor.take(parent)
         parent_axes = chunk.frames[child.frame]
         world_origin = child.origin + np.einsum("ni,nij->nj", origin, parent_axes)
         frame = chunk.frames.add(np.einsum("nij,njk->nik", axes, parent_axes))
+        shapes = Shapes(world_origin, size, frame, geom.astype(np.int32), child.lot,
+                        child_keys(child.key, site, index), child.depth, child.params, child.dynamic)
+        return self.with_context(shapes, "comp", index, parent, len(cursor)), normal, index, parent
+
+    def solid_components(self, kind: int, cursor: Shapes, which: np.ndarray):
+        """Components of the boxes, polygons and prisms ``which`` of ``cursor``: parent (into cursor),
+        index, origin, axes, size (in the parents' frames), geom, normal."""
+        shapes = cursor.take(which)
+        coords, ring_offsets, shape_offsets, plane = self.polygons_of(shapes)
+        parent, index, origin, axes, size, poly = comp_kernels.components(
+            kind, coords, ring_offsets, shape_offsets, plane, shapes.size, TOL.zero)
         geom = np.full(len(parent), -1, dtype=np.int32)
         same = poly == comp_kernels.SAME_POLY
-        geom[same] = child.geom[same]
-        for code, which in ((comp_kernels.BOTTOM_POLY, "bottom"), (comp_kernels.TOP_POLY, "top")):
-            sel = (poly == code) & (child.geom >= 0)
+        geom[same] = shapes.geom[parent[same]]
+        for code, cap in ((comp_kernels.BOTTOM_POLY, "bottom"), (comp_kernels.TOP_POLY, "top")):
+            sel = (poly == code) & is_polygon(shapes.geom[parent])
             if sel.any():
-                geom[sel] = self.cap_polygons(child.geom[sel], which)
+                geom[sel] = self.cap_polygons(shapes.geom[parent[sel]], cap)
         # a flat shape's only face is itself: its normal is its plane's axis, not its frame's z
         normal = axes[:, 2].copy()
         normal[same] = np.eye(3)[plane[parent[same]]]
-        shapes = Shapes(world_origin, size, frame, geom, child.lot, child_keys(child.key, site, index),
-                        child.depth, child.params, child.dynamic)
-        return self.with_context(shapes, "comp", index, parent, len(cursor)), normal, index, parent
+        return which[parent], index, origin, axes, size, geom, normal
 
     def polygons_of(self, shapes: Shapes):
         """Each shape's polygon as batch-local ragged arrays (implicit rectangles for scope shapes)."""
         polygons = self.chunk.polygons
         n = len(shapes)
         plane = comp_kernels.rect_plane(shapes.size, TOL.zero)
-        is_poly = shapes.geom >= 0
+        is_poly = is_polygon(shapes.geom)
         plane[is_poly] = polygons.plane[shapes.geom[is_poly]]
         if not is_poly.any():
             coords = np.concatenate([comp_kernels.RECT_RINGS[p] for p in plane]) if n else np.empty((0, 2))
@@ -450,9 +485,9 @@ class Executor:
         """The axis each shape is flat along (its face normal), -1 for solids, edges and assets."""
         flat = cursor.size <= TOL.zero
         axis = np.where(flat.sum(axis=1) == 1, np.argmax(flat, axis=1), -1)
-        poly = cursor.geom >= 0
+        poly = is_polygon(cursor.geom)
         axis[poly] = np.where(flat[poly].sum(axis=1) >= 1, self.chunk.polygons.plane[cursor.geom[poly]], -1)
-        axis[cursor.geom < -1] = -1
+        axis[(cursor.geom < -1) | is_mesh(cursor.geom)] = -1
         return axis
 
     def extrude(self, op: ir.Extrude, cursor: Shapes, symbol: int) -> Shapes:
@@ -469,6 +504,34 @@ class Executor:
         normal = self.chunk.frames[cursor.frame][rows, axis]
         origin = cursor.origin + np.minimum(height, 0.0)[:, None] * normal
         return cursor.with_scope(origin, size, cursor.frame, cursor.geom)
+
+    def roof(self, op: ir.Roof, cursor: Shapes, symbol: int) -> Shapes:
+        """A roof over each face (``backend.roofs``). CityEngine roofs faces; the paper's ``Roof`` roofs
+        the footprint of a solid (its polygon, or the scope's x-z rectangle)."""
+        env = self.env(cursor)
+        n = len(cursor)
+        value, overhang, index = (np.ascontiguousarray(np.broadcast_to(
+            np.asarray(evaluate_array(e, env), dtype=np.float64), (n,))) for e in (op.value, op.overhang, op.index))
+        checks = [
+            (cursor.geom < -1, "of an inserted asset"),
+            (~np.isfinite(value) | ~np.isfinite(overhang) | ~np.isfinite(index), "with a value that is not finite"),
+            (~op.by_height & (np.abs(value) >= 90), "with an angle of 90 degrees or more"),
+        ]
+        if self.plan.leaf_bodies:
+            checks.append((self.flat_axis(cursor) < 0, "of a solid (CityEngine roofs faces)"))
+        if op.overhang_y is not None:
+            overhang_y = evaluate_array(op.overhang_y, env)
+            checks.append((np.abs(overhang_y - overhang) > TOL.zero,
+                           "with overhangY other than overhangX (gable ends overhang as eaves do)"))
+        for bad, what in checks:
+            if np.any(bad):
+                self.fail(cursor, np.broadcast_to(bad, (n,)), f"`{op.kind}` {what}", symbol, op.span)
+        roofed, failed = roofs.build_roofs(self.chunk, cursor, op.kind, self.polygons_of(cursor), value,
+                                           op.by_height, overhang, index)
+        if failed.any():
+            self.fail(cursor, failed, f"`{op.kind}` found no roof for this polygon (its straight skeleton "
+                      "did not close)", symbol, op.span)
+        return roofed
 
     def center(self, op: ir.Center, cursor: Shapes, base) -> Shapes:
         """Centre the scope on ``base`` (the body's first scope or the last push) along ``op.axes``."""
@@ -563,7 +626,7 @@ class Executor:
         if assets.any():
             asset, mirrored = asset_of(geom[assets])
             geom[assets] = asset_geom(asset, mirrored ^ bits[assets])
-        poly = np.flatnonzero((geom >= 0) & (bits > 0))
+        poly = np.flatnonzero(is_polygon(geom) & (bits > 0))
         if len(poly):
             store = self.chunk.polygons
             coords, ring_offsets, poly_offsets = store.gather(geom[poly])
@@ -778,6 +841,8 @@ class Executor:
 
     def comp_faces(self, op: ir.CompFaces, cursor: Shapes, symbol: int) -> None:
         """CityEngine ``comp(f|e|v)``: components to the first selector they match."""
+        if op.offset is not None or op.kind != "f":
+            self.refuse_meshes(op, cursor, symbol)
         if op.offset is not None:
             self.offset_faces(op, cursor, symbol)
             return
@@ -815,8 +880,13 @@ _OPERATIONS = {
     ir.SetColor: Executor.set_color, ir.UseAsset: Executor.use_asset, ir.SetAttr: Executor.set_attr,
     ir.Report: Executor.report, ir.Case: Executor.branch, ir.Stochastic: Executor.branch,
     ir.GroupSplit: Executor.group_split, ir.CompFaces: Executor.comp_faces, ir.Empty: Executor.nothing,
-    ir.NotApplied: Executor.nothing, ir.Setback: Executor.setback,
+    ir.NotApplied: Executor.nothing, ir.Setback: Executor.setback, ir.Roof: Executor.roof,
 }
+#: Operations that take roofs (meshes): scope changes, component splits, successors, leaves.
+_MESH_OPERATIONS = frozenset({
+    ir.Symbol, ir.Translate, ir.Scale, ir.Rotate, ir.Insert, ir.Comp, ir.CompFaces, ir.Empty, ir.NotApplied,
+    ir.SetColor, ir.UseAsset, ir.SetAttr, ir.Report, ir.Case, ir.Stochastic,
+})
 
 
 def _hex_color(text: str) -> float:

@@ -7,7 +7,7 @@ A ``Shapes`` batch holds, per shape:
 - ``frame`` (n,) int32: the scope's axes, as an index into the chunk's frame table (``Frames``) - most
   operations keep the axes, so shapes share frames instead of copying 3x3 matrices;
 - ``geom`` (n,) int32: -1 when the shape's geometry is its scope box or rectangle, else a polygon in the
-  chunk's ``PolygonStore``;
+  chunk's ``PolygonStore``, or from ``MESH_BASE`` up a mesh (a roof) in its ``MeshStore``;
 - ``lot`` (n,) int32: the lot, as an index into the chunk's lots;
 - ``key`` (n,) uint64: the random-stream key (``backend.random``);
 - ``depth`` (n,) int32: rule applications on the path from the lot;

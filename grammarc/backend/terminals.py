@@ -10,7 +10,8 @@ no rule applied) into output, as CityEngine emits leaf geometry:
   quad's normal is the scope's axis k (a footprint faces up, a facade out);
 - an edge or a vertex (two or three zero axes) -> nothing: it has no surface;
 - an inserted asset (CityEngine's ``i()``) -> an instance of that asset;
-- a polygon -> faces of the mesh table (with holes); a prism -> its bottom, top and side faces.
+- a polygon -> faces of the mesh table (with holes); a prism -> its bottom, top and side faces;
+- a roof (a mesh) -> its faces.
 """
 
 from __future__ import annotations
@@ -19,9 +20,11 @@ import numpy as np
 
 from grammarc.backend.chunk import Chunk
 from grammarc.backend.kernels.scope import xforms
+from grammarc.backend.roofs import mesh_leaves
 from grammarc.backend.shapes import Shapes, asset_of
 from grammarc.constants import TOL
 from grammarc.geometry.components import reverse_rings
+from grammarc.geometry.meshes import is_mesh, is_polygon
 from grammarc.geometry.polygons import PLANE_AXES
 from grammarc.io.npz import MeshChunk
 from grammarc.ragged import offsets_from_counts, segment_of
@@ -90,9 +93,13 @@ def emit_leaves(chunk: Chunk, shapes: Shapes, symbol: int) -> None:
         permuted_size = quads.size[rows, cols]
         permuted_size[:, 2] = 0.0
         _append(chunk, quads, instance_xform(permuted_axes, permuted_size, quads.origin), QUAD, symbol)
-    polygons = shapes.take(shapes.geom >= 0)
+    polygons = shapes.take(is_polygon(shapes.geom))
     if len(polygons):
         chunk.outputs.meshes.append(polygon_meshes(chunk, polygons, symbol))
+    meshes = shapes.take(is_mesh(shapes.geom))
+    if len(meshes):
+        colors = rgba(meshes.dynamic[chunk.color_slot]) if chunk.color_slot is not None else None
+        chunk.outputs.meshes.append(mesh_leaves(chunk, meshes, symbol, colors))
 
 
 def polygon_meshes(chunk: Chunk, shapes: Shapes, symbol: int) -> MeshChunk:

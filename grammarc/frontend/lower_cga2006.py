@@ -27,8 +27,11 @@ SNAP_AXES = frozenset({"XS", "YS", "ZS", "XYS", "XZS", "YZS", "XYZS"})
 NOT_YET = {
     "Snap": "snap shapes (paper section 3.3)",
     "SnapLines": "snap lines (paper section 3.3)",
-    "Roof": "roofs (the polygon geometry issue)",
 }
+#: The paper's roof types (section 3.1) and the CityEngine roofs that build them: a cross gable is the
+#: gable roof of a cross-shaped footprint, a cone the pyramid of a many-sided one.
+ROOF_TYPES = {"hipped": "roofHip", "gabled": "roofGable", "cross-gable": "roofGable", "cone": "roofPyramid",
+              "pyramid": "roofPyramid", "shed": "roofShed"}
 #: Context queries (paper section 3.2), parsed as dotted calls.
 NOT_YET_QUERIES = {
     ("Shape", "occ"): "occlusion queries `Shape.occ` (paper section 3.2)",
@@ -36,7 +39,7 @@ NOT_YET_QUERIES = {
     ("Shape", "visible"): "visibility queries `Shape.visible` (paper section 3.2)",
 }
 
-OPERATIONS = ("T", "S", "R", "Rx", "Ry", "Rz", "I", "Subdiv", "Repeat", "Comp", *NOT_YET)
+OPERATIONS = ("T", "S", "R", "Rx", "Ry", "Rz", "I", "Subdiv", "Repeat", "Comp", "Roof", *NOT_YET)
 
 
 @dataclass(frozen=True, slots=True)
@@ -134,7 +137,8 @@ class Lowering(LoweringBase):
         for item in pushed:
             self.diags.error("syntax", "unclosed `[`", item.span,
                              hint="close it with `]` in the same successor")
-        return tuple(items)
+        # an operation may lower to several (``Roof(...){ part }`` is the roof, then its part)
+        return tuple(op for item in items for op in (item if isinstance(item, tuple) else (item,)))
 
     def parts(self, meta, *bodies):
         return tuple(bodies)
@@ -316,6 +320,28 @@ class Lowering(LoweringBase):
         index = self.expr(args[1]) if len(args) == 2 else None
         return ir.Comp(kind, index, parts, span, self.site())
 
+    def op_roof(self, op, args, parts, span):
+        """``Roof(type, angle){ part }`` (paper section 3.1): a roof over the scope's footprint, its
+        part applied to the roof. Lowered to the roof, then the part's operations."""
+        if not self.expect_args(op, args, (2,), span):
+            return ir.Empty(span)
+        kind = self.string_arg(op, args[0], span, "a roof type")
+        if kind is None:
+            return ir.Empty(span)
+        if kind not in ROOF_TYPES:
+            known = ", ".join(f'"{k}"' for k in ROOF_TYPES)
+            if kind in ("mansard", "gambrel"):
+                return self.not_yet(f'Roof("{kind}")', f"two-slope roofs; supported types: {known}",
+                                    args[0].span)
+            self.diags.error("roof", f'unknown roof type "{kind}"{suggest(kind, ROOF_TYPES)}', args[0].span)
+            return ir.Empty(span)
+        if parts is not None and len(parts) != 1:
+            self.diags.error("syntax", f"`{op}` takes one part, got {len(parts)}", span)
+            return ir.Empty(span)
+        zero = ir.Num(0.0, span)
+        roof = ir.Roof(ROOF_TYPES[kind], self.expr(args[1]), False, zero, None, zero, span)
+        return (roof, *(parts[0] if parts is not None else ()))
+
     # ------------------------------------------------------------------------------------- expressions
     def string(self, meta, tok):
         return ir.Str(str(tok)[1:-1], self.token_span(tok))
@@ -372,6 +398,7 @@ _CALLS = {
     "Subdiv": Lowering.op_subdiv,
     "Repeat": Lowering.op_repeat,
     "Comp": Lowering.op_comp,
+    "Roof": Lowering.op_roof,
 }
 
 

@@ -29,7 +29,7 @@ NOT_APPLIED = frozenset({
 #: CityEngine operations grammarc does not implement yet (the geometry and context issues bring most).
 UNSUPPORTED_OPS = frozenset({
     "innerRectangle", "innerPolygon", "convexify",
-    "cleanupGeometry", "trim", "envelope", "roofGable", "roofHip", "roofShed", "roofPyramid",
+    "cleanupGeometry", "trim", "envelope",
     "mirrorScope",
     "insertAlongUV", "scatter", "footprint", "tileUV", "splitArea", "inline", "resetGeometry", "taper",
     "primitiveCylinder", "primitiveSphere", "primitiveDisk", "primitiveCone", "primitiveQuad",
@@ -326,6 +326,32 @@ class Lowering(LoweringBase):
         want = " or ".join(str(c) for c in counts)
         self.diags.error("arity", f"`{op}` takes {want} arguments, got {len(args)}", span)
         return False
+
+    def op_roof(self, op, args, span):
+        """``roofHip``, ``roofGable``, ``roofShed``, ``roofPyramid``: by angle, or with a leading
+        ``byAngle``/``byHeight`` selector. The arguments after the value, in CityEngine's order:
+        hip (overhang, even), gable (overhangX, overhangY, even, index), shed (index), pyramid none."""
+        by_height = False
+        if args and isinstance(args[0], ir.Name) and args[0].name in ("byAngle", "byHeight"):
+            by_height = args[0].name == "byHeight"
+            args = args[1:]
+        names = _ROOF_ARGUMENTS[op] + (("index",) if op == "roofGable" and not by_height else ())
+        if not 1 <= len(args) <= 1 + len(names):
+            self.diags.error("arity", f"`{op}` takes 1 to {1 + len(names)} arguments after the "
+                             f"byAngle/byHeight selector, got {len(args)}", span)
+            return ir.Empty(span)
+        given = dict(zip(names, (self.expr(a) for a in args[1:])))
+        even = given.get("even")
+        if even is not None and not (isinstance(even, ir.Bool) and not even.value):
+            return self.unsupported(f"{op} with even ridges", even.span,
+                                    "only even = false: even ridges make non-planar faces")
+        if op == "roofGable" and "index" in given:
+            return self.unsupported("roofGable with an edge index", given["index"].span,
+                                    "the ridge follows the straight skeleton")
+        zero = ir.Num(0.0, span)
+        overhang = given.get("overhang", given.get("overhangX", zero))
+        index = given.get("index", zero) if op == "roofShed" else zero
+        return ir.Roof(op, self.expr(args[0]), by_height, overhang, given.get("overhangY"), index, span)
 
     def op_extrude(self, op, args, span):
         if len(args) != 1:
@@ -632,7 +658,14 @@ _OPS = {
     "NIL": Lowering.op_nil,
     "set": Lowering.op_set,
     "report": Lowering.op_report,
+    "roofHip": Lowering.op_roof,
+    "roofGable": Lowering.op_roof,
+    "roofShed": Lowering.op_roof,
+    "roofPyramid": Lowering.op_roof,
 }
+#: The optional arguments after a roof's value (roofGable's ``index`` only by angle).
+_ROOF_ARGUMENTS = {"roofHip": ("overhang", "even"), "roofGable": ("overhangX", "overhangY", "even"),
+                   "roofShed": ("index",), "roofPyramid": ()}
 _SPLIT_OPS = frozenset({"split", "comp"})
 _COMP_SELECTORS = {
     "f": ir.FACE_SELECTORS | ir.OFFSET_SELECTORS

@@ -10,11 +10,14 @@ from __future__ import annotations
 import numpy as np
 
 from grammarc.constants import TOL
+from grammarc.geometry import meshes as mesh_store
+from grammarc.geometry.meshes import MESH_BASE, MeshStore, is_mesh, is_polygon
 from grammarc.geometry.polygons import PLANE_AXES, PolygonStore
 from grammarc.ragged import segment_of, segment_reduce
 
 
-def area_and_volume(size: np.ndarray, geom: np.ndarray, store: PolygonStore) -> tuple[np.ndarray, np.ndarray]:
+def area_and_volume(size: np.ndarray, geom: np.ndarray, store: PolygonStore,
+                    meshes: MeshStore) -> tuple[np.ndarray, np.ndarray]:
     """Per shape: area (n,) and volume (n,) float64, from scope sizes (n, 3) and geometry ids (n,)."""
     flat = size <= TOL.zero
     n_flat = flat.sum(axis=1)
@@ -23,7 +26,7 @@ def area_and_volume(size: np.ndarray, geom: np.ndarray, store: PolygonStore) -> 
                         np.where(n_flat == 1, np.prod(np.where(flat, 1.0, size), axis=1), 0.0))
     area = box_area
     volume = sx * sy * sz
-    poly = np.flatnonzero(geom >= 0)
+    poly = np.flatnonzero(is_polygon(geom))
     if len(poly):
         ids = geom[poly]
         coords, ring_offsets, poly_offsets = store.gather(ids)
@@ -46,6 +49,10 @@ def area_and_volume(size: np.ndarray, geom: np.ndarray, store: PolygonStore) -> 
         volume = volume.copy()
         area[poly] = np.where(solid, 2 * face + perimeter * h, face)
         volume[poly] = np.where(solid, face * h, 0.0)
+    mesh = np.flatnonzero(is_mesh(geom))
+    if len(mesh):
+        area, volume = area.copy(), volume.copy()
+        area[mesh], volume[mesh] = mesh_store.area_and_volume(meshes, geom[mesh] - MESH_BASE, size[mesh])
     return area, volume
 
 
@@ -53,7 +60,7 @@ def is_rectangular(size: np.ndarray, geom: np.ndarray, store: PolygonStore, degr
     """CityEngine's ``geometry.isRectangular(tolerance)``: a face or solid whose polygon is a rectangle,
     its corners right angles within ``degrees``. Scope boxes and rectangles are; assets are not."""
     result = geom == -1
-    poly = np.flatnonzero(geom >= 0)
+    poly = np.flatnonzero(is_polygon(geom))
     if not len(poly):
         return result
     ids = geom[poly]
@@ -81,14 +88,15 @@ def is_rectangular(size: np.ndarray, geom: np.ndarray, store: PolygonStore, degr
     return result
 
 
-def vertex_and_face_counts(size: np.ndarray, geom: np.ndarray, store: PolygonStore):
+def vertex_and_face_counts(size: np.ndarray, geom: np.ndarray, store: PolygonStore, meshes: MeshStore):
     """CityEngine's ``geometry.nVertices`` and ``geometry.nFaces`` per shape, (n,) float64 each: a box
     has 8 and 6, a rectangle 4 and 1, a polygon its vertices and 1 face, a prism twice its vertices and
-    its edges plus 2 faces; an inserted asset counts as its box."""
+    its edges plus 2 faces; a mesh the vertices of its face rings and its faces; an inserted asset
+    counts as its box."""
     flat = (size <= TOL.zero).sum(axis=1)
     vertices = np.where(flat == 0, 8.0, np.where(flat == 1, 4.0, np.where(flat == 2, 2.0, 1.0)))
     faces = np.where(flat == 0, 6.0, np.where(flat == 1, 1.0, 0.0))
-    poly = np.flatnonzero(geom >= 0)
+    poly = np.flatnonzero(is_polygon(geom))
     if len(poly):
         ids = geom[poly]
         counts = np.diff(store.ring_offsets)[segment_of(store.poly_offsets)]
@@ -98,4 +106,12 @@ def vertex_and_face_counts(size: np.ndarray, geom: np.ndarray, store: PolygonSto
         faces = faces.copy()
         vertices[poly] = np.where(solid, 2 * per_poly, per_poly)
         faces[poly] = np.where(solid, per_poly + 2, 1.0)
+    mesh = np.flatnonzero(is_mesh(geom))
+    if len(mesh):
+        coords, ring_offsets, face_offsets, mesh_offsets = meshes.gather(geom[mesh] - MESH_BASE)
+        vertex_mesh = np.repeat(np.arange(len(mesh)), np.diff(ring_offsets[face_offsets[mesh_offsets]]))
+        distinct = np.unique(np.column_stack([vertex_mesh, np.round(coords, 9)]), axis=0)[:, 0]
+        vertices, faces = vertices.copy(), faces.copy()
+        vertices[mesh] = np.bincount(distinct.astype(np.int64), minlength=len(mesh))
+        faces[mesh] = np.diff(mesh_offsets)
     return vertices, faces

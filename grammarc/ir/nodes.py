@@ -471,6 +471,22 @@ class Setback:
     site: int = 0
 
 
+@dataclass(frozen=True, slots=True)
+class Roof:
+    """CityEngine ``roofHip``, ``roofGable``, ``roofShed``, ``roofPyramid`` and the paper's
+    ``Roof(type, angle)``: the face becomes a roof mesh over it (``geometry.roofs``). ``value`` is the
+    slope in degrees, or the height when ``by_height``; ``overhang`` and ``overhang_y`` the eave and
+    gable overhangs; ``index`` the shed's edge."""
+
+    kind: str
+    value: Expr
+    by_height: bool
+    overhang: Expr
+    overhang_y: Expr | None
+    index: Expr
+    span: Span = NO_SPAN
+
+
 #: Selectors of the faces an ``offset`` makes.
 OFFSET_SELECTORS = frozenset({"inside", "border", "all"})
 #: Edge and vertex selectors of ``comp(e)`` and ``comp(v)``.
@@ -494,7 +510,7 @@ class CompFaces:
 
 Op = (Symbol | Empty | Translate | Scale | Rotate | Push | Pop | Insert | Split | Repeat | Comp | Extrude
       | Center | UseAsset | Case | Stochastic | SetAttr | Report | NotApplied | GroupSplit | CompFaces
-      | AlignScope | Mirror | Offset | SetColor | Setback)
+      | AlignScope | Mirror | Offset | SetColor | Setback | Roof)
 Body = tuple[Op, ...]
 
 

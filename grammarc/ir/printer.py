@@ -100,6 +100,11 @@ def print_op(op: ir.Op) -> str:
         return f"color({', '.join(print_expr(v) for v in op.values)})"
     if isinstance(op, ir.Offset):
         return f"offset({print_expr(op.distance)}, {op.select})"
+    if isinstance(op, ir.Roof):
+        args = [("byHeight" if op.by_height else "byAngle"), print_expr(op.value), print_expr(op.overhang)]
+        if op.overhang_y is not None:
+            args.append(print_expr(op.overhang_y))
+        return f"{op.kind}({', '.join(args)}, index={print_expr(op.index)})"
     if isinstance(op, ir.CompFaces):
         head = f"offset({print_expr(op.offset)}) " if op.offset is not None else ""
         return head + f"comp({op.kind}){{ " + " | ".join(f"{s}: {print_body(b) or 'ε'}"

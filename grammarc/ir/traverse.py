@@ -95,6 +95,12 @@ def rewrite_op(op: ir.Op, fn: ExprFn) -> ir.Op:
     if isinstance(op, ir.Offset):
         distance = ex(op.distance)
         return op if distance is op.distance else replace(op, distance=distance)
+    if isinstance(op, ir.Roof):
+        value, overhang, index = ex(op.value), ex(op.overhang), ex(op.index)
+        overhang_y = ex(op.overhang_y) if op.overhang_y is not None else None
+        if value is op.value and overhang is op.overhang and index is op.index and overhang_y is op.overhang_y:
+            return op
+        return replace(op, value=value, overhang=overhang, overhang_y=overhang_y, index=index)
     if isinstance(op, (ir.Case, ir.Stochastic)):
         branches = _tuple(op.branches, lambda br: _branch(br, fn))
         default = rewrite_body(op.default, fn)
@@ -206,6 +212,8 @@ def op_exprs(op: ir.Op) -> Iterator[ir.Expr]:
         yield from op.axes
     elif isinstance(op, ir.Offset):
         yield op.distance
+    elif isinstance(op, ir.Roof):
+        yield from (e for e in (op.value, op.overhang, op.overhang_y, op.index) if e is not None)
     elif isinstance(op, ir.SetColor):
         yield from op.values
     elif isinstance(op, ir.CompFaces) and op.offset is not None:

@@ -85,7 +85,7 @@ def test_lowering_errors(text, expected):
     ('a ~> Snap("Y", "entrancesnap") b', 6, "`Snap` is not supported yet"),
     ('a ~> b SnapLines("y")', 8, "`SnapLines` is not supported yet"),
     ("a ~> b Snap", 8, "`Snap` is not supported yet"),
-    ('a ~> Roof("hipped", 30){ r }', 6, "`Roof` is not supported yet"),
+    ('a ~> Roof("mansard", 30){ r }', 11, '`Roof("mansard")` is not supported yet'),
     ('a ~> Repeat("XS", 2){ b }', 13, '`Repeat("XS")` is not supported yet'),
     ('a ~> Subdiv("YS", 1r){ b }', 13, '`Subdiv("YS")` is not supported yet'),
 ])
@@ -110,10 +110,10 @@ def test_all_errors_of_a_file_are_reported():
         'a ~> Subdv("Y", 1){ b } T(1r, 0, 0)\n'
         "b ~> T(1, 2) c(1, 2)\n"
         'c(x) ~> I("cube")\n'
-        'd ~> Comp("edge"){ e } Roof("hipped", 30){ r }'
+        'd ~> Comp("edge"){ e } Roof("hiped", 30){ r }'
     )
     positions = [(line, col) for line, col, _ in errors(text)]
-    assert positions == [(1, 6), (1, 27), (2, 6), (2, 14), (4, 6), (4, 24)]
+    assert positions == [(1, 6), (1, 27), (2, 6), (2, 14), (4, 6), (4, 29)]
 
 
 def test_unknown_operation_renders_with_a_caret_under_the_name():

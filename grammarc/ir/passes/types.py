@@ -75,6 +75,12 @@ def _check_op(op, check, param_types, diags) -> None:
         check(op.height, T.NUM, "a height")
     elif isinstance(op, ir.Offset):
         check(op.distance, T.NUM, "an offset distance")
+    elif isinstance(op, ir.Roof):
+        check(op.value, T.NUM, "a roof height" if op.by_height else "a roof angle")
+        for e in (op.overhang, op.overhang_y):
+            if e is not None:
+                check(e, T.NUM, "an overhang")
+        check(op.index, T.NUM, "an edge index")
     elif isinstance(op, ir.SetColor):
         want = T.STR if len(op.values) == 1 else T.NUM
         for v in op.values:

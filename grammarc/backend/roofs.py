@@ -1,0 +1,91 @@
+"""Roof shapes on the shape columns: building them, splitting them into faces, emitting them as leaves.
+
+A roof is a mesh (``geometry.meshes``) built over a face's polygon by ``geometry.roofs``. Its scope
+follows CityEngine: x kept, y along the face's normal, z = x cross y, and the box fitted to the mesh
+(an overhang widens it and moves its origin below the eaves). For the usual footprint (normal along
+scope y) the frame stays; a face from a component split (normal along z) turns about x.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from grammarc.backend.chunk import Chunk
+from grammarc.backend.shapes import Shapes
+from grammarc.constants import TOL
+from grammarc.geometry.meshes import MESH_BASE, face_frames, face_vertices
+from grammarc.geometry.polygons import PLANE_U, PLANE_V
+from grammarc.geometry.roofs import ROOF_KINDS, roof_meshes
+from grammarc.io.npz import MeshChunk
+from grammarc.ragged import segment_of, segment_reduce
+
+#: Per normal axis n: the roof frame's axes as rows in the face scope's frame (y' along axis n).
+_ROOF_FRAME = np.array([
+    [[0, 0, 1], [1, 0, 0], [0, 1, 0]],   # n = x: (z, x, y), a cyclic turn
+    [[1, 0, 0], [0, 1, 0], [0, 0, 1]],   # n = y: unchanged
+    [[1, 0, 0], [0, 0, 1], [0, -1, 0]],  # n = z: (x, z, -y), a turn about x
+], dtype=np.float64)
+
+
+def build_roofs(chunk: Chunk, shapes: Shapes, kind: str, polygons, value, by_height: bool, overhang,
+                index) -> tuple[Shapes, np.ndarray]:
+    """Roof shapes over ``shapes``' polygons (``polygons``: coords, ring_offsets, shape_offsets and the
+    plane of each, as ``Executor.polygons_of`` gives them) and a mask (n,) of the shapes whose roof
+    could not be built (their shapes keep their old geometry and must be reported)."""
+    coords, ring_offsets, shape_offsets, plane = polygons
+    rows = np.arange(len(shapes))
+    size_a = shapes.size[rows, PLANE_U[plane]]
+    size_b = shapes.size[rows, PLANE_V[plane]]
+    verts, rings, faces, meshes, ok = roof_meshes(
+        ROOF_KINDS[kind], coords, ring_offsets, shape_offsets, plane.astype(np.int8), size_a, size_b,
+        value, by_height, overhang, index.astype(np.int64))
+    vertex_shape = segment_of(meshes)[segment_of(faces)[segment_of(rings)]]
+    vplane = plane[vertex_shape].astype(np.int64)
+    local = np.zeros((len(verts), 3))
+    at = np.arange(len(verts))
+    local[at, PLANE_U[vplane]] = verts[:, 0]
+    local[at, PLANE_V[vplane]] = verts[:, 1]
+    local[at, vplane] = verts[:, 2]
+    turn = _ROOF_FRAME[plane.astype(np.int64)]
+    roofed = np.einsum("vij,vj->vi", turn[vertex_shape], local)
+    vertex_offsets = rings[faces[meshes]]
+    low = np.stack([segment_reduce(np.minimum, roofed[:, j], vertex_offsets, 0.0) for j in range(3)], 1)
+    high = np.stack([segment_reduce(np.maximum, roofed[:, j], vertex_offsets, 0.0) for j in range(3)], 1)
+    size = high - low
+    scale = np.where(size > TOL.zero, size, np.inf)
+    normalized = (roofed - low[vertex_shape]) / scale[vertex_shape]
+    ids = chunk.meshes.add(normalized, rings, faces, meshes)
+    parent_axes = chunk.frames[shapes.frame]
+    axes = np.einsum("nij,njk->nik", turn, parent_axes)
+    frame = shapes.frame.copy()
+    turned = plane != 1
+    if turned.any():
+        frame[turned] = chunk.frames.add(axes[turned])
+    origin = shapes.origin + np.einsum("ni,nij->nj", low, axes)
+    geom = (MESH_BASE + ids).astype(np.int32)
+    return shapes.with_scope(origin, np.where(size > TOL.zero, size, 0.0), frame, geom), ~ok
+
+
+def mesh_components(chunk: Chunk, shapes: Shapes):
+    """The faces of mesh shapes as polygon shapes' scopes: parent (m,), index (m,), origin (m, 3) and
+    axes (m, 3, 3) in the parent's frame, size (m, 3), geom (m,) new polygons (plane z)."""
+    verts, ring_offsets, face_offsets, mesh_offsets, _ = face_vertices(
+        chunk.meshes, shapes.geom - MESH_BASE, shapes.size)
+    origin, axes, size, uv, ok = face_frames(verts, ring_offsets, face_offsets, TOL.zero)
+    face_mesh = segment_of(mesh_offsets)
+    index = np.arange(len(face_mesh)) - mesh_offsets[face_mesh]
+    geom = chunk.polygons.add(uv, ring_offsets, face_offsets, np.full(len(face_mesh), 2, dtype=np.int8))
+    return face_mesh[ok], index[ok], origin[ok], axes[ok], size[ok], geom[ok]
+
+
+def mesh_leaves(chunk: Chunk, shapes: Shapes, symbol: int, colors) -> MeshChunk:
+    """The faces of leaf mesh shapes in world coordinates."""
+    verts, ring_offsets, face_offsets, mesh_offsets, vertex_shape = face_vertices(
+        chunk.meshes, shapes.geom - MESH_BASE, shapes.size)
+    axes = chunk.frames[shapes.frame]
+    world = shapes.origin[vertex_shape] + np.einsum("vi,vij->vj", verts, axes[vertex_shape])
+    face_shape = segment_of(mesh_offsets)
+    return MeshChunk(
+        vertices=world.astype(np.float32), ring_offsets=ring_offsets, face_offsets=face_offsets,
+        lot=shapes.lot[face_shape].astype(np.int32), symbol=np.full(len(face_shape), symbol, dtype=np.int32),
+        color=colors[face_shape] if colors is not None else None)

@@ -1,0 +1,310 @@
+"""Roofs of many polygons in one numba pass: hip, gable, shed and pyramid, as CityEngine builds them.
+
+Input is the ragged polygon store's layout (normalized (u, v) rings, exterior counter-clockwise around
+the plane's normal, holes clockwise) with each polygon's size along u and v. Output is one mesh per
+polygon, in (a, b, h) coordinates: a and b along the polygon's axes in the polygon's units, h along
+its normal. Face 0 of every mesh is the original polygon seen from below (CityEngine's
+``roof.bottom``), then come the roof faces:
+
+- ``hip``: one face per edge, from the straight skeleton (``skeleton.py``); the face starts with its
+  eave, so a comp(f) scope runs along the eave and up the slope;
+- ``gable``: the hip roof, where each triangular hip end whose apex ends a ridge is turned into a
+  vertical gable by moving the apex onto the end's eave line; footprints whose skeleton has no ridge
+  (a regular polygon's is one point) keep their hips;
+- ``shed``: one sloped face rising from edge ``index`` of the exterior ring, and a vertical wall under
+  each edge (none where the wall has no height);
+- ``pyramid``: the average of the exterior's vertices lifted, and a triangle per exterior edge; holes
+  stay in the bottom face only.
+
+``value`` is the slope angle in degrees, or with ``by_height`` the roof's height (hip and gable: the
+highest skeleton node; shed: the highest point; pyramid: the apex). Overhangs (hip and gable) are
+measured on the roof plane, as CityEngine's are; with ``by_height`` they are measured horizontally,
+because the slope is only known once the skeleton is. Gable ends overhang by the same distance as eaves.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+from grammarc.geometry.skeleton import skeleton_faces
+
+HIP, GABLE, SHED, PYRAMID = 0, 1, 2, 3
+ROOF_KINDS = {"roofHip": HIP, "roofGable": GABLE, "roofShed": SHED, "roofPyramid": PYRAMID}
+
+
+@njit(cache=True)
+def _grow(a, need):
+    """``a`` with room for ``need`` rows (doubling), the first rows kept."""
+    if need <= len(a):
+        return a
+    shape = (max(need, 2 * len(a)),) + a.shape[1:]
+    out = np.empty(shape, a.dtype)
+    out[: len(a)] = a
+    return out
+
+
+@njit(cache=True)
+def _clean_rings(pts, ring_offsets, eps):
+    """Rings without repeated vertices and without vertices between collinear edges; rings left with
+    fewer than three vertices are dropped (the exterior too: then nothing is left)."""
+    out = np.empty_like(pts)
+    offsets = np.zeros(len(ring_offsets), np.int64)
+    n_out = 0
+    n_rings = 0
+    for r in range(len(ring_offsets) - 1):
+        r0, r1 = ring_offsets[r], ring_offsets[r + 1]
+        keep = np.ones(r1 - r0, np.bool_)
+        for _ in range(r1 - r0):  # each pass may expose a new collinear vertex
+            changed = False
+            m = r1 - r0
+            for j in range(m):
+                if not keep[j]:
+                    continue
+                p = j - 1
+                while not keep[p % m]:
+                    p -= 1
+                q = j + 1
+                while not keep[q % m]:
+                    q += 1
+                p, q = p % m, q % m
+                if p == j or q == j:
+                    break
+                ax, ay = pts[r0 + j, 0] - pts[r0 + p, 0], pts[r0 + j, 1] - pts[r0 + p, 1]
+                bx, by = pts[r0 + q, 0] - pts[r0 + j, 0], pts[r0 + q, 1] - pts[r0 + j, 1]
+                la, lb = np.sqrt(ax * ax + ay * ay), np.sqrt(bx * bx + by * by)
+                if la <= eps or (lb > eps and abs(ax * by - ay * bx) <= eps * (la + lb)
+                                 and ax * bx + ay * by > 0):
+                    keep[j] = False
+                    changed = True
+            if not changed:
+                break
+        count = 0
+        for j in range(r1 - r0):
+            if keep[j]:
+                out[n_out + count] = pts[r0 + j]
+                count += 1
+        if count >= 3:
+            n_out += count
+            n_rings += 1
+            offsets[n_rings] = n_out
+        elif r == 0:
+            return out[:0], offsets[:1]
+    return out[:n_out], offsets[: n_rings + 1]
+
+
+@njit(cache=True)
+def _gable_apexes(node_xy, node_t, faces, face_offsets, xy, succ, start_time, eps):
+    """Move the apex of each hip end that ends a ridge onto its eave line (in place)."""
+    n = len(face_offsets) - 1
+    apex = np.full(n, -1, np.int64)
+    for k in range(n):
+        if face_offsets[k + 1] - face_offsets[k] == 3:
+            apex[k] = faces[face_offsets[k] + 2]
+    moves = np.zeros((n, 2))
+    for k in range(n):
+        if apex[k] < 0:
+            continue
+        # hip ends meeting in one point: a ridge end only for one, or two opposite ones
+        dx, dy = xy[succ[k], 0] - xy[k, 0], xy[succ[k], 1] - xy[k, 1]
+        length = np.sqrt(dx * dx + dy * dy)
+        dx, dy = dx / length, dy / length
+        others = 0
+        opposite = True
+        for j in range(n):
+            if j == k or apex[j] < 0:
+                continue
+            if (abs(node_xy[apex[j], 0] - node_xy[apex[k], 0]) <= eps
+                    and abs(node_xy[apex[j], 1] - node_xy[apex[k], 1]) <= eps):
+                others += 1
+                ex, ey = xy[succ[j], 0] - xy[j, 0], xy[succ[j], 1] - xy[j, 1]
+                if (dx * ex + dy * ey) / np.sqrt(ex * ex + ey * ey) > -0.999:
+                    opposite = False
+        if others > 1 or not opposite:
+            continue
+        # along the inward normal back to the eave line (the edge moved out by the overhang)
+        shift = node_t[apex[k]] - start_time
+        moves[k, 0], moves[k, 1] = dy * shift, -dx * shift
+    for k in range(n):
+        if apex[k] >= 0:
+            node_xy[apex[k], 0] += moves[k, 0]
+            node_xy[apex[k], 1] += moves[k, 1]
+
+
+@njit(cache=True)
+def roof_meshes(kind, coords, ring_offsets, poly_offsets, plane, size_a, size_b, value, by_height,
+                overhang, index):
+    """Roof meshes of k polygons.
+
+    kind : HIP, GABLE, SHED or PYRAMID. coords (V, 2), ring_offsets, poly_offsets : the polygons in the
+    store's layout; plane (k,) int8 their plane codes; size_a, size_b (k,) their sizes along u and v;
+    value (k,) the angle in degrees or (``by_height``) the height; overhang (k,) for hip and gable;
+    index (k,) int64 the shed's edge.
+    Returns verts (V', 3) as (a, b, h), ring_offsets (R'+1,), face_offsets (F'+1,) into rings,
+    mesh_offsets (k+1,) into faces, and ok (k,): False where the roof could not be made.
+    """
+    k_polys = len(poly_offsets) - 1
+    verts = np.empty((max(16, 8 * len(coords)), 3))
+    rings = np.zeros(max(16, 4 * len(ring_offsets)), np.int64)
+    faces = np.zeros(max(16, 4 * len(ring_offsets)), np.int64)
+    mesh_offsets = np.zeros(k_polys + 1, np.int64)
+    ok = np.ones(k_polys, np.bool_)
+    n_v = 0
+    n_r = 0
+    n_f = 0
+    for g in range(k_polys):
+        r_first, r_last = poly_offsets[g], poly_offsets[g + 1]
+        v0, v1 = ring_offsets[r_first], ring_offsets[r_last]
+        pts = np.empty((v1 - v0, 2))
+        pts[:, 0] = coords[v0:v1, 0] * size_a[g]
+        pts[:, 1] = coords[v0:v1, 1] * size_b[g]
+        area = 0.0
+        e0, e1 = ring_offsets[r_first] - v0, ring_offsets[r_first + 1] - v0
+        for j in range(e0, e1):
+            q = e0 + (j - e0 + 1) % (e1 - e0)
+            area += pts[j, 0] * pts[q, 1] - pts[q, 0] * pts[j, 1]
+        flip = area < 0.0
+        if flip:
+            pts[:, 1] = -pts[:, 1]
+        scale = max(size_a[g], size_b[g], 1e-300)
+        eps = 1e-9 * max(scale, 1.0)
+        pts, pring = _clean_rings(pts, ring_offsets[r_first:r_last + 1] - v0, eps)
+        angle = np.radians(value[g])
+        if len(pring) < 2 or (not by_height and not (-np.pi / 2 < angle < np.pi / 2)):
+            ok[g] = False
+            mesh_offsets[g + 1] = n_f
+            continue
+        slope = np.tan(angle)
+        n = len(pts)
+        succ = np.empty(n, np.int64)
+        for r in range(len(pring) - 1):
+            for j in range(pring[r], pring[r + 1]):
+                succ[j] = pring[r] + (j - pring[r] + 1) % (pring[r + 1] - pring[r])
+        # ---- the roof's points (x, y, h) and its faces as rings of point ids
+        if kind == HIP or kind == GABLE:
+            start_time = -overhang[g] * (1.0 if by_height else np.cos(angle))
+            node_xy, node_t, fnodes, foff, done = skeleton_faces(pts, pring, start_time)
+            if not done:
+                ok[g] = False
+                mesh_offsets[g + 1] = n_f
+                continue
+            if kind == GABLE:
+                _gable_apexes(node_xy, node_t, fnodes, foff, pts, succ, start_time, eps)
+            if by_height:
+                top = node_t.max()
+                slope = value[g] / top if top > eps else 0.0
+            point = np.empty((len(node_xy), 3))
+            point[:, 0] = node_xy[:, 0]
+            point[:, 1] = node_xy[:, 1]
+            point[:, 2] = node_t * slope
+            face_ids = fnodes
+            face_off = foff
+            lifted = np.empty(0)
+        elif kind == SHED:
+            ext = pring[1]
+            e = index[g] % ext
+            q = succ[e]
+            dx, dy = pts[q, 0] - pts[e, 0], pts[q, 1] - pts[e, 1]
+            length = np.sqrt(dx * dx + dy * dy)
+            nx, ny = -dy / length, dx / length
+            dist = (pts[:, 0] - pts[e, 0]) * nx + (pts[:, 1] - pts[e, 1]) * ny
+            if by_height:
+                slope = value[g] / dist.max() if dist.max() > eps else 0.0
+            # points: the lifted polygon (the sloped face, appended with the bottom), then the
+            # polygon's own vertices for the walls
+            point = np.empty((2 * n, 3))
+            point[:n, :2] = pts
+            point[:n, 2] = dist * slope
+            point[n:, :2] = pts
+            point[n:, 2] = 0.0
+            lifted = point[:n, 2]
+            face_ids = np.empty(4 * n, np.int64)
+            face_off = np.zeros(n + 1, np.int64)
+            count = 0
+            n_face = 0
+            for j in range(n):
+                hj, hq = point[j, 2], point[succ[j], 2]
+                if abs(hj) <= eps and abs(hq) <= eps:
+                    continue
+                face_ids[count], face_ids[count + 1] = n + j, n + succ[j]
+                face_ids[count + 2], face_ids[count + 3] = succ[j], j
+                count += 4
+                n_face += 1
+                face_off[n_face] = count
+            face_ids = face_ids[:count]
+            face_off = face_off[: n_face + 1]
+        else:
+            ext = pring[1]
+            cx, cy = pts[:ext, 0].mean(), pts[:ext, 1].mean()
+            height = value[g]
+            if not by_height:
+                dx, dy = pts[1, 0] - pts[0, 0], pts[1, 1] - pts[0, 1]
+                length = np.sqrt(dx * dx + dy * dy)
+                height = slope * abs((cx - pts[0, 0]) * -dy + (cy - pts[0, 1]) * dx) / length
+            point = np.empty((ext + 1, 3))
+            point[:ext, :2] = pts[:ext]
+            point[:ext, 2] = 0.0
+            point[ext, 0], point[ext, 1], point[ext, 2] = cx, cy, height
+            lifted = np.empty(0)
+            face_ids = np.empty(3 * ext, np.int64)
+            face_off = np.zeros(ext + 1, np.int64)
+            for j in range(ext):
+                face_ids[3 * j], face_ids[3 * j + 1], face_ids[3 * j + 2] = j, succ[j], ext
+                face_off[j + 1] = 3 * j + 3
+        # ---- append: the bottom (seen from below), the shed's sloped face, then the roof faces
+        # without repeated points
+        n_rings_new = 2 * (len(pring) - 1) + len(face_off) - 1
+        verts = _grow(verts, n_v + 2 * n + len(face_ids))
+        rings = _grow(rings, n_r + n_rings_new + 1)
+        faces = _grow(faces, n_f + len(face_off) + 2)
+        reverse = flip != (plane[g] == 1)
+        mesh_start = n_v
+        for cap in range(1 + (len(lifted) > 0)):
+            for r in range(len(pring) - 1):
+                for j in range(pring[r], pring[r + 1]):
+                    # the bottom runs backwards unless the output is reversed anyway
+                    at = j if (cap == 1) != reverse else pring[r + 1] - 1 - (j - pring[r])
+                    verts[n_v, 0], verts[n_v, 1] = pts[at, 0], pts[at, 1]
+                    verts[n_v, 2] = lifted[at] if cap == 1 else 0.0
+                    n_v += 1
+                rings[n_r + 1] = n_v
+                n_r += 1
+            n_f += 1
+            faces[n_f] = n_r
+        for f in range(len(face_off) - 1):
+            start = n_v
+            for j in range(face_off[f], face_off[f + 1]):
+                p = point[face_ids[j]]
+                if n_v > start and (abs(p[0] - verts[n_v - 1, 0]) <= eps and abs(p[1] - verts[n_v - 1, 1])
+                                    <= eps and abs(p[2] - verts[n_v - 1, 2]) <= eps):
+                    continue
+                verts[n_v] = p
+                n_v += 1
+            while n_v - start > 1 and (abs(verts[start, 0] - verts[n_v - 1, 0]) <= eps
+                                       and abs(verts[start, 1] - verts[n_v - 1, 1]) <= eps
+                                       and abs(verts[start, 2] - verts[n_v - 1, 2]) <= eps):
+                n_v -= 1
+            if n_v - start < 3:
+                n_v = start  # a face that shrank to an edge or a point
+                continue
+            if reverse:
+                _reverse_keeping_first_edge(verts, start, n_v)
+            rings[n_r + 1] = n_v
+            n_r += 1
+            n_f += 1
+            faces[n_f] = n_r
+        if flip:
+            verts[mesh_start:n_v, 1] = -verts[mesh_start:n_v, 1]
+        mesh_offsets[g + 1] = n_f
+    return verts[:n_v], rings[: n_r + 1], faces[: n_f + 1], mesh_offsets, ok
+
+
+@njit(cache=True)
+def _reverse_keeping_first_edge(verts, start, end):
+    """Reverse a ring so that its first edge stays first (reversed): [0, 1, 2, 3] -> [1, 0, 3, 2]."""
+    ring = verts[start:end].copy()
+    m = end - start
+    verts[start] = ring[1]
+    verts[start + 1] = ring[0]
+    for j in range(2, m):
+        verts[start + j] = ring[m + 1 - j]

@@ -1,0 +1,299 @@
+"""Straight skeletons of many polygons with holes, in one numba pass: the faces of hip roofs.
+
+Every edge line moves inward at unit speed (``n . x = c + t``, n the inward normal), and the wavefront
+polygon is the set of the moved lines between its vertices. Its vertices live in a circular doubly
+linked list (``prev``/``next``) over all rings at once, so a split event that joins a hole to the outer
+ring and one that cuts a ring in two are the same relinking. Events, the earliest first:
+
+- edge event: an edge of the wavefront shrinks to nothing where its line and its neighbours' lines
+  meet; its two vertices become one;
+- split event: a reflex vertex reaches the line of another wavefront edge between that edge's
+  vertices; the ring is cut there (or two rings join).
+
+Event points are found by solving for the point and time at which three moving lines meet, never by
+moving vertices, so collinear-opposite edges (the ridge of a rectangle) need no special velocity.
+Each vertex's path, from the node where it was made to the node where it ended, is an arc between the
+faces of its two edges; the face of an input edge is the cycle of arcs that have that edge on one
+side. A ring that shrinks to two vertices has become a ridge segment: one arc closes it.
+
+Cost is O(n^2) per event and O(n) events per polygon, cubic in the vertices of one polygon but linear
+in the number of polygons: real footprints have tens of vertices. A polygon whose skeleton cannot be
+completed (degenerate input that the events do not resolve) is flagged, and its shape is reported.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+#: Relative tolerance of event times and positions (times are distances, in the polygon's units).
+_EPS = 1e-9
+
+
+@njit(cache=True)
+def _solve3(a0, a1, a2, b0, b1, b2, c0, c1, c2):
+    """The point (x, y) and time t where three moving lines (nx, ny, c: n . x = c + t) meet; ok False
+    when they never meet in one point (two of them parallel and apart, or all concurrent always)."""
+    det = a0 * (b1 * -1.0 - (-1.0) * c1) - a1 * (b0 * -1.0 - (-1.0) * c0) + (-1.0) * (b0 * c1 - b1 * c0)
+    if abs(det) < 1e-12:
+        return 0.0, 0.0, 0.0, False
+    # Cramer's rule on [[a0, a1, -1], [b0, b1, -1], [c0, c1, -1]] (x, y, t) = (a2, b2, c2)
+    dx = a2 * (b1 * -1.0 - (-1.0) * c1) - a1 * (b2 * -1.0 - (-1.0) * c2) + (-1.0) * (b2 * c1 - b1 * c2)
+    dy = a0 * (b2 * -1.0 - (-1.0) * c2) - a2 * (b0 * -1.0 - (-1.0) * c0) + (-1.0) * (b0 * c2 - b2 * c0)
+    dt = a0 * (b1 * c2 - b2 * c1) - a1 * (b0 * c2 - b2 * c0) + a2 * (b0 * c1 - b1 * c0)
+    return dx / det, dy / det, dt / det, True
+
+
+@njit(cache=True)
+def _vertex_at(nrm, c, e0, e1, t):
+    """Where the lines of edges e0 and e1 cross at time t; ok False when they are parallel."""
+    a0, a1, b0, b1 = nrm[e0, 0], nrm[e0, 1], nrm[e1, 0], nrm[e1, 1]
+    det = a0 * b1 - a1 * b0
+    if abs(det) < 1e-12:
+        return 0.0, 0.0, False
+    r0, r1 = c[e0] + t, c[e1] + t
+    return (r0 * b1 - a1 * r1) / det, (a0 * r1 - r0 * b0) / det, True
+
+
+@njit(cache=True)
+def skeleton_faces(xy, ring_offsets, start_time):
+    """Faces of the straight skeleton of one polygon with holes.
+
+    xy : (n, 2) float64, the polygon's vertices, exterior counter-clockwise then holes clockwise (ring
+    ``r`` is ``ring_offsets[r]:ring_offsets[r+1]``), without repeated or collinear consecutive vertices.
+    start_time : <= 0; the wavefront starts from the edges moved out by -start_time (an overhang).
+    Returns node_xy (N, 2), node_t (N,), face_nodes (ragged node ids of each edge's face, starting with
+    the edge's two ends), face_offsets (n+1,) and ok.
+    """
+    n = len(xy)
+    cap = 6 * n + 16
+    # edge lines: edge k runs from vertex k to the next vertex of its ring
+    succ = np.empty(n, np.int64)
+    pred = np.empty(n, np.int64)
+    for r in range(len(ring_offsets) - 1):
+        r0, r1 = ring_offsets[r], ring_offsets[r + 1]
+        for k in range(r0, r1):
+            succ[k] = r0 + (k - r0 + 1) % (r1 - r0)
+            pred[k] = r0 + (k - r0 - 1) % (r1 - r0)
+    nrm = np.empty((n, 2))
+    c = np.empty(n)
+    direction = np.empty((n, 2))
+    scale = 0.0
+    for k in range(n):
+        dx, dy = xy[succ[k], 0] - xy[k, 0], xy[succ[k], 1] - xy[k, 1]
+        length = np.sqrt(dx * dx + dy * dy)
+        scale = max(scale, abs(xy[k, 0]), abs(xy[k, 1]), length)
+        if length == 0.0:
+            length = 1.0
+        direction[k, 0], direction[k, 1] = dx / length, dy / length
+        nrm[k, 0], nrm[k, 1] = -dy / length, dx / length
+        c[k] = nrm[k, 0] * xy[k, 0] + nrm[k, 1] * xy[k, 1]
+    eps = _EPS * max(scale, 1.0)
+
+    node_xy = np.empty((cap, 2))
+    node_t = np.empty(cap)
+    in_edge = np.empty(cap, np.int64)
+    out_edge = np.empty(cap, np.int64)
+    prev = np.empty(cap, np.int64)
+    nxt = np.empty(cap, np.int64)
+    alive = np.zeros(cap, np.bool_)
+    start = np.empty(cap, np.int64)
+    # arcs: (from node, to node, in edge, out edge); the in edge's face runs along it, the out edge's
+    # face against it
+    arcs = np.empty((cap, 4), np.int64)
+    n_arcs = 0
+    for k in range(n):
+        in_edge[k], out_edge[k], prev[k], nxt[k] = pred[k], k, pred[k], succ[k]
+        alive[k] = True
+        start[k] = k
+        if start_time == 0.0:
+            node_xy[k, 0], node_xy[k, 1] = xy[k, 0], xy[k, 1]
+        else:
+            px, py, ok = _vertex_at(nrm, c, pred[k], k, start_time)
+            if not ok:
+                px, py = xy[k, 0] - nrm[k, 0] * start_time, xy[k, 1] - nrm[k, 1] * start_time
+            node_xy[k, 0], node_xy[k, 1] = px, py
+        node_t[k] = start_time
+    n_nodes = n
+    n_verts = n
+    now = start_time
+    ok = True
+    alive_count = n
+    for _ in range(cap):
+        if alive_count == 0:
+            break
+        # ---- the earliest event
+        best_t = np.inf
+        best_kind = -1
+        best_v = -1
+        best_u = -1
+        best_x = 0.0
+        best_y = 0.0
+        for v in range(n_verts):
+            if not alive[v]:
+                continue
+            w = nxt[v]
+            a, e, b = in_edge[v], out_edge[v], out_edge[w]
+            x, y, t, solved = _solve3(nrm[a, 0], nrm[a, 1], c[a], nrm[e, 0], nrm[e, 1], c[e],
+                                      nrm[b, 0], nrm[b, 1], c[b])
+            if solved and t >= now - eps and t < best_t - eps:
+                best_t, best_kind, best_v, best_x, best_y = t, 0, v, x, y
+        for v in range(n_verts):
+            if not alive[v]:
+                continue
+            a, b = in_edge[v], out_edge[v]
+            if direction[a, 0] * direction[b, 1] - direction[a, 1] * direction[b, 0] > -1e-12:
+                continue  # not reflex
+            vx, vy, moving = _vertex_at(nrm, c, a, b, now)
+            if not moving:
+                continue
+            for u in range(n_verts):
+                if not alive[u] or u == v or nxt[u] == v:
+                    continue
+                e = out_edge[u]
+                if e == a or e == b:
+                    continue
+                # v must be ahead of the edge's line now, and meet it later
+                if nrm[e, 0] * vx + nrm[e, 1] * vy - c[e] - now < -eps:
+                    continue
+                x, y, t, solved = _solve3(nrm[a, 0], nrm[a, 1], c[a], nrm[b, 0], nrm[b, 1], c[b],
+                                          nrm[e, 0], nrm[e, 1], c[e])
+                if not solved or t < now - eps or t >= best_t - eps:
+                    continue
+                w = nxt[u]
+                ux, uy, ok_u = _vertex_at(nrm, c, in_edge[u], e, t)
+                wx, wy, ok_w = _vertex_at(nrm, c, e, out_edge[w], t)
+                if not (ok_u and ok_w):
+                    continue
+                s = (x - ux) * direction[e, 0] + (y - uy) * direction[e, 1]
+                length = (wx - ux) * direction[e, 0] + (wy - uy) * direction[e, 1]
+                if s < -eps or s > length + eps:
+                    continue
+                best_t, best_kind, best_v, best_u, best_x, best_y = t, 1, v, u, x, y
+        if best_kind < 0 or n_verts + 2 > cap or n_nodes + 1 > cap or n_arcs + 4 > cap:
+            ok = False
+            break
+        now = max(best_t, now)
+        node = n_nodes
+        node_xy[node, 0], node_xy[node, 1] = best_x, best_y
+        node_t[node] = now
+        n_nodes += 1
+        v = best_v
+        if best_kind == 0:
+            # ---- edge event: v and its successor w become z
+            w = nxt[v]
+            for q in (v, w):
+                arcs[n_arcs, 0], arcs[n_arcs, 1] = start[q], node
+                arcs[n_arcs, 2], arcs[n_arcs, 3] = in_edge[q], out_edge[q]
+                n_arcs += 1
+                alive[q] = False
+            alive_count -= 2
+            if prev[v] == w:  # a ring of two: both ended here
+                continue
+            z = n_verts
+            n_verts += 1
+            in_edge[z], out_edge[z] = in_edge[v], out_edge[w]
+            prev[z], nxt[z] = prev[v], nxt[w]
+            nxt[prev[v]] = z
+            prev[nxt[w]] = z
+            start[z] = node
+            alive[z] = True
+            alive_count += 1
+            n_arcs, alive_count = _close_pair(z, nxt, in_edge, out_edge, start, alive, arcs, n_arcs,
+                                              alive_count)
+        else:
+            # ---- split event: v reaches edge u -> w; X ends the ring before v, Y starts the one after
+            u = best_u
+            w = nxt[u]
+            arcs[n_arcs, 0], arcs[n_arcs, 1] = start[v], node
+            arcs[n_arcs, 2], arcs[n_arcs, 3] = in_edge[v], out_edge[v]
+            n_arcs += 1
+            alive[v] = False
+            e = out_edge[u]
+            x_v, y_v = n_verts, n_verts + 1
+            n_verts += 2
+            in_edge[x_v], out_edge[x_v], prev[x_v], nxt[x_v] = in_edge[v], e, prev[v], w
+            in_edge[y_v], out_edge[y_v], prev[y_v], nxt[y_v] = e, out_edge[v], u, nxt[v]
+            nxt[prev[v]] = x_v
+            prev[w] = x_v
+            nxt[u] = y_v
+            prev[nxt[v]] = y_v
+            for q in (x_v, y_v):
+                start[q] = node
+                alive[q] = True
+            alive_count += 1
+            for q in (x_v, y_v):
+                if alive[q]:
+                    n_arcs, alive_count = _close_pair(q, nxt, in_edge, out_edge, start, alive, arcs,
+                                                      n_arcs, alive_count)
+    if alive_count != 0:
+        ok = False
+    face_nodes, face_offsets, faces_ok = _faces(arcs[:n_arcs], n, succ)
+    return node_xy[:n_nodes], node_t[:n_nodes], face_nodes, face_offsets, ok and faces_ok
+
+
+@njit(cache=True)
+def _close_pair(z, nxt, in_edge, out_edge, start, alive, arcs, n_arcs, alive_count):
+    """A ring of two vertices (the new ``z`` and an older one) has no area left: the older vertex's
+    path runs to z's node, and the ring is done. Rings of one vertex (a degenerate collapse) end too."""
+    other = nxt[z]
+    if other == z:
+        alive[z] = False
+        return n_arcs, alive_count - 1
+    if nxt[other] != z:
+        return n_arcs, alive_count
+    arcs[n_arcs, 0], arcs[n_arcs, 1] = start[other], start[z]
+    arcs[n_arcs, 2], arcs[n_arcs, 3] = in_edge[other], out_edge[other]
+    n_arcs += 1
+    alive[z] = False
+    alive[other] = False
+    return n_arcs, alive_count - 2
+
+
+@njit(cache=True)
+def _faces(arcs, n, succ):
+    """The face of each input edge as a cycle of nodes: the edge from node k to node succ[k], then the
+    arcs that have k on one side, each followed from the node the last one reached."""
+    m = len(arcs)
+    # directed segments per face: the in edge's face along the arc, the out edge's against it
+    seg_face = np.empty(2 * m, np.int64)
+    seg_from = np.empty(2 * m, np.int64)
+    seg_to = np.empty(2 * m, np.int64)
+    for i in range(m):
+        seg_face[2 * i], seg_from[2 * i], seg_to[2 * i] = arcs[i, 2], arcs[i, 0], arcs[i, 1]
+        seg_face[2 * i + 1], seg_from[2 * i + 1], seg_to[2 * i + 1] = arcs[i, 3], arcs[i, 1], arcs[i, 0]
+    order = np.argsort(seg_face, kind="mergesort")
+    first = np.zeros(n + 1, np.int64)
+    for i in range(2 * m):
+        first[seg_face[i] + 1] += 1
+    for k in range(n):
+        first[k + 1] += first[k]
+    used = np.zeros(2 * m, np.bool_)
+    out = np.empty(2 * m + 2 * n, np.int64)
+    offsets = np.zeros(n + 1, np.int64)
+    count = 0
+    ok = True
+    for k in range(n):
+        out[count] = k
+        out[count + 1] = succ[k]
+        count += 2
+        here = succ[k]
+        steps = 0
+        while here != k:
+            found = -1
+            for j in range(first[k], first[k + 1]):
+                s = order[j]
+                if not used[s] and seg_from[s] == here:
+                    found = s
+                    break
+            if found < 0 or steps > first[k + 1] - first[k]:
+                ok = False
+                break
+            used[found] = True
+            here = seg_to[found]
+            steps += 1
+            if here != k:
+                out[count] = here
+                count += 1
+        offsets[k + 1] = count
+    return out[:count], offsets, ok

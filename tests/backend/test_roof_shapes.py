@@ -1,0 +1,97 @@
+"""backend/roofs.py: roof shapes in derivations - scopes as CityEngine sets them, component splits, leaves,
+measures, errors."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from conftest import LOT_ZOO
+from test_cityengine import assets, face_area, mesh_faces, names, rect, run, totals
+
+from grammarc.errors import GrammarError
+
+TAN30 = np.tan(np.radians(30))
+
+
+def test_roof_on_a_footprint_keeps_x_puts_y_up_and_fits_the_mesh(write):
+    r = run(write, "Lot --> roofHip(30) Roof\nRoof --> primitiveCube()\n", [rect(12, 8)])
+    [x] = r["xform"]
+    np.testing.assert_allclose(x[:, 0], [12, 0, 0], atol=1e-6)
+    np.testing.assert_allclose(x[:, 1], [0, 4 * TAN30, 0], atol=1e-6)
+    np.testing.assert_allclose(x[:, 3], [0, 0, -8], atol=1e-6)
+
+
+def test_roof_on_the_top_face_of_a_mass_sits_on_it(write):
+    text = ("Lot --> extrude(10) comp(f){ top : Top | all : NIL }\n"
+            "Top --> roofGable(30) Roof\nRoof --> primitiveCube()\n")
+    [x] = run(write, text, [rect(12, 8)])["xform"]
+    # the top face's normal is world +y: the roof's y; its x stays along the lot's x
+    np.testing.assert_allclose(x[:, 1], [0, 4 * TAN30, 0], atol=1e-6)
+    np.testing.assert_allclose(x[:, 0] / np.linalg.norm(x[:, 0]), [1, 0, 0], atol=1e-9)
+    assert x[1, 3] == pytest.approx(10.0)
+
+
+def test_roof_leaf_is_its_faces_and_comp_selects_them_by_normal(write):
+    r = run(write, "Lot --> roofGable(30) Roof\n", [rect(12, 8)])
+    faces = mesh_faces(r)
+    assert len(faces) == 5 and names(r) == []
+    # bottom, two slopes of 12 x 4 / cos 30, two gable triangles of 8 x (4 tan 30) / 2
+    total = sum(face_area(f) for f in faces)
+    assert total == pytest.approx(96 + 96 / np.cos(np.radians(30)) + 8 * 4 * TAN30)
+    text = ("Lot --> roofGable(30) comp(f){ bottom : B | top : T | side : S }\n"
+            "B --> primitiveCube()\nT --> primitiveCube()\nS --> primitiveCube()\n")
+    r = run(write, text, [rect(12, 8)])
+    assert sorted(names(r)) == ["B", "S", "S", "T", "T"]
+
+
+def test_roof_faces_have_eave_aligned_scopes_and_their_areas(write):
+    text = "Lot --> roofHip(30) comp(f){ top : Plane }\nPlane --> report(\"a\", geometry.area) primitiveCube()\n"
+    r = run(write, text, [rect(12, 8)])
+    x = r["xform"].astype(float)
+    # every roof plane: x along its eave (horizontal), y up the slope at 30 degrees
+    assert np.abs(x[:, 1, 0]).max() < 1e-6
+    rise = x[:, 1, 1] / np.linalg.norm(x[:, :, 1], axis=1)
+    np.testing.assert_allclose(rise, np.sin(np.radians(30)), atol=1e-6)
+    assert totals(r)["a_sum"] == pytest.approx(12 * 8 / np.cos(np.radians(30)))
+
+
+def test_geometry_volume_and_area_of_a_roof(write):
+    text = ('Lot --> roofHip(30) report("v", geometry.volume) report("n", geometry.nFaces) '
+            'report("k", geometry.nVertices)\n')
+    r = run(write, text, [rect(12, 8)])
+    h = 4 * TAN30
+    assert totals(r)["v_sum"] == pytest.approx(12 * 8 * h / 2 - 64 * h / 6)
+    assert totals(r)["n_sum"] == 5 and totals(r)["k_sum"] == 6
+
+
+@pytest.mark.parametrize("op", ["roofHip(30)", "roofGable(30, 0.5)", "roofShed(15, 2)", "roofPyramid(byHeight, 4)",
+                                "roofHip(byHeight, 3, 1)"])
+def test_every_roof_on_every_zoo_lot_derives(write, op):
+    r = run(write, f"Lot --> {op} comp(f){{ all : F }}\nF --> X\n",
+            [LOT_ZOO[n] for n in ("square", "rect_12x8", "concave_L", "courtyard")])
+    assert r["bad"] == () and set(r["mesh"].lot.tolist()) == {0, 1, 2, 3}
+
+
+def test_paper_roof_covers_the_footprint_of_the_mass(write):
+    text = 'lot ~> S(1r, 10, 1r) T(0, 10, 0) Roof("hipped", 30){ roof }\nroof ~> Comp("faces"){ I("cube") }\n'
+    r = run(write, text, [rect(12, 8)], version=False)
+    assert assets(r).count("builtin:cube") == 5
+    assert r["xform"][:, 1, 3].min() == pytest.approx(10.0, abs=1e-5)
+
+
+def test_split_of_a_roof_is_reported_with_the_rule(write):
+    r = run(write, "Lot --> roofHip(30) split(x){ 1 : A }*\n", [rect(12, 8)])
+    [bad] = r["bad"]
+    assert "`split` of a roof is not supported yet" in bad.reason and "rule `Lot`" in bad.reason
+
+
+def test_roof_of_a_solid_and_overhang_y_are_reported(write):
+    r = run(write, "Lot --> extrude(3) roofHip(30)\n", [rect(12, 8)])
+    assert "of a solid" in r["bad"][0].reason
+    r = run(write, "Lot --> roofGable(30, 1, 2)\n", [rect(12, 8)])
+    assert "overhangY other than overhangX" in r["bad"][0].reason
+
+
+def test_paper_roof_types_outside_the_supported_set_are_errors(write):
+    with pytest.raises(GrammarError, match="not supported yet"):
+        run(write, 'lot ~> Roof("gambrel", 30){ roof }\n', [rect(12, 8)], version=False)

@@ -1,0 +1,119 @@
+"""Roof meshes: hip, gable, shed and pyramid against their analytic volumes, closed and outward-facing."""
+
+from __future__ import annotations
+
+from collections import Counter
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+from test_skeleton import COURTYARD, L_SHAPE, OCTAGON, RECT, random_polygon
+
+from grammarc.geometry.roofs import GABLE, HIP, PYRAMID, SHED, roof_meshes
+
+TAN30 = np.tan(np.radians(30))
+
+
+def roof(kind, rings, value=30.0, *, plane=2, by_height=False, overhang=0.0, index=0):
+    """The roof mesh of one polygon given in real units: faces as lists of (V, 3) rings in (a, b, h)."""
+    pts = np.concatenate([np.asarray(r, dtype=float) for r in rings])
+    low, size = pts.min(axis=0), np.ptp(pts, axis=0)
+    ring_offsets = np.cumsum([0] + [len(r) for r in rings]).astype(np.int64)
+    verts, ro, fo, mo, ok = roof_meshes(
+        kind, (pts - low) / size, ring_offsets, np.array([0, len(rings)]), np.array([plane], np.int8),
+        size[:1], size[1:], np.array([value]), by_height, np.array([overhang]), np.array([index]))
+    assert ok.all() and list(mo) == [0, len(fo) - 1]
+    return [[verts[ro[r]:ro[r + 1]] + [*low, 0] for r in range(fo[f], fo[f + 1])] for f in range(len(fo) - 1)]
+
+
+def volume(faces):
+    """Signed volume enclosed by the faces (positive when they face outward), by fans of tetrahedra."""
+    return sum(np.dot(ring[0], np.cross(ring[j], ring[j + 1])) / 6
+               for rings in faces for ring in rings for j in range(1, len(ring) - 1))
+
+
+def unmatched_edges(faces):
+    """Directed edges without their reverse in another face: none for a closed, consistently wound mesh."""
+    edges = Counter()
+    for rings in faces:
+        for ring in rings:
+            keys = [tuple(np.round(p, 6)) for p in ring]
+            for a, b in zip(keys, keys[1:] + keys[:1]):
+                edges[(a, b)] += 1
+    return sum(n for (a, b), n in edges.items() if edges[(b, a)] != n)
+
+
+def test_hip_roof_on_a_rectangle_has_the_analytic_volume_and_ridge():
+    faces = roof(HIP, RECT)
+    length, width = 10.0, 4.0
+    height = width / 2 * TAN30
+    # a gable prism less the two hip wedges
+    assert volume(faces) == pytest.approx(length * width * height / 2 - width**2 * height / 6)
+    ridge = {tuple(p) for f in faces for r in f for p in np.round(r, 9) if abs(p[2] - height) < 1e-9}
+    assert ridge == {(2.0, 2.0, round(height, 9)), (8.0, 2.0, round(height, 9))}
+    assert len(faces) == 5 and unmatched_edges(faces) == 0
+
+
+def test_gable_roof_turns_the_hip_ends_into_vertical_gables():
+    faces = roof(GABLE, RECT)
+    height = 2 * TAN30
+    assert volume(faces) == pytest.approx(10 * 4 * height / 2)
+    normals = [np.cross(f[0][1] - f[0][0], f[0][2] - f[0][1]) for f in faces[1:]]
+    assert sum(abs(n[2]) < 1e-9 for n in normals) == 2 and unmatched_edges(faces) == 0
+
+
+def test_gable_roof_of_a_square_has_one_ridge_and_an_octagon_keeps_its_hips():
+    square = roof(GABLE, [[(0, 0), (6, 0), (6, 6), (0, 6)]])
+    assert volume(square) == pytest.approx(6 * 6 * 3 * TAN30 / 2) and unmatched_edges(square) == 0
+    octagon_hip, octagon_gable = roof(HIP, OCTAGON), roof(GABLE, OCTAGON)
+    assert volume(octagon_gable) == pytest.approx(volume(octagon_hip))
+
+
+def test_shed_rises_from_its_edge_and_pyramid_from_the_vertex_average():
+    shed = roof(SHED, RECT, 45.0, index=1)  # edge 1 is x = 10: the roof rises towards x = 0
+    assert volume(shed) == pytest.approx(4 * 10 * 10 / 2) and unmatched_edges(shed) == 0
+    assert max(p[2] for f in shed for r in f for p in r) == pytest.approx(10.0)
+    pyramid = roof(PYRAMID, RECT, 45.0)
+    assert volume(pyramid) == pytest.approx(40 * 2 / 3) and unmatched_edges(pyramid) == 0
+
+
+@pytest.mark.parametrize("kind", [HIP, GABLE, SHED, PYRAMID])
+def test_by_height_gives_the_roof_that_height(kind):
+    faces = roof(kind, L_SHAPE, 3.5, by_height=True)
+    assert max(p[2] for f in faces for r in f for p in r) == pytest.approx(3.5)
+
+
+def test_overhang_is_measured_on_the_roof_plane():
+    faces = roof(HIP, RECT, overhang=2.0)
+    eaves = min(p[2] for f in faces for r in f for p in r)
+    assert eaves == pytest.approx(-2.0 * np.sin(np.radians(30)))
+    assert faces[1][0][0][:2] == pytest.approx([-2 * np.cos(np.radians(30))] * 2)
+
+
+def test_faces_of_a_store_plane_one_polygon_face_out_in_scope_axes():
+    """Plane 1 maps (a, b, h) onto scope (x, z, y), a mirror: its (counter-clockwise around +y) input
+    runs clockwise in (a, b), and the faces keep facing out of the roof after the mirror."""
+    flipped = [[(p[0], -p[1]) for p in RECT[0]][::-1]]
+    faces = roof(HIP, flipped, plane=1)
+    assert volume(faces) < 0  # in (a, b, h); positive in (x, y, z) = (a, h, b)
+    assert unmatched_edges(faces) == 0
+
+
+def test_collinear_and_repeated_vertices_do_not_change_the_roof():
+    noisy = [[(0, 0), (5, 0), (10, 0), (10, 0), (10, 4), (0, 4)]]
+    assert volume(roof(HIP, noisy)) == pytest.approx(volume(roof(HIP, RECT)))
+
+
+def test_courtyard_hip_roof_is_a_ring_of_constant_section():
+    faces = roof(HIP, COURTYARD)
+    assert volume(faces) == pytest.approx(10 * 5 * TAN30 / 2 * 120)  # section times centre line
+    assert unmatched_edges(faces) == 0
+
+
+@settings(max_examples=100, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.booleans(), st.sampled_from([HIP, GABLE]))
+def test_roofs_of_random_concave_polygons_are_closed_and_face_out(seed, hole, kind):
+    faces = roof(kind, random_polygon(seed, hole))
+    assert unmatched_edges(faces) == 0
+    assert volume(faces) > 0
