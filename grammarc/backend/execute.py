@@ -379,7 +379,7 @@ class Executor:
 
     # ------------------------------------------------------------------------------------------- comp
     def comp(self, op: ir.Comp, cursor: Shapes, symbol: int) -> None:
-        if op.kind != "faces":
+        if comp_kernels.KIND_CODES[op.kind] not in roofs.MESH_KINDS:
             self.refuse_meshes(op, cursor, symbol)
         index_of = None
         if op.index is not None:
@@ -392,7 +392,7 @@ class Executor:
     def components(self, kind: int, cursor: Shapes, site: int, wanted=None):
         """Component shapes of ``cursor``, their normals in the parents' frames (m, 3), their indices
         among their parent's components (m,) and their parents (m,); ``wanted`` (n,) keeps, per shape,
-        only that index. Roofs (meshes) have faces only (``comp_faces`` and ``comp`` check)."""
+        only that index. Roofs (meshes) have faces and edges (``comp_faces`` and ``comp`` check)."""
         chunk = self.chunk
         mesh = is_mesh(cursor.geom)
         pieces = []
@@ -400,7 +400,7 @@ class Executor:
             pieces.append(self.solid_components(kind, cursor, np.flatnonzero(~mesh)))
         if mesh.any():
             which = np.flatnonzero(mesh)
-            parent, index, origin, axes, size, geom = roofs.mesh_components(chunk, cursor.take(which))
+            parent, index, origin, axes, size, geom = roofs.mesh_components(chunk, cursor.take(which), kind)
             pieces.append((which[parent], index, origin, axes, size, geom, axes[:, 2]))
         parent, index, origin, axes, size, geom, normal = (
             pieces[0] if len(pieces) == 1 else
@@ -841,7 +841,7 @@ class Executor:
 
     def comp_faces(self, op: ir.CompFaces, cursor: Shapes, symbol: int) -> None:
         """CityEngine ``comp(f|e|v)``: components to the first selector they match."""
-        if op.offset is not None or op.kind != "f":
+        if op.offset is not None or op.kind == "v":
             self.refuse_meshes(op, cursor, symbol)
         if op.offset is not None:
             self.offset_faces(op, cursor, symbol)

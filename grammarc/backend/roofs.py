@@ -13,11 +13,11 @@ import numpy as np
 from grammarc.backend.chunk import Chunk
 from grammarc.backend.shapes import Shapes
 from grammarc.constants import TOL
-from grammarc.geometry.meshes import MESH_BASE, face_frames, face_vertices
+from grammarc.geometry.meshes import MESH_BASE, face_frames, face_vertices, mesh_edges
 from grammarc.geometry.polygons import PLANE_U, PLANE_V
 from grammarc.geometry.roofs import ROOF_KINDS, roof_meshes
 from grammarc.io.npz import MeshChunk
-from grammarc.ragged import segment_of, segment_reduce
+from grammarc.ragged import rank_within, segment_of, segment_reduce
 
 #: Per normal axis n: the roof frame's axes as rows in the face scope's frame (y' along axis n).
 _ROOF_FRAME = np.array([
@@ -66,16 +66,33 @@ def build_roofs(chunk: Chunk, shapes: Shapes, kind: str, polygons, value, by_hei
     return shapes.with_scope(origin, np.where(size > TOL.zero, size, 0.0), frame, geom), ~ok
 
 
-def mesh_components(chunk: Chunk, shapes: Shapes):
-    """The faces of mesh shapes as polygon shapes' scopes: parent (m,), index (m,), origin (m, 3) and
-    axes (m, 3, 3) in the parent's frame, size (m, 3), geom (m,) new polygons (plane z)."""
+#: Component kinds of roofs (``components.KIND_CODES``): faces and edges. The bottom is face 0.
+FACES, SIDEFACES, BOTTOM, EDGES, SIDEEDGES, TOPEDGES, BOTTOMEDGES = 0, 1, 3, 4, 5, 6, 7
+MESH_KINDS = frozenset({FACES, SIDEFACES, BOTTOM, EDGES, SIDEEDGES, TOPEDGES, BOTTOMEDGES})
+#: mesh_edges' edge kinds wanted by each edge component kind.
+_EDGE_KINDS = {EDGES: (0, 1, 2), BOTTOMEDGES: (0,), SIDEEDGES: (1,), TOPEDGES: (2,)}
+
+
+def mesh_components(chunk: Chunk, shapes: Shapes, kind: int):
+    """Components of mesh shapes: parent (m,), index (m,) among the parent's components of this kind,
+    origin (m, 3) and axes (m, 3, 3) in the parent's frame, size (m, 3), geom (m,): faces become
+    polygons (plane z) with CityEngine's face scopes, edges scope edges (``meshes.mesh_edges``)."""
     verts, ring_offsets, face_offsets, mesh_offsets, _ = face_vertices(
         chunk.meshes, shapes.geom - MESH_BASE, shapes.size)
+    if kind in _EDGE_KINDS:
+        parent, origin, axes, size, edge_kind = mesh_edges(verts, ring_offsets, face_offsets, mesh_offsets,
+                                                           TOL.zero)
+        keep = np.isin(edge_kind, _EDGE_KINDS[kind])
+        parent, origin, axes, size = parent[keep], origin[keep], axes[keep], size[keep]
+        return parent, rank_within(parent), origin, axes, size, np.full(len(parent), -1, dtype=np.int32)
     origin, axes, size, uv, ok = face_frames(verts, ring_offsets, face_offsets, TOL.zero)
     face_mesh = segment_of(mesh_offsets)
     index = np.arange(len(face_mesh)) - mesh_offsets[face_mesh]
     geom = chunk.polygons.add(uv, ring_offsets, face_offsets, np.full(len(face_mesh), 2, dtype=np.int8))
-    return face_mesh[ok], index[ok], origin[ok], axes[ok], size[ok], geom[ok]
+    keep = ok & {FACES: index >= 0, SIDEFACES: index > 0, BOTTOM: index == 0}[kind]
+    if kind == SIDEFACES:
+        index = index - 1
+    return face_mesh[keep], index[keep], origin[keep], axes[keep], size[keep], geom[keep]
 
 
 def mesh_leaves(chunk: Chunk, shapes: Shapes, symbol: int, colors) -> MeshChunk:

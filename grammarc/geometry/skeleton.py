@@ -56,6 +56,16 @@ def _vertex_at(nrm, c, e0, e1, t):
 
 
 @njit(cache=True)
+def _position(nrm, c, node_xy, node_t, start, e0, e1, v, t, eps):
+    """Where vertex v (between edges e0 and e1) is at time t; a spike tip, whose lines are parallel,
+    is only anywhere at the time it was made."""
+    x, y, ok = _vertex_at(nrm, c, e0, e1, t)
+    if not ok and abs(t - node_t[start[v]]) <= eps:
+        return node_xy[start[v], 0], node_xy[start[v], 1], True
+    return x, y, ok
+
+
+@njit(cache=True)
 def skeleton_faces(xy, ring_offsets, start_time):
     """Faces of the straight skeleton of one polygon with holes.
 
@@ -134,6 +144,8 @@ def skeleton_faces(xy, ring_offsets, start_time):
                 continue
             w = nxt[v]
             a, e, b = in_edge[v], out_edge[v], out_edge[w]
+            if _spike(direction, v, in_edge, out_edge) or _spike(direction, w, in_edge, out_edge):
+                continue
             x, y, t, solved = _solve3(nrm[a, 0], nrm[a, 1], c[a], nrm[e, 0], nrm[e, 1], c[e],
                                       nrm[b, 0], nrm[b, 1], c[b])
             if solved and t >= now - eps and t < best_t - eps:
@@ -161,8 +173,8 @@ def skeleton_faces(xy, ring_offsets, start_time):
                 if not solved or t < now - eps or t >= best_t - eps:
                     continue
                 w = nxt[u]
-                ux, uy, ok_u = _vertex_at(nrm, c, in_edge[u], e, t)
-                wx, wy, ok_w = _vertex_at(nrm, c, e, out_edge[w], t)
+                ux, uy, ok_u = _position(nrm, c, node_xy, node_t, start, in_edge[u], e, u, t, eps)
+                wx, wy, ok_w = _position(nrm, c, node_xy, node_t, start, e, out_edge[w], w, t, eps)
                 if not (ok_u and ok_w):
                     continue
                 s = (x - ux) * direction[e, 0] + (y - uy) * direction[e, 1]
@@ -228,8 +240,29 @@ def skeleton_faces(xy, ring_offsets, start_time):
                                                       n_arcs, alive_count)
     if alive_count != 0:
         ok = False
+    # the wavefront reaches every point no later than the boundary's offset does: a node later than
+    # its distance to the (moved-out) boundary is a wrong event order
+    for q in range(n_nodes):
+        reach = np.inf
+        for k in range(n):
+            ax, ay = node_xy[k, 0], node_xy[k, 1]
+            bx, by = node_xy[succ[k], 0] - ax, node_xy[succ[k], 1] - ay
+            px, py = node_xy[q, 0] - ax, node_xy[q, 1] - ay
+            f = min(max((px * bx + py * by) / max(bx * bx + by * by, 1e-300), 0.0), 1.0)
+            reach = min(reach, np.sqrt((px - f * bx) ** 2 + (py - f * by) ** 2))
+        if node_t[q] - start_time > reach + 1e3 * eps:
+            ok = False
     face_nodes, face_offsets, faces_ok = _faces(arcs[:n_arcs], n, succ)
     return node_xy[:n_nodes], node_t[:n_nodes], face_nodes, face_offsets, ok and faces_ok
+
+
+@njit(cache=True)
+def _spike(direction, v, in_edge, out_edge):
+    """Whether v's two edges run back on each other: the tip of a wavefront that folded onto itself
+    (two edges whose lines met all along). Its edges do not shrink linearly, so they have no edge
+    events; the spike ends by the split event of the vertex that reaches it, or by closing its ring."""
+    a, b = in_edge[v], out_edge[v]
+    return direction[a, 0] * direction[b, 0] + direction[a, 1] * direction[b, 1] < -1.0 + 1e-9
 
 
 @njit(cache=True)

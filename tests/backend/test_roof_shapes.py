@@ -3,14 +3,25 @@ measures, errors."""
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 import pytest
+import shapely
 from conftest import LOT_ZOO
 from test_cityengine import assets, face_area, mesh_faces, names, rect, run, totals
 
+from grammarc.build import BuildOptions, derive
+from grammarc.compiler import compile_grammar
 from grammarc.errors import GrammarError
+from grammarc.io.lots import lots_from_polygons
 
 TAN30 = np.tan(np.radians(30))
+SIMPLE_BUILDING = Path(__file__).resolve().parents[1] / "frontend" / "grammars" / "simple_building.cga"
+
+
+def shapely_area(rings):
+    return shapely.Polygon(rings[0], rings[1:]).area
 
 
 def test_roof_on_a_footprint_keeps_x_puts_y_up_and_fits_the_mesh(write):
@@ -95,3 +106,48 @@ def test_roof_of_a_solid_and_overhang_y_are_reported(write):
 def test_paper_roof_types_outside_the_supported_set_are_errors(write):
     with pytest.raises(GrammarError, match="not supported yet"):
         run(write, 'lot ~> Roof("gambrel", 30){ roof }\n', [rect(12, 8)], version=False)
+
+
+def test_paper_comp_of_a_roof_gives_planes_hips_and_the_ridge(write):
+    text = ('lot ~> Roof("hipped", 30){ roof }\n'
+            'roof ~> Comp("sidefaces"){ plane } Comp("sideedges"){ hip } Comp("topedges"){ ridge }\n'
+            'plane ~> I("cube")\nhip ~> I("cube")\nridge ~> I("cube")\n')
+    r = run(write, text, [rect(12, 8)], version=False)
+    count = {n: names(r).count(n) for n in ("plane", "hip", "ridge")}
+    assert count == {"plane": 4, "hip": 4, "ridge": 1}
+    ridge = r["xform"][np.array(names(r)) == "ridge"][0]
+    assert np.linalg.norm(ridge[:, 0]) == pytest.approx(4.0)  # 12 - 8: the ridge of a hip roof
+    assert ridge[1, 3] == pytest.approx(4 * TAN30, abs=1e-5)
+    hips = r["xform"][np.array(names(r)) == "hip"]
+    np.testing.assert_allclose(np.linalg.norm(hips[:, :, 0], axis=1), np.sqrt(32 + (4 * TAN30) ** 2), rtol=1e-6)
+
+
+def test_cityengine_comp_e_of_a_roof_selects_edges_by_direction(write):
+    text = "Lot --> roofGable(30) comp(e){ horizontal : H | aslant : A | all : V }\n"
+    for sym in "HAV":
+        text += f'{sym} --> report("{sym}", 1)\n'
+    r = run(write, text, [rect(12, 8)])
+    # 4 footprint edges and the ridge; 4 rafters at the gable ends; no vertical edge
+    assert {k: v for k, v in totals(r).items() if k.endswith("_n")} == {"A_n": 4, "H_n": 5}
+
+
+@pytest.mark.parametrize("lot", ["concave_L", "courtyard", "rect_12x8"])
+def test_paper_section4_building_covers_its_hipped_roof_with_bricks(lot):
+    """The simple building of the CGA paper (section 4, rules 1-13 less the two context rules) on concave
+    footprints: bricks and roof edges lie on the roof, between the eaves and the ridge."""
+    grammar = compile_grammar(SIMPLE_BUILDING)
+    r = derive(grammar, lots_from_polygons([LOT_ZOO[lot]]), BuildOptions())
+    assert r["bad"] == ()
+    symbol = np.array(names(r))
+    assert {"flatbrick", "roofedge", "window", "wall"} <= set(symbol.tolist())
+    ridge = 5 * TAN30 if lot != "rect_12x8" else 4 * TAN30
+    for name in ("flatbrick", "roofedge"):
+        y = r["xform"][symbol == name][:, 1, 3]
+        assert (y >= 9 - 1e-4).all() and (y <= 9 + ridge + 1e-4).all()
+    # the roof planes are covered: bricks of 0.4 x 0.3 m at least fill the planes' rectangular parts
+    bricks = r["xform"][symbol == "flatbrick"].astype(float)
+    brick_area = np.linalg.norm(np.cross(bricks[:, :, 0], bricks[:, :, 1]), axis=1).sum()
+    mesh = r["mesh"]
+    pieces = sum(face_area(f) for f, s in zip(mesh_faces(r), mesh.symbol) if r["symbols"][s] == "flatbrick")
+    footprint = shapely_area(LOT_ZOO[lot])
+    assert brick_area + pieces == pytest.approx(footprint / np.cos(np.radians(30)), rel=1e-4)
