@@ -1,6 +1,7 @@
 """Asset names: built-in primitives and OBJ files, resolved inside the asset roots.
 
-``I("cube")`` and ``I("builtin:cube")`` name the built-in unit cube; ``I("facade/window.obj")`` names a file
+``I("cube")`` and ``I("builtin:cube")`` name the built-in unit cube (built-ins: ``cube``, ``quad``,
+``cylinder`` and ``cylinderN`` with N sides, and the paper's mass-model blocks ``L``, ``H``, ``U``, ``T``); ``I("facade/window.obj")`` names a file
 relative to an asset root (the grammar's folder first, then any ``--assets`` folders). The record keeps a
 canonical name: ``builtin:NAME`` or the POSIX path relative to the root that holds it. A name that is
 absolute or climbs out of every root (``../../etc/passwd``) is refused: grammars are shared, and a rule
@@ -13,7 +14,17 @@ import os
 from dataclasses import dataclass
 from pathlib import Path, PurePosixPath
 
-BUILTINS = ("cube", "quad", "cylinder")
+BUILTINS = ("cube", "quad", "cylinder", "L", "H", "U", "T")
+#: ``cylinderN``: a cylinder of N sides (``cylinder`` has 16).
+CYLINDER_SIDES_RANGE = range(3, 257)
+
+
+def builtin_name(bare: str) -> bool:
+    """Whether ``bare`` (without ``builtin:``) names a built-in: one of ``BUILTINS`` or ``cylinderN``."""
+    if bare in BUILTINS:
+        return True
+    digits = bare.removeprefix("cylinder")
+    return digits != bare and digits.isdigit() and int(digits) in CYLINDER_SIDES_RANGE
 #: Assets every record can use for leaves: volumes are cubes, faces are quads.
 LEAF_CUBE = "builtin:cube"
 LEAF_QUAD = "builtin:quad"
@@ -30,11 +41,11 @@ class ResolvedAsset:
 def resolve_asset(name: str, roots: list[Path]) -> ResolvedAsset:
     """Resolve one ``I()`` name against ``roots`` (searched in order)."""
     bare = name.removeprefix("builtin:")
-    if bare in BUILTINS:
+    if builtin_name(bare):
         return ResolvedAsset(f"builtin:{bare}", None)
     if name.startswith("builtin:"):
         return ResolvedAsset(name, None, problem=f"unknown built-in asset `{name}` (built-ins: "
-                             + ", ".join(BUILTINS) + ")")
+                             + ", ".join(BUILTINS) + ", cylinderN for N sides)")
     pure = PurePosixPath(name.replace("\\", "/"))
     if pure.is_absolute() or (len(name) > 1 and name[1] == ":"):
         return ResolvedAsset(name, None, problem=f"asset path `{name}` is absolute; give it relative "

@@ -9,7 +9,9 @@ Assets, each an ``AssetMesh`` in the unit box [0, 1]^3:
 * ``builtin:cube``: the unit cube, 8 vertices, 12 triangles, normals outward;
 * ``builtin:quad``: the unit square on z = 0, normal +z, 2 triangles;
 * ``builtin:cylinder``: axis along y through (0.5, ., 0.5), radius 0.5, y in [0, 1], 16 sides, capped
-  (60 triangles);
+  (60 triangles); ``builtin:cylinderN`` the same with N sides;
+* ``builtin:L``, ``H``, ``U``, ``T``: the paper's mass-model blocks, prisms over outlines with wings a
+  third of the box thick;
 * a file (OBJ, or any mesh format trimesh reads), resolved in the asset roots as the compiler resolves it
   (``grammarc.io.assets.resolve_asset``) and loaded with trimesh, then mapped from its bounding box onto
   [0, 1]^3 as CityEngine fits an inserted asset to the scope. An axis along which the asset is flat stays
@@ -52,7 +54,7 @@ from typing import TYPE_CHECKING, ClassVar
 import numpy as np
 
 from grammarc.errors import AssetError, UsageError
-from grammarc.io.assets import resolve_asset
+from grammarc.io.assets import builtin_name, resolve_asset
 from grammarc.io.npz import MeshChunk, TerminalChunk
 from grammarc.io.obj import ObjError, read_obj
 from grammarc.ragged import fan_out, offsets_from_counts, segment_reduce
@@ -79,6 +81,14 @@ MAX_TRIANGLES = 50_000_000
 _BLOCK_VERTICES = 1 << 21
 #: Sides of ``builtin:cylinder``.
 CYLINDER_SIDES = 16
+#: The paper's mass-model blocks (section 3.1, after Schmitt): outlines in thirds of the unit square, as
+#: (x, z) counter-clockwise seen from +y; wings one third thick.
+BLOCKS = {
+    "L": [(0, 0), (0, 3), (3, 3), (3, 2), (1, 2), (1, 0)],
+    "U": [(0, 0), (0, 3), (3, 3), (3, 0), (2, 0), (2, 2), (1, 2), (1, 0)],
+    "T": [(1, 0), (1, 2), (0, 2), (0, 3), (3, 3), (3, 2), (2, 2), (2, 0)],
+    "H": [(0, 0), (0, 3), (1, 3), (1, 2), (2, 2), (2, 3), (3, 3), (3, 0), (2, 0), (2, 1), (1, 1), (1, 0)],
+}
 #: An asset's extent below this (in its own units) is a flat axis, mapped to 0 rather than stretched.
 _FLAT = 1e-12
 #: A polygon's turn at a vertex counts as convex above ``-_CONVEX * |e_prev| |e_next| |n|`` (collinear
@@ -143,23 +153,35 @@ def builtin_mesh(name: str) -> AssetMesh:
     if bare == "quad":
         vertices = np.array([[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0]], np.float64)
         return _frozen(vertices, np.array([[0, 1, 2], [0, 2, 3]]), np.array([4]))
-    if bare == "cylinder":
-        k = CYLINDER_SIDES
-        # Angles around +y: x = 0.5 + 0.5 cos(a), z = 0.5 - 0.5 sin(a), so increasing a turns
-        # counter-clockwise seen from +y (right-handed, y up). a = 0 and pi put vertices on x = 0 and 1.
+    if bare in BLOCKS:
+        return _prism(np.array(BLOCKS[bare], dtype=np.float64) / 3.0)
+    if builtin_name(bare) and bare.startswith("cylinder"):
+        k = int(bare.removeprefix("cylinder") or CYLINDER_SIDES)
+        # a = 0 and pi put vertices on x = 0 and 1; increasing a turns counter-clockwise seen from +y
         angle = 2 * np.pi * np.arange(k) / k
-        ring = np.stack([0.5 + 0.5 * np.cos(angle), np.zeros(k), 0.5 - 0.5 * np.sin(angle)], axis=1)
-        top = ring + [0.0, 1.0, 0.0]
-        vertices = np.concatenate([ring, top])
-        i = np.arange(k)
-        j = (i + 1) % k
-        sides = np.stack([i, j, j + k, i + k], axis=1)  # outward: bottom i, bottom j, top j, top i
-        fan = np.arange(1, k - 1)
-        top_cap = np.stack([np.full(k - 2, k), fan + k, fan + k + 1], axis=1)  # counter-clockwise from +y
-        bottom_cap = np.stack([np.zeros(k - 2, np.int64), fan + 1, fan], axis=1)  # clockwise from +y
-        faces = np.concatenate([_quads_to_triangles(sides), top_cap, bottom_cap])
-        return _frozen(vertices, faces, np.array([4] * k + [k, k]))
-    raise AssetError(f"unknown built-in asset `{name}` (built-ins: cube, quad, cylinder)")
+        return _prism(np.stack([0.5 + 0.5 * np.cos(angle), 0.5 - 0.5 * np.sin(angle)], axis=1))
+    raise AssetError(f"unknown built-in asset `{name}` (built-ins: cube, quad, cylinder, cylinderN, L, H, U, T)")
+
+
+def _prism(outline: np.ndarray) -> AssetMesh:
+    """The prism over ``outline`` ((k, 2) as (x, z), counter-clockwise seen from +y) from y = 0 to 1,
+    fitted to the unit box: side quads, then the top and bottom caps (earcut: the blocks are concave)."""
+    import mapbox_earcut
+
+    k = len(outline)
+    ring = np.stack([outline[:, 0], np.zeros(k), outline[:, 1]], axis=1)
+    vertices = np.concatenate([ring, ring + [0.0, 1.0, 0.0]])
+    i = np.arange(k)
+    j = (i + 1) % k
+    sides = np.stack([i, j, j + k, i + k], axis=1)  # outward: bottom i, bottom j, top j, top i
+    cap = mapbox_earcut.triangulate_float64(outline, np.array([k], dtype=np.uint32)).reshape(-1, 3)
+    # the top faces +y: counter-clockwise from +y is clockwise in (x, z); the bottom the other way
+    a, b, c = outline[cap[:, 0]], outline[cap[:, 1]], outline[cap[:, 2]]
+    turn = (b[:, 0] - a[:, 0]) * (c[:, 1] - a[:, 1]) - (b[:, 1] - a[:, 1]) * (c[:, 0] - a[:, 0])
+    top = np.where((turn < 0)[:, None], cap, cap[:, ::-1])
+    top, bottom = top + k, top[:, ::-1]
+    faces = np.concatenate([_quads_to_triangles(sides), top, bottom]).astype(np.int64)
+    return _frozen(_fitted(vertices), faces, np.array([4] * k + [k, k]))
 
 
 def load_asset(name: str, asset_roots: Sequence[str | os.PathLike] = ()) -> AssetMesh:

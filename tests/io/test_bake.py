@@ -78,6 +78,20 @@ def test_builtins_are_closed_outward_unit_shapes():
         builtin_mesh("builtin:sphere")
 
 
+@pytest.mark.parametrize("name, volume, sides", [
+    ("L", 5 / 9, 6), ("U", 7 / 9, 8), ("T", 5 / 9, 8), ("H", 7 / 9, 12), ("cylinder6", 0.75, 6),
+    ("cylinder40", np.pi / 4, 40),
+])
+def test_block_and_cylinder_builtins_are_closed_outward_prisms_filling_the_unit_box(name, volume, sides):
+    """The paper's L, H, U, T blocks (wings a third thick) and cylinders of N sides, fitted to [0, 1]^3."""
+    shape = builtin_mesh(f"builtin:{name}")
+    mesh = trimesh.Trimesh(shape.vertices, shape.faces, process=True)
+    assert mesh.is_watertight and mesh.is_winding_consistent
+    assert mesh.bounds.tolist() == [[0, 0, 0], [1, 1, 1]]
+    assert mesh.volume == pytest.approx(volume, rel=0.02 if name.startswith("cylinder") else 1e-12)
+    assert dict(zip(*np.unique(shape.polygon_sizes, return_counts=True))) == {4: sides, sides: 2}
+
+
 def test_cube_instance():
     # Sizes 2, 3, 4 along the scope axes, turned 30 degrees about y, at (5, 1, -2).
     linear = rotation_y(30) * [2, 3, 4]
