@@ -530,7 +530,8 @@ class Executor:
                                            op.by_height, overhang, index)
         if failed.any():
             self.fail(cursor, failed, f"`{op.kind}` found no roof for this polygon (its straight skeleton "
-                      "did not close)", symbol, op.span)
+                      "did not close, or the overhang's outline crosses itself at a sharp corner)", symbol,
+                      op.span)
         return roofed
 
     def center(self, op: ir.Center, cursor: Shapes, base) -> Shapes:

@@ -16,8 +16,11 @@ Each vertex's path, from the node where it was made to the node where it ended, 
 faces of its two edges; the face of an input edge is the cycle of arcs that have that edge on one
 side. A ring that shrinks to two vertices has become a ridge segment: one arc closes it.
 
-Cost is O(n^2) per event and O(n) events per polygon, cubic in the vertices of one polygon but linear
-in the number of polygons: real footprints have tens of vertices. A polygon whose skeleton cannot be
+Edge events are cached per vertex until its edge changes; a reflex vertex's split candidates (the time
+it meets each line) are solved once when it is made and sorted, and each step checks them in time order
+against the wavefront's current edges, stopping at the earliest event so far. Cost is O(n) per event
+in practice, O(n^2) at worst, for O(n) events per polygon: cubic at worst in the vertices of one
+polygon but linear in the number of polygons; real footprints have tens of vertices. A polygon whose skeleton cannot be
 completed (degenerate input that the events do not resolve) is flagged, and its shape is reported.
 """
 
@@ -112,6 +115,16 @@ def skeleton_faces(xy, ring_offsets, start_time):
     # face against it
     arcs = np.empty((cap, 4), np.int64)
     n_arcs = 0
+    dirty = np.ones(cap, np.bool_)
+    edge_t = np.full(cap, np.inf)
+    edge_x = np.zeros(cap)
+    edge_y = np.zeros(cap)
+    cand_t = np.empty((cap, n))
+    cand_x = np.empty((cap, n))
+    cand_y = np.empty((cap, n))
+    cand_e = np.empty((cap, n), np.int64)
+    n_cand = np.zeros(cap, np.int64)
+    cand_first = np.zeros(cap, np.int64)
     for k in range(n):
         in_edge[k], out_edge[k], prev[k], nxt[k] = pred[k], k, pred[k], succ[k]
         alive[k] = True
@@ -126,13 +139,18 @@ def skeleton_faces(xy, ring_offsets, start_time):
         node_t[k] = start_time
     n_nodes = n
     n_verts = n
+    for k in range(n):
+        _split_candidates(k, nrm, c, direction, node_xy, node_t, start, in_edge, out_edge, alive, n, eps,
+                          cand_t, cand_x, cand_y, cand_e, n_cand, cand_first)
     now = start_time
     ok = True
     alive_count = n
     for _ in range(cap):
         if alive_count == 0:
             break
-        # ---- the earliest event
+        # ---- the earliest event: edge events (cached per vertex until its edge changes), then split
+        # events (each reflex vertex's candidates against the lines, sorted by time once, checked
+        # against the wavefront's current edges in time order)
         best_t = np.inf
         best_kind = -1
         best_v = -1
@@ -142,46 +160,50 @@ def skeleton_faces(xy, ring_offsets, start_time):
         for v in range(n_verts):
             if not alive[v]:
                 continue
-            w = nxt[v]
-            a, e, b = in_edge[v], out_edge[v], out_edge[w]
-            if _spike(direction, v, in_edge, out_edge) or _spike(direction, w, in_edge, out_edge):
-                continue
-            x, y, t, solved = _solve3(nrm[a, 0], nrm[a, 1], c[a], nrm[e, 0], nrm[e, 1], c[e],
-                                      nrm[b, 0], nrm[b, 1], c[b])
-            if solved and t >= now - eps and t < best_t - eps:
-                best_t, best_kind, best_v, best_x, best_y = t, 0, v, x, y
+            if dirty[v]:
+                dirty[v] = False
+                edge_t[v] = np.inf
+                w = nxt[v]
+                a, e, b = in_edge[v], out_edge[v], out_edge[w]
+                if not (_spike(direction, v, in_edge, out_edge) or _spike(direction, w, in_edge, out_edge)):
+                    x, y, t, solved = _solve3(nrm[a, 0], nrm[a, 1], c[a], nrm[e, 0], nrm[e, 1], c[e],
+                                              nrm[b, 0], nrm[b, 1], c[b])
+                    if solved:
+                        edge_t[v], edge_x[v], edge_y[v] = t, x, y
+            t = edge_t[v]
+            if t >= now - eps and t < best_t - eps:
+                best_t, best_kind, best_v, best_x, best_y = t, 0, v, edge_x[v], edge_y[v]
         for v in range(n_verts):
-            if not alive[v]:
+            if not alive[v] or n_cand[v] == 0:
                 continue
             a, b = in_edge[v], out_edge[v]
-            if direction[a, 0] * direction[b, 1] - direction[a, 1] * direction[b, 0] > -1e-12:
-                continue  # not reflex
-            vx, vy, moving = _vertex_at(nrm, c, a, b, now)
-            if not moving:
-                continue
-            for u in range(n_verts):
-                if not alive[u] or u == v or nxt[u] == v:
+            found = False
+            for j in range(cand_first[v], n_cand[v]):
+                t = cand_t[v, j]
+                if t < now - eps:
+                    cand_first[v] = j + 1  # in the past for good
                     continue
-                e = out_edge[u]
-                if e == a or e == b:
-                    continue
-                # v must be ahead of the edge's line now, and meet it later
-                if nrm[e, 0] * vx + nrm[e, 1] * vy - c[e] - now < -eps:
-                    continue
-                x, y, t, solved = _solve3(nrm[a, 0], nrm[a, 1], c[a], nrm[b, 0], nrm[b, 1], c[b],
-                                          nrm[e, 0], nrm[e, 1], c[e])
-                if not solved or t < now - eps or t >= best_t - eps:
-                    continue
-                w = nxt[u]
-                ux, uy, ok_u = _position(nrm, c, node_xy, node_t, start, in_edge[u], e, u, t, eps)
-                wx, wy, ok_w = _position(nrm, c, node_xy, node_t, start, e, out_edge[w], w, t, eps)
-                if not (ok_u and ok_w):
-                    continue
-                s = (x - ux) * direction[e, 0] + (y - uy) * direction[e, 1]
-                length = (wx - ux) * direction[e, 0] + (wy - uy) * direction[e, 1]
-                if s < -eps or s > length + eps:
-                    continue
-                best_t, best_kind, best_v, best_u, best_x, best_y = t, 1, v, u, x, y
+                if t >= best_t - eps:
+                    break
+                e = cand_e[v, j]
+                x, y = cand_x[v, j], cand_y[v, j]
+                for u in range(n_verts):
+                    if not alive[u] or out_edge[u] != e or u == v or nxt[u] == v:
+                        continue
+                    w = nxt[u]
+                    ux, uy, ok_u = _position(nrm, c, node_xy, node_t, start, in_edge[u], e, u, t, eps)
+                    wx, wy, ok_w = _position(nrm, c, node_xy, node_t, start, e, out_edge[w], w, t, eps)
+                    if not (ok_u and ok_w):
+                        continue
+                    along = (x - ux) * direction[e, 0] + (y - uy) * direction[e, 1]
+                    length = (wx - ux) * direction[e, 0] + (wy - uy) * direction[e, 1]
+                    if along < -eps or along > length + eps:
+                        continue
+                    best_t, best_kind, best_v, best_u, best_x, best_y = t, 1, v, u, x, y
+                    found = True
+                    break
+                if found:
+                    break
         if best_kind < 0 or n_verts + 2 > cap or n_nodes + 1 > cap or n_arcs + 4 > cap:
             ok = False
             break
@@ -211,8 +233,12 @@ def skeleton_faces(xy, ring_offsets, start_time):
             start[z] = node
             alive[z] = True
             alive_count += 1
+            dirty[prev[z]] = True
             n_arcs, alive_count = _close_pair(z, nxt, in_edge, out_edge, start, alive, arcs, n_arcs,
                                               alive_count)
+            if alive[z]:
+                _split_candidates(z, nrm, c, direction, node_xy, node_t, start, in_edge, out_edge, alive,
+                                  n_verts, eps, cand_t, cand_x, cand_y, cand_e, n_cand, cand_first)
         else:
             # ---- split event: v reaches edge u -> w; X ends the ring before v, Y starts the one after
             u = best_u
@@ -234,10 +260,16 @@ def skeleton_faces(xy, ring_offsets, start_time):
                 start[q] = node
                 alive[q] = True
             alive_count += 1
+            dirty[prev[x_v]] = True
+            dirty[u] = True
             for q in (x_v, y_v):
                 if alive[q]:
                     n_arcs, alive_count = _close_pair(q, nxt, in_edge, out_edge, start, alive, arcs,
                                                       n_arcs, alive_count)
+            for q in (x_v, y_v):
+                if alive[q]:
+                    _split_candidates(q, nrm, c, direction, node_xy, node_t, start, in_edge, out_edge,
+                                      alive, n_verts, eps, cand_t, cand_x, cand_y, cand_e, n_cand, cand_first)
     if alive_count != 0:
         ok = False
     # the wavefront reaches every point no later than the boundary's offset does: a node later than
@@ -263,6 +295,44 @@ def _spike(direction, v, in_edge, out_edge):
     events; the spike ends by the split event of the vertex that reaches it, or by closing its ring."""
     a, b = in_edge[v], out_edge[v]
     return direction[a, 0] * direction[b, 0] + direction[a, 1] * direction[b, 1] < -1.0 + 1e-9
+
+
+@njit(cache=True)
+def _split_candidates(v, nrm, c, direction, node_xy, node_t, start, in_edge, out_edge, alive, n_verts, eps,
+                      cand_t, cand_x, cand_y, cand_e, n_cand, cand_first):
+    """Where and when a reflex vertex v, from where it was made, would meet each line of the wavefront's
+    edges that it moves towards: its split event candidates, in time order (row v of the cand_*
+    arrays). Lines are fixed, so these never change; whether the edge still spans the point at that
+    time is checked when the event is looked for."""
+    a, b = in_edge[v], out_edge[v]
+    n_cand[v] = 0
+    cand_first[v] = 0
+    if direction[a, 0] * direction[b, 1] - direction[a, 1] * direction[b, 0] > -1e-12:
+        return  # not reflex
+    t0 = node_t[start[v]]
+    px, py = node_xy[start[v], 0], node_xy[start[v], 1]
+    present = np.zeros(len(c), np.bool_)
+    for u in range(n_verts):
+        if alive[u]:
+            present[out_edge[u]] = True
+    count = 0
+    for e in range(len(c)):
+        if not present[e] or e == a or e == b:
+            continue
+        if nrm[e, 0] * px + nrm[e, 1] * py - c[e] - t0 < -eps:
+            continue  # behind the line: moving away from it
+        x, y, t, solved = _solve3(nrm[a, 0], nrm[a, 1], c[a], nrm[b, 0], nrm[b, 1], c[b],
+                                  nrm[e, 0], nrm[e, 1], c[e])
+        if not solved or t < t0 - eps:
+            continue
+        cand_t[v, count], cand_x[v, count], cand_y[v, count], cand_e[v, count] = t, x, y, e
+        count += 1
+    order = np.argsort(cand_t[v, :count], kind="mergesort")
+    cand_t[v, :count] = cand_t[v, :count][order]
+    cand_x[v, :count] = cand_x[v, :count][order]
+    cand_y[v, :count] = cand_y[v, :count][order]
+    cand_e[v, :count] = cand_e[v, :count][order]
+    n_cand[v] = count
 
 
 @njit(cache=True)
