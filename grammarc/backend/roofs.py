@@ -47,7 +47,11 @@ def build_roofs(chunk: Chunk, shapes: Shapes, kind: str, polygons, value, by_hei
     local[at, PLANE_V[vplane]] = verts[:, 1]
     local[at, vplane] = verts[:, 2]
     turn = _ROOF_FRAME[plane.astype(np.int64)]
-    roofed = np.einsum("vij,vj->vi", turn[vertex_shape], local)
+    roofed = local
+    for p in np.unique(plane):  # three frames at most: one matrix product each
+        if p != 1:
+            sel = vplane == p
+            roofed[sel] = local[sel] @ _ROOF_FRAME[p].T
     vertex_offsets = rings[faces[meshes]]
     low = np.stack([segment_reduce(np.minimum, roofed[:, j], vertex_offsets, 0.0) for j in range(3)], 1)
     high = np.stack([segment_reduce(np.maximum, roofed[:, j], vertex_offsets, 0.0) for j in range(3)], 1)
@@ -99,8 +103,10 @@ def mesh_leaves(chunk: Chunk, shapes: Shapes, symbol: int, colors) -> MeshChunk:
     """The faces of leaf mesh shapes in world coordinates."""
     verts, ring_offsets, face_offsets, mesh_offsets, vertex_shape = face_vertices(
         chunk.meshes, shapes.geom - MESH_BASE, shapes.size)
-    axes = chunk.frames[shapes.frame]
-    world = shapes.origin[vertex_shape] + np.einsum("vi,vij->vj", verts, axes[vertex_shape])
+    axes = chunk.frames[shapes.frame][vertex_shape]
+    world = shapes.origin[vertex_shape]
+    for j in range(3):
+        world += verts[:, j, None] * axes[:, j]
     face_shape = segment_of(mesh_offsets)
     return MeshChunk(
         vertices=world.astype(np.float32), ring_offsets=ring_offsets, face_offsets=face_offsets,
