@@ -29,6 +29,7 @@ from grammarc.constants import TOL, Limits
 from grammarc.errors import ChunkTooLarge, LimitError, LotFailure
 from grammarc.geometry import components as comp_kernels
 from grammarc.geometry.clip import clip_to_slabs, fit_pieces, scope_polygons
+from grammarc.geometry.inner_rectangle import largest_rectangles
 from grammarc.geometry.meshes import is_mesh, is_polygon
 from grammarc.geometry.polygons import PLANE_U, PLANE_V
 from grammarc.geometry.reframe import reframe
@@ -800,8 +801,22 @@ class Executor:
         regions, remainder = setback_regions(polygons, edges, distance,
                                              classify_faces(normal, owners, frames), len(owners))
         by_owner = dict(zip(owners, regions))
-        pieces = [fit_pieces(by_owner[s] if s != "remainder" else remainder, plane, cursor.size)
-                  for s in op.selectors]
+        self.run_regions(op, cursor, [by_owner[s] if s != "remainder" else remainder for s in op.selectors],
+                         plane, symbol)
+
+    def inner_rectangle(self, op: ir.InnerRectangle, cursor: Shapes, symbol: int) -> None:
+        """``innerRectangle``: the face's largest inner rectangle (``geometry.inner_rectangle``) and the
+        rest of the face, in the face's own scope frame (CityEngine keeps the scope's orientation)."""
+        polygons, plane = self.face_polygons(cursor, "innerRectangle", symbol, op.span)
+        rectangle = largest_rectangles(polygons, op.align)
+        remainder = shapely.difference(polygons, rectangle)
+        self.run_regions(op, cursor, [rectangle if s == "shape" else remainder for s in op.selectors], plane,
+                         symbol)
+
+    def run_regions(self, op: ir.Setback | ir.InnerRectangle, cursor: Shapes, regions: list, plane, symbol):
+        """Part k of ``op`` on the pieces of ``regions[k]`` (m,) (polygons in the shapes' scope units),
+        each parent's pieces together, numbered in stream ``op.site`` part by part."""
+        pieces = [fit_pieces(region, plane, cursor.size) for region in regions]
         shapes, kind = self.pieces_by_parent(cursor, pieces, [(op.site << 20) + k for k in range(len(pieces))])
         self.count(shapes, symbol, op.span)
         order, offsets = group_by(kind, len(op.parts))
@@ -882,6 +897,7 @@ _OPERATIONS = {
     ir.Report: Executor.report, ir.Case: Executor.branch, ir.Stochastic: Executor.branch,
     ir.GroupSplit: Executor.group_split, ir.CompFaces: Executor.comp_faces, ir.Empty: Executor.nothing,
     ir.NotApplied: Executor.nothing, ir.Setback: Executor.setback, ir.Roof: Executor.roof,
+    ir.InnerRectangle: Executor.inner_rectangle,
 }
 #: Operations that take roofs (meshes): scope changes, component splits, successors, leaves.
 _MESH_OPERATIONS = frozenset({

@@ -97,7 +97,7 @@ def make_plan(grammar: Grammar) -> Plan:
 #: Operations after which a body's shape is not the body's to emit: it was replaced by successors, split
 #: into parts, deleted, or handed to case branches (which emit their own leaves).
 _CONSUMING = (ir.Symbol, ir.Empty, ir.Split, ir.Repeat, ir.Comp, ir.GroupSplit, ir.CompFaces, ir.Insert,
-              ir.Case, ir.Stochastic, ir.Setback)
+              ir.Case, ir.Stochastic, ir.Setback, ir.InnerRectangle)
 
 
 def consumes(body: ir.Body) -> bool:

@@ -28,7 +28,7 @@ NOT_APPLIED = frozenset({
 })
 #: CityEngine operations grammarc does not implement yet (the geometry and context issues bring most).
 UNSUPPORTED_OPS = frozenset({
-    "innerRectangle", "innerPolygon", "convexify",
+    "innerPolygon", "convexify",
     "cleanupGeometry", "trim", "envelope",
     "mirrorScope",
     "insertAlongUV", "scatter", "footprint", "tileUV", "splitArea", "inline", "resetGeometry", "taper",
@@ -301,7 +301,7 @@ class Lowering(LoweringBase):
             return ir.NotApplied(op, span)
         if op in UNSUPPORTED_OPS or op in _SPLIT_OPS:
             return self.unsupported(op, span)
-        if op in _SETBACK_OPS:
+        if op in _SETBACK_OPS or op == "innerRectangle":
             return self.unsupported(f"{op} without selector parts", span,
                                     f"write {op}(...) {{ ... | remainder: ... }}")
         return ir.Symbol(op, tuple(self.expr(a) for a in args), span, self.site())
@@ -318,6 +318,10 @@ class Lowering(LoweringBase):
             if star is not None:
                 return self.unsupported(f"`*` after {op}", self.token_span(star), "only split repeats")
             return self.op_setback(op, args, parts, span)
+        if op == "innerRectangle":
+            if star is not None:
+                return self.unsupported(f"`*` after {op}", self.token_span(star), "only split repeats")
+            return self.op_inner_rectangle(op, args, parts, span)
         return self.unsupported(op, span)
 
     def arity(self, op, args, counts, span) -> bool:
@@ -534,31 +538,52 @@ class Lowering(LoweringBase):
         if not self.arity(op, args, (len(sides) if sides else 1,), span):
             return None
         known = _SETBACK_SELECTORS if not sides else frozenset({"shape", "remainder"})
-        selectors, bodies = [], []
-        for part in parts:
-            if isinstance(part, Group):
-                return self.unsupported(f"repeat group in {op}", part.span)
-            value = part.size.value
-            if part.size.kind is not ir.SizeKind.ABSOLUTE or not isinstance(value, ir.Name):
-                return self.unsupported(f"this {op} selector", part.span)
-            if value.name not in known:
-                why = ("street selectors come with the context issue" if "treet" in value.name else
-                       f"{op} selects {', '.join(sorted(known - {'remainder'}))} and remainder")
-                return self.unsupported(f"{op} selector `{value.name}`", value.span,
-                                        why + suggest(value.name, known))
-            if part.merged:
-                self.diags.warning(
-                    "merged", f"`{value.name}=` gives one shape for all its polygons in CityEngine; grammarc "
-                    "derives them one by one (the same leaves; operations that read the scope differ)",
-                    part.span)
-            selectors.append("all" if value.name == "shape" else value.name)
-            bodies.append(part.body)
+        chosen = self.selector_parts(op, parts, known)
+        if chosen is None:
+            return ir.Empty(span)
+        selectors = tuple("all" if s == "shape" else s for s in chosen[0])
         exprs = tuple(self.expr(a) for a in args)
         if sides:
             distances = tuple(zip(sides, exprs))
         else:
             distances = tuple((s, exprs[0]) for s in selectors if s != "remainder")
-        return ir.Setback(distances, tuple(selectors), tuple(bodies), span, self.site())
+        return ir.Setback(distances, selectors, chosen[1], span, self.site())
+
+    def op_inner_rectangle(self, op, args, parts, span):
+        """``innerRectangle(scope|edge) { shape: A | remainder: B }``."""
+        if len(args) != 1 or not isinstance(args[0], ir.Name) or args[0].name not in ("scope", "edge"):
+            return self.unsupported("innerRectangle with these arguments", span,
+                                    "innerRectangle(scope) and innerRectangle(edge)")
+        chosen = self.selector_parts(op, parts, frozenset({"shape", "remainder"}))
+        if chosen is None:
+            return ir.Empty(span)
+        return ir.InnerRectangle(args[0].name, chosen[0], chosen[1], span, self.site())
+
+    def selector_parts(self, op, parts, known):
+        """The selectors and bodies of ``{ sel: A | ... }`` parts, all among ``known`` (None after an
+        error); ``sel=`` is derived as ``sel:``, with a warning."""
+        selectors, bodies = [], []
+        for part in parts:
+            if isinstance(part, Group):
+                self.unsupported(f"repeat group in {op}", part.span)
+                return None
+            value = part.size.value
+            if part.size.kind is not ir.SizeKind.ABSOLUTE or not isinstance(value, ir.Name):
+                self.unsupported(f"this {op} selector", part.span)
+                return None
+            if value.name not in known:
+                why = ("street selectors come with the context issue" if "treet" in value.name else
+                       f"{op} selects {', '.join(sorted(known - {'remainder'}))} and remainder")
+                self.unsupported(f"{op} selector `{value.name}`", value.span, why + suggest(value.name, known))
+                return None
+            if part.merged:
+                self.diags.warning(
+                    "merged", f"`{value.name}=` gives one shape for all its polygons in CityEngine; grammarc "
+                    "derives them one by one (the same leaves; operations that read the scope differ)",
+                    part.span)
+            selectors.append(value.name)
+            bodies.append(part.body)
+        return tuple(selectors), tuple(bodies)
 
     # ------------------------------------------------------------------------------------- expressions
     def value_case(self, meta, *items):

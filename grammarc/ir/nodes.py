@@ -472,6 +472,18 @@ class Setback:
 
 
 @dataclass(frozen=True, slots=True)
+class InnerRectangle:
+    """CityEngine ``innerRectangle(scope|edge) { shape: A | remainder: B }``: the largest rectangle inside
+    the face (sides along the scope's x, or along one of its long edges) and the rest of the face."""
+
+    align: str
+    selectors: tuple[str, ...]
+    parts: tuple[Body, ...]
+    span: Span = NO_SPAN
+    site: int = 0
+
+
+@dataclass(frozen=True, slots=True)
 class Roof:
     """CityEngine ``roofHip``, ``roofGable``, ``roofShed``, ``roofPyramid`` and the paper's
     ``Roof(type, angle)``: the face becomes a roof mesh over it (``geometry.roofs``). ``value`` is the
@@ -510,7 +522,7 @@ class CompFaces:
 
 Op = (Symbol | Empty | Translate | Scale | Rotate | Push | Pop | Insert | Split | Repeat | Comp | Extrude
       | Center | UseAsset | Case | Stochastic | SetAttr | Report | NotApplied | GroupSplit | CompFaces
-      | AlignScope | Mirror | Offset | SetColor | Setback | Roof)
+      | AlignScope | Mirror | Offset | SetColor | Setback | Roof | InnerRectangle)
 Body = tuple[Op, ...]
 
 

@@ -100,6 +100,9 @@ def print_op(op: ir.Op) -> str:
         return f"color({', '.join(print_expr(v) for v in op.values)})"
     if isinstance(op, ir.Offset):
         return f"offset({print_expr(op.distance)}, {op.select})"
+    if isinstance(op, ir.InnerRectangle):
+        return f"innerRectangle({op.align}){{ " + " | ".join(f"{s}: {print_body(b) or 'ε'}"
+                                                          for s, b in zip(op.selectors, op.parts)) + " }"
     if isinstance(op, ir.Roof):
         args = [("byHeight" if op.by_height else "byAngle"), print_expr(op.value), print_expr(op.overhang)]
         if op.overhang_y is not None:

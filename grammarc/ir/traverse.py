@@ -89,6 +89,9 @@ def rewrite_op(op: ir.Op, fn: ExprFn) -> ir.Op:
         if parts is op.parts and all(a[1] is b[1] for a, b in zip(distances, op.distances)):
             return op
         return replace(op, parts=parts, distances=distances)
+    if isinstance(op, ir.InnerRectangle):
+        parts = _tuple(op.parts, lambda b: rewrite_body(b, fn))
+        return op if parts is op.parts else replace(op, parts=parts)
     if isinstance(op, ir.SetColor):
         values = _tuple(op.values, ex)
         return op if values is op.values else replace(op, values=values)
@@ -177,7 +180,8 @@ def iter_ops(body: ir.Body) -> Iterator[ir.Op]:
 
 def sub_bodies(op: ir.Op) -> tuple[ir.Body, ...]:
     """The bodies nested in ``op``: split parts, case and stochastic branches."""
-    if isinstance(op, (ir.Split, ir.Repeat, ir.Comp, ir.GroupSplit, ir.CompFaces, ir.Setback)):
+    if isinstance(op, (ir.Split, ir.Repeat, ir.Comp, ir.GroupSplit, ir.CompFaces, ir.Setback,
+                       ir.InnerRectangle)):
         return op.parts
     if isinstance(op, (ir.Case, ir.Stochastic)):
         return (*(body for _, body in op.branches), op.default)

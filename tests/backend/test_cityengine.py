@@ -592,3 +592,25 @@ def test_offset_inside_of_a_rectangle_stays_a_box_path_rectangle(write):
 def test_offset_without_its_comp_is_named(write):
     with pytest.raises(GrammarError, match="offset\\(d\\) without comp"):
         run(write, "Lot --> offset(-1) extrude(3)\n", [rect(12, 8)])
+
+
+def test_inner_rectangle_and_remainder_tile_the_lot_in_the_lot_frame(write):
+    text = ("Lot --> innerRectangle(scope){ shape : A | remainder : B }\n"
+            'A --> report("a", geometry.area) X\nB --> report("b", geometry.area) Y\n')
+    r = run(write, text, [LOT_ZOO["concave_L"], LOT_ZOO["courtyard"]])
+    t = per_lot(r)
+    assert t[0]["a_sum"] == pytest.approx(300) and t[0]["b_sum"] == pytest.approx(100)
+    assert t[1]["a_sum"] == pytest.approx(400) and t[1]["b_sum"] == pytest.approx(800)
+    assert t[1]["b_n"] == 1  # the rest of the ring is one piece (a U)
+
+
+def test_inner_rectangle_by_edge_finds_a_rotated_lot_whole(write):
+    angle = np.radians(30)
+    turn = np.array([[np.cos(angle), -np.sin(angle)], [np.sin(angle), np.cos(angle)]])
+    lot = [np.array([[0, 0], [25, 0], [25, 15], [0, 15]], float) @ turn.T]
+    found = {}
+    for align in ("edge", "scope"):
+        # the lot's scope runs along its first edge; aligned with the world's axes, scope and edge differ
+        text = f'Lot --> alignScopeToAxes() innerRectangle({align}){{ shape : A }}\nA --> report("a", geometry.area)\n'
+        found[align] = totals(run(write, text, [lot]))["a_sum"]
+    assert found["edge"] == pytest.approx(375.0) and found["scope"] < 300
