@@ -151,3 +151,17 @@ def test_paper_section4_building_covers_its_hipped_roof_with_bricks(lot):
     pieces = sum(face_area(f) for f, s in zip(mesh_faces(r), mesh.symbol) if r["symbols"][s] == "flatbrick")
     footprint = shapely_area(LOT_ZOO[lot])
     assert brick_area + pieces == pytest.approx(footprint / np.cos(np.radians(30)), rel=1e-4)
+
+
+@pytest.mark.parametrize("op", ["roofHip(30)", "roofGable(45)", "roofShed(10)", "roofPyramid(20)"])
+def test_roofs_on_degenerate_footprints_derive_or_are_reported(write, op):
+    """A sliver, repeated and collinear vertices, and a clockwise ring (the lot reader turns it)."""
+    noisy = [np.array([[0, 0], [5, 0], [5, 0], [10, 0], [10, 6], [10, 6], [0, 6]], float)]
+    clockwise = [LOT_ZOO["concave_L"][0][::-1].copy()]
+    r = run(write, f"Lot --> {op} Roof.\n", [LOT_ZOO["sliver"], noisy, clockwise])
+    assert r["bad"] == ()
+    assert set(r["mesh"].lot.tolist()) == {0, 1, 2}
+    # the noisy rectangle's roof is the clean rectangle's
+    clean = run(write, f"Lot --> {op} Roof.\n", [rect(10, 6)])
+    assert sum(face_area(f) for f, lot in zip(mesh_faces(r), r["mesh"].lot) if lot == 1) == pytest.approx(
+        sum(face_area(f) for f in mesh_faces(clean)))
