@@ -16,7 +16,7 @@ from dataclasses import replace
 import numpy as np
 import shapely
 
-from grammarc.backend import roofs, terminals
+from grammarc.backend import mesh_shapes, terminals
 from grammarc.backend.chunk import Chunk
 from grammarc.backend.evaluate import Env, elementwise, evaluate, evaluate_array
 from grammarc.backend.kernels import scope as scope_kernels
@@ -29,6 +29,7 @@ from grammarc.constants import TOL, Limits
 from grammarc.errors import ChunkTooLarge, LimitError, LotFailure
 from grammarc.geometry import components as comp_kernels
 from grammarc.geometry.clip import clip_to_slabs, fit_pieces, scope_polygons
+from grammarc.geometry.convexify import convex_parts
 from grammarc.geometry.inner_rectangle import largest_rectangles
 from grammarc.geometry.meshes import is_mesh, is_polygon
 from grammarc.geometry.polygons import PLANE_U, PLANE_V
@@ -380,7 +381,7 @@ class Executor:
 
     # ------------------------------------------------------------------------------------------- comp
     def comp(self, op: ir.Comp, cursor: Shapes, symbol: int) -> None:
-        if comp_kernels.KIND_CODES[op.kind] not in roofs.MESH_KINDS:
+        if comp_kernels.KIND_CODES[op.kind] not in mesh_shapes.MESH_KINDS:
             self.refuse_meshes(op, cursor, symbol)
         index_of = None
         if op.index is not None:
@@ -401,7 +402,7 @@ class Executor:
             pieces.append(self.solid_components(kind, cursor, np.flatnonzero(~mesh)))
         if mesh.any():
             which = np.flatnonzero(mesh)
-            parent, index, origin, axes, size, geom = roofs.mesh_components(chunk, cursor.take(which), kind)
+            parent, index, origin, axes, size, geom = mesh_shapes.mesh_components(chunk, cursor.take(which), kind)
             pieces.append((which[parent], index, origin, axes, size, geom, axes[:, 2]))
         parent, index, origin, axes, size, geom, normal = (
             pieces[0] if len(pieces) == 1 else
@@ -527,7 +528,7 @@ class Executor:
         for bad, what in checks:
             if np.any(bad):
                 self.fail(cursor, np.broadcast_to(bad, (n,)), f"`{op.kind}` {what}", symbol, op.span)
-        roofed, failed = roofs.build_roofs(self.chunk, cursor, op.kind, self.polygons_of(cursor), value,
+        roofed, failed = mesh_shapes.build_roofs(self.chunk, cursor, op.kind, self.polygons_of(cursor), value,
                                            op.by_height, overhang, index)
         if failed.any():
             self.fail(cursor, failed, f"`{op.kind}` found no roof for this polygon (its straight skeleton "
@@ -804,6 +805,17 @@ class Executor:
         self.run_regions(op, cursor, [by_owner[s] if s != "remainder" else remainder for s in op.selectors],
                          plane, symbol)
 
+    def convexify(self, op: ir.Convexify, cursor: Shapes, symbol: int) -> Shapes:
+        """``convexify``: the face becomes its convex parts (``geometry.convexify``), one shape whose
+        faces they are (a mesh; a convex face stays as it is)."""
+        polygons, plane = self.face_polygons(cursor, "convexify", symbol, op.span)
+        limit = None
+        if op.max_length is not None:
+            limit = np.broadcast_to(np.asarray(evaluate_array(op.max_length, self.env(cursor)), float),
+                                    (len(cursor),))
+        parts, source = convex_parts(polygons, limit)
+        return mesh_shapes.flat_meshes(self.chunk, cursor, parts, source, plane)
+
     def inner_rectangle(self, op: ir.InnerRectangle, cursor: Shapes, symbol: int) -> None:
         """``innerRectangle``: the face's largest inner rectangle (``geometry.inner_rectangle``) and the
         rest of the face, in the face's own scope frame (CityEngine keeps the scope's orientation)."""
@@ -897,7 +909,7 @@ _OPERATIONS = {
     ir.Report: Executor.report, ir.Case: Executor.branch, ir.Stochastic: Executor.branch,
     ir.GroupSplit: Executor.group_split, ir.CompFaces: Executor.comp_faces, ir.Empty: Executor.nothing,
     ir.NotApplied: Executor.nothing, ir.Setback: Executor.setback, ir.Roof: Executor.roof,
-    ir.InnerRectangle: Executor.inner_rectangle,
+    ir.InnerRectangle: Executor.inner_rectangle, ir.Convexify: Executor.convexify,
 }
 #: Operations that take roofs (meshes): scope changes, component splits, successors, leaves.
 _MESH_OPERATIONS = frozenset({

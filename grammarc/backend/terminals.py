@@ -20,7 +20,7 @@ import numpy as np
 
 from grammarc.backend.chunk import Chunk
 from grammarc.backend.kernels.scope import xforms
-from grammarc.backend.roofs import mesh_leaves
+from grammarc.backend.mesh_shapes import mesh_leaves
 from grammarc.backend.shapes import Shapes, asset_of
 from grammarc.constants import TOL
 from grammarc.geometry.components import reverse_rings

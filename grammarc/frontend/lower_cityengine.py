@@ -28,7 +28,7 @@ NOT_APPLIED = frozenset({
 })
 #: CityEngine operations grammarc does not implement yet (the geometry and context issues bring most).
 UNSUPPORTED_OPS = frozenset({
-    "innerPolygon", "convexify",
+    "innerPolygon",
     "cleanupGeometry", "trim", "envelope",
     "mirrorScope",
     "insertAlongUV", "scatter", "footprint", "tileUV", "splitArea", "inline", "resetGeometry", "taper",
@@ -549,6 +549,12 @@ class Lowering(LoweringBase):
             distances = tuple((s, exprs[0]) for s in selectors if s != "remainder")
         return ir.Setback(distances, selectors, chosen[1], span, self.site())
 
+    def op_convexify(self, op, args, span):
+        if len(args) > 1:
+            return self.unsupported(f"convexify with {len(args)} arguments", span,
+                                    "convexify() and convexify(maxLength)")
+        return ir.Convexify(self.expr(args[0]) if args else None, span)
+
     def op_inner_rectangle(self, op, args, parts, span):
         """``innerRectangle(scope|edge) { shape: A | remainder: B }``."""
         if len(args) != 1 or not isinstance(args[0], ir.Name) or args[0].name not in ("scope", "edge"):
@@ -683,6 +689,7 @@ _OPS = {
     "NIL": Lowering.op_nil,
     "set": Lowering.op_set,
     "report": Lowering.op_report,
+    "convexify": Lowering.op_convexify,
     "roofHip": Lowering.op_roof,
     "roofGable": Lowering.op_roof,
     "roofShed": Lowering.op_roof,

@@ -472,6 +472,15 @@ class Setback:
 
 
 @dataclass(frozen=True, slots=True)
+class Convexify:
+    """CityEngine ``convexify()`` and ``convexify(maxLength)``: the face becomes its convex parts (one
+    shape whose faces ``comp(f)`` splits), cut only along split lines shorter than ``max_length``."""
+
+    max_length: Expr | None
+    span: Span = NO_SPAN
+
+
+@dataclass(frozen=True, slots=True)
 class InnerRectangle:
     """CityEngine ``innerRectangle(scope|edge) { shape: A | remainder: B }``: the largest rectangle inside
     the face (sides along the scope's x, or along one of its long edges) and the rest of the face."""
@@ -522,7 +531,7 @@ class CompFaces:
 
 Op = (Symbol | Empty | Translate | Scale | Rotate | Push | Pop | Insert | Split | Repeat | Comp | Extrude
       | Center | UseAsset | Case | Stochastic | SetAttr | Report | NotApplied | GroupSplit | CompFaces
-      | AlignScope | Mirror | Offset | SetColor | Setback | Roof | InnerRectangle)
+      | AlignScope | Mirror | Offset | SetColor | Setback | Roof | InnerRectangle | Convexify)
 Body = tuple[Op, ...]
 
 

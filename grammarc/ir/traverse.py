@@ -92,6 +92,9 @@ def rewrite_op(op: ir.Op, fn: ExprFn) -> ir.Op:
     if isinstance(op, ir.InnerRectangle):
         parts = _tuple(op.parts, lambda b: rewrite_body(b, fn))
         return op if parts is op.parts else replace(op, parts=parts)
+    if isinstance(op, ir.Convexify) and op.max_length is not None:
+        max_length = ex(op.max_length)
+        return op if max_length is op.max_length else replace(op, max_length=max_length)
     if isinstance(op, ir.SetColor):
         values = _tuple(op.values, ex)
         return op if values is op.values else replace(op, values=values)
@@ -216,6 +219,8 @@ def op_exprs(op: ir.Op) -> Iterator[ir.Expr]:
         yield from op.axes
     elif isinstance(op, ir.Offset):
         yield op.distance
+    elif isinstance(op, ir.Convexify) and op.max_length is not None:
+        yield op.max_length
     elif isinstance(op, ir.Roof):
         yield from (e for e in (op.value, op.overhang, op.overhang_y, op.index) if e is not None)
     elif isinstance(op, ir.SetColor):

@@ -1,5 +1,5 @@
-"""backend/roofs.py: roof shapes in derivations - scopes as CityEngine sets them, component splits, leaves,
-measures, errors."""
+"""backend/mesh_shapes.py: roof and convex-part shapes in derivations - scopes as CityEngine sets them,
+component splits, leaves, measures, errors."""
 
 from __future__ import annotations
 
@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 import shapely
 from conftest import LOT_ZOO
-from test_cityengine import assets, face_area, mesh_faces, names, rect, run, totals
+from test_cityengine import assets, face_area, mesh_faces, names, per_lot, rect, run, totals
 
 from grammarc.build import BuildOptions, derive
 from grammarc.compiler import compile_grammar
@@ -165,3 +165,20 @@ def test_roofs_on_degenerate_footprints_derive_or_are_reported(write, op):
     clean = run(write, f"Lot --> {op} Roof.\n", [rect(10, 6)])
     assert sum(face_area(f) for f, lot in zip(mesh_faces(r), r["mesh"].lot) if lot == 1) == pytest.approx(
         sum(face_area(f) for f in mesh_faces(clean)))
+
+
+def test_convexify_makes_one_shape_whose_faces_are_the_convex_parts(write):
+    text = ('Lot --> convexify() report("n", geometry.nFaces) comp(f){ all : Part }\n'
+            'Part --> report("a", geometry.area) Kind\n'
+            'Kind --> case geometry.isRectangular(0) : report("rect", 1)\n        else : report("other", 1)\n')
+    r = run(write, text, [LOT_ZOO["concave_L"], LOT_ZOO["rect_12x8"]])
+    t = per_lot(r)
+    assert t[0]["n_sum"] == 2 and t[0]["a_n"] == 2 and t[0]["a_sum"] == pytest.approx(400)
+    assert t[0]["rect_n"] == 2 and "other_n" not in t[0]  # an L is two rectangles
+    assert t[1]["n_sum"] == 1 and t[1]["a_sum"] == pytest.approx(96)  # a convex face stays itself
+
+
+def test_convexified_leaf_emits_its_parts(write):
+    r = run(write, "Lot --> convexify()\n", [LOT_ZOO["courtyard"]])
+    faces = mesh_faces(r)
+    assert len(faces) == 4 and sum(face_area(f) for f in faces) == pytest.approx(1200)

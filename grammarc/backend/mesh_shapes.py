@@ -1,4 +1,5 @@
-"""Roof shapes on the shape columns: building them, splitting them into faces, emitting them as leaves.
+"""Mesh shapes on the shape columns: roofs and faces of several parts (``convexify``), built, split into
+faces and edges, and emitted as leaves.
 
 A roof is a mesh (``geometry.meshes``) built over a face's polygon by ``geometry.roofs``. Its scope
 follows CityEngine: x kept, y along the face's normal, z = x cross y, and the box fitted to the mesh
@@ -9,6 +10,7 @@ scope y) the frame stays; a face from a component split (normal along z) turns a
 from __future__ import annotations
 
 import numpy as np
+import shapely
 
 from grammarc.backend.chunk import Chunk
 from grammarc.backend.shapes import Shapes
@@ -68,6 +70,42 @@ def build_roofs(chunk: Chunk, shapes: Shapes, kind: str, polygons, value, by_hei
     origin = shapes.origin + np.einsum("ni,nij->nj", low, axes)
     geom = (MESH_BASE + ids).astype(np.int32)
     return shapes.with_scope(origin, np.where(size > TOL.zero, size, 0.0), frame, geom), ~ok
+
+
+def flat_meshes(chunk: Chunk, shapes: Shapes, parts: np.ndarray, source: np.ndarray, plane: np.ndarray) -> Shapes:
+    """``shapes`` (flat) whose geometry becomes its ``parts``: shapely polygons (k,) in scope units, each
+    of the shape ``source`` (k,), in the plane ``plane`` (n,). A shape of one part keeps its geometry
+    (the part is its face); one of several becomes a mesh of them in its own scope."""
+    several = np.bincount(source, minlength=len(shapes)) > 1
+    pick = several[source]
+    if not pick.any():
+        return shapes
+    parts, source = parts[pick], source[pick]
+    part_plane = plane[source]
+    # outlines wind counter-clockwise around the plane's normal: clockwise in (u, v) for plane 1
+    for flip in (True, False):
+        sel = (part_plane == 1) == flip
+        if sel.any():
+            parts[sel] = shapely.orient_polygons(parts[sel], exterior_cw=flip)
+    _, coords, (ring_offsets, face_offsets) = shapely.to_ragged_array(parts)
+    ring_offsets = np.asarray(ring_offsets, dtype=np.int64)
+    open_ = np.ones(len(coords), dtype=bool)
+    open_[ring_offsets[1:] - 1] = False  # the closing points
+    vertex_part = segment_of(np.asarray(face_offsets, dtype=np.int64))[segment_of(ring_offsets)][open_]
+    coords = np.asarray(coords)[open_, :2]
+    ring_offsets = ring_offsets - np.arange(len(ring_offsets))
+    owner = source[vertex_part]
+    local = np.zeros((len(coords), 3))
+    at = np.arange(len(coords))
+    local[at, PLANE_U[part_plane[vertex_part]]] = coords[:, 0]
+    local[at, PLANE_V[part_plane[vertex_part]]] = coords[:, 1]
+    size = np.where(shapes.size > TOL.zero, shapes.size, np.inf)
+    mesh_offsets = np.r_[0, np.cumsum(np.bincount(source, minlength=len(shapes))[several])]
+    ids = chunk.meshes.add(local / size[owner], ring_offsets, np.asarray(face_offsets, dtype=np.int64),
+                           mesh_offsets)
+    geom = shapes.geom.copy()
+    geom[several] = (MESH_BASE + ids).astype(np.int32)
+    return shapes.with_scope(shapes.origin, shapes.size, shapes.frame, geom)
 
 
 #: Component kinds of roofs (``components.KIND_CODES``): faces and edges. The bottom is face 0.

@@ -1,0 +1,189 @@
+"""Convex parts of polygons with holes (CityEngine's ``convexify``), all polygons of a batch at once.
+
+Each round cuts every piece that still has a reflex vertex along a line through its first one: the line
+of the edge that arrives there (on one side the vertex becomes straight, on the other its angle drops
+below 180 degrees), or, where the corner turns by less than ``SHARP_DEGREES``, the line across the
+boundary (a cut along a nearly straight edge would shave off slivers). A cut never makes a reflex
+vertex, so the reflex vertices of a lineage strictly decrease. A hole's
+corners are reflex too, so holes are cut open. Rectilinear footprints come out as rectangles (an L in
+two, a U in three). The cut is the whole line through the piece: a concave piece may be cut in more
+places than the reflex vertex needs.
+
+A cut that only shaves off a sliver (below the area floor) is tried again across the boundary; if that
+fails too, the piece stays concave (about one piece in 10^4 on random star-shaped footprints).
+
+``max_length`` (CityEngine's ``convexify(maxLength)``): a reflex vertex is only cut where the cut's
+chord through the piece, from boundary to boundary through the vertex, is shorter; a piece whose reflex
+vertices all have longer chords stays concave.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import shapely
+
+from grammarc.constants import TOL
+from grammarc.ragged import segment_of
+
+#: Reflex corners turning more than this are cut along their incoming edge, flatter ones across.
+SHARP_DEGREES = 20.0
+#: Cutting rounds at most (each removes at least one reflex vertex from every piece it cuts).
+MAX_ROUNDS = 256
+
+
+def convex_parts(polygons: np.ndarray, max_length: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """Convex pieces of shapely polygons (m,): (pieces (k,), source (k,)), each source's pieces together
+    in cutting order. ``max_length`` (m,): longest chord to cut along, per polygon (None: no limit)."""
+    pieces = shapely.orient_polygons(np.asarray(polygons, dtype=object), exterior_cw=False)
+    source = np.arange(len(pieces))
+    across = np.zeros(len(pieces), dtype=bool)  # cut across the boundary this time
+    done_pieces, done_source = [], []
+    for _ in range(MAX_ROUNDS):
+        if not len(pieces):
+            break
+        pieces = _without_spikes(pieces)
+        limit = None if max_length is None else max_length[source]
+        vertex, direction = _cut_vertices(pieces, limit, across)
+        finished = np.isnan(vertex[:, 0])
+        done_pieces.append(pieces[finished])
+        done_source.append(source[finished])
+        pieces, source, vertex, direction, across = (pieces[~finished], source[~finished], vertex[~finished],
+                                                     direction[~finished], across[~finished])
+        if not len(pieces):
+            break
+        left, right = _half_planes(vertex, direction, _reach(pieces))
+        cut = np.concatenate([shapely.intersection(pieces, left), shapely.intersection(pieces, right)])
+        parts, index = shapely.get_parts(cut, return_index=True)
+        keep = (shapely.get_type_id(parts) == shapely.GeometryType.POLYGON) & (shapely.area(parts) > TOL.area_floor)
+        parent = np.concatenate([np.arange(len(pieces))] * 2)[index[keep]]
+        # a cut that only shaves off a sliver (an edge's line running close to another edge) is tried
+        # again across the boundary; if that fails too, the piece stays as it is
+        stuck = np.bincount(parent, minlength=len(pieces)) < 2
+        given_up = stuck & across
+        done_pieces.append(pieces[given_up])
+        done_source.append(source[given_up])
+        retry = np.flatnonzero(stuck & ~across)
+        parts, parent = parts[keep][~stuck[parent]], parent[~stuck[parent]]
+        order = np.argsort(np.concatenate([parent, retry]), kind="stable")
+        pieces = shapely.orient_polygons(np.concatenate([parts, pieces[retry]])[order], exterior_cw=False)
+        across = np.concatenate([np.zeros(len(parts), dtype=bool), np.ones(len(retry), dtype=bool)])[order]
+        source = source[np.concatenate([parent, retry])[order]]
+    else:
+        done_pieces.append(pieces)
+        done_source.append(source)
+    pieces, source = np.concatenate(done_pieces), np.concatenate(done_source)
+    order = np.argsort(source, kind="stable")
+    return pieces[order], source[order]
+
+
+def _cut_vertices(pieces: np.ndarray, limit: np.ndarray | None, across: np.ndarray):
+    """Per piece, its first reflex vertex that may be cut (k, 2) and the cut's direction (k, 2): along
+    the edge arriving there, or across the boundary (flat corners, and pieces flagged ``across``); NaN
+    where there is none (the piece is convex, or every cut is too long)."""
+    _, coords, (ring_offsets, part_offsets) = shapely.to_ragged_array(pieces)
+    coords = np.asarray(coords)[:, :2]
+    ring_offsets = np.asarray(ring_offsets, dtype=np.int64)
+    ring = segment_of(ring_offsets)
+    # closed rings: vertex j of a ring (its last point repeats its first) has neighbours j - 1 and j + 1,
+    # the previous of its first being the one before its closing point
+    start, end = ring_offsets[:-1][ring], ring_offsets[1:][ring] - 1
+    at = np.arange(len(coords))
+    real = at < end
+    prev = np.where(at > start, at - 1, end - 1)
+    nxt = at + 1
+    d_in = coords[at] - coords[prev]
+    d_out = coords[np.minimum(nxt, len(coords) - 1)] - coords[at]
+    cross = d_in[:, 0] * d_out[:, 1] - d_in[:, 1] * d_out[:, 0]
+    scale = np.hypot(d_in[:, 0], d_in[:, 1]) * np.hypot(d_out[:, 0], d_out[:, 1])
+    reflex = real & (cross < -1e-9 * np.maximum(scale, TOL.zero))
+    piece = segment_of(np.asarray(part_offsets, dtype=np.int64))[ring]
+    candidates = np.flatnonzero(reflex)
+    a = d_in[candidates] / np.hypot(d_in[candidates, 0], d_in[candidates, 1])[:, None]
+    b = d_out[candidates] / np.hypot(d_out[candidates, 0], d_out[candidates, 1])[:, None]
+    # a clear corner is cut along its incoming edge (rectilinear footprints into rectangles); a nearly
+    # straight one across the boundary, which no edge's line runs close to
+    sharp = (a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0]) < -np.sin(np.radians(SHARP_DEGREES))
+    tangent = a + b
+    normal = np.stack([-tangent[:, 1], tangent[:, 0]], axis=1)
+    normal /= np.maximum(np.hypot(normal[:, 0], normal[:, 1]), 1e-300)[:, None]
+    direction = np.where((sharp & ~across[piece[candidates]])[:, None], a, normal)
+    if limit is not None and len(candidates):
+        chord = _chords(pieces[piece[candidates]], coords[candidates], direction)
+        keep = chord < limit[piece[candidates]]
+        candidates, direction = candidates[keep], direction[keep]
+    vertex = np.full((len(pieces), 2), np.nan)
+    chosen = np.full((len(pieces), 2), np.nan)
+    # the first candidate of each piece (candidates are in vertex order)
+    first = np.r_[True, piece[candidates][1:] != piece[candidates][:-1]] if len(candidates) else np.zeros(0, bool)
+    vertex[piece[candidates[first]]] = coords[candidates[first]]
+    chosen[piece[candidates[first]]] = direction[first]
+    return vertex, chosen
+
+
+def _chords(pieces: np.ndarray, point: np.ndarray, direction: np.ndarray) -> np.ndarray:
+    """Length of the part of each piece's cut line that runs through ``point``: the split line."""
+    reach = _reach(pieces)
+    lines = shapely.linestrings(np.stack([point - direction * reach[:, None], point + direction * reach[:, None]],
+                                         axis=1))
+    parts, index = shapely.get_parts(shapely.intersection(lines, pieces), return_index=True)
+    through = shapely.distance(parts, shapely.points(point[index])) <= 1e-9 * (reach[index] + 1.0)
+    length = np.full(len(pieces), np.inf)
+    np.minimum.at(length, index[through], shapely.length(parts[through]))
+    return length
+
+
+def _without_spikes(pieces: np.ndarray) -> np.ndarray:
+    """Pieces without repeated vertices and the vertices where the boundary runs straight on or turns
+    straight back (a cut along a line nearly collinear with an edge leaves such zero-width spikes)."""
+    if not len(pieces):
+        return pieces
+    _, coords, (ring_offsets, part_offsets) = shapely.to_ragged_array(pieces)
+    ring_offsets = np.asarray(ring_offsets, dtype=np.int64)
+    # open rings: drop each ring's closing point
+    closing = ring_offsets[1:] - 1
+    keep = np.ones(len(coords), dtype=bool)
+    keep[closing] = False
+    coords = np.asarray(coords)[keep, :2]
+    ring = segment_of(ring_offsets)[keep]
+    n_rings = len(ring_offsets) - 1
+    for _ in range(64):  # removing a spike's tip makes its base straight; one of two neighbours a pass
+        counts = np.bincount(ring, minlength=n_rings)
+        offsets = np.r_[0, np.cumsum(counts)]
+        at = np.arange(len(coords))
+        start, stop = offsets[:-1][ring], offsets[1:][ring]
+        prev = np.where(at > start, at - 1, stop - 1)
+        nxt = np.where(at + 1 < stop, at + 1, start)
+        d_in, d_out = coords - coords[prev], coords[nxt] - coords
+        out_length = np.hypot(d_out[:, 0], d_out[:, 1])
+        cross = d_in[:, 0] * d_out[:, 1] - d_in[:, 1] * d_out[:, 0]
+        repeated = out_length <= 1e-9 * (1.0 + np.abs(coords).max(axis=1))
+        straight = repeated | (np.abs(cross) <= 1e-9 * np.hypot(d_in[:, 0], d_in[:, 1]) * out_length)
+        # never below a triangle; of two neighbours both straight, the first goes this time
+        drop = straight & (counts[ring] > 3) & ~(straight[prev] & (prev != at) & (at > start))
+        if not drop.any():
+            break
+        coords, ring = coords[~drop], ring[~drop]
+    counts = np.bincount(ring, minlength=n_rings)
+    offsets = np.r_[0, np.cumsum(counts)]
+    # closed again: each ring's first vertex after its last
+    order = np.concatenate([np.arange(len(coords)), offsets[:-1]])
+    order = order[np.argsort(np.concatenate([ring, np.arange(n_rings)]), kind="stable")]
+    return shapely.from_ragged_array(shapely.GeometryType.POLYGON, coords[order],
+                                     (np.r_[0, np.cumsum(counts + 1)], part_offsets))
+
+
+def _reach(pieces: np.ndarray) -> np.ndarray:
+    """A length past which a line through a point of the piece has left it: twice its box's diagonal."""
+    bounds = shapely.bounds(pieces).reshape(-1, 4)
+    return 2.0 * np.hypot(bounds[:, 2] - bounds[:, 0], bounds[:, 3] - bounds[:, 1]) + 1.0
+
+
+def _half_planes(vertex: np.ndarray, direction: np.ndarray, reach: np.ndarray):
+    """Squares of side 2 * reach on the left and the right of each line through ``vertex``."""
+    normal = np.stack([-direction[:, 1], direction[:, 0]], axis=1)
+    along = direction * reach[:, None]
+    across = normal * (2 * reach)[:, None]
+    a, b = vertex - along, vertex + along
+    left = shapely.polygons(np.stack([a, b, b + across, a + across], axis=1))
+    right = shapely.polygons(np.stack([a, a - across, b - across, b], axis=1))
+    return left, right
