@@ -778,10 +778,18 @@ class Executor:
         inside, border = self.offset_pieces(op.distance, cursor, symbol, op.span)
         pieces = inside if op.select == "inside" else border
         several = np.bincount(pieces.source, minlength=len(cursor)) > 1
-        if several.any():
-            self.fail(cursor, several, "`offset` parts the face into pieces: several faces in one shape are "
-                      "not supported yet", symbol, op.span)
-        return self.piece_shapes(cursor, pieces, 0)
+        if not several.any():
+            return self.piece_shapes(cursor, pieces, 0)
+        # a face the offset parts into pieces stays one shape: a mesh of the pieces in one fitted scope
+        rows = np.flatnonzero(several)
+        mine = several[pieces.source]
+        single = self.piece_shapes(cursor, pieces.take(~mine), 0)
+        grouped = pieces.take(mine)
+        grouped = replace(grouped, source=np.searchsorted(rows, grouped.source))
+        meshes = mesh_shapes.piece_meshes(self.chunk, cursor.take(rows), grouped)
+        meshes = replace(meshes, key=child_keys(meshes.key, 0, np.zeros(len(rows), dtype=np.int64)))
+        row = np.concatenate([pieces.source[~mine], rows])
+        return Shapes.concat([single, meshes]).take(np.argsort(row, kind="stable"))
 
     def setback(self, op: ir.Setback, cursor: Shapes, symbol: int) -> None:
         """``setback`` and ``shapeL/U/O``: the face's edge strips and its remainder to their parts."""

@@ -14,12 +14,12 @@ import shapely
 
 from grammarc.backend.chunk import Chunk
 from grammarc.backend.shapes import Shapes
-from grammarc.constants import TOL
+from grammarc.constants import STRICT, TOL
 from grammarc.geometry.meshes import MESH_BASE, face_frames, face_vertices, mesh_edges
 from grammarc.geometry.polygons import PLANE_U, PLANE_V
 from grammarc.geometry.roofs import ROOF_KINDS, roof_meshes
 from grammarc.io.npz import MeshChunk
-from grammarc.ragged import rank_within, segment_of, segment_reduce
+from grammarc.ragged import ragged_take, rank_within, segment_of, segment_reduce
 
 #: Per normal axis n: the roof frame's axes as rows in the face scope's frame (y' along axis n).
 _ROOF_FRAME = np.array([
@@ -106,6 +106,34 @@ def flat_meshes(chunk: Chunk, shapes: Shapes, parts: np.ndarray, source: np.ndar
     geom = shapes.geom.copy()
     geom[several] = (MESH_BASE + ids).astype(np.int32)
     return shapes.with_scope(shapes.origin, shapes.size, shapes.frame, geom)
+
+
+def piece_meshes(chunk: Chunk, shapes: Shapes, pieces) -> Shapes:
+    """One shape per row of ``shapes`` from its several ``pieces`` (``geometry.clip.Clipped``, every
+    piece's source among the rows): the scope fitted around all of them, the pieces its mesh's faces."""
+    n = len(shapes)
+    src = pieces.source
+    low = np.full((n, 3), np.inf)
+    high = np.full((n, 3), -np.inf)
+    np.minimum.at(low, src, pieces.low)
+    np.maximum.at(high, src, pieces.low + pieces.extent)
+    size = high - low
+    rings, poly_offsets = ragged_take(pieces.poly_offsets, np.arange(len(src)))
+    vertices, ring_offsets = ragged_take(pieces.ring_offsets, rings)
+    vertex_piece = segment_of(poly_offsets)[segment_of(ring_offsets)]
+    plane = pieces.plane[vertex_piece].astype(np.int64)
+    at = np.arange(len(vertices))
+    local = pieces.low[vertex_piece] - low[src[vertex_piece]]
+    for axis, which in ((PLANE_U[plane], 0), (PLANE_V[plane], 1)):
+        local[at, axis] += pieces.coords[vertices, which] * pieces.extent[vertex_piece, axis]
+    scale = np.where(size > TOL.zero, size, np.inf)
+    if STRICT:
+        assert (np.diff(src) >= 0).all(), "pieces must come grouped by row"
+    mesh_offsets = np.r_[0, np.cumsum(np.bincount(src, minlength=n))]
+    ids = chunk.meshes.add(local / scale[src[vertex_piece]], ring_offsets, poly_offsets, mesh_offsets)
+    origin = shapes.origin + np.einsum("ni,nij->nj", low, chunk.frames[shapes.frame])
+    return shapes.with_scope(origin, np.where(size > TOL.zero, size, 0.0), shapes.frame,
+                             (MESH_BASE + ids).astype(np.int32))
 
 
 #: Component kinds of roofs (``components.KIND_CODES``): faces and edges. The bottom is face 0.

@@ -18,7 +18,7 @@ from grammarc.constants import TOL
 from grammarc.geometry.polygons import PLANE_U as _A
 from grammarc.geometry.polygons import PLANE_V as _B
 from grammarc.geometry.polygons import PolygonStore
-from grammarc.ragged import offsets_from_counts, segment_of, segment_reduce
+from grammarc.ragged import offsets_from_counts, ragged_take, segment_of, segment_reduce
 
 
 @dataclass(frozen=True)
@@ -39,6 +39,14 @@ class Clipped:
     ring_offsets: np.ndarray
     poly_offsets: np.ndarray
     plane: np.ndarray
+
+    def take(self, index: np.ndarray) -> Clipped:
+        """The pieces at ``index`` (a boolean mask or indices), with their polygons."""
+        index = np.flatnonzero(index) if np.asarray(index).dtype == bool else np.asarray(index, np.int64)
+        rings, poly_offsets = ragged_take(self.poly_offsets, index)
+        vertices, ring_offsets = ragged_take(self.ring_offsets, rings)
+        return Clipped(self.source[index], self.low[index], self.extent[index], self.is_rect[index],
+                       self.coords[vertices], ring_offsets, poly_offsets, self.plane[index])
 
 
 def scope_polygons(store: PolygonStore, geom: np.ndarray, size: np.ndarray) -> np.ndarray:

@@ -182,3 +182,15 @@ def test_convexified_leaf_emits_its_parts(write):
     r = run(write, "Lot --> convexify()\n", [LOT_ZOO["courtyard"]])
     faces = mesh_faces(r)
     assert len(faces) == 4 and sum(face_area(f) for f in faces) == pytest.approx(1200)
+
+
+def test_offset_that_parts_a_face_keeps_one_shape_of_its_pieces(write):
+    """A dumbbell: two 10 x 10 squares joined by a 1 m neck; moving in by 1 m leaves the two squares."""
+    dumbbell = [np.array([[0, 0], [10, 0], [10, 4.5], [20, 4.5], [20, 0], [30, 0], [30, 10], [20, 10],
+                          [20, 5.5], [10, 5.5], [10, 10], [0, 10]], float)]
+    text = ('Lot --> offset(-1, inside) report("n", geometry.nFaces) report("a", geometry.area) '
+            'comp(f){ all : Part }\nPart --> report("part", geometry.area)\n')
+    r = run(write, text, [dumbbell, rect(12, 8)])
+    t = per_lot(r)
+    assert t[0]["n_sum"] == 2 and t[0]["a_sum"] == pytest.approx(128) and t[0]["part_n"] == 2
+    assert t[1]["n_sum"] == 1 and t[1]["a_sum"] == pytest.approx(60)
