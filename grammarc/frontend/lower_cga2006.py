@@ -28,10 +28,11 @@ NOT_YET = {
     "Snap": "snap shapes (paper section 3.3)",
     "SnapLines": "snap lines (paper section 3.3)",
 }
-#: The paper's roof types (section 3.1) and the CityEngine roofs that build them: a cross gable is the
-#: gable roof of a cross-shaped footprint, a cone the pyramid of a many-sided one.
+#: The paper's roof types (section 3.1) and the roofs that build them: a cross gable is the gable roof of
+#: a cross-shaped footprint, a cone the pyramid of a many-sided one; mansard and gambrel are the hip and
+#: the gable roof with two slopes (``geometry.roofs``).
 ROOF_TYPES = {"hipped": "roofHip", "gabled": "roofGable", "cross-gable": "roofGable", "cone": "roofPyramid",
-              "pyramid": "roofPyramid", "shed": "roofShed"}
+              "pyramid": "roofPyramid", "shed": "roofShed", "mansard": "mansard", "gambrel": "gambrel"}
 #: Context queries (paper section 3.2), parsed as dotted calls.
 NOT_YET_QUERIES = {
     ("Shape", "occ"): "occlusion queries `Shape.occ` (paper section 3.2)",
@@ -329,10 +330,6 @@ class Lowering(LoweringBase):
         if kind is None:
             return ir.Empty(span)
         if kind not in ROOF_TYPES:
-            known = ", ".join(f'"{k}"' for k in ROOF_TYPES)
-            if kind in ("mansard", "gambrel"):
-                return self.not_yet(f'Roof("{kind}")', f"two-slope roofs; supported types: {known}",
-                                    args[0].span)
             self.diags.error("roof", f'unknown roof type "{kind}"{suggest(kind, ROOF_TYPES)}', args[0].span)
             return ir.Empty(span)
         if parts is not None and len(parts) != 1:

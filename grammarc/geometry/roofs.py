@@ -14,7 +14,10 @@ its normal. Face 0 of every mesh is the original polygon seen from below (CityEn
 - ``shed``: one sloped face rising from edge ``index`` of the exterior ring, and a vertical wall under
   each edge (none where the wall has no height);
 - ``pyramid``: the average of the exterior's vertices lifted, and a triangle per exterior edge; holes
-  stay in the bottom face only.
+  stay in the bottom face only;
+- ``mansard`` and ``gambrel`` (the paper's ``Roof`` types): the hip and the gable roof with two slopes,
+  every plane cut where the inset reaches ``BREAK_SHARE`` of the skeleton's height: steep below,
+  ``angle`` above. A gambrel's gable ends are vertical pentagons.
 
 ``value`` is the slope angle in degrees, or with ``by_height`` the roof's height (hip and gable: the
 highest skeleton node; shed: the highest point; pyramid: the apex). Overhangs (hip and gable) are
@@ -29,8 +32,12 @@ from numba import njit
 
 from grammarc.geometry.skeleton import skeleton_faces
 
-HIP, GABLE, SHED, PYRAMID = 0, 1, 2, 3
-ROOF_KINDS = {"roofHip": HIP, "roofGable": GABLE, "roofShed": SHED, "roofPyramid": PYRAMID}
+HIP, GABLE, SHED, PYRAMID, MANSARD, GAMBREL = 0, 1, 2, 3, 4, 5
+ROOF_KINDS = {"roofHip": HIP, "roofGable": GABLE, "roofShed": SHED, "roofPyramid": PYRAMID, "mansard": MANSARD,
+              "gambrel": GAMBREL}
+#: Two-slope roofs (the paper's mansard and gambrel): the lower planes rise to this share of the
+#: skeleton's height in inset, at the steeper angle ``90 - (90 - angle) / 3`` (70 degrees for 30).
+BREAK_SHARE = 1.0 / 3.0
 
 
 @njit(cache=True)
@@ -94,18 +101,18 @@ def _clean_rings(pts, ring_offsets, eps):
 
 
 @njit(cache=True)
-def _gable_apexes(node_xy, node_t, faces, face_offsets, xy, succ, start_time, eps):
-    """Move the apex of each hip end that ends a ridge onto its eave line (in place)."""
+def _gable_ends(node_xy, faces, face_offsets, xy, succ, eps):
+    """Which edges' hip faces become gables: triangles whose apex ends a ridge (no other hip end meets
+    there, or only the opposite one)."""
     n = len(face_offsets) - 1
     apex = np.full(n, -1, np.int64)
     for k in range(n):
         if face_offsets[k + 1] - face_offsets[k] == 3:
             apex[k] = faces[face_offsets[k] + 2]
-    moves = np.zeros((n, 2))
+    ends = np.zeros(n, np.bool_)
     for k in range(n):
         if apex[k] < 0:
             continue
-        # hip ends meeting in one point: a ridge end only for one, or two opposite ones
         dx, dy = xy[succ[k], 0] - xy[k, 0], xy[succ[k], 1] - xy[k, 1]
         length = np.sqrt(dx * dx + dy * dy)
         dx, dy = dx / length, dy / length
@@ -120,15 +127,96 @@ def _gable_apexes(node_xy, node_t, faces, face_offsets, xy, succ, start_time, ep
                 ex, ey = xy[succ[j], 0] - xy[j, 0], xy[succ[j], 1] - xy[j, 1]
                 if (dx * ex + dy * ey) / np.sqrt(ex * ex + ey * ey) > -0.999:
                     opposite = False
-        if others > 1 or not opposite:
+        ends[k] = others <= 1 and opposite
+    return ends
+
+
+@njit(cache=True)
+def _move_gable_ends(node_xy, node_t, faces, face_offsets, origin, ends, xy, succ, start_time):
+    """Turn the gable ends vertical (in place): every node of a face that came from a gable end's hip
+    face, other than its eave, moves along the edge's inward normal back onto the eave line."""
+    moves = np.zeros((len(node_xy), 2))
+    moved = np.zeros(len(node_xy), np.bool_)
+    for f in range(len(face_offsets) - 1):
+        k = origin[f]
+        if not ends[k]:
             continue
-        # along the inward normal back to the eave line (the edge moved out by the overhang)
-        shift = node_t[apex[k]] - start_time
-        moves[k, 0], moves[k, 1] = dy * shift, -dx * shift
-    for k in range(n):
-        if apex[k] >= 0:
-            node_xy[apex[k], 0] += moves[k, 0]
-            node_xy[apex[k], 1] += moves[k, 1]
+        dx, dy = xy[succ[k], 0] - xy[k, 0], xy[succ[k], 1] - xy[k, 1]
+        length = np.sqrt(dx * dx + dy * dy)
+        dx, dy = dx / length, dy / length
+        for j in range(face_offsets[f], face_offsets[f + 1]):
+            q = faces[j]
+            if moved[q] or node_t[q] <= start_time:
+                continue
+            shift = node_t[q] - start_time
+            moves[q, 0], moves[q, 1] = dy * shift, -dx * shift
+            moved[q] = True
+    node_xy += moves
+
+
+@njit(cache=True)
+def _split_at(node_xy, node_t, faces, face_offsets, knee, eps):
+    """Each face cut where its inset reaches ``knee``: its part below, then its part above (either may
+    be missing), new nodes where face boundaries cross the knee, shared by the faces that meet there.
+    Returns nodes (xy, t), faces, offsets and each new face's original face."""
+    n_faces = len(face_offsets) - 1
+    m = len(faces)
+    xy = np.empty((len(node_xy) + m, 2))
+    t = np.empty(len(node_t) + m)
+    xy[: len(node_xy)] = node_xy
+    t[: len(node_t)] = node_t
+    n_nodes = len(node_t)
+    break_key = np.empty((m, 2), np.int64)
+    n_breaks = 0
+    out = np.empty(4 * m + 8, np.int64)
+    offsets = np.zeros(2 * n_faces + 1, np.int64)
+    origin = np.empty(2 * n_faces, np.int64)
+    count = 0
+    n_out = 0
+    for f in range(n_faces):
+        f0, f1 = face_offsets[f], face_offsets[f + 1]
+        size = f1 - f0
+        for upper in (False, True):
+            start = count
+            for j in range(size):
+                a = faces[f0 + (j - 1) % size]
+                b = faces[f0 + j]
+                a_in = (t[a] >= knee - eps) if upper else (t[a] <= knee + eps)
+                b_in = (t[b] >= knee - eps) if upper else (t[b] <= knee + eps)
+                if a_in != b_in:
+                    lo, hi = min(a, b), max(a, b)
+                    found = -1
+                    for q in range(n_breaks):
+                        if break_key[q, 0] == lo and break_key[q, 1] == hi:
+                            found = q
+                            break
+                    if found < 0:
+                        f_ = (knee - t[a]) / (t[b] - t[a])
+                        xy[n_nodes, 0] = xy[a, 0] + f_ * (xy[b, 0] - xy[a, 0])
+                        xy[n_nodes, 1] = xy[a, 1] + f_ * (xy[b, 1] - xy[a, 1])
+                        t[n_nodes] = knee
+                        break_key[n_breaks, 0], break_key[n_breaks, 1] = lo, hi
+                        found = n_breaks
+                        n_breaks += 1
+                        n_nodes += 1
+                    out[count] = len(node_t) + found
+                    count += 1
+                if b_in:
+                    out[count] = b
+                    count += 1
+            if not upper:  # the part below keeps the eave first
+                for j in range(start, count):
+                    if out[j] == faces[f0] and j > start:
+                        rolled = np.concatenate((out[j:count], out[start:j]))
+                        out[start:count] = rolled
+                        break
+            if count - start >= 3:
+                origin[n_out] = f
+                n_out += 1
+                offsets[n_out] = count
+            else:
+                count = start
+    return xy[:n_nodes], t[:n_nodes], out[:count], offsets[: n_out + 1], origin[:n_out]
 
 
 @njit(cache=True)
@@ -181,22 +269,32 @@ def roof_meshes(kind, coords, ring_offsets, poly_offsets, plane, size_a, size_b,
             for j in range(pring[r], pring[r + 1]):
                 succ[j] = pring[r] + (j - pring[r] + 1) % (pring[r + 1] - pring[r])
         # ---- the roof's points (x, y, h) and its faces as rings of point ids
-        if kind == HIP or kind == GABLE:
+        if kind == HIP or kind == GABLE or kind == MANSARD or kind == GAMBREL:
             start_time = -overhang[g] * (1.0 if by_height else np.cos(angle))
             node_xy, node_t, fnodes, foff, done = skeleton_faces(pts, pring, start_time)
             if not done:
                 ok[g] = False
                 mesh_offsets[g + 1] = n_f
                 continue
-            if kind == GABLE:
-                _gable_apexes(node_xy, node_t, fnodes, foff, pts, succ, start_time, eps)
+            ends = _gable_ends(node_xy, fnodes, foff, pts, succ, eps) if kind == GABLE or kind == GAMBREL \
+                else np.zeros(n, np.bool_)
+            lower = slope
+            knee = np.inf
+            if kind == MANSARD or kind == GAMBREL:
+                knee = BREAK_SHARE * node_t.max()
+                lower = np.tan(np.radians(90.0 - (90.0 - value[g]) / 3.0))
+                node_xy, node_t, fnodes, foff, origin = _split_at(node_xy, node_t, fnodes, foff, knee, eps)
+            else:
+                origin = np.arange(n)
+            _move_gable_ends(node_xy, node_t, fnodes, foff, origin, ends, pts, succ, start_time)
             if by_height:
                 top = node_t.max()
                 slope = value[g] / top if top > eps else 0.0
+                lower = slope
             point = np.empty((len(node_xy), 3))
             point[:, 0] = node_xy[:, 0]
             point[:, 1] = node_xy[:, 1]
-            point[:, 2] = node_t * slope
+            point[:, 2] = np.where(node_t <= knee, node_t * lower, knee * lower + (node_t - knee) * slope)
             face_ids = fnodes
             face_off = foff
             lifted = np.empty(0)

@@ -103,9 +103,16 @@ def test_roof_of_a_solid_and_overhang_y_are_reported(write):
     assert "overhangY other than overhangX" in r["bad"][0].reason
 
 
-def test_paper_roof_types_outside_the_supported_set_are_errors(write):
-    with pytest.raises(GrammarError, match="not supported yet"):
-        run(write, 'lot ~> Roof("gambrel", 30){ roof }\n', [rect(12, 8)], version=False)
+def test_paper_roof_types_outside_the_known_set_are_errors(write):
+    with pytest.raises(GrammarError, match='unknown roof type "gambril"'):
+        run(write, 'lot ~> Roof("gambril", 30){ roof }\n', [rect(12, 8)], version=False)
+
+
+@pytest.mark.parametrize("kind", ["mansard", "gambrel", "cross-gable", "cone", "shed", "pyramid"])
+def test_every_paper_roof_type_derives_on_concave_footprints(write, kind):
+    text = f'lot ~> S(1r, 6, 1r) T(0, 6, 0) Roof("{kind}", 30){{ roof }}\nroof ~> Comp("sidefaces"){{ I("cube") }}\n'
+    r = run(write, text, [LOT_ZOO["concave_L"], LOT_ZOO["courtyard"]], version=False)
+    assert r["bad"] == () and set(r["lot"].tolist()) == {0, 1}
 
 
 def test_paper_comp_of_a_roof_gives_planes_hips_and_the_ridge(write):

@@ -85,7 +85,6 @@ def test_lowering_errors(text, expected):
     ('a ~> Snap("Y", "entrancesnap") b', 6, "`Snap` is not supported yet"),
     ('a ~> b SnapLines("y")', 8, "`SnapLines` is not supported yet"),
     ("a ~> b Snap", 8, "`Snap` is not supported yet"),
-    ('a ~> Roof("mansard", 30){ r }', 11, '`Roof("mansard")` is not supported yet'),
     ('a ~> Repeat("XS", 2){ b }', 13, '`Repeat("XS")` is not supported yet'),
     ('a ~> Subdiv("YS", 1r){ b }', 13, '`Subdiv("YS")` is not supported yet'),
 ])

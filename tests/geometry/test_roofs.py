@@ -6,11 +6,12 @@ from collections import Counter
 
 import numpy as np
 import pytest
+import shapely
 from hypothesis import given, settings
 from hypothesis import strategies as st
 from test_skeleton import COURTYARD, L_SHAPE, OCTAGON, RECT, random_polygon
 
-from grammarc.geometry.roofs import GABLE, HIP, PYRAMID, SHED, roof_meshes
+from grammarc.geometry.roofs import GABLE, GAMBREL, HIP, MANSARD, PYRAMID, SHED, roof_meshes
 
 TAN30 = np.tan(np.radians(30))
 
@@ -111,9 +112,29 @@ def test_courtyard_hip_roof_is_a_ring_of_constant_section():
     assert unmatched_edges(faces) == 0
 
 
+def test_gambrel_and_mansard_break_at_a_third_of_the_inset_with_two_slopes():
+    """A 10 x 4 gambrel: 70 degrees up to 2/3 m in, 30 degrees to the ridge 2 m in; a prism of that
+    section. The mansard has the same planes on its long sides and hips at its ends."""
+    steep, knee = np.tan(np.radians(70)), 2 / 3
+    ridge = knee * steep + (2 - knee) * TAN30
+    section = 2 * (knee * knee * steep / 2 + (2 - knee) * knee * steep + (2 - knee) ** 2 * TAN30 / 2)
+    gambrel, mansard = roof(GAMBREL, RECT), roof(MANSARD, RECT)
+    assert volume(gambrel) == pytest.approx(10 * section)
+    assert max(p[2] for f in gambrel for r in f for p in r) == pytest.approx(ridge)
+    assert volume(mansard) < volume(gambrel) and unmatched_edges(gambrel) == unmatched_edges(mansard) == 0
+    assert len(gambrel) == 1 + 2 * 4  # every plane in two: below and above the break
+
+
 @settings(max_examples=100, deadline=None)
-@given(st.integers(0, 2**32 - 1), st.booleans(), st.sampled_from([HIP, GABLE]))
+@given(st.integers(0, 2**32 - 1), st.booleans(), st.sampled_from([HIP, GABLE, MANSARD, GAMBREL]))
 def test_roofs_of_random_concave_polygons_are_closed_and_face_out(seed, hole, kind):
-    faces = roof(kind, random_polygon(seed, hole))
-    assert unmatched_edges(faces) == 0
+    rings = random_polygon(seed, hole)
+    faces = roof(kind, rings)
     assert volume(faces) > 0
+    # the planes cover the footprint once, seen from above
+    covered = sum(np.cross(r[:, :2], np.roll(r[:, :2], -1, axis=0)).sum() / 2 for f in faces[1:] for r in f)
+    assert covered == pytest.approx(shapely.Polygon(rings[0], rings[1:]).area, rel=1e-9)
+    if kind in (HIP, GABLE):
+        assert unmatched_edges(faces) == 0
+    # two-slope roofs cut non-monotone planes at the break into parts that may meet along the break in
+    # zero-width bridges, whose edges have no twin
