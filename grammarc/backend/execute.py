@@ -14,33 +14,30 @@ from collections import defaultdict
 from dataclasses import replace
 
 import numpy as np
-import shapely
 
 from grammarc.backend import mesh_shapes, terminals
 from grammarc.backend.chunk import Chunk
 from grammarc.backend.evaluate import Env, elementwise, evaluate, evaluate_array
+from grammarc.backend.face_operations import FaceOperations
 from grammarc.backend.kernels import scope as scope_kernels
 from grammarc.backend.kernels import split as split_kernels
 from grammarc.backend.kernels.order import group_by
 from grammarc.backend.plan import COLOR_SLOT, Plan, SymbolPlan, consumes
 from grammarc.backend.random import child_keys, uniform
+from grammarc.backend.selectors import classify_edges, classify_faces
 from grammarc.backend.shapes import Shapes, asset_geom, asset_of
 from grammarc.constants import TOL, Limits
 from grammarc.errors import ChunkTooLarge, LimitError, LotFailure
 from grammarc.geometry import components as comp_kernels
-from grammarc.geometry.clip import clip_to_slabs, fit_pieces, scope_polygons
-from grammarc.geometry.convexify import convex_parts
-from grammarc.geometry.inner_rectangle import largest_rectangles
+from grammarc.geometry.clip import clip_to_slabs
 from grammarc.geometry.meshes import is_mesh, is_polygon
-from grammarc.geometry.polygons import PLANE_U, PLANE_V
 from grammarc.geometry.reframe import reframe
-from grammarc.geometry.setback import polygon_edges, setback_regions
 from grammarc.ir import nodes as ir
 from grammarc.ir.printer import print_op
 from grammarc.ragged import ragged_take, rank_within
 
 
-class Executor:
+class Executor(FaceOperations):
     """Derives one chunk: a worklist of pending batches per symbol, and the operations."""
 
     def __init__(self, plan: Plan, chunk: Chunk, limits: Limits, chunk_budget: int):
@@ -507,35 +504,6 @@ class Executor:
         origin = cursor.origin + np.minimum(height, 0.0)[:, None] * normal
         return cursor.with_scope(origin, size, cursor.frame, cursor.geom)
 
-    def roof(self, op: ir.Roof, cursor: Shapes, symbol: int) -> Shapes:
-        """A roof over each face (``backend.roofs``). CityEngine roofs faces; the paper's ``Roof`` roofs
-        the footprint of a solid (its polygon, or the scope's x-z rectangle)."""
-        env = self.env(cursor)
-        n = len(cursor)
-        value, overhang, index = (np.ascontiguousarray(np.broadcast_to(
-            np.asarray(evaluate_array(e, env), dtype=np.float64), (n,))) for e in (op.value, op.overhang, op.index))
-        checks = [
-            (cursor.geom < -1, "of an inserted asset"),
-            (~np.isfinite(value) | ~np.isfinite(overhang) | ~np.isfinite(index), "with a value that is not finite"),
-            (~op.by_height & (np.abs(value) >= 90), "with an angle of 90 degrees or more"),
-        ]
-        if self.plan.leaf_bodies:
-            checks.append((self.flat_axis(cursor) < 0, "of a solid (CityEngine roofs faces)"))
-        if op.overhang_y is not None:
-            overhang_y = evaluate_array(op.overhang_y, env)
-            checks.append((np.abs(overhang_y - overhang) > TOL.zero,
-                           "with overhangY other than overhangX (gable ends overhang as eaves do)"))
-        for bad, what in checks:
-            if np.any(bad):
-                self.fail(cursor, np.broadcast_to(bad, (n,)), f"`{op.kind}` {what}", symbol, op.span)
-        roofed, failed = mesh_shapes.build_roofs(self.chunk, cursor, op.kind, self.polygons_of(cursor), value,
-                                           op.by_height, overhang, index)
-        if failed.any():
-            self.fail(cursor, failed, f"`{op.kind}` found no roof for this polygon (its straight skeleton "
-                      "did not close, or the overhang's outline crosses itself at a sharp corner)", symbol,
-                      op.span)
-        return roofed
-
     def center(self, op: ir.Center, cursor: Shapes, base) -> Shapes:
         """Centre the scope on ``base`` (the body's first scope or the last push) along ``op.axes``."""
         base_origin, base_size, base_frame = base
@@ -735,146 +703,6 @@ class Executor:
         self.count(children, symbol, op.span)
         self.run_parts(op.parts, children, offsets, symbol)
 
-    def face_polygons(self, cursor: Shapes, what: str, symbol: int, span) -> tuple[np.ndarray, np.ndarray]:
-        """Shapely polygons (m,) of flat shapes in their scope units, and each one's plane (m,)."""
-        bad = (cursor.size <= TOL.zero).sum(axis=1) != 1
-        if bad.any():
-            self.fail(cursor, bad, f"`{what}` of a solid is not supported yet (only of faces)", symbol, span)
-        store = self.chunk.polygons
-        geom = cursor.geom.copy()
-        rects = np.flatnonzero(geom < 0)
-        if len(rects):
-            plane = comp_kernels.rect_plane(cursor.size[rects], TOL.zero)
-            geom[rects] = store.add(np.concatenate([comp_kernels.RECT_RINGS[q] for q in plane]),
-                                    np.arange(0, 4 * len(rects) + 1, 4, dtype=np.int64),
-                                    np.arange(len(rects) + 1, dtype=np.int64), plane)
-        return scope_polygons(store, geom, cursor.size), store.plane[geom]
-
-    def offset_pieces(self, distance: ir.Expr, cursor: Shapes, symbol: int, span):
-        """The inside and border pieces of each flat shape's polygon offset by ``distance``."""
-        polygons, plane = self.face_polygons(cursor, "offset", symbol, span)
-        d = evaluate_array(distance, self.env(cursor))
-        inset = shapely.buffer(polygons, d, join_style="mitre", mitre_limit=1e6)
-        border = shapely.difference(polygons, inset)
-        return fit_pieces(inset, plane, cursor.size), fit_pieces(border, plane, cursor.size)
-
-    def piece_shapes(self, cursor: Shapes, pieces, site: int) -> Shapes:
-        """Shapes of clipped or offset pieces: the parent's frame, the piece's box and polygon."""
-        child = cursor.take(pieces.source)
-        geom = np.full(len(pieces.source), -1, dtype=np.int32)
-        shaped = np.flatnonzero(~pieces.is_rect)
-        if len(shaped):
-            rings, poly_offsets = ragged_take(pieces.poly_offsets, shaped)
-            vertices, ring_offsets = ragged_take(pieces.ring_offsets, rings)
-            geom[shaped] = self.chunk.polygons.add(pieces.coords[vertices], ring_offsets, poly_offsets,
-                                                   pieces.plane[shaped])
-        origin = child.origin + np.einsum("ni,nij->nj", pieces.low, self.chunk.frames[child.frame])
-        index = rank_within(pieces.source)
-        return Shapes(origin, pieces.extent, child.frame, geom, child.lot,
-                      child_keys(child.key, site, index), child.depth, child.params, child.dynamic)
-
-    def offset(self, op: ir.Offset, cursor: Shapes, symbol: int) -> Shapes:
-        """``offset(d, inside|border)``: the shape's face becomes its inset or the ring around it."""
-        inside, border = self.offset_pieces(op.distance, cursor, symbol, op.span)
-        pieces = inside if op.select == "inside" else border
-        several = np.bincount(pieces.source, minlength=len(cursor)) > 1
-        if not several.any():
-            return self.piece_shapes(cursor, pieces, 0)
-        # a face the offset parts into pieces stays one shape: a mesh of the pieces in one fitted scope
-        rows = np.flatnonzero(several)
-        mine = several[pieces.source]
-        single = self.piece_shapes(cursor, pieces.take(~mine), 0)
-        grouped = pieces.take(mine)
-        grouped = replace(grouped, source=np.searchsorted(rows, grouped.source))
-        meshes = mesh_shapes.piece_meshes(self.chunk, cursor.take(rows), grouped)
-        meshes = replace(meshes, key=child_keys(meshes.key, 0, np.zeros(len(rows), dtype=np.int64)))
-        row = np.concatenate([pieces.source[~mine], rows])
-        return Shapes.concat([single, meshes]).take(np.argsort(row, kind="stable"))
-
-    def setback(self, op: ir.Setback, cursor: Shapes, symbol: int) -> None:
-        """``setback`` and ``shapeL/U/O``: the face's edge strips and its remainder to their parts."""
-        polygons, plane = self.face_polygons(cursor, "setback", symbol, op.span)
-        edges = polygon_edges(polygons)
-        m = len(cursor)
-        normal = np.zeros((len(edges.poly), 3))
-        rows = np.arange(len(edges.poly))
-        normal[rows, PLANE_U[plane[edges.poly]]] = -edges.inward[:, 0]
-        normal[rows, PLANE_V[plane[edges.poly]]] = -edges.inward[:, 1]
-        frames = self.selector_frames(normal, cursor, edges.poly, (*op.selectors, *(s for s, _ in op.distances)))
-        env = self.env(cursor)
-        table = np.zeros((len(op.distances) + 1, m))
-        for k, (_, expr) in enumerate(op.distances):
-            table[k] = evaluate_array(expr, env)
-        distance = table[classify_faces(normal, tuple(s for s, _ in op.distances), frames), edges.poly]
-        owners = tuple(s for s in op.selectors if s != "remainder")
-        regions, remainder = setback_regions(polygons, edges, distance,
-                                             classify_faces(normal, owners, frames), len(owners))
-        by_owner = dict(zip(owners, regions))
-        self.run_regions(op, cursor, [by_owner[s] if s != "remainder" else remainder for s in op.selectors],
-                         plane, symbol)
-
-    def convexify(self, op: ir.Convexify, cursor: Shapes, symbol: int) -> Shapes:
-        """``convexify``: the face becomes its convex parts (``geometry.convexify``), one shape whose
-        faces they are (a mesh; a convex face stays as it is)."""
-        polygons, plane = self.face_polygons(cursor, "convexify", symbol, op.span)
-        limit = None
-        if op.max_length is not None:
-            limit = np.broadcast_to(np.asarray(evaluate_array(op.max_length, self.env(cursor)), float),
-                                    (len(cursor),))
-        parts, source = convex_parts(polygons, limit)
-        return mesh_shapes.flat_meshes(self.chunk, cursor, parts, source, plane)
-
-    def inner_rectangle(self, op: ir.InnerRectangle, cursor: Shapes, symbol: int) -> None:
-        """``innerRectangle``: the face's largest inner rectangle (``geometry.inner_rectangle``) and the
-        rest of the face, in the face's own scope frame (CityEngine keeps the scope's orientation)."""
-        polygons, plane = self.face_polygons(cursor, "innerRectangle", symbol, op.span)
-        rectangle = largest_rectangles(polygons, op.align)
-        remainder = shapely.difference(polygons, rectangle)
-        self.run_regions(op, cursor, [rectangle if s == "shape" else remainder for s in op.selectors], plane,
-                         symbol)
-
-    def run_regions(self, op: ir.Setback | ir.InnerRectangle, cursor: Shapes, regions: list, plane, symbol):
-        """Part k of ``op`` on the pieces of ``regions[k]`` (m,) (polygons in the shapes' scope units),
-        each parent's pieces together, numbered in stream ``op.site`` part by part."""
-        pieces = [fit_pieces(region, plane, cursor.size) for region in regions]
-        shapes, kind = self.pieces_by_parent(cursor, pieces, [(op.site << 20) + k for k in range(len(pieces))])
-        self.count(shapes, symbol, op.span)
-        order, offsets = group_by(kind, len(op.parts))
-        self.run_parts(op.parts, shapes.take(order), offsets, symbol)
-
-    def pieces_by_parent(self, cursor: Shapes, pieces, sites) -> tuple[Shapes, np.ndarray]:
-        """Shapes of several kinds of pieces (kind k: ``pieces[k]``, numbered in stream ``sites[k]``),
-        each parent's pieces together in kind order, and each shape's kind."""
-        shapes = Shapes.concat([self.piece_shapes(cursor, p, site) for p, site in zip(pieces, sites)])
-        kind = np.concatenate([np.full(len(p.source), k, dtype=np.int64) for k, p in enumerate(pieces)])
-        order = np.argsort(np.concatenate([p.source for p in pieces]), kind="stable")
-        return shapes.take(order), kind[order]
-
-    def selector_frames(self, normal: np.ndarray, cursor: Shapes, parent: np.ndarray,
-                        selectors) -> dict | None:
-        """Normals (m, 3) in the world's and the lot's frames when a selector names them (``world.``)."""
-        if not any("." in s for s in selectors):
-            return None
-        world = np.einsum("mi,mij->mj", normal, self.chunk.frames[cursor.frame][parent])
-        lot = np.einsum("mj,mij->mi", world, self.chunk.lot_axes[cursor.lot[parent]])
-        return {"world": world, "object": lot}
-
-    def offset_faces(self, op: ir.CompFaces, cursor: Shapes, symbol: int) -> None:
-        """``offset(d) comp(f){ inside: ... | border: ... }``: the offset's faces as components."""
-        pieces = self.offset_pieces(op.offset, cursor, symbol, op.span)
-        border_site = (op.site << 20) + 1  # another stream than the inside faces'
-        shapes, kind = self.pieces_by_parent(cursor, pieces, [op.site, border_site])
-        names = ("inside", "border")
-        which = np.full(len(kind), len(op.selectors), dtype=np.int64)
-        for i in range(len(op.selectors) - 1, -1, -1):
-            selector = op.selectors[i]
-            which[(selector == "all") | (np.array(names)[kind] == selector)] = i
-        keep = which < len(op.selectors)
-        shapes, which = shapes.take(keep), which[keep]
-        self.count(shapes, symbol, op.span)
-        order, offsets = group_by(which, len(op.parts))
-        self.run_parts(op.parts, shapes.take(order), offsets, symbol)
-
     def comp_faces(self, op: ir.CompFaces, cursor: Shapes, symbol: int) -> None:
         """CityEngine ``comp(f|e|v)``: components to the first selector they match."""
         if op.offset is not None or op.kind == "v":
@@ -976,57 +804,6 @@ def _size_matrix(values: list, n: int) -> np.ndarray:
 
 #: GroupSplit size kinds for the kernel.
 _SIZE_KIND = {ir.SizeKind.ABSOLUTE: 0, ir.SizeKind.RELATIVE: 1, ir.SizeKind.FLOATING: 2}
-#: A face is "top" or "bottom" when its normal is within 45 degrees of the scope's y axis; "horizontal"
-#: and "vertical" within this tolerance of exactly so.
-_FLAT_TOLERANCE = 1e-6
-
-
-def classify_faces(normal: np.ndarray, selectors: tuple[str, ...], frames: dict | None = None) -> np.ndarray:
-    """Index of the first selector each face matches (len(selectors) for none), from normals (m, 3) in
-    the parent's scope frame: front +z, back -z, right +x, left -x, top +y, bottom -y. ``frames`` gives
-    the normals in the lot's frame (``object.`` selectors) and the world's (``world.``)."""
-    which = np.full(len(normal), len(selectors), dtype=np.int64)
-    for i in range(len(selectors) - 1, -1, -1):
-        prefix, _, name = selectors[i].rpartition(".")
-        which[_face_masks((frames or {}).get(prefix, normal))[name]] = i
-    return which
-
-
-def _face_masks(normal: np.ndarray) -> dict[str, np.ndarray]:
-    x, y, z = normal[:, 0], normal[:, 1], normal[:, 2]
-    top, bottom = y > np.sqrt(0.5), y < -np.sqrt(0.5)
-    side = ~top & ~bottom
-    front = side & (z >= np.abs(x))
-    back = side & (-z >= np.abs(x)) & ~front
-    right = side & (x > np.abs(z))
-    left = side & (-x > np.abs(z))
-    vertical = np.abs(y) <= _FLAT_TOLERANCE
-    horizontal = np.abs(y) >= 1 - _FLAT_TOLERANCE
-    masks = {
-        "front": front, "back": back, "left": left, "right": right, "top": top, "bottom": bottom,
-        "side": side, "vertical": vertical, "horizontal": horizontal,
-        "aslant": ~vertical & ~horizontal & (y > 0), "nutant": ~vertical & ~horizontal & (y < 0),
-        "all": np.ones(len(normal), dtype=bool),
-        # the faces an offset makes: a shape not offset has none
-        "inside": np.zeros(len(normal), dtype=bool), "border": np.zeros(len(normal), dtype=bool),
-    }
-    return masks
-
-
-def classify_edges(direction: np.ndarray | None, selectors: tuple[str, ...], n: int) -> np.ndarray:
-    """Index of the first selector each edge (or vertex, ``direction`` None) matches: an edge is
-    vertical along the world's y axis, horizontal across it, aslant otherwise."""
-    masks = {"all": np.ones(n, dtype=bool)}
-    if direction is not None:
-        y = np.abs(direction[:, 1])
-        masks.update(vertical=y >= 1 - _FLAT_TOLERANCE, horizontal=y <= _FLAT_TOLERANCE,
-                     aslant=(y > _FLAT_TOLERANCE) & (y < 1 - _FLAT_TOLERANCE))
-    which = np.full(n, len(selectors), dtype=np.int64)
-    for i in range(len(selectors) - 1, -1, -1):
-        which[masks[selectors[i]]] = i
-    return which
-
-
 def report_rows(lot: np.ndarray, key, value, n: int) -> tuple:
     """One ``report`` call's rows: lot (n,), key ids (n,), values (n,) float64 and the value kind
     ("num", "bool" or "str"; strings as their ids)."""
