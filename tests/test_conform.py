@@ -228,5 +228,15 @@ def test_grammarc_matches_prt(reference, rpk, footprint, attrs):
 def test_unsupported_operations_are_named(reference):
     from grammarc.conform import run_conformance
 
-    result = run_conformance(KIT / "rpk" / "massing.rpk", "rect_30x20", reference=reference)
-    assert not result.passed and "unsupported: " in result.error and "massing.cga:" in result.error
+    result = run_conformance(KIT / "rpk" / "candler.rpk", "rect_30x20", reference=reference)
+    assert not result.passed and "unsupported: envelope" in result.error and "Candler Building.cga:" in result.error
+
+
+@needs_kit
+@pytest.mark.parametrize("footprint", ["rect_30x20", "rect_12x8", "L_30x20", "triangle"])
+def test_massing_setbacks_per_edge_match_prt(reference, footprint):
+    """massing's default: offset, split, then tiers set back per edge by ``listItem(..., comp.index)``."""
+    from grammarc.conform import run_conformance
+
+    result = run_conformance(KIT / "rpk" / "massing.rpk", footprint, reference=reference)
+    assert result.passed, result.verdict

@@ -116,6 +116,25 @@ def concatenate(left, right, strings) -> np.ndarray | int:
     return ids[inverse.reshape(-1)]
 
 
+def list_item(items, index, strings) -> np.ndarray | int:
+    """CityEngine's ``listItem(list, index)``: item ``index`` of a ``;``-separated string list ("" out of
+    range), once per distinct pair of list and index."""
+    names = list(strings.ids)
+    a, b = np.broadcast_arrays(np.asarray(items), np.asarray(index, dtype=np.float64))
+
+    def item(text: str, i: float) -> int:
+        parts = text.split(";")
+        k = int(np.floor(i)) if np.isfinite(i) else -1
+        return strings.intern(parts[k] if 0 <= k < len(parts) else "")
+
+    if a.ndim == 0:
+        return item(names[int(a[()])], float(b[()]))
+    pairs = np.stack([a.astype(np.float64), b], axis=1)
+    distinct, inverse = np.unique(pairs, axis=0, return_inverse=True)
+    ids = np.array([item(names[int(x)], y) for x, y in distinct], dtype=np.int32)
+    return ids[inverse.reshape(-1)]
+
+
 def evaluate_array(expr: ir.Expr, env: Env, dtype=np.float64) -> np.ndarray:
     """``evaluate`` broadcast to one value per shape."""
     value = np.asarray(evaluate(expr, env), dtype=dtype)
@@ -189,6 +208,8 @@ def _call(expr: ir.Call, env: Env):
         return concatenate(env.plan.strings.intern(""), args[0], env.plan.strings)
     if f == "float":
         return _to_float(args[0], env)
+    if f == "listItem":
+        return list_item(args[0], args[1], env.plan.strings)
     if f == "bool":
         return np.asarray(args[0]) != 0
     if f in ("floor", "ceil", "abs"):

@@ -31,7 +31,7 @@ from grammarc.errors import ChunkTooLarge, LimitError, LotFailure
 from grammarc.geometry import components as comp_kernels
 from grammarc.geometry.clip import clip_to_slabs
 from grammarc.geometry.meshes import is_mesh, is_polygon
-from grammarc.geometry.reframe import reframe
+from grammarc.geometry.reframe import NORMAL_UP, reframe
 from grammarc.ir import nodes as ir
 from grammarc.ir.printer import print_op
 from grammarc.ragged import ragged_take, rank_within
@@ -490,18 +490,27 @@ class Executor(FaceOperations):
         return axis
 
     def extrude(self, op: ir.Extrude, cursor: Shapes, symbol: int) -> Shapes:
-        """A face becomes a solid along its normal; a negative height extrudes behind the face."""
+        """A face becomes a solid along its normal; a negative height extrudes behind the face. As in
+        CityEngine, the solid's scope keeps x and has y along the extrusion: a face whose normal is
+        another scope axis (a comp(f) face's z) is first re-expressed in such a scope."""
         height = evaluate_array(op.height, self.env(cursor))
         axis = self.flat_axis(cursor)
         bad = (axis < 0) | ~np.isfinite(height)
         if bad.any():
             self.fail(cursor, bad, "`extrude` needs a face (a flat shape) and a finite height", symbol,
                       op.span)
-        rows = np.arange(len(cursor))
+        turn = axis != 1
+        if turn.any():
+            rows = np.flatnonzero(turn)
+            sub = cursor.take(rows)
+            new_axes = np.einsum("nij,njk->nik", NORMAL_UP[axis[rows]], self.chunk.frames[sub.frame])
+            turned = self.reframed(sub, new_axes, symbol, op.span)
+            cursor = Shapes.concat([cursor.take(~turn), turned]).take(
+                np.argsort(np.concatenate([np.flatnonzero(~turn), rows]), kind="stable"))
         size = cursor.size.copy()
-        size[rows, axis] = np.abs(height)
-        normal = self.chunk.frames[cursor.frame][rows, axis]
-        origin = cursor.origin + np.minimum(height, 0.0)[:, None] * normal
+        size[:, 1] = np.abs(height)
+        up = self.chunk.frames[cursor.frame][:, 1]
+        origin = cursor.origin + np.minimum(height, 0.0)[:, None] * up
         return cursor.with_scope(origin, size, cursor.frame, cursor.geom)
 
     def center(self, op: ir.Center, cursor: Shapes, base) -> Shapes:
@@ -538,16 +547,21 @@ class Executor(FaceOperations):
             new_axes = np.einsum("nij,njk->nik", _rotation(*angles), axes)
         else:
             new_axes = self.geometry_axes(op, cursor, axes, symbol)
+        return self.reframed(cursor, new_axes, symbol, op.span)
+
+    def reframed(self, cursor: Shapes, new_axes: np.ndarray, symbol: int, span) -> Shapes:
+        """The same geometry in scopes with ``new_axes`` (n, 3, 3), fitted to it (``geometry.reframe``)."""
+        n = len(cursor)
         bad = cursor.geom < -1
         if bad.any():
-            self.fail(cursor, bad, "aligning the scope of an inserted asset is not supported yet", symbol,
-                      op.span)
+            self.fail(cursor, bad, "aligning the scope of an inserted asset is not supported yet", symbol, span)
         coords, ring_offsets, shape_offsets, plane = self.polygons_of(cursor)
         ok, plane, origin, size, is_rect, new_coords = reframe(
-            cursor.origin, cursor.size, axes, coords, ring_offsets, shape_offsets, plane, new_axes)
+            cursor.origin, cursor.size, self.chunk.frames[cursor.frame], coords, ring_offsets, shape_offsets,
+            plane, new_axes)
         if not ok.all():
             self.fail(cursor, ~ok, "turning a scope out of its geometry's plane is not supported yet",
-                      symbol, op.span)
+                      symbol, span)
         geom = np.full(n, -1, dtype=np.int32)
         poly = np.flatnonzero(~is_rect)
         if len(poly):
@@ -555,7 +569,7 @@ class Executor(FaceOperations):
             vertices, packed_rings = ragged_take(ring_offsets, rings)
             geom[poly] = self.chunk.polygons.add(new_coords[vertices], packed_rings, packed_shapes,
                                                  plane[poly])
-        return cursor.with_scope(origin, size, frames.add(np.ascontiguousarray(new_axes)), geom)
+        return cursor.with_scope(origin, size, self.chunk.frames.add(np.ascontiguousarray(new_axes)), geom)
 
     def geometry_axes(self, op: ir.AlignScope, cursor: Shapes, axes: np.ndarray, symbol: int):
         """Axes of ``alignScopeToGeometry``: up along the face's normal, x along its edge ``k``."""

@@ -129,11 +129,18 @@ class FaceOperations:
         normal[rows, PLANE_U[plane[edges.poly]]] = -edges.inward[:, 0]
         normal[rows, PLANE_V[plane[edges.poly]]] = -edges.inward[:, 1]
         frames = self.selector_frames(normal, cursor, edges.poly, (*op.selectors, *(s for s, _ in op.distances)))
-        env = self.env(cursor)
-        table = np.zeros((len(op.distances) + 1, m))
+        # distances per face, or per edge (setback(comp(fe){...}): each edge is comp.index of comp.total)
+        if op.per_edge:
+            index = rank_within(edges.poly)
+            shapes = self.with_context(cursor.take(edges.poly), "comp", index, edges.poly, m)
+            column = np.arange(len(edges.poly))
+        else:
+            shapes, column = cursor, edges.poly
+        env = self.env(shapes)
+        table = np.zeros((len(op.distances) + 1, len(shapes)))
         for k, (_, expr) in enumerate(op.distances):
             table[k] = evaluate_array(expr, env)
-        distance = table[classify_faces(normal, tuple(s for s, _ in op.distances), frames), edges.poly]
+        distance = table[classify_faces(normal, tuple(s for s, _ in op.distances), frames), column]
         owners = tuple(s for s in op.selectors if s != "remainder")
         regions, remainder = setback_regions(polygons, edges, distance,
                                              classify_faces(normal, owners, frames), len(owners))

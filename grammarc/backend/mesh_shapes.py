@@ -17,16 +17,10 @@ from grammarc.backend.shapes import Shapes
 from grammarc.constants import STRICT, TOL
 from grammarc.geometry.meshes import MESH_BASE, face_frames, face_vertices, mesh_edges
 from grammarc.geometry.polygons import PLANE_U, PLANE_V
+from grammarc.geometry.reframe import NORMAL_UP
 from grammarc.geometry.roofs import ROOF_KINDS, roof_meshes
 from grammarc.io.npz import MeshChunk
 from grammarc.ragged import ragged_take, rank_within, segment_of, segment_reduce
-
-#: Per normal axis n: the roof frame's axes as rows in the face scope's frame (y' along axis n).
-_ROOF_FRAME = np.array([
-    [[0, 0, 1], [1, 0, 0], [0, 1, 0]],   # n = x: (z, x, y), a cyclic turn
-    [[1, 0, 0], [0, 1, 0], [0, 0, 1]],   # n = y: unchanged
-    [[1, 0, 0], [0, 0, 1], [0, -1, 0]],  # n = z: (x, z, -y), a turn about x
-], dtype=np.float64)
 
 
 def build_roofs(chunk: Chunk, shapes: Shapes, kind: str, polygons, value, by_height: bool, overhang,
@@ -48,12 +42,12 @@ def build_roofs(chunk: Chunk, shapes: Shapes, kind: str, polygons, value, by_hei
     local[at, PLANE_U[vplane]] = verts[:, 0]
     local[at, PLANE_V[vplane]] = verts[:, 1]
     local[at, vplane] = verts[:, 2]
-    turn = _ROOF_FRAME[plane.astype(np.int64)]
+    turn = NORMAL_UP[plane.astype(np.int64)]
     roofed = local
     for p in np.unique(plane):  # three frames at most: one matrix product each
         if p != 1:
             sel = vplane == p
-            roofed[sel] = local[sel] @ _ROOF_FRAME[p].T
+            roofed[sel] = local[sel] @ NORMAL_UP[p].T
     vertex_offsets = rings[faces[meshes]]
     low = np.stack([segment_reduce(np.minimum, roofed[:, j], vertex_offsets, 0.0) for j in range(3)], 1)
     high = np.stack([segment_reduce(np.maximum, roofed[:, j], vertex_offsets, 0.0) for j in range(3)], 1)

@@ -78,6 +78,14 @@ class PendingOffset:
 
 
 @dataclass(frozen=True, slots=True)
+class EdgeDistances:
+    """``comp(fe){ sel: d | ... }`` as ``setback``'s argument: a distance per edge selector."""
+
+    values: tuple[tuple[str, ir.Expr], ...]
+    span: Span
+
+
+@dataclass(frozen=True, slots=True)
 class Import:
     """``import prefix : "file.cga"`` (or without a prefix): the file's rules and attributes, named
     ``prefix.Name``; an attribute the importing file declares too takes the importing file's value."""
@@ -135,6 +143,9 @@ class Lowering(LoweringBase):
             if value.kind is not ir.SizeKind.ABSOLUTE:
                 self.unsupported("relative or floating value here", value.span)
             return value.value
+        if isinstance(value, EdgeDistances):
+            self.unsupported("comp(fe){...} outside setback", value.span)
+            return ir.placeholder(value.span)
         return value
 
     # ------------------------------------------------------------------------------------- declarations
@@ -270,7 +281,28 @@ class Lowering(LoweringBase):
         return Sized(ir.SizeKind.FLOATING, value, self.token_span(tilde))
 
     def selector_function(self, meta, name, args, parts):
-        return self.unsupported(f"{name}(...){{...}} as an argument", self.token_span(name))
+        """``comp(fe){ sel: d | ... }`` as setback's argument: per-edge distances (``EdgeDistances``);
+        any other operation with parts is no argument."""
+        span = self.token_span(name)
+        if str(name) != "comp" or len(args or ()) != 1 or not isinstance(args[0], ir.Name) or \
+                args[0].name != "fe":
+            return self.unsupported(f"{name}(...){{...}} as an argument", span, "only setback(comp(fe){ ... })")
+        chosen = self.selector_parts("comp(fe)", parts, _SETBACK_SELECTORS - {"remainder"})
+        if chosen is None:
+            return ir.placeholder(span)
+        values = []
+        for selector, body in zip(*chosen):
+            # a part's body is one expression, parsed as an operation: a call, or a name
+            if len(body) == 1 and isinstance(body[0], ir.Symbol):
+                op = body[0]
+                func = FUNCTION_NAMES.get(op.name, op.name)
+                value = ir.Call(func, op.args, op.span, self.site()) if op.args or func in ir.FUNCTIONS \
+                    else ir.Name(op.name, op.span)
+            else:
+                self.unsupported("this comp(fe) part", span, "each part gives one distance: `all : 3`")
+                return ir.placeholder(span)
+            values.append((selector, value))
+        return EdgeDistances(tuple(values), span)
 
     def size_prefix(self, meta, prefix):
         if prefix is None:
@@ -533,8 +565,14 @@ class Lowering(LoweringBase):
         return ir.CompFaces(tuple(selectors), tuple(bodies), span, self.site(), kind)
 
     def op_setback(self, op, args, parts, span):
-        """``setback(d) { sel: A | remainder: B }``; ``shapeL/U/O(widths...) { shape: A | remainder: B }``."""
+        """``setback(d) { sel: A | remainder: B }``; ``shapeL/U/O(widths...) { shape: A | remainder: B }``;
+        ``setback(comp(fe){ sel: d | ... }) { ... }`` with distances per edge."""
         sides = _SETBACK_OPS[op]
+        if op == "setback" and len(args) == 1 and isinstance(args[0], EdgeDistances):
+            chosen = self.selector_parts(op, parts, _SETBACK_SELECTORS)
+            if chosen is None:
+                return ir.Empty(span)
+            return ir.Setback(args[0].values, chosen[0], chosen[1], span, self.site(), per_edge=True)
         if not self.arity(op, args, (len(sides) if sides else 1,), span):
             return None
         known = _SETBACK_SELECTORS if not sides else frozenset({"shape", "remainder"})

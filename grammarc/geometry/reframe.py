@@ -16,6 +16,14 @@ from grammarc.constants import TOL
 from grammarc.geometry.polygons import PLANE_AXES
 from grammarc.ragged import segment_of, segment_reduce
 
+#: Per normal axis n: new scope axes, as rows in the old frame, that put y along axis n and keep x where
+#: they can (CityEngine's extrude and roofs: "x kept, y along the normal, z = x cross y").
+NORMAL_UP = np.array([
+    [[0, 0, 1], [1, 0, 0], [0, 1, 0]],   # n = x: (z, x, y), a cyclic turn
+    [[1, 0, 0], [0, 1, 0], [0, 0, 1]],   # n = y: unchanged
+    [[1, 0, 0], [0, 0, 1], [0, -1, 0]],  # n = z: (x, z, -y), a turn about x
+], dtype=np.float64)
+
 _A = np.array([PLANE_AXES[p][0] for p in range(3)])
 _B = np.array([PLANE_AXES[p][1] for p in range(3)])
 

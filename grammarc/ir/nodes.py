@@ -190,7 +190,8 @@ FUNCTIONS: dict[str, tuple[int, int, Type]] = {
     "fileRandom": (0, 0, Type.NUM),
 }
 #: Functions that take strings or any type (their argument types are checked by ``passes.types``).
-CONVERSIONS: dict[str, Type] = {"str": Type.STR, "float": Type.NUM, "bool": Type.BOOL, "len": Type.NUM}
+CONVERSIONS: dict[str, Type] = {"str": Type.STR, "float": Type.NUM, "bool": Type.BOOL, "len": Type.NUM,
+                                 "listItem": Type.STR}
 
 
 # ------------------------------------------------------------------------------------------------ operations
@@ -462,13 +463,16 @@ class Setback:
     the face's edges move in, each edge by the distance of the first selector of ``distances`` it
     matches (selectors as comp(f) names the faces an extrusion would give the edges). A part takes the
     strips of the edges whose first matching selector it is; ``remainder`` takes the rest of the face.
-    ``shapeL/U/O`` are setbacks of the front, right, back and left edges whose strips all go to ``all``."""
+    ``shapeL/U/O`` are setbacks of the front, right, back and left edges whose strips all go to ``all``.
+    ``per_edge``: ``setback(comp(fe){ sel: d | ... })``, the distances evaluated for each edge, which sees
+    ``comp.index`` (its number in the face's edge order) and ``comp.total``."""
 
     distances: tuple[tuple[str, Expr], ...]
     selectors: tuple[str, ...]
     parts: tuple[Body, ...]
     span: Span = NO_SPAN
     site: int = 0
+    per_edge: bool = False
 
 
 @dataclass(frozen=True, slots=True)

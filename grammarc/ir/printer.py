@@ -116,6 +116,8 @@ def print_op(op: ir.Op) -> str:
                                          for s, b in zip(op.selectors, op.parts)) + " }"
     if isinstance(op, ir.Setback):
         moves = ", ".join(f"{s}={print_expr(d)}" for s, d in op.distances)
+        if op.per_edge:
+            moves = f"comp(fe){{ {moves} }}"
         return f"setback({moves}){{ " + " | ".join(f"{s}: {print_body(b) or 'ε'}"
                                                   for s, b in zip(op.selectors, op.parts)) + " }"
     if isinstance(op, (ir.Case, ir.Stochastic)):
