@@ -233,10 +233,21 @@ def test_unsupported_operations_are_named(reference):
 
 
 @needs_kit
-@pytest.mark.parametrize("footprint", ["rect_30x20", "rect_12x8", "L_30x20", "triangle"])
+@pytest.mark.parametrize("footprint", ["rect_30x20", "rect_12x8", "L_30x20", "triangle", "rotated_25x15"])
 def test_massing_setbacks_per_edge_match_prt(reference, footprint):
     """massing's default: offset, split, then tiers set back per edge by ``listItem(..., comp.index)``."""
     from grammarc.conform import run_conformance
 
     result = run_conformance(KIT / "rpk" / "massing.rpk", footprint, reference=reference)
     assert result.passed, result.verdict
+
+
+@needs_kit
+@pytest.mark.parametrize("footprint", ["U_40x30", "courtyard_40x40"])
+def test_massing_on_concave_footprints_is_within_the_issue_tolerance(reference, footprint):
+    """Edge numbers after offset and split follow CityEngine's (``clip.ring_starts``): the tiers land where
+    PRT puts them (bbox within 2 cm, area within 1 %, issue 4), though not yet to the kit's 1e-4."""
+    from grammarc.conform import run_conformance
+
+    result = run_conformance(KIT / "rpk" / "massing.rpk", footprint, reference=reference)
+    assert result.verdict.bbox_deviation < 0.02 and result.verdict.area_rel_error < 0.01, result.verdict

@@ -84,7 +84,7 @@ class FaceOperations:
         d = evaluate_array(distance, self.env(cursor))
         inset = shapely.buffer(polygons, d, join_style="mitre", mitre_limit=1e6)
         border = shapely.difference(polygons, inset)
-        return fit_pieces(inset, plane, cursor.size), fit_pieces(border, plane, cursor.size)
+        return fit_pieces(inset, plane, cursor.size, polygons), fit_pieces(border, plane, cursor.size, polygons)
 
     def piece_shapes(self, cursor: Shapes, pieces, site: int) -> Shapes:
         """Shapes of clipped or offset pieces: the parent's frame, the piece's box and polygon."""
@@ -146,7 +146,7 @@ class FaceOperations:
                                              classify_faces(normal, owners, frames), len(owners))
         by_owner = dict(zip(owners, regions))
         self.run_regions(op, cursor, [by_owner[s] if s != "remainder" else remainder for s in op.selectors],
-                         plane, symbol)
+                         plane, symbol, polygons)
 
     def convexify(self, op: ir.Convexify, cursor: Shapes, symbol: int) -> Shapes:
         """``convexify``: the face becomes its convex parts (``geometry.convexify``), one shape whose
@@ -166,12 +166,13 @@ class FaceOperations:
         rectangle = largest_rectangles(polygons, op.align)
         remainder = shapely.difference(polygons, rectangle)
         self.run_regions(op, cursor, [rectangle if s == "shape" else remainder for s in op.selectors], plane,
-                         symbol)
+                         symbol, polygons)
 
-    def run_regions(self, op: ir.Setback | ir.InnerRectangle, cursor: Shapes, regions: list, plane, symbol):
-        """Part k of ``op`` on the pieces of ``regions[k]`` (m,) (polygons in the shapes' scope units),
-        each parent's pieces together, numbered in stream ``op.site`` part by part."""
-        pieces = [fit_pieces(region, plane, cursor.size) for region in regions]
+    def run_regions(self, op: ir.Setback | ir.InnerRectangle, cursor: Shapes, regions: list, plane, symbol,
+                    polygons):
+        """Part k of ``op`` on the pieces of ``regions[k]`` (m,) (polygons in the shapes' scope units, cut
+        from ``polygons``), each parent's pieces together, numbered in stream ``op.site`` part by part."""
+        pieces = [fit_pieces(region, plane, cursor.size, polygons) for region in regions]
         shapes, kind = self.pieces_by_parent(cursor, pieces, [(op.site << 20) + k for k in range(len(pieces))])
         self.count(shapes, symbol, op.span)
         order, offsets = group_by(kind, len(op.parts))

@@ -13,6 +13,7 @@ from dataclasses import dataclass
 
 import numpy as np
 import shapely
+from numba import njit
 
 from grammarc.constants import TOL
 from grammarc.geometry.polygons import PLANE_U as _A
@@ -78,11 +79,16 @@ def clip_to_slabs(store: PolygonStore, geom: np.ndarray, size: np.ndarray, axis:
     ymin = np.where(along_a, -big, pos)
     ymax = np.where(along_a, big, pos + length)
     pieces = shapely.intersection(polygons, shapely.box(xmin, ymin, xmax, ymax))
-    return fit_pieces(pieces, plane, size)
+    return fit_pieces(pieces, plane, size, polygons)
 
 
-def fit_pieces(geometries: np.ndarray, plane: np.ndarray, size: np.ndarray) -> Clipped:
-    """Polygons (or multipolygons) in scope units, one per source row, as pieces with fitted boxes."""
+def fit_pieces(geometries: np.ndarray, plane: np.ndarray, size: np.ndarray,
+               parents: np.ndarray | None = None) -> Clipped:
+    """Polygons (or multipolygons) in scope units, one per source row, as pieces with fitted boxes.
+
+    ``parents`` (one polygon per source row, the polygons the pieces were cut or moved in from): each
+    piece's rings then start where CityEngine's do (``ring_starts``), so that edge numbers
+    (``comp.index`` of ``comp(fe)``) follow the parent's."""
     parts, source = shapely.get_parts(geometries, return_index=True)
     keep = (shapely.get_type_id(parts) == shapely.GeometryType.POLYGON) & (
         shapely.area(parts) > TOL.area_floor)
@@ -101,6 +107,12 @@ def fit_pieces(geometries: np.ndarray, plane: np.ndarray, size: np.ndarray) -> C
                                                                         np.zeros(1, np.int64))))
     flat, ring_offsets = _open_rings(np.asarray(flat)[:, :2], np.asarray(closed_rings, dtype=np.int64))
     part_offsets = np.asarray(part_offsets, dtype=np.int64)
+    if parents is not None and len(parts):
+        _, parent_flat, (parent_closed, parent_offsets) = shapely.to_ragged_array(parents)
+        parent_flat, parent_rings = _open_rings(np.asarray(parent_flat)[:, :2],
+                                                np.asarray(parent_closed, dtype=np.int64))
+        flat = ring_starts(flat, ring_offsets, segment_of(part_offsets), source, parent_flat, parent_rings,
+                           np.asarray(parent_offsets, dtype=np.int64))
     vertex_part = segment_of(part_offsets)[segment_of(ring_offsets)]
     low2 = bounds[:, :2]
     extent2 = bounds[:, 2:] - bounds[:, :2]
@@ -119,6 +131,60 @@ def fit_pieces(geometries: np.ndarray, plane: np.ndarray, size: np.ndarray) -> C
         np.abs(area - 1.0) <= TOL.rect)
     return Clipped(source, low, extent, is_rect, normalized, ring_offsets, part_offsets,
                    part_plane.astype(np.int8))
+
+
+@njit(cache=True)
+def ring_starts(coords, ring_offsets, ring_part, part_source, parent_coords, parent_rings, parent_offsets):
+    """Each ring of each piece turned to start where CityEngine's clipping and offsets start it.
+
+    CityEngine keeps a polygon's vertex order through offsets (vertex i of the inset is the mitre of
+    vertex i) and clips it Sutherland-Hodgman fashion (the edges in order, from the one that arrives at
+    vertex 0; a crossing point before the vertex that ends its edge). So every piece vertex gets the
+    position along the parent's boundary of the nearest point on it: edge i (into vertex i, ring after
+    ring) plus the fraction along it, vertex 0 counting as the end of the last edge; each ring starts
+    at its smallest position. Returns the coords (V, 2) with every ring turned.
+    """
+    out = np.empty_like(coords)
+    for r in range(len(ring_offsets) - 1):
+        r0, r1 = ring_offsets[r], ring_offsets[r + 1]
+        g = part_source[ring_part[r]]
+        best_key = np.inf
+        best = r0
+        for j in range(r0, r1):
+            px, py = coords[j, 0], coords[j, 1]
+            near, key = np.inf, np.inf          # the nearest boundary point's position
+            near_vertex, vertex_key = np.inf, np.inf  # the nearest vertex's position
+            scale = 0.0
+            base = 0
+            for q in range(parent_offsets[g], parent_offsets[g + 1]):
+                q0, q1 = parent_rings[q], parent_rings[q + 1]
+                m = q1 - q0
+                for i in range(m):  # edge i runs from vertex i - 1 into vertex i: positions base + [i, i + 1]
+                    ax, ay = parent_coords[q0 + (i - 1) % m, 0], parent_coords[q0 + (i - 1) % m, 1]
+                    bx, by = parent_coords[q0 + i, 0] - ax, parent_coords[q0 + i, 1] - ay
+                    length2 = bx * bx + by * by
+                    scale = max(scale, length2)
+                    f = 0.0 if length2 == 0.0 else min(max(((px - ax) * bx + (py - ay) * by) / length2, 0.0), 1.0)
+                    d = (px - ax - f * bx) ** 2 + (py - ay - f * by) ** 2
+                    position = base + i + f
+                    if i == 0 and f < 1e-9:
+                        position = base + m  # vertex 0's predecessor ends the last edge
+                    if d < near - 1e-18 or (d <= near + 1e-18 and position < key):
+                        near, key = d, position
+                    dv = (px - ax - bx) ** 2 + (py - ay - by) ** 2  # to vertex i
+                    if dv < near_vertex:
+                        near_vertex, vertex_key = dv, base + i + 1.0
+                base += m
+            # on the boundary (a cut's crossing, an unmoved vertex): its place there; moved in (an
+            # offset's mitre): the place of the vertex it came from
+            if near > 1e-12 * max(scale, 1.0):
+                key = vertex_key
+            if key < best_key:
+                best_key, best = key, j
+        for j in range(r0, r1):
+            k = r0 + (best - r0 + j - r0) % (r1 - r0)
+            out[j, 0], out[j, 1] = coords[k, 0], coords[k, 1]
+    return out
 
 
 def _polygons(coords: np.ndarray, ring_offsets: np.ndarray, poly_offsets: np.ndarray) -> np.ndarray:

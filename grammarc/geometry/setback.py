@@ -71,7 +71,8 @@ def setback_regions(polygons: np.ndarray, edges: Edges, distance: np.ndarray, ow
     distance (E,): how far each edge moves in; owner (E,): the owner of its strip (n_owners for none).
     """
     m = len(polygons)
-    d = np.where(owner < n_owners, np.maximum(distance, 0.0), 0.0)
+    # a distance that is not a number (``float("")`` of a missing list item) moves nothing
+    d = np.where((owner < n_owners) & np.isfinite(distance), np.maximum(distance, 0.0), 0.0)
     corner = _mitres(edges, d)
     moved = d > TOL.zero
     idx = np.flatnonzero(moved)

@@ -89,3 +89,26 @@ def test_paper_notation_splits_a_concave_lot(write):
     assert not record["bad"]
     names = set(record["symbols"][record["symbol"]]) | set(record["symbols"][record["mesh"].symbol])
     assert names == {"a", "b", "c"}
+
+
+def test_pieces_start_where_cityengine_starts_them():
+    """Offsets keep vertex i at the mitre of vertex i; a cut keeps the parent's order from the edge that
+    arrives at vertex 0 (Sutherland-Hodgman), so edge numbers follow the parent's. The U lot of the PRT
+    kit in its footprint plane (x, z), clockwise there: counter-clockwise seen from +y."""
+    import shapely
+
+    from grammarc.geometry.clip import fit_pieces
+
+    u_lot = shapely.Polygon([(0, 0), (0, 30), (10, 30), (10, 15), (30, 15), (30, 30), (40, 30), (40, 0)])
+    plane, size = np.array([1]), np.array([[40.0, 0.0, 30.0]])
+
+    def first_vertex(pieces):
+        return pieces.coords[0] * pieces.extent[0, [0, 2]] + pieces.low[0, [0, 2]]
+
+    inset = shapely.buffer(u_lot, -3, join_style="mitre")  # GEOS starts it anywhere
+    np.testing.assert_allclose(first_vertex(fit_pieces(np.array([inset]), plane, size, np.array([u_lot]))),
+                               [3, 3])  # vertex 0's mitre
+    ordered = shapely.Polygon([(3, 3), (3, 27), (7, 27), (7, 12), (33, 12), (33, 27), (37, 27), (37, 3)])
+    cut = shapely.intersection(ordered, shapely.box(20, -1, 50, 40))
+    np.testing.assert_allclose(first_vertex(fit_pieces(np.array([cut]), plane, size, np.array([ordered]))),
+                               [20, 3])  # where the edge into vertex 0 crosses the cut
