@@ -10,11 +10,11 @@ scope y) the frame stays; a face from a component split (normal along z) turns a
 from __future__ import annotations
 
 import numpy as np
-import shapely
 
 from grammarc.backend.chunk import Chunk
 from grammarc.backend.shapes import Shapes
 from grammarc.constants import STRICT, TOL
+from grammarc.geometry.clip import oriented_rings
 from grammarc.geometry.meshes import MESH_BASE, face_frames, face_vertices, mesh_edges
 from grammarc.geometry.polygons import PLANE_U, PLANE_V
 from grammarc.geometry.reframe import NORMAL_UP
@@ -76,18 +76,8 @@ def flat_meshes(chunk: Chunk, shapes: Shapes, parts: np.ndarray, source: np.ndar
         return shapes
     parts, source = parts[pick], source[pick]
     part_plane = plane[source]
-    # outlines wind counter-clockwise around the plane's normal: clockwise in (u, v) for plane 1
-    for flip in (True, False):
-        sel = (part_plane == 1) == flip
-        if sel.any():
-            parts[sel] = shapely.orient_polygons(parts[sel], exterior_cw=flip)
-    _, coords, (ring_offsets, face_offsets) = shapely.to_ragged_array(parts)
-    ring_offsets = np.asarray(ring_offsets, dtype=np.int64)
-    open_ = np.ones(len(coords), dtype=bool)
-    open_[ring_offsets[1:] - 1] = False  # the closing points
-    vertex_part = segment_of(np.asarray(face_offsets, dtype=np.int64))[segment_of(ring_offsets)][open_]
-    coords = np.asarray(coords)[open_, :2]
-    ring_offsets = ring_offsets - np.arange(len(ring_offsets))
+    _, coords, ring_offsets, face_offsets = oriented_rings(parts, part_plane)
+    vertex_part = segment_of(face_offsets)[segment_of(ring_offsets)]
     owner = source[vertex_part]
     local = np.zeros((len(coords), 3))
     at = np.arange(len(coords))
@@ -95,8 +85,7 @@ def flat_meshes(chunk: Chunk, shapes: Shapes, parts: np.ndarray, source: np.ndar
     local[at, PLANE_V[part_plane[vertex_part]]] = coords[:, 1]
     size = np.where(shapes.size > TOL.zero, shapes.size, np.inf)
     mesh_offsets = np.r_[0, np.cumsum(np.bincount(source, minlength=len(shapes))[several])]
-    ids = chunk.meshes.add(local / size[owner], ring_offsets, np.asarray(face_offsets, dtype=np.int64),
-                           mesh_offsets)
+    ids = chunk.meshes.add(local / size[owner], ring_offsets, face_offsets, mesh_offsets)
     geom = shapes.geom.copy()
     geom[several] = (MESH_BASE + ids).astype(np.int32)
     return shapes.with_scope(shapes.origin, shapes.size, shapes.frame, geom)

@@ -82,6 +82,22 @@ def clip_to_slabs(store: PolygonStore, geom: np.ndarray, size: np.ndarray, axis:
     return fit_pieces(pieces, plane, size, polygons)
 
 
+def oriented_rings(parts: np.ndarray, part_plane: np.ndarray):
+    """Shapely polygons (k,) in their planes, turned so that exteriors wind counter-clockwise around
+    the plane's normal (clockwise in (u, v) for plane 1, whose (x, z) axes make a left-handed pair with
+    y), and their open rings: (parts, coords (V, 2), ring_offsets (R+1,), part_offsets (k+1,))."""
+    parts = parts.copy()
+    for flip in (True, False):
+        sel = (part_plane == 1) == flip
+        if sel.any():
+            parts[sel] = shapely.orient_polygons(parts[sel], exterior_cw=flip)
+    if not len(parts):
+        return parts, np.zeros((0, 2)), np.zeros(1, np.int64), np.zeros(1, np.int64)
+    _, flat, (closed_rings, part_offsets) = shapely.to_ragged_array(parts)
+    flat, ring_offsets = _open_rings(np.asarray(flat)[:, :2], np.asarray(closed_rings, dtype=np.int64))
+    return parts, flat, ring_offsets, np.asarray(part_offsets, dtype=np.int64)
+
+
 def fit_pieces(geometries: np.ndarray, plane: np.ndarray, size: np.ndarray,
                parents: np.ndarray | None = None) -> Clipped:
     """Polygons (or multipolygons) in scope units, one per source row, as pieces with fitted boxes.
@@ -95,18 +111,8 @@ def fit_pieces(geometries: np.ndarray, plane: np.ndarray, size: np.ndarray,
     parts, source = parts[keep], source[keep]
     a, b = _A[plane], _B[plane]
     part_plane = plane[source]
-    # exteriors wind counter-clockwise around the plane's normal: clockwise in (u, v) for plane 1, whose
-    # (x, z) axes make a left-handed pair with y
-    for flip in (True, False):
-        sel = (part_plane == 1) == flip
-        if sel.any():
-            parts[sel] = shapely.orient_polygons(parts[sel], exterior_cw=flip)
+    parts, flat, ring_offsets, part_offsets = oriented_rings(parts, part_plane)
     bounds = shapely.bounds(parts).reshape(-1, 4)
-    _, flat, (closed_rings, part_offsets) = (shapely.to_ragged_array(parts) if len(parts) else
-                                              (None, np.zeros((0, 2)), (np.zeros(1, np.int64),
-                                                                        np.zeros(1, np.int64))))
-    flat, ring_offsets = _open_rings(np.asarray(flat)[:, :2], np.asarray(closed_rings, dtype=np.int64))
-    part_offsets = np.asarray(part_offsets, dtype=np.int64)
     if parents is not None and len(parts):
         _, parent_flat, (parent_closed, parent_offsets) = shapely.to_ragged_array(parents)
         parent_flat, parent_rings = _open_rings(np.asarray(parent_flat)[:, :2],
