@@ -228,8 +228,8 @@ def test_grammarc_matches_prt(reference, rpk, footprint, attrs):
 def test_unsupported_operations_are_named(reference):
     from grammarc.conform import run_conformance
 
-    result = run_conformance(KIT / "rpk" / "candler.rpk", "rect_30x20", reference=reference)
-    assert not result.passed and "unsupported: envelope" in result.error and "Candler Building.cga:" in result.error
+    result = run_conformance(KIT / "rpk" / "reporting.rpk", "rect_30x20", reference=reference)
+    assert not result.passed and "unsupported: " in result.error and "reporting_01.cga:" in result.error
 
 
 @needs_kit

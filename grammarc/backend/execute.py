@@ -30,7 +30,7 @@ from grammarc.constants import TOL, Limits
 from grammarc.errors import ChunkTooLarge, LimitError, LotFailure
 from grammarc.geometry import components as comp_kernels
 from grammarc.geometry.clip import clip_to_slabs
-from grammarc.geometry.meshes import is_mesh, is_polygon
+from grammarc.geometry.meshes import MESH_BASE, is_convex, is_mesh, is_polygon
 from grammarc.geometry.reframe import NORMAL_UP, reframe
 from grammarc.ir import nodes as ir
 from grammarc.ir.printer import print_op
@@ -266,7 +266,8 @@ class Executor(FaceOperations):
         for level, axis in enumerate(op.axes):
             parent, step, pos, length = cut(shapes, level, axis)
             parent, step, pos, length, _, geometry = self.clip(shapes, axis, parent, step, pos, length,
-                                                               np.zeros(len(parent), dtype=np.int64))
+                                                               np.zeros(len(parent), dtype=np.int64), symbol,
+                                                               op.span)
             cell = cell[parent] + step
             if level == len(op.axes) - 1:
                 shapes, offsets = self.grouped_children(shapes, axis, parent, cell, pos, length, op.site,
@@ -293,19 +294,26 @@ class Executor(FaceOperations):
                 "Raise the limit with --max-shapes N."
             )
 
-    def clip(self, shapes: Shapes, axis: int, parent, step, pos, length, index):
+    def clip(self, shapes: Shapes, axis: int, parent, step, pos, length, index, symbol: int, span):
         """Children of polygons split across their plane become the pieces of the polygon in their slabs
         (``geometry.clip``): empty ones go, a slab that cuts the polygon apart gives one child a piece.
+        Children of meshes (roofs, envelopes) become the mesh cut to their slab and closed
+        (``mesh_shapes.clip_meshes``; convex meshes only).
 
         Takes and returns the split's children as (parent, step, pos, length, index) arrays, and the
         pieces' geometry for ``children`` (None when no child is a polygon split across its plane).
         """
+        if len(self.chunk.meshes) and is_mesh(shapes.geom[parent]).any():
+            parent, step, pos, length, index, meshes = self.clip_meshes(shapes, axis, parent, step, pos, length,
+                                                                        index, symbol, span)
+        else:
+            meshes = None
         store = self.chunk.polygons
         geom = shapes.geom[parent]
         poly = np.flatnonzero(is_polygon(geom))
         poly = poly[store.plane[geom[poly]] != axis]
         if not len(poly):
-            return parent, step, pos, length, index, None
+            return parent, step, pos, length, index, meshes
         clipped = clip_to_slabs(store, geom[poly], shapes.size[parent[poly]], axis, pos[poly], length[poly])
         whole = np.ones(len(parent), dtype=bool)
         whole[poly] = False
@@ -325,7 +333,38 @@ class Executor(FaceOperations):
         pos[is_piece] = clipped.low[piece[is_piece], axis]
         length[is_piece] = clipped.extent[piece[is_piece], axis]
         geometry = (is_piece, new_geom[piece], clipped.low[piece], clipped.extent[piece])
+        if meshes is not None:  # the mesh children keep their cut meshes
+            from_mesh = ~is_piece & meshes[0][rows]
+            for mine, theirs in zip(geometry, meshes):
+                mine[from_mesh] = theirs[rows][from_mesh]
         return parent[rows], step[rows], pos, length, index[rows], geometry
+
+    def clip_meshes(self, shapes: Shapes, axis: int, parent, step, pos, length, index, symbol: int, span):
+        """``clip`` for the children of mesh shapes: each gets its parent's mesh cut to its slab, a child
+        whose slab misses the mesh goes. Returns the children and their geometry (as ``clip``'s)."""
+        mesh_rows = np.flatnonzero(is_mesh(shapes.geom[parent]))
+        parents = np.unique(parent[mesh_rows])
+        convex = is_convex(self.chunk.meshes, shapes.geom[parents] - MESH_BASE, shapes.size[parents])
+        if not convex.all():
+            bad = np.zeros(len(shapes), dtype=bool)
+            bad[parents[~convex]] = True
+            self.fail(shapes, bad, "`split` of a concave mesh (a roof over a concave footprint) is not "
+                      "supported yet (split its faces after comp(f))", symbol, span)
+        geom, low, extent, keep = mesh_shapes.clip_meshes(self.chunk, shapes, parent[mesh_rows], axis,
+                                                          pos[mesh_rows], length[mesh_rows])
+        n = len(parent)
+        kept = np.ones(n, dtype=bool)
+        kept[mesh_rows[~keep]] = False
+        is_piece = np.zeros(n, dtype=bool)
+        piece_geom = np.full(n, -1, dtype=np.int32)
+        piece_low = np.zeros((n, 3))
+        piece_extent = np.zeros((n, 3))
+        is_piece[mesh_rows] = True
+        piece_geom[mesh_rows], piece_low[mesh_rows], piece_extent[mesh_rows] = geom, low, extent
+        pos, length = pos.copy(), length.copy()
+        pos[mesh_rows], length[mesh_rows] = low[:, axis], extent[:, axis]
+        geometry = tuple(a[kept] for a in (is_piece, piece_geom, piece_low, piece_extent))
+        return parent[kept], step[kept], pos[kept], length[kept], index[kept], geometry
 
     def children(self, shapes: Shapes, axis: int, parent, index, pos, length, site: int,
                  order=None, geometry=None) -> Shapes:
@@ -550,7 +589,18 @@ class Executor(FaceOperations):
         return self.reframed(cursor, new_axes, symbol, op.span)
 
     def reframed(self, cursor: Shapes, new_axes: np.ndarray, symbol: int, span) -> Shapes:
-        """The same geometry in scopes with ``new_axes`` (n, 3, 3), fitted to it (``geometry.reframe``)."""
+        """The same geometry in scopes with ``new_axes`` (n, 3, 3), fitted to it (``geometry.reframe``;
+        meshes: ``mesh_shapes.reframe_meshes``)."""
+        mesh = is_mesh(cursor.geom)
+        if mesh.any():
+            new_axes = np.asarray(new_axes)
+            if mesh.all():
+                return mesh_shapes.reframe_meshes(self.chunk, cursor, new_axes)
+            rows = np.flatnonzero(mesh)
+            others = np.flatnonzero(~mesh)
+            parts = [mesh_shapes.reframe_meshes(self.chunk, cursor.take(rows), new_axes[rows]),
+                     self.reframed(cursor.take(others), new_axes[others], symbol, span)]
+            return Shapes.concat(parts).take(np.argsort(np.concatenate([rows, others]), kind="stable"))
         n = len(cursor)
         bad = cursor.geom < -1
         if bad.any():
@@ -711,7 +761,7 @@ class Executor(FaceOperations):
         parent, part, pos, length, index = split_kernels.group_split(
             np.ascontiguousarray(cursor.size[:, op.axis]), values, kind, groups, n_groups, TOL.zero)
         parent, part, pos, length, index, geometry = self.clip(cursor, op.axis, parent, part, pos, length,
-                                                               index)
+                                                               index, symbol, op.span)
         order, offsets = group_by(part, len(op.parts))
         children = self.children(cursor, op.axis, parent, index, pos, length, op.site, order, geometry)
         self.count(children, symbol, op.span)
@@ -764,7 +814,8 @@ _OPERATIONS = {
 #: Operations that take roofs (meshes): scope changes, component splits, successors, leaves.
 _MESH_OPERATIONS = frozenset({
     ir.Symbol, ir.Translate, ir.Scale, ir.Rotate, ir.Insert, ir.Comp, ir.CompFaces, ir.Empty, ir.NotApplied,
-    ir.SetColor, ir.UseAsset, ir.SetAttr, ir.Report, ir.Case, ir.Stochastic,
+    ir.SetColor, ir.UseAsset, ir.SetAttr, ir.Report, ir.Case, ir.Stochastic, ir.Split, ir.Repeat, ir.GroupSplit,
+    ir.AlignScope,
 })
 
 

@@ -46,8 +46,18 @@ class FaceOperations:
             (~np.isfinite(value) | ~np.isfinite(overhang) | ~np.isfinite(index), "with a value that is not finite"),
             (~op.by_height & (np.abs(value) >= 90), "with an angle of 90 degrees or more"),
         ]
-        if self.plan.leaf_bodies:
+        # CityEngine roofs faces. A face that ``s`` gave a size across it stays flat in CityEngine but is a
+        # box here: an envelope (candler sizes its ventilation faces so) takes the box's base
+        if self.plan.leaf_bodies and op.kind != "envelope":
             checks.append((self.flat_axis(cursor) < 0, "of a solid (CityEngine roofs faces)"))
+        cap = None
+        if op.cap is not None:
+            cap = np.broadcast_to(np.asarray(evaluate_array(op.cap, env), float), (n,))
+            for height, angle in op.sides:
+                differs = (np.abs(evaluate_array(height, env) - overhang) > TOL.zero) | (
+                    np.abs(evaluate_array(angle, env) - value) > TOL.zero)
+                why = "with different heights or angles per side (one slope all round is supported)"
+                checks.append((differs, why))
         if op.overhang_y is not None:
             overhang_y = evaluate_array(op.overhang_y, env)
             checks.append((np.abs(overhang_y - overhang) > TOL.zero,
@@ -56,7 +66,7 @@ class FaceOperations:
             if np.any(bad):
                 self.fail(cursor, np.broadcast_to(bad, (n,)), f"`{op.kind}` {what}", symbol, op.span)
         roofed, failed = mesh_shapes.build_roofs(self.chunk, cursor, op.kind, self.polygons_of(cursor), value,
-                                           op.by_height, overhang, index)
+                                                 op.by_height, overhang, index, cap)
         if failed.any():
             self.fail(cursor, failed, f"`{op.kind}` found no roof for this polygon (its straight skeleton "
                       "did not close, or the overhang's outline crosses itself at a sharp corner)", symbol,

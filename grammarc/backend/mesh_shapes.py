@@ -15,7 +15,7 @@ from grammarc.backend.chunk import Chunk
 from grammarc.backend.shapes import Shapes
 from grammarc.constants import STRICT, TOL
 from grammarc.geometry.clip import oriented_rings
-from grammarc.geometry.meshes import MESH_BASE, face_frames, face_vertices, mesh_edges
+from grammarc.geometry.meshes import MESH_BASE, clip_slabs, face_frames, face_vertices, mesh_edges
 from grammarc.geometry.polygons import PLANE_U, PLANE_V
 from grammarc.geometry.reframe import NORMAL_UP
 from grammarc.geometry.roofs import ROOF_KINDS, roof_meshes
@@ -24,7 +24,7 @@ from grammarc.ragged import ragged_take, rank_within, segment_of, segment_reduce
 
 
 def build_roofs(chunk: Chunk, shapes: Shapes, kind: str, polygons, value, by_height: bool, overhang,
-                index) -> tuple[Shapes, np.ndarray]:
+                index, cap=None) -> tuple[Shapes, np.ndarray]:
     """Roof shapes over ``shapes``' polygons (``polygons``: coords, ring_offsets, shape_offsets and the
     plane of each, as ``Executor.polygons_of`` gives them) and a mask (n,) of the shapes whose roof
     could not be built (their shapes keep their old geometry and must be reported)."""
@@ -34,7 +34,8 @@ def build_roofs(chunk: Chunk, shapes: Shapes, kind: str, polygons, value, by_hei
     size_b = shapes.size[rows, PLANE_V[plane]]
     verts, rings, faces, meshes, ok = roof_meshes(
         ROOF_KINDS[kind], coords, ring_offsets, shape_offsets, plane.astype(np.int8), size_a, size_b,
-        value, by_height, overhang, index.astype(np.int64))
+        value, by_height, overhang, index.astype(np.int64),
+        np.full(len(shapes), np.inf) if cap is None else np.asarray(cap, dtype=np.float64))
     vertex_shape = segment_of(meshes)[segment_of(faces)[segment_of(rings)]]
     vplane = plane[vertex_shape].astype(np.int64)
     local = np.zeros((len(verts), 3))
@@ -146,6 +147,51 @@ def mesh_components(chunk: Chunk, shapes: Shapes, kind: int):
     if kind == SIDEFACES:
         index = index - 1
     return face_mesh[keep], index[keep], origin[keep], axes[keep], size[keep], geom[keep]
+
+
+def clip_meshes(chunk: Chunk, shapes: Shapes, parent: np.ndarray, axis: int, pos: np.ndarray,
+                length: np.ndarray):
+    """Split children of (convex) mesh shapes: each child's copy of its parent's mesh cut to its slab
+    [pos, pos + length] along ``axis`` and closed (``meshes.clip_slabs``). Returns the children's new
+    geometry codes (m,), their boxes' low corners and extents (m, 3) in the parents' scopes, and which
+    children have any mesh left (m,)."""
+    verts, ring_offsets, face_offsets, mesh_offsets, _ = face_vertices(
+        chunk.meshes, shapes.geom[parent] - MESH_BASE, shapes.size[parent])
+    verts, ring_offsets, face_offsets, mesh_offsets = clip_slabs(
+        verts, ring_offsets, face_offsets, mesh_offsets, np.arange(len(parent)), axis, pos, pos + length,
+        TOL.zero)
+    keep = np.diff(mesh_offsets) > 0
+    vertex_child = segment_of(mesh_offsets)[segment_of(face_offsets)[segment_of(ring_offsets)]]
+    vertex_offsets = ring_offsets[face_offsets[mesh_offsets]]
+    low = np.stack([segment_reduce(np.minimum, verts[:, j], vertex_offsets, 0.0) for j in range(3)], 1)
+    high = np.stack([segment_reduce(np.maximum, verts[:, j], vertex_offsets, 0.0) for j in range(3)], 1)
+    extent = high - low
+    scale = np.where(extent > TOL.zero, extent, np.inf)
+    ids = chunk.meshes.add((verts - low[vertex_child]) / scale[vertex_child], ring_offsets, face_offsets,
+                           mesh_offsets)
+    return (MESH_BASE + ids).astype(np.int32), low, np.where(extent > TOL.zero, extent, 0.0), keep
+
+
+def reframe_meshes(chunk: Chunk, shapes: Shapes, new_axes: np.ndarray) -> Shapes:
+    """Mesh shapes in scopes with ``new_axes`` (n, 3, 3) around unchanged geometry (``alignScopeToAxes``,
+    ``rotateScope``): any turn, since a mesh is not tied to a plane; the scope fitted to the mesh."""
+    verts, ring_offsets, face_offsets, mesh_offsets, vertex_shape = face_vertices(
+        chunk.meshes, shapes.geom - MESH_BASE, shapes.size)
+    old_axes = chunk.frames[shapes.frame]
+    # world offsets from the old origin, then coordinates along the new axes
+    world = np.einsum("vi,vij->vj", verts, old_axes[vertex_shape])
+    local = np.einsum("vj,vij->vi", world, new_axes[vertex_shape])
+    vertex_offsets = ring_offsets[face_offsets[mesh_offsets]]
+    low = np.stack([segment_reduce(np.minimum, local[:, j], vertex_offsets, 0.0) for j in range(3)], 1)
+    high = np.stack([segment_reduce(np.maximum, local[:, j], vertex_offsets, 0.0) for j in range(3)], 1)
+    size = high - low
+    scale = np.where(size > TOL.zero, size, np.inf)
+    ids = chunk.meshes.add((local - low[vertex_shape]) / scale[vertex_shape], ring_offsets, face_offsets,
+                           mesh_offsets)
+    origin = shapes.origin + np.einsum("ni,nij->nj", low, new_axes)
+    frame = chunk.frames.add(np.ascontiguousarray(new_axes))
+    return shapes.with_scope(origin, np.where(size > TOL.zero, size, 0.0), frame,
+                             (MESH_BASE + ids).astype(np.int32))
 
 
 def mesh_leaves(chunk: Chunk, shapes: Shapes, symbol: int, colors) -> MeshChunk:

@@ -29,7 +29,7 @@ NOT_APPLIED = frozenset({
 #: CityEngine operations grammarc does not implement yet (the geometry and context issues bring most).
 UNSUPPORTED_OPS = frozenset({
     "innerPolygon",
-    "cleanupGeometry", "trim", "envelope",
+    "cleanupGeometry", "trim",
     "mirrorScope",
     "insertAlongUV", "scatter", "footprint", "tileUV", "splitArea", "inline", "resetGeometry", "taper",
     "primitiveCylinder", "primitiveSphere", "primitiveDisk", "primitiveCone", "primitiveQuad",
@@ -389,6 +389,19 @@ class Lowering(LoweringBase):
         index = given.get("index", zero) if op == "roofShed" else zero
         return ir.Roof(op, self.expr(args[0]), by_height, overhang, given.get("overhangY"), index, span)
 
+    def op_envelope(self, op, args, span):
+        """``envelope(normal|world.up, maxHeight, baseHeight, angle, ...)``: one (baseHeight, angle) pair,
+        or the pairs for front, back, sides (or right and left), which must come out equal."""
+        if len(args) not in (4, 6, 8, 10):
+            return self.unsupported(f"envelope with {len(args)} arguments", span,
+                                    "envelope(direction, maxHeight, baseHeight, angle, ...) with 1 to 4 sides")
+        if not isinstance(args[0], ir.Name) or args[0].name not in ("normal", "world.up", "face.normal"):
+            return self.unsupported("envelope with this direction", span, "normal or world.up")
+        pairs = [(self.expr(args[k]), self.expr(args[k + 1])) for k in range(2, len(args), 2)]
+        (base, angle), others = pairs[0], tuple(pairs[1:])
+        zero = ir.Num(0.0, span)
+        return ir.Roof("envelope", angle, False, base, None, zero, span, cap=self.expr(args[1]), sides=others)
+
     def op_extrude(self, op, args, span):
         if len(args) != 1:
             return self.unsupported(f"extrude with {len(args)} arguments", span, "only extrude(height)")
@@ -728,6 +741,7 @@ _OPS = {
     "set": Lowering.op_set,
     "report": Lowering.op_report,
     "convexify": Lowering.op_convexify,
+    "envelope": Lowering.op_envelope,
     "roofHip": Lowering.op_roof,
     "roofGable": Lowering.op_roof,
     "roofShed": Lowering.op_roof,

@@ -205,3 +205,190 @@ def mesh_edges(verts, ring_offsets, face_offsets, mesh_offsets, eps: float):
     low = np.maximum(start[:, 1], end[:, 1]) <= eps
     kind = np.where(~horizontal, 1, np.where(low, 0, 2))
     return mesh[edge], start, axes, size, kind
+
+
+def is_convex(store: MeshStore, ids: np.ndarray, size: np.ndarray) -> np.ndarray:
+    """Whether each mesh (scaled by its scope size (k, 3)) is convex: all its vertices lie behind the
+    plane of every one of its faces."""
+    verts, ring_offsets, face_offsets, mesh_offsets, _ = face_vertices(store, ids, size)
+    scale = max(float(np.abs(verts).max(initial=0.0)), 1.0)
+    return _convex(verts, ring_offsets, face_offsets, mesh_offsets, scale)
+
+
+@njit(cache=True)
+def _convex(verts, ring_offsets, face_offsets, mesh_offsets, scale):
+    out = np.ones(len(mesh_offsets) - 1, np.bool_)
+    for g in range(len(mesh_offsets) - 1):
+        v0, v1 = ring_offsets[face_offsets[mesh_offsets[g]]], ring_offsets[face_offsets[mesh_offsets[g + 1]]]
+        for f in range(mesh_offsets[g], mesh_offsets[g + 1]):
+            o0, o1 = ring_offsets[face_offsets[f]], ring_offsets[face_offsets[f] + 1]
+            normal = np.zeros(3)
+            for j in range(o0, o1):
+                q = o0 + (j - o0 + 1) % (o1 - o0)
+                normal[0] += (verts[j, 1] - verts[q, 1]) * (verts[j, 2] + verts[q, 2])
+                normal[1] += (verts[j, 2] - verts[q, 2]) * (verts[j, 0] + verts[q, 0])
+                normal[2] += (verts[j, 0] - verts[q, 0]) * (verts[j, 1] + verts[q, 1])
+            length = np.sqrt((normal ** 2).sum())
+            if length == 0.0:
+                continue
+            normal /= length
+            for v in range(v0, v1):
+                if ((verts[v] - verts[o0]) * normal).sum() > 1e-9 * scale:
+                    out[g] = False
+                    break
+            if not out[g]:
+                break
+    return out
+
+
+@njit(cache=True)
+def clip_slabs(verts, ring_offsets, face_offsets, mesh_offsets, child_mesh, axis, lo, hi, eps):
+    """Convex meshes cut to slabs ``lo <= coordinate[axis] <= hi`` and closed by their cut faces.
+
+    verts (V, 3) in the parents' scope units; child_mesh (m,) the mesh each slab cuts. Every face ring
+    is clipped to the slab (Sutherland-Hodgman, both planes); the points where faces cross a plane make
+    that plane's cap, their convex hull (the meshes are convex), facing out of the slab.
+    Returns verts (V', 3), ring_offsets, face_offsets, mesh_offsets (m+1,): an empty mesh for a slab
+    the mesh does not reach.
+    """
+    m = len(child_mesh)
+    out_v = np.empty((max(16, 4 * len(verts)), 3))
+    out_r = np.zeros(max(16, 4 * len(ring_offsets)), np.int64)
+    out_f = np.zeros(max(16, 4 * len(face_offsets)), np.int64)
+    out_m = np.zeros(m + 1, np.int64)
+    n_v = 0
+    n_r = 0
+    n_f = 0
+    a, b = (axis + 1) % 3, (axis + 2) % 3
+    for c in range(m):
+        g = child_mesh[c]
+        caps = np.empty((2, 4 * (ring_offsets[face_offsets[mesh_offsets[g + 1]]]
+                                 - ring_offsets[face_offsets[mesh_offsets[g]]]) + 8, 3))
+        n_cap = np.zeros(2, np.int64)
+        closed = np.zeros(2, np.bool_)  # a face of the mesh already lies on the plane
+        for f in range(mesh_offsets[g], mesh_offsets[g + 1]):
+            face_start = n_r
+            for r in range(face_offsets[f], face_offsets[f + 1]):
+                ring = verts[ring_offsets[r]:ring_offsets[r + 1]].copy()
+                for side in range(2):  # keep >= lo, then <= hi
+                    plane = lo[c] if side == 0 else hi[c]
+                    sign = 1.0 if side == 0 else -1.0
+                    count = len(ring)
+                    clipped = np.empty((2 * count + 2, 3))
+                    k = 0
+                    for j in range(count):
+                        s_ = ring[(j - 1) % count]
+                        e_ = ring[j]
+                        s_in = sign * (s_[axis] - plane) >= -eps
+                        e_in = sign * (e_[axis] - plane) >= -eps
+                        if e_in != s_in:
+                            t = (plane - s_[axis]) / (e_[axis] - s_[axis])
+                            p = s_ + t * (e_ - s_)
+                            p[axis] = plane
+                            clipped[k] = p
+                            k += 1
+                            caps[side, n_cap[side]] = p
+                            n_cap[side] += 1
+                        if e_in:
+                            clipped[k] = e_
+                            k += 1
+                            if abs(e_[axis] - plane) <= eps:
+                                caps[side, n_cap[side]] = e_
+                                n_cap[side] += 1
+                    ring = clipped[:k]
+                    if k < 3:
+                        break
+                if len(ring) < 3:
+                    continue
+                for side in range(2):
+                    plane = lo[c] if side == 0 else hi[c]
+                    if np.abs(ring[:, axis] - plane).max() <= eps:
+                        closed[side] = True
+                out_v = _grow3(out_v, n_v + len(ring))
+                out_r = _grow1(out_r, n_r + 2)
+                out_v[n_v:n_v + len(ring)] = ring
+                n_v += len(ring)
+                n_r += 1
+                out_r[n_r] = n_v
+            if n_r > face_start:
+                out_f = _grow1(out_f, n_f + 4)
+                n_f += 1
+                out_f[n_f] = n_r
+        any_face = n_f > out_m[c]
+        for side in range(2):
+            if not any_face or n_cap[side] < 3 or closed[side]:
+                continue
+            hull = _hull(caps[side, :n_cap[side]], a, b, eps)
+            if len(hull) < 3:
+                continue
+            if side == 0:  # the lo cap faces -axis: reverse the hull's (counter-clockwise in (a, b)) turn
+                hull = hull[::-1].copy()
+            out_v = _grow3(out_v, n_v + len(hull))
+            out_r = _grow1(out_r, n_r + 2)
+            out_f = _grow1(out_f, n_f + 2)
+            out_v[n_v:n_v + len(hull)] = hull
+            n_v += len(hull)
+            n_r += 1
+            out_r[n_r] = n_v
+            n_f += 1
+            out_f[n_f] = n_r
+        out_m[c + 1] = n_f
+    return out_v[:n_v], out_r[: n_r + 1], out_f[: n_f + 1], out_m
+
+
+@njit(cache=True)
+def _hull(points, a, b, eps):
+    """Convex hull of points on a plane, by their coordinates a and b, counter-clockwise in (a, b)
+    (Andrew's monotone chain); repeated points count once."""
+    n = len(points)
+    order = np.argsort(points[:, a].copy(), kind="mergesort")
+    for i in range(1, n):  # ties in a: by b (insertion sort; the points are few)
+        j = i
+        while j > 0 and abs(points[order[j], a] - points[order[j - 1], a]) <= eps and \
+                points[order[j], b] < points[order[j - 1], b]:
+            order[j], order[j - 1] = order[j - 1], order[j]
+            j -= 1
+    hull = np.empty(2 * n + 1, np.int64)
+    k = 0
+    for idx in range(n):
+        i = order[idx]
+        while k >= 2 and _turn(points, hull[k - 2], hull[k - 1], i, a, b) <= eps * eps:
+            k -= 1
+        hull[k] = i
+        k += 1
+    lower = k + 1
+    for idx in range(n - 2, -1, -1):
+        i = order[idx]
+        while k >= lower and _turn(points, hull[k - 2], hull[k - 1], i, a, b) <= eps * eps:
+            k -= 1
+        hull[k] = i
+        k += 1
+    k = max(k - 1, 0)
+    out = np.empty((k, 3))
+    for i in range(k):
+        out[i] = points[hull[i]]
+    return out
+
+
+@njit(cache=True)
+def _turn(points, p, q, r, a, b):
+    return ((points[q, a] - points[p, a]) * (points[r, b] - points[p, b])
+            - (points[q, b] - points[p, b]) * (points[r, a] - points[p, a]))
+
+
+@njit(cache=True)
+def _grow3(a, need):
+    if need <= len(a):
+        return a
+    out = np.empty((max(need, 2 * len(a)), 3))
+    out[: len(a)] = a
+    return out
+
+
+@njit(cache=True)
+def _grow1(a, need):
+    if need <= len(a):
+        return a
+    out = np.zeros(max(need, 2 * len(a)), a.dtype)
+    out[: len(a)] = a
+    return out

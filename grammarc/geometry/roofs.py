@@ -17,7 +17,10 @@ its normal. Face 0 of every mesh is the original polygon seen from below (CityEn
   stay in the bottom face only;
 - ``mansard`` and ``gambrel`` (the paper's ``Roof`` types): the hip and the gable roof with two slopes,
   every plane cut where the inset reaches ``BREAK_SHARE`` of the skeleton's height: steep below,
-  ``angle`` above. A gambrel's gable ends are vertical pentagons.
+  ``angle`` above. A gambrel's gable ends are vertical pentagons;
+- ``envelope`` (CityEngine's building envelope): walls ``overhang`` high under every edge, the hip
+  roof's planes from their tops, cut flat at height ``cap``: what is left of each plane above the cut
+  lies in the flat top.
 
 ``value`` is the slope angle in degrees, or with ``by_height`` the roof's height (hip and gable: the
 highest skeleton node; shed: the highest point; pyramid: the apex). Overhangs (hip and gable) are
@@ -32,9 +35,9 @@ from numba import njit
 
 from grammarc.geometry.skeleton import skeleton_faces
 
-HIP, GABLE, SHED, PYRAMID, MANSARD, GAMBREL = 0, 1, 2, 3, 4, 5
+HIP, GABLE, SHED, PYRAMID, MANSARD, GAMBREL, ENVELOPE = 0, 1, 2, 3, 4, 5, 6
 ROOF_KINDS = {"roofHip": HIP, "roofGable": GABLE, "roofShed": SHED, "roofPyramid": PYRAMID, "mansard": MANSARD,
-              "gambrel": GAMBREL}
+              "gambrel": GAMBREL, "envelope": ENVELOPE}
 #: Two-slope roofs (the paper's mansard and gambrel): the lower planes rise to this share of the
 #: skeleton's height in inset, at the steeper angle ``90 - (90 - angle) / 3`` (70 degrees for 30).
 BREAK_SHARE = 1.0 / 3.0
@@ -221,13 +224,13 @@ def _split_at(node_xy, node_t, faces, face_offsets, knee, eps):
 
 @njit(cache=True)
 def roof_meshes(kind, coords, ring_offsets, poly_offsets, plane, size_a, size_b, value, by_height,
-                overhang, index):
+                overhang, index, cap):
     """Roof meshes of k polygons.
 
     kind : HIP, GABLE, SHED or PYRAMID. coords (V, 2), ring_offsets, poly_offsets : the polygons in the
     store's layout; plane (k,) int8 their plane codes; size_a, size_b (k,) their sizes along u and v;
     value (k,) the angle in degrees or (``by_height``) the height; overhang (k,) for hip and gable;
-    index (k,) int64 the shed's edge.
+    index (k,) int64 the shed's edge; cap (k,) the envelope's height (its walls' is ``overhang``).
     Returns verts (V', 3) as (a, b, h), ring_offsets (R'+1,), face_offsets (F'+1,) into rings,
     mesh_offsets (k+1,) into faces, and ok (k,): False where the roof could not be made.
     """
@@ -269,8 +272,9 @@ def roof_meshes(kind, coords, ring_offsets, poly_offsets, plane, size_a, size_b,
             for j in range(pring[r], pring[r + 1]):
                 succ[j] = pring[r] + (j - pring[r] + 1) % (pring[r + 1] - pring[r])
         # ---- the roof's points (x, y, h) and its faces as rings of point ids
-        if kind == HIP or kind == GABLE or kind == MANSARD or kind == GAMBREL:
-            start_time = -overhang[g] * (1.0 if by_height else np.cos(angle))
+        if kind == HIP or kind == GABLE or kind == MANSARD or kind == GAMBREL or kind == ENVELOPE:
+            wall = overhang[g] if kind == ENVELOPE else 0.0
+            start_time = 0.0 if kind == ENVELOPE else -overhang[g] * (1.0 if by_height else np.cos(angle))
             node_xy, node_t, fnodes, foff, done = skeleton_faces(pts, pring, start_time)
             if not done:
                 ok[g] = False
@@ -284,6 +288,9 @@ def roof_meshes(kind, coords, ring_offsets, poly_offsets, plane, size_a, size_b,
                 knee = BREAK_SHARE * node_t.max()
                 lower = np.tan(np.radians(90.0 - (90.0 - value[g]) / 3.0))
                 node_xy, node_t, fnodes, foff, origin = _split_at(node_xy, node_t, fnodes, foff, knee, eps)
+            elif kind == ENVELOPE and slope > 0 and (cap[g] - wall) / slope < node_t.max():
+                knee = max(cap[g] - wall, 0.0) / slope
+                node_xy, node_t, fnodes, foff, origin = _split_at(node_xy, node_t, fnodes, foff, knee, eps)
             else:
                 origin = np.arange(n)
             _move_gable_ends(node_xy, node_t, fnodes, foff, origin, ends, pts, succ, start_time)
@@ -291,12 +298,25 @@ def roof_meshes(kind, coords, ring_offsets, poly_offsets, plane, size_a, size_b,
                 top = node_t.max()
                 slope = value[g] / top if top > eps else 0.0
                 lower = slope
-            point = np.empty((len(node_xy), 3))
-            point[:, 0] = node_xy[:, 0]
-            point[:, 1] = node_xy[:, 1]
-            point[:, 2] = np.where(node_t <= knee, node_t * lower, knee * lower + (node_t - knee) * slope)
+            flat_top = slope if kind != ENVELOPE else 0.0  # above the cut an envelope is flat
+            point = np.empty((len(node_xy) + (n if kind == ENVELOPE else 0), 3))
+            point[: len(node_xy), 0] = node_xy[:, 0]
+            point[: len(node_xy), 1] = node_xy[:, 1]
+            point[: len(node_xy), 2] = wall + np.where(node_t <= knee, node_t * lower,
+                                                       knee * lower + (node_t - knee) * flat_top)
             face_ids = fnodes
             face_off = foff
+            if kind == ENVELOPE:
+                # the walls: under edge k from node k (its start) to node succ[k], up to the roof's eave
+                bottom = len(node_xy)
+                point[bottom:, :2] = pts
+                point[bottom:, 2] = 0.0
+                walls = np.empty(4 * n, np.int64)
+                for k in range(n):
+                    walls[4 * k], walls[4 * k + 1] = bottom + k, bottom + succ[k]
+                    walls[4 * k + 2], walls[4 * k + 3] = succ[k], k
+                face_ids = np.concatenate((fnodes, walls))
+                face_off = np.concatenate((foff, foff[-1] + 4 * np.arange(1, n + 1)))
             lifted = np.empty(0)
         elif kind == SHED:
             ext = pring[1]
@@ -357,13 +377,13 @@ def roof_meshes(kind, coords, ring_offsets, poly_offsets, plane, size_a, size_b,
         faces = _grow(faces, n_f + len(face_off) + 2)
         reverse = flip != (plane[g] == 1)
         mesh_start = n_v
-        for cap in range(1 + (len(lifted) > 0)):
+        for layer in range(1 + (len(lifted) > 0)):
             for r in range(len(pring) - 1):
                 for j in range(pring[r], pring[r + 1]):
                     # the bottom runs backwards unless the output is reversed anyway
-                    at = j if (cap == 1) != reverse else pring[r + 1] - 1 - (j - pring[r])
+                    at = j if (layer == 1) != reverse else pring[r + 1] - 1 - (j - pring[r])
                     verts[n_v, 0], verts[n_v, 1] = pts[at, 0], pts[at, 1]
-                    verts[n_v, 2] = lifted[at] if cap == 1 else 0.0
+                    verts[n_v, 2] = lifted[at] if layer == 1 else 0.0
                     n_v += 1
                 rings[n_r + 1] = n_v
                 n_r += 1

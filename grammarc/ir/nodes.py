@@ -498,7 +498,7 @@ class InnerRectangle:
 
 @dataclass(frozen=True, slots=True)
 class Roof:
-    """CityEngine ``roofHip``, ``roofGable``, ``roofShed``, ``roofPyramid`` and the paper's
+    """CityEngine ``roofHip``, ``roofGable``, ``roofShed``, ``roofPyramid``, ``envelope`` and the paper's
     ``Roof(type, angle)``: the face becomes a roof mesh over it (``geometry.roofs``). ``value`` is the
     slope in degrees, or the height when ``by_height``; ``overhang`` and ``overhang_y`` the eave and
     gable overhangs; ``index`` the shed's edge."""
@@ -510,6 +510,10 @@ class Roof:
     overhang_y: Expr | None
     index: Expr
     span: Span = NO_SPAN
+    #: ``envelope(dir, maxHeight, baseHeight, angle, ...)``: the height where it is cut flat, and the other
+    #: sides' (baseHeight, angle) pairs, which must equal the first (``overhang``, ``value``).
+    cap: Expr | None = None
+    sides: tuple[tuple[Expr, Expr], ...] = ()
 
 
 #: Selectors of the faces an ``offset`` makes.

@@ -109,6 +109,9 @@ def print_op(op: ir.Op) -> str:
         args = [("byHeight" if op.by_height else "byAngle"), print_expr(op.value), print_expr(op.overhang)]
         if op.overhang_y is not None:
             args.append(print_expr(op.overhang_y))
+        if op.cap is not None:
+            args.append(f"cap={print_expr(op.cap)}")
+        args += [f"{print_expr(h)}/{print_expr(a)}" for h, a in op.sides]
         return f"{op.kind}({', '.join(args)}, index={print_expr(op.index)})"
     if isinstance(op, ir.CompFaces):
         head = f"offset({print_expr(op.offset)}) " if op.offset is not None else ""

@@ -104,9 +104,13 @@ def rewrite_op(op: ir.Op, fn: ExprFn) -> ir.Op:
     if isinstance(op, ir.Roof):
         value, overhang, index = ex(op.value), ex(op.overhang), ex(op.index)
         overhang_y = ex(op.overhang_y) if op.overhang_y is not None else None
-        if value is op.value and overhang is op.overhang and index is op.index and overhang_y is op.overhang_y:
+        cap = ex(op.cap) if op.cap is not None else None
+        sides = _tuple(op.sides, lambda pair: _tuple(pair, ex))
+        if (value is op.value and overhang is op.overhang and index is op.index and overhang_y is op.overhang_y
+                and cap is op.cap and sides is op.sides):
             return op
-        return replace(op, value=value, overhang=overhang, overhang_y=overhang_y, index=index)
+        return replace(op, value=value, overhang=overhang, overhang_y=overhang_y, index=index, cap=cap,
+                       sides=sides)
     if isinstance(op, (ir.Case, ir.Stochastic)):
         branches = _tuple(op.branches, lambda br: _branch(br, fn))
         default = rewrite_body(op.default, fn)
@@ -222,7 +226,8 @@ def op_exprs(op: ir.Op) -> Iterator[ir.Expr]:
     elif isinstance(op, ir.Convexify) and op.max_length is not None:
         yield op.max_length
     elif isinstance(op, ir.Roof):
-        yield from (e for e in (op.value, op.overhang, op.overhang_y, op.index) if e is not None)
+        yield from (e for e in (op.value, op.overhang, op.overhang_y, op.index, op.cap) if e is not None)
+        yield from (e for pair in op.sides for e in pair)
     elif isinstance(op, ir.SetColor):
         yield from op.values
     elif isinstance(op, ir.CompFaces) and op.offset is not None:

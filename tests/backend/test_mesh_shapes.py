@@ -90,10 +90,48 @@ def test_paper_roof_covers_the_footprint_of_the_mass(write):
     assert r["xform"][:, 1, 3].min() == pytest.approx(10.0, abs=1e-5)
 
 
-def test_split_of_a_roof_is_reported_with_the_rule(write):
-    r = run(write, "Lot --> roofHip(30) split(x){ 1 : A }*\n", [rect(12, 8)])
+def test_split_of_a_concave_roof_is_reported_with_the_rule(write):
+    r = run(write, "Lot --> roofHip(30) split(x){ 1 : A }*\n", [LOT_ZOO["concave_L"]])
     [bad] = r["bad"]
-    assert "`split` of a roof is not supported yet" in bad.reason and "rule `Lot`" in bad.reason
+    assert "`split` of a concave mesh" in bad.reason and "rule `Lot`" in bad.reason
+    r = run(write, "Lot --> roofHip(30) extrude(3)\n", [rect(12, 8)])
+    assert "`extrude` of a roof is not supported yet" in r["bad"][0].reason
+
+
+def test_split_of_a_convex_roof_cuts_it_into_closed_slabs(write):
+    """A hip roof on a rectangle is convex: split across its ridge, the slabs are its pieces, closed by
+    their cut faces (volumes add up to the roof's), and each slab's scope fits its piece."""
+    text = ('Lot --> roofHip(45) split(x){ 3 : Slab | ~1 : Slab | 3 : Slab }\n'
+            'Slab --> report("v", geometry.volume) report("sx", scope.sx) report("n", geometry.nFaces)\n')
+    r = run(write, text, [rect(12, 8)])
+    t = totals(r)
+    height = 4.0  # 45 degrees over half the 8 m width
+    assert t["v_sum"] == pytest.approx(12 * 8 * height / 2 - 64 * height / 6)
+    assert t["v_n"] == 3 and t["sx_sum"] == pytest.approx(12)
+    assert t["n_max"] == 7 and t["n_min"] == 5  # ends: 3 planes, bottom, cap; middle: 4 planes, bottom, 2 caps
+
+
+def test_envelope_is_walls_and_slopes_cut_flat(write):
+    """candler's ventilation housing: envelope(world.up, 0.6, 0.45, 45, ...) over a 10 x 4 face: 0.45 m
+    walls, then 45 degree planes, cut at 0.6 m: a box and a frustum."""
+    text = ('Lot --> envelope(world.up, 0.6, 0.45, 45, 0.45, 45, 0.45, 45) report("v", geometry.volume) '
+            'report("sy", scope.sy) comp(f){ top : Top | all : NIL }\nTop --> report("top", geometry.area)\n')
+    r = run(write, text, [rect(10, 4)])
+    t = totals(r)
+    frustum = sum((10 - 2 * s) * (4 - 2 * s) * 0.0015 for s in np.arange(0.00075, 0.15, 0.0015))
+    assert t["v_sum"] == pytest.approx(18 + frustum, rel=1e-6) and t["sy_sum"] == pytest.approx(0.6)
+    assert t["top_sum"] == pytest.approx(9.7 * 3.7)
+    r = run(write, "Lot --> envelope(normal, 5, 1, 45, 2, 30)\n", [rect(10, 4)])
+    assert "different heights or angles per side" in r["bad"][0].reason
+
+
+def test_rotate_scope_of_a_roof_turns_its_scope_around_the_same_mesh(write):
+    text = ('Lot --> roofHip(30) rotateScope(0, 90, 0) report("sx", scope.sx) report("sz", scope.sz) '
+            'report("a", geometry.area)\n')
+    r = run(write, text, [rect(12, 8)])
+    t = totals(r)
+    assert (t["sx_sum"], t["sz_sum"]) == (pytest.approx(8), pytest.approx(12))
+    assert t["a_sum"] == pytest.approx(96 + 96 / np.cos(np.radians(30)))
 
 
 def test_roof_of_a_solid_and_overhang_y_are_reported(write):

@@ -16,14 +16,15 @@ from grammarc.geometry.roofs import GABLE, GAMBREL, HIP, MANSARD, PYRAMID, SHED,
 TAN30 = np.tan(np.radians(30))
 
 
-def roof(kind, rings, value=30.0, *, plane=2, by_height=False, overhang=0.0, index=0):
+def roof(kind, rings, value=30.0, *, plane=2, by_height=False, overhang=0.0, index=0, cap=np.inf):
     """The roof mesh of one polygon given in real units: faces as lists of (V, 3) rings in (a, b, h)."""
     pts = np.concatenate([np.asarray(r, dtype=float) for r in rings])
     low, size = pts.min(axis=0), np.ptp(pts, axis=0)
     ring_offsets = np.cumsum([0] + [len(r) for r in rings]).astype(np.int64)
     verts, ro, fo, mo, ok = roof_meshes(
         kind, (pts - low) / size, ring_offsets, np.array([0, len(rings)]), np.array([plane], np.int8),
-        size[:1], size[1:], np.array([value]), by_height, np.array([overhang]), np.array([index]))
+        size[:1], size[1:], np.array([value]), by_height, np.array([overhang]), np.array([index]),
+        np.array([cap]))
     assert ok.all() and list(mo) == [0, len(fo) - 1]
     return [[verts[ro[r]:ro[r + 1]] + [*low, 0] for r in range(fo[f], fo[f + 1])] for f in range(len(fo) - 1)]
 

@@ -83,6 +83,11 @@ def _check_op(op, check, param_types, diags) -> None:
             if e is not None:
                 check(e, T.NUM, "an overhang")
         check(op.index, T.NUM, "an edge index")
+        if op.cap is not None:
+            check(op.cap, T.NUM, "a height")
+        for height, angle in op.sides:
+            check(height, T.NUM, "a base height")
+            check(angle, T.NUM, "an angle")
     elif isinstance(op, ir.SetColor):
         want = T.STR if len(op.values) == 1 else T.NUM
         for v in op.values:
