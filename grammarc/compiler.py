@@ -33,6 +33,8 @@ class Grammar:
     asset_ids: dict[str, int]
     warnings: tuple[Diagnostic, ...]
     sources: dict[str, str]
+    #: Folders the assets were resolved in (the grammar's, then ``--assets`` ones), for loading them.
+    asset_roots: tuple[Path, ...] = ()
 
 
 def compile_grammar(path: str | Path, *, text: str | None = None, start: str | None = None,
@@ -83,6 +85,7 @@ def compile_grammar(path: str | Path, *, text: str | None = None, start: str | N
         asset_ids=asset_ids,
         warnings=tuple(d for d in diags if not d.is_error),
         sources=sources,
+        asset_roots=tuple(roots),
     )
 
 

@@ -82,6 +82,10 @@ class Chunk:
     #: Index of the colour column in ``Shapes.dynamic`` when the grammar sets colours (else no colours
     #: are recorded and the record's rows are white).
     color_slot: int | None = None
+    #: Index of the first trim-plane column in ``Shapes.dynamic`` (``plan.TRIM_SLOTS``), and the asset
+    #: meshes (id -> ``AssetMesh`` or None), when inserted geometry is trimmed.
+    trim_slot: int | None = None
+    asset_mesh: object = None
 
     def __post_init__(self) -> None:
         if self.shape_count is None:

@@ -10,6 +10,7 @@ its chunk; sorting the chunk's records by lot (stably) makes the output independ
 from __future__ import annotations
 
 from dataclasses import replace
+from functools import cache
 
 import numpy as np
 
@@ -18,11 +19,12 @@ from grammarc.backend.chunk import Chunk, Frames
 from grammarc.backend.evaluate import Env
 from grammarc.backend.execute import Executor
 from grammarc.backend.kernels.order import group_by, scatter_rows
-from grammarc.backend.plan import COLOR_SLOT, WHITE_RGB, Plan
+from grammarc.backend.plan import COLOR_SLOT, TRIM_SLOTS, WHITE_RGB, Plan
 from grammarc.backend.random import lot_keys
 from grammarc.backend.reports import aggregate_chunk
 from grammarc.backend.shapes import Shapes
 from grammarc.constants import Limits
+from grammarc.errors import AssetError
 from grammarc.geometry.footprint import footprint_polygons, lot_scopes
 from grammarc.geometry.polygons import PolygonStore
 from grammarc.io.lots import Lots
@@ -59,6 +61,9 @@ def derive_chunk(plan: Plan, lots: Lots, *, seed: int, limits: Limits, overrides
     attribute_columns(plan.grammar.module, Env(shapes, chunk, plan), lots.attrs, overrides, plan.strings)
     shapes = replace(shapes, dynamic=tuple(initial_dynamic(plan, name, chunk, shapes) for name in plan.dynamic))
     chunk.color_slot = plan.dynamic.get(COLOR_SLOT)
+    if TRIM_SLOTS[0] in plan.dynamic:
+        chunk.trim_slot = plan.dynamic[TRIM_SLOTS[0]]
+        chunk.asset_mesh = asset_loader(plan.grammar)
     executor = Executor(plan, chunk, limits, chunk_budget)
     executor.pending[plan.start].append(shapes)
     for stage in plan.stages:
@@ -74,6 +79,19 @@ def derive_chunk(plan: Plan, lots: Lots, *, seed: int, limits: Limits, overrides
     return collect(chunk), reports
 
 
+def asset_loader(grammar):
+    """``asset id -> AssetMesh`` (None for an asset no root holds), loaded once per process."""
+    from grammarc.io.bake import load_asset
+
+    @cache
+    def load(asset: int):
+        try:
+            return load_asset(grammar.assets[asset], grammar.asset_roots)
+        except AssetError:
+            return None
+    return load
+
+
 def initial_dynamic(plan: Plan, name: str, chunk: Chunk, shapes: Shapes) -> np.ndarray:
     """A lot's starting value of a per-shape column: its attribute, or the context of no split yet."""
     n = len(shapes)
@@ -85,6 +103,8 @@ def initial_dynamic(plan: Plan, name: str, chunk: Chunk, shapes: Shapes) -> np.n
         return np.ones(n)
     if name in ("split.index", "comp.index"):
         return np.zeros(n)
+    if name in TRIM_SLOTS:
+        return np.full(n, np.nan)
     return chunk.attrs[name][shapes.lot]
 
 

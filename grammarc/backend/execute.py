@@ -31,7 +31,8 @@ from grammarc.errors import ChunkTooLarge, LimitError, LotFailure
 from grammarc.geometry import components as comp_kernels
 from grammarc.geometry.clip import clip_to_slabs
 from grammarc.geometry.meshes import MESH_BASE, is_convex, is_mesh, is_polygon
-from grammarc.geometry.reframe import NORMAL_UP, reframe
+from grammarc.geometry.reframe import NORMAL_OUT, NORMAL_UP, reframe
+from grammarc.geometry.trim import side_face_planes
 from grammarc.ir import nodes as ir
 from grammarc.ir.printer import print_op
 from grammarc.ragged import ragged_take, rank_within
@@ -767,6 +768,22 @@ class Executor(FaceOperations):
         self.count(children, symbol, op.span)
         self.run_parts(op.parts, children, offsets, symbol)
 
+    def face_scopes(self, shapes: Shapes, cursor: Shapes, parent: np.ndarray, symbol: int, span) -> Shapes:
+        """A flat shape's face component is the shape itself; as every CityEngine face scope, it gets z
+        along the face's normal (x kept, y = z cross x)."""
+        axis = self.flat_axis(cursor)[parent]
+        turn = (axis >= 0) & (axis != 2) & (shapes.geom > -2) & ~is_mesh(shapes.geom)
+        turn &= (shapes.size <= TOL.zero).sum(axis=1) == 1
+        if not turn.any():
+            return shapes
+        rows = np.flatnonzero(turn)
+        sub = shapes.take(rows)
+        new_axes = np.einsum("nij,njk->nik", NORMAL_OUT[axis[rows]], self.chunk.frames[sub.frame])
+        turned = self.reframed(sub, new_axes, symbol, span)
+        others = np.flatnonzero(~turn)
+        return Shapes.concat([shapes.take(others), turned]).take(
+            np.argsort(np.concatenate([others, rows]), kind="stable"))
+
     def comp_faces(self, op: ir.CompFaces, cursor: Shapes, symbol: int) -> None:
         """CityEngine ``comp(f|e|v)``: components to the first selector they match."""
         if op.offset is not None or op.kind == "v":
@@ -779,6 +796,15 @@ class Executor(FaceOperations):
             self.fail(cursor, bad, "`comp` of an inserted asset is not supported yet", symbol, op.span)
         kind = {"f": "faces", "e": "edges", "v": "vertices"}[op.kind]
         shapes, normal, _, parent = self.components(comp_kernels.KIND_CODES[kind], cursor, op.site)
+        if op.kind == "f":
+            shapes = self.face_scopes(shapes, cursor, parent, symbol, op.span)
+        if op.kind == "f" and self.chunk.trim_slot is not None:
+            # the faces' trim planes where they meet their neighbours (``geometry.trim``)
+            planes = side_face_planes(self.chunk.frames[shapes.frame], shapes.origin, shapes.size, parent)
+            slot = self.chunk.trim_slot
+            dynamic = list(shapes.dynamic)
+            dynamic[slot:slot + 8] = list(planes.T)
+            shapes = replace(shapes, dynamic=tuple(dynamic))
         if op.kind == "f":
             which = classify_faces(normal, op.selectors, self.selector_frames(normal, cursor, parent,
                                                                                 op.selectors))

@@ -83,8 +83,12 @@ def make_plan(grammar: Grammar) -> Plan:
     ops = [op for rule in module.rules for alt in rule.alternatives for op in iter_ops(alt.body)]
     context = [e.name for e in _all_exprs(module) if isinstance(e, ir.ContextRef)]
     colour = [COLOR_SLOT] if any(isinstance(op, ir.SetColor) for op in ops) else []
+    # CityEngine trims inserted geometry at the planes a comp(f) leaves between neighbouring faces
+    trims = list(TRIM_SLOTS) if module.dialect == "cityengine" and any(
+        isinstance(op, ir.CompFaces) and op.kind == "f" for op in ops) and any(
+        isinstance(op, ir.UseAsset) for op in ops) else []
     dynamic = {name: i for i, name in enumerate(dict.fromkeys(
-        [op.name for op in ops if isinstance(op, ir.SetAttr)] + sorted(set(context)) + colour))}
+        [op.name for op in ops if isinstance(op, ir.SetAttr)] + sorted(set(context)) + colour + trims))}
     not_applied = tuple(sorted({op.name for op in ops if isinstance(op, ir.NotApplied)}))
     strings.intern("")
     for selector in ir.FACE_SELECTORS:
@@ -92,6 +96,11 @@ def make_plan(grammar: Grammar) -> Plan:
     asset_of_string = {strings.intern(raw): asset for raw, asset in grammar.asset_ids.items()}
     return Plan(grammar, tuple(symbols), ids, ids[grammar.graph.start], strings, stages, dynamic,
                 module.dialect == "cityengine", not_applied, asset_of_string)
+
+
+#: Per-shape columns of a shape's two vertical trim planes, (nx, ny, nz, d) each in world coordinates:
+#: inserted geometry keeps the side where n . X + d >= 0 (NaN: no plane).
+TRIM_SLOTS = tuple(f"trim.{k}" for k in range(8))
 
 
 #: Operations after which a body's shape is not the body's to emit: it was replaced by successors, split

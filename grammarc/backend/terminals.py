@@ -26,6 +26,7 @@ from grammarc.constants import TOL
 from grammarc.geometry.components import reverse_rings
 from grammarc.geometry.meshes import is_mesh, is_polygon
 from grammarc.geometry.polygons import PLANE_AXES
+from grammarc.geometry.trim import trim_triangles
 from grammarc.io.npz import MeshChunk
 from grammarc.ragged import offsets_from_counts, segment_of
 
@@ -50,7 +51,42 @@ def emit_instances(chunk: Chunk, shapes: Shapes, asset: int, symbol: int, mirror
         if mirrored >> axis & 1:
             xform[:, :, 3] += xform[:, :, axis]
             xform[:, :, axis] *= -1
+    if chunk.trim_slot is not None:
+        cut = _crossing_trim_planes(chunk, shapes, xform)
+        mesh = chunk.asset_mesh(asset) if cut.any() else None
+        if mesh is not None:
+            chunk.outputs.meshes.append(_trimmed(chunk, shapes.take(cut), xform[cut], mesh, symbol))
+            shapes, xform = shapes.take(~cut), xform[~cut]
     _append(chunk, shapes, xform, asset, symbol)
+
+
+def _trim_planes(chunk: Chunk, shapes: Shapes) -> np.ndarray:
+    slot = chunk.trim_slot
+    return np.stack(shapes.dynamic[slot:slot + 8], axis=1)
+
+
+def _crossing_trim_planes(chunk: Chunk, shapes: Shapes, xform: np.ndarray) -> np.ndarray:
+    """Which placed boxes reach past one of their shape's trim planes (those are cut, not instanced)."""
+    planes = _trim_planes(chunk, shapes)
+    corners = np.array([[i & 1, i >> 1 & 1, i >> 2 & 1] for i in range(8)], dtype=np.float64)
+    points = np.einsum("nij,cj->nci", xform[:, :, :3].astype(np.float64), corners) + xform[:, None, :, 3]
+    cut = np.zeros(len(shapes), dtype=bool)
+    for p in range(2):
+        plane = planes[:, 4 * p:4 * p + 4]
+        side = np.einsum("nci,ni->nc", points, np.nan_to_num(plane[:, :3])) + np.nan_to_num(plane[:, 3:4])
+        cut |= ~np.isnan(plane[:, 0]) & (side < -TOL.zero).any(axis=1)
+    return cut
+
+
+def _trimmed(chunk: Chunk, shapes: Shapes, xform: np.ndarray, mesh, symbol: int) -> MeshChunk:
+    """The asset's triangles placed by ``xform`` and cut by the shapes' trim planes, as mesh faces."""
+    vertices, ring_offsets, owner = trim_triangles(mesh.vertices, mesh.faces, xform.astype(np.float64),
+                                                   _trim_planes(chunk, shapes), TOL.zero)
+    return MeshChunk(
+        vertices=vertices.astype(np.float32), ring_offsets=ring_offsets,
+        face_offsets=np.arange(len(owner) + 1, dtype=np.int64), lot=shapes.lot[owner].astype(np.int32),
+        symbol=np.full(len(owner), symbol, dtype=np.int32),
+        color=rgba(shapes.dynamic[chunk.color_slot][owner]) if chunk.color_slot is not None else None)
 
 
 def _append(chunk: Chunk, shapes: Shapes, xform: np.ndarray, asset: int, symbol: int) -> None:

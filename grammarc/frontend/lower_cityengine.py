@@ -249,6 +249,8 @@ class Lowering(LoweringBase):
             return ir.Empty(span)
         if text == "primitiveCube":
             return ir.UseAsset("builtin:cube", span)
+        if text == "convexify":  # operations without arguments may drop their parentheses
+            return ir.Convexify(None, span)
         if text in NOT_APPLIED:
             return ir.NotApplied(text, span)
         if text in UNSUPPORTED_OPS:

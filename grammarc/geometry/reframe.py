@@ -24,6 +24,13 @@ NORMAL_UP = np.array([
     [[1, 0, 0], [0, 0, 1], [0, -1, 0]],  # n = z: (x, z, -y), a turn about x
 ], dtype=np.float64)
 
+#: The same for z along axis n (a comp(f) face: x kept where it can, z its normal, y = z cross x).
+NORMAL_OUT = np.array([
+    [[0, 1, 0], [0, 0, 1], [1, 0, 0]],   # n = x: (y, z, x), a cyclic turn
+    [[1, 0, 0], [0, 0, -1], [0, 1, 0]],  # n = y: (x, -z, y), a turn about x
+    [[1, 0, 0], [0, 1, 0], [0, 0, 1]],   # n = z: unchanged
+], dtype=np.float64)
+
 _A = np.array([PLANE_AXES[p][0] for p in range(3)])
 _B = np.array([PLANE_AXES[p][1] for p in range(3)])
 

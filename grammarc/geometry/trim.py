@@ -1,0 +1,106 @@
+"""CityEngine's trim planes: where a component split's neighbouring faces meet, inserted geometry is cut.
+
+A comp(f) gives each side face (one whose edges to its neighbours are steeper than 40 degrees) a plane at
+each of those edges, bisecting the angle between the two faces; geometry inserted under that face keeps
+the side of both planes the face is on, so ledges and cornices enlarged to run past a corner meet their
+neighbours in a mitre. Horizontal trim planes (CityEngine's ``trim.horizontal``, off by default) are not
+made. ``side_face_planes`` finds the planes of many faces at once; ``trim_triangles`` cuts the triangles
+of many placed assets by them (numba).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+#: A shared edge steeper than this (degrees from the horizontal) makes a vertical trim plane.
+VERTICAL_DEGREES = 40.0
+
+
+def side_face_planes(axes: np.ndarray, origin: np.ndarray, size: np.ndarray, parent: np.ndarray) -> np.ndarray:
+    """Trim planes (m, 8) of component faces: (nx, ny, nz, d) at the face's start edge, then at its end
+    edge, keeping n . X + d >= 0; NaN where a face has no such neighbour or its edges are not steep.
+
+    axes (m, 3, 3) world rows (x along the face's bottom edge, y up its side), origin (m, 3) the start of
+    the bottom edge, size (m, 3), parent (m,): faces of one parent meet where one's end is the next's
+    start."""
+    m = len(parent)
+    out = np.full((m, 8), np.nan)
+    if not m:
+        return out
+    x, y = axes[:, 0], axes[:, 1]
+    steep = (np.abs(y[:, 1]) >= np.sin(np.radians(VERTICAL_DEGREES))) & (size[:, 0] > 0) & (size[:, 1] > 0)
+    start = origin
+    end = origin + size[:, 0:1] * x
+    scale = max(float(np.abs(origin).max()), 1.0) * 1e-7
+    keys = np.concatenate([np.column_stack([parent, np.round(start / scale)]),
+                           np.column_stack([parent, np.round(end / scale)])]).astype(np.int64)
+    _, inverse = np.unique(keys, axis=0, return_inverse=True)
+    inverse = inverse.reshape(-1)
+    at_start, at_end = inverse[:m], inverse[m:]
+    ending = np.full(int(inverse.max()) + 1, -1)
+    ending[at_end] = np.arange(m)
+    starting = np.full(int(inverse.max()) + 1, -1)
+    starting[at_start] = np.arange(m)
+    before, after = ending[at_start], starting[at_end]  # the neighbour sharing each face's start / end
+    for which, neighbour, corner, sign in ((0, before, start, 1.0), (1, after, end, -1.0)):
+        ok = steep & (neighbour >= 0)
+        ok[ok] &= steep[neighbour[ok]]
+        rows = np.flatnonzero(ok)
+        bisector = x[rows] + x[neighbour[rows]]
+        length = np.linalg.norm(bisector, axis=1)
+        good = length > 1e-9
+        rows, bisector = rows[good], bisector[good] / length[good, None]
+        normal = sign * bisector
+        out[rows, 4 * which: 4 * which + 3] = normal
+        out[rows, 4 * which + 3] = -np.einsum("ij,ij->i", normal, corner[rows])
+    return out
+
+
+@njit(cache=True)
+def trim_triangles(verts, tris, xform, planes, eps):
+    """Triangles of an asset (verts (v, 3) in its unit box, tris (t, 3)) placed by xform (k, 3, 4) and
+    cut by each placement's two planes (k, 8; NaN: none): the kept polygons in world coordinates.
+    Returns vertices (V, 3), ring_offsets (F+1,) and each polygon's placement (F,)."""
+    k_count, t_count = len(xform), len(tris)
+    out = np.empty((k_count * t_count * 5 + 1, 3))
+    offsets = np.zeros(k_count * t_count + 1, np.int64)
+    owner = np.empty(k_count * t_count, np.int64)
+    n_v = 0
+    n_f = 0
+    poly = np.empty((8, 3))
+    clipped = np.empty((8, 3))
+    for k in range(k_count):
+        for t in range(t_count):
+            count = 3
+            for c in range(3):
+                v = verts[tris[t, c]]
+                for r in range(3):
+                    poly[c, r] = xform[k, r, 0] * v[0] + xform[k, r, 1] * v[1] + xform[k, r, 2] * v[2] + xform[k, r, 3]
+            for p in range(2):
+                nx, ny, nz, d = planes[k, 4 * p], planes[k, 4 * p + 1], planes[k, 4 * p + 2], planes[k, 4 * p + 3]
+                if np.isnan(nx) or count < 3:
+                    continue
+                kept = 0
+                for j in range(count):
+                    s_ = poly[(j - 1) % count]
+                    e_ = poly[j]
+                    ds = nx * s_[0] + ny * s_[1] + nz * s_[2] + d
+                    de = nx * e_[0] + ny * e_[1] + nz * e_[2] + d
+                    if (de >= -eps) != (ds >= -eps):
+                        f = ds / (ds - de)
+                        clipped[kept] = s_ + f * (e_ - s_)
+                        kept += 1
+                    if de >= -eps:
+                        clipped[kept] = e_
+                        kept += 1
+                count = kept
+                poly[:count] = clipped[:count]
+            if count < 3:
+                continue
+            out[n_v:n_v + count] = poly[:count]
+            n_v += count
+            owner[n_f] = k
+            n_f += 1
+            offsets[n_f] = n_v
+    return out[:n_v], offsets[: n_f + 1], owner[:n_f]
