@@ -1,7 +1,7 @@
 """Convex parts of polygons with holes (CityEngine's ``convexify``), all polygons of a batch at once.
 
 Each round cuts every piece that still has a reflex vertex along a line through its first one: the line
-of the edge that arrives there (on one side the vertex becomes straight, on the other its angle drops
+of the edge that leaves it (on one side the vertex becomes straight, on the other its angle drops
 below 180 degrees), or, where the corner turns by less than ``SHARP_DEGREES``, the line across the
 boundary (a cut along a nearly straight edge would shave off slivers). A cut never makes a reflex
 vertex, so the reflex vertices of a lineage strictly decrease. A hole's
@@ -25,7 +25,7 @@ import shapely
 from grammarc.constants import TOL
 from grammarc.ragged import segment_of
 
-#: Reflex corners turning more than this are cut along their incoming edge, flatter ones across.
+#: Reflex corners turning more than this are cut along their outgoing edge, flatter ones across.
 SHARP_DEGREES = 20.0
 #: Cutting rounds at most (each removes at least one reflex vertex from every piece it cuts).
 MAX_ROUNDS = 256
@@ -78,7 +78,7 @@ def convex_parts(polygons: np.ndarray, max_length: np.ndarray | None = None) -> 
 
 def _cut_vertices(pieces: np.ndarray, limit: np.ndarray | None, across: np.ndarray):
     """Per piece, its first reflex vertex that may be cut (k, 2) and the cut's direction (k, 2): along
-    the edge arriving there, or across the boundary (flat corners, and pieces flagged ``across``); NaN
+    the edge leaving it, or across the boundary (flat corners, and pieces flagged ``across``); NaN
     where there is none (the piece is convex, or every cut is too long)."""
     _, coords, (ring_offsets, part_offsets) = shapely.to_ragged_array(pieces)
     coords = np.asarray(coords)[:, :2]
@@ -100,13 +100,14 @@ def _cut_vertices(pieces: np.ndarray, limit: np.ndarray | None, across: np.ndarr
     candidates = np.flatnonzero(reflex)
     a = d_in[candidates] / np.hypot(d_in[candidates, 0], d_in[candidates, 1])[:, None]
     b = d_out[candidates] / np.hypot(d_out[candidates, 0], d_out[candidates, 1])[:, None]
-    # a clear corner is cut along its incoming edge (rectilinear footprints into rectangles); a nearly
+    # a clear corner is cut along its outgoing edge (rectilinear footprints into rectangles, as PRT's
+    # candler roofs show: an L into two 10 m arms); a nearly
     # straight one across the boundary, which no edge's line runs close to
     sharp = (a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0]) < -np.sin(np.radians(SHARP_DEGREES))
     tangent = a + b
     normal = np.stack([-tangent[:, 1], tangent[:, 0]], axis=1)
     normal /= np.maximum(np.hypot(normal[:, 0], normal[:, 1]), 1e-300)[:, None]
-    direction = np.where((sharp & ~across[piece[candidates]])[:, None], a, normal)
+    direction = np.where((sharp & ~across[piece[candidates]])[:, None], b, normal)
     if limit is not None and len(candidates):
         chord = _chords(pieces[piece[candidates]], coords[candidates], direction)
         keep = chord < limit[piece[candidates]]

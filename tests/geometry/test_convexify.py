@@ -22,7 +22,7 @@ def is_convex(pieces):
 
 
 @pytest.mark.parametrize("polygon, areas", [
-    (L_SHAPE, [300, 100]), (U_SHAPE, [300, 300, 200]), (COURTYARD, [400, 300, 300, 200]),
+    (L_SHAPE, [200, 200]), (U_SHAPE, [400, 200, 200]), (COURTYARD, [400, 400, 200, 200]),
     (shapely.box(0, 0, 5, 3), [15]),
 ])
 def test_rectilinear_footprints_become_rectangles(polygon, areas):
