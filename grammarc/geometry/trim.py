@@ -35,8 +35,12 @@ def side_face_planes(axes: np.ndarray, origin: np.ndarray, size: np.ndarray, par
     scale = max(float(np.abs(origin).max()), 1.0) * 1e-7
     keys = np.concatenate([np.column_stack([parent, np.round(start / scale)]),
                            np.column_stack([parent, np.round(end / scale)])]).astype(np.int64)
-    _, inverse = np.unique(keys, axis=0, return_inverse=True)
-    inverse = inverse.reshape(-1)
+    # the same corner of the same parent: one id (rows sorted with lexsort, which is fast on columns)
+    order = np.lexsort(keys.T[::-1])
+    sorted_keys = keys[order]
+    group = np.cumsum(np.r_[True, (sorted_keys[1:] != sorted_keys[:-1]).any(axis=1)]) - 1
+    inverse = np.empty(len(keys), dtype=np.int64)
+    inverse[order] = group
     at_start, at_end = inverse[:m], inverse[m:]
     ending = np.full(int(inverse.max()) + 1, -1)
     ending[at_end] = np.arange(m)
