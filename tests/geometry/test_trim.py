@@ -1,0 +1,62 @@
+"""Trim planes: bisectors at the corners where a component split's side faces meet, and triangles cut by
+them."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from grammarc.geometry.trim import side_face_planes, trim_triangles
+from grammarc.io.bake import builtin_mesh
+
+
+def box_sides(width=10.0, depth=6.0, height=3.0):
+    """The four side faces of a width x depth box, counter-clockwise seen from above (x east, y up):
+    axes rows (edge direction, up, outward normal), origin at each face's start corner."""
+    corners = np.array([[0, 0, 0], [width, 0, 0], [width, 0, -depth], [0, 0, -depth]], float)
+    axes, origin, size = [], [], []
+    for k in range(4):
+        a, b = corners[k], corners[(k + 1) % 4]
+        x = (b - a) / np.linalg.norm(b - a)
+        y = np.array([0.0, 1.0, 0.0])
+        axes.append([x, y, np.cross(x, y)])
+        origin.append(a)
+        size.append([np.linalg.norm(b - a), height, 0.0])
+    return np.array(axes), np.array(origin), np.array(size)
+
+
+def test_side_faces_of_a_box_meet_in_45_degree_planes():
+    axes, origin, size = box_sides()
+    planes = side_face_planes(axes, origin, size, np.zeros(4, dtype=np.int64))
+    assert not np.isnan(planes).any()
+    # face 0 runs east along z = 0; its start plane bisects the corner with face 3 (running south to
+    # north along x = 0): points of face 0 are kept, points of face 3 beyond the corner are not
+    start, end = planes[0, :4], planes[0, 4:]
+    np.testing.assert_allclose(np.abs(start[:3]), [np.sqrt(0.5), 0, np.sqrt(0.5)], atol=1e-12)
+    assert start[:3] @ [5, 1, 0] + start[3] > 0 and start[:3] @ [-1, 1, 0.5] + start[3] < 0
+    assert end[:3] @ [5, 1, 0] + end[3] > 0 and end[:3] @ [11, 1, 0.5] + end[3] < 0
+
+
+def test_faces_without_a_steep_neighbour_have_no_planes():
+    axes, origin, size = box_sides()
+    lying = axes.copy()
+    lying[:, 1] = [0, 0, 1]  # "up" along the ground: the shared edges are horizontal
+    planes = side_face_planes(lying, origin, size, np.zeros(4, dtype=np.int64))
+    assert np.isnan(planes).all()
+    planes = side_face_planes(axes[:2], origin[:2], size[:2], np.zeros(2, dtype=np.int64))
+    assert np.isnan(planes[0, :4]).all() and not np.isnan(planes[0, 4:]).any()  # only 0 -> 1 meet
+
+
+def test_a_ledge_past_the_corner_is_cut_along_the_mitre():
+    """A 12 m ledge centred on a 10 m facade, 1 m deep: cut at both 45-degree corner planes its top is a
+    trapezoid of 10 and 12 m sides (the 1 m it sticks out beyond the facade is mitred)."""
+    axes, origin, size = box_sides()
+    planes = side_face_planes(axes, origin, size, np.zeros(4, dtype=np.int64))[:1]
+    cube = builtin_mesh("builtin:cube")
+    xform = np.array([[[12.0, 0, 0, -1.0], [0, 0.5, 0, 2.0], [0, 0, 1.0, 0.0]]])  # x -1..11, z 0..1
+    vertices, rings, owner = trim_triangles(cube.vertices, cube.faces, xform, planes, 1e-12)
+    top = [vertices[rings[f]:rings[f + 1]] for f in range(len(rings) - 1)]
+    top = [ring for ring in top if np.allclose(ring[:, 1], 2.5)]
+    area = sum(np.linalg.norm(np.cross(r, np.roll(r, -1, axis=0)).sum(axis=0)) / 2 for r in top)
+    assert area == pytest.approx((10 + 12) / 2 * 1.0)
+    assert (owner == 0).all()
