@@ -23,6 +23,21 @@ from grammarc.io.npz import MeshChunk
 from grammarc.ragged import ragged_take, rank_within, segment_of, segment_reduce
 
 
+def store_fitted(chunk: Chunk, verts: np.ndarray, ring_offsets, face_offsets, mesh_offsets):
+    """Add meshes given in their scopes' units, each fitted to its own box: the box's low corner (k, 3)
+    and size (k, 3) (0 along a flat axis) become the scope, the vertices are stored relative to it.
+    Returns the meshes' ``geom`` codes (k,), low corners and sizes."""
+    vertex_mesh = segment_of(mesh_offsets)[segment_of(face_offsets)[segment_of(ring_offsets)]]
+    vertex_offsets = ring_offsets[face_offsets[mesh_offsets]]
+    low = np.stack([segment_reduce(np.minimum, verts[:, j], vertex_offsets, 0.0) for j in range(3)], 1)
+    high = np.stack([segment_reduce(np.maximum, verts[:, j], vertex_offsets, 0.0) for j in range(3)], 1)
+    size = high - low
+    scale = np.where(size > TOL.zero, size, np.inf)
+    ids = chunk.meshes.add((verts - low[vertex_mesh]) / scale[vertex_mesh], ring_offsets, face_offsets,
+                           mesh_offsets)
+    return (MESH_BASE + ids).astype(np.int32), low, np.where(size > TOL.zero, size, 0.0)
+
+
 def build_roofs(chunk: Chunk, shapes: Shapes, kind: str, polygons, value, by_height: bool, overhang,
                 index, cap=None) -> tuple[Shapes, np.ndarray]:
     """Roof shapes over ``shapes``' polygons (``polygons``: coords, ring_offsets, shape_offsets and the
@@ -49,13 +64,7 @@ def build_roofs(chunk: Chunk, shapes: Shapes, kind: str, polygons, value, by_hei
         if p != 1:
             sel = vplane == p
             roofed[sel] = local[sel] @ NORMAL_UP[p].T
-    vertex_offsets = rings[faces[meshes]]
-    low = np.stack([segment_reduce(np.minimum, roofed[:, j], vertex_offsets, 0.0) for j in range(3)], 1)
-    high = np.stack([segment_reduce(np.maximum, roofed[:, j], vertex_offsets, 0.0) for j in range(3)], 1)
-    size = high - low
-    scale = np.where(size > TOL.zero, size, np.inf)
-    normalized = (roofed - low[vertex_shape]) / scale[vertex_shape]
-    ids = chunk.meshes.add(normalized, rings, faces, meshes)
+    geom, low, size = store_fitted(chunk, roofed, rings, faces, meshes)
     parent_axes = chunk.frames[shapes.frame]
     axes = np.einsum("nij,njk->nik", turn, parent_axes)
     frame = shapes.frame.copy()
@@ -63,8 +72,7 @@ def build_roofs(chunk: Chunk, shapes: Shapes, kind: str, polygons, value, by_hei
     if turned.any():
         frame[turned] = chunk.frames.add(axes[turned])
     origin = shapes.origin + np.einsum("ni,nij->nj", low, axes)
-    geom = (MESH_BASE + ids).astype(np.int32)
-    return shapes.with_scope(origin, np.where(size > TOL.zero, size, 0.0), frame, geom), ~ok
+    return shapes.with_scope(origin, size, frame, geom), ~ok
 
 
 def flat_meshes(chunk: Chunk, shapes: Shapes, parts: np.ndarray, source: np.ndarray, plane: np.ndarray) -> Shapes:
@@ -160,16 +168,8 @@ def clip_meshes(chunk: Chunk, shapes: Shapes, parent: np.ndarray, axis: int, pos
     verts, ring_offsets, face_offsets, mesh_offsets = clip_slabs(
         verts, ring_offsets, face_offsets, mesh_offsets, np.arange(len(parent)), axis, pos, pos + length,
         TOL.zero)
-    keep = np.diff(mesh_offsets) > 0
-    vertex_child = segment_of(mesh_offsets)[segment_of(face_offsets)[segment_of(ring_offsets)]]
-    vertex_offsets = ring_offsets[face_offsets[mesh_offsets]]
-    low = np.stack([segment_reduce(np.minimum, verts[:, j], vertex_offsets, 0.0) for j in range(3)], 1)
-    high = np.stack([segment_reduce(np.maximum, verts[:, j], vertex_offsets, 0.0) for j in range(3)], 1)
-    extent = high - low
-    scale = np.where(extent > TOL.zero, extent, np.inf)
-    ids = chunk.meshes.add((verts - low[vertex_child]) / scale[vertex_child], ring_offsets, face_offsets,
-                           mesh_offsets)
-    return (MESH_BASE + ids).astype(np.int32), low, np.where(extent > TOL.zero, extent, 0.0), keep
+    geom, low, extent = store_fitted(chunk, verts, ring_offsets, face_offsets, mesh_offsets)
+    return geom, low, extent, np.diff(mesh_offsets) > 0
 
 
 def reframe_meshes(chunk: Chunk, shapes: Shapes, new_axes: np.ndarray) -> Shapes:
@@ -181,17 +181,9 @@ def reframe_meshes(chunk: Chunk, shapes: Shapes, new_axes: np.ndarray) -> Shapes
     # world offsets from the old origin, then coordinates along the new axes
     world = np.einsum("vi,vij->vj", verts, old_axes[vertex_shape])
     local = np.einsum("vj,vij->vi", world, new_axes[vertex_shape])
-    vertex_offsets = ring_offsets[face_offsets[mesh_offsets]]
-    low = np.stack([segment_reduce(np.minimum, local[:, j], vertex_offsets, 0.0) for j in range(3)], 1)
-    high = np.stack([segment_reduce(np.maximum, local[:, j], vertex_offsets, 0.0) for j in range(3)], 1)
-    size = high - low
-    scale = np.where(size > TOL.zero, size, np.inf)
-    ids = chunk.meshes.add((local - low[vertex_shape]) / scale[vertex_shape], ring_offsets, face_offsets,
-                           mesh_offsets)
+    geom, low, size = store_fitted(chunk, local, ring_offsets, face_offsets, mesh_offsets)
     origin = shapes.origin + np.einsum("ni,nij->nj", low, new_axes)
-    frame = chunk.frames.add(np.ascontiguousarray(new_axes))
-    return shapes.with_scope(origin, np.where(size > TOL.zero, size, 0.0), frame,
-                             (MESH_BASE + ids).astype(np.int32))
+    return shapes.with_scope(origin, size, chunk.frames.add(np.ascontiguousarray(new_axes)), geom)
 
 
 def mesh_leaves(chunk: Chunk, shapes: Shapes, symbol: int, colors) -> MeshChunk:
