@@ -112,11 +112,14 @@ def _axis_rectangle(pts, rings, subdivisions):
     xs = _grid(pts[:, 0], subdivisions)
     ys = _grid(pts[:, 1], subdivisions)
     nx, ny = len(xs) - 1, len(ys) - 1
-    inside = np.ones((ny, nx), np.bool_)
+    inside = np.zeros((ny, nx), np.bool_)
     crossings = np.empty(len(pts))
+    which = np.empty((2, nx), np.int64)  # the inside interval holding each cell, per sample (-1: none)
+    tol = 1e-9 * (xs[-1] - xs[0] + 1.0)
     for j in range(ny):
         pad = (ys[j + 1] - ys[j]) * 1e-6
-        for y in (ys[j] + pad, ys[j + 1] - pad):
+        for sample in range(2):
+            y = ys[j] + pad if sample == 0 else ys[j + 1] - pad
             count = 0
             for r in range(len(rings) - 1):
                 for q in range(rings[r], rings[r + 1] - 1):  # closed rings: q -> q + 1
@@ -126,12 +129,16 @@ def _axis_rectangle(pts, rings, subdivisions):
                         crossings[count] = pts[q, 0] + f * (pts[q + 1, 0] - pts[q, 0])
                         count += 1
             cut = np.sort(crossings[:count])
-            tol = 1e-9 * (xs[-1] - xs[0] + 1.0)
             p = 0  # both sorted: one sweep over the cells and the inside intervals [cut[p], cut[p + 1]]
             for i in range(nx):
                 while p + 1 < count and cut[p + 1] + tol < xs[i + 1]:
                     p += 2
-                inside[j, i] = inside[j, i] and p + 1 < count and cut[p] <= xs[i] + tol
+                which[sample, i] = p if p + 1 < count and cut[p] <= xs[i] + tol else -1
+        # no vertex lies inside the band, so its crossings keep their order: a cell in the same interval
+        # at the bottom and at the top of the band stays in it all the way (an interval's ends move
+        # linearly), while one in different intervals has the boundary pass through it
+        for i in range(nx):
+            inside[j, i] = which[0, i] >= 0 and which[0, i] == which[1, i]
     # largest rectangle under each row's histogram of inside heights (bars of the cells' widths)
     best, bx0, by0, bx1, by1 = 0.0, 0.0, 0.0, 0.0, 0.0
     height = np.zeros(nx + 1)
