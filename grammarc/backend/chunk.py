@@ -86,6 +86,8 @@ class Chunk:
     #: meshes (id -> ``AssetMesh`` or None), when inserted geometry is trimmed.
     trim_slot: int | None = None
     asset_mesh: object = None
+    #: Index of the ``trim.vertical`` column (0: planes off) when the grammar sets it.
+    trim_switch: int | None = None
 
     def __post_init__(self) -> None:
         if self.shape_count is None:

@@ -19,7 +19,7 @@ from grammarc.backend.chunk import Chunk, Frames
 from grammarc.backend.evaluate import Env
 from grammarc.backend.execute import Executor
 from grammarc.backend.kernels.order import group_by, scatter_rows
-from grammarc.backend.plan import COLOR_SLOT, TRIM_SLOTS, WHITE_RGB, Plan
+from grammarc.backend.plan import COLOR_SLOT, TRIM_SLOTS, TRIM_SWITCH, WHITE_RGB, Plan
 from grammarc.backend.random import lot_keys
 from grammarc.backend.reports import aggregate_chunk
 from grammarc.backend.shapes import Shapes
@@ -63,6 +63,7 @@ def derive_chunk(plan: Plan, lots: Lots, *, seed: int, limits: Limits, overrides
     chunk.color_slot = plan.dynamic.get(COLOR_SLOT)
     if TRIM_SLOTS[0] in plan.dynamic:
         chunk.trim_slot = plan.dynamic[TRIM_SLOTS[0]]
+        chunk.trim_switch = plan.dynamic.get(TRIM_SWITCH)
         chunk.asset_mesh = asset_loader(plan.grammar)
     executor = Executor(plan, chunk, limits, chunk_budget)
     executor.pending[plan.start].append(shapes)
@@ -105,6 +106,8 @@ def initial_dynamic(plan: Plan, name: str, chunk: Chunk, shapes: Shapes) -> np.n
         return np.zeros(n)
     if name in TRIM_SLOTS:
         return np.full(n, np.nan)
+    if name == TRIM_SWITCH:
+        return np.ones(n)
     return chunk.attrs[name][shapes.lot]
 
 

@@ -101,6 +101,8 @@ def make_plan(grammar: Grammar) -> Plan:
 #: Per-shape columns of a shape's two vertical trim planes, (nx, ny, nz, d) each in world coordinates:
 #: inserted geometry keeps the side where n . X + d >= 0 (NaN: no plane).
 TRIM_SLOTS = tuple(f"trim.{k}" for k in range(8))
+#: ``set(trim.vertical, false)`` turns the planes off for a shape and its successors (1: on, 0: off).
+TRIM_SWITCH = "trim.vertical"
 
 
 #: Operations after which a body's shape is not the body's to emit: it was replaced by successors, split

@@ -61,8 +61,12 @@ def emit_instances(chunk: Chunk, shapes: Shapes, asset: int, symbol: int, mirror
 
 
 def _trim_planes(chunk: Chunk, shapes: Shapes) -> np.ndarray:
+    """The shapes' trim planes (n, 8), NaN where there are none or ``set(trim.vertical, false)``."""
     slot = chunk.trim_slot
-    return np.stack(shapes.dynamic[slot:slot + 8], axis=1)
+    planes = np.stack(shapes.dynamic[slot:slot + 8], axis=1)
+    if chunk.trim_switch is not None:
+        planes[shapes.dynamic[chunk.trim_switch] == 0] = np.nan
+    return planes
 
 
 def _crossing_trim_planes(chunk: Chunk, shapes: Shapes, xform: np.ndarray) -> np.ndarray:

@@ -508,7 +508,15 @@ class Lowering(LoweringBase):
         if not self.arity(op, args, (2,), span):
             return ir.Empty(span)
         target = args[0]
-        if isinstance(target, ir.Name) and target.name.startswith(("material.", "trim.")):
+        if isinstance(target, ir.Name) and target.name in ir.SHAPE_ATTRIBUTES:
+            return ir.SetAttr(target.name, self.expr(args[1]), span)
+        if isinstance(target, ir.Name) and target.name == "trim.horizontal":
+            value = self.expr(args[1])
+            if isinstance(value, ir.Bool) and not value.value:
+                return ir.NotApplied("set(trim.horizontal)", span)  # CityEngine's default
+            return self.unsupported("set(trim.horizontal, ...) other than false", span,
+                                    "horizontal trim planes are not made")
+        if isinstance(target, ir.Name) and target.name.startswith("material."):
             return ir.NotApplied(f"set({target.name})", span)
         if not isinstance(target, ir.Name):
             return self.unsupported("set of this target", span, "set(attribute, value)")

@@ -189,6 +189,8 @@ FUNCTIONS: dict[str, tuple[int, int, Type]] = {
     "geometry.nFaces": (0, 0, Type.NUM),
     "fileRandom": (0, 0, Type.NUM),
 }
+#: CityEngine shape attributes that ``set`` changes for a shape and its successors (not declared attrs).
+SHAPE_ATTRIBUTES: dict[str, Type] = {"trim.vertical": Type.BOOL}
 #: Functions that take strings or any type (their argument types are checked by ``passes.types``).
 CONVERSIONS: dict[str, Type] = {"str": Type.STR, "float": Type.NUM, "bool": Type.BOOL, "len": Type.NUM,
                                  "listItem": Type.STR}

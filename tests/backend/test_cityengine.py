@@ -617,3 +617,17 @@ def test_inner_rectangle_by_edge_finds_a_rotated_lot_whole(write):
         text = f'Lot --> alignScopeToAxes() innerRectangle({align}){{ shape : A }}\nA --> report("a", geometry.area)\n'
         found[align] = totals(run(write, text, [lot]))["a_sum"]
     assert found["edge"] == pytest.approx(375.0) and found["scope"] < 300
+
+
+def test_trim_planes_mitre_inserts_at_corners_unless_turned_off(write):
+    """A ledge wider than its facade is cut at the corners' trim planes (mesh faces, not instances);
+    ``set(trim.vertical, false)`` keeps it whole; horizontal trim planes are refused."""
+    base = ("Lot --> extrude(10) {set}comp(f){{ side : Facade }}\n"
+            "Facade --> split(y){{ 1 : Ledge | ~1 : NIL }}\n"
+            "Ledge --> s('1.2, '1, 0.5) center(x) primitiveCube()\n")
+    trimmed = run(write, base.format(set=""), [rect(12, 8)])
+    assert len(trimmed["asset"]) == 0 and len(trimmed["mesh"].lot) > 0
+    whole = run(write, base.format(set="set(trim.vertical, false) "), [rect(12, 8)])
+    assert len(whole["asset"]) == 4 and len(whole["mesh"].lot) == 0
+    with pytest.raises(GrammarError, match="horizontal"):
+        run(write, base.format(set="set(trim.horizontal, true) "), [rect(12, 8)])

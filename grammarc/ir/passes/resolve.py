@@ -73,7 +73,7 @@ def _check_set_targets(rule: ir.Rule, module: ir.Module, diags: Diagnostics) -> 
     attrs = {a.name: a for a in module.attrs}
     for alt in rule.alternatives:
         for op in iter_ops(alt.body):
-            if not isinstance(op, ir.SetAttr):
+            if not isinstance(op, ir.SetAttr) or op.name in ir.SHAPE_ATTRIBUTES:
                 continue
             attr = attrs.get(op.name)
             if attr is None:

@@ -112,7 +112,7 @@ def _check_op(op, check, param_types, diags) -> None:
         for chance, _ in op.branches:
             check(chance, T.NUM, "a percentage")
     elif isinstance(op, ir.SetAttr):
-        want = check.keywords["attrs"].get(op.name)
+        want = ir.SHAPE_ATTRIBUTES.get(op.name) or check.keywords["attrs"].get(op.name)
         if want is not None and want is not T.UNKNOWN:
             check(op.value, want, f"the value of `{op.name}`")
 
