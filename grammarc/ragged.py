@@ -8,6 +8,7 @@ A ragged array is flat items plus ``offsets`` (n+1,) int64 starting at 0 (Arrow,
 from __future__ import annotations
 
 import numpy as np
+from numba import njit
 
 
 def offsets_from_counts(counts: np.ndarray) -> np.ndarray:
@@ -72,3 +73,14 @@ def fan_out(counts: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     # position of each child minus the offset of its parent's first child
     index = np.arange(offsets[-1], dtype=np.int64) - offsets[:-1][parent]
     return parent, index
+
+
+@njit(cache=True)
+def grow(items: np.ndarray, need: int) -> np.ndarray:
+    """``items`` with room for ``need`` rows (the length at least doubles), its rows kept: the append
+    buffer of numba kernels that build ragged outputs of unknown size."""
+    if need <= len(items):
+        return items
+    out = np.empty((max(need, 2 * len(items)),) + items.shape[1:], items.dtype)
+    out[: len(items)] = items
+    return out

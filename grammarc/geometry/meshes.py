@@ -16,7 +16,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from grammarc.ragged import ragged_take, segment_of, segment_reduce
+from grammarc.ragged import grow, ragged_take, segment_of, segment_reduce
 
 #: ``geom`` codes from here up are meshes; polygons of the store are 0 .. MESH_BASE - 1.
 MESH_BASE = 1 << 30
@@ -304,14 +304,14 @@ def clip_slabs(verts, ring_offsets, face_offsets, mesh_offsets, child_mesh, axis
                     plane = lo[c] if side == 0 else hi[c]
                     if np.abs(ring[:, axis] - plane).max() <= eps:
                         closed[side] = True
-                out_v = _grow3(out_v, n_v + len(ring))
-                out_r = _grow1(out_r, n_r + 2)
+                out_v = grow(out_v, n_v + len(ring))
+                out_r = grow(out_r, n_r + 2)
                 out_v[n_v:n_v + len(ring)] = ring
                 n_v += len(ring)
                 n_r += 1
                 out_r[n_r] = n_v
             if n_r > face_start:
-                out_f = _grow1(out_f, n_f + 4)
+                out_f = grow(out_f, n_f + 4)
                 n_f += 1
                 out_f[n_f] = n_r
         any_face = n_f > out_m[c]
@@ -323,9 +323,9 @@ def clip_slabs(verts, ring_offsets, face_offsets, mesh_offsets, child_mesh, axis
                 continue
             if side == 0:  # the lo cap faces -axis: reverse the hull's (counter-clockwise in (a, b)) turn
                 hull = hull[::-1].copy()
-            out_v = _grow3(out_v, n_v + len(hull))
-            out_r = _grow1(out_r, n_r + 2)
-            out_f = _grow1(out_f, n_f + 2)
+            out_v = grow(out_v, n_v + len(hull))
+            out_r = grow(out_r, n_r + 2)
+            out_f = grow(out_f, n_f + 2)
             out_v[n_v:n_v + len(hull)] = hull
             n_v += len(hull)
             n_r += 1
@@ -374,21 +374,3 @@ def _hull(points, a, b, eps):
 def _turn(points, p, q, r, a, b):
     return ((points[q, a] - points[p, a]) * (points[r, b] - points[p, b])
             - (points[q, b] - points[p, b]) * (points[r, a] - points[p, a]))
-
-
-@njit(cache=True)
-def _grow3(a, need):
-    if need <= len(a):
-        return a
-    out = np.empty((max(need, 2 * len(a)), 3))
-    out[: len(a)] = a
-    return out
-
-
-@njit(cache=True)
-def _grow1(a, need):
-    if need <= len(a):
-        return a
-    out = np.zeros(max(need, 2 * len(a)), a.dtype)
-    out[: len(a)] = a
-    return out

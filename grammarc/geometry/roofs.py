@@ -34,6 +34,7 @@ import numpy as np
 from numba import njit
 
 from grammarc.geometry.skeleton import skeleton_faces
+from grammarc.ragged import grow
 
 HIP, GABLE, SHED, PYRAMID, MANSARD, GAMBREL, ENVELOPE = 0, 1, 2, 3, 4, 5, 6
 ROOF_KINDS = {"roofHip": HIP, "roofGable": GABLE, "roofShed": SHED, "roofPyramid": PYRAMID, "mansard": MANSARD,
@@ -41,17 +42,6 @@ ROOF_KINDS = {"roofHip": HIP, "roofGable": GABLE, "roofShed": SHED, "roofPyramid
 #: Two-slope roofs (the paper's mansard and gambrel): the lower planes rise to this share of the
 #: skeleton's height in inset, at the steeper angle ``90 - (90 - angle) / 3`` (70 degrees for 30).
 BREAK_SHARE = 1.0 / 3.0
-
-
-@njit(cache=True)
-def _grow(a, need):
-    """``a`` with room for ``need`` rows (doubling), the first rows kept."""
-    if need <= len(a):
-        return a
-    shape = (max(need, 2 * len(a)),) + a.shape[1:]
-    out = np.empty(shape, a.dtype)
-    out[: len(a)] = a
-    return out
 
 
 @njit(cache=True)
@@ -372,9 +362,9 @@ def roof_meshes(kind, coords, ring_offsets, poly_offsets, plane, size_a, size_b,
         # ---- append: the bottom (seen from below), the shed's sloped face, then the roof faces
         # without repeated points
         n_rings_new = 2 * (len(pring) - 1) + len(face_off) - 1
-        verts = _grow(verts, n_v + 2 * n + len(face_ids))
-        rings = _grow(rings, n_r + n_rings_new + 1)
-        faces = _grow(faces, n_f + len(face_off) + 2)
+        verts = grow(verts, n_v + 2 * n + len(face_ids))
+        rings = grow(rings, n_r + n_rings_new + 1)
+        faces = grow(faces, n_f + len(face_off) + 2)
         reverse = flip != (plane[g] == 1)
         mesh_start = n_v
         for layer in range(1 + (len(lifted) > 0)):
