@@ -5,7 +5,15 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from grammarc.ragged import fan_out, offsets_from_counts, ragged_take, rank_within, segment_of, segment_reduce
+from grammarc.ragged import (
+    fan_out,
+    offsets_from_counts,
+    ragged_take,
+    rank_within,
+    row_groups,
+    segment_of,
+    segment_reduce,
+)
 
 
 def random_counts(rng, n):
@@ -106,3 +114,12 @@ def test_fan_out_docstring_example():
     parent, index = fan_out([2, 0, 3])
     assert parent.tolist() == [0, 0, 2, 2, 2]
     assert index.tolist() == [0, 1, 0, 1, 2]
+
+
+def test_row_groups_number_equal_rows_as_unique_does():
+    keys = np.array([[1, 5], [0, 2], [1, 5], [0, 3], [0, 2]])
+    groups, first = row_groups(keys)
+    _, want_first, want_groups = np.unique(keys, axis=0, return_index=True, return_inverse=True)
+    assert groups.tolist() == want_groups.reshape(-1).tolist() and first.tolist() == want_first.tolist()
+    empty_groups, empty_first = row_groups(np.zeros((0, 2), dtype=np.int64))
+    assert len(empty_groups) == len(empty_first) == 0

@@ -19,7 +19,7 @@ import numpy as np
 import shapely
 from numba import njit
 
-from grammarc.ragged import offsets_from_counts, segment_of
+from grammarc.ragged import offsets_from_counts, row_groups, segment_of
 
 #: Even grid steps across the polygon's extent, besides its vertices' coordinates.
 SUBDIVISIONS = {"scope": 64, "edge": 32}
@@ -62,8 +62,7 @@ def _edge_directions(coords, ring_offsets, poly_offsets):
     poly = poly[keep]
     # one per distinct direction of a polygon
     key = np.round(angle, 9)
-    _, first = np.unique(np.column_stack([poly, key]), axis=0, return_index=True)
-    first = np.sort(first)
+    first = np.sort(row_groups(np.column_stack([poly, key]))[1])
     return angle[first], offsets_from_counts(np.bincount(poly[first], minlength=len(poly_offsets) - 1))
 
 

@@ -16,7 +16,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from grammarc.ragged import grow, ragged_take, segment_of, segment_reduce
+from grammarc.ragged import grow, ragged_take, row_groups, segment_of, segment_reduce
 
 #: ``geom`` codes from here up are meshes; polygons of the store are 0 .. MESH_BASE - 1.
 MESH_BASE = 1 << 30
@@ -178,8 +178,7 @@ def mesh_edges(verts, ring_offsets, face_offsets, mesh_offsets, eps: float):
     lo, hi = np.where(swap[:, None], b, a), np.where(swap[:, None], a, b)
     keep = (lo != hi).any(axis=1)
     key = np.column_stack([mesh, lo, hi])[keep]
-    _, first, inverse = np.unique(key, axis=0, return_index=True, return_inverse=True)
-    inverse = inverse.reshape(-1)
+    inverse, first = row_groups(key)
     order = np.argsort(first, kind="stable")  # first appearance, which keeps meshes in order
     rank = np.empty(len(order), dtype=np.int64)
     rank[order] = np.arange(len(order))

@@ -13,6 +13,8 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
+from grammarc.ragged import row_groups
+
 #: A shared edge steeper than this (degrees from the horizontal) makes a vertical trim plane.
 VERTICAL_DEGREES = 40.0
 
@@ -35,12 +37,7 @@ def side_face_planes(axes: np.ndarray, origin: np.ndarray, size: np.ndarray, par
     scale = max(float(np.abs(origin).max()), 1.0) * 1e-7
     keys = np.concatenate([np.column_stack([parent, np.round(start / scale)]),
                            np.column_stack([parent, np.round(end / scale)])]).astype(np.int64)
-    # the same corner of the same parent: one id (rows sorted with lexsort, which is fast on columns)
-    order = np.lexsort(keys.T[::-1])
-    sorted_keys = keys[order]
-    group = np.cumsum(np.r_[True, (sorted_keys[1:] != sorted_keys[:-1]).any(axis=1)]) - 1
-    inverse = np.empty(len(keys), dtype=np.int64)
-    inverse[order] = group
+    inverse, _ = row_groups(keys)  # the same corner of the same parent: one id
     at_start, at_end = inverse[:m], inverse[m:]
     ending = np.full(int(inverse.max()) + 1, -1)
     ending[at_end] = np.arange(m)
