@@ -539,14 +539,7 @@ class Executor(FaceOperations):
         if bad.any():
             self.fail(cursor, bad, "`extrude` needs a face (a flat shape) and a finite height", symbol,
                       op.span)
-        turn = axis != 1
-        if turn.any():
-            rows = np.flatnonzero(turn)
-            sub = cursor.take(rows)
-            new_axes = np.einsum("nij,njk->nik", NORMAL_UP[axis[rows]], self.chunk.frames[sub.frame])
-            turned = self.reframed(sub, new_axes, symbol, op.span)
-            cursor = Shapes.concat([cursor.take(~turn), turned]).take(
-                np.argsort(np.concatenate([np.flatnonzero(~turn), rows]), kind="stable"))
+        cursor = self.turned(cursor, axis != 1, NORMAL_UP, axis, symbol, op.span)
         size = cursor.size.copy()
         size[:, 1] = np.abs(height)
         up = self.chunk.frames[cursor.frame][:, 1]
@@ -589,6 +582,17 @@ class Executor(FaceOperations):
             new_axes = self.geometry_axes(op, cursor, axes, symbol)
         return self.reframed(cursor, new_axes, symbol, op.span)
 
+    def turned(self, cursor: Shapes, turn: np.ndarray, matrices: np.ndarray, axis: np.ndarray, symbol: int,
+               span) -> Shapes:
+        """``cursor`` with the shapes ``turn`` (mask) given the axes ``matrices[axis]`` (rows in their
+        present frames: ``NORMAL_UP``, ``NORMAL_OUT``) around their unchanged geometry."""
+        if not turn.any():
+            return cursor
+        rows, others = np.flatnonzero(turn), np.flatnonzero(~turn)
+        sub = cursor.take(rows)
+        new_axes = np.einsum("nij,njk->nik", matrices[axis[rows]], self.chunk.frames[sub.frame])
+        return Shapes.merge([cursor.take(others), self.reframed(sub, new_axes, symbol, span)], [others, rows])
+
     def reframed(self, cursor: Shapes, new_axes: np.ndarray, symbol: int, span) -> Shapes:
         """The same geometry in scopes with ``new_axes`` (n, 3, 3), fitted to it (``geometry.reframe``;
         meshes: ``mesh_shapes.reframe_meshes``)."""
@@ -599,9 +603,9 @@ class Executor(FaceOperations):
                 return mesh_shapes.reframe_meshes(self.chunk, cursor, new_axes)
             rows = np.flatnonzero(mesh)
             others = np.flatnonzero(~mesh)
-            parts = [mesh_shapes.reframe_meshes(self.chunk, cursor.take(rows), new_axes[rows]),
-                     self.reframed(cursor.take(others), new_axes[others], symbol, span)]
-            return Shapes.concat(parts).take(np.argsort(np.concatenate([rows, others]), kind="stable"))
+            return Shapes.merge([mesh_shapes.reframe_meshes(self.chunk, cursor.take(rows), new_axes[rows]),
+                                 self.reframed(cursor.take(others), new_axes[others], symbol, span)],
+                                [rows, others])
         n = len(cursor)
         bad = cursor.geom < -1
         if bad.any():
@@ -774,15 +778,7 @@ class Executor(FaceOperations):
         axis = self.flat_axis(cursor)[parent]
         turn = (axis >= 0) & (axis != 2) & (shapes.geom > -2) & ~is_mesh(shapes.geom)
         turn &= (shapes.size <= TOL.zero).sum(axis=1) == 1
-        if not turn.any():
-            return shapes
-        rows = np.flatnonzero(turn)
-        sub = shapes.take(rows)
-        new_axes = np.einsum("nij,njk->nik", NORMAL_OUT[axis[rows]], self.chunk.frames[sub.frame])
-        turned = self.reframed(sub, new_axes, symbol, span)
-        others = np.flatnonzero(~turn)
-        return Shapes.concat([shapes.take(others), turned]).take(
-            np.argsort(np.concatenate([others, rows]), kind="stable"))
+        return self.turned(shapes, turn, NORMAL_OUT, axis, symbol, span)
 
     def comp_faces(self, op: ir.CompFaces, cursor: Shapes, symbol: int) -> None:
         """CityEngine ``comp(f|e|v)``: components to the first selector they match."""

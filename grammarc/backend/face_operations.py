@@ -126,8 +126,7 @@ class FaceOperations:
         grouped = replace(grouped, source=np.searchsorted(rows, grouped.source))
         meshes = mesh_shapes.piece_meshes(self.chunk, cursor.take(rows), grouped)
         meshes = replace(meshes, key=child_keys(meshes.key, 0, np.zeros(len(rows), dtype=np.int64)))
-        row = np.concatenate([pieces.source[~mine], rows])
-        return Shapes.concat([single, meshes]).take(np.argsort(row, kind="stable"))
+        return Shapes.merge([single, meshes], [pieces.source[~mine], rows])
 
     def setback(self, op: ir.Setback, cursor: Shapes, symbol: int) -> None:
         """``setback`` and ``shapeL/U/O``: the face's edge strips and its remainder to their parts."""

@@ -64,6 +64,12 @@ class Shapes:
         return replace(self, origin=origin, size=size, frame=frame, geom=geom)
 
     @staticmethod
+    def merge(batches: list[Shapes], rows: list[np.ndarray]) -> Shapes:
+        """Batches whose shapes stand for ``rows`` (one index array per batch) together in row order:
+        the batch an operation treated in parts, whole again."""
+        return Shapes.concat(batches).take(np.argsort(np.concatenate(rows), kind="stable"))
+
+    @staticmethod
     def concat(batches: list[Shapes]) -> Shapes:
         if len(batches) == 1:
             return batches[0]
