@@ -52,10 +52,11 @@ def emit_instances(chunk: Chunk, shapes: Shapes, asset: int, symbol: int, mirror
             xform[:, :, 3] += xform[:, :, axis]
             xform[:, :, axis] *= -1
     if chunk.trim_slot is not None:
-        cut = _crossing_trim_planes(chunk, shapes, xform)
+        planes = _trim_planes(chunk, shapes)
+        cut = _crossing(planes, xform)
         mesh = chunk.asset_mesh(asset) if cut.any() else None
         if mesh is not None:
-            chunk.outputs.meshes.append(_trimmed(chunk, shapes.take(cut), xform[cut], mesh, symbol))
+            chunk.outputs.meshes.append(_trimmed(chunk, shapes.take(cut), xform[cut], planes[cut], mesh, symbol))
             shapes, xform = shapes.take(~cut), xform[~cut]
     _append(chunk, shapes, xform, asset, symbol)
 
@@ -69,12 +70,11 @@ def _trim_planes(chunk: Chunk, shapes: Shapes) -> np.ndarray:
     return planes
 
 
-def _crossing_trim_planes(chunk: Chunk, shapes: Shapes, xform: np.ndarray) -> np.ndarray:
-    """Which placed boxes reach past one of their shape's trim planes (those are cut, not instanced)."""
-    planes = _trim_planes(chunk, shapes)
+def _crossing(planes: np.ndarray, xform: np.ndarray) -> np.ndarray:
+    """Which placed boxes reach past one of their trim planes (n, 8) (those are cut, not instanced)."""
     corners = np.array([[i & 1, i >> 1 & 1, i >> 2 & 1] for i in range(8)], dtype=np.float64)
     points = np.einsum("nij,cj->nci", xform[:, :, :3].astype(np.float64), corners) + xform[:, None, :, 3]
-    cut = np.zeros(len(shapes), dtype=bool)
+    cut = np.zeros(len(planes), dtype=bool)
     for p in range(2):
         plane = planes[:, 4 * p:4 * p + 4]
         side = np.einsum("nci,ni->nc", points, np.nan_to_num(plane[:, :3])) + np.nan_to_num(plane[:, 3:4])
@@ -82,10 +82,10 @@ def _crossing_trim_planes(chunk: Chunk, shapes: Shapes, xform: np.ndarray) -> np
     return cut
 
 
-def _trimmed(chunk: Chunk, shapes: Shapes, xform: np.ndarray, mesh, symbol: int) -> MeshChunk:
-    """The asset's triangles placed by ``xform`` and cut by the shapes' trim planes, as mesh faces."""
+def _trimmed(chunk: Chunk, shapes: Shapes, xform: np.ndarray, planes: np.ndarray, mesh, symbol: int) -> MeshChunk:
+    """The asset's triangles placed by ``xform`` and cut by the shapes' trim ``planes``, as mesh faces."""
     vertices, ring_offsets, owner = trim_triangles(mesh.vertices, mesh.faces, xform.astype(np.float64),
-                                                   _trim_planes(chunk, shapes), TOL.zero)
+                                                   planes, TOL.zero)
     return MeshChunk(
         vertices=vertices.astype(np.float32), ring_offsets=ring_offsets,
         face_offsets=np.arange(len(owner) + 1, dtype=np.int64), lot=shapes.lot[owner].astype(np.int32),
