@@ -56,7 +56,8 @@ def emit_instances(chunk: Chunk, shapes: Shapes, asset: int, symbol: int, mirror
         cut = _crossing(planes, xform)
         mesh = chunk.asset_mesh(asset) if cut.any() else None
         if mesh is not None:
-            chunk.outputs.meshes.append(_trimmed(chunk, shapes.take(cut), xform[cut], planes[cut], mesh, symbol))
+            trimmed = _trimmed(chunk, shapes.take(cut), xform[cut], planes[cut], mesh, symbol)
+            chunk.outputs.meshes.append(trimmed)
             shapes, xform = shapes.take(~cut), xform[~cut]
     _append(chunk, shapes, xform, asset, symbol)
 
@@ -82,7 +83,8 @@ def _crossing(planes: np.ndarray, xform: np.ndarray) -> np.ndarray:
     return cut
 
 
-def _trimmed(chunk: Chunk, shapes: Shapes, xform: np.ndarray, planes: np.ndarray, mesh, symbol: int) -> MeshChunk:
+def _trimmed(chunk: Chunk, shapes: Shapes, xform: np.ndarray, planes: np.ndarray, mesh,
+             symbol: int) -> MeshChunk:
     """The asset's triangles placed by ``xform`` and cut by the shapes' trim ``planes``, as mesh faces."""
     vertices, ring_offsets, owner = trim_triangles(mesh.vertices, mesh.faces, xform.astype(np.float64),
                                                    planes, TOL.zero)
