@@ -245,12 +245,8 @@ class Lowering(LoweringBase):
 
     def symbol(self, meta, name):
         text, span = str(name), self.token_span(name)
-        if text == "NIL":
-            return ir.Empty(span)
-        if text == "primitiveCube":
-            return ir.UseAsset("builtin:cube", span)
-        if text == "convexify":  # operations without arguments may drop their parentheses
-            return ir.Convexify(None, span)
+        if text in _BARE_OPS:
+            return _OPS[text](self, text, (), span)
         if text in NOT_APPLIED:
             return ir.NotApplied(text, span)
         if text in UNSUPPORTED_OPS:
@@ -760,6 +756,8 @@ _OPS = {
 #: The optional arguments after a roof's value (roofGable's ``index`` only by angle).
 _ROOF_ARGUMENTS = {"roofHip": ("overhang", "even"), "roofGable": ("overhangX", "overhangY", "even"),
                    "roofShed": ("index",), "roofPyramid": ()}
+#: Operations CityEngine also takes without their parentheses (other bare names are rules).
+_BARE_OPS = frozenset({"NIL", "primitiveCube", "convexify"})
 _SPLIT_OPS = frozenset({"split", "comp"})
 _COMP_SELECTORS = {
     "f": ir.FACE_SELECTORS | ir.OFFSET_SELECTORS
