@@ -159,14 +159,15 @@ def mesh_components(chunk: Chunk, shapes: Shapes, kind: int):
 
 def clip_meshes(chunk: Chunk, shapes: Shapes, parent: np.ndarray, axis: int, pos: np.ndarray,
                 length: np.ndarray):
-    """Split children of (convex) mesh shapes: each child's copy of its parent's mesh cut to its slab
+    """Split children of (convex) mesh shapes: its parent's mesh cut to each child's slab
     [pos, pos + length] along ``axis`` and closed (``meshes.clip_slabs``). Returns the children's new
     geometry codes (m,), their boxes' low corners and extents (m, 3) in the parents' scopes, and which
     children have any mesh left (m,)."""
+    parents, child_mesh = np.unique(parent, return_inverse=True)  # each parent's mesh gathered once
     verts, ring_offsets, face_offsets, mesh_offsets, _ = face_vertices(
-        chunk.meshes, shapes.geom[parent] - MESH_BASE, shapes.size[parent])
+        chunk.meshes, shapes.geom[parents] - MESH_BASE, shapes.size[parents])
     verts, ring_offsets, face_offsets, mesh_offsets = clip_slabs(
-        verts, ring_offsets, face_offsets, mesh_offsets, np.arange(len(parent)), axis, pos, pos + length,
+        verts, ring_offsets, face_offsets, mesh_offsets, child_mesh.reshape(-1), axis, pos, pos + length,
         TOL.zero)
     geom, low, extent = store_fitted(chunk, verts, ring_offsets, face_offsets, mesh_offsets)
     return geom, low, extent, np.diff(mesh_offsets) > 0
