@@ -30,7 +30,7 @@ from grammarc.constants import TOL, Limits
 from grammarc.errors import ChunkTooLarge, LimitError, LotFailure
 from grammarc.geometry import components as comp_kernels
 from grammarc.geometry.clip import clip_to_slabs
-from grammarc.geometry.meshes import MESH_BASE, is_convex, is_mesh, is_polygon
+from grammarc.geometry.meshes import is_mesh, is_polygon
 from grammarc.geometry.reframe import NORMAL_OUT, NORMAL_UP, reframe
 from grammarc.geometry.trim import side_face_planes
 from grammarc.ir import nodes as ir
@@ -344,15 +344,14 @@ class Executor(FaceOperations):
         """``clip`` for the children of mesh shapes: each gets its parent's mesh cut to its slab, a child
         whose slab misses the mesh goes. Returns the children and their geometry (as ``clip``'s)."""
         mesh_rows = np.flatnonzero(is_mesh(shapes.geom[parent]))
-        parents = np.unique(parent[mesh_rows])
-        convex = is_convex(self.chunk.meshes, shapes.geom[parents] - MESH_BASE, shapes.size[parents])
-        if not convex.all():
+        concave, cut = mesh_shapes.clip_meshes(self.chunk, shapes, parent[mesh_rows], axis, pos[mesh_rows],
+                                               length[mesh_rows])
+        if len(concave):
             bad = np.zeros(len(shapes), dtype=bool)
-            bad[parents[~convex]] = True
+            bad[concave] = True
             self.fail(shapes, bad, "`split` of a concave mesh (a roof over a concave footprint) is not "
                       "supported yet (split its faces after comp(f))", symbol, span)
-        geom, low, extent, keep = mesh_shapes.clip_meshes(self.chunk, shapes, parent[mesh_rows], axis,
-                                                          pos[mesh_rows], length[mesh_rows])
+        geom, low, extent, keep = cut
         n = len(parent)
         kept = np.ones(n, dtype=bool)
         kept[mesh_rows[~keep]] = False

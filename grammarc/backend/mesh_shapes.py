@@ -15,7 +15,7 @@ from grammarc.backend.chunk import Chunk
 from grammarc.backend.shapes import Shapes
 from grammarc.constants import STRICT, TOL
 from grammarc.geometry.clip import oriented_rings
-from grammarc.geometry.meshes import MESH_BASE, clip_slabs, face_frames, face_vertices, mesh_edges
+from grammarc.geometry.meshes import MESH_BASE, clip_slabs, face_frames, face_vertices, is_convex, mesh_edges
 from grammarc.geometry.polygons import PLANE_U, PLANE_V
 from grammarc.geometry.reframe import NORMAL_UP
 from grammarc.geometry.roofs import ROOF_KINDS, roof_meshes
@@ -159,18 +159,21 @@ def mesh_components(chunk: Chunk, shapes: Shapes, kind: int):
 
 def clip_meshes(chunk: Chunk, shapes: Shapes, parent: np.ndarray, axis: int, pos: np.ndarray,
                 length: np.ndarray):
-    """Split children of (convex) mesh shapes: its parent's mesh cut to each child's slab
-    [pos, pos + length] along ``axis`` and closed (``meshes.clip_slabs``). Returns the children's new
-    geometry codes (m,), their boxes' low corners and extents (m, 3) in the parents' scopes, and which
-    children have any mesh left (m,)."""
+    """Split children of convex mesh shapes, each its parent's mesh cut to its slab [pos, pos + length]
+    along ``axis`` and closed (``meshes.clip_slabs``). Returns the parents that are not convex (their cut
+    faces would be wrong; then nothing else) and the children's new geometry codes (m,), their boxes' low
+    corners and extents (m, 3) in the parents' scopes, and which children have any mesh left (m,)."""
     parents, child_mesh = np.unique(parent, return_inverse=True)  # each parent's mesh gathered once
     verts, ring_offsets, face_offsets, mesh_offsets, _ = face_vertices(
         chunk.meshes, shapes.geom[parents] - MESH_BASE, shapes.size[parents])
+    concave = parents[~is_convex(verts, ring_offsets, face_offsets, mesh_offsets)]
+    if len(concave):
+        return concave, None
     verts, ring_offsets, face_offsets, mesh_offsets = clip_slabs(
         verts, ring_offsets, face_offsets, mesh_offsets, child_mesh.reshape(-1), axis, pos, pos + length,
         TOL.zero)
     geom, low, extent = store_fitted(chunk, verts, ring_offsets, face_offsets, mesh_offsets)
-    return geom, low, extent, np.diff(mesh_offsets) > 0
+    return concave, (geom, low, extent, np.diff(mesh_offsets) > 0)
 
 
 def reframe_meshes(chunk: Chunk, shapes: Shapes, new_axes: np.ndarray) -> Shapes:

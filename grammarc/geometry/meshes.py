@@ -206,10 +206,9 @@ def mesh_edges(verts, ring_offsets, face_offsets, mesh_offsets, eps: float):
     return mesh[edge], start, axes, size, kind
 
 
-def is_convex(store: MeshStore, ids: np.ndarray, size: np.ndarray) -> np.ndarray:
-    """Whether each mesh (scaled by its scope size (k, 3)) is convex: all its vertices lie behind the
-    plane of every one of its faces."""
-    verts, ring_offsets, face_offsets, mesh_offsets, _ = face_vertices(store, ids, size)
+def is_convex(verts, ring_offsets, face_offsets, mesh_offsets) -> np.ndarray:
+    """Whether each mesh (gathered, in its scope's units: ``face_vertices``) is convex: all its vertices
+    lie behind the plane of every one of its faces."""
     scale = max(float(np.abs(verts).max(initial=0.0)), 1.0)
     return _convex(verts, ring_offsets, face_offsets, mesh_offsets, scale)
 
