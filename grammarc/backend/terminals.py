@@ -25,7 +25,7 @@ from grammarc.backend.shapes import Shapes, asset_of
 from grammarc.constants import TOL
 from grammarc.geometry.components import reverse_rings
 from grammarc.geometry.meshes import is_mesh, is_polygon
-from grammarc.geometry.polygons import PLANE_AXES
+from grammarc.geometry.polygons import PLANE_U, PLANE_V
 from grammarc.geometry.trim import trim_triangles
 from grammarc.io.npz import MeshChunk
 from grammarc.ragged import offsets_from_counts, segment_of
@@ -148,8 +148,7 @@ def polygon_meshes(chunk: Chunk, shapes: Shapes, symbol: int) -> MeshChunk:
     """Faces of polygon shapes in world coordinates: the polygon, or a prism's bottom, top and sides."""
     coords, ring_offsets, poly_offsets = chunk.polygons.gather(shapes.geom)
     plane = chunk.polygons.plane[shapes.geom]
-    a_axis = np.array([PLANE_AXES[p][0] for p in range(3)])[plane]
-    b_axis = np.array([PLANE_AXES[p][1] for p in range(3)])[plane]
+    a_axis, b_axis = PLANE_U[plane], PLANE_V[plane]
     rows = np.arange(len(shapes))
     axes = chunk.frames[shapes.frame]
     height = shapes.size[rows, plane]

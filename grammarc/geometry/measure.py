@@ -12,7 +12,7 @@ import numpy as np
 from grammarc.constants import TOL
 from grammarc.geometry import meshes as mesh_store
 from grammarc.geometry.meshes import MESH_BASE, MeshStore, is_mesh, is_polygon
-from grammarc.geometry.polygons import PLANE_AXES, PolygonStore
+from grammarc.geometry.polygons import PLANE_U, PLANE_V, PolygonStore
 from grammarc.ragged import segment_of, segment_reduce
 
 
@@ -31,8 +31,7 @@ def area_and_volume(size: np.ndarray, geom: np.ndarray, store: PolygonStore,
         ids = geom[poly]
         coords, ring_offsets, poly_offsets = store.gather(ids)
         plane = store.plane[ids]
-        a_axis = np.array([PLANE_AXES[p][0] for p in range(3)])[plane]
-        b_axis = np.array([PLANE_AXES[p][1] for p in range(3)])[plane]
+        a_axis, b_axis = PLANE_U[plane], PLANE_V[plane]
         sa, sb, h = size[poly, a_axis], size[poly, b_axis], size[poly, plane]
         vertex_ring = segment_of(ring_offsets)
         vertex_poly = segment_of(poly_offsets)[vertex_ring]
@@ -66,8 +65,7 @@ def is_rectangular(size: np.ndarray, geom: np.ndarray, store: PolygonStore, degr
     ids = geom[poly]
     coords, ring_offsets, poly_offsets = store.gather(ids)
     plane = store.plane[ids]
-    a_axis = np.array([PLANE_AXES[p][0] for p in range(3)])[plane]
-    b_axis = np.array([PLANE_AXES[p][1] for p in range(3)])[plane]
+    a_axis, b_axis = PLANE_U[plane], PLANE_V[plane]
     vertex_ring = segment_of(ring_offsets)
     vertex_poly = segment_of(poly_offsets)[vertex_ring]
     at = np.arange(len(coords))

@@ -13,7 +13,7 @@ from __future__ import annotations
 import numpy as np
 
 from grammarc.constants import TOL
-from grammarc.geometry.polygons import PLANE_AXES
+from grammarc.geometry.polygons import PLANE_U, PLANE_V
 from grammarc.ragged import segment_of, segment_reduce
 
 #: Per normal axis n: new scope axes, as rows in the old frame, that put y along axis n and keep x where
@@ -31,10 +31,6 @@ NORMAL_OUT = np.array([
     [[1, 0, 0], [0, 1, 0], [0, 0, 1]],   # n = z: unchanged
 ], dtype=np.float64)
 
-_A = np.array([PLANE_AXES[p][0] for p in range(3)])
-_B = np.array([PLANE_AXES[p][1] for p in range(3)])
-
-
 def reframe(origin, size, axes, coords, ring_offsets, shape_offsets, plane, new_axes):
     """Scopes of the same polygons in new axes.
 
@@ -46,7 +42,7 @@ def reframe(origin, size, axes, coords, ring_offsets, shape_offsets, plane, new_
     """
     n = len(plane)
     rows = np.arange(n)
-    a, b = _A[plane], _B[plane]
+    a, b = PLANE_U[plane], PLANE_V[plane]
     normal_old = axes[rows, plane]
     alignment = np.einsum("nj,nkj->nk", normal_old, new_axes)
     new_plane = np.argmax(alignment, axis=1)
@@ -61,7 +57,7 @@ def reframe(origin, size, axes, coords, ring_offsets, shape_offsets, plane, new_
     low = segment_reduce(np.minimum, local, vertex_offsets, 0.0)
     high = segment_reduce(np.maximum, local, vertex_offsets, 0.0)
     plane = new_plane
-    a, b = _A[plane], _B[plane]
+    a, b = PLANE_U[plane], PLANE_V[plane]
     new_size = high - low
     new_size[rows, plane] = height
     shift = low.copy()
