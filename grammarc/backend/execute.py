@@ -31,6 +31,7 @@ from grammarc.errors import ChunkTooLarge, LimitError, LotFailure
 from grammarc.geometry import components as comp_kernels
 from grammarc.geometry.clip import clip_to_slabs
 from grammarc.geometry.meshes import is_mesh, is_polygon
+from grammarc.geometry.polygons import PLANE_U, PLANE_V
 from grammarc.geometry.reframe import NORMAL_OUT, NORMAL_UP, reframe
 from grammarc.geometry.trim import side_face_planes
 from grammarc.ir import nodes as ir
@@ -639,8 +640,7 @@ class Executor(FaceOperations):
         count = ring_offsets[shape_offsets[:-1] + 1] - start
         j = start + np.mod(edge, count)
         k = start + np.mod(edge + 1, count)
-        a = np.where(plane == 0, 1, 0)  # the plane's in-plane axes (polygons.PLANE_AXES)
-        b = np.where(plane == 2, 1, 2)
+        a, b = PLANE_U[plane], PLANE_V[plane]
 
         def world(v):
             return ((coords[v, 0] * cursor.size[rows, a])[:, None] * axes[rows, a]
