@@ -24,7 +24,7 @@ from grammarc.geometry import components as comp_kernels
 from grammarc.geometry.clip import fit_pieces, scope_polygons
 from grammarc.geometry.convexify import convex_parts
 from grammarc.geometry.inner_rectangle import largest_rectangles
-from grammarc.geometry.polygons import PLANE_U, PLANE_V
+from grammarc.geometry.polygons import plane_to_scope
 from grammarc.geometry.setback import polygon_edges, setback_regions
 from grammarc.ir import nodes as ir
 from grammarc.ragged import ragged_take, rank_within
@@ -133,10 +133,7 @@ class FaceOperations:
         polygons, plane = self.face_polygons(cursor, "setback", symbol, op.span)
         edges = polygon_edges(polygons)
         m = len(cursor)
-        normal = np.zeros((len(edges.poly), 3))
-        rows = np.arange(len(edges.poly))
-        normal[rows, PLANE_U[plane[edges.poly]]] = -edges.inward[:, 0]
-        normal[rows, PLANE_V[plane[edges.poly]]] = -edges.inward[:, 1]
+        normal = plane_to_scope(-edges.inward, plane[edges.poly])
         frames = self.selector_frames(normal, cursor, edges.poly, (*op.selectors, *(s for s, _ in op.distances)))
         # distances per face, or per edge (setback(comp(fe){...}): each edge is comp.index of comp.total)
         if op.per_edge:

@@ -16,7 +16,7 @@ from grammarc.backend.shapes import Shapes
 from grammarc.constants import STRICT, TOL
 from grammarc.geometry.clip import oriented_rings
 from grammarc.geometry.meshes import MESH_BASE, clip_slabs, face_frames, face_vertices, is_convex, mesh_edges
-from grammarc.geometry.polygons import PLANE_U, PLANE_V
+from grammarc.geometry.polygons import PLANE_U, PLANE_V, plane_to_scope
 from grammarc.geometry.reframe import NORMAL_UP
 from grammarc.geometry.roofs import ROOF_KINDS, roof_meshes
 from grammarc.io.npz import MeshChunk
@@ -53,11 +53,7 @@ def build_roofs(chunk: Chunk, shapes: Shapes, kind: str, polygons, value, by_hei
         np.full(len(shapes), np.inf) if cap is None else np.asarray(cap, dtype=np.float64))
     vertex_shape = segment_of(meshes)[segment_of(faces)[segment_of(rings)]]
     vplane = plane[vertex_shape].astype(np.int64)
-    local = np.zeros((len(verts), 3))
-    at = np.arange(len(verts))
-    local[at, PLANE_U[vplane]] = verts[:, 0]
-    local[at, PLANE_V[vplane]] = verts[:, 1]
-    local[at, vplane] = verts[:, 2]
+    local = plane_to_scope(verts[:, :2], vplane, verts[:, 2])
     turn = NORMAL_UP[plane.astype(np.int64)]
     roofed = local
     for p in np.unique(plane):  # three frames at most: one matrix product each
@@ -88,10 +84,7 @@ def flat_meshes(chunk: Chunk, shapes: Shapes, parts: np.ndarray, source: np.ndar
     _, coords, ring_offsets, face_offsets = oriented_rings(parts, part_plane)
     vertex_part = segment_of(face_offsets)[segment_of(ring_offsets)]
     owner = source[vertex_part]
-    local = np.zeros((len(coords), 3))
-    at = np.arange(len(coords))
-    local[at, PLANE_U[part_plane[vertex_part]]] = coords[:, 0]
-    local[at, PLANE_V[part_plane[vertex_part]]] = coords[:, 1]
+    local = plane_to_scope(coords, part_plane[vertex_part])
     size = np.where(shapes.size > TOL.zero, shapes.size, np.inf)
     mesh_offsets = np.r_[0, np.cumsum(np.bincount(source, minlength=len(shapes))[several])]
     ids = chunk.meshes.add(local / size[owner], ring_offsets, face_offsets, mesh_offsets)

@@ -27,6 +27,18 @@ PLANE_U = np.array([PLANE_AXES[p][0] for p in range(3)])
 PLANE_V = np.array([PLANE_AXES[p][1] for p in range(3)])
 
 
+def plane_to_scope(uv: np.ndarray, plane: np.ndarray, height: np.ndarray | None = None) -> np.ndarray:
+    """Points (k, 3) in scope axes from in-plane coordinates ``uv`` (k, 2) of the planes ``plane`` (k,)
+    and, if given, their ``height`` (k,) along each plane's normal axis (0 otherwise)."""
+    out = np.zeros((len(uv), 3))
+    at = np.arange(len(uv))
+    out[at, PLANE_U[plane]] = uv[:, 0]
+    out[at, PLANE_V[plane]] = uv[:, 1]
+    if height is not None:
+        out[at, plane] = height
+    return out
+
+
 class PolygonStore:
     """Append-only ragged storage of normalized polygons for one chunk of lots."""
 

@@ -1,11 +1,12 @@
-"""PolygonStore (grammarc.geometry.polygons): add then gather gives the polygons back, in any order."""
+"""PolygonStore (grammarc.geometry.polygons): add then gather gives the polygons back, in any order;
+plane_to_scope places in-plane coordinates on the scope axes."""
 
 from __future__ import annotations
 
 import numpy as np
 import pytest
 
-from grammarc.geometry.polygons import PolygonStore
+from grammarc.geometry.polygons import PolygonStore, plane_to_scope
 
 
 def random_polygons(rng, k):
@@ -93,3 +94,10 @@ def test_gather_accepts_int32_ids():
     polygons = random_polygons(np.random.default_rng(0), 3)
     ids = store.add(*ragged(polygons), np.ones(3, np.int8))
     assert_same(unpack(*store.gather(ids[::-1])), polygons[::-1])
+
+
+def test_plane_to_scope_puts_uv_on_each_planes_axes_and_height_on_its_normal():
+    uv = np.array([[1.0, 2.0], [3.0, 4.0], [5.0, 6.0]])
+    plane = np.array([0, 1, 2])
+    assert np.array_equal(plane_to_scope(uv, plane), [[0, 1, 2], [3, 0, 4], [5, 6, 0]])
+    assert np.array_equal(plane_to_scope(uv, plane, np.array([7.0, 8.0, 9.0])), [[7, 1, 2], [3, 8, 4], [5, 6, 9]])
