@@ -86,7 +86,8 @@ def build(grammar_path, output, *, lots_path=None, options: BuildOptions = Build
     """
     started = time.perf_counter()
     with grammar_source(Path(grammar_path), options) as (source, display, resolved):
-        return _build(source, display, Path(grammar_path), output, lots_path, resolved, progress, started)
+        return _build(source, display, Path(grammar_path), output, lots_path, resolved, progress, started,
+                      recorded_roots=options.asset_roots)
 
 
 @contextmanager
@@ -108,7 +109,7 @@ def grammar_source(path: Path, options: BuildOptions):
 
 
 def _build(source: Path, display: str | None, grammar_path: Path, output, lots_path,
-           options: BuildOptions, progress, started: float) -> BuildResult:
+           options: BuildOptions, progress, started: float, recorded_roots: tuple[Path, ...]) -> BuildResult:
     grammar = compile_grammar(source, start=options.start, asset_roots=options.asset_roots,
                               dialect=options.dialect, display=display)
     plan = make_plan(grammar)
@@ -125,8 +126,9 @@ def _build(source: Path, display: str | None, grammar_path: Path, output, lots_p
         "attrs": {k: v for k, v in sorted(options.attrs.items())},
         "lots_source": lots.source,
         "dialect": grammar.module.dialect,
-        # where the record's assets are (baking, conformance); a package's are temporary
-        "asset_roots": [str(r) for r in options.asset_roots],
+        # the user's asset folders (baking); a package's own are left out: extracted to a fresh temporary
+        # folder for this build only, their names would make each run's record differ
+        "asset_roots": [str(r) for r in recorded_roots],
         # operations accepted without effect on the record (material, texture, UV, print)
         "not_applied": list(plan.not_applied),
     }

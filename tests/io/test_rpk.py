@@ -132,3 +132,14 @@ def test_errors(tmp_path, monkeypatch):
     monkeypatch.setitem(sys.modules, "py7zr", None)  # import py7zr now raises ImportError
     with pytest.raises(UsageError, match=r"grammarc\[rpk\]"):
         open_rpk(tmp_path / "text.rpk")
+
+
+@needs_kit
+def test_a_package_builds_to_the_same_bytes_each_time(tmp_path):
+    """The package is extracted to a new temporary folder each run; the record must not name it."""
+    from grammarc.build import build
+
+    outputs = [tmp_path / f"run{k}.npz" for k in range(2)]
+    for out in outputs:
+        build(KIT / "rpk" / "complexpatterns.rpk", out)
+    assert outputs[0].read_bytes() == outputs[1].read_bytes()
