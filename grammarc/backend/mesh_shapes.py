@@ -2,9 +2,10 @@
 faces and edges, and emitted as leaves.
 
 A roof is a mesh (``geometry.meshes``) built over a face's polygon by ``geometry.roofs``. Its scope
-follows CityEngine: x kept, y along the face's normal, z = x cross y, and the box fitted to the mesh
-(an overhang widens it and moves its origin below the eaves). For the usual footprint (normal along
-scope y) the frame stays; a face from a component split (normal along z) turns about x.
+keeps the face's axes, the box fitted to the mesh (an overhang widens it and moves its origin below the
+eaves): the roof rises along the face's normal axis, y for a footprint, z for a face from a component
+split. PRT keeps them so: candler's ``envelope`` on a comp(f) face then splits along the face's
+in-plane y (``scope.sy``), not along the envelope's height.
 """
 
 from __future__ import annotations
@@ -17,7 +18,6 @@ from grammarc.constants import STRICT, TOL
 from grammarc.geometry.clip import oriented_rings
 from grammarc.geometry.meshes import MESH_BASE, clip_slabs, face_frames, face_vertices, is_convex, mesh_edges
 from grammarc.geometry.polygons import PLANE_U, PLANE_V, plane_to_scope
-from grammarc.geometry.reframe import NORMAL_UP
 from grammarc.geometry.roofs import ROOF_KINDS, roof_meshes
 from grammarc.io.npz import MeshChunk
 from grammarc.ragged import ragged_take, rank_within, segment_of, segment_reduce
@@ -53,22 +53,10 @@ def build_roofs(chunk: Chunk, shapes: Shapes, kind: str, polygons, value, by_hei
         np.full(len(shapes), np.inf) if cap is None else np.asarray(cap, dtype=np.float64))
     vertex_shape = segment_of(meshes)[segment_of(faces)[segment_of(rings)]]
     vplane = plane[vertex_shape].astype(np.int64)
-    local = plane_to_scope(verts[:, :2], vplane, verts[:, 2])
-    turn = NORMAL_UP[plane.astype(np.int64)]
-    roofed = local
-    for p in np.unique(plane):  # three frames at most: one matrix product each
-        if p != 1:
-            sel = vplane == p
-            roofed[sel] = local[sel] @ NORMAL_UP[p].T
+    roofed = plane_to_scope(verts[:, :2], vplane, verts[:, 2])
     geom, low, size = store_fitted(chunk, roofed, rings, faces, meshes)
-    parent_axes = chunk.frames[shapes.frame]
-    axes = np.einsum("nij,njk->nik", turn, parent_axes)
-    frame = shapes.frame.copy()
-    turned = plane != 1
-    if turned.any():
-        frame[turned] = chunk.frames.add(axes[turned])
-    origin = shapes.origin + np.einsum("ni,nij->nj", low, axes)
-    return shapes.with_scope(origin, size, frame, geom), ~ok
+    origin = shapes.origin + np.einsum("ni,nij->nj", low, chunk.frames[shapes.frame])
+    return shapes.with_scope(origin, size, shapes.frame, geom), ~ok
 
 
 def flat_meshes(chunk: Chunk, shapes: Shapes, parts: np.ndarray, source: np.ndarray, plane: np.ndarray) -> Shapes:

@@ -3,7 +3,7 @@
 Layouts are computed by hand from the kernel's rule (its docstring): fixed parts and floating parts outside
 groups keep their written sizes while the groups share what is left in proportion to one repetition's
 size; a group with floating parts repeats round(share / repetition) times (at least once when there is
-room), a group of fixed sizes floor(share / repetition) times with the rest of its share left empty; then
+room and no floating part outside the groups), a group of fixed sizes floor(share / repetition) times with the rest of its share left empty; then
 one factor scales every floating size so that the parts fill the extent. A plain Python reference of the
 same rule checks random batches.
 """
@@ -123,6 +123,15 @@ def test_floating_repeat_group_without_room_makes_nothing():
     assert_layout(layout(8.5, [8, "~3"], groups=[-1, 0]), [(0, 8), (1, 0.5)])
 
 
+def test_floating_repeat_group_may_vanish_beside_a_floating_part():
+    # candler's Windows(1): { ~w : Window | 0.25 : Wall }* | ~w : Window on an extent of w is one window
+    # (PRT), the floating part outside the group taking the room
+    assert_layout(layout(1.2, ["~1.2", 0.25, "~1.2"], groups=[0, 0, -1]), [(2, 0, 1.2)])
+    # with room for it, the group repeats: two windows and the divider
+    assert_layout(layout(2.15, ["~1.075", 0.25, "~1.075"], groups=[0, 0, -1]),
+                  [(0, 0, 0.95), (1, 0.95, 0.25), (2, 1.2, 0.95)])
+
+
 def test_absolute_repeat_group_floors_and_leaves_the_rest_empty():
     # { 3 }* on 10: three parts, one metre empty at the end
     assert_layout(layout(10, [3], groups=[0]), [(0, 3)] * 3)
@@ -222,6 +231,7 @@ def reference(extent, values, kind, group, n_groups, tol):
         nominal = [sum(s for s, g in zip(size, group) if g == gi) for gi in range(n_groups)]
         room = e - fixed
         avail = max(room - floating, 0.0)
+        loose = floating
         reps, gaps = [0] * n_groups, [0.0] * n_groups
         for gi in range(n_groups):
             if nominal[gi] <= tol:
@@ -230,7 +240,7 @@ def reference(extent, values, kind, group, n_groups, tol):
             has_float = any(k == FLT for k, g in zip(kind, group) if g == gi)
             if has_float:
                 reps[gi] = int(np.floor(share / nominal[gi] + 0.5))
-                if reps[gi] == 0 and room > tol:
+                if reps[gi] == 0 and room > tol and loose <= 0.0:
                     reps[gi] = 1
             else:
                 reps[gi] = int(np.floor(share / nominal[gi] + 1e-9))

@@ -32,13 +32,15 @@ def test_roof_on_a_footprint_keeps_x_puts_y_up_and_fits_the_mesh(write):
     np.testing.assert_allclose(x[:, 3], [0, 0, -8], atol=1e-6)
 
 
-def test_roof_on_the_top_face_of_a_mass_sits_on_it(write):
+def test_roof_on_the_top_face_of_a_mass_sits_on_it_and_keeps_the_face_axes(write):
     text = ("Lot --> extrude(10) comp(f){ top : Top | all : NIL }\n"
             "Top --> roofGable(30) Roof\nRoof --> primitiveCube()\n")
     [x] = run(write, text, [rect(12, 8)])["xform"]
-    # the top face's normal is world +y: the roof's y; its x stays along the lot's x
-    np.testing.assert_allclose(x[:, 1], [0, 4 * TAN30, 0], atol=1e-6)
-    np.testing.assert_allclose(x[:, 0] / np.linalg.norm(x[:, 0]), [1, 0, 0], atol=1e-9)
+    # the top face's scope: x along the lot's x, y across it, z its normal (world +y); the roof keeps
+    # them, as PRT keeps an envelope's, and rises along z
+    np.testing.assert_allclose(x[:, 0], [12, 0, 0], atol=1e-6)
+    np.testing.assert_allclose(np.abs(x[:, 1]), [0, 0, 8], atol=1e-6)
+    np.testing.assert_allclose(x[:, 2], [0, 4 * TAN30, 0], atol=1e-6)
     assert x[1, 3] == pytest.approx(10.0)
 
 

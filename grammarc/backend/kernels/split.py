@@ -126,8 +126,9 @@ def group_split(extent, values, kind, group, n_groups, tol):
 
     The rule (grammarc's reading of CityEngine's): what the fixed parts and the floating parts outside
     groups leave at their written sizes is shared by the groups in proportion to one repetition's size.
-    A group with floating parts repeats round(share / repetition) times (at least once when there is
-    room); a group of fixed sizes floor(share / repetition) times, the rest of its share left empty at
+    A group with floating parts repeats round(share / repetition) times, at least once when there is
+    room and no floating part outside the groups to fill it (PRT's ``{ ~w: A | d: B }* | ~w: A`` on an
+    extent of w gives one A, not two); a group of fixed sizes floor(share / repetition) times, the rest of its share left empty at
     its end. Then every floating size, in groups or not, is scaled by one factor so that the parts fill
     the extent. Parts are laid end to end; parts beyond the extent are dropped, the last one cut; parts
     of length <= tol are dropped.
@@ -166,6 +167,7 @@ def group_split(extent, values, kind, group, n_groups, tol):
                     group_fixed[g] += size
         room = extent[i] - fixed
         avail = room - floating
+        loose = floating
         all_nominal = 0.0
         for g in range(n_groups):
             all_nominal += nominal[g]
@@ -175,7 +177,7 @@ def group_split(extent, values, kind, group, n_groups, tol):
             share = max(avail, 0.0) * nominal[g] / all_nominal
             if group_float[g] > 0.0:
                 r = int(np.floor(share / nominal[g] + 0.5))
-                if r == 0 and room > tol:
+                if r == 0 and room > tol and loose <= 0.0:
                     r = 1
             else:
                 r = int(np.floor(share / nominal[g] + 1e-9))
