@@ -795,7 +795,8 @@ class Executor(FaceOperations):
             shapes = self.face_scopes(shapes, cursor, parent, symbol, op.span)
         if op.kind == "f" and self.chunk.trim_slot is not None:
             # the faces' trim planes where they meet their neighbours (``geometry.trim``)
-            planes = side_face_planes(self.chunk.frames[shapes.frame], shapes.origin, shapes.size, parent)
+            up = self.chunk.frames[cursor.frame[parent]][:, 1]
+            planes = side_face_planes(self.chunk.frames[shapes.frame], shapes.origin, shapes.size, parent, up)
             slot = self.chunk.trim_slot
             dynamic = list(shapes.dynamic)
             dynamic[slot:slot + 8] = list(planes.T)

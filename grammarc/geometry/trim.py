@@ -1,10 +1,12 @@
 """CityEngine's trim planes: where a component split's neighbouring faces meet, inserted geometry is cut.
 
-A comp(f) gives each side face (one whose edges to its neighbours are steeper than 40 degrees) a plane at
-each of those edges, bisecting the angle between the two faces; geometry inserted under that face keeps
+A comp(f) gives each side face (one whose edges to its neighbours are steeper than 40 degrees to the x-z
+plane of the split shape's scope) a plane at each of those edges, bisecting the angle between the two faces; geometry inserted under that face keeps
 the side of both planes the face is on, so ledges and cornices enlarged to run past a corner meet their
 neighbours in a mitre. Horizontal trim planes (CityEngine's ``trim.horizontal``, off by default) are not
-made. ``side_face_planes`` finds the planes of many faces at once; ``trim_triangles`` cuts the triangles
+made. CityEngine measures the 40 degrees from the x-z plane of the pivot; grammarc measures them from the
+split shape's scope, which is the same for the solids of a footprint (y up) and, as PRT does, trims a
+pipe extruded sideways from a wall (candler's VerticalPipes) at its four corners. ``side_face_planes`` finds the planes of many faces at once; ``trim_triangles`` cuts the triangles
 of many placed assets by them (numba).
 """
 
@@ -19,19 +21,20 @@ from grammarc.ragged import row_groups
 VERTICAL_DEGREES = 40.0
 
 
-def side_face_planes(axes: np.ndarray, origin: np.ndarray, size: np.ndarray, parent: np.ndarray) -> np.ndarray:
+def side_face_planes(axes: np.ndarray, origin: np.ndarray, size: np.ndarray, parent: np.ndarray,
+                     up: np.ndarray) -> np.ndarray:
     """Trim planes (m, 8) of component faces: (nx, ny, nz, d) at the face's start edge, then at its end
     edge, keeping n . X + d >= 0; NaN where a face has no such neighbour or its edges are not steep.
 
     axes (m, 3, 3) world rows (x along the face's bottom edge, y up its side), origin (m, 3) the start of
     the bottom edge, size (m, 3), parent (m,): faces of one parent meet where one's end is the next's
-    start."""
+    start; up (m, 3) the split shape's scope y axis in world coordinates."""
     m = len(parent)
     out = np.full((m, 8), np.nan)
     if not m:
         return out
     x, y = axes[:, 0], axes[:, 1]
-    steep = (np.abs(y[:, 1]) >= np.sin(np.radians(VERTICAL_DEGREES))) & (size[:, 0] > 0) & (size[:, 1] > 0)
+    steep = (np.abs(np.einsum("ij,ij->i", y, up)) >= np.sin(np.radians(VERTICAL_DEGREES))) & (size[:, 0] > 0) & (size[:, 1] > 0)
     start = origin
     end = origin + size[:, 0:1] * x
     scale = max(float(np.abs(origin).max()), 1.0) * 1e-7

@@ -2,8 +2,8 @@
 
 Layouts are computed by hand from the kernel's rule (its docstring): fixed parts and floating parts outside
 groups keep their written sizes while the groups share what is left in proportion to one repetition's
-size; a group with floating parts repeats round(share / repetition) times (at least once when there is
-room and no floating part outside the groups), a group of fixed sizes floor(share / repetition) times with the rest of its share left empty; then
+size, in order, each from what the earlier ones left; a group with floating parts repeats round(share /
+repetition) times (at least once when room is left and no floating part outside the groups), a group of fixed sizes floor(share / repetition) times with the rest of its share left empty; then
 one factor scales every floating size so that the parts fill the extent. A plain Python reference of the
 same rule checks random batches.
 """
@@ -109,9 +109,10 @@ def test_floating_sizes_vanish_when_the_fixed_parts_fill_the_extent():
 # ------------------------------------------------------------------------------------------ repeat groups
 
 
-@pytest.mark.parametrize("extent, reps", [(10, 3), (11, 4), (9, 3), (4.4, 1), (1, 1)])
+@pytest.mark.parametrize("extent, reps", [(10, 3), (11, 4), (9, 3), (4.4, 2), (4.2, 1), (7.3, 2), (7.4, 3), (1, 1)])
 def test_floating_repeat_group_rounds_and_fills(extent, reps):
-    """{ ~3 : A }*: round(extent / 3) repetitions (at least one), stretched to fill the extent."""
+    """{ ~3 : A }*: the count whose stretch is nearest 1 as a ratio (at least one), stretched to fill
+    the extent: 4.4 m is 1.47 repetitions, nearer 2 (x 0.73) than 1 (x 1.47)."""
     got = layout(extent, ["~3"], groups=[0])
     assert_layout(got, [(0, extent / reps)] * reps)
 
@@ -130,6 +131,16 @@ def test_floating_repeat_group_may_vanish_beside_a_floating_part():
     # with room for it, the group repeats: two windows and the divider
     assert_layout(layout(2.15, ["~1.075", 0.25, "~1.075"], groups=[0, 0, -1]),
                   [(0, 0, 0.95), (1, 0.95, 0.25), (2, 1.2, 0.95)])
+
+
+def test_floating_repeat_groups_take_their_shares_in_order():
+    # candler's wide floor, 1 | 3.55 | {~3.55}* | 3.55 | {~3.55}* | 3.55 | 1, as PRT lays it: on 15 m
+    # one repetition, in the first group (six windows a floor on the triangle's front); on 20 m one in
+    # each; on 30 m two, then three from the 10.25 m the first left
+    parts, groups = [1, 3.55, "~3.55", 3.55, "~3.55", 3.55, 1], [-1, -1, 0, -1, 1, -1, -1]
+    assert [p for p, *_ in layout(15, parts, groups=groups)] == [0, 1, 2, 3, 5, 6]
+    assert [p for p, *_ in layout(20, parts, groups=groups)] == [0, 1, 2, 3, 4, 5, 6]
+    assert [p for p, *_ in layout(30, parts, groups=groups)] == [0, 1, 2, 2, 3, 4, 4, 4, 5, 6]
 
 
 def test_absolute_repeat_group_floors_and_leaves_the_rest_empty():
@@ -159,20 +170,6 @@ def test_floating_parts_outside_a_group_keep_their_written_size_for_the_count():
 def test_relative_sizes_inside_a_group_are_fixed():
     # { '0.1 }* on 10: ten parts of 1
     assert_layout(layout(10, ["'0.1"], groups=[0]), [(0, 1)] * 10)
-
-
-def test_candler_floor_two_groups_share_the_rest():
-    """candler's Floor: 1 | 3.55 | {~3.55}* | 3.55 | {~3.55}* | 3.55 | 1 on 30 m.
-
-    Fixed 12.65; the groups share 17.35 equally, 8.675 each: round(8.675 / 3.55) = 2 repetitions each;
-    four floating parts fill the 17.35, 4.3375 each.
-    """
-    sizes = [1, 3.55, "~3.55", 3.55, "~3.55", 3.55, 1]
-    groups = [-1, -1, 0, -1, 1, -1, -1]
-    w = 17.35 / 4
-    got = layout(30, sizes, groups=groups)
-    assert_layout(got, [(0, 1), (1, 3.55), (2, w), (2, w), (3, 3.55), (4, w), (4, w), (5, 3.55), (6, 1)])
-    assert got[-1][1] + got[-1][2] == pytest.approx(30)
 
 
 def test_whole_split_repeat_is_one_group():
@@ -220,6 +217,18 @@ def test_values_per_shape_are_read_per_row():
     np.testing.assert_array_equal(index, [0, 1, 0, 1])
 
 
+def stretch_nearest_one(share, nominal, g_fixed, g_float, loose, tol):
+    """The repetition count whose stretch is nearest 1 as a ratio, by search: the group's own
+    (share / (n nominal)) from one repetition up; below one repetition, with floating parts outside
+    the groups, that of all floating parts with and without the repetition."""
+    if share <= tol:
+        return 0
+    if share < nominal and loose > 0:
+        stretch = [(share + loose) / loose, max(share + loose - g_fixed, tol) / (loose + g_float)]
+        return min((0, 1), key=lambda n: abs(np.log(stretch[n])))
+    return min(range(1, int(share / nominal) + 3), key=lambda n: abs(np.log(share / (n * nominal))))
+
+
 def reference(extent, values, kind, group, n_groups, tol):
     """The docstring's rule in plain Python, one shape at a time."""
     out = []
@@ -236,16 +245,16 @@ def reference(extent, values, kind, group, n_groups, tol):
         for gi in range(n_groups):
             if nominal[gi] <= tol:
                 continue
-            share = avail * nominal[gi] / sum(nominal)
-            has_float = any(k == FLT for k, g in zip(kind, group) if g == gi)
-            if has_float:
-                reps[gi] = int(np.floor(share / nominal[gi] + 0.5))
-                if reps[gi] == 0 and room > tol and loose <= 0.0:
-                    reps[gi] = 1
+            share = avail * nominal[gi] / sum(nominal[gi:])
+            members = [(s, k) for s, k, g in zip(size, kind, group) if g == gi]
+            g_float = sum(s for s, k in members if k == FLT)
+            if g_float > 0:
+                reps[gi] = stretch_nearest_one(share, nominal[gi], nominal[gi] - g_float, g_float, loose, tol)
+                avail = max(avail - reps[gi] * nominal[gi], 0.0)
             else:
                 reps[gi] = int(np.floor(share / nominal[gi] + 1e-9))
                 gaps[gi] = share - reps[gi] * nominal[gi]
-            members = [(s, k) for s, k, g in zip(size, kind, group) if g == gi]
+                avail -= share
             fixed += reps[gi] * sum(s for s, k in members if k != FLT) + gaps[gi]
             floating += reps[gi] * sum(s for s, k in members if k == FLT)
         scale = max(e - fixed, 0.0) / floating if floating > 0 else 1.0

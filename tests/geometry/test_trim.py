@@ -9,6 +9,8 @@ import pytest
 from grammarc.geometry.trim import side_face_planes, trim_triangles
 from grammarc.io.bake import builtin_mesh
 
+UP = np.tile([0.0, 1.0, 0.0], (4, 1))  # the split solid's scope y: world up
+
 
 def box_sides(width=10.0, depth=6.0, height=3.0):
     """The four side faces of a width x depth box, counter-clockwise seen from above (x east, y up):
@@ -27,7 +29,7 @@ def box_sides(width=10.0, depth=6.0, height=3.0):
 
 def test_side_faces_of_a_box_meet_in_45_degree_planes():
     axes, origin, size = box_sides()
-    planes = side_face_planes(axes, origin, size, np.zeros(4, dtype=np.int64))
+    planes = side_face_planes(axes, origin, size, np.zeros(4, dtype=np.int64), UP)
     assert not np.isnan(planes).any()
     # face 0 runs east along z = 0; its start plane bisects the corner with face 3 (running south to
     # north along x = 0): points of face 0 are kept, points of face 3 beyond the corner are not
@@ -41,17 +43,27 @@ def test_faces_without_a_steep_neighbour_have_no_planes():
     axes, origin, size = box_sides()
     lying = axes.copy()
     lying[:, 1] = [0, 0, 1]  # "up" along the ground: the shared edges are horizontal
-    planes = side_face_planes(lying, origin, size, np.zeros(4, dtype=np.int64))
+    planes = side_face_planes(lying, origin, size, np.zeros(4, dtype=np.int64), UP)
     assert np.isnan(planes).all()
-    planes = side_face_planes(axes[:2], origin[:2], size[:2], np.zeros(2, dtype=np.int64))
+    planes = side_face_planes(axes[:2], origin[:2], size[:2], np.zeros(2, dtype=np.int64), UP[:2])
     assert np.isnan(planes[0, :4]).all() and not np.isnan(planes[0, 4:]).any()  # only 0 -> 1 meet
+
+
+def test_steepness_is_measured_from_the_split_shapes_scope():
+    """A box extruded sideways (its scope y along world x, as candler's pipes off a wall): the edges
+    along that y are its side faces' vertical edges, and they get planes."""
+    axes, origin, size = box_sides()
+    sideways = axes.copy()
+    sideways[:, 1] = [0, 0, 1]
+    planes = side_face_planes(sideways, origin, size, np.zeros(4, dtype=np.int64), np.tile([0.0, 0, 1], (4, 1)))
+    assert not np.isnan(planes).any()
 
 
 def test_a_ledge_past_the_corner_is_cut_along_the_mitre():
     """A 12 m ledge centred on a 10 m facade, 1 m deep: cut at both 45-degree corner planes its top is a
     trapezoid of 10 and 12 m sides (the 1 m it sticks out beyond the facade is mitred)."""
     axes, origin, size = box_sides()
-    planes = side_face_planes(axes, origin, size, np.zeros(4, dtype=np.int64))[:1]
+    planes = side_face_planes(axes, origin, size, np.zeros(4, dtype=np.int64), UP)[:1]
     cube = builtin_mesh("builtin:cube")
     xform = np.array([[[12.0, 0, 0, -1.0], [0, 0.5, 0, 2.0], [0, 0, 1.0, 0.0]]])  # x -1..11, z 0..1
     vertices, rings, owner = trim_triangles(cube.vertices, cube.faces, xform, planes, 1e-12)

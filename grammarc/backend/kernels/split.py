@@ -124,14 +124,17 @@ def group_split(extent, values, kind, group, n_groups, tol):
     0 absolute, 1 relative (a fraction of the extent), 2 floating (``~``); group : (P,) int64 the repeat
     group of each part, -1 for none; n_groups : int.
 
-    The rule (grammarc's reading of CityEngine's): what the fixed parts and the floating parts outside
-    groups leave at their written sizes is shared by the groups in proportion to one repetition's size.
-    A group with floating parts repeats round(share / repetition) times, at least once when there is
-    room and no floating part outside the groups to fill it (PRT's ``{ ~w: A | d: B }* | ~w: A`` on an
-    extent of w gives one A, not two); a group of fixed sizes floor(share / repetition) times, the rest of its share left empty at
-    its end. Then every floating size, in groups or not, is scaled by one factor so that the parts fill
-    the extent. Parts are laid end to end; parts beyond the extent are dropped, the last one cut; parts
-    of length <= tol are dropped.
+    The rule (grammarc's reading of CityEngine's, fitted to PRT): what the fixed parts and the floating
+    parts outside groups leave at their written sizes goes to the groups in order, each taking a share
+    of what the earlier ones left in proportion to its repetition's size among the groups still to
+    come. A group with floating parts repeats as often as stretches it least as a ratio
+    (``_repetitions``) and uses that many repetitions' room. PRT lays candler's
+    ``1 | 3.55 | {~3.55}* | 3.55 | {~3.55}* | 3.55 | 1`` with 2 then 3 repetitions on 30 m, 2 and 2 on
+    25 m, 1 and 1 on 20 m, 1 then 0 on 15 m, and ``{ ~w: A | d: B }* | ~w: A`` on an extent of w as one
+    A. A group of fixed sizes repeats floor(share / repetition) times, the rest of its share left empty
+    at its end. Then every floating size, in groups or not, is scaled by one factor so that the parts
+    fill the extent. Parts are laid end to end; parts beyond the extent are dropped, the last one cut;
+    parts of length <= tol are dropped.
 
     Returns parent, part (index into the P parts), position, length (m,) and index (m,) int64, the
     child's number within its parent.
@@ -168,20 +171,23 @@ def group_split(extent, values, kind, group, n_groups, tol):
         room = extent[i] - fixed
         avail = room - floating
         loose = floating
-        all_nominal = 0.0
+        # the groups in order, each sharing what the earlier ones left with the later ones
+        left = max(avail, 0.0)
+        later = 0.0
         for g in range(n_groups):
-            all_nominal += nominal[g]
+            later += nominal[g]
         for g in range(n_groups):
             if nominal[g] <= tol:
                 continue
-            share = max(avail, 0.0) * nominal[g] / all_nominal
+            share = left * nominal[g] / later
+            later -= nominal[g]
             if group_float[g] > 0.0:
-                r = int(np.floor(share / nominal[g] + 0.5))
-                if r == 0 and room > tol and loose <= 0.0:
-                    r = 1
+                r = _repetitions(share, nominal[g], group_fixed[g], group_float[g], loose, tol)
+                left = max(left - r * nominal[g], 0.0)
             else:
                 r = int(np.floor(share / nominal[g] + 1e-9))
                 gap[i, g] = share - r * nominal[g]
+                left -= share
             reps[i, g] = r
             fixed += r * group_fixed[g] + gap[i, g]
             floating += r * group_float[g]
@@ -220,6 +226,25 @@ def group_split(extent, values, kind, group, n_groups, tol):
             at += gap[i, g]
             j = end
     return parent[:m], part[:m], pos[:m], length[:m], index[:m]
+
+
+@njit(cache=True)
+def _repetitions(share, nominal, fixed, floating, loose, tol):
+    """How often a group with floating parts repeats in ``share``: the count whose stretch (share over
+    the repetitions' nominal size) is nearest 1 as a ratio, so 1.74 rounds to 2 and 2.44 to 2
+    (sqrt(2) and sqrt(6) are the thresholds). Below one repetition the group repeats once, unless
+    floating parts outside the groups (``loose``, their nominal size) stretch less without it."""
+    x = share / nominal
+    if x >= 1.0:
+        r = int(np.floor(x))
+        return r + 1 if x * x > r * (r + 1) else r
+    if share <= tol:
+        return 0
+    if loose <= 0.0:
+        return 1
+    without = (share + loose) / loose
+    with_one = max(share + loose - fixed, tol) / (loose + floating)
+    return 1 if abs(np.log(with_one)) < abs(np.log(without)) else 0
 
 
 @njit(cache=True)
