@@ -199,10 +199,18 @@ def test_footprints_and_kit(tmp_path, monkeypatch):
 
 FOOTPRINTS = ["rect_30x20", "rect_12x8", "L_30x20", "U_40x30", "courtyard_40x40", "rotated_25x15",
               "triangle", "octagon"]
-#: The issue's targets that grammarc meets: (rpk, footprints, attributes). The records of the other
-#: combinations need operations of the geometry issue (offset, setback, envelope, convexify) or PRT's own
-#: random numbers (extrusion_rule with its default random height, reporting).
+#: The records grammarc meets at the kit's tolerances: (rpk, footprints, attributes). The others need PRT's
+#: own random numbers (extrusion_rule with its default random height) or street selectors (reporting).
+#: candler's courtyard variant passes by a hair (0.9995 % of area): convexify parts the roof's ring
+#: differently from PRT (two roof accesses here, three there).
+CANDLER_VARIANT = {"BuildingHeight": 40, "FloorHeight": 3.2, "TileWidth": 3}
 PASSING = [
+    ("massing", FOOTPRINTS, {}),
+    ("candler", FOOTPRINTS, {}),
+    ("candler", FOOTPRINTS, CANDLER_VARIANT),
+    ("candler", ["rect_30x20"], {"BuildingHeight": 40}),
+    ("candler", ["rect_30x20"], {"FloorHeight": 3.2}),
+    ("candler", ["rect_30x20"], {"TileWidth": 3}),
     ("extrude_color", FOOTPRINTS, {}),
     ("genattrs", FOOTPRINTS, {}),
     ("translateModel", FOOTPRINTS, {}),
@@ -230,24 +238,3 @@ def test_unsupported_operations_are_named(reference):
 
     result = run_conformance(KIT / "rpk" / "reporting.rpk", "rect_30x20", reference=reference)
     assert not result.passed and "unsupported: " in result.error and "reporting_01.cga:" in result.error
-
-
-@needs_kit
-@pytest.mark.parametrize("footprint", ["rect_30x20", "rect_12x8", "L_30x20", "triangle", "rotated_25x15"])
-def test_massing_setbacks_per_edge_match_prt(reference, footprint):
-    """massing's default: offset, split, then tiers set back per edge by ``listItem(..., comp.index)``."""
-    from grammarc.conform import run_conformance
-
-    result = run_conformance(KIT / "rpk" / "massing.rpk", footprint, reference=reference)
-    assert result.passed, result.verdict
-
-
-@needs_kit
-@pytest.mark.parametrize("footprint", ["U_40x30", "courtyard_40x40"])
-def test_massing_on_concave_footprints_is_within_the_issue_tolerance(reference, footprint):
-    """Edge numbers after offset and split follow CityEngine's (``clip.ring_starts``): the tiers land where
-    PRT puts them (bbox within 2 cm, area within 1 %, issue 4), though not yet to the kit's 1e-4."""
-    from grammarc.conform import run_conformance
-
-    result = run_conformance(KIT / "rpk" / "massing.rpk", footprint, reference=reference)
-    assert result.verdict.bbox_deviation < 0.02 and result.verdict.area_rel_error < 0.01, result.verdict

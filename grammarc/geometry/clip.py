@@ -143,54 +143,78 @@ def fit_pieces(geometries: np.ndarray, plane: np.ndarray, size: np.ndarray,
 def ring_starts(coords, ring_offsets, ring_part, part_source, parent_coords, parent_rings, parent_offsets):
     """Each ring of each piece turned to start where CityEngine's clipping and offsets start it.
 
-    CityEngine keeps a polygon's vertex order through offsets (vertex i of the inset is the mitre of
-    vertex i) and clips it Sutherland-Hodgman fashion (the edges in order, from the one that arrives at
-    vertex 0; a crossing point before the vertex that ends its edge). So every piece vertex gets the
-    position along the parent's boundary of the nearest point on it: edge i (into vertex i, ring after
-    ring) plus the fraction along it, vertex 0 counting as the end of the last edge; each ring starts
-    at its smallest position. Returns the coords (V, 2) with every ring turned.
+    A ring a cut made starts with its cut edge (a chord: an edge between two boundary points of the
+    parent that runs inside it), at the point where the parent's boundary leaves the piece: PRT's half
+    of massing's octagon starts with its cut edge whichever vertex the octagon starts at. With several
+    chords, or none, CityEngine keeps a polygon's vertex order through offsets (vertex i of the inset
+    is the mitre of vertex i) and clips it Sutherland-Hodgman fashion (the edges in order, from the one
+    that arrives at vertex 0; a crossing point before the vertex that ends its edge). So every piece
+    vertex gets the position along the parent's boundary of the nearest point on it: edge i (into
+    vertex i, ring after ring) plus the fraction along it, vertex 0 counting as the end of the last
+    edge; the ring starts at the chord whose start has the smallest position, else at its smallest
+    position. Returns the coords (V, 2) with every ring turned.
     """
     out = np.empty_like(coords)
     for r in range(len(ring_offsets) - 1):
         r0, r1 = ring_offsets[r], ring_offsets[r + 1]
+        n = r1 - r0
         g = part_source[ring_part[r]]
-        best_key = np.inf
-        best = r0
-        for j in range(r0, r1):
-            px, py = coords[j, 0], coords[j, 1]
-            near, key = np.inf, np.inf          # the nearest boundary point's position
-            near_vertex, vertex_key = np.inf, np.inf  # the nearest vertex's position
-            scale = 0.0
-            base = 0
-            for q in range(parent_offsets[g], parent_offsets[g + 1]):
-                q0, q1 = parent_rings[q], parent_rings[q + 1]
-                m = q1 - q0
-                for i in range(m):  # edge i runs from vertex i - 1 into vertex i: positions base + [i, i + 1]
-                    ax, ay = parent_coords[q0 + (i - 1) % m, 0], parent_coords[q0 + (i - 1) % m, 1]
-                    bx, by = parent_coords[q0 + i, 0] - ax, parent_coords[q0 + i, 1] - ay
-                    length2 = bx * bx + by * by
-                    scale = max(scale, length2)
-                    f = 0.0 if length2 == 0.0 else min(max(((px - ax) * bx + (py - ay) * by) / length2, 0.0), 1.0)
-                    d = (px - ax - f * bx) ** 2 + (py - ay - f * by) ** 2
-                    position = base + i + f
-                    if i == 0 and f < 1e-9:
-                        position = base + m  # vertex 0's predecessor ends the last edge
-                    if d < near - 1e-18 or (d <= near + 1e-18 and position < key):
-                        near, key = d, position
-                    dv = (px - ax - bx) ** 2 + (py - ay - by) ** 2  # to vertex i
-                    if dv < near_vertex:
-                        near_vertex, vertex_key = dv, base + i + 1.0
-                base += m
+        keys = np.empty(n)
+        on = np.empty(n, np.bool_)
+        for j in range(n):
+            near, key, vertex_key, scale = _boundary_place(coords[r0 + j, 0], coords[r0 + j, 1], g,
+                                                           parent_coords, parent_rings, parent_offsets)
             # on the boundary (a cut's crossing, an unmoved vertex): its place there; moved in (an
             # offset's mitre): the place of the vertex it came from
+            on[j] = near <= 1e-12 * max(scale, 1.0)
+            keys[j] = key if on[j] else vertex_key
+        best = -1
+        for j in range(n):
+            k = (j + 1) % n
+            if not (on[j] and on[k]) or (best >= 0 and keys[j] >= keys[best]):
+                continue
+            near, _, _, scale = _boundary_place(0.5 * (coords[r0 + j, 0] + coords[r0 + k, 0]),
+                                                0.5 * (coords[r0 + j, 1] + coords[r0 + k, 1]), g,
+                                                parent_coords, parent_rings, parent_offsets)
             if near > 1e-12 * max(scale, 1.0):
-                key = vertex_key
-            if key < best_key:
-                best_key, best = key, j
-        for j in range(r0, r1):
-            k = r0 + (best - r0 + j - r0) % (r1 - r0)
-            out[j, 0], out[j, 1] = coords[k, 0], coords[k, 1]
+                best = j
+        if best < 0:
+            best = int(np.argmin(keys))
+        for j in range(n):
+            k = r0 + (best + j) % n
+            out[r0 + j, 0], out[r0 + j, 1] = coords[k, 0], coords[k, 1]
     return out
+
+
+@njit(cache=True)
+def _boundary_place(px, py, g, parent_coords, parent_rings, parent_offsets):
+    """The nearest point of polygon g's boundary to (px, py): its squared distance, its position (edge
+    i into vertex i, ring after ring, plus the fraction along it; vertex 0 ends the last edge), the
+    position of the nearest vertex, and the largest squared edge length (a scale for tolerances)."""
+    near, key = np.inf, np.inf
+    near_vertex, vertex_key = np.inf, np.inf
+    scale = 0.0
+    base = 0
+    for q in range(parent_offsets[g], parent_offsets[g + 1]):
+        q0, q1 = parent_rings[q], parent_rings[q + 1]
+        m = q1 - q0
+        for i in range(m):  # edge i runs from vertex i - 1 into vertex i: positions base + [i, i + 1]
+            ax, ay = parent_coords[q0 + (i - 1) % m, 0], parent_coords[q0 + (i - 1) % m, 1]
+            bx, by = parent_coords[q0 + i, 0] - ax, parent_coords[q0 + i, 1] - ay
+            length2 = bx * bx + by * by
+            scale = max(scale, length2)
+            f = 0.0 if length2 == 0.0 else min(max(((px - ax) * bx + (py - ay) * by) / length2, 0.0), 1.0)
+            d = (px - ax - f * bx) ** 2 + (py - ay - f * by) ** 2
+            position = base + i + f
+            if i == 0 and f < 1e-9:
+                position = base + m  # vertex 0's predecessor ends the last edge
+            if d < near - 1e-18 or (d <= near + 1e-18 and position < key):
+                near, key = d, position
+            dv = (px - ax - bx) ** 2 + (py - ay - by) ** 2  # to vertex i
+            if dv < near_vertex:
+                near_vertex, vertex_key = dv, base + i + 1.0
+        base += m
+    return near, key, vertex_key, scale
 
 
 def _polygons(coords: np.ndarray, ring_offsets: np.ndarray, poly_offsets: np.ndarray) -> np.ndarray:

@@ -22,6 +22,8 @@ from grammarc.ragged import offsets_from_counts, rank_within
 #: A mitre longer than this many setback distances (a near-reversal of the boundary) is cut to the
 #: edge's rectangle.
 _MITRE_LIMIT = 10.0
+#: The grid (scope units, metres) that setback regions are snapped to, collapsing zero-width spikes.
+_SNAP = 1e-9
 
 
 @dataclass(frozen=True)
@@ -73,10 +75,13 @@ def setback_regions(polygons: np.ndarray, edges: Edges, distance: np.ndarray, ow
     m = len(polygons)
     # a distance that is not a number (``float("")`` of a missing list item) moves nothing
     d = np.where((owner < n_owners) & np.isfinite(distance), np.maximum(distance, 0.0), 0.0)
-    corner = _mitres(edges, d)
+    corner, mitred = _mitres(edges, d)
+    # a strip ends at its next edge's mitre; where the two do not meet in one (a straight vertex, as
+    # between the collinear edges a setback leaves, or a spike), at its own moved end
+    end_corner = np.where(mitred[edges.next][:, None], corner[edges.next], edges.inward * d[:, None])
     moved = d > TOL.zero
     idx = np.flatnonzero(moved)
-    quads = np.stack([edges.start[idx], edges.end[idx], edges.end[idx] + corner[edges.next[idx]],
+    quads = np.stack([edges.start[idx], edges.end[idx], edges.end[idx] + end_corner[idx],
                       edges.start[idx] + corner[idx]], axis=1)
     strips = shapely.polygons(quads) if len(idx) else np.empty(0, dtype=object)
     folded = ~shapely.is_valid(strips)
@@ -90,13 +95,21 @@ def setback_regions(polygons: np.ndarray, edges: Edges, distance: np.ndarray, ow
     regions, covered = [], np.full(m, shapely.Polygon(), dtype=object)
     for k in range(n_owners):
         region = shapely.difference(shapely.intersection(polygons, united[k]), covered)
-        regions.append(region)
+        regions.append(_without_spikes(region))
         covered = shapely.union(covered, region)
-    return regions, shapely.difference(polygons, covered)
+    return regions, _without_spikes(shapely.difference(polygons, covered))
 
 
-def _mitres(edges: Edges, d: np.ndarray) -> np.ndarray:
-    """(E, 2): where the moved line of each edge meets its previous edge's, relative to the shared vertex."""
+def _without_spikes(geometries: np.ndarray) -> np.ndarray:
+    """Regions snapped to a nanometre grid. A strip whose side runs along an unmoved edge leaves the
+    difference a spike out along that edge, zero wide but for rounding (massing's half octagon): the
+    snap collapses it, moving the other vertices by half a nanometre at most."""
+    return shapely.set_precision(geometries, _SNAP)
+
+
+def _mitres(edges: Edges, d: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(E, 2): where the moved line of each edge meets its previous edge's, relative to the shared vertex
+    (the edge's own move where they do not meet near it), and (E,) whether they do."""
     a, b = edges.inward[edges.prev], edges.inward
     da, db = d[edges.prev], d
     det = a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0]
@@ -105,7 +118,7 @@ def _mitres(edges: Edges, d: np.ndarray) -> np.ndarray:
     straight = b * db[:, None]
     reach = np.hypot(corner[:, 0], corner[:, 1])
     too_far = (np.abs(det) <= 1e-9) | (reach > _MITRE_LIMIT * np.maximum(np.maximum(da, db), TOL.zero))
-    return np.where(too_far[:, None], straight, corner)
+    return np.where(too_far[:, None], straight, corner), ~too_far
 
 
 def _union_by_group(geometries: np.ndarray, group: np.ndarray, n_groups: int) -> np.ndarray:

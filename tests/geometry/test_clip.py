@@ -112,3 +112,19 @@ def test_pieces_start_where_cityengine_starts_them():
     cut = shapely.intersection(ordered, shapely.box(20, -1, 50, 40))
     np.testing.assert_allclose(first_vertex(fit_pieces(np.array([cut]), plane, size, np.array([ordered]))),
                                [20, 3])  # where the edge into vertex 0 crosses the cut
+
+
+def test_a_cut_piece_starts_with_its_cut_edge():
+    """PRT's half of massing's octagon starts with the cut edge, at the point where the octagon's
+    boundary leaves the half, though Sutherland-Hodgman from vertex 0 (in the other half) would
+    start at the point where it enters."""
+    import shapely
+
+    from grammarc.geometry.clip import fit_pieces
+
+    a, b = 11.08655439, 4.592201188
+    octagon = shapely.Polygon([(-a, -b), (-a, b), (-b, a), (b, a), (a, b), (a, -b), (b, -a), (-b, -a)])
+    half = shapely.intersection(octagon, shapely.box(0, -20, 20, 20))
+    pieces = fit_pieces(np.array([half]), np.array([1]), np.array([[2 * a, 0.0, 2 * a]]), np.array([octagon]))
+    ring = pieces.coords[:6] * pieces.extent[0, [0, 2]] + pieces.low[0, [0, 2]]
+    np.testing.assert_allclose(ring[:3], [[0, -a], [0, a], [b, a]], atol=1e-9)

@@ -53,6 +53,32 @@ def test_moved_neighbours_share_their_corner_along_the_mitre():
     assert shapely.area(remainder[0]) == pytest.approx(20 * 10)
 
 
+def test_collinear_edges_with_different_distances_step_instead_of_slanting():
+    """A top edge in two collinear pieces set back 4 and 3 (as a second setback meets the edges a first
+    one left, massing's U): the remainder steps at the shared vertex, 10 x 6 + 10 x 7."""
+    polygon = shapely.Polygon([(0, 0), (20, 0), (20, 10), (10, 10), (0, 10)])
+    edges = polygon_edges(np.array([polygon]))
+    mid = (edges.start + edges.end) / 2
+    top = np.where(mid[:, 1] > 9, np.where(mid[:, 0] > 10, 4.0, 3.0), 0.0)
+    _, remainder = setback_regions(np.array([polygon]), edges, top, np.zeros(len(top), np.int64), 1)
+    expected = shapely.union(shapely.box(10, 0, 20, 6), shapely.box(0, 0, 10, 7))
+    assert shapely.area(remainder[0]) == pytest.approx(130)
+    assert shapely.area(shapely.symmetric_difference(remainder[0], expected)) == pytest.approx(0, abs=1e-9)
+
+
+def test_a_strip_along_an_unmoved_edge_leaves_no_spike():
+    """massing's half octagon (scope units, cut edge first) with distances 4;0;4;4;0: the remainder is
+    the thin quad between the moved edges, without a zero-wide spike out along the unmoved diagonal."""
+    half = shapely.from_wkt("POLYGON ((0 0, 16.17310878 0, 16.17310878 3.3495605008807163, 11.436114890880717 "
+                            "8.08655439, 4.736993889119285 8.08655439, 0 3.3495605008807154, 0 0))")
+    edges = polygon_edges(np.array([half]))
+    distance = np.array([4.0, 0.0, 4.0, 4.0, 0.0, np.nan])
+    _, remainder = setback_regions(np.array([half]), edges, distance, np.zeros(6, np.int64), 1)
+    low_x, low_y, high_x, high_y = shapely.bounds(remainder[0])
+    assert (low_x, low_y, high_x, high_y) == pytest.approx((0.6504395, 4.0, 9.865815, 4.0865544), abs=1e-6)
+    assert shapely.get_num_coordinates(remainder[0]) == 5
+
+
 def random_polygon(seed):
     rng = np.random.default_rng(seed)
     n = int(rng.integers(5, 14))
