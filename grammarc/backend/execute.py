@@ -300,7 +300,7 @@ class Executor(FaceOperations):
         """Children of polygons split across their plane become the pieces of the polygon in their slabs
         (``geometry.clip``): empty ones go, a slab that cuts the polygon apart gives one child a piece.
         Children of meshes (roofs, envelopes) become the mesh cut to their slab and closed
-        (``mesh_shapes.clip_meshes``; convex meshes only).
+        (``mesh_shapes.clip_meshes``).
 
         Takes and returns the split's children as (parent, step, pos, length, index) arrays, and the
         pieces' geometry for ``children`` (None when no child is a polygon split across its plane).
@@ -345,14 +345,8 @@ class Executor(FaceOperations):
         """``clip`` for the children of mesh shapes: each gets its parent's mesh cut to its slab, a child
         whose slab misses the mesh goes. Returns the children and their geometry (as ``clip``'s)."""
         mesh_rows = np.flatnonzero(is_mesh(shapes.geom[parent]))
-        concave, cut = mesh_shapes.clip_meshes(self.chunk, shapes, parent[mesh_rows], axis, pos[mesh_rows],
-                                               length[mesh_rows])
-        if len(concave):
-            bad = np.zeros(len(shapes), dtype=bool)
-            bad[concave] = True
-            self.fail(shapes, bad, "`split` of a concave mesh (a roof over a concave footprint) is not "
-                      "supported yet (split its faces after comp(f))", symbol, span)
-        geom, low, extent, keep = cut
+        geom, low, extent, keep = mesh_shapes.clip_meshes(self.chunk, shapes, parent[mesh_rows], axis,
+                                                          pos[mesh_rows], length[mesh_rows])
         n = len(parent)
         kept = np.ones(n, dtype=bool)
         kept[mesh_rows[~keep]] = False

@@ -19,6 +19,7 @@ from grammarc.geometry.clip import oriented_rings
 from grammarc.geometry.meshes import MESH_BASE, clip_slabs, face_frames, face_vertices, is_convex, mesh_edges
 from grammarc.geometry.polygons import PLANE_U, PLANE_V, plane_to_scope
 from grammarc.geometry.roofs import ROOF_KINDS, roof_meshes
+from grammarc.geometry.sections import append_caps, plane_segments, section_caps
 from grammarc.io.npz import MeshChunk
 from grammarc.ragged import ragged_take, rank_within, segment_of, segment_reduce
 
@@ -140,21 +141,25 @@ def mesh_components(chunk: Chunk, shapes: Shapes, kind: int):
 
 def clip_meshes(chunk: Chunk, shapes: Shapes, parent: np.ndarray, axis: int, pos: np.ndarray,
                 length: np.ndarray):
-    """Split children of convex mesh shapes, each its parent's mesh cut to its slab [pos, pos + length]
-    along ``axis`` and closed (``meshes.clip_slabs``). Returns the parents that are not convex (their cut
-    faces would be wrong; then nothing else) and the children's new geometry codes (m,), their boxes' low
-    corners and extents (m, 3) in the parents' scopes, and which children have any mesh left (m,)."""
+    """Split children of mesh shapes, each its parent's mesh cut to its slab [pos, pos + length] along
+    ``axis`` and closed: a convex mesh by the hull of its crossings (``meshes.clip_slabs``), any other
+    by its sections (``geometry.sections``). Returns the children's new geometry codes (m,), their
+    boxes' low corners and extents (m, 3) in the parents' scopes, and which children have any mesh
+    left (m,)."""
     parents, child_mesh = np.unique(parent, return_inverse=True)  # each parent's mesh gathered once
+    child_mesh = child_mesh.reshape(-1)
     verts, ring_offsets, face_offsets, mesh_offsets, _ = face_vertices(
         chunk.meshes, shapes.geom[parents] - MESH_BASE, shapes.size[parents])
-    concave = parents[~is_convex(verts, ring_offsets, face_offsets, mesh_offsets)]
-    if len(concave):
-        return concave, None
-    verts, ring_offsets, face_offsets, mesh_offsets = clip_slabs(
-        verts, ring_offsets, face_offsets, mesh_offsets, child_mesh.reshape(-1), axis, pos, pos + length,
-        TOL.zero)
-    geom, low, extent = store_fitted(chunk, verts, ring_offsets, face_offsets, mesh_offsets)
-    return concave, (geom, low, extent, np.diff(mesh_offsets) > 0)
+    hull = is_convex(verts, ring_offsets, face_offsets, mesh_offsets)[child_mesh]
+    hi = pos + length
+    cut = clip_slabs(verts, ring_offsets, face_offsets, mesh_offsets, child_mesh, axis, pos, hi, hull, TOL.zero)
+    if not hull.all():
+        ends, cap = plane_segments(verts, ring_offsets, face_offsets, mesh_offsets, child_mesh,
+                                   np.flatnonzero(~hull), axis, pos, hi)
+        parts, which = section_caps(ends, cap, axis)
+        cut = append_caps(*cut, parts, which, axis, pos, hi)
+    geom, low, extent = store_fitted(chunk, *cut)
+    return geom, low, extent, np.diff(cut[3]) > 0
 
 
 def reframe_meshes(chunk: Chunk, shapes: Shapes, new_axes: np.ndarray) -> Shapes:

@@ -240,12 +240,14 @@ def _convex(verts, ring_offsets, face_offsets, mesh_offsets, scale):
 
 
 @njit(cache=True)
-def clip_slabs(verts, ring_offsets, face_offsets, mesh_offsets, child_mesh, axis, lo, hi, eps):
-    """Convex meshes cut to slabs ``lo <= coordinate[axis] <= hi`` and closed by their cut faces.
+def clip_slabs(verts, ring_offsets, face_offsets, mesh_offsets, child_mesh, axis, lo, hi, convex, eps):
+    """Meshes cut to slabs ``lo <= coordinate[axis] <= hi``, convex ones closed by their cut faces.
 
     verts (V, 3) in the parents' scope units; child_mesh (m,) the mesh each slab cuts. Every face ring
-    is clipped to the slab (Sutherland-Hodgman, both planes); the points where faces cross a plane make
-    that plane's cap, their convex hull (the meshes are convex), facing out of the slab.
+    is clipped to the slab (Sutherland-Hodgman, both planes; a concave face cut apart stays one ring,
+    joined along the plane). Where ``convex[c]`` the points where faces cross a
+    plane make that plane's cap, their convex hull, facing out of the slab; other slabs are left open
+    for ``sections`` to close.
     Returns verts (V', 3), ring_offsets, face_offsets, mesh_offsets (m+1,): an empty mesh for a slab
     the mesh does not reach.
     """
@@ -314,7 +316,7 @@ def clip_slabs(verts, ring_offsets, face_offsets, mesh_offsets, child_mesh, axis
                 out_f[n_f] = n_r
         any_face = n_f > out_m[c]
         for side in range(2):
-            if not any_face or n_cap[side] < 3 or closed[side]:
+            if not convex[c] or not any_face or n_cap[side] < 3 or closed[side]:
                 continue
             hull = _hull(caps[side, :n_cap[side]], a, b, eps)
             if len(hull) < 3:
