@@ -481,14 +481,14 @@ class Executor(FaceOperations):
         is_poly = is_polygon(shapes.geom)
         plane[is_poly] = polygons.plane[shapes.geom[is_poly]]
         if not is_poly.any():
-            coords = np.concatenate([comp_kernels.RECT_RINGS[p] for p in plane]) if n else np.empty((0, 2))
+            coords = comp_kernels.rect_rings(plane)
             return (coords, np.arange(0, 4 * n + 1, 4, dtype=np.int64), np.arange(n + 1, dtype=np.int64),
                     plane)
         # Mixed batch: give scope shapes a stored rectangle so one gather serves all.
         geom = shapes.geom.copy()
         rects = np.flatnonzero(~is_poly)
         if len(rects):
-            rect_coords = np.concatenate([comp_kernels.RECT_RINGS[p] for p in plane[rects]])
+            rect_coords = comp_kernels.rect_rings(plane[rects])
             geom[rects] = polygons.add(rect_coords, np.arange(0, 4 * len(rects) + 1, 4, dtype=np.int64),
                                        np.arange(len(rects) + 1, dtype=np.int64), plane[rects])
         coords, ring_offsets, shape_offsets = polygons.gather(geom)

@@ -83,7 +83,7 @@ class FaceOperations:
         rects = np.flatnonzero(geom < 0)
         if len(rects):
             plane = comp_kernels.rect_plane(cursor.size[rects], TOL.zero)
-            geom[rects] = store.add(np.concatenate([comp_kernels.RECT_RINGS[q] for q in plane]),
+            geom[rects] = store.add(comp_kernels.rect_rings(plane),
                                     np.arange(0, 4 * len(rects) + 1, 4, dtype=np.int64),
                                     np.arange(len(rects) + 1, dtype=np.int64), plane)
         return scope_polygons(store, geom, cursor.size), store.plane[geom]

@@ -26,7 +26,7 @@ from grammarc.constants import TOL
 from grammarc.geometry.components import reverse_rings
 from grammarc.geometry.meshes import is_mesh, is_polygon
 from grammarc.geometry.polygons import PLANE_U, PLANE_V
-from grammarc.geometry.trim import trim_triangles
+from grammarc.geometry.trim import boxes_crossing, trim_triangles
 from grammarc.io.npz import MeshChunk
 from grammarc.ragged import offsets_from_counts, segment_of
 
@@ -53,7 +53,7 @@ def emit_instances(chunk: Chunk, shapes: Shapes, asset: int, symbol: int, mirror
             xform[:, :, axis] *= -1
     if chunk.trim_slot is not None:
         planes = _trim_planes(chunk, shapes)
-        cut = _crossing(planes, xform)
+        cut = boxes_crossing(planes, xform.astype(np.float64), TOL.zero)
         mesh = chunk.asset_mesh(asset) if cut.any() else None
         if mesh is not None:
             trimmed = _trimmed(chunk, shapes.take(cut), xform[cut], planes[cut], mesh, symbol)
@@ -69,18 +69,6 @@ def _trim_planes(chunk: Chunk, shapes: Shapes) -> np.ndarray:
     if chunk.trim_switch is not None:
         planes[shapes.dynamic[chunk.trim_switch] == 0] = np.nan
     return planes
-
-
-def _crossing(planes: np.ndarray, xform: np.ndarray) -> np.ndarray:
-    """Which placed boxes reach past one of their trim planes (n, 8) (those are cut, not instanced)."""
-    corners = np.array([[i & 1, i >> 1 & 1, i >> 2 & 1] for i in range(8)], dtype=np.float64)
-    points = np.einsum("nij,cj->nci", xform[:, :, :3].astype(np.float64), corners) + xform[:, None, :, 3]
-    cut = np.zeros(len(planes), dtype=bool)
-    for p in range(2):
-        plane = planes[:, 4 * p:4 * p + 4]
-        side = np.einsum("nci,ni->nc", points, np.nan_to_num(plane[:, :3])) + np.nan_to_num(plane[:, 3:4])
-        cut |= ~np.isnan(plane[:, 0]) & (side < -TOL.zero).any(axis=1)
-    return cut
 
 
 def _trimmed(chunk: Chunk, shapes: Shapes, xform: np.ndarray, planes: np.ndarray, mesh,

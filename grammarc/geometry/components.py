@@ -211,11 +211,16 @@ def components(kind, coords, ring_offsets, shape_offsets, plane, size, tol):
 #: Implicit rectangles of shapes whose geometry is their scope, per plane code: counter-clockwise
 #: around the +normal axis, the first edge along the in-plane x (or y) axis. For a box (plane 1) the
 #: first side face is the one facing +z.
-RECT_RINGS = {
-    0: np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]]),
-    1: np.array([[0.0, 1.0], [1.0, 1.0], [1.0, 0.0], [0.0, 0.0]]),
-    2: np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]]),
-}
+RECT_RINGS = np.array([
+    [[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]],
+    [[0.0, 1.0], [1.0, 1.0], [1.0, 0.0], [0.0, 0.0]],
+    [[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]],
+])
+
+
+def rect_rings(plane: np.ndarray) -> np.ndarray:
+    """The implicit rectangles of shapes in planes ``plane`` (n,), one after another: (4 n, 2)."""
+    return RECT_RINGS[plane].reshape(-1, 2)
 
 
 def rect_plane(size: np.ndarray, tol: float) -> np.ndarray:

@@ -50,9 +50,10 @@ def reframe(origin, size, axes, coords, ring_offsets, shape_offsets, plane, new_
     height = size[rows, plane]
     vertex_shape = segment_of(shape_offsets)[segment_of(ring_offsets)]
     s = vertex_shape
-    world = ((coords[:, 0] * size[s, a[s]])[:, None] * axes[s, a[s]]
-             + (coords[:, 1] * size[s, b[s]])[:, None] * axes[s, b[s]])  # relative to the old origin
-    local = np.einsum("vj,vij->vi", world, new_axes[s])
+    # each shape's in-plane axes, scaled by its size, in the new axes: a vertex is u, v along them
+    along_u = np.einsum("nj,nij->ni", axes[rows, a] * size[rows, a, None], new_axes)
+    along_v = np.einsum("nj,nij->ni", axes[rows, b] * size[rows, b, None], new_axes)
+    local = coords[:, 0, None] * along_u[s] + coords[:, 1, None] * along_v[s]  # from the old origin
     vertex_offsets = ring_offsets[shape_offsets]
     low = segment_reduce(np.minimum, local, vertex_offsets, 0.0)
     high = segment_reduce(np.maximum, local, vertex_offsets, 0.0)

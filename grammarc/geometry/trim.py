@@ -62,6 +62,30 @@ def side_face_planes(axes: np.ndarray, origin: np.ndarray, size: np.ndarray, par
 
 
 @njit(cache=True)
+def boxes_crossing(planes, xform, eps):
+    """Which unit boxes placed by xform (k, 3, 4) reach past one of their planes (k, 8; NaN: none) by
+    more than eps: those are cut, the others stay instances."""
+    out = np.zeros(len(xform), np.bool_)
+    for k in range(len(xform)):
+        for p in range(2):
+            nx, ny, nz, d = planes[k, 4 * p], planes[k, 4 * p + 1], planes[k, 4 * p + 2], planes[k, 4 * p + 3]
+            if np.isnan(nx):
+                continue
+            for c in range(8):
+                fx, fy, fz = c & 1, c >> 1 & 1, c >> 2 & 1
+                side = d
+                for r in range(3):
+                    coord = xform[k, r, 0] * fx + xform[k, r, 1] * fy + xform[k, r, 2] * fz + xform[k, r, 3]
+                    side += coord * (nx if r == 0 else ny if r == 1 else nz)
+                if side < -eps:
+                    out[k] = True
+                    break
+            if out[k]:
+                break
+    return out
+
+
+@njit(cache=True)
 def trim_triangles(verts, tris, xform, planes, eps):
     """Triangles of an asset (verts (v, 3) in its unit box, tris (t, 3)) placed by xform (k, 3, 4) and
     cut by each placement's two planes (k, 8; NaN: none): the kept polygons in world coordinates.
