@@ -775,9 +775,8 @@ class Executor(FaceOperations):
 
     def comp_faces(self, op: ir.CompFaces, cursor: Shapes, symbol: int) -> None:
         """CityEngine ``comp(f|e|v)``: components to the first selector they match."""
-        if op.offset is not None or op.kind == "v":
-            self.refuse_meshes(op, cursor, symbol)
         if op.offset is not None:
+            self.refuse_meshes(op, cursor, symbol)
             self.offset_faces(op, cursor, symbol)
             return
         bad = cursor.geom < -1

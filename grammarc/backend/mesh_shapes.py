@@ -16,7 +16,15 @@ from grammarc.backend.chunk import Chunk
 from grammarc.backend.shapes import Shapes
 from grammarc.constants import STRICT, TOL
 from grammarc.geometry.clip import oriented_rings
-from grammarc.geometry.meshes import MESH_BASE, clip_slabs, face_frames, face_vertices, is_convex, mesh_edges
+from grammarc.geometry.meshes import (
+    MESH_BASE,
+    clip_slabs,
+    face_frames,
+    face_vertices,
+    is_convex,
+    mesh_corners,
+    mesh_edges,
+)
 from grammarc.geometry.polygons import PLANE_U, PLANE_V, plane_to_scope
 from grammarc.geometry.roofs import ROOF_KINDS, roof_meshes
 from grammarc.geometry.sections import append_caps, plane_segments, section_caps
@@ -110,9 +118,9 @@ def piece_meshes(chunk: Chunk, shapes: Shapes, pieces) -> Shapes:
                              (MESH_BASE + ids).astype(np.int32))
 
 
-#: Component kinds of roofs (``components.KIND_CODES``): faces and edges. The bottom is face 0.
-FACES, SIDEFACES, BOTTOM, EDGES, SIDEEDGES, TOPEDGES, BOTTOMEDGES = 0, 1, 3, 4, 5, 6, 7
-MESH_KINDS = frozenset({FACES, SIDEFACES, BOTTOM, EDGES, SIDEEDGES, TOPEDGES, BOTTOMEDGES})
+#: Component kinds of roofs (``components.KIND_CODES``): faces, edges, vertices. The bottom is face 0.
+FACES, SIDEFACES, BOTTOM, EDGES, SIDEEDGES, TOPEDGES, BOTTOMEDGES, VERTICES = 0, 1, 3, 4, 5, 6, 7, 8
+MESH_KINDS = frozenset({FACES, SIDEFACES, BOTTOM, EDGES, SIDEEDGES, TOPEDGES, BOTTOMEDGES, VERTICES})
 #: mesh_edges' edge kinds wanted by each edge component kind.
 _EDGE_KINDS = {EDGES: (0, 1, 2), BOTTOMEDGES: (0,), SIDEEDGES: (1,), TOPEDGES: (2,)}
 
@@ -120,9 +128,14 @@ _EDGE_KINDS = {EDGES: (0, 1, 2), BOTTOMEDGES: (0,), SIDEEDGES: (1,), TOPEDGES: (
 def mesh_components(chunk: Chunk, shapes: Shapes, kind: int):
     """Components of mesh shapes: parent (m,), index (m,) among the parent's components of this kind,
     origin (m, 3) and axes (m, 3, 3) in the parent's frame, size (m, 3), geom (m,): faces become
-    polygons (plane z) with CityEngine's face scopes, edges scope edges (``meshes.mesh_edges``)."""
+    polygons (plane z) with CityEngine's face scopes, edges scope edges (``meshes.mesh_edges``),
+    vertices points (``meshes.mesh_corners``)."""
     verts, ring_offsets, face_offsets, mesh_offsets, _ = face_vertices(
         chunk.meshes, shapes.geom - MESH_BASE, shapes.size)
+    if kind == VERTICES:
+        parent, origin, axes = mesh_corners(verts, ring_offsets, face_offsets, mesh_offsets, TOL.zero)
+        return (parent, rank_within(parent), origin, axes, np.zeros((len(parent), 3)),
+                np.full(len(parent), -1, dtype=np.int32))
     if kind in _EDGE_KINDS:
         parent, origin, axes, size, edge_kind = mesh_edges(verts, ring_offsets, face_offsets, mesh_offsets,
                                                            TOL.zero)

@@ -160,17 +160,8 @@ def mesh_edges(verts, ring_offsets, face_offsets, mesh_offsets, eps: float):
     footprint and the eaves), 1 for side edges (sloped: hips and valleys), 2 for top edges (horizontal
     above the base: ridges), each mesh's edges in the order they first appear in its faces.
     """
-    ring = segment_of(ring_offsets)
-    face = segment_of(face_offsets)[ring]
-    mesh = segment_of(mesh_offsets)[face]
-    at = np.arange(len(verts))
-    nxt = np.where(at + 1 < ring_offsets[1:][ring], at + 1, ring_offsets[:-1][ring])
+    face, mesh, nxt, face_normal = _ring_walk(verts, ring_offsets, face_offsets, mesh_offsets)
     p, q = verts, verts[nxt]
-    # each face's unit normal (Newell), for the edges' y axes
-    cross = np.cross(p, q)
-    face_normal = np.stack([segment_reduce(np.add, cross[:, j], ring_offsets[face_offsets], 0.0)
-                            for j in range(3)], 1)
-    face_normal /= np.maximum(np.linalg.norm(face_normal, axis=1, keepdims=True), 1e-300)
     # an undirected edge is its mesh and its endpoints in lexicographic order, on a grid of eps
     a, b = np.round(p / eps), np.round(q / eps)
     step = b - a
@@ -204,6 +195,45 @@ def mesh_edges(verts, ring_offsets, face_offsets, mesh_offsets, eps: float):
     low = np.maximum(start[:, 1], end[:, 1]) <= eps
     kind = np.where(~horizontal, 1, np.where(low, 0, 2))
     return mesh[edge], start, axes, size, kind
+
+
+def mesh_corners(verts, ring_offsets, face_offsets, mesh_offsets, eps: float):
+    """The distinct vertices of meshes (a vertex its faces share counts once), as ``comp(v)`` places
+    them: y the mean of the normals of the faces that meet there, x along the first edge that leaves
+    it (across y), size 0. Returns mesh (K,), origin (K, 3), axes (K, 3, 3), each mesh's vertices in
+    the order they first appear in its faces."""
+    face, mesh, nxt, face_normal = _ring_walk(verts, ring_offsets, face_offsets, mesh_offsets)
+    inverse, first = row_groups(np.column_stack([mesh, np.round(verts / eps)]).astype(np.int64))
+    order = np.argsort(first, kind="stable")
+    rank = np.empty(len(order), dtype=np.int64)
+    rank[order] = np.arange(len(order))
+    corner = first[order]
+    normal_sum = np.zeros((len(order), 3))
+    np.add.at(normal_sum, rank[inverse], face_normal[face])
+    y = normal_sum / np.maximum(np.linalg.norm(normal_sum, axis=1, keepdims=True), 1e-300)
+    x = verts[nxt[corner]] - verts[corner]
+    x -= np.einsum("ij,ij->i", x, y)[:, None] * y
+    norm = np.linalg.norm(x, axis=1)
+    fallback = np.where(np.abs(y[:, :1]) < 0.9, [[1.0, 0.0, 0.0]], [[0.0, 0.0, 1.0]])
+    fallback -= np.einsum("ij,ij->i", fallback, y)[:, None] * y
+    x = np.where((norm > 1e-9)[:, None], x, fallback)
+    x /= np.linalg.norm(x, axis=1, keepdims=True)
+    return mesh[corner], verts[corner], np.stack([x, y, np.cross(x, y)], axis=1)
+
+
+def _ring_walk(verts, ring_offsets, face_offsets, mesh_offsets):
+    """Per ring vertex: its face and mesh, the next vertex of its ring; and each face's unit normal
+    (Newell's, from all its rings)."""
+    ring = segment_of(ring_offsets)
+    face = segment_of(face_offsets)[ring]
+    mesh = segment_of(mesh_offsets)[face]
+    at = np.arange(len(verts))
+    nxt = np.where(at + 1 < ring_offsets[1:][ring], at + 1, ring_offsets[:-1][ring])
+    cross = np.cross(verts, verts[nxt])
+    face_normal = np.stack([segment_reduce(np.add, cross[:, j], ring_offsets[face_offsets], 0.0)
+                            for j in range(3)], 1)
+    face_normal /= np.maximum(np.linalg.norm(face_normal, axis=1, keepdims=True), 1e-300)
+    return face, mesh, nxt, face_normal
 
 
 def is_convex(verts, ring_offsets, face_offsets, mesh_offsets) -> np.ndarray:

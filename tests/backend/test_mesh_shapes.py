@@ -68,6 +68,17 @@ def test_roof_faces_have_eave_aligned_scopes_and_their_areas(write):
     assert totals(r)["a_sum"] == pytest.approx(12 * 8 / np.cos(np.radians(30)))
 
 
+def test_comp_v_of_a_roof_gives_each_vertex_once_with_y_along_its_mean_normal(write):
+    text = ('Lot --> roofHip(30) comp(v){ all : V }\n'
+            'V --> report("size", scope.sx + scope.sy + scope.sz) s(1, 1, 1) primitiveCube()\n')
+    r = run(write, text, [rect(12, 8)])
+    x = r["xform"].astype(float)
+    np.testing.assert_allclose(np.sort(x[:, 1, 3]), [0, 0, 0, 0, 4 * TAN30, 4 * TAN30], atol=1e-5)
+    assert totals(r)["size_max"] == 0  # points
+    ridge = x[:, 1, 3] > 1
+    assert (x[ridge, 1, 1] > 0.9).all()  # the ridge ends' y is nearly up: the mean of three planes
+
+
 def test_geometry_volume_and_area_of_a_roof(write):
     text = ('Lot --> roofHip(30) report("v", geometry.volume) report("n", geometry.nFaces) '
             'report("k", geometry.nVertices)\n')
