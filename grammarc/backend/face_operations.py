@@ -1,4 +1,5 @@
-"""Operations on the outlines of faces: offset, setback and shapeL/U/O, innerRectangle, convexify, roofs.
+"""Operations on the outlines of faces: offset, setback and shapeL/U/O, innerRectangle, convexify, roofs,
+cleanupGeometry.
 
 ``FaceOperations`` is a part of ``Executor`` (``backend.execute``), kept apart because these operations
 share one pattern: the batch's faces as shapely polygons in their scopes' units (``face_polygons``),
@@ -24,6 +25,7 @@ from grammarc.geometry import components as comp_kernels
 from grammarc.geometry.clip import fit_pieces, scope_polygons
 from grammarc.geometry.convexify import convex_parts
 from grammarc.geometry.inner_rectangle import largest_rectangles
+from grammarc.geometry.meshes import is_mesh, is_polygon
 from grammarc.geometry.polygons import plane_to_scope
 from grammarc.geometry.setback import polygon_edges, setback_regions
 from grammarc.ir import nodes as ir
@@ -164,6 +166,32 @@ class FaceOperations:
                                     (len(cursor),))
         parts, source = convex_parts(polygons, limit)
         return mesh_shapes.flat_meshes(self.chunk, cursor, parts, source, plane)
+
+    def cleanup_geometry(self, op: ir.CleanupGeometry, cursor: Shapes, symbol: int) -> Shapes:
+        """``cleanupGeometry``: polygons (faces, prisms through their base, flat rectangles) and meshes
+        cleaned (``geometry.cleanup``) in their scopes, which stay: the operation is meant to keep a
+        model's look, and the geometry only loses vertices and faces, so it stays inside its scope.
+        A tolerance outside [0, 1] is taken as the nearer end. Scope boxes and inserted assets stay as
+        they are: a box has no repeated or collinear vertices and no duplicate faces (that its faces
+        could be too small or its edges too short to keep is ignored: as a mesh it would leave the
+        instancing path), and an asset is an instance whose mesh grammarc does not open."""
+        tolerance = np.broadcast_to(np.asarray(evaluate_array(op.tolerance, self.env(cursor)), float),
+                                    (len(cursor),))
+        bad = ~np.isfinite(tolerance)
+        if bad.any():
+            self.fail(cursor, bad, "`cleanupGeometry` with a tolerance that is not finite", symbol, op.span)
+        tolerance = np.clip(tolerance, 0.0, 1.0)
+        flat = (cursor.size <= TOL.zero).sum(axis=1) == 1
+        geom = cursor.geom.copy()
+        polygon = np.flatnonzero(is_polygon(geom) | ((geom == -1) & flat))
+        if len(polygon):
+            shapes = cursor.take(polygon)
+            geom[polygon] = mesh_shapes.clean_polygons(self.chunk, shapes, self.polygons_of(shapes),
+                                                       tolerance[polygon], op.component)
+        mesh = np.flatnonzero(is_mesh(cursor.geom))
+        if len(mesh):
+            geom[mesh] = mesh_shapes.clean_meshes(self.chunk, cursor.take(mesh), tolerance[mesh], op.component)
+        return cursor.with_scope(cursor.origin, cursor.size, cursor.frame, geom)
 
     def inner_rectangle(self, op: ir.InnerRectangle, cursor: Shapes, symbol: int) -> None:
         """``innerRectangle``: the face's largest inner rectangle (``geometry.inner_rectangle``) and the

@@ -1,5 +1,5 @@
 """Mesh shapes on the shape columns: roofs and faces of several parts (``convexify``), built, split into
-faces and edges, and emitted as leaves.
+faces and edges, cleaned (``cleanupGeometry``), and emitted as leaves.
 
 A roof is a mesh (``geometry.meshes``) built over a face's polygon by ``geometry.roofs``. Its scope
 keeps the face's axes, the box fitted to the mesh (an overhang widens it and moves its origin below the
@@ -15,6 +15,7 @@ import numpy as np
 from grammarc.backend.chunk import Chunk
 from grammarc.backend.shapes import Shapes
 from grammarc.constants import STRICT, TOL
+from grammarc.geometry.cleanup import cleanup_meshes
 from grammarc.geometry.clip import oriented_rings
 from grammarc.geometry.meshes import (
     MESH_BASE,
@@ -187,6 +188,78 @@ def reframe_meshes(chunk: Chunk, shapes: Shapes, new_axes: np.ndarray) -> Shapes
     geom, low, size = store_fitted(chunk, local, ring_offsets, face_offsets, mesh_offsets)
     origin = shapes.origin + np.einsum("ni,nij->nj", low, new_axes)
     return shapes.with_scope(origin, size, chunk.frames.add(np.ascontiguousarray(new_axes)), geom)
+
+
+def clean_meshes(chunk: Chunk, shapes: Shapes, tolerance: np.ndarray, component: str) -> np.ndarray:
+    """``cleanupGeometry`` of mesh shapes in their scopes: their new ``geom`` codes (n,). A flat shape
+    left with one face (convexify's parts joined back) is a face again, a polygon in its scope's plane,
+    which the face operations take."""
+    verts, ring_offsets, face_offsets, mesh_offsets, _ = face_vertices(
+        chunk.meshes, shapes.geom - MESH_BASE, shapes.size)
+    verts, ring_offsets, face_offsets, mesh_offsets = cleanup_meshes(
+        verts, ring_offsets, face_offsets, mesh_offsets, tolerance, component)
+    normalized = _normalized(verts, ring_offsets, face_offsets, mesh_offsets, shapes.size)
+    geom = (MESH_BASE + chunk.meshes.add(normalized, ring_offsets, face_offsets, mesh_offsets)).astype(np.int32)
+    flat = shapes.size <= TOL.zero
+    face = np.flatnonzero((np.diff(mesh_offsets) == 1) & (flat.sum(axis=1) == 1))
+    if len(face):
+        geom[face] = _add_polygons(chunk, normalized, ring_offsets, face_offsets, mesh_offsets[face],
+                                   np.argmax(flat[face], axis=1))
+    return geom
+
+
+def clean_polygons(chunk: Chunk, shapes: Shapes, polygons, tolerance: np.ndarray, component: str) -> np.ndarray:
+    """``cleanupGeometry`` of polygon shapes (``polygons`` as ``Executor.polygons_of`` gives them), each
+    its one face, in their scopes: their new ``geom`` codes (n,). A polygon that changed is stored anew,
+    one whose face went becomes an empty mesh (its scope stays, for the operations after it), the others
+    keep their codes (a flat rectangle its fast path). A prism is cleaned through its base, which is not
+    its only face, so it keeps its small faces."""
+    coords, ring_offsets, shape_offsets, plane = polygons
+    n = len(shapes)
+    rows = np.arange(n)
+    vertex_shape = segment_of(shape_offsets)[segment_of(ring_offsets)]
+    in_plane = np.stack([shapes.size[rows, PLANE_U[plane]], shapes.size[rows, PLANE_V[plane]]], axis=1)
+    points = plane_to_scope(coords * in_plane[vertex_shape], plane[vertex_shape])
+    cleaned, cleaned_rings, cleaned_faces, cleaned_shapes = cleanup_meshes(
+        points, ring_offsets, shape_offsets, np.arange(n + 1, dtype=np.int64), tolerance, component,
+        keep_small=shapes.size[rows, plane] > TOL.zero)
+    # the same vertices in the same rings, unmoved: nothing changed (cleaning only drops and merges)
+    before = ring_offsets[shape_offsets]
+    after = cleaned_rings[cleaned_faces[cleaned_shapes]]
+    changed = np.diff(before) != np.diff(after)
+    same = np.flatnonzero(~changed)
+    old, _ = ragged_take(before, same)
+    new, counts = ragged_take(after, same)
+    moved = (points[old] != cleaned[new]).any(axis=1)
+    changed[same] = segment_reduce(np.maximum, moved, counts, False)
+    geom = shapes.geom.copy()
+    empty = np.diff(cleaned_shapes) == 0
+    if empty.any():
+        none = np.zeros(int(empty.sum()) + 1, dtype=np.int64)
+        geom[empty] = MESH_BASE + chunk.meshes.add(np.empty((0, 3)), none[:1], none[:1], none)
+    store = np.flatnonzero(changed & ~empty)
+    if len(store):
+        normalized = _normalized(cleaned, cleaned_rings, cleaned_faces, cleaned_shapes, shapes.size)
+        geom[store] = _add_polygons(chunk, normalized, cleaned_rings, cleaned_faces, cleaned_shapes[store],
+                                    plane[store])
+    return geom
+
+
+def _normalized(verts, ring_offsets, face_offsets, mesh_offsets, size):
+    """Mesh vertices (V, 3) in their scopes' units as fractions of the scope sizes (n, 3) (0 on a
+    flat axis), as the stores keep them."""
+    vertex_mesh = segment_of(mesh_offsets)[segment_of(face_offsets)[segment_of(ring_offsets)]]
+    return verts / np.where(size > TOL.zero, size, np.inf)[vertex_mesh]
+
+
+def _add_polygons(chunk: Chunk, normalized, ring_offsets, face_offsets, faces, plane) -> np.ndarray:
+    """Store faces ``faces`` (k,) of meshes (normalized vertices, lying in the planes ``plane`` (k,) of
+    their scopes) as polygons; returns their ids (k,)."""
+    rings, poly_offsets = ragged_take(face_offsets, faces)
+    vertices, polygon_rings = ragged_take(ring_offsets, rings)
+    vertex_plane = plane[segment_of(poly_offsets)[segment_of(polygon_rings)]]
+    uv = np.stack([normalized[vertices, PLANE_U[vertex_plane]], normalized[vertices, PLANE_V[vertex_plane]]], 1)
+    return chunk.polygons.add(uv, polygon_rings, poly_offsets, plane)
 
 
 def mesh_leaves(chunk: Chunk, shapes: Shapes, symbol: int, colors) -> MeshChunk:

@@ -29,7 +29,7 @@ NOT_APPLIED = frozenset({
 #: CityEngine operations grammarc does not implement yet (the geometry and context issues bring most).
 UNSUPPORTED_OPS = frozenset({
     "innerPolygon",
-    "cleanupGeometry", "trim",
+    "trim",
     "mirrorScope",
     "insertAlongUV", "scatter", "footprint", "tileUV", "splitArea", "inline", "resetGeometry", "taper",
     "primitiveCylinder", "primitiveSphere", "primitiveDisk", "primitiveCone", "primitiveQuad",
@@ -612,6 +612,20 @@ class Lowering(LoweringBase):
                                     "convexify() and convexify(maxLength)")
         return ir.Convexify(self.expr(args[0]) if args else None, span)
 
+    def op_cleanup(self, op, args, span):
+        """``cleanupGeometry(components, tolerance)``, components one of ``ir.CLEANUP_COMPONENTS``."""
+        if not self.arity(op, args, (2,), span):
+            return ir.Empty(span)
+        component = args[0]
+        known = ir.CLEANUP_COMPONENTS
+        if not isinstance(component, ir.Name) or component.name not in known:
+            got = (f"`{component.name}`{suggest(component.name, known)}" if isinstance(component, ir.Name)
+                   else "a string" if isinstance(component, ir.Str) else "an expression")
+            self.diags.error("component", f"`{op}` cleans up {', '.join(sorted(known))}, got {got}",
+                             getattr(component, "span", span))
+            return ir.Empty(span)
+        return ir.CleanupGeometry(component.name, self.expr(args[1]), span)
+
     def op_inner_rectangle(self, op, args, parts, span):
         """``innerRectangle(scope|edge) { shape: A | remainder: B }``."""
         if len(args) != 1 or not isinstance(args[0], ir.Name) or args[0].name not in ("scope", "edge"):
@@ -747,6 +761,7 @@ _OPS = {
     "set": Lowering.op_set,
     "report": Lowering.op_report,
     "convexify": Lowering.op_convexify,
+    "cleanupGeometry": Lowering.op_cleanup,
     "envelope": Lowering.op_envelope,
     "roofHip": Lowering.op_roof,
     "roofGable": Lowering.op_roof,

@@ -97,8 +97,7 @@ def vertex_and_face_counts(size: np.ndarray, geom: np.ndarray, store: PolygonSto
     poly = np.flatnonzero(is_polygon(geom))
     if len(poly):
         ids = geom[poly]
-        counts = np.diff(store.ring_offsets)[segment_of(store.poly_offsets)]
-        per_poly = segment_reduce(np.add, counts, store.poly_offsets, 0)[ids].astype(np.float64)
+        per_poly = segment_reduce(np.add, np.diff(store.ring_offsets), store.poly_offsets, 0)[ids].astype(np.float64)
         solid = size[poly, store.plane[ids]] > TOL.zero
         vertices = vertices.copy()
         faces = faces.copy()

@@ -76,11 +76,7 @@ def area_and_volume(store: MeshStore, ids: np.ndarray, size: np.ndarray):
     the length of each face's vector area, and the divergence theorem over the faces (the volume a
     roof closes with its bottom face; an overhang's open eaves make it approximate)."""
     verts, ring_offsets, face_offsets, mesh_offsets, _ = face_vertices(store, ids, size)
-    ring = segment_of(ring_offsets)
-    at = np.arange(len(verts))
-    nxt = np.where(at + 1 < ring_offsets[1:][ring], at + 1, ring_offsets[:-1][ring])
-    cross = np.cross(verts, verts[nxt])
-    ring_vector = np.stack([segment_reduce(np.add, cross[:, j], ring_offsets, 0.0) for j in range(3)], 1) / 2
+    ring_vector = ring_vector_areas(verts, ring_offsets)
     # a planar ring's cone to the origin: a third of its vector area dotted with any of its points
     ring_volume = np.einsum("ij,ij->i", verts[ring_offsets[:-1]], ring_vector) / 3
     # holes wind the other way: the vector areas of a face's rings add up to the face's
@@ -89,6 +85,16 @@ def area_and_volume(store: MeshStore, ids: np.ndarray, size: np.ndarray):
     area = segment_reduce(np.add, face_area, mesh_offsets, 0.0)
     volume = segment_reduce(np.add, segment_reduce(np.add, ring_volume, face_offsets, 0.0), mesh_offsets, 0.0)
     return area, volume
+
+
+def ring_vector_areas(verts: np.ndarray, ring_offsets: np.ndarray) -> np.ndarray:
+    """Vector area (R, 3) of each ring of points (V, 3) in space (Newell): its length is the ring's
+    area, its direction the normal the ring winds counter-clockwise around."""
+    ring = segment_of(ring_offsets)
+    at = np.arange(len(verts))
+    nxt = np.where(at + 1 < ring_offsets[1:][ring], at + 1, ring_offsets[:-1][ring])
+    cross = np.cross(verts, verts[nxt])
+    return np.stack([segment_reduce(np.add, cross[:, j], ring_offsets, 0.0) for j in range(3)], 1) / 2
 
 
 @njit(cache=True)

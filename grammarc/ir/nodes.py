@@ -486,6 +486,22 @@ class Convexify:
     span: Span = NO_SPAN
 
 
+#: Components of CityEngine's ``cleanupGeometry``.
+CLEANUP_COMPONENTS = frozenset({"vertices", "edges", "faces", "all"})
+
+
+@dataclass(frozen=True, slots=True)
+class CleanupGeometry:
+    """CityEngine ``cleanupGeometry(components, tolerance)``: the shape's geometry tidied in its scope
+    (``geometry.cleanup``): vertices merged, then collinear vertices (``vertices``), the edges between
+    coplanar faces (``edges``), duplicate and small faces (``faces``) or all of them removed.
+    ``tolerance`` runs from 0 (exact matches) to 1 (1 m, 10 degrees, 1 m^2)."""
+
+    component: str
+    tolerance: Expr
+    span: Span = NO_SPAN
+
+
 @dataclass(frozen=True, slots=True)
 class InnerRectangle:
     """CityEngine ``innerRectangle(scope|edge) { shape: A | remainder: B }``: the largest rectangle inside
@@ -541,7 +557,8 @@ class CompFaces:
 
 Op = (Symbol | Empty | Translate | Scale | Rotate | Push | Pop | Insert | Split | Repeat | Comp | Extrude
       | Center | UseAsset | Case | Stochastic | SetAttr | Report | NotApplied | GroupSplit | CompFaces
-      | AlignScope | Mirror | Offset | SetColor | Setback | Roof | InnerRectangle | Convexify)
+      | AlignScope | Mirror | Offset | SetColor | Setback | Roof | InnerRectangle | Convexify
+      | CleanupGeometry)
 Body = tuple[Op, ...]
 
 

@@ -102,6 +102,8 @@ def print_op(op: ir.Op) -> str:
         return f"offset({print_expr(op.distance)}, {op.select})"
     if isinstance(op, ir.Convexify):
         return f"convexify({print_expr(op.max_length) if op.max_length is not None else ''})"
+    if isinstance(op, ir.CleanupGeometry):
+        return f"cleanupGeometry({op.component}, {print_expr(op.tolerance)})"
     if isinstance(op, ir.InnerRectangle):
         return f"innerRectangle({op.align}){{ " + " | ".join(f"{s}: {print_body(b) or 'ε'}"
                                                           for s, b in zip(op.selectors, op.parts)) + " }"

@@ -95,6 +95,9 @@ def rewrite_op(op: ir.Op, fn: ExprFn) -> ir.Op:
     if isinstance(op, ir.Convexify) and op.max_length is not None:
         max_length = ex(op.max_length)
         return op if max_length is op.max_length else replace(op, max_length=max_length)
+    if isinstance(op, ir.CleanupGeometry):
+        tolerance = ex(op.tolerance)
+        return op if tolerance is op.tolerance else replace(op, tolerance=tolerance)
     if isinstance(op, ir.SetColor):
         values = _tuple(op.values, ex)
         return op if values is op.values else replace(op, values=values)
@@ -225,6 +228,8 @@ def op_exprs(op: ir.Op) -> Iterator[ir.Expr]:
         yield op.distance
     elif isinstance(op, ir.Convexify) and op.max_length is not None:
         yield op.max_length
+    elif isinstance(op, ir.CleanupGeometry):
+        yield op.tolerance
     elif isinstance(op, ir.Roof):
         yield from (e for e in (op.value, op.overhang, op.overhang_y, op.index, op.cap) if e is not None)
         yield from (e for pair in op.sides for e in pair)

@@ -528,6 +528,13 @@ def test_shape_queries(write):
     assert t["fr_sum"] == t["fr2_sum"] and 0 <= t["fr_sum"] < 1
 
 
+def test_n_vertices_counts_each_polygons_own_rings(write):
+    """Regression: a polygon's count summed the counts of the rings numbered like the store's polygons,
+    wrong for every polygon after one with a hole (the L after the courtyard counted 4)."""
+    r = run(write, 'Lot --> report("nv", geometry.nVertices)\n', [LOT_ZOO["courtyard"], LOT_ZOO["concave_L"]])
+    assert [t["nv_sum"] for t in per_lot(r).values()] == [8, 6]
+
+
 def test_offset_inside_and_border_faces(write):
     """offset(-2) comp(f){ border | inside } on the L: a ring with an L-shaped hole and the inset L."""
     r = run(write, "Lot --> offset(-2) comp(f){ border : B. | inside : I. }\n", [LOT_ZOO["concave_L"]])

@@ -1,5 +1,5 @@
 """backend/mesh_shapes.py: roof and convex-part shapes in derivations - scopes as CityEngine sets them,
-component splits, leaves, measures, errors."""
+component splits, leaves, measures, errors - and cleanupGeometry of polygons and meshes."""
 
 from __future__ import annotations
 
@@ -263,3 +263,71 @@ def test_offset_that_parts_a_face_keeps_one_shape_of_its_pieces(write):
     t = per_lot(r)
     assert t[0]["n_sum"] == 2 and t[0]["a_sum"] == pytest.approx(128) and t[0]["part_n"] == 2
     assert t[1]["n_sum"] == 1 and t[1]["a_sum"] == pytest.approx(60)
+
+
+# ------------------------------------------------------------------------------------- cleanupGeometry
+
+#: A 10 x 6 rectangle with a collinear vertex and one 1 mm off a corner.
+NOISY = [np.array([[0, 0], [5, 0], [10, 0], [10, 6], [10.001, 6.001], [0, 6]], float)]
+MEASURES = ('report("{0}v", geometry.nVertices) report("{0}f", geometry.nFaces) report("{0}a", geometry.area) '
+            'report("{0}x", scope.sx) report("{0}z", scope.sz)')
+
+
+def test_cleanup_geometry_joins_convex_parts_back_into_their_face(write):
+    text = (f"Lot --> convexify() {MEASURES.format('before')} cleanupGeometry(all, 0) {MEASURES.format('after')} "
+            "comp(f){ all : Part }\nPart --> report(\"part\", geometry.area)\n")
+    r = run(write, text, [LOT_ZOO["concave_L"], LOT_ZOO["courtyard"]])
+    for lot, (parts, vertices, area) in enumerate([(2, 6, 400), (4, 8, 1200)]):
+        t = per_lot(r)[lot]
+        assert t["beforef_sum"] == parts and t["afterf_sum"] == 1 and t["afterv_sum"] == vertices
+        assert t["aftera_sum"] == pytest.approx(area) and t["part_n"] == 1 and t["part_sum"] == pytest.approx(area)
+        assert (t["afterx_sum"], t["afterz_sum"]) == (t["beforex_sum"], t["beforez_sum"])
+    # one face in its scope's plane is a polygon again, which face operations take
+    r = run(write, 'Lot --> convexify() cleanupGeometry(edges, 0) extrude(3) report("v", geometry.volume)\n',
+            [LOT_ZOO["concave_L"], LOT_ZOO["courtyard"]])
+    assert r["bad"] == () and [t["v_sum"] for t in per_lot(r).values()] == pytest.approx([1200, 3600])
+
+
+def test_cleanup_geometry_of_a_polygon_keeps_its_scope_and_an_unchanged_rectangle_its_quad(write):
+    text = f"Lot --> cleanupGeometry(all, 0.01) {MEASURES.format('')}\n"
+    r = run(write, text, [NOISY, rect(12, 8)])
+    noisy, clean = per_lot(r)[0], per_lot(r)[1]
+    assert noisy["v_sum"] == 4 and noisy["a_sum"] == pytest.approx(60, abs=0.01)
+    assert (noisy["x_sum"], noisy["z_sum"]) == pytest.approx((10.001, 6.001))  # the scope stays as it was
+    [face] = mesh_faces(r)
+    assert len(face) == 1 and len(face[0]) == 4
+    assert clean["v_sum"] == 4 and assets(r) == ["builtin:quad"]
+    # tolerance 0: only exact matches go: the collinear vertex, not the one 1 mm off the corner
+    r = run(write, "Lot --> cleanupGeometry(vertices, 0) Face.\n", [NOISY])
+    assert [len(ring) for ring in mesh_faces(r)[0]] == [5]
+
+
+def test_cleanup_geometry_of_a_prism_cleans_its_base(write):
+    text = f"Lot --> extrude(3) cleanupGeometry(vertices, 0.01) {MEASURES.format('')} report(\"vol\", geometry.volume)\n"
+    t = per_lot(run(write, text, [NOISY]))[0]
+    assert t["v_sum"] == 8 and t["f_sum"] == 6 and t["vol_sum"] == pytest.approx(180, abs=0.1)
+
+
+def test_cleanup_geometry_that_removes_the_face_keeps_the_shape_without_geometry(write):
+    # the 0.05 m wide sliver collapses under a 0.1 m merge distance; the shape goes on in its scope
+    text = ('Lot --> cleanupGeometry(vertices, 0.1) report("f", geometry.nFaces) report("x", scope.sx) '
+            '[ i("builtin:cube") Box ] Empty\n')
+    r = run(write, text, [LOT_ZOO["sliver"], rect(12, 8)])
+    sliver = per_lot(r)[0]
+    assert sliver["f_sum"] == 0 and sliver["x_sum"] == pytest.approx(50)
+    assert sorted(names(r)) == ["Box", "Box", "Empty"]  # the sliver's Empty leaf has no geometry
+    assert len(r["mesh"].lot) == 0
+
+
+def test_cleanup_geometry_leaves_boxes_assets_and_clean_roofs_as_they_are(write):
+    for body in ("extrude(3)", 'i("builtin:cube")', "roofHip(30)"):
+        plain = run(write, f"Lot --> {body} Leaf\n", [rect(12, 8), LOT_ZOO["concave_L"]])
+        cleaned = run(write, f"Lot --> {body} cleanupGeometry(all, 0) Leaf\n", [rect(12, 8), LOT_ZOO["concave_L"]])
+        np.testing.assert_array_equal(cleaned["xform"], plain["xform"])
+        np.testing.assert_allclose(cleaned["mesh"].vertices, plain["mesh"].vertices, atol=1e-5)
+
+
+def test_cleanup_geometry_with_a_tolerance_that_is_not_finite_fails_its_lot(write):
+    r = run(write, "Lot --> cleanupGeometry(all, ln(scope.sx - 12)) Face\n", [rect(12, 8), rect(20, 8)])
+    assert [b.index for b in r["bad"]] == [0]
+    assert "`cleanupGeometry` with a tolerance that is not finite" in r["bad"][0].reason

@@ -136,6 +136,8 @@ def test_the_same_text_lowers_in_the_dialect_asked_for():
     ("extrude(rint(scope.sx)) A", "extrude(round(Scope.sx)) A"),
     ("extrude(ln(scope.sx)) A", "extrude(log(Scope.sx)) A"),
     ("extrude(rand(2, 4)) A", "extrude(rand(2, 4)) A"),
+    ("cleanupGeometry(all, 0.1) A", "cleanupGeometry(all, 0.1) A"),
+    ("cleanupGeometry(faces, h / 10) A", "cleanupGeometry(faces, (@h / 10)) A"),
     ('report("k", scope.sx > 1 && !(scope.sz < 2) || h == 3) A',
      'report("k", (((Scope.sx > 1) && !(Scope.sz < 2)) || (@h == 3))) A'),
 ])
@@ -459,6 +461,18 @@ def test_setback_moves_the_edges_its_parts_select():
                    ).rules[0].alternatives[0].body[0]
     assert [s for s, _ in op.distances] == ["front", "left"]
     assert op.selectors == ("front", "left", "remainder")
+
+
+@pytest.mark.parametrize("line, at, message", [
+    ("Lot --> cleanupGeometry(vertex, 0) A", "vertex",
+     "`cleanupGeometry` cleans up all, edges, faces, vertices, got `vertex` (did you mean `vertices`?)"),
+    ('Lot --> cleanupGeometry("all", 0) A', '"all"',
+     "`cleanupGeometry` cleans up all, edges, faces, vertices, got a string"),
+    ("Lot --> cleanupGeometry(all) A", "cleanupGeometry", "`cleanupGeometry` takes 2 arguments, got 1"),
+    ("Lot --> cleanupGeometry(all, 0, 1) A", "cleanupGeometry", "`cleanupGeometry` takes 2 arguments, got 3"),
+])
+def test_cleanup_geometry_names_a_wrong_component_or_argument_count_at_its_line(line, at, message):
+    assert errors(VERSION + line + "\n") == [(2, line.index(at) + 1, message)]
 
 
 # ------------------------------------------------------------------------------------ the unsupported

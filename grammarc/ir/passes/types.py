@@ -77,6 +77,8 @@ def _check_op(op, check, param_types, diags) -> None:
         check(op.distance, T.NUM, "an offset distance")
     elif isinstance(op, ir.Convexify) and op.max_length is not None:
         check(op.max_length, T.NUM, "a split line length")
+    elif isinstance(op, ir.CleanupGeometry):
+        check(op.tolerance, T.NUM, "a cleanup tolerance")
     elif isinstance(op, ir.Roof):
         check(op.value, T.NUM, "a roof height" if op.by_height else "a roof angle")
         for e in (op.overhang, op.overhang_y):
