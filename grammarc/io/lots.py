@@ -41,6 +41,8 @@ from grammarc.ragged import offsets_from_counts, ragged_take, segment_reduce
 
 __all__ = ["BadLot", "Lots", "default_lot", "lots_from_polygons", "read_lots"]
 
+#: The lot property that marks street edges, as CityEngine's object attribute.
+STREET_WIDTH = "streetWidth"
 # GEOS reasons end with the offending point, e.g. "Self-intersection[3 4.5]".
 _GEOS_REASON = re.compile(r"^(?P<what>.*)\[(?P<x>\S+) (?P<y>\S+)\]$")
 
@@ -71,6 +73,9 @@ class Lots:
       at least 3 vertices. Exterior rings have a +Y Newell normal, holes a -Y one.
     lot_offsets : (L + 1,) int64
       Lot ``i`` is rings ``lot_offsets[i]:lot_offsets[i + 1]``, the exterior ring first, then its holes.
+    street : (V,) bool
+      Whether the edge from each vertex to the next of its ring faces a street: CityEngine's
+      ``streetWidth`` object attribute (one number per edge of the exterior ring, > 0 for a street).
     attrs : dict of str to (L,) float64 or object
       Per-lot property columns: float64 with nan for missing values, or object with ``str`` values and
       None for missing ones.
@@ -85,6 +90,7 @@ class Lots:
     vertices: np.ndarray
     ring_offsets: np.ndarray
     lot_offsets: np.ndarray
+    street: np.ndarray
     attrs: dict[str, np.ndarray]
     bad: tuple[BadLot, ...]
     source: str
@@ -114,6 +120,7 @@ class Lots:
             vertices=self.vertices[vertex],
             ring_offsets=ring_offsets,
             lot_offsets=lot_offsets,
+            street=self.street[vertex],
             attrs={name: column[lot] for name, column in self.attrs.items()},
             bad=self.bad,
             source=self.source,
@@ -182,6 +189,7 @@ def lots_from_polygons(
     *,
     ids=None,
     attrs=None,
+    street=None,
     source: str = "<memory>",
 ) -> Lots:
     """Make lots in memory from map-coordinate polygons, cleaned and validated as GeoJSON lots are.
@@ -195,6 +203,9 @@ def lots_from_polygons(
     attrs : dict of str to sequence, optional
       Per-lot property columns of length ``len(polygons)``; typed as GeoJSON properties are (numbers and
       None become float64 with nan, anything else ``str`` with None).
+    street : sequence, optional
+      Per lot, None or CityEngine's ``streetWidth``: a number per edge of the exterior ring, > 0 where
+      the edge faces a street.
     source : str
       Recorded in ``Lots.source``.
 
@@ -218,8 +229,9 @@ def lots_from_polygons(
         if length != len(polygons):
             raise ValueError(f"{name} has {length} entries for {len(polygons)} polygons")
     builder = _Builder(world=False)
-    for index, (lot_id, rings) in enumerate(zip(ids, polygons)):
-        builder.add_positions(index, lot_id, rings, {})
+    street = [None] * len(polygons) if street is None else street
+    for index, (lot_id, rings, widths) in enumerate(zip(ids, polygons, street)):
+        builder.add_positions(index, lot_id, rings, {} if widths is None else {STREET_WIDTH: list(widths)})
     return builder.finish({name: _column(list(values)) for name, values in attrs.items()}, source)
 
 
@@ -251,6 +263,7 @@ class _Builder:
         self.index: list[int] = []
         self.ids: list[str] = []
         self.props: list[dict] = []
+        self.street: list[np.ndarray] = []  # per ring, a flag per position: its edge faces a street
         self.bad: list[BadLot] = []
         self.polygons = 0  # lots added or rejected; a file without any has "no polygon"
 
@@ -260,12 +273,23 @@ class _Builder:
         self.bad.append(BadLot(index, lot_id, reason))
 
     def add(self, index: int, lot_id: str, rings: list[np.ndarray], props: dict) -> None:
-        """Add a lot: its exterior ring, then its holes."""
+        """Add a lot: its exterior ring, then its holes. A ``streetWidth`` property (CityEngine's: a
+        number per edge of the exterior ring, > 0 where a street runs) marks its street edges."""
         if not rings:
             self.reject(index, lot_id, "empty polygon")
             return
+        street = [np.zeros(len(ring), dtype=bool) for ring in rings]
+        widths = props.get(STREET_WIDTH)
+        if widths is not None:
+            flags = _street_flags(widths, rings[0])
+            if isinstance(flags, str):
+                self.reject(index, lot_id, flags)
+                return
+            street[0] = flags
+            props = {name: value for name, value in props.items() if name != STREET_WIDTH}
         self.polygons += 1
         self.rings.extend(rings)
+        self.street.extend(street)
         self.ring_counts.append(len(rings))
         self.index.append(index)
         self.ids.append(lot_id)
@@ -288,18 +312,23 @@ class _Builder:
             # world (x, 0, -y); 0.0 - y keeps z = +0.0 where y = 0
             x, y = vertices.T
             vertices = np.column_stack([x, np.zeros_like(x), np.subtract(0.0, y)])
-        vertices, ring_offsets = _clean(vertices, offsets_from_counts(counts))
+        keep, owner, ring_offsets = _clean(vertices, offsets_from_counts(counts))
+        vertices = vertices[keep]
+        street = np.zeros(len(vertices), dtype=bool)
+        np.logical_or.at(street, owner, np.concatenate([np.zeros(0, dtype=bool), *self.street]))
         lot_offsets = offsets_from_counts(np.array(self.ring_counts, dtype=np.int64))
         normals = _newell(vertices, ring_offsets)
         exterior = np.zeros(len(normals), dtype=bool)
         exterior[lot_offsets[:-1]] = True
-        vertices = _orient(vertices, ring_offsets, exterior, normals[:, 1])
+        vertex_order, edge_order = _orient(ring_offsets, exterior, normals[:, 1])
+        vertices, street = vertices[vertex_order], street[edge_order]
         lots = Lots(
             ids=np.array(self.ids, dtype=object),
             index=np.array(self.index, dtype=np.int64),
             vertices=vertices,
             ring_offsets=ring_offsets,
             lot_offsets=lot_offsets,
+            street=street,
             attrs=attrs,
             bad=(),
             source=source,
@@ -309,6 +338,18 @@ class _Builder:
         bad = self.bad + [BadLot(int(lots.index[i]), lots.ids[i], reasons[i]) for i in rejected]
         good = lots.take(np.flatnonzero(reasons == ""))
         return replace(good, bad=tuple(sorted(bad, key=lambda b: b.index)))
+
+
+def _street_flags(widths, ring: np.ndarray) -> np.ndarray | str:
+    """Per position of ``ring``, whether its edge faces a street, from a ``streetWidth`` value (one
+    number per edge; a ring given closed has one edge fewer than positions); a reason if malformed."""
+    if not isinstance(widths, list) or not all(isinstance(w, numbers.Real) for w in widths):
+        return f"{STREET_WIDTH} is not a list of numbers"
+    closed = len(ring) > 1 and np.array_equal(ring[0], ring[-1])
+    edges = len(ring) - 1 if closed else len(ring)
+    if len(widths) != edges:
+        return f"{STREET_WIDTH} has {len(widths)} values for {edges} edges"
+    return np.r_[np.asarray(widths, dtype=np.float64) > 0, np.zeros(int(closed), dtype=bool)]
 
 
 def _ring_xy(ring) -> np.ndarray:
@@ -429,8 +470,10 @@ def _successor(start: np.ndarray, count: np.ndarray) -> np.ndarray:
     return np.where(at + 1 < start + count, at + 1, start)
 
 
-def _clean(vertices: np.ndarray, ring_offsets: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Merge consecutive vertices closer than ``TOL.merge``, keeping the first of each run.
+def _clean(vertices: np.ndarray, ring_offsets: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Merge consecutive vertices closer than ``TOL.merge``, keeping the first of each run: which
+    vertices stay (V,) bool, the kept vertex each one merges into (V,) int64 (numbered among the kept),
+    and the kept rings' offsets.
 
     A run may wrap around the ring's end (a closing vertex equal to the first, or a duplicated last
     vertex): it belongs to the first vertex, which always stays first.
@@ -446,7 +489,10 @@ def _clean(vertices: np.ndarray, ring_offsets: np.ndarray) -> tuple[np.ndarray, 
     np.maximum.at(last_far, ring, np.where(close_next, -1, at))
     keep = first | (~close_prev & (at <= last_far[ring]))
     kept = segment_reduce(np.add, keep.astype(np.int64), ring_offsets, 0)
-    return vertices[keep], offsets_from_counts(kept)
+    owner = np.cumsum(keep) - 1
+    wraps = at > last_far[ring]
+    owner[wraps] = owner[start[wraps]]
+    return keep, owner, offsets_from_counts(kept)
 
 
 def _newell(vertices: np.ndarray, ring_offsets: np.ndarray) -> np.ndarray:
@@ -459,15 +505,18 @@ def _newell(vertices: np.ndarray, ring_offsets: np.ndarray) -> np.ndarray:
     return segment_reduce(np.add, np.cross(local, local[_successor(start, count)]), ring_offsets, 0.0)
 
 
-def _orient(vertices, ring_offsets, exterior, normal_y) -> np.ndarray:
-    """Reverse exterior rings with a -Y normal and holes with a +Y one, keeping each ring's first vertex.
+def _orient(ring_offsets, exterior, normal_y) -> tuple[np.ndarray, np.ndarray]:
+    """Reverse exterior rings with a -Y normal and holes with a +Y one, keeping each ring's first vertex:
+    where each vertex and each edge (from its vertex to the next) comes from, (V,) int64 each.
 
-    A reversed ring of n vertices takes position p from position (n - p) % n: v0, v_{n-1}, ..., v1.
+    A reversed ring of n vertices takes position p from position (n - p) % n: v0, v_{n-1}, ..., v1; its
+    edge p is the old edge (n - p - 1) % n run backwards.
     """
     ring, start, count = _ring_positions(ring_offsets)
     flip = np.where(exterior, normal_y < 0, normal_y > 0)[ring]
-    position = np.arange(len(vertices)) - start
-    return vertices[start + np.where(flip, (count - position) % count, position)]
+    position = np.arange(len(ring)) - start
+    return (start + np.where(flip, (count - position) % count, position),
+            start + np.where(flip, (count - position - 1) % count, position))
 
 
 def _validate(lots: Lots, normals: np.ndarray, world: bool) -> np.ndarray:

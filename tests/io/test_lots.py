@@ -97,6 +97,38 @@ def test_hole_gets_down_normal_and_exterior_up_normal(tmp_path):
     assert lot_area(lots, 0) == pytest.approx(1200.0)
 
 
+def street_edges(lots: Lots, i: int) -> list[list[list[float]]]:
+    """The street edges of lot i's exterior ring as [start, end] map points."""
+    ring = rings(lots, i)[0]
+    flags = lots.street[lots.ring_offsets[lots.lot_offsets[i]]:][:len(ring)]
+    ends = [(ring[k], ring[(k + 1) % len(ring)]) for k in np.flatnonzero(flags)]
+    return [[[a[0], -a[2]], [b[0], -b[2]]] for a, b in ends]
+
+
+def test_street_width_marks_edges_through_reversal_closing_and_merged_points(tmp_path):
+    """CityEngine's streetWidth: a number per edge, > 0 for a street. The edge keeps its mark when its
+    ring is reversed, given closed, or has a duplicated point."""
+    ccw = feature([SQUARE + [SQUARE[0]]], id="ccw", properties={"streetWidth": [0, 8, 0, 0]})
+    cw = feature([[[0, 0], [0, 10], [10, 10], [10, 0]]], id="cw", properties={"streetWidth": [0, 0, 8, 0]})
+    doubled = feature([[[0, 0], [10, 0], [10, 0], [10, 10], [0, 10]]], id="dup",
+                      properties={"streetWidth": [0, 0, 5, 0, 0], "h": 3})
+    lots = read_lots(write_geojson(tmp_path, [ccw, cw, doubled]))
+    assert lots.bad == () and "streetWidth" not in lots.attrs and lots.attrs["h"][2] == 3
+    assert street_edges(lots, 0) == [[[10, 0], [10, 10]]]
+    assert street_edges(lots, 1) == [[[10, 0], [10, 10]]]  # the east edge, run the other way now
+    assert street_edges(lots, 2) == [[[10, 0], [10, 10]]]
+
+
+def test_a_street_width_that_does_not_fit_the_ring_is_a_bad_lot(tmp_path):
+    lots = read_lots(write_geojson(tmp_path, [
+        feature([SQUARE], id="short", properties={"streetWidth": [1, 0]}),
+        feature([SQUARE], id="text", properties={"streetWidth": "front"}),
+        feature([SQUARE], id="ok")]))
+    assert lots.ids.tolist() == ["ok"]
+    assert [b.reason for b in lots.bad] == ["streetWidth has 2 values for 4 edges",
+                                            "streetWidth is not a list of numbers"]
+
+
 def test_multipolygon_gives_one_lot_per_polygon_with_shared_properties(tmp_path):
     far = [[p[0] + 100, p[1]] for p in SQUARE]
     multi = feature([[SQUARE], [far]], kind="MultiPolygon", id="blk", properties={"height": 12})
