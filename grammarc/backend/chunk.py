@@ -12,6 +12,7 @@ import numpy as np
 from grammarc.constants import STRICT
 from grammarc.geometry.meshes import MeshStore
 from grammarc.geometry.polygons import PolygonStore
+from grammarc.geometry.streets import Streets
 
 
 class Frames:
@@ -75,6 +76,8 @@ class Chunk:
     polygons: PolygonStore
     outputs: Outputs = field(default_factory=Outputs)
     meshes: MeshStore = field(default_factory=MeshStore)
+    #: The lots' street edges and street frames (``geometry.streets``).
+    streets: Streets | None = None
     #: Shapes created so far per lot, for the ``max_shapes`` limit.
     shape_count: np.ndarray | None = None
     #: The lots' root random keys (``fileRandom`` draws from them).

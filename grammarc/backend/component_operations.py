@@ -158,8 +158,10 @@ class ComponentOperations:
             dynamic[slot:slot + 8] = list(planes.T)
             shapes = replace(shapes, dynamic=tuple(dynamic))
         if op.kind == "f":
+            axes = self.chunk.frames[shapes.frame]
+            base = (shapes.origin, shapes.origin + axes[:, 0] * shapes.size[:, :1])  # each face's bottom edge
             which = classify_faces(normal, op.selectors, self.selector_frames(normal, cursor, parent,
-                                                                                op.selectors))
+                                                                                op.selectors, base))
         else:
             direction = self.chunk.frames[shapes.frame][:, 0] if op.kind == "e" else None
             which = classify_edges(direction, op.selectors, len(shapes))

@@ -27,6 +27,7 @@ from grammarc.constants import Limits
 from grammarc.errors import AssetError
 from grammarc.geometry.footprint import footprint_polygons, lot_scopes
 from grammarc.geometry.polygons import PolygonStore
+from grammarc.geometry.streets import lot_streets
 from grammarc.io.lots import Lots
 from grammarc.io.npz import MeshChunk, TerminalChunk
 from grammarc.ragged import ragged_take
@@ -42,7 +43,8 @@ def initial_chunk(lots: Lots) -> tuple[Chunk, Shapes]:
     geom[~is_rect] = polygons.add(coords, ring_offsets, poly_offsets,
                                   np.ones(int((~is_rect).sum()), dtype=np.int8))
     chunk = Chunk(lot_index=lots.index, lot_ids=lots.ids, attrs={}, lot_origin=origin, lot_axes=axes,
-                  frames=frames, polygons=polygons)
+                  frames=frames, polygons=polygons,
+                  streets=lot_streets(lots.vertices, lots.ring_offsets, lots.lot_offsets, lots.street, axes))
     n = len(lots)
     shapes = Shapes(origin, size, frames.add(axes), geom, np.arange(n, dtype=np.int32),
                     np.zeros(n, dtype=np.uint64), np.zeros(n, dtype=np.int32))

@@ -18,7 +18,7 @@ from grammarc.backend import mesh_shapes
 from grammarc.backend.evaluate import evaluate_array
 from grammarc.backend.kernels.order import group_by
 from grammarc.backend.random import child_keys
-from grammarc.backend.selectors import classify_faces
+from grammarc.backend.selectors import STREET_ALIASES, classify_faces
 from grammarc.backend.shapes import Shapes
 from grammarc.constants import TOL
 from grammarc.geometry import components as comp_kernels
@@ -28,6 +28,7 @@ from grammarc.geometry.inner_rectangle import largest_rectangles
 from grammarc.geometry.meshes import is_mesh, is_polygon
 from grammarc.geometry.polygons import plane_to_scope
 from grammarc.geometry.setback import polygon_edges, setback_regions
+from grammarc.geometry.streets import along_street
 from grammarc.ir import nodes as ir
 from grammarc.ragged import ragged_take, rank_within
 
@@ -136,7 +137,8 @@ class FaceOperations:
         edges = polygon_edges(polygons)
         m = len(cursor)
         normal = plane_to_scope(-edges.inward, plane[edges.poly])
-        frames = self.selector_frames(normal, cursor, edges.poly, (*op.selectors, *(s for s, _ in op.distances)))
+        frames = self.selector_frames(normal, cursor, edges.poly, (*op.selectors, *(s for s, _ in op.distances)),
+                                      self.world_points(cursor, edges.poly, plane, (edges.start, edges.end)))
         # distances per face, or per edge (setback(comp(fe){...}): each edge is comp.index of comp.total)
         if op.per_edge:
             index = rank_within(edges.poly)
@@ -220,14 +222,30 @@ class FaceOperations:
         order = np.argsort(np.concatenate([p.source for p in pieces]), kind="stable")
         return shapes.take(order), kind[order]
 
-    def selector_frames(self, normal: np.ndarray, cursor: Shapes, parent: np.ndarray,
-                        selectors) -> dict | None:
-        """Normals (m, 3) in the world's and the lot's frames when a selector names them (``world.``)."""
-        if not any("." in s for s in selectors):
+    def selector_frames(self, normal: np.ndarray, cursor: Shapes, parent: np.ndarray, selectors,
+                        base: tuple[np.ndarray, np.ndarray] | None = None) -> dict | None:
+        """Normals (m, 3) in the world's, the lot's and its street's frames when a selector names them
+        (``world.``, ``object.``, ``street.``), and which components lie along a street: their base
+        edges ``base`` (start, end: (m, 3) world points), if given, on one of their lot's street edges."""
+        if not any("." in s or s in STREET_ALIASES for s in selectors):
             return None
         world = np.einsum("mi,mij->mj", normal, self.chunk.frames[cursor.frame][parent])
-        lot = np.einsum("mj,mij->mi", world, self.chunk.lot_axes[cursor.lot[parent]])
-        return {"world": world, "object": lot}
+        lot = cursor.lot[parent]
+        frames = {"world": world, "object": np.einsum("mj,mij->mi", world, self.chunk.lot_axes[lot])}
+        streets = self.chunk.streets
+        if any(s.startswith("street.") or s in STREET_ALIASES for s in selectors):
+            frames["street"] = np.einsum("mj,mij->mi", world, streets.axes[lot])
+            frames["street_along"] = (along_street(streets, lot, base[0], base[1], world) if base is not None
+                                      else np.zeros(len(lot), dtype=bool))
+            frames["street_known"] = np.diff(streets.lot_offsets)[lot] > 0
+        return frames
+
+    def world_points(self, cursor: Shapes, row: np.ndarray, plane: np.ndarray, points) -> tuple:
+        """In-plane points (k, 2) in the scope units of the shapes ``row`` (k,) of ``cursor``, whose
+        polygons lie in ``plane`` (n,), as world points (k, 3)."""
+        axes = self.chunk.frames[cursor.frame[row]]
+        return tuple(cursor.origin[row] + np.einsum("ki,kij->kj", plane_to_scope(p, plane[row]), axes)
+                     for p in points)
 
     def offset_faces(self, op: ir.CompFaces, cursor: Shapes, symbol: int) -> None:
         """``offset(d) comp(f){ inside: ... | border: ... }``: the offset's faces as components."""

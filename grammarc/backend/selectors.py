@@ -2,7 +2,12 @@
 directions) ``front``, ``top``, ``vertical``, ``aslant``... name.
 
 Normals are in the parent's scope frame (front +z, back -z, right +x, left -x, top +y, bottom -y), or in the
-lot's (``object.``) or the world's (``world.``) when a selector names that frame.
+lot's (``object.``), the world's (``world.``) or the lot's street frame (``street.``, ``geometry.streets``)
+when a selector names that frame; ``street.front`` also takes the faces and edges that lie along a
+street (``street_along``). ``streetSide`` and ``noStreetSide``, CityEngine's older names, are
+``street.front`` and the other side edges of lots with street edges, and nothing on other lots (PRT's
+reporting.rpk sets nothing back on the kit's footprints, which have none); ``street.`` selectors fall
+back to the lot's own frame there, as CityEngine documents.
 """
 
 from __future__ import annotations
@@ -19,13 +24,21 @@ def classify_faces(normal: np.ndarray, selectors: tuple[str, ...], frames: dict 
     the parent's scope frame: front +z, back -z, right +x, left -x, top +y, bottom -y. ``frames`` gives
     the normals in the lot's frame (``object.`` selectors) and the world's (``world.``)."""
     which = np.full(len(normal), len(selectors), dtype=np.int64)
+    frames = frames or {}
     for i in range(len(selectors) - 1, -1, -1):
-        prefix, _, name = selectors[i].rpartition(".")
-        which[_face_masks((frames or {}).get(prefix, normal))[name]] = i
+        prefix, _, name = STREET_ALIASES.get(selectors[i], selectors[i]).rpartition(".")
+        mask = _face_masks(frames.get(prefix, normal), frames.get(f"{prefix}_along"))[name]
+        if selectors[i] in STREET_ALIASES:  # PRT: nothing on a lot without street edges
+            mask = mask & frames["street_known"]
+        which[mask] = i
     return which
 
 
-def _face_masks(normal: np.ndarray) -> dict[str, np.ndarray]:
+#: CityEngine's older street selectors of ``setback``.
+STREET_ALIASES = {"streetSide": "street.front", "noStreetSide": "street.rest"}
+
+
+def _face_masks(normal: np.ndarray, along: np.ndarray | None = None) -> dict[str, np.ndarray]:
     x, y, z = normal[:, 0], normal[:, 1], normal[:, 2]
     top, bottom = y > np.sqrt(0.5), y < -np.sqrt(0.5)
     side = ~top & ~bottom
@@ -33,11 +46,13 @@ def _face_masks(normal: np.ndarray) -> dict[str, np.ndarray]:
     back = side & (-z >= np.abs(x)) & ~front
     right = side & (x > np.abs(z))
     left = side & (-x > np.abs(z))
+    if along is not None:  # lying along a street makes a side front, whichever way the frame turns
+        front, back, right, left = front | (side & along), back & ~along, right & ~along, left & ~along
     vertical = np.abs(y) <= _FLAT_TOLERANCE
     horizontal = np.abs(y) >= 1 - _FLAT_TOLERANCE
     masks = {
         "front": front, "back": back, "left": left, "right": right, "top": top, "bottom": bottom,
-        "side": side, "vertical": vertical, "horizontal": horizontal,
+        "side": side, "rest": side & ~front, "vertical": vertical, "horizontal": horizontal,
         "aslant": ~vertical & ~horizontal & (y > 0), "nutant": ~vertical & ~horizontal & (y < 0),
         "all": np.ones(len(normal), dtype=bool),
         # the faces an offset makes: a shape not offset has none

@@ -569,10 +569,7 @@ class Lowering(LoweringBase):
             if part.size.kind is not ir.SizeKind.ABSOLUTE or not isinstance(value, ir.Name):
                 return self.unsupported("this comp selector", part.span)
             if value.name not in known:
-                if kind == "f":
-                    why = "street selectors come with the context issue" + suggest(value.name, known)
-                else:
-                    why = f"comp({kind}) selects {', '.join(sorted(known))}"
+                why = f"comp({kind}) selects {', '.join(sorted(known))}" + suggest(value.name, known)
                 return self.unsupported(f"comp({kind}) selector `{value.name}`", value.span, why)
             if part.merged:
                 self.diags.warning(
@@ -649,8 +646,7 @@ class Lowering(LoweringBase):
                 self.unsupported(f"this {op} selector", part.span)
                 return None
             if value.name not in known:
-                why = ("street selectors come with the context issue" if "treet" in value.name else
-                       f"{op} selects {', '.join(sorted(known - {'remainder'}))} and remainder")
+                why = f"{op} selects {', '.join(sorted(known - {'remainder'}))} and remainder"
                 self.unsupported(f"{op} selector `{value.name}`", value.span, why + suggest(value.name, known))
                 return None
             if part.merged:
@@ -774,8 +770,10 @@ _ROOF_ARGUMENTS = {"roofHip": ("overhang", "even"), "roofGable": ("overhangX", "
 #: Operations CityEngine also takes without their parentheses (other bare names are rules).
 _BARE_OPS = frozenset({"NIL", "primitiveCube", "convexify"})
 _SPLIT_OPS = frozenset({"split", "comp"})
+#: CityEngine's street selectors (``geometry.streets``): the lot's street edges and the faces along them.
+_STREET_SELECTORS = frozenset(f"street.{s}" for s in ("front", "back", "left", "right", "side"))
 _COMP_SELECTORS = {
-    "f": ir.FACE_SELECTORS | ir.OFFSET_SELECTORS
+    "f": ir.FACE_SELECTORS | ir.OFFSET_SELECTORS | _STREET_SELECTORS
     | {f"{frame}.{s}" for frame in ("object", "world") for s in ir.FACE_SELECTORS},
     "e": ir.EDGE_SELECTORS,
     "v": ir.VERTEX_SELECTORS,
@@ -784,7 +782,7 @@ _COMP_SELECTORS = {
 _SETBACK_OPS = {"setback": (), "shapeL": ("front", "left"), "shapeU": ("front", "right", "left"),
                 "shapeO": ("front", "right", "back", "left")}
 #: Edge selectors of ``setback``: an edge is named as the face an extrusion of the polygon would make of it.
-_SETBACK_SELECTORS = (_COMP_SELECTORS["f"] - ir.OFFSET_SELECTORS) | {"all", "remainder"}
+_SETBACK_SELECTORS = (_COMP_SELECTORS["f"] - ir.OFFSET_SELECTORS) | {"all", "remainder", "streetSide", "noStreetSide"}
 #: Shape attributes that grammarc does not provide yet: comp.index, split.index, initialShape.origin...
 _UNSUPPORTED_MEMBERS = frozenset({"comp", "split", "initialShape", "geometry"})
 

@@ -481,7 +481,7 @@ def test_cleanup_geometry_names_a_wrong_component_or_argument_count_at_its_line(
 @pytest.mark.parametrize("line, name, at", [
     ("Lot --> offset(-2) Inner", "offset(d) without comp(f){ inside | border } after it", "offset"),
     ("Lot --> offset(-2, outside) Inner", "offset with these arguments", "offset"),
-    ("Lot --> setback(3){ street.front : Garden | remainder : Building }", "setback selector `street.front`",
+    ("Lot --> setback(3){ street.top : Garden | remainder : Building }", "setback selector `street.top`",
      "street"),
     ("Lot --> setback(3) Garden", "setback without selector parts", "setback"),
     ("Lot --> setback(3){ 2 : Garden }", "this setback selector", "2"),
@@ -498,7 +498,7 @@ def test_cleanup_geometry_names_a_wrong_component_or_argument_count_at_its_line(
     ("Lot --> mirrorScope(true, false, false) A", "mirrorScope", "mirrorScope"),
     ("Lot --> taper(4) A", "taper", "taper"),
     ("Lot --> comp(x){ all : A }", "comp(x)", "comp"),
-    ("Lot --> comp(f){ street.front : A }", "comp(f) selector `street.front`", "street"),
+    ("Lot --> comp(f){ street.top : A }", "comp(f) selector `street.top`", "street"),
     ("Lot --> comp(f){ fornt : A }", "comp(f) selector `fornt`", "fornt"),
     ("Lot --> comp(e){ front : A }", "comp(e) selector `front`", "front"),
     ("Lot --> comp(f){ 0 : A }", "this comp selector", "0"),
