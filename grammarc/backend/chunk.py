@@ -9,6 +9,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from grammarc.backend.snaps import SnapStore
 from grammarc.constants import STRICT
 from grammarc.geometry.meshes import MeshStore
 from grammarc.geometry.polygons import PolygonStore
@@ -76,6 +77,8 @@ class Chunk:
     polygons: PolygonStore
     outputs: Outputs = field(default_factory=Outputs)
     meshes: MeshStore = field(default_factory=MeshStore)
+    #: Snap planes of the paper's ``Snap`` / ``SnapLines`` (``backend.snaps``).
+    snaps: SnapStore = field(default_factory=SnapStore)
     #: The lots' street edges and street frames (``geometry.streets``).
     streets: Streets | None = None
     #: Shapes created so far per lot, for the ``max_shapes`` limit.

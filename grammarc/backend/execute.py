@@ -267,13 +267,13 @@ _OPERATIONS = {
     ir.GroupSplit: Executor.group_split, ir.CompFaces: Executor.comp_faces, ir.Empty: Executor.nothing,
     ir.NotApplied: Executor.nothing, ir.Setback: Executor.setback, ir.Roof: Executor.roof,
     ir.InnerRectangle: Executor.inner_rectangle, ir.Convexify: Executor.convexify,
-    ir.CleanupGeometry: Executor.cleanup_geometry,
+    ir.CleanupGeometry: Executor.cleanup_geometry, ir.Snap: Executor.snap,
 }
 #: Operations that take roofs (meshes): scope changes, component splits, successors, leaves, cleanup.
 _MESH_OPERATIONS = frozenset({
     ir.Symbol, ir.Translate, ir.Scale, ir.Rotate, ir.Insert, ir.Comp, ir.CompFaces, ir.Empty, ir.NotApplied,
     ir.SetColor, ir.UseAsset, ir.SetAttr, ir.Report, ir.Case, ir.Stochastic, ir.Split, ir.Repeat, ir.GroupSplit,
-    ir.AlignScope, ir.CleanupGeometry,
+    ir.AlignScope, ir.CleanupGeometry, ir.Snap,
 })
 
 

@@ -43,6 +43,8 @@ class SplitOperations:
             parent, part, pos, length = split_kernels.subdiv(
                 np.ascontiguousarray(shapes.size[:, axis]), values, relative, TOL.zero
             )
+            if op.snap:
+                split_kernels.snap_subdiv(parent, pos, length, *self.snaps_across(shapes, axis, op.snap_label))
             if values.shape[0] > 1:
                 values = values[parent]  # the next axis' sizes follow the children
             return parent, part * len(op.sizes) ** level, pos, length
@@ -63,14 +65,36 @@ class SplitOperations:
                           op.span)
             extent = np.ascontiguousarray(shapes.size[:, axis])
             counts = split_kernels.repeat_counts(extent, size, TOL.zero)
-            self.check_fan_out(shapes, counts, symbol, op.span)
-            parent, part, pos, length = split_kernels.repeat(extent, counts)
+            if op.snap:  # each snap plane adds one element at most
+                offsets, snaps = self.snaps_across(shapes, axis, op.snap_label)
+                self.check_fan_out(shapes, counts + np.diff(offsets), symbol, op.span)
+                parent, part, pos, length = split_kernels.snapped_repeat(extent, size, offsets, snaps, TOL.zero)
+                counts = np.bincount(parent, minlength=len(shapes))
+            else:
+                self.check_fan_out(shapes, counts, symbol, op.span)
+                parent, part, pos, length = split_kernels.repeat(extent, counts)
             step = part * stride[parent]
             stride = stride[parent] * counts[parent]
             sizes = [s[parent] for s in sizes]  # the next axes' sizes follow the children
             return parent, step, pos, length
 
         self.fan_out(op, cursor, symbol, cut)
+
+    def snaps_across(self, shapes: Shapes, axis: int, label: str | None) -> tuple[np.ndarray, np.ndarray]:
+        """Where the snap planes of each shape's lot cross its scope along ``axis`` (``SnapStore.across``)."""
+        axes = self.chunk.frames[shapes.frame]
+        return self.chunk.snaps.across(shapes.lot, shapes.origin, np.ascontiguousarray(axes[:, axis]),
+                                       np.ascontiguousarray(shapes.size[:, axis]), label, TOL.zero)
+
+    def snap(self, op: ir.Snap, cursor: Shapes, symbol: int) -> None:
+        """``Snap`` / ``SnapLines``: the lot's construction planes across the scope axis ``op.normal``,
+        through the scope's origin (and, for lines, its far end too)."""
+        axes = self.chunk.frames[cursor.frame]
+        normal = np.ascontiguousarray(axes[:, op.normal])
+        self.chunk.snaps.add(cursor.lot, cursor.origin.copy(), normal, op.label)
+        if op.lines:
+            far = cursor.origin + normal * cursor.size[:, op.normal, None]
+            self.chunk.snaps.add(cursor.lot, far, normal, op.label)
 
     def fan_out(self, op: ir.Split | ir.Repeat, cursor: Shapes, symbol: int, cut) -> None:
         """Split ``cursor`` along each of ``op.axes`` in turn and run the parts on the cells.

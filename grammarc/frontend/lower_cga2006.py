@@ -20,14 +20,13 @@ AXES = {
     "X": (0,), "Y": (1,), "Z": (2,),
     "XY": (0, 1), "XZ": (0, 2), "YZ": (1, 2), "XYZ": (0, 1, 2),
 }
-#: Snap split axes (paper section 3.3) belong to the context issue.
-SNAP_AXES = frozenset({"XS", "YS", "ZS", "XYS", "XZS", "YZS", "XYZS"})
+#: Snap split axes (paper section 3.3): the axis with ``S`` snaps to the lot's snap planes.
+SNAP_AXES = {"XS": (0,), "YS": (1,), "ZS": (2,)}
+#: The scope axis across a snap shape's plane, by the axes the paper names (``Snap("XZ")``: the floor
+#: plane, across y; ``Snap("Y")``: the vertical line of a facade, a plane through it and the facade's
+#: normal z, so across x).
+SNAP_NORMALS = {"XZ": 1, "ZX": 1, "XY": 2, "YX": 2, "YZ": 0, "ZY": 0, "X": 1, "Y": 0, "Z": 0}
 
-#: Operations of the paper that later issues implement: parsed, then reported with their line.
-NOT_YET = {
-    "Snap": "snap shapes (paper section 3.3)",
-    "SnapLines": "snap lines (paper section 3.3)",
-}
 #: The paper's roof types (section 3.1) and the roofs that build them: a cross gable is the gable roof of
 #: a cross-shaped footprint, a cone the pyramid of a many-sided one; mansard and gambrel are the hip and
 #: the gable roof with two slopes (``geometry.roofs``).
@@ -40,7 +39,7 @@ NOT_YET_QUERIES = {
     ("Shape", "visible"): "visibility queries `Shape.visible` (paper section 3.2)",
 }
 
-OPERATIONS = ("T", "S", "R", "Rx", "Ry", "Rz", "I", "Subdiv", "Repeat", "Comp", "Roof", *NOT_YET)
+OPERATIONS = ("T", "S", "R", "Rx", "Ry", "Rz", "I", "Subdiv", "Repeat", "Comp", "Roof", "Snap", "SnapLines")
 
 
 @dataclass(frozen=True, slots=True)
@@ -145,8 +144,6 @@ class Lowering(LoweringBase):
         return tuple(bodies)
 
     def symbol(self, meta, name):
-        if str(name) in NOT_YET:
-            return self.not_yet(str(name), NOT_YET[str(name)], self.token_span(name))
         return ir.Symbol(str(name), (), self.token_span(name), self.site())
 
     def empty(self, meta, tok):
@@ -171,8 +168,6 @@ class Lowering(LoweringBase):
         handler = _CALLS.get(op)
         if handler is not None:
             return handler(self, op, args, parts, span)
-        if op in NOT_YET:
-            return self.not_yet(op, NOT_YET[op], span)
         if parts is not None:
             self.diags.error("unknown-op", f"unknown operation `{op}`{suggest(op, OPERATIONS)}", span)
             return ir.Empty(span)
@@ -221,19 +216,26 @@ class Lowering(LoweringBase):
         self.diags.error("type", f"`{op}` expects {what} as a string literal", getattr(arg, "span", span))
         return None
 
-    def axes(self, op, arg, span) -> tuple[int, ...] | None:
+    def axes(self, op, arg, span) -> tuple[tuple[int, ...], bool] | None:
+        """A split's axes and whether it snaps (``"XS"``), or None after an error."""
         text = self.string_arg(op, arg, span, "an axis")
         if text is None:
             return None
         if text in SNAP_AXES:
-            self.not_yet(f"{op}(\"{text}\")", "snap split axes (paper section 3.3)", arg.span)
-            return None
+            return SNAP_AXES[text], True
         if text not in AXES:
+            known = [*AXES, *SNAP_AXES]
             self.diags.error(
-                "axis", f"unknown split axis \"{text}\", expected one of {', '.join(AXES)}", arg.span
+                "axis", f"unknown split axis \"{text}\", expected one of {', '.join(known)}", arg.span
             )
             return None
-        return AXES[text]
+        return AXES[text], False
+
+    def snap_label(self, op, args, snap: bool, span) -> tuple[tuple, str | None]:
+        """A snapped split's trailing label (``Subdiv("XS", ..., "tilesnap")``) and the other args."""
+        if snap and args and isinstance(args[-1], ir.Str):
+            return args[:-1], args[-1].value
+        return args, None
 
     def op_translate(self, op, args, parts, span):
         self.expect_no_parts(op, parts, span)
@@ -273,10 +275,12 @@ class Lowering(LoweringBase):
             self.diags.error("arity", f"`{op}` takes an axis and at least one size, "
                              f"got {_count(len(args), 'argument')}", span)
             return ir.Empty(span)
-        axes = self.axes(op, args[0], span)
-        sizes = tuple(self.size(a) for a in args[1:])
-        if axes is None:
+        chosen = self.axes(op, args[0], span)
+        if chosen is None:
             return ir.Empty(span)
+        axes, snap = chosen
+        rest, label = self.snap_label(op, args[1:], snap, span)
+        sizes = tuple(self.size(a) for a in rest)
         cells = len(sizes) ** len(axes)
         if len(parts) != cells and not (len(axes) > 1 and len(parts) == 1):
             self.diags.error(
@@ -286,7 +290,7 @@ class Lowering(LoweringBase):
                 span,
                 hint="give one successor per size, separated by `|` (use ε for an empty part)",
             )
-        return ir.Split(axes, sizes, parts, span, self.site())
+        return ir.Split(axes, sizes, parts, span, self.site(), snap, label)
 
     def op_repeat(self, op, args, parts, span):
         parts = self.expect_parts(op, parts, span)
@@ -294,14 +298,31 @@ class Lowering(LoweringBase):
             self.diags.error("arity", f"`{op}` takes an axis and a size per axis, "
                              f"got {_count(len(args), 'argument')}", span)
             return ir.Empty(span)
-        axes = self.axes(op, args[0], span)
-        if axes is None:
+        chosen = self.axes(op, args[0], span)
+        if chosen is None:
             return ir.Empty(span)
-        if len(args) - 1 != len(axes):
+        axes, snap = chosen
+        rest, label = self.snap_label(op, args[1:], snap, span)
+        if len(rest) != len(axes):
             self.diags.error("arity", f"`{op}(\"{args[0].value!s}\", ...)` takes {len(axes)} "
-                             f"size{'s' if len(axes) > 1 else ''}, got {len(args) - 1}", span)
+                             f"size{'s' if len(axes) > 1 else ''}, got {len(rest)}", span)
             return ir.Empty(span)
-        return ir.Repeat(axes, tuple(self.expr(a) for a in args[1:]), parts, span, self.site())
+        return ir.Repeat(axes, tuple(self.expr(a) for a in rest), parts, span, self.site(), snap, label)
+
+    def op_snap(self, op, args, parts, span):
+        """``Snap(axes[, label])`` and ``SnapLines(axes[, label])``: construction planes (``ir.Snap``)."""
+        self.expect_no_parts(op, parts, span)
+        if not self.expect_args(op, args, (1, 2), span):
+            return ir.Empty(span)
+        text = self.string_arg(op, args[0], span, "the axes of its plane")
+        label = self.string_arg(op, args[1], span, "a label") if len(args) == 2 else None
+        if text is None or (len(args) == 2 and label is None):
+            return ir.Empty(span)
+        if text not in SNAP_NORMALS:
+            self.diags.error("axis", f"unknown snap axes \"{text}\", expected one of "
+                             f"{', '.join(SNAP_NORMALS)}", args[0].span)
+            return ir.Empty(span)
+        return ir.Snap(SNAP_NORMALS[text], label, op == "SnapLines", span)
 
     def op_comp(self, op, args, parts, span):
         parts = self.expect_parts(op, parts, span)
@@ -394,6 +415,8 @@ _CALLS = {
     "I": Lowering.op_insert,
     "Subdiv": Lowering.op_subdiv,
     "Repeat": Lowering.op_repeat,
+    "Snap": Lowering.op_snap,
+    "SnapLines": Lowering.op_snap,
     "Comp": Lowering.op_comp,
     "Roof": Lowering.op_roof,
 }

@@ -285,6 +285,10 @@ class Split:
     parts: tuple[Body, ...]
     span: Span = NO_SPAN
     site: int = 0
+    #: ``Subdiv("XS", ...)``: each snap plane across the scope moves the split line nearest to it (paper
+    #: section 3.3); ``snap_label`` names the snap shapes to use (None: all of the lot's).
+    snap: bool = False
+    snap_label: str | None = None
 
 
 @dataclass(frozen=True, slots=True)
@@ -296,6 +300,23 @@ class Repeat:
     parts: tuple[Body, ...]
     span: Span = NO_SPAN
     site: int = 0
+    #: ``Repeat("XS", ...)``: the snap planes across the scope cut it first and each piece repeats on
+    #: its own (paper section 3.3); ``snap_label`` as for ``Split``.
+    snap: bool = False
+    snap_label: str | None = None
+
+
+@dataclass(frozen=True, slots=True)
+class Snap:
+    """The paper's ``Snap(axes[, label])`` and ``SnapLines(axes[, label])`` (section 3.3): construction
+    planes of the lot, for the snapped splits of later rules. ``normal`` is the scope axis across the
+    plane; ``Snap`` puts one plane through the scope's origin, ``SnapLines`` one at each end of the
+    scope along ``normal``. The shape itself goes on."""
+
+    normal: int
+    label: str | None
+    lines: bool
+    span: Span = NO_SPAN
 
 
 #: Component selectors of ``Comp``; those in COMP_INDEXED take an index argument.
@@ -558,7 +579,7 @@ class CompFaces:
 Op = (Symbol | Empty | Translate | Scale | Rotate | Push | Pop | Insert | Split | Repeat | Comp | Extrude
       | Center | UseAsset | Case | Stochastic | SetAttr | Report | NotApplied | GroupSplit | CompFaces
       | AlignScope | Mirror | Offset | SetColor | Setback | Roof | InnerRectangle | Convexify
-      | CleanupGeometry)
+      | CleanupGeometry | Snap)
 Body = tuple[Op, ...]
 
 

@@ -52,8 +52,12 @@ def _branches(op) -> str:
     return "{ " + " ".join(parts) + f" else: {print_body(op.default) or 'ε'} }}"
 
 
-def _axes(axes: tuple[int, ...]) -> str:
-    return '"' + "".join(_AXES[a] for a in axes) + '"'
+def _axes(axes: tuple[int, ...], snap: bool = False) -> str:
+    return '"' + "".join(_AXES[a] for a in axes) + ("S" if snap else "") + '"'
+
+
+def _label(label: str | None) -> str:
+    return f', "{label}"' if label is not None else ""
 
 
 def _parts(parts) -> str:
@@ -79,9 +83,14 @@ def print_op(op: ir.Op) -> str:
     if isinstance(op, ir.Insert):
         return f'I("{op.asset}")'
     if isinstance(op, ir.Split):
-        return f"Subdiv({_axes(op.axes)}, {', '.join(_size(s) for s in op.sizes)}){_parts(op.parts)}"
+        sizes = ", ".join(_size(s) for s in op.sizes)
+        return f"Subdiv({_axes(op.axes, op.snap)}, {sizes}{_label(op.snap_label)}){_parts(op.parts)}"
     if isinstance(op, ir.Repeat):
-        return f"Repeat({_axes(op.axes)}, {', '.join(print_expr(e) for e in op.sizes)}){_parts(op.parts)}"
+        sizes = ", ".join(print_expr(e) for e in op.sizes)
+        return f"Repeat({_axes(op.axes, op.snap)}, {sizes}{_label(op.snap_label)}){_parts(op.parts)}"
+    if isinstance(op, ir.Snap):
+        axes = {0: "Y", 1: "XZ", 2: "XY"}[op.normal]
+        return f'{"SnapLines" if op.lines else "Snap"}("{axes}"{_label(op.label)})'
     if isinstance(op, ir.Comp):
         index = f", {print_expr(op.index)}" if op.index is not None else ""
         return f'Comp("{op.kind}"{index}){_parts(op.parts)}'

@@ -56,7 +56,7 @@ def errors(text: str) -> list[tuple[int, int, str]]:
     ('a ~> Repeat("X"){ b }', [(1, 6, "`Repeat` takes an axis and a size per axis, got 1 argument")]),
     ('a ~> Repeat("X", 1r){ b }', [(1, 18, "a relative size like `1r` is only allowed in `S` and `Subdiv`")]),
     ('a ~> Subdiv("Q", 1){ b }',
-     [(1, 13, 'unknown split axis "Q", expected one of X, Y, Z, XY, XZ, YZ, XYZ')]),
+     [(1, 13, 'unknown split axis "Q", expected one of X, Y, Z, XY, XZ, YZ, XYZ, XS, YS, ZS')]),
     ("a ~> Subdiv(Y, 1){ b }", [(1, 13, "`Subdiv` expects an axis as a string literal")]),
     ("a ~> T(1, 2, 3){ b }", [(1, 6, "`T` takes no `{...}` body")]),
     # component splits
@@ -81,12 +81,6 @@ def test_lowering_errors(text, expected):
     ('a : Shape.occ("all") == "none" ~> b', 5, "`Shape.occ` is not supported yet"),
     ('a : Scope.occ("noparent") != "none" ~> b', 5, "`Scope.occ` is not supported yet"),
     ('a : Shape.visible("front") ~> b', 5, "`Shape.visible` is not supported yet"),
-    ('a ~> b Snap("XZ")', 8, "`Snap` is not supported yet"),
-    ('a ~> Snap("Y", "entrancesnap") b', 6, "`Snap` is not supported yet"),
-    ('a ~> b SnapLines("y")', 8, "`SnapLines` is not supported yet"),
-    ("a ~> b Snap", 8, "`Snap` is not supported yet"),
-    ('a ~> Repeat("XS", 2){ b }', 13, '`Repeat("XS")` is not supported yet'),
-    ('a ~> Subdiv("YS", 1r){ b }', 13, '`Subdiv("YS")` is not supported yet'),
 ])
 def test_not_supported_yet_each_with_its_line_and_nothing_else(text, col, what):
     # the second line proves the position is this construct's, and that nothing cascades from it
@@ -94,6 +88,33 @@ def test_not_supported_yet_each_with_its_line_and_nothing_else(text, col, what):
     assert [(d.span.line, d.span.col) for d in diags if d.is_error] == [(2, col)]
     [d] = [d for d in diags if d.is_error]
     assert d.message.startswith(what) and d.code == "not-supported"
+
+
+def test_snap_shapes_and_snapped_splits_lower_as_the_paper_writes_them():
+    from grammarc.ir import nodes as ir
+    from grammarc.ir.printer import print_op
+
+    module = run_passes(parse_source(
+        'a ~> Repeat("YS", 3){ b Snap("XZ") }\n'
+        'b ~> Subdiv("XS", 1r, 2, 7r, "tilesnap"){ c | d SnapLines("Y", "entrancesnap") | c }\n',
+        FILE, Diagnostics()), Diagnostics(), check=True)
+    repeat = module.rules[0].alternatives[0].body[0]
+    split = module.rules[1].alternatives[0].body[0]
+    assert isinstance(repeat, ir.Repeat) and repeat.snap and repeat.snap_label is None
+    assert split.snap and split.snap_label == "tilesnap" and len(split.sizes) == 3
+    assert print_op(repeat) == 'Repeat("YS", 3){ b Snap("XZ") }'
+    assert print_op(split.parts[1][1]) == 'SnapLines("Y", "entrancesnap")'
+
+
+@pytest.mark.parametrize("text, expected", [
+    ('a ~> b Snap("W")', [(1, 13, 'unknown snap axes "W", expected one of XZ, ZX, XY, YX, YZ, ZY, X, Y, Z')]),
+    ('a ~> b Snap("X", "a", "b")', [(1, 8, "`Snap` takes 1 or 2 arguments, got 3")]),
+    ('a ~> b SnapLines(3)', [(1, 18, "`SnapLines` expects the axes of its plane as a string literal")]),
+    ('a ~> Repeat("WS", 2){ b }', [(1, 13, ('unknown split axis "WS", expected one of X, Y, Z, XY, XZ, YZ, XYZ, '
+                                           'XS, YS, ZS'))]),
+])
+def test_snap_errors(text, expected):
+    assert errors(text) == expected
 
 
 def test_errors_inside_nested_bodies_are_found():

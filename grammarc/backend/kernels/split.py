@@ -269,3 +269,78 @@ def _place(parent, part, pos, length, index, m, i, j, at, size, extent, tol, chi
         m += 1
         child += 1
     return m, at + size, child
+
+
+@njit(cache=True)
+def snap_subdiv(parent, pos, length, offsets, snaps):
+    """Subdiv children moved to snap planes (paper section 3.3, Fig. 9 right): each snap position of a
+    parent moves the line between two of its consecutive children nearest to it there, if both keep a
+    positive length; a line two snaps would move goes to the nearer. ``parent``, ``pos``, ``length``
+    (m,) the children, grouped by parent in order; ``offsets`` (n+1,) and ``snaps`` (k,) each parent's
+    sorted positions. Changes pos and length in place."""
+    m = len(parent)
+    best = np.full(m, np.inf)  # per line (after child c): distance and position of its nearest snap
+    target = np.zeros(m)
+    c = 0
+    while c < m:
+        p = parent[c]
+        end = c
+        while end < m and parent[end] == p:
+            end += 1
+        for s in range(offsets[p], offsets[p + 1]):
+            t = snaps[s]
+            line = -1
+            for k in range(c, end - 1):  # the line between child k and k + 1
+                d = abs(pos[k] + length[k] - t)
+                if line < 0 or d < abs(pos[line] + length[line] - t):
+                    line = k
+            if line >= 0 and pos[line] < t < pos[line + 1] + length[line + 1]:
+                d = abs(pos[line] + length[line] - t)
+                if d < best[line]:
+                    best[line] = d
+                    target[line] = t
+        for k in range(c, end - 1):
+            if best[k] < np.inf:
+                right = pos[k + 1] + length[k + 1]
+                length[k] = target[k] - pos[k]
+                pos[k + 1] = target[k]
+                length[k + 1] = right - target[k]
+        c = end
+
+
+@njit(cache=True)
+def snapped_repeat(extent, size, offsets, snaps, tol):
+    """Children of a snapped ``Repeat`` (paper section 3.3, Fig. 9 left): the snap positions cut each
+    extent into pieces first and each piece repeats on its own, ceil(piece / size) equal elements.
+    Returns parent, part (the element's number within its parent), position and length."""
+    n = len(extent)
+    total = 0
+    for i in range(n):
+        at = 0.0
+        for s in range(offsets[i], offsets[i + 1] + 1):
+            stop = snaps[s] if s < offsets[i + 1] else extent[i]
+            if stop - at > tol:
+                total += max(int(np.ceil((stop - at) / size[i] - 1e-9)), 1)
+            at = stop
+    parent = np.empty(total, np.int64)
+    part = np.empty(total, np.int64)
+    pos = np.empty(total)
+    length = np.empty(total)
+    m = 0
+    for i in range(n):
+        at = 0.0
+        j = 0
+        for s in range(offsets[i], offsets[i + 1] + 1):
+            stop = snaps[s] if s < offsets[i + 1] else extent[i]
+            if stop - at > tol:
+                count = max(int(np.ceil((stop - at) / size[i] - 1e-9)), 1)
+                step = (stop - at) / count
+                for e in range(count):
+                    parent[m] = i
+                    part[m] = j
+                    pos[m] = at + e * step
+                    length[m] = step
+                    m += 1
+                    j += 1
+            at = stop
+    return parent, part, pos, length
