@@ -1,0 +1,172 @@
+"""Assembly of a CityEngine CGA file's lowered statements into one IR module: the start rule, rules
+overloaded by arity (one symbol per arity), functions and constants inlined, imported modules merged
+under their prefixes.
+"""
+
+from __future__ import annotations
+
+from dataclasses import replace
+
+from grammarc.diagnostics import Diagnostics, Span, suggest
+from grammarc.frontend.cityengine_nodes import Annotated, FunctionDef, RuleDef, Style
+from grammarc.ir import nodes as ir
+from grammarc.ir.traverse import rewrite_body, rewrite_expr, sub_bodies
+
+
+def assemble(file: str, statements: list, diags: Diagnostics, imports=()) -> ir.Module:
+    """Declarations in source order -> Module: start rule, overloads by arity, functions inlined, the
+    imported modules' rules and attributes merged under their prefixes."""
+    attrs: list[ir.AttrDecl] = []
+    functions: dict[str, FunctionDef] = {}
+    rules: list[tuple[RuleDef, tuple]] = []
+    style = None
+    for st in statements:
+        if not isinstance(st, Annotated):
+            st = Annotated((), st)  # a declaration without annotations comes bare from the parser
+        decl = st.declaration
+        if isinstance(decl, Style):
+            if style is None:
+                diags.warning("style", f"style `{decl.name}` is not derived: grammarc derives the Default "
+                              "style (PRT's Default$...)", decl.span)
+            style = decl
+            continue
+        if style is not None and isinstance(decl, ir.AttrDecl):
+            continue  # a redefinition for the style
+        if isinstance(decl, ir.AttrDecl):
+            if any(a.name == decl.name for a in attrs):
+                diags.error("duplicate-attr", f"attribute `{decl.name}` is declared twice", decl.span)
+            attrs.append(replace(decl, annotations=st.annotations))
+        elif isinstance(decl, FunctionDef):
+            functions[decl.name] = decl
+        elif isinstance(decl, RuleDef):
+            rules.append((decl, st.annotations))
+    arities: dict[str, set[int]] = {}
+    for rule, _ in rules:
+        arities.setdefault(rule.name, set()).add(len(rule.params))
+
+    def symbol_name(name: str, arity: int) -> str:
+        return f"{name}/{arity}" if len(arities.get(name, ())) > 1 else name
+
+    inline = _Inliner(functions, {a.name for a in attrs}, diags)
+    attrs = [replace(a, default=inline.expr(a.default, frozenset())) for a in attrs]
+    start = None
+    lowered: list[ir.Rule] = []
+    for rule, notes in rules:
+        name = symbol_name(rule.name, len(rule.params))
+        if any(a[0] == "StartRule" for a in notes) and start is None:
+            start = name
+        params = frozenset(rule.params)
+        # a leaf `X.` names a shape, not a rule: it keeps its name when rules `X` are overloaded
+        body = _map_symbols(rule.body, lambda op: replace(op, name=symbol_name(op.name, len(op.args)))
+                            if op.name in arities and not op.leaf else op)
+        body = rewrite_body(body, lambda e, p=params: inline.expr(e, p))
+        lowered.append(ir.Rule(symbol=name, params=rule.params, guard=None,
+                               alternatives=(ir.Alternative(body, None, rule.span),), priority=0,
+                               span=rule.span, site=rule.site))
+    if start is None and lowered:
+        start = lowered[0].symbol
+    imported = []
+    for statement, module in imports:
+        more_attrs, more_rules = _prefixed(module, statement.prefix, {a.name for a in attrs})
+        attrs.extend(more_attrs)
+        lowered.extend(more_rules)
+        imported.extend((module.file, *module.imported))
+    return ir.Module(file=file, attrs=tuple(attrs), rules=tuple(lowered), start=start, dialect="cityengine",
+                     imported=tuple(dict.fromkeys(imported)))
+
+
+def _prefixed(module: ir.Module, prefix: str | None, forwarded: set[str]):
+    """An imported module's attributes and rules under ``prefix.``; its attributes that the importing
+    file declares too are dropped, so that their names resolve to the importer's (forwarding)."""
+    if prefix is None:
+        return [a for a in module.attrs if a.name not in forwarded], list(module.rules)
+    own_attrs = {a.name for a in module.attrs} - forwarded
+
+    def rename(params):
+        def visit(e):
+            if isinstance(e, ir.Name) and e.name in own_attrs and e.name not in params:
+                return replace(e, name=f"{prefix}.{e.name}")
+            if isinstance(e, ir.AttrRef) and e.name in own_attrs:  # from an inlined function
+                return replace(e, name=f"{prefix}.{e.name}")
+            return e
+        return visit
+
+    attrs = [replace(a, name=f"{prefix}.{a.name}", default=rewrite_expr(a.default, rename(())))
+             for a in module.attrs if a.name in own_attrs]
+    rules = []
+    for rule in module.rules:
+        bodies = []
+        for alt in rule.alternatives:
+            body = _map_symbols(alt.body, lambda op: replace(op, name=f"{prefix}.{op.name}"))
+            bodies.append(replace(alt, body=rewrite_body(body, rename(set(rule.params)))))
+        rules.append(replace(rule, symbol=f"{prefix}.{rule.symbol}", alternatives=tuple(bodies)))
+    return attrs, rules
+
+
+def _map_symbols(body: ir.Body, fn) -> ir.Body:
+    """``body`` with ``fn`` applied to every successor symbol, nested bodies included."""
+    out = []
+    for op in body:
+        if isinstance(op, ir.Symbol):
+            op = fn(op)
+        elif isinstance(op, (ir.Case, ir.Stochastic)):
+            op = replace(op, branches=tuple((c, _map_symbols(b, fn)) for c, b in op.branches),
+                         default=_map_symbols(op.default, fn))
+        elif sub_bodies(op):
+            op = replace(op, parts=tuple(_map_symbols(b, fn) for b in op.parts))
+        out.append(op)
+    return tuple(out)
+
+
+class _Inliner:
+    """Replaces calls of user functions (and bare names of parameterless ones) by their bodies.
+
+    A function's body is inlined in its own scope (its parameters, then the attributes) before the
+    caller's arguments are bound, so that its names never see the parameters of the rule that calls it.
+    """
+
+    def __init__(self, functions: dict[str, FunctionDef], attrs: set[str], diags: Diagnostics):
+        self.functions = functions
+        self.attrs = attrs
+        self.diags = diags
+        #: Function name -> its body with the functions it calls inlined (computed once per function).
+        self.bodies: dict[str, ir.Expr] = {}
+
+    def expr(self, expr: ir.Expr, params: frozenset, calling: tuple[str, ...] = ()) -> ir.Expr:
+        """``expr`` with user functions inlined; ``calling`` are the functions being inlined around it."""
+        def visit(e: ir.Expr) -> ir.Expr:
+            if isinstance(e, ir.Name) and e.name not in params and e.name not in self.attrs \
+                    and e.name in self.functions and not self.functions[e.name].params:
+                return self.call(self.functions[e.name], (), e.span, calling)
+            if isinstance(e, ir.Call) and e.func not in ir.FUNCTIONS and e.func not in ir.CONVERSIONS:
+                fn = self.functions.get(e.func)
+                if fn is None:
+                    self.diags.error("unknown-function", f"unknown function `{e.func}`"
+                                     f"{suggest(e.func, [*ir.FUNCTIONS, *self.functions])}", e.span)
+                    return ir.placeholder(e.span)
+                if len(fn.params) != len(e.args):
+                    self.diags.error("arity", f"`{e.func}` takes {len(fn.params)} arguments, got "
+                                     f"{len(e.args)}", e.span)
+                    return ir.placeholder(e.span)
+                return self.call(fn, e.args, e.span, calling)
+            return e
+
+        return rewrite_expr(expr, visit)
+
+    def call(self, fn: FunctionDef, args: tuple, span: Span, calling: tuple[str, ...]) -> ir.Expr:
+        if fn.name in calling:
+            # reported where the function calls itself, once (its body is inlined once)
+            self.diags.error("unsupported", f"unsupported: recursive function `{fn.name}`", span)
+            return ir.placeholder(span)
+        if fn.name not in self.bodies:
+            self.bodies[fn.name] = self.expr(fn.value, frozenset(fn.params), (*calling, fn.name))
+        bound = dict(zip(fn.params, args))
+
+        def substitute(e: ir.Expr) -> ir.Expr:
+            if not isinstance(e, ir.Name):
+                return e
+            if e.name in bound:
+                return bound[e.name]  # the caller's expression, already inlined in the caller's scope
+            return ir.AttrRef(e.name, e.span) if e.name in self.attrs else e
+
+        return rewrite_expr(self.bodies[fn.name], substitute)

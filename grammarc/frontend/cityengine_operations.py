@@ -1,0 +1,385 @@
+"""The operations of CityEngine CGA lowered to IR operations (``split``, ``comp``, ``setback``, roofs,
+scope operations, ``set``, ``report``...): the mixin of ``lower_cityengine.Lowering``, with the tables of
+operation names, selectors and roof arguments it checks calls against. An operation or construct grammarc
+does not implement is an error ``unsupported: NAME`` at its span.
+"""
+
+from __future__ import annotations
+
+from grammarc.diagnostics import suggest
+from grammarc.frontend.cityengine_nodes import EdgeDistances, Group, Part, PendingOffset, Sized
+from grammarc.ir import nodes as ir
+
+
+class OperationLowering:
+    """The operation handlers of ``Lowering`` (which provides ``expr``, ``diags``, ``site``...)."""
+
+    def arity(self, op, args, counts, span) -> bool:
+        if len(args) in counts:
+            return True
+        want = " or ".join(str(c) for c in counts)
+        self.diags.error("arity", f"`{op}` takes {want} arguments, got {len(args)}", span)
+        return False
+
+    def op_roof(self, op, args, span):
+        """``roofHip``, ``roofGable``, ``roofShed``, ``roofPyramid``: by angle, or with a leading
+        ``byAngle``/``byHeight`` selector. The arguments after the value, in CityEngine's order:
+        hip (overhang, even), gable (overhangX, overhangY, even, index), shed (index), pyramid none."""
+        by_height = False
+        if args and isinstance(args[0], ir.Name) and args[0].name in ("byAngle", "byHeight"):
+            by_height = args[0].name == "byHeight"
+            args = args[1:]
+        names = ROOF_ARGUMENTS[op] + (("index",) if op == "roofGable" and not by_height else ())
+        if not 1 <= len(args) <= 1 + len(names):
+            self.diags.error("arity", f"`{op}` takes 1 to {1 + len(names)} arguments after the "
+                             f"byAngle/byHeight selector, got {len(args)}", span)
+            return ir.Empty(span)
+        given = dict(zip(names, (self.expr(a) for a in args[1:])))
+        even = given.get("even")
+        if even is not None and not (isinstance(even, ir.Bool) and not even.value):
+            return self.unsupported(f"{op} with even ridges", even.span,
+                                    "only even = false: even ridges make non-planar faces")
+        if op == "roofGable" and "index" in given:
+            return self.unsupported("roofGable with an edge index", given["index"].span,
+                                    "the ridge follows the straight skeleton")
+        zero = ir.Num(0.0, span)
+        overhang = given.get("overhang", given.get("overhangX", zero))
+        index = given.get("index", zero) if op == "roofShed" else zero
+        return ir.Roof(op, self.expr(args[0]), by_height, overhang, given.get("overhangY"), index, span)
+
+    def op_envelope(self, op, args, span):
+        """``envelope(normal|world.up, maxHeight, baseHeight, angle, ...)``: one (baseHeight, angle) pair,
+        or the pairs for front, back, sides (or right and left), which must come out equal."""
+        if len(args) not in (4, 6, 8, 10):
+            return self.unsupported(f"envelope with {len(args)} arguments", span,
+                                    "envelope(direction, maxHeight, baseHeight, angle, ...) with 1 to 4 sides")
+        if not isinstance(args[0], ir.Name) or args[0].name not in ("normal", "world.up", "face.normal"):
+            return self.unsupported("envelope with this direction", span, "normal or world.up")
+        pairs = [(self.expr(args[k]), self.expr(args[k + 1])) for k in range(2, len(args), 2)]
+        (base, angle), others = pairs[0], tuple(pairs[1:])
+        zero = ir.Num(0.0, span)
+        return ir.Roof("envelope", angle, False, base, None, zero, span, cap=self.expr(args[1]), sides=others)
+
+    def op_extrude(self, op, args, span):
+        if len(args) != 1:
+            return self.unsupported(f"extrude with {len(args)} arguments", span, "only extrude(height)")
+        return ir.Extrude(self.expr(args[0]), span)
+
+    def op_translate(self, op, args, span):
+        if not self.arity(op, args, (3,), span):
+            return ir.Empty(span)
+        return ir.Translate(tuple(self.scoped(a, axis) for axis, a in enumerate(args)), span)
+
+    def scoped(self, arg, axis: int) -> ir.Expr:
+        """``'v`` in ``t``: v times the scope size on that axis."""
+        if isinstance(arg, Sized) and arg.kind is ir.SizeKind.RELATIVE:
+            return ir.Binary("*", arg.value, ir.ScopeRef("s" + "xyz"[axis], arg.span), arg.span)
+        return self.expr(arg)
+
+    def op_scale(self, op, args, span):
+        if not self.arity(op, args, (3,), span):
+            return ir.Empty(span)
+        sizes = []
+        for a in args:
+            if isinstance(a, Sized) and a.kind is ir.SizeKind.RELATIVE:
+                sizes.append(ir.Size(ir.SizeKind.RELATIVE, a.value, a.span))
+            else:
+                value = self.expr(a)
+                sizes.append(ir.Size(ir.SizeKind.ABSOLUTE, value, getattr(value, "span", span)))
+        return ir.Scale(tuple(sizes), span)
+
+    def op_rotate(self, op, args, span):
+        if len(args) != 3:
+            return self.unsupported(f"r with {len(args)} arguments", span, "only r(x, y, z)")
+        return ir.Rotate(tuple(self.expr(a) for a in args), span)
+
+    def op_color(self, op, args, span):
+        if len(args) not in (1, 3, 4):
+            return self.unsupported(f"color with {len(args)} arguments", span,
+                                    'color(r, g, b) or color("#rrggbb")')
+        return ir.SetColor(tuple(self.expr(a) for a in args[:3]), span)
+
+    def op_offset(self, op, args, span):
+        if len(args) == 1:
+            return PendingOffset(self.expr(args[0]), span)
+        if len(args) == 2 and isinstance(args[1], ir.Name) and args[1].name in ("inside", "border"):
+            return ir.Offset(self.expr(args[0]), args[1].name, span)
+        return self.unsupported("offset with these arguments", span,
+                                "offset(d), offset(d, inside), offset(d, border)")
+
+    def op_mirror(self, op, args, span):
+        if not self.arity(op, args, (3,), span):
+            return ir.Empty(span)
+        return ir.Mirror(tuple(self.expr(a) for a in args), span)
+
+    def op_align(self, op, args, span):
+        if not args or (len(args) == 1 and isinstance(args[0], ir.Name) and args[0].name == "world.xyz"):
+            return ir.AlignScope("world", None, span)
+        if len(args) == 1 and isinstance(args[0], ir.Name) and args[0].name in ("y", "world.y"):
+            return ir.AlignScope("y", None, span)
+        return self.unsupported("alignScopeToAxes with this axis", span,
+                                "alignScopeToAxes(), alignScopeToAxes(world.xyz) and alignScopeToAxes(y)")
+
+    def op_align_geometry(self, op, args, span):
+        if len(args) not in (2, 3) or not isinstance(args[0], ir.Name) or args[0].name not in ("yUp", "zUp"):
+            return self.unsupported("alignScopeToGeometry with these arguments", span,
+                                    "alignScopeToGeometry(yUp|zUp, 0[, edgeIndex])")
+        face = self.expr(args[1])
+        if not (isinstance(face, ir.Num) and face.value == 0):
+            return self.unsupported("alignScopeToGeometry on a face other than 0", getattr(face, "span", span))
+        edge = self.expr(args[2]) if len(args) == 3 else ir.Num(0.0, span)
+        return ir.AlignScope("geometry-" + args[0].name[0], (edge, ir.Num(0.0), ir.Num(0.0)), span)
+
+    def op_rotate_scope(self, op, args, span):
+        if len(args) != 3:
+            return self.unsupported(f"rotateScope with {len(args)} arguments", span)
+        return ir.AlignScope("rotate", tuple(self.expr(a) for a in args), span)
+
+    def op_center(self, op, args, span):
+        axes = self.axis_argument(op, args, span)
+        return ir.Center(axes, span) if axes else ir.Empty(span)
+
+    def axis_argument(self, op, args, span) -> tuple[int, ...]:
+        if len(args) == 1 and isinstance(args[0], ir.Name) and args[0].name in AXIS_NAMES:
+            return AXIS_NAMES[args[0].name]
+        self.diags.error("axis", f"`{op}` expects an axis selector (x, y, z, xy, xz, yz, xyz)", span)
+        return ()
+
+    def op_insert(self, op, args, span):
+        if len(args) != 1:
+            return self.unsupported(f"i with {len(args)} arguments", span, "only i(asset)")
+        if isinstance(args[0], ir.Str):
+            return ir.UseAsset(args[0].value, span)
+        return ir.UseAsset("", span, name=self.expr(args[0]))
+
+    def op_cube(self, op, args, span):
+        if args:
+            return self.unsupported("primitiveCube with arguments", span)
+        return ir.UseAsset("builtin:cube", span)
+
+    def op_nil(self, op, args, span):
+        return ir.Empty(span)
+
+    def op_set(self, op, args, span):
+        if not self.arity(op, args, (2,), span):
+            return ir.Empty(span)
+        target = args[0]
+        if isinstance(target, ir.Name) and target.name in ir.SHAPE_ATTRIBUTES:
+            return ir.SetAttr(target.name, self.expr(args[1]), span)
+        if isinstance(target, ir.Name) and target.name == "trim.horizontal":
+            value = self.expr(args[1])
+            if isinstance(value, ir.Bool) and not value.value:
+                return ir.NotApplied("set(trim.horizontal)", span)  # CityEngine's default
+            return self.unsupported("set(trim.horizontal, ...) other than false", span,
+                                    "horizontal trim planes are not made")
+        if isinstance(target, ir.Name) and target.name.startswith("material."):
+            return ir.NotApplied(f"set({target.name})", span)
+        if not isinstance(target, ir.Name):
+            return self.unsupported("set of this target", span, "set(attribute, value)")
+        return ir.SetAttr(target.name, self.expr(args[1]), span)
+
+    def op_report(self, op, args, span):
+        if not self.arity(op, args, (2,), span):
+            return ir.Empty(span)
+        return ir.Report(self.expr(args[0]), self.expr(args[1]), span)
+
+    def op_split(self, args, parts, repeat, span):
+        if not args or not isinstance(args[0], ir.Name) or args[0].name not in ("x", "y", "z"):
+            self.diags.error("axis", "`split` expects an axis x, y or z", span)
+            return ir.Empty(span)
+        for extra in args[1:]:
+            if not (isinstance(extra, ir.Name) and extra.name in ("adjust", "noAdjust")):
+                return self.unsupported("this split option", getattr(extra, "span", span))
+            if extra.name == "noAdjust":
+                return self.unsupported("split(..., noAdjust)", extra.span)
+        sizes, groups, bodies = [], [], []
+        n_groups = 0
+        for item in parts:
+            if isinstance(item, Group):
+                for inner in item.parts:
+                    if isinstance(inner, Group):
+                        return self.unsupported("nested repeat groups", inner.span)
+                    sizes.append(self.size_of(inner))
+                    groups.append(n_groups)
+                    bodies.append(inner.body)
+                n_groups += 1
+            else:
+                sizes.append(self.size_of(item))
+                groups.append(-1)
+                bodies.append(item.body)
+        return ir.GroupSplit("xyz".index(args[0].name), tuple(sizes), tuple(groups), tuple(bodies), repeat,
+                             span, self.site())
+
+    def size_of(self, part: Part) -> ir.Size:
+        if part.merged:
+            self.unsupported("`=` in split", part.span)
+        return ir.Size(part.size.kind, part.size.value, part.size.span)
+
+    def op_comp(self, args, parts, span):
+        if len(args) != 1 or not isinstance(args[0], ir.Name) or args[0].name not in COMP_SELECTORS:
+            kind = args[0].name if args and isinstance(args[0], ir.Name) else "?"
+            return self.unsupported(f"comp({kind})", span, "comp(f), comp(e) and comp(v)")
+        kind = args[0].name
+        known = COMP_SELECTORS[kind]
+        selectors, bodies = [], []
+        for part in parts:
+            if isinstance(part, Group):
+                return self.unsupported("repeat group in comp", part.span)
+            value = part.size.value
+            if part.size.kind is not ir.SizeKind.ABSOLUTE or not isinstance(value, ir.Name):
+                return self.unsupported("this comp selector", part.span)
+            if value.name not in known:
+                why = f"comp({kind}) selects {', '.join(sorted(known))}" + suggest(value.name, known)
+                return self.unsupported(f"comp({kind}) selector `{value.name}`", value.span, why)
+            if part.merged:
+                self.diags.warning(
+                    "merged", f"`{value.name}=` gives one shape for all its faces in CityEngine; grammarc "
+                    "derives them one by one (the same leaves; operations that read the scope differ)",
+                    part.span)
+            selectors.append(value.name)
+            bodies.append(part.body)
+        return ir.CompFaces(tuple(selectors), tuple(bodies), span, self.site(), kind)
+
+    def op_setback(self, op, args, parts, span):
+        """``setback(d) { sel: A | remainder: B }``; ``shapeL/U/O(widths...) { shape: A | remainder: B }``;
+        ``setback(comp(fe){ sel: d | ... }) { ... }`` with distances per edge."""
+        sides = SETBACK_OPS[op]
+        if op == "setback" and len(args) == 1 and isinstance(args[0], EdgeDistances):
+            chosen = self.selector_parts(op, parts, SETBACK_SELECTORS)
+            if chosen is None:
+                return ir.Empty(span)
+            return ir.Setback(args[0].values, chosen[0], chosen[1], span, self.site(), per_edge=True)
+        if not self.arity(op, args, (len(sides) if sides else 1,), span):
+            return None
+        known = SETBACK_SELECTORS if not sides else frozenset({"shape", "remainder"})
+        chosen = self.selector_parts(op, parts, known)
+        if chosen is None:
+            return ir.Empty(span)
+        selectors = tuple("all" if s == "shape" else s for s in chosen[0])
+        exprs = tuple(self.expr(a) for a in args)
+        if sides:
+            distances = tuple(zip(sides, exprs))
+        else:
+            distances = tuple((s, exprs[0]) for s in selectors if s != "remainder")
+        return ir.Setback(distances, selectors, chosen[1], span, self.site())
+
+    def op_convexify(self, op, args, span):
+        if len(args) > 1:
+            return self.unsupported(f"convexify with {len(args)} arguments", span,
+                                    "convexify() and convexify(maxLength)")
+        return ir.Convexify(self.expr(args[0]) if args else None, span)
+
+    def op_cleanup(self, op, args, span):
+        """``cleanupGeometry(components, tolerance)``, components one of ``ir.CLEANUP_COMPONENTS``."""
+        if not self.arity(op, args, (2,), span):
+            return ir.Empty(span)
+        component = args[0]
+        known = ir.CLEANUP_COMPONENTS
+        if not isinstance(component, ir.Name) or component.name not in known:
+            got = (f"`{component.name}`{suggest(component.name, known)}" if isinstance(component, ir.Name)
+                   else "a string" if isinstance(component, ir.Str) else "an expression")
+            self.diags.error("component", f"`{op}` cleans up {', '.join(sorted(known))}, got {got}",
+                             getattr(component, "span", span))
+            return ir.Empty(span)
+        return ir.CleanupGeometry(component.name, self.expr(args[1]), span)
+
+    def op_inner_rectangle(self, op, args, parts, span):
+        """``innerRectangle(scope|edge) { shape: A | remainder: B }``."""
+        if len(args) != 1 or not isinstance(args[0], ir.Name) or args[0].name not in ("scope", "edge"):
+            return self.unsupported("innerRectangle with these arguments", span,
+                                    "innerRectangle(scope) and innerRectangle(edge)")
+        chosen = self.selector_parts(op, parts, frozenset({"shape", "remainder"}))
+        if chosen is None:
+            return ir.Empty(span)
+        return ir.InnerRectangle(args[0].name, chosen[0], chosen[1], span, self.site())
+
+    def selector_parts(self, op, parts, known):
+        """The selectors and bodies of ``{ sel: A | ... }`` parts, all among ``known`` (None after an
+        error); ``sel=`` is derived as ``sel:``, with a warning."""
+        selectors, bodies = [], []
+        for part in parts:
+            if isinstance(part, Group):
+                self.unsupported(f"repeat group in {op}", part.span)
+                return None
+            value = part.size.value
+            if part.size.kind is not ir.SizeKind.ABSOLUTE or not isinstance(value, ir.Name):
+                self.unsupported(f"this {op} selector", part.span)
+                return None
+            if value.name not in known:
+                why = f"{op} selects {', '.join(sorted(known - {'remainder'}))} and remainder"
+                self.unsupported(f"{op} selector `{value.name}`", value.span, why + suggest(value.name, known))
+                return None
+            if part.merged:
+                self.diags.warning(
+                    "merged", f"`{value.name}=` gives one shape for all its polygons in CityEngine; grammarc "
+                    "derives them one by one (the same leaves; operations that read the scope differ)",
+                    part.span)
+            selectors.append(value.name)
+            bodies.append(part.body)
+        return tuple(selectors), tuple(bodies)
+
+
+OPS = {
+    "color": OperationLowering.op_color,
+    "offset": OperationLowering.op_offset,
+    "mirror": OperationLowering.op_mirror,
+    "alignScopeToAxes": OperationLowering.op_align,
+    "alignScopeToGeometry": OperationLowering.op_align_geometry,
+    "rotateScope": OperationLowering.op_rotate_scope,
+    "extrude": OperationLowering.op_extrude,
+    "t": OperationLowering.op_translate,
+    "s": OperationLowering.op_scale,
+    "r": OperationLowering.op_rotate,
+    "center": OperationLowering.op_center,
+    "i": OperationLowering.op_insert,
+    "primitiveCube": OperationLowering.op_cube,
+    "NIL": OperationLowering.op_nil,
+    "set": OperationLowering.op_set,
+    "report": OperationLowering.op_report,
+    "convexify": OperationLowering.op_convexify,
+    "cleanupGeometry": OperationLowering.op_cleanup,
+    "envelope": OperationLowering.op_envelope,
+    "roofHip": OperationLowering.op_roof,
+    "roofGable": OperationLowering.op_roof,
+    "roofShed": OperationLowering.op_roof,
+    "roofPyramid": OperationLowering.op_roof,
+}
+#: The optional arguments after a roof's value (roofGable's ``index`` only by angle).
+ROOF_ARGUMENTS = {"roofHip": ("overhang", "even"), "roofGable": ("overhangX", "overhangY", "even"),
+                   "roofShed": ("index",), "roofPyramid": ()}
+#: Operations CityEngine also takes without their parentheses (other bare names are rules).
+BARE_OPS = frozenset({"NIL", "primitiveCube", "convexify"})
+SPLIT_OPS = frozenset({"split", "comp"})
+#: CityEngine's street selectors (``geometry.streets``): the lot's street edges and the faces along them.
+STREET_SELECTORS = frozenset(f"street.{s}" for s in ("front", "back", "left", "right", "side"))
+COMP_SELECTORS = {
+    "f": ir.FACE_SELECTORS | ir.OFFSET_SELECTORS | STREET_SELECTORS
+    | {f"{frame}.{s}" for frame in ("object", "world") for s in ir.FACE_SELECTORS},
+    "e": ir.EDGE_SELECTORS,
+    "v": ir.VERTEX_SELECTORS,
+}
+#: Setback operations and the edges their distances move (``setback`` moves those its parts select).
+SETBACK_OPS = {"setback": (), "shapeL": ("front", "left"), "shapeU": ("front", "right", "left"),
+                "shapeO": ("front", "right", "back", "left")}
+#: Edge selectors of ``setback``: an edge is named as the face an extrusion of the polygon would make of it.
+SETBACK_SELECTORS = (COMP_SELECTORS["f"] - ir.OFFSET_SELECTORS) | {"all", "remainder", "streetSide", "noStreetSide"}
+#: Shape attributes that grammarc does not provide yet: comp.index, split.index, initialShape.origin...
+UNSUPPORTED_MEMBERS = frozenset({"comp", "split", "initialShape", "geometry"})
+#: Operations that are parsed and accepted but do not change the record (listed in its meta).
+NOT_APPLIED = frozenset({
+    "texture", "setupProjection", "projectUV", "tileUV", "translateUV", "scaleUV", "rotateUV",
+    "normalizeUV", "deleteUV", "reverseNormals", "print", "setNormals", "softenNormals", "label",
+    # the pivot only moves the model's own origin in an export; scope.t* stay relative to the lot
+    "setPivot",
+})
+#: CityEngine operations grammarc does not implement yet (the geometry and context issues bring most).
+UNSUPPORTED_OPS = frozenset({
+    "innerPolygon",
+    "trim",
+    "mirrorScope",
+    "insertAlongUV", "scatter", "footprint", "tileUV", "splitArea", "inline", "resetGeometry", "taper",
+    "primitiveCylinder", "primitiveSphere", "primitiveDisk", "primitiveCone", "primitiveQuad",
+    "deleteHoles", "reduceGeometry", "rectify", "semiPolygon",
+} - NOT_APPLIED)
+#: Axis selectors of ``center`` and ``alignScopeToAxes``.
+AXIS_NAMES = {"x": (0,), "y": (1,), "z": (2,), "xy": (0, 1), "xz": (0, 2), "yz": (1, 2), "xyz": (0, 1, 2)}
