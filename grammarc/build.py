@@ -24,6 +24,7 @@ import numpy as np
 from grammarc import __version__
 from grammarc.backend.attributes import check_overrides
 from grammarc.backend.derive import derive_chunk
+from grammarc.backend.occlusion import Occluders
 from grammarc.backend.plan import make_plan
 from grammarc.backend.reports import Reports
 from grammarc.compiler import Grammar, compile_grammar
@@ -184,15 +185,17 @@ def _derive_all(plan, lots: Lots, options: BuildOptions, writer, failed: list[Ba
 
     A chunk holds at most ``options.chunk_size`` lots, and fewer when the lots so far made many records:
     the next chunk aims at ``ROWS_PER_CHUNK`` records, which keeps its arrays in the caches and its memory
-    small whatever the grammar. The records do not depend on the chunking.
+    small whatever the grammar. The records do not depend on the chunking. A grammar whose occlusion
+    queries look at other lots is derived twice: first for everyone's occluders (``_occluders``).
     """
     derived = 0
     first = 0
     size = min(options.chunk_size, 64)
     rows = 0
+    foreign = _occluders(plan, lots, options) if plan.inter else None
     while first < len(lots):
         part = lots.take(slice(first, first + size))
-        derived_now, made = _derive(plan, part, options, writer, failed, reports)
+        derived_now, made = _derive(plan, part, options, writer, failed, reports, foreign)
         derived += derived_now
         rows += made
         first += len(part)
@@ -204,34 +207,56 @@ def _derive_all(plan, lots: Lots, options: BuildOptions, writer, failed: list[Ba
 
 
 def _derive(plan, lots: Lots, options: BuildOptions, writer, failed: list[BadLot],
-            reports: Reports) -> tuple[int, int]:
+            reports: Reports, foreign=None) -> tuple[int, int]:
     """Derive ``lots`` into ``writer``, skipping failing lots and splitting oversized chunks.
 
     Returns the number of lots derived and of records made.
     """
-    queue = [lots]
     derived = 0
     rows = 0
+    for part, (records, per_lot) in _attempts(lots, lambda part: derive_chunk(
+            plan, part, seed=options.seed, limits=options.limits, overrides=options.attrs,
+            chunk_budget=options.chunk_budget, foreign=foreign), failed):
+        writer.write(records)
+        reports.add(per_lot)
+        derived += len(part)
+        rows += len(records.asset) + len(records.mesh.lot)
+    return derived, rows
+
+
+def _attempts(lots: Lots, derive_part, failed: list[BadLot] | None):
+    """``(part, derive_part(part))`` over ``lots``: lots that fail are left out (and listed in ``failed``),
+    a chunk too large for memory is halved."""
+    queue = [lots]
     while queue:
         part = queue.pop(0)
         if not len(part):
             continue
         try:
-            records, per_lot = derive_chunk(plan, part, seed=options.seed, limits=options.limits,
-                                            overrides=options.attrs, chunk_budget=options.chunk_budget)
+            result = derive_part(part)
         except LotFailure as failure:
             skip = np.zeros(len(part), dtype=bool)
             skip[failure.lots] = True
-            failed.extend(BadLot(int(part.index[i]), str(part.ids[i]), str(failure))
-                          for i in np.flatnonzero(skip))
+            if failed is not None:
+                failed.extend(BadLot(int(part.index[i]), str(part.ids[i]), str(failure))
+                              for i in np.flatnonzero(skip))
             queue.insert(0, part.take(~skip))
             continue
         except ChunkTooLarge:
             half = len(part) // 2
             queue[:0] = [part.take(slice(0, half)), part.take(slice(half, None))]
             continue
-        writer.write(records)
-        reports.add(per_lot)
-        derived += len(part)
-        rows += len(records.asset) + len(records.mesh.lot)
-    return derived, rows
+        yield part, result
+
+
+def _occluders(plan, lots: Lots, options: BuildOptions) -> Occluders:
+    """The first pass of a grammar whose queries look at other lots: every lot derived up to its first
+    query, and the occluders made up to there (``backend.occlusion``). Lots that fail are left out here
+    and reported by the second pass."""
+    tables = []
+    for first in range(0, len(lots), options.chunk_size):
+        part = lots.take(slice(first, first + options.chunk_size))
+        tables.extend(table for _, table in _attempts(part, lambda p: derive_chunk(
+            plan, p, seed=options.seed, limits=options.limits, overrides=options.attrs,
+            chunk_budget=options.chunk_budget, occluders_only=True), None))
+    return Occluders.concat(tables)

@@ -9,6 +9,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from grammarc.backend.occlusion import Occluders, OccluderStore
 from grammarc.backend.snaps import SnapStore
 from grammarc.constants import STRICT
 from grammarc.geometry.meshes import MeshStore
@@ -77,6 +78,9 @@ class Chunk:
     polygons: PolygonStore
     outputs: Outputs = field(default_factory=Outputs)
     meshes: MeshStore = field(default_factory=MeshStore)
+    #: Occluders made so far (``backend.occlusion``), and those of every lot from a first pass (``inter``).
+    occluders: OccluderStore = field(default_factory=OccluderStore)
+    foreign: Occluders | None = None
     #: Snap planes of the paper's ``Snap`` / ``SnapLines`` (``backend.snaps``).
     snaps: SnapStore = field(default_factory=SnapStore)
     #: The lots' street edges and street frames (``geometry.streets``).

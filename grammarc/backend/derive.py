@@ -19,6 +19,7 @@ from grammarc.backend.chunk import Chunk, Frames
 from grammarc.backend.evaluate import Env
 from grammarc.backend.execute import Executor
 from grammarc.backend.kernels.order import group_by, scatter_rows
+from grammarc.backend.occlusion import ANCESTORS, Occluders
 from grammarc.backend.plan import COLOR_SLOT, TRIM_SLOTS, TRIM_SWITCH, WHITE_RGB, Plan
 from grammarc.backend.random import lot_keys
 from grammarc.backend.reports import aggregate_chunk
@@ -52,8 +53,13 @@ def initial_chunk(lots: Lots) -> tuple[Chunk, Shapes]:
 
 
 def derive_chunk(plan: Plan, lots: Lots, *, seed: int, limits: Limits, overrides: dict,
-                 chunk_budget: int) -> tuple[TerminalChunk, dict]:
+                 chunk_budget: int, foreign: Occluders | None = None,
+                 occluders_only: bool = False) -> tuple[TerminalChunk, dict] | Occluders:
     """Derive ``lots``: their records and their reports per lot (``reports.aggregate_chunk``).
+
+    ``foreign`` are the occluders of every lot from a first pass, for ``inter`` queries; with
+    ``occluders_only`` this is that first pass: the derivation stops where the first query would run
+    and returns the occluders made up to there.
 
     Raises ``LotFailure`` naming lots to skip, ``ChunkTooLarge``, or ``LimitError``.
     """
@@ -67,17 +73,28 @@ def derive_chunk(plan: Plan, lots: Lots, *, seed: int, limits: Limits, overrides
         chunk.trim_slot = plan.dynamic[TRIM_SLOTS[0]]
         chunk.trim_switch = plan.dynamic.get(TRIM_SWITCH)
         chunk.asset_mesh = asset_loader(plan.grammar)
+    chunk.foreign = foreign
     executor = Executor(plan, chunk, limits, chunk_budget)
     executor.pending[plan.start].append(shapes)
     for stage in plan.stages:
         # A fixed visiting order per round: whether a lot's shapes are processed in a round depends only
-        # on that lot, never on which other lots have shapes pending (see the module docstring).
+        # on that lot, never on which other lots have shapes pending (see the module docstring). Rules
+        # that ask occlusion queries wait until nothing else of the stage is pending.
         order = [s.id for s in plan.symbols if s.rules and s.priority <= stage]
+        others = [s for s in order if s not in plan.queries]
         while any(executor.pending.get(s) for s in order):
+            if occluders_only and not any(executor.pending.get(s) for s in others):
+                return chunk.occluders.table()
             for sym_id in order:
+                # a lot's queries run once it has nothing else pending: waiting for other lots too
+                # changes nothing of its own derivation
+                if sym_id in plan.queries and (occluders_only or any(executor.pending.get(s) for s in others)):
+                    continue
                 batches = executor.pending.pop(sym_id, None)
                 if batches:
                     executor.apply(plan.symbols[sym_id], Shapes.concat(batches))
+    if occluders_only:
+        return chunk.occluders.table()
     reports = aggregate_chunk(chunk.outputs.reports, chunk.lot_index, list(plan.strings.ids))
     return collect(chunk), reports
 
@@ -106,7 +123,7 @@ def initial_dynamic(plan: Plan, name: str, chunk: Chunk, shapes: Shapes) -> np.n
         return np.ones(n)
     if name in ("split.index", "comp.index"):
         return np.zeros(n)
-    if name in TRIM_SLOTS:
+    if name in TRIM_SLOTS or name in ANCESTORS:
         return np.full(n, np.nan)
     if name == TRIM_SWITCH:
         return np.ones(n)

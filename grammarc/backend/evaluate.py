@@ -14,6 +14,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 from numba import njit
 
+from grammarc.backend import occlusion
 from grammarc.backend.chunk import Chunk
 from grammarc.backend.random import uniform
 from grammarc.backend.shapes import Shapes
@@ -60,6 +61,8 @@ def evaluate(expr: ir.Expr, env: Env):
         return column[env.shapes.lot]
     if isinstance(expr, ir.ContextRef):
         return env.shapes.dynamic[env.plan.dynamic[expr.name]]
+    if isinstance(expr, ir.Occlusion):
+        return occlusion.query(expr, env)
     if isinstance(expr, ir.Select):
         cond = evaluate(expr.cond, env)
         return np.where(cond, evaluate(expr.then, env), evaluate(expr.other, env))

@@ -21,6 +21,7 @@ from grammarc.backend.component_operations import ComponentOperations
 from grammarc.backend.evaluate import Env, evaluate, evaluate_array
 from grammarc.backend.face_operations import FaceOperations
 from grammarc.backend.kernels.order import group_by
+from grammarc.backend.occlusion import ANCESTORS, add_occluders, with_ancestor
 from grammarc.backend.plan import COLOR_SLOT, Plan, SymbolPlan, consumes
 from grammarc.backend.random import child_keys, uniform
 from grammarc.backend.scope_operations import ScopeOperations
@@ -59,6 +60,16 @@ class Executor(ScopeOperations, SplitOperations, ComponentOperations, FaceOperat
         if bad.any():
             row = values[np.flatnonzero(bad)[0]]
             self.fail(shapes, bad, f"{message} ({', '.join(f'{v:g}' for v in np.atleast_1d(row))})", symbol, span)
+
+    def occluding(self, cursor: Shapes, children: Shapes, parent: np.ndarray) -> Shapes:
+        """A component split's solids become occluders; their components carry them as ancestors."""
+        if ANCESTORS[0] not in self.plan.dynamic:
+            return children
+        return with_ancestor(self.plan, children, add_occluders(self.chunk, cursor)[parent])
+
+    def label(self, op: ir.Label, cursor: Shapes, symbol: int) -> Shapes:
+        """``label(name)``: the shape's solid is an occluder with that label, and its own ancestor."""
+        return with_ancestor(self.plan, cursor, add_occluders(self.chunk, cursor, op.name))
 
     def count(self, shapes: Shapes, symbol: int, span) -> None:
         """Add new shapes to the per-lot counters and enforce the shape limits."""
@@ -143,6 +154,8 @@ class Executor(ScopeOperations, SplitOperations, ComponentOperations, FaceOperat
                 if changed is not None:
                     cursor = changed
         if leaf_at_end and self.plan.leaf_bodies and len(cursor) and not consumes(body):
+            if ANCESTORS[0] in self.plan.dynamic:
+                add_occluders(self.chunk, cursor)  # a leaf solid occludes
             terminals.emit_leaves(self.chunk, cursor, symbol)
 
     def refuse_meshes(self, op: ir.Op, cursor: Shapes, symbol: int) -> None:
@@ -267,13 +280,13 @@ _OPERATIONS = {
     ir.GroupSplit: Executor.group_split, ir.CompFaces: Executor.comp_faces, ir.Empty: Executor.nothing,
     ir.NotApplied: Executor.nothing, ir.Setback: Executor.setback, ir.Roof: Executor.roof,
     ir.InnerRectangle: Executor.inner_rectangle, ir.Convexify: Executor.convexify,
-    ir.CleanupGeometry: Executor.cleanup_geometry, ir.Snap: Executor.snap,
+    ir.CleanupGeometry: Executor.cleanup_geometry, ir.Snap: Executor.snap, ir.Label: Executor.label,
 }
 #: Operations that take roofs (meshes): scope changes, component splits, successors, leaves, cleanup.
 _MESH_OPERATIONS = frozenset({
     ir.Symbol, ir.Translate, ir.Scale, ir.Rotate, ir.Insert, ir.Comp, ir.CompFaces, ir.Empty, ir.NotApplied,
     ir.SetColor, ir.UseAsset, ir.SetAttr, ir.Report, ir.Case, ir.Stochastic, ir.Split, ir.Repeat, ir.GroupSplit,
-    ir.AlignScope, ir.CleanupGeometry, ir.Snap,
+    ir.AlignScope, ir.CleanupGeometry, ir.Snap, ir.Label,
 })
 
 

@@ -7,6 +7,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+from grammarc.backend.occlusion import ANCESTORS
 from grammarc.compiler import Grammar
 from grammarc.ir import nodes as ir
 from grammarc.ir.traverse import iter_exprs, iter_ops, op_exprs
@@ -59,6 +60,10 @@ class Plan:
     not_applied: tuple[str, ...]
     #: Interned string id -> asset id, for assets named by computed strings (``i(asset)``); -1: none.
     asset_of_string: dict[int, int]
+    #: Symbols whose rules ask occlusion queries (they wait for the rest of their stage), and whether
+    #: any query looks at other lots (then the build derives twice: ``backend.occlusion``).
+    queries: frozenset[int] = frozenset()
+    inter: bool = False
 
     @property
     def symbol_names(self) -> tuple[str, ...]:
@@ -87,15 +92,21 @@ def make_plan(grammar: Grammar) -> Plan:
     trims = list(TRIM_SLOTS) if module.dialect == "cityengine" and any(
         isinstance(op, ir.CompFaces) and op.kind == "f" for op in ops) and any(
         isinstance(op, ir.UseAsset) for op in ops) else []
+    occlusion = {symbol.id: [e for rule in symbol.rules for e in _rule_exprs(rule) if isinstance(e, ir.Occlusion)]
+                 for symbol in symbols}
+    occlusion = {k: v for k, v in occlusion.items() if v}
+    ancestors = list(ANCESTORS) if occlusion or any(isinstance(op, ir.Label) for op in ops) else []
     dynamic = {name: i for i, name in enumerate(dict.fromkeys(
-        [op.name for op in ops if isinstance(op, ir.SetAttr)] + sorted(set(context)) + colour + trims))}
+        [op.name for op in ops if isinstance(op, ir.SetAttr)] + sorted(set(context)) + colour + trims
+        + ancestors))}
     not_applied = tuple(sorted({op.name for op in ops if isinstance(op, ir.NotApplied)}))
     strings.intern("")
     for selector in ir.FACE_SELECTORS:
         strings.intern(selector)
     asset_of_string = {strings.intern(raw): asset for raw, asset in grammar.asset_ids.items()}
     return Plan(grammar, tuple(symbols), ids, ids[grammar.graph.start], strings, stages, dynamic,
-                module.dialect == "cityengine", not_applied, asset_of_string)
+                module.dialect == "cityengine", not_applied, asset_of_string, frozenset(occlusion),
+                any(e.target != "intra" for found in occlusion.values() for e in found))
 
 
 #: Per-shape columns of a shape's two vertical trim planes, (nx, ny, nz, d) each in world coordinates:
@@ -117,14 +128,18 @@ def consumes(body: ir.Body) -> bool:
 
 
 def _all_exprs(module: ir.Module):
-    roots = [a.default for a in module.attrs]
+    for attr in module.attrs:
+        yield from iter_exprs(attr.default)
     for rule in module.rules:
-        if rule.guard is not None:
-            roots.append(rule.guard)
-        for alt in rule.alternatives:
-            if alt.prob is not None:
-                roots.append(alt.prob)
-            for op in iter_ops(alt.body):
-                roots.extend(op_exprs(op))
+        yield from _rule_exprs(rule)
+
+
+def _rule_exprs(rule: ir.Rule):
+    roots = [rule.guard] if rule.guard is not None else []
+    for alt in rule.alternatives:
+        if alt.prob is not None:
+            roots.append(alt.prob)
+        for op in iter_ops(alt.body):
+            roots.extend(op_exprs(op))
     for root in roots:
         yield from iter_exprs(root)

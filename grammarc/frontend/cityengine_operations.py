@@ -263,6 +263,11 @@ class OperationLowering:
             distances = tuple((s, exprs[0]) for s in selectors if s != "remainder")
         return ir.Setback(distances, selectors, chosen[1], span, self.site())
 
+    def op_label(self, op, args, span):
+        if len(args) != 1 or not isinstance(args[0], ir.Str):
+            return self.unsupported("label with these arguments", span, 'label("name")')
+        return ir.Label(args[0].value, span)
+
     def op_convexify(self, op, args, span):
         if len(args) > 1:
             return self.unsupported(f"convexify with {len(args)} arguments", span,
@@ -338,6 +343,7 @@ OPS = {
     "report": OperationLowering.op_report,
     "convexify": OperationLowering.op_convexify,
     "cleanupGeometry": OperationLowering.op_cleanup,
+    "label": OperationLowering.op_label,
     "envelope": OperationLowering.op_envelope,
     "roofHip": OperationLowering.op_roof,
     "roofGable": OperationLowering.op_roof,
@@ -368,7 +374,7 @@ UNSUPPORTED_MEMBERS = frozenset({"comp", "split", "initialShape", "geometry"})
 #: Operations that are parsed and accepted but do not change the record (listed in its meta).
 NOT_APPLIED = frozenset({
     "texture", "setupProjection", "projectUV", "tileUV", "translateUV", "scaleUV", "rotateUV",
-    "normalizeUV", "deleteUV", "reverseNormals", "print", "setNormals", "softenNormals", "label",
+    "normalizeUV", "deleteUV", "reverseNormals", "print", "setNormals", "softenNormals",
     # the pivot only moves the model's own origin in an export; scope.t* stay relative to the lot
     "setPivot",
 })

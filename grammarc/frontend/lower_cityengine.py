@@ -346,6 +346,8 @@ class Lowering(OperationLowering, LoweringBase):
 
     def function(self, meta, name, args):
         span = self.token_span(name)
+        if str(name) in ir.OCCLUSION_KINDS:
+            return self.occlusion(str(name), args or (), span)
         func = FUNCTION_NAMES.get(str(name), str(name))
         args = tuple(self.expr(a) for a in (args or ()))
         if func == "p" and len(args) == 1:
@@ -353,6 +355,17 @@ class Lowering(OperationLowering, LoweringBase):
         if func == "fileRandom" and not args:
             return ir.Call("fileRandom", (), span, 0)  # one draw per lot for the whole file
         return ir.Call(func, args, span, self.site())
+
+    def occlusion(self, kind: str, args, span) -> ir.Expr:
+        """``inside`` / ``overlaps`` / ``touches([intra|inter|all[, "label"]])``."""
+        target = args[0].name if args and isinstance(args[0], ir.Name) else None
+        label = args[1] if len(args) == 2 else None
+        if len(args) > 2 or (args and target not in ir.OCCLUSION_TARGETS) or (
+                label is not None and not isinstance(label, ir.Str)):
+            self.unsupported(f"{kind} with these arguments", span,
+                             f"{kind}(), {kind}(intra|inter|all) and {kind}(intra|inter|all, \"label\")")
+            return ir.placeholder(span)
+        return ir.Occlusion(kind, target or "all", label.value if label is not None else None, span)
 
     def array(self, meta, *items):
         self.unsupported("arrays", self.span(meta))

@@ -146,6 +146,23 @@ class ContextRef:
     span: Span = NO_SPAN
 
 
+#: CityEngine's occlusion queries and their targets.
+OCCLUSION_KINDS = frozenset({"inside", "overlaps", "touches"})
+OCCLUSION_TARGETS = frozenset({"intra", "inter", "all"})
+
+
+@dataclass(frozen=True, slots=True)
+class Occlusion:
+    """CityEngine's ``inside`` / ``overlaps`` / ``touches([target[, label]])``: whether the shape's
+    geometry lies in, overlaps or touches a closed occluder of its own lot (``intra``), of other lots
+    (``inter``) or of either (``all``), of any label or of ``label`` (``backend.occlusion``)."""
+
+    kind: str
+    target: str
+    label: str | None
+    span: Span = NO_SPAN
+
+
 @dataclass(frozen=True, slots=True)
 class Select:
     """``cond ? then : other`` per shape: CityEngine's ``case`` and ``p% :`` expressions lower to it."""
@@ -156,7 +173,8 @@ class Select:
     span: Span = NO_SPAN
 
 
-Expr = Num | Str | Bool | Name | Param | AttrRef | ScopeRef | Unary | Binary | Call | Select | ContextRef
+Expr = (Num | Str | Bool | Name | Param | AttrRef | ScopeRef | Unary | Binary | Call | Select | ContextRef
+        | Occlusion)
 
 #: Built-in functions: name -> (min args, max args, result type). Argument types are numbers.
 FUNCTIONS: dict[str, tuple[int, int, Type]] = {
@@ -304,6 +322,14 @@ class Repeat:
     #: its own (paper section 3.3); ``snap_label`` as for ``Split``.
     snap: bool = False
     snap_label: str | None = None
+
+
+@dataclass(frozen=True, slots=True)
+class Label:
+    """CityEngine's ``label(name)``: the shape's closed geometry becomes an occluder with that label."""
+
+    name: str
+    span: Span = NO_SPAN
 
 
 @dataclass(frozen=True, slots=True)
@@ -579,7 +605,7 @@ class CompFaces:
 Op = (Symbol | Empty | Translate | Scale | Rotate | Push | Pop | Insert | Split | Repeat | Comp | Extrude
       | Center | UseAsset | Case | Stochastic | SetAttr | Report | NotApplied | GroupSplit | CompFaces
       | AlignScope | Mirror | Offset | SetColor | Setback | Roof | InnerRectangle | Convexify
-      | CleanupGeometry | Snap)
+      | CleanupGeometry | Snap | Label)
 Body = tuple[Op, ...]
 
 

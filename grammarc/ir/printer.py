@@ -32,6 +32,9 @@ def print_expr(e: ir.Expr) -> str:
         return f"({print_expr(e.left)} {e.op} {print_expr(e.right)})"
     if isinstance(e, ir.Call):
         return f"{e.func}({', '.join(print_expr(a) for a in e.args)})"
+    if isinstance(e, ir.Occlusion):
+        label = f', "{e.label}"' if e.label is not None else ""
+        return f"{e.kind}({e.target}{label})"
     if isinstance(e, ir.ContextRef):
         return e.name
     if isinstance(e, ir.Select):
@@ -88,6 +91,8 @@ def print_op(op: ir.Op) -> str:
     if isinstance(op, ir.Repeat):
         sizes = ", ".join(print_expr(e) for e in op.sizes)
         return f"Repeat({_axes(op.axes, op.snap)}, {sizes}{_label(op.snap_label)}){_parts(op.parts)}"
+    if isinstance(op, ir.Label):
+        return f'label("{op.name}")'
     if isinstance(op, ir.Snap):
         axes = {0: "Y", 1: "XZ", 2: "XY"}[op.normal]
         return f'{"SnapLines" if op.lines else "Snap"}("{axes}"{_label(op.label)})'

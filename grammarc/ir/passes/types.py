@@ -189,6 +189,8 @@ def type_of(expr: ir.Expr, attrs: dict, params: tuple, diags: Diagnostics) -> ir
         return T.NUM
     if isinstance(expr, ir.ContextRef):
         return ir.CONTEXT_FIELDS[expr.name]
+    if isinstance(expr, ir.Occlusion):
+        return T.BOOL
     if isinstance(expr, ir.AttrRef):
         return attrs.get(expr.name, T.UNKNOWN)
     if isinstance(expr, ir.Param):

@@ -1,0 +1,203 @@
+"""CityEngine's occlusion queries on the shape columns: occluders, who sees which, and the answers.
+
+Occluders are closed solids (CityEngine tests only closed geometry): a shape that a component split takes
+apart (the mass a facade comes from), a leaf solid (a box, a prism, ``primitiveCube``) and a shape given a
+``label``. Each is stored as a prism (``geometry.occlusion.Prisms``) with its lot, an id (the lot's number
+times 2^24 plus its count in the lot: the same whatever the chunking) and its label. Roofs and other
+meshes do not occlude yet.
+
+A query (``inside``, ``overlaps``, ``touches``) of a shape tests its scope box (a solid's) or rectangle
+(a face's) against:
+
+- ``intra``: the occluders of its own lot that are not its ancestors. A shape carries the ids of its
+  nearest ``ANCESTORS`` occluding ancestors; descendants do not exist yet when a query runs.
+- ``inter``: the occluders of the other lots, from the first pass of a two-pass build
+  (``build._derive_all``): every lot is derived up to its first query, its occluders are kept, then the
+  city is derived again with them. So a lot's answers do not depend on its chunk.
+
+Rules that query wait (``derive.derive_chunk``) until nothing else of their stage is pending, so the
+occluders of every other branch exist when they run.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field, replace
+
+import numpy as np
+import shapely
+
+from grammarc.backend.shapes import asset_geom
+from grammarc.geometry.clip import scope_polygons
+from grammarc.geometry.meshes import is_polygon
+from grammarc.geometry.occlusion import BOX_CORNERS, BOX_EDGES, QUAD_CORNERS, QUAD_EDGES, Prisms, relations
+from grammarc.geometry.polygons import PLANE_U, PLANE_V
+
+#: The per-shape columns of the ids of its nearest occluding ancestors (NaN: none), nearest first.
+ANCESTORS = tuple(f"occluder.{k}" for k in range(4))
+#: Occluders per lot are numbered below this.
+_PER_LOT = 2 ** 24
+_KIND = {"inside": 0, "overlaps": 1, "touches": 2}
+#: The ``geom`` of a ``primitiveCube`` (the built-in cube, asset 0, not mirrored): a box.
+_CUBE = int(asset_geom(np.array([0]))[0])
+
+
+@dataclass(frozen=True)
+class Occluders:
+    """A table of occluders: ``lot`` (k,) global lot numbers, ``ident`` (k,) float64 ids, ``label`` (k,)
+    object (str or None), and their ``prisms``."""
+
+    lot: np.ndarray
+    ident: np.ndarray
+    label: np.ndarray
+    prisms: Prisms
+
+    @staticmethod
+    def concat(tables: list[Occluders]) -> Occluders:
+        tables = [t for t in tables if len(t.lot)] or [_EMPTY]
+        prisms = Prisms(*(np.concatenate([getattr(t.prisms, f) for t in tables])
+                          for f in ("origin", "axes", "plane", "height", "polygon")))
+        return Occluders(np.concatenate([t.lot for t in tables]), np.concatenate([t.ident for t in tables]),
+                         np.concatenate([t.label for t in tables]), prisms)
+
+    def take(self, rows: np.ndarray) -> Occluders:
+        p = self.prisms
+        return Occluders(self.lot[rows], self.ident[rows], self.label[rows],
+                         Prisms(p.origin[rows], p.axes[rows], p.plane[rows], p.height[rows], p.polygon[rows]))
+
+
+_EMPTY = Occluders(np.zeros(0, np.int64), np.zeros(0), np.zeros(0, dtype=object),
+                   Prisms(np.zeros((0, 3)), np.zeros((0, 3, 3)), np.zeros(0, np.int64), np.zeros(0),
+                          np.zeros(0, dtype=object)))
+
+
+@dataclass
+class OccluderStore:
+    """The occluders a chunk has made so far, and how many per lot (for their ids)."""
+
+    tables: list[Occluders] = field(default_factory=list)
+    count: np.ndarray | None = None
+
+    def table(self) -> Occluders:
+        return Occluders.concat(self.tables)
+
+
+def add_occluders(chunk, shapes, label: str | None = None) -> np.ndarray:
+    """Store the closed solids among ``shapes`` (scope boxes and polygon prisms) as occluders of their
+    lots; returns each shape's new id (NaN for a shape that is not a solid)."""
+    ident = np.full(len(shapes), np.nan)
+    flat = (shapes.size <= 1e-9).any(axis=1)
+    polygon = is_polygon(shapes.geom)
+    solid = ~flat & ((shapes.geom == -1) | (shapes.geom == _CUBE) | polygon)
+    rows = np.flatnonzero(solid)
+    if not len(rows):
+        return ident
+    store = chunk.occluders
+    if store.count is None:
+        store.count = np.zeros(len(chunk.lot_index), dtype=np.int64)
+    lot = shapes.lot[rows]
+    # numbered per lot in row order: the same rows in any chunk
+    order = np.argsort(lot, kind="stable")
+    first = np.searchsorted(lot[order], lot[order])
+    number = np.empty(len(rows), dtype=np.int64)
+    number[order] = store.count[lot[order]] + (np.arange(len(rows)) - first)
+    np.add.at(store.count, lot, 1)
+    ident[rows] = chunk.lot_index[lot].astype(np.float64) * _PER_LOT + number
+    sub = shapes.take(rows)
+    plane = np.ones(len(rows), dtype=np.int64)
+    is_poly = polygon[rows]
+    plane[is_poly] = chunk.polygons.plane[sub.geom[is_poly]]
+    polygons = np.empty(len(rows), dtype=object)
+    k = np.arange(len(rows))
+    polygons[~is_poly] = shapely.box(0, 0, sub.size[k, PLANE_U[plane]][~is_poly], sub.size[k, PLANE_V[plane]][~is_poly])
+    if is_poly.any():
+        polygons[is_poly] = scope_polygons(chunk.polygons, sub.geom[is_poly], sub.size[is_poly])
+    prisms = Prisms(sub.origin.copy(), chunk.frames[sub.frame], plane, sub.size[k, plane], polygons)
+    store.tables.append(Occluders(chunk.lot_index[lot], ident[rows], np.full(len(rows), label, dtype=object),
+                                  prisms))
+    return ident
+
+
+def with_ancestor(plan, shapes, ident: np.ndarray):
+    """``shapes`` with ``ident`` (n,) pushed onto their occluding ancestors (where it is not NaN)."""
+    slots = [plan.dynamic[name] for name in ANCESTORS]
+    dynamic = list(shapes.dynamic)
+    has = ~np.isnan(ident)
+    for k in range(len(slots) - 1, 0, -1):
+        dynamic[slots[k]] = np.where(has, dynamic[slots[k - 1]], dynamic[slots[k]])
+    dynamic[slots[0]] = np.where(has, ident, dynamic[slots[0]])
+    return replace(shapes, dynamic=tuple(dynamic))
+
+
+def query(expr, env) -> np.ndarray:
+    """The answer (n,) bool of an ``ir.Occlusion`` for every shape of ``env``."""
+    shapes, chunk = env.shapes, env.chunk
+    answer = np.zeros(len(shapes), dtype=bool)
+    if not len(shapes):
+        return answer
+    own = chunk.lot_index[shapes.lot]
+    sources = []  # (occluders, of the shape's own lot or of the others)
+    if expr.target in ("intra", "all"):
+        sources.append((chunk.occluders.table(), True))
+    if expr.target in ("inter", "all"):
+        sources.append((chunk.foreign, False))
+    ancestors = np.stack([shapes.dynamic[env.plan.dynamic[name]] for name in ANCESTORS], axis=1)
+    for table, intra in sources:
+        if expr.label is not None:
+            table = table.take(np.flatnonzero(table.label == expr.label))
+        rows, occluder = _pairs(shapes, chunk, table)
+        same = table.lot[occluder] == own[rows]
+        keep = same & ~(ancestors[rows] == table.ident[occluder, None]).any(axis=1) if intra else ~same
+        rows, occluder = rows[keep], occluder[keep]
+        if len(rows):
+            np.logical_or.at(answer, rows, _relation(expr.kind, shapes, chunk, rows, table.take(occluder)))
+    return answer
+
+
+def _relation(kind: str, shapes, chunk, rows: np.ndarray, occluders: Occluders) -> np.ndarray:
+    """``kind`` of the shapes ``rows`` (p,) (their scope boxes, or rectangles for faces) against the
+    pairs' occluders."""
+    out = np.zeros(len(rows), dtype=bool)
+    axes = chunk.frames[shapes.frame[rows]]
+    flat = shapes.size[rows] <= 1e-9
+    face = flat.any(axis=1)
+    for is_face, unit, edges in ((False, BOX_CORNERS, BOX_EDGES), (True, QUAD_CORNERS, QUAD_EDGES)):
+        pick = np.flatnonzero(face == is_face)
+        if not len(pick):
+            continue
+        size, frame = shapes.size[rows[pick]], axes[pick]
+        if is_face:  # the face's two extents as its x and y
+            k = np.argmax(flat[pick], axis=1)
+            cols = np.stack([(k + 1) % 3, (k + 2) % 3, k], axis=1)
+            at = np.arange(len(pick))[:, None]
+            size, frame = size[at, cols], frame[at, cols]
+        corners = shapes.origin[rows[pick], None] + np.einsum("cj,pj,pji->pci", unit, size, frame)
+        out[pick] = relations(corners, edges, occluders.take(pick).prisms)[_KIND[kind]]
+    return out
+
+
+def _pairs(shapes, chunk, table: Occluders) -> tuple[np.ndarray, np.ndarray]:
+    """(query row, occluder) pairs whose world boxes meet (GEOS STRtree on the ground plane, then y)."""
+    if not len(table.lot):
+        return np.zeros(0, np.int64), np.zeros(0, np.int64)
+    q_low, q_high = _world_boxes(shapes.origin, chunk.frames[shapes.frame], shapes.size)
+    p = table.prisms
+    local_size = np.zeros((len(p.plane), 3))
+    bounds = shapely.bounds(p.polygon)
+    k = np.arange(len(p.plane))
+    lows = np.zeros((len(p.plane), 3))
+    lows[k, PLANE_U[p.plane]], lows[k, PLANE_V[p.plane]] = bounds[:, 0], bounds[:, 1]
+    local_size[k, PLANE_U[p.plane]] = bounds[:, 2] - bounds[:, 0]
+    local_size[k, PLANE_V[p.plane]] = bounds[:, 3] - bounds[:, 1]
+    local_size[k, p.plane] = p.height
+    o_low, o_high = _world_boxes(p.origin + np.einsum("pi,pij->pj", lows, p.axes), p.axes, local_size)
+    pad = 1e-3
+    tree = shapely.STRtree(shapely.box(o_low[:, 0] - pad, o_low[:, 2] - pad, o_high[:, 0] + pad, o_high[:, 2] + pad))
+    q, o = tree.query(shapely.box(q_low[:, 0], q_low[:, 2], q_high[:, 0], q_high[:, 2]))
+    keep = (q_low[q, 1] <= o_high[o, 1] + pad) & (o_low[o, 1] <= q_high[q, 1] + pad)
+    return q[keep], o[keep]
+
+
+def _world_boxes(origin, axes, size):
+    """World axis-aligned bounds (low, high) of scope boxes."""
+    corners = origin[:, None] + np.einsum("cj,pj,pji->pci", BOX_CORNERS, size, axes)
+    return corners.min(axis=1), corners.max(axis=1)

@@ -1,0 +1,63 @@
+"""CityEngine's occlusion queries in derivations: no window where a mass meets another (intra), where a
+building meets its neighbour (inter, the same whatever the chunking), and labelled occluders."""
+
+from __future__ import annotations
+
+import numpy as np
+from test_cityengine import names, rect, run
+
+MASSES = """
+Lot --> [ s('0.6, '1, '1) Mass ] t('0.4, 0, 0) s('0.6, '1, '1) Mass
+Mass --> extrude(10) comp(f){ side : Facade }
+Facade --> split(x){ ~2 : Tile }*
+Tile --> case {query} : Wall. else : Window.
+"""
+
+
+def count(record, name):
+    return int((np.array(names(record)) == name).sum())
+
+
+def test_no_window_where_two_masses_of_a_lot_meet(write):
+    """Two 18 x 20 m masses overlapping by 6 m: the tiles of a front or back in the other's face, and
+    the sides inside the other mass, are walls; 2 x (6 + 6 + 10) windows are left."""
+    r = run(write, MASSES.replace("{query}", "touches(intra)"), [rect(30, 20)])
+    assert r["bad"] == ()
+    assert count(r, "Window") == 44 and count(r, "Wall") == 2 * (3 + 3 + 10)
+    # overlaps: only the sides inside the other mass; inside: those and the coplanar front tiles
+    assert count(run(write, MASSES.replace("{query}", "overlaps(intra)"), [rect(30, 20)]), "Wall") == 20
+    assert count(run(write, MASSES.replace("{query}", "inside(intra)"), [rect(30, 20)]), "Wall") == 32
+
+
+NEIGHBOURS = """
+Lot --> extrude(10) comp(f){ side : Facade }
+Facade --> split(x){ ~2 : Tile }*
+Tile --> case touches() : Wall. else : Window.
+"""
+
+
+def test_no_window_on_a_wall_shared_with_the_neighbour_whatever_the_chunking(write):
+    lots = [rect(20, 20), [np.array([[20, 0], [40, 0], [40, 20], [20, 20]], float)],
+            [np.array([[100, 0], [120, 0], [120, 20], [100, 20]], float)]]
+    r = run(write, NEIGHBOURS, lots)
+    walls = np.array(names(r)) == "Wall"
+    # the two touching lots lose their shared side's 10 tiles each; the lot far away loses none
+    assert np.bincount(r["lot"][walls], minlength=3).tolist() == [10, 10, 0]
+    again = run(write, NEIGHBOURS, lots, chunk_size=1)
+    np.testing.assert_array_equal(r["xform"], again["xform"])
+    assert names(r) == names(again)
+    # intra only: a lot does not see its neighbour
+    assert count(run(write, NEIGHBOURS.replace("touches()", "touches(intra)"), lots), "Wall") == 0
+
+
+def test_a_labelled_occluder_is_seen_by_its_label_only(write):
+    text = """
+Lot --> [ s(4, 3, 4) t(2, 0, 2) primitiveCube() label("kiosk") ] extrude(10) comp(f){ bottom : Floor }
+Floor --> split(x){ ~2 : Cell }*
+Cell --> case overlaps(all, "kiosk") : Taken. case touches(all, "tree") : Shaded. else : Free.
+"""
+    r = run(write, text, [rect(20, 20)])
+    # the floor's 2 m strips at x 2..6 (two of them) run under the kiosk's 4 x 4 m base
+    assert count(r, "Taken") == 0 and count(r, "Shaded") == 0  # a face on the base touches, not overlaps
+    r = run(write, text.replace("overlaps(all", "touches(all"), [rect(20, 20)])
+    assert count(r, "Taken") == 2 and count(r, "Free") == 8

@@ -1,0 +1,64 @@
+"""Occlusion relations of query boxes and faces against prism occluders (``geometry.occlusion``)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+import shapely
+
+from grammarc.geometry.occlusion import BOX_CORNERS, BOX_EDGES, QUAD_CORNERS, QUAD_EDGES, Prisms, relations
+
+L_SHAPE = shapely.Polygon([(0, 0), (30, 0), (30, 10), (10, 10), (10, 20), (0, 20)])
+
+
+def prism(polygon, height, n=1):
+    """An upright prism (x-z plane, extruded along y) at the world origin, n copies."""
+    return Prisms(np.zeros((n, 3)), np.tile(np.eye(3), (n, 1, 1)), np.ones(n, dtype=np.int64),
+                  np.full(n, float(height)), np.full(n, polygon, dtype=object))
+
+
+def box(low, size):
+    return np.asarray(low, float) + BOX_CORNERS * np.asarray(size, float)
+
+
+def quad(origin, x, y):
+    origin, x, y = (np.asarray(a, float) for a in (origin, x, y))
+    return origin + QUAD_CORNERS[:, :1] * x + QUAD_CORNERS[:, 1:2] * y
+
+
+@pytest.mark.parametrize("low, size, expected", [
+    ([2, 1, 2], [3, 3, 3], (True, True, True)),        # in the L's first arm
+    ([8, 1, 8], [4, 3, 4], (False, True, True)),       # across the inner corner, partly in the notch
+    ([12, 1, 12], [4, 3, 4], (False, False, False)),   # in the notch: the hull of the L would say inside
+    ([30, 1, 2], [4, 3, 4], (False, False, True)),     # against the end wall x = 30
+    ([2, 10, 2], [4, 3, 4], (False, False, True)),     # standing on the roof (height 10)
+    ([30, 10, 2], [4, 3, 4], (False, False, False)),   # only an edge in common
+    ([40, 1, 2], [4, 3, 4], (False, False, False)),    # away
+])
+def test_boxes_against_a_concave_prism(low, size, expected):
+    inside, overlaps, touches = relations(box(low, size)[None], BOX_EDGES, prism(L_SHAPE, 10))
+    assert (bool(inside[0]), bool(overlaps[0]), bool(touches[0])) == expected
+
+
+@pytest.mark.parametrize("face, expected", [
+    (quad([30, 0, 2], [0, 0, 4], [0, 3, 0]), (True, False, True)),     # a window in the end wall's plane
+    (quad([30, 0, 12], [0, 0, 4], [0, 3, 0]), (False, False, False)),  # in that plane, but past the wall
+    (quad([25, 0, 2], [0, 0, 4], [0, 3, 0]), (True, True, True)),      # through the solid
+    (quad([5, 4, 5], [2, 0, 0], [0, 0, 2]), (True, True, True)),       # a floor inside
+    (quad([5, 10, 5], [2, 0, 0], [0, 0, 2]), (True, False, True)),     # on the roof
+    (quad([5, 12, 5], [2, 0, 0], [0, 0, 2]), (False, False, False)),   # above it
+])
+def test_faces_against_a_concave_prism(face, expected):
+    inside, overlaps, touches = relations(face[None], QUAD_EDGES, prism(L_SHAPE, 10))
+    assert (bool(inside[0]), bool(overlaps[0]), bool(touches[0])) == expected
+
+
+def test_pairs_are_independent_and_the_prism_may_turn():
+    turned = Prisms(np.array([[0.0, 0, 0]]), np.array([[[0.0, 0, 1], [0, 1, 0], [-1, 0, 0]]]),
+                    np.array([1]), np.array([10.0]), np.array([shapely.box(0, 0, 5, 5)], dtype=object))
+    # the scope's x runs along world z, its z along world -x: the box covers world x -5..0, z 0..5
+    corners = np.stack([box([-4, 1, 1], [2, 2, 2]), box([1, 1, 1], [2, 2, 2])])
+    inside, overlaps, touches = relations(corners, BOX_EDGES, Prisms(*(np.concatenate([a, a]) for a in (
+        turned.origin, turned.axes, turned.plane, turned.height, turned.polygon))))
+    assert inside.tolist() == [True, False] and overlaps.tolist() == [True, False]
+    assert touches.tolist() == [True, False]
