@@ -62,7 +62,8 @@ def evaluate(expr: ir.Expr, env: Env):
     if isinstance(expr, ir.ContextRef):
         return env.shapes.dynamic[env.plan.dynamic[expr.name]]
     if isinstance(expr, ir.Occlusion):
-        return occlusion.query(expr, env)
+        distance = evaluate(expr.distance, env) if expr.distance is not None else None
+        return occlusion.query(expr, env, distance)
     if isinstance(expr, ir.Select):
         cond = evaluate(expr.cond, env)
         return np.where(cond, evaluate(expr.then, env), evaluate(expr.other, env))

@@ -65,7 +65,7 @@ class Executor(ScopeOperations, SplitOperations, ComponentOperations, FaceOperat
         """A component split's solids become occluders; their components carry them as ancestors."""
         if ANCESTORS[0] not in self.plan.dynamic:
             return children
-        return with_ancestor(self.plan, children, add_occluders(self.chunk, cursor)[parent])
+        return with_ancestor(self.plan, children, add_occluders(self.chunk, cursor, active=False)[parent])
 
     def label(self, op: ir.Label, cursor: Shapes, symbol: int) -> Shapes:
         """``label(name)``: the shape's solid is an occluder with that label, and its own ancestor."""

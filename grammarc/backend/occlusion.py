@@ -44,11 +44,12 @@ _CUBE = int(asset_geom(np.array([0]))[0])
 @dataclass(frozen=True)
 class Occluders:
     """A table of occluders: ``lot`` (k,) global lot numbers, ``ident`` (k,) float64 ids, ``label`` (k,)
-    object (str or None), and their ``prisms``."""
+    object (str or None), ``active`` (k,) bool (a leaf, not a shape taken apart), and their ``prisms``."""
 
     lot: np.ndarray
     ident: np.ndarray
     label: np.ndarray
+    active: np.ndarray
     prisms: Prisms
 
     @staticmethod
@@ -56,16 +57,16 @@ class Occluders:
         tables = [t for t in tables if len(t.lot)] or [_EMPTY]
         prisms = Prisms(*(np.concatenate([getattr(t.prisms, f) for t in tables])
                           for f in ("origin", "axes", "plane", "height", "polygon")))
-        return Occluders(np.concatenate([t.lot for t in tables]), np.concatenate([t.ident for t in tables]),
-                         np.concatenate([t.label for t in tables]), prisms)
+        return Occluders(*(np.concatenate([getattr(t, f) for t in tables]) for f in ("lot", "ident", "label", "active")),
+                         prisms)
 
     def take(self, rows: np.ndarray) -> Occluders:
         p = self.prisms
-        return Occluders(self.lot[rows], self.ident[rows], self.label[rows],
+        return Occluders(self.lot[rows], self.ident[rows], self.label[rows], self.active[rows],
                          Prisms(p.origin[rows], p.axes[rows], p.plane[rows], p.height[rows], p.polygon[rows]))
 
 
-_EMPTY = Occluders(np.zeros(0, np.int64), np.zeros(0), np.zeros(0, dtype=object),
+_EMPTY = Occluders(np.zeros(0, np.int64), np.zeros(0), np.zeros(0, dtype=object), np.zeros(0, dtype=bool),
                    Prisms(np.zeros((0, 3)), np.zeros((0, 3, 3)), np.zeros(0, np.int64), np.zeros(0),
                           np.zeros(0, dtype=object)))
 
@@ -81,9 +82,10 @@ class OccluderStore:
         return Occluders.concat(self.tables)
 
 
-def add_occluders(chunk, shapes, label: str | None = None) -> np.ndarray:
+def add_occluders(chunk, shapes, label: str | None = None, active: bool = True) -> np.ndarray:
     """Store the closed solids among ``shapes`` (scope boxes and polygon prisms) as occluders of their
-    lots; returns each shape's new id (NaN for a shape that is not a solid)."""
+    lots (``active``: leaves, not shapes being taken apart); returns each shape's new id (NaN for a
+    shape that is not a solid)."""
     ident = np.full(len(shapes), np.nan)
     flat = (shapes.size <= 1e-9).any(axis=1)
     polygon = is_polygon(shapes.geom)
@@ -113,7 +115,7 @@ def add_occluders(chunk, shapes, label: str | None = None) -> np.ndarray:
         polygons[is_poly] = scope_polygons(chunk.polygons, sub.geom[is_poly], sub.size[is_poly])
     prisms = Prisms(sub.origin.copy(), chunk.frames[sub.frame], plane, sub.size[k, plane], polygons)
     store.tables.append(Occluders(chunk.lot_index[lot], ident[rows], np.full(len(rows), label, dtype=object),
-                                  prisms))
+                                  np.full(len(rows), active), prisms))
     return ident
 
 
@@ -128,12 +130,16 @@ def with_ancestor(plan, shapes, ident: np.ndarray):
     return replace(shapes, dynamic=tuple(dynamic))
 
 
-def query(expr, env) -> np.ndarray:
-    """The answer (n,) bool of an ``ir.Occlusion`` for every shape of ``env``."""
+def query(expr, env, distance: np.ndarray | None = None) -> np.ndarray:
+    """The answer of an ``ir.Occlusion`` for every shape of ``env``: (n,) bool, or for the paper's
+    ``Shape.occ`` the interned strings "none", "part", "full" (n,); ``distance`` (n,) the value of its
+    ``distance`` expression."""
     shapes, chunk = env.shapes, env.chunk
-    answer = np.zeros(len(shapes), dtype=bool)
-    if not len(shapes):
-        return answer
+    n = len(shapes)
+    occ = expr.kind == "occ"
+    kinds = ("inside", "touches") if occ else (expr.kind,)
+    found = {kind: np.zeros(n, dtype=bool) for kind in kinds}
+    distance = np.zeros(n) if distance is None else np.broadcast_to(np.asarray(distance, np.float64), (n,))
     own = chunk.lot_index[shapes.lot]
     sources = []  # (occluders, of the shape's own lot or of the others)
     if expr.target in ("intra", "all"):
@@ -142,44 +148,58 @@ def query(expr, env) -> np.ndarray:
         sources.append((chunk.foreign, False))
     ancestors = np.stack([shapes.dynamic[env.plan.dynamic[name]] for name in ANCESTORS], axis=1)
     for table, intra in sources:
-        if expr.label is not None:
-            table = table.take(np.flatnonzero(table.label == expr.label))
-        rows, occluder = _pairs(shapes, chunk, table)
+        if expr.label is not None or expr.active:
+            table = table.take(np.flatnonzero((table.label == expr.label) if expr.label is not None else table.active))
+        rows, occluder = _pairs(shapes, chunk, table, distance)
         same = table.lot[occluder] == own[rows]
-        keep = same & ~(ancestors[rows] == table.ident[occluder, None]).any(axis=1) if intra else ~same
+        keep = same if intra else ~same
+        if intra and not expr.parents:
+            keep &= ~(ancestors[rows] == table.ident[occluder, None]).any(axis=1)
         rows, occluder = rows[keep], occluder[keep]
         if len(rows):
-            np.logical_or.at(answer, rows, _relation(expr.kind, shapes, chunk, rows, table.take(occluder)))
-    return answer
+            for kind, result in zip(kinds, _relations(kinds, shapes, chunk, rows, table.take(occluder),
+                                                      distance[rows])):
+                np.logical_or.at(found[kind], rows, result)
+    if not occ:
+        return found[expr.kind]
+    full, part = found["inside"], found["touches"] & ~found["inside"]
+    strings = env.strings
+    return np.where(full, strings["full"], np.where(part, strings["part"], strings["none"])).astype(np.int32)
 
 
-def _relation(kind: str, shapes, chunk, rows: np.ndarray, occluders: Occluders) -> np.ndarray:
-    """``kind`` of the shapes ``rows`` (p,) (their scope boxes, or rectangles for faces) against the
-    pairs' occluders."""
-    out = np.zeros(len(rows), dtype=bool)
+def _relations(kinds, shapes, chunk, rows: np.ndarray, occluders: Occluders, distance: np.ndarray):
+    """The ``kinds`` (each (p,) bool) of the shapes ``rows`` (p,) (their scope boxes, or rectangles for
+    faces, enlarged by ``distance`` (p,)) against the pairs' occluders."""
+    out = [np.zeros(len(rows), dtype=bool) for _ in kinds]
     axes = chunk.frames[shapes.frame[rows]]
-    flat = shapes.size[rows] <= 1e-9
+    size = shapes.size[rows] + 2 * distance[:, None]
+    origin = shapes.origin[rows] - np.einsum("p,pij->pj", distance, axes)
+    flat = size <= 1e-9
     face = flat.any(axis=1)
     for is_face, unit, edges in ((False, BOX_CORNERS, BOX_EDGES), (True, QUAD_CORNERS, QUAD_EDGES)):
         pick = np.flatnonzero(face == is_face)
         if not len(pick):
             continue
-        size, frame = shapes.size[rows[pick]], axes[pick]
+        s, frame = size[pick], axes[pick]
         if is_face:  # the face's two extents as its x and y
             k = np.argmax(flat[pick], axis=1)
             cols = np.stack([(k + 1) % 3, (k + 2) % 3, k], axis=1)
             at = np.arange(len(pick))[:, None]
-            size, frame = size[at, cols], frame[at, cols]
-        corners = shapes.origin[rows[pick], None] + np.einsum("cj,pj,pji->pci", unit, size, frame)
-        out[pick] = relations(corners, edges, occluders.take(pick).prisms)[_KIND[kind]]
+            s, frame = s[at, cols], frame[at, cols]
+        corners = origin[pick, None] + np.einsum("cj,pj,pji->pci", unit, s, frame)
+        found = relations(corners, edges, occluders.take(pick).prisms)
+        for k, kind in enumerate(kinds):
+            out[k][pick] = found[_KIND[kind]]
     return out
 
 
-def _pairs(shapes, chunk, table: Occluders) -> tuple[np.ndarray, np.ndarray]:
+def _pairs(shapes, chunk, table: Occluders, distance: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """(query row, occluder) pairs whose world boxes meet (GEOS STRtree on the ground plane, then y)."""
     if not len(table.lot):
         return np.zeros(0, np.int64), np.zeros(0, np.int64)
-    q_low, q_high = _world_boxes(shapes.origin, chunk.frames[shapes.frame], shapes.size)
+    axes = chunk.frames[shapes.frame]
+    q_low, q_high = _world_boxes(shapes.origin - np.einsum("p,pij->pj", distance, axes), axes,
+                                 shapes.size + 2 * distance[:, None])
     p = table.prisms
     local_size = np.zeros((len(p.plane), 3))
     bounds = shapely.bounds(p.polygon)

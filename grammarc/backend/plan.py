@@ -101,6 +101,8 @@ def make_plan(grammar: Grammar) -> Plan:
         + ancestors))}
     not_applied = tuple(sorted({op.name for op in ops if isinstance(op, ir.NotApplied)}))
     strings.intern("")
+    for answer in ("none", "part", "full"):  # of Shape.occ
+        strings.intern(answer)
     for selector in ir.FACE_SELECTORS:
         strings.intern(selector)
     asset_of_string = {strings.intern(raw): asset for raw, asset in grammar.asset_ids.items()}

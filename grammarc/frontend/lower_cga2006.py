@@ -34,10 +34,10 @@ ROOF_TYPES = {"hipped": "roofHip", "gabled": "roofGable", "cross-gable": "roofGa
               "pyramid": "roofPyramid", "shed": "roofShed", "mansard": "mansard", "gambrel": "gambrel"}
 #: Context queries (paper section 3.2), parsed as dotted calls.
 NOT_YET_QUERIES = {
-    ("Shape", "occ"): "occlusion queries `Shape.occ` (paper section 3.2)",
-    ("Scope", "occ"): "occlusion queries `Scope.occ` (paper section 3.2)",
     ("Shape", "visible"): "visibility queries `Shape.visible` (paper section 3.2)",
 }
+#: Occlusion queries (section 3.2): both test the shape's scope.
+OCCLUSION_QUERIES = {("Shape", "occ"), ("Scope", "occ")}
 
 OPERATIONS = ("T", "S", "R", "Rx", "Ry", "Rz", "I", "Subdiv", "Repeat", "Comp", "Roof", "Snap", "SnapLines")
 
@@ -377,12 +377,29 @@ class Lowering(LoweringBase):
 
     def dotted_function(self, meta, head, field, args):
         span = Span(self.file, head.line, head.column, field.end_line, field.end_column)
+        if (str(head), str(field)) in OCCLUSION_QUERIES:
+            return self.occlusion(f"{head}.{field}", args or (), span)
         what = NOT_YET_QUERIES.get((str(head), str(field)))
         if what is not None:
             self.not_yet(f"{head}.{field}", what, span)
         else:
             self.diags.error("unknown-function", f"unknown function `{head}.{field}`", span)
         return ir.placeholder(span)
+
+    def occlusion(self, name: str, args, span) -> ir.Expr:
+        """``Shape.occ("all" | "active" | "noparent" | LABEL[, "distance", d])``."""
+        args = tuple(self.expr(a) for a in args)
+        which = args[0].value if args and isinstance(args[0], ir.Str) else None
+        distance = None
+        if which is not None and len(args) == 3 and isinstance(args[1], ir.Str) and args[1].value == "distance":
+            distance = args[2]
+        elif len(args) != 1 or which is None:
+            self.diags.error("arity", f'`{name}` takes "all", "active", "noparent" or a label, and '
+                             'optionally "distance" and a distance', span)
+            return ir.Str("none", span)
+        label = which if which not in ("all", "active", "noparent") else None
+        return ir.Occlusion("occ", "all", label, span, parents=which != "noparent", active=which == "active",
+                            distance=distance)
 
     def function(self, meta, name, args):
         span = self.token_span(name)

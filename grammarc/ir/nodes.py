@@ -155,12 +155,18 @@ OCCLUSION_TARGETS = frozenset({"intra", "inter", "all"})
 class Occlusion:
     """CityEngine's ``inside`` / ``overlaps`` / ``touches([target[, label]])``: whether the shape's
     geometry lies in, overlaps or touches a closed occluder of its own lot (``intra``), of other lots
-    (``inter``) or of either (``all``), of any label or of ``label`` (``backend.occlusion``)."""
+    (``inter``) or of either (``all``), of any label or of ``label`` (``backend.occlusion``). The
+    paper's ``Shape.occ(...)`` is kind ``occ``: ``"none"``, ``"part"`` or ``"full"``, against the shapes
+    of every lot, its ancestors too unless ``parents`` is false, leaves only if ``active``, the scope
+    enlarged by ``distance``."""
 
     kind: str
     target: str
     label: str | None
     span: Span = NO_SPAN
+    parents: bool = False
+    active: bool = False
+    distance: Expr | None = None
 
 
 @dataclass(frozen=True, slots=True)

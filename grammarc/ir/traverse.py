@@ -30,6 +30,10 @@ def rewrite_expr(expr: ir.Expr, fn: ExprFn) -> ir.Expr:
         args = _tuple(expr.args, lambda a: rewrite_expr(a, fn))
         if args is not expr.args:
             expr = replace(expr, args=args)
+    elif isinstance(expr, ir.Occlusion) and expr.distance is not None:
+        distance = rewrite_expr(expr.distance, fn)
+        if distance is not expr.distance:
+            expr = replace(expr, distance=distance)
     elif isinstance(expr, ir.Select):
         parts = _tuple((expr.cond, expr.then, expr.other), lambda a: rewrite_expr(a, fn))
         if parts is not (expr.cond, expr.then, expr.other) and any(
@@ -260,3 +264,5 @@ def iter_exprs(expr: ir.Expr) -> Iterator[ir.Expr]:
     elif isinstance(expr, ir.Select):
         for a in (expr.cond, expr.then, expr.other):
             yield from iter_exprs(a)
+    elif isinstance(expr, ir.Occlusion) and expr.distance is not None:
+        yield from iter_exprs(expr.distance)

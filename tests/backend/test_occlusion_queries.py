@@ -61,3 +61,38 @@ Cell --> case overlaps(all, "kiosk") : Taken. case touches(all, "tree") : Shaded
     assert count(r, "Taken") == 0 and count(r, "Shaded") == 0  # a face on the base touches, not overlaps
     r = run(write, text.replace("overlaps(all", "touches(all"), [rect(20, 20)])
     assert count(r, "Taken") == 2 and count(r, "Free") == 8
+
+
+FIG13 = """
+lot ~> S(1r, 10, 1r) facades
+facades ~> Comp("sidefaces"){ facade }
+facade ~> Repeat("X", 2){ tile }
+tile : Shape.occ("noparent") == "none" ~> window
+tile : Shape.occ("noparent") == "part" ~> wall
+tile ~> ε
+"""
+
+
+def test_fig13_no_window_where_a_building_meets_its_neighbours(write):
+    """Three buildings on touching 20 x 20 m lots (the paper's Fig. 13): the tiles of the walls they
+    share lie on the neighbour's surface ("full") and go; the ends keep three facades, the middle two."""
+    lots = [[np.array([[x, 0], [x + 20, 0], [x + 20, 20], [x, 20]], float)] for x in (0, 20, 40)]
+    r = run(write, FIG13, lots, version=False)
+    windows = np.array(names(r)) == "window"
+    assert np.bincount(r["lot"][windows], minlength=3).tolist() == [30, 20, 30]
+    assert count(r, "wall") == 0
+    # "all" counts the building's own mass: every tile is fully occluded by its parent
+    assert count(run(write, FIG13.replace('"noparent"', '"all"'), lots, version=False), "window") == 0
+
+
+def test_an_enlarged_scope_finds_a_neighbour_a_little_away(write):
+    """Shape.occ("noparent", "distance", d): buildings 1 m apart; with d = 1.5 the facing sides' tiles
+    (10 each) and the end tiles of the fronts and backs next to the gap (4) reach the neighbour ("part");
+    with d = 0.5 none do."""
+    lots = [[np.array([[x, 0], [x + 20, 0], [x + 20, 20], [x, 20]], float)] for x in (0, 21)]
+    near = FIG13.replace('Shape.occ("noparent")', 'Shape.occ("noparent", "distance", 1.5)')
+    r = run(write, near, lots, version=False)
+    assert count(r, "wall") == 24 and count(r, "window") == 80 - 24
+    far = FIG13.replace('Shape.occ("noparent")', 'Shape.occ("noparent", "distance", 0.5)')
+    r = run(write, far, lots, version=False)
+    assert count(r, "wall") == 0 and count(r, "window") == 80

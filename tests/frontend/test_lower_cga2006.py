@@ -78,8 +78,6 @@ def test_lowering_errors(text, expected):
 
 
 @pytest.mark.parametrize("text, col, what", [
-    ('a : Shape.occ("all") == "none" ~> b', 5, "`Shape.occ` is not supported yet"),
-    ('a : Scope.occ("noparent") != "none" ~> b', 5, "`Scope.occ` is not supported yet"),
     ('a : Shape.visible("front") ~> b', 5, "`Shape.visible` is not supported yet"),
 ])
 def test_not_supported_yet_each_with_its_line_and_nothing_else(text, col, what):
@@ -106,7 +104,24 @@ def test_snap_shapes_and_snapped_splits_lower_as_the_paper_writes_them():
     assert print_op(split.parts[1][1]) == 'SnapLines("Y", "entrancesnap")'
 
 
+def test_occlusion_queries_lower_with_their_subsets():
+    from grammarc.ir import nodes as ir
+    from grammarc.ir.printer import print_expr
+
+    module = run_passes(parse_source(
+        'a : Shape.occ("noparent") == "none" ~> b\n'
+        'b : Scope.occ("all", "distance", 4) != "full" ~> c\n'
+        'c : Shape.occ("active") == "part" ~> d\n', FILE, Diagnostics()), Diagnostics(), check=True)
+    found = [rule.guard.left for rule in module.rules]
+    assert [(e.parents, e.active, e.label) for e in found] == [(False, False, None), (True, False, None),
+                                                               (True, True, None)]
+    assert all(isinstance(e, ir.Occlusion) and e.kind == "occ" for e in found)
+    assert print_expr(found[1]) == 'Shape.occ("all", "distance", 4)'
+
+
 @pytest.mark.parametrize("text, expected", [
+    ('a : Shape.occ(1) == "none" ~> b', [(1, 5, ('`Shape.occ` takes "all", "active", "noparent" or a label, '
+                                               'and optionally "distance" and a distance'))]),
     ('a ~> b Snap("W")', [(1, 13, 'unknown snap axes "W", expected one of XZ, ZX, XY, YX, YZ, ZY, X, Y, Z')]),
     ('a ~> b Snap("X", "a", "b")', [(1, 8, "`Snap` takes 1 or 2 arguments, got 3")]),
     ('a ~> b SnapLines(3)', [(1, 18, "`SnapLines` expects the axes of its plane as a string literal")]),

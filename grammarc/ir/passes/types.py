@@ -190,7 +190,9 @@ def type_of(expr: ir.Expr, attrs: dict, params: tuple, diags: Diagnostics) -> ir
     if isinstance(expr, ir.ContextRef):
         return ir.CONTEXT_FIELDS[expr.name]
     if isinstance(expr, ir.Occlusion):
-        return T.BOOL
+        if expr.distance is not None:
+            _expect(expr.distance, T.NUM, "a distance", attrs, params, diags)
+        return T.STR if expr.kind == "occ" else T.BOOL
     if isinstance(expr, ir.AttrRef):
         return attrs.get(expr.name, T.UNKNOWN)
     if isinstance(expr, ir.Param):
