@@ -22,6 +22,7 @@ occluders of every other branch exist when they run.
 from __future__ import annotations
 
 from dataclasses import dataclass, field, replace
+from functools import cached_property
 
 import numpy as np
 import shapely
@@ -29,14 +30,23 @@ import shapely
 from grammarc.backend.shapes import asset_geom
 from grammarc.geometry.clip import scope_polygons
 from grammarc.geometry.meshes import is_polygon
-from grammarc.geometry.occlusion import BOX_CORNERS, BOX_EDGES, QUAD_CORNERS, QUAD_EDGES, Prisms, relations
+from grammarc.geometry.occlusion import (
+    BOX_CORNERS,
+    BOX_EDGES,
+    QUAD_CORNERS,
+    QUAD_EDGES,
+    Prisms,
+    prisms,
+    relations,
+)
 from grammarc.geometry.polygons import PLANE_U, PLANE_V
 
 #: The per-shape columns of the ids of its nearest occluding ancestors (NaN: none), nearest first.
 ANCESTORS = tuple(f"occluder.{k}" for k in range(4))
 #: Occluders per lot are numbered below this.
 _PER_LOT = 2 ** 24
-_KIND = {"inside": 0, "overlaps": 1, "touches": 2}
+#: How far (metres) apart boxes may be and still be paired for the exact test.
+_PAD = 1e-3
 #: The ``geom`` of a ``primitiveCube`` (the built-in cube, asset 0, not mirrored): a box.
 _CUBE = int(asset_geom(np.array([0]))[0])
 
@@ -55,19 +65,36 @@ class Occluders:
     @staticmethod
     def concat(tables: list[Occluders]) -> Occluders:
         tables = [t for t in tables if len(t.lot)] or [_EMPTY]
-        prisms = Prisms(*(np.concatenate([getattr(t.prisms, f) for t in tables])
-                          for f in ("origin", "axes", "plane", "height", "polygon")))
+        if len(tables) == 1:
+            return tables[0]
         return Occluders(*(np.concatenate([getattr(t, f) for t in tables]) for f in ("lot", "ident", "label", "active")),
-                         prisms)
+                         Prisms.concat([t.prisms for t in tables]))
 
     def take(self, rows: np.ndarray) -> Occluders:
-        p = self.prisms
         return Occluders(self.lot[rows], self.ident[rows], self.label[rows], self.active[rows],
-                         Prisms(p.origin[rows], p.axes[rows], p.plane[rows], p.height[rows], p.polygon[rows]))
+                         self.prisms.take(rows))
+
+    @cached_property
+    def index(self):
+        """The occluders' world boxes (low, high (k, 3)) and a GEOS STRtree of their ground rectangles."""
+        p = self.prisms
+        k = np.arange(len(p.plane))
+        bounds = shapely.bounds(p.polygon)
+        low = np.zeros((len(k), 3))
+        size = np.zeros((len(k), 3))
+        low[k, PLANE_U[p.plane]], low[k, PLANE_V[p.plane]] = bounds[:, 0], bounds[:, 1]
+        size[k, PLANE_U[p.plane]] = bounds[:, 2] - bounds[:, 0]
+        size[k, PLANE_V[p.plane]] = bounds[:, 3] - bounds[:, 1]
+        size[k, p.plane] = p.height
+        o_low, o_high = _world_boxes(p.origin + np.einsum("pi,pij->pj", low, p.axes), p.axes, size)
+        pad = _PAD
+        tree = shapely.STRtree(shapely.box(o_low[:, 0] - pad, o_low[:, 2] - pad, o_high[:, 0] + pad,
+                                           o_high[:, 2] + pad))
+        return o_low, o_high, tree
 
 
 _EMPTY = Occluders(np.zeros(0, np.int64), np.zeros(0), np.zeros(0, dtype=object), np.zeros(0, dtype=bool),
-                   Prisms(np.zeros((0, 3)), np.zeros((0, 3, 3)), np.zeros(0, np.int64), np.zeros(0),
+                   prisms(np.zeros((0, 3)), np.zeros((0, 3, 3)), np.zeros(0, np.int64), np.zeros(0),
                           np.zeros(0, dtype=object)))
 
 
@@ -113,9 +140,9 @@ def add_occluders(chunk, shapes, label: str | None = None, active: bool = True) 
     polygons[~is_poly] = shapely.box(0, 0, sub.size[k, PLANE_U[plane]][~is_poly], sub.size[k, PLANE_V[plane]][~is_poly])
     if is_poly.any():
         polygons[is_poly] = scope_polygons(chunk.polygons, sub.geom[is_poly], sub.size[is_poly])
-    prisms = Prisms(sub.origin.copy(), chunk.frames[sub.frame], plane, sub.size[k, plane], polygons)
     store.tables.append(Occluders(chunk.lot_index[lot], ident[rows], np.full(len(rows), label, dtype=object),
-                                  np.full(len(rows), active), prisms))
+                                  np.full(len(rows), active),
+                                  prisms(sub.origin.copy(), chunk.frames[sub.frame], plane, sub.size[k, plane], polygons)))
     return ident
 
 
@@ -187,9 +214,9 @@ def _relations(kinds, shapes, chunk, rows: np.ndarray, occluders: Occluders, dis
             at = np.arange(len(pick))[:, None]
             s, frame = s[at, cols], frame[at, cols]
         corners = origin[pick, None] + np.einsum("cj,pj,pji->pci", unit, s, frame)
-        found = relations(corners, edges, occluders.take(pick).prisms)
+        found = relations(corners, edges, occluders.prisms.take(pick), kinds)
         for k, kind in enumerate(kinds):
-            out[k][pick] = found[_KIND[kind]]
+            out[k][pick] = found[kind]
     return out
 
 
@@ -200,20 +227,9 @@ def _pairs(shapes, chunk, table: Occluders, distance: np.ndarray) -> tuple[np.nd
     axes = chunk.frames[shapes.frame]
     q_low, q_high = _world_boxes(shapes.origin - np.einsum("p,pij->pj", distance, axes), axes,
                                  shapes.size + 2 * distance[:, None])
-    p = table.prisms
-    local_size = np.zeros((len(p.plane), 3))
-    bounds = shapely.bounds(p.polygon)
-    k = np.arange(len(p.plane))
-    lows = np.zeros((len(p.plane), 3))
-    lows[k, PLANE_U[p.plane]], lows[k, PLANE_V[p.plane]] = bounds[:, 0], bounds[:, 1]
-    local_size[k, PLANE_U[p.plane]] = bounds[:, 2] - bounds[:, 0]
-    local_size[k, PLANE_V[p.plane]] = bounds[:, 3] - bounds[:, 1]
-    local_size[k, p.plane] = p.height
-    o_low, o_high = _world_boxes(p.origin + np.einsum("pi,pij->pj", lows, p.axes), p.axes, local_size)
-    pad = 1e-3
-    tree = shapely.STRtree(shapely.box(o_low[:, 0] - pad, o_low[:, 2] - pad, o_high[:, 0] + pad, o_high[:, 2] + pad))
+    o_low, o_high, tree = table.index
     q, o = tree.query(shapely.box(q_low[:, 0], q_low[:, 2], q_high[:, 0], q_high[:, 2]))
-    keep = (q_low[q, 1] <= o_high[o, 1] + pad) & (o_low[o, 1] <= q_high[q, 1] + pad)
+    keep = (q_low[q, 1] <= o_high[o, 1] + _PAD) & (o_low[o, 1] <= q_high[q, 1] + _PAD)
     return q[keep], o[keep]
 
 

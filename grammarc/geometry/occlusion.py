@@ -20,7 +20,7 @@ predicates for the planar part. ``EPS`` (metres) absorbs rounding, so faces that
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, fields
 
 import numpy as np
 import shapely
@@ -41,37 +41,65 @@ QUAD_EDGES = np.array([[0, 1], [1, 2], [2, 3], [3, 0]])
 class Prisms:
     """Occluders: ``origin`` (k, 3) and ``axes`` (k, 3, 3) (rows) of their scopes, ``plane`` (k,) the scope
     axis along which each extrudes, ``height`` (k,), ``polygon`` (k,) shapely polygons in the plane's
-    (u, v) = (axis PLANE_U, axis PLANE_V) coordinates, in metres from the origin."""
+    (u, v) = (axis PLANE_U, axis PLANE_V) coordinates, in metres from the origin; ``outer`` and
+    ``inner`` (k,) the polygons grown and shrunk by ``EPS``, ``boundary`` (k,) their outlines (made
+    once by ``prisms``, not per query)."""
 
     origin: np.ndarray
     axes: np.ndarray
     plane: np.ndarray
     height: np.ndarray
     polygon: np.ndarray
+    outer: np.ndarray
+    inner: np.ndarray
+    boundary: np.ndarray
+
+    def take(self, rows) -> Prisms:
+        return Prisms(*(getattr(self, f.name)[rows] for f in fields(self)))
+
+    @staticmethod
+    def concat(parts: list[Prisms]) -> Prisms:
+        return Prisms(*(np.concatenate([getattr(p, f.name) for p in parts]) for f in fields(Prisms)))
 
 
-def relations(corners: np.ndarray, edges: np.ndarray, prisms: Prisms) -> tuple[np.ndarray, ...]:
-    """``inside``, ``overlaps``, ``touches`` (p,) bool of p pairs: query corners (p, c, 3) in world
-    coordinates with the corner pairs ``edges`` (e, 2) of their polytope, against the pairs' prisms."""
-    p = len(corners)
-    local = np.einsum("pcj,pij->pci", corners - prisms.origin[:, None], prisms.axes)
-    rows = np.arange(p)[:, None]
-    u = local[rows, np.arange(corners.shape[1])[None], PLANE_U[prisms.plane][:, None]]
-    v = local[rows, np.arange(corners.shape[1])[None], PLANE_V[prisms.plane][:, None]]
-    w = local[rows, np.arange(corners.shape[1])[None], prisms.plane[:, None]]
-    h = prisms.height[:, None]
-    uv = np.stack([u, v], axis=2)
-    polygon = prisms.polygon
-    hull = _hulls(uv, np.ones(w.shape, dtype=bool))
-    inside = (w >= -EPS).all(axis=1) & (w <= h + EPS).all(axis=1) & shapely.covers(
-        shapely.buffer(polygon, EPS, join_style="mitre"), hull)
-    open_part, _ = _slab_part(uv, w, edges, EPS, prisms.height - EPS)
-    overlaps = shapely.intersects(open_part, shapely.buffer(polygon, -EPS, join_style="mitre"))
-    closed_part, w_extent = _slab_part(uv, w, edges, -EPS, prisms.height + EPS)
-    met = shapely.intersection(closed_part, polygon)
-    along = shapely.length(shapely.intersection(closed_part, shapely.boundary(polygon)))
-    touches = overlaps | (shapely.area(met) > EPS * EPS) | ((along > EPS) & (w_extent > EPS))
-    return inside, overlaps, touches
+def prisms(origin, axes, plane, height, polygon) -> Prisms:
+    """Prisms with their grown and shrunk polygons and outlines."""
+    return Prisms(origin, axes, plane, height, polygon, shapely.buffer(polygon, EPS, join_style="mitre"),
+                  shapely.buffer(polygon, -EPS, join_style="mitre"), shapely.boundary(polygon))
+
+
+def relations(corners: np.ndarray, edges: np.ndarray, prisms: Prisms,
+              kinds=("inside", "overlaps", "touches")) -> dict[str, np.ndarray]:
+    """The ``kinds`` of p pairs, each (p,) bool: query corners (p, c, 3) in world coordinates with the
+    corner pairs ``edges`` (e, 2) of their polytope, against the pairs' prisms."""
+    p, c = corners.shape[:2]
+    local = np.matmul(corners - prisms.origin[:, None], np.transpose(prisms.axes, (0, 2, 1)))
+    rows, cols = np.arange(p)[:, None], np.arange(c)[None]
+    uv = np.stack([local[rows, cols, PLANE_U[prisms.plane][:, None]],
+                   local[rows, cols, PLANE_V[prisms.plane][:, None]]], axis=2)
+    w = local[rows, cols, prisms.plane[:, None]]
+    out = {}
+    if "inside" in kinds:
+        within = (w >= -EPS).all(axis=1) & (w <= prisms.height[:, None] + EPS).all(axis=1)
+        out["inside"] = within
+        if within.any():
+            out["inside"][within] = shapely.covers(prisms.outer[within],
+                                                   _hulls(uv[within], np.ones(w[within].shape, dtype=bool)))
+    if "overlaps" in kinds or "touches" in kinds:
+        open_part, _ = _slab_part(uv, w, edges, EPS, prisms.height - EPS)
+        out["overlaps"] = shapely.intersects(open_part, prisms.inner)
+    if "touches" in kinds:
+        touches = out["overlaps"].copy()
+        rest = np.flatnonzero(~touches)
+        if len(rest):
+            part, w_extent = _slab_part(uv[rest], w[rest], edges, -EPS, prisms.height[rest] + EPS)
+            near = np.flatnonzero(shapely.intersects(part, prisms.polygon[rest]))  # cheap before the exact
+            part, w_extent, rest = part[near], w_extent[near], rest[near]
+            met = shapely.area(shapely.intersection(part, prisms.polygon[rest])) > EPS * EPS
+            along = shapely.length(shapely.intersection(part, prisms.boundary[rest])) > EPS
+            touches[rest] = met | (along & (w_extent > EPS))
+        out["touches"] = touches
+    return out
 
 
 def _slab_part(uv: np.ndarray, w: np.ndarray, edges: np.ndarray, low, high) -> tuple[np.ndarray, np.ndarray]:
@@ -96,9 +124,11 @@ def _slab_part(uv: np.ndarray, w: np.ndarray, edges: np.ndarray, low, high) -> t
 
 def _hulls(points: np.ndarray, keep: np.ndarray) -> np.ndarray:
     """Convex hulls (p,) of the kept points (p, k, 2) of each row (empty geometries where none)."""
-    row, col = np.nonzero(keep)
+    counts = keep.sum(axis=1)
     hulls = np.full(len(points), shapely.GeometryCollection(), dtype=object)
-    if len(row):
-        rows, dense = np.unique(row, return_inverse=True)
-        hulls[rows] = shapely.convex_hull(shapely.multipoints(points[row, col], indices=dense))
+    some = counts > 0
+    if some.any():
+        offsets = np.concatenate([[0], np.cumsum(counts[some])])
+        multi = shapely.from_ragged_array(shapely.GeometryType.MULTIPOINT, points[keep], (offsets,))
+        hulls[some] = shapely.convex_hull(multi)
     return hulls

@@ -6,14 +6,14 @@ import numpy as np
 import pytest
 import shapely
 
-from grammarc.geometry.occlusion import BOX_CORNERS, BOX_EDGES, QUAD_CORNERS, QUAD_EDGES, Prisms, relations
+from grammarc.geometry.occlusion import BOX_CORNERS, BOX_EDGES, QUAD_CORNERS, QUAD_EDGES, prisms, relations
 
 L_SHAPE = shapely.Polygon([(0, 0), (30, 0), (30, 10), (10, 10), (10, 20), (0, 20)])
 
 
 def prism(polygon, height, n=1):
     """An upright prism (x-z plane, extruded along y) at the world origin, n copies."""
-    return Prisms(np.zeros((n, 3)), np.tile(np.eye(3), (n, 1, 1)), np.ones(n, dtype=np.int64),
+    return prisms(np.zeros((n, 3)), np.tile(np.eye(3), (n, 1, 1)), np.ones(n, dtype=np.int64),
                   np.full(n, float(height)), np.full(n, polygon, dtype=object))
 
 
@@ -36,7 +36,7 @@ def quad(origin, x, y):
     ([40, 1, 2], [4, 3, 4], (False, False, False)),    # away
 ])
 def test_boxes_against_a_concave_prism(low, size, expected):
-    inside, overlaps, touches = relations(box(low, size)[None], BOX_EDGES, prism(L_SHAPE, 10))
+    inside, overlaps, touches = relations(box(low, size)[None], BOX_EDGES, prism(L_SHAPE, 10)).values()
     assert (bool(inside[0]), bool(overlaps[0]), bool(touches[0])) == expected
 
 
@@ -49,16 +49,16 @@ def test_boxes_against_a_concave_prism(low, size, expected):
     (quad([5, 12, 5], [2, 0, 0], [0, 0, 2]), (False, False, False)),   # above it
 ])
 def test_faces_against_a_concave_prism(face, expected):
-    inside, overlaps, touches = relations(face[None], QUAD_EDGES, prism(L_SHAPE, 10))
+    inside, overlaps, touches = relations(face[None], QUAD_EDGES, prism(L_SHAPE, 10)).values()
     assert (bool(inside[0]), bool(overlaps[0]), bool(touches[0])) == expected
 
 
 def test_pairs_are_independent_and_the_prism_may_turn():
-    turned = Prisms(np.array([[0.0, 0, 0]]), np.array([[[0.0, 0, 1], [0, 1, 0], [-1, 0, 0]]]),
-                    np.array([1]), np.array([10.0]), np.array([shapely.box(0, 0, 5, 5)], dtype=object))
+    turned = prisms(np.array([[0.0, 0, 0]] * 2), np.array([[[0.0, 0, 1], [0, 1, 0], [-1, 0, 0]]] * 2),
+                    np.array([1, 1]), np.array([10.0, 10.0]), np.array([shapely.box(0, 0, 5, 5)] * 2, dtype=object))
     # the scope's x runs along world z, its z along world -x: the box covers world x -5..0, z 0..5
     corners = np.stack([box([-4, 1, 1], [2, 2, 2]), box([1, 1, 1], [2, 2, 2])])
-    inside, overlaps, touches = relations(corners, BOX_EDGES, Prisms(*(np.concatenate([a, a]) for a in (
-        turned.origin, turned.axes, turned.plane, turned.height, turned.polygon))))
-    assert inside.tolist() == [True, False] and overlaps.tolist() == [True, False]
-    assert touches.tolist() == [True, False]
+    found = relations(corners, BOX_EDGES, turned)
+    assert found["inside"].tolist() == [True, False] and found["overlaps"].tolist() == [True, False]
+    assert found["touches"].tolist() == [True, False]
+    assert set(relations(corners, BOX_EDGES, turned, ("inside",))) == {"inside"}
