@@ -14,8 +14,10 @@ query Q, with w its coordinate along the normal and Q's projection onto the plan
   (the part of Q in the closed slab projects onto P with positive area) or against a side (that part
   runs along P's boundary for a positive length and over a positive height).
 
-Everything runs on arrays of pairs: numpy for the frames and slab clipping, shapely's vectorized
-predicates for the planar part. ``EPS`` (metres) absorbs rounding, so faces that meet exactly touch.
+Everything runs on arrays of pairs: a box occluder (the common case: masses, cubes) by separating axes
+in numba (``box_relations``), any other prism with numpy for the frames and slab clipping and shapely's
+vectorized predicates for the planar part. ``EPS`` (metres) absorbs rounding, so faces that meet exactly
+touch.
 """
 
 from __future__ import annotations
