@@ -66,7 +66,7 @@ def test_syntax_errors_all_reported_with_caret_exit_2(write, tmp_path, capsys):
     ("lot ~> f(1, 2)\nf(a) ~> x\n", "`f` takes 1 argument, got 2"),
     ("lot ~> a : 0.5\n    ~> b : 0.4\n", "probabilities of `lot` sum to 0.9"),
     ("lot ~> Shape.occ(\"all\")\n", "unexpected"),
-    ("lot : Shape.visible(\"street\") ~> x\n", "`Shape.visible` is not supported yet"),
+    ("lot : Shape.visible(\"river\") ~> x\n", "`Shape.visible` takes \"street\" (the lot's street edges) or \"front\""),
 ])
 def test_grammar_errors_exit_2(write, tmp_path, capsys, text, message):
     out = tmp_path / "out.npz"

@@ -45,6 +45,8 @@ from grammarc.geometry.polygons import PLANE_U, PLANE_V
 ANCESTORS = tuple(f"occluder.{k}" for k in range(4))
 #: Occluders per lot are numbered below this.
 _PER_LOT = 2 ** 24
+#: A sightline: one edge between its two ends.
+_SEGMENT = np.array([[0, 1]])
 #: How far (metres) apart boxes may be and still be paired for the exact test.
 _PAD = 1e-3
 #: The ``geom`` of a ``primitiveCube`` (the built-in cube, asset 0, not mirrored): a box.
@@ -163,6 +165,8 @@ def query(expr, env, distance: np.ndarray | None = None) -> np.ndarray:
     ``distance`` expression."""
     shapes, chunk = env.shapes, env.chunk
     n = len(shapes)
+    if expr.kind == "visible":
+        return _visible(shapes, chunk)
     occ = expr.kind == "occ"
     kinds = ("inside", "touches") if occ else (expr.kind,)
     found = {kind: np.zeros(n, dtype=bool) for kind in kinds}
@@ -194,6 +198,40 @@ def query(expr, env, distance: np.ndarray | None = None) -> np.ndarray:
     return np.where(full, strings["full"], np.where(part, strings["part"], strings["none"])).astype(np.int32)
 
 
+def _visible(shapes, chunk) -> np.ndarray:
+    """The paper's ``Shape.visible("street")``: the sightline from the centre of each shape's scope to the
+    nearest point of its lot's street edges (its front edge where it has none) passes through no
+    occluder's interior, of any lot (its own building's mass included: a facade turned away from the
+    street looks through it)."""
+    n = len(shapes)
+    axes = chunk.frames[shapes.frame]
+    centre = shapes.origin + 0.5 * np.einsum("pj,pji->pi", shapes.size, axes)
+    start, end, row = chunk.streets.of_lots(shapes.lot)
+    step = end - start
+    t = np.clip(np.einsum("kj,kj->k", centre[row] - start, step) / np.maximum(
+        np.einsum("kj,kj->k", step, step), 1e-300), 0.0, 1.0)
+    point = start + t[:, None] * step
+    distance = np.linalg.norm(point - centre[row], axis=1)
+    nearest = np.full(n, np.inf)
+    np.minimum.at(nearest, row, distance)
+    chosen = np.flatnonzero(distance <= nearest[row])
+    chosen = chosen[np.unique(row[chosen], return_index=True)[1]]  # one sightline a shape
+    sight = np.stack([centre[row[chosen]], point[chosen]], axis=1)
+    blocked = np.zeros(n, dtype=bool)
+    own = chunk.lot_index[shapes.lot]
+    sources = [(chunk.occluders.table(), True)] + ([(chunk.foreign, False)] if chunk.foreign is not None else [])
+    for table, intra in sources:
+        q, o = _candidates(table, sight.min(axis=1), sight.max(axis=1))
+        shape_row = row[chosen][q]
+        same = table.lot[o] == own[shape_row]
+        keep = same if intra else ~same
+        q, o, shape_row = q[keep], o[keep], shape_row[keep]
+        if len(q):
+            hit = relations(sight[q], _SEGMENT, table.prisms.take(o), ("overlaps",))["overlaps"]
+            np.logical_or.at(blocked, shape_row, hit)
+    return ~blocked
+
+
 def _relations(kinds, shapes, chunk, rows: np.ndarray, occluders: Occluders, distance: np.ndarray):
     """The ``kinds`` (each (p,) bool) of the shapes ``rows`` (p,) (their scope boxes, or rectangles for
     faces, enlarged by ``distance`` (p,)) against the pairs' occluders."""
@@ -221,15 +259,21 @@ def _relations(kinds, shapes, chunk, rows: np.ndarray, occluders: Occluders, dis
 
 
 def _pairs(shapes, chunk, table: Occluders, distance: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """(query row, occluder) pairs whose world boxes meet (GEOS STRtree on the ground plane, then y)."""
+    """(query row, occluder) pairs whose world boxes meet, the scopes enlarged by ``distance``."""
+    axes = chunk.frames[shapes.frame]
+    low, high = _world_boxes(shapes.origin - np.einsum("p,pij->pj", distance, axes), axes,
+                             shapes.size + 2 * distance[:, None])
+    return _candidates(table, low, high)
+
+
+def _candidates(table: Occluders, low: np.ndarray, high: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(query, occluder) pairs whose world boxes (query boxes ``low``, ``high`` (n, 3)) meet: GEOS
+    STRtree on the ground plane, then the heights."""
     if not len(table.lot):
         return np.zeros(0, np.int64), np.zeros(0, np.int64)
-    axes = chunk.frames[shapes.frame]
-    q_low, q_high = _world_boxes(shapes.origin - np.einsum("p,pij->pj", distance, axes), axes,
-                                 shapes.size + 2 * distance[:, None])
     o_low, o_high, tree = table.index
-    q, o = tree.query(shapely.box(q_low[:, 0], q_low[:, 2], q_high[:, 0], q_high[:, 2]))
-    keep = (q_low[q, 1] <= o_high[o, 1] + _PAD) & (o_low[o, 1] <= q_high[q, 1] + _PAD)
+    q, o = tree.query(shapely.box(low[:, 0], low[:, 2], high[:, 0], high[:, 2]))
+    keep = (low[q, 1] <= o_high[o, 1] + _PAD) & (o_low[o, 1] <= high[q, 1] + _PAD)
     return q[keep], o[keep]
 
 

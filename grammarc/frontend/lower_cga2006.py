@@ -33,9 +33,6 @@ SNAP_NORMALS = {"XZ": 1, "ZX": 1, "XY": 2, "YX": 2, "YZ": 0, "ZY": 0, "X": 1, "Y
 ROOF_TYPES = {"hipped": "roofHip", "gabled": "roofGable", "cross-gable": "roofGable", "cone": "roofPyramid",
               "pyramid": "roofPyramid", "shed": "roofShed", "mansard": "mansard", "gambrel": "gambrel"}
 #: Context queries (paper section 3.2), parsed as dotted calls.
-NOT_YET_QUERIES = {
-    ("Shape", "visible"): "visibility queries `Shape.visible` (paper section 3.2)",
-}
 #: Occlusion queries (section 3.2): both test the shape's scope.
 OCCLUSION_QUERIES = {("Shape", "occ"), ("Scope", "occ")}
 
@@ -173,11 +170,6 @@ class Lowering(LoweringBase):
             return ir.Empty(span)
         return ir.Symbol(op, tuple(self.expr(a) for a in args), span, self.site())
 
-    def not_yet(self, what: str, description: str, span: Span):
-        self.diags.error("not-supported", f"`{what}` is not supported yet: {description}", span)
-        return ir.Empty(span)
-
-    # ------------------------------------------------------------------------------------- operations
     def expect_args(self, op, args, counts, span) -> bool:
         if len(args) not in counts:
             want = " or ".join(str(c) for c in counts)
@@ -379,12 +371,18 @@ class Lowering(LoweringBase):
         span = Span(self.file, head.line, head.column, field.end_line, field.end_column)
         if (str(head), str(field)) in OCCLUSION_QUERIES:
             return self.occlusion(f"{head}.{field}", args or (), span)
-        what = NOT_YET_QUERIES.get((str(head), str(field)))
-        if what is not None:
-            self.not_yet(f"{head}.{field}", what, span)
-        else:
-            self.diags.error("unknown-function", f"unknown function `{head}.{field}`", span)
+        if (str(head), str(field)) == ("Shape", "visible"):
+            return self.visible(tuple(self.expr(a) for a in args or ()), span)
+        self.diags.error("unknown-function", f"unknown function `{head}.{field}`", span)
         return ir.placeholder(span)
+
+    def visible(self, args, span) -> ir.Expr:
+        """``Shape.visible("street")``: whether the shortest sightline to the lot's street is clear. The
+        Puuc paper writes ``Shape.visible("front")`` for the same: the lot's front is its street."""
+        if len(args) != 1 or not isinstance(args[0], ir.Str) or args[0].value.lower() not in ("street", "front"):
+            self.diags.error("arity", '`Shape.visible` takes "street" (the lot\'s street edges) or "front"', span)
+            return ir.Bool(True, span)
+        return ir.Occlusion("visible", "all", None, span, parents=True)
 
     def occlusion(self, name: str, args, span) -> ir.Expr:
         """``Shape.occ("all" | "active" | "noparent" | LABEL[, "distance", d])``."""

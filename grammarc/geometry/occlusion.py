@@ -108,6 +108,9 @@ def _boxes(local: np.ndarray, edges: np.ndarray, prisms: Prisms) -> np.ndarray:
     if c == 8:  # a box: its edge directions are its faces' normals
         dirs = np.stack([local[:, 1] - local[:, 0], local[:, 2] - local[:, 0], local[:, 4] - local[:, 0]], axis=1)
         normals = dirs
+    elif c == 2:  # a segment: one direction, no face
+        dirs = (local[:, 1] - local[:, 0])[:, None]
+        normals = np.zeros((p, 0, 3))
     else:  # a face: two edge directions and its normal
         dirs = np.stack([local[:, 1] - local[:, 0], local[:, 3] - local[:, 0]], axis=1)
         normals = np.cross(dirs[:, 0], dirs[:, 1])[:, None]

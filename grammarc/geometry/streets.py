@@ -28,12 +28,22 @@ ALONG = 0.01
 class Streets:
     """The street edges of a chunk's lots: ``start``, ``end`` (S, 3) world points, grouped by lot with
     ``lot_offsets`` (L+1,); ``axes`` (L, 3, 3) each lot's street frame (rows x, y, z), its own frame
-    where it has no street edge."""
+    where it has no street edge; ``front`` (L, 2, 3) each lot's first edge (its front)."""
 
     start: np.ndarray
     end: np.ndarray
     lot_offsets: np.ndarray
     axes: np.ndarray
+    front: np.ndarray
+
+    def of_lots(self, lot: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """The street edges of the lots ``lot`` (n,), their front edge where they have none: the edges'
+        ``start``, ``end`` (k, 3) and the row of ``lot`` each belongs to (k,)."""
+        edge, offsets = ragged_take(self.lot_offsets, lot)
+        row = np.repeat(np.arange(len(lot)), np.diff(offsets))
+        bare = np.flatnonzero(np.diff(offsets) == 0)
+        return (np.concatenate([self.start[edge], self.front[lot[bare], 0]]),
+                np.concatenate([self.end[edge], self.front[lot[bare], 1]]), np.concatenate([row, bare]))
 
 
 def lot_streets(vertices: np.ndarray, ring_offsets: np.ndarray, lot_offsets: np.ndarray, street: np.ndarray,
@@ -56,7 +66,9 @@ def lot_streets(vertices: np.ndarray, ring_offsets: np.ndarray, lot_offsets: np.
     z = facing[has] / norm[has, None]
     y = np.tile([0.0, 1.0, 0.0], (int(has.sum()), 1))
     axes[has] = np.stack([np.cross(y, z), y, z], axis=1)
-    return Streets(start, end, offsets_from_counts(np.bincount(lot, minlength=len(norm))), axes)
+    first = ring_offsets[lot_offsets[:-1]]
+    front = np.stack([vertices[first], vertices[nxt[first]]], axis=1)
+    return Streets(start, end, offsets_from_counts(np.bincount(lot, minlength=len(norm))), axes, front)
 
 
 def along_street(streets: Streets, lot: np.ndarray, start: np.ndarray, end: np.ndarray,

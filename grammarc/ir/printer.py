@@ -33,6 +33,8 @@ def print_expr(e: ir.Expr) -> str:
     if isinstance(e, ir.Call):
         return f"{e.func}({', '.join(print_expr(a) for a in e.args)})"
     if isinstance(e, ir.Occlusion):
+        if e.kind == "visible":
+            return 'Shape.visible("street")'
         if e.kind == "occ":
             which = e.label if e.label is not None else "active" if e.active else "all" if e.parents else "noparent"
             distance = f', "distance", {print_expr(e.distance)}' if e.distance is not None else ""

@@ -96,3 +96,25 @@ def test_an_enlarged_scope_finds_a_neighbour_a_little_away(write):
     far = FIG13.replace('Shape.occ("noparent")', 'Shape.occ("noparent", "distance", 0.5)')
     r = run(write, far, lots, version=False)
     assert count(r, "wall") == 0 and count(r, "window") == 80
+
+
+def test_only_the_facades_that_see_the_street_see_it(write):
+    """Section 4 rule 3: Shape.visible("street"). A 20 x 15 m lot whose street is its first (south) edge:
+    the north facade looks through its own building; the south one faces the street and the two side
+    ones see its ends along their walls."""
+    text = """
+lot ~> S(1r, 10, 1r) facades
+facades ~> Comp("sidefaces"){ facade }
+facade : Shape.visible("street") ~> seen
+facade ~> hidden
+"""
+    lot = [np.array([[0, 0], [20, 0], [20, 15], [0, 15]], float)]
+    for street in ([8, 0, 0, 0], None):  # marked, or the lot's first edge by default
+        from grammarc.build import BuildOptions, derive
+        from grammarc.compiler import compile_grammar
+        from grammarc.io.lots import lots_from_polygons
+
+        r = derive(compile_grammar(write("v.cga", text)), lots_from_polygons([lot], street=[street]), BuildOptions())
+        hidden = r["xform"][np.array(names(r)) == "hidden"].astype(float)
+        assert count(r, "seen") == 3 and len(hidden) == 1
+        np.testing.assert_allclose(hidden[0, 2, 3], -15)  # the north facade (map y = 15: world z = -15)

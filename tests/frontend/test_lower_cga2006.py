@@ -77,15 +77,11 @@ def test_lowering_errors(text, expected):
     assert errors(text) == expected
 
 
-@pytest.mark.parametrize("text, col, what", [
-    ('a : Shape.visible("front") ~> b', 5, "`Shape.visible` is not supported yet"),
-])
-def test_not_supported_yet_each_with_its_line_and_nothing_else(text, col, what):
+def test_a_bad_context_query_is_one_error_at_its_line_and_nothing_else():
     # the second line proves the position is this construct's, and that nothing cascades from it
-    diags = diagnose("z ~> a\n" + text)
-    assert [(d.span.line, d.span.col) for d in diags if d.is_error] == [(2, col)]
+    diags = diagnose('z ~> a\na : Shape.visible("river") ~> b')
     [d] = [d for d in diags if d.is_error]
-    assert d.message.startswith(what) and d.code == "not-supported"
+    assert (d.span.line, d.span.col) == (2, 5) and d.message.startswith('`Shape.visible` takes "street" (the lot')
 
 
 def test_snap_shapes_and_snapped_splits_lower_as_the_paper_writes_them():

@@ -192,7 +192,7 @@ def type_of(expr: ir.Expr, attrs: dict, params: tuple, diags: Diagnostics) -> ir
     if isinstance(expr, ir.Occlusion):
         if expr.distance is not None:
             _expect(expr.distance, T.NUM, "a distance", attrs, params, diags)
-        return T.STR if expr.kind == "occ" else T.BOOL
+        return T.STR if expr.kind == "occ" else T.BOOL  # inside, overlaps, touches, visible
     if isinstance(expr, ir.AttrRef):
         return attrs.get(expr.name, T.UNKNOWN)
     if isinstance(expr, ir.Param):
