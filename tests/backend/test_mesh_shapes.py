@@ -208,7 +208,7 @@ def test_paper_section4_building_covers_its_hipped_roof_with_bricks(lot):
     r = derive(grammar, lots_from_polygons([LOT_ZOO[lot]]), BuildOptions())
     assert r["bad"] == ()
     symbol = np.array(names(r))
-    assert {"flatbrick", "roofedge", "window", "wall"} <= set(symbol.tolist())
+    assert {"flatbrick", "roofedge", "window", "wall", "door"} <= set(symbol.tolist())  # rule 3: an entrance
     ridge = 5 * TAN30 if lot != "rect_12x8" else 4 * TAN30
     for name in ("flatbrick", "roofedge"):
         y = r["xform"][symbol == name][:, 1, 3]
