@@ -118,3 +118,15 @@ facade ~> hidden
         hidden = r["xform"][np.array(names(r)) == "hidden"].astype(float)
         assert count(r, "seen") == 3 and len(hidden) == 1
         np.testing.assert_allclose(hidden[0, 2, 3], -15)  # the north facade (map y = 15: world z = -15)
+
+
+def test_section5_compares_visibility_with_zero(write):
+    """Section 5 rule 5 writes ``Shape.visible("Street") == 0``: a truth value compares as 1 or 0."""
+    text = """
+lot ~> S(1r, 10, 1r) facades
+facades ~> Comp("sidefaces"){ facade }
+facade : Shape.visible("Street") == 0 ~> hidden
+facade ~> seen
+"""
+    r = run(write, text, [[np.array([[0, 0], [20, 0], [20, 15], [0, 15]], float)]], version=False)
+    assert count(r, "hidden") == 1 and count(r, "seen") == 3

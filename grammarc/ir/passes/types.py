@@ -225,7 +225,8 @@ def type_of(expr: ir.Expr, attrs: dict, params: tuple, diags: Diagnostics) -> ir
         if expr.op in ir.LOGIC_OPS:
             ok, result = left is T.BOOL and right is T.BOOL, T.BOOL
         elif expr.op in ("==", "!="):
-            ok, result = left is right, T.BOOL
+            # the paper compares truth values with numbers (``Shape.visible("Street") == 0``): 1 or 0
+            ok, result = left is right or {left, right} == {T.BOOL, T.NUM}, T.BOOL
         elif expr.op in ir.COMPARE_OPS:
             ok, result = left is T.NUM and right is T.NUM, T.BOOL
         elif expr.op == "+" and T.STR in (left, right):
