@@ -34,7 +34,7 @@ class ComponentOperations:
         if op.index is not None:
             index_of = evaluate_array(op.index, self.env(cursor))
         shapes, _, index, parent = self.components(comp_kernels.KIND_CODES[op.kind], cursor, op.site, index_of)
-        shapes = self.occluding(cursor, shapes, parent)
+        shapes = self.occluding(cursor, shapes, parent, symbol)
         self.count(shapes, symbol, op.span)
         order, offsets = group_by(index % len(op.parts), len(op.parts))
         self.run_parts(op.parts, shapes.take(order), offsets, symbol)
@@ -148,7 +148,7 @@ class ComponentOperations:
             self.fail(cursor, bad, "`comp` of an inserted asset is not supported yet", symbol, op.span)
         kind = {"f": "faces", "e": "edges", "v": "vertices"}[op.kind]
         shapes, normal, _, parent = self.components(comp_kernels.KIND_CODES[kind], cursor, op.site)
-        shapes = self.occluding(cursor, shapes, parent)
+        shapes = self.occluding(cursor, shapes, parent, symbol)
         if op.kind == "f":
             shapes = self.face_scopes(shapes, cursor, parent, symbol, op.span)
         if op.kind == "f" and self.chunk.trim_slot is not None:

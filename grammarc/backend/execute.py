@@ -61,11 +61,17 @@ class Executor(ScopeOperations, SplitOperations, ComponentOperations, FaceOperat
             row = values[np.flatnonzero(bad)[0]]
             self.fail(shapes, bad, f"{message} ({', '.join(f'{v:g}' for v in np.atleast_1d(row))})", symbol, span)
 
-    def occluding(self, cursor: Shapes, children: Shapes, parent: np.ndarray) -> Shapes:
+    def occluding(self, cursor: Shapes, children: Shapes, parent: np.ndarray, symbol: int) -> Shapes:
         """A component split's solids become occluders; their components carry them as ancestors."""
         if ANCESTORS[0] not in self.plan.dynamic:
             return children
-        return with_ancestor(self.plan, children, add_occluders(self.chunk, cursor, active=False)[parent])
+        ident = add_occluders(self.chunk, cursor, self.occluder_label(symbol), active=False)
+        return with_ancestor(self.plan, children, ident[parent])
+
+    def occluder_label(self, symbol: int) -> str | None:
+        """The label of the occluders a rule of ``symbol`` makes: the paper names a shape by its symbol
+        (``Shape.occ("balcony")``); CityEngine labels with ``label()`` only."""
+        return None if self.plan.leaf_bodies else self.plan.symbols[symbol].name
 
     def label(self, op: ir.Label, cursor: Shapes, symbol: int) -> Shapes:
         """``label(name)``: the shape's solid is an occluder with that label, and its own ancestor."""
@@ -167,7 +173,9 @@ class Executor(ScopeOperations, SplitOperations, ComponentOperations, FaceOperat
                       "with comp(f) first)", symbol, op.span)
 
     def insert(self, op: ir.Insert, cursor: Shapes, symbol: int) -> None:
-        """The paper's ``I(name)``: an instance of the asset on the scope."""
+        """The paper's ``I(name)``: an instance of the asset on the scope (a solid one occludes)."""
+        if ANCESTORS[0] in self.plan.dynamic:
+            add_occluders(self.chunk, cursor, self.occluder_label(symbol))
         terminals.emit_instances(self.chunk, cursor, self.plan.grammar.asset_ids[op.asset], symbol)
 
     def nothing(self, op: ir.Empty | ir.NotApplied, cursor: Shapes, symbol: int) -> None:
@@ -184,6 +192,8 @@ class Executor(ScopeOperations, SplitOperations, ComponentOperations, FaceOperat
                         child_keys(cursor.key, op.site), cursor.depth + 1, params, cursor.dynamic)
         self.count(shapes, symbol, op.span)
         if sym.terminal or op.leaf:
+            if ANCESTORS[0] in self.plan.dynamic:
+                add_occluders(self.chunk, shapes, self.occluder_label(sym.id))  # a leaf solid occludes
             terminals.emit_leaves(self.chunk, shapes, sym.id)
         else:
             self.pending[sym.id].append(shapes)

@@ -130,3 +130,21 @@ facade ~> seen
 """
     r = run(write, text, [[np.array([[0, 0], [20, 0], [20, 15], [0, 15]], float)]], version=False)
     assert count(r, "hidden") == 1 and count(r, "seen") == 3
+
+
+def test_section6_trees_keep_their_distance_from_the_house(write):
+    """Section 6: trees are kept at a distance from the house. The paper names a shape by its symbol, so
+    Shape.occ("house", "distance", 2.5) sees the house only: of a row of ten 2 m trees across the house's
+    10 m front, the two end ones, more than 2.5 m from it, stay."""
+    text = """
+lot ~> S(1r, 0, 1r) [ T(5, 0, 6) S(10, 6, 8) house ] trees
+trees ~> Subdiv("Z", 9, 2, 1r){ ε | row | ε }
+row ~> Repeat("X", 2){ tree }
+tree : Shape.occ("house", "distance", 2.5) == "none" ~> S(1r, 4, 1r) I("tree.obj")
+tree ~> ε
+"""
+    r = run(write, text, [rect(20, 20)], version=False)
+    x = np.sort(r["xform"][np.array(names(r)) == "tree"][:, 0, 3].astype(float))
+    assert len(x) == 2 and count(r, "house") == 1
+    # any other label sees nothing: every tree stays
+    assert count(run(write, text.replace('"house"', '"garage"'), [rect(20, 20)], version=False), "tree") == 10
