@@ -45,9 +45,9 @@ class Prisms:
     """Occluders: ``origin`` (k, 3) and ``axes`` (k, 3, 3) (rows) of their scopes, ``plane`` (k,) the scope
     axis along which each extrudes, ``height`` (k,), ``polygon`` (k,) shapely polygons in the plane's
     (u, v) = (axis PLANE_U, axis PLANE_V) coordinates, in metres from the origin; ``outer`` and
-    ``inner`` (k,) the polygons grown and shrunk by ``EPS``, ``boundary`` (k,) their outlines,
-    ``bounds`` (k, 4) and ``rect`` (k,) whether the polygon is its bounding rectangle (a box: tested by
-    separating axes in numba, ``box_relations``), all made once by ``prisms``, not per query."""
+    ``inner`` (k,) the polygons grown and shrunk by ``EPS``, ``boundary`` (k,) their outlines (None for
+    boxes), ``bounds`` (k, 4) and ``rect`` (k,) whether the polygon is its bounding rectangle (a box:
+    tested by separating axes in numba, ``box_relations``), all made once by ``prisms``, not per query."""
 
     origin: np.ndarray
     axes: np.ndarray
@@ -69,12 +69,18 @@ class Prisms:
 
 
 def prisms(origin, axes, plane, height, polygon) -> Prisms:
-    """Prisms with their grown and shrunk polygons, outlines and bounds."""
+    """Prisms with their bounds and, for those that are not boxes (the GEOS path), their grown and shrunk
+    polygons and outlines (None for boxes: they are never asked)."""
     bounds = shapely.bounds(polygon).reshape(-1, 4)
     box_area = (bounds[:, 2] - bounds[:, 0]) * (bounds[:, 3] - bounds[:, 1])
     rect = (shapely.get_num_coordinates(polygon) == 5) & (np.abs(shapely.area(polygon) - box_area) <= 1e-9 * box_area)
-    return Prisms(origin, axes, plane, height, polygon, shapely.buffer(polygon, EPS, join_style="mitre"),
-                  shapely.buffer(polygon, -EPS, join_style="mitre"), shapely.boundary(polygon), bounds, rect)
+    outer, inner, boundary = (np.full(len(polygon), None, dtype=object) for _ in range(3))
+    other = ~rect
+    if other.any():
+        outer[other] = shapely.buffer(polygon[other], EPS, join_style="mitre")
+        inner[other] = shapely.buffer(polygon[other], -EPS, join_style="mitre")
+        boundary[other] = shapely.boundary(polygon[other])
+    return Prisms(origin, axes, plane, height, polygon, outer, inner, boundary, bounds, rect)
 
 
 def relations(corners: np.ndarray, edges: np.ndarray, prisms: Prisms,
