@@ -20,7 +20,7 @@ from grammarc.errors import LimitError
 from grammarc.geometry.clip import clip_to_slabs
 from grammarc.geometry.meshes import is_mesh, is_polygon
 from grammarc.ir import nodes as ir
-from grammarc.ragged import ragged_take
+from grammarc.ragged import offsets_from_counts, ragged_take, rank_within
 
 
 class SplitOperations:
@@ -68,7 +68,13 @@ class SplitOperations:
             if op.snap:  # each snap plane adds one element at most
                 offsets, snaps = self.snaps_across(shapes, axis, op.snap_label)
                 self.check_fan_out(shapes, counts + np.diff(offsets), symbol, op.span)
-                parent, part, pos, length = split_kernels.snapped_repeat(extent, size, offsets, snaps, TOL.zero)
+                # the snap planes cut the scope first and each piece repeats on its own (Fig. 9)
+                piece_parent, start, piece = _pieces(extent, offsets, snaps)
+                piece_counts = split_kernels.repeat_counts(piece, size[piece_parent], TOL.zero)
+                child, _, pos, length = split_kernels.repeat(piece, piece_counts)
+                parent = piece_parent[child]
+                pos += start[child]
+                part = rank_within(parent)
                 counts = np.bincount(parent, minlength=len(shapes))
             else:
                 self.check_fan_out(shapes, counts, symbol, op.span)
@@ -264,6 +270,19 @@ class SplitOperations:
         children = self.children(cursor, op.axis, parent, index, pos, length, op.site, order, geometry)
         self.count(children, symbol, op.span)
         self.run_parts(op.parts, children, offsets, symbol)
+
+
+def _pieces(extent: np.ndarray, offsets: np.ndarray, cuts: np.ndarray):
+    """The pieces of each extent (n,) cut at its sorted positions ``cuts`` (``offsets`` (n+1,)): each
+    piece's extent, its start and the extent it belongs to, (k,) each, in order."""
+    count = np.diff(offsets) + 1
+    parent = np.repeat(np.arange(len(extent)), count)
+    j = np.arange(count.sum()) - np.repeat(offsets_from_counts(count)[:-1], count)
+    bounds = np.concatenate([cuts, [0.0]])  # a harmless last entry for the gathers below
+    at = offsets[parent] + j
+    start = np.where(j > 0, bounds[at - 1], 0.0)
+    end = np.where(j < count[parent] - 1, bounds[at], extent[parent])
+    return parent, start, np.ascontiguousarray(end - start)
 
 
 def _size_matrix(values: list, n: int) -> np.ndarray:

@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 from test_cityengine import names, rect, run
 
-from grammarc.backend.kernels.split import snap_subdiv, snapped_repeat
+from grammarc.backend.kernels.split import snap_subdiv
 from grammarc.backend.snaps import SnapStore
 
 TOL = 1e-9
@@ -30,16 +30,16 @@ def test_planes_cross_a_scope_of_their_own_lot_across_its_axis_once_each():
     assert offsets.tolist() == [0, 0, 0, 0]
 
 
-def test_fig9_a_snapped_repeat_repeats_each_side_of_the_snap_line():
+def test_fig9_a_snapped_repeat_repeats_each_side_of_the_snap_line(write):
     """10 m with 3 m elements: 4 of 2.5 m; a snap line at 4 m: 2 of 2 m, then 2 of 3 m."""
-    parent, part, pos, length = snapped_repeat(np.array([10.0]), np.array([3.0]), np.array([0, 0]),
-                                               np.zeros(0), TOL)
-    np.testing.assert_allclose(length, [2.5] * 4)
-    parent, part, pos, length = snapped_repeat(np.array([10.0]), np.array([3.0]), np.array([0, 1]),
-                                               np.array([4.0]), TOL)
-    np.testing.assert_allclose(pos, [0, 2, 4, 7])
-    np.testing.assert_allclose(length, [2, 2, 3, 3])
-    assert part.tolist() == [0, 1, 2, 3] and parent.tolist() == [0, 0, 0, 0]
+    text = ('PRIORITY 1:\nstart ~> lot lot2\n'
+            'lot ~> S(10, 3, 0) Subdiv("X", 4, 6){ rest | marker Snap("Y") }\n'
+            'PRIORITY 2:\nlot2 ~> S(10, 3, 0) Repeat("{axis}", 3){ el }\n')
+    for axis, pos, length in (("X", [0, 2.5, 5, 7.5], [2.5] * 4), ("XS", [0, 2, 4, 7], [2, 2, 3, 3])):
+        r = run(write, text.replace("{axis}", axis), [rect(20, 10)], version=False)
+        el = np.array(names(r)) == "el"
+        np.testing.assert_allclose(r["xform"][el, 0, 3], pos, atol=1e-6)
+        np.testing.assert_allclose(r["xform"][el, 0, 0], length, atol=1e-6)
 
 
 def test_fig9_a_snapped_subdiv_moves_only_the_line_nearest_the_snap():
