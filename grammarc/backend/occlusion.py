@@ -27,7 +27,7 @@ from functools import cached_property
 import numpy as np
 import shapely
 
-from grammarc.backend.shapes import asset_geom
+from grammarc.backend.shapes import asset_geom, face_axes
 from grammarc.geometry.clip import scope_polygons
 from grammarc.geometry.meshes import is_polygon
 from grammarc.geometry.occlusion import (
@@ -172,18 +172,12 @@ def query(expr, env, distance: np.ndarray | None = None) -> np.ndarray:
     found = {kind: np.zeros(n, dtype=bool) for kind in kinds}
     distance = np.zeros(n) if distance is None else np.broadcast_to(np.asarray(distance, np.float64), (n,))
     own = chunk.lot_index[shapes.lot]
-    sources = []  # (occluders, of the shape's own lot or of the others)
-    if expr.target in ("intra", "all"):
-        sources.append((chunk.occluders.table(), True))
-    if expr.target in ("inter", "all"):
-        sources.append((chunk.foreign, False))
     ancestors = np.stack([shapes.dynamic[env.plan.dynamic[name]] for name in ANCESTORS], axis=1)
-    for table, intra in sources:
+    for table, intra in _sources(chunk, expr.target):
         if expr.label is not None or expr.active:
             table = table.take(np.flatnonzero((table.label == expr.label) if expr.label is not None else table.active))
         rows, occluder = _pairs(shapes, chunk, table, distance)
-        same = table.lot[occluder] == own[rows]
-        keep = same if intra else ~same
+        keep = (table.lot[occluder] == own[rows]) == intra
         if intra and not expr.parents:
             keep &= ~(ancestors[rows] == table.ident[occluder, None]).any(axis=1)
         rows, occluder = rows[keep], occluder[keep]
@@ -219,17 +213,26 @@ def _visible(shapes, chunk) -> np.ndarray:
     sight = np.stack([centre[row[chosen]], point[chosen]], axis=1)
     blocked = np.zeros(n, dtype=bool)
     own = chunk.lot_index[shapes.lot]
-    sources = [(chunk.occluders.table(), True)] + ([(chunk.foreign, False)] if chunk.foreign is not None else [])
-    for table, intra in sources:
+    for table, intra in _sources(chunk, "all"):
         q, o = _candidates(table, sight.min(axis=1), sight.max(axis=1))
         shape_row = row[chosen][q]
-        same = table.lot[o] == own[shape_row]
-        keep = same if intra else ~same
+        keep = (table.lot[o] == own[shape_row]) == intra
         q, o, shape_row = q[keep], o[keep], shape_row[keep]
         if len(q):
             hit = relations(sight[q], _SEGMENT, table.prisms.take(o), ("overlaps",))["overlaps"]
             np.logical_or.at(blocked, shape_row, hit)
     return ~blocked
+
+
+def _sources(chunk, target: str) -> list[tuple[Occluders, bool]]:
+    """The occluders a query of ``target`` tests, each table with whether it is for the shape's own lot
+    (the chunk's, as they are now) or for the other lots (the first pass's)."""
+    sources = []
+    if target in ("intra", "all"):
+        sources.append((chunk.occluders.table(), True))
+    if target in ("inter", "all") and chunk.foreign is not None:
+        sources.append((chunk.foreign, False))
+    return sources
 
 
 def _relations(kinds, shapes, chunk, rows: np.ndarray, occluders: Occluders, distance: np.ndarray):
@@ -247,10 +250,7 @@ def _relations(kinds, shapes, chunk, rows: np.ndarray, occluders: Occluders, dis
             continue
         s, frame = size[pick], axes[pick]
         if is_face:  # the face's two extents as its x and y
-            k = np.argmax(flat[pick], axis=1)
-            cols = np.stack([(k + 1) % 3, (k + 2) % 3, k], axis=1)
-            at = np.arange(len(pick))[:, None]
-            s, frame = s[at, cols], frame[at, cols]
+            frame, s = face_axes(frame, s, np.argmax(flat[pick], axis=1))
         corners = origin[pick, None] + np.einsum("cj,pj,pji->pci", unit, s, frame)
         found = relations(corners, edges, occluders.prisms.take(pick), kinds)
         for k, kind in enumerate(kinds):

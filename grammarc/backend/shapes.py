@@ -31,6 +31,14 @@ def asset_geom(asset: np.ndarray, mirrored: np.ndarray | int = 0) -> np.ndarray:
     return (-2 - (np.asarray(asset, dtype=np.int64) * 8 + mirrored)).astype(np.int32)
 
 
+def face_axes(axes: np.ndarray, size: np.ndarray, flat_axis: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Flat scopes' axes (n, 3, 3) (rows) and sizes (n, 3) reordered so that their two extents come
+    first and their flat axis ``flat_axis`` (n,) last, keeping the turn: a face's x, y and normal."""
+    cols = np.stack([(flat_axis + 1) % 3, (flat_axis + 2) % 3, flat_axis], axis=1)
+    rows = np.arange(len(flat_axis))[:, None]
+    return axes[rows, cols], size[rows, cols]
+
+
 def asset_of(geom: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Asset ids and mirror bits of asset ``geom`` codes (< -1)."""
     code = -2 - geom.astype(np.int64)

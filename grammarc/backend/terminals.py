@@ -21,7 +21,7 @@ import numpy as np
 from grammarc.backend.chunk import Chunk
 from grammarc.backend.kernels.scope import xforms
 from grammarc.backend.mesh_shapes import mesh_leaves
-from grammarc.backend.shapes import Shapes, asset_of
+from grammarc.backend.shapes import Shapes, asset_of, face_axes
 from grammarc.constants import TOL
 from grammarc.geometry.components import reverse_rings
 from grammarc.geometry.meshes import is_mesh, is_polygon
@@ -115,12 +115,8 @@ def emit_leaves(chunk: Chunk, shapes: Shapes, symbol: int) -> None:
     emit_instances(chunk, shapes.take(box & (zeros == 0)), CUBE, symbol)
     quads = shapes.take(box & (zeros == 1))
     if len(quads):
-        k = np.argmax(flat[box & (zeros == 1)], axis=1)
-        axes = chunk.frames[quads.frame]
-        cols = np.stack([(k + 1) % 3, (k + 2) % 3, k], axis=1)
-        rows = np.arange(len(quads))[:, None]
-        permuted_axes = axes[rows, cols]
-        permuted_size = quads.size[rows, cols]
+        permuted_axes, permuted_size = face_axes(chunk.frames[quads.frame], quads.size,
+                                                 np.argmax(flat[box & (zeros == 1)], axis=1))
         permuted_size[:, 2] = 0.0
         _append(chunk, quads, instance_xform(permuted_axes, permuted_size, quads.origin), QUAD, symbol)
     polygons = shapes.take(is_polygon(shapes.geom))
