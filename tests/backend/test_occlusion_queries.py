@@ -148,3 +148,26 @@ tree ~> ε
     assert len(x) == 2 and count(r, "house") == 1
     # any other label sees nothing: every tree stays
     assert count(run(write, text.replace('"house"', '"garage"'), [rect(20, 20)], version=False), "tree") == 10
+
+
+def test_section6_the_driveway_takes_the_sidewalk_where_they_cross(write):
+    """Section 6 lays the sidewalk and the driveway as overlapping shapes and resolves the conflict later
+    with an occlusion query: the driveway (priority 1) crosses the 2 m sidewalk at x 11.5..15.5, and the
+    sidewalk's slabs (priority 2) that it covers are dropped, so no slab lies under the driveway."""
+    text = """
+PRIORITY 1:
+lot ~> S(1r, 0, 1r) [ T(11.5, 0, 0) S(4, 0.1, 8) driveway ] Subdiv("Z", 2, 1r){ sidewalk | yard }
+PRIORITY 2:
+sidewalk ~> Repeat("X", 1.4){ slab }
+slab : Shape.occ("driveway") == "none" ~> S(1r, 0.1, 1r) I("slab.obj")
+slab ~> ε
+"""
+    r = run(write, text, [rect(20, 20)], version=False)
+    slabs = np.array(names(r)) == "slab"
+    left = r["xform"][slabs][:, 0, 3].astype(float)
+    right = left + r["xform"][slabs][:, 0, 0].astype(float)
+    # 15 slabs of 4/3 m; the four between x 10.67 and 16 run under the driveway
+    assert slabs.sum() == 11 and count(r, "driveway") == 1
+    assert np.all((right <= 11.5) | (left >= 15.5))
+    # without the driveway the sidewalk is whole
+    assert count(run(write, text.replace("driveway ]", "ramp ]"), [rect(20, 20)], version=False), "slab") == 15
