@@ -15,6 +15,7 @@ written.
 from __future__ import annotations
 
 import time
+from collections.abc import Sequence
 from contextlib import contextmanager
 from dataclasses import dataclass, field, replace
 from pathlib import Path
@@ -30,7 +31,7 @@ from grammarc.backend.reports import Reports
 from grammarc.compiler import Grammar, compile_grammar
 from grammarc.constants import LIMITS, Limits
 from grammarc.errors import ChunkTooLarge, LotFailure, UsageError
-from grammarc.io import writer_for
+from grammarc.io import OutputOptions, writer_for
 from grammarc.io.lots import BadLot, Lots, default_lot, read_lots
 from grammarc.io.npz import MeshChunk
 
@@ -80,15 +81,21 @@ def load_lots(grammar_path: Path, lots_path: Path | None) -> Lots:
 
 
 def build(grammar_path, output, *, lots_path=None, options: BuildOptions = BuildOptions(),
-          progress=None) -> BuildResult:
+          progress=None, output_options: OutputOptions | None = None,
+          select: Sequence[str] | None = None, reports_to: Path | None = None) -> BuildResult:
     """Derive the lots with the grammar and write the records to ``output`` (atomically).
 
     ``progress(done, total)`` is called with the number of lots finished after each chunk.
+    ``select``: derive only the lots of these ids (``--select``); occlusion queries still see every
+    lot's occluders, so a selected lot looks as it does in the whole city. ``reports_to``: where the
+    values of ``report()`` go, ``.json`` or ``.csv`` (default ``reports_path(output)``).
     """
     started = time.perf_counter()
     with grammar_source(Path(grammar_path), options) as (source, display, resolved):
         return _build(source, display, Path(grammar_path), output, lots_path, resolved, progress, started,
-                      recorded_roots=options.asset_roots)
+                      recorded_roots=options.asset_roots, output_options=output_options or OutputOptions(),
+                      select=select,
+                      reports_to=reports_to)
 
 
 @contextmanager
@@ -110,14 +117,17 @@ def grammar_source(path: Path, options: BuildOptions):
 
 
 def _build(source: Path, display: str | None, grammar_path: Path, output, lots_path,
-           options: BuildOptions, progress, started: float, recorded_roots: tuple[Path, ...]) -> BuildResult:
+           options: BuildOptions, progress, started: float, recorded_roots: tuple[Path, ...],
+           output_options: OutputOptions, select: Sequence[str] | None,
+           reports_to: Path | None) -> BuildResult:
     grammar = compile_grammar(source, start=options.start, asset_roots=options.asset_roots,
                               dialect=options.dialect, display=display)
     plan = make_plan(grammar)
     check_overrides(grammar.module, options.attrs)
-    writer_class = writer_for(output)
+    writer_class = writer_for(output, output_options)
     Path(output).parent.mkdir(parents=True, exist_ok=True)
-    lots = load_lots(grammar_path, Path(lots_path) if lots_path else None)
+    every = load_lots(grammar_path, Path(lots_path) if lots_path else None)
+    lots = every if select is None else every.select(select)
     meta = {
         "grammar": str(grammar_path),
         "grammar_sha256": grammar.digest,
@@ -136,10 +146,11 @@ def _build(source: Path, display: str | None, grammar_path: Path, output, lots_p
     failed: list[BadLot] = []
     reports = Reports()
     with writer_class(output, assets=grammar.assets, symbols=plan.symbol_names, meta=meta) as writer:
-        derived = _derive_all(plan, lots, options, writer, failed, reports, progress)
+        derived = _derive_all(plan, lots, options, writer, failed, reports, progress, every)
         counts = writer.close()
     if reports:
-        reports.write(reports_path(Path(output)))
+        reports.write(Path(reports_to) if reports_to else reports_path(Path(output)),
+                      dict(zip(every.index.tolist(), every.ids.tolist())))
     bad = tuple(sorted((*lots.bad, *failed), key=lambda b: b.index))
     return BuildResult(Path(output), len(lots) + len(lots.bad), derived, bad, counts,
                        time.perf_counter() - started, grammar)
@@ -180,19 +191,20 @@ def reports_path(output: Path) -> Path:
 
 
 def _derive_all(plan, lots: Lots, options: BuildOptions, writer, failed: list[BadLot], reports: Reports,
-                progress=None) -> int:
+                progress=None, context: Lots | None = None) -> int:
     """Derive all ``lots`` chunk by chunk into ``writer``; returns the number of lots derived.
 
     A chunk holds at most ``options.chunk_size`` lots, and fewer when the lots so far made many records:
     the next chunk aims at ``ROWS_PER_CHUNK`` records, which keeps its arrays in the caches and its memory
     small whatever the grammar. The records do not depend on the chunking. A grammar whose occlusion
-    queries look at other lots is derived twice: first for everyone's occluders (``_occluders``).
+    queries look at other lots is derived twice: first for everyone's occluders (``_occluders``), those of
+    ``context`` when given (the whole city of a selection).
     """
     derived = 0
     first = 0
     size = min(options.chunk_size, 64)
     rows = 0
-    foreign = _occluders(plan, lots, options) if plan.inter else None
+    foreign = _occluders(plan, lots if context is None else context, options) if plan.inter else None
     while first < len(lots):
         part = lots.take(slice(first, first + size))
         derived_now, made = _derive(plan, part, options, writer, failed, reports, foreign)

@@ -130,7 +130,7 @@ def test_unreadable_lots_exit_1(write, tmp_path, capsys, content, message):
 
 
 @pytest.mark.parametrize("args, message", [
-    (["--emit", "out.usd"], "output format `.usd` is not supported"),
+    (["--emit", "out.fbx"], "output format `.fbx` is not supported"),
     (["--emit", "out.npz", "--attr", "nope=1"], "declares no attribute `nope`"),
     (["--emit", "out.npz", "--attr", "height=tall"], "`height` is a num, not a str"),
     (["--emit", "out.npz", "--start", "missing"], "start symbol `missing` has no rule"),

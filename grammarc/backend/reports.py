@@ -8,6 +8,7 @@ are grouped by (lot, key) with one sort; the per-lot tables then merge into the 
 
 from __future__ import annotations
 
+import csv
 import json
 import os
 from pathlib import Path
@@ -79,14 +80,32 @@ class Reports:
                 out[f"{key}_{suffix}"] = e[suffix]
         return out
 
-    def write(self, path: Path) -> None:
-        data = {
-            "total": self.table(self.totals()),
-            "lots": {str(lot): self.table(self.lots[lot]) for lot in sorted(self.lots)},
-        }
+    def write(self, path: Path, ids: dict[int, str] | None = None) -> None:
+        """The per-lot tables and the total, as JSON (``{"total": {...}, "lots": {index: {...}},
+        "ids": {index: id}}``) or, for a ``.csv`` path, as one table: a row per lot (its input number and
+        id) and a last row ``total``, a column per ``key_n``/``_sum``/``_avg``/``_min``/``_max``, empty where
+        a lot did not report the key. Written atomically."""
+        ids = ids or {}
+        lots = {lot: self.table(self.lots[lot]) for lot in sorted(self.lots)}
+        total = self.table(self.totals())
         tmp = path.with_name(f".{path.name}.tmp")
-        tmp.write_text(json.dumps(data, indent=1, sort_keys=False) + "\n")
+        if path.suffix.lower() == ".csv":
+            with open(tmp, "w", newline="") as out:
+                table = csv.writer(out)
+                table.writerow(["lot", "id", *total])
+                for lot, row in lots.items():
+                    table.writerow([lot, ids.get(lot, ""), *(_cell(row.get(key, "")) for key in total)])
+                table.writerow(["total", "", *(_cell(v) for v in total.values())])
+        else:
+            data = {"total": total, "lots": {str(lot): row for lot, row in lots.items()},
+                    "ids": {str(lot): ids[lot] for lot in lots if lot in ids}}
+            tmp.write_text(json.dumps(data, indent=1, sort_keys=False) + "\n")
         os.replace(tmp, path)
+
+
+def _cell(value) -> str:
+    """A CSV cell: numbers as Python's shortest repr, booleans as true/false, as JSON writes them."""
+    return json.dumps(value) if isinstance(value, bool) else str(value)
 
 
 def entry_values(e: dict) -> dict:

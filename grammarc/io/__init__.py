@@ -1,31 +1,63 @@
 """Lots in, assets, instance records out.
 
 Output formats register here by extension, one module per format (as trimesh's ``exchange/``); the build
-asks ``writer_for`` for the writer of ``--emit PATH``.
+asks ``writer_for`` for the writer of ``--emit PATH``:
+
+* ``.npz``: the instance record (``io/npz.py``);
+* ``.usda``, ``.usdc``, ``.usd``: instanced USD, one PointInstancer per tile (``io/usd.py``);
+* ``.glb``: glTF with GPU instancing (``io/gltf.py``), or baked with ``--bake``;
+* ``.obj``, ``.ply``, ``.stl``: the record baked into one mesh (``io/bake.py``), as a .glb with ``--bake``.
 """
 
 from __future__ import annotations
 
+import functools
+from dataclasses import dataclass
 from pathlib import Path
 
 from grammarc.errors import UsageError
 
-#: Output extension -> writer class name in its module. Later formats (USD, glTF, OBJ) add a line each.
-WRITERS = {".npz": ("grammarc.io.npz", "InstanceWriter")}
-WRITERS[".obj"] = ("grammarc.io.bake", "BakedWriter")  # meshes: the record baked on close (io/bake.py)
-WRITERS[".ply"] = ("grammarc.io.bake", "BakedWriter")
-WRITERS[".stl"] = ("grammarc.io.bake", "BakedWriter")
-WRITERS[".glb"] = ("grammarc.io.bake", "BakedWriter")
+_BAKED = ("grammarc.io.bake", "BakedWriter", ("lod", "max_triangles"))
+#: Output extension -> (module, writer class, the ``OutputOptions`` fields it takes).
+WRITERS = {
+    ".npz": ("grammarc.io.npz", "InstanceWriter", ()),
+    ".usda": ("grammarc.io.usd", "UsdWriter", ("lod", "tile_size")),
+    ".usdc": ("grammarc.io.usd", "UsdWriter", ("lod", "tile_size")),
+    ".usd": ("grammarc.io.usd", "UsdWriter", ("lod", "tile_size")),
+    ".glb": ("grammarc.io.gltf", "GltfWriter", ("lod", "tile_size")),
+    ".obj": _BAKED,
+    ".ply": _BAKED,
+    ".stl": _BAKED,
+}
+#: Formats ``--bake`` applies to: always baked but for .glb, which is instanced without it.
+BAKEABLE = (".obj", ".ply", ".stl", ".glb")
 
 
-def writer_for(path: str | Path):
-    """The writer class for an output path, or a UsageError naming the supported extensions."""
+@dataclass(frozen=True)
+class OutputOptions:
+    """How a record is written, beyond its rows: ``bake`` instances into meshes (at most ``max_triangles``),
+    the level of detail of assets (``io.bake.load_asset``), the tile edge of the instanced formats
+    (``io.instancing``). None: the writer's default."""
+
+    bake: bool = False
+    lod: str | None = None
+    tile_size: float | None = None
+    max_triangles: int | None = None
+
+
+def writer_for(path: str | Path, options: OutputOptions = OutputOptions()):
+    """The writer factory for an output path: ``factory(path, assets=, symbols=, meta=)``; a UsageError
+    names the supported extensions."""
     suffix = Path(path).suffix.lower()
     if suffix not in WRITERS:
         supported = ", ".join(WRITERS)
         raise UsageError(f"cannot write `{path}`: output format `{suffix or '(none)'}` is not supported "
                          f"(supported: {supported})")
-    module, name = WRITERS[suffix]
+    if options.bake and suffix not in BAKEABLE:
+        raise UsageError(f"--bake writes meshes ({', '.join(BAKEABLE)}), not `{suffix}`")
+    module, name, takes = _BAKED if options.bake else WRITERS[suffix]
     from importlib import import_module
 
-    return getattr(import_module(module), name)
+    writer = getattr(import_module(module), name)
+    given = {field: getattr(options, field) for field in takes if getattr(options, field) is not None}
+    return functools.partial(writer, **given) if given else writer

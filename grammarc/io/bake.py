@@ -63,9 +63,11 @@ if TYPE_CHECKING:
     from typing_extensions import Self
 
 __all__ = [
+    "LOD_STAND_IN",
     "MAX_TRIANGLES",
     "AssetMesh",
     "BakedWriter",
+    "asset_library",
     "bake",
     "builtin_mesh",
     "count_triangles",
@@ -77,6 +79,8 @@ __all__ = [
 #: development machine holds next to the record; an instance record of the same city is ~60 bytes a row
 #: whatever the assets. ``GRAMMARC_MAX_TRIANGLES`` overrides it for the writers.
 MAX_TRIANGLES = 50_000_000
+#: ``--lod builtin``: a built-in cube stands in for an asset file that is missing.
+LOD_STAND_IN = "builtin"
 #: Vertices expanded per einsum call: bounds the float64 temporaries of a block of instances (~50 MB).
 _BLOCK_VERTICES = 1 << 21
 #: Sides of ``builtin:cylinder``.
@@ -184,7 +188,7 @@ def _prism(outline: np.ndarray) -> AssetMesh:
     return _frozen(_fitted(vertices), faces, np.array([4] * k + [k, k]))
 
 
-def load_asset(name: str, asset_roots: Sequence[str | os.PathLike] = ()) -> AssetMesh:
+def load_asset(name: str, asset_roots: Sequence[str | os.PathLike] = (), lod: str | None = None) -> AssetMesh:
     """Load an asset by its record name: a built-in, or a file resolved in ``asset_roots``.
 
     Parameters
@@ -194,6 +198,10 @@ def load_asset(name: str, asset_roots: Sequence[str | os.PathLike] = ()) -> Asse
     asset_roots : sequence of path-like
         Folders searched in order (the grammar's folder, ``--assets`` folders, a rule package's
         ``asset_roots``).
+    lod : str, optional
+        A level of detail: ``window.obj`` is replaced by ``window.<lod>.obj`` beside it where that file
+        exists (the paper's Pompeii had high, middle and low LoD assets). ``builtin`` gives the built-in
+        cube as a stand-in for an asset file that no root holds, where otherwise that is an error.
 
     Returns
     -------
@@ -207,13 +215,20 @@ def load_asset(name: str, asset_roots: Sequence[str | os.PathLike] = ()) -> Asse
     """
     if name.startswith("builtin:"):
         return builtin_mesh(name)
-    resolved = resolve_asset(name, [Path(r) for r in asset_roots])
+    roots = [Path(r) for r in asset_roots]
+    resolved = resolve_asset(name, roots)
     if resolved.problem:
         raise AssetError(resolved.problem)
     if resolved.path is None:
-        roots = ", ".join(str(r) for r in asset_roots) or "(no asset roots given)"
-        raise AssetError(f"asset `{name}` not found in {roots}")
-    return _load_file(resolved.path, resolved.path.stat().st_mtime_ns)
+        if lod == LOD_STAND_IN:
+            return builtin_mesh("builtin:cube")
+        shown = ", ".join(str(r) for r in asset_roots) or "(no asset roots given)"
+        raise AssetError(f"asset `{name}` not found in {shown} (--lod {LOD_STAND_IN} puts a cube in its place)")
+    path = resolved.path
+    if lod and lod != LOD_STAND_IN:
+        substitute = path.with_name(f"{path.stem}.{lod}{path.suffix}")
+        path = substitute if substitute.is_file() else path
+    return _load_file(path, path.stat().st_mtime_ns)
 
 
 @lru_cache(maxsize=64)
@@ -271,14 +286,15 @@ def _frozen(vertices, faces, sizes) -> AssetMesh:
 class _Library:
     """Asset meshes of a record's asset names, loaded when first used."""
 
-    def __init__(self, names: Sequence[str], roots: Sequence[str | os.PathLike]):
+    def __init__(self, names: Sequence[str], roots: Sequence[str | os.PathLike], lod: str | None = None):
         self.names = [str(n) for n in names]
         self.roots = [Path(r) for r in roots]
+        self.lod = lod
         self._meshes: dict[int, AssetMesh] = {}
 
     def __getitem__(self, index: int) -> AssetMesh:
         if index not in self._meshes:
-            self._meshes[index] = load_asset(self.names[index], self.roots)
+            self._meshes[index] = load_asset(self.names[index], self.roots, self.lod)
         return self._meshes[index]
 
     def triangles(self, used: np.ndarray) -> int:
@@ -289,14 +305,21 @@ class _Library:
 # ---------------------------------------------------------------------------------------- the record
 
 
-def count_triangles(record: Mapping, asset_roots: Sequence[str | os.PathLike] | None = None) -> int:
+def asset_library(names: Sequence[str], record: Mapping, asset_roots=None, lod: str | None = None) -> _Library:
+    """The meshes of asset ``names``, loaded when first used from ``asset_roots`` or the roots that the
+    record's meta names (the grammar's folder, then its ``asset_roots``), at level of detail ``lod``."""
+    return _Library(names, _roots(record, asset_roots), lod)
+
+
+def count_triangles(record: Mapping, asset_roots: Sequence[str | os.PathLike] | None = None,
+                    lod: str | None = None) -> int:
     """The number of triangles ``bake`` makes of ``record`` at most, without baking it.
 
     Loads the assets the record uses (not the mesh). Faces of the mesh table count ``V + 2H - 2``
     triangles (V vertices in all rings, H holes), what earcut makes of a simple polygon.
     """
     names, asset, _, mesh = _columns(record)
-    library = _Library(names, _roots(record, asset_roots))
+    library = asset_library(names, record, asset_roots, lod)
     return library.triangles(np.bincount(asset, minlength=len(names))) + _mesh_triangles(mesh)
 
 
@@ -346,7 +369,7 @@ def bake(
     (12, 52.0, [[1.0, 0.0, 0.0], [3.0, 3.0, 4.0]])
     """
     names, asset, xform, mesh = _columns(record)
-    return _bake(_Library(names, _roots(record, asset_roots)), asset, xform, mesh, max_triangles)
+    return _bake(asset_library(names, record, asset_roots), asset, xform, mesh, max_triangles)
 
 
 def _bake(library: _Library, asset: np.ndarray, xform: np.ndarray, mesh: MeshChunk, max_triangles: int):
@@ -602,13 +625,15 @@ class BakedWriter:
         Folders to resolve file assets in.
     max_triangles : int, optional
         The limit; by default ``GRAMMARC_MAX_TRIANGLES`` or ``MAX_TRIANGLES``.
+    lod : str, optional
+        Level of detail of the assets (``load_asset``).
     """
 
     FORMATS: ClassVar[dict[str, str]] = {".obj": "obj", ".ply": "ply", ".stl": "stl", ".glb": "glb"}
 
     def __init__(self, path: str | os.PathLike, *, assets: Sequence[str], symbols: Sequence[str],
                  meta: dict, asset_roots: Sequence[str | os.PathLike] | None = None,
-                 max_triangles: int | None = None):
+                 max_triangles: int | None = None, lod: str | None = None):
         self.path = Path(path)
         suffix = self.path.suffix.lower()
         if suffix not in self.FORMATS:
@@ -620,8 +645,7 @@ class BakedWriter:
             raise ValueError("assets: names must be unique")
         self._symbols = list(symbols)
         self._meta = dict(meta)
-        roots = _roots({"meta": self._meta}, asset_roots)
-        self._library = _Library(names, roots)
+        self._library = asset_library(names, {"meta": self._meta}, asset_roots, lod)
         if max_triangles is None:
             max_triangles = int(os.environ.get("GRAMMARC_MAX_TRIANGLES", MAX_TRIANGLES))
         self.max_triangles = max_triangles
@@ -657,8 +681,9 @@ class BakedWriter:
             if self._triangles + triangles > self.max_triangles:
                 raise UsageError(
                     f"{self.path}: the baked mesh passes {self.max_triangles:,} triangles after "
-                    f"{self._rows + len(asset):,} instances; raise the limit with "
-                    "GRAMMARC_MAX_TRIANGLES=N or write an instance record (.npz) instead"
+                    f"{self._rows + len(asset):,} instances; raise the limit with --max-triangles N "
+                    "(GRAMMARC_MAX_TRIANGLES=N), bake a few lots with --select, or write an instance "
+                    "record (.npz) or instanced .glb/.usdc instead"
                 )
         except BaseException:
             self.abort()

@@ -35,7 +35,7 @@ import orjson
 import shapely
 
 from grammarc.constants import TOL
-from grammarc.errors import LotsError
+from grammarc.errors import LotsError, UsageError
 from grammarc.io.obj import ObjError, read_obj
 from grammarc.ragged import offsets_from_counts, ragged_take, segment_reduce
 
@@ -125,6 +125,23 @@ class Lots:
             bad=self.bad,
             source=self.source,
         )
+
+    def select(self, ids) -> Lots:
+        """The lots of these ids (``--select``), in input order; bad lots not among them are dropped.
+
+        Raises
+        ------
+        UsageError
+            If an id names no lot of the input.
+        """
+        wanted = {str(i) for i in ids}
+        ids = self.ids.astype(str)
+        unknown = sorted(wanted - set(ids.tolist()) - {b.id for b in self.bad})
+        if unknown:
+            raise UsageError(f"--select: no lot has the id {', '.join(map(repr, unknown[:10]))}"
+                             + (f" (and {len(unknown) - 10} more)" if len(unknown) > 10 else ""))
+        keep = np.isin(ids, sorted(wanted))
+        return replace(self.take(keep), bad=tuple(b for b in self.bad if b.id in wanted))
 
 
 def read_lots(path: str | os.PathLike) -> Lots:

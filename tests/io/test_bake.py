@@ -11,7 +11,7 @@ import trimesh
 
 from grammarc.errors import AssetError, UsageError
 from grammarc.io import bake as bake_module
-from grammarc.io import writer_for
+from grammarc.io import OutputOptions, writer_for
 from grammarc.io.bake import (
     BakedWriter,
     bake,
@@ -279,7 +279,7 @@ def chunks():
 @pytest.mark.parametrize("suffix", [".obj", ".ply", ".stl", ".glb"])
 def test_writers_round_trip(tmp_path, suffix):
     path = tmp_path / f"city{suffix}"
-    assert writer_for(path) is BakedWriter
+    assert writer_for(path, OutputOptions(bake=True)) is BakedWriter
     with BakedWriter(path, assets=ASSETS, symbols=["A"], meta={"grammarc": "0", "grammar": "g.cga"}) as out:
         for chunk in chunks():
             out.write(chunk)

@@ -1,0 +1,344 @@
+"""glTF with GPU instancing: ``--emit city.glb`` (``--bake`` writes a baked mesh instead, ``io/bake.py``).
+
+One binary glTF (GLB) whose scene has a node per tile of the city (``io.instancing``), translated to
+the tile's corner (JSON numbers: exact), and under it a node per (asset, colour) group carrying the
+group's instances in ``EXT_mesh_gpu_instancing``: ``TRANSLATION``, ``ROTATION`` and ``SCALE``
+accessors, float32 relative to the tile. Each asset is one mesh of the file, in its unit box (as
+``io.bake`` loads it); each colour is a material whose ``baseColorFactor`` is the record's colour
+(converted from sRGB to glTF's linear factors), so colours show in any viewer. A tile with more than
+``MAX_GROUPS`` (asset, colour) groups, which a grammar colouring each shape at random makes, groups by
+asset only and draws them white: a node per colour would make the file a node per instance. Normals are
+left out: viewers compute flat normals, which is what the assets' polygons are. The mesh table's
+polygons are triangulated into one mesh per tile with per-vertex colours (``COLOR_0``).
+
+The extension is listed in ``extensionsUsed`` but not required: a viewer without it (trimesh, at the
+time of writing, among them) still opens the file and shows each group's mesh once.
+
+GLB keeps sizes in 32-bit fields, so a file holds at most 4 GiB. Tiles are written one at a time into a
+part's binary chunk; a tile that would pass ``max_bytes`` starts a new part. One part is ``city.glb``;
+more are ``city.glb``, ``city.1.glb``, ... with ``city.glb.json`` listing them. Memory is bounded by a
+tile (the binary chunk goes to a temporary file, and the JSON is small), and nothing is moved into
+place before every part is complete.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import shutil
+import struct
+import tempfile
+from collections.abc import Sequence
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from grammarc.errors import UsageError
+from grammarc.io.instancing import TILE_SIZE, Tile, TileSpool, decompose
+from grammarc.io.npz import TerminalChunk
+
+if TYPE_CHECKING:
+    from typing_extensions import Self
+
+__all__ = ["MAX_BYTES", "MAX_GROUPS", "GltfWriter", "part_paths"]
+
+#: GLB's 32-bit length fields, less room for the JSON chunk.
+MAX_BYTES = (1 << 32) - (64 << 20)
+#: (asset, colour) groups of a tile beyond which it groups by asset only (module docstring).
+MAX_GROUPS = 256
+_EXTENSION = "EXT_mesh_gpu_instancing"
+_FLOAT, _UINT, _UBYTE = 5126, 5125, 5121
+_ARRAY_BUFFER, _ELEMENT_ARRAY_BUFFER = 34962, 34963
+_WHITE = (255, 255, 255, 255)
+
+
+def part_paths(path: str | os.PathLike, parts: int) -> list[Path]:
+    """The files of a GLB written in ``parts`` parts: ``city.glb``, ``city.1.glb``, ..."""
+    path = Path(path)
+    return [path] + [path.with_name(f"{path.stem}.{k}{path.suffix}") for k in range(1, parts)]
+
+
+class GltfWriter:
+    """Streams TerminalChunks into tiles and writes the instanced GLB on ``close``.
+
+    The interface of ``InstanceWriter`` (``write``, ``close``, ``abort``, a context manager).
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The ``.glb`` file. Its directory must exist.
+    assets, symbols : sequence of str
+        The record's asset and symbol names.
+    meta : dict
+        Facts about the run, kept in ``asset.extras.grammarc``; its ``grammar`` and ``asset_roots`` give
+        the asset roots when ``asset_roots`` is not given.
+    asset_roots : sequence of path-like, optional
+    tile_size : float
+        Edge of a tile in metres.
+    lod : str, optional
+        Level of detail of the asset meshes (``io.bake.load_asset``).
+    max_bytes : int
+        The largest binary chunk of one part.
+    """
+
+    def __init__(self, path: str | os.PathLike, *, assets: Sequence[str], symbols: Sequence[str], meta: dict,
+                 asset_roots: Sequence[str | os.PathLike] | None = None, tile_size: float = TILE_SIZE,
+                 lod: str | None = None, max_bytes: int = MAX_BYTES):
+        from grammarc.io.bake import asset_library
+
+        self.path = Path(path)
+        if self.path.suffix.lower() != ".glb":
+            raise UsageError(f"cannot write `{path}` as instanced glTF: use .glb")
+        self._meta = dict(meta)
+        self._library = asset_library(assets, {"meta": self._meta}, asset_roots, lod=lod)
+        self.max_bytes = int(max_bytes)
+        self._tmp = Path(tempfile.mkdtemp(prefix=f".{self.path.name}.tmp", dir=self.path.parent))
+        (self._tmp / "spool").mkdir()
+        self._spool = TileSpool(self._tmp / "spool", tile_size)
+        self._state = "open"
+        self._counts: dict = {}
+
+    def write(self, chunk: TerminalChunk) -> None:
+        """Sort a chunk's rows into the tile spools."""
+        if self._state != "open":
+            raise ValueError(f"write to a GltfWriter that is {self._state}")
+        asset = np.asarray(chunk.asset)
+        if np.asarray(chunk.xform).shape != (len(asset), 3, 4):
+            raise ValueError(f"TerminalChunk: asset {asset.shape} and xform {np.shape(chunk.xform)} disagree")
+        if len(asset) and (asset.min() < 0 or asset.max() >= len(self._library.names)):
+            raise ValueError(f"TerminalChunk.asset: index out of range [0, {len(self._library.names)})")
+        try:
+            self._spool.add(chunk)
+        except BaseException:
+            self.abort()
+            raise
+
+    def close(self) -> dict:
+        """Write the parts and move them into place.
+
+        Returns
+        -------
+        counts : dict
+            ``instances``, ``mesh_faces``, ``mesh_triangles``, ``tiles``, ``parts``. Closing again returns the same.
+        """
+        if self._state == "closed":
+            return dict(self._counts)
+        if self._state == "aborted":
+            raise ValueError("close of a GltfWriter that is aborted")
+        try:
+            parts = [_Part(self._tmp / "part0.bin", self._library, self._meta)]
+            tiles = 0
+            for tile in self._spool.tiles():
+                tiles += 1
+                if not parts[-1].add_tile(tile, self.max_bytes):
+                    parts.append(_Part(self._tmp / f"part{len(parts)}.bin", self._library, self._meta))
+                    if not parts[-1].add_tile(tile, self.max_bytes):
+                        raise UsageError(f"{self.path}: tile {tile.name} alone passes {self.max_bytes:,} bytes; "
+                                         "give a smaller --tile-size")
+            paths = part_paths(self.path, len(parts))
+            staged = [self._tmp / f"part{k}.glb" for k in range(len(parts))]
+            for part, out in zip(parts, staged):
+                part.finish(out)
+            if len(parts) > 1:
+                index = self._tmp / "index.json"
+                index.write_text(json.dumps({"parts": [p.name for p in paths],
+                                             "instances": [p.instances for p in parts]}, indent=1))
+                os.replace(index, self.path.with_name(self.path.name + ".json"))
+            for out, path in zip(staged, paths):
+                os.replace(out, path)
+        except BaseException:
+            self.abort()
+            raise
+        shutil.rmtree(self._tmp, ignore_errors=True)
+        self._state = "closed"
+        self._counts = {"instances": self._spool.instances, "mesh_faces": self._spool.faces,
+                        "mesh_triangles": self._spool.triangles,
+                        "tiles": tiles, "parts": len(parts)}
+        return dict(self._counts)
+
+    def abort(self) -> None:
+        """Drop the spools; nothing is left at ``path`` that was not there before."""
+        if self._state == "open":
+            self._state = "aborted"
+            shutil.rmtree(self._tmp, ignore_errors=True)
+
+    def __enter__(self) -> Self:
+        return self
+
+    def __exit__(self, exc_type, exc, tb) -> None:
+        if exc_type is not None:
+            self.abort()
+        elif self._state == "open":
+            self.close()
+
+    def __del__(self) -> None:
+        if getattr(self, "_state", None) == "open":
+            self.abort()
+
+
+class _Part:
+    """One GLB file being built: its JSON lists and its binary chunk in a temporary file."""
+
+    def __init__(self, binary: Path, library, meta: dict):
+        self.library = library
+        self.binary = open(binary, "w+b")  # noqa: SIM115 - closed by finish(), or with the temporary folder
+        self.size = 0
+        self.instances = 0
+        self.json: dict = {
+            "asset": {"version": "2.0", "generator": f"grammarc {meta.get('grammarc', '')}".strip(),
+                      "extras": {"grammarc": meta}},
+            "extensionsUsed": [_EXTENSION],
+            "scene": 0, "scenes": [{"nodes": []}],
+            "nodes": [], "meshes": [], "materials": [], "accessors": [], "bufferViews": [],
+            "buffers": [{"byteLength": 0}],
+        }
+        self._assets: dict[int, tuple[int, int]] = {}  # asset -> (POSITION accessor, indices accessor)
+        self._meshes: dict[tuple[int, int], int] = {}  # (asset, material) -> mesh
+        self._materials: dict[tuple[int, ...], int] = {}  # RGBA -> material
+
+    def add_tile(self, tile: Tile, max_bytes: int) -> bool:
+        """Add a tile's nodes, unless it would take the part past ``max_bytes`` (a part keeps at least
+        one tile when it can): returns whether it was added."""
+        groups = _groups(tile.instances)
+        new_assets = {int(group[0]) for group in groups} - set(self._assets)
+        need = (tile.instances.size * 40 + tile.triangles.size * 3 * 16
+                + sum(self.library[a].vertices.size * 4 + self.library[a].faces.size * 4 + 8
+                      for a in new_assets) + 64 * (len(groups) + 2))
+        if self.size + need > max_bytes:
+            return False
+        nodes = []
+        rows = tile.instances
+        if len(rows):
+            positions, orientations, scales = decompose(rows["xform"], tile.origin)
+            for asset, color, members in groups:
+                nodes.append({
+                    "name": self.library.names[asset],
+                    "mesh": self._mesh(asset, color),
+                    "extensions": {_EXTENSION: {"attributes": {
+                        "TRANSLATION": self._accessor(positions[members], "VEC3"),
+                        "ROTATION": self._accessor(orientations[members], "VEC4"),
+                        "SCALE": self._accessor(scales[members], "VEC3"),
+                    }}},
+                })
+        if len(tile.triangles):
+            nodes.append({"name": "mesh", "mesh": self._polygons(tile)})
+        self.json["nodes"].extend(nodes)
+        first = len(self.json["nodes"]) - len(nodes)
+        self.json["nodes"].append({"name": tile.name, "translation": [float(v) for v in tile.origin],
+                                   "children": list(range(first, first + len(nodes)))})
+        self.json["scenes"][0]["nodes"].append(len(self.json["nodes"]) - 1)
+        self.instances += len(rows)
+        return True
+
+    def finish(self, out: Path) -> None:
+        """Write the GLB: header, JSON chunk, binary chunk (copied from the temporary file)."""
+        self.json["buffers"][0]["byteLength"] = self.size
+        for key in ("meshes", "materials", "accessors", "bufferViews"):
+            if not self.json[key]:
+                del self.json[key]
+        text = json.dumps(self.json, separators=(",", ":")).encode("utf-8")
+        text += b" " * (-len(text) % 4)
+        total = 12 + 8 + len(text) + 8 + self.size
+        with open(out, "wb") as glb:
+            glb.write(struct.pack("<4sII", b"glTF", 2, total))
+            glb.write(struct.pack("<I4s", len(text), b"JSON"))
+            glb.write(text)
+            glb.write(struct.pack("<I4s", self.size, b"BIN\x00"))
+            self.binary.seek(0)
+            shutil.copyfileobj(self.binary, glb, 16 << 20)
+            glb.flush()
+            os.fsync(glb.fileno())
+        self.binary.close()
+
+    # ------------------------------------------------------------------------------------------- parts
+
+    def _view(self, data: np.ndarray, target: int | None = None) -> int:
+        data = np.ascontiguousarray(data)
+        self.binary.write(data.tobytes())
+        view = {"buffer": 0, "byteOffset": self.size, "byteLength": data.nbytes}
+        if target is not None:
+            view["target"] = target
+        self.size += data.nbytes
+        pad = -self.size % 4
+        self.binary.write(b"\x00" * pad)
+        self.size += pad
+        self.json["bufferViews"].append(view)
+        return len(self.json["bufferViews"]) - 1
+
+    def _accessor(self, data: np.ndarray, kind: str, target: int | None = None, bounds: bool = False,
+                  normalized: bool = False) -> int:
+        component = {np.dtype(np.float32): _FLOAT, np.dtype(np.uint32): _UINT,
+                     np.dtype(np.uint8): _UBYTE}[data.dtype]
+        accessor = {"bufferView": self._view(data, target), "componentType": component,
+                    "count": len(data), "type": kind}
+        if normalized:
+            accessor["normalized"] = True
+        if bounds:
+            accessor["min"] = [float(v) for v in data.min(axis=0)]
+            accessor["max"] = [float(v) for v in data.max(axis=0)]
+        self.json["accessors"].append(accessor)
+        return len(self.json["accessors"]) - 1
+
+    def _material(self, rgba: tuple[int, ...], translucent: bool = False) -> int:
+        """The material of a colour; ``translucent``: its vertex colours have alpha below 1."""
+        key = (*rgba, translucent)
+        if key not in self._materials:
+            srgb = np.array(rgba[:3], float) / 255.0
+            linear = np.where(srgb <= 0.04045, srgb / 12.92, ((srgb + 0.055) / 1.055) ** 2.4)
+            material = {"pbrMetallicRoughness": {"baseColorFactor": [*map(float, linear), rgba[3] / 255.0],
+                                                 "metallicFactor": 0.0, "roughnessFactor": 0.9},
+                        "doubleSided": True}
+            if rgba[3] < 255 or translucent:
+                material["alphaMode"] = "BLEND"
+            self.json["materials"].append(material)
+            self._materials[key] = len(self.json["materials"]) - 1
+        return self._materials[key]
+
+    def _mesh(self, asset: int, rgba: tuple[int, ...]) -> int:
+        material = self._material(rgba)
+        if (asset, material) not in self._meshes:
+            if asset not in self._assets:
+                shape = self.library[asset]
+                self._assets[asset] = (
+                    self._accessor(shape.vertices.astype(np.float32), "VEC3", _ARRAY_BUFFER, bounds=True),
+                    self._accessor(shape.faces.astype(np.uint32).reshape(-1), "SCALAR", _ELEMENT_ARRAY_BUFFER),
+                )
+            position, indices = self._assets[asset]
+            self.json["meshes"].append({"name": self.library.names[asset], "primitives": [
+                {"attributes": {"POSITION": position}, "indices": indices, "material": material}]})
+            self._meshes[asset, material] = len(self.json["meshes"]) - 1
+        return self._meshes[asset, material]
+
+    def _polygons(self, tile: Tile) -> int:
+        """The tile's mesh-table triangles as one mesh with per-vertex colours."""
+        triangles = tile.triangles
+        points = (triangles["vertices"].reshape(-1, 3).astype(np.float64) - tile.origin).astype(np.float32)
+        colors = np.repeat(triangles["color"], 3, axis=0)
+        self.json["meshes"].append({"name": f"{tile.name}_polygons", "primitives": [{
+            "attributes": {"POSITION": self._accessor(points, "VEC3", _ARRAY_BUFFER, bounds=True),
+                           "COLOR_0": self._accessor(colors, "VEC4", _ARRAY_BUFFER, normalized=True)},
+            "material": self._material(_WHITE, translucent=bool((colors[:, 3] < 255).any())),
+        }]})
+        return len(self.json["meshes"]) - 1
+
+
+def _groups(rows: np.ndarray) -> list[tuple[int, tuple[int, ...], np.ndarray]]:
+    """(asset, RGBA, row indices) of a tile's instances, by (asset, colour) unless that makes more than
+    ``MAX_GROUPS`` groups, then by asset in white; in order of asset, then colour."""
+    if not len(rows):
+        return []
+    color = rows["color"].view(np.uint32).reshape(-1).astype(np.int64)
+    key = rows["asset"].astype(np.int64) << 32 | color
+    unique, inverse = np.unique(key, return_inverse=True)
+    if len(unique) > MAX_GROUPS:
+        unique, inverse = np.unique(rows["asset"].astype(np.int64) << 32 | np.int64(0xFFFFFFFF),
+                                    return_inverse=True)
+    inverse = inverse.reshape(-1)
+    order = np.argsort(inverse, kind="stable")
+    bounds = np.searchsorted(inverse[order], np.arange(len(unique) + 1))
+    groups = []
+    for k, value in enumerate(unique.tolist()):
+        rgba = tuple(np.array([value & 0xFFFFFFFF], np.uint32).view(np.uint8).tolist())
+        groups.append((value >> 32, rgba, order[bounds[k]:bounds[k + 1]]))
+    return groups

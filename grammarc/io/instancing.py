@@ -1,0 +1,234 @@
+"""What the instancing formats (USD's PointInstancer, glTF's ``EXT_mesh_gpu_instancing``) need of a record.
+
+Both formats place a prototype by translation, rotation (a unit quaternion) and per-axis scale:
+``world = position + R(q) (scale * p)``. A record's ``xform`` is ``M p + t`` with the columns of ``M`` the
+scope's axes times its sizes (DESIGN.md), so ``decompose`` takes the column lengths as the scales and the
+normalized columns as the rotation. Two cases need care:
+
+* a flat scope (a facade quad: one zero column; a snap line: two) has no direction for that axis. The
+  rotation is completed by cross products (``z = x cross y``, and so on), and the scale of that axis is
+  0, which keeps the prototype flat whatever the completed direction is;
+* a mirroring transform (negative determinant: ``s('-1, ...)``, a mirrored split) is not a rotation:
+  its x axis is negated into a rotation and its x scale made negative, which both formats allow.
+
+Tiles: a city spans kilometres, and both formats store positions as float32, which at 10 km from the
+origin is a millimetre step. So instances are grouped in square tiles of the ground plane (world x and
+z) by the centre of their box, and positions are stored relative to the tile's corner: within a 500 m
+tile float32 is exact to about 30 micrometres. ``TileSpool`` sorts a stream of chunks into tiles on
+disk, so a writer can then make one tile at a time with bounded memory (the record may have 10^8 rows).
+Within a tile, rows keep the record's order, so the output does not depend on the chunking.
+"""
+
+from __future__ import annotations
+
+import os
+from dataclasses import dataclass
+from pathlib import Path
+
+import numba as nb
+import numpy as np
+
+from grammarc.io.npz import WHITE, TerminalChunk
+
+__all__ = ["INSTANCE", "TRIANGLE", "Tile", "TileSpool", "decompose"]
+
+#: Default tile edge (metres): see the module docstring.
+TILE_SIZE = 500.0
+#: One instance row in a tile's spool.
+INSTANCE = np.dtype([("row", "<i8"), ("asset", "<i4"), ("lot", "<i4"), ("symbol", "<i4"), ("color", "u1", (4,)),
+                     ("xform", "<f4", (3, 4))])
+#: One triangle of the mesh table in a tile's spool: world vertices, the face's colour and symbol.
+TRIANGLE = np.dtype([("vertices", "<f4", (3, 3)), ("color", "u1", (4,)), ("symbol", "<i4")])
+#: A column shorter than this (in world units) is a flat axis.
+_FLAT = 1e-9
+
+
+def decompose(xform: np.ndarray, origin: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray,
+                                                                             np.ndarray]:
+    """Positions, orientations and scales of instances (see the module docstring).
+
+    Parameters
+    ----------
+    xform : (n, 3, 4) float
+        The record's transforms.
+    origin : (3,) float, optional
+        Subtracted from the positions (a tile's corner), in float64 before rounding to float32.
+
+    Returns
+    -------
+    positions : (n, 3) float32
+    orientations : (n, 4) float32
+        Unit quaternions as (x, y, z, w), the memory order of glTF and of USD's ``GfQuat``.
+    scales : (n, 3) float32
+    """
+    xform = np.asarray(xform, np.float64)
+    origin = np.zeros(3) if origin is None else np.asarray(origin, np.float64)
+    positions = (xform[:, :, 3] - origin).astype(np.float32)
+    orientations = np.empty((len(xform), 4), np.float32)
+    scales = np.empty((len(xform), 3), np.float32)
+    _decompose(np.ascontiguousarray(xform[:, :, :3]), orientations, scales)
+    return positions, orientations, scales
+
+
+@nb.njit(cache=True)
+def _decompose(linear, orientations, scales):
+    n = linear.shape[0]
+    axes = np.empty((3, 3))
+    known = np.empty(3, np.bool_)
+    for i in range(n):
+        for j in range(3):
+            length = np.sqrt(linear[i, 0, j] ** 2 + linear[i, 1, j] ** 2 + linear[i, 2, j] ** 2)
+            scales[i, j] = length
+            known[j] = length > _FLAT
+            for k in range(3):
+                axes[k, j] = linear[i, k, j] / length if known[j] else 0.0
+        count = known.sum()
+        if count == 0:
+            axes[:, :] = 0.0
+            for k in range(3):
+                axes[k, k] = 1.0
+        elif count == 1:
+            # a line: the next axis perpendicular to it, crossed with the world axis least aligned
+            j = np.argmax(known)
+            best = np.argmin(np.abs(axes[:, j]))
+            helper = np.zeros(3)
+            helper[best] = 1.0
+            _cross_into(axes[:, j], helper, axes, (j + 1) % 3)
+            known[(j + 1) % 3] = True
+        # one axis left flat: the cross product of the other two in cyclic order (x = y cross z, ...)
+        for j in range(3):
+            if not known[j]:
+                _cross_into(axes[:, (j + 1) % 3], axes[:, (j + 2) % 3], axes, j)
+        det = (axes[0, 0] * (axes[1, 1] * axes[2, 2] - axes[2, 1] * axes[1, 2])
+               - axes[0, 1] * (axes[1, 0] * axes[2, 2] - axes[2, 0] * axes[1, 2])
+               + axes[0, 2] * (axes[1, 0] * axes[2, 1] - axes[2, 0] * axes[1, 1]))
+        if det < 0.0:
+            for k in range(3):
+                axes[k, 0] = -axes[k, 0]
+            scales[i, 0] = -scales[i, 0]
+        _quaternion(axes, orientations[i])
+
+
+@nb.njit(cache=True)
+def _cross_into(a, b, axes, out):
+    """``axes[:, out] = normalize(a x b)``."""
+    x = a[1] * b[2] - a[2] * b[1]
+    y = a[2] * b[0] - a[0] * b[2]
+    z = a[0] * b[1] - a[1] * b[0]
+    norm = np.sqrt(x * x + y * y + z * z)
+    axes[0, out], axes[1, out], axes[2, out] = x / norm, y / norm, z / norm
+
+
+@nb.njit(cache=True)
+def _quaternion(m, out):
+    """(x, y, z, w) of the rotation matrix ``m`` (Shepperd's method: the largest of the four divisors)."""
+    trace = m[0, 0] + m[1, 1] + m[2, 2]
+    if trace > 0.0:
+        s = np.sqrt(trace + 1.0) * 2.0
+        w, x, y, z = 0.25 * s, (m[2, 1] - m[1, 2]) / s, (m[0, 2] - m[2, 0]) / s, (m[1, 0] - m[0, 1]) / s
+    elif m[0, 0] > m[1, 1] and m[0, 0] > m[2, 2]:
+        s = np.sqrt(1.0 + m[0, 0] - m[1, 1] - m[2, 2]) * 2.0
+        w, x, y, z = (m[2, 1] - m[1, 2]) / s, 0.25 * s, (m[0, 1] + m[1, 0]) / s, (m[0, 2] + m[2, 0]) / s
+    elif m[1, 1] > m[2, 2]:
+        s = np.sqrt(1.0 + m[1, 1] - m[0, 0] - m[2, 2]) * 2.0
+        w, x, y, z = (m[0, 2] - m[2, 0]) / s, (m[0, 1] + m[1, 0]) / s, 0.25 * s, (m[1, 2] + m[2, 1]) / s
+    else:
+        s = np.sqrt(1.0 + m[2, 2] - m[0, 0] - m[1, 1]) * 2.0
+        w, x, y, z = (m[1, 0] - m[0, 1]) / s, (m[0, 2] + m[2, 0]) / s, (m[1, 2] + m[2, 1]) / s, 0.25 * s
+    norm = np.sqrt(w * w + x * x + y * y + z * z)
+    if w < 0.0:  # one of the two signs, so equal rotations give equal bytes
+        norm = -norm
+    out[0], out[1], out[2], out[3] = x / norm, y / norm, z / norm, w / norm
+
+
+@dataclass(frozen=True)
+class Tile:
+    """One tile of a spool: its grid key, its corner in world coordinates and its rows."""
+
+    key: tuple[int, int]
+    origin: np.ndarray  # (3,) float64: (ix * size, 0, iz * size)
+    instances: np.ndarray  # (n,) INSTANCE
+    triangles: np.ndarray  # (t,) TRIANGLE
+
+    @property
+    def name(self) -> str:
+        """A prim or node name: ``tile_<ix>_<iz>`` with ``m`` for a minus sign."""
+        return "tile_" + "_".join(str(k).replace("-", "m") for k in self.key)
+
+
+class TileSpool:
+    """Sorts chunks of a record into square tiles, each an append-only pair of files in ``directory``.
+
+    ``add`` groups a chunk's rows by tile with one stable sort and appends each group to its tile's
+    file (the record's order is kept inside a tile); the polygons of the mesh table are triangulated
+    first (``bake.triangulate_polygons``) and go to the tile of their first vertex. ``tiles()`` reads
+    the tiles back one at a time in key order.
+    """
+
+    def __init__(self, directory: str | os.PathLike, tile_size: float = TILE_SIZE):
+        if not tile_size > 0:
+            raise ValueError(f"tile_size must be positive, got {tile_size}")
+        self.directory = Path(directory)
+        self.tile_size = float(tile_size)
+        self.keys: set[tuple[int, int]] = set()
+        self.instances = 0
+        self.faces = 0
+        self.triangles = 0
+
+    def add(self, chunk: TerminalChunk) -> None:
+        rows = np.empty(len(chunk.asset), INSTANCE)
+        rows["asset"], rows["lot"], rows["symbol"] = chunk.asset, chunk.lot, chunk.symbol
+        rows["color"] = WHITE if chunk.color is None else chunk.color
+        rows["xform"] = chunk.xform
+        rows["row"] = np.arange(self.instances, self.instances + len(rows))
+        xform = np.asarray(chunk.xform, np.float64)
+        centre = xform[:, :, 3] + 0.5 * xform[:, :, :3].sum(axis=2)
+        self._append("instances", self._keys(centre), rows)
+        self.instances += len(rows)
+
+        mesh = chunk.mesh
+        if len(mesh.face_offsets) > 1:
+            from grammarc.io.bake import triangulate_polygons
+
+            vertices = np.asarray(mesh.vertices, np.float64)
+            faces = triangulate_polygons(vertices, mesh.ring_offsets, mesh.face_offsets)
+            face_of_vertex = np.repeat(np.arange(len(mesh.face_offsets) - 1),
+                                       np.diff(np.asarray(mesh.ring_offsets)[mesh.face_offsets]))
+            face = face_of_vertex[faces[:, 0]]
+            triangles = np.empty(len(faces), TRIANGLE)
+            triangles["vertices"] = vertices[faces]
+            triangles["color"] = mesh.colors()[face]
+            triangles["symbol"] = np.asarray(mesh.symbol)[face]
+            first = vertices[np.asarray(mesh.ring_offsets)[mesh.face_offsets[:-1]]]
+            self._append("triangles", self._keys(first)[face], triangles)
+            self.faces += len(mesh.face_offsets) - 1
+            self.triangles += len(triangles)
+
+    def tiles(self):
+        """Each tile, in key order, read back from its files."""
+        for key in sorted(self.keys):
+            origin = np.array([key[0] * self.tile_size, 0.0, key[1] * self.tile_size])
+            yield Tile(key, origin, self._read("instances", key, INSTANCE), self._read("triangles", key, TRIANGLE))
+
+    def _keys(self, points: np.ndarray) -> np.ndarray:
+        """(n, 2) int64 tile keys of world points."""
+        return np.floor(points[:, [0, 2]] / self.tile_size).astype(np.int64)
+
+    def _path(self, kind: str, key: tuple[int, int]) -> Path:
+        return self.directory / f"{kind}_{key[0]}_{key[1]}.bin"
+
+    def _append(self, kind: str, keys: np.ndarray, rows: np.ndarray) -> None:
+        if not len(rows):
+            return
+        unique, inverse = np.unique(keys, axis=0, return_inverse=True)
+        inverse = inverse.reshape(-1)
+        order = np.argsort(inverse, kind="stable")
+        bounds = np.searchsorted(inverse[order], np.arange(len(unique) + 1))
+        for k, (ix, iz) in enumerate(unique.tolist()):
+            with open(self._path(kind, (ix, iz)), "ab") as out:
+                out.write(rows[order[bounds[k]:bounds[k + 1]]].tobytes())
+            self.keys.add((ix, iz))
+
+    def _read(self, kind: str, key: tuple[int, int], dtype: np.dtype) -> np.ndarray:
+        path = self._path(kind, key)
+        return np.fromfile(path, dtype) if path.exists() else np.zeros(0, dtype)

@@ -1,0 +1,284 @@
+"""Instanced USD: ``--emit city.usda | city.usdc | city.usd`` (the ``usd`` extra, usd-core).
+
+The layout, for ``city.usdc``::
+
+    city.usdc                        root layer: /City (the default prim), one child per tile
+    city.usdc.tiles/prototypes.usdc  /Prototypes/<asset>: one Mesh per asset, in its unit box [0, 1]^3
+    city.usdc.tiles/tile_3_m2.usdc   /Tile: Instances (a PointInstancer) and Meshes (the mesh table)
+
+* **Tiles** (``io.instancing``): instances are grouped in square tiles of the ground plane, each tile's
+  prim translated to its corner in float64 and its positions relative to the corner, so float32
+  positions stay exact far from the origin. The root layer references each tile's layer, so a viewer
+  or a pipeline can load, deactivate or swap a tile on its own.
+* **Instances**: one ``UsdGeomPointInstancer`` per tile: ``protoIndices``, ``positions``,
+  ``orientations`` (quath), ``scales``, ``ids`` (the instance's row in the record, so a tile's
+  instances can be matched with ``instances.npz``), the per-instance colour as ``primvars:displayColor``
+  (and ``displayOpacity``) of vertex interpolation, which prototypes inherit, and ``grammarc:lot`` and
+  ``grammarc:symbol``. Its ``prototypes`` are children of the instancer referencing the prototype
+  layer, one for each asset the tile uses.
+* **Prototypes**: the asset meshes as ``io.bake`` loads them (OBJ and other formats through trimesh,
+  built-ins generated), fitted to the unit box as CityEngine fits an inserted asset to its scope;
+  ``subdivisionScheme`` is ``none`` (they are polygon models, not subdivision cages).
+* **Meshes**: the mesh table's polygons (leaves that are not instances) triangulated, one Mesh per
+  tile with a colour per face.
+
+Writing streams: ``write`` sorts each chunk into tile spools on disk (``TileSpool``), and ``close``
+makes one tile layer at a time, so memory is bounded by the largest tile, not by the city. Everything
+is written in a temporary folder next to the output; ``close`` moves the tile folder and then the root
+layer into place, so the root never names a tile layer that is not complete. ``.usda`` writes text
+layers throughout (small cities, for reading); ``.usdc`` and ``.usd`` write crate layers.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import shutil
+import tempfile
+from collections.abc import Sequence
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from grammarc.errors import UsageError
+from grammarc.io.instancing import TILE_SIZE, Tile, TileSpool, decompose
+from grammarc.io.npz import TerminalChunk
+
+try:  # the `usd` extra: this module is imported only for a USD output, and says what to install
+    from pxr import Gf, Sdf, Tf, Usd, UsdGeom, Vt
+except ImportError:
+    Gf = Sdf = Tf = Usd = UsdGeom = Vt = None
+
+if TYPE_CHECKING:
+    from typing_extensions import Self
+
+__all__ = ["UsdWriter", "tiles_folder"]
+
+
+def tiles_folder(path: str | os.PathLike) -> Path:
+    """The folder of a root layer's tile layers: ``city.usdc`` -> ``city.usdc.tiles`` (so ``city.usda`` and
+    ``city.usdc`` side by side do not share one)."""
+    path = Path(path)
+    return path.with_name(f"{path.name}.tiles")
+
+
+def _require_pxr() -> None:
+    if Usd is None:
+        raise UsageError("writing USD needs usd-core: pip install 'grammarc[usd]' (or pip install usd-core)")
+
+
+class UsdWriter:
+    """Streams TerminalChunks into tiles and writes the instanced USD layers on ``close``.
+
+    The interface of ``InstanceWriter`` (``write``, ``close``, ``abort``, a context manager).
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The root layer: ``.usda``, ``.usdc`` or ``.usd``. Its directory must exist.
+    assets, symbols : sequence of str
+        The record's asset and symbol names.
+    meta : dict
+        Facts about the run, kept as the root layer's ``customLayerData["grammarc"]`` (JSON); its
+        ``grammar`` and ``asset_roots`` give the asset roots when ``asset_roots`` is not given.
+    asset_roots : sequence of path-like, optional
+        Folders to resolve file assets in.
+    tile_size : float
+        Edge of a tile in metres.
+    lod : str, optional
+        Level of detail of the prototypes (``io.bake.load_asset``).
+    """
+
+    def __init__(self, path: str | os.PathLike, *, assets: Sequence[str], symbols: Sequence[str], meta: dict,
+                 asset_roots: Sequence[str | os.PathLike] | None = None, tile_size: float = TILE_SIZE,
+                 lod: str | None = None):
+        from grammarc.io.bake import asset_library
+
+        _require_pxr()
+        self.path = Path(path)
+        if self.path.suffix.lower() not in (".usda", ".usdc", ".usd"):
+            raise UsageError(f"cannot write `{path}` as USD: use .usda, .usdc or .usd")
+        self._ext = ".usda" if self.path.suffix.lower() == ".usda" else ".usdc"
+        self._symbols = list(symbols)
+        self._meta = dict(meta)
+        self._library = asset_library(assets, {"meta": self._meta}, asset_roots, lod=lod)
+        self._tmp = Path(tempfile.mkdtemp(prefix=f".{self.path.name}.tmp", dir=self.path.parent))
+        (self._tmp / "spool").mkdir()
+        self._spool = TileSpool(self._tmp / "spool", tile_size)
+        self._used = np.zeros(len(self._library.names), np.int64)
+        self._state = "open"
+        self._counts: dict = {}
+
+    def write(self, chunk: TerminalChunk) -> None:
+        """Sort a chunk's rows into the tile spools."""
+        if self._state != "open":
+            raise ValueError(f"write to a UsdWriter that is {self._state}")
+        asset = np.asarray(chunk.asset)
+        if np.asarray(chunk.xform).shape != (len(asset), 3, 4):
+            raise ValueError(f"TerminalChunk: asset {asset.shape} and xform {np.shape(chunk.xform)} disagree")
+        if len(asset) and (asset.min() < 0 or asset.max() >= len(self._used)):
+            raise ValueError(f"TerminalChunk.asset: index out of range [0, {len(self._used)})")
+        try:
+            self._spool.add(chunk)
+            self._used += np.bincount(asset, minlength=len(self._used))
+        except BaseException:
+            self.abort()
+            raise
+
+    def close(self) -> dict:
+        """Write the prototype, tile and root layers and move them into place.
+
+        Returns
+        -------
+        counts : dict
+            ``instances``, ``mesh_faces``, ``mesh_triangles``, ``tiles``. Closing again returns the same counts.
+        """
+        if self._state == "closed":
+            return dict(self._counts)
+        if self._state == "aborted":
+            raise ValueError("close of a UsdWriter that is aborted")
+        try:
+            out = self._tmp / "out"
+            folder = out / tiles_folder(self.path).name
+            folder.mkdir(parents=True)
+            prototypes = self._write_prototypes(folder / f"prototypes{self._ext}")
+            tiles = [self._write_tile(folder, tile, prototypes) for tile in self._spool.tiles()]
+            self._write_root(out / self.path.name, tiles)
+            self._move_into_place(out)
+        except BaseException:
+            self.abort()
+            raise
+        shutil.rmtree(self._tmp, ignore_errors=True)
+        self._state = "closed"
+        self._counts = {"instances": self._spool.instances, "mesh_faces": self._spool.faces,
+                        "mesh_triangles": self._spool.triangles,
+                        "tiles": len(tiles)}
+        return dict(self._counts)
+
+    def abort(self) -> None:
+        """Drop the spools; nothing is left at ``path`` that was not there before."""
+        if self._state == "open":
+            self._state = "aborted"
+            shutil.rmtree(self._tmp, ignore_errors=True)
+
+    def __enter__(self) -> Self:
+        return self
+
+    def __exit__(self, exc_type, exc, tb) -> None:
+        if exc_type is not None:
+            self.abort()
+        elif self._state == "open":
+            self.close()
+
+    def __del__(self) -> None:
+        if getattr(self, "_state", None) == "open":
+            self.abort()
+
+    # ------------------------------------------------------------------------------------------ layers
+
+    def _write_prototypes(self, path: Path) -> dict[int, str]:
+        """The prototype layer: a Mesh per used asset; returns asset index -> prim path."""
+        stage = Usd.Stage.CreateNew(str(path))
+        UsdGeom.SetStageUpAxis(stage, UsdGeom.Tokens.y)
+        UsdGeom.SetStageMetersPerUnit(stage, 1.0)
+        root = UsdGeom.Scope.Define(stage, "/Prototypes").GetPrim()
+        stage.SetDefaultPrim(root)
+        paths = {}
+        for index in np.flatnonzero(self._used):
+            shape = self._library[int(index)]
+            prim = f"/Prototypes/{_prim_name(int(index), self._library.names[index])}"
+            mesh = UsdGeom.Mesh.Define(stage, prim)
+            mesh.CreatePointsAttr(Vt.Vec3fArray.FromNumpy(shape.vertices.astype(np.float32)))
+            mesh.CreateFaceVertexCountsAttr(Vt.IntArray.FromNumpy(np.full(len(shape.faces), 3, np.int32)))
+            mesh.CreateFaceVertexIndicesAttr(Vt.IntArray.FromNumpy(shape.faces.astype(np.int32).reshape(-1)))
+            mesh.CreateSubdivisionSchemeAttr(UsdGeom.Tokens.none)
+            low, high = shape.vertices.min(axis=0), shape.vertices.max(axis=0)
+            mesh.CreateExtentAttr(Vt.Vec3fArray([Gf.Vec3f(*map(float, low)), Gf.Vec3f(*map(float, high))]))
+            mesh.GetPrim().SetCustomDataByKey("grammarc:asset", self._library.names[index])
+            paths[int(index)] = prim
+        stage.GetRootLayer().Save()
+        return paths
+
+    def _write_tile(self, folder: Path, tile: Tile, prototypes: dict[int, str]) -> Tile:
+        """One tile's layer: /Tile with its PointInstancer and its Mesh."""
+        stage = Usd.Stage.CreateNew(str(folder / f"{tile.name}{self._ext}"))
+        UsdGeom.SetStageUpAxis(stage, UsdGeom.Tokens.y)
+        UsdGeom.SetStageMetersPerUnit(stage, 1.0)
+        root = UsdGeom.Xform.Define(stage, "/Tile").GetPrim()
+        stage.SetDefaultPrim(root)
+        rows = tile.instances
+        if len(rows):
+            instancer = UsdGeom.PointInstancer.Define(stage, "/Tile/Instances")
+            used, local = np.unique(rows["asset"], return_inverse=True)
+            UsdGeom.Scope.Define(stage, "/Tile/Instances/Prototypes")
+            targets = []
+            for asset in used.tolist():
+                name = prototypes[asset].rsplit("/", 1)[1]
+                child = stage.DefinePrim(f"/Tile/Instances/Prototypes/{name}")
+                child.GetReferences().AddReference(f"./prototypes{self._ext}", prototypes[asset])
+                targets.append(child.GetPath())
+            instancer.CreatePrototypesRel().SetTargets(targets)
+            positions, orientations, scales = decompose(rows["xform"], tile.origin)
+            instancer.CreateProtoIndicesAttr(Vt.IntArray.FromNumpy(local.astype(np.int32).reshape(-1)))
+            instancer.CreatePositionsAttr(Vt.Vec3fArray.FromNumpy(positions))
+            instancer.CreateOrientationsAttr(Vt.QuathArray.FromNumpy(orientations.astype(np.float16)))
+            instancer.CreateScalesAttr(Vt.Vec3fArray.FromNumpy(scales))
+            instancer.CreateIdsAttr(Vt.Int64Array.FromNumpy(rows["row"]))
+            _colors(UsdGeom.PrimvarsAPI(instancer), rows["color"], UsdGeom.Tokens.vertex)
+            for name, column in (("grammarc:lot", "lot"), ("grammarc:symbol", "symbol")):
+                instancer.GetPrim().CreateAttribute(name, Sdf.ValueTypeNames.IntArray).Set(
+                    Vt.IntArray.FromNumpy(np.ascontiguousarray(rows[column])))
+        triangles = tile.triangles
+        if len(triangles):
+            mesh = UsdGeom.Mesh.Define(stage, "/Tile/Meshes")
+            points = (triangles["vertices"].reshape(-1, 3).astype(np.float64) - tile.origin).astype(np.float32)
+            mesh.CreatePointsAttr(Vt.Vec3fArray.FromNumpy(points))
+            mesh.CreateFaceVertexCountsAttr(Vt.IntArray.FromNumpy(np.full(len(triangles), 3, np.int32)))
+            mesh.CreateFaceVertexIndicesAttr(Vt.IntArray.FromNumpy(np.arange(len(points), dtype=np.int32)))
+            mesh.CreateSubdivisionSchemeAttr(UsdGeom.Tokens.none)
+            _colors(UsdGeom.PrimvarsAPI(mesh), triangles["color"], UsdGeom.Tokens.uniform)
+        stage.GetRootLayer().Save()
+        return tile
+
+    def _write_root(self, path: Path, tiles: list[Tile]) -> None:
+        stage = Usd.Stage.CreateNew(str(path))
+        UsdGeom.SetStageUpAxis(stage, UsdGeom.Tokens.y)
+        UsdGeom.SetStageMetersPerUnit(stage, 1.0)
+        city = UsdGeom.Xform.Define(stage, "/City").GetPrim()
+        stage.SetDefaultPrim(city)
+        folder = tiles_folder(self.path).name
+        for tile in tiles:
+            xform = UsdGeom.Xform.Define(stage, f"/City/{tile.name}")
+            xform.AddTranslateOp().Set(Gf.Vec3d(*map(float, tile.origin)))
+            xform.GetPrim().GetReferences().AddReference(f"./{folder}/{tile.name}{self._ext}")
+        layer = stage.GetRootLayer()
+        layer.customLayerData = {"grammarc": json.dumps(self._meta, sort_keys=True),
+                                 "grammarc:symbols": json.dumps(self._symbols)}
+        layer.Save()
+
+    def _move_into_place(self, out: Path) -> None:
+        """The tile folder first (an older one moved aside, then removed), the root layer last."""
+        folder = tiles_folder(self.path)
+        old = None
+        if folder.exists():
+            old = self._tmp / "old_tiles"
+            os.replace(folder, old)
+        os.replace(out / folder.name, folder)
+        os.replace(out / self.path.name, self.path)
+        if old is not None:
+            shutil.rmtree(old, ignore_errors=True)
+
+
+def _prim_name(index: int, name: str) -> str:
+    """A valid, unique prim name for asset ``index``: ``a3_window_obj`` for ``facade/window.obj``."""
+    return f"a{index}_{Tf.MakeValidIdentifier(name.rsplit('/', 1)[-1].removeprefix('builtin:'))}"
+
+
+def _colors(primvars, rgba: np.ndarray, interpolation) -> None:
+    """``displayColor`` (and ``displayOpacity`` where any alpha is below 255) from RGBA bytes."""
+    color = primvars.CreatePrimvar("displayColor", Sdf.ValueTypeNames.Color3fArray, interpolation)
+    color.Set(Vt.Vec3fArray.FromNumpy(np.ascontiguousarray(rgba[:, :3], np.float32) / 255.0))
+    if (rgba[:, 3] < 255).any():
+        opacity = primvars.CreatePrimvar("displayOpacity", Sdf.ValueTypeNames.FloatArray, interpolation)
+        opacity.Set(Vt.FloatArray.FromNumpy(rgba[:, 3].astype(np.float32) / 255.0))

@@ -1,0 +1,78 @@
+"""Instanced glTF: trimesh opens the GLB, and its EXT_mesh_gpu_instancing nodes hold the record's
+instances; a city past the size of a part is split into parts with an index."""
+
+import json
+
+import numpy as np
+import pytest
+import trimesh
+from writers_city import city, world
+
+from grammarc.io.gltf import GltfWriter, part_paths
+from grammarc.io.npz import MeshChunk, TerminalChunk
+
+pygltflib = pytest.importorskip("pygltflib")
+
+
+def accessor(gltf, blob: bytes, index: int) -> np.ndarray:
+    a = gltf.accessors[index]
+    view = gltf.bufferViews[a.bufferView]
+    dtype = {5126: np.float32, 5125: np.uint32, 5121: np.uint8}[a.componentType]
+    width = {"SCALAR": 1, "VEC3": 3, "VEC4": 4}[a.type]
+    data = np.frombuffer(blob, dtype, a.count * width, view.byteOffset + (a.byteOffset or 0))
+    return data.reshape(a.count, width) if width > 1 else data
+
+
+def instances(path) -> tuple[np.ndarray, list[str]]:
+    """World transforms (n, 3, 4) and asset names of every instance of a GLB, tile by tile."""
+    gltf = pygltflib.GLTF2().load(str(path))
+    blob = gltf.binary_blob()
+    xforms, names = [], []
+    for tile in gltf.scenes[0].nodes:
+        origin = np.array(gltf.nodes[tile].translation)
+        for child in gltf.nodes[tile].children:
+            node = gltf.nodes[child]
+            if not node.extensions:
+                continue
+            attributes = node.extensions["EXT_mesh_gpu_instancing"]["attributes"]
+            t, r, s = (accessor(gltf, blob, attributes[k]) for k in ("TRANSLATION", "ROTATION", "SCALE"))
+            xforms.append(world(t + origin, r, s))
+            names += [gltf.meshes[node.mesh].name] * len(t)
+    return np.concatenate(xforms), names
+
+
+def test_glb_holds_the_record_and_trimesh_opens_it(tmp_path):
+    record, path, counts = city(tmp_path, "city.glb", tile_size=100.0)
+    scene = trimesh.load(path)  # without the extension, a viewer shows each group's mesh once
+    assert isinstance(scene, trimesh.Scene) and len(scene.geometry) >= 2
+    got, names = instances(path)
+    assert counts["instances"] == len(got) == len(record["asset"]) and counts["parts"] == 1
+    # tiles group by asset and colour: match the record's rows by asset and position
+    want = record["xform"].astype(float)
+    wanted = np.lexsort(np.round(want[:, :, 3], 2).T)
+    found = np.lexsort(np.round(got[:, :, 3], 2).T)
+    np.testing.assert_allclose(got[found], want[wanted], atol=2e-5 * 40)
+    assert [names[i] for i in found] == list(record["assets"][record["asset"]][wanted])
+    gltf = pygltflib.GLTF2().load(str(path))
+    colours = {tuple(np.round(m.pbrMetallicRoughness.baseColorFactor, 3)) for m in gltf.materials}
+    assert (0.527, 0.051, 0.014, 1.0) in colours  # #c04020 in linear light
+
+
+def test_a_large_city_is_split_into_parts(tmp_path):
+    """Parts of at most ``max_bytes`` of binary (a tile is not split): city.glb, city.1.glb, ... and
+    the index city.glb.json; together they hold every instance."""
+    record, _, _ = city(tmp_path, "city.npz")
+    path = tmp_path / "small.glb"
+    with GltfWriter(path, assets=list(record["assets"]), symbols=list(record["symbols"]), meta=record["meta"],
+                    tile_size=10.0, max_bytes=3000) as writer:
+        writer.write(TerminalChunk(asset=record["asset"], xform=record["xform"], lot=record["lot"],
+                                   symbol=record["symbol"], mesh=MeshChunk.empty(), color=record["color"]))
+        parts = writer.close()["parts"]
+    assert parts > 2
+    index = json.loads(path.with_name("small.glb.json").read_text())
+    assert index["parts"] == [p.name for p in part_paths(path, parts)] and index["parts"][0] == "small.glb"
+    assert sum(index["instances"]) == sum(len(instances(p)[0]) for p in part_paths(path, parts)) == len(
+        record["asset"])
+    for part in part_paths(path, parts):
+        gltf = pygltflib.GLTF2().load(str(part))
+        assert gltf.buffers[0].byteLength <= 3000 + 2000  # the asset meshes a part needs come on top

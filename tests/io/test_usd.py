@@ -1,0 +1,56 @@
+"""Instanced USD: the layers read back with pxr give the record's instances, in tiles far from the origin."""
+
+import numpy as np
+import pytest
+from writers_city import city, world
+
+pxr = pytest.importorskip("pxr")
+from pxr import Usd, UsdGeom  # noqa: E402
+
+from grammarc.io.usd import tiles_folder  # noqa: E402
+
+
+def instancers(path):
+    stage = Usd.Stage.Open(str(path))
+    return stage, [UsdGeom.PointInstancer(p) for p in stage.Traverse() if p.IsA(UsdGeom.PointInstancer)]
+
+
+@pytest.mark.parametrize("suffix", [".usda", ".usdc"])
+def test_usd_round_trip(tmp_path, suffix):
+    record, path, counts = city(tmp_path, f"city{suffix}", tile_size=100.0)
+    stage, found = instancers(path)
+    assert UsdGeom.GetStageUpAxis(stage) == "Y" and stage.GetDefaultPrim().GetName() == "City"
+    assert counts["instances"] == len(record["asset"]) and counts["tiles"] == len(found) == 3  # z = -300 parts two rows
+    ids, xforms, assets = [], [], []
+    for instancer in found:
+        tile = UsdGeom.Xformable(instancer.GetPrim()).ComputeLocalToWorldTransform(Usd.TimeCode.Default())
+        origin = np.array(tile.ExtractTranslation())
+        positions = np.array(instancer.GetPositionsAttr().Get(), float) + origin
+        orientations = np.array([[*q.GetImaginary(), q.GetReal()] for q in instancer.GetOrientationsAttr().Get()])
+        xforms.append(world(positions, orientations, np.array(instancer.GetScalesAttr().Get())))
+        ids.append(np.array(instancer.GetIdsAttr().Get()))
+        targets = instancer.GetPrototypesRel().GetTargets()
+        names = [stage.GetPrimAtPath(t).GetCustomDataByKey("grammarc:asset") for t in targets]
+        assets.append(np.array(names)[np.array(instancer.GetProtoIndicesAttr().Get())])
+    ids = np.concatenate(ids)
+    order = np.argsort(ids)
+    assert (ids[order] == np.arange(len(record["asset"]))).all()
+    # the same instances: assets, positions exact to float32 in the tile, rotations to quath's precision
+    assert (np.concatenate(assets)[order] == record["assets"][record["asset"]]).all()
+    got = np.concatenate(xforms)[order]
+    np.testing.assert_allclose(got[:, :, 3], record["xform"][:, :, 3], atol=2e-3)
+    size = np.linalg.norm(record["xform"][:, :, :3], axis=1)[:, None, :]
+    assert (np.abs(got[:, :, :3] - record["xform"][:, :, :3]) <= 2e-3 * size + 1e-5).all()
+    # the roof polygons: a Mesh per tile with their triangles
+    meshes = [UsdGeom.Mesh(p) for p in stage.Traverse() if p.IsA(UsdGeom.Mesh) and p.GetName() == "Meshes"]
+    assert sum(len(m.GetFaceVertexCountsAttr().Get()) for m in meshes) == counts["mesh_triangles"] > 0
+    assert (tiles_folder(path) / f"prototypes{'.usda' if suffix == '.usda' else '.usdc'}").is_file()
+
+
+def test_a_failed_usd_build_leaves_nothing(tmp_path):
+    from grammarc.io.usd import UsdWriter
+
+    with pytest.raises(RuntimeError), UsdWriter(tmp_path / "c.usdc", assets=["builtin:cube"], symbols=["A"],
+                                                 meta={}) as writer:
+        raise RuntimeError("derivation failed")
+    assert writer._state == "aborted" and sorted(p.name for p in tmp_path.iterdir()) == []
