@@ -27,19 +27,13 @@ import json
 import os
 import shutil
 import struct
-import tempfile
 from collections.abc import Sequence
 from pathlib import Path
-from typing import TYPE_CHECKING
 
 import numpy as np
 
 from grammarc.errors import UsageError
-from grammarc.io.instancing import TILE_SIZE, Tile, TileSpool, decompose
-from grammarc.io.npz import TerminalChunk
-
-if TYPE_CHECKING:
-    from typing_extensions import Self
+from grammarc.io.instancing import TILE_SIZE, Tile, TiledWriter, decompose
 
 __all__ = ["MAX_BYTES", "MAX_GROUPS", "GltfWriter", "part_paths"]
 
@@ -59,10 +53,8 @@ def part_paths(path: str | os.PathLike, parts: int) -> list[Path]:
     return [path] + [path.with_name(f"{path.stem}.{k}{path.suffix}") for k in range(1, parts)]
 
 
-class GltfWriter:
-    """Streams TerminalChunks into tiles and writes the instanced GLB on ``close``.
-
-    The interface of ``InstanceWriter`` (``write``, ``close``, ``abort``, a context manager).
+class GltfWriter(TiledWriter):
+    """Streams TerminalChunks into tiles and writes the instanced GLB on ``close`` (``TiledWriter``).
 
     Parameters
     ----------
@@ -85,96 +77,32 @@ class GltfWriter:
     def __init__(self, path: str | os.PathLike, *, assets: Sequence[str], symbols: Sequence[str], meta: dict,
                  asset_roots: Sequence[str | os.PathLike] | None = None, tile_size: float = TILE_SIZE,
                  lod: str | None = None, max_bytes: int = MAX_BYTES):
-        from grammarc.io.bake import asset_library
-
-        self.path = Path(path)
-        if self.path.suffix.lower() != ".glb":
+        if Path(path).suffix.lower() != ".glb":
             raise UsageError(f"cannot write `{path}` as instanced glTF: use .glb")
-        self._meta = dict(meta)
-        self._library = asset_library(assets, {"meta": self._meta}, asset_roots, lod=lod)
+        super().__init__(path, assets=assets, meta=meta, asset_roots=asset_roots, tile_size=tile_size, lod=lod)
         self.max_bytes = int(max_bytes)
-        self._tmp = Path(tempfile.mkdtemp(prefix=f".{self.path.name}.tmp", dir=self.path.parent))
-        (self._tmp / "spool").mkdir()
-        self._spool = TileSpool(self._tmp / "spool", tile_size)
-        self._state = "open"
-        self._counts: dict = {}
 
-    def write(self, chunk: TerminalChunk) -> None:
-        """Sort a chunk's rows into the tile spools."""
-        if self._state != "open":
-            raise ValueError(f"write to a GltfWriter that is {self._state}")
-        asset = np.asarray(chunk.asset)
-        if np.asarray(chunk.xform).shape != (len(asset), 3, 4):
-            raise ValueError(f"TerminalChunk: asset {asset.shape} and xform {np.shape(chunk.xform)} disagree")
-        if len(asset) and (asset.min() < 0 or asset.max() >= len(self._library.names)):
-            raise ValueError(f"TerminalChunk.asset: index out of range [0, {len(self._library.names)})")
-        try:
-            self._spool.add(chunk)
-        except BaseException:
-            self.abort()
-            raise
-
-    def close(self) -> dict:
-        """Write the parts and move them into place.
-
-        Returns
-        -------
-        counts : dict
-            ``instances``, ``mesh_faces``, ``mesh_triangles``, ``tiles``, ``parts``. Closing again returns the same.
-        """
-        if self._state == "closed":
-            return dict(self._counts)
-        if self._state == "aborted":
-            raise ValueError("close of a GltfWriter that is aborted")
-        try:
-            parts = [_Part(self._tmp / "part0.bin", self._library, self._meta)]
-            tiles = 0
-            for tile in self._spool.tiles():
-                tiles += 1
+    def _finish(self) -> dict:
+        """The parts (``parts`` in the counts), the index when there are several."""
+        parts = [_Part(self._tmp / "part0.bin", self._library, self._meta)]
+        for tile in self._spool.tiles():
+            if not parts[-1].add_tile(tile, self.max_bytes):
+                parts.append(_Part(self._tmp / f"part{len(parts)}.bin", self._library, self._meta))
                 if not parts[-1].add_tile(tile, self.max_bytes):
-                    parts.append(_Part(self._tmp / f"part{len(parts)}.bin", self._library, self._meta))
-                    if not parts[-1].add_tile(tile, self.max_bytes):
-                        raise UsageError(f"{self.path}: tile {tile.name} alone passes {self.max_bytes:,} bytes; "
-                                         "give a smaller --tile-size")
-            paths = part_paths(self.path, len(parts))
-            staged = [self._tmp / f"part{k}.glb" for k in range(len(parts))]
-            for part, out in zip(parts, staged):
-                part.finish(out)
-            if len(parts) > 1:
-                index = self._tmp / "index.json"
-                index.write_text(json.dumps({"parts": [p.name for p in paths],
-                                             "instances": [p.instances for p in parts]}, indent=1))
-                os.replace(index, self.path.with_name(self.path.name + ".json"))
-            for out, path in zip(staged, paths):
-                os.replace(out, path)
-        except BaseException:
-            self.abort()
-            raise
-        shutil.rmtree(self._tmp, ignore_errors=True)
-        self._state = "closed"
-        self._counts = {"instances": self._spool.instances, "mesh_faces": self._spool.faces,
-                        "mesh_triangles": self._spool.triangles,
-                        "tiles": tiles, "parts": len(parts)}
-        return dict(self._counts)
-
-    def abort(self) -> None:
-        """Drop the spools; nothing is left at ``path`` that was not there before."""
-        if self._state == "open":
-            self._state = "aborted"
-            shutil.rmtree(self._tmp, ignore_errors=True)
-
-    def __enter__(self) -> Self:
-        return self
-
-    def __exit__(self, exc_type, exc, tb) -> None:
-        if exc_type is not None:
-            self.abort()
-        elif self._state == "open":
-            self.close()
-
-    def __del__(self) -> None:
-        if getattr(self, "_state", None) == "open":
-            self.abort()
+                    raise UsageError(f"{self.path}: tile {tile.name} alone passes {self.max_bytes:,} bytes; "
+                                     "give a smaller --tile-size")
+        paths = part_paths(self.path, len(parts))
+        staged = [self._tmp / f"part{k}.glb" for k in range(len(parts))]
+        for part, out in zip(parts, staged):
+            part.finish(out)
+        if len(parts) > 1:
+            index = self._tmp / "index.json"
+            index.write_text(json.dumps({"parts": [p.name for p in paths],
+                                         "instances": [p.instances for p in parts]}, indent=1))
+            os.replace(index, self.path.with_name(self.path.name + ".json"))
+        for out, path in zip(staged, paths):
+            os.replace(out, path)
+        return {"parts": len(parts)}
 
 
 class _Part:

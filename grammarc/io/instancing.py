@@ -22,15 +22,22 @@ Within a tile, rows keep the record's order, so the output does not depend on th
 from __future__ import annotations
 
 import os
+import shutil
+import tempfile
+from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numba as nb
 import numpy as np
 
 from grammarc.io.npz import WHITE, TerminalChunk
 
-__all__ = ["INSTANCE", "TRIANGLE", "Tile", "TileSpool", "decompose"]
+if TYPE_CHECKING:
+    from typing_extensions import Self
+
+__all__ = ["INSTANCE", "TRIANGLE", "Tile", "TileSpool", "TiledWriter", "decompose"]
 
 #: Default tile edge (metres): see the module docstring.
 TILE_SIZE = 500.0
@@ -220,15 +227,97 @@ class TileSpool:
     def _append(self, kind: str, keys: np.ndarray, rows: np.ndarray) -> None:
         if not len(rows):
             return
-        unique, inverse = np.unique(keys, axis=0, return_inverse=True)
-        inverse = inverse.reshape(-1)
-        order = np.argsort(inverse, kind="stable")
-        bounds = np.searchsorted(inverse[order], np.arange(len(unique) + 1))
-        for k, (ix, iz) in enumerate(unique.tolist()):
-            with open(self._path(kind, (ix, iz)), "ab") as out:
-                out.write(rows[order[bounds[k]:bounds[k + 1]]].tobytes())
-            self.keys.add((ix, iz))
+        # one int64 per key (tiles are within +-2^31 of the origin), one stable sort: rows keep their order
+        combined = (keys[:, 0] << 32) + (keys[:, 1] & 0xFFFFFFFF)
+        order = np.argsort(combined, kind="stable")
+        combined = combined[order]
+        starts = np.flatnonzero(np.r_[True, combined[1:] != combined[:-1]])
+        for first, last in zip(starts, [*starts[1:], len(order)]):
+            key = (int(keys[order[first], 0]), int(keys[order[first], 1]))
+            with open(self._path(kind, key), "ab") as out:
+                out.write(rows[order[first:last]].tobytes())
+            self.keys.add(key)
 
     def _read(self, kind: str, key: tuple[int, int], dtype: np.dtype) -> np.ndarray:
         path = self._path(kind, key)
         return np.fromfile(path, dtype) if path.exists() else np.zeros(0, dtype)
+
+
+class TiledWriter:
+    """What the instanced writers share: the interface of ``InstanceWriter`` (``write``, ``close``,
+    ``abort``, a context manager) over a ``TileSpool`` in a temporary folder next to the output.
+
+    ``write`` validates a chunk and spools it; ``close`` calls the subclass's ``_finish()``, which writes
+    the files from ``self._spool.tiles()`` into ``self._tmp`` and moves them into place, and returns
+    its counts; any failure (or ``abort``) removes the temporary folder and leaves the output as it was.
+    """
+
+    def __init__(self, path: str | os.PathLike, *, assets: Sequence[str], meta: dict,
+                 asset_roots: Sequence[str | os.PathLike] | None, tile_size: float, lod: str | None):
+        from grammarc.io.bake import asset_library
+
+        self.path = Path(path)
+        self._meta = dict(meta)
+        self._library = asset_library(assets, {"meta": self._meta}, asset_roots, lod=lod)
+        self._tmp = Path(tempfile.mkdtemp(prefix=f".{self.path.name}.tmp", dir=self.path.parent))
+        (self._tmp / "spool").mkdir()
+        self._spool = TileSpool(self._tmp / "spool", tile_size)
+        self._used = np.zeros(len(self._library.names), np.int64)  # instances of each asset
+        self._state = "open"
+        self._counts: dict = {}
+
+    def write(self, chunk: TerminalChunk) -> None:
+        """Sort a chunk's rows into the tile spools (not kept in memory)."""
+        if self._state != "open":
+            raise ValueError(f"write to a {type(self).__name__} that is {self._state}")
+        asset = np.asarray(chunk.asset)
+        if np.asarray(chunk.xform).shape != (len(asset), 3, 4):
+            raise ValueError(f"TerminalChunk: asset {asset.shape} and xform {np.shape(chunk.xform)} disagree")
+        if len(asset) and (asset.min() < 0 or asset.max() >= len(self._used)):
+            raise ValueError(f"TerminalChunk.asset: index out of range [0, {len(self._used)})")
+        try:
+            self._spool.add(chunk)
+            self._used += np.bincount(asset, minlength=len(self._used))
+        except BaseException:
+            self.abort()
+            raise
+
+    def close(self) -> dict:
+        """Write the output and move it into place; the counts (closing again returns them again):
+        ``instances``, ``mesh_faces``, ``mesh_triangles``, ``tiles`` and the format's own."""
+        if self._state == "closed":
+            return dict(self._counts)
+        if self._state == "aborted":
+            raise ValueError(f"close of a {type(self).__name__} that is aborted")
+        try:
+            counts = self._finish()
+        except BaseException:
+            self.abort()
+            raise
+        shutil.rmtree(self._tmp, ignore_errors=True)
+        self._state = "closed"
+        self._counts = {"instances": self._spool.instances, "mesh_faces": self._spool.faces,
+                        "mesh_triangles": self._spool.triangles, "tiles": len(self._spool.keys), **counts}
+        return dict(self._counts)
+
+    def _finish(self) -> dict:
+        raise NotImplementedError
+
+    def abort(self) -> None:
+        """Drop the spools; nothing is left at ``path`` that was not there before."""
+        if self._state == "open":
+            self._state = "aborted"
+            shutil.rmtree(self._tmp, ignore_errors=True)
+
+    def __enter__(self) -> Self:
+        return self
+
+    def __exit__(self, exc_type, exc, tb) -> None:
+        if exc_type is not None:
+            self.abort()
+        elif self._state == "open":
+            self.close()
+
+    def __del__(self) -> None:
+        if getattr(self, "_state", None) == "open":
+            self.abort()

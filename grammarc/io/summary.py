@@ -82,8 +82,8 @@ def _corners(xform: np.ndarray) -> np.ndarray:
 def format_summary(info: dict) -> str:
     """The summary as text, a table per section."""
     lines = [f"{info['path']}: {info['bytes'] / 1e6:,.1f} MB, grammar {info['grammar']}, seed {info['seed']}",
-             f"  instances   {info['instances']:,} ({info['bytes'] / max(info['instances'], 1):,.1f} bytes each), "
-             f"mesh faces {info['mesh_faces']:,}",
+             (f"  instances   {info['instances']:,} ({info['bytes'] / max(info['instances'], 1):,.1f} bytes "
+              f"each), mesh faces {info['mesh_faces']:,}"),
              f"  lots        {info['lots']:,}"]
     if info["per_lot"]:
         p = info["per_lot"]

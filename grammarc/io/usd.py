@@ -34,24 +34,18 @@ from __future__ import annotations
 import json
 import os
 import shutil
-import tempfile
 from collections.abc import Sequence
 from pathlib import Path
-from typing import TYPE_CHECKING
 
 import numpy as np
 
 from grammarc.errors import UsageError
-from grammarc.io.instancing import TILE_SIZE, Tile, TileSpool, decompose
-from grammarc.io.npz import TerminalChunk
+from grammarc.io.instancing import TILE_SIZE, Tile, TiledWriter, decompose
 
 try:  # the `usd` extra: this module is imported only for a USD output, and says what to install
     from pxr import Gf, Sdf, Tf, Usd, UsdGeom, Vt
 except ImportError:
     Gf = Sdf = Tf = Usd = UsdGeom = Vt = None
-
-if TYPE_CHECKING:
-    from typing_extensions import Self
 
 __all__ = ["UsdWriter", "tiles_folder"]
 
@@ -68,10 +62,8 @@ def _require_pxr() -> None:
         raise UsageError("writing USD needs usd-core: pip install 'grammarc[usd]' (or pip install usd-core)")
 
 
-class UsdWriter:
-    """Streams TerminalChunks into tiles and writes the instanced USD layers on ``close``.
-
-    The interface of ``InstanceWriter`` (``write``, ``close``, ``abort``, a context manager).
+class UsdWriter(TiledWriter):
+    """Streams TerminalChunks into tiles and writes the instanced USD layers on ``close`` (``TiledWriter``).
 
     Parameters
     ----------
@@ -93,87 +85,23 @@ class UsdWriter:
     def __init__(self, path: str | os.PathLike, *, assets: Sequence[str], symbols: Sequence[str], meta: dict,
                  asset_roots: Sequence[str | os.PathLike] | None = None, tile_size: float = TILE_SIZE,
                  lod: str | None = None):
-        from grammarc.io.bake import asset_library
-
         _require_pxr()
-        self.path = Path(path)
-        if self.path.suffix.lower() not in (".usda", ".usdc", ".usd"):
+        if Path(path).suffix.lower() not in (".usda", ".usdc", ".usd"):
             raise UsageError(f"cannot write `{path}` as USD: use .usda, .usdc or .usd")
+        super().__init__(path, assets=assets, meta=meta, asset_roots=asset_roots, tile_size=tile_size, lod=lod)
         self._ext = ".usda" if self.path.suffix.lower() == ".usda" else ".usdc"
         self._symbols = list(symbols)
-        self._meta = dict(meta)
-        self._library = asset_library(assets, {"meta": self._meta}, asset_roots, lod=lod)
-        self._tmp = Path(tempfile.mkdtemp(prefix=f".{self.path.name}.tmp", dir=self.path.parent))
-        (self._tmp / "spool").mkdir()
-        self._spool = TileSpool(self._tmp / "spool", tile_size)
-        self._used = np.zeros(len(self._library.names), np.int64)
-        self._state = "open"
-        self._counts: dict = {}
 
-    def write(self, chunk: TerminalChunk) -> None:
-        """Sort a chunk's rows into the tile spools."""
-        if self._state != "open":
-            raise ValueError(f"write to a UsdWriter that is {self._state}")
-        asset = np.asarray(chunk.asset)
-        if np.asarray(chunk.xform).shape != (len(asset), 3, 4):
-            raise ValueError(f"TerminalChunk: asset {asset.shape} and xform {np.shape(chunk.xform)} disagree")
-        if len(asset) and (asset.min() < 0 or asset.max() >= len(self._used)):
-            raise ValueError(f"TerminalChunk.asset: index out of range [0, {len(self._used)})")
-        try:
-            self._spool.add(chunk)
-            self._used += np.bincount(asset, minlength=len(self._used))
-        except BaseException:
-            self.abort()
-            raise
-
-    def close(self) -> dict:
-        """Write the prototype, tile and root layers and move them into place.
-
-        Returns
-        -------
-        counts : dict
-            ``instances``, ``mesh_faces``, ``mesh_triangles``, ``tiles``. Closing again returns the same counts.
-        """
-        if self._state == "closed":
-            return dict(self._counts)
-        if self._state == "aborted":
-            raise ValueError("close of a UsdWriter that is aborted")
-        try:
-            out = self._tmp / "out"
-            folder = out / tiles_folder(self.path).name
-            folder.mkdir(parents=True)
-            prototypes = self._write_prototypes(folder / f"prototypes{self._ext}")
-            tiles = [self._write_tile(folder, tile, prototypes) for tile in self._spool.tiles()]
-            self._write_root(out / self.path.name, tiles)
-            self._move_into_place(out)
-        except BaseException:
-            self.abort()
-            raise
-        shutil.rmtree(self._tmp, ignore_errors=True)
-        self._state = "closed"
-        self._counts = {"instances": self._spool.instances, "mesh_faces": self._spool.faces,
-                        "mesh_triangles": self._spool.triangles,
-                        "tiles": len(tiles)}
-        return dict(self._counts)
-
-    def abort(self) -> None:
-        """Drop the spools; nothing is left at ``path`` that was not there before."""
-        if self._state == "open":
-            self._state = "aborted"
-            shutil.rmtree(self._tmp, ignore_errors=True)
-
-    def __enter__(self) -> Self:
-        return self
-
-    def __exit__(self, exc_type, exc, tb) -> None:
-        if exc_type is not None:
-            self.abort()
-        elif self._state == "open":
-            self.close()
-
-    def __del__(self) -> None:
-        if getattr(self, "_state", None) == "open":
-            self.abort()
+    def _finish(self) -> dict:
+        """The prototype, tile and root layers, moved into place."""
+        out = self._tmp / "out"
+        folder = out / tiles_folder(self.path).name
+        folder.mkdir(parents=True)
+        prototypes = self._write_prototypes(folder / f"prototypes{self._ext}")
+        tiles = [self._write_tile(folder, tile, prototypes) for tile in self._spool.tiles()]  # (name, origin)
+        self._write_root(out / self.path.name, tiles)
+        self._move_into_place(out)
+        return {}
 
     # ------------------------------------------------------------------------------------------ layers
 
@@ -200,8 +128,9 @@ class UsdWriter:
         stage.GetRootLayer().Save()
         return paths
 
-    def _write_tile(self, folder: Path, tile: Tile, prototypes: dict[int, str]) -> Tile:
-        """One tile's layer: /Tile with its PointInstancer and its Mesh."""
+    def _write_tile(self, folder: Path, tile: Tile, prototypes: dict[int, str]) -> tuple[str, np.ndarray]:
+        """One tile's layer: /Tile with its PointInstancer and its Mesh; the tile's name and origin (not
+        the tile: its rows are let go)."""
         stage = Usd.Stage.CreateNew(str(folder / f"{tile.name}{self._ext}"))
         UsdGeom.SetStageUpAxis(stage, UsdGeom.Tokens.y)
         UsdGeom.SetStageMetersPerUnit(stage, 1.0)
@@ -239,19 +168,19 @@ class UsdWriter:
             mesh.CreateSubdivisionSchemeAttr(UsdGeom.Tokens.none)
             _colors(UsdGeom.PrimvarsAPI(mesh), triangles["color"], UsdGeom.Tokens.uniform)
         stage.GetRootLayer().Save()
-        return tile
+        return tile.name, tile.origin
 
-    def _write_root(self, path: Path, tiles: list[Tile]) -> None:
+    def _write_root(self, path: Path, tiles: list[tuple[str, np.ndarray]]) -> None:
         stage = Usd.Stage.CreateNew(str(path))
         UsdGeom.SetStageUpAxis(stage, UsdGeom.Tokens.y)
         UsdGeom.SetStageMetersPerUnit(stage, 1.0)
         city = UsdGeom.Xform.Define(stage, "/City").GetPrim()
         stage.SetDefaultPrim(city)
         folder = tiles_folder(self.path).name
-        for tile in tiles:
-            xform = UsdGeom.Xform.Define(stage, f"/City/{tile.name}")
-            xform.AddTranslateOp().Set(Gf.Vec3d(*map(float, tile.origin)))
-            xform.GetPrim().GetReferences().AddReference(f"./{folder}/{tile.name}{self._ext}")
+        for name, origin in tiles:
+            xform = UsdGeom.Xform.Define(stage, f"/City/{name}")
+            xform.AddTranslateOp().Set(Gf.Vec3d(*map(float, origin)))
+            xform.GetPrim().GetReferences().AddReference(f"./{folder}/{name}{self._ext}")
         layer = stage.GetRootLayer()
         layer.customLayerData = {"grammarc": json.dumps(self._meta, sort_keys=True),
                                  "grammarc:symbols": json.dumps(self._symbols)}
