@@ -75,7 +75,7 @@ def test_lod_picks_the_substitute_beside_the_asset(city):
 
 def test_reports_as_csv(city):
     assert build(city, "c.npz", "--reports", str(city / "areas.csv")) == 0
-    rows = list(csv.DictReader(open(city / "areas.csv")))
+    rows = list(csv.DictReader((city / "areas.csv").read_text().splitlines()))
     assert [r["id"] for r in rows] == ["L0", "L1", "L2", "L3", ""] and rows[-1]["lot"] == "total"
     assert float(rows[0]["floor_area_sum"]) == pytest.approx(108)
     assert float(rows[-1]["floor_area_sum"]) == pytest.approx(4 * 108)

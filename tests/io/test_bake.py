@@ -10,8 +10,8 @@ import pytest
 import trimesh
 
 from grammarc.errors import AssetError, UsageError
-from grammarc.io import bake as bake_module
 from grammarc.io import OutputOptions, writer_for
+from grammarc.io import bake as bake_module
 from grammarc.io.bake import (
     BakedWriter,
     bake,

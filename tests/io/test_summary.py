@@ -3,7 +3,6 @@
 import json
 
 import numpy as np
-
 from writers_city import city
 
 from grammarc.cli import main

@@ -5,9 +5,9 @@ import pytest
 from writers_city import city, world
 
 pxr = pytest.importorskip("pxr")
-from pxr import Usd, UsdGeom  # noqa: E402
+from pxr import Usd, UsdGeom
 
-from grammarc.io.usd import tiles_folder  # noqa: E402
+from grammarc.io.usd import tiles_folder
 
 
 def instancers(path):
