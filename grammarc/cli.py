@@ -45,7 +45,8 @@ def _parser() -> argparse.ArgumentParser:
     build.add_argument("grammar", type=Path,
                        help="the grammar: a .cga file (paper notation or CityEngine CGA) or a .rpk package")
     build.add_argument("--emit", required=True, metavar="OUT",
-                       help="output file: .npz (instance record), or .obj/.ply/.stl/.glb (baked mesh)")
+                       help="output file: .npz (instance record), .usda/.usdc/.usd (instanced USD, extra "
+                            "`usd`), .glb (glTF with GPU instancing), or .obj/.ply/.stl (baked mesh)")
     build.add_argument("--lots", type=Path, metavar="PATH",
                        help="footprints: GeoJSON or OBJ (default: the lots beside the grammar, or one "
                             "30 x 20 m lot)")
@@ -65,6 +66,20 @@ def _parser() -> argparse.ArgumentParser:
                        help="a further folder for I() assets (the grammar's folder comes first)")
     build.add_argument("--dialect", choices=("cga2006", "cityengine"),
                        help="the grammar's notation (default: detected from its text)")
+    build.add_argument("--bake", action="store_true",
+                       help="expand the instances into one mesh (.glb; .obj/.ply/.stl always are)")
+    build.add_argument("--max-triangles", type=_positive, metavar="N",
+                       help=f"refuse a baked mesh of more triangles (default {LIMITS.max_triangles:,}, or "
+                            "GRAMMARC_MAX_TRIANGLES)")
+    build.add_argument("--lod", metavar="NAME",
+                       help="level of detail: asset `x.obj` is drawn as `x.NAME.obj` where that file exists; "
+                            "`builtin`: a cube stands in for a missing asset file")
+    build.add_argument("--tile-size", type=float, metavar="M",
+                       help=f"edge of the tiles of .usd*/.glb outputs in metres (default {LIMITS.tile_size:g})")
+    build.add_argument("--select", metavar="IDS",
+                       help="derive only these lots (comma-separated ids), e.g. to bake a few")
+    build.add_argument("--reports", type=Path, metavar="PATH",
+                       help="where report() values go: .json or .csv (default: OUT's name + .reports.json)")
     build.add_argument("--quiet", "-q", action="store_true", help="no progress bar and no summary")
     build.set_defaults(run=_build)
 
@@ -84,6 +99,26 @@ def _parser() -> argparse.ArgumentParser:
     check.add_argument("--dialect", choices=("cga2006", "cityengine"),
                        help="the grammar's notation (default: detected from its text)")
     check.set_defaults(run=_check)
+
+    info = sub.add_parser("info", help="what an instance record holds: counts, lots, bbox, polygons")
+    info.add_argument("record", type=Path, help="an instances.npz written by build")
+    info.add_argument("--assets", type=Path, action="append", metavar="DIR",
+                      help="folders for file assets (default: those the record names)")
+    info.add_argument("--lod", metavar="NAME", help="count polygons at this level of detail")
+    info.add_argument("--json", action="store_true", help="print the summary as JSON")
+    info.set_defaults(run=_info)
+
+    render = sub.add_parser("render", help="draw an instance record as a shaded picture (PNG)")
+    render.add_argument("record", type=Path, help="an instance record (.npz) written by `grammarc build`")
+    render.add_argument("-o", "--output", required=True, type=Path, metavar="PNG", help="the picture, .png")
+    render.add_argument("--view", choices=("oblique", "top"), default="oblique",
+                        help="oblique: perspective from above at an angle (default); top: orthographic")
+    render.add_argument("--size", default="1600x1000", metavar="WxH", help="pixels (default 1600x1000)")
+    render.add_argument("--color", choices=("material", "symbol", "asset"), default="material",
+                        help="the record's colours (default), or a colour per symbol or per asset")
+    render.add_argument("--assets", type=Path, action="append", default=[], metavar="DIR",
+                        help="a folder for file assets, instead of the grammar's folder (repeatable)")
+    render.set_defaults(run=_render)
     return parser
 
 
@@ -119,6 +154,33 @@ def _check(args) -> int:
     print(f"  recursive: {', '.join(sorted(graph.recursive)) or '-'}")
     print(f"  attrs:     {', '.join(a.name for a in grammar.module.attrs) or '-'}")
     print(f"  assets:    {', '.join(grammar.assets)}")
+    return 0
+
+
+def _render(args) -> int:
+    from grammarc.render.picture import parse_size, render
+
+    result = render(args.record, args.output, size=parse_size(args.size), view=args.view, color=args.color,
+                    asset_roots=args.assets)
+    for name in result["missing_assets"]:
+        print(f"grammarc: asset `{name}` not found (give its folder with --assets); drawn as boxes",
+              file=sys.stderr)
+    print(f"{args.output}: {result['instances']:,} instances, {result['mesh_faces']:,} mesh faces",
+          file=sys.stderr)
+    return 0
+
+
+def _info(args) -> int:
+    import json
+
+    from grammarc.errors import UsageError
+    from grammarc.io.summary import format_summary, summarize
+
+    try:
+        summary = summarize(args.record, args.assets, args.lod)
+    except (OSError, ValueError, KeyError) as error:
+        raise UsageError(f"{args.record}: not an instance record ({error})") from error
+    print(json.dumps(summary, indent=1) if args.json else format_summary(summary))
     return 0
 
 
@@ -169,6 +231,7 @@ def _conform(args) -> int:
 def _build(args) -> int:
     from grammarc.backend.attributes import parse_override
     from grammarc.build import BuildOptions, build
+    from grammarc.io import OutputOptions
 
     options = BuildOptions(
         seed=args.seed,
@@ -181,7 +244,11 @@ def _build(args) -> int:
     )
     bar = _ProgressBar() if not args.quiet else None
     try:
-        result = build(args.grammar, args.emit, lots_path=args.lots, options=options, progress=bar)
+        result = build(args.grammar, args.emit, lots_path=args.lots, options=options, progress=bar,
+                       output_options=OutputOptions(bake=args.bake, lod=args.lod, tile_size=args.tile_size,
+                                                    max_triangles=args.max_triangles),
+                       select=None if args.select is None else [i for i in args.select.split(",") if i],
+                       reports_to=args.reports)
     finally:
         if bar is not None:
             bar.close()

@@ -38,6 +38,14 @@ class Limits:
     #: before memory is at risk (a shape costs ~100 bytes).
     max_shapes: int = 2_000_000
 
+    #: Triangles of a baked mesh (``--max-triangles``): 50 million are ~3 GB of float64 vertices and
+    #: int64 faces, what a development machine holds next to the record; an instance record of the same
+    #: city is ~60 bytes a row whatever the assets. ``GRAMMARC_MAX_TRIANGLES`` overrides it for the writers.
+    max_triangles: int = 50_000_000
+    #: Edge (metres) of the tiles of the instanced outputs (``--tile-size``): float32 positions relative
+    #: to a 500 m tile's corner are exact to about 30 micrometres (``io.instancing``).
+    tile_size: float = 500.0
+
 
 TOL = Tol()
 LIMITS = Limits()

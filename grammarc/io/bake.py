@@ -53,6 +53,7 @@ from typing import TYPE_CHECKING, ClassVar
 
 import numpy as np
 
+from grammarc.constants import LIMITS
 from grammarc.errors import AssetError, UsageError
 from grammarc.io.assets import builtin_name, resolve_asset
 from grammarc.io.npz import MeshChunk, TerminalChunk
@@ -75,10 +76,8 @@ __all__ = [
     "triangulate_polygons",
 ]
 
-#: Default limit of ``bake``: 50 million triangles are ~3 GB of float64 vertices and int64 faces, what a
-#: development machine holds next to the record; an instance record of the same city is ~60 bytes a row
-#: whatever the assets. ``GRAMMARC_MAX_TRIANGLES`` overrides it for the writers.
-MAX_TRIANGLES = 50_000_000
+#: Default limit of ``bake`` (``constants.Limits.max_triangles``).
+MAX_TRIANGLES = LIMITS.max_triangles
 #: ``--lod builtin``: a built-in cube stands in for an asset file that is missing.
 LOD_STAND_IN = "builtin"
 #: Vertices expanded per einsum call: bounds the float64 temporaries of a block of instances (~50 MB).

@@ -32,6 +32,7 @@ from typing import TYPE_CHECKING
 import numba as nb
 import numpy as np
 
+from grammarc.constants import LIMITS
 from grammarc.io.npz import WHITE, TerminalChunk
 
 if TYPE_CHECKING:
@@ -40,7 +41,7 @@ if TYPE_CHECKING:
 __all__ = ["INSTANCE", "TRIANGLE", "Tile", "TileSpool", "TiledWriter", "decompose"]
 
 #: Default tile edge (metres): see the module docstring.
-TILE_SIZE = 500.0
+TILE_SIZE = LIMITS.tile_size
 #: One instance row in a tile's spool.
 INSTANCE = np.dtype([("row", "<i8"), ("asset", "<i4"), ("lot", "<i4"), ("symbol", "<i4"), ("color", "u1", (4,)),
                      ("xform", "<f4", (3, 4))])

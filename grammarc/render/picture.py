@@ -1,0 +1,291 @@
+"""``render``: a shaded picture of an instance record, drawn on the CPU and written as a PNG.
+
+The record's instances are drawn by ``raster.draw_instances`` in record order, each as a splat, a box or its
+asset's triangles by its size on screen (see ``raster``), then the mesh table's polygons, triangulated by
+``io.bake.triangulate_polygons``. Asset meshes come from ``io.bake.asset_library``, as the mesh writers load
+them; a file asset that cannot be found or read is drawn as its instances' boxes and named in the result,
+so a record moved away from its grammar still gives a picture.
+
+Colours: ``"material"`` is the record's colour of each instance and face (CityEngine's ``color``, white by
+default); ``"symbol"`` and ``"asset"`` colour by the symbol or asset index from ``palette`` (mesh faces,
+which have no asset, are ``MESH_GREY`` then). The alpha channel is ignored; the background is ``SKY``.
+
+The picture depends on the record and the options only (no clock, no threads), and Pillow writes no time
+into the PNG, so the same record gives the same bytes.
+"""
+
+from __future__ import annotations
+
+import os
+import shutil
+import tempfile
+import zipfile
+from collections.abc import Mapping, Sequence
+from pathlib import Path
+
+import numpy as np
+
+from grammarc.errors import AssetError, UsageError
+from grammarc.io.bake import asset_library, builtin_mesh, triangulate_polygons
+from grammarc.render.camera import VIEWS, Camera, fit_camera
+from grammarc.render.raster import draw_instances, draw_triangles
+
+__all__ = ["COLORS", "SKY", "palette", "parse_size", "render"]
+
+#: The colourings ``render`` takes.
+COLORS = ("material", "symbol", "asset")
+#: Background: a light sky blue (RGB).
+SKY = (172, 200, 230)
+#: Colour of mesh faces in the ``"asset"`` colouring (they are polygons, not instances of an asset).
+MESH_GREY = (190, 190, 190)
+#: Instances smaller than this on screen (pixels) are splats.
+SPLAT_PX = 2.0
+#: Assets of more triangles than this are drawn as their box while smaller than ``DETAIL_PX`` on screen.
+HEAVY_TRIANGLES = 64
+DETAIL_PX = 24.0
+#: The largest picture side: a z-buffer of 16384^2 is 2 GB already.
+MAX_SIDE = 16384
+
+
+def render(record, path, *, size: tuple[int, int] = (1600, 1000), view: str = "oblique",
+           color: str = "material", asset_roots: Sequence[str | os.PathLike] = ()) -> dict:
+    """Draw the city of an instance record and write it to ``path`` as a PNG.
+
+    Parameters
+    ----------
+    record : path-like or mapping
+        An instance record file (``io.npz``), or the dict ``read_instances`` returns for one.
+    path : path-like
+        The picture, a ``.png`` in an existing folder; written to a temporary file beside it and moved
+        into place, so it is complete or unchanged.
+    size : (int, int)
+        Width and height in pixels.
+    view : str
+        ``"oblique"``: perspective from the south-south-east, looking down at the city; ``"top"``:
+        orthographic from above, north up. Either way the city's bounding box fills the picture.
+    color : str
+        ``"material"``, ``"symbol"`` or ``"asset"`` (see the module docstring).
+    asset_roots : sequence of path-like
+        Folders to find file assets in; by default the folder of the record's grammar, then the record's
+        ``meta["asset_roots"]``.
+
+    Returns
+    -------
+    dict
+        ``instances`` and ``mesh_faces`` drawn; ``splats``, ``boxes``, ``meshes``: how many instances were
+        drawn each way; ``missing_assets``: names of file assets drawn as boxes because they could not
+        be loaded.
+
+    Raises
+    ------
+    UsageError
+        If the record cannot be read or is not an instance record, an option is wrong, or ``path`` is not
+        a ``.png`` in an existing folder.
+    """
+    width, height = _checked_size(size)
+    if view not in VIEWS:
+        raise UsageError(f"view must be one of {', '.join(VIEWS)}, got `{view}`")
+    if color not in COLORS:
+        raise UsageError(f"color must be one of {', '.join(COLORS)}, got `{color}`")
+    out = Path(path)
+    if out.suffix.lower() != ".png":
+        raise UsageError(f"cannot write `{out}`: the picture is a PNG, name it `.png`")
+    if not out.parent.is_dir():
+        raise UsageError(f"cannot write `{out}`: folder `{out.parent}` does not exist")
+    record = _read(record)
+    names, asset, xform = record["assets"], record["asset"], record["xform"]
+    vertices, ring_offsets, face_offsets = record["mesh"]
+
+    camera = fit_camera(*_bounds(xform, vertices), (width, height), view)
+    image = np.empty((height, width, 3), np.uint8)
+    image[:] = SKY
+    depth = np.full((height, width), -np.inf)
+    light = camera.light()
+
+    library = asset_library(names, record, [Path(r) for r in asset_roots] or None)
+    meshes, missing = [], []
+    for a in np.flatnonzero(np.bincount(asset, minlength=len(names))):
+        try:
+            meshes.append((a, library[a]))
+        except AssetError:
+            missing.append(names[a])
+    counts = _draw_instances(asset, xform, _instance_colors(record, color), meshes, len(names), camera,
+                             light, image, depth)
+    if len(face_offsets) > 1:
+        triangles = triangulate_polygons(vertices, ring_offsets, face_offsets)
+        # The face of each triangle: its first vertex's ring, that ring's face.
+        ring = np.searchsorted(ring_offsets, triangles[:, 0], side="right") - 1
+        face = np.searchsorted(face_offsets, ring, side="right") - 1
+        draw_triangles(camera.to_camera(vertices), camera.project(vertices), triangles,
+                       _face_colors(record, color)[face], camera.lens[3], camera.perspective, light, image,
+                       depth)
+    _write_png(image, out)
+    return {
+        "instances": len(asset),
+        "mesh_faces": len(face_offsets) - 1,
+        "splats": int(counts[0]),
+        "boxes": int(counts[1]),
+        "meshes": int(counts[2]),
+        "missing_assets": missing,
+    }
+
+
+def parse_size(text: str) -> tuple[int, int]:
+    """``"1600x1000"`` -> (1600, 1000); a UsageError for anything else.
+
+    Examples
+    --------
+    >>> parse_size("800x600")
+    (800, 600)
+    """
+    width, sep, height = text.lower().partition("x")
+    if not (sep and width.strip().isdigit() and height.strip().isdigit()):
+        raise UsageError(f"size must be WIDTHxHEIGHT in pixels (1600x1000), got `{text}`")
+    return _checked_size((int(width), int(height)))
+
+
+def palette(n: int) -> np.ndarray:
+    """(n, 3) uint8: n distinct colours, the same for every n (colour k does not depend on n).
+
+    Hues step by the golden ratio of a turn, so neighbouring indices differ strongly; saturation and
+    value stay where a shaded face still shows its hue.
+
+    Examples
+    --------
+    >>> palette(3).tolist()
+    [[235, 117, 117], [117, 152, 235], [186, 235, 117]]
+    """
+    hue = (np.arange(n) * 0.6180339887498949) % 1.0
+    saturation, value = 0.5, 0.92
+    # HSV to RGB: channel c is v (1 - s clip(min(k, 4 - k), 0, 1)), k = (c_offset + 6 h) mod 6.
+    k = (np.array([5.0, 3.0, 1.0]) + 6.0 * hue[:, None]) % 6.0
+    rgb = value * (1.0 - saturation * np.clip(np.minimum(k, 4.0 - k), 0.0, 1.0))
+    return np.round(rgb * 255).astype(np.uint8)
+
+
+def _checked_size(size) -> tuple[int, int]:
+    width, height = (int(s) for s in size)
+    if not (0 < width <= MAX_SIDE and 0 < height <= MAX_SIDE):
+        raise UsageError(f"size must be 1 to {MAX_SIDE} pixels a side, got {width}x{height}")
+    return width, height
+
+
+def _read(record) -> dict:
+    """The columns ``render`` draws, checked: ``assets`` (list of str), ``asset`` (N,) int32, ``xform``
+    (N, 3, 4) float32, ``mesh`` (vertices (V, 3) float64, ring and face offsets int64), ``meta``, and
+    ``color``, ``symbol``, ``symbols``, ``mesh_color``, ``mesh_symbol`` where the record has them."""
+    if not isinstance(record, Mapping):
+        from grammarc.io.npz import read_instances
+
+        if not Path(record).is_file():
+            raise UsageError(f"record `{record}` not found")
+        # np.load takes any other file for a pickle, and says so: name the actual problem instead.
+        if not zipfile.is_zipfile(record):
+            raise UsageError(f"`{record}` is not an instance record (not an .npz file)")
+        try:
+            record = read_instances(record)
+        except (OSError, ValueError, EOFError, KeyError, zipfile.BadZipFile) as error:
+            raise UsageError(f"cannot read record `{record}`: {error}") from error
+    missing = [key for key in ("assets", "asset", "xform") if key not in record]
+    if missing:
+        raise UsageError(f"not an instance record: no {', '.join(missing)}")
+    out = dict(record)
+    out["assets"] = [str(n) for n in np.asarray(record["assets"]).reshape(-1)]
+    out["asset"] = np.ascontiguousarray(record["asset"], np.int32).reshape(-1)
+    out["xform"] = np.ascontiguousarray(record["xform"], np.float32)
+    n = len(out["asset"])
+    if out["xform"].shape != (n, 3, 4):
+        raise UsageError(f"not an instance record: xform is {out['xform'].shape}, expected ({n}, 3, 4)")
+    if n and (out["asset"].min() < 0 or out["asset"].max() >= len(out["assets"])):
+        raise UsageError(f"not an instance record: asset index out of range [0, {len(out['assets'])})")
+    if "mesh_face_offsets" in record:
+        out["mesh"] = (np.asarray(record["mesh_vertices"], np.float64).reshape(-1, 3),
+                       np.asarray(record["mesh_ring_offsets"], np.int64),
+                       np.asarray(record["mesh_face_offsets"], np.int64))
+    else:
+        out["mesh"] = (np.zeros((0, 3)), np.zeros(1, np.int64), np.zeros(1, np.int64))
+    return out
+
+
+def _bounds(xform: np.ndarray, vertices: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The world bounding box (low, high) float64 of every instance's box and every mesh vertex."""
+    # An instance's box spans origin + sum over its axes of [min(0, axis), max(0, axis)], per coordinate;
+    # column by column, as (N, 3) sums: a (N, 3, 3) temporary would cost more than the sums.
+    low, high = xform[:, :, 3].copy(), xform[:, :, 3].copy()
+    for j in range(3):
+        low += np.minimum(xform[:, :, j], 0)
+        high += np.maximum(xform[:, :, j], 0)
+    low, high = np.concatenate([low, vertices]), np.concatenate([high, vertices])
+    if not len(low):
+        return np.zeros(3), np.zeros(3)
+    return low.min(axis=0).astype(np.float64), high.max(axis=0).astype(np.float64)
+
+
+def _draw_instances(asset, xform, rgb, meshes, n_assets, camera: Camera, light, image, depth) -> np.ndarray:
+    """Lay the loaded asset meshes out as the ragged tables of ``draw_instances`` and draw; an asset
+    absent from ``meshes`` (not used, or not loaded) has no triangles, so it is always its box."""
+    cube = builtin_mesh("builtin:cube")
+    vertex_counts = np.zeros(n_assets + 1, np.int64)
+    face_counts = np.zeros(n_assets + 1, np.int64)
+    detail_px = np.full(n_assets + 1, np.inf)  # no triangles: the box at every size
+    vertices, faces = [], []
+    for a, mesh in meshes:
+        vertex_counts[a], face_counts[a] = len(mesh.vertices), len(mesh.faces)
+        detail_px[a] = DETAIL_PX if mesh.n_triangles > HEAVY_TRIANGLES else 0.0
+        vertices.append(mesh.vertices)
+        faces.append(mesh.faces)
+    vertex_counts[-1], face_counts[-1] = len(cube.vertices), len(cube.faces)
+    vertex_offsets = np.concatenate([[0], np.cumsum(vertex_counts)])
+    face_offsets = np.concatenate([[0], np.cumsum(face_counts)])
+    return draw_instances(xform, rgb, asset, vertex_offsets, face_offsets,
+                          np.concatenate([*vertices, cube.vertices]).astype(np.float64),
+                          np.concatenate([*faces, cube.faces]).astype(np.int64), detail_px, SPLAT_PX,
+                          camera.view, camera.lens, camera.perspective, light, image, depth)
+
+
+def _instance_colors(record: dict, color: str) -> np.ndarray:
+    """(N, 3 or 4) uint8: each instance's colour in the colouring ``color`` (RGB first)."""
+    n = len(record["asset"])
+    if color == "material":
+        return _rgba(record, "color", n)
+    return _by_index(record, color, n)
+
+
+def _face_colors(record: dict, color: str) -> np.ndarray:
+    """(F, 3 or 4) uint8: each mesh face's colour in the colouring ``color``."""
+    n = len(record["mesh"][2]) - 1
+    if color == "asset":
+        return np.broadcast_to(np.array(MESH_GREY, np.uint8), (n, 3))
+    if color == "symbol":
+        return _by_index(record, "mesh_symbol", n)
+    return _rgba(record, "mesh_color", n)
+
+
+def _by_index(record: dict, key: str, n: int) -> np.ndarray:
+    """(n, 3) uint8: the palette colour of each row's index in column ``key`` (0 if the record has none)."""
+    index = np.asarray(record[key], np.int64).reshape(n) if key in record else np.zeros(n, np.int64)
+    return palette(int(index.max(initial=0)) + 1)[index]
+
+
+def _rgba(record: dict, key: str, n: int) -> np.ndarray:
+    """Colour column ``key`` as (n, 4) uint8, white if the record has none."""
+    if key not in record:
+        return np.full((n, 4), 255, np.uint8)
+    return np.ascontiguousarray(record[key], np.uint8).reshape(n, 4)
+
+
+def _write_png(image: np.ndarray, path: Path) -> None:
+    """Write ``image`` (h, w, 3) uint8 as a PNG to a private folder beside ``path``, fsync it and move it
+    onto ``path``; the folder is removed whatever happens."""
+    from PIL import Image
+
+    tmpdir = tempfile.mkdtemp(prefix=f".{path.name}.tmp", dir=path.parent)
+    try:
+        tmp = os.path.join(tmpdir, path.name)
+        with open(tmp, "xb") as file:
+            Image.fromarray(image).save(file, format="PNG")
+            file.flush()
+            os.fsync(file.fileno())
+        os.replace(tmp, path)
+    finally:
+        shutil.rmtree(tmpdir, ignore_errors=True)
