@@ -15,7 +15,9 @@ written.
 from __future__ import annotations
 
 import time
+from collections import deque
 from collections.abc import Sequence
+from concurrent.futures import ThreadPoolExecutor
 from contextlib import contextmanager
 from dataclasses import dataclass, field, replace
 from pathlib import Path
@@ -53,6 +55,8 @@ class BuildOptions:
     chunk_budget: int = CHUNK_BUDGET
     #: ``cga2006`` or ``cityengine``; detected from the grammar's text when None.
     dialect: str | None = None
+    #: Chunks derived at once, on as many threads (``_derive_all``); the output does not depend on it.
+    workers: int = 1
 
 
 @dataclass(frozen=True)
@@ -199,41 +203,58 @@ def _derive_all(plan, lots: Lots, options: BuildOptions, writer, failed: list[Ba
     small whatever the grammar. The records do not depend on the chunking. A grammar whose occlusion
     queries look at other lots is derived twice: first for everyone's occluders (``_occluders``), those of
     ``context`` when given (the whole city of a selection).
+
+    ``options.workers`` chunks are derived at once on as many threads: the kernels release the GIL
+    (``nogil``), as numpy does for large arrays, so the cores share the work. Results are written in
+    chunk order, and a chunk's size is decided from the chunks finished before it in that order, so the
+    chunking does not depend on timing (and the records never depend on the chunking).
     """
     derived = 0
     first = 0
     size = min(options.chunk_size, 64)
     rows = 0
+    written = 0
     foreign = _occluders(plan, lots if context is None else context, options) if plan.inter else None
-    while first < len(lots):
-        part = lots.take(slice(first, first + size))
-        derived_now, made = _derive(plan, part, options, writer, failed, reports, foreign)
-        derived += derived_now
-        rows += made
-        first += len(part)
-        per_lot = rows / max(first, 1)
-        size = int(np.clip(ROWS_PER_CHUNK / max(per_lot, 1.0), 1, options.chunk_size))
-        if progress is not None:
-            progress(first, len(lots))
+    if foreign is not None:
+        foreign.index  # noqa: B018 - built once here, before threads share it
+    with ThreadPoolExecutor(max_workers=options.workers, thread_name_prefix="derive") as pool:
+        window: deque = deque()
+        try:
+            while first < len(lots) or window:
+                while first < len(lots) and len(window) < options.workers:
+                    part = lots.take(slice(first, first + size))
+                    window.append((len(part), pool.submit(_derive, plan, part, options, foreign)))
+                    first += len(part)
+                n_lots, future = window.popleft()
+                results, part_failed = future.result()
+                failed.extend(part_failed)
+                for part, (records, per_lot) in results:
+                    writer.write(records)
+                    reports.add(per_lot)
+                    derived += len(part)
+                    rows += len(records.asset) + len(records.mesh.lot)
+                written += n_lots
+                per_lot = rows / max(written, 1)
+                size = int(np.clip(ROWS_PER_CHUNK / max(per_lot, 1.0), 1, options.chunk_size))
+                if progress is not None:
+                    progress(written, len(lots))
+        except BaseException:
+            for _, future in window:
+                future.cancel()
+            raise
     return derived
 
 
-def _derive(plan, lots: Lots, options: BuildOptions, writer, failed: list[BadLot],
-            reports: Reports, foreign=None) -> tuple[int, int]:
-    """Derive ``lots`` into ``writer``, skipping failing lots and splitting oversized chunks.
+def _derive(plan, lots: Lots, options: BuildOptions, foreign=None) -> tuple[list, list[BadLot]]:
+    """Derive ``lots`` (on a worker thread), skipping failing lots and splitting oversized chunks.
 
-    Returns the number of lots derived and of records made.
+    Returns ``[(part, (records, per_lot))]`` in lot order and the lots that failed.
     """
-    derived = 0
-    rows = 0
-    for part, (records, per_lot) in _attempts(lots, lambda part: derive_chunk(
-            plan, part, seed=options.seed, limits=options.limits, overrides=options.attrs,
-            chunk_budget=options.chunk_budget, foreign=foreign), failed):
-        writer.write(records)
-        reports.add(per_lot)
-        derived += len(part)
-        rows += len(records.asset) + len(records.mesh.lot)
-    return derived, rows
+    failed: list[BadLot] = []
+    results = list(_attempts(lots, lambda part: derive_chunk(
+        plan, part, seed=options.seed, limits=options.limits, overrides=options.attrs,
+        chunk_budget=options.chunk_budget, foreign=foreign), failed))
+    return results, failed
 
 
 def _attempts(lots: Lots, derive_part, failed: list[BadLot] | None):

@@ -8,6 +8,7 @@ errors or the command line is wrong. Errors go to stderr; no output file is left
 from __future__ import annotations
 
 import argparse
+import os
 import sys
 from dataclasses import replace
 from pathlib import Path
@@ -66,6 +67,9 @@ def _parser() -> argparse.ArgumentParser:
                        help="a further folder for I() assets (the grammar's folder comes first)")
     build.add_argument("--dialect", choices=("cga2006", "cityengine"),
                        help="the grammar's notation (default: detected from its text)")
+    build.add_argument("--workers", type=_positive, default=_cores(), metavar="N",
+                       help=f"chunks derived at once, on N threads (default: the {_cores()} cores this process "
+                            "may use); the output does not depend on it")
     build.add_argument("--bake", action="store_true",
                        help="expand the instances into one mesh (.glb; .obj/.ply/.stl always are)")
     build.add_argument("--max-triangles", type=_positive, metavar="N",
@@ -120,6 +124,11 @@ def _parser() -> argparse.ArgumentParser:
                         help="a folder for file assets, instead of the grammar's folder (repeatable)")
     render.set_defaults(run=_render)
     return parser
+
+
+def _cores() -> int:
+    """The cores this process may run on (its affinity, as a container or ``taskset`` limits it)."""
+    return len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else (os.cpu_count() or 1)
 
 
 def _positive(text: str) -> int:
@@ -241,6 +250,7 @@ def _build(args) -> int:
         limits=replace(LIMITS, max_depth=args.max_depth, max_shapes=args.max_shapes),
         asset_roots=tuple(args.assets),
         dialect=args.dialect,
+        workers=args.workers,
     )
     bar = _ProgressBar() if not args.quiet else None
     try:

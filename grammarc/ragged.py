@@ -92,7 +92,7 @@ def row_groups(keys: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return groups, order[new]
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def grow(items: np.ndarray, need: int) -> np.ndarray:
     """``items`` with room for ``need`` rows (the length at least doubles), its rows kept: the append
     buffer of numba kernels that build ragged outputs of unknown size."""

@@ -251,7 +251,7 @@ def _to_float(value, env: Env):
     return out if np.ndim(value) else float(out[0])
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def elementwise(code, x):
     """Elementwise function ``code`` (see ``_MATH``) of x : (n,) float64, degrees for trigonometry."""
     out = np.empty_like(x)
@@ -279,7 +279,7 @@ def elementwise(code, x):
     return out
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def _atan2_deg(y, x):
     out = np.empty_like(y)
     for i in range(len(y)):

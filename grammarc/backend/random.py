@@ -15,7 +15,7 @@ from numba import njit
 _SEED_SALT = 0x5EED
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, nogil=True, inline="always")
 def mix1(key, value):
     """One key mixed with one integer: SplitMix64's finalizer of key ^ ((value + 1) * golden)."""
     z = key ^ ((np.uint64(value) + np.uint64(1)) * np.uint64(0x9E3779B97F4A7C15))
@@ -24,7 +24,7 @@ def mix1(key, value):
     return z ^ (z >> np.uint64(31))
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def _mix(key, value):
     out = np.empty(len(key), np.uint64)
     for i in range(len(key)):
@@ -32,7 +32,7 @@ def _mix(key, value):
     return out
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def _child_keys(key, site, index):
     out = np.empty(len(key), np.uint64)
     for i in range(len(key)):
@@ -40,7 +40,7 @@ def _child_keys(key, site, index):
     return out
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def _uniform(key, site):
     out = np.empty(len(key))
     scale = 1.0 / 9007199254740992.0  # 2**-53

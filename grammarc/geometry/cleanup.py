@@ -150,7 +150,7 @@ def _duplicate_faces(mesh: Mesh) -> np.ndarray:
     return _repeats(mesh.ids, mesh.ring_offsets, mesh.face_offsets, np.argsort(group, kind="stable"), group)
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def _merge_vertices(coords, vertex_offsets, distance):
     """Each vertex's representative (V,) int64: per mesh g (vertices vertex_offsets[g] to [g + 1]),
     taken in order of x, a vertex joins the nearest-in-x earlier representative within distance[g],
@@ -172,7 +172,7 @@ def _merge_vertices(coords, vertex_offsets, distance):
     return rep
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def _ring_keep(ids, coords, ring_offsets, sine):
     """Vertices (V,) bool that stay in their rings: a vertex goes when it repeats the one before it,
     or, where sine[r] >= 0, when the lines of its edges meet at an angle whose sine is at most sine[r]
@@ -205,7 +205,7 @@ def _ring_keep(ids, coords, ring_offsets, sine):
     return keep
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def _repeats(ids, ring_offsets, face_offsets, order, group):
     """Faces (F,) bool equal to an earlier face of their candidate group (``order`` sorts faces by
     ``group``, keeping their order within it)."""
@@ -224,7 +224,7 @@ def _repeats(ids, ring_offsets, face_offsets, order, group):
     return repeat
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def _same_face(ids, ring_offsets, face_offsets, e, f):
     """Whether faces e and f have the same rings in turn, each the same cycle either way round."""
     if face_offsets[e + 1] - face_offsets[e] != face_offsets[f + 1] - face_offsets[f]:
@@ -250,7 +250,7 @@ def _same_face(ids, ring_offsets, face_offsets, e, f):
     return True
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def _split_edges(ids, coords, ring_offsets, face_offsets, mesh_offsets, distance):
     """The rings with every vertex of their mesh that lies on one of their edges (within distance[g],
     strictly between its ends) put into that edge, in order along it: where a face's edge meets two
@@ -299,7 +299,7 @@ def _split_edges(ids, coords, ring_offsets, face_offsets, mesh_offsets, distance
     return out_ids[:n], out_coords[:n], out_r
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def _coplanar_groups(ids, ring_offsets, face_offsets, normal, cosine):
     """Each face's group (F,) int64, numbered by its first face: faces that share an edge (its two
     vertices, run in opposite directions) and whose unit normals (F, 3) meet at an angle whose cosine
@@ -338,7 +338,7 @@ def _coplanar_groups(ids, ring_offsets, face_offsets, normal, cosine):
     return root
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def _join_groups(ids, coords, ring_offsets, face_offsets, mesh_offsets, split_ids, split_coords,
                  split_rings, normal, group):
     """The mesh with each group of several faces (``group`` (F,), numbered by its first face) one face,
@@ -387,7 +387,7 @@ def _join_groups(ids, coords, ring_offsets, face_offsets, mesh_offsets, split_id
     return out_ids[:n_v], out_coords[:n_v], out_r[:n_r + 1], out_f[:n_f + 1], out_m
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def _find(root, f):
     while root[f] != f:
         root[f] = root[root[f]]
@@ -395,7 +395,7 @@ def _find(root, f):
     return f
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def _boundary(ids, coords, ring_offsets, face_offsets, faces, up):
     """The boundary of a group of faces: their rings' edges less the pairs that run between the same
     vertices in opposite directions, chained into rings. Returns the rings' vertices (indices into

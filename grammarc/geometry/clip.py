@@ -139,7 +139,7 @@ def fit_pieces(geometries: np.ndarray, plane: np.ndarray, size: np.ndarray,
                    part_plane.astype(np.int8))
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def ring_starts(coords, ring_offsets, ring_part, part_source, parent_coords, parent_rings, parent_offsets):
     """Each ring of each piece turned to start where CityEngine's clipping and offsets start it.
 
@@ -186,7 +186,7 @@ def ring_starts(coords, ring_offsets, ring_part, part_source, parent_coords, par
     return out
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def _boundary_place(px, py, g, parent_coords, parent_rings, parent_offsets):
     """The nearest point of polygon g's boundary to (px, py): its squared distance, its position (edge
     i into vertex i, ring after ring, plus the fraction along it; vertex 0 ends the last edge), the

@@ -34,7 +34,7 @@ KIND_CODES = {
 RECT, BOTTOM_POLY, TOP_POLY, SAME_POLY = 0, 1, 2, 3
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def _axes_of(plane):
     """(a, b) in-plane axes and the normal axis n of a polygon plane code."""
     if plane == 0:
@@ -44,12 +44,12 @@ def _axes_of(plane):
     return 0, 1, 2
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def _cross(a, b):
     return np.array([a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]])
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def _edge(coords, j, r0, count, a, b, size_row):
     """Ring edge from vertex j to its successor in local coordinates: start p (3,), unit direction and
     length (the direction is zero for a zero-length edge)."""
@@ -66,7 +66,7 @@ def _edge(coords, j, r0, count, a, b, size_row):
     return p, d, length
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def _put(out, m, i, o, x, y, z, s, code):
     """Write component m: parent i, origin o, axes x, y, z (rows), size s (3,), geometry code."""
     parent, origin, axes, csize, poly = out
@@ -80,7 +80,7 @@ def _put(out, m, i, o, x, y, z, s, code):
     return m + 1
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def _sizes(sx, sy):
     s = np.zeros(3)
     s[0] = sx
@@ -88,13 +88,13 @@ def _sizes(sx, sy):
     return s
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def _cap_size(size_row, a, b):
     """Size of a top or bottom face: the polygon's two in-plane extents."""
     return _sizes(size_row[a], size_row[b])
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def _count(kind, n_edges, volume):
     if volume:
         if kind == 0:
@@ -113,7 +113,7 @@ def _count(kind, n_edges, volume):
     return 0
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def components(kind, coords, ring_offsets, shape_offsets, plane, size, tol):
     """Component scopes of n shapes, in each shape's local frame.
 
@@ -232,7 +232,7 @@ def rect_plane(size: np.ndarray, tol: float) -> np.ndarray:
     return plane
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def reverse_rings(coords, ring_offsets):
     """Each ring in reverse order, keeping its first vertex first: (V, 2) float64, a new array."""
     out = np.empty_like(coords)

@@ -66,7 +66,7 @@ def _edge_directions(coords, ring_offsets, poly_offsets):
     return angle[first], offsets_from_counts(np.bincount(poly[first], minlength=len(poly_offsets) - 1))
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def _rectangles(coords, ring_offsets, poly_offsets, angle, angle_offsets, subdivisions):
     """(m, 5, 2) closed corner rings of each polygon's best rectangle over its candidate angles; NaN
     where none was found."""
@@ -91,7 +91,7 @@ def _rectangles(coords, ring_offsets, poly_offsets, angle, angle_offsets, subdiv
     return out
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def _grid(values, subdivisions):
     lo, hi = values.min(), values.max()
     steps = np.linspace(lo, hi, subdivisions + 1)
@@ -104,7 +104,7 @@ def _grid(values, subdivisions):
     return grid[keep]
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def _axis_rectangle(pts, rings, subdivisions):
     """The largest axis-aligned rectangle of whole grid cells inside the polygon (closed rings ``rings``
     into ``pts``): area, x0, y0, x1, y1."""

@@ -97,7 +97,7 @@ def ring_vector_areas(verts: np.ndarray, ring_offsets: np.ndarray) -> np.ndarray
     return np.stack([segment_reduce(np.add, cross[:, j], ring_offsets, 0.0) for j in range(3)], 1) / 2
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def face_frames(verts, ring_offsets, face_offsets, eps):
     """Scopes and polygons of faces in space (``comp(f)`` of a mesh), as CityEngine places them: x along
     the face's first edge, z its normal (the outline winds counter-clockwise around it), y = z x x;
@@ -249,7 +249,7 @@ def is_convex(verts, ring_offsets, face_offsets, mesh_offsets) -> np.ndarray:
     return _convex(verts, ring_offsets, face_offsets, mesh_offsets, scale)
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def _convex(verts, ring_offsets, face_offsets, mesh_offsets, scale):
     out = np.ones(len(mesh_offsets) - 1, np.bool_)
     for g in range(len(mesh_offsets) - 1):
@@ -275,7 +275,7 @@ def _convex(verts, ring_offsets, face_offsets, mesh_offsets, scale):
     return out
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def clip_slabs(verts, ring_offsets, face_offsets, mesh_offsets, child_mesh, axis, lo, hi, convex, eps):
     """Meshes cut to slabs ``lo <= coordinate[axis] <= hi``, convex ones closed by their cut faces.
 
@@ -372,7 +372,7 @@ def clip_slabs(verts, ring_offsets, face_offsets, mesh_offsets, child_mesh, axis
     return out_v[:n_v], out_r[: n_r + 1], out_f[: n_f + 1], out_m
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def _hull(points, a, b, eps):
     """Convex hull of points on a plane, by their coordinates a and b, counter-clockwise in (a, b)
     (Andrew's monotone chain); repeated points count once."""
@@ -406,7 +406,7 @@ def _hull(points, a, b, eps):
     return out
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def _turn(points, p, q, r, a, b):
     return ((points[q, a] - points[p, a]) * (points[r, b] - points[p, b])
             - (points[q, b] - points[p, b]) * (points[r, a] - points[p, a]))

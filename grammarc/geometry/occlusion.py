@@ -187,7 +187,7 @@ def _hulls(points: np.ndarray, keep: np.ndarray) -> np.ndarray:
     return hulls
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def box_relations(local, low, high, dirs, normals, eps):
     """``relations`` of convex queries against boxes, exactly, by separating axes (numba): corners
     ``local`` (p, c, 3) in the box's frame, the box ``low``..``high`` (p, 3), the query's edge

@@ -73,7 +73,7 @@ class PolygonStore:
         return _gather(self.coords, self.ring_offsets, self.poly_offsets, np.asarray(ids, np.int64))
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def _gather(coords, ring_offsets, poly_offsets, ids):
     """Copy polygons ``ids`` out of a ragged store.
 

@@ -44,7 +44,7 @@ ROOF_KINDS = {"roofHip": HIP, "roofGable": GABLE, "roofShed": SHED, "roofPyramid
 BREAK_SHARE = 1.0 / 3.0
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def _clean_rings(pts, ring_offsets, eps):
     """Rings without repeated vertices and without vertices between collinear edges; rings left with
     fewer than three vertices are dropped (the exterior too: then nothing is left)."""
@@ -93,7 +93,7 @@ def _clean_rings(pts, ring_offsets, eps):
     return out[:n_out], offsets[: n_rings + 1]
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def _gable_ends(node_xy, faces, face_offsets, xy, succ, eps):
     """Which edges' hip faces become gables: triangles whose apex ends a ridge (no other hip end meets
     there, or only the opposite one)."""
@@ -124,7 +124,7 @@ def _gable_ends(node_xy, faces, face_offsets, xy, succ, eps):
     return ends
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def _move_gable_ends(node_xy, node_t, faces, face_offsets, origin, ends, xy, succ, start_time):
     """Turn the gable ends vertical (in place): every node of a face that came from a gable end's hip
     face, other than its eave, moves along the edge's inward normal back onto the eave line."""
@@ -147,7 +147,7 @@ def _move_gable_ends(node_xy, node_t, faces, face_offsets, origin, ends, xy, suc
     node_xy += moves
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def _split_at(node_xy, node_t, faces, face_offsets, knee, eps):
     """Each face cut where its inset reaches ``knee``: its part below, then its part above (either may
     be missing), new nodes where face boundaries cross the knee, shared by the faces that meet there.
@@ -212,7 +212,7 @@ def _split_at(node_xy, node_t, faces, face_offsets, knee, eps):
     return xy[:n_nodes], t[:n_nodes], out[:count], offsets[: n_out + 1], origin[:n_out]
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def roof_meshes(kind, coords, ring_offsets, poly_offsets, plane, size_a, size_b, value, by_height,
                 overhang, index, cap):
     """Roof meshes of k polygons.
@@ -407,7 +407,7 @@ def roof_meshes(kind, coords, ring_offsets, poly_offsets, plane, size_a, size_b,
     return verts[:n_v], rings[: n_r + 1], faces[: n_f + 1], mesh_offsets, ok
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def _reverse_keeping_first_edge(verts, start, end):
     """Reverse a ring so that its first edge stays first (reversed): [0, 1, 2, 3] -> [1, 0, 3, 2]."""
     ring = verts[start:end].copy()

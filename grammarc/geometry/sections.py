@@ -19,7 +19,7 @@ from grammarc.constants import TOL
 from grammarc.ragged import grow, offsets_from_counts, ragged_take, rank_within, segment_of
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def plane_segments(verts, ring_offsets, face_offsets, mesh_offsets, child_mesh, cut, axis, lo, hi):
     """Segments where the faces of the meshes ``child_mesh[c]`` (for the children ``cut``) meet the
     planes ``coordinate[axis] = lo[c]`` and ``= hi[c]``.

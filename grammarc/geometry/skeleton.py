@@ -33,7 +33,7 @@ from numba import njit
 _EPS = 1e-9
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def _solve3(a0, a1, a2, b0, b1, b2, c0, c1, c2):
     """The point (x, y) and time t where three moving lines (nx, ny, c: n . x = c + t) meet; ok False
     when they never meet in one point (two of them parallel and apart, or all concurrent always)."""
@@ -47,7 +47,7 @@ def _solve3(a0, a1, a2, b0, b1, b2, c0, c1, c2):
     return dx / det, dy / det, dt / det, True
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def _vertex_at(nrm, c, e0, e1, t):
     """Where the lines of edges e0 and e1 cross at time t; ok False when they are parallel."""
     a0, a1, b0, b1 = nrm[e0, 0], nrm[e0, 1], nrm[e1, 0], nrm[e1, 1]
@@ -58,7 +58,7 @@ def _vertex_at(nrm, c, e0, e1, t):
     return (r0 * b1 - a1 * r1) / det, (a0 * r1 - r0 * b0) / det, True
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def _position(nrm, c, node_xy, node_t, start, e0, e1, v, t, eps):
     """Where vertex v (between edges e0 and e1) is at time t; a spike tip, whose lines are parallel,
     is only anywhere at the time it was made."""
@@ -68,7 +68,7 @@ def _position(nrm, c, node_xy, node_t, start, e0, e1, v, t, eps):
     return x, y, ok
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def skeleton_faces(xy, ring_offsets, start_time):
     """Faces of the straight skeleton of one polygon with holes.
 
@@ -288,7 +288,7 @@ def skeleton_faces(xy, ring_offsets, start_time):
     return node_xy[:n_nodes], node_t[:n_nodes], face_nodes, face_offsets, ok and faces_ok
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def _spike(direction, v, in_edge, out_edge):
     """Whether v's two edges run back on each other: the tip of a wavefront that folded onto itself
     (two edges whose lines met all along). Its edges do not shrink linearly, so they have no edge
@@ -297,7 +297,7 @@ def _spike(direction, v, in_edge, out_edge):
     return direction[a, 0] * direction[b, 0] + direction[a, 1] * direction[b, 1] < -1.0 + 1e-9
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def _split_candidates(v, nrm, c, direction, node_xy, node_t, start, in_edge, out_edge, alive, n_verts, eps,
                       cand_t, cand_x, cand_y, cand_e, n_cand, cand_first):
     """Where and when a reflex vertex v, from where it was made, would meet each line of the wavefront's
@@ -335,7 +335,7 @@ def _split_candidates(v, nrm, c, direction, node_xy, node_t, start, in_edge, out
     n_cand[v] = count
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def _close_pair(z, nxt, in_edge, out_edge, start, alive, arcs, n_arcs, alive_count):
     """A ring of two vertices (the new ``z`` and an older one) has no area left: the older vertex's
     path runs to z's node, and the ring is done. Rings of one vertex (a degenerate collapse) end too."""
@@ -353,7 +353,7 @@ def _close_pair(z, nxt, in_edge, out_edge, start, alive, arcs, n_arcs, alive_cou
     return n_arcs, alive_count - 2
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def _faces(arcs, n, succ):
     """The face of each input edge as a cycle of nodes: the edge from node k to node succ[k], then the
     arcs that have k on one side, each followed from the node the last one reached."""

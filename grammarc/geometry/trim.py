@@ -61,7 +61,7 @@ def side_face_planes(axes: np.ndarray, origin: np.ndarray, size: np.ndarray, par
     return out
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def boxes_crossing(planes, xform, eps):
     """Which unit boxes placed by xform (k, 3, 4) reach past one of their planes (k, 8; NaN: none) by
     more than eps: those are cut, the others stay instances."""
@@ -85,7 +85,7 @@ def boxes_crossing(planes, xform, eps):
     return out
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def trim_triangles(verts, tris, xform, planes, eps):
     """Triangles of an asset (verts (v, 3) in its unit box, tris (t, 3)) placed by xform (k, 3, 4) and
     cut by each placement's two planes (k, 8; NaN: none): the kept polygons in world coordinates.

@@ -78,7 +78,7 @@ def decompose(xform: np.ndarray, origin: np.ndarray | None = None) -> tuple[np.n
     return positions, orientations, scales
 
 
-@nb.njit(cache=True)
+@nb.njit(cache=True, nogil=True)
 def _decompose(linear, orientations, scales):
     n = linear.shape[0]
     axes = np.empty((3, 3))
@@ -117,7 +117,7 @@ def _decompose(linear, orientations, scales):
         _quaternion(axes, orientations[i])
 
 
-@nb.njit(cache=True)
+@nb.njit(cache=True, nogil=True)
 def _cross_into(a, b, axes, out):
     """``axes[:, out] = normalize(a x b)``."""
     x = a[1] * b[2] - a[2] * b[1]
@@ -127,7 +127,7 @@ def _cross_into(a, b, axes, out):
     axes[0, out], axes[1, out], axes[2, out] = x / norm, y / norm, z / norm
 
 
-@nb.njit(cache=True)
+@nb.njit(cache=True, nogil=True)
 def _quaternion(m, out):
     """(x, y, z, w) of the rotation matrix ``m`` (Shepperd's method: the largest of the four divisors)."""
     trace = m[0, 0] + m[1, 1] + m[2, 2]

@@ -41,7 +41,7 @@ import numpy as np
 from numba import njit
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def project(points, lens, perspective, out):
     """Pixel coordinates and nearness of camera-space ``points`` (n, 3) float64 into ``out`` (n, 3) float64:
     columns x, y (pixels, continuous) and nearness (larger is nearer). Returns ``out``."""
@@ -59,7 +59,7 @@ def project(points, lens, perspective, out):
     return out
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def draw_triangles(cam, screen, faces, rgb, near, perspective, light, image, depth):
     """Draw triangles given by their vertices, in order: the mesh table's polygons.
 
@@ -74,7 +74,7 @@ def draw_triangles(cam, screen, faces, rgb, near, perspective, light, image, dep
         _fill(cam, screen, a, b, c, rgb[t, 0], rgb[t, 1], rgb[t, 2], perspective, light, image, depth)
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def draw_instances(xform, rgb, asset, vertex_offsets, face_offsets, vertices, faces, detail_px, splat_px,
                    view, lens, perspective, light, image, depth):
     """Draw every instance, in record order, as a splat, its box or its asset's triangles (module docstring).
@@ -149,7 +149,7 @@ def draw_instances(xform, rgb, asset, vertex_offsets, face_offsets, vertices, fa
     return counts
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def _fill(cam, screen, a, b, c, red, green, blue, perspective, light, image, depth):
     """Rasterize triangle (a, b, c), indices into ``cam`` and ``screen`` (see ``draw_triangles``)."""
     height, width = depth.shape
@@ -185,7 +185,7 @@ def _fill(cam, screen, a, b, c, red, green, blue, perspective, light, image, dep
             _put(image, depth, j, i, (wa * ka + wb * kb + wc * kc) / (sign * area), r, g, bl)
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def _splat(frame, x0, x1, y0, y1, red, green, blue, perspective, light, image, depth):
     """Fill the pixels whose centres lie in [x0, x1] x [y0, y1], at least the one under its centre, at the
     depth of the box's centre, shaded by its faces that face the eye; none if no face does (module
@@ -222,7 +222,7 @@ def _splat(frame, x0, x1, y0, y1, red, green, blue, perspective, light, image, d
             _put(image, depth, j, i, key, r, g, b)
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def _face_light(ux, uy, uz, vx, vy, vz, px, py, pz, perspective, light):
     """How much of a flat face the eye sees, and its shade: the plane through p spanned by u and v.
 
@@ -243,7 +243,7 @@ def _face_light(ux, uy, uz, vx, vy, vz, px, py, pz, perspective, light):
     return abs(facing), light[3] + light[4] * max(lit, 0.0)
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def _put(image, depth, j, i, key, red, green, blue):
     """Write pixel (row j, column i) if ``key`` is strictly nearer than what it holds."""
     if key > depth[j, i]:
@@ -253,7 +253,7 @@ def _put(image, depth, j, i, key, red, green, blue):
         image[j, i, 2] = blue
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def _shaded(channel, shade):
     """A colour channel (0-255) times ``shade``, rounded and clipped to a byte."""
     return np.uint8(min(255.0, channel * shade + 0.5))

@@ -216,6 +216,7 @@ def test_same_seed_same_records_and_chunking_does_not_matter(write):
     _same(base, run(write, SECTION_4, polygons, seed=7))
     _same(base, run(write, SECTION_4, polygons, seed=7, chunk_size=1))
     _same(base, run(write, SECTION_4, polygons, seed=7, chunk_size=3))
+    _same(base, run(write, SECTION_4, polygons, seed=7, chunk_size=2, workers=2))
     other = run(write, SECTION_4, polygons, seed=8)
     assert not np.array_equal(base["xform"], other["xform"])
 
@@ -229,6 +230,10 @@ def test_chunk_split_on_budget_keeps_records(write):
 def test_negative_size_lot_is_reported_and_skipped(write):
     r = run(write, 'lot ~> S(Scope.sx - 11, 1, 1r) I("cube")\n', [rect(12, 5), rect(10, 5), rect(20, 5)])
     assert list(np.unique(r["lot"])) == [0, 2]
+    on_threads = run(write, 'lot ~> S(Scope.sx - 11, 1, 1r) I("cube")\n', [rect(12, 5), rect(10, 5), rect(20, 5)],
+                     chunk_size=1, workers=2)
+    _same(r, on_threads)
+    assert on_threads["bad"] == r["bad"]
     assert len(r["bad"]) == 1 and r["bad"][0].index == 1
     assert "negative or NaN size" in r["bad"][0].reason and "g.cga:1" in r["bad"][0].reason
 

@@ -6,7 +6,7 @@ import numpy as np
 from numba import njit
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def group_by(group, k):
     """Stable counting sort of children by body part: ``order`` (m,) int64 and ``offsets`` (k+1,) int64.
 
@@ -27,7 +27,7 @@ def group_by(group, k):
     return order, offsets
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def scatter_rows(src, dest, out):
     """out[dest[i]] = src[i] for rows of 2-D arrays: src (k, w), dest (k,) int64, out (N, w)."""
     for i in range(len(dest)):

@@ -12,7 +12,7 @@ from numba import njit
 from grammarc.backend.random import mix1
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def place_children(origin, size, key, frame, geom, lot, depth, frames, axis, order, parent, pos, length,
                    site, index):
     """Columns of split children, in the order ``order`` (children grouped by body part).
@@ -50,7 +50,7 @@ def place_children(origin, size, key, frame, geom, lot, depth, frames, axis, ord
     return out_origin, out_size, out_key, out_frame, out_geom, out_lot, out_depth, out_parent
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def xforms(frames, frame, size, origin):
     """Record transforms (n, 3, 4) float32: column j = scope axis j * size j, column 3 = origin."""
     n = len(frame)

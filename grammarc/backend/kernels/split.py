@@ -11,7 +11,7 @@ import numpy as np
 from numba import njit
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def subdiv(extent, values, relative, tol):
     """Sizes of ``Subdiv`` parts (paper section 2, "Basic split rule" and "Scaling of rules").
 
@@ -71,7 +71,7 @@ def subdiv(extent, values, relative, tol):
     return parent, part, out_pos, out_len
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def repeat_counts(extent, size, tol):
     """Elements of ``Repeat``: ceil(extent / size) per shape (paper section 2, "Repeat"), (n,) int64.
 
@@ -86,7 +86,7 @@ def repeat_counts(extent, size, tol):
     return counts
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def repeat(extent, counts):
     """Children of ``Repeat``: each shape's extent cut into counts[i] equal elements.
 
@@ -116,7 +116,7 @@ def repeat(extent, counts):
 
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def group_split(extent, values, kind, group, n_groups, tol):
     """Parts of CityEngine's ``split`` with absolute, relative and floating sizes and repeat groups.
 
@@ -228,7 +228,7 @@ def group_split(extent, values, kind, group, n_groups, tol):
     return parent[:m], part[:m], pos[:m], length[:m], index[:m]
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def _repetitions(share, nominal, fixed, floating, loose, tol):
     """How often a group with floating parts repeats in ``share``: the count whose stretch (share over
     the repetitions' nominal size) is nearest 1 as a ratio, so 1.74 rounds to 2 and 2.44 to 2
@@ -247,7 +247,7 @@ def _repetitions(share, nominal, fixed, floating, loose, tol):
     return 1 if abs(np.log(with_one)) < abs(np.log(without)) else 0
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def _part_size(value, kind, extent, scale):
     if kind == 1:
         return value * extent
@@ -256,7 +256,7 @@ def _part_size(value, kind, extent, scale):
     return value
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def _place(parent, part, pos, length, index, m, i, j, at, size, extent, tol, child):
     """Lay one part at ``at``; cut at the extent, drop if empty. Returns (m, next position, child)."""
     end = min(at + size, extent)
@@ -271,7 +271,7 @@ def _place(parent, part, pos, length, index, m, i, j, at, size, extent, tol, chi
     return m, at + size, child
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def snap_subdiv(parent, pos, length, offsets, snaps):
     """Subdiv children moved to snap planes (paper section 3.3, Fig. 9 right): each snap position of a
     parent moves the line between two of its consecutive children nearest to it there, if both keep a
