@@ -14,11 +14,11 @@ written.
 
 from __future__ import annotations
 
+import contextlib
 import time
 from collections import deque
 from collections.abc import Sequence
-from concurrent.futures import ThreadPoolExecutor
-from contextlib import contextmanager
+from concurrent.futures import Future, ThreadPoolExecutor
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 
@@ -102,7 +102,7 @@ def build(grammar_path, output, *, lots_path=None, options: BuildOptions = Build
                       reports_to=reports_to)
 
 
-@contextmanager
+@contextlib.contextmanager
 def grammar_source(path: Path, options: BuildOptions):
     """The rule file to compile and the options to use: a ``.rpk`` package is extracted for the
     duration of the build, its main rule file compiled, its assets and start rule used."""
@@ -217,13 +217,15 @@ def _derive_all(plan, lots: Lots, options: BuildOptions, writer, failed: list[Ba
     foreign = _occluders(plan, lots if context is None else context, options) if plan.inter else None
     if foreign is not None:
         foreign.index  # noqa: B018 - built once here, before threads share it
-    with ThreadPoolExecutor(max_workers=options.workers, thread_name_prefix="derive") as pool:
+    threads = ThreadPoolExecutor(options.workers, "derive") if options.workers > 1 else None
+    with threads or contextlib.nullcontext():
+        submit = threads.submit if threads else _at_once
         window: deque = deque()
         try:
             while first < len(lots) or window:
                 while first < len(lots) and len(window) < options.workers:
                     part = lots.take(slice(first, first + size))
-                    window.append((len(part), pool.submit(_derive, plan, part, options, foreign)))
+                    window.append((len(part), submit(_derive, plan, part, options, foreign)))
                     first += len(part)
                 n_lots, future = window.popleft()
                 results, part_failed = future.result()
@@ -243,6 +245,17 @@ def _derive_all(plan, lots: Lots, options: BuildOptions, writer, failed: list[Ba
                 future.cancel()
             raise
     return derived
+
+
+def _at_once(fn, *args) -> Future:
+    """``fn(*args)`` run now, on this thread, as a finished future: one worker needs no thread (and a
+    profiler then sees the derivation)."""
+    future: Future = Future()
+    try:
+        future.set_result(fn(*args))
+    except BaseException as error:  # noqa: BLE001 - handed to the caller by future.result()
+        future.set_exception(error)
+    return future
 
 
 def _derive(plan, lots: Lots, options: BuildOptions, foreign=None) -> tuple[list, list[BadLot]]:

@@ -1,0 +1,158 @@
+"""GeoParquet lots (the ``parquet`` extra, pyarrow): a city's footprints read as columns.
+
+GeoJSON makes a Python object of every coordinate: reading 10^5 lots takes seconds and most of a build's
+memory. A GeoParquet file holds the footprints as WKB in one column and the properties as typed columns;
+``read_geoparquet`` decodes the WKB with shapely (GEOS, vectorized) and takes the rings as ragged arrays
+(``shapely.to_ragged_array``), so no Python object is made per lot but its id.
+
+The lots are the same as the GeoJSON's (``io.lots.read_lots``): a Polygon is a lot, a MultiPolygon a lot
+per polygon (ids ``"<id>:<k>"``), any other geometry a bad lot; the id is the ``id`` column, else
+``name``, else the row number; the other columns are properties (numbers as float64 with nan for
+nulls, the rest as text), and a list column ``streetWidth`` marks street edges as in GeoJSON.
+``write_geoparquet`` writes lots back (``grammarc lots IN OUT.parquet`` converts a GeoJSON once).
+"""
+
+from __future__ import annotations
+
+import json
+import os
+from pathlib import Path
+
+import numpy as np
+import shapely
+
+from grammarc.errors import LotsError, UsageError
+from grammarc.io.lots import STREET_WIDTH, Lots, _Builder, _street_flags
+from grammarc.io.lots import _column as json_column
+
+__all__ = ["read_geoparquet", "write_geoparquet"]
+
+_POLYGON, _MULTIPOLYGON = 3, 6
+
+
+def _parquet():
+    try:
+        import pyarrow as pa
+        import pyarrow.parquet as pq
+    except ImportError as error:
+        raise UsageError("GeoParquet lots need pyarrow: pip install 'grammarc[parquet]' (or pip install "
+                         "pyarrow)") from error
+    return pa, pq
+
+
+def read_geoparquet(path: str | os.PathLike) -> tuple[_Builder, dict[str, np.ndarray]]:
+    """The lots of a GeoParquet file, for ``_Builder.finish``: the builder and the property columns."""
+    pa, pq = _parquet()
+    try:
+        table = pq.read_table(path)
+    except (OSError, pa.ArrowInvalid) as error:
+        raise LotsError(f"cannot read lots file {path}: {error}") from error
+    geo = json.loads((table.schema.metadata or {}).get(b"geo", b"{}"))
+    column = geo.get("primary_column", "geometry")
+    encoding = geo.get("columns", {}).get(column, {}).get("encoding", "WKB")
+    if column not in table.column_names or encoding.upper() != "WKB":
+        raise LotsError(f"{path}: no WKB geometry column (GeoParquet's `geo` metadata names "
+                        f"{column!r}, encoding {encoding!r})")
+    try:
+        geometry = shapely.from_wkb(table.column(column).to_numpy(zero_copy_only=False))
+    except shapely.errors.GEOSException as error:
+        raise LotsError(f"{path}: bad WKB in column {column!r}: {error}") from error
+    n = len(geometry)
+    names = [c for c in table.column_names if c != column]
+    ids = _ids(table, names, n)
+
+    kind = shapely.get_type_id(geometry)
+    good = np.isin(kind, (_POLYGON, _MULTIPOLYGON)) & ~shapely.is_empty(geometry)
+    parts, feature = shapely.get_parts(geometry[good], return_index=True)
+    feature = np.flatnonzero(good)[feature]
+    # lots are numbered in file order: a feature's parts, then the next feature's
+    per_feature = np.where(good, 0, 1)  # a bad feature takes one number, as in GeoJSON
+    np.add.at(per_feature, feature, 1)
+    first = np.cumsum(per_feature) - per_feature
+    k = np.arange(len(parts)) - np.searchsorted(feature, feature)  # part number within its feature
+    index = first[feature] + k
+    multi = kind[feature] == _MULTIPOLYGON
+    lot_ids = [f"{ids[f]}:{j}" if m else ids[f] for f, j, m in zip(feature.tolist(), k.tolist(), multi.tolist())]
+
+    builder = _Builder(world=False)
+    for f in np.flatnonzero(~good):
+        what = "empty polygon" if kind[f] in (_POLYGON, _MULTIPOLYGON) else f"not a polygon ({_type_name(kind[f])})"
+        builder.reject(int(first[f]), ids[f], what)
+    columns = {name: _column(table.column(name), pa) for name in names if name not in ("id", STREET_WIDTH)}
+    widths = table.column(STREET_WIDTH).to_pylist() if STREET_WIDTH in names else None
+    if widths is not None:  # only files with street widths pay a loop over their lots
+        exterior = shapely.get_num_coordinates(shapely.get_exterior_ring(parts))
+        keep = np.ones(len(parts), dtype=bool)
+        for lot in range(len(parts)):
+            value = widths[feature[lot]]
+            problem = _street_flags(value, np.zeros((exterior[lot], 2))) if value is not None else None
+            if isinstance(problem, str):
+                keep[lot] = False
+                builder.reject(int(index[lot]), lot_ids[lot], problem)
+        parts, feature, index = parts[keep], feature[keep], index[keep]
+        lot_ids = [i for i, kept in zip(lot_ids, keep) if kept]
+    attrs = {name: values[feature] for name, values in columns.items()}
+    if len(parts):
+        _, coords, (ring_offsets, lot_offsets) = shapely.to_ragged_array(parts)
+        street = np.zeros(len(coords), dtype=bool)
+        if widths is not None:
+            for lot, start in enumerate(ring_offsets[lot_offsets[:-1]].tolist()):
+                value = widths[feature[lot]]
+                if value is not None:
+                    street[start:start + len(value)] = np.asarray(value, dtype=np.float64) > 0
+        builder.add_block(index, lot_ids, coords[:, :2], np.diff(ring_offsets), np.diff(lot_offsets), street)
+    return builder, attrs
+
+
+def _column(values, pa) -> np.ndarray:
+    """A property column as GeoJSON's are typed (``io.lots._column``): numbers and booleans float64 with
+    nan for nulls, anything else text (object, None for nulls); read by type, not value by value."""
+    kind = values.type
+    if pa.types.is_integer(kind) or pa.types.is_floating(kind) or pa.types.is_boolean(kind) or pa.types.is_null(kind):
+        return values.cast(pa.float64()).to_numpy(zero_copy_only=False).astype(np.float64)
+    if pa.types.is_string(kind) or pa.types.is_large_string(kind):
+        return values.to_numpy(zero_copy_only=False).astype(object)
+    return json_column(values.to_pylist())
+
+
+def _ids(table, names: list[str], n: int) -> list[str]:
+    for name in ("id", "name"):
+        if name in names:
+            values = table.column(name).to_pylist()
+            return [str(v) if v is not None else str(i) for i, v in enumerate(values)]
+    return [str(i) for i in range(n)]
+
+
+def _type_name(type_id: int) -> str:
+    return {0: "Point", 1: "LineString", 2: "LinearRing", 4: "MultiPoint", 5: "MultiLineString",
+            7: "GeometryCollection"}.get(int(type_id), "null geometry")
+
+
+def write_geoparquet(lots: Lots, path: str | os.PathLike) -> None:
+    """Write lots as GeoParquet (WKB polygons in map coordinates, ids, properties, street widths 1/0),
+    atomically."""
+    pa, pq = _parquet()
+    path = Path(path)
+    xy = np.column_stack([lots.vertices[:, 0], np.subtract(0.0, lots.vertices[:, 2])])
+    # closed rings, as WKB has them
+    counts = np.diff(lots.ring_offsets)
+    starts = lots.ring_offsets[:-1]
+    at = np.insert(np.arange(len(xy)), lots.ring_offsets[1:], starts)
+    closed = xy[at]
+    ring_offsets = np.concatenate([[0], np.cumsum(counts + 1)])
+    polygons = shapely.from_ragged_array(shapely.GeometryType.POLYGON, closed, (ring_offsets, lots.lot_offsets))
+    exterior = lots.ring_offsets[lots.lot_offsets[:-1]]
+    ends = lots.ring_offsets[lots.lot_offsets[:-1] + 1]
+    widths = [lots.street[a:b].astype(float).tolist() for a, b in zip(exterior.tolist(), ends.tolist())]
+    columns = {"id": pa.array([str(i) for i in lots.ids]),
+               "geometry": pa.array(shapely.to_wkb(polygons), type=pa.binary())}
+    for name, values in lots.attrs.items():
+        columns[name] = pa.array(values.tolist())
+    if lots.street.any():
+        columns[STREET_WIDTH] = pa.array(widths, type=pa.list_(pa.float64()))
+    geo = {"version": "1.0.0", "primary_column": "geometry",
+           "columns": {"geometry": {"encoding": "WKB", "geometry_types": ["Polygon"]}}}
+    table = pa.table(columns).replace_schema_metadata({"geo": json.dumps(geo)})
+    tmp = path.with_name(f".{path.name}.tmp")
+    pq.write_table(table, tmp)
+    os.replace(tmp, path)

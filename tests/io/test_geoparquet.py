@@ -1,0 +1,75 @@
+"""GeoParquet lots read as the same lots as the GeoJSON they were converted from, bad ones included."""
+
+import json
+
+import numpy as np
+import pytest
+
+pa = pytest.importorskip("pyarrow")
+import pyarrow.parquet as pq
+import shapely
+
+from grammarc.cli import main
+from grammarc.io.geoparquet import write_geoparquet
+from grammarc.io.lots import read_lots
+
+FEATURES = [
+    {"type": "Feature", "id": "a", "properties": {"kind": "house", "h": 12, "streetWidth": [8, 0, 0, 0]},
+     "geometry": {"type": "Polygon", "coordinates": [[[0, 0], [20, 0], [20, 15], [0, 15], [0, 0]]]}},
+    {"type": "Feature", "id": "line", "properties": {"kind": "x", "h": None},
+     "geometry": {"type": "LineString", "coordinates": [[0, 0], [5, 5]]}},
+    {"type": "Feature", "id": "m", "properties": {"kind": "court", "h": 7.5},
+     "geometry": {"type": "MultiPolygon", "coordinates": [
+         [[[40, 0], [80, 0], [80, 40], [40, 40], [40, 0]], [[50, 10], [50, 30], [70, 30], [70, 10], [50, 10]]],
+         [[[100, 0], [110, 0], [110, 10], [100, 0]]]]}},
+    {"type": "Feature", "id": "bad-width", "properties": {"kind": "house", "h": 3, "streetWidth": [1, 2]},
+     "geometry": {"type": "Polygon", "coordinates": [[[0, 30], [10, 30], [10, 40], [0, 40], [0, 30]]]}},
+]
+
+
+def same(a, b, numbers=True):
+    assert list(a.ids) == list(b.ids)
+    assert a.index.tolist() == b.index.tolist() or not numbers
+    for key in ("vertices", "ring_offsets", "lot_offsets", "street"):
+        np.testing.assert_array_equal(getattr(a, key), getattr(b, key))
+    assert list(a.attrs) == list(b.attrs)
+    for name in a.attrs:
+        assert a.attrs[name].dtype == b.attrs[name].dtype
+        assert a.attrs[name].astype(str).tolist() == b.attrs[name].astype(str).tolist()
+
+
+def test_a_parquet_file_gives_the_lots_of_its_geojson(tmp_path):
+    """Written from the features directly (a GIS tool's GeoParquet): the same lots, the same bad lots."""
+    path = tmp_path / "lots.geojson"
+    path.write_text(json.dumps({"type": "FeatureCollection", "features": FEATURES}))
+    geometry = [shapely.from_geojson(json.dumps(f["geometry"])) for f in FEATURES]
+    table = pa.table({
+        "id": [f["id"] for f in FEATURES],
+        "kind": [f["properties"]["kind"] for f in FEATURES],
+        "h": pa.array([f["properties"]["h"] for f in FEATURES], type=pa.float64()),
+        "streetWidth": [f["properties"].get("streetWidth") for f in FEATURES],
+        "geometry": shapely.to_wkb(geometry),
+    }).replace_schema_metadata({"geo": json.dumps({"primary_column": "geometry",
+                                                   "columns": {"geometry": {"encoding": "WKB"}}})})
+    pq.write_table(table, tmp_path / "lots.parquet")
+    geojson, parquet = read_lots(path), read_lots(tmp_path / "lots.parquet")
+    same(geojson, parquet)
+    assert parquet.ids.tolist() == ["a", "m:0", "m:1"] and parquet.street.sum() == 1
+    assert parquet.bad == geojson.bad and [b.id for b in parquet.bad] == ["line", "bad-width"]
+
+
+def test_lots_command_converts_and_the_conversion_reads_back(tmp_path, capsys):
+    path = tmp_path / "lots.geojson"
+    path.write_text(json.dumps({"type": "FeatureCollection", "features": FEATURES}))
+    assert main(["lots", str(path), "--to", str(tmp_path / "out.parquet")]) == 0
+    assert "3 lots, 2 bad" in capsys.readouterr().out
+    same(read_lots(path), read_lots(tmp_path / "out.parquet"), numbers=False)  # the bad lots are left out
+    assert main(["lots", str(path), "--to", str(tmp_path / "out.json")]) == 2
+
+
+def test_write_geoparquet_round_trips_a_city(tmp_path):
+    city = read_lots(__import__("pathlib").Path(__file__).parents[2] / "examples" / "city" / "city.geojson")
+    write_geoparquet(city, tmp_path / "city.parquet")
+    back = read_lots(tmp_path / "city.parquet")
+    assert back.ids.tolist() == city.ids.tolist()
+    np.testing.assert_allclose(back.vertices, city.vertices)
