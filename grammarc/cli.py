@@ -56,8 +56,8 @@ def _parser() -> argparse.ArgumentParser:
                        help="override an attribute for every lot (repeatable)")
     build.add_argument("--start", metavar="SYMBOL",
                        help="start symbol (default: @StartRule, else the first rule's)")
-    build.add_argument("--chunk-size", type=_positive, default=4096, metavar="N",
-                       help="at most N lots derived together (default 4096; fewer when lots make many "
+    build.add_argument("--chunk-size", type=_positive, default=16384, metavar="N",
+                       help="at most N lots derived together (default 16384; fewer when lots make many "
                             "records); the output does not depend on it")
     build.add_argument("--max-depth", type=_positive, default=LIMITS.max_depth, metavar="N",
                        help=f"rule applications along one path (default {LIMITS.max_depth})")
