@@ -15,10 +15,11 @@ written.
 from __future__ import annotations
 
 import contextlib
+import multiprocessing
 import time
 from collections import deque
 from collections.abc import Sequence
-from concurrent.futures import Future, ThreadPoolExecutor
+from concurrent.futures import Future, ProcessPoolExecutor
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 
@@ -57,7 +58,7 @@ class BuildOptions:
     chunk_budget: int = CHUNK_BUDGET
     #: ``cga2006`` or ``cityengine``; detected from the grammar's text when None.
     dialect: str | None = None
-    #: Chunks derived at once, on as many threads (``_derive_all``); the output does not depend on it.
+    #: Chunks derived at once, in as many processes (``_workers``); the output does not depend on it.
     workers: int = 1
 
 
@@ -206,10 +207,9 @@ def _derive_all(plan, lots: Lots, options: BuildOptions, writer, failed: list[Ba
     queries look at other lots is derived twice: first for everyone's occluders (``_occluders``), those of
     ``context`` when given (the whole city of a selection).
 
-    ``options.workers`` chunks are derived at once on as many threads: the kernels release the GIL
-    (``nogil``), as numpy does for large arrays, so the cores share the work. Results are written in
-    chunk order, and a chunk's size is decided from the chunks finished before it in that order, so the
-    chunking does not depend on timing (and the records never depend on the chunking).
+    ``options.workers`` chunks are derived at once, each in a worker process (``_workers``). Results are
+    written in chunk order, and a chunk's size is decided from the chunks finished before it in that
+    order, so the chunking does not depend on timing (and the records never depend on the chunking).
     """
     derived = 0
     first = 0
@@ -218,16 +218,14 @@ def _derive_all(plan, lots: Lots, options: BuildOptions, writer, failed: list[Ba
     written = 0
     foreign = _occluders(plan, lots if context is None else context, options) if plan.inter else None
     if foreign is not None:
-        foreign.index  # noqa: B018 - built once here, before threads share it
-    threads = ThreadPoolExecutor(options.workers, "derive") if options.workers > 1 else None
-    with threads or contextlib.nullcontext():
-        submit = threads.submit if threads else _at_once
+        foreign.index  # noqa: B018 - built once here, before the workers inherit it
+    with _workers(plan, options, foreign) as submit:
         window: deque = deque()
         try:
             while first < len(lots) or window:
                 while first < len(lots) and len(window) < options.workers:
                     part = lots.take(slice(first, first + size))
-                    window.append((len(part), submit(_derive, plan, part, options, foreign)))
+                    window.append((len(part), submit(part)))
                     first += len(part)
                 n_lots, future = window.popleft()
                 results, part_failed = future.result()
@@ -249,15 +247,42 @@ def _derive_all(plan, lots: Lots, options: BuildOptions, writer, failed: list[Ba
     return derived
 
 
-def _at_once(fn, *args) -> Future:
-    """``fn(*args)`` run now, on this thread, as a finished future: one worker needs no thread (and a
-    profiler then sees the derivation)."""
-    future: Future = Future()
+#: What a worker process derives with: set in the parent before the workers are forked, so the plan
+#: (with its compiled kernels) and the occluders are inherited, not pickled.
+_WORKER: dict = {}
+
+
+@contextlib.contextmanager
+def _workers(plan, options: BuildOptions, foreign):
+    """``submit(lots) -> Future`` of ``_derive(plan, lots, options, foreign)``.
+
+    With one worker, or where processes cannot be forked (Windows), the chunk is derived at once in this
+    process (and a profiler sees it). Otherwise in ``options.workers`` forked processes: the derivation
+    is mostly Python driving numpy and numba over columns, so threads would share one interpreter
+    lock (measured: no gain on two cores), while processes use both. Each chunk's lots go to a worker
+    and its records come back pickled, ~60 bytes a record, which costs far less than deriving them.
+    """
+    if options.workers == 1 or "fork" not in multiprocessing.get_all_start_methods():
+        def at_once(lots: Lots) -> Future:
+            future: Future = Future()
+            try:
+                future.set_result(_derive(plan, lots, options, foreign))
+            except BaseException as error:  # noqa: BLE001 - handed to the caller by future.result()
+                future.set_exception(error)
+            return future
+
+        yield at_once
+        return
+    _WORKER.update(plan=plan, options=options, foreign=foreign)
     try:
-        future.set_result(fn(*args))
-    except BaseException as error:  # noqa: BLE001 - handed to the caller by future.result()
-        future.set_exception(error)
-    return future
+        with ProcessPoolExecutor(options.workers, mp_context=multiprocessing.get_context("fork")) as pool:
+            yield lambda lots: pool.submit(_derive_in_worker, lots)
+    finally:
+        _WORKER.clear()
+
+
+def _derive_in_worker(lots: Lots):
+    return _derive(_WORKER["plan"], lots, _WORKER["options"], _WORKER["foreign"])
 
 
 def _derive(plan, lots: Lots, options: BuildOptions, foreign=None) -> tuple[list, list[BadLot]]:

@@ -68,7 +68,7 @@ def _parser() -> argparse.ArgumentParser:
     build.add_argument("--dialect", choices=("cga2006", "cityengine"),
                        help="the grammar's notation (default: detected from its text)")
     build.add_argument("--workers", type=_positive, default=_cores(), metavar="N",
-                       help=f"chunks derived at once, on N threads (default: the {_cores()} cores this process "
+                       help=f"chunks derived at once, in N processes (default: the {_cores()} cores this process "
                             "may use); the output does not depend on it")
     build.add_argument("--bake", action="store_true",
                        help="expand the instances into one mesh (.glb; .obj/.ply/.stl always are)")
