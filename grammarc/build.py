@@ -131,7 +131,7 @@ def _build(source: Path, display: str | None, grammar_path: Path, output, lots_p
                               dialect=options.dialect, display=display)
     plan = make_plan(grammar)
     check_overrides(grammar.module, options.attrs)
-    writer_class = writer_for(output, output_options)
+    writer_class = writer_for(output, replace(output_options, asset_roots=tuple(grammar.asset_roots)))
     Path(output).parent.mkdir(parents=True, exist_ok=True)
     every = load_lots(grammar_path, Path(lots_path) if lots_path else None)
     lots = every if select is None else every.select(select)

@@ -17,14 +17,14 @@ from pathlib import Path
 
 from grammarc.errors import UsageError
 
-_BAKED = ("grammarc.io.bake", "BakedWriter", ("lod", "max_triangles"))
+_BAKED = ("grammarc.io.bake", "BakedWriter", ("lod", "max_triangles", "asset_roots"))
 #: Output extension -> (module, writer class, the ``OutputOptions`` fields it takes).
 WRITERS = {
     ".npz": ("grammarc.io.npz", "InstanceWriter", ()),
-    ".usda": ("grammarc.io.usd", "UsdWriter", ("lod", "tile_size")),
-    ".usdc": ("grammarc.io.usd", "UsdWriter", ("lod", "tile_size")),
-    ".usd": ("grammarc.io.usd", "UsdWriter", ("lod", "tile_size")),
-    ".glb": ("grammarc.io.gltf", "GltfWriter", ("lod", "tile_size")),
+    ".usda": ("grammarc.io.usd", "UsdWriter", ("lod", "tile_size", "asset_roots")),
+    ".usdc": ("grammarc.io.usd", "UsdWriter", ("lod", "tile_size", "asset_roots")),
+    ".usd": ("grammarc.io.usd", "UsdWriter", ("lod", "tile_size", "asset_roots")),
+    ".glb": ("grammarc.io.gltf", "GltfWriter", ("lod", "tile_size", "asset_roots")),
     ".obj": _BAKED,
     ".ply": _BAKED,
     ".stl": _BAKED,
@@ -37,12 +37,14 @@ BAKEABLE = (".obj", ".ply", ".stl", ".glb")
 class OutputOptions:
     """How a record is written, beyond its rows: ``bake`` instances into meshes (at most ``max_triangles``),
     the level of detail of assets (``io.bake.load_asset``), the tile edge of the instanced formats
-    (``io.instancing``). None: the writer's default."""
+    (``io.instancing``), the folders assets are loaded from (the build gives the grammar's, a rule
+    package's while it is extracted, and ``--assets``). None: the writer's default."""
 
     bake: bool = False
     lod: str | None = None
     tile_size: float | None = None
     max_triangles: int | None = None
+    asset_roots: tuple | None = None
 
 
 def writer_for(path: str | Path, options: OutputOptions = OutputOptions()):

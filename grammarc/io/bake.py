@@ -57,7 +57,7 @@ from grammarc.constants import LIMITS
 from grammarc.errors import AssetError, UsageError
 from grammarc.io.assets import builtin_name, resolve_asset
 from grammarc.io.npz import MeshChunk, TerminalChunk
-from grammarc.io.obj import ObjError, read_obj
+from grammarc.io.obj import ObjError, obj_bytes, read_obj
 from grammarc.ragged import fan_out, offsets_from_counts, segment_reduce
 
 if TYPE_CHECKING:
@@ -762,12 +762,8 @@ class BakedWriter:
         """The file's bytes. OBJ without normals or texture (the bake has neither), a header naming
         the grammar; PLY and STL binary; GLB as trimesh writes a scene of one mesh."""
         if self._file_type == "obj":
-            from trimesh.exchange.obj import export_obj
-
             header = f"grammarc {self._meta.get('grammarc', '')} bake of {self._meta.get('grammar', '')}"
-            text = export_obj(mesh, include_normals=False, include_color=False, include_texture=False,
-                              header=" ".join(header.split()))
-            return text.encode("utf-8")
+            return obj_bytes(mesh.vertices, mesh.faces, " ".join(header.split()))
         mesh.metadata = {}  # glb writes metadata as extras; keep the file to geometry
         data = mesh.export(file_type=self._file_type)
         return data if isinstance(data, bytes) else data.encode("utf-8")

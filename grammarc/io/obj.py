@@ -1,4 +1,4 @@
-"""Wavefront OBJ geometry: vertices and polygon faces, nothing else.
+"""Wavefront OBJ geometry: vertices and polygon faces, nothing else; read, and written fast.
 
 Lots (one per face) and assets (meshes fitted to scopes) are read from OBJ files; both want only the
 ``v`` and ``f`` lines. Materials, texture coordinates and normals are ignored (they would need Pillow and
@@ -8,6 +8,7 @@ are not part of grammarc's records), and so is every other line.
 from __future__ import annotations
 
 import numpy as np
+from numba import njit
 
 
 class ObjError(ValueError):
@@ -38,3 +39,86 @@ def read_obj(text: str, path: str = "<obj>") -> tuple[np.ndarray, list[np.ndarra
         except ValueError as error:
             raise ObjError(f"{path}:{number}: bad {fields[0]!r} line: {line.strip()!r} ({error})") from error
     return np.array(points, dtype=np.float64).reshape(-1, 3), faces
+
+
+#: Decimals of the coordinates ``obj_bytes`` writes: a micrometre, below the float32 step of a record's
+#: coordinates beyond 10 m from the origin.
+DECIMALS = 6
+
+
+def obj_bytes(vertices: np.ndarray, faces: np.ndarray, header: str = "") -> bytes:
+    """An OBJ file of ``vertices`` (V, 3) and triangles ``faces`` (T, 3) (0-based), as bytes.
+
+    A baked city has 10^7 triangles and more; formatting them with Python's ``str.format`` (as trimesh
+    does) took 15 s for 50 candler buildings. Here a numba kernel writes the digits into one buffer:
+    coordinates in fixed point with ``DECIMALS`` decimals, trailing zeros dropped; indices 1-based.
+    """
+    vertices = np.ascontiguousarray(vertices, dtype=np.float64)
+    faces = np.ascontiguousarray(faces, dtype=np.int64)
+    if not np.isfinite(vertices).all():
+        raise ValueError("obj_bytes: vertices must be finite")
+    lines = "".join(f"# {line}\n" for line in header.splitlines() if line)
+    # the longest line: "v " + 3 * ("-" + 19 digits + "." + decimals + " "), "f " + 3 * (19 digits + " ")
+    buffer = np.empty(len(vertices) * (2 + 3 * (22 + DECIMALS)) + len(faces) * (2 + 3 * 20) + 1, np.uint8)
+    used = _write_obj(vertices, faces, buffer, 10 ** DECIMALS)
+    return lines.encode() + buffer[:used].tobytes()
+
+
+@njit(cache=True, nogil=True)
+def _write_obj(vertices, faces, out, scale):
+    at = 0
+    for i in range(vertices.shape[0]):
+        out[at] = 118  # v
+        at += 1
+        for k in range(3):
+            out[at] = 32
+            at = _fixed(vertices[i, k], scale, out, at + 1)
+        out[at] = 10
+        at += 1
+    for i in range(faces.shape[0]):
+        out[at] = 102  # f
+        at += 1
+        for k in range(3):
+            out[at] = 32
+            at = _integer(faces[i, k] + 1, out, at + 1)
+        out[at] = 10
+        at += 1
+    return at
+
+
+@njit(cache=True, nogil=True)
+def _integer(value, out, at):
+    """The decimal digits of ``value`` >= 0 at ``out[at:]``; the position after them."""
+    digits = 1
+    rest = value // 10
+    while rest:
+        digits += 1
+        rest //= 10
+    for d in range(digits - 1, -1, -1):
+        out[at + d] = 48 + value % 10
+        value //= 10
+    return at + digits
+
+
+@njit(cache=True, nogil=True)
+def _fixed(value, scale, out, at):
+    """``value`` in fixed point (rounded to 1 / ``scale``, trailing zeros and a bare point dropped)."""
+    units = np.int64(np.round(abs(value) * scale))
+    if units and value < 0:
+        out[at] = 45  # -
+        at += 1
+    at = _integer(units // scale, out, at)
+    fraction = units % scale
+    if fraction:
+        out[at] = 46  # .
+        at += 1
+        width = 0
+        step = scale // 10
+        while step:
+            out[at + width] = 48 + (fraction // step) % 10
+            width += 1
+            step //= 10
+        while out[at + width - 1] == 48:
+            width -= 1
+        at += width
+    return at

@@ -349,3 +349,19 @@ def test_bake_read_instances_with_assets_from_meta(tmp_path):
     assert len(mesh.faces) == 12 + 2 + 12 + 8 + 2
     assert mesh.area == pytest.approx(22 + 4 + 6 + 84 + 9, rel=1e-6)
     assert mesh.metadata["n_polygons"] == 6 + 1 + 6 + 2 + 1
+
+
+def test_obj_bytes_writes_what_read_obj_reads():
+    from grammarc.io.obj import obj_bytes, read_obj
+
+    rng = np.random.default_rng(3)
+    vertices = rng.uniform(-2e4, 2e4, (500, 3))
+    vertices[:3] = [[0.0, -0.0, 4e-7], [-0.5, 12.25, 3.0], [1e6, -1e6, 0.000001]]
+    faces = rng.integers(0, 500, (900, 3))
+    text = obj_bytes(vertices, faces, "grammarc bake").decode()
+    assert text.startswith("# grammarc bake\nv 0 0 0\nv -0.5 12.25 3\nv 1000000 -1000000 0.000001\n")
+    points, read = read_obj(text)
+    np.testing.assert_allclose(points, vertices, atol=5e-7, rtol=0)
+    np.testing.assert_array_equal(np.array(read), faces)
+    with pytest.raises(ValueError, match="finite"):
+        obj_bytes(np.array([[np.nan, 0, 0]]), faces[:0])
