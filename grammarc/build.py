@@ -260,7 +260,9 @@ def _workers(plan, options: BuildOptions, foreign):
     process (and a profiler sees it). Otherwise in ``options.workers`` forked processes: the derivation
     is mostly Python driving numpy and numba over columns, so threads would share one interpreter
     lock (measured: no gain on two cores), while processes use both. Each chunk's lots go to a worker
-    and its records come back pickled, ~60 bytes a record, which costs far less than deriving them.
+    and its records come back pickled, ~60 bytes a record. That pays where a record costs much to derive
+    (examples/pompeii x100: 14.3 s -> 13.5 s on two cores) and not where it is cheap (the facade
+    benchmark at 10^5 lots: 15.4 s -> 21.2 s), so the command's default is one worker.
     """
     if options.workers == 1 or "fork" not in multiprocessing.get_all_start_methods():
         def at_once(lots: Lots) -> Future:
