@@ -15,11 +15,10 @@ written.
 from __future__ import annotations
 
 import contextlib
-import multiprocessing
+import functools
 import time
 from collections import deque
 from collections.abc import Sequence
-from concurrent.futures import Future, ProcessPoolExecutor
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 
@@ -37,6 +36,7 @@ from grammarc.errors import ChunkTooLarge, LotFailure, UsageError
 from grammarc.io import OutputOptions, writer_for
 from grammarc.io.lots import BadLot, Lots, default_lot, read_lots
 from grammarc.io.npz import MeshChunk
+from grammarc.workers import worker_pool
 
 #: Shapes plus records one chunk may make before it is split: ~100 bytes each, so about 2 GB.
 CHUNK_BUDGET = 20_000_000
@@ -58,7 +58,7 @@ class BuildOptions:
     chunk_budget: int = CHUNK_BUDGET
     #: ``cga2006`` or ``cityengine``; detected from the grammar's text when None.
     dialect: str | None = None
-    #: Chunks derived at once, in as many processes (``_workers``); the output does not depend on it.
+    #: Chunks derived at once, in as many processes (``grammarc.workers``); the output does not depend on it.
     workers: int = 1
 
 
@@ -207,7 +207,7 @@ def _derive_all(plan, lots: Lots, options: BuildOptions, writer, failed: list[Ba
     queries look at other lots is derived twice: first for everyone's occluders (``_occluders``), those of
     ``context`` when given (the whole city of a selection).
 
-    ``options.workers`` chunks are derived at once, each in a worker process (``_workers``). Results are
+    ``options.workers`` chunks are derived at once, each in a worker process (``workers.py``). Results are
     written in chunk order, and a chunk's size is decided from the chunks finished before it in that
     order, so the chunking does not depend on timing (and the records never depend on the chunking).
     """
@@ -219,7 +219,7 @@ def _derive_all(plan, lots: Lots, options: BuildOptions, writer, failed: list[Ba
     foreign = _occluders(plan, lots if context is None else context, options) if plan.inter else None
     if foreign is not None:
         foreign.index  # noqa: B018 - built once here, before the workers inherit it
-    with _workers(plan, options, foreign) as submit:
+    with worker_pool(functools.partial(_derive, plan, options=options, foreign=foreign), options.workers) as submit:
         window: deque = deque()
         try:
             while first < len(lots) or window:
@@ -230,10 +230,10 @@ def _derive_all(plan, lots: Lots, options: BuildOptions, writer, failed: list[Ba
                 n_lots, future = window.popleft()
                 results, part_failed = future.result()
                 failed.extend(part_failed)
-                for part, (records, per_lot) in results:
+                for n_lots_derived, (records, per_lot) in results:
                     writer.write(records)
                     reports.add(per_lot)
-                    derived += len(part)
+                    derived += n_lots_derived
                     rows += len(records.asset) + len(records.mesh.lot)
                 written += n_lots
                 per_lot = rows / max(written, 1)
@@ -247,55 +247,15 @@ def _derive_all(plan, lots: Lots, options: BuildOptions, writer, failed: list[Ba
     return derived
 
 
-#: What a worker process derives with: set in the parent before the workers are forked, so the plan
-#: (with its compiled kernels) and the occluders are inherited, not pickled.
-_WORKER: dict = {}
-
-
-@contextlib.contextmanager
-def _workers(plan, options: BuildOptions, foreign):
-    """``submit(lots) -> Future`` of ``_derive(plan, lots, options, foreign)``.
-
-    With one worker, or where processes cannot be forked (Windows), the chunk is derived at once in this
-    process (and a profiler sees it). Otherwise in ``options.workers`` forked processes: the derivation
-    is mostly Python driving numpy and numba over columns, so threads would share one interpreter
-    lock (measured: no gain on two cores), while processes use both. Each chunk's lots go to a worker
-    and its records come back pickled, ~60 bytes a record. That pays where a record costs much to derive
-    (examples/pompeii x100: 14.3 s -> 13.5 s on two cores) and not where it is cheap (the facade
-    benchmark at 10^5 lots: 15.4 s -> 21.2 s), so the command's default is one worker.
-    """
-    if options.workers == 1 or "fork" not in multiprocessing.get_all_start_methods():
-        def at_once(lots: Lots) -> Future:
-            future: Future = Future()
-            try:
-                future.set_result(_derive(plan, lots, options, foreign))
-            except BaseException as error:  # noqa: BLE001 - handed to the caller by future.result()
-                future.set_exception(error)
-            return future
-
-        yield at_once
-        return
-    _WORKER.update(plan=plan, options=options, foreign=foreign)
-    try:
-        with ProcessPoolExecutor(options.workers, mp_context=multiprocessing.get_context("fork")) as pool:
-            yield lambda lots: pool.submit(_derive_in_worker, lots)
-    finally:
-        _WORKER.clear()
-
-
-def _derive_in_worker(lots: Lots):
-    return _derive(_WORKER["plan"], lots, _WORKER["options"], _WORKER["foreign"])
-
-
 def _derive(plan, lots: Lots, options: BuildOptions, foreign=None) -> tuple[list, list[BadLot]]:
-    """Derive ``lots`` (on a worker thread), skipping failing lots and splitting oversized chunks.
+    """Derive ``lots`` (maybe in a worker process), skipping failing lots and splitting oversized chunks.
 
-    Returns ``[(part, (records, per_lot))]`` in lot order and the lots that failed.
+    Returns ``[(lots derived, (records, per_lot))]`` in lot order and the lots that failed.
     """
     failed: list[BadLot] = []
-    results = list(_attempts(lots, lambda part: derive_chunk(
+    results = [(len(part), result) for part, result in _attempts(lots, lambda part: derive_chunk(
         plan, part, seed=options.seed, limits=options.limits, overrides=options.attrs,
-        chunk_budget=options.chunk_budget, foreign=foreign), failed))
+        chunk_budget=options.chunk_budget, foreign=foreign), failed)]
     return results, failed
 
 

@@ -71,10 +71,9 @@ def _parser() -> argparse.ArgumentParser:
                        help="a further folder for I() assets (the grammar's folder comes first)")
     build.add_argument("--dialect", choices=("cga2006", "cityengine"),
                        help="the grammar's notation (default: detected from its text)")
-    build.add_argument("--workers", type=_positive, default=1, metavar="N",
-                       help=f"chunks derived at once, in N forked processes (default 1; this machine lets us use "
-                            f"{_cores()}): pays where rules cost more than moving their records back; the "
-                            "output does not depend on it")
+    build.add_argument("--workers", type=_positive, default=_cores(), metavar="N",
+                       help=f"chunks derived at once, in N forked processes (default: the {_cores()} cores this "
+                            "process may use); the output does not depend on it")
     build.add_argument("--bake", action="store_true",
                        help="expand the instances into one mesh (.glb; .obj/.ply/.stl always are)")
     build.add_argument("--max-triangles", type=_positive, metavar="N",

@@ -1,0 +1,33 @@
+"""Worker processes: records shipped through memory files come back equal; errors come back raised."""
+
+import numpy as np
+import pytest
+
+from grammarc.build import BuildOptions, derive
+from grammarc.compiler import compile_grammar
+from grammarc.errors import LimitError
+from grammarc.io.lots import lots_from_polygons
+from grammarc.io.npz import MeshChunk, TerminalChunk
+from grammarc.workers import _ship, _unship
+
+
+def test_a_shipped_chunk_comes_back_equal(tmp_path):
+    mesh = MeshChunk(vertices=np.arange(12, dtype=np.float32).reshape(4, 3), ring_offsets=np.array([0, 4]),
+                     face_offsets=np.array([0, 1]), lot=np.array([1], np.int32), symbol=np.array([0], np.int32))
+    chunk = TerminalChunk(asset=np.array([0, 1, 1], np.int32), xform=np.random.default_rng(0).normal(
+        size=(3, 3, 4)).astype(np.float32), lot=np.array([0, 0, 1], np.int32), symbol=np.zeros(3, np.int32),
+        mesh=mesh)
+    back = _unship(_ship(chunk, tmp_path / "c.bin"))
+    assert not (tmp_path / "c.bin").exists() and back.color is None and back.mesh.color is None
+    for name in ("asset", "xform", "lot", "symbol"):
+        np.testing.assert_array_equal(getattr(back, name), getattr(chunk, name))
+        assert getattr(back, name).dtype == getattr(chunk, name).dtype
+    for name in ("vertices", "ring_offsets", "face_offsets", "lot", "symbol"):
+        np.testing.assert_array_equal(getattr(back.mesh, name), getattr(mesh, name))
+
+
+def test_a_limit_reached_in_a_worker_stops_the_build(write):
+    grammar = compile_grammar(write("g.cga", "lot ~> grow\ngrow ~> S(1r, 1r, 1r) grow\n"))
+    lots = lots_from_polygons([[np.array([[0, 0], [10, 0], [10, 10], [0, 10]], float)]] * 4)
+    with pytest.raises(LimitError, match="max-depth"):
+        derive(grammar, lots, BuildOptions(workers=2, chunk_size=1))
