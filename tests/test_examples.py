@@ -39,7 +39,7 @@ def test_example_city_records_are_unchanged(tmp_path):
     assert record_digest(out) == (CITY / "records.sha256").read_text().split()[0]
 
 
-def test_example_city_is_the_same_in_small_chunks_and_on_threads(tmp_path):
+def test_example_city_is_the_same_in_small_chunks_and_in_workers(tmp_path):
     build(CITY / "city.cga", tmp_path / "a.npz")
     build(CITY / "city.cga", tmp_path / "b.npz", options=BuildOptions(chunk_size=5))
     build(CITY / "city.cga", tmp_path / "c.npz", options=BuildOptions(chunk_size=7, workers=3))

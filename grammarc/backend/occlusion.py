@@ -192,26 +192,57 @@ def query(expr, env, distance: np.ndarray | None = None) -> np.ndarray:
     return np.where(full, strings["full"], np.where(part, strings["part"], strings["none"])).astype(np.int32)
 
 
+#: A face sees street points more than this (metres) in front of its plane (``_visible``).
+_AHEAD = 1e-3
+#: Where a sightline ends: this far (metres) out from the lot's street edge, on the street.
+_STREET_OUTSET = 1.0
+
+
 def _visible(shapes, chunk) -> np.ndarray:
     """The paper's ``Shape.visible("street")``: the sightline from the centre of each shape's scope to the
-    nearest point of its lot's street edges (its front edge where it has none) passes through no
-    occluder's interior, of any lot (its own building's mass included: a facade turned away from the
-    street looks through it)."""
+    nearest point of its lot's street (its street edges, or its front edge where it has none, moved
+    ``_STREET_OUTSET`` out onto the street) passes through no occluder's interior, of any lot (its own building's mass included: a facade turned away from the
+    street looks through it).
+
+    A wall (a flat scope standing up) looks only ahead: its sightline goes to the nearest street point in
+    front of its plane (more than ``_AHEAD`` m), and it sees nothing when there is none. So a wall square to the
+    street on the lot's boundary (a party wall, a row house's end) does not see the street, though the
+    line along its surface meets no interior; set back from the boundary, it sees the street obliquely.
+    """
     n = len(shapes)
     axes = chunk.frames[shapes.frame]
     centre = shapes.origin + 0.5 * np.einsum("pj,pji->pi", shapes.size, axes)
     start, end, row = chunk.streets.of_lots(shapes.lot)
     step = end - start
+    # the street runs beside the lot, not on its edge: 1 m out (lots are counter-clockwise seen from +y)
+    out = np.cross(step, [0.0, 1.0, 0.0])
+    out *= _STREET_OUTSET / np.maximum(np.linalg.norm(out, axis=1, keepdims=True), 1e-300)
+    start, end = start + out, end + out
     t = np.clip(np.einsum("kj,kj->k", centre[row] - start, step) / np.maximum(
         np.einsum("kj,kj->k", step, step), 1e-300), 0.0, 1.0)
+    # a wall (a flat scope whose normal is mostly horizontal): t limited to the part of the street edge
+    # ahead of it, on the side its normal points to (empty: lo > hi); roofs and ground shapes look anywhere
+    flat = shapes.size[row] <= 1e-9
+    normal = np.einsum("pk,pki->pi", flat.astype(float), axes[row])  # the flat axis: the face's normal
+    normal[:, 1] = 0.0
+    face = flat.any(axis=1) & (np.linalg.norm(normal, axis=1) > 0.5)
+    a = np.einsum("pi,pi->p", start - centre[row], normal) - _AHEAD
+    b = np.einsum("pi,pi->p", end - centre[row], normal) - _AHEAD
+    with np.errstate(divide="ignore", invalid="ignore"):
+        crossing = np.where(a != b, a / (a - b), 0.0)  # where a + t (b - a) = 0
+    lo = np.where(face & (a <= 0) & (b > 0), crossing, 0.0)
+    hi = np.where(face & (a > 0) & (b <= 0), crossing, 1.0)
+    ahead = ~face | (a > 0) | (b > 0)
+    t = np.clip(t, lo, hi)
     point = start + t[:, None] * step
-    distance = np.linalg.norm(point - centre[row], axis=1)
+    distance = np.where(ahead & (lo <= hi), np.linalg.norm(point - centre[row], axis=1), np.inf)
     nearest = np.full(n, np.inf)
     np.minimum.at(nearest, row, distance)
-    chosen = np.flatnonzero(distance <= nearest[row])
+    chosen = np.flatnonzero((distance <= nearest[row]) & np.isfinite(distance))
     chosen = chosen[np.unique(row[chosen], return_index=True)[1]]  # one sightline a shape
     sight = np.stack([centre[row[chosen]], point[chosen]], axis=1)
-    blocked = np.zeros(n, dtype=bool)
+    blocked = np.ones(n, dtype=bool)
+    blocked[row[chosen]] = False  # a shape with no street ahead sees none
     own = chunk.lot_index[shapes.lot]
     for table, intra in _sources(chunk, "all"):
         q, o = _candidates(table, sight.min(axis=1), sight.max(axis=1))

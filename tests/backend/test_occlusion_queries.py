@@ -100,8 +100,9 @@ def test_an_enlarged_scope_finds_a_neighbour_a_little_away(write):
 
 def test_only_the_facades_that_see_the_street_see_it(write):
     """Section 4 rule 3: Shape.visible("street"). A 20 x 15 m lot whose street is its first (south) edge:
-    the north facade looks through its own building; the south one faces the street and the two side
-    ones see its ends along their walls."""
+    the south facade faces the street; the north one looks through its own building; the two side ones,
+    on the lot's boundary, have no street ahead of them (a party wall of a row must not get the door).
+    Set back 2 m from the sides, the side facades see the street obliquely."""
     text = """
 lot ~> S(1r, 10, 1r) facades
 facades ~> Comp("sidefaces"){ facade }
@@ -115,9 +116,13 @@ facade ~> hidden
         from grammarc.io.lots import lots_from_polygons
 
         r = derive(compile_grammar(write("v.cga", text)), lots_from_polygons([lot], street=[street]), BuildOptions())
-        hidden = r["xform"][np.array(names(r)) == "hidden"].astype(float)
-        assert count(r, "seen") == 3 and len(hidden) == 1
-        np.testing.assert_allclose(hidden[0, 2, 3], -15)  # the north facade (map y = 15: world z = -15)
+        seen = r["xform"][np.array(names(r)) == "seen"].astype(float)
+        assert len(seen) == 1 and count(r, "hidden") == 3
+        np.testing.assert_allclose(seen[0, 2, 3], 0)  # the south facade (map y = 0: world z = 0)
+        inset = text.replace("S(1r, 10, 1r)", "S(1r, 10, 1r) T(2, 0, 0) S(Scope.sx - 4, 10, 1r)")
+        r = derive(compile_grammar(write("w.cga", inset)), lots_from_polygons([lot], street=[street]),
+                   BuildOptions())
+        assert count(r, "seen") == 3 and count(r, "hidden") == 1
 
 
 def test_section5_compares_visibility_with_zero(write):
@@ -129,7 +134,7 @@ facade : Shape.visible("Street") == 0 ~> hidden
 facade ~> seen
 """
     r = run(write, text, [[np.array([[0, 0], [20, 0], [20, 15], [0, 15]], float)]], version=False)
-    assert count(r, "hidden") == 1 and count(r, "seen") == 3
+    assert count(r, "hidden") == 3 and count(r, "seen") == 1  # the back, and the sides on the boundary
 
 
 def test_section6_trees_keep_their_distance_from_the_house(write):
