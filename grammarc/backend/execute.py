@@ -10,6 +10,7 @@ one call per part. Python cost is per operation and batch, never per shape.
 
 from __future__ import annotations
 
+import weakref
 from collections import defaultdict
 from dataclasses import replace
 
@@ -43,6 +44,10 @@ class Executor(ScopeOperations, SplitOperations, ComponentOperations, FaceOperat
         self.limits = limits
         self.chunk_budget = chunk_budget
         self.pending: dict[int, list[Shapes]] = defaultdict(list)
+        #: The occluder ids of shapes taken apart (``occluding``): a shape split by two component splits
+        #: (``Comp("sideface", 0){ a } Comp("sideface", 2){ a }``) is one occluder, not two of which each
+        #: split's faces would see the other as a neighbour.
+        self.taken_apart: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
 
     # ------------------------------------------------------------------------------------------ helpers
     def env(self, shapes: Shapes) -> Env:
@@ -65,7 +70,10 @@ class Executor(ScopeOperations, SplitOperations, ComponentOperations, FaceOperat
         """A component split's solids become occluders; their components carry them as ancestors."""
         if ANCESTORS[0] not in self.plan.dynamic:
             return children
-        ident = add_occluders(self.chunk, cursor, self.occluder_label(symbol), active=False)
+        ident = self.taken_apart.get(cursor)
+        if ident is None:
+            ident = self.taken_apart[cursor] = add_occluders(self.chunk, cursor, self.occluder_label(symbol),
+                                                             active=False)
         return with_ancestor(self.plan, children, ident[parent])
 
     def occluder_label(self, symbol: int) -> str | None:

@@ -176,3 +176,15 @@ slab ~> ε
     assert np.all((right <= 11.5) | (left >= 15.5))
     # without the driveway the sidewalk is whole
     assert count(run(write, text.replace("driveway ]", "ramp ]"), [rect(20, 20)], version=False), "slab") == 15
+
+
+def test_a_mass_split_by_two_component_splits_is_one_occluder(write):
+    """Two Comp()s of one mass: their faces (opposite sides of the box) do not see the mass as another
+    shape, as they would if each split registered it again."""
+    text = """
+lot ~> S(10, 6, 10) Comp("sideface", 0){ a } Comp("sideface", 2){ a }
+a : Scope.occ("noparent") != "none" ~> hit
+a ~> free
+"""
+    r = run(write, text, [rect(20, 20)], version=False)
+    assert count(r, "free") == 2 and count(r, "hit") == 0
