@@ -5,7 +5,6 @@ The derivation looks everything up here by symbol id; nothing in it refers to sy
 
 from __future__ import annotations
 
-import threading
 from dataclasses import dataclass
 
 from grammarc.backend.occlusion import ANCESTORS
@@ -21,19 +20,14 @@ WHITE_RGB = float(0xFFFFFF)
 class Strings:
     """Interned strings: a string value in a column is an int32 id, compared by equality.
 
-    Chunks derived on several threads share the table; a lock keeps one id per string (``setdefault``
-    with ``len`` is two steps)."""
+    Each worker process has its own table (``grammarc.workers``): ids never leave the process that made
+    them (reports and records carry the strings)."""
 
     def __init__(self) -> None:
         self.ids: dict[str, int] = {}
-        self._lock = threading.Lock()
 
     def intern(self, text: str) -> int:
-        found = self.ids.get(text)
-        if found is not None:
-            return found
-        with self._lock:
-            return self.ids.setdefault(text, len(self.ids))
+        return self.ids.setdefault(text, len(self.ids))
 
 
 @dataclass(frozen=True)
