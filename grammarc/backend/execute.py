@@ -33,6 +33,8 @@ from grammarc.errors import ChunkTooLarge, LimitError, LotFailure
 from grammarc.geometry.meshes import is_mesh
 from grammarc.ir import nodes as ir
 from grammarc.ir.printer import print_op
+from grammarc.ir.traverse import iter_ops
+from grammarc.ragged import rank_within
 
 
 class Executor(ScopeOperations, SplitOperations, ComponentOperations, FaceOperations):
@@ -48,6 +50,8 @@ class Executor(ScopeOperations, SplitOperations, ComponentOperations, FaceOperat
         #: (``Comp("sideface", 0){ a } Comp("sideface", 2){ a }``) is one occluder, not two of which each
         #: split's faces would see the other as a neighbour.
         self.taken_apart: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
+        #: Symbol id -> whether its rules split on snap planes (``apply``).
+        self.snapping: dict[int, bool] = {}
 
     # ------------------------------------------------------------------------------------------ helpers
     def env(self, shapes: Shapes) -> Env:
@@ -97,7 +101,26 @@ class Executor(ScopeOperations, SplitOperations, ComponentOperations, FaceOperat
 
     # ---------------------------------------------------------------------------------- rule application
     def apply(self, sym: SymbolPlan, shapes: Shapes) -> None:
-        """Apply the rules of ``sym`` to all of ``shapes``; shapes no rule applies to become leaves."""
+        """Apply the rules of ``sym`` to all of ``shapes``; shapes no rule applies to become leaves.
+
+        A symbol whose rules split on snap planes (``Repeat("YS", ...)``) takes a lot's shapes one after
+        the other, as the paper derives: its first shape's snaps are there when its second one splits
+        (the front volume's floors set the levels of the wings'). All lots still go together: the k-th
+        shape of every lot in one batch.
+        """
+        if sym.id not in self.snapping:
+            self.snapping[sym.id] = any(getattr(op, "snap", False) for rule in sym.rules
+                                        for alt in rule.alternatives for op in iter_ops(alt.body))
+        if self.snapping[sym.id] and len(shapes) > 1:
+            rank = rank_within(shapes.lot)
+            if rank.max() > 0:
+                for k in range(int(rank.max()) + 1):
+                    self.apply_all(sym, shapes.take(rank == k))
+                return
+        self.apply_all(sym, shapes)
+
+    def apply_all(self, sym: SymbolPlan, shapes: Shapes) -> None:
+        """``apply`` on all of ``shapes`` at once."""
         deepest = int(np.argmax(shapes.depth))
         if shapes.depth[deepest] >= self.limits.max_depth:
             rule = sym.rules[0]

@@ -81,3 +81,23 @@ def test_a_labelled_snap_line_moves_the_nearest_split_of_a_labelled_subdiv(write
     got = {n: (x[i], width[i]) for i, n in enumerate(names(r)) if n in "abc"}
     assert got["a"] == pytest.approx((0, 4)) and got["b"] == pytest.approx((4, 2))
     assert got["c"] == pytest.approx((6, 4))
+
+
+def test_shapes_of_one_batch_snap_to_the_planes_of_those_before_them(write):
+    """The paper derives one shape at a time: of two volumes whose floors are repeated by one batch,
+    the first's floors (above a 2 m base) set the levels the second's snap to."""
+    text = """
+lot ~> S(1r, 10, 1r) Subdiv("X", 1r, 1r){ f | g }
+f ~> Subdiv("Y", 2, 1r){ base | floors }
+g ~> floors
+floors ~> Repeat("YS", 3){ fl Snap("XZ") }
+"""
+    r = run(write, text, [rect(20, 20), rect(20, 20)], version=False)
+    fl = np.array(names(r)) == "fl"
+    x, bottom = r["xform"][fl][:, 0, 3], r["xform"][fl][:, 1, 3]
+    for lot in (0, 1):
+        mine = r["lot"][fl] == lot
+        f_levels = np.sort(bottom[mine & (x == 0)])
+        g_levels = np.sort(bottom[mine & (x == 10)])
+        np.testing.assert_allclose(f_levels, [2, 2 + 8 / 3, 2 + 16 / 3], atol=1e-5)
+        np.testing.assert_allclose(g_levels, [0, *f_levels], atol=1e-5)
