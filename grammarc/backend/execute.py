@@ -229,16 +229,7 @@ class Executor(ScopeOperations, SplitOperations, ComponentOperations, FaceOperat
         else:
             self.pending[sym.id].append(shapes)
 
-
-    # ------------------------------------------------------------------------------------------- splits
-
-
-    # ------------------------------------------------------------------------------------------- comp
-
-
     # ------------------------------------------------------------------------------ CityEngine operations
-
-
     def use_asset(self, op: ir.UseAsset, cursor: Shapes, symbol: int) -> Shapes:
         """The geometry becomes the asset fitted to the scope (a cube is the scope box itself)."""
         if op.name is None:
