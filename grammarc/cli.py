@@ -114,8 +114,8 @@ def _parser() -> argparse.ArgumentParser:
                       help="write the good lots as GeoParquet (extra `parquet`), which reads ~3x faster")
     lots.set_defaults(run=_lots)
 
-    info = sub.add_parser("info", help="what an instance record holds: counts, lots, bbox, polygons")
-    info.add_argument("record", type=Path, help="an instances.npz written by build")
+    info = sub.add_parser("info", help="what a city holds: counts, lots, bbox, polygons")
+    info.add_argument("record", type=Path, help="an output of build: .npz, .usda/.usdc/.usd or .glb")
     info.add_argument("--assets", type=Path, action="append", metavar="DIR",
                       help="folders for file assets (default: those the record names)")
     info.add_argument("--lod", metavar="NAME", help="count polygons at this level of detail")
@@ -217,7 +217,7 @@ def _info(args) -> int:
     try:
         summary = summarize(args.record, args.assets, args.lod)
     except (OSError, ValueError, KeyError) as error:
-        raise UsageError(f"{args.record}: not an instance record ({error})") from error
+        raise UsageError(f"{args.record}: not an output of grammarc build ({error})") from error
     print(json.dumps(summary, indent=1) if args.json else format_summary(summary))
     return 0
 

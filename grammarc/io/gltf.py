@@ -33,9 +33,9 @@ from pathlib import Path
 import numpy as np
 
 from grammarc.errors import UsageError
-from grammarc.io.instancing import TILE_SIZE, Tile, TiledWriter, decompose
+from grammarc.io.instancing import TILE_SIZE, Tile, TiledWriter, compose, decompose
 
-__all__ = ["MAX_BYTES", "MAX_GROUPS", "GltfWriter", "part_paths"]
+__all__ = ["MAX_BYTES", "MAX_GROUPS", "GltfWriter", "part_paths", "read_glb"]
 
 #: GLB's 32-bit length fields, less room for the JSON chunk.
 MAX_BYTES = (1 << 32) - (64 << 20)
@@ -270,3 +270,60 @@ def _groups(rows: np.ndarray) -> list[tuple[int, tuple[int, ...], np.ndarray]]:
         rgba = tuple(np.array([value & 0xFFFFFFFF], np.uint32).view(np.uint8).tolist())
         groups.append((value >> 32, rgba, order[bounds[k]:bounds[k + 1]]))
     return groups
+
+
+def read_glb(path: str | os.PathLike) -> dict:
+    """The instances of a city written by ``GltfWriter`` (all its parts), as a record dict (the keys of
+    ``io.npz.read_instances`` that glTF keeps: assets, asset, xform (float64, world), the mesh table as
+    triangles, meta); grouped by tile and (asset, colour), not in the record's order."""
+    path = Path(path)
+    index = path.with_name(path.name + ".json")
+    parts = ([path.with_name(name) for name in json.loads(index.read_text())["parts"]] if index.exists()
+             else [path])
+    names: dict[str, int] = {}
+    assets, xforms, triangles, meta = [], [], [], {}
+    for part in parts:
+        tree, blob = _read_part(part)
+        meta = tree.get("asset", {}).get("extras", {}).get("grammarc", meta)
+        nodes = tree.get("nodes", [])
+        for root in tree.get("scenes", [{}])[0].get("nodes", []):
+            corner = np.array(nodes[root].get("translation", [0.0, 0.0, 0.0]), np.float64)
+            for child in nodes[root].get("children", []):
+                node = nodes[child]
+                mesh = tree["meshes"][node["mesh"]]
+                instancing = node.get("extensions", {}).get(_EXTENSION)
+                if instancing is None:  # the tile's polygons
+                    points = _accessor(tree, blob, mesh["primitives"][0]["attributes"]["POSITION"])
+                    triangles.append(points.astype(np.float64) + corner)
+                    continue
+                attributes = instancing["attributes"]
+                t, r, s = (_accessor(tree, blob, attributes[k]) for k in ("TRANSLATION", "ROTATION", "SCALE"))
+                xforms.append(compose(t.astype(np.float64) + corner, r, s))
+                assets.append(np.full(len(t), names.setdefault(mesh["name"], len(names)), np.int64))
+    vertices = np.concatenate(triangles) if triangles else np.zeros((0, 3))
+    return {"assets": np.array(list(names)), "asset": np.concatenate(assets) if assets else np.zeros(0, np.int64),
+            "xform": np.concatenate(xforms) if xforms else np.zeros((0, 3, 4)), "meta": meta,
+            "mesh_vertices": vertices, "mesh_ring_offsets": np.arange(0, len(vertices) + 1, 3),
+            "mesh_face_offsets": np.arange(len(vertices) // 3 + 1)}
+
+
+def _read_part(path: Path) -> tuple[dict, bytes]:
+    data = path.read_bytes()
+    magic, _, _ = struct.unpack_from("<4sII", data, 0)
+    length, kind = struct.unpack_from("<I4s", data, 12)
+    if magic != b"glTF" or kind != b"JSON":
+        raise ValueError(f"{path}: not a binary glTF")
+    tree = json.loads(data[20:20 + length])
+    start = 20 + length
+    blob = data[start + 8:] if len(data) > start else b""
+    return tree, blob
+
+
+def _accessor(tree: dict, blob: bytes, index: int) -> np.ndarray:
+    accessor = tree["accessors"][index]
+    view = tree["bufferViews"][accessor["bufferView"]]
+    dtype = {_FLOAT: np.float32, _UINT: np.uint32, _UBYTE: np.uint8}[accessor["componentType"]]
+    width = {"SCALAR": 1, "VEC3": 3, "VEC4": 4}[accessor["type"]]
+    offset = view.get("byteOffset", 0) + accessor.get("byteOffset", 0)
+    values = np.frombuffer(blob, dtype, accessor["count"] * width, offset)
+    return values.reshape(-1, width) if width > 1 else values

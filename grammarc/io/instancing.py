@@ -322,3 +322,16 @@ class TiledWriter:
     def __del__(self) -> None:
         if getattr(self, "_state", None) == "open":
             self.abort()
+
+
+def compose(positions: np.ndarray, orientations: np.ndarray, scales: np.ndarray) -> np.ndarray:
+    """The record's (n, 3, 4) float64 transforms of translations, (x, y, z, w) unit quaternions and scales:
+    what ``decompose`` took apart (readers of the instanced formats use it)."""
+    x, y, z, w = (np.asarray(orientations, np.float64)[:, k] for k in range(4))
+    rotation = np.stack([
+        np.stack([1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)], axis=1),
+        np.stack([2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)], axis=1),
+        np.stack([2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)], axis=1),
+    ], axis=1)
+    linear = rotation * np.asarray(scales, np.float64)[:, None, :]
+    return np.concatenate([linear, np.asarray(positions, np.float64)[:, :, None]], axis=2)

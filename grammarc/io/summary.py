@@ -1,4 +1,8 @@
-"""``grammarc info RECORD``: what a record holds, without opening another program.
+"""``grammarc info OUT``: what a city's output holds, without opening another program.
+
+OUT is an instance record (``.npz``), or instanced USD or glTF as ``build`` writes them (read back by
+``io.usd.read_usd`` and ``io.gltf.read_glb``): glTF keeps no lots or symbols, so those lines are left out
+for it; the bytes are those of every file of the output (USD's tile layers, glTF's parts).
 
 Counts per asset and per symbol, terminals per lot (min, median, max), the bounding box, and what the city
 weighs once instanced assets are expanded: polygons and triangles as ``bake`` would make them (each asset
@@ -10,6 +14,7 @@ loaded is reported and left out of the polygon counts rather than failing the su
 
 from __future__ import annotations
 
+import json
 import os
 from pathlib import Path
 
@@ -24,13 +29,15 @@ __all__ = ["format_summary", "summarize"]
 
 def summarize(path: str | os.PathLike, asset_roots=None, lod: str | None = None) -> dict:
     """The facts ``grammarc info`` prints, as a JSON-ready dict (see the module docstring)."""
-    record = read_instances(path)
+    record, files = _read(Path(path))
     names = [str(n) for n in record["assets"]]
-    symbols = [str(n) for n in record["symbols"]]
+    symbols = [str(n) for n in record.get("symbols", ())]
     asset = record["asset"].astype(np.int64)
     per_asset = np.bincount(asset, minlength=len(names))
-    per_symbol = np.bincount(record["symbol"].astype(np.int64), minlength=len(symbols))
-    per_lot = np.bincount(record["lot"].astype(np.int64)) if len(asset) else np.zeros(0, np.int64)
+    per_symbol = np.bincount(record["symbol"].astype(np.int64), minlength=len(symbols)) if "symbol" in record \
+        else np.zeros(0, np.int64)
+    per_lot = np.bincount(record["lot"].astype(np.int64)) if len(asset) and "lot" in record \
+        else np.zeros(0, np.int64)
     per_lot = per_lot[per_lot > 0]
     xform = record["xform"].astype(np.float64)
     corners = _corners(xform)
@@ -54,7 +61,7 @@ def summarize(path: str | os.PathLike, asset_roots=None, lod: str | None = None)
         assets[names[a]] = entry
     return {
         "path": str(path),
-        "bytes": Path(path).stat().st_size,
+        "bytes": sum(f.stat().st_size for f in files),
         "grammar": record["meta"].get("grammar"),
         "seed": record["meta"].get("seed"),
         "instances": len(asset),
@@ -73,6 +80,22 @@ def summarize(path: str | os.PathLike, asset_roots=None, lod: str | None = None)
     }
 
 
+def _read(path: Path) -> tuple[dict, list[Path]]:
+    """The record of an output, and the files it is made of."""
+    suffix = path.suffix.lower()
+    if suffix in (".usd", ".usda", ".usdc"):
+        from grammarc.io.usd import read_usd, tiles_folder
+
+        return read_usd(path), [path, *(f for f in tiles_folder(path).glob("*") if f.is_file())]
+    if suffix == ".glb":
+        from grammarc.io.gltf import read_glb
+
+        index = path.with_name(path.name + ".json")
+        parts = [path.with_name(n) for n in json.loads(index.read_text())["parts"]] if index.exists() else [path]
+        return read_glb(path), parts + ([index] if index.exists() else [])
+    return read_instances(path), [path]
+
+
 def _corners(xform: np.ndarray) -> np.ndarray:
     """(8n, 3) corners of the instances' boxes."""
     unit = np.array([[i, j, k] for i in (0, 1) for j in (0, 1) for k in (0, 1)], np.float64)
@@ -83,11 +106,11 @@ def format_summary(info: dict) -> str:
     """The summary as text, a table per section."""
     lines = [f"{info['path']}: {info['bytes'] / 1e6:,.1f} MB, grammar {info['grammar']}, seed {info['seed']}",
              (f"  instances   {info['instances']:,} ({info['bytes'] / max(info['instances'], 1):,.1f} bytes "
-              f"each), mesh faces {info['mesh_faces']:,}"),
-             f"  lots        {info['lots']:,}"]
+              f"each), mesh faces {info['mesh_faces']:,}")]
     if info["per_lot"]:
         p = info["per_lot"]
-        lines[-1] += f", terminals per lot min {p['min']:,} median {p['median']:,.1f} max {p['max']:,}"
+        lines.append(f"  lots        {info['lots']:,}, terminals per lot min {p['min']:,} median "
+                     f"{p['median']:,.1f} max {p['max']:,}")
     if info["bbox"]:
         low, high = (np.array(info["bbox"][k]) for k in ("min", "max"))
         lines.append(f"  bbox        {_xyz(low)} .. {_xyz(high)} (size {_xyz(high - low)})")
@@ -99,7 +122,8 @@ def format_summary(info: dict) -> str:
     for name, entry in sorted(info["assets"].items(), key=lambda kv: -kv[1]["instances"]):
         extra = f"  x {entry['polygons']:,} polygons" if "polygons" in entry else "  (not loaded)"
         lines.append(f"    {name:<{width}}  {entry['instances']:>12,}{extra}")
-    lines.append("  symbols")
+    if info["symbols"]:
+        lines.append("  symbols")
     width = max((len(n) for n in info["symbols"]), default=0)
     for name, count in sorted(info["symbols"].items(), key=lambda kv: -kv[1]):
         lines.append(f"    {name:<{width}}  {count:>12,}")

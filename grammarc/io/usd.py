@@ -40,14 +40,14 @@ from pathlib import Path
 import numpy as np
 
 from grammarc.errors import UsageError
-from grammarc.io.instancing import TILE_SIZE, Tile, TiledWriter, decompose
+from grammarc.io.instancing import TILE_SIZE, Tile, TiledWriter, compose, decompose
 
 try:  # the `usd` extra: this module is imported only for a USD output, and says what to install
     from pxr import Gf, Sdf, Tf, Usd, UsdGeom, Vt
 except ImportError:
     Gf = Sdf = Tf = Usd = UsdGeom = Vt = None
 
-__all__ = ["UsdWriter", "tiles_folder"]
+__all__ = ["UsdWriter", "read_usd", "tiles_folder"]
 
 
 def tiles_folder(path: str | os.PathLike) -> Path:
@@ -211,3 +211,47 @@ def _colors(primvars, rgba: np.ndarray, interpolation) -> None:
     if (rgba[:, 3] < 255).any():
         opacity = primvars.CreatePrimvar("displayOpacity", Sdf.ValueTypeNames.FloatArray, interpolation)
         opacity.Set(Vt.FloatArray.FromNumpy(rgba[:, 3].astype(np.float32) / 255.0))
+
+
+def read_usd(path: str | os.PathLike) -> dict:
+    """The instances of a city written by ``UsdWriter``, as a record dict (``io.npz.read_instances``'s
+    keys): assets, asset, xform (float64, world), lot, symbol, symbols, the mesh table (a face per
+    triangle), meta; rows in the record's order (by ``ids``)."""
+    _require_pxr()
+    stage = Usd.Stage.Open(str(path))
+    if stage is None:
+        raise ValueError(f"{path}: not a USD stage")
+    data = stage.GetRootLayer().customLayerData
+    meta = json.loads(data.get("grammarc", "{}"))
+    symbols = json.loads(data.get("grammarc:symbols", "[]"))
+    names: dict[str, int] = {}
+    columns: dict[str, list] = {"id": [], "asset": [], "xform": [], "lot": [], "symbol": []}
+    triangles = []
+    time = Usd.TimeCode.Default()
+    for prim in stage.Traverse():
+        if prim.IsA(UsdGeom.PointInstancer):
+            instancer = UsdGeom.PointInstancer(prim)
+            corner = np.array(UsdGeom.Xformable(prim).ComputeLocalToWorldTransform(time).ExtractTranslation())
+            targets = instancer.GetPrototypesRel().GetTargets()
+            local = np.array([names.setdefault(str(stage.GetPrimAtPath(t).GetCustomDataByKey("grammarc:asset")),
+                                               len(names)) for t in targets], np.int64)
+            orientations = np.array([[*q.GetImaginary(), q.GetReal()] for q in instancer.GetOrientationsAttr().Get()])
+            columns["xform"].append(compose(np.array(instancer.GetPositionsAttr().Get(), np.float64) + corner,
+                                            orientations.reshape(-1, 4), np.array(instancer.GetScalesAttr().Get())))
+            columns["asset"].append(local[np.array(instancer.GetProtoIndicesAttr().Get(), np.int64)])
+            columns["id"].append(np.array(instancer.GetIdsAttr().Get(), np.int64))
+            for name in ("lot", "symbol"):
+                columns[name].append(np.array(prim.GetAttribute(f"grammarc:{name}").Get(), np.int64))
+        elif prim.IsA(UsdGeom.Mesh) and prim.GetName() == "Meshes":
+            corner = np.array(UsdGeom.Xformable(prim).ComputeLocalToWorldTransform(time).ExtractTranslation())
+            triangles.append(np.array(UsdGeom.Mesh(prim).GetPointsAttr().Get(), np.float64) + corner)
+    order = np.argsort(np.concatenate(columns["id"])) if columns["id"] else np.zeros(0, np.int64)
+    record = {name: np.concatenate(values)[order] if values else np.zeros(0, np.int64)
+              for name, values in columns.items() if name != "xform"}
+    record["xform"] = np.concatenate(columns["xform"])[order] if columns["xform"] else np.zeros((0, 3, 4))
+    vertices = np.concatenate(triangles) if triangles else np.zeros((0, 3))
+    record.update(assets=np.array(list(names)), symbols=np.array(symbols), meta=meta,
+                  mesh_vertices=vertices, mesh_ring_offsets=np.arange(0, len(vertices) + 1, 3),
+                  mesh_face_offsets=np.arange(len(vertices) // 3 + 1))
+    del record["id"]
+    return record

@@ -3,6 +3,7 @@
 import json
 
 import numpy as np
+import pytest
 from writers_city import city
 
 from grammarc.cli import main
@@ -34,4 +35,23 @@ def test_info_command(tmp_path, capsys):
     assert main(["info", str(tmp_path / "city.npz"), "--json"]) == 0
     assert json.loads(capsys.readouterr().out)["lots"] == 3
     assert main(["info", str(tmp_path / "missing.npz")]) == 2
-    assert "not an instance record" in capsys.readouterr().err
+    assert "not an output of grammarc build" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("output", ["city.usdc", "city.glb"])
+def test_info_of_instanced_outputs_counts_what_the_record_has(tmp_path, output):
+    """USD and glTF read back (``read_usd``, ``read_glb``): the same instances per asset, the same box;
+    USD keeps lots and symbols too."""
+    if output.endswith(".usdc"):
+        pytest.importorskip("pxr")
+    city(tmp_path, output, tile_size=100.0)
+    npz, other = summarize(tmp_path / "city.npz"), summarize(tmp_path / output)
+    assert other["instances"] == npz["instances"] and other["assets"] == npz["assets"]
+    np.testing.assert_allclose(other["bbox"]["min"], npz["bbox"]["min"], atol=2e-3)
+    np.testing.assert_allclose(other["bbox"]["max"], npz["bbox"]["max"], atol=2e-3)
+    assert other["polygons"]["baked_triangles"] == npz["polygons"]["baked_triangles"]
+    if output.endswith(".usdc"):
+        assert other["symbols"] == npz["symbols"] and other["per_lot"] == npz["per_lot"]
+    else:
+        assert other["symbols"] == {} and "symbols" not in format_summary(other)
+    assert other["bytes"] > 0 and output in format_summary(other)
