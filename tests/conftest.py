@@ -37,6 +37,16 @@ def make_lots(*names: str, attrs: dict | None = None):
     return lots_from_polygons([LOT_ZOO[n] for n in names], ids=list(names), attrs=attrs)
 
 
+def example_script(folder: Path, name: str):
+    """Import one of an example's scripts (``examples/NAME`` is not a package)."""
+    import importlib.util
+
+    spec = importlib.util.spec_from_file_location(f"{folder.name}_{name}", folder / f"{name}.py")
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
 @pytest.fixture
 def write(tmp_path):
     """Write a text file under tmp_path and return its path: ``write("g.cga", text)``."""

@@ -12,7 +12,6 @@ The whole town (2,505 lots) derives in about a second, so the tests build it who
 
 from __future__ import annotations
 
-import importlib.util
 import json
 import re
 import sys
@@ -20,6 +19,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from conftest import example_script
 from test_examples import record_digest
 
 from grammarc.build import build
@@ -33,11 +33,7 @@ NOT_BUILDINGS = ("street", "crossing", "wall", "tower")
 
 
 def _script(name: str):
-    """Import one of the example's scripts (the example folder is not a package)."""
-    spec = importlib.util.spec_from_file_location(f"pompeii_{name}", POMPEII / f"{name}.py")
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
+    return example_script(POMPEII, name)
 
 
 @pytest.fixture(scope="module")

@@ -15,13 +15,13 @@ The town (799 lots) derives in about a second, so the tests build it whole, once
 
 from __future__ import annotations
 
-import importlib.util
 import json
 import sys
 from pathlib import Path
 
 import numpy as np
 import pytest
+from conftest import example_script
 from test_examples import record_digest
 
 from grammarc.build import build
@@ -34,11 +34,7 @@ GRAMMAR = VITRUVIAN / "vitruvian.cga"
 
 
 def _script(name: str):
-    """Import one of the example's scripts (the example folder is not a package)."""
-    spec = importlib.util.spec_from_file_location(f"vitruvian_{name}", VITRUVIAN / f"{name}.py")
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
+    return example_script(VITRUVIAN, name)
 
 
 @pytest.fixture(scope="module")

@@ -15,13 +15,13 @@ column 1 its y axis times its height, column 2 its z axis times its depth, colum
 
 from __future__ import annotations
 
-import importlib.util
 import json
 import sys
 from pathlib import Path
 
 import numpy as np
 import pytest
+from conftest import example_script
 from test_examples import record_digest
 
 from grammarc.build import build
@@ -37,11 +37,7 @@ TOL = 1e-3
 
 
 def _script(name: str):
-    """Import one of the example's scripts (the example folder is not a package)."""
-    spec = importlib.util.spec_from_file_location(f"xkipche_{name}", XKIPCHE / f"{name}.py")
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
+    return example_script(XKIPCHE, name)
 
 
 @pytest.fixture(scope="module")

@@ -16,95 +16,17 @@ written in the unit box [0, 1]^3 with 4 decimals, so the same script always writ
 
 from __future__ import annotations
 
-import argparse
 import math
-from itertools import pairwise
+import sys
 from pathlib import Path
 
 import numpy as np
 
-
-class Mesh:
-    """Polygons (counter-clockwise seen from outside) over a growing vertex list."""
-
-    def __init__(self) -> None:
-        self.vertices: list[tuple[float, float, float]] = []
-        self.faces: list[list[int]] = []
-
-    def add(self, points, faces) -> Mesh:
-        base = len(self.vertices)
-        self.vertices.extend(tuple(map(float, p)) for p in points)
-        self.faces.extend([base + i for i in face] for face in faces)
-        return self
-
-    def merge(self, other: Mesh) -> Mesh:
-        return self.add(other.vertices, other.faces)
-
-    def triangles(self) -> int:
-        return sum(len(f) - 2 for f in self.faces)
-
-    def obj(self, title: str) -> str:
-        """The OBJ text, fitted to the unit box (the grammar gives the size, the asset the form)."""
-        v = np.array(self.vertices)
-        lo, hi = v.min(axis=0), v.max(axis=0)
-        span = np.where(hi - lo > 1e-12, hi - lo, 1.0)
-        v = (v - lo) / span
-        lines = [f"# {title}", "# made by make_assets.py (grammarc Pompeii example); unit box, y up, +z front"]
-        lines += [f"v {x:.4f} {y:.4f} {z:.4f}".replace("-0.0000", "0.0000") for x, y, z in v]
-        lines += ["f " + " ".join(str(i + 1) for i in face) for face in self.faces]
-        return "\n".join(lines) + "\n"
-
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))  # examples/assetkit.py
+import assetkit
+from assetkit import Mesh, box, combine, extrude_x, lathe
 
 # ------------------------------------------------------------------------------------------ primitives
-
-
-def box(x0, y0, z0, x1, y1, z1) -> Mesh:
-    """An axis-aligned box (the corner order of grammarc's built-in cube)."""
-    points = [(x1 if i & 1 else x0, y1 if i >> 1 & 1 else y0, z1 if i >> 2 & 1 else z0) for i in range(8)]
-    quads = [[0, 4, 6, 2], [1, 3, 7, 5], [0, 1, 5, 4], [2, 6, 7, 3], [0, 2, 3, 1], [4, 5, 7, 6]]
-    return Mesh().add(points, quads)
-
-
-def lathe(profile, sides: int, cx: float = 0.0, cz: float = 0.0, caps: bool = True) -> Mesh:
-    """A solid of revolution about the vertical line through (cx, cz): ``profile`` is (radius, y) from
-    bottom to top; a radius of 0 closes the solid in a point. Columns, amphorae, basins, trees."""
-    mesh = Mesh()
-    rings = []
-    for r, y in profile:
-        if r == 0:
-            rings.append([len(mesh.vertices)])
-            mesh.vertices.append((cx, y, cz))
-            continue
-        start = len(mesh.vertices)
-        for k in range(sides):
-            a = 2 * math.pi * k / sides
-            mesh.vertices.append((cx + r * math.cos(a), y, cz - r * math.sin(a)))
-        rings.append(list(range(start, start + sides)))
-    for lower, upper in pairwise(rings):
-        for k in range(sides):
-            k1 = (k + 1) % sides
-            if len(lower) == 1:
-                mesh.faces.append([lower[0], upper[k1], upper[k]])
-            elif len(upper) == 1:
-                mesh.faces.append([lower[k], lower[k1], upper[0]])
-            else:
-                mesh.faces.append([lower[k], lower[k1], upper[k1], upper[k]])
-    if caps:
-        if len(rings[0]) > 1:
-            mesh.faces.append(list(reversed(rings[0])))
-        if len(rings[-1]) > 1:
-            mesh.faces.append(list(rings[-1]))
-    return mesh
-
-
-def extrude_x(profile, x0: float, x1: float) -> Mesh:
-    """A prism along x over ``profile``: (z, y) points, counter-clockwise in the (z, y) plane. Roofs, steps,
-    mouldings: everything whose section is the same along a wall."""
-    n = len(profile)
-    points = [(x0, y, z) for z, y in profile] + [(x1, y, z) for z, y in profile]
-    faces = [list(range(n)), list(reversed(range(n, 2 * n)))]
-    faces += [[k, n + k, n + (k + 1) % n, (k + 1) % n] for k in range(n)]
-    return Mesh().add(points, faces)
 
 
 def extrude_z(profile, z0: float, z1: float) -> Mesh:
@@ -120,13 +42,6 @@ def extrude_z(profile, z0: float, z1: float) -> Mesh:
 def two_sided_quad(p0, p1, p2, p3) -> Mesh:
     """A quad with a face on each side: the leaves of a crossed-quad tree are seen from everywhere."""
     return Mesh().add([p0, p1, p2, p3], [[0, 1, 2, 3], [3, 2, 1, 0]])
-
-
-def combine(*meshes: Mesh) -> Mesh:
-    out = Mesh()
-    for mesh in meshes:
-        out.merge(mesh)
-    return out
 
 
 # -------------------------------------------------------------------------------- columns and orders
@@ -465,24 +380,13 @@ ASSETS = {
 }  # fmt: skip
 
 
+NOTE = "made by make_assets.py (grammarc Pompeii example); unit box, y up, +z front"
+
+
 def obj_files() -> dict[str, tuple[str, int]]:
-    """Each asset's file name, its OBJ text and its triangle count (what main writes; tests compare)."""
-    files = {}
-    for name, make in ASSETS.items():
-        mesh = make()
-        files[f"{name}.obj"] = (mesh.obj(f"{name}: {make.__doc__.splitlines()[0]}"), mesh.triangles())
-    return files
-
-
-def main() -> None:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--out", type=Path, default=Path(__file__).resolve().parent / "assets")
-    args = parser.parse_args()
-    args.out.mkdir(parents=True, exist_ok=True)
-    for name, (text, triangles) in obj_files().items():
-        (args.out / name).write_text(text)
-        print(f"{name:24s} {triangles:4d} triangles")
+    """Each asset's file name, OBJ text and triangle count (``assetkit.obj_files``; the tests compare)."""
+    return assetkit.obj_files(ASSETS, NOTE)
 
 
 if __name__ == "__main__":
-    main()
+    assetkit.main(ASSETS, NOTE, Path(__file__).resolve().parent, __doc__.splitlines()[0])

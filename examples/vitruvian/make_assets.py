@@ -15,87 +15,16 @@ with 4 decimals, so the same script always writes the same bytes.
 
 from __future__ import annotations
 
-import argparse
 import math
-from itertools import pairwise
+import sys
 from pathlib import Path
 
-import numpy as np
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))  # examples/assetkit.py
+import assetkit
+from assetkit import Mesh, box, combine, lathe
 
 #: The shaft's top diameter over its foot's (III.2.12, as the thesis has it): the test reads it back.
 SHAFT_TOP = 0.75
-
-
-class Mesh:
-    """Polygons (counter-clockwise seen from outside) over a growing vertex list."""
-
-    def __init__(self) -> None:
-        self.vertices: list[tuple[float, float, float]] = []
-        self.faces: list[list[int]] = []
-
-    def add(self, points, faces) -> Mesh:
-        base = len(self.vertices)
-        self.vertices.extend(tuple(map(float, p)) for p in points)
-        self.faces.extend([base + i for i in face] for face in faces)
-        return self
-
-    def triangles(self) -> int:
-        return sum(len(f) - 2 for f in self.faces)
-
-    def obj(self, title: str) -> str:
-        """The OBJ text, fitted to the unit box."""
-        v = np.array(self.vertices)
-        lo, hi = v.min(axis=0), v.max(axis=0)
-        v = (v - lo) / np.where(hi - lo > 1e-12, hi - lo, 1.0)
-        lines = [f"# {title}", "# made by make_assets.py (grammarc Vitruvian example); unit box, y up, +z front"]
-        lines += [f"v {x:.4f} {y:.4f} {z:.4f}".replace("-0.0000", "0.0000") for x, y, z in v]
-        lines += ["f " + " ".join(str(i + 1) for i in face) for face in self.faces]
-        return "\n".join(lines) + "\n"
-
-
-def combine(*meshes: Mesh) -> Mesh:
-    out = Mesh()
-    for mesh in meshes:
-        out.add(mesh.vertices, mesh.faces)
-    return out
-
-
-def box(x0, y0, z0, x1, y1, z1) -> Mesh:
-    """An axis-aligned box."""
-    points = [(x1 if i & 1 else x0, y1 if i >> 1 & 1 else y0, z1 if i >> 2 & 1 else z0) for i in range(8)]
-    quads = [[0, 4, 6, 2], [1, 3, 7, 5], [0, 1, 5, 4], [2, 6, 7, 3], [0, 2, 3, 1], [4, 5, 7, 6]]
-    return Mesh().add(points, quads)
-
-
-def lathe(profile, sides: int, axis: str = "y") -> Mesh:
-    """A solid of revolution: ``profile`` is (radius, height) from one end to the other; a radius of 0
-    closes it in a point. About the vertical (y) axis, or the z axis for the capital's volutes."""
-    mesh, rings = Mesh(), []
-    for r, h in profile:
-        if r == 0:
-            rings.append([len(mesh.vertices)])
-            mesh.vertices.append((0.0, h, 0.0) if axis == "y" else (0.0, 0.0, h))
-            continue
-        start = len(mesh.vertices)
-        for k in range(sides):
-            a = 2 * math.pi * k / sides
-            c, s = r * math.cos(a), r * math.sin(a)
-            mesh.vertices.append((c, h, -s) if axis == "y" else (c, s, h))
-        rings.append(list(range(start, start + sides)))
-    for lower, upper in pairwise(rings):
-        for k in range(sides):
-            k1 = (k + 1) % sides
-            if len(lower) == 1:
-                mesh.faces.append([lower[0], upper[k1], upper[k]])
-            elif len(upper) == 1:
-                mesh.faces.append([lower[k], lower[k1], upper[0]])
-            else:
-                mesh.faces.append([lower[k], lower[k1], upper[k1], upper[k]])
-    if len(rings[0]) > 1:
-        mesh.faces.append(list(reversed(rings[0])))
-    if len(rings[-1]) > 1:
-        mesh.faces.append(list(rings[-1]))
-    return mesh
 
 
 def ionic_base() -> Mesh:
@@ -178,24 +107,13 @@ ASSETS = {"ionic_base": ionic_base, "ionic_shaft": ionic_shaft, "ionic_capital":
           "archway": archway, "statue": statue, "tree_cypress": tree_cypress, "tree_pine": tree_pine}
 
 
+NOTE = "made by make_assets.py (grammarc Vitruvian example); unit box, y up, +z front"
+
+
 def obj_files() -> dict[str, tuple[str, int]]:
-    """Each asset's file name, its OBJ text and its triangle count (what main writes; tests compare)."""
-    files = {}
-    for name, make in ASSETS.items():
-        mesh = make()
-        files[f"{name}.obj"] = (mesh.obj(f"{name}: {make.__doc__.splitlines()[0]}"), mesh.triangles())
-    return files
-
-
-def main() -> None:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--out", type=Path, default=Path(__file__).resolve().parent / "assets")
-    args = parser.parse_args()
-    args.out.mkdir(parents=True, exist_ok=True)
-    for name, (text, triangles) in obj_files().items():
-        (args.out / name).write_text(text)
-        print(f"{name:20s} {triangles:4d} triangles")
+    """Each asset's file name, OBJ text and triangle count (``assetkit.obj_files``; the tests compare)."""
+    return assetkit.obj_files(ASSETS, NOTE)
 
 
 if __name__ == "__main__":
-    main()
+    assetkit.main(ASSETS, NOTE, Path(__file__).resolve().parent, __doc__.splitlines()[0])
