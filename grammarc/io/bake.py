@@ -602,12 +602,14 @@ def _earcut_faces(vertices: np.ndarray, ring_offsets: np.ndarray, face_offsets: 
 class BakedWriter:
     """Collects TerminalChunks and writes them baked into one mesh on close: .obj, .ply, .stl or .glb.
 
-    The interface of ``InstanceWriter``: the format follows the path's extension. A mesh cannot be
-    streamed the way an instance record is (a glb's buffers and an obj's vertex indices need the whole
-    mesh), so the chunks are kept in memory; the writer counts the triangles they will make as they come
-    and refuses a chunk that would pass ``max_triangles``, which bounds the memory. ``close()`` bakes,
-    exports with trimesh to a temporary file next to ``path`` and renames it onto ``path``; nothing is
-    written before, so ``abort()`` (or an exception inside ``with``) leaves no file.
+    The interface of ``InstanceWriter``: the format follows the path's extension. OBJ is streamed: each
+    chunk is baked as it comes and appended to a temporary file next to ``path`` (its vertices, then its
+    triangles indexing them from the vertices written before), so memory holds one chunk's mesh (candler
+    x500, 2.1 GB of OBJ, took 8.4 GB when kept whole). PLY, STL and GLB need the whole mesh (counts in
+    their headers, one buffer), so their chunks are kept until ``close()``, which bakes and exports them
+    with trimesh. Either way the writer counts the triangles chunks will make as they come and refuses a
+    chunk that would pass ``max_triangles``; the file is renamed onto ``path`` only when complete, so
+    ``abort()`` (or an exception inside ``with``) leaves nothing there.
 
     Parameters
     ----------
@@ -653,9 +655,19 @@ class BakedWriter:
         self._rows = 0
         self._state = "open"
         self._counts: dict = {}
+        self._made = {"triangles": 0, "vertices": 0, "polygons": 0, "mesh_faces": 0, "mesh_vertices": 0}
+        # a private directory next to the output (same filesystem, for the rename); the file in it gets
+        # the umask's permissions, as the npz writer's output does (mkstemp would give 0600)
+        self._tmpdir: str | None = None
+        self._obj = None
+        if self._file_type == "obj":
+            self._tmpdir = tempfile.mkdtemp(prefix=f".{self.path.name}.tmp", dir=self.path.parent)
+            self._obj = open(os.path.join(self._tmpdir, self.path.name), "xb")  # noqa: SIM115 - closed by close/abort
+            header = f"grammarc {self._meta.get('grammarc', '')} bake of {self._meta.get('grammar', '')}"
+            self._obj.write(f"# {' '.join(header.split())}\n".encode())
 
     def write(self, chunk: TerminalChunk) -> None:
-        """Keep a chunk's instances and polygons for ``close()`` (not copied: do not modify them).
+        """Bake a chunk into the OBJ, or keep it for ``close()`` (not copied: do not modify it).
 
         Raises
         ------
@@ -684,12 +696,26 @@ class BakedWriter:
                     "(GRAMMARC_MAX_TRIANGLES=N), bake a few lots with --select, or write an instance "
                     "record (.npz) or instanced .glb/.usdc instead"
                 )
+            if self._obj is not None:
+                mesh = _bake(self._library, asset.astype(np.int64, copy=False), xform, chunk.mesh,
+                             self.max_triangles)
+                self._obj.write(obj_bytes(mesh.vertices, mesh.faces + self._made["vertices"]))
+                self._count(mesh, chunk.mesh)
+            else:
+                self._chunks.append((asset, xform, chunk.mesh))
         except BaseException:
             self.abort()
             raise
-        self._chunks.append((asset, xform, chunk.mesh))
         self._triangles += triangles
         self._rows += len(asset)
+
+    def _count(self, mesh, table: MeshChunk) -> None:
+        made = self._made
+        made["triangles"] += len(mesh.faces)
+        made["vertices"] += len(mesh.vertices)
+        made["polygons"] += int(mesh.metadata["n_polygons"])
+        made["mesh_faces"] += int(len(table.face_offsets) - 1)
+        made["mesh_vertices"] += len(table.vertices)
 
     def close(self) -> dict:
         """Bake the chunks, export the mesh next to ``path`` and rename it onto ``path``.
@@ -704,50 +730,42 @@ class BakedWriter:
             return dict(self._counts)
         if self._state == "aborted":
             raise ValueError("close of a BakedWriter that is aborted")
-        tmpdir = None
         try:
-            chunks, self._chunks = self._chunks, []
-            mesh_table = MeshChunk.concat([c[2] for c in chunks])
-            asset = np.concatenate([c[0] for c in chunks]) if chunks else np.zeros(0, np.int64)
-            xform = np.concatenate([c[1] for c in chunks]) if chunks else np.zeros((0, 3, 4), np.float32)
-            del chunks
-            mesh = _bake(self._library, asset.astype(np.int64, copy=False), xform, mesh_table,
-                         self.max_triangles)
-            del asset, xform
-            n_polygons = int(mesh.metadata["n_polygons"])
-            data = self._export(mesh)
-            # A private directory next to the output (same filesystem, for the rename); the file in it
-            # gets the umask's permissions, as the npz writer's output does (mkstemp would give 0600).
-            tmpdir = tempfile.mkdtemp(prefix=f".{self.path.name}.tmp", dir=self.path.parent)
-            tmp = os.path.join(tmpdir, self.path.name)
-            with open(tmp, "xb") as out:
-                out.write(data)
-                out.flush()
-                os.fsync(out.fileno())
-            del data
-            os.replace(tmp, self.path)
+            if self._obj is None:
+                self._tmpdir = tempfile.mkdtemp(prefix=f".{self.path.name}.tmp", dir=self.path.parent)
+                self._obj = open(os.path.join(self._tmpdir, self.path.name), "xb")  # noqa: SIM115
+                chunks, self._chunks = self._chunks, []
+                mesh_table = MeshChunk.concat([c[2] for c in chunks])
+                asset = np.concatenate([c[0] for c in chunks]) if chunks else np.zeros(0, np.int64)
+                xform = np.concatenate([c[1] for c in chunks]) if chunks else np.zeros((0, 3, 4), np.float32)
+                del chunks
+                mesh = _bake(self._library, asset.astype(np.int64, copy=False), xform, mesh_table,
+                             self.max_triangles)
+                del asset, xform
+                self._count(mesh, mesh_table)
+                self._obj.write(self._export(mesh))
+                del mesh
+            self._obj.flush()
+            os.fsync(self._obj.fileno())
+            self._obj.close()
+            os.replace(os.path.join(self._tmpdir, self.path.name), self.path)
         except BaseException:
             self.abort()
             raise
-        finally:
-            if tmpdir is not None:
-                shutil.rmtree(tmpdir, ignore_errors=True)
+        shutil.rmtree(self._tmpdir, ignore_errors=True)
         self._state = "closed"
-        self._counts = {
-            "instances": self._rows,
-            "mesh_faces": int(len(mesh_table.face_offsets) - 1),
-            "mesh_vertices": len(mesh_table.vertices),
-            "triangles": len(mesh.faces),
-            "vertices": len(mesh.vertices),
-            "polygons": n_polygons,
-        }
+        self._counts = {"instances": self._rows, **self._made}
         return dict(self._counts)
 
     def abort(self) -> None:
-        """Drop the chunks; nothing was written, and a file already at ``path`` is left untouched."""
+        """Drop the chunks and the partial file; a file already at ``path`` is left untouched."""
         if self._state == "open":
             self._state = "aborted"
             self._chunks = []
+            if self._obj is not None:
+                self._obj.close()
+            if self._tmpdir is not None:
+                shutil.rmtree(self._tmpdir, ignore_errors=True)
 
     def __enter__(self) -> Self:
         return self
@@ -759,11 +777,7 @@ class BakedWriter:
             self.close()
 
     def _export(self, mesh) -> bytes:
-        """The file's bytes. OBJ without normals or texture (the bake has neither), a header naming
-        the grammar; PLY and STL binary; GLB as trimesh writes a scene of one mesh."""
-        if self._file_type == "obj":
-            header = f"grammarc {self._meta.get('grammarc', '')} bake of {self._meta.get('grammar', '')}"
-            return obj_bytes(mesh.vertices, mesh.faces, " ".join(header.split()))
+        """The bytes of a PLY or STL (binary), or a GLB as trimesh writes a scene of one mesh."""
         mesh.metadata = {}  # glb writes metadata as extras; keep the file to geometry
         data = mesh.export(file_type=self._file_type)
         return data if isinstance(data, bytes) else data.encode("utf-8")
