@@ -41,8 +41,8 @@ def read_obj(text: str, path: str = "<obj>") -> tuple[np.ndarray, list[np.ndarra
     return np.array(points, dtype=np.float64).reshape(-1, 3), faces
 
 
-#: Decimals of the coordinates ``obj_bytes`` writes: a micrometre, below the float32 step of a record's
-#: coordinates beyond 10 m from the origin.
+#: Decimals of the coordinates ``obj_bytes`` writes (``_fixed`` writes them as three digit pairs): a
+#: micrometre, below the float32 step of a record's coordinates beyond 10 m from the origin.
 DECIMALS = 6
 
 
@@ -60,19 +60,19 @@ def obj_bytes(vertices: np.ndarray, faces: np.ndarray, header: str = "") -> byte
     lines = "".join(f"# {line}\n" for line in header.splitlines() if line)
     # the longest line: "v " + 3 * ("-" + 19 digits + "." + decimals + " "), "f " + 3 * (19 digits + " ")
     buffer = np.empty(len(vertices) * (2 + 3 * (22 + DECIMALS)) + len(faces) * (2 + 3 * 20) + 1, np.uint8)
-    used = _write_obj(vertices, faces, buffer, 10 ** DECIMALS)
+    used = _write_obj(vertices, faces, buffer)
     return lines.encode() + buffer[:used].tobytes()
 
 
 @njit(cache=True, nogil=True)
-def _write_obj(vertices, faces, out, scale):
+def _write_obj(vertices, faces, out):
     at = 0
     for i in range(vertices.shape[0]):
         out[at] = 118  # v
         at += 1
         for k in range(3):
             out[at] = 32
-            at = _fixed(vertices[i, k], scale, out, at + 1)
+            at = _fixed(vertices[i, k], out, at + 1)
         out[at] = 10
         at += 1
     for i in range(faces.shape[0]):
@@ -86,39 +86,49 @@ def _write_obj(vertices, faces, out, scale):
     return at
 
 
+#: "00" .. "99": digits are written two at a time (half the divisions).
+_PAIRS = np.array([ord(c) for k in range(100) for c in f"{k:02d}"], dtype=np.uint8)
+
+
 @njit(cache=True, nogil=True)
 def _integer(value, out, at):
     """The decimal digits of ``value`` >= 0 at ``out[at:]``; the position after them."""
     digits = 1
-    rest = value // 10
-    while rest:
+    bound = 10
+    while value >= bound and digits < 19:
         digits += 1
-        rest //= 10
-    for d in range(digits - 1, -1, -1):
-        out[at + d] = 48 + value % 10
-        value //= 10
-    return at + digits
+        bound *= 10
+    end = at + digits
+    pos = end
+    while value >= 100:
+        pair = value % 100
+        value //= 100
+        out[pos - 2] = _PAIRS[2 * pair]
+        out[pos - 1] = _PAIRS[2 * pair + 1]
+        pos -= 2
+    if value >= 10:
+        out[pos - 2] = _PAIRS[2 * value]
+        out[pos - 1] = _PAIRS[2 * value + 1]
+    else:
+        out[pos - 1] = 48 + value
+    return end
 
 
 @njit(cache=True, nogil=True)
-def _fixed(value, scale, out, at):
-    """``value`` in fixed point (rounded to 1 / ``scale``, trailing zeros and a bare point dropped)."""
-    units = np.int64(np.round(abs(value) * scale))
+def _fixed(value, out, at):
+    """``value`` in fixed point with ``DECIMALS`` (6) decimals, trailing zeros and a bare point dropped."""
+    units = np.int64(np.round(abs(value) * 1_000_000))
     if units and value < 0:
         out[at] = 45  # -
         at += 1
-    at = _integer(units // scale, out, at)
-    fraction = units % scale
+    at = _integer(units // 1_000_000, out, at)
+    fraction = units % 1_000_000
     if fraction:
         out[at] = 46  # .
-        at += 1
-        width = 0
-        step = scale // 10
-        while step:
-            out[at + width] = 48 + (fraction // step) % 10
-            width += 1
-            step //= 10
-        while out[at + width - 1] == 48:
-            width -= 1
-        at += width
+        for k, pair in enumerate((fraction // 10_000, fraction // 100 % 100, fraction % 100)):
+            out[at + 1 + 2 * k] = _PAIRS[2 * pair]
+            out[at + 2 + 2 * k] = _PAIRS[2 * pair + 1]
+        at += 7
+        while out[at - 1] == 48:
+            at -= 1
     return at
