@@ -377,7 +377,7 @@ class _Builder:
         reasons = _validate(lots, normals, self.world)
         rejected = np.flatnonzero(reasons != "")
         bad = self.bad + [BadLot(int(lots.index[i]), lots.ids[i], reasons[i]) for i in rejected]
-        good = lots.take(np.flatnonzero(reasons == ""))
+        good = lots.take(np.flatnonzero(reasons == "")) if len(rejected) else lots  # a copy only to drop some
         return replace(good, bad=tuple(sorted(bad, key=lambda b: b.index)))
 
 
