@@ -61,6 +61,16 @@ def test_unreachable_rules_warn():
     ]
 
 
+def test_a_recursion_whose_every_rule_has_a_guard_warns():
+    """The shape that ends such a recursion stays in the record as a leaf: rarely meant."""
+    text = 'lot ~> row(0)\nrow(k) : k < 2 ~> [ T(k * 2, 0, 0) S(1, 1, 1) post ] row(k + 1)\n'
+    _, diags = graph(text)
+    assert [(d.span.line, d.message) for d in diags] == [(2, (
+        "every rule of recursive `row` has a guard: the shape that ends the recursion becomes a leaf (a box "
+        "in the record); add `row ~> ε` to drop it"))]
+    assert not list(graph(text + "row(k) ~> ε\n")[1])
+
+
 def test_another_start_symbol():
     g, diags = graph("lot ~> a\na ~> b", start="a")
     assert g.reachable == frozenset({"a", "b"})

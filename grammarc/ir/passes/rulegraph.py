@@ -44,7 +44,25 @@ def analyze_rules(module: ir.Module, start: str, diags: Diagnostics) -> RuleGrap
             diags.warning("unreachable", f"rule for `{rule.symbol}` is never reached from `{start}`",
                           rule.span)
     frozen = {s: tuple(dict.fromkeys(t)) for s, t in edges.items()}
-    return RuleGraph(start, nonterminals, terminals, frozenset(reachable), _recursive(frozen), frozen)
+    recursive = _recursive(frozen)
+    _warn_guarded_recursion(module, recursive & reachable, diags)
+    return RuleGraph(start, nonterminals, terminals, frozenset(reachable), recursive, frozen)
+
+
+def _warn_guarded_recursion(module: ir.Module, recursive: frozenset[str], diags: Diagnostics) -> None:
+    """In the paper's notation a shape no rule applies to is a leaf: a recursion whose every rule has a
+    guard (``row(k) : k < n ~> ... row(k + 1)``) leaves its last shape in the record as a stray box,
+    which is seldom meant. CityEngine's rules always apply (``case ... else``), so only the paper's."""
+    if module.dialect != "cga2006":
+        return
+    rules: dict[str, list[ir.Rule]] = {}
+    for rule in module.rules:
+        rules.setdefault(rule.symbol, []).append(rule)
+    for symbol in sorted(recursive):
+        if all(rule.guard is not None for rule in rules.get(symbol, ())):
+            diags.warning("guarded-recursion", f"every rule of recursive `{symbol}` has a guard: the shape "
+                          f"that ends the recursion becomes a leaf (a box in the record); add `{symbol} ~> ε` "
+                          "to drop it", rules[symbol][0].span)
 
 
 def _reach(start: str, edges) -> set[str]:
