@@ -23,6 +23,8 @@ Conventions, those of CityEngine and Esri PRT:
 
 from __future__ import annotations
 
+import contextlib
+import gc
 import json
 import numbers
 import os
@@ -182,10 +184,11 @@ def read_lots(path: str | os.PathLike) -> Lots:
     if suffix == ".parquet":
         from grammarc.io.geoparquet import read_geoparquet
 
-        builder, attrs = read_geoparquet(path)
-        if builder.polygons == 0:
-            raise LotsError(f"no polygon in lots file {path}")
-        return builder.finish(attrs, str(path))
+        with _no_cycle_collection():
+            builder, attrs = read_geoparquet(path)
+            if builder.polygons == 0:
+                raise LotsError(f"no polygon in lots file {path}")
+            return builder.finish(attrs, str(path))
     if suffix not in (".geojson", ".json", ".obj"):
         raise LotsError(f"unknown lots file type {suffix!r} (expected .geojson, .json, .obj or .parquet): "
                         f"{path}")
@@ -193,6 +196,26 @@ def read_lots(path: str | os.PathLike) -> Lots:
         text = path.read_text(encoding="utf-8")
     except (OSError, UnicodeDecodeError) as error:
         raise LotsError(f"cannot read lots file {path}: {error}") from error
+    with _no_cycle_collection():
+        return _read_text(text, path, suffix)
+
+
+@contextlib.contextmanager
+def _no_cycle_collection():
+    """The cyclic garbage collector off while a file is parsed: JSON makes millions of dicts and lists
+    (a tree, no cycles, freed by reference counting), and each collection walks them all again. At
+    2.5 * 10^5 lots reading took 8.9 s with it, 4.7 s without."""
+    was_enabled = gc.isenabled()
+    gc.disable()
+    try:
+        yield
+    finally:
+        if was_enabled:
+            gc.enable()
+
+
+def _read_text(text: str, path: Path, suffix: str) -> Lots:
+    """``read_lots`` of a text file's contents."""
     if suffix == ".obj":
         builder = _parse_obj(text, path)
     else:
