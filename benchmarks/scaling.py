@@ -22,8 +22,8 @@ from pathlib import Path
 
 from conftest import HERE, grid_lots, run_build
 
-#: The facade grammar with one 3 m floor of 6 m tiles: 50 terminals a lot, so 10^6 lots are 5 * 10^7
-#: records (3 GB), which this machine's disk and memory take.
+#: The facade grammar with one 3 m floor of 6 m tiles: 70 terminals a lot, so 10^6 lots are 7 * 10^7
+#: records (4.2 GB), which this machine's disk and memory take.
 FACADE_ATTRS = ["--attr", "height=3", "--attr", "tile_w=6"]
 
 
