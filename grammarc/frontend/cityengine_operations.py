@@ -220,25 +220,10 @@ class OperationLowering:
             kind = args[0].name if args and isinstance(args[0], ir.Name) else "?"
             return self.unsupported(f"comp({kind})", span, "comp(f), comp(e) and comp(v)")
         kind = args[0].name
-        known = COMP_SELECTORS[kind]
-        selectors, bodies = [], []
-        for part in parts:
-            if isinstance(part, Group):
-                return self.unsupported("repeat group in comp", part.span)
-            value = part.size.value
-            if part.size.kind is not ir.SizeKind.ABSOLUTE or not isinstance(value, ir.Name):
-                return self.unsupported("this comp selector", part.span)
-            if value.name not in known:
-                why = f"comp({kind}) selects {', '.join(sorted(known))}" + suggest(value.name, known)
-                return self.unsupported(f"comp({kind}) selector `{value.name}`", value.span, why)
-            if part.merged:
-                self.diags.warning(
-                    "merged", f"`{value.name}=` gives one shape for all its faces in CityEngine; grammarc "
-                    "derives them one by one (the same leaves; operations that read the scope differ)",
-                    part.span)
-            selectors.append(value.name)
-            bodies.append(part.body)
-        return ir.CompFaces(tuple(selectors), tuple(bodies), span, self.site(), kind)
+        chosen = self.selector_parts("comp", parts, COMP_SELECTORS[kind], named=f"comp({kind})", noun="faces")
+        if chosen is None:
+            return ir.Empty(span)
+        return ir.CompFaces(*chosen, span, self.site(), kind)
 
     def op_setback(self, op, args, parts, span):
         """``setback(d) { sel: A | remainder: B }``; ``shapeL/U/O(widths...) { shape: A | remainder: B }``;
@@ -298,9 +283,11 @@ class OperationLowering:
             return ir.Empty(span)
         return ir.InnerRectangle(args[0].name, chosen[0], chosen[1], span, self.site())
 
-    def selector_parts(self, op, parts, known):
+    def selector_parts(self, op, parts, known, named=None, noun="polygons"):
         """The selectors and bodies of ``{ sel: A | ... }`` parts, all among ``known`` (None after an
-        error); ``sel=`` is derived as ``sel:``, with a warning."""
+        error); ``sel=`` is derived as ``sel:``, with a warning. ``named`` is the operation as a selector
+        error names it (``comp(f)``; default ``op``), ``noun`` what ``sel=`` would merge."""
+        named = named or op
         selectors, bodies = [], []
         for part in parts:
             if isinstance(part, Group):
@@ -311,12 +298,13 @@ class OperationLowering:
                 self.unsupported(f"this {op} selector", part.span)
                 return None
             if value.name not in known:
-                why = f"{op} selects {', '.join(sorted(known - {'remainder'}))} and remainder"
-                self.unsupported(f"{op} selector `{value.name}`", value.span, why + suggest(value.name, known))
+                listed = ", ".join(sorted(known - {"remainder"}))
+                why = f"{named} selects {listed}" + (" and remainder" if "remainder" in known else "")
+                self.unsupported(f"{named} selector `{value.name}`", value.span, why + suggest(value.name, known))
                 return None
             if part.merged:
                 self.diags.warning(
-                    "merged", f"`{value.name}=` gives one shape for all its polygons in CityEngine; grammarc "
+                    "merged", f"`{value.name}=` gives one shape for all its {noun} in CityEngine; grammarc "
                     "derives them one by one (the same leaves; operations that read the scope differ)",
                     part.span)
             selectors.append(value.name)
