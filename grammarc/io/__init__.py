@@ -33,6 +33,20 @@ WRITERS = {
 BAKEABLE = (".obj", ".ply", ".stl", ".glb")
 
 
+class WriterBlock:
+    """``with writer:`` for writers with ``close``, ``abort`` and a ``_state``: closed when the block
+    ends, aborted when it raises; a writer closed or aborted inside the block is left as it is."""
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, exc_type, exc, tb) -> None:
+        if exc_type is not None:
+            self.abort()
+        elif self._state == "open":
+            self.close()
+
+
 @dataclass(frozen=True)
 class OutputOptions:
     """How a record is written, beyond its rows: ``bake`` instances into meshes (at most ``max_triangles``),

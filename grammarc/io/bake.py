@@ -49,19 +49,17 @@ from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from functools import cache, lru_cache
 from pathlib import Path
-from typing import TYPE_CHECKING, ClassVar
+from typing import ClassVar
 
 import numpy as np
 
 from grammarc.constants import LIMITS
 from grammarc.errors import AssetError, UsageError
+from grammarc.io import WriterBlock
 from grammarc.io.assets import builtin_name, resolve_asset
 from grammarc.io.npz import MeshChunk, TerminalChunk
 from grammarc.io.obj import ObjError, obj_bytes, read_obj
 from grammarc.ragged import fan_out, offsets_from_counts, segment_reduce
-
-if TYPE_CHECKING:
-    from typing_extensions import Self
 
 __all__ = [
     "LOD_STAND_IN",
@@ -599,7 +597,7 @@ def _earcut_faces(vertices: np.ndarray, ring_offsets: np.ndarray, face_offsets: 
 # -------------------------------------------------------------------------------------------- writers
 
 
-class BakedWriter:
+class BakedWriter(WriterBlock):
     """Collects TerminalChunks and writes them baked into one mesh on close: .obj, .ply, .stl or .glb.
 
     The interface of ``InstanceWriter``: the format follows the path's extension. OBJ is streamed: each
@@ -766,15 +764,6 @@ class BakedWriter:
                 self._obj.close()
             if self._tmpdir is not None:
                 shutil.rmtree(self._tmpdir, ignore_errors=True)
-
-    def __enter__(self) -> Self:
-        return self
-
-    def __exit__(self, exc_type, exc, tb) -> None:
-        if exc_type is not None:
-            self.abort()
-        elif self._state == "open":  # closed or aborted inside the block: nothing left to do
-            self.close()
 
     def _export(self, mesh) -> bytes:
         """The bytes of a PLY or STL (binary), or a GLB as trimesh writes a scene of one mesh."""

@@ -27,16 +27,13 @@ import tempfile
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from typing import TYPE_CHECKING
 
 import numba as nb
 import numpy as np
 
 from grammarc.constants import LIMITS
+from grammarc.io import WriterBlock
 from grammarc.io.npz import WHITE, TerminalChunk
-
-if TYPE_CHECKING:
-    from typing_extensions import Self
 
 __all__ = ["INSTANCE", "TRIANGLE", "Tile", "TileSpool", "TiledWriter", "decompose"]
 
@@ -244,7 +241,7 @@ class TileSpool:
         return np.fromfile(path, dtype) if path.exists() else np.zeros(0, dtype)
 
 
-class TiledWriter:
+class TiledWriter(WriterBlock):
     """What the instanced writers share: the interface of ``InstanceWriter`` (``write``, ``close``,
     ``abort``, a context manager) over a ``TileSpool`` in a temporary folder next to the output.
 
@@ -309,15 +306,6 @@ class TiledWriter:
         if self._state == "open":
             self._state = "aborted"
             shutil.rmtree(self._tmp, ignore_errors=True)
-
-    def __enter__(self) -> Self:
-        return self
-
-    def __exit__(self, exc_type, exc, tb) -> None:
-        if exc_type is not None:
-            self.abort()
-        elif self._state == "open":
-            self.close()
 
     def __del__(self) -> None:
         if getattr(self, "_state", None) == "open":
