@@ -35,7 +35,7 @@ import numpy as np
 from grammarc.errors import UsageError
 from grammarc.io.instancing import TILE_SIZE, Tile, TiledWriter, compose, decompose
 
-__all__ = ["MAX_BYTES", "MAX_GROUPS", "GltfWriter", "part_paths", "read_glb"]
+__all__ = ["MAX_BYTES", "MAX_GROUPS", "GltfWriter", "index_path", "part_paths", "read_glb", "written_parts"]
 
 #: GLB's 32-bit length fields, less room for the JSON chunk.
 MAX_BYTES = (1 << 32) - (64 << 20)
@@ -45,6 +45,18 @@ _EXTENSION = "EXT_mesh_gpu_instancing"
 _FLOAT, _UINT, _UBYTE = 5126, 5125, 5121
 _ARRAY_BUFFER, _ELEMENT_ARRAY_BUFFER = 34962, 34963
 _WHITE = (255, 255, 255, 255)
+
+
+def index_path(path: str | os.PathLike) -> Path:
+    """The index of a GLB written in parts: ``city.glb`` -> ``city.glb.json``."""
+    path = Path(path)
+    return path.with_name(path.name + ".json")
+
+
+def written_parts(path: str | os.PathLike) -> list[Path]:
+    """The part files of a GLB as ``GltfWriter`` wrote it: those its index lists, else the file alone."""
+    path, index = Path(path), index_path(path)
+    return [path.with_name(name) for name in json.loads(index.read_text())["parts"]] if index.exists() else [path]
 
 
 def part_paths(path: str | os.PathLike, parts: int) -> list[Path]:
@@ -99,7 +111,7 @@ class GltfWriter(TiledWriter):
             index = self._tmp / "index.json"
             index.write_text(json.dumps({"parts": [p.name for p in paths],
                                          "instances": [p.instances for p in parts]}, indent=1))
-            os.replace(index, self.path.with_name(self.path.name + ".json"))
+            os.replace(index, index_path(self.path))
         for out, path in zip(staged, paths):
             os.replace(out, path)
         return {"parts": len(parts)}
@@ -276,10 +288,7 @@ def read_glb(path: str | os.PathLike) -> dict:
     """The instances of a city written by ``GltfWriter`` (all its parts), as a record dict (the keys of
     ``io.npz.read_instances`` that glTF keeps: assets, asset, xform (float64, world), the mesh table as
     triangles, meta); grouped by tile and (asset, colour), not in the record's order."""
-    path = Path(path)
-    index = path.with_name(path.name + ".json")
-    parts = ([path.with_name(name) for name in json.loads(index.read_text())["parts"]] if index.exists()
-             else [path])
+    parts = written_parts(path)
     names: dict[str, int] = {}
     assets, xforms, triangles, meta = [], [], [], {}
     for part in parts:

@@ -14,7 +14,6 @@ loaded is reported and left out of the polygon counts rather than failing the su
 
 from __future__ import annotations
 
-import json
 import os
 from pathlib import Path
 
@@ -88,11 +87,10 @@ def _read(path: Path) -> tuple[dict, list[Path]]:
 
         return read_usd(path), [path, *(f for f in tiles_folder(path).glob("*") if f.is_file())]
     if suffix == ".glb":
-        from grammarc.io.gltf import read_glb
+        from grammarc.io.gltf import index_path, read_glb, written_parts
 
-        index = path.with_name(path.name + ".json")
-        parts = [path.with_name(n) for n in json.loads(index.read_text())["parts"]] if index.exists() else [path]
-        return read_glb(path), parts + ([index] if index.exists() else [])
+        index = index_path(path)
+        return read_glb(path), written_parts(path) + ([index] if index.exists() else [])
     return read_instances(path), [path]
 
 

@@ -107,11 +107,7 @@ class UsdWriter(TiledWriter):
 
     def _write_prototypes(self, path: Path) -> dict[int, str]:
         """The prototype layer: a Mesh per used asset; returns asset index -> prim path."""
-        stage = Usd.Stage.CreateNew(str(path))
-        UsdGeom.SetStageUpAxis(stage, UsdGeom.Tokens.y)
-        UsdGeom.SetStageMetersPerUnit(stage, 1.0)
-        root = UsdGeom.Scope.Define(stage, "/Prototypes").GetPrim()
-        stage.SetDefaultPrim(root)
+        stage = _new_stage(path, UsdGeom.Scope, "/Prototypes")
         paths = {}
         for index in np.flatnonzero(self._used):
             shape = self._library[int(index)]
@@ -131,11 +127,7 @@ class UsdWriter(TiledWriter):
     def _write_tile(self, folder: Path, tile: Tile, prototypes: dict[int, str]) -> tuple[str, np.ndarray]:
         """One tile's layer: /Tile with its PointInstancer and its Mesh; the tile's name and origin (not
         the tile: its rows are let go)."""
-        stage = Usd.Stage.CreateNew(str(folder / f"{tile.name}{self._ext}"))
-        UsdGeom.SetStageUpAxis(stage, UsdGeom.Tokens.y)
-        UsdGeom.SetStageMetersPerUnit(stage, 1.0)
-        root = UsdGeom.Xform.Define(stage, "/Tile").GetPrim()
-        stage.SetDefaultPrim(root)
+        stage = _new_stage(folder / f"{tile.name}{self._ext}", UsdGeom.Xform, "/Tile")
         rows = tile.instances
         if len(rows):
             instancer = UsdGeom.PointInstancer.Define(stage, "/Tile/Instances")
@@ -171,11 +163,7 @@ class UsdWriter(TiledWriter):
         return tile.name, tile.origin
 
     def _write_root(self, path: Path, tiles: list[tuple[str, np.ndarray]]) -> None:
-        stage = Usd.Stage.CreateNew(str(path))
-        UsdGeom.SetStageUpAxis(stage, UsdGeom.Tokens.y)
-        UsdGeom.SetStageMetersPerUnit(stage, 1.0)
-        city = UsdGeom.Xform.Define(stage, "/City").GetPrim()
-        stage.SetDefaultPrim(city)
+        stage = _new_stage(path, UsdGeom.Xform, "/City")
         folder = tiles_folder(self.path).name
         for name, origin in tiles:
             xform = UsdGeom.Xform.Define(stage, f"/City/{name}")
@@ -197,6 +185,15 @@ class UsdWriter(TiledWriter):
         os.replace(out / self.path.name, self.path)
         if old is not None:
             shutil.rmtree(old, ignore_errors=True)
+
+
+def _new_stage(path: Path, kind, root: str):
+    """A new layer at ``path``, y up in metres, whose default prim is ``root``, a ``kind`` prim."""
+    stage = Usd.Stage.CreateNew(str(path))
+    UsdGeom.SetStageUpAxis(stage, UsdGeom.Tokens.y)
+    UsdGeom.SetStageMetersPerUnit(stage, 1.0)
+    stage.SetDefaultPrim(kind.Define(stage, root).GetPrim())
+    return stage
 
 
 def _prim_name(index: int, name: str) -> str:
