@@ -33,7 +33,6 @@ from grammarc.errors import ChunkTooLarge, LimitError, LotFailure
 from grammarc.geometry.meshes import is_mesh
 from grammarc.ir import nodes as ir
 from grammarc.ir.printer import print_op
-from grammarc.ir.traverse import iter_ops
 from grammarc.ragged import rank_within
 
 
@@ -50,8 +49,6 @@ class Executor(ScopeOperations, SplitOperations, ComponentOperations, FaceOperat
         #: (``Comp("sideface", 0){ a } Comp("sideface", 2){ a }``) is one occluder, not two of which each
         #: split's faces would see the other as a neighbour.
         self.taken_apart: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
-        #: Symbol id -> whether its rules split on snap planes (``apply``).
-        self.snapping: dict[int, bool] = {}
 
     # ------------------------------------------------------------------------------------------ helpers
     def env(self, shapes: Shapes) -> Env:
@@ -108,10 +105,7 @@ class Executor(ScopeOperations, SplitOperations, ComponentOperations, FaceOperat
         (the front volume's floors set the levels of the wings'). All lots still go together: the k-th
         shape of every lot in one batch.
         """
-        if sym.id not in self.snapping:
-            self.snapping[sym.id] = any(getattr(op, "snap", False) for rule in sym.rules
-                                        for alt in rule.alternatives for op in iter_ops(alt.body))
-        if self.snapping[sym.id] and len(shapes) > 1:
+        if sym.id in self.plan.snapping and len(shapes) > 1:
             rank = rank_within(shapes.lot)
             if rank.max() > 0:
                 for k in range(int(rank.max()) + 1):

@@ -67,6 +67,9 @@ class Plan:
     #: any query looks at other lots (then the build derives twice: ``backend.occlusion``).
     queries: frozenset[int] = frozenset()
     inter: bool = False
+    #: Symbols whose rules split on snap planes: each lot's shapes are taken one after the other
+    #: (``Executor.apply``).
+    snapping: frozenset[int] = frozenset()
 
     @property
     def symbol_names(self) -> tuple[str, ...]:
@@ -111,7 +114,9 @@ def make_plan(grammar: Grammar) -> Plan:
     asset_of_string = {strings.intern(raw): asset for raw, asset in grammar.asset_ids.items()}
     return Plan(grammar, tuple(symbols), ids, ids[grammar.graph.start], strings, stages, dynamic,
                 module.dialect == "cityengine", not_applied, asset_of_string, frozenset(occlusion),
-                any(e.target != "intra" for found in occlusion.values() for e in found))
+                any(e.target != "intra" for found in occlusion.values() for e in found),
+                frozenset(s.id for s in symbols if any(getattr(op, "snap", False) for rule in s.rules
+                                                       for alt in rule.alternatives for op in iter_ops(alt.body))))
 
 
 #: Per-shape columns of a shape's two vertical trim planes, (nx, ny, nz, d) each in world coordinates:
