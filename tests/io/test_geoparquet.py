@@ -73,3 +73,14 @@ def test_write_geoparquet_round_trips_a_city(tmp_path):
     back = read_lots(tmp_path / "city.parquet")
     assert back.ids.tolist() == city.ids.tolist()
     np.testing.assert_allclose(back.vertices, city.vertices)
+
+
+def test_a_parquet_file_without_footprints_is_refused_by_name(tmp_path):
+    from grammarc.errors import LotsError
+
+    pq.write_table(pa.table({"id": ["a"], "height": [3.0]}), tmp_path / "plain.parquet")
+    with pytest.raises(LotsError, match="plain.parquet: no WKB geometry column"):
+        read_lots(tmp_path / "plain.parquet")
+    pq.write_table(pa.table({"id": ["a"], "geometry": [b"not wkb"]}), tmp_path / "bad.parquet")
+    with pytest.raises(LotsError, match="bad.parquet: bad WKB in column 'geometry'"):
+        read_lots(tmp_path / "bad.parquet")
