@@ -207,7 +207,9 @@ def _derive_all(plan, lots: Lots, options: BuildOptions, writer, failed: list[Ba
     queries look at other lots is derived twice: first for everyone's occluders (``_occluders``), those of
     ``context`` when given (the whole city of a selection).
 
-    ``options.workers`` chunks are derived at once, each in a worker process (``workers.py``). Results are
+    ``options.workers`` chunks are derived at once, each in a worker process (``workers.py``), and one more
+    waits in the pool's queue, so a worker that finishes starts on it while the parent writes the chunk it
+    returned (pompeii x100 on two workers: 11.4-11.7 s -> 9.8 s). Results are
     written in chunk order, and a chunk's size is decided from the chunks finished before it in that
     order, so the chunking does not depend on timing (and the records never depend on the chunking).
     """
@@ -223,7 +225,7 @@ def _derive_all(plan, lots: Lots, options: BuildOptions, writer, failed: list[Ba
         window: deque = deque()
         try:
             while first < len(lots) or window:
-                while first < len(lots) and len(window) < options.workers:
+                while first < len(lots) and len(window) <= options.workers:
                     part = lots.take(slice(first, first + size))
                     window.append((len(part), submit(part)))
                     first += len(part)
