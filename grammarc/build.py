@@ -135,25 +135,11 @@ def _build(source: Path, display: str | None, grammar_path: Path, output, lots_p
     Path(output).parent.mkdir(parents=True, exist_ok=True)
     every = load_lots(grammar_path, Path(lots_path) if lots_path else None)
     lots = every if select is None else every.select(select)
-    meta = {
-        "grammar": str(grammar_path),
-        "grammar_sha256": grammar.digest,
-        "grammarc": __version__,
-        "seed": options.seed,
-        "start": plan.symbols[plan.start].name,
-        "attrs": {k: v for k, v in sorted(options.attrs.items())},
-        "lots_source": lots.source,
-        "dialect": grammar.module.dialect,
-        # the user's asset folders (baking); a package's own are left out: extracted to a fresh temporary
-        # folder for this build only, their names would make each run's record differ
-        "asset_roots": [str(r) for r in recorded_roots],
-        # operations accepted without effect on the record (material, texture, UV, print)
-        "not_applied": list(plan.not_applied),
-    }
+    meta = record_meta(grammar_path, grammar, plan, options, lots.source, recorded_roots)
     failed: list[BadLot] = []
     reports = Reports()
     with writer_class(output, assets=grammar.assets, symbols=plan.symbol_names, meta=meta) as writer:
-        derived = _derive_all(plan, lots, options, writer, failed, reports, progress, every)
+        derived = derive_all(plan, lots, options, writer, failed, reports, progress, every)
         counts = writer.close()
     if reports:
         reports.write(Path(reports_to) if reports_to else reports_path(Path(output)),
@@ -161,6 +147,26 @@ def _build(source: Path, display: str | None, grammar_path: Path, output, lots_p
     bad = tuple(sorted((*lots.bad, *failed), key=lambda b: b.index))
     return BuildResult(Path(output), len(lots) + len(lots.bad), derived, bad, counts,
                        time.perf_counter() - started, grammar)
+
+
+def record_meta(grammar_path: Path, grammar: Grammar, plan, options: BuildOptions, lots_source: str,
+                recorded_roots: tuple[Path, ...]) -> dict:
+    """The ``meta`` of a build's record: what it was made from."""
+    return {
+        "grammar": str(grammar_path),
+        "grammar_sha256": grammar.digest,
+        "grammarc": __version__,
+        "seed": options.seed,
+        "start": plan.symbols[plan.start].name,
+        "attrs": {k: v for k, v in sorted(options.attrs.items())},
+        "lots_source": lots_source,
+        "dialect": grammar.module.dialect,
+        # the user's asset folders (baking); a package's own are left out: extracted to a fresh temporary
+        # folder for this build only, their names would make each run's record differ
+        "asset_roots": [str(r) for r in recorded_roots],
+        # operations accepted without effect on the record (material, texture, UV, print)
+        "not_applied": list(plan.not_applied),
+    }
 
 
 def derive(grammar: Grammar, lots: Lots, options: BuildOptions = BuildOptions()) -> dict:
@@ -177,7 +183,7 @@ def derive(grammar: Grammar, lots: Lots, options: BuildOptions = BuildOptions())
         write = staticmethod(chunks.append)
 
     reports = Reports()
-    _derive_all(plan, lots, options, Collect, failed, reports)
+    derive_all(plan, lots, options, Collect, failed, reports)
     mesh = MeshChunk.concat([c.mesh for c in chunks]) if chunks else MeshChunk.empty()
     columns = {
         name: (np.concatenate([getattr(c, name) for c in chunks]) if chunks else
@@ -197,15 +203,16 @@ def reports_path(output: Path) -> Path:
     return output.with_name(output.stem + ".reports.json")
 
 
-def _derive_all(plan, lots: Lots, options: BuildOptions, writer, failed: list[BadLot], reports: Reports,
-                progress=None, context: Lots | None = None) -> int:
+def derive_all(plan, lots: Lots, options: BuildOptions, writer, failed: list[BadLot], reports: Reports,
+               progress=None, context: Lots | None = None, foreign: Occluders | None = None) -> int:
     """Derive all ``lots`` chunk by chunk into ``writer``; returns the number of lots derived.
 
     A chunk holds at most ``options.chunk_size`` lots, and fewer when the lots so far made many records:
     the next chunk aims at ``ROWS_PER_CHUNK`` records, which keeps its arrays in the caches and its memory
     small whatever the grammar. The records do not depend on the chunking. A grammar whose occlusion
     queries look at other lots is derived twice: first for everyone's occluders (``_occluders``), those of
-    ``context`` when given (the whole city of a selection).
+    ``context`` when given (the whole city of a selection), unless ``foreign`` gives them (a cluster
+    build's partition: the occluders of every partition).
 
     ``options.workers`` chunks are derived at once, each in a worker process (``workers.py``), and one more
     waits in the pool's queue, so a worker that finishes starts on it while the parent writes the chunk it
@@ -218,7 +225,8 @@ def _derive_all(plan, lots: Lots, options: BuildOptions, writer, failed: list[Ba
     size = min(options.chunk_size, 64)
     rows = 0
     written = 0
-    foreign = _occluders(plan, lots if context is None else context, options) if plan.inter else None
+    if plan.inter and foreign is None:
+        foreign = occluders(plan, lots if context is None else context, options)
     if foreign is not None:
         foreign.index  # noqa: B018 - built once here, before the workers inherit it
     with worker_pool(functools.partial(_derive, plan, options=options, foreign=foreign), options.workers) as submit:
@@ -286,7 +294,7 @@ def _attempts(lots: Lots, derive_part, failed: list[BadLot] | None):
         yield part, result
 
 
-def _occluders(plan, lots: Lots, options: BuildOptions) -> Occluders:
+def occluders(plan, lots: Lots, options: BuildOptions) -> Occluders:
     """The first pass of a grammar whose queries look at other lots: every lot derived up to its first
     query, and the occluders made up to there (``backend.occlusion``). Lots that fail are left out here
     and reported by the second pass."""

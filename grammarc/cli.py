@@ -88,6 +88,14 @@ def _parser() -> argparse.ArgumentParser:
                        help="derive only these lots (comma-separated ids), e.g. to bake a few")
     build.add_argument("--reports", type=Path, metavar="PATH",
                        help="where report() values go: .json or .csv (default: OUT's name + .reports.json)")
+    build.add_argument("--dask", metavar="ADDRESS",
+                       help="derive on a Dask cluster: a scheduler address, or local:N for N local worker "
+                            "processes; writes OUT's shards and manifest (extra `dask`)")
+    build.add_argument("--partition-size", type=_positive, default=20_000, metavar="N",
+                       help="with --dask: features of the lots file per task (default 20,000)")
+    build.add_argument("--resume", action="store_true",
+                       help="with --dask: keep the shards of an earlier run of the same build that are "
+                            "complete and verified")
     build.add_argument("--quiet", "-q", action="store_true", help="no progress bar and no summary")
     build.set_defaults(run=_build)
 
@@ -241,6 +249,21 @@ class _ProgressBar:
             self.bar.close()
 
 
+def _build_on_dask(args, options, bar):
+    from grammarc.cluster import build_on_dask
+    from grammarc.errors import UsageError
+    from grammarc.io import OutputOptions
+
+    refused = [flag for flag, given in (("--select", args.select is not None), ("--reports", args.reports),
+                                        ("--bake", args.bake)) if given]
+    if refused:
+        raise UsageError(f"{', '.join(refused)} cannot go with --dask: a cluster build writes shards (with "
+                         "their reports beside them); select, bake or convert from them")
+    return build_on_dask(args.grammar, args.emit, dask=args.dask, lots_path=args.lots, options=options,
+                         output_options=OutputOptions(lod=args.lod, tile_size=args.tile_size),
+                         partition_size=args.partition_size, resume=args.resume, progress=bar)
+
+
 def _conform(args) -> int:
     from grammarc.backend.attributes import parse_override
     from grammarc.conform import kit_dir, load_reference, run_conformance
@@ -283,7 +306,7 @@ def _build(args) -> int:
     )
     bar = _ProgressBar() if not args.quiet else None
     try:
-        result = build(args.grammar, args.emit, lots_path=args.lots, options=options, progress=bar,
+        result = _build_on_dask(args, options, bar) if args.dask else build(args.grammar, args.emit, lots_path=args.lots, options=options, progress=bar,
                        output_options=OutputOptions(bake=args.bake, lod=args.lod, tile_size=args.tile_size,
                                                     max_triangles=args.max_triangles),
                        select=None if args.select is None else [i for i in args.select.split(",") if i],

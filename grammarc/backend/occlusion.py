@@ -12,7 +12,7 @@ A query (``inside``, ``overlaps``, ``touches``) of a shape tests its scope box (
 - ``intra``: the occluders of its own lot that are not its ancestors. A shape carries the ids of its
   nearest ``ANCESTORS`` occluding ancestors; descendants do not exist yet when a query runs.
 - ``inter``: the occluders of the other lots, from the first pass of a two-pass build
-  (``build._derive_all``): every lot is derived up to its first query, its occluders are kept, then the
+  (``build.derive_all``): every lot is derived up to its first query, its occluders are kept, then the
   city is derived again with them. So a lot's answers do not depend on its chunk.
 
 Rules that query wait (``derive.derive_chunk``) until nothing else of their stage is pending, so the

@@ -28,6 +28,8 @@ from grammarc.io.lots import _column as json_column
 __all__ = ["read_geoparquet", "write_geoparquet"]
 
 _POLYGON, _MULTIPOLYGON = 3, 6
+#: Rows per row group that ``write_geoparquet`` writes.
+ROW_GROUP = 16384
 
 
 def _parquet():
@@ -40,35 +42,22 @@ def _parquet():
     return pa, pq
 
 
-def read_geoparquet(path: str | os.PathLike) -> tuple[_Builder, dict[str, np.ndarray]]:
-    """The lots of a GeoParquet file, for ``_Builder.finish``: the builder and the property columns."""
-    pa, pq = _parquet()
-    try:
-        table = pq.read_table(path)
-    except (OSError, pa.ArrowInvalid) as error:
-        raise LotsError(f"cannot read lots file {path}: {error}") from error
-    geo = json.loads((table.schema.metadata or {}).get(b"geo", b"{}"))
-    column = geo.get("primary_column", "geometry")
-    encoding = geo.get("columns", {}).get(column, {}).get("encoding", "WKB")
-    if column not in table.column_names or encoding.upper() != "WKB":
-        raise LotsError(f"{path}: no WKB geometry column (GeoParquet's `geo` metadata names "
-                        f"{column!r}, encoding {encoding!r})")
-    try:
-        geometry = shapely.from_wkb(table.column(column).to_numpy(zero_copy_only=False))
-    except shapely.errors.GEOSException as error:
-        raise LotsError(f"{path}: bad WKB in column {column!r}: {error}") from error
+def read_geoparquet(path: str | os.PathLike, rows: tuple[int, int] | None = None,
+                    first_index: int = 0) -> tuple[_Builder, dict[str, np.ndarray]]:
+    """The lots of a GeoParquet file, for ``_Builder.finish``: the builder and the property columns.
+
+    ``rows`` (start, stop) reads only those rows (a partition, ``io.lot_partitions``; only the row groups
+    that hold them are read), whose first polygon is lot number ``first_index`` of the file.
+    """
+    pa, _ = _parquet()
+    table = _read_table(path, rows)
+    column = _geometry_column(table, path)
+    geometry = _geometry(table, column, path)
     n = len(geometry)
     names = [c for c in table.column_names if c != column]
-    ids = _ids(table, names, n)
-
-    kind = shapely.get_type_id(geometry)
-    good = np.isin(kind, (_POLYGON, _MULTIPOLYGON)) & ~shapely.is_empty(geometry)
-    parts, feature = shapely.get_parts(geometry[good], return_index=True)
-    feature = np.flatnonzero(good)[feature]
-    # lots are numbered in file order: a feature's parts, then the next feature's
-    per_feature = np.where(good, 0, 1)  # a bad feature takes one number, as in GeoJSON
-    np.add.at(per_feature, feature, 1)
-    first = np.cumsum(per_feature) - per_feature
+    ids = _ids(table, names, n, rows[0] if rows else 0)
+    kind, good, parts, feature, per_feature = _parts(geometry)
+    first = np.cumsum(per_feature) - per_feature + first_index
     k = np.arange(len(parts)) - np.searchsorted(feature, feature)  # part number within its feature
     index = first[feature] + k
     multi = kind[feature] == _MULTIPOLYGON
@@ -104,6 +93,71 @@ def read_geoparquet(path: str | os.PathLike) -> tuple[_Builder, dict[str, np.nda
     return builder, attrs
 
 
+def count_polygons(path: str | os.PathLike, rows: tuple[int, int]) -> int:
+    """The lot numbers that ``rows`` of a GeoParquet file take: a polygon one, a multipolygon one per
+    part, anything else one (a bad lot). Only the geometry column is read."""
+    table = _read_table(path, rows, geometry_only=True)
+    return int(_parts(_geometry(table, _geometry_column(table, path), path))[4].sum())
+
+
+def parquet_rows(path: str | os.PathLike) -> int:
+    """The rows of a GeoParquet file, from its footer."""
+    pa, pq = _parquet()
+    try:
+        return pq.ParquetFile(path).metadata.num_rows
+    except (OSError, pa.ArrowInvalid) as error:
+        raise LotsError(f"cannot read lots file {path}: {error}") from error
+
+
+def _read_table(path, rows: tuple[int, int] | None, geometry_only: bool = False):
+    """The table of a GeoParquet file, or of its rows ``(start, stop)`` (the row groups that hold them)."""
+    pa, pq = _parquet()
+    try:
+        if rows is None:
+            return pq.read_table(path)
+        file = pq.ParquetFile(path)
+        columns = [_geometry_column(file.schema_arrow, path)] if geometry_only else None
+        meta = file.metadata
+        starts = np.cumsum([0] + [meta.row_group(g).num_rows for g in range(meta.num_row_groups)])
+        groups = [g for g in range(meta.num_row_groups) if starts[g] < rows[1] and starts[g + 1] > rows[0]]
+        table = file.read_row_groups(groups, columns=columns) if groups else file.schema_arrow.empty_table()
+        first = int(starts[groups[0]]) if groups else 0
+        return table.slice(rows[0] - first, rows[1] - rows[0])
+    except (OSError, pa.ArrowInvalid) as error:
+        raise LotsError(f"cannot read lots file {path}: {error}") from error
+
+
+def _geometry_column(table, path) -> str:
+    """The WKB column GeoParquet's ``geo`` metadata names (of a table or a schema)."""
+    schema = getattr(table, "schema", table)
+    geo = json.loads((schema.metadata or {}).get(b"geo", b"{}"))
+    column = geo.get("primary_column", "geometry")
+    encoding = geo.get("columns", {}).get(column, {}).get("encoding", "WKB")
+    if column not in schema.names or encoding.upper() != "WKB":
+        raise LotsError(f"{path}: no WKB geometry column (GeoParquet's `geo` metadata names "
+                        f"{column!r}, encoding {encoding!r})")
+    return column
+
+
+def _geometry(table, column: str, path) -> np.ndarray:
+    try:
+        return shapely.from_wkb(table.column(column).to_numpy(zero_copy_only=False))
+    except shapely.errors.GEOSException as error:
+        raise LotsError(f"{path}: bad WKB in column {column!r}: {error}") from error
+
+
+def _parts(geometry: np.ndarray):
+    """Each feature's kind and goodness, the polygons of the good ones with their feature, and the lot
+    numbers each feature takes (lots are numbered in file order: a feature's parts, then the next's)."""
+    kind = shapely.get_type_id(geometry)
+    good = np.isin(kind, (_POLYGON, _MULTIPOLYGON)) & ~shapely.is_empty(geometry)
+    parts, feature = shapely.get_parts(geometry[good], return_index=True)
+    feature = np.flatnonzero(good)[feature]
+    per_feature = np.where(good, 0, 1)  # a bad feature takes one number, as in GeoJSON
+    np.add.at(per_feature, feature, 1)
+    return kind, good, parts, feature, per_feature
+
+
 def _column(values, pa) -> np.ndarray:
     """A property column as GeoJSON's are typed (``io.lots._column``): numbers and booleans float64 with
     nan for nulls, anything else text (object, None for nulls); read by type, not value by value."""
@@ -115,12 +169,12 @@ def _column(values, pa) -> np.ndarray:
     return json_column(values.to_pylist())
 
 
-def _ids(table, names: list[str], n: int) -> list[str]:
+def _ids(table, names: list[str], n: int, first_row: int) -> list[str]:
     for name in ("id", "name"):
         if name in names:
             values = table.column(name).to_pylist()
-            return [str(v) if v is not None else str(i) for i, v in enumerate(values)]
-    return [str(i) for i in range(n)]
+            return [str(v) if v is not None else str(i) for i, v in enumerate(values, first_row)]
+    return [str(i) for i in range(first_row, first_row + n)]
 
 
 def _type_name(type_id: int) -> str:
@@ -154,5 +208,6 @@ def write_geoparquet(lots: Lots, path: str | os.PathLike) -> None:
            "columns": {"geometry": {"encoding": "WKB", "geometry_types": ["Polygon"]}}}
     table = pa.table(columns).replace_schema_metadata({"geo": json.dumps(geo)})
     tmp = path.with_name(f".{path.name}.tmp")
-    pq.write_table(table, tmp)
+    # row groups of 2^14 lots: a partition of a cluster build reads only the groups that hold its rows
+    pq.write_table(table, tmp, row_group_size=ROW_GROUP)
     os.replace(tmp, path)

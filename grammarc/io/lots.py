@@ -43,6 +43,8 @@ from grammarc.ragged import offsets_from_counts, ragged_take, segment_reduce
 
 __all__ = ["BadLot", "Lots", "default_lot", "lots_from_polygons", "read_lots"]
 
+#: Suffixes of GeoJSON sequences (``io.lot_partitions``): a Feature or a geometry per line.
+SEQUENCE_SUFFIXES = (".geojsonl", ".geojsons", ".geojsonseq", ".jsonl", ".ndjson")
 #: The lot property that marks street edges, as CityEngine's object attribute.
 STREET_WIDTH = "streetWidth"
 # GEOS reasons end with the offending point, e.g. "Self-intersection[3 4.5]".
@@ -147,8 +149,9 @@ class Lots:
 
 
 def read_lots(path: str | os.PathLike) -> Lots:
-    """Read lots from a GeoJSON (``.geojson``, ``.json``), OBJ (``.obj``) or GeoParquet (``.parquet``,
-    ``io.geoparquet``: the fast way for 10^5 lots and more) file.
+    """Read lots from a GeoJSON (``.geojson``, ``.json``), GeoJSON sequence (``SEQUENCE_SUFFIXES``: a
+    feature per line), OBJ (``.obj``) or GeoParquet (``.parquet``, ``io.geoparquet``: the fast way for
+    10^5 lots and more) file.
 
     GeoJSON may be a FeatureCollection, a single Feature or a bare Polygon / MultiPolygon geometry,
     in map coordinates taken as metres (longitude/latitude is not reprojected). A Polygon is one lot
@@ -189,9 +192,13 @@ def read_lots(path: str | os.PathLike) -> Lots:
             if builder.polygons == 0:
                 raise LotsError(f"no polygon in lots file {path}")
             return builder.finish(attrs, str(path))
+    if suffix in SEQUENCE_SUFFIXES:
+        from grammarc.io.lot_partitions import read_sequence
+
+        return read_sequence(path)
     if suffix not in (".geojson", ".json", ".obj"):
-        raise LotsError(f"unknown lots file type {suffix!r} (expected .geojson, .json, .obj or .parquet): "
-                        f"{path}")
+        raise LotsError(f"unknown lots file type {suffix!r} (expected .geojson, .json, .obj, .parquet or a "
+                        f"GeoJSON sequence, {', '.join(SEQUENCE_SUFFIXES)}): {path}")
     try:
         text = path.read_text(encoding="utf-8")
     except (OSError, UnicodeDecodeError) as error:
@@ -316,6 +323,7 @@ class _Builder:
         self.street: list[np.ndarray] = []  # per ring, a flag per position: its edge faces a street
         self.bad: list[BadLot] = []
         self.polygons = 0  # lots added or rejected; a file without any has "no polygon"
+        self.end = 0  # lot numbers the parsed features took (GeoJSON)
 
     def reject(self, index: int, lot_id: str, reason: str) -> None:
         """A polygon that is bad before any geometry check (malformed, empty)."""
@@ -446,8 +454,14 @@ def _parse_geojson(data) -> _Builder:
         features = [{"type": "Feature", "geometry": data}]
     else:
         features = []
+    return parse_features(features)
+
+
+def parse_features(features, first_index: int = 0) -> _Builder:
+    """Lots of a list of GeoJSON features whose first polygon is number ``first_index`` of its file (a
+    partition of a GeoJSON sequence starts where the polygons before it end)."""
     builder = _Builder(world=False)
-    index = 0
+    index = first_index
     for feature in features:
         if not isinstance(feature, dict):
             continue
@@ -468,6 +482,7 @@ def _parse_geojson(data) -> _Builder:
         else:
             builder.bad.append(BadLot(index, lot_id, f"not a polygon ({kind or 'null geometry'})"))
             index += 1
+    builder.end = index - first_index
     return builder
 
 

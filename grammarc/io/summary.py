@@ -22,13 +22,70 @@ import numpy as np
 from grammarc.errors import AssetError
 from grammarc.io.bake import asset_library, count_triangles
 from grammarc.io.npz import read_instances
+from grammarc.io.shards import is_manifest, manifest_path, shard_outputs
 
 __all__ = ["format_summary", "summarize"]
 
 
 def summarize(path: str | os.PathLike, asset_roots=None, lod: str | None = None) -> dict:
-    """The facts ``grammarc info`` prints, as a JSON-ready dict (see the module docstring)."""
-    record, files = _read(Path(path))
+    """The facts ``grammarc info`` prints, as a JSON-ready dict (see the module docstring).
+
+    ``path`` may be the manifest of a cluster build (``io.shards``): its shards are read one at a time and
+    their counts added up, so a city larger than memory can be summarized.
+    """
+    path = Path(path)
+    if (path.suffix.lower() in (".usd", ".usda", ".usdc") and manifest_path(path).is_file()
+            and not path.with_name(f"{path.name}.tiles").exists()):
+        path = manifest_path(path)  # the root layer of a cluster build's shards
+    tallies = [_tally(*_read(p), asset_roots, lod) for p in (shard_outputs(path) if is_manifest(path) else [path])]
+    names = list(dict.fromkeys(n for t in tallies for n in t["assets"]))
+    per_asset = {n: sum(t["assets"].get(n, 0) for t in tallies) for n in names}
+    symbols = {}
+    for t in tallies:
+        for name, count in t["symbols"].items():
+            symbols[name] = symbols.get(name, 0) + count
+    per_lot = np.concatenate([t["per_lot"] for t in tallies])
+    points = [t["bbox"] for t in tallies if t["bbox"] is not None]
+    meta = tallies[0]["meta"] if tallies else {}
+    mesh_rings = sum(t["mesh_rings"] for t in tallies)
+    library = asset_library(names, {"meta": meta}, asset_roots, lod)
+    assets, polygons, instanced, problems = {}, 0, mesh_rings, []
+    for name in names:
+        entry = {"instances": per_asset[name]}
+        try:
+            shape = library[names.index(name)]
+        except AssetError as error:
+            problems.append(str(error))
+        else:
+            entry.update(polygons=shape.n_polygons, triangles=shape.n_triangles)
+            polygons += shape.n_polygons * per_asset[name]
+            instanced += shape.n_polygons
+        assets[name] = entry
+    return {
+        "path": str(path),
+        "bytes": sum(t["bytes"] for t in tallies) + (path.stat().st_size if is_manifest(path) else 0),
+        "grammar": meta.get("grammar"),
+        "seed": meta.get("seed"),
+        "instances": sum(per_asset.values()),
+        "mesh_faces": sum(t["mesh_faces"] for t in tallies),
+        "lots": len(per_lot),
+        "per_lot": ({"min": int(per_lot.min()), "median": float(np.median(per_lot)), "max": int(per_lot.max())}
+                    if len(per_lot) else None),
+        "bbox": ({"min": np.min([p[0] for p in points], axis=0).tolist(),
+                  "max": np.max([p[1] for p in points], axis=0).tolist()} if points else None),
+        "assets": assets,
+        "symbols": symbols,
+        # the mesh table counts a polygon per ring, as bake and PRT's encoder do
+        "polygons": {"instanced": int(instanced), "baked": int(polygons + mesh_rings),
+                     "baked_triangles": None if problems or any(t["triangles"] is None for t in tallies)
+                     else sum(t["triangles"] for t in tallies)},
+        "problems": problems,
+    }
+
+
+def _tally(record: dict, files: list[Path], asset_roots, lod: str | None) -> dict:
+    """What one output adds to a summary: counts by name, terminals per lot, its box, its bytes, its
+    baked triangles (None when an asset does not load)."""
     names = [str(n) for n in record["assets"]]
     symbols = [str(n) for n in record.get("symbols", ())]
     asset = record["asset"].astype(np.int64)
@@ -37,46 +94,27 @@ def summarize(path: str | os.PathLike, asset_roots=None, lod: str | None = None)
         else np.zeros(0, np.int64)
     per_lot = np.bincount(record["lot"].astype(np.int64)) if len(asset) and "lot" in record \
         else np.zeros(0, np.int64)
-    per_lot = per_lot[per_lot > 0]
-    xform = record["xform"].astype(np.float64)
-    corners = _corners(xform)
+    corners = _corners(record["xform"].astype(np.float64))
     mesh_vertices = record["mesh_vertices"].astype(np.float64)
     points = np.concatenate([corners, mesh_vertices]) if len(mesh_vertices) else corners
-    mesh_faces = len(record["mesh_face_offsets"]) - 1
-    mesh_rings = len(record["mesh_ring_offsets"]) - 1
-
-    library = asset_library(names, record, asset_roots, lod)
-    assets, polygons, instanced, problems = {}, 0, mesh_rings, []
-    for a in np.flatnonzero(per_asset):
-        entry = {"instances": int(per_asset[a])}
-        try:
-            shape = library[int(a)]
-        except AssetError as error:
-            problems.append(str(error))
-        else:
-            entry.update(polygons=shape.n_polygons, triangles=shape.n_triangles)
-            polygons += shape.n_polygons * int(per_asset[a])
-            instanced += shape.n_polygons
-        assets[names[a]] = entry
     return {
-        "path": str(path),
-        "bytes": sum(f.stat().st_size for f in files),
-        "grammar": record["meta"].get("grammar"),
-        "seed": record["meta"].get("seed"),
-        "instances": len(asset),
-        "mesh_faces": mesh_faces,
-        "lots": len(per_lot),
-        "per_lot": ({"min": int(per_lot.min()), "median": float(np.median(per_lot)), "max": int(per_lot.max())}
-                    if len(per_lot) else None),
-        "bbox": ({"min": points.min(axis=0).tolist(), "max": points.max(axis=0).tolist()}
-                 if len(points) else None),
-        "assets": assets,
+        "meta": record["meta"],
+        "assets": {names[a]: int(per_asset[a]) for a in np.flatnonzero(per_asset)},
         "symbols": {symbols[s]: int(per_symbol[s]) for s in np.flatnonzero(per_symbol)},
-        # the mesh table counts a polygon per ring, as bake and PRT's encoder do
-        "polygons": {"instanced": int(instanced), "baked": int(polygons + mesh_rings),
-                     "baked_triangles": None if problems else count_triangles(record, asset_roots, lod)},
-        "problems": problems,
+        "per_lot": per_lot[per_lot > 0],
+        "bbox": (points.min(axis=0), points.max(axis=0)) if len(points) else None,
+        "mesh_faces": len(record["mesh_face_offsets"]) - 1,
+        "mesh_rings": len(record["mesh_ring_offsets"]) - 1,
+        "bytes": sum(f.stat().st_size for f in files),
+        "triangles": _triangles(record, asset_roots, lod),
     }
+
+
+def _triangles(record: dict, asset_roots, lod: str | None) -> int | None:
+    try:
+        return count_triangles(record, asset_roots, lod)
+    except AssetError:
+        return None
 
 
 def _read(path: Path) -> tuple[dict, list[Path]]:

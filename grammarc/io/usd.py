@@ -47,7 +47,7 @@ try:  # the `usd` extra: this module is imported only for a USD output, and says
 except ImportError:
     Gf = Sdf = Tf = Usd = UsdGeom = Vt = None
 
-__all__ = ["UsdWriter", "read_usd", "tiles_folder"]
+__all__ = ["UsdWriter", "read_usd", "tiles_folder", "write_shards_root"]
 
 
 def tiles_folder(path: str | os.PathLike) -> Path:
@@ -185,6 +185,23 @@ class UsdWriter(TiledWriter):
         os.replace(out / self.path.name, self.path)
         if old is not None:
             shutil.rmtree(old, ignore_errors=True)
+
+
+def write_shards_root(output: Path, manifest: dict) -> None:
+    """The root layer of a cluster build (``io.shards``): ``/City`` with a child per shard the manifest
+    lists, referencing the shard's own root layer (whose tiles it places). Written atomically."""
+    _require_pxr()
+    tmp = output.with_name(f".{output.name}.tmp{os.getpid()}{output.suffix}")
+    stage = _new_stage(tmp, UsdGeom.Xform, "/City")
+    for shard in manifest["shards"]:
+        name = Path(shard["path"]).name.split(".")[0].replace("-", "_")
+        UsdGeom.Xform.Define(stage, f"/City/{name}").GetPrim().GetReferences().AddReference(f"./{shard['path']}")
+    layer = stage.GetRootLayer()
+    layer.customLayerData = {"grammarc": json.dumps(manifest["meta"], sort_keys=True),
+                             "grammarc:symbols": json.dumps(manifest["symbols"]),
+                             "grammarc:manifest": output.stem + ".manifest.json"}
+    layer.Save()
+    os.replace(tmp, output)
 
 
 def _new_stage(path: Path, kind, root: str):
