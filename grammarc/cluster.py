@@ -18,7 +18,9 @@ checksums hold is kept: only the others are derived.
 
 Partitions hold ``--partition-size`` features (default ``PARTITION_SIZE``): each task then costs seconds,
 far above Dask's per-task overhead (about a millisecond), and its records stay well within a worker's
-memory. The lots file must be readable at the same path by every worker (a shared filesystem).
+memory. The lots file, and the asset files where the output needs them (USD prototypes, CityEngine's
+trim planes), must be readable at the same paths by every worker (a shared filesystem); a rule package is
+extracted on the client, so a cluster of other machines needs it extracted to a shared folder first.
 """
 
 from __future__ import annotations
@@ -54,6 +56,7 @@ from grammarc.io.lots import BadLot
 from grammarc.io.shards import (
     complete_shard,
     file_digests,
+    instance_box,
     manifest_path,
     run_key,
     shard_name,
@@ -274,13 +277,7 @@ class _Bounds:
         return Watched()
 
     def add(self, records) -> None:
-        if len(records.xform):
-            # an instance's box is its unit cube mapped by the affine xform: per world axis, the
-            # translation plus the negative (or positive) parts of the linear map's row
-            linear = records.xform[:, :, :3].astype(np.float64)
-            origin = records.xform[:, :, 3].astype(np.float64)
-            self.low = np.minimum(self.low, (origin + np.minimum(linear, 0).sum(axis=2)).min(axis=0))
-            self.high = np.maximum(self.high, (origin + np.maximum(linear, 0).sum(axis=2)).max(axis=0))
+        instance_box(records.xform, self.low, self.high)
         if len(records.mesh.vertices):
             self.low = np.minimum(self.low, records.mesh.vertices.min(axis=0))
             self.high = np.maximum(self.high, records.mesh.vertices.max(axis=0))

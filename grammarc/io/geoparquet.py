@@ -49,13 +49,20 @@ def read_geoparquet(path: str | os.PathLike, rows: tuple[int, int] | None = None
     ``rows`` (start, stop) reads only those rows (a partition, ``io.lot_partitions``; only the row groups
     that hold them are read), whose first polygon is lot number ``first_index`` of the file.
     """
-    pa, _ = _parquet()
     table = _read_table(path, rows)
-    column = _geometry_column(table, path)
+    return lots_from_table(table, _geometry_column(table, path), path, rows[0] if rows else 0, first_index)
+
+
+def lots_from_table(table, column: str, path, first_row: int = 0,
+                    first_index: int = 0) -> tuple[_Builder, dict[str, np.ndarray]]:
+    """The lots of an Arrow table with WKB footprints in ``column`` (GeoParquet's, or a GIS file's read by
+    ``io.gis``), its first row being row ``first_row`` of the file and its first polygon lot number
+    ``first_index``: the builder and the property columns."""
+    pa, _ = _parquet()
     geometry = _geometry(table, column, path)
     n = len(geometry)
     names = [c for c in table.column_names if c != column]
-    ids = _ids(table, names, n, rows[0] if rows else 0)
+    ids = _ids(table, names, n, first_row)
     kind, good, parts, feature, per_feature = _parts(geometry)
     first = np.cumsum(per_feature) - per_feature + first_index
     k = np.arange(len(parts)) - np.searchsorted(feature, feature)  # part number within its feature
@@ -68,7 +75,7 @@ def read_geoparquet(path: str | os.PathLike, rows: tuple[int, int] | None = None
         what = "empty polygon" if kind[f] in (_POLYGON, _MULTIPOLYGON) else f"not a polygon ({_type_name(kind[f])})"
         builder.reject(int(first[f]), ids[f], what)
     columns = {name: _column(table.column(name), pa) for name in names if name not in ("id", STREET_WIDTH)}
-    widths = table.column(STREET_WIDTH).to_pylist() if STREET_WIDTH in names else None
+    widths = [_text_list(w) for w in table.column(STREET_WIDTH).to_pylist()] if STREET_WIDTH in names else None
     if widths is not None:  # only files with street widths pay a loop over their lots
         exterior = shapely.get_num_coordinates(shapely.get_exterior_ring(parts))
         keep = np.ones(len(parts), dtype=bool)
@@ -94,19 +101,26 @@ def read_geoparquet(path: str | os.PathLike, rows: tuple[int, int] | None = None
 
 
 def count_polygons(path: str | os.PathLike, rows: tuple[int, int]) -> int:
-    """The lot numbers that ``rows`` of a GeoParquet file take: a polygon one, a multipolygon one per
-    part, anything else one (a bad lot). Only the geometry column is read."""
+    """The lot numbers that ``rows`` of a GeoParquet file take (``table_lot_numbers``). Only the geometry
+    column is read."""
     table = _read_table(path, rows, geometry_only=True)
-    return int(_parts(_geometry(table, _geometry_column(table, path), path))[4].sum())
+    return table_lot_numbers(table, _geometry_column(table, path), path)
 
 
-def parquet_rows(path: str | os.PathLike) -> int:
-    """The rows of a GeoParquet file, from its footer."""
+def table_lot_numbers(table, column: str, path) -> int:
+    """The lot numbers the rows of a table take: a polygon one, a multipolygon one per part, anything else
+    one (a bad lot)."""
+    return int(_parts(_geometry(table, column, path))[4].sum())
+
+
+def row_group_bounds(path: str | os.PathLike) -> np.ndarray:
+    """Where a GeoParquet file's row groups start, and its number of rows last, from its footer."""
     pa, pq = _parquet()
     try:
-        return pq.ParquetFile(path).metadata.num_rows
+        meta = pq.ParquetFile(path).metadata
     except (OSError, pa.ArrowInvalid) as error:
         raise LotsError(f"cannot read lots file {path}: {error}") from error
+    return np.cumsum([0] + [meta.row_group(g).num_rows for g in range(meta.num_row_groups)])
 
 
 def _read_table(path, rows: tuple[int, int] | None, geometry_only: bool = False):
@@ -140,8 +154,14 @@ def _geometry_column(table, path) -> str:
 
 
 def _geometry(table, column: str, path) -> np.ndarray:
+    values = table.column(column)
+    if hasattr(values.type, "storage_type"):  # an extension type (geoarrow.wkb): its WKB bytes
+        values = [chunk.storage for chunk in values.chunks]
+        values = np.concatenate([v.to_numpy(zero_copy_only=False) for v in values]) if values else np.zeros(0, object)
+    else:
+        values = values.to_numpy(zero_copy_only=False)
     try:
-        return shapely.from_wkb(table.column(column).to_numpy(zero_copy_only=False))
+        return shapely.from_wkb(values)
     except shapely.errors.GEOSException as error:
         raise LotsError(f"{path}: bad WKB in column {column!r}: {error}") from error
 
@@ -156,6 +176,16 @@ def _parts(geometry: np.ndarray):
     per_feature = np.where(good, 0, 1)  # a bad feature takes one number, as in GeoJSON
     np.add.at(per_feature, feature, 1)
     return kind, good, parts, feature, per_feature
+
+
+def _text_list(value):
+    """A ``streetWidth`` value; text (GIS formats have no list fields) is read as a JSON list."""
+    if not isinstance(value, str):
+        return value
+    try:
+        return json.loads(value)
+    except ValueError:
+        return value  # refused by name as "not a list of numbers"
 
 
 def _column(values, pa) -> np.ndarray:

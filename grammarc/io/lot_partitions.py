@@ -3,7 +3,9 @@
 A country's footprints do not fit in one process's memory, nor should they cross a scheduler. A partition
 names a range of a lots file; the worker that derives it reads that range and nothing else:
 
-- GeoParquet (``.parquet``): rows ``[start, stop)``, read from the row groups that hold them (pyarrow);
+- GeoParquet (``.parquet``): rows ``[start, stop)``, cut at row-group boundaries where one is near, and
+  read from the row groups that hold them (pyarrow);
+- a GIS file GDAL reads (``.gpkg``, ``.shp``, ``.fgb``, ...: ``io.gis``): features ``[start, stop)``;
 - a GeoJSON sequence (RFC 8142 or newline-delimited: ``.geojsonl``, ``.geojsons``, ``.geojsonseq``,
   ``.jsonl``, ``.ndjson``; a Feature or a geometry per line): lines ``[start, stop)``, bytes
   ``[offset, end)`` of the file, found by one scan for line ends;
@@ -20,6 +22,7 @@ on the whole file, numbers, ids, properties and bad lots alike (tests), and so d
 from __future__ import annotations
 
 import functools
+import itertools
 import os
 from dataclasses import dataclass, replace
 from pathlib import Path
@@ -29,6 +32,7 @@ import orjson
 
 from grammarc.errors import LotsError
 from grammarc.io.lots import (
+    GIS_SUFFIXES,
     SEQUENCE_SUFFIXES,
     Lots,
     _columns,
@@ -58,21 +62,28 @@ class Partition:
 
 
 def file_kind(path: str | os.PathLike) -> str:
-    """``parquet``, ``sequence``, or ``whole`` (a file read at once)."""
+    """``parquet``, ``gis``, ``sequence``, or ``whole`` (a file read at once)."""
     suffix = Path(path).suffix.lower()
-    return "parquet" if suffix == ".parquet" else "sequence" if suffix in SEQUENCE_SUFFIXES else "whole"
+    if suffix == ".parquet":
+        return "parquet"
+    return "gis" if suffix in GIS_SUFFIXES else "sequence" if suffix in SEQUENCE_SUFFIXES else "whole"
 
 
 def partition_lots(path: str | os.PathLike, size: int) -> list[Partition]:
-    """The partitions of a lots file, ``size`` features each (the last one fewer)."""
+    """The partitions of a lots file, about ``size`` features each (GeoParquet's follow its row groups)."""
     path = Path(path)
     if not path.is_file():
         raise LotsError(f"lots file not found: {path}")
     kind = file_kind(path)
     if kind == "parquet":
-        from grammarc.io.geoparquet import parquet_rows
+        from grammarc.io.geoparquet import row_group_bounds
 
-        n = parquet_rows(path)
+        cuts = _aligned(row_group_bounds(path), size)
+        return [Partition(k, str(path), kind, int(a), int(b)) for k, (a, b) in enumerate(itertools.pairwise(cuts))]
+    if kind == "gis":
+        from grammarc.io.gis import gis_features
+
+        n = gis_features(path)
         return [Partition(k, str(path), kind, a, min(a + size, n)) for k, a in enumerate(range(0, n, size))]
     if kind == "sequence":
         starts = _line_starts(path)
@@ -90,6 +101,10 @@ def count_lots(part: Partition) -> int:
         from grammarc.io.geoparquet import count_polygons
 
         return count_polygons(part.path, (part.start, part.stop))
+    if part.kind == "gis":
+        from grammarc.io.gis import count_gis
+
+        return count_gis(part.path, (part.start, part.stop))
     if part.kind == "sequence":
         return parse_features(_features(part), 0).end
     return part.stop - part.start
@@ -103,6 +118,12 @@ def read_partition(part: Partition, first_index: int) -> Lots:
 
         with _no_cycle_collection():
             builder, attrs = read_geoparquet(part.path, (part.start, part.stop), first_index)
+            return builder.finish(attrs, part.path)
+    if part.kind == "gis":
+        from grammarc.io.gis import read_gis
+
+        with _no_cycle_collection():
+            builder, attrs = read_gis(part.path, (part.start, part.stop), first_index)
             return builder.finish(attrs, part.path)
     if part.kind == "sequence":
         with _no_cycle_collection():
@@ -142,6 +163,19 @@ def _features(part: Partition) -> list:
         except orjson.JSONDecodeError as error:
             raise LotsError(f"{part.path}:{number}: not valid JSON: {error.msg}") from error
     return features
+
+
+def _aligned(bounds: np.ndarray, size: int) -> list[int]:
+    """Cuts of rows ``[0, bounds[-1])`` into parts of about ``size``, at the row-group ``bounds`` nearest
+    to it where one is within ``size / 2`` (a partition then decodes only its own groups), else at ``size``."""
+    n = int(bounds[-1])
+    cuts = [0]
+    while cuts[-1] < n:
+        want = cuts[-1] + size
+        later = bounds[bounds > cuts[-1]]
+        nearest = int(later[np.argmin(np.abs(later - want))])
+        cuts.append(nearest if abs(nearest - want) <= size // 2 else min(want, n))
+    return cuts
 
 
 def _line_starts(path: Path) -> np.ndarray:

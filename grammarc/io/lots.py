@@ -45,6 +45,8 @@ __all__ = ["BadLot", "Lots", "default_lot", "lots_from_polygons", "read_lots"]
 
 #: Suffixes of GeoJSON sequences (``io.lot_partitions``): a Feature or a geometry per line.
 SEQUENCE_SUFFIXES = (".geojsonl", ".geojsons", ".geojsonseq", ".jsonl", ".ndjson")
+#: Suffixes of GIS files read through GDAL (``io.gis``, the ``gis`` extra).
+GIS_SUFFIXES = (".gpkg", ".shp", ".fgb", ".gml", ".kml", ".sqlite", ".tab")
 #: The lot property that marks street edges, as CityEngine's object attribute.
 STREET_WIDTH = "streetWidth"
 # GEOS reasons end with the offending point, e.g. "Self-intersection[3 4.5]".
@@ -150,8 +152,8 @@ class Lots:
 
 def read_lots(path: str | os.PathLike) -> Lots:
     """Read lots from a GeoJSON (``.geojson``, ``.json``), GeoJSON sequence (``SEQUENCE_SUFFIXES``: a
-    feature per line), OBJ (``.obj``) or GeoParquet (``.parquet``, ``io.geoparquet``: the fast way for
-    10^5 lots and more) file.
+    feature per line), OBJ (``.obj``), GeoParquet (``.parquet``, ``io.geoparquet``: the fast way for
+    10^5 lots and more) or GIS (``GIS_SUFFIXES``, through GDAL: ``io.gis``) file.
 
     GeoJSON may be a FeatureCollection, a single Feature or a bare Polygon / MultiPolygon geometry,
     in map coordinates taken as metres (longitude/latitude is not reprojected). A Polygon is one lot
@@ -192,13 +194,22 @@ def read_lots(path: str | os.PathLike) -> Lots:
             if builder.polygons == 0:
                 raise LotsError(f"no polygon in lots file {path}")
             return builder.finish(attrs, str(path))
+    if suffix in GIS_SUFFIXES:
+        from grammarc.io.gis import read_gis
+
+        with _no_cycle_collection():
+            builder, attrs = read_gis(path)
+            if builder.polygons == 0:
+                raise LotsError(f"no polygon in lots file {path}")
+            return builder.finish(attrs, str(path))
     if suffix in SEQUENCE_SUFFIXES:
         from grammarc.io.lot_partitions import read_sequence
 
         return read_sequence(path)
     if suffix not in (".geojson", ".json", ".obj"):
-        raise LotsError(f"unknown lots file type {suffix!r} (expected .geojson, .json, .obj, .parquet or a "
-                        f"GeoJSON sequence, {', '.join(SEQUENCE_SUFFIXES)}): {path}")
+        raise LotsError(f"unknown lots file type {suffix!r} (expected .geojson, .json, .obj, .parquet, a "
+                        f"GeoJSON sequence ({', '.join(SEQUENCE_SUFFIXES)}) or a GIS file "
+                        f"({', '.join(GIS_SUFFIXES)})): {path}")
     try:
         text = path.read_text(encoding="utf-8")
     except (OSError, UnicodeDecodeError) as error:

@@ -24,6 +24,9 @@ import os
 import tempfile
 from pathlib import Path
 
+import numba
+import numpy as np
+
 __all__ = ["is_manifest", "manifest_path", "read_manifest", "shard_outputs", "shards_folder"]
 
 #: A manifest's name ends so.
@@ -104,6 +107,24 @@ def write_json(path: Path, value: dict) -> None:
     except BaseException:
         Path(tmp).unlink(missing_ok=True)
         raise
+
+
+@numba.njit(cache=True, nogil=True)
+def instance_box(xform: np.ndarray, low: np.ndarray, high: np.ndarray) -> None:
+    """Grow ``low``/``high`` (3,) float64 to the boxes of instances ``xform`` (n, 3, 4): the unit cube
+    mapped by each affine transform, per world axis its translation plus the negative (or positive)
+    entries of the linear map's row. One pass, no temporaries (numpy's took 0.17 s per 6 * 10^5)."""
+    for n in range(xform.shape[0]):
+        for i in range(3):
+            lo = hi = np.float64(xform[n, i, 3])
+            for j in range(3):
+                v = np.float64(xform[n, i, j])
+                if v < 0:
+                    lo += v
+                else:
+                    hi += v
+            low[i] = min(low[i], lo)
+            high[i] = max(high[i], hi)
 
 
 def _sha256(path: Path) -> str:

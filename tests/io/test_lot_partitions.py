@@ -52,6 +52,22 @@ def _files(tmp_path):
     return whole, sequence, parquet
 
 
+def _gis_file(tmp_path):
+    """The features as a GeoPackage (a layer of mixed geometry types), written through GDAL."""
+    raw = pytest.importorskip("pyogrio.raw")
+    import shapely
+
+    path = tmp_path / "lots.gpkg"
+    fields = ["name", "h", "streetWidth"]
+    data = [np.array([f.get("id") for f in FEATURES], dtype=object),
+            np.array([f["properties"]["h"] for f in FEATURES], dtype=float),
+            np.array([json.dumps(f["properties"]["streetWidth"]) if "streetWidth" in f["properties"] else None
+                      for f in FEATURES], dtype=object)]
+    geometry = shapely.to_wkb([shapely.from_geojson(json.dumps(f["geometry"])) for f in FEATURES])
+    raw.write(path, geometry, data, fields, geometry_type="Unknown", driver="GPKG", crs="EPSG:32633")
+    return path
+
+
 def _read_in_parts(path, size):
     parts = partition_lots(path, size)
     counts = [count_lots(p) for p in parts]
@@ -59,13 +75,14 @@ def _read_in_parts(path, size):
     return parts, [read_partition(p, int(f)) for p, f in zip(parts, firsts)]
 
 
-@pytest.mark.parametrize("kind", ["geojson", "sequence", "parquet"])
+@pytest.mark.parametrize("kind", ["geojson", "sequence", "parquet", "gpkg"])
 @pytest.mark.parametrize("size", [1, 3, 5, 100])
 def test_partitions_together_are_the_whole_file(tmp_path, kind, size):
-    path = dict(zip(["geojson", "sequence", "parquet"], _files(tmp_path)))[kind]
+    path = _gis_file(tmp_path) if kind == "gpkg" else \
+        dict(zip(["geojson", "sequence", "parquet"], _files(tmp_path)))[kind]
     whole = read_lots(path)
     parts, lots = _read_in_parts(path, size)
-    assert len(parts) == -(-len(FEATURES) // size) or kind != "parquet"  # a sequence counts lines
+    assert parts[0].start == 0 and all(a.stop == b.start for a, b in itertools.pairwise(parts))
     assert np.concatenate([p.index for p in lots]).tolist() == whole.index.tolist()
     assert np.concatenate([p.ids for p in lots]).tolist() == whole.ids.tolist()
     np.testing.assert_array_equal(np.concatenate([p.vertices for p in lots]), whole.vertices)
@@ -75,11 +92,30 @@ def test_partitions_together_are_the_whole_file(tmp_path, kind, size):
     np.testing.assert_array_equal(heights.astype(float), whole.attrs["h"].astype(float))
 
 
+def test_a_gis_file_reads_as_its_features(tmp_path):
+    """GeoPackage through GDAL: the lots, ids, MultiPolygon parts, street edges and bad lots of the
+    GeoJSON (`streetWidth` is JSON text in a GeoPackage field, which has no lists)."""
+    whole = read_lots(_files(tmp_path)[0])
+    gis = read_lots(_gis_file(tmp_path))
+    assert gis.ids.tolist()[:3] == ["a", "m:0", "m:1"] and gis.index.tolist() == whole.index.tolist()
+    assert gis.bad == whole.bad and [b.id for b in gis.bad] == ["line", "bad-width"]
+    np.testing.assert_allclose(gis.vertices, whole.vertices)
+    np.testing.assert_array_equal(gis.street, whole.street)
+    np.testing.assert_array_equal(gis.attrs["h"].astype(float), whole.attrs["h"].astype(float))
+
+
 def test_a_sequence_reads_as_its_feature_collection(tmp_path):
     whole, sequence, _ = _files(tmp_path)
     a, b = read_lots(whole), read_lots(sequence)
     assert a.ids.tolist() == b.ids.tolist() and a.index.tolist() == b.index.tolist() and a.bad == b.bad
     np.testing.assert_array_equal(a.vertices, b.vertices)
+
+
+def test_parquet_partitions_follow_row_groups_near_their_size(tmp_path):
+    parquet = _files(tmp_path)[2]  # row groups of 2 rows, 13 rows
+    assert [(p.start, p.stop) for p in partition_lots(parquet, 3)] == [(0, 2), (2, 4), (4, 6), (6, 8), (8, 10),
+                                                                        (10, 13)]
+    assert [(p.start, p.stop) for p in partition_lots(parquet, 6)] == [(0, 6), (6, 12), (12, 13)]
 
 
 def test_a_bad_line_of_a_sequence_is_named(tmp_path):

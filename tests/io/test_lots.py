@@ -277,9 +277,17 @@ def test_file_without_polygons_raises(tmp_path):
 
 
 def test_unknown_suffix_raises(tmp_path):
+    path = tmp_path / "lots.dwg"
+    path.write_bytes(b"\0")
+    with pytest.raises(LotsError, match="unknown lots file type '.dwg'.*lots.dwg"):
+        read_lots(path)
+
+
+def test_a_broken_gis_file_raises(tmp_path):
+    pytest.importorskip("pyogrio")
     path = tmp_path / "lots.shp"
     path.write_bytes(b"\0")
-    with pytest.raises(LotsError, match="unknown lots file type '.shp'.*lots.shp"):
+    with pytest.raises(LotsError, match="cannot read lots file .*lots.shp"):
         read_lots(path)
 
 
