@@ -125,17 +125,16 @@ class Executor(ScopeOperations, SplitOperations, ComponentOperations, FaceOperat
             )
         remaining = shapes
         for rule in sym.rules:
-            if not len(remaining):
-                break
-            if rule.guard is None:
-                chosen, remaining = remaining, remaining.take(np.zeros(0, dtype=np.int64))
-            else:
+            if rule.guard is not None:
                 holds = evaluate_array(rule.guard, self.env(remaining), dtype=bool)
-                chosen, remaining = remaining.take(holds), remaining.take(~holds)
-            if len(chosen):
-                self.apply_rule(sym, rule, chosen)
-        if len(remaining):
-            terminals.emit_leaves(self.chunk, remaining, sym.id)
+                if not holds.all():  # a guard that holds for all or none of a batch copies nothing
+                    if holds.any():
+                        self.apply_rule(sym, rule, remaining.take(holds))
+                        remaining = remaining.take(~holds)
+                    continue
+            self.apply_rule(sym, rule, remaining)
+            return
+        terminals.emit_leaves(self.chunk, remaining, sym.id)
 
     def apply_rule(self, sym: SymbolPlan, rule: ir.Rule, shapes: Shapes) -> None:
         symbol = sym.id
@@ -152,7 +151,8 @@ class Executor(ScopeOperations, SplitOperations, ComponentOperations, FaceOperat
         draw = uniform(shapes.key, rule.site)
         choice = np.minimum((draw[:, None] >= cumulative).sum(axis=1), len(alts) - 1)
         for i, alt in enumerate(alts):
-            picked = shapes.take(choice == i)
+            mine = choice == i
+            picked = shapes if mine.all() else shapes.take(mine)
             if len(picked):
                 self.run(alt.body, picked, symbol, leaf_at_end=True)
 
