@@ -18,19 +18,22 @@ checksums hold is kept: only the others are derived.
 
 Partitions hold ``--partition-size`` features (default ``PARTITION_SIZE``): each task then costs seconds,
 far above Dask's per-task overhead (about a millisecond), and its records stay well within a worker's
-memory. The lots file, and the asset files where the output needs them (USD prototypes, CityEngine's
-trim planes), must be readable at the same paths by every worker (a shared filesystem); a rule package is
-extracted on the client, so a cluster of other machines needs it extracted to a shared folder first.
+memory. The lots file must be readable at the same path by every worker (a shared filesystem). The
+grammar's asset files (which USD prototypes and CityEngine's trim planes load) are read on the client,
+sent once to each worker and written to a folder of its own (``_asset_root``), so a rule package
+extracted on the client, or an ``--assets`` folder only the client has, works on a cluster of machines.
 """
 
 from __future__ import annotations
 
 import contextlib
+import hashlib
 import os
 import shutil
+import tempfile
 import time
 from dataclasses import dataclass, replace
-from pathlib import Path
+from pathlib import Path, PurePosixPath
 
 import numpy as np
 
@@ -51,6 +54,7 @@ from grammarc.build import (
 from grammarc.compiler import compile_grammar
 from grammarc.errors import UsageError
 from grammarc.io import OutputOptions, writer_for
+from grammarc.io.assets import resolve_asset
 from grammarc.io.lot_partitions import Partition, count_lots, partition_lots, read_partition
 from grammarc.io.lots import BadLot
 from grammarc.io.shards import (
@@ -87,6 +91,8 @@ class _Job:
     assets: tuple[str, ...]
     symbols: tuple[str, ...]
     meta: dict
+    #: The SHA-256 of the shipped asset files (``_asset_files``), which name their folder on a worker.
+    assets_digest: str = ""
 
 
 def build_on_dask(grammar_path, output, *, dask: str, lots_path=None, options: BuildOptions | None = None,
@@ -117,15 +123,17 @@ def build_on_dask(grammar_path, output, *, dask: str, lots_path=None, options: B
         meta = record_meta(Path(grammar_path), grammar, plan, options, str(lots_path), options.asset_roots)
         key = run_key({"meta": meta, "lots": [stat_key(stamp)], "partition_size": partition_size,
                        "format": suffix, "limits": options.limits, "version": __version__})
+        files = _asset_files(grammar, output_options.lod)
+        key = run_key({"run": key, "assets": _digest(files)})
         folder = shards_folder(output)
         if folder.exists() and not resume:
             shutil.rmtree(folder)
         folder.mkdir(parents=True, exist_ok=True)
         job = _Job(folder, suffix, key, replace(resolved, workers=1), output_options, tuple(grammar.assets),
-                   tuple(plan.symbol_names), meta)
+                   tuple(plan.symbol_names), meta, _digest(files))
         with _client(dask) as client:
             firsts = _first_numbers(client, partitions)
-            sidecars = _derive_partitions(client, plan, partitions, firsts, job, resume, progress)
+            sidecars = _derive_partitions(client, plan, files, partitions, firsts, job, resume, progress)
         _remove_temporaries(folder)
         manifest = _manifest(output, job, partitions, sidecars)
         write_json(manifest_path(output), manifest)
@@ -175,7 +183,8 @@ def _first_numbers(client, partitions: list[Partition]) -> list[int]:
     return np.concatenate([[0], np.cumsum(counts)[:-1]]).astype(int).tolist()
 
 
-def _derive_partitions(client, plan, partitions, firsts, job: _Job, resume: bool, progress) -> list[dict]:
+def _derive_partitions(client, plan, files, partitions, firsts, job: _Job, resume: bool,
+                       progress) -> list[dict]:
     """Passes 2 and 3: the occluders (if the grammar asks), then a shard per partition not yet complete;
     the sidecars in partition order."""
     from dask.distributed import as_completed
@@ -194,13 +203,14 @@ def _derive_partitions(client, plan, partitions, firsts, job: _Job, resume: bool
     if not todo:
         return [sidecars[p.number] for p in partitions]
     plan_future = client.scatter(plan, broadcast=True)
+    files_future = client.scatter(files, broadcast=True)
     foreign = None
     if plan.inter:
         tables = client.gather([client.submit(_occluders_task, plan_future, p, f, job.options, pure=False,
                                               retries=RETRIES) for p, f in zip(partitions, firsts)])
         foreign = client.scatter(Occluders.concat(tables), broadcast=True)
-    futures = [client.submit(_shard_task, plan_future, part, first, job, foreign, pure=False, retries=RETRIES)
-               for part, first in todo]
+    futures = [client.submit(_shard_task, plan_future, part, first, job, foreign, files_future, pure=False,
+                             retries=RETRIES) for part, first in todo]
     try:
         for future in as_completed(futures):
             sidecar = future.result()
@@ -220,8 +230,11 @@ def _occluders_task(plan, part: Partition, first: int, options: BuildOptions) ->
     return occluders(plan, read_partition(part, first), options)
 
 
-def _shard_task(plan, part: Partition, first: int, job: _Job, foreign) -> dict:
+def _shard_task(plan, part: Partition, first: int, job: _Job, foreign, files: dict[str, bytes]) -> dict:
     """On a worker: read the partition, derive it into its shard, write the sidecar; the sidecar."""
+    roots = (_asset_root(files, job.assets_digest),)
+    plan = replace(plan, grammar=replace(plan.grammar, asset_roots=roots))
+    job = replace(job, output_options=replace(job.output_options, asset_roots=roots))
     lots = read_partition(part, first)
     path = job.folder / shard_name(part.number, job.suffix)
     failed: list[BadLot] = []
@@ -257,6 +270,47 @@ def _shard_task(plan, part: Partition, first: int, job: _Job, foreign) -> dict:
     }
     write_json(sidecar_path(job.folder, part.number), sidecar)
     return sidecar
+
+
+def _asset_files(grammar, lod: str | None) -> dict[str, bytes]:
+    """The grammar's asset files (and their ``lod`` variants), by their names in the record."""
+    files = {}
+    for name in grammar.assets:
+        found = resolve_asset(name, list(grammar.asset_roots))
+        if found.path is None:
+            continue  # a built-in, or missing: reported where it is loaded, as in one process
+        variants = [found.path] + ([found.path.with_name(f"{found.path.stem}.{lod}{found.path.suffix}")]
+                                   if lod else [])
+        for path in variants:
+            if path.is_file():
+                files[(PurePosixPath(found.name).parent / path.name).as_posix()] = path.read_bytes()
+    return files
+
+
+def _digest(files: dict[str, bytes]) -> str:
+    """The SHA-256 of named files, in name order."""
+    digest = hashlib.sha256()
+    for name in sorted(files):
+        digest.update(name.encode() + b"\0" + hashlib.sha256(files[name]).digest())
+    return digest.hexdigest()
+
+
+def _asset_root(files: dict[str, bytes], digest: str) -> Path:
+    """On a worker: the shipped asset files written to a folder named by their digest, once per machine
+    (a worker that finds it complete uses it; one that writes it renames it into place when done)."""
+    folder = Path(tempfile.gettempdir()) / f"grammarc-assets-{digest[:24]}"
+    if folder.is_dir():
+        return folder
+    staging = Path(tempfile.mkdtemp(prefix=f".{folder.name}.", dir=folder.parent))
+    for name, data in files.items():
+        path = staging / name
+        path.parent.mkdir(parents=True, exist_ok=True)
+        path.write_bytes(data)
+    try:
+        os.rename(staging, folder)
+    except OSError:  # another worker of this machine was first
+        shutil.rmtree(staging, ignore_errors=True)
+    return folder
 
 
 class _Bounds:

@@ -156,3 +156,20 @@ def test_cli_local_cluster(city_lots, tmp_path, capsys):
     assert "c.manifest.json: 403,552 instances" in capsys.readouterr().err
     assert main(["info", str(manifest_path(out))]) == 0
     assert "instances" in capsys.readouterr().out
+
+
+def test_asset_files_are_shipped_to_a_folder_of_the_worker_s_own(tmp_path, monkeypatch):
+    """The grammar's asset files travel with the plan, so workers without the client's folders (a rule
+    package extracted on the client) load them; a folder once written is reused."""
+    from grammarc.cluster import _asset_files, _asset_root, _digest
+    from grammarc.compiler import compile_grammar
+
+    grammar = compile_grammar(CITY)
+    files = _asset_files(grammar, None)
+    assert set(files) == {n for n in grammar.assets if not n.startswith("builtin:")} and files
+    monkeypatch.setattr("tempfile.tempdir", str(tmp_path))
+    folder = _asset_root(files, _digest(files))
+    for name, data in files.items():
+        assert (folder / name).read_bytes() == data
+    (folder / "marker").write_text("kept")
+    assert _asset_root(files, _digest(files)) == folder and (folder / "marker").exists()
