@@ -186,19 +186,14 @@ def read_lots(path: str | os.PathLike) -> Lots:
     if not path.is_file():
         raise LotsError(f"lots file not found: {path}")
     suffix = path.suffix.lower()
-    if suffix == ".parquet":
-        from grammarc.io.geoparquet import read_geoparquet
-
+    if suffix == ".parquet" or suffix in GIS_SUFFIXES:
+        # columnar: the footprints as WKB and typed property columns, from pyarrow or GDAL
+        if suffix == ".parquet":
+            from grammarc.io.geoparquet import read_geoparquet as read_columns
+        else:
+            from grammarc.io.gis import read_gis as read_columns
         with _no_cycle_collection():
-            builder, attrs = read_geoparquet(path)
-            if builder.polygons == 0:
-                raise LotsError(f"no polygon in lots file {path}")
-            return builder.finish(attrs, str(path))
-    if suffix in GIS_SUFFIXES:
-        from grammarc.io.gis import read_gis
-
-        with _no_cycle_collection():
-            builder, attrs = read_gis(path)
+            builder, attrs = read_columns(path)
             if builder.polygons == 0:
                 raise LotsError(f"no polygon in lots file {path}")
             return builder.finish(attrs, str(path))

@@ -5,22 +5,14 @@ import json
 
 import numpy as np
 import pytest
+from lot_features import FEATURES as BASE_FEATURES
 
 from grammarc.errors import LotsError
 from grammarc.io.lot_partitions import count_lots, partition_lots, read_partition
 from grammarc.io.lots import read_lots
 
 FEATURES = [
-    {"type": "Feature", "id": "a", "properties": {"kind": "house", "h": 12, "streetWidth": [8, 0, 0, 0]},
-     "geometry": {"type": "Polygon", "coordinates": [[[0, 0], [20, 0], [20, 15], [0, 15], [0, 0]]]}},
-    {"type": "Feature", "id": "line", "properties": {"kind": "x", "h": None},
-     "geometry": {"type": "LineString", "coordinates": [[0, 0], [5, 5]]}},
-    {"type": "Feature", "id": "m", "properties": {"kind": "court", "h": 7.5},
-     "geometry": {"type": "MultiPolygon", "coordinates": [
-         [[[40, 0], [80, 0], [80, 40], [40, 40], [40, 0]], [[50, 10], [50, 30], [70, 30], [70, 10], [50, 10]]],
-         [[[100, 0], [110, 0], [110, 10], [100, 0]]]]}},
-    {"type": "Feature", "id": "bad-width", "properties": {"kind": "house", "h": 3, "streetWidth": [1, 2]},
-     "geometry": {"type": "Polygon", "coordinates": [[[0, 30], [10, 30], [10, 40], [0, 40], [0, 30]]]}},
+    *BASE_FEATURES,
     *({"type": "Feature", "properties": {"h": float(k)},
        "geometry": {"type": "Polygon", "coordinates": [[[0, 50 + 10 * k], [8, 50 + 10 * k], [8, 58 + 10 * k],
                                                         [0, 58 + 10 * k], [0, 50 + 10 * k]]]}}
