@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import contextlib
 import functools
+import gc
 import time
 from collections import deque
 from collections.abc import Sequence
@@ -210,7 +211,7 @@ def derive_all(plan, lots: Lots, options: BuildOptions, writer, failed: list[Bad
     A chunk holds at most ``options.chunk_size`` lots, and fewer when the lots so far made many records:
     the next chunk aims at ``ROWS_PER_CHUNK`` records, which keeps its arrays in the caches and its memory
     small whatever the grammar. The records do not depend on the chunking. A grammar whose occlusion
-    queries look at other lots is derived twice: first for everyone's occluders (``_occluders``), those of
+    queries look at other lots is derived twice: first for everyone's occluders (``occluders``), those of
     ``context`` when given (the whole city of a selection), unless ``foreign`` gives them (a cluster
     build's partition: the occluders of every partition).
 
@@ -220,15 +221,38 @@ def derive_all(plan, lots: Lots, options: BuildOptions, writer, failed: list[Bad
     written in chunk order, and a chunk's size is decided from the chunks finished before it in that
     order, so the chunking does not depend on timing (and the records never depend on the chunking).
     """
+    if plan.inter and foreign is None:
+        foreign = occluders(plan, lots if context is None else context, options)
+    if foreign is not None:
+        foreign.index  # noqa: B018 - built once here, before the workers inherit it
+    with _collecting():
+        return _derive_chunks(plan, lots, options, writer, failed, reports, progress, foreign)
+
+
+@contextlib.contextmanager
+def _collecting():
+    """The cyclic garbage collector on while chunks are derived (an executor's cycles must go with its
+    chunk), after what the set-up made is frozen out of its sight: the grammar's IR, the plan, numba's
+    dispatchers live to the end, and full collections need not walk them, nor forked workers touch their
+    pages. ``grammarc``'s command turns the collector off for the set-up (0.15 s of its start)."""
+    was_enabled = gc.isenabled()
+    gc.freeze()
+    gc.enable()
+    try:
+        yield
+    finally:
+        if not was_enabled:
+            gc.disable()
+
+
+def _derive_chunks(plan, lots: Lots, options: BuildOptions, writer, failed: list[BadLot], reports: Reports,
+                   progress, foreign) -> int:
+    """``derive_all`` once the occluders are known."""
     derived = 0
     first = 0
     size = min(options.chunk_size, 64)
     rows = 0
     written = 0
-    if plan.inter and foreign is None:
-        foreign = occluders(plan, lots if context is None else context, options)
-    if foreign is not None:
-        foreign.index  # noqa: B018 - built once here, before the workers inherit it
     with worker_pool(functools.partial(_derive, plan, options=options, foreign=foreign), options.workers) as submit:
         window: deque = deque()
         try:
