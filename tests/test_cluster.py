@@ -173,3 +173,24 @@ def test_asset_files_are_shipped_to_a_folder_of_the_worker_s_own(tmp_path, monke
         assert (folder / name).read_bytes() == data
     (folder / "marker").write_text("kept")
     assert _asset_root(files, _digest(files)) == folder and (folder / "marker").exists()
+
+
+def test_bad_lots_are_reported_by_the_shard_that_read_them(cluster, tmp_path):
+    """A bad lot is skipped and listed with its number and id, as in one process, whichever partition
+    it falls in; a lot whose derivation fails is listed too."""
+    address, _ = cluster
+    square = [[0, 0], [20, 0], [20, 15], [0, 15], [0, 0]]
+    features = [{"type": "Feature", "id": f"lot{k}", "properties": {},
+                 "geometry": {"type": "Polygon", "coordinates": [[[x + 30 * k, y] for x, y in square]]}}
+                for k in range(7)]
+    features[2]["geometry"] = {"type": "Point", "coordinates": [0, 0]}
+    features[5]["geometry"]["coordinates"][0][2] = [30 * 5 + 20, -15]  # self-intersecting
+    lots = tmp_path / "lots.geojsonl"
+    lots.write_text("".join(json.dumps(f) + "\n" for f in features))
+    result = build_on_dask(CITY, tmp_path / "b.npz", dask=address, lots_path=lots, partition_size=2)
+    single = build(CITY, tmp_path / "one.npz", lots_path=lots, options=BuildOptions(workers=1))
+    assert [(b.index, b.id) for b in result.bad] == [(b.index, b.id) for b in single.bad] == [(2, "lot2"),
+                                                                                              (5, "lot5")]
+    assert [b["id"] for b in read_manifest(result.output)["bad"]] == ["lot2", "lot5"]
+    assert result.derived == single.derived == 5
+    assert_same_records(read_instances(tmp_path / "one.npz"), result.output)
