@@ -92,7 +92,7 @@ def derive_chunk(plan: Plan, lots: Lots, *, seed: int, limits: Limits, overrides
                     continue
                 batches = executor.pending.pop(sym_id, None)
                 if batches:
-                    executor.apply(plan.symbols[sym_id], Shapes.concat(batches))
+                    executor.apply_pending(plan.symbols[sym_id], batches)
     if occluders_only:
         return chunk.occluders.table()
     reports = aggregate_chunk(chunk.outputs.reports, chunk.lot_index, list(plan.strings.ids))

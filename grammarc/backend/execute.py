@@ -88,10 +88,14 @@ class Executor(ScopeOperations, SplitOperations, ComponentOperations, FaceOperat
 
     def count(self, shapes: Shapes, symbol: int, span) -> None:
         """Add new shapes to the per-lot counters and enforce the shape limits."""
-        if not len(shapes):
+        self.count_lots(shapes.lot, symbol, span)
+
+    def count_lots(self, lot: np.ndarray, symbol: int, span) -> None:
+        """``count`` of new shapes given by their lots."""
+        if not len(lot):
             return
         counts = self.chunk.shape_count
-        counts += np.bincount(shapes.lot, minlength=len(counts))
+        counts += np.bincount(lot, minlength=len(counts))
         self.check_shape_limit(counts, symbol, span)
         if counts.sum() > self.chunk_budget and len(counts) > 1:
             raise ChunkTooLarge()
@@ -112,6 +116,21 @@ class Executor(ScopeOperations, SplitOperations, ComponentOperations, FaceOperat
                     self.apply_all(sym, shapes.take(rank == k))
                 return
         self.apply_all(sym, shapes)
+
+    def apply_pending(self, sym: SymbolPlan, batches: list) -> None:
+        """``apply`` to a symbol's pending batches, in order: shapes, and records of a leaf-insert symbol
+        made ahead of its turn (``leaf_parts``), emitted now, where its rule would have emitted them."""
+        shapes: list[Shapes] = []
+        for batch in [*batches, None]:
+            if isinstance(batch, Shapes):
+                shapes.append(batch)
+                continue
+            if shapes:
+                self.apply(sym, Shapes.concat(shapes))
+                shapes = []
+            if batch is not None:
+                terminals.append_records(self.chunk, batch.xform, batch.lot, self.plan.leaf_inserts[sym.id].asset,
+                                         sym.id, None)
 
     def apply_all(self, sym: SymbolPlan, shapes: Shapes) -> None:
         """``apply`` on all of ``shapes`` at once."""

@@ -5,8 +5,9 @@ The derivation looks everything up here by symbol id; nothing in it refers to sy
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field, replace
 
+from grammarc.backend.leaf_parts import leaf_inserts
 from grammarc.backend.occlusion import ANCESTORS
 from grammarc.compiler import Grammar
 from grammarc.ir import nodes as ir
@@ -70,6 +71,9 @@ class Plan:
     #: Symbols whose rules split on snap planes: each lot's shapes are taken one after the other
     #: (``Executor.apply``).
     snapping: frozenset[int] = frozenset()
+    #: Symbols whose rule only places an asset, by id: split parts naming them skip the shape stage
+    #: (``backend.leaf_parts``).
+    leaf_inserts: dict = field(default_factory=dict)
 
     @property
     def symbol_names(self) -> tuple[str, ...]:
@@ -112,11 +116,12 @@ def make_plan(grammar: Grammar) -> Plan:
     for selector in ir.FACE_SELECTORS:
         strings.intern(selector)
     asset_of_string = {strings.intern(raw): asset for raw, asset in grammar.asset_ids.items()}
-    return Plan(grammar, tuple(symbols), ids, ids[grammar.graph.start], strings, stages, dynamic,
+    plan = Plan(grammar, tuple(symbols), ids, ids[grammar.graph.start], strings, stages, dynamic,
                 module.dialect == "cityengine", not_applied, asset_of_string, frozenset(occlusion),
                 any(e.target != "intra" for found in occlusion.values() for e in found),
                 frozenset(s.id for s in symbols if any(getattr(op, "snap", False) for rule in s.rules
                                                        for alt in rule.alternatives for op in iter_ops(alt.body))))
+    return replace(plan, leaf_inserts=leaf_inserts(plan))
 
 
 #: Per-shape columns of a shape's two vertical trim planes, (nx, ny, nz, d) each in world coordinates:

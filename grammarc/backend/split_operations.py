@@ -14,6 +14,7 @@ from grammarc.backend.evaluate import evaluate, evaluate_array
 from grammarc.backend.kernels import scope as scope_kernels
 from grammarc.backend.kernels import split as split_kernels
 from grammarc.backend.kernels.order import group_by
+from grammarc.backend.leaf_parts import LeafRecords
 from grammarc.backend.shapes import Shapes
 from grammarc.constants import TOL
 from grammarc.errors import LimitError
@@ -117,6 +118,10 @@ class SplitOperations:
                                                                op.span)
             cell = cell[parent] + step
             if level == len(op.axes) - 1:
+                leaves = self.leaf_parts(op.parts, shapes, geometry)
+                if leaves is not None:
+                    self.fan_out_leaves(op, shapes, axis, parent, cell, pos, length, leaves, symbol)
+                    return
                 shapes, offsets = self.grouped_children(shapes, axis, parent, cell, pos, length, op.site,
                                                         len(op.parts), geometry)
             else:
@@ -124,6 +129,51 @@ class SplitOperations:
                                        geometry=geometry)
         self.count(shapes, symbol, op.span)
         self.run_parts(op.parts, shapes, offsets, symbol)
+
+    def leaf_parts(self, parts: tuple[ir.Body, ...], shapes: Shapes, geometry) -> list | None:
+        """Per body part, the ``LeafInsert`` of the symbol it names if its records can be written straight
+        from the parent's scope (``backend.leaf_parts``), else None; None if no part can."""
+        inserts = self.plan.leaf_inserts
+        if not inserts or geometry is not None or "split.total" in self.plan.dynamic:
+            return None
+        leaves = [inserts.get(self.plan.symbol_ids[body[0].name])
+                  if len(body) == 1 and isinstance(body[0], ir.Symbol) and not body[0].args and not body[0].leaf
+                  else None for body in parts]
+        # the successor would be one rule application deeper: where that reaches --max-depth, the
+        # general path reports it
+        if not any(leaves) or int(shapes.depth.max()) + 1 >= self.limits.max_depth:
+            return None
+        return leaves
+
+    def fan_out_leaves(self, op, shapes: Shapes, axis: int, parent, cell, pos, length, leaves: list,
+                       symbol: int) -> None:
+        """The last axis of ``fan_out`` when some parts only place an asset: their records are computed
+        from ``shapes`` and the cuts and queued for their symbol (``LeafRecords``); the other parts' children
+        are made and run as usual. Shape counts are kept as the general path keeps them."""
+        n_parts = len(op.parts)
+        order, offsets = group_by(cell % n_parts if n_parts > 1 else np.zeros_like(cell), n_parts)
+        self.count_lots(shapes.lot[parent], symbol, op.span)  # the children, as `fan_out` counts them
+        general = [i for i, leaf in enumerate(leaves) if leaf is None]
+        rows = [order[offsets[i]:offsets[i + 1]] for i in range(n_parts)]
+        if general:
+            kept = np.concatenate([rows[i] for i in general])
+            children = self.children(shapes, axis, parent, cell, pos, length, op.site, kept)
+            starts = dict(zip(general, np.cumsum([0] + [len(rows[i]) for i in general]).tolist()))
+        frames = self.chunk.frames.data
+        for i, body in enumerate(op.parts):
+            if not len(rows[i]):
+                continue
+            leaf = leaves[i]
+            if leaf is None:
+                part = children.take(slice(starts[i], starts[i] + len(rows[i])))
+                self.run(body, part, symbol, leaf_at_end=True)
+                continue
+            owner = parent[rows[i]]
+            self.count_lots(shapes.lot[owner], symbol, body[0].span)  # the successors
+            xform = scope_kernels.leaf_xforms(
+                shapes.origin, shapes.size, shapes.frame, frames, axis, rows[i], parent, pos, length, leaf.size,
+                leaf.relative, leaf.offset if leaf.offset is not None else np.zeros(0))
+            self.pending[leaf.symbol].append(LeafRecords(xform, shapes.lot[owner]))
 
     def check_fan_out(self, shapes: Shapes, counts: np.ndarray, symbol: int, span) -> None:
         """Refuse a repeat that would exceed --max-shapes before allocating its children."""

@@ -84,13 +84,20 @@ def _trimmed(chunk: Chunk, shapes: Shapes, xform: np.ndarray, planes: np.ndarray
 
 
 def _append(chunk: Chunk, shapes: Shapes, xform: np.ndarray, asset: int, symbol: int) -> None:
+    append_records(chunk, xform, shapes.lot, asset, symbol,
+                   shapes.dynamic[chunk.color_slot] if chunk.color_slot is not None else None)
+
+
+def append_records(chunk: Chunk, xform: np.ndarray, lot: np.ndarray, asset: int, symbol: int,
+                   color: np.ndarray | None) -> None:
+    """Add instance records: transforms, lots, and colours (0xRRGGBB floats) where the grammar sets them."""
     out = chunk.outputs
     out.xform.append(xform)
-    out.asset.append(np.full(len(shapes), asset, dtype=np.int32))
-    out.lot.append(shapes.lot.astype(np.int32))
-    out.symbol.append(np.full(len(shapes), symbol, dtype=np.int32))
+    out.asset.append(np.full(len(lot), asset, dtype=np.int32))
+    out.lot.append(lot.astype(np.int32))
+    out.symbol.append(np.full(len(lot), symbol, dtype=np.int32))
     if chunk.color_slot is not None:
-        out.color.append(rgba(shapes.dynamic[chunk.color_slot]))
+        out.color.append(rgba(color))
 
 
 def rgba(packed: np.ndarray) -> np.ndarray:

@@ -62,3 +62,38 @@ def xforms(frames, frame, size, origin):
                 out[i, r, j] = frames[f, j, r] * size[i, j]
             out[i, r, 3] = origin[i, r]
     return out
+
+
+@njit(cache=True, nogil=True)
+def leaf_xforms(origin, size, frame, frames, axis, rows, parent, pos, length, new_size, relative, offset):
+    """Record transforms (m, 3, 4) float32 of split children ``rows`` whose symbol only places an asset
+    after a constant ``S`` and ``T`` (``leaf_parts``): the child's scope as ``place_children`` makes it,
+    sized as ``Executor.scale`` and moved as ``Executor.translate`` would (the same operations in the same
+    order, so the same bits), then as ``xforms``. ``new_size`` (3,): NaN keeps the axis' size, else an
+    absolute size or, where ``relative``, a factor; ``offset`` (3,) along the scope axes, or empty."""
+    m = len(rows)
+    out = np.empty((m, 3, 4), np.float32)
+    o = np.empty(3)
+    s = np.empty(3)
+    for c in range(m):
+        k = rows[c]
+        p = parent[k]
+        f = frame[p]
+        for j in range(3):
+            o[j] = origin[p, j] + pos[k] * frames[f, axis, j]
+            s[j] = size[p, j]
+        s[axis] = length[k]
+        for j in range(3):
+            if not np.isnan(new_size[j]):
+                s[j] = new_size[j] * s[j] if relative[j] else new_size[j]
+        if len(offset):
+            for j in range(3):
+                delta = 0.0
+                for i in range(3):
+                    delta += offset[i] * frames[f, i, j]
+                o[j] = o[j] + delta
+        for r in range(3):
+            for j in range(3):
+                out[c, r, j] = frames[f, j, r] * s[j]
+            out[c, r, 3] = o[r]
+    return out
