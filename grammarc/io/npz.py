@@ -45,13 +45,13 @@ import struct
 import tempfile
 import threading
 import weakref
-import zlib
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING
 
 import numpy as np
+from zlib_ng.zlib_ng import crc32  # zlib's CRC-32 with SIMD: 3x as fast, and every record byte passes it
 
 if TYPE_CHECKING:
     from typing_extensions import Self
@@ -532,7 +532,7 @@ class _Sink:
             if len(body) + written != np.dtype(descr).itemsize * int(np.prod(shape)):
                 raise RuntimeError(f"{key}: {len(body) + written} bytes for an array {descr} {shape}")
             size = len(header) + len(body) + written
-            crc = _crc32_combine(zlib.crc32(body, zlib.crc32(header)), self._crc.get(key, 0), written)
+            crc = _crc32_combine(crc32(body, crc32(header)), self._crc.get(key, 0), written)
             name = f"{key}.npy".encode()
             local = _local_header(name, crc, size)
             if key == _STREAMED:
@@ -594,7 +594,7 @@ class _Sink:
         for key, column in columns.items():
             data = column.reshape(-1).view(np.uint8)  # the bytes of the contiguous column, not a copy
             if len(data):
-                self._crc[key] = zlib.crc32(data, self._crc[key])
+                self._crc[key] = crc32(data, self._crc[key])
                 _write_all(self._fds["" if key == _STREAMED else key], data)
                 self._size[key] += len(data)
         end = self._head_size + self._size[_STREAMED]
