@@ -203,7 +203,7 @@ def _derive_partitions(client, plan, files, partitions, firsts, job: _Job, resum
     if not todo:
         return [sidecars[p.number] for p in partitions]
     plan_future = client.scatter(plan, broadcast=True)
-    files_future = client.scatter(files, broadcast=True)
+    files_future = client.scatter([files], broadcast=True)[0]  # a dict alone would be taken as many items
     foreign = None
     if plan.inter:
         tables = client.gather([client.submit(_occluders_task, plan_future, p, f, job.options, pure=False,

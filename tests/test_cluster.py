@@ -69,6 +69,14 @@ def test_shards_in_order_hold_the_records_of_one_process(cluster, city_lots, tmp
     np.testing.assert_allclose(manifest["bbox"]["max"], theirs["bbox"]["max"], atol=1e-4)
 
 
+def test_a_grammar_of_built_in_assets_only(cluster, city_lots, tmp_path):
+    """No asset files to send (the facade benchmark's grammar)."""
+    address, _ = cluster
+    grammar = Path(__file__).resolve().parents[1] / "benchmarks" / "facade.cga"
+    result = build_on_dask(grammar, tmp_path / "f.npz", dask=address, lots_path=city_lots, partition_size=200)
+    assert_same_records(one_process(grammar, city_lots, tmp_path), result.output)
+
+
 def test_occlusion_across_partitions_sees_every_lot(cluster, tmp_path):
     """Section 4's buildings ask whether their neighbours' masses hide a wall: the neighbours are in
     other partitions, and their occluders come from the cluster's first pass."""
