@@ -90,12 +90,14 @@ class Executor(ScopeOperations, SplitOperations, ComponentOperations, FaceOperat
         """Add new shapes to the per-lot counters and enforce the shape limits."""
         self.count_lots(shapes.lot, symbol, span)
 
-    def count_lots(self, lot: np.ndarray, symbol: int, span) -> None:
-        """``count`` of new shapes given by their lots."""
-        if not len(lot):
-            return
+    def count_lots(self, lot: np.ndarray, symbol: int, span, per_lot: np.ndarray | None = None) -> None:
+        """``count`` of new shapes given by their lots, or as their number ``per_lot`` (L,)."""
+        if per_lot is None:
+            if not len(lot):
+                return
+            per_lot = np.bincount(lot, minlength=len(self.chunk.shape_count))
         counts = self.chunk.shape_count
-        counts += np.bincount(lot, minlength=len(counts))
+        counts += per_lot
         self.check_shape_limit(counts, symbol, span)
         if counts.sum() > self.chunk_budget and len(counts) > 1:
             raise ChunkTooLarge()

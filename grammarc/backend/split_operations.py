@@ -152,7 +152,10 @@ class SplitOperations:
         are made and run as usual. Shape counts are kept as the general path keeps them."""
         n_parts = len(op.parts)
         order, offsets = group_by(cell % n_parts if n_parts > 1 else np.zeros_like(cell), n_parts)
-        self.count_lots(shapes.lot[parent], symbol, op.span)  # the children, as `fan_out` counts them
+        # the children, as `fan_out` counts them: per parent, then per lot (fewer rows to gather)
+        per_parent = np.bincount(parent, minlength=len(shapes))
+        self.count_lots(None, symbol, op.span, np.bincount(shapes.lot, weights=per_parent,
+                                                           minlength=len(self.chunk.shape_count)).astype(np.int64))
         general = [i for i, leaf in enumerate(leaves) if leaf is None]
         rows = [order[offsets[i]:offsets[i + 1]] for i in range(n_parts)]
         if general:
@@ -168,12 +171,12 @@ class SplitOperations:
                 part = children.take(slice(starts[i], starts[i] + len(rows[i])))
                 self.run(body, part, symbol, leaf_at_end=True)
                 continue
-            owner = parent[rows[i]]
-            self.count_lots(shapes.lot[owner], symbol, body[0].span)  # the successors
+            lot = shapes.lot[parent[rows[i]]]
+            self.count_lots(lot, symbol, body[0].span)  # the successors
             xform = scope_kernels.leaf_xforms(
                 shapes.origin, shapes.size, shapes.frame, frames, axis, rows[i], parent, pos, length, leaf.size,
                 leaf.relative, leaf.offset if leaf.offset is not None else np.zeros(0))
-            self.pending[leaf.symbol].append(LeafRecords(xform, shapes.lot[owner]))
+            self.pending[leaf.symbol].append(LeafRecords(xform, lot))
 
     def check_fan_out(self, shapes: Shapes, counts: np.ndarray, symbol: int, span) -> None:
         """Refuse a repeat that would exceed --max-shapes before allocating its children."""
