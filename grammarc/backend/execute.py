@@ -88,14 +88,11 @@ class Executor(ScopeOperations, SplitOperations, ComponentOperations, FaceOperat
 
     def count(self, shapes: Shapes, symbol: int, span) -> None:
         """Add new shapes to the per-lot counters and enforce the shape limits."""
-        self.count_lots(shapes.lot, symbol, span)
+        if len(shapes):
+            self.add_counts(np.bincount(shapes.lot, minlength=len(self.chunk.shape_count)), symbol, span)
 
-    def count_lots(self, lot: np.ndarray, symbol: int, span, per_lot: np.ndarray | None = None) -> None:
-        """``count`` of new shapes given by their lots, or as their number ``per_lot`` (L,)."""
-        if per_lot is None:
-            if not len(lot):
-                return
-            per_lot = np.bincount(lot, minlength=len(self.chunk.shape_count))
+    def add_counts(self, per_lot: np.ndarray, symbol: int, span) -> None:
+        """``count`` of new shapes given as their number per lot (L,) int64."""
         counts = self.chunk.shape_count
         counts += per_lot
         self.check_shape_limit(counts, symbol, span)
@@ -148,10 +145,10 @@ class Executor(ScopeOperations, SplitOperations, ComponentOperations, FaceOperat
         for rule in sym.rules:
             if rule.guard is not None:
                 holds = evaluate_array(rule.guard, self.env(remaining), dtype=bool)
-                if not holds.all():  # a guard that holds for all or none of a batch copies nothing
+                if not holds.all():
                     if holds.any():
                         self.apply_rule(sym, rule, remaining.take(holds))
-                        remaining = remaining.take(~holds)
+                    remaining = remaining.take(~holds)  # all of them, uncopied, where none holds
                     continue
             self.apply_rule(sym, rule, remaining)
             return
@@ -172,8 +169,7 @@ class Executor(ScopeOperations, SplitOperations, ComponentOperations, FaceOperat
         draw = uniform(shapes.key, rule.site)
         choice = np.minimum((draw[:, None] >= cumulative).sum(axis=1), len(alts) - 1)
         for i, alt in enumerate(alts):
-            mine = choice == i
-            picked = shapes if mine.all() else shapes.take(mine)
+            picked = shapes.take(choice == i)
             if len(picked):
                 self.run(alt.body, picked, symbol, leaf_at_end=True)
 

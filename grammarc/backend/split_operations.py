@@ -151,11 +151,12 @@ class SplitOperations:
         from ``shapes`` and the cuts and queued for their symbol (``LeafRecords``); the other parts' children
         are made and run as usual. Shape counts are kept as the general path keeps them."""
         n_parts = len(op.parts)
-        order, offsets = group_by(cell % n_parts if n_parts > 1 else np.zeros_like(cell), n_parts)
+        order, offsets = _by_part(cell, n_parts)
         # the children, as `fan_out` counts them: per parent, then per lot (fewer rows to gather)
+        n_lots = len(self.chunk.shape_count)
         per_parent = np.bincount(parent, minlength=len(shapes))
-        self.count_lots(None, symbol, op.span, np.bincount(shapes.lot, weights=per_parent,
-                                                           minlength=len(self.chunk.shape_count)).astype(np.int64))
+        self.add_counts(np.bincount(shapes.lot, weights=per_parent, minlength=n_lots).astype(np.int64), symbol,
+                        op.span)
         general = [i for i, leaf in enumerate(leaves) if leaf is None]
         rows = [order[offsets[i]:offsets[i + 1]] for i in range(n_parts)]
         if general:
@@ -172,7 +173,7 @@ class SplitOperations:
                 self.run(body, part, symbol, leaf_at_end=True)
                 continue
             lot = shapes.lot[parent[rows[i]]]
-            self.count_lots(lot, symbol, body[0].span)  # the successors
+            self.add_counts(np.bincount(lot, minlength=n_lots), symbol, body[0].span)  # the successors
             xform = scope_kernels.leaf_xforms(
                 shapes.origin, shapes.size, shapes.frame, frames, axis, rows[i], parent, pos, length, leaf.size,
                 leaf.relative, leaf.offset if leaf.offset is not None else np.zeros(0))
@@ -300,7 +301,7 @@ class SplitOperations:
 
     def grouped_children(self, shapes, axis, parent, cell, pos, length, site, n_parts, geometry=None):
         """``children`` ordered by body part (cell mod parts): each part's batch is then a slice."""
-        order, offsets = group_by(cell % n_parts if n_parts > 1 else np.zeros_like(cell), n_parts)
+        order, offsets = _by_part(cell, n_parts)
         return self.children(shapes, axis, parent, cell, pos, length, site, order, geometry), offsets
 
     def run_parts(self, parts: tuple[ir.Body, ...], shapes: Shapes, offsets: np.ndarray, symbol) -> None:
@@ -323,6 +324,11 @@ class SplitOperations:
         children = self.children(cursor, op.axis, parent, index, pos, length, op.site, order, geometry)
         self.count(children, symbol, op.span)
         self.run_parts(op.parts, children, offsets, symbol)
+
+
+def _by_part(cell: np.ndarray, n_parts: int) -> tuple[np.ndarray, np.ndarray]:
+    """Children ordered by body part (cell mod parts), and where each part's run starts (``group_by``)."""
+    return group_by(cell % n_parts if n_parts > 1 else np.zeros_like(cell), n_parts)
 
 
 def _pieces(extent: np.ndarray, offsets: np.ndarray, cuts: np.ndarray):

@@ -115,32 +115,25 @@ def emit_leaves(chunk: Chunk, shapes: Shapes, symbol: int) -> None:
     if assets.any():
         for code in np.unique(shapes.geom[assets]):
             asset, mirrored = asset_of(np.array([code]))
-            emit_instances(chunk, _part(shapes, shapes.geom == code), int(asset[0]), symbol, int(mirrored[0]))
+            emit_instances(chunk, shapes.take(shapes.geom == code), int(asset[0]), symbol, int(mirrored[0]))
     box = shapes.geom == -1
     flat = shapes.size <= TOL.zero
     zeros = flat.sum(axis=1)
-    emit_instances(chunk, _part(shapes, box & (zeros == 0)), CUBE, symbol)
+    emit_instances(chunk, shapes.take(box & (zeros == 0)), CUBE, symbol)
     is_quad = box & (zeros == 1)
-    quads = _part(shapes, is_quad)
+    quads = shapes.take(is_quad)
     if len(quads):
         permuted_axes, permuted_size = face_axes(chunk.frames[quads.frame], quads.size,
                                                  np.argmax(flat[is_quad], axis=1))
         permuted_size[:, 2] = 0.0
         _append(chunk, quads, instance_xform(permuted_axes, permuted_size, quads.origin), QUAD, symbol)
-    polygons = _part(shapes, is_polygon(shapes.geom))
+    polygons = shapes.take(is_polygon(shapes.geom))
     if len(polygons):
         chunk.outputs.meshes.append(polygon_meshes(chunk, polygons, symbol))
-    meshes = _part(shapes, is_mesh(shapes.geom))
+    meshes = shapes.take(is_mesh(shapes.geom))
     if len(meshes):
         colors = rgba(meshes.dynamic[chunk.color_slot]) if chunk.color_slot is not None else None
         chunk.outputs.meshes.append(mesh_leaves(chunk, meshes, symbol, colors))
-
-
-def _part(shapes: Shapes, mask: np.ndarray) -> Shapes:
-    """The shapes of a kind: leaves are mostly of one kind, and then nothing is copied."""
-    if mask.all():
-        return shapes
-    return shapes.take(mask) if mask.any() else shapes.take(slice(0, 0))
 
 
 def polygon_meshes(chunk: Chunk, shapes: Shapes, symbol: int) -> MeshChunk:
