@@ -32,6 +32,7 @@ import os
 import shutil
 import tempfile
 import time
+from collections import Counter
 from dataclasses import dataclass, replace
 from pathlib import Path, PurePosixPath
 
@@ -55,7 +56,7 @@ from grammarc.compiler import compile_grammar
 from grammarc.errors import UsageError
 from grammarc.io import OutputOptions, writer_for
 from grammarc.io.assets import resolve_asset
-from grammarc.io.lot_partitions import Partition, count_lots, partition_lots, read_partition
+from grammarc.io.lot_partitions import Partition, count_lots, file_stamp, partition_lots, read_partition
 from grammarc.io.lots import BadLot
 from grammarc.io.shards import (
     complete_shard,
@@ -119,18 +120,18 @@ def build_on_dask(grammar_path, output, *, dask: str, lots_path=None, options: B
         output_options = replace(output_options or OutputOptions(), asset_roots=tuple(grammar.asset_roots))
         writer_for(output, output_options)  # refuses a format it cannot write before the cluster starts
         partitions = partition_lots(lots_path, partition_size)
-        stamp = lots_path.stat()
         meta = record_meta(Path(grammar_path), grammar, plan, options, str(lots_path), options.asset_roots)
-        key = run_key({"meta": meta, "lots": [stat_key(stamp)], "partition_size": partition_size,
-                       "format": suffix, "limits": options.limits, "version": __version__})
         files = _asset_files(grammar, output_options.lod)
-        key = run_key({"run": key, "assets": _digest(files)})
+        assets_digest = _digest(files)
+        key = run_key({"meta": meta, "lots": file_stamp(lots_path), "partition_size": partition_size,
+                       "format": suffix, "limits": options.limits, "version": __version__,
+                       "assets": assets_digest})
         folder = shards_folder(output)
         if folder.exists() and not resume:
             shutil.rmtree(folder)
         folder.mkdir(parents=True, exist_ok=True)
         job = _Job(folder, suffix, key, replace(resolved, workers=1), output_options, tuple(grammar.assets),
-                   tuple(plan.symbol_names), meta, _digest(files))
+                   tuple(plan.symbol_names), meta, assets_digest)
         with _client(dask) as client:
             firsts = _first_numbers(client, partitions)
             sidecars = _derive_partitions(client, plan, files, partitions, firsts, job, resume, progress)
@@ -144,11 +145,6 @@ def build_on_dask(grammar_path, output, *, dask: str, lots_path=None, options: B
     bad = tuple(BadLot(b["index"], b["id"], b["reason"]) for s in sidecars for b in s["bad"])
     return BuildResult(manifest_path(output), manifest["lots"], manifest["derived"], bad, manifest["counts"],
                        time.perf_counter() - started, grammar)
-
-
-def stat_key(stamp: os.stat_result) -> list[int]:
-    """What identifies a file's contents cheaply: its size and modification time."""
-    return [stamp.st_size, stamp.st_mtime_ns]
 
 
 @contextlib.contextmanager
@@ -239,11 +235,11 @@ def _shard_task(plan, part: Partition, first: int, job: _Job, foreign, files: di
     path = job.folder / shard_name(part.number, job.suffix)
     failed: list[BadLot] = []
     reports = Reports()
-    bounds = _Bounds()
     meta = {**job.meta, "shard": {"partition": part.number, "features": [part.start, part.stop]}}
     writer_class = writer_for(path, job.output_options)
     with writer_class(path, assets=job.assets, symbols=job.symbols, meta=meta) as writer:
-        derived = derive_all(plan, lots, job.options, bounds.watching(writer), failed, reports, foreign=foreign)
+        bounded = _Bounded(writer)
+        derived = derive_all(plan, lots, job.options, bounded, failed, reports, foreign=foreign)
         counts = writer.close()
     files = [path]
     if job.suffix != ".npz":
@@ -265,7 +261,7 @@ def _shard_task(plan, part: Partition, first: int, job: _Job, foreign, files: di
         "derived": derived,
         "bad": [{"index": b.index, "id": b.id, "reason": b.reason} for b in bad],
         "counts": counts,
-        "bbox": bounds.box(),
+        "bbox": bounded.box(),
         "files": file_digests(files, job.folder),
     }
     write_json(sidecar_path(job.folder, part.number), sidecar)
@@ -313,28 +309,20 @@ def _asset_root(files: dict[str, bytes], digest: str) -> Path:
     return folder
 
 
-class _Bounds:
-    """The box of the records written through it: instances' boxes and mesh vertices."""
+class _Bounded:
+    """A writer's ``write``, keeping the box of the records written: instances' boxes and mesh vertices."""
 
-    def __init__(self) -> None:
+    def __init__(self, writer) -> None:
+        self.writer = writer
         self.low = np.full(3, np.inf)
         self.high = np.full(3, -np.inf)
 
-    def watching(self, writer):
-        bounds = self
-
-        class Watched:
-            def write(self, records) -> None:
-                bounds.add(records)
-                writer.write(records)
-
-        return Watched()
-
-    def add(self, records) -> None:
+    def write(self, records) -> None:
         instance_box(records.xform, self.low, self.high)
         if len(records.mesh.vertices):
             self.low = np.minimum(self.low, records.mesh.vertices.min(axis=0))
             self.high = np.maximum(self.high, records.mesh.vertices.max(axis=0))
+        self.writer.write(records)
 
     def box(self) -> dict | None:
         return None if np.isinf(self.low).any() else {"min": self.low.tolist(), "max": self.high.tolist()}
@@ -342,10 +330,9 @@ class _Bounds:
 
 def _manifest(output: Path, job: _Job, partitions: list[Partition], sidecars: list[dict]) -> dict:
     boxes = [s["bbox"] for s in sidecars if s["bbox"]]
-    counts: dict[str, int] = {}
+    counts: Counter = Counter()
     for sidecar in sidecars:
-        for name, value in sidecar["counts"].items():
-            counts[name] = counts.get(name, 0) + value
+        counts.update(sidecar["counts"])
     folder = job.folder.name
     return {
         "kind": "grammarc-shards",
@@ -356,7 +343,7 @@ def _manifest(output: Path, job: _Job, partitions: list[Partition], sidecars: li
         "partitions": len(partitions),
         "lots": sum(s["lots"] for s in sidecars),
         "derived": sum(s["derived"] for s in sidecars),
-        "counts": counts,
+        "counts": dict(counts),
         "bbox": ({"min": np.min([b["min"] for b in boxes], axis=0).tolist(),
                   "max": np.max([b["max"] for b in boxes], axis=0).tolist()} if boxes else None),
         "bad": [b for s in sidecars for b in s["bad"]],

@@ -120,6 +120,11 @@ def row_group_bounds(path: str | os.PathLike) -> np.ndarray:
         meta = pq.ParquetFile(path).metadata
     except (OSError, pa.ArrowInvalid) as error:
         raise LotsError(f"cannot read lots file {path}: {error}") from error
+    return _group_starts(meta)
+
+
+def _group_starts(meta) -> np.ndarray:
+    """From a Parquet footer: where each row group starts, and the number of rows last."""
     return np.cumsum([0] + [meta.row_group(g).num_rows for g in range(meta.num_row_groups)])
 
 
@@ -131,9 +136,8 @@ def _read_table(path, rows: tuple[int, int] | None, geometry_only: bool = False)
             return pq.read_table(path)
         file = pq.ParquetFile(path)
         columns = [_geometry_column(file.schema_arrow, path)] if geometry_only else None
-        meta = file.metadata
-        starts = np.cumsum([0] + [meta.row_group(g).num_rows for g in range(meta.num_row_groups)])
-        groups = [g for g in range(meta.num_row_groups) if starts[g] < rows[1] and starts[g + 1] > rows[0]]
+        starts = _group_starts(file.metadata)
+        groups = [g for g in range(len(starts) - 1) if starts[g] < rows[1] and starts[g + 1] > rows[0]]
         table = file.read_row_groups(groups, columns=columns) if groups else file.schema_arrow.empty_table()
         first = int(starts[groups[0]]) if groups else 0
         return table.slice(rows[0] - first, rows[1] - rows[0])

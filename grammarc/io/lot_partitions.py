@@ -41,7 +41,7 @@ from grammarc.io.lots import (
     read_lots,
 )
 
-__all__ = ["SEQUENCE_SUFFIXES", "Partition", "count_lots", "partition_lots", "read_partition", "read_sequence"]
+__all__ = ["SEQUENCE_SUFFIXES", "Partition", "count_lots", "partition_lots", "read_partition", "read_whole"]
 
 #: Bytes read at a time while looking for line ends.
 _SCAN_BLOCK = 1 << 26
@@ -75,36 +75,32 @@ def partition_lots(path: str | os.PathLike, size: int) -> list[Partition]:
     if not path.is_file():
         raise LotsError(f"lots file not found: {path}")
     kind = file_kind(path)
+    starts = None  # a sequence's line starts: its partitions' byte ranges
     if kind == "parquet":
         from grammarc.io.geoparquet import row_group_bounds
 
         cuts = _aligned(row_group_bounds(path), size)
-        return [Partition(k, str(path), kind, int(a), int(b)) for k, (a, b) in enumerate(itertools.pairwise(cuts))]
-    if kind == "gis":
-        from grammarc.io.gis import gis_features
+    else:
+        if kind == "gis":
+            from grammarc.io.gis import gis_features
 
-        n = gis_features(path)
-        return [Partition(k, str(path), kind, a, min(a + size, n)) for k, a in enumerate(range(0, n, size))]
-    if kind == "sequence":
-        starts = _line_starts(path)
-        n = len(starts) - 1
-        return [Partition(k, str(path), kind, a, min(a + size, n), int(starts[a]), int(starts[min(a + size, n)]))
-                for k, a in enumerate(range(0, n, size))]
-    lots = _whole(str(path), *_stamp(path))
-    n = 1 + max([int(lots.index.max()) if len(lots) else -1, *(b.index for b in lots.bad)])
-    return [Partition(k, str(path), kind, a, min(a + size, n)) for k, a in enumerate(range(0, n, size))]
+            n = gis_features(path)
+        elif kind == "sequence":
+            starts = _line_starts(path)
+            n = len(starts) - 1
+        else:
+            lots = _whole(str(path), *file_stamp(path))
+            n = 1 + max([int(lots.index.max()) if len(lots) else -1, *(b.index for b in lots.bad)])
+        cuts = [*range(0, n, size), n]
+    return [Partition(k, str(path), kind, int(a), int(b),
+                      *((int(starts[a]), int(starts[b])) if starts is not None else ()))
+            for k, (a, b) in enumerate(itertools.pairwise(cuts))]
 
 
 def count_lots(part: Partition) -> int:
     """The lot numbers the features of ``part`` take (see the module docstring)."""
-    if part.kind == "parquet":
-        from grammarc.io.geoparquet import count_polygons
-
-        return count_polygons(part.path, (part.start, part.stop))
-    if part.kind == "gis":
-        from grammarc.io.gis import count_gis
-
-        return count_gis(part.path, (part.start, part.stop))
+    if part.kind in ("parquet", "gis"):
+        return _columnar(part.kind)[1](part.path, (part.start, part.stop))
     if part.kind == "sequence":
         return parse_features(_features(part), 0).end
     return part.stop - part.start
@@ -113,36 +109,44 @@ def count_lots(part: Partition) -> int:
 def read_partition(part: Partition, first_index: int) -> Lots:
     """The lots of ``part``, the first numbered ``first_index`` (``count_lots`` of the partitions before;
     ignored for a file read whole, whose lots keep their numbers)."""
-    if part.kind == "parquet":
-        from grammarc.io.geoparquet import read_geoparquet
-
+    if part.kind in ("parquet", "gis"):
         with _no_cycle_collection():
-            builder, attrs = read_geoparquet(part.path, (part.start, part.stop), first_index)
-            return builder.finish(attrs, part.path)
-    if part.kind == "gis":
-        from grammarc.io.gis import read_gis
-
-        with _no_cycle_collection():
-            builder, attrs = read_gis(part.path, (part.start, part.stop), first_index)
+            builder, attrs = _columnar(part.kind)[0](part.path, (part.start, part.stop), first_index)
             return builder.finish(attrs, part.path)
     if part.kind == "sequence":
         with _no_cycle_collection():
             builder = parse_features(_features(part), first_index)
             return builder.finish(_columns(builder.props), part.path)
-    lots = _whole(part.path, *_stamp(Path(part.path)))
+    lots = _whole(part.path, *file_stamp(Path(part.path)))
     inside = (lots.index >= part.start) & (lots.index < part.stop)
     return replace(lots.take(np.flatnonzero(inside)),
                    bad=tuple(b for b in lots.bad if part.start <= b.index < part.stop))
 
 
-def read_sequence(path: Path) -> Lots:
-    """All lots of a GeoJSON sequence (``read_lots`` of a sequence file)."""
-    whole = Partition(0, str(path), "sequence", 0, 0, 0, path.stat().st_size)
+def read_whole(path: Path) -> Lots:
+    """All lots of a GeoParquet, GIS or GeoJSON-sequence file (``read_lots`` of these kinds)."""
+    kind = file_kind(path)
     with _no_cycle_collection():
-        builder = parse_features(_features(whole), 0)
-    if builder.polygons == 0:
-        raise LotsError(f"no polygon in lots file {path}")
-    return builder.finish(_columns(builder.props), str(path))
+        if kind == "sequence":
+            builder = parse_features(_features(Partition(0, str(path), kind, 0, 0, 0, path.stat().st_size)), 0)
+            attrs = _columns(builder.props)
+        else:
+            builder, attrs = _columnar(kind)[0](path)
+        if builder.polygons == 0:
+            raise LotsError(f"no polygon in lots file {path}")
+        return builder.finish(attrs, str(path))
+
+
+def _columnar(kind: str):
+    """The reader and the lot counter of a columnar kind: footprints as WKB in an Arrow table, from
+    pyarrow (``parquet``) or GDAL (``gis``)."""
+    if kind == "parquet":
+        from grammarc.io.geoparquet import count_polygons, read_geoparquet
+
+        return read_geoparquet, count_polygons
+    from grammarc.io.gis import count_gis, read_gis
+
+    return read_gis, count_gis
 
 
 def _features(part: Partition) -> list:
@@ -192,7 +196,8 @@ def _line_starts(path: Path) -> np.ndarray:
     return np.concatenate([*starts, [size]]) if size else np.zeros(1, np.int64)
 
 
-def _stamp(path: Path) -> tuple[int, int]:
+def file_stamp(path: Path) -> tuple[int, int]:
+    """What tells a file's contents apart cheaply: its modification time and size."""
     info = path.stat()
     return info.st_mtime_ns, info.st_size
 

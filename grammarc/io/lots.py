@@ -186,21 +186,10 @@ def read_lots(path: str | os.PathLike) -> Lots:
     if not path.is_file():
         raise LotsError(f"lots file not found: {path}")
     suffix = path.suffix.lower()
-    if suffix == ".parquet" or suffix in GIS_SUFFIXES:
-        # columnar: the footprints as WKB and typed property columns, from pyarrow or GDAL
-        if suffix == ".parquet":
-            from grammarc.io.geoparquet import read_geoparquet as read_columns
-        else:
-            from grammarc.io.gis import read_gis as read_columns
-        with _no_cycle_collection():
-            builder, attrs = read_columns(path)
-            if builder.polygons == 0:
-                raise LotsError(f"no polygon in lots file {path}")
-            return builder.finish(attrs, str(path))
-    if suffix in SEQUENCE_SUFFIXES:
-        from grammarc.io.lot_partitions import read_sequence
+    if suffix == ".parquet" or suffix in GIS_SUFFIXES or suffix in SEQUENCE_SUFFIXES:
+        from grammarc.io.lot_partitions import read_whole  # read as a cluster's workers read them
 
-        return read_sequence(path)
+        return read_whole(path)
     if suffix not in (".geojson", ".json", ".obj"):
         raise LotsError(f"unknown lots file type {suffix!r} (expected .geojson, .json, .obj, .parquet, a "
                         f"GeoJSON sequence ({', '.join(SEQUENCE_SUFFIXES)}) or a GIS file "

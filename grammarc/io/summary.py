@@ -15,6 +15,7 @@ loaded is reported and left out of the polygon counts rather than failing the su
 from __future__ import annotations
 
 import os
+from collections import Counter
 from pathlib import Path
 
 import numpy as np
@@ -38,22 +39,19 @@ def summarize(path: str | os.PathLike, asset_roots=None, lod: str | None = None)
             and not path.with_name(f"{path.name}.tiles").exists()):
         path = manifest_path(path)  # the root layer of a cluster build's shards
     tallies = [_tally(*_read(p), asset_roots, lod) for p in (shard_outputs(path) if is_manifest(path) else [path])]
-    names = list(dict.fromkeys(n for t in tallies for n in t["assets"]))
-    per_asset = {n: sum(t["assets"].get(n, 0) for t in tallies) for n in names}
-    symbols = {}
-    for t in tallies:
-        for name, count in t["symbols"].items():
-            symbols[name] = symbols.get(name, 0) + count
+    per_asset = sum((Counter(t["assets"]) for t in tallies), Counter())
+    symbols = sum((Counter(t["symbols"]) for t in tallies), Counter())
+    names = list(per_asset)
     per_lot = np.concatenate([t["per_lot"] for t in tallies])
     points = [t["bbox"] for t in tallies if t["bbox"] is not None]
     meta = tallies[0]["meta"] if tallies else {}
     mesh_rings = sum(t["mesh_rings"] for t in tallies)
     library = asset_library(names, {"meta": meta}, asset_roots, lod)
     assets, polygons, instanced, problems = {}, 0, mesh_rings, []
-    for name in names:
+    for index, name in enumerate(names):
         entry = {"instances": per_asset[name]}
         try:
-            shape = library[names.index(name)]
+            shape = library[index]
         except AssetError as error:
             problems.append(str(error))
         else:
@@ -74,7 +72,7 @@ def summarize(path: str | os.PathLike, asset_roots=None, lod: str | None = None)
         "bbox": ({"min": np.min([p[0] for p in points], axis=0).tolist(),
                   "max": np.max([p[1] for p in points], axis=0).tolist()} if points else None),
         "assets": assets,
-        "symbols": symbols,
+        "symbols": dict(symbols),
         # the mesh table counts a polygon per ring, as bake and PRT's encoder do
         "polygons": {"instanced": int(instanced), "baked": int(polygons + mesh_rings),
                      "baked_triangles": None if problems or any(t["triangles"] is None for t in tallies)
