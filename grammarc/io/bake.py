@@ -654,15 +654,12 @@ class BakedWriter(WriterBlock):
         self._state = "open"
         self._counts: dict = {}
         self._made = {"triangles": 0, "vertices": 0, "polygons": 0, "mesh_faces": 0, "mesh_vertices": 0}
-        # a private directory next to the output (same filesystem, for the rename); the file in it gets
-        # the umask's permissions, as the npz writer's output does (mkstemp would give 0600)
         self._tmpdir: str | None = None
-        self._obj = None
+        self._file = None  # the output being written, in _tmpdir: OBJ from the first chunk, else on close
         if self._file_type == "obj":
-            self._tmpdir = tempfile.mkdtemp(prefix=f".{self.path.name}.tmp", dir=self.path.parent)
-            self._obj = open(os.path.join(self._tmpdir, self.path.name), "xb")  # noqa: SIM115 - closed by close/abort
+            self._open_file()
             header = f"grammarc {self._meta.get('grammarc', '')} bake of {self._meta.get('grammar', '')}"
-            self._obj.write(f"# {' '.join(header.split())}\n".encode())
+            self._file.write(f"# {' '.join(header.split())}\n".encode())
 
     def write(self, chunk: TerminalChunk) -> None:
         """Bake a chunk into the OBJ, or keep it for ``close()`` (not copied: do not modify it).
@@ -694,10 +691,10 @@ class BakedWriter(WriterBlock):
                     "(GRAMMARC_MAX_TRIANGLES=N), bake a few lots with --select, or write an instance "
                     "record (.npz) or instanced .glb/.usdc instead"
                 )
-            if self._obj is not None:
+            if self._file is not None:
                 mesh = _bake(self._library, asset.astype(np.int64, copy=False), xform, chunk.mesh,
                              self.max_triangles)
-                self._obj.write(obj_bytes(mesh.vertices, mesh.faces + self._made["vertices"]))
+                self._file.write(obj_bytes(mesh.vertices, mesh.faces + self._made["vertices"]))
                 self._count(mesh, chunk.mesh)
             else:
                 self._chunks.append((asset, xform, chunk.mesh))
@@ -729,9 +726,8 @@ class BakedWriter(WriterBlock):
         if self._state == "aborted":
             raise ValueError("close of a BakedWriter that is aborted")
         try:
-            if self._obj is None:
-                self._tmpdir = tempfile.mkdtemp(prefix=f".{self.path.name}.tmp", dir=self.path.parent)
-                self._obj = open(os.path.join(self._tmpdir, self.path.name), "xb")  # noqa: SIM115
+            if self._file is None:
+                self._open_file()
                 chunks, self._chunks = self._chunks, []
                 mesh_table = MeshChunk.concat([c[2] for c in chunks])
                 asset = np.concatenate([c[0] for c in chunks]) if chunks else np.zeros(0, np.int64)
@@ -741,11 +737,11 @@ class BakedWriter(WriterBlock):
                              self.max_triangles)
                 del asset, xform
                 self._count(mesh, mesh_table)
-                self._obj.write(self._export(mesh))
+                self._file.write(self._export(mesh))
                 del mesh
-            self._obj.flush()
-            os.fsync(self._obj.fileno())
-            self._obj.close()
+            self._file.flush()
+            os.fsync(self._file.fileno())
+            self._file.close()
             os.replace(os.path.join(self._tmpdir, self.path.name), self.path)
         except BaseException:
             self.abort()
@@ -760,10 +756,16 @@ class BakedWriter(WriterBlock):
         if self._state == "open":
             self._state = "aborted"
             self._chunks = []
-            if self._obj is not None:
-                self._obj.close()
+            if self._file is not None:
+                self._file.close()
             if self._tmpdir is not None:
                 shutil.rmtree(self._tmpdir, ignore_errors=True)
+
+    def _open_file(self) -> None:
+        """The output's file, in a private directory next to it (same filesystem, for the rename), with
+        the umask's permissions as the npz writer's output has (mkstemp would give 0600)."""
+        self._tmpdir = tempfile.mkdtemp(prefix=f".{self.path.name}.tmp", dir=self.path.parent)
+        self._file = open(os.path.join(self._tmpdir, self.path.name), "xb")  # noqa: SIM115 - closed by close/abort
 
     def _export(self, mesh) -> bytes:
         """The bytes of a PLY or STL (binary), or a GLB as trimesh writes a scene of one mesh."""
