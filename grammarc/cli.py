@@ -15,7 +15,7 @@ from dataclasses import replace
 from pathlib import Path
 
 from grammarc import __version__
-from grammarc.constants import LIMITS
+from grammarc.constants import LIMITS, PARTITION_SIZE
 from grammarc.diagnostics import render_all
 from grammarc.errors import GrammarcError, GrammarError
 
@@ -61,8 +61,8 @@ def _parser() -> argparse.ArgumentParser:
                        help="output file: .npz (instance record), .usda/.usdc/.usd (instanced USD, extra "
                             "`usd`), .glb (glTF with GPU instancing), or .obj/.ply/.stl (baked mesh)")
     build.add_argument("--lots", type=Path, metavar="PATH",
-                       help="footprints: GeoJSON or OBJ (default: the lots beside the grammar, or one "
-                            "30 x 20 m lot)")
+                       help="footprints: GeoJSON, a GeoJSON sequence, GeoParquet, a GIS file (.gpkg, .shp, "
+                            ".fgb, ...) or OBJ (default: the lots beside the grammar, or one 30 x 20 m lot)")
     build.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
     build.add_argument("--attr", action="append", default=[], metavar="NAME=VALUE",
                        help="override an attribute for every lot (repeatable)")
@@ -99,8 +99,8 @@ def _parser() -> argparse.ArgumentParser:
     build.add_argument("--dask", metavar="ADDRESS",
                        help="derive on a Dask cluster: a scheduler address, or local:N for N local worker "
                             "processes; writes OUT's shards and manifest (extra `dask`)")
-    build.add_argument("--partition-size", type=_positive, default=20_000, metavar="N",
-                       help="with --dask: features of the lots file per task (default 20,000)")
+    build.add_argument("--partition-size", type=_positive, default=PARTITION_SIZE, metavar="N",
+                       help=f"with --dask: features of the lots file per task (default {PARTITION_SIZE:,})")
     build.add_argument("--resume", action="store_true",
                        help="with --dask: keep the shards of an earlier run of the same build that are "
                             "complete and verified")
@@ -125,7 +125,8 @@ def _parser() -> argparse.ArgumentParser:
     check.set_defaults(run=_check)
 
     lots = sub.add_parser("lots", help="read a lots file and report its lots; convert it to GeoParquet")
-    lots.add_argument("path", type=Path, help="GeoJSON, OBJ, PRT shape JSON or GeoParquet")
+    lots.add_argument("path", type=Path, help="GeoJSON, a GeoJSON sequence, GeoParquet, a GIS file, OBJ or PRT "
+                                              "shape JSON")
     lots.add_argument("--to", type=Path, metavar="OUT.parquet",
                       help="write the good lots as GeoParquet (extra `parquet`), which reads ~3x faster")
     lots.set_defaults(run=_lots)
@@ -314,11 +315,14 @@ def _build(args) -> int:
     )
     bar = _ProgressBar() if not args.quiet else None
     try:
-        result = _build_on_dask(args, options, bar) if args.dask else build(args.grammar, args.emit, lots_path=args.lots, options=options, progress=bar,
-                       output_options=OutputOptions(bake=args.bake, lod=args.lod, tile_size=args.tile_size,
-                                                    max_triangles=args.max_triangles),
-                       select=None if args.select is None else [i for i in args.select.split(",") if i],
-                       reports_to=args.reports)
+        if args.dask:
+            result = _build_on_dask(args, options, bar)
+        else:
+            result = build(args.grammar, args.emit, lots_path=args.lots, options=options, progress=bar,
+                           output_options=OutputOptions(bake=args.bake, lod=args.lod, tile_size=args.tile_size,
+                                                        max_triangles=args.max_triangles),
+                           select=None if args.select is None else [i for i in args.select.split(",") if i],
+                           reports_to=args.reports)
     finally:
         if bar is not None:
             bar.close()

@@ -53,6 +53,7 @@ from grammarc.build import (
     record_meta,
 )
 from grammarc.compiler import compile_grammar
+from grammarc.constants import PARTITION_SIZE
 from grammarc.errors import UsageError
 from grammarc.io import OutputOptions, writer_for
 from grammarc.io.assets import resolve_asset
@@ -70,10 +71,7 @@ from grammarc.io.shards import (
     write_json,
 )
 
-__all__ = ["PARTITION_SIZE", "build_on_dask"]
-
-#: Features of the lots file per partition (a task).
-PARTITION_SIZE = 20_000
+__all__ = ["build_on_dask"]
 #: Times Dask runs a failed task again.
 RETRIES = 3
 #: Shard formats: the suffixes ``--emit`` may have with ``--dask``.

@@ -53,3 +53,7 @@ LIMITS = Limits()
 #: Invariant checks too slow to ship (axes orthonormal, offsets monotone, child counts). The test suite
 #: sets GRAMMARC_STRICT=1.
 STRICT = os.environ.get("GRAMMARC_STRICT", "") not in ("", "0")
+
+#: Features of the lots file per task of a cluster build (``--partition-size``, ``grammarc.cluster``): a
+#: task of seconds, far above Dask's per-task overhead of about a millisecond.
+PARTITION_SIZE = 20_000
