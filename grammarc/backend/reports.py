@@ -10,10 +10,11 @@ from __future__ import annotations
 
 import csv
 import json
-import os
 from pathlib import Path
 
 import numpy as np
+
+from grammarc.io.atomic import replacing
 
 
 def aggregate_chunk(rows: list[tuple], lot_index: np.ndarray, names: list[str]) -> dict[int, dict]:
@@ -88,19 +89,18 @@ class Reports:
         ids = ids or {}
         lots = {lot: self.table(self.lots[lot]) for lot in sorted(self.lots)}
         total = self.table(self.totals())
-        tmp = path.with_name(f".{path.name}.tmp")
-        if path.suffix.lower() == ".csv":
-            with open(tmp, "w", newline="") as out:
-                table = csv.writer(out)
-                table.writerow(["lot", "id", *total])
-                for lot, row in lots.items():
-                    table.writerow([lot, ids.get(lot, ""), *(_cell(row.get(key, "")) for key in total)])
-                table.writerow(["total", "", *(_cell(v) for v in total.values())])
-        else:
-            data = {"total": total, "lots": {str(lot): row for lot, row in lots.items()},
-                    "ids": {str(lot): ids[lot] for lot in lots if lot in ids}}
-            tmp.write_text(json.dumps(data, indent=1, sort_keys=False) + "\n")
-        os.replace(tmp, path)
+        with replacing(path) as tmp:
+            if path.suffix.lower() == ".csv":
+                with open(tmp, "w", newline="") as out:
+                    table = csv.writer(out)
+                    table.writerow(["lot", "id", *total])
+                    for lot, row in lots.items():
+                        table.writerow([lot, ids.get(lot, ""), *(_cell(row.get(key, "")) for key in total)])
+                    table.writerow(["total", "", *(_cell(v) for v in total.values())])
+            else:
+                data = {"total": total, "lots": {str(lot): row for lot, row in lots.items()},
+                        "ids": {str(lot): ids[lot] for lot in lots if lot in ids}}
+                tmp.write_text(json.dumps(data, indent=1, sort_keys=False) + "\n")
 
 
 def _cell(value) -> str:

@@ -22,6 +22,7 @@ import numpy as np
 import shapely
 
 from grammarc.errors import LotsError, UsageError
+from grammarc.io.atomic import replacing
 from grammarc.io.lots import STREET_WIDTH, Lots, _Builder, _street_flags
 from grammarc.io.lots import _column as json_column
 
@@ -241,7 +242,6 @@ def write_geoparquet(lots: Lots, path: str | os.PathLike) -> None:
     geo = {"version": "1.0.0", "primary_column": "geometry",
            "columns": {"geometry": {"encoding": "WKB", "geometry_types": ["Polygon"]}}}
     table = pa.table(columns).replace_schema_metadata({"geo": json.dumps(geo)})
-    tmp = path.with_name(f".{path.name}.tmp")
-    # row groups of 2^14 lots: a partition of a cluster build reads only the groups that hold its rows
-    pq.write_table(table, tmp, row_group_size=ROW_GROUP)
-    os.replace(tmp, path)
+    with replacing(path) as tmp:
+        # row groups of 2^14 lots: a partition of a cluster build reads only the groups that hold its rows
+        pq.write_table(table, tmp, row_group_size=ROW_GROUP)

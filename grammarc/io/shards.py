@@ -20,12 +20,12 @@ from __future__ import annotations
 
 import hashlib
 import json
-import os
-import tempfile
 from pathlib import Path
 
 import numba
 import numpy as np
+
+from grammarc.io.atomic import replacing
 
 __all__ = ["is_manifest", "manifest_path", "read_manifest", "shard_outputs", "shards_folder"]
 
@@ -96,17 +96,9 @@ def complete_shard(folder: Path, number: int, key: str) -> dict | None:
 
 
 def write_json(path: Path, value: dict) -> None:
-    """Write JSON to ``path`` atomically: a temporary beside it, fsynced, renamed onto it."""
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.tmp", dir=path.parent)
-    try:
-        with os.fdopen(fd, "w") as file:
-            json.dump(value, file, indent=1)
-            file.flush()
-            os.fsync(file.fileno())
-        os.replace(tmp, path)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
+    """Write JSON to ``path`` atomically (``atomic.replacing``)."""
+    with replacing(path) as tmp:
+        tmp.write_text(json.dumps(value, indent=1))
 
 
 @numba.njit(cache=True, nogil=True)

@@ -17,8 +17,6 @@ into the PNG, so the same record gives the same bytes.
 from __future__ import annotations
 
 import os
-import shutil
-import tempfile
 import zipfile
 from collections.abc import Mapping, Sequence
 from pathlib import Path
@@ -26,6 +24,7 @@ from pathlib import Path
 import numpy as np
 
 from grammarc.errors import AssetError, UsageError
+from grammarc.io.atomic import replacing
 from grammarc.io.bake import asset_library, builtin_mesh, triangulate_polygons
 from grammarc.render.camera import VIEWS, Camera, fit_camera
 from grammarc.render.raster import draw_instances, draw_triangles
@@ -279,13 +278,5 @@ def _write_png(image: np.ndarray, path: Path) -> None:
     onto ``path``; the folder is removed whatever happens."""
     from PIL import Image
 
-    tmpdir = tempfile.mkdtemp(prefix=f".{path.name}.tmp", dir=path.parent)
-    try:
-        tmp = os.path.join(tmpdir, path.name)
-        with open(tmp, "xb") as file:
-            Image.fromarray(image).save(file, format="PNG")
-            file.flush()
-            os.fsync(file.fileno())
-        os.replace(tmp, path)
-    finally:
-        shutil.rmtree(tmpdir, ignore_errors=True)
+    with replacing(path) as tmp:
+        Image.fromarray(image).save(tmp, format="PNG")
