@@ -28,6 +28,7 @@ import numpy as np
 import shapely
 
 from grammarc.backend.shapes import asset_geom, face_axes
+from grammarc.constants import TOL
 from grammarc.geometry.clip import scope_polygons
 from grammarc.geometry.meshes import is_polygon
 from grammarc.geometry.occlusion import (
@@ -222,7 +223,7 @@ def _visible(shapes, chunk) -> np.ndarray:
         np.einsum("kj,kj->k", step, step), 1e-300), 0.0, 1.0)
     # a wall (a flat scope whose normal is mostly horizontal): t limited to the part of the street edge
     # ahead of it, on the side its normal points to (empty: lo > hi); roofs and ground shapes look anywhere
-    flat = shapes.size[row] <= 1e-9
+    flat = shapes.size[row] <= TOL.zero
     normal = np.einsum("pk,pki->pi", flat.astype(float), axes[row])  # the flat axis: the face's normal
     normal[:, 1] = 0.0
     face = flat.any(axis=1) & (np.linalg.norm(normal, axis=1) > 0.5)

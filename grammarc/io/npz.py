@@ -124,7 +124,7 @@ class MeshChunk:
         """(F, 4) uint8: the faces' colours, white where none was given."""
         if self.color is not None:
             return self.color
-        return np.broadcast_to(WHITE, (len(self.lot), 4))
+        return _white(len(self.lot))
 
     @staticmethod
     def empty() -> MeshChunk:
