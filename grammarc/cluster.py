@@ -193,8 +193,8 @@ def _derive_partitions(client, plan, files, partitions, firsts, job: _Job, resum
     lots_done = sum(partitions[n].stop - partitions[n].start for n in sidecars)
     if progress is not None:
         progress(lots_done, total)
-    todo = [(p, f) for p, f in zip(partitions, firsts) if p.number not in sidecars]
-    if not todo:
+    remaining = [(p, f) for p, f in zip(partitions, firsts) if p.number not in sidecars]
+    if not remaining:
         return [sidecars[p.number] for p in partitions]
     plan_future = client.scatter(plan, broadcast=True)
     files_future = client.scatter([files], broadcast=True)[0]  # a dict alone would be taken as many items
@@ -204,7 +204,7 @@ def _derive_partitions(client, plan, files, partitions, firsts, job: _Job, resum
                                               retries=RETRIES) for p, f in zip(partitions, firsts)])
         foreign = client.scatter(Occluders.concat(tables), broadcast=True)
     futures = [client.submit(_shard_task, plan_future, part, first, job, foreign, files_future, pure=False,
-                             retries=RETRIES) for part, first in todo]
+                             retries=RETRIES) for part, first in remaining]
     try:
         for future in as_completed(futures):
             sidecar = future.result()

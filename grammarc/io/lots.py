@@ -604,19 +604,19 @@ def _validate(lots: Lots, normals: np.ndarray, world: bool) -> np.ndarray:
     wall = segment_reduce(np.add, wall_ring.astype(np.int64), lots.lot_offsets, 0) > 0
     reasons[wall & (reasons == "")] = "not a footprint: face normal is not vertical"
 
-    todo = np.flatnonzero(reasons == "")
-    polygons = _map_polygons(lots.take(todo))
+    candidates = np.flatnonzero(reasons == "")
+    polygons = _map_polygons(lots.take(candidates))
     why = shapely.is_valid_reason(polygons)
     valid = why == "Valid Geometry"
     area = shapely.area(polygons)
     # a symmetric bowtie has zero area too; only a polygon whose convex hull is flat is "zero area"
     small = area < TOL.area_floor
-    flat = np.zeros(len(todo), dtype=bool)
+    flat = np.zeros(len(candidates), dtype=bool)
     flat[small] = shapely.area(shapely.convex_hull(polygons[small])) < TOL.area_floor
     zero = flat | (small & valid)
-    reasons[todo[zero]] = "zero area"
+    reasons[candidates[zero]] = "zero area"
     invalid = ~valid & ~zero
-    reasons[todo[invalid]] = [_geos_reason(text, world) for text in why[invalid]]
+    reasons[candidates[invalid]] = [_geos_reason(text, world) for text in why[invalid]]
     return reasons
 
 
