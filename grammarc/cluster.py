@@ -107,6 +107,7 @@ def build_on_dask(grammar_path, output, *, dask: str, lots_path=None, options: B
     if suffix not in _FORMATS:
         raise UsageError(f"--dask writes .npz or USD shards, not `{output.name}`: bake or convert the shards "
                          "afterwards")
+    local_workers = _local_workers(dask)  # a bad address is refused before anything is written
     lots_path = Path(lots_path) if lots_path else find_lots(Path(grammar_path))
     if lots_path is None:
         raise UsageError("--dask needs a lots file (--lots), which every worker reads its partitions of")
@@ -130,7 +131,7 @@ def build_on_dask(grammar_path, output, *, dask: str, lots_path=None, options: B
         folder.mkdir(parents=True, exist_ok=True)
         job = _Job(folder, suffix, key, replace(resolved, workers=1), output_options, tuple(grammar.assets),
                    tuple(plan.symbol_names), meta, assets_digest)
-        with _client(dask) as client:
+        with _client(dask, local_workers) as client:
             firsts = _first_numbers(client, partitions)
             sidecars = _derive_partitions(client, plan, files, partitions, firsts, job, resume, progress)
         _remove_temporaries(folder)
@@ -145,20 +146,26 @@ def build_on_dask(grammar_path, output, *, dask: str, lots_path=None, options: B
                        time.perf_counter() - started, grammar)
 
 
+def _local_workers(address: str) -> int | None:
+    """The workers of a local cluster (``local:N``, ``local``: one per core), or None for an address."""
+    if not address.startswith("local"):
+        return None
+    _, _, n = address.partition(":")
+    if n and not n.isdigit() or n == "0":
+        raise UsageError(f"--dask {address}: expected local:N with N workers, or a scheduler address")
+    return int(n) if n else os.cpu_count() or 1
+
+
 @contextlib.contextmanager
-def _client(address: str):
-    """A client of the cluster at ``address``, or of a new local cluster for ``local:N``."""
+def _client(address: str, local_workers: int | None):
+    """A client of the cluster at ``address``, or of a new local cluster of ``local_workers``."""
     try:
         from dask import distributed
     except ImportError as error:
         raise UsageError("--dask needs dask.distributed: pip install 'grammarc[dask]'") from error
-    if address.startswith("local"):
-        _, _, n = address.partition(":")
-        if n and not n.isdigit() or n == "0":
-            raise UsageError(f"--dask {address}: expected local:N with N workers, or a scheduler address")
-        with distributed.LocalCluster(n_workers=int(n) if n else os.cpu_count() or 1, threads_per_worker=1,
-                                      processes=True, dashboard_address=None) as cluster, \
-                distributed.Client(cluster) as client:
+    if local_workers is not None:
+        with distributed.LocalCluster(n_workers=local_workers, threads_per_worker=1, processes=True,
+                                      dashboard_address=None) as cluster, distributed.Client(cluster) as client:
             yield client
         return
     try:

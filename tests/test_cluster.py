@@ -155,6 +155,9 @@ def test_cli_refuses_what_a_cluster_build_cannot_write(tmp_path, capsys):
     err = capsys.readouterr().err
     assert "--dask writes .npz or USD shards" in err and "--select cannot go with --dask" in err
     assert not list(tmp_path.iterdir())
+    assert main(["build", str(CITY), "--dask", "local:two", "--emit", str(tmp_path / "c.npz")]) == 2
+    assert "--dask local:two: expected local:N with N workers, or a scheduler address" in capsys.readouterr().err
+    assert not list(tmp_path.iterdir())
 
 
 def test_cli_local_cluster(city_lots, tmp_path, capsys):
