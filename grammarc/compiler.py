@@ -59,7 +59,6 @@ def compile_grammar(path: str | Path, *, text: str | None = None, start: str | N
         diags.error("empty", "the grammar has no rules", Span(file, 1, 1, 1, 1))
     start = start or module.start
     graph = None
-    sources = {file: text}
     if module.rules:
         symbols = {r.symbol for r in module.rules}
         if start not in symbols:

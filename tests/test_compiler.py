@@ -57,6 +57,16 @@ def test_every_error_of_every_stage_is_listed(write):
     ]
 
 
+def test_an_error_in_an_imported_file_shows_its_line_and_caret(write):
+    write("facade.cga", 'version "2022.0"\nFacade --> extrude(depht)\n')
+    main = write("main.cga", 'version "2022.0"\nimport f : "facade.cga"\nLot --> f.Facade\n')
+    with pytest.raises(GrammarError) as info:
+        compile_grammar(main)
+    shown = str(info.value).splitlines()
+    assert shown[0].startswith(f"{main.parent / 'facade.cga'}:2:20: error: unknown identifier `depht`")
+    assert shown[1:3] == [" 2 | Facade --> extrude(depht)", "   |                    ^^^^^"]
+
+
 def test_grammar_error_renders_every_error_with_its_line_and_caret(write):
     path = write("g.cga", "a ~> b c\nb ~> Subdv(\"Y\", 1){ c }\nc ~> T(1r, 0, 0)\n")
     with pytest.raises(GrammarError) as info:
