@@ -7,7 +7,7 @@ writer builds the zip itself, as the rows arrive:
 * ``xform`` (48 of the 60 bytes of a row) is written once, straight into the output: it is the first member of
   the file, its local header and ``.npy`` header are written up front with a placeholder shape and sizes of fixed
   width, each chunk's bytes are appended behind them, and ``close()`` patches the headers in place. Its CRC is
-  kept running over the data and combined with the CRC of the final ``.npy`` header (``_crc32_combine``).
+  kept running over the data and combined with the CRC of the final ``.npy`` header (zlib's ``crc32_combine``).
 * The other columns (12 bytes a row, and the mesh table) are appended to spool files, their CRCs kept running,
   and ``close()`` copies each spool behind the others in the kernel (``os.copy_file_range``) and unlinks it.
 * ``write()`` validates the chunk and hands its columns to one background thread that does the file I/O
@@ -36,7 +36,6 @@ from __future__ import annotations
 
 import contextlib
 import errno
-import functools
 import json
 import os
 import queue
@@ -51,7 +50,9 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 import numpy as np
-from zlib_ng.zlib_ng import crc32  # zlib's CRC-32 with SIMD: 3x as fast, and every record byte passes it
+
+# zlib's CRC-32 with SIMD (3x as fast: every record byte passes it), and its crc32_combine
+from zlib_ng.zlib_ng import crc32, crc32_combine
 
 if TYPE_CHECKING:
     from typing_extensions import Self
@@ -532,7 +533,7 @@ class _Sink:
             if len(body) + written != np.dtype(descr).itemsize * int(np.prod(shape)):
                 raise RuntimeError(f"{key}: {len(body) + written} bytes for an array {descr} {shape}")
             size = len(header) + len(body) + written
-            crc = _crc32_combine(crc32(body, crc32(header)), self._crc.get(key, 0), written)
+            crc = crc32_combine(crc32(body, crc32(header)), self._crc.get(key, 0), written)
             name = f"{key}.npy".encode()
             local = _local_header(name, crc, size)
             if key == _STREAMED:
@@ -738,47 +739,6 @@ def _end_records(count: int, offset: int, size: int) -> bytes:
         records += struct.pack("<4sLQL", b"PK\x06\x07", 0, offset + size, 1)
         count, offset, size = min(count, 0xFFFF), min(offset, _FULL32), min(size, _FULL32)
     return records + struct.pack("<4s4H2LH", b"PK\x05\x06", 0, 0, count, count, size, offset, 0)
-
-
-def _crc32_combine(crc1: int, crc2: int, size2: int) -> int:
-    """The CRC-32 of ``a + b`` from ``crc1 = crc32(a)``, ``crc2 = crc32(b)`` and ``size2 = len(b)``.
-
-    zlib's ``crc32_combine``, which Python does not expose: appending a zero byte to the message maps the CRC
-    register through a linear operator over GF(2), a 32x32 bit matrix; ``_zeros_operator(k)`` is the one for
-    2**k zero bytes, and ``crc1`` goes through those of the bits of ``size2``, then ``crc2`` is added.
-    """
-    k = 0
-    while size2:
-        if size2 & 1:
-            crc1 = _gf2_times(_zeros_operator(k), crc1)
-        size2 >>= 1
-        k += 1
-    return crc1 ^ crc2
-
-
-@functools.cache
-def _zeros_operator(k: int) -> tuple[int, ...]:
-    """The operator appending 2**k zero bytes to a CRC-32 message: 32 columns, each a 32-bit int."""
-    if k:
-        return _gf2_square(_zeros_operator(k - 1))
-    # One zero bit: shift right, folding the reflected polynomial back in when the low bit falls off.
-    one_bit = (0xEDB88320, *(1 << n for n in range(31)))
-    return _gf2_square(_gf2_square(_gf2_square(one_bit)))  # 2, 4, then 8 zero bits
-
-
-def _gf2_times(matrix: tuple[int, ...], vector: int) -> int:
-    total = 0
-    for column in matrix:
-        if not vector:
-            break
-        if vector & 1:
-            total ^= column
-        vector >>= 1
-    return total
-
-
-def _gf2_square(matrix: tuple[int, ...]) -> tuple[int, ...]:
-    return tuple(_gf2_times(matrix, column) for column in matrix)
 
 
 def _fsync_dir(path: Path) -> None:

@@ -28,7 +28,6 @@ import tempfile
 import weakref
 from pathlib import Path, PurePosixPath
 from typing import TYPE_CHECKING
-from xml.etree import ElementTree
 
 from grammarc.errors import UsageError
 
@@ -69,9 +68,6 @@ class RulePackage:
     start_rule : str or None
         The rule after ``@StartRule`` in ``main_rule_file`` (``"Footprint"``); None if it has none.
         PRT names it with its style, ``"Default$Footprint"``.
-    resolve_map : dict of str to str
-        ``.resolvemap.xml``: workspace paths (``"/Project/assets/x.obj"``, ``"assets/x.obj"``) to
-        paths in the package; empty when the package has no resolve map.
 
     Examples
     --------
@@ -92,7 +88,6 @@ class RulePackage:
         self.assets_root = root / "assets" if (root / "assets").is_dir() else root
         self.main_rule_file = _main_rule_file(self.rules, self.compiled)
         self.start_rule = start_rule_of(self.main_rule_file) if self.main_rule_file is not None else None
-        self.resolve_map = _resolve_map(root / ".resolvemap.xml")
 
     @property
     def asset_roots(self) -> tuple[Path, ...]:
@@ -209,18 +204,3 @@ def _main_rule_file(rules: dict[str, Path], compiled: list[str]) -> Path | None:
         return candidates[0]
     with_start = [p for p in candidates if start_rule_of(p) is not None]
     return with_start[0] if with_start else candidates[0]
-
-
-def _resolve_map(path: Path) -> dict[str, str]:
-    """``.resolvemap.xml`` entries, key -> value; empty if the file is absent or unreadable."""
-    if not path.is_file():
-        return {}
-    try:
-        tree = ElementTree.parse(path)
-    except ElementTree.ParseError:
-        return {}
-    return {
-        entry.get("key", ""): entry.get("value", "")
-        for entry in tree.getroot().iter("entry")
-        if entry.get("key") is not None
-    }

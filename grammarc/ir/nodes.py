@@ -110,7 +110,6 @@ class Unary:
 
 
 #: Binary operators by category; the category decides the result type.
-ARITH_OPS = frozenset({"+", "-", "*", "/", "%"})
 COMPARE_OPS = frozenset({"<", "<=", ">", ">=", "==", "!="})
 LOGIC_OPS = frozenset({"&&", "||"})
 

@@ -50,7 +50,6 @@ def test_kit_package(name, reference):
         has_assets = (rpk.root / "assets").is_dir()
         assert rpk.assets_root == (rpk.root / "assets" if has_assets else rpk.root)
         assert rpk.asset_roots[-1] == rpk.root
-        assert rpk.resolve_map  # every kit package has a .resolvemap.xml
 
 
 @needs_kit
@@ -59,7 +58,6 @@ def test_candler_assets_resolve_in_assets_folder():
     with open_rpk(KIT / "rpk" / "candler.rpk") as rpk:
         resolved = resolve_asset("facade/windows/win.single.05.sashwindow.obj", list(rpk.asset_roots))
         assert resolved.path == rpk.root / "assets" / "facade" / "windows" / "win.single.05.sashwindow.obj"
-        assert rpk.resolve_map["assets/primitives/cylinder.hor.obj"] == "assets/primitives/cylinder.hor.obj"
         assert rpk.rules["rules/Candler Building.cga"] == rpk.main_rule_file
 
 
@@ -96,7 +94,7 @@ def test_main_rule_file_choice(tmp_path):
     with open_rpk(package) as rpk:
         assert rpk.main_rule_file.name == "main.cga"
         assert rpk.start_rule == "Lot"
-        assert rpk.assets_root == rpk.root and rpk.resolve_map == {}
+        assert rpk.assets_root == rpk.root
     # The .cga named as the compiled rule file wins, even without @StartRule.
     package = make_rpk(tmp_path / "cgb.rpk", {
         "rules/a.cga": "@StartRule\nA --> X\n", "rules/b.cga": "B --> X\n", "bin/b.cgb": "",
