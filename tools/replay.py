@@ -78,7 +78,9 @@ def digest(grammar: Path, lots: Path | None, options: BuildOptions, folder: Path
     h = hashlib.sha256(record_digest(out).encode())
     if reports.exists():
         h.update(reports.read_bytes())
-    h.update(json.dumps([(b.index, b.id, b.reason) for b in result.bad]).encode())
+    # a reason may name the grammar by its path: the checkout's folder is left out of the digest
+    reasons = [(b.index, b.id, b.reason.replace(str(ROOT), "<root>")) for b in result.bad]
+    h.update(json.dumps(reasons).encode())
     return h.hexdigest()[:32]
 
 
