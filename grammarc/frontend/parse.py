@@ -11,7 +11,6 @@ from __future__ import annotations
 import itertools
 import re
 from functools import cache
-from importlib import resources
 from pathlib import Path
 
 from lark import Lark
@@ -58,10 +57,11 @@ _TERMINALS = {
 
 @cache
 def _parser(grammar_file: str = "grammars/cga2006.lark") -> Lark:
-    grammar = resources.files("grammarc.frontend").joinpath(grammar_file).read_text("utf-8")
-    # cache=True keeps the LALR tables in the temp folder, keyed by the grammar's hash: saves ~0.2 s a run
-    return Lark(grammar, start="statement", parser="lalr", propagate_positions=True,
-                maybe_placeholders=True, cache=True)
+    # from the package, so that `%import .expressions` finds its file beside the dialect's; cache=True
+    # keeps the LALR tables in the temp folder, keyed by the grammar's hash and checked against the
+    # imported file's
+    return Lark.open_from_package("grammarc.frontend", grammar_file, start="statement", parser="lalr",
+                                  propagate_positions=True, maybe_placeholders=True, cache=True)
 
 
 def parse_source(text: str, file: str, diags: Diagnostics, dialect: str | None = None, *,
