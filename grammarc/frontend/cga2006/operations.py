@@ -70,11 +70,22 @@ class OperationLowering:
             return None
         return AXES[text], False
 
-    def snap_label(self, op, args, snap: bool, span) -> tuple[tuple, str | None]:
-        """A snapped split's trailing label (``Subdiv("XS", ..., "tilesnap")``) and the other args."""
-        if snap and args and isinstance(args[-1], ir.Str):
-            return args[:-1], args[-1].value
-        return args, None
+    def split_arguments(self, op, args, span, takes: str):
+        """A split's axes, whether it snaps (``"XS"``), its sizes and its snap label (the trailing string of
+        ``Subdiv("XS", ..., "tilesnap")``), or None after an error; ``takes`` says what it takes after
+        the axis."""
+        if len(args) < 2:
+            self.diags.error("arity", f"`{op}` takes an axis and {takes}, "
+                             f"got {_count(len(args), 'argument')}", span)
+            return None
+        chosen = self.axes(op, args[0], span)
+        if chosen is None:
+            return None
+        axes, snap = chosen
+        rest = args[1:]
+        if snap and isinstance(rest[-1], ir.Str):
+            return axes, snap, rest[:-1], rest[-1].value
+        return axes, snap, rest, None
 
     # ------------------------------------------------------------------------------- calls without parts
     def op_scale(self, op, args, span):
@@ -114,15 +125,10 @@ class OperationLowering:
     # ---------------------------------------------------------------------------------- calls with parts
     def op_subdiv(self, op, args, parts, span):
         parts = self.expect_parts(op, parts, span)
-        if len(args) < 2:
-            self.diags.error("arity", f"`{op}` takes an axis and at least one size, "
-                             f"got {_count(len(args), 'argument')}", span)
+        split = self.split_arguments(op, args, span, "at least one size")
+        if split is None:
             return ir.Empty(span)
-        chosen = self.axes(op, args[0], span)
-        if chosen is None:
-            return ir.Empty(span)
-        axes, snap = chosen
-        rest, label = self.snap_label(op, args[1:], snap, span)
+        axes, snap, rest, label = split
         sizes = tuple(self.size(a) for a in rest)
         cells = len(sizes) ** len(axes)
         if len(parts) != cells and not (len(axes) > 1 and len(parts) == 1):
@@ -137,15 +143,10 @@ class OperationLowering:
 
     def op_repeat(self, op, args, parts, span):
         parts = self.expect_parts(op, parts, span)
-        if len(args) < 2:
-            self.diags.error("arity", f"`{op}` takes an axis and a size per axis, "
-                             f"got {_count(len(args), 'argument')}", span)
+        split = self.split_arguments(op, args, span, "a size per axis")
+        if split is None:
             return ir.Empty(span)
-        chosen = self.axes(op, args[0], span)
-        if chosen is None:
-            return ir.Empty(span)
-        axes, snap = chosen
-        rest, label = self.snap_label(op, args[1:], snap, span)
+        axes, snap, rest, label = split
         if len(rest) != len(axes):
             self.diags.error("arity", f"`{op}(\"{args[0].value!s}\", ...)` takes {len(axes)} "
                              f"size{'s' if len(axes) > 1 else ''}, got {len(rest)}", span)
