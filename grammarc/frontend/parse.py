@@ -74,7 +74,7 @@ _TERMINALS = {
 
 
 @cache
-def _parser(grammar_file: str = "grammars/cga2006.lark") -> Lark:
+def _parser(grammar_file: str) -> Lark:
     # from the package, so that `%import .expressions` finds its file beside the dialect's; cache=True
     # keeps the LALR tables in the temp folder, keyed by the grammar's hash and checked against the
     # imported file's
@@ -91,19 +91,19 @@ def parse_source(text: str, file: str, diags: Diagnostics, dialect: str | None =
     the file on disk, from which CityEngine ``import``s are resolved; the texts of imported files are
     added to ``sources`` (for diagnostics); ``sites`` numbers random-stream sites across imported files.
     """
-    read = DIALECTS[dialect or detect_dialect(text)]
-    parser = _parser(read.grammar)
+    spec = DIALECTS[dialect or detect_dialect(text)]
+    parser = _parser(spec.grammar)
     sites = sites if sites is not None else itertools.count(1)
     lowered = []
-    for statement in split_statements(text, read.layout):
+    for statement in split_statements(text, spec.layout):
         try:
             tree = parser.parse("\n" * (statement.line - 1) + statement.text)
         except UnexpectedInput as error:
             _syntax_error(error, file, statement.text, statement.line, diags)
             continue
-        lowered.append(read.lowering(file, diags, sites).transform(tree))
-    if read is not DIALECTS["cityengine"]:  # the paper notation imports no files
-        return read.assemble(file, lowered, diags)
+        lowered.append(spec.lowering(file, diags, sites).transform(tree))
+    if spec is not DIALECTS["cityengine"]:  # the paper notation imports no files
+        return spec.assemble(file, lowered, diags)
     imports = []
     for st in lowered:
         declaration = getattr(st, "declaration", st)
@@ -111,7 +111,7 @@ def parse_source(text: str, file: str, diags: Diagnostics, dialect: str | None =
             module = _import(declaration, file, path, diags, sources, sites, importing)
             if module is not None:
                 imports.append((declaration, module))
-    return read.assemble(file, lowered, diags, imports)
+    return spec.assemble(file, lowered, diags, imports)
 
 
 def _import(statement, file: str, path: Path | None, diags: Diagnostics, sources, sites, importing):
