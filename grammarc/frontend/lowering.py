@@ -1,10 +1,17 @@
-"""What the lowerings of both dialects share: spans, random-stream sites, the expression operators.
+"""What the lowerings of both dialects share: spans, random-stream sites, the expression operators of
+``grammars/expressions.lark``, scope brackets and argument lists, arity checks, and ``direct``, the lowering
+of an operation whose arguments are its IR node's fields.
 
 A dialect's ``Lowering`` subclasses ``LoweringBase`` and defines ``expr`` (how an argument that must be a
-plain expression is checked) and its own statements and operations.
+plain expression is checked), its statements, and its operations in two tables: ``OPERATIONS`` for calls
+without parts, name -> handler(lowering, op, args, span); ``PART_OPERATIONS`` for calls with parts
+``{ ... }``, name -> handler(lowering, op, args, parts, span).
 """
 
 from __future__ import annotations
+
+import dataclasses
+import typing
 
 from lark import Token, Transformer, v_args
 
@@ -15,6 +22,9 @@ from grammarc.ir import nodes as ir
 @v_args(inline=True, meta=True)
 class LoweringBase(Transformer):
     """Parse tree of one statement -> IR pieces. ``sites`` numbers random-stream sites in source order."""
+
+    #: How an arity error counts one argument (``Rx`` takes 1 argument).
+    one_argument = "argument"
 
     def __init__(self, file: str, diags: Diagnostics, sites):
         super().__init__()
@@ -38,6 +48,28 @@ class LoweringBase(Transformer):
     def expr(self, value) -> ir.Expr:
         """``value`` as a plain expression; a dialect reports its special argument forms here."""
         return value
+
+    def arity(self, op: str, args: tuple, counts: tuple[int, ...], span: Span) -> bool:
+        """Whether ``op`` got one of ``counts`` arguments; an ``arity`` error at ``span`` if not."""
+        if len(args) in counts:
+            return True
+        want = " or ".join(str(c) for c in counts)
+        noun = self.one_argument if counts == (1,) else "arguments"
+        self.diags.error("arity", f"`{op}` takes {want} {noun}, got {len(args)}", span)
+        return False
+
+    # ------------------------------------------------------------------- scope brackets, arguments, parts
+    def push(self, meta, tok):
+        return ir.Push(self.token_span(tok))
+
+    def pop(self, meta, tok):
+        return ir.Pop(self.token_span(tok))
+
+    def args(self, meta, *args):
+        return tuple(args)
+
+    def parts(self, meta, *parts):
+        return tuple(parts)
 
     # ------------------------------------------------------------------------------------- expressions
     def or_(self, meta, left, right):
@@ -66,3 +98,41 @@ class LoweringBase(Transformer):
 
     def name(self, meta, tok):
         return ir.Name(str(tok), self.token_span(tok))
+
+
+def direct(node: type):
+    """The lowering of an operation whose arguments are ``node``'s fields in order, each a plain
+    expression: a line ``"report": direct(ir.Report)`` in a dialect's ``OPERATIONS``.
+
+    The fields before ``span`` say how many arguments the operation takes: an ``Expr`` field one, a
+    ``tuple[Expr, Expr, Expr]`` field three (``ir.Translate``). A call with another count is an ``arity``
+    error and lowers to ``ir.Empty``. A ``site`` field gets the next random-stream site, drawn after the
+    arguments' own as everywhere in lowering. A node with any other field before ``span`` needs a handler
+    of its own: ``TypeError`` here.
+    """
+    names = [f.name for f in dataclasses.fields(node)]
+    hints = typing.get_type_hints(node)
+    widths = []  # per field before span: None for one expression, n for a tuple of n
+    for name in names[:names.index("span")]:
+        hint = hints[name]
+        if hint == ir.Expr:
+            widths.append(None)
+        elif typing.get_origin(hint) is tuple and all(a == ir.Expr for a in typing.get_args(hint)):
+            widths.append(len(typing.get_args(hint)))
+        else:
+            raise TypeError(f"`{node.__name__}.{name}` is not an expression: lower {node.__name__} "
+                            "with a handler of its own")
+    count = sum(1 if w is None else w for w in widths)
+    random = "site" in names
+
+    def lower(lowering: LoweringBase, op: str, args: tuple, span: Span):
+        if not lowering.arity(op, args, (count,), span):
+            return ir.Empty(span)
+        values = iter([lowering.expr(a) for a in args])
+        fields = [next(values) if w is None else tuple(next(values) for _ in range(w)) for w in widths]
+        if random:
+            return node(*fields, span, site=lowering.site())
+        return node(*fields, span)
+
+    lower.__qualname__ = lower.__name__ = f"direct({node.__name__})"
+    return lower

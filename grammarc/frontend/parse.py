@@ -1,31 +1,48 @@
 """Parse grammar text into IR with every syntax error reported, not just the first.
 
-Two dialects, one IR: the paper notation (``grammars/cga2006.lark``, ``lower_cga2006``) and CityEngine CGA
-(``grammars/cityengine.lark``, ``lower_cityengine``). Each lark grammar is loaded once per process (LALR,
-positions on). The text is cut into statements (``statements.py``, with the dialect's layout); each is
-parsed on its own, with leading newlines so that lark's line numbers are the file's, and lowered to IR.
+Two dialects, one IR: the paper notation (``grammars/cga2006.lark``, the ``cga2006`` package) and
+CityEngine CGA (``grammars/cityengine.lark``, the ``cityengine`` package), laid out alike; both grammars
+import their expressions from ``grammars/expressions.lark``. Each lark grammar is loaded once per process
+(LALR, positions on). The text is cut into statements (``statements.py``, with the dialect's layout); each
+is parsed on its own, with leading newlines so that lark's line numbers are the file's, lowered to IR by
+the dialect's ``Lowering``, and the statements are assembled into a module by its ``assemble``.
 """
 
 from __future__ import annotations
 
 import itertools
 import re
+from collections.abc import Callable
+from dataclasses import dataclass
 from functools import cache
-from importlib import resources
 from pathlib import Path
 
 from lark import Lark
 from lark.exceptions import UnexpectedCharacters, UnexpectedEOF, UnexpectedInput, UnexpectedToken
 
 from grammarc.diagnostics import Diagnostics, Span
-from grammarc.frontend import lower_cga2006, lower_cityengine
-from grammarc.frontend.statements import CITYENGINE, PAPER, split_statements
+from grammarc.frontend import cga2006, cityengine
+from grammarc.frontend.cityengine.nodes import Import
+from grammarc.frontend.lowering import LoweringBase
+from grammarc.frontend.statements import CITYENGINE, PAPER, Layout, split_statements
 from grammarc.ir import nodes as ir
 
-#: Dialect name -> (grammar file, statement layout, lowering module).
+
+@dataclass(frozen=True, slots=True)
+class Dialect:
+    """How a dialect is read: its lark grammar (a file of the package), how its statements are laid out,
+    the Transformer that lowers one statement, and the function that assembles the lowered statements of a
+    file into a module."""
+
+    grammar: str
+    layout: Layout
+    lowering: type[LoweringBase]
+    assemble: Callable[..., ir.Module]
+
+
 DIALECTS = {
-    "cga2006": ("grammars/cga2006.lark", PAPER, lower_cga2006),
-    "cityengine": ("grammars/cityengine.lark", CITYENGINE, lower_cityengine),
+    "cga2006": Dialect("grammars/cga2006.lark", PAPER, cga2006.Lowering, cga2006.assemble),
+    "cityengine": Dialect("grammars/cityengine.lark", CITYENGINE, cityengine.Lowering, cityengine.assemble),
 }
 #: Text that only CityEngine CGA has: its version line, annotations, lower-case operations, const.
 _CITYENGINE_MARKS = re.compile(r'^\s*(version\s+"|@StartRule|const\s)|\b(extrude|split|comp)\s*\(',
@@ -57,11 +74,12 @@ _TERMINALS = {
 
 
 @cache
-def _parser(grammar_file: str = "grammars/cga2006.lark") -> Lark:
-    grammar = resources.files("grammarc.frontend").joinpath(grammar_file).read_text("utf-8")
-    # cache=True keeps the LALR tables in the temp folder, keyed by the grammar's hash: saves ~0.2 s a run
-    return Lark(grammar, start="statement", parser="lalr", propagate_positions=True,
-                maybe_placeholders=True, cache=True)
+def _parser(grammar_file: str) -> Lark:
+    # from the package, so that `%import .expressions` finds its file beside the dialect's; cache=True
+    # keeps the LALR tables in the temp folder, keyed by the grammar's hash and checked against the
+    # imported file's
+    return Lark.open_from_package("grammarc.frontend", grammar_file, start="statement", parser="lalr",
+                                  propagate_positions=True, maybe_placeholders=True, cache=True)
 
 
 def parse_source(text: str, file: str, diags: Diagnostics, dialect: str | None = None, *,
@@ -73,27 +91,27 @@ def parse_source(text: str, file: str, diags: Diagnostics, dialect: str | None =
     the file on disk, from which CityEngine ``import``s are resolved; the texts of imported files are
     added to ``sources`` (for diagnostics); ``sites`` numbers random-stream sites across imported files.
     """
-    grammar_file, layout, lowering = DIALECTS[dialect or detect_dialect(text)]
-    parser = _parser(grammar_file)
+    spec = DIALECTS[dialect or detect_dialect(text)]
+    parser = _parser(spec.grammar)
     sites = sites if sites is not None else itertools.count(1)
     lowered = []
-    for statement in split_statements(text, layout):
+    for statement in split_statements(text, spec.layout):
         try:
             tree = parser.parse("\n" * (statement.line - 1) + statement.text)
         except UnexpectedInput as error:
             _syntax_error(error, file, statement.text, statement.line, diags)
             continue
-        lowered.append(lowering.Lowering(file, diags, sites).transform(tree))
-    if lowering is not lower_cityengine:
-        return lowering.assemble(file, lowered, diags)
+        lowered.append(spec.lowering(file, diags, sites).transform(tree))
+    if spec is not DIALECTS["cityengine"]:  # the paper notation imports no files
+        return spec.assemble(file, lowered, diags)
     imports = []
     for st in lowered:
         declaration = getattr(st, "declaration", st)
-        if isinstance(declaration, lower_cityengine.Import):
+        if isinstance(declaration, Import):
             module = _import(declaration, file, path, diags, sources, sites, importing)
             if module is not None:
                 imports.append((declaration, module))
-    return lowering.assemble(file, lowered, diags, imports)
+    return spec.assemble(file, lowered, diags, imports)
 
 
 def _import(statement, file: str, path: Path | None, diags: Diagnostics, sources, sites, importing):

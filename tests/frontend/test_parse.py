@@ -1,21 +1,27 @@
-"""frontend/parse.py and grammars/cga2006.lark: what the paper notation accepts, and syntax errors.
+"""frontend/parse.py: which dialect reads a text, how a file is parsed statement by statement (rules over
+several lines, comments), and syntax errors: every one reported, at its place, named for people.
 
-Accepted syntax is checked as one-liners: grammar text -> canonical text of the IR after all passes
-(``$h`` parameters, ``@name`` attributes, binaries parenthesized, every alternative with its probability).
+Accepted syntax is checked as grammar text -> canonical text of the IR after all passes (``$h``
+parameters, ``@name`` attributes, binaries parenthesized, every alternative with its probability).
 """
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import pytest
 
+from grammarc.compiler import compile_grammar
 from grammarc.diagnostics import Diagnostics, render, render_all
-from grammarc.frontend.parse import parse_source
+from grammarc.errors import GrammarError
+from grammarc.frontend.parse import detect_dialect, parse_source
 from grammarc.ir import nodes as ir
 from grammarc.ir.pipeline import run_passes
-from grammarc.ir.printer import print_module, print_rule
-from grammarc.ir.traverse import iter_exprs, iter_ops, op_exprs
+from grammarc.ir.printer import print_rule
 
 FILE = "g.cga"
+CITYENGINE = Path(__file__).parent / "grammars" / "cityengine"
+VERSION = 'version "2022.0"\n'
 
 
 def compile_ir(text: str) -> tuple[ir.Module, Diagnostics]:
@@ -36,84 +42,44 @@ def syntax_errors(text: str) -> list[tuple[int, int, str]]:
     return [(d.span.line, d.span.col, d.message) for d in diags if d.is_error]
 
 
-# ------------------------------------------------------------------------------------------- accepted syntax
 
-@pytest.mark.parametrize("arrow", ["~>", "->", "-->", "\u2192", "\u21dd", ";"])
-def test_every_arrow_form(arrow):
-    assert rules(f"a {arrow} b c") == ["a ~> b c : 1"]
+# ------------------------------------------------------------------------------------------ the dialect
 
 
-@pytest.mark.parametrize("text, expected", [
-    # rule labels as in the paper, with or without a space
-    ("1: a ~> b", "a ~> b : 1"),
-    ("12 : a ~> b", "a ~> b : 1"),
-    # parameters and guards
-    ("a(h) : h > 9 ~> b", "a(h) : ($h > 9) ~> b : 1"),
-    ("a(x, y) ~> b", "a(x, y) ~> b : 1"),
-    ("a() ~> b", "a ~> b : 1"),
-    ("a : Scope.sx >= 2 ~> b", "a : (Scope.sx >= 2) ~> b : 1"),
-    # empty shapes and the scope stack
-    ("a ~> \u03b5", "a ~> \u03b5 : 1"),
-    ("a ~> epsilon", "a ~> \u03b5 : 1"),
-    ("a ~> null", "a ~> \u03b5 : 1"),
-    ("a ~>", "a ~> \u03b5 : 1"),
-    ("a ~> [ T(1, 2, 3) b ] c", "a ~> [ T(1, 2, 3) b ] c : 1"),
-    ("a ~> [[b]]", "a ~> [ [ b ] ] : 1"),
-    # scope rules
-    ("a ~> T(0,0,6) S(8,10,18) R(0,90,0)", "a ~> T(0, 0, 6) S(8, 10, 18) R(0, 90, 0) : 1"),
-    ("a ~> Rx(10) Ry(20) Rz(30)", "a ~> R(10, 0, 0) R(0, 20, 0) R(0, 0, 30) : 1"),
-    ("a ~> S(1r, 0.5r, 2)", "a ~> S(1r, 0.5r, 2) : 1"),
-    ('a ~> I("cube") I("win.obj")', 'a ~> I("cube") I("win.obj") : 1'),
-    # typographic quotes of the extracted paper
-    ("a ~> I(\u201dcube\u201d)", 'a ~> I("cube") : 1'),
-    ("a ~> I(\u201ccube\u201d)", 'a ~> I("cube") : 1'),
-    ("a ~> Subdiv(\u201dX\u201d, 1r){ b }", 'a ~> Subdiv("X", 1r){ b } : 1'),
-    # splits
-    ('a ~> Subdiv("Y",3.5,0.3,1r){ b | c | d }', 'a ~> Subdiv("Y", 3.5, 0.3, 1r){ b | c | d } : 1'),
-    ('a ~> Subdiv("X", 1r, 1r){ \u03b5 | b c }', 'a ~> Subdiv("X", 1r, 1r){ \u03b5 | b c } : 1'),
-    ('a ~> Subdiv("XY", 1, 2){ b }', 'a ~> Subdiv("XY", 1, 2){ b } : 1'),
-    ('a ~> Subdiv("XZ", 1, 2){ b | c | d | e }', 'a ~> Subdiv("XZ", 1, 2){ b | c | d | e } : 1'),
-    ('a ~> Repeat("X", 2){ b }', 'a ~> Repeat("X", 2){ b } : 1'),
-    ('a ~> Repeat("XY", 1, 2){ b }', 'a ~> Repeat("XY", 1, 2){ b } : 1'),
-    ('a ~> Repeat("XYZ", 1, 2, 3){ b | c }', 'a ~> Repeat("XYZ", 1, 2, 3){ b | c } : 1'),
-    ('a ~> Comp("edge", 3){A}', 'a ~> Comp("edge", 3){ A } : 1'),
-    ('a ~> Comp("faces"){ A }', 'a ~> Comp("faces"){ A } : 1'),
-    ('a ~> Comp("sidefaces"){ A | B }', 'a ~> Comp("sidefaces"){ A | B } : 1'),
-    ('a ~> Comp("vertex", 0){ A } Comp("topedges"){ B }',
-     'a ~> Comp("vertex", 0){ A } Comp("topedges"){ B } : 1'),
-    # boolean operators, words and symbols, with C precedence (not > and > or)
-    ("a(x) : x > 1 and x < 2 ~> b", "a(x) : (($x > 1) && ($x < 2)) ~> b : 1"),
-    ("a(x) : x > 1 && x < 2 ~> b", "a(x) : (($x > 1) && ($x < 2)) ~> b : 1"),
-    ("a(x) : x < 1 or x > 2 ~> b", "a(x) : (($x < 1) || ($x > 2)) ~> b : 1"),
-    ("a(x) : x < 1 || x > 2 ~> b", "a(x) : (($x < 1) || ($x > 2)) ~> b : 1"),
-    ("a(x) : not x > 1 ~> b", "a(x) : !($x > 1) ~> b : 1"),
-    ("a(x) : !(x > 1) ~> b", "a(x) : !($x > 1) ~> b : 1"),
-    ("a(x) : x < 1 || x > 2 && x != 5 ~> b", "a(x) : (($x < 1) || (($x > 2) && ($x != 5))) ~> b : 1"),
-    ("a(x) : (x < 1 || x > 2) && x != 5 ~> b", "a(x) : ((($x < 1) || ($x > 2)) && ($x != 5)) ~> b : 1"),
-    ("a(x) : not x > 1 or x == 0 ~> b", "a(x) : (!($x > 1) || ($x == 0)) ~> b : 1"),
-    # arithmetic precedence and associativity
-    ("a(x) ~> T(x - 1 - 2, x * 2 + 1, x / 2 / 4)",
-     "a(x) ~> T((($x - 1) - 2), (($x * 2) + 1), (($x / 2) / 4)) : 1"),
-    ("a(x) ~> T(-x, +x, x % 3)", "a(x) ~> T(-$x, $x, ($x % 3)) : 1"),
-    ("a(x) ~> T(1e2, .5, 2.)", "a(x) ~> T(100, 0.5, 2) : 1"),
-    # keywords do not eat the start of longer names
-    (("a(nullable, trueh, falsey, order, android, notice) ~> "
-      "T(nullable + trueh, falsey + order, android + notice)"),
-     ("a(nullable, trueh, falsey, order, android, notice) ~> "
-      "T(($nullable + $trueh), ($falsey + $order), ($android + $notice)) : 1")),
-    ("a ~> epsilons nulls attribute PRIORITYx", "a ~> epsilons nulls attribute PRIORITYx : 1"),
+@pytest.mark.parametrize("text", [
+    'version "2022.0"\nLot --> A\n',
+    '@StartRule\nLot --> A\n',
+    "Lot --> extrude(10) Mass\n",
+    "Lot -->\n    A\n",
+    "Facade --> split(y){ ~3.5 : Floor }*\n",
+    "Mass --> comp(f){ top : Roof }\n",
+    "const h = 3\nLot --> A\n",
 ])
-def test_accepted(text, expected):
-    assert rules(text) == [expected]
+def test_cityengine_is_detected(text):
+    assert detect_dialect(text) == "cityengine"
+    assert parse_source(text, FILE, Diagnostics()).dialect == "cityengine"
 
 
-def test_stochastic_alternatives_on_one_line():
-    assert rules("a ~> b : 0.5 ~> c : 0.3 ; d : 0.2") == ["a ~> b : 0.5 ~> c : 0.3 ~> d : 0.2"]
+@pytest.mark.parametrize("text", [
+    "lot ~> S(1r, 10, 1r) facades\n",
+    'facade ~> Subdiv("Y", 3.5, 1r){ floor | facade }\n',
+    "1: a --> b c\n",
+    'attr h = 3\nfacades ~> Comp("sidefaces"){ facade }\n',
+])
+def test_paper_notation_is_detected(text):
+    assert detect_dialect(text) == "cga2006"
+    assert parse_source(text, FILE, Diagnostics()).dialect == "cga2006"
 
 
-def test_stochastic_continuation_lines_indented_and_at_column1():
-    text = "a ~> b : 0.5\n    ~> c : 0.25\n; d : 0.125\n\u2192 e : 0.125\nf ~> g"
-    assert rules(text) == ["a ~> b : 0.5 ~> c : 0.25 ~> d : 0.125 ~> e : 0.125", "f ~> g : 1"]
+def test_the_same_text_lowers_in_the_dialect_asked_for():
+    diags = Diagnostics()
+    module = parse_source("Lot --> A B\n", FILE, diags, "cityengine")
+    assert module.dialect == "cityengine" and not diags
+    assert [type(op) for op in module.rules[0].alternatives[0].body] == [ir.Symbol, ir.Symbol]
+
+
+
+# ----------------------------------------------------------------------------------- statements over lines
 
 
 def test_rule_split_over_lines_as_in_the_paper():
@@ -144,29 +110,6 @@ def test_nested_bodies_over_lines():
     assert rules(text) == ['a ~> Subdiv("X", 1r, 2, 1r){ b | Subdiv("Y", 2r, 1, 1r){ c | d | c } | b } : 1']
 
 
-def test_priority_blocks_assign_priorities():
-    text = "a ~> b\nPRIORITY 1:\nb ~> c\nc ~> d\nPRIORITY 3:\nd ~> e\nPRIORITY 2:\ne ~> f"
-    module, diags = compile_ir(text)
-    assert not diags
-    priorities = [(r.symbol, r.priority) for r in module.rules]
-    assert priorities == [("a", 0), ("b", 1), ("c", 1), ("d", 3), ("e", 2)]
-    assert print_module(module).splitlines()[:3] == ["PRIORITY 0:", "a ~> b : 1", "PRIORITY 1:"]
-
-
-def test_labels_are_kept():
-    module, _ = compile_ir("1: a ~> b\nb ~> c\n17: c ~> d")
-    assert [r.label for r in module.rules] == ["1", None, "17"]
-
-
-def test_attr_declarations():
-    module, diags = compile_ir('attr h = 3\nattr name = "brick"\nattr tall = h > 2\na ~> S(1r, h, 1r)')
-    assert not diags
-    assert print_module(module) == (
-        'attr h = 3\nattr name = "brick"\nattr tall = (@h > 2)\nPRIORITY 0:\na ~> S(1r, @h, 1r) : 1'
-    )
-    assert [a.type for a in module.attrs] == [ir.Type.NUM, ir.Type.STR, ir.Type.BOOL]
-
-
 @pytest.mark.parametrize("comment", [
     "// line comment", "# hash comment", "/* block */", "/* block\n   over lines */",
 ])
@@ -177,33 +120,6 @@ def test_comments(comment):
 def test_comment_inside_a_rule_between_items():
     assert rules("a ~> b /* c */ d // e\n  f # g\n  h") == ["a ~> b d f h : 1"]
 
-
-def test_start_is_the_first_rule():
-    module, _ = compile_ir("attr x = 1\nlot ~> a\na ~> b")
-    assert module.start == "lot"
-
-
-def test_spans_are_file_line_col():
-    module, _ = compile_ir("attr x = 1\n\nlot ~> T(x, 0, 0)\n  b(2)")
-    rule = module.rules[0]
-    assert (rule.span.file, rule.span.line, rule.span.col) == (FILE, 3, 1)
-    translate, symbol = rule.alternatives[0].body
-    assert (translate.span.line, translate.span.col) == (3, 8)
-    assert (translate.vector[0].span.line, translate.vector[0].span.col) == (3, 10)
-    assert (symbol.span.line, symbol.span.col) == (4, 3)
-
-
-def test_call_sites_are_unique_and_in_source_order():
-    # sites number the random streams: rules, successor symbols, splits and function calls
-    module, _ = compile_ir('a ~> b c Subdiv("X", 1r){ d }\nb ~> T(rand(), 0, 0) Repeat("X", 1){ e }')
-    sites = [r.site for r in module.rules]
-    for rule in module.rules:
-        for op in iter_ops(rule.alternatives[0].body):
-            sites += [op.site] if hasattr(op, "site") else []
-            sites += [e.site for x in op_exprs(op) for e in iter_exprs(x) if isinstance(e, ir.Call)]
-    assert sorted(sites) == list(range(1, 10))
-    a_ops = module.rules[0].alternatives[0].body
-    assert a_ops[0].site < a_ops[1].site < a_ops[2].site
 
 
 # ---------------------------------------------------------------------------------------------- syntax errors
@@ -245,17 +161,6 @@ def test_unclosed_bracket_then_column1_brace_hints_at_the_bracket():
     assert d.hint == "a `(` on line 1 of this rule is not closed"
 
 
-@pytest.mark.parametrize("text, errors", [
-    ("a ~> [ b", [(1, 6, "unclosed `[`")]),
-    ("a ~> b ] c", [(1, 8, "`]` without a `[` before it")]),
-    ("a ~> ] [ b", [(1, 6, "`]` without a `[` before it"), (1, 8, "unclosed `[`")]),
-    ('a ~> Subdiv("X", 1r, 1r){ [ b | ] c }',
-     [(1, 27, "unclosed `[`"), (1, 33, "`]` without a `[` before it")]),
-])
-def test_scope_brackets_pair_up_in_each_successor(text, errors):
-    assert syntax_errors(text) == errors
-
-
 def test_unterminated_string():
     assert syntax_errors('a ~> I("cube)') == [(1, 8, 'unexpected character `"`')]
 
@@ -290,14 +195,6 @@ def test_expected_tokens_are_named_for_people():
     assert "`not`" in diags[0].hint and "NOT" not in diags[0].hint
 
 
-def test_stochastic_continuation_without_a_rule():
-    diags = Diagnostics()
-    parse_source("// nothing before\n~> x : 1", FILE, diags)
-    [d] = diags
-    assert (d.span.line, d.span.col) == (2, 1)
-    assert d.message == "a stochastic alternative needs a rule before it"
-
-
 def test_render_shows_the_line_and_a_caret_under_the_error():
     text = "a ~> b\nb ~> g $ h\n"
     diags = Diagnostics()
@@ -327,3 +224,31 @@ def test_render_all_sorts_by_position():
     parse_source(text, FILE, diags)
     out = render_all(list(reversed(diags)), {FILE: text})
     assert out.index("g.cga:1:") < out.index("g.cga:2:")
+
+
+
+def test_syntax_errors_of_several_statements_are_all_reported():
+    """``syntax_errors.cga``: one error per broken statement, the statements between them still lowered."""
+    text = (CITYENGINE / "syntax_errors.cga").read_text()
+    diags = Diagnostics()
+    module = parse_source(text, FILE, diags)
+    assert module.dialect == "cityengine"
+    found = [(d.span.line, d.message.split(",")[0]) for d in diags if d.is_error]
+    assert found == [
+        (6, "unexpected `|`"),  # inside the `(` left open on line 5
+        (8, "unexpected `}`"),
+        (11, "unexpected `Floor`"),
+        (14, "unclosed `{`"),
+        (18, "unexpected `:`"),
+    ]
+    assert [r.symbol for r in module.rules] == ["Lot", "Tile"]
+
+
+def test_syntax_error_renders_with_the_file_line_and_caret(tmp_path):
+    path = tmp_path / "bad.cga"
+    path.write_text(VERSION + "Lot --> extrude(10) Mass\nMass --> comp(f){ top : Roof | }\n")
+    with pytest.raises(GrammarError) as caught:
+        compile_grammar(path)
+    (diag,) = caught.value.diagnostics
+    assert (diag.span.line, diag.span.col) == (3, 32)
+    assert f"{path}:3:32: error: unexpected `}}`" in str(caught.value)

@@ -1,25 +1,23 @@
 """The operations of CityEngine CGA lowered to IR operations (``split``, ``comp``, ``setback``, roofs,
-scope operations, ``set``, ``report``...): the mixin of ``lower_cityengine.Lowering``, with the tables of
-operation names, selectors and roof arguments it checks calls against. An operation or construct grammarc
-does not implement is an error ``unsupported: NAME`` at its span.
+scope operations, ``set``, ``report``...): ``OperationLowering`` is the mixin of ``lowering.Lowering`` with a
+handler per operation that needs one; ``OPERATIONS`` and ``PART_OPERATIONS`` (calls with parts
+``{ sel : A | ... }``) map names to handlers, or to ``direct`` where the arguments are the IR node's
+fields; the other tables name the selectors and roof arguments calls are checked against, and the
+operations that are accepted but not applied or not implemented. An operation or construct grammarc does
+not implement is an error ``unsupported: NAME`` at its span.
 """
 
 from __future__ import annotations
 
 from grammarc.diagnostics import suggest
-from grammarc.frontend.cityengine_nodes import EdgeDistances, Group, Part, PendingOffset, Sized
+from grammarc.frontend.cityengine.nodes import EdgeDistances, Group, Part, PendingOffset, Sized
+from grammarc.frontend.lowering import direct
 from grammarc.ir import nodes as ir
 
 
 class OperationLowering:
-    """The operation handlers of ``Lowering`` (which provides ``expr``, ``diags``, ``site``...)."""
-
-    def arity(self, op, args, counts, span) -> bool:
-        if len(args) in counts:
-            return True
-        want = " or ".join(str(c) for c in counts)
-        self.diags.error("arity", f"`{op}` takes {want} arguments, got {len(args)}", span)
-        return False
+    """The operation handlers of ``Lowering`` (which provides ``expr``, ``arity``, ``unsupported``,
+    ``diags``, ``site``...)."""
 
     def op_roof(self, op, args, span):
         """``roofHip``, ``roofGable``, ``roofShed``, ``roofPyramid``: by angle, or with a leading
@@ -107,11 +105,6 @@ class OperationLowering:
         return self.unsupported("offset with these arguments", span,
                                 "offset(d), offset(d, inside), offset(d, border)")
 
-    def op_mirror(self, op, args, span):
-        if not self.arity(op, args, (3,), span):
-            return ir.Empty(span)
-        return ir.Mirror(tuple(self.expr(a) for a in args), span)
-
     def op_align(self, op, args, span):
         if not args or (len(args) == 1 and isinstance(args[0], ir.Name) and args[0].name == "world.xyz"):
             return ir.AlignScope("world", None, span)
@@ -178,12 +171,9 @@ class OperationLowering:
             return self.unsupported("set of this target", span, "set(attribute, value)")
         return ir.SetAttr(target.name, self.expr(args[1]), span)
 
-    def op_report(self, op, args, span):
-        if not self.arity(op, args, (2,), span):
-            return ir.Empty(span)
-        return ir.Report(self.expr(args[0]), self.expr(args[1]), span)
-
-    def op_split(self, args, parts, repeat, span):
+    def op_split(self, op, args, parts, span, repeat=False):
+        """``split(axis[, adjust]){ size : A | { size : B }* | ... }``, repeated as a whole when ``repeat``
+        (``{ ... }*``)."""
         if not args or not isinstance(args[0], ir.Name) or args[0].name not in ("x", "y", "z"):
             self.diags.error("axis", "`split` expects an axis x, y or z", span)
             return ir.Empty(span)
@@ -215,7 +205,7 @@ class OperationLowering:
             self.unsupported("`=` in split", part.span)
         return ir.Size(part.size.kind, part.size.value, part.size.span)
 
-    def op_comp(self, args, parts, span):
+    def op_comp(self, op, args, parts, span):
         if len(args) != 1 or not isinstance(args[0], ir.Name) or args[0].name not in COMP_SELECTORS:
             kind = args[0].name if args and isinstance(args[0], ir.Name) else "?"
             return self.unsupported(f"comp({kind})", span, "comp(f), comp(e) and comp(v)")
@@ -312,10 +302,11 @@ class OperationLowering:
         return tuple(selectors), tuple(bodies)
 
 
-OPS = {
+#: Operations called without parts: name -> handler(lowering, op, args, span).
+OPERATIONS = {
     "color": OperationLowering.op_color,
     "offset": OperationLowering.op_offset,
-    "mirror": OperationLowering.op_mirror,
+    "mirror": direct(ir.Mirror),
     "alignScopeToAxes": OperationLowering.op_align,
     "alignScopeToGeometry": OperationLowering.op_align_geometry,
     "rotateScope": OperationLowering.op_rotate_scope,
@@ -328,7 +319,7 @@ OPS = {
     "primitiveCube": OperationLowering.op_cube,
     "NIL": OperationLowering.op_nil,
     "set": OperationLowering.op_set,
-    "report": OperationLowering.op_report,
+    "report": direct(ir.Report),
     "convexify": OperationLowering.op_convexify,
     "cleanupGeometry": OperationLowering.op_cleanup,
     "label": OperationLowering.op_label,
@@ -338,11 +329,24 @@ OPS = {
     "roofShed": OperationLowering.op_roof,
     "roofPyramid": OperationLowering.op_roof,
 }
+#: Operations with parts ``{ ... }``: name -> handler(lowering, op, args, parts, span); ``split`` alone also
+#: repeats (``{ ... }*``).
+PART_OPERATIONS = {
+    "split": OperationLowering.op_split,
+    "comp": OperationLowering.op_comp,
+    "setback": OperationLowering.op_setback,
+    "shapeL": OperationLowering.op_setback,
+    "shapeU": OperationLowering.op_setback,
+    "shapeO": OperationLowering.op_setback,
+    "innerRectangle": OperationLowering.op_inner_rectangle,
+}
 #: The optional arguments after a roof's value (roofGable's ``index`` only by angle).
 ROOF_ARGUMENTS = {"roofHip": ("overhang", "even"), "roofGable": ("overhangX", "overhangY", "even"),
                    "roofShed": ("index",), "roofPyramid": ()}
 #: Operations CityEngine also takes without their parentheses (other bare names are rules).
 BARE_OPS = frozenset({"NIL", "primitiveCube", "convexify"})
+#: Part operations whose parts are sizes or faces: without parts, `unsupported: split` (the others say
+#: that their selector parts are missing).
 SPLIT_OPS = frozenset({"split", "comp"})
 #: CityEngine's street selectors (``geometry.streets``): the lot's street edges and the faces along them.
 STREET_SELECTORS = frozenset(f"street.{s}" for s in ("front", "back", "left", "right", "side"))

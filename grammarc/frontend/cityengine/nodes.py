@@ -1,5 +1,5 @@
 """The intermediate nodes of CityEngine CGA lowering: declarations, split parts and pending operations
-that ``lower_cityengine`` builds statement by statement and ``cityengine_assembly`` puts together.
+that ``lowering`` builds statement by statement and ``assembly`` puts together.
 """
 
 from __future__ import annotations

@@ -8,7 +8,7 @@ from __future__ import annotations
 from dataclasses import replace
 
 from grammarc.diagnostics import Diagnostics, Span, suggest
-from grammarc.frontend.cityengine_nodes import Annotated, FunctionDef, RuleDef, Style
+from grammarc.frontend.cityengine.nodes import Annotated, FunctionDef, RuleDef, Style
 from grammarc.ir import nodes as ir
 from grammarc.ir.traverse import rewrite_body, rewrite_expr, sub_bodies
 

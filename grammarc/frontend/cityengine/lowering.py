@@ -1,4 +1,6 @@
-"""Lower CityEngine CGA (cityengine.lark) to the IR, one statement at a time.
+"""Lower CityEngine CGA (cityengine.lark) to the IR, one statement at a time: declarations, rule bodies and
+CityEngine's expressions here, the operations in ``operations``, the expression operators in
+``LoweringBase``.
 
 The same IR as the paper notation: CityEngine's ``split`` becomes ``GroupSplit`` (absolute, ``'`` relative
 and ``~`` floating sizes, repeat groups), ``comp(f)`` with selectors ``CompFaces``, ``case`` and ``p%``
@@ -15,8 +17,7 @@ from dataclasses import replace
 from lark import Token, v_args
 
 from grammarc.diagnostics import Span
-from grammarc.frontend.cityengine_assembly import assemble  # noqa: F401 (the dialect's, for parse)
-from grammarc.frontend.cityengine_nodes import (
+from grammarc.frontend.cityengine.nodes import (
     Annotated,
     EdgeDistances,
     FunctionDef,
@@ -29,11 +30,11 @@ from grammarc.frontend.cityengine_nodes import (
     Style,
     as_body,
 )
-from grammarc.frontend.cityengine_operations import (
+from grammarc.frontend.cityengine.operations import (
     BARE_OPS,
     NOT_APPLIED,
-    OPS,
-    SETBACK_OPS,
+    OPERATIONS,
+    PART_OPERATIONS,
     SETBACK_SELECTORS,
     SPLIT_OPS,
     UNSUPPORTED_MEMBERS,
@@ -56,6 +57,9 @@ GEOMETRY_QUERIES = ("geometry.area", "geometry.volume", "geometry.nVertices", "g
 @v_args(inline=True, meta=True)
 class Lowering(OperationLowering, LoweringBase):
     """One CityEngine statement's parse tree -> IR pieces (``Annotated`` declarations)."""
+
+    #: CityEngine's arity errors say "`setback` takes 1 arguments"; kept as they were.
+    one_argument = "arguments"
 
     def unsupported(self, name: str, span: Span, why: str = ""):
         self.diags.error("unsupported", f"unsupported: {name}" + (f" ({why})" if why else ""), span)
@@ -173,7 +177,7 @@ class Lowering(OperationLowering, LoweringBase):
     def symbol(self, meta, name):
         text, span = str(name), self.token_span(name)
         if text in BARE_OPS:
-            return OPS[text](self, text, (), span)
+            return OPERATIONS[text](self, text, (), span)
         if text in NOT_APPLIED:
             return ir.NotApplied(text, span)
         if text in UNSUPPORTED_OPS:
@@ -189,15 +193,6 @@ class Lowering(OperationLowering, LoweringBase):
     def imported_call(self, meta, prefix, name, args):
         return ir.Symbol(f"{prefix}.{name}", tuple(self.expr(a) for a in (args or ())), self.token_span(prefix),
                          self.site())
-
-    def push(self, meta, tok):
-        return ir.Push(self.token_span(tok))
-
-    def pop(self, meta, tok):
-        return ir.Pop(self.token_span(tok))
-
-    def args(self, meta, *args):
-        return tuple(args)
 
     def relative(self, meta, prime, value):
         return Sized(ir.SizeKind.RELATIVE, value, self.token_span(prime))
@@ -245,42 +240,33 @@ class Lowering(OperationLowering, LoweringBase):
     def repeat_group(self, meta, parts, star):
         return Group(parts, self.span(meta))
 
-    def parts(self, meta, *parts):
-        return tuple(parts)
-
     # -------------------------------------------------------------------------------------- operations
     def call(self, meta, name, args):
+        """``op(args)``: an operation of ``OPERATIONS``, one accepted but not applied, or a rule call."""
         op, span, args = str(name), self.token_span(name), args or ()
-        handler = OPS.get(op)
+        handler = OPERATIONS.get(op)
         if handler is not None:
             return handler(self, op, args, span)
         if op in NOT_APPLIED:
             return ir.NotApplied(op, span)
         if op in UNSUPPORTED_OPS or op in SPLIT_OPS:
             return self.unsupported(op, span)
-        if op in SETBACK_OPS or op == "innerRectangle":
+        if op in PART_OPERATIONS:
             return self.unsupported(f"{op} without selector parts", span,
                                     f"write {op}(...) {{ ... | remainder: ... }}")
         return ir.Symbol(op, tuple(self.expr(a) for a in args), span, self.site())
 
     def split_call(self, meta, name, args, parts, star):
+        """``op(args){ parts }``, and ``split(args){ parts }*``: an operation of ``PART_OPERATIONS``."""
         op, span, args = str(name), self.token_span(name), args or ()
-        if op == "split":
-            return self.op_split(args, parts, star is not None, span)
-        if op == "comp":
-            if star is not None:
-                return self.unsupported("`*` after comp", self.token_span(star), "only split repeats")
-            return self.op_comp(args, parts, span)
-        if op in SETBACK_OPS:
-            if star is not None:
-                return self.unsupported(f"`*` after {op}", self.token_span(star), "only split repeats")
-            return self.op_setback(op, args, parts, span)
-        if op == "innerRectangle":
-            if star is not None:
-                return self.unsupported(f"`*` after {op}", self.token_span(star), "only split repeats")
-            return self.op_inner_rectangle(op, args, parts, span)
-        return self.unsupported(op, span)
-
+        handler = PART_OPERATIONS.get(op)
+        if handler is None:
+            return self.unsupported(op, span)
+        if star is None:
+            return handler(self, op, args, parts, span)
+        if op != "split":
+            return self.unsupported(f"`*` after {op}", self.token_span(star), "only split repeats")
+        return self.op_split(op, args, parts, span, repeat=True)
 
     # ------------------------------------------------------------------------------------- expressions
     def value_case(self, meta, *items):

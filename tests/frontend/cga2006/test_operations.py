@@ -1,40 +1,47 @@
-"""frontend/lower_cga2006.py: operations, their arities and the constructs that are not supported yet.
+"""frontend/cga2006/operations.py: the paper's operations, their arities, bodies, axes and components.
 
-Each case is a one-rule grammar and the exact errors (line, column, message) that lowering and the IR
-passes report for it: no error may hide another, and none may cascade from one already reported.
+Accepted operations are checked as one-liners, grammar text -> canonical IR text after all passes; errors
+as the exact (line, column, message) that lowering and the IR passes report.
 """
 
 from __future__ import annotations
 
 import pytest
 
-from grammarc.diagnostics import Diagnostics, render
+from grammarc.diagnostics import Diagnostics
+from grammarc.frontend.cga2006.operations import OPERATIONS, PART_OPERATIONS
 from grammarc.frontend.parse import parse_source
+from grammarc.ir import nodes as ir
 from grammarc.ir.pipeline import run_passes
 
-FILE = "g.cga"
-
-
-def diagnose(text: str) -> Diagnostics:
-    diags = Diagnostics()
-    run_passes(parse_source(text, FILE, diags), diags, check=True)
-    return diags
-
-
-def errors(text: str) -> list[tuple[int, int, str]]:
-    return sorted((d.span.line, d.span.col, d.message) for d in diagnose(text) if d.is_error)
+from .lowered import FILE, errors, rules
 
 
 @pytest.mark.parametrize("text, expected", [
-    # unknown operations, functions and names
-    ('a ~> Subdv("Y", 1){ b }', [(1, 6, "unknown operation `Subdv` (did you mean `Subdiv`?)")]),
-    ('a ~> Repaet("X", 1){ b }', [(1, 6, "unknown operation `Repaet` (did you mean `Repeat`?)")]),
-    ("a ~> T(sqr(4), 0, 0)", [(1, 8, "unknown function `sqr` (did you mean `sqrt`?)")]),
-    ("a ~> T(frobnicate(4), 0, 0)", [(1, 8, "unknown function `frobnicate`")]),
-    ("a ~> T(Scope.foo, 0, 0)", [(1, 8, "unknown scope attribute `Scope.foo`")]),
-    ("a ~> T(Scope.szz, 0, 0)", [(1, 8, "unknown scope attribute `Scope.szz` (did you mean `sz`?)")]),
-    ("a ~> T(Lot.area, 0, 0)", [(1, 8, "unknown name `Lot.area`")]),
-    ("a ~> T(Lot.area(), 0, 0)", [(1, 8, "unknown function `Lot.area`")]),
+    # scope rules
+    ("a ~> T(0,0,6) S(8,10,18) R(0,90,0)", "a ~> T(0, 0, 6) S(8, 10, 18) R(0, 90, 0) : 1"),
+    ("a ~> Rx(10) Ry(20) Rz(30)", "a ~> R(10, 0, 0) R(0, 20, 0) R(0, 0, 30) : 1"),
+    ("a ~> S(1r, 0.5r, 2)", "a ~> S(1r, 0.5r, 2) : 1"),
+    ('a ~> I("cube") I("win.obj")', 'a ~> I("cube") I("win.obj") : 1'),
+    # splits
+    ('a ~> Subdiv("Y",3.5,0.3,1r){ b | c | d }', 'a ~> Subdiv("Y", 3.5, 0.3, 1r){ b | c | d } : 1'),
+    ('a ~> Subdiv("X", 1r, 1r){ \u03b5 | b c }', 'a ~> Subdiv("X", 1r, 1r){ \u03b5 | b c } : 1'),
+    ('a ~> Subdiv("XY", 1, 2){ b }', 'a ~> Subdiv("XY", 1, 2){ b } : 1'),
+    ('a ~> Subdiv("XZ", 1, 2){ b | c | d | e }', 'a ~> Subdiv("XZ", 1, 2){ b | c | d | e } : 1'),
+    ('a ~> Repeat("X", 2){ b }', 'a ~> Repeat("X", 2){ b } : 1'),
+    ('a ~> Repeat("XY", 1, 2){ b }', 'a ~> Repeat("XY", 1, 2){ b } : 1'),
+    ('a ~> Repeat("XYZ", 1, 2, 3){ b | c }', 'a ~> Repeat("XYZ", 1, 2, 3){ b | c } : 1'),
+    ('a ~> Comp("edge", 3){A}', 'a ~> Comp("edge", 3){ A } : 1'),
+    ('a ~> Comp("faces"){ A }', 'a ~> Comp("faces"){ A } : 1'),
+    ('a ~> Comp("sidefaces"){ A | B }', 'a ~> Comp("sidefaces"){ A | B } : 1'),
+    ('a ~> Comp("vertex", 0){ A } Comp("topedges"){ B }',
+     'a ~> Comp("vertex", 0){ A } Comp("topedges"){ B } : 1'),
+])
+def test_operations_lower(text, expected):
+    assert rules(text) == [expected]
+
+
+@pytest.mark.parametrize("text, expected", [
     # arities of operations
     ("a ~> T(1, 2)", [(1, 6, "`T` takes 3 arguments, got 2")]),
     ("a ~> S(1, 2, 3, 4)", [(1, 6, "`S` takes 3 arguments, got 4")]),
@@ -42,9 +49,6 @@ def errors(text: str) -> list[tuple[int, int, str]]:
     ("a ~> Rx(1, 2)", [(1, 6, "`Rx` takes 1 argument, got 2")]),
     ('a ~> I("cube", 2)', [(1, 6, "`I` takes 1 argument, got 2")]),
     ("a ~> I(cube)", [(1, 8, "`I` expects an asset name as a string literal")]),
-    ("a ~> floor(1, 2)", []),  # a successor symbol, not the function: it has no rule, see the warning test
-    ("a ~> T(floor(1, 2), 0, 0)", [(1, 8, "`floor` takes 1 argument, got 2")]),
-    ("a ~> T(rand(1, 2, 3), 0, 0)", [(1, 8, "`rand` takes 0 to 2 arguments, got 3")]),
     # splits
     ('a ~> Subdiv("Y", 1, 2){ b }', [(1, 6, "`Subdiv` has 2 parts but 1 successor in its body")]),
     ('a ~> Subdiv("Y", 1){ b | c }', [(1, 6, "`Subdiv` has 1 parts but 2 successors in its body")]),
@@ -69,19 +73,9 @@ def errors(text: str) -> list[tuple[int, int, str]]:
     # relative sizes are for S and Subdiv only
     ("a ~> T(1r, 0, 0)", [(1, 8, "a relative size like `1r` is only allowed in `S` and `Subdiv`")]),
     ("a ~> R(0, 0.5r, 0)", [(1, 11, "a relative size like `1r` is only allowed in `S` and `Subdiv`")]),
-    ("a ~> b(1r)", [(1, 8, "a relative size like `1r` is only allowed in `S` and `Subdiv`")]),
-    # parameters
-    ("a(x, x) ~> b", [(1, 6, "parameter `x` appears twice")]),
 ])
-def test_lowering_errors(text, expected):
+def test_operation_errors(text, expected):
     assert errors(text) == expected
-
-
-def test_a_bad_context_query_is_one_error_at_its_line_and_nothing_else():
-    # the second line proves the position is this construct's, and that nothing cascades from it
-    diags = diagnose('z ~> a\na : Shape.visible("river") ~> b')
-    [d] = [d for d in diags if d.is_error]
-    assert (d.span.line, d.span.col) == (2, 5) and d.message.startswith('`Shape.visible` takes "street" (the lot')
 
 
 def test_snap_shapes_and_snapped_splits_lower_as_the_paper_writes_them():
@@ -98,21 +92,6 @@ def test_snap_shapes_and_snapped_splits_lower_as_the_paper_writes_them():
     assert split.snap and split.snap_label == "tilesnap" and len(split.sizes) == 3
     assert print_op(repeat) == 'Repeat("YS", 3){ b Snap("XZ") }'
     assert print_op(split.parts[1][1]) == 'SnapLines("Y", "entrancesnap")'
-
-
-def test_occlusion_queries_lower_with_their_subsets():
-    from grammarc.ir import nodes as ir
-    from grammarc.ir.printer import print_expr
-
-    module = run_passes(parse_source(
-        'a : Shape.occ("noparent") == "none" ~> b\n'
-        'b : Scope.occ("all", "distance", 4) != "full" ~> c\n'
-        'c : Shape.occ("active") == "part" ~> d\n', FILE, Diagnostics()), Diagnostics(), check=True)
-    found = [rule.guard.left for rule in module.rules]
-    assert [(e.parents, e.active, e.label) for e in found] == [(False, False, None), (True, False, None),
-                                                               (True, True, None)]
-    assert all(isinstance(e, ir.Occlusion) and e.kind == "occ" for e in found)
-    assert print_expr(found[1]) == 'Shape.occ("all", "distance", 4)'
 
 
 @pytest.mark.parametrize("text, expected", [
@@ -136,29 +115,15 @@ def test_errors_inside_nested_bodies_are_found():
     ]
 
 
-def test_all_errors_of_a_file_are_reported():
-    text = (
-        'a ~> Subdv("Y", 1){ b } T(1r, 0, 0)\n'
-        "b ~> T(1, 2) c(1, 2)\n"
-        'c(x) ~> I("cube")\n'
-        'd ~> Comp("edge"){ e } Roof("hiped", 30){ r }'
-    )
-    positions = [(line, col) for line, col, _ in errors(text)]
-    assert positions == [(1, 6), (1, 27), (2, 6), (2, 14), (4, 6), (4, 29)]
+# ---------------------------------------------------------------------------------------------- the tables
 
 
-def test_unknown_operation_renders_with_a_caret_under_the_name():
-    text = 'facade ~> Subdv("Y", 3){ floor }\n'
-    [d] = [d for d in diagnose(text) if d.is_error]
-    assert render(d, {FILE: text}) == (
-        "g.cga:1:11: error: unknown operation `Subdv` (did you mean `Subdiv`?)\n"
-        ' 1 | facade ~> Subdv("Y", 3){ floor }\n'
-        "   |           ^^^^^"
-    )
+def test_each_operation_name_is_in_one_table():
+    assert not OPERATIONS.keys() & PART_OPERATIONS.keys()
 
 
-def test_arguments_of_a_symbol_without_rules_are_a_warning():
-    diags = diagnose("a ~> floor(1, 2)")
-    [d] = diags
-    assert (d.severity.value, d.span.col, d.message) == (
-        "warning", 6, "`floor` has no rule, so its arguments are not used")
+def test_a_body_after_an_operation_without_parts_is_an_error_and_the_operation_stays():
+    diags = Diagnostics()
+    module = run_passes(parse_source("a ~> T(1, 2, 3){ b } c", FILE, diags), diags)
+    assert [d.message for d in diags if d.is_error] == ["`T` takes no `{...}` body"]
+    assert [type(op) for op in module.rules[0].alternatives[0].body] == [ir.Translate, ir.Symbol]

@@ -1,0 +1,1 @@
+"""Tests of frontend/cityengine: CityEngine CGA lowered to IR."""

@@ -1,0 +1,212 @@
+"""frontend/cityengine/lowering.py with grammars/cityengine.lark: declarations, rule bodies and
+CityEngine's expressions lowered to IR.
+
+Accepted constructs are checked as grammar text -> canonical IR text after all passes, or by the IR nodes
+they make; what grammarc does not implement must come out as ``unsupported: NAME`` at its span, never be
+skipped.
+"""
+
+from __future__ import annotations
+
+import pytest
+
+from grammarc.backend.attributes import check_overrides
+from grammarc.backend.plan import make_plan
+from grammarc.compiler import compile_grammar
+from grammarc.errors import UsageError
+from grammarc.ir import nodes as ir
+from grammarc.ir.printer import print_expr
+from grammarc.ir.traverse import iter_ops
+
+from .lowered import GRAMMARS, VERSION, assert_unsupported_at, body_of, errors, module_of
+
+# -------------------------------------------------------------------------------------- declarations
+
+
+def test_annotations_are_kept_on_attributes():
+    module = module_of(VERSION + """
+@Group("Building", 1) @Order(2)
+@Range(min=1, max=5)
+attr floors = 3
+@Enum("flat", "gable")
+@Description("the roof")
+attr roof = "flat"
+@Hidden
+attr seed = 0
+@Range(1, 5) @Distance
+attr width = 2
+attr plain = 1
+@StartRule
+Lot --> A
+""")
+    notes = {a.name: a.annotations for a in module.attrs}
+    assert notes == {
+        "floors": (("Group", ('"Building"', "1")), ("Order", ("2",)), ("Range", ("min=1", "max=5"))),
+        "roof": (("Enum", ('"flat"', '"gable"')), ("Description", ('"the roof"',))),
+        "seed": (("Hidden", ()),),
+        "width": (("Range", ("1", "5")), ("Distance", ())),
+        "plain": (),
+    }
+
+
+def test_annotations_on_the_declarations_line():
+    module = module_of(VERSION + "@Hidden attr seed = 0\nattr plain = 1\nLot --> A\n")
+    assert {a.name: a.annotations for a in module.attrs} == {"seed": (("Hidden", ()),), "plain": ()}
+
+
+def test_const_is_an_attribute_that_cannot_be_set():
+    module = module_of(VERSION + "const w = 3\nattr h = w * 2\nLot --> extrude(h) s(w, '1, '1) A\n")
+    attrs = {a.name: a for a in module.attrs}
+    assert attrs["w"].const and not attrs["h"].const
+    assert body_of(VERSION + "const w = 3\nattr h = w * 2\nLot --> extrude(h) s(w, '1, '1) A\n") \
+        == "extrude(@h) S(@w, 1r, 1r) A"
+    # --attr on an attribute is fine, on a constant a usage error
+    check_overrides(module, {"h": 4.0})
+    with pytest.raises(UsageError, match="`w` is a constant"):
+        check_overrides(module, {"w": 4.0})
+    assert errors(VERSION + "const w = 3\nLot --> set(w, 4) A\n") == [(3, 9, "`set` of the constant `w`")]
+
+
+
+# ------------------------------------------------------------------------------------- case and p%
+
+
+def test_case_block_with_else():
+    text = VERSION + """attr h = 10
+Lot -->
+    case scope.sx > 10 && h > 5 :
+        extrude(h) Tall
+    case scope.sx > 5 || scope.sz > 5 :
+        Wide
+    else :
+        NIL
+"""
+    assert body_of(text) == ("{ case ((Scope.sx > 10) && (@h > 5)): extrude(@h) Tall "
+                             "case ((Scope.sx > 5) || (Scope.sz > 5)): Wide else: \u03b5 }")
+    case = module_of(text).rules[0].alternatives[0].body[0]
+    assert isinstance(case, ir.Case) and len(case.branches) == 2
+
+
+def test_nested_case_and_stochastic_blocks():
+    text = VERSION + """Lot -->
+    case scope.sx > 10 :
+        case scope.sz > 10 : Big
+        else : Wide
+    case scope.sx > 5 :
+        30% : A
+        20% : B
+        else : C
+    else :
+        [ t(0, 1, 0) A. ] B.
+"""
+    assert body_of(text) == ("{ case (Scope.sx > 10): { case (Scope.sz > 10): Big else: Wide } "
+                             "case (Scope.sx > 5): { % 30: A % 20: B else: C } else: [ T(0, 1, 0) A. ] B. }")
+
+
+def test_stochastic_block():
+    body = module_of(VERSION + "Lot -->\n    30% : A\n    20% : B B\n    else : C\n").rules[0] \
+        .alternatives[0].body
+    assert len(body) == 1 and isinstance(body[0], ir.Stochastic)
+    op = body[0]
+    assert [(print_expr(p), len(b)) for p, b in op.branches] == [("30", 1), ("20", 2)]
+    assert [s.name for s in op.default] == ["C"]
+
+
+def test_stochastic_block_without_else_and_with_an_attribute_as_percentage():
+    assert body_of(VERSION + "attr share = 40\nLot -->\n    share% : A\n") == "{ % @share: A else: \u03b5 }"
+    assert body_of(VERSION + "Lot -->\n    50% : A\n    else : NIL\n") == "{ % 50: A else: \u03b5 }"
+
+
+
+# ------------------------------------------------------------------------------------------ expressions
+
+
+def test_case_and_stochastic_expressions_in_attribute_defaults():
+    module = module_of(VERSION + """attr h = 12
+attr style = case h > 30 : "tower" case h > 10 : "block" else : "house"
+attr floors = case h > 10 : (case h > 20 : 6 else : 4) else : 1
+attr roof = 30% : "flat" 20% : "gable" else : "hip"
+Lot --> A
+""")
+    defaults = {a.name: print_expr(a.default) for a in module.attrs}
+    assert defaults["style"] == '((@h > 30) ? "tower" : ((@h > 10) ? "block" : "house"))'
+    assert defaults["floors"] == "((@h > 10) ? ((@h > 20) ? 6 : 4) : 1)"
+    # one draw per shape, compared with the cumulative shares
+    roof = module.attrs[3].default
+    assert print_expr(roof) == '((rand() < 0.3) ? "flat" : ((rand() < 0.5) ? "gable" : "hip"))'
+    assert roof.cond.left.site == roof.other.cond.left.site
+    assert {a.name: a.type for a in module.attrs}["roof"] is ir.Type.STR
+
+
+def test_string_concatenation():
+    module = module_of(VERSION + 'attr level = 2\nattr name = "floor_" + str(level) + ".obj"\n'
+                       'Lot --> report("level " + level, 1) A\n')
+    assert print_expr(module.attrs[1].default) == '(("floor_" + str(@level)) + ".obj")'
+    assert module.attrs[1].type is ir.Type.STR
+
+
+def test_context_attributes_lower_to_context_refs():
+    module = module_of(VERSION + 'Lot --> comp(f){ side : Side }\nSide --> report("i", comp.index) '
+                       'report("n", comp.total) report("s", comp.sel == "left") split(x){ 1 : Part }*\n'
+                       'Part --> report("p", split.index + split.total) Part.\n')
+    refs = {e.name for r in module.rules for op in iter_ops(r.alternatives[0].body)
+            if isinstance(op, ir.Report) for e in _exprs(op.value) if isinstance(e, ir.ContextRef)}
+    assert refs == {"comp.index", "comp.total", "comp.sel", "split.index", "split.total"}
+
+
+def _exprs(e):
+    from grammarc.ir.traverse import iter_exprs
+
+    return list(iter_exprs(e))
+
+
+
+# ------------------------------------------------------------------------------------ the unsupported
+
+
+@pytest.mark.parametrize("line, name, at", [
+    ("Lot --> case inside(near) : A else : B", "inside with these arguments", "inside"),
+    ("Lot --> case touches(all, 3) : A else : B", "touches with these arguments", "touches"),
+    ("Lot --> extrude(geometry.height) A", "geometry.height", "geometry"),
+    ("Lot --> extrude(initialShape.startRule) A", "initialShape.startRule", "initialShape"),
+    ("Lot --> extrude(geometry.du(0, unitSpace)) A", "geometry.du()", "geometry"),
+    ("Lot --> extrude(heights[0]) A", "array indexing", "heights"),
+    ("attr heights = [3, 4, 5]", "arrays", "["),
+    ('import facade : "facade.cga" (Facade, Wall)', "import with a list of names", "import"),
+])
+def test_unsupported_construct_is_named_at_its_span(line, name, at):
+    assert_unsupported_at(line, name, at)
+
+
+def test_the_unsupported_fixture_reports_every_construct_once():
+    """``unsupported.cga``: each line marked ``//! NAME`` gives exactly one error, ``unsupported: NAME``,
+    on that line and nowhere else; no line is skipped."""
+    text = (GRAMMARS / "unsupported.cga").read_text()
+    want = {}
+    for number, line in enumerate(text.splitlines(), start=1):
+        if "//!" in line:
+            want[number] = line.split("//!")[1].strip()
+    found = errors(text)
+    assert sorted(line for line, _, _ in found) == sorted(want), found
+    for line, _, message in found:
+        assert message.startswith(f"unsupported: {want[line]}"), (line, message)
+
+
+
+# -------------------------------------------------------------------------------------------- fixture
+
+
+def test_building_fixture_lowers_every_construct():
+    grammar = compile_grammar(GRAMMARS / "building.cga")
+    module = grammar.module
+    assert module.dialect == "cityengine" and module.start == "Lot"
+    assert [w.code for w in grammar.warnings] == ["asset"]  # assets/window.obj is not shipped
+    ops = {type(op) for r in module.rules for alt in r.alternatives for op in iter_ops(alt.body)}
+    assert ops >= {ir.Extrude, ir.CompFaces, ir.GroupSplit, ir.Case, ir.Stochastic, ir.SetAttr, ir.Report,
+                   ir.UseAsset, ir.NotApplied, ir.Center, ir.Translate, ir.Scale, ir.Empty, ir.Symbol}
+    consts = [a.name for a in module.attrs if a.const]
+    assert consts == ["window_asset", "floor_h", "tile_w"]
+    height = next(a for a in module.attrs if a.name == "height")
+    assert ("Range", ("min=3", "max=30", "restricted=false")) in height.annotations
+    assert grammar.assets == ("builtin:cube", "builtin:quad", "assets/window.obj")
+    assert make_plan(grammar).not_applied == ("print", "projectUV", "setupProjection", "texture")

@@ -1,0 +1,238 @@
+"""frontend/cityengine/operations.py: CityEngine's operations lowered to IR operations (scope operations,
+split, comp, setback, roofs, set, report...), and the operations grammarc accepts without applying them or
+does not implement (``unsupported: NAME`` at their span).
+"""
+
+from __future__ import annotations
+
+import pytest
+
+from grammarc.backend.plan import make_plan
+from grammarc.compiler import compile_grammar
+from grammarc.frontend.cityengine.operations import NOT_APPLIED, OPERATIONS, PART_OPERATIONS, UNSUPPORTED_OPS
+from grammarc.ir import nodes as ir
+from grammarc.ir.printer import print_expr
+from grammarc.ir.traverse import iter_ops
+
+from .lowered import VERSION, assert_unsupported_at, body_of, compile_ir, errors, module_of
+
+
+@pytest.mark.parametrize("body, printed", [
+    ("extrude(10) Mass", "extrude(10) Mass"),
+    ("extrude(h * 2)", "extrude((@h * 2))"),
+    ("t(1, 2, 3) A", "T(1, 2, 3) A"),
+    ("t('0.5, 0, '-1) A", "T((0.5 * Scope.sx), 0, (-1 * Scope.sz)) A"),
+    ("s('1, '0.5, 2) A", "S(1r, 0.5r, 2) A"),
+    ("s(scope.sx - 1, 3, '1) A", "S((Scope.sx - 1), 3, 1r) A"),
+    ("r(0, 90, 0) A", "R(0, 90, 0) A"),
+    ("[ t(0, 3, 0) A ] B", "[ T(0, 3, 0) A ] B"),
+    ("NIL", "\u03b5"),
+    ("A.", "A."),
+    ("A. B", "A. B"),
+    ('i("builtin:cube")', 'i("builtin:cube")'),
+    ("primitiveCube()", 'i("builtin:cube")'),
+    ("primitiveCube", 'i("builtin:cube")'),
+    ("center(xz) A", "center(xz) A"),
+    ("center(x) A", "center(x) A"),
+    ("alignScopeToAxes() A", "alignScopeToAxes() A"),
+    ("alignScopeToAxes(world.xyz) A", "alignScopeToAxes() A"),
+    ("alignScopeToAxes(y) A", "alignScopeToAxes(y) A"),
+    ("rotateScope(0, 90, 0) A", "rotateScope(0, 90, 0) A"),
+    ("set(h, h + 1) A", "set(h, (@h + 1)) A"),
+    ('report("area", geometry.area) A', 'report("area", geometry.area()) A'),
+    ('report("volume", geometry.volume()) A', 'report("volume", geometry.volume()) A'),
+    ("split(z){ 1 : A | ~1 : B }", "split(z){ 1: A | ~1: B }"),
+    ("comp(f){ front : A | side : B. | top : NIL }", "comp(f){ front: A | side: B. | top: \u03b5 }"),
+    ('color("#ff0000") A', 'color("#ff0000") A'),
+    ("color(1, 0.5, 0) A", "color(1, 0.5, 0) A"),
+    ('texture("brick.jpg") A', "texture(...) A"),
+    ("setupProjection(0, scope.xy, ~1.5, ~1) projectUV(0) A", "setupProjection(...) projectUV(...) A"),
+    ('print("h = " + h) A', "print(...) A"),
+    ("set(material.color.r, 1) A", "set(material.color.r)(...) A"),
+    ("set(trim.vertical, false) A", "set(trim.vertical, false) A"),
+    ("set(trim.horizontal, false) A", "set(trim.horizontal)(...) A"),
+    ("extrude(rint(scope.sx)) A", "extrude(round(Scope.sx)) A"),
+    ("extrude(ln(scope.sx)) A", "extrude(log(Scope.sx)) A"),
+    ("extrude(rand(2, 4)) A", "extrude(rand(2, 4)) A"),
+    ("cleanupGeometry(all, 0.1) A", "cleanupGeometry(all, 0.1) A"),
+    ("cleanupGeometry(faces, h / 10) A", "cleanupGeometry(faces, (@h / 10)) A"),
+    ('report("k", scope.sx > 1 && !(scope.sz < 2) || h == 3) A',
+     'report("k", (((Scope.sx > 1) && !(Scope.sz < 2)) || (@h == 3))) A'),
+])
+def test_operations_lower(body, printed):
+    assert body_of(f"{VERSION}attr h = 3\nLot --> {body}\n") == printed
+
+
+def test_operations_lower_to_their_nodes():
+    module = module_of(VERSION + 'Lot --> extrude(3) center(x) alignScopeToAxes() i("builtin:cube") '
+                       'color("#fff") set(h, 2) report("k", 1) comp(f){ all : A } \nattr h = 1\n')
+    ops = list(iter_ops(module.rules[0].alternatives[0].body))
+    assert [type(op) for op in ops] == [ir.Extrude, ir.Center, ir.AlignScope, ir.UseAsset, ir.SetColor,
+                                        ir.SetAttr, ir.Report, ir.CompFaces, ir.Symbol]
+    assert ops[7].selectors == ("all",)
+
+
+def test_not_applied_operations_are_listed_for_the_meta(tmp_path):
+    path = tmp_path / "g.cga"
+    path.write_text(VERSION + 'Lot --> color(1, 0, 0) extrude(3) texture("a.jpg") tileUV(0, 1, 1) '
+                    'print(scope.sx) set(material.opacity, 0.5) Mass.\n')
+    assert make_plan(compile_grammar(path)).not_applied == (
+        "print", "set(material.opacity)", "texture", "tileUV")
+
+
+
+# ------------------------------------------------------------------------------------- split and comp
+
+
+def test_split_sizes_and_repeat_groups():
+    text = VERSION + ("Floor --> split(x){ 0.5 : Wall | { ~3 : Tile | 1 : Pillar }* | '0.1 : Wall"
+                      " | { ~2 : Tile }* | 0.5 : Wall }\n")
+    op = module_of(text).rules[0].alternatives[0].body[0]
+    assert isinstance(op, ir.GroupSplit) and op.axis == 0 and not op.repeat
+    K = ir.SizeKind
+    assert [(s.kind, print_expr(s.value)) for s in op.sizes] == [
+        (K.ABSOLUTE, "0.5"), (K.FLOATING, "3"), (K.ABSOLUTE, "1"), (K.RELATIVE, "0.1"), (K.FLOATING, "2"),
+        (K.ABSOLUTE, "0.5")]
+    assert op.groups == (-1, 0, 0, -1, 1, -1)
+    assert [[s.name for s in p] for p in op.parts] == [["Wall"], ["Tile"], ["Pillar"], ["Wall"], ["Tile"],
+                                                       ["Wall"]]
+
+
+def test_whole_split_repeat_and_nested_splits():
+    op = module_of(VERSION + "Facade --> split(y){ ~3.5 : split(x){ { ~2 : Tile }* } | 0.2 : Ledge }*\n") \
+        .rules[0].alternatives[0].body[0]
+    assert op.axis == 1 and op.repeat and op.groups == (-1, -1)
+    inner = op.parts[0][0]
+    assert isinstance(inner, ir.GroupSplit) and inner.axis == 0 and inner.groups == (0,)
+
+
+def test_split_parts_take_operation_sequences():
+    assert body_of(VERSION + "Lot --> split(z){ 2 : t(0, 1, 0) s('1, 2, '1) A | ~1 : [ B ] C. }\n") \
+        == "split(z){ 2: T(0, 1, 0) S(1r, 2, 1r) A | ~1: [ B ] C. }"
+
+
+@pytest.mark.parametrize("selectors", [
+    ("front", "back", "left", "right", "top", "bottom"),
+    ("side", "top"),
+    ("vertical", "horizontal"),
+    ("aslant", "nutant", "all"),
+])
+def test_comp_faces_selectors(selectors):
+    parts = " | ".join(f"{s} : {s.capitalize()}" for s in selectors)
+    op = module_of(f"{VERSION}Mass --> comp(f){{ {parts} }}\n").rules[0].alternatives[0].body[0]
+    assert isinstance(op, ir.CompFaces)
+    assert op.selectors == selectors
+    assert [p[0].name for p in op.parts] == [s.capitalize() for s in selectors]
+
+
+def test_shape_u_moves_front_right_and_left_edges_into_its_shape_part():
+    op = module_of(f"{VERSION}Lot --> shapeU(5, 3, 11){{ shape : A | remainder = B }}\n"
+                   ).rules[0].alternatives[0].body[0]
+    assert isinstance(op, ir.Setback)
+    assert [s for s, _ in op.distances] == ["front", "right", "left"]
+    assert [d.value for _, d in op.distances] == [5, 3, 11]
+    assert op.selectors == ("all", "remainder")
+
+
+def test_setback_moves_the_edges_its_parts_select():
+    op = module_of(f"{VERSION}Lot --> setback(4){{ front : A | left : B | remainder : C }}\n"
+                   ).rules[0].alternatives[0].body[0]
+    assert [s for s, _ in op.distances] == ["front", "left"]
+    assert op.selectors == ("front", "left", "remainder")
+
+
+@pytest.mark.parametrize("line, at, message", [
+    ("Lot --> cleanupGeometry(vertex, 0) A", "vertex",
+     "`cleanupGeometry` cleans up all, edges, faces, vertices, got `vertex` (did you mean `vertices`?)"),
+    ('Lot --> cleanupGeometry("all", 0) A', '"all"',
+     "`cleanupGeometry` cleans up all, edges, faces, vertices, got a string"),
+    ("Lot --> cleanupGeometry(all) A", "cleanupGeometry", "`cleanupGeometry` takes 2 arguments, got 1"),
+    ("Lot --> cleanupGeometry(all, 0, 1) A", "cleanupGeometry", "`cleanupGeometry` takes 2 arguments, got 3"),
+])
+def test_cleanup_geometry_names_a_wrong_component_or_argument_count_at_its_line(line, at, message):
+    assert errors(VERSION + line + "\n") == [(2, line.index(at) + 1, message)]
+
+
+@pytest.mark.parametrize("line, at", [
+    ("Mass --> comp(f){ side= Wall }", "side"),
+    ("Mass --> comp(f){ top : Roof | all= Rest }", "all="),
+])
+def test_merged_selector_is_derived_face_by_face_with_a_warning(line, at):
+    module, diags = compile_ir(VERSION + line + "\n")
+    assert not diags.has_errors
+    assert [(d.code, d.span.line, d.span.col) for d in diags] == [("merged", 2, line.index(at) + 1)]
+    assert isinstance(module.rules[0].alternatives[0].body[0], ir.CompFaces)
+
+
+
+# ------------------------------------------------------------------------------------ the unsupported
+
+
+@pytest.mark.parametrize("line, name, at", [
+    ("Lot --> offset(-2) Inner", "offset(d) without comp(f){ inside | border } after it", "offset"),
+    ("Lot --> offset(-2, outside) Inner", "offset with these arguments", "offset"),
+    ("Lot --> setback(3){ street.top : Garden | remainder : Building }", "setback selector `street.top`",
+     "street"),
+    ("Lot --> setback(3) Garden", "setback without selector parts", "setback"),
+    ("Lot --> setback(3){ 2 : Garden }", "this setback selector", "2"),
+    ("Lot --> roofGable(30, 1, 1, false, 2) Roof", "roofGable with an edge index", "2)"),
+    ("Lot --> roofHip(30, 1, true) Roof", "roofHip with even ridges", "true"),
+    ("Lot --> envelope(normal, 10, 45) Roof", "envelope with 3 arguments", "envelope"),
+    ("Lot --> trim() Roof", "trim", "trim"),
+    ("Lot --> label(3) A", "label with these arguments", "label"),
+    ("Lot --> shapeL(4, 4){ front : A | remainder : NIL }", "shapeL selector `front`", "front"),
+    ("Lot --> innerRectangle(world){ shape : A | remainder : NIL }", "innerRectangle with these arguments",
+     "innerRectangle"),
+    ("Lot --> innerRectangle(scope){ front : A | remainder : NIL }", "innerRectangle selector `front`",
+     "front"),
+    ("Lot --> primitiveCylinder(16, 1, 2)", "primitiveCylinder", "primitiveCylinder"),
+    ("Lot --> mirrorScope(true, false, false) A", "mirrorScope", "mirrorScope"),
+    ("Lot --> taper(4) A", "taper", "taper"),
+    ("Lot --> comp(x){ all : A }", "comp(x)", "comp"),
+    ("Lot --> comp(f){ street.top : A }", "comp(f) selector `street.top`", "street"),
+    ("Lot --> comp(f){ fornt : A }", "comp(f) selector `fornt`", "fornt"),
+    ("Lot --> comp(e){ front : A }", "comp(e) selector `front`", "front"),
+    ("Lot --> comp(f){ 0 : A }", "this comp selector", "0"),
+    ("Lot --> comp(f){ { front : A }* }", "repeat group in comp", "{ front"),
+    ("Lot --> comp(f){ front : A }*", "`*` after comp", "*"),
+    ("Lot --> split(x, noAdjust){ 1 : A }*", "split(..., noAdjust)", "noAdjust"),
+    ("Lot --> split(x){ 1 = A }", "`=` in split", "1 = A"),
+    ("Lot --> split(x){ { 1 : A | { 2 : B }* }* }", "nested repeat groups", "{ 2"),
+    ("Lot --> extrude(world.y, 10)", "extrude with 2 arguments", "extrude"),
+    ("Lot --> i(\"a.obj\", yUp, keepSizeAndPosition)", "i with 3 arguments", "i("),
+    ("Lot --> alignScopeToAxes(x) A", "alignScopeToAxes with this axis", "alignScopeToAxes"),
+    ("Lot --> alignScopeToGeometry(xUp, 0) A", "alignScopeToGeometry with these arguments",
+     "alignScopeToGeometry"),
+    ("Lot --> alignScopeToGeometry(yUp, any, longest) A", "alignScopeToGeometry on a face other than 0",
+     "any"),
+    ("Lot --> r(scopeCenter, 0, 45, 0) A", "r with 4 arguments", "r("),
+])
+def test_unsupported_operation_is_named_at_its_span(line, name, at):
+    assert_unsupported_at(line, name, at)
+
+
+# ---------------------------------------------------------------------------------------------- the tables
+
+
+def test_each_operation_name_is_in_one_table():
+    """The lowering asks the tables in turn: a name in two would be lowered by the first alone (an
+    operation added to ``OPERATIONS`` leaves ``UNSUPPORTED_OPS``)."""
+    names = [*OPERATIONS, *PART_OPERATIONS, *NOT_APPLIED, *UNSUPPORTED_OPS]
+    assert len(names) == len(set(names))
+
+
+@pytest.mark.parametrize("line, message", [
+    ("Lot --> mirror(true, false) A", "`mirror` takes 3 arguments, got 2"),
+    ('Lot --> report("k") A', "`report` takes 2 arguments, got 1"),
+    ("Lot --> t(1, 2, 3, 4) A", "`t` takes 3 arguments, got 4"),
+    ("Lot --> setback(1, 2){ front : A | remainder : B }", "`setback` takes 1 arguments, got 2"),
+])
+def test_a_wrong_argument_count_is_an_arity_error_at_the_operation(line, message):
+    assert errors(VERSION + line + "\n") == [(2, 9, message)]
+
+
+def test_the_arguments_of_a_direct_operation_are_its_fields_in_order():
+    body = module_of(VERSION + 'Lot --> mirror(true, false, true) report("k", 2) A\n').rules[0].alternatives[0].body
+    mirror, report = body[0], body[1]
+    assert isinstance(mirror, ir.Mirror) and [print_expr(a) for a in mirror.axes] == ["true", "false", "true"]
+    assert isinstance(report, ir.Report) and (print_expr(report.key), print_expr(report.value)) == ('"k"', "2")
