@@ -23,8 +23,8 @@ from pathlib import Path
 
 import numpy as np
 
+from grammarc.atomic import replacing
 from grammarc.errors import AssetError, UsageError
-from grammarc.io.atomic import replacing
 from grammarc.io.bake import asset_library, builtin_mesh, triangulate_polygons
 from grammarc.render.camera import VIEWS, Camera, fit_camera
 from grammarc.render.raster import draw_instances, draw_triangles
