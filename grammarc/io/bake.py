@@ -57,8 +57,8 @@ from grammarc.constants import LIMITS
 from grammarc.errors import AssetError, UsageError
 from grammarc.io import WriterBlock
 from grammarc.io.assets import builtin_name, resolve_asset
-from grammarc.io.npz import MeshChunk, TerminalChunk
 from grammarc.io.obj import ObjError, obj_bytes, read_obj
+from grammarc.model.records import MeshChunk, TerminalChunk
 from grammarc.ragged import fan_out, offsets_from_counts, segment_reduce
 
 __all__ = [

@@ -33,7 +33,7 @@ import numpy as np
 
 from grammarc.constants import LIMITS
 from grammarc.io import WriterBlock
-from grammarc.io.npz import WHITE, TerminalChunk
+from grammarc.model.records import WHITE, TerminalChunk
 
 __all__ = ["INSTANCE", "TRIANGLE", "Tile", "TileSpool", "TiledWriter", "decompose"]
 

@@ -20,7 +20,8 @@ from grammarc.io.bake import (
     load_asset,
     triangulate_polygons,
 )
-from grammarc.io.npz import InstanceWriter, MeshChunk, TerminalChunk, read_instances
+from grammarc.io.npz import InstanceWriter, read_instances
+from grammarc.model.records import MeshChunk, TerminalChunk
 
 KIT = Path(__file__).resolve().parents[2].parent / "shared" / "prt"
 needs_kit = pytest.mark.skipif(not (KIT / "rpk").is_dir(), reason="PRT kit (../shared/prt) absent")

@@ -17,7 +17,8 @@ import numpy as np
 import pytest
 
 from grammarc.io import npz
-from grammarc.io.npz import InstanceWriter, MeshChunk, TerminalChunk, read_instances
+from grammarc.io.npz import InstanceWriter, read_instances
+from grammarc.model.records import MeshChunk, TerminalChunk
 
 ASSETS = ["builtin:cube", "builtin:quad", "facade/window.obj"]
 SYMBOLS = ["Wall", "Window", "Roof", "Ledge"]
@@ -150,30 +151,6 @@ def test_concat_matches_written_mesh(tmp_path, chunks):
     joined = MeshChunk.concat([c.mesh for c in chunks])
     for field in ("vertices", "ring_offsets", "face_offsets", "lot", "symbol"):
         np.testing.assert_array_equal(getattr(joined, field), record[f"mesh_{field}"])
-
-
-def test_concat_shifts_offsets():
-    triangle = MeshChunk(
-        vertices=np.zeros((3, 3), np.float32),
-        ring_offsets=np.array([0, 3], np.int64),
-        face_offsets=np.array([0, 1], np.int64),
-        lot=np.array([0], np.int32),
-        symbol=np.array([0], np.int32),
-    )
-    square_with_hole = MeshChunk(
-        vertices=np.ones((7, 3), np.float32),
-        ring_offsets=np.array([0, 4, 7], np.int64),
-        face_offsets=np.array([0, 2], np.int64),
-        lot=np.array([1], np.int32),
-        symbol=np.array([2], np.int32),
-    )
-    joined = MeshChunk.concat([triangle, MeshChunk.empty(), square_with_hole, triangle])
-    assert joined.ring_offsets.tolist() == [0, 3, 7, 10, 13]
-    assert joined.face_offsets.tolist() == [0, 1, 3, 4]
-    assert joined.lot.tolist() == [0, 1, 0]
-    assert joined.vertices.shape == (13, 3)
-    empty = MeshChunk.concat([])
-    assert empty.ring_offsets.tolist() == [0] and empty.face_offsets.tolist() == [0]
 
 
 def test_loads_with_plain_np_load(tmp_path, chunks):
