@@ -4,7 +4,7 @@ One binary glTF (GLB) whose scene has a node per tile of the city (``io.instanci
 the tile's corner (JSON numbers: exact), and under it a node per (asset, colour) group carrying the
 group's instances in ``EXT_mesh_gpu_instancing``: ``TRANSLATION``, ``ROTATION`` and ``SCALE``
 accessors, float32 relative to the tile. Each asset is one mesh of the file, in its unit box (as
-``io.bake`` loads it); each colour is a material whose ``baseColorFactor`` is the record's colour
+``model.assets`` loads it); each colour is a material whose ``baseColorFactor`` is the record's colour
 (converted from sRGB to glTF's linear factors), so colours show in any viewer. A tile with more than
 ``MAX_GROUPS`` (asset, colour) groups, which a grammar colouring each shape at random makes, groups by
 asset only and draws them white: a node per colour would make the file a node per instance. Normals are
@@ -81,7 +81,7 @@ class GltfWriter(TiledWriter):
     tile_size : float
         Edge of a tile in metres.
     lod : str, optional
-        Level of detail of the asset meshes (``io.bake.load_asset``).
+        Level of detail of the asset meshes (``model.assets.load_asset``).
     max_bytes : int
         The largest binary chunk of one part.
     """

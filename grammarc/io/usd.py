@@ -16,9 +16,9 @@ The layout, for ``city.usdc``::
   (and ``displayOpacity``) of vertex interpolation, which prototypes inherit, and ``grammarc:lot`` and
   ``grammarc:symbol``. Its ``prototypes`` are children of the instancer referencing the prototype
   layer, one for each asset the tile uses.
-* **Prototypes**: the asset meshes as ``io.bake`` loads them (OBJ and other formats through trimesh,
-  built-ins generated), fitted to the unit box as CityEngine fits an inserted asset to its scope;
-  ``subdivisionScheme`` is ``none`` (they are polygon models, not subdivision cages).
+* **Prototypes**: the asset meshes as ``model.assets`` loads them (OBJ by its own reader, other formats
+  through trimesh, built-ins generated), fitted to the unit box as CityEngine fits an inserted asset to its
+  scope; ``subdivisionScheme`` is ``none`` (they are polygon models, not subdivision cages).
 * **Meshes**: the mesh table's polygons (leaves that are not instances) triangulated, one Mesh per
   tile with a colour per face.
 
@@ -79,7 +79,7 @@ class UsdWriter(TiledWriter):
     tile_size : float
         Edge of a tile in metres.
     lod : str, optional
-        Level of detail of the prototypes (``io.bake.load_asset``).
+        Level of detail of the prototypes (``model.assets.load_asset``).
     """
 
     def __init__(self, path: str | os.PathLike, *, assets: Sequence[str], symbols: Sequence[str], meta: dict,
