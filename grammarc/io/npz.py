@@ -44,6 +44,7 @@ import struct
 import tempfile
 import threading
 import weakref
+import zipfile
 from collections.abc import Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -53,6 +54,8 @@ import numpy as np
 # zlib's CRC-32 with SIMD (3x as fast: every record byte passes it), and its crc32_combine
 from zlib_ng.zlib_ng import crc32, crc32_combine
 
+from grammarc.errors import UsageError
+
 # MeshChunk and TerminalChunk stay importable here for the backend (derive, terminals, mesh_shapes) and the
 # benchmarks until they import grammarc.model.records.
 from grammarc.model.records import MeshChunk, TerminalChunk  # noqa: F401
@@ -60,7 +63,7 @@ from grammarc.model.records import MeshChunk, TerminalChunk  # noqa: F401
 if TYPE_CHECKING:
     from typing_extensions import Self
 
-__all__ = ["InstanceWriter", "read_instances"]
+__all__ = ["InstanceWriter", "load_record", "read_instances"]
 
 _FORMAT = "grammarc.instances/1"
 _FADVISE = hasattr(os, "posix_fadvise")  # Linux: DONTNEED starts the writeback of a range, drops clean pages
@@ -274,6 +277,26 @@ def read_instances(path: str | os.PathLike) -> dict[str, np.ndarray | dict]:
         raise ValueError(f"{os.fspath(path)}: format {meta.get('format')!r}, expected {_FORMAT!r}")
     record["meta"] = meta
     return record
+
+
+def load_record(path: str | os.PathLike) -> dict[str, np.ndarray | dict]:
+    """``read_instances`` of a record the user named (``grammarc render``): every problem a UsageError.
+
+    Raises
+    ------
+    UsageError
+        If ``path`` is not a file, not a zip (so not an .npz), or not an instance record this version
+        reads.
+    """
+    if not Path(path).is_file():
+        raise UsageError(f"record `{path}` not found")
+    # np.load takes any other file for a pickle, and says so: name the actual problem instead.
+    if not zipfile.is_zipfile(path):
+        raise UsageError(f"`{path}` is not an instance record (not an .npz file)")
+    try:
+        return read_instances(path)
+    except (OSError, ValueError, EOFError, KeyError, zipfile.BadZipFile) as error:
+        raise UsageError(f"cannot read record `{path}`: {error}") from error
 
 
 def _names(field: str, names: Sequence[str]) -> np.ndarray:

@@ -16,8 +16,9 @@ import zlib
 import numpy as np
 import pytest
 
+from grammarc.errors import UsageError
 from grammarc.io import npz
-from grammarc.io.npz import InstanceWriter, read_instances
+from grammarc.io.npz import InstanceWriter, load_record, read_instances
 from grammarc.model.records import MeshChunk, TerminalChunk
 
 ASSETS = ["builtin:cube", "builtin:quad", "facade/window.obj"]
@@ -381,6 +382,34 @@ def test_read_instances_refuses_other_npz(tmp_path):
 
 
 # The writer's internals: the zip and .npy records it writes by hand, and its background thread.
+
+
+def bad_record(directory, kind):
+    """A path that is no instance record: absent, a folder, a text file, another npz."""
+    if kind == "text":
+        (directory / "text.npz").write_text("hello")
+        return directory / "text.npz"
+    if kind == "other npz":
+        np.savez(directory / "other.npz", a=np.zeros(2))
+        return directory / "other.npz"
+    return directory / "none.npz" if kind == "absent" else directory
+
+
+@pytest.mark.parametrize(("kind", "message"), [
+    ("absent", "record `.*none.npz` not found"),
+    ("folder", "record `.*` not found"),
+    ("text", "`.*text.npz` is not an instance record \\(not an .npz file\\)"),
+    ("other npz", "cannot read record `.*other.npz`: .*no 'meta' member"),
+])
+def test_load_record_names_the_problem_in_a_usage_error(tmp_path, kind, message):
+    with pytest.raises(UsageError, match=message):
+        load_record(bad_record(tmp_path, kind))
+
+
+def test_load_record_reads_an_instance_record(tmp_path, chunks):
+    write(tmp_path / "city.npz", chunks)
+    record = load_record(tmp_path / "city.npz")
+    np.testing.assert_array_equal(record["lot"], read_instances(tmp_path / "city.npz")["lot"])
 
 
 def writer_threads():
