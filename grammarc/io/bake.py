@@ -45,7 +45,7 @@ from grammarc.model.assets import AssetLibrary, AssetMesh, asset_library, builti
 from grammarc.model.records import MeshChunk, TerminalChunk
 from grammarc.ragged import offsets_from_counts
 
-__all__ = ["MAX_TRIANGLES", "BakedWriter", "bake", "count_triangles"]
+__all__ = ["MAX_TRIANGLES", "WRITERS", "BakedWriter", "bake", "count_triangles"]
 
 #: Default limit of ``bake`` (``constants.Limits.max_triangles``).
 MAX_TRIANGLES = LIMITS.max_triangles
@@ -262,6 +262,8 @@ class BakedWriter(WriterBlock):
     """
 
     FORMATS: ClassVar[dict[str, str]] = {".obj": "obj", ".ply": "ply", ".stl": "stl", ".glb": "glb"}
+    #: It writes baked meshes: what ``--bake`` asks for (``grammarc.io.writers``).
+    bakes: ClassVar[bool] = True
 
     def __init__(self, path: str | os.PathLike, *, assets: Sequence[str], symbols: Sequence[str],
                  meta: dict, asset_roots: Sequence[str | os.PathLike] | None = None,
@@ -406,3 +408,6 @@ class BakedWriter(WriterBlock):
         data = mesh.export(file_type=self._file_type)
         return data if isinstance(data, bytes) else data.encode("utf-8")
 
+
+#: The extensions this module writes (``grammarc.io.writers``): all baked.
+WRITERS = dict.fromkeys(BakedWriter.FORMATS, BakedWriter)

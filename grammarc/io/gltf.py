@@ -35,7 +35,9 @@ import numpy as np
 from grammarc.errors import UsageError
 from grammarc.io.instancing import TILE_SIZE, Tile, TiledWriter, compose, decompose
 
-__all__ = ["MAX_BYTES", "MAX_GROUPS", "GltfWriter", "index_path", "part_paths", "read_glb", "written_parts"]
+__all__ = [
+    "MAX_BYTES", "MAX_GROUPS", "WRITERS", "GltfWriter", "index_path", "part_paths", "read_glb", "written_parts",
+]
 
 #: GLB's 32-bit length fields, less room for the JSON chunk.
 MAX_BYTES = (1 << 32) - (64 << 20)
@@ -115,6 +117,10 @@ class GltfWriter(TiledWriter):
         for out, path in zip(staged, paths):
             os.replace(out, path)
         return {"parts": len(parts)}
+
+
+#: The extension this module writes (``grammarc.io.writers``); ``--bake`` writes it with ``io.bake`` instead.
+WRITERS = {".glb": GltfWriter}
 
 
 class _Part:

@@ -63,7 +63,7 @@ from grammarc.model.records import MeshChunk, TerminalChunk  # noqa: F401
 if TYPE_CHECKING:
     from typing_extensions import Self
 
-__all__ = ["InstanceWriter", "load_record", "read_instances"]
+__all__ = ["WRITERS", "InstanceWriter", "load_record", "read_instances"]
 
 _FORMAT = "grammarc.instances/1"
 _FADVISE = hasattr(os, "posix_fadvise")  # Linux: DONTNEED starts the writeback of a range, drops clean pages
@@ -277,6 +277,10 @@ def read_instances(path: str | os.PathLike) -> dict[str, np.ndarray | dict]:
         raise ValueError(f"{os.fspath(path)}: format {meta.get('format')!r}, expected {_FORMAT!r}")
     record["meta"] = meta
     return record
+
+
+#: The extension this module writes (``grammarc.io.writers``).
+WRITERS = {".npz": InstanceWriter}
 
 
 def load_record(path: str | os.PathLike) -> dict[str, np.ndarray | dict]:
