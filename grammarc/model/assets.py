@@ -41,16 +41,7 @@ from grammarc.errors import AssetError
 from grammarc.io.assets import builtin_name, resolve_asset
 from grammarc.model.obj import ObjError, read_obj
 
-__all__ = [
-    "BLOCKS",
-    "CYLINDER_SIDES",
-    "LOD_STAND_IN",
-    "AssetLibrary",
-    "AssetMesh",
-    "asset_library",
-    "builtin_mesh",
-    "load_asset",
-]
+__all__ = ["LOD_STAND_IN", "AssetLibrary", "AssetMesh", "asset_library", "builtin_mesh", "load_asset"]
 
 #: ``--lod builtin``: a built-in cube stands in for an asset file that is missing.
 LOD_STAND_IN = "builtin"

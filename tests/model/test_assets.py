@@ -52,12 +52,13 @@ def write_obj(path, text: str):
 
 
 def test_obj_asset_fitted_to_the_unit_box_counts_its_face_lines(tmp_path):
-    # A flat panel (z = 0.3 everywhere) spanning x -5..5, y 2..4: one quad and one pentagon.
-    write_obj(tmp_path / "panel.obj", "v -5 2 0.3\nv 0 2 0.3\nv 5 2 0.3\nv 5 4 0.3\nv 0 4 0.3\nv -5 4 0.3\n"
-              "f 1 2 5 6\nf 2 3 4 5\n")
-    shape = load_asset("panel.obj", [tmp_path])
-    np.testing.assert_allclose([shape.vertices.min(0), shape.vertices.max(0)], [[0, 0, 0], [1, 1, 0]])
-    assert shape.polygon_sizes.tolist() == [4, 4] and shape.n_triangles == 4
+    # A pentagon on z = 2 and a triangle standing on its edge 1-5, in a box 2 x 5 x 3 away from the origin.
+    write_obj(tmp_path / "gable.obj", "v 2 2 2\nv 4 2 2\nv 4 6 2\nv 3 7 2\nv 2 6 2\nv 2 4 5\n"
+              "f 1 2 3 4 5\nf 1 5 6\nf 1 2\n")  # a two-vertex face is not a polygon: dropped
+    shape = load_asset("gable.obj", [tmp_path])
+    np.testing.assert_allclose(shape.vertices[[0, 3, 5]], [[0, 0, 0], [0.5, 1, 0], [0, 0.4, 1]])
+    assert shape.polygon_sizes.tolist() == [5, 3] and shape.faces.tolist() == [[0, 1, 2], [0, 2, 3],
+                                                                               [0, 3, 4], [0, 4, 5]]
     with pytest.raises(ValueError, match="read-only"):
         shape.vertices[0, 0] = 1.0  # cached and shared
 

@@ -1,18 +1,24 @@
 """The record's chunks: joined meshes shift their offsets, colours default to white."""
 
+import dataclasses
+
 import numpy as np
 
 from grammarc.model.records import WHITE, MeshChunk, TerminalChunk
 
 
-def test_concat_shifts_offsets():
-    triangle = MeshChunk(
+def triangle() -> MeshChunk:
+    """One face, a triangle, lot 0, symbol 0, no colour."""
+    return MeshChunk(
         vertices=np.zeros((3, 3), np.float32),
         ring_offsets=np.array([0, 3], np.int64),
         face_offsets=np.array([0, 1], np.int64),
         lot=np.array([0], np.int32),
         symbol=np.array([0], np.int32),
     )
+
+
+def test_concat_shifts_offsets():
     square_with_hole = MeshChunk(
         vertices=np.ones((7, 3), np.float32),
         ring_offsets=np.array([0, 4, 7], np.int64),
@@ -20,7 +26,7 @@ def test_concat_shifts_offsets():
         lot=np.array([1], np.int32),
         symbol=np.array([2], np.int32),
     )
-    joined = MeshChunk.concat([triangle, MeshChunk.empty(), square_with_hole, triangle])
+    joined = MeshChunk.concat([triangle(), MeshChunk.empty(), square_with_hole, triangle()])
     assert joined.ring_offsets.tolist() == [0, 3, 7, 10, 13]
     assert joined.face_offsets.tolist() == [0, 1, 3, 4]
     assert joined.lot.tolist() == [0, 1, 0]
@@ -30,21 +36,10 @@ def test_concat_shifts_offsets():
 
 
 def test_colours_default_to_white():
-    mesh = MeshChunk(
-        vertices=np.zeros((3, 3), np.float32),
-        ring_offsets=np.array([0, 3], np.int64),
-        face_offsets=np.array([0, 1], np.int64),
-        lot=np.array([0], np.int32),
-        symbol=np.array([0], np.int32),
-    )
     plain = TerminalChunk(asset=np.zeros(3, np.int32), xform=np.zeros((3, 3, 4), np.float32),
-                          lot=np.zeros(3, np.int32), symbol=np.zeros(3, np.int32), mesh=mesh)
+                          lot=np.zeros(3, np.int32), symbol=np.zeros(3, np.int32), mesh=triangle())
     assert plain.colors().tolist() == [WHITE.tolist()] * 3 and plain.colors().flags.c_contiguous
     assert plain.mesh.colors().tolist() == [WHITE.tolist()]
     red = np.tile(np.array([[255, 0, 0, 255]], np.uint8), (3, 1))
-    assert TerminalChunk(**{**vars_of(plain), "color": red}).colors() is red
+    assert dataclasses.replace(plain, color=red).colors() is red
     assert MeshChunk.empty().colors().shape == (0, 4)
-
-
-def vars_of(chunk) -> dict:
-    return {field: getattr(chunk, field) for field in ("asset", "xform", "lot", "symbol", "mesh")}
