@@ -36,7 +36,7 @@ from grammarc.constants import LIMITS, Limits
 from grammarc.errors import ChunkTooLarge, LotFailure, UsageError
 from grammarc.io import OutputOptions, writer_for
 from grammarc.io.lots import BadLot, Lots, default_lot, read_lots
-from grammarc.io.npz import MeshChunk
+from grammarc.model.records import MeshChunk
 from grammarc.workers import worker_pool
 
 #: Shapes plus records one chunk may make before it is split: ~100 bytes each, so about 2 GB.

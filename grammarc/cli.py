@@ -194,9 +194,12 @@ def _check(args) -> int:
 
 
 def _render(args) -> int:
-    from grammarc.render.picture import parse_size, render
+    from grammarc.io.npz import load_record
+    from grammarc.render.picture import parse_size, png_path, render
 
-    result = render(args.record, args.output, size=parse_size(args.size), view=args.view, color=args.color,
+    size = parse_size(args.size)
+    png_path(args.output)  # before the record is read, which may be large
+    result = render(load_record(args.record), args.output, size=size, view=args.view, color=args.color,
                     asset_roots=args.assets)
     for name in result["missing_assets"]:
         print(f"grammarc: asset `{name}` not found (give its folder with --assets); drawn as boxes",

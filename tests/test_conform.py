@@ -20,7 +20,7 @@ from grammarc.conform import (
 )
 from grammarc.errors import UsageError
 from grammarc.io.bake import bake
-from grammarc.io.npz import MeshChunk
+from grammarc.model.records import MeshChunk
 
 KIT = Path(__file__).resolve().parents[1].parent / "shared" / "prt"
 needs_kit = pytest.mark.skipif(not (KIT / "reference.json").is_file(),

@@ -7,7 +7,7 @@ from grammarc.build import BuildOptions, derive
 from grammarc.compiler import compile_grammar
 from grammarc.errors import LimitError
 from grammarc.io.lots import lots_from_polygons
-from grammarc.io.npz import MeshChunk, TerminalChunk
+from grammarc.model.records import MeshChunk, TerminalChunk
 from grammarc.workers import _ship, _unship
 
 

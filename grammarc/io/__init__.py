@@ -1,36 +1,34 @@
-"""Lots in, assets, instance records out.
+"""Lots in, instance records out: the readers and writers, leaves above the model.
 
-Output formats register here by extension, one module per format (as trimesh's ``exchange/``); the build
-asks ``writer_for`` for the writer of ``--emit PATH``:
+Output formats register by extension, one module per format, as trimesh's ``exchange/`` modules declare
+their exporters: each writer module has ``WRITERS``, the extensions it writes -> its writer class, and
+``writers()`` collects them. The build asks ``writer_for`` for the writer of ``--emit PATH``:
 
 * ``.npz``: the instance record (``io/npz.py``);
 * ``.usda``, ``.usdc``, ``.usd``: instanced USD, one PointInstancer per tile (``io/usd.py``);
 * ``.glb``: glTF with GPU instancing (``io/gltf.py``), or baked with ``--bake``;
 * ``.obj``, ``.ply``, ``.stl``: the record baked into one mesh (``io/bake.py``), as a .glb with ``--bake``.
+
+A writer class whose ``bakes`` is true writes baked meshes: ``--bake`` asks for it, and an extension that
+no other writer takes is written baked anyway. A writer takes the ``OutputOptions`` its constructor names.
+The writer modules are imported when a lookup reaches them, not with this package: importing grammarc loads
+none of them, nor usd-core or trimesh (which they import when they write), and an .npz build only the npz
+writer.
 """
 
 from __future__ import annotations
 
+import dataclasses
 import functools
+import inspect
 from dataclasses import dataclass
+from importlib import import_module
 from pathlib import Path
 
 from grammarc.errors import UsageError
 
-_BAKED = ("grammarc.io.bake", "BakedWriter", ("lod", "max_triangles", "asset_roots"))
-#: Output extension -> (module, writer class, the ``OutputOptions`` fields it takes).
-WRITERS = {
-    ".npz": ("grammarc.io.npz", "InstanceWriter", ()),
-    ".usda": ("grammarc.io.usd", "UsdWriter", ("lod", "tile_size", "asset_roots")),
-    ".usdc": ("grammarc.io.usd", "UsdWriter", ("lod", "tile_size", "asset_roots")),
-    ".usd": ("grammarc.io.usd", "UsdWriter", ("lod", "tile_size", "asset_roots")),
-    ".glb": ("grammarc.io.gltf", "GltfWriter", ("lod", "tile_size", "asset_roots")),
-    ".obj": _BAKED,
-    ".ply": _BAKED,
-    ".stl": _BAKED,
-}
-#: Formats ``--bake`` applies to: always baked but for .glb, which is instanced without it.
-BAKEABLE = (".obj", ".ply", ".stl", ".glb")
+#: The modules that declare ``WRITERS``, in the order ``writer_for``'s messages list their extensions.
+WRITER_MODULES = ("grammarc.io.npz", "grammarc.io.usd", "grammarc.io.gltf", "grammarc.io.bake")
 
 
 class WriterBlock:
@@ -50,7 +48,7 @@ class WriterBlock:
 @dataclass(frozen=True)
 class OutputOptions:
     """How a record is written, beyond its rows: ``bake`` instances into meshes (at most ``max_triangles``),
-    the level of detail of assets (``io.bake.load_asset``), the tile edge of the instanced formats
+    the level of detail of assets (``model.assets.load_asset``), the tile edge of the instanced formats
     (``io.instancing``), the folders assets are loaded from (the build gives the grammar's, a rule
     package's while it is extracted, and ``--assets``). None: the writer's default."""
 
@@ -61,19 +59,45 @@ class OutputOptions:
     asset_roots: tuple | None = None
 
 
-def writer_for(path: str | Path, options: OutputOptions = OutputOptions()):
-    """The writer factory for an output path: ``factory(path, assets=, symbols=, meta=)``; a UsageError
-    names the supported extensions."""
-    suffix = Path(path).suffix.lower()
-    if suffix not in WRITERS:
-        supported = ", ".join(WRITERS)
-        raise UsageError(f"cannot write `{path}`: output format `{suffix or '(none)'}` is not supported "
-                         f"(supported: {supported})")
-    if options.bake and suffix not in BAKEABLE:
-        raise UsageError(f"--bake writes meshes ({', '.join(BAKEABLE)}), not `{suffix}`")
-    module, name, takes = _BAKED if options.bake else WRITERS[suffix]
-    from importlib import import_module
+def _declared():
+    """``((extension, bakes), writer class)`` of each writer module's ``WRITERS``, in order; a module is
+    imported when the walk reaches it, so that looking up ``.npz`` imports no other writer."""
+    for name in WRITER_MODULES:
+        for suffix, writer in import_module(name).WRITERS.items():
+            yield (suffix, bool(getattr(writer, "bakes", False))), writer
 
-    writer = getattr(import_module(module), name)
-    given = {field: getattr(options, field) for field in takes if getattr(options, field) is not None}
+
+@functools.cache
+def writers() -> dict[tuple[str, bool], type]:
+    """``(extension, bakes) -> writer class`` of every writer module, in declaration order."""
+    return dict(_declared())
+
+
+def writer_for(path: str | Path, options: OutputOptions = OutputOptions()):
+    """The writer factory for an output path: ``factory(path, assets=, symbols=, meta=)``, with the
+    options its constructor takes; a UsageError names the supported extensions."""
+    suffix = Path(path).suffix.lower()
+    # --bake: the extension's baked writer; else its instanced writer, or the baked one if it has none.
+    writer = _first((suffix, options.bake)) or (None if options.bake else _first((suffix, True)))
+    if writer is None:
+        table = writers()
+        if (suffix, False) not in table and (suffix, True) not in table:
+            supported = ", ".join(dict.fromkeys(s for s, _ in table))
+            raise UsageError(f"cannot write `{path}`: output format `{suffix or '(none)'}` is not supported "
+                             f"(supported: {supported})")
+        bakeable = ", ".join(s for s, bakes in table if bakes)
+        raise UsageError(f"--bake writes meshes ({bakeable}), not `{suffix}`")
+    given = _taken(writer, options)
     return functools.partial(writer, **given) if given else writer
+
+
+def _first(key: tuple[str, bool]) -> type | None:
+    """The writer declared for ``key``, walking the modules only as far as its declaration."""
+    return next((writer for found, writer in _declared() if found == key), None)
+
+
+def _taken(writer: type, options: OutputOptions) -> dict:
+    """The options that are set and that ``writer``'s constructor takes, by the name of its keyword."""
+    keywords = inspect.signature(writer).parameters
+    return {field.name: getattr(options, field.name) for field in dataclasses.fields(options)
+            if field.name in keywords and getattr(options, field.name) is not None}

@@ -1,21 +1,9 @@
 """Baking an instance record into one triangle mesh, and the mesh writers (.obj, .ply, .stl, .glb).
 
 A record (README, "The record") holds instances (an asset and the affine map of its unit box) and leaf
-polygons (the mesh table). Baking expands every instance into the asset's triangles and triangulates the
-polygons, so that the city can be looked at, exported, or measured against PRT (``grammarc.conform``).
-
-Assets, each an ``AssetMesh`` in the unit box [0, 1]^3:
-
-* ``builtin:cube``: the unit cube, 8 vertices, 12 triangles, normals outward;
-* ``builtin:quad``: the unit square on z = 0, normal +z, 2 triangles;
-* ``builtin:cylinder``: axis along y through (0.5, ., 0.5), radius 0.5, y in [0, 1], 16 sides, capped
-  (60 triangles); ``builtin:cylinderN`` the same with N sides;
-* ``builtin:L``, ``H``, ``U``, ``T``: the paper's mass-model blocks, prisms over outlines with wings a
-  third of the box thick;
-* a file (OBJ, or any mesh format trimesh reads), resolved in the asset roots as the compiler resolves it
-  (``grammarc.io.assets.resolve_asset``) and loaded with trimesh, then mapped from its bounding box onto
-  [0, 1]^3 as CityEngine fits an inserted asset to the scope. An axis along which the asset is flat stays
-  flat (at 0): there is nothing to stretch.
+polygons (the mesh table). Baking expands every instance into its asset's triangles (``model.assets``) and
+triangulates the polygons (``geometry.triangulation``), so that the city can be looked at, exported, or
+measured against PRT (``grammarc.conform``).
 
 Instances are expanded per asset, all instances of one asset at once: ``einsum`` of the (n, 3, 3) linear
 parts with the asset's (v, 3) vertices, faces offset by ``arange(n) * v``. An instance whose transform
@@ -23,16 +11,10 @@ mirrors (negative determinant) gets its triangles reversed, so a mirrored cube s
 transform (a quad's zero column) keeps the asset's winding, whose normal is then ``col0 x col1``, the
 face's normal by the record's convention.
 
-Polygons of the mesh table are triangulated in the plane of their outline's Newell normal: a convex face
-without holes as a fan (vectorized over all such faces), any other face with mapbox-earcut (one call per
-face), triangles turned to face along the normal.
-
 Polygon counts. Conformance compares face counts with PRT, whose encoder returns polygons, not triangles,
 so ``bake`` also counts the polygons before triangulation, in the mesh's ``metadata``:
 
-* a built-in counts its faces: cube 6 quads, quad 1, cylinder 16 quads and two 16-gons;
-* an OBJ asset counts its ``f`` lines (trimesh triangulates faces as it loads them, and keeps no count
-  of them), each a polygon of as many vertices as the line has; other formats count triangles;
+* an instance counts its asset's polygons (``AssetMesh.polygon_sizes``, see ``model.assets``);
 * a face of the mesh table counts each of its rings, outline and holes, as PRT's encoder returns them
   (README of the PRT kit: "a face with holes comes back as its outer ring plus one face per hole ring").
 
@@ -46,266 +28,30 @@ import os
 import shutil
 import tempfile
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass
-from functools import cache, lru_cache
 from pathlib import Path
 from typing import ClassVar
 
 import numpy as np
 
 from grammarc.constants import LIMITS
-from grammarc.errors import AssetError, UsageError
+from grammarc.errors import UsageError
+from grammarc.geometry.triangulation import triangulate_polygons
 from grammarc.io import WriterBlock
-from grammarc.io.assets import builtin_name, resolve_asset
-from grammarc.io.npz import MeshChunk, TerminalChunk
-from grammarc.io.obj import ObjError, obj_bytes, read_obj
-from grammarc.ragged import fan_out, offsets_from_counts, segment_reduce
+from grammarc.io.obj import obj_bytes
 
-__all__ = [
-    "LOD_STAND_IN",
-    "MAX_TRIANGLES",
-    "AssetMesh",
-    "BakedWriter",
-    "asset_library",
-    "bake",
-    "builtin_mesh",
-    "count_triangles",
-    "load_asset",
-    "triangulate_polygons",
-]
+# builtin_mesh and load_asset stay importable here for the backend (derive) and tests/geometry/test_trim.py
+# until they import grammarc.model.assets.
+from grammarc.model.assets import AssetLibrary, AssetMesh, asset_library, builtin_mesh, load_asset  # noqa: F401
+from grammarc.model.records import MeshChunk, TerminalChunk
+from grammarc.ragged import offsets_from_counts
+
+__all__ = ["MAX_TRIANGLES", "WRITERS", "BakedWriter", "bake", "count_triangles"]
 
 #: Default limit of ``bake`` (``constants.Limits.max_triangles``).
 MAX_TRIANGLES = LIMITS.max_triangles
-#: ``--lod builtin``: a built-in cube stands in for an asset file that is missing.
-LOD_STAND_IN = "builtin"
 #: Vertices expanded per einsum call: bounds the float64 temporaries of a block of instances (~50 MB).
 _BLOCK_VERTICES = 1 << 21
-#: Sides of ``builtin:cylinder``.
-CYLINDER_SIDES = 16
-#: The paper's mass-model blocks (section 3.1, after Schmitt): outlines in thirds of the unit square, as
-#: (x, z) counter-clockwise seen from +y; wings one third thick.
-BLOCKS = {
-    "L": [(0, 0), (0, 3), (3, 3), (3, 2), (1, 2), (1, 0)],
-    "U": [(0, 0), (0, 3), (3, 3), (3, 0), (2, 0), (2, 2), (1, 2), (1, 0)],
-    "T": [(1, 0), (1, 2), (0, 2), (0, 3), (3, 3), (3, 2), (2, 2), (2, 0)],
-    "H": [(0, 0), (0, 3), (1, 3), (1, 2), (2, 2), (2, 3), (3, 3), (3, 0), (2, 0), (2, 1), (1, 1), (1, 0)],
-}
-#: An asset's extent below this (in its own units) is a flat axis, mapped to 0 rather than stretched.
-_FLAT = 1e-12
-#: A polygon's turn at a vertex counts as convex above ``-_CONVEX * |e_prev| |e_next| |n|`` (collinear
-#: vertices, and rounding of float32 world coordinates, are not concavities).
-_CONVEX = 1e-7
-
-
-@dataclass(frozen=True, eq=False)
-class AssetMesh:
-    """An asset's triangles in its unit box, and the polygons they came from.
-
-    Attributes
-    ----------
-    vertices : (v, 3) float64
-        In [0, 1]^3; the bounding box of a non-flat asset is exactly the unit box.
-    faces : (t, 3) int64
-        Triangles, counter-clockwise seen from outside.
-    polygon_sizes : (p,) int64
-        Vertex count of each polygon before triangulation (see the module docstring).
-    """
-
-    vertices: np.ndarray
-    faces: np.ndarray
-    polygon_sizes: np.ndarray
-
-    @property
-    def n_triangles(self) -> int:
-        return len(self.faces)
-
-    @property
-    def n_polygons(self) -> int:
-        return len(self.polygon_sizes)
-
-
-# --------------------------------------------------------------------------------------------- assets
-
-
-@cache
-def builtin_mesh(name: str) -> AssetMesh:
-    """The mesh of a built-in asset: ``"cube"``, ``"quad"`` or ``"cylinder"`` (``builtin:`` optional).
-
-    Examples
-    --------
-    >>> cube = builtin_mesh("builtin:cube")
-    >>> cube.vertices.shape, cube.faces.shape, cube.n_polygons
-    ((8, 3), (12, 3), 6)
-    """
-    bare = name.removeprefix("builtin:")
-    if bare == "cube":
-        # vertex i has coordinates (i & 1, i >> 1 & 1, i >> 2 & 1); each face's quad counter-clockwise
-        # seen from outside, split along its first diagonal.
-        vertices = np.array([[i & 1, i >> 1 & 1, i >> 2 & 1] for i in range(8)], np.float64)
-        quads = np.array([
-            [0, 4, 6, 2],  # x = 0
-            [1, 3, 7, 5],  # x = 1
-            [0, 1, 5, 4],  # y = 0
-            [2, 6, 7, 3],  # y = 1
-            [0, 2, 3, 1],  # z = 0
-            [4, 5, 7, 6],  # z = 1
-        ])  # fmt: skip
-        return _frozen(vertices, _quads_to_triangles(quads), np.full(6, 4))
-    if bare == "quad":
-        vertices = np.array([[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0]], np.float64)
-        return _frozen(vertices, np.array([[0, 1, 2], [0, 2, 3]]), np.array([4]))
-    if bare in BLOCKS:
-        return _prism(np.array(BLOCKS[bare], dtype=np.float64) / 3.0)
-    if builtin_name(bare) and bare.startswith("cylinder"):
-        k = int(bare.removeprefix("cylinder") or CYLINDER_SIDES)
-        # a = 0 and pi put vertices on x = 0 and 1; increasing a turns counter-clockwise seen from +y
-        angle = 2 * np.pi * np.arange(k) / k
-        return _prism(np.stack([0.5 + 0.5 * np.cos(angle), 0.5 - 0.5 * np.sin(angle)], axis=1))
-    raise AssetError(f"unknown built-in asset `{name}` (built-ins: cube, quad, cylinder, cylinderN, L, H, U, T)")
-
-
-def _prism(outline: np.ndarray) -> AssetMesh:
-    """The prism over ``outline`` ((k, 2) as (x, z), counter-clockwise seen from +y) from y = 0 to 1,
-    fitted to the unit box: side quads, then the top and bottom caps (earcut: the blocks are concave)."""
-    import mapbox_earcut
-
-    k = len(outline)
-    ring = np.stack([outline[:, 0], np.zeros(k), outline[:, 1]], axis=1)
-    vertices = np.concatenate([ring, ring + [0.0, 1.0, 0.0]])
-    i = np.arange(k)
-    j = (i + 1) % k
-    sides = np.stack([i, j, j + k, i + k], axis=1)  # outward: bottom i, bottom j, top j, top i
-    cap = mapbox_earcut.triangulate_float64(outline, np.array([k], dtype=np.uint32)).reshape(-1, 3)
-    # the top faces +y: counter-clockwise from +y is clockwise in (x, z); the bottom the other way
-    a, b, c = outline[cap[:, 0]], outline[cap[:, 1]], outline[cap[:, 2]]
-    turn = (b[:, 0] - a[:, 0]) * (c[:, 1] - a[:, 1]) - (b[:, 1] - a[:, 1]) * (c[:, 0] - a[:, 0])
-    top = np.where((turn < 0)[:, None], cap, cap[:, ::-1])
-    top, bottom = top + k, top[:, ::-1]
-    faces = np.concatenate([_quads_to_triangles(sides), top, bottom]).astype(np.int64)
-    return _frozen(_fitted(vertices), faces, np.array([4] * k + [k, k]))
-
-
-def load_asset(name: str, asset_roots: Sequence[str | os.PathLike] = (), lod: str | None = None) -> AssetMesh:
-    """Load an asset by its record name: a built-in, or a file resolved in ``asset_roots``.
-
-    Parameters
-    ----------
-    name : str
-        As in the record's ``assets``: ``builtin:cube`` or a path relative to an asset root.
-    asset_roots : sequence of path-like
-        Folders searched in order (the grammar's folder, ``--assets`` folders, a rule package's
-        ``asset_roots``).
-    lod : str, optional
-        A level of detail: ``window.obj`` is replaced by ``window.<lod>.obj`` beside it where that file
-        exists (the paper's Pompeii had high, middle and low LoD assets). ``builtin`` gives the built-in
-        cube as a stand-in for an asset file that no root holds, where otherwise that is an error.
-
-    Returns
-    -------
-    AssetMesh
-        The asset mapped from its bounding box onto [0, 1]^3.
-
-    Raises
-    ------
-    AssetError
-        If the name is refused (absolute, leaves the roots), no root holds it, or trimesh cannot read it.
-    """
-    if name.startswith("builtin:"):
-        return builtin_mesh(name)
-    roots = [Path(r) for r in asset_roots]
-    resolved = resolve_asset(name, roots)
-    if resolved.problem:
-        raise AssetError(resolved.problem)
-    if resolved.path is None:
-        if lod == LOD_STAND_IN:
-            return builtin_mesh("builtin:cube")
-        shown = ", ".join(str(r) for r in asset_roots) or "(no asset roots given)"
-        raise AssetError(f"asset `{name}` not found in {shown} (--lod {LOD_STAND_IN} puts a cube in its place)")
-    path = resolved.path
-    if lod and lod != LOD_STAND_IN:
-        substitute = path.with_name(f"{path.stem}.{lod}{path.suffix}")
-        path = substitute if substitute.is_file() else path
-    return _load_file(path, path.stat().st_mtime_ns)
-
-
-@lru_cache(maxsize=64)
-def _load_file(path: Path, mtime_ns: int) -> AssetMesh:
-    """A file asset, cached by path and modification time (a city uses a few assets many times).
-
-    OBJ files are read by ``io.obj`` (geometry only: their materials would need Pillow), their polygons
-    fanned into triangles; other formats go through trimesh.
-    """
-    if path.suffix.lower() == ".obj":
-        try:
-            vertices, polygons = read_obj(path.read_text(encoding="utf-8", errors="replace"), str(path))
-        except (OSError, ObjError) as error:
-            raise AssetError(f"cannot read asset `{path}`: {error}") from error
-        polygons = [f for f in polygons if len(f) >= 3 and (f >= 0).all() and (f < len(vertices)).all()]
-        sizes = np.array([len(f) for f in polygons], np.int64)
-        faces = np.concatenate([np.stack([np.full(len(f) - 2, f[0]), f[1:-1], f[2:]], axis=1)
-                                for f in polygons]) if polygons else np.zeros((0, 3), np.int64)
-        return _frozen(_fitted(vertices), faces, sizes)
-    import trimesh
-
-    try:
-        mesh = trimesh.load(path, force="mesh", process=False)
-    except Exception as error:
-        raise AssetError(f"cannot read asset `{path}`: {error}") from error
-    vertices = np.asarray(getattr(mesh, "vertices", np.zeros((0, 3))), np.float64).reshape(-1, 3)
-    faces = np.asarray(getattr(mesh, "faces", np.zeros((0, 3))), np.int64).reshape(-1, 3)
-    return _frozen(_fitted(vertices), faces, np.full(len(faces), 3, np.int64))
-
-
-def _fitted(vertices: np.ndarray) -> np.ndarray:
-    """Vertices mapped from their bounding box onto [0, 1]^3, as CityEngine fits an asset to a scope;
-    a flat axis maps to 0."""
-    if not len(vertices):
-        return vertices
-    low, high = vertices.min(axis=0), vertices.max(axis=0)
-    extent = high - low
-    flat = extent <= _FLAT * max(1.0, float(np.abs(vertices).max()))
-    scale = np.divide(1.0, extent, out=np.zeros(3), where=~flat)  # a flat axis maps to 0
-    return (vertices - low) * scale
-
-
-def _quads_to_triangles(quads: np.ndarray) -> np.ndarray:
-    """(2q, 3) triangles of (q, 4) quads, each split along its diagonal 0-2, in quad order."""
-    return np.stack([quads[:, [0, 1, 2]], quads[:, [0, 2, 3]]], axis=1).reshape(-1, 3)
-
-
-def _frozen(vertices, faces, sizes) -> AssetMesh:
-    arrays = [np.array(vertices, np.float64), np.array(faces, np.int64), np.array(sizes, np.int64)]
-    for array in arrays:
-        array.flags.writeable = False  # cached and shared: nobody may change them
-    return AssetMesh(*arrays)
-
-
-class _Library:
-    """Asset meshes of a record's asset names, loaded when first used."""
-
-    def __init__(self, names: Sequence[str], roots: Sequence[str | os.PathLike], lod: str | None = None):
-        self.names = [str(n) for n in names]
-        self.roots = [Path(r) for r in roots]
-        self.lod = lod
-        self._meshes: dict[int, AssetMesh] = {}
-
-    def __getitem__(self, index: int) -> AssetMesh:
-        if index not in self._meshes:
-            self._meshes[index] = load_asset(self.names[index], self.roots, self.lod)
-        return self._meshes[index]
-
-    def triangles(self, used: np.ndarray) -> int:
-        """Triangles of ``used[a]`` instances of each asset ``a``, ``used`` (A,) int64."""
-        return sum(int(used[a]) * self[a].n_triangles for a in np.flatnonzero(used))
-
-
 # ---------------------------------------------------------------------------------------- the record
-
-
-def asset_library(names: Sequence[str], record: Mapping, asset_roots=None, lod: str | None = None) -> _Library:
-    """The meshes of asset ``names``, loaded when first used from ``asset_roots`` or the roots that the
-    record's meta names (the grammar's folder, then its ``asset_roots``), at level of detail ``lod``."""
-    return _Library(names, _roots(record, asset_roots), lod)
 
 
 def count_triangles(record: Mapping, asset_roots: Sequence[str | os.PathLike] | None = None,
@@ -369,7 +115,7 @@ def bake(
     return _bake(asset_library(names, record, asset_roots), asset, xform, mesh, max_triangles)
 
 
-def _bake(library: _Library, asset: np.ndarray, xform: np.ndarray, mesh: MeshChunk, max_triangles: int):
+def _bake(library: AssetLibrary, asset: np.ndarray, xform: np.ndarray, mesh: MeshChunk, max_triangles: int):
     """``bake`` of a record's columns, its assets in ``library``."""
     import trimesh
 
@@ -481,119 +227,6 @@ def _columns(record: Mapping) -> tuple[list[str], np.ndarray, np.ndarray, MeshCh
     return names, asset, xform, mesh
 
 
-def _roots(record: Mapping, asset_roots) -> list[Path]:
-    """``asset_roots``, or the roots a record's meta names: the grammar's folder, then ``asset_roots``."""
-    if asset_roots is not None:
-        return [Path(r) for r in asset_roots]
-    meta = record.get("meta")
-    if not isinstance(meta, Mapping):
-        return []
-    roots = [Path(meta["grammar"]).parent] if meta.get("grammar") else []
-    return roots + [Path(r) for r in meta.get("asset_roots", ())]
-
-
-# ------------------------------------------------------------------------------------------ polygons
-
-
-def triangulate_polygons(vertices: np.ndarray, ring_offsets: np.ndarray,
-                         face_offsets: np.ndarray) -> np.ndarray:
-    """Triangles of planar polygons with holes, facing along each outline's Newell normal.
-
-    Parameters
-    ----------
-    vertices : (V, 3) float
-        Ring vertices, ring after ring.
-    ring_offsets : (R+1,) int64
-        Ring ``r`` is ``vertices[ring_offsets[r]:ring_offsets[r+1]]``.
-    face_offsets : (F+1,) int64
-        Face ``f`` is rings ``face_offsets[f]:face_offsets[f+1]``: its outline, then its holes.
-
-    Returns
-    -------
-    (T, 3) int64
-        Indices into ``vertices``; the convex faces without holes first (fans), then the others
-        (mapbox-earcut), each group in face order. A face whose outline has no area gives none.
-
-    Examples
-    --------
-    >>> square = np.array([[0, 0, 0], [0, 0, 4], [4, 0, 4], [4, 0, 0],   # outline, normal +y
-    ...                    [1, 0, 1], [3, 0, 1], [3, 0, 3], [1, 0, 3]], float)  # hole
-    >>> triangulate_polygons(square, np.array([0, 4, 8]), np.array([0, 2])).shape
-    (8, 3)
-    """
-    vertices = np.asarray(vertices, np.float64)
-    ring_offsets = np.asarray(ring_offsets, np.int64)
-    face_offsets = np.asarray(face_offsets, np.int64)
-    n_faces = len(face_offsets) - 1
-    if n_faces == 0:
-        return np.zeros((0, 3), np.int64)
-    ring_counts = np.diff(ring_offsets)
-    n_rings = len(ring_counts)
-    ring = np.repeat(np.arange(n_rings), ring_counts)  # (V,) ring of each vertex
-    start = ring_offsets[:-1][ring]
-    at = np.arange(len(vertices))
-    after = np.where(at + 1 < start + ring_counts[ring], at + 1, start)  # successor in the ring
-    before = np.where(at > start, at - 1, start + ring_counts[ring] - 1)
-    local = vertices - vertices[start]  # relative to each ring's first vertex: no loss far from 0
-    newell = segment_reduce(np.add, np.cross(local, local[after]), ring_offsets, 0.0)  # (R, 3)
-    outline = face_offsets[:-1]  # (F,) the outline ring of each face
-    normal = newell[outline]  # (F, 3), twice the outline's vector area
-    face_of_ring = np.repeat(np.arange(n_faces), np.diff(face_offsets))
-    has_area = np.linalg.norm(normal, axis=1) > 0
-
-    # Convex: every turn of the outline is to the left of the normal (or straight).
-    e_in = vertices[at] - vertices[before]
-    e_out = vertices[after] - vertices[at]
-    n_vertex = normal[face_of_ring[ring]]
-    turn = np.einsum("vi,vi->v", np.cross(e_in, e_out), n_vertex)
-    slack = _CONVEX * np.linalg.norm(e_in, axis=1) * np.linalg.norm(e_out, axis=1)
-    slack *= np.linalg.norm(n_vertex, axis=1)
-    concave_ring = segment_reduce(np.add, (turn < -slack).astype(np.int64), ring_offsets, 0) > 0
-    single = np.diff(face_offsets) == 1
-    fan = has_area & single & ~concave_ring[outline] & (ring_counts[outline] >= 3)
-    triangles = [_fans(ring_offsets[outline[fan]], ring_counts[outline[fan]])]
-
-    rest = np.flatnonzero(has_area & ~fan)
-    if len(rest):
-        triangles.append(_earcut_faces(vertices, ring_offsets, face_offsets, normal, rest))
-    return np.concatenate(triangles)
-
-
-def _fans(starts: np.ndarray, counts: np.ndarray) -> np.ndarray:
-    """(sum(counts - 2), 3) int64 fan triangles (s, s+i+1, s+i+2) of rings at ``starts``, ``counts``."""
-    parent, index = fan_out(counts - 2)
-    first = starts[parent]
-    return np.stack([first, first + index + 1, first + index + 2], axis=1)
-
-
-def _earcut_faces(vertices: np.ndarray, ring_offsets: np.ndarray, face_offsets: np.ndarray,
-                  normal: np.ndarray, faces: np.ndarray) -> np.ndarray:
-    """Triangles of ``faces`` (k,) by mapbox-earcut, in each face's plane, turned along its normal."""
-    try:
-        import mapbox_earcut
-    except ImportError as error:
-        raise UsageError("triangulating concave polygons and polygons with holes needs mapbox-earcut: "
-                         "pip install mapbox-earcut") from error
-    unit = normal[faces] / np.linalg.norm(normal[faces], axis=1, keepdims=True)  # (k, 3)
-    # In-plane axes u, v with u x v = n: cross n with the world axis it is least aligned with.
-    helper = np.eye(3)[np.argmin(np.abs(unit), axis=1)]
-    u = np.cross(unit, helper)
-    u /= np.linalg.norm(u, axis=1, keepdims=True)
-    v = np.cross(unit, u)
-    out = []
-    for k, f in enumerate(faces):
-        first, last = ring_offsets[face_offsets[f]], ring_offsets[face_offsets[f + 1]]
-        points = vertices[first:last] - vertices[first]
-        plane = np.stack([points @ u[k], points @ v[k]], axis=1)
-        ends = (ring_offsets[face_offsets[f] + 1 : face_offsets[f + 1] + 1] - first).astype(np.uint32)
-        tris = mapbox_earcut.triangulate_float64(plane, ends).astype(np.int64).reshape(-1, 3)
-        a, b, c = plane[tris[:, 0]], plane[tris[:, 1]], plane[tris[:, 2]]
-        clockwise = (b[:, 0] - a[:, 0]) * (c[:, 1] - a[:, 1]) - (b[:, 1] - a[:, 1]) * (c[:, 0] - a[:, 0]) < 0
-        tris[clockwise] = tris[clockwise][:, [0, 2, 1]]
-        out.append(tris + first)
-    return np.concatenate(out)
-
-
 # -------------------------------------------------------------------------------------------- writers
 
 
@@ -629,6 +262,8 @@ class BakedWriter(WriterBlock):
     """
 
     FORMATS: ClassVar[dict[str, str]] = {".obj": "obj", ".ply": "ply", ".stl": "stl", ".glb": "glb"}
+    #: It writes baked meshes: what ``--bake`` asks for (``grammarc.io.writers``).
+    bakes: ClassVar[bool] = True
 
     def __init__(self, path: str | os.PathLike, *, assets: Sequence[str], symbols: Sequence[str],
                  meta: dict, asset_roots: Sequence[str | os.PathLike] | None = None,
@@ -773,3 +408,6 @@ class BakedWriter(WriterBlock):
         data = mesh.export(file_type=self._file_type)
         return data if isinstance(data, bytes) else data.encode("utf-8")
 
+
+#: The extensions this module writes (``grammarc.io.writers``): all baked.
+WRITERS = dict.fromkeys(BakedWriter.FORMATS, BakedWriter)

@@ -4,7 +4,7 @@ One binary glTF (GLB) whose scene has a node per tile of the city (``io.instanci
 the tile's corner (JSON numbers: exact), and under it a node per (asset, colour) group carrying the
 group's instances in ``EXT_mesh_gpu_instancing``: ``TRANSLATION``, ``ROTATION`` and ``SCALE``
 accessors, float32 relative to the tile. Each asset is one mesh of the file, in its unit box (as
-``io.bake`` loads it); each colour is a material whose ``baseColorFactor`` is the record's colour
+``model.assets`` loads it); each colour is a material whose ``baseColorFactor`` is the record's colour
 (converted from sRGB to glTF's linear factors), so colours show in any viewer. A tile with more than
 ``MAX_GROUPS`` (asset, colour) groups, which a grammar colouring each shape at random makes, groups by
 asset only and draws them white: a node per colour would make the file a node per instance. Normals are
@@ -35,7 +35,9 @@ import numpy as np
 from grammarc.errors import UsageError
 from grammarc.io.instancing import TILE_SIZE, Tile, TiledWriter, compose, decompose
 
-__all__ = ["MAX_BYTES", "MAX_GROUPS", "GltfWriter", "index_path", "part_paths", "read_glb", "written_parts"]
+__all__ = [
+    "MAX_BYTES", "MAX_GROUPS", "WRITERS", "GltfWriter", "index_path", "part_paths", "read_glb", "written_parts",
+]
 
 #: GLB's 32-bit length fields, less room for the JSON chunk.
 MAX_BYTES = (1 << 32) - (64 << 20)
@@ -81,7 +83,7 @@ class GltfWriter(TiledWriter):
     tile_size : float
         Edge of a tile in metres.
     lod : str, optional
-        Level of detail of the asset meshes (``io.bake.load_asset``).
+        Level of detail of the asset meshes (``model.assets.load_asset``).
     max_bytes : int
         The largest binary chunk of one part.
     """
@@ -115,6 +117,10 @@ class GltfWriter(TiledWriter):
         for out, path in zip(staged, paths):
             os.replace(out, path)
         return {"parts": len(parts)}
+
+
+#: The extension this module writes (``grammarc.io.writers``); ``--bake`` writes it with ``io.bake`` instead.
+WRITERS = {".glb": GltfWriter}
 
 
 class _Part:

@@ -32,8 +32,10 @@ import numba as nb
 import numpy as np
 
 from grammarc.constants import LIMITS
+from grammarc.geometry.triangulation import triangulate_polygons
 from grammarc.io import WriterBlock
-from grammarc.io.npz import WHITE, TerminalChunk
+from grammarc.model.assets import asset_library
+from grammarc.model.records import WHITE, TerminalChunk
 
 __all__ = ["INSTANCE", "TRIANGLE", "Tile", "TileSpool", "TiledWriter", "decompose"]
 
@@ -166,7 +168,7 @@ class TileSpool:
 
     ``add`` groups a chunk's rows by tile with one stable sort and appends each group to its tile's
     file (the record's order is kept inside a tile); the polygons of the mesh table are triangulated
-    first (``bake.triangulate_polygons``) and go to the tile of their first vertex. ``tiles()`` reads
+    first (``geometry.triangulation``) and go to the tile of their first vertex. ``tiles()`` reads
     the tiles back one at a time in key order.
     """
 
@@ -193,8 +195,6 @@ class TileSpool:
 
         mesh = chunk.mesh
         if len(mesh.face_offsets) > 1:
-            from grammarc.io.bake import triangulate_polygons
-
             vertices = np.asarray(mesh.vertices, np.float64)
             faces = triangulate_polygons(vertices, mesh.ring_offsets, mesh.face_offsets)
             face_of_vertex = np.repeat(np.arange(len(mesh.face_offsets) - 1),
@@ -252,8 +252,6 @@ class TiledWriter(WriterBlock):
 
     def __init__(self, path: str | os.PathLike, *, assets: Sequence[str], meta: dict,
                  asset_roots: Sequence[str | os.PathLike] | None, tile_size: float, lod: str | None):
-        from grammarc.io.bake import asset_library
-
         self.path = Path(path)
         self._meta = dict(meta)
         self._library = asset_library(assets, {"meta": self._meta}, asset_roots, lod=lod)

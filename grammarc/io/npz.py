@@ -1,8 +1,8 @@
 """The terminal record ``instances.npz``: a streaming, atomic writer and its reader.
 
-A city's terminals (10^7-10^8 rows, gigabytes) arrive chunk by chunk from the derivation, and the writer must
-hold no more than a few chunks in memory (DESIGN.md, invariant 3). ``np.savez`` needs every array whole, so the
-writer builds the zip itself, as the rows arrive:
+A city's terminals (10^7-10^8 rows, gigabytes) arrive chunk by chunk from the derivation
+(``model.records``), and the writer must hold no more than a few chunks in memory (DESIGN.md, invariant 3).
+``np.savez`` needs every array whole, so the writer builds the zip itself, as the rows arrive:
 
 * ``xform`` (48 of the 60 bytes of a row) is written once, straight into the output: it is the first member of
   the file, its local header and ``.npy`` header are written up front with a placeholder shape and sizes of fixed
@@ -44,8 +44,8 @@ import struct
 import tempfile
 import threading
 import weakref
+import zipfile
 from collections.abc import Sequence
-from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -54,10 +54,16 @@ import numpy as np
 # zlib's CRC-32 with SIMD (3x as fast: every record byte passes it), and its crc32_combine
 from zlib_ng.zlib_ng import crc32, crc32_combine
 
+from grammarc.errors import UsageError
+
+# MeshChunk and TerminalChunk stay importable here for the backend (derive, terminals, mesh_shapes) and the
+# benchmarks until they import grammarc.model.records.
+from grammarc.model.records import MeshChunk, TerminalChunk  # noqa: F401
+
 if TYPE_CHECKING:
     from typing_extensions import Self
 
-__all__ = ["InstanceWriter", "MeshChunk", "TerminalChunk", "read_instances"]
+__all__ = ["WRITERS", "InstanceWriter", "load_record", "read_instances"]
 
 _FORMAT = "grammarc.instances/1"
 _FADVISE = hasattr(os, "posix_fadvise")  # Linux: DONTNEED starts the writeback of a range, drops clean pages
@@ -89,111 +95,6 @@ _KEYS = (
     "assets", "asset", "xform", "lot", "symbols", "symbol", "color", "meta",
     "mesh_vertices", "mesh_ring_offsets", "mesh_face_offsets", "mesh_lot", "mesh_symbol", "mesh_color",
 )  # fmt: skip
-#: Colour of rows that carry none: opaque white (RGBA).
-WHITE = np.array([255, 255, 255, 255], np.uint8)
-
-
-# eq=False: the generated __eq__ would compare arrays elementwise and fail on truth testing.
-@dataclass(frozen=True, eq=False)
-class MeshChunk:
-    """Leaf polygons that cannot be instances: faces with holes, in world coordinates.
-
-    Attributes
-    ----------
-    vertices : (V, 3) float32
-        Ring vertices, ring after ring.
-    ring_offsets : (R+1,) int64
-        Ring ``r`` is ``vertices[ring_offsets[r]:ring_offsets[r+1]]`` (Arrow-style, starts at 0).
-    face_offsets : (F+1,) int64
-        Face ``f`` is rings ``face_offsets[f]:face_offsets[f+1]``: its outline, then its holes.
-    lot : (F,) int32
-        Lot of each face.
-    symbol : (F,) int32
-        Symbol of each face, an index into the writer's ``symbols``.
-    color : (F, 4) uint8, optional
-        RGBA colour of each face (CityEngine's ``color``); None: white.
-    """
-
-    vertices: np.ndarray
-    ring_offsets: np.ndarray
-    face_offsets: np.ndarray
-    lot: np.ndarray
-    symbol: np.ndarray
-    color: np.ndarray | None = None
-
-    def colors(self) -> np.ndarray:
-        """(F, 4) uint8: the faces' colours, white where none was given."""
-        if self.color is not None:
-            return self.color
-        return _white(len(self.lot))
-
-    @staticmethod
-    def empty() -> MeshChunk:
-        """A chunk without faces: zero-length arrays of the right dtypes, offsets ``[0]``."""
-        return MeshChunk(
-            vertices=np.zeros((0, 3), np.float32),
-            ring_offsets=np.zeros(1, np.int64),
-            face_offsets=np.zeros(1, np.int64),
-            lot=np.zeros(0, np.int32),
-            symbol=np.zeros(0, np.int32),
-            color=np.zeros((0, 4), np.uint8),
-        )
-
-    @staticmethod
-    def concat(chunks: Sequence[MeshChunk]) -> MeshChunk:
-        """The faces of ``chunks``, in order, as one chunk whose offsets index the joined arrays."""
-        if not chunks:
-            return MeshChunk.empty()
-        n_vertices = np.array([len(c.vertices) for c in chunks], np.int64)
-        n_rings = np.array([len(c.ring_offsets) - 1 for c in chunks], np.int64)
-        n_faces = np.array([len(c.face_offsets) - 1 for c in chunks], np.int64)
-        return MeshChunk(
-            vertices=np.concatenate([c.vertices for c in chunks]),
-            ring_offsets=_join_offsets([c.ring_offsets for c in chunks], n_vertices, n_rings),
-            face_offsets=_join_offsets([c.face_offsets for c in chunks], n_rings, n_faces),
-            lot=np.concatenate([c.lot for c in chunks]),
-            symbol=np.concatenate([c.symbol for c in chunks]),
-            color=np.concatenate([c.colors() for c in chunks]),
-        )
-
-
-def _join_offsets(offsets: list[np.ndarray], n_items: np.ndarray, n_groups: np.ndarray) -> np.ndarray:
-    """Join per-chunk offsets, shifting each chunk's by the items (vertices, rings) of the chunks before it."""
-    # n_items [3, 5], n_groups [1, 2]: bases [0, 3], repeated per group [0, 3, 3], added to the offsets
-    # without their leading 0: [3] + [2, 5] -> [3, 5, 8], and 0 in front.
-    bases = np.cumsum(n_items) - n_items
-    tails = np.concatenate([o[1:] for o in offsets]) + np.repeat(bases, n_groups)
-    return np.concatenate([np.zeros(1, np.int64), tails])
-
-
-@dataclass(frozen=True, eq=False)
-class TerminalChunk:
-    """A batch of terminals: instances of assets, and the leaf polygons that could not be instances.
-
-    Attributes
-    ----------
-    asset : (n,) int32
-        Index into the writer's ``assets``.
-    xform : (n, 3, 4) float32
-        Affine map from the asset's unit box to world: ``world = xform[:, :, :3] @ p + xform[:, :, 3]``.
-    lot : (n,) int32
-        Lot (initial shape) of each instance.
-    symbol : (n,) int32
-        Index into the writer's ``symbols``: the shape's symbol when it became a terminal.
-    mesh : MeshChunk
-        Faces of this batch that are not instances.
-    color : (n, 4) uint8, optional
-        RGBA colour of each instance (CityEngine's ``color``); None: white.
-    """
-
-    asset: np.ndarray
-    xform: np.ndarray
-    lot: np.ndarray
-    symbol: np.ndarray
-    mesh: MeshChunk
-    color: np.ndarray | None = None
-
-
 class InstanceWriter:
     """Streams TerminalChunks into an .npz; the output appears complete on close() or not at all.
 
@@ -216,6 +117,7 @@ class InstanceWriter:
     Examples
     --------
     >>> import tempfile
+    >>> from grammarc.model.records import MeshChunk, TerminalChunk
     >>> tmp = tempfile.TemporaryDirectory()
     >>> path = os.path.join(tmp.name, "city.npz")
     >>> chunk = TerminalChunk(
@@ -377,6 +279,30 @@ def read_instances(path: str | os.PathLike) -> dict[str, np.ndarray | dict]:
     return record
 
 
+#: The extension this module writes (``grammarc.io.writers``).
+WRITERS = {".npz": InstanceWriter}
+
+
+def load_record(path: str | os.PathLike) -> dict[str, np.ndarray | dict]:
+    """``read_instances`` of a record the user named (``grammarc render``): every problem a UsageError.
+
+    Raises
+    ------
+    UsageError
+        If ``path`` is not a file, not a zip (so not an .npz), or not an instance record this version
+        reads.
+    """
+    if not Path(path).is_file():
+        raise UsageError(f"record `{path}` not found")
+    # np.load takes any other file for a pickle, and says so: name the actual problem instead.
+    if not zipfile.is_zipfile(path):
+        raise UsageError(f"`{path}` is not an instance record (not an .npz file)")
+    try:
+        return read_instances(path)
+    except (OSError, ValueError, EOFError, KeyError, zipfile.BadZipFile) as error:
+        raise UsageError(f"cannot read record `{path}`: {error}") from error
+
+
 def _names(field: str, names: Sequence[str]) -> np.ndarray:
     """``names`` as a numpy unicode array ``(k,)``, after checking they are unique strings."""
     names = list(names)
@@ -396,7 +322,7 @@ def _validate(chunk: TerminalChunk, n_assets: int, n_symbols: int) -> dict[str, 
         ("lot", "TerminalChunk.lot", chunk.lot),
         ("symbol", "TerminalChunk.symbol", chunk.symbol),
         ("color", "TerminalChunk.color",
-         chunk.color if chunk.color is not None else _white(len(chunk.asset))),
+         chunk.colors()),
         ("mesh_vertices", "MeshChunk.vertices", chunk.mesh.vertices),
         ("mesh_ring_offsets", "MeshChunk.ring_offsets", chunk.mesh.ring_offsets),
         ("mesh_face_offsets", "MeshChunk.face_offsets", chunk.mesh.face_offsets),
@@ -425,17 +351,6 @@ def _validate(chunk: TerminalChunk, n_assets: int, n_symbols: int) -> dict[str, 
     for key in _OFFSETS:
         columns[key] = columns[key][1:]
     return columns
-
-
-_WHITE_ROWS = [np.zeros((0, 4), np.uint8)]
-
-
-def _white(n: int) -> np.ndarray:
-    """(n, 4) opaque white, C-contiguous: a view of one block kept for the chunks that follow, where a
-    broadcast white would be copied for every chunk (0.4 s of the facade benchmark's 10^5 lots)."""
-    if len(_WHITE_ROWS[0]) < n:
-        _WHITE_ROWS[0] = np.full((max(n, 2 * len(_WHITE_ROWS[0])), 4), 255, np.uint8)
-    return _WHITE_ROWS[0][:n]
 
 
 def _column(field: str, value, dtype: str, row_shape: tuple) -> np.ndarray:

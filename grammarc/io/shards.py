@@ -25,7 +25,7 @@ from pathlib import Path
 import numba
 import numpy as np
 
-from grammarc.io.atomic import replacing
+from grammarc.atomic import replacing
 
 __all__ = ["is_manifest", "manifest_path", "read_manifest", "shard_outputs", "shards_folder"]
 
@@ -96,7 +96,7 @@ def complete_shard(folder: Path, number: int, key: str) -> dict | None:
 
 
 def write_json(path: Path, value: dict) -> None:
-    """Write JSON to ``path`` atomically (``atomic.replacing``)."""
+    """Write JSON to ``path`` atomically (``grammarc.atomic.replacing``)."""
     with replacing(path) as tmp:
         tmp.write_text(json.dumps(value, indent=1))
 

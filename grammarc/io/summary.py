@@ -21,9 +21,10 @@ from pathlib import Path
 import numpy as np
 
 from grammarc.errors import AssetError
-from grammarc.io.bake import asset_library, count_triangles
+from grammarc.io.bake import count_triangles
 from grammarc.io.npz import read_instances
 from grammarc.io.shards import is_manifest, manifest_path, shard_outputs
+from grammarc.model.assets import asset_library
 
 __all__ = ["format_summary", "summarize"]
 

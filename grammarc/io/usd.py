@@ -16,9 +16,9 @@ The layout, for ``city.usdc``::
   (and ``displayOpacity``) of vertex interpolation, which prototypes inherit, and ``grammarc:lot`` and
   ``grammarc:symbol``. Its ``prototypes`` are children of the instancer referencing the prototype
   layer, one for each asset the tile uses.
-* **Prototypes**: the asset meshes as ``io.bake`` loads them (OBJ and other formats through trimesh,
-  built-ins generated), fitted to the unit box as CityEngine fits an inserted asset to its scope;
-  ``subdivisionScheme`` is ``none`` (they are polygon models, not subdivision cages).
+* **Prototypes**: the asset meshes as ``model.assets`` loads them (OBJ by its own reader, other formats
+  through trimesh, built-ins generated), fitted to the unit box as CityEngine fits an inserted asset to its
+  scope; ``subdivisionScheme`` is ``none`` (they are polygon models, not subdivision cages).
 * **Meshes**: the mesh table's polygons (leaves that are not instances) triangulated, one Mesh per
   tile with a colour per face.
 
@@ -42,12 +42,11 @@ import numpy as np
 from grammarc.errors import UsageError
 from grammarc.io.instancing import TILE_SIZE, Tile, TiledWriter, compose, decompose
 
-try:  # the `usd` extra: this module is imported only for a USD output, and says what to install
-    from pxr import Gf, Sdf, Tf, Usd, UsdGeom, Vt
-except ImportError:
-    Gf = Sdf = Tf = Usd = UsdGeom = Vt = None
+# usd-core's modules (the `usd` extra), imported by _require_pxr when USD is first written or read: the writer
+# registry imports this module for every output, which must not load usd-core.
+Gf = Sdf = Tf = Usd = UsdGeom = Vt = None
 
-__all__ = ["UsdWriter", "read_usd", "tiles_folder", "write_shards_root"]
+__all__ = ["WRITERS", "UsdWriter", "read_usd", "tiles_folder", "write_shards_root"]
 
 
 def tiles_folder(path: str | os.PathLike) -> Path:
@@ -58,8 +57,15 @@ def tiles_folder(path: str | os.PathLike) -> Path:
 
 
 def _require_pxr() -> None:
-    if Usd is None:
-        raise UsageError("writing USD needs usd-core: pip install 'grammarc[usd]' (or pip install usd-core)")
+    """Import usd-core's modules into this module's globals, or say which extra to install."""
+    global Gf, Sdf, Tf, Usd, UsdGeom, Vt
+    if Usd is not None:
+        return
+    try:
+        from pxr import Gf, Sdf, Tf, Usd, UsdGeom, Vt
+    except ImportError as error:
+        raise UsageError("writing USD needs usd-core: pip install 'grammarc[usd]' (or pip install usd-core)") \
+            from error
 
 
 class UsdWriter(TiledWriter):
@@ -79,14 +85,14 @@ class UsdWriter(TiledWriter):
     tile_size : float
         Edge of a tile in metres.
     lod : str, optional
-        Level of detail of the prototypes (``io.bake.load_asset``).
+        Level of detail of the prototypes (``model.assets.load_asset``).
     """
 
     def __init__(self, path: str | os.PathLike, *, assets: Sequence[str], symbols: Sequence[str], meta: dict,
                  asset_roots: Sequence[str | os.PathLike] | None = None, tile_size: float = TILE_SIZE,
                  lod: str | None = None):
         _require_pxr()
-        if Path(path).suffix.lower() not in (".usda", ".usdc", ".usd"):
+        if Path(path).suffix.lower() not in WRITERS:
             raise UsageError(f"cannot write `{path}` as USD: use .usda, .usdc or .usd")
         super().__init__(path, assets=assets, meta=meta, asset_roots=asset_roots, tile_size=tile_size, lod=lod)
         self._ext = ".usda" if self.path.suffix.lower() == ".usda" else ".usdc"
@@ -185,6 +191,10 @@ class UsdWriter(TiledWriter):
         os.replace(out / self.path.name, self.path)
         if old is not None:
             shutil.rmtree(old, ignore_errors=True)
+
+
+#: The extensions this module writes (``grammarc.io.writers``).
+WRITERS = dict.fromkeys((".usda", ".usdc", ".usd"), UsdWriter)
 
 
 def write_shards_root(output: Path, manifest: dict) -> None:

@@ -1,10 +1,12 @@
 """``render``: a shaded picture of an instance record, drawn on the CPU and written as a PNG.
 
-The record's instances are drawn by ``raster.draw_instances`` in record order, each as a splat, a box or its
-asset's triangles by its size on screen (see ``raster``), then the mesh table's polygons, triangulated by
-``io.bake.triangulate_polygons``. Asset meshes come from ``io.bake.asset_library``, as the mesh writers load
-them; a file asset that cannot be found or read is drawn as its instances' boxes and named in the result,
-so a record moved away from its grammar still gives a picture.
+``render`` takes the record's columns, a mapping (the command line reads the file with ``io.npz``):
+drawing knows no file format. The record's instances are drawn by ``raster.draw_instances`` in record
+order, each as a splat, a box or its asset's triangles by its size on screen (see ``raster``), then the
+mesh table's polygons, triangulated by ``geometry.triangulation`` as the mesh writers triangulate them.
+Asset meshes come from ``model.assets``, loaded as the writers load them; a file asset that cannot be
+found or read is drawn as its instances' boxes and named in the result, so a record moved away from its
+grammar still gives a picture.
 
 Colours: ``"material"`` is the record's colour of each instance and face (CityEngine's ``color``, white by
 default); ``"symbol"`` and ``"asset"`` colour by the symbol or asset index from ``palette`` (mesh faces,
@@ -17,19 +19,19 @@ into the PNG, so the same record gives the same bytes.
 from __future__ import annotations
 
 import os
-import zipfile
 from collections.abc import Mapping, Sequence
 from pathlib import Path
 
 import numpy as np
 
+from grammarc.atomic import replacing
 from grammarc.errors import AssetError, UsageError
-from grammarc.io.atomic import replacing
-from grammarc.io.bake import asset_library, builtin_mesh, triangulate_polygons
+from grammarc.geometry.triangulation import triangulate_polygons
+from grammarc.model.assets import asset_library, builtin_mesh
 from grammarc.render.camera import VIEWS, Camera, fit_camera
 from grammarc.render.raster import draw_instances, draw_triangles
 
-__all__ = ["COLORS", "SKY", "palette", "parse_size", "render"]
+__all__ = ["COLORS", "SKY", "palette", "parse_size", "png_path", "render"]
 
 #: The colourings ``render`` takes.
 COLORS = ("material", "symbol", "asset")
@@ -46,17 +48,20 @@ DETAIL_PX = 24.0
 MAX_SIDE = 16384
 
 
-def render(record, path, *, size: tuple[int, int] = (1600, 1000), view: str = "oblique",
+def render(record: Mapping, path, *, size: tuple[int, int] = (1600, 1000), view: str = "oblique",
            color: str = "material", asset_roots: Sequence[str | os.PathLike] = ()) -> dict:
     """Draw the city of an instance record and write it to ``path`` as a PNG.
 
     Parameters
     ----------
-    record : path-like or mapping
-        An instance record file (``io.npz``), or the dict ``read_instances`` returns for one.
+    record : mapping
+        The record's columns: ``assets`` (A,) str, ``asset`` (N,) int, ``xform`` (N, 3, 4) float, and
+        where the record has them ``color`` (N, 4) uint8, ``symbol`` (N,) int, ``meta`` (dict), the mesh
+        table (``mesh_vertices`` (V, 3), ``mesh_ring_offsets`` (R+1,), ``mesh_face_offsets`` (F+1,),
+        ``mesh_color`` (F, 4), ``mesh_symbol`` (F,)): the dict of ``io.npz.read_instances``.
     path : path-like
-        The picture, a ``.png`` in an existing folder; written to a temporary file beside it and moved
-        into place, so it is complete or unchanged.
+        The picture, a ``.png`` in an existing folder (``png_path``); written to a temporary file beside it
+        and moved into place, so it is complete or unchanged.
     size : (int, int)
         Width and height in pixels.
     view : str
@@ -78,20 +83,16 @@ def render(record, path, *, size: tuple[int, int] = (1600, 1000), view: str = "o
     Raises
     ------
     UsageError
-        If the record cannot be read or is not an instance record, an option is wrong, or ``path`` is not
-        a ``.png`` in an existing folder.
+        If the record's columns are missing or disagree, an option is wrong, or ``path`` is not a ``.png``
+        in an existing folder.
     """
     width, height = _checked_size(size)
     if view not in VIEWS:
         raise UsageError(f"view must be one of {', '.join(VIEWS)}, got `{view}`")
     if color not in COLORS:
         raise UsageError(f"color must be one of {', '.join(COLORS)}, got `{color}`")
-    out = Path(path)
-    if out.suffix.lower() != ".png":
-        raise UsageError(f"cannot write `{out}`: the picture is a PNG, name it `.png`")
-    if not out.parent.is_dir():
-        raise UsageError(f"cannot write `{out}`: folder `{out.parent}` does not exist")
-    record = _read(record)
+    out = png_path(path)
+    record = _columns(record)
     names, asset, xform = record["assets"], record["asset"], record["xform"]
     vertices, ring_offsets, face_offsets = record["mesh"]
 
@@ -127,6 +128,17 @@ def render(record, path, *, size: tuple[int, int] = (1600, 1000), view: str = "o
         "meshes": int(counts[2]),
         "missing_assets": missing,
     }
+
+
+def png_path(path: str | os.PathLike) -> Path:
+    """``path`` as the picture's path, checked: a ``.png`` in an existing folder, else a UsageError (the
+    command line checks it before it reads the record)."""
+    out = Path(path)
+    if out.suffix.lower() != ".png":
+        raise UsageError(f"cannot write `{out}`: the picture is a PNG, name it `.png`")
+    if not out.parent.is_dir():
+        raise UsageError(f"cannot write `{out}`: folder `{out.parent}` does not exist")
+    return out
 
 
 def parse_size(text: str) -> tuple[int, int]:
@@ -169,22 +181,13 @@ def _checked_size(size) -> tuple[int, int]:
     return width, height
 
 
-def _read(record) -> dict:
+def _columns(record: Mapping) -> dict:
     """The columns ``render`` draws, checked: ``assets`` (list of str), ``asset`` (N,) int32, ``xform``
     (N, 3, 4) float32, ``mesh`` (vertices (V, 3) float64, ring and face offsets int64), ``meta``, and
     ``color``, ``symbol``, ``symbols``, ``mesh_color``, ``mesh_symbol`` where the record has them."""
     if not isinstance(record, Mapping):
-        from grammarc.io.npz import read_instances
-
-        if not Path(record).is_file():
-            raise UsageError(f"record `{record}` not found")
-        # np.load takes any other file for a pickle, and says so: name the actual problem instead.
-        if not zipfile.is_zipfile(record):
-            raise UsageError(f"`{record}` is not an instance record (not an .npz file)")
-        try:
-            record = read_instances(record)
-        except (OSError, ValueError, EOFError, KeyError, zipfile.BadZipFile) as error:
-            raise UsageError(f"cannot read record `{record}`: {error}") from error
+        raise TypeError(f"render takes a record's columns (a mapping, as io.npz.read_instances returns), "
+                        f"not {type(record).__name__}")
     missing = [key for key in ("assets", "asset", "xform") if key not in record]
     if missing:
         raise UsageError(f"not an instance record: no {', '.join(missing)}")

@@ -1,9 +1,8 @@
-"""Baking records into meshes: built-ins, mirrored and flat transforms, polygons with holes, OBJ assets,
-the size guard, and the mesh writers."""
+"""Baking records into meshes: mirrored and flat transforms, polygons with holes, OBJ assets, the size
+guard, and the mesh writers."""
 
 import importlib.util
 import tracemalloc
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -12,18 +11,11 @@ import trimesh
 from grammarc.errors import AssetError, UsageError
 from grammarc.io import OutputOptions, writer_for
 from grammarc.io import bake as bake_module
-from grammarc.io.bake import (
-    BakedWriter,
-    bake,
-    builtin_mesh,
-    count_triangles,
-    load_asset,
-    triangulate_polygons,
-)
-from grammarc.io.npz import InstanceWriter, MeshChunk, TerminalChunk, read_instances
+from grammarc.io.bake import BakedWriter, bake, count_triangles
+from grammarc.io.npz import InstanceWriter, read_instances
+from grammarc.model.assets import builtin_mesh
+from grammarc.model.records import MeshChunk, TerminalChunk
 
-KIT = Path(__file__).resolve().parents[2].parent / "shared" / "prt"
-needs_kit = pytest.mark.skipif(not (KIT / "rpk").is_dir(), reason="PRT kit (../shared/prt) absent")
 needs_earcut = pytest.mark.skipif(importlib.util.find_spec("mapbox_earcut") is None,
                                   reason="mapbox-earcut not installed")
 ASSETS = ["builtin:cube", "builtin:quad", "builtin:cylinder"]
@@ -59,37 +51,6 @@ def mesh_chunk(faces: list[list[np.ndarray]]) -> MeshChunk:
         lot=np.zeros(len(faces), np.int32),
         symbol=np.zeros(len(faces), np.int32),
     )
-
-
-def test_builtins_are_closed_outward_unit_shapes():
-    for name, n_triangles, polygons in (("cube", 12, {4: 6}), ("cylinder", 60, {4: 16, 16: 2})):
-        shape = builtin_mesh(name)
-        mesh = trimesh.Trimesh(shape.vertices, shape.faces, process=False)
-        assert len(mesh.faces) == n_triangles
-        assert mesh.bounds.tolist() == [[0, 0, 0], [1, 1, 1]]
-        assert mesh.volume > 0 and mesh.is_winding_consistent
-        outward = np.einsum("ij,ij->i", mesh.face_normals, mesh.triangles_center - 0.5)
-        assert (outward > 0).all()
-        assert dict(zip(*np.unique(shape.polygon_sizes, return_counts=True))) == polygons
-    quad = builtin_mesh("builtin:quad")
-    normals = trimesh.Trimesh(quad.vertices, quad.faces, process=False).face_normals
-    np.testing.assert_allclose(normals, [[0, 0, 1], [0, 0, 1]], atol=1e-12)
-    with pytest.raises(AssetError, match="unknown built-in"):
-        builtin_mesh("builtin:sphere")
-
-
-@pytest.mark.parametrize("name, volume, sides", [
-    ("L", 5 / 9, 6), ("U", 7 / 9, 8), ("T", 5 / 9, 8), ("H", 7 / 9, 12), ("cylinder6", 0.75, 6),
-    ("cylinder40", np.pi / 4, 40),
-])
-def test_block_and_cylinder_builtins_are_closed_outward_prisms_filling_the_unit_box(name, volume, sides):
-    """The paper's L, H, U, T blocks (wings a third thick) and cylinders of N sides, fitted to [0, 1]^3."""
-    shape = builtin_mesh(f"builtin:{name}")
-    mesh = trimesh.Trimesh(shape.vertices, shape.faces, process=True)
-    assert mesh.is_watertight and mesh.is_winding_consistent
-    assert mesh.bounds.tolist() == [[0, 0, 0], [1, 1, 1]]
-    assert mesh.volume == pytest.approx(volume, rel=0.02 if name.startswith("cylinder") else 1e-12)
-    assert dict(zip(*np.unique(shape.polygon_sizes, return_counts=True))) == {4: sides, sides: 2}
 
 
 def test_cube_instance():
@@ -185,16 +146,6 @@ def test_polygons_with_holes_concave_and_convex():
                              "face_sizes": {4: 2, 5: 1, 6: 1}}
 
 
-def test_convex_faces_are_fans_and_degenerate_faces_vanish():
-    square = np.array([[0, 0, 0], [0, 5, 0], [0, 5, 5], [0, 0, 5.0]])  # normal -x
-    line = np.array([[0, 0, 0], [1, 0, 0], [2, 0, 0.0]])
-    chunk = mesh_chunk([[square], [line]])
-    triangles = triangulate_polygons(chunk.vertices, chunk.ring_offsets, chunk.face_offsets)
-    assert triangles.tolist() == [[0, 1, 2], [0, 2, 3]]
-    no_offsets = np.zeros(1, np.int64)
-    assert triangulate_polygons(np.zeros((0, 3)), no_offsets, no_offsets).shape == (0, 3)
-
-
 def write_obj(path, text: str):
     path.write_text(text, encoding="utf-8")
     return path
@@ -211,22 +162,6 @@ def test_obj_asset_normalized_to_unit_box(tmp_path):
     assert len(mesh.faces) == 4
     assert mesh.metadata["n_polygons"] == 2 and mesh.metadata["face_sizes"] == {4: 2}
     assert count_triangles(shape, [tmp_path]) == 4
-
-
-@needs_kit
-def test_candler_assets(tmp_path):
-    # CityEngine's own assets: each fills the unit box, and counts its OBJ faces as polygons.
-    from grammarc.io.rpk import open_rpk
-
-    pytest.importorskip("py7zr")
-    with open_rpk(KIT / "rpk" / "candler.rpk", tmpdir=tmp_path) as rpk:
-        for path in sorted(rpk.assets_root.rglob("*.obj")):
-            name = path.relative_to(rpk.assets_root).as_posix()
-            shape = load_asset(name, rpk.asset_roots)
-            np.testing.assert_allclose([shape.vertices.min(0), shape.vertices.max(0)], [[0] * 3, [1] * 3])
-            f_lines = [line.split() for line in path.read_text().splitlines() if line.startswith("f ")]
-            assert shape.polygon_sizes.tolist() == [len(f) - 1 for f in f_lines]
-            assert shape.n_triangles == sum(len(f) - 3 for f in f_lines)
 
 
 def test_asset_errors(tmp_path):
@@ -349,19 +284,3 @@ def test_bake_read_instances_with_assets_from_meta(tmp_path):
     assert len(mesh.faces) == 12 + 2 + 12 + 8 + 2
     assert mesh.area == pytest.approx(22 + 4 + 6 + 84 + 9, rel=1e-6)
     assert mesh.metadata["n_polygons"] == 6 + 1 + 6 + 2 + 1
-
-
-def test_obj_bytes_writes_what_read_obj_reads():
-    from grammarc.io.obj import obj_bytes, read_obj
-
-    rng = np.random.default_rng(3)
-    vertices = rng.uniform(-2e4, 2e4, (500, 3))
-    vertices[:3] = [[0.0, -0.0, 4e-7], [-0.5, 12.25, 3.0], [1e6, -1e6, 0.000001]]
-    faces = rng.integers(0, 500, (900, 3))
-    text = obj_bytes(vertices, faces, "grammarc bake").decode()
-    assert text.startswith("# grammarc bake\nv 0 0 0\nv -0.5 12.25 3\nv 1000000 -1000000 0.000001\n")
-    points, read = read_obj(text)
-    np.testing.assert_allclose(points, vertices, atol=5e-7, rtol=0)
-    np.testing.assert_array_equal(np.array(read), faces)
-    with pytest.raises(ValueError, match="finite"):
-        obj_bytes(np.array([[np.nan, 0, 0]]), faces[:0])

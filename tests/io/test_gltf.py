@@ -9,7 +9,7 @@ import trimesh
 from writers_city import city, world
 
 from grammarc.io.gltf import GltfWriter, part_paths
-from grammarc.io.npz import MeshChunk, TerminalChunk
+from grammarc.model.records import MeshChunk, TerminalChunk
 
 pygltflib = pytest.importorskip("pygltflib")
 

@@ -6,7 +6,7 @@ from scipy.spatial.transform import Rotation
 from writers_city import world
 
 from grammarc.io.instancing import INSTANCE, TileSpool, decompose
-from grammarc.io.npz import MeshChunk, TerminalChunk
+from grammarc.model.records import MeshChunk, TerminalChunk
 
 
 def transforms(n: int, seed: int = 1) -> np.ndarray:

@@ -16,8 +16,10 @@ import zlib
 import numpy as np
 import pytest
 
+from grammarc.errors import UsageError
 from grammarc.io import npz
-from grammarc.io.npz import InstanceWriter, MeshChunk, TerminalChunk, read_instances
+from grammarc.io.npz import InstanceWriter, load_record, read_instances
+from grammarc.model.records import MeshChunk, TerminalChunk
 
 ASSETS = ["builtin:cube", "builtin:quad", "facade/window.obj"]
 SYMBOLS = ["Wall", "Window", "Roof", "Ledge"]
@@ -150,30 +152,6 @@ def test_concat_matches_written_mesh(tmp_path, chunks):
     joined = MeshChunk.concat([c.mesh for c in chunks])
     for field in ("vertices", "ring_offsets", "face_offsets", "lot", "symbol"):
         np.testing.assert_array_equal(getattr(joined, field), record[f"mesh_{field}"])
-
-
-def test_concat_shifts_offsets():
-    triangle = MeshChunk(
-        vertices=np.zeros((3, 3), np.float32),
-        ring_offsets=np.array([0, 3], np.int64),
-        face_offsets=np.array([0, 1], np.int64),
-        lot=np.array([0], np.int32),
-        symbol=np.array([0], np.int32),
-    )
-    square_with_hole = MeshChunk(
-        vertices=np.ones((7, 3), np.float32),
-        ring_offsets=np.array([0, 4, 7], np.int64),
-        face_offsets=np.array([0, 2], np.int64),
-        lot=np.array([1], np.int32),
-        symbol=np.array([2], np.int32),
-    )
-    joined = MeshChunk.concat([triangle, MeshChunk.empty(), square_with_hole, triangle])
-    assert joined.ring_offsets.tolist() == [0, 3, 7, 10, 13]
-    assert joined.face_offsets.tolist() == [0, 1, 3, 4]
-    assert joined.lot.tolist() == [0, 1, 0]
-    assert joined.vertices.shape == (13, 3)
-    empty = MeshChunk.concat([])
-    assert empty.ring_offsets.tolist() == [0] and empty.face_offsets.tolist() == [0]
 
 
 def test_loads_with_plain_np_load(tmp_path, chunks):
@@ -404,6 +382,34 @@ def test_read_instances_refuses_other_npz(tmp_path):
 
 
 # The writer's internals: the zip and .npy records it writes by hand, and its background thread.
+
+
+def bad_record(directory, kind):
+    """A path that is no instance record: absent, a folder, a text file, another npz."""
+    if kind == "text":
+        (directory / "text.npz").write_text("hello")
+        return directory / "text.npz"
+    if kind == "other npz":
+        np.savez(directory / "other.npz", a=np.zeros(2))
+        return directory / "other.npz"
+    return directory / "none.npz" if kind == "absent" else directory
+
+
+@pytest.mark.parametrize(("kind", "message"), [
+    ("absent", "record `.*none.npz` not found"),
+    ("folder", "record `.*` not found"),
+    ("text", "`.*text.npz` is not an instance record \\(not an .npz file\\)"),
+    ("other npz", "cannot read record `.*other.npz`: .*no 'meta' member"),
+])
+def test_load_record_names_the_problem_in_a_usage_error(tmp_path, kind, message):
+    with pytest.raises(UsageError, match=message):
+        load_record(bad_record(tmp_path, kind))
+
+
+def test_load_record_reads_an_instance_record(tmp_path, chunks):
+    write(tmp_path / "city.npz", chunks)
+    record = load_record(tmp_path / "city.npz")
+    np.testing.assert_array_equal(record["lot"], read_instances(tmp_path / "city.npz")["lot"])
 
 
 def writer_threads():

@@ -4,7 +4,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from grammarc.io.npz import InstanceWriter, MeshChunk, TerminalChunk
+from grammarc.io.npz import InstanceWriter
+from grammarc.model.records import MeshChunk, TerminalChunk
 
 #: The background colour, as the PNG stores it.
 SKY = np.array([172, 200, 230], np.uint8)

@@ -32,13 +32,14 @@ def block_city(tmp_path):
     xforms = [box_xform([20 * i, 0, -20 * j - 8], [8, 6, 8]) for i in range(6) for j in range(6)]
     xforms.append(box_xform([42, 0, -48], [6, 40, 6]))
     colors = [GREY] * 36 + [RED]
-    return write_record(tmp_path / "city.npz", xforms, colors=colors), np.array([45.0, 40.0, -45.0])
+    record = read_instances(write_record(tmp_path / "city.npz", xforms, colors=colors))
+    return record, np.array([45.0, 40.0, -45.0])
 
 
 def test_same_record_same_bytes(block_city, tmp_path):
     record, _ = block_city
     render(record, tmp_path / "a.png", size=(320, 200))
-    render(read_instances(record), tmp_path / "b.png", size=(320, 200))
+    render(dict(record), tmp_path / "b.png", size=(320, 200))
     assert (tmp_path / "a.png").read_bytes() == (tmp_path / "b.png").read_bytes()
     assert sorted(p.name for p in tmp_path.iterdir()) == ["a.png", "b.png", "city.npz"]  # no temporaries
 
@@ -59,7 +60,7 @@ def test_the_tower_is_where_the_oblique_camera_puts_it(block_city, tmp_path):
 
 
 def test_top_view_puts_a_unit_cube_in_its_pixel_rectangle(tmp_path):
-    record = write_record(tmp_path / "cube.npz", [box_xform([7, 3, -12], [1, 1, 1])])
+    record = read_instances(write_record(tmp_path / "cube.npz", [box_xform([7, 3, -12], [1, 1, 1])]))
     render(record, tmp_path / "cube.png", size=(200, 100), view="top")
     image = pixels(tmp_path / "cube.png")
     # The cube fills the height less the margins, centred: 92 px a metre, columns 54-146, rows 4-96.
@@ -77,8 +78,8 @@ def test_top_view_puts_a_unit_cube_in_its_pixel_rectangle(tmp_path):
 
 def test_colourings_by_symbol_and_asset_use_the_palette(tmp_path):
     xforms = [box_xform([0, 0, -10], [10, 10, 10]), box_xform([20, 0, -10], [10, 10, 10])]
-    record = write_record(tmp_path / "two.npz", xforms, asset=[0, 1],
-                          assets=["builtin:cube", "builtin:cylinder"])
+    record = read_instances(write_record(tmp_path / "two.npz", xforms, asset=[0, 1],
+                                         assets=["builtin:cube", "builtin:cylinder"]))
     render(record, tmp_path / "asset.png", size=(200, 100), view="top", color="asset")
     render(record, tmp_path / "symbol.png", size=(200, 100), view="top", color="symbol")
     by_asset, by_symbol = pixels(tmp_path / "asset.png"), pixels(tmp_path / "symbol.png")
@@ -104,7 +105,7 @@ def test_a_derived_city_with_mesh_faces(write, tmp_path):
     build(grammar, tmp_path / "city.npz", lots_path=lots)
     record = read_instances(tmp_path / "city.npz")
     assert record["meta"]["counts"]["mesh_faces"] > 0
-    result = render(tmp_path / "city.npz", tmp_path / "top.png", size=(250, 100), view="top", color="symbol")
+    result = render(record, tmp_path / "top.png", size=(250, 100), view="top", color="symbol")
     image = pixels(tmp_path / "top.png")
     camera = fit_camera([0, 0, -20], [50, 9, 0], (250, 100), "top")
     x, y, _ = camera.project([[5, 9, -15]])[0]  # on the L's roof, a mesh face
@@ -117,40 +118,30 @@ def test_a_derived_city_with_mesh_faces(write, tmp_path):
 
 
 def test_a_missing_file_asset_is_drawn_as_boxes(tmp_path):
-    record = write_record(tmp_path / "r.npz", [box_xform([0, 0, -1], [1, 1, 1])], assets=["gone/window.obj"],
-                          meta={"grammar": str(tmp_path / "g.cga")})
+    record = read_instances(write_record(tmp_path / "r.npz", [box_xform([0, 0, -1], [1, 1, 1])],
+                                         assets=["gone/window.obj"], meta={"grammar": str(tmp_path / "g.cga")}))
     result = render(record, tmp_path / "r.png", size=(40, 40), view="top")
     assert result["missing_assets"] == ["gone/window.obj"] and result["boxes"] == 1
     assert not background(pixels(tmp_path / "r.png"))[20, 20]
 
 
 def test_an_empty_record_gives_the_sky(tmp_path):
-    record = write_record(tmp_path / "empty.npz", np.zeros((0, 3, 4)))
+    record = read_instances(write_record(tmp_path / "empty.npz", np.zeros((0, 3, 4))))
     render(record, tmp_path / "empty.png", size=(30, 20))
     assert background(pixels(tmp_path / "empty.png")).all()
 
 
-def bad_record(directory, kind):
-    """A path that is no instance record: absent, a folder, a text file, another npz."""
-    if kind == "text":
-        (directory / "text.npz").write_text("hello")
-        return directory / "text.npz"
-    if kind == "other npz":
-        np.savez(directory / "other.npz", a=np.zeros(2))
-        return directory / "other.npz"
-    return directory / "none.npz" if kind == "absent" else directory
-
-
-@pytest.mark.parametrize(("kind", "message"), [
-    ("absent", "not found"),
-    ("folder", "not found"),
-    ("text", "not an instance record"),
-    ("other npz", "no 'meta' member"),
+@pytest.mark.parametrize(("columns", "message"), [
+    ({"assets": ["builtin:cube"]}, "no asset, xform"),
+    ({"assets": ["builtin:cube"], "asset": [0], "xform": np.zeros((2, 3, 4))}, r"xform is \(2, 3, 4\)"),
+    ({"assets": ["builtin:cube"], "asset": [1], "xform": np.zeros((1, 3, 4))}, "asset index out of range"),
 ])
-def test_a_missing_or_invalid_record_is_a_usage_error(tmp_path, kind, message):
-    with pytest.raises(UsageError, match=message):
-        render(bad_record(tmp_path, kind), tmp_path / "out.png")
+def test_columns_that_are_no_record_are_a_usage_error(tmp_path, columns, message):
+    with pytest.raises(UsageError, match=f"not an instance record: {message}"):
+        render(columns, tmp_path / "out.png")
     assert not (tmp_path / "out.png").exists()
+    with pytest.raises(TypeError, match="a mapping"):
+        render(tmp_path / "city.npz", tmp_path / "out.png")  # files are read by io.npz.load_record
 
 
 @pytest.mark.parametrize(("options", "message"), [

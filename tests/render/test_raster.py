@@ -4,7 +4,7 @@ is drawn, and framing."""
 import numpy as np
 import pytest
 
-from grammarc.io.bake import builtin_mesh
+from grammarc.model.assets import builtin_mesh
 from grammarc.render.camera import MARGIN, fit_camera
 from grammarc.render.raster import draw_instances, draw_triangles, project
 

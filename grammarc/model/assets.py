@@ -1,0 +1,276 @@
+"""Asset meshes: what an inserted asset looks like, in its unit box, for every layer that draws or writes it.
+
+An instance of the record is an asset name and the affine map of the asset's unit box [0, 1]^3 into the
+world. The derivation (which trims inserted geometry), the renderer and every mesh writer need the asset's
+triangles, loaded the same way: so they live on the model floor, below all of them.
+
+Assets, each an ``AssetMesh`` in the unit box [0, 1]^3:
+
+* ``builtin:cube``: the unit cube, 8 vertices, 12 triangles, normals outward;
+* ``builtin:quad``: the unit square on z = 0, normal +z, 2 triangles;
+* ``builtin:cylinder``: axis along y through (0.5, ., 0.5), radius 0.5, y in [0, 1], 16 sides, capped
+  (60 triangles); ``builtin:cylinderN`` the same with N sides;
+* ``builtin:L``, ``H``, ``U``, ``T``: the paper's mass-model blocks, prisms over outlines with wings a
+  third of the box thick;
+* a file (OBJ, or any mesh format trimesh reads), resolved in the asset roots as the compiler resolves it
+  (``resolve_asset``) and loaded (OBJ by ``model.obj``, others with trimesh), then mapped from its bounding
+  box onto [0, 1]^3 as CityEngine fits an inserted asset to the scope. An axis along which the asset is
+  flat stays flat (at 0): there is nothing to stretch.
+
+Polygon counts. Conformance compares face counts with PRT, whose encoder returns polygons, not triangles,
+so an ``AssetMesh`` keeps the polygons it was triangulated from (``polygon_sizes``):
+
+* a built-in counts its faces: cube 6 quads, quad 1, cylinder 16 quads and two 16-gons;
+* an OBJ asset counts its ``f`` lines (trimesh triangulates faces as it loads them, and keeps no count
+  of them), each a polygon of as many vertices as the line has; other formats count triangles.
+"""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+from functools import cache, lru_cache
+from pathlib import Path
+
+import numpy as np
+
+from grammarc.errors import AssetError
+
+# Temporary: the IR resolves asset names (grammarc/ir, after integration); until then they live in io.assets.
+from grammarc.io.assets import builtin_name, resolve_asset
+from grammarc.model.obj import ObjError, read_obj
+
+__all__ = ["LOD_STAND_IN", "AssetLibrary", "AssetMesh", "asset_library", "builtin_mesh", "load_asset"]
+
+#: ``--lod builtin``: a built-in cube stands in for an asset file that is missing.
+LOD_STAND_IN = "builtin"
+#: Sides of ``builtin:cylinder``.
+CYLINDER_SIDES = 16
+#: The paper's mass-model blocks (section 3.1, after Schmitt): outlines in thirds of the unit square, as
+#: (x, z) counter-clockwise seen from +y; wings one third thick.
+BLOCKS = {
+    "L": [(0, 0), (0, 3), (3, 3), (3, 2), (1, 2), (1, 0)],
+    "U": [(0, 0), (0, 3), (3, 3), (3, 0), (2, 0), (2, 2), (1, 2), (1, 0)],
+    "T": [(1, 0), (1, 2), (0, 2), (0, 3), (3, 3), (3, 2), (2, 2), (2, 0)],
+    "H": [(0, 0), (0, 3), (1, 3), (1, 2), (2, 2), (2, 3), (3, 3), (3, 0), (2, 0), (2, 1), (1, 1), (1, 0)],
+}
+#: An asset's extent below this (in its own units) is a flat axis, mapped to 0 rather than stretched.
+_FLAT = 1e-12
+
+
+@dataclass(frozen=True, eq=False)
+class AssetMesh:
+    """An asset's triangles in its unit box, and the polygons they came from.
+
+    Attributes
+    ----------
+    vertices : (v, 3) float64
+        In [0, 1]^3; the bounding box of a non-flat asset is exactly the unit box.
+    faces : (t, 3) int64
+        Triangles, counter-clockwise seen from outside.
+    polygon_sizes : (p,) int64
+        Vertex count of each polygon before triangulation (see the module docstring).
+    """
+
+    vertices: np.ndarray
+    faces: np.ndarray
+    polygon_sizes: np.ndarray
+
+    @property
+    def n_triangles(self) -> int:
+        return len(self.faces)
+
+    @property
+    def n_polygons(self) -> int:
+        return len(self.polygon_sizes)
+
+
+@cache
+def builtin_mesh(name: str) -> AssetMesh:
+    """The mesh of a built-in asset: ``"cube"``, ``"quad"`` or ``"cylinder"`` (``builtin:`` optional).
+
+    Examples
+    --------
+    >>> cube = builtin_mesh("builtin:cube")
+    >>> cube.vertices.shape, cube.faces.shape, cube.n_polygons
+    ((8, 3), (12, 3), 6)
+    """
+    bare = name.removeprefix("builtin:")
+    if bare == "cube":
+        # vertex i has coordinates (i & 1, i >> 1 & 1, i >> 2 & 1); each face's quad counter-clockwise
+        # seen from outside, split along its first diagonal.
+        vertices = np.array([[i & 1, i >> 1 & 1, i >> 2 & 1] for i in range(8)], np.float64)
+        quads = np.array([
+            [0, 4, 6, 2],  # x = 0
+            [1, 3, 7, 5],  # x = 1
+            [0, 1, 5, 4],  # y = 0
+            [2, 6, 7, 3],  # y = 1
+            [0, 2, 3, 1],  # z = 0
+            [4, 5, 7, 6],  # z = 1
+        ])  # fmt: skip
+        return _frozen(vertices, _quads_to_triangles(quads), np.full(6, 4))
+    if bare == "quad":
+        vertices = np.array([[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0]], np.float64)
+        return _frozen(vertices, np.array([[0, 1, 2], [0, 2, 3]]), np.array([4]))
+    if bare in BLOCKS:
+        return _prism(np.array(BLOCKS[bare], dtype=np.float64) / 3.0)
+    if builtin_name(bare) and bare.startswith("cylinder"):
+        k = int(bare.removeprefix("cylinder") or CYLINDER_SIDES)
+        # a = 0 and pi put vertices on x = 0 and 1; increasing a turns counter-clockwise seen from +y
+        angle = 2 * np.pi * np.arange(k) / k
+        return _prism(np.stack([0.5 + 0.5 * np.cos(angle), 0.5 - 0.5 * np.sin(angle)], axis=1))
+    raise AssetError(f"unknown built-in asset `{name}` (built-ins: cube, quad, cylinder, cylinderN, L, H, U, T)")
+
+
+def _prism(outline: np.ndarray) -> AssetMesh:
+    """The prism over ``outline`` ((k, 2) as (x, z), counter-clockwise seen from +y) from y = 0 to 1,
+    fitted to the unit box: side quads, then the top and bottom caps (earcut: the blocks are concave)."""
+    import mapbox_earcut
+
+    k = len(outline)
+    ring = np.stack([outline[:, 0], np.zeros(k), outline[:, 1]], axis=1)
+    vertices = np.concatenate([ring, ring + [0.0, 1.0, 0.0]])
+    i = np.arange(k)
+    j = (i + 1) % k
+    sides = np.stack([i, j, j + k, i + k], axis=1)  # outward: bottom i, bottom j, top j, top i
+    cap = mapbox_earcut.triangulate_float64(outline, np.array([k], dtype=np.uint32)).reshape(-1, 3)
+    # the top faces +y: counter-clockwise from +y is clockwise in (x, z); the bottom the other way
+    a, b, c = outline[cap[:, 0]], outline[cap[:, 1]], outline[cap[:, 2]]
+    turn = (b[:, 0] - a[:, 0]) * (c[:, 1] - a[:, 1]) - (b[:, 1] - a[:, 1]) * (c[:, 0] - a[:, 0])
+    top = np.where((turn < 0)[:, None], cap, cap[:, ::-1])
+    top, bottom = top + k, top[:, ::-1]
+    faces = np.concatenate([_quads_to_triangles(sides), top, bottom]).astype(np.int64)
+    return _frozen(_fitted(vertices), faces, np.array([4] * k + [k, k]))
+
+
+def load_asset(name: str, asset_roots: Sequence[str | os.PathLike] = (), lod: str | None = None) -> AssetMesh:
+    """Load an asset by its record name: a built-in, or a file resolved in ``asset_roots``.
+
+    Parameters
+    ----------
+    name : str
+        As in the record's ``assets``: ``builtin:cube`` or a path relative to an asset root.
+    asset_roots : sequence of path-like
+        Folders searched in order (the grammar's folder, ``--assets`` folders, a rule package's
+        ``asset_roots``).
+    lod : str, optional
+        A level of detail: ``window.obj`` is replaced by ``window.<lod>.obj`` beside it where that file
+        exists (the paper's Pompeii had high, middle and low LoD assets). ``builtin`` gives the built-in
+        cube as a stand-in for an asset file that no root holds, where otherwise that is an error.
+
+    Returns
+    -------
+    AssetMesh
+        The asset mapped from its bounding box onto [0, 1]^3.
+
+    Raises
+    ------
+    AssetError
+        If the name is refused (absolute, leaves the roots), no root holds it, or trimesh cannot read it.
+    """
+    if name.startswith("builtin:"):
+        return builtin_mesh(name)
+    roots = [Path(r) for r in asset_roots]
+    resolved = resolve_asset(name, roots)
+    if resolved.problem:
+        raise AssetError(resolved.problem)
+    if resolved.path is None:
+        if lod == LOD_STAND_IN:
+            return builtin_mesh("builtin:cube")
+        shown = ", ".join(str(r) for r in asset_roots) or "(no asset roots given)"
+        raise AssetError(f"asset `{name}` not found in {shown} (--lod {LOD_STAND_IN} puts a cube in its place)")
+    path = resolved.path
+    if lod and lod != LOD_STAND_IN:
+        substitute = path.with_name(f"{path.stem}.{lod}{path.suffix}")
+        path = substitute if substitute.is_file() else path
+    return _load_file(path, path.stat().st_mtime_ns)
+
+
+@lru_cache(maxsize=64)
+def _load_file(path: Path, mtime_ns: int) -> AssetMesh:
+    """A file asset, cached by path and modification time (a city uses a few assets many times).
+
+    OBJ files are read by ``model.obj`` (geometry only: their materials would need Pillow), their polygons
+    fanned into triangles; other formats go through trimesh.
+    """
+    if path.suffix.lower() == ".obj":
+        try:
+            vertices, polygons = read_obj(path.read_text(encoding="utf-8", errors="replace"), str(path))
+        except (OSError, ObjError) as error:
+            raise AssetError(f"cannot read asset `{path}`: {error}") from error
+        polygons = [f for f in polygons if len(f) >= 3 and (f >= 0).all() and (f < len(vertices)).all()]
+        sizes = np.array([len(f) for f in polygons], np.int64)
+        faces = np.concatenate([np.stack([np.full(len(f) - 2, f[0]), f[1:-1], f[2:]], axis=1)
+                                for f in polygons]) if polygons else np.zeros((0, 3), np.int64)
+        return _frozen(_fitted(vertices), faces, sizes)
+    import trimesh
+
+    try:
+        mesh = trimesh.load(path, force="mesh", process=False)
+    except Exception as error:
+        raise AssetError(f"cannot read asset `{path}`: {error}") from error
+    vertices = np.asarray(getattr(mesh, "vertices", np.zeros((0, 3))), np.float64).reshape(-1, 3)
+    faces = np.asarray(getattr(mesh, "faces", np.zeros((0, 3))), np.int64).reshape(-1, 3)
+    return _frozen(_fitted(vertices), faces, np.full(len(faces), 3, np.int64))
+
+
+def _fitted(vertices: np.ndarray) -> np.ndarray:
+    """Vertices mapped from their bounding box onto [0, 1]^3, as CityEngine fits an asset to a scope;
+    a flat axis maps to 0."""
+    if not len(vertices):
+        return vertices
+    low, high = vertices.min(axis=0), vertices.max(axis=0)
+    extent = high - low
+    flat = extent <= _FLAT * max(1.0, float(np.abs(vertices).max()))
+    scale = np.divide(1.0, extent, out=np.zeros(3), where=~flat)  # a flat axis maps to 0
+    return (vertices - low) * scale
+
+
+def _quads_to_triangles(quads: np.ndarray) -> np.ndarray:
+    """(2q, 3) triangles of (q, 4) quads, each split along its diagonal 0-2, in quad order."""
+    return np.stack([quads[:, [0, 1, 2]], quads[:, [0, 2, 3]]], axis=1).reshape(-1, 3)
+
+
+def _frozen(vertices, faces, sizes) -> AssetMesh:
+    arrays = [np.array(vertices, np.float64), np.array(faces, np.int64), np.array(sizes, np.int64)]
+    for array in arrays:
+        array.flags.writeable = False  # cached and shared: nobody may change them
+    return AssetMesh(*arrays)
+
+
+class AssetLibrary:
+    """Asset meshes of a record's asset names, loaded when first used: ``library[a]`` is the mesh of asset
+    index ``a`` (an ``AssetError`` if it cannot be loaded), ``names`` the record's asset names."""
+
+    def __init__(self, names: Sequence[str], roots: Sequence[str | os.PathLike], lod: str | None = None):
+        self.names = [str(n) for n in names]
+        self.roots = [Path(r) for r in roots]
+        self.lod = lod
+        self._meshes: dict[int, AssetMesh] = {}
+
+    def __getitem__(self, index: int) -> AssetMesh:
+        if index not in self._meshes:
+            self._meshes[index] = load_asset(self.names[index], self.roots, self.lod)
+        return self._meshes[index]
+
+    def triangles(self, used: np.ndarray) -> int:
+        """Triangles of ``used[a]`` instances of each asset ``a``, ``used`` (A,) int64."""
+        return sum(int(used[a]) * self[a].n_triangles for a in np.flatnonzero(used))
+
+
+def asset_library(names: Sequence[str], record: Mapping, asset_roots=None, lod: str | None = None) -> AssetLibrary:
+    """The meshes of asset ``names``, loaded when first used from ``asset_roots`` or the roots that the
+    record's meta names (the grammar's folder, then its ``asset_roots``), at level of detail ``lod``."""
+    return AssetLibrary(names, _roots(record, asset_roots), lod)
+
+
+def _roots(record: Mapping, asset_roots) -> list[Path]:
+    """``asset_roots``, or the roots a record's meta names: the grammar's folder, then ``asset_roots``."""
+    if asset_roots is not None:
+        return [Path(r) for r in asset_roots]
+    meta = record.get("meta")
+    if not isinstance(meta, Mapping):
+        return []
+    roots = [Path(meta["grammar"]).parent] if meta.get("grammar") else []
+    return roots + [Path(r) for r in meta.get("asset_roots", ())]

@@ -1,0 +1,138 @@
+"""The record's chunks: what the derivation hands to every writer, a batch of terminals at a time.
+
+A ``TerminalChunk`` holds a batch's instances (an asset and the affine map of its unit box, per row) and,
+in a ``MeshChunk``, the leaf polygons that could not be instances (faces with holes). The derivation builds
+them, and every writer (the npz record, USD, glTF, the baked meshes) and the renderer take them: they
+live on the model floor so that neither side imports the other. Ragged columns follow ``grammarc.ragged``'s
+convention (offsets starting at 0).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+__all__ = ["WHITE", "MeshChunk", "TerminalChunk"]
+
+#: Colour of rows that carry none: opaque white (RGBA).
+WHITE = np.array([255, 255, 255, 255], np.uint8)
+
+
+# eq=False: the generated __eq__ would compare arrays elementwise and fail on truth testing.
+@dataclass(frozen=True, eq=False)
+class MeshChunk:
+    """Leaf polygons that cannot be instances: faces with holes, in world coordinates.
+
+    Attributes
+    ----------
+    vertices : (V, 3) float32
+        Ring vertices, ring after ring.
+    ring_offsets : (R+1,) int64
+        Ring ``r`` is ``vertices[ring_offsets[r]:ring_offsets[r+1]]`` (Arrow-style, starts at 0).
+    face_offsets : (F+1,) int64
+        Face ``f`` is rings ``face_offsets[f]:face_offsets[f+1]``: its outline, then its holes.
+    lot : (F,) int32
+        Lot of each face.
+    symbol : (F,) int32
+        Symbol of each face, an index into the writer's ``symbols``.
+    color : (F, 4) uint8, optional
+        RGBA colour of each face (CityEngine's ``color``); None: white.
+    """
+
+    vertices: np.ndarray
+    ring_offsets: np.ndarray
+    face_offsets: np.ndarray
+    lot: np.ndarray
+    symbol: np.ndarray
+    color: np.ndarray | None = None
+
+    def colors(self) -> np.ndarray:
+        """(F, 4) uint8: the faces' colours, white where none was given."""
+        if self.color is not None:
+            return self.color
+        return _white(len(self.lot))
+
+    @staticmethod
+    def empty() -> MeshChunk:
+        """A chunk without faces: zero-length arrays of the right dtypes, offsets ``[0]``."""
+        return MeshChunk(
+            vertices=np.zeros((0, 3), np.float32),
+            ring_offsets=np.zeros(1, np.int64),
+            face_offsets=np.zeros(1, np.int64),
+            lot=np.zeros(0, np.int32),
+            symbol=np.zeros(0, np.int32),
+            color=np.zeros((0, 4), np.uint8),
+        )
+
+    @staticmethod
+    def concat(chunks: Sequence[MeshChunk]) -> MeshChunk:
+        """The faces of ``chunks``, in order, as one chunk whose offsets index the joined arrays."""
+        if not chunks:
+            return MeshChunk.empty()
+        n_vertices = np.array([len(c.vertices) for c in chunks], np.int64)
+        n_rings = np.array([len(c.ring_offsets) - 1 for c in chunks], np.int64)
+        n_faces = np.array([len(c.face_offsets) - 1 for c in chunks], np.int64)
+        return MeshChunk(
+            vertices=np.concatenate([c.vertices for c in chunks]),
+            ring_offsets=_join_offsets([c.ring_offsets for c in chunks], n_vertices, n_rings),
+            face_offsets=_join_offsets([c.face_offsets for c in chunks], n_rings, n_faces),
+            lot=np.concatenate([c.lot for c in chunks]),
+            symbol=np.concatenate([c.symbol for c in chunks]),
+            color=np.concatenate([c.colors() for c in chunks]),
+        )
+
+
+def _join_offsets(offsets: list[np.ndarray], n_items: np.ndarray, n_groups: np.ndarray) -> np.ndarray:
+    """Join per-chunk offsets, shifting each chunk's by the items (vertices, rings) of the chunks before it."""
+    # n_items [3, 5], n_groups [1, 2]: bases [0, 3], repeated per group [0, 3, 3], added to the offsets
+    # without their leading 0: [3] + [2, 5] -> [3, 5, 8], and 0 in front.
+    bases = np.cumsum(n_items) - n_items
+    tails = np.concatenate([o[1:] for o in offsets]) + np.repeat(bases, n_groups)
+    return np.concatenate([np.zeros(1, np.int64), tails])
+
+
+@dataclass(frozen=True, eq=False)
+class TerminalChunk:
+    """A batch of terminals: instances of assets, and the leaf polygons that could not be instances.
+
+    Attributes
+    ----------
+    asset : (n,) int32
+        Index into the writer's ``assets``.
+    xform : (n, 3, 4) float32
+        Affine map from the asset's unit box to world: ``world = xform[:, :, :3] @ p + xform[:, :, 3]``.
+    lot : (n,) int32
+        Lot (initial shape) of each instance.
+    symbol : (n,) int32
+        Index into the writer's ``symbols``: the shape's symbol when it became a terminal.
+    mesh : MeshChunk
+        Faces of this batch that are not instances.
+    color : (n, 4) uint8, optional
+        RGBA colour of each instance (CityEngine's ``color``); None: white.
+    """
+
+    asset: np.ndarray
+    xform: np.ndarray
+    lot: np.ndarray
+    symbol: np.ndarray
+    mesh: MeshChunk
+    color: np.ndarray | None = None
+
+    def colors(self) -> np.ndarray:
+        """(n, 4) uint8: the instances' colours, white where none was given."""
+        if self.color is not None:
+            return self.color
+        return _white(len(self.asset))
+
+
+_WHITE_ROWS = [np.zeros((0, 4), np.uint8)]
+
+
+def _white(n: int) -> np.ndarray:
+    """(n, 4) opaque white, C-contiguous: a view of one block kept for the chunks that follow, where a
+    broadcast white would be copied for every chunk of every writer."""
+    if len(_WHITE_ROWS[0]) < n:
+        _WHITE_ROWS[0] = np.full((max(n, 2 * len(_WHITE_ROWS[0])), 4), 255, np.uint8)
+    return _WHITE_ROWS[0][:n]

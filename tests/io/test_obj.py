@@ -1,0 +1,28 @@
+"""The OBJ writer: what ``obj_bytes`` writes, ``read_obj`` reads back."""
+
+import numpy as np
+import pytest
+
+from grammarc.io.obj import obj_bytes
+from grammarc.model.obj import ObjError, read_obj
+
+
+def test_obj_bytes_writes_what_read_obj_reads():
+    rng = np.random.default_rng(3)
+    vertices = rng.uniform(-2e4, 2e4, (500, 3))
+    vertices[:3] = [[0.0, -0.0, 4e-7], [-0.5, 12.25, 3.0], [1e6, -1e6, 0.000001]]
+    faces = rng.integers(0, 500, (900, 3))
+    text = obj_bytes(vertices, faces, "grammarc bake").decode()
+    assert text.startswith("# grammarc bake\nv 0 0 0\nv -0.5 12.25 3\nv 1000000 -1000000 0.000001\n")
+    points, read = read_obj(text)
+    np.testing.assert_allclose(points, vertices, atol=5e-7, rtol=0)
+    np.testing.assert_array_equal(np.array(read), faces)
+    with pytest.raises(ValueError, match="finite"):
+        obj_bytes(np.array([[np.nan, 0, 0]]), faces[:0])
+
+
+def test_read_obj_takes_vertex_tokens_and_negative_indices_and_names_a_bad_line():
+    points, faces = read_obj("# c\nv 0 0 0\nv 1 0 0\nv 1 1 0\nvt 0 0\nf 1/1 2//3 -1/2/3\n")
+    assert points.shape == (3, 3) and [f.tolist() for f in faces] == [[0, 1, 2]]
+    with pytest.raises(ObjError, match="^lot.obj:2: bad 'v' line"):
+        read_obj("v 0 0 0\nv 1 x 0\n", "lot.obj")

@@ -1,0 +1,45 @@
+"""The record's chunks: joined meshes shift their offsets, colours default to white."""
+
+import dataclasses
+
+import numpy as np
+
+from grammarc.model.records import WHITE, MeshChunk, TerminalChunk
+
+
+def triangle() -> MeshChunk:
+    """One face, a triangle, lot 0, symbol 0, no colour."""
+    return MeshChunk(
+        vertices=np.zeros((3, 3), np.float32),
+        ring_offsets=np.array([0, 3], np.int64),
+        face_offsets=np.array([0, 1], np.int64),
+        lot=np.array([0], np.int32),
+        symbol=np.array([0], np.int32),
+    )
+
+
+def test_concat_shifts_offsets():
+    square_with_hole = MeshChunk(
+        vertices=np.ones((7, 3), np.float32),
+        ring_offsets=np.array([0, 4, 7], np.int64),
+        face_offsets=np.array([0, 2], np.int64),
+        lot=np.array([1], np.int32),
+        symbol=np.array([2], np.int32),
+    )
+    joined = MeshChunk.concat([triangle(), MeshChunk.empty(), square_with_hole, triangle()])
+    assert joined.ring_offsets.tolist() == [0, 3, 7, 10, 13]
+    assert joined.face_offsets.tolist() == [0, 1, 3, 4]
+    assert joined.lot.tolist() == [0, 1, 0]
+    assert joined.vertices.shape == (13, 3)
+    empty = MeshChunk.concat([])
+    assert empty.ring_offsets.tolist() == [0] and empty.face_offsets.tolist() == [0]
+
+
+def test_colours_default_to_white():
+    plain = TerminalChunk(asset=np.zeros(3, np.int32), xform=np.zeros((3, 3, 4), np.float32),
+                          lot=np.zeros(3, np.int32), symbol=np.zeros(3, np.int32), mesh=triangle())
+    assert plain.colors().tolist() == [WHITE.tolist()] * 3 and plain.colors().flags.c_contiguous
+    assert plain.mesh.colors().tolist() == [WHITE.tolist()]
+    red = np.tile(np.array([[255, 0, 0, 255]], np.uint8), (3, 1))
+    assert dataclasses.replace(plain, color=red).colors() is red
+    assert MeshChunk.empty().colors().shape == (0, 4)
