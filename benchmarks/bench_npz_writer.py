@@ -22,7 +22,8 @@ import time
 
 import numpy as np
 
-from grammarc.io.npz import InstanceWriter, MeshChunk, TerminalChunk
+from grammarc.io.npz import InstanceWriter
+from grammarc.model.records import MeshChunk, TerminalChunk
 
 ASSETS = ["builtin:cube", "builtin:quad", "facade/window.obj"]
 SYMBOLS = ["Wall", "Window", "Roof", "Ledge"]

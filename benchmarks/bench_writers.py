@@ -27,7 +27,7 @@ import numpy as np
 import pytest
 
 from grammarc.io import writer_for
-from grammarc.io.npz import MeshChunk, TerminalChunk
+from grammarc.model.records import MeshChunk, TerminalChunk
 
 CHUNK = 200_000
 ASSETS = ["builtin:quad", "builtin:cube"]

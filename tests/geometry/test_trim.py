@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from grammarc.geometry.trim import side_face_planes, trim_triangles
-from grammarc.io.bake import builtin_mesh
+from grammarc.model.assets import builtin_mesh
 
 UP = np.tile([0.0, 1.0, 0.0], (4, 1))  # the split solid's scope y: world up
 
