@@ -335,29 +335,6 @@ def test_obj_malformed_line_raises_with_line_number(tmp_path):
         read_lots(write_obj(tmp_path, "v 0 0 0\n"))
 
 
-# ------------------------------------------------------------------------------------------------- take
-
-
-def test_take_rebases_offsets_and_slices_attrs():
-    squares = [[np.array(SQUARE) + 100 * i] for i in range(3)]
-    holed = [
-        np.array([[0, 0], [40, 0], [40, 40], [0, 40]]),
-        np.array([[10, 10], [10, 30], [30, 30], [30, 10]]),
-    ]
-    lots = lots_from_polygons([*squares, holed], attrs={"k": [0, 1, 2, 3]}, ids=list("abcd"))
-    sub = lots.take(np.array([3, 1]))
-    assert sub.ids.tolist() == ["d", "b"] and sub.index.tolist() == [3, 1]
-    assert sub.lot_offsets.tolist() == [0, 2, 3] and sub.ring_offsets.tolist() == [0, 4, 8, 12]
-    np.testing.assert_array_equal(sub.attrs["k"], [3.0, 1.0])
-    for j, i in enumerate([3, 1]):
-        for got, want in zip(rings(sub, j), rings(lots, i), strict=True):
-            np.testing.assert_array_equal(got, want)
-    tail = lots.take(slice(1, None))
-    assert tail.ids.tolist() == ["b", "c", "d"] and tail.lot_offsets.tolist() == [0, 1, 2, 4]
-    assert len(lots.take(np.array([], dtype=np.int64))) == 0
-    assert tail.bad is lots.bad and tail.source == lots.source
-
-
 # --------------------------------------------------------------------------------------- in memory
 
 
