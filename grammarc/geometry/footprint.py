@@ -13,7 +13,7 @@ from __future__ import annotations
 import numpy as np
 
 from grammarc.constants import TOL
-from grammarc.io.lots import Lots
+from grammarc.model.lots import Lots
 from grammarc.ragged import ragged_take, segment_of, segment_reduce
 
 

@@ -1,22 +1,28 @@
 """Lots from GIS files through GDAL (the ``gis`` extra: pyogrio, pyarrow): GeoPackage, shapefiles,
-FlatGeobuf and the other vector formats GDAL reads (``GIS_SUFFIXES``).
+FlatGeobuf and the other vector formats GDAL reads (``SUFFIXES``).
 
 pyogrio reads a layer into an Arrow table (WKB footprints and typed fields), which becomes lots as a
-GeoParquet file's table does (``geoparquet.lots_from_table``): the same ids (``id``, else ``name``, else
-the feature's number), properties, MultiPolygon parts and bad lots. ``rows`` reads only those features
-(``skip_features``/``max_features``), which is how a cluster's workers read their partitions of a file
-larger than memory (``io.lot_partitions``). Coordinates are taken as metres as they are: reproject a
+GeoParquet file's table does (``io.arrow_lots``): the same ids (``id``, else ``name``, else the feature's
+number), properties, MultiPolygon parts and bad lots. A partition is features ``[start, stop)`` of the
+first layer, read alone (``skip_features``/``max_features``), which is how a cluster's workers read their
+partitions of a file larger than memory. Coordinates are taken as metres as they are: reproject a
 longitude/latitude layer first (``ogr2ogr -t_srs EPSG:32633``).
 """
 
 from __future__ import annotations
 
 import os
+from pathlib import Path
 
 from grammarc.errors import LotsError, UsageError
-from grammarc.io.lots import GIS_SUFFIXES
+from grammarc.io.arrow_lots import lots_from_table, table_lot_numbers
+from grammarc.io.lot_format import LotsFormat, Partition, partitions_at
+from grammarc.model.lots import Lots
 
-__all__ = ["GIS_SUFFIXES", "count_gis", "gis_features", "read_gis"]
+__all__ = ["FORMAT", "SUFFIXES", "count_gis", "gis_partitions", "read_gis", "read_gis_partition"]
+
+#: Suffixes of the GIS files read through GDAL.
+SUFFIXES = (".gpkg", ".shp", ".fgb", ".gml", ".kml", ".sqlite", ".tab")
 
 
 def _pyogrio():
@@ -28,30 +34,40 @@ def _pyogrio():
     return pyogrio
 
 
-def gis_features(path: str | os.PathLike) -> int:
+def read_gis(path: Path) -> Lots:
+    """All lots of a GIS file's first layer; a ``LotsError`` if GDAL cannot read it, it has no geometry,
+    or it holds no polygon."""
+    table, column = _table(path, None)
+    builder, attrs = lots_from_table(table, column, path)
+    return builder.finish_file(attrs, path)
+
+
+def gis_partitions(path: Path, size: int) -> list[Partition]:
+    """Partitions of ``size`` features of the first layer (the last may be shorter)."""
+    n = _features(path)
+    return partitions_at(path, "gis", [*range(0, n, size), n])
+
+
+def count_gis(part: Partition) -> int:
+    """The lot numbers a partition's features take (``arrow_lots.table_lot_numbers``); no fields read."""
+    table, column = _table(part.path, (part.start, part.stop), columns=[])
+    return table_lot_numbers(table, column, part.path)
+
+
+def read_gis_partition(part: Partition, first_index: int) -> Lots:
+    """The lots of a partition's features, the first numbered ``first_index``."""
+    table, column = _table(part.path, (part.start, part.stop))
+    builder, attrs = lots_from_table(table, column, part.path, part.start, first_index)
+    return builder.finish(attrs, part.path)
+
+
+def _features(path: str | os.PathLike) -> int:
     """The features of the file's first layer."""
     pyogrio = _pyogrio()
     try:
         return int(pyogrio.read_info(path, force_feature_count=True)["features"])
     except Exception as error:
         raise LotsError(f"cannot read lots file {path}: {error}") from error
-
-
-def read_gis(path: str | os.PathLike, rows: tuple[int, int] | None = None, first_index: int = 0):
-    """The lots of a GIS file (its features ``rows``, the first numbered ``first_index``), for
-    ``_Builder.finish``: the builder and the property columns."""
-    from grammarc.io.geoparquet import lots_from_table
-
-    table, column = _table(path, rows)
-    return lots_from_table(table, column, path, rows[0] if rows else 0, first_index)
-
-
-def count_gis(path: str | os.PathLike, rows: tuple[int, int]) -> int:
-    """The lot numbers the features ``rows`` take (``geoparquet.table_lot_numbers``); no fields read."""
-    from grammarc.io.geoparquet import table_lot_numbers
-
-    table, column = _table(path, rows, columns=[])
-    return table_lot_numbers(table, column, path)
 
 
 def _table(path, rows, columns=None):
@@ -65,3 +81,7 @@ def _table(path, rows, columns=None):
     if column not in table.column_names:
         raise LotsError(f"{path}: no geometry in its first layer")
     return table, column
+
+
+FORMAT = LotsFormat(kind="gis", suffixes=SUFFIXES, title="a GIS file", read=read_gis,
+                    partitions=gis_partitions, count=count_gis, read_partition=read_gis_partition)

@@ -1,171 +1,66 @@
-"""Lots in: footprints from GeoJSON or OBJ, cleaned, validated and oriented as CityEngine takes them.
+"""Lots in: the table of lots formats by suffix, and the entry points that read a file whole or in partitions.
 
-Every lot becomes an initial shape, and the backend derives shapes in batches of arrays, so lots are read
-once into flat ragged arrays (Arrow-style offsets that start at 0, as in shapely's ``from_ragged_array``)
-rather than into one object per lot. Cleanup, orientation and validation then run over all lots at once:
-numpy over the ragged arrays, and shapely's vectorized predicates on the whole array of polygons. Python
-loops only where parsing needs them (over JSON features and OBJ lines) and over the bad lots' messages.
+Each format is one module describing itself with a ``LotsFormat`` (``io.lot_format``), as trimesh's
+``exchange`` modules do; ``FORMATS`` lists them and every entry point dispatches on the file's suffix:
 
-A bad lot (self-intersecting, zero area, not a polygon, a wall) is data, not an exception (DESIGN.md,
-invariant 5): it is listed in ``Lots.bad`` with its id and a reason, and the other lots load. Only a file
-that cannot be read at all raises :class:`~grammarc.errors.LotsError`.
+- ``.geojson``, ``.json``: a GeoJSON document, or a PRT initial shape as JSON (``io.geojson``);
+- ``.obj``: a face per lot (``io.obj_lots``);
+- ``.parquet``: GeoParquet, the fast way for 10^5 lots and more (``io.geoparquet``, the ``parquet`` extra);
+- ``.geojsonl``, ``.geojsons``, ``.geojsonseq``, ``.jsonl``, ``.ndjson``: a GeoJSON sequence, a Feature or
+  a geometry per line (``io.geojson_sequence``);
+- ``.gpkg``, ``.shp``, ``.fgb``, ...: a GIS file read through GDAL (``io.gis``, the ``gis`` extra).
 
-Conventions, those of CityEngine and Esri PRT:
+All of them give the same lots for the same footprints, cleaned, validated and oriented as CityEngine takes
+them (``io.lot_builder``). A bad lot (self-intersecting, zero area, not a polygon, a wall) is data, not an
+exception: it is listed in ``Lots.bad`` and the other lots load. Only a file that cannot be read at all
+raises :class:`~grammarc.errors.LotsError`.
 
-- Map to world: world x = map x, world y = 0, world z = -map y (north is -z). Coordinates are taken as
-  metres as they are: longitude/latitude is not reprojected (project the file first, e.g. to UTM).
-- The exterior ring of a lot has a +Y Newell normal (counter-clockwise on the map, as RFC 7946 wants),
-  holes a -Y normal. A ring wound the other way is reversed keeping its first vertex first
-  (v0, v_{n-1}, ..., v1): the first edge v0 -> v1 is the lot's scope x axis downstream.
-- Rings are open (the first vertex is not repeated); consecutive vertices closer than ``TOL.merge`` are
-  merged, and lots with less area than ``TOL.area_floor`` are bad.
+A country's footprints do not fit in one process's memory, nor should they cross a cluster's scheduler
+(``grammarc.cluster``). ``partition_lots`` cuts a file into ``Partition``s that workers read themselves:
+rows of GeoParquet (at row groups), features of a GIS file, lines of a GeoJSON sequence; a file of any
+other format fits in memory by construction and is read whole, once per worker process, a partition being
+its lots numbered ``[start, stop)``. A lot's number (``Lots.index``) is its place among the file's polygons,
+and it seeds the lot's random stream, so a partition must know the number of its first polygon:
+``count_lots`` gives the numbers each partition takes (a MultiPolygon takes one per part), a pass the
+cluster runs before deriving, and ``read_partition`` reads a partition with its first number. The lots then
+equal those of ``read_lots`` on the whole file, numbers, ids, properties and bad lots alike (tests), and so
+do their records.
 """
 
 from __future__ import annotations
 
 import contextlib
+import functools
 import gc
-import json
-import numbers
 import os
-import re
-from dataclasses import dataclass, replace
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
-import orjson
-import shapely
 
-from grammarc.constants import TOL
-from grammarc.errors import LotsError, UsageError
-from grammarc.io.obj import ObjError, read_obj
-from grammarc.ragged import offsets_from_counts, ragged_take, segment_reduce
+from grammarc.errors import LotsError
+from grammarc.io import geojson, geojson_sequence, geoparquet, gis, obj_lots
+from grammarc.io.lot_builder import STREET_WIDTH, LotBuilder, property_column
+from grammarc.io.lot_format import LotsFormat, Partition, partitions_at
 
-__all__ = ["BadLot", "Lots", "default_lot", "lots_from_polygons", "read_lots"]
+# BadLot and Lots are the model's (grammarc.model.lots); named here too until their users import them there.
+from grammarc.model.lots import BadLot, Lots
 
-#: Suffixes of GeoJSON sequences (``io.lot_partitions``): a Feature or a geometry per line.
-SEQUENCE_SUFFIXES = (".geojsonl", ".geojsons", ".geojsonseq", ".jsonl", ".ndjson")
-#: Suffixes of GIS files read through GDAL (``io.gis``, the ``gis`` extra).
-GIS_SUFFIXES = (".gpkg", ".shp", ".fgb", ".gml", ".kml", ".sqlite", ".tab")
-#: The lot property that marks street edges, as CityEngine's object attribute.
-STREET_WIDTH = "streetWidth"
-# GEOS reasons end with the offending point, e.g. "Self-intersection[3 4.5]".
-_GEOS_REASON = re.compile(r"^(?P<what>.*)\[(?P<x>\S+) (?P<y>\S+)\]$")
+__all__ = [
+    "FORMATS", "BadLot", "Lots", "Partition", "count_lots", "default_lot", "file_stamp", "lots_from_polygons",
+    "partition_lots", "read_lots", "read_partition",
+]
 
-
-@dataclass(frozen=True)
-class BadLot:
-    """A lot that was skipped: its number in the input, its id and why."""
-
-    index: int
-    id: str
-    reason: str
-
-
-@dataclass(frozen=True, eq=False)
-class Lots:
-    """Footprints in world coordinates (y up), rings as Arrow-style ragged arrays (offsets start at 0).
-
-    Attributes
-    ----------
-    ids : (L,) object
-      Lot identifiers, ``str``.
-    index : (L,) int64
-      Each lot's number in the input; bad lots keep theirs, so the good lots' numbers are stable.
-    vertices : (V, 3) float64
-      Ring vertices in world coordinates.
-    ring_offsets : (R + 1,) int64
-      Ring ``r`` is ``vertices[ring_offsets[r]:ring_offsets[r + 1]]``, open (first vertex not repeated),
-      at least 3 vertices. Exterior rings have a +Y Newell normal, holes a -Y one.
-    lot_offsets : (L + 1,) int64
-      Lot ``i`` is rings ``lot_offsets[i]:lot_offsets[i + 1]``, the exterior ring first, then its holes.
-    street : (V,) bool
-      Whether the edge from each vertex to the next of its ring faces a street: CityEngine's
-      ``streetWidth`` object attribute (one number per edge of the exterior ring, > 0 for a street).
-    attrs : dict of str to (L,) float64 or object
-      Per-lot property columns: float64 with nan for missing values, or object with ``str`` values and
-      None for missing ones.
-    bad : tuple of BadLot
-      Lots of the input that were skipped, ordered by ``index``.
-    source : str
-      The path read, or ``"<memory>"``.
-    """
-
-    ids: np.ndarray
-    index: np.ndarray
-    vertices: np.ndarray
-    ring_offsets: np.ndarray
-    lot_offsets: np.ndarray
-    street: np.ndarray
-    attrs: dict[str, np.ndarray]
-    bad: tuple[BadLot, ...]
-    source: str
-
-    def __len__(self) -> int:
-        return len(self.ids)
-
-    def take(self, sel: np.ndarray | slice) -> Lots:
-        """A subset of the lots, in the order of ``sel``.
-
-        Parameters
-        ----------
-        sel : (k,) int, (L,) bool or slice
-          The lots to keep.
-
-        Returns
-        -------
-        lots : Lots
-          The selected lots with rebased offsets and sliced attrs; ``bad`` and ``source`` are kept as is.
-        """
-        lot = np.atleast_1d(np.arange(len(self))[sel])
-        ring, lot_offsets = ragged_take(self.lot_offsets, lot)
-        vertex, ring_offsets = ragged_take(self.ring_offsets, ring)
-        return Lots(
-            ids=self.ids[lot],
-            index=self.index[lot],
-            vertices=self.vertices[vertex],
-            ring_offsets=ring_offsets,
-            lot_offsets=lot_offsets,
-            street=self.street[vertex],
-            attrs={name: column[lot] for name, column in self.attrs.items()},
-            bad=self.bad,
-            source=self.source,
-        )
-
-    def select(self, ids) -> Lots:
-        """The lots of these ids (``--select``), in input order; bad lots not among them are dropped.
-
-        Raises
-        ------
-        UsageError
-            If an id names no lot of the input.
-        """
-        wanted = {str(i) for i in ids}
-        ids = self.ids.astype(str)
-        unknown = sorted(wanted - set(ids.tolist()) - {b.id for b in self.bad})
-        if unknown:
-            raise UsageError(f"--select: no lot has the id {', '.join(map(repr, unknown[:10]))}"
-                             + (f" (and {len(unknown) - 10} more)" if len(unknown) > 10 else ""))
-        keep = np.isin(ids, sorted(wanted))
-        return replace(self.take(keep), bad=tuple(b for b in self.bad if b.id in wanted))
+#: The lots formats, in the order an unknown suffix's error lists them.
+FORMATS: tuple[LotsFormat, ...] = (
+    geojson.FORMAT, obj_lots.FORMAT, geoparquet.FORMAT, geojson_sequence.FORMAT, gis.FORMAT,
+)
+_BY_SUFFIX = {suffix: form for form in FORMATS for suffix in form.suffixes}
+_BY_KIND = {form.kind: form for form in FORMATS}
 
 
 def read_lots(path: str | os.PathLike) -> Lots:
-    """Read lots from a GeoJSON (``.geojson``, ``.json``), GeoJSON sequence (``SEQUENCE_SUFFIXES``: a
-    feature per line), OBJ (``.obj``), GeoParquet (``.parquet``, ``io.geoparquet``: the fast way for
-    10^5 lots and more) or GIS (``GIS_SUFFIXES``, through GDAL: ``io.gis``) file.
-
-    GeoJSON may be a FeatureCollection, a single Feature or a bare Polygon / MultiPolygon geometry,
-    in map coordinates taken as metres (longitude/latitude is not reprojected). A Polygon is one lot
-    and a MultiPolygon one lot per polygon (ids ``"<feature id>:<k>"``, each with the feature's
-    properties); other geometries are bad lots. A lot's id is the feature's ``id``, else its property
-    ``id``, else ``name``, else its index; ``index`` numbers polygons in file order. Properties become
-    ``attrs`` columns, typed over all polygon lots of the file. A ``.json`` file holding a PRT initial
-    shape (``vertices``, ``face_indices``, ``face_counts``, ``holes`` in world coordinates, as the PRT
-    kit's ``courtyard_40x40.json``) is read too: one lot per face that is not a hole, ids ``"face<k>"``.
-
-    In OBJ, each face is one lot without holes, ids ``"face<k>"``, index the face number; vertices are
-    world coordinates. A face whose normal is not roughly vertical (a wall) is a bad lot.
+    """Read all lots of a file, of any format of ``FORMATS`` (by its suffix; see the format's module).
 
     Parameters
     ----------
@@ -181,58 +76,62 @@ def read_lots(path: str | os.PathLike) -> Lots:
     ------
     LotsError
       The file is missing, unreadable, not valid JSON, of an unknown suffix, or holds no polygon.
+    UsageError
+      The format needs an extra that is not installed (pyarrow, pyogrio).
     """
     path = Path(path)
     if not path.is_file():
         raise LotsError(f"lots file not found: {path}")
-    suffix = path.suffix.lower()
-    if suffix == ".parquet" or suffix in GIS_SUFFIXES or suffix in SEQUENCE_SUFFIXES:
-        from grammarc.io.lot_partitions import read_whole  # read as a cluster's workers read them
-
-        return read_whole(path)
-    if suffix not in (".geojson", ".json", ".obj"):
-        raise LotsError(f"unknown lots file type {suffix!r} (expected .geojson, .json, .obj, .parquet, a "
-                        f"GeoJSON sequence ({', '.join(SEQUENCE_SUFFIXES)}) or a GIS file "
-                        f"({', '.join(GIS_SUFFIXES)})): {path}")
-    try:
-        text = path.read_text(encoding="utf-8")
-    except (OSError, UnicodeDecodeError) as error:
-        raise LotsError(f"cannot read lots file {path}: {error}") from error
+    form = _BY_SUFFIX.get(path.suffix.lower())
+    if form is None:
+        raise LotsError(f"unknown lots file type {path.suffix.lower()!r} (expected {_expected()}): {path}")
     with _no_cycle_collection():
-        return _read_text(text, path, suffix)
+        return form.read(path)
 
 
-@contextlib.contextmanager
-def _no_cycle_collection():
-    """The cyclic garbage collector off while a file is parsed: JSON makes millions of dicts and lists
-    (a tree, no cycles, freed by reference counting), and each collection walks them all again. At
-    2.5 * 10^5 lots reading took 8.9 s with it, 4.7 s without."""
-    was_enabled = gc.isenabled()
-    gc.disable()
-    try:
-        yield
-    finally:
-        if was_enabled:
-            gc.enable()
+def partition_lots(path: str | os.PathLike, size: int) -> list[Partition]:
+    """The partitions of a lots file, about ``size`` features each (GeoParquet's follow its row groups).
+
+    Returns
+    -------
+    partitions : list of Partition
+      In file order, numbered from 0; the first starts at 0 and each ends where the next starts. A file
+      read whole is cut into lot numbers (kind ``"whole"``).
+    """
+    path = Path(path)
+    if not path.is_file():
+        raise LotsError(f"lots file not found: {path}")
+    form = _BY_SUFFIX.get(path.suffix.lower())
+    if form is not None and form.partitions is not None:
+        return form.partitions(path, size)
+    lots = _whole(str(path), *file_stamp(path))
+    n = 1 + max([int(lots.index.max()) if len(lots) else -1, *(b.index for b in lots.bad)])
+    return partitions_at(path, "whole", [*range(0, n, size), n])
 
 
-def _read_text(text: str, path: Path, suffix: str) -> Lots:
-    """``read_lots`` of a text file's contents."""
-    if suffix == ".obj":
-        builder = _parse_obj(text, path)
-    else:
-        try:
-            data = orjson.loads(text)  # about twice as fast as the stdlib on city-sized files
-        except orjson.JSONDecodeError as error:
-            where = f"{path}:{error.lineno}:{error.colno}"
-            raise LotsError(f"{where}: not valid JSON: {error.msg}") from error
-        if isinstance(data, dict) and "face_counts" in data and "type" not in data:
-            builder = _parse_prt_shape(data, path)
-        else:
-            builder = _parse_geojson(data)
-    if builder.polygons == 0:
-        raise LotsError(f"no polygon in lots file {path}")
-    return builder.finish(_columns(builder.props), str(path))
+def count_lots(part: Partition) -> int:
+    """The lot numbers the features of ``part`` take (see the module docstring)."""
+    if part.kind == "whole":
+        return part.stop - part.start
+    return _BY_KIND[part.kind].count(part)
+
+
+def read_partition(part: Partition, first_index: int) -> Lots:
+    """The lots of ``part``, the first numbered ``first_index`` (``count_lots`` of the partitions before;
+    ignored for a file read whole, whose lots keep their numbers)."""
+    if part.kind != "whole":
+        with _no_cycle_collection():
+            return _BY_KIND[part.kind].read_partition(part, first_index)
+    lots = _whole(part.path, *file_stamp(Path(part.path)))
+    inside = (lots.index >= part.start) & (lots.index < part.stop)
+    return replace(lots.take(np.flatnonzero(inside)),
+                   bad=tuple(b for b in lots.bad if part.start <= b.index < part.stop))
+
+
+def file_stamp(path: Path) -> tuple[int, int]:
+    """What tells a file's contents apart cheaply: its modification time and size."""
+    info = path.stat()
+    return info.st_mtime_ns, info.st_size
 
 
 def lots_from_polygons(
@@ -279,11 +178,11 @@ def lots_from_polygons(
     for name, length in lengths.items():
         if length != len(polygons):
             raise ValueError(f"{name} has {length} entries for {len(polygons)} polygons")
-    builder = _Builder(world=False)
+    builder = LotBuilder(world=False)
     street = [None] * len(polygons) if street is None else street
     for index, (lot_id, rings, widths) in enumerate(zip(ids, polygons, street)):
         builder.add_positions(index, lot_id, rings, {} if widths is None else {STREET_WIDTH: list(widths)})
-    return builder.finish({name: _column(list(values)) for name, values in attrs.items()}, source)
+    return builder.finish({name: property_column(list(values)) for name, values in attrs.items()}, source)
 
 
 def default_lot() -> Lots:
@@ -298,342 +197,29 @@ def default_lot() -> Lots:
     return lots_from_polygons([[rectangle]], ids=["default"])
 
 
-# ---------------------------------------------------------------------------------------------- parsing
+def _expected() -> str:
+    """The suffixes ``read_lots`` takes, for its error: a format with a title as one item (``a GIS file
+    (.gpkg, ...)``), the others' suffixes each by itself; the last item after "or"."""
+    items = [item for form in FORMATS
+             for item in ([f"{form.title} ({', '.join(form.suffixes)})"] if form.title else form.suffixes)]
+    return f"{', '.join(items[:-1])} or {items[-1]}"
 
 
-class _Builder:
-    """Collects lots while a file is parsed; ``finish`` cleans, orients and validates them all at once.
-
-    Rings are (k, 3) float64 world coordinates if ``world``, else (k, 2) float64 map coordinates.
-    """
-
-    def __init__(self, world: bool):
-        self.world = world
-        self.rings: list[np.ndarray] = []  # rings, or a block of rings (``add_block``)
-        self.sizes: list[np.ndarray] = []  # vertices per ring, an array per lot or block
-        self.ring_counts: list[int] = []  # rings per lot
-        self.index: list[int] = []
-        self.ids: list[str] = []
-        self.props: list[dict] = []
-        self.street: list[np.ndarray] = []  # per ring, a flag per position: its edge faces a street
-        self.bad: list[BadLot] = []
-        self.polygons = 0  # lots added or rejected; a file without any has "no polygon"
-        self.end = 0  # lot numbers the parsed features took (GeoJSON)
-
-    def reject(self, index: int, lot_id: str, reason: str) -> None:
-        """A polygon that is bad before any geometry check (malformed, empty)."""
-        self.polygons += 1
-        self.bad.append(BadLot(index, lot_id, reason))
-
-    def add(self, index: int, lot_id: str, rings: list[np.ndarray], props: dict) -> None:
-        """Add a lot: its exterior ring, then its holes. A ``streetWidth`` property (CityEngine's: a
-        number per edge of the exterior ring, > 0 where a street runs) marks its street edges."""
-        if not rings:
-            self.reject(index, lot_id, "empty polygon")
-            return
-        street = [np.zeros(len(ring), dtype=bool) for ring in rings]
-        widths = props.get(STREET_WIDTH)
-        if widths is not None:
-            flags = _street_flags(widths, rings[0])
-            if isinstance(flags, str):
-                self.reject(index, lot_id, flags)
-                return
-            street[0] = flags
-            props = {name: value for name, value in props.items() if name != STREET_WIDTH}
-        self.polygons += 1
-        self.rings.extend(rings)
-        self.sizes.append(np.array([len(ring) for ring in rings], dtype=np.int64))
-        self.street.extend(street)
-        self.ring_counts.append(len(rings))
-        self.index.append(index)
-        self.ids.append(lot_id)
-        self.props.append(props)
-
-    def add_block(self, index: np.ndarray, ids: list[str], vertices: np.ndarray, sizes: np.ndarray,
-                  ring_counts: np.ndarray, street: np.ndarray) -> None:
-        """Add many lots at once from columns (a columnar file): ``vertices`` of all their rings,
-        ``sizes`` vertices per ring, ``ring_counts`` rings per lot, ``street`` a flag per vertex. Their
-        properties are not kept here: the caller passes them to ``finish`` as columns."""
-        self.polygons += len(ids)
-        self.rings.append(vertices)
-        self.sizes.append(np.asarray(sizes, dtype=np.int64))
-        self.street.append(street)
-        self.ring_counts.extend(np.asarray(ring_counts).tolist())
-        self.index.extend(np.asarray(index).tolist())
-        self.ids.extend(ids)
-
-    def add_positions(self, index: int, lot_id: str, rings, props: dict) -> None:
-        """Add a lot given as lists of map positions (GeoJSON); extra components are ignored."""
-        try:
-            xy = [_ring_xy(ring) for ring in rings]
-        except (TypeError, ValueError, IndexError):
-            self.reject(index, lot_id, "malformed coordinates")
-            return
-        self.add(index, lot_id, xy, props)
-
-    def finish(self, attrs: dict[str, np.ndarray], source: str) -> Lots:
-        """Clean, orient and validate every lot at once; ``attrs`` are columns over all added lots."""
-        counts = np.concatenate([np.zeros(0, dtype=np.int64), *self.sizes])
-        vertices = np.concatenate([np.zeros((0, 3 if self.world else 2)), *self.rings])
-        if not self.world:
-            # world (x, 0, -y); 0.0 - y keeps z = +0.0 where y = 0
-            x, y = vertices.T
-            vertices = np.column_stack([x, np.zeros_like(x), np.subtract(0.0, y)])
-        keep, owner, ring_offsets = _clean(vertices, offsets_from_counts(counts))
-        vertices = vertices[keep]
-        street = np.zeros(len(vertices), dtype=bool)
-        np.logical_or.at(street, owner, np.concatenate([np.zeros(0, dtype=bool), *self.street]))
-        lot_offsets = offsets_from_counts(np.array(self.ring_counts, dtype=np.int64))
-        normals = _newell(vertices, ring_offsets)
-        exterior = np.zeros(len(normals), dtype=bool)
-        exterior[lot_offsets[:-1]] = True
-        vertex_order, edge_order = _orient(ring_offsets, exterior, normals[:, 1])
-        vertices, street = vertices[vertex_order], street[edge_order]
-        lots = Lots(
-            ids=np.array(self.ids, dtype=object),
-            index=np.array(self.index, dtype=np.int64),
-            vertices=vertices,
-            ring_offsets=ring_offsets,
-            lot_offsets=lot_offsets,
-            street=street,
-            attrs=attrs,
-            bad=(),
-            source=source,
-        )
-        reasons = _validate(lots, normals, self.world)
-        rejected = np.flatnonzero(reasons != "")
-        bad = self.bad + [BadLot(int(lots.index[i]), lots.ids[i], reasons[i]) for i in rejected]
-        good = lots.take(np.flatnonzero(reasons == "")) if len(rejected) else lots  # a copy only to drop some
-        return replace(good, bad=tuple(sorted(bad, key=lambda b: b.index)))
-
-
-def _street_flags(widths, ring: np.ndarray) -> np.ndarray | str:
-    """Per position of ``ring``, whether its edge faces a street, from a ``streetWidth`` value (one
-    number per edge; a ring given closed has one edge fewer than positions); a reason if malformed."""
-    if not isinstance(widths, list) or not all(isinstance(w, numbers.Real) for w in widths):
-        return f"{STREET_WIDTH} is not a list of numbers"
-    closed = len(ring) > 1 and np.array_equal(ring[0], ring[-1])
-    edges = len(ring) - 1 if closed else len(ring)
-    if len(widths) != edges:
-        return f"{STREET_WIDTH} has {len(widths)} values for {edges} edges"
-    return np.r_[np.asarray(widths, dtype=np.float64) > 0, np.zeros(int(closed), dtype=bool)]
-
-
-def _ring_xy(ring) -> np.ndarray:
-    """A ring's positions as (k, 2) float64; a third component (elevation) is dropped."""
+@contextlib.contextmanager
+def _no_cycle_collection():
+    """The cyclic garbage collector off while a file is parsed: JSON makes millions of dicts and lists (a
+    tree, no cycles, freed by reference counting), and each collection would walk them all again, which on
+    a city's file costs about as much as the parsing itself."""
+    was_enabled = gc.isenabled()
+    gc.disable()
     try:
-        array = np.asarray(ring, dtype=np.float64)
-    except ValueError:  # positions of mixed length, e.g. some with an elevation
-        array = np.array([position[:2] for position in ring], dtype=np.float64)
-    if array.size == 0:
-        return np.zeros((0, 2))
-    if array.ndim != 2 or array.shape[1] < 2:
-        raise ValueError("a ring is a list of positions")
-    return array[:, :2]
+        yield
+    finally:
+        if was_enabled:
+            gc.enable()
 
 
-def _feature_id(feature: dict, props: dict, index: int) -> str:
-    for value in (feature.get("id"), props.get("id"), props.get("name")):
-        if value is not None:
-            return str(value)
-    return str(index)
-
-
-def _parse_geojson(data) -> _Builder:
-    """Lots of a FeatureCollection, a Feature or a bare geometry; ``index`` counts polygons in order."""
-    if isinstance(data, dict) and data.get("type") == "FeatureCollection":
-        features = data.get("features") or []
-    elif isinstance(data, dict) and data.get("type") == "Feature":
-        features = [data]
-    elif isinstance(data, dict):
-        features = [{"type": "Feature", "geometry": data}]
-    else:
-        features = []
-    return parse_features(features)
-
-
-def parse_features(features, first_index: int = 0) -> _Builder:
-    """Lots of a list of GeoJSON features whose first polygon is number ``first_index`` of its file (a
-    partition of a GeoJSON sequence starts where the polygons before it end)."""
-    builder = _Builder(world=False)
-    index = first_index
-    for feature in features:
-        if not isinstance(feature, dict):
-            continue
-        props = feature.get("properties") if isinstance(feature.get("properties"), dict) else {}
-        geometry = feature.get("geometry") if isinstance(feature.get("geometry"), dict) else {}
-        kind = geometry.get("type")
-        lot_id = _feature_id(feature, props, index)
-        if kind == "Polygon":
-            builder.add_positions(index, lot_id, geometry.get("coordinates") or [], props)
-            index += 1
-        elif kind == "MultiPolygon" and not geometry.get("coordinates"):
-            builder.reject(index, lot_id, "empty polygon")
-            index += 1
-        elif kind == "MultiPolygon":
-            for k, rings in enumerate(geometry["coordinates"]):
-                builder.add_positions(index, f"{lot_id}:{k}", rings or [], props)
-                index += 1
-        else:
-            builder.bad.append(BadLot(index, lot_id, f"not a polygon ({kind or 'null geometry'})"))
-            index += 1
-    builder.end = index - first_index
-    return builder
-
-
-def _parse_obj(text: str, path: Path) -> _Builder:
-    """One lot per ``f`` line; ``v`` lines are world coordinates, every other line is ignored."""
-    try:
-        vertices, faces = read_obj(text, str(path))
-    except ObjError as error:
-        raise LotsError(str(error)) from error
-    builder = _Builder(world=True)
-    for k, face in enumerate(faces):
-        if np.any((face < 0) | (face >= len(vertices))):
-            builder.reject(k, f"face{k}", "vertex index out of range")
-        else:
-            builder.add(k, f"face{k}", [vertices[face]], {})
-    return builder
-
-
-def _parse_prt_shape(data: dict, path: Path) -> _Builder:
-    """A PRT initial shape as JSON: the arguments of ``pyprt.InitialShape`` (vertices, indices, counts,
-    holes), in world coordinates; a hole face is listed after its face in ``holes``."""
-    try:
-        vertices = np.asarray(data["vertices"], dtype=np.float64).reshape(-1, 3)
-        indices = np.asarray(data["face_indices"], dtype=np.int64)
-        faces = np.split(indices, np.cumsum(data["face_counts"])[:-1])
-        holes = {int(group[0]): [int(h) for h in group[1:]] for group in data.get("holes") or []}
-        is_hole = {h for group in holes.values() for h in group}
-        builder = _Builder(world=True)
-        lots = [k for k in range(len(faces)) if k not in is_hole]
-        for index, k in enumerate(lots):
-            builder.add(index, f"face{k}", [vertices[faces[f]] for f in [k, *holes.get(k, [])]], {})
-    except (KeyError, TypeError, ValueError, IndexError) as error:
-        raise LotsError(f"{path}: not a PRT initial shape ({error!r})") from error
-    return builder
-
-
-def _column(values: list) -> np.ndarray:
-    """One property column: all numbers (bools too) or None -> float64 with nan, else object str/None."""
-    if all(v is None or isinstance(v, (numbers.Real, np.bool_)) for v in values):
-        return np.array([np.nan if v is None else float(v) for v in values], dtype=np.float64)
-    column = np.empty(len(values), dtype=object)
-    column[:] = [v if v is None or isinstance(v, str) else json.dumps(v) for v in values]
-    return column
-
-
-def _columns(props: list[dict]) -> dict[str, np.ndarray]:
-    names = dict.fromkeys(name for p in props for name in p)  # first-seen order
-    return {name: _column([p.get(name) for p in props]) for name in names}
-
-
-# ------------------------------------------------------------------------------------- ragged kernels
-
-
-def _ring_positions(ring_offsets: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Per vertex: its ring, its ring's start and its ring's vertex count, each (V,) int64."""
-    counts = np.diff(ring_offsets)
-    ring = np.repeat(np.arange(len(counts)), counts)
-    return ring, ring_offsets[:-1][ring], counts[ring]
-
-
-def _successor(start: np.ndarray, count: np.ndarray) -> np.ndarray:
-    """(V,) int64 index of each vertex's successor in its ring; the last vertex wraps to the first."""
-    at = np.arange(len(start))
-    return np.where(at + 1 < start + count, at + 1, start)
-
-
-def _clean(vertices: np.ndarray, ring_offsets: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Merge consecutive vertices closer than ``TOL.merge``, keeping the first of each run: which
-    vertices stay (V,) bool, the kept vertex each one merges into (V,) int64 (numbered among the kept),
-    and the kept rings' offsets.
-
-    A run may wrap around the ring's end (a closing vertex equal to the first, or a duplicated last
-    vertex): it belongs to the first vertex, which always stays first.
-    """
-    ring, start, count = _ring_positions(ring_offsets)
-    at = np.arange(len(vertices))
-    close_next = np.linalg.norm(vertices[_successor(start, count)] - vertices, axis=1) < TOL.merge
-    close_prev = np.zeros(len(vertices), dtype=bool)
-    close_prev[1:] = close_next[:-1]
-    first = at == start
-    # the last vertex of each ring that is not close to its successor: vertices after it chain into v0
-    last_far = np.full(len(ring_offsets) - 1, -1, dtype=np.int64)
-    np.maximum.at(last_far, ring, np.where(close_next, -1, at))
-    keep = first | (~close_prev & (at <= last_far[ring]))
-    kept = segment_reduce(np.add, keep.astype(np.int64), ring_offsets, 0)
-    owner = np.cumsum(keep) - 1
-    wraps = at > last_far[ring]
-    owner[wraps] = owner[start[wraps]]
-    return keep, owner, offsets_from_counts(kept)
-
-
-def _newell(vertices: np.ndarray, ring_offsets: np.ndarray) -> np.ndarray:
-    """(R, 3) float64 Newell normals, twice the vector area; ``normal[:, 1]`` = 2 x the map signed area.
-
-    The ring's first vertex is subtracted first, so large world coordinates lose no precision.
-    """
-    _, start, count = _ring_positions(ring_offsets)
-    local = vertices - vertices[start]
-    return segment_reduce(np.add, np.cross(local, local[_successor(start, count)]), ring_offsets, 0.0)
-
-
-def _orient(ring_offsets, exterior, normal_y) -> tuple[np.ndarray, np.ndarray]:
-    """Reverse exterior rings with a -Y normal and holes with a +Y one, keeping each ring's first vertex:
-    where each vertex and each edge (from its vertex to the next) comes from, (V,) int64 each.
-
-    A reversed ring of n vertices takes position p from position (n - p) % n: v0, v_{n-1}, ..., v1; its
-    edge p is the old edge (n - p - 1) % n run backwards.
-    """
-    ring, start, count = _ring_positions(ring_offsets)
-    flip = np.where(exterior, normal_y < 0, normal_y > 0)[ring]
-    position = np.arange(len(ring)) - start
-    return (start + np.where(flip, (count - position) % count, position),
-            start + np.where(flip, (count - position - 1) % count, position))
-
-
-def _validate(lots: Lots, normals: np.ndarray, world: bool) -> np.ndarray:
-    """(L,) object: why each lot is bad, "" for a good lot; the first failed check gives the reason."""
-    reasons = np.full(len(lots), "", dtype=object)
-    short_ring = (np.diff(lots.ring_offsets) < 3).astype(np.int64)
-    short = segment_reduce(np.add, short_ring, lots.lot_offsets, 0) > 0
-    reasons[short] = "fewer than 3 distinct vertices"
-    norm = np.linalg.norm(normals, axis=1)
-    wall_ring = (norm >= 2 * TOL.area_floor) & (np.abs(normals[:, 1]) < 0.5 * norm)
-    wall = segment_reduce(np.add, wall_ring.astype(np.int64), lots.lot_offsets, 0) > 0
-    reasons[wall & (reasons == "")] = "not a footprint: face normal is not vertical"
-
-    candidates = np.flatnonzero(reasons == "")
-    polygons = _map_polygons(lots.take(candidates))
-    why = shapely.is_valid_reason(polygons)
-    valid = why == "Valid Geometry"
-    area = shapely.area(polygons)
-    # a symmetric bowtie has zero area too; only a polygon whose convex hull is flat is "zero area"
-    small = area < TOL.area_floor
-    flat = np.zeros(len(candidates), dtype=bool)
-    flat[small] = shapely.area(shapely.convex_hull(polygons[small])) < TOL.area_floor
-    zero = flat | (small & valid)
-    reasons[candidates[zero]] = "zero area"
-    invalid = ~valid & ~zero
-    reasons[candidates[invalid]] = [_geos_reason(text, world) for text in why[invalid]]
-    return reasons
-
-
-def _map_polygons(lots: Lots) -> np.ndarray:
-    """(L,) shapely Polygons in map coordinates (x, -z), rings closed as GeoArrow requires."""
-    xy = np.column_stack([lots.vertices[:, 0], -lots.vertices[:, 2]])
-    closed = np.insert(xy, lots.ring_offsets[1:], xy[lots.ring_offsets[:-1]], axis=0)
-    ring_offsets = lots.ring_offsets + np.arange(len(lots.ring_offsets))
-    offsets = (ring_offsets, lots.lot_offsets)
-    return shapely.from_ragged_array(shapely.GeometryType.POLYGON, closed, offsets)
-
-
-def _geos_reason(text: str, world: bool) -> str:
-    """'Self-intersection[3 4.5]' -> 'self-intersection at (3.0, 4.5)' in the input's coordinates."""
-    match = _GEOS_REASON.match(text)
-    if match is None:
-        return text[:1].lower() + text[1:]
-    what, x, y = match["what"], float(match["x"]), float(match["y"])
-    where = f"x={x}, z={0.0 - y}" if world else f"({x}, {y})"
-    return f"{what[:1].lower()}{what[1:]} at {where}"
+@functools.lru_cache(maxsize=1)
+def _whole(path: str, mtime_ns: int, size: int) -> Lots:
+    """A lots file read whole, once per process while it is unchanged (its stamp is in the key)."""
+    return read_lots(path)

@@ -8,11 +8,11 @@ import pytest
 pa = pytest.importorskip("pyarrow")
 import pyarrow.parquet as pq
 import shapely
-from lot_features import FEATURES
+from lot_features import FEATURES, lot_files
 
 from grammarc.cli import main
 from grammarc.io.geoparquet import write_geoparquet
-from grammarc.io.lots import read_lots
+from grammarc.io.lots import partition_lots, read_lots
 
 
 def same(a, b, numbers=True):
@@ -72,3 +72,11 @@ def test_a_parquet_file_without_footprints_is_refused_by_name(tmp_path):
     pq.write_table(pa.table({"id": ["a"], "geometry": [b"not wkb"]}), tmp_path / "bad.parquet")
     with pytest.raises(LotsError, match="bad.parquet: bad WKB in column 'geometry'"):
         read_lots(tmp_path / "bad.parquet")
+
+
+def test_parquet_partitions_follow_row_groups_near_their_size(tmp_path):
+    parquet = lot_files(tmp_path)[2]  # row groups of 2 rows, 13 rows
+    assert [(p.start, p.stop) for p in partition_lots(parquet, 3)] == [(0, 2), (2, 4), (4, 6), (6, 8), (8, 10),
+                                                                        (10, 13)]
+    assert [(p.start, p.stop) for p in partition_lots(parquet, 6)] == [(0, 6), (6, 12), (12, 13)]
+

@@ -1,0 +1,369 @@
+"""What every lots format shares: a builder that collects lots while a file is parsed, then cleans, orients
+and validates them all at once; GeoJSON features to lots; property columns; street flags.
+
+The format modules (``io.geojson``, ``io.geojson_sequence``, ``io.obj_lots``, ``io.arrow_lots``) parse
+their files into a ``LotBuilder``, a lot or a block of lots at a time; ``LotBuilder.finish`` then runs
+over all lots at once: numpy over the ragged arrays, and shapely's vectorized predicates on the whole
+array of polygons. Python loops only where parsing needs them (over JSON features) and over the bad lots'
+messages. A bad lot is listed with its number, its id and a reason (``grammarc.model.lots.BadLot``), and
+the other lots load.
+
+Conventions, those of CityEngine and Esri PRT:
+
+- Map to world: world x = map x, world y = 0, world z = -map y (north is -z). Coordinates are taken as
+  metres as they are: longitude/latitude is not reprojected (project the file first, e.g. to UTM).
+- The exterior ring of a lot has a +Y Newell normal (counter-clockwise on the map, as RFC 7946 wants),
+  holes a -Y normal. A ring wound the other way is reversed keeping its first vertex first
+  (v0, v_{n-1}, ..., v1): the first edge v0 -> v1 is the lot's scope x axis downstream.
+- Rings are open (the first vertex is not repeated); consecutive vertices closer than ``TOL.merge`` are
+  merged, and lots with less area than ``TOL.area_floor`` are bad.
+"""
+
+from __future__ import annotations
+
+import json
+import numbers
+import re
+from dataclasses import replace
+
+import numpy as np
+import shapely
+
+from grammarc.constants import TOL
+from grammarc.errors import LotsError
+from grammarc.model.lots import BadLot, Lots
+from grammarc.ragged import offsets_from_counts, segment_reduce
+
+__all__ = [
+    "STREET_WIDTH", "LotBuilder", "parse_features", "property_column", "property_columns", "street_flags",
+]
+
+#: The lot property that marks street edges, as CityEngine's object attribute.
+STREET_WIDTH = "streetWidth"
+# GEOS reasons end with the offending point, e.g. "Self-intersection[3 4.5]".
+_GEOS_REASON = re.compile(r"^(?P<what>.*)\[(?P<x>\S+) (?P<y>\S+)\]$")
+
+
+class LotBuilder:
+    """Collects lots while a file is parsed; ``finish`` cleans, orients and validates them all at once.
+
+    Rings are (k, 3) float64 world coordinates if ``world``, else (k, 2) float64 map coordinates.
+    """
+
+    def __init__(self, world: bool):
+        self.world = world
+        self.rings: list[np.ndarray] = []  # rings, or a block of rings (``add_block``)
+        self.sizes: list[np.ndarray] = []  # vertices per ring, an array per lot or block
+        self.ring_counts: list[int] = []  # rings per lot
+        self.index: list[int] = []
+        self.ids: list[str] = []
+        self.props: list[dict] = []
+        self.street: list[np.ndarray] = []  # per ring, a flag per position: its edge faces a street
+        self.bad: list[BadLot] = []
+        self.polygons = 0  # lots added or rejected; a file without any has "no polygon"
+        self.end = 0  # lot numbers the parsed features took (GeoJSON)
+
+    def reject(self, index: int, lot_id: str, reason: str) -> None:
+        """A polygon that is bad before any geometry check (malformed, empty)."""
+        self.polygons += 1
+        self.bad.append(BadLot(index, lot_id, reason))
+
+    def add(self, index: int, lot_id: str, rings: list[np.ndarray], props: dict) -> None:
+        """Add a lot: its exterior ring, then its holes. A ``streetWidth`` property (CityEngine's: a
+        number per edge of the exterior ring, > 0 where a street runs) marks its street edges."""
+        if not rings:
+            self.reject(index, lot_id, "empty polygon")
+            return
+        street = [np.zeros(len(ring), dtype=bool) for ring in rings]
+        widths = props.get(STREET_WIDTH)
+        if widths is not None:
+            flags = street_flags(widths, rings[0])
+            if isinstance(flags, str):
+                self.reject(index, lot_id, flags)
+                return
+            street[0] = flags
+            props = {name: value for name, value in props.items() if name != STREET_WIDTH}
+        self.polygons += 1
+        self.rings.extend(rings)
+        self.sizes.append(np.array([len(ring) for ring in rings], dtype=np.int64))
+        self.street.extend(street)
+        self.ring_counts.append(len(rings))
+        self.index.append(index)
+        self.ids.append(lot_id)
+        self.props.append(props)
+
+    def add_block(self, index: np.ndarray, ids: list[str], vertices: np.ndarray, sizes: np.ndarray,
+                  ring_counts: np.ndarray, street: np.ndarray) -> None:
+        """Add many lots at once from columns (a columnar file): ``vertices`` of all their rings,
+        ``sizes`` vertices per ring, ``ring_counts`` rings per lot, ``street`` a flag per vertex. Their
+        properties are not kept here: the caller passes them to ``finish`` as columns."""
+        self.polygons += len(ids)
+        self.rings.append(vertices)
+        self.sizes.append(np.asarray(sizes, dtype=np.int64))
+        self.street.append(street)
+        self.ring_counts.extend(np.asarray(ring_counts).tolist())
+        self.index.extend(np.asarray(index).tolist())
+        self.ids.extend(ids)
+
+    def add_positions(self, index: int, lot_id: str, rings, props: dict) -> None:
+        """Add a lot given as lists of map positions (GeoJSON); extra components are ignored."""
+        try:
+            xy = [_ring_xy(ring) for ring in rings]
+        except (TypeError, ValueError, IndexError):
+            self.reject(index, lot_id, "malformed coordinates")
+            return
+        self.add(index, lot_id, xy, props)
+
+    def finish(self, attrs: dict[str, np.ndarray], source: str) -> Lots:
+        """Clean, orient and validate every lot at once; ``attrs`` are columns over all added lots."""
+        counts = np.concatenate([np.zeros(0, dtype=np.int64), *self.sizes])
+        vertices = np.concatenate([np.zeros((0, 3 if self.world else 2)), *self.rings])
+        if not self.world:
+            # world (x, 0, -y); 0.0 - y keeps z = +0.0 where y = 0
+            x, y = vertices.T
+            vertices = np.column_stack([x, np.zeros_like(x), np.subtract(0.0, y)])
+        keep, owner, ring_offsets = _clean(vertices, offsets_from_counts(counts))
+        vertices = vertices[keep]
+        street = np.zeros(len(vertices), dtype=bool)
+        np.logical_or.at(street, owner, np.concatenate([np.zeros(0, dtype=bool), *self.street]))
+        lot_offsets = offsets_from_counts(np.array(self.ring_counts, dtype=np.int64))
+        normals = _newell(vertices, ring_offsets)
+        exterior = np.zeros(len(normals), dtype=bool)
+        exterior[lot_offsets[:-1]] = True
+        vertex_order, edge_order = _orient(ring_offsets, exterior, normals[:, 1])
+        vertices, street = vertices[vertex_order], street[edge_order]
+        lots = Lots(
+            ids=np.array(self.ids, dtype=object),
+            index=np.array(self.index, dtype=np.int64),
+            vertices=vertices,
+            ring_offsets=ring_offsets,
+            lot_offsets=lot_offsets,
+            street=street,
+            attrs=attrs,
+            bad=(),
+            source=source,
+        )
+        reasons = _validate(lots, normals, self.world)
+        rejected = np.flatnonzero(reasons != "")
+        bad = self.bad + [BadLot(int(lots.index[i]), lots.ids[i], reasons[i]) for i in rejected]
+        good = lots.take(np.flatnonzero(reasons == "")) if len(rejected) else lots  # a copy only to drop some
+        return replace(good, bad=tuple(sorted(bad, key=lambda b: b.index)))
+
+    def finish_file(self, attrs: dict[str, np.ndarray], path) -> Lots:
+        """``finish`` for a whole lots file, which must hold a polygon (a good or a bad one)."""
+        if self.polygons == 0:
+            raise LotsError(f"no polygon in lots file {path}")
+        return self.finish(attrs, str(path))
+
+
+def street_flags(widths, ring: np.ndarray) -> np.ndarray | str:
+    """Where a ring's edges face a street, from a ``streetWidth`` value.
+
+    Parameters
+    ----------
+    widths : object
+      The value: a list of one number per edge, > 0 where the edge faces a street.
+    ring : (k, 2) or (k, 3) float64
+      The exterior ring's positions; a ring given closed has one edge fewer than positions.
+
+    Returns
+    -------
+    flags : (k,) bool or str
+      Per position, whether its edge faces a street (False at a closing position); or why ``widths``
+      does not fit the ring, the bad lot's reason.
+    """
+    if not isinstance(widths, list) or not all(isinstance(w, numbers.Real) for w in widths):
+        return f"{STREET_WIDTH} is not a list of numbers"
+    closed = len(ring) > 1 and np.array_equal(ring[0], ring[-1])
+    edges = len(ring) - 1 if closed else len(ring)
+    if len(widths) != edges:
+        return f"{STREET_WIDTH} has {len(widths)} values for {edges} edges"
+    return np.r_[np.asarray(widths, dtype=np.float64) > 0, np.zeros(int(closed), dtype=bool)]
+
+
+def _ring_xy(ring) -> np.ndarray:
+    """A ring's positions as (k, 2) float64; a third component (elevation) is dropped."""
+    try:
+        array = np.asarray(ring, dtype=np.float64)
+    except ValueError:  # positions of mixed length, e.g. some with an elevation
+        array = np.array([position[:2] for position in ring], dtype=np.float64)
+    if array.size == 0:
+        return np.zeros((0, 2))
+    if array.ndim != 2 or array.shape[1] < 2:
+        raise ValueError("a ring is a list of positions")
+    return array[:, :2]
+
+
+def _feature_id(feature: dict, props: dict, index: int) -> str:
+    for value in (feature.get("id"), props.get("id"), props.get("name")):
+        if value is not None:
+            return str(value)
+    return str(index)
+
+
+def parse_features(features, first_index: int = 0) -> LotBuilder:
+    """The lots of GeoJSON features, whose first polygon is number ``first_index`` of its file (a
+    partition of a GeoJSON sequence starts where the polygons before it end).
+
+    A Polygon is one lot and a MultiPolygon one lot per polygon (ids ``"<feature id>:<k>"``, each with
+    the feature's properties); other geometries are bad lots. A lot's id is the feature's ``id``, else its
+    property ``id``, else ``name``, else its number. The builder's ``end`` is the count of lot numbers
+    the features took, its ``props`` the properties of its lots (``property_columns``).
+    """
+    builder = LotBuilder(world=False)
+    index = first_index
+    for feature in features:
+        if not isinstance(feature, dict):
+            continue
+        props = feature.get("properties") if isinstance(feature.get("properties"), dict) else {}
+        geometry = feature.get("geometry") if isinstance(feature.get("geometry"), dict) else {}
+        kind = geometry.get("type")
+        lot_id = _feature_id(feature, props, index)
+        if kind == "Polygon":
+            builder.add_positions(index, lot_id, geometry.get("coordinates") or [], props)
+            index += 1
+        elif kind == "MultiPolygon" and not geometry.get("coordinates"):
+            builder.reject(index, lot_id, "empty polygon")
+            index += 1
+        elif kind == "MultiPolygon":
+            for k, rings in enumerate(geometry["coordinates"]):
+                builder.add_positions(index, f"{lot_id}:{k}", rings or [], props)
+                index += 1
+        else:
+            builder.bad.append(BadLot(index, lot_id, f"not a polygon ({kind or 'null geometry'})"))
+            index += 1
+    builder.end = index - first_index
+    return builder
+
+
+def property_column(values: list) -> np.ndarray:
+    """One property column, typed over all its values.
+
+    Returns
+    -------
+    column : (n,) float64 or object
+      float64 with nan for None if every value is a number (bools too) or None, else object: ``str``
+      values as they are, None kept, anything else as its JSON text.
+    """
+    if all(v is None or isinstance(v, (numbers.Real, np.bool_)) for v in values):
+        return np.array([np.nan if v is None else float(v) for v in values], dtype=np.float64)
+    column = np.empty(len(values), dtype=object)
+    column[:] = [v if v is None or isinstance(v, str) else json.dumps(v) for v in values]
+    return column
+
+
+def property_columns(props: list[dict]) -> dict[str, np.ndarray]:
+    """Per-lot property dicts as columns (``property_column``), named in first-seen order."""
+    names = dict.fromkeys(name for p in props for name in p)
+    return {name: property_column([p.get(name) for p in props]) for name in names}
+
+
+# ------------------------------------------------------------------------------------- ragged kernels
+
+
+def _ring_positions(ring_offsets: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Per vertex: its ring, its ring's start and its ring's vertex count, each (V,) int64."""
+    counts = np.diff(ring_offsets)
+    ring = np.repeat(np.arange(len(counts)), counts)
+    return ring, ring_offsets[:-1][ring], counts[ring]
+
+
+def _successor(start: np.ndarray, count: np.ndarray) -> np.ndarray:
+    """(V,) int64 index of each vertex's successor in its ring; the last vertex wraps to the first."""
+    at = np.arange(len(start))
+    return np.where(at + 1 < start + count, at + 1, start)
+
+
+def _clean(vertices: np.ndarray, ring_offsets: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Merge consecutive vertices closer than ``TOL.merge``, keeping the first of each run: which
+    vertices stay (V,) bool, the kept vertex each one merges into (V,) int64 (numbered among the kept),
+    and the kept rings' offsets.
+
+    A run may wrap around the ring's end (a closing vertex equal to the first, or a duplicated last
+    vertex): it belongs to the first vertex, which always stays first.
+    """
+    ring, start, count = _ring_positions(ring_offsets)
+    at = np.arange(len(vertices))
+    close_next = np.linalg.norm(vertices[_successor(start, count)] - vertices, axis=1) < TOL.merge
+    close_prev = np.zeros(len(vertices), dtype=bool)
+    close_prev[1:] = close_next[:-1]
+    first = at == start
+    # the last vertex of each ring that is not close to its successor: vertices after it chain into v0
+    last_far = np.full(len(ring_offsets) - 1, -1, dtype=np.int64)
+    np.maximum.at(last_far, ring, np.where(close_next, -1, at))
+    keep = first | (~close_prev & (at <= last_far[ring]))
+    kept = segment_reduce(np.add, keep.astype(np.int64), ring_offsets, 0)
+    owner = np.cumsum(keep) - 1
+    wraps = at > last_far[ring]
+    owner[wraps] = owner[start[wraps]]
+    return keep, owner, offsets_from_counts(kept)
+
+
+def _newell(vertices: np.ndarray, ring_offsets: np.ndarray) -> np.ndarray:
+    """(R, 3) float64 Newell normals, twice the vector area; ``normal[:, 1]`` = 2 x the map signed area.
+
+    The ring's first vertex is subtracted first, so large world coordinates lose no precision.
+    """
+    _, start, count = _ring_positions(ring_offsets)
+    local = vertices - vertices[start]
+    return segment_reduce(np.add, np.cross(local, local[_successor(start, count)]), ring_offsets, 0.0)
+
+
+def _orient(ring_offsets, exterior, normal_y) -> tuple[np.ndarray, np.ndarray]:
+    """Reverse exterior rings with a -Y normal and holes with a +Y one, keeping each ring's first vertex:
+    where each vertex and each edge (from its vertex to the next) comes from, (V,) int64 each.
+
+    A reversed ring of n vertices takes position p from position (n - p) % n: v0, v_{n-1}, ..., v1; its
+    edge p is the old edge (n - p - 1) % n run backwards.
+    """
+    ring, start, count = _ring_positions(ring_offsets)
+    flip = np.where(exterior, normal_y < 0, normal_y > 0)[ring]
+    position = np.arange(len(ring)) - start
+    return (start + np.where(flip, (count - position) % count, position),
+            start + np.where(flip, (count - position - 1) % count, position))
+
+
+def _validate(lots: Lots, normals: np.ndarray, world: bool) -> np.ndarray:
+    """(L,) object: why each lot is bad, "" for a good lot; the first failed check gives the reason."""
+    reasons = np.full(len(lots), "", dtype=object)
+    short_ring = (np.diff(lots.ring_offsets) < 3).astype(np.int64)
+    short = segment_reduce(np.add, short_ring, lots.lot_offsets, 0) > 0
+    reasons[short] = "fewer than 3 distinct vertices"
+    norm = np.linalg.norm(normals, axis=1)
+    wall_ring = (norm >= 2 * TOL.area_floor) & (np.abs(normals[:, 1]) < 0.5 * norm)
+    wall = segment_reduce(np.add, wall_ring.astype(np.int64), lots.lot_offsets, 0) > 0
+    reasons[wall & (reasons == "")] = "not a footprint: face normal is not vertical"
+
+    candidates = np.flatnonzero(reasons == "")
+    polygons = _map_polygons(lots.take(candidates))
+    why = shapely.is_valid_reason(polygons)
+    valid = why == "Valid Geometry"
+    area = shapely.area(polygons)
+    # a symmetric bowtie has zero area too; only a polygon whose convex hull is flat is "zero area"
+    small = area < TOL.area_floor
+    flat = np.zeros(len(candidates), dtype=bool)
+    flat[small] = shapely.area(shapely.convex_hull(polygons[small])) < TOL.area_floor
+    zero = flat | (small & valid)
+    reasons[candidates[zero]] = "zero area"
+    invalid = ~valid & ~zero
+    reasons[candidates[invalid]] = [_geos_reason(text, world) for text in why[invalid]]
+    return reasons
+
+
+def _map_polygons(lots: Lots) -> np.ndarray:
+    """(L,) shapely Polygons in map coordinates (x, -z), rings closed as GeoArrow requires."""
+    xy = np.column_stack([lots.vertices[:, 0], -lots.vertices[:, 2]])
+    closed = np.insert(xy, lots.ring_offsets[1:], xy[lots.ring_offsets[:-1]], axis=0)
+    ring_offsets = lots.ring_offsets + np.arange(len(lots.ring_offsets))
+    offsets = (ring_offsets, lots.lot_offsets)
+    return shapely.from_ragged_array(shapely.GeometryType.POLYGON, closed, offsets)
+
+
+def _geos_reason(text: str, world: bool) -> str:
+    """'Self-intersection[3 4.5]' -> 'self-intersection at (3.0, 4.5)' in the input's coordinates."""
+    match = _GEOS_REASON.match(text)
+    if match is None:
+        return text[:1].lower() + text[1:]
+    what, x, y = match["what"], float(match["x"]), float(match["y"])
+    where = f"x={x}, z={0.0 - y}" if world else f"({x}, {y})"
+    return f"{what[:1].lower()}{what[1:]} at {where}"
