@@ -35,7 +35,8 @@ from grammarc.compiler import Grammar, compile_grammar
 from grammarc.constants import LIMITS, Limits
 from grammarc.errors import ChunkTooLarge, LotFailure, UsageError
 from grammarc.io import OutputOptions, writer_for
-from grammarc.io.lots import BadLot, Lots, default_lot, read_lots
+from grammarc.io.lots import default_lot, read_lots
+from grammarc.model.lots import BadLot, Lots
 from grammarc.model.records import MeshChunk
 from grammarc.workers import worker_pool
 

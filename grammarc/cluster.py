@@ -2,7 +2,7 @@
 
 A region's footprints outgrow one machine; a Dask cluster takes them with no change to the grammar, and
 gives the records a one-process build gives (tests). The build runs in passes, each a task per partition
-of the lots (``io.lot_partitions``):
+of the lots (``io.lots``):
 
 1. counting: each partition's lot numbers (a lot's number seeds its random stream, so a partition must
    know where its numbers start); skipped for a file read whole, whose lots keep their numbers;
@@ -57,8 +57,7 @@ from grammarc.constants import PARTITION_SIZE
 from grammarc.errors import UsageError
 from grammarc.io import OutputOptions, writer_for
 from grammarc.io.assets import resolve_asset
-from grammarc.io.lot_partitions import Partition, count_lots, file_stamp, partition_lots, read_partition
-from grammarc.io.lots import BadLot
+from grammarc.io.lots import Partition, count_lots, file_stamp, partition_lots, read_partition
 from grammarc.io.shards import (
     complete_shard,
     file_digests,
@@ -70,6 +69,7 @@ from grammarc.io.shards import (
     sidecar_path,
     write_json,
 )
+from grammarc.model.lots import BadLot
 
 __all__ = ["build_on_dask"]
 #: Times Dask runs a failed task again.

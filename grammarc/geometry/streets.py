@@ -1,7 +1,7 @@
 """Streets of lots: CityEngine's ``street.front|back|left|right|side`` selectors and the older
 ``streetSide`` / ``noStreetSide``.
 
-A lot's street edges come from its ``streetWidth`` attribute (``io.lots``). CityEngine selects the edges
+A lot's street edges come from its ``streetWidth`` attribute (``io.lot_builder``). CityEngine selects the edges
 (and the faces built on them) that lie along a street as ``street.front``, the rear ones as
 ``street.back`` and those in between as ``street.left`` / ``street.right``. grammarc reads that with a
 *street frame* per lot: z the mean outward normal of its street edges (weighted by length), y up, x = y
@@ -48,7 +48,7 @@ class Streets:
 
 def lot_streets(vertices: np.ndarray, ring_offsets: np.ndarray, lot_offsets: np.ndarray, street: np.ndarray,
                 lot_axes: np.ndarray) -> Streets:
-    """The street edges and frames of lots given as ``io.lots.Lots`` arrays (exterior rings wind
+    """The street edges and frames of lots given as ``model.lots.Lots`` arrays (exterior rings wind
     counter-clockwise seen from above, so an edge's outward normal is its direction turned clockwise)."""
     ring = segment_of(ring_offsets)
     at = np.arange(len(vertices))

@@ -17,9 +17,9 @@ from pathlib import Path
 import numpy as np
 import shapely
 
+from grammarc.atomic import replacing
 from grammarc.errors import LotsError
 from grammarc.io.arrow_lots import import_pyarrow, lots_from_table, table_lot_numbers
-from grammarc.io.atomic import replacing
 from grammarc.io.lot_builder import STREET_WIDTH, LotBuilder
 from grammarc.io.lot_format import LotsFormat, Partition, partitions_at
 from grammarc.model.lots import Lots

@@ -14,8 +14,8 @@ import numpy as np
 from grammarc.errors import LotsError
 from grammarc.io.lot_builder import LotBuilder
 from grammarc.io.lot_format import LotsFormat, read_text
-from grammarc.io.obj import ObjError, read_obj
 from grammarc.model.lots import Lots
+from grammarc.model.obj import ObjError, read_obj
 
 __all__ = ["FORMAT", "read_obj_lots"]
 
