@@ -24,7 +24,6 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from grammarc.backend.occlusion import ANCESTORS
 from grammarc.ir import nodes as ir
 
 __all__ = ["LeafInsert", "LeafRecords", "leaf_inserts"]
@@ -46,6 +45,7 @@ class LeafInsert:
 class LeafRecords:
     """Records of a ``LeafInsert`` symbol made ahead of its turn: emitted when its batch comes."""
 
+    symbol: int
     xform: np.ndarray  # (m, 3, 4) float32
     lot: np.ndarray  # (m,) int32
 
@@ -55,9 +55,7 @@ class LeafRecords:
 
 def leaf_inserts(plan) -> dict[int, LeafInsert]:
     """The symbols of ``plan`` whose rule only places an asset (see the module docstring), by id."""
-    from grammarc.backend.plan import COLOR_SLOT  # the plan module calls this one as it makes a plan
-
-    if plan.leaf_bodies or plan.queries or ANCESTORS[0] in plan.dynamic or COLOR_SLOT in plan.dynamic:
+    if plan.leaf_bodies or plan.queries or plan.occluders or plan.color_slot is not None:
         return {}
     found = {}
     for sym in plan.symbols:
