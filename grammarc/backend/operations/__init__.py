@@ -13,14 +13,13 @@ columns:
 - ``faces``: ``offset``, ``setback``, ``innerRectangle``, ``convexify``, roofs, ``cleanupGeometry``;
 - ``inserts``: ``I``, ``i``, ``label``;
 - ``successors``: successor symbols, ``ε``/``NIL`` and operations without effect;
-- ``attributes``: ``set``, ``color``, ``report``;
+- ``values``: ``set``, ``color``, ``report``;
 - ``control``: ``case`` and ``p%`` blocks.
 
 A new operation is its IR node, its lowering and its function here: importing this package registers them.
 """
 
 from grammarc.backend.operations import (  # noqa: F401 - each registers its operations
-    attributes,
     component_splits,
     control,
     faces,
@@ -28,6 +27,7 @@ from grammarc.backend.operations import (  # noqa: F401 - each registers its ope
     scope,
     splits,
     successors,
+    values,
 )
 from grammarc.backend.operations.table import OPERATIONS, Operation, Parts
 
