@@ -157,7 +157,8 @@ def run_parts(ctx: Context, parts: Parts) -> None:
     for i, body in enumerate(parts.bodies):
         leaf = parts.leaves[i] if parts.leaves else None
         if leaf is not None:
-            ctx.add_counts(np.bincount(leaf.lot, minlength=len(ctx.chunk.shape_count)), body[0].span)
-            ctx.pending[leaf.symbol].append(leaf)
+            records = leaf.records(ctx.chunk.frames.data)
+            ctx.add_counts(np.bincount(records.lot, minlength=len(ctx.chunk.shape_count)), body[0].span)
+            ctx.pending[records.symbol].append(records)
         elif offsets[i + 1] > offsets[i]:
             run(ctx, body, parts.shapes.take(slice(offsets[i], offsets[i + 1])), leaf_at_end=True)

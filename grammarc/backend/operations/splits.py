@@ -16,10 +16,9 @@ import numpy as np
 from grammarc.backend.children import by_part, children, clip, grouped_children
 from grammarc.backend.context import Context
 from grammarc.backend.evaluate import evaluate, evaluate_array
-from grammarc.backend.kernels import scope as scope_kernels
 from grammarc.backend.kernels import split as split_kernels
 from grammarc.backend.kernels.order import group_by
-from grammarc.backend.leaf_parts import LeafRecords
+from grammarc.backend.leaf_parts import LeafPart
 from grammarc.backend.operations.table import Parts, operation
 from grammarc.backend.shapes import Shapes
 from grammarc.constants import TOL
@@ -172,8 +171,8 @@ def _leaf_parts(ctx: Context, parts: tuple[ir.Body, ...], shapes: Shapes, geomet
 def _fan_out_leaves(ctx: Context, op, shapes: Shapes, axis: int, parent, cell, pos, length,
                     leaves: list) -> Parts:
     """The last axis of ``_fan_out`` when some parts only place an asset: their records are computed from
-    ``shapes`` and the cuts (``LeafRecords``, queued for their symbol when the runner reaches their part);
-    the other parts' children are made as usual. Shape counts are kept as the general path keeps them."""
+    ``shapes`` and the cuts when the runner reaches their part (``LeafPart``); the other parts' children
+    are made as usual. Shape counts are kept as the general path keeps them."""
     n_parts = len(op.parts)
     order, offsets = by_part(cell, n_parts)
     # the children, as `_fan_out` counts them: per parent, then per lot (fewer rows to gather)
@@ -184,18 +183,10 @@ def _fan_out_leaves(ctx: Context, op, shapes: Shapes, axis: int, parent, cell, p
     general = [i for i, leaf in enumerate(leaves) if leaf is None]
     kept = np.concatenate([rows[i] for i in general]) if general else order[:0]
     made = children(ctx, shapes, axis, parent, cell, pos, length, op.site, kept) if general else shapes.take(kept)
-    frames = ctx.chunk.frames.data
-    records = []
-    for i, leaf in enumerate(leaves):
-        if leaf is None or not len(rows[i]):
-            records.append(None)
-            continue
-        xform = scope_kernels.leaf_xforms(
-            shapes.origin, shapes.size, shapes.frame, frames, axis, rows[i], parent, pos, length, leaf.size,
-            leaf.relative, leaf.offset if leaf.offset is not None else np.zeros(0))
-        records.append(LeafRecords(leaf.symbol, xform, shapes.lot[parent[rows[i]]]))
+    parts = tuple(None if leaf is None or not len(rows[i]) else
+                  LeafPart(leaf, shapes, axis, rows[i], parent, pos, length) for i, leaf in enumerate(leaves))
     sizes = [len(rows[i]) if leaves[i] is None else 0 for i in range(n_parts)]
-    return Parts(op.parts, made, offsets_from_counts(np.array(sizes, dtype=np.int64)), tuple(records))
+    return Parts(op.parts, made, offsets_from_counts(np.array(sizes, dtype=np.int64)), parts)
 
 
 def _pieces(extent: np.ndarray, offsets: np.ndarray, cuts: np.ndarray):

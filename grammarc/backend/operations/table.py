@@ -65,8 +65,9 @@ class Parts:
     """Shapes an operation made for the bodies of its parts: body k runs on ``shapes`` rows
     ``offsets[k]:offsets[k + 1]`` (``offsets`` (len(bodies) + 1,) int64).
 
-    ``leaves``, when given, has per body the ``LeafRecords`` of a part that only places an asset
-    (``backend.leaf_parts``), queued for its symbol in the parts' order, or None for a body that runs.
+    ``leaves``, when given, has per body the ``LeafPart`` of a part that only places an asset
+    (``backend.leaf_parts``), whose records the runner queues for its symbol when it reaches the part, or
+    None for a body that runs.
     """
 
     bodies: tuple[ir.Body, ...]
