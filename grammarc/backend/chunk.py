@@ -62,43 +62,35 @@ class Outputs:
 
 @dataclass
 class Chunk:
-    """One chunk of lots being derived.
+    """One chunk of lots being derived, made whole by ``derive.initial_chunk``.
 
     ``lot_index`` (L,) int64 numbers the lots in the input (for records and random keys), ``lot_ids``
-    (L,) their identifiers, ``attrs`` the per-lot attribute columns (L,) after overrides, ``lot_origin``
-    (L, 3) and ``lot_axes`` (L, 3, 3) the lots' own scopes (``Scope.tx`` is relative to them).
+    (L,) their identifiers, ``lot_key`` (L,) uint64 their root random keys (``fileRandom`` draws from them),
+    ``attrs`` the per-lot attribute columns (L,) after overrides (evaluated into it in dependency order, as
+    a default may read the attributes before it), ``lot_origin`` (L, 3) and ``lot_axes`` (L, 3, 3) the
+    lots' own scopes (``Scope.tx`` is relative to them), ``streets`` their street edges and street frames
+    (``geometry.streets``). The stores, outputs and counters grow as the derivation goes.
     """
 
     lot_index: np.ndarray
     lot_ids: np.ndarray
+    lot_key: np.ndarray
     attrs: dict[str, np.ndarray]
     lot_origin: np.ndarray
     lot_axes: np.ndarray
+    streets: Streets
     frames: Frames
     polygons: PolygonStore
+    #: The occluders of every lot from a first pass (``inter`` queries), when there was one.
+    foreign: Occluders | None = None
     outputs: Outputs = field(default_factory=Outputs)
     meshes: MeshStore = field(default_factory=MeshStore)
-    #: Occluders made so far (``backend.occlusion``), and those of every lot from a first pass (``inter``).
+    #: Occluders made so far (``backend.occlusion``).
     occluders: OccluderStore = field(default_factory=OccluderStore)
-    foreign: Occluders | None = None
     #: Snap planes of the paper's ``Snap`` / ``SnapLines`` (``backend.snaps``).
     snaps: SnapStore = field(default_factory=SnapStore)
-    #: The lots' street edges and street frames (``geometry.streets``).
-    streets: Streets | None = None
     #: Shapes created so far per lot, for the ``max_shapes`` limit.
-    shape_count: np.ndarray | None = None
-    #: The lots' root random keys (``fileRandom`` draws from them).
-    lot_key: np.ndarray | None = None
-    #: Index of the colour column in ``Shapes.dynamic`` when the grammar sets colours (else no colours
-    #: are recorded and the record's rows are white).
-    color_slot: int | None = None
-    #: Index of the first trim-plane column in ``Shapes.dynamic`` (``plan.TRIM_SLOTS``), and the asset
-    #: meshes (id -> ``AssetMesh`` or None), when inserted geometry is trimmed.
-    trim_slot: int | None = None
-    asset_mesh: object = None
-    #: Index of the ``trim.vertical`` column (0: planes off) when the grammar sets it.
-    trim_switch: int | None = None
+    shape_count: np.ndarray = field(init=False)
 
     def __post_init__(self) -> None:
-        if self.shape_count is None:
-            self.shape_count = np.zeros(len(self.lot_index), dtype=np.int64)
+        self.shape_count = np.zeros(len(self.lot_index), dtype=np.int64)

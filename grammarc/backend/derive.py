@@ -10,22 +10,22 @@ its chunk; sorting the chunk's records by lot (stably) makes the output independ
 from __future__ import annotations
 
 from dataclasses import replace
-from functools import cache
 
 import numpy as np
 
 from grammarc.backend.attributes import attribute_columns
 from grammarc.backend.chunk import Chunk, Frames
+from grammarc.backend.context import Context
 from grammarc.backend.evaluate import Env
-from grammarc.backend.execute import Executor
+from grammarc.backend.execute import apply_pending
 from grammarc.backend.kernels.order import group_by, scatter_rows
-from grammarc.backend.occlusion import ANCESTORS, Occluders
-from grammarc.backend.plan import COLOR_SLOT, TRIM_SLOTS, TRIM_SWITCH, WHITE_RGB, Plan
+from grammarc.backend.occlusion import Occluders
+from grammarc.backend.plan import Plan
 from grammarc.backend.random import lot_keys
 from grammarc.backend.reports import aggregate_chunk
 from grammarc.backend.shapes import Shapes
+from grammarc.backend.slots import ANCESTORS, COLOR_SLOT, TRIM_SLOTS, TRIM_SWITCH, WHITE_RGB
 from grammarc.constants import Limits
-from grammarc.errors import AssetError
 from grammarc.geometry.footprint import footprint_polygons, lot_scopes
 from grammarc.geometry.polygons import PolygonStore
 from grammarc.geometry.streets import lot_streets
@@ -34,8 +34,9 @@ from grammarc.io.npz import MeshChunk, TerminalChunk
 from grammarc.ragged import ragged_take
 
 
-def initial_chunk(lots: Lots) -> tuple[Chunk, Shapes]:
-    """The chunk state and initial shapes (one per lot) of ``lots``."""
+def initial_chunk(lots: Lots, seed: int, foreign: Occluders | None = None) -> tuple[Chunk, Shapes]:
+    """The chunk state and initial shapes (one per lot) of ``lots``, their random keys from ``seed``;
+    ``foreign`` the occluders of every lot from a first pass (``derive_chunk``)."""
     origin, axes, size, local = lot_scopes(lots)
     is_rect, coords, ring_offsets, poly_offsets = footprint_polygons(lots, size, local)
     frames = Frames(capacity=max(256, 4 * len(lots)))
@@ -43,12 +44,13 @@ def initial_chunk(lots: Lots) -> tuple[Chunk, Shapes]:
     geom = np.full(len(lots), -1, dtype=np.int32)
     geom[~is_rect] = polygons.add(coords, ring_offsets, poly_offsets,
                                   np.ones(int((~is_rect).sum()), dtype=np.int8))
-    chunk = Chunk(lot_index=lots.index, lot_ids=lots.ids, attrs={}, lot_origin=origin, lot_axes=axes,
-                  frames=frames, polygons=polygons,
-                  streets=lot_streets(lots.vertices, lots.ring_offsets, lots.lot_offsets, lots.street, axes))
+    key = lot_keys(seed, lots.index)
+    chunk = Chunk(lot_index=lots.index, lot_ids=lots.ids, lot_key=key, attrs={}, lot_origin=origin, lot_axes=axes,
+                  streets=lot_streets(lots.vertices, lots.ring_offsets, lots.lot_offsets, lots.street, axes),
+                  frames=frames, polygons=polygons, foreign=foreign)
     n = len(lots)
-    shapes = Shapes(origin, size, frames.add(axes), geom, np.arange(n, dtype=np.int32),
-                    np.zeros(n, dtype=np.uint64), np.zeros(n, dtype=np.int32))
+    shapes = Shapes(origin, size, frames.add(axes), geom, np.arange(n, dtype=np.int32), key,
+                    np.zeros(n, dtype=np.int32))
     return chunk, shapes
 
 
@@ -63,53 +65,33 @@ def derive_chunk(plan: Plan, lots: Lots, *, seed: int, limits: Limits, overrides
 
     Raises ``LotFailure`` naming lots to skip, ``ChunkTooLarge``, or ``LimitError``.
     """
-    chunk, shapes = initial_chunk(lots)
-    shapes = replace(shapes, key=lot_keys(seed, lots.index))
-    chunk.lot_key = shapes.key
+    chunk, shapes = initial_chunk(lots, seed, foreign)
     attribute_columns(plan.grammar.module, Env(shapes, chunk, plan), lots.attrs, overrides, plan.strings)
     shapes = replace(shapes, dynamic=tuple(initial_dynamic(plan, name, chunk, shapes) for name in plan.dynamic))
-    chunk.color_slot = plan.dynamic.get(COLOR_SLOT)
-    if TRIM_SLOTS[0] in plan.dynamic:
-        chunk.trim_slot = plan.dynamic[TRIM_SLOTS[0]]
-        chunk.trim_switch = plan.dynamic.get(TRIM_SWITCH)
-        chunk.asset_mesh = asset_loader(plan.grammar)
-    chunk.foreign = foreign
-    executor = Executor(plan, chunk, limits, chunk_budget)
-    executor.pending[plan.start].append(shapes)
+    ctx = Context(plan, chunk, limits, chunk_budget)
+    pending = ctx.pending
+    pending[plan.start].append(shapes)
     for stage in plan.stages:
         # A fixed visiting order per round: whether a lot's shapes are processed in a round depends only
         # on that lot, never on which other lots have shapes pending (see the module docstring). Rules
         # that ask occlusion queries wait until nothing else of the stage is pending.
         order = [s.id for s in plan.symbols if s.rules and s.priority <= stage]
         others = [s for s in order if s not in plan.queries]
-        while any(executor.pending.get(s) for s in order):
-            if occluders_only and not any(executor.pending.get(s) for s in others):
+        while any(pending.get(s) for s in order):
+            if occluders_only and not any(pending.get(s) for s in others):
                 return chunk.occluders.table()
             for sym_id in order:
                 # a lot's queries run once it has nothing else pending: waiting for other lots too
                 # changes nothing of its own derivation
-                if sym_id in plan.queries and (occluders_only or any(executor.pending.get(s) for s in others)):
+                if sym_id in plan.queries and (occluders_only or any(pending.get(s) for s in others)):
                     continue
-                batches = executor.pending.pop(sym_id, None)
+                batches = pending.pop(sym_id, None)
                 if batches:
-                    executor.apply_pending(plan.symbols[sym_id], batches)
+                    apply_pending(ctx, plan.symbols[sym_id], batches)
     if occluders_only:
         return chunk.occluders.table()
     reports = aggregate_chunk(chunk.outputs.reports, chunk.lot_index, list(plan.strings.ids))
     return collect(chunk), reports
-
-
-def asset_loader(grammar):
-    """``asset id -> AssetMesh`` (None for an asset no root holds), loaded once per process."""
-    from grammarc.io.bake import load_asset
-
-    @cache
-    def load(asset: int):
-        try:
-            return load_asset(grammar.assets[asset], grammar.asset_roots)
-        except AssetError:
-            return None
-    return load
 
 
 def initial_dynamic(plan: Plan, name: str, chunk: Chunk, shapes: Shapes) -> np.ndarray:

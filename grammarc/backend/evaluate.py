@@ -164,10 +164,10 @@ def _scope_field(name: str, env: Env):
 
 def _scope_angles(env: Env) -> np.ndarray:
     """The scope's rotation relative to its lot's scope, as angles (n, 3) in degrees about x, then y,
-    then z (the order of ``R``): the inverse of ``scope_operations._rotation``."""
+    then z (the order of ``R``): the inverse of ``operations.scope._rotation``."""
     relative = np.einsum("nij,nkj->nik", env.chunk.frames[env.shapes.frame],
                          env.chunk.lot_axes[env.shapes.lot])  # rows: new axes in the lot's frame
-    # relative = Rz @ Ry @ Rx with rows as in scope_operations._rotation; read the angles off its entries
+    # relative = Rz @ Ry @ Rx with rows as in operations.scope._rotation; read the angles off its entries
     ry = np.degrees(np.arcsin(np.clip(-relative[:, 0, 2], -1.0, 1.0)))
     rx = np.degrees(np.arctan2(relative[:, 1, 2], relative[:, 2, 2]))
     rz = np.degrees(np.arctan2(relative[:, 0, 1], relative[:, 0, 0]))

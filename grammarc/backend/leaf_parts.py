@@ -24,10 +24,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from grammarc.backend.occlusion import ANCESTORS
+from grammarc.backend.kernels.scope import leaf_xforms
+from grammarc.backend.shapes import Shapes
 from grammarc.ir import nodes as ir
 
-__all__ = ["LeafInsert", "LeafRecords", "leaf_inserts"]
+__all__ = ["LeafInsert", "LeafPart", "LeafRecords", "leaf_inserts"]
 
 
 @dataclass(frozen=True)
@@ -46,6 +47,7 @@ class LeafInsert:
 class LeafRecords:
     """Records of a ``LeafInsert`` symbol made ahead of its turn: emitted when its batch comes."""
 
+    symbol: int
     xform: np.ndarray  # (m, 3, 4) float32
     lot: np.ndarray  # (m,) int32
 
@@ -53,11 +55,32 @@ class LeafRecords:
         return len(self.lot)
 
 
+@dataclass(frozen=True, eq=False)
+class LeafPart:
+    """A split part naming a ``LeafInsert`` symbol: its children ``rows`` (k,) of the split's cut (each
+    child's ``parent`` row of ``shapes``, ``pos`` and ``length`` along ``axis``), whose records the body
+    runner makes when it reaches the part (``records``), where it would have run the part's body."""
+
+    leaf: LeafInsert
+    shapes: Shapes
+    axis: int
+    rows: np.ndarray
+    parent: np.ndarray
+    pos: np.ndarray
+    length: np.ndarray
+
+    def records(self, frames: np.ndarray) -> LeafRecords:
+        """The part's records from the chunk's frame table ``frames`` (F, 3, 3) (``kernels.scope.leaf_xforms``)."""
+        leaf, shapes = self.leaf, self.shapes
+        xform = leaf_xforms(shapes.origin, shapes.size, shapes.frame, frames, self.axis, self.rows, self.parent,
+                            self.pos, self.length, leaf.size, leaf.relative,
+                            leaf.offset if leaf.offset is not None else np.zeros(0))
+        return LeafRecords(leaf.symbol, xform, shapes.lot[self.parent[self.rows]])
+
+
 def leaf_inserts(plan) -> dict[int, LeafInsert]:
     """The symbols of ``plan`` whose rule only places an asset (see the module docstring), by id."""
-    from grammarc.backend.plan import COLOR_SLOT  # the plan module calls this one as it makes a plan
-
-    if plan.leaf_bodies or plan.queries or ANCESTORS[0] in plan.dynamic or COLOR_SLOT in plan.dynamic:
+    if plan.leaf_bodies or plan.queries or plan.occluders or plan.color_slot is not None:
         return {}
     found = {}
     for sym in plan.symbols:

@@ -51,7 +51,7 @@ def store_fitted(chunk: Chunk, verts: np.ndarray, ring_offsets, face_offsets, me
 def build_roofs(chunk: Chunk, shapes: Shapes, kind: str, polygons, value, by_height: bool, overhang,
                 index, cap=None) -> tuple[Shapes, np.ndarray]:
     """Roof shapes over ``shapes``' polygons (``polygons``: coords, ring_offsets, shape_offsets and the
-    plane of each, as ``Executor.polygons_of`` gives them) and a mask (n,) of the shapes whose roof
+    plane of each, as ``outlines.polygons_of`` gives them) and a mask (n,) of the shapes whose roof
     could not be built (their shapes keep their old geometry and must be reported)."""
     coords, ring_offsets, shape_offsets, plane = polygons
     rows = np.arange(len(shapes))
@@ -209,7 +209,7 @@ def clean_meshes(chunk: Chunk, shapes: Shapes, tolerance: np.ndarray, component:
 
 
 def clean_polygons(chunk: Chunk, shapes: Shapes, polygons, tolerance: np.ndarray, component: str) -> np.ndarray:
-    """``cleanupGeometry`` of polygon shapes (``polygons`` as ``Executor.polygons_of`` gives them), each
+    """``cleanupGeometry`` of polygon shapes (``polygons`` as ``outlines.polygons_of`` gives them), each
     its one face, in their scopes: their new ``geom`` codes (n,). A polygon that changed is stored anew,
     one whose face went becomes an empty mesh (its scope stays, for the operations after it), the others
     keep their codes (a flat rectangle its fast path). A prism is cleaned through its base, which is not

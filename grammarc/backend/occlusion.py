@@ -28,6 +28,7 @@ import numpy as np
 import shapely
 
 from grammarc.backend.shapes import asset_geom, face_axes
+from grammarc.backend.slots import ANCESTORS
 from grammarc.constants import TOL
 from grammarc.geometry.clip import scope_polygons
 from grammarc.geometry.meshes import is_polygon
@@ -42,8 +43,6 @@ from grammarc.geometry.occlusion import (
 )
 from grammarc.geometry.polygons import PLANE_U, PLANE_V
 
-#: The per-shape columns of the ids of its nearest occluding ancestors (NaN: none), nearest first.
-ANCESTORS = tuple(f"occluder.{k}" for k in range(4))
 #: Occluders per lot are numbered below this.
 _PER_LOT = 2 ** 24
 #: A sightline: one edge between its two ends.
@@ -158,6 +157,25 @@ def with_ancestor(plan, shapes, ident: np.ndarray):
         dynamic[slots[k]] = np.where(has, dynamic[slots[k - 1]], dynamic[slots[k]])
     dynamic[slots[0]] = np.where(has, ident, dynamic[slots[0]])
     return replace(shapes, dynamic=tuple(dynamic))
+
+
+def take_apart(ctx, shapes, children, parent: np.ndarray):
+    """``children`` (a component split's, of ``shapes`` rows ``parent`` (m,)) carrying their parents as
+    occluding ancestors: the parents, solids taken apart, become occluders, once each
+    (``Context.taken_apart``)."""
+    if not ctx.plan.occluders:
+        return children
+    ident = ctx.taken_apart.get(shapes)
+    if ident is None:
+        ident = ctx.taken_apart[shapes] = add_occluders(ctx.chunk, shapes, occluder_label(ctx.plan, ctx.symbol),
+                                                        active=False)
+    return with_ancestor(ctx.plan, children, ident[parent])
+
+
+def occluder_label(plan, symbol: int) -> str | None:
+    """The label of the occluders a rule of ``symbol`` makes: the paper names a shape by its symbol
+    (``Shape.occ("balcony")``); CityEngine labels with ``label()`` only."""
+    return None if plan.leaf_bodies else plan.symbols[symbol].name
 
 
 def query(expr, env, distance: np.ndarray | None = None) -> np.ndarray:

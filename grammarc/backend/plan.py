@@ -5,17 +5,14 @@ The derivation looks everything up here by symbol id; nothing in it refers to sy
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass, field, replace
 
 from grammarc.backend.leaf_parts import leaf_inserts
-from grammarc.backend.occlusion import ANCESTORS
+from grammarc.backend.slots import ANCESTORS, COLOR_SLOT, TRIM_SLOTS, TRIM_SWITCH
 from grammarc.compiler import Grammar
 from grammarc.ir import nodes as ir
 from grammarc.ir.traverse import iter_exprs, iter_ops, op_exprs
-
-#: The per-shape column of the colour set by ``color()``: 0xRRGGBB as a float (white to begin with).
-COLOR_SLOT = "#color"
-WHITE_RGB = float(0xFFFFFF)
 
 
 class Strings:
@@ -69,18 +66,32 @@ class Plan:
     queries: frozenset[int] = frozenset()
     inter: bool = False
     #: Symbols whose rules split on snap planes: each lot's shapes are taken one after the other
-    #: (``Executor.apply``).
+    #: (``execute.apply``).
     snapping: frozenset[int] = frozenset()
     #: Symbols whose rule only places an asset, by id: split parts naming them skip the shape stage
     #: (``backend.leaf_parts``).
     leaf_inserts: dict = field(default_factory=dict)
+    #: Indices into ``Shapes.dynamic`` of the columns the derivation adds (``backend.slots``), None where
+    #: the grammar needs none: the colour (else no colours are recorded and the rows are white), the first
+    #: of the trim planes (when inserted geometry is trimmed) and ``trim.vertical`` (when the grammar sets it).
+    color_slot: int | None = None
+    trim_slot: int | None = None
+    trim_switch: int | None = None
+    #: Whether shapes carry their occluding ancestors (``backend.occlusion``): the grammar asks occlusion
+    #: queries or labels shapes.
+    occluders: bool = False
+    #: ``load_asset(name, asset_roots) -> AssetMesh``: how trimmed inserts get their asset's triangles (set
+    #: by whoever makes the plan: the derivation reads no asset file of its own accord).
+    load_asset: Callable | None = None
 
     @property
     def symbol_names(self) -> tuple[str, ...]:
         return tuple(s.name for s in self.symbols)
 
 
-def make_plan(grammar: Grammar) -> Plan:
+def make_plan(grammar: Grammar, *, load_asset: Callable | None = None) -> Plan:
+    """The plan of ``grammar``; ``load_asset(name, asset_roots) -> AssetMesh`` loads the assets whose
+    inserts are trimmed (``Plan.load_asset``)."""
     module = grammar.module
     names = list(grammar.graph.nonterminals) + list(grammar.graph.terminals)
     ids = {name: i for i, name in enumerate(names)}
@@ -116,30 +127,25 @@ def make_plan(grammar: Grammar) -> Plan:
     for selector in ir.FACE_SELECTORS:
         strings.intern(selector)
     asset_of_string = {strings.intern(raw): asset for raw, asset in grammar.asset_ids.items()}
-    plan = Plan(grammar, tuple(symbols), ids, ids[grammar.graph.start], strings, stages, dynamic,
-                module.dialect == "cityengine", not_applied, asset_of_string, frozenset(occlusion),
-                any(e.target != "intra" for found in occlusion.values() for e in found),
-                frozenset(s.id for s in symbols if any(getattr(op, "snap", False) for rule in s.rules
-                                                       for alt in rule.alternatives for op in iter_ops(alt.body))))
+    trim_slot = dynamic.get(TRIM_SLOTS[0])
+    plan = Plan(
+        grammar=grammar, symbols=tuple(symbols), symbol_ids=ids, start=ids[grammar.graph.start], strings=strings,
+        stages=stages, dynamic=dynamic, leaf_bodies=module.dialect == "cityengine", not_applied=not_applied,
+        asset_of_string=asset_of_string, queries=frozenset(occlusion),
+        inter=any(e.target != "intra" for found in occlusion.values() for e in found),
+        snapping=frozenset(s.id for s in symbols if any(getattr(op, "snap", False) for rule in s.rules
+                                                        for alt in rule.alternatives for op in iter_ops(alt.body))),
+        color_slot=dynamic.get(COLOR_SLOT), trim_slot=trim_slot,
+        trim_switch=dynamic.get(TRIM_SWITCH) if trim_slot is not None else None,
+        occluders=ANCESTORS[0] in dynamic, load_asset=load_asset or _load_asset)
     return replace(plan, leaf_inserts=leaf_inserts(plan))
 
 
-#: Per-shape columns of a shape's two vertical trim planes, (nx, ny, nz, d) each in world coordinates:
-#: inserted geometry keeps the side where n . X + d >= 0 (NaN: no plane).
-TRIM_SLOTS = tuple(f"trim.{k}" for k in range(8))
-#: ``set(trim.vertical, false)`` turns the planes off for a shape and its successors (1: on, 0: off).
-TRIM_SWITCH = "trim.vertical"
+def _load_asset(name: str, asset_roots):
+    """The loader of a plan made without one: until the builders pass theirs (to go then)."""
+    from grammarc.io.bake import load_asset
 
-
-#: Operations after which a body's shape is not the body's to emit: it was replaced by successors, split
-#: into parts, deleted, or handed to case branches (which emit their own leaves).
-_CONSUMING = (ir.Symbol, ir.Empty, ir.Split, ir.Repeat, ir.Comp, ir.GroupSplit, ir.CompFaces, ir.Insert,
-              ir.Case, ir.Stochastic, ir.Setback, ir.InnerRectangle)
-
-
-def consumes(body: ir.Body) -> bool:
-    """Whether ``body`` replaces its shape (CityEngine: a body that does not leaves a leaf)."""
-    return any(isinstance(op, _CONSUMING) for op in body)
+    return load_asset(name, asset_roots)
 
 
 def _all_exprs(module: ir.Module):

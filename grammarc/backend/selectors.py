@@ -3,8 +3,8 @@ directions) ``front``, ``top``, ``vertical``, ``aslant``... name.
 
 Normals are in the parent's scope frame (front +z, back -z, right +x, left -x, top +y, bottom -y), or in the
 lot's (``object.``), the world's (``world.``) or the lot's street frame (``street.``, ``geometry.streets``)
-when a selector names that frame; ``street.front`` also takes the faces and edges that lie along a
-street (``street_along``). ``streetSide`` and ``noStreetSide``, CityEngine's older names, are
+when a selector names that frame (``selector_frames`` turns them into it); ``street.front`` also takes the
+faces and edges that lie along a street (``street_along``). ``streetSide`` and ``noStreetSide``, CityEngine's older names, are
 ``street.front`` and the other side edges of lots with street edges, and nothing on other lots (PRT's
 reporting.rpk sets nothing back on the kit's footprints, which have none); ``street.`` selectors fall
 back to the lot's own frame there, as CityEngine documents.
@@ -13,6 +13,8 @@ back to the lot's own frame there, as CityEngine documents.
 from __future__ import annotations
 
 import numpy as np
+
+from grammarc.geometry.streets import along_street
 
 #: A face is "top" or "bottom" when its normal is within 45 degrees of the scope's y axis; "horizontal"
 #: and "vertical" within this tolerance of exactly so.
@@ -73,3 +75,23 @@ def classify_edges(direction: np.ndarray | None, selectors: tuple[str, ...], n: 
     for i in range(len(selectors) - 1, -1, -1):
         which[masks[selectors[i]]] = i
     return which
+
+
+def selector_frames(chunk, normal: np.ndarray, shapes, parent: np.ndarray, selectors,
+                    base: tuple[np.ndarray, np.ndarray] | None = None) -> dict | None:
+    """Normals (m, 3) of components of ``shapes`` rows ``parent`` (m,) in the world's, the lot's and its
+    street's frames when a selector names them (``world.``, ``object.``, ``street.``), and which components
+    lie along a street: their base edges ``base`` (start, end: (m, 3) world points), if given, on one of
+    their lot's street edges. None when no selector names a frame."""
+    if not any("." in s or s in STREET_ALIASES for s in selectors):
+        return None
+    world = np.einsum("mi,mij->mj", normal, chunk.frames[shapes.frame][parent])
+    lot = shapes.lot[parent]
+    frames = {"world": world, "object": np.einsum("mj,mij->mi", world, chunk.lot_axes[lot])}
+    streets = chunk.streets
+    if any(s.startswith("street.") or s in STREET_ALIASES for s in selectors):
+        frames["street"] = np.einsum("mj,mij->mi", world, streets.axes[lot])
+        frames["street_along"] = (along_street(streets, lot, base[0], base[1], world) if base is not None
+                                  else np.zeros(len(lot), dtype=bool))
+        frames["street_known"] = np.diff(streets.lot_offsets)[lot] > 0
+    return frames

@@ -21,7 +21,7 @@ possibly mirrored along scope axes (``mirror``): ``asset_geom`` and ``asset_of``
 
 from __future__ import annotations
 
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, fields, replace
 
 import numpy as np
 
@@ -98,3 +98,7 @@ class Shapes:
             params=tuple(np.concatenate([b.params[i] for b in batches]) for i in range(len(first.params))),
             dynamic=tuple(np.concatenate([b.dynamic[i] for b in batches]) for i in range(len(first.dynamic))),
         )
+
+
+#: The names of a batch's columns, in order.
+COLUMNS = tuple(f.name for f in fields(Shapes))

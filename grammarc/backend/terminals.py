@@ -18,7 +18,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from grammarc.backend.chunk import Chunk
+from grammarc.backend.context import Context
 from grammarc.backend.kernels.scope import xforms
 from grammarc.backend.mesh_shapes import mesh_leaves
 from grammarc.backend.shapes import Shapes, asset_of, face_axes
@@ -41,38 +41,39 @@ def instance_xform(axes: np.ndarray, size: np.ndarray, origin: np.ndarray) -> np
     return xform
 
 
-def emit_instances(chunk: Chunk, shapes: Shapes, asset: int, symbol: int, mirrored: int = 0) -> None:
+def emit_instances(ctx: Context, shapes: Shapes, asset: int, symbol: int, mirrored: int = 0) -> None:
     """Instances of ``asset`` on the scopes of ``shapes``; ``mirrored`` bits (1 x, 2 y, 4 z) flip the
-    asset along those scope axes (the column is negated and the origin moved to the far side)."""
+    asset along those scope axes (the column is negated and the origin moved to the far side). Where the
+    grammar trims inserts, those crossing their trim planes become the asset's triangles cut by them."""
     if not len(shapes):
         return
+    chunk = ctx.chunk
     xform = xforms(chunk.frames.data, shapes.frame, shapes.size, shapes.origin)
     for axis in range(3):
         if mirrored >> axis & 1:
             xform[:, :, 3] += xform[:, :, axis]
             xform[:, :, axis] *= -1
-    if chunk.trim_slot is not None:
-        planes = _trim_planes(chunk, shapes)
+    if ctx.plan.trim_slot is not None:
+        planes = _trim_planes(ctx.plan, shapes)
         cut = boxes_crossing(planes, xform.astype(np.float64), TOL.zero)
-        mesh = chunk.asset_mesh(asset) if cut.any() else None
+        mesh = ctx.asset_mesh(asset) if cut.any() else None
         if mesh is not None:
-            trimmed = _trimmed(chunk, shapes.take(cut), xform[cut], planes[cut], mesh, symbol)
+            trimmed = _trimmed(ctx.plan, shapes.take(cut), xform[cut], planes[cut], mesh, symbol)
             chunk.outputs.meshes.append(trimmed)
             shapes, xform = shapes.take(~cut), xform[~cut]
-    _append(chunk, shapes, xform, asset, symbol)
+    _append(ctx, shapes, xform, asset, symbol)
 
 
-def _trim_planes(chunk: Chunk, shapes: Shapes) -> np.ndarray:
+def _trim_planes(plan, shapes: Shapes) -> np.ndarray:
     """The shapes' trim planes (n, 8), NaN where there are none or ``set(trim.vertical, false)``."""
-    slot = chunk.trim_slot
+    slot = plan.trim_slot
     planes = np.stack(shapes.dynamic[slot:slot + 8], axis=1)
-    if chunk.trim_switch is not None:
-        planes[shapes.dynamic[chunk.trim_switch] == 0] = np.nan
+    if plan.trim_switch is not None:
+        planes[shapes.dynamic[plan.trim_switch] == 0] = np.nan
     return planes
 
 
-def _trimmed(chunk: Chunk, shapes: Shapes, xform: np.ndarray, planes: np.ndarray, mesh,
-             symbol: int) -> MeshChunk:
+def _trimmed(plan, shapes: Shapes, xform: np.ndarray, planes: np.ndarray, mesh, symbol: int) -> MeshChunk:
     """The asset's triangles placed by ``xform`` and cut by the shapes' trim ``planes``, as mesh faces."""
     vertices, ring_offsets, owner = trim_triangles(mesh.vertices, mesh.faces, xform.astype(np.float64),
                                                    planes, TOL.zero)
@@ -80,23 +81,29 @@ def _trimmed(chunk: Chunk, shapes: Shapes, xform: np.ndarray, planes: np.ndarray
         vertices=vertices.astype(np.float32), ring_offsets=ring_offsets,
         face_offsets=np.arange(len(owner) + 1, dtype=np.int64), lot=shapes.lot[owner].astype(np.int32),
         symbol=np.full(len(owner), symbol, dtype=np.int32),
-        color=rgba(shapes.dynamic[chunk.color_slot][owner]) if chunk.color_slot is not None else None)
+        color=_colors(plan, shapes, owner))
 
 
-def _append(chunk: Chunk, shapes: Shapes, xform: np.ndarray, asset: int, symbol: int) -> None:
-    append_records(chunk, xform, shapes.lot, asset, symbol,
-                   shapes.dynamic[chunk.color_slot] if chunk.color_slot is not None else None)
+def _colors(plan, shapes: Shapes, rows=slice(None)) -> np.ndarray | None:
+    """The colours (m, 4) uint8 of ``shapes`` rows ``rows``, where the grammar sets colours."""
+    return rgba(shapes.dynamic[plan.color_slot][rows]) if plan.color_slot is not None else None
 
 
-def append_records(chunk: Chunk, xform: np.ndarray, lot: np.ndarray, asset: int, symbol: int,
+def _append(ctx: Context, shapes: Shapes, xform: np.ndarray, asset: int, symbol: int) -> None:
+    color_slot = ctx.plan.color_slot
+    append_records(ctx, xform, shapes.lot, asset, symbol,
+                   shapes.dynamic[color_slot] if color_slot is not None else None)
+
+
+def append_records(ctx: Context, xform: np.ndarray, lot: np.ndarray, asset: int, symbol: int,
                    color: np.ndarray | None) -> None:
     """Add instance records: transforms, lots, and colours (0xRRGGBB floats) where the grammar sets them."""
-    out = chunk.outputs
+    out = ctx.chunk.outputs
     out.xform.append(xform)
     out.asset.append(np.full(len(lot), asset, dtype=np.int32))
     out.lot.append(lot.astype(np.int32))
     out.symbol.append(np.full(len(lot), symbol, dtype=np.int32))
-    if chunk.color_slot is not None:
+    if ctx.plan.color_slot is not None:
         out.color.append(rgba(color))
 
 
@@ -107,37 +114,38 @@ def rgba(packed: np.ndarray) -> np.ndarray:
                     axis=1).astype(np.uint8)
 
 
-def emit_leaves(chunk: Chunk, shapes: Shapes, symbol: int) -> None:
+def emit_leaves(ctx: Context, shapes: Shapes, symbol: int) -> None:
     """Emit the geometry of leaf shapes: instances for scope boxes and rectangles, meshes for polygons."""
     if not len(shapes):
         return
+    chunk = ctx.chunk
     assets = shapes.geom < -1
     if assets.any():
         for code in np.unique(shapes.geom[assets]):
             asset, mirrored = asset_of(np.array([code]))
-            emit_instances(chunk, shapes.take(shapes.geom == code), int(asset[0]), symbol, int(mirrored[0]))
+            emit_instances(ctx, shapes.take(shapes.geom == code), int(asset[0]), symbol, int(mirrored[0]))
     box = shapes.geom == -1
     flat = shapes.size <= TOL.zero
     zeros = flat.sum(axis=1)
-    emit_instances(chunk, shapes.take(box & (zeros == 0)), CUBE, symbol)
+    emit_instances(ctx, shapes.take(box & (zeros == 0)), CUBE, symbol)
     is_quad = box & (zeros == 1)
     quads = shapes.take(is_quad)
     if len(quads):
         permuted_axes, permuted_size = face_axes(chunk.frames[quads.frame], quads.size,
                                                  np.argmax(flat[is_quad], axis=1))
         permuted_size[:, 2] = 0.0
-        _append(chunk, quads, instance_xform(permuted_axes, permuted_size, quads.origin), QUAD, symbol)
+        _append(ctx, quads, instance_xform(permuted_axes, permuted_size, quads.origin), QUAD, symbol)
     polygons = shapes.take(is_polygon(shapes.geom))
     if len(polygons):
-        chunk.outputs.meshes.append(polygon_meshes(chunk, polygons, symbol))
+        chunk.outputs.meshes.append(polygon_meshes(ctx, polygons, symbol))
     meshes = shapes.take(is_mesh(shapes.geom))
     if len(meshes):
-        colors = rgba(meshes.dynamic[chunk.color_slot]) if chunk.color_slot is not None else None
-        chunk.outputs.meshes.append(mesh_leaves(chunk, meshes, symbol, colors))
+        chunk.outputs.meshes.append(mesh_leaves(chunk, meshes, symbol, _colors(ctx.plan, meshes)))
 
 
-def polygon_meshes(chunk: Chunk, shapes: Shapes, symbol: int) -> MeshChunk:
+def polygon_meshes(ctx: Context, shapes: Shapes, symbol: int) -> MeshChunk:
     """Faces of polygon shapes in world coordinates: the polygon, or a prism's bottom, top and sides."""
+    chunk = ctx.chunk
     coords, ring_offsets, poly_offsets = chunk.polygons.gather(shapes.geom)
     plane = chunk.polygons.plane[shapes.geom]
     a_axis, b_axis = PLANE_U[plane], PLANE_V[plane]
@@ -187,7 +195,7 @@ def polygon_meshes(chunk: Chunk, shapes: Shapes, symbol: int) -> MeshChunk:
         face_offsets=offsets_from_counts(rings_per_face),
         lot=shapes.lot[face_owner].astype(np.int32),
         symbol=np.full(len(face_owner), symbol, dtype=np.int32),
-        color=rgba(shapes.dynamic[chunk.color_slot][face_owner]) if chunk.color_slot is not None else None,
+        color=_colors(ctx.plan, shapes, face_owner),
     )
 
 

@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 import shapely
 from conftest import LOT_ZOO
-from test_cityengine import assets, face_area, mesh_faces, names, per_lot, rect, run, totals
+from operations.derivations import assets, face_area, mesh_faces, names, per_lot, rect, run, totals
 
 from grammarc.build import BuildOptions, derive
 from grammarc.compiler import compile_grammar

@@ -4,7 +4,7 @@ building meets its neighbour (inter, the same whatever the chunking), and labell
 from __future__ import annotations
 
 import numpy as np
-from test_cityengine import names, rect, run
+from operations.derivations import names, rect, run
 
 MASSES = """
 Lot --> [ s('0.6, '1, '1) Mass ] t('0.4, 0, 0) s('0.6, '1, '1) Mass

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from test_cityengine import names, rect, run
+from operations.derivations import names, rect, run
 
 from grammarc.backend.kernels.split import snap_subdiv
 from grammarc.backend.snaps import SnapStore

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from test_cityengine import VERSION, names, rect, totals
+from operations.derivations import VERSION, names, rect, totals
 
 from grammarc.build import BuildOptions, derive
 from grammarc.compiler import compile_grammar

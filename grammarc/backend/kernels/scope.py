@@ -68,8 +68,8 @@ def xforms(frames, frame, size, origin):
 def leaf_xforms(origin, size, frame, frames, axis, rows, parent, pos, length, new_size, relative, offset):
     """Record transforms (m, 3, 4) float32 of split children ``rows`` whose symbol only places an asset
     after a constant ``S`` and ``T`` (``leaf_parts``): the child's scope as ``place_children`` makes it,
-    sized as ``Executor.scale`` and moved as ``Executor.translate`` would (the same operations in the same
-    order, so the same bits), then as ``xforms``. ``new_size`` (3,): NaN keeps the axis' size, else an
+    sized as ``operations.scope.scale`` and moved as ``operations.scope.translate`` would (the same
+    operations in the same order, so the same bits), then as ``xforms``. ``new_size`` (3,): NaN keeps the axis' size, else an
     absolute size or, where ``relative``, a factor; ``offset`` (3,) along the scope axes, or empty."""
     m = len(rows)
     out = np.empty((m, 3, 4), np.float32)

@@ -1,0 +1,144 @@
+"""The children of a split: scopes placed along the split axis, polygons and meshes cut to their slabs,
+and the split or component context (``split.index``, ``comp.total``...) of new children.
+
+A split operation computes where its children lie along one axis (parent, position, length, and a number:
+their cell or index); ``clip`` cuts the geometry of polygon and mesh parents to those slabs (dropping the
+children left empty), and ``children`` makes the child shapes: the parent's scope moved and cut, a new
+random key, the parent's parameters and attributes, the context the grammar reads.
+"""
+
+from __future__ import annotations
+
+from dataclasses import replace
+
+import numpy as np
+
+from grammarc.backend import mesh_shapes
+from grammarc.backend.chunk import Chunk
+from grammarc.backend.context import Context
+from grammarc.backend.kernels import scope as scope_kernels
+from grammarc.backend.kernels.order import group_by
+from grammarc.backend.plan import Plan
+from grammarc.backend.shapes import Shapes
+from grammarc.geometry.clip import clip_to_slabs
+from grammarc.geometry.meshes import is_mesh, is_polygon
+from grammarc.ragged import ragged_take
+
+
+def children(ctx: Context, shapes: Shapes, axis: int, parent, index, pos, length, site: int, order=None,
+             geometry=None) -> Shapes:
+    """Children of a split along ``axis``: the parent's scope moved by ``pos`` and cut to ``length``.
+
+    ``order`` (default: as given) picks and orders the children; ``geometry`` (from ``clip``) gives
+    the clipped pieces their own boxes and polygons.
+    """
+    frames = ctx.chunk.frames
+    if order is None:
+        order = np.arange(len(parent))
+    origin, size, key, frame, geom, lot, depth, parents = scope_kernels.place_children(
+        shapes.origin, shapes.size, shapes.key, shapes.frame, shapes.geom, shapes.lot, shapes.depth,
+        frames.data, axis, order, parent, pos, length, site, index,
+    )
+    if geometry is not None:
+        is_piece, piece_geom, low, extent = (g[order] for g in geometry)
+        rows = np.flatnonzero(is_piece)
+        axes = frames[frame[rows]]
+        origin[rows] = shapes.origin[parents[rows]] + np.einsum("ni,nij->nj", low[rows], axes)
+        size[rows] = extent[rows]
+        geom[rows] = piece_geom[rows]
+    made = Shapes(origin, size, frame, geom, lot, key, depth, tuple(p[parents] for p in shapes.params),
+                  tuple(d[parents] for d in shapes.dynamic))
+    return with_context(ctx.plan, made, "split", index[order], parents, len(shapes))
+
+
+def grouped_children(ctx: Context, shapes: Shapes, axis: int, parent, cell, pos, length, site: int,
+                     n_parts: int, geometry=None) -> tuple[Shapes, np.ndarray]:
+    """``children`` ordered by body part (cell mod parts), each part's batch then a slice, and where each
+    part's slice starts (``offsets`` (n_parts+1,))."""
+    order, offsets = by_part(cell, n_parts)
+    return children(ctx, shapes, axis, parent, cell, pos, length, site, order, geometry), offsets
+
+
+def by_part(cell: np.ndarray, n_parts: int) -> tuple[np.ndarray, np.ndarray]:
+    """Children ordered by body part (cell mod parts), and where each part's run starts (``group_by``)."""
+    return group_by(cell % n_parts if n_parts > 1 else np.zeros_like(cell), n_parts)
+
+
+def with_context(plan: Plan, shapes: Shapes, kind: str, index, parents, n_parents: int, selector=None) -> Shapes:
+    """Set ``split.index``/``split.total`` (or ``comp.*``) of new children, where the grammar reads
+    them: the child's number and its parent's number of children."""
+    dynamic = list(shapes.dynamic)
+    slots = plan.dynamic
+    if f"{kind}.index" in slots:
+        dynamic[slots[f"{kind}.index"]] = index.astype(np.float64)
+    if f"{kind}.total" in slots:
+        dynamic[slots[f"{kind}.total"]] = np.bincount(parents, minlength=n_parents)[parents].astype(np.float64)
+    if selector is not None and "comp.sel" in slots:
+        dynamic[slots["comp.sel"]] = selector
+    return replace(shapes, dynamic=tuple(dynamic))
+
+
+def clip(chunk: Chunk, shapes: Shapes, axis: int, parent, step, pos, length, index):
+    """Children of polygons split across their plane become the pieces of the polygon in their slabs
+    (``geometry.clip``): empty ones go, a slab that cuts the polygon apart gives one child a piece.
+    Children of meshes (roofs, envelopes) become the mesh cut to their slab and closed
+    (``mesh_shapes.clip_meshes``).
+
+    Takes and returns the split's children as (parent, step, pos, length, index) arrays, and the
+    pieces' geometry for ``children`` (None when no child is a polygon split across its plane).
+    """
+    if len(chunk.meshes) and is_mesh(shapes.geom[parent]).any():
+        parent, step, pos, length, index, meshes = _clip_meshes(chunk, shapes, axis, parent, step, pos, length,
+                                                                index)
+    else:
+        meshes = None
+    store = chunk.polygons
+    geom = shapes.geom[parent]
+    poly = np.flatnonzero(is_polygon(geom))
+    poly = poly[store.plane[geom[poly]] != axis]
+    if not len(poly):
+        return parent, step, pos, length, index, meshes
+    clipped = clip_to_slabs(store, geom[poly], shapes.size[parent[poly]], axis, pos[poly], length[poly])
+    whole = np.ones(len(parent), dtype=bool)
+    whole[poly] = False
+    rows = np.concatenate([np.flatnonzero(whole), poly[clipped.source]])
+    piece = np.concatenate([np.full(int(whole.sum()), -1), np.arange(len(clipped.source))])
+    order = np.lexsort((piece, rows))  # pieces take their child's place, in GEOS's order
+    rows, piece = rows[order], piece[order]
+    new_geom = np.full(len(clipped.source), -1, dtype=np.int32)
+    shaped = np.flatnonzero(~clipped.is_rect)
+    if len(shaped):
+        rings, poly_offsets = ragged_take(clipped.poly_offsets, shaped)
+        vertices, ring_offsets = ragged_take(clipped.ring_offsets, rings)
+        new_geom[shaped] = store.add(clipped.coords[vertices], ring_offsets, poly_offsets, clipped.plane[shaped])
+    is_piece = piece >= 0
+    pos, length = pos[rows].copy(), length[rows].copy()
+    pos[is_piece] = clipped.low[piece[is_piece], axis]
+    length[is_piece] = clipped.extent[piece[is_piece], axis]
+    geometry = (is_piece, new_geom[piece], clipped.low[piece], clipped.extent[piece])
+    if meshes is not None:  # the mesh children keep their cut meshes
+        from_mesh = ~is_piece & meshes[0][rows]
+        for mine, theirs in zip(geometry, meshes):
+            mine[from_mesh] = theirs[rows][from_mesh]
+    return parent[rows], step[rows], pos, length, index[rows], geometry
+
+
+def _clip_meshes(chunk: Chunk, shapes: Shapes, axis: int, parent, step, pos, length, index):
+    """``clip`` for the children of mesh shapes: each gets its parent's mesh cut to its slab, a child
+    whose slab misses the mesh goes. Returns the children and their geometry (as ``clip``'s)."""
+    mesh_rows = np.flatnonzero(is_mesh(shapes.geom[parent]))
+    geom, low, extent, keep = mesh_shapes.clip_meshes(chunk, shapes, parent[mesh_rows], axis,
+                                                      pos[mesh_rows], length[mesh_rows])
+    n = len(parent)
+    kept = np.ones(n, dtype=bool)
+    kept[mesh_rows[~keep]] = False
+    is_piece = np.zeros(n, dtype=bool)
+    piece_geom = np.full(n, -1, dtype=np.int32)
+    piece_low = np.zeros((n, 3))
+    piece_extent = np.zeros((n, 3))
+    is_piece[mesh_rows] = True
+    piece_geom[mesh_rows], piece_low[mesh_rows], piece_extent[mesh_rows] = geom, low, extent
+    pos, length = pos.copy(), length.copy()
+    pos[mesh_rows], length[mesh_rows] = low[:, axis], extent[:, axis]
+    geometry = tuple(a[kept] for a in (is_piece, piece_geom, piece_low, piece_extent))
+    return parent[kept], step[kept], pos[kept], length[kept], index[kept], geometry

@@ -1,0 +1,118 @@
+"""What the derivation of one chunk knows as it applies rules: the ``Context`` every operation is given.
+
+An operation is a function ``f(ctx, shapes, op)`` (``backend.operations``). What it needs beyond its shapes and
+its node is here: the plan, the chunk being derived (stores, outputs, counters), the limits, the worklist of
+pending batches per symbol, the occluder bookkeeping, and the symbol whose rule is being applied (its name goes
+into messages, its id onto leaves). The helpers every operation uses are the context's methods: ``env`` for
+expressions, ``fail`` and ``fail_negative`` to report bad lots, ``count`` and its kin for the shape limits.
+"""
+
+from __future__ import annotations
+
+import weakref
+from collections import defaultdict
+
+import numpy as np
+
+from grammarc.backend.chunk import Chunk
+from grammarc.backend.evaluate import Env
+from grammarc.backend.plan import Plan
+from grammarc.backend.shapes import Shapes
+from grammarc.constants import Limits
+from grammarc.errors import AssetError, ChunkTooLarge, LimitError, LotFailure
+from grammarc.geometry.meshes import is_mesh
+from grammarc.ir import nodes as ir
+from grammarc.ir.printer import print_op
+
+
+class Context:
+    """Deriving one chunk of lots with a plan: the state the operations share."""
+
+    __slots__ = ("_asset_meshes", "chunk", "chunk_budget", "limits", "pending", "plan", "symbol", "taken_apart")
+
+    def __init__(self, plan: Plan, chunk: Chunk, limits: Limits, chunk_budget: int) -> None:
+        self.plan = plan
+        self.chunk = chunk
+        self.limits = limits
+        #: Shapes a chunk may make in all before it is halved (``ChunkTooLarge``).
+        self.chunk_budget = chunk_budget
+        #: Symbol id -> the batches waiting for its rules: shapes, or records of a leaf-insert symbol made
+        #: ahead of its turn (``backend.leaf_parts``).
+        self.pending: defaultdict[int, list] = defaultdict(list)
+        #: The occluder ids of shapes taken apart (``occlusion.take_apart``): a shape split by two component
+        #: splits (``Comp("sideface", 0){ a } Comp("sideface", 2){ a }``) is one occluder, not two of which
+        #: each split's faces would see the other as a neighbour.
+        self.taken_apart: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
+        #: The symbol whose rule is being applied (``execute.apply_pending`` sets it for each batch).
+        self.symbol = plan.start
+        self._asset_meshes: dict[int, object] = {}
+
+    def env(self, shapes: Shapes) -> Env:
+        """What expressions on ``shapes`` read."""
+        return Env(shapes, self.chunk, self.plan)
+
+    # ------------------------------------------------------------------------------------------- failures
+    def fail(self, shapes: Shapes, bad: np.ndarray, message: str, span) -> None:
+        """Report the lots of shapes ``bad`` (n,) bool as failed: raises ``LotFailure``."""
+        lots = np.unique(shapes.lot[bad])
+        rule = self.plan.symbols[self.symbol].name
+        raise LotFailure(f"{message} in rule `{rule}` at {span}", lots)
+
+    def fail_negative(self, shapes: Shapes, values: np.ndarray, message: str, span) -> None:
+        """Fail the shapes whose sizes (n, k), or (1, k) for all, are negative or NaN, quoting the first."""
+        bad = ~(values >= 0).all(axis=1)
+        if bad.any():
+            row = values[np.flatnonzero(bad)[0]]
+            self.fail(shapes, bad, f"{message} ({', '.join(f'{v:g}' for v in np.atleast_1d(row))})", span)
+
+    def refuse_meshes(self, op: ir.Op, shapes: Shapes) -> None:
+        """Fail the roofs (meshes) among ``shapes``: ``op`` does not take them (``Operation.meshes``)."""
+        mesh = is_mesh(shapes.geom)
+        if mesh.any():
+            name = print_op(op).split("(")[0]
+            self.fail(shapes, mesh, f"`{name}` of a roof is not supported yet (split the roof into faces "
+                      "with comp(f) first)", op.span)
+
+    # ------------------------------------------------------------------------------------------ the limits
+    def count(self, shapes: Shapes, span) -> None:
+        """Add new shapes to the per-lot counters and enforce the shape limits."""
+        if len(shapes):
+            self.add_counts(np.bincount(shapes.lot, minlength=len(self.chunk.shape_count)), span)
+
+    def add_counts(self, per_lot: np.ndarray, span) -> None:
+        """``count`` of new shapes given as their number per lot (L,) int64."""
+        counts = self.chunk.shape_count
+        counts += per_lot
+        self.check_shape_limit(counts, span)
+        if counts.sum() > self.chunk_budget and len(counts) > 1:
+            raise ChunkTooLarge()
+
+    def check_fan_out(self, shapes: Shapes, counts: np.ndarray, span) -> None:
+        """Refuse a fan-out of ``counts`` (n,) children per shape that would exceed --max-shapes, before
+        allocating them."""
+        per_lot = np.bincount(shapes.lot, weights=counts, minlength=len(self.chunk.shape_count))
+        self.check_shape_limit(per_lot + self.chunk.shape_count, span)
+
+    def check_shape_limit(self, counts: np.ndarray, span) -> None:
+        """LimitError naming the rule if a lot's shape count (made or about to be) exceeds --max-shapes."""
+        worst = int(np.argmax(counts))
+        if counts[worst] > self.limits.max_shapes:
+            rule = self.plan.symbols[self.symbol].name
+            raise LimitError(
+                f"lot {self.chunk.lot_ids[worst]} makes more than {self.limits.max_shapes:,} shapes "
+                f"({int(counts[worst]):,}) in rule `{rule}` at {span}: a runaway grammar? "
+                "Raise the limit with --max-shapes N."
+            )
+
+    # -------------------------------------------------------------------------------------------- assets
+    def asset_mesh(self, asset: int):
+        """The ``AssetMesh`` of asset id ``asset`` for trimming (``Plan.load_asset``), None for an asset no
+        root holds; each loaded once per chunk."""
+        if asset not in self._asset_meshes:
+            grammar = self.plan.grammar
+            try:
+                mesh = self.plan.load_asset(grammar.assets[asset], grammar.asset_roots)
+            except AssetError:
+                mesh = None
+            self._asset_meshes[asset] = mesh
+        return self._asset_meshes[asset]

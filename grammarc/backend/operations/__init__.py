@@ -1,0 +1,34 @@
+"""The operations of the derivation, one function each, registered by IR node type in one table.
+
+An operation is an ordinary function ``f(ctx, shapes, node)`` of the derivation context
+(``backend.context``), the batch it runs on (the body's cursor) and its IR node; ``@operation(ir.Node, ...)``
+beside it registers it in ``OPERATIONS`` with what it declares (``table``): which shape columns it writes,
+whether it takes roofs, whether it replaces its shape. The body runner (``backend.execute``) looks each
+operation up there. The families, each module stating what its operations read and write of the shape
+columns:
+
+- ``scope``: ``T S R``, ``extrude``, the scope alignments, ``mirror``, ``center``;
+- ``splits``: ``Subdiv``/``Repeat``, CityEngine's ``split``, ``Snap``;
+- ``component_splits``: ``Comp``, ``comp(f|e|v)``;
+- ``faces``: ``offset``, ``setback``, ``innerRectangle``, ``convexify``, roofs, ``cleanupGeometry``;
+- ``inserts``: ``I``, ``i``, ``label``;
+- ``successors``: successor symbols, ``ε``/``NIL`` and operations without effect;
+- ``values``: ``set``, ``color``, ``report``;
+- ``control``: ``case`` and ``p%`` blocks.
+
+A new operation is its IR node, its lowering and its function here: importing this package registers them.
+"""
+
+from grammarc.backend.operations import (  # noqa: F401 - each registers its operations
+    component_splits,
+    control,
+    faces,
+    inserts,
+    scope,
+    splits,
+    successors,
+    values,
+)
+from grammarc.backend.operations.table import OPERATIONS, Operation, Parts
+
+__all__ = ["OPERATIONS", "Operation", "Parts"]

@@ -1,0 +1,177 @@
+"""Component splits: the paper's ``Comp`` and CityEngine's ``comp(f|e|v)`` on boxes, prisms, polygons and
+meshes (roofs), with the face scopes, selectors, context (``comp.index``, ``comp.total``, ``comp.sel``) and
+trim planes they set.
+
+A component split makes a shape per component (its own scope in the parent's frame, a key, the parent's
+parameters and attributes) and returns them as ``Parts`` for its bodies; the parent, a solid taken apart,
+becomes an occluder where the grammar asks occlusion queries. Reads: every column (the children inherit
+``lot``, ``depth``, ``params``, ``dynamic``), and the selector frames (lot, street). Writes: no column of the
+cursor.
+"""
+
+from __future__ import annotations
+
+from dataclasses import replace
+
+import numpy as np
+
+from grammarc.backend import mesh_shapes
+from grammarc.backend.children import with_context
+from grammarc.backend.context import Context
+from grammarc.backend.evaluate import evaluate_array
+from grammarc.backend.kernels.order import group_by
+from grammarc.backend.occlusion import take_apart
+from grammarc.backend.operations.faces import offset_faces
+from grammarc.backend.operations.table import Parts, operation
+from grammarc.backend.outlines import flat_axis, polygons_of
+from grammarc.backend.random import child_keys
+from grammarc.backend.reframing import turned
+from grammarc.backend.selectors import classify_edges, classify_faces, selector_frames
+from grammarc.backend.shapes import Shapes
+from grammarc.constants import TOL
+from grammarc.geometry import components as comp_kernels
+from grammarc.geometry.meshes import is_mesh, is_polygon
+from grammarc.geometry.reframe import NORMAL_OUT
+from grammarc.geometry.trim import side_face_planes
+from grammarc.ir import nodes as ir
+from grammarc.ragged import rank_within
+
+
+@operation(ir.Comp, meshes=True, consumes=True)
+def comp(ctx: Context, cursor: Shapes, op: ir.Comp) -> Parts:
+    if comp_kernels.KIND_CODES[op.kind] not in mesh_shapes.MESH_KINDS:
+        ctx.refuse_meshes(op, cursor)
+    index_of = None
+    if op.index is not None:
+        index_of = evaluate_array(op.index, ctx.env(cursor))
+    shapes, _, index, parent = components(ctx, comp_kernels.KIND_CODES[op.kind], cursor, op.site, index_of)
+    shapes = take_apart(ctx, cursor, shapes, parent)
+    ctx.count(shapes, op.span)
+    order, offsets = group_by(index % len(op.parts), len(op.parts))
+    return Parts(op.parts, shapes.take(order), offsets)
+
+
+@operation(ir.CompFaces, meshes=True, consumes=True)
+def comp_faces(ctx: Context, cursor: Shapes, op: ir.CompFaces) -> Parts:
+    """CityEngine ``comp(f|e|v)``: components to the first selector they match."""
+    if op.offset is not None:
+        ctx.refuse_meshes(op, cursor)
+        return offset_faces(ctx, cursor, op)
+    bad = cursor.geom < -1
+    if bad.any():
+        ctx.fail(cursor, bad, "`comp` of an inserted asset is not supported yet", op.span)
+    chunk = ctx.chunk
+    kind = {"f": "faces", "e": "edges", "v": "vertices"}[op.kind]
+    shapes, normal, _, parent = components(ctx, comp_kernels.KIND_CODES[kind], cursor, op.site)
+    shapes = take_apart(ctx, cursor, shapes, parent)
+    if op.kind == "f":
+        shapes = _face_scopes(ctx, shapes, cursor, parent, op.span)
+    slot = ctx.plan.trim_slot
+    if op.kind == "f" and slot is not None:
+        # the faces' trim planes where they meet their neighbours (``geometry.trim``)
+        up = chunk.frames[cursor.frame[parent]][:, 1]
+        planes = side_face_planes(chunk.frames[shapes.frame], shapes.origin, shapes.size, parent, up)
+        dynamic = list(shapes.dynamic)
+        dynamic[slot:slot + 8] = list(planes.T)
+        shapes = replace(shapes, dynamic=tuple(dynamic))
+    if op.kind == "f":
+        axes = chunk.frames[shapes.frame]
+        base = (shapes.origin, shapes.origin + axes[:, 0] * shapes.size[:, :1])  # each face's bottom edge
+        which = classify_faces(normal, op.selectors, selector_frames(chunk, normal, cursor, parent, op.selectors,
+                                                                      base))
+    else:
+        direction = chunk.frames[shapes.frame][:, 0] if op.kind == "e" else None
+        which = classify_edges(direction, op.selectors, len(shapes))
+    keep = which < len(op.selectors)
+    shapes, which, parent = shapes.take(keep), which[keep], parent[keep]
+    if {"comp.index", "comp.total", "comp.sel"} & set(ctx.plan.dynamic):
+        # CityEngine numbers the components of each selector: the front face is 0 of 1
+        group = parent * (len(op.selectors) + 1) + which
+        rank = rank_within(group)
+        ids = np.array([ctx.plan.strings.ids[s] for s in op.selectors], dtype=np.int32)
+        shapes = with_context(ctx.plan, shapes, "comp", rank, group, int(group.max(initial=0)) + 1,
+                              selector=ids[which])
+    ctx.count(shapes, op.span)
+    order, offsets = group_by(which, len(op.parts))
+    return Parts(op.parts, shapes.take(order), offsets)
+
+
+def components(ctx: Context, kind: int, cursor: Shapes, site: int, wanted=None):
+    """Component shapes of ``cursor``, their normals in the parents' frames (m, 3), their indices
+    among their parent's components (m,) and their parents (m,); ``wanted`` (n,) keeps, per shape,
+    only that index. Roofs (meshes) have faces and edges (``comp_faces`` and ``comp`` check)."""
+    chunk = ctx.chunk
+    mesh = is_mesh(cursor.geom)
+    pieces = []
+    if not mesh.all():
+        pieces.append(_solid_components(chunk, kind, cursor, np.flatnonzero(~mesh)))
+    if mesh.any():
+        which = np.flatnonzero(mesh)
+        parent, index, origin, axes, size, geom = mesh_shapes.mesh_components(chunk, cursor.take(which), kind)
+        pieces.append((which[parent], index, origin, axes, size, geom, axes[:, 2]))
+    parent, index, origin, axes, size, geom, normal = (
+        pieces[0] if len(pieces) == 1 else
+        (np.concatenate(columns) for columns in zip(*pieces)))
+    if len(pieces) > 1:
+        order = np.argsort(parent, kind="stable")
+        parent, index, origin, axes, size, geom, normal = (
+            a[order] for a in (parent, index, origin, axes, size, geom, normal))
+    if wanted is not None:
+        keep = index == np.round(wanted[parent])
+        parent, index, origin, axes, size, geom, normal = (
+            a[keep] for a in (parent, index, origin, axes, size, geom, normal))
+    child = cursor.take(parent)
+    parent_axes = chunk.frames[child.frame]
+    world_origin = child.origin + np.einsum("ni,nij->nj", origin, parent_axes)
+    frame = chunk.frames.add(np.einsum("nij,njk->nik", axes, parent_axes))
+    shapes = Shapes(world_origin, size, frame, geom.astype(np.int32), child.lot,
+                    child_keys(child.key, site, index), child.depth, child.params, child.dynamic)
+    return with_context(ctx.plan, shapes, "comp", index, parent, len(cursor)), normal, index, parent
+
+
+def _solid_components(chunk, kind: int, cursor: Shapes, which: np.ndarray):
+    """Components of the boxes, polygons and prisms ``which`` of ``cursor``: parent (into cursor),
+    index, origin, axes, size (in the parents' frames), geom, normal."""
+    shapes = cursor.take(which)
+    coords, ring_offsets, shape_offsets, plane = polygons_of(chunk, shapes)
+    parent, index, origin, axes, size, poly = comp_kernels.components(
+        kind, coords, ring_offsets, shape_offsets, plane, shapes.size, TOL.zero)
+    geom = np.full(len(parent), -1, dtype=np.int32)
+    same = poly == comp_kernels.SAME_POLY
+    geom[same] = shapes.geom[parent[same]]
+    for code, cap in ((comp_kernels.BOTTOM_POLY, "bottom"), (comp_kernels.TOP_POLY, "top")):
+        sel = (poly == code) & is_polygon(shapes.geom[parent])
+        if sel.any():
+            geom[sel] = _cap_polygons(chunk, shapes.geom[parent[sel]], cap)
+    # a flat shape's only face is itself: its normal is its plane's axis, not its frame's z
+    normal = axes[:, 2].copy()
+    normal[same] = np.eye(3)[plane[parent[same]]]
+    return which[parent], index, origin, axes, size, geom, normal
+
+
+def _cap_polygons(chunk, geom: np.ndarray, which: str) -> np.ndarray:
+    """New store polygons for the bottom or top faces of prisms ``geom`` (in the face's own plane).
+
+    The face's x is the polygon's first axis; its y runs along the second axis or against it, and
+    the bottom face sees the rings from below, so they are reversed (see components.py).
+    """
+    polygons = chunk.polygons
+    coords, ring_offsets, poly_offsets = polygons.gather(geom)
+    plane = polygons.plane[geom]
+    flip = (plane == 1) if which == "top" else (plane != 1)
+    vertex_poly = np.repeat(np.repeat(np.arange(len(geom)), np.diff(poly_offsets)),
+                            np.diff(ring_offsets))
+    coords = coords.copy()
+    coords[:, 1] = np.where(flip[vertex_poly], 1.0 - coords[:, 1], coords[:, 1])
+    if which == "bottom":
+        coords = comp_kernels.reverse_rings(coords, ring_offsets)
+    return polygons.add(coords, ring_offsets, poly_offsets, np.full(len(geom), 2, dtype=np.int8))
+
+
+def _face_scopes(ctx: Context, shapes: Shapes, cursor: Shapes, parent: np.ndarray, span) -> Shapes:
+    """A flat shape's face component is the shape itself; as every CityEngine face scope, it gets z
+    along the face's normal (x kept, y = z cross x)."""
+    axis = flat_axis(ctx.chunk, cursor)[parent]
+    turn = (axis >= 0) & (axis != 2) & (shapes.geom > -2) & ~is_mesh(shapes.geom)
+    turn &= (shapes.size <= TOL.zero).sum(axis=1) == 1
+    return turned(ctx, shapes, turn, NORMAL_OUT, axis, span)

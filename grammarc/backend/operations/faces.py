@@ -1,0 +1,267 @@
+"""Operations on the outlines of faces: ``offset``, ``setback`` and ``shapeL/U/O``, ``innerRectangle``,
+``convexify``, the roofs, ``cleanupGeometry`` (and ``comp(f)`` after an ``offset``, for
+``operations.component_splits``).
+
+They share one pattern: the batch's faces as shapely polygons in their scopes' units (``face_polygons``), one
+vectorized geometry step, then the pieces back as shapes (``Parts`` for the bodies of ``setback`` and
+``innerRectangle``) or the face's geometry replaced (a mesh of pieces, a roof: ``backend.mesh_shapes``).
+Reads: the scope (``origin``, ``size``, ``frame``), ``geom``, ``lot`` (street selectors), and what their
+expressions read. Writes: the roofs ``origin``, ``size`` and ``geom``; ``convexify`` and ``cleanupGeometry``
+the ``geom``; ``offset`` every column, as it makes the shapes of its pieces anew (new keys; a face with no
+piece left goes).
+"""
+
+from __future__ import annotations
+
+from dataclasses import replace
+
+import numpy as np
+import shapely
+
+from grammarc.backend import mesh_shapes
+from grammarc.backend.children import with_context
+from grammarc.backend.context import Context
+from grammarc.backend.evaluate import evaluate_array
+from grammarc.backend.kernels.order import group_by
+from grammarc.backend.operations.table import Parts, operation
+from grammarc.backend.outlines import flat_axis, polygons_of
+from grammarc.backend.random import child_keys
+from grammarc.backend.selectors import classify_faces, selector_frames
+from grammarc.backend.shapes import COLUMNS, Shapes
+from grammarc.constants import TOL
+from grammarc.geometry import components as comp_kernels
+from grammarc.geometry.clip import fit_pieces, scope_polygons
+from grammarc.geometry.convexify import convex_parts
+from grammarc.geometry.inner_rectangle import largest_rectangles
+from grammarc.geometry.meshes import is_mesh, is_polygon
+from grammarc.geometry.polygons import plane_to_scope
+from grammarc.geometry.setback import polygon_edges, setback_regions
+from grammarc.ir import nodes as ir
+from grammarc.ragged import ragged_take, rank_within
+
+
+@operation(ir.Roof, writes=("origin", "size", "geom"))
+def roof(ctx: Context, cursor: Shapes, op: ir.Roof) -> Shapes:
+    """A roof over each face (``geometry.roofs``). CityEngine roofs faces; the paper's ``Roof`` roofs
+    the footprint of a solid (its polygon, or the scope's x-z rectangle)."""
+    env = ctx.env(cursor)
+    n = len(cursor)
+    value, overhang, index = (np.ascontiguousarray(np.broadcast_to(
+        np.asarray(evaluate_array(e, env), dtype=np.float64), (n,))) for e in (op.value, op.overhang, op.index))
+    checks = [
+        (cursor.geom < -1, "of an inserted asset"),
+        (~np.isfinite(value) | ~np.isfinite(overhang) | ~np.isfinite(index), "with a value that is not finite"),
+        (~op.by_height & (np.abs(value) >= 90), "with an angle of 90 degrees or more"),
+    ]
+    # CityEngine roofs faces. A face that ``s`` gave a size across it stays flat in CityEngine but is a
+    # box here: an envelope (candler sizes its ventilation faces so) takes the box's base
+    if ctx.plan.leaf_bodies and op.kind != "envelope":
+        checks.append((flat_axis(ctx.chunk, cursor) < 0, "of a solid (CityEngine roofs faces)"))
+    cap = None
+    if op.cap is not None:
+        cap = np.broadcast_to(np.asarray(evaluate_array(op.cap, env), float), (n,))
+        for height, angle in op.sides:
+            differs = (np.abs(evaluate_array(height, env) - overhang) > TOL.zero) | (
+                np.abs(evaluate_array(angle, env) - value) > TOL.zero)
+            why = "with different heights or angles per side (one slope all round is supported)"
+            checks.append((differs, why))
+    if op.overhang_y is not None:
+        overhang_y = evaluate_array(op.overhang_y, env)
+        checks.append((np.abs(overhang_y - overhang) > TOL.zero,
+                       "with overhangY other than overhangX (gable ends overhang as eaves do)"))
+    for bad, what in checks:
+        if np.any(bad):
+            ctx.fail(cursor, np.broadcast_to(bad, (n,)), f"`{op.kind}` {what}", op.span)
+    roofed, failed = mesh_shapes.build_roofs(ctx.chunk, cursor, op.kind, polygons_of(ctx.chunk, cursor), value,
+                                             op.by_height, overhang, index, cap)
+    if failed.any():
+        ctx.fail(cursor, failed, f"`{op.kind}` found no roof for this polygon (its straight skeleton "
+                 "did not close, or the overhang's outline crosses itself at a sharp corner)", op.span)
+    return roofed
+
+
+@operation(ir.Offset, writes=COLUMNS)
+def offset(ctx: Context, cursor: Shapes, op: ir.Offset) -> Shapes:
+    """``offset(d, inside|border)``: the shape's face becomes its inset or the ring around it."""
+    inside, border = _offset_pieces(ctx, op.distance, cursor, op.span)
+    pieces = inside if op.select == "inside" else border
+    several = np.bincount(pieces.source, minlength=len(cursor)) > 1
+    if not several.any():
+        return _piece_shapes(ctx, cursor, pieces, 0)
+    # a face the offset parts into pieces stays one shape: a mesh of the pieces in one fitted scope
+    rows = np.flatnonzero(several)
+    mine = several[pieces.source]
+    single = _piece_shapes(ctx, cursor, pieces.take(~mine), 0)
+    grouped = pieces.take(mine)
+    grouped = replace(grouped, source=np.searchsorted(rows, grouped.source))
+    meshes = mesh_shapes.piece_meshes(ctx.chunk, cursor.take(rows), grouped)
+    meshes = replace(meshes, key=child_keys(meshes.key, 0, np.zeros(len(rows), dtype=np.int64)))
+    return Shapes.merge([single, meshes], [pieces.source[~mine], rows])
+
+
+def offset_faces(ctx: Context, cursor: Shapes, op: ir.CompFaces) -> Parts:
+    """``offset(d) comp(f){ inside: ... | border: ... }``: the offset's faces as components."""
+    pieces = _offset_pieces(ctx, op.offset, cursor, op.span)
+    border_site = (op.site << 20) + 1  # another stream than the inside faces'
+    shapes, kind = _pieces_by_parent(ctx, cursor, pieces, [op.site, border_site])
+    names = ("inside", "border")
+    which = np.full(len(kind), len(op.selectors), dtype=np.int64)
+    for i in range(len(op.selectors) - 1, -1, -1):
+        selector = op.selectors[i]
+        which[(selector == "all") | (np.array(names)[kind] == selector)] = i
+    keep = which < len(op.selectors)
+    shapes, which = shapes.take(keep), which[keep]
+    ctx.count(shapes, op.span)
+    order, offsets = group_by(which, len(op.parts))
+    return Parts(op.parts, shapes.take(order), offsets)
+
+
+@operation(ir.Setback, consumes=True)
+def setback(ctx: Context, cursor: Shapes, op: ir.Setback) -> Parts:
+    """``setback`` and ``shapeL/U/O``: the face's edge strips and its remainder to their parts."""
+    polygons, plane = face_polygons(ctx, cursor, "setback", op.span)
+    edges = polygon_edges(polygons)
+    m = len(cursor)
+    normal = plane_to_scope(-edges.inward, plane[edges.poly])
+    frames = selector_frames(ctx.chunk, normal, cursor, edges.poly, (*op.selectors, *(s for s, _ in op.distances)),
+                             _world_points(ctx, cursor, edges.poly, plane, (edges.start, edges.end)))
+    # distances per face, or per edge (setback(comp(fe){...}): each edge is comp.index of comp.total)
+    if op.per_edge:
+        index = rank_within(edges.poly)
+        shapes = with_context(ctx.plan, cursor.take(edges.poly), "comp", index, edges.poly, m)
+        column = np.arange(len(edges.poly))
+    else:
+        shapes, column = cursor, edges.poly
+    env = ctx.env(shapes)
+    table = np.zeros((len(op.distances) + 1, len(shapes)))
+    for k, (_, expr) in enumerate(op.distances):
+        table[k] = evaluate_array(expr, env)
+    distance = table[classify_faces(normal, tuple(s for s, _ in op.distances), frames), column]
+    owners = tuple(s for s in op.selectors if s != "remainder")
+    regions, remainder = setback_regions(polygons, edges, distance,
+                                         classify_faces(normal, owners, frames), len(owners))
+    by_owner = dict(zip(owners, regions))
+    return _regions(ctx, op, cursor, [by_owner[s] if s != "remainder" else remainder for s in op.selectors],
+                    plane, polygons)
+
+
+@operation(ir.InnerRectangle, consumes=True)
+def inner_rectangle(ctx: Context, cursor: Shapes, op: ir.InnerRectangle) -> Parts:
+    """``innerRectangle``: the face's largest inner rectangle (``geometry.inner_rectangle``) and the
+    rest of the face, in the face's own scope frame (CityEngine keeps the scope's orientation)."""
+    polygons, plane = face_polygons(ctx, cursor, "innerRectangle", op.span)
+    rectangle = largest_rectangles(polygons, op.align)
+    remainder = shapely.difference(polygons, rectangle)
+    return _regions(ctx, op, cursor, [rectangle if s == "shape" else remainder for s in op.selectors], plane,
+                    polygons)
+
+
+@operation(ir.Convexify, writes=("geom",))
+def convexify(ctx: Context, cursor: Shapes, op: ir.Convexify) -> Shapes:
+    """``convexify``: the face becomes its convex parts (``geometry.convexify``), one shape whose
+    faces they are (a mesh; a convex face stays as it is)."""
+    polygons, plane = face_polygons(ctx, cursor, "convexify", op.span)
+    limit = None
+    if op.max_length is not None:
+        limit = np.broadcast_to(np.asarray(evaluate_array(op.max_length, ctx.env(cursor)), float),
+                                (len(cursor),))
+    parts, source = convex_parts(polygons, limit)
+    return mesh_shapes.flat_meshes(ctx.chunk, cursor, parts, source, plane)
+
+
+@operation(ir.CleanupGeometry, writes=("geom",), meshes=True)
+def cleanup_geometry(ctx: Context, cursor: Shapes, op: ir.CleanupGeometry) -> Shapes:
+    """``cleanupGeometry``: polygons (faces, prisms through their base, flat rectangles) and meshes
+    cleaned (``geometry.cleanup``) in their scopes, which stay: the operation is meant to keep a
+    model's look, and the geometry only loses vertices and faces, so it stays inside its scope.
+    A tolerance outside [0, 1] is taken as the nearer end. Scope boxes and inserted assets stay as
+    they are: a box has no repeated or collinear vertices and no duplicate faces (that its faces
+    could be too small or its edges too short to keep is ignored: as a mesh it would leave the
+    instancing path), and an asset is an instance whose mesh grammarc does not open."""
+    tolerance = np.broadcast_to(np.asarray(evaluate_array(op.tolerance, ctx.env(cursor)), float),
+                                (len(cursor),))
+    bad = ~np.isfinite(tolerance)
+    if bad.any():
+        ctx.fail(cursor, bad, "`cleanupGeometry` with a tolerance that is not finite", op.span)
+    tolerance = np.clip(tolerance, 0.0, 1.0)
+    flat = (cursor.size <= TOL.zero).sum(axis=1) == 1
+    geom = cursor.geom.copy()
+    polygon = np.flatnonzero(is_polygon(geom) | ((geom == -1) & flat))
+    if len(polygon):
+        shapes = cursor.take(polygon)
+        geom[polygon] = mesh_shapes.clean_polygons(ctx.chunk, shapes, polygons_of(ctx.chunk, shapes),
+                                                   tolerance[polygon], op.component)
+    mesh = np.flatnonzero(is_mesh(cursor.geom))
+    if len(mesh):
+        geom[mesh] = mesh_shapes.clean_meshes(ctx.chunk, cursor.take(mesh), tolerance[mesh], op.component)
+    return cursor.with_scope(cursor.origin, cursor.size, cursor.frame, geom)
+
+
+def face_polygons(ctx: Context, cursor: Shapes, what: str, span) -> tuple[np.ndarray, np.ndarray]:
+    """Shapely polygons (n,) of flat shapes in their scope units, and each one's plane (n,); fails the
+    lots of solids."""
+    bad = (cursor.size <= TOL.zero).sum(axis=1) != 1
+    if bad.any():
+        ctx.fail(cursor, bad, f"`{what}` of a solid is not supported yet (only of faces)", span)
+    store = ctx.chunk.polygons
+    geom = cursor.geom.copy()
+    rects = np.flatnonzero(geom < 0)
+    if len(rects):
+        plane = comp_kernels.rect_plane(cursor.size[rects], TOL.zero)
+        geom[rects] = store.add(comp_kernels.rect_rings(plane),
+                                np.arange(0, 4 * len(rects) + 1, 4, dtype=np.int64),
+                                np.arange(len(rects) + 1, dtype=np.int64), plane)
+    return scope_polygons(store, geom, cursor.size), store.plane[geom]
+
+
+def _offset_pieces(ctx: Context, distance: ir.Expr, cursor: Shapes, span):
+    """The inside and border pieces of each flat shape's polygon offset by ``distance``."""
+    polygons, plane = face_polygons(ctx, cursor, "offset", span)
+    d = evaluate_array(distance, ctx.env(cursor))
+    inset = shapely.buffer(polygons, d, join_style="mitre", mitre_limit=1e6)
+    border = shapely.difference(polygons, inset)
+    return fit_pieces(inset, plane, cursor.size, polygons), fit_pieces(border, plane, cursor.size, polygons)
+
+
+def _piece_shapes(ctx: Context, cursor: Shapes, pieces, site: int) -> Shapes:
+    """Shapes of clipped or offset pieces: the parent's frame, the piece's box and polygon."""
+    chunk = ctx.chunk
+    child = cursor.take(pieces.source)
+    geom = np.full(len(pieces.source), -1, dtype=np.int32)
+    shaped = np.flatnonzero(~pieces.is_rect)
+    if len(shaped):
+        rings, poly_offsets = ragged_take(pieces.poly_offsets, shaped)
+        vertices, ring_offsets = ragged_take(pieces.ring_offsets, rings)
+        geom[shaped] = chunk.polygons.add(pieces.coords[vertices], ring_offsets, poly_offsets, pieces.plane[shaped])
+    origin = child.origin + np.einsum("ni,nij->nj", pieces.low, chunk.frames[child.frame])
+    index = rank_within(pieces.source)
+    return Shapes(origin, pieces.extent, child.frame, geom, child.lot,
+                  child_keys(child.key, site, index), child.depth, child.params, child.dynamic)
+
+
+def _regions(ctx: Context, op: ir.Setback | ir.InnerRectangle, cursor: Shapes, regions: list, plane,
+             polygons) -> Parts:
+    """Part k of ``op`` on the pieces of ``regions[k]`` (n,) (polygons in the shapes' scope units, cut
+    from ``polygons``), each parent's pieces together, numbered in stream ``op.site`` part by part."""
+    pieces = [fit_pieces(region, plane, cursor.size, polygons) for region in regions]
+    shapes, kind = _pieces_by_parent(ctx, cursor, pieces, [(op.site << 20) + k for k in range(len(pieces))])
+    ctx.count(shapes, op.span)
+    order, offsets = group_by(kind, len(op.parts))
+    return Parts(op.parts, shapes.take(order), offsets)
+
+
+def _pieces_by_parent(ctx: Context, cursor: Shapes, pieces, sites) -> tuple[Shapes, np.ndarray]:
+    """Shapes of several kinds of pieces (kind k: ``pieces[k]``, numbered in stream ``sites[k]``),
+    each parent's pieces together in kind order, and each shape's kind."""
+    shapes = Shapes.concat([_piece_shapes(ctx, cursor, p, site) for p, site in zip(pieces, sites)])
+    kind = np.concatenate([np.full(len(p.source), k, dtype=np.int64) for k, p in enumerate(pieces)])
+    order = np.argsort(np.concatenate([p.source for p in pieces]), kind="stable")
+    return shapes.take(order), kind[order]
+
+
+def _world_points(ctx: Context, cursor: Shapes, row: np.ndarray, plane: np.ndarray, points) -> tuple:
+    """In-plane points (k, 2) in the scope units of the shapes ``row`` (k,) of ``cursor``, whose
+    polygons lie in ``plane`` (n,), as world points (k, 3)."""
+    axes = ctx.chunk.frames[cursor.frame[row]]
+    return tuple(cursor.origin[row] + np.einsum("ki,kij->kj", plane_to_scope(p, plane[row]), axes)
+                 for p in points)

@@ -1,0 +1,213 @@
+"""Splits: the paper's ``Subdiv`` and ``Repeat`` (on one axis or several), CityEngine's ``split`` with repeat
+groups, and the paper's ``Snap``/``SnapLines``, whose planes snapped splits move their cuts to.
+
+A split makes children (``backend.children``: scopes moved and cut along the axis, polygons and meshes cut to
+their slabs, new keys, ``split.index``/``split.total``) and returns them as ``Parts`` for its bodies; parts
+that only place an asset take a shortcut to their records (``backend.leaf_parts``). Reads: the scope
+(``origin``, ``size``, ``frame``), ``geom``, ``lot``, ``key``, ``depth``, ``params`` and ``dynamic`` (the
+children inherit them), and what the sizes read. Writes: no column of the cursor; ``Snap`` adds planes to
+the chunk.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from grammarc.backend.children import by_part, children, clip, grouped_children
+from grammarc.backend.context import Context
+from grammarc.backend.evaluate import evaluate, evaluate_array
+from grammarc.backend.kernels import split as split_kernels
+from grammarc.backend.kernels.order import group_by
+from grammarc.backend.leaf_parts import LeafPart
+from grammarc.backend.operations.table import Parts, operation
+from grammarc.backend.shapes import Shapes
+from grammarc.constants import TOL
+from grammarc.ir import nodes as ir
+from grammarc.ragged import offsets_from_counts, rank_within
+
+
+@operation(ir.Split, meshes=True, consumes=True)
+def split(ctx: Context, cursor: Shapes, op: ir.Split) -> Parts | None:
+    values = _split_sizes(ctx, cursor, op, "Subdiv")
+    relative = np.array([s.kind is ir.SizeKind.RELATIVE for s in op.sizes])
+
+    def cut(shapes: Shapes, level: int, axis: int):
+        nonlocal values
+        parent, part, pos, length = split_kernels.subdiv(
+            np.ascontiguousarray(shapes.size[:, axis]), values, relative, TOL.zero
+        )
+        if op.snap:
+            split_kernels.snap_subdiv(parent, pos, length, *_snaps_across(ctx, shapes, axis, op.snap_label))
+        if values.shape[0] > 1:
+            values = values[parent]  # the next axis' sizes follow the children
+        return parent, part * len(op.sizes) ** level, pos, length
+
+    return _fan_out(ctx, cursor, op, cut)
+
+
+@operation(ir.Repeat, meshes=True, consumes=True)
+def repeat(ctx: Context, cursor: Shapes, op: ir.Repeat) -> Parts | None:
+    env = ctx.env(cursor)
+    sizes = [evaluate_array(e, env) for e in op.sizes]
+    stride = np.ones(len(cursor), dtype=np.int64)
+
+    def cut(shapes: Shapes, level: int, axis: int):
+        nonlocal sizes, stride
+        size = sizes[level]
+        bad = ~(size > 0)
+        if bad.any():
+            ctx.fail(shapes, bad, f"`Repeat` needs a positive size, got {size[bad][0]:g}", op.span)
+        extent = np.ascontiguousarray(shapes.size[:, axis])
+        counts = split_kernels.repeat_counts(extent, size, TOL.zero)
+        if op.snap:  # each snap plane adds one element at most
+            offsets, snaps = _snaps_across(ctx, shapes, axis, op.snap_label)
+            ctx.check_fan_out(shapes, counts + np.diff(offsets), op.span)
+            # the snap planes cut the scope first and each piece repeats on its own (Fig. 9)
+            piece_parent, start, piece = _pieces(extent, offsets, snaps)
+            piece_counts = split_kernels.repeat_counts(piece, size[piece_parent], TOL.zero)
+            child, _, pos, length = split_kernels.repeat(piece, piece_counts)
+            parent = piece_parent[child]
+            pos += start[child]
+            part = rank_within(parent)
+            counts = np.bincount(parent, minlength=len(shapes))
+        else:
+            ctx.check_fan_out(shapes, counts, op.span)
+            parent, part, pos, length = split_kernels.repeat(extent, counts)
+        step = part * stride[parent]
+        stride = stride[parent] * counts[parent]
+        sizes = [s[parent] for s in sizes]  # the next axes' sizes follow the children
+        return parent, step, pos, length
+
+    return _fan_out(ctx, cursor, op, cut)
+
+
+@operation(ir.GroupSplit, meshes=True, consumes=True)
+def group_split(ctx: Context, cursor: Shapes, op: ir.GroupSplit) -> Parts:
+    values = _split_sizes(ctx, cursor, op, "split")
+    kind = np.array([_SIZE_KIND[s.kind] for s in op.sizes], dtype=np.int64)
+    groups = np.array(op.groups, dtype=np.int64)
+    if op.repeat:
+        groups = np.zeros_like(groups)
+    n_groups = int(groups.max()) + 1 if len(groups) else 0
+    parent, part, pos, length, index = split_kernels.group_split(
+        np.ascontiguousarray(cursor.size[:, op.axis]), values, kind, groups, n_groups, TOL.zero)
+    parent, part, pos, length, index, geometry = clip(ctx.chunk, cursor, op.axis, parent, part, pos, length,
+                                                      index)
+    order, offsets = group_by(part, len(op.parts))
+    made = children(ctx, cursor, op.axis, parent, index, pos, length, op.site, order, geometry)
+    ctx.count(made, op.span)
+    return Parts(op.parts, made, offsets)
+
+
+@operation(ir.Snap, meshes=True)
+def snap(ctx: Context, cursor: Shapes, op: ir.Snap) -> None:
+    """``Snap`` / ``SnapLines``: the lot's construction planes across the scope axis ``op.normal``,
+    through the scope's origin (and, for lines, its far end too)."""
+    axes = ctx.chunk.frames[cursor.frame]
+    normal = np.ascontiguousarray(axes[:, op.normal])
+    ctx.chunk.snaps.add(cursor.lot, cursor.origin.copy(), normal, op.label)
+    if op.lines:
+        far = cursor.origin + normal * cursor.size[:, op.normal, None]
+        ctx.chunk.snaps.add(cursor.lot, far, normal, op.label)
+
+
+def _split_sizes(ctx: Context, cursor: Shapes, op: ir.Split | ir.GroupSplit, what: str) -> np.ndarray:
+    """The parts' sizes, (n, P) or (1, P) when the same for all shapes; a negative or NaN one fails."""
+    env = ctx.env(cursor)
+    values = _size_matrix([evaluate(s.value, env) for s in op.sizes], len(cursor))
+    ctx.fail_negative(cursor, values, f"`{what}` has a negative or NaN size", op.span)
+    return values
+
+
+def _snaps_across(ctx: Context, shapes: Shapes, axis: int, label: str | None) -> tuple[np.ndarray, np.ndarray]:
+    """Where the snap planes of each shape's lot cross its scope along ``axis`` (``SnapStore.across``)."""
+    axes = ctx.chunk.frames[shapes.frame]
+    return ctx.chunk.snaps.across(shapes.lot, shapes.origin, np.ascontiguousarray(axes[:, axis]),
+                                  np.ascontiguousarray(shapes.size[:, axis]), label, TOL.zero)
+
+
+def _fan_out(ctx: Context, cursor: Shapes, op: ir.Split | ir.Repeat, cut) -> Parts | None:
+    """Split ``cursor`` along each of ``op.axes`` in turn: the cells, for the parts.
+
+    ``cut(shapes, level, axis)`` returns the children of one axis as (parent, cell step, position,
+    length); a cell's number adds up the steps, the first axis varying fastest.
+    """
+    shapes = cursor
+    cell = np.zeros(len(cursor), dtype=np.int64)
+    for level, axis in enumerate(op.axes):
+        parent, step, pos, length = cut(shapes, level, axis)
+        parent, step, pos, length, _, geometry = clip(ctx.chunk, shapes, axis, parent, step, pos, length,
+                                                      np.zeros(len(parent), dtype=np.int64))
+        cell = cell[parent] + step
+        if level == len(op.axes) - 1:
+            leaves = _leaf_parts(ctx, op.parts, shapes, geometry)
+            if leaves is not None:
+                return _fan_out_leaves(ctx, op, shapes, axis, parent, cell, pos, length, leaves)
+            shapes, offsets = grouped_children(ctx, shapes, axis, parent, cell, pos, length, op.site,
+                                               len(op.parts), geometry)
+        else:
+            shapes = children(ctx, shapes, axis, parent, cell, pos, length, op.site, geometry=geometry)
+    ctx.count(shapes, op.span)
+    return Parts(op.parts, shapes, offsets)
+
+
+def _leaf_parts(ctx: Context, parts: tuple[ir.Body, ...], shapes: Shapes, geometry) -> list | None:
+    """Per body part, the ``LeafInsert`` of the symbol it names if its records can be written straight
+    from the parent's scope (``backend.leaf_parts``), else None; None if no part can."""
+    plan = ctx.plan
+    inserts = plan.leaf_inserts
+    if not inserts or geometry is not None or "split.total" in plan.dynamic:
+        return None
+    leaves = [inserts.get(plan.symbol_ids[body[0].name])
+              if len(body) == 1 and isinstance(body[0], ir.Symbol) and not body[0].args and not body[0].leaf
+              else None for body in parts]
+    # the successor would be one rule application deeper: where that reaches --max-depth, the
+    # general path reports it
+    if not any(leaves) or int(shapes.depth.max()) + 1 >= ctx.limits.max_depth:
+        return None
+    return leaves
+
+
+def _fan_out_leaves(ctx: Context, op, shapes: Shapes, axis: int, parent, cell, pos, length,
+                    leaves: list) -> Parts:
+    """The last axis of ``_fan_out`` when some parts only place an asset: their records are computed from
+    ``shapes`` and the cuts when the runner reaches their part (``LeafPart``); the other parts' children
+    are made as usual. Shape counts are kept as the general path keeps them."""
+    n_parts = len(op.parts)
+    order, offsets = by_part(cell, n_parts)
+    # the children, as `_fan_out` counts them: per parent, then per lot (fewer rows to gather)
+    n_lots = len(ctx.chunk.shape_count)
+    per_parent = np.bincount(parent, minlength=len(shapes))
+    ctx.add_counts(np.bincount(shapes.lot, weights=per_parent, minlength=n_lots).astype(np.int64), op.span)
+    rows = [order[offsets[i]:offsets[i + 1]] for i in range(n_parts)]
+    general = [i for i, leaf in enumerate(leaves) if leaf is None]
+    kept = np.concatenate([rows[i] for i in general]) if general else order[:0]
+    made = children(ctx, shapes, axis, parent, cell, pos, length, op.site, kept) if general else shapes.take(kept)
+    parts = tuple(None if leaf is None or not len(rows[i]) else
+                  LeafPart(leaf, shapes, axis, rows[i], parent, pos, length) for i, leaf in enumerate(leaves))
+    sizes = [len(rows[i]) if leaves[i] is None else 0 for i in range(n_parts)]
+    return Parts(op.parts, made, offsets_from_counts(np.array(sizes, dtype=np.int64)), parts)
+
+
+def _pieces(extent: np.ndarray, offsets: np.ndarray, cuts: np.ndarray):
+    """The pieces of each extent (n,) cut at its sorted positions ``cuts`` (``offsets`` (n+1,)): each
+    piece's extent, its start and the extent it belongs to, (k,) each, in order."""
+    count = np.diff(offsets) + 1
+    parent = np.repeat(np.arange(len(extent)), count)
+    j = np.arange(count.sum()) - np.repeat(offsets_from_counts(count)[:-1], count)
+    bounds = np.concatenate([cuts, [0.0]])  # a harmless last entry for the gathers below
+    at = offsets[parent] + j
+    start = np.where(j > 0, bounds[at - 1], 0.0)
+    end = np.where(j < count[parent] - 1, bounds[at], extent[parent])
+    return parent, start, np.ascontiguousarray(end - start)
+
+
+def _size_matrix(values: list, n: int) -> np.ndarray:
+    """Split sizes as (n, P) float64, or (1, P) when every size is the same for all shapes."""
+    if all(np.ndim(v) == 0 for v in values):
+        return np.array([values], dtype=np.float64)
+    return np.stack([np.broadcast_to(np.asarray(v, np.float64), (n,)) for v in values], axis=1)
+
+
+#: GroupSplit size kinds for the kernel.
+_SIZE_KIND = {ir.SizeKind.ABSOLUTE: 0, ir.SizeKind.RELATIVE: 1, ir.SizeKind.FLOATING: 2}

@@ -1,0 +1,84 @@
+"""Values a shape carries or reports: ``set(attr, value)``, ``color()`` and CityEngine's ``report``.
+
+``set`` and ``color`` give the shape (and so its successors and parts) a new value in its ``dynamic`` column;
+``report`` adds rows to the chunk's reports (``backend.reports``). Reads: what their expressions read, and
+``lot`` (reports). Writes: ``set`` and ``color`` the ``dynamic`` column of their value.
+"""
+
+from __future__ import annotations
+
+from dataclasses import replace
+
+import numpy as np
+
+from grammarc.backend.context import Context
+from grammarc.backend.evaluate import evaluate, evaluate_array
+from grammarc.backend.operations.table import operation
+from grammarc.backend.shapes import Shapes
+from grammarc.ir import nodes as ir
+
+
+@operation(ir.SetAttr, writes=("dynamic",), meshes=True)
+def set_attr(ctx: Context, cursor: Shapes, op: ir.SetAttr) -> Shapes:
+    index = ctx.plan.dynamic[op.name]
+    column = cursor.dynamic[index]
+    value = evaluate_array(op.value, ctx.env(cursor), dtype=column.dtype)
+    dynamic = cursor.dynamic[:index] + (value,) + cursor.dynamic[index + 1:]
+    return Shapes(cursor.origin, cursor.size, cursor.frame, cursor.geom, cursor.lot, cursor.key,
+                  cursor.depth, cursor.params, dynamic)
+
+
+@operation(ir.SetColor, writes=("dynamic",), meshes=True)
+def set_color(ctx: Context, cursor: Shapes, op: ir.SetColor) -> Shapes:
+    """The shape's colour as 0xRRGGBB: from components in [0, 1], or parsed from "#rrggbb"."""
+    env = ctx.env(cursor)
+    n = len(cursor)
+    if len(op.values) == 3:
+        parts = [np.clip(np.round(np.broadcast_to(evaluate_array(v, env), (n,)) * 255), 0, 255)
+                 for v in op.values]
+        packed = parts[0] * 65536 + parts[1] * 256 + parts[2]
+    else:
+        ids = np.broadcast_to(evaluate_array(op.values[0], env, dtype=np.int32), (n,))
+        names = list(ctx.plan.strings.ids)
+        distinct, inverse = np.unique(ids, return_inverse=True)
+        packed = np.array([_hex_color(names[int(i)]) for i in distinct])[inverse.reshape(-1)]
+        bad = np.isnan(packed)
+        if bad.any():
+            text = names[int(ids[np.flatnonzero(bad)[0]])]
+            ctx.fail(cursor, bad, f'color("{text}") is not a colour "#rrggbb"', op.span)
+    index = ctx.plan.color_slot
+    dynamic = cursor.dynamic[:index] + (packed.astype(np.float64),) + cursor.dynamic[index + 1:]
+    return replace(cursor, dynamic=dynamic)
+
+
+@operation(ir.Report, meshes=True)
+def report(ctx: Context, cursor: Shapes, op: ir.Report) -> None:
+    env = ctx.env(cursor)
+    key = evaluate_array(op.key, env, dtype=np.int32)
+    value = evaluate(op.value, env)
+    ctx.chunk.outputs.reports.append(report_rows(cursor.lot, key, value, len(cursor)))
+
+
+def report_rows(lot: np.ndarray, key, value, n: int) -> tuple:
+    """One ``report`` call's rows: lot (n,), key ids (n,), values (n,) float64 and the value kind
+    ("num", "bool" or "str"; strings as their ids)."""
+    key = np.broadcast_to(np.asarray(key, dtype=np.int32), (n,))
+    if isinstance(value, (bool, np.bool_)) or (isinstance(value, np.ndarray) and value.dtype == bool):
+        kind = "bool"
+    elif isinstance(value, (int, np.integer)) or (isinstance(value, np.ndarray) and value.dtype == np.int32):
+        kind = "str"
+    else:
+        kind = "num"
+    values = np.broadcast_to(np.asarray(value, dtype=np.float64), (n,))
+    return lot, key, values, kind
+
+
+def _hex_color(text: str) -> float:
+    """0xRRGGBB of "#rrggbb" (or "#rgb"), NaN when the text is no such colour."""
+    digits = text.strip().lstrip("#")
+    if len(digits) == 3:
+        digits = "".join(c * 2 for c in digits)
+    try:
+        return float(int(digits, 16)) if len(digits) == 6 else float("nan")
+    except ValueError:
+        return float("nan")

@@ -1,0 +1,63 @@
+"""Shapes given new scope axes around their unchanged geometry, the scope fitted to it again.
+
+``alignScopeToAxes``, ``alignScopeToGeometry`` and ``rotateScope`` turn every shape's scope; ``extrude`` and a
+``comp(f)`` face turn some (a face whose normal is not the axis they want it along). Polygons go through
+``geometry.reframe``, meshes through ``mesh_shapes.reframe_meshes``.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from grammarc.backend import mesh_shapes
+from grammarc.backend.context import Context
+from grammarc.backend.outlines import polygons_of
+from grammarc.backend.shapes import Shapes
+from grammarc.geometry.meshes import is_mesh
+from grammarc.geometry.reframe import reframe
+from grammarc.ragged import ragged_take
+
+
+def turned(ctx: Context, shapes: Shapes, turn: np.ndarray, matrices: np.ndarray, axis: np.ndarray,
+           span) -> Shapes:
+    """``shapes`` with the shapes ``turn`` (n,) bool given the axes ``matrices[axis]`` (rows in their present
+    frames: ``NORMAL_UP``, ``NORMAL_OUT``) around their unchanged geometry."""
+    if not turn.any():
+        return shapes
+    rows, others = np.flatnonzero(turn), np.flatnonzero(~turn)
+    sub = shapes.take(rows)
+    new_axes = np.einsum("nij,njk->nik", matrices[axis[rows]], ctx.chunk.frames[sub.frame])
+    return Shapes.merge([shapes.take(others), reframed(ctx, sub, new_axes, span)], [others, rows])
+
+
+def reframed(ctx: Context, shapes: Shapes, new_axes: np.ndarray, span) -> Shapes:
+    """The same geometry in scopes with ``new_axes`` (n, 3, 3), fitted to it; fails the lots of inserted
+    assets and of polygons turned out of their plane."""
+    chunk = ctx.chunk
+    mesh = is_mesh(shapes.geom)
+    if mesh.any():
+        new_axes = np.asarray(new_axes)
+        if mesh.all():
+            return mesh_shapes.reframe_meshes(chunk, shapes, new_axes)
+        rows = np.flatnonzero(mesh)
+        others = np.flatnonzero(~mesh)
+        return Shapes.merge([mesh_shapes.reframe_meshes(chunk, shapes.take(rows), new_axes[rows]),
+                             reframed(ctx, shapes.take(others), new_axes[others], span)],
+                            [rows, others])
+    n = len(shapes)
+    bad = shapes.geom < -1
+    if bad.any():
+        ctx.fail(shapes, bad, "aligning the scope of an inserted asset is not supported yet", span)
+    coords, ring_offsets, shape_offsets, plane = polygons_of(chunk, shapes)
+    ok, plane, origin, size, is_rect, new_coords = reframe(
+        shapes.origin, shapes.size, chunk.frames[shapes.frame], coords, ring_offsets, shape_offsets,
+        plane, new_axes)
+    if not ok.all():
+        ctx.fail(shapes, ~ok, "turning a scope out of its geometry's plane is not supported yet", span)
+    geom = np.full(n, -1, dtype=np.int32)
+    poly = np.flatnonzero(~is_rect)
+    if len(poly):
+        rings, packed_shapes = ragged_take(shape_offsets, poly)
+        vertices, packed_rings = ragged_take(ring_offsets, rings)
+        geom[poly] = chunk.polygons.add(new_coords[vertices], packed_rings, packed_shapes, plane[poly])
+    return shapes.with_scope(origin, size, chunk.frames.add(np.ascontiguousarray(new_axes)), geom)

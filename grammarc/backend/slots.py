@@ -1,0 +1,22 @@
+"""The per-shape columns the derivation keeps beside the grammar's own attributes, by name.
+
+``Plan.dynamic`` numbers every per-shape value a grammar needs (``Shapes.dynamic``): the attributes its rules
+``set``, the split and component context it reads (``split.index``...), and these, which the derivation adds
+for operations that need them. They are named here, below the plan and the modules that decide whether a
+grammar needs them (``plan``, ``leaf_parts``, ``occlusion``), so that none of those imports another for a name.
+"""
+
+from __future__ import annotations
+
+#: The shape's colour set by ``color()``: 0xRRGGBB as a float, white to begin with.
+COLOR_SLOT = "#color"
+WHITE_RGB = float(0xFFFFFF)
+
+#: A shape's two vertical trim planes, (nx, ny, nz, d) each in world coordinates: inserted geometry keeps
+#: the side where n . X + d >= 0 (NaN: no plane).
+TRIM_SLOTS = tuple(f"trim.{k}" for k in range(8))
+#: ``set(trim.vertical, false)`` turns the planes off for a shape and its successors (1: on, 0: off).
+TRIM_SWITCH = "trim.vertical"
+
+#: The ids of a shape's nearest occluding ancestors (NaN: none), nearest first (``backend.occlusion``).
+ANCESTORS = tuple(f"occluder.{k}" for k in range(4))

@@ -1,0 +1,129 @@
+"""backend/operations/component_splits.py in derivations: the paper's Comp and CityEngine's
+comp(f) on boxes and prisms, selectors, ``comp.sel``, ``comp.index`` and ``comp.total``."""
+
+from __future__ import annotations
+
+from collections import Counter
+
+import numpy as np
+import pytest
+from derivations import (
+    assets,
+    make_lots_polys,
+    names,
+    paper,
+    quad_centres,
+    quad_normals,
+    rect,
+    rows,
+    run,
+    totals,
+)
+
+
+def test_comp_front_side_top_on_a_box(write):
+    r = run(write, "Lot --> extrude(10) Mass\nMass --> comp(f){ front : A | side : B | top : C }\n",
+            [rect(12, 8)])
+    assert set(assets(r)) == {"builtin:quad"}
+    assert Counter(names(r)) == {"A": 1, "B": 3, "C": 1}  # the bottom matches nothing: dropped
+    n, c = quad_normals(r), quad_centres(r)
+    a, b, top = rows(r, "A"), rows(r, "B"), rows(r, "C")
+    # front is the mass scope's +z: world +z, the face at z = 0
+    np.testing.assert_allclose(n[a], [[0, 0, 1]], atol=1e-6)
+    np.testing.assert_allclose(c[a], [[6, 5, 0]], atol=1e-6)
+    np.testing.assert_allclose(sorted(map(tuple, np.round(n[b], 6))), [(-1, 0, 0), (0, 0, -1), (1, 0, 0)])
+    np.testing.assert_allclose(n[top], [[0, 1, 0]], atol=1e-6)
+    np.testing.assert_allclose(c[top], [[6, 10, -4]], atol=1e-6)
+    # the quads span their faces: 12 x 10 front, 12 x 8 top
+    x = r["xform"]
+    assert np.linalg.norm(x[a][0, :, 0]) * np.linalg.norm(x[a][0, :, 1]) == pytest.approx(120)
+    assert np.linalg.norm(x[top][0, :, 0]) * np.linalg.norm(x[top][0, :, 1]) == pytest.approx(96)
+
+
+def test_comp_faces_go_to_the_first_selector_they_match(write):
+    r = run(write, "Lot --> extrude(10) comp(f){ side : B | front : A }\n", [rect(12, 8)])
+    assert Counter(names(r)) == {"B": 4}
+
+
+@pytest.mark.parametrize("selectors, want", [
+    ("all : X", {"X": 6}),
+    ("vertical : V | horizontal : H", {"V": 4, "H": 2}),
+    ("bottom : Bottom", {"Bottom": 1}),
+    ("top : NIL | all : X", {"X": 5}),
+    ("left : L | right : R | back : K", {"L": 1, "R": 1, "K": 1}),
+])
+def test_comp_selectors(write, selectors, want):
+    r = run(write, f"Lot --> extrude(10) comp(f){{ {selectors} }}\n", [rect(12, 8)])
+    assert Counter(names(r)) == want
+    n = quad_normals(r)
+    expected = {"Bottom": (0, -1, 0), "L": (-1, 0, 0), "R": (1, 0, 0), "K": (0, 0, -1)}
+    for name, normal in expected.items():
+        if name in want:
+            np.testing.assert_allclose(n[rows(r, name)], [normal], atol=1e-6)
+    if "H" in want:
+        np.testing.assert_allclose(sorted(n[rows(r, "H")][:, 1]), [-1, 1], atol=1e-6)
+        np.testing.assert_allclose(n[rows(r, "V")][:, 1], 0, atol=1e-6)
+
+
+def test_comp_sel_names_the_selector_that_took_the_face(write):
+    r = run(write, 'Lot --> extrude(4) comp(f){ left : Side | right : Side | side : Other }\n'
+                   'Side -->\n    case comp.sel == "left" : L\n    else : R\n'
+                   'Other --> report("sel", comp.sel)\n', [rect(12, 8)])
+    assert Counter(names(r)) == {"L": 1, "R": 1, "Other": 2}
+    np.testing.assert_allclose(quad_normals(r)[rows(r, "L")], [[-1, 0, 0]], atol=1e-6)
+    assert totals(r)["sel_sum"] == "side" and totals(r)["sel_n"] == 2
+
+
+def test_comp_index_and_total_are_per_selector(write):
+    r = run(write, 'Lot --> extrude(4) comp(f){ front : F | side : S }\n'
+                   'F --> report("f.index", comp.index) report("f.total", comp.total)\n'
+                   'S --> report("s.index", comp.index) report("s.total", comp.total)\n', [rect(12, 8)])
+    t = totals(r)
+    assert (t["f.index_max"], t["f.total_max"]) == (0, 1)
+    assert (t["s.index_min"], t["s.index_max"], t["s.index_sum"], t["s.total_max"]) == (0, 2, 3, 3)
+
+
+def test_world_and_object_face_selectors(write):
+    """world.* classifies by the world's axes, object.* by the lot's scope (x along the first edge)."""
+    r = run(write, "Lot --> extrude(4) comp(f){ world.front : WF | object.front : OF | world.top : T }\n",
+            [rect(12, 8)])
+    normals = quad_normals(r)
+    np.testing.assert_allclose(normals[rows(r, "WF")], [[0, 0, 1]], atol=1e-6)
+    np.testing.assert_allclose(normals[rows(r, "T")], [[0, 1, 0]], atol=1e-6)
+    assert Counter(names(r)) == {"WF": 1, "T": 1}  # map rectangles: the lot's front is the world's front
+
+
+def _face_area_normal(mesh, face):
+    """Signed area vector (Newell) of a mesh face: its outline minus its holes."""
+    total = np.zeros(3)
+    for ring in range(mesh.face_offsets[face], mesh.face_offsets[face + 1]):
+        p = mesh.vertices[mesh.ring_offsets[ring]:mesh.ring_offsets[ring + 1]].astype(np.float64)
+        total += np.cross(p, np.roll(p, -1, axis=0)).sum(axis=0) / 2
+    return total
+
+
+@pytest.mark.parametrize("lot, area", [("concave_L", 400.0), ("courtyard", 1200.0)])
+def test_polygon_top_and_bottom_faces(write, lot, area):
+    """Comp("top"/"bottom") of a prism on a concave or holed lot: polygon faces at the right height,
+    with the footprint's area, facing up and down."""
+    r = paper(write, 'lot ~> S(1r, 7, 1r) Comp("top"){ roof } Comp("bottom"){ floor }\n', make_lots_polys(lot))
+    mesh = r["mesh"]
+    names = r["symbols"][mesh.symbol]
+    assert sorted(names) == ["floor", "roof"] and len(r["asset"]) == 0
+    for face, name in enumerate(names):
+        vector = _face_area_normal(mesh, face)
+        np.testing.assert_allclose(np.linalg.norm(vector), area, rtol=1e-6)
+        y = mesh.vertices[mesh.ring_offsets[mesh.face_offsets[face]]:
+                          mesh.ring_offsets[mesh.face_offsets[face + 1]], 1]
+        np.testing.assert_allclose(y, 7.0 if name == "roof" else 0.0, atol=1e-5)
+        assert np.sign(vector[1]) == (1 if name == "roof" else -1)
+
+
+def test_comp_faces_of_a_courtyard_prism(write):
+    r = paper(write, 'lot ~> S(1r, 5, 1r) Comp("faces"){ f }\n', make_lots_polys("courtyard"))
+    # 8 side faces (4 outer, 4 facing the hole) are quads; top and bottom are polygons with a hole
+    assert len(r["asset"]) == 8 and len(r["mesh"].lot) == 2
+    assert list(np.diff(r["mesh"].face_offsets)) == [2, 2]
+    quad_area = np.linalg.norm(np.cross(r["xform"][:, :, 0], r["xform"][:, :, 1]), axis=1).sum()
+    np.testing.assert_allclose(quad_area, (160 + 80) * 5, rtol=1e-6)
+

@@ -1,0 +1,109 @@
+"""backend/operations/faces.py in derivations: offset, setback and shapeL/U/O, innerRectangle (roofs,
+convexify and cleanupGeometry: test_mesh_shapes.py)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+import shapely
+from conftest import LOT_ZOO
+from derivations import (
+    names,
+    per_lot,
+    rect,
+    run,
+    totals,
+)
+
+from grammarc.errors import GrammarError
+
+
+def test_offset_inside_and_border_faces(write):
+    """offset(-2) comp(f){ border | inside } on the L: a ring with an L-shaped hole and the inset L."""
+    r = run(write, "Lot --> offset(-2) comp(f){ border : B. | inside : I. }\n", [LOT_ZOO["concave_L"]])
+    mesh = r["mesh"]
+    names = list(r["symbols"][mesh.symbol])
+    assert sorted(zip(names, np.diff(mesh.face_offsets))) == [("B", 2), ("I", 1)]
+
+    def area(face):
+
+        rings = [mesh.vertices[mesh.ring_offsets[k]:mesh.ring_offsets[k + 1]][:, [0, 2]]
+                 for k in range(mesh.face_offsets[face], mesh.face_offsets[face + 1])]
+        return shapely.Polygon(rings[0], rings[1:]).area
+
+    inside, border = area(names.index("I")), area(names.index("B"))
+    # the L of 400 m2 (arms 10 wide) shrunk by 2: arms 6 wide, 26 and 16 long
+    assert inside == pytest.approx(26 * 6 + 10 * 6, rel=1e-6)
+    assert inside + border == pytest.approx(400, rel=1e-6)
+
+
+AREA_REPORTS = ('A --> report("a", geometry.area) A.\nB --> report("b", geometry.area) B.\n'
+                'R --> report("r", geometry.area) R.\n')
+
+
+@pytest.mark.parametrize("op, strips, remainder", [
+    # the front edge is the lot's first edge, 30 long; its strip is 5 deep, the left one 11 wide
+    ("shapeL(5, 11)", 30 * 5 + 11 * 15, 19 * 15),
+    ("shapeU(5, 3, 11)", 30 * 5 + 11 * 15 + 3 * 15, 16 * 15),
+    ("shapeO(2, 2, 2, 2)", 600 - 26 * 16, 26 * 16),
+])
+def test_shape_l_u_o_on_a_rectangle(write, op, strips, remainder):
+    r = run(write, f"Lot --> {op}{{ shape : A | remainder : R }}\n" + AREA_REPORTS, [rect(30, 20)])
+    t = totals(r)
+    assert (t["a_n"], t["r_n"]) == (1, 1)
+    assert (t["a_sum"], t["r_sum"]) == (pytest.approx(strips), pytest.approx(remainder))
+
+
+def test_setback_of_all_edges_on_concave_and_holed_lots(write):
+    """The L's strip is one piece; the courtyard's are two rings, around the lot and around the hole."""
+    r = run(write, "Lot --> setback(2){ all : A | remainder : R }\n" + AREA_REPORTS,
+            [LOT_ZOO["concave_L"], LOT_ZOO["courtyard"]])
+    lots = per_lot(r)
+    assert lots[0]["a_sum"] == pytest.approx(400 - 216) and lots[0]["r_sum"] == pytest.approx(216)
+    assert lots[1]["a_n"] == 2 and lots[1]["a_sum"] + lots[1]["r_sum"] == pytest.approx(1200)
+
+
+def test_setback_of_a_facade_selects_its_top_and_bottom_edges(write):
+    r = run(write, "Lot --> extrude(10) comp(f){ front : F }\n"
+                   "F --> setback(1){ top : A | bottom : B | remainder : R }\n" + AREA_REPORTS, [rect(30, 20)])
+    t = totals(r)
+    assert (t["a_sum"], t["b_sum"], t["r_sum"]) == (30, 30, 240)
+
+
+def test_setback_leaves_its_parts_to_cityengine_leaf_rules(write):
+    r = run(write, "Lot --> setback(3){ front : Yard | remainder : extrude(6) Mass }\n", [rect(30, 20)])
+    assert sorted(names(r)) == ["Mass", "Yard"]
+
+
+def test_offset_inside_of_a_rectangle_stays_a_box_path_rectangle(write):
+    r = run(write, "Lot --> offset(-1, inside) extrude(2) X.\n", [rect(12, 8)])
+    np.testing.assert_allclose(np.diagonal(np.abs(r["xform"][0, :, :3])), [10, 2, 6])
+    np.testing.assert_allclose(r["xform"][0, :, 3], [1, 0, -7])
+
+
+def test_offset_without_its_comp_is_named(write):
+    with pytest.raises(GrammarError, match="offset\\(d\\) without comp"):
+        run(write, "Lot --> offset(-1) extrude(3)\n", [rect(12, 8)])
+
+
+def test_inner_rectangle_and_remainder_tile_the_lot_in_the_lot_frame(write):
+    text = ("Lot --> innerRectangle(scope){ shape : A | remainder : B }\n"
+            'A --> report("a", geometry.area) X\nB --> report("b", geometry.area) Y\n')
+    r = run(write, text, [LOT_ZOO["concave_L"], LOT_ZOO["courtyard"]])
+    t = per_lot(r)
+    assert t[0]["a_sum"] == pytest.approx(300) and t[0]["b_sum"] == pytest.approx(100)
+    assert t[1]["a_sum"] == pytest.approx(400) and t[1]["b_sum"] == pytest.approx(800)
+    assert t[1]["b_n"] == 1  # the rest of the ring is one piece (a U)
+
+
+def test_inner_rectangle_by_edge_finds_a_rotated_lot_whole(write):
+    angle = np.radians(30)
+    turn = np.array([[np.cos(angle), -np.sin(angle)], [np.sin(angle), np.cos(angle)]])
+    lot = [np.array([[0, 0], [25, 0], [25, 15], [0, 15]], float) @ turn.T]
+    found = {}
+    for align in ("edge", "scope"):
+        # the lot's scope runs along its first edge; aligned with the world's axes, scope and edge differ
+        text = f'Lot --> alignScopeToAxes() innerRectangle({align}){{ shape : A }}\nA --> report("a", geometry.area)\n'
+        found[align] = totals(run(write, text, [lot]))["a_sum"]
+    assert found["edge"] == pytest.approx(375.0) and found["scope"] < 300
+

@@ -1,0 +1,92 @@
+"""backend/operations/splits.py in derivations: the paper's Subdiv and Repeat on the sizes of its
+section 2, CityEngine's split, and sizes that fail their lot (snapped splits: test_snaps.py, the
+layouts of CityEngine's split: test_group_split.py)."""
+
+from __future__ import annotations
+
+from collections import Counter
+
+import numpy as np
+import pytest
+from derivations import (
+    names,
+    of_symbol,
+    paper,
+    rect,
+    rows,
+    run,
+    totals,
+)
+
+
+def test_split_index_numbers_the_floors_from_the_bottom(write):
+    r = run(write, 'Lot --> extrude(10) split(y){ ~3 : Floor }*\n'
+                   'Floor --> report("floor" + split.index, split.total) Kind\n'
+                   'Kind -->\n    case split.index == 0 : Ground.\n    else : Upper.\n', [rect(5, 5)])
+    assert Counter(names(r)) == {"Ground": 1, "Upper": 2}
+    ground, upper = r["xform"][rows(r, "Ground")], r["xform"][rows(r, "Upper")]
+    assert ground[0, 1, 3] == 0 and (upper[:, 1, 3] > 3).all()
+    np.testing.assert_allclose(r["xform"][:, 1, 1], 10 / 3, rtol=1e-6)
+    t = totals(r)
+    assert [t[f"floor{i}_sum"] for i in range(3)] == [3, 3, 3]
+
+
+def test_split_along_z_with_absolute_and_floating_parts(write):
+    r = run(write, "Lot --> extrude(3) split(z){ 2 : Front | ~1 : Middle | 2 : Back }\n", [rect(4, 10)])
+    assert names(r) == ["Front", "Middle", "Back"]
+    np.testing.assert_allclose(r["xform"][:, 2, 2], [2, 6, 2])
+    np.testing.assert_allclose(r["xform"][:, 2, 3], [-10, -8, -2])
+
+
+def test_subdiv_relative_sizes_on_widths_12_and_10(write):
+    """Paper section 2: Subdiv("X",2,1r,1r,2) gives 2,4,4,2 on width 12 and 2,3,3,2 on width 10."""
+    r = paper(write, 'floor ~> S(1r, 3, 1r) Subdiv("X",2,1r,1r,2){ B | A | A | B }\n'
+                   'A ~> I("cube")\nB ~> I("cube")\n', [rect(12, 5), rect(10, 5)])
+    for lot, want in ((0, [2, 4, 4, 2]), (1, [2, 3, 3, 2])):
+        rows = r["lot"] == lot
+        order = np.argsort(r["xform"][rows, 0, 3])
+        np.testing.assert_allclose(r["xform"][rows, 0, 0][order], want)
+        np.testing.assert_allclose(r["xform"][rows, 0, 3][order], np.cumsum([0, *want[:-1]]))
+    # B at both ends, A in the middle
+    rows = r["lot"] == 0
+    symbols = r["symbols"][r["symbol"][rows][np.argsort(r["xform"][rows, 0, 3])]]
+    assert list(symbols) == ["B", "A", "A", "B"]
+
+
+def test_subdiv_facade_of_12_8(write):
+    """Paper section 2: Subdiv("Y",3.5,0.3,3,3,3) on a facade 12.8 high: four floors and a ledge."""
+    r = paper(write, 'lot ~> S(1r, 12.8, 1r) Comp("sideface", 0){ fac }\n'
+                   'fac ~> Subdiv("Y",3.5,0.3,3,3,3){ floor | ledge | floor | floor | floor }\n',
+            [rect(10, 10)])
+    heights = r["xform"][:, 1, 1]
+    bottoms = r["xform"][:, 1, 3]
+    order = np.argsort(bottoms)
+    np.testing.assert_allclose(heights[order], [3.5, 0.3, 3, 3, 3])
+    np.testing.assert_allclose(bottoms[order], [0, 3.5, 3.8, 6.8, 9.8])
+    assert list(r["symbols"][r["symbol"][order]]) == ["floor", "ledge", "floor", "floor", "floor"]
+    # leaves of a flat scope are quads
+    assert set(r["assets"][r["asset"]]) == {"builtin:quad"}
+
+
+@pytest.mark.parametrize("width, count", [(12, 6), (11, 6), (10.5, 6), (2, 1), (0.5, 1)])
+def test_repeat_counts_ceil(write, width, count):
+    """Paper section 2: Repeat("X",2) makes ceil(Scope.sx/2) elements of equal, adjusted size."""
+    r = paper(write, 'floor ~> S(1r, 3, 1r) Repeat("X", 2){ B }\nB ~> I("cube")\n', [rect(width, 4)])
+    assert len(r["asset"]) == count
+    np.testing.assert_allclose(r["xform"][:, 0, 0], width / count)
+    np.testing.assert_allclose(np.sort(r["xform"][:, 0, 3]), np.arange(count) * width / count, atol=1e-5)
+
+
+def test_repeat_xy_grid_and_alternating_parts(write):
+    r = paper(write, 'f ~> S(1r, 4, 1r) Comp("sideface", 0){ g }\ng ~> Repeat("XY", 2, 1){ A | B }\n',
+            [rect(6, 6)])
+    assert len(r["asset"]) == 3 * 4
+    assert of_symbol(r, "A").sum() == 6 and of_symbol(r, "B").sum() == 6
+
+
+def test_nan_split_size_lot_is_reported(write):
+    r = paper(write, 'lot ~> S(1r, 2, 1r) Subdiv("X", 1, sqrt(Scope.sx - 11)){ a | b }\n',
+            [rect(12, 5), rect(10, 5)])
+    assert list(np.unique(r["lot"])) == [0]
+    assert r["bad"][0].index == 1 and "Subdiv" in r["bad"][0].reason
+

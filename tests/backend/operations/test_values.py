@@ -1,0 +1,54 @@
+"""backend/operations/values.py in derivations: ``set`` inherited by successors and parts, undone by
+a pop, and ``report`` per lot and in total."""
+
+from __future__ import annotations
+
+import pytest
+from derivations import (
+    names,
+    per_lot,
+    rect,
+    run,
+    totals,
+)
+
+
+def test_set_is_inherited_by_successors_and_seen_by_case(write):
+    r = run(write, "attr h = 3\nLot --> set(h, 7) extrude(h) Mass\n"
+                   "Mass -->\n    case h > 5 : Tall\n    else : Short\n", [rect(2, 2)])
+    assert names(r) == ["Tall"]
+    assert r["xform"][0, 1, 1] == 7
+
+
+def test_set_reaches_split_parts_and_grandchildren(write):
+    r = run(write, 'attr floor = -1\nLot --> extrude(9) split(y){ ~3 : Floor }*\n'
+                   'Floor --> set(floor, split.index) split(x){ ~1 : Tile }*\n'
+                   'Tile --> report("floor" + floor, 1)\n', [rect(4, 4)])
+    t = totals(r)
+    assert [t[f"floor{i}_n"] for i in range(3)] == [4, 4, 4]
+
+
+def test_set_inside_push_pop_is_undone_by_the_pop(write):
+    r = run(write, 'attr h = 3\nLot --> extrude(1) [ set(h, 7) A ] B\nA --> report("a", h)\n'
+                   'B --> report("b", h)\n', [rect(2, 2)])
+    assert (totals(r)["a_sum"], totals(r)["b_sum"]) == (7, 3)
+
+
+def test_reports_per_lot_and_totals(write):
+    r = run(write, 'Lot --> report("lots", 1) report("area", geometry.area) report("big", scope.sx > 10)\n'
+                   '    report("name", "lot" + scope.sx) extrude(5) comp(f){ side : Side }\n'
+                   'Side --> report("side.width", scope.sx)\n', [rect(12, 8), rect(6, 4)])
+    lots = per_lot(r)
+    assert lots[0]["side.width_n"] == 4 and lots[0]["side.width_sum"] == pytest.approx(40)
+    assert (lots[1]["side.width_min"], lots[1]["side.width_max"], lots[1]["side.width_avg"]) == (4, 6, 5)
+    t = totals(r)
+    assert (t["lots_n"], t["lots_sum"], t["lots_avg"]) == (2, 2, 1)
+    assert (t["area_sum"], t["area_min"], t["area_max"], t["area_avg"]) == (120, 24, 96, 60)
+    assert (t["side.width_n"], t["side.width_sum"], t["side.width_avg"]) == (8, 60, 7.5)
+    # booleans: sum and max any, min all, avg the majority
+    assert (t["big_n"], t["big_sum"], t["big_min"], t["big_max"]) == (2, True, False, True)
+    assert (lots[1]["big_sum"], lots[1]["big_avg"]) == (False, False)
+    # strings: the first value for sum and avg, compared as text for min and max
+    assert (t["name_n"], t["name_sum"], t["name_avg"]) == (2, "lot12", "lot12")
+    assert (t["name_min"], t["name_max"]) == ("lot12", "lot6")
+

@@ -1,0 +1,71 @@
+"""backend/terminals.py: leaves as quads and mesh faces, and inserts trimmed at their trim planes
+with the asset meshes the plan's loader gives."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from operations.derivations import VERSION, make_lots_polys, paper, rect, run
+
+from grammarc.backend.derive import derive_chunk
+from grammarc.backend.plan import make_plan
+from grammarc.compiler import compile_grammar
+from grammarc.constants import LIMITS
+from grammarc.errors import AssetError, GrammarError
+from grammarc.io.bake import load_asset
+from grammarc.io.lots import lots_from_polygons
+
+LEDGE = ("Lot --> extrude(10) {set}comp(f){{ side : Facade }}\n"
+         "Facade --> split(y){{ 1 : Ledge | ~1 : NIL }}\n"
+         "Ledge --> s('1.2, '1, 0.5) center(x) primitiveCube()\n")
+
+
+def test_trim_planes_mitre_inserts_at_corners_unless_turned_off(write):
+    """A ledge wider than its facade is cut at the corners' trim planes (mesh faces, not instances);
+    ``set(trim.vertical, false)`` keeps it whole; horizontal trim planes are refused."""
+    base = LEDGE
+    trimmed = run(write, base.format(set=""), [rect(12, 8)])
+    assert len(trimmed["asset"]) == 0 and len(trimmed["mesh"].lot) > 0
+    whole = run(write, base.format(set="set(trim.vertical, false) "), [rect(12, 8)])
+    assert len(whole["asset"]) == 4 and len(whole["mesh"].lot) == 0
+    with pytest.raises(GrammarError, match="horizontal"):
+        run(write, base.format(set="set(trim.horizontal, true) "), [rect(12, 8)])
+
+
+def test_trims_take_their_asset_meshes_from_the_plans_loader(write):
+    """The derivation opens no asset file itself: the plan's loader gives the meshes trims cut, each asked
+    for once in a chunk; an asset the loader cannot give stays whole."""
+    grammar = compile_grammar(write("g.cga", VERSION + LEDGE.format(set="")))
+    lots = lots_from_polygons([rect(12, 8), rect(10, 10)])
+    asked = []
+
+    def counting(name, roots):
+        asked.append(name)
+        return load_asset(name, roots)
+
+    def missing(name, roots):
+        raise AssetError(f"no root holds {name}")
+
+    options = {"seed": 0, "limits": LIMITS, "overrides": {}, "chunk_budget": 10**9}
+    trimmed, _ = derive_chunk(make_plan(grammar, load_asset=counting), lots, **options)
+    assert asked == ["builtin:cube"] and len(trimmed.asset) == 0 and len(trimmed.mesh.lot) > 0
+    whole, _ = derive_chunk(make_plan(grammar, load_asset=missing), lots, **options)
+    assert len(whole.asset) == 8 and len(whole.mesh.lot) == 0
+
+
+def test_leaf_face_is_a_quad_facing_outwards(write):
+    r = paper(write, 'lot ~> S(1r, 3, 1r) Comp("sidefaces"){ wall }\n', make_lots_polys("square"))
+    assert set(r["assets"][r["asset"]]) == {"builtin:quad"}
+    normals = np.cross(r["xform"][:, :, 0], r["xform"][:, :, 1])
+    centres = r["xform"][:, :, 3] + (r["xform"][:, :, 0] + r["xform"][:, :, 1]) / 2
+    middle = np.array([5, 1.5, -5])
+    assert (np.einsum("ij,ij->i", normals, centres - middle) > 0).all()
+
+
+def test_polygon_leaves_go_to_the_mesh_table(write):
+    r = paper(write, 'lot ~> S(1r, 3, 1r) mass\n', make_lots_polys("concave_L", "square"))
+    mesh = r["mesh"]
+    # the L prism: bottom, top and 6 sides; the square is a box: one cube instance
+    assert list(mesh.lot) == [0] * 8 and list(r["lot"]) == [1]
+    assert len(r["asset"]) == 1 and r["assets"][r["asset"][0]] == "builtin:cube"
+
