@@ -29,8 +29,8 @@ from grammarc.constants import Limits
 from grammarc.geometry.footprint import footprint_polygons, lot_scopes
 from grammarc.geometry.polygons import PolygonStore
 from grammarc.geometry.streets import lot_streets
-from grammarc.io.lots import Lots
-from grammarc.io.npz import MeshChunk, TerminalChunk
+from grammarc.model.lots import Lots
+from grammarc.model.records import MeshChunk, TerminalChunk
 from grammarc.ragged import ragged_take
 
 

@@ -29,7 +29,7 @@ from grammarc.geometry.meshes import (
 from grammarc.geometry.polygons import PLANE_U, PLANE_V, plane_to_scope
 from grammarc.geometry.roofs import ROOF_KINDS, roof_meshes
 from grammarc.geometry.sections import append_caps, plane_segments, section_caps
-from grammarc.io.npz import MeshChunk
+from grammarc.model.records import MeshChunk
 from grammarc.ragged import ragged_take, rank_within, segment_of, segment_reduce
 
 

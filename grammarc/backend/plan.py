@@ -13,6 +13,7 @@ from grammarc.backend.slots import ANCESTORS, COLOR_SLOT, TRIM_SLOTS, TRIM_SWITC
 from grammarc.compiler import Grammar
 from grammarc.ir import nodes as ir
 from grammarc.ir.traverse import iter_exprs, iter_ops, op_exprs
+from grammarc.model.assets import load_asset
 
 
 class Strings:
@@ -80,16 +81,16 @@ class Plan:
     #: Whether shapes carry their occluding ancestors (``backend.occlusion``): the grammar asks occlusion
     #: queries or labels shapes.
     occluders: bool = False
-    #: ``load_asset(name, asset_roots) -> AssetMesh``: how trimmed inserts get their asset's triangles (set
-    #: by whoever makes the plan: the derivation reads no asset file of its own accord).
-    load_asset: Callable | None = None
+    #: ``load_asset(name, asset_roots) -> AssetMesh``: how trimmed inserts get their asset's triangles
+    #: (the model's loader, or a test's stand-in).
+    load_asset: Callable = load_asset
 
     @property
     def symbol_names(self) -> tuple[str, ...]:
         return tuple(s.name for s in self.symbols)
 
 
-def make_plan(grammar: Grammar, *, load_asset: Callable | None = None) -> Plan:
+def make_plan(grammar: Grammar, *, load_asset: Callable = load_asset) -> Plan:
     """The plan of ``grammar``; ``load_asset(name, asset_roots) -> AssetMesh`` loads the assets whose
     inserts are trimmed (``Plan.load_asset``)."""
     module = grammar.module
@@ -137,15 +138,9 @@ def make_plan(grammar: Grammar, *, load_asset: Callable | None = None) -> Plan:
                                                         for alt in rule.alternatives for op in iter_ops(alt.body))),
         color_slot=dynamic.get(COLOR_SLOT), trim_slot=trim_slot,
         trim_switch=dynamic.get(TRIM_SWITCH) if trim_slot is not None else None,
-        occluders=ANCESTORS[0] in dynamic, load_asset=load_asset or _load_asset)
+        occluders=ANCESTORS[0] in dynamic, load_asset=load_asset)
     return replace(plan, leaf_inserts=leaf_inserts(plan))
 
-
-def _load_asset(name: str, asset_roots):
-    """The loader of a plan made without one: until the builders pass theirs (to go then)."""
-    from grammarc.io.bake import load_asset
-
-    return load_asset(name, asset_roots)
 
 
 def _all_exprs(module: ir.Module):

@@ -27,7 +27,7 @@ from grammarc.geometry.components import reverse_rings
 from grammarc.geometry.meshes import is_mesh, is_polygon
 from grammarc.geometry.polygons import PLANE_U, PLANE_V
 from grammarc.geometry.trim import boxes_crossing, trim_triangles
-from grammarc.io.npz import MeshChunk
+from grammarc.model.records import MeshChunk
 from grammarc.ragged import offsets_from_counts, segment_of
 
 CUBE, QUAD = 0, 1  # asset ids of the leaf built-ins (see compiler._assets)

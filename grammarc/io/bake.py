@@ -38,10 +38,7 @@ from grammarc.errors import UsageError
 from grammarc.geometry.triangulation import triangulate_polygons
 from grammarc.io import WriterBlock
 from grammarc.io.obj import obj_bytes
-
-# builtin_mesh and load_asset stay importable here for the backend (derive) and tests/geometry/test_trim.py
-# until they import grammarc.model.assets.
-from grammarc.model.assets import AssetLibrary, AssetMesh, asset_library, builtin_mesh, load_asset  # noqa: F401
+from grammarc.model.assets import AssetLibrary, AssetMesh, asset_library
 from grammarc.model.records import MeshChunk, TerminalChunk
 from grammarc.ragged import offsets_from_counts
 

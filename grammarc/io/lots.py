@@ -42,12 +42,10 @@ from grammarc.errors import LotsError
 from grammarc.io import geojson, geojson_sequence, geoparquet, gis, obj_lots
 from grammarc.io.lot_builder import STREET_WIDTH, LotBuilder, property_column
 from grammarc.io.lot_format import LotsFormat, Partition, partitions_at
-
-# BadLot and Lots are the model's (grammarc.model.lots); named here too until their users import them there.
-from grammarc.model.lots import BadLot, Lots
+from grammarc.model.lots import Lots
 
 __all__ = [
-    "FORMATS", "BadLot", "Lots", "Partition", "count_lots", "default_lot", "file_stamp", "lots_from_polygons",
+    "FORMATS", "Partition", "count_lots", "default_lot", "file_stamp", "lots_from_polygons",
     "partition_lots", "read_lots", "read_partition",
 ]
 

@@ -55,10 +55,7 @@ import numpy as np
 from zlib_ng.zlib_ng import crc32, crc32_combine
 
 from grammarc.errors import UsageError
-
-# MeshChunk and TerminalChunk stay importable here for the backend (derive, terminals, mesh_shapes) and the
-# benchmarks until they import grammarc.model.records.
-from grammarc.model.records import MeshChunk, TerminalChunk  # noqa: F401
+from grammarc.model.records import TerminalChunk
 
 if TYPE_CHECKING:
     from typing_extensions import Self

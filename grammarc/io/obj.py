@@ -8,9 +8,6 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-# read_obj and ObjError stay importable here for io.lots until it imports grammarc.model.obj.
-from grammarc.model.obj import ObjError, read_obj  # noqa: F401
-
 __all__ = ["obj_bytes"]
 
 

@@ -12,8 +12,8 @@ from grammarc.backend.plan import make_plan
 from grammarc.compiler import compile_grammar
 from grammarc.constants import LIMITS
 from grammarc.errors import AssetError, GrammarError
-from grammarc.io.bake import load_asset
 from grammarc.io.lots import lots_from_polygons
+from grammarc.model.assets import load_asset
 
 LEDGE = ("Lot --> extrude(10) {set}comp(f){{ side : Facade }}\n"
          "Facade --> split(y){{ 1 : Ledge | ~1 : NIL }}\n"
