@@ -30,14 +30,15 @@ from grammarc.backend.attributes import check_overrides
 from grammarc.backend.derive import derive_chunk
 from grammarc.backend.occlusion import Occluders
 from grammarc.backend.plan import make_plan
-from grammarc.backend.reports import Reports
 from grammarc.compiler import Grammar, compile_grammar
 from grammarc.constants import LIMITS, Limits
 from grammarc.errors import ChunkTooLarge, LotFailure, UsageError
 from grammarc.io import OutputOptions, writer_for
 from grammarc.io.lots import default_lot, read_lots
+from grammarc.io.reports import write_reports
 from grammarc.model.lots import BadLot, Lots
 from grammarc.model.records import MeshChunk
+from grammarc.model.reports import Reports
 from grammarc.workers import worker_pool
 
 #: Shapes plus records one chunk may make before it is split: ~100 bytes each, so about 2 GB.
@@ -144,7 +145,7 @@ def _build(source: Path, display: str | None, grammar_path: Path, output, lots_p
         derived = derive_all(plan, lots, options, writer, failed, reports, progress, every)
         counts = writer.close()
     if reports:
-        reports.write(Path(reports_to) if reports_to else reports_path(Path(output)),
+        write_reports(reports, Path(reports_to) if reports_to else reports_path(Path(output)),
                       dict(zip(every.index.tolist(), every.ids.tolist())))
     bad = tuple(sorted((*lots.bad, *failed), key=lambda b: b.index))
     return BuildResult(Path(output), len(lots) + len(lots.bad), derived, bad, counts,

@@ -41,7 +41,6 @@ import numpy as np
 from grammarc import __version__
 from grammarc.backend.occlusion import Occluders
 from grammarc.backend.plan import make_plan
-from grammarc.backend.reports import Reports
 from grammarc.build import (
     BuildOptions,
     BuildResult,
@@ -58,6 +57,7 @@ from grammarc.errors import UsageError
 from grammarc.io import OutputOptions, writer_for
 from grammarc.io.assets import resolve_asset
 from grammarc.io.lots import Partition, count_lots, file_stamp, partition_lots, read_partition
+from grammarc.io.reports import write_reports
 from grammarc.io.shards import (
     complete_shard,
     file_digests,
@@ -70,6 +70,7 @@ from grammarc.io.shards import (
     write_json,
 )
 from grammarc.model.lots import BadLot
+from grammarc.model.reports import Reports
 
 __all__ = ["build_on_dask"]
 #: Times Dask runs a failed task again.
@@ -253,7 +254,7 @@ def _shard_task(plan, part: Partition, first: int, job: _Job, foreign, files: di
         files += [f for f in tiles_folder(path).rglob("*") if f.is_file()]
     if reports:
         report = job.folder / shard_name(part.number, ".reports.json")
-        reports.write(report, dict(zip(lots.index.tolist(), lots.ids.tolist())))
+        write_reports(reports, report, dict(zip(lots.index.tolist(), lots.ids.tolist())))
         files.append(report)
     bad = sorted((*lots.bad, *failed), key=lambda b: b.index)
     sidecar = {
