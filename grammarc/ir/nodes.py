@@ -21,6 +21,7 @@ from __future__ import annotations
 from collections.abc import Callable
 from dataclasses import Field, dataclass, field, fields
 from enum import Enum
+from pathlib import Path
 from typing import Any
 
 from grammarc.diagnostics import NO_SPAN, Span
@@ -738,9 +739,32 @@ class AttrDecl:
     annotations: tuple[tuple[str, tuple[str, ...]], ...] = ()
 
 
+@dataclass(frozen=True)
+class RuleGraph:
+    """What ``passes.rulegraph`` finds of the symbols: those with rules, the leaves, what the start symbol
+    reaches and what recurses. It lives here, beside the ``Module`` that carries it, because every layer
+    after the passes reads it from the module."""
+
+    start: str
+    #: Symbols with rules, in order of first definition.
+    nonterminals: tuple[str, ...]
+    #: Symbols used in successors that have no rule: their shapes are leaves.
+    terminals: tuple[str, ...]
+    reachable: frozenset[str]
+    #: Symbols on a cycle of the graph (directly or mutually recursive).
+    recursive: frozenset[str]
+    edges: dict[str, tuple[str, ...]]
+
+
 @dataclass(frozen=True, slots=True)
 class Module:
-    """A whole grammar: its file, attributes, rules in source order, and the start symbol."""
+    """A whole grammar: its file, attributes, rules in source order, and the start symbol.
+
+    The analyses travel with it: every pass takes a module and returns one (``pipeline``), so what the
+    rule graph and asset resolution find becomes fields of the module they return (``graph``,
+    ``assets``, ``asset_ids``), and the checked module carries everything the backend reads. The
+    compiler sets ``start`` and ``roots`` before the passes, as the file's own and the caller's choices.
+    """
 
     file: str
     attrs: tuple[AttrDecl, ...] = child(holds=Holds.NODES)
@@ -753,3 +777,13 @@ class Module:
     dialect: str = "cga2006"
     #: Files whose rules and attributes were imported into this module (CityEngine ``import``).
     imported: tuple[str, ...] = ()
+    #: Folders that ``I()`` names are resolved in, in order (the grammar's, then ``--assets`` ones). None
+    #: for a module lowered outside the compiler (by a test, a tool): checked, but not made ready to derive
+    #: (its start rule may take parameters, its asset names stay unresolved).
+    roots: tuple[Path, ...] | None = None
+    #: The symbol graph from ``start``, found by ``passes.rulegraph`` (None before, or without rules).
+    graph: RuleGraph | None = None
+    #: Canonical asset names, found by ``passes.assets``: an asset's index is its id in the record.
+    assets: tuple[str, ...] = ()
+    #: ``I()`` name as written -> asset id, as pairs: the module is frozen (``model.Grammar`` has the dict).
+    asset_ids: tuple[tuple[str, int], ...] = ()
