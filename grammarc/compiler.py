@@ -45,4 +45,4 @@ def compile_grammar(path: str | Path, *, text: str | None = None, start: str | N
     if diags.has_errors:
         raise GrammarError(diags, sources)
     return Grammar(path=file, digest=hashlib.sha256(text.encode()).hexdigest(), module=module,
-                   warnings=tuple(d for d in diags if not d.is_error), sources=sources)
+                   warnings=tuple(d for d in diags if not d.is_error), sources=sources, asset_roots=module.roots)

@@ -26,6 +26,9 @@ class Grammar:
     warnings: tuple[Diagnostic, ...]
     #: File name -> text of the grammar and of the files it imports.
     sources: dict[str, str]
+    #: Folders the assets are loaded from: those the compiler resolved them in (``Module.roots``), or the
+    #: copy of them a cluster worker is given. A field, not the module's: it changes when the grammar moves.
+    asset_roots: tuple[Path, ...] = ()
 
     @property
     def graph(self) -> ir.RuleGraph:
@@ -40,8 +43,3 @@ class Grammar:
     def asset_ids(self) -> dict[str, int]:
         """``I()`` name as written -> asset id."""
         return dict(self.module.asset_ids)
-
-    @property
-    def asset_roots(self) -> tuple[Path, ...]:
-        """Folders the assets were resolved in (the grammar's, then ``--assets`` ones), for loading them."""
-        return self.module.roots

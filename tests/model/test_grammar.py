@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import pickle
+from dataclasses import replace
 
 from grammarc.compiler import Grammar, compile_grammar
 from grammarc.model import grammar as model
@@ -18,6 +19,9 @@ def test_the_grammar_reads_what_the_passes_found_from_its_module(write):
     assert grammar.asset_ids == {"cylinder": 2, "win.obj": 3} and module.asset_ids == (("cylinder", 2),
                                                                                         ("win.obj", 3))
     assert grammar.asset_roots == (path.parent,) == module.roots
+    # a cluster worker loads the assets from its own copy of them
+    moved = replace(grammar, asset_roots=(path.parent / "copy",))
+    assert moved.asset_roots == (path.parent / "copy",) and moved.module is module
 
 
 def test_a_grammar_pickles_whole(write):
