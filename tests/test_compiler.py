@@ -1,4 +1,4 @@
-"""compiler.py: compile_grammar runs the frontend, the passes, the rule graph and assets.
+"""compiler.py: compile_grammar reads, parses and runs the passes (the rule graph and assets among them).
 
 A grammar with errors raises GrammarError listing every one; warnings come back with the grammar.
 """

@@ -5,14 +5,24 @@ one or more stochastic ``Alternative``s, each a ``Body`` (a tuple of operations 
 current scope). Expressions are typed trees (``Type``); names are resolved by ``passes.resolve`` from
 ``Name`` into ``Param`` or ``AttrRef``.
 
+Every node declares its children once, on its fields (``child``): which fields hold expressions, and of
+which type they must be, which hold bodies. ``traverse`` walks and rebuilds any node from these
+declarations, ``passes.types`` checks the expressions against them and ``printer`` prints a node it has
+no format for from them, so a new operation is its class here and nothing in those three.
+
 Geometry conventions (shared with the backend): a scope has an origin, three orthonormal axes (rows of a
 3x3 matrix, right-handed) and a size. Angles are in degrees. Axis indices are 0, 1, 2 for x, y, z.
 """
 
+# ruff: noqa: RUF009 - ``child()`` returns a ``dataclasses.Field``, which ruff cannot see through
+
 from __future__ import annotations
 
-from dataclasses import dataclass
+from collections.abc import Callable
+from dataclasses import Field, dataclass, field, fields
 from enum import Enum
+from pathlib import Path
+from typing import Any
 
 from grammarc.diagnostics import NO_SPAN, Span
 
@@ -29,6 +39,71 @@ class SizeKind(Enum):
     RELATIVE = "rel"
     #: CityEngine's `~` sizes; the paper notation has none, the CityEngine frontend will lower to it.
     FLOATING = "float"
+
+
+# ---------------------------------------------------------------------------------------------- declarations
+
+
+class Holds(Enum):
+    """What a child field holds, which says where a walk finds its expressions and bodies."""
+
+    #: Expressions, alone or in (nested) tuples and ``Size``s, with plain values (str, int, bool) beside
+    #: them: the node's own arguments.
+    EXPRS = "exprs"
+    #: One body (a tuple of operations).
+    BODY = "body"
+    #: A tuple of bodies (the parts of a split).
+    BODIES = "bodies"
+    #: ``(condition, body)`` pairs (the branches of ``case`` and of a stochastic choice).
+    BRANCHES = "branches"
+    #: A tuple of nodes walked on their own (a module's rules, a rule's alternatives).
+    NODES = "nodes"
+
+
+@dataclass(frozen=True, slots=True)
+class Child:
+    """The declaration of one child field (see ``child``)."""
+
+    want: Type | Callable[[Any], Type | None] | None
+    what: str | tuple[str, ...] | Callable[[Any], str]
+    holds: Holds
+
+    def want_of(self, node) -> Type | None:
+        """The type the field's expressions must have in ``node``; None: not checked from here."""
+        return self.want(node) if callable(self.want) else self.want
+
+    def what_of(self, node) -> str | tuple[str, ...]:
+        return self.what(node) if callable(self.what) else self.what
+
+
+def child(want: Type | Callable | None = None, what: str | tuple | Callable = "", *,
+          holds: Holds = Holds.EXPRS, **options) -> Field:
+    """A dataclass field that holds children of the node, declared once for every walker.
+
+    ``want`` is the type the field's expressions must have (``passes.types`` checks it), or a function of
+    the node for the few that depend on it, or None where the checker types them another way. ``what``
+    names them in the type error ("a size must be a num, got a str"): a string, a function of the node,
+    or a tuple of nouns taken in turn for the field's expressions (``Roof.sides``: height, angle, height,
+    ...). ``holds`` says what the field holds; ``options`` go to ``dataclasses.field`` (``default=``).
+    A plain field (a string, a number) may be declared too, so that the printer shows it.
+    """
+    return field(metadata={_CHILD: Child(want, what, holds)}, **options)
+
+
+_CHILD = "grammarc.child"
+_DECLARED: dict[type, tuple[tuple[str, Child], ...]] = {}
+
+
+def children(cls: type) -> tuple[tuple[str, Child], ...]:
+    """The declared child fields of a node class, as (field name, declaration) in field order.
+
+    Read from the dataclass fields once per class: every walk asks for every node it visits.
+    """
+    declared = _DECLARED.get(cls)
+    if declared is None:
+        declared = _DECLARED[cls] = tuple((f.name, f.metadata[_CHILD]) for f in fields(cls)
+                                          if _CHILD in f.metadata)
+    return declared
 
 
 # ----------------------------------------------------------------------------------------------- expressions
@@ -102,10 +177,14 @@ class ScopeRef:
     span: Span = NO_SPAN
 
 
+#: Unary operators and the type each takes and gives.
+UNARY_TYPES = {"-": Type.NUM, "!": Type.BOOL}
+
+
 @dataclass(frozen=True, slots=True)
 class Unary:
     op: str  # "-", "!"
-    operand: Expr
+    operand: Expr = child(lambda e: UNARY_TYPES[e.op], lambda e: f"the operand of `{e.op}`")
     span: Span = NO_SPAN
 
 
@@ -117,8 +196,9 @@ LOGIC_OPS = frozenset({"&&", "||"})
 @dataclass(frozen=True, slots=True)
 class Binary:
     op: str
-    left: Expr
-    right: Expr
+    #: typed by the operator (``passes.types.type_of``): ``==`` takes any one type, ``+`` strings too
+    left: Expr = child()
+    right: Expr = child()
     span: Span = NO_SPAN
 
 
@@ -127,7 +207,9 @@ class Call:
     """A built-in function. ``site`` numbers the call so that ``rand`` draws differ per call site."""
 
     func: str
-    args: tuple[Expr, ...]
+    #: numbers, but for the conversions (``CONVERSIONS``), which take any type
+    args: tuple[Expr, ...] = child(lambda e: None if e.func in CONVERSIONS else Type.NUM,
+                                   lambda e: f"an argument of `{e.func}`")
     span: Span = NO_SPAN
     site: int = 0
 
@@ -165,16 +247,17 @@ class Occlusion:
     span: Span = NO_SPAN
     parents: bool = False
     active: bool = False
-    distance: Expr | None = None
+    distance: Expr | None = child(Type.NUM, "a distance", default=None)
 
 
 @dataclass(frozen=True, slots=True)
 class Select:
     """``cond ? then : other`` per shape: CityEngine's ``case`` and ``p% :`` expressions lower to it."""
 
-    cond: Expr
-    then: Expr
-    other: Expr
+    cond: Expr = child(Type.BOOL, "a condition")
+    #: of one type, whichever it is (``passes.types.type_of``)
+    then: Expr = child()
+    other: Expr = child()
     span: Span = NO_SPAN
 
 
@@ -227,7 +310,7 @@ class Size:
     """One size of ``S`` or ``Subdiv``: an expression and whether it is absolute or relative (``1r``)."""
 
     kind: SizeKind
-    value: Expr
+    value: Expr = child()  # checked as the size of the operation that holds it
     span: Span = NO_SPAN
 
 
@@ -239,7 +322,8 @@ class Symbol:
     """
 
     name: str
-    args: tuple[Expr, ...]
+    #: typed by the parameters of ``name``'s rules (``passes.types``)
+    args: tuple[Expr, ...] = child()
     span: Span = NO_SPAN
     site: int = 0
     leaf: bool = False
@@ -256,7 +340,7 @@ class Empty:
 class Translate:
     """``T(x,y,z)``: move the scope origin along its own axes."""
 
-    vector: tuple[Expr, Expr, Expr]
+    vector: tuple[Expr, Expr, Expr] = child(Type.NUM, "a translation")
     span: Span = NO_SPAN
 
 
@@ -264,7 +348,7 @@ class Translate:
 class Scale:
     """``S(x,y,z)``: set the scope size; relative sizes scale the current size."""
 
-    sizes: tuple[Size, Size, Size]
+    sizes: tuple[Size, Size, Size] = child(Type.NUM, "a size")
     span: Span = NO_SPAN
 
 
@@ -272,7 +356,7 @@ class Scale:
 class Rotate:
     """Rotate the scope axes about its own x, then y, then z axis (degrees), around the origin."""
 
-    angles: tuple[Expr, Expr, Expr]
+    angles: tuple[Expr, Expr, Expr] = child(Type.NUM, "an angle")
     span: Span = NO_SPAN
 
 
@@ -304,8 +388,8 @@ class Split:
     """
 
     axes: tuple[int, ...]
-    sizes: tuple[Size, ...]
-    parts: tuple[Body, ...]
+    sizes: tuple[Size, ...] = child(Type.NUM, "a size")
+    parts: tuple[Body, ...] = child(holds=Holds.BODIES)
     span: Span = NO_SPAN
     site: int = 0
     #: ``Subdiv("XS", ...)``: each snap plane across the scope moves the split line nearest to it (paper
@@ -319,8 +403,8 @@ class Repeat:
     """``Repeat(axes, size per axis){parts}``: ceil(scope size / size) elements per axis, sizes adjusted."""
 
     axes: tuple[int, ...]
-    sizes: tuple[Expr, ...]
-    parts: tuple[Body, ...]
+    sizes: tuple[Expr, ...] = child(Type.NUM, "a size")
+    parts: tuple[Body, ...] = child(holds=Holds.BODIES)
     span: Span = NO_SPAN
     site: int = 0
     #: ``Repeat("XS", ...)``: the snap planes across the scope cut it first and each piece repeats on
@@ -363,8 +447,8 @@ class Comp:
     """``Comp(kind[, index]){parts}``: split into faces, edges or vertices; component i takes part i mod k."""
 
     kind: str
-    index: Expr | None
-    parts: tuple[Body, ...]
+    index: Expr | None = child(Type.NUM, "a component index")
+    parts: tuple[Body, ...] = child(holds=Holds.BODIES)
     span: Span = NO_SPAN
     site: int = 0
 
@@ -374,7 +458,7 @@ class Extrude:
     """CityEngine ``extrude(h)``: a flat shape becomes a solid along its normal (its flat scope axis);
     a negative height extrudes against the normal."""
 
-    height: Expr
+    height: Expr = child(Type.NUM, "a height")
     span: Span = NO_SPAN
 
 
@@ -398,7 +482,7 @@ class UseAsset:
 
     asset: str
     span: Span = NO_SPAN
-    name: Expr | None = None
+    name: Expr | None = child(Type.STR, "an asset name", default=None)
 
 
 @dataclass(frozen=True, slots=True)
@@ -409,7 +493,7 @@ class AlignScope:
     ``angles``)."""
 
     mode: str
-    angles: tuple[Expr, Expr, Expr] | None = None
+    angles: tuple[Expr, Expr, Expr] | None = child(Type.NUM, "an angle", default=None)
     span: Span = NO_SPAN
 
 
@@ -418,7 +502,8 @@ class SetColor:
     """CityEngine ``color(r, g, b)`` (0 to 1 each) or ``color("#rrggbb")``: the shape's colour, which its
     instances and faces carry into the record."""
 
-    values: tuple[Expr, ...]
+    values: tuple[Expr, ...] = child(lambda op: Type.STR if len(op.values) == 1 else Type.NUM,
+                                     lambda op: "a colour" if len(op.values) == 1 else "a colour component")
     span: Span = NO_SPAN
 
 
@@ -427,7 +512,7 @@ class Offset:
     """CityEngine ``offset(d, inside|border)``: the face's polygon grown (d > 0) or shrunk (d < 0) with
     mitred corners, keeping the inset (``inside``) or the ring around it (``border``)."""
 
-    distance: Expr
+    distance: Expr = child(Type.NUM, "an offset distance")
     select: str
     span: Span = NO_SPAN
 
@@ -436,7 +521,7 @@ class Offset:
 class Mirror:
     """CityEngine ``mirror(x, y, z)``: mirror the geometry along the scope axes whose flag is true."""
 
-    axes: tuple[Expr, Expr, Expr]
+    axes: tuple[Expr, Expr, Expr] = child(Type.BOOL, "a mirror flag")
     span: Span = NO_SPAN
 
 
@@ -444,8 +529,8 @@ class Mirror:
 class Case:
     """``case c1: B1 case c2: B2 else: B`` inside a body: each shape runs the first branch that holds."""
 
-    branches: tuple[tuple[Expr, Body], ...]
-    default: Body
+    branches: tuple[tuple[Expr, Body], ...] = child(Type.BOOL, "a case condition", holds=Holds.BRANCHES)
+    default: Body = child(holds=Holds.BODY)
     span: Span = NO_SPAN
 
 
@@ -453,8 +538,8 @@ class Case:
 class Stochastic:
     """``30% : B1 20% : B2 else: B``: each shape draws one branch (percentages, ``else`` the rest)."""
 
-    branches: tuple[tuple[Expr, Body], ...]
-    default: Body
+    branches: tuple[tuple[Expr, Body], ...] = child(Type.NUM, "a percentage", holds=Holds.BRANCHES)
+    default: Body = child(holds=Holds.BODY)
     span: Span = NO_SPAN
     site: int = 0
 
@@ -464,7 +549,8 @@ class SetAttr:
     """CityEngine ``set(attr, value)``: the attribute's value for this shape and its descendants."""
 
     name: str
-    value: Expr
+    #: typed by the attribute ``name`` (``passes.types``)
+    value: Expr = child()
     span: Span = NO_SPAN
 
 
@@ -472,8 +558,8 @@ class SetAttr:
 class Report:
     """CityEngine ``report(key, value)``: summed per lot (count, sum, mean, min, max) beside the output."""
 
-    key: Expr
-    value: Expr
+    key: Expr = child()  # any type: its text is the key
+    value: Expr = child()  # any type: numbers are summed, other values counted
     span: Span = NO_SPAN
 
 
@@ -496,9 +582,9 @@ class GroupSplit:
     """
 
     axis: int
-    sizes: tuple[Size, ...]
+    sizes: tuple[Size, ...] = child(Type.NUM, "a size")
     groups: tuple[int, ...]
-    parts: tuple[Body, ...]
+    parts: tuple[Body, ...] = child(holds=Holds.BODIES)
     repeat: bool
     span: Span = NO_SPAN
     site: int = 0
@@ -521,9 +607,9 @@ class Setback:
     ``per_edge``: ``setback(comp(fe){ sel: d | ... })``, the distances evaluated for each edge, which sees
     ``comp.index`` (its number in the face's edge order) and ``comp.total``."""
 
-    distances: tuple[tuple[str, Expr], ...]
+    distances: tuple[tuple[str, Expr], ...] = child(Type.NUM, "a setback distance")
     selectors: tuple[str, ...]
-    parts: tuple[Body, ...]
+    parts: tuple[Body, ...] = child(holds=Holds.BODIES)
     span: Span = NO_SPAN
     site: int = 0
     per_edge: bool = False
@@ -534,7 +620,7 @@ class Convexify:
     """CityEngine ``convexify()`` and ``convexify(maxLength)``: the face becomes its convex parts (one
     shape whose faces ``comp(f)`` splits), cut only along split lines shorter than ``max_length``."""
 
-    max_length: Expr | None
+    max_length: Expr | None = child(Type.NUM, "a split line length")
     span: Span = NO_SPAN
 
 
@@ -550,7 +636,7 @@ class CleanupGeometry:
     ``tolerance`` runs from 0 (exact matches) to 1 (1 m, 10 degrees, 1 m^2)."""
 
     component: str
-    tolerance: Expr
+    tolerance: Expr = child(Type.NUM, "a cleanup tolerance")
     span: Span = NO_SPAN
 
 
@@ -561,7 +647,7 @@ class InnerRectangle:
 
     align: str
     selectors: tuple[str, ...]
-    parts: tuple[Body, ...]
+    parts: tuple[Body, ...] = child(holds=Holds.BODIES)
     span: Span = NO_SPAN
     site: int = 0
 
@@ -574,16 +660,16 @@ class Roof:
     gable overhangs; ``index`` the shed's edge."""
 
     kind: str
-    value: Expr
+    value: Expr = child(Type.NUM, lambda op: "a roof height" if op.by_height else "a roof angle")
     by_height: bool
-    overhang: Expr
-    overhang_y: Expr | None
-    index: Expr
+    overhang: Expr = child(Type.NUM, "an overhang")
+    overhang_y: Expr | None = child(Type.NUM, "an overhang")
+    index: Expr = child(Type.NUM, "an edge index")
     span: Span = NO_SPAN
     #: ``envelope(dir, maxHeight, baseHeight, angle, ...)``: the height where it is cut flat, and the other
     #: sides' (baseHeight, angle) pairs, which must equal the first (``overhang``, ``value``).
-    cap: Expr | None = None
-    sides: tuple[tuple[Expr, Expr], ...] = ()
+    cap: Expr | None = child(Type.NUM, "a height", default=None)
+    sides: tuple[tuple[Expr, Expr], ...] = child(Type.NUM, ("a base height", "an angle"), default=())
 
 
 #: Selectors of the faces an ``offset`` makes.
@@ -599,12 +685,12 @@ class CompFaces:
     it matches; ``kind`` is "f", "e" or "v"."""
 
     selectors: tuple[str, ...]
-    parts: tuple[Body, ...]
+    parts: tuple[Body, ...] = child(holds=Holds.BODIES)
     span: Span = NO_SPAN
     site: int = 0
     kind: str = "f"
     #: ``offset(d) comp(f){ inside: ... | border: ... }``: the faces are the offset's inside and border.
-    offset: Expr | None = None
+    offset: Expr | None = child(Type.NUM, "an offset distance", default=None)
 
 
 Op = (Symbol | Empty | Translate | Scale | Rotate | Push | Pop | Insert | Split | Repeat | Comp | Extrude
@@ -619,8 +705,8 @@ Body = tuple[Op, ...]
 
 @dataclass(frozen=True, slots=True)
 class Alternative:
-    body: Body
-    prob: Expr | None
+    body: Body = child(holds=Holds.BODY)
+    prob: Expr | None = child(Type.NUM, "a probability")
     span: Span = NO_SPAN
 
 
@@ -630,8 +716,8 @@ class Rule:
 
     symbol: str
     params: tuple[str, ...]
-    guard: Expr | None
-    alternatives: tuple[Alternative, ...]
+    guard: Expr | None = child(Type.BOOL, "a guard")
+    alternatives: tuple[Alternative, ...] = child(holds=Holds.NODES)
     priority: int
     label: str | None = None
     span: Span = NO_SPAN
@@ -646,20 +732,43 @@ class AttrDecl:
     """
 
     name: str
-    default: Expr
+    default: Expr = child()  # its type is the attribute's
     span: Span = NO_SPAN
     type: Type = Type.UNKNOWN
     const: bool = False
     annotations: tuple[tuple[str, tuple[str, ...]], ...] = ()
 
 
+@dataclass(frozen=True)
+class RuleGraph:
+    """What ``passes.rulegraph`` finds of the symbols: those with rules, the leaves, what the start symbol
+    reaches and what recurses. It lives here, beside the ``Module`` that carries it, because every layer
+    after the passes reads it from the module."""
+
+    start: str
+    #: Symbols with rules, in order of first definition.
+    nonterminals: tuple[str, ...]
+    #: Symbols used in successors that have no rule: their shapes are leaves.
+    terminals: tuple[str, ...]
+    reachable: frozenset[str]
+    #: Symbols on a cycle of the graph (directly or mutually recursive).
+    recursive: frozenset[str]
+    edges: dict[str, tuple[str, ...]]
+
+
 @dataclass(frozen=True, slots=True)
 class Module:
-    """A whole grammar: its file, attributes, rules in source order, and the start symbol."""
+    """A whole grammar: its file, attributes, rules in source order, and the start symbol.
+
+    The analyses travel with it: every pass takes a module and returns one (``pipeline``), so what the
+    rule graph and asset resolution find becomes fields of the module they return (``graph``,
+    ``assets``, ``asset_ids``), and the checked module carries everything the backend reads. The
+    compiler sets ``start`` and ``roots`` before the passes, as the file's own and the caller's choices.
+    """
 
     file: str
-    attrs: tuple[AttrDecl, ...]
-    rules: tuple[Rule, ...]
+    attrs: tuple[AttrDecl, ...] = child(holds=Holds.NODES)
+    rules: tuple[Rule, ...] = child(holds=Holds.NODES)
     start: str | None
     #: Parameter types per symbol, filled by ``passes.types``.
     param_types: tuple[tuple[str, tuple[Type, ...]], ...] = ()
@@ -668,3 +777,13 @@ class Module:
     dialect: str = "cga2006"
     #: Files whose rules and attributes were imported into this module (CityEngine ``import``).
     imported: tuple[str, ...] = ()
+    #: Folders that ``I()`` names are resolved in, in order (the grammar's, then ``--assets`` ones). None
+    #: for a module lowered outside the compiler (by a test, a tool): checked, but not made ready to derive
+    #: (its start rule may take parameters, its asset names stay unresolved).
+    roots: tuple[Path, ...] | None = None
+    #: The symbol graph from ``start``, found by ``passes.rulegraph`` (None before, or without rules).
+    graph: RuleGraph | None = None
+    #: Canonical asset names, found by ``passes.assets``: an asset's index is its id in the record.
+    assets: tuple[str, ...] = ()
+    #: ``I()`` name as written -> asset id, as pairs: the module is frozen (``model.Grammar`` has the dict).
+    asset_ids: tuple[tuple[str, int], ...] = ()

@@ -2,6 +2,8 @@
 
 Each pass takes a module and a diagnostics list and returns a module. All passes run even after an error,
 so that one ``grammarc check`` lists every problem; errors become placeholders that later passes accept.
+The analyses are passes too: what they find travels with the module they return (``Module.graph``,
+``Module.assets``), so the checked module is everything the backend needs.
 """
 
 from __future__ import annotations
@@ -9,9 +11,11 @@ from __future__ import annotations
 from grammarc.constants import STRICT
 from grammarc.diagnostics import Diagnostics
 from grammarc.ir import nodes as ir
+from grammarc.ir.passes.assets import resolve_assets
 from grammarc.ir.passes.fold import fold_constants
 from grammarc.ir.passes.probabilities import check_probabilities
 from grammarc.ir.passes.resolve import resolve_names
+from grammarc.ir.passes.rulegraph import rule_graph
 from grammarc.ir.passes.types import infer_types
 from grammarc.ir.verify import verify
 
@@ -20,6 +24,8 @@ PASSES = (
     ("types", infer_types),             # expression types, arities, parameter types
     ("fold", fold_constants),           # constant subexpressions -> constants
     ("probabilities", check_probabilities),  # stochastic alternatives sum to 1
+    ("rulegraph", rule_graph),          # the start rule; reachable, recursive and terminal symbols
+    ("assets", resolve_assets),         # I() names -> canonical asset names and ids
 )
 
 

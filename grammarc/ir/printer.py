@@ -2,50 +2,56 @@
 
 The text is the paper notation with every binary expression parenthesized, resolved names marked
 (``$h`` is a rule parameter, ``@height`` an attribute) and one rule per line.
+
+Each node type has its format in a table; an operation without one prints from its declared children
+(``nodes.child``) as ``name(arguments){ bodies }``, so a new operation prints before it has a format.
 """
 
 from __future__ import annotations
 
 from grammarc.ir import nodes as ir
+from grammarc.ir.traverse import EXPRESSIONS
 
 _AXES = "XYZ"
 
 
 def print_expr(e: ir.Expr) -> str:
-    if isinstance(e, ir.Num):
-        return f"{e.value:g}"
-    if isinstance(e, ir.Str):
-        return f'"{e.value}"'
-    if isinstance(e, ir.Bool):
-        return "true" if e.value else "false"
-    if isinstance(e, ir.Name):
-        return e.name
-    if isinstance(e, ir.Param):
-        return f"${e.name}"
-    if isinstance(e, ir.AttrRef):
-        return f"@{e.name}"
-    if isinstance(e, ir.ScopeRef):
-        return f"Scope.{e.field}"
-    if isinstance(e, ir.Unary):
-        return f"{e.op}{print_expr(e.operand)}"
-    if isinstance(e, ir.Binary):
-        return f"({print_expr(e.left)} {e.op} {print_expr(e.right)})"
-    if isinstance(e, ir.Call):
-        return f"{e.func}({', '.join(print_expr(a) for a in e.args)})"
-    if isinstance(e, ir.Occlusion):
-        if e.kind == "visible":
-            return 'Shape.visible("street")'
-        if e.kind == "occ":
-            which = e.label if e.label is not None else "active" if e.active else "all" if e.parents else "noparent"
-            distance = f', "distance", {print_expr(e.distance)}' if e.distance is not None else ""
-            return f'Shape.occ("{which}"{distance})'
-        label = f', "{e.label}"' if e.label is not None else ""
-        return f"{e.kind}({e.target}{label})"
-    if isinstance(e, ir.ContextRef):
-        return e.name
-    if isinstance(e, ir.Select):
-        return f"({print_expr(e.cond)} ? {print_expr(e.then)} : {print_expr(e.other)})"
-    raise TypeError(f"not an expression: {e!r}")
+    form = _EXPR_FORMATS.get(type(e))
+    if form is None:
+        raise TypeError(f"not an expression: {e!r}")
+    return form(e)
+
+
+def _occlusion(e: ir.Occlusion) -> str:
+    if e.kind == "visible":
+        return 'Shape.visible("street")'
+    if e.kind == "occ":
+        which = e.label if e.label is not None else "active" if e.active else "all" if e.parents else "noparent"
+        distance = f', "distance", {print_expr(e.distance)}' if e.distance is not None else ""
+        return f'Shape.occ("{which}"{distance})'
+    label = f', "{e.label}"' if e.label is not None else ""
+    return f"{e.kind}({e.target}{label})"
+
+
+_EXPR_FORMATS = {
+    ir.Num: lambda e: f"{e.value:g}",
+    ir.Str: lambda e: f'"{e.value}"',
+    ir.Bool: lambda e: "true" if e.value else "false",
+    ir.Name: lambda e: e.name,
+    ir.Param: lambda e: f"${e.name}",
+    ir.AttrRef: lambda e: f"@{e.name}",
+    ir.ScopeRef: lambda e: f"Scope.{e.field}",
+    ir.Unary: lambda e: f"{e.op}{print_expr(e.operand)}",
+    ir.Binary: lambda e: f"({print_expr(e.left)} {e.op} {print_expr(e.right)})",
+    ir.Call: lambda e: f"{e.func}({_list(e.args)})",
+    ir.Occlusion: _occlusion,
+    ir.ContextRef: lambda e: e.name,
+    ir.Select: lambda e: f"({print_expr(e.cond)} ? {print_expr(e.then)} : {print_expr(e.other)})",
+}
+
+
+def _list(exprs) -> str:
+    return ", ".join(print_expr(e) for e in exprs)
 
 
 def _size(s: ir.Size) -> str:
@@ -57,8 +63,8 @@ def _size(s: ir.Size) -> str:
 
 def _branches(op) -> str:
     head = "case" if isinstance(op, ir.Case) else "%"
-    parts = [f"{head} {print_expr(c)}: {print_body(b) or 'ε'}" for c, b in op.branches]
-    return "{ " + " ".join(parts) + f" else: {print_body(op.default) or 'ε'} }}"
+    parts = [f"{head} {print_expr(c)}: {_body(b)}" for c, b in op.branches]
+    return "{ " + " ".join(parts) + f" else: {_body(op.default)} }}"
 
 
 def _axes(axes: tuple[int, ...], snap: bool = False) -> str:
@@ -69,105 +75,142 @@ def _label(label: str | None) -> str:
     return f', "{label}"' if label is not None else ""
 
 
+def _body(body: ir.Body) -> str:
+    return print_body(body) or "ε"
+
+
 def _parts(parts) -> str:
-    return "{ " + " | ".join(print_body(p) or "ε" for p in parts) + " }"
+    return "{ " + " | ".join(_body(p) for p in parts) + " }"
+
+
+def _selected(selectors, parts) -> str:
+    return "{ " + " | ".join(f"{s}: {_body(b)}" for s, b in zip(selectors, parts)) + " }"
+
+
+def _group_split(op: ir.GroupSplit) -> str:
+    items, group = [], None
+    for size, body, g in zip(op.sizes, op.parts, op.groups):
+        text = f"{_size(size)}: {_body(body)}"
+        if g >= 0 and g == group:
+            items[-1].append(text)
+        else:
+            items.append([text] if g < 0 else ["{", text])
+        group = g
+    shown = [" | ".join(i) if i[0] != "{" else "{ " + " | ".join(i[1:]) + " }*" for i in items]
+    return f"split({'xyz'[op.axis]}){{ {' | '.join(shown)} }}{'*' if op.repeat else ''}"
+
+
+def _roof(op: ir.Roof) -> str:
+    args = [("byHeight" if op.by_height else "byAngle"), print_expr(op.value), print_expr(op.overhang)]
+    if op.overhang_y is not None:
+        args.append(print_expr(op.overhang_y))
+    if op.cap is not None:
+        args.append(f"cap={print_expr(op.cap)}")
+    args += [f"{print_expr(h)}/{print_expr(a)}" for h, a in op.sides]
+    return f"{op.kind}({', '.join(args)}, index={print_expr(op.index)})"
+
+
+def _setback(op: ir.Setback) -> str:
+    moves = ", ".join(f"{s}={print_expr(d)}" for s, d in op.distances)
+    if op.per_edge:
+        moves = f"comp(fe){{ {moves} }}"
+    return f"setback({moves}){_selected(op.selectors, op.parts)}"
+
+
+#: The axes of a snap plane, by the scope axis across it.
+_SNAP_AXES = {0: "Y", 1: "XZ", 2: "XY"}
+
+
+def _align_scope(op: ir.AlignScope) -> str:
+    if op.mode.startswith("geometry"):
+        return f"alignScopeToGeometry({op.mode[-1]}Up, 0, {print_expr(op.angles[0])})"
+    if op.angles is not None:
+        return f"rotateScope({_list(op.angles)})"
+    return "alignScopeToAxes()" if op.mode == "world" else f"alignScopeToAxes({op.mode})"
+
+
+_OP_FORMATS = {
+    ir.Symbol: lambda op: op.name + (f"({_list(op.args)})" if op.args else "") + ("." if op.leaf else ""),
+    ir.Empty: lambda op: "ε",
+    ir.Translate: lambda op: f"T({_list(op.vector)})",
+    ir.Scale: lambda op: f"S({', '.join(_size(s) for s in op.sizes)})",
+    ir.Rotate: lambda op: f"R({_list(op.angles)})",
+    ir.Push: lambda op: "[",
+    ir.Pop: lambda op: "]",
+    ir.Insert: lambda op: f'I("{op.asset}")',
+    ir.Split: lambda op: (f"Subdiv({_axes(op.axes, op.snap)}, {', '.join(_size(s) for s in op.sizes)}"
+                          f"{_label(op.snap_label)}){_parts(op.parts)}"),
+    ir.Repeat: lambda op: (f"Repeat({_axes(op.axes, op.snap)}, {_list(op.sizes)}{_label(op.snap_label)})"
+                           f"{_parts(op.parts)}"),
+    ir.Label: lambda op: f'label("{op.name}")',
+    ir.Snap: lambda op: f'{"SnapLines" if op.lines else "Snap"}("{_SNAP_AXES[op.normal]}"{_label(op.label)})',
+    ir.Comp: lambda op: (f'Comp("{op.kind}"{f", {print_expr(op.index)}" if op.index is not None else ""})'
+                         f"{_parts(op.parts)}"),
+    ir.GroupSplit: _group_split,
+    ir.SetColor: lambda op: f"color({_list(op.values)})",
+    ir.Offset: lambda op: f"offset({print_expr(op.distance)}, {op.select})",
+    ir.Convexify: lambda op: f"convexify({print_expr(op.max_length) if op.max_length is not None else ''})",
+    ir.CleanupGeometry: lambda op: f"cleanupGeometry({op.component}, {print_expr(op.tolerance)})",
+    ir.InnerRectangle: lambda op: f"innerRectangle({op.align}){_selected(op.selectors, op.parts)}",
+    ir.Roof: _roof,
+    ir.CompFaces: lambda op: ((f"offset({print_expr(op.offset)}) " if op.offset is not None else "")
+                              + f"comp({op.kind}){_selected(op.selectors, op.parts)}"),
+    ir.Setback: _setback,
+    ir.Case: _branches,
+    ir.Stochastic: _branches,
+    ir.Extrude: lambda op: f"extrude({print_expr(op.height)})",
+    ir.Center: lambda op: f"center({''.join('xyz'[a] for a in op.axes)})",
+    ir.UseAsset: lambda op: f"i({print_expr(op.name)})" if op.name is not None else f'i("{op.asset}")',
+    ir.SetAttr: lambda op: f"set({op.name}, {print_expr(op.value)})",
+    ir.Report: lambda op: f"report({print_expr(op.key)}, {print_expr(op.value)})",
+    ir.Mirror: lambda op: f"mirror({_list(op.axes)})",
+    ir.AlignScope: _align_scope,
+    ir.NotApplied: lambda op: f"{op.name}(...)",
+}
 
 
 def print_op(op: ir.Op) -> str:
-    if isinstance(op, ir.Symbol):
-        args = f"({', '.join(print_expr(a) for a in op.args)})" if op.args else ""
-        return op.name + args + ("." if op.leaf else "")
-    if isinstance(op, ir.Empty):
-        return "ε"
-    if isinstance(op, ir.Translate):
-        return f"T({', '.join(print_expr(e) for e in op.vector)})"
-    if isinstance(op, ir.Scale):
-        return f"S({', '.join(_size(s) for s in op.sizes)})"
-    if isinstance(op, ir.Rotate):
-        return f"R({', '.join(print_expr(e) for e in op.angles)})"
-    if isinstance(op, ir.Push):
-        return "["
-    if isinstance(op, ir.Pop):
-        return "]"
-    if isinstance(op, ir.Insert):
-        return f'I("{op.asset}")'
-    if isinstance(op, ir.Split):
-        sizes = ", ".join(_size(s) for s in op.sizes)
-        return f"Subdiv({_axes(op.axes, op.snap)}, {sizes}{_label(op.snap_label)}){_parts(op.parts)}"
-    if isinstance(op, ir.Repeat):
-        sizes = ", ".join(print_expr(e) for e in op.sizes)
-        return f"Repeat({_axes(op.axes, op.snap)}, {sizes}{_label(op.snap_label)}){_parts(op.parts)}"
-    if isinstance(op, ir.Label):
-        return f'label("{op.name}")'
-    if isinstance(op, ir.Snap):
-        axes = {0: "Y", 1: "XZ", 2: "XY"}[op.normal]
-        return f'{"SnapLines" if op.lines else "Snap"}("{axes}"{_label(op.label)})'
-    if isinstance(op, ir.Comp):
-        index = f", {print_expr(op.index)}" if op.index is not None else ""
-        return f'Comp("{op.kind}"{index}){_parts(op.parts)}'
-    if isinstance(op, ir.GroupSplit):
-        items, group = [], None
-        for size, body, g in zip(op.sizes, op.parts, op.groups):
-            text = f"{_size(size)}: {print_body(body) or 'ε'}"
-            if g >= 0 and g == group:
-                items[-1].append(text)
-            else:
-                items.append([text] if g < 0 else ["{", text])
-            group = g
-        shown = [" | ".join(i) if i[0] != "{" else "{ " + " | ".join(i[1:]) + " }*" for i in items]
-        return f"split({'xyz'[op.axis]}){{ {' | '.join(shown)} }}{'*' if op.repeat else ''}"
-    if isinstance(op, ir.SetColor):
-        return f"color({', '.join(print_expr(v) for v in op.values)})"
-    if isinstance(op, ir.Offset):
-        return f"offset({print_expr(op.distance)}, {op.select})"
-    if isinstance(op, ir.Convexify):
-        return f"convexify({print_expr(op.max_length) if op.max_length is not None else ''})"
-    if isinstance(op, ir.CleanupGeometry):
-        return f"cleanupGeometry({op.component}, {print_expr(op.tolerance)})"
-    if isinstance(op, ir.InnerRectangle):
-        return f"innerRectangle({op.align}){{ " + " | ".join(f"{s}: {print_body(b) or 'ε'}"
-                                                          for s, b in zip(op.selectors, op.parts)) + " }"
-    if isinstance(op, ir.Roof):
-        args = [("byHeight" if op.by_height else "byAngle"), print_expr(op.value), print_expr(op.overhang)]
-        if op.overhang_y is not None:
-            args.append(print_expr(op.overhang_y))
-        if op.cap is not None:
-            args.append(f"cap={print_expr(op.cap)}")
-        args += [f"{print_expr(h)}/{print_expr(a)}" for h, a in op.sides]
-        return f"{op.kind}({', '.join(args)}, index={print_expr(op.index)})"
-    if isinstance(op, ir.CompFaces):
-        head = f"offset({print_expr(op.offset)}) " if op.offset is not None else ""
-        return head + f"comp({op.kind}){{ " + " | ".join(f"{s}: {print_body(b) or 'ε'}"
-                                         for s, b in zip(op.selectors, op.parts)) + " }"
-    if isinstance(op, ir.Setback):
-        moves = ", ".join(f"{s}={print_expr(d)}" for s, d in op.distances)
-        if op.per_edge:
-            moves = f"comp(fe){{ {moves} }}"
-        return f"setback({moves}){{ " + " | ".join(f"{s}: {print_body(b) or 'ε'}"
-                                                  for s, b in zip(op.selectors, op.parts)) + " }"
-    if isinstance(op, (ir.Case, ir.Stochastic)):
-        return _branches(op)
-    if isinstance(op, ir.Extrude):
-        return f"extrude({print_expr(op.height)})"
-    if isinstance(op, ir.Center):
-        return f"center({''.join('xyz'[a] for a in op.axes)})"
-    if isinstance(op, ir.UseAsset):
-        return f"i({print_expr(op.name)})" if op.name is not None else f'i("{op.asset}")'
-    if isinstance(op, ir.SetAttr):
-        return f"set({op.name}, {print_expr(op.value)})"
-    if isinstance(op, ir.Report):
-        return f"report({print_expr(op.key)}, {print_expr(op.value)})"
-    if isinstance(op, ir.Mirror):
-        return f"mirror({', '.join(print_expr(a) for a in op.axes)})"
-    if isinstance(op, ir.AlignScope):
-        if op.mode.startswith("geometry"):
-            return f"alignScopeToGeometry({op.mode[-1]}Up, 0, {print_expr(op.angles[0])})"
-        if op.angles is not None:
-            return f"rotateScope({', '.join(print_expr(a) for a in op.angles)})"
-        return "alignScopeToAxes()" if op.mode == "world" else f"alignScopeToAxes({op.mode})"
-    if isinstance(op, ir.NotApplied):
-        return f"{op.name}(...)"
-    raise TypeError(f"not an operation: {op!r}")
+    form = _OP_FORMATS.get(type(op))
+    if form is not None:
+        return form(op)
+    if type(op) in EXPRESSIONS or not hasattr(type(op), "__dataclass_fields__"):
+        raise TypeError(f"not an operation: {op!r}")
+    return _declared(op)
+
+
+def _declared(op) -> str:
+    """An operation without a format, from its declared children: its name (the class attribute
+    ``cga_name``, or the class name in lower camel case), its arguments, then its bodies in braces."""
+    cls = type(op)
+    name = getattr(cls, "cga_name", None) or cls.__name__[0].lower() + cls.__name__[1:]
+    args, bodies = [], []
+    for field, spec in ir.children(cls):
+        value = getattr(op, field)
+        if spec.holds is ir.Holds.EXPRS:
+            args.extend(_arguments(value))
+        elif spec.holds is ir.Holds.BODY:
+            bodies.append(_body(value))
+        elif spec.holds is ir.Holds.BODIES:
+            bodies.extend(_body(b) for b in value)
+        elif spec.holds is ir.Holds.BRANCHES:
+            bodies.extend(f"{print_expr(c)}: {_body(b)}" for c, b in value)
+    return f"{name}({', '.join(args)})" + ("{ " + " | ".join(bodies) + " }" if bodies else "")
+
+
+def _arguments(value) -> list[str]:
+    """The printed arguments in an argument field: expressions, sizes and plain values, tuples flattened,
+    None left out."""
+    if value is None:
+        return []
+    if type(value) is tuple:
+        return [text for v in value for text in _arguments(v)]
+    if type(value) is ir.Size:
+        return [_size(value)]
+    if type(value) in EXPRESSIONS:
+        return [print_expr(value)]
+    if isinstance(value, bool):
+        return ["true" if value else "false"]
+    return [f"{value:g}" if isinstance(value, float) else str(value)]
 
 
 def print_body(body: ir.Body) -> str:
@@ -181,7 +224,7 @@ def print_rule(rule: ir.Rule) -> str:
     alts = []
     for alt in rule.alternatives:
         prob = f" : {print_expr(alt.prob)}" if alt.prob is not None else ""
-        alts.append(f"~> {print_body(alt.body) or 'ε'}{prob}")
+        alts.append(f"~> {_body(alt.body)}{prob}")
     return f"{head} " + " ".join(alts)
 
 

@@ -1,10 +1,14 @@
 """ir/printer.py: IR as canonical text ($param, @attr, every binary parenthesized, one rule per line)."""
 
+# ruff: noqa: RUF009 - ``ir.child()`` returns a ``dataclasses.Field``, which ruff cannot see through
+
 from __future__ import annotations
+
+from dataclasses import dataclass
 
 import pytest
 
-from grammarc.diagnostics import Diagnostics
+from grammarc.diagnostics import NO_SPAN, Diagnostics, Span
 from grammarc.frontend.parse import parse_source
 from grammarc.ir import nodes as ir
 from grammarc.ir.pipeline import run_passes
@@ -93,6 +97,50 @@ def test_print_rejects_non_nodes():
         print_expr(ir.Empty())
     with pytest.raises(TypeError):
         print_op(N(1.0))
+    with pytest.raises(TypeError):
+        print_op("T(1, 2, 3)")
+
+
+@dataclass(frozen=True, slots=True)
+class MirrorScope:
+    """An operation the printer has no format for: it prints from its declared children."""
+
+    axes: tuple[ir.Expr, ...] = ir.child(ir.Type.BOOL, "a mirror flag")
+    span: Span = NO_SPAN
+
+
+@dataclass(frozen=True, slots=True)
+class Shatter:
+    cga_name = "shatterInto"  # not its class name in lower camel case
+
+    sizes: tuple[ir.Size, ...] = ir.child(ir.Type.NUM, "a size")
+    mode: str = ir.child()  # a plain argument, declared so that it prints
+    by_volume: bool = ir.child()
+    seed: ir.Expr | None = ir.child(ir.Type.NUM, "a seed")
+    parts: tuple[ir.Body, ...] = ir.child(holds=ir.Holds.BODIES)
+    span: Span = NO_SPAN
+    site: int = 0  # not a child: not printed
+
+
+def test_an_operation_without_a_format_prints_from_its_declared_children():
+    flags = (ir.Bool(True), ir.Bool(False), ir.AttrRef("flip"))
+    assert print_op(MirrorScope(flags)) == "mirrorScope(true, false, @flip)"
+    shatter = Shatter((ir.Size(REL, N(1.0)), ir.Size(ABS, N(2.5))), "cells", True, None,
+                      ((MirrorScope(flags[:1]), ir.Symbol("a", ())), ()), site=7)
+    assert print_op(shatter) == 'shatterInto(1r, 2.5, cells, true){ mirrorScope(true) a | ε }'
+    assert print_body((ir.Push(), shatter, ir.Pop())) == f"[ {print_op(shatter)} ]"
+
+
+def test_branches_and_a_body_without_a_format_print_in_braces():
+    @dataclass(frozen=True, slots=True)
+    class Pick:
+        branches: tuple[tuple[ir.Expr, ir.Body], ...] = ir.child(ir.Type.BOOL, "a condition",
+                                                                holds=ir.Holds.BRANCHES)
+        default: ir.Body = ir.child(holds=ir.Holds.BODY)
+        span: Span = NO_SPAN
+
+    pick = Pick(((ir.Bool(True), (ir.Symbol("a", ()),)), (ir.AttrRef("b"), ())), (ir.Symbol("c", ()),))
+    assert print_op(pick) == "pick(){ true: a | @b: ε | c }"
 
 
 @pytest.mark.parametrize("text", [

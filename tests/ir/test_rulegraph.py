@@ -1,24 +1,27 @@
-"""ir/passes/rulegraph.py: terminals, reachable symbols, recursion and unreachable rules."""
+"""ir/passes/rulegraph.py: the start rule, terminals, reachable symbols, recursion and unreachable rules."""
 
 from __future__ import annotations
 
 import random
+from dataclasses import replace
 
 import pytest
 
 from grammarc.diagnostics import Diagnostics
+from grammarc.errors import UsageError
 from grammarc.frontend.parse import parse_source
-from grammarc.ir.passes.rulegraph import RuleGraph, analyze_rules
+from grammarc.ir import nodes as ir
 from grammarc.ir.pipeline import run_passes
 
 FILE = "g.cga"
 
 
-def graph(text: str, start: str | None = None) -> tuple[RuleGraph, Diagnostics]:
+def graph(text: str, start: str | None = None) -> tuple[ir.RuleGraph, Diagnostics]:
     diags = Diagnostics()
-    module = run_passes(parse_source(text, FILE, diags), diags, check=True)
+    module = parse_source(text, FILE, diags)
+    module = run_passes(replace(module, start=start or module.start), diags, check=True)
     assert not diags.has_errors
-    return analyze_rules(module, start or module.start, diags), diags
+    return module.graph, diags
 
 
 def test_terminals_nonterminals_and_edges():
@@ -105,3 +108,41 @@ def test_recursion_and_reachability_match_a_brute_force_reference():
         assert g.recursive == frozenset(s for s in names if _reaches(edges, s, s)), text
         reached = {s for s in [*names, "leaf"] if _reaches(edges, "s0", s)}
         assert g.reachable == frozenset({"s0"} | reached), text
+
+
+def test_the_pass_sets_the_graph_of_the_start_symbol_on_the_module():
+    diags = Diagnostics()
+    module = run_passes(parse_source("a ~> b\nb ~> c", FILE, diags), diags, check=True, stop_after="rulegraph")
+    assert module.graph == ir.RuleGraph("a", ("a", "b"), ("c",), frozenset("abc"), frozenset(),
+                                        {"a": ("b",), "b": ("c",)})
+
+
+def test_the_start_rule_of_a_module_to_derive_takes_no_parameters():
+    text = "lot(w) ~> b(w)\nb(x) ~> c"
+    diags = Diagnostics()
+    module = run_passes(replace(parse_source(text, FILE, diags), roots=()), diags, check=True)
+    assert [(d.code, d.span.line, d.message) for d in diags] == [
+        ("start-params", 1, "the start rule `lot` cannot take parameters: a lot has no arguments to pass")]
+    assert module.graph.start == "lot"  # made all the same
+    # a fragment lowered by a test (no asset folders) is not derived: it may start anywhere
+    diags = Diagnostics()
+    assert run_passes(parse_source(text, FILE, diags), diags, check=True).graph.start == "lot"
+    assert not diags
+
+
+def test_no_rules_is_an_error_unless_rules_failed_to_parse():
+    diags = Diagnostics()
+    assert run_passes(parse_source("attr h = 1\n", FILE, diags), diags).graph is None
+    assert [(d.code, d.span.line, d.span.col) for d in diags] == [("empty", 1, 1)]
+    diags = Diagnostics()
+    run_passes(parse_source("a ~> T(1,,2)", FILE, diags), diags)
+    assert [d.code for d in diags] == ["syntax"]
+
+
+def test_a_start_symbol_without_a_rule_is_the_callers_mistake_unless_errors_are_listed():
+    module = parse_source("a ~> b", FILE, Diagnostics())
+    with pytest.raises(UsageError, match=f"start symbol `zz` has no rule in {FILE}"):
+        run_passes(replace(module, start="zz"), Diagnostics())
+    diags = Diagnostics()
+    diags.error("syntax", "the start rule failed to parse", module.rules[0].span)
+    assert run_passes(replace(module, start="zz"), diags).graph is None

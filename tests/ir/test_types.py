@@ -1,14 +1,20 @@
 """ir/passes/types.py: expression types, successor arities and parameter types from call sites."""
 
+# ruff: noqa: RUF009 - ``ir.child()`` returns a ``dataclasses.Field``, which ruff cannot see through
+
 from __future__ import annotations
 
-import pytest
+from dataclasses import dataclass, replace
 
-from grammarc.diagnostics import Diagnostics
+import pytest
+from node_zoo import EXPRESSIONS, NODE_CLASSES, Zoo, sentinels
+
+from grammarc.diagnostics import NO_SPAN, Diagnostics, Span
 from grammarc.frontend.parse import parse_source
 from grammarc.ir import nodes as ir
 from grammarc.ir.passes.types import infer_types
 from grammarc.ir.pipeline import run_passes
+from grammarc.ir.traverse import iter_nodes, rewrite_expr, rewrite_node
 
 FILE = "g.cga"
 T = ir.Type
@@ -133,3 +139,77 @@ def test_types_pass_fills_param_types_for_every_symbol():
 
     module = infer_types(resolve_names(module, diags), diags)
     assert module.param_types == (("a", ()), ("b", (T.NUM,)), ("c", ()))
+
+
+# ------------------------------------------------------------------------------- the declarations drive it
+
+#: A literal of each type, and one of another type.
+_RIGHT = {T.NUM: ir.Num(1.0), T.BOOL: ir.Bool(True), T.STR: ir.Str("x.obj"), None: ir.Num(1.0)}
+_WRONG = {T.NUM: ir.Str("x"), T.BOOL: ir.Num(1.0), T.STR: ir.Num(1.0)}
+
+
+def _wanted(node) -> dict[int, tuple[ir.Type | None, str]]:
+    """Sentinel id -> (its wanted type, its noun), from the declarations of the node that holds it."""
+    found = {}
+    for holder in [node] if type(node) in EXPRESSIONS else iter_nodes(node):
+        for name, spec in ir.children(type(holder)):
+            value = getattr(holder, name)
+            if spec.holds is ir.Holds.BRANCHES:
+                value = tuple(cond for cond, _ in value)
+            elif spec.holds is not ir.Holds.EXPRS:
+                continue
+            what = spec.what_of(holder)
+            nouns = what if isinstance(what, tuple) else (what,)
+            for k, sentinel in enumerate(sentinels(value)):
+                found[id(sentinel)] = spec.want_of(holder), nouns[k % len(nouns)]
+    return found
+
+
+def _type_errors(node) -> list[tuple[Span, str]]:
+    """The type errors of ``node`` in a module: an expression as an attribute's default, an operation in
+    a rule's body, an alternative or a rule as itself."""
+    if type(node) in EXPRESSIONS:
+        attrs, rules = (ir.AttrDecl("x", node),), ()
+    else:
+        alt = node if isinstance(node, ir.Alternative) else ir.Alternative((node,), ir.Num(1.0))
+        attrs, rules = (), (node if isinstance(node, ir.Rule) else ir.Rule("a", (), None, (alt,), 0),)
+    diags = Diagnostics()
+    infer_types(ir.Module("g.cga", attrs, rules, rules[0].symbol if rules else None), diags)
+    return [(d.span, d.message) for d in diags if d.is_error]
+
+
+CHECKED = [c for c in NODE_CLASSES if any(spec.want is not None for _, spec in ir.children(c))]
+
+
+@pytest.mark.parametrize("cls", CHECKED, ids=lambda c: c.__name__)
+def test_every_declared_child_is_checked_for_its_type(cls):
+    """One wrong-typed expression in a checked child: one error, at it, naming it as declared."""
+    node = Zoo().node(cls)
+    wanted = _wanted(node)
+    rewrite = rewrite_expr if cls in EXPRESSIONS else rewrite_node
+
+    def filled(wrong=None):
+        def fill(e):
+            if id(e) not in wanted:
+                return e
+            literal = _WRONG[wanted[id(e)][0]] if e is wrong else _RIGHT[wanted[id(e)][0]]
+            return replace(literal, span=e.span)
+        return rewrite(node, fill)
+
+    assert _type_errors(filled()) == []
+    checked = [s for s in sentinels(node) if wanted.get(id(s), (None,))[0] is not None]
+    assert checked
+    for s in checked:
+        want, what = wanted[id(s)]
+        got = {T.NUM: T.STR}.get(want, T.NUM)
+        assert _type_errors(filled(s)) == [(s.span, f"{what} must be a {want.value}, got a {got.value}")]
+
+
+def test_a_new_operation_is_checked_from_its_declarations_alone():
+    @dataclass(frozen=True, slots=True)
+    class Twist:
+        angle: ir.Expr = ir.child(ir.Type.NUM, "a twist angle")
+        span: Span = NO_SPAN
+
+    where = Span("g.cga", 1, 7, 1, 10)
+    assert _type_errors(Twist(ir.Str("x", where))) == [(where, "a twist angle must be a num, got a str")]

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from dataclasses import replace
+from pathlib import Path
 
 import pytest
 
@@ -19,11 +20,12 @@ GRAMMAR = (
 )
 
 
-def lowered(text: str = GRAMMAR) -> ir.Module:
+def lowered(text: str = GRAMMAR, roots: tuple[Path, ...] | None = (Path(__file__).parent,)) -> ir.Module:
+    """The module as the compiler hands it to the passes (with asset folders), or as a test lowers it."""
     diags = Diagnostics()
     module = parse_source(text, FILE, diags)
     assert not diags
-    return module
+    return replace(module, roots=roots)
 
 
 def test_pipeline_lists_the_stages_in_order():
@@ -102,8 +104,30 @@ def test_pipeline_checks_ir_and_raises_on_illegal_ir():
 def test_pipeline_runs_every_pass_after_errors_and_skips_the_checks():
     # errors become placeholders: all passes still run, so one call lists problems of every pass
     diags = Diagnostics()
-    run_passes(lowered("a ~> T(zz, 0, 0) b : 0.5 ~> c : 0.4\nd : 1 ~> T(1 / 0, 0, 0)"), diags, check=True)
-    assert [d.code for d in diags] == ["unknown-name", "type", "division", "probability"]
+    text = 'a ~> T(zz, 0, 0) b : 0.5 ~> c : 0.4\nd : 1 ~> T(1 / 0, 0, 0) I("/x.obj")'
+    run_passes(lowered(text), diags, check=True)
+    assert [d.code for d in diags] == ["unknown-name", "type", "division", "probability", "unreachable", "asset"]
+
+
+def test_the_graph_must_be_the_start_symbols():
+    module = run_passes(lowered(), Diagnostics(), check=True, stop_after="rulegraph")
+    assert verify(replace(module, graph=None), "rulegraph") == ["module: no rule graph"]
+    assert verify(replace(module, start="floor"), "rulegraph") == [
+        "module: the graph starts at `lot`, the module at `floor`"]
+    other = replace(module.graph, nonterminals=("lot",))
+    assert verify(replace(module, graph=other), "rulegraph") == [
+        "module: the graph's symbols with rules are not the rules'"]
+
+
+def test_every_inserted_asset_must_have_an_id():
+    module = run_passes(lowered(), Diagnostics(), check=True)
+    assert module.asset_ids == (("cube", 0),)
+    assert verify(replace(module, asset_ids=()), "assets") == [
+        "module: asset `cube` at g.cga:4:11 has no id"]
+    assert verify(replace(module, assets=("builtin:quad",)), "assets") == [
+        "module: assets 0 and 1 are not the leaf cube and quad"]
+    # a module lowered outside the compiler keeps its asset names unresolved
+    assert verify(replace(module, roots=None, asset_ids=()), "assets") == []
 
 
 def test_stop_after():

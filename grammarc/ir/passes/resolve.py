@@ -71,13 +71,12 @@ def _resolver(params: dict[str, int], attrs: list[str], diags: Diagnostics, wher
 def _check_set_targets(rule: ir.Rule, module: ir.Module, diags: Diagnostics) -> None:
     """``set(name, v)`` needs an attribute (not a constant) called ``name``."""
     attrs = {a.name: a for a in module.attrs}
-    for alt in rule.alternatives:
-        for op in iter_ops(alt.body):
-            if not isinstance(op, ir.SetAttr) or op.name in ir.SHAPE_ATTRIBUTES:
-                continue
-            attr = attrs.get(op.name)
-            if attr is None:
-                diags.error("unknown-name", f"`set` of `{op.name}`, which is not an attribute"
-                            f"{suggest(op.name, attrs)}", op.span)
-            elif attr.const:
-                diags.error("const", f"`set` of the constant `{op.name}`", op.span)
+    for op in iter_ops(rule):
+        if not isinstance(op, ir.SetAttr) or op.name in ir.SHAPE_ATTRIBUTES:
+            continue
+        attr = attrs.get(op.name)
+        if attr is None:
+            diags.error("unknown-name", f"`set` of `{op.name}`, which is not an attribute"
+                        f"{suggest(op.name, attrs)}", op.span)
+        elif attr.const:
+            diags.error("const", f"`set` of the constant `{op.name}`", op.span)

@@ -1,29 +1,43 @@
 """The rule graph: which symbols a start symbol reaches, which recurse, which are terminals.
 
-An analysis, not a rewrite: it returns a ``RuleGraph`` and warns about rules the start symbol never
-reaches. Recursion is found as strongly connected components of the symbol graph (Tarjan).
+Assumes: names resolved and types checked. Guarantees: the grammar has rules, its start symbol has one,
+and ``Module.graph`` holds the ``RuleGraph`` from it; rules the start symbol never reaches are warned
+about. The start rule takes no parameters in a module to derive (one with asset folders, ``roots``, as
+the compiler makes it: a lot has no arguments to pass; a fragment lowered by a test may start anywhere).
+A start symbol without a rule is the caller's mistake (``--start``), not the grammar's: a
+``UsageError``, unless errors are listed already (the start rule may be one that failed to parse: its
+errors say more than "no rule").
+
+An analysis, not a rewrite: the module comes back with its graph. Recursion is found as strongly
+connected components of the symbol graph (Tarjan).
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import replace
 
-from grammarc.diagnostics import Diagnostics
+from grammarc.diagnostics import Diagnostics, Span
+from grammarc.errors import UsageError
 from grammarc.ir import nodes as ir
+from grammarc.ir.nodes import RuleGraph
 from grammarc.ir.traverse import iter_ops
 
 
-@dataclass(frozen=True)
-class RuleGraph:
-    start: str
-    #: Symbols with rules, in order of first definition.
-    nonterminals: tuple[str, ...]
-    #: Symbols used in successors that have no rule: their shapes are leaves.
-    terminals: tuple[str, ...]
-    reachable: frozenset[str]
-    #: Symbols on a cycle of the graph (directly or mutually recursive).
-    recursive: frozenset[str]
-    edges: dict[str, tuple[str, ...]]
+def rule_graph(module: ir.Module, diags: Diagnostics) -> ir.Module:
+    """The pass: the module with ``graph`` from its start symbol, which must have a rule."""
+    if not module.rules:
+        if not diags.has_errors:  # rules that failed to parse are not "no rules"
+            diags.error("empty", "the grammar has no rules", Span(module.file, 1, 1, 1, 1))
+        return module
+    start = next((r for r in module.rules if r.symbol == module.start), None)
+    if start is None:
+        if diags.has_errors:
+            return module
+        raise UsageError(f"start symbol `{module.start}` has no rule in {module.file}")
+    if start.params and module.roots is not None:  # a module to derive: lots pass no arguments
+        diags.error("start-params", f"the start rule `{start.symbol}` cannot take parameters: a lot has no "
+                    "arguments to pass", start.span)
+    return replace(module, graph=analyze_rules(module, start.symbol, diags))
 
 
 def analyze_rules(module: ir.Module, start: str, diags: Diagnostics) -> RuleGraph:
@@ -31,12 +45,11 @@ def analyze_rules(module: ir.Module, start: str, diags: Diagnostics) -> RuleGrap
     edges: dict[str, list[str]] = {s: [] for s in nonterminals}
     used: dict[str, None] = {}
     for rule in module.rules:
-        for alt in rule.alternatives:
-            for op in iter_ops(alt.body):
-                if isinstance(op, ir.Symbol):
-                    used[op.name] = None
-                    if not op.leaf:  # `X.` ends the derivation: no edge to X's rules
-                        edges[rule.symbol].append(op.name)
+        for op in iter_ops(rule):
+            if isinstance(op, ir.Symbol):
+                used[op.name] = None
+                if not op.leaf:  # `X.` ends the derivation: no edge to X's rules
+                    edges[rule.symbol].append(op.name)
     terminals = tuple(s for s in used if s not in edges)
     reachable = _reach(start, edges)
     for rule in module.rules:

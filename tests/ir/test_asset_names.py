@@ -1,0 +1,53 @@
+"""ir/asset_names.py: built-in names, and file names resolved inside the asset roots, never outside."""
+
+from __future__ import annotations
+
+import pytest
+
+from grammarc.ir.asset_names import LEAF_CUBE, LEAF_QUAD, builtin_name, resolve_asset
+
+
+@pytest.mark.parametrize("bare, builtin", [
+    ("cube", True), ("quad", True), ("cylinder", True), ("L", True), ("T", True), ("cylinder3", True),
+    ("cylinder256", True), ("cylinder2", False), ("cylinder257", False), ("cylinderx", False),
+    ("sphere", False), ("cube.obj", False),
+])
+def test_builtin_names(bare, builtin):
+    assert builtin_name(bare) is builtin
+
+
+def test_the_leaf_assets_are_builtins():
+    assert resolve_asset(LEAF_CUBE, []).name == LEAF_CUBE and resolve_asset("quad", []).name == LEAF_QUAD
+
+
+def test_a_builtin_is_canonical_with_or_without_its_prefix():
+    assert resolve_asset("cylinder12", []) == resolve_asset("builtin:cylinder12", [])
+    assert resolve_asset("cylinder12", []).name == "builtin:cylinder12"
+    assert "unknown built-in asset" in resolve_asset("builtin:sphere", []).problem
+
+
+def test_a_file_is_named_relative_to_the_first_root_that_holds_it(tmp_path):
+    first, second = tmp_path / "grammar", tmp_path / "kit"
+    (first / "sub").mkdir(parents=True)
+    second.mkdir()
+    (first / "sub" / "door.obj").write_text("v 0 0 0\n")
+    (second / "win.obj").write_text("v 0 0 0\n")
+    door = resolve_asset("./sub/door.obj", [first, second])
+    assert (door.name, door.path, door.problem, door.missing) == ("sub/door.obj", first / "sub" / "door.obj",
+                                                                   "", False)
+    assert resolve_asset("win.obj", [first, second]).path == second / "win.obj"
+    assert resolve_asset("sub\\door.obj", [first]).name == "sub/door.obj"
+
+
+def test_a_file_no_root_holds_is_missing_and_keeps_its_name(tmp_path):
+    missing = resolve_asset("facade/./win.obj", [tmp_path])
+    assert (missing.name, missing.path, missing.problem, missing.missing) == ("facade/win.obj", None, "", True)
+
+
+@pytest.mark.parametrize("name, problem", [
+    ("/etc/passwd", "is absolute"), ("C:/x.obj", "is absolute"), ("../x.obj", "leaves the asset folders"),
+    ("a/../../x.obj", "leaves the asset folders"),
+])
+def test_a_name_outside_every_root_is_refused(tmp_path, name, problem):
+    resolved = resolve_asset(name, [tmp_path / "g"])
+    assert problem in resolved.problem and resolved.path is None

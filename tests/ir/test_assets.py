@@ -1,0 +1,46 @@
+"""ir/passes/assets.py: the names ``I()`` and ``i()`` give become asset ids on the module."""
+
+from __future__ import annotations
+
+from dataclasses import replace
+
+from grammarc.diagnostics import Diagnostics
+from grammarc.frontend.parse import parse_source
+from grammarc.ir.pipeline import run_passes
+
+FILE = "g.cga"
+VERSION = 'version "2022.0"\n'
+
+
+def resolved(text: str, roots, dialect=None):
+    diags = Diagnostics()
+    module = replace(parse_source(text, FILE, diags, dialect), roots=roots)
+    return run_passes(module, diags, check=True), diags
+
+
+def test_assets_are_numbered_after_the_leaf_cube_and_quad(tmp_path):
+    (tmp_path / "win.obj").write_text("v 0 0 0\n")
+    module, diags = resolved('a ~> I("win.obj") b\nb ~> I("quad") I("./win.obj") I("cylinder")', (tmp_path,))
+    assert not diags
+    assert module.assets == ("builtin:cube", "builtin:quad", "win.obj", "builtin:cylinder")
+    assert module.asset_ids == (("win.obj", 2), ("quad", 1), ("./win.obj", 2), ("cylinder", 3))
+
+
+def test_a_computed_asset_name_resolves_every_string_constant_that_names_a_file(tmp_path):
+    (tmp_path / "a.obj").write_text("v 0 0 0\n")
+    text = VERSION + 'const kind = "a.obj"\nLot --> i(kind) X\nX --> case p(0.5) : i("b.OBJ") else : i(kind + "")\n'
+    module, diags = resolved(text, (tmp_path,), "cityengine")
+    assert dict(module.asset_ids) == {"b.OBJ": 2, "a.obj": 3}
+    assert [(d.code, d.span.line) for d in diags] == [("asset", 4)]  # b.OBJ is missing
+
+
+def test_errors_and_warnings_at_the_name(tmp_path):
+    module, diags = resolved('a ~> I("../up.obj") I("gone.obj")', (tmp_path / "g",))
+    assert [(d.code, d.severity.value, d.span.col) for d in diags] == [
+        ("asset", "error", 6), ("asset", "warning", 21)]
+    assert dict(module.asset_ids) == {"gone.obj": 2}
+
+
+def test_a_module_lowered_outside_the_compiler_keeps_its_names_unresolved():
+    module, diags = resolved('a ~> I("/etc/passwd")', None)
+    assert not diags and module.assets == () and module.asset_ids == ()
