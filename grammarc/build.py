@@ -30,12 +30,13 @@ from grammarc.backend.attributes import check_overrides
 from grammarc.backend.derive import derive_chunk
 from grammarc.backend.occlusion import Occluders
 from grammarc.backend.plan import make_plan
-from grammarc.compiler import Grammar, compile_grammar
+from grammarc.compiler import compile_grammar
 from grammarc.constants import LIMITS, Limits
 from grammarc.errors import ChunkTooLarge, LotFailure, UsageError
 from grammarc.io import OutputOptions, writer_for
 from grammarc.io.lots import default_lot, read_lots
 from grammarc.io.reports import write_reports
+from grammarc.model.grammar import Grammar
 from grammarc.model.lots import BadLot, Lots
 from grammarc.model.records import MeshChunk
 from grammarc.model.reports import Reports

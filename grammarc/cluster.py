@@ -55,7 +55,6 @@ from grammarc.compiler import compile_grammar
 from grammarc.constants import PARTITION_SIZE
 from grammarc.errors import UsageError
 from grammarc.io import OutputOptions, writer_for
-from grammarc.io.assets import resolve_asset
 from grammarc.io.lots import Partition, count_lots, file_stamp, partition_lots, read_partition
 from grammarc.io.reports import write_reports
 from grammarc.io.shards import (
@@ -69,6 +68,7 @@ from grammarc.io.shards import (
     sidecar_path,
     write_json,
 )
+from grammarc.ir.asset_names import resolve_asset
 from grammarc.model.lots import BadLot
 from grammarc.model.reports import Reports
 

@@ -10,10 +10,10 @@ from dataclasses import dataclass, field, replace
 
 from grammarc.backend.leaf_parts import leaf_inserts
 from grammarc.backend.slots import ANCESTORS, COLOR_SLOT, TRIM_SLOTS, TRIM_SWITCH
-from grammarc.compiler import Grammar
 from grammarc.ir import nodes as ir
-from grammarc.ir.traverse import iter_exprs, iter_ops, op_exprs
+from grammarc.ir.traverse import all_exprs, iter_ops
 from grammarc.model.assets import load_asset
+from grammarc.model.grammar import Grammar
 
 
 class Strings:
@@ -103,18 +103,18 @@ def make_plan(grammar: Grammar, *, load_asset: Callable = load_asset) -> Plan:
         priority = min((r.priority for r in rules), default=0)
         symbols.append(SymbolPlan(i, name, rules, priority, param_types.get(name, ())))
     strings = Strings()
-    for expr in _all_exprs(module):
+    for expr in all_exprs(module):
         if isinstance(expr, ir.Str):
             strings.intern(expr.value)
     stages = tuple(sorted({s.priority for s in symbols if s.rules}))
-    ops = [op for rule in module.rules for alt in rule.alternatives for op in iter_ops(alt.body)]
-    context = [e.name for e in _all_exprs(module) if isinstance(e, ir.ContextRef)]
+    ops = iter_ops(module)
+    context = [e.name for e in all_exprs(module) if isinstance(e, ir.ContextRef)]
     colour = [COLOR_SLOT] if any(isinstance(op, ir.SetColor) for op in ops) else []
     # CityEngine trims inserted geometry at the planes a comp(f) leaves between neighbouring faces
     trims = list(TRIM_SLOTS) if module.dialect == "cityengine" and any(
         isinstance(op, ir.CompFaces) and op.kind == "f" for op in ops) and any(
         isinstance(op, ir.UseAsset) for op in ops) else []
-    occlusion = {symbol.id: [e for rule in symbol.rules for e in _rule_exprs(rule) if isinstance(e, ir.Occlusion)]
+    occlusion = {symbol.id: [e for rule in symbol.rules for e in all_exprs(rule) if isinstance(e, ir.Occlusion)]
                  for symbol in symbols}
     occlusion = {k: v for k, v in occlusion.items() if v}
     ancestors = list(ANCESTORS) if occlusion or any(isinstance(op, ir.Label) for op in ops) else []
@@ -135,27 +135,8 @@ def make_plan(grammar: Grammar, *, load_asset: Callable = load_asset) -> Plan:
         asset_of_string=asset_of_string, queries=frozenset(occlusion),
         inter=any(e.target != "intra" for found in occlusion.values() for e in found),
         snapping=frozenset(s.id for s in symbols if any(getattr(op, "snap", False) for rule in s.rules
-                                                        for alt in rule.alternatives for op in iter_ops(alt.body))),
+                                                        for op in iter_ops(rule))),
         color_slot=dynamic.get(COLOR_SLOT), trim_slot=trim_slot,
         trim_switch=dynamic.get(TRIM_SWITCH) if trim_slot is not None else None,
         occluders=ANCESTORS[0] in dynamic, load_asset=load_asset)
     return replace(plan, leaf_inserts=leaf_inserts(plan))
-
-
-
-def _all_exprs(module: ir.Module):
-    for attr in module.attrs:
-        yield from iter_exprs(attr.default)
-    for rule in module.rules:
-        yield from _rule_exprs(rule)
-
-
-def _rule_exprs(rule: ir.Rule):
-    roots = [rule.guard] if rule.guard is not None else []
-    for alt in rule.alternatives:
-        if alt.prob is not None:
-            roots.append(alt.prob)
-        for op in iter_ops(alt.body):
-            roots.extend(op_exprs(op))
-    for root in roots:
-        yield from iter_exprs(root)

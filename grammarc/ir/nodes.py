@@ -14,8 +14,6 @@ Geometry conventions (shared with the backend): a scope has an origin, three ort
 3x3 matrix, right-handed) and a size. Angles are in degrees. Axis indices are 0, 1, 2 for x, y, z.
 """
 
-# ruff: noqa: RUF009 - ``child()`` returns a ``dataclasses.Field``, which ruff cannot see through
-
 from __future__ import annotations
 
 from collections.abc import Callable

@@ -36,9 +36,7 @@ from pathlib import Path
 import numpy as np
 
 from grammarc.errors import AssetError
-
-# Temporary: the IR resolves asset names (grammarc/ir, after integration); until then they live in io.assets.
-from grammarc.io.assets import builtin_name, resolve_asset
+from grammarc.ir.asset_names import builtin_name, resolve_asset
 from grammarc.model.obj import ObjError, read_obj
 
 __all__ = ["LOD_STAND_IN", "AssetLibrary", "AssetMesh", "asset_library", "builtin_mesh", "load_asset"]

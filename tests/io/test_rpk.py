@@ -8,8 +8,8 @@ from pathlib import Path
 import pytest
 
 from grammarc.errors import UsageError
-from grammarc.io.assets import resolve_asset
 from grammarc.io.rpk import open_rpk, start_rule_of
+from grammarc.ir.asset_names import resolve_asset
 
 py7zr = pytest.importorskip("py7zr")
 

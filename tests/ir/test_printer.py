@@ -1,7 +1,5 @@
 """ir/printer.py: IR as canonical text ($param, @attr, every binary parenthesized, one rule per line)."""
 
-# ruff: noqa: RUF009 - ``ir.child()`` returns a ``dataclasses.Field``, which ruff cannot see through
-
 from __future__ import annotations
 
 from dataclasses import dataclass

@@ -4,8 +4,6 @@ Every expression, operation and structural class of ``ir`` is built with a senti
 it holds and in its nested bodies (``node_zoo``), and every walk must reach each sentinel.
 """
 
-# ruff: noqa: RUF009 - ``ir.child()`` returns a ``dataclasses.Field``, which ruff cannot see through
-
 from __future__ import annotations
 
 from dataclasses import dataclass, replace

@@ -1,7 +1,5 @@
 """ir/passes/types.py: expression types, successor arities and parameter types from call sites."""
 
-# ruff: noqa: RUF009 - ``ir.child()`` returns a ``dataclasses.Field``, which ruff cannot see through
-
 from __future__ import annotations
 
 from dataclasses import dataclass, replace

@@ -5,8 +5,9 @@ from __future__ import annotations
 import pickle
 from dataclasses import replace
 
-from grammarc.compiler import Grammar, compile_grammar
+from grammarc.compiler import compile_grammar
 from grammarc.model import grammar as model
+from grammarc.model.grammar import Grammar
 
 
 def test_the_grammar_reads_what_the_passes_found_from_its_module(write):

@@ -10,7 +10,7 @@ from dataclasses import replace
 from grammarc.diagnostics import Diagnostics, Span, suggest
 from grammarc.frontend.cityengine.nodes import Annotated, FunctionDef, RuleDef, Style
 from grammarc.ir import nodes as ir
-from grammarc.ir.traverse import rewrite_body, rewrite_expr, sub_bodies
+from grammarc.ir.traverse import rewrite_body, rewrite_expr, rewrite_ops
 
 
 def assemble(file: str, statements: list, diags: Diagnostics, imports=()) -> ir.Module:
@@ -105,17 +105,7 @@ def _prefixed(module: ir.Module, prefix: str | None, forwarded: set[str]):
 
 def _map_symbols(body: ir.Body, fn) -> ir.Body:
     """``body`` with ``fn`` applied to every successor symbol, nested bodies included."""
-    out = []
-    for op in body:
-        if isinstance(op, ir.Symbol):
-            op = fn(op)
-        elif isinstance(op, (ir.Case, ir.Stochastic)):
-            op = replace(op, branches=tuple((c, _map_symbols(b, fn)) for c, b in op.branches),
-                         default=_map_symbols(op.default, fn))
-        elif sub_bodies(op):
-            op = replace(op, parts=tuple(_map_symbols(b, fn) for b in op.parts))
-        out.append(op)
-    return tuple(out)
+    return rewrite_ops(body, lambda op: fn(op) if isinstance(op, ir.Symbol) else op)
 
 
 class _Inliner:

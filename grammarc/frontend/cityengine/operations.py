@@ -225,7 +225,7 @@ class OperationLowering:
                 return ir.Empty(span)
             return ir.Setback(args[0].values, chosen[0], chosen[1], span, self.site(), per_edge=True)
         if not self.arity(op, args, (len(sides) if sides else 1,), span):
-            return None
+            return ir.Empty(span)
         known = SETBACK_SELECTORS if not sides else frozenset({"shape", "remainder"})
         chosen = self.selector_parts(op, parts, known)
         if chosen is None:
