@@ -639,6 +639,14 @@ class CleanupGeometry:
 
 
 @dataclass(frozen=True, slots=True)
+class DeleteHoles:
+    """CityEngine ``deleteHoles()``: the faces of the shape's geometry lose their holes, keeping their
+    outer rings."""
+
+    span: Span = NO_SPAN
+
+
+@dataclass(frozen=True, slots=True)
 class InnerRectangle:
     """CityEngine ``innerRectangle(scope|edge) { shape: A | remainder: B }``: the largest rectangle inside
     the face (sides along the scope's x, or along one of its long edges) and the rest of the face."""
@@ -694,7 +702,7 @@ class CompFaces:
 Op = (Symbol | Empty | Translate | Scale | Rotate | Push | Pop | Insert | Split | Repeat | Comp | Extrude
       | Center | UseAsset | Case | Stochastic | SetAttr | Report | NotApplied | GroupSplit | CompFaces
       | AlignScope | Mirror | Offset | SetColor | Setback | Roof | InnerRectangle | Convexify
-      | CleanupGeometry | Snap | Label)
+      | CleanupGeometry | DeleteHoles | Snap | Label)
 Body = tuple[Op, ...]
 
 

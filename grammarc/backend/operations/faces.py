@@ -33,7 +33,7 @@ from grammarc.geometry import components as comp_kernels
 from grammarc.geometry.clip import fit_pieces, scope_polygons
 from grammarc.geometry.convexify import convex_parts
 from grammarc.geometry.inner_rectangle import largest_rectangles
-from grammarc.geometry.meshes import is_mesh, is_polygon
+from grammarc.geometry.meshes import MESH_BASE, is_mesh, is_polygon
 from grammarc.geometry.polygons import plane_to_scope
 from grammarc.geometry.setback import polygon_edges, setback_regions
 from grammarc.ir import nodes as ir
@@ -194,6 +194,37 @@ def cleanup_geometry(ctx: Context, cursor: Shapes, op: ir.CleanupGeometry) -> Sh
     mesh = np.flatnonzero(is_mesh(cursor.geom))
     if len(mesh):
         geom[mesh] = mesh_shapes.clean_meshes(ctx.chunk, cursor.take(mesh), tolerance[mesh], op.component)
+    return cursor.with_scope(cursor.origin, cursor.size, cursor.frame, geom)
+
+
+@operation(ir.DeleteHoles, writes=("geom",), meshes=True)
+def delete_holes(ctx: Context, cursor: Shapes, op: ir.DeleteHoles) -> Shapes:
+    """``deleteHoles``: each face keeps its outer ring. A flat polygon or a mesh (a roof) with holes is
+    stored again without its hole rings, in the same scope (holes lie inside the outer ring); boxes,
+    rectangles and assets have none. A prism with holes is refused: CityEngine keeps its hole walls, faces
+    that a prism here has only as the rings of its base."""
+    geom = cursor.geom.copy()
+    polygon = np.flatnonzero(is_polygon(geom))
+    store = ctx.chunk.polygons
+    rings = store.poly_offsets[geom[polygon] + 1] - store.poly_offsets[geom[polygon]]
+    holed = polygon[rings > 1]
+    solid = cursor.size[holed, store.plane[geom[holed]]] > TOL.zero
+    if solid.any():
+        bad = np.zeros(len(cursor), dtype=bool)
+        bad[holed[solid]] = True
+        ctx.fail(cursor, bad, "`deleteHoles` of a solid with holes is not supported yet (delete the holes "
+                 "of its face before `extrude`)", op.span)
+    if len(holed):
+        coords, ring_offsets, poly_offsets = store.gather(geom[holed])
+        vertices, outer = ragged_take(ring_offsets, poly_offsets[:-1])
+        geom[holed] = store.add(coords[vertices], outer, np.arange(len(holed) + 1), store.plane[geom[holed]])
+    mesh = np.flatnonzero(is_mesh(geom))
+    if len(mesh):
+        coords, ring_offsets, face_offsets, mesh_offsets = ctx.chunk.meshes.gather(geom[mesh] - MESH_BASE)
+        if len(face_offsets) < len(ring_offsets):  # some face has a hole
+            vertices, outer = ragged_take(ring_offsets, face_offsets[:-1])
+            ids = ctx.chunk.meshes.add(coords[vertices], outer, np.arange(len(face_offsets)), mesh_offsets)
+            geom[mesh] = MESH_BASE + ids
     return cursor.with_scope(cursor.origin, cursor.size, cursor.frame, geom)
 
 

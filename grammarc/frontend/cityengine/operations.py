@@ -322,6 +322,7 @@ OPERATIONS = {
     "report": direct(ir.Report),
     "convexify": OperationLowering.op_convexify,
     "cleanupGeometry": OperationLowering.op_cleanup,
+    "deleteHoles": direct(ir.DeleteHoles),
     "label": OperationLowering.op_label,
     "envelope": OperationLowering.op_envelope,
     "roofHip": OperationLowering.op_roof,
@@ -377,7 +378,7 @@ UNSUPPORTED_OPS = frozenset({
     "mirrorScope",
     "insertAlongUV", "scatter", "footprint", "tileUV", "splitArea", "inline", "resetGeometry", "taper",
     "primitiveCylinder", "primitiveSphere", "primitiveDisk", "primitiveCone", "primitiveQuad",
-    "deleteHoles", "reduceGeometry", "rectify", "semiPolygon",
+    "reduceGeometry", "rectify", "semiPolygon",
 } - NOT_APPLIED)
 #: Axis selectors of ``center`` and ``alignScopeToAxes``.
 AXIS_NAMES = {"x": (0,), "y": (1,), "z": (2,), "xy": (0, 1), "xz": (0, 2), "yz": (1, 2), "xyz": (0, 1, 2)}

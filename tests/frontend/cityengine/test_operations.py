@@ -56,6 +56,7 @@ from .lowered import VERSION, assert_unsupported_at, body_of, compile_ir, errors
     ("extrude(rand(2, 4)) A", "extrude(rand(2, 4)) A"),
     ("cleanupGeometry(all, 0.1) A", "cleanupGeometry(all, 0.1) A"),
     ("cleanupGeometry(faces, h / 10) A", "cleanupGeometry(faces, (@h / 10)) A"),
+    ("deleteHoles() A", "deleteHoles() A"),
     ('report("k", scope.sx > 1 && !(scope.sz < 2) || h == 3) A',
      'report("k", (((Scope.sx > 1) && !(Scope.sz < 2)) || (@h == 3))) A'),
 ])
@@ -225,6 +226,7 @@ def test_each_operation_name_is_in_one_table():
     ("Lot --> mirror(true, false) A", "`mirror` takes 3 arguments, got 2"),
     ('Lot --> report("k") A', "`report` takes 2 arguments, got 1"),
     ("Lot --> t(1, 2, 3, 4) A", "`t` takes 3 arguments, got 4"),
+    ("Lot --> deleteHoles(1) A", "`deleteHoles` takes 0 arguments, got 1"),
     ("Lot --> setback(1, 2){ front : A | remainder : B }", "`setback` takes 1 arguments, got 2"),
 ])
 def test_a_wrong_argument_count_is_an_arity_error_at_the_operation(line, message):
