@@ -1,7 +1,7 @@
 """``grammarc build``: grammar and lots in, instance records out, chunk by chunk.
 
 Lots are derived in chunks of ``chunk_size`` and each chunk's records are streamed to the writer, so memory
-is bounded by a chunk (DESIGN.md, invariant 3). A chunk that cannot be derived whole is not lost:
+is bounded by a chunk (docs/architecture.md, invariant 3). A chunk that cannot be derived whole is not lost:
 
 - lots that fail (a negative size, an unsupported geometry) are reported by id and skipped, and the chunk
   is derived again without them;
@@ -45,9 +45,9 @@ from grammarc.workers import worker_pool
 #: Shapes plus records one chunk may make before it is split: ~100 bytes each, so about 2 GB.
 CHUNK_BUDGET = 20_000_000
 #: Records a chunk aims at (the chunk size adapts to the records per lot seen so far). Each operation of
-#: each rule costs a fixed ~50 us per chunk in Python besides its work on the columns, so a grammar of
-#: 150 rules (examples/pompeii) wants large chunks: 6 * 10^5 records took its 2.5 * 10^5 lots from 23.5 s
-#: (1.5 * 10^5 records a chunk) to 15.4 s; the facade benchmark (7 rules) is as fast at either size.
+#: each rule costs a fixed time per chunk in Python besides its work on the columns, so a grammar of
+#: many rules (examples/pompeii) wants large chunks; one of a few rules (the facade benchmark) is as fast
+#: with small ones (README, "Figures").
 ROWS_PER_CHUNK = 600_000
 
 
@@ -220,8 +220,7 @@ def derive_all(plan, lots: Lots, options: BuildOptions, writer, failed: list[Bad
 
     ``options.workers`` chunks are derived at once, each in a worker process (``workers.py``), and one more
     waits in the pool's queue, so a worker that finishes starts on it while the parent writes the chunk it
-    returned (pompeii x100 on two workers: 11.4-11.7 s -> 9.8 s). Results are
-    written in chunk order, and a chunk's size is decided from the chunks finished before it in that
+    returned, rather than wait. Results are written in chunk order, and a chunk's size is decided from the chunks finished before it in that
     order, so the chunking does not depend on timing (and the records never depend on the chunking).
     """
     if plan.inter and foreign is None:
@@ -237,7 +236,7 @@ def _collecting():
     """The cyclic garbage collector on while chunks are derived (an executor's cycles must go with its
     chunk), after what the set-up made is frozen out of its sight: the grammar's IR, the plan, numba's
     dispatchers live to the end, and full collections need not walk them, nor forked workers touch their
-    pages. ``grammarc``'s command turns the collector off for the set-up (0.15 s of its start)."""
+    pages. ``grammarc``'s command turns the collector off for the set-up."""
     was_enabled = gc.isenabled()
     gc.freeze()
     gc.enable()

@@ -24,7 +24,7 @@ def main(argv: list[str] | None = None) -> int:
     parser = _parser()
     args = parser.parse_args(argv)
     # Imports and compiling make many objects and little garbage: the cyclic collector only costs there
-    # (0.15 s of a build's start). ``build.derive_all`` turns it on while chunks are derived.
+    # (README, "Figures"). ``build.derive_all`` turns it on while chunks are derived.
     collecting = gc.isenabled()
     gc.disable()
     try:
@@ -128,7 +128,7 @@ def _parser() -> argparse.ArgumentParser:
     lots.add_argument("path", type=Path, help="GeoJSON, a GeoJSON sequence, GeoParquet, a GIS file, OBJ or PRT "
                                               "shape JSON")
     lots.add_argument("--to", type=Path, metavar="OUT.parquet",
-                      help="write the good lots as GeoParquet (extra `parquet`), which reads ~3x faster")
+                      help="write the good lots as GeoParquet (extra `parquet`), which reads faster")
     lots.set_defaults(run=_lots)
 
     info = sub.add_parser("info", help="what a city holds: counts, lots, bbox, polygons")

@@ -57,7 +57,7 @@ BBOX_TOL = 1e-4
 AREA_REL_TOL = 1e-4
 #: Nearest sample sites whose triangles ``surface_distance`` tries per point. With 8, a point near the
 #: diagonal of a large quad sometimes had only sites of the quad's other triangle (a 1e-5 m mean error
-#: on a 10 m cube); 16 was exact there, at ~0.4 s for 2 x 20,000 points.
+#: on a 10 m cube); 16 was exact there.
 _CANDIDATES = 16
 
 

@@ -1,7 +1,7 @@
 """Chunks of lots derived in forked worker processes, their records shipped back through memory files.
 
 The derivation is mostly Python driving numpy and numba over columns, so threads would share one
-interpreter lock (measured: no gain on two cores); processes use both cores. The work is set before the
+interpreter lock; processes use both cores. The work is set before the
 workers are forked, so they inherit the compiled plan and the occluders rather than receive them pickled;
 each task sends only its lots.
 
@@ -9,13 +9,9 @@ A chunk's records (6 * 10^5 rows, ~40 MB) do not come back through the pool's pi
 pushing them through a pipe cost more than deriving them on a grammar as cheap as the facade benchmark.
 A worker writes each record's arrays into one file in a private folder on a memory filesystem
 (``/dev/shm`` where there is one), and the parent maps the file into memory, takes the arrays as views
-of the mapping and deletes it: the records are copied once on their way, by the writer (the facade
-benchmark at 10^5 lots: 16.5 s -> 14.1 s against reading the file into a buffer first). The folder goes when the pool does, so a failed build leaves nothing behind.
-
-Measured on two cores (other work on the machine): examples/pompeii x100 10.7-12.2 s with two workers
-against 12.3-13.0 s with one; the facade benchmark at 10^5 lots, whose records are cheap and 3.6 GB, the
-same either way (17.4-20.0 s against 17.7-19.0 s: the parent's reading and writing bound it). Through the
-pool's pipe, the records made two workers slower than one on the facade benchmark (21.2 s against 15.4 s).
+of the mapping and deletes it: the records are copied once on their way, by the writer. The folder goes
+when the pool does, so a failed build leaves nothing behind. What two workers gain, and what the pipe and
+a read buffer cost, is measured in the README ("Figures").
 """
 
 from __future__ import annotations

@@ -1,6 +1,6 @@
 """Terminal records: instances mapping an asset's unit box onto a scope, and leaf geometry.
 
-``instance_xform`` builds the (n, 3, 4) record transform of DESIGN.md: column j is scope axis j times
+``instance_xform`` builds the (n, 3, 4) record transform (README, "The record"): column j is scope axis j times
 scope size j, column 3 the scope origin. ``emit_leaves`` turns shapes whose symbol has no rule (or to which
 no rule applied) into output, as CityEngine emits leaf geometry:
 

@@ -232,8 +232,8 @@ class BakedWriter(WriterBlock):
 
     The interface of ``InstanceWriter``: the format follows the path's extension. OBJ is streamed: each
     chunk is baked as it comes and appended to a temporary file next to ``path`` (its vertices, then its
-    triangles indexing them from the vertices written before), so memory holds one chunk's mesh (candler
-    x500, 2.1 GB of OBJ, took 8.4 GB when kept whole). PLY, STL and GLB need the whole mesh (counts in
+    triangles indexing them from the vertices written before), so memory holds one chunk's mesh, not the
+    city's (four times the size of the OBJ file when kept whole). PLY, STL and GLB need the whole mesh (counts in
     their headers, one buffer), so their chunks are kept until ``close()``, which bakes and exports them
     with trimesh. Either way the writer counts the triangles chunks will make as they come and refuses a
     chunk that would pass ``max_triangles``; the file is renamed onto ``path`` only when complete, so

@@ -2,7 +2,7 @@
 
 Both formats place a prototype by translation, rotation (a unit quaternion) and per-axis scale:
 ``world = position + R(q) (scale * p)``. A record's ``xform`` is ``M p + t`` with the columns of ``M`` the
-scope's axes times its sizes (DESIGN.md), so ``decompose`` takes the column lengths as the scales and the
+scope's axes times its sizes (README, "The record"), so ``decompose`` takes the column lengths as the scales and the
 normalized columns as the rotation. Two cases need care:
 
 * a flat scope (a facade quad: one zero column; a snap line: two) has no direction for that axis. The

@@ -1,7 +1,7 @@
 """The terminal record ``instances.npz``: a streaming, atomic writer and its reader.
 
 A city's terminals (10^7-10^8 rows, gigabytes) arrive chunk by chunk from the derivation
-(``model.records``), and the writer must hold no more than a few chunks in memory (DESIGN.md, invariant 3).
+(``model.records``), and the writer must hold no more than a few chunks in memory (docs/architecture.md, invariant 3).
 ``np.savez`` needs every array whole, so the writer builds the zip itself, as the rows arrive:
 
 * ``xform`` (48 of the 60 bytes of a row) is written once, straight into the output: it is the first member of
@@ -51,7 +51,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-# zlib's CRC-32 with SIMD (3x as fast: every record byte passes it), and its crc32_combine
+# zlib's CRC-32 with SIMD (every record byte passes it), and its crc32_combine
 from zlib_ng.zlib_ng import crc32, crc32_combine
 
 from grammarc.errors import UsageError
@@ -86,7 +86,7 @@ _SPOOLED = {
 _OFFSETS = ("mesh_ring_offsets", "mesh_face_offsets")
 # The column written straight into the output, as its first member; the others are spooled.
 _STREAMED = "xform"
-# Central directory order, the order of np.load(path).files: the record's table in DESIGN.md, then the mesh
+# Central directory order, the order of np.load(path).files: the record's table in the README, then the mesh
 # table. In the file, xform comes first and the others follow in this order.
 _KEYS = (
     "assets", "asset", "xform", "lot", "symbols", "symbol", "color", "meta",
@@ -257,7 +257,7 @@ def read_instances(path: str | os.PathLike) -> dict[str, np.ndarray | dict]:
     Returns
     -------
     record : dict
-        Every array of the record by key (see DESIGN.md, "The terminal record"), with ``"meta"``
+        Every array of the record by key (see the README, "The record"), with ``"meta"``
         parsed from JSON into a dict.
 
     Raises

@@ -19,8 +19,8 @@ DECIMALS = 6
 def obj_bytes(vertices: np.ndarray, faces: np.ndarray, header: str = "") -> bytes:
     """An OBJ file of ``vertices`` (V, 3) and triangles ``faces`` (T, 3) (0-based), as bytes.
 
-    A baked city has 10^7 triangles and more; formatting them with Python's ``str.format`` (as trimesh
-    does) took 15 s for 50 candler buildings. Here a numba kernel writes the digits into one buffer:
+    A baked city has 10^7 triangles and more, too many to format one by one with Python's ``str.format``
+    (as trimesh does). Here a numba kernel writes the digits into one buffer:
     coordinates in fixed point with ``DECIMALS`` decimals, trailing zeros dropped; indices 1-based.
     """
     vertices = np.ascontiguousarray(vertices, dtype=np.float64)

@@ -1,6 +1,6 @@
 """Cameras that frame a city's bounding box: an oblique perspective view (the default) and a top view.
 
-World is y-up with map north at -z (DESIGN.md, "The terminal record"). The oblique camera looks at the
+World is y-up with map north at -z (README, "The record"). The oblique camera looks at the
 box's centre from the south-south-east, down at ``OBLIQUE_ELEVATION``: the south and east walls face it,
 and the sun (``SUN``, from the south-west) lights the south walls and leaves the east ones in shade, so
 roofs, south and east walls take three different shades. The top camera is orthographic, looking down,

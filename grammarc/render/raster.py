@@ -29,10 +29,10 @@ corners, and each is drawn in one of three ways, cheapest first:
 2. smaller than the asset's ``detail_px``: its box (12 triangles), a proxy for assets of many triangles;
 3. otherwise the asset's triangles.
 
-The loops are serial. On the facade benchmark (``benchmarks/bench_render.py``, 10^6 instances) drawing is
-about 0.2 s of the 0.45 s ``render`` takes, reading the record and encoding the PNG the rest, so threads
-could save little; and they would have to split the picture into bands, each thread projecting every
-instance, because a pixel written by two threads breaks both the depth test and determinism.
+The loops are serial. Drawing is under half of what ``render`` takes (``benchmarks/bench_render.py``;
+reading the record and encoding the PNG are the rest), so threads could save little; and they would have
+to split the picture into bands, each thread projecting every instance, because a pixel written by two
+threads breaks both the depth test and determinism.
 """
 
 from __future__ import annotations

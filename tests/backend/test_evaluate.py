@@ -202,7 +202,7 @@ def test_rand_sites_are_independent(env):
 
 
 def test_rand_does_not_depend_on_batch(env):
-    """A shape draws the same number alone or in a batch (DESIGN.md invariant 2)."""
+    """A shape draws the same number alone or in a batch (docs/architecture.md, invariant 2)."""
     whole = evaluate(call("rand", num(2), num(9), site=3), env)
     sel = np.random.default_rng(0).permutation(N)[:50]
     part = Env(env.shapes.take(sel), env.chunk, env.plan)

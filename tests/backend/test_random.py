@@ -81,7 +81,7 @@ def test_lot_keys_bit_for_bit(seed):
 
 
 def test_lot_keys_depend_only_on_the_lot():
-    """A lot's key is the same alone, in any chunk and any order (DESIGN.md invariant 2)."""
+    """A lot's key is the same alone, in any chunk and any order (docs/architecture.md, invariant 2)."""
     index = np.arange(50)
     everything = lot_keys(42, index)
     rng = np.random.default_rng(0)

@@ -1,6 +1,6 @@
 """Lot scopes and footprint polygons (grammarc.geometry.footprint) on the zoo, rotated and shifted.
 
-Conventions (DESIGN.md): world x = map x, world z = -map y; scope x along the lot's first edge, y up,
+Conventions (README, "The record"): world x = map x, world z = -map y; scope x along the lot's first edge, y up,
 z = x cross y; origin where the footprint's box starts, so the footprint lies in the positive quadrant.
 """
 
