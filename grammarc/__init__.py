@@ -1,13 +1,20 @@
 """grammarc: a compiler from CGA shape grammars to batched numeric code.
 
-The packages follow the data flow, in this order:
+The packages are floors, each importing only from those below it (docs/architecture.md;
+tests/test_layout.py checks), from the ground up:
 
-- ``grammarc.frontend``: grammar text to IR (lark grammar per dialect, lowering, diagnostics with spans).
-- ``grammarc.ir``: the language's meaning, independent of syntax (nodes, verification, passes, printer).
-- ``grammarc.geometry``: footprints to initial shapes, the ragged polygon store, component splits.
-- ``grammarc.backend``: the IR as vectorized operations over columns of shapes, and the derivation.
-- ``grammarc.io``: lots in, assets, instance records out.
-- ``grammarc.build`` and ``grammarc.cli``: the ``grammarc`` command.
+- ``constants``, ``diagnostics``, ``ragged``, ``atomic``, ``errors``: tolerances and limits, diagnostics
+  with spans, ragged arrays, files written atomically, the exceptions.
+- ``grammarc.ir``: the language's meaning, independent of syntax (nodes, one traversal, passes, printer).
+- ``grammarc.model``: the data every layer passes (the checked grammar, lots, record chunks, reports,
+  asset meshes).
+- ``grammarc.frontend``: grammar text to IR (a lark grammar and a lowering per dialect, every error with
+  its span); ``grammarc.geometry``: polygon and mesh kernels on arrays.
+- ``grammarc.compiler``: text to the checked grammar; ``grammarc.backend``: the derivation, the IR's
+  operations over columns of shapes.
+- ``grammarc.io``: lots in, records out (a table of formats each way); ``grammarc.render``: pictures.
+- ``grammarc.workers``, ``grammarc.build``, ``grammarc.cluster``, ``grammarc.conform``, ``grammarc.cli``:
+  the ``grammarc`` command.
 """
 
 __version__ = "0.1.0"

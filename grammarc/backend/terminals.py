@@ -30,7 +30,7 @@ from grammarc.geometry.trim import boxes_crossing, trim_triangles
 from grammarc.model.records import MeshChunk
 from grammarc.ragged import offsets_from_counts, segment_of
 
-CUBE, QUAD = 0, 1  # asset ids of the leaf built-ins (see compiler._assets)
+CUBE, QUAD = 0, 1  # asset ids of the leaf built-ins (see ir.passes.assets)
 
 
 def instance_xform(axes: np.ndarray, size: np.ndarray, origin: np.ndarray) -> np.ndarray:

@@ -278,7 +278,7 @@ def test_geometry_area_of_a_lot_and_volume_after_extrude(write):
     assert (lots[1]["area_sum"], lots[1]["volume_sum"]) == pytest.approx((1200, 12000))
 
 
-@pytest.mark.xfail(strict=True, reason="lower_cityengine inlines a function's rand() with the site of its "
+@pytest.mark.xfail(strict=True, reason="the CityEngine lowering inlines a function's rand() with the site of its "
                    "definition: every use of `h = rand()` in a rule draws the same number; CityEngine draws "
                    "at each evaluation")
 def test_a_function_with_rand_draws_at_each_use(write):
