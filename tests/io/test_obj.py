@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from grammarc.io.obj import obj_bytes
-from grammarc.model.obj import ObjError, read_obj
+from grammarc.model.obj import read_obj
 
 
 def test_obj_bytes_writes_what_read_obj_reads():
@@ -19,10 +19,3 @@ def test_obj_bytes_writes_what_read_obj_reads():
     np.testing.assert_array_equal(np.array(read), faces)
     with pytest.raises(ValueError, match="finite"):
         obj_bytes(np.array([[np.nan, 0, 0]]), faces[:0])
-
-
-def test_read_obj_takes_vertex_tokens_and_negative_indices_and_names_a_bad_line():
-    points, faces = read_obj("# c\nv 0 0 0\nv 1 0 0\nv 1 1 0\nvt 0 0\nf 1/1 2//3 -1/2/3\n")
-    assert points.shape == (3, 3) and [f.tolist() for f in faces] == [[0, 1, 2]]
-    with pytest.raises(ObjError, match="^lot.obj:2: bad 'v' line"):
-        read_obj("v 0 0 0\nv 1 x 0\n", "lot.obj")
