@@ -6,7 +6,7 @@ in ``operations`` (one function per IR node type, in modules by family) and runs
 chunk's state and the helpers every operation uses). Below them: ``plan`` (the grammar numbered for the
 derivation, with ``slots``: the per-shape columns the derivation adds), ``attributes`` (the lots' attribute
 columns), ``shapes`` (a batch as columns), ``chunk`` (a chunk's stores and outputs), ``evaluate``
-(expressions on a batch), ``terminals`` (records), ``reports``, and the helpers the operations share
+(expressions on a batch), ``terminals`` (records), ``report_rows``, and the helpers the operations share
 (``children``, ``reframing``, ``outlines``, ``selectors``, ``mesh_shapes``, ``occlusion``, ``snaps``,
 ``leaf_parts``, ``random``, ``kernels``).
 """

@@ -22,7 +22,7 @@ from grammarc.backend.kernels.order import group_by, scatter_rows
 from grammarc.backend.occlusion import Occluders
 from grammarc.backend.plan import Plan
 from grammarc.backend.random import lot_keys
-from grammarc.backend.reports import aggregate_chunk
+from grammarc.backend.report_rows import aggregate_chunk
 from grammarc.backend.shapes import Shapes
 from grammarc.backend.slots import ANCESTORS, COLOR_SLOT, TRIM_SLOTS, TRIM_SWITCH, WHITE_RGB
 from grammarc.constants import Limits

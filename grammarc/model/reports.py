@@ -1,6 +1,6 @@
 """The values of CityEngine's ``report(key, value)``: per lot, and over the whole city.
 
-The derivation aggregates a chunk's rows per lot (``backend.reports``); ``Reports`` collects the lots of
+The derivation aggregates a chunk's rows per lot (``backend.report_rows``); ``Reports`` collects the lots of
 every chunk and merges them into the totals, in PRT's flat form (``key_n``, ``key_sum``, ``key_avg``,
 ``key_min``, ``key_max``). ``io.reports`` writes them beside the output.
 """

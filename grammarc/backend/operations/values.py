@@ -1,7 +1,7 @@
 """Values a shape carries or reports: ``set(attr, value)``, ``color()`` and CityEngine's ``report``.
 
 ``set`` and ``color`` give the shape (and so its successors and parts) a new value in its ``dynamic`` column;
-``report`` adds rows to the chunk's reports (``backend.reports``). Reads: what their expressions read, and
+``report`` adds rows to the chunk's reports (``backend.report_rows``). Reads: what their expressions read, and
 ``lot`` (reports). Writes: ``set`` and ``color`` the ``dynamic`` column of their value.
 """
 

@@ -1,10 +1,10 @@
-"""backend/reports.py: a chunk's report rows aggregated per lot and key, each kind as PRT aggregates it."""
+"""backend/report_rows.py: a chunk's report rows aggregated per lot and key, each kind as PRT aggregates it."""
 
 from __future__ import annotations
 
 import numpy as np
 
-from grammarc.backend.reports import aggregate_chunk
+from grammarc.backend.report_rows import aggregate_chunk
 
 
 def test_rows_aggregate_per_lot_and_key_numbered_as_in_the_input():
