@@ -5,13 +5,20 @@ declaration order, the value of a lot is: the ``--attr`` override if one was giv
 lot), else the lot's property of the same name where the lot has one, else the default expression,
 evaluated on the lot's own shape (defaults may use earlier attributes, ``rand`` and ``Scope``).
 A property of the wrong type (text for a numeric attribute) makes its lot bad, with the value named.
+
+An array attribute (``attr heights = [10, 20]``) is a column of ``backend.arrays.Arrays``, one array per
+lot. A lot overrides it with a JSON array property (GeoJSON ``"heights": [10, 20]``, a list of rows
+``[[1, 2], [3, 4]]`` for a 2-D array) or a single value (a 1x1 array); ``--attr`` cannot give arrays.
 """
 
 from __future__ import annotations
 
+import json
+
 import numpy as np
 
-from grammarc.backend.evaluate import Env, evaluate_array
+from grammarc.backend.arrays import Arrays
+from grammarc.backend.evaluate import Env, evaluate, evaluate_array
 from grammarc.errors import LotFailure, UsageError
 from grammarc.ir import nodes as ir
 from grammarc.ir.traverse import iter_exprs
@@ -43,6 +50,9 @@ def check_overrides(module: ir.Module, overrides: dict[str, object]) -> None:
             known = ", ".join(types) or "none"
             raise UsageError(f"--attr {name}: the grammar declares no attribute `{name}` (attributes: {known})")
         want = types[name]
+        if want.is_array:
+            raise UsageError(f"--attr {name}: `{name}` is an array ({want.value}), which --attr cannot give; "
+                             "give it per lot as a property of the lots")
         got = T.BOOL if isinstance(value, bool) else T.NUM if isinstance(value, float) else T.STR
         if want is not got and want is not T.UNKNOWN:
             raise UsageError(f"--attr {name}={value}: `{name}` is a {want.value}, not a {got.value}")
@@ -54,6 +64,12 @@ def attribute_columns(module: ir.Module, env: Env, lot_attrs: dict[str, np.ndarr
     columns = env.chunk.attrs
     n = len(env.shapes)
     for attr in dependency_order(module.attrs):
+        if attr.type.is_array:
+            column = evaluate(attr.default, env)
+            if attr.name in lot_attrs and not attr.const:
+                column = _arrays_from_lots(attr, lot_attrs[attr.name], column, strings)
+            columns[attr.name] = column
+            continue
         dtype = np.int32 if attr.type is T.STR else bool if attr.type is T.BOOL else np.float64
         if attr.name in overrides and not attr.const:
             value = overrides[attr.name]
@@ -114,6 +130,54 @@ def _from_lots(attr: ir.AttrDecl, values: np.ndarray, column: np.ndarray, string
                          np.flatnonzero(bad))
     column[given] = parsed[given] if attr.type is T.NUM else parsed[given] != 0
     return column
+
+
+def _arrays_from_lots(attr: ir.AttrDecl, values: np.ndarray, column: Arrays, strings) -> Arrays:
+    """``column`` with the lots' own arrays where they have one: JSON arrays (or single values) parsed
+    once per distinct text; a value of the wrong element type or shape makes its lots bad."""
+    n = len(column)
+    given = ~np.isnan(values) if values.dtype != object else values != None  # elementwise
+    if not given.any():
+        return column
+    texts = [str(v) if values.dtype == object else json.dumps(float(v)) for v in values[given]]
+    distinct, inverse = np.unique(np.array(texts, dtype=object), return_inverse=True)
+    parsed = [_parse_array(text, attr.type, strings) for text in distinct]
+    failed = np.array([p is None for p in parsed])[inverse.reshape(-1)]
+    if failed.any():
+        lots = np.flatnonzero(given)[failed]
+        raise LotFailure(f"attribute `{attr.name}` is {texts[int(np.flatnonzero(failed)[0])]}, not a "
+                         f"{attr.type.value}", lots)
+    dtype = column.values.dtype
+    table = Arrays(np.concatenate([column.values, *(np.asarray(p[0], dtype=dtype) for p in parsed)]),
+                   np.concatenate([column.offsets, column.offsets[-1] + np.cumsum([len(p[0]) for p in parsed],
+                                                                                  dtype=np.int64)]),
+                   np.concatenate([column.columns, np.array([p[1] for p in parsed], dtype=np.int64)]))
+    which = np.arange(n)
+    which[given] = n + inverse.reshape(-1)
+    return table.take(which)
+
+
+def _parse_array(text: str, want: ir.Type, strings) -> tuple[list, int] | None:
+    """A lot's array property as (elements row by row, columns), or None when it is not a ``want``: a
+    JSON array of elements, a JSON array of equally long rows, or a single element."""
+    try:
+        value = json.loads(text)
+    except ValueError:
+        value = text  # a plain string property: one string element
+    rows = value if isinstance(value, list) and value and all(isinstance(r, list) for r in value) else [
+        value if isinstance(value, list) else [value]]
+    width = len(rows[0])
+    if any(len(r) != width for r in rows):
+        return None
+    elements = [e for r in rows for e in r]
+    element = want.element
+    if element is T.NUM and all(isinstance(e, (int, float)) and not isinstance(e, bool) for e in elements):
+        return [float(e) for e in elements], width if elements else 0
+    if element is T.BOOL and all(isinstance(e, bool) for e in elements):
+        return elements, width if elements else 0
+    if element is T.STR and all(isinstance(e, str) for e in elements):
+        return [strings.intern(e) for e in elements], width if elements else 0
+    return None
 
 
 def _number(text: str, want: ir.Type) -> float:

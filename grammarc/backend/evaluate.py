@@ -2,7 +2,7 @@
 
 ``evaluate`` returns a numpy array with one value per shape, or a Python scalar when the value is the same
 for every shape (constants); callers broadcast. Numbers are float64, booleans bool, strings int32 ids of
-``Plan.strings``. Angles of trigonometric functions are degrees, as in CGA. Transcendental functions run in
+``Plan.strings``. CityEngine's arrays are ``backend.arrays.Arrays``, one array per shape. Angles of trigonometric functions are degrees, as in CGA. Transcendental functions run in
 a numba loop rather than numpy's SIMD kernels, so a value never depends on its position in the batch.
 """
 
@@ -14,10 +14,12 @@ from typing import TYPE_CHECKING
 import numpy as np
 from numba import njit
 
-from grammarc.backend import occlusion
+from grammarc.backend import arrays, occlusion
+from grammarc.backend.arrays import Arrays
 from grammarc.backend.chunk import Chunk
 from grammarc.backend.random import uniform
 from grammarc.backend.shapes import Shapes
+from grammarc.errors import LotFailure
 from grammarc.geometry.measure import area_and_volume, is_rectangular, vertex_and_face_counts
 from grammarc.ir import nodes as ir
 
@@ -58,7 +60,7 @@ def evaluate(expr: ir.Expr, env: Env):
         if index is not None and env.shapes.dynamic:
             return env.shapes.dynamic[index]
         column = env.chunk.attrs[expr.name]
-        return column[env.shapes.lot]
+        return column.take(env.shapes.lot) if isinstance(column, Arrays) else column[env.shapes.lot]
     if isinstance(expr, ir.ContextRef):
         return env.shapes.dynamic[env.plan.dynamic[expr.name]]
     if isinstance(expr, ir.Occlusion):
@@ -66,7 +68,10 @@ def evaluate(expr: ir.Expr, env: Env):
         return occlusion.query(expr, env, distance)
     if isinstance(expr, ir.Select):
         cond = evaluate(expr.cond, env)
-        return np.where(cond, evaluate(expr.then, env), evaluate(expr.other, env))
+        then, other = evaluate(expr.then, env), evaluate(expr.other, env)
+        if isinstance(then, Arrays):
+            return arrays.choose(cond, then, other)
+        return np.where(cond, then, other)
     if isinstance(expr, ir.ScopeRef):
         return _scope_field(expr.field, env)
     if isinstance(expr, ir.Unary):
@@ -78,6 +83,9 @@ def evaluate(expr: ir.Expr, env: Env):
             return np.logical_and(left, right)
         if expr.op == "||":
             return np.logical_or(left, right)
+        if isinstance(left, Arrays):  # `==` and `!=` of whole arrays (``passes.types``)
+            same = arrays.equal(left, right)
+            return same if expr.op == "==" else ~same
         if expr.op in _COMPARE:
             return _COMPARE[expr.op](left, right)
         if expr.op == "+" and (_is_string(left) or _is_string(right)):
@@ -86,7 +94,95 @@ def evaluate(expr: ir.Expr, env: Env):
             return _ARITH[expr.op](np.asarray(left, dtype=np.float64), right)
     if isinstance(expr, ir.Call):
         return _call(expr, env)
+    if isinstance(expr, (ir.ArrayLit, ir.Range, ir.Index)):
+        return _ARRAY_EXPRESSIONS[type(expr)](expr, env)
     raise TypeError(f"cannot evaluate {expr!r}")
+
+
+# -------------------------------------------------------------------------------------------------- arrays
+
+
+def _as_arrays(value, env: Env) -> Arrays:
+    """A value as arrays: an array stays, a scalar is the 1x1 array of its value per shape."""
+    if isinstance(value, Arrays):
+        return value
+    dtype = np.int32 if _is_string(value) else np.asarray(value).dtype
+    return arrays.from_scalars(value, len(env.shapes), dtype)
+
+
+def _checked(result: tuple[Arrays, np.ndarray], env: Env, what: str, span) -> Arrays:
+    """The arrays of an array function, or ``LotFailure`` for the lots of the shapes it failed on."""
+    value, bad = result
+    if bad.any():
+        raise LotFailure(f"{what} at {span}", np.unique(env.shapes.lot[bad]))
+    return value
+
+
+def _array_literal(expr: ir.ArrayLit, env: Env) -> Arrays:
+    rows = []
+    for row in expr.rows:
+        pieces = [_as_arrays(evaluate(e, env), env) for e in row]
+        rows.append(pieces[0] if len(pieces) == 1 else _checked(
+            arrays.concatenate_row(pieces), env, "the values of an array row differ in their rows", expr.span))
+    if len(rows) == 1:
+        return rows[0]
+    return _checked(arrays.stack_rows(rows), env, "the rows of an array differ in length", expr.span)
+
+
+def _colon(expr: ir.Range, env: Env) -> Arrays:
+    base, step, limit = (evaluate(e, env) for e in (expr.base, expr.step, expr.limit))
+    return _checked(arrays.colon(base, step, limit, len(env.shapes)), env,
+                    f"a range of more than {arrays.MAX_ELEMENTS} elements", expr.span)
+
+
+def _index(expr: ir.Index, env: Env):
+    """``a[i]``, ``a[i, j]``: elements for number indices, arrays when an index is an array."""
+    array = evaluate(expr.array, env)
+    default = env.plan.strings.intern("") if array.values.dtype == np.int32 else array.values.dtype.type(0)
+    index = evaluate(expr.index, env)
+    if expr.column is None:
+        if isinstance(index, Arrays):
+            return arrays.gather(array, index, default)
+        return arrays.item(array, index, default)
+    column = evaluate(expr.column, env)
+    if isinstance(index, Arrays) or isinstance(column, Arrays):
+        return arrays.gather_cells(array, _as_arrays(index, env), _as_arrays(column, env), default)
+    return arrays.cell(array, index, column, default)
+
+
+_ARRAY_EXPRESSIONS = {ir.ArrayLit: _array_literal, ir.Range: _colon, ir.Index: _index}
+
+
+def _string_ranks(env: Env) -> np.ndarray:
+    """(strings,) int64 the rank of each interned string's text in sorted order."""
+    names = list(env.plan.strings.ids)
+    ranks = np.empty(len(names), dtype=np.int64)
+    ranks[np.argsort(np.array(names, dtype=object), kind="stable")] = np.arange(len(names))
+    return ranks
+
+
+def _array_call(f: str, args: list, env: Env):
+    """CityEngine's array functions (``ir.ARRAY_FUNCTIONS``) on evaluated arguments."""
+    if f == "isNull":
+        if _is_string(args[0]):
+            null = env.plan.strings.ids.get("\ue000", -1)
+            return np.equal(args[0], null)
+        return np.isnan(np.asarray(args[0], dtype=np.float64))
+    array = args[0]
+    if f == "size":
+        return array.sizes.astype(np.float64)
+    if f == "nRows":
+        return array.rows.astype(np.float64)
+    if f == "nColumns":
+        return array.columns.astype(np.float64)
+    if f == "transpose":
+        return arrays.transpose(array)
+    ranks = _string_ranks(env) if array.values.dtype == np.int32 else None
+    if f == "sortIndices":
+        return arrays.sort_indices(array, ranks)
+    if f == "sortRowIndices":
+        return arrays.sort_row_indices(array, ranks)
+    return arrays.find_first(array, *args[1:])
 
 
 def _is_string(value) -> bool:
@@ -177,6 +273,8 @@ def _scope_angles(env: Env) -> np.ndarray:
 def _call(expr: ir.Call, env: Env):
     args = [evaluate(a, env) for a in expr.args]
     f = expr.func
+    if f in ir.ARRAY_FUNCTIONS:
+        return _array_call(f, args, env)
     if f == "rand":
         u = uniform(env.shapes.key, expr.site)
         if not args:

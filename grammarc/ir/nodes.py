@@ -29,7 +29,29 @@ class Type(Enum):
     NUM = "num"
     BOOL = "bool"
     STR = "str"
+    #: CityEngine's arrays (``float[]``, ``bool[]``, ``string[]``): 1-D or 2-D, of one element type.
+    NUMS = "num[]"
+    BOOLS = "bool[]"
+    STRS = "str[]"
     UNKNOWN = "unknown"
+
+    @property
+    def is_array(self) -> bool:
+        return self in _ELEMENTS
+
+    @property
+    def element(self) -> Type:
+        """The element type of an array type; a scalar type is its own."""
+        return _ELEMENTS.get(self, self)
+
+    @property
+    def array(self) -> Type:
+        """The array type of a scalar type (UNKNOWN for UNKNOWN); an array type is its own."""
+        return _ARRAYS.get(self, self)
+
+
+_ELEMENTS = {Type.NUMS: Type.NUM, Type.BOOLS: Type.BOOL, Type.STRS: Type.STR}
+_ARRAYS = {element: array for array, element in _ELEMENTS.items()}
 
 
 class SizeKind(Enum):
@@ -205,8 +227,9 @@ class Call:
     """A built-in function. ``site`` numbers the call so that ``rand`` draws differ per call site."""
 
     func: str
-    #: numbers, but for the conversions (``CONVERSIONS``), which take any type
-    args: tuple[Expr, ...] = child(lambda e: None if e.func in CONVERSIONS else Type.NUM,
+    #: numbers, but for the conversions (``CONVERSIONS``), which take any type, and the array functions
+    args: tuple[Expr, ...] = child(lambda e: None if e.func in CONVERSIONS or e.func in ARRAY_FUNCTIONS
+                                   else Type.NUM,
                                    lambda e: f"an argument of `{e.func}`")
     span: Span = NO_SPAN
     site: int = 0
@@ -259,8 +282,43 @@ class Select:
     span: Span = NO_SPAN
 
 
+@dataclass(frozen=True, slots=True)
+class ArrayLit:
+    """CityEngine's array initialization ``[a, b ; c, d]``: ``rows`` separated by ``;``, each the values
+    separated by ``,``. A value may be an array (``Range`` too): it is concatenated in place, so
+    ``[0, [1, 2]]`` is ``[0, 1, 2]`` and ``[a ; b]`` stacks the rows of ``a`` over those of ``b``."""
+
+    #: of one element type, scalars or arrays (``passes.types.type_of``)
+    rows: tuple[tuple[Expr, ...], ...] = child()
+    span: Span = NO_SPAN
+
+
+@dataclass(frozen=True, slots=True)
+class Range:
+    """CityEngine's colon operator ``base : step : limit`` inside brackets: the numbers base, base + step,
+    ... up to ``limit`` (included), as a 1-row array; empty when ``step`` goes away from ``limit``."""
+
+    base: Expr = child(Type.NUM, "the start of a range")
+    step: Expr = child(Type.NUM, "the step of a range")
+    limit: Expr = child(Type.NUM, "the end of a range")
+    span: Span = NO_SPAN
+
+
+@dataclass(frozen=True, slots=True)
+class Index:
+    """CityEngine's index operator ``a[i]`` (linear, row by row) and ``a[i, j]`` (row, column). An index
+    that is an array selects several elements (bool arrays: where true) and gives an array shaped like
+    it; an index out of range gives the element type's default (0, false, "")."""
+
+    array: Expr = child()  # an array (``passes.types.type_of``)
+    #: numbers or arrays of numbers or bools (``passes.types.type_of``)
+    index: Expr = child()
+    column: Expr | None = child(default=None)
+    span: Span = NO_SPAN
+
+
 Expr = (Num | Str | Bool | Name | Param | AttrRef | ScopeRef | Unary | Binary | Call | Select | ContextRef
-        | Occlusion)
+        | Occlusion | ArrayLit | Range | Index)
 
 #: Built-in functions: name -> (min args, max args, result type). Argument types are numbers.
 FUNCTIONS: dict[str, tuple[int, int, Type]] = {
@@ -292,7 +350,20 @@ FUNCTIONS: dict[str, tuple[int, int, Type]] = {
     "geometry.nVertices": (0, 0, Type.NUM),
     "geometry.nFaces": (0, 0, Type.NUM),
     "fileRandom": (0, 0, Type.NUM),
+    # CityEngine's array functions: their argument types, and some result types, depend on the arguments'
+    # (``passes.types``); the type here is that of ``size``, ``nRows``, ``nColumns`` and ``findFirst``
+    "size": (1, 1, Type.NUM),
+    "nRows": (1, 1, Type.NUM),
+    "nColumns": (1, 1, Type.NUM),
+    "findFirst": (2, 3, Type.NUM),
+    "transpose": (1, 1, Type.UNKNOWN),
+    "sortIndices": (1, 1, Type.NUMS),
+    "sortRowIndices": (1, 1, Type.NUMS),
+    "isNull": (1, 1, Type.BOOL),
 }
+ARRAY_FUNCTIONS = frozenset({"size", "nRows", "nColumns", "findFirst", "transpose", "sortIndices",
+                             "sortRowIndices", "isNull"})
+
 #: CityEngine shape attributes that ``set`` changes for a shape and its successors (not declared attrs).
 SHAPE_ATTRIBUTES: dict[str, Type] = {"trim.vertical": Type.BOOL}
 #: Functions that take strings or any type (their argument types are checked by ``passes.types``).
@@ -556,8 +627,8 @@ class SetAttr:
 class Report:
     """CityEngine ``report(key, value)``: summed per lot (count, sum, mean, min, max) beside the output."""
 
-    key: Expr = child()  # any type: its text is the key
-    value: Expr = child()  # any type: numbers are summed, other values counted
+    key: Expr = child(what="a report key")  # any type: its text is the key
+    value: Expr = child(what="a reported value")  # any type: numbers are summed, other values counted
     span: Span = NO_SPAN
 
 

@@ -47,6 +47,10 @@ _EXPR_FORMATS = {
     ir.Occlusion: _occlusion,
     ir.ContextRef: lambda e: e.name,
     ir.Select: lambda e: f"({print_expr(e.cond)} ? {print_expr(e.then)} : {print_expr(e.other)})",
+    ir.ArrayLit: lambda e: f"[{' ; '.join(_list(row) for row in e.rows)}]",
+    ir.Range: lambda e: f"[{print_expr(e.base)}:{print_expr(e.step)}:{print_expr(e.limit)}]",
+    ir.Index: lambda e: f"{print_expr(e.array)}[{print_expr(e.index)}"
+                        f"{'' if e.column is None else ', ' + print_expr(e.column)}]",
 }
 
 

@@ -353,10 +353,22 @@ class Lowering(OperationLowering, LoweringBase):
             return ir.placeholder(span)
         return ir.Occlusion(kind, target or "all", label.value if label is not None else None, span)
 
-    def array(self, meta, *items):
-        self.unsupported("arrays", self.span(meta))
-        return ir.placeholder(self.span(meta))
+    def array(self, meta, *rows):
+        """``[a, b ; c, d]``: an array literal; ``[base:limit]`` alone is its range."""
+        if len(rows) == 1 and len(rows[0]) == 1 and isinstance(rows[0][0], ir.Range):
+            return rows[0][0]
+        return ir.ArrayLit(tuple(rows), self.span(meta))
 
-    def index(self, meta, array, index):
-        self.unsupported("array indexing", self.span(meta))
-        return ir.placeholder(self.span(meta))
+    def array_row(self, meta, *items):
+        return tuple(self.expr(i) for i in items)
+
+    def range(self, meta, base, second, third):
+        base, second = self.expr(base), self.expr(second)
+        if third is None:  # base : limit
+            return ir.Range(base, ir.Num(1.0, self.span(meta)), second, self.span(meta))
+        return ir.Range(base, second, self.expr(third), self.span(meta))
+
+    def index(self, meta, array, index, column):
+        """``a[i]`` and ``a[i, j]``; an index may be an array or a range (``a[1:3]``)."""
+        return ir.Index(self.expr(array), self.expr(index), None if column is None else self.expr(column),
+                        self.span(meta))

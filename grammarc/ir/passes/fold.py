@@ -1,7 +1,9 @@
 """Constant folding: operators and pure functions on constant operands become constants.
 
 Assumes: names resolved and types checked. Guarantees: no ``Unary``, ``Binary`` or non-random ``Call``
-has only constant operands. Attributes stay references (a lot may override them); ``rand`` stays a call.
+has only constant operands. Attributes stay references (a lot may override them); ``rand`` stays a call. Arrays are not folded:
+CityEngine's array literals, indexing and array functions (``ir.ARRAY_FUNCTIONS``) are evaluated by the
+backend, on constants as on anything else.
 A constant division by zero is an error at its span.
 """
 

@@ -36,7 +36,11 @@ def infer_types(module: ir.Module, diags: Diagnostics) -> ir.Module:
         for node in iter_nodes(rule):
             for expr, want, what in _wanted(node, attr_types, param_types):
                 if want is not None:
-                    _expect(expr, want, what, attr_types, params, diags)
+                    got = _expect(expr, want, what, attr_types, params, diags)
+                else:  # not checked here, but an array where the backend takes a value is refused
+                    got = type_of(expr, attr_types, params, Diagnostics())
+                if got.is_array and (want is None or want.is_array):
+                    diags.error("unsupported", f"unsupported: an array as {what}", expr.span)
     return replace(module, attrs=tuple(attrs), param_types=tuple(sorted(param_types.items())))
 
 
@@ -165,6 +169,12 @@ def _binary(expr: ir.Binary, got: list[ir.Type], diags: Diagnostics) -> ir.Type:
     left, right = got
     if T.UNKNOWN in (left, right):
         return T.BOOL if expr.op in ir.COMPARE_OPS | ir.LOGIC_OPS else T.UNKNOWN
+    if left.is_array or right.is_array:
+        # CityEngine compares whole arrays with `==` and `!=`; its other operators on arrays are dotted
+        if expr.op in ("==", "!=") and left is right:
+            return T.BOOL
+        diags.error("type", f"`{expr.op}` cannot combine a {left.value} and a {right.value}", expr.span)
+        return T.UNKNOWN
     if expr.op in ir.LOGIC_OPS:
         ok, result = left is T.BOOL and right is T.BOOL, T.BOOL
     elif expr.op in ("==", "!="):
@@ -183,11 +193,72 @@ def _binary(expr: ir.Binary, got: list[ir.Type], diags: Diagnostics) -> ir.Type:
     return result
 
 
+def _array(expr: ir.ArrayLit, got: list[ir.Type], diags: Diagnostics) -> ir.Type:
+    """The values of an array literal, scalars or arrays, share one element type."""
+    elements = {t.element for t in got if t is not T.UNKNOWN}
+    if len(elements) > 1:
+        names = " and a ".join(sorted(t.value for t in elements))
+        diags.error("type", f"the values of an array are a {names}", expr.span)
+        return T.UNKNOWN
+    return elements.pop().array if elements else T.UNKNOWN
+
+
+def _index(expr: ir.Index, got: list[ir.Type], diags: Diagnostics) -> ir.Type:
+    """An element for number indices, an array when an index is an array (of numbers or bools)."""
+    array, *indices = got
+    if array is not T.UNKNOWN and not array.is_array:
+        diags.error("type", f"only an array can be indexed, got a {array.value}", expr.array.span)
+        return T.UNKNOWN
+    for t, e in zip(indices, [expr.index, expr.column]):
+        if t not in (T.NUM, T.NUMS, T.BOOLS, T.UNKNOWN):
+            diags.error("type", f"an index must be a num, a num[] or a bool[], got a {t.value}", e.span)
+            return T.UNKNOWN
+    if array is T.UNKNOWN:
+        return T.UNKNOWN
+    return array if any(t.is_array for t in indices) else array.element
+
+
+#: What each array function takes: a predicate of its first argument's type, and the noun of the error.
+_ARRAY_ARGUMENT = {
+    "sortIndices": (lambda t: t in (T.NUMS, T.STRS), "a num[] or a str[]"),
+    "sortRowIndices": (lambda t: t in (T.NUMS, T.STRS), "a num[] or a str[]"),
+    "isNull": (lambda t: t in (T.NUM, T.STR), "a num or a str"),
+}
+
+
+def _call(expr: ir.Call, got: list[ir.Type], diags: Diagnostics) -> ir.Type:
+    if expr.func not in ir.ARRAY_FUNCTIONS:
+        return ir.CONVERSIONS.get(expr.func) or ir.FUNCTIONS[expr.func][2]
+    low, high, result = ir.FUNCTIONS[expr.func]
+    if not low <= len(got) <= high:
+        want = str(low) if low == high else f"{low} or {high}"
+        diags.error("arity", f"`{expr.func}` takes {want} arguments, got {len(got)}", expr.span)
+        return T.UNKNOWN
+    first = got[0]
+    ok, noun = _ARRAY_ARGUMENT.get(expr.func, (lambda t: t.is_array, "an array"))
+    if first is not T.UNKNOWN and not ok(first):
+        diags.error("type", f"the argument of `{expr.func}` must be {noun}, got a {first.value}",
+                    expr.args[0].span)
+        return T.UNKNOWN
+    if expr.func == "findFirst":
+        value = got[1]
+        if T.UNKNOWN not in (first, value) and value is not first.element:
+            diags.error("type", f"`findFirst` looks for a {first.element.value} in a {first.value}, "
+                        f"got a {value.value}", expr.args[1].span)
+        if len(got) == 3 and got[2] not in (T.NUM, T.UNKNOWN):
+            diags.error("type", f"the tolerance of `findFirst` must be a num, got a {got[2].value}",
+                        expr.args[2].span)
+    return first if expr.func == "transpose" else result
+
+
 #: The types of expressions with children, from the children's types.
 _RESULTS = {
     ir.Occlusion: lambda e, got, diags: T.STR if e.kind == "occ" else T.BOOL,  # inside, overlaps, touches, visible
     ir.Select: _select,
-    ir.Call: lambda e, got, diags: ir.CONVERSIONS.get(e.func) or ir.FUNCTIONS[e.func][2],
+    ir.Call: _call,
+    ir.ArrayLit: _array,
+    ir.Range: lambda e, got, diags: T.NUMS,
+    ir.Index: _index,
     ir.Unary: lambda e, got, diags: ir.UNARY_TYPES[e.op],  # the type it takes
     ir.Binary: _binary,
 }
