@@ -76,9 +76,14 @@ def evaluate(expr: ir.Expr, env: Env):
         return _scope_field(expr.field, env)
     if isinstance(expr, ir.Unary):
         value = evaluate(expr.operand, env)
+        if isinstance(value, Arrays):  # `.-a`, `.!a`
+            values = np.logical_not(value.values) if expr.op == ".!" else np.negative(value.values)
+            return Arrays(values, value.offsets, value.columns)
         return np.logical_not(value) if expr.op == "!" else np.negative(value)
     if isinstance(expr, ir.Binary):
         left, right = evaluate(expr.left, env), evaluate(expr.right, env)
+        if expr.op.startswith("."):
+            return _elementwise(expr, left, right, env)
         if expr.op == "&&":
             return np.logical_and(left, right)
         if expr.op == "||":
@@ -150,6 +155,41 @@ def _index(expr: ir.Index, env: Env):
     return arrays.cell(array, index, column, default)
 
 
+def _elementwise(expr: ir.Binary, left, right, env: Env) -> Arrays:
+    """``a .+ b``, ``a .< b``...: the operator on each element of an array and the element at the same
+    place of the other array (of equal dimensions) or the shape's scalar; shaped as the array."""
+    shape = left if isinstance(left, Arrays) else right
+    owner = shape.owner()
+    bad = np.zeros(len(shape), dtype=bool)
+
+    def elements(value):
+        nonlocal bad
+        if not isinstance(value, Arrays):
+            return value if np.ndim(value) == 0 else np.asarray(value)[owner]
+        bad |= (value.sizes != shape.sizes) | (value.columns != shape.columns)
+        return value.values[np.where(bad[owner], 0, value.offsets[:-1][owner] + shape.position())] \
+            if len(value.values) else value.values
+    a, b = elements(left), elements(right)
+    if bad.any():
+        raise LotFailure(f"`{expr.op}` on arrays of different dimensions at {expr.span}",
+                         np.unique(env.shapes.lot[bad]))
+    op = expr.op[1:]
+    if op == "&&" or op == "||":
+        values = (np.logical_and if op == "&&" else np.logical_or)(a, b)
+    elif op == "+" and (_is_string(a) or _is_string(b)):
+        values = concatenate(a, b, env.plan.strings)
+    elif op in _COMPARE:
+        if op not in ("==", "!=") and _is_string(a):  # strings in order of their text
+            ranks = _string_ranks(env)
+            a, b = ranks[a], ranks[b]
+        values = _COMPARE[op](a, b)
+    else:
+        with np.errstate(divide="ignore", invalid="ignore"):
+            values = _ARITH[op](np.asarray(a, dtype=np.float64), b)
+    values = np.broadcast_to(values, owner.shape) if np.ndim(values) == 0 else values
+    return Arrays(np.asarray(values), shape.offsets, shape.columns)
+
+
 _ARRAY_EXPRESSIONS = {ir.ArrayLit: _array_literal, ir.Range: _colon, ir.Index: _index}
 
 
@@ -211,7 +251,11 @@ def concatenate(left, right, strings) -> np.ndarray | int:
         return strings.intern(text)
     pairs = np.stack([a.astype(np.float64), b.astype(np.float64)], axis=1)
     distinct, inverse = np.unique(pairs, axis=0, return_inverse=True)
-    ids = np.array([strings.intern(format_value(x, left_str, names) + format_value(y, right_str, names))
+    # the pairs are numbers: flags get their type back, to print as true/false
+    as_left = bool if a.dtype == np.bool_ else float
+    as_right = bool if b.dtype == np.bool_ else float
+    ids = np.array([strings.intern(format_value(as_left(x), left_str, names)
+                                   + format_value(as_right(y), right_str, names))
                     for x, y in distinct], dtype=np.int32)
     return ids[inverse.reshape(-1)]
 

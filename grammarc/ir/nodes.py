@@ -198,17 +198,18 @@ class ScopeRef:
 
 
 #: Unary operators and the type each takes and gives.
-UNARY_TYPES = {"-": Type.NUM, "!": Type.BOOL}
+UNARY_TYPES = {"-": Type.NUM, "!": Type.BOOL, ".-": Type.NUMS, ".!": Type.BOOLS}
 
 
 @dataclass(frozen=True, slots=True)
 class Unary:
-    op: str  # "-", "!"
+    op: str  # "-", "!", and on arrays ".-", ".!"
     operand: Expr = child(lambda e: UNARY_TYPES[e.op], lambda e: f"the operand of `{e.op}`")
     span: Span = NO_SPAN
 
 
-#: Binary operators by category; the category decides the result type.
+#: Binary operators by category; the category decides the result type. CityEngine's element-wise
+#: operators on arrays are these with a dot before them (``.+``, ``.<``, ``.&&``).
 COMPARE_OPS = frozenset({"<", "<=", ">", ">=", "==", "!="})
 LOGIC_OPS = frozenset({"&&", "||"})
 

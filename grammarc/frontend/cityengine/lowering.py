@@ -353,6 +353,12 @@ class Lowering(OperationLowering, LoweringBase):
             return ir.placeholder(span)
         return ir.Occlusion(kind, target or "all", label.value if label is not None else None, span)
 
+    def elementwise_unary(self, meta, op, operand):
+        """``.-a``, ``.+a``, ``.!a`` on arrays (``.+a`` is ``a``)."""
+        if str(op) == ".+":
+            return self.expr(operand)
+        return ir.Unary(str(op), self.expr(operand), self.span(meta))
+
     def array(self, meta, *rows):
         """``[a, b ; c, d]``: an array literal; ``[base:limit]`` alone is its range."""
         if len(rows) == 1 and len(rows[0]) == 1 and isinstance(rows[0][0], ir.Range):

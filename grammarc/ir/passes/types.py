@@ -169,6 +169,8 @@ def _binary(expr: ir.Binary, got: list[ir.Type], diags: Diagnostics) -> ir.Type:
     left, right = got
     if T.UNKNOWN in (left, right):
         return T.BOOL if expr.op in ir.COMPARE_OPS | ir.LOGIC_OPS else T.UNKNOWN
+    if expr.op.startswith("."):
+        return _elementwise(expr, left, right, diags)
     if left.is_array or right.is_array:
         # CityEngine compares whole arrays with `==` and `!=`; its other operators on arrays are dotted
         if expr.op in ("==", "!=") and left is right:
@@ -188,6 +190,25 @@ def _binary(expr: ir.Binary, got: list[ir.Type], diags: Diagnostics) -> ir.Type:
     else:
         ok, result = left is T.NUM and right is T.NUM, T.NUM
     if not ok:
+        diags.error("type", f"`{expr.op}` cannot combine a {left.value} and a {right.value}", expr.span)
+        return T.UNKNOWN
+    return result
+
+
+def _elementwise(expr: ir.Binary, left: ir.Type, right: ir.Type, diags: Diagnostics) -> ir.Type:
+    """CityEngine's element-wise operators: an array and an array or a scalar, element by element."""
+    op, a, b = expr.op[1:], left.element, right.element
+    if op in ir.LOGIC_OPS:
+        ok, result = a is b is T.BOOL, T.BOOLS
+    elif op in ("==", "!="):
+        ok, result = a is b, T.BOOLS
+    elif op in ir.COMPARE_OPS:
+        ok, result = a is b and a in (T.NUM, T.STR), T.BOOLS
+    elif op == "+" and T.STR in (a, b):
+        ok, result = True, T.STRS
+    else:
+        ok, result = a is b is T.NUM, T.NUMS
+    if not ok or not (left.is_array or right.is_array):
         diags.error("type", f"`{expr.op}` cannot combine a {left.value} and a {right.value}", expr.span)
         return T.UNKNOWN
     return result
