@@ -211,3 +211,55 @@ def test_a_new_operation_is_checked_from_its_declarations_alone():
 
     where = Span("g.cga", 1, 7, 1, 10)
     assert _type_errors(Twist(ir.Str("x", where))) == [(where, "a twist angle must be a num, got a str")]
+
+
+# --------------------------------------------------------------------------------------------------- arrays
+
+
+def cityengine_errors(text: str) -> list[tuple[int, int, str]]:
+    diags = Diagnostics()
+    run_passes(parse_source('version "2022.0"\n' + text, FILE, diags, "cityengine"), diags, check=True,
+               stop_after="types")
+    return [(d.span.line - 1, d.span.col, d.message) for d in diags if d.is_error]
+
+
+def attr_types(text: str) -> dict[str, ir.Type]:
+    diags = Diagnostics()
+    module = run_passes(parse_source('version "2022.0"\n' + text + "\nLot --> X\n", FILE, diags, "cityengine"),
+                        diags, check=True, stop_after="types")
+    assert not diags.has_errors
+    return {a.name: a.type for a in module.attrs}
+
+
+def test_array_types_follow_their_elements_and_indices():
+    got = attr_types('attr a = [1, 2 ; 3, 4]\nattr s = ["x", "y"]\nattr b = [true]\nattr r = [0 : 3]\n'
+                     'attr i = a[1, 0]\nattr j = a[[0, 1]]\nattr k = s[a .> 2]\nattr n = size(s)\n'
+                     'attr t = transpose(s)\nattr o = sortIndices(s)\nattr e = a == [1]\nattr w = s .+ 1\n'
+                     'attr c = case n > 1 : a else : [0]\nattr f = findFirst(b, true)\nattr z = isNull("x")')
+    assert got == {"a": T.NUMS, "s": T.STRS, "b": T.BOOLS, "r": T.NUMS, "i": T.NUM, "j": T.NUMS, "k": T.STRS,
+                   "n": T.NUM, "t": T.STRS, "o": T.NUMS, "e": T.BOOL, "w": T.STRS, "c": T.NUMS, "f": T.NUM,
+                   "z": T.BOOL}
+
+
+@pytest.mark.parametrize("text, expected", [
+    ('attr a = [1, "x"]', [(1, 10, "the values of an array are a num and a str")]),
+    ('attr a = [1, ["x"]]', [(1, 10, "the values of an array are a num and a str")]),
+    ("attr a = 3\nattr b = a[0]", [(2, 10, "only an array can be indexed, got a num")]),
+    ('attr a = [1]\nattr b = a["x"]', [(2, 12, "an index must be a num, a num[] or a bool[], got a str")]),
+    ('attr a = [1]\nattr b = a + 1', [(2, 12, "`+` cannot combine a num[] and a num")]),
+    ('attr a = [1]\nattr b = a < [2]', [(2, 12, "`<` cannot combine a num[] and a num[]")]),
+    ('attr a = [1]\nattr b = a == ["x"]', [(2, 12, "`==` cannot combine a num[] and a str[]")]),
+    ("attr b = 1 .+ 2", [(1, 12, "`.+` cannot combine a num and a num")]),
+    ("attr b = [true] .+ [1]", [(1, 17, "`.+` cannot combine a bool[] and a num[]")]),
+    ('attr b = [true] .< [false]', [(1, 17, "`.<` cannot combine a bool[] and a bool[]")]),
+    ("attr b = size(3)", [(1, 15, "the argument of `size` must be an array, got a num")]),
+    ("attr b = sortIndices([true])",
+     [(1, 22, "the argument of `sortIndices` must be a num[] or a str[], got a bool[]")]),
+    ('attr b = findFirst([1], "x")', [(1, 25, "`findFirst` looks for a num in a num[], got a str")]),
+    ("attr b = nRows([1], [2])", [(1, 10, "`nRows` takes 1 arguments, got 2")]),
+    ("attr b = [0 : true]", [(1, 15, "the end of a range must be a num, got a bool")]),
+    ("Lot --> extrude([1, 2])", [(1, 17, "a height must be a num, got a num[]")]),
+    ("attr h = [1]\nLot --> set(h, [2]) X", [(2, 16, "unsupported: an array as the value of `h`")]),
+])
+def test_array_type_errors(text, expected):
+    assert cityengine_errors(text) == expected

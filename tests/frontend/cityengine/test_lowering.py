@@ -145,6 +145,24 @@ def test_string_concatenation():
     assert module.attrs[1].type is ir.Type.STR
 
 
+def test_arrays_lower_to_literals_ranges_and_indices():
+    module = module_of(VERSION + 'const a = [1, 2 ;\n           3, 4]\nconst r = [0 : 2 : size(a) - 1]\n'
+                       'attr b = a[a .> 1 .&& .!(a .== 4)][0] + a[1, [0, 1]][1] + a[1:2][0]\n'
+                       'attr s = ["x", "y"] .+ "z"\nLot --> extrude(b) [ s(1, 1, 1) A ] B\n')
+    printed = {a.name: print_expr(a.default) for a in module.attrs}
+    assert printed == {
+        "a": "[1, 2 ; 3, 4]",
+        "r": "[0:2:(size(@a) - 1)]",
+        "b": "((@a[((@a .> 1) .&& .!(@a .== 4))][0] + @a[1, [0, 1]][1]) + @a[[1:1:2]][0])",
+        "s": '(["x", "y"] .+ "z")',
+    }
+
+
+def test_brackets_in_bodies_are_still_push_and_pop():
+    assert body_of(VERSION + "attr a = [2, 3]\nLot --> [ t(a[0], 0, 0) A ] [ B ] C\n") == \
+        "[ T(@a[0], 0, 0) A ] [ B ] C"
+
+
 def test_context_attributes_lower_to_context_refs():
     module = module_of(VERSION + 'Lot --> comp(f){ side : Side }\nSide --> report("i", comp.index) '
                        'report("n", comp.total) report("s", comp.sel == "left") split(x){ 1 : Part }*\n'
