@@ -128,7 +128,10 @@ class _Inliner:
             if isinstance(e, ir.Name) and e.name not in params and e.name not in self.attrs \
                     and e.name in self.functions and not self.functions[e.name].params:
                 return self.call(self.functions[e.name], (), e.span, calling)
-            if isinstance(e, ir.Call) and e.func not in ir.FUNCTIONS and e.func not in ir.CONVERSIONS:
+            # a function of the file's own wins over an array built-in of its name (ESRI.lib's string
+            # `findFirst(text, match)` predates the array one)
+            if isinstance(e, ir.Call) and (e.func in ir.ARRAY_FUNCTIONS and e.func in self.functions
+                                           or e.func not in ir.FUNCTIONS and e.func not in ir.CONVERSIONS):
                 fn = self.functions.get(e.func)
                 if fn is None:
                     self.diags.error("unknown-function", f"unknown function `{e.func}`"

@@ -249,6 +249,10 @@ _ARRAY_ARGUMENT = {
 
 def _call(expr: ir.Call, got: list[ir.Type], diags: Diagnostics) -> ir.Type:
     if expr.func not in ir.ARRAY_FUNCTIONS:
+        for t, arg in zip(got, expr.args):
+            if t.is_array and expr.func in ir.CONVERSIONS:  # they take any scalar, the others numbers
+                diags.error("type", f"`{expr.func}` takes no array, got a {t.value}", arg.span)
+                return T.UNKNOWN
         return ir.CONVERSIONS.get(expr.func) or ir.FUNCTIONS[expr.func][2]
     low, high, result = ir.FUNCTIONS[expr.func]
     if not low <= len(got) <= high:
@@ -266,7 +270,10 @@ def _call(expr: ir.Call, got: list[ir.Type], diags: Diagnostics) -> ir.Type:
         if T.UNKNOWN not in (first, value) and value is not first.element:
             diags.error("type", f"`findFirst` looks for a {first.element.value} in a {first.value}, "
                         f"got a {value.value}", expr.args[1].span)
-        if len(got) == 3 and got[2] not in (T.NUM, T.UNKNOWN):
+        if len(got) == 3 and first not in (T.NUMS, T.UNKNOWN):
+            diags.error("type", f"a tolerance of `findFirst` is for a num[], not a {first.value}",
+                        expr.args[2].span)
+        elif len(got) == 3 and got[2] not in (T.NUM, T.UNKNOWN):
             diags.error("type", f"the tolerance of `findFirst` must be a num, got a {got[2].value}",
                         expr.args[2].span)
     return first if expr.func == "transpose" else result

@@ -131,3 +131,9 @@ Single(x) --> A
         "Pipe/3": "Pipe/3(a, b, c) ~> S($a, $b, $c) Pipe. : 1",
         "Single": "Single(x) ~> A : 1",
     }
+
+
+def test_a_function_of_the_file_wins_over_the_array_builtin_of_its_name():
+    """ESRI.lib's string utilities define `findFirst(text, match)`: the file's function is called."""
+    assert body_of(VERSION + 'findFirst(text, match) = len(text) - len(match)\n'
+                   'Lot --> extrude(findFirst("abc", "b")) X\n') == 'extrude((len("abc") - len("b"))) X'
