@@ -139,21 +139,23 @@ def _arrays_from_lots(attr: ir.AttrDecl, values: np.ndarray, column: Arrays, str
     given = ~np.isnan(values) if values.dtype != object else values != None  # elementwise
     if not given.any():
         return column
-    texts = [str(v) if values.dtype == object else json.dumps(float(v)) for v in values[given]]
-    distinct, inverse = np.unique(np.array(texts, dtype=object), return_inverse=True)
-    parsed = [_parse_array(text, attr.type, strings) for text in distinct]
-    failed = np.array([p is None for p in parsed])[inverse.reshape(-1)]
+    raw = values[given]
+    distinct, inverse = np.unique(raw.astype(str) if raw.dtype == object else raw, return_inverse=True)
+    inverse = inverse.reshape(-1)
+    texts = [str(v) if values.dtype == object else json.dumps(float(v)) for v in distinct]
+    parsed = [_parse_array(text, attr.type, strings) for text in texts]
+    failed = np.array([p is None for p in parsed])[inverse]
     if failed.any():
-        lots = np.flatnonzero(given)[failed]
-        raise LotFailure(f"attribute `{attr.name}` is {texts[int(np.flatnonzero(failed)[0])]}, not a "
-                         f"{attr.type.value}", lots)
+        first = texts[inverse[np.flatnonzero(failed)[0]]]
+        raise LotFailure(f"attribute `{attr.name}` is {first}, not a {attr.type.value}",
+                         np.flatnonzero(given)[failed])
     dtype = column.values.dtype
     table = Arrays(np.concatenate([column.values, *(np.asarray(p[0], dtype=dtype) for p in parsed)]),
                    np.concatenate([column.offsets, column.offsets[-1] + np.cumsum([len(p[0]) for p in parsed],
                                                                                   dtype=np.int64)]),
                    np.concatenate([column.columns, np.array([p[1] for p in parsed], dtype=np.int64)]))
     which = np.arange(n)
-    which[given] = n + inverse.reshape(-1)
+    which[given] = n + inverse
     return table.take(which)
 
 
