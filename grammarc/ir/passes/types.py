@@ -5,6 +5,10 @@ operators get operands of the types they take; each successor ``sym(args)`` of a
 as many arguments as its rules take parameters, and the rules of one symbol agree on that number.
 Parameter types are inferred from the call sites (a parameter never passed a value is a number); the
 module comes back with ``param_types`` and typed ``attrs``.
+
+CityEngine's arrays (``num[]``, ``bool[]``, ``str[]``) are values of attributes, constants and
+expressions; an operation takes none, and an array passed to a rule's parameter or reported is an
+``unsupported`` error at its span (the derivation carries no array per shape from rule to rule).
 """
 
 from __future__ import annotations
