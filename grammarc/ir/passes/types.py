@@ -179,6 +179,11 @@ def _binary(expr: ir.Binary, got: list[ir.Type], diags: Diagnostics) -> ir.Type:
         # CityEngine compares whole arrays with `==` and `!=`; its other operators on arrays are dotted
         if expr.op in ("==", "!=") and left is right:
             return T.BOOL
+        if expr.op in ir.COMPARE_OPS and left is right or expr.op == "+" and T.STR in (left, right):
+            # CityEngine orders whole arrays and writes them into strings; grammarc does not (yet)
+            what = "the order of whole arrays" if expr.op != "+" else "an array written into a string"
+            diags.error("unsupported", f"unsupported: {what} (`{expr.op}`)", expr.span)
+            return T.UNKNOWN
         diags.error("type", f"`{expr.op}` cannot combine a {left.value} and a {right.value}", expr.span)
         return T.UNKNOWN
     if expr.op in ir.LOGIC_OPS:
