@@ -92,10 +92,6 @@ def from_scalars(value, n: int, dtype) -> Arrays:
                   np.ones(n, dtype=np.int64))
 
 
-def empty(n: int, dtype) -> Arrays:
-    return Arrays(np.zeros(0, dtype=dtype), np.zeros(n + 1, dtype=np.int64), np.zeros(n, dtype=np.int64))
-
-
 def concatenate_row(pieces: list[Arrays]) -> tuple[Arrays, np.ndarray]:
     """``[a, b, ...]``: the pieces side by side, per shape; empty pieces are left out.
 
