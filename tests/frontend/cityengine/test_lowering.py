@@ -172,7 +172,6 @@ def _exprs(e):
     ("Lot --> extrude(geometry.du(0, unitSpace)) A", "geometry.du()", "geometry"),
     ("Lot --> extrude(heights[0]) A", "array indexing", "heights"),
     ("attr heights = [3, 4, 5]", "arrays", "["),
-    ('import facade : "facade.cga" (Facade, Wall)', "import with a list of names", "import"),
 ])
 def test_unsupported_construct_is_named_at_its_span(line, name, at):
     assert_unsupported_at(line, name, at)
