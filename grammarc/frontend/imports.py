@@ -94,6 +94,10 @@ def find_roots(grammar: Path, workspace: Path | None = None) -> Roots:
     return Roots(home, project, tuple(dict.fromkeys(workspaces)))
 
 
+def _is_project(folder: Path) -> bool:
+    return (folder / ".project").is_file() or (folder / "rules").is_dir() or (folder / "assets").is_dir()
+
+
 def _project_of(folder: Path) -> Path | None:
     for depth, candidate in enumerate((folder, *folder.parents)):
         if depth > _PROJECT_DEPTH:
@@ -119,6 +123,9 @@ def resolve_import(name: str, importing: Path, roots: Roots) -> Path:
                             "workspace path /Project/rules/...")
     if pure.is_absolute():
         searched = roots.folders
+        named = [w / pure.parts[1] for w in roots.workspaces if len(pure.parts) > 2]
+        if any(p.is_dir() and not _is_project(p) for p in named):
+            raise ImportRefused(f"`{name}`: `/{pure.parts[1]}` is not a CityEngine project of the workspace")
     else:
         searched = (importing.parent, *filter(None, (roots.project,)))
     # each candidate is resolved (links followed) and kept only inside its own folder, and that folder is

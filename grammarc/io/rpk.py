@@ -6,6 +6,7 @@ A rule package is a 7-zip archive as CityEngine exports it::
     bin/Candler Building.cgb        compiled rules; the main one carries the start rule
     assets/facade/windows/x.obj     assets and textures (absent in packages without any)
     .resolvemap.xml                 workspace path -> path in the package
+    .ws/ESRI.lib/rules/x.cga        files of other projects of the workspace (in some packages)
 
 ``open_rpk`` extracts the archive to a temporary directory that lives as long as the returned
 ``RulePackage`` (use it as a context manager, or call ``close()``), so rule files and assets are plain
@@ -14,7 +15,9 @@ paths the compiler and the baker read as they read any other.
 Assets are resolved as CityEngine resolves a relative ``i("facade/windows/x.obj")`` of a rule file: first
 in the ``assets`` folder of the project the rule file is in, then in that project's root
 (CityEngine manual, "Asset and texture search"). ``RulePackage.asset_roots`` lists those folders in that
-order; a package is one project.
+order; a package is one project. Workspace paths (``/Project/assets/x.obj``, ``import x :
+"/ESRI.lib/rules/y.cga"``) are looked up in its ``.ws`` folder, else in the package itself (an export
+keeps a project's files at the package's root): ``RulePackage.workspace``, and ``frontend.imports``.
 
 py7zr is an optional dependency (the ``rpk`` extra), imported when a package is opened.
 """
@@ -93,6 +96,12 @@ class RulePackage:
     def asset_roots(self) -> tuple[Path, ...]:
         """Folders to resolve asset names in, in CityEngine's order: ``assets``, then the package root."""
         return (self.assets_root,) if self.assets_root == self.root else (self.assets_root, self.root)
+
+    @property
+    def workspace(self) -> Path:
+        """The package's workspace, its ``.ws`` folder (which may not exist): workspace paths are looked up
+        there and in the package, never in the folders around the extracted package."""
+        return self.root / ".ws"
 
     @property
     def closed(self) -> bool:
