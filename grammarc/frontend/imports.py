@@ -135,9 +135,13 @@ def resolve_import(name: str, importing: Path, roots: Roots) -> Path:
     found = locate(name, searched)
     if found is not None:
         return found[1]
-    where = ", ".join(str(r) for r in (roots.workspaces if pure.is_absolute() else searched)) or "no workspace"
-    if not pure.is_absolute() and not any(_inside((s.resolve() / pure).resolve(), s.resolve())
-                                          for s in searched):
+    if pure.is_absolute():
+        if not roots.workspaces:
+            raise ImportRefused(f"`{name}` is a workspace path and the grammar is in no CityEngine workspace "
+                                "(give the folder of its projects with --workspace)")
+        raise ImportRefused(f"`{name}` is not found in the workspace ({', '.join(map(str, roots.workspaces))})")
+    where = ", ".join(str(r) for r in searched)
+    if not any(_inside((s.resolve() / pure).resolve(), s.resolve()) for s in searched):
         raise ImportRefused(f"`{name}` leaves the grammar's folders ({where})")
     raise ImportRefused(f"`{name}` is not found in {where}")
 
@@ -191,6 +195,6 @@ def load_import(statement, file: str, path: Path | None, roots: Roots, importing
         return None
     pure = PurePosixPath(statement.path.replace("\\", "/"))
     display = statement.path if pure.is_absolute() else (PurePosixPath(file).parent / pure).as_posix()
-    if fallback is not None:
+    if fallback is not None and not any(d.message == encoding_warning(display) for d in diags):
         diags.warning("encoding", encoding_warning(display), statement.span)
     return display, text, target

@@ -31,8 +31,7 @@ def decode_grammar(data: bytes) -> tuple[str, str | None]:
     fallback : str or None
         ``"cp1252"`` when the bytes are not UTF-8, else None.
     """
-    if data.startswith(codecs.BOM_UTF8):
-        data = data[len(codecs.BOM_UTF8):]
+    data = data.removeprefix(codecs.BOM_UTF8)
     try:
         return data.decode("utf-8"), None
     except UnicodeDecodeError:
