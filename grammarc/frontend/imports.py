@@ -23,7 +23,7 @@ the project.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path, PurePosixPath
 
 from grammarc.diagnostics import Diagnostics
@@ -55,11 +55,14 @@ class Roots:
         The CityEngine project (or rule package) around the grammar.
     workspaces : tuple of Path
         Folders of projects, where workspace paths ``/Project/...`` are looked up.
+    imported_projects : dict of Path to None
+        The projects of the imported files, in the order met (filled by ``load_import``).
     """
 
     home: Path
     project: Path | None = None
     workspaces: tuple[Path, ...] = ()
+    imported_projects: dict[Path, None] = field(default_factory=dict)
 
     @property
     def folders(self) -> tuple[Path, ...]:
@@ -69,9 +72,13 @@ class Roots:
     def asset_roots(self, given: tuple[Path, ...] = ()) -> tuple[Path, ...]:
         """Where assets are resolved, in order: the grammar's folder (as grammarc always did), then as
         CityEngine does, the project's ``assets`` and its root, then the ``given`` folders (``--assets``,
-        a package's), then the workspaces."""
-        project = () if self.project is None else (self.project / "assets", self.project)
-        found = [p for p in (*project, *given, *self.workspaces) if p.is_dir()]
+        a package's), then the projects of imported files, then the workspaces.
+
+        CityEngine looks an asset up from the project of the rule file that inserts it; grammarc resolves
+        the names of a module at once, so an imported file's project comes after the grammar's own."""
+        own = () if self.project is None else (self.project / "assets", self.project)
+        imported = [folder for p in self.imported_projects for folder in (p / "assets", p)]
+        found = [p for p in (*own, *given, *imported, *self.workspaces) if p.is_dir()]
         seen = {self.home.resolve()}
         return (self.home, *[p for p in found if not (p.resolve() in seen or seen.add(p.resolve()))])
 
@@ -193,6 +200,9 @@ def load_import(statement, file: str, path: Path | None, roots: Roots, importing
     except ImportRefused as refused:
         diags.error("import", f"cannot import `{statement.path}`: {refused}", statement.span)
         return None
+    project = _project_of(target.parent)
+    if project is not None:
+        roots.imported_projects[project] = None
     pure = PurePosixPath(statement.path.replace("\\", "/"))
     display = statement.path if pure.is_absolute() else (PurePosixPath(file).parent / pure).as_posix()
     if fallback is not None and not any(d.message == encoding_warning(display) for d in diags):

@@ -123,15 +123,16 @@ def test_a_prefixed_leaf(tmp_path):
 def test_the_town_of_the_miniature_workspace():
     """Imports across projects by workspace paths, twice with different values, a rule of the town
     overriding the house's, a Windows-1252 file (warned once), a file with a BOM, and assets found by
-    project-absolute and project-relative paths: one asset per file."""
+    project-absolute and project-relative paths and from an imported file's project: one asset per file."""
     grammar = compile_grammar(TOWN)
     assert [w.message for w in grammar.warnings if w.code == "encoding"] == [
         "`/ESRI.lib/rules/facade.cga` is not UTF-8: read as Windows-1252 (save it as UTF-8 to silence this)"]
     assert attrs(grammar)["tall.height"] == "12" and attrs(grammar)["low.height"] == "4"
     assert attrs(grammar)["low.roofColor"] == "@townRoof"
     assert rules(grammar)["tall.Roof"].startswith("tall.Roof ~> color(@roofColor) Door")
-    assert rules(grammar)["low.Roof"] == "low.Roof ~> color(@low.roofColor) low.Roof. : 1"
-    assert grammar.assets == ("builtin:cube", "builtin:quad", "assets/door.obj", "Houses/assets/window.obj")
+    assert rules(grammar)["low.Roof"] == "low.Roof ~> color(@low.roofColor) low.Chimney : 1"
+    assert grammar.assets == ("builtin:cube", "builtin:quad", "assets/door.obj", "chimney.obj",
+                              "Houses/assets/window.obj")
     assert not [w for w in grammar.warnings if w.code == "asset"]
 
 
