@@ -11,7 +11,7 @@ refused without its contents ever reaching a message.
 Paths are resolved as CityEngine resolves them (CGA reference, "import" and "Asset search"):
 
 * ``"facade.cga"``, ``facade.cga`` (unquoted) or ``"sub/facade.cga"``: relative to the importing file's
-  folder, else to its project's root (``"rules/facade.cga"``);
+  folder, else to the root of its project (``"rules/facade.cga"``);
 * ``"/Project/rules/facade.cga"``: a workspace path, looked up in the workspace; in a rule package, whose
   export flattens the workspace, in the package (``.ws/Project/...`` or the package's own files, see
   ``grammarc.ir.asset_names.locate``).
@@ -133,8 +133,9 @@ def resolve_import(name: str, importing: Path, roots: Roots) -> Path:
         named = [w / pure.parts[1] for w in roots.workspaces if len(pure.parts) > 2]
         if any(p.is_dir() and not _is_project(p) for p in named):
             raise ImportRefused(f"`{name}`: `/{pure.parts[1]}` is not a CityEngine project of the workspace")
-    else:
-        searched = (importing.parent, *filter(None, (roots.project,)))
+    else:  # the importing file's folder, then its project's root
+        project = _project_of(importing.parent.resolve()) or roots.project
+        searched = (importing.parent, *filter(None, (project,)))
     # each candidate is resolved (links followed) and kept only inside its own folder, and that folder is
     # one of the roots
     allowed = tuple(r.resolve() for r in roots.folders)
