@@ -141,6 +141,8 @@ def _build(source: Path, display: str | None, grammar_path: Path, output, lots_p
     Path(output).parent.mkdir(parents=True, exist_ok=True)
     every = load_lots(grammar_path, Path(lots_path) if lots_path else None)
     lots = every if select is None else every.select(select)
+    if display is None:  # a rule file on disk: its CityEngine project's folders too, for a later render
+        recorded_roots = (*recorded_roots, *(r for r in grammar.asset_roots[1:] if r not in recorded_roots))
     meta = record_meta(grammar_path, grammar, plan, options, lots.source, recorded_roots)
     failed: list[BadLot] = []
     reports = Reports()

@@ -248,3 +248,15 @@ def test_imports_inside_a_rule_package_stay_inside_it(tmp_path):
             pytest.raises(GrammarError) as caught:
         compile_grammar(source, display=display, asset_roots=options.asset_roots, workspace=options.workspace)
     assert [d.code for d in caught.value.diagnostics if d.is_error] == ["import"] * 3
+
+
+def test_the_record_of_a_project_build_finds_its_assets_again(tmp_path):
+    """The record's meta names the project's folders: a later render loads the assets it inserted."""
+    from grammarc.build import build
+    from grammarc.io.npz import read_instances
+    from grammarc.model.assets import asset_library
+
+    build(TOWN, tmp_path / "town.npz")
+    record = read_instances(tmp_path / "town.npz")
+    library = asset_library(list(record["assets"]), record)
+    assert [library[i].n_polygons for i in range(2, 5)] == [2, 4, 1]  # door, chimney, window
