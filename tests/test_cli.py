@@ -163,7 +163,7 @@ def test_workspace_option_of_check_and_build(write, capsys, tmp_path):
     assert main(["check", str(grammar)]) == 2
     assert "is in no CityEngine workspace" in capsys.readouterr().err
     assert main(["check", "--workspace", str(workspace), str(grammar)]) == 0
-    assert "assets:    builtin:cube, builtin:quad, Houses/assets/window.obj" in capsys.readouterr().out
+    assert "assets:    builtin:cube, builtin:quad, chimney.obj, Houses/assets/window.obj" in capsys.readouterr().out
     out = tmp_path / "o.npz"
     assert main(["build", "--workspace", str(workspace), str(grammar), "--emit", str(out), "--quiet"]) == 0
     assert "Houses/assets/window.obj" in list(read_instances(out)["assets"])

@@ -33,6 +33,7 @@ from pathlib import Path, PurePosixPath
 from typing import TYPE_CHECKING
 
 from grammarc.errors import UsageError
+from grammarc.frontend.source import read_grammar_text
 
 if TYPE_CHECKING:
     from typing_extensions import Self
@@ -171,9 +172,10 @@ def start_rule_of(cga: str | os.PathLike) -> str | None:
     """The name of the rule after the first ``@StartRule`` annotation of a CGA file, or None.
 
     Comments are ignored (a commented-out ``// @StartRule`` does not count); further annotations between
-    ``@StartRule`` and the rule are skipped.
+    ``@StartRule`` and the rule are skipped. The file is read as the compiler reads it (UTF-8 with or
+    without a BOM, else Windows-1252).
     """
-    text = Path(cga).read_text(encoding="utf-8", errors="replace")
+    text, _ = read_grammar_text(cga)
     match = _START_RULE.search(_strip_comments(text))
     return match.group(1) if match else None
 
