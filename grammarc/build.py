@@ -64,6 +64,8 @@ class BuildOptions:
     dialect: str | None = None
     #: Chunks derived at once, in as many processes (``grammarc.workers``); the output does not depend on it.
     workers: int = 1
+    #: A CityEngine workspace (a folder of projects) for workspace paths ``/Project/...`` (``--workspace``).
+    workspace: Path | None = None
 
 
 @dataclass(frozen=True)
@@ -124,7 +126,7 @@ def grammar_source(path: Path, options: BuildOptions):
         inside = package.main_rule_file.relative_to(package.root).as_posix()
         yield package.main_rule_file, f"{path.name}/{inside}", replace(
             options, asset_roots=(*package.asset_roots, *options.asset_roots),
-            start=options.start or package.start_rule)
+            start=options.start or package.start_rule, workspace=options.workspace or package.workspace)
 
 
 def _build(source: Path, display: str | None, grammar_path: Path, output, lots_path,
@@ -132,13 +134,15 @@ def _build(source: Path, display: str | None, grammar_path: Path, output, lots_p
            output_options: OutputOptions, select: Sequence[str] | None,
            reports_to: Path | None) -> BuildResult:
     grammar = compile_grammar(source, start=options.start, asset_roots=options.asset_roots,
-                              dialect=options.dialect, display=display)
+                              dialect=options.dialect, display=display, workspace=options.workspace)
     plan = make_plan(grammar)
     check_overrides(grammar.module, options.attrs)
     writer_class = writer_for(output, replace(output_options, asset_roots=tuple(grammar.asset_roots)))
     Path(output).parent.mkdir(parents=True, exist_ok=True)
     every = load_lots(grammar_path, Path(lots_path) if lots_path else None)
     lots = every if select is None else every.select(select)
+    if display is None:  # a rule file on disk: its CityEngine project's folders too, for a later render
+        recorded_roots = (*recorded_roots, *(r for r in grammar.asset_roots[1:] if r not in recorded_roots))
     meta = record_meta(grammar_path, grammar, plan, options, lots.source, recorded_roots)
     failed: list[BadLot] = []
     reports = Reports()

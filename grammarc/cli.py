@@ -75,6 +75,7 @@ def _parser() -> argparse.ArgumentParser:
                        help=f"rule applications along one path (default {LIMITS.max_depth})")
     build.add_argument("--max-shapes", type=_positive, default=LIMITS.max_shapes, metavar="N",
                        help=f"shapes made from one lot (default {LIMITS.max_shapes:,})")
+    _workspace_option(build)
     build.add_argument("--assets", type=Path, action="append", default=[], metavar="DIR",
                        help="a further folder for I() assets (the grammar's folder comes first)")
     build.add_argument("--dialect", choices=("cga2006", "cityengine"),
@@ -120,6 +121,7 @@ def _parser() -> argparse.ArgumentParser:
     check.add_argument("grammar", type=Path)
     check.add_argument("--start", metavar="SYMBOL")
     check.add_argument("--dump-ir", action="store_true", help="print the IR after the passes")
+    _workspace_option(check)
     check.add_argument("--dialect", choices=("cga2006", "cityengine"),
                        help="the grammar's notation (default: detected from its text)")
     check.set_defaults(run=_check)
@@ -165,6 +167,13 @@ def _positive(text: str) -> int:
     return value
 
 
+def _workspace_option(command) -> None:
+    command.add_argument("--workspace", type=Path, metavar="DIR",
+                         help="a CityEngine workspace (a folder of projects) where workspace paths "
+                              "/Project/rules/x.cga and /Project/assets/x.obj are looked up (default: the "
+                              "folder holding the grammar's project)")
+
+
 def _warn(grammar) -> None:
     if grammar.warnings:
         print(render_all(list(grammar.warnings), grammar.sources), file=sys.stderr)
@@ -175,10 +184,10 @@ def _check(args) -> int:
     from grammarc.compiler import compile_grammar
     from grammarc.ir.printer import print_module
 
-    options = BuildOptions(start=args.start, dialect=args.dialect)
+    options = BuildOptions(start=args.start, dialect=args.dialect, workspace=args.workspace)
     with grammar_source(args.grammar, options) as (source, display, resolved):
         grammar = compile_grammar(source, start=resolved.start, dialect=resolved.dialect, display=display,
-                                  asset_roots=resolved.asset_roots)
+                                  asset_roots=resolved.asset_roots, workspace=resolved.workspace)
     _warn(grammar)
     graph = grammar.graph
     if args.dump_ir:
@@ -315,6 +324,7 @@ def _build(args) -> int:
         asset_roots=tuple(args.assets),
         dialect=args.dialect,
         workers=args.workers,
+        workspace=args.workspace,
     )
     bar = _ProgressBar() if not args.quiet else None
     try:

@@ -12,9 +12,11 @@ import hashlib
 from dataclasses import replace
 from pathlib import Path
 
-from grammarc.diagnostics import Diagnostics
+from grammarc.diagnostics import Diagnostics, Span
 from grammarc.errors import GrammarError, UsageError
+from grammarc.frontend.imports import find_roots
 from grammarc.frontend.parse import parse_source
+from grammarc.frontend.source import encoding_warning, read_grammar_text
 from grammarc.ir.pipeline import run_passes
 from grammarc.model.grammar import Grammar
 
@@ -23,24 +25,30 @@ __all__ = ["Grammar", "compile_grammar"]
 
 def compile_grammar(path: str | Path, *, text: str | None = None, start: str | None = None,
                     asset_roots: tuple[Path, ...] = (), dialect: str | None = None,
-                    display: str | None = None) -> Grammar:
+                    display: str | None = None, workspace: Path | None = None) -> Grammar:
     """Parse, check and analyse a grammar file; raise ``GrammarError`` listing every error.
 
-    ``start`` overrides the grammar's start symbol; assets are resolved in the grammar's folder, then in
-    ``asset_roots``. ``display`` names the file in diagnostics (a rule file inside a package:
-    ``candler.rpk/rules/x.cga``).
+    ``start`` overrides the grammar's start symbol; assets are resolved in the grammar's folder, its
+    CityEngine project (``assets``, then the project's root), then in ``asset_roots`` and the workspace
+    (``workspace``, a folder of CityEngine projects, or the folder holding the grammar's project), where
+    imports are looked up too (``frontend.imports``). ``display`` names the file in diagnostics (a rule
+    file inside a package: ``candler.rpk/rules/x.cga``). A file that is not UTF-8 is read as
+    Windows-1252, with a warning (``frontend.source``).
     """
     path = Path(path)
-    if text is None:
-        try:
-            text = path.read_text(encoding="utf-8")
-        except (OSError, UnicodeDecodeError) as error:
-            raise UsageError(f"cannot read grammar {path}: {error}") from None
     file = display or str(path)
     diags = Diagnostics()
+    if text is None:
+        try:
+            text, fallback = read_grammar_text(path)
+        except OSError as error:
+            raise UsageError(f"cannot read grammar {path}: {error.strerror or error}") from None
+        if fallback is not None:
+            diags.warning("encoding", encoding_warning(file), Span(file, 1, 1, 1, 1))
     sources = {file: text}
-    module = parse_source(text, file, diags, dialect, path=path, sources=sources)
-    module = replace(module, start=start or module.start, roots=(path.parent, *asset_roots))
+    roots = find_roots(path, workspace)
+    module = parse_source(text, file, diags, dialect, path=path, sources=sources, roots=roots)
+    module = replace(module, start=start or module.start, roots=roots.asset_roots(tuple(asset_roots)))
     module = run_passes(module, diags)
     if diags.has_errors:
         raise GrammarError(diags, sources)

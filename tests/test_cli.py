@@ -155,6 +155,20 @@ def test_check_dump_ir(write, capsys):
     assert "lot ~> S(1r, @h, 1r) x" in capsys.readouterr().out
 
 
+def test_workspace_option_of_check_and_build(write, capsys, tmp_path):
+    from pathlib import Path
+
+    workspace = Path(__file__).parent / "frontend" / "grammars" / "cityengine" / "workspace"
+    grammar = write("g.cga", 'version "2019.0"\nimport h : "/Houses/rules/house.cga"\n@StartRule\nLot --> h.Lot\n')
+    assert main(["check", str(grammar)]) == 2
+    assert "is in no CityEngine workspace" in capsys.readouterr().err
+    assert main(["check", "--workspace", str(workspace), str(grammar)]) == 0
+    assert "assets:    builtin:cube, builtin:quad, chimney.obj, Houses/assets/window.obj" in capsys.readouterr().out
+    out = tmp_path / "o.npz"
+    assert main(["build", "--workspace", str(workspace), str(grammar), "--emit", str(out), "--quiet"]) == 0
+    assert "Houses/assets/window.obj" in list(read_instances(out)["assets"])
+
+
 def test_check_reports_errors_exit_2(write, capsys):
     assert main(["check", str(write("g.cga", "lot ~> T(1, 2)\n"))]) == 2
     assert "`T` takes 3 arguments, got 2" in capsys.readouterr().err

@@ -23,6 +23,7 @@ from lark.exceptions import UnexpectedCharacters, UnexpectedEOF, UnexpectedInput
 from grammarc.diagnostics import Diagnostics, Span
 from grammarc.frontend import cga2006, cityengine
 from grammarc.frontend.cityengine.nodes import Import
+from grammarc.frontend.imports import Roots, find_roots, load_import
 from grammarc.frontend.lowering import LoweringBase
 from grammarc.frontend.statements import CITYENGINE, PAPER, Layout, split_statements
 from grammarc.ir import nodes as ir
@@ -84,12 +85,13 @@ def _parser(grammar_file: str) -> Lark:
 
 def parse_source(text: str, file: str, diags: Diagnostics, dialect: str | None = None, *,
                  path: Path | None = None, sources: dict[str, str] | None = None, sites=None,
-                 importing: tuple[Path, ...] = ()) -> ir.Module:
+                 importing: tuple[Path, ...] = (), roots: Roots | None = None) -> ir.Module:
     """Parse and lower ``text`` (named ``file`` in diagnostics); problems go to ``diags``.
 
     ``dialect`` is ``cga2006`` or ``cityengine``; by default it is detected from the text. ``path`` is
-    the file on disk, from which CityEngine ``import``s are resolved; the texts of imported files are
-    added to ``sources`` (for diagnostics); ``sites`` numbers random-stream sites across imported files.
+    the file on disk, from which CityEngine ``import``s are resolved inside ``roots`` (by default those
+    of ``path``, ``imports.find_roots``); the texts of imported files are added to ``sources`` (for
+    diagnostics); ``sites`` numbers random-stream sites across imported files.
     """
     spec = DIALECTS[dialect or detect_dialect(text)]
     parser = _parser(spec.grammar)
@@ -108,34 +110,23 @@ def parse_source(text: str, file: str, diags: Diagnostics, dialect: str | None =
     for st in lowered:
         declaration = getattr(st, "declaration", st)
         if isinstance(declaration, Import):
-            module = _import(declaration, file, path, diags, sources, sites, importing)
+            module = _import(declaration, file, path, diags, sources, sites, importing, roots)
             if module is not None:
                 imports.append((declaration, module))
     return spec.assemble(file, lowered, diags, imports)
 
 
-def _import(statement, file: str, path: Path | None, diags: Diagnostics, sources, sites, importing):
-    """Parse the file an ``import`` names, relative to the importing file."""
-    if path is None:
-        diags.error("import", "`import` needs the grammar's folder (the text was given without a file)",
-                    statement.span)
+def _import(statement, file: str, path: Path | None, diags: Diagnostics, sources, sites, importing, roots):
+    """Parse the file an ``import`` names (``imports.load_import`` finds and reads it)."""
+    roots = roots or (find_roots(path) if path is not None else None)
+    loaded = load_import(statement, file, path, roots, importing, diags)
+    if loaded is None:
         return None
-    target = (path.parent / statement.path).resolve()
-    if target in importing or target == path.resolve():
-        diags.error("import", f"`{statement.path}` imports itself (through {len(importing)} files)",
-                    statement.span)
-        return None
-    try:
-        text = target.read_text(encoding="utf-8")
-    except (OSError, UnicodeDecodeError) as error:
-        diags.error("import", f"cannot read imported file `{statement.path}`: {error.strerror or error}",
-                    statement.span)
-        return None
-    display = str(Path(file).parent / statement.path)
+    display, text, target = loaded
     if sources is not None:
         sources[display] = text
     return parse_source(text, display, diags, "cityengine", path=target, sources=sources, sites=sites,
-                        importing=(*importing, path.resolve()))
+                        importing=(*importing, path.resolve()), roots=roots)
 
 
 def _syntax_error(error: UnexpectedInput, file: str, text: str, first_line: int, diags: Diagnostics):

@@ -6,6 +6,7 @@ A rule package is a 7-zip archive as CityEngine exports it::
     bin/Candler Building.cgb        compiled rules; the main one carries the start rule
     assets/facade/windows/x.obj     assets and textures (absent in packages without any)
     .resolvemap.xml                 workspace path -> path in the package
+    .ws/ESRI.lib/rules/x.cga        files of other projects of the workspace (in some packages)
 
 ``open_rpk`` extracts the archive to a temporary directory that lives as long as the returned
 ``RulePackage`` (use it as a context manager, or call ``close()``), so rule files and assets are plain
@@ -14,7 +15,9 @@ paths the compiler and the baker read as they read any other.
 Assets are resolved as CityEngine resolves a relative ``i("facade/windows/x.obj")`` of a rule file: first
 in the ``assets`` folder of the project the rule file is in, then in that project's root
 (CityEngine manual, "Asset and texture search"). ``RulePackage.asset_roots`` lists those folders in that
-order; a package is one project.
+order; a package is one project. Workspace paths (``/Project/assets/x.obj``, ``import x :
+"/ESRI.lib/rules/y.cga"``) are looked up in its ``.ws`` folder, else in the package itself (an export
+keeps a project's files at the package's root): ``RulePackage.workspace``, and ``frontend.imports``.
 
 py7zr is an optional dependency (the ``rpk`` extra), imported when a package is opened.
 """
@@ -30,6 +33,7 @@ from pathlib import Path, PurePosixPath
 from typing import TYPE_CHECKING
 
 from grammarc.errors import UsageError
+from grammarc.frontend.source import read_grammar_text
 
 if TYPE_CHECKING:
     from typing_extensions import Self
@@ -93,6 +97,12 @@ class RulePackage:
     def asset_roots(self) -> tuple[Path, ...]:
         """Folders to resolve asset names in, in CityEngine's order: ``assets``, then the package root."""
         return (self.assets_root,) if self.assets_root == self.root else (self.assets_root, self.root)
+
+    @property
+    def workspace(self) -> Path:
+        """The package's workspace, its ``.ws`` folder (which may not exist): workspace paths are looked up
+        there and in the package, never in the folders around the extracted package."""
+        return self.root / ".ws"
 
     @property
     def closed(self) -> bool:
@@ -162,9 +172,10 @@ def start_rule_of(cga: str | os.PathLike) -> str | None:
     """The name of the rule after the first ``@StartRule`` annotation of a CGA file, or None.
 
     Comments are ignored (a commented-out ``// @StartRule`` does not count); further annotations between
-    ``@StartRule`` and the rule are skipped.
+    ``@StartRule`` and the rule are skipped. The file is read as the compiler reads it (UTF-8 with or
+    without a BOM, else Windows-1252).
     """
-    text = Path(cga).read_text(encoding="utf-8", errors="replace")
+    text, _ = read_grammar_text(cga)
     match = _START_RULE.search(_strip_comments(text))
     return match.group(1) if match else None
 

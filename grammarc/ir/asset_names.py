@@ -45,28 +45,61 @@ class ResolvedAsset:
 
 
 def resolve_asset(name: str, roots: list[Path]) -> ResolvedAsset:
-    """Resolve one ``I()`` name against ``roots`` (searched in order)."""
+    """Resolve one ``I()`` name against ``roots`` (searched in order).
+
+    A workspace path ``/Project/assets/x.obj`` (CityEngine's absolute paths, which start at the
+    workspace) is looked up as ``Project/assets/x.obj`` in the roots (one of them may be a workspace, a
+    folder of projects), else, when no root holds a folder ``Project``, as ``assets/x.obj`` (a rule package
+    or a lone project is the project its paths name). A drive path ``C:/...`` is refused, as is a name that
+    climbs out of every root or holds a NUL byte.
+    """
     bare = name.removeprefix("builtin:")
     if builtin_name(bare):
         return ResolvedAsset(f"builtin:{bare}", None)
     if name.startswith("builtin:"):
         return ResolvedAsset(name, None, problem=f"unknown built-in asset `{name}` (built-ins: "
                              + ", ".join(BUILTINS) + ", cylinderN for N sides)")
+    if "\0" in name:
+        shown = name.replace("\0", "\\0")
+        return ResolvedAsset(shown, None, problem=f"asset path `{shown}` holds a NUL byte")
     pure = PurePosixPath(name.replace("\\", "/"))
-    if pure.is_absolute() or (len(name) > 1 and name[1] == ":"):
+    if len(name) > 1 and name[1] == ":":
         return ResolvedAsset(name, None, problem=f"asset path `{name}` is absolute; give it relative "
                              "to the grammar's folder or an --assets folder")
-    for root in roots:
-        root = root.resolve()
-        candidate = (root / pure).resolve()
-        if not _inside(candidate, root):
-            continue
-        if candidate.is_file():
-            return ResolvedAsset(candidate.relative_to(root).as_posix(), candidate)
+    found = locate(name, roots)
+    if found is not None:
+        root, path = found
+        return ResolvedAsset(path.relative_to(root).as_posix(), path)
+    if pure.is_absolute():
+        return ResolvedAsset(name, None, problem=f"asset path `{name}` is absolute and no workspace holds "
+                             "it; give it relative to the grammar's folder or an --assets folder")
     if not any(_inside((r.resolve() / pure).resolve(), r.resolve()) for r in roots):
         return ResolvedAsset(name, None, problem=f"asset path `{name}` leaves the asset folders "
                              f"({', '.join(str(r) for r in roots)})")
     return ResolvedAsset(pure.as_posix(), None, missing=True)
+
+
+def locate(name: str, roots) -> tuple[Path, Path] | None:
+    """The first root holding the file ``name`` and the file (resolved), or None.
+
+    ``name`` is relative to a root, or a workspace path ``/Project/rest`` (see ``resolve_asset``). A
+    candidate that leaves its root (``..``, or a link pointing out of it) is skipped: what a grammar reads
+    stays inside the folders its user gave.
+    """
+    pure = PurePosixPath(name.replace("\\", "/"))
+    relatives = [pure]
+    if pure.is_absolute():
+        inner = PurePosixPath(*pure.parts[1:])
+        relatives = [inner]
+        if len(inner.parts) > 1 and not any((Path(r) / inner.parts[0]).is_dir() for r in roots):
+            relatives.append(PurePosixPath(*inner.parts[1:]))
+    for relative in relatives:
+        for root in roots:
+            root = Path(root).resolve()
+            candidate = (root / relative).resolve()
+            if _inside(candidate, root) and candidate.is_file():
+                return root, candidate
+    return None
 
 
 def _inside(path: Path, root: Path) -> bool:

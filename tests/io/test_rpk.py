@@ -141,3 +141,15 @@ def test_a_package_builds_to_the_same_bytes_each_time(tmp_path):
     for out in outputs:
         build(KIT / "rpk" / "complexpatterns.rpk", out)
     assert outputs[0].read_bytes() == outputs[1].read_bytes()
+
+
+@needs_kit
+def test_a_package_is_its_own_workspace():
+    """Workspace paths of a package's rules are looked up in its `.ws` folder and in the package, never
+    in the folders around the extracted package."""
+    from grammarc.frontend.imports import find_roots
+
+    with open_rpk(KIT / "rpk" / "candler.rpk") as rpk:
+        assert rpk.workspace == rpk.root / ".ws"
+        roots = find_roots(rpk.main_rule_file, rpk.workspace)
+        assert roots.project == rpk.root.resolve() and rpk.root.parent.resolve() not in roots.folders

@@ -51,3 +51,19 @@ def test_a_file_no_root_holds_is_missing_and_keeps_its_name(tmp_path):
 def test_a_name_outside_every_root_is_refused(tmp_path, name, problem):
     resolved = resolve_asset(name, [tmp_path / "g"])
     assert problem in resolved.problem and resolved.path is None
+
+
+def test_a_nul_byte_in_a_name_is_refused_not_a_crash(tmp_path):
+    resolved = resolve_asset("win\0.obj", [tmp_path])
+    assert resolved.problem == "asset path `win\\0.obj` holds a NUL byte" and resolved.path is None
+
+
+def test_workspace_paths_resolve_in_a_workspace_or_in_the_project_they_name(tmp_path):
+    (tmp_path / "Proj" / "assets").mkdir(parents=True)
+    (tmp_path / "Proj" / "assets" / "x.obj").write_text("v 0 0 0\n")
+    in_workspace = resolve_asset("/Proj/assets/x.obj", [tmp_path / "Proj", tmp_path])
+    assert (in_workspace.name, in_workspace.path) == ("Proj/assets/x.obj", tmp_path / "Proj" / "assets" / "x.obj")
+    # a package (or a lone project) is the project its paths name, whatever its name was
+    exported = resolve_asset("/Tutorial_09/assets/x.obj", [tmp_path / "Proj"])
+    assert (exported.name, exported.problem) == ("assets/x.obj", "")
+    assert "is absolute" in resolve_asset("/Proj/assets/gone.obj", [tmp_path]).problem

@@ -44,3 +44,21 @@ def test_errors_and_warnings_at_the_name(tmp_path):
 def test_a_module_lowered_outside_the_compiler_keeps_its_names_unresolved():
     module, diags = resolved('a ~> I("/etc/passwd")', None)
     assert not diags and module.assets == () and module.asset_ids == ()
+
+
+def test_a_nul_byte_in_an_asset_name_is_an_error_at_the_name(tmp_path):
+    """It crashed `check` with `ValueError: embedded null byte`."""
+    _, diags = resolved('a ~> I("w\0.obj")', (tmp_path,))
+    assert [(d.code, d.severity.value, d.span.col, d.message) for d in diags] == [
+        ("asset", "error", 6, "asset path `w\\0.obj` holds a NUL byte")]
+
+
+def test_one_file_named_from_two_roots_is_one_asset(tmp_path):
+    """A project's root lies inside its workspace: `assets/x.obj` and `/Proj/assets/x.obj` are one file."""
+    project = tmp_path / "Proj"
+    (project / "assets").mkdir(parents=True)
+    (project / "assets" / "x.obj").write_text("v 0 0 0\n")
+    module, diags = resolved('a ~> I("assets/x.obj") I("/Proj/assets/x.obj")', (project, tmp_path))
+    assert not diags
+    assert module.assets == ("builtin:cube", "builtin:quad", "assets/x.obj")
+    assert dict(module.asset_ids) == {"assets/x.obj": 2, "/Proj/assets/x.obj": 2}

@@ -8,7 +8,7 @@ from __future__ import annotations
 from dataclasses import replace
 
 from grammarc.diagnostics import Diagnostics, Span, suggest
-from grammarc.frontend.cityengine.nodes import Annotated, FunctionDef, RuleDef, Style
+from grammarc.frontend.cityengine.nodes import Annotated, FunctionDef, Import, RuleDef, Style
 from grammarc.ir import nodes as ir
 from grammarc.ir.traverse import rewrite_body, rewrite_expr, rewrite_ops
 
@@ -19,6 +19,7 @@ def assemble(file: str, statements: list, diags: Diagnostics, imports=()) -> ir.
     attrs: list[ir.AttrDecl] = []
     functions: dict[str, FunctionDef] = {}
     rules: list[tuple[RuleDef, tuple]] = []
+    extensions: list[tuple[RuleDef, tuple]] = []
     style = None
     for st in statements:
         if not isinstance(st, Annotated):
@@ -40,6 +41,9 @@ def assemble(file: str, statements: list, diags: Diagnostics, imports=()) -> ir.
             functions[decl.name] = decl
         elif isinstance(decl, RuleDef):
             rules.append((decl, st.annotations))
+        elif isinstance(decl, Import):  # `import p : "f.cga" (Ext --> ...)` redefines p.Ext here
+            extensions.extend((replace(r, name=_in(decl.prefix, r.name)), ()) for r in decl.extensions)
+    rules.extend(extensions)  # after the file's own rules: never its first rule
     arities: dict[str, set[int]] = {}
     for rule, _ in rules:
         arities.setdefault(rule.name, set()).add(len(rule.params))
@@ -66,20 +70,35 @@ def assemble(file: str, statements: list, diags: Diagnostics, imports=()) -> ir.
     if start is None and lowered:
         start = lowered[0].symbol
     imported = []
+    own = {rule.symbol for rule in lowered}
     for statement, module in imports:
-        more_attrs, more_rules = _prefixed(module, statement.prefix, {a.name for a in attrs})
+        values = {v.name: inline.expr(v.default, frozenset()) for v in statement.values}
+        forwarded = set() if statement.protect_all else \
+            {a.name for a in attrs} - set(statement.protected) - set(values)
+        for name in sorted(set(values) - {a.name for a in module.attrs}):
+            diags.warning("import", f"`{statement.path}` declares no attribute `{name}`: its value is not "
+                          "used", statement.span)
+        more_attrs, more_rules = _prefixed(module, statement.prefix, forwarded, values)
         attrs.extend(more_attrs)
-        lowered.extend(more_rules)
+        # a rule the importing file defines as `prefix.Rule` replaces the imported one, also where the
+        # imported file calls it (its calls are prefixed too)
+        lowered.extend(rule for rule in more_rules if rule.symbol not in own)
         imported.extend((module.file, *module.imported))
     return ir.Module(file=file, attrs=tuple(attrs), rules=tuple(lowered), start=start, dialect="cityengine",
                      imported=tuple(dict.fromkeys(imported)))
 
 
-def _prefixed(module: ir.Module, prefix: str | None, forwarded: set[str]):
-    """An imported module's attributes and rules under ``prefix.``; its attributes that the importing
-    file declares too are dropped, so that their names resolve to the importer's (forwarding)."""
+def _in(prefix: str | None, name: str) -> str:
+    return name if prefix is None else f"{prefix}.{name}"
+
+
+def _prefixed(module: ir.Module, prefix: str | None, forwarded: set[str], values: dict[str, ir.Expr]):
+    """An imported module's attributes and rules under ``prefix.``; its ``forwarded`` attributes (those
+    the importing file declares too and does not protect) are dropped, so that their names resolve to the
+    importer's, and those in ``values`` take the importing file's expression as their default."""
     if prefix is None:
-        return [a for a in module.attrs if a.name not in forwarded], list(module.rules)
+        return [replace(a, default=values[a.name]) if a.name in values else a
+                for a in module.attrs if a.name not in forwarded], list(module.rules)
     own_attrs = {a.name for a in module.attrs} - forwarded
 
     def rename(params):
@@ -91,7 +110,8 @@ def _prefixed(module: ir.Module, prefix: str | None, forwarded: set[str]):
             return e
         return visit
 
-    attrs = [replace(a, name=f"{prefix}.{a.name}", default=rewrite_expr(a.default, rename(())))
+    attrs = [replace(a, name=f"{prefix}.{a.name}", default=values[a.name] if a.name in values
+                     else rewrite_expr(a.default, rename(())))
              for a in module.attrs if a.name in own_attrs]
     rules = []
     for rule in module.rules:

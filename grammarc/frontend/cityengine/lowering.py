@@ -103,13 +103,40 @@ class Lowering(OperationLowering, LoweringBase):
     def style(self, meta, name):
         return Style(str(name), self.token_span(name))
 
-    def import_prefixed(self, meta, prefix, path, *names):
-        if any(n is not None for n in names):
-            return self.unsupported("import with a list of names", self.span(meta))
-        return Import(str(prefix), str(path)[1:-1], self.span(meta))
+    def import_prefixed(self, meta, prefix, styles, path, args):
+        # the styles to import are not kept: grammarc derives the Default style
+        return self.import_plain(meta, path, args, str(prefix))
 
-    def import_plain(self, meta, path):
-        return Import(None, str(path)[1:-1], self.span(meta))
+    def import_plain(self, meta, path, args, prefix=None):
+        protected = tuple(a for a in args or () if isinstance(a, str))
+        return Import(prefix, path, self.span(meta), protected, args == (),
+                      tuple(a for a in args or () if isinstance(a, ir.AttrDecl)),
+                      tuple(a for a in args or () if isinstance(a, RuleDef)))
+
+    def import_styles(self, meta, *names):
+        return None
+
+    def import_path(self, meta, path):
+        return str(path)[1:-1] if path.type == "STRING" else str(path)
+
+    def import_args(self, meta, *args):
+        return tuple(a for a in args if a is not None)
+
+    def import_protect(self, meta, name):
+        return str(name)
+
+    def import_attr(self, meta, name, value):
+        return ir.AttrDecl(str(name), value, self.token_span(name))
+
+    def import_extension(self, meta, name, params, arrow, body):
+        return RuleDef(str(name), params or (), as_body(body), self.token_span(name), self.site())
+
+    def import_rule_override(self, meta, prefix, name, params, arrow, body):
+        """``prefix.Rule --> ...``: the importing file's own ``Rule`` of an imported file (assembly)."""
+        return RuleDef(f"{prefix}.{name}", params or (), as_body(body), self.token_span(prefix), self.site())
+
+    def import_leaf(self, meta, prefix, name, dot):
+        return ir.Symbol(f"{prefix}.{name}", (), self.token_span(prefix), self.site(), leaf=True)
 
     def attr_decl(self, meta, name, value):
         return ir.AttrDecl(str(name), value, self.token_span(name))

@@ -33,6 +33,8 @@ def resolve_assets(module: ir.Module, diags: Diagnostics) -> ir.Module:
     roots = list(module.roots)
     names = [LEAF_CUBE, LEAF_QUAD]
     ids: dict[str, int] = {}
+    # one file is one asset, whichever root names it (a project's root lies inside its workspace)
+    by_file: dict = {}
     for name, span in named:
         if name in ids:
             continue
@@ -43,7 +45,8 @@ def resolve_assets(module: ir.Module, diags: Diagnostics) -> ir.Module:
         if resolved.missing:
             diags.warning("asset", f"asset `{name}` not found in {', '.join(str(r) for r in roots)}; the "
                           "record keeps its name", span)
-        if resolved.name not in names:
-            names.append(resolved.name)
-        ids[name] = names.index(resolved.name)
+        canonical = by_file.setdefault(resolved.path, resolved.name) if resolved.path else resolved.name
+        if canonical not in names:
+            names.append(canonical)
+        ids[name] = names.index(canonical)
     return replace(module, assets=tuple(names), asset_ids=tuple(ids.items()))

@@ -190,7 +190,6 @@ def _exprs(e):
     ("Lot --> extrude(geometry.du(0, unitSpace)) A", "geometry.du()", "geometry"),
     ("Lot --> F([3, 4])\nF(h) --> extrude(h[0])", "an array as argument 1 of `F`", "["),
     ('Lot --> report("h", [3, 4])', "an array as a reported value", "["),
-    ('import facade : "facade.cga" (Facade, Wall)', "import with a list of names", "import"),
 ])
 def test_unsupported_construct_is_named_at_its_span(line, name, at):
     assert_unsupported_at(line, name, at)
