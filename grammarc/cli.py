@@ -20,6 +20,10 @@ from grammarc.diagnostics import render_all
 from grammarc.errors import GrammarcError, GrammarError
 
 
+START_HELP = ("the start rule (default: @StartRule, else the first rule); a call `Lot(10, \"a\", true)` "
+              "gives the arguments of a start rule with parameters")
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = _parser()
     args = parser.parse_args(argv)
@@ -66,8 +70,7 @@ def _parser() -> argparse.ArgumentParser:
     build.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
     build.add_argument("--attr", action="append", default=[], metavar="NAME=VALUE",
                        help="override an attribute for every lot (repeatable)")
-    build.add_argument("--start", metavar="SYMBOL",
-                       help="start symbol (default: @StartRule, else the first rule's)")
+    build.add_argument("--start", metavar="RULE", help=START_HELP)
     build.add_argument("--chunk-size", type=_positive, default=16384, metavar="N",
                        help="at most N lots derived together (default 16384; fewer when lots make many "
                             "records); the output does not depend on it")
@@ -118,7 +121,7 @@ def _parser() -> argparse.ArgumentParser:
 
     check = sub.add_parser("check", help="report every problem of a grammar, and a summary")
     check.add_argument("grammar", type=Path)
-    check.add_argument("--start", metavar="SYMBOL")
+    check.add_argument("--start", metavar="RULE", help=START_HELP)
     check.add_argument("--dump-ir", action="store_true", help="print the IR after the passes")
     check.add_argument("--dialect", choices=("cga2006", "cityengine"),
                        help="the grammar's notation (default: detected from its text)")
@@ -178,7 +181,7 @@ def _check(args) -> int:
     options = BuildOptions(start=args.start, dialect=args.dialect)
     with grammar_source(args.grammar, options) as (source, display, resolved):
         grammar = compile_grammar(source, start=resolved.start, dialect=resolved.dialect, display=display,
-                                  asset_roots=resolved.asset_roots)
+                                  asset_roots=resolved.asset_roots, derive=False)
     _warn(grammar)
     graph = grammar.graph
     if args.dump_ir:

@@ -15,6 +15,7 @@ from pathlib import Path
 from grammarc.diagnostics import Diagnostics
 from grammarc.errors import GrammarError, UsageError
 from grammarc.frontend.parse import parse_source
+from grammarc.frontend.start import START_FILE, with_start
 from grammarc.ir.pipeline import run_passes
 from grammarc.model.grammar import Grammar
 
@@ -23,12 +24,14 @@ __all__ = ["Grammar", "compile_grammar"]
 
 def compile_grammar(path: str | Path, *, text: str | None = None, start: str | None = None,
                     asset_roots: tuple[Path, ...] = (), dialect: str | None = None,
-                    display: str | None = None) -> Grammar:
+                    display: str | None = None, derive: bool = True) -> Grammar:
     """Parse, check and analyse a grammar file; raise ``GrammarError`` listing every error.
 
-    ``start`` overrides the grammar's start symbol; assets are resolved in the grammar's folder, then in
+    ``start`` overrides the grammar's start symbol, or calls a start rule with parameters
+    (``Lot(10, "tall")``, ``frontend.start``); assets are resolved in the grammar's folder, then in
     ``asset_roots``. ``display`` names the file in diagnostics (a rule file inside a package:
-    ``candler.rpk/rules/x.cga``).
+    ``candler.rpk/rules/x.cga``). A grammar to ``derive`` needs the arguments of a start rule with
+    parameters (``UsageError`` without them); ``grammarc check`` checks it without.
     """
     path = Path(path)
     if text is None:
@@ -40,9 +43,14 @@ def compile_grammar(path: str | Path, *, text: str | None = None, start: str | N
     diags = Diagnostics()
     sources = {file: text}
     module = parse_source(text, file, diags, dialect, path=path, sources=sources)
-    module = replace(module, start=start or module.start, roots=(path.parent, *asset_roots))
+    module = replace(module, roots=(path.parent, *asset_roots))
+    if start:
+        module = with_start(module, start)
+        sources[START_FILE] = start
     module = run_passes(module, diags)
     if diags.has_errors:
         raise GrammarError(diags, sources)
+    if derive and any(d.code == "start-params" for d in diags):
+        raise UsageError(next(d for d in diags if d.code == "start-params").message)
     return Grammar(path=file, digest=hashlib.sha256(text.encode()).hexdigest(), module=module,
                    warnings=tuple(d for d in diags if not d.is_error), sources=sources, asset_roots=module.roots)

@@ -15,7 +15,8 @@ from grammarc.ir.traverse import rewrite_body, rewrite_expr, rewrite_ops
 
 def assemble(file: str, statements: list, diags: Diagnostics, imports=()) -> ir.Module:
     """Declarations in source order -> Module: start rule, overloads by arity, functions inlined, the
-    imported modules' rules and attributes merged under their prefixes."""
+    imported modules' rules and attributes merged under their prefixes. Without ``@StartRule`` the start
+    is None: ``passes.rulegraph`` starts with the first rule and says so."""
     attrs: list[ir.AttrDecl] = []
     functions: dict[str, FunctionDef] = {}
     rules: list[tuple[RuleDef, tuple]] = []
@@ -63,8 +64,6 @@ def assemble(file: str, statements: list, diags: Diagnostics, imports=()) -> ir.
         lowered.append(ir.Rule(symbol=name, params=rule.params, guard=None,
                                alternatives=(ir.Alternative(body, None, rule.span),), priority=0,
                                span=rule.span, site=rule.site))
-    if start is None and lowered:
-        start = lowered[0].symbol
     imported = []
     for statement, module in imports:
         more_attrs, more_rules = _prefixed(module, statement.prefix, {a.name for a in attrs})

@@ -1,0 +1,105 @@
+"""The start rule the command line names (``--start``): a symbol (``Lot``, an imported ``p.Lot``), or a call
+of a start rule with parameters with constant arguments (``Lot(12, "tall", true)``).
+
+CityEngine lets a start rule take parameters; a lot has no values for them, so they come from the command
+line. A call becomes a rule of its own, named as the call (``Lot(12, "tall", true)``), whose body is the
+call: the backend derives a module from a start symbol without parameters, and the types pass checks the
+arguments against the rule's parameters as it checks every call (an error then points into the
+``--start`` text). The arguments are numbers, strings and booleans, read by a small strict reader: an
+expression would need the attributes of a lot that does not exist yet.
+"""
+
+from __future__ import annotations
+
+import re
+from dataclasses import replace
+
+from grammarc.diagnostics import Span
+from grammarc.errors import UsageError
+from grammarc.ir import nodes as ir
+
+__all__ = ["START_FILE", "with_start"]
+
+#: The file that diagnostics of the ``--start`` text name (its text is in the compiler's ``sources``).
+START_FILE = "--start"
+
+_NAME = re.compile(r"\s*([A-Za-z_]\w*(?:\.[A-Za-z_]\w*)*)\s*")
+_ARGUMENT = re.compile(r"""\s*(?:(?P<num>[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)|"(?P<dq>[^"\\]*)"|'(?P<sq>[^'\\]*)'"""
+                       r"""|(?P<bool>true|false))\s*""")
+
+
+def with_start(module: ir.Module, text: str) -> ir.Module:
+    """``module`` starting as ``text`` says: the symbol it names, or a rule that calls it with the arguments.
+
+    Raises ``UsageError`` when ``text`` is not a name or a call with constant arguments, or calls a rule
+    with a wrong number of arguments. A name without a rule is left to ``passes.rulegraph`` to report.
+    """
+    name, args = _parse(text)
+    arities = {r.symbol: len(r.params) for r in module.rules}
+    if args is None:
+        # a start rule overloaded by arity (`Lot/0`, `Lot/2`) is named by its name alone
+        return replace(module, start=name if name in arities or f"{name}/0" not in arities else f"{name}/0")
+    symbol = name if name in arities else f"{name}/{len(args)}"
+    if symbol not in arities:
+        if name not in {s.partition("/")[0] for s in arities}:
+            return replace(module, start=name)  # no rule (or one that failed to parse): the pass says
+        takes = sorted(n for s, n in arities.items() if s.partition("/")[0] == name)
+        raise UsageError(f"--start calls `{name}` with {len(args)} arguments; its rules take "
+                         f"{' or '.join(map(str, takes))}")
+    params = next(r.params for r in module.rules if r.symbol == symbol)
+    if len(params) != len(args):
+        raise UsageError(f"--start calls `{name}` with {len(args)} argument{'s' if len(args) != 1 else ''}; "
+                         f"it takes {len(params)} ({', '.join(params) or 'none'})")
+    span = Span(START_FILE, 1, 1, 1, len(text) + 1)
+    call = f"{name}({', '.join(_shown(a) for a in args)})"
+    rule = ir.Rule(symbol=call, params=(), guard=None,
+                   alternatives=(ir.Alternative((ir.Symbol(symbol, args, span),), None, span),),
+                   priority=0, span=span)
+    return replace(module, rules=(*module.rules, rule), start=call)
+
+
+def _parse(text: str) -> tuple[str, tuple[ir.Expr, ...] | None]:
+    """``Name`` -> (Name, None); ``Name(1, "a", true)`` -> (Name, its arguments as IR constants)."""
+    match = _NAME.match(text)
+    if match is None:
+        raise UsageError(f"--start takes a rule name or a call `Rule(1, \"a\", true)`, got `{text}`")
+    name, at = match.group(1), match.end()
+    if at == len(text):
+        return name, None
+    if text[at] != "(" or not text.rstrip().endswith(")"):
+        raise UsageError(f"--start takes a rule name or a call `Rule(1, \"a\", true)`, got `{text}`")
+    inner_end = text.rstrip().rindex(")")
+    args: list[ir.Expr] = []
+    at += 1
+    if text[at:inner_end].strip():
+        while True:
+            arg = _ARGUMENT.match(text, at, inner_end)
+            if arg is None:
+                if not text[at:inner_end].strip(" ,"):
+                    raise UsageError(f"--start has an empty argument: `{text}`")
+                raise UsageError(f"--start arguments are numbers, strings and true/false: cannot read "
+                                 f"`{text[at:inner_end].strip()}` in `{text}`")
+            args.append(_constant(arg, Span(START_FILE, 1, arg.start() + 1, 1, arg.end() + 1)))
+            at = arg.end()
+            if at == inner_end:
+                break
+            if text[at] != ",":
+                raise UsageError(f"--start arguments are separated by commas: `{text}`")
+            at += 1
+    return name, tuple(args)
+
+
+def _constant(match: re.Match, span: Span) -> ir.Expr:
+    if match.group("num") is not None:
+        return ir.Num(float(match.group("num")), span)
+    if match.group("bool") is not None:
+        return ir.Bool(match.group("bool") == "true", span)
+    return ir.Str(match.group("dq") if match.group("dq") is not None else match.group("sq"), span)
+
+
+def _shown(arg: ir.Expr) -> str:
+    if isinstance(arg, ir.Num):
+        return f"{arg.value:g}"
+    if isinstance(arg, ir.Bool):
+        return "true" if arg.value else "false"
+    return f'"{arg.value}"'
