@@ -64,6 +64,8 @@ class BuildOptions:
     dialect: str | None = None
     #: Chunks derived at once, in as many processes (``grammarc.workers``); the output does not depend on it.
     workers: int = 1
+    #: Whether a warning of the grammar stops the build as an error would (``--warnings-as-errors``).
+    warnings_as_errors: bool = False
 
 
 @dataclass(frozen=True)
@@ -132,7 +134,8 @@ def _build(source: Path, display: str | None, grammar_path: Path, output, lots_p
            output_options: OutputOptions, select: Sequence[str] | None,
            reports_to: Path | None) -> BuildResult:
     grammar = compile_grammar(source, start=options.start, asset_roots=options.asset_roots,
-                              dialect=options.dialect, display=display)
+                              dialect=options.dialect, display=display,
+                              warnings_as_errors=options.warnings_as_errors)
     plan = make_plan(grammar)
     check_overrides(grammar.module, options.attrs)
     writer_class = writer_for(output, replace(output_options, asset_roots=tuple(grammar.asset_roots)))

@@ -22,6 +22,7 @@ from grammarc.errors import GrammarcError, GrammarError
 
 START_HELP = ("the start rule (default: @StartRule, else the first rule); a call `Lot(10, \"a\", true)` "
               "gives the arguments of a start rule with parameters")
+WARNINGS_HELP = "treat the grammar's warnings as errors: exit 2, nothing written"
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -71,6 +72,7 @@ def _parser() -> argparse.ArgumentParser:
     build.add_argument("--attr", action="append", default=[], metavar="NAME=VALUE",
                        help="override an attribute for every lot (repeatable)")
     build.add_argument("--start", metavar="RULE", help=START_HELP)
+    build.add_argument("--warnings-as-errors", action="store_true", help=WARNINGS_HELP)
     build.add_argument("--chunk-size", type=_positive, default=16384, metavar="N",
                        help="at most N lots derived together (default 16384; fewer when lots make many "
                             "records); the output does not depend on it")
@@ -122,6 +124,7 @@ def _parser() -> argparse.ArgumentParser:
     check = sub.add_parser("check", help="report every problem of a grammar, and a summary")
     check.add_argument("grammar", type=Path)
     check.add_argument("--start", metavar="RULE", help=START_HELP)
+    check.add_argument("--warnings-as-errors", action="store_true", help=WARNINGS_HELP)
     check.add_argument("--dump-ir", action="store_true", help="print the IR after the passes")
     check.add_argument("--dialect", choices=("cga2006", "cityengine"),
                        help="the grammar's notation (default: detected from its text)")
@@ -181,7 +184,8 @@ def _check(args) -> int:
     options = BuildOptions(start=args.start, dialect=args.dialect)
     with grammar_source(args.grammar, options) as (source, display, resolved):
         grammar = compile_grammar(source, start=resolved.start, dialect=resolved.dialect, display=display,
-                                  asset_roots=resolved.asset_roots, derive=False)
+                                  asset_roots=resolved.asset_roots, derive=False,
+                                  warnings_as_errors=args.warnings_as_errors)
     _warn(grammar)
     graph = grammar.graph
     if args.dump_ir:
@@ -318,6 +322,7 @@ def _build(args) -> int:
         asset_roots=tuple(args.assets),
         dialect=args.dialect,
         workers=args.workers,
+        warnings_as_errors=args.warnings_as_errors,
     )
     bar = _ProgressBar() if not args.quiet else None
     try:

@@ -12,7 +12,7 @@ import hashlib
 from dataclasses import replace
 from pathlib import Path
 
-from grammarc.diagnostics import Diagnostics
+from grammarc.diagnostics import Diagnostics, Severity
 from grammarc.errors import GrammarError, UsageError
 from grammarc.frontend.parse import parse_source
 from grammarc.frontend.start import START_FILE, with_start
@@ -24,14 +24,16 @@ __all__ = ["Grammar", "compile_grammar"]
 
 def compile_grammar(path: str | Path, *, text: str | None = None, start: str | None = None,
                     asset_roots: tuple[Path, ...] = (), dialect: str | None = None,
-                    display: str | None = None, derive: bool = True) -> Grammar:
+                    display: str | None = None, derive: bool = True,
+                    warnings_as_errors: bool = False) -> Grammar:
     """Parse, check and analyse a grammar file; raise ``GrammarError`` listing every error.
 
     ``start`` overrides the grammar's start symbol, or calls a start rule with parameters
     (``Lot(10, "tall")``, ``frontend.start``); assets are resolved in the grammar's folder, then in
     ``asset_roots``. ``display`` names the file in diagnostics (a rule file inside a package:
     ``candler.rpk/rules/x.cga``). A grammar to ``derive`` needs the arguments of a start rule with
-    parameters (``UsageError`` without them); ``grammarc check`` checks it without.
+    parameters (``UsageError`` without them); ``grammarc check`` checks it without. With
+    ``warnings_as_errors`` every warning is an error (``--warnings-as-errors``).
     """
     path = Path(path)
     if text is None:
@@ -48,6 +50,8 @@ def compile_grammar(path: str | Path, *, text: str | None = None, start: str | N
         module = with_start(module, start)
         sources[START_FILE] = start
     module = run_passes(module, diags)
+    if warnings_as_errors:
+        diags = Diagnostics(replace(d, severity=Severity.ERROR) for d in diags)
     if diags.has_errors:
         raise GrammarError(diags, sources)
     if derive and any(d.code == "start-params" for d in diags):

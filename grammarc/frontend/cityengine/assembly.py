@@ -9,6 +9,7 @@ from dataclasses import replace
 
 from grammarc.diagnostics import Diagnostics, Span, suggest
 from grammarc.frontend.cityengine.nodes import Annotated, FunctionDef, RuleDef, Style
+from grammarc.frontend.cityengine.operations import check_calls
 from grammarc.ir import nodes as ir
 from grammarc.ir.traverse import rewrite_body, rewrite_expr, rewrite_ops
 
@@ -64,6 +65,7 @@ def assemble(file: str, statements: list, diags: Diagnostics, imports=()) -> ir.
         lowered.append(ir.Rule(symbol=name, params=rule.params, guard=None,
                                alternatives=(ir.Alternative(body, None, rule.span),), priority=0,
                                span=rule.span, site=rule.site))
+    lowered = check_calls(lowered, diags)
     imported = []
     for statement, module in imports:
         more_attrs, more_rules = _prefixed(module, statement.prefix, {a.name for a in attrs})
