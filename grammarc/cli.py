@@ -19,10 +19,9 @@ from grammarc.constants import LIMITS, PARTITION_SIZE
 from grammarc.diagnostics import render_all
 from grammarc.errors import GrammarcError, GrammarError
 
-
-START_HELP = ("the start rule (default: @StartRule, else the first rule); a call `Lot(10, \"a\", true)` "
+_START_HELP = ("the start rule (default: @StartRule, else the first rule); a call `Lot(10, \"a\", true)` "
               "gives the arguments of a start rule with parameters")
-WARNINGS_HELP = "treat the grammar's warnings as errors: exit 2, nothing written"
+_WARNINGS_HELP = "treat the grammar's warnings as errors: exit 2, nothing written"
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -71,8 +70,8 @@ def _parser() -> argparse.ArgumentParser:
     build.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
     build.add_argument("--attr", action="append", default=[], metavar="NAME=VALUE",
                        help="override an attribute for every lot (repeatable)")
-    build.add_argument("--start", metavar="RULE", help=START_HELP)
-    build.add_argument("--warnings-as-errors", action="store_true", help=WARNINGS_HELP)
+    build.add_argument("--start", metavar="RULE", help=_START_HELP)
+    build.add_argument("--warnings-as-errors", action="store_true", help=_WARNINGS_HELP)
     build.add_argument("--chunk-size", type=_positive, default=16384, metavar="N",
                        help="at most N lots derived together (default 16384; fewer when lots make many "
                             "records); the output does not depend on it")
@@ -123,8 +122,8 @@ def _parser() -> argparse.ArgumentParser:
 
     check = sub.add_parser("check", help="report every problem of a grammar, and a summary")
     check.add_argument("grammar", type=Path)
-    check.add_argument("--start", metavar="RULE", help=START_HELP)
-    check.add_argument("--warnings-as-errors", action="store_true", help=WARNINGS_HELP)
+    check.add_argument("--start", metavar="RULE", help=_START_HELP)
+    check.add_argument("--warnings-as-errors", action="store_true", help=_WARNINGS_HELP)
     check.add_argument("--dump-ir", action="store_true", help="print the IR after the passes")
     check.add_argument("--dialect", choices=("cga2006", "cityengine"),
                        help="the grammar's notation (default: detected from its text)")

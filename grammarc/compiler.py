@@ -15,7 +15,7 @@ from pathlib import Path
 from grammarc.diagnostics import Diagnostics, Severity
 from grammarc.errors import GrammarError, UsageError
 from grammarc.frontend.parse import parse_source
-from grammarc.frontend.start import START_FILE, with_start
+from grammarc.frontend.start import with_start
 from grammarc.ir.pipeline import run_passes
 from grammarc.model.grammar import Grammar
 
@@ -48,7 +48,6 @@ def compile_grammar(path: str | Path, *, text: str | None = None, start: str | N
     module = replace(module, roots=(path.parent, *asset_roots))
     if start:
         module = with_start(module, start)
-        sources[START_FILE] = start
     module = run_passes(module, diags)
     if warnings_as_errors:
         diags = Diagnostics(replace(d, severity=Severity.ERROR) for d in diags)

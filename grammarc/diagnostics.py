@@ -104,10 +104,11 @@ def close_match(name: str, candidates) -> str | None:
 
 def typo_of(name: str, candidates) -> str | None:
     """The candidate that ``name`` is a typo of, or None: one edit away (a letter missing, extra, wrong, or
-    two swapped), two for names of eight letters or more, letter case aside. Stricter than ``suggest``,
-    which picks the likeliest of names that must exist; a name that need not exist (a leaf) is only
-    suspect when it is that close."""
-    most = 1 if len(name) < 8 else 2
+    two swapped) for names of four to seven letters, two for longer ones, letter case aside (names of one
+    to three letters are all one edit apart: only their case). Stricter than ``suggest``, which picks the
+    likeliest of names that must exist; a name that need not exist (a leaf) is only suspect when it is
+    that close."""
+    most = 0 if len(name) < 4 else 1 if len(name) < 8 else 2
     lowered = name.lower()
     for candidate in candidates:
         if candidate != name and abs(len(candidate) - len(name)) <= most \

@@ -4,8 +4,9 @@ of a start rule with parameters with constant arguments (``Lot(12, "tall", true)
 CityEngine lets a start rule take parameters; a lot has no values for them, so they come from the command
 line. A call becomes a rule of its own, named as the call (``Lot(12, "tall", true)``), whose body is the
 call: the backend derives a module from a start symbol without parameters, and the types pass checks the
-arguments against the rule's parameters as it checks every call (an error then points into the
-``--start`` text). The arguments are numbers, strings and booleans, read by a small strict reader: an
+arguments against the rule's parameters as it checks every call. The new rule and its call are placed at
+the called rule (their spans are its span), so that every node of the module stays in its files. The
+arguments are numbers, strings and booleans, read by a small strict reader: an
 expression would need the attributes of a lot that does not exist yet.
 """
 
@@ -14,14 +15,10 @@ from __future__ import annotations
 import re
 from dataclasses import replace
 
-from grammarc.diagnostics import Span
 from grammarc.errors import UsageError
 from grammarc.ir import nodes as ir
 
-__all__ = ["START_FILE", "with_start"]
-
-#: The file that diagnostics of the ``--start`` text name (its text is in the compiler's ``sources``).
-START_FILE = "--start"
+__all__ = ["with_start"]
 
 _NAME = re.compile(r"\s*([A-Za-z_]\w*(?:\.[A-Za-z_]\w*)*)\s*")
 _ARGUMENT = re.compile(r"""\s*(?:(?P<num>[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)|"(?P<dq>[^"\\]*)"|'(?P<sq>[^'\\]*)'"""
@@ -46,11 +43,12 @@ def with_start(module: ir.Module, text: str) -> ir.Module:
         takes = sorted(n for s, n in arities.items() if s.partition("/")[0] == name)
         raise UsageError(f"--start calls `{name}` with {len(args)} arguments; its rules take "
                          f"{' or '.join(map(str, takes))}")
-    params = next(r.params for r in module.rules if r.symbol == symbol)
+    called = next(r for r in module.rules if r.symbol == symbol)
+    params, span = called.params, called.span
+    args = tuple(replace(a, span=span) for a in args)
     if len(params) != len(args):
         raise UsageError(f"--start calls `{name}` with {len(args)} argument{'s' if len(args) != 1 else ''}; "
                          f"it takes {len(params)} ({', '.join(params) or 'none'})")
-    span = Span(START_FILE, 1, 1, 1, len(text) + 1)
     call = f"{name}({', '.join(_shown(a) for a in args)})"
     rule = ir.Rule(symbol=call, params=(), guard=None,
                    alternatives=(ir.Alternative((ir.Symbol(symbol, args, span),), None, span),),
@@ -79,7 +77,7 @@ def _parse(text: str) -> tuple[str, tuple[ir.Expr, ...] | None]:
                     raise UsageError(f"--start has an empty argument: `{text}`")
                 raise UsageError(f"--start arguments are numbers, strings and true/false: cannot read "
                                  f"`{text[at:inner_end].strip()}` in `{text}`")
-            args.append(_constant(arg, Span(START_FILE, 1, arg.start() + 1, 1, arg.end() + 1)))
+            args.append(_constant(arg))
             at = arg.end()
             if at == inner_end:
                 break
@@ -89,12 +87,12 @@ def _parse(text: str) -> tuple[str, tuple[ir.Expr, ...] | None]:
     return name, tuple(args)
 
 
-def _constant(match: re.Match, span: Span) -> ir.Expr:
+def _constant(match: re.Match) -> ir.Expr:
     if match.group("num") is not None:
-        return ir.Num(float(match.group("num")), span)
+        return ir.Num(float(match.group("num")))
     if match.group("bool") is not None:
-        return ir.Bool(match.group("bool") == "true", span)
-    return ir.Str(match.group("dq") if match.group("dq") is not None else match.group("sq"), span)
+        return ir.Bool(match.group("bool") == "true")
+    return ir.Str(match.group("dq") if match.group("dq") is not None else match.group("sq"))
 
 
 def _shown(arg: ir.Expr) -> str:

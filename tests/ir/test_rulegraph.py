@@ -117,12 +117,13 @@ def test_the_pass_sets_the_graph_of_the_start_symbol_on_the_module():
                                         {"a": ("b",), "b": ("c",)})
 
 
-def test_the_start_rule_of_a_module_to_derive_takes_no_parameters():
+def test_a_start_rule_with_parameters_in_a_module_to_derive_warns():
     text = "lot(w) ~> b(w)\nb(x) ~> c"
     diags = Diagnostics()
     module = run_passes(replace(parse_source(text, FILE, diags), roots=()), diags, check=True)
-    assert [(d.code, d.span.line, d.message) for d in diags] == [
-        ("start-params", 1, "the start rule `lot` cannot take parameters: a lot has no arguments to pass")]
+    assert [(d.code, d.severity.value, d.span.line, d.message) for d in diags] == [
+        ("start-params", "warning", 1, ("the start rule `lot` takes parameters (w): a lot has no arguments to "
+         "pass; build it with --start 'lot(...)' giving their values"))]
     assert module.graph.start == "lot"  # made all the same
     # a fragment lowered by a test (no asset folders) is not derived: it may start anywhere
     diags = Diagnostics()

@@ -40,8 +40,9 @@ def rule_graph(module: ir.Module, diags: Diagnostics) -> ir.Module:
         return module
     if module.start is None:
         first = module.rules[0]
-        diags.warning("start-rule", f"no @StartRule: starting with `{first.symbol}`, the first rule",
-                      first.span, hint="mark the start rule with @StartRule, or give it with --start")
+        if not diags.has_errors:  # a note to a grammar that works: its errors come first
+            diags.warning("start-rule", f"no @StartRule: starting with `{first.symbol}`, the first rule",
+                          first.span, hint="mark the start rule with @StartRule, or give it with --start")
         module = replace(module, start=first.symbol)
     start = next((r for r in module.rules if r.symbol == module.start), None)
     if start is None:

@@ -161,7 +161,8 @@ def test_cleanup_geometry_names_a_wrong_component_or_argument_count_at_its_line(
 def test_merged_selector_is_derived_face_by_face_with_a_warning(line, at):
     module, diags = compile_ir(VERSION + line + "\n")
     assert not diags.has_errors
-    assert [(d.code, d.span.line, d.span.col) for d in diags] == [("merged", 2, line.index(at) + 1)]
+    assert [(d.code, d.span.line, d.span.col) for d in diags] == [("merged", 2, line.index(at) + 1),
+                                                                  ("start-rule", 2, 1)]
     assert isinstance(module.rules[0].alternatives[0].body[0], ir.CompFaces)
 
 
