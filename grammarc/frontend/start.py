@@ -72,9 +72,10 @@ def _parse(text: str) -> tuple[str, tuple[ir.Expr, ...] | None]:
     if text[at:inner_end].strip():
         while True:
             arg = _ARGUMENT.match(text, at, inner_end)
+            rest = text[at:inner_end].lstrip()
+            if not rest or rest.startswith(","):
+                raise UsageError(f"--start has an empty argument: `{text}`")
             if arg is None:
-                if not text[at:inner_end].strip(" ,"):
-                    raise UsageError(f"--start has an empty argument: `{text}`")
                 raise UsageError(f"--start arguments are numbers, strings and true/false: cannot read "
                                  f"`{text[at:inner_end].strip()}` in `{text}`")
             args.append(_constant(arg))
