@@ -274,16 +274,19 @@ def test_a_call_of_no_rule_that_is_no_typo_stays_a_leaf_with_a_warning():
 
 
 #: Every operation of CityEngine's CGA reference (2019-2025), geometry, texturing, scope and tags.
-REFERENCE_OPERATIONS = """
-alignScopeToAxes alignScopeToGeometry alignScopeToGeometryBBox center cleanupGeometry color comp convexify copyUV
-deleteHoles deleteTags deleteUV envelope extrude footprint i inline innerRectangle insertAlongUV label mirror
-mirrorScope modify NIL normalizeUV offset primitiveCone primitiveCube primitiveCylinder primitiveDisk
-primitiveQuad primitiveSphere print projectUV r rectify reduceGeometry report resetGeometry resetMaterial
-reverseNormals roofGable roofHip roofPyramid roofRidge roofShed rotate rotateScope rotateUV s scaleUV scatter set
-setback setbackPerEdge setbackToArea setMaterial setNormals setPivot setTagsFromEdgeAttrs setupProjection shapeL
-shapeU shapeO softenNormals split splitAndSetbackPerimeter splitArea t tag taper texture tileUV translate
-translateUV trim union subtract intersect
-""".split()
+REFERENCE_OPERATIONS = (
+    "alignScopeToAxes", "alignScopeToGeometry", "alignScopeToGeometryBBox", "center", "cleanupGeometry",
+    "color", "comp", "convexify", "copyUV", "deleteHoles", "deleteTags", "deleteUV", "envelope", "extrude",
+    "footprint", "i", "inline", "innerRectangle", "insertAlongUV", "label", "mirror", "mirrorScope",
+    "modify", "NIL", "normalizeUV", "offset", "primitiveCone", "primitiveCube", "primitiveCylinder",
+    "primitiveDisk", "primitiveQuad", "primitiveSphere", "print", "projectUV", "r", "rectify",
+    "reduceGeometry", "report", "resetGeometry", "resetMaterial", "reverseNormals", "roofGable", "roofHip",
+    "roofPyramid", "roofRidge", "roofShed", "rotate", "rotateScope", "rotateUV", "s", "scaleUV", "scatter",
+    "set", "setback", "setbackPerEdge", "setbackToArea", "setMaterial", "setNormals", "setPivot",
+    "setTagsFromEdgeAttrs", "setupProjection", "shapeL", "shapeU", "shapeO", "softenNormals", "split",
+    "splitAndSetbackPerimeter", "splitArea", "t", "tag", "taper", "texture", "tileUV", "translate",
+    "translateUV", "trim", "union", "subtract", "intersect",
+)
 
 
 def test_every_operation_of_the_reference_is_known():
