@@ -6,8 +6,8 @@ line. A call becomes a rule of its own, named as the call (``Lot(12, "tall", tru
 call: the backend derives a module from a start symbol without parameters, and the types pass checks the
 arguments against the rule's parameters as it checks every call. The new rule and its call are placed at
 the called rule (their spans are its span), so that every node of the module stays in its files. The
-arguments are numbers, strings and booleans, read by a small strict reader: an
-expression would need the attributes of a lot that does not exist yet.
+arguments are numbers, strings and booleans, read by a small strict reader: an expression would need the
+attributes of a lot that does not exist yet.
 """
 
 from __future__ import annotations
@@ -21,8 +21,9 @@ from grammarc.ir import nodes as ir
 __all__ = ["with_start"]
 
 _NAME = re.compile(r"\s*([A-Za-z_]\w*(?:\.[A-Za-z_]\w*)*)\s*")
-_ARGUMENT = re.compile(r"""\s*(?:(?P<num>[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)|"(?P<dq>[^"\\]*)"|'(?P<sq>[^'\\]*)'"""
-                       r"""|(?P<bool>true|false))\s*""")
+#: One argument: a number, a string in double or single quotes (no escapes), or a boolean.
+_ARGUMENT = re.compile(r"""\s*(?:(?P<num>[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)"""
+                       r"""|"(?P<dq>[^"\\]*)"|'(?P<sq>[^'\\]*)'|(?P<bool>true|false))\s*""")
 
 
 def with_start(module: ir.Module, text: str) -> ir.Module:
