@@ -186,3 +186,14 @@ def test_the_paper_notation_warns_of_typos_too_without_the_leaf_marker_hint():
     assert [(d.code, d.span.col, d.hint) for d in diags] == [("undefined-rule", 29, ""),
                                                               ("unreachable", 1, "")]
     assert "facdes" in g.terminals
+
+
+@pytest.mark.parametrize("leaves, rules", [
+    ("Bay3 Bay12", "Bay1 --> X\n"),  # a numbered family
+    ("Window Tile", "Windows --> X\nTileRow --> X\n"),  # a prefix either way
+])
+def test_leaves_named_beside_rules_as_files_name_them_do_not_warn(leaves, rules):
+    text = f'version "2022.0"\n@StartRule\nLot --> extrude(10) {leaves}\n{rules}'
+    diags = Diagnostics()
+    run_passes(parse_source(text, FILE, diags, "cityengine"), diags, check=True)
+    assert [d for d in diags if d.code == "undefined-rule"] == []

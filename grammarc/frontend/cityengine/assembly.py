@@ -65,7 +65,7 @@ def assemble(file: str, statements: list, diags: Diagnostics, imports=()) -> ir.
         lowered.append(ir.Rule(symbol=name, params=rule.params, guard=None,
                                alternatives=(ir.Alternative(body, None, rule.span),), priority=0,
                                span=rule.span, site=rule.site))
-    lowered = check_calls(lowered, diags)
+    lowered = check_calls(lowered, [module for _, module in imports], diags)
     imported = []
     for statement, module in imports:
         more_attrs, more_rules = _prefixed(module, statement.prefix, {a.name for a in attrs})

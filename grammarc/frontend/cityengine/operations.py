@@ -395,19 +395,21 @@ ALL_OPERATIONS = frozenset(OPERATIONS) | frozenset(PART_OPERATIONS) | NOT_APPLIE
 AXIS_NAMES = {"x": (0,), "y": (1,), "z": (2,), "xy": (0, 1), "xz": (0, 2), "yz": (1, 2), "xyz": (0, 1, 2)}
 
 
-def check_calls(rules: list[ir.Rule], diags: Diagnostics) -> list[ir.Rule]:
+def check_calls(rules: list[ir.Rule], imported, diags: Diagnostics) -> list[ir.Rule]:
     """``rules`` (a file's own) with their misspelt operations reported and dropped.
 
-    A call ``name(args)`` that names neither an operation nor one of the rules (an imported rule,
-    ``p.Rule(...)``, is not looked at) is a rule call in CityEngine, of a missing rule: a leaf. When the name
-    is a typo of an operation (``spilt(x)``), that is what was meant: an error ``unknown operation`` with
-    the suggestion. Other names stay calls of a missing rule, which the types pass warns about.
+    A call ``name(args)`` that names neither an operation, nor one of the rules, nor a rule of the
+    ``imported`` modules (those imported without a prefix merge theirs; a prefixed call ``p.Rule(...)`` is
+    not looked at) is a rule call in CityEngine, of a missing rule: a leaf. When the name is a typo of an
+    operation (``spilt(x)``), that is what was meant: an error ``unknown operation`` with the suggestion.
+    Other names stay calls of a missing rule, which the types pass warns about; so do capitalised ones
+    (``Envelope(h)``): operations are lower-case, rules are mostly named in capitals.
     """
-    defined = {r.symbol for r in rules}
+    defined = {r.symbol for r in rules} | {r.symbol for module in imported for r in module.rules}
 
     def check(op):
         if isinstance(op, ir.Symbol) and op.args and not op.leaf and op.name not in defined \
-                and "." not in op.name:
+                and "." not in op.name and not op.name[0].isupper():
             close = typo_of(op.name, ALL_OPERATIONS)
             if close is not None:
                 diags.error("unknown-op", f"unknown operation `{op.name}` (did you mean `{close}`?)",

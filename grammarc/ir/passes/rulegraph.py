@@ -13,9 +13,11 @@ errors say more than "no rule").
 
 A successor symbol without a rule is a leaf, in both notations; CityEngine marks an intended one ``X.``,
 but most files write bare leaves (``Wall``, ``Glass``) without rules, so a bare one is warned about
-(``undefined-rule``) only when its name looks like a typo of a rule's: close to a rule's name
-(``diagnostics.suggest``) and neither a prefix of it nor one of its prefixes (``Window`` beside a rule
-``Windows``, ``Tile`` beside ``TileRow`` are the usual naming, not typos).
+(``undefined-rule``) only when its name looks like a typo of a rule's (``diagnostics.typo_of``: one or two
+letters off, ``facdes`` for ``facades``, or the letter case), of a rule under the same import prefix, and
+is not one of the usual ways of naming leaves beside rules: a prefix of the rule's name or the other way
+round (``Window`` beside ``Windows``, ``Tile`` beside ``TileRow``), or a number of a numbered family
+(``Bay3`` beside ``Bay1``).
 
 An analysis, not a rewrite: the module comes back with its graph. Recursion is found as strongly
 connected components of the symbol graph (Tarjan).
@@ -91,14 +93,23 @@ def _warn_undefined(module: ir.Module, nonterminals, edges, diags: Diagnostics) 
         if not isinstance(op, ir.Symbol) or op.leaf or op.args or op.name in edges:
             continue
         if op.name not in typos:
-            close = typo_of(op.name, nonterminals)
-            prefix = close is not None and (close.startswith(op.name) or op.name.startswith(close))
-            typos[op.name] = None if prefix else close
+            prefix = op.name.rpartition(".")[0]
+            close = typo_of(op.name, [s for s in nonterminals if s.rpartition(".")[0] == prefix])
+            typos[op.name] = close if close is not None and not _naming_habit(op.name, close) else None
         close = typos[op.name]
         if close is not None:
             hint = f"write `{op.name}.` if it is meant as a leaf" if module.dialect == "cityengine" else ""
             diags.warning("undefined-rule", f"`{op.name}` has no rule, so it is a leaf (did you mean "
                           f"`{close}`?)", op.span, hint=hint)
+
+
+def _naming_habit(leaf: str, rule: str) -> bool:
+    """Whether a leaf beside a rule of a close name is named so on purpose (module docstring)."""
+    return rule.startswith(leaf) or leaf.startswith(rule) or \
+        leaf.translate(_NO_DIGITS) == rule.translate(_NO_DIGITS)
+
+
+_NO_DIGITS = str.maketrans("", "", "0123456789")
 
 
 def _warn_guarded_recursion(module: ir.Module, recursive: frozenset[str], diags: Diagnostics) -> None:

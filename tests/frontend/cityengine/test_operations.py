@@ -9,6 +9,7 @@ import pytest
 
 from grammarc.backend.plan import make_plan
 from grammarc.compiler import compile_grammar
+from grammarc.diagnostics import Diagnostics
 from grammarc.frontend.cityengine.operations import (
     ALL_OPERATIONS,
     NOT_APPLIED,
@@ -16,6 +17,7 @@ from grammarc.frontend.cityengine.operations import (
     PART_OPERATIONS,
     UNSUPPORTED_OPS,
 )
+from grammarc.frontend.parse import parse_source
 from grammarc.ir import nodes as ir
 from grammarc.ir.printer import print_expr
 from grammarc.ir.traverse import iter_ops
@@ -291,3 +293,17 @@ REFERENCE_OPERATIONS = (
 
 def test_every_operation_of_the_reference_is_known():
     assert set(REFERENCE_OPERATIONS) - ALL_OPERATIONS == set()
+
+
+def test_a_capitalised_call_of_no_rule_is_a_rule_call_not_a_misspelt_operation():
+    _, diags = compile_ir(VERSION + "@StartRule\nLot --> Envelope(10) Extrude(3)\n")
+    assert [(d.code, d.severity.value) for d in diags] == [("terminal-args", "warning")] * 2
+
+
+def test_a_rule_of_a_file_imported_without_prefix_is_called(tmp_path):
+    (tmp_path / "envelope.cga").write_text(VERSION + "envelop(h) --> extrude(h) X\n")
+    main = tmp_path / "main.cga"
+    main.write_text(VERSION + 'import "envelope.cga"\n@StartRule\nLot --> envelop(10)\n')
+    diags = Diagnostics()
+    parse_source(main.read_text(), str(main), diags, path=main)
+    assert not diags.has_errors, diags
