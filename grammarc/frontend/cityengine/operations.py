@@ -4,7 +4,9 @@ handler per operation that needs one; ``OPERATIONS`` and ``PART_OPERATIONS`` (ca
 ``{ sel : A | ... }``) map names to handlers, or to ``direct`` where the arguments are the IR node's
 fields; the other tables name the selectors and roof arguments calls are checked against, and the
 operations that are accepted but not applied or not implemented. An operation or construct grammarc does
-not implement is an error ``unsupported: NAME`` at its span.
+not implement is an error ``unsupported: NAME`` at its span; a name that is no operation of CityEngine's
+reference where only an operation can be (``spilt(y){ ... }``, or a typo of one called where no rule has
+the name) is ``unknown operation NAME`` (``check_calls``).
 """
 
 from __future__ import annotations
