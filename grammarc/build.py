@@ -66,6 +66,8 @@ class BuildOptions:
     workers: int = 1
     #: A CityEngine workspace (a folder of projects) for workspace paths ``/Project/...`` (``--workspace``).
     workspace: Path | None = None
+    #: Whether a warning of the grammar stops the build as an error would (``--warnings-as-errors``).
+    warnings_as_errors: bool = False
 
 
 @dataclass(frozen=True)
@@ -134,7 +136,8 @@ def _build(source: Path, display: str | None, grammar_path: Path, output, lots_p
            output_options: OutputOptions, select: Sequence[str] | None,
            reports_to: Path | None) -> BuildResult:
     grammar = compile_grammar(source, start=options.start, asset_roots=options.asset_roots,
-                              dialect=options.dialect, display=display, workspace=options.workspace)
+                              dialect=options.dialect, display=display, workspace=options.workspace,
+                              warnings_as_errors=options.warnings_as_errors)
     plan = make_plan(grammar)
     check_overrides(grammar.module, options.attrs)
     writer_class = writer_for(output, replace(output_options, asset_roots=tuple(grammar.asset_roots)))

@@ -19,6 +19,10 @@ from grammarc.constants import LIMITS, PARTITION_SIZE
 from grammarc.diagnostics import render_all
 from grammarc.errors import GrammarcError, GrammarError
 
+_START_HELP = ("the start rule (default: @StartRule, else the first rule); a call `Lot(10, \"a\", true)` "
+              "gives the arguments of a start rule with parameters")
+_WARNINGS_HELP = "treat the grammar's warnings as errors: exit 2, nothing written"
+
 
 def main(argv: list[str] | None = None) -> int:
     parser = _parser()
@@ -66,8 +70,8 @@ def _parser() -> argparse.ArgumentParser:
     build.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
     build.add_argument("--attr", action="append", default=[], metavar="NAME=VALUE",
                        help="override an attribute for every lot (repeatable)")
-    build.add_argument("--start", metavar="SYMBOL",
-                       help="start symbol (default: @StartRule, else the first rule's)")
+    build.add_argument("--start", metavar="RULE", help=_START_HELP)
+    build.add_argument("--warnings-as-errors", action="store_true", help=_WARNINGS_HELP)
     build.add_argument("--chunk-size", type=_positive, default=16384, metavar="N",
                        help="at most N lots derived together (default 16384; fewer when lots make many "
                             "records); the output does not depend on it")
@@ -119,7 +123,8 @@ def _parser() -> argparse.ArgumentParser:
 
     check = sub.add_parser("check", help="report every problem of a grammar, and a summary")
     check.add_argument("grammar", type=Path)
-    check.add_argument("--start", metavar="SYMBOL")
+    check.add_argument("--start", metavar="RULE", help=_START_HELP)
+    check.add_argument("--warnings-as-errors", action="store_true", help=_WARNINGS_HELP)
     check.add_argument("--dump-ir", action="store_true", help="print the IR after the passes")
     _workspace_option(check)
     check.add_argument("--dialect", choices=("cga2006", "cityengine"),
@@ -187,7 +192,8 @@ def _check(args) -> int:
     options = BuildOptions(start=args.start, dialect=args.dialect, workspace=args.workspace)
     with grammar_source(args.grammar, options) as (source, display, resolved):
         grammar = compile_grammar(source, start=resolved.start, dialect=resolved.dialect, display=display,
-                                  asset_roots=resolved.asset_roots, workspace=resolved.workspace)
+                                  asset_roots=resolved.asset_roots, workspace=resolved.workspace,
+                                  derive=False, warnings_as_errors=args.warnings_as_errors)
     _warn(grammar)
     graph = grammar.graph
     if args.dump_ir:
@@ -325,6 +331,7 @@ def _build(args) -> int:
         dialect=args.dialect,
         workers=args.workers,
         workspace=args.workspace,
+        warnings_as_errors=args.warnings_as_errors,
     )
     bar = _ProgressBar() if not args.quiet else None
     try:

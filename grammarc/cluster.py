@@ -114,7 +114,8 @@ def build_on_dask(grammar_path, output, *, dask: str, lots_path=None, options: B
         raise UsageError("--dask needs a lots file (--lots), which every worker reads its partitions of")
     with grammar_source(Path(grammar_path), options) as (source, display, resolved):
         grammar = compile_grammar(source, start=resolved.start, asset_roots=resolved.asset_roots,
-                                  dialect=resolved.dialect, display=display, workspace=resolved.workspace)
+                                  dialect=resolved.dialect, display=display, workspace=resolved.workspace,
+                                  warnings_as_errors=resolved.warnings_as_errors)
         plan = make_plan(grammar)
         check_overrides(grammar.module, resolved.attrs)
         output_options = replace(output_options or OutputOptions(), asset_roots=tuple(grammar.asset_roots))

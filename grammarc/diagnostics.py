@@ -92,5 +92,42 @@ def render_all(diags: list[Diagnostic], sources: dict[str, str]) -> str:
 
 def suggest(name: str, candidates) -> str:
     """`` (did you mean `x`?)`` for the closest candidate, or an empty string."""
+    close = close_match(name, candidates)
+    return f" (did you mean `{close}`?)" if close is not None else ""
+
+
+def close_match(name: str, candidates) -> str | None:
+    """The candidate closest to ``name`` if one is close enough to be what was meant, else None."""
     close = difflib.get_close_matches(name, list(candidates), n=1, cutoff=0.6)
-    return f" (did you mean `{close[0]}`?)" if close else ""
+    return close[0] if close else None
+
+
+def typo_of(name: str, candidates) -> str | None:
+    """The candidate that ``name`` is a typo of, or None: one edit away (a letter missing, extra, wrong, or
+    two swapped) for names of four to seven letters, two for longer ones, letter case aside (names of one
+    to three letters are all one edit apart: only their case). Stricter than ``suggest``, which picks the
+    likeliest of names that must exist; a name that need not exist (a leaf) is only suspect when it is
+    that close."""
+    most = 0 if len(name) < 4 else 1 if len(name) < 8 else 2
+    lowered = name.lower()
+    for candidate in candidates:
+        if candidate != name and abs(len(candidate) - len(name)) <= most \
+                and _edits(lowered, candidate.lower(), most) <= most:
+            return candidate
+    return None
+
+
+def _edits(a: str, b: str, most: int) -> int:
+    """Optimal string alignment distance of ``a`` and ``b`` (insertions, deletions, substitutions and
+    swaps of neighbours), or ``most + 1`` once it is sure to exceed ``most``."""
+    before, row = None, list(range(len(b) + 1))
+    for i, x in enumerate(a, 1):
+        current = [i] + [0] * len(b)
+        for j, y in enumerate(b, 1):
+            current[j] = min(row[j] + 1, current[j - 1] + 1, row[j - 1] + (x != y))
+            if before is not None and i > 1 and j > 1 and x == b[j - 2] and a[i - 2] == y:
+                current[j] = min(current[j], before[j - 2] + 1)
+        if min(current) > most:
+            return most + 1
+        before, row = row, current
+    return row[-1]

@@ -172,3 +172,54 @@ def test_workspace_option_of_check_and_build(write, capsys, tmp_path):
 def test_check_reports_errors_exit_2(write, capsys):
     assert main(["check", str(write("g.cga", "lot ~> T(1, 2)\n"))]) == 2
     assert "`T` takes 3 arguments, got 2" in capsys.readouterr().err
+
+
+CITYENGINE_START = 'version "2022.0"\n@StartRule\nLot(h, floors) --> extrude(h) split(y){ ~floors : Floor }*\n'
+
+
+def test_build_calls_a_start_rule_with_the_arguments_of_start(write, tmp_path, capsys):
+    grammar = write("g.cga", CITYENGINE_START)
+    out = tmp_path / "out.npz"
+    assert main(["build", str(grammar), "--emit", str(out), "--start", "Lot(12, 3)", "--quiet"]) == 0
+    record = read_instances(out)
+    assert len(record["asset"]) == 4  # 12 m in floors of about 3
+    np.testing.assert_allclose(record["xform"][:, 1, 1], 3)
+    assert main(["check", str(grammar), "--start", "Lot(12, 3)"]) == 0
+    assert "start:     Lot(12, 3)" in capsys.readouterr().out
+
+
+def test_a_start_rule_with_parameters_checks_with_a_warning_and_does_not_build_without_them(write, tmp_path,
+                                                                                           capsys):
+    grammar = write("g.cga", CITYENGINE_START)
+    assert main(["check", str(grammar)]) == 0
+    assert "warning: the start rule `Lot` takes parameters (h, floors)" in capsys.readouterr().err
+    out = tmp_path / "out.npz"
+    assert main(["build", str(grammar), "--emit", str(out)]) == 2
+    assert "build it with --start 'Lot(...)' giving their values" in capsys.readouterr().err
+    assert main(["build", str(grammar), "--emit", str(out), "--start", "Lot(12)"]) == 2
+    assert "--start calls `Lot` with 1 argument; it takes 2 (h, floors)" in capsys.readouterr().err
+    assert not out.exists()
+
+
+def test_check_says_which_rule_starts_without_start_rule(write, capsys):
+    assert main(["check", str(write("g.cga", 'version "2022.0"\nLot --> extrude(3) Mass\nMass --> X\n'))]) == 0
+    assert "warning: no @StartRule: starting with `Lot`, the first rule" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("command", ["check", "build"])
+def test_warnings_as_errors_exit_2(write, tmp_path, capsys, command):
+    grammar = write("g.cga", 'version "2022.0"\n@StartRule\nLot --> extrude(3) comp(f){ side : Facdae }\n'
+                             "Facade --> X\n")
+    args = [command, str(grammar)] + (["--emit", str(tmp_path / "out.npz")] if command == "build" else [])
+    assert main(args + ["--warnings-as-errors"]) == 2
+    err = capsys.readouterr().err
+    assert "error: `Facdae` has no rule, so it is a leaf (did you mean `Facade`?)" in err
+    assert "2 errors; nothing was written" in err  # and the unreachable rule
+    assert not (tmp_path / "out.npz").exists()
+    assert main(args + ["--quiet"] * (command == "build")) == 0
+
+
+def test_a_cycle_of_attributes_is_an_error_not_a_crash(write, tmp_path, capsys):
+    grammar = write("g.cga", 'version "2022.0"\nattr a = b\nattr b = a\n@StartRule\nLot --> extrude(a) X\n')
+    assert main(["build", str(grammar), "--emit", str(tmp_path / "out.npz")]) == 2
+    assert "attribute `a` has no value: its default uses itself (attr a -> b -> a)" in capsys.readouterr().err

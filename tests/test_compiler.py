@@ -38,7 +38,7 @@ def test_compiles_and_reads_the_file(write):
 
 def test_every_error_of_every_stage_is_listed(write):
     text = (
-        "lot(x) ~> a b c d\n"                    # start rule with a parameter (compiler)
+        "lot(x) ~> a b c d\n"                    # start rule with a parameter (a warning)
         'a ~> Subdv("Y", 1){ b }\n'              # unknown operation (lowering)
         "b ~> T(1, 2\n"                          # syntax error
         "c ~> T(zz, 0, 0)\n"                     # unknown identifier (resolve)
@@ -47,7 +47,8 @@ def test_every_error_of_every_stage_is_listed(write):
     )
     errors = compile_errors(write("g.cga", text))
     assert sorted(errors, key=lambda e: e[1:3]) == [
-        ("start-params", 1, 1, "the start rule `lot` cannot take parameters: a lot has no arguments to pass"),
+        ("start-params", 1, 1, ("the start rule `lot` takes parameters (x): a lot has no arguments to pass; "
+         "build it with --start 'lot(...)' giving their values")),
         ("unknown-op", 2, 6, "unknown operation `Subdv` (did you mean `Subdiv`?)"),
         ("syntax", 3, 7, "unclosed `(`"),
         ("unknown-name", 4, 8, "unknown identifier `zz` in rule `c`"),
@@ -121,9 +122,31 @@ def test_start_rule_that_failed_to_parse_reports_its_syntax_error(tmp_path):
         ("syntax", 2, 9, "unclosed `(`")]
 
 
-def test_start_rule_with_parameters(tmp_path):
-    assert compile_errors(tmp_path / "g.cga", "attr h = 1\nlot(w) ~> b(w)\nb(x) ~> c") == [
-        ("start-params", 2, 1, "the start rule `lot` cannot take parameters: a lot has no arguments to pass")]
+def test_start_rule_with_parameters_needs_their_values_to_be_derived(tmp_path):
+    text = "attr h = 1\nlot(w) ~> b(w)\nb(x) ~> c"
+    with pytest.raises(UsageError, match=r"the start rule `lot` takes parameters \(w\): a lot has no arguments "
+                       r"to pass; build it with --start 'lot\(...\)' giving their values"):
+        compile_grammar(tmp_path / "g.cga", text=text)
+    checked = compile_grammar(tmp_path / "g.cga", text=text, derive=False)  # `grammarc check`
+    assert [(w.code, w.span.line) for w in checked.warnings] == [("start-params", 2)]
+    derived = compile_grammar(tmp_path / "g.cga", text=text, start="lot(3)")
+    assert derived.graph.start == "lot(3)" and not derived.warnings
+    assert derived.graph.edges["lot(3)"] == ("lot",)
+
+
+def test_start_arguments_that_do_not_fit_the_rule(tmp_path):
+    text = 'lot(w, kind) ~> b(w)\nb(x) ~> S(x, 1, 1) c'
+    with pytest.raises(UsageError, match=r"--start calls `lot` with 1 argument; it takes 2 \(w, kind\)"):
+        compile_grammar(tmp_path / "g.cga", text=text, start="lot(3)")
+    errors = compile_errors(tmp_path / "g.cga", text, start='lot("tall", "a")')
+    assert errors == [("type", 2, 11, "a size must be a num, got a str")]  # at the use of `w`
+
+
+def test_warnings_as_errors(tmp_path):
+    text = "lot ~> a\nlost ~> x"
+    assert compile_errors(tmp_path / "g.cga", text, warnings_as_errors=True) == [
+        ("unreachable", 2, 1, "rule for `lost` is never reached from `lot`")]
+    assert [w.code for w in compile_grammar(tmp_path / "g.cga", text=text).warnings] == ["unreachable"]
 
 
 @pytest.mark.parametrize("name, fragment", [

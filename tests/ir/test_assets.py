@@ -31,7 +31,7 @@ def test_a_computed_asset_name_resolves_every_string_constant_that_names_a_file(
     text = VERSION + 'const kind = "a.obj"\nLot --> i(kind) X\nX --> case p(0.5) : i("b.OBJ") else : i(kind + "")\n'
     module, diags = resolved(text, (tmp_path,), "cityengine")
     assert dict(module.asset_ids) == {"b.OBJ": 2, "a.obj": 3}
-    assert [(d.code, d.span.line) for d in diags] == [("asset", 4)]  # b.OBJ is missing
+    assert [(d.code, d.span.line) for d in diags] == [("start-rule", 3), ("asset", 4)]  # b.OBJ is missing
 
 
 def test_errors_and_warnings_at_the_name(tmp_path):

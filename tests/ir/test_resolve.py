@@ -102,3 +102,23 @@ def test_nothing_to_resolve_returns_the_same_module():
     diags = Diagnostics()
     module = parse_source('attr a = 1\nx ~> T(1, 2, 3) Subdiv("X", 1r){ y }', FILE, diags)
     assert resolve_names(module, diags) is module
+
+
+@pytest.mark.parametrize("declarations, expected", [
+    ("attr a = b\nattr b = a\n", [(2, "attribute `a` has no value: its default uses itself (attr a -> b -> a)")]),
+    ("attr a = a + 1\n", [(2, "attribute `a` has no value: its default uses itself (attr a -> a)")]),
+    # through a constant, and through a function (inlined by then)
+    ("attr a = 2 * c\nconst c = b\nattr b = a\n",
+     [(2, "attribute `a` has no value: its default uses itself (attr a -> c -> b -> a)")]),
+    ("f(x) = x + e\nattr e = f(1)\n", [(3, "attribute `e` has no value: its default uses itself (attr e -> e)")]),
+    # an attribute that uses a cycle is not on it: one error, at the cycle
+    ("attr g = a\nattr a = b\nattr b = a\n",
+     [(3, "attribute `a` has no value: its default uses itself (attr a -> b -> a)")]),
+    ("attr a = b\nattr b = 3\n", []),  # a later attribute, no cycle
+])
+def test_a_cycle_of_cityengine_attributes_is_an_error_naming_it(declarations, expected):
+    text = 'version "2022.0"\n' + declarations + "@StartRule\nLot --> X\n"
+    diags = Diagnostics()
+    run_passes(parse_source(text, FILE, diags, "cityengine"), diags, check=True)
+    assert [(d.span.line, d.message) for d in diags if d.code == "attr-cycle"] == expected
+    assert [d.code for d in diags if d.is_error and d.code != "attr-cycle"] == []

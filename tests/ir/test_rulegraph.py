@@ -117,12 +117,13 @@ def test_the_pass_sets_the_graph_of_the_start_symbol_on_the_module():
                                         {"a": ("b",), "b": ("c",)})
 
 
-def test_the_start_rule_of_a_module_to_derive_takes_no_parameters():
+def test_a_start_rule_with_parameters_in_a_module_to_derive_warns():
     text = "lot(w) ~> b(w)\nb(x) ~> c"
     diags = Diagnostics()
     module = run_passes(replace(parse_source(text, FILE, diags), roots=()), diags, check=True)
-    assert [(d.code, d.span.line, d.message) for d in diags] == [
-        ("start-params", 1, "the start rule `lot` cannot take parameters: a lot has no arguments to pass")]
+    assert [(d.code, d.severity.value, d.span.line, d.message) for d in diags] == [
+        ("start-params", "warning", 1, ("the start rule `lot` takes parameters (w): a lot has no arguments to "
+         "pass; build it with --start 'lot(...)' giving their values"))]
     assert module.graph.start == "lot"  # made all the same
     # a fragment lowered by a test (no asset folders) is not derived: it may start anywhere
     diags = Diagnostics()
@@ -146,3 +147,53 @@ def test_a_start_symbol_without_a_rule_is_the_callers_mistake_unless_errors_are_
     diags = Diagnostics()
     diags.error("syntax", "the start rule failed to parse", module.rules[0].span)
     assert run_passes(replace(module, start="zz"), diags).graph is None
+
+
+def test_a_cityengine_file_without_start_rule_starts_with_its_first_rule_and_says_so():
+    diags = Diagnostics()
+    text = 'version "2022.0"\nLot --> Helper\nHelper --> A\n'
+    module = run_passes(parse_source(text, FILE, diags, "cityengine"), diags, check=True)
+    assert module.start == module.graph.start == "Lot"
+    assert [(d.code, d.span.line, d.message) for d in diags] == [
+        ("start-rule", 2, "no @StartRule: starting with `Lot`, the first rule")]
+    # the paper's start is its first rule by definition: nothing to say
+    assert not graph("a ~> b\nb ~> c")[1]
+
+
+CITYENGINE = 'version "2022.0"\n@StartRule\nLot --> extrude(10) comp(f){ side : LEAF | top : Roof. }\n'
+
+
+@pytest.mark.parametrize("leaf, warned", [
+    ("facdes", "`facdes` has no rule, so it is a leaf (did you mean `facades`?)"),
+    ("Facades", "`Facades` has no rule, so it is a leaf (did you mean `facades`?)"),  # letter case
+    ("facades_window", None),  # no rule's name is close
+    ("facade", None),  # a prefix of a rule's name: `Window` beside `Windows` is a naming habit
+    ("facdes.", None),  # the leaf marker says it is meant
+    ("fac", None),  # a short name: every short name is one letter from another
+])
+def test_a_bare_leaf_that_looks_like_a_typo_of_a_rule_warns(leaf, warned):
+    text = CITYENGINE.replace("LEAF", leaf) + "facades --> split(y){ ~3 : Floor }*\n"
+    diags = Diagnostics()
+    run_passes(parse_source(text, FILE, diags, "cityengine"), diags, check=True)
+    found = [(d.span.line, d.span.col, d.message, d.hint) for d in diags if d.code == "undefined-rule"]
+    col = text.splitlines()[2].index(leaf.rstrip(".")) + 1
+    hint = f"write `{leaf}.` if it is meant as a leaf"
+    assert found == ([] if warned is None else [(3, col, warned, hint)])
+
+
+def test_the_paper_notation_warns_of_typos_too_without_the_leaf_marker_hint():
+    g, diags = graph('lot ~> Subdiv("Y", 1r, 1r){ facdes | roof }\nfacades ~> wall')
+    assert [(d.code, d.span.col, d.hint) for d in diags] == [("undefined-rule", 29, ""),
+                                                              ("unreachable", 1, "")]
+    assert "facdes" in g.terminals
+
+
+@pytest.mark.parametrize("leaves, rules", [
+    ("Bay3 Bay12", "Bay1 --> X\n"),  # a numbered family
+    ("Window Tile", "Windows --> X\nTileRow --> X\n"),  # a prefix either way
+])
+def test_leaves_named_beside_rules_as_files_name_them_do_not_warn(leaves, rules):
+    text = f'version "2022.0"\n@StartRule\nLot --> extrude(10) {leaves}\n{rules}'
+    diags = Diagnostics()
+    run_passes(parse_source(text, FILE, diags, "cityengine"), diags, check=True)
+    assert [d for d in diags if d.code == "undefined-rule"] == []

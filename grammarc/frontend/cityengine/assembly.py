@@ -9,13 +9,15 @@ from dataclasses import replace
 
 from grammarc.diagnostics import Diagnostics, Span, suggest
 from grammarc.frontend.cityengine.nodes import Annotated, FunctionDef, Import, RuleDef, Style
+from grammarc.frontend.cityengine.operations import check_calls
 from grammarc.ir import nodes as ir
 from grammarc.ir.traverse import rewrite_body, rewrite_expr, rewrite_ops
 
 
 def assemble(file: str, statements: list, diags: Diagnostics, imports=()) -> ir.Module:
     """Declarations in source order -> Module: start rule, overloads by arity, functions inlined, the
-    imported modules' rules and attributes merged under their prefixes."""
+    imported modules' rules and attributes merged under their prefixes. Without ``@StartRule`` the start
+    is None: ``passes.rulegraph`` starts with the first rule and says so."""
     attrs: list[ir.AttrDecl] = []
     functions: dict[str, FunctionDef] = {}
     rules: list[tuple[RuleDef, tuple]] = []
@@ -67,8 +69,7 @@ def assemble(file: str, statements: list, diags: Diagnostics, imports=()) -> ir.
         lowered.append(ir.Rule(symbol=name, params=rule.params, guard=None,
                                alternatives=(ir.Alternative(body, None, rule.span),), priority=0,
                                span=rule.span, site=rule.site))
-    if start is None and lowered:
-        start = lowered[0].symbol
+    lowered = check_calls(lowered, [module for _, module in imports], diags)
     imported = []
     own = {rule.symbol for rule in lowered}
     for statement, module in imports:

@@ -16,7 +16,7 @@ from dataclasses import replace
 
 from lark import Token, v_args
 
-from grammarc.diagnostics import Span
+from grammarc.diagnostics import Span, suggest
 from grammarc.frontend.cityengine.nodes import (
     Annotated,
     EdgeDistances,
@@ -31,6 +31,7 @@ from grammarc.frontend.cityengine.nodes import (
     as_body,
 )
 from grammarc.frontend.cityengine.operations import (
+    ALL_OPERATIONS,
     BARE_OPS,
     NOT_APPLIED,
     OPERATIONS,
@@ -288,6 +289,10 @@ class Lowering(OperationLowering, LoweringBase):
         op, span, args = str(name), self.token_span(name), args or ()
         handler = PART_OPERATIONS.get(op)
         if handler is None:
+            if op not in ALL_OPERATIONS:  # a rule call takes no parts: a misspelt operation
+                self.diags.error("unknown-op", f"unknown operation `{op}`"
+                                 f"{suggest(op, PART_OPERATIONS) or suggest(op, ALL_OPERATIONS)}", span)
+                return ir.Empty(span)
             return self.unsupported(op, span)
         if star is None:
             return handler(self, op, args, parts, span)

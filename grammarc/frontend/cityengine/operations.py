@@ -4,15 +4,20 @@ handler per operation that needs one; ``OPERATIONS`` and ``PART_OPERATIONS`` (ca
 ``{ sel : A | ... }``) map names to handlers, or to ``direct`` where the arguments are the IR node's
 fields; the other tables name the selectors and roof arguments calls are checked against, and the
 operations that are accepted but not applied or not implemented. An operation or construct grammarc does
-not implement is an error ``unsupported: NAME`` at its span.
+not implement is an error ``unsupported: NAME`` at its span; a name that is no operation of CityEngine's
+reference where only an operation can be (``spilt(y){ ... }``, or a typo of one called where no rule has
+the name) is ``unknown operation NAME`` (``check_calls``).
 """
 
 from __future__ import annotations
 
-from grammarc.diagnostics import suggest
+from dataclasses import replace
+
+from grammarc.diagnostics import Diagnostics, suggest, typo_of
 from grammarc.frontend.cityengine.nodes import EdgeDistances, Group, Part, PendingOffset, Sized
 from grammarc.frontend.lowering import direct
 from grammarc.ir import nodes as ir
+from grammarc.ir.traverse import rewrite_ops
 
 
 class OperationLowering:
@@ -372,6 +377,8 @@ NOT_APPLIED = frozenset({
     "setPivot",
 })
 #: CityEngine operations grammarc does not implement yet (the geometry and context issues bring most).
+#: With ``OPERATIONS``, ``PART_OPERATIONS`` and ``NOT_APPLIED`` they are every operation of CityEngine's
+#: CGA reference, so that any other name called with parts, or a typo of one of them, is unknown.
 UNSUPPORTED_OPS = frozenset({
     "innerPolygon",
     "trim",
@@ -379,6 +386,38 @@ UNSUPPORTED_OPS = frozenset({
     "insertAlongUV", "scatter", "footprint", "tileUV", "splitArea", "inline", "resetGeometry", "taper",
     "primitiveCylinder", "primitiveSphere", "primitiveDisk", "primitiveCone", "primitiveQuad",
     "reduceGeometry", "rectify", "semiPolygon",
+    "alignScopeToGeometryBBox", "rotate", "translate", "roofRidge", "modify",
+    "setbackPerEdge", "setbackToArea", "splitAndSetbackPerimeter",
+    "tag", "deleteTags", "setTagsFromEdgeAttrs", "union", "subtract", "intersect",
+    "copyUV", "setMaterial", "resetMaterial",
 } - NOT_APPLIED)
+#: Every operation name CityEngine knows: what a misspelt one is suggested from.
+ALL_OPERATIONS = frozenset(OPERATIONS) | frozenset(PART_OPERATIONS) | NOT_APPLIED | UNSUPPORTED_OPS
 #: Axis selectors of ``center`` and ``alignScopeToAxes``.
 AXIS_NAMES = {"x": (0,), "y": (1,), "z": (2,), "xy": (0, 1), "xz": (0, 2), "yz": (1, 2), "xyz": (0, 1, 2)}
+
+
+def check_calls(rules: list[ir.Rule], imported, diags: Diagnostics) -> list[ir.Rule]:
+    """``rules`` (a file's own) with their misspelt operations reported and dropped.
+
+    A call ``name(args)`` that names neither an operation, nor one of the rules, nor a rule of the
+    ``imported`` modules (those imported without a prefix merge theirs; a prefixed call ``p.Rule(...)`` is
+    not looked at) is a rule call in CityEngine, of a missing rule: a leaf. When the name is a typo of an
+    operation (``spilt(x)``), that is what was meant: an error ``unknown operation`` with the suggestion.
+    Other names stay calls of a missing rule, which the types pass warns about; so do capitalised ones
+    (``Envelope(h)``): operations are lower-case, rules are mostly named in capitals.
+    """
+    defined = {r.symbol for r in rules} | {r.symbol for module in imported for r in module.rules}
+
+    def check(op):
+        if isinstance(op, ir.Symbol) and op.args and not op.leaf and op.name not in defined \
+                and "." not in op.name and not op.name[0].isupper():
+            close = typo_of(op.name, ALL_OPERATIONS)
+            if close is not None:
+                diags.error("unknown-op", f"unknown operation `{op.name}` (did you mean `{close}`?)",
+                            op.span)
+                return ir.Empty(op.span)
+        return op
+
+    return [replace(rule, alternatives=tuple(replace(alt, body=rewrite_ops(alt.body, check))
+                                             for alt in rule.alternatives)) for rule in rules]

@@ -2,7 +2,9 @@
 
 Assumes: a lowered module. Guarantees: no ``Name`` is left; an identifier that is neither a parameter of
 its rule nor a declared attribute is an error that names it (attribute defaults may only use attributes
-declared before them).
+declared before them). A CityEngine attribute whose default uses itself, through other attributes or
+constants (``attr a = b``, ``attr b = a``; functions are inlined by then, so cycles through them count) has
+no value: an error at its declaration naming the cycle (``attr a -> b -> a``), once per cycle.
 """
 
 from __future__ import annotations
@@ -11,7 +13,7 @@ from dataclasses import replace
 
 from grammarc.diagnostics import Diagnostics, suggest
 from grammarc.ir import nodes as ir
-from grammarc.ir.traverse import iter_ops, rewrite_expr, rewrite_rule
+from grammarc.ir.traverse import iter_exprs, iter_ops, rewrite_expr, rewrite_rule
 
 
 def resolve_names(module: ir.Module, diags: Diagnostics) -> ir.Module:
@@ -27,6 +29,8 @@ def resolve_names(module: ir.Module, diags: Diagnostics) -> ir.Module:
         default = rewrite_expr(attr.default, _resolver({}, visible, diags, where, later=all_attrs))
         attrs.append(attr if default is attr.default else replace(attr, default=default))
         declared.append(attr.name)
+    if lazy:
+        _check_cycles(attrs, diags)
     rules = []
     for rule in module.rules:
         params = {name: i for i, name in enumerate(rule.params)}
@@ -39,6 +43,35 @@ def resolve_names(module: ir.Module, diags: Diagnostics) -> ir.Module:
     if all(a is b for a, b in zip(attrs, module.attrs)) and all(a is b for a, b in zip(rules, module.rules)):
         return module
     return replace(module, attrs=tuple(attrs), rules=tuple(rules))
+
+
+def _check_cycles(attrs: list[ir.AttrDecl], diags: Diagnostics) -> None:
+    """An error for each cycle of attribute defaults, at the attribute of it declared first."""
+    uses = {a.name: [e.name for e in iter_exprs(a.default) if isinstance(e, ir.AttrRef)] for a in attrs}
+    on_cycle: set[str] = set()
+    for attr in attrs:
+        if attr.name in on_cycle:
+            continue
+        # breadth first from the attribute: the shortest way back to it, if there is one
+        came_from: dict[str, str] = {}
+        frontier = [attr.name]
+        while frontier and attr.name not in came_from:
+            following = []
+            for name in frontier:
+                for used in uses.get(name, ()):
+                    if used not in came_from:
+                        came_from[used] = name
+                        following.append(used)
+            frontier = following
+        if attr.name not in came_from:
+            continue
+        cycle = [attr.name]
+        while came_from[cycle[-1]] != attr.name:
+            cycle.append(came_from[cycle[-1]])
+        cycle.reverse()
+        on_cycle.update(cycle)
+        diags.error("attr-cycle", f"attribute `{attr.name}` has no value: its default uses itself "
+                    f"(attr {' -> '.join([attr.name, *cycle[:-1], attr.name])})", attr.span)
 
 
 def _resolver(params: dict[str, int], attrs: list[str], diags: Diagnostics, where: str,

@@ -2,11 +2,22 @@
 
 Assumes: names resolved and types checked. Guarantees: the grammar has rules, its start symbol has one,
 and ``Module.graph`` holds the ``RuleGraph`` from it; rules the start symbol never reaches are warned
-about. The start rule takes no parameters in a module to derive (one with asset folders, ``roots``, as
-the compiler makes it: a lot has no arguments to pass; a fragment lowered by a test may start anywhere).
+about. A module without a start symbol (a CityEngine file without ``@StartRule``) starts with its first
+rule, as CityEngine's inspector does, and says so. A start rule with parameters in a module to derive (one
+with asset folders, ``roots``, as the compiler makes it) is a warning here: the grammar is sound, but a lot
+has no arguments to pass, so ``build`` needs them from the command line (``--start 'Lot(10)'``, which
+``frontend.start`` makes into a rule calling it); a fragment lowered by a test may start anywhere.
 A start symbol without a rule is the caller's mistake (``--start``), not the grammar's: a
 ``UsageError``, unless errors are listed already (the start rule may be one that failed to parse: its
 errors say more than "no rule").
+
+A successor symbol without a rule is a leaf, in both notations; CityEngine marks an intended one ``X.``,
+but most files write bare leaves (``Wall``, ``Glass``) without rules, so a bare one is warned about
+(``undefined-rule``) only when its name looks like a typo of a rule's (``diagnostics.typo_of``: one or two
+letters off, ``facdes`` for ``facades``, or the letter case), of a rule under the same import prefix, and
+is not one of the usual ways of naming leaves beside rules: a prefix of the rule's name or the other way
+round (``Window`` beside ``Windows``, ``Tile`` beside ``TileRow``), or a number of a numbered family
+(``Bay3`` beside ``Bay1``).
 
 An analysis, not a rewrite: the module comes back with its graph. Recursion is found as strongly
 connected components of the symbol graph (Tarjan).
@@ -16,7 +27,7 @@ from __future__ import annotations
 
 from dataclasses import replace
 
-from grammarc.diagnostics import Diagnostics, Span
+from grammarc.diagnostics import Diagnostics, Span, typo_of
 from grammarc.errors import UsageError
 from grammarc.ir import nodes as ir
 from grammarc.ir.nodes import RuleGraph
@@ -29,15 +40,27 @@ def rule_graph(module: ir.Module, diags: Diagnostics) -> ir.Module:
         if not diags.has_errors:  # rules that failed to parse are not "no rules"
             diags.error("empty", "the grammar has no rules", Span(module.file, 1, 1, 1, 1))
         return module
+    if module.start is None:
+        first = module.rules[0]
+        if not diags.has_errors:  # a note to a grammar that works: its errors come first
+            diags.warning("start-rule", f"no @StartRule: starting with `{first.symbol}`, the first rule",
+                          first.span, hint="mark the start rule with @StartRule, or give it with --start")
+        module = replace(module, start=first.symbol)
     start = next((r for r in module.rules if r.symbol == module.start), None)
     if start is None:
         if diags.has_errors:
             return module
         raise UsageError(f"start symbol `{module.start}` has no rule in {module.file}")
     if start.params and module.roots is not None:  # a module to derive: lots pass no arguments
-        diags.error("start-params", f"the start rule `{start.symbol}` cannot take parameters: a lot has no "
-                    "arguments to pass", start.span)
+        diags.warning("start-params", start_params_message(start), start.span)
     return replace(module, graph=analyze_rules(module, start.symbol, diags))
+
+
+def start_params_message(start: ir.Rule) -> str:
+    """What to say of a start rule with parameters: a lot has no arguments to pass, the command line does."""
+    name = start.symbol.partition("/")[0]  # `Lot/2` when Lot is overloaded by arity
+    return (f"the start rule `{start.symbol}` takes parameters ({', '.join(start.params)}): a lot has no "
+            f"arguments to pass; build it with --start '{name}(...)' giving their values")
 
 
 def analyze_rules(module: ir.Module, start: str, diags: Diagnostics) -> RuleGraph:
@@ -51,6 +74,7 @@ def analyze_rules(module: ir.Module, start: str, diags: Diagnostics) -> RuleGrap
                 if not op.leaf:  # `X.` ends the derivation: no edge to X's rules
                     edges[rule.symbol].append(op.name)
     terminals = tuple(s for s in used if s not in edges)
+    _warn_undefined(module, nonterminals, edges, diags)
     reachable = _reach(start, edges)
     for rule in module.rules:
         if rule.symbol not in reachable:
@@ -60,6 +84,32 @@ def analyze_rules(module: ir.Module, start: str, diags: Diagnostics) -> RuleGrap
     recursive = _recursive(frozen)
     _warn_guarded_recursion(module, recursive & reachable, diags)
     return RuleGraph(start, nonterminals, terminals, frozenset(reachable), recursive, frozen)
+
+
+def _warn_undefined(module: ir.Module, nonterminals, edges, diags: Diagnostics) -> None:
+    """A bare successor without a rule whose name looks like a typo of a rule's (module docstring)."""
+    typos: dict[str, str | None] = {}
+    for op in iter_ops(module):
+        if not isinstance(op, ir.Symbol) or op.leaf or op.args or op.name in edges:
+            continue
+        if op.name not in typos:
+            prefix = op.name.rpartition(".")[0]
+            close = typo_of(op.name, [s for s in nonterminals if s.rpartition(".")[0] == prefix])
+            typos[op.name] = close if close is not None and not _naming_habit(op.name, close) else None
+        close = typos[op.name]
+        if close is not None:
+            hint = f"write `{op.name}.` if it is meant as a leaf" if module.dialect == "cityengine" else ""
+            diags.warning("undefined-rule", f"`{op.name}` has no rule, so it is a leaf (did you mean "
+                          f"`{close}`?)", op.span, hint=hint)
+
+
+def _naming_habit(leaf: str, rule: str) -> bool:
+    """Whether a leaf beside a rule of a close name is named so on purpose (module docstring)."""
+    return rule.startswith(leaf) or leaf.startswith(rule) or \
+        leaf.translate(_NO_DIGITS) == rule.translate(_NO_DIGITS)
+
+
+_NO_DIGITS = str.maketrans("", "", "0123456789")
 
 
 def _warn_guarded_recursion(module: ir.Module, recursive: frozenset[str], diags: Diagnostics) -> None:

@@ -1,6 +1,6 @@
 """frontend/cityengine/operations.py: CityEngine's operations lowered to IR operations (scope operations,
 split, comp, setback, roofs, set, report...), and the operations grammarc accepts without applying them or
-does not implement (``unsupported: NAME`` at their span).
+does not implement (``unsupported: NAME`` at their span); a misspelt operation is unknown.
 """
 
 from __future__ import annotations
@@ -9,7 +9,15 @@ import pytest
 
 from grammarc.backend.plan import make_plan
 from grammarc.compiler import compile_grammar
-from grammarc.frontend.cityengine.operations import NOT_APPLIED, OPERATIONS, PART_OPERATIONS, UNSUPPORTED_OPS
+from grammarc.diagnostics import Diagnostics
+from grammarc.frontend.cityengine.operations import (
+    ALL_OPERATIONS,
+    NOT_APPLIED,
+    OPERATIONS,
+    PART_OPERATIONS,
+    UNSUPPORTED_OPS,
+)
+from grammarc.frontend.parse import parse_source
 from grammarc.ir import nodes as ir
 from grammarc.ir.printer import print_expr
 from grammarc.ir.traverse import iter_ops
@@ -161,7 +169,8 @@ def test_cleanup_geometry_names_a_wrong_component_or_argument_count_at_its_line(
 def test_merged_selector_is_derived_face_by_face_with_a_warning(line, at):
     module, diags = compile_ir(VERSION + line + "\n")
     assert not diags.has_errors
-    assert [(d.code, d.span.line, d.span.col) for d in diags] == [("merged", 2, line.index(at) + 1)]
+    assert [(d.code, d.span.line, d.span.col) for d in diags] == [("merged", 2, line.index(at) + 1),
+                                                                  ("start-rule", 2, 1)]
     assert isinstance(module.rules[0].alternatives[0].body[0], ir.CompFaces)
 
 
@@ -238,3 +247,63 @@ def test_the_arguments_of_a_direct_operation_are_its_fields_in_order():
     mirror, report = body[0], body[1]
     assert isinstance(mirror, ir.Mirror) and [print_expr(a) for a in mirror.axes] == ["true", "false", "true"]
     assert isinstance(report, ir.Report) and (print_expr(report.key), print_expr(report.value)) == ('"k"', "2")
+
+
+# ------------------------------------------------------------------------------------- the unknown
+
+
+@pytest.mark.parametrize("line, message, at", [
+    ("Lot --> spilt(y){ 3 : Floor }*", "unknown operation `spilt` (did you mean `split`?)", "spilt"),
+    ("Lot --> setbak(2){ front : A | remainder : B }", "unknown operation `setbak` (did you mean `setback`?)",
+     "setbak"),
+    ("Lot --> extrdue(10) Mass", "unknown operation `extrdue` (did you mean `extrude`?)", "extrdue"),
+    ("Lot --> Mass colour(1, 0, 0)", "unknown operation `colour` (did you mean `color`?)", "colour"),
+    ("Lot --> qq(x){ 3 : A }", "unknown operation `qq`", "qq"),
+])
+def test_a_misspelt_operation_is_unknown_with_a_suggestion(line, message, at):
+    assert errors(VERSION + line + "\n") == [(2, line.index(at) + 1, message)]
+
+
+def test_a_rule_named_like_a_misspelt_operation_is_called():
+    module = module_of(VERSION + "@StartRule\nLot --> extrude(10) spilt(3)\nspilt(n) --> split(y){ ~n : A }*\n")
+    assert [op.name for op in module.rules[0].alternatives[0].body if isinstance(op, ir.Symbol)] == ["spilt"]
+
+
+def test_a_call_of_no_rule_that_is_no_typo_stays_a_leaf_with_a_warning():
+    module, diags = compile_ir(VERSION + "@StartRule\nLot --> extrude(10) Facade(3)\n")
+    assert [(d.code, d.severity.value) for d in diags] == [("terminal-args", "warning")]
+    assert module.graph.terminals == ("Facade",)
+
+
+#: Every operation of CityEngine's CGA reference (2019-2025), geometry, texturing, scope and tags.
+REFERENCE_OPERATIONS = (
+    "alignScopeToAxes", "alignScopeToGeometry", "alignScopeToGeometryBBox", "center", "cleanupGeometry",
+    "color", "comp", "convexify", "copyUV", "deleteHoles", "deleteTags", "deleteUV", "envelope", "extrude",
+    "footprint", "i", "inline", "innerRectangle", "insertAlongUV", "label", "mirror", "mirrorScope",
+    "modify", "NIL", "normalizeUV", "offset", "primitiveCone", "primitiveCube", "primitiveCylinder",
+    "primitiveDisk", "primitiveQuad", "primitiveSphere", "print", "projectUV", "r", "rectify",
+    "reduceGeometry", "report", "resetGeometry", "resetMaterial", "reverseNormals", "roofGable", "roofHip",
+    "roofPyramid", "roofRidge", "roofShed", "rotate", "rotateScope", "rotateUV", "s", "scaleUV", "scatter",
+    "set", "setback", "setbackPerEdge", "setbackToArea", "setMaterial", "setNormals", "setPivot",
+    "setTagsFromEdgeAttrs", "setupProjection", "shapeL", "shapeU", "shapeO", "softenNormals", "split",
+    "splitAndSetbackPerimeter", "splitArea", "t", "tag", "taper", "texture", "tileUV", "translate",
+    "translateUV", "trim", "union", "subtract", "intersect",
+)
+
+
+def test_every_operation_of_the_reference_is_known():
+    assert set(REFERENCE_OPERATIONS) - ALL_OPERATIONS == set()
+
+
+def test_a_capitalised_call_of_no_rule_is_a_rule_call_not_a_misspelt_operation():
+    _, diags = compile_ir(VERSION + "@StartRule\nLot --> Envelope(10) Extrude(3)\n")
+    assert [(d.code, d.severity.value) for d in diags] == [("terminal-args", "warning")] * 2
+
+
+def test_a_rule_of_a_file_imported_without_prefix_is_called(tmp_path):
+    (tmp_path / "envelope.cga").write_text(VERSION + "envelop(h) --> extrude(h) X\n")
+    main = tmp_path / "main.cga"
+    main.write_text(VERSION + 'import "envelope.cga"\n@StartRule\nLot --> envelop(10)\n')
+    diags = Diagnostics()
+    parse_source(main.read_text(), str(main), diags, path=main)
+    assert not diags.has_errors, diags
