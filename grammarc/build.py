@@ -131,13 +131,19 @@ def grammar_source(path: Path, options: BuildOptions):
             start=options.start or package.start_rule, workspace=options.workspace or package.workspace)
 
 
+def compile_source(source: Path, display: str | None, options: BuildOptions, *, derive: bool = True):
+    """Compile the rule file ``grammar_source`` gave, with the options that concern the grammar (``check``
+    compiles with ``derive=False``: a start rule's missing arguments are then a warning)."""
+    return compile_grammar(source, start=options.start, asset_roots=options.asset_roots,
+                           dialect=options.dialect, display=display, workspace=options.workspace,
+                           warnings_as_errors=options.warnings_as_errors, derive=derive)
+
+
 def _build(source: Path, display: str | None, grammar_path: Path, output, lots_path,
            options: BuildOptions, progress, started: float, recorded_roots: tuple[Path, ...],
            output_options: OutputOptions, select: Sequence[str] | None,
            reports_to: Path | None) -> BuildResult:
-    grammar = compile_grammar(source, start=options.start, asset_roots=options.asset_roots,
-                              dialect=options.dialect, display=display, workspace=options.workspace,
-                              warnings_as_errors=options.warnings_as_errors)
+    grammar = compile_source(source, display, options)
     plan = make_plan(grammar)
     check_overrides(grammar.module, options.attrs)
     writer_class = writer_for(output, replace(output_options, asset_roots=tuple(grammar.asset_roots)))

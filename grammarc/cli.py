@@ -185,15 +185,13 @@ def _warn(grammar) -> None:
 
 
 def _check(args) -> int:
-    from grammarc.build import BuildOptions, grammar_source
-    from grammarc.compiler import compile_grammar
+    from grammarc.build import BuildOptions, compile_source, grammar_source
     from grammarc.ir.printer import print_module
 
-    options = BuildOptions(start=args.start, dialect=args.dialect, workspace=args.workspace)
+    options = BuildOptions(start=args.start, dialect=args.dialect, workspace=args.workspace,
+                           warnings_as_errors=args.warnings_as_errors)
     with grammar_source(args.grammar, options) as (source, display, resolved):
-        grammar = compile_grammar(source, start=resolved.start, dialect=resolved.dialect, display=display,
-                                  asset_roots=resolved.asset_roots, workspace=resolved.workspace,
-                                  derive=False, warnings_as_errors=args.warnings_as_errors)
+        grammar = compile_source(source, display, resolved, derive=False)
     _warn(grammar)
     graph = grammar.graph
     if args.dump_ir:

@@ -45,13 +45,13 @@ from grammarc.build import (
     BuildOptions,
     BuildResult,
     check_overrides,
+    compile_source,
     derive_all,
     find_lots,
     grammar_source,
     occluders,
     record_meta,
 )
-from grammarc.compiler import compile_grammar
 from grammarc.constants import PARTITION_SIZE
 from grammarc.errors import UsageError
 from grammarc.io import OutputOptions, writer_for
@@ -113,9 +113,7 @@ def build_on_dask(grammar_path, output, *, dask: str, lots_path=None, options: B
     if lots_path is None:
         raise UsageError("--dask needs a lots file (--lots), which every worker reads its partitions of")
     with grammar_source(Path(grammar_path), options) as (source, display, resolved):
-        grammar = compile_grammar(source, start=resolved.start, asset_roots=resolved.asset_roots,
-                                  dialect=resolved.dialect, display=display, workspace=resolved.workspace,
-                                  warnings_as_errors=resolved.warnings_as_errors)
+        grammar = compile_source(source, display, resolved)
         plan = make_plan(grammar)
         check_overrides(grammar.module, resolved.attrs)
         output_options = replace(output_options or OutputOptions(), asset_roots=tuple(grammar.asset_roots))
