@@ -9,8 +9,9 @@ and sorts each file by its *first* error, so that the table shows what blocks mo
 
 The categories: ``ok`` (exit 0), ``syntax`` (the parser refused the file), ``unsupported NAME`` (a construct
 grammarc knows it does not do), ``unknown-function NAME``, ``import`` (an import could not be read or
-resolved), ``crash`` (a traceback, or an exit code other than 0, 1 and 2), ``timeout``, and ``other SHAPE`` for
-every other error, grouped by the shape of its message (names and numbers blanked out). A file's own errors
+resolved), ``encoding`` (the file is not UTF-8: CityEngine's older rule files are often Windows-1250/1252),
+``crash`` (a traceback, or an exit code other than 0, 1 and 2), ``timeout``, and ``other SHAPE`` for every other
+error, grouped by the shape of its message (names, paths and numbers blanked out). A file's own errors
 and those of the files it imports count alike: the first one printed wins, as it is the one a user reads.
 
 The blocking names count, for each unsupported construct and unknown function, the files in which it is *any*
@@ -43,8 +44,9 @@ SYNTAX = re.compile(
 UNSUPPORTED = re.compile(r"^unsupported(?::| construct) (?P<name>.+?)(?: \(.*)?$")
 UNKNOWN_FUNCTION = re.compile(r"^unknown function `(?P<name>[^`]+)`")
 IMPORT = re.compile(r"\bimport")
+ENCODING = re.compile(r"codec can't decode")
 QUOTED = re.compile(r"`[^`]*`")
-BLANKS = re.compile(r"`[^`]*`|\d+(\.\d+)?")
+BLANKS = re.compile(r"`[^`]*`|\S*[/\\]\S*|\S+\.cga\b|\d+(\.\d+)?")
 
 
 @dataclass
@@ -67,6 +69,8 @@ def classify(message: str) -> str:
         return f"unsupported {QUOTED.sub('_', match['name'])}"
     if match := UNKNOWN_FUNCTION.match(message):
         return f"unknown-function {match['name']}"
+    if ENCODING.search(message):
+        return "encoding"
     if IMPORT.search(message):
         return "import"
     return f"other {BLANKS.sub('_', message)[:70]}"
@@ -87,7 +91,7 @@ def check(path: Path) -> Outcome:
     if done.returncode == 0:
         return Outcome(str(path), "ok", 0)
     errors = list(ERROR.finditer(done.stderr))
-    if not errors:  # a GrammarcError: `grammarc: error: ...`, exit code 1
+    if not errors:  # a GrammarcError: `grammarc: error: ...`, with no place in a file
         message = done.stderr.strip().splitlines()[0] if done.stderr.strip() else f"exit code {done.returncode}"
         return Outcome(str(path), classify(message.removeprefix("grammarc: error: ")), done.returncode,
                        message=message)
