@@ -266,6 +266,10 @@ class Lowering(OperationLowering, LoweringBase):
                                     f"write {op}(...) {{ ... | remainder: ... }}")
         return ir.Symbol(op, tuple(self.expr(a) for a in args), span, self.site())
 
+    def scatter(self, meta, name, args, body):
+        """``scatter(...) { operations }``: parsed, so that it is reported as unsupported at its place."""
+        return self.unsupported("scatter", self.token_span(name))
+
     def split_call(self, meta, name, args, parts, star):
         """``op(args){ parts }``, and ``split(args){ parts }*``: an operation of ``PART_OPERATIONS``."""
         op, span, args = str(name), self.token_span(name), args or ()

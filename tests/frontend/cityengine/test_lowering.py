@@ -273,3 +273,7 @@ Lot --> A(2, "x", true, 1)
 A(float h, string s, bool b, float[] a) --> extrude(half(h)) print(label(s, b)) B.
 """
     assert rules(text)["A"].startswith("A(h, s, b, a) ~> extrude(($h / 2))")
+
+
+def test_scatter_with_operations_in_braces_is_unsupported_not_a_syntax_error():
+    assert_unsupported_at("Lot --> extrude(3) scatter(surface, 10, uniform) { Tree } A", "scatter", "scatter")
