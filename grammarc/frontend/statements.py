@@ -176,8 +176,8 @@ def split_cityengine(text: str) -> list[Statement]:
             if kind == "@":
                 starts, annotations_only = not annotations_only, True
             elif not (before == "@" or (kind == "(" and before == "@name")):  # not the annotation's own
-                starts = before not in ("member", "keyword") and _declares(tokens, i, text) \
-                    and not annotations_only
+                starts = kind == "word" and before not in ("member", "keyword") and not annotations_only \
+                    and _declares(tokens, i, text)
                 annotations_only = False
         # the name after a keyword is declared, not a declaration (`attr h = 1`)
         before = "@name" if before == "@" else "keyword" if text[start:stop] in _KEYWORDS else kind
@@ -199,12 +199,10 @@ def split_cityengine(text: str) -> list[Statement]:
 
 
 def _declares(tokens: list, i: int, text: str) -> bool:
-    """Whether ``tokens[i]`` begins a declaration: a keyword of ``_KEYWORDS`` with what must follow it,
+    """Whether the word ``tokens[i]`` begins a declaration: a keyword of ``_KEYWORDS`` with what must follow it,
     or a name (dotted maybe) with parameters maybe, then ``-->`` or ``=``. Looks no further than the
     parameters go."""
-    kind, start, stop = tokens[i]
-    if kind != "word":
-        return False
+    _, start, stop = tokens[i]
     j = i + 1
     follows = _KEYWORDS.get(text[start:stop])
     if follows is not None:
