@@ -2,10 +2,11 @@
 
 Two dialects, one IR: the paper notation (``grammars/cga2006.lark``, the ``cga2006`` package) and
 CityEngine CGA (``grammars/cityengine.lark``, the ``cityengine`` package), laid out alike; both grammars
-import their expressions from ``grammars/expressions.lark``. Each lark grammar is loaded once per process
-(LALR, positions on). The text is cut into statements (``statements.py``, with the dialect's layout); each
-is parsed on its own, with leading newlines so that lark's line numbers are the file's, lowered to IR by
-the dialect's ``Lowering``, and the statements are assembled into a module by its ``assemble``.
+import their expressions from ``grammars/expressions.lark``; their parsers come from ``parsers.py``. The
+text is cut into statements (``statements.py``, each dialect its way); each is parsed on its own, with
+leading newlines so that lark's line numbers are the file's, checked for a nesting that the recursive
+passes after it could not take, lowered to IR by the dialect's ``Lowering``, and the statements are
+assembled into a module by its ``assemble``.
 """
 
 from __future__ import annotations
@@ -30,7 +31,7 @@ from grammarc.ir import nodes as ir
 
 @dataclass(frozen=True, slots=True)
 class Dialect:
-    """How a dialect is read: its lark grammar (a file of the package), how its statements are laid out,
+    """How a dialect is read: its lark grammar (a file of the package), how its text is cut into statements,
     the Transformer that lowers one statement, and the function that assembles the lowered statements of a
     file into a module."""
 
@@ -42,7 +43,8 @@ class Dialect:
 
 DIALECTS = {
     "cga2006": Dialect("grammars/cga2006.lark", split_paper, cga2006.Lowering, cga2006.assemble),
-    "cityengine": Dialect("grammars/cityengine.lark", split_cityengine, cityengine.Lowering, cityengine.assemble),
+    "cityengine": Dialect("grammars/cityengine.lark", split_cityengine, cityengine.Lowering,
+                          cityengine.assemble),
 }
 #: Text that only CityEngine CGA has: its version line, annotations, lower-case operations, const.
 _CITYENGINE_MARKS = re.compile(r'^[ \t]*(version\s+"|@StartRule|const\s)|\b(extrude|split|comp)\s*\(',
