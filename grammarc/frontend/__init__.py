@@ -1,8 +1,10 @@
 """Grammar text to IR, for both dialects of CGA, with every problem reported as a diagnostic with its span.
 
 - ``parse``: picks the dialect, cuts the text into statements, parses each and names syntax errors for
-  people; its table ``DIALECTS`` names each dialect's grammar, layout, lowering and assembly.
-- ``statements``: the cutting of a file into statements (each dialect's layout).
+  people; its table ``DIALECTS`` names each dialect's grammar, splitter, lowering and assembly.
+- ``parsers``: the lark parsers, their tables cached in the user's own cache folder.
+- ``statements``: the cutting of a file into statements (column 1 in the paper notation, where the next
+  declaration begins in CityEngine CGA).
 - ``grammars/``: the lark grammars, ``cga2006.lark`` and ``cityengine.lark``, which import the expressions
   both write alike from ``expressions.lark``.
 - ``lowering``: what the two lowerings share (spans, sites, expression operators, argument lists, arity

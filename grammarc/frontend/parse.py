@@ -2,10 +2,11 @@
 
 Two dialects, one IR: the paper notation (``grammars/cga2006.lark``, the ``cga2006`` package) and
 CityEngine CGA (``grammars/cityengine.lark``, the ``cityengine`` package), laid out alike; both grammars
-import their expressions from ``grammars/expressions.lark``. Each lark grammar is loaded once per process
-(LALR, positions on). The text is cut into statements (``statements.py``, with the dialect's layout); each
-is parsed on its own, with leading newlines so that lark's line numbers are the file's, lowered to IR by
-the dialect's ``Lowering``, and the statements are assembled into a module by its ``assemble``.
+import their expressions from ``grammars/expressions.lark``; their parsers come from ``parsers.py``. The
+text is cut into statements (``statements.py``, each dialect its way); each is parsed on its own, with
+leading newlines so that lark's line numbers are the file's, checked for a nesting that the recursive
+passes after it could not take, lowered to IR by the dialect's ``Lowering``, and the statements are
+assembled into a module by its ``assemble``.
 """
 
 from __future__ import annotations
@@ -14,10 +15,9 @@ import itertools
 import re
 from collections.abc import Callable
 from dataclasses import dataclass
-from functools import cache
 from pathlib import Path
 
-from lark import Lark
+from lark import Tree
 from lark.exceptions import UnexpectedCharacters, UnexpectedEOF, UnexpectedInput, UnexpectedToken
 
 from grammarc.diagnostics import Diagnostics, Span
@@ -25,38 +25,42 @@ from grammarc.frontend import cga2006, cityengine
 from grammarc.frontend.cityengine.nodes import Import
 from grammarc.frontend.imports import Roots, find_roots, load_import
 from grammarc.frontend.lowering import LoweringBase
-from grammarc.frontend.statements import CITYENGINE, PAPER, Layout, split_statements
+from grammarc.frontend.parsers import parser_for
+from grammarc.frontend.statements import Statement, split_cityengine, split_paper
 from grammarc.ir import nodes as ir
 
 
 @dataclass(frozen=True, slots=True)
 class Dialect:
-    """How a dialect is read: its lark grammar (a file of the package), how its statements are laid out,
+    """How a dialect is read: its lark grammar (a file of the package), how its text is cut into statements,
     the Transformer that lowers one statement, and the function that assembles the lowered statements of a
     file into a module."""
 
     grammar: str
-    layout: Layout
+    split: Callable[[str], list[Statement]]
     lowering: type[LoweringBase]
     assemble: Callable[..., ir.Module]
 
 
 DIALECTS = {
-    "cga2006": Dialect("grammars/cga2006.lark", PAPER, cga2006.Lowering, cga2006.assemble),
-    "cityengine": Dialect("grammars/cityengine.lark", CITYENGINE, cityengine.Lowering, cityengine.assemble),
+    "cga2006": Dialect("grammars/cga2006.lark", split_paper, cga2006.Lowering, cga2006.assemble),
+    "cityengine": Dialect("grammars/cityengine.lark", split_cityengine, cityengine.Lowering,
+                          cityengine.assemble),
 }
 #: Text that only CityEngine CGA has: its version line, annotations, lower-case operations, const.
-_CITYENGINE_MARKS = re.compile(r'^\s*(version\s+"|@StartRule|const\s)|\b(extrude|split|comp)\s*\(',
+_CITYENGINE_MARKS = re.compile(r'^[ \t]*(version\s+"|@StartRule|const\s)|\b(extrude|split|comp)\s*\(',
                                re.MULTILINE)
 #: Text that only the paper notation has: its arrows, PRIORITY blocks, capitalised operations.
-_PAPER_MARKS = re.compile(r"~>|\u2192|\u21dd|^\s*(PRIORITY\b|\d+\s*:)|\b(Subdiv|Repeat|Comp|I|S|T)\s*\(",
+_PAPER_MARKS = re.compile(r"~>|\u2192|\u21dd|^[ \t]*(PRIORITY\b|\d+\s*:)|\b(Subdiv|Repeat|Comp|I|S|T)\s*\(",
                           re.MULTILINE)
 
 
 def detect_dialect(text: str) -> str:
     """``cityengine`` for CityEngine CGA, ``cga2006`` for the paper notation.
 
-    A rule arrow ``-->`` is CityEngine's unless the text has the paper notation's own marks.
+    A rule arrow ``-->`` is CityEngine's unless the text has the paper notation's own marks. The marks
+    that stand at a line's start allow blanks before them but no line break (``^\\s*`` would try every
+    following blank line from every line start: quadratic).
     """
     if _CITYENGINE_MARKS.search(text):
         return "cityengine"
@@ -70,17 +74,8 @@ _TERMINALS = {
     "COMPARE": "a comparison", "ADD": "`+` or `-`", "MUL": "`*`, `/` or `%`", "EQUAL": "`=`",
     "DOT": "`.`", "MINUS": "`-`", "PLUS": "`+`", "BANG": "`!`", "TRUE": "`true`", "FALSE": "`false`",
     "AND": "`&&`", "OR": "`||`", "NOT": "`not`", "PRIORITY": "`PRIORITY`", "ATTR": "`attr`",
-    "$END": "the end of the statement",
+    "PRIME": "`'`", "TILDE": "`~`", "$END": "the end of the statement",
 }
-
-
-@cache
-def _parser(grammar_file: str) -> Lark:
-    # from the package, so that `%import .expressions` finds its file beside the dialect's; cache=True
-    # keeps the LALR tables in the temp folder, keyed by the grammar's hash and checked against the
-    # imported file's
-    return Lark.open_from_package("grammarc.frontend", grammar_file, start="statement", parser="lalr",
-                                  propagate_positions=True, maybe_placeholders=True, cache=True)
 
 
 def parse_source(text: str, file: str, diags: Diagnostics, dialect: str | None = None, *,
@@ -93,15 +88,22 @@ def parse_source(text: str, file: str, diags: Diagnostics, dialect: str | None =
     of ``path``, ``imports.find_roots``); the texts of imported files are added to ``sources`` (for
     diagnostics); ``sites`` numbers random-stream sites across imported files.
     """
+    text = text.removeprefix("\ufeff")  # a UTF-8 byte order mark, read as text
     spec = DIALECTS[dialect or detect_dialect(text)]
-    parser = _parser(spec.grammar)
+    parser = parser_for(spec.grammar)
     sites = sites if sites is not None else itertools.count(1)
     lowered = []
-    for statement in split_statements(text, spec.layout):
+    for statement in spec.split(text):
         try:
             tree = parser.parse("\n" * (statement.line - 1) + statement.text)
         except UnexpectedInput as error:
             _syntax_error(error, file, statement.text, statement.line, diags)
+            continue
+        if _too_deep(tree):
+            column = len(statement.text) - len(statement.text.lstrip()) + 1
+            diags.error("nesting", f"nesting too deep: grammarc reads statements of up to {MAX_NESTING} "
+                        "levels of brackets and operators", Span(file, statement.line, column,
+                                                                 statement.line, column + 1))
             continue
         lowered.append(spec.lowering(file, diags, sites).transform(tree))
     if spec is not DIALECTS["cityengine"]:  # the paper notation imports no files
@@ -114,6 +116,25 @@ def parse_source(text: str, file: str, diags: Diagnostics, dialect: str | None =
             if module is not None:
                 imports.append((declaration, module))
     return spec.assemble(file, lowered, diags, imports)
+
+
+#: The deepest parse tree a statement may have. Lowering, the IR passes and the derivation walk a
+#: statement's tree and the IR made from it recursively, a few calls per level: at this depth they stay
+#: well within Python's recursion limit (tests/frontend/test_parse.py builds the deepest accepted nesting
+#: of either dialect). One level of brackets or of an operator is a level or two of the tree.
+MAX_NESTING = 150
+
+
+def _too_deep(tree: Tree) -> bool:
+    """Whether ``tree`` is deeper than ``MAX_NESTING``, found without recursion (the tree may be deeper
+    than Python's recursion limit)."""
+    stack = [(tree, 1)]
+    while stack:
+        node, depth = stack.pop()
+        if depth > MAX_NESTING:
+            return True
+        stack.extend((child, depth + 1) for child in node.children if isinstance(child, Tree))
+    return False
 
 
 def _import(statement, file: str, path: Path | None, diags: Diagnostics, sources, sites, importing, roots):

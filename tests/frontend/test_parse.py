@@ -252,3 +252,95 @@ def test_syntax_error_renders_with_the_file_line_and_caret(tmp_path):
     (diag,) = caught.value.diagnostics
     assert (diag.span.line, diag.span.col) == (3, 32)
     assert f"{path}:3:32: error: unexpected `}}`" in str(caught.value)
+
+
+# --------------------------------------------------------------------------- free layout, BOM, large inputs
+
+
+def test_cityengine_syntax_errors_of_a_free_layout_are_all_reported_at_their_place():
+    text = VERSION + "  attr h = (1\nLot --> extrude(h) A B --> s(1,, 1) C\n   D = 1 +\nE --> F\n"
+    found = syntax_errors(text)
+    assert [(line, col) for line, col, _ in found] == [(2, 12), (3, 32), (4, 10)]
+    assert found[0][2] == "unclosed `(`" and found[1][2].startswith("unexpected `,`, expected one of")
+    assert found[2][2] == "unexpected end of statement"
+
+
+def test_byte_order_mark_is_no_syntax_error():
+    module, diags = compile_ir("\ufeff" + VERSION + "Lot --> A\n")
+    assert not diags.has_errors and module.dialect == "cityengine"
+    assert syntax_errors("\ufeffLot ~> A\n") == []
+    # the mark is not a column: an error on the first line is where the eye sees it
+    assert syntax_errors("\ufeffattr x = (1\nLot --> A") == [(1, 10, "unclosed `(`")]
+
+
+def test_dialect_detection_is_linear_in_blank_lines():
+    import time
+
+    start = time.perf_counter()
+    assert detect_dialect("\n" * 1_000_000 + "Lot --> A\n") == "cityengine"
+    assert detect_dialect("\n" * 1_000_000 + "Lot ~> A\n") == "cga2006"
+    assert parse_source("\n" * 1_000_000 + "Lot --> A\n", FILE, Diagnostics()).rules[0].span.line == 1_000_001
+    assert time.perf_counter() - start < 30  # quadratic: hours
+
+
+# ------------------------------------------------------------------------------------------ deep nesting
+def _nested(kind: str, n: int) -> str:
+    """A statement nesting ``n`` levels of one construct."""
+    body = "A"
+    if kind == "subdiv":
+        for _ in range(n):
+            body = f'Subdiv("X", 1r, 1r){{ {body} | B }}'
+        return f"Lot ~> {body}\n"
+    if kind == "split":
+        for _ in range(n):
+            body = f"split(x){{ 1 : {body} | ~1 : B }}"
+    elif kind == "case":
+        for i in range(n):
+            body = f"case scope.sx > {i} : {body} else : B"
+    elif kind == "minus":
+        body = f"extrude({'-' * n}1) A"
+    elif kind == "sum":
+        body = f"extrude({' + '.join(['1'] * n)}) A"
+    return f"{VERSION}Lot --> {body}\n"
+
+
+def _deepest(kind: str) -> int:
+    """The deepest nesting of ``kind`` that parses without a `nesting` error."""
+    low, high = 1, 1
+    while not _too_deep(_nested(kind, high)):
+        low, high = high, high * 2
+    while high - low > 1:
+        middle = (low + high) // 2
+        low, high = (low, middle) if _too_deep(_nested(kind, middle)) else (middle, high)
+    return low
+
+
+def _too_deep(text: str) -> bool:
+    diags = Diagnostics()
+    parse_source(text, FILE, diags)
+    codes = [d.code for d in diags if d.is_error]
+    assert codes in ([], ["nesting"]), codes
+    return codes == ["nesting"]
+
+
+@pytest.mark.parametrize("kind", ["subdiv", "split", "case", "minus", "sum"])
+def test_deepest_accepted_nesting_builds_and_one_more_level_is_an_error(kind, tmp_path, capsys):
+    from grammarc.cli import main
+
+    deepest = _deepest(kind)
+    assert deepest >= 20  # real grammars nest a handful of levels
+    grammar = tmp_path / "g.cga"
+    grammar.write_text(_nested(kind, deepest))
+    assert main(["build", str(grammar), "--emit", str(tmp_path / "out.npz"), "--quiet", "--workers", "1",
+                 "--max-depth", "400"]) == 0
+    grammar.write_text(_nested(kind, deepest + 1))
+    assert main(["check", str(grammar)]) == 2
+    assert "nesting too deep" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("kind, n", [("subdiv", 1000), ("split", 300), ("minus", 500)])
+def test_the_issues_deep_nestings_are_errors_at_their_line(kind, n):
+    diags = Diagnostics()
+    parse_source("\n" + _nested(kind, n), FILE, diags)
+    line = 2 if kind == "subdiv" else 3  # after the version line
+    assert [(d.code, d.span.line, d.span.col) for d in diags] == [("nesting", line, 1)]

@@ -1,14 +1,14 @@
-"""frontend/statements.py: a file is cut into statements at column-1 lines."""
+"""frontend/statements.py: paper notation cut at column-1 lines, CityEngine CGA where declarations begin."""
 
 from __future__ import annotations
 
 import pytest
 
-from grammarc.frontend.statements import Statement, split_statements
+from grammarc.frontend.statements import Statement, split_cityengine, split_paper
 
 
 def cut(text: str) -> list[tuple[int, str]]:
-    return [(s.line, s.text) for s in split_statements(text)]
+    return [(s.line, s.text) for s in split_paper(text)]
 
 
 def test_one_statement_per_column1_line():
@@ -18,7 +18,7 @@ def test_one_statement_per_column1_line():
 
 
 def test_statement_is_a_frozen_record():
-    assert split_statements("a ~> b") == [Statement("a ~> b", 1)]
+    assert split_paper("a ~> b") == [Statement("a ~> b", 1)]
 
 
 @pytest.mark.parametrize("indent", [" ", "    ", "\t"])
@@ -98,3 +98,82 @@ def test_empty_and_comment_only_texts_have_no_statements():
 
 def test_crlf_line_ends():
     assert cut("a ~> b\r\n  c\r\nd ~> e\r\n") == [(1, "a ~> b\n  c"), (3, "d ~> e")]
+
+
+# ------------------------------------------------------------------------------------------ CityEngine CGA
+def ce(text: str) -> list[tuple[int, str]]:
+    return [(s.line, s.text) for s in split_cityengine(text)]
+
+
+def test_cityengine_indented_declarations_start_statements():
+    # the indentation becomes blanks, one per character: the parser's columns are the file's
+    text = 'version "2022.0"\n  attr h = 10\n\tconst w = 2\n    Lot --> extrude(h) A\n'
+    assert ce(text) == [(1, 'version "2022.0"'), (2, "  attr h = 10"), (3, " const w = 2"),
+                        (4, "    Lot --> extrude(h) A")]
+
+
+def test_cityengine_bodies_go_on_in_column1():
+    text = "Lot -->\nextrude(10)\ncomp(f) { top : Roof | side : Wall }\nRoof --> X."
+    assert ce(text) == [(1, "Lot -->\nextrude(10)\ncomp(f) { top : Roof | side : Wall }"), (4, "Roof --> X.")]
+
+
+def test_cityengine_several_statements_on_a_line_keep_their_columns():
+    # a statement starting within a line is padded to its column
+    assert ce("attr a = 1 attr b = 2 f(x) = x * a A --> B") == [
+        (1, "attr a = 1"), (1, "           attr b = 2"), (1, "                      f(x) = x * a"),
+        (1, "                                   A --> B"),
+    ]
+
+
+@pytest.mark.parametrize("head", ["R", "R(a, b)", "R(float h, string s, bool b, float[] a)", "vol.Slab",
+                                  "R ( a )"])
+@pytest.mark.parametrize("arrow", ["-->", "="])
+def test_cityengine_declarations_begin_at_a_name_with_arrow_or_equals(head, arrow):
+    assert [line for line, _ in ce(f"Lot --> A\n  B C\n{head} {arrow} D\n")] == [1, 3]
+
+
+def test_cityengine_names_in_bodies_and_comparisons_start_nothing():
+    text = 'Lot --> case style == "a" && version != 2 : A(1) B. else : C\n  D.E F(x) X'
+    assert [line for line, _ in ce(text)] == [1]
+
+
+def test_cityengine_annotations_glue_to_the_declaration_after_them():
+    text = ('@Group("a (b") @Order(6)#@Range(0,6)\n  attr x = 1\n@Hidden\n@Range(min=0, max=10)\n'
+            "attr y = 2\n@StartRule Lot --> A\n@Hidden attr z = 3")
+    assert ce(text) == [
+        (1, '@Group("a (b") @Order(6)#@Range(0,6)\n  attr x = 1'),
+        (3, "@Hidden\n@Range(min=0, max=10)\nattr y = 2"), (6, "@StartRule Lot --> A"), (7, "@Hidden attr z = 3"),
+    ]
+
+
+def test_cityengine_strings_and_comments_hide_brackets_and_declarations():
+    text = 'Lot --> print("( attr x = 1") A # (\n// B --> C\n/* D --> E\n*/ F\nG --> H'
+    assert [line for line, _ in ce(text)] == [1, 5]
+
+
+def test_cityengine_unclosed_bracket_does_not_swallow_declarations():
+    text = "Lot --> extrude(10\n  A\nattr h = 1\n@Hidden\nB(x) --> s(1,\n  C --> D\nE = 1"
+    assert [line for line, _ in ce(text)] == [1, 3, 4, 6, 7]
+
+
+def test_cityengine_unclosed_block_comment_is_code():
+    # the parser reports it, rather than the rest of the file vanishing into a comment
+    assert ce("A --> B\n/* C --> D") == [(1, "A --> B\n/* C --> D")]
+
+
+def test_cityengine_crlf_and_cr_line_ends():
+    assert ce("A --> B\r\n  C\r\nD --> E\rF --> G") == [(1, "A --> B\n  C"), (3, "D --> E"), (4, "F --> G")]
+
+
+def test_cityengine_split_is_linear():
+    # a million blank lines, and a file of 20,000 statements: a few seconds at most (quadratic would be hours)
+    import time
+
+    start = time.perf_counter()
+    assert ce("\n" * 1_000_000 + "A --> B") == [(1_000_001, "A --> B")]
+    assert len(split_cityengine("attr a = f(1, 2) A(x) --> B(x) C.\n" * 10_000)) == 20_000
+    assert time.perf_counter() - start < 30
+
+
+def test_cityengine_statements_sharing_a_later_line():
+    assert ce("A --> B\n  C --> D E --> F") == [(1, "A --> B"), (2, "  C --> D"), (2, "          E --> F")]

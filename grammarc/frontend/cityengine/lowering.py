@@ -12,6 +12,7 @@ constants-as-functions are inlined by ``assemble``; rules overloaded by arity ge
 
 from __future__ import annotations
 
+import re
 from dataclasses import replace
 
 from lark import Token, v_args
@@ -45,6 +46,12 @@ from grammarc.frontend.cityengine.operations import (
 from grammarc.frontend.lowering import LoweringBase
 from grammarc.ir import nodes as ir
 
+#: The annotations of CityEngine's CGA reference ("Annotations", 2019-2025).
+ANNOTATIONS = frozenset((
+    "Angle", "Color", "Description", "Directory", "DisplayName", "Distance", "Enum", "File", "Group",
+    "Handle", "Hidden", "InLine", "InMesh", "InPoint", "InPointCloud", "InPolygon", "MaterialFile", "Order",
+    "Out", "Percent", "Range", "StartRule",
+))
 #: CityEngine built-in functions mapped onto the IR's.
 FUNCTION_NAMES = {"rint": "round", "ln": "log"}
 SCOPE_MEMBERS = {
@@ -86,17 +93,13 @@ class Lowering(OperationLowering, LoweringBase):
         return Annotated(tuple(annotations), declaration)
 
     def annotation(self, meta, name, args):
-        return (str(name), tuple(args or ()))
-
-    def annotation_args(self, meta, *args):
-        from grammarc.ir.printer import print_expr
-
-        return tuple(a if isinstance(a, str) else print_expr(self.expr(a)) for a in args)
-
-    def keyword_arg(self, meta, name, value):
-        from grammarc.ir.printer import print_expr
-
-        return f"{name}={print_expr(self.expr(value))}"
+        """``@Name(args)`` -> (name, argument texts): annotations only guide CityEngine's inspector (but
+        ``@StartRule``), so their arguments are kept as written, blanks around a keyword's ``=`` dropped.
+        An annotation CityEngine does not document is kept with a warning, as CityEngine does."""
+        if str(name) not in ANNOTATIONS:
+            self.diags.warning("annotation", f"unknown annotation `@{name}`: kept, but nothing reads it",
+                               self.token_span(name))
+        return (str(name), _annotation_arguments(str(args)[1:-1]) if args is not None else ())
 
     def version(self, meta, text):
         return None
@@ -154,6 +157,11 @@ class Lowering(OperationLowering, LoweringBase):
     def params(self, meta, *names):
         return tuple(str(n) for n in names if n is not None)
 
+    def typed_param(self, meta, kind, name):
+        """``float h``: CityEngine infers a parameter's type from its uses, and so does grammarc; the
+        declared type is accepted and not checked."""
+        return name
+
     # ------------------------------------------------------------------------------------------ bodies
     def body(self, meta, *items):
         return self.fuse_offsets(items)
@@ -185,8 +193,10 @@ class Lowering(OperationLowering, LoweringBase):
         return tuple(out)
 
     def case_block(self, meta, *branches):
+        """``case c : A ... [else : B]``; without ``else`` a shape that meets no condition gets no
+        successor (CityEngine's reference always writes the ``else``; public files leave it out)."""
         *cases, default = branches
-        return (ir.Case(tuple(cases), default, self.span(meta)),)
+        return (ir.Case(tuple(cases), default if default is not None else (), self.span(meta)),)
 
     def case_branch(self, meta, cond, body):
         return (cond, as_body(body))
@@ -283,6 +293,10 @@ class Lowering(OperationLowering, LoweringBase):
             return self.unsupported(f"{op} without selector parts", span,
                                     f"write {op}(...) {{ ... | remainder: ... }}")
         return ir.Symbol(op, tuple(self.expr(a) for a in args), span, self.site())
+
+    def scatter(self, meta, name, args, body):
+        """``scatter(...) { operations }``: parsed, so that it is reported as unsupported at its place."""
+        return self.unsupported("scatter", self.token_span(name))
 
     def split_call(self, meta, name, args, parts, star):
         """``op(args){ parts }``, and ``split(args){ parts }*``: an operation of ``PART_OPERATIONS``."""
@@ -410,3 +424,21 @@ class Lowering(OperationLowering, LoweringBase):
         """``a[i]`` and ``a[i, j]``; an index may be an array or a range (``a[1:3]``)."""
         return ir.Index(self.expr(array), self.expr(index), None if column is None else self.expr(column),
                         self.span(meta))
+
+
+#: An annotation's arguments: strings whole, brackets balanced, split at the commas outside them.
+_ANNOTATION_PIECE = re.compile(r'"(?:\\.|[^"\\])*"|[([{]|[)\]}]|,|[^"()\[\]{},]+')
+
+
+def _annotation_arguments(text: str) -> tuple[str, ...]:
+    """``min = 0, max=f(1, 2), "a, b"`` -> ``("min=0", "max=f(1, 2)", '"a, b"')``."""
+    arguments, current, depth = [], [], 0
+    for piece in _ANNOTATION_PIECE.findall(text):
+        if piece == "," and depth == 0:
+            arguments.append("".join(current))
+            current = []
+            continue
+        depth += (piece in "([{") - (piece in ")]}") if len(piece) == 1 else 0
+        current.append(piece)
+    arguments.append("".join(current))
+    return tuple(re.sub(r"^\s*(\w+)\s*=(?!=)\s*", r"\1=", a).strip() for a in arguments if a.strip())

@@ -92,7 +92,7 @@ def _check_arity(module: ir.Module, diags: Diagnostics) -> dict[str, int]:
                 rule.span,
             )
     for op in iter_ops(module):
-        if not isinstance(op, ir.Symbol):
+        if not isinstance(op, ir.Symbol) or op.leaf:  # a leaf `X.` applies no rule of X
             continue
         want = arity.get(op.name)
         if want is None:

@@ -18,7 +18,7 @@ from grammarc.ir import nodes as ir
 from grammarc.ir.printer import print_expr
 from grammarc.ir.traverse import iter_ops
 
-from .lowered import GRAMMARS, VERSION, assert_unsupported_at, body_of, errors, module_of
+from .lowered import GRAMMARS, VERSION, assert_unsupported_at, body_of, compile_ir, errors, module_of, rules
 
 # -------------------------------------------------------------------------------------- declarations
 
@@ -227,3 +227,71 @@ def test_building_fixture_lowers_every_construct():
     assert ("Range", ("min=3", "max=30", "restricted=false")) in height.annotations
     assert grammar.assets == ("builtin:cube", "builtin:quad", "assets/window.obj")
     assert make_plan(grammar).not_applied == ("print", "projectUV", "setupProjection", "texture")
+
+
+# ------------------------------------------------------------------------------ the free syntax (issue 17)
+
+
+def test_annotation_arguments_are_kept_as_written():
+    module, diags = compile_ir(VERSION + """
+@Description("post width (and depth)") @Order(6)#@Range(0,6)
+attr w = 1
+@Handle(shape=Post*^2, axis = y) @Range(min = 0, max=f(1, 2), restricted=false) @Enum("a, b", [1, 2])
+attr h = 2
+@Frobnicate(3)
+attr k = 3
+@StartRule
+Lot --> A
+""")
+    notes = {a.name: a.annotations for a in module.attrs}
+    assert notes == {
+        "w": (("Description", ('"post width (and depth)"',)), ("Order", ("6",))),
+        "h": (("Handle", ("shape=Post*^2", "axis=y")), ("Range", ("min=0", "max=f(1, 2)", "restricted=false")),
+              ("Enum", ('"a, b"', "[1, 2]"))),
+        "k": (("Frobnicate", ("3",)),),
+    }
+    # CityEngine warns of an annotation it does not know, and goes on
+    assert [(d.code, d.span.line, d.message) for d in diags] == [
+        ("annotation", 7, "unknown annotation `@Frobnicate`: kept, but nothing reads it")]
+
+
+def test_case_and_stochastic_expressions_as_arguments():
+    text = VERSION + """attr h = 14
+Lot --> extrude(case h > 10 : h else : 10) set(material.color.r, case h > 1 : 0.5 else : 1) # not applied
+    s('1, (case h > 12 : 1 else : 0.8) * scope.sy, '1) A(30% : 1 else : 2)
+A(x) --> X.
+"""
+    assert body_of(text) == ("extrude(((@h > 10) ? @h : 10)) set(material.color.r)(...) "
+                             "S(1r, (((@h > 12) ? 1 : 0.8) * Scope.sy), 1r) A(((rand() < 0.3) ? 1 : 2))")
+
+
+def test_value_case_needs_else():
+    # the reference writes every value case with its else; without one there is no value
+    assert errors(VERSION + "attr h = case 1 > 0 : 2\nLot --> A\n")[0][2].startswith("unexpected end")
+
+
+def test_case_block_without_else_gives_no_successor():
+    text = VERSION + "Lot -->\n    case scope.sx > 10 : Big\n    case scope.sx > 5 : Wide\n"
+    case = module_of(text).rules[0].alternatives[0].body[0]
+    assert isinstance(case, ir.Case) and len(case.branches) == 2 and case.default == ()
+
+
+def test_leaf_of_a_rule_with_parameters():
+    text = VERSION + "Lot --> extrude(2) Facade. Facade(3)\nFacade(n) --> s(n, '1, '1) F.\n"
+    body = module_of(text).rules[0].alternatives[0].body
+    leaf, call = body[1], body[2]
+    assert (leaf.name, leaf.args, leaf.leaf) == ("Facade", (), True)
+    assert (call.name, len(call.args), call.leaf) == ("Facade", 1, False)
+
+
+def test_typed_parameters_of_rules_and_functions():
+    text = VERSION + """half(float x) = x / 2
+label(string s, bool b) = case b : s else : "no"
+Lot --> A(2, "x", true, 1)
+A(float h, string s, bool b, float[] a) --> extrude(half(h)) print(label(s, b)) B.
+"""
+    assert rules(text)["A"].startswith("A(h, s, b, a) ~> extrude(($h / 2))")
+
+
+def test_scatter_with_operations_in_braces_is_unsupported_not_a_syntax_error():
+    assert_unsupported_at("Lot --> extrude(3) scatter(surface, 10, uniform) { Tree } A", "scatter", "scatter")
