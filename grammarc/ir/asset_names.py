@@ -2,7 +2,8 @@
 
 ``I("cube")`` and ``I("builtin:cube")`` name the built-in unit cube (built-ins: ``cube``, ``quad``,
 ``cylinder`` and ``cylinderN`` with N sides, and the paper's mass-model blocks ``L``, ``H``, ``U``,
-``T``); ``I("facade/window.obj")`` names a file relative to an asset root (the grammar's folder first,
+``T``; CityEngine's ``builtin:cube:notex``, a cube without texture coordinates, is the cube: records
+carry none); ``I("facade/window.obj")`` names a file relative to an asset root (the grammar's folder first,
 then any ``--assets`` folders). The record keeps a canonical name: ``builtin:NAME`` or the POSIX path
 relative to the root that holds it. A name that is absolute or climbs out of every root
 (``../../etc/passwd``) is refused: grammars are shared, and a rule file must not read outside the folders
@@ -54,6 +55,8 @@ def resolve_asset(name: str, roots: list[Path]) -> ResolvedAsset:
     climbs out of every root or holds a NUL byte.
     """
     bare = name.removeprefix("builtin:")
+    if name == "builtin:cube:notex":
+        bare = "cube"
     if builtin_name(bare):
         return ResolvedAsset(f"builtin:{bare}", None)
     if name.startswith("builtin:"):

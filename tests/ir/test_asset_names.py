@@ -26,6 +26,11 @@ def test_a_builtin_is_canonical_with_or_without_its_prefix():
     assert "unknown built-in asset" in resolve_asset("builtin:sphere", []).problem
 
 
+def test_cityengine_cube_without_texture_coordinates_is_the_cube():
+    assert resolve_asset("builtin:cube:notex", []).name == "builtin:cube"
+    assert resolve_asset("builtin:quad:notex", []).problem
+
+
 def test_a_file_is_named_relative_to_the_first_root_that_holds_it(tmp_path):
     first, second = tmp_path / "grammar", tmp_path / "kit"
     (first / "sub").mkdir(parents=True)

@@ -116,6 +116,16 @@ def test_a_parameter_never_passed_a_value_is_a_number():
     assert dict(module.param_types)["b"] == (T.NUM,)
 
 
+def test_a_parameter_no_call_passes_takes_its_type_from_its_uses():
+    # a library's rule, called only from the files that import it: CityEngine infers its parameters
+    text = ('version "2022.0"\nPlank(kind, name, big, n) -->\n    case kind == "nailed" && big :\n'
+            '        s(n, 1, 1) i(name)\n    else : X.\n')
+    diags = Diagnostics()
+    module = run_passes(parse_source(text, FILE, diags, "cityengine"), diags, check=True, stop_after="types")
+    assert not diags.has_errors
+    assert dict(module.param_types)["Plank"] == (T.STR, T.STR, T.BOOL, T.NUM)
+
+
 def test_conflicting_call_sites_report_the_later_one():
     # the first call site decides the type; later ones are checked against it
     module, diags = typed('a ~> b(1) b("x")\nb(x) ~> c')

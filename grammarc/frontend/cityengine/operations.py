@@ -125,6 +125,8 @@ class OperationLowering:
         face = self.expr(args[1])
         if not (isinstance(face, ir.Num) and face.value == 0):
             return self.unsupported("alignScopeToGeometry on a face other than 0", getattr(face, "span", span))
+        if len(args) == 3 and isinstance(args[2], ir.Name) and args[2].name in ("longest", "world.lowest"):
+            return self.unsupported(f"alignScopeToGeometry with edge {args[2].name}", span)
         edge = self.expr(args[2]) if len(args) == 3 else ir.Num(0.0, span)
         return ir.AlignScope("geometry-" + args[0].name[0], (edge, ir.Num(0.0), ir.Num(0.0)), span)
 
@@ -179,6 +181,8 @@ class OperationLowering:
     def op_split(self, op, args, parts, span, repeat=False):
         """``split(axis[, adjust]){ size : A | { size : B }* | ... }``, repeated as a whole when ``repeat``
         (``{ ... }*``)."""
+        if args and isinstance(args[0], ir.Name) and args[0].name in ("u", "v"):
+            return self.unsupported(f"split({args[0].name}, ...)", span, "splits of texture space")
         if not args or not isinstance(args[0], ir.Name) or args[0].name not in ("x", "y", "z"):
             self.diags.error("axis", "`split` expects an axis x, y or z", span)
             return ir.Empty(span)

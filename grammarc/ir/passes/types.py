@@ -3,8 +3,9 @@
 Assumes: names resolved. Guarantees: guards are bool, sizes, angles and probabilities are numbers,
 operators get operands of the types they take; each successor ``sym(args)`` of a symbol with rules passes
 as many arguments as its rules take parameters, and the rules of one symbol agree on that number.
-Parameter types are inferred from the call sites (a parameter never passed a value is a number); the
-module comes back with ``param_types`` and typed ``attrs``.
+Parameter types are inferred from the call sites, else from their uses (a parameter neither passed a
+value nor used as a typed value is a number); the module comes back with ``param_types`` and typed
+``attrs``.
 
 CityEngine's arrays (``num[]``, ``bool[]``, ``str[]``) are values of attributes, constants and
 expressions; an operation takes none, and an array passed to a rule's parameter or reported is an
@@ -19,7 +20,7 @@ from dataclasses import replace
 
 from grammarc.diagnostics import Diagnostics
 from grammarc.ir import nodes as ir
-from grammarc.ir.traverse import expr_fields, field_exprs, iter_nodes, iter_ops
+from grammarc.ir.traverse import all_exprs, expr_fields, field_exprs, iter_nodes, iter_ops
 
 T = ir.Type
 
@@ -123,7 +124,34 @@ def _infer_param_types(module, attr_types, arity) -> dict[str, tuple[ir.Type, ..
                         changed = True
         if not changed:
             break
+    for rule in module.rules:
+        if T.UNKNOWN in types.get(rule.symbol, ()):
+            _infer_from_uses(rule, types[rule.symbol], attr_types)
     return {sym: tuple(T.NUM if t is T.UNKNOWN else t for t in ts) for sym, ts in types.items()}
+
+
+def _infer_from_uses(rule: ir.Rule, slots: list, attr_types) -> None:
+    """A parameter that no call passes a value to (a library's rule, called from the files that import
+    it) takes its type from its rule's uses: compared with a typed value (``type == "nailed"``), an
+    operand of ``&&`` or ``||``, or given where a type is wanted (``i(name)``, ``s(n, 1, 1)``)."""
+    def settle(expr, want):
+        if isinstance(expr, ir.Param) and expr.index < len(slots) and slots[expr.index] is T.UNKNOWN \
+                and want not in (None, T.UNKNOWN):
+            slots[expr.index] = want
+
+    for node in iter_nodes(rule):
+        for expr, want, _ in _declared(node):
+            settle(expr, want)
+    for expr in all_exprs(rule):
+        if isinstance(expr, ir.Binary) and expr.op in ir.LOGIC_OPS:
+            settle(expr.left, T.BOOL)
+            settle(expr.right, T.BOOL)
+        elif isinstance(expr, ir.Binary) and expr.op in ir.COMPARE_OPS:
+            for this, other in ((expr.left, expr.right), (expr.right, expr.left)):
+                settle(this, type_of(other, attr_types, tuple(slots), Diagnostics()))
+        else:
+            for this, want, _ in _declared(expr):
+                settle(this, want)
 
 
 def _expect(expr, want, what, attr_types, ptypes, diags) -> ir.Type:

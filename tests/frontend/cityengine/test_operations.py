@@ -215,6 +215,9 @@ def test_merged_selector_is_derived_face_by_face_with_a_warning(line, at):
      "alignScopeToGeometry"),
     ("Lot --> alignScopeToGeometry(yUp, any, longest) A", "alignScopeToGeometry on a face other than 0",
      "any"),
+    ("Lot --> alignScopeToGeometry(yUp, 0, longest) A", "alignScopeToGeometry with edge longest",
+     "alignScopeToGeometry"),
+    ("Lot --> split(v, unitSpace, 0){ 1 : A | ~1 : B }", "split(v, ...)", "split"),
     ("Lot --> r(scopeCenter, 0, 45, 0) A", "r with 4 arguments", "r("),
 ])
 def test_unsupported_operation_is_named_at_its_span(line, name, at):
