@@ -143,10 +143,10 @@ class Lowering(OperationLowering, LoweringBase):
         return ir.Symbol(f"{prefix}.{name}", (), self.token_span(prefix), self.site(), leaf=True)
 
     def attr_decl(self, meta, name, value):
-        return ir.AttrDecl(str(name), value, self.token_span(name))
+        return ir.AttrDecl(str(name), self.expr(value), self.token_span(name))
 
     def const_decl(self, meta, name, value):
-        return ir.AttrDecl(str(name), value, self.token_span(name), const=True)
+        return ir.AttrDecl(str(name), self.expr(value), self.token_span(name), const=True)
 
     def function_def(self, meta, name, params, value):
         return FunctionDef(str(name), params or (), value, self.token_span(name))
@@ -164,7 +164,12 @@ class Lowering(OperationLowering, LoweringBase):
 
     # ------------------------------------------------------------------------------------------ bodies
     def body(self, meta, *items):
-        return self.fuse_offsets(items)
+        return self.fuse_offsets([op for item in items for op in as_body(item)])
+
+    def bracketed(self, meta, lsqb, body, rsqb):
+        """``[ ... ]``: the scope pushed, the operations (a body, or a ``case`` or ``p%`` block, which
+        ends at the ``]``) run, the scope popped; what follows continues from the pushed scope."""
+        return (ir.Push(self.token_span(lsqb)), *as_body(body), ir.Pop(self.token_span(rsqb)))
 
     def fuse_offsets(self, items) -> ir.Body:
         """``offset(d) comp(f){ inside: ... | border: ... }`` becomes one component split of the offset's
@@ -277,6 +282,14 @@ class Lowering(OperationLowering, LoweringBase):
 
     def repeat_group(self, meta, parts, star):
         return Group(parts, self.span(meta))
+
+    def group_once(self, meta, parts):
+        """``{ a : A | b : B }`` without ``*``: a group taken once is its parts, in their place (public
+        files write it beside repeated groups, `split(x){ {~0.5 : Wall} | {~3 : Tile}* }`)."""
+        return parts
+
+    def parts(self, meta, *parts):
+        return tuple(p for part in parts for p in (part if isinstance(part, tuple) else (part,)))
 
     # -------------------------------------------------------------------------------------- operations
     def call(self, meta, name, args):

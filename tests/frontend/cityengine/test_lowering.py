@@ -232,6 +232,33 @@ def test_building_fixture_lowers_every_construct():
 # ------------------------------------------------------------------------------ the free syntax (issue 17)
 
 
+def test_a_case_block_in_brackets_ends_at_the_bracket():
+    # ESRI.lib's streets: `[ case type == "MAJOR" : ... else : ... ]` then more operations
+    text = VERSION + """attr type = "MAJOR"
+Lot -->
+  	[ extrude(3) A ]
+	[ case type == "MAJOR":
+		t(0, 1, 0) B
+	  else:
+		C ]
+	[ 30% : D else : E ] F
+"""
+    assert body_of(text) == ('[ extrude(3) A ] [ { case (@type == "MAJOR"): T(0, 1, 0) B else: C } ] '
+                             "[ { % 30: D else: E } ] F")
+    assert errors(VERSION + "Lot --> [ A B\n") and errors(VERSION + "Lot --> A ] B\n")
+
+
+def test_a_split_group_without_star_is_its_parts_in_place():
+    # the Swiss building rules: `split(x){ {~0.5 : Wall} | ~0.8 : Door | {~0.5 : Wall} }`
+    text = VERSION + "Lot --> split(x){ {~0.5 : W} | ~0.8 : D | { ~3 : T | 1 : S }* | {~0.5 : W | 2 : V} }\n"
+    assert body_of(text) == "split(x){ ~0.5: W | ~0.8: D | { ~3: T | 1: S }* | ~0.5: W | 2: V }"
+
+
+def test_edge_distances_as_a_constant_are_named_unsupported():
+    assert_unsupported_at("const d = comp(fe){ street.front : a | street.back = b }", "comp(fe){...} outside "
+                          "setback", "comp")
+
+
 def test_annotation_arguments_are_kept_as_written():
     module, diags = compile_ir(VERSION + """
 @Description("post width (and depth)") @Order(6)#@Range(0,6)
