@@ -65,7 +65,7 @@ def assemble(file: str, statements: list, diags: Diagnostics, imports=()) -> ir.
         # a leaf `X.` names a shape, not a rule: it keeps its name when rules `X` are overloaded
         body = _map_symbols(rule.body, lambda op: replace(op, name=symbol_name(op.name, len(op.args)))
                             if op.name in arities and not op.leaf else op)
-        body = rewrite_body(body, lambda e, p=params: inline.expr(e, p))
+        body = rewrite_body(_without_numbers(body, diags), lambda e, p=params: inline.expr(e, p))
         lowered.append(ir.Rule(symbol=name, params=rule.params, guard=None,
                                alternatives=(ir.Alternative(body, None, rule.span),), priority=0,
                                span=rule.span, site=rule.site))
@@ -122,6 +122,17 @@ def _prefixed(module: ir.Module, prefix: str | None, forwarded: set[str], values
             bodies.append(replace(alt, body=rewrite_body(body, rename(set(rule.params)))))
         rules.append(replace(rule, symbol=f"{prefix}.{rule.symbol}", alternatives=tuple(bodies)))
     return attrs, rules
+
+
+def _without_numbers(body: ir.Body, diags: Diagnostics) -> ir.Body:
+    """A part's body may parse as a number, for ``comp(fe){ all : 3 }``'s distances; in any other part
+    it is an error."""
+    def visit(op):
+        if isinstance(op, ir.Num):
+            diags.error("syntax", "a number where operations are expected", op.span)
+            return ir.Empty(op.span)
+        return op
+    return rewrite_ops(body, visit)
 
 
 def _map_symbols(body: ir.Body, fn) -> ir.Body:

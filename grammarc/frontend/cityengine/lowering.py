@@ -256,7 +256,9 @@ class Lowering(OperationLowering, LoweringBase):
         values = []
         for selector, body in zip(*chosen):
             # a part's body is one expression, parsed as an operation: a call, or a name
-            if len(body) == 1 and isinstance(body[0], ir.Symbol):
+            if len(body) == 1 and isinstance(body[0], ir.Num):
+                value = body[0]
+            elif len(body) == 1 and isinstance(body[0], ir.Symbol):
                 op = body[0]
                 func = FUNCTION_NAMES.get(op.name, op.name)
                 value = ir.Call(func, op.args, op.span, self.site()) if op.args or func in ir.FUNCTIONS \
@@ -279,6 +281,14 @@ class Lowering(OperationLowering, LoweringBase):
     def merged_part(self, meta, kind, value, body):
         return Part(Sized(kind, value, getattr(value, "span", self.span(meta))), as_body(body), True,
                     self.span(meta))
+
+    def number_part(self, meta, kind, value, number):
+        """``all : 3``: a part whose body is a number, a distance of ``comp(fe){ ... }``
+        (``selector_function`` takes it); in any other split the number is an error (``assembly``)."""
+        return self.part(meta, kind, value, ir.Num(float(number), self.token_span(number)))
+
+    def merged_number_part(self, meta, kind, value, number):
+        return self.merged_part(meta, kind, value, ir.Num(float(number), self.token_span(number)))
 
     def repeat_group(self, meta, parts, star):
         return Group(parts, self.span(meta))

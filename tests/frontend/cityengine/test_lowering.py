@@ -254,6 +254,13 @@ def test_a_split_group_without_star_is_its_parts_in_place():
     assert body_of(text) == "split(x){ ~0.5: W | ~0.8: D | { ~3: T | 1: S }* | ~0.5: W | 2: V }"
 
 
+def test_edge_distances_may_be_numbers_and_a_number_elsewhere_is_an_error():
+    text = VERSION + "Lot --> setback(comp(fe){ street.front : 3 | street.back = 1.5 }){ all : A | remainder : B }\n"
+    assert body_of(text) == "setback(comp(fe){ street.front=3, street.back=1.5 }){ all: A | remainder: B }"
+    assert errors(VERSION + "Lot --> split(x){ 2 : 3 | ~1 : A }\nB --> comp(f){ front : 4 }\n") == [
+        (2, 34, "a number where operations are expected"), (3, 27, "a number where operations are expected")]
+
+
 def test_edge_distances_as_a_constant_are_named_unsupported():
     assert_unsupported_at("const d = comp(fe){ street.front : a | street.back = b }", "comp(fe){...} outside "
                           "setback", "comp")
