@@ -258,7 +258,7 @@ def test_edge_distances_may_be_numbers_and_a_number_elsewhere_is_an_error():
     text = VERSION + "Lot --> setback(comp(fe){ street.front : 3 | street.back = 1.5 }){ all : A | remainder : B }\n"
     assert body_of(text) == "setback(comp(fe){ street.front=3, street.back=1.5 }){ all: A | remainder: B }"
     assert errors(VERSION + "Lot --> split(x){ 2 : 3 | ~1 : A }\nB --> comp(f){ front : 4 }\n") == [
-        (2, 34, "a number where operations are expected"), (3, 27, "a number where operations are expected")]
+        (2, 23, "a number where operations are expected"), (3, 24, "a number where operations are expected")]
 
 
 def test_edge_distances_as_a_constant_are_named_unsupported():
