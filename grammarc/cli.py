@@ -199,11 +199,20 @@ def _check(args) -> int:
     print(f"{args.grammar}: ok")
     print(f"  rules:     {len(grammar.module.rules)} ({len(graph.nonterminals)} symbols with rules)")
     print(f"  start:     {graph.start}")
-    print(f"  terminals: {', '.join(graph.terminals) or '-'}")
-    print(f"  recursive: {', '.join(sorted(graph.recursive)) or '-'}")
-    print(f"  attrs:     {', '.join(a.name for a in grammar.module.attrs) or '-'}")
-    print(f"  assets:    {', '.join(grammar.assets)}")
+    print(f"  terminals: {_listed(graph.terminals)}")
+    print(f"  recursive: {_listed(sorted(graph.recursive))}")
+    print(f"  attrs:     {_listed([a.name for a in grammar.module.attrs])}")
+    print(f"  assets:    {_listed(grammar.assets)}")
     return 0
+
+
+def _listed(names, most: int = 40) -> str:
+    """Names for the summary of ``check``: a grammar of thousands of rules shows the first ``most``."""
+    names = list(names)
+    if not names:
+        return "-"
+    more = f" and {len(names) - most:,} more" if len(names) > most else ""
+    return ", ".join(names[:most]) + more
 
 
 def _render(args) -> int:

@@ -150,6 +150,14 @@ def test_check_prints_a_summary(write, capsys):
     assert "terminals: leaf" in out and "recursive: grow" in out
 
 
+def test_check_summary_of_a_grammar_of_many_rules_stays_short(write, capsys):
+    leaves = " ".join(f"W{i}." for i in range(45))
+    grammar = write("g.cga", f'version "2022.0"\n@StartRule\nLot --> {leaves}\n')
+    assert main(["check", str(grammar)]) == 0
+    line = next(s for s in capsys.readouterr().out.splitlines() if "terminals:" in s)
+    assert line.endswith("W39 and 5 more") and "W40" not in line
+
+
 def test_check_dump_ir(write, capsys):
     assert main(["check", "--dump-ir", str(write("g.cga", "attr h = 2 * 3\nlot ~> S(1r, h, 1r) x\n"))]) == 0
     assert "lot ~> S(1r, @h, 1r) x" in capsys.readouterr().out
