@@ -92,29 +92,56 @@ def render_all(diags: list[Diagnostic], sources: dict[str, str]) -> str:
 
 def suggest(name: str, candidates) -> str:
     """`` (did you mean `x`?)`` for the closest candidate, or an empty string."""
-    close = close_match(name, candidates)
-    return f" (did you mean `{close}`?)" if close is not None else ""
-
-
-def close_match(name: str, candidates) -> str | None:
-    """The candidate closest to ``name`` if one is close enough to be what was meant, else None."""
     close = difflib.get_close_matches(name, list(candidates), n=1, cutoff=0.6)
-    return close[0] if close else None
+    return f" (did you mean `{close[0]}`?)" if close else ""
 
 
 def typo_of(name: str, candidates) -> str | None:
-    """The candidate that ``name`` is a typo of, or None: one edit away (a letter missing, extra, wrong, or
-    two swapped) for names of four to seven letters, two for longer ones, letter case aside (names of one
-    to three letters are all one edit apart: only their case). Stricter than ``suggest``, which picks the
-    likeliest of names that must exist; a name that need not exist (a leaf) is only suspect when it is
-    that close."""
-    most = 0 if len(name) < 4 else 1 if len(name) < 8 else 2
-    lowered = name.lower()
-    for candidate in candidates:
-        if candidate != name and abs(len(candidate) - len(name)) <= most \
-                and _edits(lowered, candidate.lower(), most) <= most:
-            return candidate
-    return None
+    """The candidate that ``name`` is a typo of, or None (see ``Typos``, for many names against one set)."""
+    return Typos(candidates).of(name)
+
+
+class Typos:
+    """Which of a fixed set of names another name is a typo of: one edit away (a letter missing, extra,
+    wrong, or two swapped) for names of four to seven letters, two for longer ones, letter case aside
+    (names of one to three letters are all one edit apart: only their case). Stricter than ``suggest``,
+    which picks the likeliest of names that must exist; a name that need not exist (a leaf) is only suspect
+    when it is that close.
+
+    The candidates are indexed by what is left of each (in lower case) after deleting up to two of its
+    letters: two names at most k edits apart leave a common string after k deletions from each, so a name
+    is compared only with the candidates that share one with it, not with all of them (a grammar of
+    thousands of rules has thousands of leaves to look at).
+    """
+
+    def __init__(self, candidates):
+        self.candidates = list(candidates)
+        self.index: dict[str, list[int]] = {}
+        for order, candidate in enumerate(self.candidates):
+            for left in _deletions(candidate.lower(), 2):
+                self.index.setdefault(left, []).append(order)
+
+    def of(self, name: str) -> str | None:
+        """The first candidate, in the given order, that ``name`` is a typo of; None if there is none."""
+        most = 0 if len(name) < 4 else 1 if len(name) < 8 else 2
+        lowered = name.lower()
+        near = sorted({order for left in _deletions(lowered, most) for order in self.index.get(left, ())})
+        for order in near:
+            candidate = self.candidates[order]
+            if candidate != name and abs(len(candidate) - len(name)) <= most \
+                    and _edits(lowered, candidate.lower(), most) <= most:
+                return candidate
+        return None
+
+
+def _deletions(word: str, most: int) -> set[str]:
+    """``word`` and every string left of it after deleting up to ``most`` of its letters."""
+    found = {word}
+    layer = {word}
+    for _ in range(most):
+        layer = {w[:i] + w[i + 1:] for w in layer for i in range(len(w))}
+        found |= layer
+    return found
 
 
 def _edits(a: str, b: str, most: int) -> int:

@@ -2,9 +2,11 @@
 
 from __future__ import annotations
 
+import random
+
 import pytest
 
-from grammarc.diagnostics import Diagnostics, Span, render, suggest, typo_of
+from grammarc.diagnostics import Diagnostics, Span, Typos, _edits, render, suggest, typo_of
 
 
 def test_render_shows_the_line_and_a_caret_under_the_span():
@@ -34,3 +36,22 @@ def test_suggest_the_likeliest_name():
 ])
 def test_typo_of_finds_names_one_or_two_edits_away(name, candidates, typo):
     assert typo_of(name, candidates) == typo
+
+
+def test_the_index_finds_what_comparing_with_every_candidate_finds():
+    # Typos compares a name only with the candidates that share a string of deletions with it: the same
+    # answers as comparing it with all of them, in their order
+    rng = random.Random(17)
+    letters = "abcdeAB_1"
+
+    def word():
+        return "".join(rng.choice(letters) for _ in range(rng.randint(1, 11)))
+
+    candidates = list(dict.fromkeys(word() for _ in range(300)))
+    typos = Typos(candidates)
+    for _ in range(500):
+        name = rng.choice([word(), rng.choice(candidates)[:-1] + rng.choice(letters)])
+        most = 0 if len(name) < 4 else 1 if len(name) < 8 else 2
+        expected = next((c for c in candidates if c != name and abs(len(c) - len(name)) <= most
+                         and _edits(name.lower(), c.lower(), most) <= most), None)
+        assert typos.of(name) == expected, name

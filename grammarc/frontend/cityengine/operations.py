@@ -12,8 +12,9 @@ the name) is ``unknown operation NAME`` (``check_calls``).
 from __future__ import annotations
 
 from dataclasses import replace
+from functools import cache
 
-from grammarc.diagnostics import Diagnostics, suggest, typo_of
+from grammarc.diagnostics import Diagnostics, Typos, suggest
 from grammarc.frontend.cityengine.nodes import EdgeDistances, Group, Part, PendingOffset, Sized
 from grammarc.frontend.lowering import direct
 from grammarc.ir import nodes as ir
@@ -401,6 +402,13 @@ ALL_OPERATIONS = frozenset(OPERATIONS) | frozenset(PART_OPERATIONS) | NOT_APPLIE
 AXIS_NAMES = {"x": (0,), "y": (1,), "z": (2,), "xy": (0, 1), "xz": (0, 2), "yz": (1, 2), "xyz": (0, 1, 2)}
 
 
+@cache
+def _operation_typos() -> Typos:
+    """The operations, sorted (a frozenset's order changes between processes), indexed for typos once a
+    file calls a rule that does not exist."""
+    return Typos(sorted(ALL_OPERATIONS))
+
+
 def check_calls(rules: list[ir.Rule], imported, diags: Diagnostics) -> list[ir.Rule]:
     """``rules`` (a file's own) with their misspelt operations reported and dropped.
 
@@ -416,7 +424,7 @@ def check_calls(rules: list[ir.Rule], imported, diags: Diagnostics) -> list[ir.R
     def check(op):
         if isinstance(op, ir.Symbol) and op.args and not op.leaf and op.name not in defined \
                 and "." not in op.name and not op.name[0].isupper():
-            close = typo_of(op.name, ALL_OPERATIONS)
+            close = _operation_typos().of(op.name)
             if close is not None:
                 diags.error("unknown-op", f"unknown operation `{op.name}` (did you mean `{close}`?)",
                             op.span)

@@ -13,7 +13,7 @@ errors say more than "no rule").
 
 A successor symbol without a rule is a leaf, in both notations; CityEngine marks an intended one ``X.``,
 but most files write bare leaves (``Wall``, ``Glass``) without rules, so a bare one is warned about
-(``undefined-rule``) only when its name looks like a typo of a rule's (``diagnostics.typo_of``: one or two
+(``undefined-rule``) only when its name looks like a typo of a rule's (``diagnostics.Typos``: one or two
 letters off, ``facdes`` for ``facades``, or the letter case), of a rule under the same import prefix, and
 is not one of the usual ways of naming leaves beside rules: a prefix of the rule's name or the other way
 round (``Window`` beside ``Windows``, ``Tile`` beside ``TileRow``), or a number of a numbered family
@@ -27,7 +27,7 @@ from __future__ import annotations
 
 from dataclasses import replace
 
-from grammarc.diagnostics import Diagnostics, Span, typo_of
+from grammarc.diagnostics import Diagnostics, Span, Typos
 from grammarc.errors import UsageError
 from grammarc.ir import nodes as ir
 from grammarc.ir.nodes import RuleGraph
@@ -88,13 +88,17 @@ def analyze_rules(module: ir.Module, start: str, diags: Diagnostics) -> RuleGrap
 
 def _warn_undefined(module: ir.Module, nonterminals, edges, diags: Diagnostics) -> None:
     """A bare successor without a rule whose name looks like a typo of a rule's (module docstring)."""
+    by_prefix: dict[str, list[str]] = {}
+    for symbol in nonterminals:
+        by_prefix.setdefault(symbol.rpartition(".")[0], []).append(symbol)
+    rules_of = {prefix: Typos(symbols) for prefix, symbols in by_prefix.items()}
     typos: dict[str, str | None] = {}
     for op in iter_ops(module):
         if not isinstance(op, ir.Symbol) or op.leaf or op.args or op.name in edges:
             continue
         if op.name not in typos:
             prefix = op.name.rpartition(".")[0]
-            close = typo_of(op.name, [s for s in nonterminals if s.rpartition(".")[0] == prefix])
+            close = rules_of[prefix].of(op.name) if prefix in rules_of else None
             typos[op.name] = close if close is not None and not _naming_habit(op.name, close) else None
         close = typos[op.name]
         if close is not None:
