@@ -61,7 +61,8 @@ def compile_grammar(path: str | Path, *, text: str | None = None, start: str | N
         diags = Diagnostics(replace(d, severity=Severity.ERROR) for d in diags)
     if diags.has_errors:
         raise GrammarError(diags, sources)
-    if derive and any(d.code == "start-params" for d in diags):
-        raise UsageError(next(d for d in diags if d.code == "start-params").message)
+    unfed = next((d for d in diags if d.code == "start-params"), None)
+    if derive and unfed is not None:
+        raise UsageError(unfed.message)
     return Grammar(path=file, digest=hashlib.sha256(text.encode()).hexdigest(), module=module,
                    warnings=tuple(d for d in diags if not d.is_error), sources=sources, asset_roots=module.roots)
