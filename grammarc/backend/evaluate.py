@@ -2,50 +2,25 @@
 
 ``evaluate`` returns a numpy array with one value per shape, or a Python scalar when the value is the same
 for every shape (constants); callers broadcast. Numbers are float64, booleans bool, strings int32 ids of
-``Plan.strings``. CityEngine's arrays are ``backend.arrays.Arrays``, one array per shape. Angles of trigonometric functions are degrees, as in CGA. Transcendental functions run in
-a numba loop rather than numpy's SIMD kernels, so a value never depends on its position in the batch.
+``Plan.strings``. CityEngine's arrays are ``backend.arrays.Arrays``, one array per shape. Built-in functions
+are computed by ``backend.functions``.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-from typing import TYPE_CHECKING
-
 import numpy as np
-from numba import njit
 
 from grammarc.backend import arrays, occlusion
 from grammarc.backend.arrays import Arrays
-from grammarc.backend.chunk import Chunk
-from grammarc.backend.random import uniform
-from grammarc.backend.shapes import Shapes
+from grammarc.backend.env import Env
+from grammarc.backend.functions import FUNCTIONS
+from grammarc.backend.functions.strings import concatenate, is_string, string_ranks
 from grammarc.errors import LotFailure
-from grammarc.geometry.measure import area_and_volume, is_rectangular, vertex_and_face_counts
 from grammarc.ir import nodes as ir
-
-if TYPE_CHECKING:
-    from grammarc.backend.plan import Plan
-
-
-@dataclass(frozen=True, eq=False)
-class Env:
-    """What an expression can read: the shapes (scope, params, keys, set attributes), their chunk (lot
-    attributes, geometry) and the plan (interned strings, which attributes are set per shape)."""
-
-    shapes: Shapes
-    chunk: Chunk
-    plan: Plan
-
-    @property
-    def strings(self) -> dict[str, int]:
-        return self.plan.strings.ids
-
 
 _ARITH = {"+": np.add, "-": np.subtract, "*": np.multiply, "/": np.divide, "%": np.fmod}
 _COMPARE = {"<": np.less, "<=": np.less_equal, ">": np.greater, ">=": np.greater_equal,
             "==": np.equal, "!=": np.not_equal}
-#: Codes of the functions computed by ``elementwise``.
-_MATH = {"sin": 0, "cos": 1, "tan": 2, "asin": 3, "acos": 4, "atan": 5, "exp": 6, "log": 7, "sqrt": 8}
 
 
 def evaluate(expr: ir.Expr, env: Env):
@@ -93,7 +68,7 @@ def evaluate(expr: ir.Expr, env: Env):
             return same if expr.op == "==" else ~same
         if expr.op in _COMPARE:
             return _COMPARE[expr.op](left, right)
-        if expr.op == "+" and (_is_string(left) or _is_string(right)):
+        if expr.op == "+" and (is_string(left) or is_string(right)):
             return concatenate(left, right, env.plan.strings)
         with np.errstate(divide="ignore", invalid="ignore"):
             return _ARITH[expr.op](np.asarray(left, dtype=np.float64), right)
@@ -111,7 +86,7 @@ def _as_arrays(value, env: Env) -> Arrays:
     """A value as arrays: an array stays, a scalar is the 1x1 array of its value per shape."""
     if isinstance(value, Arrays):
         return value
-    dtype = np.int32 if _is_string(value) else np.asarray(value).dtype
+    dtype = np.int32 if is_string(value) else np.asarray(value).dtype
     return arrays.from_scalars(value, len(env.shapes), dtype)
 
 
@@ -176,11 +151,11 @@ def _elementwise(expr: ir.Binary, left, right, env: Env) -> Arrays:
     op = expr.op[1:]
     if op == "&&" or op == "||":
         values = (np.logical_and if op == "&&" else np.logical_or)(a, b)
-    elif op == "+" and (_is_string(a) or _is_string(b)):
+    elif op == "+" and (is_string(a) or is_string(b)):
         values = concatenate(a, b, env.plan.strings)
     elif op in _COMPARE:
-        if op not in ("==", "!=") and _is_string(a):  # strings in order of their text
-            ranks = _string_ranks(env)
+        if op not in ("==", "!=") and is_string(a):  # strings in order of their text
+            ranks = string_ranks(env)
             a, b = ranks[a], ranks[b]
         values = _COMPARE[op](a, b)
     else:
@@ -191,92 +166,6 @@ def _elementwise(expr: ir.Binary, left, right, env: Env) -> Arrays:
 
 
 _ARRAY_EXPRESSIONS = {ir.ArrayLit: _array_literal, ir.Range: _colon, ir.Index: _index}
-
-
-def _string_ranks(env: Env) -> np.ndarray:
-    """(strings,) int64 the rank of each interned string's text in sorted order."""
-    names = list(env.plan.strings.ids)
-    ranks = np.empty(len(names), dtype=np.int64)
-    ranks[np.argsort(np.array(names, dtype=object), kind="stable")] = np.arange(len(names))
-    return ranks
-
-
-def _array_call(f: str, args: list, env: Env):
-    """CityEngine's array functions (``ir.ARRAY_FUNCTIONS``) on evaluated arguments."""
-    if f == "isNull":
-        if _is_string(args[0]):
-            null = env.plan.strings.ids.get("\ue000", -1)
-            return np.equal(args[0], null)
-        return np.isnan(np.asarray(args[0], dtype=np.float64))
-    array = args[0]
-    if f == "size":
-        return array.sizes.astype(np.float64)
-    if f == "nRows":
-        return array.rows.astype(np.float64)
-    if f == "nColumns":
-        return array.columns.astype(np.float64)
-    if f == "transpose":
-        return arrays.transpose(array)
-    ranks = _string_ranks(env) if array.values.dtype == np.int32 else None
-    if f == "sortIndices":
-        return arrays.sort_indices(array, ranks)
-    if f == "sortRowIndices":
-        return arrays.sort_row_indices(array, ranks)
-    return arrays.find_first(array, *args[1:])
-
-
-def _is_string(value) -> bool:
-    """String values are interned ids: Python ints or int32 arrays (numbers are float, flags bool)."""
-    return isinstance(value, (int, np.integer)) and not isinstance(value, (bool, np.bool_)) or (
-        isinstance(value, np.ndarray) and value.dtype == np.int32)
-
-
-def format_value(value, is_string: bool, names: list[str]) -> str:
-    """A value as CityEngine prints it in strings: 3.0 -> "3", 2.5 -> "2.5", True -> "true"."""
-    if is_string:
-        return names[int(value)]
-    if isinstance(value, (bool, np.bool_)):
-        return "true" if value else "false"
-    value = float(value)
-    return str(int(value)) if value.is_integer() and abs(value) < 1e15 else repr(value)
-
-
-def concatenate(left, right, strings) -> np.ndarray | int:
-    """CityEngine's ``+`` on strings, per shape: once per distinct pair of operands, then spread."""
-    names = list(strings.ids)
-    left_str, right_str = _is_string(left), _is_string(right)
-    a, b = np.broadcast_arrays(np.asarray(left), np.asarray(right))
-    if a.ndim == 0:
-        text = format_value(a[()], left_str, names) + format_value(b[()], right_str, names)
-        return strings.intern(text)
-    pairs = np.stack([a.astype(np.float64), b.astype(np.float64)], axis=1)
-    distinct, inverse = np.unique(pairs, axis=0, return_inverse=True)
-    # the pairs are numbers: flags get their type back, to print as true/false
-    as_left = bool if a.dtype == np.bool_ else float
-    as_right = bool if b.dtype == np.bool_ else float
-    ids = np.array([strings.intern(format_value(as_left(x), left_str, names)
-                                   + format_value(as_right(y), right_str, names))
-                    for x, y in distinct], dtype=np.int32)
-    return ids[inverse.reshape(-1)]
-
-
-def list_item(items, index, strings) -> np.ndarray | int:
-    """CityEngine's ``listItem(list, index)``: item ``index`` of a ``;``-separated string list ("" out of
-    range), once per distinct pair of list and index."""
-    names = list(strings.ids)
-    a, b = np.broadcast_arrays(np.asarray(items), np.asarray(index, dtype=np.float64))
-
-    def item(text: str, i: float) -> int:
-        parts = text.split(";")
-        k = int(np.floor(i)) if np.isfinite(i) else -1
-        return strings.intern(parts[k] if 0 <= k < len(parts) else "")
-
-    if a.ndim == 0:
-        return item(names[int(a[()])], float(b[()]))
-    pairs = np.stack([a.astype(np.float64), b], axis=1)
-    distinct, inverse = np.unique(pairs, axis=0, return_inverse=True)
-    ids = np.array([item(names[int(x)], y) for x, y in distinct], dtype=np.int32)
-    return ids[inverse.reshape(-1)]
 
 
 def evaluate_array(expr: ir.Expr, env: Env, dtype=np.float64) -> np.ndarray:
@@ -315,115 +204,4 @@ def _scope_angles(env: Env) -> np.ndarray:
 
 
 def _call(expr: ir.Call, env: Env):
-    args = [evaluate(a, env) for a in expr.args]
-    f = expr.func
-    if f in ir.ARRAY_FUNCTIONS:
-        return _array_call(f, args, env)
-    if f == "rand":
-        u = uniform(env.shapes.key, expr.site)
-        if not args:
-            return u
-        low, high = (0.0, args[0]) if len(args) == 1 else args
-        return low + (np.subtract(high, low)) * u
-    if f == "p":
-        return uniform(env.shapes.key, expr.site) < np.asarray(args[0], dtype=np.float64)
-    if f == "fileRandom":
-        return uniform(env.chunk.lot_key[env.shapes.lot], 0x5F11E)
-    if f in ("geometry.nVertices", "geometry.nFaces"):
-        vertices, faces = vertex_and_face_counts(env.shapes.size, env.shapes.geom, env.chunk.polygons,
-                                                  env.chunk.meshes)
-        return vertices if f == "geometry.nVertices" else faces
-    if f == "len":
-        names = list(env.plan.strings.ids)
-        ids = np.asarray(args[0])
-        distinct, inverse = np.unique(np.atleast_1d(ids), return_inverse=True)
-        lengths = np.array([len(names[int(i)]) for i in distinct], dtype=np.float64)[inverse.reshape(-1)]
-        return lengths if ids.ndim else float(lengths[0])
-    if f == "geometry.isRectangular":
-        return is_rectangular(env.shapes.size, env.shapes.geom, env.chunk.polygons,
-                              float(np.max(args[0])) if np.size(args[0]) else 0.0)
-    if f in ("geometry.area", "geometry.volume"):
-        area, volume = area_and_volume(env.shapes.size, env.shapes.geom, env.chunk.polygons, env.chunk.meshes)
-        return area if f == "geometry.area" else volume
-    if f == "isnan":
-        return np.isnan(np.asarray(args[0], dtype=np.float64))
-    if f == "log10":
-        with np.errstate(divide="ignore", invalid="ignore"):
-            return np.log10(np.asarray(args[0], dtype=np.float64))
-    if f == "str":
-        return concatenate(env.plan.strings.intern(""), args[0], env.plan.strings)
-    if f == "float":
-        return _to_float(args[0], env)
-    if f == "listItem":
-        return list_item(args[0], args[1], env.plan.strings)
-    if f == "bool":
-        return np.asarray(args[0]) != 0
-    if f in ("floor", "ceil", "abs"):
-        return getattr(np, f)(args[0])
-    if f == "round":
-        x = np.asarray(args[0], dtype=np.float64)
-        return np.copysign(np.floor(np.abs(x) + 0.5), x)
-    if f in ("min", "max"):
-        return (np.minimum if f == "min" else np.maximum)(args[0], args[1])
-    if f == "pow":
-        with np.errstate(invalid="ignore", over="ignore"):
-            return np.power(np.asarray(args[0], dtype=np.float64), args[1])
-    if f == "atan2":
-        y, x = np.broadcast_arrays(np.asarray(args[0], np.float64), np.asarray(args[1], np.float64))
-        return _atan2_deg(np.ascontiguousarray(y).ravel(), np.ascontiguousarray(x).ravel()).reshape(y.shape)
-    x = np.atleast_1d(np.asarray(args[0], dtype=np.float64))
-    out = elementwise(_MATH[f], np.ascontiguousarray(x))
-    return out if np.ndim(args[0]) else float(out[0])
-
-
-def _to_float(value, env: Env):
-    """``float(x)``: numbers stay, booleans become 0/1, strings are parsed (NaN when not a number)."""
-    if not _is_string(value):
-        return np.asarray(value, dtype=np.float64)
-    names = list(env.plan.strings.ids)
-    ids = np.atleast_1d(np.asarray(value))
-    distinct, inverse = np.unique(ids, return_inverse=True)
-    parsed = []
-    for i in distinct:
-        try:
-            parsed.append(float(names[int(i)]))
-        except ValueError:
-            parsed.append(np.nan)
-    out = np.array(parsed)[inverse.reshape(-1)]
-    return out if np.ndim(value) else float(out[0])
-
-
-@njit(cache=True, nogil=True)
-def elementwise(code, x):
-    """Elementwise function ``code`` (see ``_MATH``) of x : (n,) float64, degrees for trigonometry."""
-    out = np.empty_like(x)
-    rad = np.pi / 180.0
-    for i in range(len(x)):
-        v = x[i]
-        if code == 0:
-            out[i] = np.sin(v * rad)
-        elif code == 1:
-            out[i] = np.cos(v * rad)
-        elif code == 2:
-            out[i] = np.tan(v * rad)
-        elif code == 3:
-            out[i] = np.arcsin(v) / rad
-        elif code == 4:
-            out[i] = np.arccos(v) / rad
-        elif code == 5:
-            out[i] = np.arctan(v) / rad
-        elif code == 6:
-            out[i] = np.exp(v)
-        elif code == 7:
-            out[i] = np.log(v) if v > 0 else (-np.inf if v == 0 else np.nan)
-        else:
-            out[i] = np.sqrt(v) if v >= 0 else np.nan
-    return out
-
-
-@njit(cache=True, nogil=True)
-def _atan2_deg(y, x):
-    out = np.empty_like(y)
-    for i in range(len(y)):
-        out[i] = np.arctan2(y[i], x[i]) * 180.0 / np.pi
-    return out
+    return FUNCTIONS[expr.func](expr, [evaluate(a, env) for a in expr.args], env)

@@ -225,13 +225,12 @@ class Binary:
 
 @dataclass(frozen=True, slots=True)
 class Call:
-    """A built-in function. ``site`` numbers the call so that ``rand`` draws differ per call site."""
+    """A built-in function (``ir.functions``). ``site`` numbers the call so that ``rand`` draws differ per
+    call site."""
 
     func: str
-    #: numbers, but for the conversions (``CONVERSIONS``), which take any type, and the array functions
-    args: tuple[Expr, ...] = child(lambda e: None if e.func in CONVERSIONS or e.func in ARRAY_FUNCTIONS
-                                   else Type.NUM,
-                                   lambda e: f"an argument of `{e.func}`")
+    #: typed by the function's signature (``passes.types``)
+    args: tuple[Expr, ...] = child(None, lambda e: f"an argument of `{e.func}`")
     span: Span = NO_SPAN
     site: int = 0
 
@@ -321,56 +320,8 @@ class Index:
 Expr = (Num | Str | Bool | Name | Param | AttrRef | ScopeRef | Unary | Binary | Call | Select | ContextRef
         | Occlusion | ArrayLit | Range | Index)
 
-#: Built-in functions: name -> (min args, max args, result type). Argument types are numbers.
-FUNCTIONS: dict[str, tuple[int, int, Type]] = {
-    "rand": (0, 2, Type.NUM),
-    "floor": (1, 1, Type.NUM),
-    "ceil": (1, 1, Type.NUM),
-    "round": (1, 1, Type.NUM),
-    "abs": (1, 1, Type.NUM),
-    "sqrt": (1, 1, Type.NUM),
-    "sin": (1, 1, Type.NUM),
-    "cos": (1, 1, Type.NUM),
-    "tan": (1, 1, Type.NUM),
-    "asin": (1, 1, Type.NUM),
-    "acos": (1, 1, Type.NUM),
-    "atan": (1, 1, Type.NUM),
-    "atan2": (2, 2, Type.NUM),
-    "exp": (1, 1, Type.NUM),
-    "log": (1, 1, Type.NUM),
-    "pow": (2, 2, Type.NUM),
-    "min": (2, 2, Type.NUM),
-    "max": (2, 2, Type.NUM),
-    # CityEngine built-ins
-    "p": (1, 1, Type.BOOL),
-    "log10": (1, 1, Type.NUM),
-    "isnan": (1, 1, Type.BOOL),
-    "geometry.area": (0, 0, Type.NUM),
-    "geometry.volume": (0, 0, Type.NUM),
-    "geometry.isRectangular": (1, 1, Type.BOOL),
-    "geometry.nVertices": (0, 0, Type.NUM),
-    "geometry.nFaces": (0, 0, Type.NUM),
-    "fileRandom": (0, 0, Type.NUM),
-    # CityEngine's array functions: their argument types, and some result types, depend on the arguments'
-    # (``passes.types``); the type here is that of ``size``, ``nRows``, ``nColumns`` and ``findFirst``
-    "size": (1, 1, Type.NUM),
-    "nRows": (1, 1, Type.NUM),
-    "nColumns": (1, 1, Type.NUM),
-    "findFirst": (2, 3, Type.NUM),
-    "transpose": (1, 1, Type.UNKNOWN),
-    "sortIndices": (1, 1, Type.NUMS),
-    "sortRowIndices": (1, 1, Type.NUMS),
-    "isNull": (1, 1, Type.BOOL),
-}
-ARRAY_FUNCTIONS = frozenset({"size", "nRows", "nColumns", "findFirst", "transpose", "sortIndices",
-                             "sortRowIndices", "isNull"})
-
 #: CityEngine shape attributes that ``set`` changes for a shape and its successors (not declared attrs).
 SHAPE_ATTRIBUTES: dict[str, Type] = {"trim.vertical": Type.BOOL}
-#: Functions that take strings or any type (their argument types are checked by ``passes.types``).
-CONVERSIONS: dict[str, Type] = {"str": Type.STR, "float": Type.NUM, "bool": Type.BOOL, "len": Type.NUM,
-                                 "listItem": Type.STR}
-
 
 # ------------------------------------------------------------------------------------------------ operations
 

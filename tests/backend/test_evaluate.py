@@ -12,7 +12,8 @@ from conftest import LOT_ZOO, make_lots
 from operations.derivations import per_lot, rect, run, totals
 
 from grammarc.backend.derive import initial_chunk
-from grammarc.backend.evaluate import _MATH, Env, elementwise, evaluate, evaluate_array
+from grammarc.backend.evaluate import Env, evaluate, evaluate_array
+from grammarc.backend.functions.math import _MATH, elementwise
 from grammarc.backend.plan import Strings
 from grammarc.backend.random import mix
 from grammarc.ir import nodes as ir

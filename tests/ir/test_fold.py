@@ -7,7 +7,8 @@ import pytest
 from grammarc.diagnostics import Diagnostics, Span
 from grammarc.frontend.parse import parse_source
 from grammarc.ir import nodes as ir
-from grammarc.ir.passes.fold import PURE, SHAPE_DEPENDENT, fold_constants
+from grammarc.ir.functions import FUNCTIONS
+from grammarc.ir.passes.fold import PURE, fold_constants
 from grammarc.ir.pipeline import run_passes
 from grammarc.ir.printer import print_expr, print_module, print_rule
 from grammarc.ir.traverse import rewrite_expr
@@ -178,6 +179,8 @@ def test_rewrite_expr_identity():
     assert swapped.right is expr.right
 
 
-def test_every_pure_function_folds_and_rand_is_not_pure():
-    assert "rand" not in PURE
-    assert set(PURE) == set(ir.FUNCTIONS) - SHAPE_DEPENDENT - ir.ARRAY_FUNCTIONS
+def test_every_math_function_folds_and_none_that_reads_the_shape():
+    assert not any(FUNCTIONS[f].shape for f in PURE)
+    numeric = {f for f, s in FUNCTIONS.items() if s.params and set(s.params) == {ir.Type.NUM}
+               and s.result in (ir.Type.NUM, ir.Type.BOOL) and not s.shape}
+    assert numeric <= set(PURE)

@@ -13,7 +13,8 @@ from __future__ import annotations
 import numpy as np
 
 from grammarc.backend.context import Context
-from grammarc.backend.evaluate import elementwise, evaluate, evaluate_array
+from grammarc.backend.evaluate import evaluate, evaluate_array
+from grammarc.backend.functions.math import elementwise
 from grammarc.backend.operations.table import operation
 from grammarc.backend.outlines import flat_axis, polygons_of
 from grammarc.backend.reframing import reframed, turned

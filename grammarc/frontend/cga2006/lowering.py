@@ -16,6 +16,7 @@ from grammarc.frontend.cga2006.nodes import ContinuationStatement, PriorityState
 from grammarc.frontend.cga2006.operations import OPERATIONS, PART_OPERATIONS, OperationLowering
 from grammarc.frontend.lowering import LoweringBase
 from grammarc.ir import nodes as ir
+from grammarc.ir.functions import FUNCTIONS
 
 #: Occlusion queries (paper section 3.2), parsed as dotted calls: both test the shape's scope.
 OCCLUSION_QUERIES = {("Shape", "occ"), ("Scope", "occ")}
@@ -166,15 +167,14 @@ class Lowering(OperationLowering, LoweringBase):
         span = self.token_span(name)
         args = tuple(self.expr(a) for a in (args or ()))
         func = str(name)
-        if func not in ir.FUNCTIONS:
+        signature = FUNCTIONS.get(func)
+        if signature is None:
             self.diags.error("unknown-function",
-                             f"unknown function `{func}`{suggest(func, ir.FUNCTIONS)}", span)
+                             f"unknown function `{func}`{suggest(func, FUNCTIONS)}", span)
             return ir.placeholder(span)
-        low, high, _ = ir.FUNCTIONS[func]
-        if not low <= len(args) <= high:
-            want = str(low) if low == high else f"{low} to {high}"
-            self.diags.error("arity", f"`{func}` takes {want} argument{'s' if high != 1 else ''}, "
-                             f"got {len(args)}", span)
+        if not signature.takes(len(args)):
+            self.diags.error("arity", f"`{func}` takes {signature.arity()} "
+                             f"argument{'s' if len(signature.params) != 1 else ''}, got {len(args)}", span)
             return ir.Num(0.0, span)
         return ir.Call(func, args, span, self.site())
 

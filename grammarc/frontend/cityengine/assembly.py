@@ -11,6 +11,7 @@ from grammarc.diagnostics import Diagnostics, Span, suggest
 from grammarc.frontend.cityengine.nodes import Annotated, FunctionDef, Import, RuleDef, Style
 from grammarc.frontend.cityengine.operations import check_calls
 from grammarc.ir import nodes as ir
+from grammarc.ir.functions import FUNCTIONS
 from grammarc.ir.traverse import rewrite_body, rewrite_expr, rewrite_ops
 
 
@@ -160,14 +161,13 @@ class _Inliner:
             if isinstance(e, ir.Name) and e.name not in params and e.name not in self.attrs \
                     and e.name in self.functions and not self.functions[e.name].params:
                 return self.call(self.functions[e.name], (), e.span, calling)
-            # a function of the file's own wins over an array built-in of its name (ESRI.lib's string
+            # a function of the file's own wins over a built-in of its name (ESRI.lib's string
             # `findFirst(text, match)` predates the array one)
-            if isinstance(e, ir.Call) and (e.func in ir.ARRAY_FUNCTIONS and e.func in self.functions
-                                           or e.func not in ir.FUNCTIONS and e.func not in ir.CONVERSIONS):
+            if isinstance(e, ir.Call) and (e.func in self.functions or e.func not in FUNCTIONS):
                 fn = self.functions.get(e.func)
                 if fn is None:
                     self.diags.error("unknown-function", f"unknown function `{e.func}`"
-                                     f"{suggest(e.func, [*ir.FUNCTIONS, *self.functions])}", e.span)
+                                     f"{suggest(e.func, [*FUNCTIONS, *self.functions])}", e.span)
                     return ir.placeholder(e.span)
                 if len(fn.params) != len(e.args):
                     self.diags.error("arity", f"`{e.func}` takes {len(fn.params)} arguments, got "

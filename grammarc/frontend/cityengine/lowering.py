@@ -45,6 +45,7 @@ from grammarc.frontend.cityengine.operations import (
 )
 from grammarc.frontend.lowering import LoweringBase
 from grammarc.ir import nodes as ir
+from grammarc.ir.functions import FUNCTIONS
 
 #: The annotations of CityEngine's CGA reference ("Annotations", 2019-2025).
 ANNOTATIONS = frozenset((
@@ -261,7 +262,7 @@ class Lowering(OperationLowering, LoweringBase):
             elif len(body) == 1 and isinstance(body[0], ir.Symbol):
                 op = body[0]
                 func = FUNCTION_NAMES.get(op.name, op.name)
-                value = ir.Call(func, op.args, op.span, self.site()) if op.args or func in ir.FUNCTIONS \
+                value = ir.Call(func, op.args, op.span, self.site()) if op.args or func in FUNCTIONS \
                     else ir.Name(op.name, op.span)
             else:
                 self.unsupported("this comp(fe) part", span, "each part gives one distance: `all : 3`")

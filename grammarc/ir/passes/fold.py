@@ -2,7 +2,7 @@
 
 Assumes: names resolved and types checked. Guarantees: no ``Unary``, ``Binary`` or non-random ``Call``
 has only constant operands. Attributes stay references (a lot may override them); ``rand`` stays a call. Arrays are not folded:
-CityEngine's array literals, indexing and array functions (``ir.ARRAY_FUNCTIONS``) are evaluated by the
+CityEngine's array literals, indexing and array functions (``functions.ARRAY_FUNCTIONS``) are evaluated by the
 backend, on constants as on anything else.
 A constant division by zero is an error at its span.
 """
@@ -30,9 +30,6 @@ PURE = {
     "atan": lambda x: math.degrees(math.atan(x)), "atan2": lambda y, x: math.degrees(math.atan2(y, x)),
     "pow": math.pow, "min": min, "max": max, "log10": math.log10, "isnan": math.isnan,
 }
-#: Functions that read the shape or draw random numbers: never folded.
-SHAPE_DEPENDENT = frozenset({"rand", "p", "geometry.area", "geometry.volume", "geometry.isRectangular",
-                             "geometry.nVertices", "geometry.nFaces", "fileRandom"})
 _CONSTANT = (ir.Num, ir.Str, ir.Bool)
 
 

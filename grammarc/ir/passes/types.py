@@ -20,6 +20,7 @@ from dataclasses import replace
 
 from grammarc.diagnostics import Diagnostics
 from grammarc.ir import nodes as ir
+from grammarc.ir.functions import ARRAY_FUNCTIONS, FUNCTIONS
 from grammarc.ir.traverse import all_exprs, expr_fields, field_exprs, iter_nodes, iter_ops
 
 T = ir.Type
@@ -149,6 +150,9 @@ def _infer_from_uses(rule: ir.Rule, slots: list, attr_types) -> None:
         elif isinstance(expr, ir.Binary) and expr.op in ir.COMPARE_OPS:
             for this, other in ((expr.left, expr.right), (expr.right, expr.left)):
                 settle(this, type_of(other, attr_types, tuple(slots), Diagnostics()))
+        elif isinstance(expr, ir.Call) and expr.func not in ARRAY_FUNCTIONS:
+            for this, want in zip(expr.args, FUNCTIONS[expr.func].params):
+                settle(this, want)
         else:
             for this, want, _ in _declared(expr):
                 settle(this, want)
@@ -285,17 +289,21 @@ _ARRAY_ARGUMENT = {
 
 
 def _call(expr: ir.Call, got: list[ir.Type], diags: Diagnostics) -> ir.Type:
-    if expr.func not in ir.ARRAY_FUNCTIONS:
-        for t, arg in zip(got, expr.args):
-            if t.is_array and expr.func in ir.CONVERSIONS:  # they take any scalar, the others numbers
+    signature = FUNCTIONS[expr.func]
+    if not signature.takes(len(got)):
+        diags.error("arity", f"`{expr.func}` takes {signature.arity()} arguments, got {len(got)}", expr.span)
+        return T.UNKNOWN
+    if expr.func not in ARRAY_FUNCTIONS:
+        for t, want, arg in zip(got, signature.params, expr.args):
+            if want is None and t.is_array:  # any scalar
                 diags.error("type", f"`{expr.func}` takes no array, got a {t.value}", arg.span)
                 return T.UNKNOWN
-        return ir.CONVERSIONS.get(expr.func) or ir.FUNCTIONS[expr.func][2]
-    low, high, result = ir.FUNCTIONS[expr.func]
-    if not low <= len(got) <= high:
-        want = str(low) if low == high else f"{low} or {high}"
-        diags.error("arity", f"`{expr.func}` takes {want} arguments, got {len(got)}", expr.span)
-        return T.UNKNOWN
+            if want is not None and t is not T.UNKNOWN and t is not want:
+                diags.error("type", f"an argument of `{expr.func}` must be a {want.value}, got a {t.value}",
+                            arg.span)
+                return T.UNKNOWN
+        return signature.result
+    result = signature.result
     first = got[0]
     ok, noun = _ARRAY_ARGUMENT.get(expr.func, (lambda t: t.is_array, "an array"))
     if first is not T.UNKNOWN and not ok(first):
