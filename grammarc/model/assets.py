@@ -69,11 +69,16 @@ class AssetMesh:
         Triangles, counter-clockwise seen from outside.
     polygon_sizes : (p,) int64
         Vertex count of each polygon before triangulation (see the module docstring).
+    bounds : (2, 3) float64
+        The lowest and highest corner of the asset's bounding box in its own coordinates and units, before
+        it was fitted to the unit box (what ``assetInfo`` reports and ``keepSizeAndPosition`` keeps); the
+        unit box for a built-in.
     """
 
     vertices: np.ndarray
     faces: np.ndarray
     polygon_sizes: np.ndarray
+    bounds: np.ndarray
 
     @property
     def n_triangles(self) -> int:
@@ -110,7 +115,7 @@ def builtin_mesh(name: str) -> AssetMesh:
         return _frozen(vertices, _quads_to_triangles(quads), np.full(6, 4))
     if bare == "quad":
         vertices = np.array([[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0]], np.float64)
-        return _frozen(vertices, np.array([[0, 1, 2], [0, 2, 3]]), np.array([4]))
+        return _frozen(vertices, np.array([[0, 1, 2], [0, 2, 3]]), np.array([4]), ((0.0, 0.0, 0.0), (1.0, 1.0, 0.0)))
     if bare in BLOCKS:
         return _prism(np.array(BLOCKS[bare], dtype=np.float64) / 3.0)
     if builtin_name(bare) and bare.startswith("cylinder"):
@@ -201,7 +206,7 @@ def _load_file(path: Path, mtime_ns: int) -> AssetMesh:
         sizes = np.array([len(f) for f in polygons], np.int64)
         faces = np.concatenate([np.stack([np.full(len(f) - 2, f[0]), f[1:-1], f[2:]], axis=1)
                                 for f in polygons]) if polygons else np.zeros((0, 3), np.int64)
-        return _frozen(_fitted(vertices), faces, sizes)
+        return _from_own_coordinates(vertices, faces, sizes)
     import trimesh
 
     try:
@@ -210,7 +215,7 @@ def _load_file(path: Path, mtime_ns: int) -> AssetMesh:
         raise AssetError(f"cannot read asset `{path}`: {error}") from error
     vertices = np.asarray(getattr(mesh, "vertices", np.zeros((0, 3))), np.float64).reshape(-1, 3)
     faces = np.asarray(getattr(mesh, "faces", np.zeros((0, 3))), np.int64).reshape(-1, 3)
-    return _frozen(_fitted(vertices), faces, np.full(len(faces), 3, np.int64))
+    return _from_own_coordinates(vertices, faces, np.full(len(faces), 3, np.int64))
 
 
 def _fitted(vertices: np.ndarray) -> np.ndarray:
@@ -225,13 +230,20 @@ def _fitted(vertices: np.ndarray) -> np.ndarray:
     return (vertices - low) * scale
 
 
+def _from_own_coordinates(vertices, faces, sizes) -> AssetMesh:
+    """A file asset: its vertices fitted to the unit box, its bounds in its own coordinates kept."""
+    bounds = np.array([vertices.min(axis=0), vertices.max(axis=0)]) if len(vertices) else np.zeros((2, 3))
+    return _frozen(_fitted(vertices), faces, sizes, bounds)
+
+
 def _quads_to_triangles(quads: np.ndarray) -> np.ndarray:
     """(2q, 3) triangles of (q, 4) quads, each split along its diagonal 0-2, in quad order."""
     return np.stack([quads[:, [0, 1, 2]], quads[:, [0, 2, 3]]], axis=1).reshape(-1, 3)
 
 
-def _frozen(vertices, faces, sizes) -> AssetMesh:
-    arrays = [np.array(vertices, np.float64), np.array(faces, np.int64), np.array(sizes, np.int64)]
+def _frozen(vertices, faces, sizes, bounds=((0.0, 0.0, 0.0), (1.0, 1.0, 1.0))) -> AssetMesh:
+    arrays = [np.array(vertices, np.float64), np.array(faces, np.int64), np.array(sizes, np.int64),
+              np.array(bounds, np.float64)]
     for array in arrays:
         array.flags.writeable = False  # cached and shared: nobody may change them
     return AssetMesh(*arrays)

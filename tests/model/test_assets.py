@@ -107,3 +107,10 @@ def test_candler_assets(tmp_path):
             f_lines = [line.split() for line in path.read_text().splitlines() if line.startswith("f ")]
             assert shape.polygon_sizes.tolist() == [len(f) - 1 for f in f_lines]
             assert shape.n_triangles == sum(len(f) - 3 for f in f_lines)
+
+
+def test_a_file_asset_keeps_its_bounds_in_its_own_units(tmp_path):
+    (tmp_path / "post.obj").write_text("v -1 0 2\nv 1 0 2\nv 1 3 2\nv -1 3 2.5\nf 1 2 3 4\n")
+    mesh = load_asset("post.obj", [tmp_path])
+    np.testing.assert_array_equal(mesh.bounds, [[-1, 0, 2], [1, 3, 2.5]])
+    np.testing.assert_array_equal(builtin_mesh("quad").bounds, [[0, 0, 0], [1, 1, 0]])
