@@ -55,6 +55,7 @@ FUNCTIONS: dict[str, Signature] = {
                                       "acos", "atan", "exp", "log", "log10")},
     **{name: _numeric(2) for name in ("atan2", "pow", "min", "max")},
     "isnan": Signature((T.NUM,), T.BOOL),
+    "isinf": Signature((T.NUM,), T.BOOL),
     "rand": Signature((T.NUM, T.NUM), T.NUM, optional=2, shape=True),
     "p": Signature((T.NUM,), T.BOOL, shape=True),
     # ------------------------------------------------------------------------------ strings (backend.functions.strings)
@@ -87,6 +88,12 @@ FUNCTIONS: dict[str, Signature] = {
     "sortIndices": Signature((None,), T.NUMS),
     "sortRowIndices": Signature((None,), T.NUMS),
     "isNull": Signature((None,), T.BOOL),
+    "sum": Signature((None,), T.NUM),  # a str for a str[]
+    "floatArray": Signature((None,), T.NUMS, optional=1),
+    "boolArray": Signature((None,), T.BOOLS, optional=1),
+    "stringArray": Signature((None,), T.STRS, optional=1),
 }
 ARRAY_FUNCTIONS = frozenset({"size", "nRows", "nColumns", "findFirst", "transpose", "sortIndices",
-                             "sortRowIndices", "isNull"})
+                             "sortRowIndices", "isNull", "sum", "floatArray", "boolArray", "stringArray"})
+#: The array conversions and the scalar conversion each applies to every element.
+ARRAY_CONVERSIONS = {"floatArray": "float", "boolArray": "bool", "stringArray": "str"}

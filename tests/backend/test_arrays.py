@@ -138,6 +138,21 @@ A2 = "const a = [1, 2, 3 ; 4, 5, 6 ; 7, 8, 9]\n"
     ('const v = ["a", "b"] .+ "c"', [["ac", "bc"]]), ('const v = "a" .+ [1, 2 ; 3, 4]', [["a1", "a2"], ["a3", "a4"]]),
     ('const v = [1 ; 2] .+ ["a" ; "b"]', [["1a"], ["2b"]]), ('const v = [true ; false] .+ "a"', [["truea"], ["falsea"]]),
     ('const v = ["a" ; "b"] .+ [false ; true]', [["afalse"], ["btrue"]]),
+    # sum
+    ("const v = sum([1, 2, 3])", 6), ("const v = sum([true, false, true])", 2),
+    ('const v = sum(["a", "b", "c"])', "abc"), ('const v = sum(["a", "bc" ; "d", ""])', "abcd"),
+    ("const v = sum([4 : 2])", 0), ('const v = sum(["a", "b"][[false, false]])', ""),
+    # floatArray, boolArray, stringArray
+    ("const v = floatArray([1, 0, 1.777, 20])", [[1, 0, 1.777, 20]]),
+    ('const v = floatArray(["1.5", "-2", "0"])', [[1.5, -2, 0]]),
+    ("const v = floatArray([true, false, true])", [[1, 0, 1]]), ("const v = floatArray()", []),
+    ("const v = boolArray([1, 0, 1, 20])", [[True, False, True, True]]),
+    ("const v = boolArray([true, false, true])", [[True, False, True]]),
+    ("const v = stringArray([1, 0, 1.777, 20])", [["1", "0", "1.777", "20"]]),
+    ("const v = stringArray([true, false ; true, true])", [["true", "false"], ["true", "true"]]),
+    ('const v = stringArray(["true", "CityEngine", ""])', [["true", "CityEngine", ""]]),
+    # isinf (the math functions fold on constants; an attribute is evaluated per lot)
+    ("attr x = 1e308\nconst v = isinf(x / 0)", True), ("attr x = 1e308\nconst v = isinf(x)", False),
     # a case expression of arrays
     ("attr n = 3\nconst v = case n > 2 : [1, 2] else : [3]", [[1, 2]]),
 ])

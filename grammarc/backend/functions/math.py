@@ -35,9 +35,9 @@ def probability(call, args, env: Env):
     return uniform(env.shapes.key, call.site) < np.asarray(args[0], dtype=np.float64)
 
 
-@function("isnan")
-def isnan(call, args, env: Env):
-    return np.isnan(np.asarray(args[0], dtype=np.float64))
+@function("isnan", "isinf")
+def is_special(call, args, env: Env):
+    return (np.isnan if call.func == "isnan" else np.isinf)(np.asarray(args[0], dtype=np.float64))
 
 
 @function("log10")

@@ -304,6 +304,8 @@ def _call(expr: ir.Call, got: list[ir.Type], diags: Diagnostics) -> ir.Type:
                 return T.UNKNOWN
         return signature.result
     result = signature.result
+    if not got:  # `floatArray()`: an empty array
+        return result
     first = got[0]
     ok, noun = _ARRAY_ARGUMENT.get(expr.func, (lambda t: t.is_array, "an array"))
     if first is not T.UNKNOWN and not ok(first):
@@ -321,6 +323,8 @@ def _call(expr: ir.Call, got: list[ir.Type], diags: Diagnostics) -> ir.Type:
         elif len(got) == 3 and got[2] not in (T.NUM, T.UNKNOWN):
             diags.error("type", f"the tolerance of `findFirst` must be a num, got a {got[2].value}",
                         expr.args[2].span)
+    if expr.func == "sum" and first is T.STRS:  # the strings concatenated
+        return T.STR
     return first if expr.func == "transpose" else result
 
 
