@@ -77,6 +77,9 @@ FUNCTIONS: dict[str, Signature] = {
     "geometry.isRectangular": Signature((T.NUM,), T.BOOL, shape=True),
     "geometry.nVertices": Signature((), T.NUM, shape=True),
     "geometry.nFaces": Signature((), T.NUM, shape=True),
+    # ---------------------------------------------------------------------------- miscellaneous (backend.functions.math)
+    # `print(x)` gives x (typed as x by ``passes.types``); grammarc prints nothing, as its `print` operation
+    "print": Signature((None,), T.UNKNOWN),
     # ---------------------------------------------------------------------------------- arrays (backend.functions.arrays)
     # their argument types, and some result types, depend on the arguments' (``passes.types``); the type here
     # is that of ``size``, ``nRows``, ``nColumns`` and ``findFirst``

@@ -151,6 +151,8 @@ A2 = "const a = [1, 2, 3 ; 4, 5, 6 ; 7, 8, 9]\n"
     ("const v = stringArray([1, 0, 1.777, 20])", [["1", "0", "1.777", "20"]]),
     ("const v = stringArray([true, false ; true, true])", [["true", "false"], ["true", "true"]]),
     ('const v = stringArray(["true", "CityEngine", ""])', [["true", "CityEngine", ""]]),
+    # print gives its value, whatever its type
+    ("const v = print([1, 2])", [[1, 2]]), ('const v = print("a") + "b"', "ab"),
     # isinf (the math functions fold on constants; an attribute is evaluated per lot)
     ("attr x = 1e308\nconst v = isinf(x / 0)", True), ("attr x = 1e308\nconst v = isinf(x)", False),
     # a case expression of arrays

@@ -4,7 +4,7 @@ Each is an ordinary function ``f(call, args, env)`` registered with ``@function(
 ``evaluate`` looks a call up there. Its signature (parameter and result types) is in ``ir.functions``. The
 families, as that table groups them:
 
-- ``math``: arithmetic, trigonometry in degrees, ``rand``, ``p``;
+- ``math``: arithmetic, trigonometry in degrees, ``rand``, ``p``, ``print`` (which gives its value);
 - ``strings``: ``str``, ``float``, ``bool``, ``len``, and string concatenation;
 - ``lists``: the ``;``-separated string lists;
 - ``files``: ``fileRandom``;

@@ -293,6 +293,8 @@ def _call(expr: ir.Call, got: list[ir.Type], diags: Diagnostics) -> ir.Type:
     if not signature.takes(len(got)):
         diags.error("arity", f"`{expr.func}` takes {signature.arity()} arguments, got {len(got)}", expr.span)
         return T.UNKNOWN
+    if expr.func == "print":  # gives its value, of any type
+        return got[0]
     if expr.func not in ARRAY_FUNCTIONS:
         for t, want, arg in zip(got, signature.params, expr.args):
             if want is None and t.is_array:  # any scalar
