@@ -26,7 +26,7 @@ from grammarc.errors import AssetError
 from grammarc.ir import nodes as ir
 from grammarc.ir.asset_names import LEAF_CUBE, LEAF_QUAD, resolve_asset
 from grammarc.ir.file_search import ASSET_SUFFIXES, constant_folder, search
-from grammarc.ir.traverse import all_exprs, iter_ops
+from grammarc.ir.traverse import all_exprs, iter_exprs, iter_ops
 
 #: Built-ins whose first argument is a file search whose matches ``i()`` may insert.
 SEARCHES = frozenset({"fileRandom", "fileSearch", "filesSearch", "assetBestSize", "assetApproxSize",
@@ -44,7 +44,7 @@ def resolve_assets(module: ir.Module, diags: Diagnostics) -> ir.Module:
         # a computed asset name: every string constant that looks like an asset may be one
         queries = _queries(module)
         named.extend((e.value, e.span) for e in all_exprs(module) if isinstance(e, ir.Str)
-                     and e.value.lower().endswith(ASSET_SUFFIXES) and e.value not in queries)
+                     and e.value.lower().endswith(ASSET_SUFFIXES) and not (_wild(e.value) or e.value in queries))
         named.extend(searched(module, queries, diags))
     roots = list(module.roots)
     names = [LEAF_CUBE, LEAF_QUAD]
@@ -71,11 +71,18 @@ def resolve_assets(module: ir.Module, diags: Diagnostics) -> ir.Module:
 def _queries(module: ir.Module) -> set[str]:
     """The string constants that are file searches: the constant queries of searches, and the constants
     with wildcards (or ``$`` regular expressions) that end as asset files do (``"assets/*.obj"``)."""
-    given = {e.args[0].value for e in all_exprs(module)
-             if isinstance(e, ir.Call) and e.func in SEARCHES and e.args and isinstance(e.args[0], ir.Str)}
-    wild = {e.value for e in all_exprs(module) if isinstance(e, ir.Str) and e.value.lower().endswith(ASSET_SUFFIXES)
-            and ("*" in e.value or "?" in e.value or e.value.startswith("$"))}
-    return given | wild
+    searches = [e.args[0] for e in all_exprs(module) if isinstance(e, ir.Call) and e.func in SEARCHES and e.args]
+    given = {q.value for q in searches if isinstance(q, ir.Str)}
+    # the pieces of a computed query ("/*.obj" in "assets/" + kind + "/*.obj") are no queries of their own
+    pieces = {e.value for q in searches if not isinstance(q, ir.Str) for e in iter_exprs(q) if isinstance(e, ir.Str)}
+    wild = {e.value for e in all_exprs(module)
+            if isinstance(e, ir.Str) and e.value.lower().endswith(ASSET_SUFFIXES) and _wild(e.value)}
+    return given | (wild - pieces)
+
+
+def _wild(text: str) -> bool:
+    """Whether a text is a search rather than a path: it has wildcards or is a ``$`` regular expression."""
+    return "*" in text or "?" in text or text.startswith("$")
 
 
 def _leading_text(expr: ir.Expr) -> str | None:
@@ -98,7 +105,7 @@ def searched(module: ir.Module, queries: set[str], diags: Diagnostics) -> list[t
             found.append((expr.value, expr.span, False))
     roots = tuple(Path(r) for r in module.roots)
     named = []
-    for text, span, computed in found:
+    for text, span, computed in dict.fromkeys(found):  # a walk may meet an expression twice
         try:
             files = search(text, roots)
         except AssetError as error:
