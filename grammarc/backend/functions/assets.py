@@ -182,29 +182,16 @@ def assets_sort_ratio(call, args, env: Env):
     return sort_list(call, args, env, by_ratio, extents)
 
 
-@function("assetBestSize")
-def asset_best_size(call, args, env: Env):
-    return choose(call, args, env, by_size, extents, "best")
+#: The choosers: how they rank the search's assets, and which of them they draw from (``choose``).
+CHOOSERS = {"assetBestSize": (by_size, "best"), "assetApproxSize": (by_size, "approx"),
+            "assetFitSize": (by_size, "fit"), "assetBestRatio": (by_ratio, "best"),
+            "assetApproxRatio": (by_ratio, "approx")}
 
 
-@function("assetApproxSize")
-def asset_approx_size(call, args, env: Env):
-    return choose(call, args, env, by_size, extents, "approx")
-
-
-@function("assetFitSize")
-def asset_fit_size(call, args, env: Env):
-    return choose(call, args, env, by_size, extents, "fit")
-
-
-@function("assetBestRatio")
-def asset_best_ratio(call, args, env: Env):
-    return choose(call, args, env, by_ratio, extents, "best")
-
-
-@function("assetApproxRatio")
-def asset_approx_ratio(call, args, env: Env):
-    return choose(call, args, env, by_ratio, extents, "approx")
+@function(*CHOOSERS)
+def asset_choice(call, args, env: Env):
+    errors, mode = CHOOSERS[call.func]
+    return choose(call, args, env, errors, extents, mode)
 
 
 def naming(env: Env, name: str, selector: str) -> tuple[str, ...]:

@@ -79,11 +79,6 @@ def images_sort_ratio(call, args, env: Env):
     return sort_list(call, args, env, by_ratio, sizes)
 
 
-@function("imageBestRatio")
-def image_best_ratio(call, args, env: Env):
-    return choose(call, args, env, by_ratio, sizes, "best")
-
-
-@function("imageApproxRatio")
-def image_approx_ratio(call, args, env: Env):
-    return choose(call, args, env, by_ratio, sizes, "approx_or_all")
+@function("imageBestRatio", "imageApproxRatio")
+def image_choice(call, args, env: Env):
+    return choose(call, args, env, by_ratio, sizes, "best" if call.func == "imageBestRatio" else "approx_or_all")

@@ -103,3 +103,11 @@ def test_file_exists_searches_as_an_insert_does(tmp_path):
                           'report("no", fileExists("assets/trees/ash.obj")) report("up", fileExists("../g.cga"))',
                 LOTS[:1])
     assert (reported(r, "yes"), reported(r, "no"), reported(r, "up")) == ([True], [False], [False])
+
+
+def test_an_insert_of_a_search_that_found_nothing_fails_its_lot(tmp_path):
+    write_files(tmp_path, TREES)
+    r = derived(tmp_path, 'attr kind = "trees"\nLot --> extrude(1) T\n'
+                          'T --> i(fileRandom("assets/" + kind + "/*.glb"))', LOTS[:2])
+    assert [b.index for b in r["bad"]] == [0, 1]
+    assert "`i` of ``, a file search that found nothing" in r["bad"][0].reason
