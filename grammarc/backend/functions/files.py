@@ -35,9 +35,12 @@ def roots(env: Env) -> tuple:
 def groups(keys: list, n: int) -> Iterator[tuple[tuple[int, ...], np.ndarray]]:
     """Each distinct tuple of ``keys`` (scalars or (n,) int arrays: string ids) and the (k,) int64 shapes
     holding it, in increasing order of the tuples."""
-    columns = np.stack([np.broadcast_to(np.asarray(k, dtype=np.int64), (n,)) for k in keys], axis=1)
     if n == 0:
         return
+    if all(np.ndim(k) == 0 for k in keys):  # constants: one group, no sort
+        yield tuple(int(k) for k in keys), np.arange(n)
+        return
+    columns = np.stack([np.broadcast_to(np.asarray(k, dtype=np.int64), (n,)) for k in keys], axis=1)
     values, inverse = np.unique(columns, axis=0, return_inverse=True)
     order = np.argsort(inverse.reshape(-1), kind="stable")
     starts = np.searchsorted(inverse.reshape(-1)[order], np.arange(len(values)))
