@@ -36,7 +36,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from grammarc.backend.functions.files import found, groups, pick, ragged_strings, roots, string_list
+from grammarc.backend.functions.files import found, groups, per_key, pick, ragged_strings, roots, string_list
 from grammarc.backend.functions.table import distinct, function
 from grammarc.errors import AssetError
 from grammarc.ir.asset_names import resolve_asset
@@ -71,7 +71,7 @@ def asset_info(call, args, env: Env):
         if box is None:
             return 0.0
         return float(box[1, axis] - box[0, axis]) if row < 0 else float(box[row, axis])
-    return distinct(info, args[0], args[1])
+    return per_key(info, [args[0], args[1]], len(env.shapes))
 
 
 def extents(env: Env, names) -> np.ndarray:

@@ -32,20 +32,55 @@ def roots(env: Env) -> tuple:
     return tuple(env.plan.grammar.asset_roots)
 
 
+def distinct_keys(keys: list, n: int) -> tuple[list[tuple[int, ...]], np.ndarray]:
+    """The distinct tuples of ``keys`` (one or two scalars or (n,) arrays of string ids), in increasing
+    order, and (n,) int64 the index of each shape's tuple among them.
+
+    String ids are small, so a tuple is one number (mixed radix) and a table over their range replaces a
+    sort of the shapes: linear in n, where ``np.unique`` of the rows would sort them."""
+    columns = [np.broadcast_to(np.asarray(k, dtype=np.int64), (n,)) for k in keys]
+    radix = [int(c.max()) + 1 if n else 1 for c in columns]
+    code = np.zeros(n, dtype=np.int64)
+    for column, base in zip(columns, radix):
+        code = code * base + column
+    top = int(code.max()) + 1 if n else 0
+    if top <= 8 * n + 4096:
+        present = np.zeros(top, dtype=bool)
+        present[code] = True
+        values = np.flatnonzero(present)
+        inverse = (np.cumsum(present) - 1)[code]
+    else:
+        values, inverse = np.unique(code, return_inverse=True)
+    tuples = []
+    for value in values.tolist():
+        digits = []
+        for base in reversed(radix):
+            value, digit = divmod(value, base)
+            digits.append(digit)
+        tuples.append(tuple(reversed(digits)))
+    return tuples, inverse.reshape(-1)
+
+
 def groups(keys: list, n: int) -> Iterator[tuple[tuple[int, ...], np.ndarray]]:
-    """Each distinct tuple of ``keys`` (scalars or (n,) int arrays: string ids) and the (k,) int64 shapes
-    holding it, in increasing order of the tuples."""
+    """Each distinct tuple of ``keys`` (see ``distinct_keys``) and the (k,) int64 shapes holding it."""
     if n == 0:
         return
-    if all(np.ndim(k) == 0 for k in keys):  # constants: one group, no sort
+    if all(np.ndim(k) == 0 for k in keys):  # constants: one group, no table
         yield tuple(int(k) for k in keys), np.arange(n)
         return
-    columns = np.stack([np.broadcast_to(np.asarray(k, dtype=np.int64), (n,)) for k in keys], axis=1)
-    values, inverse = np.unique(columns, axis=0, return_inverse=True)
-    order = np.argsort(inverse.reshape(-1), kind="stable")
-    starts = np.searchsorted(inverse.reshape(-1)[order], np.arange(len(values)))
-    for value, rows in zip(values, np.split(order, starts[1:])):
-        yield tuple(int(v) for v in value), rows
+    values, inverse = distinct_keys(keys, n)
+    order = np.argsort(inverse, kind="stable")
+    starts = np.searchsorted(inverse[order], np.arange(len(values)))
+    yield from zip(values, np.split(order, starts[1:]))
+
+
+def per_key(compute: Callable, keys: list, n: int, dtype=np.float64):
+    """``compute(*key)`` once per distinct tuple of ``keys`` (string ids), spread over the shapes: a
+    scalar when the keys are, else (n,) ``dtype``."""
+    if all(np.ndim(k) == 0 for k in keys):
+        return compute(*(int(k) for k in keys))
+    values, inverse = distinct_keys(keys, n)
+    return np.array([compute(*value) for value in values], dtype=dtype)[inverse]
 
 
 def found(env: Env, query: int) -> tuple[str, ...]:
