@@ -29,6 +29,9 @@ Nothing outside the roots is listed: a folder is walked only inside its root, li
 followed and links to files outside their root are skipped, and names beginning with ``.`` are hidden (a
 rule package's ``.ws`` is a root of its own). A query climbing out of the roots (``"../*"``) or naming
 a host path (``"/etc/*"``) finds nothing there. A search lists at most ``MAX_LISTED`` files of a root.
+
+A process answers a query once (the compiler, then the derivation of every chunk ask the same): files
+added to the roots during a build are not seen by it.
 """
 
 from __future__ import annotations
@@ -41,12 +44,10 @@ from pathlib import Path, PurePosixPath
 from grammarc.errors import AssetError
 from grammarc.ir.asset_names import locate
 
-__all__ = ["ASSET_SUFFIXES", "IMAGE_SUFFIXES", "MAX_LISTED", "constant_folder", "search"]
+__all__ = ["ASSET_SUFFIXES", "MAX_LISTED", "constant_folder", "search"]
 
 #: File endings of the geometry assets ``i()`` inserts.
 ASSET_SUFFIXES = (".obj", ".glb", ".gltf", ".dae", ".fbx", ".3ds")
-#: File endings of the images ``imageInfo`` reads.
-IMAGE_SUFFIXES = (".png", ".jpg", ".jpeg", ".tif", ".tiff", ".bmp", ".gif", ".tga", ".webp")
 #: The most files listed under one root for one search.
 MAX_LISTED = 200_000
 _PROPERTIES = ("name", "ext", "path", "project")
