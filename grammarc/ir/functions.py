@@ -66,9 +66,29 @@ FUNCTIONS: dict[str, Signature] = {
     # ------------------------------------------------------------------------ string lists (backend.functions.lists)
     "listItem": Signature((T.STR, T.NUM), T.STR),
     # ---------------------------------------------------------------------------------- files (backend.functions.files)
-    "fileRandom": Signature((), T.NUM, shape=True),
+    # a search query (``ir.file_search``) or a path; the choosers draw from the shape's stream
+    "fileRandom": Signature((T.STR,), T.STR, shape=True),
+    "fileSearch": Signature((T.STR,), T.STR),
+    "filesSearch": Signature((T.STR,), T.STRS),
+    "fileExists": Signature((T.STR,), T.BOOL),
+    **{name: Signature((T.STR,), T.STR) for name in ("fileName", "fileBasename", "fileDirectory", "fileExtension")},
     # ---------------------------------------------------------------------------- assets (backend.functions.assets)
+    # a selector (``sx``, ``xz``...) is lowered to its text; the sorting and choosing ones read the scope
+    "assetInfo": Signature((T.STR, T.STR), T.NUM),
+    "assetNamingInfo": Signature((T.STR, T.STR), T.STR),
+    "assetNamingInfos": Signature((T.STR, T.STR), T.STRS),
+    "assetsSortSize": Signature((T.STR, T.STR, T.NUM), T.STR, shape=True),
+    "assetsSortRatio": Signature((T.STR, T.STR), T.STR, shape=True),
+    "assetBestSize": Signature((T.STR, T.STR), T.STR, shape=True),
+    "assetApproxSize": Signature((T.STR, T.STR, T.NUM), T.STR, shape=True),
+    "assetFitSize": Signature((T.STR, T.STR, T.NUM), T.STR, shape=True),
+    "assetBestRatio": Signature((T.STR, T.STR), T.STR, shape=True),
+    "assetApproxRatio": Signature((T.STR, T.STR, T.NUM), T.STR, shape=True),
     # ---------------------------------------------------------------------------- images (backend.functions.images)
+    "imageInfo": Signature((T.STR, T.STR), T.NUM),
+    "imagesSortRatio": Signature((T.STR, T.STR), T.STR, shape=True),
+    "imageBestRatio": Signature((T.STR, T.STR), T.STR, shape=True),
+    "imageApproxRatio": Signature((T.STR, T.STR, T.NUM), T.STR, shape=True),
     # ---------------------------------------------------------------------------- tables (backend.functions.tables)
     # ---------------------------------------------------------------------------- colours (backend.functions.colors)
     # ------------------------------------------------------------------------ geometry (backend.functions.geometry)

@@ -290,12 +290,11 @@ def test_a_function_with_rand_draws_at_each_use(write):
 def test_shape_queries(write):
     r = run(write, 'Lot --> report("nv", geometry.nVertices) report("nf", geometry.nFaces) extrude(3) A\n'
                    'A --> report("nv3", geometry.nVertices) report("nf3", geometry.nFaces) r(0, 30, 0) '
-                   'report("ry", scope.ry) report("ox", initialShape.origin.px) report("len", len("abcd")) '
-                   'report("fr", fileRandom) report("fr2", fileRandom) X.\n', [LOT_ZOO["concave_L"]])
+                   'report("ry", scope.ry) report("ox", initialShape.origin.px) report("len", len("abcd")) X.\n',
+          [LOT_ZOO["concave_L"]])
     t = totals(r)
     assert (t["nv_sum"], t["nf_sum"], t["nv3_sum"], t["nf3_sum"]) == (6, 1, 12, 8)
     assert t["ry_sum"] == pytest.approx(30) and t["len_sum"] == 4 and t["ox_sum"] == 0
-    assert t["fr_sum"] == t["fr2_sum"] and 0 <= t["fr_sum"] < 1
 
 
 def test_n_vertices_counts_each_polygons_own_rings(write):

@@ -6,6 +6,7 @@ from dataclasses import replace
 
 from grammarc.diagnostics import Diagnostics
 from grammarc.frontend.parse import parse_source
+from grammarc.ir.passes import assets as assets_pass
 from grammarc.ir.pipeline import run_passes
 
 FILE = "g.cga"
@@ -62,3 +63,56 @@ def test_one_file_named_from_two_roots_is_one_asset(tmp_path):
     assert not diags
     assert module.assets == ("builtin:cube", "builtin:quad", "assets/x.obj")
     assert dict(module.asset_ids) == {"assets/x.obj": 2, "/Proj/assets/x.obj": 2}
+
+
+def files(root, *names):
+    for name in names:
+        (root / name).parent.mkdir(parents=True, exist_ok=True)
+        (root / name).write_text("v 0 0 0\n")
+
+
+def test_a_computed_insert_may_insert_what_a_constant_search_finds_in_sorted_order(tmp_path):
+    files(tmp_path, "assets/trees/oak.glb", "assets/trees/elm.obj", "assets/trees/notes.txt", "w.obj")
+    text = VERSION + 'Lot --> i("w.obj") T\nT --> i(fileRandom("assets/trees/*"))\n'
+    module, diags = resolved(text, (tmp_path,), "cityengine")
+    assert module.assets == ("builtin:cube", "builtin:quad", "w.obj", "assets/trees/elm.obj", "assets/trees/oak.glb")
+    assert dict(module.asset_ids) == {"w.obj": 2, "assets/trees/elm.obj": 3, "assets/trees/oak.glb": 4}
+    assert [d.code for d in diags] == ["start-rule"]
+
+
+def test_a_query_held_by_a_constant_is_searched_and_not_taken_for_a_missing_asset(tmp_path):
+    files(tmp_path, "assets/a.obj", "assets/b.dae")
+    text = VERSION + 'attr pool = "assets/*.dae"\nLot --> i(fileRandom(pool))\n'
+    module, diags = resolved(text, (tmp_path,), "cityengine")
+    assert dict(module.asset_ids) == {"assets/b.dae": 2}
+    assert [d.code for d in diags] == ["start-rule"]
+
+
+def test_a_computed_query_may_find_any_asset_file_under_its_constant_folder(tmp_path):
+    files(tmp_path, "assets/oak/1.obj", "assets/elm/2.fbx", "assets/elm/3.png", "other/4.obj")
+    text = VERSION + 'attr kind = "oak"\nLot --> i(fileRandom("assets/" + kind + "/*.obj"))\n'
+    module, diags = resolved(text, (tmp_path,), "cityengine")
+    assert dict(module.asset_ids) == {"assets/elm/2.fbx": 2, "assets/oak/1.obj": 3}
+    assert [d.code for d in diags] == ["start-rule"]
+
+
+def test_a_computed_query_under_too_many_asset_files_is_an_error(tmp_path, monkeypatch):
+    monkeypatch.setattr(assets_pass, "MAX_COMPUTED_MATCHES", 1)
+    files(tmp_path, "assets/a/1.obj", "assets/b/2.obj")
+    text = VERSION + 'attr kind = "a"\nLot --> i(assetBestSize("assets/" + kind + "/*.obj", "xz"))\n'
+    _, diags = resolved(text, (tmp_path,), "cityengine")
+    assert [(d.code, d.severity.value, d.span.line) for d in diags if d.code == "asset"] == [("asset", "error", 3)]
+    assert "under `assets/` may find any of its 2 asset files, more than 1" in str(diags)
+
+
+def test_a_search_that_finds_nothing_is_a_warning_at_the_query(tmp_path):
+    text = VERSION + 'Lot --> i(fileRandom("assets/*.obj"))\n'
+    _, diags = resolved(text, (tmp_path,), "cityengine")
+    assert [(d.code, d.span.col) for d in diags if d.code == "asset"] == [("asset", 22)]
+
+
+def test_without_a_computed_insert_searches_make_no_asset(tmp_path):
+    files(tmp_path, "assets/a.obj")
+    text = VERSION + 'Lot --> report("a", fileRandom("assets/*.obj")) i("assets/a.obj")\n'
+    module, _ = resolved(text, (tmp_path,), "cityengine")
+    assert module.assets == ("builtin:cube", "builtin:quad", "assets/a.obj")

@@ -7,7 +7,9 @@ families, as that table groups them:
 - ``math``: arithmetic, trigonometry in degrees, ``rand``, ``p``, ``print`` (which gives its value);
 - ``strings``: ``str``, ``float``, ``bool``, ``len``, and string concatenation;
 - ``lists``: the ``;``-separated string lists;
-- ``files``: ``fileRandom``;
+- ``files``: searches in the grammar's roots (``fileSearch``, ``fileRandom``...) and paths taken apart;
+- ``assets``: an asset's size (``assetInfo``) and assets chosen by how they fit the scope;
+- ``images``: an image's resolution (``imageInfo``) and images chosen by their proportions;
 - ``geometry``: ``geometry.area``... of the shape's geometry;
 - ``arrays``: CityEngine's arrays.
 
@@ -17,8 +19,10 @@ package registers them.
 
 from grammarc.backend.functions import (  # noqa: F401 - each registers its functions
     arrays,
+    assets,
     files,
     geometry,
+    images,
     lists,
     math,
     strings,

@@ -1,16 +1,185 @@
-"""File functions: paths of the grammar's roots, chosen and taken apart per shape."""
+"""File functions: CityEngine's search queries answered in the grammar's roots, a file picked per shape, and
+paths taken apart.
+
+``fileSearch(query)`` lists the matching files as a string list (``"a.obj;b.obj;"``), ``filesSearch`` as
+a ``str[]``, ``fileRandom(query)`` picks one per shape from its random stream (``""`` when none matches),
+``fileExists(path)`` resolves a path as an insert does. The query language, the roots and the names
+returned are ``ir.file_search``'s: a query is searched once per distinct text, its names interned, and the
+shapes gather them. ``fileName``, ``fileBasename``, ``fileDirectory`` and ``fileExtension`` follow the CGA
+reference's own definitions in its ``ce.lib`` (``fileExtension("assets/v1.2/x")`` is ``"2/x"`` there
+too: it is the text after the last dot).
+"""
 
 from __future__ import annotations
 
+from collections.abc import Callable, Iterator
 from typing import TYPE_CHECKING
 
-from grammarc.backend.functions.table import function
+import numpy as np
+
+from grammarc.backend.arrays import Arrays
+from grammarc.backend.functions.table import distinct, function
 from grammarc.backend.random import uniform
+from grammarc.ir.asset_names import resolve_asset
+from grammarc.ir.file_search import search
 
 if TYPE_CHECKING:
     from grammarc.backend.env import Env
 
 
+def roots(env: Env) -> tuple:
+    """The folders the grammar's files are searched and resolved in (``Grammar.asset_roots``)."""
+    return tuple(env.plan.grammar.asset_roots)
+
+
+def distinct_keys(keys: list, n: int) -> tuple[list[tuple[int, ...]], np.ndarray]:
+    """The distinct tuples of ``keys`` (one or two scalars or (n,) arrays of string ids), in increasing
+    order, and (n,) int64 the index of each shape's tuple among them.
+
+    String ids are small, so a tuple is one number (mixed radix) and a table over their range replaces a
+    sort of the shapes: linear in n, where ``np.unique`` of the rows would sort them."""
+    columns = [np.broadcast_to(np.asarray(k, dtype=np.int64), (n,)) for k in keys]
+    radix = [int(c.max()) + 1 if n else 1 for c in columns]
+    code = np.zeros(n, dtype=np.int64)
+    for column, base in zip(columns, radix):
+        code = code * base + column
+    top = int(code.max()) + 1 if n else 0
+    if top <= 8 * n + 4096:
+        present = np.zeros(top, dtype=bool)
+        present[code] = True
+        values = np.flatnonzero(present)
+        inverse = (np.cumsum(present) - 1)[code]
+    else:
+        values, inverse = np.unique(code, return_inverse=True)
+    tuples = []
+    for value in values.tolist():
+        digits = []
+        for base in reversed(radix):
+            value, digit = divmod(value, base)
+            digits.append(digit)
+        tuples.append(tuple(reversed(digits)))
+    return tuples, inverse.reshape(-1)
+
+
+def groups(keys: list, n: int) -> Iterator[tuple[tuple[int, ...], np.ndarray]]:
+    """Each distinct tuple of ``keys`` (see ``distinct_keys``) and the (k,) int64 shapes holding it."""
+    if n == 0:
+        return
+    if all(np.ndim(k) == 0 for k in keys):  # constants: one group, no table
+        yield tuple(int(k) for k in keys), np.arange(n)
+        return
+    values, inverse = distinct_keys(keys, n)
+    order = np.argsort(inverse, kind="stable")
+    starts = np.searchsorted(inverse[order], np.arange(len(values)))
+    yield from zip(values, np.split(order, starts[1:]))
+
+
+def per_key(compute: Callable, keys: list, n: int, dtype=np.float64):
+    """``compute(*key)`` once per distinct tuple of ``keys`` (string ids), spread over the shapes: a
+    scalar when the keys are, else (n,) ``dtype``."""
+    if all(np.ndim(k) == 0 for k in keys):
+        return compute(*(int(k) for k in keys))
+    values, inverse = distinct_keys(keys, n)
+    return np.array([compute(*value) for value in values], dtype=dtype)[inverse]
+
+
+def found(env: Env, query: int) -> tuple[str, ...]:
+    """The names of the files the query with string id ``query`` finds."""
+    return search(list(env.plan.strings.ids)[query], roots(env))
+
+
+def pick(choices: Callable[[tuple[int, ...], np.ndarray], np.ndarray], keys: list, call, env: Env) -> np.ndarray:
+    """One choice per shape, drawn from its stream at the call's site: (n,) int32 string ids.
+
+    ``choices(key, rows)`` gives, for the shapes ``rows`` (k,) of one distinct tuple of ``keys`` (string
+    ids: a query, a selector), their candidates as interned ids, one row per shape or one row for all
+    ((k, c) or (1, c) int32, a row's candidates first and -1 after them where a shape has fewer); a shape
+    picks uniformly among its own, ``""`` when it has none."""
+    n = len(env.shapes)
+    u = uniform(env.shapes.key, call.site)
+    out = np.full(n, env.plan.strings.intern(""), dtype=np.int32)
+    for key, rows in groups(keys, n):
+        options = np.asarray(choices(key, rows))
+        options = np.broadcast_to(options, (len(rows), options.shape[1]))
+        count = (options >= 0).sum(axis=1)
+        k = np.minimum((u[rows] * count).astype(np.int64), np.maximum(count - 1, 0))
+        chosen = options[np.arange(len(rows)), k] if options.shape[1] else np.full(len(rows), -1)
+        out[rows] = np.where(count > 0, chosen, out[rows])
+    return out
+
+
+def interned(env: Env, names) -> np.ndarray:
+    """(1, c) int32 the ids of ``names``, as ``pick`` takes the same candidates for every shape."""
+    return np.array([[env.plan.strings.intern(name) for name in names]], dtype=np.int32).reshape(1, -1)
+
+
 @function("fileRandom")
 def file_random(call, args, env: Env):
-    return uniform(env.chunk.lot_key[env.shapes.lot], 0x5F11E)
+    return pick(lambda key, rows: interned(env, found(env, key[0])), [args[0]], call, env)
+
+
+def string_list(names) -> str:
+    """CityEngine's string list of ``names``: each item ended by ``;``. The reference's ``fileSearch``
+    examples give ``";"`` when nothing matches, and so does this."""
+    return "".join(f"{name};" for name in names) or ";"
+
+
+@function("fileSearch")
+def file_search(call, args, env: Env):
+    strings = env.plan.strings
+    return distinct(lambda query: strings.intern(string_list(found(env, query))), args[0], dtype=np.int32)
+
+
+@function("filesSearch")
+def files_search(call, args, env: Env):
+    """``filesSearch(query)``: the matches as a ``str[]`` per shape (a row, as ``[a, b]`` is)."""
+    return ragged_strings(env, [args[0]], lambda key: found(env, key[0]))
+
+
+def ragged_strings(env: Env, keys: list, names_of: Callable[[tuple[int, ...]], tuple[str, ...]]) -> Arrays:
+    """Per shape the ``str[]`` (a row) of ``names_of(key)`` for its tuple of ``keys`` (scalars or (n,)
+    int ids), each distinct tuple's names interned once."""
+    n = len(env.shapes)
+    sizes = np.zeros(n, dtype=np.int64)
+    lists = []
+    for key, rows in groups(keys, n):
+        lists.append((rows, np.array([env.plan.strings.intern(s) for s in names_of(key)], dtype=np.int32)))
+        sizes[rows] = len(lists[-1][1])
+    offsets = np.concatenate([[0], np.cumsum(sizes)]).astype(np.int64)
+    values = np.empty(offsets[-1], dtype=np.int32)
+    for rows, ids in lists:  # one scatter per distinct tuple, every shape of it at once
+        values[(offsets[:-1][rows, None] + np.arange(len(ids))).reshape(-1)] = np.tile(ids, len(rows))
+    return Arrays(values, offsets, sizes.copy())
+
+
+@function("fileExists")
+def file_exists(call, args, env: Env):
+    names = list(env.plan.strings.ids)
+    return distinct(lambda path: resolve_asset(names[path], list(roots(env))).path is not None, args[0],
+                    dtype=bool)
+
+
+def _after(text: str, mark: str) -> str:
+    """The text after the last ``mark`` (all of it without one): the reference's ``getSuffix``."""
+    return text.rsplit(mark, 1)[1] if mark in text else text
+
+
+def file_name(path: str) -> str:
+    """``fileName``: the path without its folders (``/`` first, else ``\\``)."""
+    return _after(path, "/") if "/" in path else _after(path, "\\")
+
+
+PARTS = {
+    "fileName": file_name,
+    "fileExtension": lambda path: _after(path, ".") if "." in path else "",
+    "fileBasename": lambda path: file_name(path.rsplit(".", 1)[0]) if "." in file_name(path) else file_name(path),
+    "fileDirectory": lambda path: next((path[:path.rfind(mark) + 1] for mark in "/\\" if mark in path), ""),
+}
+
+
+@function(*PARTS)
+def path_part(call, args, env: Env):
+    strings = env.plan.strings
+    names = list(strings.ids)
+    part = PARTS[call.func]
+    return distinct(lambda path: strings.intern(part(names[path])), args[0], dtype=np.int32)

@@ -34,13 +34,15 @@ def use_asset(ctx: Context, cursor: Shapes, op: ir.UseAsset) -> Shapes:
         asset = np.full(len(cursor), plan.grammar.asset_ids[op.asset], dtype=np.int32)
     else:
         names = evaluate_array(op.name, ctx.env(cursor), dtype=np.int32)
-        lookup = plan.asset_of_string
-        asset = np.array([lookup.get(int(s), -1) for s in np.unique(names)], dtype=np.int32)[
-            np.unique(names, return_inverse=True)[1].reshape(-1)]
+        distinct, inverse = np.unique(names, return_inverse=True)
+        asset = np.array([plan.asset_of_string.get(int(s), -1) for s in distinct], dtype=np.int32)[inverse.reshape(-1)]
         bad = asset < 0
         if bad.any():
             name = list(plan.strings.ids)[int(names[np.flatnonzero(bad)[0]])]
-            ctx.fail(cursor, bad, f"`i` of `{name}`, which is not an asset of the grammar", op.span)
+            # the assets a computed name may take are found when compiling (``passes.assets``)
+            why = ("a file search that found nothing" if not name else "not an asset of the grammar: a computed "
+                   "name is a string constant of an asset file, or a file a search may find")
+            ctx.fail(cursor, bad, f"`i` of `{name}`, {why}", op.span)
     geom = np.where(asset == 0, -1, asset_geom(asset)).astype(np.int32)  # asset 0 is builtin:cube
     return cursor.with_scope(cursor.origin, cursor.size, cursor.frame, geom)
 

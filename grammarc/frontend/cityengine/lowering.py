@@ -59,6 +59,15 @@ SCOPE_MEMBERS = {
     **{f"scope.{f}": f for f in ("sx", "sy", "sz", "tx", "ty", "tz", "rx", "ry", "rz")},
     "initialShape.origin.px": "ox", "initialShape.origin.py": "oy", "initialShape.origin.pz": "oz",
 }
+#: Built-ins taking a selector keyword (``assetInfo(a, sx)``): the argument's index and the keywords, lowered
+#: to their text (CityEngine takes them quoted too, ``assetBestSize(q, "xz")``).
+SELECTOR_ARGUMENTS = {
+    **dict.fromkeys(("assetInfo",), (1, frozenset({"sx", "sy", "sz", "tx", "ty", "tz"}))),
+    **dict.fromkeys(("imageInfo",), (1, frozenset({"sx", "sy"}))),
+    **dict.fromkeys(("assetNamingInfo", "assetNamingInfos"), (1, frozenset({"g", "m"}))),
+    **dict.fromkeys(("assetsSortSize", "assetsSortRatio", "imagesSortRatio"),
+                    (1, frozenset({"x", "y", "z", "xy", "xz", "yz", "xyz", "yx", "zx", "zy"}))),
+}
 #: Shape queries without arguments, written as members (``geometry.area``) or calls (``geometry.area()``).
 GEOMETRY_QUERIES = ("geometry.area", "geometry.volume", "geometry.nVertices", "geometry.nFaces")
 
@@ -369,8 +378,6 @@ class Lowering(OperationLowering, LoweringBase):
                                                   names[-1].end_line, names[-1].end_column)
 
     def name(self, meta, tok):
-        if str(tok) == "fileRandom":
-            return ir.Call("fileRandom", (), self.token_span(tok), 0)
         return ir.Name(str(tok), self.token_span(tok))
 
     def member(self, meta, dotted):
@@ -408,8 +415,9 @@ class Lowering(OperationLowering, LoweringBase):
         args = tuple(self.expr(a) for a in (args or ()))
         if func == "p" and len(args) == 1:
             return ir.Call("p", args, span, self.site())
-        if func == "fileRandom" and not args:
-            return ir.Call("fileRandom", (), span, 0)  # one draw per lot for the whole file
+        index, keywords = SELECTOR_ARGUMENTS.get(func, (-1, ()))
+        if 0 <= index < len(args) and isinstance(args[index], ir.Name) and args[index].name in keywords:
+            args = args[:index] + (ir.Str(args[index].name, args[index].span),) + args[index + 1:]
         return ir.Call(func, args, span, self.site())
 
     def occlusion(self, kind: str, args, span) -> ir.Expr:

@@ -6,19 +6,33 @@ Guarantees: ``Module.assets`` lists the canonical names, the leaf cube and quad 
 being its id in the record; ``Module.asset_ids`` gives each name as written its id. A name that is
 absolute or leaves the folders is an error, a file that no folder holds a warning (the record keeps its
 name).
+
+A computed ``i(name)`` may insert any asset the grammar can name, so then the assets are also: the string
+constants that are asset files (``"facade/window.obj"``), and the asset files that file searches find
+(``i(fileRandom("assets/trees/*.glb"))``, ``ir.file_search``): those of each constant query, of each string
+constant that is a query of asset files (an attribute holding one), and, for a computed query that begins
+with a constant folder (``"assets/" + kind + "/*.obj"``), every asset file under that folder, at most
+``MAX_COMPUTED_MATCHES`` of them. They follow the names written, in the module's order and each search's
+sorted order, so an asset's id never depends on the lots, chunks or workers.
 """
 
 from __future__ import annotations
 
 from dataclasses import replace
+from pathlib import Path
 
 from grammarc.diagnostics import Diagnostics
+from grammarc.errors import AssetError
 from grammarc.ir import nodes as ir
 from grammarc.ir.asset_names import LEAF_CUBE, LEAF_QUAD, resolve_asset
-from grammarc.ir.traverse import all_exprs, iter_ops
+from grammarc.ir.file_search import ASSET_SUFFIXES, constant_folder, search
+from grammarc.ir.traverse import all_exprs, iter_exprs, iter_ops
 
-#: File endings of assets that a computed ``i(name)`` may name: string constants ending so are resolved.
-ASSET_SUFFIXES = (".obj",)
+#: Built-ins whose first argument is a file search whose matches ``i()`` may insert.
+SEARCHES = frozenset({"fileRandom", "fileSearch", "filesSearch", "assetBestSize", "assetApproxSize",
+                      "assetFitSize", "assetBestRatio", "assetApproxRatio"})
+#: The most asset files a computed search registers (every asset file under its constant folder).
+MAX_COMPUTED_MATCHES = 1000
 
 
 def resolve_assets(module: ir.Module, diags: Diagnostics) -> ir.Module:
@@ -28,8 +42,10 @@ def resolve_assets(module: ir.Module, diags: Diagnostics) -> ir.Module:
     named = [(op.asset, op.span) for op in ops if isinstance(op, (ir.Insert, ir.UseAsset)) and op.asset]
     if any(isinstance(op, ir.UseAsset) and op.name is not None for op in ops):
         # a computed asset name: every string constant that looks like an asset may be one
-        named.extend((e.value, e.span) for e in all_exprs(module)
-                     if isinstance(e, ir.Str) and e.value.lower().endswith(ASSET_SUFFIXES))
+        queries = _queries(module)
+        named.extend((e.value, e.span) for e in all_exprs(module) if isinstance(e, ir.Str)
+                     and e.value.lower().endswith(ASSET_SUFFIXES) and not (_wild(e.value) or e.value in queries))
+        named.extend(searched(module, queries, diags))
     roots = list(module.roots)
     names = [LEAF_CUBE, LEAF_QUAD]
     ids: dict[str, int] = {}
@@ -50,3 +66,59 @@ def resolve_assets(module: ir.Module, diags: Diagnostics) -> ir.Module:
             names.append(canonical)
         ids[name] = names.index(canonical)
     return replace(module, assets=tuple(names), asset_ids=tuple(ids.items()))
+
+
+def _queries(module: ir.Module) -> set[str]:
+    """The string constants that are file searches: the constant queries of searches, and the constants
+    with wildcards (or ``$`` regular expressions) that end as asset files do (``"assets/*.obj"``)."""
+    searches = [e.args[0] for e in all_exprs(module) if isinstance(e, ir.Call) and e.func in SEARCHES and e.args]
+    given = {q.value for q in searches if isinstance(q, ir.Str)}
+    # the pieces of a computed query ("/*.obj" in "assets/" + kind + "/*.obj") are no queries of their own
+    pieces = {e.value for q in searches if not isinstance(q, ir.Str) for e in iter_exprs(q) if isinstance(e, ir.Str)}
+    wild = {e.value for e in all_exprs(module)
+            if isinstance(e, ir.Str) and e.value.lower().endswith(ASSET_SUFFIXES) and _wild(e.value)}
+    return given | (wild - pieces)
+
+
+def _wild(text: str) -> bool:
+    """Whether a text is a search rather than a path: it has wildcards or is a ``$`` regular expression."""
+    return "*" in text or "?" in text or text.startswith("$")
+
+
+def _leading_text(expr: ir.Expr) -> str | None:
+    """The constant text a computed string begins with: the leftmost constant of a ``+`` chain."""
+    while isinstance(expr, ir.Binary) and expr.op == "+":
+        expr = expr.left
+    return expr.value if isinstance(expr, ir.Str) else None
+
+
+def searched(module: ir.Module, queries: set[str], diags: Diagnostics) -> list[tuple[str, object]]:
+    """(name, span) of the asset files the module's file searches (``queries`` and the computed ones) may
+    find, in the module's order."""
+    found: list[tuple[str, object, bool]] = []
+    for expr in all_exprs(module):
+        if isinstance(expr, ir.Call) and expr.func in SEARCHES and expr.args and not isinstance(expr.args[0], ir.Str):
+            folder = constant_folder(_leading_text(expr.args[0]) or "")
+            if folder:
+                found.append((folder + "*", expr.args[0].span, True))
+        elif isinstance(expr, ir.Str) and expr.value in queries:
+            found.append((expr.value, expr.span, False))
+    roots = tuple(Path(r) for r in module.roots)
+    named = []
+    for text, span, computed in dict.fromkeys(found):  # a walk may meet an expression twice
+        try:
+            files = search(text, roots)
+        except AssetError as error:
+            diags.error("asset", str(error), span)
+            continue
+        assets = [name for name in files if name.lower().endswith(ASSET_SUFFIXES)]
+        if computed and len(assets) > MAX_COMPUTED_MATCHES:
+            diags.error("asset", f"a computed file search under `{text[:-1]}` may find any of its "
+                        f"{len(assets)} asset files, more than {MAX_COMPUTED_MATCHES}; begin it with a "
+                        "narrower folder", span)
+            continue
+        if not files and not computed:
+            diags.warning("asset", f"the file search `{text}` finds no file in "
+                          f"{', '.join(str(r) for r in roots)}", span)
+        named.extend((name, span) for name in assets)
+    return named

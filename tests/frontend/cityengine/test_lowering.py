@@ -145,6 +145,15 @@ def test_string_concatenation():
     assert module.attrs[1].type is ir.Type.STR
 
 
+def test_a_selector_argument_is_its_keywords_text():
+    """`assetInfo(a, sx)`: CityEngine's selector keyword, as `assetInfo(a, "sx")`; another name stays one."""
+    module = module_of(VERSION + 'attr q = "sy"\nLot --> report("a", assetInfo("x.obj", sx)) '
+                       'report("b", assetInfo("x.obj", q)) report("c", assetsSortSize("x.obj;", xz, 0))\n')
+    reports = [op for op in iter_ops(module) if isinstance(op, ir.Report)]
+    assert [print_expr(op.value) for op in reports] == [
+        'assetInfo("x.obj", "sx")', 'assetInfo("x.obj", @q)', 'assetsSortSize("x.obj;", "xz", 0)']
+
+
 def test_arrays_lower_to_literals_ranges_and_indices():
     module = module_of(VERSION + 'const a = [1, 2 ;\n           3, 4]\nconst r = [0 : 2 : size(a) - 1]\n'
                        'attr b = a[a .> 1 .&& .!(a .== 4)][0] + a[1, [0, 1]][1] + a[1:2][0]\n'
