@@ -106,8 +106,8 @@ class Context:
 
     # -------------------------------------------------------------------------------------------- assets
     def asset_mesh(self, asset: int):
-        """The ``AssetMesh`` of asset id ``asset`` for trimming (``Plan.load_asset``), None for an asset no
-        root holds; each loaded once per chunk."""
+        """The ``AssetMesh`` of asset id ``asset`` for trimming and the insert modes that keep its size
+        (``Plan.load_asset``), None for an asset that cannot be loaded; each loaded once per chunk."""
         if asset not in self._asset_meshes:
             grammar = self.plan.grammar
             try:

@@ -18,7 +18,7 @@ from grammarc.ir.asset_names import LEAF_CUBE, LEAF_QUAD, resolve_asset
 from grammarc.ir.traverse import all_exprs, iter_ops
 
 #: File endings of assets that a computed ``i(name)`` may name: string constants ending so are resolved.
-ASSET_SUFFIXES = (".obj",)
+ASSET_SUFFIXES = (".obj", ".glb", ".gltf", ".dae", ".fbx", ".3ds")
 
 
 def resolve_assets(module: ir.Module, diags: Diagnostics) -> ir.Module:
