@@ -226,7 +226,7 @@ def _render(args) -> int:
     with record_asset_roots(record.get("meta"), args.assets or None) as roots:
         result = render(record, args.output, size=size, view=args.view, color=args.color, asset_roots=roots)
     for problem in result["asset_problems"]:
-        print(f"grammarc: {problem} (give its folder with --assets); drawn as boxes", file=sys.stderr)
+        print(f"grammarc: {problem}; drawn as boxes (--assets DIR gives a folder)", file=sys.stderr)
     print(f"{args.output}: {result['instances']:,} instances, {result['mesh_faces']:,} mesh faces",
           file=sys.stderr)
     return 0

@@ -112,7 +112,12 @@ class Context:
             grammar = self.plan.grammar
             try:
                 mesh = self.plan.load_asset(grammar.assets[asset], grammar.asset_roots)
-            except AssetError:
-                mesh = None
+            except AssetError as error:
+                mesh = error  # asset_problem tells why
             self._asset_meshes[asset] = mesh
-        return self._asset_meshes[asset]
+        mesh = self._asset_meshes[asset]
+        return None if isinstance(mesh, AssetError) else mesh
+
+    def asset_problem(self, asset: int) -> str:
+        """Why ``asset_mesh(asset)`` is None (after it was asked)."""
+        return str(self._asset_meshes[asset])

@@ -36,7 +36,7 @@ from pathlib import Path
 import numpy as np
 
 from grammarc.errors import AssetError
-from grammarc.ir.asset_names import builtin_name, resolve_asset
+from grammarc.ir.asset_names import builtin_name, resolve_asset, unsupported_format
 from grammarc.model.obj import ObjError, read_obj
 
 __all__ = ["LOD_STAND_IN", "AssetLibrary", "AssetMesh", "asset_library", "builtin_mesh", "load_asset",
@@ -276,12 +276,10 @@ def _read_assimp(path: Path):
     """FBX and 3DS through the Open Asset Import Library (``assimp-py``), which applies the node transforms
     and an FBX file's declared axes (the result is y-up), triangulated. Their sizes are in the file's units
     (an FBX in centimetres stays in centimetres): assimp-py does not expose the unit conversion."""
-    label = path.suffix.lstrip(".").upper()
     try:
         import assimp_py
     except ImportError as error:
-        raise AssetError(f"unsupported asset format: {label} (`{path.name}`; pip install 'grammarc[fbx]' "
-                         "reads FBX and 3DS)") from error
+        raise AssetError(unsupported_format(path) or f"cannot read asset `{path}`: {error}") from error
     scene = assimp_py.import_file(str(path), assimp_py.Process_Triangulate | assimp_py.Process_PreTransformVertices)
     vertices, faces, start = [], [], 0
     for mesh in scene.meshes:

@@ -62,3 +62,15 @@ def test_one_file_named_from_two_roots_is_one_asset(tmp_path):
     assert not diags
     assert module.assets == ("builtin:cube", "builtin:quad", "assets/x.obj")
     assert dict(module.asset_ids) == {"assets/x.obj": 2, "/Proj/assets/x.obj": 2}
+
+
+def test_an_fbx_without_its_reader_is_an_error_at_the_insert(tmp_path, monkeypatch):
+    import sys
+
+    monkeypatch.setitem(sys.modules, "assimp_py", None)  # as if it were not installed
+    (tmp_path / "mill.fbx").write_text("; FBX\n")
+    (tmp_path / "post.glb").write_bytes(b"")
+    _, diags = resolved(VERSION + 'Lot --> i("post.glb") X\nX --> i("mill.fbx", zUp)\n', (tmp_path,), "cityengine")
+    (error,) = [d for d in diags if d.code == "asset"]
+    assert error.severity.value == "error" and error.span.line == 3
+    assert error.message.startswith("unsupported asset format: FBX (`mill.fbx`; pip install 'grammarc[fbx]'")

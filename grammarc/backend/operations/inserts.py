@@ -82,8 +82,8 @@ def _bounds(ctx: Context, cursor: Shapes, op: ir.UseAsset, asset: np.ndarray) ->
     for k, a in enumerate(ids.tolist()):
         mesh = ctx.asset_mesh(a)
         if mesh is None:
-            ctx.fail(cursor, asset == a, f"`i(..., {op.mode})` of `{ctx.plan.grammar.assets[a]}`, which cannot "
-                     "be loaded", op.span)
+            ctx.fail(cursor, asset == a, f"`i(..., {op.mode})` needs the asset's size: {ctx.asset_problem(a)}",
+                     op.span)
         table[k] = mesh.bounds
     low, high = table[:, 0], table[:, 1]
     if op.up == "zUp":  # (x, y, z) -> (x, z, -y): the highest y becomes the lowest z

@@ -76,4 +76,5 @@ def test_the_scope_after_a_mode_that_keeps_the_size_is_the_asset_box(write):
 
 def test_a_mode_that_keeps_the_size_of_an_asset_that_cannot_be_loaded_fails_the_lot(write):
     r = run(write, 'Lot --> extrude(4) i("gone.obj", yUp, keepSizeAndPosition)\n', [rect(12, 8)])
-    assert len(r["bad"]) == 1 and "which cannot be loaded" in r["bad"][0].reason
+    assert len(r["bad"]) == 1
+    assert "`i(..., keepSizeAndPosition)` needs the asset's size: asset `gone.obj` not found" in r["bad"][0].reason
