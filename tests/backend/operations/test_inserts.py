@@ -78,3 +78,11 @@ def test_a_mode_that_keeps_the_size_of_an_asset_that_cannot_be_loaded_fails_the_
     r = run(write, 'Lot --> extrude(4) i("gone.obj", yUp, keepSizeAndPosition)\n', [rect(12, 8)])
     assert len(r["bad"]) == 1
     assert "`i(..., keepSizeAndPosition)` needs the asset's size: asset `gone.obj` not found" in r["bad"][0].reason
+
+
+def test_a_z_up_asset_turns_in_its_box_before_a_mirror_of_the_scope(write):
+    """mirror(false, true, false) after i(a, zUp) flips the turned asset upside down: its top (its own
+    +z) lands at the scope's y = 0, the order CityEngine's reference gives (the asset is turned as read)."""
+    write("post.obj", POST)
+    r = run(write, 'Lot --> extrude(4) i("post.obj", zUp) mirror(false, true, false) Post\n', [rect(12, 8)])
+    np.testing.assert_allclose(r["xform"][0], [[12, 0, 0, 0], [0, 0, -4, 4], [0, -8, 0, 0]], atol=1e-6)
