@@ -12,17 +12,34 @@ Assets, each an ``AssetMesh`` in the unit box [0, 1]^3:
   (60 triangles); ``builtin:cylinderN`` the same with N sides;
 * ``builtin:L``, ``H``, ``U``, ``T``: the paper's mass-model blocks, prisms over outlines with wings a
   third of the box thick;
-* a file (OBJ, or any mesh format trimesh reads), resolved in the asset roots as the compiler resolves it
-  (``resolve_asset``) and loaded (OBJ by ``model.obj``, others with trimesh), then mapped from its bounding
-  box onto [0, 1]^3 as CityEngine fits an inserted asset to the scope. An axis along which the asset is
-  flat stays flat (at 0): there is nothing to stretch.
+* a file, resolved in the asset roots as the compiler resolves it (``resolve_asset``), read by the reader
+  of its format (``READERS``), then mapped from its bounding box onto [0, 1]^3 as CityEngine fits an
+  inserted asset to the scope. An axis along which the asset is flat stays flat (at 0): there is nothing
+  to stretch.
+
+Formats, and how their axes and units are read. CityEngine is y-up and places an asset as its file
+declares it; ``i(asset, zUp)`` turns a file that declares nothing but was made z-up (the insert's work,
+not the loader's). Every reader returns y-up vertices:
+
+* OBJ (``model.obj``): no up axis nor unit in the format: y-up, as written;
+* glTF and GLB (trimesh): y-up metres by the glTF specification; a scene's nodes are concatenated with
+  their transforms applied;
+* Collada ``.dae`` (trimesh, with pycollada): scaled to metres by ``<unit meter>`` and turned y-up from
+  ``<up_axis>`` (``Z_UP``: -90 degrees about x, as ``zUp``; ``X_UP``: +90 degrees about z);
+* FBX and 3DS (the Open Asset Import Library through ``assimp-py``, an optional package): assimp applies
+  the node transforms and turns FBX's declared axes and 3DS's z-up to y-up; sizes stay in the file's
+  units (assimp-py does not expose assimp's unit conversion). Without the package they are an error
+  ``unsupported asset format: FBX`` (``ir.asset_names.unsupported_format``), at the insert when the
+  grammar compiles;
+* any other ending trimesh reads (PLY, STL, OFF...): as trimesh reads it.
 
 Polygon counts. Conformance compares face counts with PRT, whose encoder returns polygons, not triangles,
 so an ``AssetMesh`` keeps the polygons it was triangulated from (``polygon_sizes``):
 
 * a built-in counts its faces: cube 6 quads, quad 1, cylinder 16 quads and two 16-gons;
 * an OBJ asset counts its ``f`` lines (trimesh triangulates faces as it loads them, and keeps no count
-  of them), each a polygon of as many vertices as the line has; other formats count triangles.
+  of them), each a polygon of as many vertices as the line has; other formats count triangles (their
+  readers triangulate).
 """
 
 from __future__ import annotations
