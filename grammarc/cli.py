@@ -217,15 +217,16 @@ def _listed(names, most: int = 40) -> str:
 
 def _render(args) -> int:
     from grammarc.io.npz import load_record
+    from grammarc.io.rpk import record_asset_roots
     from grammarc.render.picture import parse_size, png_path, render
 
     size = parse_size(args.size)
     png_path(args.output)  # before the record is read, which may be large
-    result = render(load_record(args.record), args.output, size=size, view=args.view, color=args.color,
-                    asset_roots=args.assets)
-    for name in result["missing_assets"]:
-        print(f"grammarc: asset `{name}` not found (give its folder with --assets); drawn as boxes",
-              file=sys.stderr)
+    record = load_record(args.record)
+    with record_asset_roots(record.get("meta"), args.assets or None) as roots:
+        result = render(record, args.output, size=size, view=args.view, color=args.color, asset_roots=roots)
+    for problem in result["asset_problems"]:
+        print(f"grammarc: {problem}; drawn as boxes (--assets DIR gives a folder)", file=sys.stderr)
     print(f"{args.output}: {result['instances']:,} instances, {result['mesh_faces']:,} mesh faces",
           file=sys.stderr)
     return 0

@@ -106,13 +106,18 @@ class Context:
 
     # -------------------------------------------------------------------------------------------- assets
     def asset_mesh(self, asset: int):
-        """The ``AssetMesh`` of asset id ``asset`` for trimming (``Plan.load_asset``), None for an asset no
-        root holds; each loaded once per chunk."""
+        """The ``AssetMesh`` of asset id ``asset`` for trimming and the insert modes that keep its size
+        (``Plan.load_asset``), None for an asset that cannot be loaded; each loaded once per chunk."""
         if asset not in self._asset_meshes:
             grammar = self.plan.grammar
             try:
                 mesh = self.plan.load_asset(grammar.assets[asset], grammar.asset_roots)
-            except AssetError:
-                mesh = None
+            except AssetError as error:
+                mesh = error  # asset_problem tells why
             self._asset_meshes[asset] = mesh
-        return self._asset_meshes[asset]
+        mesh = self._asset_meshes[asset]
+        return None if isinstance(mesh, AssetError) else mesh
+
+    def asset_problem(self, asset: int) -> str:
+        """Why ``asset_mesh(asset)`` is None (after it was asked)."""
+        return str(self._asset_meshes[asset])

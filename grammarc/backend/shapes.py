@@ -16,7 +16,8 @@ A ``Shapes`` batch holds, per shape:
   inherited by children.
 
 ``geom`` < -1 means the shape's geometry is an inserted asset fitted to its scope (CityEngine's ``i()``),
-possibly mirrored along scope axes (``mirror``): ``asset_geom`` and ``asset_of`` encode and decode it.
+possibly mirrored along scope axes (``mirror``) and turned z-up (``i(asset, zUp)``): ``asset_geom`` and
+``asset_of`` encode and decode it.
 """
 
 from __future__ import annotations
@@ -25,10 +26,14 @@ from dataclasses import dataclass, fields, replace
 
 import numpy as np
 
+#: The bit of an asset's ``geom`` code for an asset inserted ``zUp``: its z is the scope's y (it is turned
+#: -90 degrees about x before it is fitted, and before any mirror).
+Z_UP = 8
+
 
 def asset_geom(asset: np.ndarray, mirrored: np.ndarray | int = 0) -> np.ndarray:
-    """The ``geom`` code (int32) of asset ids, with mirror bits (1: x, 2: y, 4: z)."""
-    return (-2 - (np.asarray(asset, dtype=np.int64) * 8 + mirrored)).astype(np.int32)
+    """The ``geom`` code (int32) of asset ids, with mirror bits (1: x, 2: y, 4: z) and ``Z_UP``."""
+    return (-2 - (np.asarray(asset, dtype=np.int64) * 16 + mirrored)).astype(np.int32)
 
 
 def face_axes(axes: np.ndarray, size: np.ndarray, flat_axis: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -40,9 +45,9 @@ def face_axes(axes: np.ndarray, size: np.ndarray, flat_axis: np.ndarray) -> tupl
 
 
 def asset_of(geom: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Asset ids and mirror bits of asset ``geom`` codes (< -1)."""
+    """Asset ids and mirror bits (with ``Z_UP``) of asset ``geom`` codes (< -1)."""
     code = -2 - geom.astype(np.int64)
-    return code // 8, code % 8
+    return code // 16, code % 16
 
 
 @dataclass(frozen=True, eq=False)

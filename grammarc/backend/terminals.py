@@ -21,7 +21,7 @@ import numpy as np
 from grammarc.backend.context import Context
 from grammarc.backend.kernels.scope import xforms
 from grammarc.backend.mesh_shapes import mesh_leaves
-from grammarc.backend.shapes import Shapes, asset_of, face_axes
+from grammarc.backend.shapes import Z_UP, Shapes, asset_of, face_axes
 from grammarc.constants import TOL
 from grammarc.geometry.components import reverse_rings
 from grammarc.geometry.meshes import is_mesh, is_polygon
@@ -43,8 +43,9 @@ def instance_xform(axes: np.ndarray, size: np.ndarray, origin: np.ndarray) -> np
 
 def emit_instances(ctx: Context, shapes: Shapes, asset: int, symbol: int, mirrored: int = 0) -> None:
     """Instances of ``asset`` on the scopes of ``shapes``; ``mirrored`` bits (1 x, 2 y, 4 z) flip the
-    asset along those scope axes (the column is negated and the origin moved to the far side). Where the
-    grammar trims inserts, those crossing their trim planes become the asset's triangles cut by them."""
+    asset along those scope axes (the column is negated and the origin moved to the far side); ``Z_UP``
+    turns the asset in its box before that. Where the grammar trims inserts, those crossing their trim planes become the asset's
+    triangles cut by them."""
     if not len(shapes):
         return
     chunk = ctx.chunk
@@ -53,6 +54,8 @@ def emit_instances(ctx: Context, shapes: Shapes, asset: int, symbol: int, mirror
         if mirrored >> axis & 1:
             xform[:, :, 3] += xform[:, :, axis]
             xform[:, :, axis] *= -1
+    if mirrored & Z_UP:  # the asset turns in its own box, before the mirror in the scope's
+        xform = z_up(xform)
     if ctx.plan.trim_slot is not None:
         planes = _trim_planes(ctx.plan, shapes)
         cut = boxes_crossing(planes, xform.astype(np.float64), TOL.zero)
@@ -62,6 +65,15 @@ def emit_instances(ctx: Context, shapes: Shapes, asset: int, symbol: int, mirror
             chunk.outputs.meshes.append(trimmed)
             shapes, xform = shapes.take(~cut), xform[~cut]
     _append(ctx, shapes, xform, asset, symbol)
+
+
+def z_up(xform: np.ndarray) -> np.ndarray:
+    """Transforms (n, 3, 4) of z-up assets: the unit box turned -90 degrees about x, (u, v, w) to
+    (u, w, 1 - v), then placed by ``xform``; its columns become (x, -z, y), the origin moved along z."""
+    turned = xform[:, :, [0, 2, 1, 3]]
+    turned[:, :, 1] *= -1
+    turned[:, :, 3] += xform[:, :, 2]
+    return turned
 
 
 def _trim_planes(plan, shapes: Shapes) -> np.ndarray:

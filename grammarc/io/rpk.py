@@ -24,21 +24,24 @@ py7zr is an optional dependency (the ``rpk`` extra), imported when a package is 
 
 from __future__ import annotations
 
+import contextlib
 import os
 import re
 import shutil
 import tempfile
 import weakref
+from collections.abc import Iterator, Mapping
 from pathlib import Path, PurePosixPath
 from typing import TYPE_CHECKING
 
 from grammarc.errors import UsageError
 from grammarc.frontend.source import read_grammar_text
+from grammarc.model.assets import record_roots
 
 if TYPE_CHECKING:
     from typing_extensions import Self
 
-__all__ = ["RulePackage", "open_rpk", "start_rule_of"]
+__all__ = ["RulePackage", "open_rpk", "record_asset_roots", "start_rule_of"]
 
 _INSTALL_HINT = "pip install 'grammarc[rpk]' (or pip install py7zr)"
 
@@ -215,3 +218,18 @@ def _main_rule_file(rules: dict[str, Path], compiled: list[str]) -> Path | None:
         return candidates[0]
     with_start = [p for p in candidates if start_rule_of(p) is not None]
     return with_start[0] if with_start else candidates[0]
+
+
+@contextlib.contextmanager
+def record_asset_roots(meta: Mapping | None, asset_roots=None) -> Iterator[list[Path] | None]:
+    """The folders a record's assets load from, for ``render`` and ``info`` after the build: a record built
+    from a rule package names the ``.rpk`` as its grammar (the folder it was extracted to was temporary),
+    so while the block runs the package is extracted again and its ``asset_roots`` come first, then
+    ``asset_roots`` or the record's own (``model.assets.record_roots``). Any other record, or a package no
+    longer where the record says: ``asset_roots`` as given (None: the record's own)."""
+    grammar = meta.get("grammar") if isinstance(meta, Mapping) else None
+    if not (grammar and str(grammar).lower().endswith(".rpk") and Path(grammar).is_file()):
+        yield asset_roots
+        return
+    with open_rpk(grammar) as package:
+        yield [*package.asset_roots, *record_roots({"meta": meta}, asset_roots)]

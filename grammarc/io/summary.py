@@ -14,6 +14,7 @@ loaded is reported and left out of the polygon counts rather than failing the su
 
 from __future__ import annotations
 
+import contextlib
 import os
 from collections import Counter
 from pathlib import Path
@@ -23,6 +24,7 @@ import numpy as np
 from grammarc.errors import AssetError
 from grammarc.io.bake import count_triangles
 from grammarc.io.npz import read_instances
+from grammarc.io.rpk import record_asset_roots
 from grammarc.io.shards import is_manifest, manifest_path, shard_outputs
 from grammarc.model.assets import asset_library
 
@@ -39,7 +41,18 @@ def summarize(path: str | os.PathLike, asset_roots=None, lod: str | None = None)
     if (path.suffix.lower() in (".usd", ".usda", ".usdc") and manifest_path(path).is_file()
             and not path.with_name(f"{path.name}.tiles").exists()):
         path = manifest_path(path)  # the root layer of a cluster build's shards
-    tallies = [_tally(*_read(p), asset_roots, lod) for p in (shard_outputs(path) if is_manifest(path) else [path])]
+    with contextlib.ExitStack() as package:
+        tallies = []
+        for part in shard_outputs(path) if is_manifest(path) else [path]:
+            record, files = _read(part)
+            if not tallies:  # a rule package's assets: extracted again while the summary is made
+                asset_roots = package.enter_context(record_asset_roots(record["meta"], asset_roots))
+            tallies.append(_tally(record, files, asset_roots, lod))
+        return _summary(path, tallies, asset_roots, lod)
+
+
+def _summary(path: Path, tallies: list[dict], asset_roots, lod: str | None) -> dict:
+    """The summary of ``tallies``, the assets loaded from ``asset_roots`` (or the record's own)."""
     per_asset = sum((Counter(t["assets"]) for t in tallies), Counter())
     symbols = sum((Counter(t["symbols"]) for t in tallies), Counter())
     names = list(per_asset)

@@ -107,3 +107,23 @@ def locate(name: str, roots) -> tuple[Path, Path] | None:
 
 def _inside(path: Path, root: Path) -> bool:
     return os.path.commonpath([path, root]) == str(root)
+
+
+#: Asset formats read only through an optional package: file ending -> (the format's name, the module).
+OPTIONAL_FORMATS = {".fbx": ("FBX", "assimp_py"), ".3ds": ("3DS", "assimp_py")}
+
+
+def unsupported_format(path: str | os.PathLike) -> str:
+    """Why an asset file cannot be read here, or "": its format needs a package that is not installed
+    (the compiler says so at the insert; the loader when it is asked for the file)."""
+    import importlib.util
+
+    entry = OPTIONAL_FORMATS.get(Path(path).suffix.lower())
+    if entry is None:
+        return ""
+    try:
+        if importlib.util.find_spec(entry[1]) is not None:
+            return ""
+    except ValueError:  # set to None in sys.modules: importing it fails
+        pass
+    return f"unsupported asset format: {entry[0]} (`{Path(path).name}`; pip install 'grammarc[fbx]' reads FBX and 3DS)"

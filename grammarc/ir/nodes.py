@@ -494,16 +494,24 @@ class Center:
 
 @dataclass(frozen=True, slots=True)
 class UseAsset:
-    """CityEngine ``i(asset)`` and ``primitiveCube()``: the shape's geometry becomes the asset fitted to
-    its scope; the shape goes on (a leaf emits the asset as an instance).
+    """CityEngine ``i(asset, up, mode)`` and ``primitiveCube()``: the shape's geometry becomes the asset
+    placed by ``mode``; the shape goes on (a leaf emits the asset as an instance).
 
     ``asset`` is the name when it is written as a string; otherwise ``name`` computes it per shape (a
-    parameter or constant holding an asset path).
+    parameter or constant holding an asset path). ``up`` is the asset's up axis, ``"yUp"`` or ``"zUp"``
+    (turned -90 degrees about x); ``mode`` one of ``INSERT_MODES``: fitted to the scope, or the scope
+    made the asset's own size, at the asset's own position or centred on the scope's xz.
     """
 
     asset: str
     span: Span = NO_SPAN
     name: Expr | None = child(Type.STR, "an asset name", default=None)
+    up: str = "yUp"
+    mode: str = "alignSizeAndPosition"
+
+
+#: ``i()``'s insert modes, the default first.
+INSERT_MODES = ("alignSizeAndPosition", "keepSizeAndPosition", "keepSizeAlignPosition")
 
 
 @dataclass(frozen=True, slots=True)

@@ -164,7 +164,9 @@ _OP_FORMATS = {
     ir.Stochastic: _branches,
     ir.Extrude: lambda op: f"extrude({print_expr(op.height)})",
     ir.Center: lambda op: f"center({''.join('xyz'[a] for a in op.axes)})",
-    ir.UseAsset: lambda op: f"i({print_expr(op.name)})" if op.name is not None else f'i("{op.asset}")',
+    ir.UseAsset: lambda op: "i(" + ", ".join([
+        print_expr(op.name) if op.name is not None else f'"{op.asset}"',
+        *([op.up, op.mode] if (op.up, op.mode) != ("yUp", ir.INSERT_MODES[0]) else [])]) + ")",
     ir.SetAttr: lambda op: f"set({op.name}, {print_expr(op.value)})",
     ir.Report: lambda op: f"report({print_expr(op.key)}, {print_expr(op.value)})",
     ir.Mirror: lambda op: f"mirror({_list(op.axes)})",

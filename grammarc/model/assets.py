@@ -12,17 +12,34 @@ Assets, each an ``AssetMesh`` in the unit box [0, 1]^3:
   (60 triangles); ``builtin:cylinderN`` the same with N sides;
 * ``builtin:L``, ``H``, ``U``, ``T``: the paper's mass-model blocks, prisms over outlines with wings a
   third of the box thick;
-* a file (OBJ, or any mesh format trimesh reads), resolved in the asset roots as the compiler resolves it
-  (``resolve_asset``) and loaded (OBJ by ``model.obj``, others with trimesh), then mapped from its bounding
-  box onto [0, 1]^3 as CityEngine fits an inserted asset to the scope. An axis along which the asset is
-  flat stays flat (at 0): there is nothing to stretch.
+* a file, resolved in the asset roots as the compiler resolves it (``resolve_asset``), read by the reader
+  of its format (``READERS``), then mapped from its bounding box onto [0, 1]^3 as CityEngine fits an
+  inserted asset to the scope. An axis along which the asset is flat stays flat (at 0): there is nothing
+  to stretch.
+
+Formats, and how their axes and units are read. CityEngine is y-up and places an asset as its file
+declares it; ``i(asset, zUp)`` turns a file that declares nothing but was made z-up (the insert's work,
+not the loader's). Every reader returns y-up vertices:
+
+* OBJ (``model.obj``): no up axis nor unit in the format: y-up, as written;
+* glTF and GLB (trimesh): y-up metres by the glTF specification; a scene's nodes are concatenated with
+  their transforms applied;
+* Collada ``.dae`` (trimesh, with pycollada): scaled to metres by ``<unit meter>`` and turned y-up from
+  ``<up_axis>`` (``Z_UP``: -90 degrees about x, as ``zUp``; ``X_UP``: +90 degrees about z);
+* FBX and 3DS (the Open Asset Import Library through ``assimp-py``, an optional package): assimp applies
+  the node transforms and turns FBX's declared axes and 3DS's z-up to y-up; sizes stay in the file's
+  units (assimp-py does not expose assimp's unit conversion). Without the package they are an error
+  ``unsupported asset format: FBX`` (``ir.asset_names.unsupported_format``), at the insert when the
+  grammar compiles;
+* any other ending trimesh reads (PLY, STL, OFF...): as trimesh reads it.
 
 Polygon counts. Conformance compares face counts with PRT, whose encoder returns polygons, not triangles,
 so an ``AssetMesh`` keeps the polygons it was triangulated from (``polygon_sizes``):
 
 * a built-in counts its faces: cube 6 quads, quad 1, cylinder 16 quads and two 16-gons;
 * an OBJ asset counts its ``f`` lines (trimesh triangulates faces as it loads them, and keeps no count
-  of them), each a polygon of as many vertices as the line has; other formats count triangles.
+  of them), each a polygon of as many vertices as the line has; other formats count triangles (their
+  readers triangulate).
 """
 
 from __future__ import annotations
@@ -36,10 +53,11 @@ from pathlib import Path
 import numpy as np
 
 from grammarc.errors import AssetError
-from grammarc.ir.asset_names import builtin_name, resolve_asset
+from grammarc.ir.asset_names import builtin_name, resolve_asset, unsupported_format
 from grammarc.model.obj import ObjError, read_obj
 
-__all__ = ["LOD_STAND_IN", "AssetLibrary", "AssetMesh", "asset_library", "builtin_mesh", "load_asset"]
+__all__ = ["LOD_STAND_IN", "AssetLibrary", "AssetMesh", "asset_library", "builtin_mesh", "load_asset",
+           "record_roots"]
 
 #: ``--lod builtin``: a built-in cube stands in for an asset file that is missing.
 LOD_STAND_IN = "builtin"
@@ -192,30 +210,110 @@ def load_asset(name: str, asset_roots: Sequence[str | os.PathLike] = (), lod: st
 
 @lru_cache(maxsize=64)
 def _load_file(path: Path, mtime_ns: int) -> AssetMesh:
-    """A file asset, cached by path and modification time (a city uses a few assets many times).
+    """A file asset, cached by path and modification time (a city uses a few assets many times), read by
+    the reader of its format (``READERS``) and turned y-up in its file's units."""
+    suffix = path.suffix.lower()
+    reader = READERS.get(suffix, _read_trimesh)
+    try:
+        vertices, faces, sizes = reader(path)
+    except AssetError:
+        raise
+    except Exception as error:  # each reader's own errors: a broken file is the asset's problem
+        raise AssetError(f"cannot read asset `{path}`: {error}") from error
+    return _from_own_coordinates(vertices, faces, sizes)
 
-    OBJ files are read by ``model.obj`` (geometry only: their materials would need Pillow), their polygons
-    fanned into triangles; other formats go through trimesh.
-    """
-    if path.suffix.lower() == ".obj":
-        try:
-            vertices, polygons = read_obj(path.read_text(encoding="utf-8", errors="replace"), str(path))
-        except (OSError, ObjError) as error:
-            raise AssetError(f"cannot read asset `{path}`: {error}") from error
-        polygons = [f for f in polygons if len(f) >= 3 and (f >= 0).all() and (f < len(vertices)).all()]
-        sizes = np.array([len(f) for f in polygons], np.int64)
-        faces = np.concatenate([np.stack([np.full(len(f) - 2, f[0]), f[1:-1], f[2:]], axis=1)
-                                for f in polygons]) if polygons else np.zeros((0, 3), np.int64)
-        return _from_own_coordinates(vertices, faces, sizes)
+
+def _read_obj(path: Path):
+    """OBJ by ``model.obj`` (geometry only: materials would need Pillow), polygons fanned into triangles;
+    OBJ has no up axis or unit: y-up, as CityEngine reads it."""
+    try:
+        vertices, polygons = read_obj(path.read_text(encoding="utf-8", errors="replace"), str(path))
+    except (OSError, ObjError) as error:
+        raise AssetError(f"cannot read asset `{path}`: {error}") from error
+    polygons = [f for f in polygons if len(f) >= 3 and (f >= 0).all() and (f < len(vertices)).all()]
+    sizes = np.array([len(f) for f in polygons], np.int64)
+    faces = np.concatenate([np.stack([np.full(len(f) - 2, f[0]), f[1:-1], f[2:]], axis=1)
+                            for f in polygons]) if polygons else np.zeros((0, 3), np.int64)
+    return vertices, faces, sizes
+
+
+def _read_trimesh(path: Path):
+    """glTF and GLB (y-up metres by the glTF specification) and any other format trimesh reads: a scene's
+    meshes concatenated with their node transforms applied (``force="mesh"``)."""
     import trimesh
 
-    try:
-        mesh = trimesh.load(path, force="mesh", process=False)
-    except Exception as error:
-        raise AssetError(f"cannot read asset `{path}`: {error}") from error
+    mesh = trimesh.load(path, force="mesh", process=False)
     vertices = np.asarray(getattr(mesh, "vertices", np.zeros((0, 3))), np.float64).reshape(-1, 3)
     faces = np.asarray(getattr(mesh, "faces", np.zeros((0, 3))), np.int64).reshape(-1, 3)
-    return _from_own_coordinates(vertices, faces, np.full(len(faces), 3, np.int64))
+    return vertices, faces, np.full(len(faces), 3, np.int64)
+
+
+def _read_collada(path: Path):
+    """Collada through trimesh (which needs pycollada), then scaled to metres by the file's
+    ``<unit meter=...>`` and turned y-up from its ``<up_axis>``: CityEngine places a Collada asset as its
+    author declared it, where trimesh only notes both."""
+    try:
+        import collada  # noqa: F401  (trimesh's Collada reader)
+    except ImportError as error:
+        raise AssetError(f"cannot read Collada asset `{path}`: pycollada is not installed "
+                         "(pip install pycollada)") from error
+    vertices, faces, sizes = _read_trimesh(path)
+    meter, up = _collada_unit_and_up(path)
+    return _y_up(vertices * meter, up), faces, sizes
+
+
+def _collada_unit_and_up(path: Path) -> tuple[float, str]:
+    """A Collada file's ``<asset><unit meter>`` (1 when absent) and ``<up_axis>`` (``Y_UP`` when absent)."""
+    from xml.etree import ElementTree
+
+    meter, up = 1.0, "Y_UP"
+    for element in ElementTree.parse(path).getroot().iter():
+        tag = element.tag.rsplit("}", 1)[-1]
+        if tag == "unit" and element.get("meter"):
+            meter = float(element.get("meter"))
+        elif tag == "up_axis" and element.text:
+            up = element.text.strip().upper()
+        elif tag in ("library_geometries", "library_visual_scenes", "scene"):
+            break  # the document's <asset> comes first
+    return meter, up
+
+
+def _y_up(vertices: np.ndarray, up: str) -> np.ndarray:
+    """Vertices of a file whose up axis is ``up`` (``X_UP``, ``Y_UP``, ``Z_UP``) turned y-up, right-handed:
+    Z_UP turns -90 degrees about x (CityEngine's ``zUp``), X_UP +90 degrees about z."""
+    x, y, z = vertices.T
+    if up == "Z_UP":
+        return np.stack([x, z, -y], axis=1)
+    if up == "X_UP":
+        return np.stack([-y, x, z], axis=1)
+    return vertices
+
+
+def _read_assimp(path: Path):
+    """FBX and 3DS through the Open Asset Import Library (``assimp-py``), which applies the node transforms
+    and an FBX file's declared axes (the result is y-up), triangulated. Their sizes are in the file's units
+    (an FBX in centimetres stays in centimetres): assimp-py does not expose the unit conversion."""
+    try:
+        import assimp_py
+    except ImportError as error:
+        raise AssetError(unsupported_format(path) or f"cannot read asset `{path}`: {error}") from error
+    scene = assimp_py.import_file(str(path), assimp_py.Process_Triangulate | assimp_py.Process_PreTransformVertices)
+    vertices, faces, start = [], [], 0
+    for mesh in scene.meshes:
+        points = np.asarray(mesh.vertices, np.float64).reshape(-1, 3)
+        triangles = np.asarray(mesh.indices, np.int64).reshape(-1, 3)
+        vertices.append(points)
+        faces.append(triangles + start)
+        start += len(points)
+    vertices = np.concatenate(vertices) if vertices else np.zeros((0, 3))
+    faces = np.concatenate(faces) if faces else np.zeros((0, 3), np.int64)
+    return vertices, faces, np.full(len(faces), 3, np.int64)
+
+
+#: Readers by file ending; any other ending goes through trimesh. Each returns vertices (v, 3) y-up,
+#: triangles (t, 3) and the polygon sizes (p,) they came from.
+READERS = {".obj": _read_obj, ".glb": _read_trimesh, ".gltf": _read_trimesh, ".dae": _read_collada,
+           ".fbx": _read_assimp, ".3ds": _read_assimp}
 
 
 def _fitted(vertices: np.ndarray) -> np.ndarray:
@@ -272,11 +370,12 @@ class AssetLibrary:
 def asset_library(names: Sequence[str], record: Mapping, asset_roots=None, lod: str | None = None) -> AssetLibrary:
     """The meshes of asset ``names``, loaded when first used from ``asset_roots`` or the roots that the
     record's meta names (the grammar's folder, then its ``asset_roots``), at level of detail ``lod``."""
-    return AssetLibrary(names, _roots(record, asset_roots), lod)
+    return AssetLibrary(names, record_roots(record, asset_roots), lod)
 
 
-def _roots(record: Mapping, asset_roots) -> list[Path]:
-    """``asset_roots``, or the roots a record's meta names: the grammar's folder, then ``asset_roots``."""
+def record_roots(record: Mapping, asset_roots=None) -> list[Path]:
+    """``asset_roots``, or the roots a record's meta names: the grammar's folder, then ``asset_roots``
+    (a rule package's own folders are not among them: ``io.rpk.record_asset_roots`` adds them)."""
     if asset_roots is not None:
         return [Path(r) for r in asset_roots]
     meta = record.get("meta")

@@ -78,7 +78,7 @@ def render(record: Mapping, path, *, size: tuple[int, int] = (1600, 1000), view:
     dict
         ``instances`` and ``mesh_faces`` drawn; ``splats``, ``boxes``, ``meshes``: how many instances were
         drawn each way; ``missing_assets``: names of file assets drawn as boxes because they could not
-        be loaded.
+        be loaded, ``asset_problems`` why (each an ``AssetError``'s message).
 
     Raises
     ------
@@ -102,13 +102,14 @@ def render(record: Mapping, path, *, size: tuple[int, int] = (1600, 1000), view:
     depth = np.full((height, width), -np.inf)
     light = camera.light()
 
-    library = asset_library(names, record, [Path(r) for r in asset_roots] or None)
-    meshes, missing = [], []
+    library = asset_library(names, record, [Path(r) for r in asset_roots or ()] or None)
+    meshes, missing, problems = [], [], []
     for a in np.flatnonzero(np.bincount(asset, minlength=len(names))):
         try:
             meshes.append((a, library[a]))
-        except AssetError:
+        except AssetError as error:
             missing.append(names[a])
+            problems.append(str(error))
     counts = _draw_instances(asset, xform, _instance_colors(record, color), meshes, len(names), camera,
                              light, image, depth)
     if len(face_offsets) > 1:
@@ -127,6 +128,7 @@ def render(record: Mapping, path, *, size: tuple[int, int] = (1600, 1000), view:
         "boxes": int(counts[1]),
         "meshes": int(counts[2]),
         "missing_assets": missing,
+        "asset_problems": problems,
     }
 
 

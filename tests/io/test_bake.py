@@ -284,3 +284,14 @@ def test_bake_read_instances_with_assets_from_meta(tmp_path):
     assert len(mesh.faces) == 12 + 2 + 12 + 8 + 2
     assert mesh.area == pytest.approx(22 + 4 + 6 + 84 + 9, rel=1e-6)
     assert mesh.metadata["n_polygons"] == 6 + 1 + 6 + 2 + 1
+
+
+def test_a_glb_asset_inserted_z_up_bakes_standing(tmp_path):
+    """The baked city holds the GLB's triangles per instance, the z-up mast standing 6 m tall."""
+    from writers_city import glb_city
+
+    record, _, triangles = glb_city(tmp_path, "masts.npz")
+    mesh = bake(record, [tmp_path])
+    assert len(mesh.faces) == 3 * triangles
+    np.testing.assert_allclose(mesh.bounds[:, 1], [0, 6], atol=1e-5)
+    np.testing.assert_allclose(mesh.bounds[1, 0] - mesh.bounds[0, 0], 20 + 2, atol=1e-5)  # lots 10 m apart, 2 m vane

@@ -6,7 +6,7 @@ import json
 import numpy as np
 import pytest
 import trimesh
-from writers_city import city, world
+from writers_city import city, glb_city, world
 
 from grammarc.io.gltf import GltfWriter, part_paths
 from grammarc.model.records import MeshChunk, TerminalChunk
@@ -76,3 +76,14 @@ def test_a_large_city_is_split_into_parts(tmp_path):
     for part in part_paths(path, parts):
         gltf = pygltflib.GLTF2().load(str(part))
         assert gltf.buffers[0].byteLength <= 3000 + 2000  # the asset meshes a part needs come on top
+
+
+def test_a_glb_asset_is_its_own_prototype(tmp_path):
+    """The prototype of a GLB asset is its mesh (both nodes), not a box; its instances are the record's."""
+    record, path, triangles = glb_city(tmp_path, "masts.glb")
+    gltf = pygltflib.GLTF2().load(str(path))
+    (mesh,) = [m for m in gltf.meshes if m.name == "mast.glb"]
+    assert sum(gltf.accessors[p.indices].count for p in mesh.primitives) == 3 * triangles
+    got, names = instances(path)
+    assert names == ["mast.glb"] * 3
+    np.testing.assert_allclose(got[np.argsort(got[:, 0, 3])], record["xform"], atol=1e-4)

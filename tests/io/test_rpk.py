@@ -153,3 +153,33 @@ def test_a_package_is_its_own_workspace():
         assert rpk.workspace == rpk.root / ".ws"
         roots = find_roots(rpk.main_rule_file, rpk.workspace)
         assert roots.project == rpk.root.resolve() and rpk.root.parent.resolve() not in roots.folders
+
+
+def test_a_record_of_a_package_loads_the_package_assets_again(tmp_path, capsys):
+    """The record names the .rpk, not the folder it was extracted to: ``info`` and ``render`` extract it
+    again and load the package's own assets (they said "not loaded" and drew boxes)."""
+    from grammarc.build import build
+    from grammarc.cli import main
+    from grammarc.io.npz import load_record
+    from grammarc.io.rpk import record_asset_roots
+    from grammarc.io.summary import summarize
+
+    package = make_rpk(tmp_path / "posts.rpk", {
+        "rules/posts.cga": '@StartRule\nLot --> extrude(2) i("props/post.obj")\n',
+        "assets/props/post.obj": "v 0 0 0\nv 1 0 0\nv 1 3 0\nv 0 3 1\nf 1 2 3\nf 1 3 4\n",
+    })  # fmt: skip
+    (tmp_path / "lot.geojson").write_text(json.dumps({"type": "FeatureCollection", "features": [
+        {"type": "Feature", "properties": {}, "geometry": {"type": "Polygon", "coordinates": [
+            [[0, 0], [4, 0], [4, 4], [0, 4], [0, 0]]]}}]}))
+    build(package, tmp_path / "posts.npz", lots_path=tmp_path / "lot.geojson")
+    meta = load_record(tmp_path / "posts.npz")["meta"]
+    with record_asset_roots(meta) as roots:
+        assert (roots[0] / "props" / "post.obj").is_file() and roots[-1] == tmp_path
+    assert not roots[0].exists()  # extracted for the block only
+    with record_asset_roots({"grammar": str(tmp_path / "x.cga")}, [tmp_path]) as roots:
+        assert roots == [tmp_path]  # not a package: the roots as given
+    info = summarize(tmp_path / "posts.npz")
+    assert info["assets"]["props/post.obj"] == {"instances": 1, "polygons": 2, "triangles": 2}
+    assert not info["problems"]
+    assert main(["render", str(tmp_path / "posts.npz"), "-o", str(tmp_path / "posts.png")]) == 0
+    assert "drawn as boxes" not in capsys.readouterr().err

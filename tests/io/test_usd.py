@@ -2,7 +2,7 @@
 
 import numpy as np
 import pytest
-from writers_city import city, world
+from writers_city import city, glb_city, world
 
 pxr = pytest.importorskip("pxr")
 from pxr import Usd, UsdGeom
@@ -54,3 +54,14 @@ def test_a_failed_usd_build_leaves_nothing(tmp_path):
                                                  meta={}) as writer:
         raise RuntimeError("derivation failed")
     assert writer._state == "aborted" and sorted(p.name for p in tmp_path.iterdir()) == []
+
+
+def test_a_glb_asset_is_its_own_prototype(tmp_path):
+    """The prototype Mesh of a GLB asset holds the asset's triangles, in its unit box."""
+    _, path, triangles = glb_city(tmp_path, "masts.usda")
+    stage = Usd.Stage.Open(str(tiles_folder(path) / "prototypes.usda"))
+    (mesh,) = [UsdGeom.Mesh(p) for p in stage.Traverse()
+               if p.IsA(UsdGeom.Mesh) and p.GetCustomDataByKey("grammarc:asset") == "mast.glb"]
+    assert len(mesh.GetFaceVertexCountsAttr().Get()) == triangles
+    points = np.array(mesh.GetPointsAttr().Get())
+    np.testing.assert_allclose([points.min(0), points.max(0)], [[0, 0, 0], [1, 1, 1]], atol=1e-6)

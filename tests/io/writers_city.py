@@ -45,3 +45,28 @@ def world(position, orientation_xyzw, scale) -> np.ndarray:
     rotation = Rotation.from_quat(np.asarray(orientation_xyzw, float)).as_matrix()
     linear = rotation * np.asarray(scale, float)[:, None, :]
     return np.concatenate([linear, np.asarray(position, float)[:, :, None]], axis=2)
+
+
+def glb_city(tmp_path: Path, output: str) -> tuple[dict, Path, int]:
+    """(the npz record, the output path, the asset's triangles) of a mast inserted on three lots from a
+    GLB made here: a z-up export (a 1 x 1 x 6 m post and a 2 m vane on top, two nodes) inserted
+    ``i("mast.glb", zUp, keepSizeAlignPosition)`` on each lot's centre, standing 6 m tall."""
+    import trimesh
+    from trimesh.transformations import translation_matrix
+
+    scene = trimesh.Scene()
+    scene.add_geometry(trimesh.creation.box(extents=(1, 1, 6)), transform=translation_matrix((0, 0, 3)))
+    scene.add_geometry(trimesh.creation.cylinder(radius=0.1, height=2.0, sections=6),
+                       transform=translation_matrix((0.5, 0, 5)) @ trimesh.transformations.rotation_matrix(
+                           np.pi / 2, [0, 1, 0]))
+    (tmp_path / "mast.glb").write_bytes(scene.export(file_type="glb"))
+    (tmp_path / "g.cga").write_text("Lot --> t('0.5, 0, '0.5) s(0, 0, 0) "
+                                    'i("mast.glb", zUp, keepSizeAlignPosition) Mast.\n')
+    lots = {"type": "FeatureCollection", "features": [
+        {"type": "Feature", "id": f"lot{k}", "properties": {},
+         "geometry": {"type": "Polygon", "coordinates": [[[x, 0], [x + 8, 0], [x + 8, 8], [x, 8], [x, 0]]]}}
+        for k, x in enumerate([0, 10, 20])]}
+    (tmp_path / "lots.geojson").write_text(json.dumps(lots))
+    build(tmp_path / "g.cga", tmp_path / "city.npz", lots_path=tmp_path / "lots.geojson")
+    build(tmp_path / "g.cga", tmp_path / output, lots_path=tmp_path / "lots.geojson")
+    return read_instances(tmp_path / "city.npz"), tmp_path / output, len(scene.to_geometry().faces)

@@ -116,3 +116,15 @@ def test_without_a_computed_insert_searches_make_no_asset(tmp_path):
     text = VERSION + 'Lot --> report("a", fileRandom("assets/*.obj")) i("assets/a.obj")\n'
     module, _ = resolved(text, (tmp_path,), "cityengine")
     assert module.assets == ("builtin:cube", "builtin:quad", "assets/a.obj")
+
+
+def test_an_fbx_without_its_reader_is_an_error_at_the_insert(tmp_path, monkeypatch):
+    import sys
+
+    monkeypatch.setitem(sys.modules, "assimp_py", None)  # as if it were not installed
+    (tmp_path / "mill.fbx").write_text("; FBX\n")
+    (tmp_path / "post.glb").write_bytes(b"")
+    _, diags = resolved(VERSION + 'Lot --> i("post.glb") X\nX --> i("mill.fbx", zUp)\n', (tmp_path,), "cityengine")
+    (error,) = [d for d in diags if d.code == "asset"]
+    assert error.severity.value == "error" and error.span.line == 3
+    assert error.message.startswith("unsupported asset format: FBX (`mill.fbx`; pip install 'grammarc[fbx]'")

@@ -114,3 +114,133 @@ def test_a_file_asset_keeps_its_bounds_in_its_own_units(tmp_path):
     mesh = load_asset("post.obj", [tmp_path])
     np.testing.assert_array_equal(mesh.bounds, [[-1, 0, 2], [1, 3, 2.5]])
     np.testing.assert_array_equal(builtin_mesh("quad").bounds, [[0, 0, 0], [1, 1, 0]])
+
+
+def box_scene():
+    """Two boxes 1 x 2 x 3 placed by their nodes at x = 10 and y = 5: a scene whose transforms count."""
+    box = trimesh.creation.box(extents=(1, 2, 3))
+    scene = trimesh.Scene()
+    scene.add_geometry(box, transform=trimesh.transformations.translation_matrix((10, 0, 0)))
+    scene.add_geometry(box, transform=trimesh.transformations.translation_matrix((0, 5, 0)))
+    return scene
+
+
+@pytest.mark.parametrize("suffix", ["glb", "gltf"])
+def test_gltf_scenes_load_with_their_node_transforms(tmp_path, suffix):
+    box_scene().export(tmp_path / f"pair.{suffix}")
+    mesh = load_asset(f"pair.{suffix}", [tmp_path])
+    np.testing.assert_allclose(mesh.bounds, [[-0.5, -1, -1.5], [10.5, 6, 1.5]])  # y-up metres: as written
+    np.testing.assert_allclose([mesh.vertices.min(0), mesh.vertices.max(0)], [[0] * 3, [1] * 3])
+    assert mesh.n_triangles == mesh.n_polygons == 24
+
+
+def collada(tmp_path, name: str, asset: str = "") -> Path:
+    """A Collada box 1 x 2 x 3 (trimesh's writer), its ``<asset>`` holding ``asset`` instead of Y_UP."""
+    pytest.importorskip("collada")
+    text = trimesh.exchange.dae.export_collada(trimesh.creation.box(extents=(1, 2, 3)))
+    text = text.decode() if isinstance(text, bytes) else text
+    (tmp_path / name).write_text(text.replace("<up_axis>Y_UP</up_axis>", asset or "<up_axis>Y_UP</up_axis>"))
+    return tmp_path / name
+
+
+def test_collada_is_read_in_metres_with_its_up_axis_turned_to_y(tmp_path):
+    collada(tmp_path, "y.dae")
+    collada(tmp_path, "z.dae", '<unit meter="0.01" name="centimeter"/><up_axis>Z_UP</up_axis>')
+    collada(tmp_path, "x.dae", "<up_axis>X_UP</up_axis>")
+    np.testing.assert_allclose(load_asset("y.dae", [tmp_path]).bounds, [[-0.5, -1, -1.5], [0.5, 1, 1.5]])
+    # z-up: its z (3 cm) is the height, its y (2 cm) the depth, turned -90 degrees about x
+    np.testing.assert_allclose(load_asset("z.dae", [tmp_path]).bounds,
+                               [[-0.005, -0.015, -0.01], [0.005, 0.015, 0.01]])
+    # x-up: its x (1) is the height, its y (2) along -x
+    np.testing.assert_allclose(load_asset("x.dae", [tmp_path]).bounds, [[-1, -0.5, -1.5], [1, 0.5, 1.5]])
+    assert load_asset("z.dae", [tmp_path]).n_triangles == 12
+
+
+#: A quad of an ASCII FBX 7.4 file, y-up or z-up by its GlobalSettings, its model moved 10 along x.
+FBX = """; FBX 7.4.0 project file
+FBXHeaderExtension:  {
+\tFBXHeaderVersion: 1003
+\tFBXVersion: 7400
+}
+GlobalSettings:  {
+\tVersion: 1000
+\tProperties70:  {
+\t\tP: "UpAxis", "int", "Integer", "",UP
+\t\tP: "UpAxisSign", "int", "Integer", "",1
+\t\tP: "FrontAxis", "int", "Integer", "",FRONT
+\t\tP: "FrontAxisSign", "int", "Integer", "",SIGN
+\t\tP: "CoordAxis", "int", "Integer", "",0
+\t\tP: "CoordAxisSign", "int", "Integer", "",1
+\t}
+}
+Objects:  {
+\tGeometry: 1000, "Geometry::quad", "Mesh" {
+\t\tVertices: *12 {
+\t\t\ta: 0,0,0,1,0,0,1,2,0,0,2,3
+\t\t}
+\t\tPolygonVertexIndex: *4 {
+\t\t\ta: 0,1,2,-4
+\t\t}
+\t}
+\tModel: 2000, "Model::quad", "Mesh" {
+\t\tProperties70:  {
+\t\t\tP: "Lcl Translation", "Lcl Translation", "", "A",10,0,0
+\t\t}
+\t}
+}
+Connections:  {
+\tC: "OO",1000,2000
+\tC: "OO",2000,0
+}
+"""
+
+
+def test_fbx_is_read_through_assimp_with_its_transforms_and_axes(tmp_path):
+    pytest.importorskip("assimp_py")
+    (tmp_path / "y.fbx").write_text(FBX.replace("UP", "1").replace("FRONT", "2").replace("SIGN", "1"))
+    (tmp_path / "z.fbx").write_text(FBX.replace("UP", "2").replace("FRONT", "1").replace("SIGN", "-1"))
+    y = load_asset("y.fbx", [tmp_path])
+    np.testing.assert_allclose(y.bounds, [[10, 0, 0], [11, 2, 3]])
+    assert y.n_triangles == 2 and y.n_polygons == 2
+    np.testing.assert_allclose(load_asset("z.fbx", [tmp_path]).bounds, [[10, 0, -2], [11, 3, 0]])
+
+
+def write_3ds(path: Path, vertices, triangles) -> Path:
+    """A minimal 3DS file: main chunk, editor, one named object with a triangle mesh."""
+    import struct
+
+    def chunk(kind, body):
+        return struct.pack("<HI", kind, 6 + len(body)) + body
+
+    points = chunk(0x4110, struct.pack("<H", len(vertices)) + np.asarray(vertices, "<f4").tobytes())
+    faces = chunk(0x4120, struct.pack("<H", len(triangles))
+                  + b"".join(struct.pack("<4H", *t, 0) for t in triangles))
+    editor = chunk(0x3D3D, chunk(0x4000, b"part\0" + chunk(0x4100, points + faces)))
+    path.write_bytes(chunk(0x4D4D, chunk(0x0002, struct.pack("<I", 3)) + editor))
+    return path
+
+
+def test_3ds_is_read_through_assimp_z_up_as_3ds_files_are(tmp_path):
+    pytest.importorskip("assimp_py")
+    write_3ds(tmp_path / "part.3ds", [[0, 0, 0], [1, 0, 0], [1, 2, 0], [0, 2, 3]], [(0, 1, 2), (0, 2, 3)])
+    mesh = load_asset("part.3ds", [tmp_path])
+    np.testing.assert_allclose(mesh.bounds, [[0, 0, -2], [1, 3, 0]])  # its z (3) is the height
+    assert mesh.n_triangles == 2
+
+
+def test_fbx_and_3ds_without_assimp_are_unsupported_formats(tmp_path, monkeypatch):
+    import sys
+
+    monkeypatch.setitem(sys.modules, "assimp_py", None)  # as if it were not installed
+    (tmp_path / "a.fbx").write_text(FBX)
+    write_3ds(tmp_path / "b.3ds", [[0, 0, 0], [1, 0, 0], [1, 1, 0]], [(0, 1, 2)])
+    with pytest.raises(AssetError, match=r"unsupported asset format: FBX \(`a.fbx`; pip install"):
+        load_asset("a.fbx", [tmp_path])
+    with pytest.raises(AssetError, match="unsupported asset format: 3DS"):
+        load_asset("b.3ds", [tmp_path])
+
+
+def test_a_broken_file_is_an_asset_error(tmp_path):
+    (tmp_path / "bad.glb").write_bytes(b"glTF not really")
+    with pytest.raises(AssetError, match="cannot read asset .*bad.glb"):
+        load_asset("bad.glb", [tmp_path])

@@ -122,7 +122,20 @@ def test_a_missing_file_asset_is_drawn_as_boxes(tmp_path):
                                          assets=["gone/window.obj"], meta={"grammar": str(tmp_path / "g.cga")}))
     result = render(record, tmp_path / "r.png", size=(40, 40), view="top")
     assert result["missing_assets"] == ["gone/window.obj"] and result["boxes"] == 1
+    assert result["asset_problems"] == [
+        f"asset `gone/window.obj` not found in {tmp_path} (--lod builtin puts a cube in its place)"]
     assert not background(pixels(tmp_path / "r.png"))[20, 20]
+
+
+def test_an_asset_of_a_format_without_its_reader_says_so(tmp_path, monkeypatch):
+    import sys
+
+    monkeypatch.setitem(sys.modules, "assimp_py", None)  # as if it were not installed
+    (tmp_path / "mill.fbx").write_text("; FBX 7.4.0 project file\n")
+    record = read_instances(write_record(tmp_path / "r.npz", [box_xform([0, 0, -1], [1, 1, 1])],
+                                         assets=["mill.fbx"], meta={"grammar": str(tmp_path / "g.cga")}))
+    result = render(record, tmp_path / "r.png", size=(40, 40), view="top")
+    assert result["boxes"] == 1 and result["asset_problems"][0].startswith("unsupported asset format: FBX")
 
 
 def test_an_empty_record_gives_the_sky(tmp_path):

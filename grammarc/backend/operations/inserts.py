@@ -2,7 +2,8 @@
 ``i(name)`` (the shape's geometry becomes the asset) and ``label(name)`` (the shape's solid an occluder).
 
 Reads: the scope (``origin``, ``size``, ``frame``), ``geom``, ``lot``, ``dynamic`` (colour, trim planes,
-occluding ancestors). Writes: ``i`` the ``geom``; ``label`` the ``dynamic`` ancestors.
+occluding ancestors). Writes: ``i`` the ``geom``, and the scope's ``origin`` and ``size`` in the insert modes
+that keep the asset's size; ``label`` the ``dynamic`` ancestors.
 """
 
 from __future__ import annotations
@@ -14,7 +15,7 @@ from grammarc.backend.context import Context
 from grammarc.backend.evaluate import evaluate_array
 from grammarc.backend.occlusion import add_occluders, occluder_label, with_ancestor
 from grammarc.backend.operations.table import operation
-from grammarc.backend.shapes import Shapes, asset_geom
+from grammarc.backend.shapes import Z_UP, Shapes, asset_geom
 from grammarc.ir import nodes as ir
 
 
@@ -26,9 +27,9 @@ def insert(ctx: Context, cursor: Shapes, op: ir.Insert) -> None:
     terminals.emit_instances(ctx, cursor, ctx.plan.grammar.asset_ids[op.asset], ctx.symbol)
 
 
-@operation(ir.UseAsset, writes=("geom",), meshes=True)
+@operation(ir.UseAsset, writes=("origin", "size", "geom"), meshes=True)
 def use_asset(ctx: Context, cursor: Shapes, op: ir.UseAsset) -> Shapes:
-    """The geometry becomes the asset fitted to the scope (a cube is the scope box itself)."""
+    """The geometry becomes the asset placed by the insert mode (``placed``)."""
     plan = ctx.plan
     if op.name is None:
         asset = np.full(len(cursor), plan.grammar.asset_ids[op.asset], dtype=np.int32)
@@ -43,8 +44,55 @@ def use_asset(ctx: Context, cursor: Shapes, op: ir.UseAsset) -> Shapes:
             why = ("a file search that found nothing" if not name else "not an asset of the grammar: a computed "
                    "name is a string constant of an asset file, or a file a search may find")
             ctx.fail(cursor, bad, f"`i` of `{name}`, {why}", op.span)
-    geom = np.where(asset == 0, -1, asset_geom(asset)).astype(np.int32)  # asset 0 is builtin:cube
-    return cursor.with_scope(cursor.origin, cursor.size, cursor.frame, geom)
+    return placed(ctx, cursor, op, asset)
+
+
+def placed(ctx: Context, cursor: Shapes, op: ir.UseAsset, asset: np.ndarray) -> Shapes:
+    """The shapes with asset ids ``asset`` (n,) int32 as their geometry, and their scopes as
+    ``op.mode`` makes them (CityEngine's reference of ``i``):
+
+    - ``alignSizeAndPosition``: the asset fitted to the scope, which is unchanged (a cube is the scope box
+      itself);
+    - ``keepSizeAndPosition``: the scope becomes the asset's bounding box, in the asset's own units and
+      at its own position, both read along the scope's axes (as ``s(0, 0, 0)`` then ``i`` would);
+    - ``keepSizeAlignPosition``: the scope gets the asset's size, centred on the old scope in x and z and
+      standing on its y = 0.
+
+    ``zUp``: the asset turns -90 degrees about x before it is placed (its z is the scope's y), so its
+    bounding box does too.
+    """
+    up = Z_UP if op.up == "zUp" else 0
+    geom = np.where(asset == 0, -1, asset_geom(asset, up)).astype(np.int32)  # asset 0 is builtin:cube
+    if op.mode == ir.INSERT_MODES[0]:
+        return cursor.with_scope(cursor.origin, cursor.size, cursor.frame, geom)
+    low, high = _bounds(ctx, cursor, op, asset)
+    size = high - low
+    if op.mode == "keepSizeAndPosition":
+        offset = low
+    else:
+        offset = (cursor.size - size) * np.array([0.5, 0.0, 0.5])
+    axes = ctx.chunk.frames.data[cursor.frame]  # (n, 3, 3): row j is scope axis j
+    origin = cursor.origin + np.einsum("nj,njr->nr", offset, axes)
+    return cursor.with_scope(origin, size, cursor.frame, geom)
+
+
+def _bounds(ctx: Context, cursor: Shapes, op: ir.UseAsset, asset: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The lowest and highest corners (n, 3) of the shapes' assets' bounding boxes in their own units,
+    turned z-up where ``op`` says; each asset read once. A shape whose asset cannot be loaded fails."""
+    ids, inverse = np.unique(asset, return_inverse=True)
+    table = np.empty((len(ids), 2, 3))
+    for k, a in enumerate(ids.tolist()):
+        mesh = ctx.asset_mesh(a)
+        if mesh is None:
+            ctx.fail(cursor, asset == a, f"`i(..., {op.mode})` needs the asset's size: {ctx.asset_problem(a)}",
+                     op.span)
+        table[k] = mesh.bounds
+    low, high = table[:, 0], table[:, 1]
+    if op.up == "zUp":  # (x, y, z) -> (x, z, -y): the highest y becomes the lowest z
+        low, high = (np.stack([low[:, 0], low[:, 2], -high[:, 1]], axis=1),
+                     np.stack([high[:, 0], high[:, 2], -low[:, 1]], axis=1))
+    rows = inverse.reshape(-1)
+    return low[rows], high[rows]
 
 
 @operation(ir.Label, writes=("dynamic",), meshes=True)

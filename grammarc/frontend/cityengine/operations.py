@@ -147,11 +147,23 @@ class OperationLowering:
         return ()
 
     def op_insert(self, op, args, span):
-        if len(args) != 1:
-            return self.unsupported(f"i with {len(args)} arguments", span, "only i(asset)")
+        """``i(asset[, yUp|zUp[, insertMode[, cleanupMode]]])``; a selector may be written as a string
+        (``"zUp"``), as older rule files do. The cleanup mode changes nothing here: grammarc does not
+        clean up an inserted asset's geometry."""
+        if not 1 <= len(args) <= 4:
+            return self.unsupported(f"i with {len(args)} arguments", span,
+                                    "i(asset[, upAxis[, insertMode[, cleanupMode]]])")
+        choices = (("yUp", "zUp"), ir.INSERT_MODES, ("numericalCleanup", "noCleanup"))
+        chosen = [c[0] for c in choices]  # the defaults
+        for k, (arg, allowed) in enumerate(zip(args[1:], choices)):
+            chosen[k] = arg.name if isinstance(arg, ir.Name) else arg.value if isinstance(arg, ir.Str) else None
+            if chosen[k] not in allowed:
+                return self.unsupported("i with this selector", arg.span, f"one of {', '.join(allowed)} "
+                                        "written out (a computed selector is not supported)")
+        up, mode, _ = chosen
         if isinstance(args[0], ir.Str):
-            return ir.UseAsset(args[0].value, span)
-        return ir.UseAsset("", span, name=self.expr(args[0]))
+            return ir.UseAsset(args[0].value, span, up=up, mode=mode)
+        return ir.UseAsset("", span, name=self.expr(args[0]), up=up, mode=mode)
 
     def op_cube(self, op, args, span):
         if args:

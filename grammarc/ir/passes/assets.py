@@ -24,7 +24,7 @@ from pathlib import Path
 from grammarc.diagnostics import Diagnostics
 from grammarc.errors import AssetError
 from grammarc.ir import nodes as ir
-from grammarc.ir.asset_names import LEAF_CUBE, LEAF_QUAD, resolve_asset
+from grammarc.ir.asset_names import LEAF_CUBE, LEAF_QUAD, resolve_asset, unsupported_format
 from grammarc.ir.file_search import ASSET_SUFFIXES, constant_folder, search
 from grammarc.ir.traverse import all_exprs, iter_exprs, iter_ops
 
@@ -58,6 +58,8 @@ def resolve_assets(module: ir.Module, diags: Diagnostics) -> ir.Module:
         if resolved.problem:
             diags.error("asset", resolved.problem, span)
             continue
+        if resolved.path is not None and unsupported_format(resolved.path):
+            diags.error("asset", unsupported_format(resolved.path), span)
         if resolved.missing:
             diags.warning("asset", f"asset `{name}` not found in {', '.join(str(r) for r in roots)}; the "
                           "record keeps its name", span)

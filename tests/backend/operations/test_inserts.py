@@ -39,3 +39,50 @@ def test_asset_named_by_a_computed_constant(write, const):
     r = run(write, f"const a = {const}\nLot --> extrude(4) i(a)\n", [rect(12, 8)])
     assert r["bad"] == () and len(r["asset"]) == 1
 
+
+
+#: An asset 2 x 3 x 0.5 whose bounding box is [-1, 0, 2] .. [1, 3, 2.5] in its own coordinates.
+POST = "v -1 0 2\nv 1 0 2\nv 1 3 2\nv -1 3 2.5\nf 1 2 3 4\n"
+
+
+@pytest.mark.parametrize("mode, xform", [
+    # the scope of the extruded lot 12 x 4 x 8 (origin (0, 0, -8)) is kept and the asset fitted to it
+    ("yUp, alignSizeAndPosition", [[12, 0, 0, 0], [0, 4, 0, 0], [0, 0, 8, -8]]),
+    # the reference: scope.sx = asset.sx ..., scope.tx += asset.tx ... (as after s(0, 0, 0))
+    ("yUp, keepSizeAndPosition", [[2, 0, 0, -1], [0, 3, 0, 0], [0, 0, 0.5, -6]]),
+    # the asset's size, centred on the scope in x and z ((12 - 2) / 2, (8 - 0.5) / 2), standing on y = 0
+    ("yUp, keepSizeAlignPosition", [[2, 0, 0, 5], [0, 3, 0, 0], [0, 0, 0.5, -4.25]]),
+    # zUp: the unit box turned -90 degrees about x; its columns x, -z, y of the scope
+    ("zUp", [[12, 0, 0, 0], [0, 0, 4, 0], [0, -8, 0, 0]]),
+    # zUp keeping size and position: the box [-1, 2, -3] .. [1, 2.5, 0] once turned
+    ('"zUp", keepSizeAndPosition', [[2, 0, 0, -1], [0, 0, 0.5, 2], [0, -3, 0, -8]]),
+])  # fmt: skip
+def test_insert_modes_place_the_asset_as_the_reference_says(write, mode, xform):
+    write("post.obj", POST)
+    r = run(write, f'Lot --> extrude(4) i("post.obj", {mode}) Post\n', [rect(12, 8)])
+    assert r["bad"] == () and assets(r) == ["post.obj"]
+    np.testing.assert_allclose(r["xform"][0], xform, atol=1e-6)
+
+
+def test_the_scope_after_a_mode_that_keeps_the_size_is_the_asset_box(write):
+    """Operations after ``i`` see the new scope: a split of the post's own 2 m width."""
+    write("post.obj", POST)
+    r = run(write, 'Lot --> extrude(4) i("post.obj", zUp, keepSizeAlignPosition) split(x){ 0.5 : A | ~1 : B }\n'
+                   'A --> primitiveCube() X\nB --> primitiveCube() Y\n', [rect(12, 8)])
+    assert names(r) == ["X", "Y"]
+    np.testing.assert_allclose(r["xform"][:, 0, 0], [0.5, 1.5])
+    np.testing.assert_allclose(r["xform"][:, :, 3], [[5, 0, -5.5], [5.5, 0, -5.5]])  # -8 + (8 - 3) / 2
+
+
+def test_a_mode_that_keeps_the_size_of_an_asset_that_cannot_be_loaded_fails_the_lot(write):
+    r = run(write, 'Lot --> extrude(4) i("gone.obj", yUp, keepSizeAndPosition)\n', [rect(12, 8)])
+    assert len(r["bad"]) == 1
+    assert "`i(..., keepSizeAndPosition)` needs the asset's size: asset `gone.obj` not found" in r["bad"][0].reason
+
+
+def test_a_z_up_asset_turns_in_its_box_before_a_mirror_of_the_scope(write):
+    """mirror(false, true, false) after i(a, zUp) flips the turned asset upside down: its top (its own
+    +z) lands at the scope's y = 0, the order CityEngine's reference gives (the asset is turned as read)."""
+    write("post.obj", POST)
+    r = run(write, 'Lot --> extrude(4) i("post.obj", zUp) mirror(false, true, false) Post\n', [rect(12, 8)])
+    np.testing.assert_allclose(r["xform"][0], [[12, 0, 0, 0], [0, 0, -4, 4], [0, -8, 0, 0]], atol=1e-6)
