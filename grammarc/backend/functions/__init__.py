@@ -8,6 +8,9 @@ families, as that table groups them:
 - ``strings``: ``str``, ``float``, ``bool``, ``len``, and string concatenation;
 - ``lists``: the ``;``-separated string lists;
 - ``files``: ``fileRandom``;
+- ``tables``: ``readTextFile``, ``readStringTable``, ``readFloatTable`` of the grammar's folders;
+- ``colors``: ``colorRamp`` and the conversions between colour strings, RGB and HSV;
+- ``coordinates``: ``convert`` between coordinate systems, ``initialShape.name`` and ``startRule``;
 - ``geometry``: ``geometry.area``... of the shape's geometry;
 - ``arrays``: CityEngine's arrays.
 
@@ -17,11 +20,14 @@ package registers them.
 
 from grammarc.backend.functions import (  # noqa: F401 - each registers its functions
     arrays,
+    colors,
+    coordinates,
     files,
     geometry,
     lists,
     math,
     strings,
+    tables,
 )
 from grammarc.backend.functions.table import FUNCTIONS
 

@@ -45,7 +45,7 @@ from grammarc.frontend.cityengine.operations import (
 )
 from grammarc.frontend.lowering import LoweringBase
 from grammarc.ir import nodes as ir
-from grammarc.ir.functions import FUNCTIONS
+from grammarc.ir.functions import CONVERT_SELECTORS, FUNCTIONS
 
 #: The annotations of CityEngine's CGA reference ("Annotations", 2019-2025).
 ANNOTATIONS = frozenset((
@@ -59,6 +59,8 @@ SCOPE_MEMBERS = {
     **{f"scope.{f}": f for f in ("sx", "sy", "sz", "tx", "ty", "tz", "rx", "ry", "rz")},
     "initialShape.origin.px": "ox", "initialShape.origin.py": "oy", "initialShape.origin.pz": "oz",
 }
+#: ``initialShape.origin.o{x|y|z}``: the lot's orientation, a component of ``convert``'s.
+INITIAL_ORIENTATION = {f"initialShape.origin.o{c}": c for c in "xyz"}
 #: Shape queries without arguments, written as members (``geometry.area``) or calls (``geometry.area()``).
 GEOMETRY_QUERIES = ("geometry.area", "geometry.volume", "geometry.nVertices", "geometry.nFaces")
 
@@ -382,6 +384,12 @@ class Lowering(OperationLowering, LoweringBase):
             return ir.Call(text, (), span, self.site())
         if text in ir.CONTEXT_FIELDS:
             return ir.ContextRef(text, span)
+        if text in ("initialShape.name", "initialShape.startRule"):
+            return ir.Call(text, (), span, self.site())
+        if text in INITIAL_ORIENTATION:  # the lot's orientation in world: its object system's
+            zero = ir.Num(0.0, span)
+            return self.convert((ir.Name(INITIAL_ORIENTATION[text], span), ir.Name("object", span),
+                                 ir.Name("world", span), ir.Name("orient", span), zero, zero, zero), span)
         if names[0] in UNSUPPORTED_MEMBERS:
             self.unsupported(text, span)
             return ir.placeholder(span)
@@ -410,7 +418,25 @@ class Lowering(OperationLowering, LoweringBase):
             return ir.Call("p", args, span, self.site())
         if func == "fileRandom" and not args:
             return ir.Call("fileRandom", (), span, 0)  # one draw per lot for the whole file
+        if func == "convert":
+            return self.convert(args, span)
         return ir.Call(func, args, span, self.site())
+
+    def convert(self, args, span) -> ir.Expr:
+        """``convert(x|y|z, from, to, pos|orient, x, y, z)`` with its keywords as strings, and
+        ``convert(from, to, pos|orient, coordinates)`` as the array of the three components' calls."""
+        if len(args) == 4:
+            coordinates = tuple(ir.Index(args[3], ir.Num(float(i), span), None, span) for i in range(3))
+            return ir.ArrayLit((tuple(self.convert((ir.Name(c, span), *args[:3], *coordinates), span)
+                                      for c in "xyz"),), span)
+        if len(args) != 7 or not all(isinstance(a, ir.Name) and a.name in keywords
+                                     for a, keywords in zip(args, CONVERT_SELECTORS)):
+            self.unsupported("convert with these arguments", span, "convert(x|y|z, scope|pivot|object|world, "
+                             "scope|pivot|object|world, pos|orient, x, y, z) or convert(from, to, pos|orient, "
+                             "[x, y, z])")
+            return ir.placeholder(span)
+        selectors = tuple(ir.Str(a.name, a.span) for a in args[:4])
+        return ir.Call("convert", selectors + tuple(args[4:]), span, self.site())
 
     def occlusion(self, kind: str, args, span) -> ir.Expr:
         """``inside`` / ``overlaps`` / ``touches([intra|inter|all[, "label"]])``."""
