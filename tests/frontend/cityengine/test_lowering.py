@@ -186,7 +186,7 @@ def _exprs(e):
     ("Lot --> case inside(near) : A else : B", "inside with these arguments", "inside"),
     ("Lot --> case touches(all, 3) : A else : B", "touches with these arguments", "touches"),
     ("Lot --> extrude(geometry.height) A", "geometry.height", "geometry"),
-    ("Lot --> extrude(initialShape.startRule) A", "initialShape.startRule", "initialShape"),
+    ("Lot --> extrude(initialShape.origin.qx) A", "initialShape.origin.qx", "initialShape"),
     ("Lot --> extrude(geometry.du(0, unitSpace)) A", "geometry.du()", "geometry"),
     ("Lot --> F([3, 4])\nF(h) --> extrude(h[0])", "an array as argument 1 of `F`", "["),
     ('Lot --> report("h", [3, 4])', "an array as a reported value", "["),
