@@ -60,6 +60,7 @@ FUNCTIONS: dict[str, Signature] = {
                                       "acos", "atan", "exp", "log", "log10")},
     **{name: _numeric(2) for name in ("atan2", "pow", "min", "max")},
     "isnan": Signature((T.NUM,), T.BOOL),
+    "isinf": Signature((T.NUM,), T.BOOL),
     "rand": Signature((T.NUM, T.NUM), T.NUM, optional=2, shape=True),
     "p": Signature((T.NUM,), T.BOOL, shape=True),
     # ------------------------------------------------------------------------------ strings (backend.functions.strings)

@@ -35,9 +35,9 @@ def probability(call, args, env: Env):
     return uniform(env.shapes.key, call.site) < np.asarray(args[0], dtype=np.float64)
 
 
-@function("isnan")
+@function("isnan", "isinf")
 def isnan(call, args, env: Env):
-    return np.isnan(np.asarray(args[0], dtype=np.float64))
+    return getattr(np, call.func)(np.asarray(args[0], dtype=np.float64))
 
 
 @function("log10")

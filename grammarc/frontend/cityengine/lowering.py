@@ -420,6 +420,8 @@ class Lowering(OperationLowering, LoweringBase):
             return ir.Call("fileRandom", (), span, 0)  # one draw per lot for the whole file
         if func == "convert":
             return self.convert(args, span)
+        if func == "print" and len(args) == 1:  # prints its value and gives it back: printing is not applied
+            return args[0]
         return ir.Call(func, args, span, self.site())
 
     def convert(self, args, span) -> ir.Expr:
