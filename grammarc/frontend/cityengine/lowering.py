@@ -426,19 +426,21 @@ class Lowering(OperationLowering, LoweringBase):
 
     def convert(self, args, span) -> ir.Expr:
         """``convert(x|y|z, from, to, pos|orient, x, y, z)`` with its keywords as strings, and
-        ``convert(from, to, pos|orient, coordinates)`` as the array of the three components' calls."""
-        if len(args) == 4:
-            coordinates = tuple(ir.Index(args[3], ir.Num(float(i), span), None, span) for i in range(3))
-            return ir.ArrayLit((tuple(self.convert((ir.Name(c, span), *args[:3], *coordinates), span)
-                                      for c in "xyz"),), span)
-        if len(args) != 7 or not all(isinstance(a, ir.Name) and a.name in keywords
-                                     for a, keywords in zip(args, CONVERT_SELECTORS)):
+        ``convert(from, to, pos|orient, coordinates)`` as the array of its three components' calls."""
+        on_array = len(args) == 4
+        keywords = (ir.Name("x", span), *args[:3]) if on_array else args[:4]
+        if len(args) not in (4, 7) or not all(isinstance(a, ir.Name) and a.name in allowed
+                                              for a, allowed in zip(keywords, CONVERT_SELECTORS)):
             self.unsupported("convert with these arguments", span, "convert(x|y|z, scope|pivot|object|world, "
                              "scope|pivot|object|world, pos|orient, x, y, z) or convert(from, to, pos|orient, "
                              "[x, y, z])")
             return ir.placeholder(span)
-        selectors = tuple(ir.Str(a.name, a.span) for a in args[:4])
-        return ir.Call("convert", selectors + tuple(args[4:]), span, self.site())
+        systems = tuple(ir.Str(a.name, a.span) for a in keywords[1:])
+        if not on_array:
+            return ir.Call("convert", (ir.Str(args[0].name, args[0].span), *systems, *args[4:]), span, self.site())
+        values = tuple(ir.Index(args[3], ir.Num(float(i), span), None, span) for i in range(3))
+        return ir.ArrayLit((tuple(ir.Call("convert", (ir.Str(c, span), *systems, *values), span, self.site())
+                                  for c in "xyz"),), span)
 
     def occlusion(self, kind: str, args, span) -> ir.Expr:
         """``inside`` / ``overlaps`` / ``touches([intra|inter|all[, "label"]])``."""

@@ -91,7 +91,9 @@ def test_initial_shape_name_start_rule_and_orientation(write):
 
 
 @pytest.mark.parametrize("call", ["convert(w, scope, world, pos, 0, 0, 0)", "convert(x, scope, world, 0, 0, 0)",
-                                  "convert(x, scope, earth, pos, 0, 0, 0)", 'convert("x", scope, world, pos, 0, 0, 0)'])
+                                  "convert(x, scope, earth, pos, 0, 0, 0)", 'convert("x", scope, world, pos, 0, 0, 0)',
+                                  "convert(scope, world, angle, [0, 0, 0])"])
 def test_convert_takes_its_keywords(write, call):
-    with pytest.raises(GrammarError, match="unsupported: convert with these arguments"):
+    with pytest.raises(GrammarError, match="unsupported: convert with these arguments") as error:
         reported(write, f'Lot --> report("k", {call}) X\n')
+    assert len([d for d in error.value.diagnostics if d.is_error]) == 1
