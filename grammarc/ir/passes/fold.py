@@ -28,7 +28,7 @@ PURE = {
     "tan": lambda d: math.tan(math.radians(d)),
     "asin": lambda x: math.degrees(math.asin(x)), "acos": lambda x: math.degrees(math.acos(x)),
     "atan": lambda x: math.degrees(math.atan(x)), "atan2": lambda y, x: math.degrees(math.atan2(y, x)),
-    "pow": math.pow, "min": min, "max": max, "log10": math.log10, "isnan": math.isnan,
+    "pow": math.pow, "min": min, "max": max, "log10": math.log10, "isnan": math.isnan, "isinf": math.isinf,
 }
 _CONSTANT = (ir.Num, ir.Str, ir.Bool)
 
