@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from grammarc.backend import arrays, occlusion
+from grammarc.backend import arrays, euler, occlusion
 from grammarc.backend.arrays import Arrays
 from grammarc.backend.env import Env
 from grammarc.backend.functions import FUNCTIONS
@@ -193,14 +193,10 @@ def _scope_field(name: str, env: Env):
 
 def _scope_angles(env: Env) -> np.ndarray:
     """The scope's rotation relative to its lot's scope, as angles (n, 3) in degrees about x, then y,
-    then z (the order of ``R``): the inverse of ``operations.scope._rotation``."""
+    then z (the order of ``R``)."""
     relative = np.einsum("nij,nkj->nik", env.chunk.frames[env.shapes.frame],
                          env.chunk.lot_axes[env.shapes.lot])  # rows: new axes in the lot's frame
-    # relative = Rz @ Ry @ Rx with rows as in operations.scope._rotation; read the angles off its entries
-    ry = np.degrees(np.arcsin(np.clip(-relative[:, 0, 2], -1.0, 1.0)))
-    rx = np.degrees(np.arctan2(relative[:, 1, 2], relative[:, 2, 2]))
-    rz = np.degrees(np.arctan2(relative[:, 0, 1], relative[:, 0, 0]))
-    return np.stack([rx, ry, rz], axis=1)
+    return euler.angles(relative)
 
 
 def _call(expr: ir.Call, env: Env):

@@ -49,6 +49,11 @@ def _numeric(count: int) -> Signature:
     return Signature((T.NUM,) * count, T.NUM)
 
 
+#: The keywords ``convert`` takes for its coordinate, the systems it converts from and to, and what it converts.
+CONVERT_SELECTORS = (("x", "y", "z"), ("scope", "pivot", "object", "world"), ("scope", "pivot", "object", "world"),
+                     ("pos", "orient"))
+
+
 FUNCTIONS: dict[str, Signature] = {
     # ------------------------------------------------------------------------------------ math (backend.functions.math)
     **{name: _numeric(1) for name in ("floor", "ceil", "round", "abs", "sqrt", "sin", "cos", "tan", "asin",
@@ -90,7 +95,22 @@ FUNCTIONS: dict[str, Signature] = {
     "imageBestRatio": Signature((T.STR, T.STR), T.STR, shape=True),
     "imageApproxRatio": Signature((T.STR, T.STR, T.NUM), T.STR, shape=True),
     # ---------------------------------------------------------------------------- tables (backend.functions.tables)
+    "readTextFile": Signature((T.STR,), T.STR),
+    "readStringTable": Signature((T.STR,), T.STRS),
+    "readFloatTable": Signature((T.STR,), T.NUMS),
     # ---------------------------------------------------------------------------- colours (backend.functions.colors)
+    "colorRamp": Signature((T.STR, T.NUM), T.STR),
+    "colorRGBToHex": Signature((T.NUM,) * 3, T.STR),
+    "colorRGBOToHex": Signature((T.NUM,) * 4, T.STR),
+    "colorHSVToHex": Signature((T.NUM,) * 3, T.STR),
+    "colorHSVOToHex": Signature((T.NUM,) * 4, T.STR),
+    **{f"colorHexTo{c}": Signature((T.STR,), T.NUM) for c in "RGBOHSV"},
+    # ---------------------------------------- coordinates and the initial shape (backend.functions.coordinates)
+    # ``convert``'s first four arguments are its selectors as strings (``CONVERT_SELECTORS``): the lowering
+    # makes them of CityEngine's keywords, and turns the form on an array into three calls
+    "convert": Signature((T.STR,) * 4 + (T.NUM,) * 3, T.NUM, shape=True),
+    "initialShape.name": Signature((), T.STR, shape=True),
+    "initialShape.startRule": Signature((), T.STR),
     # ------------------------------------------------------------------------ geometry (backend.functions.geometry)
     "geometry.area": Signature((), T.NUM, shape=True),
     "geometry.volume": Signature((), T.NUM, shape=True),

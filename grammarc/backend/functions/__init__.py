@@ -10,6 +10,9 @@ families, as that table groups them:
 - ``files``: searches in the grammar's roots (``fileSearch``, ``fileRandom``...) and paths taken apart;
 - ``assets``: an asset's size (``assetInfo``) and assets chosen by how they fit the scope;
 - ``images``: an image's resolution (``imageInfo``) and images chosen by their proportions;
+- ``tables``: ``readTextFile``, ``readStringTable``, ``readFloatTable`` of the grammar's folders;
+- ``colors``: ``colorRamp`` and the conversions between colour strings, RGB and HSV;
+- ``coordinates``: ``convert`` between coordinate systems, ``initialShape.name`` and ``startRule``;
 - ``geometry``: ``geometry.area``... of the shape's geometry;
 - ``arrays``: CityEngine's arrays.
 
@@ -20,12 +23,15 @@ package registers them.
 from grammarc.backend.functions import (  # noqa: F401 - each registers its functions
     arrays,
     assets,
+    colors,
+    coordinates,
     files,
     geometry,
     images,
     lists,
     math,
     strings,
+    tables,
 )
 from grammarc.backend.functions.table import FUNCTIONS
 

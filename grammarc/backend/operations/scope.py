@@ -13,8 +13,8 @@ from __future__ import annotations
 import numpy as np
 
 from grammarc.backend.context import Context
+from grammarc.backend.euler import rotation
 from grammarc.backend.evaluate import evaluate, evaluate_array
-from grammarc.backend.functions.math import elementwise
 from grammarc.backend.operations.table import operation
 from grammarc.backend.outlines import flat_axis, polygons_of
 from grammarc.backend.reframing import reframed, turned
@@ -56,12 +56,12 @@ def rotate(ctx: Context, cursor: Shapes, op: ir.Rotate) -> Shapes:
     if all(np.ndim(a) == 0 for a in angles):
         # One rotation for all: rotate each distinct frame once.
         unique, inverse = np.unique(cursor.frame, return_inverse=True)
-        matrix = _rotation(*(np.full(1, a, dtype=np.float64) for a in angles))[0]
+        matrix = rotation(*(np.full(1, a, dtype=np.float64) for a in angles))[0]
         new = frames.add(np.einsum("ij,fjk->fik", matrix, frames[unique]))
         frame = new[inverse.reshape(-1)]
     else:
         n = len(cursor)
-        matrices = _rotation(*(np.broadcast_to(np.asarray(a, np.float64), (n,)) for a in angles))
+        matrices = rotation(*(np.broadcast_to(np.asarray(a, np.float64), (n,)) for a in angles))
         frame = frames.add(np.einsum("nij,njk->nik", matrices, frames[cursor.frame]))
     return cursor.with_scope(cursor.origin, cursor.size, frame, cursor.geom)
 
@@ -117,7 +117,7 @@ def align_scope(ctx: Context, cursor: Shapes, op: ir.AlignScope) -> Shapes:
     elif op.mode == "rotate":
         env = ctx.env(cursor)
         angles = [np.broadcast_to(evaluate_array(e, env), (n,)) for e in op.angles]
-        new_axes = np.einsum("nij,njk->nik", _rotation(*angles), axes)
+        new_axes = np.einsum("nij,njk->nik", rotation(*angles), axes)
     else:
         new_axes = _geometry_axes(ctx, cursor, op, axes)
     return reframed(ctx, cursor, new_axes, op.span)
@@ -182,26 +182,3 @@ def mirror(ctx: Context, cursor: Shapes, op: ir.Mirror) -> Shapes:
         coords = np.where(once[:, None], comp_kernels.reverse_rings(coords, ring_offsets), coords)
         geom[poly] = store.add(coords, ring_offsets, poly_offsets, plane)
     return cursor.with_scope(cursor.origin, cursor.size, cursor.frame, geom)
-
-
-def _rotation(ax: np.ndarray, ay: np.ndarray, az: np.ndarray) -> np.ndarray:
-    """(n, 3, 3) matrices M with new axes = M @ axes: about x, then the new y, then the new z (degrees)."""
-    n = len(ax)
-    out = np.empty((n, 3, 3))
-    cx, sx = _cos_sin(ax)
-    cy, sy = _cos_sin(ay)
-    cz, sz = _cos_sin(az)
-    one, zero = np.ones(n), np.zeros(n)
-    mx = np.stack([np.stack([one, zero, zero], 1), np.stack([zero, cx, sx], 1),
-                   np.stack([zero, -sx, cx], 1)], 1)
-    my = np.stack([np.stack([cy, zero, -sy], 1), np.stack([zero, one, zero], 1),
-                   np.stack([sy, zero, cy], 1)], 1)
-    mz = np.stack([np.stack([cz, sz, zero], 1), np.stack([-sz, cz, zero], 1),
-                   np.stack([zero, zero, one], 1)], 1)
-    np.matmul(mz, np.matmul(my, mx), out=out)
-    return out
-
-
-def _cos_sin(degrees: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    d = np.ascontiguousarray(degrees, dtype=np.float64)
-    return elementwise(1, d), elementwise(0, d)

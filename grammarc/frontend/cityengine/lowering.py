@@ -45,7 +45,7 @@ from grammarc.frontend.cityengine.operations import (
 )
 from grammarc.frontend.lowering import LoweringBase
 from grammarc.ir import nodes as ir
-from grammarc.ir.functions import FUNCTIONS
+from grammarc.ir.functions import CONVERT_SELECTORS, FUNCTIONS
 
 #: The annotations of CityEngine's CGA reference ("Annotations", 2019-2025).
 ANNOTATIONS = frozenset((
@@ -68,6 +68,8 @@ SELECTOR_ARGUMENTS = {
     **dict.fromkeys(("assetsSortSize", "assetsSortRatio", "imagesSortRatio"),
                     (1, frozenset({"x", "y", "z", "xy", "xz", "yz", "xyz", "yx", "zx", "zy"}))),
 }
+#: ``initialShape.origin.o{x|y|z}``: the lot's orientation, a component of ``convert``'s.
+INITIAL_ORIENTATION = {f"initialShape.origin.o{c}": c for c in "xyz"}
 #: Shape queries without arguments, written as members (``geometry.area``) or calls (``geometry.area()``).
 GEOMETRY_QUERIES = ("geometry.area", "geometry.volume", "geometry.nVertices", "geometry.nFaces")
 
@@ -389,6 +391,12 @@ class Lowering(OperationLowering, LoweringBase):
             return ir.Call(text, (), span, self.site())
         if text in ir.CONTEXT_FIELDS:
             return ir.ContextRef(text, span)
+        if text in ("initialShape.name", "initialShape.startRule"):
+            return ir.Call(text, (), span, self.site())
+        if text in INITIAL_ORIENTATION:  # the lot's orientation in world: its object system's
+            zero = ir.Num(0.0, span)
+            return self.convert((ir.Name(INITIAL_ORIENTATION[text], span), ir.Name("object", span),
+                                 ir.Name("world", span), ir.Name("orient", span), zero, zero, zero), span)
         if names[0] in UNSUPPORTED_MEMBERS:
             self.unsupported(text, span)
             return ir.placeholder(span)
@@ -418,7 +426,27 @@ class Lowering(OperationLowering, LoweringBase):
         index, keywords = SELECTOR_ARGUMENTS.get(func, (-1, ()))
         if 0 <= index < len(args) and isinstance(args[index], ir.Name) and args[index].name in keywords:
             args = args[:index] + (ir.Str(args[index].name, args[index].span),) + args[index + 1:]
+        if func == "convert":
+            return self.convert(args, span)
         return ir.Call(func, args, span, self.site())
+
+    def convert(self, args, span) -> ir.Expr:
+        """``convert(x|y|z, from, to, pos|orient, x, y, z)`` with its keywords as strings, and
+        ``convert(from, to, pos|orient, coordinates)`` as the array of its three components' calls."""
+        on_array = len(args) == 4
+        keywords = (ir.Name("x", span), *args[:3]) if on_array else args[:4]
+        if len(args) not in (4, 7) or not all(isinstance(a, ir.Name) and a.name in allowed
+                                              for a, allowed in zip(keywords, CONVERT_SELECTORS)):
+            self.unsupported("convert with these arguments", span, "convert(x|y|z, scope|pivot|object|world, "
+                             "scope|pivot|object|world, pos|orient, x, y, z) or convert(from, to, pos|orient, "
+                             "[x, y, z])")
+            return ir.placeholder(span)
+        systems = tuple(ir.Str(a.name, a.span) for a in keywords[1:])
+        if not on_array:
+            return ir.Call("convert", (ir.Str(args[0].name, args[0].span), *systems, *args[4:]), span, self.site())
+        values = tuple(ir.Index(args[3], ir.Num(float(i), span), None, span) for i in range(3))
+        return ir.ArrayLit((tuple(ir.Call("convert", (ir.Str(c, span), *systems, *values), span, self.site())
+                                  for c in "xyz"),), span)
 
     def occlusion(self, kind: str, args, span) -> ir.Expr:
         """``inside`` / ``overlaps`` / ``touches([intra|inter|all[, "label"]])``."""

@@ -172,6 +172,21 @@ def test_brackets_in_bodies_are_still_push_and_pop():
         "[ T(@a[0], 0, 0) A ] [ B ] C"
 
 
+def test_convert_initial_shape_and_print_lower_to_calls():
+    """``convert``'s keywords become strings, its form on an array three calls; ``initialShape.origin.o*``
+    is the lot's orientation; the ``print`` function is a call that gives its argument."""
+    module = module_of(VERSION + "attr a = convert(x, scope, world, pos, 1, 2, 3)\n"
+                       "attr b = convert(scope, pivot, orient, [1, 2, 3])\nattr c = initialShape.origin.oy\n"
+                       "attr d = initialShape.name + initialShape.startRule\nattr e = print(2) + 1\nLot --> A\n")
+    printed = {a.name: print_expr(a.default) for a in module.attrs}
+    assert printed["a"] == 'convert("x", "scope", "world", "pos", 1, 2, 3)'
+    assert printed["b"] == "[" + ", ".join(f'convert("{c}", "scope", "pivot", "orient", [1, 2, 3][0], '
+                                           '[1, 2, 3][1], [1, 2, 3][2])' for c in "xyz") + "]"
+    assert printed["c"] == 'convert("y", "object", "world", "orient", 0, 0, 0)'
+    assert printed["d"] == "(initialShape.name() + initialShape.startRule())"
+    assert printed["e"] == "(print(2) + 1)"
+
+
 def test_context_attributes_lower_to_context_refs():
     module = module_of(VERSION + 'Lot --> comp(f){ side : Side }\nSide --> report("i", comp.index) '
                        'report("n", comp.total) report("s", comp.sel == "left") split(x){ 1 : Part }*\n'
@@ -195,7 +210,7 @@ def _exprs(e):
     ("Lot --> case inside(near) : A else : B", "inside with these arguments", "inside"),
     ("Lot --> case touches(all, 3) : A else : B", "touches with these arguments", "touches"),
     ("Lot --> extrude(geometry.height) A", "geometry.height", "geometry"),
-    ("Lot --> extrude(initialShape.startRule) A", "initialShape.startRule", "initialShape"),
+    ("Lot --> extrude(initialShape.origin.qx) A", "initialShape.origin.qx", "initialShape"),
     ("Lot --> extrude(geometry.du(0, unitSpace)) A", "geometry.du()", "geometry"),
     ("Lot --> F([3, 4])\nF(h) --> extrude(h[0])", "an array as argument 1 of `F`", "["),
     ('Lot --> report("h", [3, 4])', "an array as a reported value", "["),
