@@ -71,11 +71,16 @@ FUNCTIONS: dict[str, Signature] = {
     # ---------------------------------------------------------------------------- tables (backend.functions.tables)
     # ---------------------------------------------------------------------------- colours (backend.functions.colors)
     # ------------------------------------------------------------------------ geometry (backend.functions.geometry)
-    "geometry.area": Signature((), T.NUM, shape=True),
-    "geometry.volume": Signature((), T.NUM, shape=True),
+    # a selector argument (``top``, ``world.up``, ``maxSlope``) is its name as a constant string
+    "geometry.area": Signature((T.STR,), T.NUM, optional=1, shape=True),
+    "geometry.angle": Signature((T.STR,), T.NUM, shape=True),
+    "geometry.isOriented": Signature((T.STR,), T.BOOL, shape=True),
+    "geometry.isPlanar": Signature((T.NUM,), T.BOOL, shape=True),
     "geometry.isRectangular": Signature((T.NUM,), T.BOOL, shape=True),
-    "geometry.nVertices": Signature((), T.NUM, shape=True),
-    "geometry.nFaces": Signature((), T.NUM, shape=True),
+    **{f"geometry.{name}": Signature((), T.NUM, shape=True)
+       for name in ("volume", "nVertices", "nFaces", "nEdges", "nHoles", "boundaryLength", "height")},
+    **{f"geometry.{name}": Signature((), T.BOOL, shape=True)
+       for name in ("isConcave", "isClosedSurface", "isInstanced")},
     # ---------------------------------------------------------------------------------- arrays (backend.functions.arrays)
     # their argument types, and some result types, depend on the arguments' (``passes.types``); the type here
     # is that of ``size``, ``nRows``, ``nColumns`` and ``findFirst``

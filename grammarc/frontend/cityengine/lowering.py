@@ -60,7 +60,24 @@ SCOPE_MEMBERS = {
     "initialShape.origin.px": "ox", "initialShape.origin.py": "oy", "initialShape.origin.pz": "oz",
 }
 #: Shape queries without arguments, written as members (``geometry.area``) or calls (``geometry.area()``).
-GEOMETRY_QUERIES = ("geometry.area", "geometry.volume", "geometry.nVertices", "geometry.nFaces")
+GEOMETRY_QUERIES = frozenset(name for name, signature in FUNCTIONS.items()
+                             if name.startswith("geometry.") and signature.least == 0)
+#: The faces ``geometry.isOriented`` checks for, by their normals, as ``comp(f)`` selects them.
+_ORIENTATIONS = frozenset(
+    {f"{frame}{s}" for frame in ("", "object.") for s in ("front", "back", "left", "right", "top", "bottom", "side")}
+    | {f"world.{s}" for s in ("north", "south", "west", "east", "up", "down", "side")}
+    | {f"street.{s}" for s in ("front", "back", "left", "right", "side")})
+#: The selector of each geometry query that takes one: the faces it measures, or the angle it gives.
+GEOMETRY_SELECTORS = {
+    "geometry.area": _ORIENTATIONS | {"all", "surface"},
+    "geometry.isOriented": _ORIENTATIONS,
+    "geometry.angle": frozenset({"maxSlope", "azimuth", "zenith"}),
+}
+#: CityEngine's compass selectors as the scope's names in the world's frame (north is -z, east +x).
+WORLD_DIRECTIONS = {"world.north": "world.back", "world.south": "world.front", "world.east": "world.right",
+                    "world.west": "world.left", "world.up": "world.top", "world.down": "world.bottom"}
+#: Texture-coordinate queries: grammarc keeps no texture coordinates yet.
+UV_QUERIES = frozenset(f"geometry.{name}" for name in ("du", "dv", "uMin", "uMax", "vMin", "vMax"))
 
 
 @v_args(inline=True, meta=True)
@@ -382,6 +399,8 @@ class Lowering(OperationLowering, LoweringBase):
             return ir.Call(text, (), span, self.site())
         if text in ir.CONTEXT_FIELDS:
             return ir.ContextRef(text, span)
+        if text in UV_QUERIES:
+            return self.uv_query(text, span)
         if names[0] in UNSUPPORTED_MEMBERS:
             self.unsupported(text, span)
             return ir.placeholder(span)
@@ -392,12 +411,32 @@ class Lowering(OperationLowering, LoweringBase):
     def member_function(self, meta, dotted, args):
         names, span = dotted
         text = ".".join(names)
-        if text in GEOMETRY_QUERIES and not args:
-            return ir.Call(text, (), span, self.site())
-        if text == "geometry.isRectangular" and len(args or ()) <= 1:
-            tolerance = self.expr(args[0]) if args else ir.Num(0.0, span)
-            return ir.Call(text, (tolerance,), span, self.site())
+        args = tuple(self.expr(a) for a in args or ())
+        if text in UV_QUERIES:
+            return self.uv_query(f"{text}()", span)
+        if text in GEOMETRY_SELECTORS and len(args) == 1:
+            return self.geometry_selector(text, args[0], span)
+        if text == "geometry.isRectangular" and not args:
+            args = (ir.Num(0.0, span),)
+        if text.startswith("geometry.") and text in FUNCTIONS:  # the checker checks the arguments
+            return ir.Call(text, args, span, self.site())
         self.unsupported(f"{text}()", span)
+        return ir.placeholder(span)
+
+    def geometry_selector(self, query: str, value: ir.Expr, span: Span) -> ir.Expr:
+        """``geometry.area(top)``, ``geometry.angle(azimuth)``: the selector as a constant string, the
+        compass directions as the world frame's faces (``WORLD_DIRECTIONS``)."""
+        known = GEOMETRY_SELECTORS[query]
+        if not isinstance(value, ir.Name) or value.name not in known:
+            name = value.name if isinstance(value, ir.Name) else "this"
+            self.unsupported(f"{query} selector `{name}`", value.span,
+                             f"{query} selects {', '.join(sorted(known))}" + suggest(name, known))
+            return ir.placeholder(span)
+        selector = ir.Str(WORLD_DIRECTIONS.get(value.name, value.name), value.span)
+        return ir.Call(query, (selector,), span, self.site())
+
+    def uv_query(self, name: str, span: Span) -> ir.Expr:
+        self.unsupported(name, span, "texture coordinates: grammarc keeps none yet")
         return ir.placeholder(span)
 
     def function(self, meta, name, args):

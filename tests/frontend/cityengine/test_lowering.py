@@ -185,9 +185,10 @@ def _exprs(e):
 @pytest.mark.parametrize("line, name, at", [
     ("Lot --> case inside(near) : A else : B", "inside with these arguments", "inside"),
     ("Lot --> case touches(all, 3) : A else : B", "touches with these arguments", "touches"),
-    ("Lot --> extrude(geometry.height) A", "geometry.height", "geometry"),
+    ("Lot --> extrude(geometry.uMin) A", "geometry.uMin", "geometry"),
     ("Lot --> extrude(initialShape.startRule) A", "initialShape.startRule", "initialShape"),
     ("Lot --> extrude(geometry.du(0, unitSpace)) A", "geometry.du()", "geometry"),
+    ("Lot --> extrude(geometry.area(north)) A", "geometry.area selector `north`", "north"),
     ("Lot --> F([3, 4])\nF(h) --> extrude(h[0])", "an array as argument 1 of `F`", "["),
     ('Lot --> report("h", [3, 4])', "an array as a reported value", "["),
 ])
