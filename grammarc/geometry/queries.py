@@ -237,6 +237,28 @@ def planar_faces(verts, ring_offsets, face_offsets, vector, degrees):
     return out
 
 
+@njit(cache=True, nogil=True)
+def rectangular_faces(verts, ring_offsets, face_offsets, degrees):
+    """Whether each face is a rectangle (F,): one ring of 4 corners, without holes, each a right angle
+    within ``degrees`` (the cosine between the edges that meet there at most the sine of ``degrees``)."""
+    bound = np.sin(np.radians(degrees)) + 1e-9
+    n_faces = len(face_offsets) - 1
+    out = np.zeros(n_faces, np.bool_)
+    for f in range(n_faces):
+        r0, r1 = ring_offsets[face_offsets[f]], ring_offsets[face_offsets[f] + 1]
+        if face_offsets[f + 1] - face_offsets[f] != 1 or r1 - r0 != 4:
+            continue
+        out[f] = True
+        for j in range(r0, r1):
+            before = verts[j] - verts[r0 + (j - r0 - 1) % 4]
+            after = verts[r0 + (j - r0 + 1) % 4] - verts[j]
+            scale = max(np.sqrt((before ** 2).sum() * (after ** 2).sum()), 1e-300)
+            if abs((before * after).sum()) / scale > bound:
+                out[f] = False
+                break
+    return out
+
+
 def shared_edges(faces: Faces, n: int):
     """The edges of each of ``n`` shapes' faces, an edge two faces share counted once: their number (n,)
     float64, the summed length of the boundary edges (n,) (those of one face only), and whether every

@@ -8,7 +8,15 @@ import pytest
 
 from grammarc.geometry.meshes import MESH_BASE, MeshStore
 from grammarc.geometry.polygons import PolygonStore
-from grammarc.geometry.queries import Faces, face_shapes, planar_faces, shape_any, shape_faces, shared_edges
+from grammarc.geometry.queries import (
+    Faces,
+    face_shapes,
+    planar_faces,
+    rectangular_faces,
+    shape_any,
+    shape_faces,
+    shared_edges,
+)
 
 #: Rings in a polygon's (u, v), counter-clockwise around +y for a footprint (v runs along z, to the south).
 L_RING = np.array([[0, 20], [30, 20], [30, 10], [10, 10], [10, 0], [0, 0]], float)
@@ -137,3 +145,17 @@ def test_a_batch_is_each_shape_alone():
             assert batch[key][i] == pytest.approx(alone[key][0]), (i, key)
         for got, want in zip(batch["edges"], alone["edges"]):
             assert got[i] == pytest.approx(want[0]), i
+
+
+def test_rectangles_within_a_tolerance():
+    """A rectangle, a parallelogram leaning 5 degrees, the courtyard (a square with a hole) and the L:
+    only the rectangle is one at 1 degree; the parallelogram is at 6."""
+    lean = np.tan(np.radians(5)) * 10
+    store, ids = store_of([np.array([[0, 10], [10, 10], [10, 0], [0, 0]], float)],
+                          [np.array([[lean, 10], [10 + lean, 10], [10, 0], [0, 0]], float)], COURT, [L_RING],
+                          extents=[(10, 10), (10 + lean, 10), (40, 40), (30, 20)])
+    size = np.array([[10, 0, 10], [10 + lean, 0, 10], [40, 0, 40], [30, 0, 20]], float)
+    faces = shape_faces(size, np.array(ids, np.int32), store, MeshStore())
+    args = (faces.verts, faces.ring_offsets, faces.face_offsets)
+    assert rectangular_faces(*args, 1.0).tolist() == [True, False, False, False]
+    assert rectangular_faces(*args, 6.0).tolist() == [True, True, False, False]

@@ -15,9 +15,16 @@ import numpy as np
 
 from grammarc.backend.functions.table import function
 from grammarc.backend.selectors import classify_faces, selector_frames
-from grammarc.geometry.measure import area_and_volume, is_rectangular, vertex_and_face_counts
+from grammarc.geometry.measure import area_and_volume, vertex_and_face_counts
 from grammarc.geometry.meshes import is_mesh, is_polygon
-from grammarc.geometry.queries import face_shapes, planar_faces, shape_any, shape_faces, shared_edges
+from grammarc.geometry.queries import (
+    face_shapes,
+    planar_faces,
+    rectangular_faces,
+    shape_any,
+    shape_faces,
+    shared_edges,
+)
 
 if TYPE_CHECKING:
     from grammarc.backend.env import Env
@@ -34,8 +41,11 @@ def counts(call, args, env: Env):
 
 @function("geometry.isRectangular")
 def rectangular(call, args, env: Env):
-    return is_rectangular(env.shapes.size, env.shapes.geom, env.chunk.polygons,
-                          float(np.max(args[0])) if np.size(args[0]) else 0.0)
+    """``geometry.isRectangular(tolerance)``: the shape has a face and all its faces are rectangles
+    (``queries.rectangular_faces``). An inserted asset's faces are not known here: it is not."""
+    faces = shape_faces(env.shapes.size, env.shapes.geom, env.chunk.polygons, env.chunk.meshes)
+    square = rectangular_faces(faces.verts, faces.ring_offsets, faces.face_offsets, _tolerance(args[0]))
+    return ~shape_any(~square, faces) & (np.diff(faces.shape_offsets) > 0) & (env.shapes.geom >= -1)
 
 
 @function("geometry.area", "geometry.volume")
@@ -113,8 +123,7 @@ def planar(call, args, env: Env):
     """``geometry.isPlanar(tolerance)``: the shape has a face and all its faces are planar within
     ``tolerance`` degrees (``queries.planar_faces``)."""
     faces, vector, _, _ = _faces(env)
-    flat = planar_faces(faces.verts, faces.ring_offsets, faces.face_offsets, vector,
-                        float(np.max(args[0])) if np.size(args[0]) else 0.0)
+    flat = planar_faces(faces.verts, faces.ring_offsets, faces.face_offsets, vector, _tolerance(args[0]))
     return ~shape_any(~flat, faces) & (np.diff(faces.shape_offsets) > 0)
 
 
@@ -148,6 +157,11 @@ def height(call, args, env: Env):
 def instanced(call, args, env: Env):
     """An inserted asset, unchanged since its insert (grammarc changes none in place)."""
     return env.shapes.geom < -1
+
+
+def _tolerance(value) -> float:
+    """A tolerance in degrees for the whole batch: the largest asked (CityEngine's are constants)."""
+    return float(np.max(value)) if np.size(value) else 0.0
 
 
 def _faces(env: Env):

@@ -76,8 +76,13 @@ GEOMETRY_SELECTORS = {
 #: CityEngine's compass selectors as the scope's names in the world's frame (north is -z, east +x).
 WORLD_DIRECTIONS = {"world.north": "world.back", "world.south": "world.front", "world.east": "world.right",
                     "world.west": "world.left", "world.up": "world.top", "world.down": "world.bottom"}
-#: Texture-coordinate queries: grammarc keeps no texture coordinates yet.
-UV_QUERIES = frozenset(f"geometry.{name}" for name in ("du", "dv", "uMin", "uMax", "vMin", "vMax"))
+#: The geometry queries of the reference that grammarc cannot answer yet, and why.
+UNANSWERED_QUERIES = {
+    **{f"geometry.{name}": "texture coordinates: grammarc keeps none yet"
+       for name in ("du", "dv", "uMin", "uMax", "vMin", "vMax")},
+    **{f"geometry.{name}": "the groups and materials of assets are not kept" for name in ("groups", "materials")},
+    **{f"geometry.{name}": "geometry tags, as `tag` makes them" for name in ("hasTags", "tags")},
+}
 
 
 @v_args(inline=True, meta=True)
@@ -399,8 +404,8 @@ class Lowering(OperationLowering, LoweringBase):
             return ir.Call(text, (), span, self.site())
         if text in ir.CONTEXT_FIELDS:
             return ir.ContextRef(text, span)
-        if text in UV_QUERIES:
-            return self.uv_query(text, span)
+        if text in UNANSWERED_QUERIES:
+            return self.unanswered(text, span)
         if names[0] in UNSUPPORTED_MEMBERS:
             self.unsupported(text, span)
             return ir.placeholder(span)
@@ -412,8 +417,8 @@ class Lowering(OperationLowering, LoweringBase):
         names, span = dotted
         text = ".".join(names)
         args = tuple(self.expr(a) for a in args or ())
-        if text in UV_QUERIES:
-            return self.uv_query(f"{text}()", span)
+        if text in UNANSWERED_QUERIES:
+            return self.unanswered(text, span, "()")
         if text in GEOMETRY_SELECTORS and len(args) == 1:
             return self.geometry_selector(text, args[0], span)
         if text == "geometry.isRectangular" and not args:
@@ -435,8 +440,8 @@ class Lowering(OperationLowering, LoweringBase):
         selector = ir.Str(WORLD_DIRECTIONS.get(value.name, value.name), value.span)
         return ir.Call(query, (selector,), span, self.site())
 
-    def uv_query(self, name: str, span: Span) -> ir.Expr:
-        self.unsupported(name, span, "texture coordinates: grammarc keeps none yet")
+    def unanswered(self, query: str, span: Span, called: str = "") -> ir.Expr:
+        self.unsupported(query + called, span, UNANSWERED_QUERIES[query])
         return ir.placeholder(span)
 
     def function(self, meta, name, args):

@@ -200,3 +200,13 @@ def test_uv_queries_are_unsupported_by_name_and_line(write):
         compile_grammar(path)
     assert "g.cga:4:" in str(err.value)
     assert "unsupported: geometry.du() (texture coordinates" in str(err.value)
+
+
+@pytest.mark.parametrize("prefix, want", [
+    ("", [1, 0]), ("extrude(3)", [1, 0]), ("convexify()", [1, 1]),  # the L's two parts are rectangles
+    ("roofHip(30)", [0, 0]), ("extrude(3) comp(e){ all : E }\nE -->", [0, 0]),  # an edge has no face
+    ('extrude(3) i("box.obj")', [0, 0]),  # an asset's faces are not known
+])
+def test_rectangular_when_every_face_is(write, prefix, want):
+    write("box.obj", "v 0 0 0\nv 1 0 0\nv 1 1 0\nf 1 2 3\n")
+    assert query(write, "geometry.isRectangular(1)", [SOUTH_EDGE_FIRST, LOT_ZOO["concave_L"]], prefix) == want

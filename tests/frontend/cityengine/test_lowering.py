@@ -189,6 +189,8 @@ def _exprs(e):
     ("Lot --> extrude(initialShape.startRule) A", "initialShape.startRule", "initialShape"),
     ("Lot --> extrude(geometry.du(0, unitSpace)) A", "geometry.du()", "geometry"),
     ("Lot --> extrude(geometry.area(north)) A", "geometry.area selector `north`", "north"),
+    ('Lot --> case geometry.hasTags("roof") : A else : B', "geometry.hasTags()", "geometry"),
+    ("Lot --> extrude(size(geometry.materials())) A", "geometry.materials()", "geometry"),
     ("Lot --> F([3, 4])\nF(h) --> extrude(h[0])", "an array as argument 1 of `F`", "["),
     ('Lot --> report("h", [3, 4])', "an array as a reported value", "["),
 ])
