@@ -26,7 +26,7 @@ from grammarc.constants import TOL
 from grammarc.geometry.components import rect_plane, rect_rings
 from grammarc.geometry.meshes import MESH_BASE, MeshStore, face_vertices, is_mesh, is_polygon
 from grammarc.geometry.polygons import PLANE_U, PLANE_V, PolygonStore
-from grammarc.ragged import offsets_from_counts, ragged_take, row_groups, segment_of, segment_reduce
+from grammarc.ragged import offsets_from_counts, ragged_take, segment_of, segment_reduce
 
 
 @dataclass(frozen=True, eq=False)
@@ -63,6 +63,11 @@ def shape_faces(size: np.ndarray, geom: np.ndarray, store: PolygonStore, meshes:
         ring_offsets = np.concatenate([ring_offsets, ring_offsets[-1] + 4 * np.arange(1, len(box) + 1)])
         poly_offsets = np.concatenate([poly_offsets, poly_offsets[-1] + np.arange(1, len(box) + 1)])
         rows = np.concatenate([poly, box])
+        if len(poly) and len(box):  # the polygons in the shapes' order, so that their faces come in it
+            order = np.argsort(rows, kind="stable")
+            rings, poly_offsets = ragged_take(poly_offsets, order)
+            vertices, ring_offsets = ragged_take(ring_offsets, rings)
+            coords, plane, rows = coords[vertices], plane[order], rows[order]
         verts, rings, faces, owner = _prism_faces(coords, ring_offsets, poly_offsets, plane, size[rows], TOL.zero)
         pieces.append((verts, rings, faces, rows[owner]))
     if len(mesh):
@@ -71,12 +76,12 @@ def shape_faces(size: np.ndarray, geom: np.ndarray, store: PolygonStore, meshes:
     if not pieces:
         return Faces(np.empty((0, 3)), np.zeros(1, np.int64), np.zeros(1, np.int64), np.zeros(n + 1, np.int64))
     verts, ring_offsets, face_offsets, face_shape = pieces[0] if len(pieces) == 1 else _concatenate(pieces)
-    # faces grouped by shape, each shape's in the order they were made
-    order = np.argsort(face_shape, kind="stable")
-    rings, face_offsets = ragged_take(face_offsets, order)
-    vertices, ring_offsets = ragged_take(ring_offsets, rings)
-    return Faces(verts[vertices], ring_offsets, face_offsets,
-                 offsets_from_counts(np.bincount(face_shape, minlength=n)))
+    if (np.diff(face_shape) < 0).any():  # meshes among the others: faces grouped by shape, in their order
+        order = np.argsort(face_shape, kind="stable")
+        rings, face_offsets = ragged_take(face_offsets, order)
+        vertices, ring_offsets = ragged_take(ring_offsets, rings)
+        verts, face_shape = verts[vertices], face_shape[order]
+    return Faces(verts, ring_offsets, face_offsets, offsets_from_counts(np.bincount(face_shape, minlength=n)))
 
 
 def _concatenate(pieces):
@@ -93,12 +98,12 @@ def _concatenate(pieces):
 
 
 @njit(cache=True, nogil=True)
-def _point(coords, j, a, b, nrm, size_row, height):
-    p = np.zeros(3)
-    p[a] = coords[j, 0] * size_row[a]
-    p[b] = coords[j, 1] * size_row[b]
-    p[nrm] = height
-    return p
+def _put(verts, v, coords, j, a, b, nrm, su, sv, height):
+    """Write ring vertex ``j`` scaled by (su, sv) and lifted by ``height`` as point ``v``; returns v + 1."""
+    verts[v, a] = coords[j, 0] * su
+    verts[v, b] = coords[j, 1] * sv
+    verts[v, nrm] = height
+    return v + 1
 
 
 @njit(cache=True, nogil=True)
@@ -134,47 +139,60 @@ def _prism_faces(coords, ring_offsets, poly_offsets, plane, size, tol):
     f = 0
     for i in range(k):
         a, b, nrm = PLANE_U[plane[i]], PLANE_V[plane[i]], plane[i]
-        h = size[i, nrm]
+        su, sv, h = size[i, a], size[i, b], size[i, nrm]
         solid = h > tol
-        # bottom (reversed) then top of a prism; the face itself when flat
-        for cap in range(2):
-            if not solid and cap == 0:
-                continue
-            if solid and cap == 1:
-                # the side quads come between the bottom and the top
+        # a prism's bottom (its rings reversed), its sides, its top; a flat polygon's face
+        for part in range(0 if solid else 2, 3):
+            if part == 1:
                 for ring in range(poly_offsets[i], poly_offsets[i + 1]):
                     r0 = ring_offsets[ring]
                     count = ring_offsets[ring + 1] - r0
                     for j in range(r0, r0 + count):
                         q = r0 + (j - r0 + 1) % count
-                        p0 = _point(coords, j, a, b, nrm, size[i], 0.0)
-                        p1 = _point(coords, q, a, b, nrm, size[i], 0.0)
-                        if np.sqrt(((p1 - p0) ** 2).sum()) <= tol:
+                        du = (coords[q, 0] - coords[j, 0]) * su
+                        dv = (coords[q, 1] - coords[j, 1]) * sv
+                        if np.sqrt(du * du + dv * dv) <= tol:
                             continue
-                        verts[v] = p0
-                        verts[v + 1] = p1
-                        verts[v + 2] = _point(coords, q, a, b, nrm, size[i], h)
-                        verts[v + 3] = _point(coords, j, a, b, nrm, size[i], h)
-                        v += 4
+                        v = _put(verts, v, coords, j, a, b, nrm, su, sv, 0.0)
+                        v = _put(verts, v, coords, q, a, b, nrm, su, sv, 0.0)
+                        v = _put(verts, v, coords, q, a, b, nrm, su, sv, h)
+                        v = _put(verts, v, coords, j, a, b, nrm, su, sv, h)
                         r += 1
                         out_rings[r] = v
                         owner[f] = i
                         f += 1
                         out_faces[f] = r
-            height = h if (solid and cap == 1) else 0.0
+                continue
+            height = h if (solid and part == 2) else 0.0
             for ring in range(poly_offsets[i], poly_offsets[i + 1]):
                 r0 = ring_offsets[ring]
                 count = ring_offsets[ring + 1] - r0
                 for q in range(count):
-                    j = r0 + ((count - q) % count if cap == 0 else q)
-                    verts[v] = _point(coords, j, a, b, nrm, size[i], height)
-                    v += 1
+                    j = r0 + ((count - q) % count if part == 0 else q)
+                    v = _put(verts, v, coords, j, a, b, nrm, su, sv, height)
                 r += 1
                 out_rings[r] = v
             owner[f] = i
             f += 1
             out_faces[f] = r
     return verts[:v], out_rings[:r + 1], out_faces[:f + 1], owner[:f]
+
+
+@njit(cache=True, nogil=True)
+def _corner(verts, p, j, q):
+    """The edges p -> j and j -> q that meet at corner j: their cross product (three numbers), their dot
+    product and the product of their lengths."""
+    ax, ay, az = verts[j, 0] - verts[p, 0], verts[j, 1] - verts[p, 1], verts[j, 2] - verts[p, 2]
+    bx, by, bz = verts[q, 0] - verts[j, 0], verts[q, 1] - verts[j, 1], verts[q, 2] - verts[j, 2]
+    scale = np.sqrt((ax * ax + ay * ay + az * az) * (bx * bx + by * by + bz * bz))
+    return ay * bz - az * by, az * bx - ax * bz, ax * by - ay * bx, ax * bx + ay * by + az * bz, scale
+
+
+@njit(cache=True, nogil=True)
+def _around(ring_offsets, ring, j):
+    """The vertices before and after vertex ``j`` of ``ring``."""
+    r0, count = ring_offsets[ring], ring_offsets[ring + 1] - ring_offsets[ring]
+    return r0 + (j - r0 - 1) % count, r0 + (j - r0 + 1) % count
 
 
 @njit(cache=True, nogil=True)
@@ -187,23 +205,24 @@ def face_shapes(verts, ring_offsets, face_offsets):
     holes = np.zeros(n_faces, np.int64)
     concave = np.zeros(n_faces, np.bool_)
     for f in range(n_faces):
+        nx = ny = nz = 0.0
         for ring in range(face_offsets[f], face_offsets[f + 1]):
-            r0, r1 = ring_offsets[ring], ring_offsets[ring + 1]
-            for j in range(r0, r1):
-                vector[f] += np.cross(verts[j], verts[r0 + (j - r0 + 1) % (r1 - r0)]) / 2
+            for j in range(ring_offsets[ring], ring_offsets[ring + 1]):
+                q = _around(ring_offsets, ring, j)[1]
+                nx += (verts[j, 1] - verts[q, 1]) * (verts[j, 2] + verts[q, 2])
+                ny += (verts[j, 2] - verts[q, 2]) * (verts[j, 0] + verts[q, 0])
+                nz += (verts[j, 0] - verts[q, 0]) * (verts[j, 1] + verts[q, 1])
+        vector[f, 0], vector[f, 1], vector[f, 2] = nx / 2, ny / 2, nz / 2
         holes[f] = face_offsets[f + 1] - face_offsets[f] - 1
-        length = np.sqrt((vector[f] ** 2).sum())
+        length = np.sqrt(nx * nx + ny * ny + nz * nz)
         if holes[f] > 0 or length == 0.0:
             concave[f] = holes[f] > 0
             continue
-        normal = vector[f] / length
-        r0, r1 = ring_offsets[face_offsets[f]], ring_offsets[face_offsets[f] + 1]
-        count = r1 - r0
-        for j in range(r0, r1):
-            before = verts[j] - verts[r0 + (j - r0 - 1) % count]
-            after = verts[r0 + (j - r0 + 1) % count] - verts[j]
-            scale = np.sqrt((before ** 2).sum() * (after ** 2).sum())
-            if (np.cross(before, after) * normal).sum() < -1e-9 * scale:
+        outline = face_offsets[f]
+        for j in range(ring_offsets[outline], ring_offsets[outline + 1]):
+            p, q = _around(ring_offsets, outline, j)
+            cx, cy, cz, _, scale = _corner(verts, p, j, q)
+            if (cx * nx + cy * ny + cz * nz) / length < -1e-9 * scale:
                 concave[f] = True
                 break
     return vector, holes, concave
@@ -215,23 +234,22 @@ def planar_faces(verts, ring_offsets, face_offsets, vector, degrees):
     cross product of the edges that meet there (the corner's own normal) is within ``degrees`` of the
     face's normal (``vector``, from ``face_shapes``). A straight corner has no normal of its own and
     passes; a reflex one is taken by its line, not its sense, so that a concave face is planar."""
-    bound = np.cos(np.radians(degrees))
+    bound = np.cos(np.radians(degrees)) * (1 - 1e-12)
     n_faces = len(face_offsets) - 1
     out = np.ones(n_faces, np.bool_)
     for f in range(n_faces):
         length = np.sqrt((vector[f] ** 2).sum())
         if length == 0.0:
             continue
-        normal = vector[f] / length
         for ring in range(face_offsets[f], face_offsets[f + 1]):
-            r0, r1 = ring_offsets[ring], ring_offsets[ring + 1]
-            count = r1 - r0
-            for j in range(r0, r1):
-                corner = np.cross(verts[j] - verts[r0 + (j - r0 - 1) % count],
-                                verts[r0 + (j - r0 + 1) % count] - verts[j])
-                size = np.sqrt((corner ** 2).sum())
-                if size > 1e-12 and abs((corner * normal).sum()) < bound * size * (1 - 1e-12):
+            for j in range(ring_offsets[ring], ring_offsets[ring + 1]):
+                p, q = _around(ring_offsets, ring, j)
+                cx, cy, cz, _, _ = _corner(verts, p, j, q)
+                size = np.sqrt(cx * cx + cy * cy + cz * cz)
+                along = abs(cx * vector[f, 0] + cy * vector[f, 1] + cz * vector[f, 2]) / length
+                if size > 1e-12 and along < bound * size:
                     out[f] = False
+                    break
             if not out[f]:
                 break
     return out
@@ -245,43 +263,75 @@ def rectangular_faces(verts, ring_offsets, face_offsets, degrees):
     n_faces = len(face_offsets) - 1
     out = np.zeros(n_faces, np.bool_)
     for f in range(n_faces):
-        r0, r1 = ring_offsets[face_offsets[f]], ring_offsets[face_offsets[f] + 1]
-        if face_offsets[f + 1] - face_offsets[f] != 1 or r1 - r0 != 4:
+        outline = face_offsets[f]
+        if face_offsets[f + 1] - outline != 1 or ring_offsets[outline + 1] - ring_offsets[outline] != 4:
             continue
         out[f] = True
-        for j in range(r0, r1):
-            before = verts[j] - verts[r0 + (j - r0 - 1) % 4]
-            after = verts[r0 + (j - r0 + 1) % 4] - verts[j]
-            scale = max(np.sqrt((before ** 2).sum() * (after ** 2).sum()), 1e-300)
-            if abs((before * after).sum()) / scale > bound:
+        for j in range(ring_offsets[outline], ring_offsets[outline + 1]):
+            p, q = _around(ring_offsets, outline, j)
+            _, _, _, dot, scale = _corner(verts, p, j, q)
+            if abs(dot) / max(scale, 1e-300) > bound:
                 out[f] = False
                 break
     return out
 
 
-def shared_edges(faces: Faces, n: int):
-    """The edges of each of ``n`` shapes' faces, an edge two faces share counted once: their number (n,)
-    float64, the summed length of the boundary edges (n,) (those of one face only), and whether every
-    edge is shared by exactly two faces (n,) bool."""
-    verts, ring_offsets = faces.verts, faces.ring_offsets
-    ring = segment_of(ring_offsets)
-    at = np.arange(len(verts))
-    nxt = np.where(at + 1 < ring_offsets[1:][ring], at + 1, ring_offsets[:-1][ring])
-    shape = faces.face_shape()[segment_of(faces.face_offsets)][ring]
-    # an undirected edge is its shape and its ends in lexicographic order, on a grid of TOL.zero
-    a, b = np.round(verts / TOL.zero), np.round(verts[nxt] / TOL.zero)
-    step = b - a
-    backwards = step[at, np.argmax(step != 0, axis=1)] < 0
-    lo, hi = np.where(backwards[:, None], b, a), np.where(backwards[:, None], a, b)
-    keep = (lo != hi).any(axis=1)
-    group, first = row_groups(np.column_stack([shape, lo, hi])[keep])
-    uses = np.bincount(group, minlength=len(first))
-    edge_shape = shape[keep][first]
-    length = np.linalg.norm(verts[nxt][keep][first] - verts[keep][first], axis=1)
-    count = np.bincount(edge_shape, minlength=n).astype(np.float64)
-    boundary = np.bincount(edge_shape, weights=np.where(uses == 1, length, 0.0), minlength=n)
-    unshared = np.bincount(edge_shape, weights=uses != 2, minlength=n)
-    return count, boundary, (unshared == 0) & (np.diff(faces.shape_offsets) > 0)
+def shared_edges(faces: Faces, n: int, eps: float = TOL.zero):
+    """The edges of each of ``n`` shapes' faces, an edge two faces share counted once (its ends the same
+    on a grid of ``eps``): their number (n,) float64, the summed length of the boundary edges (n,) (those
+    of one face only), and whether the shape has a face and every edge is shared by exactly two faces
+    (n,) bool."""
+    quantized = np.round(faces.verts / eps).astype(np.int64)
+    return _shared_edges(faces.verts, quantized, faces.ring_offsets, faces.face_offsets, faces.shape_offsets)
+
+
+@njit(cache=True, nogil=True)
+def _shared_edges(verts, quantized, ring_offsets, face_offsets, shape_offsets):
+    """``shared_edges`` shape by shape: each ring edge is matched with the earlier edges of its shape
+    (a shape's edges are few: tens for a prism, hundreds for a roof)."""
+    n = len(shape_offsets) - 1
+    count = np.zeros(n)
+    boundary = np.zeros(n)
+    closed = np.zeros(n, np.bool_)
+    for s in range(n):
+        r_first, r_last = face_offsets[shape_offsets[s]], face_offsets[shape_offsets[s + 1]]
+        v0, v1 = ring_offsets[r_first], ring_offsets[r_last]
+        keys = np.empty((v1 - v0, 6), np.int64)  # each edge's ends, the lower one first
+        ends = np.empty((v1 - v0, 2), np.int64)
+        m = 0
+        for ring in range(r_first, r_last):
+            for j in range(ring_offsets[ring], ring_offsets[ring + 1]):
+                q = _around(ring_offsets, ring, j)[1]
+                axis = 0
+                while axis < 3 and quantized[j, axis] == quantized[q, axis]:
+                    axis += 1
+                if axis == 3:  # no length
+                    continue
+                lo, hi = (j, q) if quantized[j, axis] < quantized[q, axis] else (q, j)
+                keys[m, :3], keys[m, 3:] = quantized[lo], quantized[hi]
+                ends[m, 0], ends[m, 1] = j, q
+                m += 1
+        uses = np.zeros(m, np.int64)
+        for e in range(m):
+            first = e
+            for other in range(e):
+                if uses[other] > 0:
+                    c = 0
+                    while c < 6 and keys[other, c] == keys[e, c]:
+                        c += 1
+                    if c == 6:
+                        first = other
+                        break
+            uses[first] += 1
+        closed[s] = shape_offsets[s + 1] > shape_offsets[s]
+        for e in range(m):
+            if uses[e] == 0:
+                continue
+            count[s] += 1
+            closed[s] &= uses[e] == 2
+            if uses[e] == 1:
+                boundary[s] += np.sqrt(((verts[ends[e, 1]] - verts[ends[e, 0]]) ** 2).sum())
+    return count, boundary, closed
 
 
 def shape_any(flags: np.ndarray, faces: Faces) -> np.ndarray:
