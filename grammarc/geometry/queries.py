@@ -65,9 +65,8 @@ def shape_faces(size: np.ndarray, geom: np.ndarray, store: PolygonStore, meshes:
         rows = np.concatenate([poly, box])
         if len(poly) and len(box):  # the polygons in the shapes' order, so that their faces come in it
             order = np.argsort(rows, kind="stable")
-            rings, poly_offsets = ragged_take(poly_offsets, order)
-            vertices, ring_offsets = ragged_take(ring_offsets, rings)
-            coords, plane, rows = coords[vertices], plane[order], rows[order]
+            coords, ring_offsets, poly_offsets = _take(order, coords, ring_offsets, poly_offsets)
+            plane, rows = plane[order], rows[order]
         verts, rings, faces, owner = _prism_faces(coords, ring_offsets, poly_offsets, plane, size[rows], TOL.zero)
         pieces.append((verts, rings, faces, rows[owner]))
     if len(mesh):
@@ -78,10 +77,16 @@ def shape_faces(size: np.ndarray, geom: np.ndarray, store: PolygonStore, meshes:
     verts, ring_offsets, face_offsets, face_shape = pieces[0] if len(pieces) == 1 else _concatenate(pieces)
     if (np.diff(face_shape) < 0).any():  # meshes among the others: faces grouped by shape, in their order
         order = np.argsort(face_shape, kind="stable")
-        rings, face_offsets = ragged_take(face_offsets, order)
-        vertices, ring_offsets = ragged_take(ring_offsets, rings)
-        verts, face_shape = verts[vertices], face_shape[order]
+        verts, ring_offsets, face_offsets = _take(order, verts, ring_offsets, face_offsets)
+        face_shape = face_shape[order]
     return Faces(verts, ring_offsets, face_offsets, offsets_from_counts(np.bincount(face_shape, minlength=n)))
+
+
+def _take(order, points, ring_offsets, offsets):
+    """Polygons (or faces) ``order`` of ragged rings: their points, ring_offsets and offsets anew."""
+    rings, offsets = ragged_take(offsets, order)
+    vertices, ring_offsets = ragged_take(ring_offsets, rings)
+    return points[vertices], ring_offsets, offsets
 
 
 def _concatenate(pieces):
