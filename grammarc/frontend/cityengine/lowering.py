@@ -59,9 +59,6 @@ SCOPE_MEMBERS = {
     **{f"scope.{f}": f for f in ("sx", "sy", "sz", "tx", "ty", "tz", "rx", "ry", "rz")},
     "initialShape.origin.px": "ox", "initialShape.origin.py": "oy", "initialShape.origin.pz": "oz",
 }
-#: Shape queries without arguments, written as members (``geometry.area``) or calls (``geometry.area()``).
-GEOMETRY_QUERIES = frozenset(name for name, signature in FUNCTIONS.items()
-                             if name.startswith("geometry.") and signature.least == 0)
 #: The faces ``geometry.isOriented`` checks for, by their normals, as ``comp(f)`` selects them.
 _ORIENTATIONS = frozenset(
     {f"{frame}{s}" for frame in ("", "object.") for s in ("front", "back", "left", "right", "top", "bottom", "side")}
@@ -400,12 +397,12 @@ class Lowering(OperationLowering, LoweringBase):
         text = ".".join(names)
         if text in SCOPE_MEMBERS:
             return ir.ScopeRef(SCOPE_MEMBERS[text], span)
-        if text in GEOMETRY_QUERIES:
-            return ir.Call(text, (), span, self.site())
         if text in ir.CONTEXT_FIELDS:
             return ir.ContextRef(text, span)
         if text in UNANSWERED_QUERIES:
             return self.unanswered(text, span)
+        if names[0] == "geometry":  # the checker names what it takes, or the closest query to an unknown one
+            return ir.Call(text, (), span, self.site())
         if names[0] in UNSUPPORTED_MEMBERS:
             self.unsupported(text, span)
             return ir.placeholder(span)
@@ -423,7 +420,7 @@ class Lowering(OperationLowering, LoweringBase):
             return self.geometry_selector(text, args[0], span)
         if text == "geometry.isRectangular" and not args:
             args = (ir.Num(0.0, span),)
-        if text.startswith("geometry.") and text in FUNCTIONS:  # the checker checks the arguments
+        if names[0] == "geometry":  # the checker checks the arguments, or names the closest query
             return ir.Call(text, args, span, self.site())
         self.unsupported(f"{text}()", span)
         return ir.placeholder(span)
@@ -433,9 +430,9 @@ class Lowering(OperationLowering, LoweringBase):
         compass directions as the world frame's faces (``WORLD_DIRECTIONS``)."""
         known = GEOMETRY_SELECTORS[query]
         if not isinstance(value, ir.Name) or value.name not in known:
-            name = value.name if isinstance(value, ir.Name) else "this"
-            self.unsupported(f"{query} selector `{name}`", value.span,
-                             f"{query} selects {', '.join(sorted(known))}" + suggest(name, known))
+            named = isinstance(value, ir.Name)
+            self.unsupported(f"{query} selector `{value.name}`" if named else f"this {query} selector", value.span,
+                             f"{query} selects {', '.join(sorted(known))}" + (suggest(value.name, known) if named else ""))
             return ir.placeholder(span)
         selector = ir.Str(WORLD_DIRECTIONS.get(value.name, value.name), value.span)
         return ir.Call(query, (selector,), span, self.site())

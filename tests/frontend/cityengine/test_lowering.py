@@ -179,6 +179,29 @@ def _exprs(e):
 
 
 
+# ---------------------------------------------------------------------------------- geometry queries
+
+
+def test_geometry_queries_with_and_without_parentheses_and_their_selectors():
+    """A query is a call whether written as a member or with parentheses; a selector becomes its name
+    as a string, a compass direction the world frame's face (north is the world's back, -z)."""
+    body = body_of(VERSION + "Lot --> extrude(geometry.height + geometry.height() + geometry.area(top) "
+                   "+ geometry.area(world.north) + geometry.angle(azimuth)) A\nA --> X.\n")
+    for call in ("geometry.height()", 'geometry.area("top")', 'geometry.area("world.back")',
+                 'geometry.angle("azimuth")'):
+        assert call in body, body
+
+
+@pytest.mark.parametrize("line, message", [
+    ("Lot --> case geometry.isConcav : A else : B",
+     "unknown function `geometry.isConcav` (did you mean `geometry.isConcave`?)"),
+    ("Lot --> extrude(geometry.isPlanar) A", "`geometry.isPlanar` takes 1 arguments, got 0"),
+    ("Lot --> extrude(geometry.nEdges(2)) A", "`geometry.nEdges` takes 0 arguments, got 1"),
+])
+def test_unknown_queries_and_their_arguments_are_named(line, message):
+    assert [m for _, _, m in errors(VERSION + line + "\nA --> X.\nB --> X.\n")] == [message]
+
+
 # ------------------------------------------------------------------------------------ the unsupported
 
 
