@@ -78,9 +78,11 @@ FUNCTIONS: dict[str, Signature] = {
     "geometry.isPlanar": Signature((T.NUM,), T.BOOL, shape=True),
     "geometry.isRectangular": Signature((T.NUM,), T.BOOL, shape=True),
     **{f"geometry.{name}": Signature((), T.NUM, shape=True)
-       for name in ("volume", "nVertices", "nFaces", "nEdges", "nHoles", "boundaryLength", "height")},
+       for name in ("volume", "nEdges", "nHoles", "boundaryLength", "height")},
     **{f"geometry.{name}": Signature((), T.BOOL, shape=True)
        for name in ("isConcave", "isClosedSurface", "isInstanced")},
+    "geometry.nVertices": Signature((), T.NUM, shape=True),
+    "geometry.nFaces": Signature((), T.NUM, shape=True),
     # ---------------------------------------------------------------------------------- arrays (backend.functions.arrays)
     # their argument types, and some result types, depend on the arguments' (``passes.types``); the type here
     # is that of ``size``, ``nRows``, ``nColumns`` and ``findFirst``
