@@ -397,12 +397,10 @@ class Lowering(OperationLowering, LoweringBase):
         text = ".".join(names)
         if text in SCOPE_MEMBERS:
             return ir.ScopeRef(SCOPE_MEMBERS[text], span)
+        if names[0] == "geometry":  # the checker names what it takes, or the closest query to an unknown one
+            return self.unanswered(text, span) if text in UNANSWERED_QUERIES else ir.Call(text, (), span, self.site())
         if text in ir.CONTEXT_FIELDS:
             return ir.ContextRef(text, span)
-        if text in UNANSWERED_QUERIES:
-            return self.unanswered(text, span)
-        if names[0] == "geometry":  # the checker names what it takes, or the closest query to an unknown one
-            return ir.Call(text, (), span, self.site())
         if names[0] in UNSUPPORTED_MEMBERS:
             self.unsupported(text, span)
             return ir.placeholder(span)
