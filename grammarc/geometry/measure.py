@@ -1,4 +1,6 @@
-"""Areas and volumes of shapes, for CityEngine's ``geometry.area`` and ``geometry.volume``.
+"""Areas, volumes and counts of shapes, for CityEngine's ``geometry.area``, ``geometry.volume``,
+``geometry.nVertices`` and ``geometry.nFaces`` (the queries that look at faces one by one are in
+``geometry.queries``).
 
 A flat shape's area is its face's; a solid's area is its surface (as CityEngine reports it), its volume
 the prism's. Boxes and inserted assets measure as their scope box; polygons from the store, scaled by
@@ -53,37 +55,6 @@ def area_and_volume(size: np.ndarray, geom: np.ndarray, store: PolygonStore,
         area, volume = area.copy(), volume.copy()
         area[mesh], volume[mesh] = mesh_store.area_and_volume(meshes, geom[mesh] - MESH_BASE, size[mesh])
     return area, volume
-
-
-def is_rectangular(size: np.ndarray, geom: np.ndarray, store: PolygonStore, degrees: float) -> np.ndarray:
-    """CityEngine's ``geometry.isRectangular(tolerance)``: a face or solid whose polygon is a rectangle,
-    its corners right angles within ``degrees``. Scope boxes and rectangles are; assets are not."""
-    result = geom == -1
-    poly = np.flatnonzero(is_polygon(geom))
-    if not len(poly):
-        return result
-    ids = geom[poly]
-    coords, ring_offsets, poly_offsets = store.gather(ids)
-    plane = store.plane[ids]
-    a_axis, b_axis = PLANE_U[plane], PLANE_V[plane]
-    vertex_ring = segment_of(ring_offsets)
-    vertex_poly = segment_of(poly_offsets)[vertex_ring]
-    at = np.arange(len(coords))
-    start, end = ring_offsets[:-1][vertex_ring], ring_offsets[1:][vertex_ring]
-    nxt = np.where(at + 1 < end, at + 1, start)
-    prv = np.where(at > start, at - 1, end - 1)
-    u = coords[:, 0] * size[poly, a_axis][vertex_poly]
-    v = coords[:, 1] * size[poly, b_axis][vertex_poly]
-    d1 = np.stack([u[nxt] - u, v[nxt] - v], axis=1)
-    d0 = np.stack([u - u[prv], v - v[prv]], axis=1)
-    cos = np.abs(np.einsum("ij,ij->i", d0, d1)) / np.maximum(
-        np.linalg.norm(d0, axis=1) * np.linalg.norm(d1, axis=1), 1e-300)
-    square = cos <= np.sin(np.radians(degrees)) + 1e-9
-    corners_ok = segment_reduce(np.minimum, square.astype(np.int64), ring_offsets[poly_offsets], 1) > 0
-    four = (np.diff(poly_offsets) == 1) & (np.diff(ring_offsets[poly_offsets]) == 4)
-    result = result.copy()
-    result[poly] = four & corners_ok
-    return result
 
 
 def vertex_and_face_counts(size: np.ndarray, geom: np.ndarray, store: PolygonStore, meshes: MeshStore):

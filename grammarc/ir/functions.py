@@ -112,9 +112,16 @@ FUNCTIONS: dict[str, Signature] = {
     "initialShape.name": Signature((), T.STR, shape=True),
     "initialShape.startRule": Signature((), T.STR),
     # ------------------------------------------------------------------------ geometry (backend.functions.geometry)
-    "geometry.area": Signature((), T.NUM, shape=True),
-    "geometry.volume": Signature((), T.NUM, shape=True),
+    # a selector argument (``top``, ``world.up``, ``maxSlope``) is its name as a constant string
+    "geometry.area": Signature((T.STR,), T.NUM, optional=1, shape=True),
+    "geometry.angle": Signature((T.STR,), T.NUM, shape=True),
+    "geometry.isOriented": Signature((T.STR,), T.BOOL, shape=True),
+    "geometry.isPlanar": Signature((T.NUM,), T.BOOL, shape=True),
     "geometry.isRectangular": Signature((T.NUM,), T.BOOL, shape=True),
+    **{f"geometry.{name}": Signature((), T.NUM, shape=True)
+       for name in ("volume", "nEdges", "nHoles", "boundaryLength", "height")},
+    **{f"geometry.{name}": Signature((), T.BOOL, shape=True)
+       for name in ("isConcave", "isClosedSurface", "isInstanced")},
     "geometry.nVertices": Signature((), T.NUM, shape=True),
     "geometry.nFaces": Signature((), T.NUM, shape=True),
     # ---------------------------------------------------------------------------- miscellaneous (backend.functions.math)

@@ -70,8 +70,27 @@ SELECTOR_ARGUMENTS = {
 }
 #: ``initialShape.origin.o{x|y|z}``: the lot's orientation, a component of ``convert``'s.
 INITIAL_ORIENTATION = {f"initialShape.origin.o{c}": c for c in "xyz"}
-#: Shape queries without arguments, written as members (``geometry.area``) or calls (``geometry.area()``).
-GEOMETRY_QUERIES = ("geometry.area", "geometry.volume", "geometry.nVertices", "geometry.nFaces")
+#: The faces ``geometry.isOriented`` checks for, by their normals, as ``comp(f)`` selects them.
+_ORIENTATIONS = frozenset(
+    {f"{frame}{s}" for frame in ("", "object.") for s in ("front", "back", "left", "right", "top", "bottom", "side")}
+    | {f"world.{s}" for s in ("north", "south", "west", "east", "up", "down", "side")}
+    | {f"street.{s}" for s in ("front", "back", "left", "right", "side")})
+#: The selector of each geometry query that takes one: the faces it measures, or the angle it gives.
+GEOMETRY_SELECTORS = {
+    "geometry.area": _ORIENTATIONS | {"all", "surface"},
+    "geometry.isOriented": _ORIENTATIONS,
+    "geometry.angle": frozenset({"maxSlope", "azimuth", "zenith"}),
+}
+#: CityEngine's compass selectors as the scope's names in the world's frame (north is -z, east +x).
+WORLD_DIRECTIONS = {"world.north": "world.back", "world.south": "world.front", "world.east": "world.right",
+                    "world.west": "world.left", "world.up": "world.top", "world.down": "world.bottom"}
+#: The geometry queries of the reference that grammarc cannot answer yet, and why.
+UNANSWERED_QUERIES = {
+    **{f"geometry.{name}": "texture coordinates: grammarc keeps none yet"
+       for name in ("du", "dv", "uMin", "uMax", "vMin", "vMax")},
+    **{f"geometry.{name}": "the groups and materials of assets are not kept" for name in ("groups", "materials")},
+    **{f"geometry.{name}": "geometry tags, as `tag` makes them" for name in ("hasTags", "tags")},
+}
 
 
 @v_args(inline=True, meta=True)
@@ -387,8 +406,8 @@ class Lowering(OperationLowering, LoweringBase):
         text = ".".join(names)
         if text in SCOPE_MEMBERS:
             return ir.ScopeRef(SCOPE_MEMBERS[text], span)
-        if text in GEOMETRY_QUERIES:
-            return ir.Call(text, (), span, self.site())
+        if names[0] == "geometry":  # the checker names what it takes, or the closest query to an unknown one
+            return self.unanswered(text, span) if text in UNANSWERED_QUERIES else ir.Call(text, (), span, self.site())
         if text in ir.CONTEXT_FIELDS:
             return ir.ContextRef(text, span)
         if text in ("initialShape.name", "initialShape.startRule"):
@@ -407,12 +426,32 @@ class Lowering(OperationLowering, LoweringBase):
     def member_function(self, meta, dotted, args):
         names, span = dotted
         text = ".".join(names)
-        if text in GEOMETRY_QUERIES and not args:
-            return ir.Call(text, (), span, self.site())
-        if text == "geometry.isRectangular" and len(args or ()) <= 1:
-            tolerance = self.expr(args[0]) if args else ir.Num(0.0, span)
-            return ir.Call(text, (tolerance,), span, self.site())
+        args = tuple(self.expr(a) for a in args or ())
+        if text in UNANSWERED_QUERIES:
+            return self.unanswered(text, span, "()")
+        if text in GEOMETRY_SELECTORS and len(args) == 1:
+            return self.geometry_selector(text, args[0], span)
+        if text == "geometry.isRectangular" and not args:
+            args = (ir.Num(0.0, span),)
+        if names[0] == "geometry":  # the checker checks the arguments, or names the closest query
+            return ir.Call(text, args, span, self.site())
         self.unsupported(f"{text}()", span)
+        return ir.placeholder(span)
+
+    def geometry_selector(self, query: str, value: ir.Expr, span: Span) -> ir.Expr:
+        """``geometry.area(top)``, ``geometry.angle(azimuth)``: the selector as a constant string, the
+        compass directions as the world frame's faces (``WORLD_DIRECTIONS``)."""
+        known = GEOMETRY_SELECTORS[query]
+        if not isinstance(value, ir.Name) or value.name not in known:
+            named = isinstance(value, ir.Name)
+            self.unsupported(f"{query} selector `{value.name}`" if named else f"this {query} selector", value.span,
+                             f"{query} selects {', '.join(sorted(known))}" + (suggest(value.name, known) if named else ""))
+            return ir.placeholder(span)
+        selector = ir.Str(WORLD_DIRECTIONS.get(value.name, value.name), value.span)
+        return ir.Call(query, (selector,), span, self.site())
+
+    def unanswered(self, query: str, span: Span, called: str = "") -> ir.Expr:
+        self.unsupported(query + called, span, UNANSWERED_QUERIES[query])
         return ir.placeholder(span)
 
     def function(self, meta, name, args):

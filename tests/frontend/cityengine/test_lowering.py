@@ -203,15 +203,41 @@ def _exprs(e):
 
 
 
+# ---------------------------------------------------------------------------------- geometry queries
+
+
+def test_geometry_queries_with_and_without_parentheses_and_their_selectors():
+    """A query is a call whether written as a member or with parentheses; a selector becomes its name
+    as a string, a compass direction the world frame's face (north is the world's back, -z)."""
+    body = body_of(VERSION + "Lot --> extrude(geometry.height + geometry.height() + geometry.area(top) "
+                   "+ geometry.area(world.north) + geometry.angle(azimuth)) A\nA --> X.\n")
+    for call in ("geometry.height()", 'geometry.area("top")', 'geometry.area("world.back")',
+                 'geometry.angle("azimuth")'):
+        assert call in body, body
+
+
+@pytest.mark.parametrize("line, message", [
+    ("Lot --> case geometry.isConcav : A else : B",
+     "unknown function `geometry.isConcav` (did you mean `geometry.isConcave`?)"),
+    ("Lot --> extrude(geometry.isPlanar) A", "`geometry.isPlanar` takes 1 arguments, got 0"),
+    ("Lot --> extrude(geometry.nEdges(2)) A", "`geometry.nEdges` takes 0 arguments, got 1"),
+])
+def test_unknown_queries_and_their_arguments_are_named(line, message):
+    assert [m for _, _, m in errors(VERSION + line + "\nA --> X.\nB --> X.\n")] == [message]
+
+
 # ------------------------------------------------------------------------------------ the unsupported
 
 
 @pytest.mark.parametrize("line, name, at", [
     ("Lot --> case inside(near) : A else : B", "inside with these arguments", "inside"),
     ("Lot --> case touches(all, 3) : A else : B", "touches with these arguments", "touches"),
-    ("Lot --> extrude(geometry.height) A", "geometry.height", "geometry"),
+    ("Lot --> extrude(geometry.uMin) A", "geometry.uMin", "geometry"),
     ("Lot --> extrude(initialShape.origin.qx) A", "initialShape.origin.qx", "initialShape"),
     ("Lot --> extrude(geometry.du(0, unitSpace)) A", "geometry.du()", "geometry"),
+    ("Lot --> extrude(geometry.area(north)) A", "geometry.area selector `north`", "north"),
+    ('Lot --> case geometry.hasTags("roof") : A else : B', "geometry.hasTags()", "geometry"),
+    ("Lot --> extrude(size(geometry.materials())) A", "geometry.materials()", "geometry"),
     ("Lot --> F([3, 4])\nF(h) --> extrude(h[0])", "an array as argument 1 of `F`", "["),
     ('Lot --> report("h", [3, 4])', "an array as a reported value", "["),
 ])
