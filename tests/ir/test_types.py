@@ -268,7 +268,7 @@ def test_array_types_follow_their_elements_and_indices():
     ("attr b = sortIndices([true])",
      [(1, 22, "the argument of `sortIndices` must be a num[] or a str[], got a bool[]")]),
     ('attr b = findFirst([1], "x")', [(1, 25, "`findFirst` looks for a num in a num[], got a str")]),
-    ("attr b = nRows([1], [2])", [(1, 10, "`nRows` takes 1 arguments, got 2")]),
+    ("attr b = nRows([1], [2])", [(1, 10, "`nRows` takes 1 argument, got 2")]),
     ('attr b = findFirst(["a"], "a", 0.5)', [(1, 32, "a tolerance of `findFirst` is for a num[], not a str[]")]),
     ("attr b = str([1, 2])", [(1, 14, "`str` takes no array, got a num[]")]),
     ("attr b = floor([1.5])", [(1, 16, "an argument of `floor` must be a num, got a num[]")]),

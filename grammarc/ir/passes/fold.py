@@ -14,6 +14,7 @@ import operator
 
 from grammarc.diagnostics import Diagnostics
 from grammarc.ir import nodes as ir
+from grammarc.ir.functions import FUNCTIONS
 from grammarc.ir.traverse import rewrite_module
 
 _ARITH = {"+": operator.add, "-": operator.sub, "*": operator.mul, "/": operator.truediv,
@@ -62,8 +63,8 @@ def _folder(diags: Diagnostics):
                 return ir.Bool(bool(a or b), expr.span)
         if isinstance(expr, ir.Select) and isinstance(expr.cond, ir.Bool):
             return expr.then if expr.cond.value else expr.other
-        if isinstance(expr, ir.Call) and expr.func in PURE \
-                and all(isinstance(a, ir.Num) for a in expr.args):
+        if isinstance(expr, ir.Call) and expr.func in PURE and FUNCTIONS[expr.func].takes(len(expr.args)) \
+                and all(isinstance(a, ir.Num) for a in expr.args):  # a wrong count is the checker's error
             try:
                 value = PURE[expr.func](*(a.value for a in expr.args))
                 if isinstance(value, bool):

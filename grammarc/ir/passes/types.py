@@ -291,7 +291,8 @@ _ARRAY_ARGUMENT = {
 def _call(expr: ir.Call, got: list[ir.Type], diags: Diagnostics) -> ir.Type:
     signature = FUNCTIONS[expr.func]
     if not signature.takes(len(got)):
-        diags.error("arity", f"`{expr.func}` takes {signature.arity()} arguments, got {len(got)}", expr.span)
+        noun = "argument" if signature.arity() == "1" else "arguments"
+        diags.error("arity", f"`{expr.func}` takes {signature.arity()} {noun}, got {len(got)}", expr.span)
         return T.UNKNOWN
     if expr.func == "print":  # gives its value, of any type
         return got[0]

@@ -219,7 +219,7 @@ def test_geometry_queries_with_and_without_parentheses_and_their_selectors():
 @pytest.mark.parametrize("line, message", [
     ("Lot --> case geometry.isConcav : A else : B",
      "unknown function `geometry.isConcav` (did you mean `geometry.isConcave`?)"),
-    ("Lot --> extrude(geometry.isPlanar) A", "`geometry.isPlanar` takes 1 arguments, got 0"),
+    ("Lot --> extrude(geometry.isPlanar) A", "`geometry.isPlanar` takes 1 argument, got 0"),
     ("Lot --> extrude(geometry.nEdges(2)) A", "`geometry.nEdges` takes 0 arguments, got 1"),
 ])
 def test_unknown_queries_and_their_arguments_are_named(line, message):
