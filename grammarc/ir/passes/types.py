@@ -43,8 +43,8 @@ def infer_types(module: ir.Module, diags: Diagnostics) -> ir.Module:
             for expr, want, what in _wanted(node, attr_types, param_types):
                 if want is not None:
                     got = _expect(expr, want, what, attr_types, params, diags)
-                else:  # not checked here, but an array where the backend takes a value is refused
-                    got = type_of(expr, attr_types, params, Diagnostics())
+                else:  # any type (its operands checked); an array where the backend takes a value is refused
+                    got = type_of(expr, attr_types, params, diags)
                 if got.is_array and (want is None or want.is_array):
                     diags.error("unsupported", f"unsupported: an array as {what}", expr.span)
     return replace(module, attrs=tuple(attrs), param_types=tuple(sorted(param_types.items())))
