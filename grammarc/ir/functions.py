@@ -65,6 +65,7 @@ FUNCTIONS: dict[str, Signature] = {
     "count": Signature((T.STR, T.STR), T.NUM),
     "find": Signature((T.STR, T.STR, T.NUM), T.NUM),
     "substring": Signature((T.STR, T.NUM, T.NUM), T.STR),
+    "splitString": Signature((T.STR, T.STR), T.STRS),
     # CityEngine's utility library (ce.lib), built on the four above
     "findLast": Signature((T.STR, T.STR), T.NUM),
     "getPrefix": Signature((T.STR, T.STR), T.STR),

@@ -6,7 +6,7 @@ text (``count``, ``find``, ``substring``..., the specification, tested against t
 once on a batch, where ``texts`` runs it once per distinct argument tuple (``table.distinct``) and interns
 what it makes.
 
-CityEngine's own functions are ``count find len substring`` and the conversions ``str float bool``; its
+CityEngine's own functions are ``count find len splitString substring`` and the conversions ``str float bool``; its
 utility library (``ce.lib``, callable without an import) adds ``findLast getPrefix getSuffix getRange replace``
 written in CGA on top of them, and these follow that CGA: ``replace`` with nothing to replace gives the text
 back, ``getPrefix`` without the match the whole text. Where the reference is silent: an empty match string
@@ -17,12 +17,15 @@ indices.
 from __future__ import annotations
 
 import math
+import re
 from collections.abc import Callable
 from typing import TYPE_CHECKING
 
 import numpy as np
 
+from grammarc.backend.arrays import Arrays
 from grammarc.backend.functions.table import distinct, function
+from grammarc.errors import LotFailure
 from grammarc.ir.functions import FUNCTIONS
 from grammarc.ir.nodes import Type
 
@@ -114,6 +117,17 @@ def replace(text: str, old: str, new: str) -> str:
     return text.replace(old, new) if old else text
 
 
+def split(text: str, delimiter: str) -> list[str]:
+    """``splitString``: the pieces of ``text`` between the delimiters; a delimiter starting with ``$`` is a
+    regular expression (Python's, which reads the reference's examples as CityEngine's does), and the
+    empty delimiter splits around every character (``"abc"``: "", "a", "b", "c", "").
+
+    Raises ``re.error`` for a regular expression that is not one."""
+    if delimiter.startswith("$"):
+        return re.split(delimiter[1:], text)
+    return re.split(re.escape(delimiter), text)
+
+
 def parse_float(text: str) -> float:
     """``float(text)``: the number written in the text (blanks around it allowed), NaN (CGA's missing
     value) when it is not one."""
@@ -164,6 +178,30 @@ on_texts("getSuffix")(suffix)
 on_texts("getRange")(between)
 on_texts("replace")(replace)
 on_texts("len")(len)
+
+
+@function("splitString")
+def split_string(call, args, env: Env) -> Arrays:
+    """``splitString(text, delimiter)``: per shape the array of its pieces, split once per distinct
+    (text, delimiter); the lots of the shapes whose delimiter is no regular expression fail."""
+    strings, known = env.plan.strings, texts(env)
+    pieces: list[list[int]] = []
+
+    def split_once(text: int, delimiter: int) -> int:
+        try:
+            found = split(known[text], known[delimiter])
+        except re.error:
+            return -1
+        pieces.append([strings.intern(piece) for piece in found])
+        return len(pieces) - 1
+    which = np.broadcast_to(np.asarray(distinct(split_once, *args), dtype=np.int64), (len(env.shapes),))
+    bad = which < 0
+    if bad.any():
+        raise LotFailure(f"splitString: no regular expression at {call.span}", np.unique(env.shapes.lot[bad]))
+    sizes = np.array([len(p) for p in pieces], dtype=np.int64)
+    table = Arrays(np.array([i for p in pieces for i in p], dtype=np.int32),
+                   np.concatenate([[0], np.cumsum(sizes)]).astype(np.int64), sizes)
+    return table.take(which)
 
 
 def as_string(value, strings):

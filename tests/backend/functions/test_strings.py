@@ -180,3 +180,39 @@ def test_operators_that_do_not_combine_a_string_and_a_number(write):
     assert errors(write, 'Lot -->\n    case "a" < 1: X.\n    else: X.\nX --> Y.\n') == [
         (3, 14, "`<` cannot combine a str and a num")]
     assert errors(write, 'Lot --> s("2" * 2, 1, 1) X.\n') == [(2, 15, "`*` cannot combine a str and a num")]
+
+
+# ------------------------------------------------------------------------------------------- splitString
+
+
+@pytest.mark.parametrize("text, delimiter, want", [
+    ("a.b.c", ".", ["a", "b", "c"]),
+    (".b.", ".", ["", "b", ""]),
+    ("a.b\nc.d", "\n", ["a.b", "c.d"]),
+    ("a\\b\\c", "\\", ["a", "b", "c"]),
+    ("abc", "", ["", "a", "b", "c", ""]),
+    ("a;b;c", "$;", ["a", "b", "c"]),
+    ("a.b.c", "$\\.", ["a", "b", "c"]),
+    ("a\t\tb\tc", "$\t+", ["a", "b", "c"]),
+    ("a b c", "$\\s+", ["a", "b", "c"]),
+    ("a$b$c", "$\\$", ["a", "b", "c"]),
+    ("abc", "$\\B", ["a", "b", "c"]),
+    ("abacba", "$(?<=a)b(?=a)", ["a", "acba"]),
+])
+def test_split_string_reference_examples(text, delimiter, want):
+    assert strings.split(text, delimiter) == want
+
+
+def test_split_string_gives_an_array_per_shape(write):
+    got = reported(write, 'attr path = ""\nattr parts = splitString(path, "/")\n'
+                          'Lot --> report("n", size(parts)) report("last", parts[size(parts) - 1])\n'
+                          '    report("first", splitString(path, "$[/.]")[0]) X.\n',
+                   lots=3, attrs={"path": ["assets/doors/door.obj", "", "x.y"]})
+    assert got == [{"n": 3, "last": "door.obj", "first": "assets"}, {"n": 1, "last": "", "first": ""},
+                   {"n": 1, "last": "x.y", "first": "x"}]
+
+
+def test_split_string_by_no_regular_expression_fails_the_lots_that_split_by_it(write):
+    got = reported(write, 'attr d = "."\nLot --> report("n", size(splitString("a.b", d))) X.\n',
+                   lots=2, attrs={"d": [".", "$("]})
+    assert got == [{"n": 2}, {}]
