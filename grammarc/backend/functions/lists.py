@@ -6,8 +6,8 @@ not clean (no ``;`` at the end, empty items ``;;``) and on indices out of range 
 
 - an item is what lies between two ``;``: ``"a;;b;"`` has three items, the second empty; the last item
   needs no ``;`` (``listSize("a;b")`` is 2) and ``""`` has none;
-- ``listItem`` out of range, and of a negative index, is ``""``; ``listRange`` clamps its indices and ends
-  its list with ``;``;
+- an index is truncated toward zero (``1.5`` is 1, ``-0.5`` is 0); ``listItem`` of an index out of range
+  (below 0, or not below the size) is ``""``; ``listRange`` clamps its indices and ends its list with ``;``;
 - a search string (``listIndex``, ``listCount``, ``listRemove``...) matches an item equal to it, or, with
   a ``*`` at its start, end or both, an item ending with, starting with or containing the rest.
 

@@ -62,6 +62,9 @@ def test_reference_examples(function, args, want):
     (lists.first, ("abc",), "abc"),
     (lists.terminate, ("",), ""),
     (lists.clean, (";;",), ""),
+    # an index is truncated toward zero
+    (lists.item, ("a;b;c;", 1.5), "b"),
+    (lists.item, ("a;b;c;", -0.5), "a"),
     # out of range: nothing
     (lists.item, ("a;b;", 2), ""),
     (lists.item, ("a;b;", -1), ""),
