@@ -11,9 +11,9 @@ not clean (no ``;`` at the end, empty items ``;;``) and on indices out of range 
 - a search string (``listIndex``, ``listCount``, ``listRemove``...) matches an item equal to it, or, with
   a ``*`` at its start, end or both, an item ending with, starting with or containing the rest.
 
-On a batch each runs once per distinct argument tuple (``strings.on_texts``); ``listRandom`` draws an
-index per shape from its random stream, as ``rand`` does, and takes the item once per distinct (list,
-index).
+On a batch each runs once per distinct argument tuple (``strings.on_texts``); ``listRandom`` cuts each
+distinct list into its items once and gathers the item of an index drawn per shape from its random
+stream, as ``rand`` draws.
 """
 
 from __future__ import annotations
@@ -23,7 +23,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from grammarc.backend.functions.strings import count, find, find_last, on_texts, prefix, substring, texts
-from grammarc.backend.functions.table import distinct, function
+from grammarc.backend.functions.table import function
 from grammarc.backend.random import uniform
 
 if TYPE_CHECKING:
@@ -151,8 +151,15 @@ def retain_all(items: str, search: str) -> str:
 @function("listRandom")
 def list_random(call, args, env: Env):
     """``listRandom(list)``: an item drawn per shape (index ``floor(u * (size - SHY))``, "" of an empty
-    list), from the shape's stream at the call's site as ``rand`` draws."""
+    list), from the shape's stream at the call's site as ``rand`` draws. Each distinct list is cut into its
+    items once; the items are gathered per shape by the drawn index."""
     strings, known = env.plan.strings, texts(env)
-    sizes = distinct(lambda i: float(size(known[i])), args[0])
-    index = np.floor(uniform(env.shapes.key, call.site) * (np.asarray(sizes) - SHY))
-    return distinct(lambda i, k: strings.intern(item(known[i], k)), args[0], index, dtype=np.int32)
+    u = uniform(env.shapes.key, call.site)
+    lists, which = np.unique(np.broadcast_to(args[0], u.shape), return_inverse=True)
+    items = [[strings.intern(item(known[text], k)) for k in range(size(known[text]))] for text in lists.tolist()]
+    sizes = np.array([len(i) for i in items], dtype=np.int64)
+    starts = np.concatenate([[0], np.cumsum(sizes)[:-1]]).astype(np.int64)
+    # every item, then "" for the draws of an empty list (index -1)
+    flat = np.array([i for each in items for i in each] + [strings.intern("")], dtype=np.int32)
+    index = np.floor(u * (sizes[which] - SHY)).astype(np.int64)
+    return flat[np.where(index >= 0, starts[which] + index, len(flat) - 1)]

@@ -5,12 +5,15 @@ and ``listRandom``'s draws."""
 from __future__ import annotations
 
 from collections import Counter
+from types import SimpleNamespace
 
 import numpy as np
 import pytest
 from reported import errors, reported
 
-from grammarc.backend.functions import lists
+from grammarc.backend.functions import FUNCTIONS, lists
+from grammarc.backend.plan import Strings
+from grammarc.backend.random import uniform
 
 RULES = "rule;your;designs;and;your;cities;"
 TEXTURES = "texture_1;texture_2;texture_3;texture_4;texture_5;texture_6;"
@@ -141,6 +144,21 @@ def test_list_random_draws_every_item_per_shape_and_again_the_same(write):
     assert sum(g["r"] != g["s"] for g in got) > 100
     assert reported(write, text, lots=lots, attrs=attrs, chunk_size=7) == got
     assert reported(write, text, lots=lots, attrs=attrs, seed=1) != got
+
+
+def test_list_random_is_the_item_at_the_drawn_index_shape_by_shape():
+    strings = Strings()
+    texts = ["a;b;c;", "", "x;;y", "solo", ";"]
+    ids = np.array([strings.intern(t) for t in texts], dtype=np.int32)
+    rng = np.random.default_rng(5)
+    key = rng.integers(0, 2**63, 500, dtype=np.uint64)
+    which = rng.integers(0, len(texts), 500)
+    env = SimpleNamespace(shapes=SimpleNamespace(key=key), plan=SimpleNamespace(strings=strings))
+    got = FUNCTIONS["listRandom"](SimpleNamespace(site=9, func="listRandom"), [ids[which]], env)
+    u = uniform(key, 9)
+    names = list(strings.ids)
+    want = [lists.item(texts[w], np.floor(x * (lists.size(texts[w]) - lists.SHY))) for w, x in zip(which, u)]
+    assert [names[g] for g in got] == want
 
 
 def test_list_functions_take_strings(write):
