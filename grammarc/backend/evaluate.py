@@ -14,7 +14,7 @@ from grammarc.backend import arrays, euler, occlusion
 from grammarc.backend.arrays import Arrays
 from grammarc.backend.env import Env
 from grammarc.backend.functions import FUNCTIONS
-from grammarc.backend.functions.strings import concatenate, is_string, string_ranks
+from grammarc.backend.functions.strings import as_string, concatenate, is_string, string_ranks
 from grammarc.errors import LotFailure
 from grammarc.ir import nodes as ir
 
@@ -67,7 +67,7 @@ def evaluate(expr: ir.Expr, env: Env):
             same = arrays.equal(left, right)
             return same if expr.op == "==" else ~same
         if expr.op in _COMPARE:
-            return _COMPARE[expr.op](left, right)
+            return _compare(expr.op, left, right, env)
         if expr.op == "+" and (is_string(left) or is_string(right)):
             return concatenate(left, right, env.plan.strings)
         with np.errstate(divide="ignore", invalid="ignore"):
@@ -77,6 +77,18 @@ def evaluate(expr: ir.Expr, env: Env):
     if isinstance(expr, (ir.ArrayLit, ir.Range, ir.Index)):
         return _ARRAY_EXPRESSIONS[type(expr)](expr, env)
     raise TypeError(f"cannot evaluate {expr!r}")
+
+
+def _compare(op: str, left, right, env: Env):
+    """A comparison of two values: numbers (and truth values, 1 or 0) by value; strings by their text, in
+    its order for ``<``...; a string and a number or a truth value as strings, the other written as ``str``
+    writes it (``passes.types``), so that no string id is ever compared with a number."""
+    if is_string(left) != is_string(right):
+        left, right = as_string(left, env.plan.strings), as_string(right, env.plan.strings)
+    if op not in ("==", "!=") and is_string(left):
+        ranks = string_ranks(env)
+        left, right = ranks[left], ranks[right]
+    return _COMPARE[op](left, right)
 
 
 # -------------------------------------------------------------------------------------------------- arrays
@@ -154,10 +166,7 @@ def _elementwise(expr: ir.Binary, left, right, env: Env) -> Arrays:
     elif op == "+" and (is_string(a) or is_string(b)):
         values = concatenate(a, b, env.plan.strings)
     elif op in _COMPARE:
-        if op not in ("==", "!=") and is_string(a):  # strings in order of their text
-            ranks = string_ranks(env)
-            a, b = ranks[a], ranks[b]
-        values = _COMPARE[op](a, b)
+        values = _compare(op, a, b, env)
     else:
         with np.errstate(divide="ignore", invalid="ignore"):
             values = _ARITH[op](np.asarray(a, dtype=np.float64), b)

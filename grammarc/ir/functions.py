@@ -68,8 +68,26 @@ FUNCTIONS: dict[str, Signature] = {
     "float": Signature((None,), T.NUM),
     "bool": Signature((None,), T.BOOL),
     "len": Signature((T.STR,), T.NUM),
+    "count": Signature((T.STR, T.STR), T.NUM),
+    "find": Signature((T.STR, T.STR, T.NUM), T.NUM),
+    "substring": Signature((T.STR, T.NUM, T.NUM), T.STR),
+    "splitString": Signature((T.STR, T.STR), T.STRS),
+    # CityEngine's utility library (ce.lib), built on the four above
+    "findLast": Signature((T.STR, T.STR), T.NUM),
+    "getPrefix": Signature((T.STR, T.STR), T.STR),
+    "getSuffix": Signature((T.STR, T.STR), T.STR),
+    "getRange": Signature((T.STR, T.STR, T.STR), T.STR),
+    "replace": Signature((T.STR, T.STR, T.STR), T.STR),
     # ------------------------------------------------------------------------ string lists (backend.functions.lists)
+    **{name: Signature((T.STR,), T.STR) for name in ("listTerminate", "listClean", "listFirst", "listLast")},
+    **{name: Signature((T.STR, T.STR), T.STR) for name in ("listAdd", "listRemove", "listRemoveAll",
+                                                           "listRetainAll")},
+    "listSize": Signature((T.STR,), T.NUM),
     "listItem": Signature((T.STR, T.NUM), T.STR),
+    "listRange": Signature((T.STR, T.NUM, T.NUM), T.STR),
+    "listIndex": Signature((T.STR, T.STR), T.NUM),
+    "listCount": Signature((T.STR, T.STR), T.NUM),
+    "listRandom": Signature((T.STR,), T.STR, shape=True),
     # ---------------------------------------------------------------------------------- files (backend.functions.files)
     # a search query (``ir.file_search``) or a path; the choosers draw from the shape's stream
     "fileRandom": Signature((T.STR,), T.STR, shape=True),

@@ -187,5 +187,5 @@ def test_every_math_function_folds_and_none_that_reads_the_shape():
 
 
 def test_a_call_with_a_wrong_count_of_arguments_is_the_checkers_error_not_folded():
-    module, diags = folded('version "2022.0"\nLot --> extrude(sqrt(4, 3)) A\n')
+    _, diags = folded('version "2022.0"\nLot --> extrude(sqrt(4, 3)) A\n')
     assert [(d.code, d.message) for d in diags if d.is_error] == [("arity", "`sqrt` takes 1 argument, got 2")]

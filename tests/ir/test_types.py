@@ -36,9 +36,9 @@ def errors(text: str) -> list[tuple[int, int, str]]:
     # operators
     ('a ~> T("a" * 1, 0, 0)', [(1, 12, "`*` cannot combine a str and a num")]),
     ('a ~> T(2 * "b", 0, 0)', [(1, 10, "`*` cannot combine a num and a str")]),
-    ('a : 1 == "x" ~> b', [(1, 7, "`==` cannot combine a num and a str")]),
-    ('a : "x" != 1 ~> b', [(1, 9, "`!=` cannot combine a str and a num")]),
-    ('a : "a" < "b" ~> b', [(1, 9, "`<` cannot combine a str and a str")]),
+    ('a : 1 < "x" ~> b', [(1, 7, "`<` cannot combine a num and a str")]),
+    ('a : "x" >= true ~> b', [(1, 9, "`>=` cannot combine a str and a bool")]),
+    ("a : true < false ~> b", [(1, 10, "`<` cannot combine a bool and a bool")]),
     ("a : true + 1 > 0 ~> b", [(1, 10, "`+` cannot combine a bool and a num")]),
     ("a : 1 && true ~> b", [(1, 5, "`&&` cannot combine a num and a bool")]),
     ("a : !1 ~> b", [(1, 6, "the operand of `!` must be a bool, got a num")]),
@@ -53,8 +53,10 @@ def errors(text: str) -> list[tuple[int, int, str]]:
     ('a ~> b : "p" ~> c : 0.5', [(1, 10, "a probability must be a num, got a str")]),
     # attribute defaults are checked too
     ('attr a = "x" - 1\nb ~> c', [(1, 14, "`-` cannot combine a str and a num")]),
-    # well-typed: equality on any one type, logic on bools
+    # well-typed: equality on any two values (a string and another as strings), order on numbers and on
+    # strings, logic on bools
     ('a : "x" == "x" && true != false || !(1 >= 2) ~> b', []),
+    ('a : 1 == "x" || "x" != true || "a" < "b" ~> b', []),
 ])
 def test_type_errors(text, expected):
     assert errors(text) == expected

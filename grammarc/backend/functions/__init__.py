@@ -5,8 +5,9 @@ Each is an ordinary function ``f(call, args, env)`` registered with ``@function(
 families, as that table groups them:
 
 - ``math``: arithmetic, trigonometry in degrees, ``rand``, ``p``, ``print`` (which gives its value);
-- ``strings``: ``str``, ``float``, ``bool``, ``len``, and string concatenation;
-- ``lists``: the ``;``-separated string lists;
+- ``strings``: ``str float bool``, ``count find len splitString substring`` and ce.lib's string utilities,
+  string concatenation and comparison;
+- ``lists``: the ``;``-separated string lists (ce.lib's ``list*``, ``listRandom`` per shape);
 - ``files``: searches in the grammar's roots (``fileSearch``, ``fileRandom``...) and paths taken apart;
 - ``assets``: an asset's size (``assetInfo``) and assets chosen by how they fit the scope;
 - ``images``: an image's resolution (``imageInfo``) and images chosen by their proportions;

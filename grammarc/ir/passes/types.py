@@ -43,8 +43,8 @@ def infer_types(module: ir.Module, diags: Diagnostics) -> ir.Module:
             for expr, want, what in _wanted(node, attr_types, param_types):
                 if want is not None:
                     got = _expect(expr, want, what, attr_types, params, diags)
-                else:  # not checked here, but an array where the backend takes a value is refused
-                    got = type_of(expr, attr_types, params, Diagnostics())
+                else:  # any type (its operands checked); an array where the backend takes a value is refused
+                    got = type_of(expr, attr_types, params, diags)
                 if got.is_array and (want is None or want.is_array):
                     diags.error("unsupported", f"unsupported: an array as {what}", expr.span)
     return replace(module, attrs=tuple(attrs), param_types=tuple(sorted(param_types.items())))
@@ -133,8 +133,10 @@ def _infer_param_types(module, attr_types, arity) -> dict[str, tuple[ir.Type, ..
 
 def _infer_from_uses(rule: ir.Rule, slots: list, attr_types) -> None:
     """A parameter that no call passes a value to (a library's rule, called from the files that import
-    it) takes its type from its rule's uses: compared with a typed value (``type == "nailed"``), an
-    operand of ``&&`` or ``||``, or given where a type is wanted (``i(name)``, ``s(n, 1, 1)``)."""
+    it) takes its type from its rule's uses: given where a type is wanted (``i(name)``, ``s(n, 1, 1)``),
+    an operand of ``&&`` or ``||``, of ``-``, ``*``, ``/`` or ``%``, else compared with a typed value
+    (``type == "nailed"``). Comparisons come last: CityEngine compares a number with a string too
+    (``mix != ""``), so a parameter used as a number elsewhere stays a number."""
     def settle(expr, want):
         if isinstance(expr, ir.Param) and expr.index < len(slots) and slots[expr.index] is T.UNKNOWN \
                 and want not in (None, T.UNKNOWN):
@@ -143,19 +145,26 @@ def _infer_from_uses(rule: ir.Rule, slots: list, attr_types) -> None:
     for node in iter_nodes(rule):
         for expr, want, _ in _declared(node):
             settle(expr, want)
+    compared = []
     for expr in all_exprs(rule):
-        if isinstance(expr, ir.Binary) and expr.op in ir.LOGIC_OPS:
-            settle(expr.left, T.BOOL)
-            settle(expr.right, T.BOOL)
+        if isinstance(expr, ir.Binary) and expr.op in ir.LOGIC_OPS | _ARITHMETIC:
+            settle(expr.left, T.BOOL if expr.op in ir.LOGIC_OPS else T.NUM)
+            settle(expr.right, T.BOOL if expr.op in ir.LOGIC_OPS else T.NUM)
         elif isinstance(expr, ir.Binary) and expr.op in ir.COMPARE_OPS:
-            for this, other in ((expr.left, expr.right), (expr.right, expr.left)):
-                settle(this, type_of(other, attr_types, tuple(slots), Diagnostics()))
+            compared.append(expr)
         elif isinstance(expr, ir.Call) and expr.func not in ARRAY_FUNCTIONS:
             for this, want in zip(expr.args, FUNCTIONS[expr.func].params):
                 settle(this, want)
         else:
             for this, want, _ in _declared(expr):
                 settle(this, want)
+    for expr in compared:
+        for this, other in ((expr.left, expr.right), (expr.right, expr.left)):
+            settle(this, type_of(other, attr_types, tuple(slots), Diagnostics()))
+
+
+#: The operators that take numbers only (``+`` writes strings too).
+_ARITHMETIC = frozenset({"-", "*", "/", "%"})
 
 
 def _expect(expr, want, what, attr_types, ptypes, diags) -> ir.Type:
@@ -221,12 +230,15 @@ def _binary(expr: ir.Binary, got: list[ir.Type], diags: Diagnostics) -> ir.Type:
     if expr.op in ir.LOGIC_OPS:
         ok, result = left is T.BOOL and right is T.BOOL, T.BOOL
     elif expr.op in ("==", "!="):
-        # the paper compares truth values with numbers (``Shape.visible("Street") == 0``): 1 or 0
-        ok, result = left is right or {left, right} == {T.BOOL, T.NUM}, T.BOOL
+        # any two values: the paper compares truth values with numbers (``Shape.visible("Street") == 0``: 1
+        # or 0); a string and a number or a truth value compare as strings, the other written as ``str``
+        # writes it (``mix != ""``; ``"1" == 1``), as ``+`` writes it into a string
+        ok, result = True, T.BOOL
     elif expr.op in ir.COMPARE_OPS:
-        ok, result = left is T.NUM and right is T.NUM, T.BOOL
+        # numbers by value, strings in the order of their text (CityEngine's relational operators)
+        ok, result = left is right and left in (T.NUM, T.STR), T.BOOL
     elif expr.op == "+" and T.STR in (left, right):
-        # CityEngine's string concatenation: "Height." + 3 is "Height.3"
+        # CityEngine's string concatenation: "Height." + 3 is "Height.3", true + "x" is "truex"
         ok, result = True, T.STR
     else:
         ok, result = left is T.NUM and right is T.NUM, T.NUM
