@@ -36,8 +36,8 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from grammarc.backend.functions.files import found, groups, per_key, pick, ragged_strings, roots, string_list
-from grammarc.backend.functions.table import distinct, function
+from grammarc.backend.functions.files import found, pick, ragged_strings, roots, string_list
+from grammarc.backend.functions.table import distinct, function, groups
 from grammarc.errors import AssetError
 from grammarc.ir.asset_names import resolve_asset
 
@@ -71,7 +71,7 @@ def asset_info(call, args, env: Env):
         if box is None:
             return 0.0
         return float(box[1, axis] - box[0, axis]) if row < 0 else float(box[row, axis])
-    return per_key(info, [args[0], args[1]], len(env.shapes))
+    return distinct(info, args[0], args[1])
 
 
 def extents(env: Env, names) -> np.ndarray:
@@ -133,7 +133,7 @@ def sort_list(call, args, env: Env, errors: Errors, measure: Callable, within=No
     texts = list(strings.ids)
     n = len(env.shapes)
     out = np.empty(n, dtype=np.int32)
-    for (items, selector), rows in groups([args[0], args[1]], n):
+    for (items, selector), rows in groups(n, args[0], args[1]):
         names = [name for name in texts[items].split(";") if name]
         errors_ = errors(env, rows, measure(env, names), texts[selector])
         keep = None

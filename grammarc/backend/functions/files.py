@@ -12,13 +12,13 @@ too: it is the text after the last dot).
 
 from __future__ import annotations
 
-from collections.abc import Callable, Iterator
+from collections.abc import Callable
 from typing import TYPE_CHECKING
 
 import numpy as np
 
 from grammarc.backend.arrays import Arrays
-from grammarc.backend.functions.table import distinct, function
+from grammarc.backend.functions.table import distinct, function, groups
 from grammarc.backend.random import uniform
 from grammarc.ir.asset_names import resolve_asset
 from grammarc.ir.file_search import search
@@ -30,57 +30,6 @@ if TYPE_CHECKING:
 def roots(env: Env) -> tuple:
     """The folders the grammar's files are searched and resolved in (``Grammar.asset_roots``)."""
     return tuple(env.plan.grammar.asset_roots)
-
-
-def distinct_keys(keys: list, n: int) -> tuple[list[tuple[int, ...]], np.ndarray]:
-    """The distinct tuples of ``keys`` (one or two scalars or (n,) arrays of string ids), in increasing
-    order, and (n,) int64 the index of each shape's tuple among them.
-
-    String ids are small, so a tuple is one number (mixed radix) and a table over their range replaces a
-    sort of the shapes: linear in n, where ``np.unique`` of the rows would sort them."""
-    columns = [np.broadcast_to(np.asarray(k, dtype=np.int64), (n,)) for k in keys]
-    radix = [int(c.max()) + 1 if n else 1 for c in columns]
-    code = np.zeros(n, dtype=np.int64)
-    for column, base in zip(columns, radix):
-        code = code * base + column
-    top = int(code.max()) + 1 if n else 0
-    if top <= 8 * n + 4096:
-        present = np.zeros(top, dtype=bool)
-        present[code] = True
-        values = np.flatnonzero(present)
-        inverse = (np.cumsum(present) - 1)[code]
-    else:
-        values, inverse = np.unique(code, return_inverse=True)
-    tuples = []
-    for value in values.tolist():
-        digits = []
-        for base in reversed(radix):
-            value, digit = divmod(value, base)
-            digits.append(digit)
-        tuples.append(tuple(reversed(digits)))
-    return tuples, inverse.reshape(-1)
-
-
-def groups(keys: list, n: int) -> Iterator[tuple[tuple[int, ...], np.ndarray]]:
-    """Each distinct tuple of ``keys`` (see ``distinct_keys``) and the (k,) int64 shapes holding it."""
-    if n == 0:
-        return
-    if all(np.ndim(k) == 0 for k in keys):  # constants: one group, no table
-        yield tuple(int(k) for k in keys), np.arange(n)
-        return
-    values, inverse = distinct_keys(keys, n)
-    order = np.argsort(inverse, kind="stable")
-    starts = np.searchsorted(inverse[order], np.arange(len(values)))
-    yield from zip(values, np.split(order, starts[1:]))
-
-
-def per_key(compute: Callable, keys: list, n: int, dtype=np.float64):
-    """``compute(*key)`` once per distinct tuple of ``keys`` (string ids), spread over the shapes: a
-    scalar when the keys are, else (n,) ``dtype``."""
-    if all(np.ndim(k) == 0 for k in keys):
-        return compute(*(int(k) for k in keys))
-    values, inverse = distinct_keys(keys, n)
-    return np.array([compute(*value) for value in values], dtype=dtype)[inverse]
 
 
 def found(env: Env, query: int) -> tuple[str, ...]:
@@ -98,7 +47,7 @@ def pick(choices: Callable[[tuple[int, ...], np.ndarray], np.ndarray], keys: lis
     n = len(env.shapes)
     u = uniform(env.shapes.key, call.site)
     out = np.full(n, env.plan.strings.intern(""), dtype=np.int32)
-    for key, rows in groups(keys, n):
+    for key, rows in groups(n, *keys):
         options = np.asarray(choices(key, rows))
         options = np.broadcast_to(options, (len(rows), options.shape[1]))
         count = (options >= 0).sum(axis=1)
@@ -142,7 +91,7 @@ def ragged_strings(env: Env, keys: list, names_of: Callable[[tuple[int, ...]], t
     n = len(env.shapes)
     sizes = np.zeros(n, dtype=np.int64)
     lists = []
-    for key, rows in groups(keys, n):
+    for key, rows in groups(n, *keys):
         lists.append((rows, np.array([env.plan.strings.intern(s) for s in names_of(key)], dtype=np.int32)))
         sizes[rows] = len(lists[-1][1])
     offsets = np.concatenate([[0], np.cumsum(sizes)]).astype(np.int64)

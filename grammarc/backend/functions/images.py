@@ -19,8 +19,8 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from grammarc.backend.functions.assets import choose, ratio_errors, sort_list
-from grammarc.backend.functions.files import per_key, roots
-from grammarc.backend.functions.table import function
+from grammarc.backend.functions.files import roots
+from grammarc.backend.functions.table import distinct, function
 from grammarc.ir.asset_names import resolve_asset
 
 if TYPE_CHECKING:
@@ -59,7 +59,7 @@ def image_info(call, args, env: Env):
             return np.nan
         size = image_size(env, names[image])[names[query] == "sy"]
         return 0.0 if np.isnan(size) else size
-    return per_key(info, [args[0], args[1]], len(env.shapes))
+    return distinct(info, args[0], args[1])
 
 
 def sizes(env: Env, names) -> np.ndarray:

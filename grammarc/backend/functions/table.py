@@ -9,11 +9,13 @@ string function computes once per distinct argument (``distinct``) and gathers, 
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 
 import numpy as np
 
-__all__ = ["FUNCTIONS", "distinct", "function"]
+from grammarc.ragged import row_groups
+
+__all__ = ["FUNCTIONS", "distinct", "function", "groups"]
 
 #: Function name (as in ``ir.functions.FUNCTIONS``) -> its implementation.
 FUNCTIONS: dict[str, Callable] = {}
@@ -41,17 +43,29 @@ def distinct(compute: Callable, *args, dtype=np.float64):
     if all(np.ndim(a) == 0 for a in args):
         return compute(*(a.item() if isinstance(a, np.generic) else a for a in args))
     columns = np.broadcast_arrays(*(np.asarray(a) for a in args))
-    kinds = [c.dtype for c in columns]
-    stacked = np.stack([c.astype(np.float64) for c in columns], axis=1)
-    keys, inverse = np.unique(stacked, axis=0, return_inverse=True)
-    results = np.array([compute(*(_typed(v, kind) for v, kind in zip(key, kinds))) for key in keys], dtype=dtype)
-    return results[inverse.reshape(-1)]
+    inverse, first = _tuples(columns)
+    results = np.array([compute(*(c[row].item() for c in columns)) for row in first.tolist()], dtype=dtype)
+    return results[inverse]
 
 
-def _typed(value: float, kind: np.dtype):
-    """A value of a stacked key back in its own type: a flag as bool, an id as int, a number as float."""
-    if kind == np.bool_:
-        return bool(value)
-    if np.issubdtype(kind, np.integer):
-        return int(value)
-    return float(value)
+def groups(n: int, *args) -> Iterator[tuple[tuple, np.ndarray]]:
+    """Each distinct tuple of argument values (as ``distinct`` takes them) among ``n`` shapes and the (k,)
+    int64 shapes holding it, for a function that computes per group rather than per value."""
+    if n == 0:
+        return
+    if all(np.ndim(a) == 0 for a in args):  # constants: one group
+        yield tuple(a.item() if isinstance(a, np.generic) else a for a in args), np.arange(n)
+        return
+    columns = np.broadcast_arrays(*(np.asarray(a) for a in args))
+    inverse, first = _tuples(columns)
+    order = np.argsort(inverse, kind="stable")
+    starts = np.searchsorted(inverse[order], np.arange(len(first)))
+    keys = [tuple(c[row].item() for c in columns) for row in first.tolist()]
+    yield from zip(keys, np.split(order, starts[1:]))
+
+
+def _tuples(columns: list[np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
+    """Each shape's tuple among the distinct ones (n,) int64 and a shape holding each (g,) int64, from one
+    lexsort of the values' bits (equal bits, equal values: NaNs are one value)."""
+    bits = np.stack([np.ascontiguousarray(c, dtype=np.float64).view(np.int64) for c in columns], axis=1)
+    return row_groups(bits)

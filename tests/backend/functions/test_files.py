@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 from function_derivations import box_obj, derived, rectangles, reported, write_files
 
-from grammarc.backend.functions.files import distinct_keys
+from grammarc.backend.functions.table import groups
 
 TREES = {f"assets/trees/{name}": box_obj((1, 1, 1)) for name in ("oak.obj", "elm.obj", "fir.obj")}
 PICKS = sorted(TREES)
@@ -116,12 +116,13 @@ def test_an_insert_of_a_search_that_found_nothing_fails_its_lot(tmp_path):
     assert "`i` of ``, a file search that found nothing" in r["bad"][0].reason
 
 
-@pytest.mark.parametrize("high", [10, 2**40])  # small ids: a table; large: a sort
-def test_distinct_keys_numbers_each_shapes_tuple(high):
+@pytest.mark.parametrize("high", [10, 2**40])  # small and large ids
+def test_groups_number_each_shapes_tuple(high):
     rng = np.random.default_rng(0)
     a = rng.integers(0, 5, 200) * (high // 5)
     b = rng.integers(0, 3, 200)
-    values, inverse = distinct_keys([a, b], 200)
-    assert values == sorted(set(zip(a.tolist(), b.tolist())))
-    assert [values[i] for i in inverse] == list(zip(a.tolist(), b.tolist()))
-    assert distinct_keys([a, 7], 200)[0] == [(v, 7) for v in sorted(set(a.tolist()))]
+    found = dict(groups(200, a, b))
+    assert sorted(found) == sorted(set(zip(a.tolist(), b.tolist())))
+    assert all((a[rows] == key[0]).all() and (b[rows] == key[1]).all() for key, rows in found.items())
+    assert sum(len(rows) for rows in found.values()) == 200
+    assert sorted(dict(groups(200, a, 7))) == [(v, 7) for v in sorted(set(a.tolist()))]

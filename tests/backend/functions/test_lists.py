@@ -167,4 +167,4 @@ def test_list_functions_take_strings(write):
     assert errors(write, 'Lot --> report("i", listItem("a;b;", "1")) X.\n') == [
         (2, 38, "an argument of `listItem` must be a num, got a str")]
     assert errors(write, 'Lot --> report("r", listRandom()) X.\n') == [
-        (2, 21, "`listRandom` takes 1 arguments, got 0")]
+        (2, 21, "`listRandom` takes 1 argument, got 0")]
