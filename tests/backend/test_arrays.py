@@ -114,6 +114,8 @@ A2 = "const a = [1, 2, 3 ; 4, 5, 6 ; 7, 8, 9]\n"
     ("const v = findFirst([1, 2, 3, 4], 2, 0)", 1), ("const v = findFirst([1, 2, 3 ; 4, 5, 6], 4, 0)", 3),
     ("const v = findFirst([6, 8.1, 6, 8.1], 8, 0.5)", 1), ('const v = findFirst(["a", "b"], "c")', -1),
     ("const v = findFirst([false, true], true)", 1),
+    # ce.lib's findFirst on strings: find(text, match, 0)
+    ('const v = findFirst("ab;cd;", "cd")', 3), ('const v = findFirst("ab;cd;", "x")', -1),
     # equality of whole arrays
     ("const v = [1, 2] == [1, 2]", True), ('const v = ["a", "b"] == ["a" ; "b"]', False),
     ("const v = [true, false] == [true, true]", False), ("const v = [1, 2] != [1 ; 2]", True),

@@ -8,8 +8,8 @@ import numpy as np
 
 from grammarc.backend import arrays
 from grammarc.backend.arrays import Arrays
-from grammarc.backend.functions.strings import concatenate, is_string, string_ranks
-from grammarc.backend.functions.table import FUNCTIONS, function
+from grammarc.backend.functions.strings import concatenate, find, is_string, string_ranks, texts
+from grammarc.backend.functions.table import FUNCTIONS, distinct, function
 from grammarc.ir.functions import ARRAY_CONVERSIONS
 
 if TYPE_CHECKING:
@@ -53,6 +53,10 @@ def sort_indices(call, args, env: Env):
 
 @function("findFirst")
 def find_first(call, args, env: Env):
+    """The first index of a value in an array, or ce.lib's ``findFirst(text, match)``: ``find(text, match, 0)``."""
+    if not isinstance(args[0], Arrays):
+        known = texts(env)
+        return distinct(lambda text, match: float(find(known[text], known[match], 0)), args[0], args[1])
     return arrays.find_first(*args)
 
 

@@ -297,6 +297,8 @@ _ARRAY_ARGUMENT = {
     "sortIndices": (lambda t: t in (T.NUMS, T.STRS), "a num[] or a str[]"),
     "sortRowIndices": (lambda t: t in (T.NUMS, T.STRS), "a num[] or a str[]"),
     "isNull": (lambda t: t in (T.NUM, T.STR), "a num or a str"),
+    # ce.lib's `findFirst(text, match)` on strings predates the array function
+    "findFirst": (lambda t: t.is_array or t is T.STR, "an array or a str"),
 }
 
 
