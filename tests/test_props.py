@@ -1,7 +1,7 @@
 """The props example (examples/props): wind turbines, trees and fences inserted from GLB assets.
 
-The record is held to what each insert mode promises, measured on the instances: towers fitted to their
-4 m box as tall as the lot says, nacelles at their own 3 x 3 x 10 m centred on the tower top, rotors (a
+The record is held to what each insert mode promises, measured on the instances: towers fitted to a box
+of their asset's footprint (``assetInfo``) as tall as the lot says, nacelles at their own 3 x 3 x 10 m centred on the tower top, rotors (a
 z-up export) at their own size with their hub, the asset's origin, 1.5 m above the tower, trees at their
 own proportions standing on the ground, fence posts as tall as the lot's fence. The assets and lots are
 what the scripts make, ``render`` draws the GLB meshes (no box stands in), and the records keep a digest
@@ -66,8 +66,9 @@ def test_towers_are_fitted_and_nacelles_keep_their_size_on_top(site):
     _, _, record, features = site
     tower, lots = instances(record, "Tower")
     heights = np.array([features[lot]["properties"]["turbineHeight"] for lot in lots])
+    width, _, depth = extents("assets/turbine/tower.glb")  # the box is the asset's footprint (assetInfo)
     np.testing.assert_allclose(np.linalg.norm(tower[:, :, :3], axis=1),
-                               np.stack([np.full(len(lots), 4.0), heights, np.full(len(lots), 4.0)], 1), atol=TOL)
+                               np.stack([np.full(len(lots), width), heights, np.full(len(lots), depth)], 1), atol=TOL)
     nacelle, _ = instances(record, "Nacelle")
     np.testing.assert_allclose(np.linalg.norm(nacelle[:, :, :3], axis=1), [[3, 3, 10]] * len(lots), atol=TOL)
     # the nacelle's bottom centre is the tower's top centre
@@ -90,6 +91,7 @@ def test_rotors_keep_their_size_and_turn_about_their_hub(site):
 
 
 def test_trees_keep_their_proportions_and_stand_on_the_ground(site):
+    """Both trees of the folder are drawn (``fileRandom``), with the leaf colours of the list."""
     _, _, record, _ = site
     tree, _ = instances(record, "TreeModel")
     names = record["assets"][record["asset"][record["symbols"][record["symbol"]] == "TreeModel"]]
@@ -100,6 +102,9 @@ def test_trees_keep_their_proportions_and_stand_on_the_ground(site):
     np.testing.assert_allclose(scale, scale[:, :1].repeat(3, axis=1), atol=TOL)
     assert ((0.75 - TOL < scale[:, 0]) & (scale[:, 0] < 1.3 + TOL)).all()
     assert np.abs(tree[:, 1, 3]).max() < TOL  # every tree's bottom on y = 0
+    colours = record["color"][record["symbols"][record["symbol"]] == "TreeModel"][:, :3]
+    leaves = {(0x5D, 0x8F, 0x3E), (0x2F, 0x6A, 0x44), (0x6B, 0x9A, 0x45), (0x3F, 0x7A, 0x4F)}
+    assert {tuple(c) for c in colours.tolist()} == leaves
 
 
 def test_fence_posts_are_as_tall_as_the_lot_says(site):
