@@ -11,7 +11,7 @@ from grammarc.diagnostics import Diagnostics, Span, suggest
 from grammarc.frontend.cityengine.nodes import Annotated, FunctionDef, Import, RuleDef, Style
 from grammarc.frontend.cityengine.operations import check_calls
 from grammarc.ir import nodes as ir
-from grammarc.ir.functions import FUNCTIONS
+from grammarc.ir.functions import FUNCTIONS, UNSUPPORTED_FUNCTIONS
 from grammarc.ir.traverse import rewrite_body, rewrite_expr, rewrite_ops
 
 
@@ -165,6 +165,9 @@ class _Inliner:
             # `findFirst(text, match)` predates the array one)
             if isinstance(e, ir.Call) and (e.func in self.functions or e.func not in FUNCTIONS):
                 fn = self.functions.get(e.func)
+                if fn is None and e.func in UNSUPPORTED_FUNCTIONS:
+                    self.diags.error("unsupported", f"unsupported: {e.func}", e.span)
+                    return ir.placeholder(e.span)
                 if fn is None:
                     self.diags.error("unknown-function", f"unknown function `{e.func}`"
                                      f"{suggest(e.func, [*FUNCTIONS, *self.functions])}", e.span)

@@ -96,6 +96,11 @@ def test_unknown_function_and_wrong_arity_are_errors():
                             (3, 29, "`half` takes 1 arguments, got 2")]
 
 
+def test_a_built_in_of_the_reference_that_grammarc_does_not_compute_is_unsupported():
+    text = VERSION + 'Lot --> extrude(minimumDistance(intra, "x") + 1) A\nA --> report("k", getTreeKey()) X.\n'
+    assert errors(text) == [(2, 17, "unsupported: minimumDistance"), (3, 19, "unsupported: getTreeKey")]
+
+
 def test_functions_of_an_imported_file_see_its_attributes(tmp_path):
     """An imported file's functions read its attributes under its prefix, or the importer's attribute of
     the same name (forwarding), as its rules do."""
