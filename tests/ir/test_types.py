@@ -128,6 +128,16 @@ def test_a_parameter_no_call_passes_takes_its_type_from_its_uses():
     assert dict(module.param_types)["Plank"] == (T.STR, T.STR, T.BOOL, T.NUM)
 
 
+def test_a_parameter_only_passed_on_takes_the_type_of_the_parameter_it_is_passed_to():
+    # a start rule's parameters, which no call gives values, handed down to rules that use them
+    text = ('version "2022.0"\n@StartRule\nStairway(colour, steps) --> Level(colour, steps)\n'
+            'Level(c, n) --> Step(c) split(x){ ~n : X. }*\nStep(c) --> color(c) Y.\n')
+    diags = Diagnostics()
+    module = run_passes(parse_source(text, FILE, diags, "cityengine"), diags, check=True, stop_after="types")
+    assert not diags.has_errors
+    assert dict(module.param_types)["Stairway"] == (T.STR, T.NUM)
+
+
 def test_conflicting_call_sites_report_the_later_one():
     # the first call site decides the type; later ones are checked against it
     module, diags = typed('a ~> b(1) b("x")\nb(x) ~> c')

@@ -128,7 +128,25 @@ def _infer_param_types(module, attr_types, arity) -> dict[str, tuple[ir.Type, ..
     for rule in module.rules:
         if T.UNKNOWN in types.get(rule.symbol, ()):
             _infer_from_uses(rule, types[rule.symbol], attr_types)
+    _infer_from_successors(calls, types)
     return {sym: tuple(T.NUM if t is T.UNKNOWN else t for t in ts) for sym, ts in types.items()}
+
+
+def _infer_from_successors(calls, types) -> None:
+    """A parameter still untyped that its rule passes on to a successor takes the type of the parameter it
+    is passed to: a start rule's parameters, which no call gives values, handing them down
+    (``Stairway(colour) --> Level(colour)`` where ``Level`` uses its ``colour`` as a string)."""
+    changed = True
+    while changed:  # each round types at least one more parameter, or ends
+        changed = False
+        for symbol, successors in calls:
+            slots = types[symbol]
+            for op in successors:
+                for arg, t in zip(op.args, types[op.name]):
+                    if isinstance(arg, ir.Param) and arg.index < len(slots) and slots[arg.index] is T.UNKNOWN \
+                            and t is not T.UNKNOWN:
+                        slots[arg.index] = t
+                        changed = True
 
 
 def _infer_from_uses(rule: ir.Rule, slots: list, attr_types) -> None:
