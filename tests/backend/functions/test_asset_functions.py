@@ -19,15 +19,19 @@ SIZES = {"assets/a.obj": box_obj((1, 1, 1)), "assets/b.obj": box_obj((2, 1, 2)),
 RATIOS = {"assets/r1.obj": box_obj((1, 1, 1)), "assets/r2.obj": box_obj((2, 1, 1)), "assets/r4.obj": box_obj((4, 1, 1))}
 
 
-def glb(size, corner) -> bytes:
+def exported(size, corner, file_type: str) -> bytes:
+    """A box of ``size`` with its lowest corner at ``corner``, as trimesh writes it (``glb``, ``dae``)."""
     mesh = trimesh.creation.box(extents=size)
     mesh.apply_translation([c + s / 2 for c, s in zip(corner, size)])
-    return mesh.export(file_type="glb")
+    data = mesh.export(file_type=file_type)
+    return data if isinstance(data, bytes) else data.encode()
 
 
-@pytest.mark.parametrize("asset", ["assets/unitCube.obj", "assets/unitCube.glb"])
+@pytest.mark.parametrize("asset", ["assets/unitCube.obj", "assets/unitCube.glb", "assets/unitCube.dae"])
 def test_asset_info_is_the_size_and_lowest_corner_in_the_assets_units(tmp_path, asset):
-    write_files(tmp_path, {"assets/unitCube.obj": CUBE, "assets/unitCube.glb": glb((0.2, 0.3, 0.4), (0.5, 0.55, 0.6))})
+    """Every format gives the same answer (FBX and 3DS bounds: ``tests/model/test_assets.py``)."""
+    write_files(tmp_path, {"assets/unitCube.obj": CUBE, **{
+        f"assets/unitCube.{kind}": exported((0.2, 0.3, 0.4), (0.5, 0.55, 0.6), kind) for kind in ("glb", "dae")}})
     reports = " ".join(f'report("{k}", assetInfo("{asset}", {k})) report("q{k}", assetInfo("{asset}", "{k}"))'
                        for k in INFO)
     r = derived(tmp_path, f"Lot --> {reports}", rectangles((1, 1)))
