@@ -375,10 +375,12 @@ class Scale:
 
 @dataclass(frozen=True, slots=True)
 class Rotate:
-    """Rotate the scope axes about its own x, then y, then z axis (degrees), around the origin."""
+    """Rotate the scope axes about its own x, then y, then z axis (degrees), around the origin, or around
+    the scope's centre when ``center`` (CityEngine ``r(scopeCenter, x, y, z)``)."""
 
     angles: tuple[Expr, Expr, Expr] = child(Type.NUM, "an angle")
     span: Span = NO_SPAN
+    center: bool = False
 
 
 @dataclass(frozen=True, slots=True)
@@ -730,10 +732,29 @@ class CompFaces:
     offset: Expr | None = child(Type.NUM, "an offset distance", default=None)
 
 
+
+#: CityEngine's coordinate systems of ``translate`` and ``rotate``.
+COORDINATE_SYSTEMS = frozenset({"scope", "pivot", "object", "world"})
+
+
+@dataclass(frozen=True, slots=True)
+class Transform:
+    """CityEngine ``translate(rel|abs, system, x, y, z)`` (``kind`` "translate": the scope origin moved by,
+    or set to, a position in ``system``) and ``rotate(rel|abs, system, x, y, z)`` ("rotate": the scope's
+    angles in ``system`` added to, or set to, the given ones, around the scope origin)."""
+
+    kind: str
+    relative: bool
+    system: str
+    values: tuple[Expr, Expr, Expr] = child(
+        Type.NUM, lambda op: "a translation" if op.kind == "translate" else "an angle")
+    span: Span = NO_SPAN
+
 Op = (Symbol | Empty | Translate | Scale | Rotate | Push | Pop | Insert | Split | Repeat | Comp | Extrude
       | Center | UseAsset | Case | Stochastic | SetAttr | Report | NotApplied | GroupSplit | CompFaces
       | AlignScope | Mirror | Offset | SetColor | Setback | Roof | InnerRectangle | Convexify
-      | CleanupGeometry | DeleteHoles | Snap | Label)
+      | CleanupGeometry | DeleteHoles | Snap | Label
+      | Transform)
 Body = tuple[Op, ...]
 
 

@@ -37,8 +37,8 @@ def convert(call, args, env: Env):
     coordinate, source, target, kind = (a.value for a in call.args[:4])
     n = len(env.shapes)
     values = np.stack([np.broadcast_to(np.asarray(a, dtype=np.float64), (n,)) for a in args[4:]], axis=1)
-    from_origin, from_axes = _system(source, env)
-    to_origin, to_axes = _system(target, env)
+    from_origin, from_axes = system(source, env)
+    to_origin, to_axes = system(target, env)
     if kind == "pos":
         world = from_origin + np.einsum("ni,nij->nj", values, from_axes)
         out = np.einsum("nj,nij->ni", world - to_origin, to_axes)
@@ -48,7 +48,7 @@ def convert(call, args, env: Env):
     return out[:, "xyz".index(coordinate)]
 
 
-def _system(name: str, env: Env) -> tuple[np.ndarray, np.ndarray]:
+def system(name: str, env: Env) -> tuple[np.ndarray, np.ndarray]:
     """The origins (n, 3) and axes (n, 3, 3) (rows, in world) of coordinate system ``name`` per shape."""
     shapes, chunk = env.shapes, env.chunk
     if name == "scope":

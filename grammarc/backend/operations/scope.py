@@ -1,10 +1,12 @@
-"""Scope operations: ``T``/``S``/``R`` (``t s r``), ``extrude``, ``alignScopeToAxes``/``alignScopeToGeometry``/
-``rotateScope`` and ``mirror``; and ``center``, which the body runner calls (it centres on the scope the body
-began with or last pushed, which only the runner holds).
+"""Scope operations: ``T``/``S``/``R`` (``t s r``), CityEngine's ``translate`` and ``rotate`` in a coordinate
+system, ``extrude``, ``alignScopeToAxes``/``alignScopeToGeometry``/``rotateScope`` and ``mirror``; and
+``center``, which the body runner calls (it centres on the scope the body began with or last pushed, which
+only the runner holds).
 
 They change the cursor's scope and return it. Reads: the scope (``origin``, ``size``, ``frame``), ``geom``
-(extrude, align, mirror), and what their expressions read. Writes: ``T`` and ``center`` the ``origin``, ``S``
-the ``size``, ``R`` the ``frame``, ``mirror`` the ``geom``; ``extrude`` and the alignments all four of the
+(extrude, align, mirror), and what their expressions read. Writes: ``T``, ``translate`` and ``center`` the
+``origin``, ``S`` the ``size``, ``R`` and ``rotate`` the ``frame`` (and ``r(scopeCenter, ...)`` the
+``origin``, to keep the centre), ``mirror`` the ``geom``; ``extrude`` and the alignments all four of the
 scope and geometry, as they turn scopes around their geometry (``backend.reframing``).
 """
 
@@ -13,8 +15,10 @@ from __future__ import annotations
 import numpy as np
 
 from grammarc.backend.context import Context
-from grammarc.backend.euler import rotation
+from grammarc.backend.euler import angles as euler_angles
+from grammarc.backend.euler import orientation, rotation
 from grammarc.backend.evaluate import evaluate, evaluate_array
+from grammarc.backend.functions.coordinates import system
 from grammarc.backend.operations.table import operation
 from grammarc.backend.outlines import flat_axis, polygons_of
 from grammarc.backend.reframing import reframed, turned
@@ -48,8 +52,10 @@ def scale(ctx: Context, cursor: Shapes, op: ir.Scale) -> Shapes:
     return cursor.with_scope(cursor.origin, size, cursor.frame, cursor.geom)
 
 
-@operation(ir.Rotate, writes=("frame",), meshes=True)
+@operation(ir.Rotate, writes=("origin", "frame"), meshes=True)
 def rotate(ctx: Context, cursor: Shapes, op: ir.Rotate) -> Shapes:
+    """``R``/``r(x, y, z)`` about the scope's own axes around its origin; ``r(scopeCenter, x, y, z)``
+    turns the same way and moves the origin so that the scope's centre stays where it was."""
     env = ctx.env(cursor)
     angles = [evaluate(e, env) for e in op.angles]
     frames = ctx.chunk.frames
@@ -63,6 +69,38 @@ def rotate(ctx: Context, cursor: Shapes, op: ir.Rotate) -> Shapes:
         n = len(cursor)
         matrices = rotation(*(np.broadcast_to(np.asarray(a, np.float64), (n,)) for a in angles))
         frame = frames.add(np.einsum("nij,njk->nik", matrices, frames[cursor.frame]))
+    origin = cursor.origin
+    if op.center:
+        half = cursor.size / 2
+        origin = origin + np.einsum("ni,nij->nj", half, frames[cursor.frame] - frames[frame])
+    return cursor.with_scope(origin, cursor.size, frame, cursor.geom)
+
+
+@operation(ir.Transform, writes=("origin", "frame"), meshes=True)
+def transform(ctx: Context, cursor: Shapes, op: ir.Transform) -> Shapes:
+    """CityEngine ``translate`` and ``rotate`` in a coordinate system (``functions.coordinates.system``;
+    the pivot is the object system, as grammarc does not apply ``setPivot``).
+
+    ``translate``: ``rel`` adds the vector along the system's axes, ``abs`` puts the scope origin at the
+    position in the system. ``rotate``: the scope's orientation in the system, as the angles ``scope.r``
+    reads (about the system's x, then y, then z: ``backend.euler``), becomes the given angles (``abs``) or
+    those angles plus the given ones (``rel``, as the reference says: the angles are added); the scope turns
+    around its origin. In the scope system the scope's own angles are 0, so ``rel`` and ``abs`` agree there:
+    a turn about the scope's axes in that order.
+    """
+    env = ctx.env(cursor)
+    n = len(cursor)
+    values = np.stack([np.broadcast_to(evaluate_array(e, env), (n,)) for e in op.values], axis=1)
+    origin, axes = system(op.system, env)
+    frames = ctx.chunk.frames
+    if op.kind == "translate":
+        base = cursor.origin if op.relative else origin  # the scope system's origin is the scope's
+        new_origin = base + np.einsum("ni,nij->nj", values, axes)
+        return cursor.with_scope(new_origin, cursor.size, cursor.frame, cursor.geom)
+    if op.relative and op.system != "scope":
+        # rows: the scope's axes in the system's coordinates
+        values = values + euler_angles(np.einsum("nij,nkj->nik", frames[cursor.frame], axes))
+    frame = frames.add(np.einsum("nij,njk->nik", orientation(*values.T), axes))
     return cursor.with_scope(cursor.origin, cursor.size, frame, cursor.geom)
 
 

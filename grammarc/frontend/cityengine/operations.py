@@ -93,9 +93,31 @@ class OperationLowering:
         return ir.Scale(tuple(sizes), span)
 
     def op_rotate(self, op, args, span):
+        """``r(x, y, z)`` and ``r(scopeOrigin|scopeCenter, x, y, z)``: the same turn, around the scope's
+        origin or centre (the reference spells the default ``scopeOrgin`` too)."""
+        center = False
+        if len(args) == 4 and isinstance(args[0], ir.Name) \
+                and args[0].name in ("scopeOrigin", "scopeOrgin", "scopeCenter"):
+            center = args[0].name == "scopeCenter"
+            args = args[1:]
         if len(args) != 3:
-            return self.unsupported(f"r with {len(args)} arguments", span, "only r(x, y, z)")
-        return ir.Rotate(tuple(self.expr(a) for a in args), span)
+            return self.unsupported(f"r with {len(args)} arguments", span,
+                                    "r(x, y, z) and r(scopeOrigin|scopeCenter, x, y, z)")
+        return ir.Rotate(tuple(self.expr(a) for a in args), span, center=center)
+
+    def op_transform(self, op, args, span):
+        """``translate|rotate(rel|abs, scope|pivot|object|world, x, y, z)``."""
+        if not self.arity(op, args, (5,), span):
+            return ir.Empty(span)
+        mode, system = args[0], args[1]
+        if not isinstance(mode, ir.Name) or mode.name not in ("rel", "abs"):
+            self.diags.error("selector", f"`{op}` expects rel or abs first", span)
+            return ir.Empty(span)
+        if not isinstance(system, ir.Name) or system.name not in ir.COORDINATE_SYSTEMS:
+            self.diags.error("selector", f"`{op}` expects a coordinate system scope, pivot, object or world "
+                             "second", span)
+            return ir.Empty(span)
+        return ir.Transform(op, mode.name == "rel", system.name, tuple(self.expr(a) for a in args[2:]), span)
 
     def op_color(self, op, args, span):
         if len(args) not in (1, 3, 4):
@@ -336,6 +358,8 @@ OPERATIONS = {
     "t": OperationLowering.op_translate,
     "s": OperationLowering.op_scale,
     "r": OperationLowering.op_rotate,
+    "translate": OperationLowering.op_transform,
+    "rotate": OperationLowering.op_transform,
     "center": OperationLowering.op_center,
     "i": OperationLowering.op_insert,
     "primitiveCube": OperationLowering.op_cube,
@@ -403,7 +427,7 @@ UNSUPPORTED_OPS = frozenset({
     "insertAlongUV", "scatter", "footprint", "tileUV", "splitArea", "inline", "resetGeometry", "taper",
     "primitiveCylinder", "primitiveSphere", "primitiveDisk", "primitiveCone", "primitiveQuad",
     "reduceGeometry", "rectify", "semiPolygon",
-    "alignScopeToGeometryBBox", "rotate", "translate", "roofRidge", "modify",
+    "alignScopeToGeometryBBox", "roofRidge", "modify",
     "setbackPerEdge", "setbackToArea", "splitAndSetbackPerimeter",
     "tag", "deleteTags", "setTagsFromEdgeAttrs", "union", "subtract", "intersect",
     "copyUV", "setMaterial", "resetMaterial",

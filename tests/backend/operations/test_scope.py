@@ -1,5 +1,6 @@
-"""backend/operations/scope.py in derivations: ``T S R`` and ``t s r``, ``center``, ``extrude``,
-``alignScopeToAxes`` and ``rotateScope``, and sizes that fail their lot."""
+"""backend/operations/scope.py in derivations: ``T S R`` and ``t s r``, ``r(scopeCenter, ...)``, ``translate``
+and ``rotate`` in coordinate systems, ``center``, ``extrude``, ``alignScopeToAxes`` and ``rotateScope``, and
+sizes that fail their lot."""
 
 from __future__ import annotations
 
@@ -74,6 +75,116 @@ def test_translate_and_scale_with_relative_values(write):
     r = run(write, "Lot --> extrude(6) s('0.5, '1, 2) t('0.25, 0, 1) X\n", [rect(12, 8)])
     np.testing.assert_allclose(r["xform"][0], [[6, 0, 0, 1.5], [0, 6, 0, 0], [0, 0, 2, -7]])
 
+
+
+def _centres(r):
+    """The centre of each instance's scope box, (n, 3)."""
+    x = r["xform"].astype(float)
+    return x[:, :, 3] + x[:, :, :3].sum(axis=2) / 2
+
+
+def test_r_around_the_scope_centre_keeps_each_slice_centre(write):
+    """The reference's example: slices of a mass turned about their own centres, each by its own angle."""
+    r = run(write, "Lot --> extrude(6) split(y){ 2 : r(scopeCenter, 0, scope.ty * 15, 0) X }*\n", [rect(12, 8)])
+    np.testing.assert_allclose(_centres(r), [[6, 1, -4], [6, 3, -4], [6, 5, -4]], atol=1e-9)
+    turns = np.radians([0, 30, 60])
+    x_axes = r["xform"][:, :, 0].astype(float) / 12
+    np.testing.assert_allclose(x_axes, np.c_[np.cos(turns), np.zeros(3), -np.sin(turns)], atol=1e-9)
+    np.testing.assert_allclose(r["xform"][:, :, 1], [[0, 2, 0]] * 3, atol=1e-9)
+
+
+def test_r_around_the_scope_origin_is_r(write):
+    text = "Lot --> extrude(6) split(y){{ 2 : r({}0, scope.ty * 15, 10) X }}*\n"
+    same_records(run(write, text.format(""), [rotated_rectangle()]),
+                 run(write, text.format("scopeOrigin, "), [rotated_rectangle()]))
+
+
+def test_translate_in_each_coordinate_system(write):
+    """rel adds the vector along the system's axes; abs puts the scope origin at the position."""
+    lot = [rotated_rectangle()]
+    base = run(write, "Lot --> extrude(3) X\n", lot)["xform"][0].astype(float)
+
+    def moved(op):
+        x = run(write, f"Lot --> extrude(3) {op} X\n", lot)["xform"][0].astype(float)
+        np.testing.assert_allclose(x[:, :3], base[:, :3], atol=1e-9)  # the axes and sizes stay
+        return x[:, 3]
+
+    np.testing.assert_allclose(moved("translate(rel, world, 2, 0, 0)"), base[:, 3] + [2, 0, 0], atol=1e-9)
+    # the object system is the lot's scope: x along its first edge, turned 30 degrees on the map
+    along = [np.cos(np.radians(30)), 0, -np.sin(np.radians(30))]
+    np.testing.assert_allclose(moved("translate(rel, object, 2, 0, 0)"), base[:, 3] + np.multiply(2, along),
+                               atol=1e-9)
+    np.testing.assert_allclose(moved("translate(abs, world, 1, 2, 3)"), [1, 2, 3], atol=1e-9)
+    np.testing.assert_allclose(moved("translate(rel, scope, 1, 2, 3)"), moved("t(1, 2, 3)"), atol=1e-9)
+    np.testing.assert_allclose(moved("translate(abs, scope, 1, 2, 3)"), moved("t(1, 2, 3)"), atol=1e-9)
+    r = run(write, 'Lot --> t(4, 1, 2) translate(abs, pivot, 1, 2, 3) report("tx", scope.tx) '
+                   'report("ty", scope.ty) report("tz", scope.tz) X\n', lot)
+    t = totals(r)
+    assert (t["tx_sum"], t["ty_sum"], t["tz_sum"]) == pytest.approx((1, 2, 3))
+
+
+def test_rotate_sets_or_adds_the_scopes_angles_in_a_system(write):
+    """The reference's example: rotate(abs, world, 0, 90, 0) turns the scope to world angles (x to world
+    -z, z to world +x) around its origin, whatever the lot's own turn."""
+    lot = [rotated_rectangle()]
+    head = "Lot --> extrude(10) t('0.2, 0, '0.3) s('0.5, '1, '0.5) "
+    base = run(write, head + "X\n", lot)["xform"][0].astype(float)
+    x = run(write, head + "rotate(abs, world, 0, 90, 0) X\n", lot)["xform"][0].astype(float)
+    np.testing.assert_allclose(x[:, 3], base[:, 3], atol=1e-9)
+    np.testing.assert_allclose(x[:, :3], [[0, 0, 2], [0, 10, 0], [-5, 0, 0]], atol=1e-9)
+    r = run(write, 'Lot --> rotate(abs, object, 10, 20, 30) report("rx", scope.rx) report("ry", scope.ry) '
+                   'report("rz", scope.rz) X\n', lot)
+    t = totals(r)
+    assert (t["rx_sum"], t["ry_sum"], t["rz_sum"]) == pytest.approx((10, 20, 30))
+
+    def xform(ops):
+        return run(write, f"Lot --> extrude(4) {ops} X\n", lot)["xform"][0].astype(float)
+
+    # rel adds the angles: twice 30 about the pivot's y is 60
+    np.testing.assert_allclose(xform("rotate(rel, pivot, 0, 30, 0) rotate(rel, pivot, 0, 30, 0)"),
+                               xform("rotate(abs, pivot, 0, 60, 0)"), atol=1e-9)
+    np.testing.assert_allclose(xform("rotate(rel, world, 0, 90, 0)"), xform("r(0, 90, 0)"), atol=1e-9)
+    np.testing.assert_allclose(xform("rotate(rel, scope, 0, 0, 45)"), xform("r(0, 0, 45)"), atol=1e-9)
+
+
+def test_transforms_move_every_kind_of_shape(write):
+    """A roof, a concave prism (meshes), a lot polygon and an inserted asset move and turn with their
+    scope: r(scopeCenter, 0, 90, 0) swaps the footprint's sides around its centre."""
+    for body in ("roofHip(30)", "extrude(3)", "", 'i("builtin:cube")'):
+        lot = LOT_ZOO["concave_L"] if body == "extrude(3)" else rect(10, 6)
+        text = f"Lot --> {body} translate(rel, world, 0, 5, 0) r(scopeCenter, 0, 90, 0) X\n"
+        r = run(write, text, [lot])
+        if len(r["asset"]):
+            x = r["xform"].astype(float)
+            corners = x[:, :, 3][:, None] + np.array(np.meshgrid([0, 1], [0, 1], [0, 1])).reshape(3, -1).T @ \
+                np.swapaxes(x[:, :, :3], 1, 2)
+            points = corners.reshape(-1, 3)
+        else:
+            points = r["mesh"].vertices.astype(float)
+        outline = lot[0]
+        width, depth = np.ptp(outline[:, 0]), np.ptp(outline[:, 1])
+        centre = (outline[:, 0].min() + width / 2, -(outline[:, 1].min() + depth / 2))
+        np.testing.assert_allclose(points[:, 1].min(), 5, atol=1e-6)
+        np.testing.assert_allclose([np.ptp(points[:, 0]), np.ptp(points[:, 2])], [depth, width], atol=1e-6)
+        np.testing.assert_allclose([points[:, 0].min() + depth / 2, points[:, 2].min() + width / 2], centre,
+                                   atol=1e-6)
+
+
+def test_transforms_of_a_batch_equal_each_shape_alone(write):
+    """Angles and vectors that differ per shape: a chunk of lots derives each lot as it would alone."""
+    text = ("Lot --> extrude(scope.sx / 4) r(scopeCenter, scope.sx, 10, scope.sz) translate(rel, object, scope.sz, 1, 0)"
+            " rotate(rel, pivot, 0, scope.sx * 3, 5) translate(abs, world, scope.sx, 0, 2)"
+            " rotate(abs, world, 0, scope.sz, 0) X\n")
+    lots = [rect(12, 8), rotated_rectangle(), LOT_ZOO["concave_L"], rotated_rectangle(70, 6, 9)]
+    batch = run(write, text, lots)
+    faces = mesh_faces(batch)
+    for k, lot in enumerate(lots):
+        alone = run(write, text, [lot])
+        np.testing.assert_allclose(batch["xform"][batch["lot"] == k], alone["xform"], atol=1e-9)
+        mine = [f for f, owner in zip(faces, batch["mesh"].lot) if owner == k]
+        assert len(mine) == len(mesh_faces(alone))
+        for got, want in zip(mine, mesh_faces(alone)):
+            np.testing.assert_allclose(np.concatenate(got), np.concatenate(want), atol=1e-9)
 
 def test_center_centres_on_the_rules_starting_scope(write):
     """center(x) in A centres on A's own scope (the split part from 0 to 4), not on the lot."""

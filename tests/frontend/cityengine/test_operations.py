@@ -33,6 +33,12 @@ from .lowered import VERSION, assert_unsupported_at, body_of, compile_ir, errors
     ("s('1, '0.5, 2) A", "S(1r, 0.5r, 2) A"),
     ("s(scope.sx - 1, 3, '1) A", "S((Scope.sx - 1), 3, 1r) A"),
     ("r(0, 90, 0) A", "R(0, 90, 0) A"),
+    ("r(scopeCenter, 0, 90, 0) A", "R(scopeCenter, 0, 90, 0) A"),
+    ("r(scopeOrigin, 0, 90, 0) A", "R(0, 90, 0) A"),
+    ("translate(rel, world, 0, h, 0) A", "translate(rel, world, 0, @h, 0) A"),
+    ("translate(abs, pivot, 1, 2, 3) A", "translate(abs, pivot, 1, 2, 3) A"),
+    ("rotate(abs, world, 0, 90, 0) A", "rotate(abs, world, 0, 90, 0) A"),
+    ("rotate(rel, scope, h, 0, 0) A", "rotate(rel, scope, @h, 0, 0) A"),
     ("[ t(0, 3, 0) A ] B", "[ T(0, 3, 0) A ] B"),
     ("NIL", "\u03b5"),
     ("A.", "A."),
@@ -223,7 +229,7 @@ def test_merged_selector_is_derived_face_by_face_with_a_warning(line, at):
     ("Lot --> alignScopeToGeometry(yUp, 0, longest) A", "alignScopeToGeometry with edge longest",
      "alignScopeToGeometry"),
     ("Lot --> split(v, unitSpace, 0){ 1 : A | ~1 : B }", "split(v, ...)", "split"),
-    ("Lot --> r(scopeCenter, 0, 45, 0) A", "r with 4 arguments", "r("),
+    ("Lot --> r(scopeMiddle, 0, 45, 0) A", "r with 4 arguments", "r("),
 ])
 def test_unsupported_operation_is_named_at_its_span(line, name, at):
     assert_unsupported_at(line, name, at)
@@ -244,6 +250,11 @@ def test_each_operation_name_is_in_one_table():
     ('Lot --> report("k") A', "`report` takes 2 arguments, got 1"),
     ("Lot --> t(1, 2, 3, 4) A", "`t` takes 3 arguments, got 4"),
     ("Lot --> deleteHoles(1) A", "`deleteHoles` takes 0 arguments, got 1"),
+    ("Lot --> translate(rel, 1, 2, 3) A", "`translate` takes 5 arguments, got 4"),
+    ("Lot --> rotate(rel, world, 1, 2, 3, 4) A", "`rotate` takes 5 arguments, got 6"),
+    ("Lot --> translate(by, world, 1, 2, 3) A", "`translate` expects rel or abs first"),
+    ("Lot --> rotate(abs, lot, 1, 2, 3) A",
+     "`rotate` expects a coordinate system scope, pivot, object or world second"),
     ("Lot --> setback(1, 2){ front : A | remainder : B }", "`setback` takes 1 arguments, got 2"),
 ])
 def test_a_wrong_argument_count_is_an_arity_error_at_the_operation(line, message):
