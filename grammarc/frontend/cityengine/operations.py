@@ -199,6 +199,8 @@ class OperationLowering:
         if not self.arity(op, args, (2,), span):
             return ir.Empty(span)
         target = args[0]
+        if isinstance(target, ir.ScopeRef) and target.field[0] in "tsr":
+            return self.set_scope(target, self.expr(args[1]), span)
         if isinstance(target, ir.Name) and target.name in ir.SHAPE_ATTRIBUTES:
             return ir.SetAttr(target.name, self.expr(args[1]), span)
         if isinstance(target, ir.Name) and target.name == "trim.horizontal":
@@ -212,6 +214,16 @@ class OperationLowering:
         if not isinstance(target, ir.Name):
             return self.unsupported("set of this target", span, "set(attribute, value)")
         return ir.SetAttr(target.name, self.expr(args[1]), span)
+
+    def set_scope(self, target: ir.ScopeRef, value: ir.Expr, span) -> ir.Op:
+        """``set(scope.tx, v)`` and its kin: the one field set, the other two of its vector kept. Positions
+        and angles are the pivot's (``scope.t*``, ``scope.r*`` read them there), so they become an absolute
+        ``translate``/``rotate`` in the pivot system; sizes an ``s`` of absolute sizes."""
+        kind, axis = target.field[0], "xyz".index(target.field[1])
+        values = tuple(value if k == axis else ir.ScopeRef(kind + "xyz"[k], target.span) for k in range(3))
+        if kind == "s":
+            return ir.Scale(tuple(ir.Size(ir.SizeKind.ABSOLUTE, v, getattr(v, "span", span)) for v in values), span)
+        return ir.Transform("translate" if kind == "t" else "rotate", False, "pivot", values, span)
 
     def op_split(self, op, args, parts, span, repeat=False):
         """``split(axis[, adjust]){ size : A | { size : B }* | ... }``, repeated as a whole when ``repeat``

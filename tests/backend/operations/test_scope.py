@@ -147,6 +147,17 @@ def test_rotate_sets_or_adds_the_scopes_angles_in_a_system(write):
     np.testing.assert_allclose(xform("rotate(rel, scope, 0, 0, 45)"), xform("r(0, 0, 45)"), atol=1e-9)
 
 
+
+def test_set_of_a_scope_field_keeps_the_other_two(write):
+    report = "".join(f'report("{f}", scope.{f}) ' for f in ("tx", "ty", "tz", "sx", "sy", "sz", "rx", "ry", "rz"))
+    head = "Lot --> extrude(4) t(1, 2, 3) r(0, 30, 0) "
+    t = totals(run(write, head + report + "X\n", [rotated_rectangle()]))
+    for field, value in (("tx", 7), ("ty", -1), ("tz", 0.5), ("sx", 3), ("sy", 9), ("sz", 2),
+                         ("rx", 20), ("ry", -45), ("rz", 10)):
+        got = totals(run(write, f"{head}set(scope.{field}, {value}) {report}X\n", [rotated_rectangle()]))
+        want = {key: (value if key == f"{field}_sum" else t[key]) for key in t if key.endswith("_sum")}
+        assert {key: got[key] for key in want} == pytest.approx(want, abs=1e-9), field
+
 def test_transforms_move_every_kind_of_shape(write):
     """A roof, a concave prism (meshes), a lot polygon and an inserted asset move and turn with their
     scope: r(scopeCenter, 0, 90, 0) swaps the footprint's sides around its centre."""
