@@ -87,6 +87,12 @@ def transform(ctx: Context, cursor: Shapes, op: ir.Transform) -> Shapes:
     those angles plus the given ones (``rel``, as the reference says: the angles are added); the scope turns
     around its origin. In the scope system the scope's own angles are 0, so ``rel`` and ``abs`` agree there:
     a turn about the scope's axes in that order.
+
+    The reference calls ``r(x, y, z)`` the same as ``rotate(rel, pivot, x, y, z)``; grammarc's ``R`` turns
+    about the scope's own axes instead (x, then the new y, then the new z), which gives the same scope when
+    the scope's axes are the pivot's and one angle is not 0, and when the angles come in z, y, x order of
+    calls, but not in general (``r(10, 20, 0)`` reads back as ``scope.r`` (10.6, 19.7, 3.6), not (10, 20,
+    0)). The records of ``r`` stay as they were; ``rotate`` follows the reference.
     """
     env = ctx.env(cursor)
     n = len(cursor)
