@@ -1,0 +1,248 @@
+"""Scatter: CityEngine's ``scatter(surface|volume|scope, n, uniform|gaussian[, mean, stddev]) { ... }``, point
+shapes drawn on the surface, in the volume or in the scope box of each shape, for the operations in braces.
+
+The points of all shapes are one ragged fan-out (``ragged.fan_out`` of the per-shape counts): point k of a
+shape gets the key of child k at the operation's site, and its draws come from that key alone
+(``backend.random``), so a lot's points do not depend on the lots around it. A point is a shape with a
+zero-size scope at the point (geometry: the scope, a point); on a surface its scope's y is the surface's
+normal (its x the parent's x laid into the surface, or its z where x stands along the normal), elsewhere it
+keeps the parent's axes, as the reference says.
+
+- ``surface``: the shape's faces (``geometry.queries.shape_faces``: a box its six rectangles, a polygon its
+  face with its holes, a prism its bottom, sides and top, a roof or mesh its faces) are triangulated
+  (``geometry.triangulation``) and a triangle is drawn by area, then a point in it. A shape without area
+  (a line or a point) draws in its scope.
+- ``volume``: a solid box (or an inserted asset, taken as its box, as ``geometry.volume`` has it) draws in
+  its scope; a prism draws a point of its base polygon and a height. grammarc takes a flat face, a roof and
+  any other mesh as open, so they fall back to ``surface``, as the reference says of an open mesh.
+- ``scope``: in the scope box.
+- ``gaussian``: each scope axis draws around ``mean`` (``center``, or the middle of the scope's face
+  ``front`` (z = sz), ``back``, ``left`` (x = 0), ``right``, ``top`` (y = sy), ``bottom``) with the standard
+  deviation ``stddev``, in metres or times the scope's size on that axis (``'0.16`` by default). The point
+  is then the nearest point of the domain: clamped to the scope box, or the nearest point of the surface
+  (of the base polygon for a prism, its height clamped), so that no point leaves the shape.
+
+``n`` is evaluated per shape and truncated (CityEngine's rule files floor it themselves); a negative
+count makes no point, a NaN one fails the lot. Reads: the scope, ``geom``, ``key``, and what ``n`` reads;
+the points inherit ``lot``, ``depth``, ``params`` and ``dynamic``. Writes: no column of the cursor (the
+shape goes on after its points, as in CityEngine, whose rule files end a scatter with ``NIL``).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+from grammarc.backend.context import Context
+from grammarc.backend.evaluate import evaluate_array
+from grammarc.backend.operations.table import Parts, operation
+from grammarc.backend.random import child_keys, mix, uniform
+from grammarc.backend.shapes import Shapes
+from grammarc.constants import TOL
+from grammarc.geometry.meshes import is_polygon
+from grammarc.geometry.queries import shape_faces
+from grammarc.geometry.triangulation import triangulate_polygons
+from grammarc.ir import nodes as ir
+from grammarc.ragged import fan_out, offsets_from_counts
+
+#: Salt of the points' draw keys, so that their draws do not repeat the ``rand`` sites their bodies use.
+_DRAW_SALT = 0x5CA77E
+#: The gaussian's mean in the scope, as fractions of its size.
+_MEANS = {"center": (0.5, 0.5, 0.5), "front": (0.5, 0.5, 1.0), "back": (0.5, 0.5, 0.0),
+          "left": (0.0, 0.5, 0.5), "right": (1.0, 0.5, 0.5), "top": (0.5, 1.0, 0.5), "bottom": (0.5, 0.0, 0.5)}
+
+
+@operation(ir.Scatter, meshes=True)
+def scatter(ctx: Context, cursor: Shapes, op: ir.Scatter) -> Parts:
+    env = ctx.env(cursor)
+    count = np.broadcast_to(evaluate_array(op.count, env), (len(cursor),))
+    bad = np.isnan(count)
+    if bad.any():
+        ctx.fail(cursor, bad, "`scatter` needs a number of points, got NaN", op.span)
+    counts = np.where(bad, 0, np.clip(count, 0, 2.0**62)).astype(np.int64)
+    ctx.check_fan_out(cursor, counts, op.span)
+    parent, index = fan_out(counts)
+    key = child_keys(cursor.key[parent], op.site, index)
+    draw_key = mix(key, _DRAW_SALT)
+    u = np.stack([uniform(draw_key, d) for d in range(4)], axis=1)  # (m, 4)
+    size = cursor.size[parent]
+    target = _gaussian(op, env, u, size, parent) if op.gaussian else None
+
+    kind = _domains(ctx, cursor, op.domain)[parent]
+    local = np.empty((len(parent), 3))
+    normal = np.full((len(parent), 3), np.nan)  # the surface's normal in the scope, where the point has one
+    on_surface = kind == _SURFACE
+    if on_surface.any():
+        rows = np.flatnonzero(on_surface)
+        point, normal[rows], found = _on_faces(ctx, cursor, parent[rows], u[rows],
+                                               None if target is None else target[rows], flat=False)
+        local[rows] = point
+        kind[rows[~found]] = _SCOPE  # no area: the scope it is
+    prism = kind == _PRISM
+    if prism.any():
+        rows = np.flatnonzero(prism)
+        axis = ctx.chunk.polygons.plane[cursor.geom[parent[rows]]].astype(np.int64)
+        point, _, found = _on_faces(ctx, cursor, parent[rows], u[rows],
+                                    None if target is None else target[rows], flat=True)
+        height = size[rows, axis]
+        point[np.arange(len(rows)), axis] = (u[rows, 3] * height if target is None else
+                                             np.clip(target[rows, axis], 0.0, height))
+        local[rows] = point
+        kind[rows[~found]] = _SCOPE
+    in_scope = kind == _SCOPE
+    if in_scope.any():
+        local[in_scope] = (u[in_scope, :3] * size[in_scope] if target is None else
+                           np.clip(target[in_scope], 0.0, size[in_scope]))
+
+    frames = ctx.chunk.frames
+    axes = frames[cursor.frame[parent]]
+    origin = cursor.origin[parent] + np.einsum("ni,nij->nj", local, axes)
+    frame = cursor.frame[parent].copy()
+    turned = np.flatnonzero((kind == _SURFACE) & ~(np.abs(normal[:, 1] - 1.0) <= TOL.zero))
+    if len(turned):
+        frame[turned] = frames.add(np.einsum("nij,njk->nik", _surface_axes(normal[turned]), axes[turned]))
+    made = Shapes(origin, np.zeros((len(parent), 3)), frame.astype(np.int32),
+                  np.full(len(parent), -1, dtype=np.int32), cursor.lot[parent], key, cursor.depth[parent],
+                  tuple(p[parent] for p in cursor.params), tuple(d[parent] for d in cursor.dynamic))
+    ctx.count(made, op.span)
+    return Parts(op.parts, made, np.array([0, len(made)], dtype=np.int64))
+
+
+#: Where a shape's points are drawn.
+_SCOPE, _SURFACE, _PRISM = 0, 1, 2
+
+
+def _domains(ctx: Context, cursor: Shapes, domain: str) -> np.ndarray:
+    """Per shape (n,) int64, what its points are drawn on: the scope, the surface, or a prism's base
+    and height (module docstring)."""
+    if domain == "scope":
+        return np.full(len(cursor), _SCOPE, dtype=np.int64)
+    kind = np.full(len(cursor), _SURFACE, dtype=np.int64)
+    if domain == "volume":
+        solid = (cursor.size > TOL.zero).all(axis=1)
+        kind[solid & (cursor.geom < 0)] = _SCOPE  # a box, or an inserted asset taken as its box
+        rows = np.flatnonzero(is_polygon(cursor.geom))
+        if len(rows):
+            axis = ctx.chunk.polygons.plane[cursor.geom[rows]].astype(np.int64)
+            kind[rows[cursor.size[rows, axis] > TOL.zero]] = _PRISM
+    return kind
+
+
+def _gaussian(op: ir.Scatter, env, u: np.ndarray, size: np.ndarray, parent: np.ndarray) -> np.ndarray:
+    """The gaussian draws (m, 3) in the points' scopes: ``op.mean`` plus ``op.stddev`` times a normal
+    draw per axis (Box-Muller of the draws ``u`` (m, 4))."""
+    stddev = np.broadcast_to(evaluate_array(op.stddev, env), (len(env.shapes),))[parent][:, None]
+    if op.relative:
+        stddev = stddev * size
+    radius = np.sqrt(-2.0 * np.log1p(-u[:, [0, 0, 2]]))
+    angle = 2.0 * np.pi * u[:, [1, 1, 3]]
+    normal = radius * np.where(np.arange(3) == 1, np.sin(angle), np.cos(angle))
+    return np.asarray(_MEANS[op.mean]) * size + stddev * normal
+
+
+def _on_faces(ctx: Context, cursor: Shapes, parent: np.ndarray, u: np.ndarray, target: np.ndarray | None,
+              flat: bool):
+    """Points (m, 3) on the faces of shapes ``parent`` (m,) of ``cursor`` (in their scopes), with the
+    faces' normals (m, 3), and whether the shape had area (m,) bool. ``flat``: on the polygon of a prism
+    (its size across its plane taken as 0). Uniform by area from the draws ``u`` (m, 4), or the nearest
+    point to ``target`` (m, 3)."""
+    shapes, back = np.unique(parent, return_inverse=True)
+    size = cursor.size[shapes]
+    if flat:
+        size = size.copy()
+        size[np.arange(len(shapes)), ctx.chunk.polygons.plane[cursor.geom[shapes]]] = 0.0
+    faces = shape_faces(size, cursor.geom[shapes], ctx.chunk.polygons, ctx.chunk.meshes)
+    triangles = triangulate_polygons(faces.verts, faces.ring_offsets, faces.face_offsets)
+    owner = faces.vertex_shape()[triangles[:, 0]]
+    order = np.argsort(owner, kind="stable")
+    triangles = faces.verts[triangles[order]]  # (T, 3 corners, 3)
+    offsets = offsets_from_counts(np.bincount(owner, minlength=len(shapes)))
+    gaussian = target is not None
+    return _points(np.ascontiguousarray(triangles), offsets, back.astype(np.int64), np.ascontiguousarray(u),
+                   np.ascontiguousarray(target) if gaussian else np.zeros((len(parent), 3)), gaussian)
+
+
+def _surface_axes(normal: np.ndarray) -> np.ndarray:
+    """Scope axes (m, 3, 3) (rows) in the parent's scope with y along ``normal`` (m, 3): x is the parent's
+    x laid into the surface, or its z where x stands along the normal."""
+    x = np.eye(3)[np.where(np.abs(normal[:, 0]) < 1.0 - 1e-6, 0, 2)]
+    x = x - np.einsum("ni,ni->n", x, normal)[:, None] * normal
+    x /= np.linalg.norm(x, axis=1, keepdims=True)
+    return np.stack([x, normal, np.cross(x, normal)], axis=1)
+
+
+@njit(cache=True, nogil=True)
+def _points(triangles, offsets, shape, u, target, gaussian):
+    """Per point, on the triangles ``offsets[s]:offsets[s+1]`` (T, 3, 3) of its shape ``s``: uniform by
+    area (draw u[:, 0] picks the triangle, u[:, 1:3] the point in it) or the nearest to ``target``.
+    Returns points (m, 3), the triangles' unit normals (m, 3), and whether the shape had area (m,)."""
+    n_tri = triangles.shape[0]
+    cumulative = np.empty(n_tri)
+    for s in range(len(offsets) - 1):  # each shape's areas summed from its own first triangle
+        total = 0.0
+        for t in range(offsets[s], offsets[s + 1]):
+            total += 0.5 * _norm(_cross(triangles[t, 1] - triangles[t, 0], triangles[t, 2] - triangles[t, 0]))
+            cumulative[t] = total
+    m = len(shape)
+    points = np.zeros((m, 3))
+    normals = np.zeros((m, 3))
+    found = np.zeros(m, dtype=np.bool_)
+    for i in range(m):
+        lo, hi = offsets[shape[i]], offsets[shape[i] + 1]
+        if hi == lo or cumulative[hi - 1] <= 0.0:
+            continue
+        found[i] = True
+        if gaussian:
+            best, pick = np.inf, lo
+            for t in range(lo, hi):
+                p = _closest(target[i], triangles[t, 0], triangles[t, 1], triangles[t, 2])
+                d = np.sum((p - target[i]) ** 2)
+                if d < best:
+                    best, pick, points[i] = d, t, p
+        else:
+            pick = lo + np.searchsorted(cumulative[lo:hi], u[i, 0] * cumulative[hi - 1], side="right")
+            pick = min(pick, hi - 1)
+            r = np.sqrt(u[i, 1])
+            a, b, c = triangles[pick, 0], triangles[pick, 1], triangles[pick, 2]
+            points[i] = (1.0 - r) * a + r * (1.0 - u[i, 2]) * b + r * u[i, 2] * c
+        n = _cross(triangles[pick, 1] - triangles[pick, 0], triangles[pick, 2] - triangles[pick, 0])
+        normals[i] = n / max(_norm(n), 1e-300)
+    return points, normals, found
+
+
+@njit(cache=True, nogil=True, inline="always")
+def _cross(a, b):
+    return np.array([a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]])
+
+
+@njit(cache=True, nogil=True, inline="always")
+def _norm(a):
+    return np.sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2])
+
+
+@njit(cache=True, nogil=True)
+def _closest(p, a, b, c):
+    """The point of triangle (a, b, c) nearest to ``p`` (Ericson, Real-Time Collision Detection 5.1.5)."""
+    ab, ac, ap = b - a, c - a, p - a
+    d1, d2 = np.dot(ab, ap), np.dot(ac, ap)
+    if d1 <= 0.0 and d2 <= 0.0:
+        return a.copy()
+    bp = p - b
+    d3, d4 = np.dot(ab, bp), np.dot(ac, bp)
+    if d3 >= 0.0 and d4 <= d3:
+        return b.copy()
+    vc = d1 * d4 - d3 * d2
+    if vc <= 0.0 and d1 >= 0.0 and d3 <= 0.0:
+        return a + d1 / (d1 - d3) * ab
+    cp = p - c
+    d5, d6 = np.dot(ab, cp), np.dot(ac, cp)
+    if d6 >= 0.0 and d5 <= d6:
+        return c.copy()
+    vb = d5 * d2 - d1 * d6
+    if vb <= 0.0 and d2 >= 0.0 and d6 <= 0.0:
+        return a + d2 / (d2 - d6) * ac
+    va = d3 * d6 - d5 * d4
+    if va <= 0.0 and d4 - d3 >= 0.0 and d5 - d6 >= 0.0:
+        return b + (d4 - d3) / ((d4 - d3) + (d5 - d6)) * (c - b)
+    denominator = 1.0 / (va + vb + vc)
+    return a + ab * (vb * denominator) + ac * (vc * denominator)
