@@ -36,7 +36,7 @@ from numba import njit
 from grammarc.backend.context import Context
 from grammarc.backend.evaluate import evaluate_array
 from grammarc.backend.operations.table import Parts, operation
-from grammarc.backend.random import child_keys, mix, uniform
+from grammarc.backend.random import child_keys, mix, mix1, uniform
 from grammarc.backend.shapes import Shapes
 from grammarc.constants import TOL
 from grammarc.geometry.meshes import is_polygon
@@ -66,33 +66,24 @@ def scatter(ctx: Context, cursor: Shapes, op: ir.Scatter) -> Parts:
     draw_key = mix(key, _DRAW_SALT)
     u = np.stack([uniform(draw_key, d) for d in range(4)], axis=1)  # (m, 4)
     size = cursor.size[parent]
-    target = _gaussian(op, env, u, size, parent) if op.gaussian else None
+    mean, sigma = _spread(op, env, size, parent)
 
     kind = _domains(ctx, cursor, op.domain)[parent]
     local = np.empty((len(parent), 3))
     normal = np.full((len(parent), 3), np.nan)  # the surface's normal in the scope, where the point has one
-    on_surface = kind == _SURFACE
-    if on_surface.any():
-        rows = np.flatnonzero(on_surface)
-        point, normal[rows], found = _on_faces(ctx, cursor, parent[rows], u[rows],
-                                               None if target is None else target[rows], flat=False)
-        local[rows] = point
+    for domain in (_SURFACE, _PRISM):
+        rows = np.flatnonzero(kind == domain)
+        if not len(rows):
+            continue
+        axis = (ctx.chunk.polygons.plane[cursor.geom[parent[rows]]].astype(np.int64) if domain == _PRISM
+                else np.full(len(rows), -1, dtype=np.int64))
+        local[rows], normal[rows], found = _on_faces(ctx, cursor, parent[rows], axis, draw_key[rows], u[rows],
+                                                     mean[rows], sigma[rows], op.gaussian)
         kind[rows[~found]] = _SCOPE  # no area: the scope it is
-    prism = kind == _PRISM
-    if prism.any():
-        rows = np.flatnonzero(prism)
-        axis = ctx.chunk.polygons.plane[cursor.geom[parent[rows]]].astype(np.int64)
-        point, _, found = _on_faces(ctx, cursor, parent[rows], u[rows],
-                                    None if target is None else target[rows], flat=True)
-        height = size[rows, axis]
-        point[np.arange(len(rows)), axis] = (u[rows, 3] * height if target is None else
-                                             np.clip(target[rows, axis], 0.0, height))
-        local[rows] = point
-        kind[rows[~found]] = _SCOPE
-    in_scope = kind == _SCOPE
-    if in_scope.any():
-        local[in_scope] = (u[in_scope, :3] * size[in_scope] if target is None else
-                           np.clip(target[in_scope], 0.0, size[in_scope]))
+    rows = np.flatnonzero(kind == _SCOPE)
+    if len(rows):
+        local[rows] = (_in_box(draw_key[rows], mean[rows], sigma[rows], size[rows], TOL.zero) if op.gaussian
+                       else u[rows, :3] * size[rows])
 
     frames = ctx.chunk.frames
     axes = frames[cursor.frame[parent]]
@@ -110,6 +101,8 @@ def scatter(ctx: Context, cursor: Shapes, op: ir.Scatter) -> Parts:
 
 #: Where a shape's points are drawn.
 _SCOPE, _SURFACE, _PRISM = 0, 1, 2
+#: Draws of a gaussian point before it takes the nearest point of its domain.
+_TRIES = 64
 
 
 def _domains(ctx: Context, cursor: Shapes, domain: str) -> np.ndarray:
@@ -128,38 +121,39 @@ def _domains(ctx: Context, cursor: Shapes, domain: str) -> np.ndarray:
     return kind
 
 
-def _gaussian(op: ir.Scatter, env, u: np.ndarray, size: np.ndarray, parent: np.ndarray) -> np.ndarray:
-    """The gaussian draws (m, 3) in the points' scopes: ``op.mean`` plus ``op.stddev`` times a normal
-    draw per axis (Box-Muller of the draws ``u`` (m, 4))."""
+def _spread(op: ir.Scatter, env, size: np.ndarray, parent: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The gaussian's mean and standard deviation per point and scope axis, (m, 3) each (zeros when
+    the points are uniform)."""
+    if not op.gaussian:
+        return np.zeros_like(size), np.zeros_like(size)
     stddev = np.broadcast_to(evaluate_array(op.stddev, env), (len(env.shapes),))[parent][:, None]
-    if op.relative:
-        stddev = stddev * size
-    radius = np.sqrt(-2.0 * np.log1p(-u[:, [0, 0, 2]]))
-    angle = 2.0 * np.pi * u[:, [1, 1, 3]]
-    normal = radius * np.where(np.arange(3) == 1, np.sin(angle), np.cos(angle))
-    return np.asarray(_MEANS[op.mean]) * size + stddev * normal
+    sigma = stddev * size if op.relative else np.repeat(stddev, 3, axis=1)
+    return np.asarray(_MEANS[op.mean]) * size, np.ascontiguousarray(sigma)
 
 
-def _on_faces(ctx: Context, cursor: Shapes, parent: np.ndarray, u: np.ndarray, target: np.ndarray | None,
-              flat: bool):
-    """Points (m, 3) on the faces of shapes ``parent`` (m,) of ``cursor`` (in their scopes), with the
-    faces' normals (m, 3), and whether the shape had area (m,) bool. ``flat``: on the polygon of a prism
-    (its size across its plane taken as 0). Uniform by area from the draws ``u`` (m, 4), or the nearest
-    point to ``target`` (m, 3)."""
+def _on_faces(ctx: Context, cursor: Shapes, parent: np.ndarray, axis: np.ndarray, key: np.ndarray,
+              u: np.ndarray, mean: np.ndarray, sigma: np.ndarray, gaussian: bool):
+    """Points (m, 3) on the faces of shapes ``parent`` (m,) of ``cursor`` (in their scopes), the faces'
+    normals (m, 3), and whether the shape had area (m,) bool. Where ``axis`` (m,) is not -1 the shape
+    is a prism across that axis: the point is drawn on its polygon and lifted by a height. Uniform by
+    area from the draws ``u`` (m, 4), or gaussian (``_points``)."""
     shapes, back = np.unique(parent, return_inverse=True)
     size = cursor.size[shapes]
-    if flat:
+    prism = np.zeros(len(shapes), dtype=bool)
+    prism[back[axis >= 0]] = True
+    rows = np.flatnonzero(prism)
+    height = cursor.size[parent, np.maximum(axis, 0)]
+    if len(rows):
         size = size.copy()
-        size[np.arange(len(shapes)), ctx.chunk.polygons.plane[cursor.geom[shapes]]] = 0.0
+        size[rows, ctx.chunk.polygons.plane[cursor.geom[shapes[rows]]]] = 0.0  # the prism's polygon
     faces = shape_faces(size, cursor.geom[shapes], ctx.chunk.polygons, ctx.chunk.meshes)
     triangles = triangulate_polygons(faces.verts, faces.ring_offsets, faces.face_offsets)
     owner = faces.vertex_shape()[triangles[:, 0]]
     order = np.argsort(owner, kind="stable")
     triangles = faces.verts[triangles[order]]  # (T, 3 corners, 3)
     offsets = offsets_from_counts(np.bincount(owner, minlength=len(shapes)))
-    gaussian = target is not None
-    return _points(np.ascontiguousarray(triangles), offsets, back.astype(np.int64), np.ascontiguousarray(u),
-                   np.ascontiguousarray(target) if gaussian else np.zeros((len(parent), 3)), gaussian)
+    return _points(np.ascontiguousarray(triangles), offsets, back.astype(np.int64), axis, height,
+                   np.ascontiguousarray(key), np.ascontiguousarray(u), mean, sigma, gaussian, TOL.zero)
 
 
 def _surface_axes(normal: np.ndarray) -> np.ndarray:
@@ -172,10 +166,13 @@ def _surface_axes(normal: np.ndarray) -> np.ndarray:
 
 
 @njit(cache=True, nogil=True)
-def _points(triangles, offsets, shape, u, target, gaussian):
-    """Per point, on the triangles ``offsets[s]:offsets[s+1]`` (T, 3, 3) of its shape ``s``: uniform by
-    area (draw u[:, 0] picks the triangle, u[:, 1:3] the point in it) or the nearest to ``target``.
-    Returns points (m, 3), the triangles' unit normals (m, 3), and whether the shape had area (m,)."""
+def _points(triangles, offsets, shape, axis, height, key, u, mean, sigma, gaussian, tol):
+    """Per point, on the triangles ``offsets[s]:offsets[s+1]`` (T, 3, 3) of its shape ``s``, lifted
+    along ``axis`` (-1: not) within ``height``. Uniform: draw u[:, 0] picks a triangle by area,
+    u[:, 1:3] the point in it, u[:, 3] the height. Gaussian (``_gauss``): drawn again while the draw
+    is not over the surface (its nearest point is not straight below it) or not within the height,
+    then the nearest point of the last draw. Returns points (m, 3), the triangles' unit normals (m, 3),
+    and whether the shape had area (m,) bool."""
     n_tri = triangles.shape[0]
     cumulative = np.empty(n_tri)
     for s in range(len(offsets) - 1):  # each shape's areas summed from its own first triangle
@@ -192,22 +189,70 @@ def _points(triangles, offsets, shape, u, target, gaussian):
         if hi == lo or cumulative[hi - 1] <= 0.0:
             continue
         found[i] = True
+        a = axis[i]
         if gaussian:
-            best, pick = np.inf, lo
-            for t in range(lo, hi):
-                p = _closest(target[i], triangles[t, 0], triangles[t, 1], triangles[t, 2])
-                d = np.sum((p - target[i]) ** 2)
-                if d < best:
-                    best, pick, points[i] = d, t, p
+            for attempt in range(_TRIES):
+                g = _gauss(key[i], attempt, mean[i], sigma[i])
+                best, pick = np.inf, lo
+                for t in range(lo, hi):
+                    p = _closest(g, triangles[t, 0], triangles[t, 1], triangles[t, 2])
+                    d = np.sum((p - g) ** 2)
+                    if d < best:
+                        best, pick, points[i] = d, t, p
+                n = _cross(triangles[pick, 1] - triangles[pick, 0], triangles[pick, 2] - triangles[pick, 0])
+                n = n / max(_norm(n), 1e-300)
+                off = g - points[i]
+                off = off - np.dot(off, n) * n
+                if _norm(off) <= tol and (a < 0 or 0.0 <= g[a] <= height[i]):
+                    break
+            if a >= 0:
+                points[i, a] = min(max(g[a], 0.0), height[i])
         else:
             pick = lo + np.searchsorted(cumulative[lo:hi], u[i, 0] * cumulative[hi - 1], side="right")
             pick = min(pick, hi - 1)
             r = np.sqrt(u[i, 1])
-            a, b, c = triangles[pick, 0], triangles[pick, 1], triangles[pick, 2]
-            points[i] = (1.0 - r) * a + r * (1.0 - u[i, 2]) * b + r * u[i, 2] * c
+            points[i] = ((1.0 - r) * triangles[pick, 0] + r * (1.0 - u[i, 2]) * triangles[pick, 1]
+                         + r * u[i, 2] * triangles[pick, 2])
+            if a >= 0:
+                points[i, a] = u[i, 3] * height[i]
         n = _cross(triangles[pick, 1] - triangles[pick, 0], triangles[pick, 2] - triangles[pick, 0])
         normals[i] = n / max(_norm(n), 1e-300)
     return points, normals, found
+
+
+@njit(cache=True, nogil=True)
+def _in_box(key, mean, sigma, size, tol):
+    """Gaussian points (m, 3) in the scope boxes ``size`` (m, 3): drawn again while outside the box on
+    an axis where it has extent, then clamped into it."""
+    out = np.empty((len(key), 3))
+    for i in range(len(key)):
+        for attempt in range(_TRIES):
+            g = _gauss(key[i], attempt, mean[i], sigma[i])
+            inside = True
+            for j in range(3):
+                if size[i, j] > tol and not 0.0 <= g[j] <= size[i, j]:
+                    inside = False
+            if inside:
+                break
+        for j in range(3):
+            out[i, j] = min(max(g[j], 0.0), size[i, j])
+    return out
+
+
+@njit(cache=True, nogil=True)
+def _gauss(key, attempt, mean, sigma):
+    """Draw ``attempt`` of a point's gaussian: ``mean`` (3,) plus ``sigma`` (3,) times normal draws
+    (Box-Muller of four uniform draws of the point's key)."""
+    k = mix1(key, attempt)
+    u = np.empty(4)
+    for d in range(4):
+        u[d] = (mix1(k, d) >> np.uint64(11)) * (1.0 / 9007199254740992.0)  # 53 bits, as ``random.uniform``
+    r0, r1 = np.sqrt(-2.0 * np.log1p(-u[0])), np.sqrt(-2.0 * np.log1p(-u[2]))
+    out = np.empty(3)
+    out[0] = mean[0] + sigma[0] * r0 * np.cos(2.0 * np.pi * u[1])
+    out[1] = mean[1] + sigma[1] * r0 * np.sin(2.0 * np.pi * u[1])
+    out[2] = mean[2] + sigma[2] * r1 * np.cos(2.0 * np.pi * u[3])
+    return out
 
 
 @njit(cache=True, nogil=True, inline="always")

@@ -97,18 +97,35 @@ def test_scope_draws_in_the_scope_box(write):
 
 def test_gaussian_is_centred_on_its_mean_with_its_deviation(write):
     """The reference's examples: gaussian around the centre ('0.16 of the scope), and moved to the left
-    with '0.1: x centres on 0 (clamped into the scope, so half the points lie on its left side)."""
+    with '0.1: x centres on the scope's left side, the half inside it kept (a half-normal), z as before."""
     r = run(write, f"Lot --> scatter(scope, 4000, gaussian) {{ {CUBE} }} NIL\n", [rect(100, 50)])
     p, _ = points(r)
     assert p[:, 0].mean() == pytest.approx(50, abs=0.5) and p[:, 0].std() == pytest.approx(16, rel=0.05)
     assert p[:, 2].mean() == pytest.approx(-25, abs=0.3) and p[:, 2].std() == pytest.approx(8, rel=0.05)
     r = run(write, f"Lot --> scatter(surface, 4000, gaussian, left, '0.1) {{ {CUBE} }} NIL\n", [rect(100, 50)])
     p, _ = points(r)
-    assert (p[:, 0] >= 0).all() and (p[:, 0] < 1e-9).mean() == pytest.approx(0.5, abs=0.05)
+    assert (p[:, 0] > 0).all() and np.allclose(p[:, 1], 0.0)
+    half_normal = 10 * np.sqrt(2 / np.pi), 10 * np.sqrt(1 - 2 / np.pi)
+    assert (p[:, 0].mean(), p[:, 0].std()) == (pytest.approx(half_normal[0], rel=0.05),
+                                               pytest.approx(half_normal[1], rel=0.05))
     assert p[:, 2].mean() == pytest.approx(-25, abs=0.3) and p[:, 2].std() == pytest.approx(5, rel=0.05)
     r = run(write, f"Lot --> scatter(surface, 4000, gaussian, center, 2) {{ {CUBE} }} NIL\n", [rect(100, 50)])
     p, _ = points(r)
     assert p[:, 0].std() == pytest.approx(2, rel=0.05) and p[:, 2].std() == pytest.approx(2, rel=0.05)
+
+
+def test_a_wide_gaussian_is_cut_to_the_shape_not_piled_on_its_border(write):
+    """'1 of the scope, as public files write it: the points outside the lot are drawn again, so few of
+    them lie on its edges; on a concave lot they stay inside it."""
+    r = run(write, f"Lot --> scatter(surface, 2000, gaussian, center, '1) {{ {CUBE} }} NIL\n",
+            [rect(30, 20), LOT_ZOO["concave_L"]])
+    p, _ = points(r)
+    lot = r["lot"][np.array(names(r)) == "P"]
+    square = p[lot == 0]
+    on_edge = (np.abs(square[:, 0]) < 1e-6) | (np.abs(square[:, 0] - 30) < 1e-6) | (np.abs(square[:, 2]) < 1e-6)
+    assert on_edge.mean() < 0.01
+    ell = shapely.Polygon(LOT_ZOO["concave_L"][0]).buffer(1e-6)
+    assert shapely.contains_xy(ell, p[lot == 1, 0], -p[lot == 1, 2]).all()
 
 
 def test_the_count_is_an_expression_per_shape_truncated(write):
