@@ -13,14 +13,18 @@ keeps the parent's axes, as the reference says.
   (``geometry.triangulation``) and a triangle is drawn by area, then a point in it. A shape without area
   (a line or a point) draws in its scope.
 - ``volume``: a solid box (or an inserted asset, taken as its box, as ``geometry.volume`` has it) draws in
-  its scope; a prism draws a point of its base polygon and a height. grammarc takes a flat face, a roof and
-  any other mesh as open, so they fall back to ``surface``, as the reference says of an open mesh.
+  its scope; a prism draws a point of its base polygon and a height. A flat face has no volume and falls
+  back to ``surface``, as the reference says of an open mesh; so, for now, do roofs and other meshes, which
+  grammarc does not fill.
 - ``scope``: in the scope box.
 - ``gaussian``: each scope axis draws around ``mean`` (``center``, or the middle of the scope's face
   ``front`` (z = sz), ``back``, ``left`` (x = 0), ``right``, ``top`` (y = sy), ``bottom``) with the standard
-  deviation ``stddev``, in metres or times the scope's size on that axis (``'0.16`` by default). The point
-  is then the nearest point of the domain: clamped to the scope box, or the nearest point of the surface
-  (of the base polygon for a prism, its height clamped), so that no point leaves the shape.
+  deviation ``stddev``, in metres or times the scope's size on that axis (``'0.16`` by default). The
+  reference does not say what becomes of a draw outside the domain; grammarc draws again (up to
+  ``_TRIES`` times) while it falls outside the scope box, or is not straight above (along the face's
+  normal) a point of the surface, so that the distribution is the gaussian cut to the shape rather than
+  piled on its border; the last draw takes the nearest point of the domain. A point inside a solid goes
+  to the nearest face.
 
 ``n`` is evaluated per shape and truncated (CityEngine's rule files floor it themselves); a negative
 count makes no point, a NaN one fails the lot. Reads: the scope, ``geom``, ``key``, and what ``n`` reads;
