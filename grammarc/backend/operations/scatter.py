@@ -179,10 +179,14 @@ def _points(triangles, offsets, shape, axis, height, key, u, mean, sigma, gaussi
     and whether the shape had area (m,) bool."""
     n_tri = triangles.shape[0]
     cumulative = np.empty(n_tri)
+    unit = np.empty((n_tri, 3))
     for s in range(len(offsets) - 1):  # each shape's areas summed from its own first triangle
         total = 0.0
         for t in range(offsets[s], offsets[s + 1]):
-            total += 0.5 * _norm(_cross(triangles[t, 1] - triangles[t, 0], triangles[t, 2] - triangles[t, 0]))
+            n = np.cross(triangles[t, 1] - triangles[t, 0], triangles[t, 2] - triangles[t, 0])
+            length = np.sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2])
+            unit[t] = n / max(length, 1e-300)
+            total += 0.5 * length
             cumulative[t] = total
     m = len(shape)
     points = np.zeros((m, 3))
@@ -194,33 +198,33 @@ def _points(triangles, offsets, shape, axis, height, key, u, mean, sigma, gaussi
             continue
         found[i] = True
         a = axis[i]
+        pick = lo
         if gaussian:
             for attempt in range(_TRIES):
                 g = _gauss(key[i], attempt, mean[i], sigma[i])
-                best, pick = np.inf, lo
+                best = np.inf
                 for t in range(lo, hi):
-                    p = _closest(g, triangles[t, 0], triangles[t, 1], triangles[t, 2])
-                    d = np.sum((p - g) ** 2)
+                    q = _closest(g[0], g[1], g[2], triangles[t])
+                    d = (q[0] - g[0]) ** 2 + (q[1] - g[1]) ** 2 + (q[2] - g[2]) ** 2
                     if d < best:
-                        best, pick, points[i] = d, t, p
-                n = _cross(triangles[pick, 1] - triangles[pick, 0], triangles[pick, 2] - triangles[pick, 0])
-                n = n / max(_norm(n), 1e-300)
-                off = g - points[i]
-                off = off - np.dot(off, n) * n
-                if _norm(off) <= tol and (a < 0 or 0.0 <= g[a] <= height[i]):
+                        best, pick, near = d, t, q
+                n = unit[pick]
+                off = (g[0] - near[0], g[1] - near[1], g[2] - near[2])
+                along = off[0] * n[0] + off[1] * n[1] + off[2] * n[2]
+                side = (off[0] - along * n[0]) ** 2 + (off[1] - along * n[1]) ** 2 + (off[2] - along * n[2]) ** 2
+                if side <= tol * tol and (a < 0 or 0.0 <= g[a] <= height[i]):
                     break
+            points[i, 0], points[i, 1], points[i, 2] = near
             if a >= 0:
                 points[i, a] = min(max(g[a], 0.0), height[i])
         else:
-            pick = lo + np.searchsorted(cumulative[lo:hi], u[i, 0] * cumulative[hi - 1], side="right")
-            pick = min(pick, hi - 1)
+            pick = min(lo + np.searchsorted(cumulative[lo:hi], u[i, 0] * cumulative[hi - 1], side="right"), hi - 1)
             r = np.sqrt(u[i, 1])
             points[i] = ((1.0 - r) * triangles[pick, 0] + r * (1.0 - u[i, 2]) * triangles[pick, 1]
                          + r * u[i, 2] * triangles[pick, 2])
             if a >= 0:
                 points[i, a] = u[i, 3] * height[i]
-        n = _cross(triangles[pick, 1] - triangles[pick, 0], triangles[pick, 2] - triangles[pick, 0])
-        normals[i] = n / max(_norm(n), 1e-300)
+        normals[i] = unit[pick]
     return points, normals, found
 
 
@@ -243,55 +247,51 @@ def _in_box(key, mean, sigma, size, tol):
     return out
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, inline="always")
 def _gauss(key, attempt, mean, sigma):
     """Draw ``attempt`` of a point's gaussian: ``mean`` (3,) plus ``sigma`` (3,) times normal draws
-    (Box-Muller of four uniform draws of the point's key)."""
+    (Box-Muller of four uniform draws of the point's key, 53 bits each as ``random.uniform``'s)."""
     k = mix1(key, attempt)
-    u = np.empty(4)
-    for d in range(4):
-        u[d] = (mix1(k, d) >> np.uint64(11)) * (1.0 / 9007199254740992.0)  # 53 bits, as ``random.uniform``
-    r0, r1 = np.sqrt(-2.0 * np.log1p(-u[0])), np.sqrt(-2.0 * np.log1p(-u[2]))
-    out = np.empty(3)
-    out[0] = mean[0] + sigma[0] * r0 * np.cos(2.0 * np.pi * u[1])
-    out[1] = mean[1] + sigma[1] * r0 * np.sin(2.0 * np.pi * u[1])
-    out[2] = mean[2] + sigma[2] * r1 * np.cos(2.0 * np.pi * u[3])
-    return out
+    scale = 1.0 / 9007199254740992.0
+    u0, u1 = (mix1(k, 0) >> np.uint64(11)) * scale, (mix1(k, 1) >> np.uint64(11)) * scale
+    u2, u3 = (mix1(k, 2) >> np.uint64(11)) * scale, (mix1(k, 3) >> np.uint64(11)) * scale
+    r0, r1 = np.sqrt(-2.0 * np.log1p(-u0)), np.sqrt(-2.0 * np.log1p(-u2))
+    return (mean[0] + sigma[0] * r0 * np.cos(2.0 * np.pi * u1), mean[1] + sigma[1] * r0 * np.sin(2.0 * np.pi * u1),
+            mean[2] + sigma[2] * r1 * np.cos(2.0 * np.pi * u3))
 
 
 @njit(cache=True, nogil=True, inline="always")
-def _cross(a, b):
-    return np.array([a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]])
-
-
-@njit(cache=True, nogil=True, inline="always")
-def _norm(a):
-    return np.sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2])
-
-
-@njit(cache=True, nogil=True)
-def _closest(p, a, b, c):
-    """The point of triangle (a, b, c) nearest to ``p`` (Ericson, Real-Time Collision Detection 5.1.5)."""
-    ab, ac, ap = b - a, c - a, p - a
-    d1, d2 = np.dot(ab, ap), np.dot(ac, ap)
+def _closest(px, py, pz, tri):
+    """The point of triangle ``tri`` (3, 3) nearest to (px, py, pz), as a tuple (Ericson, Real-Time
+    Collision Detection 5.1.5), in scalars: it runs per draw and triangle."""
+    ax, ay, az = tri[0, 0], tri[0, 1], tri[0, 2]
+    bx, by, bz = tri[1, 0], tri[1, 1], tri[1, 2]
+    cx, cy, cz = tri[2, 0], tri[2, 1], tri[2, 2]
+    abx, aby, abz, acx, acy, acz = bx - ax, by - ay, bz - az, cx - ax, cy - ay, cz - az
+    d1 = abx * (px - ax) + aby * (py - ay) + abz * (pz - az)
+    d2 = acx * (px - ax) + acy * (py - ay) + acz * (pz - az)
     if d1 <= 0.0 and d2 <= 0.0:
-        return a.copy()
-    bp = p - b
-    d3, d4 = np.dot(ab, bp), np.dot(ac, bp)
+        return ax, ay, az
+    d3 = abx * (px - bx) + aby * (py - by) + abz * (pz - bz)
+    d4 = acx * (px - bx) + acy * (py - by) + acz * (pz - bz)
     if d3 >= 0.0 and d4 <= d3:
-        return b.copy()
+        return bx, by, bz
     vc = d1 * d4 - d3 * d2
     if vc <= 0.0 and d1 >= 0.0 and d3 <= 0.0:
-        return a + d1 / (d1 - d3) * ab
-    cp = p - c
-    d5, d6 = np.dot(ab, cp), np.dot(ac, cp)
+        v = d1 / (d1 - d3)
+        return ax + v * abx, ay + v * aby, az + v * abz
+    d5 = abx * (px - cx) + aby * (py - cy) + abz * (pz - cz)
+    d6 = acx * (px - cx) + acy * (py - cy) + acz * (pz - cz)
     if d6 >= 0.0 and d5 <= d6:
-        return c.copy()
+        return cx, cy, cz
     vb = d5 * d2 - d1 * d6
     if vb <= 0.0 and d2 >= 0.0 and d6 <= 0.0:
-        return a + d2 / (d2 - d6) * ac
+        w = d2 / (d2 - d6)
+        return ax + w * acx, ay + w * acy, az + w * acz
     va = d3 * d6 - d5 * d4
     if va <= 0.0 and d4 - d3 >= 0.0 and d5 - d6 >= 0.0:
-        return b + (d4 - d3) / ((d4 - d3) + (d5 - d6)) * (c - b)
+        w = (d4 - d3) / ((d4 - d3) + (d5 - d6))
+        return bx + w * (cx - bx), by + w * (cy - by), bz + w * (cz - bz)
     denominator = 1.0 / (va + vb + vc)
-    return a + ab * (vb * denominator) + ac * (vc * denominator)
+    v, w = vb * denominator, vc * denominator
+    return ax + abx * v + acx * w, ay + aby * v + acy * w, az + abz * v + acz * w
