@@ -63,7 +63,7 @@ def scatter(ctx: Context, cursor: Shapes, op: ir.Scatter) -> Parts:
     bad = np.isnan(count)
     if bad.any():
         ctx.fail(cursor, bad, "`scatter` needs a number of points, got NaN", op.span)
-    counts = np.where(bad, 0, np.clip(count, 0, 2.0**62)).astype(np.int64)
+    counts = np.clip(count, 0, 2.0**62).astype(np.int64)  # truncated; too many is --max-shapes' error
     ctx.check_fan_out(cursor, counts, op.span)
     parent, index = fan_out(counts)
     key = child_keys(cursor.key[parent], op.site, index)
