@@ -1,9 +1,10 @@
 """The operations of CityEngine CGA lowered to IR operations (``split``, ``comp``, ``setback``, roofs,
 scope operations, ``set``, ``report``...): ``OperationLowering`` is the mixin of ``lowering.Lowering`` with a
-handler per operation that needs one; ``OPERATIONS`` and ``PART_OPERATIONS`` (calls with parts
-``{ sel : A | ... }``) map names to handlers, or to ``direct`` where the arguments are the IR node's
-fields; the other tables name the selectors and roof arguments calls are checked against, and the
-operations that are accepted but not applied or not implemented. An operation or construct grammarc does
+handler per operation that needs one; ``OPERATIONS``, ``PART_OPERATIONS`` (calls with parts
+``{ sel : A | ... }``) and ``BODY_OPERATIONS`` (``scatter``, whose braces hold operations) map names to
+handlers, or to ``direct`` where the arguments are the IR node's fields; the other tables name the
+selectors and roof arguments calls are checked against, and the operations that are accepted but not
+applied or not implemented. An operation or construct grammarc does
 not implement is an error ``unsupported: NAME`` at its span; a name that is no operation of CityEngine's
 reference where only an operation can be (``spilt(y){ ... }``, or a typo of one called where no rule has
 the name) is ``unknown operation NAME`` (``check_calls``).
