@@ -732,7 +732,6 @@ class CompFaces:
     offset: Expr | None = child(Type.NUM, "an offset distance", default=None)
 
 
-
 #: CityEngine's coordinate systems of ``translate`` and ``rotate``.
 COORDINATE_SYSTEMS = frozenset({"scope", "pivot", "object", "world"})
 
@@ -750,11 +749,34 @@ class Transform:
         Type.NUM, lambda op: "a translation" if op.kind == "translate" else "an angle")
     span: Span = NO_SPAN
 
+
+#: Where ``scatter`` draws its points, and the scope positions its gaussian can centre on.
+SCATTER_DOMAINS = frozenset({"surface", "volume", "scope"})
+SCATTER_MEANS = frozenset({"center", "front", "back", "left", "right", "top", "bottom"})
+
+
+@dataclass(frozen=True, slots=True)
+class Scatter:
+    """CityEngine ``scatter(domain, n, uniform|gaussian[, mean, stddev]) { body }``: ``count`` point shapes
+    (zero-size scopes) on the surface, in the volume or in the scope of the shape, each running ``parts[0]``.
+    ``gaussian`` draws around the scope position ``mean`` with standard deviation ``stddev``, in metres or,
+    when ``relative``, times the scope's size on each axis. The shape itself goes on."""
+
+    domain: str
+    count: Expr = child(Type.NUM, "a number of points")
+    gaussian: bool
+    mean: str
+    stddev: Expr = child(Type.NUM, "a standard deviation")
+    relative: bool
+    parts: tuple[Body, ...] = child(holds=Holds.BODIES)
+    span: Span = NO_SPAN
+    site: int = 0
+
+
 Op = (Symbol | Empty | Translate | Scale | Rotate | Push | Pop | Insert | Split | Repeat | Comp | Extrude
       | Center | UseAsset | Case | Stochastic | SetAttr | Report | NotApplied | GroupSplit | CompFaces
       | AlignScope | Mirror | Offset | SetColor | Setback | Roof | InnerRectangle | Convexify
-      | CleanupGeometry | DeleteHoles | Snap | Label
-      | Transform)
+      | CleanupGeometry | DeleteHoles | Snap | Label | Transform | Scatter)
 Body = tuple[Op, ...]
 
 

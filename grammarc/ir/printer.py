@@ -133,6 +133,12 @@ def _align_scope(op: ir.AlignScope) -> str:
     return "alignScopeToAxes()" if op.mode == "world" else f"alignScopeToAxes({op.mode})"
 
 
+def _scatter(op: ir.Scatter) -> str:
+    spread = (f"gaussian, {op.mean}, {print_expr(op.stddev)}{'r' if op.relative else ''}" if op.gaussian
+              else "uniform")
+    return f"scatter({op.domain}, {print_expr(op.count)}, {spread}){_parts(op.parts)}"
+
+
 _OP_FORMATS = {
     ir.Symbol: lambda op: op.name + (f"({_list(op.args)})" if op.args else "") + ("." if op.leaf else ""),
     ir.Empty: lambda op: "ε",
@@ -173,6 +179,7 @@ _OP_FORMATS = {
     ir.Mirror: lambda op: f"mirror({_list(op.axes)})",
     ir.AlignScope: _align_scope,
     ir.NotApplied: lambda op: f"{op.name}(...)",
+    ir.Scatter: _scatter,
 }
 
 

@@ -14,7 +14,8 @@ columns:
 - ``inserts``: ``I``, ``i``, ``label``;
 - ``successors``: successor symbols, ``ε``/``NIL`` and operations without effect;
 - ``values``: ``set``, ``color``, ``report``;
-- ``control``: ``case`` and ``p%`` blocks.
+- ``control``: ``case`` and ``p%`` blocks;
+- ``scatter``: ``scatter``, point shapes on, in or around the shape.
 
 A new operation is its IR node, its lowering and its function here: importing this package registers them.
 """
@@ -24,6 +25,7 @@ from grammarc.backend.operations import (  # noqa: F401 - each registers its ope
     control,
     faces,
     inserts,
+    scatter,
     scope,
     splits,
     successors,

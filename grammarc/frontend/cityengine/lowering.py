@@ -34,6 +34,7 @@ from grammarc.frontend.cityengine.nodes import (
 from grammarc.frontend.cityengine.operations import (
     ALL_OPERATIONS,
     BARE_OPS,
+    BODY_OPERATIONS,
     NOT_APPLIED,
     OPERATIONS,
     PART_OPERATIONS,
@@ -349,8 +350,11 @@ class Lowering(OperationLowering, LoweringBase):
         return ir.Symbol(op, tuple(self.expr(a) for a in args), span, self.site())
 
     def scatter(self, meta, name, args, body):
-        """``scatter(...) { operations }``: parsed, so that it is reported as unsupported at its place."""
-        return self.unsupported("scatter", self.token_span(name))
+        """``scatter(...) { operations }``: an operation of ``BODY_OPERATIONS``; without braces its points
+        have an empty body (they stay leaves)."""
+        op = str(name)
+        return BODY_OPERATIONS[op](self, op, args or (), as_body(body) if body is not None else (),
+                                   self.token_span(name))
 
     def split_call(self, meta, name, args, parts, star):
         """``op(args){ parts }``, and ``split(args){ parts }*``: an operation of ``PART_OPERATIONS``."""

@@ -1,9 +1,10 @@
 """The operations of CityEngine CGA lowered to IR operations (``split``, ``comp``, ``setback``, roofs,
 scope operations, ``set``, ``report``...): ``OperationLowering`` is the mixin of ``lowering.Lowering`` with a
-handler per operation that needs one; ``OPERATIONS`` and ``PART_OPERATIONS`` (calls with parts
-``{ sel : A | ... }``) map names to handlers, or to ``direct`` where the arguments are the IR node's
-fields; the other tables name the selectors and roof arguments calls are checked against, and the
-operations that are accepted but not applied or not implemented. An operation or construct grammarc does
+handler per operation that needs one; ``OPERATIONS``, ``PART_OPERATIONS`` (calls with parts
+``{ sel : A | ... }``) and ``BODY_OPERATIONS`` (``scatter``, whose braces hold operations) map names to
+handlers, or to ``direct`` where the arguments are the IR node's fields; the other tables name the
+selectors and roof arguments calls are checked against, and the operations that are accepted but not
+applied or not implemented. An operation or construct grammarc does
 not implement is an error ``unsupported: NAME`` at its span; a name that is no operation of CityEngine's
 reference where only an operation can be (``spilt(y){ ... }``, or a typo of one called where no rule has
 the name) is ``unknown operation NAME`` (``check_calls``).
@@ -329,6 +330,29 @@ class OperationLowering:
             return ir.Empty(span)
         return ir.InnerRectangle(args[0].name, chosen[0], chosen[1], span, self.site())
 
+    def op_scatter(self, op, args, body, span):
+        """``scatter(domain, n, uniform|gaussian[, mean[, stddev]]) { operations }``: the gaussian's mean
+        defaults to ``center`` and its deviation to ``'0.16``, as the reference has them."""
+        if not 3 <= len(args) <= 5:
+            self.diags.error("arity", f"`{op}` takes 3 to 5 arguments, got {len(args)}", span)
+            return ir.Empty(span)
+        names = [a.name if isinstance(a, ir.Name) else None for a in args]
+        for i, noun, known in ((0, "domain", ir.SCATTER_DOMAINS), (2, "distribution", SCATTER_TYPES)):
+            if names[i] not in known:
+                return self.unsupported(f"scatter {noun} `{names[i] or 'expression'}`", args[i].span,
+                                        f"scatter takes {', '.join(sorted(known))}")
+        if len(args) > 3 and names[2] != "gaussian":
+            return self.unsupported("scatter uniform with a mean", args[3].span, "only gaussian takes one")
+        mean = names[3] if len(args) > 3 else "center"
+        if mean not in ir.SCATTER_MEANS:
+            return self.unsupported(f"scatter mean `{mean or 'expression'}`", args[3].span,
+                                    f"the mean is one of {', '.join(sorted(ir.SCATTER_MEANS))}")
+        stddev = args[4] if len(args) > 4 else Sized(ir.SizeKind.RELATIVE, ir.Num(0.16, span), span)
+        relative = isinstance(stddev, Sized) and stddev.kind is ir.SizeKind.RELATIVE
+        value = stddev.value if relative else self.expr(stddev)
+        return ir.Scatter(names[0], self.expr(args[1]), names[2] == "gaussian", mean, value, relative, (body,),
+                          span, self.site())
+
     def selector_parts(self, op, parts, known, named=None, noun="polygons"):
         """The selectors and bodies of ``{ sel: A | ... }`` parts, all among ``known`` (None after an
         error); ``sel=`` is derived as ``sel:``, with a warning. ``named`` is the operation as a selector
@@ -399,6 +423,12 @@ PART_OPERATIONS = {
     "shapeO": OperationLowering.op_setback,
     "innerRectangle": OperationLowering.op_inner_rectangle,
 }
+#: Operations with a body ``{ operations }``: name -> handler(lowering, op, args, body, span).
+BODY_OPERATIONS = {
+    "scatter": OperationLowering.op_scatter,
+}
+#: The distributions of ``scatter``.
+SCATTER_TYPES = frozenset({"uniform", "gaussian"})
 #: The optional arguments after a roof's value (roofGable's ``index`` only by angle).
 ROOF_ARGUMENTS = {"roofHip": ("overhang", "even"), "roofGable": ("overhangX", "overhangY", "even"),
                    "roofShed": ("index",), "roofPyramid": ()}
@@ -436,7 +466,7 @@ UNSUPPORTED_OPS = frozenset({
     "innerPolygon",
     "trim",
     "mirrorScope",
-    "insertAlongUV", "scatter", "footprint", "tileUV", "splitArea", "inline", "resetGeometry", "taper",
+    "insertAlongUV", "footprint", "tileUV", "splitArea", "inline", "resetGeometry", "taper",
     "primitiveCylinder", "primitiveSphere", "primitiveDisk", "primitiveCone", "primitiveQuad",
     "reduceGeometry", "rectify", "semiPolygon",
     "alignScopeToGeometryBBox", "roofRidge", "modify",
@@ -445,7 +475,8 @@ UNSUPPORTED_OPS = frozenset({
     "copyUV", "setMaterial", "resetMaterial",
 } - NOT_APPLIED)
 #: Every operation name CityEngine knows: what a misspelt one is suggested from.
-ALL_OPERATIONS = frozenset(OPERATIONS) | frozenset(PART_OPERATIONS) | NOT_APPLIED | UNSUPPORTED_OPS
+ALL_OPERATIONS = (frozenset(OPERATIONS) | frozenset(PART_OPERATIONS) | frozenset(BODY_OPERATIONS) | NOT_APPLIED
+                  | UNSUPPORTED_OPS)
 #: Axis selectors of ``center`` and ``alignScopeToAxes``.
 AXIS_NAMES = {"x": (0,), "y": (1,), "z": (2,), "xy": (0, 1), "xz": (0, 2), "yz": (1, 2), "xyz": (0, 1, 2)}
 

@@ -377,5 +377,6 @@ A(float h, string s, bool b, float[] a) --> extrude(half(h)) print(label(s, b)) 
     assert rules(text)["A"].startswith("A(h, s, b, a) ~> extrude(($h / 2))")
 
 
-def test_scatter_with_operations_in_braces_is_unsupported_not_a_syntax_error():
-    assert_unsupported_at("Lot --> extrude(3) scatter(surface, 10, uniform) { Tree } A", "scatter", "scatter")
+def test_scatter_with_operations_in_braces_lowers_with_its_body():
+    assert body_of(VERSION + "Lot --> extrude(3) scatter(surface, 10, uniform) { s(1, 1, 1) Tree } A\n") == (
+        "extrude(3) scatter(surface, 10, uniform){ S(1, 1, 1) Tree } A")

@@ -12,6 +12,7 @@ from grammarc.compiler import compile_grammar
 from grammarc.diagnostics import Diagnostics
 from grammarc.frontend.cityengine.operations import (
     ALL_OPERATIONS,
+    BODY_OPERATIONS,
     NOT_APPLIED,
     OPERATIONS,
     PART_OPERATIONS,
@@ -238,13 +239,40 @@ def test_unsupported_operation_is_named_at_its_span(line, name, at):
     assert_unsupported_at(line, name, at)
 
 
+@pytest.mark.parametrize("body, printed", [
+    ("scatter(surface, 100, uniform) { Leaf }", "scatter(surface, 100, uniform){ Leaf }"),
+    ("scatter(surface, 100, gaussian) { Leaf }", "scatter(surface, 100, gaussian, center, 0.16r){ Leaf }"),
+    ("scatter(surface, 100, gaussian, left, '0.1) { Leaf }", "scatter(surface, 100, gaussian, left, 0.1r){ Leaf }"),
+    ("scatter(volume, geometry.area / 10, gaussian, top, 2) { s(1, 1, 1) A } NIL",
+     "scatter(volume, (geometry.area() / 10), gaussian, top, 2){ S(1, 1, 1) A } \u03b5"),
+    ("scatter(scope, 3, uniform)", "scatter(scope, 3, uniform){ \u03b5 }"),
+])
+def test_scatter_lowers_its_forms_with_the_references_defaults(body, printed):
+    assert body_of(VERSION + f"Lot --> {body}\n") == printed
+
+
+@pytest.mark.parametrize("line, name, at", [
+    ("Lot --> scatter(edges, 10, uniform) { A }", "scatter domain `edges`", "edges"),
+    ("Lot --> scatter(surface, 10, poisson) { A }", "scatter distribution `poisson`", "poisson"),
+    ("Lot --> scatter(surface, 10, gaussian, middle, 1) { A }", "scatter mean `middle`", "middle"),
+    ("Lot --> scatter(surface, 10, uniform, center) { A }", "scatter uniform with a mean", "center"),
+])
+def test_scatter_with_an_unknown_selector_is_unsupported_at_it(line, name, at):
+    assert_unsupported_at(line, name, at)
+
+
+def test_scatter_with_a_wrong_argument_count_is_an_arity_error():
+    assert errors(VERSION + "Lot --> scatter(surface, 10) { A }\n") == [
+        (2, 9, "`scatter` takes 3 to 5 arguments, got 2")]
+
+
 # ---------------------------------------------------------------------------------------------- the tables
 
 
 def test_each_operation_name_is_in_one_table():
     """The lowering asks the tables in turn: a name in two would be lowered by the first alone (an
     operation added to ``OPERATIONS`` leaves ``UNSUPPORTED_OPS``)."""
-    names = [*OPERATIONS, *PART_OPERATIONS, *NOT_APPLIED, *UNSUPPORTED_OPS]
+    names = [*OPERATIONS, *PART_OPERATIONS, *BODY_OPERATIONS, *NOT_APPLIED, *UNSUPPORTED_OPS]
     assert len(names) == len(set(names))
 
 
