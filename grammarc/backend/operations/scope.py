@@ -166,9 +166,13 @@ def align_to_geometry(ctx: Context, cursor: Shapes, op: ir.AlignToGeometry) -> S
     edge = np.zeros((n, 3))
     edge[found] = verts[end[found]] - verts[start[found]]
     new_axes, ok = aligned_axes(edge, normal, axes, op.up)
-    if not ok.all():
-        ctx.fail(cursor, ~ok, "alignScopeToGeometry finds no such face or edge", op.span)
-    return reframed(ctx, cursor, new_axes, op.span)
+    if ok.all():
+        return reframed(ctx, cursor, new_axes, op.span)
+    # no face with an area, or no edge with a length (a line, a point, a degenerate face): the scope stays,
+    # as CityEngine leaves it rather than stopping the model
+    rows, others = np.flatnonzero(ok), np.flatnonzero(~ok)
+    return Shapes.merge([reframed(ctx, cursor.take(rows), new_axes[rows], op.span), cursor.take(others)],
+                        [rows, others])
 
 
 @operation(ir.Mirror, writes=("geom",))

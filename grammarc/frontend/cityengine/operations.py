@@ -370,7 +370,7 @@ PART_OPERATIONS = {
 ROOF_ARGUMENTS = {"roofHip": ("overhang", "even"), "roofGable": ("overhangX", "overhangY", "even"),
                    "roofShed": ("index",), "roofPyramid": ()}
 #: Operations CityEngine also takes without their parentheses (other bare names are rules).
-BARE_OPS = frozenset({"NIL", "primitiveCube", "convexify"})
+BARE_OPS = frozenset({"NIL", "primitiveCube", "convexify", "alignScopeToAxes"})
 #: Part operations whose parts are sizes or faces: without parts, `unsupported: split` (the others say
 #: that their selector parts are missing).
 SPLIT_OPS = frozenset({"split", "comp"})

@@ -262,3 +262,15 @@ def test_align_scope_to_one_world_axis(write, axis, k):
     corners = before[:, 3] + np.array([[i, j, m] for i in (0, 1) for j in (0, 1) for m in (0, 1)]) @ before[:, :3].T
     local = np.linalg.solve(after[:, :3], (corners - after[:, 3]).T).T
     assert local.min() == pytest.approx(0, abs=1e-6) and local.max() == pytest.approx(1, abs=1e-6)
+
+
+def test_align_to_geometry_without_an_edge_keeps_the_scope(write):
+    """A shape with no face to align to (a scope box shrunk to a line) keeps its scope, next to one that
+    turns."""
+    text = ("Lot --> extrude(4) comp(f){ front : F }\n"
+            "F --> [ s(0, '1, 0) E ] G\n"
+            "E --> alignScopeToGeometry(zUp, largest, longest) report(\"sy\", scope.sy) report(\"ty\", scope.ty)\n"
+            "G --> alignScopeToGeometry(yUp, 0, 0) i(\"builtin:cube\")\n")
+    r = run(write, text, [rect(12, 8)])
+    assert (totals(r)["sy_sum"], totals(r)["ty_sum"]) == pytest.approx((4, 0))
+    assert names(r) == ["G"]  # the face beside it turned and made its quad

@@ -49,6 +49,7 @@ from .lowered import VERSION, assert_unsupported_at, body_of, compile_ir, errors
     ("alignScopeToAxes(world.xyz) A", "alignScopeToAxes() A"),
     ("alignScopeToAxes(y) A", "alignScopeToAxes(y) A"),
     ('alignScopeToAxes("y") A', "alignScopeToAxes(y) A"),
+    ("alignScopeToAxes split(y){ 1 : A }", "alignScopeToAxes() split(y){ 1: A }"),
     ("alignScopeToAxes(world.z) A", "alignScopeToAxes(z) A"),
     ("alignScopeToAxes(x) A", "alignScopeToAxes(x) A"),
     ("alignScopeToGeometry(yUp, 2) A", "alignScopeToGeometry(yUp, 2, 0) A"),
