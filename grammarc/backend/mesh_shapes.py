@@ -27,6 +27,7 @@ from grammarc.geometry.meshes import (
     mesh_edges,
 )
 from grammarc.geometry.polygons import PLANE_U, PLANE_V, plane_to_scope
+from grammarc.geometry.queries import shape_faces
 from grammarc.geometry.roofs import ROOF_KINDS, roof_meshes
 from grammarc.geometry.sections import append_caps, plane_segments, section_caps
 from grammarc.model.records import MeshChunk
@@ -177,15 +178,20 @@ def clip_meshes(chunk: Chunk, shapes: Shapes, parent: np.ndarray, axis: int, pos
 
 
 def reframe_meshes(chunk: Chunk, shapes: Shapes, new_axes: np.ndarray) -> Shapes:
-    """Mesh shapes in scopes with ``new_axes`` (n, 3, 3) around unchanged geometry (``alignScopeToAxes``,
-    ``rotateScope``): any turn, since a mesh is not tied to a plane; the scope fitted to the mesh."""
-    verts, ring_offsets, face_offsets, mesh_offsets, vertex_shape = face_vertices(
-        chunk.meshes, shapes.geom - MESH_BASE, shapes.size)
+    """Shapes in scopes with ``new_axes`` (n, 3, 3) around unchanged geometry (``alignScopeToAxes``,
+    ``rotateScope``, ``alignScopeToGeometry``): any turn, their faces (``geometry.queries.shape_faces``: a
+    polygon or a prism its faces, a mesh its own) stored as a mesh fitted to the new scope. A scope box
+    turned by quarter turns (each new axis an old one or its opposite) stays a box."""
+    faces = shape_faces(shapes.size, shapes.geom, chunk.polygons, chunk.meshes)
+    vertex_shape = faces.vertex_shape()
     old_axes = chunk.frames[shapes.frame]
     # world offsets from the old origin, then coordinates along the new axes
-    world = np.einsum("vi,vij->vj", verts, old_axes[vertex_shape])
+    world = np.einsum("vi,vij->vj", faces.verts, old_axes[vertex_shape])
     local = np.einsum("vj,vij->vi", world, new_axes[vertex_shape])
-    geom, low, size = store_fitted(chunk, local, ring_offsets, face_offsets, mesh_offsets)
+    geom, low, size = store_fitted(chunk, local, faces.ring_offsets, faces.face_offsets, faces.shape_offsets)
+    turns = np.abs(np.einsum("nij,nkj->nik", new_axes, old_axes))
+    box = (shapes.geom == -1) & (np.abs(turns.max(axis=2) - 1) < 1e-9).all(axis=1)
+    geom[box] = -1
     origin = shapes.origin + np.einsum("ni,nij->nj", low, new_axes)
     return shapes.with_scope(origin, size, chunk.frames.add(np.ascontiguousarray(new_axes)), geom)
 

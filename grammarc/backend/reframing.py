@@ -1,8 +1,9 @@
 """Shapes given new scope axes around their unchanged geometry, the scope fitted to it again.
 
 ``alignScopeToAxes``, ``alignScopeToGeometry`` and ``rotateScope`` turn every shape's scope; ``extrude`` and a
-``comp(f)`` face turn some (a face whose normal is not the axis they want it along). Polygons go through
-``geometry.reframe``, meshes through ``mesh_shapes.reframe_meshes``.
+``comp(f)`` face turn some (a face whose normal is not the axis they want it along). Polygons and prisms
+go through ``geometry.reframe`` while one new axis is their plane's normal; meshes, and polygons turned out
+of their plane, through ``mesh_shapes.reframe_meshes`` (a box turned by quarter turns stays a box).
 """
 
 from __future__ import annotations
@@ -32,7 +33,7 @@ def turned(ctx: Context, shapes: Shapes, turn: np.ndarray, matrices: np.ndarray,
 
 def reframed(ctx: Context, shapes: Shapes, new_axes: np.ndarray, span) -> Shapes:
     """The same geometry in scopes with ``new_axes`` (n, 3, 3), fitted to it; fails the lots of inserted
-    assets and of polygons turned out of their plane."""
+    assets."""
     chunk = ctx.chunk
     mesh = is_mesh(shapes.geom)
     if mesh.any():
@@ -52,12 +53,16 @@ def reframed(ctx: Context, shapes: Shapes, new_axes: np.ndarray, span) -> Shapes
     ok, plane, origin, size, is_rect, new_coords = reframe(
         shapes.origin, shapes.size, chunk.frames[shapes.frame], coords, ring_offsets, shape_offsets,
         plane, new_axes)
-    if not ok.all():
-        ctx.fail(shapes, ~ok, "turning a scope out of its geometry's plane is not supported yet", span)
     geom = np.full(n, -1, dtype=np.int32)
-    poly = np.flatnonzero(~is_rect)
+    poly = np.flatnonzero(~is_rect & ok)
     if len(poly):
         rings, packed_shapes = ragged_take(shape_offsets, poly)
         vertices, packed_rings = ragged_take(ring_offsets, rings)
         geom[poly] = chunk.polygons.add(new_coords[vertices], packed_rings, packed_shapes, plane[poly])
-    return shapes.with_scope(origin, size, chunk.frames.add(np.ascontiguousarray(new_axes)), geom)
+    result = shapes.with_scope(origin, size, chunk.frames.add(np.ascontiguousarray(new_axes)), geom)
+    if ok.all():
+        return result
+    # Turned out of their polygon's plane (a prism onto a side face, a face tilted): their faces as meshes.
+    rows, others = np.flatnonzero(~ok), np.flatnonzero(ok)
+    turned = mesh_shapes.reframe_meshes(chunk, shapes.take(rows), new_axes[rows])
+    return Shapes.merge([result.take(others), turned], [others, rows])

@@ -519,9 +519,8 @@ INSERT_MODES = ("alignSizeAndPosition", "keepSizeAndPosition", "keepSizeAlignPos
 @dataclass(frozen=True, slots=True)
 class AlignScope:
     """New scope axes, the geometry unchanged: CityEngine ``alignScopeToAxes()`` (``mode`` "world"),
-    ``alignScopeToAxes(y)`` ("y"), ``rotateScope(x, y, z)`` ("rotate", ``angles``) and
-    ``alignScopeToGeometry(yUp|zUp, 0, edge)`` ("geometry-y"/"geometry-z", the edge index first in
-    ``angles``)."""
+    ``alignScopeToAxes(x|y|z)`` ("x", "y", "z": that world axis, the next axis projected) and
+    ``rotateScope(x, y, z)`` ("rotate", ``angles``)."""
 
     mode: str
     angles: tuple[Expr, Expr, Expr] | None = child(Type.NUM, "an angle", default=None)
@@ -772,11 +771,25 @@ class Scatter:
     span: Span = NO_SPAN
     site: int = 0
 
+@dataclass(frozen=True, slots=True)
+class AlignToGeometry:
+    """CityEngine ``alignScopeToGeometry(upAxis, face, edge)``: the scope's x along an edge of a face of the
+    geometry, its y (``up`` "yUp") or z ("zUp") along the face's normal, fitted to the unchanged geometry.
+    ``face`` is "index" (``face_index``), "largest", "world.lowest" or "any"; ``edge`` is "index"
+    (``edge_index``), "longest" or "world.lowest" (``geometry.align``)."""
+
+    up: str
+    face: str
+    edge: str
+    face_index: Expr | None = child(Type.NUM, "a face index", default=None)
+    edge_index: Expr | None = child(Type.NUM, "an edge index", default=None)
+    span: Span = NO_SPAN
+
 
 Op = (Symbol | Empty | Translate | Scale | Rotate | Push | Pop | Insert | Split | Repeat | Comp | Extrude
       | Center | UseAsset | Case | Stochastic | SetAttr | Report | NotApplied | GroupSplit | CompFaces
       | AlignScope | Mirror | Offset | SetColor | Setback | Roof | InnerRectangle | Convexify
-      | CleanupGeometry | DeleteHoles | Snap | Label | Transform | Scatter)
+      | CleanupGeometry | DeleteHoles | Snap | Label | Transform | Scatter | AlignToGeometry)
 Body = tuple[Op, ...]
 
 

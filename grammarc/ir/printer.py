@@ -126,8 +126,6 @@ _SNAP_AXES = {0: "Y", 1: "XZ", 2: "XY"}
 
 
 def _align_scope(op: ir.AlignScope) -> str:
-    if op.mode.startswith("geometry"):
-        return f"alignScopeToGeometry({op.mode[-1]}Up, 0, {print_expr(op.angles[0])})"
     if op.angles is not None:
         return f"rotateScope({_list(op.angles)})"
     return "alignScopeToAxes()" if op.mode == "world" else f"alignScopeToAxes({op.mode})"
@@ -178,6 +176,9 @@ _OP_FORMATS = {
     ir.Report: lambda op: f"report({print_expr(op.key)}, {print_expr(op.value)})",
     ir.Mirror: lambda op: f"mirror({_list(op.axes)})",
     ir.AlignScope: _align_scope,
+    ir.AlignToGeometry: lambda op: "alignScopeToGeometry(" + ", ".join([
+        op.up, op.face if op.face_index is None else print_expr(op.face_index),
+        op.edge if op.edge_index is None else print_expr(op.edge_index)]) + ")",
     ir.NotApplied: lambda op: f"{op.name}(...)",
     ir.Scatter: _scatter,
 }

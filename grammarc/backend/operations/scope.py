@@ -20,13 +20,13 @@ from grammarc.backend.euler import orientation, rotation
 from grammarc.backend.evaluate import evaluate, evaluate_array
 from grammarc.backend.functions.coordinates import system
 from grammarc.backend.operations.table import operation
-from grammarc.backend.outlines import flat_axis, polygons_of
+from grammarc.backend.outlines import flat_axis
 from grammarc.backend.reframing import reframed, turned
 from grammarc.backend.shapes import Shapes, asset_geom, asset_of
-from grammarc.constants import TOL
 from grammarc.geometry import components as comp_kernels
+from grammarc.geometry.align import EDGE_MODES, FACE_MODES, aligned_axes, pick_edges
 from grammarc.geometry.meshes import is_polygon
-from grammarc.geometry.polygons import PLANE_U, PLANE_V
+from grammarc.geometry.queries import face_shapes, shape_faces
 from grammarc.geometry.reframe import NORMAL_UP
 from grammarc.ir import nodes as ir
 
@@ -151,47 +151,72 @@ def align_scope(ctx: Context, cursor: Shapes, op: ir.AlignScope) -> Shapes:
     n = len(cursor)
     if op.mode == "world":
         new_axes = np.broadcast_to(np.eye(3), (n, 3, 3))
-    elif op.mode == "y":
-        up = np.array([0.0, 1.0, 0.0])
-        x = axes[:, 0] - axes[:, 0, 1:2] * up
-        flat = np.linalg.norm(x, axis=1) < 1e-9
-        x[flat] = axes[flat, 2] - axes[flat, 2, 1:2] * up
-        x /= np.linalg.norm(x, axis=1, keepdims=True)
-        new_axes = np.stack([x, np.broadcast_to(up, x.shape), np.cross(x, up)], axis=1)
     elif op.mode == "rotate":
         env = ctx.env(cursor)
         angles = [np.broadcast_to(evaluate_array(e, env), (n,)) for e in op.angles]
         new_axes = np.einsum("nij,njk->nik", rotation(*angles), axes)
     else:
-        new_axes = _geometry_axes(ctx, cursor, op, axes)
+        new_axes = _world_axis(axes, "xyz".index(op.mode))
     return reframed(ctx, cursor, new_axes, op.span)
 
 
-def _geometry_axes(ctx: Context, cursor: Shapes, op: ir.AlignScope, axes: np.ndarray):
-    """Axes of ``alignScopeToGeometry``: up along the face's normal, x along its edge ``k``."""
-    flat = cursor.size <= TOL.zero
-    bad = flat.sum(axis=1) != 1
-    if bad.any():
-        ctx.fail(cursor, bad, "alignScopeToGeometry of a solid is not supported yet (only faces)", op.span)
-    coords, ring_offsets, shape_offsets, plane = polygons_of(ctx.chunk, cursor)
-    rows = np.arange(len(cursor))
-    edge = np.round(evaluate_array(op.angles[0], ctx.env(cursor))).astype(np.int64)
-    start = ring_offsets[shape_offsets[:-1]]
-    count = ring_offsets[shape_offsets[:-1] + 1] - start
-    j = start + np.mod(edge, count)
-    k = start + np.mod(edge + 1, count)
-    a, b = PLANE_U[plane], PLANE_V[plane]
+#: Per world axis k of ``alignScopeToAxes(k)``: the scope axis projected onto the plane across it (the
+#: reference's "second axis"), and the one projected instead where that one is parallel to axis k.
+_SECOND_AXIS = ((2, 1), (0, 2), (0, 1))
 
-    def world(v):
-        return ((coords[v, 0] * cursor.size[rows, a])[:, None] * axes[rows, a]
-                + (coords[v, 1] * cursor.size[rows, b])[:, None] * axes[rows, b])
 
-    x = world(k) - world(j)
-    x /= np.linalg.norm(x, axis=1, keepdims=True)
-    normal = axes[rows, plane]
-    if op.mode == "geometry-y":
-        return np.stack([x, normal, np.cross(x, normal)], axis=1)
-    return np.stack([x, np.cross(normal, x), normal], axis=1)
+def _world_axis(axes: np.ndarray, k: int) -> np.ndarray:
+    """Axes (n, 3, 3) with axis k along world axis k and the second axis (``_SECOND_AXIS``) the old one
+    projected across it; the third completes a right-handed frame."""
+    world = np.eye(3)[k]
+    second, fallback = _SECOND_AXIS[k]
+    along = axes[:, second] - axes[:, second, k:k + 1] * world
+    flat = np.linalg.norm(along, axis=1) < 1e-9
+    along[flat] = axes[flat, fallback] - axes[flat, fallback, k:k + 1] * world
+    along /= np.linalg.norm(along, axis=1, keepdims=True)
+    new_axes = np.empty_like(axes)
+    new_axes[:, k] = world
+    new_axes[:, second] = along
+    third = 3 - k - second
+    new_axes[:, third] = np.cross(new_axes[:, (third + 1) % 3], new_axes[:, (third + 2) % 3])
+    return new_axes
+
+
+@operation(ir.AlignToGeometry, writes=_SCOPE, meshes=True)
+def align_to_geometry(ctx: Context, cursor: Shapes, op: ir.AlignToGeometry) -> Shapes:
+    """``alignScopeToGeometry``: every shape's faces in world space, a face and an edge picked per shape
+    (``geometry.align``), the scope turned to them around the unchanged geometry."""
+    chunk = ctx.chunk
+    n = len(cursor)
+    env = ctx.env(cursor)
+    axes = chunk.frames[cursor.frame]
+    faces = shape_faces(cursor.size, cursor.geom, chunk.polygons, chunk.meshes)
+    # world-oriented offsets from each scope's origin: a shape's own shift does not change its choices
+    verts = np.einsum("vi,vij->vj", faces.verts, axes[faces.vertex_shape()])
+    vector = face_shapes(verts, faces.ring_offsets, faces.face_offsets)[0]
+    area = np.linalg.norm(vector, axis=1)
+
+    def index(expr):
+        if expr is None:
+            return np.zeros(n, np.int64)
+        return np.round(np.broadcast_to(evaluate_array(expr, env), (n,))).astype(np.int64)
+
+    face, start, end = pick_edges(verts, faces.ring_offsets, faces.face_offsets, faces.shape_offsets, area,
+                                  FACE_MODES[op.face], index(op.face_index), EDGE_MODES[op.edge],
+                                  index(op.edge_index))
+    found = face >= 0
+    normal = np.full((n, 3), np.nan)
+    normal[found] = vector[face[found]] / area[face[found], None]
+    edge = np.zeros((n, 3))
+    edge[found] = verts[end[found]] - verts[start[found]]
+    new_axes, ok = aligned_axes(edge, normal, axes, op.up)
+    if ok.all():
+        return reframed(ctx, cursor, new_axes, op.span)
+    # no face with an area, or no edge with a length (a line, a point, a degenerate face): the scope stays,
+    # as CityEngine leaves it rather than stopping the model
+    rows, others = np.flatnonzero(ok), np.flatnonzero(~ok)
+    return Shapes.merge([reframed(ctx, cursor.take(rows), new_axes[rows], op.span), cursor.take(others)],
+                        [rows, others])
 
 
 @operation(ir.Mirror, writes=("geom",))

@@ -135,24 +135,27 @@ class OperationLowering:
                                 "offset(d), offset(d, inside), offset(d, border)")
 
     def op_align(self, op, args, span):
-        if not args or (len(args) == 1 and isinstance(args[0], ir.Name) and args[0].name == "world.xyz"):
+        axis = _selector(args[0]) if len(args) == 1 else None
+        if not args or axis == "world.xyz":
             return ir.AlignScope("world", None, span)
-        if len(args) == 1 and isinstance(args[0], ir.Name) and args[0].name in ("y", "world.y"):
-            return ir.AlignScope("y", None, span)
+        if axis is not None and axis.removeprefix("world.") in ("x", "y", "z"):
+            return ir.AlignScope(axis.removeprefix("world."), None, span)
         return self.unsupported("alignScopeToAxes with this axis", span,
-                                "alignScopeToAxes(), alignScopeToAxes(world.xyz) and alignScopeToAxes(y)")
+                                "alignScopeToAxes(), alignScopeToAxes(world.xyz) and alignScopeToAxes(x|y|z)")
 
     def op_align_geometry(self, op, args, span):
-        if len(args) not in (2, 3) or not isinstance(args[0], ir.Name) or args[0].name not in ("yUp", "zUp"):
+        up = _selector(args[0]) if args else None
+        if len(args) not in (2, 3) or up not in ("yUp", "zUp"):
             return self.unsupported("alignScopeToGeometry with these arguments", span,
-                                    "alignScopeToGeometry(yUp|zUp, 0[, edgeIndex])")
-        face = self.expr(args[1])
-        if not (isinstance(face, ir.Num) and face.value == 0):
-            return self.unsupported("alignScopeToGeometry on a face other than 0", getattr(face, "span", span))
-        if len(args) == 3 and isinstance(args[2], ir.Name) and args[2].name in ("longest", "world.lowest"):
-            return self.unsupported(f"alignScopeToGeometry with edge {args[2].name}", span)
-        edge = self.expr(args[2]) if len(args) == 3 else ir.Num(0.0, span)
-        return ir.AlignScope("geometry-" + args[0].name[0], (edge, ir.Num(0.0), ir.Num(0.0)), span)
+                                    "alignScopeToGeometry(yUp|zUp, face[, edge])")
+        face, edge = _selector(args[1]), _selector(args[2]) if len(args) == 3 else None
+        if face is not None and face not in ALIGN_FACES:
+            return self.unsupported(f"alignScopeToGeometry with face {face}", getattr(args[1], "span", span))
+        if edge is not None and edge not in ALIGN_EDGES:
+            return self.unsupported(f"alignScopeToGeometry with edge {edge}", getattr(args[2], "span", span))
+        face_index = None if face is not None else self.expr(args[1])
+        edge_index = None if edge is not None else self.expr(args[2]) if len(args) == 3 else ir.Num(0.0, span)
+        return ir.AlignToGeometry(up, face or "index", edge or "index", face_index, edge_index, span)
 
     def op_rotate_scope(self, op, args, span):
         if len(args) != 3:
@@ -433,7 +436,7 @@ SCATTER_TYPES = frozenset({"uniform", "gaussian"})
 ROOF_ARGUMENTS = {"roofHip": ("overhang", "even"), "roofGable": ("overhangX", "overhangY", "even"),
                    "roofShed": ("index",), "roofPyramid": ()}
 #: Operations CityEngine also takes without their parentheses (other bare names are rules).
-BARE_OPS = frozenset({"NIL", "primitiveCube", "convexify"})
+BARE_OPS = frozenset({"NIL", "primitiveCube", "convexify", "alignScopeToAxes"})
 #: Part operations whose parts are sizes or faces: without parts, `unsupported: split` (the others say
 #: that their selector parts are missing).
 SPLIT_OPS = frozenset({"split", "comp"})
@@ -477,8 +480,18 @@ UNSUPPORTED_OPS = frozenset({
 #: Every operation name CityEngine knows: what a misspelt one is suggested from.
 ALL_OPERATIONS = (frozenset(OPERATIONS) | frozenset(PART_OPERATIONS) | frozenset(BODY_OPERATIONS) | NOT_APPLIED
                   | UNSUPPORTED_OPS)
+#: Face and edge selectors of ``alignScopeToGeometry``.
+ALIGN_FACES = frozenset({"largest", "world.lowest", "any"})
+ALIGN_EDGES = frozenset({"longest", "world.lowest"})
 #: Axis selectors of ``center`` and ``alignScopeToAxes``.
 AXIS_NAMES = {"x": (0,), "y": (1,), "z": (2,), "xy": (0, 1), "xz": (0, 2), "yz": (1, 2), "xyz": (0, 1, 2)}
+
+
+def _selector(arg) -> str | None:
+    """A selector argument's name (CityEngine also takes a selector as a string: ``"zUp"``), else None."""
+    if isinstance(arg, ir.Name):
+        return arg.name
+    return arg.value if isinstance(arg, ir.Str) else None
 
 
 @cache

@@ -268,3 +268,131 @@ def test_negative_size_lot_is_reported_and_skipped(write):
     assert len(r["bad"]) == 1 and r["bad"][0].index == 1
     assert "negative or NaN size" in r["bad"][0].reason and "g.cga:1" in r["bad"][0].reason
 
+
+
+def _cube(r):
+    """The xform (3, 4) of each cube record, as floats."""
+    return r["xform"][np.array(assets(r)) == "builtin:cube"].astype(float)
+
+
+def test_align_to_geometry_side_face_of_a_box(write):
+    """A box's face 1 is its first side (the lot's first edge, world z = 0, facing +z): yUp puts y along
+    that normal and x along its first edge, so z points down; zUp puts z along it and y up. The box stays a
+    box (quarter turns), in the same place."""
+    text = "Lot --> extrude(4) alignScopeToGeometry({}, 1, 0) i(\"builtin:cube\")\n"
+    np.testing.assert_allclose(_cube(run(write, text.format("yUp"), [rect(12, 8)]))[0],
+                               [[12, 0, 0, 0], [0, 0, -4, 4], [0, 8, 0, -8]], atol=1e-9)
+    np.testing.assert_allclose(_cube(run(write, text.format("zUp"), [rect(12, 8)]))[0],
+                               [[12, 0, 0, 0], [0, 4, 0, 0], [0, 0, 8, -8]], atol=1e-9)
+
+
+def test_align_to_geometry_of_a_rotated_lot_by_edge_index_and_longest(write):
+    """The 10 x 4 lot turned by 30 degrees: edge 1 is a short side, ``longest`` the first long one."""
+    lot = rotated_rectangle()
+    for edge, size in (("1", (4, 10)), ("longest", (10, 4)), ("-1", (4, 10))):
+        r = run(write, f'Lot --> alignScopeToGeometry(yUp, 0, {edge}) report("sx", scope.sx) '
+                       'report("sy", scope.sy) report("sz", scope.sz) X\n', [lot])
+        t = totals(r)
+        assert (t["sx_sum"], t["sy_sum"], t["sz_sum"]) == pytest.approx((*size[:1], 0, size[1]))
+        # a rectangle filling its new scope: a quad on the lot's corners
+        assert assets(r) == ["builtin:quad"]
+        x = r["xform"][0].astype(float)
+        corners = [x[:, 3] + a * x[:, 0] + c * x[:, 2] for a in (0, 1) for c in (0, 1)]
+        world = np.c_[lot[0][:, 0], np.zeros(4), -lot[0][:, 1]]
+        assert max(np.linalg.norm(world - p, axis=1).min() for p in corners) < 1e-4
+
+
+def test_align_to_geometry_of_an_l_prism_lowest_face_longest_edge(write):
+    """The L's lowest face is its bottom (its sides reach as low, their middles do not); the bottom's ring
+    runs backwards, so its longest edge runs along world -x; y is the bottom's normal (down). The prism,
+    turned out of its plane, becomes a mesh where it was."""
+    lot = LOT_ZOO["concave_L"]
+    text = ('Lot --> extrude(10) {}report("sx", scope.sx) report("sy", scope.sy) report("sz", scope.sz) '
+            '[ s(\'1, 0.5, \'1) i("builtin:cube") C ] X\n')
+    r = run(write, text.format("alignScopeToGeometry(yUp, world.lowest, longest) "), [lot])
+    t = totals(r)
+    assert (t["sx_sum"], t["sy_sum"], t["sz_sum"]) == pytest.approx((30, 10, 20))
+    axes = _cube(r)[0][:, :3] / [30, 0.5, 20]
+    np.testing.assert_allclose(axes, [[-1, 0, 0], [0, -1, 0], [0, 0, 1]], atol=1e-9)
+    before = run(write, text.format(""), [lot])
+    got, want = mesh_faces(r), mesh_faces(before)
+    assert sum(face_area(f) for f in got) == pytest.approx(sum(face_area(f) for f in want))
+    np.testing.assert_allclose(np.concatenate([f[0] for f in got]).min(axis=0),
+                               np.concatenate([f[0] for f in want]).min(axis=0), atol=1e-5)
+    np.testing.assert_allclose(np.concatenate([f[0] for f in got]).max(axis=0),
+                               np.concatenate([f[0] for f in want]).max(axis=0), atol=1e-5)
+
+
+@pytest.mark.parametrize("roof, up", [
+    # a hip roof at 30 degrees: its base (96) is larger than a slope (36.9), and faces down
+    ("roofHip(30)", (0, -1, 0)),
+    # a gable roof at 70 degrees: a slope (12 x 4 / cos 70 = 140) is larger than the base
+    ("roofGable(70)", (0, np.cos(np.radians(70)), np.sin(np.radians(70)))),
+])
+def test_align_to_geometry_largest_face_of_a_roof(write, roof, up):
+    """On 12 x 8, x along the largest face's longest edge (12 long), y its normal; the whole roof fits the
+    scope along x."""
+    r = run(write, f'Lot --> {roof} alignScopeToGeometry(yUp, largest, longest) report("sx", scope.sx) '
+                   "[ s('1, 1, '1) i(\"builtin:cube\") C ]\n", [rect(12, 8)])
+    assert totals(r)["sx_sum"] == pytest.approx(12)
+    x, y = (_cube(r)[0][:, k] for k in (0, 1))
+    np.testing.assert_allclose(np.abs(x / np.linalg.norm(x)), [1, 0, 0], atol=1e-9)
+    y = y / np.linalg.norm(y)
+    np.testing.assert_allclose([y[0], y[1], abs(y[2])], up, atol=1e-9)
+
+
+def test_align_to_geometry_any_lowest_puts_y_up_the_slope_of_each_roof_face(write):
+    """The reference's use: each face of a roof, zUp along its normal and x along its lowest edge (the
+    eave), has its y going up the slope."""
+    r = run(write, "Lot --> roofHip(30) comp(f){ all : F }\n"
+                   "F --> alignScopeToGeometry(zUp, any, world.lowest) i(\"builtin:cube\")\n", [rect(12, 8)])
+    slopes = r["xform"][quad_normals(r)[:, 1] > 0].astype(float)  # not the base
+    assert len(slopes) == 4
+    np.testing.assert_allclose(slopes[:, 1, 0], 0, atol=1e-9)  # x horizontal
+    assert (slopes[:, 1, 1] > 0).all()  # y up the slope
+    np.testing.assert_allclose(sorted(np.linalg.norm(slopes[:, :, 0], axis=1)), [8, 8, 12, 12], atol=1e-9)
+
+
+def test_align_to_geometry_in_a_batch_equals_each_lot_alone(write):
+    """Edge indices and selectors per shape: a batch gives each lot what it gets alone."""
+    lots = [rect(12, 8), rotated_rectangle(), LOT_ZOO["concave_L"], LOT_ZOO["courtyard"]]
+    for align in ("largest, longest", "0, floor(scope.sx) % 5", "world.lowest, world.lowest", "any, longest",
+                  "-2, 1"):
+        text = f"Lot --> extrude(5) alignScopeToGeometry(zUp, {align}) [ i(\"builtin:cube\") C ] X\n"
+        batch = run(write, text, lots)
+        for k, lot in enumerate(lots):
+            alone = run(write, text, [lot])
+            np.testing.assert_array_equal(batch["xform"][batch["lot"] == k], alone["xform"])
+            mesh, one = batch["mesh"], alone["mesh"]
+            np.testing.assert_array_equal(mesh.vertices[np.repeat(mesh.lot, np.diff(
+                mesh.ring_offsets[mesh.face_offsets]))== k], one.vertices)
+
+
+@pytest.mark.parametrize("axis, k", [("x", 0), ("world.z", 2), ("y", 1)])
+def test_align_scope_to_one_world_axis(write, axis, k):
+    """alignScopeToAxes(x|y|z) of a turned box: that scope axis is the world's, the next one the old one
+    projected across it (z for x, x for y and z), and the box's corners stay inside the new scope."""
+    text = "Lot --> extrude(8) t(5, 0, 4) s(8, 24, 8) r(10, 20, 30) {}i(\"builtin:cube\")\n"
+    before = _cube(run(write, text.format(""), [rect(12, 8)]))[0]
+    after = _cube(run(write, text.format(f"alignScopeToAxes({axis}) "), [rect(12, 8)]))[0]
+    axes = after[:, :3] / np.linalg.norm(after[:, :3], axis=0)
+    np.testing.assert_allclose(axes[:, k], np.eye(3)[k], atol=1e-12)
+    second = {0: 2, 1: 0, 2: 0}[k]
+    old = before[:, second] / np.linalg.norm(before[:, second])
+    projected = old - old[k] * np.eye(3)[k]
+    np.testing.assert_allclose(axes[:, second], projected / np.linalg.norm(projected), atol=1e-9)
+    corners = before[:, 3] + np.array([[i, j, m] for i in (0, 1) for j in (0, 1) for m in (0, 1)]) @ before[:, :3].T
+    local = np.linalg.solve(after[:, :3], (corners - after[:, 3]).T).T
+    assert local.min() == pytest.approx(0, abs=1e-6) and local.max() == pytest.approx(1, abs=1e-6)
+
+
+def test_align_to_geometry_without_an_edge_keeps_the_scope(write):
+    """A shape with no face to align to (a scope box shrunk to a line) keeps its scope, next to one that
+    turns."""
+    text = ("Lot --> extrude(4) comp(f){ front : F }\n"
+            "F --> [ s(0, '1, 0) E ] G\n"
+            "E --> alignScopeToGeometry(zUp, largest, longest) report(\"sy\", scope.sy) report(\"ty\", scope.ty)\n"
+            "G --> alignScopeToGeometry(yUp, 0, 0) i(\"builtin:cube\")\n")
+    r = run(write, text, [rect(12, 8)])
+    assert (totals(r)["sy_sum"], totals(r)["ty_sum"]) == pytest.approx((4, 0))
+    assert names(r) == ["G"]  # the face beside it turned and made its quad
