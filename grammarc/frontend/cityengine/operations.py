@@ -65,9 +65,19 @@ class OperationLowering:
         return ir.Roof("envelope", angle, False, base, None, zero, span, cap=self.expr(args[1]), sides=others)
 
     def op_extrude(self, op, args, span):
-        if len(args) != 1:
-            return self.unsupported(f"extrude with {len(args)} arguments", span, "only extrude(height)")
-        return ir.Extrude(self.expr(args[0]), span)
+        """``extrude(h)`` or ``extrude(direction, h)``, the direction one of ``ir.EXTRUDE_DIRECTIONS``
+        (``world.y`` read as ``world.up``)."""
+        if len(args) == 1:
+            return ir.Extrude(self.expr(args[0]), span)
+        if len(args) != 2:
+            return self.unsupported(f"extrude with {len(args)} arguments", span,
+                                    "extrude(height) and extrude(direction, height)")
+        name = args[0].name if isinstance(args[0], ir.Name) else None
+        direction = "world.up" if name == "world.y" else name
+        if direction not in ir.EXTRUDE_DIRECTIONS:
+            return self.unsupported("extrude with this direction", getattr(args[0], "span", span),
+                                    ", ".join(sorted(ir.EXTRUDE_DIRECTIONS)))
+        return ir.Extrude(self.expr(args[1]), span, direction)
 
     def op_translate(self, op, args, span):
         if not self.arity(op, args, (3,), span):
