@@ -4,7 +4,8 @@ directions) ``front``, ``top``, ``vertical``, ``aslant``... name.
 Normals are in the parent's scope frame (front +z, back -z, right +x, left -x, top +y, bottom -y), or in the
 lot's (``object.``), the world's (``world.``) or the lot's street frame (``street.``, ``geometry.streets``)
 when a selector names that frame (``selector_frames`` turns them into it); ``street.front`` also takes the
-faces and edges that lie along a street (``street_along``). ``streetSide`` and ``noStreetSide``, CityEngine's older names, are
+faces and edges that lie along a street (``street_along``); ``world.south``... are CityEngine's compass names of ``world.``
+selectors (``ir.WORLD_COMPASS``). ``streetSide`` and ``noStreetSide``, CityEngine's older names, are
 ``street.front`` and the other side edges of lots with street edges, and nothing on other lots (PRT's
 reporting.rpk sets nothing back on the kit's footprints, which have none); ``street.`` selectors fall
 back to the lot's own frame there, as CityEngine documents.
@@ -15,6 +16,7 @@ from __future__ import annotations
 import numpy as np
 
 from grammarc.geometry.streets import along_street
+from grammarc.ir.nodes import WORLD_COMPASS
 
 #: A face is "top" or "bottom" when its normal is within 45 degrees of the scope's y axis; "horizontal"
 #: and "vertical" within this tolerance of exactly so.
@@ -28,7 +30,8 @@ def classify_faces(normal: np.ndarray, selectors: tuple[str, ...], frames: dict 
     which = np.full(len(normal), len(selectors), dtype=np.int64)
     frames = frames or {}
     for i in range(len(selectors) - 1, -1, -1):
-        prefix, _, name = STREET_ALIASES.get(selectors[i], selectors[i]).rpartition(".")
+        named = WORLD_COMPASS.get(selectors[i]) or STREET_ALIASES.get(selectors[i], selectors[i])
+        prefix, _, name = named.rpartition(".")
         mask = _face_masks(frames.get(prefix, normal), frames.get(f"{prefix}_along"))[name]
         if selectors[i] in STREET_ALIASES:  # PRT: nothing on a lot without street edges
             mask = mask & frames["street_known"]

@@ -631,6 +631,11 @@ FACE_SELECTORS = frozenset({
     "nutant", "all",
 })
 
+#: CityEngine's compass names of the world's face selectors (the world's x east, z south, y up): the
+#: ``world.`` selectors they are.
+WORLD_COMPASS = {"world.south": "world.front", "world.north": "world.back", "world.east": "world.right",
+                 "world.west": "world.left", "world.up": "world.top", "world.down": "world.bottom"}
+
 
 @dataclass(frozen=True, slots=True)
 class Setback:

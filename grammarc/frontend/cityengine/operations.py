@@ -385,7 +385,7 @@ SPLIT_OPS = frozenset({"split", "comp"})
 STREET_SELECTORS = frozenset(f"street.{s}" for s in ("front", "back", "left", "right", "side"))
 COMP_SELECTORS = {
     "f": ir.FACE_SELECTORS | ir.OFFSET_SELECTORS | STREET_SELECTORS
-    | {f"{frame}.{s}" for frame in ("object", "world") for s in ir.FACE_SELECTORS},
+    | {f"{frame}.{s}" for frame in ("object", "world") for s in ir.FACE_SELECTORS} | set(ir.WORLD_COMPASS),
     "e": ir.EDGE_SELECTORS,
     "v": ir.VERTEX_SELECTORS,
 }

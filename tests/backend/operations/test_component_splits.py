@@ -93,6 +93,18 @@ def test_world_and_object_face_selectors(write):
     assert Counter(names(r)) == {"WF": 1, "T": 1}  # map rectangles: the lot's front is the world's front
 
 
+@pytest.mark.parametrize("name, normal", [
+    ("world.south", [0, 0, 1]), ("world.north", [0, 0, -1]), ("world.east", [1, 0, 0]),
+    ("world.west", [-1, 0, 0]), ("world.up", [0, 1, 0]), ("world.down", [0, -1, 0]),
+])
+def test_world_compass_face_selectors(write, name, normal):
+    """The reference's world.south, north, east, west, up, down: the world's z south, x east, y up. The
+    lot is turned so that its own front is not south."""
+    r = run(write, f"Lot --> rotateScope(0, 90, 0) extrude(4) comp(f){{ {name} : A }}\n", [rect(12, 8)])
+    assert names(r) == ["A"]
+    np.testing.assert_allclose(quad_normals(r), [normal], atol=1e-6)
+
+
 def _face_area_normal(mesh, face):
     """Signed area vector (Newell) of a mesh face: its outline minus its holes."""
     total = np.zeros(3)
