@@ -242,7 +242,8 @@ class OperationLowering:
             kind = args[0].name if args and isinstance(args[0], ir.Name) else "?"
             return self.unsupported(f"comp({kind})", span, "comp(f), comp(e) and comp(v)")
         kind = args[0].name
-        chosen = self.selector_parts("comp", parts, COMP_SELECTORS[kind], named=f"comp({kind})", noun="faces")
+        chosen = self.selector_parts("comp", parts, COMP_SELECTORS[kind], named=f"comp({kind})", noun="faces",
+                                     indices=True)
         if chosen is None:
             return ir.Empty(span)
         return ir.CompFaces(*chosen, span, self.site(), kind)
@@ -305,10 +306,11 @@ class OperationLowering:
             return ir.Empty(span)
         return ir.InnerRectangle(args[0].name, chosen[0], chosen[1], span, self.site())
 
-    def selector_parts(self, op, parts, known, named=None, noun="polygons"):
+    def selector_parts(self, op, parts, known, named=None, noun="polygons", indices=False):
         """The selectors and bodies of ``{ sel: A | ... }`` parts, all among ``known`` (None after an
         error); ``sel=`` is derived as ``sel:``, with a warning. ``named`` is the operation as a selector
-        error names it (``comp(f)``; default ``op``), ``noun`` what ``sel=`` would merge."""
+        error names it (``comp(f)``; default ``op``), ``noun`` what ``sel=`` would merge. With ``indices``
+        a whole number ``3`` selects the component of that index (the selector ``"3"``)."""
         named = named or op
         selectors, bodies = [], []
         for part in parts:
@@ -316,6 +318,11 @@ class OperationLowering:
                 self.unsupported(f"repeat group in {op}", part.span)
                 return None
             value = part.size.value
+            if (indices and part.size.kind is ir.SizeKind.ABSOLUTE and isinstance(value, ir.Num)
+                    and value.value >= 0 and value.value == int(value.value)):
+                selectors.append(str(int(value.value)))
+                bodies.append(part.body)
+                continue
             if part.size.kind is not ir.SizeKind.ABSOLUTE or not isinstance(value, ir.Name):
                 self.unsupported(f"this {op} selector", part.span)
                 return None

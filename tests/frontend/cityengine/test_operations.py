@@ -209,7 +209,7 @@ def test_merged_selector_is_derived_face_by_face_with_a_warning(line, at):
     ("Lot --> comp(f){ street.top : A }", "comp(f) selector `street.top`", "street"),
     ("Lot --> comp(f){ fornt : A }", "comp(f) selector `fornt`", "fornt"),
     ("Lot --> comp(e){ front : A }", "comp(e) selector `front`", "front"),
-    ("Lot --> comp(f){ 0 : A }", "this comp selector", "0"),
+    ("Lot --> comp(f){ 1.5 : A }", "this comp selector", "1.5"),
     ("Lot --> comp(f){ { front : A }* }", "repeat group in comp", "{ front"),
     ("Lot --> comp(f){ front : A }*", "`*` after comp", "*"),
     ("Lot --> split(x, noAdjust){ 1 : A }*", "split(..., noAdjust)", "noAdjust"),
