@@ -4,7 +4,8 @@ directions) ``front``, ``top``, ``vertical``, ``aslant``... name.
 Normals are in the parent's scope frame (front +z, back -z, right +x, left -x, top +y, bottom -y), or in the
 lot's (``object.``), the world's (``world.``) or the lot's street frame (``street.``, ``geometry.streets``)
 when a selector names that frame (``selector_frames`` turns them into it); ``street.front`` also takes the
-faces and edges that lie along a street (``street_along``). ``streetSide`` and ``noStreetSide``, CityEngine's older names, are
+faces and edges that lie along a street (``street_along``); ``world.south``... are CityEngine's compass names of ``world.``
+selectors (``ir.WORLD_COMPASS``). ``streetSide`` and ``noStreetSide``, CityEngine's older names, are
 ``street.front`` and the other side edges of lots with street edges, and nothing on other lots (PRT's
 reporting.rpk sets nothing back on the kit's footprints, which have none); ``street.`` selectors fall
 back to the lot's own frame there, as CityEngine documents.
@@ -15,20 +16,28 @@ from __future__ import annotations
 import numpy as np
 
 from grammarc.geometry.streets import along_street
+from grammarc.ir.nodes import WORLD_COMPASS
+from grammarc.ragged import rank_within
 
 #: A face is "top" or "bottom" when its normal is within 45 degrees of the scope's y axis; "horizontal"
 #: and "vertical" within this tolerance of exactly so.
 _FLAT_TOLERANCE = 1e-6
 
 
-def classify_faces(normal: np.ndarray, selectors: tuple[str, ...], frames: dict | None = None) -> np.ndarray:
+def classify_faces(normal: np.ndarray, selectors: tuple[str, ...], frames: dict | None = None,
+                   index: np.ndarray | None = None) -> np.ndarray:
     """Index of the first selector each face matches (len(selectors) for none), from normals (m, 3) in
     the parent's scope frame: front +z, back -z, right +x, left -x, top +y, bottom -y. ``frames`` gives
-    the normals in the lot's frame (``object.`` selectors) and the world's (``world.``)."""
+    the normals in the lot's frame (``object.`` selectors) and the world's (``world.``); ``index`` (m,)
+    each face's number among its shape's (``component_index``), which index selectors ``"3"`` match."""
     which = np.full(len(normal), len(selectors), dtype=np.int64)
     frames = frames or {}
     for i in range(len(selectors) - 1, -1, -1):
-        prefix, _, name = STREET_ALIASES.get(selectors[i], selectors[i]).rpartition(".")
+        if selectors[i].isdigit():
+            which[index == int(selectors[i])] = i
+            continue
+        named = WORLD_COMPASS.get(selectors[i]) or STREET_ALIASES.get(selectors[i], selectors[i])
+        prefix, _, name = named.rpartition(".")
         mask = _face_masks(frames.get(prefix, normal), frames.get(f"{prefix}_along"))[name]
         if selectors[i] in STREET_ALIASES:  # PRT: nothing on a lot without street edges
             mask = mask & frames["street_known"]
@@ -63,10 +72,13 @@ def _face_masks(normal: np.ndarray, along: np.ndarray | None = None) -> dict[str
     return masks
 
 
-def classify_edges(direction: np.ndarray | None, selectors: tuple[str, ...], n: int) -> np.ndarray:
+def classify_edges(direction: np.ndarray | None, selectors: tuple[str, ...], n: int,
+                   index: np.ndarray | None = None) -> np.ndarray:
     """Index of the first selector each edge (or vertex, ``direction`` None) matches: an edge is
-    vertical along the world's y axis, horizontal across it, aslant otherwise."""
+    vertical along the world's y axis, horizontal across it, aslant otherwise; an index selector ``"3"``
+    the component whose ``index`` (n,) is 3."""
     masks = {"all": np.ones(n, dtype=bool)}
+    masks.update({s: index == int(s) for s in selectors if s.isdigit()})
     if direction is not None:
         y = np.abs(direction[:, 1])
         masks.update(vertical=y >= 1 - _FLAT_TOLERANCE, horizontal=y <= _FLAT_TOLERANCE,
@@ -75,6 +87,13 @@ def classify_edges(direction: np.ndarray | None, selectors: tuple[str, ...], n: 
     for i in range(len(selectors) - 1, -1, -1):
         which[masks[selectors[i]]] = i
     return which
+
+
+def component_index(selectors: tuple[str, ...], parent: np.ndarray) -> np.ndarray | None:
+    """Each component's number among its shape's (``parent`` (m,) in the order the split makes them:
+    an extrusion's bottom 0, its sides along the footprint's edges, its top last, as CityEngine numbers
+    them), when an index selector asks for it; None otherwise."""
+    return rank_within(parent) if any(s.isdigit() for s in selectors) else None
 
 
 def selector_frames(chunk, normal: np.ndarray, shapes, parent: np.ndarray, selectors,

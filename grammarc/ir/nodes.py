@@ -478,11 +478,17 @@ class Comp:
 
 @dataclass(frozen=True, slots=True)
 class Extrude:
-    """CityEngine ``extrude(h)``: a flat shape becomes a solid along its normal (its flat scope axis);
-    a negative height extrudes against the normal."""
+    """CityEngine ``extrude(h)`` and ``extrude(direction, h)``: a flat shape becomes a solid along its
+    normal (its flat scope axis; ``face.normal``, ``vertex.normal``) or the world's up axis (``world.up``,
+    ``world.up.flatTop``, one of ``EXTRUDE_DIRECTIONS``); a negative height extrudes the other way."""
 
     height: Expr = child(Type.NUM, "a height")
     span: Span = NO_SPAN
+    direction: str = "face.normal"
+
+
+#: ``extrude``'s directions: CityEngine's names (``world.y`` is an older spelling of ``world.up``).
+EXTRUDE_DIRECTIONS = frozenset({"face.normal", "vertex.normal", "world.up", "world.up.flatTop"})
 
 
 @dataclass(frozen=True, slots=True)
@@ -625,6 +631,11 @@ FACE_SELECTORS = frozenset({
     "front", "back", "left", "right", "top", "bottom", "side", "vertical", "horizontal", "aslant",
     "nutant", "all",
 })
+
+#: CityEngine's compass names of the world's face selectors (the world's x east, z south, y up): the
+#: ``world.`` selectors they are.
+WORLD_COMPASS = {"world.south": "world.front", "world.north": "world.back", "world.east": "world.right",
+                 "world.west": "world.left", "world.up": "world.top", "world.down": "world.bottom"}
 
 
 @dataclass(frozen=True, slots=True)

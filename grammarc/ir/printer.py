@@ -167,7 +167,8 @@ _OP_FORMATS = {
     ir.Setback: _setback,
     ir.Case: _branches,
     ir.Stochastic: _branches,
-    ir.Extrude: lambda op: f"extrude({print_expr(op.height)})",
+    ir.Extrude: lambda op: ("extrude(" + ("" if op.direction == "face.normal" else f"{op.direction}, ")
+                            + f"{print_expr(op.height)})"),
     ir.Center: lambda op: f"center({''.join('xyz'[a] for a in op.axes)})",
     ir.UseAsset: lambda op: "i(" + ", ".join([
         print_expr(op.name) if op.name is not None else f'"{op.asset}"',

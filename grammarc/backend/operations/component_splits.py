@@ -26,7 +26,7 @@ from grammarc.backend.operations.table import Parts, operation
 from grammarc.backend.outlines import flat_axis, polygons_of
 from grammarc.backend.random import child_keys
 from grammarc.backend.reframing import turned
-from grammarc.backend.selectors import classify_edges, classify_faces, selector_frames
+from grammarc.backend.selectors import classify_edges, classify_faces, component_index, selector_frames
 from grammarc.backend.shapes import Shapes
 from grammarc.constants import TOL
 from grammarc.geometry import components as comp_kernels
@@ -78,10 +78,10 @@ def comp_faces(ctx: Context, cursor: Shapes, op: ir.CompFaces) -> Parts:
         axes = chunk.frames[shapes.frame]
         base = (shapes.origin, shapes.origin + axes[:, 0] * shapes.size[:, :1])  # each face's bottom edge
         which = classify_faces(normal, op.selectors, selector_frames(chunk, normal, cursor, parent, op.selectors,
-                                                                      base))
+                                                                      base), component_index(op.selectors, parent))
     else:
         direction = chunk.frames[shapes.frame][:, 0] if op.kind == "e" else None
-        which = classify_edges(direction, op.selectors, len(shapes))
+        which = classify_edges(direction, op.selectors, len(shapes), component_index(op.selectors, parent))
     keep = which < len(op.selectors)
     shapes, which, parent = shapes.take(keep), which[keep], parent[keep]
     if {"comp.index", "comp.total", "comp.sel"} & set(ctx.plan.dynamic):

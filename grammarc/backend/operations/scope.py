@@ -19,16 +19,21 @@ from grammarc.backend.euler import angles as euler_angles
 from grammarc.backend.euler import orientation, rotation
 from grammarc.backend.evaluate import evaluate, evaluate_array
 from grammarc.backend.functions.coordinates import system
+from grammarc.backend.mesh_shapes import store_fitted
 from grammarc.backend.operations.table import operation
-from grammarc.backend.outlines import flat_axis
+from grammarc.backend.outlines import flat_axis, polygons_of
 from grammarc.backend.reframing import reframed, turned
 from grammarc.backend.shapes import Shapes, asset_geom, asset_of
+from grammarc.constants import TOL
 from grammarc.geometry import components as comp_kernels
 from grammarc.geometry.align import EDGE_MODES, FACE_MODES, aligned_axes, pick_edges
+from grammarc.geometry.extrusion import extruded_meshes
 from grammarc.geometry.meshes import is_polygon
+from grammarc.geometry.polygons import PLANE_U, PLANE_V, plane_to_scope
 from grammarc.geometry.queries import face_shapes, shape_faces
 from grammarc.geometry.reframe import NORMAL_UP
 from grammarc.ir import nodes as ir
+from grammarc.ragged import segment_of, segment_reduce
 
 _SCOPE = ("origin", "size", "frame", "geom")
 
@@ -130,18 +135,80 @@ def center(ctx: Context, cursor: Shapes, op: ir.Center, base) -> Shapes:
 def extrude(ctx: Context, cursor: Shapes, op: ir.Extrude) -> Shapes:
     """A face becomes a solid along its normal; a negative height extrudes behind the face. As in
     CityEngine, the solid's scope keeps x and has y along the extrusion: a face whose normal is
-    another scope axis (a comp(f) face's z) is first re-expressed in such a scope."""
+    another scope axis (a comp(f) face's z) is first re-expressed in such a scope.
+
+    ``vertex.normal`` is ``face.normal``: a shape here is one plane, so all its vertex normals are its
+    face's. ``world.up`` extrudes a face looking up as its normal would; any other face becomes a mesh
+    in a scope with y up and x the old x laid level, each vertex moved straight up, and
+    ``world.up.flatTop`` moves them to one level: ``h`` above the lowest vertex, at least up to the
+    highest; with a negative ``h`` down from the highest, at least to the lowest."""
     height = evaluate_array(op.height, ctx.env(cursor))
     axis = flat_axis(ctx.chunk, cursor)
     bad = (axis < 0) | ~np.isfinite(height)
     if bad.any():
         ctx.fail(cursor, bad, "`extrude` needs a face (a flat shape) and a finite height", op.span)
-    cursor = turned(ctx, cursor, axis != 1, NORMAL_UP, axis, op.span)
+    if op.direction in ("world.up", "world.up.flatTop"):
+        height = np.broadcast_to(height, (len(cursor),))
+        normal_y = ctx.chunk.frames[cursor.frame][np.arange(len(cursor)), np.maximum(axis, 0), 1]
+        slanted = (normal_y < 1 - TOL.zero) & (axis >= 0)
+        if slanted.any():
+            rows, others = np.flatnonzero(slanted), np.flatnonzero(~slanted)
+            meshes = _extruded_upwards(ctx, cursor.take(rows), height[rows], op.direction == "world.up")
+            level = _extruded_along_normal(ctx, cursor.take(others), height[others], axis[others], op.span)
+            return Shapes.merge([level, meshes], [others, rows])
+    return _extruded_along_normal(ctx, cursor, height, axis, op.span)
+
+
+def _extruded_along_normal(ctx: Context, cursor: Shapes, height, axis: np.ndarray, span) -> Shapes:
+    cursor = turned(ctx, cursor, axis != 1, NORMAL_UP, axis, span)
     size = cursor.size.copy()
     size[:, 1] = np.abs(height)
     up = ctx.chunk.frames[cursor.frame][:, 1]
     origin = cursor.origin + np.minimum(height, 0.0)[:, None] * up
     return cursor.with_scope(origin, size, cursor.frame, cursor.geom)
+
+
+def _upright_axes(axes: np.ndarray) -> np.ndarray:
+    """Scope axes (n, 3, 3) with y the world's up and x the old x laid level (the old z where x is
+    upright), as CityEngine keeps "the x-axis direction as much as possible"."""
+    up = np.array([0.0, 1.0, 0.0])
+    x = axes[:, 0] - axes[:, 0, 1:2] * up
+    flat = np.linalg.norm(x, axis=1) < 1e-9
+    x[flat] = axes[flat, 2] - axes[flat, 2, 1:2] * up
+    x /= np.linalg.norm(x, axis=1, keepdims=True)
+    return np.stack([x, np.broadcast_to(up, x.shape), np.cross(x, up)], axis=1)
+
+
+def _extruded_upwards(ctx: Context, cursor: Shapes, height: np.ndarray, straight: bool) -> Shapes:
+    """Faces that are not level extruded along the world's up axis into meshes in upright scopes:
+    every vertex by ``height`` (``straight``) or to one level (flatTop)."""
+    chunk = ctx.chunk
+    axes = chunk.frames[cursor.frame]
+    coords, ring_offsets, shape_offsets, plane = polygons_of(chunk, cursor)
+    vertex_shape = segment_of(shape_offsets)[segment_of(ring_offsets)]
+    rows = np.arange(len(cursor))
+    scaled = coords * np.stack([cursor.size[rows, PLANE_U[plane]], cursor.size[rows, PLANE_V[plane]]], 1)[
+        vertex_shape]
+    in_scope = plane_to_scope(scaled, plane[vertex_shape])
+    new_axes = _upright_axes(axes)
+    # a vertex in the upright scope, from the old origin: its scope point turned into the new axes
+    bottom = np.einsum("vi,vij,vkj->vk", in_scope, axes[vertex_shape], new_axes[vertex_shape])
+    if straight:
+        lift = height[vertex_shape]
+    else:
+        vertex_offsets = ring_offsets[shape_offsets]
+        low = segment_reduce(np.minimum, bottom[:, 1], vertex_offsets, 0.0)
+        high = segment_reduce(np.maximum, bottom[:, 1], vertex_offsets, 0.0)
+        level = np.where(height >= 0, np.maximum(low + height, high), np.minimum(high + height, low))
+        lift = level[vertex_shape] - bottom[:, 1]
+    top = bottom.copy()
+    top[:, 1] += lift
+    normal_y = axes[rows, plane, 1]
+    verts, rings, faces, meshes = extruded_meshes(bottom, top, ring_offsets, shape_offsets,
+                                                  (normal_y >= 0) == (height >= 0))
+    geom, low, size = store_fitted(chunk, verts, rings, faces, meshes)
+    origin = cursor.origin + np.einsum("ni,nij->nj", low, new_axes)
+    return cursor.with_scope(origin, size, chunk.frames.add(np.ascontiguousarray(new_axes)), geom)
 
 
 @operation(ir.AlignScope, writes=_SCOPE, meshes=True)

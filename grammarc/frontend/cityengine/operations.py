@@ -66,9 +66,19 @@ class OperationLowering:
         return ir.Roof("envelope", angle, False, base, None, zero, span, cap=self.expr(args[1]), sides=others)
 
     def op_extrude(self, op, args, span):
-        if len(args) != 1:
-            return self.unsupported(f"extrude with {len(args)} arguments", span, "only extrude(height)")
-        return ir.Extrude(self.expr(args[0]), span)
+        """``extrude(h)`` or ``extrude(direction, h)``, the direction one of ``ir.EXTRUDE_DIRECTIONS``
+        (``world.y`` read as ``world.up``)."""
+        if len(args) == 1:
+            return ir.Extrude(self.expr(args[0]), span)
+        if len(args) != 2:
+            return self.unsupported(f"extrude with {len(args)} arguments", span,
+                                    "extrude(height) and extrude(direction, height)")
+        name = args[0].name if isinstance(args[0], ir.Name) else None
+        direction = "world.up" if name == "world.y" else name
+        if direction not in ir.EXTRUDE_DIRECTIONS:
+            return self.unsupported("extrude with this direction", getattr(args[0], "span", span),
+                                    ", ".join(sorted(ir.EXTRUDE_DIRECTIONS)))
+        return ir.Extrude(self.expr(args[1]), span, direction)
 
     def op_translate(self, op, args, span):
         if not self.arity(op, args, (3,), span):
@@ -270,7 +280,8 @@ class OperationLowering:
             kind = args[0].name if args and isinstance(args[0], ir.Name) else "?"
             return self.unsupported(f"comp({kind})", span, "comp(f), comp(e) and comp(v)")
         kind = args[0].name
-        chosen = self.selector_parts("comp", parts, COMP_SELECTORS[kind], named=f"comp({kind})", noun="faces")
+        chosen = self.selector_parts("comp", parts, COMP_SELECTORS[kind], named=f"comp({kind})", noun="faces",
+                                     indices=True)
         if chosen is None:
             return ir.Empty(span)
         return ir.CompFaces(*chosen, span, self.site(), kind)
@@ -356,10 +367,11 @@ class OperationLowering:
         return ir.Scatter(names[0], self.expr(args[1]), names[2] == "gaussian", mean, value, relative, (body,),
                           span, self.site())
 
-    def selector_parts(self, op, parts, known, named=None, noun="polygons"):
+    def selector_parts(self, op, parts, known, named=None, noun="polygons", indices=False):
         """The selectors and bodies of ``{ sel: A | ... }`` parts, all among ``known`` (None after an
         error); ``sel=`` is derived as ``sel:``, with a warning. ``named`` is the operation as a selector
-        error names it (``comp(f)``; default ``op``), ``noun`` what ``sel=`` would merge."""
+        error names it (``comp(f)``; default ``op``), ``noun`` what ``sel=`` would merge. With ``indices``
+        a whole number ``3`` selects the component of that index (the selector ``"3"``)."""
         named = named or op
         selectors, bodies = [], []
         for part in parts:
@@ -367,6 +379,11 @@ class OperationLowering:
                 self.unsupported(f"repeat group in {op}", part.span)
                 return None
             value = part.size.value
+            if (indices and part.size.kind is ir.SizeKind.ABSOLUTE and isinstance(value, ir.Num)
+                    and value.value >= 0 and value.value == int(value.value)):
+                selectors.append(str(int(value.value)))
+                bodies.append(part.body)
+                continue
             if part.size.kind is not ir.SizeKind.ABSOLUTE or not isinstance(value, ir.Name):
                 self.unsupported(f"this {op} selector", part.span)
                 return None
@@ -444,7 +461,7 @@ SPLIT_OPS = frozenset({"split", "comp"})
 STREET_SELECTORS = frozenset(f"street.{s}" for s in ("front", "back", "left", "right", "side"))
 COMP_SELECTORS = {
     "f": ir.FACE_SELECTORS | ir.OFFSET_SELECTORS | STREET_SELECTORS
-    | {f"{frame}.{s}" for frame in ("object", "world") for s in ir.FACE_SELECTORS},
+    | {f"{frame}.{s}" for frame in ("object", "world") for s in ir.FACE_SELECTORS} | set(ir.WORLD_COMPASS),
     "e": ir.EDGE_SELECTORS,
     "v": ir.VERTEX_SELECTORS,
 }

@@ -93,6 +93,36 @@ def test_world_and_object_face_selectors(write):
     assert Counter(names(r)) == {"WF": 1, "T": 1}  # map rectangles: the lot's front is the world's front
 
 
+@pytest.mark.parametrize("name, normal", [
+    ("world.south", [0, 0, 1]), ("world.north", [0, 0, -1]), ("world.east", [1, 0, 0]),
+    ("world.west", [-1, 0, 0]), ("world.up", [0, 1, 0]), ("world.down", [0, -1, 0]),
+])
+def test_world_compass_face_selectors(write, name, normal):
+    """The reference's world.south, north, east, west, up, down: the world's z south, x east, y up. The
+    lot is turned so that its own front is not south."""
+    r = run(write, f"Lot --> rotateScope(0, 90, 0) extrude(4) comp(f){{ {name} : A }}\n", [rect(12, 8)])
+    assert names(r) == ["A"]
+    np.testing.assert_allclose(quad_normals(r), [normal], atol=1e-6)
+
+
+def test_index_selectors_take_the_component_of_that_number(write):
+    """The reference's ``comp(f){ 3 : B }``: an extrusion's bottom is face 0, its sides follow the
+    footprint's edges, its top is last; a face is taken by the first part that selects it, so ``side``
+    after ``1`` takes the other three sides. Edges and vertices are numbered along the outline."""
+    r = run(write, "Lot --> extrude(4) comp(f){ 0 : Bottom | 5 : Top | 1 : First | side : Side | 9 : None }\n",
+            [rect(12, 8)])
+    assert Counter(names(r)) == {"Bottom": 1, "Top": 1, "First": 1, "Side": 3}
+    normals = quad_normals(r)
+    np.testing.assert_allclose(normals[rows(r, "Bottom")], [[0, -1, 0]], atol=1e-6)
+    np.testing.assert_allclose(normals[rows(r, "Top")], [[0, 1, 0]], atol=1e-6)
+    np.testing.assert_allclose(normals[rows(r, "First")], [[0, 0, 1]], atol=1e-6)  # the edge along x at y = 0
+    r = run(write, "Lot --> comp(e){ 2 : E }\nE --> report(\"len\", scope.sx)\n", [rect(12, 8)] * 2)
+    assert totals(r)["len_n"] == 2 and totals(r)["len_sum"] == pytest.approx(24)  # the third edge, 12 long
+    r = run(write, 'Lot --> comp(v){ 0 : V | 3 : W }\nV --> report("v", 1)\nW --> report("w", 1)\n',
+            [rect(12, 8)])
+    assert (totals(r)["v_n"], totals(r)["w_n"]) == (1, 1)
+
+
 def _face_area_normal(mesh, face):
     """Signed area vector (Newell) of a mesh face: its outline minus its holes."""
     total = np.zeros(3)

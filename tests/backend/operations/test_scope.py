@@ -70,6 +70,96 @@ def test_extrude_of_a_side_face_goes_outward(write):
     np.testing.assert_allclose([low, high], [[12, 0, -8], [14, 5, 0]], atol=1e-6)
 
 
+def _signed_volume(faces):
+    """Volume enclosed by mesh faces (positive when they wind outwards), each ring fanned from its first
+    vertex."""
+    total = 0.0
+    for rings in faces:
+        for ring in rings:
+            total += sum(np.dot(ring[0], np.cross(ring[k], ring[k + 1])) for k in range(1, len(ring) - 1))
+    return total / 6
+
+
+@pytest.mark.parametrize("direction", ["world.y", "world.up", "world.up.flatTop", "face.normal",
+                                       "vertex.normal"])
+def test_extrude_of_a_footprint_along_any_direction_is_the_plain_extrude(write, direction):
+    """The reference: on a horizontal footprint world.up and face.normal agree (and a flat face's vertex
+    normals are its normal); so does flatTop, whose lowest and highest vertex are the same level."""
+    lots = [rect(12, 8), LOT_ZOO["concave_L"]]
+    r = run(write, f"Lot --> extrude({direction}, 10)\n", lots)
+    assert r["bad"] == () and len(r["asset"]) == 1 and len(r["mesh"].lot) == 8
+    same_records(r, run(write, "Lot --> extrude(10)\n", lots))
+
+
+def test_extrude_along_the_normal_of_a_roof_plane_is_a_slanted_box(write):
+    """face.normal and vertex.normal extrude a roof plane across itself: its scope's y is the plane's
+    normal, the box as thick as the height."""
+    grammar = "Lot --> roofGable(30) comp(f){{ aslant : Plane }}\nPlane --> extrude({}, 1)\n"
+    r = run(write, grammar.format("vertex.normal"), [rect(12, 8)])
+    same_records(r, run(write, grammar.format("face.normal"), [rect(12, 8)]))
+    x = r["xform"].astype(float)
+    np.testing.assert_allclose(np.linalg.norm(x[:, :, 1], axis=1), [1, 1])
+    np.testing.assert_allclose(np.abs(x[:, 1, 1]), np.cos(np.radians(30)))
+
+
+# a gable over 12 x 8 at 30 degrees: the ridge at 4 tan 30 above the eaves, each plane 12 x 4 in plan
+RIDGE = 4 * np.tan(np.radians(30))
+
+
+@pytest.mark.parametrize("direction, top, volume", [
+    # every vertex 1 up: the prism over each plane's plan, 12 * 4 * 1
+    ("world.up", RIDGE + 1, 2 * 48.0),
+    # a flat top at the lowest vertex + 1, at least up to the ridge: the wedge between plane and ridge
+    ("world.up.flatTop", RIDGE, 2 * 48.0 * RIDGE / 2),
+])
+def test_extrude_of_a_roof_plane_along_the_world_up_axis_is_a_mesh(write, direction, top, volume):
+    """The reference's "extrusion along world axes": a slanted face extruded vertically, each vertex
+    straight up (or to one flat top), closed by the face, its copy and a side per edge, all outward."""
+    r = run(write, "Lot --> roofGable(30) comp(f){ aslant : Plane }\n"
+                   f'Plane --> extrude({direction}, 1) report("sy", scope.sy) report("sx", scope.sx)\n',
+            [rect(12, 8)])
+    assert len(r["asset"]) == 0
+    faces = mesh_faces(r)
+    assert len(faces) == 2 * 6  # each plane: bottom, top, four sides
+    vertices = r["mesh"].vertices
+    assert vertices[:, 1].min() == pytest.approx(0, abs=1e-5)
+    assert vertices[:, 1].max() == pytest.approx(top, abs=1e-5)
+    assert _signed_volume(faces) == pytest.approx(volume, rel=1e-5)
+    t = totals(r)
+    # the scope is upright (y the world's up), fitted to the solid; x along the eaves
+    assert (t["sy_sum"], t["sx_sum"]) == pytest.approx((2 * top, 24), abs=1e-5)
+
+
+def test_extrude_world_up_flat_top_negative_and_a_face_looking_down(write):
+    """A negative flatTop distance is measured from the highest vertex down (at least to the lowest);
+    a face looking down extruded world.up rises above it, outward."""
+    r = run(write, "Lot --> roofGable(30) comp(f){ aslant : Plane }\nPlane --> extrude(world.up.flatTop, -1)\n",
+            [rect(12, 8)])
+    vertices = r["mesh"].vertices
+    assert (vertices[:, 1].min(), vertices[:, 1].max()) == pytest.approx((0, RIDGE), abs=1e-5)
+    assert abs(_signed_volume(mesh_faces(r))) == pytest.approx(48 * RIDGE, rel=1e-5)
+    r = run(write, "Lot --> extrude(5) comp(f){ bottom : Under }\nUnder --> extrude(world.up, 2)\n",
+            [rect(12, 8)])
+    faces = mesh_faces(r)
+    vertices = r["mesh"].vertices
+    assert (vertices[:, 1].min(), vertices[:, 1].max()) == pytest.approx((0, 2), abs=1e-5)
+    assert _signed_volume(faces) == pytest.approx(12 * 8 * 2, rel=1e-5)
+
+
+def test_extrude_along_world_up_in_a_batch_equals_each_lot_alone(write):
+    grammar = ("Lot --> extrude(4) comp(f){ bottom : Under | top : Roof }\n"
+               "Roof --> roofHip(25) comp(f){ aslant : Plane }\nPlane --> extrude(world.up.flatTop, 0.5)\n"
+               "Under --> extrude(world.up, 1)\n")
+    lots = [rect(12, 8), LOT_ZOO["concave_L"]]
+    together = run(write, grammar, lots)
+    alone = [run(write, grammar, [lot]) for lot in lots]
+    assert together["bad"] == () and len(alone[0]["mesh"].lot) == 2 * 6  # the solid under, one plane
+    assert len(together["mesh"].lot) == sum(len(a["mesh"].lot) for a in alone)
+    offset = len(alone[0]["mesh"].vertices)
+    np.testing.assert_array_equal(together["mesh"].vertices[:offset], alone[0]["mesh"].vertices)
+    np.testing.assert_array_equal(together["mesh"].vertices[offset:], alone[1]["mesh"].vertices)
+
+
 def test_translate_and_scale_with_relative_values(write):
     """s('0.5, '1, 2): half the width; t('0.25, 0, 1): a quarter of the current (scaled) width."""
     r = run(write, "Lot --> extrude(6) s('0.5, '1, 2) t('0.25, 0, 1) X\n", [rect(12, 8)])
