@@ -730,10 +730,38 @@ class CompFaces:
     offset: Expr | None = child(Type.NUM, "an offset distance", default=None)
 
 
+#: CityEngine's primitives: their segment arguments (with defaults) and their size arguments, in order.
+PRIMITIVES = {
+    "cube": ((), ("width", "height", "depth")),
+    "quad": ((), ("width", "length")),
+    "disk": ((16,), ("radius",)),
+    "cylinder": ((16,), ("radius", "height")),
+    "cone": ((16,), ("radius", "height")),
+    "sphere": ((16, 16), ("radius",)),
+}
+
+
+@dataclass(frozen=True, slots=True)
+class Primitive:
+    """CityEngine ``primitiveCube/Quad/Disk/Cylinder/Sphere/Cone(segments..., sizes...)``: the shape's
+    geometry becomes the primitive (``PRIMITIVES`` names each kind's arguments).
+
+    Without ``sizes`` the primitive fills the scope; with them the scope takes the primitive's size,
+    centred on the old scope in x and z and standing on its y = 0 (a radius gives a diameter). ``segments``
+    must fold to constants: they choose the built-in mesh (``asset_names.primitive_asset``).
+    """
+
+    kind: str
+    segments: tuple[Expr, ...] = child(Type.NUM, "a number of segments")
+    sizes: tuple[Expr, ...] | None = child(Type.NUM, "a size", default=None)
+    span: Span = NO_SPAN
+
+
 Op = (Symbol | Empty | Translate | Scale | Rotate | Push | Pop | Insert | Split | Repeat | Comp | Extrude
       | Center | UseAsset | Case | Stochastic | SetAttr | Report | NotApplied | GroupSplit | CompFaces
       | AlignScope | Mirror | Offset | SetColor | Setback | Roof | InnerRectangle | Convexify
-      | CleanupGeometry | DeleteHoles | Snap | Label)
+      | CleanupGeometry | DeleteHoles | Snap | Label
+      | Primitive)
 Body = tuple[Op, ...]
 
 

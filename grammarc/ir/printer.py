@@ -172,6 +172,7 @@ _OP_FORMATS = {
     ir.Mirror: lambda op: f"mirror({_list(op.axes)})",
     ir.AlignScope: _align_scope,
     ir.NotApplied: lambda op: f"{op.name}(...)",
+    ir.Primitive: lambda op: f"primitive{op.kind.title()}({_list(op.segments + (op.sizes or ()))})",
 }
 
 

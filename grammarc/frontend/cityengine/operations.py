@@ -166,9 +166,22 @@ class OperationLowering:
         return ir.UseAsset("", span, name=self.expr(args[0]), up=up, mode=mode)
 
     def op_cube(self, op, args, span):
-        if args:
-            return self.unsupported("primitiveCube with arguments", span)
-        return ir.UseAsset("builtin:cube", span)
+        """``primitiveCube()`` is ``i("builtin:cube")``; with its sizes a ``Primitive``."""
+        if not args:
+            return ir.UseAsset("builtin:cube", span)
+        return self.op_primitive(op, args, span)
+
+    def op_primitive(self, op, args, span):
+        """``primitiveQuad/Disk/Cylinder/Sphere/Cone(segments..., sizes...)``: all segments or none, then all
+        sizes or none (``ir.PRIMITIVES``)."""
+        kind = op.removeprefix("primitive").lower()
+        defaults, sizes = ir.PRIMITIVES[kind]
+        if not self.arity(op, args, tuple(sorted({0, len(defaults), len(defaults) + len(sizes)})), span):
+            return ir.Empty(span)
+        values = [self.expr(a) for a in args]
+        segments = tuple(values[:len(defaults)]) if values else tuple(ir.Num(float(d), span) for d in defaults)
+        given = tuple(values[len(defaults):])
+        return ir.Primitive(kind, segments, given or None, span)
 
     def op_nil(self, op, args, span):
         return ir.Empty(span)
@@ -339,6 +352,11 @@ OPERATIONS = {
     "center": OperationLowering.op_center,
     "i": OperationLowering.op_insert,
     "primitiveCube": OperationLowering.op_cube,
+    "primitiveQuad": OperationLowering.op_primitive,
+    "primitiveDisk": OperationLowering.op_primitive,
+    "primitiveCylinder": OperationLowering.op_primitive,
+    "primitiveSphere": OperationLowering.op_primitive,
+    "primitiveCone": OperationLowering.op_primitive,
     "NIL": OperationLowering.op_nil,
     "set": OperationLowering.op_set,
     "report": direct(ir.Report),
@@ -367,7 +385,8 @@ PART_OPERATIONS = {
 ROOF_ARGUMENTS = {"roofHip": ("overhang", "even"), "roofGable": ("overhangX", "overhangY", "even"),
                    "roofShed": ("index",), "roofPyramid": ()}
 #: Operations CityEngine also takes without their parentheses (other bare names are rules).
-BARE_OPS = frozenset({"NIL", "primitiveCube", "convexify"})
+BARE_OPS = frozenset({"NIL", "primitiveCube", "convexify", "primitiveQuad", "primitiveDisk", "primitiveCylinder",
+                      "primitiveSphere", "primitiveCone"})
 #: Part operations whose parts are sizes or faces: without parts, `unsupported: split` (the others say
 #: that their selector parts are missing).
 SPLIT_OPS = frozenset({"split", "comp"})
@@ -401,7 +420,6 @@ UNSUPPORTED_OPS = frozenset({
     "trim",
     "mirrorScope",
     "insertAlongUV", "scatter", "footprint", "tileUV", "splitArea", "inline", "resetGeometry", "taper",
-    "primitiveCylinder", "primitiveSphere", "primitiveDisk", "primitiveCone", "primitiveQuad",
     "reduceGeometry", "rectify", "semiPolygon",
     "alignScopeToGeometryBBox", "rotate", "translate", "roofRidge", "modify",
     "setbackPerEdge", "setbackToArea", "splitAndSetbackPerimeter",

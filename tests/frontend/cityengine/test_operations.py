@@ -43,6 +43,14 @@ from .lowered import VERSION, assert_unsupported_at, body_of, compile_ir, errors
     ('i("a.obj", zUp, keepSizeAlignPosition, noCleanup)', 'i("a.obj", zUp, keepSizeAlignPosition)'),
     ('i("a.obj", "zUp", alignSizeAndPosition)', 'i("a.obj", zUp, alignSizeAndPosition)'),
     ("primitiveCube", 'i("builtin:cube")'),
+    ("primitiveCube(1, 2, h)", "primitiveCube(1, 2, @h)"),
+    ("primitiveQuad", "primitiveQuad()"),
+    ("primitiveQuad(2, 3)", "primitiveQuad(2, 3)"),
+    ("primitiveDisk(8, 2)", "primitiveDisk(8, 2)"),
+    ("primitiveCylinder()", "primitiveCylinder(16)"),
+    ("primitiveCylinder(8, 1, h)", "primitiveCylinder(8, 1, @h)"),
+    ("primitiveSphere(8, 4)", "primitiveSphere(8, 4)"),
+    ("primitiveCone(5, 1, 2)", "primitiveCone(5, 1, 2)"),
     ("center(xz) A", "center(xz) A"),
     ("center(x) A", "center(x) A"),
     ("alignScopeToAxes() A", "alignScopeToAxes() A"),
@@ -198,7 +206,6 @@ def test_merged_selector_is_derived_face_by_face_with_a_warning(line, at):
      "innerRectangle"),
     ("Lot --> innerRectangle(scope){ front : A | remainder : NIL }", "innerRectangle selector `front`",
      "front"),
-    ("Lot --> primitiveCylinder(16, 1, 2)", "primitiveCylinder", "primitiveCylinder"),
     ("Lot --> mirrorScope(true, false, false) A", "mirrorScope", "mirrorScope"),
     ("Lot --> taper(4) A", "taper", "taper"),
     ("Lot --> comp(x){ all : A }", "comp(x)", "comp"),
@@ -245,6 +252,9 @@ def test_each_operation_name_is_in_one_table():
     ("Lot --> t(1, 2, 3, 4) A", "`t` takes 3 arguments, got 4"),
     ("Lot --> deleteHoles(1) A", "`deleteHoles` takes 0 arguments, got 1"),
     ("Lot --> setback(1, 2){ front : A | remainder : B }", "`setback` takes 1 arguments, got 2"),
+    ("Lot --> primitiveCube(1, 2) A", "`primitiveCube` takes 0 or 3 arguments, got 2"),
+    ("Lot --> primitiveCylinder(8, 1) A", "`primitiveCylinder` takes 0 or 1 or 3 arguments, got 2"),
+    ("Lot --> primitiveSphere(8) A", "`primitiveSphere` takes 0 or 2 or 3 arguments, got 1"),
 ])
 def test_a_wrong_argument_count_is_an_arity_error_at_the_operation(line, message):
     assert errors(VERSION + line + "\n") == [(2, 9, message)]
