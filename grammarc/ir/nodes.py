@@ -617,6 +617,9 @@ class GroupSplit:
     repeat: bool
     span: Span = NO_SPAN
     site: int = 0
+    #: ``split(axis, noAdjust)`` when false: each part's scope is its slab of the parent's scope, not the
+    #: bounding box of its piece of the geometry.
+    adjust: bool = True
 
 
 #: Face selectors of CityEngine's ``comp(f)``, relative to the shape's scope.

@@ -205,8 +205,8 @@ class OperationLowering:
         return ir.SetAttr(target.name, self.expr(args[1]), span)
 
     def op_split(self, op, args, parts, span, repeat=False):
-        """``split(axis[, adjust]){ size : A | { size : B }* | ... }``, repeated as a whole when ``repeat``
-        (``{ ... }*``)."""
+        """``split(axis[, adjust|noAdjust]){ size : A | { size : B }* | ... }``, repeated as a whole when
+        ``repeat`` (``{ ... }*``)."""
         if args and isinstance(args[0], ir.Name) and args[0].name in ("u", "v"):
             return self.unsupported(f"split({args[0].name}, ...)", span, "splits of texture space")
         if not args or not isinstance(args[0], ir.Name) or args[0].name not in ("x", "y", "z"):
@@ -215,8 +215,6 @@ class OperationLowering:
         for extra in args[1:]:
             if not (isinstance(extra, ir.Name) and extra.name in ("adjust", "noAdjust")):
                 return self.unsupported("this split option", getattr(extra, "span", span))
-            if extra.name == "noAdjust":
-                return self.unsupported("split(..., noAdjust)", extra.span)
         sizes, groups, bodies = [], [], []
         n_groups = 0
         for item in parts:
@@ -232,8 +230,9 @@ class OperationLowering:
                 sizes.append(self.size_of(item))
                 groups.append(-1)
                 bodies.append(item.body)
+        adjust = not any(isinstance(extra, ir.Name) and extra.name == "noAdjust" for extra in args[1:])
         return ir.GroupSplit("xyz".index(args[0].name), tuple(sizes), tuple(groups), tuple(bodies), repeat,
-                             span, self.site())
+                             span, self.site(), adjust)
 
     def size_of(self, part: Part) -> ir.Size:
         if part.merged:
