@@ -20,9 +20,12 @@ from grammarc.backend.kernels import scope as scope_kernels
 from grammarc.backend.kernels.order import group_by
 from grammarc.backend.plan import Plan
 from grammarc.backend.shapes import Shapes
+from grammarc.constants import TOL
 from grammarc.geometry.clip import clip_to_slabs
-from grammarc.geometry.meshes import is_mesh, is_polygon
-from grammarc.ragged import ragged_take
+from grammarc.geometry.components import rect_rings
+from grammarc.geometry.meshes import MESH_BASE, is_mesh, is_polygon
+from grammarc.geometry.polygons import PLANE_U, PLANE_V
+from grammarc.ragged import ragged_take, segment_of
 
 
 def children(ctx: Context, shapes: Shapes, axis: int, parent, index, pos, length, site: int, order=None,
@@ -78,7 +81,66 @@ def with_context(plan: Plan, shapes: Shapes, kind: str, index, parents, n_parent
     return replace(shapes, dynamic=tuple(dynamic))
 
 
-def clip(chunk: Chunk, shapes: Shapes, axis: int, parent, step, pos, length, index):
+def clip(chunk: Chunk, shapes: Shapes, axis: int, parent, step, pos, length, index, adjust: bool = True):
+    """``clip_pieces``; with ``adjust`` false (CityEngine's ``split(axis, noAdjust)``) the pieces keep
+    their slabs as their scopes (``fill_slabs``), so the children's scopes fill the parent's without gaps."""
+    if adjust:
+        return clip_pieces(chunk, shapes, axis, parent, step, pos, length, index)
+    # the children's row numbers go through in place of their numbers: their slabs are taken by them
+    parent, step, _, _, source, geometry = clip_pieces(chunk, shapes, axis, parent, step, pos, length,
+                                                       np.arange(len(parent)))
+    if geometry is not None:
+        geometry = fill_slabs(chunk, shapes, axis, parent, pos[source], length[source], geometry)
+    return parent, step, pos[source], length[source], index[source], geometry
+
+
+def fill_slabs(chunk: Chunk, shapes: Shapes, axis: int, parent, pos, length, geometry):
+    """The geometry of ``clip_pieces`` with each piece's box its slab of the parent's scope: a piece that
+    does not fill its slab gets its polygon or mesh again, normalized to the slab (a rectangle piece
+    becomes a polygon)."""
+    is_piece, geom, low, extent = (g.copy() for g in geometry)
+    slab_low = np.zeros((len(parent), 3))
+    slab_low[:, axis] = pos
+    slab_extent = shapes.size[parent].copy()
+    slab_extent[:, axis] = length
+    fits = (np.abs(low - slab_low) <= TOL.zero).all(axis=1) & (np.abs(extent - slab_extent) <= TOL.zero).all(axis=1)
+    moved = np.flatnonzero(is_piece & ~fits)
+    if not len(moved):
+        return geometry
+    meshes = moved[is_mesh(geom[moved])]
+    polygons = moved[~is_mesh(geom[moved])]
+    if len(polygons):
+        store = chunk.polygons
+        plane = np.where(geom[polygons] >= 0, store.plane[np.maximum(geom[polygons], 0)],
+                         store.plane[shapes.geom[parent[polygons]]]).astype(np.int8)
+        rects = np.flatnonzero(geom[polygons] < 0)
+        ids = geom[polygons].astype(np.int64)
+        if len(rects):
+            ids[rects] = store.add(rect_rings(plane[rects]), np.arange(0, 4 * len(rects) + 1, 4, dtype=np.int64),
+                                   np.arange(len(rects) + 1, dtype=np.int64), plane[rects])
+        coords, ring_offsets, poly_offsets = store.gather(ids)
+        vertex_piece = segment_of(poly_offsets)[segment_of(ring_offsets)]
+        of = polygons[vertex_piece][:, None]
+        uv = np.stack([PLANE_U[plane], PLANE_V[plane]], axis=1)[vertex_piece]  # (V, 2): the scope axes of u, v
+        coords = _renormalized(coords, low[of, uv], extent[of, uv], slab_low[of, uv], slab_extent[of, uv])
+        geom[polygons] = store.add(coords, ring_offsets, poly_offsets, plane)
+    if len(meshes):
+        coords, ring_offsets, face_offsets, mesh_offsets = chunk.meshes.gather(geom[meshes] - MESH_BASE)
+        of = meshes[segment_of(mesh_offsets)[segment_of(face_offsets)[segment_of(ring_offsets)]]]
+        coords = _renormalized(coords, low[of], extent[of], slab_low[of], slab_extent[of])
+        geom[meshes] = (MESH_BASE + chunk.meshes.add(coords, ring_offsets, face_offsets, mesh_offsets)).astype(np.int32)
+    low[moved], extent[moved] = slab_low[moved], slab_extent[moved]
+    return is_piece, geom, low, extent
+
+
+def _renormalized(coords, low, extent, slab_low, slab_extent) -> np.ndarray:
+    """Coordinates normalized to a piece's box (``low``, ``extent``) normalized to its slab instead, per
+    vertex and axis (an axis of no extent at 0)."""
+    scope = low + coords * extent
+    return np.divide(scope - slab_low, slab_extent, out=np.zeros_like(scope), where=slab_extent > TOL.zero)
+
+
+def clip_pieces(chunk: Chunk, shapes: Shapes, axis: int, parent, step, pos, length, index):
     """Children of polygons split across their plane become the pieces of the polygon in their slabs
     (``geometry.clip``): empty ones go, a slab that cuts the polygon apart gives one child a piece.
     Children of meshes (roofs, envelopes) become the mesh cut to their slab and closed

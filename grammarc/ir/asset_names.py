@@ -1,10 +1,10 @@
 """Asset names: built-in primitives and OBJ files, resolved inside the asset roots.
 
 ``I("cube")`` and ``I("builtin:cube")`` name the built-in unit cube (built-ins: ``cube``, ``quad``,
-``cylinder`` and ``cylinderN`` with N sides, and the paper's mass-model blocks ``L``, ``H``, ``U``,
-``T``; CityEngine's ``builtin:cube:notex``, a cube without texture coordinates, is the cube: records
-carry none); ``I("facade/window.obj")`` names a file relative to an asset root (the grammar's folder first,
-then any ``--assets`` folders). The record keeps a canonical name: ``builtin:NAME`` or the POSIX path
+``cylinder`` and ``cylinderN`` with N sides, ``coneN``, ``sphereNxM`` (CityEngine's primitives), and the
+paper's mass-model blocks ``L``, ``H``, ``U``, ``T``; CityEngine's ``builtin:cube:notex``, a cube without
+texture coordinates, is the cube: records carry none); ``I("facade/window.obj")`` names a file relative to
+an asset root (the grammar's folder first, then any ``--assets`` folders). The record keeps a canonical name: ``builtin:NAME`` or the POSIX path
 relative to the root that holds it. A name that is absolute or climbs out of every root
 (``../../etc/passwd``) is refused: grammars are shared, and a rule file must not read outside the folders
 its user gave.
@@ -15,21 +15,49 @@ baker that load the files ask it too.
 
 from __future__ import annotations
 
+import math
 import os
 from dataclasses import dataclass
 from pathlib import Path, PurePosixPath
 
 BUILTINS = ("cube", "quad", "cylinder", "L", "H", "U", "T")
-#: ``cylinderN``: a cylinder of N sides (``cylinder`` has 16).
-CYLINDER_SIDES_RANGE = range(3, 257)
+#: Built-ins with segment counts, and how many: ``cylinderN`` and ``coneN`` (N sides), ``sphereNxM`` (N
+#: sides around, M divisions from pole to pole); ``cylinder`` is ``cylinder16``.
+SEGMENTED = {"cylinder": 1, "cone": 1, "sphere": 2}
+#: The segment counts a built-in may have.
+SEGMENTS_RANGE = range(3, 257)
 
 
 def builtin_name(bare: str) -> bool:
-    """Whether ``bare`` (without ``builtin:``) names a built-in: one of ``BUILTINS`` or ``cylinderN``."""
-    if bare in BUILTINS:
-        return True
-    digits = bare.removeprefix("cylinder")
-    return digits != bare and digits.isdigit() and int(digits) in CYLINDER_SIDES_RANGE
+    """Whether ``bare`` (without ``builtin:``) names a built-in: one of ``BUILTINS``, or one of
+    ``SEGMENTED`` with its segment counts."""
+    return bare in BUILTINS or builtin_segments(bare) is not None
+
+
+def builtin_segments(bare: str) -> tuple[str, tuple[int, ...]] | None:
+    """The kind and segment counts of a segmented built-in (``"sphere8x4"`` -> ``("sphere", (8, 4))``),
+    or None when ``bare`` names none."""
+    for kind, count in SEGMENTED.items():
+        digits = bare.removeprefix(kind).split("x")
+        if bare.startswith(kind) and len(digits) == count and all(d.isdigit() for d in digits):
+            numbers = tuple(int(d) for d in digits)
+            if all(n in SEGMENTS_RANGE for n in numbers):
+                return kind, numbers
+    return None
+
+
+def primitive_asset(kind: str, counts: tuple[int, ...]) -> str | None:
+    """The built-in asset of a CityEngine primitive of ``kind`` with segment ``counts``
+    (``segment_counts``), or None for those that are no asset (cube, quad, disk)."""
+    if kind not in SEGMENTED:
+        return None
+    return f"builtin:{kind}{'x'.join(str(n) for n in counts)}"
+
+
+def segment_counts(values) -> tuple[int, ...]:
+    """Segment counts from a primitive's segment arguments: rounded (half up) to whole numbers and kept within
+    ``SEGMENTS_RANGE`` (CityEngine asks for at least 3; 256 sides are round to the eye)."""
+    return tuple(min(max(math.floor(float(v) + 0.5), SEGMENTS_RANGE.start), SEGMENTS_RANGE.stop - 1) for v in values)
 
 
 #: Assets every record can use for leaves: volumes are cubes, faces are quads.
@@ -61,7 +89,7 @@ def resolve_asset(name: str, roots: list[Path]) -> ResolvedAsset:
         return ResolvedAsset(f"builtin:{bare}", None)
     if name.startswith("builtin:"):
         return ResolvedAsset(name, None, problem=f"unknown built-in asset `{name}` (built-ins: "
-                             + ", ".join(BUILTINS) + ", cylinderN for N sides)")
+                             + ", ".join(BUILTINS) + ", cylinderN and coneN for N sides, sphereNxM)")
     if "\0" in name:
         shown = name.replace("\0", "\\0")
         return ResolvedAsset(shown, None, problem=f"asset path `{shown}` holds a NUL byte")

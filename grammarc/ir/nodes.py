@@ -624,6 +624,9 @@ class GroupSplit:
     repeat: bool
     span: Span = NO_SPAN
     site: int = 0
+    #: ``split(axis, noAdjust)`` when false: each part's scope is its slab of the parent's scope, not the
+    #: bounding box of its piece of the geometry.
+    adjust: bool = True
 
 
 #: Face selectors of CityEngine's ``comp(f)``, relative to the shape's scope.
@@ -797,10 +800,37 @@ class AlignToGeometry:
     span: Span = NO_SPAN
 
 
+#: CityEngine's primitives: their segment arguments (with defaults) and their size arguments, in order.
+PRIMITIVES = {
+    "cube": ((), ("width", "height", "depth")),
+    "quad": ((), ("width", "length")),
+    "disk": ((16,), ("radius",)),
+    "cylinder": ((16,), ("radius", "height")),
+    "cone": ((16,), ("radius", "height")),
+    "sphere": ((16, 16), ("radius",)),
+}
+
+
+@dataclass(frozen=True, slots=True)
+class Primitive:
+    """CityEngine ``primitiveCube/Quad/Disk/Cylinder/Sphere/Cone(segments..., sizes...)``: the shape's
+    geometry becomes the primitive (``PRIMITIVES`` names each kind's arguments).
+
+    Without ``sizes`` the primitive fills the scope; with them the scope takes the primitive's size,
+    centred on the old scope in x and z and standing on its y = 0 (a radius gives a diameter). ``segments``
+    must fold to constants: they choose the built-in mesh (``asset_names.primitive_asset``).
+    """
+
+    kind: str
+    segments: tuple[Expr, ...] = child(Type.NUM, "a number of segments")
+    sizes: tuple[Expr, ...] | None = child(Type.NUM, "a size", default=None)
+    span: Span = NO_SPAN
+
+
 Op = (Symbol | Empty | Translate | Scale | Rotate | Push | Pop | Insert | Split | Repeat | Comp | Extrude
       | Center | UseAsset | Case | Stochastic | SetAttr | Report | NotApplied | GroupSplit | CompFaces
       | AlignScope | Mirror | Offset | SetColor | Setback | Roof | InnerRectangle | Convexify
-      | CleanupGeometry | DeleteHoles | Snap | Label | Transform | Scatter | AlignToGeometry)
+      | CleanupGeometry | DeleteHoles | Snap | Label | Transform | Scatter | AlignToGeometry | Primitive)
 Body = tuple[Op, ...]
 
 

@@ -101,7 +101,8 @@ def _group_split(op: ir.GroupSplit) -> str:
             items.append([text] if g < 0 else ["{", text])
         group = g
     shown = [" | ".join(i) if i[0] != "{" else "{ " + " | ".join(i[1:]) + " }*" for i in items]
-    return f"split({'xyz'[op.axis]}){{ {' | '.join(shown)} }}{'*' if op.repeat else ''}"
+    options = "" if op.adjust else ", noAdjust"
+    return f"split({'xyz'[op.axis]}{options}){{ {' | '.join(shown)} }}{'*' if op.repeat else ''}"
 
 
 def _roof(op: ir.Roof) -> str:
@@ -182,6 +183,7 @@ _OP_FORMATS = {
         op.edge if op.edge_index is None else print_expr(op.edge_index)]) + ")",
     ir.NotApplied: lambda op: f"{op.name}(...)",
     ir.Scatter: _scatter,
+    ir.Primitive: lambda op: f"primitive{op.kind.title()}({_list(op.segments + (op.sizes or ()))})",
 }
 
 

@@ -10,6 +10,8 @@ Assets, each an ``AssetMesh`` in the unit box [0, 1]^3:
 * ``builtin:quad``: the unit square on z = 0, normal +z, 2 triangles;
 * ``builtin:cylinder``: axis along y through (0.5, ., 0.5), radius 0.5, y in [0, 1], 16 sides, capped
   (60 triangles); ``builtin:cylinderN`` the same with N sides;
+* ``builtin:coneN``: the cone over the N-sided base of ``cylinderN``, apex at (0.5, 1, 0.5);
+* ``builtin:sphereNxM``: the sphere in the unit box, N segments around y and M from pole to pole;
 * ``builtin:L``, ``H``, ``U``, ``T``: the paper's mass-model blocks, prisms over outlines with wings a
   third of the box thick;
 * a file, resolved in the asset roots as the compiler resolves it (``resolve_asset``), read by the reader
@@ -53,7 +55,7 @@ from pathlib import Path
 import numpy as np
 
 from grammarc.errors import AssetError
-from grammarc.ir.asset_names import builtin_name, resolve_asset, unsupported_format
+from grammarc.ir.asset_names import builtin_segments, resolve_asset, unsupported_format
 from grammarc.model.obj import ObjError, read_obj
 
 __all__ = ["LOD_STAND_IN", "AssetLibrary", "AssetMesh", "asset_library", "builtin_mesh", "load_asset",
@@ -136,12 +138,58 @@ def builtin_mesh(name: str) -> AssetMesh:
         return _frozen(vertices, np.array([[0, 1, 2], [0, 2, 3]]), np.array([4]), ((0.0, 0.0, 0.0), (1.0, 1.0, 0.0)))
     if bare in BLOCKS:
         return _prism(np.array(BLOCKS[bare], dtype=np.float64) / 3.0)
-    if builtin_name(bare) and bare.startswith("cylinder"):
-        k = int(bare.removeprefix("cylinder") or CYLINDER_SIDES)
-        # a = 0 and pi put vertices on x = 0 and 1; increasing a turns counter-clockwise seen from +y
-        angle = 2 * np.pi * np.arange(k) / k
-        return _prism(np.stack([0.5 + 0.5 * np.cos(angle), 0.5 - 0.5 * np.sin(angle)], axis=1))
-    raise AssetError(f"unknown built-in asset `{name}` (built-ins: cube, quad, cylinder, cylinderN, L, H, U, T)")
+    segmented = ("cylinder", (CYLINDER_SIDES,)) if bare == "cylinder" else builtin_segments(bare)
+    if segmented is not None:
+        kind, counts = segmented
+        if kind == "cylinder":
+            return _prism(_circle(counts[0]))
+        if kind == "cone":
+            return _cone(_circle(counts[0]))
+        return _sphere(*counts)
+    raise AssetError(f"unknown built-in asset `{name}` (built-ins: cube, quad, cylinder, cylinderN, coneN, "
+                     "sphereNxM, L, H, U, T)")
+
+
+def _circle(k: int) -> np.ndarray:
+    """The regular k-gon inscribed in the unit square, (k, 2) as (x, z) counter-clockwise seen from +y:
+    angle 0 and pi put vertices on x = 0 and 1."""
+    angle = 2 * np.pi * np.arange(k) / k
+    return np.stack([0.5 + 0.5 * np.cos(angle), 0.5 - 0.5 * np.sin(angle)], axis=1)
+
+
+def _cone(outline: np.ndarray) -> AssetMesh:
+    """The cone over ``outline`` (``_circle``) from its base on y = 0 to its apex (0.5, 1, 0.5): a
+    triangle per side, and the base."""
+    k = len(outline)
+    base = np.stack([outline[:, 0], np.zeros(k), outline[:, 1]], axis=1)
+    vertices = np.concatenate([base, [[0.5, 1.0, 0.5]]])
+    i = np.arange(k)
+    sides = np.stack([i, (i + 1) % k, np.full(k, k)], axis=1)
+    # the base faces -y: counter-clockwise from +y is clockwise from below; a fan from vertex 0
+    bottom = np.stack([np.zeros(k - 2, np.int64), i[2:], i[1:-1]], axis=1)
+    return _frozen(_fitted(vertices), np.concatenate([sides, bottom]), np.array([3] * k + [k]))
+
+
+def _sphere(sides: int, divisions: int) -> AssetMesh:
+    """The UV sphere fitted to the unit box: ``sides`` segments around y, ``divisions`` from the south pole
+    (y = 0) to the north pole; triangles at the poles, quads between."""
+    ring = _circle(sides) - 0.5
+    polar = np.pi * np.arange(1, divisions) / divisions  # from the south pole
+    rings = [np.stack([ring[:, 0] * np.sin(t), np.full(sides, -0.5 * np.cos(t)), ring[:, 1] * np.sin(t)], axis=1)
+             for t in polar]
+    vertices = np.concatenate([[[0.0, -0.5, 0.0]], *rings, [[0.0, 0.5, 0.0]]]) + 0.5
+    north = len(vertices) - 1
+    i = np.arange(sides)
+    j = (i + 1) % sides
+    first = 1 + (divisions - 2) * sides  # the first vertex of the last ring
+    south = np.stack([np.zeros(sides, np.int64), j + 1, i + 1], axis=1)
+    top = np.stack([first + i, first + j, np.full(sides, north)], axis=1)
+    quads = np.concatenate([np.stack([1 + r * sides + i, 1 + r * sides + j, 1 + (r + 1) * sides + j,
+                                      1 + (r + 1) * sides + i], axis=1) for r in range(divisions - 2)]
+                           or [np.empty((0, 4), np.int64)])
+    faces = np.concatenate([south, _quads_to_triangles(quads), top]).astype(np.int64)
+    sizes = [3] * sides + [4] * len(quads) + [3] * sides
+    return _frozen(_fitted(vertices), faces, np.array(sizes))
 
 
 def _prism(outline: np.ndarray) -> AssetMesh:

@@ -4,16 +4,32 @@ from __future__ import annotations
 
 import pytest
 
-from grammarc.ir.asset_names import LEAF_CUBE, LEAF_QUAD, builtin_name, resolve_asset
+from grammarc.ir.asset_names import (
+    LEAF_CUBE,
+    LEAF_QUAD,
+    builtin_name,
+    primitive_asset,
+    resolve_asset,
+    segment_counts,
+)
 
 
 @pytest.mark.parametrize("bare, builtin", [
     ("cube", True), ("quad", True), ("cylinder", True), ("L", True), ("T", True), ("cylinder3", True),
     ("cylinder256", True), ("cylinder2", False), ("cylinder257", False), ("cylinderx", False),
-    ("sphere", False), ("cube.obj", False),
+    ("sphere", False), ("cube.obj", False), ("cone8", True), ("cone", False), ("sphere8x4", True),
+    ("sphere8", False), ("sphere8x2", False), ("sphere8x4x2", False),
 ])
 def test_builtin_names(bare, builtin):
     assert builtin_name(bare) is builtin
+
+
+@pytest.mark.parametrize("kind, values, asset", [
+    ("cylinder", (8,), "builtin:cylinder8"), ("cone", (2.5,), "builtin:cone3"), ("cone", (300,), "builtin:cone256"),
+    ("sphere", (7.5, 4.4), "builtin:sphere8x4"), ("disk", (6,), None), ("cube", (), None),
+])  # fmt: skip
+def test_a_primitive_names_the_builtin_of_its_rounded_segment_counts(kind, values, asset):
+    assert primitive_asset(kind, segment_counts(values)) == asset
 
 
 def test_the_leaf_assets_are_builtins():

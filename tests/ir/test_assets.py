@@ -128,3 +128,15 @@ def test_an_fbx_without_its_reader_is_an_error_at_the_insert(tmp_path, monkeypat
     (error,) = [d for d in diags if d.code == "asset"]
     assert error.severity.value == "error" and error.span.line == 3
     assert error.message.startswith("unsupported asset format: FBX (`mill.fbx`; pip install 'grammarc[fbx]'")
+
+
+def test_a_primitive_registers_the_builtin_of_its_segments_a_number_or_a_declared_attribute(tmp_path):
+    text = (VERSION + "const n = 6\nattr m = 5.6\n@StartRule\nLot --> primitiveCylinder(n) A(3)\n"
+            "A(k) --> primitiveSphere(m, 4) primitiveDisk(7) primitiveCylinder()\n")
+    module, diags = resolved(text, (tmp_path,), "cityengine")
+    assert not diags
+    assert module.assets == ("builtin:cube", "builtin:quad", "builtin:cylinder6", "builtin:sphere6x4",
+                             "builtin:cylinder16")
+    module, diags = resolved(text.replace("primitiveDisk(7)", "primitiveDisk(k)"), (tmp_path,), "cityengine")
+    why = "unsupported: primitiveDisk with a computed number of segments (give a number or an attribute declared"
+    assert [(d.code, d.span.line, d.message) for d in diags] == [("unsupported", 6, why + " as one)")]

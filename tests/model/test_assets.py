@@ -30,6 +30,8 @@ def test_builtins_are_closed_outward_unit_shapes():
     np.testing.assert_allclose(normals, [[0, 0, 1], [0, 0, 1]], atol=1e-12)
     with pytest.raises(AssetError, match="unknown built-in"):
         builtin_mesh("builtin:sphere")
+    with pytest.raises(AssetError, match="unknown built-in"):
+        builtin_mesh("builtin:cone2")
 
 
 @pytest.mark.parametrize("name, volume, sides", [
@@ -44,6 +46,23 @@ def test_block_and_cylinder_builtins_are_closed_outward_prisms_filling_the_unit_
     assert mesh.bounds.tolist() == [[0, 0, 0], [1, 1, 1]]
     assert mesh.volume == pytest.approx(volume, rel=0.02 if name.startswith("cylinder") else 1e-12)
     assert dict(zip(*np.unique(shape.polygon_sizes, return_counts=True))) == {4: sides, sides: 2}
+
+
+@pytest.mark.parametrize("name, volume, polygons", [
+    ("cone8", np.sqrt(0.5) / 3, {3: 8, 8: 1}),  # a third of the octagonal prism's 0.7071
+    ("cone64", np.pi / 12, {3: 64, 64: 1}),
+    ("sphere8x4", None, {3: 16, 4: 16}),
+    ("sphere64x32", np.pi / 6, {3: 128, 4: 64 * 30}),
+])  # fmt: skip
+def test_cone_and_sphere_builtins_are_closed_outward_meshes_filling_the_unit_box(name, volume, polygons):
+    """CityEngine's primitiveCone and primitiveSphere with their segment counts, fitted to [0, 1]^3."""
+    shape = builtin_mesh(f"builtin:{name}")
+    mesh = trimesh.Trimesh(shape.vertices, shape.faces, process=True)
+    assert mesh.is_watertight and mesh.is_winding_consistent and mesh.volume > 0
+    np.testing.assert_allclose(mesh.bounds, [[0, 0, 0], [1, 1, 1]], atol=1e-12)
+    if volume is not None:
+        assert mesh.volume == pytest.approx(volume, rel=0.01)
+    assert dict(zip(*np.unique(shape.polygon_sizes, return_counts=True))) == polygons
 
 
 def write_obj(path, text: str):

@@ -12,6 +12,7 @@ columns:
 - ``component_splits``: ``Comp``, ``comp(f|e|v)``;
 - ``faces``: ``offset``, ``setback``, ``innerRectangle``, ``convexify``, roofs, ``cleanupGeometry``;
 - ``inserts``: ``I``, ``i``, ``label``;
+- ``primitives``: CityEngine's ``primitiveCube/Quad/Disk/Cylinder/Sphere/Cone``;
 - ``successors``: successor symbols, ``ε``/``NIL`` and operations without effect;
 - ``values``: ``set``, ``color``, ``report``;
 - ``control``: ``case`` and ``p%`` blocks;
@@ -25,6 +26,7 @@ from grammarc.backend.operations import (  # noqa: F401 - each registers its ope
     control,
     faces,
     inserts,
+    primitives,
     scatter,
     scope,
     splits,

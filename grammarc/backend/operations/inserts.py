@@ -71,6 +71,12 @@ def placed(ctx: Context, cursor: Shapes, op: ir.UseAsset, asset: np.ndarray) -> 
         offset = low
     else:
         offset = (cursor.size - size) * np.array([0.5, 0.0, 0.5])
+    return scope_at(ctx, cursor, offset, size, geom)
+
+
+def scope_at(ctx: Context, cursor: Shapes, offset: np.ndarray, size: np.ndarray, geom: np.ndarray) -> Shapes:
+    """The shapes with their scopes moved by ``offset`` (n, 3) along their own axes, of size ``size``
+    (n, 3) and geometry ``geom`` (n,)."""
     axes = ctx.chunk.frames.data[cursor.frame]  # (n, 3, 3): row j is scope axis j
     origin = cursor.origin + np.einsum("nj,njr->nr", offset, axes)
     return cursor.with_scope(origin, size, cursor.frame, geom)

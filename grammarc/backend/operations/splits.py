@@ -92,7 +92,7 @@ def group_split(ctx: Context, cursor: Shapes, op: ir.GroupSplit) -> Parts:
     parent, part, pos, length, index = split_kernels.group_split(
         np.ascontiguousarray(cursor.size[:, op.axis]), values, kind, groups, n_groups, TOL.zero)
     parent, part, pos, length, index, geometry = clip(ctx.chunk, cursor, op.axis, parent, part, pos, length,
-                                                      index)
+                                                      index, op.adjust)
     order, offsets = group_by(part, len(op.parts))
     made = children(ctx, cursor, op.axis, parent, index, pos, length, op.site, order, geometry)
     ctx.count(made, op.span)

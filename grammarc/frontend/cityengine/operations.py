@@ -202,9 +202,22 @@ class OperationLowering:
         return ir.UseAsset("", span, name=self.expr(args[0]), up=up, mode=mode)
 
     def op_cube(self, op, args, span):
-        if args:
-            return self.unsupported("primitiveCube with arguments", span)
-        return ir.UseAsset("builtin:cube", span)
+        """``primitiveCube()`` is ``i("builtin:cube")``; with its sizes a ``Primitive``."""
+        if not args:
+            return ir.UseAsset("builtin:cube", span)
+        return self.op_primitive(op, args, span)
+
+    def op_primitive(self, op, args, span):
+        """``primitiveQuad/Disk/Cylinder/Sphere/Cone(segments..., sizes...)``: all segments or none, then all
+        sizes or none (``ir.PRIMITIVES``)."""
+        kind = op.removeprefix("primitive").lower()
+        defaults, sizes = ir.PRIMITIVES[kind]
+        if not self.arity(op, args, tuple(sorted({0, len(defaults), len(defaults) + len(sizes)})), span):
+            return ir.Empty(span)
+        values = [self.expr(a) for a in args]
+        segments = tuple(values[:len(defaults)]) if values else tuple(ir.Num(float(d), span) for d in defaults)
+        given = tuple(values[len(defaults):])
+        return ir.Primitive(kind, segments, given or None, span)
 
     def op_nil(self, op, args, span):
         return ir.Empty(span)
@@ -240,8 +253,8 @@ class OperationLowering:
         return ir.Transform("translate" if kind == "t" else "rotate", False, "pivot", values, span)
 
     def op_split(self, op, args, parts, span, repeat=False):
-        """``split(axis[, adjust]){ size : A | { size : B }* | ... }``, repeated as a whole when ``repeat``
-        (``{ ... }*``)."""
+        """``split(axis[, adjust|noAdjust]){ size : A | { size : B }* | ... }``, repeated as a whole when
+        ``repeat`` (``{ ... }*``)."""
         if args and isinstance(args[0], ir.Name) and args[0].name in ("u", "v"):
             return self.unsupported(f"split({args[0].name}, ...)", span, "splits of texture space")
         if not args or not isinstance(args[0], ir.Name) or args[0].name not in ("x", "y", "z"):
@@ -250,8 +263,6 @@ class OperationLowering:
         for extra in args[1:]:
             if not (isinstance(extra, ir.Name) and extra.name in ("adjust", "noAdjust")):
                 return self.unsupported("this split option", getattr(extra, "span", span))
-            if extra.name == "noAdjust":
-                return self.unsupported("split(..., noAdjust)", extra.span)
         sizes, groups, bodies = [], [], []
         n_groups = 0
         for item in parts:
@@ -267,8 +278,9 @@ class OperationLowering:
                 sizes.append(self.size_of(item))
                 groups.append(-1)
                 bodies.append(item.body)
+        adjust = not any(isinstance(extra, ir.Name) and extra.name == "noAdjust" for extra in args[1:])
         return ir.GroupSplit("xyz".index(args[0].name), tuple(sizes), tuple(groups), tuple(bodies), repeat,
-                             span, self.site())
+                             span, self.site(), adjust)
 
     def size_of(self, part: Part) -> ir.Size:
         if part.merged:
@@ -419,6 +431,11 @@ OPERATIONS = {
     "center": OperationLowering.op_center,
     "i": OperationLowering.op_insert,
     "primitiveCube": OperationLowering.op_cube,
+    "primitiveQuad": OperationLowering.op_primitive,
+    "primitiveDisk": OperationLowering.op_primitive,
+    "primitiveCylinder": OperationLowering.op_primitive,
+    "primitiveSphere": OperationLowering.op_primitive,
+    "primitiveCone": OperationLowering.op_primitive,
     "NIL": OperationLowering.op_nil,
     "set": OperationLowering.op_set,
     "report": direct(ir.Report),
@@ -453,7 +470,8 @@ SCATTER_TYPES = frozenset({"uniform", "gaussian"})
 ROOF_ARGUMENTS = {"roofHip": ("overhang", "even"), "roofGable": ("overhangX", "overhangY", "even"),
                    "roofShed": ("index",), "roofPyramid": ()}
 #: Operations CityEngine also takes without their parentheses (other bare names are rules).
-BARE_OPS = frozenset({"NIL", "primitiveCube", "convexify", "alignScopeToAxes"})
+BARE_OPS = frozenset({"NIL", "primitiveCube", "convexify", "alignScopeToAxes", "primitiveQuad", "primitiveDisk",
+                      "primitiveCylinder", "primitiveSphere", "primitiveCone"})
 #: Part operations whose parts are sizes or faces: without parts, `unsupported: split` (the others say
 #: that their selector parts are missing).
 SPLIT_OPS = frozenset({"split", "comp"})
@@ -487,7 +505,6 @@ UNSUPPORTED_OPS = frozenset({
     "trim",
     "mirrorScope",
     "insertAlongUV", "footprint", "tileUV", "splitArea", "inline", "resetGeometry", "taper",
-    "primitiveCylinder", "primitiveSphere", "primitiveDisk", "primitiveCone", "primitiveQuad",
     "reduceGeometry", "rectify", "semiPolygon",
     "alignScopeToGeometryBBox", "roofRidge", "modify",
     "setbackPerEdge", "setbackToArea", "splitAndSetbackPerimeter",

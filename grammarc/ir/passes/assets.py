@@ -24,7 +24,14 @@ from pathlib import Path
 from grammarc.diagnostics import Diagnostics
 from grammarc.errors import AssetError
 from grammarc.ir import nodes as ir
-from grammarc.ir.asset_names import LEAF_CUBE, LEAF_QUAD, resolve_asset, unsupported_format
+from grammarc.ir.asset_names import (
+    LEAF_CUBE,
+    LEAF_QUAD,
+    primitive_asset,
+    resolve_asset,
+    segment_counts,
+    unsupported_format,
+)
 from grammarc.ir.file_search import ASSET_SUFFIXES, constant_folder, search
 from grammarc.ir.traverse import all_exprs, iter_exprs, iter_ops
 
@@ -40,6 +47,7 @@ def resolve_assets(module: ir.Module, diags: Diagnostics) -> ir.Module:
         return module
     ops = list(iter_ops(module))
     named = [(op.asset, op.span) for op in ops if isinstance(op, (ir.Insert, ir.UseAsset)) and op.asset]
+    named.extend(_primitives(module, ops, diags))
     if any(isinstance(op, ir.UseAsset) and op.name is not None for op in ops):
         # a computed asset name: every string constant that looks like an asset may be one
         queries = _queries(module)
@@ -68,6 +76,25 @@ def resolve_assets(module: ir.Module, diags: Diagnostics) -> ir.Module:
             names.append(canonical)
         ids[name] = names.index(canonical)
     return replace(module, assets=tuple(names), asset_ids=tuple(ids.items()))
+
+
+def _primitives(module: ir.Module, ops: list, diags: Diagnostics) -> list[tuple[str, object]]:
+    """The built-in assets of CityEngine's primitives. Their segment counts choose the mesh, so each must
+    be a number or an attribute declared as one (a lot that overrides it to a count the grammar never
+    names fails)."""
+    declared = {a.name: a.default.value for a in module.attrs if isinstance(a.default, ir.Num)}
+    named = []
+    for op in ops:
+        if not isinstance(op, ir.Primitive):
+            continue
+        values = [s.value if isinstance(s, ir.Num) else declared.get(s.name) if isinstance(s, ir.AttrRef)
+                  else None for s in op.segments]
+        if None in values:
+            diags.error("unsupported", f"unsupported: primitive{op.kind.title()} with a computed number of "
+                        "segments (give a number or an attribute declared as one)", op.span)
+        elif primitive_asset(op.kind, segment_counts(values)) is not None:
+            named.append((primitive_asset(op.kind, segment_counts(values)), op.span))
+    return named
 
 
 def _queries(module: ir.Module) -> set[str]:

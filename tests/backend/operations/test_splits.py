@@ -9,12 +9,15 @@ from collections import Counter
 import numpy as np
 import pytest
 from derivations import (
+    make_lots_polys,
+    mesh_faces,
     names,
     of_symbol,
     paper,
     rect,
     rows,
     run,
+    same_records,
     totals,
 )
 
@@ -90,3 +93,51 @@ def test_nan_split_size_lot_is_reported(write):
     assert list(np.unique(r["lot"])) == [0]
     assert r["bad"][0].index == 1 and "Subdiv" in r["bad"][0].reason
 
+
+
+SCOPE_REPORT = 'P --> report("sx", scope.sx) report("sz", scope.sz) report("tx", scope.tx) report("tz", scope.tz) Q\n'
+
+
+def _scope_of_p(r):
+    return {k: v["sum"] for k, v in r["reports"].lots[0].items()}
+
+
+def _outline(r):
+    """The vertices of every mesh face and quad of the records, sorted (the same surface however kept)."""
+    quads = [x[:, 3] + x[:, :3] @ c for x in r["xform"].astype(float) for c in ([0, 0, 0], [1, 0, 0], [1, 1, 0],
+                                                                                  [0, 1, 0])]
+    faces = [v for face in mesh_faces(r) for ring in face for v in ring.astype(float)]
+    return np.unique(np.round(np.array(quads + faces).reshape(-1, 3), 6), axis=0)
+
+
+def test_no_adjust_keeps_a_part_scope_its_slab_of_the_lot_and_its_piece_of_the_geometry(write):
+    """The L lot (30 x 10 below, 10 x 10 above on the left), split across its two wings: the part of the
+    upper wing is a 10 x 4 piece whose scope is fitted to it, or with noAdjust the whole slab 30 x 4
+    (CityEngine's reference: the scopes fill the parent's scope without gaps)."""
+    adjusted = run(write, "Lot --> split(z){ 4 : P | ~1 : NIL }\n" + SCOPE_REPORT, make_lots_polys("concave_L"))
+    slab = run(write, "Lot --> split(z, noAdjust){ 4 : P | ~1 : NIL }\n" + SCOPE_REPORT,
+               make_lots_polys("concave_L"))
+    assert _scope_of_p(adjusted) == {"sx": 10, "sz": 4, "tx": 0, "tz": 0}
+    assert _scope_of_p(slab) == {"sx": 30, "sz": 4, "tx": 0, "tz": 0}
+    np.testing.assert_allclose(_outline(slab), _outline(adjusted))
+    np.testing.assert_allclose(_outline(slab), [[0, 0, -20], [0, 0, -16], [10, 0, -20], [10, 0, -16]])
+
+
+def test_no_adjust_on_a_roof_keeps_the_slab_and_the_cut_mesh(write):
+    text = "Lot --> roofHip(30) split(y{}){{ 1 : NIL | ~1 : P }}\n" + SCOPE_REPORT
+    adjusted = run(write, text.format(""), [rect(20, 10)])
+    slab = run(write, text.format(", noAdjust"), [rect(20, 10)])
+    assert _scope_of_p(slab)["sx"] == 20 and _scope_of_p(adjusted)["sx"] < 17
+    np.testing.assert_allclose(_outline(slab), _outline(adjusted), atol=1e-6)
+
+
+def test_no_adjust_changes_nothing_where_the_pieces_fill_their_slabs(write):
+    text = "Lot --> extrude(6) split(x{}){{ 4 : A | {{ ~2 : B | 1 : C }}* }}\n"
+    lots = [rect(20, 10), rect(13, 7)]
+    same_records(run(write, text.format(""), lots), run(write, text.format(", noAdjust"), lots))
+
+
+def test_no_adjust_derives_a_batch_as_lot_by_lot(write):
+    text = "Lot --> split(x, noAdjust){ ~3 : A | 2 : B }*\nA --> split(z, noAdjust){ 3 : C | ~1 : D }\n"
+    lots = make_lots_polys("concave_L", "courtyard", "sliver", "rect_12x8")
+    same_records(run(write, text, lots), run(write, text, lots, chunk_size=1))
