@@ -168,17 +168,6 @@ def _extruded_along_normal(ctx: Context, cursor: Shapes, height, axis: np.ndarra
     return cursor.with_scope(origin, size, cursor.frame, cursor.geom)
 
 
-def _upright_axes(axes: np.ndarray) -> np.ndarray:
-    """Scope axes (n, 3, 3) with y the world's up and x the old x laid level (the old z where x is
-    upright), as CityEngine keeps "the x-axis direction as much as possible"."""
-    up = np.array([0.0, 1.0, 0.0])
-    x = axes[:, 0] - axes[:, 0, 1:2] * up
-    flat = np.linalg.norm(x, axis=1) < 1e-9
-    x[flat] = axes[flat, 2] - axes[flat, 2, 1:2] * up
-    x /= np.linalg.norm(x, axis=1, keepdims=True)
-    return np.stack([x, np.broadcast_to(up, x.shape), np.cross(x, up)], axis=1)
-
-
 def _extruded_upwards(ctx: Context, cursor: Shapes, height: np.ndarray, straight: bool) -> Shapes:
     """Faces that are not level extruded along the world's up axis into meshes in upright scopes:
     every vertex by ``height`` (``straight``) or to one level (flatTop)."""
@@ -190,7 +179,7 @@ def _extruded_upwards(ctx: Context, cursor: Shapes, height: np.ndarray, straight
     scaled = coords * np.stack([cursor.size[rows, PLANE_U[plane]], cursor.size[rows, PLANE_V[plane]]], 1)[
         vertex_shape]
     in_scope = plane_to_scope(scaled, plane[vertex_shape])
-    new_axes = _upright_axes(axes)
+    new_axes = _world_axis(axes, 1)  # y the world's up, x the old x laid level (or the old z)
     # a vertex in the upright scope, from the old origin: its scope point turned into the new axes
     bottom = np.einsum("vi,vij,vkj->vk", in_scope, axes[vertex_shape], new_axes[vertex_shape])
     if straight:
