@@ -36,7 +36,8 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from grammarc.backend.functions.files import found, pick, ragged_strings, roots, string_list
+from grammarc.backend.functions.files import found, pick, roots, string_list
+from grammarc.backend.functions.strings import string_arrays
 from grammarc.backend.functions.table import distinct, function, groups
 from grammarc.errors import AssetError
 from grammarc.ir.asset_names import resolve_asset
@@ -224,4 +225,4 @@ def asset_naming_info(call, args, env: Env):
 @function("assetNamingInfos")
 def asset_naming_infos(call, args, env: Env):
     texts = list(env.plan.strings.ids)
-    return ragged_strings(env, [args[0], args[1]], lambda key: naming(env, texts[key[0]], texts[key[1]]))
+    return string_arrays(env, lambda asset, selector: naming(env, texts[asset], texts[selector]), args[0], args[1])

@@ -17,7 +17,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from grammarc.backend.arrays import Arrays
+from grammarc.backend.functions.strings import string_arrays
 from grammarc.backend.functions.table import distinct, function, groups
 from grammarc.backend.random import uniform
 from grammarc.ir.asset_names import resolve_asset
@@ -82,23 +82,7 @@ def file_search(call, args, env: Env):
 @function("filesSearch")
 def files_search(call, args, env: Env):
     """``filesSearch(query)``: the matches as a ``str[]`` per shape (a row, as ``[a, b]`` is)."""
-    return ragged_strings(env, [args[0]], lambda key: found(env, key[0]))
-
-
-def ragged_strings(env: Env, keys: list, names_of: Callable[[tuple[int, ...]], tuple[str, ...]]) -> Arrays:
-    """Per shape the ``str[]`` (a row) of ``names_of(key)`` for its tuple of ``keys`` (scalars or (n,)
-    int ids), each distinct tuple's names interned once."""
-    n = len(env.shapes)
-    sizes = np.zeros(n, dtype=np.int64)
-    lists = []
-    for key, rows in groups(n, *keys):
-        lists.append((rows, np.array([env.plan.strings.intern(s) for s in names_of(key)], dtype=np.int32)))
-        sizes[rows] = len(lists[-1][1])
-    offsets = np.concatenate([[0], np.cumsum(sizes)]).astype(np.int64)
-    values = np.empty(offsets[-1], dtype=np.int32)
-    for rows, ids in lists:  # one scatter per distinct tuple, every shape of it at once
-        values[(offsets[:-1][rows, None] + np.arange(len(ids))).reshape(-1)] = np.tile(ids, len(rows))
-    return Arrays(values, offsets, sizes.copy())
+    return string_arrays(env, lambda query: found(env, query), args[0])
 
 
 @function("fileExists")

@@ -184,22 +184,35 @@ on_texts("len")(len)
 def split_string(call, args, env: Env) -> Arrays:
     """``splitString(text, delimiter)``: per shape the array of its pieces, split once per distinct
     (text, delimiter); the lots of the shapes whose delimiter is no regular expression fail."""
-    strings, known = env.plan.strings, texts(env)
-    pieces: list[list[int]] = []
+    known = texts(env)
 
-    def split_once(text: int, delimiter: int) -> int:
+    def split_once(text: int, delimiter: int) -> list[str] | None:
         try:
-            found = split(known[text], known[delimiter])
+            return split(known[text], known[delimiter])
         except re.error:
+            return None
+    return string_arrays(env, split_once, *args, failure=f"splitString: no regular expression at {call.span}")
+
+
+def string_arrays(env: Env, names_of: Callable, *args, failure: str = "") -> Arrays:
+    """Per shape the ``str[]`` (a row) ``names_of(*values)`` gives for its tuple of argument values, each
+    distinct tuple's names computed and interned once. Where ``names_of`` gives None the lots of those
+    shapes fail with ``failure``."""
+    strings = env.plan.strings
+    rows: list[list[int]] = []
+
+    def one(*values) -> int:
+        names = names_of(*values)
+        if names is None:
             return -1
-        pieces.append([strings.intern(piece) for piece in found])
-        return len(pieces) - 1
-    which = np.broadcast_to(np.asarray(distinct(split_once, *args), dtype=np.int64), (len(env.shapes),))
+        rows.append([strings.intern(name) for name in names])
+        return len(rows) - 1
+    which = np.broadcast_to(np.asarray(distinct(one, *args), dtype=np.int64), (len(env.shapes),))
     bad = which < 0
     if bad.any():
-        raise LotFailure(f"splitString: no regular expression at {call.span}", np.unique(env.shapes.lot[bad]))
-    sizes = np.array([len(p) for p in pieces], dtype=np.int64)
-    table = Arrays(np.array([i for p in pieces for i in p], dtype=np.int32),
+        raise LotFailure(failure, np.unique(env.shapes.lot[bad]))
+    sizes = np.array([len(r) for r in rows], dtype=np.int64)
+    table = Arrays(np.array([i for r in rows for i in r], dtype=np.int32),
                    np.concatenate([[0], np.cumsum(sizes)]).astype(np.int64), sizes)
     return table.take(which)
 
