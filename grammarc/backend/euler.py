@@ -7,8 +7,9 @@ that rotation and ``angles`` reads it back. The reference's ``convert`` example 
 ``r(-10, 70, 0)`` on a lot turned about the vertical, the scope's orientation in world is (-10, 70 plus
 the lot's turn, 0).
 
-``rotation`` is what grammarc's ``R`` applies: about x, then the new y, then the new z. It is the same
-rotation as ``orientation`` when one angle only is not 0, and the other order when more are.
+``rotation`` is what the paper's ``R`` applies: about x, then the new y, then the new z. It is the same
+rotation as ``orientation`` when one angle only is not 0, and the other order when more are; CityEngine's
+``r`` and ``rotateScope`` turn by ``orientation``.
 """
 
 from __future__ import annotations

@@ -375,12 +375,15 @@ class Scale:
 
 @dataclass(frozen=True, slots=True)
 class Rotate:
-    """Rotate the scope axes about its own x, then y, then z axis (degrees), around the origin, or around
-    the scope's centre when ``center`` (CityEngine ``r(scopeCenter, x, y, z)``)."""
+    """Rotate the scope axes by angles in degrees, around the origin, or around the scope's centre when
+    ``center`` (CityEngine ``r(scopeCenter, x, y, z)``): about its own x, then the new y, then the new z
+    (the paper's ``R``), or, when ``fixed``, about its x, then y, then z as they were (CityEngine's ``r``:
+    ``backend.euler``)."""
 
     angles: tuple[Expr, Expr, Expr] = child(Type.NUM, "an angle")
     span: Span = NO_SPAN
     center: bool = False
+    fixed: bool = False
 
 
 @dataclass(frozen=True, slots=True)

@@ -143,7 +143,7 @@ _OP_FORMATS = {
     ir.Empty: lambda op: "ε",
     ir.Translate: lambda op: f"T({_list(op.vector)})",
     ir.Scale: lambda op: f"S({', '.join(_size(s) for s in op.sizes)})",
-    ir.Rotate: lambda op: f"R({'scopeCenter, ' if op.center else ''}{_list(op.angles)})",
+    ir.Rotate: lambda op: f"{'r' if op.fixed else 'R'}({'scopeCenter, ' if op.center else ''}{_list(op.angles)})",
     ir.Transform: lambda op: f"{op.kind}({'rel' if op.relative else 'abs'}, {op.system}, {_list(op.values)})",
     ir.Push: lambda op: "[",
     ir.Pop: lambda op: "]",

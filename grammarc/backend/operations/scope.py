@@ -59,20 +59,22 @@ def scale(ctx: Context, cursor: Shapes, op: ir.Scale) -> Shapes:
 
 @operation(ir.Rotate, writes=("origin", "frame"), meshes=True)
 def rotate(ctx: Context, cursor: Shapes, op: ir.Rotate) -> Shapes:
-    """``R``/``r(x, y, z)`` about the scope's own axes around its origin; ``r(scopeCenter, x, y, z)``
-    turns the same way and moves the origin so that the scope's centre stays where it was."""
+    """``R`` about the scope's own turning axes, CityEngine's ``r(x, y, z)`` about its axes as they were
+    (``op.fixed``), around its origin; ``r(scopeCenter, x, y, z)`` turns the same way and moves the origin
+    so that the scope's centre stays where it was."""
     env = ctx.env(cursor)
     angles = [evaluate(e, env) for e in op.angles]
     frames = ctx.chunk.frames
+    turn = orientation if op.fixed else rotation
     if all(np.ndim(a) == 0 for a in angles):
         # One rotation for all: rotate each distinct frame once.
         unique, inverse = np.unique(cursor.frame, return_inverse=True)
-        matrix = rotation(*(np.full(1, a, dtype=np.float64) for a in angles))[0]
+        matrix = turn(*(np.full(1, a, dtype=np.float64) for a in angles))[0]
         new = frames.add(np.einsum("ij,fjk->fik", matrix, frames[unique]))
         frame = new[inverse.reshape(-1)]
     else:
         n = len(cursor)
-        matrices = rotation(*(np.broadcast_to(np.asarray(a, np.float64), (n,)) for a in angles))
+        matrices = turn(*(np.broadcast_to(np.asarray(a, np.float64), (n,)) for a in angles))
         frame = frames.add(np.einsum("nij,njk->nik", matrices, frames[cursor.frame]))
     origin = cursor.origin
     if op.center:
@@ -93,11 +95,8 @@ def transform(ctx: Context, cursor: Shapes, op: ir.Transform) -> Shapes:
     around its origin. In the scope system the scope's own angles are 0, so ``rel`` and ``abs`` agree there:
     a turn about the scope's axes in that order.
 
-    The reference calls ``r(x, y, z)`` the same as ``rotate(rel, pivot, x, y, z)``; grammarc's ``R`` turns
-    about the scope's own axes instead (x, then the new y, then the new z), which gives the same scope when
-    the scope's axes are the pivot's and one angle is not 0, and when the angles come in z, y, x order of
-    calls, but not in general (``r(10, 20, 0)`` reads back as ``scope.r`` (10.6, 19.7, 3.6), not (10, 20,
-    0)). The records of ``r`` stay as they were; ``rotate`` follows the reference.
+    The reference calls ``r(x, y, z)`` the same as ``rotate(rel, pivot, x, y, z)``; grammarc's ``r`` is
+    that where the scope's axes are its pivot's (``rotate`` above).
     """
     env = ctx.env(cursor)
     n = len(cursor)
@@ -207,10 +206,10 @@ def align_scope(ctx: Context, cursor: Shapes, op: ir.AlignScope) -> Shapes:
     n = len(cursor)
     if op.mode == "world":
         new_axes = np.broadcast_to(np.eye(3), (n, 3, 3))
-    elif op.mode == "rotate":
+    elif op.mode == "rotate":  # rotateScope: in xyz order as r
         env = ctx.env(cursor)
         angles = [np.broadcast_to(evaluate_array(e, env), (n,)) for e in op.angles]
-        new_axes = np.einsum("nij,njk->nik", rotation(*angles), axes)
+        new_axes = np.einsum("nij,njk->nik", orientation(*angles), axes)
     else:
         new_axes = _world_axis(axes, "xyz".index(op.mode))
     return reframed(ctx, cursor, new_axes, op.span)

@@ -105,7 +105,14 @@ class OperationLowering:
 
     def op_rotate(self, op, args, span):
         """``r(x, y, z)`` and ``r(scopeOrigin|scopeCenter, x, y, z)``: the same turn, around the scope's
-        origin or centre (the reference spells the default ``scopeOrgin`` too)."""
+        origin or centre (the reference spells the default ``scopeOrgin`` too).
+
+        The reference's ``r`` adds the angles to ``scope.r``, the scope's angles about its pivot's x, then
+        y, then z. A component split aligns the pivot with each component's scope (its default ``zUp``),
+        and an initial shape's scope is its pivot, so where ``r`` mostly runs the scope's angles are 0 and
+        the turn is about the scope's x, then y, then z as they were: ``fixed``. grammarc keeps no pivot
+        per shape, so a second ``r`` with several angles turns from the first one's axes instead of adding
+        to its angles."""
         center = False
         if len(args) == 4 and isinstance(args[0], ir.Name) \
                 and args[0].name in ("scopeOrigin", "scopeOrgin", "scopeCenter"):
@@ -114,7 +121,7 @@ class OperationLowering:
         if len(args) != 3:
             return self.unsupported(f"r with {len(args)} arguments", span,
                                     "r(x, y, z) and r(scopeOrigin|scopeCenter, x, y, z)")
-        return ir.Rotate(tuple(self.expr(a) for a in args), span, center=center)
+        return ir.Rotate(tuple(self.expr(a) for a in args), span, center=center, fixed=True)
 
     def op_transform(self, op, args, span):
         """``translate|rotate(rel|abs, scope|pivot|object|world, x, y, z)``."""

@@ -237,6 +237,23 @@ def test_rotate_sets_or_adds_the_scopes_angles_in_a_system(write):
     np.testing.assert_allclose(xform("rotate(rel, scope, 0, 0, 45)"), xform("r(0, 0, 45)"), atol=1e-9)
 
 
+def test_r_adds_its_angles_to_a_scope_aligned_with_its_pivot(write):
+    """CityEngine's ``r`` adds its angles to ``scope.r`` (about x, then y, then z of the pivot): on a lot,
+    whose scope is its pivot, r(10, 20, 30) reads back as (10, 20, 30) and is rotate(rel, pivot, ...);
+    turning about the scope's own turning axes instead would read (10.6, 19.7, 3.6) for r(10, 20, 0)."""
+    lot = [rotated_rectangle()]
+    t = totals(run(write, 'Lot --> r(10, 20, 30) report("rx", scope.rx) report("ry", scope.ry) '
+                          'report("rz", scope.rz) X\n', lot))
+    assert (t["rx_sum"], t["ry_sum"], t["rz_sum"]) == pytest.approx((10, 20, 30))
+
+    def xform(ops):
+        return run(write, f"Lot --> extrude(4) {ops} X\n", lot)["xform"][0].astype(float)
+
+    np.testing.assert_allclose(xform("r(10, 20, 0)"), xform("rotate(rel, pivot, 10, 20, 0)"), atol=1e-9)
+    # in xyz order about the axes as they were: the z turn comes last, about the old z
+    np.testing.assert_allclose(xform("r(10, 20, 30)"), xform("r(0, 0, 30) r(0, 20, 0) r(10, 0, 0)"), atol=1e-9)
+
+
 
 def test_set_of_a_scope_field_keeps_the_other_two(write):
     report = "".join(f'report("{f}", scope.{f}) ' for f in ("tx", "ty", "tz", "sx", "sy", "sz", "rx", "ry", "rz"))
