@@ -113,7 +113,7 @@ def make_plan(grammar: Grammar, *, load_asset: Callable = load_asset) -> Plan:
     # CityEngine trims inserted geometry at the planes a comp(f) leaves between neighbouring faces
     trims = list(TRIM_SLOTS) if module.dialect == "cityengine" and any(
         isinstance(op, ir.CompFaces) and op.kind == "f" for op in ops) and any(
-        isinstance(op, ir.UseAsset) for op in ops) else []
+        isinstance(op, (ir.UseAsset, ir.Trim)) for op in ops) else []
     occlusion = {symbol.id: [e for rule in symbol.rules for e in all_exprs(rule) if isinstance(e, ir.Occlusion)]
                  for symbol in symbols}
     occlusion = {k: v for k, v in occlusion.items() if v}

@@ -57,7 +57,7 @@ def emit_instances(ctx: Context, shapes: Shapes, asset: int, symbol: int, mirror
     if mirrored & Z_UP:  # the asset turns in its own box, before the mirror in the scope's
         xform = z_up(xform)
     if ctx.plan.trim_slot is not None:
-        planes = _trim_planes(ctx.plan, shapes)
+        planes = trim_planes(ctx.plan, shapes)
         cut = boxes_crossing(planes, xform.astype(np.float64), TOL.zero)
         mesh = ctx.asset_mesh(asset) if cut.any() else None
         if mesh is not None:
@@ -76,7 +76,7 @@ def z_up(xform: np.ndarray) -> np.ndarray:
     return turned
 
 
-def _trim_planes(plan, shapes: Shapes) -> np.ndarray:
+def trim_planes(plan, shapes: Shapes) -> np.ndarray:
     """The shapes' trim planes (n, 8), NaN where there are none or ``set(trim.vertical, false)``."""
     slot = plan.trim_slot
     planes = np.stack(shapes.dynamic[slot:slot + 8], axis=1)

@@ -7,7 +7,8 @@ neighbours in a mitre. Horizontal trim planes (CityEngine's ``trim.horizontal``,
 made. CityEngine measures the 40 degrees from the x-z plane of the pivot; grammarc measures them from the
 split shape's scope, which is the same for the solids of a footprint (y up) and, as PRT does, trims a
 pipe extruded sideways from a wall (candler's VerticalPipes) at its four corners. ``side_face_planes`` finds the planes of many faces at once; ``trim_triangles`` cuts the triangles
-of many placed assets by them (numba).
+of many placed assets by them (numba); ``plane_coordinates`` gives each plane a frame in which the
+``trim()`` operation cuts a shape's own geometry as a split cuts a slab (``backend.operations.trims``).
 """
 
 from __future__ import annotations
@@ -59,6 +60,16 @@ def side_face_planes(axes: np.ndarray, origin: np.ndarray, size: np.ndarray, par
         out[rows, 4 * which: 4 * which + 3] = normal
         out[rows, 4 * which + 3] = -np.einsum("ij,ij->i", normal, corner[rows])
     return out
+
+
+def plane_coordinates(normal: np.ndarray) -> np.ndarray:
+    """Orthonormal right-handed frames (k, 3, 3) whose first row is each unit ``normal`` (k, 3): in them a
+    trim plane is a plane across the first axis, which the slab cuts of ``meshes.clip_slabs`` take."""
+    # the world axis least along the normal completes it
+    other = np.eye(3)[np.argmin(np.abs(normal), axis=1)]
+    second = np.cross(normal, other)
+    second /= np.linalg.norm(second, axis=1, keepdims=True)
+    return np.stack([normal, second, np.cross(normal, second)], axis=1)
 
 
 @njit(cache=True, nogil=True)

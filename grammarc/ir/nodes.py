@@ -827,10 +827,26 @@ class Primitive:
     span: Span = NO_SPAN
 
 
+@dataclass(frozen=True, slots=True)
+class Trim:
+    """CityEngine ``trim()``: the shape's geometry cut by its trim planes (those a ``comp(f)`` left between
+    neighbouring faces, ``geometry.trim``), keeping the side its face is on and closing the cuts."""
+
+    span: Span = NO_SPAN
+
+
+@dataclass(frozen=True, slots=True)
+class SplitArea(GroupSplit):
+    """CityEngine ``splitArea(axis){ area: A | 'rel: B | ~float: C | { ... }* }[*]``: a ``GroupSplit``
+    whose sizes are areas of the geometry, each part cut off by a plane across ``axis`` where the
+    geometry before it has that area."""
+
+
 Op = (Symbol | Empty | Translate | Scale | Rotate | Push | Pop | Insert | Split | Repeat | Comp | Extrude
       | Center | UseAsset | Case | Stochastic | SetAttr | Report | NotApplied | GroupSplit | CompFaces
       | AlignScope | Mirror | Offset | SetColor | Setback | Roof | InnerRectangle | Convexify
-      | CleanupGeometry | DeleteHoles | Snap | Label | Transform | Scatter | AlignToGeometry | Primitive)
+      | CleanupGeometry | DeleteHoles | Snap | Label | Transform | Scatter | AlignToGeometry | Primitive
+      | Trim | SplitArea)
 Body = tuple[Op, ...]
 
 

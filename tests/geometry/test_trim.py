@@ -6,7 +6,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from grammarc.geometry.trim import side_face_planes, trim_triangles
+from grammarc.geometry.trim import plane_coordinates, side_face_planes, trim_triangles
 from grammarc.model.assets import builtin_mesh
 
 UP = np.tile([0.0, 1.0, 0.0], (4, 1))  # the split solid's scope y: world up
@@ -72,3 +72,11 @@ def test_a_ledge_past_the_corner_is_cut_along_the_mitre():
     area = sum(np.linalg.norm(np.cross(r, np.roll(r, -1, axis=0)).sum(axis=0)) / 2 for r in top)
     assert area == pytest.approx((10 + 12) / 2 * 1.0)
     assert (owner == 0).all()
+
+
+def test_plane_coordinates_are_right_handed_frames_on_the_normal():
+    normal = np.array([[1.0, 0, 0], [0, 0, -1.0], [np.sqrt(0.5), np.sqrt(0.5), 0]])
+    frames = plane_coordinates(normal)
+    assert frames[:, 0] == pytest.approx(normal)
+    assert np.einsum("nij,nkj->nik", frames, frames) == pytest.approx(np.broadcast_to(np.eye(3), (3, 3, 3)))
+    assert np.linalg.det(frames) == pytest.approx(np.ones(3))

@@ -12,7 +12,7 @@ the name) is ``unknown operation NAME`` (``check_calls``).
 
 from __future__ import annotations
 
-from dataclasses import replace
+from dataclasses import fields, replace
 from functools import cache
 
 from grammarc.diagnostics import Diagnostics, Typos, suggest
@@ -282,6 +282,13 @@ class OperationLowering:
         return ir.GroupSplit("xyz".index(args[0].name), tuple(sizes), tuple(groups), tuple(bodies), repeat,
                              span, self.site(), adjust)
 
+    def op_split_area(self, op, args, parts, span, repeat=False):
+        """``splitArea(axis[, adjust|noAdjust]){ area : A | ... }[*]``: a split's parts, their sizes areas."""
+        split = self.op_split(op, args, parts, span, repeat)
+        if not isinstance(split, ir.GroupSplit):
+            return split
+        return ir.SplitArea(*(getattr(split, f.name) for f in fields(split)))
+
     def size_of(self, part: Part) -> ir.Size:
         if part.merged:
             self.unsupported("`=` in split", part.span)
@@ -448,11 +455,13 @@ OPERATIONS = {
     "roofGable": OperationLowering.op_roof,
     "roofShed": OperationLowering.op_roof,
     "roofPyramid": OperationLowering.op_roof,
+    "trim": direct(ir.Trim),
 }
-#: Operations with parts ``{ ... }``: name -> handler(lowering, op, args, parts, span); ``split`` alone also
-#: repeats (``{ ... }*``).
+#: Operations with parts ``{ ... }``: name -> handler(lowering, op, args, parts, span); those of ``REPEATING``
+#: also repeat (``{ ... }*``), with ``repeat=True``.
 PART_OPERATIONS = {
     "split": OperationLowering.op_split,
+    "splitArea": OperationLowering.op_split_area,
     "comp": OperationLowering.op_comp,
     "setback": OperationLowering.op_setback,
     "shapeL": OperationLowering.op_setback,
@@ -460,6 +469,7 @@ PART_OPERATIONS = {
     "shapeO": OperationLowering.op_setback,
     "innerRectangle": OperationLowering.op_inner_rectangle,
 }
+REPEATING = frozenset({"split", "splitArea"})
 #: Operations with a body ``{ operations }``: name -> handler(lowering, op, args, body, span).
 BODY_OPERATIONS = {
     "scatter": OperationLowering.op_scatter,
@@ -471,7 +481,7 @@ ROOF_ARGUMENTS = {"roofHip": ("overhang", "even"), "roofGable": ("overhangX", "o
                    "roofShed": ("index",), "roofPyramid": ()}
 #: Operations CityEngine also takes without their parentheses (other bare names are rules).
 BARE_OPS = frozenset({"NIL", "primitiveCube", "convexify", "alignScopeToAxes", "primitiveQuad", "primitiveDisk",
-                      "primitiveCylinder", "primitiveSphere", "primitiveCone"})
+                      "primitiveCylinder", "primitiveSphere", "primitiveCone", "trim"})
 #: Part operations whose parts are sizes or faces: without parts, `unsupported: split` (the others say
 #: that their selector parts are missing).
 SPLIT_OPS = frozenset({"split", "comp"})
@@ -502,9 +512,8 @@ NOT_APPLIED = frozenset({
 #: CGA reference, so that any other name called with parts, or a typo of one of them, is unknown.
 UNSUPPORTED_OPS = frozenset({
     "innerPolygon",
-    "trim",
     "mirrorScope",
-    "insertAlongUV", "footprint", "tileUV", "splitArea", "inline", "resetGeometry", "taper",
+    "insertAlongUV", "footprint", "tileUV", "inline", "resetGeometry", "taper",
     "reduceGeometry", "rectify", "semiPolygon",
     "alignScopeToGeometryBBox", "roofRidge", "modify",
     "setbackPerEdge", "setbackToArea", "splitAndSetbackPerimeter",
