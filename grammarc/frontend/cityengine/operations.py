@@ -154,11 +154,16 @@ class OperationLowering:
                                 "alignScopeToAxes(), alignScopeToAxes(world.xyz) and alignScopeToAxes(x|y|z)")
 
     def op_align_geometry(self, op, args, span):
+        """``alignScopeToGeometry(upAxis, face[, edge])``. Older rule files write the face ``auto``, which
+        the reference no longer lists: grammarc reads it as ``largest``, and without an edge as the
+        largest face's ``longest`` edge, the scope a footprint's or a roof floor's main direction gives."""
         up = _selector(args[0]) if args else None
         if len(args) not in (2, 3) or up not in ("yUp", "zUp"):
             return self.unsupported("alignScopeToGeometry with these arguments", span,
                                     "alignScopeToGeometry(yUp|zUp, face[, edge])")
         face, edge = _selector(args[1]), _selector(args[2]) if len(args) == 3 else None
+        if face == "auto":
+            face, edge = "largest", edge or ("longest" if len(args) == 2 else None)
         if face is not None and face not in ALIGN_FACES:
             return self.unsupported(f"alignScopeToGeometry with face {face}", getattr(args[1], "span", span))
         if edge is not None and edge not in ALIGN_EDGES:

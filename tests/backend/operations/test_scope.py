@@ -392,6 +392,17 @@ def test_align_to_geometry_of_a_rotated_lot_by_edge_index_and_longest(write):
         assert max(np.linalg.norm(world - p, axis=1).min() for p in corners) < 1e-4
 
 
+def test_align_to_geometry_auto_takes_the_largest_faces_longest_edge(write):
+    """Older rule files' ``alignScopeToGeometry(yUp, auto)``: a 4 x 10 lot whose first edge is a short
+    side gets its scope x along a long side, as ``largest, longest`` gives it; a box its y across its
+    largest face."""
+    for body, lot, size in (("", rect(4, 10), (10, 0, 4)), ("extrude(2) ", rect(4, 10), (10, 2, 4))):
+        r = run(write, f'Lot --> {body}alignScopeToGeometry(yUp, auto) report("sx", scope.sx) '
+                       'report("sy", scope.sy) report("sz", scope.sz) X\n', [lot])
+        t = totals(r)
+        assert (t["sx_sum"], t["sy_sum"], t["sz_sum"]) == pytest.approx(size)
+
+
 def test_align_to_geometry_of_an_l_prism_lowest_face_longest_edge(write):
     """The L's lowest face is its bottom (its sides reach as low, their middles do not); the bottom's ring
     runs backwards, so its longest edge runs along world -x; y is the bottom's normal (down). The prism,
