@@ -842,11 +842,20 @@ class SplitArea(GroupSplit):
     geometry before it has that area."""
 
 
+@dataclass(frozen=True, slots=True)
+class ReduceGeometry:
+    """CityEngine ``reduceGeometry(tolerance)``: the share ``tolerance`` (0 to 1) of the vertices of the
+    shape's faces removed where that changes them least (``geometry.reduce``)."""
+
+    tolerance: Expr = child(Type.NUM, "a tolerance")
+    span: Span = NO_SPAN
+
+
 Op = (Symbol | Empty | Translate | Scale | Rotate | Push | Pop | Insert | Split | Repeat | Comp | Extrude
       | Center | UseAsset | Case | Stochastic | SetAttr | Report | NotApplied | GroupSplit | CompFaces
       | AlignScope | Mirror | Offset | SetColor | Setback | Roof | InnerRectangle | Convexify
       | CleanupGeometry | DeleteHoles | Snap | Label | Transform | Scatter | AlignToGeometry | Primitive
-      | Trim | SplitArea)
+      | Trim | SplitArea | ReduceGeometry)
 Body = tuple[Op, ...]
 
 

@@ -461,6 +461,7 @@ OPERATIONS = {
     "roofShed": OperationLowering.op_roof,
     "roofPyramid": OperationLowering.op_roof,
     "trim": direct(ir.Trim),
+    "reduceGeometry": direct(ir.ReduceGeometry),
 }
 #: Operations with parts ``{ ... }``: name -> handler(lowering, op, args, parts, span); those of ``REPEATING``
 #: also repeat (``{ ... }*``), with ``repeat=True``.
@@ -519,7 +520,7 @@ UNSUPPORTED_OPS = frozenset({
     "innerPolygon",
     "mirrorScope",
     "insertAlongUV", "footprint", "tileUV", "inline", "resetGeometry", "taper",
-    "reduceGeometry", "rectify", "semiPolygon",
+    "rectify", "semiPolygon",
     "alignScopeToGeometryBBox", "roofRidge", "modify",
     "setbackPerEdge", "setbackToArea", "splitAndSetbackPerimeter",
     "tag", "deleteTags", "setTagsFromEdgeAttrs", "union", "subtract", "intersect",

@@ -104,6 +104,7 @@ from .lowered import VERSION, assert_unsupported_at, body_of, compile_ir, errors
     ("cleanupGeometry(faces, h / 10) A", "cleanupGeometry(faces, (@h / 10)) A"),
     ("deleteHoles() A", "deleteHoles() A"),
     ("trim() A", "trim() A"),
+    ("reduceGeometry(0.8) A", "reduceGeometry(0.8) A"),
     ("trim A", "trim() A"),
     ("splitArea(x){ '0.25 : A | ~1 : B }", "splitArea(x){ 0.25r: A | ~1: B }"),
     ("splitArea(z, noAdjust){ 10 : A }*", "splitArea(z, noAdjust){ 10: A }*"),
