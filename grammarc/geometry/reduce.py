@@ -4,7 +4,9 @@ The reference removes the share ``tolerance`` of the geometry's vertices by edge
 its look the least. On a polygon's rings an edge collapse that keeps one end is the removal of a vertex,
 and the removal that changes the face least is the vertex whose triangle with its neighbours is the
 smallest (Visvalingam and Whyatt's order): each ring loses ``floor(tolerance * n)`` of its ``n`` vertices
-that way, one at a time with its neighbours' triangles measured again, and keeps three at least.
+that way, one at a time with its neighbours' triangles measured again, and keeps three at least. A
+triangle or a quadrilateral is left whole, as a scope's rectangle is: taking a corner off a rectangle
+makes another shape, not a simpler one.
 ``reduce_rings`` does it for all the rings of a batch (numba).
 """
 
@@ -22,6 +24,8 @@ def reduce_rings(coords, ring_offsets, fraction):
     for r in range(len(ring_offsets) - 1):
         r0, r1 = ring_offsets[r], ring_offsets[r + 1]
         n = r1 - r0
+        if n <= 4:
+            continue
         drop = min(int(np.floor(fraction[r] * n + 1e-9)), n - 3)
         if drop <= 0:
             continue

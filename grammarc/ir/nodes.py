@@ -851,11 +851,20 @@ class ReduceGeometry:
     span: Span = NO_SPAN
 
 
+@dataclass(frozen=True, slots=True)
+class MirrorScope:
+    """CityEngine ``mirrorScope(x, y, z)``: the scope's axes whose flag is true reversed, its origin at
+    their far ends, the geometry unchanged."""
+
+    axes: tuple[Expr, Expr, Expr] = child(Type.BOOL, "a mirror flag")
+    span: Span = NO_SPAN
+
+
 Op = (Symbol | Empty | Translate | Scale | Rotate | Push | Pop | Insert | Split | Repeat | Comp | Extrude
       | Center | UseAsset | Case | Stochastic | SetAttr | Report | NotApplied | GroupSplit | CompFaces
       | AlignScope | Mirror | Offset | SetColor | Setback | Roof | InnerRectangle | Convexify
       | CleanupGeometry | DeleteHoles | Snap | Label | Transform | Scatter | AlignToGeometry | Primitive
-      | Trim | SplitArea | ReduceGeometry)
+      | Trim | SplitArea | ReduceGeometry | MirrorScope)
 Body = tuple[Op, ...]
 
 

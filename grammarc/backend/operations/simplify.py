@@ -1,8 +1,8 @@
 """CityEngine's ``reduceGeometry(tolerance)``: polygons with fewer vertices (``geometry.reduce``).
 
 A polygon or a prism of the polygon store loses the share ``tolerance`` of its rings' vertices, the
-scope unchanged. A scope box or rectangle is left as it is (collapsing a rectangle's edges would make it
-another shape, not a simpler one); a roof or another mesh, and an inserted asset, are refused: their
+scope unchanged. A scope box or rectangle is left as it is, as a ring of four vertices is (collapsing a
+rectangle's edges would make it another shape, not a simpler one); a roof or another mesh, and an inserted asset, are refused: their
 faces share edges that removing vertices face by face would tear open. Reads: the scope's ``size``,
 ``geom`` and what the tolerance reads. Writes: ``geom``.
 """

@@ -462,6 +462,7 @@ OPERATIONS = {
     "roofPyramid": OperationLowering.op_roof,
     "trim": direct(ir.Trim),
     "reduceGeometry": direct(ir.ReduceGeometry),
+    "mirrorScope": direct(ir.MirrorScope),
 }
 #: Operations with parts ``{ ... }``: name -> handler(lowering, op, args, parts, span); those of ``REPEATING``
 #: also repeat (``{ ... }*``), with ``repeat=True``.
@@ -518,7 +519,6 @@ NOT_APPLIED = frozenset({
 #: CGA reference, so that any other name called with parts, or a typo of one of them, is unknown.
 UNSUPPORTED_OPS = frozenset({
     "innerPolygon",
-    "mirrorScope",
     "insertAlongUV", "footprint", "tileUV", "inline", "resetGeometry", "taper",
     "rectify", "semiPolygon",
     "alignScopeToGeometryBBox", "roofRidge", "modify",
