@@ -321,7 +321,7 @@ Expr = (Num | Str | Bool | Name | Param | AttrRef | ScopeRef | Unary | Binary | 
         | Occlusion | ArrayLit | Range | Index)
 
 #: CityEngine shape attributes that ``set`` changes for a shape and its successors (not declared attrs).
-SHAPE_ATTRIBUTES: dict[str, Type] = {"trim.vertical": Type.BOOL}
+SHAPE_ATTRIBUTES: dict[str, Type] = {"trim.vertical": Type.BOOL, "trim.horizontal": Type.BOOL}
 
 # ------------------------------------------------------------------------------------------------ operations
 

@@ -1,7 +1,7 @@
 """CityEngine's ``trim()``: the shape's own geometry cut by its trim planes.
 
-A ``comp(f)`` leaves each side face a plane at each edge it shares with a steep neighbour
-(``geometry.trim``); inserts are cut by them as they are placed (``backend.terminals``), and ``trim()``
+A ``comp(f)`` leaves each side face a plane at each edge it shares with a steep neighbour, and, where the
+grammar turns them on, each face one at each shallow edge it shares (``geometry.trim``); inserts are cut by them as they are placed (``backend.terminals``), and ``trim()``
 cuts the shape's geometry itself, so that a wall or a cornice extruded from a face and stretched past its
 corners meets its neighbours in a mitre. Each plane is a plane across the first axis of a frame of its
 own (``geometry.trim.plane_coordinates``): the shape's faces go into that frame, are cut to the slab in
@@ -36,7 +36,7 @@ def trim(ctx: Context, cursor: Shapes, op: ir.Trim) -> Shapes:
     chunk = ctx.chunk
     planes = trim_planes(plan, cursor)
     planes[cursor.geom < -1] = np.nan  # an asset is trimmed where it is placed
-    rows = np.flatnonzero(~np.isnan(planes[:, [0, 4]]).all(axis=1))
+    rows = np.flatnonzero(~np.isnan(planes[:, 0::4]).all(axis=1))
     if not len(rows):
         return cursor
     shapes = cursor.take(rows)
@@ -45,7 +45,7 @@ def trim(ctx: Context, cursor: Shapes, op: ir.Trim) -> Shapes:
     mesh_offsets = faces.shape_offsets
     axes = chunk.frames[shapes.frame]
     cut_any = np.zeros(len(rows), dtype=bool)
-    for which in range(2):
+    for which in range(planes.shape[1] // 4):
         plane = planes[rows, 4 * which:4 * which + 4]
         present = ~np.isnan(plane[:, 0])
         normal = np.where(present[:, None], plane[:, :3], (1.0, 0.0, 0.0))

@@ -235,12 +235,6 @@ class OperationLowering:
             return self.set_scope(target, self.expr(args[1]), span)
         if isinstance(target, ir.Name) and target.name in ir.SHAPE_ATTRIBUTES:
             return ir.SetAttr(target.name, self.expr(args[1]), span)
-        if isinstance(target, ir.Name) and target.name == "trim.horizontal":
-            value = self.expr(args[1])
-            if isinstance(value, ir.Bool) and not value.value:
-                return ir.NotApplied("set(trim.horizontal)", span)  # CityEngine's default
-            return self.unsupported("set(trim.horizontal, ...) other than false", span,
-                                    "horizontal trim planes are not made")
         if isinstance(target, ir.Name) and target.name.startswith("material."):
             return ir.NotApplied(f"set({target.name})", span)
         if not isinstance(target, ir.Name):

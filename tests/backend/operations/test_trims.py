@@ -55,3 +55,22 @@ def test_a_trimmed_solid_splits_and_splits_into_faces(write):
     mitre = 2 * 10 * np.sqrt(2)
     assert faces["a_n"] == 24
     assert faces["a_sum"] == pytest.approx(2 * sum(10 * (w + w + 2) + 2 * (w + 1) + mitre for w in (12, 8)))
+
+
+def test_horizontal_trim_planes_mitre_a_ledge_at_the_top_and_a_roof_face_at_its_ridge(write):
+    """``set(trim.horizontal, true)``: a ledge 1.5 high at the top 1 of a facade, 0.5 deep, is cut by the
+    plane bisecting the wall and the flat roof, y <= 10 + depth: 0.625 of its 1.2 widths without the
+    corners' mitres, 0.625 width + 1/3 with them (the facades are 12, 12, 8 and 8 wide). A hip roof's face,
+    enlarged and extruded 0.5 as in the reference's example, reaches past the ridge (4 m on an 8 m wide lot)
+    only up to the vertical mitre there, 0.5 sqrt(2) above it; without horizontal planes it runs on."""
+    text = ("Lot --> extrude(10) {set}comp(f){{ side : Facade | top : T. }}\n"
+            "Facade --> split(y){{ ~1 : NIL | 1 : Ledge }}\n"
+            "Ledge --> s('1.2, '1.5, 0.5) center(x) trim() report(\"v\", geometry.volume) X.\n")
+    for switch, volume in [("", 1.5 * 21), ("set(trim.horizontal, true) set(trim.vertical, false) ", 0.625 * 48),
+                           ("set(trim.horizontal, true) ", 0.625 * 40 + 4 / 3)]:
+        assert totals(run(write, text.format(set=switch), [rect(12, 8)]))["v_sum"] == pytest.approx(volume)
+    roof = ("Lot --> roofHip(45) {set}comp(f){{ 1 : Face }}\n"
+            "Face --> s('2, '2, '1) center(x) extrude(0.5) trim() X.\n")
+    heights = [np.concatenate([r for f in mesh_faces(run(write, roof.format(set=s), [rect(12, 8)])) for r in f])[:, 1].max()
+               for s in ("", "set(trim.horizontal, true) ")]
+    assert heights[0] > 6 and heights[1] == pytest.approx(4 + 0.5 * np.sqrt(2), abs=1e-5)
