@@ -24,7 +24,15 @@ from grammarc.backend.plan import Plan
 from grammarc.backend.random import lot_keys
 from grammarc.backend.report_rows import aggregate_chunk
 from grammarc.backend.shapes import Shapes
-from grammarc.backend.slots import ANCESTORS, COLOR_SLOT, TRIM_SLOTS, TRIM_SWITCH, WHITE_RGB
+from grammarc.backend.slots import (
+    ANCESTORS,
+    COLOR_SLOT,
+    HORIZONTAL_SLOTS,
+    HORIZONTAL_SWITCH,
+    TRIM_SLOTS,
+    TRIM_SWITCH,
+    WHITE_RGB,
+)
 from grammarc.constants import Limits
 from grammarc.geometry.footprint import footprint_polygons, lot_scopes
 from grammarc.geometry.polygons import PolygonStore
@@ -105,10 +113,12 @@ def initial_dynamic(plan: Plan, name: str, chunk: Chunk, shapes: Shapes) -> np.n
         return np.ones(n)
     if name in ("split.index", "comp.index"):
         return np.zeros(n)
-    if name in TRIM_SLOTS or name in ANCESTORS:
+    if name in TRIM_SLOTS or name in HORIZONTAL_SLOTS or name in ANCESTORS:
         return np.full(n, np.nan)
     if name == TRIM_SWITCH:
         return np.ones(n)
+    if name == HORIZONTAL_SWITCH:
+        return np.zeros(n)
     return chunk.attrs[name][shapes.lot]
 
 

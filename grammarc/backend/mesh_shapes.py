@@ -162,19 +162,28 @@ def clip_meshes(chunk: Chunk, shapes: Shapes, parent: np.ndarray, axis: int, pos
     boxes' low corners and extents (m, 3) in the parents' scopes, and which children have any mesh
     left (m,)."""
     parents, child_mesh = np.unique(parent, return_inverse=True)  # each parent's mesh gathered once
-    child_mesh = child_mesh.reshape(-1)
     verts, ring_offsets, face_offsets, mesh_offsets, _ = face_vertices(
         chunk.meshes, shapes.geom[parents] - MESH_BASE, shapes.size[parents])
-    hull = is_convex(verts, ring_offsets, face_offsets, mesh_offsets)[child_mesh]
-    hi = pos + length
-    cut = clip_slabs(verts, ring_offsets, face_offsets, mesh_offsets, child_mesh, axis, pos, hi, hull, TOL.zero)
-    if not hull.all():
-        ends, cap = plane_segments(verts, ring_offsets, face_offsets, mesh_offsets, child_mesh,
-                                   np.flatnonzero(~hull), axis, pos, hi)
-        parts, which = section_caps(ends, cap, axis)
-        cut = append_caps(*cut, parts, which, axis, pos, hi)
+    cut = cut_to_slabs(verts, ring_offsets, face_offsets, mesh_offsets, child_mesh.reshape(-1), axis, pos,
+                       pos + length)
     geom, low, extent = store_fitted(chunk, *cut)
     return geom, low, extent, np.diff(cut[3]) > 0
+
+
+def cut_to_slabs(verts, ring_offsets, face_offsets, mesh_offsets, child_mesh, axis: int, lo, hi):
+    """Meshes (ragged, in scope units) cut to slabs ``lo <= coordinate[axis] <= hi`` (m,), the mesh
+    ``child_mesh`` (m,) for each, and closed: a convex mesh by the hull of its crossings
+    (``meshes.clip_slabs``), any other by its sections (``geometry.sections``). Returns the cut meshes as
+    ragged arrays (verts, ring_offsets, face_offsets, mesh_offsets (m+1,)), an empty one where a slab
+    misses its mesh."""
+    hull = is_convex(verts, ring_offsets, face_offsets, mesh_offsets)[child_mesh]
+    cut = clip_slabs(verts, ring_offsets, face_offsets, mesh_offsets, child_mesh, axis, lo, hi, hull, TOL.zero)
+    if not hull.all():
+        ends, cap = plane_segments(verts, ring_offsets, face_offsets, mesh_offsets, child_mesh,
+                                   np.flatnonzero(~hull), axis, lo, hi)
+        parts, which = section_caps(ends, cap, axis)
+        cut = append_caps(*cut, parts, which, axis, lo, hi)
+    return cut
 
 
 def reframe_meshes(chunk: Chunk, shapes: Shapes, new_axes: np.ndarray) -> Shapes:

@@ -9,7 +9,14 @@ from collections.abc import Callable
 from dataclasses import dataclass, field, replace
 
 from grammarc.backend.leaf_parts import leaf_inserts
-from grammarc.backend.slots import ANCESTORS, COLOR_SLOT, TRIM_SLOTS, TRIM_SWITCH
+from grammarc.backend.slots import (
+    ANCESTORS,
+    COLOR_SLOT,
+    HORIZONTAL_SLOTS,
+    HORIZONTAL_SWITCH,
+    TRIM_SLOTS,
+    TRIM_SWITCH,
+)
 from grammarc.ir import nodes as ir
 from grammarc.ir.traverse import all_exprs, iter_ops
 from grammarc.model.assets import load_asset
@@ -78,6 +85,9 @@ class Plan:
     color_slot: int | None = None
     trim_slot: int | None = None
     trim_switch: int | None = None
+    #: the first of the horizontal trim planes and ``trim.horizontal``, when the grammar turns them on.
+    horizontal_slot: int | None = None
+    horizontal_switch: int | None = None
     #: Whether shapes carry their occluding ancestors (``backend.occlusion``): the grammar asks occlusion
     #: queries or labels shapes.
     occluders: bool = False
@@ -113,7 +123,11 @@ def make_plan(grammar: Grammar, *, load_asset: Callable = load_asset) -> Plan:
     # CityEngine trims inserted geometry at the planes a comp(f) leaves between neighbouring faces
     trims = list(TRIM_SLOTS) if module.dialect == "cityengine" and any(
         isinstance(op, ir.CompFaces) and op.kind == "f" for op in ops) and any(
-        isinstance(op, ir.UseAsset) for op in ops) else []
+        isinstance(op, (ir.UseAsset, ir.Trim)) for op in ops) else []
+    # horizontal planes only where the grammar may turn them on (CityEngine's default is off)
+    trims += list(HORIZONTAL_SLOTS) if trims and any(
+        isinstance(op, ir.SetAttr) and op.name == HORIZONTAL_SWITCH
+        and not (isinstance(op.value, ir.Bool) and not op.value.value) for op in ops) else []
     occlusion = {symbol.id: [e for rule in symbol.rules for e in all_exprs(rule) if isinstance(e, ir.Occlusion)]
                  for symbol in symbols}
     occlusion = {k: v for k, v in occlusion.items() if v}
@@ -138,5 +152,6 @@ def make_plan(grammar: Grammar, *, load_asset: Callable = load_asset) -> Plan:
                                                         for op in iter_ops(rule))),
         color_slot=dynamic.get(COLOR_SLOT), trim_slot=trim_slot,
         trim_switch=dynamic.get(TRIM_SWITCH) if trim_slot is not None else None,
+        horizontal_slot=dynamic.get(HORIZONTAL_SLOTS[0]), horizontal_switch=dynamic.get(HORIZONTAL_SWITCH),
         occluders=ANCESTORS[0] in dynamic, load_asset=load_asset)
     return replace(plan, leaf_inserts=leaf_inserts(plan))

@@ -8,6 +8,8 @@ grammar needs them (``plan``, ``leaf_parts``, ``occlusion``), so that none of th
 
 from __future__ import annotations
 
+from grammarc.geometry.trim import HORIZONTAL_PLANES
+
 #: The shape's colour set by ``color()``: 0xRRGGBB as a float, white to begin with.
 COLOR_SLOT = "#color"
 WHITE_RGB = float(0xFFFFFF)
@@ -17,6 +19,10 @@ WHITE_RGB = float(0xFFFFFF)
 TRIM_SLOTS = tuple(f"trim.{k}" for k in range(8))
 #: ``set(trim.vertical, false)`` turns the planes off for a shape and its successors (1: on, 0: off).
 TRIM_SWITCH = "trim.vertical"
+#: A shape's horizontal trim planes (``geometry.trim.shallow_edge_planes``), made where the grammar turns
+#: them on with ``set(trim.horizontal, ...)`` (0: off, CityEngine's default; 1: on).
+HORIZONTAL_SLOTS = tuple(f"trim.h{k}" for k in range(4 * HORIZONTAL_PLANES))
+HORIZONTAL_SWITCH = "trim.horizontal"
 
 #: The ids of a shape's nearest occluding ancestors (NaN: none), nearest first (``backend.occlusion``).
 ANCESTORS = tuple(f"occluder.{k}" for k in range(4))

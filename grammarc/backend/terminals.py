@@ -22,6 +22,7 @@ from grammarc.backend.context import Context
 from grammarc.backend.kernels.scope import xforms
 from grammarc.backend.mesh_shapes import mesh_leaves
 from grammarc.backend.shapes import Z_UP, Shapes, asset_of, face_axes
+from grammarc.backend.slots import HORIZONTAL_SLOTS
 from grammarc.constants import TOL
 from grammarc.geometry.components import reverse_rings
 from grammarc.geometry.meshes import is_mesh, is_polygon
@@ -57,7 +58,7 @@ def emit_instances(ctx: Context, shapes: Shapes, asset: int, symbol: int, mirror
     if mirrored & Z_UP:  # the asset turns in its own box, before the mirror in the scope's
         xform = z_up(xform)
     if ctx.plan.trim_slot is not None:
-        planes = _trim_planes(ctx.plan, shapes)
+        planes = trim_planes(ctx.plan, shapes)
         cut = boxes_crossing(planes, xform.astype(np.float64), TOL.zero)
         mesh = ctx.asset_mesh(asset) if cut.any() else None
         if mesh is not None:
@@ -76,13 +77,20 @@ def z_up(xform: np.ndarray) -> np.ndarray:
     return turned
 
 
-def _trim_planes(plan, shapes: Shapes) -> np.ndarray:
-    """The shapes' trim planes (n, 8), NaN where there are none or ``set(trim.vertical, false)``."""
+def trim_planes(plan, shapes: Shapes) -> np.ndarray:
+    """The shapes' trim planes (n, 4 P): the two vertical ones, NaN where there are none or
+    ``set(trim.vertical, false)``; then, where the grammar turns them on, the horizontal ones, NaN where
+    ``trim.horizontal`` is false."""
     slot = plan.trim_slot
     planes = np.stack(shapes.dynamic[slot:slot + 8], axis=1)
     if plan.trim_switch is not None:
         planes[shapes.dynamic[plan.trim_switch] == 0] = np.nan
-    return planes
+    if plan.horizontal_slot is None:
+        return planes
+    slot = plan.horizontal_slot
+    shallow = np.stack(shapes.dynamic[slot:slot + len(HORIZONTAL_SLOTS)], axis=1)
+    shallow[shapes.dynamic[plan.horizontal_switch] == 0] = np.nan
+    return np.concatenate([planes, shallow], axis=1)
 
 
 def _trimmed(plan, shapes: Shapes, xform: np.ndarray, planes: np.ndarray, mesh, symbol: int) -> MeshChunk:

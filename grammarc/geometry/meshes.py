@@ -338,7 +338,8 @@ def clip_slabs(verts, ring_offsets, face_offsets, mesh_offsets, child_mesh, axis
                     continue
                 for side in range(2):
                     plane = lo[c] if side == 0 else hi[c]
-                    if np.abs(ring[:, axis] - plane).max() <= eps:
+                    # a face on the plane closes it; a ring cut down to an edge on it does not
+                    if np.abs(ring[:, axis] - plane).max() <= eps and _ring_width(ring) > eps:
                         closed[side] = True
                 out_v = grow(out_v, n_v + len(ring))
                 out_r = grow(out_r, n_r + 2)
@@ -373,9 +374,25 @@ def clip_slabs(verts, ring_offsets, face_offsets, mesh_offsets, child_mesh, axis
 
 
 @njit(cache=True, nogil=True)
+def _ring_width(ring):
+    """A planar ring's (k, 3) area over its half perimeter: about its width, 0 for a ring that is an edge
+    run there and back."""
+    nx = ny = nz = 0.0
+    perimeter = 0.0
+    k = len(ring)
+    for j in range(k):
+        p, q = ring[j], ring[(j + 1) % k]
+        nx += (p[1] - q[1]) * (p[2] + q[2])
+        ny += (p[2] - q[2]) * (p[0] + q[0])
+        nz += (p[0] - q[0]) * (p[1] + q[1])
+        perimeter += np.sqrt(((q - p) ** 2).sum())
+    return np.sqrt(nx * nx + ny * ny + nz * nz) / max(perimeter, 1e-300)
+
+
+@njit(cache=True, nogil=True)
 def _hull(points, a, b, eps):
     """Convex hull of points on a plane, by their coordinates a and b, counter-clockwise in (a, b)
-    (Andrew's monotone chain); repeated points count once."""
+    (Andrew's monotone chain); repeated points, and points within eps of each other, count once."""
     n = len(points)
     order = np.argsort(points[:, a].copy(), kind="mergesort")
     for i in range(1, n):  # ties in a: by b (insertion sort; the points are few)
@@ -384,6 +401,17 @@ def _hull(points, a, b, eps):
                 points[order[j], b] < points[order[j - 1], b]:
             order[j], order[j - 1] = order[j - 1], order[j]
             j -= 1
+    # points within eps of the one before (a crossing and a vertex on the plane, computed apart) count once
+    unique = np.empty(n, np.int64)
+    m = 0
+    for idx in range(n):
+        i = order[idx]
+        if m and abs(points[i, a] - points[unique[m - 1], a]) <= eps \
+                and abs(points[i, b] - points[unique[m - 1], b]) <= eps:
+            continue
+        unique[m] = i
+        m += 1
+    order, n = unique[:m], m
     hull = np.empty(2 * n + 1, np.int64)
     k = 0
     for idx in range(n):

@@ -1,13 +1,17 @@
 """CityEngine's trim planes: where a component split's neighbouring faces meet, inserted geometry is cut.
 
 A comp(f) gives each side face (one whose edges to its neighbours are steeper than 40 degrees to the x-z
-plane of the split shape's scope) a plane at each of those edges, bisecting the angle between the two faces; geometry inserted under that face keeps
-the side of both planes the face is on, so ledges and cornices enlarged to run past a corner meet their
-neighbours in a mitre. Horizontal trim planes (CityEngine's ``trim.horizontal``, off by default) are not
-made. CityEngine measures the 40 degrees from the x-z plane of the pivot; grammarc measures them from the
-split shape's scope, which is the same for the solids of a footprint (y up) and, as PRT does, trims a
-pipe extruded sideways from a wall (candler's VerticalPipes) at its four corners. ``side_face_planes`` finds the planes of many faces at once; ``trim_triangles`` cuts the triangles
-of many placed assets by them (numba).
+plane of the split shape's scope) a plane at each of those edges, bisecting the angle between the two
+faces; geometry inserted under that face keeps the side of both planes the face is on, so ledges and
+cornices enlarged to run past a corner meet their neighbours in a mitre. Horizontal trim planes
+(CityEngine's ``trim.horizontal``, off by default) are made alike at the shallower edges a face shares:
+a wall's top with the roof, a roof face's hips and ridge. CityEngine measures the 40 degrees from the x-z
+plane of the pivot; grammarc measures them from the split shape's scope, which is the same for the
+solids of a footprint (y up) and, as PRT does, trims a pipe extruded sideways from a wall (candler's
+VerticalPipes) at its four corners. ``side_face_planes`` and ``shallow_edge_planes`` find the planes of
+many faces at once; ``trim_triangles`` cuts the triangles of many placed assets by them (numba);
+``plane_coordinates`` gives each plane a frame in which the ``trim()`` operation cuts a shape's own
+geometry as a split cuts a slab (``backend.operations.trims``).
 """
 
 from __future__ import annotations
@@ -15,10 +19,14 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from grammarc.ragged import row_groups
+from grammarc.ragged import rank_within, row_groups
 
-#: A shared edge steeper than this (degrees from the horizontal) makes a vertical trim plane.
+#: A shared edge steeper than this (degrees from the horizontal) makes a vertical trim plane, a shallower
+#: one a horizontal plane.
 VERTICAL_DEGREES = 40.0
+#: Horizontal trim planes a face keeps (a box's top face has four shallow edges, a hip roof's face its
+#: eave, its hips and its ridge).
+HORIZONTAL_PLANES = 4
 
 
 def side_face_planes(axes: np.ndarray, origin: np.ndarray, size: np.ndarray, parent: np.ndarray,
@@ -61,13 +69,81 @@ def side_face_planes(axes: np.ndarray, origin: np.ndarray, size: np.ndarray, par
     return out
 
 
+def shallow_edge_planes(verts: np.ndarray, ring_offsets: np.ndarray, face_offsets: np.ndarray, parent: np.ndarray,
+                        up: np.ndarray) -> np.ndarray:
+    """Horizontal trim planes (m, 4 * HORIZONTAL_PLANES) of component faces: (nx, ny, nz, d) at each edge
+    a face shares with a face of the same ``parent`` (m,) that is less steep than ``VERTICAL_DEGREES`` to
+    the x-z plane of the split shape's scope (its ``up`` (m, 3)), in the order of its outline, keeping
+    n . X + d >= 0; NaN after the last.
+
+    verts (V, 3) world coordinates of the m faces (outline first: ``face_offsets`` (m+1,) into
+    ``ring_offsets``). The plane holds the shared edge and bisects the angle between the
+    faces: its normal is the direction into this face across the edge minus the one into the neighbour,
+    so a wall's ledge meets the roof's or the next slope's in a mitre, as at the vertical corners."""
+    m = len(parent)
+    out = np.full((m, 4 * HORIZONTAL_PLANES), np.nan)
+    if not m:
+        return out
+    outline = face_offsets[:-1]
+    start, stop = ring_offsets[outline], ring_offsets[outline + 1]
+    count = stop - start
+    face = np.repeat(np.arange(m), count)
+    at = np.arange(count.sum()) - np.repeat(np.cumsum(count) - count, count)
+    p = verts[start[face] + at]
+    q = verts[start[face] + (at + 1) % count[face]]
+    # each face's unit normal (Newell's, over its outline)
+    newell = np.zeros((m, 3))
+    np.add.at(newell, face, np.cross(p, q))
+    normal = newell / np.maximum(np.linalg.norm(newell, axis=1, keepdims=True), 1e-300)
+    edge = q - p
+    length = np.linalg.norm(edge, axis=1)
+    direction = edge / np.maximum(length, 1e-300)[:, None]
+    scale = max(float(np.abs(verts).max(initial=0.0)), 1.0) * 1e-7
+    ends = [np.round(x / scale).astype(np.int64) for x in (p, q)]
+    keys = np.concatenate([np.column_stack([parent[face], ends[0], ends[1]]),
+                           np.column_stack([parent[face], ends[1], ends[0]])])
+    group, _ = row_groups(keys)
+    n_edges = len(face)
+    forward = np.full(int(group.max()) + 1, -1)
+    forward[group[:n_edges]] = np.arange(n_edges)
+    neighbour = forward[group[n_edges:]]  # the edge running the other way along the same two corners
+    shallow = np.abs(np.einsum("ij,ij->i", direction, up[face])) < np.sin(np.radians(VERTICAL_DEGREES))
+    ok = (neighbour >= 0) & shallow & (length > scale)
+    ok[ok] &= face[neighbour[ok]] != face[ok]
+    rows = np.flatnonzero(ok)
+    # into each face across the edge: its normal cross the edge (outlines wind counter-clockwise)
+    into = np.cross(normal[face[rows]], direction[rows])
+    into_other = np.cross(normal[face[neighbour[rows]]], -direction[rows])
+    plane = into - into_other
+    size = np.linalg.norm(plane, axis=1)
+    good = size > 1e-9
+    rows, plane = rows[good], plane[good] / size[good, None]
+    rank = rank_within(face[rows])
+    keep = rank < HORIZONTAL_PLANES
+    rows, plane, rank = rows[keep], plane[keep], rank[keep]
+    columns = 4 * rank[:, None] + np.arange(3)
+    out[face[rows, None], columns] = plane
+    out[face[rows], 4 * rank + 3] = -np.einsum("ij,ij->i", plane, p[rows])
+    return out
+
+
+def plane_coordinates(normal: np.ndarray) -> np.ndarray:
+    """Orthonormal right-handed frames (k, 3, 3) whose first row is each unit ``normal`` (k, 3): in them a
+    trim plane is a plane across the first axis, which the slab cuts of ``meshes.clip_slabs`` take."""
+    # the world axis least along the normal completes it
+    other = np.eye(3)[np.argmin(np.abs(normal), axis=1)]
+    second = np.cross(normal, other)
+    second /= np.linalg.norm(second, axis=1, keepdims=True)
+    return np.stack([normal, second, np.cross(normal, second)], axis=1)
+
+
 @njit(cache=True, nogil=True)
 def boxes_crossing(planes, xform, eps):
-    """Which unit boxes placed by xform (k, 3, 4) reach past one of their planes (k, 8; NaN: none) by
+    """Which unit boxes placed by xform (k, 3, 4) reach past one of their planes (k, 4 P; NaN: none) by
     more than eps: those are cut, the others stay instances."""
     out = np.zeros(len(xform), np.bool_)
     for k in range(len(xform)):
-        for p in range(2):
+        for p in range(planes.shape[1] // 4):
             nx, ny, nz, d = planes[k, 4 * p], planes[k, 4 * p + 1], planes[k, 4 * p + 2], planes[k, 4 * p + 3]
             if np.isnan(nx):
                 continue
@@ -88,16 +164,17 @@ def boxes_crossing(planes, xform, eps):
 @njit(cache=True, nogil=True)
 def trim_triangles(verts, tris, xform, planes, eps):
     """Triangles of an asset (verts (v, 3) in its unit box, tris (t, 3)) placed by xform (k, 3, 4) and
-    cut by each placement's two planes (k, 8; NaN: none): the kept polygons in world coordinates.
+    cut by each placement's planes (k, 4 P; NaN: none): the kept polygons in world coordinates.
     Returns vertices (V, 3), ring_offsets (F+1,) and each polygon's placement (F,)."""
     k_count, t_count = len(xform), len(tris)
-    out = np.empty((k_count * t_count * 5 + 1, 3))
+    n_planes = planes.shape[1] // 4
+    out = np.empty((k_count * t_count * (3 + n_planes) + 1, 3))
     offsets = np.zeros(k_count * t_count + 1, np.int64)
     owner = np.empty(k_count * t_count, np.int64)
     n_v = 0
     n_f = 0
-    poly = np.empty((8, 3))
-    clipped = np.empty((8, 3))
+    poly = np.empty((3 + 2 * n_planes, 3))
+    clipped = np.empty((3 + 2 * n_planes, 3))
     for k in range(k_count):
         for t in range(t_count):
             count = 3
@@ -105,7 +182,7 @@ def trim_triangles(verts, tris, xform, planes, eps):
                 v = verts[tris[t, c]]
                 for r in range(3):
                     poly[c, r] = xform[k, r, 0] * v[0] + xform[k, r, 1] * v[1] + xform[k, r, 2] * v[2] + xform[k, r, 3]
-            for p in range(2):
+            for p in range(n_planes):
                 nx, ny, nz, d = planes[k, 4 * p], planes[k, 4 * p + 1], planes[k, 4 * p + 2], planes[k, 4 * p + 3]
                 if np.isnan(nx) or count < 3:
                     continue

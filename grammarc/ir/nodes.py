@@ -321,7 +321,7 @@ Expr = (Num | Str | Bool | Name | Param | AttrRef | ScopeRef | Unary | Binary | 
         | Occlusion | ArrayLit | Range | Index)
 
 #: CityEngine shape attributes that ``set`` changes for a shape and its successors (not declared attrs).
-SHAPE_ATTRIBUTES: dict[str, Type] = {"trim.vertical": Type.BOOL}
+SHAPE_ATTRIBUTES: dict[str, Type] = {"trim.vertical": Type.BOOL, "trim.horizontal": Type.BOOL}
 
 # ------------------------------------------------------------------------------------------------ operations
 
@@ -830,10 +830,44 @@ class Primitive:
     span: Span = NO_SPAN
 
 
+@dataclass(frozen=True, slots=True)
+class Trim:
+    """CityEngine ``trim()``: the shape's geometry cut by its trim planes (those a ``comp(f)`` left between
+    neighbouring faces, ``geometry.trim``), keeping the side its face is on and closing the cuts."""
+
+    span: Span = NO_SPAN
+
+
+@dataclass(frozen=True, slots=True)
+class SplitArea(GroupSplit):
+    """CityEngine ``splitArea(axis){ area: A | 'rel: B | ~float: C | { ... }* }[*]``: a ``GroupSplit``
+    whose sizes are areas of the geometry, each part cut off by a plane across ``axis`` where the
+    geometry before it has that area."""
+
+
+@dataclass(frozen=True, slots=True)
+class ReduceGeometry:
+    """CityEngine ``reduceGeometry(tolerance)``: the share ``tolerance`` (0 to 1) of the vertices of the
+    shape's faces removed where that changes them least (``geometry.reduce``)."""
+
+    tolerance: Expr = child(Type.NUM, "a tolerance")
+    span: Span = NO_SPAN
+
+
+@dataclass(frozen=True, slots=True)
+class MirrorScope:
+    """CityEngine ``mirrorScope(x, y, z)``: the scope's axes whose flag is true reversed, its origin at
+    their far ends, the geometry unchanged."""
+
+    axes: tuple[Expr, Expr, Expr] = child(Type.BOOL, "a mirror flag")
+    span: Span = NO_SPAN
+
+
 Op = (Symbol | Empty | Translate | Scale | Rotate | Push | Pop | Insert | Split | Repeat | Comp | Extrude
       | Center | UseAsset | Case | Stochastic | SetAttr | Report | NotApplied | GroupSplit | CompFaces
       | AlignScope | Mirror | Offset | SetColor | Setback | Roof | InnerRectangle | Convexify
-      | CleanupGeometry | DeleteHoles | Snap | Label | Transform | Scatter | AlignToGeometry | Primitive)
+      | CleanupGeometry | DeleteHoles | Snap | Label | Transform | Scatter | AlignToGeometry | Primitive
+      | Trim | SplitArea | ReduceGeometry | MirrorScope)
 Body = tuple[Op, ...]
 
 

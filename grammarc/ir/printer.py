@@ -102,7 +102,8 @@ def _group_split(op: ir.GroupSplit) -> str:
         group = g
     shown = [" | ".join(i) if i[0] != "{" else "{ " + " | ".join(i[1:]) + " }*" for i in items]
     options = "" if op.adjust else ", noAdjust"
-    return f"split({'xyz'[op.axis]}{options}){{ {' | '.join(shown)} }}{'*' if op.repeat else ''}"
+    name = "splitArea" if isinstance(op, ir.SplitArea) else "split"
+    return f"{name}({'xyz'[op.axis]}{options}){{ {' | '.join(shown)} }}{'*' if op.repeat else ''}"
 
 
 def _roof(op: ir.Roof) -> str:
@@ -157,6 +158,7 @@ _OP_FORMATS = {
     ir.Comp: lambda op: (f'Comp("{op.kind}"{f", {print_expr(op.index)}" if op.index is not None else ""})'
                          f"{_parts(op.parts)}"),
     ir.GroupSplit: _group_split,
+    ir.SplitArea: _group_split,
     ir.SetColor: lambda op: f"color({_list(op.values)})",
     ir.Offset: lambda op: f"offset({print_expr(op.distance)}, {op.select})",
     ir.Convexify: lambda op: f"convexify({print_expr(op.max_length) if op.max_length is not None else ''})",

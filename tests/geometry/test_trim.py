@@ -6,7 +6,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from grammarc.geometry.trim import side_face_planes, trim_triangles
+from grammarc.geometry.trim import plane_coordinates, shallow_edge_planes, side_face_planes, trim_triangles
 from grammarc.model.assets import builtin_mesh
 
 UP = np.tile([0.0, 1.0, 0.0], (4, 1))  # the split solid's scope y: world up
@@ -72,3 +72,34 @@ def test_a_ledge_past_the_corner_is_cut_along_the_mitre():
     area = sum(np.linalg.norm(np.cross(r, np.roll(r, -1, axis=0)).sum(axis=0)) / 2 for r in top)
     assert area == pytest.approx((10 + 12) / 2 * 1.0)
     assert (owner == 0).all()
+
+
+def test_plane_coordinates_are_right_handed_frames_on_the_normal():
+    normal = np.array([[1.0, 0, 0], [0, 0, -1.0], [np.sqrt(0.5), np.sqrt(0.5), 0]])
+    frames = plane_coordinates(normal)
+    assert frames[:, 0] == pytest.approx(normal)
+    assert np.einsum("nij,nkj->nik", frames, frames) == pytest.approx(np.broadcast_to(np.eye(3), (3, 3, 3)))
+    assert np.linalg.det(frames) == pytest.approx(np.ones(3))
+
+
+def test_shallow_edge_planes_of_a_box_bisect_its_horizontal_edges():
+    """A 2 x 1.5 x 0.5 box's six faces (outlines counter-clockwise seen from outside): the top and bottom
+    faces get a plane at each of their four edges, the sides one at their top and bottom edges; at the edge
+    between the top (y = 1.5) and the front (z = 0.5) both planes are the bisector, each keeping the points
+    of its own face and not the other's."""
+    x0, x1, y0, y1, z0, z1 = 0.0, 2.0, 0.0, 1.5, 0.0, 0.5
+    faces = [[(x0, y0, z0), (x0, y1, z0), (x1, y1, z0), (x1, y0, z0)], [(x0, y0, z1), (x1, y0, z1), (x1, y1, z1), (x0, y1, z1)],
+             [(x0, y0, z0), (x1, y0, z0), (x1, y0, z1), (x0, y0, z1)], [(x0, y1, z0), (x0, y1, z1), (x1, y1, z1), (x1, y1, z0)],
+             [(x0, y0, z0), (x0, y0, z1), (x0, y1, z1), (x0, y1, z0)], [(x1, y0, z0), (x1, y1, z0), (x1, y1, z1), (x1, y0, z1)]]
+    verts = np.array([p for f in faces for p in f])
+    planes = shallow_edge_planes(verts, np.arange(0, 25, 4), np.arange(7), np.zeros(6, np.int64), UP[:1].repeat(6, 0))
+    counts = (~np.isnan(planes[:, 0::4])).sum(axis=1)
+    assert counts.tolist() == [2, 2, 4, 4, 2, 2]
+    front, top = planes[1], planes[3]
+    edge_point = np.array([1.0, y1, z1])
+    on_front, on_top = np.array([1.0, 1.0, z1]), np.array([1.0, y1, 0.25])
+    for plane, mine, theirs in ((front, on_front, on_top), (top, on_top, on_front)):
+        (k,) = [k for k in range(4) if abs(plane[4 * k:4 * k + 3] @ edge_point + plane[4 * k + 3]) < 1e-9]
+        normal, offset = plane[4 * k:4 * k + 3], plane[4 * k + 3]
+        assert np.abs(normal) @ np.ones(3) == pytest.approx(np.sqrt(2))
+        assert normal @ mine + offset > 0 > normal @ theirs + offset

@@ -16,7 +16,9 @@ columns:
 - ``successors``: successor symbols, ``ε``/``NIL`` and operations without effect;
 - ``values``: ``set``, ``color``, ``report``;
 - ``control``: ``case`` and ``p%`` blocks;
-- ``scatter``: ``scatter``, point shapes on, in or around the shape.
+- ``scatter``: ``scatter``, point shapes on, in or around the shape;
+- ``trims``: ``trim()``, the shape's geometry cut by its trim planes;
+- ``simplify``: ``reduceGeometry``, polygons with fewer vertices.
 
 A new operation is its IR node, its lowering and its function here: importing this package registers them.
 """
@@ -29,8 +31,10 @@ from grammarc.backend.operations import (  # noqa: F401 - each registers its ope
     primitives,
     scatter,
     scope,
+    simplify,
     splits,
     successors,
+    trims,
     values,
 )
 from grammarc.backend.operations.table import OPERATIONS, Operation, Parts

@@ -31,8 +31,9 @@ from grammarc.backend.shapes import Shapes
 from grammarc.constants import TOL
 from grammarc.geometry import components as comp_kernels
 from grammarc.geometry.meshes import is_mesh, is_polygon
+from grammarc.geometry.queries import shape_faces
 from grammarc.geometry.reframe import NORMAL_OUT
-from grammarc.geometry.trim import side_face_planes
+from grammarc.geometry.trim import shallow_edge_planes, side_face_planes
 from grammarc.ir import nodes as ir
 from grammarc.ragged import rank_within
 
@@ -73,6 +74,16 @@ def comp_faces(ctx: Context, cursor: Shapes, op: ir.CompFaces) -> Parts:
         planes = side_face_planes(chunk.frames[shapes.frame], shapes.origin, shapes.size, parent, up)
         dynamic = list(shapes.dynamic)
         dynamic[slot:slot + 8] = list(planes.T)
+        shallow = ctx.plan.horizontal_slot
+        if shallow is not None:
+            # each component is one face (none for a degenerate one): its outline in world coordinates
+            faces = shape_faces(shapes.size, shapes.geom, chunk.polygons, chunk.meshes)
+            owner, at = faces.face_shape(), faces.vertex_shape()
+            world = shapes.origin[at] + np.einsum("vi,vij->vj", faces.verts, chunk.frames[shapes.frame[at]])
+            found = shallow_edge_planes(world, faces.ring_offsets, faces.face_offsets, parent[owner], up[owner])
+            planes = np.full((len(shapes), found.shape[1]), np.nan)
+            planes[owner] = found
+            dynamic[shallow:shallow + planes.shape[1]] = list(planes.T)
         shapes = replace(shapes, dynamic=tuple(dynamic))
     if op.kind == "f":
         axes = chunk.frames[shapes.frame]

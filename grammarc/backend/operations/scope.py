@@ -1,13 +1,13 @@
 """Scope operations: ``T``/``S``/``R`` (``t s r``), CityEngine's ``translate`` and ``rotate`` in a coordinate
-system, ``extrude``, ``alignScopeToAxes``/``alignScopeToGeometry``/``rotateScope`` and ``mirror``; and
-``center``, which the body runner calls (it centres on the scope the body began with or last pushed, which
-only the runner holds).
+system, ``extrude``, ``alignScopeToAxes``/``alignScopeToGeometry``/``rotateScope``, ``mirror`` and
+``mirrorScope``; and ``center``, which the body runner calls (it centres on the scope the body began with
+or last pushed, which only the runner holds).
 
 They change the cursor's scope and return it. Reads: the scope (``origin``, ``size``, ``frame``), ``geom``
 (extrude, align, mirror), and what their expressions read. Writes: ``T``, ``translate`` and ``center`` the
 ``origin``, ``S`` the ``size``, ``R`` and ``rotate`` the ``frame`` (and ``r(scopeCenter, ...)`` the
-``origin``, to keep the centre), ``mirror`` the ``geom``; ``extrude`` and the alignments all four of the
-scope and geometry, as they turn scopes around their geometry (``backend.reframing``).
+``origin``, to keep the centre), ``mirror`` the ``geom``; ``extrude``, the alignments and ``mirrorScope``
+all four of the scope and geometry, as they turn scopes around their geometry (``backend.reframing``).
 """
 
 from __future__ import annotations
@@ -28,7 +28,7 @@ from grammarc.constants import TOL
 from grammarc.geometry import components as comp_kernels
 from grammarc.geometry.align import EDGE_MODES, FACE_MODES, aligned_axes, pick_edges
 from grammarc.geometry.extrusion import extruded_meshes
-from grammarc.geometry.meshes import is_polygon
+from grammarc.geometry.meshes import MESH_BASE, is_mesh, is_polygon
 from grammarc.geometry.polygons import PLANE_U, PLANE_V, plane_to_scope
 from grammarc.geometry.queries import face_shapes, shape_faces
 from grammarc.geometry.reframe import NORMAL_UP
@@ -274,11 +274,11 @@ def align_to_geometry(ctx: Context, cursor: Shapes, op: ir.AlignToGeometry) -> S
                         [rows, others])
 
 
-@operation(ir.Mirror, writes=("geom",))
+@operation(ir.Mirror, writes=("geom",), meshes=True)
 def mirror(ctx: Context, cursor: Shapes, op: ir.Mirror) -> Shapes:
-    """Mirror the geometry inside its scope: assets flip (a bit of their geometry code), polygons
-    are stored flipped with their rings reversed (so they still wind around their normal); a scope
-    box is its own mirror image."""
+    """Mirror the geometry inside its scope: assets flip (a bit of their geometry code), polygons and
+    meshes (roofs) are stored flipped with their rings reversed where an odd number of axes flip (so they
+    still wind around their outward normals); a scope box is its own mirror image."""
     env = ctx.env(cursor)
     flips = [np.broadcast_to(evaluate_array(f, env, dtype=bool), (len(cursor),)) for f in op.axes]
     bits = flips[0] * 1 + flips[1] * 2 + flips[2] * 4
@@ -305,4 +305,34 @@ def mirror(ctx: Context, cursor: Shapes, op: ir.Mirror) -> Shapes:
         once = (flip_u ^ flip_v).astype(bool)  # one flip turns the winding round
         coords = np.where(once[:, None], comp_kernels.reverse_rings(coords, ring_offsets), coords)
         geom[poly] = store.add(coords, ring_offsets, poly_offsets, plane)
+    mesh = np.flatnonzero(is_mesh(geom) & (bits > 0))
+    if len(mesh):
+        meshes = ctx.chunk.meshes
+        coords, ring_offsets, face_offsets, mesh_offsets = meshes.gather(geom[mesh] - MESH_BASE)
+        vertex_mesh = segment_of(mesh_offsets)[segment_of(face_offsets)][segment_of(ring_offsets)]
+        # an axis of no extent keeps its coordinate 0
+        flip = ((bits[mesh, None] >> np.arange(3)) & 1).astype(bool) & (cursor.size[mesh] > TOL.zero)
+        flip = flip[vertex_mesh]
+        coords = np.where(flip, 1.0 - coords, coords)
+        odd = flip.sum(axis=1) % 2 == 1
+        coords = np.where(odd[:, None], comp_kernels.reverse_rings(coords, ring_offsets), coords)
+        geom[mesh] = (MESH_BASE + meshes.add(coords, ring_offsets, face_offsets, mesh_offsets)).astype(np.int32)
     return cursor.with_scope(cursor.origin, cursor.size, cursor.frame, geom)
+
+
+@operation(ir.MirrorScope, writes=_SCOPE, meshes=True)
+def mirror_scope(ctx: Context, cursor: Shapes, op: ir.MirrorScope) -> Shapes:
+    """``mirrorScope``: the flagged axes reversed around the unchanged geometry (``backend.reframing``:
+    the box fitted again starts at their far ends). Two reversed axes are a half turn; one or three would
+    make a left-handed scope, which grammarc's scopes (rotations, as CityEngine's ``scope.r``) cannot be:
+    those shapes' lots fail by name."""
+    env = ctx.env(cursor)
+    flips = np.stack([np.broadcast_to(evaluate_array(f, env, dtype=bool), (len(cursor),)) for f in op.axes], axis=1)
+    odd = flips.sum(axis=1) % 2 == 1
+    if odd.any():
+        ctx.fail(cursor, odd, "`mirrorScope` of one or three axes is not supported yet: the scope would be "
+                 "left-handed (reverse two axes, or mirror the geometry with `mirror`)", op.span)
+    if not flips.any():
+        return cursor
+    new_axes = ctx.chunk.frames[cursor.frame] * np.where(flips, -1.0, 1.0)[:, :, None]
+    return reframed(ctx, cursor, new_axes, op.span)

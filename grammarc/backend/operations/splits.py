@@ -1,5 +1,5 @@
 """Splits: the paper's ``Subdiv`` and ``Repeat`` (on one axis or several), CityEngine's ``split`` with repeat
-groups, and the paper's ``Snap``/``SnapLines``, whose planes snapped splits move their cuts to.
+groups and its ``splitArea`` (the same layout over the geometry's area), and the paper's ``Snap``/``SnapLines``, whose planes snapped splits move their cuts to.
 
 A split makes children (``backend.children``: scopes moved and cut along the axis, polygons and meshes cut to
 their slabs, new keys, ``split.index``/``split.total``) and returns them as ``Parts`` for its bodies; parts
@@ -22,6 +22,8 @@ from grammarc.backend.leaf_parts import LeafPart
 from grammarc.backend.operations.table import Parts, operation
 from grammarc.backend.shapes import Shapes
 from grammarc.constants import TOL
+from grammarc.geometry.area_cuts import area_positions, total_areas
+from grammarc.geometry.queries import shape_faces
 from grammarc.ir import nodes as ir
 from grammarc.ragged import offsets_from_counts, rank_within
 
@@ -83,14 +85,40 @@ def repeat(ctx: Context, cursor: Shapes, op: ir.Repeat) -> Parts | None:
 
 @operation(ir.GroupSplit, meshes=True, consumes=True)
 def group_split(ctx: Context, cursor: Shapes, op: ir.GroupSplit) -> Parts:
-    values = _split_sizes(ctx, cursor, op, "split")
+    extent = np.ascontiguousarray(cursor.size[:, op.axis])
+    parent, part, pos, length, index = _group_layout(ctx, cursor, op, extent)
+    return _group_children(ctx, cursor, op, parent, part, pos, length, index)
+
+
+@operation(ir.SplitArea, consumes=True)
+def split_area(ctx: Context, cursor: Shapes, op: ir.SplitArea) -> Parts:
+    """``splitArea``: the split's layout over each shape's area, each part's cumulative area turned into
+    the position along the axis where the faces before it have that area (``geometry.area_cuts``)."""
+    chunk = ctx.chunk
+    faces = shape_faces(cursor.size, cursor.geom, chunk.polygons, chunk.meshes)
+    rings, offsets = (faces.verts, faces.ring_offsets, faces.face_offsets), faces.shape_offsets
+    total = total_areas(*rings, offsets)
+    parent, part, start, area, index = _group_layout(ctx, cursor, op, total)
+    extent = cursor.size[parent, op.axis]
+    ends = [area_positions(*rings, offsets, op.axis, parent, a, extent, total[parent])
+            for a in (start, start + area)]
+    return _group_children(ctx, cursor, op, parent, part, ends[0], ends[1] - ends[0], index)
+
+
+def _group_layout(ctx: Context, cursor: Shapes, op: ir.GroupSplit, extent: np.ndarray):
+    """The parts of CityEngine's split over ``extent`` (n,): parent, part, position, length and index of
+    each (``kernels.split.group_split``)."""
+    values = _split_sizes(ctx, cursor, op, "splitArea" if isinstance(op, ir.SplitArea) else "split")
     kind = np.array([_SIZE_KIND[s.kind] for s in op.sizes], dtype=np.int64)
     groups = np.array(op.groups, dtype=np.int64)
     if op.repeat:
         groups = np.zeros_like(groups)
     n_groups = int(groups.max()) + 1 if len(groups) else 0
-    parent, part, pos, length, index = split_kernels.group_split(
-        np.ascontiguousarray(cursor.size[:, op.axis]), values, kind, groups, n_groups, TOL.zero)
+    return split_kernels.group_split(extent, values, kind, groups, n_groups, TOL.zero)
+
+
+def _group_children(ctx: Context, cursor: Shapes, op: ir.GroupSplit, parent, part, pos, length, index) -> Parts:
+    """The children of a split's parts along ``op.axis``, their geometry cut to their slabs, by part."""
     parent, part, pos, length, index, geometry = clip(ctx.chunk, cursor, op.axis, parent, part, pos, length,
                                                       index, op.adjust)
     order, offsets = group_by(part, len(op.parts))

@@ -38,6 +38,7 @@ from grammarc.frontend.cityengine.operations import (
     NOT_APPLIED,
     OPERATIONS,
     PART_OPERATIONS,
+    REPEATING,
     SETBACK_SELECTORS,
     SPLIT_OPS,
     UNSUPPORTED_MEMBERS,
@@ -368,9 +369,9 @@ class Lowering(OperationLowering, LoweringBase):
             return self.unsupported(op, span)
         if star is None:
             return handler(self, op, args, parts, span)
-        if op != "split":
-            return self.unsupported(f"`*` after {op}", self.token_span(star), "only split repeats")
-        return self.op_split(op, args, parts, span, repeat=True)
+        if op not in REPEATING:
+            return self.unsupported(f"`*` after {op}", self.token_span(star), "only split and splitArea repeat")
+        return handler(self, op, args, parts, span, repeat=True)
 
     # ------------------------------------------------------------------------------------- expressions
     def value_case(self, meta, *items):

@@ -12,7 +12,7 @@ the name) is ``unknown operation NAME`` (``check_calls``).
 
 from __future__ import annotations
 
-from dataclasses import replace
+from dataclasses import fields, replace
 from functools import cache
 
 from grammarc.diagnostics import Diagnostics, Typos, suggest
@@ -161,11 +161,16 @@ class OperationLowering:
                                 "alignScopeToAxes(), alignScopeToAxes(world.xyz) and alignScopeToAxes(x|y|z)")
 
     def op_align_geometry(self, op, args, span):
+        """``alignScopeToGeometry(upAxis, face[, edge])``. Older rule files write the face ``auto``, which
+        the reference no longer lists: grammarc reads it as ``largest``, and without an edge as the
+        largest face's ``longest`` edge, the scope a footprint's or a roof floor's main direction gives."""
         up = _selector(args[0]) if args else None
         if len(args) not in (2, 3) or up not in ("yUp", "zUp"):
             return self.unsupported("alignScopeToGeometry with these arguments", span,
                                     "alignScopeToGeometry(yUp|zUp, face[, edge])")
         face, edge = _selector(args[1]), _selector(args[2]) if len(args) == 3 else None
+        if face == "auto":
+            face, edge = "largest", edge or ("longest" if len(args) == 2 else None)
         if face is not None and face not in ALIGN_FACES:
             return self.unsupported(f"alignScopeToGeometry with face {face}", getattr(args[1], "span", span))
         if edge is not None and edge not in ALIGN_EDGES:
@@ -237,12 +242,6 @@ class OperationLowering:
             return self.set_scope(target, self.expr(args[1]), span)
         if isinstance(target, ir.Name) and target.name in ir.SHAPE_ATTRIBUTES:
             return ir.SetAttr(target.name, self.expr(args[1]), span)
-        if isinstance(target, ir.Name) and target.name == "trim.horizontal":
-            value = self.expr(args[1])
-            if isinstance(value, ir.Bool) and not value.value:
-                return ir.NotApplied("set(trim.horizontal)", span)  # CityEngine's default
-            return self.unsupported("set(trim.horizontal, ...) other than false", span,
-                                    "horizontal trim planes are not made")
         if isinstance(target, ir.Name) and target.name.startswith("material."):
             return ir.NotApplied(f"set({target.name})", span)
         if not isinstance(target, ir.Name):
@@ -288,6 +287,13 @@ class OperationLowering:
         adjust = not any(isinstance(extra, ir.Name) and extra.name == "noAdjust" for extra in args[1:])
         return ir.GroupSplit("xyz".index(args[0].name), tuple(sizes), tuple(groups), tuple(bodies), repeat,
                              span, self.site(), adjust)
+
+    def op_split_area(self, op, args, parts, span, repeat=False):
+        """``splitArea(axis[, adjust|noAdjust]){ area : A | ... }[*]``: a split's parts, their sizes areas."""
+        split = self.op_split(op, args, parts, span, repeat)
+        if not isinstance(split, ir.GroupSplit):
+            return split
+        return ir.SplitArea(*(getattr(split, f.name) for f in fields(split)))
 
     def size_of(self, part: Part) -> ir.Size:
         if part.merged:
@@ -455,11 +461,15 @@ OPERATIONS = {
     "roofGable": OperationLowering.op_roof,
     "roofShed": OperationLowering.op_roof,
     "roofPyramid": OperationLowering.op_roof,
+    "trim": direct(ir.Trim),
+    "reduceGeometry": direct(ir.ReduceGeometry),
+    "mirrorScope": direct(ir.MirrorScope),
 }
-#: Operations with parts ``{ ... }``: name -> handler(lowering, op, args, parts, span); ``split`` alone also
-#: repeats (``{ ... }*``).
+#: Operations with parts ``{ ... }``: name -> handler(lowering, op, args, parts, span); those of ``REPEATING``
+#: also repeat (``{ ... }*``), with ``repeat=True``.
 PART_OPERATIONS = {
     "split": OperationLowering.op_split,
+    "splitArea": OperationLowering.op_split_area,
     "comp": OperationLowering.op_comp,
     "setback": OperationLowering.op_setback,
     "shapeL": OperationLowering.op_setback,
@@ -467,6 +477,7 @@ PART_OPERATIONS = {
     "shapeO": OperationLowering.op_setback,
     "innerRectangle": OperationLowering.op_inner_rectangle,
 }
+REPEATING = frozenset({"split", "splitArea"})
 #: Operations with a body ``{ operations }``: name -> handler(lowering, op, args, body, span).
 BODY_OPERATIONS = {
     "scatter": OperationLowering.op_scatter,
@@ -478,7 +489,7 @@ ROOF_ARGUMENTS = {"roofHip": ("overhang", "even"), "roofGable": ("overhangX", "o
                    "roofShed": ("index",), "roofPyramid": ()}
 #: Operations CityEngine also takes without their parentheses (other bare names are rules).
 BARE_OPS = frozenset({"NIL", "primitiveCube", "convexify", "alignScopeToAxes", "primitiveQuad", "primitiveDisk",
-                      "primitiveCylinder", "primitiveSphere", "primitiveCone"})
+                      "primitiveCylinder", "primitiveSphere", "primitiveCone", "trim"})
 #: Part operations whose parts are sizes or faces: without parts, `unsupported: split` (the others say
 #: that their selector parts are missing).
 SPLIT_OPS = frozenset({"split", "comp"})
@@ -509,10 +520,8 @@ NOT_APPLIED = frozenset({
 #: CGA reference, so that any other name called with parts, or a typo of one of them, is unknown.
 UNSUPPORTED_OPS = frozenset({
     "innerPolygon",
-    "trim",
-    "mirrorScope",
-    "insertAlongUV", "footprint", "tileUV", "splitArea", "inline", "resetGeometry", "taper",
-    "reduceGeometry", "rectify", "semiPolygon",
+    "insertAlongUV", "footprint", "tileUV", "inline", "resetGeometry", "taper",
+    "rectify", "semiPolygon",
     "alignScopeToGeometryBBox", "roofRidge", "modify",
     "setbackPerEdge", "setbackToArea", "splitAndSetbackPerimeter",
     "tag", "deleteTags", "setTagsFromEdgeAttrs", "union", "subtract", "intersect",

@@ -365,6 +365,55 @@ def test_rotate_scope_turns_the_axes_around_the_same_geometry(write):
     np.testing.assert_allclose(r["xform"][0], [[0, 0, 12, 0], [0, 2, 0, 0], [-8, 0, 0, 0]], atol=1e-6)
 
 
+def test_mirror_scope_reverses_two_axes_around_the_same_geometry(write):
+    """mirrorScope(true, false, true): the 12 x 3 x 8 box keeps its place and sizes, its scope starts at the
+    far corner with x and z reversed (a half turn about y); one axis alone would be left-handed and fails
+    its lot by name."""
+    r = run(write, "Lot --> extrude(3) mirrorScope(true, false, true) X\n", [rect(12, 8)])
+    np.testing.assert_allclose(r["xform"][0], [[-12, 0, 0, 12], [0, 3, 0, 0], [0, 0, -8, 0]], atol=1e-6)
+    r = run(write, "Lot --> extrude(3) mirrorScope(false, true, false) X\n", [rect(12, 8)])
+    (bad,) = r["bad"]
+    assert "`mirrorScope` of one or three axes is not supported yet" in bad.reason
+
+
+def test_mirror_of_a_roof_flips_its_mesh_and_keeps_its_faces_outward(write):
+    """A shed roof rising along scope z, mirrored along z, rises the other way: the same volume, its
+    highest vertices at the other edge, and every face still facing out (its signed volume positive)."""
+    text = 'Lot --> roofShed(20) {}report("v", geometry.volume) X\n'
+    plain, mirrored = (run(write, text.format(m), [rect(12, 8)]) for m in ("", "mirror(false, false, true) "))
+    assert totals(plain)["v_sum"] == pytest.approx(totals(mirrored)["v_sum"])
+
+    def high_edge(r):
+        verts = np.concatenate([ring for face in mesh_faces(r) for ring in face])
+        return np.unique(np.round(verts[verts[:, 1] > verts[:, 1].max() - 1e-6][:, 2], 6))
+
+    def signed_volume(r):
+        total = 0.0
+        for face in mesh_faces(r):
+            ring = face[0]
+            for k in range(1, len(ring) - 1):
+                total += np.dot(ring[0], np.cross(ring[k], ring[k + 1])) / 6
+        return total
+
+    assert not np.array_equal(high_edge(plain), high_edge(mirrored))
+    assert signed_volume(mirrored) == pytest.approx(signed_volume(plain)) and signed_volume(plain) > 0
+
+
+@pytest.mark.parametrize(("given", "op"), [("", "rotateScope(0, 90, 0)"), ("", "mirror(true, false, true)"),
+                                           ("s('0.5, '1, '0.5) ", "center(xz)"), ("", "mirrorScope(true, true, false)")])
+def test_scope_operations_take_every_shape_kind(write, given, op):
+    """rotateScope, mirror, center and mirrorScope on a rectangle, a concave polygon, a box, a prism, a
+    roof, an inserted asset, a face, an edge and a roof face: no lot fails, and the area stays."""
+    kinds = ["", "extrude(3) ", "roofHip(30) ", 'i("builtin:cube") ', "extrude(3) comp(f){ front : F }\nF --> ",
+             "extrude(3) comp(e){ all : F }\nF --> ", "roofHip(30) comp(f){ all : F }\nF --> "]
+    for lot in (rect(12, 8), LOT_ZOO["concave_L"]):
+        for kind in kinds:
+            text = "Lot --> " + kind + given + '@ report("a", geometry.area) X.\n'
+            before, after = (run(write, text.replace("@", o), [lot]) for o in ("", op))
+            assert not after["bad"], (kind, after["bad"])
+            assert totals(after).get("a_sum", 0.0) == pytest.approx(totals(before).get("a_sum", 0.0)), kind
+
+
 def test_negative_size_lot_is_reported_and_skipped(write):
     r = paper(write, 'lot ~> S(Scope.sx - 11, 1, 1r) I("cube")\n', [rect(12, 5), rect(10, 5), rect(20, 5)])
     assert list(np.unique(r["lot"])) == [0, 2]
@@ -407,6 +456,17 @@ def test_align_to_geometry_of_a_rotated_lot_by_edge_index_and_longest(write):
         corners = [x[:, 3] + a * x[:, 0] + c * x[:, 2] for a in (0, 1) for c in (0, 1)]
         world = np.c_[lot[0][:, 0], np.zeros(4), -lot[0][:, 1]]
         assert max(np.linalg.norm(world - p, axis=1).min() for p in corners) < 1e-4
+
+
+def test_align_to_geometry_auto_takes_the_largest_faces_longest_edge(write):
+    """Older rule files' ``alignScopeToGeometry(yUp, auto)``: a 4 x 10 lot whose first edge is a short
+    side gets its scope x along a long side, as ``largest, longest`` gives it; a box its y across its
+    largest face."""
+    for body, lot, size in (("", rect(4, 10), (10, 0, 4)), ("extrude(2) ", rect(4, 10), (10, 2, 4))):
+        r = run(write, f'Lot --> {body}alignScopeToGeometry(yUp, auto) report("sx", scope.sx) '
+                       'report("sy", scope.sy) report("sz", scope.sz) X\n', [lot])
+        t = totals(r)
+        assert (t["sx_sum"], t["sy_sum"], t["sz_sum"]) == pytest.approx(size)
 
 
 def test_align_to_geometry_of_an_l_prism_lowest_face_longest_edge(write):

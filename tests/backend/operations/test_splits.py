@@ -8,6 +8,7 @@ from collections import Counter
 
 import numpy as np
 import pytest
+from conftest import LOT_ZOO
 from derivations import (
     make_lots_polys,
     mesh_faces,
@@ -141,3 +142,40 @@ def test_no_adjust_derives_a_batch_as_lot_by_lot(write):
     text = "Lot --> split(x, noAdjust){ ~3 : A | 2 : B }*\nA --> split(z, noAdjust){ 3 : C | ~1 : D }\n"
     lots = make_lots_polys("concave_L", "courtyard", "sliver", "rect_12x8")
     same_records(run(write, text, lots), run(write, text, lots, chunk_size=1))
+
+
+def _areas(write, text, lot):
+    """The totals of the areas reported by the parts A (``a``) and B (``b``) of ``text`` on ``lot``."""
+    rules = 'A --> report("a", geometry.area) A.\nB --> report("b", geometry.area) B.\n'
+    return totals(run(write, text + rules, [lot]))
+
+
+def test_split_area_parts_have_the_areas_written(write):
+    """The reference's rule: an absolute part has exactly its area, a relative one its share of the
+    geometry's area, floating parts share the rest; on a triangle the cut is no longer at the share of
+    the length (a quarter of its area lies in the first 13.4 % of its width)."""
+    triangle = [np.array([[0, 0], [10, 0], [0, 10]], float)]
+    for lot, total in ((rect(12, 8), 96.0), (triangle, 50.0), (LOT_ZOO["courtyard"], 1200.0)):
+        found = _areas(write, "Lot --> splitArea(x){ '0.25 : A | 5 : B | ~1 : A }\n", lot)
+        assert found["b_sum"] == pytest.approx(5.0)
+        assert found["a_sum"] == pytest.approx(total - 5.0)
+        assert found["a_min"] == pytest.approx(min(0.25 * total, 0.75 * total - 5.0))
+    r = run(write, "Lot --> splitArea(x){ '0.25 : A | ~1 : NIL }\nA --> A.\n", [triangle])
+    (face,) = mesh_faces(r)
+    assert face[0][:, 0].max() == pytest.approx(10 * (1 - np.sqrt(0.75)))
+
+
+def test_split_area_repeats_in_area(write):
+    """``splitArea(z){ 'f : A }*`` gives parts of equal area (the Swiss rule sets' lots); a repeated
+    absolute area fits as often as it goes, as a split's length does."""
+    triangle = [np.array([[0, 0], [10, 0], [0, 10]], float)]
+    found = _areas(write, "Lot --> splitArea(z){ '(1/3) : A }*\n", triangle)
+    assert (found["a_n"], found["a_min"], found["a_max"]) == pytest.approx((3, 50 / 3, 50 / 3))
+    found = _areas(write, "Lot --> splitArea(x){ 10 : A }*\n", rect(12, 8))
+    assert (found["a_n"], found["a_sum"]) == pytest.approx((9, 90.0))
+
+
+def test_split_area_of_a_roof_is_refused(write):
+    records = run(write, "Lot --> roofHip(30) splitArea(x){ '0.5 : A }*\nA --> A.\n", [rect(12, 8)])
+    (bad,) = records["bad"]
+    assert bad.reason.startswith("`splitArea` of a roof is not supported yet")
