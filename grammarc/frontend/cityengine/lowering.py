@@ -437,10 +437,9 @@ class Lowering(OperationLowering, LoweringBase):
             return self.geometry_selector(text, args[0], span)
         if text == "geometry.isRectangular" and not args:
             args = (ir.Num(0.0, span),)
-        if names[0] == "geometry":  # the checker checks the arguments, or names the closest query
-            return ir.Call(text, args, span, self.site())
-        self.unsupported(f"{text}()", span)
-        return ir.placeholder(span)
+        # a geometry query (the checker checks the arguments, or names the closest query), or a function
+        # of an imported file, `prefix.name(...)`, which assembly inlines
+        return ir.Call(text, args, span, self.site())
 
     def geometry_selector(self, query: str, value: ir.Expr, span: Span) -> ir.Expr:
         """``geometry.area(top)``, ``geometry.angle(azimuth)``: the selector as a constant string, the
