@@ -416,6 +416,11 @@ class Lowering(OperationLowering, LoweringBase):
             return ir.ContextRef(text, span)
         if text in ("initialShape.name", "initialShape.startRule"):
             return ir.Call(text, (), span, self.site())
+        if text == "scope.elevation":
+            # the reference: the height of the scope's origin above the sea, the world's y (read only)
+            zero = ir.Num(0.0, span)
+            return self.convert((ir.Name("y", span), ir.Name("scope", span), ir.Name("world", span),
+                                 ir.Name("pos", span), zero, zero, zero), span)
         if text in INITIAL_ORIENTATION:  # the lot's orientation in world: its object system's
             zero = ir.Num(0.0, span)
             return self.convert((ir.Name(INITIAL_ORIENTATION[text], span), ir.Name("object", span),

@@ -174,10 +174,12 @@ def test_brackets_in_bodies_are_still_push_and_pop():
 
 def test_convert_initial_shape_and_print_lower_to_calls():
     """``convert``'s keywords become strings, its form on an array three calls; ``initialShape.origin.o*``
-    is the lot's orientation; the ``print`` function is a call that gives its argument."""
+    is the lot's orientation, ``scope.elevation`` its origin's world y; the ``print`` function is a call that
+    gives its argument."""
     module = module_of(VERSION + "attr a = convert(x, scope, world, pos, 1, 2, 3)\n"
                        "attr b = convert(scope, pivot, orient, [1, 2, 3])\nattr c = initialShape.origin.oy\n"
-                       "attr d = initialShape.name + initialShape.startRule\nattr e = print(2) + 1\nLot --> A\n")
+                       "attr d = initialShape.name + initialShape.startRule\nattr e = print(2) + 1\n"
+                       "attr f = scope.elevation\nLot --> A\n")
     printed = {a.name: print_expr(a.default) for a in module.attrs}
     assert printed["a"] == 'convert("x", "scope", "world", "pos", 1, 2, 3)'
     assert printed["b"] == "[" + ", ".join(f'convert("{c}", "scope", "pivot", "orient", [1, 2, 3][0], '
@@ -185,6 +187,7 @@ def test_convert_initial_shape_and_print_lower_to_calls():
     assert printed["c"] == 'convert("y", "object", "world", "orient", 0, 0, 0)'
     assert printed["d"] == "(initialShape.name() + initialShape.startRule())"
     assert printed["e"] == "(print(2) + 1)"
+    assert printed["f"] == 'convert("y", "scope", "world", "pos", 0, 0, 0)'  # the scope origin's height
 
 
 def test_context_attributes_lower_to_context_refs():
