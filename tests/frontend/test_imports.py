@@ -152,9 +152,9 @@ def test_functions_of_unprefixed_and_nested_imports(tmp_path):
 
 
 def test_an_unknown_function_of_an_imported_file(tmp_path):
-    assert errors(tmp_path, 'import u : "util.cga"\nLot --> s(u.thrice(1), 1, 1) X.\n',
-                  **{"util.cga": UTILITIES}) == [("unknown-function", "unknown function `u.thrice` "
-                                                  "(did you mean `u.twice`?)")]
+    [(code, message)] = errors(tmp_path, 'import u : "util.cga"\nLot --> s(u.thrice(1), 1, 1) X.\n',
+                               **{"util.cga": UTILITIES})
+    assert (code, message) == ("unknown-function", "unknown function `u.thrice` (did you mean `u.twice`?)")
 
 
 # ---------------------------------------------------------------------------------------- the workspace
