@@ -496,15 +496,22 @@ class Lowering(OperationLowering, LoweringBase):
                                   for c in "xyz"),), span)
 
     def occlusion(self, kind: str, args, span) -> ir.Expr:
-        """``inside`` / ``overlaps`` / ``touches([intra|inter|all[, "label"]])``."""
+        """``inside`` / ``overlaps`` / ``touches([target[, label]])``: the target ``intra``, ``inter`` or
+        ``all``, or ``sel(text)`` computed; the label a string, constant or computed."""
+        args = tuple(self.expr(a) for a in args)
         target = args[0].name if args and isinstance(args[0], ir.Name) else None
-        label = args[1] if len(args) == 2 else None
-        if len(args) > 2 or (args and target not in ir.OCCLUSION_TARGETS) or (
-                label is not None and not isinstance(label, ir.Str)):
+        chosen = args[0].args[0] if args and isinstance(args[0], ir.Call) and args[0].func == "sel" \
+            and len(args[0].args) == 1 else None
+        if isinstance(chosen, ir.Str) and chosen.value in ir.OCCLUSION_TARGETS:
+            target, chosen = chosen.value, None
+        if len(args) > 2 or (args and target not in ir.OCCLUSION_TARGETS and chosen is None):
             self.unsupported(f"{kind} with these arguments", span,
-                             f"{kind}(), {kind}(intra|inter|all) and {kind}(intra|inter|all, \"label\")")
+                             f"{kind}(), {kind}(intra|inter|all[, label]) and {kind}(sel(text)[, label])")
             return ir.placeholder(span)
-        return ir.Occlusion(kind, target or "all", label.value if label is not None else None, span)
+        label = args[1] if len(args) == 2 else None
+        constant = label.value if isinstance(label, ir.Str) else None
+        return ir.Occlusion(kind, target or "all", constant, span, which=chosen,
+                            named=None if constant is not None else label)
 
     def elementwise_unary(self, meta, op, operand):
         """``.-a``, ``.+a``, ``.!a`` on arrays (``.+a`` is ``a``)."""
