@@ -235,9 +235,20 @@ class _Inliner:
         return rewrite_expr(expr, visit)
 
     def call(self, fn: FunctionDef, args: tuple, span: Span, calling: tuple[str, ...]) -> ir.Expr:
+        """``fn`` applied to ``args``: its body with the arguments in place of its parameters.
+
+        A recursive function stays an error, though CityEngine evaluates one. Inlined, its depth would
+        be unbounded; evaluated batched, it would need function values in the IR (their parameter and
+        result types inferred through the recursion, a fixed point) and an evaluation that walks the
+        recursion level by level, each level's calls masked by the conditions that reach them (``case``
+        lowers to a ``Select`` that evaluates both branches, which would recurse forever below a base
+        case). Few public files recurse (ESRI.lib's plant distributor filters its string lists so); the
+        error names the function where it calls itself.
+        """
         if fn.name in calling:
             # reported where the function calls itself, once (its body is inlined once)
-            self.diags.error("unsupported", f"unsupported: recursive function `{fn.name}`", span)
+            self.diags.error("unsupported", f"unsupported: recursive function `{fn.name}` (functions are "
+                             "inlined, and a recursion's depth is not known before the derivation)", span)
             return ir.placeholder(span)
         body = self.inlined(fn, calling)
         bound = dict(zip(fn.params, args))
