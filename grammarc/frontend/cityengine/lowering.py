@@ -56,6 +56,9 @@ ANNOTATIONS = frozenset((
 ))
 #: CityEngine built-in functions mapped onto the IR's.
 FUNCTION_NAMES = {"rint": "round", "ln": "log"}
+#: Operations of older CGA versions under their names of today: ESRI.lib's 2014.0 rule files move texture
+#: coordinates with ``offsetUV(uvSet, u, v)``, ``translateUV`` since.
+OPERATION_NAMES = {"offsetUV": "translateUV"}
 SCOPE_MEMBERS = {
     **{f"scope.{f}": f for f in ("sx", "sy", "sz", "tx", "ty", "tz", "rx", "ry", "rz")},
     "initialShape.origin.px": "ox", "initialShape.origin.py": "oy", "initialShape.origin.pz": "oz",
@@ -337,6 +340,7 @@ class Lowering(OperationLowering, LoweringBase):
     def call(self, meta, name, args):
         """``op(args)``: an operation of ``OPERATIONS``, one accepted but not applied, or a rule call."""
         op, span, args = str(name), self.token_span(name), args or ()
+        op = OPERATION_NAMES.get(op, op)
         handler = OPERATIONS.get(op)
         if handler is not None:
             return handler(self, op, args, span)

@@ -387,3 +387,8 @@ def test_a_label_is_any_string_expression():
     assert body_of(VERSION + 'attr mark = "kiosk"\nLot --> label(mark) label("k" + mark) A\n') == \
         'label(@mark) label(("k" + @mark)) A'
     assert errors(VERSION + "Lot --> label(3) A\n") == [(2, 15, "a label must be a str, got a num")]
+
+
+def test_an_operation_of_an_older_cga_version_is_todays():
+    """ESRI.lib's 2014.0 files write ``offsetUV``, today's ``translateUV``."""
+    assert body_of(VERSION + "Lot --> offsetUV(0, 0.5, 0) A\n") == body_of(VERSION + "Lot --> translateUV(0, 0.5, 0) A\n")
