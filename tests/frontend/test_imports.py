@@ -157,6 +157,11 @@ def test_an_unknown_function_of_an_imported_file(tmp_path):
     assert (code, message) == ("unknown-function", "unknown function `u.thrice` (did you mean `u.twice`?)")
 
 
+def test_calls_through_the_prefix_of_an_import_that_failed_are_not_reported_again(tmp_path):
+    [(code, message)] = errors(tmp_path, 'import u : "gone.cga"\nLot --> s(u.twice(1), u.half, 1) X.\n')
+    assert (code, message) == ("import", f"cannot import: `gone.cga` is not found in {tmp_path}")
+
+
 # ---------------------------------------------------------------------------------------- the workspace
 
 

@@ -33,6 +33,7 @@ def assemble(file: str, statements: list, diags: Diagnostics, imports=(), export
     rules: list[tuple[RuleDef, tuple]] = []
     extensions: list[tuple[RuleDef, tuple]] = []
     style = None
+    prefixes: set[str] = set()
     for st in statements:
         if not isinstance(st, Annotated):
             st = Annotated((), st)  # a declaration without annotations comes bare from the parser
@@ -54,6 +55,7 @@ def assemble(file: str, statements: list, diags: Diagnostics, imports=(), export
         elif isinstance(decl, RuleDef):
             rules.append((decl, st.annotations))
         elif isinstance(decl, Import):  # `import p : "f.cga" (Ext --> ...)` redefines p.Ext here
+            prefixes.add(decl.prefix)
             extensions.extend((replace(r, name=_in(decl.prefix, r.name)), ()) for r in decl.extensions)
     rules.extend(extensions)  # after the file's own rules: never its first rule
     arities: dict[str, set[int]] = {}
@@ -64,6 +66,8 @@ def assemble(file: str, statements: list, diags: Diagnostics, imports=(), export
         return f"{name}/{arity}" if len(arities.get(name, ())) > 1 else name
 
     inline = _Inliner(functions, {a.name for a in attrs}, diags)
+    # a name or call through the prefix of an import that failed is not reported: the import's error says why
+    inline.unread = prefixes - {statement.prefix for statement, _, _ in imports} - {None}
     forwarding = []
     for statement, module, functions_of in imports:
         forwarded = set() if statement.protect_all else \
@@ -178,6 +182,8 @@ class _Inliner:
         self.bodies: dict[str, ir.Expr] = {}
         #: An imported function's name here -> what gives its body in this file's terms (``take``).
         self.foreign: dict[str, Callable[[], ir.Expr]] = {}
+        #: The prefixes of the imports that could not be read.
+        self.unread: set[str] = set()
 
     def take(self, exports: dict, prefix: str | None, own_attrs: set[str]) -> None:
         """Make an imported file's functions (its ``exports``) callable here as ``prefix.name(...)``,
@@ -211,6 +217,9 @@ class _Inliner:
     def expr(self, expr: ir.Expr, params: frozenset, calling: tuple[str, ...] = ()) -> ir.Expr:
         """``expr`` with user functions inlined; ``calling`` are the functions being inlined around it."""
         def visit(e: ir.Expr) -> ir.Expr:
+            called = e.name if isinstance(e, ir.Name) else e.func if isinstance(e, ir.Call) else ""
+            if "." in called and called.partition(".")[0] in self.unread:
+                return ir.placeholder(e.span)
             if isinstance(e, ir.Name) and e.name not in params and e.name not in self.attrs \
                     and e.name in self.functions and not self.functions[e.name].params:
                 return self.call(self.functions[e.name], (), e.span, calling)
