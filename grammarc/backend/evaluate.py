@@ -39,8 +39,8 @@ def evaluate(expr: ir.Expr, env: Env):
     if isinstance(expr, ir.ContextRef):
         return env.shapes.dynamic[env.plan.dynamic[expr.name]]
     if isinstance(expr, ir.Occlusion):
-        distance = evaluate(expr.distance, env) if expr.distance is not None else None
-        return occlusion.query(expr, env, distance)
+        distance, which, named = (None if e is None else evaluate(e, env) for e in (expr.distance, expr.which, expr.named))
+        return occlusion.query(expr, env, distance, which, named)
     if isinstance(expr, ir.Select):
         cond = evaluate(expr.cond, env)
         then, other = evaluate(expr.then, env), evaluate(expr.other, env)

@@ -111,10 +111,10 @@ class OccluderStore:
         return Occluders.concat(self.tables)
 
 
-def add_occluders(chunk, shapes, label: str | None = None, active: bool = True) -> np.ndarray:
+def add_occluders(chunk, shapes, label: str | np.ndarray | None = None, active: bool = True) -> np.ndarray:
     """Store the closed solids among ``shapes`` (scope boxes and polygon prisms) as occluders of their
-    lots (``active``: leaves, not shapes being taken apart); returns each shape's new id (NaN for a
-    shape that is not a solid)."""
+    lots (``active``: leaves, not shapes being taken apart), labelled ``label`` (one, or (n,) texts, one
+    a shape); returns each shape's new id (NaN for a shape that is not a solid)."""
     ident = np.full(len(shapes), np.nan)
     flat = (shapes.size <= 1e-9).any(axis=1)
     polygon = is_polygon(shapes.geom)
@@ -142,7 +142,8 @@ def add_occluders(chunk, shapes, label: str | None = None, active: bool = True) 
     polygons[~is_poly] = shapely.box(0, 0, sub.size[k, PLANE_U[plane]][~is_poly], sub.size[k, PLANE_V[plane]][~is_poly])
     if is_poly.any():
         polygons[is_poly] = scope_polygons(chunk.polygons, sub.geom[is_poly], sub.size[is_poly])
-    store.tables.append(Occluders(chunk.lot_index[lot], ident[rows], np.full(len(rows), label, dtype=object),
+    labels = label[rows] if isinstance(label, np.ndarray) else np.full(len(rows), label, dtype=object)
+    store.tables.append(Occluders(chunk.lot_index[lot], ident[rows], labels,
                                   np.full(len(rows), active),
                                   prisms(sub.origin.copy(), chunk.frames[sub.frame], plane, sub.size[k, plane], polygons)))
     return ident
@@ -178,12 +179,24 @@ def occluder_label(plan, symbol: int) -> str | None:
     return None if plan.leaf_bodies else plan.symbols[symbol].name
 
 
-def query(expr, env, distance: np.ndarray | None = None) -> np.ndarray:
+def interned_texts(plan, ids: np.ndarray) -> np.ndarray:
+    """The texts (objects) of interned string ``ids``, as occluders keep their labels."""
+    return np.array(list(plan.strings.ids), dtype=object)[ids]
+
+
+def query(expr, env, distance: np.ndarray | None = None, which: np.ndarray | None = None,
+          named: np.ndarray | None = None) -> np.ndarray:
     """The answer of an ``ir.Occlusion`` for every shape of ``env``: (n,) bool, or for the paper's
     ``Shape.occ`` the interned strings "none", "part", "full" (n,); ``distance`` (n,) the value of its
-    ``distance`` expression."""
+    ``distance`` expression, ``which`` and ``named`` (n,) interned strings those of its computed target
+    and label. A computed target ``intra`` tests the shape's own lot, ``inter`` the others, any other
+    text (``all``) both."""
     shapes, chunk = env.shapes, env.chunk
     n = len(shapes)
+    if which is not None:
+        which = np.broadcast_to(interned_texts(env.plan, which), (n,))
+    if named is not None:
+        named = np.broadcast_to(interned_texts(env.plan, named), (n,))
     if expr.kind == "visible":
         return _visible(shapes, chunk)
     occ = expr.kind == "occ"
@@ -192,11 +205,15 @@ def query(expr, env, distance: np.ndarray | None = None) -> np.ndarray:
     distance = np.zeros(n) if distance is None else np.broadcast_to(np.asarray(distance, np.float64), (n,))
     own = chunk.lot_index[shapes.lot]
     ancestors = np.stack([shapes.dynamic[env.plan.dynamic[name]] for name in ANCESTORS], axis=1)
-    for table, intra in _sources(chunk, expr.target):
+    for table, intra in _sources(chunk, expr.target if which is None else "all"):
         if expr.label is not None or expr.active:
             table = table.take(np.flatnonzero((table.label == expr.label) if expr.label is not None else table.active))
         rows, occluder = _pairs(shapes, chunk, table, distance)
         keep = (table.lot[occluder] == own[rows]) == intra
+        if which is not None:
+            keep &= which[rows] != ("inter" if intra else "intra")
+        if named is not None:
+            keep &= table.label[occluder] == named[rows]
         if intra and not expr.parents:
             keep &= ~(ancestors[rows] == table.ident[occluder, None]).any(axis=1)
         rows, occluder = rows[keep], occluder[keep]

@@ -80,13 +80,15 @@ _TERMINALS = {
 
 def parse_source(text: str, file: str, diags: Diagnostics, dialect: str | None = None, *,
                  path: Path | None = None, sources: dict[str, str] | None = None, sites=None,
-                 importing: tuple[Path, ...] = (), roots: Roots | None = None) -> ir.Module:
+                 importing: tuple[Path, ...] = (), roots: Roots | None = None,
+                 exports: dict | None = None) -> ir.Module:
     """Parse and lower ``text`` (named ``file`` in diagnostics); problems go to ``diags``.
 
     ``dialect`` is ``cga2006`` or ``cityengine``; by default it is detected from the text. ``path`` is
     the file on disk, from which CityEngine ``import``s are resolved inside ``roots`` (by default those
     of ``path``, ``imports.find_roots``); the texts of imported files are added to ``sources`` (for
-    diagnostics); ``sites`` numbers random-stream sites across imported files.
+    diagnostics); ``sites`` numbers random-stream sites across imported files. A CityEngine file's
+    functions, which an importing file calls as ``prefix.name(...)``, go to ``exports`` (``assemble``).
     """
     text = text.removeprefix("\ufeff")  # a UTF-8 byte order mark, read as text
     spec = DIALECTS[dialect or detect_dialect(text)]
@@ -112,10 +114,10 @@ def parse_source(text: str, file: str, diags: Diagnostics, dialect: str | None =
     for st in lowered:
         declaration = getattr(st, "declaration", st)
         if isinstance(declaration, Import):
-            module = _import(declaration, file, path, diags, sources, sites, importing, roots)
-            if module is not None:
-                imports.append((declaration, module))
-    return spec.assemble(file, lowered, diags, imports)
+            imported = _import(declaration, file, path, diags, sources, sites, importing, roots)
+            if imported is not None:
+                imports.append((declaration, *imported))
+    return spec.assemble(file, lowered, diags, imports, exports)
 
 
 #: The deepest parse tree a statement may have. Lowering, the IR passes and the derivation walk a
@@ -138,7 +140,8 @@ def _too_deep(tree: Tree) -> bool:
 
 
 def _import(statement, file: str, path: Path | None, diags: Diagnostics, sources, sites, importing, roots):
-    """Parse the file an ``import`` names (``imports.load_import`` finds and reads it)."""
+    """The module and the functions of the file an ``import`` names (``imports.load_import`` finds and
+    reads it)."""
     roots = roots or (find_roots(path) if path is not None else None)
     loaded = load_import(statement, file, path, roots, importing, diags)
     if loaded is None:
@@ -146,8 +149,10 @@ def _import(statement, file: str, path: Path | None, diags: Diagnostics, sources
     display, text, target = loaded
     if sources is not None:
         sources[display] = text
-    return parse_source(text, display, diags, "cityengine", path=target, sources=sources, sites=sites,
-                        importing=(*importing, path.resolve()), roots=roots)
+    exports: dict = {}
+    module = parse_source(text, display, diags, "cityengine", path=target, sources=sources, sites=sites,
+                          importing=(*importing, path.resolve()), roots=roots, exports=exports)
+    return module, exports
 
 
 def _syntax_error(error: UnexpectedInput, file: str, text: str, first_line: int, diags: Diagnostics):

@@ -5,9 +5,9 @@
 paper's mass-model blocks ``L``, ``H``, ``U``, ``T``; CityEngine's ``builtin:cube:notex``, a cube without
 texture coordinates, is the cube: records carry none); ``I("facade/window.obj")`` names a file relative to
 an asset root (the grammar's folder first, then any ``--assets`` folders). The record keeps a canonical name: ``builtin:NAME`` or the POSIX path
-relative to the root that holds it. A name that is absolute or climbs out of every root
+relative to the root that holds it. A drive path (``C:/x.obj``) or a name that climbs out of every root
 (``../../etc/passwd``) is refused: grammars are shared, and a rule file must not read outside the folders
-its user gave.
+its user gave; a workspace path ``/Project/...`` is looked up inside them only.
 
 It is part of the IR because compiling resolves the names (``passes.assets``); the writers and the
 baker that load the files ask it too.
@@ -79,7 +79,8 @@ def resolve_asset(name: str, roots: list[Path]) -> ResolvedAsset:
     A workspace path ``/Project/assets/x.obj`` (CityEngine's absolute paths, which start at the
     workspace) is looked up as ``Project/assets/x.obj`` in the roots (one of them may be a workspace, a
     folder of projects), else, when no root holds a folder ``Project``, as ``assets/x.obj`` (a rule package
-    or a lone project is the project its paths name). A drive path ``C:/...`` is refused, as is a name that
+    or a lone project is the project its paths name); when no root holds it, it is missing, as a relative
+    name is. A drive path ``C:/...`` (the host's, never the workspace's) is refused, as is a name that
     climbs out of every root or holds a NUL byte.
     """
     bare = name.removeprefix("builtin:")
@@ -102,8 +103,9 @@ def resolve_asset(name: str, roots: list[Path]) -> ResolvedAsset:
         root, path = found
         return ResolvedAsset(path.relative_to(root).as_posix(), path)
     if pure.is_absolute():
-        return ResolvedAsset(name, None, problem=f"asset path `{name}` is absolute and no workspace holds "
-                             "it; give it relative to the grammar's folder or an --assets folder")
+        # a workspace path that no root holds is missing, as in CityEngine, which inserts nothing for it;
+        # only the roots were searched, so nothing outside them was read
+        return ResolvedAsset(pure.as_posix(), None, missing=True)
     if not any(_inside((r.resolve() / pure).resolve(), r.resolve()) for r in roots):
         return ResolvedAsset(name, None, problem=f"asset path `{name}` leaves the asset folders "
                              f"({', '.join(str(r) for r in roots)})")

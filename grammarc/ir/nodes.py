@@ -260,7 +260,11 @@ class Occlusion:
     (``inter``) or of either (``all``), of any label or of ``label`` (``backend.occlusion``). The
     paper's ``Shape.occ(...)`` is kind ``occ``: ``"none"``, ``"part"`` or ``"full"``, against the shapes
     of every lot, its ancestors too unless ``parents`` is false, leaves only if ``active``, the scope
-    enlarged by ``distance``."""
+    enlarged by ``distance``.
+
+    CityEngine's target may be computed, ``inside(sel(text), ...)`` (``sel`` makes a selector of a
+    string): ``which`` is that string per shape, in place of ``target``; a label may be any string
+    expression, ``named``, in place of the constant ``label``."""
 
     kind: str
     target: str
@@ -269,6 +273,8 @@ class Occlusion:
     parents: bool = False
     active: bool = False
     distance: Expr | None = child(Type.NUM, "a distance", default=None)
+    which: Expr | None = child(Type.STR, "an occlusion target", default=None)
+    named: Expr | None = child(Type.STR, "an occlusion label", default=None)
 
 
 @dataclass(frozen=True, slots=True)
@@ -441,9 +447,10 @@ class Repeat:
 
 @dataclass(frozen=True, slots=True)
 class Label:
-    """CityEngine's ``label(name)``: the shape's closed geometry becomes an occluder with that label."""
+    """CityEngine's ``label(name)``: the shape's closed geometry becomes an occluder with that label, a
+    string per shape (``label(occlusionLabel)``, an attribute, is common)."""
 
-    name: str
+    name: Expr = child(Type.STR, "a label")
     span: Span = NO_SPAN
 
 

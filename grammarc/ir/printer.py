@@ -29,8 +29,9 @@ def _occlusion(e: ir.Occlusion) -> str:
         which = e.label if e.label is not None else "active" if e.active else "all" if e.parents else "noparent"
         distance = f', "distance", {print_expr(e.distance)}' if e.distance is not None else ""
         return f'Shape.occ("{which}"{distance})'
-    label = f', "{e.label}"' if e.label is not None else ""
-    return f"{e.kind}({e.target}{label})"
+    target = e.target if e.which is None else f"sel({print_expr(e.which)})"
+    label = f', "{e.label}"' if e.label is not None else f", {print_expr(e.named)}" if e.named is not None else ""
+    return f"{e.kind}({target}{label})"
 
 
 _EXPR_FORMATS = {
@@ -153,7 +154,7 @@ _OP_FORMATS = {
                           f"{_label(op.snap_label)}){_parts(op.parts)}"),
     ir.Repeat: lambda op: (f"Repeat({_axes(op.axes, op.snap)}, {_list(op.sizes)}{_label(op.snap_label)})"
                            f"{_parts(op.parts)}"),
-    ir.Label: lambda op: f'label("{op.name}")',
+    ir.Label: lambda op: f"label({print_expr(op.name)})",
     ir.Snap: lambda op: f'{"SnapLines" if op.lines else "Snap"}("{_SNAP_AXES[op.normal]}"{_label(op.label)})',
     ir.Comp: lambda op: (f'Comp("{op.kind}"{f", {print_expr(op.index)}" if op.index is not None else ""})'
                          f"{_parts(op.parts)}"),

@@ -63,6 +63,26 @@ Cell --> case overlaps(all, "kiosk") : Taken. case touches(all, "tree") : Shaded
     assert count(r, "Taken") == 2 and count(r, "Free") == 8
 
 
+def test_targets_and_labels_computed_per_lot(write):
+    """``label(variable)`` and ``touches(sel(variable), variable)``, as ESRI.lib's fences write them: each lot
+    labels its kiosk and seeks its own label, in the targets its attribute names."""
+    text = """
+attr mark = "kiosk"
+attr seek = "kiosk"
+attr where = "all"
+Lot --> [ s(4, 3, 4) t(2, 0, 2) primitiveCube() label(mark) ] extrude(10) comp(f){ bottom : Floor }
+Floor --> split(x){ ~2 : Cell }*
+Cell --> case touches(sel(where), seek) : Taken. else : Free.
+"""
+    lots = [[np.array([[x, 0], [x + 20, 0], [x + 20, 20], [x, 20]], float)] for x in (0, 100, 200, 300, 400)]
+    attrs = {"mark": ["kiosk", "kiosk", "kiosk", "kiosk", "tree"], "seek": ["kiosk", "tree", "kiosk", "kiosk", "tree"],
+             "where": ["all", "all", "inter", "intra", "sel"]}
+    r = run(write, text, lots, lot_attrs=attrs)
+    taken = np.array(names(r)) == "Taken"
+    # the lots far apart see only their own kiosk: where they seek it, with its label, in their own lot
+    assert np.bincount(r["lot"][taken], minlength=5).tolist() == [2, 0, 0, 2, 2]
+
+
 FIG13 = """
 lot ~> S(1r, 10, 1r) facades
 facades ~> Comp("sidefaces"){ facade }

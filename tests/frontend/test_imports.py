@@ -117,6 +117,51 @@ def test_a_prefixed_leaf(tmp_path):
     assert rules(grammar)["Lot"] == "Lot ~> st.Lot st.Facade. : 1"
 
 
+# ------------------------------------------------------------------------------------------- functions
+
+#: An imported file of functions: one calls another and reads an attribute and a constant of the file.
+UTILITIES = VERSION + ("attr base = 2\nconst factor = 3\n"
+                       "twice(x) = x * 2 + base\nscaled = factor * twice(1)\n"
+                       'size(x) = case x > 1 : "big" else : "small"\n')
+
+
+def test_functions_and_constants_of_an_imported_file_are_called_through_its_prefix(tmp_path):
+    grammar = compiled(tmp_path, 'import u : "util.cga"\nattr h = u.twice(4) + u.scaled\nattr kind = u.size(h)\n'
+                       "Lot --> extrude(u.twice(h)) s(u.factor, '1, '1) X.\n",
+                       **{"util.cga": UTILITIES})
+    # the body is inlined in the imported file's scope: its attributes and constants under the prefix
+    assert attrs(grammar) == {"h": "((8 + @u.base) + (@u.factor * (2 + @u.base)))",
+                              "kind": '((@h > 1) ? "big" : "small")', "u.base": "2", "u.factor": "3"}
+    assert rules(grammar)["Lot"] == "Lot ~> extrude(((@h * 2) + @u.base)) S(@u.factor, 1r, 1r) X. : 1"
+
+
+def test_an_imported_function_reads_the_importing_files_attribute_unless_protected(tmp_path):
+    grammar = compiled(tmp_path, 'import a : "util.cga"\nimport b : "util.cga" (base)\nattr base = 10\n'
+                       "Lot --> s(a.twice(1), b.twice(1), 1) X.\n", **{"util.cga": UTILITIES})
+    assert rules(grammar)["Lot"] == "Lot ~> S((2 + @base), (2 + @b.base), 1) X. : 1"
+
+
+def test_functions_of_unprefixed_and_nested_imports(tmp_path):
+    grammar = compiled(tmp_path, 'import "util.cga"\nimport o : "outer.cga"\n'
+                       "twice(x) = x\nLot --> s(twice(5), scaled, o.u.twice(o.half(6))) X.\n",
+                       **{"util.cga": UTILITIES,
+                          "outer.cga": VERSION + 'import u : "util.cga"\nhalf(x) = u.twice(x) / 2\n'})
+    # the file's own `twice` wins over the unprefixed import's
+    assert rules(grammar)["Lot"] == ("Lot ~> S(5, (@factor * (2 + @base)), ((((12 + @o.u.base) / 2) * 2) "
+                                     "+ @o.u.base)) X. : 1")
+
+
+def test_an_unknown_function_of_an_imported_file(tmp_path):
+    [(code, message)] = errors(tmp_path, 'import u : "util.cga"\nLot --> s(u.thrice(1), 1, 1) X.\n',
+                               **{"util.cga": UTILITIES})
+    assert (code, message) == ("unknown-function", "unknown function `u.thrice` (did you mean `u.twice`?)")
+
+
+def test_calls_through_the_prefix_of_an_import_that_failed_are_not_reported_again(tmp_path):
+    [(code, message)] = errors(tmp_path, 'import u : "gone.cga"\nLot --> s(u.twice(1), u.half, 1) X.\n')
+    assert (code, message) == ("import", f"cannot import: `gone.cga` is not found in {tmp_path}")
+
+
 # ---------------------------------------------------------------------------------------- the workspace
 
 

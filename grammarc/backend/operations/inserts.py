@@ -13,7 +13,7 @@ import numpy as np
 from grammarc.backend import terminals
 from grammarc.backend.context import Context
 from grammarc.backend.evaluate import evaluate_array
-from grammarc.backend.occlusion import add_occluders, occluder_label, with_ancestor
+from grammarc.backend.occlusion import add_occluders, interned_texts, occluder_label, with_ancestor
 from grammarc.backend.operations.table import operation
 from grammarc.backend.shapes import Z_UP, Shapes, asset_geom
 from grammarc.ir import nodes as ir
@@ -104,4 +104,6 @@ def _bounds(ctx: Context, cursor: Shapes, op: ir.UseAsset, asset: np.ndarray) ->
 @operation(ir.Label, writes=("dynamic",), meshes=True)
 def label(ctx: Context, cursor: Shapes, op: ir.Label) -> Shapes:
     """``label(name)``: the shape's solid is an occluder with that label, and its own ancestor."""
-    return with_ancestor(ctx.plan, cursor, add_occluders(ctx.chunk, cursor, op.name))
+    name = op.name.value if isinstance(op.name, ir.Str) else \
+        interned_texts(ctx.plan, evaluate_array(op.name, ctx.env(cursor), dtype=np.int32))
+    return with_ancestor(ctx.plan, cursor, add_occluders(ctx.chunk, cursor, name))

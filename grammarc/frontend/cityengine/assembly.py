@@ -5,7 +5,9 @@ under their prefixes.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import replace
+from functools import partial
 
 from grammarc.diagnostics import Diagnostics, Span, suggest
 from grammarc.frontend.cityengine.nodes import Annotated, FunctionDef, Import, RuleDef, Style
@@ -15,15 +17,23 @@ from grammarc.ir.functions import FUNCTIONS, UNSUPPORTED_FUNCTIONS
 from grammarc.ir.traverse import rewrite_body, rewrite_expr, rewrite_ops
 
 
-def assemble(file: str, statements: list, diags: Diagnostics, imports=()) -> ir.Module:
+def assemble(file: str, statements: list, diags: Diagnostics, imports=(), exports: dict | None = None) -> ir.Module:
     """Declarations in source order -> Module: start rule, overloads by arity, functions inlined, the
-    imported modules' rules and attributes merged under their prefixes. Without ``@StartRule`` the start
-    is None: ``passes.rulegraph`` starts with the first rule and says so."""
+    imported modules' rules, attributes and functions merged under their prefixes. Without ``@StartRule``
+    the start is None: ``passes.rulegraph`` starts with the first rule and says so.
+
+    ``imports`` are (``Import``, module, its exports) of the files imported; ``exports``, when given, is
+    filled with this file's functions for a file that imports it: name -> (``FunctionDef``, a callable
+    giving its body in this file's scope, ``_Inliner.exported``), the functions of its own imports under
+    their prefixes included. A body is inlined when a caller asks for it, so that a function nobody
+    calls is never inlined (nor reported) twice.
+    """
     attrs: list[ir.AttrDecl] = []
     functions: dict[str, FunctionDef] = {}
     rules: list[tuple[RuleDef, tuple]] = []
     extensions: list[tuple[RuleDef, tuple]] = []
     style = None
+    prefixes: set[str] = set()
     for st in statements:
         if not isinstance(st, Annotated):
             st = Annotated((), st)  # a declaration without annotations comes bare from the parser
@@ -45,6 +55,7 @@ def assemble(file: str, statements: list, diags: Diagnostics, imports=()) -> ir.
         elif isinstance(decl, RuleDef):
             rules.append((decl, st.annotations))
         elif isinstance(decl, Import):  # `import p : "f.cga" (Ext --> ...)` redefines p.Ext here
+            prefixes.add(decl.prefix)
             extensions.extend((replace(r, name=_in(decl.prefix, r.name)), ()) for r in decl.extensions)
     rules.extend(extensions)  # after the file's own rules: never its first rule
     arities: dict[str, set[int]] = {}
@@ -55,6 +66,16 @@ def assemble(file: str, statements: list, diags: Diagnostics, imports=()) -> ir.
         return f"{name}/{arity}" if len(arities.get(name, ())) > 1 else name
 
     inline = _Inliner(functions, {a.name for a in attrs}, diags)
+    # a name or call through the prefix of an import that failed is not reported: the import's error says why
+    inline.unread = prefixes - {statement.prefix for statement, _, _ in imports} - {None}
+    forwarding = []
+    for statement, module, functions_of in imports:
+        forwarded = set() if statement.protect_all else \
+            {a.name for a in attrs} - set(statement.protected) - {v.name for v in statement.values}
+        inline.take(functions_of, statement.prefix, {a.name for a in module.attrs} - forwarded)
+        forwarding.append(forwarded)
+    if exports is not None:
+        exports.update((name, (fn, partial(inline.exported, name))) for name, fn in inline.functions.items())
     attrs = [replace(a, default=inline.expr(a.default, frozenset())) for a in attrs]
     start = None
     lowered: list[ir.Rule] = []
@@ -70,13 +91,11 @@ def assemble(file: str, statements: list, diags: Diagnostics, imports=()) -> ir.
         lowered.append(ir.Rule(symbol=name, params=rule.params, guard=None,
                                alternatives=(ir.Alternative(body, None, rule.span),), priority=0,
                                span=rule.span, site=rule.site))
-    lowered = check_calls(lowered, [module for _, module in imports], diags)
+    lowered = check_calls(lowered, [module for _, module, _ in imports], diags)
     imported = []
     own = {rule.symbol for rule in lowered}
-    for statement, module in imports:
+    for (statement, module, _), forwarded in zip(imports, forwarding):
         values = {v.name: inline.expr(v.default, frozenset()) for v in statement.values}
-        forwarded = set() if statement.protect_all else \
-            {a.name for a in attrs} - set(statement.protected) - set(values)
         for name in sorted(set(values) - {a.name for a in module.attrs}):
             diags.warning("import", f"`{statement.path}` declares no attribute `{name}`: its value is not "
                           "used", statement.span)
@@ -102,16 +121,7 @@ def _prefixed(module: ir.Module, prefix: str | None, forwarded: set[str], values
         return [replace(a, default=values[a.name]) if a.name in values else a
                 for a in module.attrs if a.name not in forwarded], list(module.rules)
     own_attrs = {a.name for a in module.attrs} - forwarded
-
-    def rename(params):
-        def visit(e):
-            if isinstance(e, ir.Name) and e.name in own_attrs and e.name not in params:
-                return replace(e, name=f"{prefix}.{e.name}")
-            if isinstance(e, ir.AttrRef) and e.name in own_attrs:  # from an inlined function
-                return replace(e, name=f"{prefix}.{e.name}")
-            return e
-        return visit
-
+    rename = partial(_renaming, prefix, own_attrs)
     attrs = [replace(a, name=f"{prefix}.{a.name}", default=values[a.name] if a.name in values
                      else rewrite_expr(a.default, rename(())))
              for a in module.attrs if a.name in own_attrs]
@@ -123,6 +133,22 @@ def _prefixed(module: ir.Module, prefix: str | None, forwarded: set[str], values
             bodies.append(replace(alt, body=rewrite_body(body, rename(set(rule.params)))))
         rules.append(replace(rule, symbol=f"{prefix}.{rule.symbol}", alternatives=tuple(bodies)))
     return attrs, rules
+
+
+def _renaming(prefix: str, own_attrs: set[str], params):
+    """The rewrite that names an imported file's own attributes (``own_attrs``, not those forwarded to the
+    importing file's) ``prefix.name`` in one of its expressions, where ``params`` are no attributes."""
+    def visit(e):
+        if isinstance(e, ir.Name) and e.name in own_attrs and e.name not in params:
+            return replace(e, name=f"{prefix}.{e.name}")
+        if isinstance(e, ir.AttrRef) and e.name in own_attrs:  # from an inlined function
+            return replace(e, name=f"{prefix}.{e.name}")
+        return e
+    return visit
+
+
+def _renamed(body: Callable[[], ir.Expr], visit) -> ir.Expr:
+    return rewrite_expr(body(), visit)
 
 
 def _without_numbers(body: ir.Body, diags: Diagnostics) -> ir.Body:
@@ -154,10 +180,46 @@ class _Inliner:
         self.diags = diags
         #: Function name -> its body with the functions it calls inlined (computed once per function).
         self.bodies: dict[str, ir.Expr] = {}
+        #: An imported function's name here -> what gives its body in this file's terms (``take``).
+        self.foreign: dict[str, Callable[[], ir.Expr]] = {}
+        #: The prefixes of the imports that could not be read.
+        self.unread: set[str] = set()
+
+    def take(self, exports: dict, prefix: str | None, own_attrs: set[str]) -> None:
+        """Make an imported file's functions (its ``exports``) callable here as ``prefix.name(...)``,
+        or by their names for an import without a prefix (a function of this file's own wins, as its
+        rules do). As CityEngine resolves an imported function, its body sees the imported file's
+        attributes and constants, named ``prefix.attr`` here (``own_attrs``), except those forwarded to
+        this file's attributes of the same name."""
+        for name, (fn, body) in exports.items():
+            called = name if prefix is None else f"{prefix}.{name}"
+            if called in self.functions:
+                continue
+            self.functions[called] = replace(fn, name=called)
+            self.foreign[called] = body if prefix is None else \
+                partial(_renamed, body, _renaming(prefix, own_attrs, set(fn.params)))
+
+    def exported(self, name: str) -> ir.Expr:
+        """The body of this file's function ``name`` for a file that imports it: the functions it calls
+        inlined, this file's attributes and constants as ``AttrRef``, its parameters as names."""
+        fn = self.functions[name]
+        return rewrite_expr(self.inlined(fn, ()), lambda e: ir.AttrRef(e.name, e.span) if isinstance(e, ir.Name)
+                            and e.name in self.attrs and e.name not in fn.params else e)
+
+    def inlined(self, fn: FunctionDef, calling: tuple[str, ...]) -> ir.Expr:
+        """``fn``'s body with the functions it calls inlined, its parameters bare names."""
+        if fn.name not in self.bodies:
+            foreign = self.foreign.get(fn.name)
+            self.bodies[fn.name] = foreign() if foreign is not None else \
+                self.expr(fn.value, frozenset(fn.params), (*calling, fn.name))
+        return self.bodies[fn.name]
 
     def expr(self, expr: ir.Expr, params: frozenset, calling: tuple[str, ...] = ()) -> ir.Expr:
         """``expr`` with user functions inlined; ``calling`` are the functions being inlined around it."""
         def visit(e: ir.Expr) -> ir.Expr:
+            called = e.name if isinstance(e, ir.Name) else e.func if isinstance(e, ir.Call) else ""
+            if "." in called and called.partition(".")[0] in self.unread:
+                return ir.placeholder(e.span)
             if isinstance(e, ir.Name) and e.name not in params and e.name not in self.attrs \
                     and e.name in self.functions and not self.functions[e.name].params:
                 return self.call(self.functions[e.name], (), e.span, calling)
@@ -182,12 +244,22 @@ class _Inliner:
         return rewrite_expr(expr, visit)
 
     def call(self, fn: FunctionDef, args: tuple, span: Span, calling: tuple[str, ...]) -> ir.Expr:
+        """``fn`` applied to ``args``: its body with the arguments in place of its parameters.
+
+        A recursive function stays an error, though CityEngine evaluates one. Inlined, its depth would
+        be unbounded; evaluated batched, it would need function values in the IR (their parameter and
+        result types inferred through the recursion, a fixed point) and an evaluation that walks the
+        recursion level by level, each level's calls masked by the conditions that reach them (``case``
+        lowers to a ``Select`` that evaluates both branches, which would recurse forever below a base
+        case). Few public files recurse (ESRI.lib's plant distributor filters its string lists so); the
+        error names the function where it calls itself.
+        """
         if fn.name in calling:
             # reported where the function calls itself, once (its body is inlined once)
-            self.diags.error("unsupported", f"unsupported: recursive function `{fn.name}`", span)
+            self.diags.error("unsupported", f"unsupported: recursive function `{fn.name}` (functions are "
+                             "inlined, and a recursion's depth is not known before the derivation)", span)
             return ir.placeholder(span)
-        if fn.name not in self.bodies:
-            self.bodies[fn.name] = self.expr(fn.value, frozenset(fn.params), (*calling, fn.name))
+        body = self.inlined(fn, calling)
         bound = dict(zip(fn.params, args))
 
         def substitute(e: ir.Expr) -> ir.Expr:
@@ -197,4 +269,4 @@ class _Inliner:
                 return bound[e.name]  # the caller's expression, already inlined in the caller's scope
             return ir.AttrRef(e.name, e.span) if e.name in self.attrs else e
 
-        return rewrite_expr(self.bodies[fn.name], substitute)
+        return rewrite_expr(body, substitute)

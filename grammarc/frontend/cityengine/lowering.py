@@ -57,6 +57,9 @@ ANNOTATIONS = frozenset((
 ))
 #: CityEngine built-in functions mapped onto the IR's.
 FUNCTION_NAMES = {"rint": "round", "ln": "log"}
+#: Operations of older CGA versions under their names of today: ESRI.lib's 2014.0 rule files move texture
+#: coordinates with ``offsetUV(uvSet, u, v)``, ``translateUV`` since.
+OPERATION_NAMES = {"offsetUV": "translateUV"}
 SCOPE_MEMBERS = {
     **{f"scope.{f}": f for f in ("sx", "sy", "sz", "tx", "ty", "tz", "rx", "ry", "rz")},
     "initialShape.origin.px": "ox", "initialShape.origin.py": "oy", "initialShape.origin.pz": "oz",
@@ -338,6 +341,7 @@ class Lowering(OperationLowering, LoweringBase):
     def call(self, meta, name, args):
         """``op(args)``: an operation of ``OPERATIONS``, one accepted but not applied, or a rule call."""
         op, span, args = str(name), self.token_span(name), args or ()
+        op = OPERATION_NAMES.get(op, op)
         handler = OPERATIONS.get(op)
         if handler is not None:
             return handler(self, op, args, span)
@@ -417,6 +421,11 @@ class Lowering(OperationLowering, LoweringBase):
             return ir.ContextRef(text, span)
         if text in ("initialShape.name", "initialShape.startRule"):
             return ir.Call(text, (), span, self.site())
+        if text == "scope.elevation":
+            # the reference: the height of the scope's origin above the sea, the world's y (read only)
+            zero = ir.Num(0.0, span)
+            return self.convert((ir.Name("y", span), ir.Name("scope", span), ir.Name("world", span),
+                                 ir.Name("pos", span), zero, zero, zero), span)
         if text in INITIAL_ORIENTATION:  # the lot's orientation in world: its object system's
             zero = ir.Num(0.0, span)
             return self.convert((ir.Name(INITIAL_ORIENTATION[text], span), ir.Name("object", span),
@@ -438,10 +447,9 @@ class Lowering(OperationLowering, LoweringBase):
             return self.geometry_selector(text, args[0], span)
         if text == "geometry.isRectangular" and not args:
             args = (ir.Num(0.0, span),)
-        if names[0] == "geometry":  # the checker checks the arguments, or names the closest query
-            return ir.Call(text, args, span, self.site())
-        self.unsupported(f"{text}()", span)
-        return ir.placeholder(span)
+        # a geometry query (the checker checks the arguments, or names the closest query), or a function
+        # of an imported file, `prefix.name(...)`, which assembly inlines
+        return ir.Call(text, args, span, self.site())
 
     def geometry_selector(self, query: str, value: ir.Expr, span: Span) -> ir.Expr:
         """``geometry.area(top)``, ``geometry.angle(azimuth)``: the selector as a constant string, the
@@ -493,15 +501,22 @@ class Lowering(OperationLowering, LoweringBase):
                                   for c in "xyz"),), span)
 
     def occlusion(self, kind: str, args, span) -> ir.Expr:
-        """``inside`` / ``overlaps`` / ``touches([intra|inter|all[, "label"]])``."""
+        """``inside`` / ``overlaps`` / ``touches([target[, label]])``: the target ``intra``, ``inter`` or
+        ``all``, or ``sel(text)`` computed; the label a string, constant or computed."""
+        args = tuple(self.expr(a) for a in args)
         target = args[0].name if args and isinstance(args[0], ir.Name) else None
-        label = args[1] if len(args) == 2 else None
-        if len(args) > 2 or (args and target not in ir.OCCLUSION_TARGETS) or (
-                label is not None and not isinstance(label, ir.Str)):
+        chosen = args[0].args[0] if args and isinstance(args[0], ir.Call) and args[0].func == "sel" \
+            and len(args[0].args) == 1 else None
+        if isinstance(chosen, ir.Str) and chosen.value in ir.OCCLUSION_TARGETS:
+            target, chosen = chosen.value, None
+        if len(args) > 2 or (args and target not in ir.OCCLUSION_TARGETS and chosen is None):
             self.unsupported(f"{kind} with these arguments", span,
-                             f"{kind}(), {kind}(intra|inter|all) and {kind}(intra|inter|all, \"label\")")
+                             f"{kind}(), {kind}(intra|inter|all[, label]) and {kind}(sel(text)[, label])")
             return ir.placeholder(span)
-        return ir.Occlusion(kind, target or "all", label.value if label is not None else None, span)
+        label = args[1] if len(args) == 2 else None
+        constant = label.value if isinstance(label, ir.Str) else None
+        return ir.Occlusion(kind, target or "all", constant, span, which=chosen,
+                            named=None if constant is not None else label)
 
     def elementwise_unary(self, meta, op, operand):
         """``.-a``, ``.+a``, ``.!a`` on arrays (``.+a`` is ``a``)."""

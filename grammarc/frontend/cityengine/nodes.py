@@ -51,8 +51,8 @@ class EdgeDistances:
 
 @dataclass(frozen=True, slots=True)
 class Import:
-    """``import prefix : "file.cga" (...)`` (or without a prefix): the file's rules and attributes, named
-    ``prefix.Name``; an attribute the importing file declares too takes the importing file's value
+    """``import prefix : "file.cga" (...)`` (or without a prefix): the file's rules, attributes, constants
+    and functions, named ``prefix.Name``; an attribute the importing file declares too takes the importing file's value
     (forwarding) unless the parentheses protect it: ``(a, b)`` protects ``a`` and ``b``, ``()`` every
     attribute. ``(a = value)`` sets the imported ``a`` to a value of the importing file's scope, and
     ``(Ext --> ...)`` redefines the imported rule ``Ext`` (an extension) as ``prefix.Ext --> ...`` in the

@@ -335,9 +335,9 @@ class OperationLowering:
         return ir.Setback(distances, selectors, chosen[1], span, self.site())
 
     def op_label(self, op, args, span):
-        if len(args) != 1 or not isinstance(args[0], ir.Str):
-            return self.unsupported("label with these arguments", span, 'label("name")')
-        return ir.Label(args[0].value, span)
+        if not self.arity(op, args, (1,), span):
+            return ir.Empty(span)
+        return ir.Label(self.expr(args[0]), span)
 
     def op_convexify(self, op, args, span):
         if len(args) > 1:

@@ -3,9 +3,9 @@
 Assumes: a rule graph (a module without one fails to compile anyway, for the errors that stopped it) and
 ``Module.roots`` (a module lowered outside the compiler has none, and keeps its names unresolved).
 Guarantees: ``Module.assets`` lists the canonical names, the leaf cube and quad first, an asset's index
-being its id in the record; ``Module.asset_ids`` gives each name as written its id. A name that is
-absolute or leaves the folders is an error, a file that no folder holds a warning (the record keeps its
-name).
+being its id in the record; ``Module.asset_ids`` gives each name as written its id. A drive path or a
+name that leaves the folders is an error, a file that no folder holds (a workspace path too) a warning: the
+record keeps its name, and CityEngine too inserts nothing for a missing asset.
 
 A computed ``i(name)`` may insert any asset the grammar can name, so then the assets are also: the string
 constants that are asset files (``"facade/window.obj"``), and the asset files that file searches find
@@ -69,8 +69,9 @@ def resolve_assets(module: ir.Module, diags: Diagnostics) -> ir.Module:
         if resolved.path is not None and unsupported_format(resolved.path):
             diags.error("asset", unsupported_format(resolved.path), span)
         if resolved.missing:
+            where = "; a workspace path: --workspace gives the folder of its projects" if name.startswith("/") else ""
             diags.warning("asset", f"asset `{name}` not found in {', '.join(str(r) for r in roots)}; the "
-                          "record keeps its name", span)
+                          f"record keeps its name{where}", span)
         canonical = by_file.setdefault(resolved.path, resolved.name) if resolved.path else resolved.name
         if canonical not in names:
             names.append(canonical)

@@ -48,6 +48,13 @@ def test_the_reference_example_on_a_turned_lot(write):
     assert (got["ox"], got["oy"], got["oz"]) == pytest.approx((-10.0, 23.46, 0.0), abs=1e-9)
 
 
+def test_scope_elevation_is_the_height_of_the_scope_origin(write):
+    got, = reported(write, "Lot --> extrude(6) t(0, 2.5, 0) comp(f){ top : Top }\n"
+                    'Top --> report("e", scope.elevation) report("w", convert(y, scope, world, pos, 0, 0, 0)) X\n')
+    assert got["e"] == pytest.approx(8.5)
+    assert got["e"] == got["w"]
+
+
 def test_the_array_form_is_the_three_components(write):
     got, = reported(write, EXAMPLE + 'A --> report("n", size(convert(scope, world, pos, [1, 2, 3]))) '
                     + " ".join(f'report("a{i}", convert(scope, world, pos, [1, 2, 3])[{i}])' for i in range(3))

@@ -174,10 +174,12 @@ def test_brackets_in_bodies_are_still_push_and_pop():
 
 def test_convert_initial_shape_and_print_lower_to_calls():
     """``convert``'s keywords become strings, its form on an array three calls; ``initialShape.origin.o*``
-    is the lot's orientation; the ``print`` function is a call that gives its argument."""
+    is the lot's orientation, ``scope.elevation`` its origin's world y; the ``print`` function is a call that
+    gives its argument."""
     module = module_of(VERSION + "attr a = convert(x, scope, world, pos, 1, 2, 3)\n"
                        "attr b = convert(scope, pivot, orient, [1, 2, 3])\nattr c = initialShape.origin.oy\n"
-                       "attr d = initialShape.name + initialShape.startRule\nattr e = print(2) + 1\nLot --> A\n")
+                       "attr d = initialShape.name + initialShape.startRule\nattr e = print(2) + 1\n"
+                       "attr f = scope.elevation\nLot --> A\n")
     printed = {a.name: print_expr(a.default) for a in module.attrs}
     assert printed["a"] == 'convert("x", "scope", "world", "pos", 1, 2, 3)'
     assert printed["b"] == "[" + ", ".join(f'convert("{c}", "scope", "pivot", "orient", [1, 2, 3][0], '
@@ -185,6 +187,7 @@ def test_convert_initial_shape_and_print_lower_to_calls():
     assert printed["c"] == 'convert("y", "object", "world", "orient", 0, 0, 0)'
     assert printed["d"] == "(initialShape.name() + initialShape.startRule())"
     assert printed["e"] == "(print(2) + 1)"
+    assert printed["f"] == 'convert("y", "scope", "world", "pos", 0, 0, 0)'  # the scope origin's height
 
 
 def test_context_attributes_lower_to_context_refs():
@@ -231,7 +234,7 @@ def test_unknown_queries_and_their_arguments_are_named(line, message):
 
 @pytest.mark.parametrize("line, name, at", [
     ("Lot --> case inside(near) : A else : B", "inside with these arguments", "inside"),
-    ("Lot --> case touches(all, 3) : A else : B", "touches with these arguments", "touches"),
+    ("Lot --> case touches(sel(1, 2)) : A else : B", "touches with these arguments", "touches"),
     ("Lot --> extrude(geometry.uMin) A", "geometry.uMin", "geometry"),
     ("Lot --> extrude(initialShape.origin.qx) A", "initialShape.origin.qx", "initialShape"),
     ("Lot --> extrude(geometry.du(0, unitSpace)) A", "geometry.du()", "geometry"),
@@ -380,3 +383,14 @@ A(float h, string s, bool b, float[] a) --> extrude(half(h)) print(label(s, b)) 
 def test_scatter_with_operations_in_braces_lowers_with_its_body():
     assert body_of(VERSION + "Lot --> extrude(3) scatter(surface, 10, uniform) { s(1, 1, 1) Tree } A\n") == (
         "extrude(3) scatter(surface, 10, uniform){ S(1, 1, 1) Tree } A")
+
+
+def test_occlusion_targets_and_labels_may_be_computed():
+    """``inside(sel(text), label)``: ``sel`` makes the target of a string, a constant one is the keyword;
+    the label is any string."""
+    module = module_of(VERSION + 'attr where = "intra"\nattr seek = "k"\n'
+                       'Lot --> case inside(sel(where), seek) || overlaps(sel("inter"), "k" + seek) : A else : B\n')
+    [case] = [op for op in iter_ops(module.rules[0].alternatives[0].body) if isinstance(op, ir.Case)]
+    assert print_expr(case.branches[0][0]) == '(inside(sel(@where), @seek) || overlaps(inter, ("k" + @seek)))'
+    assert errors(VERSION + "Lot --> case touches(all, 3) : A else : B\n") == [
+        (2, 27, "an occlusion label must be a str, got a num")]

@@ -234,7 +234,6 @@ def test_merged_selector_is_derived_face_by_face_with_a_warning(line, at):
     ("Lot --> roofGable(30, 1, 1, false, 2) Roof", "roofGable with an edge index", "2)"),
     ("Lot --> roofHip(30, 1, true) Roof", "roofHip with even ridges", "true"),
     ("Lot --> envelope(normal, 10, 45) Roof", "envelope with 3 arguments", "envelope"),
-    ("Lot --> label(3) A", "label with these arguments", "label"),
     ("Lot --> shapeL(4, 4){ front : A | remainder : NIL }", "shapeL selector `front`", "front"),
     ("Lot --> innerRectangle(world){ shape : A | remainder : NIL }", "innerRectangle with these arguments",
      "innerRectangle"),
@@ -389,3 +388,15 @@ def test_a_rule_of_a_file_imported_without_prefix_is_called(tmp_path):
     diags = Diagnostics()
     parse_source(main.read_text(), str(main), diags, path=main)
     assert not diags.has_errors, diags
+
+
+def test_a_label_is_any_string_expression():
+    """``label(name)`` takes a string, constant or computed (``label(occlusionLabel)``, an attribute)."""
+    assert body_of(VERSION + 'attr mark = "kiosk"\nLot --> label(mark) label("k" + mark) A\n') == \
+        'label(@mark) label(("k" + @mark)) A'
+    assert errors(VERSION + "Lot --> label(3) A\n") == [(2, 15, "a label must be a str, got a num")]
+
+
+def test_an_operation_of_an_older_cga_version_is_todays():
+    """ESRI.lib's 2014.0 files write ``offsetUV``, today's ``translateUV``."""
+    assert body_of(VERSION + "Lot --> offsetUV(0, 0.5, 0) A\n") == body_of(VERSION + "Lot --> translateUV(0, 0.5, 0) A\n")
