@@ -92,6 +92,17 @@ def flat_meshes(chunk: Chunk, shapes: Shapes, parts: np.ndarray, source: np.ndar
     return shapes.with_scope(shapes.origin, shapes.size, shapes.frame, geom)
 
 
+def flat_mesh_faces(chunk: Chunk, shapes: Shapes) -> tuple[np.ndarray, np.ndarray]:
+    """The faces of flat mesh shapes (each with one scope size 0) stored as polygons in that plane of
+    their scopes: the polygons' ids (F,), mesh by mesh, and each mesh's number of faces (n,)."""
+    coords, ring_offsets, face_offsets, mesh_offsets = chunk.meshes.gather(shapes.geom - MESH_BASE)
+    plane = np.argmax(shapes.size <= TOL.zero, axis=1)
+    n_faces = len(face_offsets) - 1
+    ids = _add_polygons(chunk, coords, ring_offsets, face_offsets, np.arange(n_faces),
+                        plane[segment_of(mesh_offsets)].astype(np.int8))
+    return ids, np.diff(mesh_offsets)
+
+
 def piece_meshes(chunk: Chunk, shapes: Shapes, pieces) -> Shapes:
     """One shape per row of ``shapes`` from its several ``pieces`` (``geometry.clip.Clipped``, every
     piece's source among the rows): the scope fitted around all of them, the pieces its mesh's faces."""

@@ -80,9 +80,11 @@ def roof(ctx: Context, cursor: Shapes, op: ir.Roof) -> Shapes:
     return roofed
 
 
-@operation(ir.Offset, writes=COLUMNS)
+@operation(ir.Offset, writes=COLUMNS, meshes=True)
 def offset(ctx: Context, cursor: Shapes, op: ir.Offset) -> Shapes:
-    """``offset(d, inside|border)``: the shape's face becomes its inset or the ring around it."""
+    """``offset(d, inside|border)``: the shape's face becomes its inset or the ring around it; a shape of
+    several faces in one plane (an earlier offset's pieces, convexify's parts) has each face offset, as
+    CityEngine offsets every face of a geometry."""
     inside, border = _offset_pieces(ctx, op.distance, cursor, op.span)
     pieces = inside if op.select == "inside" else border
     several = np.bincount(pieces.source, minlength=len(cursor)) > 1
@@ -246,12 +248,37 @@ def face_polygons(ctx: Context, cursor: Shapes, what: str, span) -> tuple[np.nda
 
 
 def _offset_pieces(ctx: Context, distance: ir.Expr, cursor: Shapes, span):
-    """The inside and border pieces of each flat shape's polygon offset by ``distance``."""
-    polygons, plane = face_polygons(ctx, cursor, "offset", span)
-    d = evaluate_array(distance, ctx.env(cursor))
-    inset = shapely.buffer(polygons, d, join_style="mitre", mitre_limit=1e6)
+    """The inside and border pieces of each flat shape's faces offset by ``distance``, each piece's
+    ``source`` its shape's row."""
+    d = np.broadcast_to(evaluate_array(distance, ctx.env(cursor)), (len(cursor),))
+    faces, owner = _faces_in_plane(ctx, cursor, "offset", span)
+    polygons, plane = face_polygons(ctx, faces, "offset", span)
+    inset = shapely.buffer(polygons, d[owner], join_style="mitre", mitre_limit=1e6)
     border = shapely.difference(polygons, inset)
-    return fit_pieces(inset, plane, cursor.size, polygons), fit_pieces(border, plane, cursor.size, polygons)
+    return tuple(replace(p, source=owner[p.source]) for p in (
+        fit_pieces(inset, plane, faces.size, polygons), fit_pieces(border, plane, faces.size, polygons)))
+
+
+def _faces_in_plane(ctx: Context, cursor: Shapes, what: str, span) -> tuple[Shapes, np.ndarray]:
+    """Each shape's faces as shapes in its scope: a flat mesh's faces each a polygon shape, any other
+    shape itself; and each face's row in ``cursor`` (ascending). Fails the lots of meshes that are not
+    flat (a roof's faces lie in several planes)."""
+    mesh = is_mesh(cursor.geom)
+    if not mesh.any():
+        return cursor, np.arange(len(cursor))
+    flat = (cursor.size <= TOL.zero).sum(axis=1) == 1
+    if (mesh & ~flat).any():
+        ctx.fail(cursor, mesh & ~flat, f"`{what}` of a roof is not supported yet (only of faces in one plane; "
+                 "split the roof into faces with comp(f) first)", span)
+    rows = np.flatnonzero(mesh)
+    geom, counts = mesh_shapes.flat_mesh_faces(ctx.chunk, cursor.take(rows))
+    per_shape = np.ones(len(cursor), dtype=np.int64)
+    per_shape[rows] = counts
+    owner = np.repeat(np.arange(len(cursor)), per_shape)
+    faces = cursor.take(owner)
+    face_geom = faces.geom.copy()
+    face_geom[is_mesh(face_geom)] = geom
+    return faces.with_scope(faces.origin, faces.size, faces.frame, face_geom), owner
 
 
 def _piece_shapes(ctx: Context, cursor: Shapes, pieces, site: int) -> Shapes:

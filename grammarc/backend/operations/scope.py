@@ -28,7 +28,7 @@ from grammarc.constants import TOL
 from grammarc.geometry import components as comp_kernels
 from grammarc.geometry.align import EDGE_MODES, FACE_MODES, aligned_axes, pick_edges
 from grammarc.geometry.extrusion import extruded_meshes
-from grammarc.geometry.meshes import is_polygon
+from grammarc.geometry.meshes import MESH_BASE, face_vertices, is_mesh, is_polygon, ring_vector_areas
 from grammarc.geometry.polygons import PLANE_U, PLANE_V, plane_to_scope
 from grammarc.geometry.queries import face_shapes, shape_faces
 from grammarc.geometry.reframe import NORMAL_UP
@@ -131,7 +131,7 @@ def center(ctx: Context, cursor: Shapes, op: ir.Center, base) -> Shapes:
     return cursor.with_scope(origin, cursor.size, cursor.frame, cursor.geom)
 
 
-@operation(ir.Extrude, writes=_SCOPE)
+@operation(ir.Extrude, writes=_SCOPE, meshes=True)
 def extrude(ctx: Context, cursor: Shapes, op: ir.Extrude) -> Shapes:
     """A face becomes a solid along its normal; a negative height extrudes behind the face. As in
     CityEngine, the solid's scope keeps x and has y along the extrusion: a face whose normal is
@@ -141,9 +141,19 @@ def extrude(ctx: Context, cursor: Shapes, op: ir.Extrude) -> Shapes:
     face's. ``world.up`` extrudes a face looking up as its normal would; any other face becomes a mesh
     in a scope with y up and x the old x laid level, each vertex moved straight up, and
     ``world.up.flatTop`` moves them to one level: ``h`` above the lowest vertex, at least up to the
-    highest; with a negative ``h`` down from the highest, at least to the lowest."""
-    height = evaluate_array(op.height, ctx.env(cursor))
+    highest; with a negative ``h`` down from the highest, at least to the lowest.
+
+    A shape of several faces in one plane (an offset's pieces, convexify's parts) becomes a mesh of
+    their solids, each face extruded along its own normal (``_extruded_faces``)."""
+    height = np.broadcast_to(evaluate_array(op.height, ctx.env(cursor)), (len(cursor),))
     axis = flat_axis(ctx.chunk, cursor)
+    mesh = is_mesh(cursor.geom)
+    if mesh.any():  # a flat mesh is extruded across its plane; a roof's faces lie in several planes
+        flat = cursor.size <= TOL.zero
+        axis[mesh] = np.where(flat[mesh].sum(axis=1) == 1, np.argmax(flat[mesh], axis=1), -1)
+        if (axis[mesh] < 0).any():
+            ctx.fail(cursor, mesh & (axis < 0), "`extrude` of a roof is not supported yet (only of faces in one "
+                     "plane; split the roof into faces with comp(f) first)", op.span)
     bad = (axis < 0) | ~np.isfinite(height)
     if bad.any():
         ctx.fail(cursor, bad, "`extrude` needs a face (a flat shape) and a finite height", op.span)
@@ -151,6 +161,9 @@ def extrude(ctx: Context, cursor: Shapes, op: ir.Extrude) -> Shapes:
         height = np.broadcast_to(height, (len(cursor),))
         normal_y = ctx.chunk.frames[cursor.frame][np.arange(len(cursor)), np.maximum(axis, 0), 1]
         slanted = (normal_y < 1 - TOL.zero) & (axis >= 0)
+        if (slanted & mesh).any():
+            ctx.fail(cursor, slanted & mesh, "`extrude` along the world's up of faces that are not level and "
+                     "not one face is not supported yet", op.span)
         if slanted.any():
             rows, others = np.flatnonzero(slanted), np.flatnonzero(~slanted)
             meshes = _extruded_upwards(ctx, cursor.take(rows), height[rows], op.direction == "world.up")
@@ -165,7 +178,35 @@ def _extruded_along_normal(ctx: Context, cursor: Shapes, height, axis: np.ndarra
     size[:, 1] = np.abs(height)
     up = ctx.chunk.frames[cursor.frame][:, 1]
     origin = cursor.origin + np.minimum(height, 0.0)[:, None] * up
-    return cursor.with_scope(origin, size, cursor.frame, cursor.geom)
+    extruded = cursor.with_scope(origin, size, cursor.frame, cursor.geom)
+    mesh = is_mesh(cursor.geom)
+    if not mesh.any():
+        return extruded
+    rows, others = np.flatnonzero(mesh), np.flatnonzero(~mesh)
+    return Shapes.merge([extruded.take(others), _extruded_faces(ctx, cursor.take(rows), height[rows])],
+                        [others, rows])
+
+
+def _extruded_faces(ctx: Context, cursor: Shapes, height: np.ndarray) -> Shapes:
+    """Flat meshes lying across their scopes' y (``turned``) made into meshes of solids: each face
+    extruded by ``height`` along its own normal (an offset's pieces all face along the scope's y; one
+    that faces the other way goes the other way, as CityEngine extrudes every face along its own
+    normal). The scope keeps its axes and is fitted to the solids. Faces that share an edge
+    (convexify's parts) each keep their wall there, where CityEngine leaves no such inner faces."""
+    chunk = ctx.chunk
+    verts, ring_offsets, face_offsets, mesh_offsets, _ = face_vertices(chunk.meshes, cursor.geom - MESH_BASE,
+                                                                       cursor.size)
+    face_mesh = segment_of(mesh_offsets)
+    vertex_face = segment_of(face_offsets)[segment_of(ring_offsets)]
+    # the sign of each face's normal along y, from its outer ring's vector area
+    facing = np.where(ring_vector_areas(verts, ring_offsets)[face_offsets[:-1], 1] < 0, -1.0, 1.0)
+    top = verts.copy()
+    top[:, 1] += (height[face_mesh] * facing)[vertex_face]
+    solids, rings, faces, face_solids = extruded_meshes(verts, top, ring_offsets, face_offsets,
+                                                        height[face_mesh] >= 0)
+    geom, low, size = store_fitted(chunk, solids, rings, faces, face_solids[mesh_offsets])
+    origin = cursor.origin + np.einsum("ni,nij->nj", low, chunk.frames[cursor.frame])
+    return cursor.with_scope(origin, size, cursor.frame, geom)
 
 
 def _extruded_upwards(ctx: Context, cursor: Shapes, height: np.ndarray, straight: bool) -> Shapes:
