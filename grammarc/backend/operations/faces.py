@@ -34,7 +34,8 @@ from grammarc.geometry.clip import fit_pieces, scope_polygons
 from grammarc.geometry.convexify import convex_parts
 from grammarc.geometry.inner_rectangle import largest_rectangles
 from grammarc.geometry.meshes import MESH_BASE, is_mesh, is_polygon
-from grammarc.geometry.polygons import plane_to_scope
+from grammarc.geometry.polygons import PLANE_U, PLANE_V, plane_to_scope
+from grammarc.geometry.ridges import ridge_roofs
 from grammarc.geometry.setback import polygon_edges, setback_regions
 from grammarc.ir import nodes as ir
 from grammarc.ragged import ragged_take, rank_within
@@ -65,19 +66,71 @@ def roof(ctx: Context, cursor: Shapes, op: ir.Roof) -> Shapes:
                 np.abs(evaluate_array(angle, env) - value) > TOL.zero)
             why = "with different heights or angles per side (one slope all round is supported)"
             checks.append((differs, why))
-    if op.overhang_y is not None:
+    if op.overhang_y is not None and not op.indexed:
         overhang_y = evaluate_array(op.overhang_y, env)
         checks.append((np.abs(overhang_y - overhang) > TOL.zero,
                        "with overhangY other than overhangX (gable ends overhang as eaves do)"))
     for bad, what in checks:
         if np.any(bad):
             ctx.fail(cursor, np.broadcast_to(bad, (n,)), f"`{op.kind}` {what}", op.span)
-    roofed, failed = mesh_shapes.build_roofs(ctx.chunk, cursor, op.kind, polygons_of(ctx.chunk, cursor), value,
-                                             op.by_height, overhang, index, cap)
+    ridge = np.full(n, op.kind == "roofRidge")
+    if op.indexed:
+        ridge = _convex_faces(ctx, cursor, op)
+    if ridge.any():
+        roofed, failed = _ridge_roofs(ctx, cursor, op, ridge, value, overhang, index)
+    else:
+        roofed, failed = mesh_shapes.build_roofs(ctx.chunk, cursor, op.kind, polygons_of(ctx.chunk, cursor),
+                                                 value, op.by_height, overhang, index, cap)
     if failed.any():
         ctx.fail(cursor, failed, f"`{op.kind}` found no roof for this polygon (its straight skeleton "
                  "did not close, or the overhang's outline crosses itself at a sharp corner)", op.span)
     return roofed
+
+
+def _convex_faces(ctx: Context, cursor: Shapes, op: ir.Roof) -> np.ndarray:
+    """The faces (n,) bool that ``roofGable`` with an edge index roofs along that edge: convex ones
+    without holes (the reference: the index works on convex shapes of one face). The others get the
+    gable of their straight skeleton, the index ignored."""
+    polygons, _ = face_polygons(ctx, cursor, op.kind, op.span)
+    hull = shapely.area(shapely.convex_hull(polygons))
+    return (shapely.get_num_interior_rings(polygons) == 0) & (
+        hull - shapely.area(polygons) <= TOL.area_floor + 1e-9 * hull)
+
+
+def _ridge_roofs(ctx: Context, cursor: Shapes, op: ir.Roof, ridge: np.ndarray, value, overhang, index):
+    """``roofRidge`` (every face: the ridge along the scope's x laid onto the face) and ``roofGable``
+    with an edge index (the faces ``ridge``: the ridge along that edge of the outer ring, the others
+    the skeleton's gable) (``geometry.ridges``): the roofed shapes and the mask (n,) of failures."""
+    rows, others = np.flatnonzero(ridge), np.flatnonzero(~ridge)
+    sub = cursor.take(rows)
+    polygons, plane = face_polygons(ctx, sub, op.kind, op.span)
+    if op.indexed:
+        ring = shapely.get_exterior_ring(polygons)
+        coords, owner = shapely.get_coordinates(ring, return_index=True)
+        closed = np.bincount(owner, minlength=len(rows))  # each ring's vertices and its closing repeat
+        start = np.r_[0, np.cumsum(closed)[:-1]]
+        edge = start + np.mod(index[rows], closed - 1).astype(np.int64)
+        direction = coords[edge + 1] - coords[edge]
+    else:  # the scope's x in the face's plane, or the plane's u where x is its normal
+        direction = np.zeros((len(rows), 2))
+        direction[:, 0] = (PLANE_U[plane] == 0) | (PLANE_V[plane] != 0)
+        direction[:, 1] = PLANE_V[plane] == 0
+    overhang_y = overhang if op.overhang_y is None else np.broadcast_to(
+        np.asarray(evaluate_array(op.overhang_y, ctx.env(cursor)), float), (len(cursor),))
+    overhang_x = overhang if op.indexed else np.zeros(len(cursor))
+    overhang_y = overhang_y if op.indexed else np.zeros(len(cursor))
+    verts, rings, faces, meshes, ok = ridge_roofs(polygons, plane, direction, value[rows], op.by_height,
+                                                  overhang_x[rows], overhang_y[rows], TOL.zero)
+    roofed = mesh_shapes.roof_shapes(ctx.chunk, sub, plane, verts, rings, faces, meshes)
+    failed = np.zeros(len(cursor), dtype=bool)
+    failed[rows] = ~ok
+    if not len(others):
+        return roofed, failed
+    rest = cursor.take(others)
+    gables, failed[others] = mesh_shapes.build_roofs(ctx.chunk, rest, op.kind, polygons_of(ctx.chunk, rest),
+                                                     value[others], op.by_height, overhang[others],
+                                                     np.zeros(len(others)), None)
+    return Shapes.merge([roofed, gables], [rows, others]), failed
 
 
 @operation(ir.Offset, writes=COLUMNS, meshes=True)
