@@ -8,7 +8,8 @@ vectorized geometry step, then the pieces back as shapes (``Parts`` for the bodi
 Reads: the scope (``origin``, ``size``, ``frame``), ``geom``, ``lot`` (street selectors), and what their
 expressions read. Writes: the roofs ``origin``, ``size`` and ``geom``; ``convexify`` and ``cleanupGeometry``
 the ``geom``; ``offset`` every column, as it makes the shapes of its pieces anew (new keys; a face with no
-piece left goes).
+piece left goes). ``offset`` also takes a shape of several faces in one plane (a mesh of an earlier offset's
+pieces or of convexify's parts) and offsets each face.
 """
 
 from __future__ import annotations
