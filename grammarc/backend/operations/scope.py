@@ -13,7 +13,9 @@ scope and geometry, as they turn scopes around their geometry (``backend.reframi
 from __future__ import annotations
 
 import numpy as np
+import shapely
 
+from grammarc.backend import mesh_shapes
 from grammarc.backend.context import Context
 from grammarc.backend.euler import angles as euler_angles
 from grammarc.backend.euler import orientation, rotation
@@ -27,13 +29,14 @@ from grammarc.backend.shapes import Shapes, asset_geom, asset_of
 from grammarc.constants import TOL
 from grammarc.geometry import components as comp_kernels
 from grammarc.geometry.align import EDGE_MODES, FACE_MODES, aligned_axes, pick_edges
+from grammarc.geometry.clip import oriented_rings, scope_polygons
 from grammarc.geometry.extrusion import extruded_meshes
 from grammarc.geometry.meshes import MESH_BASE, face_vertices, is_mesh, is_polygon, ring_vector_areas
 from grammarc.geometry.polygons import PLANE_U, PLANE_V, plane_to_scope
 from grammarc.geometry.queries import face_shapes, shape_faces
 from grammarc.geometry.reframe import NORMAL_UP
 from grammarc.ir import nodes as ir
-from grammarc.ragged import segment_of, segment_reduce
+from grammarc.ragged import ragged_take, segment_of, segment_reduce
 
 _SCOPE = ("origin", "size", "frame", "geom")
 
@@ -191,9 +194,13 @@ def _extruded_faces(ctx: Context, cursor: Shapes, height: np.ndarray) -> Shapes:
     """Flat meshes lying across their scopes' y (``turned``) made into meshes of solids: each face
     extruded by ``height`` along its own normal (an offset's pieces all face along the scope's y; one
     that faces the other way goes the other way, as CityEngine extrudes every face along its own
-    normal). The scope keeps its axes and is fitted to the solids. Faces that share an edge
-    (convexify's parts) each keep their wall there, where CityEngine leaves no such inner faces."""
+    normal), its bottom and top kept. As in CityEngine no lamina faces are made: the walls stand
+    around the outline of each shape's faces together (convexify's parts give the walls of the face
+    they were cut from; a straight run of the outline is one wall), facing as the shape's first face
+    does. The scope keeps its axes and is fitted
+    to the solids."""
     chunk = ctx.chunk
+    n = len(cursor)
     verts, ring_offsets, face_offsets, mesh_offsets, _ = face_vertices(chunk.meshes, cursor.geom - MESH_BASE,
                                                                        cursor.size)
     face_mesh = segment_of(mesh_offsets)
@@ -202,11 +209,46 @@ def _extruded_faces(ctx: Context, cursor: Shapes, height: np.ndarray) -> Shapes:
     facing = np.where(ring_vector_areas(verts, ring_offsets)[face_offsets[:-1], 1] < 0, -1.0, 1.0)
     top = verts.copy()
     top[:, 1] += (height[face_mesh] * facing)[vertex_face]
-    solids, rings, faces, face_solids = extruded_meshes(verts, top, ring_offsets, face_offsets,
-                                                        height[face_mesh] >= 0)
-    geom, low, size = store_fitted(chunk, solids, rings, faces, face_solids[mesh_offsets])
+    caps = extruded_meshes(verts, top, ring_offsets, face_offsets, height[face_mesh] >= 0)
+    # the outline of each shape's faces, wound around the normal of its first face
+    ids, _ = mesh_shapes.flat_mesh_faces(chunk, cursor)
+    polygons = scope_polygons(chunk.polygons, ids, cursor.size[face_mesh])
+    outline = np.full(n, shapely.Polygon(), dtype=object)
+    has_faces = np.diff(mesh_offsets) > 0
+    rows = np.flatnonzero(has_faces)
+    # the parts joined, without the vertices their joins leave along straight runs of the outline
+    outline[rows] = shapely.simplify(shapely.buffer(shapely.multipolygons(polygons, indices=face_mesh)[rows], 0.0),
+                                     0.0)
+    parts, owner = shapely.get_parts(outline, return_index=True)
+    first = np.where(has_faces, facing[np.minimum(mesh_offsets[:-1], len(facing) - 1)], 1.0)
+    # oriented_rings winds plane 1's rings around +y, and (x, z) rings of another plane code around -y
+    _, uv, outline_rings, outline_faces = oriented_rings(parts, np.where(first[owner] > 0, 1, 2))
+    outline_vertex = owner[segment_of(outline_faces)[segment_of(outline_rings)]]
+    bottom = plane_to_scope(uv, np.ones(len(uv), dtype=np.int64))
+    lifted = bottom.copy()
+    lifted[:, 1] += (height * first)[outline_vertex]
+    walls = extruded_meshes(bottom, lifted, outline_rings, outline_faces, height[owner] >= 0)
+    # each face's bottom and top (the first two faces of its solid), then each outline part's walls
+    cap_faces = np.sort(np.r_[caps[3][:-1], caps[3][:-1] + 1])
+    wall_faces = np.setdiff1d(np.arange(len(walls[2]) - 1), np.r_[walls[3][:-1], walls[3][:-1] + 1])
+    owners = np.r_[face_mesh[segment_of(caps[3])[cap_faces]], owner[segment_of(walls[3])[wall_faces]]]
+    merged = _merged_faces(caps, walls, cap_faces, wall_faces, np.argsort(owners, kind="stable"))
+    geom, low, size = store_fitted(chunk, *merged, np.r_[0, np.cumsum(np.bincount(owners, minlength=n))])
     origin = cursor.origin + np.einsum("ni,nij->nj", low, chunk.frames[cursor.frame])
     return cursor.with_scope(origin, size, cursor.frame, geom)
+
+
+def _merged_faces(a, b, faces_a: np.ndarray, faces_b: np.ndarray, order: np.ndarray):
+    """Faces ``faces_a`` of mesh arrays ``a`` and ``faces_b`` of ``b`` (each verts, ring_offsets,
+    face_offsets, ...) as one ragged mesh, the faces (a's, then b's) taken in ``order``: verts,
+    ring_offsets, face_offsets."""
+    verts = np.concatenate([a[0], b[0]])
+    rings = np.r_[a[1][:-1], b[1] + len(a[0])]
+    faces = np.r_[a[2][:-1], b[2] + len(a[1]) - 1]
+    picked = np.r_[faces_a, faces_b + len(a[2]) - 1][order]
+    picked_rings, face_offsets = ragged_take(faces, picked)
+    vertices, ring_offsets = ragged_take(rings, picked_rings)
+    return verts[vertices], ring_offsets, face_offsets
 
 
 def _extruded_upwards(ctx: Context, cursor: Shapes, height: np.ndarray, straight: bool) -> Shapes:

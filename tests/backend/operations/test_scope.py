@@ -508,3 +508,14 @@ def test_extrude_of_an_offsets_pieces_is_a_box_per_piece(write, height):
     assert (y.min(), y.max()) == (pytest.approx(min(height, 0)), pytest.approx(max(height, 0)))
     t = totals(r)
     assert (t["sx_sum"], t["sy_sum"]) == (pytest.approx(21), pytest.approx(2))
+
+
+def test_extrude_of_convex_parts_has_no_lamina_faces(write):
+    """CityEngine's extrude makes no inner faces: convexify's parts of the L extruded are the L's prism,
+    its bottom and top in parts, the walls around the L."""
+    r = run(write, 'Lot --> convexify extrude(3) comp(f){ side : report("w", geometry.area) W. | all : X. }\n',
+            [LOT_ZOO["concave_L"]])
+    got = mesh_faces(r)
+    assert sum(face_area(f) for f in got) == pytest.approx(2 * 400 + 100 * 3)
+    t = totals(r)
+    assert (t["w_n"], t["w_sum"]) == (6, pytest.approx(100 * 3))
