@@ -62,12 +62,18 @@ def build_roofs(chunk: Chunk, shapes: Shapes, kind: str, polygons, value, by_hei
         ROOF_KINDS[kind], coords, ring_offsets, shape_offsets, plane.astype(np.int8), size_a, size_b,
         value, by_height, overhang, index.astype(np.int64),
         np.full(len(shapes), np.inf) if cap is None else np.asarray(cap, dtype=np.float64))
+    return roof_shapes(chunk, shapes, plane, verts, rings, faces, meshes), ~ok
+
+
+def roof_shapes(chunk: Chunk, shapes: Shapes, plane: np.ndarray, verts, rings, faces, meshes) -> Shapes:
+    """``shapes`` whose geometry becomes the roof meshes (``geometry.roofs`` layout: (u, v, h) in each
+    shape's plane ``plane`` (n,)), their scopes fitted to them."""
     vertex_shape = segment_of(meshes)[segment_of(faces)[segment_of(rings)]]
     vplane = plane[vertex_shape].astype(np.int64)
     roofed = plane_to_scope(verts[:, :2], vplane, verts[:, 2])
     geom, low, size = store_fitted(chunk, roofed, rings, faces, meshes)
     origin = shapes.origin + np.einsum("ni,nij->nj", low, chunk.frames[shapes.frame])
-    return shapes.with_scope(origin, size, shapes.frame, geom), ~ok
+    return shapes.with_scope(origin, size, shapes.frame, geom)
 
 
 def flat_meshes(chunk: Chunk, shapes: Shapes, parts: np.ndarray, source: np.ndarray, plane: np.ndarray) -> Shapes:
@@ -90,6 +96,17 @@ def flat_meshes(chunk: Chunk, shapes: Shapes, parts: np.ndarray, source: np.ndar
     geom = shapes.geom.copy()
     geom[several] = (MESH_BASE + ids).astype(np.int32)
     return shapes.with_scope(shapes.origin, shapes.size, shapes.frame, geom)
+
+
+def flat_mesh_faces(chunk: Chunk, shapes: Shapes) -> tuple[np.ndarray, np.ndarray]:
+    """The faces of flat mesh shapes (each with one scope size 0) stored as polygons in that plane of
+    their scopes: the polygons' ids (F,), mesh by mesh, and each mesh's number of faces (n,)."""
+    coords, ring_offsets, face_offsets, mesh_offsets = chunk.meshes.gather(shapes.geom - MESH_BASE)
+    plane = np.argmax(shapes.size <= TOL.zero, axis=1)
+    n_faces = len(face_offsets) - 1
+    ids = _add_polygons(chunk, coords, ring_offsets, face_offsets, np.arange(n_faces),
+                        plane[segment_of(mesh_offsets)].astype(np.int8))
+    return ids, np.diff(mesh_offsets)
 
 
 def piece_meshes(chunk: Chunk, shapes: Shapes, pieces) -> Shapes:

@@ -22,6 +22,9 @@ its normal. Face 0 of every mesh is the original polygon seen from below (CityEn
   roof's planes from their tops, cut flat at height ``cap``: what is left of each plane above the cut
   lies in the flat top.
 
+``roofRidge`` and ``roofGable`` with an edge index, two planes under one ridge in a given direction, are
+``ridges.py``'s.
+
 ``value`` is the slope angle in degrees, or with ``by_height`` the roof's height (hip and gable: the
 highest skeleton node; shed: the highest point; pyramid: the apex). Overhangs (hip and gable) are
 measured on the roof plane, as CityEngine's are; with ``by_height`` they are measured horizontally,

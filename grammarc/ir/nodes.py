@@ -719,7 +719,8 @@ class Roof:
     """CityEngine ``roofHip``, ``roofGable``, ``roofShed``, ``roofPyramid``, ``envelope`` and the paper's
     ``Roof(type, angle)``: the face becomes a roof mesh over it (``geometry.roofs``). ``value`` is the
     slope in degrees, or the height when ``by_height``; ``overhang`` and ``overhang_y`` the eave and
-    gable overhangs; ``index`` the shed's edge."""
+    gable overhangs; ``index`` the shed's edge, and with ``indexed`` the edge a gable's ridge runs along
+    (``roofGable(angle, overhangX, overhangY, even, index)``)."""
 
     kind: str
     value: Expr = child(Type.NUM, lambda op: "a roof height" if op.by_height else "a roof angle")
@@ -732,6 +733,7 @@ class Roof:
     #: sides' (baseHeight, angle) pairs, which must equal the first (``overhang``, ``value``).
     cap: Expr | None = child(Type.NUM, "a height", default=None)
     sides: tuple[tuple[Expr, Expr], ...] = child(Type.NUM, ("a base height", "an angle"), default=())
+    indexed: bool = False
 
 
 #: Selectors of the faces an ``offset`` makes.

@@ -331,3 +331,46 @@ def test_cleanup_geometry_with_a_tolerance_that_is_not_finite_fails_its_lot(writ
     r = run(write, "Lot --> cleanupGeometry(all, ln(scope.sx - 12)) Face\n", [rect(12, 8), rect(20, 8)])
     assert [b.index for b in r["bad"]] == [0]
     assert "`cleanupGeometry` with a tolerance that is not finite" in r["bad"][0].reason
+
+
+def test_roof_ridge_on_the_top_of_a_mass_runs_along_the_scope_x(write):
+    """The reference's example: a 30 degree roofRidge on the top face of an extruded lot; the top's
+    scope x is the lot's first edge (12 long), so the ridge runs along it over the middle of the 8."""
+    text = ("Lot --> extrude(10) comp(f){ top : Top | side = Sides. }\nTop --> roofRidge(byAngle, 30) Roof.\n")
+    r = run(write, text, [rect(12, 8)])
+    got = mesh_faces(r)
+    assert len(got) == 5
+    vertices = r["mesh"].vertices
+    assert vertices[:, 1].max() == pytest.approx(10 + 4 * TAN30)
+    ridge = vertices[np.isclose(vertices[:, 1], 10 + 4 * TAN30)]
+    np.testing.assert_allclose(np.ptp(ridge, axis=0), [12, 0, 0], atol=1e-6)
+    assert sum(face_area(f) for f in got) == pytest.approx(96 + 2 * 12 * 4 / np.cos(np.radians(30))
+                                                           + 8 * 4 * TAN30)
+
+
+@pytest.mark.parametrize("index, ridge_along", [(0, 0), (1, 2), (2, 0), (5, 2)])
+def test_roof_gable_with_an_edge_index_turns_its_ridge_along_the_edge(write, index, ridge_along):
+    """On a 12 x 8 lot (edge 0 along world x, edge 1 along world z) the ridge follows edge index
+    (modulo the edge count); the height is half the width across it times tan(angle)."""
+    r = run(write, f"Lot --> roofGable(30, 0, 0, false, {index}) Roof.\n", [rect(12, 8)])
+    vertices = r["mesh"].vertices
+    width = 8 if ridge_along == 0 else 12
+    top = vertices[:, 1].max()
+    assert top == pytest.approx(width / 2 * TAN30)
+    ridge = vertices[np.isclose(vertices[:, 1], top)]
+    assert np.ptp(ridge[:, ridge_along]) == pytest.approx(20 - width)
+
+
+def test_roof_gable_with_an_index_and_overhangs_grows_eaves_and_gable_ends(write):
+    r = run(write, "Lot --> roofGable(30, 1, 0.5, false, 0) Roof.\n", [rect(12, 8)])
+    vertices = r["mesh"].vertices
+    cos30 = np.cos(np.radians(30))
+    np.testing.assert_allclose(vertices.min(axis=0), [-0.5, -0.5, -8 - cos30], atol=1e-6)
+    np.testing.assert_allclose(vertices.max(axis=0), [12.5, 4 * TAN30, cos30], atol=1e-6)
+
+
+def test_roof_gable_with_an_index_on_a_concave_lot_is_the_plain_gable(write):
+    """The reference: the index works on convex shapes only; on the L it is ignored."""
+    indexed = run(write, "Lot --> roofGable(30, 0, 0, false, 1) Roof.\n", [LOT_ZOO["concave_L"]])
+    plain = run(write, "Lot --> roofGable(30) Roof.\n", [LOT_ZOO["concave_L"]])
+    np.testing.assert_array_equal(indexed["mesh"].vertices, plain["mesh"].vertices)

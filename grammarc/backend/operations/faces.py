@@ -8,7 +8,8 @@ vectorized geometry step, then the pieces back as shapes (``Parts`` for the bodi
 Reads: the scope (``origin``, ``size``, ``frame``), ``geom``, ``lot`` (street selectors), and what their
 expressions read. Writes: the roofs ``origin``, ``size`` and ``geom``; ``convexify`` and ``cleanupGeometry``
 the ``geom``; ``offset`` every column, as it makes the shapes of its pieces anew (new keys; a face with no
-piece left goes).
+piece left goes). ``offset`` also takes a shape of several faces in one plane (a mesh of an earlier offset's
+pieces or of convexify's parts) and offsets each face.
 """
 
 from __future__ import annotations
@@ -34,7 +35,8 @@ from grammarc.geometry.clip import fit_pieces, scope_polygons
 from grammarc.geometry.convexify import convex_parts
 from grammarc.geometry.inner_rectangle import largest_rectangles
 from grammarc.geometry.meshes import MESH_BASE, is_mesh, is_polygon
-from grammarc.geometry.polygons import plane_to_scope
+from grammarc.geometry.polygons import PLANE_U, PLANE_V, plane_to_scope
+from grammarc.geometry.ridges import ridge_roofs
 from grammarc.geometry.setback import polygon_edges, setback_regions
 from grammarc.ir import nodes as ir
 from grammarc.ragged import ragged_take, rank_within
@@ -65,24 +67,78 @@ def roof(ctx: Context, cursor: Shapes, op: ir.Roof) -> Shapes:
                 np.abs(evaluate_array(angle, env) - value) > TOL.zero)
             why = "with different heights or angles per side (one slope all round is supported)"
             checks.append((differs, why))
-    if op.overhang_y is not None:
+    if op.overhang_y is not None and not op.indexed:
         overhang_y = evaluate_array(op.overhang_y, env)
         checks.append((np.abs(overhang_y - overhang) > TOL.zero,
                        "with overhangY other than overhangX (gable ends overhang as eaves do)"))
     for bad, what in checks:
         if np.any(bad):
             ctx.fail(cursor, np.broadcast_to(bad, (n,)), f"`{op.kind}` {what}", op.span)
-    roofed, failed = mesh_shapes.build_roofs(ctx.chunk, cursor, op.kind, polygons_of(ctx.chunk, cursor), value,
-                                             op.by_height, overhang, index, cap)
+    ridge = np.full(n, op.kind == "roofRidge")
+    if op.indexed:
+        ridge = _convex_faces(ctx, cursor, op)
+    if ridge.any():
+        roofed, failed = _ridge_roofs(ctx, cursor, op, ridge, value, overhang, index)
+    else:
+        roofed, failed = mesh_shapes.build_roofs(ctx.chunk, cursor, op.kind, polygons_of(ctx.chunk, cursor),
+                                                 value, op.by_height, overhang, index, cap)
     if failed.any():
         ctx.fail(cursor, failed, f"`{op.kind}` found no roof for this polygon (its straight skeleton "
                  "did not close, or the overhang's outline crosses itself at a sharp corner)", op.span)
     return roofed
 
 
-@operation(ir.Offset, writes=COLUMNS)
+def _convex_faces(ctx: Context, cursor: Shapes, op: ir.Roof) -> np.ndarray:
+    """The faces (n,) bool that ``roofGable`` with an edge index roofs along that edge: convex ones
+    without holes (the reference: the index works on convex shapes of one face). The others get the
+    gable of their straight skeleton, the index ignored."""
+    polygons, _ = face_polygons(ctx, cursor, op.kind, op.span)
+    hull = shapely.area(shapely.convex_hull(polygons))
+    return (shapely.get_num_interior_rings(polygons) == 0) & (
+        hull - shapely.area(polygons) <= TOL.area_floor + 1e-9 * hull)
+
+
+def _ridge_roofs(ctx: Context, cursor: Shapes, op: ir.Roof, ridge: np.ndarray, value, overhang, index):
+    """``roofRidge`` (every face: the ridge along the scope's x laid onto the face) and ``roofGable``
+    with an edge index (the faces ``ridge``: the ridge along that edge of the outer ring, the others
+    the skeleton's gable) (``geometry.ridges``): the roofed shapes and the mask (n,) of failures."""
+    rows, others = np.flatnonzero(ridge), np.flatnonzero(~ridge)
+    sub = cursor.take(rows)
+    polygons, plane = face_polygons(ctx, sub, op.kind, op.span)
+    if op.indexed:
+        ring = shapely.get_exterior_ring(polygons)
+        coords, owner = shapely.get_coordinates(ring, return_index=True)
+        closed = np.bincount(owner, minlength=len(rows))  # each ring's vertices and its closing repeat
+        start = np.r_[0, np.cumsum(closed)[:-1]]
+        edge = start + np.mod(index[rows], closed - 1).astype(np.int64)
+        direction = coords[edge + 1] - coords[edge]
+    else:  # the scope's x in the face's plane, or the plane's u where x is its normal
+        direction = np.zeros((len(rows), 2))
+        direction[:, 0] = (PLANE_U[plane] == 0) | (PLANE_V[plane] != 0)
+        direction[:, 1] = PLANE_V[plane] == 0
+    overhang_y = overhang if op.overhang_y is None else np.broadcast_to(
+        np.asarray(evaluate_array(op.overhang_y, ctx.env(cursor)), float), (len(cursor),))
+    overhang_x = overhang if op.indexed else np.zeros(len(cursor))
+    overhang_y = overhang_y if op.indexed else np.zeros(len(cursor))
+    verts, rings, faces, meshes, ok = ridge_roofs(polygons, plane, direction, value[rows], op.by_height,
+                                                  overhang_x[rows], overhang_y[rows], TOL.zero)
+    roofed = mesh_shapes.roof_shapes(ctx.chunk, sub, plane, verts, rings, faces, meshes)
+    failed = np.zeros(len(cursor), dtype=bool)
+    failed[rows] = ~ok
+    if not len(others):
+        return roofed, failed
+    rest = cursor.take(others)
+    gables, failed[others] = mesh_shapes.build_roofs(ctx.chunk, rest, op.kind, polygons_of(ctx.chunk, rest),
+                                                     value[others], op.by_height, overhang[others],
+                                                     np.zeros(len(others)), None)
+    return Shapes.merge([roofed, gables], [rows, others]), failed
+
+
+@operation(ir.Offset, writes=COLUMNS, meshes=True)
 def offset(ctx: Context, cursor: Shapes, op: ir.Offset) -> Shapes:
-    """``offset(d, inside|border)``: the shape's face becomes its inset or the ring around it."""
+    """``offset(d, inside|border)``: the shape's face becomes its inset or the ring around it; a shape of
+    several faces in one plane (an earlier offset's pieces, convexify's parts) has each face offset, as
+    CityEngine offsets every face of a geometry."""
     inside, border = _offset_pieces(ctx, op.distance, cursor, op.span)
     pieces = inside if op.select == "inside" else border
     several = np.bincount(pieces.source, minlength=len(cursor)) > 1
@@ -246,12 +302,37 @@ def face_polygons(ctx: Context, cursor: Shapes, what: str, span) -> tuple[np.nda
 
 
 def _offset_pieces(ctx: Context, distance: ir.Expr, cursor: Shapes, span):
-    """The inside and border pieces of each flat shape's polygon offset by ``distance``."""
-    polygons, plane = face_polygons(ctx, cursor, "offset", span)
-    d = evaluate_array(distance, ctx.env(cursor))
-    inset = shapely.buffer(polygons, d, join_style="mitre", mitre_limit=1e6)
+    """The inside and border pieces of each flat shape's faces offset by ``distance``, each piece's
+    ``source`` its shape's row."""
+    d = np.broadcast_to(evaluate_array(distance, ctx.env(cursor)), (len(cursor),))
+    faces, owner = _faces_in_plane(ctx, cursor, "offset", span)
+    polygons, plane = face_polygons(ctx, faces, "offset", span)
+    inset = shapely.buffer(polygons, d[owner], join_style="mitre", mitre_limit=1e6)
     border = shapely.difference(polygons, inset)
-    return fit_pieces(inset, plane, cursor.size, polygons), fit_pieces(border, plane, cursor.size, polygons)
+    return tuple(replace(p, source=owner[p.source]) for p in (
+        fit_pieces(inset, plane, faces.size, polygons), fit_pieces(border, plane, faces.size, polygons)))
+
+
+def _faces_in_plane(ctx: Context, cursor: Shapes, what: str, span) -> tuple[Shapes, np.ndarray]:
+    """Each shape's faces as shapes in its scope: a flat mesh's faces each a polygon shape, any other
+    shape itself; and each face's row in ``cursor`` (ascending). Fails the lots of meshes that are not
+    flat (a roof's faces lie in several planes)."""
+    mesh = is_mesh(cursor.geom)
+    if not mesh.any():
+        return cursor, np.arange(len(cursor))
+    flat = (cursor.size <= TOL.zero).sum(axis=1) == 1
+    if (mesh & ~flat).any():
+        ctx.fail(cursor, mesh & ~flat, f"`{what}` of a roof is not supported yet (only of faces in one plane; "
+                 "split the roof into faces with comp(f) first)", span)
+    rows = np.flatnonzero(mesh)
+    geom, counts = mesh_shapes.flat_mesh_faces(ctx.chunk, cursor.take(rows))
+    per_shape = np.ones(len(cursor), dtype=np.int64)
+    per_shape[rows] = counts
+    owner = np.repeat(np.arange(len(cursor)), per_shape)
+    faces = cursor.take(owner)
+    face_geom = faces.geom.copy()
+    face_geom[is_mesh(face_geom)] = geom
+    return faces.with_scope(faces.origin, faces.size, faces.frame, face_geom), owner
 
 
 def _piece_shapes(ctx: Context, cursor: Shapes, pieces, site: int) -> Shapes:

@@ -13,7 +13,9 @@ all four of the scope and geometry, as they turn scopes around their geometry (`
 from __future__ import annotations
 
 import numpy as np
+import shapely
 
+from grammarc.backend import mesh_shapes
 from grammarc.backend.context import Context
 from grammarc.backend.euler import angles as euler_angles
 from grammarc.backend.euler import orientation, rotation
@@ -27,13 +29,14 @@ from grammarc.backend.shapes import Shapes, asset_geom, asset_of
 from grammarc.constants import TOL
 from grammarc.geometry import components as comp_kernels
 from grammarc.geometry.align import EDGE_MODES, FACE_MODES, aligned_axes, pick_edges
+from grammarc.geometry.clip import oriented_rings, scope_polygons
 from grammarc.geometry.extrusion import extruded_meshes
-from grammarc.geometry.meshes import MESH_BASE, is_mesh, is_polygon
+from grammarc.geometry.meshes import MESH_BASE, face_vertices, is_mesh, is_polygon, ring_vector_areas
 from grammarc.geometry.polygons import PLANE_U, PLANE_V, plane_to_scope
 from grammarc.geometry.queries import face_shapes, shape_faces
 from grammarc.geometry.reframe import NORMAL_UP
 from grammarc.ir import nodes as ir
-from grammarc.ragged import segment_of, segment_reduce
+from grammarc.ragged import ragged_take, segment_of, segment_reduce
 
 _SCOPE = ("origin", "size", "frame", "geom")
 
@@ -130,7 +133,7 @@ def center(ctx: Context, cursor: Shapes, op: ir.Center, base) -> Shapes:
     return cursor.with_scope(origin, cursor.size, cursor.frame, cursor.geom)
 
 
-@operation(ir.Extrude, writes=_SCOPE)
+@operation(ir.Extrude, writes=_SCOPE, meshes=True)
 def extrude(ctx: Context, cursor: Shapes, op: ir.Extrude) -> Shapes:
     """A face becomes a solid along its normal; a negative height extrudes behind the face. As in
     CityEngine, the solid's scope keeps x and has y along the extrusion: a face whose normal is
@@ -140,9 +143,19 @@ def extrude(ctx: Context, cursor: Shapes, op: ir.Extrude) -> Shapes:
     face's. ``world.up`` extrudes a face looking up as its normal would; any other face becomes a mesh
     in a scope with y up and x the old x laid level, each vertex moved straight up, and
     ``world.up.flatTop`` moves them to one level: ``h`` above the lowest vertex, at least up to the
-    highest; with a negative ``h`` down from the highest, at least to the lowest."""
-    height = evaluate_array(op.height, ctx.env(cursor))
+    highest; with a negative ``h`` down from the highest, at least to the lowest.
+
+    A shape of several faces in one plane (an offset's pieces, convexify's parts) becomes a mesh of
+    their solids, each face extruded along its own normal (``_extruded_faces``)."""
+    height = np.broadcast_to(evaluate_array(op.height, ctx.env(cursor)), (len(cursor),))
     axis = flat_axis(ctx.chunk, cursor)
+    mesh = is_mesh(cursor.geom)
+    if mesh.any():  # a flat mesh is extruded across its plane; a roof's faces lie in several planes
+        flat = cursor.size <= TOL.zero
+        axis[mesh] = np.where(flat[mesh].sum(axis=1) == 1, np.argmax(flat[mesh], axis=1), -1)
+        if (axis[mesh] < 0).any():
+            ctx.fail(cursor, mesh & (axis < 0), "`extrude` of a roof is not supported yet (only of faces in one "
+                     "plane; split the roof into faces with comp(f) first)", op.span)
     bad = (axis < 0) | ~np.isfinite(height)
     if bad.any():
         ctx.fail(cursor, bad, "`extrude` needs a face (a flat shape) and a finite height", op.span)
@@ -150,6 +163,9 @@ def extrude(ctx: Context, cursor: Shapes, op: ir.Extrude) -> Shapes:
         height = np.broadcast_to(height, (len(cursor),))
         normal_y = ctx.chunk.frames[cursor.frame][np.arange(len(cursor)), np.maximum(axis, 0), 1]
         slanted = (normal_y < 1 - TOL.zero) & (axis >= 0)
+        if (slanted & mesh).any():
+            ctx.fail(cursor, slanted & mesh, "`extrude` along the world's up of faces that are not level and "
+                     "not one face is not supported yet", op.span)
         if slanted.any():
             rows, others = np.flatnonzero(slanted), np.flatnonzero(~slanted)
             meshes = _extruded_upwards(ctx, cursor.take(rows), height[rows], op.direction == "world.up")
@@ -164,7 +180,74 @@ def _extruded_along_normal(ctx: Context, cursor: Shapes, height, axis: np.ndarra
     size[:, 1] = np.abs(height)
     up = ctx.chunk.frames[cursor.frame][:, 1]
     origin = cursor.origin + np.minimum(height, 0.0)[:, None] * up
-    return cursor.with_scope(origin, size, cursor.frame, cursor.geom)
+    extruded = cursor.with_scope(origin, size, cursor.frame, cursor.geom)
+    mesh = is_mesh(cursor.geom)
+    if not mesh.any():
+        return extruded
+    rows, others = np.flatnonzero(mesh), np.flatnonzero(~mesh)
+    return Shapes.merge([extruded.take(others), _extruded_faces(ctx, cursor.take(rows), height[rows])],
+                        [others, rows])
+
+
+def _extruded_faces(ctx: Context, cursor: Shapes, height: np.ndarray) -> Shapes:
+    """Flat meshes lying across their scopes' y (``turned``) made into meshes of solids: each face
+    extruded by ``height`` along its own normal (an offset's pieces all face along the scope's y; one
+    that faces the other way goes the other way, as CityEngine extrudes every face along its own
+    normal), its bottom and top kept. As in CityEngine no lamina faces are made: the walls stand
+    around the outline of each shape's faces together (convexify's parts give the walls of the face
+    they were cut from; a straight run of the outline is one wall), facing as the shape's first face
+    does. The scope keeps its axes and is fitted
+    to the solids."""
+    chunk = ctx.chunk
+    n = len(cursor)
+    verts, ring_offsets, face_offsets, mesh_offsets, _ = face_vertices(chunk.meshes, cursor.geom - MESH_BASE,
+                                                                       cursor.size)
+    face_mesh = segment_of(mesh_offsets)
+    vertex_face = segment_of(face_offsets)[segment_of(ring_offsets)]
+    # the sign of each face's normal along y, from its outer ring's vector area
+    facing = np.where(ring_vector_areas(verts, ring_offsets)[face_offsets[:-1], 1] < 0, -1.0, 1.0)
+    top = verts.copy()
+    top[:, 1] += (height[face_mesh] * facing)[vertex_face]
+    caps = extruded_meshes(verts, top, ring_offsets, face_offsets, height[face_mesh] >= 0)
+    # the outline of each shape's faces, wound around the normal of its first face
+    ids, _ = mesh_shapes.flat_mesh_faces(chunk, cursor)
+    polygons = scope_polygons(chunk.polygons, ids, cursor.size[face_mesh])
+    outline = np.full(n, shapely.Polygon(), dtype=object)
+    has_faces = np.diff(mesh_offsets) > 0
+    rows = np.flatnonzero(has_faces)
+    # the parts joined, without the vertices their joins leave along straight runs of the outline
+    outline[rows] = shapely.simplify(shapely.buffer(shapely.multipolygons(polygons, indices=face_mesh)[rows], 0.0),
+                                     0.0)
+    parts, owner = shapely.get_parts(outline, return_index=True)
+    first = np.where(has_faces, facing[np.minimum(mesh_offsets[:-1], len(facing) - 1)], 1.0)
+    # oriented_rings winds plane 1's rings around +y, and (x, z) rings of another plane code around -y
+    _, uv, outline_rings, outline_faces = oriented_rings(parts, np.where(first[owner] > 0, 1, 2))
+    outline_vertex = owner[segment_of(outline_faces)[segment_of(outline_rings)]]
+    bottom = plane_to_scope(uv, np.ones(len(uv), dtype=np.int64))
+    lifted = bottom.copy()
+    lifted[:, 1] += (height * first)[outline_vertex]
+    walls = extruded_meshes(bottom, lifted, outline_rings, outline_faces, height[owner] >= 0)
+    # each face's bottom and top (the first two faces of its solid), then each outline part's walls
+    cap_faces = np.sort(np.r_[caps[3][:-1], caps[3][:-1] + 1])
+    wall_faces = np.setdiff1d(np.arange(len(walls[2]) - 1), np.r_[walls[3][:-1], walls[3][:-1] + 1])
+    owners = np.r_[face_mesh[segment_of(caps[3])[cap_faces]], owner[segment_of(walls[3])[wall_faces]]]
+    merged = _merged_faces(caps, walls, cap_faces, wall_faces, np.argsort(owners, kind="stable"))
+    geom, low, size = store_fitted(chunk, *merged, np.r_[0, np.cumsum(np.bincount(owners, minlength=n))])
+    origin = cursor.origin + np.einsum("ni,nij->nj", low, chunk.frames[cursor.frame])
+    return cursor.with_scope(origin, size, cursor.frame, geom)
+
+
+def _merged_faces(a, b, faces_a: np.ndarray, faces_b: np.ndarray, order: np.ndarray):
+    """Faces ``faces_a`` of mesh arrays ``a`` and ``faces_b`` of ``b`` (each verts, ring_offsets,
+    face_offsets, ...) as one ragged mesh, the faces (a's, then b's) taken in ``order``: verts,
+    ring_offsets, face_offsets."""
+    verts = np.concatenate([a[0], b[0]])
+    rings = np.r_[a[1][:-1], b[1] + len(a[0])]
+    faces = np.r_[a[2][:-1], b[2] + len(a[1]) - 1]
+    picked = np.r_[faces_a, faces_b + len(a[2]) - 1][order]
+    picked_rings, face_offsets = ragged_take(faces, picked)
+    vertices, ring_offsets = ragged_take(rings, picked_rings)
+    return verts[vertices], ring_offsets, face_offsets
 
 
 def _extruded_upwards(ctx: Context, cursor: Shapes, height: np.ndarray, straight: bool) -> Shapes:

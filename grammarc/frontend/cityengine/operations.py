@@ -27,9 +27,10 @@ class OperationLowering:
     ``diags``, ``site``...)."""
 
     def op_roof(self, op, args, span):
-        """``roofHip``, ``roofGable``, ``roofShed``, ``roofPyramid``: by angle, or with a leading
-        ``byAngle``/``byHeight`` selector. The arguments after the value, in CityEngine's order:
-        hip (overhang, even), gable (overhangX, overhangY, even, index), shed (index), pyramid none."""
+        """``roofHip``, ``roofGable``, ``roofShed``, ``roofPyramid``, ``roofRidge``: by angle, or with a
+        leading ``byAngle``/``byHeight`` selector. The arguments after the value, in CityEngine's order:
+        hip (overhang, even), gable (overhangX, overhangY, even, index), shed (index), pyramid and ridge
+        none. With an edge index a gable's ``even`` is ignored, as the reference says."""
         by_height = False
         if args and isinstance(args[0], ir.Name) and args[0].name in ("byAngle", "byHeight"):
             by_height = args[0].name == "byHeight"
@@ -41,16 +42,15 @@ class OperationLowering:
             return ir.Empty(span)
         given = dict(zip(names, (self.expr(a) for a in args[1:])))
         even = given.get("even")
-        if even is not None and not (isinstance(even, ir.Bool) and not even.value):
+        indexed = op == "roofGable" and "index" in given
+        if even is not None and not indexed and not (isinstance(even, ir.Bool) and not even.value):
             return self.unsupported(f"{op} with even ridges", even.span,
                                     "only even = false: even ridges make non-planar faces")
-        if op == "roofGable" and "index" in given:
-            return self.unsupported("roofGable with an edge index", given["index"].span,
-                                    "the ridge follows the straight skeleton")
         zero = ir.Num(0.0, span)
         overhang = given.get("overhang", given.get("overhangX", zero))
-        index = given.get("index", zero) if op == "roofShed" else zero
-        return ir.Roof(op, self.expr(args[0]), by_height, overhang, given.get("overhangY"), index, span)
+        index = given.get("index", zero) if op == "roofShed" or indexed else zero
+        return ir.Roof(op, self.expr(args[0]), by_height, overhang, given.get("overhangY"), index, span,
+                       indexed=indexed)
 
     def op_envelope(self, op, args, span):
         """``envelope(normal|world.up, maxHeight, baseHeight, angle, ...)``: one (baseHeight, angle) pair,
@@ -464,6 +464,7 @@ OPERATIONS = {
     "trim": direct(ir.Trim),
     "reduceGeometry": direct(ir.ReduceGeometry),
     "mirrorScope": direct(ir.MirrorScope),
+    "roofRidge": OperationLowering.op_roof,
 }
 #: Operations with parts ``{ ... }``: name -> handler(lowering, op, args, parts, span); those of ``REPEATING``
 #: also repeat (``{ ... }*``), with ``repeat=True``.
@@ -486,7 +487,7 @@ BODY_OPERATIONS = {
 SCATTER_TYPES = frozenset({"uniform", "gaussian"})
 #: The optional arguments after a roof's value (roofGable's ``index`` only by angle).
 ROOF_ARGUMENTS = {"roofHip": ("overhang", "even"), "roofGable": ("overhangX", "overhangY", "even"),
-                   "roofShed": ("index",), "roofPyramid": ()}
+                   "roofShed": ("index",), "roofPyramid": (), "roofRidge": ()}
 #: Operations CityEngine also takes without their parentheses (other bare names are rules).
 BARE_OPS = frozenset({"NIL", "primitiveCube", "convexify", "alignScopeToAxes", "primitiveQuad", "primitiveDisk",
                       "primitiveCylinder", "primitiveSphere", "primitiveCone", "trim"})
@@ -522,7 +523,7 @@ UNSUPPORTED_OPS = frozenset({
     "innerPolygon",
     "insertAlongUV", "footprint", "tileUV", "inline", "resetGeometry", "taper",
     "rectify", "semiPolygon",
-    "alignScopeToGeometryBBox", "roofRidge", "modify",
+    "alignScopeToGeometryBBox", "modify",
     "setbackPerEdge", "setbackToArea", "splitAndSetbackPerimeter",
     "tag", "deleteTags", "setTagsFromEdgeAttrs", "union", "subtract", "intersect",
     "copyUV", "setMaterial", "resetMaterial",

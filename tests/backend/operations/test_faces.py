@@ -136,3 +136,31 @@ def test_delete_holes_of_a_solid_with_holes_fails_its_lot(write):
     (bad,) = records["bad"]
     assert bad.index == 0 and bad.reason.startswith("`deleteHoles` of a solid with holes is not supported yet")
     assert set(records["lot"]) == {1}
+
+
+#: Two 10 x 10 squares joined by a bridge 2 wide: an inset of 1.5 leaves two disjoint squares of 7 x 7.
+DUMBBELL = [np.array([[0, 0], [10, 0], [10, 4], [14, 4], [14, 0], [24, 0], [24, 10], [14, 10], [14, 6],
+                      [10, 6], [10, 10], [0, 10]], float)]
+
+
+def test_offset_of_an_offsets_pieces_offsets_each_piece(write):
+    """CityEngine offsets every face of a shape's geometry: the second inset of the two squares left by
+    the first is two squares of 5 x 5 in one shape (candler's pipes on a courtyard's roof)."""
+    r = run(write, "Lot --> offset(-1.5, inside) offset(-1, inside) X.\n", [DUMBBELL])
+    got = mesh_faces(r)
+    assert names(r) == [] and len(got) == 2
+    assert [face_area(f) for f in got] == [pytest.approx(25), pytest.approx(25)]
+    xs = sorted(round(float(f[0][:, 0].min()), 6) for f in got)
+    assert xs == [2.5, 16.5]
+
+
+def test_offset_border_of_several_pieces_rings_each(write):
+    r = run(write, 'Lot --> offset(-1.5, inside) offset(-1, border) report("a", geometry.area) X.\n',
+            [DUMBBELL])
+    assert totals(r)["a_sum"] == pytest.approx(2 * (49 - 25))
+
+
+def test_offset_of_a_roof_fails_its_lot_by_name(write):
+    records = run(write, "Lot --> roofHip(30) offset(-1, inside) X.\n", [rect(10, 8)])
+    (bad,) = records["bad"]
+    assert bad.reason.startswith("`offset` of a roof is not supported yet (only of faces in one plane")

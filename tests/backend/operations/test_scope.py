@@ -563,3 +563,36 @@ def test_align_to_geometry_without_an_edge_keeps_the_scope(write):
     r = run(write, text, [rect(12, 8)])
     assert (totals(r)["sy_sum"], totals(r)["ty_sum"]) == pytest.approx((4, 0))
     assert names(r) == ["G"]  # the face beside it turned and made its quad
+
+
+#: Two 10 x 10 squares joined by a bridge 2 wide: an inset of 1.5 leaves two disjoint squares of 7 x 7.
+DUMBBELL = [np.array([[0, 0], [10, 0], [10, 4], [14, 4], [14, 0], [24, 0], [24, 10], [14, 10], [14, 6],
+                      [10, 6], [10, 10], [0, 10]], float)]
+
+
+@pytest.mark.parametrize("height", [2.0, -2.0])
+def test_extrude_of_an_offsets_pieces_is_a_box_per_piece(write, height):
+    """Each face of the geometry extruded along its normal: two 7 x 7 x 2 boxes in one shape, whose
+    scope is fitted to both."""
+    r = run(write, f'Lot --> offset(-1.5, inside) extrude({height}) '
+            'report("sx", scope.sx) report("sy", scope.sy) X.\n', [DUMBBELL])
+    got = mesh_faces(r)
+    level = [f for f in got if np.ptp(f[0][:, 1]) < 1e-9]
+    assert len(level) == 4  # a bottom and a top per box; the walls keep the inset's vertices along edges
+    assert sum(face_area(f) for f in level) == pytest.approx(4 * 49)
+    assert sum(face_area(f) for f in got) == pytest.approx(2 * (2 * 49 + 4 * 7 * 2))
+    y = r["mesh"].vertices[:, 1]
+    assert (y.min(), y.max()) == (pytest.approx(min(height, 0)), pytest.approx(max(height, 0)))
+    t = totals(r)
+    assert (t["sx_sum"], t["sy_sum"]) == (pytest.approx(21), pytest.approx(2))
+
+
+def test_extrude_of_convex_parts_has_no_lamina_faces(write):
+    """CityEngine's extrude makes no inner faces: convexify's parts of the L extruded are the L's prism,
+    its bottom and top in parts, the walls around the L."""
+    r = run(write, 'Lot --> convexify extrude(3) comp(f){ side : report("w", geometry.area) W. | all : X. }\n',
+            [LOT_ZOO["concave_L"]])
+    got = mesh_faces(r)
+    assert sum(face_area(f) for f in got) == pytest.approx(2 * 400 + 100 * 3)
+    t = totals(r)
+    assert (t["w_n"], t["w_sum"]) == (6, pytest.approx(100 * 3))

@@ -221,6 +221,21 @@ def test_merged_selector_is_derived_face_by_face_with_a_warning(line, at):
 
 
 
+@pytest.mark.parametrize("call, kind, by_height, indexed", [
+    ("roofGable(30, 1, 0.5, false, 2)", "roofGable", False, True),
+    ("roofGable(30, 1, 1, true, 0)", "roofGable", False, True),  # with an index, even is ignored
+    ("roofGable(30, 1, 0.5)", "roofGable", False, False),
+    ("roofRidge(byHeight, 0.4)", "roofRidge", True, False),
+    ("roofRidge(byAngle, 30)", "roofRidge", False, False),
+])
+def test_roof_gable_with_an_edge_index_and_roof_ridge_lower_to_roofs(call, kind, by_height, indexed):
+    module = module_of(VERSION + f"Lot --> {call} Roof\nRoof --> X.\n")
+    (roof,) = [op for op in iter_ops(module) if isinstance(op, ir.Roof)]
+    assert (roof.kind, roof.by_height, roof.indexed) == (kind, by_height, indexed)
+    if indexed:
+        assert roof.index.value in (2, 0)
+
+
 # ------------------------------------------------------------------------------------ the unsupported
 
 
@@ -231,7 +246,6 @@ def test_merged_selector_is_derived_face_by_face_with_a_warning(line, at):
      "street"),
     ("Lot --> setback(3) Garden", "setback without selector parts", "setback"),
     ("Lot --> setback(3){ 2 : Garden }", "this setback selector", "2"),
-    ("Lot --> roofGable(30, 1, 1, false, 2) Roof", "roofGable with an edge index", "2)"),
     ("Lot --> roofHip(30, 1, true) Roof", "roofHip with even ridges", "true"),
     ("Lot --> envelope(normal, 10, 45) Roof", "envelope with 3 arguments", "envelope"),
     ("Lot --> shapeL(4, 4){ front : A | remainder : NIL }", "shapeL selector `front`", "front"),
