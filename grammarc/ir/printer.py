@@ -164,7 +164,8 @@ _OP_FORMATS = {
     ir.InnerRectangle: lambda op: f"innerRectangle({op.align}){_selected(op.selectors, op.parts)}",
     ir.Roof: _roof,
     ir.CompFaces: lambda op: ((f"offset({print_expr(op.offset)}) " if op.offset is not None else "")
-                              + f"comp({op.kind}){_selected(op.selectors, op.parts)}"),
+                              + f"comp({op.kind})" + _selected([print_expr(op.picks[int(s[1:])]) if s[0] == "#" else s
+                                                                for s in op.selectors], op.parts)),
     ir.Setback: _setback,
     ir.Case: _branches,
     ir.Stochastic: _branches,

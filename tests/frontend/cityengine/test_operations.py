@@ -87,6 +87,9 @@ from .lowered import VERSION, assert_unsupported_at, body_of, compile_ir, errors
     ("split(z, adjust){ 1 : A | ~1 : B }", "split(z){ 1: A | ~1: B }"),
     ("split(x, noAdjust){ 1 : A | ~1 : B }*", "split(x, noAdjust){ 1: A | ~1: B }*"),
     ("comp(f){ front : A | side : B. | top : NIL }", "comp(f){ front: A | side: B. | top: \u03b5 }"),
+    ("comp(f){ h + 1 : A | h = B | 2 : C }", "comp(f){ (@h + 1): A | @h: B | 2: C }"),
+    ("comp(e){ eave : A | ridge : B | hip : C | valley : D }", "comp(e){ eave: A | ridge: B | hip: C | valley: D }"),
+    ("comp(v){ h : A }", "comp(v){ @h: A }"),
     ('color("#ff0000") A', 'color("#ff0000") A'),
     ("color(1, 0.5, 0) A", "color(1, 0.5, 0) A"),
     ('texture("brick.jpg") A', "texture(...) A"),
@@ -170,6 +173,15 @@ def test_comp_faces_selectors(selectors):
     assert [p[0].name for p in op.parts] == [s.capitalize() for s in selectors]
 
 
+def test_comp_index_expressions_are_picks_beside_the_named_selectors():
+    """``comp(f){ n + 1 : A | n : B | top : C }``: an index given by an expression, a constant or an
+    attribute is the selector ``#k`` of the k-th expression of ``picks``."""
+    op = module_of(f"{VERSION}const n = 2\nMass --> comp(f){{ n + 1 : A | n = B | top : C }}\n"
+                   ).rules[0].alternatives[0].body[0]
+    assert op.selectors == ("#0", "#1", "top")
+    assert [print_expr(e) for e in op.picks] == ["(@n + 1)", "@n"]
+
+
 def test_shape_u_moves_front_right_and_left_edges_into_its_shape_part():
     op = module_of(f"{VERSION}Lot --> shapeU(5, 3, 11){{ shape : A | remainder = B }}\n"
                    ).rules[0].alternatives[0].body[0]
@@ -237,6 +249,8 @@ def test_merged_selector_is_derived_face_by_face_with_a_warning(line, at):
     ("Lot --> comp(f){ street.top : A }", "comp(f) selector `street.top`", "street"),
     ("Lot --> comp(f){ fornt : A }", "comp(f) selector `fornt`", "fornt"),
     ("Lot --> comp(e){ front : A }", "comp(e) selector `front`", "front"),
+    ("Lot --> comp(e){ eavs : A }", "comp(e) selector `eavs`", "eavs"),
+    ("Lot --> comp(f){ ridge : A }", "comp(f) selector `ridge`", "ridge"),
     ("Lot --> comp(f){ 1.5 : A }", "this comp selector", "1.5"),
     ("Lot --> comp(f){ { front : A }* }", "repeat group in comp", "{ front"),
     ("Lot --> comp(f){ front : A }*", "`*` after comp", "*"),
