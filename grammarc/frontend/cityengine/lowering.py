@@ -21,6 +21,7 @@ from grammarc.diagnostics import Span, suggest
 from grammarc.frontend.cityengine.nodes import (
     Annotated,
     EdgeDistances,
+    EdgeTable,
     FunctionDef,
     Group,
     Import,
@@ -178,6 +179,8 @@ class Lowering(OperationLowering, LoweringBase):
         return ir.AttrDecl(str(name), self.expr(value), self.token_span(name))
 
     def const_decl(self, meta, name, value):
+        if isinstance(value, EdgeDistances):
+            return EdgeTable(str(name), value)
         return ir.AttrDecl(str(name), self.expr(value), self.token_span(name), const=True)
 
     def function_def(self, meta, name, params, value):
@@ -282,7 +285,7 @@ class Lowering(OperationLowering, LoweringBase):
         if str(name) != "comp" or len(args or ()) != 1 or not isinstance(args[0], ir.Name) or \
                 args[0].name != "fe":
             return self.unsupported(f"{name}(...){{...}} as an argument", span, "only setback(comp(fe){ ... })")
-        chosen = self.selector_parts("comp(fe)", parts, SETBACK_SELECTORS - {"remainder"})
+        chosen = self.selector_parts("comp(fe)", parts, SETBACK_SELECTORS - {"remainder"}, noun=None)
         if chosen is None:
             return ir.placeholder(span)
         values = []

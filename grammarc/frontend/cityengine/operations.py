@@ -383,7 +383,8 @@ class OperationLowering:
     def selector_parts(self, op, parts, known, named=None, noun="polygons", indices=None):
         """The selectors and bodies of ``{ sel: A | ... }`` parts, all among ``known`` (None after an
         error); ``sel=`` is derived as ``sel:``, with a warning. ``named`` is the operation as a selector
-        error names it (``comp(f)``; default ``op``), ``noun`` what ``sel=`` would merge.
+        error names it (``comp(f)``; default ``op``), ``noun`` what ``sel=`` would merge (None: nothing,
+        the parts of ``comp(fe)`` are distances).
 
         With ``indices`` (a list, comp's), a whole number ``3`` selects the component of that index (the
         selector ``"3"``), and any other expression (``n + 1``, a constant, an attribute) the component
@@ -415,7 +416,7 @@ class OperationLowering:
                 why = f"{named} selects {listed}" + (" and remainder" if "remainder" in known else "")
                 self.unsupported(f"{named} selector `{value.name}`", value.span, why + suggest(value.name, known))
                 return None
-            if part.merged:
+            if part.merged and noun is not None:
                 self.diags.warning(
                     "merged", f"`{value.name}=` gives one shape for all its {noun} in CityEngine; grammarc "
                     "derives them one by one (the same leaves; operations that read the scope differ)",
