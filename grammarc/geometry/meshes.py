@@ -201,8 +201,8 @@ def mesh_edges(verts, ring_offsets, face_offsets, mesh_offsets, eps: float):
     horizontal = np.abs(x[:, 1]) <= 1e-9
     low = np.maximum(start[:, 1], end[:, 1]) <= eps
     kind = np.where(~horizontal, 1, np.where(low, 0, 2))
-    roof = roof_edge_kinds(verts, ring_offsets, face_offsets, face[kept], rank[inverse], face_normal, start,
-                           horizontal, low, eps)
+    roof = roof_edge_kinds(verts, ring_offsets, face_offsets, mesh_offsets, face[kept], rank[inverse], face_normal,
+                           mesh[edge], start, end, eps)
     return mesh[edge], start, axes, size, kind, roof
 
 
@@ -210,29 +210,39 @@ def mesh_edges(verts, ring_offsets, face_offsets, mesh_offsets, eps: float):
 _SLOPED = 1e-6
 
 
-def roof_edge_kinds(verts, ring_offsets, face_offsets, edge_face, edge_of, face_normal, start, horizontal,
-                    low, eps: float) -> np.ndarray:
+def roof_edge_kinds(verts, ring_offsets, face_offsets, mesh_offsets, edge_face, edge_of, face_normal, edge_mesh,
+                    start, end, eps: float) -> np.ndarray:
     """Each distinct edge's place on a roof, as ``comp(e)``'s selectors name it: 0 eave, 1 ridge, 2 hip,
     3 valley (``ir.ROOF_EDGE_SELECTORS``), -1 none of them (E,) int8.
 
     The reference says only that these selectors are meant for roofs; grammarc reads them off the faces
-    that meet at the edge, as a roofer names them. A sloped face is one neither flat nor vertical, facing
-    up. An eave is a horizontal edge at or below the base (``low``) along a sloped face; a ridge a
-    horizontal edge above the base where two sloped faces meet convexly; a hip a sloped edge where two
-    sloped faces meet convexly; a valley any edge where two sloped faces meet concavely. The sloped edges
-    along a gable's vertical face and those of a flat cap are none of them: so a box, a prism or a flat
-    face has no roof edges.
+    that meet at the edge, as a roofer names them. A mesh's first face is its base (a roof's bottom),
+    whose normal points down: up is against it, whatever the scope's axes (a roof on a lot has y up, one
+    on a face from ``comp(f)`` the face's z). A sloped face is one neither flat nor vertical, facing up.
+    An eave is a horizontal edge at or below the base along a sloped face; a ridge a horizontal edge
+    above the base where two sloped faces meet convexly; a hip a sloped edge where two sloped faces meet
+    convexly; a valley any edge where two sloped faces meet concavely. The sloped edges along a gable's
+    vertical face and those of a flat cap are none of them.
 
-    verts (V, 3) in the scopes' units with y up; edge_face (k,) and edge_of (k,): the face of each ring
-    edge and its distinct edge (E of them); face_normal (F, 3) unit normals; start (E, 3) each edge's
-    first point; horizontal, low (E,) bool.
+    verts (V, 3) in the scopes' units; edge_face (k,) and edge_of (k,): the face of each ring edge and its
+    distinct edge (E of them); face_normal (F, 3) unit normals; edge_mesh (E,) each edge's mesh; start,
+    end (E, 3) its points.
     """
     n_edges = len(start)
     vertex_start = ring_offsets[face_offsets]
     count = np.maximum(np.diff(vertex_start), 1)
-    centroid = np.stack([segment_reduce(np.add, verts[:, j], vertex_start, 0.0) for j in range(3)], 1) / count[:, None]
-    up = face_normal[:, 1]
-    sloped = (up > _SLOPED) & (up < 1 - _SLOPED)
+    centroid = np.stack([segment_reduce(np.add, verts[:, j], vertex_start, 0.0) for j in range(3)], 1)
+    centroid /= count[:, None]
+    base = mesh_offsets[:-1]
+    up = -face_normal[np.minimum(base, len(face_normal) - 1)]  # per mesh
+    floor = np.einsum("ij,ij->i", verts[np.minimum(vertex_start[base], len(verts) - 1)], up)
+    edge_up, edge_floor = up[edge_mesh], floor[edge_mesh]
+    direction = end - start
+    direction /= np.maximum(np.linalg.norm(direction, axis=1, keepdims=True), 1e-300)
+    horizontal = np.abs(np.einsum("ij,ij->i", direction, edge_up)) <= _SLOPED
+    low = np.maximum(np.einsum("ij,ij->i", start, edge_up), np.einsum("ij,ij->i", end, edge_up)) <= edge_floor + eps
+    rise = np.einsum("ij,ij->i", face_normal, up[segment_of(mesh_offsets)])
+    sloped = (rise > _SLOPED) & (rise < 1 - _SLOPED)
     faces = np.bincount(edge_of, minlength=n_edges)
     first = np.full(n_edges, len(face_normal), dtype=np.int64)
     last = np.full(n_edges, -1, dtype=np.int64)
@@ -245,7 +255,7 @@ def roof_edge_kinds(verts, ring_offsets, face_offsets, edge_face, edge_of, face_
     between_slopes = two & sloped[a] & sloped[b]
     # convex: each face's centroid behind the other's plane (the edge's start lies on both planes)
     behind = np.einsum("ij,ij->i", face_normal[a], centroid[b] - start)
-    scale = np.maximum(np.abs(verts).max(initial=0.0), 1.0)
+    scale = max(float(np.abs(verts).max(initial=0.0)), 1.0)
     convex, concave = behind < -eps * scale, behind > eps * scale
     roof = np.full(n_edges, -1, dtype=np.int8)
     roof[horizontal & low & along_slope] = 0

@@ -34,6 +34,7 @@ from grammarc.geometry.meshes import is_mesh, is_polygon
 from grammarc.geometry.reframe import NORMAL_OUT
 from grammarc.geometry.trim import side_face_planes
 from grammarc.ir import nodes as ir
+from grammarc.ir.printer import comp_selectors
 from grammarc.ragged import rank_within
 
 
@@ -92,7 +93,7 @@ def comp_faces(ctx: Context, cursor: Shapes, op: ir.CompFaces) -> Parts:
         # CityEngine numbers the components of each selector: the front face is 0 of 1
         group = parent * (len(op.selectors) + 1) + which
         rank = rank_within(group)
-        ids = np.array([ctx.plan.strings.ids[s] for s in op.selectors], dtype=np.int32)
+        ids = np.array([ctx.plan.strings.ids[s] for s in comp_selectors(op)], dtype=np.int32)
         shapes = with_context(ctx.plan, shapes, "comp", rank, group, int(group.max(initial=0)) + 1,
                               selector=ids[which])
     ctx.count(shapes, op.span)

@@ -186,6 +186,8 @@ ROOF_EDGES = "comp(e){ eave : Eave | ridge : Ridge | hip : Hip | valley : Valley
     ("roofHip(30)", "concave_L", {"Eave": 6, "Hip": 5, "Valley": 1, "Ridge": 2}),
     ("roofGable(30)", "concave_L", {"Eave": 4, "Hip": 1, "Valley": 1, "Ridge": 2, "Other": 6}),
     ("extrude(3)", "rect", {"Other": 12}),  # a box has no roof edges
+    # a roof on a mass's top face: the face's z is up, not the scope's y
+    ("extrude(4) comp(f){ top : Top }\nTop --> roofGable(30)", "rect", {"Eave": 2, "Ridge": 1, "Other": 6}),
 ])
 def test_roof_edges_are_eaves_ridges_hips_and_valleys(write, roof, lot, want):
     """``comp(e){ eave | ridge | hip | valley }`` on roofs: the eaves along the base, the ridges on top,
@@ -196,3 +198,15 @@ def test_roof_edges_are_eaves_ridges_hips_and_valleys(write, roof, lot, want):
     if roof == "roofHip(30)" and lot == "rect":
         t = totals(r)
         assert t["Eave_sum"] == pytest.approx(40) and t["Ridge_sum"] == pytest.approx(4)  # 12 - 2 * 4
+
+
+def test_comp_sel_names_every_kind_of_selector_as_written(write):
+    """``comp.sel`` of an index, an index expression, a world selector and a roof edge selector: the text of
+    the selector that took the component (a selector outside the plain face names used to be unknown)."""
+    r = run(write, "const n = 1\nLot --> extrude(4) comp(f){ n + 1 : A | 1 : B | world.up : C }\n"
+                   'A --> report("a", comp.sel == "(@n + 1)")\nB --> report("b", comp.sel == "1")\n'
+                   'C --> report("c", comp.sel == "world.up") roofHip(30) comp(e){ eave : E }\n'
+                   'E --> report("e", comp.sel == "eave")\n', [rect(12, 8)])
+    t = totals(r)
+    assert (t["a_n"], t["b_n"], t["c_n"], t["e_n"]) == (1, 1, 1, 4)
+    assert t["a_min"] and t["b_min"] and t["c_min"] and t["e_min"]
