@@ -545,8 +545,9 @@ class SetColor:
 
 @dataclass(frozen=True, slots=True)
 class Offset:
-    """CityEngine ``offset(d, inside|border)``: the face's polygon grown (d > 0) or shrunk (d < 0) with
-    mitred corners, keeping the inset (``inside``) or the ring around it (``border``)."""
+    """CityEngine ``offset(d, inside|border|all)``: the face's polygon grown (d > 0) or shrunk (d < 0) with
+    mitred corners, keeping the inset (``inside``), the ring around it (``border``) or both as the faces
+    of one shape (``all``, and ``offset(d)`` that no ``comp(f)`` of them follows)."""
 
     distance: Expr = child(Type.NUM, "an offset distance")
     select: str

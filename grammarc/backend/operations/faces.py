@@ -82,9 +82,18 @@ def roof(ctx: Context, cursor: Shapes, op: ir.Roof) -> Shapes:
 
 @operation(ir.Offset, writes=COLUMNS)
 def offset(ctx: Context, cursor: Shapes, op: ir.Offset) -> Shapes:
-    """``offset(d, inside|border)``: the shape's face becomes its inset or the ring around it."""
-    inside, border = _offset_pieces(ctx, op.distance, cursor, op.span)
-    pieces = inside if op.select == "inside" else border
+    """``offset(d, inside|border|all)``: the shape's face becomes its inset, the ring around it, or both
+    (the faces of one shape)."""
+    if op.select == "all":
+        inset, border, plane, polygons = _offset_polygons(ctx, op.distance, cursor, op.span)
+        n = len(cursor)
+        pieces = fit_pieces(np.concatenate([inset, border]), np.tile(plane, 2), np.tile(cursor.size, (2, 1)),
+                            np.tile(polygons, 2))
+        pieces = replace(pieces, source=pieces.source % n)  # each shape's inside pieces, then its border's
+        pieces = pieces.take(np.argsort(pieces.source, kind="stable"))
+    else:
+        inside, border = _offset_pieces(ctx, op.distance, cursor, op.span)
+        pieces = inside if op.select == "inside" else border
     several = np.bincount(pieces.source, minlength=len(cursor)) > 1
     if not several.any():
         return _piece_shapes(ctx, cursor, pieces, 0)
@@ -245,12 +254,18 @@ def face_polygons(ctx: Context, cursor: Shapes, what: str, span) -> tuple[np.nda
     return scope_polygons(store, geom, cursor.size), store.plane[geom]
 
 
-def _offset_pieces(ctx: Context, distance: ir.Expr, cursor: Shapes, span):
-    """The inside and border pieces of each flat shape's polygon offset by ``distance``."""
+def _offset_polygons(ctx: Context, distance: ir.Expr, cursor: Shapes, span):
+    """Each flat shape's polygon offset by ``distance``: the inset and the border (n,) (shapely, in the
+    scopes' units), the polygons' planes (n,) and the polygons themselves (n,)."""
     polygons, plane = face_polygons(ctx, cursor, "offset", span)
     d = evaluate_array(distance, ctx.env(cursor))
     inset = shapely.buffer(polygons, d, join_style="mitre", mitre_limit=1e6)
-    border = shapely.difference(polygons, inset)
+    return inset, shapely.difference(polygons, inset), plane, polygons
+
+
+def _offset_pieces(ctx: Context, distance: ir.Expr, cursor: Shapes, span):
+    """The inside and border pieces of each flat shape's polygon offset by ``distance``."""
+    inset, border, plane, polygons = _offset_polygons(ctx, distance, cursor, span)
     return fit_pieces(inset, plane, cursor.size, polygons), fit_pieces(border, plane, cursor.size, polygons)
 
 

@@ -137,12 +137,14 @@ class OperationLowering:
         return ir.SetColor(tuple(self.expr(a) for a in args[:3]), span)
 
     def op_offset(self, op, args, span):
+        """``offset(d)`` (a ``comp(f){ inside | border }`` after it takes its faces: ``fuse_offsets``),
+        ``offset(d, inside|border|all)``."""
         if len(args) == 1:
             return PendingOffset(self.expr(args[0]), span)
-        if len(args) == 2 and isinstance(args[1], ir.Name) and args[1].name in ("inside", "border"):
+        if len(args) == 2 and isinstance(args[1], ir.Name) and args[1].name in ir.OFFSET_SELECTORS:
             return ir.Offset(self.expr(args[0]), args[1].name, span)
         return self.unsupported("offset with these arguments", span,
-                                "offset(d), offset(d, inside), offset(d, border)")
+                                "offset(d), offset(d, inside), offset(d, border), offset(d, all)")
 
     def op_align(self, op, args, span):
         axis = _selector(args[0]) if len(args) == 1 else None
@@ -322,6 +324,16 @@ class OperationLowering:
             distances = tuple((s, exprs[0]) for s in selectors if s != "remainder")
         return ir.Setback(distances, selectors, chosen[1], span, self.site())
 
+    def op_setback_alone(self, op, args, span):
+        """``setback(d)`` without parts (public files write it, as if it were an operation on its own):
+        the reference knows only the form with parts, and a user who writes it means the face set back by
+        ``d`` all round, the remainder that ``setback(d){ all: NIL | remainder: ... }`` would give:
+        ``offset(-d, inside)``, whose mitred inset is the same polygon."""
+        if not self.arity(op, args, (1,), span):
+            return ir.Empty(span)
+        distance = self.expr(args[0])
+        return ir.Offset(ir.Unary("-", distance, getattr(distance, "span", span)), "inside", span)
+
     def op_label(self, op, args, span):
         if len(args) != 1 or not isinstance(args[0], ir.Str):
             return self.unsupported("label with these arguments", span, 'label("name")')
@@ -471,6 +483,10 @@ PART_OPERATIONS = {
     "shapeU": OperationLowering.op_setback,
     "shapeO": OperationLowering.op_setback,
     "innerRectangle": OperationLowering.op_inner_rectangle,
+}
+#: Operations with parts that may also come without them: name -> handler(lowering, op, args, span).
+WITHOUT_PARTS = {
+    "setback": OperationLowering.op_setback_alone,
 }
 #: Operations with a body ``{ operations }``: name -> handler(lowering, op, args, body, span).
 BODY_OPERATIONS = {

@@ -90,6 +90,10 @@ from .lowered import VERSION, assert_unsupported_at, body_of, compile_ir, errors
     ("comp(f){ h + 1 : A | h = B | 2 : C }", "comp(f){ (@h + 1): A | @h: B | 2: C }"),
     ("comp(e){ eave : A | ridge : B | hip : C | valley : D }", "comp(e){ eave: A | ridge: B | hip: C | valley: D }"),
     ("comp(v){ h : A }", "comp(v){ @h: A }"),
+    ("offset(-2) A", "offset(-2, all) A"),
+    ("offset(-2, all) A", "offset(-2, all) A"),
+    ("offset(h) comp(f){ border : B }", "offset(@h) comp(f){ border: B }"),
+    ("setback(h) A", "offset(-@h, inside) A"),
     ('color("#ff0000") A', 'color("#ff0000") A'),
     ("color(1, 0.5, 0) A", "color(1, 0.5, 0) A"),
     ('texture("brick.jpg") A', "texture(...) A"),
@@ -227,11 +231,10 @@ def test_merged_selector_is_derived_face_by_face_with_a_warning(line, at):
 
 
 @pytest.mark.parametrize("line, name, at", [
-    ("Lot --> offset(-2) Inner", "offset(d) without comp(f){ inside | border } after it", "offset"),
     ("Lot --> offset(-2, outside) Inner", "offset with these arguments", "offset"),
     ("Lot --> setback(3){ street.top : Garden | remainder : Building }", "setback selector `street.top`",
      "street"),
-    ("Lot --> setback(3) Garden", "setback without selector parts", "setback"),
+    ("Lot --> shapeL(3, 2) Garden", "shapeL without selector parts", "shapeL"),
     ("Lot --> setback(3){ 2 : Garden }", "this setback selector", "2"),
     ("Lot --> roofGable(30, 1, 1, false, 2) Roof", "roofGable with an edge index", "2)"),
     ("Lot --> roofHip(30, 1, true) Roof", "roofHip with even ridges", "true"),
