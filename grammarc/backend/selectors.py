@@ -1,5 +1,7 @@
 """Component selectors as CityEngine reads them: which faces (by their normals) and edges (by their
-directions) ``front``, ``top``, ``vertical``, ``aslant``... name.
+directions) ``front``, ``top``, ``vertical``, ``aslant``... name, which edges of a roof ``eave``, ``ridge``,
+``hip`` and ``valley`` name (``geometry.meshes.roof_edge_kinds``), and which component an index ``3`` or an
+index expression ``n + 1`` takes (``index_masks``).
 
 Normals are in the parent's scope frame (front +z, back -z, right +x, left -x, top +y, bottom -y), or in the
 lot's (``object.``), the world's (``world.``) or the lot's street frame (``street.``, ``geometry.streets``)
