@@ -295,7 +295,8 @@ class OperationLowering:
             return self.unsupported(f"comp({kind})", span, "comp(f), comp(e) and comp(v)")
         kind = args[0].name
         picks: list[ir.Expr] = []
-        chosen = self.selector_parts("comp", parts, COMP_SELECTORS[kind], named=f"comp({kind})", noun="faces",
+        noun = {"f": "faces", "e": "edges", "v": "vertices"}[kind]
+        chosen = self.selector_parts("comp", parts, COMP_SELECTORS[kind], named=f"comp({kind})", noun=noun,
                                      indices=picks)
         if chosen is None:
             return ir.Empty(span)

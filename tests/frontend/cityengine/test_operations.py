@@ -214,15 +214,17 @@ def test_cleanup_geometry_names_a_wrong_component_or_argument_count_at_its_line(
     assert errors(VERSION + line + "\n") == [(2, line.index(at) + 1, message)]
 
 
-@pytest.mark.parametrize("line, at", [
-    ("Mass --> comp(f){ side= Wall }", "side"),
-    ("Mass --> comp(f){ top : Roof | all= Rest }", "all="),
+@pytest.mark.parametrize("line, at, noun", [
+    ("Mass --> comp(f){ side= Wall }", "side", "faces"),
+    ("Mass --> comp(f){ top : Roof | all= Rest }", "all=", "faces"),
+    ("Mass --> comp(e){ eave = Gutter }", "eave", "edges"),
 ])
-def test_merged_selector_is_derived_face_by_face_with_a_warning(line, at):
+def test_merged_selector_is_derived_face_by_face_with_a_warning(line, at, noun):
     module, diags = compile_ir(VERSION + line + "\n")
     assert not diags.has_errors
     assert [(d.code, d.span.line, d.span.col) for d in diags] == [("merged", 2, line.index(at) + 1),
                                                                   ("start-rule", 2, 1)]
+    assert f"for all its {noun}" in next(iter(diags)).message
     assert isinstance(module.rules[0].alternatives[0].body[0], ir.CompFaces)
 
 
