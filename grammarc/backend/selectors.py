@@ -68,7 +68,7 @@ def _face_masks(normal: np.ndarray, along: np.ndarray | None = None) -> dict[str
         "side": side, "rest": side & ~front, "vertical": vertical, "horizontal": horizontal,
         "aslant": ~vertical & ~horizontal & (y > 0), "nutant": ~vertical & ~horizontal & (y < 0),
         "all": np.ones(len(normal), dtype=bool),
-        # the faces an offset makes: a shape not offset has none
+        # the faces of an offset (or of a shape's border: ``component_splits``); here none
         "inside": np.zeros(len(normal), dtype=bool), "border": np.zeros(len(normal), dtype=bool),
     }
     return masks

@@ -730,8 +730,8 @@ OFFSET_SELECTORS = frozenset({"inside", "border", "all"})
 #: The edges of a roof by where its faces meet (``geometry.meshes.roof_edge_kinds``), selectors of ``comp(e)``.
 ROOF_EDGE_SELECTORS = ("eave", "ridge", "hip", "valley")
 #: Edge and vertex selectors of ``comp(e)`` and ``comp(v)``.
-EDGE_SELECTORS = frozenset({"vertical", "horizontal", "aslant", "all", *ROOF_EDGE_SELECTORS})
-VERTEX_SELECTORS = frozenset({"all"})
+EDGE_SELECTORS = frozenset({"vertical", "horizontal", "aslant", "all", "border", "inside", *ROOF_EDGE_SELECTORS})
+VERTEX_SELECTORS = frozenset({"all", "border", "inside"})
 
 
 @dataclass(frozen=True, slots=True)

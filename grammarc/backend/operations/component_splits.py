@@ -79,6 +79,8 @@ def comp_faces(ctx: Context, cursor: Shapes, op: ir.CompFaces) -> Parts:
     picks = [np.broadcast_to(np.asarray(evaluate_array(e, env), dtype=np.float64), (len(cursor),))
              for e in op.picks]
     picked = index_masks(op.selectors, parent, picks)
+    if {"border", "inside"} & set(op.selectors):
+        picked.update(_border_masks(ctx, cursor, parent, op))
     if op.kind == "f":
         axes = chunk.frames[shapes.frame]
         base = (shapes.origin, shapes.origin + axes[:, 0] * shapes.size[:, :1])  # each face's bottom edge
@@ -99,6 +101,18 @@ def comp_faces(ctx: Context, cursor: Shapes, op: ir.CompFaces) -> Parts:
     ctx.count(shapes, op.span)
     order, offsets = group_by(which, len(op.parts))
     return Parts(op.parts, shapes.take(order), offsets)
+
+
+def _border_masks(ctx: Context, cursor: Shapes, parent: np.ndarray, op: ir.CompFaces) -> dict[str, np.ndarray]:
+    """The components (m,) of parents ``parent`` that ``border`` and ``inside`` take on shapes no
+    ``offset`` made, as the reference defines them: a border edge meets one face, a border face or vertex
+    touches a border edge. A flat shape is one face, all of it border; a solid (a box, a prism) is closed,
+    all of it inside. The edges of meshes (roofs) are not counted yet: refused."""
+    mesh = is_mesh(cursor.geom)
+    if mesh.any():
+        ctx.fail(cursor, mesh, f"`comp({op.kind})` border and inside on a roof are not supported yet", op.span)
+    flat = ((cursor.size <= TOL.zero).sum(axis=1) >= 1)[parent]
+    return {"border": flat, "inside": ~flat}
 
 
 def components(ctx: Context, kind: int, cursor: Shapes, site: int, wanted=None):

@@ -210,3 +210,19 @@ def test_comp_sel_names_every_kind_of_selector_as_written(write):
     t = totals(r)
     assert (t["a_n"], t["b_n"], t["c_n"], t["e_n"]) == (1, 1, 1, 4)
     assert t["a_min"] and t["b_min"] and t["c_min"] and t["e_min"]
+
+
+@pytest.mark.parametrize("body, want", [
+    ("comp(f){ inside : I | border : B }", {"B": 1}),  # a flat shape: its one face has only border edges
+    ("comp(e){ inside : I | border : B }", {"B": 4}),
+    ("comp(v){ border : B }", {"B": 4}),
+    ("extrude(3) comp(f){ border : B | inside : I }", {"I": 6}),  # a closed solid: all inside
+    ("extrude(3) comp(e){ border : B | inside : I }", {"I": 12}),
+])
+def test_border_and_inside_of_shapes_no_offset_made(write, body, want):
+    """The reference's ``border`` (an edge meeting one face, a face or vertex touching such an edge) and
+    ``inside`` on faces and solids; on a roof they are refused by name."""
+    r = run(write, f"Lot --> {body}\n" + "".join(f'{n} --> report("{n}", 1)\n' for n in "IB"), [rect(12, 8)])
+    assert {k[:-2]: v for k, v in totals(r).items() if k.endswith("_n")} == want
+    r = run(write, "Lot --> roofHip(30) comp(e){ border : B }\n", [rect(12, 8)])
+    assert len(r["bad"]) == 1 and "border and inside on a roof" in r["bad"][0].reason

@@ -90,6 +90,7 @@ from .lowered import VERSION, assert_unsupported_at, body_of, compile_ir, errors
     ("comp(f){ h + 1 : A | h = B | 2 : C }", "comp(f){ (@h + 1): A | @h: B | 2: C }"),
     ("comp(e){ eave : A | ridge : B | hip : C | valley : D }", "comp(e){ eave: A | ridge: B | hip: C | valley: D }"),
     ("comp(v){ h : A }", "comp(v){ @h: A }"),
+    ("comp(e){ border : A | inside : B }", "comp(e){ border: A | inside: B }"),
     ("offset(-2) A", "offset(-2, all) A"),
     ("offset(-2, all) A", "offset(-2, all) A"),
     ("offset(h) comp(f){ border : B }", "offset(@h) comp(f){ border: B }"),
