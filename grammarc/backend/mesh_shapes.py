@@ -148,19 +148,21 @@ def mesh_components(chunk: Chunk, shapes: Shapes, kind: int):
     """Components of mesh shapes: parent (m,), index (m,) among the parent's components of this kind,
     origin (m, 3) and axes (m, 3, 3) in the parent's frame, size (m, 3), geom (m,): faces become
     polygons (plane z) with CityEngine's face scopes, edges scope edges (``meshes.mesh_edges``),
-    vertices points (``meshes.mesh_corners``)."""
+    vertices points (``meshes.mesh_corners``); and roof (m,) int32, each edge's place on the roof
+    (``meshes.roof_edge_kinds``; -1 for faces and vertices)."""
     verts, ring_offsets, face_offsets, mesh_offsets, _ = face_vertices(
         chunk.meshes, shapes.geom - MESH_BASE, shapes.size)
     if kind == VERTICES:
         parent, origin, axes = mesh_corners(verts, ring_offsets, face_offsets, mesh_offsets, TOL.zero)
-        return (parent, rank_within(parent), origin, axes, np.zeros((len(parent), 3)),
-                np.full(len(parent), -1, dtype=np.int32))
+        none = np.full(len(parent), -1, dtype=np.int32)
+        return parent, rank_within(parent), origin, axes, np.zeros((len(parent), 3)), none, none
     if kind in _EDGE_KINDS:
-        parent, origin, axes, size, edge_kind = mesh_edges(verts, ring_offsets, face_offsets, mesh_offsets,
-                                                           TOL.zero)
+        parent, origin, axes, size, edge_kind, roof = mesh_edges(verts, ring_offsets, face_offsets, mesh_offsets,
+                                                                 TOL.zero)
         keep = np.isin(edge_kind, _EDGE_KINDS[kind])
-        parent, origin, axes, size = parent[keep], origin[keep], axes[keep], size[keep]
-        return parent, rank_within(parent), origin, axes, size, np.full(len(parent), -1, dtype=np.int32)
+        parent, origin, axes, size, roof = parent[keep], origin[keep], axes[keep], size[keep], roof[keep]
+        return (parent, rank_within(parent), origin, axes, size, np.full(len(parent), -1, dtype=np.int32),
+                roof.astype(np.int32))
     origin, axes, size, uv, ok = face_frames(verts, ring_offsets, face_offsets, TOL.zero)
     face_mesh = segment_of(mesh_offsets)
     index = np.arange(len(face_mesh)) - mesh_offsets[face_mesh]
@@ -168,7 +170,8 @@ def mesh_components(chunk: Chunk, shapes: Shapes, kind: int):
     keep = ok & {FACES: index >= 0, SIDEFACES: index > 0, BOTTOM: index == 0}[kind]
     if kind == SIDEFACES:
         index = index - 1
-    return face_mesh[keep], index[keep], origin[keep], axes[keep], size[keep], geom[keep]
+    return (face_mesh[keep], index[keep], origin[keep], axes[keep], size[keep], geom[keep],
+            np.full(int(keep.sum()), -1, dtype=np.int32))
 
 
 def clip_meshes(chunk: Chunk, shapes: Shapes, parent: np.ndarray, axis: int, pos: np.ndarray,

@@ -18,6 +18,7 @@ from grammarc.backend.slots import (
     TRIM_SWITCH,
 )
 from grammarc.ir import nodes as ir
+from grammarc.ir.printer import comp_selectors
 from grammarc.ir.traverse import all_exprs, iter_ops
 from grammarc.model.assets import load_asset
 from grammarc.model.grammar import Grammar
@@ -142,6 +143,10 @@ def make_plan(grammar: Grammar, *, load_asset: Callable = load_asset) -> Plan:
     for selector in ir.FACE_SELECTORS:
         strings.intern(selector)
     asset_of_string = {strings.intern(raw): asset for raw, asset in grammar.asset_ids.items()}
+    for op in ops:  # comp.sel of every selector (after the ids above, which stay as they were)
+        if isinstance(op, ir.CompFaces):
+            for text in comp_selectors(op):
+                strings.intern(text)
     trim_slot = dynamic.get(TRIM_SLOTS[0])
     plan = Plan(
         grammar=grammar, symbols=tuple(symbols), symbol_ids=ids, start=ids[grammar.graph.start], strings=strings,

@@ -1,5 +1,7 @@
 """Component selectors as CityEngine reads them: which faces (by their normals) and edges (by their
-directions) ``front``, ``top``, ``vertical``, ``aslant``... name.
+directions) ``front``, ``top``, ``vertical``, ``aslant``... name, which edges of a roof ``eave``, ``ridge``,
+``hip`` and ``valley`` name (``geometry.meshes.roof_edge_kinds``), and which component an index ``3`` or an
+index expression ``n + 1`` takes (``index_masks``).
 
 Normals are in the parent's scope frame (front +z, back -z, right +x, left -x, top +y, bottom -y), or in the
 lot's (``object.``), the world's (``world.``) or the lot's street frame (``street.``, ``geometry.streets``)
@@ -16,7 +18,7 @@ from __future__ import annotations
 import numpy as np
 
 from grammarc.geometry.streets import along_street
-from grammarc.ir.nodes import WORLD_COMPASS
+from grammarc.ir.nodes import ROOF_EDGE_SELECTORS, WORLD_COMPASS
 from grammarc.ragged import rank_within
 
 #: A face is "top" or "bottom" when its normal is within 45 degrees of the scope's y axis; "horizontal"
@@ -25,16 +27,16 @@ _FLAT_TOLERANCE = 1e-6
 
 
 def classify_faces(normal: np.ndarray, selectors: tuple[str, ...], frames: dict | None = None,
-                   index: np.ndarray | None = None) -> np.ndarray:
+                   picked: dict[str, np.ndarray] | None = None) -> np.ndarray:
     """Index of the first selector each face matches (len(selectors) for none), from normals (m, 3) in
     the parent's scope frame: front +z, back -z, right +x, left -x, top +y, bottom -y. ``frames`` gives
-    the normals in the lot's frame (``object.`` selectors) and the world's (``world.``); ``index`` (m,)
-    each face's number among its shape's (``component_index``), which index selectors ``"3"`` match."""
+    the normals in the lot's frame (``object.`` selectors) and the world's (``world.``); ``picked`` the
+    faces of the index selectors (``index_masks``)."""
     which = np.full(len(normal), len(selectors), dtype=np.int64)
     frames = frames or {}
     for i in range(len(selectors) - 1, -1, -1):
-        if selectors[i].isdigit():
-            which[index == int(selectors[i])] = i
+        if picked and selectors[i] in picked:
+            which[picked[selectors[i]]] = i
             continue
         named = WORLD_COMPASS.get(selectors[i]) or STREET_ALIASES.get(selectors[i], selectors[i])
         prefix, _, name = named.rpartition(".")
@@ -66,34 +68,41 @@ def _face_masks(normal: np.ndarray, along: np.ndarray | None = None) -> dict[str
         "side": side, "rest": side & ~front, "vertical": vertical, "horizontal": horizontal,
         "aslant": ~vertical & ~horizontal & (y > 0), "nutant": ~vertical & ~horizontal & (y < 0),
         "all": np.ones(len(normal), dtype=bool),
-        # the faces an offset makes: a shape not offset has none
+        # the faces of an offset (or of a shape's border: ``component_splits``); here none
         "inside": np.zeros(len(normal), dtype=bool), "border": np.zeros(len(normal), dtype=bool),
     }
     return masks
 
 
 def classify_edges(direction: np.ndarray | None, selectors: tuple[str, ...], n: int,
-                   index: np.ndarray | None = None) -> np.ndarray:
+                   picked: dict[str, np.ndarray] | None = None, roof: np.ndarray | None = None) -> np.ndarray:
     """Index of the first selector each edge (or vertex, ``direction`` None) matches: an edge is
-    vertical along the world's y axis, horizontal across it, aslant otherwise; an index selector ``"3"``
-    the component whose ``index`` (n,) is 3."""
-    masks = {"all": np.ones(n, dtype=bool)}
-    masks.update({s: index == int(s) for s in selectors if s.isdigit()})
+    vertical along the world's y axis, horizontal across it, aslant otherwise; ``picked`` gives the
+    components of the index selectors (``index_masks``); ``roof`` (n,) each edge's place on a roof, an
+    index into ``ir.ROOF_EDGE_SELECTORS`` or -1 (``geometry.meshes.roof_edge_kinds``)."""
+    masks = {"all": np.ones(n, dtype=bool), **(picked or {})}
     if direction is not None:
         y = np.abs(direction[:, 1])
         masks.update(vertical=y >= 1 - _FLAT_TOLERANCE, horizontal=y <= _FLAT_TOLERANCE,
                      aslant=(y > _FLAT_TOLERANCE) & (y < 1 - _FLAT_TOLERANCE))
+        roof = np.full(n, -1) if roof is None else roof
+        masks.update({name: roof == k for k, name in enumerate(ROOF_EDGE_SELECTORS)})
     which = np.full(n, len(selectors), dtype=np.int64)
     for i in range(len(selectors) - 1, -1, -1):
         which[masks[selectors[i]]] = i
     return which
 
 
-def component_index(selectors: tuple[str, ...], parent: np.ndarray) -> np.ndarray | None:
-    """Each component's number among its shape's (``parent`` (m,) in the order the split makes them:
-    an extrusion's bottom 0, its sides along the footprint's edges, its top last, as CityEngine numbers
-    them), when an index selector asks for it; None otherwise."""
-    return rank_within(parent) if any(s.isdigit() for s in selectors) else None
+def index_masks(selectors: tuple[str, ...], parent: np.ndarray, picks: list[np.ndarray]) -> dict[str, np.ndarray]:
+    """The components (m,) bool that each index selector takes: ``"3"`` the component numbered 3 among its
+    shape's (``parent`` (m,), in the order the split makes them: an extrusion's bottom 0, its sides along
+    the footprint's edges, its top last, as CityEngine numbers them), ``"#k"`` the one numbered
+    ``picks[k]`` (n,) float64 for its shape, rounded (a value that is no component's number takes none)."""
+    indexed = [s for s in selectors if s.isdigit() or s.startswith("#")]
+    if not indexed:
+        return {}
+    index = rank_within(parent)
+    return {s: index == (int(s) if s.isdigit() else np.round(picks[int(s[1:])][parent])) for s in indexed}
 
 
 def selector_frames(chunk, normal: np.ndarray, shapes, parent: np.ndarray, selectors,

@@ -162,9 +162,10 @@ def mesh_edges(verts, ring_offsets, face_offsets, mesh_offsets, eps: float):
     cross y, size (length, 0, 0).
 
     verts (V, 3) in the scopes' units, with y the roof's up. Returns mesh (E,), origin (E, 3), axes
-    (E, 3, 3), size (E, 3) and kind (E,): 0 for bottom edges (horizontal, at or below the base: the
+    (E, 3, 3), size (E, 3), kind (E,): 0 for bottom edges (horizontal, at or below the base: the
     footprint and the eaves), 1 for side edges (sloped: hips and valleys), 2 for top edges (horizontal
-    above the base: ridges), each mesh's edges in the order they first appear in its faces.
+    above the base: ridges), and roof (E,) int8, the edge's place on a roof (``roof_edge_kinds``); each
+    mesh's edges in the order they first appear in its faces.
     """
     face, mesh, nxt, face_normal = _ring_walk(verts, ring_offsets, face_offsets, mesh_offsets)
     p, q = verts, verts[nxt]
@@ -200,7 +201,68 @@ def mesh_edges(verts, ring_offsets, face_offsets, mesh_offsets, eps: float):
     horizontal = np.abs(x[:, 1]) <= 1e-9
     low = np.maximum(start[:, 1], end[:, 1]) <= eps
     kind = np.where(~horizontal, 1, np.where(low, 0, 2))
-    return mesh[edge], start, axes, size, kind
+    roof = roof_edge_kinds(verts, ring_offsets, face_offsets, mesh_offsets, face[kept], rank[inverse], face_normal,
+                           mesh[edge], start, end, eps)
+    return mesh[edge], start, axes, size, kind, roof
+
+
+#: The sine of the slope below which a face counts as flat, or above which as vertical, for a roof's edges.
+_SLOPED = 1e-6
+
+
+def roof_edge_kinds(verts, ring_offsets, face_offsets, mesh_offsets, edge_face, edge_of, face_normal, edge_mesh,
+                    start, end, eps: float) -> np.ndarray:
+    """Each distinct edge's place on a roof, as ``comp(e)``'s selectors name it: 0 eave, 1 ridge, 2 hip,
+    3 valley (``ir.ROOF_EDGE_SELECTORS``), -1 none of them (E,) int8.
+
+    The reference says only that these selectors are meant for roofs; grammarc reads them off the faces
+    that meet at the edge, as a roofer names them. A mesh's first face is its base (a roof's bottom),
+    whose normal points down: up is against it, whatever the scope's axes (a roof on a lot has y up, one
+    on a face from ``comp(f)`` the face's z). A sloped face is one neither flat nor vertical, facing up.
+    An eave is a horizontal edge at or below the base along a sloped face; a ridge a horizontal edge
+    above the base where two sloped faces meet convexly; a hip a sloped edge where two sloped faces meet
+    convexly; a valley any edge where two sloped faces meet concavely. The sloped edges along a gable's
+    vertical face and those of a flat cap are none of them.
+
+    verts (V, 3) in the scopes' units; edge_face (k,) and edge_of (k,): the face of each ring edge and its
+    distinct edge (E of them); face_normal (F, 3) unit normals; edge_mesh (E,) each edge's mesh; start,
+    end (E, 3) its points.
+    """
+    n_edges = len(start)
+    vertex_start = ring_offsets[face_offsets]
+    count = np.maximum(np.diff(vertex_start), 1)
+    centroid = np.stack([segment_reduce(np.add, verts[:, j], vertex_start, 0.0) for j in range(3)], 1)
+    centroid /= count[:, None]
+    base = mesh_offsets[:-1]
+    up = -face_normal[np.minimum(base, len(face_normal) - 1)]  # per mesh
+    floor = np.einsum("ij,ij->i", verts[np.minimum(vertex_start[base], len(verts) - 1)], up)
+    edge_up, edge_floor = up[edge_mesh], floor[edge_mesh]
+    direction = end - start
+    direction /= np.maximum(np.linalg.norm(direction, axis=1, keepdims=True), 1e-300)
+    horizontal = np.abs(np.einsum("ij,ij->i", direction, edge_up)) <= _SLOPED
+    low = np.maximum(np.einsum("ij,ij->i", start, edge_up), np.einsum("ij,ij->i", end, edge_up)) <= edge_floor + eps
+    rise = np.einsum("ij,ij->i", face_normal, up[segment_of(mesh_offsets)])
+    sloped = (rise > _SLOPED) & (rise < 1 - _SLOPED)
+    faces = np.bincount(edge_of, minlength=n_edges)
+    first = np.full(n_edges, len(face_normal), dtype=np.int64)
+    last = np.full(n_edges, -1, dtype=np.int64)
+    np.minimum.at(first, edge_of, edge_face)
+    np.maximum.at(last, edge_of, edge_face)
+    along_slope = np.zeros(n_edges, dtype=bool)
+    np.logical_or.at(along_slope, edge_of, sloped[edge_face])
+    two = faces == 2
+    a, b = np.where(two, first, 0), np.where(two, last, 0)
+    between_slopes = two & sloped[a] & sloped[b]
+    # convex: each face's centroid behind the other's plane (the edge's start lies on both planes)
+    behind = np.einsum("ij,ij->i", face_normal[a], centroid[b] - start)
+    scale = max(float(np.abs(verts).max(initial=0.0)), 1.0)
+    convex, concave = behind < -eps * scale, behind > eps * scale
+    roof = np.full(n_edges, -1, dtype=np.int8)
+    roof[horizontal & low & along_slope] = 0
+    roof[between_slopes & convex & horizontal & ~low] = 1
+    roof[between_slopes & convex & ~horizontal] = 2
+    roof[between_slopes & concave] = 3
+    return roof
 
 
 def mesh_corners(verts, ring_offsets, face_offsets, mesh_offsets, eps: float):

@@ -555,8 +555,9 @@ class SetColor:
 
 @dataclass(frozen=True, slots=True)
 class Offset:
-    """CityEngine ``offset(d, inside|border)``: the face's polygon grown (d > 0) or shrunk (d < 0) with
-    mitred corners, keeping the inset (``inside``) or the ring around it (``border``)."""
+    """CityEngine ``offset(d, inside|border|all)``: the face's polygon grown (d > 0) or shrunk (d < 0) with
+    mitred corners, keeping the inset (``inside``), the ring around it (``border``) or both as the faces
+    of one shape (``all``, and ``offset(d)`` that no ``comp(f)`` of them follows)."""
 
     distance: Expr = child(Type.NUM, "an offset distance")
     select: str
@@ -738,15 +739,19 @@ class Roof:
 
 #: Selectors of the faces an ``offset`` makes.
 OFFSET_SELECTORS = frozenset({"inside", "border", "all"})
+#: The edges of a roof by where its faces meet (``geometry.meshes.roof_edge_kinds``), selectors of ``comp(e)``.
+ROOF_EDGE_SELECTORS = ("eave", "ridge", "hip", "valley")
 #: Edge and vertex selectors of ``comp(e)`` and ``comp(v)``.
-EDGE_SELECTORS = frozenset({"vertical", "horizontal", "aslant", "all"})
-VERTEX_SELECTORS = frozenset({"all"})
+EDGE_SELECTORS = frozenset({"vertical", "horizontal", "aslant", "all", "border", "inside", *ROOF_EDGE_SELECTORS})
+VERTEX_SELECTORS = frozenset({"all", "border", "inside"})
 
 
 @dataclass(frozen=True, slots=True)
 class CompFaces:
     """CityEngine ``comp(f|e|v){ sel: A | sel: B }``: each face (edge, vertex) goes to the first selector
-    it matches; ``kind`` is "f", "e" or "v"."""
+    it matches; ``kind`` is "f", "e" or "v". A selector ``"3"`` takes the component of that index, a
+    selector ``"#k"`` the one whose index is the value of ``picks[k]`` for its shape (``comp(f){ n + 1 : A }``
+    with an expression, a constant or an attribute)."""
 
     selectors: tuple[str, ...]
     parts: tuple[Body, ...] = child(holds=Holds.BODIES)
@@ -755,6 +760,7 @@ class CompFaces:
     kind: str = "f"
     #: ``offset(d) comp(f){ inside: ... | border: ... }``: the faces are the offset's inside and border.
     offset: Expr | None = child(Type.NUM, "an offset distance", default=None)
+    picks: tuple[Expr, ...] = child(Type.NUM, "a component index", default=())
 
 
 #: CityEngine's coordinate systems of ``translate`` and ``rotate``.

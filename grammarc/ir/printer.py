@@ -117,6 +117,12 @@ def _roof(op: ir.Roof) -> str:
     return f"{op.kind}({', '.join(args)}, index={print_expr(op.index)})"
 
 
+def comp_selectors(op: ir.CompFaces) -> list[str]:
+    """The selectors of ``op`` as written, an index expression ``#k`` as its expression: also what
+    ``comp.sel`` gives the shapes they select."""
+    return [print_expr(op.picks[int(s[1:])]) if s.startswith("#") else s for s in op.selectors]
+
+
 def _setback(op: ir.Setback) -> str:
     moves = ", ".join(f"{s}={print_expr(d)}" for s, d in op.distances)
     if op.per_edge:
@@ -167,7 +173,7 @@ _OP_FORMATS = {
     ir.InnerRectangle: lambda op: f"innerRectangle({op.align}){_selected(op.selectors, op.parts)}",
     ir.Roof: _roof,
     ir.CompFaces: lambda op: ((f"offset({print_expr(op.offset)}) " if op.offset is not None else "")
-                              + f"comp({op.kind}){_selected(op.selectors, op.parts)}"),
+                              + f"comp({op.kind}){_selected(comp_selectors(op), op.parts)}"),
     ir.Setback: _setback,
     ir.Case: _branches,
     ir.Stochastic: _branches,

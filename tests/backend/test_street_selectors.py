@@ -61,3 +61,20 @@ def test_street_side_and_no_street_side_select_nothing_on_a_lot_without_streets(
     assert t["a_sum"] == pytest.approx(60 + 40 + 40 - 8) and t["b_sum"] == pytest.approx(26 * 18)
     t = totals(run(write, text, None))
     assert "a_sum" not in t and t["b_sum"] == pytest.approx(600)
+
+
+@pytest.mark.parametrize("imported", [False, True])
+def test_a_constant_of_edge_distances_sets_back_each_street_side_by_its_own(write, imported):
+    """``const d = comp(fe){ street.front : 5 | street.back = 2 | street.side = 1 }`` and ``setback(d)``,
+    in the same file or an imported one (``setback(SU.d)``, as the Swiss building rules write it)."""
+    table = "const front = 5\nconst d = comp(fe){ street.front : front | street.back = 2 | street.side = 1 }\n"
+    use = "Lot --> setback({}){{ all = A | remainder : B }}\n" + \
+        'A --> report("a", geometry.area)\nB --> report("b", geometry.area)\n'
+    if imported:
+        write("setup.cga", VERSION + table)
+        text = 'import SU : "setup.cga"\n' + use.format("SU.d")
+    else:
+        text = table + use.format("d")
+    t = totals(run(write, text, NORTH))
+    assert t["b_sum"] == pytest.approx((30 - 2) * (20 - 5 - 2))  # the north street 5, south 2, east and west 1
+    assert t["a_sum"] == pytest.approx(600 - 28 * 13)

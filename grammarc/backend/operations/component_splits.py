@@ -26,7 +26,7 @@ from grammarc.backend.operations.table import Parts, operation
 from grammarc.backend.outlines import flat_axis, polygons_of
 from grammarc.backend.random import child_keys
 from grammarc.backend.reframing import turned
-from grammarc.backend.selectors import classify_edges, classify_faces, component_index, selector_frames
+from grammarc.backend.selectors import classify_edges, classify_faces, index_masks, selector_frames
 from grammarc.backend.shapes import Shapes
 from grammarc.constants import TOL
 from grammarc.geometry import components as comp_kernels
@@ -35,6 +35,7 @@ from grammarc.geometry.queries import shape_faces
 from grammarc.geometry.reframe import NORMAL_OUT
 from grammarc.geometry.trim import shallow_edge_planes, side_face_planes
 from grammarc.ir import nodes as ir
+from grammarc.ir.printer import comp_selectors
 from grammarc.ragged import rank_within
 
 
@@ -45,7 +46,7 @@ def comp(ctx: Context, cursor: Shapes, op: ir.Comp) -> Parts:
     index_of = None
     if op.index is not None:
         index_of = evaluate_array(op.index, ctx.env(cursor))
-    shapes, _, index, parent = components(ctx, comp_kernels.KIND_CODES[op.kind], cursor, op.site, index_of)
+    shapes, _, index, parent, _ = components(ctx, comp_kernels.KIND_CODES[op.kind], cursor, op.site, index_of)
     shapes = take_apart(ctx, cursor, shapes, parent)
     ctx.count(shapes, op.span)
     order, offsets = group_by(index % len(op.parts), len(op.parts))
@@ -63,7 +64,7 @@ def comp_faces(ctx: Context, cursor: Shapes, op: ir.CompFaces) -> Parts:
         ctx.fail(cursor, bad, "`comp` of an inserted asset is not supported yet", op.span)
     chunk = ctx.chunk
     kind = {"f": "faces", "e": "edges", "v": "vertices"}[op.kind]
-    shapes, normal, _, parent = components(ctx, comp_kernels.KIND_CODES[kind], cursor, op.site)
+    shapes, normal, _, parent, roof = components(ctx, comp_kernels.KIND_CODES[kind], cursor, op.site)
     shapes = take_apart(ctx, cursor, shapes, parent)
     if op.kind == "f":
         shapes = _face_scopes(ctx, shapes, cursor, parent, op.span)
@@ -85,21 +86,27 @@ def comp_faces(ctx: Context, cursor: Shapes, op: ir.CompFaces) -> Parts:
             planes[owner] = found
             dynamic[shallow:shallow + planes.shape[1]] = list(planes.T)
         shapes = replace(shapes, dynamic=tuple(dynamic))
+    env = ctx.env(cursor) if op.picks else None
+    picks = [np.broadcast_to(np.asarray(evaluate_array(e, env), dtype=np.float64), (len(cursor),))
+             for e in op.picks]
+    picked = index_masks(op.selectors, parent, picks)
+    if {"border", "inside"} & set(op.selectors):
+        picked.update(_border_masks(ctx, cursor, parent, op))
     if op.kind == "f":
         axes = chunk.frames[shapes.frame]
         base = (shapes.origin, shapes.origin + axes[:, 0] * shapes.size[:, :1])  # each face's bottom edge
         which = classify_faces(normal, op.selectors, selector_frames(chunk, normal, cursor, parent, op.selectors,
-                                                                      base), component_index(op.selectors, parent))
+                                                                      base), picked)
     else:
         direction = chunk.frames[shapes.frame][:, 0] if op.kind == "e" else None
-        which = classify_edges(direction, op.selectors, len(shapes), component_index(op.selectors, parent))
+        which = classify_edges(direction, op.selectors, len(shapes), picked, roof)
     keep = which < len(op.selectors)
     shapes, which, parent = shapes.take(keep), which[keep], parent[keep]
     if {"comp.index", "comp.total", "comp.sel"} & set(ctx.plan.dynamic):
         # CityEngine numbers the components of each selector: the front face is 0 of 1
         group = parent * (len(op.selectors) + 1) + which
         rank = rank_within(group)
-        ids = np.array([ctx.plan.strings.ids[s] for s in op.selectors], dtype=np.int32)
+        ids = np.array([ctx.plan.strings.ids[s] for s in comp_selectors(op)], dtype=np.int32)
         shapes = with_context(ctx.plan, shapes, "comp", rank, group, int(group.max(initial=0)) + 1,
                               selector=ids[which])
     ctx.count(shapes, op.span)
@@ -107,10 +114,24 @@ def comp_faces(ctx: Context, cursor: Shapes, op: ir.CompFaces) -> Parts:
     return Parts(op.parts, shapes.take(order), offsets)
 
 
+def _border_masks(ctx: Context, cursor: Shapes, parent: np.ndarray, op: ir.CompFaces) -> dict[str, np.ndarray]:
+    """The components (m,) of parents ``parent`` that ``border`` and ``inside`` take on shapes no
+    ``offset`` made, as the reference defines them: a border edge meets one face, a border face or vertex
+    touches a border edge. A flat shape is one face, all of it border; a solid (a box, a prism) is closed,
+    all of it inside. The edges of meshes (roofs) are not counted yet: refused."""
+    mesh = is_mesh(cursor.geom)
+    if mesh.any():
+        ctx.fail(cursor, mesh, f"`comp({op.kind})` border and inside on a roof are not supported yet", op.span)
+    flat = ((cursor.size <= TOL.zero).sum(axis=1) >= 1)[parent]
+    return {"border": flat, "inside": ~flat}
+
+
 def components(ctx: Context, kind: int, cursor: Shapes, site: int, wanted=None):
     """Component shapes of ``cursor``, their normals in the parents' frames (m, 3), their indices
-    among their parent's components (m,) and their parents (m,); ``wanted`` (n,) keeps, per shape,
-    only that index. Roofs (meshes) have faces and edges (``comp_faces`` and ``comp`` check)."""
+    among their parent's components (m,), their parents (m,) and each one's place on a roof (m,)
+    (``geometry.meshes.roof_edge_kinds``: an edge of a roof's mesh; -1 for the rest); ``wanted`` (n,)
+    keeps, per shape, only that index. Roofs (meshes) have faces and edges (``comp_faces`` and ``comp``
+    check)."""
     chunk = ctx.chunk
     mesh = is_mesh(cursor.geom)
     pieces = []
@@ -118,31 +139,32 @@ def components(ctx: Context, kind: int, cursor: Shapes, site: int, wanted=None):
         pieces.append(_solid_components(chunk, kind, cursor, np.flatnonzero(~mesh)))
     if mesh.any():
         which = np.flatnonzero(mesh)
-        parent, index, origin, axes, size, geom = mesh_shapes.mesh_components(chunk, cursor.take(which), kind)
-        pieces.append((which[parent], index, origin, axes, size, geom, axes[:, 2]))
-    parent, index, origin, axes, size, geom, normal = (
+        parent, index, origin, axes, size, geom, roof = mesh_shapes.mesh_components(chunk, cursor.take(which),
+                                                                                    kind)
+        pieces.append((which[parent], index, origin, axes, size, geom, axes[:, 2], roof))
+    parent, index, origin, axes, size, geom, normal, roof = (
         pieces[0] if len(pieces) == 1 else
         (np.concatenate(columns) for columns in zip(*pieces)))
     if len(pieces) > 1:
         order = np.argsort(parent, kind="stable")
-        parent, index, origin, axes, size, geom, normal = (
-            a[order] for a in (parent, index, origin, axes, size, geom, normal))
+        parent, index, origin, axes, size, geom, normal, roof = (
+            a[order] for a in (parent, index, origin, axes, size, geom, normal, roof))
     if wanted is not None:
         keep = index == np.round(wanted[parent])
-        parent, index, origin, axes, size, geom, normal = (
-            a[keep] for a in (parent, index, origin, axes, size, geom, normal))
+        parent, index, origin, axes, size, geom, normal, roof = (
+            a[keep] for a in (parent, index, origin, axes, size, geom, normal, roof))
     child = cursor.take(parent)
     parent_axes = chunk.frames[child.frame]
     world_origin = child.origin + np.einsum("ni,nij->nj", origin, parent_axes)
     frame = chunk.frames.add(np.einsum("nij,njk->nik", axes, parent_axes))
     shapes = Shapes(world_origin, size, frame, geom.astype(np.int32), child.lot,
                     child_keys(child.key, site, index), child.depth, child.params, child.dynamic)
-    return with_context(ctx.plan, shapes, "comp", index, parent, len(cursor)), normal, index, parent
+    return with_context(ctx.plan, shapes, "comp", index, parent, len(cursor)), normal, index, parent, roof
 
 
 def _solid_components(chunk, kind: int, cursor: Shapes, which: np.ndarray):
     """Components of the boxes, polygons and prisms ``which`` of ``cursor``: parent (into cursor),
-    index, origin, axes, size (in the parents' frames), geom, normal."""
+    index, origin, axes, size (in the parents' frames), geom, normal, roof (-1: no roof edges)."""
     shapes = cursor.take(which)
     coords, ring_offsets, shape_offsets, plane = polygons_of(chunk, shapes)
     parent, index, origin, axes, size, poly = comp_kernels.components(
@@ -157,7 +179,7 @@ def _solid_components(chunk, kind: int, cursor: Shapes, which: np.ndarray):
     # a flat shape's only face is itself: its normal is its plane's axis, not its frame's z
     normal = axes[:, 2].copy()
     normal[same] = np.eye(3)[plane[parent[same]]]
-    return which[parent], index, origin, axes, size, geom, normal
+    return which[parent], index, origin, axes, size, geom, normal, np.full(len(parent), -1, dtype=np.int32)
 
 
 def _cap_polygons(chunk, geom: np.ndarray, which: str) -> np.ndarray:

@@ -136,11 +136,19 @@ def _ridge_roofs(ctx: Context, cursor: Shapes, op: ir.Roof, ridge: np.ndarray, v
 
 @operation(ir.Offset, writes=COLUMNS, meshes=True)
 def offset(ctx: Context, cursor: Shapes, op: ir.Offset) -> Shapes:
-    """``offset(d, inside|border)``: the shape's face becomes its inset or the ring around it; a shape of
-    several faces in one plane (an earlier offset's pieces, convexify's parts) has each face offset, as
-    CityEngine offsets every face of a geometry."""
-    inside, border = _offset_pieces(ctx, op.distance, cursor, op.span)
-    pieces = inside if op.select == "inside" else border
+    """``offset(d, inside|border|all)``: the shape's face becomes its inset, the ring around it, or both
+    (the faces of one shape); a shape of several faces in one plane (an earlier offset's pieces,
+    convexify's parts) has each face offset, as CityEngine offsets every face of a geometry."""
+    if op.select == "all":
+        inset, border, plane, polygons, faces, owner = _offset_polygons(ctx, op.distance, cursor, op.span)
+        pieces = fit_pieces(np.concatenate([inset, border]), np.tile(plane, 2), np.tile(faces.size, (2, 1)),
+                            np.tile(polygons, 2))
+        # each shape's inside pieces, then its border's
+        pieces = replace(pieces, source=owner[pieces.source % len(faces)])
+        pieces = pieces.take(np.argsort(pieces.source, kind="stable"))
+    else:
+        inside, border = _offset_pieces(ctx, op.distance, cursor, op.span)
+        pieces = inside if op.select == "inside" else border
     several = np.bincount(pieces.source, minlength=len(cursor)) > 1
     if not several.any():
         return _piece_shapes(ctx, cursor, pieces, 0)
@@ -301,14 +309,21 @@ def face_polygons(ctx: Context, cursor: Shapes, what: str, span) -> tuple[np.nda
     return scope_polygons(store, geom, cursor.size), store.plane[geom]
 
 
-def _offset_pieces(ctx: Context, distance: ir.Expr, cursor: Shapes, span):
-    """The inside and border pieces of each flat shape's faces offset by ``distance``, each piece's
-    ``source`` its shape's row."""
+def _offset_polygons(ctx: Context, distance: ir.Expr, cursor: Shapes, span):
+    """Each flat shape's faces (``_faces_in_plane``) offset by ``distance``: the insets and the borders
+    (k,) (shapely, in the scopes' units), the faces' planes (k,) and polygons (k,), the faces as shapes and
+    each face's row in ``cursor``."""
     d = np.broadcast_to(evaluate_array(distance, ctx.env(cursor)), (len(cursor),))
     faces, owner = _faces_in_plane(ctx, cursor, "offset", span)
     polygons, plane = face_polygons(ctx, faces, "offset", span)
     inset = shapely.buffer(polygons, d[owner], join_style="mitre", mitre_limit=1e6)
-    border = shapely.difference(polygons, inset)
+    return inset, shapely.difference(polygons, inset), plane, polygons, faces, owner
+
+
+def _offset_pieces(ctx: Context, distance: ir.Expr, cursor: Shapes, span):
+    """The inside and border pieces of each flat shape's faces offset by ``distance``, each piece's
+    ``source`` its shape's row."""
+    inset, border, plane, polygons, faces, owner = _offset_polygons(ctx, distance, cursor, span)
     return tuple(replace(p, source=owner[p.source]) for p in (
         fit_pieces(inset, plane, faces.size, polygons), fit_pieces(border, plane, faces.size, polygons)))
 

@@ -5,12 +5,13 @@ under their prefixes.
 
 from __future__ import annotations
 
+import re
 from collections.abc import Callable
 from dataclasses import replace
 from functools import partial
 
 from grammarc.diagnostics import Diagnostics, Span, suggest
-from grammarc.frontend.cityengine.nodes import Annotated, FunctionDef, Import, RuleDef, Style
+from grammarc.frontend.cityengine.nodes import Annotated, EdgeTable, FunctionDef, Import, RuleDef, Style
 from grammarc.frontend.cityengine.operations import check_calls
 from grammarc.ir import nodes as ir
 from grammarc.ir.functions import FUNCTIONS, UNSUPPORTED_FUNCTIONS
@@ -46,6 +47,9 @@ def assemble(file: str, statements: list, diags: Diagnostics, imports=(), export
             continue
         if style is not None and isinstance(decl, ir.AttrDecl):
             continue  # a redefinition for the style
+        if isinstance(decl, EdgeTable):
+            attrs.extend(_table_attrs(decl))
+            continue
         if isinstance(decl, ir.AttrDecl):
             if any(a.name == decl.name for a in attrs):
                 diags.error("duplicate-attr", f"attribute `{decl.name}` is declared twice", decl.span)
@@ -105,8 +109,47 @@ def assemble(file: str, statements: list, diags: Diagnostics, imports=(), export
         # imported file calls it (its calls are prefixed too)
         lowered.extend(rule for rule in more_rules if rule.symbol not in own)
         imported.extend((module.file, *module.imported))
+    lowered = _setbacks_by_table(lowered, attrs)
     return ir.Module(file=file, attrs=tuple(attrs), rules=tuple(lowered), start=start, dialect="cityengine",
                      imported=tuple(dict.fromkeys(imported)))
+
+
+#: The constants a ``const name = comp(fe){ sel: d | ... }`` becomes: ``name{k:sel}``, the k-th distance (no
+#: name of the source can be one: braces end an identifier), so that an importing file gets them under its
+#: prefix as it gets any attribute, and name resolution types them.
+_TABLE_ENTRY = re.compile(r"^(?P<name>.+)\{(?P<k>\d+):(?P<selector>[^{}]+)\}$")
+
+
+def _table_attrs(table: EdgeTable) -> list[ir.AttrDecl]:
+    return [ir.AttrDecl(f"{table.name}{{{k}:{selector}}}", value, table.distances.span, const=True)
+            for k, (selector, value) in enumerate(table.distances.values)]
+
+
+def _setbacks_by_table(rules: list[ir.Rule], attrs: list[ir.AttrDecl]) -> list[ir.Rule]:
+    """``setback(name){ ... }`` of a constant ``name = comp(fe){ sel: d | ... }`` (of this file or an
+    imported one: ``setback(p.name)``) as ``setback(comp(fe){ sel: d | ... }){ ... }``, its distances per
+    edge; CityEngine files keep their setback distances per street side in such constants."""
+    tables: dict[str, list[tuple[int, str, str]]] = {}
+    for a in attrs:
+        entry = _TABLE_ENTRY.match(a.name)
+        if entry is not None:
+            tables.setdefault(entry["name"], []).append((int(entry["k"]), entry["selector"], a.name))
+    if not tables:
+        return rules
+
+    def visit(op):
+        if not isinstance(op, ir.Setback) or op.per_edge or not op.distances:
+            return op
+        named = {d.name if isinstance(d, ir.Name) else None for _, d in op.distances}
+        table = tables.get(named.pop()) if len(named) == 1 else None
+        if table is None:
+            return op
+        span = op.distances[0][1].span
+        distances = tuple((selector, ir.Name(name, span)) for _, selector, name in sorted(table))
+        return replace(op, distances=distances, per_edge=True)
+
+    return [replace(rule, alternatives=tuple(replace(alt, body=rewrite_ops(alt.body, visit))
+                                             for alt in rule.alternatives)) for rule in rules]
 
 
 def _in(prefix: str | None, name: str) -> str:

@@ -21,6 +21,7 @@ from grammarc.diagnostics import Span, suggest
 from grammarc.frontend.cityengine.nodes import (
     Annotated,
     EdgeDistances,
+    EdgeTable,
     FunctionDef,
     Group,
     Import,
@@ -43,6 +44,7 @@ from grammarc.frontend.cityengine.operations import (
     SPLIT_OPS,
     UNSUPPORTED_MEMBERS,
     UNSUPPORTED_OPS,
+    WITHOUT_PARTS,
     OperationLowering,
 )
 from grammarc.frontend.lowering import LoweringBase
@@ -182,6 +184,8 @@ class Lowering(OperationLowering, LoweringBase):
         return ir.AttrDecl(str(name), self.expr(value), self.token_span(name))
 
     def const_decl(self, meta, name, value):
+        if isinstance(value, EdgeDistances):
+            return EdgeTable(str(name), value)
         return ir.AttrDecl(str(name), self.expr(value), self.token_span(name), const=True)
 
     def function_def(self, meta, name, params, value):
@@ -209,7 +213,7 @@ class Lowering(OperationLowering, LoweringBase):
 
     def fuse_offsets(self, items) -> ir.Body:
         """``offset(d) comp(f){ inside: ... | border: ... }`` becomes one component split of the offset's
-        faces; an ``offset(d)`` that no such comp follows would need several faces in one shape."""
+        faces; an ``offset(d)`` that no such comp follows is ``offset(d, all)``, the shape of both."""
         out: list = []
         pending = None
         for item in items:
@@ -224,13 +228,11 @@ class Lowering(OperationLowering, LoweringBase):
                         set(item.selectors) <= ir.OFFSET_SELECTORS:
                     item = replace(item, offset=pending.distance)
                 else:
-                    self.unsupported("offset(d) without comp(f){ inside | border } after it", pending.span,
-                                     "write offset(d, inside) or offset(d, border) for one face")
+                    out.append(ir.Offset(pending.distance, "all", pending.span))
                 pending = None
             out.append(item)
         if pending is not None:
-            self.unsupported("offset(d) without comp(f){ inside | border } after it", pending.span,
-                             "write offset(d, inside) or offset(d, border) for one face")
+            out.append(ir.Offset(pending.distance, "all", pending.span))
         return tuple(out)
 
     def case_block(self, meta, *branches):
@@ -286,7 +288,7 @@ class Lowering(OperationLowering, LoweringBase):
         if str(name) != "comp" or len(args or ()) != 1 or not isinstance(args[0], ir.Name) or \
                 args[0].name != "fe":
             return self.unsupported(f"{name}(...){{...}} as an argument", span, "only setback(comp(fe){ ... })")
-        chosen = self.selector_parts("comp(fe)", parts, SETBACK_SELECTORS - {"remainder"})
+        chosen = self.selector_parts("comp(fe)", parts, SETBACK_SELECTORS - {"remainder"}, noun=None)
         if chosen is None:
             return ir.placeholder(span)
         values = []
@@ -349,6 +351,8 @@ class Lowering(OperationLowering, LoweringBase):
             return ir.NotApplied(op, span)
         if op in UNSUPPORTED_OPS or op in SPLIT_OPS:
             return self.unsupported(op, span)
+        if op in WITHOUT_PARTS:
+            return WITHOUT_PARTS[op](self, op, args, span)
         if op in PART_OPERATIONS:
             return self.unsupported(f"{op} without selector parts", span,
                                     f"write {op}(...) {{ ... | remainder: ... }}")

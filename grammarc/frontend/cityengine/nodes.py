@@ -50,6 +50,15 @@ class EdgeDistances:
 
 
 @dataclass(frozen=True, slots=True)
+class EdgeTable:
+    """``const name = comp(fe){ sel: d | ... }``: distances per edge selector that a ``setback(name)``
+    takes (``assembly.edge_tables``)."""
+
+    name: str
+    distances: EdgeDistances
+
+
+@dataclass(frozen=True, slots=True)
 class Import:
     """``import prefix : "file.cga" (...)`` (or without a prefix): the file's rules, attributes, constants
     and functions, named ``prefix.Name``; an attribute the importing file declares too takes the importing file's value

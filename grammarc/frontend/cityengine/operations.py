@@ -15,7 +15,7 @@ from __future__ import annotations
 from dataclasses import fields, replace
 from functools import cache
 
-from grammarc.diagnostics import Diagnostics, Typos, suggest
+from grammarc.diagnostics import Diagnostics, Typos, suggest, typo_of
 from grammarc.frontend.cityengine.nodes import EdgeDistances, Group, Part, PendingOffset, Sized
 from grammarc.frontend.lowering import direct
 from grammarc.ir import nodes as ir
@@ -144,12 +144,14 @@ class OperationLowering:
         return ir.SetColor(tuple(self.expr(a) for a in args[:3]), span)
 
     def op_offset(self, op, args, span):
+        """``offset(d)`` (a ``comp(f){ inside | border }`` after it takes its faces: ``fuse_offsets``),
+        ``offset(d, inside|border|all)``."""
         if len(args) == 1:
             return PendingOffset(self.expr(args[0]), span)
-        if len(args) == 2 and isinstance(args[1], ir.Name) and args[1].name in ("inside", "border"):
+        if len(args) == 2 and isinstance(args[1], ir.Name) and args[1].name in ir.OFFSET_SELECTORS:
             return ir.Offset(self.expr(args[0]), args[1].name, span)
         return self.unsupported("offset with these arguments", span,
-                                "offset(d), offset(d, inside), offset(d, border)")
+                                "offset(d), offset(d, inside), offset(d, border), offset(d, all)")
 
     def op_align(self, op, args, span):
         axis = _selector(args[0]) if len(args) == 1 else None
@@ -305,11 +307,13 @@ class OperationLowering:
             kind = args[0].name if args and isinstance(args[0], ir.Name) else "?"
             return self.unsupported(f"comp({kind})", span, "comp(f), comp(e) and comp(v)")
         kind = args[0].name
-        chosen = self.selector_parts("comp", parts, COMP_SELECTORS[kind], named=f"comp({kind})", noun="faces",
-                                     indices=True)
+        picks: list[ir.Expr] = []
+        noun = {"f": "faces", "e": "edges", "v": "vertices"}[kind]
+        chosen = self.selector_parts("comp", parts, COMP_SELECTORS[kind], named=f"comp({kind})", noun=noun,
+                                     indices=picks)
         if chosen is None:
             return ir.Empty(span)
-        return ir.CompFaces(*chosen, span, self.site(), kind)
+        return ir.CompFaces(*chosen, span, self.site(), kind, picks=tuple(picks))
 
     def op_setback(self, op, args, parts, span):
         """``setback(d) { sel: A | remainder: B }``; ``shapeL/U/O(widths...) { shape: A | remainder: B }``;
@@ -333,6 +337,16 @@ class OperationLowering:
         else:
             distances = tuple((s, exprs[0]) for s in selectors if s != "remainder")
         return ir.Setback(distances, selectors, chosen[1], span, self.site())
+
+    def op_setback_alone(self, op, args, span):
+        """``setback(d)`` without parts (public files write it, as if it were an operation on its own):
+        the reference knows only the form with parts, and a user who writes it means the face set back by
+        ``d`` all round, the remainder that ``setback(d){ all: NIL | remainder: ... }`` would give:
+        ``offset(-d, inside)``, whose mitred inset is the same polygon."""
+        if not self.arity(op, args, (1,), span):
+            return ir.Empty(span)
+        distance = self.expr(args[0])
+        return ir.Offset(ir.Unary("-", distance, getattr(distance, "span", span)), "inside", span)
 
     def op_label(self, op, args, span):
         if not self.arity(op, args, (1,), span):
@@ -392,11 +406,17 @@ class OperationLowering:
         return ir.Scatter(names[0], self.expr(args[1]), names[2] == "gaussian", mean, value, relative, (body,),
                           span, self.site())
 
-    def selector_parts(self, op, parts, known, named=None, noun="polygons", indices=False):
+    def selector_parts(self, op, parts, known, named=None, noun="polygons", indices=None):
         """The selectors and bodies of ``{ sel: A | ... }`` parts, all among ``known`` (None after an
         error); ``sel=`` is derived as ``sel:``, with a warning. ``named`` is the operation as a selector
-        error names it (``comp(f)``; default ``op``), ``noun`` what ``sel=`` would merge. With ``indices``
-        a whole number ``3`` selects the component of that index (the selector ``"3"``)."""
+        error names it (``comp(f)``; default ``op``), ``noun`` what ``sel=`` would merge (None: nothing,
+        the parts of ``comp(fe)`` are distances).
+
+        With ``indices`` (a list, comp's), a whole number ``3`` selects the component of that index (the
+        selector ``"3"``), and any other expression (``n + 1``, a constant, an attribute) the component
+        whose index it evaluates to for the shape: the selector ``"#k"``, the expression appended to
+        ``indices`` as its k-th. A bare name is an expression unless it is a selector word of CityEngine's,
+        or one edit from one of ``known`` (``fornt``): a typo, not a constant."""
         named = named or op
         selectors, bodies = [], []
         for part in parts:
@@ -404,9 +424,14 @@ class OperationLowering:
                 self.unsupported(f"repeat group in {op}", part.span)
                 return None
             value = part.size.value
-            if (indices and part.size.kind is ir.SizeKind.ABSOLUTE and isinstance(value, ir.Num)
+            if (indices is not None and part.size.kind is ir.SizeKind.ABSOLUTE and isinstance(value, ir.Num)
                     and value.value >= 0 and value.value == int(value.value)):
                 selectors.append(str(int(value.value)))
+                bodies.append(part.body)
+                continue
+            if indices is not None and part.size.kind is ir.SizeKind.ABSOLUTE and _index_expression(value, known):
+                selectors.append(f"#{len(indices)}")
+                indices.append(self.expr(value))
                 bodies.append(part.body)
                 continue
             if part.size.kind is not ir.SizeKind.ABSOLUTE or not isinstance(value, ir.Name):
@@ -417,7 +442,7 @@ class OperationLowering:
                 why = f"{named} selects {listed}" + (" and remainder" if "remainder" in known else "")
                 self.unsupported(f"{named} selector `{value.name}`", value.span, why + suggest(value.name, known))
                 return None
-            if part.merged:
+            if part.merged and noun is not None:
                 self.diags.warning(
                     "merged", f"`{value.name}=` gives one shape for all its {noun} in CityEngine; grammarc "
                     "derives them one by one (the same leaves; operations that read the scope differ)",
@@ -479,6 +504,10 @@ PART_OPERATIONS = {
     "innerRectangle": OperationLowering.op_inner_rectangle,
 }
 REPEATING = frozenset({"split", "splitArea"})
+#: Operations with parts that may also come without them: name -> handler(lowering, op, args, span).
+WITHOUT_PARTS = {
+    "setback": OperationLowering.op_setback_alone,
+}
 #: Operations with a body ``{ operations }``: name -> handler(lowering, op, args, body, span).
 BODY_OPERATIONS = {
     "scatter": OperationLowering.op_scatter,
@@ -536,6 +565,18 @@ ALIGN_FACES = frozenset({"largest", "world.lowest", "any"})
 ALIGN_EDGES = frozenset({"longest", "world.lowest"})
 #: Axis selectors of ``center`` and ``alignScopeToAxes``.
 AXIS_NAMES = {"x": (0,), "y": (1,), "z": (2,), "xy": (0, 1), "xz": (0, 2), "yz": (1, 2), "xyz": (0, 1, 2)}
+
+
+def _index_expression(value, known) -> bool:
+    """Whether a comp selector ``value`` is an index expression (``selector_parts``): an expression other
+    than a number, or a name that is neither a selector word nor a typo of one of ``known``."""
+    if isinstance(value, ir.Num):
+        return False
+    if not isinstance(value, ir.Name):
+        return True
+    name = value.name
+    words = {w for selectors in COMP_SELECTORS.values() for w in selectors} | SETBACK_SELECTORS
+    return name not in words and "." not in name and typo_of(name, known) is None
 
 
 def _selector(arg) -> str | None:

@@ -157,3 +157,72 @@ def test_comp_faces_of_a_courtyard_prism(write):
     quad_area = np.linalg.norm(np.cross(r["xform"][:, :, 0], r["xform"][:, :, 1]), axis=1).sum()
     np.testing.assert_allclose(quad_area, (160 + 80) * 5, rtol=1e-6)
 
+
+
+def test_index_selectors_given_by_expressions_take_the_component_they_evaluate_to(write):
+    """``comp(f){ n + 1 : A | k : B }`` with a constant and an attribute (public files index the faces of
+    their assets so), evaluated per shape: the lot's attribute picks another face on each lot."""
+    r = run(write, "const n = 2\nattr k = 1\n"
+                   "Lot --> extrude(4) comp(f){ n + 1 : A | k : B | 5 : C | k + 20 : None }\n",
+            [rect(12, 8)] * 2, lot_attrs={"k": [1.0, 4.0]})
+    assert Counter(names(r)) == {"A": 2, "B": 2, "C": 2}
+    normals, lot = quad_normals(r), r["lot"]
+    b = rows(r, "B")
+    np.testing.assert_allclose(normals[b & (lot == 0)], [[0, 0, 1]], atol=1e-6)  # face 1: the first side
+    np.testing.assert_allclose(normals[b & (lot == 1)], [[-1, 0, 0]], atol=1e-6)  # face 4: the last side
+    np.testing.assert_allclose(normals[rows(r, "A")], [[0, 0, -1]] * 2, atol=1e-6)  # face 3: the back
+
+
+ROOF_EDGES = "comp(e){ eave : Eave | ridge : Ridge | hip : Hip | valley : Valley | all : Other }\n" + "".join(
+    f'{name} --> report("{name}", scope.sx)\n' for name in ("Eave", "Ridge", "Hip", "Valley", "Other"))
+
+
+@pytest.mark.parametrize("roof, lot, want", [
+    ("roofHip(30)", "rect", {"Eave": 4, "Hip": 4, "Ridge": 1}),
+    ("roofPyramid(30)", "rect", {"Eave": 4, "Hip": 4}),
+    # the gable's triangles: their bottom edges and rakes are none of the four
+    ("roofGable(30)", "rect", {"Eave": 2, "Ridge": 1, "Other": 6}),
+    ("roofShed(20)", "rect", {"Eave": 1, "Other": 8}),
+    ("roofHip(30)", "concave_L", {"Eave": 6, "Hip": 5, "Valley": 1, "Ridge": 2}),
+    ("roofGable(30)", "concave_L", {"Eave": 4, "Hip": 1, "Valley": 1, "Ridge": 2, "Other": 6}),
+    ("extrude(3)", "rect", {"Other": 12}),  # a box has no roof edges
+    # a roof on a mass's top face: the face's z is up, not the scope's y
+    ("extrude(4) comp(f){ top : Top }\nTop --> roofGable(30)", "rect", {"Eave": 2, "Ridge": 1, "Other": 6}),
+])
+def test_roof_edges_are_eaves_ridges_hips_and_valleys(write, roof, lot, want):
+    """``comp(e){ eave | ridge | hip | valley }`` on roofs: the eaves along the base, the ridges on top,
+    hips where two slopes meet outward, valleys where they meet inward (an L's inner corner)."""
+    polygons = [rect(12, 8)] if lot == "rect" else make_lots_polys(lot)
+    r = run(write, f"Lot --> {roof} {ROOF_EDGES}", polygons)
+    assert {k[:-2]: v for k, v in totals(r).items() if k.endswith("_n")} == want
+    if roof == "roofHip(30)" and lot == "rect":
+        t = totals(r)
+        assert t["Eave_sum"] == pytest.approx(40) and t["Ridge_sum"] == pytest.approx(4)  # 12 - 2 * 4
+
+
+def test_comp_sel_names_every_kind_of_selector_as_written(write):
+    """``comp.sel`` of an index, an index expression, a world selector and a roof edge selector: the text of
+    the selector that took the component (a selector outside the plain face names used to be unknown)."""
+    r = run(write, "const n = 1\nLot --> extrude(4) comp(f){ n + 1 : A | 1 : B | world.up : C }\n"
+                   'A --> report("a", comp.sel == "(@n + 1)")\nB --> report("b", comp.sel == "1")\n'
+                   'C --> report("c", comp.sel == "world.up") roofHip(30) comp(e){ eave : E }\n'
+                   'E --> report("e", comp.sel == "eave")\n', [rect(12, 8)])
+    t = totals(r)
+    assert (t["a_n"], t["b_n"], t["c_n"], t["e_n"]) == (1, 1, 1, 4)
+    assert t["a_min"] and t["b_min"] and t["c_min"] and t["e_min"]
+
+
+@pytest.mark.parametrize("body, want", [
+    ("comp(f){ inside : I | border : B }", {"B": 1}),  # a flat shape: its one face has only border edges
+    ("comp(e){ inside : I | border : B }", {"B": 4}),
+    ("comp(v){ border : B }", {"B": 4}),
+    ("extrude(3) comp(f){ border : B | inside : I }", {"I": 6}),  # a closed solid: all inside
+    ("extrude(3) comp(e){ border : B | inside : I }", {"I": 12}),
+])
+def test_border_and_inside_of_shapes_no_offset_made(write, body, want):
+    """The reference's ``border`` (an edge meeting one face, a face or vertex touching such an edge) and
+    ``inside`` on faces and solids; on a roof they are refused by name."""
+    r = run(write, f"Lot --> {body}\n" + "".join(f'{n} --> report("{n}", 1)\n' for n in "IB"), [rect(12, 8)])
+    assert {k[:-2]: v for k, v in totals(r).items() if k.endswith("_n")} == want
+    r = run(write, "Lot --> roofHip(30) comp(e){ border : B }\n", [rect(12, 8)])
+    assert len(r["bad"]) == 1 and "border and inside on a roof" in r["bad"][0].reason

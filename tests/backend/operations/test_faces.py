@@ -18,8 +18,6 @@ from derivations import (
     totals,
 )
 
-from grammarc.errors import GrammarError
-
 
 def test_offset_inside_and_border_faces(write):
     """offset(-2) comp(f){ border | inside } on the L: a ring with an L-shaped hole and the inset L."""
@@ -84,9 +82,22 @@ def test_offset_inside_of_a_rectangle_stays_a_box_path_rectangle(write):
     np.testing.assert_allclose(r["xform"][0, :, 3], [1, 0, -7])
 
 
-def test_offset_without_its_comp_is_named(write):
-    with pytest.raises(GrammarError, match="offset\\(d\\) without comp"):
-        run(write, "Lot --> offset(-1) extrude(3)\n", [rect(12, 8)])
+def test_offset_on_its_own_keeps_the_inside_and_the_border_as_the_faces_of_one_shape(write):
+    """The reference's ``offset(d)`` without a selector is ``all``: the inset and the ring around it, one
+    shape whose faces ``comp(f)`` splits; a shape of several faces is a mesh, which ``extrude`` refuses."""
+    text = 'Lot --> offset(-2) report("a", geometry.area) report("n", geometry.nFaces) comp(f){ all : F }\n' \
+        'F --> report("f", geometry.area)\n'
+    t = totals(run(write, text, [LOT_ZOO["concave_L"]]))
+    assert (t["a_sum"], t["n_sum"], t["f_n"]) == (pytest.approx(400), 2, 2)
+    r = run(write, "Lot --> offset(-1) extrude(3)\n", [rect(12, 8)])
+    assert len(r["bad"]) == 1 and "`extrude` of a roof" in r["bad"][0].reason
+
+
+def test_setback_without_parts_is_the_face_set_back_all_round(write):
+    """``setback(d)`` alone, as public files write it: the remainder of ``setback(d){ all : ... }``."""
+    text = 'Lot --> setback(2) report("a", geometry.area) report("x", scope.sx)\n'
+    t = totals(run(write, text, [rect(12, 8)]))
+    assert (t["a_sum"], t["x_sum"]) == (pytest.approx(8 * 4), pytest.approx(8))
 
 
 def test_inner_rectangle_and_remainder_tile_the_lot_in_the_lot_frame(write):

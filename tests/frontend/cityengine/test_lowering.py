@@ -15,7 +15,7 @@ from grammarc.backend.plan import make_plan
 from grammarc.compiler import compile_grammar
 from grammarc.errors import UsageError
 from grammarc.ir import nodes as ir
-from grammarc.ir.printer import print_expr
+from grammarc.ir.printer import print_body, print_expr
 from grammarc.ir.traverse import iter_ops
 
 from .lowered import GRAMMARS, VERSION, assert_unsupported_at, body_of, compile_ir, errors, module_of, rules
@@ -314,8 +314,16 @@ def test_edge_distances_may_be_numbers_and_a_number_elsewhere_is_an_error():
         (2, 23, "a number where operations are expected"), (3, 24, "a number where operations are expected")]
 
 
-def test_edge_distances_as_a_constant_are_named_unsupported():
-    assert_unsupported_at("const d = comp(fe){ street.front : a | street.back = b }", "comp(fe){...} outside "
+def test_edge_distances_as_a_constant_are_the_distances_of_the_setbacks_that_name_it():
+    """The Swiss building rules keep ``const d = comp(fe){ ... }`` and write ``setback(d){ ... }``: the
+    constant's distances are constants ``d{k:selector}``, the setback's per edge."""
+    module, diags = compile_ir(VERSION + "const a = 4\nconst d = comp(fe){ street.front : a | street.back = 1 }\n"
+                              "Lot --> setback(d){ all = A | remainder : B }\n")
+    assert not diags.has_errors and [d.code for d in diags] == ["merged", "start-rule"]  # all=, not street.back=
+    assert [a.name for a in module.attrs] == ["a", "d{0:street.front}", "d{1:street.back}"]
+    assert print_body(module.rules[0].alternatives[0].body) == (
+        "setback(comp(fe){ street.front=@d{0:street.front}, street.back=@d{1:street.back} }){ all: A | remainder: B }")
+    assert_unsupported_at("attr d = comp(fe){ street.front : a | street.back = b }", "comp(fe){...} outside "
                           "setback", "comp")
 
 

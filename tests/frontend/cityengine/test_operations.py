@@ -89,6 +89,14 @@ from .lowered import VERSION, assert_unsupported_at, body_of, compile_ir, errors
     ("split(z, adjust){ 1 : A | ~1 : B }", "split(z){ 1: A | ~1: B }"),
     ("split(x, noAdjust){ 1 : A | ~1 : B }*", "split(x, noAdjust){ 1: A | ~1: B }*"),
     ("comp(f){ front : A | side : B. | top : NIL }", "comp(f){ front: A | side: B. | top: \u03b5 }"),
+    ("comp(f){ h + 1 : A | h = B | 2 : C }", "comp(f){ (@h + 1): A | @h: B | 2: C }"),
+    ("comp(e){ eave : A | ridge : B | hip : C | valley : D }", "comp(e){ eave: A | ridge: B | hip: C | valley: D }"),
+    ("comp(v){ h : A }", "comp(v){ @h: A }"),
+    ("comp(e){ border : A | inside : B }", "comp(e){ border: A | inside: B }"),
+    ("offset(-2) A", "offset(-2, all) A"),
+    ("offset(-2, all) A", "offset(-2, all) A"),
+    ("offset(h) comp(f){ border : B }", "offset(@h) comp(f){ border: B }"),
+    ("setback(h) A", "offset(-@h, inside) A"),
     ('color("#ff0000") A', 'color("#ff0000") A'),
     ("color(1, 0.5, 0) A", "color(1, 0.5, 0) A"),
     ('texture("brick.jpg") A', "texture(...) A"),
@@ -180,6 +188,15 @@ def test_comp_faces_selectors(selectors):
     assert [p[0].name for p in op.parts] == [s.capitalize() for s in selectors]
 
 
+def test_comp_index_expressions_are_picks_beside_the_named_selectors():
+    """``comp(f){ n + 1 : A | n : B | top : C }``: an index given by an expression, a constant or an
+    attribute is the selector ``#k`` of the k-th expression of ``picks``."""
+    op = module_of(f"{VERSION}const n = 2\nMass --> comp(f){{ n + 1 : A | n = B | top : C }}\n"
+                   ).rules[0].alternatives[0].body[0]
+    assert op.selectors == ("#0", "#1", "top")
+    assert [print_expr(e) for e in op.picks] == ["(@n + 1)", "@n"]
+
+
 def test_shape_u_moves_front_right_and_left_edges_into_its_shape_part():
     op = module_of(f"{VERSION}Lot --> shapeU(5, 3, 11){{ shape : A | remainder = B }}\n"
                    ).rules[0].alternatives[0].body[0]
@@ -208,15 +225,17 @@ def test_cleanup_geometry_names_a_wrong_component_or_argument_count_at_its_line(
     assert errors(VERSION + line + "\n") == [(2, line.index(at) + 1, message)]
 
 
-@pytest.mark.parametrize("line, at", [
-    ("Mass --> comp(f){ side= Wall }", "side"),
-    ("Mass --> comp(f){ top : Roof | all= Rest }", "all="),
+@pytest.mark.parametrize("line, at, noun", [
+    ("Mass --> comp(f){ side= Wall }", "side", "faces"),
+    ("Mass --> comp(f){ top : Roof | all= Rest }", "all=", "faces"),
+    ("Mass --> comp(e){ eave = Gutter }", "eave", "edges"),
 ])
-def test_merged_selector_is_derived_face_by_face_with_a_warning(line, at):
+def test_merged_selector_is_derived_face_by_face_with_a_warning(line, at, noun):
     module, diags = compile_ir(VERSION + line + "\n")
     assert not diags.has_errors
     assert [(d.code, d.span.line, d.span.col) for d in diags] == [("merged", 2, line.index(at) + 1),
                                                                   ("start-rule", 2, 1)]
+    assert f"for all its {noun}" in next(iter(diags)).message
     assert isinstance(module.rules[0].alternatives[0].body[0], ir.CompFaces)
 
 
@@ -240,11 +259,10 @@ def test_roof_gable_with_an_edge_index_and_roof_ridge_lower_to_roofs(call, kind,
 
 
 @pytest.mark.parametrize("line, name, at", [
-    ("Lot --> offset(-2) Inner", "offset(d) without comp(f){ inside | border } after it", "offset"),
     ("Lot --> offset(-2, outside) Inner", "offset with these arguments", "offset"),
     ("Lot --> setback(3){ street.top : Garden | remainder : Building }", "setback selector `street.top`",
      "street"),
-    ("Lot --> setback(3) Garden", "setback without selector parts", "setback"),
+    ("Lot --> shapeL(3, 2) Garden", "shapeL without selector parts", "shapeL"),
     ("Lot --> setback(3){ 2 : Garden }", "this setback selector", "2"),
     ("Lot --> roofHip(30, 1, true) Roof", "roofHip with even ridges", "true"),
     ("Lot --> envelope(normal, 10, 45) Roof", "envelope with 3 arguments", "envelope"),
@@ -258,6 +276,8 @@ def test_roof_gable_with_an_edge_index_and_roof_ridge_lower_to_roofs(call, kind,
     ("Lot --> comp(f){ street.top : A }", "comp(f) selector `street.top`", "street"),
     ("Lot --> comp(f){ fornt : A }", "comp(f) selector `fornt`", "fornt"),
     ("Lot --> comp(e){ front : A }", "comp(e) selector `front`", "front"),
+    ("Lot --> comp(e){ eavs : A }", "comp(e) selector `eavs`", "eavs"),
+    ("Lot --> comp(f){ ridge : A }", "comp(f) selector `ridge`", "ridge"),
     ("Lot --> comp(f){ 1.5 : A }", "this comp selector", "1.5"),
     ("Lot --> comp(f){ { front : A }* }", "repeat group in comp", "{ front"),
     ("Lot --> comp(f){ front : A }*", "`*` after comp", "*"),
