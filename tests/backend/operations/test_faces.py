@@ -84,13 +84,14 @@ def test_offset_inside_of_a_rectangle_stays_a_box_path_rectangle(write):
 
 def test_offset_on_its_own_keeps_the_inside_and_the_border_as_the_faces_of_one_shape(write):
     """The reference's ``offset(d)`` without a selector is ``all``: the inset and the ring around it, one
-    shape whose faces ``comp(f)`` splits; a shape of several faces is a mesh, which ``extrude`` refuses."""
+    shape whose faces ``comp(f)`` splits; extruded, its faces make one solid without inner walls."""
     text = 'Lot --> offset(-2) report("a", geometry.area) report("n", geometry.nFaces) comp(f){ all : F }\n' \
         'F --> report("f", geometry.area)\n'
     t = totals(run(write, text, [LOT_ZOO["concave_L"]]))
     assert (t["a_sum"], t["n_sum"], t["f_n"]) == (pytest.approx(400), 2, 2)
-    r = run(write, "Lot --> offset(-1) extrude(3)\n", [rect(12, 8)])
-    assert len(r["bad"]) == 1 and "`extrude` of a roof" in r["bad"][0].reason
+    r = run(write, "Lot --> offset(-1) extrude(3) comp(f){ side : S }\nS --> report(\"s\", geometry.area)\n",
+            [rect(12, 8)])
+    assert not r["bad"] and totals(r)["s_sum"] == pytest.approx(3 * 40)
 
 
 def test_setback_without_parts_is_the_face_set_back_all_round(write):
