@@ -14,6 +14,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from grammarc.ir.nodes import MATERIAL_MAPS
+
 __all__ = ["WHITE", "MeshChunk", "TerminalChunk"]
 
 #: Colour of rows that carry none: opaque white (RGBA).
@@ -38,7 +40,11 @@ class MeshChunk:
     symbol : (F,) int32
         Symbol of each face, an index into the writer's ``symbols``.
     color : (F, 4) uint8, optional
-        RGBA colour of each face (CityEngine's ``color``); None: white.
+        RGBA colour of each face (CityEngine's ``color`` and ``material.opacity``); None: white.
+    material : (F,) int32, optional
+        Each face's row of ``materials``; None (and ``materials`` None) where the grammar sets no texture.
+    materials : (M, len(MATERIAL_MAPS)) str, optional
+        The texture paths of each material, one column per channel of ``ir.MATERIAL_MAPS`` ("" for none).
     """
 
     vertices: np.ndarray
@@ -47,6 +53,8 @@ class MeshChunk:
     lot: np.ndarray
     symbol: np.ndarray
     color: np.ndarray | None = None
+    material: np.ndarray | None = None
+    materials: np.ndarray | None = None
 
     def colors(self) -> np.ndarray:
         """(F, 4) uint8: the faces' colours, white where none was given."""
@@ -81,7 +89,21 @@ class MeshChunk:
             lot=np.concatenate([c.lot for c in chunks]),
             symbol=np.concatenate([c.symbol for c in chunks]),
             color=np.concatenate([c.colors() for c in chunks]),
+            **_joined_materials(chunks, [c.material for c in chunks], [c.materials for c in chunks]),
         )
+
+
+def _joined_materials(chunks: Sequence, material: list, materials: list) -> dict:
+    """``material`` and ``materials`` of joined chunks: the tables one after the other, each chunk's rows
+    shifted by the tables before it (a chunk without textures takes the first material of no texture)."""
+    if all(table is None for table in materials):
+        return {}
+    blank = np.full((1, len(MATERIAL_MAPS)), "")
+    tables = [blank if table is None else table for table in materials]
+    bases = np.cumsum([0] + [len(table) for table in tables[:-1]])
+    rows = [np.zeros(len(c.lot), np.int32) if m is None else m + np.int32(base)
+            for c, m, base in zip(chunks, material, bases)]
+    return {"material": np.concatenate(rows).astype(np.int32), "materials": np.concatenate(tables)}
 
 
 def _join_offsets(offsets: list[np.ndarray], n_items: np.ndarray, n_groups: np.ndarray) -> np.ndarray:
@@ -110,7 +132,11 @@ class TerminalChunk:
     mesh : MeshChunk
         Faces of this batch that are not instances.
     color : (n, 4) uint8, optional
-        RGBA colour of each instance (CityEngine's ``color``); None: white.
+        RGBA colour of each instance (CityEngine's ``color`` and ``material.opacity``); None: white.
+    material : (n,) int32, optional
+        Each instance's row of ``materials``; None (and ``materials`` None) where the grammar sets no texture.
+    materials : (M, len(MATERIAL_MAPS)) str, optional
+        The texture paths of each material (as ``MeshChunk.materials``; the mesh's table is the same).
     """
 
     asset: np.ndarray
@@ -119,6 +145,8 @@ class TerminalChunk:
     symbol: np.ndarray
     mesh: MeshChunk
     color: np.ndarray | None = None
+    material: np.ndarray | None = None
+    materials: np.ndarray | None = None
 
     def colors(self) -> np.ndarray:
         """(n, 4) uint8: the instances' colours, white where none was given."""
