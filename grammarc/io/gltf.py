@@ -27,6 +27,7 @@ import json
 import os
 import shutil
 import struct
+import tempfile
 from collections.abc import Sequence
 from pathlib import Path
 
@@ -34,9 +35,10 @@ import numpy as np
 
 from grammarc.errors import UsageError
 from grammarc.io.instancing import TILE_SIZE, Tile, TiledWriter, compose, decompose
+from grammarc.ir.asset_names import locate
 
 __all__ = [
-    "MAX_BYTES", "MAX_GROUPS", "WRITERS", "GltfWriter", "index_path", "part_paths", "read_glb", "written_parts",
+    "MAX_BYTES", "MAX_GROUPS", "WRITERS", "GltfWriter", "baked_glb", "index_path", "part_paths", "read_glb", "written_parts",
 ]
 
 #: GLB's 32-bit length fields, less room for the JSON chunk.
@@ -47,6 +49,8 @@ _EXTENSION = "EXT_mesh_gpu_instancing"
 _FLOAT, _UINT, _UBYTE = 5126, 5125, 5121
 _ARRAY_BUFFER, _ELEMENT_ARRAY_BUFFER = 34962, 34963
 _WHITE = (255, 255, 255, 255)
+#: The image formats glTF's core takes for textures, by file ending.
+_IMAGE_TYPES = {".png": "image/png", ".jpg": "image/jpeg", ".jpeg": "image/jpeg"}
 
 
 def index_path(path: str | os.PathLike) -> Path:
@@ -141,7 +145,8 @@ class _Part:
         }
         self._assets: dict[int, tuple[int, int]] = {}  # asset -> (POSITION accessor, indices accessor)
         self._meshes: dict[tuple[int, int], int] = {}  # (asset, material) -> mesh
-        self._materials: dict[tuple[int, ...], int] = {}  # RGBA -> material
+        self._materials: dict[tuple, int] = {}  # (RGBA, translucent, colour map) -> material
+        self._textures: dict[Path, int | None] = {}  # image file -> texture (None: not an image glTF takes)
 
     def add_tile(self, tile: Tile, max_bytes: int) -> bool:
         """Add a tile's nodes, unless it would take the part past ``max_bytes`` (a part keeps at least
@@ -226,20 +231,36 @@ class _Part:
         self.json["accessors"].append(accessor)
         return len(self.json["accessors"]) - 1
 
-    def _material(self, rgba: tuple[int, ...], translucent: bool = False) -> int:
-        """The material of a colour; ``translucent``: its vertex colours have alpha below 1."""
-        key = (*rgba, translucent)
+    def _material(self, rgba: tuple[int, ...], translucent: bool = False, colormap: Path | None = None) -> int:
+        """The material of a colour; ``translucent``: its vertex colours have alpha below 1; ``colormap``:
+        the image file of its ``baseColorTexture`` (left out when it is neither PNG nor JPEG)."""
+        key = (*rgba, translucent, colormap)
         if key not in self._materials:
             srgb = np.array(rgba[:3], float) / 255.0
             linear = np.where(srgb <= 0.04045, srgb / 12.92, ((srgb + 0.055) / 1.055) ** 2.4)
             material = {"pbrMetallicRoughness": {"baseColorFactor": [*map(float, linear), rgba[3] / 255.0],
                                                  "metallicFactor": 0.0, "roughnessFactor": 0.9},
                         "doubleSided": True}
+            texture = self._texture(colormap) if colormap is not None else None
+            if texture is not None:
+                material["pbrMetallicRoughness"]["baseColorTexture"] = {"index": texture}
             if rgba[3] < 255 or translucent:
                 material["alphaMode"] = "BLEND"
             self.json["materials"].append(material)
             self._materials[key] = len(self.json["materials"]) - 1
         return self._materials[key]
+
+    def _texture(self, path: Path) -> int | None:
+        """The texture of an image file, its bytes in the binary chunk; None for a format glTF does not take."""
+        if path not in self._textures:
+            mime = _IMAGE_TYPES.get(path.suffix.lower())
+            self._textures[path] = None
+            if mime is not None:
+                view = self._view(np.frombuffer(path.read_bytes(), np.uint8))
+                self.json.setdefault("images", []).append({"bufferView": view, "mimeType": mime})
+                self.json.setdefault("textures", []).append({"source": len(self.json["images"]) - 1})
+                self._textures[path] = len(self.json["textures"]) - 1
+        return self._textures[path]
 
     def _mesh(self, asset: int, rgba: tuple[int, ...]) -> int:
         material = self._material(rgba)
@@ -267,6 +288,52 @@ class _Part:
             "material": self._material(_WHITE, translucent=bool((colors[:, 3] < 255).any())),
         }]})
         return len(self.json["meshes"]) - 1
+
+
+def baked_glb(vertices: np.ndarray, faces: np.ndarray, looks: np.ndarray | None, materials: list[tuple[str, ...]],
+              roots: Sequence[Path], meta: dict) -> bytes:
+    """A baked mesh as a GLB: one mesh, a primitive (and a material) per look of its triangles.
+
+    Parameters
+    ----------
+    vertices : (V, 3) float
+        World coordinates (written as float32).
+    faces : (T, 3) int
+        Triangles.
+    looks : (T,) int64 or None
+        Each triangle's material (an index into ``materials``) times 2^32 plus its RGBA as a uint32
+        (``io.bake.BakedWriter``); None: all white.
+    materials : list of tuple of str
+        Texture paths per channel of ``ir.MATERIAL_MAPS``; a colour map found in ``roots`` becomes the
+        primitive's ``baseColorTexture``.
+    """
+    with tempfile.TemporaryDirectory() as folder:
+        part = _Part(Path(folder) / "part.bin", None, meta)
+        del part.json["extensionsUsed"]
+        if looks is None:
+            looks = np.full(len(faces), 0xFFFFFFFF, np.int64)
+        primitives = []
+        if len(faces):
+            position = part._accessor(np.asarray(vertices, np.float32), "VEC3", _ARRAY_BUFFER, bounds=True)
+            distinct, inverse = np.unique(looks, return_inverse=True)
+            order = np.argsort(inverse.reshape(-1), kind="stable")
+            bounds = np.searchsorted(inverse.reshape(-1)[order], np.arange(len(distinct) + 1))
+            for k, look in enumerate(distinct.tolist()):
+                rgba = tuple(np.array([look & 0xFFFFFFFF], np.uint32).view(np.uint8).tolist())
+                colormap = materials[look >> 32][0] if materials else ""
+                found = locate(colormap, roots) if colormap else None
+                triangles = np.asarray(faces, np.int64)[order[bounds[k]:bounds[k + 1]]]
+                primitives.append({
+                    "attributes": {"POSITION": position},
+                    "indices": part._accessor(triangles.astype(np.uint32).reshape(-1), "SCALAR",
+                                              _ELEMENT_ARRAY_BUFFER),
+                    "material": part._material(rgba, colormap=found[1] if found else None)})
+            part.json["meshes"].append({"name": "city", "primitives": primitives})
+            part.json["nodes"].append({"name": "city", "mesh": 0})
+            part.json["scenes"][0]["nodes"].append(0)
+        out = Path(folder) / "baked.glb"
+        part.finish(out)
+        return out.read_bytes()
 
 
 def _groups(rows: np.ndarray) -> list[tuple[int, tuple[int, ...], np.ndarray]]:
