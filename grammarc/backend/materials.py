@@ -75,8 +75,14 @@ def collect_materials(plan, ids: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     material : (n,) int32
         Each row's material.
     """
-    distinct, inverse = np.unique(ids, axis=0, return_inverse=True)
     names = list(plan.strings.ids)
+    # one int64 key per row (the ids in base len(names)) sorts far faster than rows (np.unique(axis=0))
+    radix = np.int64(len(names)) ** np.arange(ids.shape[1], dtype=np.int64)
+    if float(len(names)) ** ids.shape[1] < 2.0 ** 62:
+        keys, inverse = np.unique(ids.astype(np.int64) @ radix, return_inverse=True)
+        distinct = keys[:, None] // radix % np.int64(len(names))
+    else:
+        distinct, inverse = np.unique(ids, axis=0, return_inverse=True)
     materials = np.full((len(distinct), len(MAP_FIELDS)), "", dtype=object)
     for column, (k, _) in enumerate(plan.material_slots):
         materials[:, k] = [names[int(i)] for i in distinct[:, column]]

@@ -2,12 +2,16 @@
 guard, and the mesh writers."""
 
 import importlib.util
+import json
 import tracemalloc
+import zlib
+from pathlib import Path
 
 import numpy as np
 import pytest
 import trimesh
 
+from grammarc.build import build
 from grammarc.errors import AssetError, UsageError
 from grammarc.io import OutputOptions, writer_for
 from grammarc.io import bake as bake_module
@@ -230,7 +234,8 @@ def test_writers_round_trip(tmp_path, suffix):
     np.testing.assert_allclose(loaded.bounds, expected.bounds, atol=1e-5)
     if suffix in (".obj", ".ply"):  # these keep the vertices as written
         assert len(loaded.vertices) == counts["vertices"]
-    assert [p.name for p in tmp_path.iterdir()] == [path.name]  # no temporaries left
+    written = [path.name] + (["city.mtl"] if suffix == ".obj" else [])  # an OBJ has its material library
+    assert sorted(p.name for p in tmp_path.iterdir()) == sorted(written)  # no temporaries left
 
 
 def test_writer_abort_leaves_no_file(tmp_path):
@@ -295,3 +300,86 @@ def test_a_glb_asset_inserted_z_up_bakes_standing(tmp_path):
     assert len(mesh.faces) == 3 * triangles
     np.testing.assert_allclose(mesh.bounds[:, 1], [0, 6], atol=1e-5)
     np.testing.assert_allclose(mesh.bounds[1, 0] - mesh.bounds[0, 0], 20 + 2, atol=1e-5)  # lots 10 m apart, 2 m vane
+
+
+# ---------------------------------------------------------------------------- colours and textures baked
+
+#: A red roof and half transparent green walls, on two lots; a textured facade.
+COLOURED = """version "2023.0"
+Lot --> extrude(6) comp(f){ top : color(1, 0, 0) Roof. | side : Facade }
+Facade --> color("#00ff00") set(material.opacity, 0.5) Wall.
+"""
+TEXTURED = """version "2023.0"
+Lot --> extrude(6) comp(f){ top : Roof. | side : texture("tex/wall.png") Wall. }
+"""
+RED, SEE_THROUGH_GREEN = [255, 0, 0, 255], [0, 255, 0, 128]
+
+
+def _png(width: int, height: int) -> bytes:
+    """A grey RGB PNG image."""
+    def chunk(kind: bytes, data: bytes) -> bytes:
+        return len(data).to_bytes(4, "big") + kind + data + zlib.crc32(kind + data).to_bytes(4, "big")
+    rows = b"".join(b"\0" + b"\x80" * 3 * width for _ in range(height))
+    header = width.to_bytes(4, "big") + height.to_bytes(4, "big") + bytes([8, 2, 0, 0, 0])
+    return b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", header) + chunk(b"IDAT", zlib.compress(rows)) + chunk(b"IEND", b"")
+
+
+PNG = _png(2, 2)
+
+
+def built(tmp_path, text: str, suffix: str) -> Path:
+    """``text`` derived on two lots and written baked as ``city{suffix}``."""
+    (tmp_path / "tex").mkdir(exist_ok=True)
+    (tmp_path / "tex" / "wall.png").write_bytes(PNG)
+    (tmp_path / "g.cga").write_text(text)
+    squares = [[[30 * k, 0], [30 * k + 12, 0], [30 * k + 12, 9], [30 * k, 9], [30 * k, 0]] for k in range(2)]
+    (tmp_path / "lots.geojson").write_text(json.dumps({"type": "FeatureCollection", "features": [
+        {"type": "Feature", "properties": {}, "geometry": {"type": "Polygon", "coordinates": [ring]}}
+        for ring in squares]}))
+    out = tmp_path / f"city{suffix}"
+    build(tmp_path / "g.cga", out, lots_path=tmp_path / "lots.geojson", output_options=OutputOptions(bake=True))
+    return out
+
+
+def test_a_baked_obj_has_a_group_per_lot_and_a_material_per_colour(tmp_path):
+    text = built(tmp_path, COLOURED, ".obj").read_text()
+    assert text.splitlines()[1] == "mtllib city.mtl"
+    assert [line for line in text.splitlines() if line.startswith("g ")] == ["g lot_0", "g lot_1"]
+    assert text.count("usemtl") == 4  # per lot: the roof's, then the walls'
+    scene = trimesh.load(tmp_path / "city.obj", process=False)
+    colours = {tuple(g.visual.material.diffuse[:3]) for g in scene.geometry.values()}
+    assert colours == {(255, 0, 0), (0, 255, 0)}
+    assert "d 0.501961" in (tmp_path / "city.mtl").read_text()
+
+
+def test_a_baked_ply_has_vertex_colours(tmp_path):
+    mesh = trimesh.load(built(tmp_path, COLOURED, ".ply"), process=False)
+    colours = mesh.visual.vertex_colors
+    assert {tuple(c) for c in colours.tolist()} == {tuple(RED), tuple(SEE_THROUGH_GREEN)}
+    roof = mesh.vertices[:, 1] > 5.9
+    assert (colours[mesh.faces[np.all(roof[mesh.faces], axis=1)]] == RED).all()
+
+
+def test_a_baked_glb_has_a_material_per_colour(tmp_path):
+    scene = trimesh.load(built(tmp_path, COLOURED, ".glb"), process=False)
+    factors = sorted(g.visual.material.baseColorFactor.tolist() for g in scene.geometry.values())
+    assert factors == sorted([RED, SEE_THROUGH_GREEN])
+    assert sum(len(g.faces) for g in scene.geometry.values()) == 2 * (4 * 2 + 2)  # walls and roof of two lots
+
+
+def test_a_baked_obj_and_glb_reference_their_texture(tmp_path):
+    built(tmp_path, TEXTURED, ".obj")
+    assert "map_Kd tex/wall.png" in (tmp_path / "city.mtl").read_text()
+    images = [g.visual.material.image for g in trimesh.load(tmp_path / "city.obj").geometry.values()]
+    assert sum(image is not None for image in images) == 1
+    scene = trimesh.load(built(tmp_path, TEXTURED, ".glb"), process=False)
+    textures = [g.visual.material.baseColorTexture for g in scene.geometry.values()]
+    assert sorted(t is not None for t in textures) == [False, True]
+    assert next(t for t in textures if t is not None).size == (2, 2)
+
+
+def test_a_texture_outside_the_roots_is_not_read(tmp_path):
+    (tmp_path / "inner").mkdir()
+    built(tmp_path / "inner", TEXTURED.replace("tex/wall.png", "../tex/wall.png"), ".glb")
+    scene = trimesh.load(tmp_path / "inner" / "city.glb", process=False)
+    assert all(g.visual.material.baseColorTexture is None for g in scene.geometry.values())
