@@ -102,10 +102,10 @@ class GltfWriter(TiledWriter):
 
     def _finish(self) -> dict:
         """The parts (``parts`` in the counts), the index when there are several."""
-        parts = [_Part(self._tmp / "part0.bin", self._library, self._meta)]
+        parts = [_Part(self._tmp / "part0.bin", self._library, self._meta, self._colormap)]
         for tile in self._spool.tiles():
             if not parts[-1].add_tile(tile, self.max_bytes):
-                parts.append(_Part(self._tmp / f"part{len(parts)}.bin", self._library, self._meta))
+                parts.append(_Part(self._tmp / f"part{len(parts)}.bin", self._library, self._meta, self._colormap))
                 if not parts[-1].add_tile(tile, self.max_bytes):
                     raise UsageError(f"{self.path}: tile {tile.name} alone passes {self.max_bytes:,} bytes; "
                                      "give a smaller --tile-size")
@@ -130,8 +130,10 @@ WRITERS = {".glb": GltfWriter}
 class _Part:
     """One GLB file being built: its JSON lists and its binary chunk in a temporary file."""
 
-    def __init__(self, binary: Path, library, meta: dict):
+    def __init__(self, binary: Path, library, meta: dict, colormap=lambda material: None):
         self.library = library
+        #: material (a row of the writer's materials) -> its colour map file, or None
+        self.colormap = colormap
         self.binary = open(binary, "w+b")  # noqa: SIM115 - closed by finish(), or with the temporary folder
         self.size = 0
         self.instances = 0
@@ -151,7 +153,7 @@ class _Part:
     def add_tile(self, tile: Tile, max_bytes: int) -> bool:
         """Add a tile's nodes, unless it would take the part past ``max_bytes`` (a part keeps at least
         one tile when it can): returns whether it was added."""
-        groups = _groups(tile.instances)
+        groups = _groups(tile.instances, tile.instance_material)
         new_assets = {int(group[0]) for group in groups} - set(self._assets)
         need = (tile.instances.size * 40 + tile.triangles.size * 3 * 16
                 + sum(self.library[a].vertices.size * 4 + self.library[a].faces.size * 4 + 8
@@ -162,10 +164,10 @@ class _Part:
         rows = tile.instances
         if len(rows):
             positions, orientations, scales = decompose(rows["xform"], tile.origin)
-            for asset, color, members in groups:
+            for asset, color, material, members in groups:
                 nodes.append({
                     "name": self.library.names[asset],
-                    "mesh": self._mesh(asset, color),
+                    "mesh": self._mesh(asset, color, self.colormap(material)),
                     "extensions": {_EXTENSION: {"attributes": {
                         "TRANSLATION": self._accessor(positions[members], "VEC3"),
                         "ROTATION": self._accessor(orientations[members], "VEC4"),
@@ -262,8 +264,8 @@ class _Part:
                 self._textures[path] = len(self.json["textures"]) - 1
         return self._textures[path]
 
-    def _mesh(self, asset: int, rgba: tuple[int, ...]) -> int:
-        material = self._material(rgba)
+    def _mesh(self, asset: int, rgba: tuple[int, ...], colormap: Path | None = None) -> int:
+        material = self._material(rgba, colormap=colormap)
         if (asset, material) not in self._meshes:
             if asset not in self._assets:
                 shape = self.library[asset]
@@ -278,15 +280,25 @@ class _Part:
         return self._meshes[asset, material]
 
     def _polygons(self, tile: Tile) -> int:
-        """The tile's mesh-table triangles as one mesh with per-vertex colours."""
+        """The tile's mesh-table triangles as one mesh with per-vertex colours, a primitive per colour map
+        where the record has textures."""
         triangles = tile.triangles
         points = (triangles["vertices"].reshape(-1, 3).astype(np.float64) - tile.origin).astype(np.float32)
         colors = np.repeat(triangles["color"], 3, axis=0)
-        self.json["meshes"].append({"name": f"{tile.name}_polygons", "primitives": [{
-            "attributes": {"POSITION": self._accessor(points, "VEC3", _ARRAY_BUFFER, bounds=True),
-                           "COLOR_0": self._accessor(colors, "VEC4", _ARRAY_BUFFER, normalized=True)},
-            "material": self._material(_WHITE, translucent=bool((colors[:, 3] < 255).any())),
-        }]})
+        attributes = {"POSITION": self._accessor(points, "VEC3", _ARRAY_BUFFER, bounds=True),
+                      "COLOR_0": self._accessor(colors, "VEC4", _ARRAY_BUFFER, normalized=True)}
+        translucent = bool((colors[:, 3] < 255).any())
+        primitives = [{"attributes": attributes, "material": self._material(_WHITE, translucent=translucent)}]
+        if tile.triangle_material is not None:
+            maps = [self.colormap(m) for m in range(int(tile.triangle_material.max()) + 1)]
+            used = np.array([maps[m] for m in tile.triangle_material.tolist()], dtype=object)
+            primitives = []
+            for colormap in dict.fromkeys(used.tolist()):
+                vertices = (np.flatnonzero(used == colormap)[:, None] * 3 + np.arange(3)).reshape(-1)
+                primitives.append({"attributes": attributes, "material": self._material(
+                    _WHITE, translucent=translucent, colormap=colormap),
+                    "indices": self._accessor(vertices.astype(np.uint32), "SCALAR", _ELEMENT_ARRAY_BUFFER)})
+        self.json["meshes"].append({"name": f"{tile.name}_polygons", "primitives": primitives})
         return len(self.json["meshes"]) - 1
 
 
@@ -336,24 +348,30 @@ def baked_glb(vertices: np.ndarray, faces: np.ndarray, looks: np.ndarray | None,
         return out.read_bytes()
 
 
-def _groups(rows: np.ndarray) -> list[tuple[int, tuple[int, ...], np.ndarray]]:
-    """(asset, RGBA, row indices) of a tile's instances, by (asset, colour) unless that makes more than
-    ``MAX_GROUPS`` groups, then by asset in white; in order of asset, then colour."""
+def _groups(rows: np.ndarray, material: np.ndarray | None = None
+            ) -> list[tuple[int, tuple[int, ...], int, np.ndarray]]:
+    """(asset, RGBA, material, row indices) of a tile's instances, by (asset, material, colour) unless that
+    makes more than ``MAX_GROUPS`` groups, then by (asset, material) in white; in order of asset, material,
+    then colour. ``material`` (n,) int32: the rows' materials (None: all 0)."""
     if not len(rows):
         return []
     color = rows["color"].view(np.uint32).reshape(-1).astype(np.int64)
-    key = rows["asset"].astype(np.int64) << 32 | color
-    unique, inverse = np.unique(key, return_inverse=True)
+    material = np.zeros(len(rows), np.int64) if material is None else material.astype(np.int64)
+    # (asset, material) pairs numbered in their order, in the high half of the key
+    pairs, pair = np.unique(rows["asset"].astype(np.int64) << 32 | material, return_inverse=True)
+    high = pair.reshape(-1).astype(np.int64) << 32
+    unique, inverse = np.unique(high | color, return_inverse=True)
     if len(unique) > MAX_GROUPS:
-        unique, inverse = np.unique(rows["asset"].astype(np.int64) << 32 | np.int64(0xFFFFFFFF),
-                                    return_inverse=True)
+        unique, inverse = np.unique(high | np.int64(0xFFFFFFFF), return_inverse=True)
     inverse = inverse.reshape(-1)
     order = np.argsort(inverse, kind="stable")
     bounds = np.searchsorted(inverse[order], np.arange(len(unique) + 1))
     groups = []
     for k, value in enumerate(unique.tolist()):
         rgba = tuple(np.array([value & 0xFFFFFFFF], np.uint32).view(np.uint8).tolist())
-        groups.append((value >> 32, rgba, order[bounds[k]:bounds[k + 1]]))
+        asset_and_material = int(pairs[value >> 32])
+        groups.append((asset_and_material >> 32, rgba, asset_and_material & 0xFFFFFFFF,
+                       order[bounds[k]:bounds[k + 1]]))
     return groups
 
 
