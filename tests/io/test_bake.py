@@ -2,16 +2,13 @@
 guard, and the mesh writers."""
 
 import importlib.util
-import json
 import tracemalloc
-import zlib
-from pathlib import Path
 
 import numpy as np
 import pytest
 import trimesh
+from writers_city import COLOURED, PNG, RED, SEE_THROUGH_GREEN, TEXTURED, textured_city
 
-from grammarc.build import build
 from grammarc.errors import AssetError, UsageError
 from grammarc.io import OutputOptions, writer_for
 from grammarc.io import bake as bake_module
@@ -304,45 +301,8 @@ def test_a_glb_asset_inserted_z_up_bakes_standing(tmp_path):
 
 # ---------------------------------------------------------------------------- colours and textures baked
 
-#: A red roof and half transparent green walls, on two lots; a textured facade.
-COLOURED = """version "2023.0"
-Lot --> extrude(6) comp(f){ top : color(1, 0, 0) Roof. | side : Facade }
-Facade --> color("#00ff00") set(material.opacity, 0.5) Wall.
-"""
-TEXTURED = """version "2023.0"
-Lot --> extrude(6) comp(f){ top : Roof. | side : texture("tex/wall.png") Wall. }
-"""
-RED, SEE_THROUGH_GREEN = [255, 0, 0, 255], [0, 255, 0, 128]
-
-
-def _png(width: int, height: int) -> bytes:
-    """A grey RGB PNG image."""
-    def chunk(kind: bytes, data: bytes) -> bytes:
-        return len(data).to_bytes(4, "big") + kind + data + zlib.crc32(kind + data).to_bytes(4, "big")
-    rows = b"".join(b"\0" + b"\x80" * 3 * width for _ in range(height))
-    header = width.to_bytes(4, "big") + height.to_bytes(4, "big") + bytes([8, 2, 0, 0, 0])
-    return b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", header) + chunk(b"IDAT", zlib.compress(rows)) + chunk(b"IEND", b"")
-
-
-PNG = _png(2, 2)
-
-
-def built(tmp_path, text: str, suffix: str) -> Path:
-    """``text`` derived on two lots and written baked as ``city{suffix}``."""
-    (tmp_path / "tex").mkdir(exist_ok=True)
-    (tmp_path / "tex" / "wall.png").write_bytes(PNG)
-    (tmp_path / "g.cga").write_text(text)
-    squares = [[[30 * k, 0], [30 * k + 12, 0], [30 * k + 12, 9], [30 * k, 9], [30 * k, 0]] for k in range(2)]
-    (tmp_path / "lots.geojson").write_text(json.dumps({"type": "FeatureCollection", "features": [
-        {"type": "Feature", "properties": {}, "geometry": {"type": "Polygon", "coordinates": [ring]}}
-        for ring in squares]}))
-    out = tmp_path / f"city{suffix}"
-    build(tmp_path / "g.cga", out, lots_path=tmp_path / "lots.geojson", output_options=OutputOptions(bake=True))
-    return out
-
-
 def test_a_baked_obj_has_a_group_per_lot_and_a_material_per_colour(tmp_path):
-    text = built(tmp_path, COLOURED, ".obj").read_text()
+    text = textured_city(tmp_path, COLOURED, ".obj", bake=True).read_text()
     assert text.splitlines()[1] == "mtllib city.mtl"
     assert [line for line in text.splitlines() if line.startswith("g ")] == ["g lot_0", "g lot_1"]
     assert text.count("usemtl") == 4  # per lot: the roof's, then the walls'
@@ -353,7 +313,7 @@ def test_a_baked_obj_has_a_group_per_lot_and_a_material_per_colour(tmp_path):
 
 
 def test_a_baked_ply_has_vertex_colours(tmp_path):
-    mesh = trimesh.load(built(tmp_path, COLOURED, ".ply"), process=False)
+    mesh = trimesh.load(textured_city(tmp_path, COLOURED, ".ply", bake=True), process=False)
     colours = mesh.visual.vertex_colors
     assert {tuple(c) for c in colours.tolist()} == {tuple(RED), tuple(SEE_THROUGH_GREEN)}
     roof = mesh.vertices[:, 1] > 5.9
@@ -361,18 +321,18 @@ def test_a_baked_ply_has_vertex_colours(tmp_path):
 
 
 def test_a_baked_glb_has_a_material_per_colour(tmp_path):
-    scene = trimesh.load(built(tmp_path, COLOURED, ".glb"), process=False)
+    scene = trimesh.load(textured_city(tmp_path, COLOURED, ".glb", bake=True), process=False)
     factors = sorted(g.visual.material.baseColorFactor.tolist() for g in scene.geometry.values())
     assert factors == sorted([RED, SEE_THROUGH_GREEN])
     assert sum(len(g.faces) for g in scene.geometry.values()) == 2 * (4 * 2 + 2)  # walls and roof of two lots
 
 
 def test_a_baked_obj_and_glb_reference_their_texture(tmp_path):
-    built(tmp_path, TEXTURED, ".obj")
+    textured_city(tmp_path, TEXTURED, ".obj", bake=True)
     assert "map_Kd tex/wall.png" in (tmp_path / "city.mtl").read_text()
     images = [g.visual.material.image for g in trimesh.load(tmp_path / "city.obj").geometry.values()]
     assert sum(image is not None for image in images) == 1
-    scene = trimesh.load(built(tmp_path, TEXTURED, ".glb"), process=False)
+    scene = trimesh.load(textured_city(tmp_path, TEXTURED, ".glb", bake=True), process=False)
     textures = [g.visual.material.baseColorTexture for g in scene.geometry.values()]
     assert sorted(t is not None for t in textures) == [False, True]
     assert next(t for t in textures if t is not None).size == (2, 2)
@@ -380,6 +340,8 @@ def test_a_baked_obj_and_glb_reference_their_texture(tmp_path):
 
 def test_a_texture_outside_the_roots_is_not_read(tmp_path):
     (tmp_path / "inner").mkdir()
-    built(tmp_path / "inner", TEXTURED.replace("tex/wall.png", "../tex/wall.png"), ".glb")
+    (tmp_path / "tex").mkdir()
+    (tmp_path / "tex" / "wall.png").write_bytes(PNG)  # beside the grammar's folder, not in it
+    textured_city(tmp_path / "inner", TEXTURED.replace("tex/wall.png", "../tex/wall.png"), ".glb", bake=True)
     scene = trimesh.load(tmp_path / "inner" / "city.glb", process=False)
     assert all(g.visual.material.baseColorTexture is None for g in scene.geometry.values())
