@@ -42,7 +42,7 @@ from grammarc.io.obj import obj_bytes, with_lines
 from grammarc.ir.asset_names import locate
 from grammarc.ir.nodes import MATERIAL_MAPS
 from grammarc.model.assets import AssetLibrary, AssetMesh, asset_library
-from grammarc.model.records import MeshChunk, TerminalChunk
+from grammarc.model.records import MaterialTable, MeshChunk, TerminalChunk
 from grammarc.ragged import offsets_from_counts, segment_of
 
 __all__ = ["MAX_TRIANGLES", "WRITERS", "BakedWriter", "bake", "count_triangles"]
@@ -290,9 +290,8 @@ class BakedWriter(WriterBlock):
             max_triangles = int(os.environ.get("GRAMMARC_MAX_TRIANGLES", MAX_TRIANGLES))
         self.max_triangles = max_triangles
         self._chunks: list[tuple[np.ndarray, np.ndarray, MeshChunk, np.ndarray | None]] = []
-        #: The record's texture channel tuples (``TerminalChunk.materials``), row 0 none; and the looks
-        #: (``_looks``) met so far, each an OBJ material or a glTF primitive.
-        self._materials: dict[tuple[str, ...], int] = {("",) * len(MATERIAL_MAPS): 0}
+        #: The record's materials, and the looks (``_looks``) met so far, each an OBJ material.
+        self._materials = MaterialTable()
         self._look_ids: dict[int, int] = {}
         self._triangles = 0
         self._rows = 0
@@ -359,9 +358,7 @@ class BakedWriter(WriterBlock):
         rgba = np.concatenate([chunk.colors(), chunk.mesh.colors()]).view(np.uint32).reshape(-1).astype(np.int64)
         if chunk.materials is None:
             return rgba
-        lookup = np.array([self._materials.setdefault(tuple(map(str, row)), len(self._materials))
-                           for row in chunk.materials], np.int64)
-        return np.concatenate([lookup[chunk.material], lookup[chunk.mesh.material]]) << 32 | rgba
+        return np.concatenate(self._materials.add(chunk)).astype(np.int64) << 32 | rgba
 
     def _look(self, look: int) -> int:
         """The OBJ material of a look, numbered as met."""
@@ -385,7 +382,7 @@ class BakedWriter(WriterBlock):
     def _mtl(self) -> bytes:
         """The OBJ's material library: per look its colour (``Kd``, ``d``) and texture maps, the paths
         resolved in the asset roots and given relative to the OBJ (as written where no root holds them)."""
-        materials = list(self._materials)
+        materials = self._materials.table()
         lines = [f"# {len(self._look_ids)} materials of {self.path.name}"]
         for look, k in self._look_ids.items():
             rgba = np.array([look & 0xFFFFFFFF], np.uint32).view(np.uint8) / 255.0
@@ -477,7 +474,7 @@ class BakedWriter(WriterBlock):
         """The bytes of a PLY (with vertex colours where the record has colours) or STL (binary), or a GLB
         with a material per look (``io.gltf.baked_glb``); ``looks`` (T,) int64 per triangle (``_looks``)."""
         if self._file_type == "glb":
-            materials = list(self._materials)
+            materials = self._materials.table()
             return baked_glb(mesh.vertices, mesh.faces, looks, materials, self._library.roots, self._meta)
         if self._file_type == "ply" and looks is not None:
             colors = np.full((len(mesh.vertices), 4), 255, np.uint8)

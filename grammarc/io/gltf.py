@@ -302,7 +302,7 @@ class _Part:
         return len(self.json["meshes"]) - 1
 
 
-def baked_glb(vertices: np.ndarray, faces: np.ndarray, looks: np.ndarray | None, materials: list[tuple[str, ...]],
+def baked_glb(vertices: np.ndarray, faces: np.ndarray, looks: np.ndarray | None, materials: np.ndarray,
               roots: Sequence[Path], meta: dict) -> bytes:
     """A baked mesh as a GLB: one mesh, a primitive (and a material) per look of its triangles.
 
@@ -315,9 +315,9 @@ def baked_glb(vertices: np.ndarray, faces: np.ndarray, looks: np.ndarray | None,
     looks : (T,) int64 or None
         Each triangle's material (an index into ``materials``) times 2^32 plus its RGBA as a uint32
         (``io.bake.BakedWriter``); None: all white.
-    materials : list of tuple of str
-        Texture paths per channel of ``ir.MATERIAL_MAPS``; a colour map found in ``roots`` becomes the
-        primitive's ``baseColorTexture``.
+    materials : (M, len(ir.MATERIAL_MAPS)) str
+        Texture paths per channel (``model.records.MaterialTable``); a colour map found in ``roots`` becomes
+        the primitive's ``baseColorTexture``.
     """
     with tempfile.TemporaryDirectory() as folder:
         part = _Part(Path(folder) / "part.bin", None, meta)
@@ -332,7 +332,7 @@ def baked_glb(vertices: np.ndarray, faces: np.ndarray, looks: np.ndarray | None,
             bounds = np.searchsorted(inverse.reshape(-1)[order], np.arange(len(distinct) + 1))
             for k, look in enumerate(distinct.tolist()):
                 rgba = tuple(np.array([look & 0xFFFFFFFF], np.uint32).view(np.uint8).tolist())
-                colormap = materials[look >> 32][0] if materials else ""
+                colormap = str(materials[look >> 32, 0])
                 found = locate(colormap, roots) if colormap else None
                 triangles = np.asarray(faces, np.int64)[order[bounds[k]:bounds[k + 1]]]
                 primitives.append({

@@ -35,9 +35,8 @@ from grammarc.constants import LIMITS
 from grammarc.geometry.triangulation import triangulate_polygons
 from grammarc.io import WriterBlock
 from grammarc.ir.asset_names import locate
-from grammarc.ir.nodes import MATERIAL_MAPS
 from grammarc.model.assets import asset_library
-from grammarc.model.records import WHITE, TerminalChunk
+from grammarc.model.records import WHITE, MaterialTable, TerminalChunk
 
 __all__ = ["INSTANCE", "TRIANGLE", "Tile", "TileSpool", "TiledWriter", "decompose"]
 
@@ -282,8 +281,8 @@ class TiledWriter(WriterBlock):
         (self._tmp / "spool").mkdir()
         self._spool = TileSpool(self._tmp / "spool", tile_size)
         self._used = np.zeros(len(self._library.names), np.int64)  # instances of each asset
-        #: The record's texture channel tuples (``TerminalChunk.materials``), row 0 none, once a chunk has any.
-        self._materials: dict[tuple[str, ...], int] = {}
+        self._materials = MaterialTable()
+        self._colormaps: dict[int, Path | None] = {}
         self._state = "open"
         self._counts: dict = {}
 
@@ -304,19 +303,17 @@ class TiledWriter(WriterBlock):
             raise
 
     def _material_rows(self, chunk: TerminalChunk) -> tuple[np.ndarray | None, np.ndarray | None]:
-        """The chunk's instances' and faces' rows of the writer's ``_materials``; None without textures."""
-        if chunk.materials is None:
-            return None, None
-        self._materials.setdefault(("",) * len(MATERIAL_MAPS), 0)
-        lookup = np.array([self._materials.setdefault(tuple(map(str, row)), len(self._materials))
-                           for row in chunk.materials], np.int32)
-        return lookup[chunk.material], lookup[chunk.mesh.material]
+        """The chunk's instances' and faces' rows of the writer's materials; None without textures."""
+        return self._materials.add(chunk) if chunk.materials is not None else (None, None)
 
     def _colormap(self, material: int) -> Path | None:
-        """The colour map file of one of ``_materials``, found in the asset roots; None without one."""
-        name = list(self._materials)[material][0] if self._materials else ""
-        found = locate(name, self._library.roots) if name else None
-        return found[1] if found else None
+        """The colour map file of one of the writer's materials, found in the asset roots; None without one
+        (asked for when the output is written, after every chunk: the files are looked for once)."""
+        if material not in self._colormaps:
+            name = str(self._materials.table()[material, 0])
+            found = locate(name, self._library.roots) if name else None
+            self._colormaps[material] = found[1] if found else None
+        return self._colormaps[material]
 
     def close(self) -> dict:
         """Write the output and move it into place; the counts (closing again returns them again):

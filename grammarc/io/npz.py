@@ -55,8 +55,7 @@ import numpy as np
 from zlib_ng.zlib_ng import crc32, crc32_combine
 
 from grammarc.errors import UsageError
-from grammarc.ir.nodes import MATERIAL_MAPS
-from grammarc.model.records import TerminalChunk
+from grammarc.model.records import MaterialTable, TerminalChunk
 
 if TYPE_CHECKING:
     from typing_extensions import Self
@@ -146,8 +145,8 @@ class InstanceWriter:
         self._meta = dict(meta)
         json.dumps(self._meta)  # a TypeError now, not after hours of derivation
         self._rows = dict.fromkeys(_SPOOLED, 0)
-        #: The record's materials (rows of texture paths) and their indices, once a chunk has any.
-        self._materials: dict[tuple[str, ...], int] = {}
+        #: The record's materials, once a chunk has textures (else None: no material columns).
+        self._materials: MaterialTable | None = None
         self._counts: dict[str, int] = {}
         self._state = "open"
         tmpdir = tempfile.mkdtemp(prefix=f".{self.path.name}.tmp", dir=self.path.parent)
@@ -190,17 +189,13 @@ class InstanceWriter:
         """Add the chunk's ``material`` and ``mesh_material`` columns, indexing the record's ``materials``,
         once any chunk has textures: row 0 of the table is no texture, which the rows of chunks without
         (and those written before the first with) take."""
-        if chunk.materials is None and not self._materials:
+        if chunk.materials is None and self._materials is None:
             return
-        if not self._materials:
-            self._materials[("",) * len(MATERIAL_MAPS)] = 0
+        if self._materials is None:
+            self._materials = MaterialTable()
         before = {"material": self._rows["asset"] - self._rows["material"],
                   "mesh_material": self._rows["mesh_lot"] - self._rows["mesh_material"]}
-        lookup = np.array([self._materials.setdefault(tuple(map(str, row)), len(self._materials))
-                           for row in (chunk.materials if chunk.materials is not None else ())], np.int32)
-        for key, rows, n in (("material", chunk.material, len(columns["asset"])),
-                             ("mesh_material", chunk.mesh.material, len(columns["mesh_lot"]))):
-            own = lookup[rows] if rows is not None else np.zeros(n, np.int32)
+        for key, own in zip(("material", "mesh_material"), self._materials.add(chunk)):
             columns[key] = np.concatenate([np.zeros(before[key], np.int32), own]) if before[key] else own
 
     def close(self) -> dict:
@@ -264,11 +259,11 @@ class InstanceWriter:
         # Sorted keys: the bytes must not depend on the order in which meta was built.
         meta = json.dumps({**self._meta, "counts": counts, "format": _FORMAT}, sort_keys=True)
         arrays = {"assets": self._assets, "symbols": self._symbols, "meta": np.array(meta)}
-        if self._materials:
-            arrays["materials"] = np.array(list(self._materials), dtype=str).reshape(-1, len(MATERIAL_MAPS))
+        if self._materials is not None:
+            arrays["materials"] = self._materials.table()
         members = {}
         for key in _KEYS:
-            if key in _MATERIAL_KEYS and not self._materials:
+            if key in _MATERIAL_KEYS and self._materials is None:
                 continue
             if key in arrays:
                 array = arrays[key]

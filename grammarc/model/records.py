@@ -16,7 +16,7 @@ import numpy as np
 
 from grammarc.ir.nodes import MATERIAL_MAPS
 
-__all__ = ["WHITE", "MeshChunk", "TerminalChunk"]
+__all__ = ["WHITE", "MaterialTable", "MeshChunk", "TerminalChunk"]
 
 #: Colour of rows that carry none: opaque white (RGBA).
 WHITE = np.array([255, 255, 255, 255], np.uint8)
@@ -153,6 +153,26 @@ class TerminalChunk:
         if self.color is not None:
             return self.color
         return _white(len(self.asset))
+
+
+class MaterialTable:
+    """A record's materials (texture paths per channel of ``MATERIAL_MAPS``) numbered as the writer meets
+    them, row 0 none: what a writer merges its chunks' own tables into."""
+
+    def __init__(self) -> None:
+        self.rows: dict[tuple[str, ...], int] = {("",) * len(MATERIAL_MAPS): 0}
+
+    def add(self, chunk: TerminalChunk) -> tuple[np.ndarray, np.ndarray]:
+        """(n,) and (F,) int32: the rows of the chunk's instances and faces in this table (0 without textures)."""
+        if chunk.materials is None:
+            return np.zeros(len(chunk.asset), np.int32), np.zeros(len(chunk.mesh.lot), np.int32)
+        lookup = np.array([self.rows.setdefault(tuple(map(str, row)), len(self.rows)) for row in chunk.materials],
+                          np.int32)
+        return lookup[chunk.material], lookup[chunk.mesh.material]
+
+    def table(self) -> np.ndarray:
+        """(M, len(MATERIAL_MAPS)) str: the materials in their order."""
+        return np.array(list(self.rows), dtype=str).reshape(-1, len(MATERIAL_MAPS))
 
 
 _WHITE_ROWS = [np.zeros((0, 4), np.uint8)]
