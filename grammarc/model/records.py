@@ -95,13 +95,13 @@ class MeshChunk:
 
 def _joined_materials(chunks: Sequence, material: list, materials: list) -> dict:
     """``material`` and ``materials`` of joined chunks: the tables one after the other, each chunk's rows
-    shifted by the tables before it (a chunk without textures takes the first material of no texture)."""
+    shifted by the tables before it (a chunk without textures gets a table of one material, none)."""
     if all(table is None for table in materials):
         return {}
     blank = np.full((1, len(MATERIAL_MAPS)), "")
     tables = [blank if table is None else table for table in materials]
     bases = np.cumsum([0] + [len(table) for table in tables[:-1]])
-    rows = [np.zeros(len(c.lot), np.int32) if m is None else m + np.int32(base)
+    rows = [np.full(len(c.lot), base, np.int32) if m is None else m + np.int32(base)
             for c, m, base in zip(chunks, material, bases)]
     return {"material": np.concatenate(rows).astype(np.int32), "materials": np.concatenate(tables)}
 
