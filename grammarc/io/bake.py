@@ -1,4 +1,4 @@
-"""Baking an instance record into one triangle mesh, and the mesh writers (.obj, .ply, .stl, .glb).
+"""Baking an instance record into one triangle mesh, and the mesh writers (.obj + .mtl, .ply, .stl, .glb).
 
 A record (README, "The record") holds instances (an asset and the affine map of its unit box) and leaf
 polygons (the mesh table). Baking expands every instance into its asset's triangles (``model.assets``) and
@@ -17,6 +17,12 @@ so ``bake`` also counts the polygons before triangulation, in the mesh's ``metad
 * an instance counts its asset's polygons (``AssetMesh.polygon_sizes``, see ``model.assets``);
 * a face of the mesh table counts each of its rings, outline and holes, as PRT's encoder returns them
   (README of the PRT kit: "a face with holes comes back as its outer ring plus one face per hole ring").
+
+Colours and textures. Every triangle keeps how its instance or face looks: its RGBA colour and its material
+(texture paths, ``model.records.MaterialTable``). The OBJ gets a material library beside it (``city.mtl``:
+a material per look, ``Kd`` and ``d`` from the colour, ``map_Kd`` and the other maps from the textures,
+resolved in the asset roots) and its triangles in a group ``g lot_N`` per lot, a ``usemtl`` run per look;
+the PLY gets vertex colours; the GLB a primitive and material per look, its colour map embedded.
 
 Memory: the baked mesh holds ~60 bytes a triangle (float64 vertices, int64 faces), so ``bake`` counts the
 triangles before it allocates anything and refuses a record beyond ``max_triangles``.
@@ -244,9 +250,10 @@ class BakedWriter(WriterBlock):
     triangles indexing them from the vertices written before), so memory holds one chunk's mesh, not the
     city's (four times the size of the OBJ file when kept whole). PLY, STL and GLB need the whole mesh (counts in
     their headers, one buffer), so their chunks are kept until ``close()``, which bakes and exports them
-    with trimesh. Either way the writer counts the triangles chunks will make as they come and refuses a
-    chunk that would pass ``max_triangles``; the file is renamed onto ``path`` only when complete, so
-    ``abort()`` (or an exception inside ``with``) leaves nothing there.
+    (PLY and STL with trimesh, GLB with ``io.gltf.baked_glb``). Either way the writer counts the
+    triangles chunks will make as they come and refuses a chunk that would pass ``max_triangles``; the
+    file is renamed onto ``path`` only when complete (an OBJ's ``.mtl`` just before it), so ``abort()``
+    (or an exception inside ``with``) leaves nothing there.
 
     Parameters
     ----------

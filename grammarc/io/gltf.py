@@ -5,7 +5,9 @@ the tile's corner (JSON numbers: exact), and under it a node per (asset, colour)
 group's instances in ``EXT_mesh_gpu_instancing``: ``TRANSLATION``, ``ROTATION`` and ``SCALE``
 accessors, float32 relative to the tile. Each asset is one mesh of the file, in its unit box (as
 ``model.assets`` loads it); each colour is a material whose ``baseColorFactor`` is the record's colour
-(converted from sRGB to glTF's linear factors), so colours show in any viewer. A tile with more than
+(converted from sRGB to glTF's linear factors), so colours show in any viewer. Where the record has
+textures, groups are by (asset, material, colour), and a material's colour map (found in the asset
+roots, PNG or JPEG) is embedded as its ``baseColorTexture``. A tile with more than
 ``MAX_GROUPS`` (asset, colour) groups, which a grammar colouring each shape at random makes, groups by
 asset only and draws them white: a node per colour would make the file a node per instance. Normals are
 left out: viewers compute flat normals, which is what the assets' polygons are. The mesh table's
