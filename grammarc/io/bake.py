@@ -360,7 +360,7 @@ class BakedWriter(WriterBlock):
         """(n + F,) int64: how each instance, then each face of the mesh table, looks: its material (a row of
         the writer's ``_materials``) times 2^32 plus its RGBA as a uint32; None where the chunk carries
         neither colours nor textures."""
-        if chunk.color is None and chunk.mesh.color is None and chunk.materials is None:
+        if chunk.color is None and chunk.materials is None:  # (a joined mesh table is white, not None)
             return None
         rgba = np.concatenate([chunk.colors(), chunk.mesh.colors()]).view(np.uint32).reshape(-1).astype(np.int64)
         if chunk.materials is None:
