@@ -345,3 +345,10 @@ def test_a_texture_outside_the_roots_is_not_read(tmp_path):
     textured_city(tmp_path / "inner", TEXTURED.replace("tex/wall.png", "../tex/wall.png"), ".glb", bake=True)
     scene = trimesh.load(tmp_path / "inner" / "city.glb", process=False)
     assert all(g.visual.material.baseColorTexture is None for g in scene.geometry.values())
+
+
+def test_a_bake_without_colours_or_textures_has_no_materials(tmp_path):
+    plain = 'version "2023.0"\nLot --> extrude(6) comp(f){ top : setback(2){ all : Rim. | remainder : Top. } }\n'
+    text = textured_city(tmp_path, plain, ".obj", bake=True).read_text()
+    assert "usemtl" not in text and text.count("g lot_") == 2
+    assert "red" not in textured_city(tmp_path, plain, ".ply", bake=True).read_bytes()[:400].decode("latin-1")
