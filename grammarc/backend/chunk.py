@@ -56,6 +56,10 @@ class Outputs:
     meshes: list = field(default_factory=list)
     #: (n, 4) uint8 colours beside ``asset``, when the grammar sets colours.
     color: list = field(default_factory=list)
+    #: (n, k) int32 texture channel ids beside ``asset`` and (F, k) beside each of ``meshes``, when the
+    #: grammar carries texture channels (``backend.materials``).
+    material: list = field(default_factory=list)
+    mesh_material: list = field(default_factory=list)
     #: ``report`` rows: (lot, key ids, values, kind) per call.
     reports: list = field(default_factory=list)
 

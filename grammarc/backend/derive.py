@@ -19,6 +19,7 @@ from grammarc.backend.context import Context
 from grammarc.backend.evaluate import Env
 from grammarc.backend.execute import apply_pending
 from grammarc.backend.kernels.order import group_by, scatter_rows
+from grammarc.backend.materials import MAP_FIELDS, collect_materials
 from grammarc.backend.occlusion import Occluders
 from grammarc.backend.plan import Plan
 from grammarc.backend.random import lot_keys
@@ -99,7 +100,7 @@ def derive_chunk(plan: Plan, lots: Lots, *, seed: int, limits: Limits, overrides
     if occluders_only:
         return chunk.occluders.table()
     reports = aggregate_chunk(chunk.outputs.reports, chunk.lot_index, list(plan.strings.ids))
-    return collect(chunk), reports
+    return collect(chunk, plan), reports
 
 
 def initial_dynamic(plan: Plan, name: str, chunk: Chunk, shapes: Shapes) -> np.ndarray:
@@ -107,7 +108,7 @@ def initial_dynamic(plan: Plan, name: str, chunk: Chunk, shapes: Shapes) -> np.n
     n = len(shapes)
     if name == COLOR_SLOT:
         return np.full(n, WHITE_RGB)
-    if name == "comp.sel":
+    if name == "comp.sel" or name in MAP_FIELDS:
         return np.full(n, plan.strings.intern(""), dtype=np.int32)
     if name in ("split.total", "comp.total"):
         return np.ones(n)
@@ -122,11 +123,11 @@ def initial_dynamic(plan: Plan, name: str, chunk: Chunk, shapes: Shapes) -> np.n
     return chunk.attrs[name][shapes.lot]
 
 
-def collect(chunk: Chunk) -> TerminalChunk:
+def collect(chunk: Chunk, plan: Plan) -> TerminalChunk:
     """The chunk's records, sorted stably by lot, with lots numbered as in the input.
 
     Rows are scattered straight from the pieces the operations emitted into their sorted places, so each
-    column is copied once.
+    column is copied once. Texture channels become the chunk's table of materials (``backend.materials``).
     """
     out = chunk.outputs
     n_lots = len(chunk.lot_index)
@@ -138,6 +139,8 @@ def collect(chunk: Chunk) -> TerminalChunk:
     names = [("asset", (), np.int32), ("xform", (3, 4), np.float32), ("symbol", (), np.int32)]
     if out.color:
         names.append(("color", (4,), np.uint8))
+    if plan.material_slots:
+        names.append(("material", (len(plan.material_slots),), np.int32))
     for name, row_shape, dtype in names:
         column = np.empty((len(lot), *row_shape), dtype=dtype)
         width = int(np.prod(row_shape))
@@ -150,16 +153,23 @@ def collect(chunk: Chunk) -> TerminalChunk:
         columns[name] = column
     index = chunk.lot_index.astype(np.int32)
     mesh = MeshChunk.concat(out.meshes) if out.meshes else MeshChunk.empty()
+    face_order = np.argsort(mesh.lot, kind="stable")
     if len(mesh.lot):
-        mesh = _sort_mesh(mesh)
+        mesh = _sort_mesh(mesh, face_order)
+    material = materials = mesh_material = None
+    if plan.material_slots:
+        width = len(plan.material_slots)
+        faces = np.concatenate(out.mesh_material)[face_order] if out.mesh_material else np.zeros((0, width), np.int32)
+        materials, both = collect_materials(plan, np.concatenate([columns["material"], faces]))
+        material, mesh_material = both[:len(lot)], both[len(lot):]
     mesh = MeshChunk(mesh.vertices, mesh.ring_offsets, mesh.face_offsets, index[mesh.lot], mesh.symbol,
-                     mesh.color)
+                     mesh.color, mesh_material, materials)
     return TerminalChunk(asset=columns["asset"], xform=columns["xform"], lot=index[lot[order]],
-                         symbol=columns["symbol"], mesh=mesh, color=columns.get("color"))
+                         symbol=columns["symbol"], mesh=mesh, color=columns.get("color"), material=material,
+                         materials=materials)
 
 
-def _sort_mesh(mesh: MeshChunk) -> MeshChunk:
-    order = np.argsort(mesh.lot, kind="stable")
+def _sort_mesh(mesh: MeshChunk, order: np.ndarray) -> MeshChunk:
     rings, face_offsets = ragged_take(mesh.face_offsets, order)
     vertices, ring_offsets = ragged_take(mesh.ring_offsets, rings)
     return MeshChunk(mesh.vertices[vertices], ring_offsets, face_offsets, mesh.lot[order],

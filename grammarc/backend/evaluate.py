@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from grammarc.backend import arrays, euler, occlusion
+from grammarc.backend import arrays, euler, materials, occlusion
 from grammarc.backend.arrays import Arrays
 from grammarc.backend.env import Env
 from grammarc.backend.functions import FUNCTIONS
@@ -37,6 +37,9 @@ def evaluate(expr: ir.Expr, env: Env):
         column = env.chunk.attrs[expr.name]
         return column.take(env.shapes.lot) if isinstance(column, Arrays) else column[env.shapes.lot]
     if isinstance(expr, ir.ContextRef):
+        if expr.name in materials.COLOR_FIELDS:
+            slot = env.plan.color_slot
+            return materials.channel(expr.name, env.shapes.dynamic[slot] if slot is not None else None)
         return env.shapes.dynamic[env.plan.dynamic[expr.name]]
     if isinstance(expr, ir.Occlusion):
         distance, which, named = (None if e is None else evaluate(e, env) for e in (expr.distance, expr.which, expr.named))

@@ -297,8 +297,8 @@ def _add_polygons(chunk: Chunk, normalized, ring_offsets, face_offsets, faces, p
     return chunk.polygons.add(uv, polygon_rings, poly_offsets, plane)
 
 
-def mesh_leaves(chunk: Chunk, shapes: Shapes, symbol: int, colors) -> MeshChunk:
-    """The faces of leaf mesh shapes in world coordinates."""
+def mesh_leaves(chunk: Chunk, shapes: Shapes, symbol: int, colors) -> tuple[MeshChunk, np.ndarray]:
+    """The faces of leaf mesh shapes in world coordinates, and the shape each face comes from."""
     verts, ring_offsets, face_offsets, mesh_offsets, vertex_shape = face_vertices(
         chunk.meshes, shapes.geom - MESH_BASE, shapes.size)
     axes = chunk.frames[shapes.frame][vertex_shape]
@@ -309,4 +309,4 @@ def mesh_leaves(chunk: Chunk, shapes: Shapes, symbol: int, colors) -> MeshChunk:
     return MeshChunk(
         vertices=world.astype(np.float32), ring_offsets=ring_offsets, face_offsets=face_offsets,
         lot=shapes.lot[face_shape].astype(np.int32), symbol=np.full(len(face_shape), symbol, dtype=np.int32),
-        color=colors[face_shape] if colors is not None else None)
+        color=colors[face_shape] if colors is not None else None), face_shape

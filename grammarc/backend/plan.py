@@ -9,6 +9,7 @@ from collections.abc import Callable
 from dataclasses import dataclass, field, replace
 
 from grammarc.backend.leaf_parts import leaf_inserts
+from grammarc.backend.materials import COLOR_FIELDS, MAP_FIELDS
 from grammarc.backend.slots import (
     ANCESTORS,
     COLOR_SLOT,
@@ -84,6 +85,9 @@ class Plan:
     #: the grammar needs none: the colour (else no colours are recorded and the rows are white), the first
     #: of the trim planes (when inserted geometry is trimmed) and ``trim.vertical`` (when the grammar sets it).
     color_slot: int | None = None
+    #: The texture channels the grammar sets or reads: (index into ``ir.MATERIAL_MAPS``, index into
+    #: ``Shapes.dynamic``) each (``backend.materials``).
+    material_slots: tuple[tuple[int, int], ...] = ()
     trim_slot: int | None = None
     trim_switch: int | None = None
     #: the first of the horizontal trim planes and ``trim.horizontal``, when the grammar turns them on.
@@ -119,8 +123,9 @@ def make_plan(grammar: Grammar, *, load_asset: Callable = load_asset) -> Plan:
             strings.intern(expr.value)
     stages = tuple(sorted({s.priority for s in symbols if s.rules}))
     ops = iter_ops(module)
-    context = [e.name for e in all_exprs(module) if isinstance(e, ir.ContextRef)]
-    colour = [COLOR_SLOT] if any(isinstance(op, ir.SetColor) for op in ops) else []
+    # the colour's components and the opacity are read from the colour column (``backend.materials``)
+    context = [e.name for e in all_exprs(module) if isinstance(e, ir.ContextRef) and e.name not in COLOR_FIELDS]
+    colour = [COLOR_SLOT] if any(isinstance(op, (ir.SetColor, ir.SetOpacity)) for op in ops) else []
     # CityEngine trims inserted geometry at the planes a comp(f) leaves between neighbouring faces
     trims = list(TRIM_SLOTS) if module.dialect == "cityengine" and any(
         isinstance(op, ir.CompFaces) and op.kind == "f" for op in ops) and any(
@@ -156,6 +161,7 @@ def make_plan(grammar: Grammar, *, load_asset: Callable = load_asset) -> Plan:
         snapping=frozenset(s.id for s in symbols if any(getattr(op, "snap", False) for rule in s.rules
                                                         for op in iter_ops(rule))),
         color_slot=dynamic.get(COLOR_SLOT), trim_slot=trim_slot,
+        material_slots=tuple((k, dynamic[name]) for k, name in enumerate(MAP_FIELDS) if name in dynamic),
         trim_switch=dynamic.get(TRIM_SWITCH) if trim_slot is not None else None,
         horizontal_slot=dynamic.get(HORIZONTAL_SLOTS[0]), horizontal_switch=dynamic.get(HORIZONTAL_SWITCH),
         occluders=ANCESTORS[0] in dynamic, load_asset=load_asset)

@@ -20,6 +20,7 @@ import numpy as np
 
 from grammarc.backend.context import Context
 from grammarc.backend.kernels.scope import xforms
+from grammarc.backend.materials import material_ids, rgba
 from grammarc.backend.mesh_shapes import mesh_leaves
 from grammarc.backend.shapes import Z_UP, Shapes, asset_of, face_axes
 from grammarc.backend.slots import HORIZONTAL_SLOTS
@@ -62,8 +63,9 @@ def emit_instances(ctx: Context, shapes: Shapes, asset: int, symbol: int, mirror
         cut = boxes_crossing(planes, xform.astype(np.float64), TOL.zero)
         mesh = ctx.asset_mesh(asset) if cut.any() else None
         if mesh is not None:
-            trimmed = _trimmed(ctx.plan, shapes.take(cut), xform[cut], planes[cut], mesh, symbol)
-            chunk.outputs.meshes.append(trimmed)
+            crossing = shapes.take(cut)
+            trimmed, owner = _trimmed(ctx.plan, crossing, xform[cut], planes[cut], mesh, symbol)
+            append_mesh(ctx, trimmed, crossing, owner)
             shapes, xform = shapes.take(~cut), xform[~cut]
     _append(ctx, shapes, xform, asset, symbol)
 
@@ -93,15 +95,17 @@ def trim_planes(plan, shapes: Shapes) -> np.ndarray:
     return np.concatenate([planes, shallow], axis=1)
 
 
-def _trimmed(plan, shapes: Shapes, xform: np.ndarray, planes: np.ndarray, mesh, symbol: int) -> MeshChunk:
-    """The asset's triangles placed by ``xform`` and cut by the shapes' trim ``planes``, as mesh faces."""
+def _trimmed(plan, shapes: Shapes, xform: np.ndarray, planes: np.ndarray, mesh,
+             symbol: int) -> tuple[MeshChunk, np.ndarray]:
+    """The asset's triangles placed by ``xform`` and cut by the shapes' trim ``planes``, as mesh faces, and
+    the row of ``shapes`` each face comes from."""
     vertices, ring_offsets, owner = trim_triangles(mesh.vertices, mesh.faces, xform.astype(np.float64),
                                                    planes, TOL.zero)
     return MeshChunk(
         vertices=vertices.astype(np.float32), ring_offsets=ring_offsets,
         face_offsets=np.arange(len(owner) + 1, dtype=np.int64), lot=shapes.lot[owner].astype(np.int32),
         symbol=np.full(len(owner), symbol, dtype=np.int32),
-        color=_colors(plan, shapes, owner))
+        color=_colors(plan, shapes, owner)), owner
 
 
 def _colors(plan, shapes: Shapes, rows=slice(None)) -> np.ndarray | None:
@@ -109,15 +113,25 @@ def _colors(plan, shapes: Shapes, rows=slice(None)) -> np.ndarray | None:
     return rgba(shapes.dynamic[plan.color_slot][rows]) if plan.color_slot is not None else None
 
 
+def append_mesh(ctx: Context, mesh: MeshChunk, shapes: Shapes, rows=slice(None)) -> None:
+    """Add leaf faces, made of ``shapes`` rows ``rows`` face by face, with their texture channels where the
+    grammar carries them (``backend.materials``)."""
+    out = ctx.chunk.outputs
+    out.meshes.append(mesh)
+    if ctx.plan.material_slots:
+        out.mesh_material.append(material_ids(ctx.plan, shapes, rows))
+
+
 def _append(ctx: Context, shapes: Shapes, xform: np.ndarray, asset: int, symbol: int) -> None:
     color_slot = ctx.plan.color_slot
     append_records(ctx, xform, shapes.lot, asset, symbol,
-                   shapes.dynamic[color_slot] if color_slot is not None else None)
+                   shapes.dynamic[color_slot] if color_slot is not None else None, material_ids(ctx.plan, shapes))
 
 
 def append_records(ctx: Context, xform: np.ndarray, lot: np.ndarray, asset: int, symbol: int,
-                   color: np.ndarray | None) -> None:
-    """Add instance records: transforms, lots, and colours (0xRRGGBB floats) where the grammar sets them."""
+                   color: np.ndarray | None, material: np.ndarray | None = None) -> None:
+    """Add instance records: transforms, lots, and colours (packed floats) and texture channels (string ids
+    (n, k)) where the grammar sets them (``backend.materials``)."""
     out = ctx.chunk.outputs
     out.xform.append(xform)
     out.asset.append(np.full(len(lot), asset, dtype=np.int32))
@@ -125,13 +139,8 @@ def append_records(ctx: Context, xform: np.ndarray, lot: np.ndarray, asset: int,
     out.symbol.append(np.full(len(lot), symbol, dtype=np.int32))
     if ctx.plan.color_slot is not None:
         out.color.append(rgba(color))
-
-
-def rgba(packed: np.ndarray) -> np.ndarray:
-    """(n, 4) uint8 opaque colours from 0xRRGGBB values (n,) stored as floats."""
-    value = packed.astype(np.int64)
-    return np.stack([value >> 16 & 255, value >> 8 & 255, value & 255, np.full_like(value, 255)],
-                    axis=1).astype(np.uint8)
+    if material is not None:
+        out.material.append(material)
 
 
 def emit_leaves(ctx: Context, shapes: Shapes, symbol: int) -> None:
@@ -157,14 +166,17 @@ def emit_leaves(ctx: Context, shapes: Shapes, symbol: int) -> None:
         _append(ctx, quads, instance_xform(permuted_axes, permuted_size, quads.origin), QUAD, symbol)
     polygons = shapes.take(is_polygon(shapes.geom))
     if len(polygons):
-        chunk.outputs.meshes.append(polygon_meshes(ctx, polygons, symbol))
+        faces, owner = polygon_meshes(ctx, polygons, symbol)
+        append_mesh(ctx, faces, polygons, owner)
     meshes = shapes.take(is_mesh(shapes.geom))
     if len(meshes):
-        chunk.outputs.meshes.append(mesh_leaves(chunk, meshes, symbol, _colors(ctx.plan, meshes)))
+        faces, owner = mesh_leaves(chunk, meshes, symbol, _colors(ctx.plan, meshes))
+        append_mesh(ctx, faces, meshes, owner)
 
 
-def polygon_meshes(ctx: Context, shapes: Shapes, symbol: int) -> MeshChunk:
-    """Faces of polygon shapes in world coordinates: the polygon, or a prism's bottom, top and sides."""
+def polygon_meshes(ctx: Context, shapes: Shapes, symbol: int) -> tuple[MeshChunk, np.ndarray]:
+    """Faces of polygon shapes in world coordinates: the polygon, or a prism's bottom, top and sides; and
+    the shape each face comes from."""
     chunk = ctx.chunk
     coords, ring_offsets, poly_offsets = chunk.polygons.gather(shapes.geom)
     plane = chunk.polygons.plane[shapes.geom]
@@ -216,7 +228,7 @@ def polygon_meshes(ctx: Context, shapes: Shapes, symbol: int) -> MeshChunk:
         lot=shapes.lot[face_owner].astype(np.int32),
         symbol=np.full(len(face_owner), symbol, dtype=np.int32),
         color=_colors(ctx.plan, shapes, face_owner),
-    )
+    ), face_owner
 
 
 def _reversed_order(ring_offsets: np.ndarray) -> np.ndarray:

@@ -1,4 +1,4 @@
-"""Baking an instance record into one triangle mesh, and the mesh writers (.obj, .ply, .stl, .glb).
+"""Baking an instance record into one triangle mesh, and the mesh writers (.obj + .mtl, .ply, .stl, .glb).
 
 A record (README, "The record") holds instances (an asset and the affine map of its unit box) and leaf
 polygons (the mesh table). Baking expands every instance into its asset's triangles (``model.assets``) and
@@ -17,6 +17,12 @@ so ``bake`` also counts the polygons before triangulation, in the mesh's ``metad
 * an instance counts its asset's polygons (``AssetMesh.polygon_sizes``, see ``model.assets``);
 * a face of the mesh table counts each of its rings, outline and holes, as PRT's encoder returns them
   (README of the PRT kit: "a face with holes comes back as its outer ring plus one face per hole ring").
+
+Colours and textures. Every triangle keeps how its instance or face looks: its RGBA colour and its material
+(texture paths, ``model.records.MaterialTable``). The OBJ gets a material library beside it (``city.mtl``:
+a material per look, ``Kd`` and ``d`` from the colour, ``map_Kd`` and the other maps from the textures,
+resolved in the asset roots) and its triangles in a group ``g lot_N`` per lot, a ``usemtl`` run per look;
+the PLY gets vertex colours; the GLB a primitive and material per look, its colour map embedded.
 
 Memory: the baked mesh holds ~60 bytes a triangle (float64 vertices, int64 faces), so ``bake`` counts the
 triangles before it allocates anything and refuses a record beyond ``max_triangles``.
@@ -37,10 +43,13 @@ from grammarc.constants import LIMITS
 from grammarc.errors import UsageError
 from grammarc.geometry.triangulation import triangulate_polygons
 from grammarc.io import WriterBlock
-from grammarc.io.obj import obj_bytes
+from grammarc.io.gltf import baked_glb
+from grammarc.io.obj import obj_bytes, with_lines
+from grammarc.ir.asset_names import locate
+from grammarc.ir.nodes import MATERIAL_MAPS
 from grammarc.model.assets import AssetLibrary, AssetMesh, asset_library
-from grammarc.model.records import MeshChunk, TerminalChunk
-from grammarc.ragged import offsets_from_counts
+from grammarc.model.records import MaterialTable, MeshChunk, TerminalChunk
+from grammarc.ragged import offsets_from_counts, segment_of
 
 __all__ = ["MAX_TRIANGLES", "WRITERS", "BakedWriter", "bake", "count_triangles"]
 
@@ -109,11 +118,12 @@ def bake(
     (12, 52.0, [[1.0, 0.0, 0.0], [3.0, 3.0, 4.0]])
     """
     names, asset, xform, mesh = _columns(record)
-    return _bake(asset_library(names, record, asset_roots), asset, xform, mesh, max_triangles)
+    return _bake(asset_library(names, record, asset_roots), asset, xform, mesh, max_triangles)[0]
 
 
 def _bake(library: AssetLibrary, asset: np.ndarray, xform: np.ndarray, mesh: MeshChunk, max_triangles: int):
-    """``bake`` of a record's columns, its assets in ``library``."""
+    """``bake`` of a record's columns, its assets in ``library``; and the source of each triangle (T,) int64:
+    its instance's row, or ``len(asset)`` plus its face in the mesh table."""
     import trimesh
 
     used = np.bincount(asset, minlength=len(library.names)).astype(np.int64)
@@ -128,6 +138,7 @@ def _bake(library: AssetLibrary, asset: np.ndarray, xform: np.ndarray, mesh: Mes
     n_vertices = sum(int(used[a]) * len(library[a].vertices) for a in assets) + len(mesh.vertices)
     vertices = np.empty((n_vertices, 3), np.float64)
     faces = np.empty((n_triangles, 3), np.int64)
+    source = np.empty(n_triangles, np.int64)
     face_sizes = np.zeros(1, np.int64)
     n_polygons = 0
     v0 = t0 = 0
@@ -136,13 +147,17 @@ def _bake(library: AssetLibrary, asset: np.ndarray, xform: np.ndarray, mesh: Mes
     for a in assets:
         shape = library[a]
         rows = order[starts[a] : starts[a + 1]]
+        first = t0
         v0, t0 = _expand(shape, xform, rows, vertices, faces, v0, t0)
+        source[first:t0] = np.repeat(rows, (t0 - first) // max(len(rows), 1))
         face_sizes = _add_counts(face_sizes, shape.polygon_sizes, int(used[a]))
         n_polygons += int(used[a]) * shape.n_polygons
     if len(mesh.face_offsets) > 1:
         vertices[v0:] = mesh.vertices
         triangles = triangulate_polygons(mesh.vertices, mesh.ring_offsets, mesh.face_offsets)
         faces[t0 : t0 + len(triangles)] = triangles + v0
+        vertex_face = segment_of(mesh.face_offsets)[segment_of(mesh.ring_offsets)]
+        source[t0 : t0 + len(triangles)] = len(asset) + vertex_face[triangles[:, 0]]
         t0 += len(triangles)
         ring_sizes = np.diff(mesh.ring_offsets)
         face_sizes = _add_counts(face_sizes, ring_sizes, 1)
@@ -155,7 +170,7 @@ def _bake(library: AssetLibrary, asset: np.ndarray, xform: np.ndarray, mesh: Mes
         "n_holes": int(len(mesh.ring_offsets) - 1 - n_faces),
         "face_sizes": {int(k): int(c) for k, c in enumerate(face_sizes) if c},
     }
-    return trimesh.Trimesh(vertices=vertices, faces=faces[:t0], process=False, metadata=metadata)
+    return trimesh.Trimesh(vertices=vertices, faces=faces[:t0], process=False, metadata=metadata), source[:t0]
 
 
 def _expand(shape: AssetMesh, xform: np.ndarray, rows: np.ndarray, vertices: np.ndarray,
@@ -235,9 +250,10 @@ class BakedWriter(WriterBlock):
     triangles indexing them from the vertices written before), so memory holds one chunk's mesh, not the
     city's (four times the size of the OBJ file when kept whole). PLY, STL and GLB need the whole mesh (counts in
     their headers, one buffer), so their chunks are kept until ``close()``, which bakes and exports them
-    with trimesh. Either way the writer counts the triangles chunks will make as they come and refuses a
-    chunk that would pass ``max_triangles``; the file is renamed onto ``path`` only when complete, so
-    ``abort()`` (or an exception inside ``with``) leaves nothing there.
+    (PLY and STL with trimesh, GLB with ``io.gltf.baked_glb``). Either way the writer counts the
+    triangles chunks will make as they come and refuses a chunk that would pass ``max_triangles``; the
+    file is renamed onto ``path`` only when complete (an OBJ's ``.mtl`` just before it), so ``abort()``
+    (or an exception inside ``with``) leaves nothing there.
 
     Parameters
     ----------
@@ -280,7 +296,10 @@ class BakedWriter(WriterBlock):
         if max_triangles is None:
             max_triangles = int(os.environ.get("GRAMMARC_MAX_TRIANGLES", MAX_TRIANGLES))
         self.max_triangles = max_triangles
-        self._chunks: list[tuple[np.ndarray, np.ndarray, MeshChunk]] = []
+        self._chunks: list[tuple[np.ndarray, np.ndarray, MeshChunk, np.ndarray | None]] = []
+        #: The record's materials, and the looks (``_looks``) met so far, each an OBJ material.
+        self._materials = MaterialTable()
+        self._look_ids: dict[int, int] = {}
         self._triangles = 0
         self._rows = 0
         self._state = "open"
@@ -291,7 +310,7 @@ class BakedWriter(WriterBlock):
         if self._file_type == "obj":
             self._open_file()
             header = f"grammarc {self._meta.get('grammarc', '')} bake of {self._meta.get('grammar', '')}"
-            self._file.write(f"# {' '.join(header.split())}\n".encode())
+            self._file.write(f"# {' '.join(header.split())}\nmtllib {self._mtl_path.name}\n".encode())
 
     def write(self, chunk: TerminalChunk) -> None:
         """Bake a chunk into the OBJ, or keep it for ``close()`` (not copied: do not modify it).
@@ -323,18 +342,66 @@ class BakedWriter(WriterBlock):
                     "(GRAMMARC_MAX_TRIANGLES=N), bake a few lots with --select, or write an instance "
                     "record (.npz) or instanced .glb/.usdc instead"
                 )
+            looks = self._looks(chunk)
             if self._file is not None:
-                mesh = _bake(self._library, asset.astype(np.int64, copy=False), xform, chunk.mesh,
-                             self.max_triangles)
-                self._file.write(obj_bytes(mesh.vertices, mesh.faces + self._made["vertices"]))
+                mesh, source = _bake(self._library, asset.astype(np.int64, copy=False), xform, chunk.mesh,
+                                     self.max_triangles)
+                self._file.write(self._obj_groups(mesh, source, np.concatenate([chunk.lot, chunk.mesh.lot]), looks))
                 self._count(mesh, chunk.mesh)
             else:
-                self._chunks.append((asset, xform, chunk.mesh))
+                self._chunks.append((asset, xform, chunk.mesh, looks))
         except BaseException:
             self.abort()
             raise
         self._triangles += triangles
         self._rows += len(asset)
+
+    def _looks(self, chunk: TerminalChunk) -> np.ndarray | None:
+        """(n + F,) int64: how each instance, then each face of the mesh table, looks: its material (a row of
+        the writer's ``_materials``) times 2^32 plus its RGBA as a uint32; None where the chunk carries
+        neither colours nor textures."""
+        if chunk.color is None and chunk.materials is None:  # (a joined mesh table is white, not None)
+            return None
+        rgba = np.concatenate([chunk.colors(), chunk.mesh.colors()]).view(np.uint32).reshape(-1).astype(np.int64)
+        if chunk.materials is None:
+            return rgba
+        return np.concatenate(self._materials.add(chunk)).astype(np.int64) << 32 | rgba
+
+    def _look(self, look: int) -> int:
+        """The OBJ material of a look, numbered as met."""
+        return self._look_ids.setdefault(look, len(self._look_ids))
+
+    def _obj_groups(self, mesh, source: np.ndarray, lot: np.ndarray, looks: np.ndarray | None) -> bytes:
+        """A chunk's vertices and triangles as OBJ, the triangles in a group ``g lot_N`` per lot (the input's
+        number), each lot's in one ``usemtl`` run per look when the chunk has colours or textures."""
+        lot = lot[source]
+        look = looks[source] if looks is not None else np.zeros(len(source), np.int64)
+        order = np.lexsort((look, lot))
+        lot, look = lot[order], look[order]
+        new_lot = np.ones(len(lot), bool)
+        new_lot[1:] = lot[1:] != lot[:-1]
+        starts = np.flatnonzero(new_lot | np.r_[True, look[1:] != look[:-1]])
+        lines = [(f"g lot_{lot[k]}\n" if new_lot[k] else "")
+                 + (f"usemtl m{self._look(int(look[k]))}\n" if looks is not None else "") for k in starts.tolist()]
+        faces = obj_bytes(np.zeros((0, 3)), mesh.faces[order] + self._made["vertices"])
+        return obj_bytes(mesh.vertices, np.zeros((0, 3), np.int64)) + with_lines(faces, starts, lines)
+
+    def _mtl(self) -> bytes:
+        """The OBJ's material library: per look its colour (``Kd``, ``d``) and texture maps, the paths
+        resolved in the asset roots and given relative to the OBJ (as written where no root holds them)."""
+        materials = self._materials.table()
+        lines = [f"# {len(self._look_ids)} materials of {self.path.name}"]
+        for look, k in self._look_ids.items():
+            rgba = np.array([look & 0xFFFFFFFF], np.uint32).view(np.uint8) / 255.0
+            lines += [f"newmtl m{k}", "Kd {:.6g} {:.6g} {:.6g}".format(*rgba[:3]), f"d {rgba[3]:.6g}"]
+            for channel, path in zip(MATERIAL_MAPS, materials[look >> 32]):
+                if path and channel in MTL_MAPS:
+                    lines.append(f"{MTL_MAPS[channel]} {self._texture_path(path)}")
+        return ("\n".join(lines) + "\n").encode()
+
+    def _texture_path(self, name: str) -> str:
+        found = locate(name, self._library.roots)
+        return os.path.relpath(found[1], self.path.parent.resolve()) if found else name
 
     def _count(self, mesh, table: MeshChunk) -> None:
         made = self._made
@@ -364,16 +431,22 @@ class BakedWriter(WriterBlock):
                 mesh_table = MeshChunk.concat([c[2] for c in chunks])
                 asset = np.concatenate([c[0] for c in chunks]) if chunks else np.zeros(0, np.int64)
                 xform = np.concatenate([c[1] for c in chunks]) if chunks else np.zeros((0, 3, 4), np.float32)
+                looks = _joined_looks(chunks)
                 del chunks
-                mesh = _bake(self._library, asset.astype(np.int64, copy=False), xform, mesh_table,
-                             self.max_triangles)
+                mesh, source = _bake(self._library, asset.astype(np.int64, copy=False), xform, mesh_table,
+                                     self.max_triangles)
                 del asset, xform
                 self._count(mesh, mesh_table)
-                self._file.write(self._export(mesh))
+                self._file.write(self._export(mesh, looks[source] if looks is not None else None))
                 del mesh
             self._file.flush()
             os.fsync(self._file.fileno())
             self._file.close()
+            if self._file_type == "obj":
+                staged = os.path.join(self._tmpdir, self._mtl_path.name)
+                with open(staged, "wb") as mtl:
+                    mtl.write(self._mtl())
+                os.replace(staged, self._mtl_path)
             os.replace(os.path.join(self._tmpdir, self.path.name), self.path)
         except BaseException:
             self.abort()
@@ -399,12 +472,42 @@ class BakedWriter(WriterBlock):
         self._tmpdir = tempfile.mkdtemp(prefix=f".{self.path.name}.tmp", dir=self.path.parent)
         self._file = open(os.path.join(self._tmpdir, self.path.name), "xb")  # noqa: SIM115 - closed by close/abort
 
-    def _export(self, mesh) -> bytes:
-        """The bytes of a PLY or STL (binary), or a GLB as trimesh writes a scene of one mesh."""
-        mesh.metadata = {}  # glb writes metadata as extras; keep the file to geometry
+    @property
+    def _mtl_path(self) -> Path:
+        """The OBJ's material library, beside it: ``city.obj`` -> ``city.mtl``."""
+        return self.path.with_suffix(".mtl")
+
+    def _export(self, mesh, looks: np.ndarray | None) -> bytes:
+        """The bytes of a PLY (with vertex colours where the record has colours) or STL (binary), or a GLB
+        with a material per look (``io.gltf.baked_glb``); ``looks`` (T,) int64 per triangle (``_looks``)."""
+        if self._file_type == "glb":
+            materials = self._materials.table()
+            return baked_glb(mesh.vertices, mesh.faces, looks, materials, self._library.roots, self._meta)
+        if self._file_type == "ply" and looks is not None:
+            colors = np.full((len(mesh.vertices), 4), 255, np.uint8)
+            rgba = (looks & 0xFFFFFFFF).astype(np.uint32).view(np.uint8).reshape(-1, 4)
+            colors[mesh.faces.reshape(-1)] = np.repeat(rgba, 3, axis=0)
+            mesh.visual.vertex_colors = colors
+        mesh.metadata = {}
         data = mesh.export(file_type=self._file_type)
         return data if isinstance(data, bytes) else data.encode("utf-8")
 
+
+def _joined_looks(chunks: list) -> np.ndarray | None:
+    """The looks of kept chunks (``BakedWriter._looks``), instances then faces as ``MeshChunk.concat`` and
+    ``_bake`` order them; white without texture for chunks without any; None when no chunk has any."""
+    if all(c[3] is None for c in chunks):
+        return None
+    white = np.int64(0xFFFFFFFF)
+    looks = [np.full(len(a) + len(m.lot), white) if lk is None else lk for a, _, m, lk in chunks]
+    counts = [len(a) for a, _, _, _ in chunks]
+    return np.concatenate([lk[:n] for lk, n in zip(looks, counts)] + [lk[n:] for lk, n in zip(looks, counts)])
+
+
+#: The OBJ material statement of each texture channel that MTL has (``norm``, ``map_Pr``, ``map_Pm`` and
+#: ``map_Ke`` are the PBR extension of MTL that Blender and others read).
+MTL_MAPS = {"colormap": "map_Kd", "bumpmap": "map_bump", "specularmap": "map_Ks", "opacitymap": "map_d",
+            "normalmap": "norm", "emissivemap": "map_Ke", "roughnessmap": "map_Pr", "metallicmap": "map_Pm"}
 
 #: The extensions this module writes (``grammarc.io.writers``): all baked.
 WRITERS = dict.fromkeys(BakedWriter.FORMATS, BakedWriter)

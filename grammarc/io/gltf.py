@@ -5,7 +5,9 @@ the tile's corner (JSON numbers: exact), and under it a node per (asset, colour)
 group's instances in ``EXT_mesh_gpu_instancing``: ``TRANSLATION``, ``ROTATION`` and ``SCALE``
 accessors, float32 relative to the tile. Each asset is one mesh of the file, in its unit box (as
 ``model.assets`` loads it); each colour is a material whose ``baseColorFactor`` is the record's colour
-(converted from sRGB to glTF's linear factors), so colours show in any viewer. A tile with more than
+(converted from sRGB to glTF's linear factors), so colours show in any viewer. Where the record has
+textures, groups are by (asset, material, colour), and a material's colour map (found in the asset
+roots, PNG or JPEG) is embedded as its ``baseColorTexture``. A tile with more than
 ``MAX_GROUPS`` (asset, colour) groups, which a grammar colouring each shape at random makes, groups by
 asset only and draws them white: a node per colour would make the file a node per instance. Normals are
 left out: viewers compute flat normals, which is what the assets' polygons are. The mesh table's
@@ -27,6 +29,7 @@ import json
 import os
 import shutil
 import struct
+import tempfile
 from collections.abc import Sequence
 from pathlib import Path
 
@@ -34,9 +37,10 @@ import numpy as np
 
 from grammarc.errors import UsageError
 from grammarc.io.instancing import TILE_SIZE, Tile, TiledWriter, compose, decompose
+from grammarc.ir.asset_names import locate
 
 __all__ = [
-    "MAX_BYTES", "MAX_GROUPS", "WRITERS", "GltfWriter", "index_path", "part_paths", "read_glb", "written_parts",
+    "MAX_BYTES", "MAX_GROUPS", "WRITERS", "GltfWriter", "baked_glb", "index_path", "part_paths", "read_glb", "written_parts",
 ]
 
 #: GLB's 32-bit length fields, less room for the JSON chunk.
@@ -47,6 +51,8 @@ _EXTENSION = "EXT_mesh_gpu_instancing"
 _FLOAT, _UINT, _UBYTE = 5126, 5125, 5121
 _ARRAY_BUFFER, _ELEMENT_ARRAY_BUFFER = 34962, 34963
 _WHITE = (255, 255, 255, 255)
+#: The image formats glTF's core takes for textures, by file ending.
+_IMAGE_TYPES = {".png": "image/png", ".jpg": "image/jpeg", ".jpeg": "image/jpeg"}
 
 
 def index_path(path: str | os.PathLike) -> Path:
@@ -98,10 +104,10 @@ class GltfWriter(TiledWriter):
 
     def _finish(self) -> dict:
         """The parts (``parts`` in the counts), the index when there are several."""
-        parts = [_Part(self._tmp / "part0.bin", self._library, self._meta)]
+        parts = [_Part(self._tmp / "part0.bin", self._library, self._meta, self._colormap)]
         for tile in self._spool.tiles():
             if not parts[-1].add_tile(tile, self.max_bytes):
-                parts.append(_Part(self._tmp / f"part{len(parts)}.bin", self._library, self._meta))
+                parts.append(_Part(self._tmp / f"part{len(parts)}.bin", self._library, self._meta, self._colormap))
                 if not parts[-1].add_tile(tile, self.max_bytes):
                     raise UsageError(f"{self.path}: tile {tile.name} alone passes {self.max_bytes:,} bytes; "
                                      "give a smaller --tile-size")
@@ -126,8 +132,10 @@ WRITERS = {".glb": GltfWriter}
 class _Part:
     """One GLB file being built: its JSON lists and its binary chunk in a temporary file."""
 
-    def __init__(self, binary: Path, library, meta: dict):
+    def __init__(self, binary: Path, library, meta: dict, colormap=lambda material: None):
         self.library = library
+        #: material (a row of the writer's materials) -> its colour map file, or None
+        self.colormap = colormap
         self.binary = open(binary, "w+b")  # noqa: SIM115 - closed by finish(), or with the temporary folder
         self.size = 0
         self.instances = 0
@@ -141,12 +149,13 @@ class _Part:
         }
         self._assets: dict[int, tuple[int, int]] = {}  # asset -> (POSITION accessor, indices accessor)
         self._meshes: dict[tuple[int, int], int] = {}  # (asset, material) -> mesh
-        self._materials: dict[tuple[int, ...], int] = {}  # RGBA -> material
+        self._materials: dict[tuple, int] = {}  # (RGBA, translucent, colour map) -> material
+        self._textures: dict[Path, int | None] = {}  # image file -> texture (None: not an image glTF takes)
 
     def add_tile(self, tile: Tile, max_bytes: int) -> bool:
         """Add a tile's nodes, unless it would take the part past ``max_bytes`` (a part keeps at least
         one tile when it can): returns whether it was added."""
-        groups = _groups(tile.instances)
+        groups = _groups(tile.instances, tile.instance_material)
         new_assets = {int(group[0]) for group in groups} - set(self._assets)
         need = (tile.instances.size * 40 + tile.triangles.size * 3 * 16
                 + sum(self.library[a].vertices.size * 4 + self.library[a].faces.size * 4 + 8
@@ -157,10 +166,10 @@ class _Part:
         rows = tile.instances
         if len(rows):
             positions, orientations, scales = decompose(rows["xform"], tile.origin)
-            for asset, color, members in groups:
+            for asset, color, material, members in groups:
                 nodes.append({
                     "name": self.library.names[asset],
-                    "mesh": self._mesh(asset, color),
+                    "mesh": self._mesh(asset, color, self.colormap(material)),
                     "extensions": {_EXTENSION: {"attributes": {
                         "TRANSLATION": self._accessor(positions[members], "VEC3"),
                         "ROTATION": self._accessor(orientations[members], "VEC4"),
@@ -226,23 +235,39 @@ class _Part:
         self.json["accessors"].append(accessor)
         return len(self.json["accessors"]) - 1
 
-    def _material(self, rgba: tuple[int, ...], translucent: bool = False) -> int:
-        """The material of a colour; ``translucent``: its vertex colours have alpha below 1."""
-        key = (*rgba, translucent)
+    def _material(self, rgba: tuple[int, ...], translucent: bool = False, colormap: Path | None = None) -> int:
+        """The material of a colour; ``translucent``: its vertex colours have alpha below 1; ``colormap``:
+        the image file of its ``baseColorTexture`` (left out when it is neither PNG nor JPEG)."""
+        key = (*rgba, translucent, colormap)
         if key not in self._materials:
             srgb = np.array(rgba[:3], float) / 255.0
             linear = np.where(srgb <= 0.04045, srgb / 12.92, ((srgb + 0.055) / 1.055) ** 2.4)
             material = {"pbrMetallicRoughness": {"baseColorFactor": [*map(float, linear), rgba[3] / 255.0],
                                                  "metallicFactor": 0.0, "roughnessFactor": 0.9},
                         "doubleSided": True}
+            texture = self._texture(colormap) if colormap is not None else None
+            if texture is not None:
+                material["pbrMetallicRoughness"]["baseColorTexture"] = {"index": texture}
             if rgba[3] < 255 or translucent:
                 material["alphaMode"] = "BLEND"
             self.json["materials"].append(material)
             self._materials[key] = len(self.json["materials"]) - 1
         return self._materials[key]
 
-    def _mesh(self, asset: int, rgba: tuple[int, ...]) -> int:
-        material = self._material(rgba)
+    def _texture(self, path: Path) -> int | None:
+        """The texture of an image file, its bytes in the binary chunk; None for a format glTF does not take."""
+        if path not in self._textures:
+            mime = _IMAGE_TYPES.get(path.suffix.lower())
+            self._textures[path] = None
+            if mime is not None:
+                view = self._view(np.frombuffer(path.read_bytes(), np.uint8))
+                self.json.setdefault("images", []).append({"bufferView": view, "mimeType": mime})
+                self.json.setdefault("textures", []).append({"source": len(self.json["images"]) - 1})
+                self._textures[path] = len(self.json["textures"]) - 1
+        return self._textures[path]
+
+    def _mesh(self, asset: int, rgba: tuple[int, ...], colormap: Path | None = None) -> int:
+        material = self._material(rgba, colormap=colormap)
         if (asset, material) not in self._meshes:
             if asset not in self._assets:
                 shape = self.library[asset]
@@ -257,36 +282,98 @@ class _Part:
         return self._meshes[asset, material]
 
     def _polygons(self, tile: Tile) -> int:
-        """The tile's mesh-table triangles as one mesh with per-vertex colours."""
+        """The tile's mesh-table triangles as one mesh with per-vertex colours, a primitive per colour map
+        where the record has textures."""
         triangles = tile.triangles
         points = (triangles["vertices"].reshape(-1, 3).astype(np.float64) - tile.origin).astype(np.float32)
         colors = np.repeat(triangles["color"], 3, axis=0)
-        self.json["meshes"].append({"name": f"{tile.name}_polygons", "primitives": [{
-            "attributes": {"POSITION": self._accessor(points, "VEC3", _ARRAY_BUFFER, bounds=True),
-                           "COLOR_0": self._accessor(colors, "VEC4", _ARRAY_BUFFER, normalized=True)},
-            "material": self._material(_WHITE, translucent=bool((colors[:, 3] < 255).any())),
-        }]})
+        attributes = {"POSITION": self._accessor(points, "VEC3", _ARRAY_BUFFER, bounds=True),
+                      "COLOR_0": self._accessor(colors, "VEC4", _ARRAY_BUFFER, normalized=True)}
+        translucent = bool((colors[:, 3] < 255).any())
+        primitives = [{"attributes": attributes, "material": self._material(_WHITE, translucent=translucent)}]
+        if tile.triangle_material is not None:
+            maps = [self.colormap(m) for m in range(int(tile.triangle_material.max()) + 1)]
+            used = np.array([maps[m] for m in tile.triangle_material.tolist()], dtype=object)
+            primitives = []
+            for colormap in dict.fromkeys(used.tolist()):
+                vertices = (np.flatnonzero(used == colormap)[:, None] * 3 + np.arange(3)).reshape(-1)
+                primitives.append({"attributes": attributes, "material": self._material(
+                    _WHITE, translucent=translucent, colormap=colormap),
+                    "indices": self._accessor(vertices.astype(np.uint32), "SCALAR", _ELEMENT_ARRAY_BUFFER)})
+        self.json["meshes"].append({"name": f"{tile.name}_polygons", "primitives": primitives})
         return len(self.json["meshes"]) - 1
 
 
-def _groups(rows: np.ndarray) -> list[tuple[int, tuple[int, ...], np.ndarray]]:
-    """(asset, RGBA, row indices) of a tile's instances, by (asset, colour) unless that makes more than
-    ``MAX_GROUPS`` groups, then by asset in white; in order of asset, then colour."""
+def baked_glb(vertices: np.ndarray, faces: np.ndarray, looks: np.ndarray | None, materials: np.ndarray,
+              roots: Sequence[Path], meta: dict) -> bytes:
+    """A baked mesh as a GLB: one mesh, a primitive (and a material) per look of its triangles.
+
+    Parameters
+    ----------
+    vertices : (V, 3) float
+        World coordinates (written as float32).
+    faces : (T, 3) int
+        Triangles.
+    looks : (T,) int64 or None
+        Each triangle's material (an index into ``materials``) times 2^32 plus its RGBA as a uint32
+        (``io.bake.BakedWriter``); None: all white.
+    materials : (M, len(ir.MATERIAL_MAPS)) str
+        Texture paths per channel (``model.records.MaterialTable``); a colour map found in ``roots`` becomes
+        the primitive's ``baseColorTexture``.
+    """
+    with tempfile.TemporaryDirectory() as folder:
+        part = _Part(Path(folder) / "part.bin", None, meta)
+        del part.json["extensionsUsed"]
+        if looks is None:
+            looks = np.full(len(faces), 0xFFFFFFFF, np.int64)
+        primitives = []
+        if len(faces):
+            position = part._accessor(np.asarray(vertices, np.float32), "VEC3", _ARRAY_BUFFER, bounds=True)
+            distinct, inverse = np.unique(looks, return_inverse=True)
+            order = np.argsort(inverse.reshape(-1), kind="stable")
+            bounds = np.searchsorted(inverse.reshape(-1)[order], np.arange(len(distinct) + 1))
+            for k, look in enumerate(distinct.tolist()):
+                rgba = tuple(np.array([look & 0xFFFFFFFF], np.uint32).view(np.uint8).tolist())
+                colormap = str(materials[look >> 32, 0])
+                found = locate(colormap, roots) if colormap else None
+                triangles = np.asarray(faces, np.int64)[order[bounds[k]:bounds[k + 1]]]
+                primitives.append({
+                    "attributes": {"POSITION": position},
+                    "indices": part._accessor(triangles.astype(np.uint32).reshape(-1), "SCALAR",
+                                              _ELEMENT_ARRAY_BUFFER),
+                    "material": part._material(rgba, colormap=found[1] if found else None)})
+            part.json["meshes"].append({"name": "city", "primitives": primitives})
+            part.json["nodes"].append({"name": "city", "mesh": 0})
+            part.json["scenes"][0]["nodes"].append(0)
+        out = Path(folder) / "baked.glb"
+        part.finish(out)
+        return out.read_bytes()
+
+
+def _groups(rows: np.ndarray, material: np.ndarray | None = None
+            ) -> list[tuple[int, tuple[int, ...], int, np.ndarray]]:
+    """(asset, RGBA, material, row indices) of a tile's instances, by (asset, material, colour) unless that
+    makes more than ``MAX_GROUPS`` groups, then by (asset, material) in white; in order of asset, material,
+    then colour. ``material`` (n,) int32: the rows' materials (None: all 0)."""
     if not len(rows):
         return []
     color = rows["color"].view(np.uint32).reshape(-1).astype(np.int64)
-    key = rows["asset"].astype(np.int64) << 32 | color
-    unique, inverse = np.unique(key, return_inverse=True)
+    material = np.zeros(len(rows), np.int64) if material is None else material.astype(np.int64)
+    # (asset, material) pairs numbered in their order, in the high half of the key
+    pairs, pair = np.unique(rows["asset"].astype(np.int64) << 32 | material, return_inverse=True)
+    high = pair.reshape(-1).astype(np.int64) << 32
+    unique, inverse = np.unique(high | color, return_inverse=True)
     if len(unique) > MAX_GROUPS:
-        unique, inverse = np.unique(rows["asset"].astype(np.int64) << 32 | np.int64(0xFFFFFFFF),
-                                    return_inverse=True)
+        unique, inverse = np.unique(high | np.int64(0xFFFFFFFF), return_inverse=True)
     inverse = inverse.reshape(-1)
     order = np.argsort(inverse, kind="stable")
     bounds = np.searchsorted(inverse[order], np.arange(len(unique) + 1))
     groups = []
     for k, value in enumerate(unique.tolist()):
         rgba = tuple(np.array([value & 0xFFFFFFFF], np.uint32).view(np.uint8).tolist())
-        groups.append((value >> 32, rgba, order[bounds[k]:bounds[k + 1]]))
+        asset_and_material = int(pairs[value >> 32])
+        groups.append((asset_and_material >> 32, rgba, asset_and_material & 0xFFFFFFFF,
+                       order[bounds[k]:bounds[k + 1]]))
     return groups
 
 

@@ -34,8 +34,9 @@ import numpy as np
 from grammarc.constants import LIMITS
 from grammarc.geometry.triangulation import triangulate_polygons
 from grammarc.io import WriterBlock
+from grammarc.ir.asset_names import locate
 from grammarc.model.assets import asset_library
-from grammarc.model.records import WHITE, TerminalChunk
+from grammarc.model.records import WHITE, MaterialTable, TerminalChunk
 
 __all__ = ["INSTANCE", "TRIANGLE", "Tile", "TileSpool", "TiledWriter", "decompose"]
 
@@ -156,6 +157,9 @@ class Tile:
     origin: np.ndarray  # (3,) float64: (ix * size, 0, iz * size)
     instances: np.ndarray  # (n,) INSTANCE
     triangles: np.ndarray  # (t,) TRIANGLE
+    #: (n,) and (t,) int32 rows of the writer's ``materials``, where the record has textures (else None).
+    instance_material: np.ndarray | None = None
+    triangle_material: np.ndarray | None = None
 
     @property
     def name(self) -> str:
@@ -181,8 +185,17 @@ class TileSpool:
         self.instances = 0
         self.faces = 0
         self.triangles = 0
+        #: Whether the chunks carry materials (``add``'s ``material``): all of a record's or none.
+        self.materials: bool | None = None
 
-    def add(self, chunk: TerminalChunk) -> None:
+    def add(self, chunk: TerminalChunk, material: np.ndarray | None = None,
+            mesh_material: np.ndarray | None = None) -> None:
+        """Spool a chunk; ``material`` (n,) and ``mesh_material`` (F,) int32: its instances' and faces'
+        rows of the writer's materials, where the record has textures."""
+        if self.materials is None:
+            self.materials = material is not None
+        if self.materials != (material is not None):
+            raise ValueError("TerminalChunk.materials: a record's chunks all carry materials or none do")
         rows = np.empty(len(chunk.asset), INSTANCE)
         rows["asset"], rows["lot"], rows["symbol"] = chunk.asset, chunk.lot, chunk.symbol
         rows["color"] = WHITE if chunk.color is None else chunk.color
@@ -190,7 +203,10 @@ class TileSpool:
         rows["row"] = np.arange(self.instances, self.instances + len(rows))
         xform = np.asarray(chunk.xform, np.float64)
         centre = xform[:, :, 3] + 0.5 * xform[:, :, :3].sum(axis=2)
-        self._append("instances", self._keys(centre), rows)
+        keys = self._keys(centre)
+        self._append("instances", keys, rows)
+        if material is not None:
+            self._append("instance_materials", keys, material.astype(np.int32))
         self.instances += len(rows)
 
         mesh = chunk.mesh
@@ -205,7 +221,10 @@ class TileSpool:
             triangles["color"] = mesh.colors()[face]
             triangles["symbol"] = np.asarray(mesh.symbol)[face]
             first = vertices[np.asarray(mesh.ring_offsets)[mesh.face_offsets[:-1]]]
-            self._append("triangles", self._keys(first)[face], triangles)
+            keys = self._keys(first)[face]
+            self._append("triangles", keys, triangles)
+            if mesh_material is not None:
+                self._append("triangle_materials", keys, mesh_material[face].astype(np.int32))
             self.faces += len(mesh.face_offsets) - 1
             self.triangles += len(triangles)
 
@@ -213,7 +232,10 @@ class TileSpool:
         """Each tile, in key order, read back from its files."""
         for key in sorted(self.keys):
             origin = np.array([key[0] * self.tile_size, 0.0, key[1] * self.tile_size])
-            yield Tile(key, origin, self._read("instances", key, INSTANCE), self._read("triangles", key, TRIANGLE))
+            materials = [self._read(f"{kind}_materials", key, np.dtype("<i4")) if self.materials else None
+                         for kind in ("instance", "triangle")]
+            yield Tile(key, origin, self._read("instances", key, INSTANCE), self._read("triangles", key, TRIANGLE),
+                       *materials)
 
     def _keys(self, points: np.ndarray) -> np.ndarray:
         """(n, 2) int64 tile keys of world points."""
@@ -259,6 +281,8 @@ class TiledWriter(WriterBlock):
         (self._tmp / "spool").mkdir()
         self._spool = TileSpool(self._tmp / "spool", tile_size)
         self._used = np.zeros(len(self._library.names), np.int64)  # instances of each asset
+        self._materials = MaterialTable()
+        self._colormaps: dict[int, Path | None] = {}
         self._state = "open"
         self._counts: dict = {}
 
@@ -272,11 +296,24 @@ class TiledWriter(WriterBlock):
         if len(asset) and (asset.min() < 0 or asset.max() >= len(self._used)):
             raise ValueError(f"TerminalChunk.asset: index out of range [0, {len(self._used)})")
         try:
-            self._spool.add(chunk)
+            self._spool.add(chunk, *self._material_rows(chunk))
             self._used += np.bincount(asset, minlength=len(self._used))
         except BaseException:
             self.abort()
             raise
+
+    def _material_rows(self, chunk: TerminalChunk) -> tuple[np.ndarray | None, np.ndarray | None]:
+        """The chunk's instances' and faces' rows of the writer's materials; None without textures."""
+        return self._materials.add(chunk) if chunk.materials is not None else (None, None)
+
+    def _colormap(self, material: int) -> Path | None:
+        """The colour map file of one of the writer's materials, found in the asset roots; None without one
+        (asked for when the output is written, after every chunk: the files are looked for once)."""
+        if material not in self._colormaps:
+            name = str(self._materials.table()[material, 0])
+            found = locate(name, self._library.roots) if name else None
+            self._colormaps[material] = found[1] if found else None
+        return self._colormaps[material]
 
     def close(self) -> dict:
         """Write the output and move it into place; the counts (closing again returns them again):

@@ -55,7 +55,7 @@ import numpy as np
 from zlib_ng.zlib_ng import crc32, crc32_combine
 
 from grammarc.errors import UsageError
-from grammarc.model.records import TerminalChunk
+from grammarc.model.records import MaterialTable, TerminalChunk
 
 if TYPE_CHECKING:
     from typing_extensions import Self
@@ -82,15 +82,20 @@ _SPOOLED = {
     "mesh_lot": ("<i4", ()),
     "mesh_symbol": ("<i4", ()),
     "mesh_color": ("|u1", (4,)),
+    "material": ("<i4", ()),
+    "mesh_material": ("<i4", ()),
 }
+#: The columns of a record whose grammar sets textures (``TerminalChunk.materials``), else left out.
+_MATERIAL_KEYS = ("materials", "material", "mesh_material")
 _OFFSETS = ("mesh_ring_offsets", "mesh_face_offsets")
 # The column written straight into the output, as its first member; the others are spooled.
 _STREAMED = "xform"
 # Central directory order, the order of np.load(path).files: the record's table in the README, then the mesh
 # table. In the file, xform comes first and the others follow in this order.
 _KEYS = (
-    "assets", "asset", "xform", "lot", "symbols", "symbol", "color", "meta",
+    "assets", "asset", "xform", "lot", "symbols", "symbol", "color", "materials", "material", "meta",
     "mesh_vertices", "mesh_ring_offsets", "mesh_face_offsets", "mesh_lot", "mesh_symbol", "mesh_color",
+    "mesh_material",
 )  # fmt: skip
 class InstanceWriter:
     """Streams TerminalChunks into an .npz; the output appears complete on close() or not at all.
@@ -140,6 +145,8 @@ class InstanceWriter:
         self._meta = dict(meta)
         json.dumps(self._meta)  # a TypeError now, not after hours of derivation
         self._rows = dict.fromkeys(_SPOOLED, 0)
+        #: The record's materials, once a chunk has textures (else None: no material columns).
+        self._materials: MaterialTable | None = None
         self._counts: dict[str, int] = {}
         self._state = "open"
         tmpdir = tempfile.mkdtemp(prefix=f".{self.path.name}.tmp", dir=self.path.parent)
@@ -165,6 +172,7 @@ class InstanceWriter:
         if self._state != "open":
             raise ValueError(f"write to an InstanceWriter that is {self._state}")
         columns = _validate(chunk, len(self._assets), len(self._symbols))
+        self._material_columns(chunk, columns)
         columns["mesh_ring_offsets"] = columns["mesh_ring_offsets"] + self._rows["mesh_vertices"]
         columns["mesh_face_offsets"] = columns["mesh_face_offsets"] + self._rows["mesh_ring_offsets"]
         try:
@@ -176,6 +184,19 @@ class InstanceWriter:
             raise
         for key, column in columns.items():
             self._rows[key] += len(column)
+
+    def _material_columns(self, chunk: TerminalChunk, columns: dict[str, np.ndarray]) -> None:
+        """Add the chunk's ``material`` and ``mesh_material`` columns, indexing the record's ``materials``,
+        once any chunk has textures: row 0 of the table is no texture, which the rows of chunks without
+        (and those written before the first with) take."""
+        if chunk.materials is None and self._materials is None:
+            return
+        if self._materials is None:
+            self._materials = MaterialTable()
+        before = {"material": self._rows["asset"] - self._rows["material"],
+                  "mesh_material": self._rows["mesh_lot"] - self._rows["mesh_material"]}
+        for key, own in zip(("material", "mesh_material"), self._materials.add(chunk)):
+            columns[key] = np.concatenate([np.zeros(before[key], np.int32), own]) if before[key] else own
 
     def close(self) -> dict:
         """Finish the npz next to the output, fsync it, and rename it onto ``path``.
@@ -238,8 +259,12 @@ class InstanceWriter:
         # Sorted keys: the bytes must not depend on the order in which meta was built.
         meta = json.dumps({**self._meta, "counts": counts, "format": _FORMAT}, sort_keys=True)
         arrays = {"assets": self._assets, "symbols": self._symbols, "meta": np.array(meta)}
+        if self._materials is not None:
+            arrays["materials"] = self._materials.table()
         members = {}
         for key in _KEYS:
+            if key in _MATERIAL_KEYS and self._materials is None:
+                continue
             if key in arrays:
                 array = arrays[key]
                 members[key] = (_descr(array.dtype), array.shape, array.tobytes())

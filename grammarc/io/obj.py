@@ -1,4 +1,4 @@
-"""Wavefront OBJ geometry written fast: a baked city's vertices and triangles (``io.bake``).
+"""Wavefront OBJ geometry written fast: a baked city's vertices and triangles, in groups (``io.bake``).
 
 The reader of OBJ geometry (lots, assets) is ``model.obj``.
 """
@@ -8,7 +8,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-__all__ = ["obj_bytes"]
+__all__ = ["obj_bytes", "with_lines"]
 
 
 #: Decimals of the coordinates ``obj_bytes`` writes (``_fixed`` writes them as three digit pairs): a
@@ -102,3 +102,35 @@ def _fixed(value, out, at):
         while out[at - 1] == 48:
             at -= 1
     return at
+
+
+def with_lines(text: bytes, first_lines: np.ndarray, lines: list[str]) -> bytes:
+    """``text`` (lines ending in newlines, as ``obj_bytes`` writes them) with ``lines[k]`` inserted before
+    its line ``first_lines[k]`` (increasing): the ``g`` and ``usemtl`` statements before groups of faces."""
+    inserted = "".join(lines).encode()
+    ends = np.cumsum([len(line.encode()) for line in lines], dtype=np.int64)
+    out = np.empty(len(text) + len(inserted), np.uint8)
+    _interleave(np.frombuffer(text, np.uint8), np.asarray(first_lines, np.int64),
+                np.frombuffer(inserted, np.uint8), ends, out)
+    return out.tobytes()
+
+
+@njit(cache=True, nogil=True)
+def _interleave(text, first_lines, inserted, ends, out):
+    at = 0
+    line = 0
+    group = 0
+    line_start = True
+    for i in range(len(text)):
+        if line_start:
+            while group < len(first_lines) and first_lines[group] == line:
+                for k in range(ends[group - 1] if group else 0, ends[group]):
+                    out[at] = inserted[k]
+                    at += 1
+                group += 1
+            line_start = False
+        out[at] = text[i]
+        at += 1
+        if text[i] == 10:
+            line += 1
+            line_start = True

@@ -15,12 +15,13 @@ The layout, for ``city.usdc``::
   instances can be matched with ``instances.npz``), the per-instance colour as ``primvars:displayColor``
   (and ``displayOpacity``) of vertex interpolation, which prototypes inherit, and ``grammarc:lot`` and
   ``grammarc:symbol``. Its ``prototypes`` are children of the instancer referencing the prototype
-  layer, one for each asset the tile uses.
+  layer, one for each asset the tile uses (for each asset and material where the record has textures:
+  those with a colour map are bound to a ``UsdPreviewSurface`` reading it through a ``UsdUVTexture``).
 * **Prototypes**: the asset meshes as ``model.assets`` loads them (OBJ by its own reader, other formats
   through trimesh, built-ins generated), fitted to the unit box as CityEngine fits an inserted asset to its
   scope; ``subdivisionScheme`` is ``none`` (they are polygon models, not subdivision cages).
 * **Meshes**: the mesh table's polygons (leaves that are not instances) triangulated, one Mesh per
-  tile with a colour per face.
+  tile with a colour per face (and a ``GeomSubset`` per material bound to it where the record has textures).
 
 Writing streams: ``write`` sorts each chunk into tile spools on disk (``TileSpool``), and ``close``
 makes one tile layer at a time, so memory is bounded by the largest tile, not by the city. Everything
@@ -44,7 +45,7 @@ from grammarc.io.instancing import TILE_SIZE, Tile, TiledWriter, compose, decomp
 
 # usd-core's modules (the `usd` extra), imported by _require_pxr when USD is first written or read: the writer
 # registry imports this module for every output, which must not load usd-core.
-Gf = Sdf = Tf = Usd = UsdGeom = Vt = None
+Gf = Sdf = Tf = Usd = UsdGeom = UsdShade = Vt = None
 
 __all__ = ["WRITERS", "UsdWriter", "read_usd", "tiles_folder", "write_shards_root"]
 
@@ -58,11 +59,11 @@ def tiles_folder(path: str | os.PathLike) -> Path:
 
 def _require_pxr() -> None:
     """Import usd-core's modules into this module's globals, or say which extra to install."""
-    global Gf, Sdf, Tf, Usd, UsdGeom, Vt
+    global Gf, Sdf, Tf, Usd, UsdGeom, UsdShade, Vt
     if Usd is not None:
         return
     try:
-        from pxr import Gf, Sdf, Tf, Usd, UsdGeom, Vt
+        from pxr import Gf, Sdf, Tf, Usd, UsdGeom, UsdShade, Vt
     except ImportError as error:
         raise UsageError("writing USD needs usd-core: pip install 'grammarc[usd]' (or pip install usd-core)") \
             from error
@@ -137,13 +138,18 @@ class UsdWriter(TiledWriter):
         rows = tile.instances
         if len(rows):
             instancer = UsdGeom.PointInstancer.Define(stage, "/Tile/Instances")
-            used, local = np.unique(rows["asset"], return_inverse=True)
+            # a prototype per asset, and per (asset, material) where the record has textures
+            material = tile.instance_material if tile.instance_material is not None else np.zeros(len(rows))
+            used, local = np.unique(rows["asset"].astype(np.int64) << 32 | material.astype(np.int64),
+                                    return_inverse=True)
             UsdGeom.Scope.Define(stage, "/Tile/Instances/Prototypes")
             targets = []
-            for asset in used.tolist():
-                name = prototypes[asset].rsplit("/", 1)[1]
+            for key in used.tolist():
+                asset, textures = key >> 32, key & 0xFFFFFFFF
+                name = prototypes[asset].rsplit("/", 1)[1] + (f"_m{textures}" if textures else "")
                 child = stage.DefinePrim(f"/Tile/Instances/Prototypes/{name}")
                 child.GetReferences().AddReference(f"./prototypes{self._ext}", prototypes[asset])
+                self._bind(stage, child, textures)
                 targets.append(child.GetPath())
             instancer.CreatePrototypesRel().SetTargets(targets)
             positions, orientations, scales = decompose(rows["xform"], tile.origin)
@@ -165,8 +171,43 @@ class UsdWriter(TiledWriter):
             mesh.CreateFaceVertexIndicesAttr(Vt.IntArray.FromNumpy(np.arange(len(points), dtype=np.int32)))
             mesh.CreateSubdivisionSchemeAttr(UsdGeom.Tokens.none)
             _colors(UsdGeom.PrimvarsAPI(mesh), triangles["color"], UsdGeom.Tokens.uniform)
+            if tile.triangle_material is not None:
+                imageable = UsdGeom.Imageable(mesh)
+                for textures in np.unique(tile.triangle_material).tolist():
+                    faces = np.flatnonzero(tile.triangle_material == textures).astype(np.int32)
+                    subset = UsdGeom.Subset.CreateGeomSubset(imageable, f"m{textures}", UsdGeom.Tokens.face,
+                                                             Vt.IntArray.FromNumpy(faces), "materialBind")
+                    self._bind(stage, subset.GetPrim(), textures)
         stage.GetRootLayer().Save()
         return tile.name, tile.origin
+
+    def _bind(self, stage, prim, textures: int) -> None:
+        """Bind ``prim`` to the tile's material of the writer's material ``textures`` when it has a colour map
+        found in the asset roots: a ``UsdPreviewSurface`` whose diffuse colour is a ``UsdUVTexture`` of the
+        file (its path relative to the tile layer), read at the primvar ``st``."""
+        colormap = self._colormap(textures)
+        if colormap is None:
+            return
+        path = f"/Tile/Materials/m{textures}"
+        material = UsdShade.Material.Get(stage, path)
+        if not material:
+            UsdGeom.Scope.Define(stage, "/Tile/Materials")
+            material = UsdShade.Material.Define(stage, path)
+            surface = UsdShade.Shader.Define(stage, f"{path}/Surface")
+            surface.CreateIdAttr("UsdPreviewSurface")
+            reader = UsdShade.Shader.Define(stage, f"{path}/St")
+            reader.CreateIdAttr("UsdPrimvarReader_float2")
+            reader.CreateInput("varname", Sdf.ValueTypeNames.Token).Set("st")
+            texture = UsdShade.Shader.Define(stage, f"{path}/Colormap")
+            texture.CreateIdAttr("UsdUVTexture")
+            texture.CreateInput("file", Sdf.ValueTypeNames.Asset).Set(
+                Sdf.AssetPath(os.path.relpath(colormap, tiles_folder(self.path).resolve())))
+            texture.CreateInput("st", Sdf.ValueTypeNames.Float2).ConnectToSource(
+                reader.ConnectableAPI(), "result")
+            surface.CreateInput("diffuseColor", Sdf.ValueTypeNames.Color3f).ConnectToSource(
+                texture.ConnectableAPI(), "rgb")
+            material.CreateSurfaceOutput().ConnectToSource(surface.ConnectableAPI(), "surface")
+        UsdShade.MaterialBindingAPI.Apply(prim).Bind(material)
 
     def _write_root(self, path: Path, tiles: list[tuple[str, np.ndarray]]) -> None:
         stage = _new_stage(path, UsdGeom.Xform, "/City")

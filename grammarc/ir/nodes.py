@@ -235,14 +235,22 @@ class Call:
     site: int = 0
 
 
-#: What a shape knows of the split or component split that made it (CityEngine's ``split.index``...).
+#: CityEngine's texture channels (``material.colormap``...), in the order of the record's ``materials``.
+MATERIAL_MAPS = ("colormap", "bumpmap", "dirtmap", "specularmap", "opacitymap", "normalmap", "emissivemap",
+                 "occlusionmap", "roughnessmap", "metallicmap")
+#: The material attributes a shape carries and expressions read: its texture channels, its colour and opacity.
+MATERIAL_FIELDS = {**{f"material.{m}": Type.STR for m in MATERIAL_MAPS},
+                   **{f"material.color.{c}": Type.NUM for c in "rgb"}, "material.opacity": Type.NUM}
+#: What a shape knows of the split or component split that made it (CityEngine's ``split.index``...), and
+#: its material.
 CONTEXT_FIELDS = {"split.index": Type.NUM, "split.total": Type.NUM, "comp.index": Type.NUM,
-                  "comp.total": Type.NUM, "comp.sel": Type.STR}
+                  "comp.total": Type.NUM, "comp.sel": Type.STR, **MATERIAL_FIELDS}
 
 
 @dataclass(frozen=True, slots=True)
 class ContextRef:
-    """``split.index``, ``split.total``, ``comp.index``, ``comp.total``, ``comp.sel`` of the shape."""
+    """``split.index``, ``split.total``, ``comp.index``, ``comp.total``, ``comp.sel`` and the material
+    attributes (``MATERIAL_FIELDS``) of the shape."""
 
     name: str
     span: Span = NO_SPAN
@@ -327,7 +335,8 @@ Expr = (Num | Str | Bool | Name | Param | AttrRef | ScopeRef | Unary | Binary | 
         | Occlusion | ArrayLit | Range | Index)
 
 #: CityEngine shape attributes that ``set`` changes for a shape and its successors (not declared attrs).
-SHAPE_ATTRIBUTES: dict[str, Type] = {"trim.vertical": Type.BOOL, "trim.horizontal": Type.BOOL}
+SHAPE_ATTRIBUTES: dict[str, Type] = {"trim.vertical": Type.BOOL, "trim.horizontal": Type.BOOL,
+                                     **{f"material.{m}": Type.STR for m in MATERIAL_MAPS}}
 
 # ------------------------------------------------------------------------------------------------ operations
 
@@ -878,11 +887,20 @@ class MirrorScope:
     span: Span = NO_SPAN
 
 
+@dataclass(frozen=True, slots=True)
+class SetOpacity:
+    """CityEngine ``set(material.opacity, v)``: the shape's opacity (1 opaque, 0 transparent), the alpha of
+    the colour its instances and faces carry into the record."""
+
+    value: Expr = child(Type.NUM, "an opacity")
+    span: Span = NO_SPAN
+
+
 Op = (Symbol | Empty | Translate | Scale | Rotate | Push | Pop | Insert | Split | Repeat | Comp | Extrude
       | Center | UseAsset | Case | Stochastic | SetAttr | Report | NotApplied | GroupSplit | CompFaces
       | AlignScope | Mirror | Offset | SetColor | Setback | Roof | InnerRectangle | Convexify
       | CleanupGeometry | DeleteHoles | Snap | Label | Transform | Scatter | AlignToGeometry | Primitive
-      | Trim | SplitArea | ReduceGeometry | MirrorScope)
+      | Trim | SplitArea | ReduceGeometry | MirrorScope | SetOpacity)
 Body = tuple[Op, ...]
 
 

@@ -193,6 +193,7 @@ _OP_FORMATS = {
     ir.NotApplied: lambda op: f"{op.name}(...)",
     ir.Scatter: _scatter,
     ir.Primitive: lambda op: f"primitive{op.kind.title()}({_list(op.segments + (op.sizes or ()))})",
+    ir.SetOpacity: lambda op: f"set(material.opacity, {print_expr(op.value)})",
 }
 
 

@@ -14,7 +14,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["WHITE", "MeshChunk", "TerminalChunk"]
+from grammarc.ir.nodes import MATERIAL_MAPS
+
+__all__ = ["WHITE", "MaterialTable", "MeshChunk", "TerminalChunk"]
 
 #: Colour of rows that carry none: opaque white (RGBA).
 WHITE = np.array([255, 255, 255, 255], np.uint8)
@@ -38,7 +40,11 @@ class MeshChunk:
     symbol : (F,) int32
         Symbol of each face, an index into the writer's ``symbols``.
     color : (F, 4) uint8, optional
-        RGBA colour of each face (CityEngine's ``color``); None: white.
+        RGBA colour of each face (CityEngine's ``color`` and ``material.opacity``); None: white.
+    material : (F,) int32, optional
+        Each face's row of ``materials``; None (and ``materials`` None) where the grammar sets no texture.
+    materials : (M, len(MATERIAL_MAPS)) str, optional
+        The texture paths of each material, one column per channel of ``ir.MATERIAL_MAPS`` ("" for none).
     """
 
     vertices: np.ndarray
@@ -47,6 +53,8 @@ class MeshChunk:
     lot: np.ndarray
     symbol: np.ndarray
     color: np.ndarray | None = None
+    material: np.ndarray | None = None
+    materials: np.ndarray | None = None
 
     def colors(self) -> np.ndarray:
         """(F, 4) uint8: the faces' colours, white where none was given."""
@@ -81,7 +89,21 @@ class MeshChunk:
             lot=np.concatenate([c.lot for c in chunks]),
             symbol=np.concatenate([c.symbol for c in chunks]),
             color=np.concatenate([c.colors() for c in chunks]),
+            **_joined_materials(chunks, [c.material for c in chunks], [c.materials for c in chunks]),
         )
+
+
+def _joined_materials(chunks: Sequence, material: list, materials: list) -> dict:
+    """``material`` and ``materials`` of joined chunks: the tables one after the other, each chunk's rows
+    shifted by the tables before it (a chunk without textures gets a table of one material, none)."""
+    if all(table is None for table in materials):
+        return {}
+    blank = np.full((1, len(MATERIAL_MAPS)), "")
+    tables = [blank if table is None else table for table in materials]
+    bases = np.cumsum([0] + [len(table) for table in tables[:-1]])
+    rows = [np.full(len(c.lot), base, np.int32) if m is None else m + np.int32(base)
+            for c, m, base in zip(chunks, material, bases)]
+    return {"material": np.concatenate(rows).astype(np.int32), "materials": np.concatenate(tables)}
 
 
 def _join_offsets(offsets: list[np.ndarray], n_items: np.ndarray, n_groups: np.ndarray) -> np.ndarray:
@@ -110,7 +132,11 @@ class TerminalChunk:
     mesh : MeshChunk
         Faces of this batch that are not instances.
     color : (n, 4) uint8, optional
-        RGBA colour of each instance (CityEngine's ``color``); None: white.
+        RGBA colour of each instance (CityEngine's ``color`` and ``material.opacity``); None: white.
+    material : (n,) int32, optional
+        Each instance's row of ``materials``; None (and ``materials`` None) where the grammar sets no texture.
+    materials : (M, len(MATERIAL_MAPS)) str, optional
+        The texture paths of each material (as ``MeshChunk.materials``; the mesh's table is the same).
     """
 
     asset: np.ndarray
@@ -119,12 +145,34 @@ class TerminalChunk:
     symbol: np.ndarray
     mesh: MeshChunk
     color: np.ndarray | None = None
+    material: np.ndarray | None = None
+    materials: np.ndarray | None = None
 
     def colors(self) -> np.ndarray:
         """(n, 4) uint8: the instances' colours, white where none was given."""
         if self.color is not None:
             return self.color
         return _white(len(self.asset))
+
+
+class MaterialTable:
+    """A record's materials (texture paths per channel of ``MATERIAL_MAPS``) numbered as the writer meets
+    them, row 0 none: what a writer merges its chunks' own tables into."""
+
+    def __init__(self) -> None:
+        self.rows: dict[tuple[str, ...], int] = {("",) * len(MATERIAL_MAPS): 0}
+
+    def add(self, chunk: TerminalChunk) -> tuple[np.ndarray, np.ndarray]:
+        """(n,) and (F,) int32: the rows of the chunk's instances and faces in this table (0 without textures)."""
+        if chunk.materials is None:
+            return np.zeros(len(chunk.asset), np.int32), np.zeros(len(chunk.mesh.lot), np.int32)
+        lookup = np.array([self.rows.setdefault(tuple(map(str, row)), len(self.rows)) for row in chunk.materials],
+                          np.int32)
+        return lookup[chunk.material], lookup[chunk.mesh.material]
+
+    def table(self) -> np.ndarray:
+        """(M, len(MATERIAL_MAPS)) str: the materials in their order."""
+        return np.array(list(self.rows), dtype=str).reshape(-1, len(MATERIAL_MAPS))
 
 
 _WHITE_ROWS = [np.zeros((0, 4), np.uint8)]

@@ -7,6 +7,7 @@ import tracemalloc
 import numpy as np
 import pytest
 import trimesh
+from writers_city import COLOURED, PNG, RED, SEE_THROUGH_GREEN, TEXTURED, textured_city
 
 from grammarc.errors import AssetError, UsageError
 from grammarc.io import OutputOptions, writer_for
@@ -230,7 +231,8 @@ def test_writers_round_trip(tmp_path, suffix):
     np.testing.assert_allclose(loaded.bounds, expected.bounds, atol=1e-5)
     if suffix in (".obj", ".ply"):  # these keep the vertices as written
         assert len(loaded.vertices) == counts["vertices"]
-    assert [p.name for p in tmp_path.iterdir()] == [path.name]  # no temporaries left
+    written = [path.name] + (["city.mtl"] if suffix == ".obj" else [])  # an OBJ has its material library
+    assert sorted(p.name for p in tmp_path.iterdir()) == sorted(written)  # no temporaries left
 
 
 def test_writer_abort_leaves_no_file(tmp_path):
@@ -295,3 +297,58 @@ def test_a_glb_asset_inserted_z_up_bakes_standing(tmp_path):
     assert len(mesh.faces) == 3 * triangles
     np.testing.assert_allclose(mesh.bounds[:, 1], [0, 6], atol=1e-5)
     np.testing.assert_allclose(mesh.bounds[1, 0] - mesh.bounds[0, 0], 20 + 2, atol=1e-5)  # lots 10 m apart, 2 m vane
+
+
+# ---------------------------------------------------------------------------- colours and textures baked
+
+def test_a_baked_obj_has_a_group_per_lot_and_a_material_per_colour(tmp_path):
+    text = textured_city(tmp_path, COLOURED, ".obj", bake=True).read_text()
+    assert text.splitlines()[1] == "mtllib city.mtl"
+    assert [line for line in text.splitlines() if line.startswith("g ")] == ["g lot_0", "g lot_1"]
+    assert text.count("usemtl") == 4  # per lot: the roof's, then the walls'
+    scene = trimesh.load(tmp_path / "city.obj", process=False)
+    colours = {tuple(g.visual.material.diffuse[:3]) for g in scene.geometry.values()}
+    assert colours == {(255, 0, 0), (0, 255, 0)}
+    assert "d 0.501961" in (tmp_path / "city.mtl").read_text()
+
+
+def test_a_baked_ply_has_vertex_colours(tmp_path):
+    mesh = trimesh.load(textured_city(tmp_path, COLOURED, ".ply", bake=True), process=False)
+    colours = mesh.visual.vertex_colors
+    assert {tuple(c) for c in colours.tolist()} == {tuple(RED), tuple(SEE_THROUGH_GREEN)}
+    roof = mesh.vertices[:, 1] > 5.9
+    assert (colours[mesh.faces[np.all(roof[mesh.faces], axis=1)]] == RED).all()
+
+
+def test_a_baked_glb_has_a_material_per_colour(tmp_path):
+    scene = trimesh.load(textured_city(tmp_path, COLOURED, ".glb", bake=True), process=False)
+    factors = sorted(g.visual.material.baseColorFactor.tolist() for g in scene.geometry.values())
+    assert factors == sorted([RED, SEE_THROUGH_GREEN])
+    assert sum(len(g.faces) for g in scene.geometry.values()) == 2 * (4 * 2 + 2)  # walls and roof of two lots
+
+
+def test_a_baked_obj_and_glb_reference_their_texture(tmp_path):
+    textured_city(tmp_path, TEXTURED, ".obj", bake=True)
+    assert "map_Kd tex/wall.png" in (tmp_path / "city.mtl").read_text()
+    images = [g.visual.material.image for g in trimesh.load(tmp_path / "city.obj").geometry.values()]
+    assert sum(image is not None for image in images) == 1
+    scene = trimesh.load(textured_city(tmp_path, TEXTURED, ".glb", bake=True), process=False)
+    textures = [g.visual.material.baseColorTexture for g in scene.geometry.values()]
+    assert sorted(t is not None for t in textures) == [False, True]
+    assert next(t for t in textures if t is not None).size == (2, 2)
+
+
+def test_a_texture_outside_the_roots_is_not_read(tmp_path):
+    (tmp_path / "inner").mkdir()
+    (tmp_path / "tex").mkdir()
+    (tmp_path / "tex" / "wall.png").write_bytes(PNG)  # beside the grammar's folder, not in it
+    textured_city(tmp_path / "inner", TEXTURED.replace("tex/wall.png", "../tex/wall.png"), ".glb", bake=True)
+    scene = trimesh.load(tmp_path / "inner" / "city.glb", process=False)
+    assert all(g.visual.material.baseColorTexture is None for g in scene.geometry.values())
+
+
+def test_a_bake_without_colours_or_textures_has_no_materials(tmp_path):
+    plain = 'version "2023.0"\nLot --> extrude(6) comp(f){ top : setback(2){ all : Rim. | remainder : Top. } }\n'
+    text = textured_city(tmp_path, plain, ".obj", bake=True).read_text()
+    assert "usemtl" not in text and text.count("g lot_") == 2
+    assert "red" not in textured_city(tmp_path, plain, ".ply", bake=True).read_bytes()[:400].decode("latin-1")

@@ -6,9 +6,9 @@ import json
 import numpy as np
 import pytest
 import trimesh
-from writers_city import city, glb_city, world
+from writers_city import TEXTURED, city, glb_city, textured_city, world
 
-from grammarc.io.gltf import GltfWriter, part_paths
+from grammarc.io.gltf import GltfWriter, _read_part, part_paths
 from grammarc.model.records import MeshChunk, TerminalChunk
 
 pygltflib = pytest.importorskip("pygltflib")
@@ -87,3 +87,13 @@ def test_a_glb_asset_is_its_own_prototype(tmp_path):
     got, names = instances(path)
     assert names == ["mast.glb"] * 3
     np.testing.assert_allclose(got[np.argsort(got[:, 0, 3])], record["xform"], atol=1e-4)
+
+
+def test_an_instanced_glb_embeds_its_textures(tmp_path):
+    tree, _ = _read_part(textured_city(tmp_path, TEXTURED, ".glb"))
+    assert tree["images"] == [{"bufferView": tree["images"][0]["bufferView"], "mimeType": "image/png"}]
+    textured = [m for m in tree["materials"] if "baseColorTexture" in m["pbrMetallicRoughness"]]
+    assert len(textured) == 1
+    # the walls' mesh (an (asset, material) group) has the textured material
+    used = {p["material"] for mesh in tree["meshes"] for p in mesh["primitives"]}
+    assert tree["materials"].index(textured[0]) in used

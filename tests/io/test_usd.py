@@ -2,7 +2,7 @@
 
 import numpy as np
 import pytest
-from writers_city import city, glb_city, world
+from writers_city import TEXTURED, city, glb_city, textured_city, world
 
 pxr = pytest.importorskip("pxr")
 from pxr import Usd, UsdGeom
@@ -65,3 +65,14 @@ def test_a_glb_asset_is_its_own_prototype(tmp_path):
     assert len(mesh.GetFaceVertexCountsAttr().Get()) == triangles
     points = np.array(mesh.GetPointsAttr().Get())
     np.testing.assert_allclose([points.min(0), points.max(0)], [[0, 0, 0], [1, 1, 1]], atol=1e-6)
+
+
+def test_instances_with_a_texture_are_bound_to_a_material_reading_it(tmp_path):
+    from pxr import UsdShade
+
+    stage = Usd.Stage.Open(str(textured_city(tmp_path, TEXTURED, ".usda")))
+    shaders = [UsdShade.Shader(p) for p in stage.Traverse() if p.GetTypeName() == "Shader"]
+    files = [s.GetInput("file").Get() for s in shaders if s.GetIdAttr().Get() == "UsdUVTexture"]
+    assert files and all(f.resolvedPath == str(tmp_path / "tex" / "wall.png") for f in files)
+    bound = [p for p in stage.Traverse() if UsdShade.MaterialBindingAPI(p).GetDirectBinding().GetMaterial()]
+    assert bound and all("_m1" in str(p.GetPath()) for p in bound)

@@ -5,6 +5,7 @@ split, colours and a polygon of the mesh table."""
 from __future__ import annotations
 
 import json
+import zlib
 from pathlib import Path
 
 import numpy as np
@@ -70,3 +71,42 @@ def glb_city(tmp_path: Path, output: str) -> tuple[dict, Path, int]:
     build(tmp_path / "g.cga", tmp_path / "city.npz", lots_path=tmp_path / "lots.geojson")
     build(tmp_path / "g.cga", tmp_path / output, lots_path=tmp_path / "lots.geojson")
     return read_instances(tmp_path / "city.npz"), tmp_path / output, len(scene.to_geometry().faces)
+
+
+#: A red roof and half transparent green walls, on two lots; a textured facade.
+COLOURED = """version "2023.0"
+Lot --> extrude(6) comp(f){ top : color(1, 0, 0) Roof. | side : Facade }
+Facade --> color("#00ff00") set(material.opacity, 0.5) Wall.
+"""
+TEXTURED = """version "2023.0"
+Lot --> extrude(6) comp(f){ top : Roof. | side : texture("tex/wall.png") Wall. }
+"""
+RED, SEE_THROUGH_GREEN = [255, 0, 0, 255], [0, 255, 0, 128]
+
+
+def _png(width: int, height: int) -> bytes:
+    """A grey RGB PNG image."""
+
+    def chunk(kind: bytes, data: bytes) -> bytes:
+        return len(data).to_bytes(4, "big") + kind + data + zlib.crc32(kind + data).to_bytes(4, "big")
+    rows = b"".join(b"\0" + b"\x80" * 3 * width for _ in range(height))
+    header = width.to_bytes(4, "big") + height.to_bytes(4, "big") + bytes([8, 2, 0, 0, 0])
+    return b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", header) + chunk(b"IDAT", zlib.compress(rows)) + chunk(b"IEND", b"")
+
+
+PNG = _png(2, 2)
+
+
+def textured_city(tmp_path: Path, text: str, suffix: str, bake: bool = False) -> Path:
+    """``text`` (a colour or texture grammar, its texture ``tex/wall.png``) derived on two lots and written
+    as ``city{suffix}``, baked if ``bake``."""
+    (tmp_path / "tex").mkdir(exist_ok=True)
+    (tmp_path / "tex" / "wall.png").write_bytes(PNG)
+    (tmp_path / "g.cga").write_text(text)
+    squares = [[[30 * k, 0], [30 * k + 12, 0], [30 * k + 12, 9], [30 * k, 9], [30 * k, 0]] for k in range(2)]
+    (tmp_path / "lots.geojson").write_text(json.dumps({"type": "FeatureCollection", "features": [
+        {"type": "Feature", "properties": {}, "geometry": {"type": "Polygon", "coordinates": [ring]}}
+        for ring in squares]}))
+    out = tmp_path / f"city{suffix}"
+    build(tmp_path / "g.cga", out, lots_path=tmp_path / "lots.geojson", output_options=OutputOptions(bake=bake))
+    return out

@@ -4,7 +4,8 @@ import dataclasses
 
 import numpy as np
 
-from grammarc.model.records import WHITE, MeshChunk, TerminalChunk
+from grammarc.ir.nodes import MATERIAL_MAPS
+from grammarc.model.records import WHITE, MaterialTable, MeshChunk, TerminalChunk
 
 
 def triangle() -> MeshChunk:
@@ -43,3 +44,31 @@ def test_colours_default_to_white():
     red = np.tile(np.array([[255, 0, 0, 255]], np.uint8), (3, 1))
     assert dataclasses.replace(plain, color=red).colors() is red
     assert MeshChunk.empty().colors().shape == (0, 4)
+
+
+def textured(chunk: MeshChunk, *colormaps: str) -> MeshChunk:
+    """``chunk`` with a table of these colour maps, its faces taking the first."""
+    table = np.full((len(colormaps), len(MATERIAL_MAPS)), "", dtype=object)
+    table[:, 0] = colormaps
+    return dataclasses.replace(chunk, material=np.zeros(len(chunk.lot), np.int32), materials=table.astype(str))
+
+
+def test_concat_joins_the_tables_of_materials():
+    """Each chunk's rows are shifted by the tables before it; a chunk without textures takes none."""
+    joined = MeshChunk.concat([textured(triangle(), "a.jpg", "b.jpg"), triangle(), textured(triangle(), "c.jpg")])
+    assert joined.materials[:, 0].tolist() == ["a.jpg", "b.jpg", "", "c.jpg"]
+    assert joined.material.tolist() == [0, 2, 3]
+    assert MeshChunk.concat([triangle(), triangle()]).materials is None
+
+
+def test_a_material_table_numbers_the_materials_of_chunks_as_met():
+    table = MaterialTable()
+    first = TerminalChunk(asset=np.zeros(2, np.int32), xform=np.zeros((2, 3, 4), np.float32),
+                          lot=np.zeros(2, np.int32), symbol=np.zeros(2, np.int32),
+                          mesh=textured(triangle(), "b.jpg"), material=np.array([1, 0], np.int32),
+                          materials=textured(triangle(), "b.jpg", "a.jpg").materials)
+    rows, faces = table.add(first)
+    assert (rows.tolist(), faces.tolist()) == ([2, 1], [1])
+    plain = dataclasses.replace(first, material=None, materials=None, mesh=triangle())
+    assert [r.tolist() for r in table.add(plain)] == [[0, 0], [0]]
+    assert table.table()[:, 0].tolist() == ["", "b.jpg", "a.jpg"]

@@ -14,7 +14,7 @@ columns:
 - ``inserts``: ``I``, ``i``, ``label``;
 - ``primitives``: CityEngine's ``primitiveCube/Quad/Disk/Cylinder/Sphere/Cone``;
 - ``successors``: successor symbols, ``ε``/``NIL`` and operations without effect;
-- ``values``: ``set``, ``color``, ``report``;
+- ``values``: ``set``, ``color``, the opacity, ``report``;
 - ``control``: ``case`` and ``p%`` blocks;
 - ``scatter``: ``scatter``, point shapes on, in or around the shape;
 - ``trims``: ``trim()``, the shape's geometry cut by its trim planes;

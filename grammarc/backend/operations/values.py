@@ -1,8 +1,9 @@
-"""Values a shape carries or reports: ``set(attr, value)``, ``color()`` and CityEngine's ``report``.
+"""Values a shape carries or reports: ``set(attr, value)``, ``color()``, the opacity and CityEngine's ``report``.
 
-``set`` and ``color`` give the shape (and so its successors and parts) a new value in its ``dynamic`` column;
-``report`` adds rows to the chunk's reports (``backend.report_rows``). Reads: what their expressions read, and
-``lot`` (reports). Writes: ``set`` and ``color`` the ``dynamic`` column of their value.
+``set``, ``color`` and ``set(material.opacity)`` give the shape (and so its successors and parts) a new
+value in its ``dynamic`` column (the colour and opacity share one: ``backend.materials``); ``report`` adds
+rows to the chunk's reports (``backend.report_rows``). Reads: what their expressions read, and ``lot``
+(reports). Writes: ``set``, ``color`` and the opacity the ``dynamic`` column of their value.
 """
 
 from __future__ import annotations
@@ -13,6 +14,7 @@ import numpy as np
 
 from grammarc.backend.context import Context
 from grammarc.backend.evaluate import evaluate, evaluate_array
+from grammarc.backend.materials import with_opacity, with_transparency_of
 from grammarc.backend.operations.table import operation
 from grammarc.backend.shapes import Shapes
 from grammarc.ir import nodes as ir
@@ -47,7 +49,17 @@ def set_color(ctx: Context, cursor: Shapes, op: ir.SetColor) -> Shapes:
             text = names[int(ids[np.flatnonzero(bad)[0]])]
             ctx.fail(cursor, bad, f'color("{text}") is not a colour "#rrggbb"', op.span)
     index = ctx.plan.color_slot
-    dynamic = cursor.dynamic[:index] + (packed.astype(np.float64),) + cursor.dynamic[index + 1:]
+    packed = with_transparency_of(packed.astype(np.float64), cursor.dynamic[index])
+    dynamic = cursor.dynamic[:index] + (packed,) + cursor.dynamic[index + 1:]
+    return replace(cursor, dynamic=dynamic)
+
+
+@operation(ir.SetOpacity, writes=("dynamic",), meshes=True)
+def set_opacity(ctx: Context, cursor: Shapes, op: ir.SetOpacity) -> Shapes:
+    """The shape's opacity, in the colour column beside its colour (``backend.materials``)."""
+    index = ctx.plan.color_slot
+    opacity = np.broadcast_to(evaluate_array(op.value, ctx.env(cursor)), (len(cursor),))
+    dynamic = cursor.dynamic[:index] + (with_opacity(cursor.dynamic[index], opacity),) + cursor.dynamic[index + 1:]
     return replace(cursor, dynamic=dynamic)
 
 

@@ -240,6 +240,8 @@ class OperationLowering:
         if not self.arity(op, args, (2,), span):
             return ir.Empty(span)
         target = args[0]
+        if isinstance(target, ir.ContextRef) and target.name in ir.MATERIAL_FIELDS:
+            return self.set_material(target.name, self.expr(args[1]), span)
         if isinstance(target, ir.ScopeRef) and target.field[0] in "tsr":
             return self.set_scope(target, self.expr(args[1]), span)
         if isinstance(target, ir.Name) and target.name in ir.SHAPE_ATTRIBUTES:
@@ -249,6 +251,24 @@ class OperationLowering:
         if not isinstance(target, ir.Name):
             return self.unsupported("set of this target", span, "set(attribute, value)")
         return ir.SetAttr(target.name, self.expr(args[1]), span)
+
+    def set_material(self, name: str, value: ir.Expr, span) -> ir.Op:
+        """``set(material.*, v)`` of an attribute the shape carries (``ir.MATERIAL_FIELDS``): a texture
+        channel is a string attribute; a colour component is ``color`` with the other two kept, the
+        opacity the colour's alpha."""
+        if name in ir.SHAPE_ATTRIBUTES:
+            return ir.SetAttr(name, value, span)
+        if name == "material.opacity":
+            return ir.SetOpacity(value, span)
+        channel = "rgb".index(name[-1])
+        return ir.SetColor(tuple(value if k == channel else ir.ContextRef(f"material.color.{c}", span)
+                                 for k, c in enumerate("rgb")), span)
+
+    def op_texture(self, op, args, span):
+        """``texture(path)`` is ``set(material.colormap, path)``."""
+        if not self.arity(op, args, (1,), span):
+            return ir.Empty(span)
+        return ir.SetAttr("material.colormap", self.expr(args[0]), span)
 
     def set_scope(self, target: ir.ScopeRef, value: ir.Expr, span) -> ir.Op:
         """``set(scope.tx, v)`` and its kin: the one field set, the other two of its vector kept. Positions
@@ -490,6 +510,7 @@ OPERATIONS = {
     "reduceGeometry": direct(ir.ReduceGeometry),
     "mirrorScope": direct(ir.MirrorScope),
     "roofRidge": OperationLowering.op_roof,
+    "texture": OperationLowering.op_texture,
 }
 #: Operations with parts ``{ ... }``: name -> handler(lowering, op, args, parts, span); those of ``REPEATING``
 #: also repeat (``{ ... }*``), with ``repeat=True``.
@@ -540,7 +561,7 @@ SETBACK_SELECTORS = (COMP_SELECTORS["f"] - ir.OFFSET_SELECTORS) | {"all", "remai
 UNSUPPORTED_MEMBERS = frozenset({"comp", "split", "initialShape", "geometry"})
 #: Operations that are parsed and accepted but do not change the record (listed in its meta).
 NOT_APPLIED = frozenset({
-    "texture", "setupProjection", "projectUV", "tileUV", "translateUV", "scaleUV", "rotateUV",
+    "setupProjection", "projectUV", "tileUV", "translateUV", "scaleUV", "rotateUV",
     "normalizeUV", "deleteUV", "reverseNormals", "print", "setNormals", "softenNormals",
     # the pivot only moves the model's own origin in an export; scope.t* stay relative to the lot
     "setPivot",

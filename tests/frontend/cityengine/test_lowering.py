@@ -279,7 +279,7 @@ def test_building_fixture_lowers_every_construct():
     height = next(a for a in module.attrs if a.name == "height")
     assert ("Range", ("min=3", "max=30", "restricted=false")) in height.annotations
     assert grammar.assets == ("builtin:cube", "builtin:quad", "assets/window.obj")
-    assert make_plan(grammar).not_applied == ("print", "projectUV", "setupProjection", "texture")
+    assert make_plan(grammar).not_applied == ("print", "projectUV", "setupProjection")
 
 
 # ------------------------------------------------------------------------------ the free syntax (issue 17)
@@ -356,7 +356,8 @@ Lot --> extrude(case h > 10 : h else : 10) set(material.color.r, case h > 1 : 0.
     s('1, (case h > 12 : 1 else : 0.8) * scope.sy, '1) A(30% : 1 else : 2)
 A(x) --> X.
 """
-    assert body_of(text) == ("extrude(((@h > 10) ? @h : 10)) set(material.color.r)(...) "
+    assert body_of(text) == ("extrude(((@h > 10) ? @h : 10)) "
+                             "color(((@h > 1) ? 0.5 : 1), material.color.g, material.color.b) "
                              "S(1r, (((@h > 12) ? 1 : 0.8) * Scope.sy), 1r) A(((rand() < 0.3) ? 1 : 2))")
 
 

@@ -1,0 +1,89 @@
+"""A shape's material: its colour and opacity packed in one column, its texture channels as string columns.
+
+CityEngine's material attributes (``material.color.r``, ``material.opacity``, ``material.colormap``...)
+are per-shape values that successors inherit. The derivation keeps those a grammar sets or reads:
+
+- the colour and the opacity share the colour column (``slots.COLOR_SLOT``), one float per shape:
+  0xRRGGBB plus the transparency ``255 - alpha`` times 2^24, so that an opaque colour is the number it
+  always was (and a record without ``set(material.opacity)`` the bytes it always was);
+- each texture channel the grammar sets or reads is a column of its own named as the attribute
+  (``material.colormap``), the interned id of its path ("" for none).
+
+Terminals carry the channels into the record as a table of distinct channel tuples (``collect_materials``),
+each tuple the texts of every channel of ``ir.MATERIAL_MAPS`` ("" where none), and an index into it per
+row; the paths are kept as the grammar wrote them and resolved by the writers that read the files.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from grammarc.ir import nodes as ir
+
+#: The transparency's place in the packed colour.
+_ALPHA_UNIT = float(1 << 24)
+#: The texture channel columns' names, in the record's order.
+MAP_FIELDS = tuple(f"material.{m}" for m in ir.MATERIAL_MAPS)
+#: The material attributes read from the colour column.
+COLOR_FIELDS = frozenset(ir.MATERIAL_FIELDS) - frozenset(MAP_FIELDS)
+
+
+def rgba(packed: np.ndarray) -> np.ndarray:
+    """(n, 4) uint8 RGBA colours from packed colours (n,) stored as floats (module docstring)."""
+    value = packed.astype(np.int64)
+    return np.stack([value >> 16 & 255, value >> 8 & 255, value & 255, 255 - (value >> 24 & 255)],
+                    axis=1).astype(np.uint8)
+
+
+def with_transparency_of(rgb: np.ndarray, packed: np.ndarray) -> np.ndarray:
+    """New colours 0xRRGGBB (n,) keeping the transparency of the shapes' packed colours (n,)."""
+    return rgb + np.floor(packed / _ALPHA_UNIT) * _ALPHA_UNIT
+
+
+def with_opacity(packed: np.ndarray, opacity: np.ndarray) -> np.ndarray:
+    """The packed colours (n,) with a new opacity (n,) in [0, 1] (clipped)."""
+    transparency = 255 - np.round(np.clip(opacity, 0.0, 1.0) * 255)
+    return packed % _ALPHA_UNIT + transparency * _ALPHA_UNIT
+
+
+def channel(name: str, packed: np.ndarray | None):
+    """``material.color.r|g|b`` or ``material.opacity`` in [0, 1] of packed colours (n,) float64, or the
+    default (white, opaque) where the grammar sets no colour (``packed`` None)."""
+    if packed is None:
+        return 1.0
+    value = packed.astype(np.int64)
+    if name == "material.opacity":
+        return (255 - (value >> 24 & 255)) / 255.0
+    return (value >> (16 - 8 * "rgb".index(name[-1])) & 255) / 255.0
+
+
+def material_ids(plan, shapes, rows=slice(None)) -> np.ndarray | None:
+    """(m, k) int32: the string ids of the ``k`` texture channels the grammar carries (``Plan.material_slots``)
+    of ``shapes`` rows ``rows``; None when it carries none."""
+    if not plan.material_slots:
+        return None
+    return np.stack([shapes.dynamic[slot][rows] for _, slot in plan.material_slots], axis=1).astype(np.int32)
+
+
+def collect_materials(plan, ids: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The chunk's table of materials and each row's index into it, from the rows' channel ids (n, k).
+
+    Returns
+    -------
+    materials : (M, len(ir.MATERIAL_MAPS)) str
+        The distinct channel tuples, in order of their ids, as texts ("" where a channel is not set).
+    material : (n,) int32
+        Each row's material.
+    """
+    names = list(plan.strings.ids)
+    # one int64 key per row (the ids in base len(names)) sorts far faster than rows (np.unique(axis=0))
+    radix = np.int64(len(names)) ** np.arange(ids.shape[1], dtype=np.int64)
+    if float(len(names)) ** ids.shape[1] < 2.0 ** 62:
+        keys, inverse = np.unique(ids.astype(np.int64) @ radix, return_inverse=True)
+        distinct = keys[:, None] // radix % np.int64(len(names))
+    else:
+        distinct, inverse = np.unique(ids, axis=0, return_inverse=True)
+    materials = np.full((len(distinct), len(MAP_FIELDS)), "", dtype=object)
+    for column, (k, _) in enumerate(plan.material_slots):
+        materials[:, k] = [names[int(i)] for i in distinct[:, column]]
+    return materials.astype(str), inverse.reshape(-1).astype(np.int32)
