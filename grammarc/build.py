@@ -208,6 +208,9 @@ def derive(grammar: Grammar, lots: Lots, options: BuildOptions = BuildOptions())
                         else np.int32))
         for name in ("asset", "xform", "lot", "symbol")
     }
+    if any(c.uv is not None for c in chunks):  # texture coordinates of set 0 (``TerminalChunk.uv``)
+        columns["uv"] = np.concatenate([c.uv if c.uv is not None else np.full((len(c.asset), 2, 4), np.nan, np.float32)
+                                        for c in chunks])
     columns.update(
         assets=np.array(grammar.assets), symbols=np.array(plan.symbol_names), mesh=mesh,
         bad=tuple(sorted((*lots.bad, *failed), key=lambda b: b.index)), reports=reports,

@@ -45,6 +45,31 @@ class Frames:
         return self.data[ids]
 
 
+class TextureMaps:
+    """Growable table of texture maps (M, 2, 4) float64, affine maps from world coordinates to (u, v)
+    (``backend.texture_space``); map 0 is NaN, no texture coordinates. Shapes hold map ids, as they hold
+    frame ids: children share their parent's maps, and most operations keep them."""
+
+    def __init__(self, capacity: int = 64) -> None:
+        self.data = np.full((capacity, 2, 4), np.nan)
+        self.count = 1
+
+    def add(self, maps: np.ndarray) -> np.ndarray:
+        """Append maps (m, 2, 4); returns their ids (m,) int32."""
+        m = len(maps)
+        if self.count + m > len(self.data):
+            grown = np.empty((max(2 * len(self.data), self.count + m), 2, 4))
+            grown[: self.count] = self.data[: self.count]
+            self.data = grown
+        self.data[self.count: self.count + m] = maps
+        ids = np.arange(self.count, self.count + m, dtype=np.int32)
+        self.count += m
+        return ids
+
+    def __getitem__(self, ids: np.ndarray) -> np.ndarray:
+        return self.data[ids]
+
+
 @dataclass
 class Outputs:
     """Terminal rows and leaf meshes of a chunk, as lists of arrays concatenated at the end."""
@@ -56,6 +81,8 @@ class Outputs:
     meshes: list = field(default_factory=list)
     #: (n, 4) uint8 colours beside ``asset``, when the grammar sets colours.
     color: list = field(default_factory=list)
+    #: (n, 2, 4) float32 texture maps beside ``asset``, when the grammar has texture coordinates of set 0.
+    uv: list = field(default_factory=list)
     #: ``report`` rows: (lot, key ids, values, kind) per call.
     reports: list = field(default_factory=list)
 
@@ -89,6 +116,8 @@ class Chunk:
     occluders: OccluderStore = field(default_factory=OccluderStore)
     #: Snap planes of the paper's ``Snap`` / ``SnapLines`` (``backend.snaps``).
     snaps: SnapStore = field(default_factory=SnapStore)
+    #: Texture maps the shapes' texture columns name (``backend.texture_space``).
+    texture_maps: TextureMaps = field(default_factory=TextureMaps)
     #: Shapes created so far per lot, for the ``max_shapes`` limit.
     shape_count: np.ndarray = field(init=False)
 

@@ -25,6 +25,7 @@ from grammarc.backend.random import lot_keys
 from grammarc.backend.report_rows import aggregate_chunk
 from grammarc.backend.shapes import Shapes
 from grammarc.backend.slots import ANCESTORS, COLOR_SLOT, TRIM_SLOTS, TRIM_SWITCH, WHITE_RGB
+from grammarc.backend.texture_space import initial_column
 from grammarc.constants import Limits
 from grammarc.geometry.footprint import footprint_polygons, lot_scopes
 from grammarc.geometry.polygons import PolygonStore
@@ -109,6 +110,10 @@ def initial_dynamic(plan: Plan, name: str, chunk: Chunk, shapes: Shapes) -> np.n
         return np.full(n, np.nan)
     if name == TRIM_SWITCH:
         return np.ones(n)
+    if plan.uv_slots:
+        texture = initial_column(plan, name, chunk, shapes)
+        if texture is not None:
+            return texture
     return chunk.attrs[name][shapes.lot]
 
 
@@ -128,6 +133,8 @@ def collect(chunk: Chunk) -> TerminalChunk:
     names = [("asset", (), np.int32), ("xform", (3, 4), np.float32), ("symbol", (), np.int32)]
     if out.color:
         names.append(("color", (4,), np.uint8))
+    if out.uv:
+        names.append(("uv", (2, 4), np.float32))
     for name, row_shape, dtype in names:
         column = np.empty((len(lot), *row_shape), dtype=dtype)
         width = int(np.prod(row_shape))
@@ -143,9 +150,9 @@ def collect(chunk: Chunk) -> TerminalChunk:
     if len(mesh.lot):
         mesh = _sort_mesh(mesh)
     mesh = MeshChunk(mesh.vertices, mesh.ring_offsets, mesh.face_offsets, index[mesh.lot], mesh.symbol,
-                     mesh.color)
+                     mesh.color, mesh.uv)
     return TerminalChunk(asset=columns["asset"], xform=columns["xform"], lot=index[lot[order]],
-                         symbol=columns["symbol"], mesh=mesh, color=columns.get("color"))
+                         symbol=columns["symbol"], mesh=mesh, color=columns.get("color"), uv=columns.get("uv"))
 
 
 def _sort_mesh(mesh: MeshChunk) -> MeshChunk:
@@ -153,4 +160,5 @@ def _sort_mesh(mesh: MeshChunk) -> MeshChunk:
     rings, face_offsets = ragged_take(mesh.face_offsets, order)
     vertices, ring_offsets = ragged_take(mesh.ring_offsets, rings)
     return MeshChunk(mesh.vertices[vertices], ring_offsets, face_offsets, mesh.lot[order],
-                     mesh.symbol[order], mesh.color[order] if mesh.color is not None else None)
+                     mesh.symbol[order], mesh.color[order] if mesh.color is not None else None,
+                     mesh.uv[vertices] if mesh.uv is not None else None)

@@ -9,7 +9,7 @@ from collections.abc import Callable
 from dataclasses import dataclass, field, replace
 
 from grammarc.backend.leaf_parts import leaf_inserts
-from grammarc.backend.slots import ANCESTORS, COLOR_SLOT, TRIM_SLOTS, TRIM_SWITCH
+from grammarc.backend.slots import ANCESTORS, COLOR_SLOT, TRIM_SLOTS, TRIM_SWITCH, uv_slots
 from grammarc.ir import nodes as ir
 from grammarc.ir.traverse import all_exprs, iter_ops
 from grammarc.model.assets import load_asset
@@ -81,6 +81,9 @@ class Plan:
     #: Whether shapes carry their occluding ancestors (``backend.occlusion``): the grammar asks occlusion
     #: queries or labels shapes.
     occluders: bool = False
+    #: Texture set -> index into ``Shapes.dynamic`` of its two columns (``slots.uv_slots``), for the sets
+    #: the grammar's texture operations and queries name; empty: no shape carries texture coordinates.
+    uv_slots: dict = field(default_factory=dict)
     #: ``load_asset(name, asset_roots) -> AssetMesh``: how trimmed inserts get their asset's triangles
     #: (the model's loader, or a test's stand-in).
     load_asset: Callable = load_asset
@@ -118,9 +121,10 @@ def make_plan(grammar: Grammar, *, load_asset: Callable = load_asset) -> Plan:
                  for symbol in symbols}
     occlusion = {k: v for k, v in occlusion.items() if v}
     ancestors = list(ANCESTORS) if occlusion or any(isinstance(op, ir.Label) for op in ops) else []
+    uv_sets = texture_sets(module, ops)
     dynamic = {name: i for i, name in enumerate(dict.fromkeys(
         [op.name for op in ops if isinstance(op, ir.SetAttr)] + sorted(set(context)) + colour + trims
-        + ancestors))}
+        + ancestors + [name for s in uv_sets for name in uv_slots(s)]))}
     not_applied = tuple(sorted({op.name for op in ops if isinstance(op, ir.NotApplied)}))
     strings.intern("")
     for answer in ("none", "part", "full"):  # of Shape.occ
@@ -138,5 +142,24 @@ def make_plan(grammar: Grammar, *, load_asset: Callable = load_asset) -> Plan:
                                                         for op in iter_ops(rule))),
         color_slot=dynamic.get(COLOR_SLOT), trim_slot=trim_slot,
         trim_switch=dynamic.get(TRIM_SWITCH) if trim_slot is not None else None,
-        occluders=ANCESTORS[0] in dynamic, load_asset=load_asset)
+        occluders=ANCESTORS[0] in dynamic, load_asset=load_asset,
+        uv_slots={s: dynamic[uv_slots(s)[0]] for s in uv_sets})
     return replace(plan, leaf_inserts=leaf_inserts(plan))
+
+
+#: CityEngine's queries of texture coordinates, whose first argument (0 when left out) names the set.
+UV_QUERIES = frozenset(f"geometry.{name}" for name in ("uMin", "uMax", "vMin", "vMax", "du", "dv"))
+
+
+def texture_sets(module: ir.Module, ops) -> list[int]:
+    """The texture sets the grammar's operations and queries name, in order (the lowering made each a
+    whole number)."""
+    sets = {op.uv_set for op in ops if isinstance(op, TEXTURE_OPS) or (isinstance(op, ir.GroupSplit)
+                                                                     and op.uv_set >= 0)}
+    for expr in all_exprs(module):
+        if isinstance(expr, ir.Call) and expr.func in UV_QUERIES:
+            sets.add(int(expr.args[0].value) if expr.args and isinstance(expr.args[0], ir.Num) else 0)
+    return sorted(sets)
+
+
+TEXTURE_OPS = (ir.SetupProjection, ir.ProjectUV, ir.TransformUV, ir.TileUV, ir.NormalizeUV)

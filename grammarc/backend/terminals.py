@@ -16,15 +16,18 @@ no rule applied) into output, as CityEngine emits leaf geometry:
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 
 from grammarc.backend.context import Context
 from grammarc.backend.kernels.scope import xforms
 from grammarc.backend.mesh_shapes import mesh_leaves
 from grammarc.backend.shapes import Z_UP, Shapes, asset_of, face_axes
+from grammarc.backend.texture_space import texture_maps
 from grammarc.constants import TOL
 from grammarc.geometry.components import reverse_rings
-from grammarc.geometry.meshes import is_mesh, is_polygon
+from grammarc.geometry.meshes import MESH_BASE, is_mesh, is_polygon
 from grammarc.geometry.polygons import PLANE_U, PLANE_V
 from grammarc.geometry.trim import boxes_crossing, trim_triangles
 from grammarc.model.records import MeshChunk
@@ -61,8 +64,8 @@ def emit_instances(ctx: Context, shapes: Shapes, asset: int, symbol: int, mirror
         cut = boxes_crossing(planes, xform.astype(np.float64), TOL.zero)
         mesh = ctx.asset_mesh(asset) if cut.any() else None
         if mesh is not None:
-            trimmed = _trimmed(ctx.plan, shapes.take(cut), xform[cut], planes[cut], mesh, symbol)
-            chunk.outputs.meshes.append(trimmed)
+            trimmed, owner = _trimmed(ctx.plan, shapes.take(cut), xform[cut], planes[cut], mesh, symbol)
+            chunk.outputs.meshes.append(_with_uv(ctx, shapes.take(cut), owner, trimmed))
             shapes, xform = shapes.take(~cut), xform[~cut]
     _append(ctx, shapes, xform, asset, symbol)
 
@@ -85,15 +88,16 @@ def _trim_planes(plan, shapes: Shapes) -> np.ndarray:
     return planes
 
 
-def _trimmed(plan, shapes: Shapes, xform: np.ndarray, planes: np.ndarray, mesh, symbol: int) -> MeshChunk:
-    """The asset's triangles placed by ``xform`` and cut by the shapes' trim ``planes``, as mesh faces."""
+def _trimmed(plan, shapes: Shapes, xform: np.ndarray, planes: np.ndarray, mesh, symbol: int):
+    """The asset's triangles placed by ``xform`` and cut by the shapes' trim ``planes``, as mesh faces, and
+    the shape of each face."""
     vertices, ring_offsets, owner = trim_triangles(mesh.vertices, mesh.faces, xform.astype(np.float64),
                                                    planes, TOL.zero)
     return MeshChunk(
         vertices=vertices.astype(np.float32), ring_offsets=ring_offsets,
         face_offsets=np.arange(len(owner) + 1, dtype=np.int64), lot=shapes.lot[owner].astype(np.int32),
         symbol=np.full(len(owner), symbol, dtype=np.int32),
-        color=_colors(plan, shapes, owner))
+        color=_colors(plan, shapes, owner)), owner
 
 
 def _colors(plan, shapes: Shapes, rows=slice(None)) -> np.ndarray | None:
@@ -104,19 +108,44 @@ def _colors(plan, shapes: Shapes, rows=slice(None)) -> np.ndarray | None:
 def _append(ctx: Context, shapes: Shapes, xform: np.ndarray, asset: int, symbol: int) -> None:
     color_slot = ctx.plan.color_slot
     append_records(ctx, xform, shapes.lot, asset, symbol,
-                   shapes.dynamic[color_slot] if color_slot is not None else None)
+                   shapes.dynamic[color_slot] if color_slot is not None else None, _instance_uv(ctx, shapes, xform))
 
 
 def append_records(ctx: Context, xform: np.ndarray, lot: np.ndarray, asset: int, symbol: int,
-                   color: np.ndarray | None) -> None:
-    """Add instance records: transforms, lots, and colours (0xRRGGBB floats) where the grammar sets them."""
+                   color: np.ndarray | None, uv: np.ndarray | None = None) -> None:
+    """Add instance records: transforms, lots, colours (0xRRGGBB floats) where the grammar sets them, and
+    texture maps (``TerminalChunk.uv``) where it has texture coordinates."""
     out = ctx.chunk.outputs
+    if uv is not None:
+        out.uv.append(uv)
     out.xform.append(xform)
     out.asset.append(np.full(len(lot), asset, dtype=np.int32))
     out.lot.append(lot.astype(np.int32))
     out.symbol.append(np.full(len(lot), symbol, dtype=np.int32))
     if ctx.plan.color_slot is not None:
         out.color.append(rgba(color))
+
+
+def _instance_uv(ctx: Context, shapes: Shapes, xform: np.ndarray) -> np.ndarray | None:
+    """(n, 2, 4) float32: the texture coordinates of set 0 of instances placed by ``xform`` as maps of
+    their unit box's points, where the grammar has texture coordinates (NaN where a shape has none)."""
+    if 0 not in ctx.plan.uv_slots:
+        return None
+    maps = texture_maps(ctx.plan, ctx.chunk, shapes, 0)
+    placed = np.einsum("nij,njk->nik", maps[:, :, :3], xform.astype(np.float64))
+    placed[:, :, 3] += maps[:, :, 3]
+    return placed.astype(np.float32)
+
+
+def _with_uv(ctx: Context, shapes: Shapes, owner: np.ndarray, mesh: MeshChunk) -> MeshChunk:
+    """``mesh`` with the texture coordinates of set 0 of its vertices (``MeshChunk.uv``), its faces those
+    of ``shapes`` rows ``owner``, where the grammar has texture coordinates."""
+    if 0 not in ctx.plan.uv_slots:
+        return mesh
+    maps = texture_maps(ctx.plan, ctx.chunk, shapes, 0)[owner][segment_of(mesh.face_offsets)]
+    maps = maps[segment_of(mesh.ring_offsets)]
+    uv = np.einsum("vij,vj->vi", maps[:, :, :3], mesh.vertices.astype(np.float64)) + maps[:, :, 3]
+    return replace(mesh, uv=uv.astype(np.float32))
 
 
 def rgba(packed: np.ndarray) -> np.ndarray:
@@ -152,7 +181,9 @@ def emit_leaves(ctx: Context, shapes: Shapes, symbol: int) -> None:
         chunk.outputs.meshes.append(polygon_meshes(ctx, polygons, symbol))
     meshes = shapes.take(is_mesh(shapes.geom))
     if len(meshes):
-        chunk.outputs.meshes.append(mesh_leaves(chunk, meshes, symbol, _colors(ctx.plan, meshes)))
+        leaves = mesh_leaves(chunk, meshes, symbol, _colors(ctx.plan, meshes))
+        owner = np.repeat(np.arange(len(meshes)), np.diff(chunk.meshes.mesh_offsets)[meshes.geom - MESH_BASE])
+        chunk.outputs.meshes.append(_with_uv(ctx, meshes, owner, leaves))
 
 
 def polygon_meshes(ctx: Context, shapes: Shapes, symbol: int) -> MeshChunk:
@@ -201,14 +232,14 @@ def polygon_meshes(ctx: Context, shapes: Shapes, symbol: int) -> MeshChunk:
     ring_sizes = np.concatenate(faces_rings)
     rings_per_face = np.concatenate(faces_shape)
     face_owner = np.concatenate([rows, np.flatnonzero(solid), s[j]])
-    return MeshChunk(
+    return _with_uv(ctx, shapes, face_owner, MeshChunk(
         vertices=vertices,
         ring_offsets=offsets_from_counts(ring_sizes),
         face_offsets=offsets_from_counts(rings_per_face),
         lot=shapes.lot[face_owner].astype(np.int32),
         symbol=np.full(len(face_owner), symbol, dtype=np.int32),
         color=_colors(ctx.plan, shapes, face_owner),
-    )
+    ))
 
 
 def _reversed_order(ring_offsets: np.ndarray) -> np.ndarray:

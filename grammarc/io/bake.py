@@ -112,8 +112,10 @@ def bake(
     return _bake(asset_library(names, record, asset_roots), asset, xform, mesh, max_triangles)
 
 
-def _bake(library: AssetLibrary, asset: np.ndarray, xform: np.ndarray, mesh: MeshChunk, max_triangles: int):
-    """``bake`` of a record's columns, its assets in ``library``."""
+def _bake(library: AssetLibrary, asset: np.ndarray, xform: np.ndarray, mesh: MeshChunk, max_triangles: int,
+          uv: np.ndarray | None = None):
+    """``bake`` of a record's columns, its assets in ``library``; the mesh has texture coordinates (0 where a
+    vertex has none) where the instances' ``uv`` (``TerminalChunk.uv``) or the mesh table's are given."""
     import trimesh
 
     used = np.bincount(asset, minlength=len(library.names)).astype(np.int64)
@@ -133,14 +135,20 @@ def _bake(library: AssetLibrary, asset: np.ndarray, xform: np.ndarray, mesh: Mes
     v0 = t0 = 0
     order = np.argsort(asset, kind="stable")  # instances grouped by asset, in record order within each
     starts = offsets_from_counts(used)
+    texture = None if uv is None and mesh.uv is None else np.zeros((n_vertices, 2), np.float64)
     for a in assets:
         shape = library[a]
         rows = order[starts[a] : starts[a + 1]]
+        if texture is not None and uv is not None:  # the instances' maps of their unit box, per vertex
+            placed = np.einsum("kij,vj->kvi", uv[rows, :, :3].astype(np.float64), shape.vertices)
+            texture[v0 : v0 + placed.shape[0] * placed.shape[1]] = (placed + uv[rows, None, :, 3]).reshape(-1, 2)
         v0, t0 = _expand(shape, xform, rows, vertices, faces, v0, t0)
         face_sizes = _add_counts(face_sizes, shape.polygon_sizes, int(used[a]))
         n_polygons += int(used[a]) * shape.n_polygons
     if len(mesh.face_offsets) > 1:
         vertices[v0:] = mesh.vertices
+        if texture is not None:
+            texture[v0:] = mesh.texture()
         triangles = triangulate_polygons(mesh.vertices, mesh.ring_offsets, mesh.face_offsets)
         faces[t0 : t0 + len(triangles)] = triangles + v0
         t0 += len(triangles)
@@ -155,7 +163,8 @@ def _bake(library: AssetLibrary, asset: np.ndarray, xform: np.ndarray, mesh: Mes
         "n_holes": int(len(mesh.ring_offsets) - 1 - n_faces),
         "face_sizes": {int(k): int(c) for k, c in enumerate(face_sizes) if c},
     }
-    return trimesh.Trimesh(vertices=vertices, faces=faces[:t0], process=False, metadata=metadata)
+    visual = None if texture is None else trimesh.visual.TextureVisuals(uv=np.nan_to_num(texture))
+    return trimesh.Trimesh(vertices=vertices, faces=faces[:t0], process=False, metadata=metadata, visual=visual)
 
 
 def _expand(shape: AssetMesh, xform: np.ndarray, rows: np.ndarray, vertices: np.ndarray,
@@ -280,12 +289,13 @@ class BakedWriter(WriterBlock):
         if max_triangles is None:
             max_triangles = int(os.environ.get("GRAMMARC_MAX_TRIANGLES", MAX_TRIANGLES))
         self.max_triangles = max_triangles
-        self._chunks: list[tuple[np.ndarray, np.ndarray, MeshChunk]] = []
+        self._chunks: list[tuple] = []
         self._triangles = 0
         self._rows = 0
         self._state = "open"
         self._counts: dict = {}
         self._made = {"triangles": 0, "vertices": 0, "polygons": 0, "mesh_faces": 0, "mesh_vertices": 0}
+        self._uv_vertices = 0  # vertices of the streamed OBJ with a texture coordinate (vt)
         self._tmpdir: str | None = None
         self._file = None  # the output being written, in _tmpdir: OBJ from the first chunk, else on close
         if self._file_type == "obj":
@@ -325,11 +335,14 @@ class BakedWriter(WriterBlock):
                 )
             if self._file is not None:
                 mesh = _bake(self._library, asset.astype(np.int64, copy=False), xform, chunk.mesh,
-                             self.max_triangles)
-                self._file.write(obj_bytes(mesh.vertices, mesh.faces + self._made["vertices"]))
+                             self.max_triangles, chunk.uv)
+                uv = _texture(mesh)
+                self._file.write(obj_bytes(mesh.vertices, mesh.faces + self._made["vertices"], uv=uv,
+                                           uv_shift=self._made["vertices"] - self._uv_vertices))
+                self._uv_vertices += len(mesh.vertices) if uv is not None else 0
                 self._count(mesh, chunk.mesh)
             else:
-                self._chunks.append((asset, xform, chunk.mesh))
+                self._chunks.append((asset, xform, chunk.mesh, chunk.uv))
         except BaseException:
             self.abort()
             raise
@@ -364,9 +377,11 @@ class BakedWriter(WriterBlock):
                 mesh_table = MeshChunk.concat([c[2] for c in chunks])
                 asset = np.concatenate([c[0] for c in chunks]) if chunks else np.zeros(0, np.int64)
                 xform = np.concatenate([c[1] for c in chunks]) if chunks else np.zeros((0, 3, 4), np.float32)
+                uv = None if all(c[3] is None for c in chunks) else np.concatenate(
+                    [c[3] if c[3] is not None else np.full((len(c[0]), 2, 4), np.nan, np.float32) for c in chunks])
                 del chunks
                 mesh = _bake(self._library, asset.astype(np.int64, copy=False), xform, mesh_table,
-                             self.max_triangles)
+                             self.max_triangles, uv)
                 del asset, xform
                 self._count(mesh, mesh_table)
                 self._file.write(self._export(mesh))
@@ -404,6 +419,11 @@ class BakedWriter(WriterBlock):
         mesh.metadata = {}  # glb writes metadata as extras; keep the file to geometry
         data = mesh.export(file_type=self._file_type)
         return data if isinstance(data, bytes) else data.encode("utf-8")
+
+
+def _texture(mesh) -> np.ndarray | None:
+    """A baked mesh's texture coordinates (V, 2), None when it has none."""
+    return getattr(mesh.visual, "uv", None)
 
 
 #: The extensions this module writes (``grammarc.io.writers``): all baked.

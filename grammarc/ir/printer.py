@@ -102,7 +102,9 @@ def _group_split(op: ir.GroupSplit) -> str:
         group = g
     shown = [" | ".join(i) if i[0] != "{" else "{ " + " | ".join(i[1:]) + " }*" for i in items]
     options = "" if op.adjust else ", noAdjust"
-    return f"split({'xyz'[op.axis]}{options}){{ {' | '.join(shown)} }}{'*' if op.repeat else ''}"
+    head = f"{'xyz'[op.axis]}{options}" if op.uv_set < 0 else \
+        f"{'uv'[op.axis]}, {'unitSpace' if op.unit_space else 'uvSpace'}, {op.uv_set}"
+    return f"split({head}){{ {' | '.join(shown)} }}{'*' if op.repeat else ''}"
 
 
 def _roof(op: ir.Roof) -> str:
@@ -184,6 +186,12 @@ _OP_FORMATS = {
     ir.NotApplied: lambda op: f"{op.name}(...)",
     ir.Scatter: _scatter,
     ir.Primitive: lambda op: f"primitive{op.kind.title()}({_list(op.segments + (op.sizes or ()))})",
+    ir.SetupProjection: lambda op: (f"setupProjection({op.uv_set}, {op.frame}.{'xyz'[op.u_axis]}{'xyz'[op.v_axis]}, "
+                                    f"{', '.join(_size(s) for s in op.sizes + op.offsets)})"),
+    ir.ProjectUV: lambda op: f"{'deleteUV' if op.delete else 'projectUV'}({op.uv_set})",
+    ir.TransformUV: lambda op: f"{op.kind}UV({op.uv_set}, {_list(op.values)})",
+    ir.TileUV: lambda op: f"tileUV({op.uv_set}, {', '.join(_size(s) for s in op.sizes)})",
+    ir.NormalizeUV: lambda op: f"normalizeUV({op.uv_set}, {op.mode})",
 }
 
 

@@ -39,6 +39,8 @@ class MeshChunk:
         Symbol of each face, an index into the writer's ``symbols``.
     color : (F, 4) uint8, optional
         RGBA colour of each face (CityEngine's ``color``); None: white.
+    uv : (V, 2) float32, optional
+        Texture coordinates of set 0 of each vertex (NaN: its face has none); None: no face has any.
     """
 
     vertices: np.ndarray
@@ -47,6 +49,7 @@ class MeshChunk:
     lot: np.ndarray
     symbol: np.ndarray
     color: np.ndarray | None = None
+    uv: np.ndarray | None = None
 
     def colors(self) -> np.ndarray:
         """(F, 4) uint8: the faces' colours, white where none was given."""
@@ -81,7 +84,12 @@ class MeshChunk:
             lot=np.concatenate([c.lot for c in chunks]),
             symbol=np.concatenate([c.symbol for c in chunks]),
             color=np.concatenate([c.colors() for c in chunks]),
+            uv=None if all(c.uv is None for c in chunks) else np.concatenate([c.texture() for c in chunks]),
         )
+
+    def texture(self) -> np.ndarray:
+        """(V, 2) float32: the vertices' texture coordinates, NaN where none were given."""
+        return self.uv if self.uv is not None else np.full((len(self.vertices), 2), np.nan, np.float32)
 
 
 def _join_offsets(offsets: list[np.ndarray], n_items: np.ndarray, n_groups: np.ndarray) -> np.ndarray:
@@ -111,6 +119,9 @@ class TerminalChunk:
         Faces of this batch that are not instances.
     color : (n, 4) uint8, optional
         RGBA colour of each instance (CityEngine's ``color``); None: white.
+    uv : (n, 2, 4) float32, optional
+        Texture coordinates of set 0 of each instance as an affine map of its asset's unit box:
+        ``uv = uv[:, :, :3] @ p + uv[:, :, 3]`` (NaN: none); None: no instance has any.
     """
 
     asset: np.ndarray
@@ -119,6 +130,7 @@ class TerminalChunk:
     symbol: np.ndarray
     mesh: MeshChunk
     color: np.ndarray | None = None
+    uv: np.ndarray | None = None
 
     def colors(self) -> np.ndarray:
         """(n, 4) uint8: the instances' colours, white where none was given."""

@@ -16,7 +16,8 @@ columns:
 - ``successors``: successor symbols, ``ε``/``NIL`` and operations without effect;
 - ``values``: ``set``, ``color``, ``report``;
 - ``control``: ``case`` and ``p%`` blocks;
-- ``scatter``: ``scatter``, point shapes on, in or around the shape.
+- ``scatter``: ``scatter``, point shapes on, in or around the shape;
+- ``texture``: ``setupProjection``, ``projectUV`` and the other operations on texture coordinates.
 
 A new operation is its IR node, its lowering and its function here: importing this package registers them.
 """
@@ -31,6 +32,7 @@ from grammarc.backend.operations import (  # noqa: F401 - each registers its ope
     scope,
     splits,
     successors,
+    texture,
     values,
 )
 from grammarc.backend.operations.table import OPERATIONS, Operation, Parts

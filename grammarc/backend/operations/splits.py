@@ -20,6 +20,8 @@ from grammarc.backend.kernels import split as split_kernels
 from grammarc.backend.kernels.order import group_by
 from grammarc.backend.leaf_parts import LeafPart
 from grammarc.backend.operations.table import Parts, operation
+from grammarc.backend.operations.texture import texture_axis
+from grammarc.backend.reframing import reframed
 from grammarc.backend.shapes import Shapes
 from grammarc.constants import TOL
 from grammarc.ir import nodes as ir
@@ -85,16 +87,23 @@ def repeat(ctx: Context, cursor: Shapes, op: ir.Repeat) -> Parts | None:
 def group_split(ctx: Context, cursor: Shapes, op: ir.GroupSplit) -> Parts:
     values = _split_sizes(ctx, cursor, op, "split")
     kind = np.array([_SIZE_KIND[s.kind] for s in op.sizes], dtype=np.int64)
+    axis, axes = op.axis, None
+    if op.uv_set >= 0:  # texture space: a split along x turned the way u (v) grows, sizes in metres
+        cursor, metres, axes = texture_axis(ctx, cursor, op)
+        values = np.where(kind == 1, values, values * metres[:, None])
+        axis = 0
     groups = np.array(op.groups, dtype=np.int64)
     if op.repeat:
         groups = np.zeros_like(groups)
     n_groups = int(groups.max()) + 1 if len(groups) else 0
     parent, part, pos, length, index = split_kernels.group_split(
-        np.ascontiguousarray(cursor.size[:, op.axis]), values, kind, groups, n_groups, TOL.zero)
-    parent, part, pos, length, index, geometry = clip(ctx.chunk, cursor, op.axis, parent, part, pos, length,
+        np.ascontiguousarray(cursor.size[:, axis]), values, kind, groups, n_groups, TOL.zero)
+    parent, part, pos, length, index, geometry = clip(ctx.chunk, cursor, axis, parent, part, pos, length,
                                                       index, op.adjust)
     order, offsets = group_by(part, len(op.parts))
-    made = children(ctx, cursor, op.axis, parent, index, pos, length, op.site, order, geometry)
+    made = children(ctx, cursor, axis, parent, index, pos, length, op.site, order, geometry)
+    if axes is not None:  # the children take their parent's axes again
+        made = reframed(ctx, made, axes[parent[order]], op.span)
     ctx.count(made, op.span)
     return Parts(op.parts, made, offsets)
 

@@ -194,14 +194,6 @@ def test_a_batch_gives_each_lot_what_it_gets_alone(write):
     assert [t for t in together[::5]] == alone
 
 
-def test_uv_queries_are_unsupported_by_name_and_line(write):
-    path = write("g.cga", 'version "2022.0"\nLot --> extrude(3) A\nA -->\n    report("u", geometry.du(0, uvSpace))\n')
-    with pytest.raises(GrammarError) as err:
-        compile_grammar(path)
-    assert "g.cga:4:" in str(err.value)
-    assert "unsupported: geometry.du() (texture coordinates" in str(err.value)
-
-
 @pytest.mark.parametrize("prefix, want", [
     ("", [1, 0]), ("extrude(3)", [1, 0]), ("convexify()", [1, 1]),  # the L's two parts are rectangles
     ("roofHip(30)", [0, 0]), ("extrude(3) comp(e){ all : E }\nE -->", [0, 0]),  # an edge has no face

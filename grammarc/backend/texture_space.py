@@ -1,0 +1,98 @@
+"""Texture space: a shape's texture coordinates as affine maps from world coordinates to (u, v).
+
+CityEngine's projections (``setupProjection``) are planar: u and v are affine functions of a point's position.
+``projectUV`` gives every vertex of the shape's faces the projection's coordinates, and ``translateUV``,
+``scaleUV``, ``rotateUV``, ``tileUV`` and ``normalizeUV`` change them by affine maps of texture space. So a
+shape's coordinates of a set are one 2 x 4 map ``M`` (``uv = M[:, :3] @ X + M[:, 3]`` for a world point
+``X``) in the chunk's ``TextureMaps``, whose id is in one of its ``dynamic`` columns (``slots.uv_slots``), its
+projection's in another: children inherit both, and since the geometry of a split or a component split
+stays where it was, their coordinates stay continuous across the cut without any work. Map 0 is NaN: the
+shape has none. Two id columns per set, not the maps' 16 numbers, keep the cost of a split low.
+
+A lot starts with coordinates of set 0 in metres along its scope's x (u) and z (v), from its scope's origin,
+the parameterization CityEngine gives a street shape (u along it, v across), so that the street rules'
+``split(v, unitSpace, 0)`` derive on footprints too.
+
+The geometry's extent in texture space (``geometry.uMin``..., ``normalizeUV``, ``tileUV`` with ``~``) is the
+map applied to the vertices of its faces (``geometry.queries``).
+"""
+
+from __future__ import annotations
+
+from dataclasses import replace
+
+import numpy as np
+
+from grammarc.backend.chunk import Chunk
+from grammarc.backend.plan import Plan
+from grammarc.backend.shapes import Shapes
+from grammarc.backend.slots import uv_slots
+from grammarc.geometry.queries import shape_faces
+from grammarc.ragged import segment_reduce
+
+#: Which of a set's two columns: its projection, or its texture coordinates.
+PROJECTION, COORDINATES = 0, 1
+
+
+def texture_maps(plan: Plan, chunk: Chunk, shapes: Shapes, uv_set: int, which: int = COORDINATES) -> np.ndarray:
+    """(n, 2, 4) float64: the shapes' map ``which`` of texture set ``uv_set`` (NaN where none; all NaN when
+    the grammar names no such set)."""
+    start = plan.uv_slots.get(uv_set)
+    if start is None:
+        return np.full((len(shapes), 2, 4), np.nan)
+    return chunk.texture_maps[shapes.dynamic[start + which]]
+
+
+def with_texture_maps(plan: Plan, chunk: Chunk, shapes: Shapes, uv_set: int, maps: np.ndarray,
+                      which: int = COORDINATES) -> Shapes:
+    """``shapes`` with their map ``which`` of texture set ``uv_set`` replaced by ``maps`` (n, 2, 4)."""
+    start = plan.uv_slots[uv_set] + which
+    dynamic = list(shapes.dynamic)
+    dynamic[start] = chunk.texture_maps.add(maps)
+    return replace(shapes, dynamic=tuple(dynamic))
+
+
+def planar_map(origin: np.ndarray, u_axis: np.ndarray, v_axis: np.ndarray) -> np.ndarray:
+    """(n, 2, 4): u and v in metres along the unit vectors ``u_axis`` and ``v_axis`` (n, 3) from ``origin``."""
+    out = np.empty((len(origin), 2, 4))
+    for row, axis in enumerate((u_axis, v_axis)):
+        out[:, row, :3] = axis
+        out[:, row, 3] = -np.einsum("ni,ni->n", axis, origin)
+    return out
+
+
+def initial_column(plan: Plan, name: str, chunk: Chunk, shapes: Shapes) -> np.ndarray | None:
+    """A lot's starting value of texture column ``name`` (None: ``name`` is no texture column): no
+    projection, and coordinates of set 0 along its scope's x and z."""
+    for uv_set in plan.uv_slots:
+        names = uv_slots(uv_set)
+        if name in names:
+            if uv_set != 0 or name == names[PROJECTION]:
+                return np.zeros(len(shapes), dtype=np.int32)
+            axes = chunk.frames[shapes.frame]
+            return chunk.texture_maps.add(planar_map(shapes.origin, axes[:, 0], axes[:, 2]))
+    return None
+
+
+def texture_bounds(chunk: Chunk, shapes: Shapes, maps: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The least and greatest (u, v) (n, 2) of the vertices of the shapes' faces under ``maps``
+    (n, 2, 4); NaN for a shape without coordinates or faces."""
+    faces = shape_faces(shapes.size, shapes.geom, chunk.polygons, chunk.meshes)
+    vertex_offsets = faces.ring_offsets[faces.face_offsets[faces.shape_offsets]]
+    owner = np.repeat(np.arange(len(shapes)), np.diff(vertex_offsets))
+    axes = chunk.frames[shapes.frame]
+    world = shapes.origin[owner] + np.einsum("vj,vjk->vk", faces.verts, axes[owner])
+    uv = np.einsum("vij,vj->vi", maps[owner, :, :3], world) + maps[owner, :, 3]
+    return (segment_reduce(np.minimum, uv, vertex_offsets, np.nan),
+            segment_reduce(np.maximum, uv, vertex_offsets, np.nan))
+
+
+def metres_per_unit(maps: np.ndarray, normal: np.ndarray | None = None) -> np.ndarray:
+    """(n, 2): metres on the surface per unit of u and of v: the inverse length of each row's gradient,
+    within the plane of unit ``normal`` (n, 3) when given."""
+    grad = maps[:, :, :3]
+    if normal is not None:
+        grad = grad - np.einsum("nij,nj->ni", grad, normal)[:, :, None] * normal[:, None, :]
+    length = np.linalg.norm(grad, axis=2)
+    with np.errstate(divide="ignore"):
+        return np.where(length > 0, 1.0 / length, np.nan)
