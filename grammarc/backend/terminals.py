@@ -137,11 +137,15 @@ def _instance_uv(ctx: Context, shapes: Shapes, xform: np.ndarray) -> np.ndarray 
     return placed.astype(np.float32)
 
 
-def _with_uv(ctx: Context, shapes: Shapes, owner: np.ndarray, mesh: MeshChunk) -> MeshChunk:
+def _with_uv(ctx: Context, shapes: Shapes, owner: np.ndarray | None, mesh: MeshChunk) -> MeshChunk:
     """``mesh`` with the texture coordinates of set 0 of its vertices (``MeshChunk.uv``), its faces those
-    of ``shapes`` rows ``owner``, where the grammar has texture coordinates."""
+    of ``shapes`` rows ``owner`` (None: the faces of mesh shapes, shape after shape), where the grammar has
+    texture coordinates."""
     if 0 not in ctx.plan.uv_slots:
         return mesh
+    if owner is None:
+        faces = np.diff(ctx.chunk.meshes.mesh_offsets)[shapes.geom - MESH_BASE]
+        owner = np.repeat(np.arange(len(shapes)), faces)
     maps = texture_maps(ctx.plan, ctx.chunk, shapes, 0)[owner][segment_of(mesh.face_offsets)]
     maps = maps[segment_of(mesh.ring_offsets)]
     uv = np.einsum("vij,vj->vi", maps[:, :, :3], mesh.vertices.astype(np.float64)) + maps[:, :, 3]
@@ -181,9 +185,8 @@ def emit_leaves(ctx: Context, shapes: Shapes, symbol: int) -> None:
         chunk.outputs.meshes.append(polygon_meshes(ctx, polygons, symbol))
     meshes = shapes.take(is_mesh(shapes.geom))
     if len(meshes):
-        leaves = mesh_leaves(chunk, meshes, symbol, _colors(ctx.plan, meshes))
-        owner = np.repeat(np.arange(len(meshes)), np.diff(chunk.meshes.mesh_offsets)[meshes.geom - MESH_BASE])
-        chunk.outputs.meshes.append(_with_uv(ctx, meshes, owner, leaves))
+        chunk.outputs.meshes.append(_with_uv(ctx, meshes, None, mesh_leaves(chunk, meshes, symbol,
+                                                                            _colors(ctx.plan, meshes))))
 
 
 def polygon_meshes(ctx: Context, shapes: Shapes, symbol: int) -> MeshChunk:

@@ -40,6 +40,9 @@ def texture_maps(plan: Plan, chunk: Chunk, shapes: Shapes, uv_set: int, which: i
     start = plan.uv_slots.get(uv_set)
     if start is None:
         return np.full((len(shapes), 2, 4), np.nan)
+    if len(shapes.dynamic) <= start:  # the lots, while their attributes are evaluated: their own
+        return lot_maps(shapes, chunk) if (uv_set, which) == (0, COORDINATES) else \
+            np.full((len(shapes), 2, 4), np.nan)
     return chunk.texture_maps[shapes.dynamic[start + which]]
 
 
@@ -69,9 +72,14 @@ def initial_column(plan: Plan, name: str, chunk: Chunk, shapes: Shapes) -> np.nd
         if name in names:
             if uv_set != 0 or name == names[PROJECTION]:
                 return np.zeros(len(shapes), dtype=np.int32)
-            axes = chunk.frames[shapes.frame]
-            return chunk.texture_maps.add(planar_map(shapes.origin, axes[:, 0], axes[:, 2]))
+            return chunk.texture_maps.add(lot_maps(shapes, chunk))
     return None
+
+
+def lot_maps(shapes: Shapes, chunk: Chunk) -> np.ndarray:
+    """(n, 2, 4): lots' own texture coordinates, metres along their scope's x and z from its origin."""
+    axes = chunk.frames[shapes.frame]
+    return planar_map(shapes.origin, axes[:, 0], axes[:, 2])
 
 
 def texture_bounds(chunk: Chunk, shapes: Shapes, maps: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

@@ -69,3 +69,18 @@ def test_polygon_leaves_go_to_the_mesh_table(write):
     assert list(mesh.lot) == [0] * 8 and list(r["lot"]) == [1]
     assert len(r["asset"]) == 1 and r["assets"][r["asset"][0]] == "builtin:cube"
 
+
+
+@pytest.mark.parametrize("leaf", [
+    "roofHip(30) R.",  # a roof: faces of the mesh store
+    "extrude(3) E.",  # a prism: its bottom, top and sides
+    "extrude(10) comp(f){ side : Facade }\nFacade --> split(y){ 1 : Ledge | ~1 : NIL }\n"  # trimmed inserts
+    "Ledge --> s('1.2, '1, 0.5) center(x) primitiveCube()",
+])
+def test_mesh_faces_carry_the_texture_coordinates_of_their_vertices(write, leaf):
+    """Projected from above in 2 m tiles: every vertex of the mesh table has u = x / 2, v = z / 2."""
+    r = run(write, f"Lot --> setupProjection(0, world.xz, 2, 2) projectUV(0) {leaf}\n",
+            make_lots_polys("concave_L"))
+    mesh = r["mesh"]
+    assert len(mesh.lot) and mesh.uv.shape == (len(mesh.vertices), 2)
+    np.testing.assert_allclose(mesh.uv, mesh.vertices[:, [0, 2]] / 2, atol=1e-5)

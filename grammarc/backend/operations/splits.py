@@ -1,5 +1,7 @@
 """Splits: the paper's ``Subdiv`` and ``Repeat`` (on one axis or several), CityEngine's ``split`` with repeat
-groups, and the paper's ``Snap``/``SnapLines``, whose planes snapped splits move their cuts to.
+groups (also in texture space, ``split(u|v, ...)``: along x of the shapes turned the way u or v grows,
+``operations.texture``), and the paper's ``Snap``/``SnapLines``, whose planes snapped splits move their cuts
+to.
 
 A split makes children (``backend.children``: scopes moved and cut along the axis, polygons and meshes cut to
 their slabs, new keys, ``split.index``/``split.total``) and returns them as ``Parts`` for its bodies; parts
