@@ -48,33 +48,33 @@ def _write_obj(vertices, faces, uv, textured, uv_shift, out):
     at = 0
     for i in range(vertices.shape[0]):
         out[at] = 118  # v
-        at += 1
-        for k in range(3):
-            out[at] = 32
-            at = _fixed(vertices[i, k], out, at + 1)
-        out[at] = 10
-        at += 1
+        at = _line(vertices[i], out, at + 1)
         if textured:
             out[at] = 118  # vt
             out[at + 1] = 116
-            at += 2
-            for k in range(2):
-                out[at] = 32
-                at = _fixed(uv[i, k], out, at + 1)
-            out[at] = 10
-            at += 1
+            at = _line(uv[i], out, at + 2)
     for i in range(faces.shape[0]):
         out[at] = 102  # f
         at += 1
         for k in range(3):
             out[at] = 32
             at = _integer(faces[i, k] + 1, out, at + 1)
-            if textured:  # the vertex's own texture coordinate: the same index
+            if textured:  # the vertex's own texture coordinate
                 out[at] = 47
                 at = _integer(faces[i, k] + 1 - uv_shift, out, at + 1)
         out[at] = 10
         at += 1
     return at
+
+
+@njit(cache=True, nogil=True)
+def _line(values, out, at):
+    """The rest of a ``v`` or ``vt`` line: each value after a blank, then the newline."""
+    for k in range(values.shape[0]):
+        out[at] = 32
+        at = _fixed(values[k], out, at + 1)
+    out[at] = 10
+    return at + 1
 
 
 #: "00" .. "99": digits are written two at a time (half the divisions).
