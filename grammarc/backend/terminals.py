@@ -44,11 +44,13 @@ def instance_xform(axes: np.ndarray, size: np.ndarray, origin: np.ndarray) -> np
     return xform
 
 
-def emit_instances(ctx: Context, shapes: Shapes, asset: int, symbol: int, mirrored: int = 0) -> None:
+def emit_instances(ctx: Context, shapes: Shapes, asset: int, symbol: int, mirrored: int = 0,
+                   textured: bool = False) -> None:
     """Instances of ``asset`` on the scopes of ``shapes``; ``mirrored`` bits (1 x, 2 y, 4 z) flip the
     asset along those scope axes (the column is negated and the origin moved to the far side); ``Z_UP``
     turns the asset in its box before that. Where the grammar trims inserts, those crossing their trim planes become the asset's
-    triangles cut by them."""
+    triangles cut by them. ``textured``: they carry the shapes' texture coordinates (a leaf box); an inserted
+    asset has its own, which grammarc does not keep, and carries none."""
     if not len(shapes):
         return
     chunk = ctx.chunk
@@ -65,9 +67,9 @@ def emit_instances(ctx: Context, shapes: Shapes, asset: int, symbol: int, mirror
         mesh = ctx.asset_mesh(asset) if cut.any() else None
         if mesh is not None:
             trimmed, owner = _trimmed(ctx.plan, shapes.take(cut), xform[cut], planes[cut], mesh, symbol)
-            chunk.outputs.meshes.append(_with_uv(ctx, shapes.take(cut), owner, trimmed))
+            chunk.outputs.meshes.append(_with_uv(ctx, shapes.take(cut), owner, trimmed) if textured else trimmed)
             shapes, xform = shapes.take(~cut), xform[~cut]
-    _append(ctx, shapes, xform, asset, symbol)
+    _append(ctx, shapes, xform, asset, symbol, textured)
 
 
 def z_up(xform: np.ndarray) -> np.ndarray:
@@ -105,10 +107,11 @@ def _colors(plan, shapes: Shapes, rows=slice(None)) -> np.ndarray | None:
     return rgba(shapes.dynamic[plan.color_slot][rows]) if plan.color_slot is not None else None
 
 
-def _append(ctx: Context, shapes: Shapes, xform: np.ndarray, asset: int, symbol: int) -> None:
+def _append(ctx: Context, shapes: Shapes, xform: np.ndarray, asset: int, symbol: int, textured: bool = True) -> None:
     color_slot = ctx.plan.color_slot
     append_records(ctx, xform, shapes.lot, asset, symbol,
-                   shapes.dynamic[color_slot] if color_slot is not None else None, _instance_uv(ctx, shapes, xform))
+                   shapes.dynamic[color_slot] if color_slot is not None else None,
+                   _instance_uv(ctx, shapes, xform, textured))
 
 
 def append_records(ctx: Context, xform: np.ndarray, lot: np.ndarray, asset: int, symbol: int,
@@ -126,11 +129,14 @@ def append_records(ctx: Context, xform: np.ndarray, lot: np.ndarray, asset: int,
         out.color.append(rgba(color))
 
 
-def _instance_uv(ctx: Context, shapes: Shapes, xform: np.ndarray) -> np.ndarray | None:
+def _instance_uv(ctx: Context, shapes: Shapes, xform: np.ndarray, textured: bool) -> np.ndarray | None:
     """(n, 2, 4) float32: the texture coordinates of set 0 of instances placed by ``xform`` as maps of
-    their unit box's points, where the grammar has texture coordinates (NaN where a shape has none)."""
+    their unit box's points, where the grammar has texture coordinates (NaN where a shape has none, or
+    all of them unless ``textured``)."""
     if 0 not in ctx.plan.uv_slots:
         return None
+    if not textured:
+        return np.full((len(shapes), 2, 4), np.nan, np.float32)
     maps = texture_maps(ctx.plan, ctx.chunk, shapes, 0)
     placed = np.einsum("nij,njk->nik", maps[:, :, :3], xform.astype(np.float64))
     placed[:, :, 3] += maps[:, :, 3]
@@ -172,7 +178,7 @@ def emit_leaves(ctx: Context, shapes: Shapes, symbol: int) -> None:
     box = shapes.geom == -1
     flat = shapes.size <= TOL.zero
     zeros = flat.sum(axis=1)
-    emit_instances(ctx, shapes.take(box & (zeros == 0)), CUBE, symbol)
+    emit_instances(ctx, shapes.take(box & (zeros == 0)), CUBE, symbol, textured=True)
     is_quad = box & (zeros == 1)
     quads = shapes.take(is_quad)
     if len(quads):
