@@ -86,7 +86,7 @@ def test_inserted_geometry_carries_no_texture_coordinates(write):
     keep: it carries none, where the boxes and faces of the same grammar carry theirs."""
     r = run(write, "Lot --> setupProjection(0, world.xz, 2, 2) projectUV(0) extrude(10) comp(f){ side : Facade "
             "| top : T. }\nFacade --> split(y){ 1 : Ledge | 1 : W | ~1 : NIL }\nW --> i(\"builtin:cylinder\")\n"
-            "Ledge --> s('1.2, '1, 0.5) center(x) primitiveCube()\n", [rect(12, 8)])
+            "Ledge --> s('1.2, '1, 0.5) center(x) i(\"builtin:cylinder\")\n", [rect(12, 8)])
     top = np.array(names(r)) == "T"
     assert np.isnan(r["uv"][~top]).all() and not np.isnan(r["uv"][top]).any()
     trimmed = r["mesh"]

@@ -15,9 +15,6 @@ import pytest
 from backend.operations.derivations import per_lot, rect, run
 from conftest import LOT_ZOO
 
-from grammarc.compiler import compile_grammar
-from grammarc.errors import GrammarError
-
 SOUTH_EDGE_FIRST = rect(12, 8)
 
 

@@ -12,9 +12,10 @@ FACADE = ("Lot --> extrude(6) comp(f){ front : Front }\n"
           "Front --> setupProjection(0, scope.xy, 2, 3, 1, 0) projectUV(0) QUERY\n")
 
 
-def reported(write, text, lots=(rect(12, 8),)):
-    return {k[:-4]: float(v) for k, v in next(iter(per_lot(run(write, text, list(lots))).values())).items()
-            if k.endswith("_sum")}
+def reported(write, text, lots=None):
+    """The reported sums of the one lot (a 12 x 8 rectangle unless ``lots`` says otherwise)."""
+    r = run(write, text, lots or [rect(12, 8)])
+    return {k[:-4]: float(v) for k, v in next(iter(per_lot(r).values())).items() if k.endswith("_sum")}
 
 
 @pytest.mark.parametrize("query, want", [
