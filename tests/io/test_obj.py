@@ -31,5 +31,6 @@ def test_obj_bytes_writes_texture_coordinates_after_each_vertex():
     assert shifted.splitlines()[-1] == "f 5/1 6/2 7/3"
     points, read = read_obj(shifted.replace("f 5/1 6/2 7/3", "f 1/1 2/2 3/3"))
     np.testing.assert_allclose(points, vertices)
+    np.testing.assert_array_equal(np.array(read), [[0, 1, 2]])  # the reader takes each corner's v
     with pytest.raises(ValueError, match="finite"):
         obj_bytes(vertices, np.zeros((0, 3), int), uv=np.full((3, 2), np.nan))
