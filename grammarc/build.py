@@ -181,7 +181,7 @@ def record_meta(grammar_path: Path, grammar: Grammar, plan, options: BuildOption
         # the user's asset folders (baking); a package's own are left out: extracted to a fresh temporary
         # folder for this build only, their names would make each run's record differ
         "asset_roots": [str(r) for r in recorded_roots],
-        # operations accepted without effect on the record (material, texture, UV, print)
+        # operations accepted without effect on the record (material, texture, print)
         "not_applied": list(plan.not_applied),
     }
 

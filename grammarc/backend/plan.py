@@ -58,7 +58,7 @@ class Plan:
     dynamic: dict[str, int]
     #: CityEngine semantics: a body that makes no successor leaves its shape as a leaf.
     leaf_bodies: bool
-    #: Names of operations accepted without effect on the record (material, UV, print).
+    #: Names of operations accepted without effect on the record (material, texture, print).
     not_applied: tuple[str, ...]
     #: Interned string id -> asset id, for assets named by computed strings (``i(asset)``); -1: none.
     asset_of_string: dict[int, int]

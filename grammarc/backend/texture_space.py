@@ -15,6 +15,12 @@ the parameterization CityEngine gives a street shape (u along it, v across), so 
 
 The geometry's extent in texture space (``geometry.uMin``..., ``normalizeUV``, ``tileUV`` with ``~``) is the
 map applied to the vertices of its faces (``geometry.queries``).
+
+Where this differs from CityEngine, which keeps coordinates per vertex: the coordinates stay in the world
+when an operation moves the geometry after ``projectUV`` (``t``, ``r``, ``s``, ``mirror``: the texture does
+not follow it), and new faces (an extrusion's sides, a roof's) take the affine map of the shape they grow
+from rather than coordinates of their own. Projected where the rules project, as they mostly do just
+before the leaves, the two agree.
 """
 
 from __future__ import annotations

@@ -601,8 +601,8 @@ class Report:
 
 @dataclass(frozen=True, slots=True)
 class NotApplied:
-    """An operation that is accepted but has no effect on the record (material, texture and UV
-    operations, ``reverseNormals``, ``print``); the output's meta lists it."""
+    """An operation that is accepted but has no effect on the record (material and texture operations,
+    ``reverseNormals``, ``print``); the output's meta lists it."""
 
     name: str
     span: Span = NO_SPAN
