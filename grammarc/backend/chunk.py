@@ -17,57 +17,53 @@ from grammarc.geometry.polygons import PolygonStore
 from grammarc.geometry.streets import Streets
 
 
-class Frames:
-    """Growable table of scope axes (F, 3, 3) float64; row j of a frame is scope axis j in world."""
+class Table:
+    """Growable table of float64 rows of one shape; a row's id (int32) is its number, and shapes hold ids so
+    that they share rows instead of copying them."""
+
+    def __init__(self, data: np.ndarray, count: int) -> None:
+        self.data = data
+        self.count = count
+
+    def add(self, rows: np.ndarray) -> np.ndarray:
+        """Append ``rows`` (m, *row shape); returns their ids (m,) int32."""
+        m = len(rows)
+        if self.count + m > len(self.data):
+            grown = np.empty((max(2 * len(self.data), self.count + m), *self.data.shape[1:]))
+            grown[: self.count] = self.data[: self.count]
+            self.data = grown
+        self.data[self.count: self.count + m] = rows
+        ids = np.arange(self.count, self.count + m, dtype=np.int32)
+        self.count += m
+        return ids
+
+    def __getitem__(self, ids: np.ndarray) -> np.ndarray:
+        return self.data[ids]
+
+
+class Frames(Table):
+    """Table of scope axes (F, 3, 3); row j of a frame is scope axis j in world."""
 
     def __init__(self, capacity: int = 256) -> None:
-        self.data = np.empty((capacity, 3, 3))
-        self.count = 0
+        super().__init__(np.empty((capacity, 3, 3)), 0)
 
     def add(self, axes: np.ndarray) -> np.ndarray:
         """Append frames (m, 3, 3); returns their ids (m,) int32."""
-        m = len(axes)
-        if STRICT and m:
+        if STRICT and len(axes):
             # frames stay orthonormal and right-handed through rotations and component splits
             gram = np.einsum("mij,mkj->mik", axes, axes)
             assert np.allclose(gram, np.eye(3), atol=1e-9), "a scope frame is not orthonormal"
             assert np.allclose(np.linalg.det(axes), 1.0, atol=1e-9), "a scope frame is left-handed"
-        if self.count + m > len(self.data):
-            grown = np.empty((max(2 * len(self.data), self.count + m), 3, 3))
-            grown[: self.count] = self.data[: self.count]
-            self.data = grown
-        self.data[self.count: self.count + m] = axes
-        ids = np.arange(self.count, self.count + m, dtype=np.int32)
-        self.count += m
-        return ids
-
-    def __getitem__(self, ids: np.ndarray) -> np.ndarray:
-        return self.data[ids]
+        return super().add(axes)
 
 
-class TextureMaps:
-    """Growable table of texture maps (M, 2, 4) float64, affine maps from world coordinates to (u, v)
+class TextureMaps(Table):
+    """Table of texture maps (M, 2, 4), affine maps from world coordinates to (u, v)
     (``backend.texture_space``); map 0 is NaN, no texture coordinates. Shapes hold map ids, as they hold
     frame ids: children share their parent's maps, and most operations keep them."""
 
     def __init__(self, capacity: int = 64) -> None:
-        self.data = np.full((capacity, 2, 4), np.nan)
-        self.count = 1
-
-    def add(self, maps: np.ndarray) -> np.ndarray:
-        """Append maps (m, 2, 4); returns their ids (m,) int32."""
-        m = len(maps)
-        if self.count + m > len(self.data):
-            grown = np.empty((max(2 * len(self.data), self.count + m), 2, 4))
-            grown[: self.count] = self.data[: self.count]
-            self.data = grown
-        self.data[self.count: self.count + m] = maps
-        ids = np.arange(self.count, self.count + m, dtype=np.int32)
-        self.count += m
-        return ids
-
-    def __getitem__(self, ids: np.ndarray) -> np.ndarray:
-        return self.data[ids]
+        super().__init__(np.full((capacity, 2, 4), np.nan), 1)
 
 
 @dataclass
