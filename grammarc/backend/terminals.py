@@ -138,7 +138,7 @@ def _instance_uv(ctx: Context, shapes: Shapes, xform: np.ndarray, textured: bool
     if not textured:
         return np.full((len(shapes), 2, 4), np.nan, np.float32)
     maps = texture_maps(ctx.plan, ctx.chunk, shapes, 0)
-    placed = np.einsum("nij,njk->nik", maps[:, :, :3], xform.astype(np.float64))
+    placed = maps[:, :, :3] @ xform
     placed[:, :, 3] += maps[:, :, 3]
     return placed.astype(np.float32)
 

@@ -89,16 +89,24 @@ def lot_maps(shapes: Shapes, chunk: Chunk) -> np.ndarray:
 
 
 def texture_bounds(chunk: Chunk, shapes: Shapes, maps: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """The least and greatest (u, v) (n, 2) of the vertices of the shapes' faces under ``maps``
-    (n, 2, 4); NaN for a shape without coordinates or faces."""
-    faces = shape_faces(shapes.size, shapes.geom, chunk.polygons, chunk.meshes)
-    vertex_offsets = faces.ring_offsets[faces.face_offsets[faces.shape_offsets]]
-    owner = np.repeat(np.arange(len(shapes)), np.diff(vertex_offsets))
-    axes = chunk.frames[shapes.frame]
-    world = shapes.origin[owner] + np.einsum("vj,vjk->vk", faces.verts, axes[owner])
-    uv = np.einsum("vij,vj->vi", maps[owner, :, :3], world) + maps[owner, :, 3]
-    return (segment_reduce(np.minimum, uv, vertex_offsets, np.nan),
-            segment_reduce(np.maximum, uv, vertex_offsets, np.nan))
+    """The least and greatest (u, v) (n, 2) of the shapes' geometry under ``maps`` (n, 2, 4); NaN for a
+    shape without coordinates or faces. A box's (or an inserted asset's, as its box) come from its size;
+    polygons' and meshes' from the vertices of their faces."""
+    # the maps of scope points, (n, 2, 3) and (n, 2): a scope point p is the world point origin + axes^T p
+    linear = maps[:, :, :3] @ chunk.frames[shapes.frame].transpose(0, 2, 1)
+    offset = (maps[:, :, :3] @ shapes.origin[:, :, None])[:, :, 0] + maps[:, :, 3]
+    span = linear * shapes.size[:, None, :]
+    low, high = offset + np.minimum(span, 0).sum(axis=2), offset + np.maximum(span, 0).sum(axis=2)
+    rows = np.flatnonzero(shapes.geom >= 0)
+    if len(rows):
+        sub = shapes.take(rows)
+        faces = shape_faces(sub.size, sub.geom, chunk.polygons, chunk.meshes)
+        vertex_offsets = faces.ring_offsets[faces.face_offsets[faces.shape_offsets]]
+        owner = rows[np.repeat(np.arange(len(rows)), np.diff(vertex_offsets))]
+        uv = (linear[owner] * faces.verts[:, None, :]).sum(axis=2) + offset[owner]  # elementwise: no tiny matmuls
+        low[rows] = segment_reduce(np.minimum, uv, vertex_offsets, np.nan)
+        high[rows] = segment_reduce(np.maximum, uv, vertex_offsets, np.nan)
+    return low, high
 
 
 def metres_per_unit(maps: np.ndarray, normal: np.ndarray | None = None) -> np.ndarray:
