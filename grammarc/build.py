@@ -181,7 +181,7 @@ def record_meta(grammar_path: Path, grammar: Grammar, plan, options: BuildOption
         # the user's asset folders (baking); a package's own are left out: extracted to a fresh temporary
         # folder for this build only, their names would make each run's record differ
         "asset_roots": [str(r) for r in recorded_roots],
-        # operations accepted without effect on the record (material, texture, UV, print)
+        # operations accepted without effect on the record (material, texture, print)
         "not_applied": list(plan.not_applied),
     }
 
@@ -208,6 +208,9 @@ def derive(grammar: Grammar, lots: Lots, options: BuildOptions = BuildOptions())
                         else np.int32))
         for name in ("asset", "xform", "lot", "symbol")
     }
+    if any(c.uv is not None for c in chunks):  # texture coordinates of set 0 (``TerminalChunk.uv``)
+        columns["uv"] = np.concatenate([c.uv if c.uv is not None else np.full((len(c.asset), 2, 4), np.nan, np.float32)
+                                        for c in chunks])
     columns.update(
         assets=np.array(grammar.assets), symbols=np.array(plan.symbol_names), mesh=mesh,
         bad=tuple(sorted((*lots.bad, *failed), key=lambda b: b.index)), reports=reports,

@@ -17,32 +17,53 @@ from grammarc.geometry.polygons import PolygonStore
 from grammarc.geometry.streets import Streets
 
 
-class Frames:
-    """Growable table of scope axes (F, 3, 3) float64; row j of a frame is scope axis j in world."""
+class Table:
+    """Growable table of float64 rows of one shape; a row's id (int32) is its number, and shapes hold ids so
+    that they share rows instead of copying them."""
 
-    def __init__(self, capacity: int = 256) -> None:
-        self.data = np.empty((capacity, 3, 3))
-        self.count = 0
+    def __init__(self, data: np.ndarray, count: int) -> None:
+        self.data = data
+        self.count = count
 
-    def add(self, axes: np.ndarray) -> np.ndarray:
-        """Append frames (m, 3, 3); returns their ids (m,) int32."""
-        m = len(axes)
-        if STRICT and m:
-            # frames stay orthonormal and right-handed through rotations and component splits
-            gram = np.einsum("mij,mkj->mik", axes, axes)
-            assert np.allclose(gram, np.eye(3), atol=1e-9), "a scope frame is not orthonormal"
-            assert np.allclose(np.linalg.det(axes), 1.0, atol=1e-9), "a scope frame is left-handed"
+    def add(self, rows: np.ndarray) -> np.ndarray:
+        """Append ``rows`` (m, *row shape); returns their ids (m,) int32."""
+        m = len(rows)
         if self.count + m > len(self.data):
-            grown = np.empty((max(2 * len(self.data), self.count + m), 3, 3))
+            grown = np.empty((max(2 * len(self.data), self.count + m), *self.data.shape[1:]))
             grown[: self.count] = self.data[: self.count]
             self.data = grown
-        self.data[self.count: self.count + m] = axes
+        self.data[self.count: self.count + m] = rows
         ids = np.arange(self.count, self.count + m, dtype=np.int32)
         self.count += m
         return ids
 
     def __getitem__(self, ids: np.ndarray) -> np.ndarray:
         return self.data[ids]
+
+
+class Frames(Table):
+    """Table of scope axes (F, 3, 3); row j of a frame is scope axis j in world."""
+
+    def __init__(self, capacity: int = 256) -> None:
+        super().__init__(np.empty((capacity, 3, 3)), 0)
+
+    def add(self, axes: np.ndarray) -> np.ndarray:
+        """Append frames (m, 3, 3); returns their ids (m,) int32."""
+        if STRICT and len(axes):
+            # frames stay orthonormal and right-handed through rotations and component splits
+            gram = np.einsum("mij,mkj->mik", axes, axes)
+            assert np.allclose(gram, np.eye(3), atol=1e-9), "a scope frame is not orthonormal"
+            assert np.allclose(np.linalg.det(axes), 1.0, atol=1e-9), "a scope frame is left-handed"
+        return super().add(axes)
+
+
+class TextureMaps(Table):
+    """Table of texture maps (M, 2, 4), affine maps from world coordinates to (u, v)
+    (``backend.texture_space``); map 0 is NaN, no texture coordinates. Shapes hold map ids, as they hold
+    frame ids: children share their parent's maps, and most operations keep them."""
+
+    def __init__(self, capacity: int = 64) -> None:
+        super().__init__(np.full((capacity, 2, 4), np.nan), 1)
 
 
 @dataclass
@@ -60,6 +81,8 @@ class Outputs:
     #: grammar carries texture channels (``backend.materials``).
     material: list = field(default_factory=list)
     mesh_material: list = field(default_factory=list)
+    #: (n, 2, 4) float32 texture maps beside ``asset``, when the grammar has texture coordinates of set 0.
+    uv: list = field(default_factory=list)
     #: ``report`` rows: (lot, key ids, values, kind) per call.
     reports: list = field(default_factory=list)
 
@@ -93,6 +116,8 @@ class Chunk:
     occluders: OccluderStore = field(default_factory=OccluderStore)
     #: Snap planes of the paper's ``Snap`` / ``SnapLines`` (``backend.snaps``).
     snaps: SnapStore = field(default_factory=SnapStore)
+    #: Texture maps the shapes' texture columns name (``backend.texture_space``).
+    texture_maps: TextureMaps = field(default_factory=TextureMaps)
     #: Shapes created so far per lot, for the ``max_shapes`` limit.
     shape_count: np.ndarray = field(init=False)
 

@@ -34,6 +34,7 @@ from grammarc.backend.slots import (
     TRIM_SWITCH,
     WHITE_RGB,
 )
+from grammarc.backend.texture_space import initial_column
 from grammarc.constants import Limits
 from grammarc.geometry.footprint import footprint_polygons, lot_scopes
 from grammarc.geometry.polygons import PolygonStore
@@ -120,6 +121,10 @@ def initial_dynamic(plan: Plan, name: str, chunk: Chunk, shapes: Shapes) -> np.n
         return np.ones(n)
     if name == HORIZONTAL_SWITCH:
         return np.zeros(n)
+    if plan.uv_slots:
+        texture = initial_column(plan, name, chunk, shapes)
+        if texture is not None:
+            return texture
     return chunk.attrs[name][shapes.lot]
 
 
@@ -141,6 +146,8 @@ def collect(chunk: Chunk, plan: Plan) -> TerminalChunk:
         names.append(("color", (4,), np.uint8))
     if plan.material_slots:
         names.append(("material", (len(plan.material_slots),), np.int32))
+    if out.uv:
+        names.append(("uv", (2, 4), np.float32))
     for name, row_shape, dtype in names:
         column = np.empty((len(lot), *row_shape), dtype=dtype)
         width = int(np.prod(row_shape))
@@ -163,14 +170,15 @@ def collect(chunk: Chunk, plan: Plan) -> TerminalChunk:
         materials, both = collect_materials(plan, np.concatenate([columns["material"], faces]))
         material, mesh_material = both[:len(lot)], both[len(lot):]
     mesh = MeshChunk(mesh.vertices, mesh.ring_offsets, mesh.face_offsets, index[mesh.lot], mesh.symbol,
-                     mesh.color, mesh_material, materials)
+                     mesh.color, mesh_material, materials, mesh.uv)
     return TerminalChunk(asset=columns["asset"], xform=columns["xform"], lot=index[lot[order]],
                          symbol=columns["symbol"], mesh=mesh, color=columns.get("color"), material=material,
-                         materials=materials)
+                         materials=materials, uv=columns.get("uv"))
 
 
 def _sort_mesh(mesh: MeshChunk, order: np.ndarray) -> MeshChunk:
     rings, face_offsets = ragged_take(mesh.face_offsets, order)
     vertices, ring_offsets = ragged_take(mesh.ring_offsets, rings)
     return MeshChunk(mesh.vertices[vertices], ring_offsets, face_offsets, mesh.lot[order],
-                     mesh.symbol[order], mesh.color[order] if mesh.color is not None else None)
+                     mesh.symbol[order], mesh.color[order] if mesh.color is not None else None,
+                     uv=mesh.uv[vertices] if mesh.uv is not None else None)

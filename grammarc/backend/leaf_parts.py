@@ -80,7 +80,8 @@ class LeafPart:
 
 def leaf_inserts(plan) -> dict[int, LeafInsert]:
     """The symbols of ``plan`` whose rule only places an asset (see the module docstring), by id."""
-    if plan.leaf_bodies or plan.queries or plan.occluders or plan.color_slot is not None or plan.material_slots:
+    if plan.leaf_bodies or plan.queries or plan.occluders or plan.color_slot is not None or plan.material_slots \
+            or plan.uv_slots:
         return {}
     found = {}
     for sym in plan.symbols:

@@ -17,6 +17,7 @@ from grammarc.backend.slots import (
     HORIZONTAL_SWITCH,
     TRIM_SLOTS,
     TRIM_SWITCH,
+    uv_slots,
 )
 from grammarc.ir import nodes as ir
 from grammarc.ir.printer import comp_selectors
@@ -67,7 +68,7 @@ class Plan:
     dynamic: dict[str, int]
     #: CityEngine semantics: a body that makes no successor leaves its shape as a leaf.
     leaf_bodies: bool
-    #: Names of operations accepted without effect on the record (material, UV, print).
+    #: Names of operations accepted without effect on the record (material, texture, print).
     not_applied: tuple[str, ...]
     #: Interned string id -> asset id, for assets named by computed strings (``i(asset)``); -1: none.
     asset_of_string: dict[int, int]
@@ -96,6 +97,9 @@ class Plan:
     #: Whether shapes carry their occluding ancestors (``backend.occlusion``): the grammar asks occlusion
     #: queries or labels shapes.
     occluders: bool = False
+    #: Texture set -> index into ``Shapes.dynamic`` of its two columns (``slots.uv_slots``), for the sets
+    #: the grammar's texture operations and queries name; empty: no shape carries texture coordinates.
+    uv_slots: dict = field(default_factory=dict)
     #: ``load_asset(name, asset_roots) -> AssetMesh``: how trimmed inserts get their asset's triangles
     #: (the model's loader, or a test's stand-in).
     load_asset: Callable = load_asset
@@ -138,9 +142,10 @@ def make_plan(grammar: Grammar, *, load_asset: Callable = load_asset) -> Plan:
                  for symbol in symbols}
     occlusion = {k: v for k, v in occlusion.items() if v}
     ancestors = list(ANCESTORS) if occlusion or any(isinstance(op, ir.Label) for op in ops) else []
+    uv_sets = texture_sets(module, ops)
     dynamic = {name: i for i, name in enumerate(dict.fromkeys(
         [op.name for op in ops if isinstance(op, ir.SetAttr)] + sorted(set(context)) + colour + trims
-        + ancestors))}
+        + ancestors + [name for s in uv_sets for name in uv_slots(s)]))}
     not_applied = tuple(sorted({op.name for op in ops if isinstance(op, ir.NotApplied)}))
     strings.intern("")
     for answer in ("none", "part", "full"):  # of Shape.occ
@@ -164,5 +169,24 @@ def make_plan(grammar: Grammar, *, load_asset: Callable = load_asset) -> Plan:
         material_slots=tuple((k, dynamic[name]) for k, name in enumerate(MAP_FIELDS) if name in dynamic),
         trim_switch=dynamic.get(TRIM_SWITCH) if trim_slot is not None else None,
         horizontal_slot=dynamic.get(HORIZONTAL_SLOTS[0]), horizontal_switch=dynamic.get(HORIZONTAL_SWITCH),
-        occluders=ANCESTORS[0] in dynamic, load_asset=load_asset)
+        occluders=ANCESTORS[0] in dynamic, load_asset=load_asset,
+        uv_slots={s: dynamic[uv_slots(s)[0]] for s in uv_sets})
     return replace(plan, leaf_inserts=leaf_inserts(plan))
+
+
+#: CityEngine's queries of texture coordinates, whose first argument (0 when left out) names the set.
+UV_QUERIES = frozenset(f"geometry.{name}" for name in ("uMin", "uMax", "vMin", "vMax", "du", "dv"))
+
+
+def texture_sets(module: ir.Module, ops) -> list[int]:
+    """The texture sets the grammar's operations and queries name, in order (the lowering made each a
+    whole number)."""
+    sets = {op.uv_set for op in ops if isinstance(op, TEXTURE_OPS) or (isinstance(op, ir.GroupSplit)
+                                                                     and op.uv_set >= 0)}
+    for expr in all_exprs(module):
+        if isinstance(expr, ir.Call) and expr.func in UV_QUERIES:
+            sets.add(int(expr.args[0].value) if expr.args and isinstance(expr.args[0], ir.Num) else 0)
+    return sorted(sets)
+
+
+TEXTURE_OPS = (ir.SetupProjection, ir.ProjectUV, ir.TransformUV, ir.TileUV, ir.NormalizeUV)

@@ -26,3 +26,13 @@ HORIZONTAL_SWITCH = "trim.horizontal"
 
 #: The ids of a shape's nearest occluding ancestors (NaN: none), nearest first (``backend.occlusion``).
 ANCESTORS = tuple(f"occluder.{k}" for k in range(4))
+
+#: Texture set s's projection, as ``setupProjection`` set it up, and its texture coordinates, as ``projectUV``
+#: applied it: ids (int32) of affine maps from world coordinates to (u, v) in the chunk's ``TextureMaps``
+#: (0: none). A planar projection is affine in space, so one map per shape gives every vertex of its faces
+#: its coordinates, and a split or a component split keeps them continuous without touching them.
+
+
+def uv_slots(uv_set: int) -> tuple[str, str]:
+    """The two per-shape columns of texture set ``uv_set``: its projection's map id, its coordinates'."""
+    return f"uv{uv_set}.projection", f"uv{uv_set}.coordinates"

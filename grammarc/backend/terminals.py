@@ -16,6 +16,8 @@ no rule applied) into output, as CityEngine emits leaf geometry:
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 
 from grammarc.backend.context import Context
@@ -24,6 +26,7 @@ from grammarc.backend.materials import material_ids, rgba
 from grammarc.backend.mesh_shapes import mesh_leaves
 from grammarc.backend.shapes import Z_UP, Shapes, asset_of, face_axes
 from grammarc.backend.slots import HORIZONTAL_SLOTS
+from grammarc.backend.texture_space import texture_maps
 from grammarc.constants import TOL
 from grammarc.geometry.components import reverse_rings
 from grammarc.geometry.meshes import is_mesh, is_polygon
@@ -43,11 +46,13 @@ def instance_xform(axes: np.ndarray, size: np.ndarray, origin: np.ndarray) -> np
     return xform
 
 
-def emit_instances(ctx: Context, shapes: Shapes, asset: int, symbol: int, mirrored: int = 0) -> None:
+def emit_instances(ctx: Context, shapes: Shapes, asset: int, symbol: int, mirrored: int = 0,
+                   textured: bool = False) -> None:
     """Instances of ``asset`` on the scopes of ``shapes``; ``mirrored`` bits (1 x, 2 y, 4 z) flip the
     asset along those scope axes (the column is negated and the origin moved to the far side); ``Z_UP``
     turns the asset in its box before that. Where the grammar trims inserts, those crossing their trim planes become the asset's
-    triangles cut by them."""
+    triangles cut by them. ``textured``: they carry the shapes' texture coordinates (a leaf box); an inserted
+    asset has its own, which grammarc does not keep, and carries none."""
     if not len(shapes):
         return
     chunk = ctx.chunk
@@ -65,9 +70,9 @@ def emit_instances(ctx: Context, shapes: Shapes, asset: int, symbol: int, mirror
         if mesh is not None:
             crossing = shapes.take(cut)
             trimmed, owner = _trimmed(ctx.plan, crossing, xform[cut], planes[cut], mesh, symbol)
-            append_mesh(ctx, trimmed, crossing, owner)
+            append_mesh(ctx, _with_uv(ctx, crossing, owner, trimmed) if textured else trimmed, crossing, owner)
             shapes, xform = shapes.take(~cut), xform[~cut]
-    _append(ctx, shapes, xform, asset, symbol)
+    _append(ctx, shapes, xform, asset, symbol, textured)
 
 
 def z_up(xform: np.ndarray) -> np.ndarray:
@@ -122,17 +127,22 @@ def append_mesh(ctx: Context, mesh: MeshChunk, shapes: Shapes, rows=slice(None))
         out.mesh_material.append(material_ids(ctx.plan, shapes, rows))
 
 
-def _append(ctx: Context, shapes: Shapes, xform: np.ndarray, asset: int, symbol: int) -> None:
+def _append(ctx: Context, shapes: Shapes, xform: np.ndarray, asset: int, symbol: int, textured: bool = True) -> None:
     color_slot = ctx.plan.color_slot
     append_records(ctx, xform, shapes.lot, asset, symbol,
-                   shapes.dynamic[color_slot] if color_slot is not None else None, material_ids(ctx.plan, shapes))
+                   shapes.dynamic[color_slot] if color_slot is not None else None, material_ids(ctx.plan, shapes),
+                   _instance_uv(ctx, shapes, xform, textured))
 
 
 def append_records(ctx: Context, xform: np.ndarray, lot: np.ndarray, asset: int, symbol: int,
-                   color: np.ndarray | None, material: np.ndarray | None = None) -> None:
+                   color: np.ndarray | None, material: np.ndarray | None = None,
+                   uv: np.ndarray | None = None) -> None:
     """Add instance records: transforms, lots, and colours (packed floats) and texture channels (string ids
-    (n, k)) where the grammar sets them (``backend.materials``)."""
+    (n, k)) where the grammar sets them (``backend.materials``), and texture maps (``TerminalChunk.uv``)
+    where it has texture coordinates."""
     out = ctx.chunk.outputs
+    if uv is not None:
+        out.uv.append(uv)
     out.xform.append(xform)
     out.asset.append(np.full(len(lot), asset, dtype=np.int32))
     out.lot.append(lot.astype(np.int32))
@@ -141,6 +151,31 @@ def append_records(ctx: Context, xform: np.ndarray, lot: np.ndarray, asset: int,
         out.color.append(rgba(color))
     if material is not None:
         out.material.append(material)
+
+
+def _instance_uv(ctx: Context, shapes: Shapes, xform: np.ndarray, textured: bool) -> np.ndarray | None:
+    """(n, 2, 4) float32: the texture coordinates of set 0 of instances placed by ``xform`` as maps of
+    their unit box's points, where the grammar has texture coordinates (NaN where a shape has none, or
+    all of them unless ``textured``)."""
+    if 0 not in ctx.plan.uv_slots:
+        return None
+    if not textured:
+        return np.full((len(shapes), 2, 4), np.nan, np.float32)
+    maps = texture_maps(ctx.plan, ctx.chunk, shapes, 0)
+    placed = maps[:, :, :3] @ xform
+    placed[:, :, 3] += maps[:, :, 3]
+    return placed.astype(np.float32)
+
+
+def _with_uv(ctx: Context, shapes: Shapes, owner: np.ndarray, mesh: MeshChunk) -> MeshChunk:
+    """``mesh`` with the texture coordinates of set 0 of its vertices (``MeshChunk.uv``), its faces those
+    of ``shapes`` rows ``owner``, where the grammar has texture coordinates."""
+    if 0 not in ctx.plan.uv_slots:
+        return mesh
+    maps = texture_maps(ctx.plan, ctx.chunk, shapes, 0)[owner][segment_of(mesh.face_offsets)]
+    maps = maps[segment_of(mesh.ring_offsets)]
+    uv = np.einsum("vij,vj->vi", maps[:, :, :3], mesh.vertices.astype(np.float64)) + maps[:, :, 3]
+    return replace(mesh, uv=uv.astype(np.float32))
 
 
 def emit_leaves(ctx: Context, shapes: Shapes, symbol: int) -> None:
@@ -156,7 +191,7 @@ def emit_leaves(ctx: Context, shapes: Shapes, symbol: int) -> None:
     box = shapes.geom == -1
     flat = shapes.size <= TOL.zero
     zeros = flat.sum(axis=1)
-    emit_instances(ctx, shapes.take(box & (zeros == 0)), CUBE, symbol)
+    emit_instances(ctx, shapes.take(box & (zeros == 0)), CUBE, symbol, textured=True)
     is_quad = box & (zeros == 1)
     quads = shapes.take(is_quad)
     if len(quads):
@@ -171,7 +206,7 @@ def emit_leaves(ctx: Context, shapes: Shapes, symbol: int) -> None:
     meshes = shapes.take(is_mesh(shapes.geom))
     if len(meshes):
         faces, owner = mesh_leaves(chunk, meshes, symbol, _colors(ctx.plan, meshes))
-        append_mesh(ctx, faces, meshes, owner)
+        append_mesh(ctx, _with_uv(ctx, meshes, owner, faces), meshes, owner)
 
 
 def polygon_meshes(ctx: Context, shapes: Shapes, symbol: int) -> tuple[MeshChunk, np.ndarray]:
@@ -221,14 +256,14 @@ def polygon_meshes(ctx: Context, shapes: Shapes, symbol: int) -> tuple[MeshChunk
     ring_sizes = np.concatenate(faces_rings)
     rings_per_face = np.concatenate(faces_shape)
     face_owner = np.concatenate([rows, np.flatnonzero(solid), s[j]])
-    return MeshChunk(
+    return _with_uv(ctx, shapes, face_owner, MeshChunk(
         vertices=vertices,
         ring_offsets=offsets_from_counts(ring_sizes),
         face_offsets=offsets_from_counts(rings_per_face),
         lot=shapes.lot[face_owner].astype(np.int32),
         symbol=np.full(len(face_owner), symbol, dtype=np.int32),
         color=_colors(ctx.plan, shapes, face_owner),
-    ), face_owner
+    )), face_owner
 
 
 def _reversed_order(ring_offsets: np.ndarray) -> np.ndarray:

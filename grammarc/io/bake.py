@@ -121,9 +121,12 @@ def bake(
     return _bake(asset_library(names, record, asset_roots), asset, xform, mesh, max_triangles)[0]
 
 
-def _bake(library: AssetLibrary, asset: np.ndarray, xform: np.ndarray, mesh: MeshChunk, max_triangles: int):
+def _bake(library: AssetLibrary, asset: np.ndarray, xform: np.ndarray, mesh: MeshChunk, max_triangles: int,
+          uv: np.ndarray | None = None):
     """``bake`` of a record's columns, its assets in ``library``; and the source of each triangle (T,) int64:
-    its instance's row, or ``len(asset)`` plus its face in the mesh table."""
+    its instance's row, or ``len(asset)`` plus its face in the mesh table. The mesh has texture coordinates
+    (0 where a vertex has none) where the instances' ``uv`` (``TerminalChunk.uv``) or the mesh table's are
+    given."""
     import trimesh
 
     used = np.bincount(asset, minlength=len(library.names)).astype(np.int64)
@@ -144,16 +147,22 @@ def _bake(library: AssetLibrary, asset: np.ndarray, xform: np.ndarray, mesh: Mes
     v0 = t0 = 0
     order = np.argsort(asset, kind="stable")  # instances grouped by asset, in record order within each
     starts = offsets_from_counts(used)
+    texture = None if uv is None and mesh.uv is None else np.zeros((n_vertices, 2), np.float64)
     for a in assets:
         shape = library[a]
         rows = order[starts[a] : starts[a + 1]]
         first = t0
+        if texture is not None and uv is not None:  # the instances' maps of their unit box, per vertex
+            placed = np.einsum("kij,vj->kvi", uv[rows, :, :3].astype(np.float64), shape.vertices)
+            texture[v0 : v0 + placed.shape[0] * placed.shape[1]] = (placed + uv[rows, None, :, 3]).reshape(-1, 2)
         v0, t0 = _expand(shape, xform, rows, vertices, faces, v0, t0)
         source[first:t0] = np.repeat(rows, (t0 - first) // max(len(rows), 1))
         face_sizes = _add_counts(face_sizes, shape.polygon_sizes, int(used[a]))
         n_polygons += int(used[a]) * shape.n_polygons
     if len(mesh.face_offsets) > 1:
         vertices[v0:] = mesh.vertices
+        if texture is not None:
+            texture[v0:] = mesh.texture()
         triangles = triangulate_polygons(mesh.vertices, mesh.ring_offsets, mesh.face_offsets)
         faces[t0 : t0 + len(triangles)] = triangles + v0
         vertex_face = segment_of(mesh.face_offsets)[segment_of(mesh.ring_offsets)]
@@ -170,7 +179,9 @@ def _bake(library: AssetLibrary, asset: np.ndarray, xform: np.ndarray, mesh: Mes
         "n_holes": int(len(mesh.ring_offsets) - 1 - n_faces),
         "face_sizes": {int(k): int(c) for k, c in enumerate(face_sizes) if c},
     }
-    return trimesh.Trimesh(vertices=vertices, faces=faces[:t0], process=False, metadata=metadata), source[:t0]
+    visual = None if texture is None else trimesh.visual.TextureVisuals(uv=np.nan_to_num(texture))
+    mesh = trimesh.Trimesh(vertices=vertices, faces=faces[:t0], process=False, metadata=metadata, visual=visual)
+    return mesh, source[:t0]
 
 
 def _expand(shape: AssetMesh, xform: np.ndarray, rows: np.ndarray, vertices: np.ndarray,
@@ -296,7 +307,7 @@ class BakedWriter(WriterBlock):
         if max_triangles is None:
             max_triangles = int(os.environ.get("GRAMMARC_MAX_TRIANGLES", MAX_TRIANGLES))
         self.max_triangles = max_triangles
-        self._chunks: list[tuple[np.ndarray, np.ndarray, MeshChunk, np.ndarray | None]] = []
+        self._chunks: list[tuple] = []  # (asset, xform, mesh table, looks, uv) of each chunk kept for close()
         #: The record's materials, and the looks (``_looks``) met so far, each an OBJ material.
         self._materials = MaterialTable()
         self._look_ids: dict[int, int] = {}
@@ -305,6 +316,7 @@ class BakedWriter(WriterBlock):
         self._state = "open"
         self._counts: dict = {}
         self._made = {"triangles": 0, "vertices": 0, "polygons": 0, "mesh_faces": 0, "mesh_vertices": 0}
+        self._uv_vertices = 0  # vertices of the streamed OBJ with a texture coordinate (vt)
         self._tmpdir: str | None = None
         self._file = None  # the output being written, in _tmpdir: OBJ from the first chunk, else on close
         if self._file_type == "obj":
@@ -345,11 +357,11 @@ class BakedWriter(WriterBlock):
             looks = self._looks(chunk)
             if self._file is not None:
                 mesh, source = _bake(self._library, asset.astype(np.int64, copy=False), xform, chunk.mesh,
-                                     self.max_triangles)
+                                     self.max_triangles, chunk.uv)
                 self._file.write(self._obj_groups(mesh, source, np.concatenate([chunk.lot, chunk.mesh.lot]), looks))
                 self._count(mesh, chunk.mesh)
             else:
-                self._chunks.append((asset, xform, chunk.mesh, looks))
+                self._chunks.append((asset, xform, chunk.mesh, looks, chunk.uv))
         except BaseException:
             self.abort()
             raise
@@ -383,8 +395,14 @@ class BakedWriter(WriterBlock):
         starts = np.flatnonzero(new_lot | np.r_[True, look[1:] != look[:-1]])
         lines = [(f"g lot_{lot[k]}\n" if new_lot[k] else "")
                  + (f"usemtl m{self._look(int(look[k]))}\n" if looks is not None else "") for k in starts.tolist()]
-        faces = obj_bytes(np.zeros((0, 3)), mesh.faces[order] + self._made["vertices"])
-        return obj_bytes(mesh.vertices, np.zeros((0, 3), np.int64)) + with_lines(faces, starts, lines)
+        # with texture coordinates a ``vt`` follows each ``v`` and faces index both, the vt numbers behind the v
+        # numbers by the vertices written before without any
+        uv = _texture(mesh)
+        shift = self._made["vertices"] - self._uv_vertices
+        faces = obj_bytes(np.zeros((0, 3)), mesh.faces[order] + self._made["vertices"],
+                          uv=None if uv is None else np.zeros((0, 2)), uv_shift=shift)
+        self._uv_vertices += len(mesh.vertices) if uv is not None else 0
+        return obj_bytes(mesh.vertices, np.zeros((0, 3), np.int64), uv=uv) + with_lines(faces, starts, lines)
 
     def _mtl(self) -> bytes:
         """The OBJ's material library: per look its colour (``Kd``, ``d``) and texture maps, the paths
@@ -432,9 +450,11 @@ class BakedWriter(WriterBlock):
                 asset = np.concatenate([c[0] for c in chunks]) if chunks else np.zeros(0, np.int64)
                 xform = np.concatenate([c[1] for c in chunks]) if chunks else np.zeros((0, 3, 4), np.float32)
                 looks = _joined_looks(chunks)
+                uv = None if all(c[4] is None for c in chunks) else np.concatenate(
+                    [c[4] if c[4] is not None else np.full((len(c[0]), 2, 4), np.nan, np.float32) for c in chunks])
                 del chunks
                 mesh, source = _bake(self._library, asset.astype(np.int64, copy=False), xform, mesh_table,
-                                     self.max_triangles)
+                                     self.max_triangles, uv)
                 del asset, xform
                 self._count(mesh, mesh_table)
                 self._file.write(self._export(mesh, looks[source] if looks is not None else None))
@@ -482,12 +502,15 @@ class BakedWriter(WriterBlock):
         with a material per look (``io.gltf.baked_glb``); ``looks`` (T,) int64 per triangle (``_looks``)."""
         if self._file_type == "glb":
             materials = self._materials.table()
-            return baked_glb(mesh.vertices, mesh.faces, looks, materials, self._library.roots, self._meta)
+            return baked_glb(mesh.vertices, mesh.faces, looks, materials, self._library.roots, self._meta,
+                             _texture(mesh))
         if self._file_type == "ply" and looks is not None:
+            import trimesh
+
             colors = np.full((len(mesh.vertices), 4), 255, np.uint8)
             rgba = (looks & 0xFFFFFFFF).astype(np.uint32).view(np.uint8).reshape(-1, 4)
             colors[mesh.faces.reshape(-1)] = np.repeat(rgba, 3, axis=0)
-            mesh.visual.vertex_colors = colors
+            mesh.visual = trimesh.visual.ColorVisuals(mesh, vertex_colors=colors)
         mesh.metadata = {}
         data = mesh.export(file_type=self._file_type)
         return data if isinstance(data, bytes) else data.encode("utf-8")
@@ -499,8 +522,8 @@ def _joined_looks(chunks: list) -> np.ndarray | None:
     if all(c[3] is None for c in chunks):
         return None
     white = np.int64(0xFFFFFFFF)
-    looks = [np.full(len(a) + len(m.lot), white) if lk is None else lk for a, _, m, lk in chunks]
-    counts = [len(a) for a, _, _, _ in chunks]
+    looks = [np.full(len(c[0]) + len(c[2].lot), white) if c[3] is None else c[3] for c in chunks]
+    counts = [len(c[0]) for c in chunks]
     return np.concatenate([lk[:n] for lk, n in zip(looks, counts)] + [lk[n:] for lk, n in zip(looks, counts)])
 
 
@@ -508,6 +531,12 @@ def _joined_looks(chunks: list) -> np.ndarray | None:
 #: ``map_Ke`` are the PBR extension of MTL that Blender and others read).
 MTL_MAPS = {"colormap": "map_Kd", "bumpmap": "map_bump", "specularmap": "map_Ks", "opacitymap": "map_d",
             "normalmap": "norm", "emissivemap": "map_Ke", "roughnessmap": "map_Pr", "metallicmap": "map_Pm"}
+
+
+def _texture(mesh) -> np.ndarray | None:
+    """A baked mesh's texture coordinates (V, 2), None when it has none."""
+    return getattr(mesh.visual, "uv", None)
+
 
 #: The extensions this module writes (``grammarc.io.writers``): all baked.
 WRITERS = dict.fromkeys(BakedWriter.FORMATS, BakedWriter)

@@ -305,7 +305,7 @@ class _Part:
 
 
 def baked_glb(vertices: np.ndarray, faces: np.ndarray, looks: np.ndarray | None, materials: np.ndarray,
-              roots: Sequence[Path], meta: dict) -> bytes:
+              roots: Sequence[Path], meta: dict, uv: np.ndarray | None = None) -> bytes:
     """A baked mesh as a GLB: one mesh, a primitive (and a material) per look of its triangles.
 
     Parameters
@@ -320,6 +320,8 @@ def baked_glb(vertices: np.ndarray, faces: np.ndarray, looks: np.ndarray | None,
     materials : (M, len(ir.MATERIAL_MAPS)) str
         Texture paths per channel (``model.records.MaterialTable``); a colour map found in ``roots`` becomes
         the primitive's ``baseColorTexture``.
+    uv : (V, 2) float, optional
+        Texture coordinates of the vertices (``TEXCOORD_0``, v turned to glTF's, down the image).
     """
     with tempfile.TemporaryDirectory() as folder:
         part = _Part(Path(folder) / "part.bin", None, meta)
@@ -328,7 +330,11 @@ def baked_glb(vertices: np.ndarray, faces: np.ndarray, looks: np.ndarray | None,
             looks = np.full(len(faces), 0xFFFFFFFF, np.int64)
         primitives = []
         if len(faces):
-            position = part._accessor(np.asarray(vertices, np.float32), "VEC3", _ARRAY_BUFFER, bounds=True)
+            attributes = {"POSITION": part._accessor(np.asarray(vertices, np.float32), "VEC3", _ARRAY_BUFFER,
+                                                     bounds=True)}
+            if uv is not None:
+                flipped = np.stack([uv[:, 0], 1 - uv[:, 1]], axis=1).astype(np.float32)
+                attributes["TEXCOORD_0"] = part._accessor(flipped, "VEC2", _ARRAY_BUFFER)
             distinct, inverse = np.unique(looks, return_inverse=True)
             order = np.argsort(inverse.reshape(-1), kind="stable")
             bounds = np.searchsorted(inverse.reshape(-1)[order], np.arange(len(distinct) + 1))
@@ -338,7 +344,7 @@ def baked_glb(vertices: np.ndarray, faces: np.ndarray, looks: np.ndarray | None,
                 found = locate(colormap, roots) if colormap else None
                 triangles = np.asarray(faces, np.int64)[order[bounds[k]:bounds[k + 1]]]
                 primitives.append({
-                    "attributes": {"POSITION": position},
+                    "attributes": attributes,
                     "indices": part._accessor(triangles.astype(np.uint32).reshape(-1), "SCALAR",
                                               _ELEMENT_ARRAY_BUFFER),
                     "material": part._material(rgba, colormap=found[1] if found else None)})

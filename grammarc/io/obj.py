@@ -16,8 +16,11 @@ __all__ = ["obj_bytes", "with_lines"]
 DECIMALS = 6
 
 
-def obj_bytes(vertices: np.ndarray, faces: np.ndarray, header: str = "") -> bytes:
-    """An OBJ file of ``vertices`` (V, 3) and triangles ``faces`` (T, 3) (0-based), as bytes.
+def obj_bytes(vertices: np.ndarray, faces: np.ndarray, header: str = "", uv: np.ndarray | None = None,
+              uv_shift: int = 0) -> bytes:
+    """An OBJ file of ``vertices`` (V, 3) and triangles ``faces`` (T, 3) (0-based), as bytes; with texture
+    coordinates ``uv`` (V, 2), a ``vt`` after each ``v`` and faces ``f a/a' b/b' c/c'``, the ``vt`` index
+    ``uv_shift`` less than the ``v`` index (the vertices written before without one, in a streamed file).
 
     A baked city has 10^7 triangles and more, too many to format one by one with Python's ``str.format``
     (as trimesh does). Here a numba kernel writes the digits into one buffer:
@@ -25,35 +28,53 @@ def obj_bytes(vertices: np.ndarray, faces: np.ndarray, header: str = "") -> byte
     """
     vertices = np.ascontiguousarray(vertices, dtype=np.float64)
     faces = np.ascontiguousarray(faces, dtype=np.int64)
-    if not np.isfinite(vertices).all():
-        raise ValueError("obj_bytes: vertices must be finite")
     lines = "".join(f"# {line}\n" for line in header.splitlines() if line)
-    # the longest line: "v " + 3 * ("-" + 19 digits + "." + decimals + " "), "f " + 3 * (19 digits + " ")
-    buffer = np.empty(len(vertices) * (2 + 3 * (22 + DECIMALS)) + len(faces) * (2 + 3 * 20) + 1, np.uint8)
-    used = _write_obj(vertices, faces, buffer)
+    textured = uv is not None
+    uv = np.ascontiguousarray(uv if textured else np.zeros((0, 2)), dtype=np.float64)
+    if not (np.isfinite(vertices).all() and np.isfinite(uv).all()):
+        raise ValueError("obj_bytes: vertices and texture coordinates must be finite")
+    # the longest line: "v " + 3 * ("-" + 19 digits + "." + decimals + " "), "f " + 3 * (19 digits + " ");
+    # with texture coordinates "vt " + 2 * (...) and "/" + 19 digits after each index
+    size = len(vertices) * (2 + 3 * (22 + DECIMALS)) + len(faces) * (2 + 3 * 20) + 1
+    if textured:
+        size += len(vertices) * (3 + 2 * (22 + DECIMALS)) + len(faces) * 3 * 20
+    buffer = np.empty(size, np.uint8)
+    used = _write_obj(vertices, faces, uv, textured, uv_shift, buffer)
     return lines.encode() + buffer[:used].tobytes()
 
 
 @njit(cache=True, nogil=True)
-def _write_obj(vertices, faces, out):
+def _write_obj(vertices, faces, uv, textured, uv_shift, out):
     at = 0
     for i in range(vertices.shape[0]):
         out[at] = 118  # v
-        at += 1
-        for k in range(3):
-            out[at] = 32
-            at = _fixed(vertices[i, k], out, at + 1)
-        out[at] = 10
-        at += 1
+        at = _line(vertices[i], out, at + 1)
+        if textured:
+            out[at] = 118  # vt
+            out[at + 1] = 116
+            at = _line(uv[i], out, at + 2)
     for i in range(faces.shape[0]):
         out[at] = 102  # f
         at += 1
         for k in range(3):
             out[at] = 32
             at = _integer(faces[i, k] + 1, out, at + 1)
+            if textured:  # the vertex's own texture coordinate
+                out[at] = 47
+                at = _integer(faces[i, k] + 1 - uv_shift, out, at + 1)
         out[at] = 10
         at += 1
     return at
+
+
+@njit(cache=True, nogil=True)
+def _line(values, out, at):
+    """The rest of a ``v`` or ``vt`` line: each value after a blank, then the newline."""
+    for k in range(values.shape[0]):
+        out[at] = 32
+        at = _fixed(values[k], out, at + 1)
+    out[at] = 10
+    return at + 1
 
 
 #: "00" .. "99": digits are written two at a time (half the divisions).

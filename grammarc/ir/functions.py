@@ -142,6 +142,11 @@ FUNCTIONS: dict[str, Signature] = {
        for name in ("isConcave", "isClosedSurface", "isInstanced")},
     "geometry.nVertices": Signature((), T.NUM, shape=True),
     "geometry.nFaces": Signature((), T.NUM, shape=True),
+    # texture space (backend.functions.texture): the uv set, a constant (0 when left out); du and dv measure
+    # in "uvSpace" or "unitSpace" (metres on the surface)
+    **{f"geometry.{name}": Signature((T.NUM,), T.NUM, optional=1, shape=True)
+       for name in ("uMin", "uMax", "vMin", "vMax")},
+    **{f"geometry.{name}": Signature((T.NUM, T.STR), T.NUM, shape=True) for name in ("du", "dv")},
     # ---------------------------------------------------------------------------- miscellaneous (backend.functions.math)
     # `print(x)` gives x (typed as x by ``passes.types``); grammarc prints nothing, as its `print` operation
     "print": Signature((None,), T.UNKNOWN),

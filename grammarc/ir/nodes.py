@@ -621,8 +621,8 @@ class Report:
 
 @dataclass(frozen=True, slots=True)
 class NotApplied:
-    """An operation that is accepted but has no effect on the record (material, texture and UV
-    operations, ``reverseNormals``, ``print``); the output's meta lists it."""
+    """An operation that is accepted but has no effect on the record (the material settings other than
+    colours, opacity and texture maps, ``reverseNormals``, ``print``); the output's meta lists it."""
 
     name: str
     span: Span = NO_SPAN
@@ -647,6 +647,10 @@ class GroupSplit:
     #: ``split(axis, noAdjust)`` when false: each part's scope is its slab of the parent's scope, not the
     #: bounding box of its piece of the geometry.
     adjust: bool = True
+    #: ``split(u|v, uvSpace|unitSpace, uvSet)``: the texture set whose u (``axis`` 0) or v (1) the split cuts
+    #: along (-1: a split of the scope), and whether sizes are metres on the surface (``unitSpace``).
+    uv_set: int = -1
+    unit_space: bool = False
 
 
 #: Face selectors of CityEngine's ``comp(f)``, relative to the shape's scope.
@@ -896,11 +900,79 @@ class SetOpacity:
     span: Span = NO_SPAN
 
 
+#: ``setupProjection`` axes: the frame ("scope" or "world") and the axes of u and v in it.
+PROJECTION_AXES = {f"{frame}.{a}{b}": (frame, "xyz".index(a), "xyz".index(b))
+                   for frame in ("scope", "world") for a in "xyz" for b in "xyz" if a != b}
+
+
+@dataclass(frozen=True, slots=True)
+class SetupProjection:
+    """CityEngine ``setupProjection(uvSet, axes, width, height[, uOffset, vOffset[, uwFactor]])``: the
+    projection of texture set ``uv_set``, kept on the shape (and inherited) until ``projectUV`` applies
+    it: u runs along the frame's axis ``u_axis`` one texture ``width`` per unit, v along ``v_axis``, from the
+    frame's origin moved by the offsets (metres). Relative and floating sizes measure the scope's extent
+    along that axis (``'0.5``: two tiles; ``~2``: whole tiles of about 2 m), and so do relative offsets
+    (``'0.5``: half of it; a floating offset is its value). ``uwFactor`` drives the w
+    coordinate, which grammarc does not keep."""
+
+    uv_set: int
+    frame: str
+    u_axis: int
+    v_axis: int
+    sizes: tuple[Size, Size] = child(Type.NUM, "a texture size")
+    offsets: tuple[Size, Size] = child(Type.NUM, "a texture offset")
+    span: Span = NO_SPAN
+
+
+@dataclass(frozen=True, slots=True)
+class ProjectUV:
+    """CityEngine ``projectUV(uvSet)``: the shape's texture coordinates of set ``uv_set`` become its
+    projection's (``deleteUV`` when ``delete``: it has none)."""
+
+    uv_set: int
+    delete: bool = False
+    span: Span = NO_SPAN
+
+
+@dataclass(frozen=True, slots=True)
+class TransformUV:
+    """CityEngine ``translateUV(uvSet, u, v)``, ``scaleUV(uvSet, u, v)`` and ``rotateUV(uvSet, degrees)``
+    (``kind``): the texture coordinates moved, scaled or turned about (0, 0) in texture space."""
+
+    kind: str
+    uv_set: int
+    values: tuple[Expr, ...] = child(Type.NUM, "a texture coordinate change")
+    span: Span = NO_SPAN
+
+
+@dataclass(frozen=True, slots=True)
+class TileUV:
+    """CityEngine ``tileUV(uvSet, width, height)``: texture coordinates rescaled so that a tile is
+    ``width`` by ``height`` metres on the surface (0: that direction is left alone; ``~``: whole tiles over
+    the geometry's extent; ``'``: a share of it)."""
+
+    uv_set: int
+    sizes: tuple[Size, Size] = child(Type.NUM, "a texture size")
+    span: Span = NO_SPAN
+
+
+@dataclass(frozen=True, slots=True)
+class NormalizeUV:
+    """CityEngine ``normalizeUV(uvSet, uv|uvUniform|u|v, separatePerFace|collectiveAllFaces)``: texture
+    coordinates moved and scaled into [0, 1] over the shape's geometry (``uvUniform``: one scale for both,
+    the larger extent's). A shape's faces share one affine texture map, so ``separatePerFace`` normalizes the
+    shape as a whole, as ``collectiveAllFaces`` does."""
+
+    uv_set: int
+    mode: str
+    span: Span = NO_SPAN
+
 Op = (Symbol | Empty | Translate | Scale | Rotate | Push | Pop | Insert | Split | Repeat | Comp | Extrude
       | Center | UseAsset | Case | Stochastic | SetAttr | Report | NotApplied | GroupSplit | CompFaces
       | AlignScope | Mirror | Offset | SetColor | Setback | Roof | InnerRectangle | Convexify
       | CleanupGeometry | DeleteHoles | Snap | Label | Transform | Scatter | AlignToGeometry | Primitive
-      | Trim | SplitArea | ReduceGeometry | MirrorScope | SetOpacity)
+      | Trim | SplitArea | ReduceGeometry | MirrorScope | SetOpacity | SetupProjection | ProjectUV | TransformUV
+      | TileUV | NormalizeUV)
 Body = tuple[Op, ...]
 
 

@@ -104,7 +104,9 @@ def _group_split(op: ir.GroupSplit) -> str:
     shown = [" | ".join(i) if i[0] != "{" else "{ " + " | ".join(i[1:]) + " }*" for i in items]
     options = "" if op.adjust else ", noAdjust"
     name = "splitArea" if isinstance(op, ir.SplitArea) else "split"
-    return f"{name}({'xyz'[op.axis]}{options}){{ {' | '.join(shown)} }}{'*' if op.repeat else ''}"
+    head = f"{'xyz'[op.axis]}{options}" if op.uv_set < 0 else \
+        f"{'uv'[op.axis]}, {'unitSpace' if op.unit_space else 'uvSpace'}, {op.uv_set}"
+    return f"{name}({head}){{ {' | '.join(shown)} }}{'*' if op.repeat else ''}"
 
 
 def _roof(op: ir.Roof) -> str:
@@ -194,6 +196,12 @@ _OP_FORMATS = {
     ir.Scatter: _scatter,
     ir.Primitive: lambda op: f"primitive{op.kind.title()}({_list(op.segments + (op.sizes or ()))})",
     ir.SetOpacity: lambda op: f"set(material.opacity, {print_expr(op.value)})",
+    ir.SetupProjection: lambda op: (f"setupProjection({op.uv_set}, {op.frame}.{'xyz'[op.u_axis]}{'xyz'[op.v_axis]}, "
+                                    f"{', '.join(_size(s) for s in op.sizes + op.offsets)})"),
+    ir.ProjectUV: lambda op: f"{'deleteUV' if op.delete else 'projectUV'}({op.uv_set})",
+    ir.TransformUV: lambda op: f"{op.kind}UV({op.uv_set}, {_list(op.values)})",
+    ir.TileUV: lambda op: f"tileUV({op.uv_set}, {', '.join(_size(s) for s in op.sizes)})",
+    ir.NormalizeUV: lambda op: f"normalizeUV({op.uv_set}, {op.mode})",
 }
 
 

@@ -45,6 +45,8 @@ class MeshChunk:
         Each face's row of ``materials``; None (and ``materials`` None) where the grammar sets no texture.
     materials : (M, len(MATERIAL_MAPS)) str, optional
         The texture paths of each material, one column per channel of ``ir.MATERIAL_MAPS`` ("" for none).
+    uv : (V, 2) float32, optional
+        Texture coordinates of set 0 of each vertex (NaN: its face has none); None: no face has any.
     """
 
     vertices: np.ndarray
@@ -55,6 +57,7 @@ class MeshChunk:
     color: np.ndarray | None = None
     material: np.ndarray | None = None
     materials: np.ndarray | None = None
+    uv: np.ndarray | None = None
 
     def colors(self) -> np.ndarray:
         """(F, 4) uint8: the faces' colours, white where none was given."""
@@ -90,7 +93,12 @@ class MeshChunk:
             symbol=np.concatenate([c.symbol for c in chunks]),
             color=np.concatenate([c.colors() for c in chunks]),
             **_joined_materials(chunks, [c.material for c in chunks], [c.materials for c in chunks]),
+            uv=None if all(c.uv is None for c in chunks) else np.concatenate([c.texture() for c in chunks]),
         )
+
+    def texture(self) -> np.ndarray:
+        """(V, 2) float32: the vertices' texture coordinates, NaN where none were given."""
+        return self.uv if self.uv is not None else np.full((len(self.vertices), 2), np.nan, np.float32)
 
 
 def _joined_materials(chunks: Sequence, material: list, materials: list) -> dict:
@@ -137,6 +145,9 @@ class TerminalChunk:
         Each instance's row of ``materials``; None (and ``materials`` None) where the grammar sets no texture.
     materials : (M, len(MATERIAL_MAPS)) str, optional
         The texture paths of each material (as ``MeshChunk.materials``; the mesh's table is the same).
+    uv : (n, 2, 4) float32, optional
+        Texture coordinates of set 0 of each instance as an affine map of its asset's unit box:
+        ``uv = uv[:, :, :3] @ p + uv[:, :, 3]`` (NaN: none); None: no instance has any.
     """
 
     asset: np.ndarray
@@ -147,6 +158,7 @@ class TerminalChunk:
     color: np.ndarray | None = None
     material: np.ndarray | None = None
     materials: np.ndarray | None = None
+    uv: np.ndarray | None = None
 
     def colors(self) -> np.ndarray:
         """(n, 4) uint8: the instances' colours, white where none was given."""

@@ -5,7 +5,7 @@ from __future__ import annotations
 from operations.derivations import VERSION
 
 from grammarc.backend.plan import make_plan
-from grammarc.backend.slots import ANCESTORS, COLOR_SLOT, TRIM_SLOTS, TRIM_SWITCH
+from grammarc.backend.slots import ANCESTORS, COLOR_SLOT, TRIM_SLOTS, TRIM_SWITCH, uv_slots
 from grammarc.compiler import compile_grammar
 
 
@@ -24,3 +24,14 @@ def test_columns_of_colours_trims_and_occluders_only_where_the_grammar_needs_the
     assert switch.trim_switch == switch.dynamic[TRIM_SWITCH]
     labelled = plan_of(write, 'Lot --> label("mass") X\n')
     assert labelled.occluders and ANCESTORS[0] in labelled.dynamic
+
+
+def test_texture_columns_only_for_the_sets_the_grammar_names(write):
+    """Two id columns per texture set an operation, a split or a query names; none without texture space
+    (its shapes carry nothing more, and its splits copy nothing more)."""
+    assert plan_of(write, "Lot --> extrude(3) X\n").uv_slots == {}
+    plan = plan_of(write, "Lot --> setupProjection(2, scope.xy, 1, 1) projectUV(2) "
+                   "split(v, unitSpace, 0){ 1 : A | ~1 : B }\nA --> report(\"u\", geometry.uMax(5)) A.\n")
+    assert sorted(plan.uv_slots) == [0, 2, 5]
+    for uv_set, start in plan.uv_slots.items():
+        assert [plan.dynamic[name] for name in uv_slots(uv_set)] == [start, start + 1]

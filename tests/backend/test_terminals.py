@@ -4,7 +4,8 @@ with the asset meshes the plan's loader gives."""
 from __future__ import annotations
 
 import numpy as np
-from operations.derivations import VERSION, make_lots_polys, paper, rect, run
+import pytest
+from operations.derivations import VERSION, make_lots_polys, names, paper, rect, run
 
 from grammarc.backend.derive import derive_chunk
 from grammarc.backend.plan import make_plan
@@ -69,3 +70,25 @@ def test_polygon_leaves_go_to_the_mesh_table(write):
     assert list(mesh.lot) == [0] * 8 and list(r["lot"]) == [1]
     assert len(r["asset"]) == 1 and r["assets"][r["asset"][0]] == "builtin:cube"
 
+
+
+@pytest.mark.parametrize("leaf", ["roofHip(30) R.", "extrude(3) E."])  # a roof; a prism's faces
+def test_mesh_faces_carry_the_texture_coordinates_of_their_vertices(write, leaf):
+    """Projected from above in 2 m tiles: every vertex of the mesh table has u = x / 2, v = z / 2."""
+    r = run(write, f"Lot --> setupProjection(0, world.xz, 2, 2) projectUV(0) {leaf}\n",
+            make_lots_polys("concave_L"))
+    mesh = r["mesh"]
+    assert len(mesh.lot) and mesh.uv.shape == (len(mesh.vertices), 2)
+    np.testing.assert_allclose(mesh.uv, mesh.vertices[:, [0, 2]] / 2, atol=1e-5)
+
+
+def test_inserted_geometry_carries_no_texture_coordinates(write):
+    """An inserted asset, whole or trimmed at the corners, has its own coordinates, which grammarc does not
+    keep: it carries none, where the boxes and faces of the same grammar carry theirs."""
+    r = run(write, "Lot --> setupProjection(0, world.xz, 2, 2) projectUV(0) extrude(10) comp(f){ side : Facade "
+            "| top : T. }\nFacade --> split(y){ 1 : Ledge | 1 : W | ~1 : NIL }\nW --> i(\"builtin:cylinder\")\n"
+            "Ledge --> s('1.2, '1, 0.5) center(x) i(\"builtin:cylinder\")\n", [rect(12, 8)])
+    top = np.array(names(r)) == "T"
+    assert np.isnan(r["uv"][~top]).all() and not np.isnan(r["uv"][top]).any()
+    trimmed = r["mesh"]
+    assert len(trimmed.lot) and trimmed.uv is None

@@ -352,3 +352,41 @@ def test_a_bake_without_colours_or_textures_has_no_materials(tmp_path):
     text = textured_city(tmp_path, plain, ".obj", bake=True).read_text()
     assert "usemtl" not in text and text.count("g lot_") == 2
     assert "red" not in textured_city(tmp_path, plain, ".ply", bake=True).read_bytes()[:400].decode("latin-1")
+def textured_chunks():
+    """``chunks()`` with texture coordinates: the first chunk's instances u = x, v = 2 z of their unit box
+    (their world's x and z halved: their columns are 2 long), the second's none, its face u = x / 10."""
+    first, second = chunks()
+    uv = np.zeros((2, 2, 4), np.float32)
+    uv[:, 0, 0], uv[:, 1, 2] = 1, 2
+    mesh = second.mesh
+    textured = MeshChunk(mesh.vertices, mesh.ring_offsets, mesh.face_offsets, mesh.lot, mesh.symbol,
+                         uv=np.stack([mesh.vertices[:, 0] / 10, mesh.vertices[:, 2] / 10], axis=1))
+    return [TerminalChunk(first.asset, first.xform, first.lot, first.symbol, first.mesh, uv=uv),
+            TerminalChunk(second.asset, second.xform, second.lot, second.symbol, textured)]
+
+
+@needs_earcut
+@pytest.mark.parametrize("suffix", [".obj", ".glb"])
+def test_writers_keep_texture_coordinates(tmp_path, suffix):
+    """OBJ ``vt`` and glTF ``TEXCOORD_0``: an instance's map of its unit box, a face's per vertex, 0 for an
+    instance without any."""
+    path = tmp_path / f"city{suffix}"
+    with BakedWriter(path, assets=ASSETS, symbols=["A"], meta={}) as out:
+        for chunk in textured_chunks():
+            out.write(chunk)
+    loaded = trimesh.load(path, force="mesh", process=False)
+    uv = loaded.visual.uv  # trimesh turns glTF's v (down the image) back
+    cube = builtin_mesh("builtin:cube").vertices
+    np.testing.assert_allclose(uv[:8], cube[:, [0, 2]] * [1, 2], atol=1e-6)
+    np.testing.assert_allclose(uv[-8:], loaded.vertices[-8:][:, [0, 2]] / 10, atol=1e-6)
+    # the second chunk's cube has none: after the first chunk's cube and quad in the streamed OBJ, after
+    # the first cube in the GLB (its instances baked together, by asset)
+    untextured = slice(12, 20) if suffix == ".obj" else slice(8, 16)
+    np.testing.assert_allclose(uv[untextured], 0)
+
+
+def test_untextured_obj_has_no_texture_coordinates(tmp_path):
+    path = tmp_path / "city.obj"
+    with BakedWriter(path, assets=ASSETS, symbols=["A"], meta={}) as out:
+        out.write(chunks()[0])
+    assert b"vt" not in path.read_bytes()

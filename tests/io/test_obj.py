@@ -19,3 +19,18 @@ def test_obj_bytes_writes_what_read_obj_reads():
     np.testing.assert_array_equal(np.array(read), faces)
     with pytest.raises(ValueError, match="finite"):
         obj_bytes(np.array([[np.nan, 0, 0]]), faces[:0])
+
+
+def test_obj_bytes_writes_texture_coordinates_after_each_vertex():
+    """A ``vt`` after each ``v``; each face corner names both, the vt index ``uv_shift`` lower (vertices
+    written before without one)."""
+    vertices = np.array([[0, 0, 0], [1, 0, 0], [1, 1, 0.0]])
+    text = obj_bytes(vertices + 0, np.array([[4, 5, 6]]) - 4, uv=vertices[:, :2] / 4).decode()
+    assert text.splitlines()[:2] == ["v 0 0 0", "vt 0 0"] and text.splitlines()[-1] == "f 1/1 2/2 3/3"
+    shifted = obj_bytes(vertices, np.array([[4, 5, 6]]), uv=vertices[:, :2], uv_shift=4).decode()
+    assert shifted.splitlines()[-1] == "f 5/1 6/2 7/3"
+    points, read = read_obj(shifted.replace("f 5/1 6/2 7/3", "f 1/1 2/2 3/3"))
+    np.testing.assert_allclose(points, vertices)
+    np.testing.assert_array_equal(np.array(read), [[0, 1, 2]])  # the reader takes each corner's v
+    with pytest.raises(ValueError, match="finite"):
+        obj_bytes(vertices, np.zeros((0, 3), int), uv=np.full((3, 2), np.nan))

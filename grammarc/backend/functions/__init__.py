@@ -15,6 +15,7 @@ families, as that table groups them:
 - ``colors``: ``colorRamp`` and the conversions between colour strings, RGB and HSV;
 - ``coordinates``: ``convert`` between coordinate systems, ``initialShape.name`` and ``startRule``;
 - ``geometry``: ``geometry.area``... of the shape's geometry;
+- ``texture``: ``geometry.uMin``... of its texture coordinates;
 - ``arrays``: CityEngine's arrays.
 
 A new function is its signature, its lowering if it needs one, and its function here: importing this
@@ -33,6 +34,7 @@ from grammarc.backend.functions import (  # noqa: F401 - each registers its func
     math,
     strings,
     tables,
+    texture,
 )
 from grammarc.backend.functions.table import FUNCTIONS
 

@@ -17,6 +17,7 @@ columns:
 - ``values``: ``set``, ``color``, the opacity, ``report``;
 - ``control``: ``case`` and ``p%`` blocks;
 - ``scatter``: ``scatter``, point shapes on, in or around the shape;
+- ``texture``: ``setupProjection``, ``projectUV`` and the other operations on texture coordinates.
 - ``trims``: ``trim()``, the shape's geometry cut by its trim planes;
 - ``simplify``: ``reduceGeometry``, polygons with fewer vertices.
 
@@ -34,6 +35,7 @@ from grammarc.backend.operations import (  # noqa: F401 - each registers its ope
     simplify,
     splits,
     successors,
+    texture,
     trims,
     values,
 )

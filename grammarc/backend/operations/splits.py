@@ -1,5 +1,7 @@
 """Splits: the paper's ``Subdiv`` and ``Repeat`` (on one axis or several), CityEngine's ``split`` with repeat
-groups and its ``splitArea`` (the same layout over the geometry's area), and the paper's ``Snap``/``SnapLines``, whose planes snapped splits move their cuts to.
+groups and its ``splitArea`` (the same layout over the geometry's area), also in texture space
+(``split(u|v, ...)``: along x of the shapes turned the way u or v grows, ``operations.texture``), and the
+paper's ``Snap``/``SnapLines``, whose planes snapped splits move their cuts to.
 
 A split makes children (``backend.children``: scopes moved and cut along the axis, polygons and meshes cut to
 their slabs, new keys, ``split.index``/``split.total``) and returns them as ``Parts`` for its bodies; parts
@@ -20,6 +22,8 @@ from grammarc.backend.kernels import split as split_kernels
 from grammarc.backend.kernels.order import group_by
 from grammarc.backend.leaf_parts import LeafPart
 from grammarc.backend.operations.table import Parts, operation
+from grammarc.backend.operations.texture import texture_axis
+from grammarc.backend.reframing import reframed
 from grammarc.backend.shapes import Shapes
 from grammarc.constants import TOL
 from grammarc.geometry.area_cuts import area_positions, total_areas
@@ -85,9 +89,15 @@ def repeat(ctx: Context, cursor: Shapes, op: ir.Repeat) -> Parts | None:
 
 @operation(ir.GroupSplit, meshes=True, consumes=True)
 def group_split(ctx: Context, cursor: Shapes, op: ir.GroupSplit) -> Parts:
-    extent = np.ascontiguousarray(cursor.size[:, op.axis])
-    parent, part, pos, length, index = _group_layout(ctx, cursor, op, extent)
-    return _group_children(ctx, cursor, op, parent, part, pos, length, index)
+    values = _split_sizes(ctx, cursor, op, "split")
+    axis, axes = op.axis, None
+    if op.uv_set >= 0:  # texture space: a split along x turned the way u (v) grows, sizes in metres
+        cursor, metres, axes = texture_axis(ctx, cursor, op)
+        values = np.where(_kinds(op) == _SIZE_KIND[ir.SizeKind.RELATIVE], values, values * metres[:, None])
+        axis = 0
+    extent = np.ascontiguousarray(cursor.size[:, axis])
+    parent, part, pos, length, index = _group_layout(op, values, extent)
+    return _group_children(ctx, cursor, op, axis, parent, part, pos, length, index, axes)
 
 
 @operation(ir.SplitArea, consumes=True)
@@ -98,18 +108,18 @@ def split_area(ctx: Context, cursor: Shapes, op: ir.SplitArea) -> Parts:
     faces = shape_faces(cursor.size, cursor.geom, chunk.polygons, chunk.meshes)
     rings, offsets = (faces.verts, faces.ring_offsets, faces.face_offsets), faces.shape_offsets
     total = total_areas(*rings, offsets)
-    parent, part, start, area, index = _group_layout(ctx, cursor, op, total)
+    values = _split_sizes(ctx, cursor, op, "splitArea")
+    parent, part, start, area, index = _group_layout(op, values, total)
     extent = cursor.size[parent, op.axis]
     ends = [area_positions(*rings, offsets, op.axis, parent, a, extent, total[parent])
             for a in (start, start + area)]
-    return _group_children(ctx, cursor, op, parent, part, ends[0], ends[1] - ends[0], index)
+    return _group_children(ctx, cursor, op, op.axis, parent, part, ends[0], ends[1] - ends[0], index)
 
 
-def _group_layout(ctx: Context, cursor: Shapes, op: ir.GroupSplit, extent: np.ndarray):
-    """The parts of CityEngine's split over ``extent`` (n,): parent, part, position, length and index of
-    each (``kernels.split.group_split``)."""
-    values = _split_sizes(ctx, cursor, op, "splitArea" if isinstance(op, ir.SplitArea) else "split")
-    kind = np.array([_SIZE_KIND[s.kind] for s in op.sizes], dtype=np.int64)
+def _group_layout(op: ir.GroupSplit, values: np.ndarray, extent: np.ndarray):
+    """The parts of CityEngine's split of sizes ``values`` (n, P) or (1, P) over ``extent`` (n,): parent,
+    part, position, length and index of each (``kernels.split.group_split``)."""
+    kind = _kinds(op)
     groups = np.array(op.groups, dtype=np.int64)
     if op.repeat:
         groups = np.zeros_like(groups)
@@ -117,12 +127,16 @@ def _group_layout(ctx: Context, cursor: Shapes, op: ir.GroupSplit, extent: np.nd
     return split_kernels.group_split(extent, values, kind, groups, n_groups, TOL.zero)
 
 
-def _group_children(ctx: Context, cursor: Shapes, op: ir.GroupSplit, parent, part, pos, length, index) -> Parts:
-    """The children of a split's parts along ``op.axis``, their geometry cut to their slabs, by part."""
-    parent, part, pos, length, index, geometry = clip(ctx.chunk, cursor, op.axis, parent, part, pos, length,
+def _group_children(ctx: Context, cursor: Shapes, op: ir.GroupSplit, axis: int, parent, part, pos, length, index,
+                    axes: np.ndarray | None = None) -> Parts:
+    """The children of a split's parts along ``axis``, their geometry cut to their slabs, by part; with the
+    parents' ``axes`` (a split in texture space, its shapes turned) they take those axes again."""
+    parent, part, pos, length, index, geometry = clip(ctx.chunk, cursor, axis, parent, part, pos, length,
                                                       index, op.adjust)
     order, offsets = group_by(part, len(op.parts))
-    made = children(ctx, cursor, op.axis, parent, index, pos, length, op.site, order, geometry)
+    made = children(ctx, cursor, axis, parent, index, pos, length, op.site, order, geometry)
+    if axes is not None:  # the children take their parent's axes again
+        made = reframed(ctx, made, axes[parent[order]], op.span)
     ctx.count(made, op.span)
     return Parts(op.parts, made, offsets)
 
@@ -239,3 +253,8 @@ def _size_matrix(values: list, n: int) -> np.ndarray:
 
 #: GroupSplit size kinds for the kernel.
 _SIZE_KIND = {ir.SizeKind.ABSOLUTE: 0, ir.SizeKind.RELATIVE: 1, ir.SizeKind.FLOATING: 2}
+
+
+def _kinds(op: ir.GroupSplit) -> np.ndarray:
+    """(P,) int64: the kind of each part's size (``_SIZE_KIND``)."""
+    return np.array([_SIZE_KIND[s.kind] for s in op.sizes], dtype=np.int64)

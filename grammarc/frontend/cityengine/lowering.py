@@ -93,8 +93,6 @@ WORLD_DIRECTIONS = {"world.north": "world.back", "world.south": "world.front", "
                     "world.west": "world.left", "world.up": "world.top", "world.down": "world.bottom"}
 #: The geometry queries of the reference that grammarc cannot answer yet, and why.
 UNANSWERED_QUERIES = {
-    **{f"geometry.{name}": "texture coordinates: grammarc keeps none yet"
-       for name in ("du", "dv", "uMin", "uMax", "vMin", "vMax")},
     **{f"geometry.{name}": "the groups and materials of assets are not kept" for name in ("groups", "materials")},
     **{f"geometry.{name}": "geometry tags, as `tag` makes them" for name in ("hasTags", "tags")},
 }
@@ -449,6 +447,11 @@ class Lowering(OperationLowering, LoweringBase):
             return self.unanswered(text, span, "()")
         if text in GEOMETRY_SELECTORS and len(args) == 1:
             return self.geometry_selector(text, args[0], span)
+        if text in ("geometry.du", "geometry.dv") and len(args) == 2:
+            if not (isinstance(args[1], ir.Name) and args[1].name in ("uvSpace", "unitSpace")):
+                self.unsupported(f"{text} in this space", span, "uvSpace or unitSpace")
+                return ir.placeholder(span)
+            args = (args[0], ir.Str(args[1].name, args[1].span))
         if text == "geometry.isRectangular" and not args:
             args = (ir.Num(0.0, span),)
         # a geometry query (the checker checks the arguments, or names the closest query), or a function

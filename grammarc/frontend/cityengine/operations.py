@@ -283,8 +283,16 @@ class OperationLowering:
     def op_split(self, op, args, parts, span, repeat=False):
         """``split(axis[, adjust|noAdjust]){ size : A | { size : B }* | ... }``, repeated as a whole when
         ``repeat`` (``{ ... }*``)."""
+        texture = None
         if args and isinstance(args[0], ir.Name) and args[0].name in ("u", "v"):
-            return self.unsupported(f"split({args[0].name}, ...)", span, "splits of texture space")
+            space = args[1].name if len(args) == 3 and isinstance(args[1], ir.Name) else None
+            if space not in ("uvSpace", "unitSpace"):
+                return self.unsupported(f"split({args[0].name}) with these arguments", span,
+                                        f"split({args[0].name}, uvSpace|unitSpace, uvSet)")
+            texture = self.uv_set("split", args[2], span), space == "unitSpace"
+            if texture[0] is None:
+                return ir.Empty(span)
+            args = (ir.Name("xy"[args[0].name == "v"], args[0].span),)
         if not args or not isinstance(args[0], ir.Name) or args[0].name not in ("x", "y", "z"):
             self.diags.error("axis", "`split` expects an axis x, y or z", span)
             return ir.Empty(span)
@@ -307,8 +315,9 @@ class OperationLowering:
                 groups.append(-1)
                 bodies.append(item.body)
         adjust = not any(isinstance(extra, ir.Name) and extra.name == "noAdjust" for extra in args[1:])
+        uv_set, unit_space = texture or (-1, False)
         return ir.GroupSplit("xyz".index(args[0].name), tuple(sizes), tuple(groups), tuple(bodies), repeat,
-                             span, self.site(), adjust)
+                             span, self.site(), adjust, uv_set, unit_space)
 
     def op_split_area(self, op, args, parts, span, repeat=False):
         """``splitArea(axis[, adjust|noAdjust]){ area : A | ... }[*]``: a split's parts, their sizes areas."""
@@ -426,6 +435,72 @@ class OperationLowering:
         return ir.Scatter(names[0], self.expr(args[1]), names[2] == "gaussian", mean, value, relative, (body,),
                           span, self.site())
 
+    def uv_set(self, op, arg, span) -> int | None:
+        """The texture set an operation names: a whole number in [0, 9] (None after an error)."""
+        if isinstance(arg, ir.Num) and arg.value == int(arg.value) and 0 <= arg.value <= 9:
+            return int(arg.value)
+        self.unsupported(f"{op} with this uvSet", getattr(arg, "span", span), "a number from 0 to 9")
+        return None
+
+    def texture_size(self, arg) -> ir.Size:
+        """A texture width, height or offset: absolute, relative (``'0.5``) or floating (``~2``)."""
+        if isinstance(arg, Sized):
+            return ir.Size(arg.kind, arg.value, arg.span)
+        value = self.expr(arg)
+        return ir.Size(ir.SizeKind.ABSOLUTE, value, getattr(value, "span", ir.NO_SPAN))
+
+    def op_setup_projection(self, op, args, span):
+        """``setupProjection(uvSet, scope.xy|world.xz|..., width, height[, uOffset, vOffset[, uwFactor]])``."""
+        if not self.arity(op, args, (4, 6, 7), span):
+            return ir.Empty(span)
+        uv_set = self.uv_set(op, args[0], span)
+        axes = ir.PROJECTION_AXES.get(args[1].name) if isinstance(args[1], ir.Name) else None
+        if axes is None:
+            return self.unsupported(f"{op} axes", getattr(args[1], "span", span),
+                                    "scope.xy, scope.xz, world.xz... (two different axes)")
+        if uv_set is None:
+            return ir.Empty(span)
+        zero = ir.Size(ir.SizeKind.ABSOLUTE, ir.Num(0.0, span), span)
+        offsets = (self.texture_size(args[4]), self.texture_size(args[5])) if len(args) > 4 else (zero, zero)
+        return ir.SetupProjection(uv_set, *axes, (self.texture_size(args[2]), self.texture_size(args[3])),
+                                  offsets, span)
+
+    def op_project_uv(self, op, args, span):
+        """``projectUV(uvSet)`` and ``deleteUV(uvSet)``."""
+        if not self.arity(op, args, (1,), span):
+            return ir.Empty(span)
+        uv_set = self.uv_set(op, args[0], span)
+        return ir.Empty(span) if uv_set is None else ir.ProjectUV(uv_set, op == "deleteUV", span)
+
+    def op_transform_uv(self, op, args, span):
+        """``translateUV(uvSet, u, v)``, ``scaleUV(uvSet, u, v)``, ``rotateUV(uvSet, degrees)``."""
+        if not self.arity(op, args, (2,) if op == "rotateUV" else (3,), span):
+            return ir.Empty(span)
+        uv_set = self.uv_set(op, args[0], span)
+        if uv_set is None:
+            return ir.Empty(span)
+        return ir.TransformUV(op[:-2], uv_set, tuple(self.expr(a) for a in args[1:]), span)
+
+    def op_tile_uv(self, op, args, span):
+        """``tileUV(uvSet, width, height)``."""
+        if not self.arity(op, args, (3,), span):
+            return ir.Empty(span)
+        uv_set = self.uv_set(op, args[0], span)
+        if uv_set is None:
+            return ir.Empty(span)
+        return ir.TileUV(uv_set, (self.texture_size(args[1]), self.texture_size(args[2])), span)
+
+    def op_normalize_uv(self, op, args, span):
+        """``normalizeUV(uvSet, uv|uvUniform|u|v, separatePerFace|collectiveAllFaces)``."""
+        if not self.arity(op, args, (3,), span):
+            return ir.Empty(span)
+        uv_set = self.uv_set(op, args[0], span)
+        names = [a.name if isinstance(a, ir.Name) else None for a in args[1:]]
+        if names[0] not in NORMALIZE_MODES or names[1] not in ("separatePerFace", "collectiveAllFaces"):
+            return self.unsupported(f"{op} with these selectors", span,
+                                    "normalizeUV(uvSet, uv|uvUniform|u|v, separatePerFace|collectiveAllFaces)")
+        return ir.Empty(span) if uv_set is None else ir.NormalizeUV(uv_set, names[0], span)
+
     def selector_parts(self, op, parts, known, named=None, noun="polygons", indices=None):
         """The selectors and bodies of ``{ sel: A | ... }`` parts, all among ``known`` (None after an
         error); ``sel=`` is derived as ``sel:``, with a warning. ``named`` is the operation as a selector
@@ -511,6 +586,14 @@ OPERATIONS = {
     "mirrorScope": direct(ir.MirrorScope),
     "roofRidge": OperationLowering.op_roof,
     "texture": OperationLowering.op_texture,
+    "setupProjection": OperationLowering.op_setup_projection,
+    "projectUV": OperationLowering.op_project_uv,
+    "deleteUV": OperationLowering.op_project_uv,
+    "translateUV": OperationLowering.op_transform_uv,
+    "scaleUV": OperationLowering.op_transform_uv,
+    "rotateUV": OperationLowering.op_transform_uv,
+    "tileUV": OperationLowering.op_tile_uv,
+    "normalizeUV": OperationLowering.op_normalize_uv,
 }
 #: Operations with parts ``{ ... }``: name -> handler(lowering, op, args, parts, span); those of ``REPEATING``
 #: also repeat (``{ ... }*``), with ``repeat=True``.
@@ -533,6 +616,8 @@ WITHOUT_PARTS = {
 BODY_OPERATIONS = {
     "scatter": OperationLowering.op_scatter,
 }
+#: The modes of ``normalizeUV``.
+NORMALIZE_MODES = frozenset({"uv", "uvUniform", "u", "v"})
 #: The distributions of ``scatter``.
 SCATTER_TYPES = frozenset({"uniform", "gaussian"})
 #: The optional arguments after a roof's value (roofGable's ``index`` only by angle).
@@ -561,8 +646,7 @@ SETBACK_SELECTORS = (COMP_SELECTORS["f"] - ir.OFFSET_SELECTORS) | {"all", "remai
 UNSUPPORTED_MEMBERS = frozenset({"comp", "split", "initialShape", "geometry"})
 #: Operations that are parsed and accepted but do not change the record (listed in its meta).
 NOT_APPLIED = frozenset({
-    "setupProjection", "projectUV", "tileUV", "translateUV", "scaleUV", "rotateUV",
-    "normalizeUV", "deleteUV", "reverseNormals", "print", "setNormals", "softenNormals",
+    "reverseNormals", "print", "setNormals", "softenNormals",
     # the pivot only moves the model's own origin in an export; scope.t* stay relative to the lot
     "setPivot",
 })
@@ -571,7 +655,7 @@ NOT_APPLIED = frozenset({
 #: CGA reference, so that any other name called with parts, or a typo of one of them, is unknown.
 UNSUPPORTED_OPS = frozenset({
     "innerPolygon",
-    "insertAlongUV", "footprint", "tileUV", "inline", "resetGeometry", "taper",
+    "insertAlongUV", "footprint", "inline", "resetGeometry", "taper",
     "rectify", "semiPolygon",
     "alignScopeToGeometryBBox", "modify",
     "setbackPerEdge", "setbackToArea", "splitAndSetbackPerimeter",

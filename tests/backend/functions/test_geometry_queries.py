@@ -15,9 +15,6 @@ import pytest
 from backend.operations.derivations import per_lot, rect, run
 from conftest import LOT_ZOO
 
-from grammarc.compiler import compile_grammar
-from grammarc.errors import GrammarError
-
 SOUTH_EDGE_FIRST = rect(12, 8)
 
 
@@ -192,14 +189,6 @@ def test_a_batch_gives_each_lot_what_it_gets_alone(write):
     together = values(write, text, lots)
     alone = [values(write, text, [lot])[0] for lot in lots[::5]]
     assert [t for t in together[::5]] == alone
-
-
-def test_uv_queries_are_unsupported_by_name_and_line(write):
-    path = write("g.cga", 'version "2022.0"\nLot --> extrude(3) A\nA -->\n    report("u", geometry.du(0, uvSpace))\n')
-    with pytest.raises(GrammarError) as err:
-        compile_grammar(path)
-    assert "g.cga:4:" in str(err.value)
-    assert "unsupported: geometry.du() (texture coordinates" in str(err.value)
 
 
 @pytest.mark.parametrize("prefix, want", [

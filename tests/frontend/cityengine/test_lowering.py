@@ -235,9 +235,8 @@ def test_unknown_queries_and_their_arguments_are_named(line, message):
 @pytest.mark.parametrize("line, name, at", [
     ("Lot --> case inside(near) : A else : B", "inside with these arguments", "inside"),
     ("Lot --> case touches(sel(1, 2)) : A else : B", "touches with these arguments", "touches"),
-    ("Lot --> extrude(geometry.uMin) A", "geometry.uMin", "geometry"),
     ("Lot --> extrude(initialShape.origin.qx) A", "initialShape.origin.qx", "initialShape"),
-    ("Lot --> extrude(geometry.du(0, unitSpace)) A", "geometry.du()", "geometry"),
+    ("Lot --> extrude(geometry.du(0, area)) A", "geometry.du in this space", "geometry"),
     ("Lot --> extrude(geometry.area(north)) A", "geometry.area selector `north`", "north"),
     ('Lot --> case geometry.hasTags("roof") : A else : B', "geometry.hasTags()", "geometry"),
     ("Lot --> extrude(size(geometry.materials())) A", "geometry.materials()", "geometry"),
@@ -273,13 +272,14 @@ def test_building_fixture_lowers_every_construct():
     assert [w.code for w in grammar.warnings] == ["asset"]  # assets/window.obj is not shipped
     ops = {type(op) for r in module.rules for alt in r.alternatives for op in iter_ops(alt.body)}
     assert ops >= {ir.Extrude, ir.CompFaces, ir.GroupSplit, ir.Case, ir.Stochastic, ir.SetAttr, ir.Report,
-                   ir.UseAsset, ir.NotApplied, ir.Center, ir.Translate, ir.Scale, ir.Empty, ir.Symbol}
+                   ir.UseAsset, ir.NotApplied, ir.Center, ir.Translate, ir.Scale, ir.Empty, ir.Symbol,
+                   ir.SetupProjection, ir.ProjectUV}
     consts = [a.name for a in module.attrs if a.const]
     assert consts == ["window_asset", "floor_h", "tile_w"]
     height = next(a for a in module.attrs if a.name == "height")
     assert ("Range", ("min=3", "max=30", "restricted=false")) in height.annotations
     assert grammar.assets == ("builtin:cube", "builtin:quad", "assets/window.obj")
-    assert make_plan(grammar).not_applied == ("print", "projectUV", "setupProjection")
+    assert make_plan(grammar).not_applied == ("print",)
 
 
 # ------------------------------------------------------------------------------ the free syntax (issue 17)

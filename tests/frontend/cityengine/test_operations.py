@@ -100,7 +100,15 @@ from .lowered import VERSION, assert_unsupported_at, body_of, compile_ir, errors
     ('color("#ff0000") A', 'color("#ff0000") A'),
     ("color(1, 0.5, 0) A", "color(1, 0.5, 0) A"),
     ('texture("brick.jpg") A', 'set(material.colormap, "brick.jpg") A'),
-    ("setupProjection(0, scope.xy, ~1.5, ~1) projectUV(0) A", "setupProjection(...) projectUV(...) A"),
+    ("setupProjection(0, scope.xy, ~1.5, ~1) projectUV(0) A",
+     "setupProjection(0, scope.xy, ~1.5, ~1, 0, 0) projectUV(0) A"),
+    ("setupProjection(1, world.zx, '1, 2, 0.5, h) deleteUV(1) A",
+     "setupProjection(1, world.zx, 1r, 2, 0.5, @h) deleteUV(1) A"),
+    ("setupProjection(0, scope.xz, '1, '20, 0, '8) A", "setupProjection(0, scope.xz, 1r, 20r, 0, 8r) A"),
+    ("translateUV(0, 1, h) scaleUV(0, 2, 2) rotateUV(0, 90) A", "translateUV(0, 1, @h) scaleUV(0, 2, 2) rotateUV(0, 90) A"),
+    ("tileUV(0, ~2, '1) normalizeUV(0, u, collectiveAllFaces) A", "tileUV(0, ~2, 1r) normalizeUV(0, u) A"),
+    ("split(u, uvSpace, 0){ 1 : A | ~1 : B }*", "split(u, uvSpace, 0){ 1: A | ~1: B }*"),
+    ("split(v, unitSpace, 1){ 1 : A | { 2 : B }* }", "split(v, unitSpace, 1){ 1: A | { 2: B }* }"),
     ('print("h = " + h) A', "print(...) A"),
     ("set(material.color.r, 1) A", "color(1, material.color.g, material.color.b) A"),
     ("set(material.opacity, h / 4) A", "set(material.opacity, (@h / 4)) A"),
@@ -141,7 +149,7 @@ def test_not_applied_operations_are_listed_for_the_meta(tmp_path):
     path = tmp_path / "g.cga"
     path.write_text(VERSION + 'Lot --> color(1, 0, 0) extrude(3) texture("a.jpg") tileUV(0, 1, 1) '
                     'print(scope.sx) set(material.shininess, 0.5) Mass.\n')
-    assert make_plan(compile_grammar(path)).not_applied == ("print", "set(material.shininess)", "tileUV")
+    assert make_plan(compile_grammar(path)).not_applied == ("print", "set(material.shininess)")
 
 
 
@@ -295,7 +303,11 @@ def test_roof_gable_with_an_edge_index_and_roof_ridge_lower_to_roofs(call, kind,
     ("Lot --> alignScopeToGeometry(yUp, smallest) A", "alignScopeToGeometry with face smallest", "smallest"),
     ("Lot --> alignScopeToGeometry(yUp, 0, shortest) A", "alignScopeToGeometry with edge shortest",
      "shortest"),
-    ("Lot --> split(v, unitSpace, 0){ 1 : A | ~1 : B }", "split(v, ...)", "split"),
+    ("Lot --> split(v, 0){ 1 : A | ~1 : B }", "split(v) with these arguments", "split"),
+    ("Lot --> split(u, uvSpace, 10){ 1 : A | ~1 : B }", "split with this uvSet", "10"),
+    ("Lot --> setupProjection(0, scope.xx, 1, 1) A", "setupProjection axes", "scope.xx"),
+    ("Lot --> projectUV(uvSet) A", "projectUV with this uvSet", "uvSet"),
+    ("Lot --> normalizeUV(0, w, collectiveAllFaces) A", "normalizeUV with these selectors", "normalizeUV"),
     ("Lot --> r(scopeMiddle, 0, 45, 0) A", "r with 4 arguments", "r("),
 ])
 def test_unsupported_operation_is_named_at_its_span(line, name, at):
