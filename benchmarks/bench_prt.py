@@ -1,8 +1,8 @@
 """grammarc against Esri's PRT on the same rule packages and lots, timed side by side in one run.
 
 Each round runs PRT (``prt_reference.py RPK rect_30x20.obj --batch N --processes 2``: PyPRT in its side
-environment, N copies of the footprint on a 50 m grid, two processes as grammarc's two workers) and then
-``grammarc build RPK`` on the same N lots, both as whole processes, start-up included; the ratio is PRT's
+environment, N copies of the footprint on a grid, two processes as grammarc's two workers) and then
+``grammarc build RPK`` on N such lots (``conftest.grid_lots``), both as whole processes, start-up included; the ratio is PRT's
 median over grammarc's, so a noisy machine slows both alike. Skipped without the PRT kit
 (``../shared/prt``) or its side environment: ``$GRAMMARC_PRT_PYTHON``, else ``.prt-venv/bin/python``
 beside the repository (the kit's README says how to make it).
@@ -17,12 +17,11 @@ import time
 from pathlib import Path
 
 import pytest
-from conftest import HERE, run_build
+from conftest import HERE, grid_lots, run_build
 
 from grammarc.conform import kit_dir
 from grammarc.io.npz import read_instances
 
-SPACING = 50.0  # prt_reference.py's grid
 ROUNDS = 3
 
 
@@ -30,21 +29,6 @@ def _prt_python() -> Path | None:
     configured = os.environ.get("GRAMMARC_PRT_PYTHON")
     python = Path(configured) if configured else HERE.parent / ".prt-venv" / "bin" / "python"
     return python if python.is_file() else None
-
-
-def _lots(path: Path, n: int) -> Path:
-    """n copies of the kit's 30 x 20 m rectangle on prt_reference.py's grid, as GeoJSON."""
-    import json
-
-    side = int(n ** 0.5 + 0.999)
-    features = []
-    for i in range(n):
-        x, y = (i % side) * SPACING, (i // side) * SPACING
-        ring = [[x, y], [x + 30, y], [x + 30, y + 20], [x, y + 20], [x, y]]
-        features.append({"type": "Feature", "id": f"lot{i}", "properties": {},
-                         "geometry": {"type": "Polygon", "coordinates": [ring]}})
-    path.write_text(json.dumps({"type": "FeatureCollection", "features": features}))
-    return path
 
 
 @pytest.mark.parametrize("n_lots", [100, 500], ids=["100", "500"])
@@ -55,9 +39,9 @@ def test_against_prt(benchmark, lots_dir, tmp_path, package, n_lots):
         pytest.skip("needs the PRT kit (../shared/prt) and PyPRT's side environment (.prt-venv or "
                     "GRAMMARC_PRT_PYTHON)")
     rpk = kit / "rpk" / f"{package}.rpk"
-    lots = lots_dir / f"prt_grid_{n_lots}.geojson"
+    lots = lots_dir / f"rect_30x20_{n_lots}.geojson"
     if not lots.exists():
-        _lots(lots, n_lots)
+        grid_lots(lots, n_lots, 30.0, 20.0)
     out = tmp_path / "out.npz"
     args = [str(rpk), "--lots", str(lots), "--emit", str(out), "--quiet"]
     prt = [str(python), str(kit / "prt_reference.py"), str(rpk), str(kit / "footprints" / "rect_30x20.obj"),
