@@ -122,3 +122,14 @@ def test_a_cycle_of_cityengine_attributes_is_an_error_naming_it(declarations, ex
     run_passes(parse_source(text, FILE, diags, "cityengine"), diags, check=True)
     assert [(d.span.line, d.message) for d in diags if d.code == "attr-cycle"] == expected
     assert [d.code for d in diags if d.is_error and d.code != "attr-cycle"] == []
+
+
+def test_a_builtin_without_arguments_may_be_written_bare():
+    """CityEngine reads ``rand`` alone as ``rand()``; each bare call draws at a site of its own, and a
+    parameter or attribute of that name wins."""
+    module, diags = resolve("a ~> T(rand, rand, 0)")
+    assert not diags
+    first, second = module.rules[0].alternatives[0].body[0].vector[:2]
+    assert (first.func, second.func) == ("rand", "rand") and first.site != second.site
+    module, _ = resolve("attr rand = 2\nb ~> T(rand, 0, 0)")
+    assert print_rule(module.rules[0]) == "b ~> T(@rand, 0, 0)"

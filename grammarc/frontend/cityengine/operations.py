@@ -450,8 +450,10 @@ class OperationLowering:
         return ir.Size(ir.SizeKind.ABSOLUTE, value, getattr(value, "span", ir.NO_SPAN))
 
     def op_setup_projection(self, op, args, span):
-        """``setupProjection(uvSet, scope.xy|world.xz|..., width, height[, uOffset, vOffset[, uwFactor]])``."""
-        if not self.arity(op, args, (4, 6, 7), span):
+        """``setupProjection(uvSet, scope.xy|world.xz|..., width, height[, uOffset, vOffset][, uwFactor])``: the
+        reference's four forms (a fifth argument alone is ``uwFactor``, which drives the w coordinate grammarc
+        does not keep)."""
+        if not self.arity(op, args, (4, 5, 6, 7), span):
             return ir.Empty(span)
         uv_set = self.uv_set(op, args[0], span)
         axes = ir.PROJECTION_AXES.get(args[1].name) if isinstance(args[1], ir.Name) else None
@@ -461,7 +463,7 @@ class OperationLowering:
         if uv_set is None:
             return ir.Empty(span)
         zero = ir.Size(ir.SizeKind.ABSOLUTE, ir.Num(0.0, span), span)
-        offsets = (self.texture_size(args[4]), self.texture_size(args[5])) if len(args) > 4 else (zero, zero)
+        offsets = (self.texture_size(args[4]), self.texture_size(args[5])) if len(args) > 5 else (zero, zero)
         return ir.SetupProjection(uv_set, *axes, (self.texture_size(args[2]), self.texture_size(args[3])),
                                   offsets, span)
 

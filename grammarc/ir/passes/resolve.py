@@ -10,9 +10,11 @@ no value: an error at its declaration naming the cycle (``attr a -> b -> a``), o
 from __future__ import annotations
 
 from dataclasses import replace
+from itertools import count
 
 from grammarc.diagnostics import Diagnostics, suggest
 from grammarc.ir import nodes as ir
+from grammarc.ir.functions import FUNCTIONS
 from grammarc.ir.traverse import iter_exprs, iter_ops, rewrite_expr, rewrite_rule
 
 
@@ -23,10 +25,11 @@ def resolve_names(module: ir.Module, diags: Diagnostics) -> ir.Module:
     # CityEngine evaluates attributes lazily, so a default may use an attribute declared after it (the
     # backend evaluates them in dependency order); the paper notation reads top to bottom.
     lazy = module.dialect == "cityengine"
+    sites = count(_BARE_SITES)
     for attr in module.attrs:
         where = f"attribute `{attr.name}`"
         visible = all_attrs if lazy else declared
-        default = rewrite_expr(attr.default, _resolver({}, visible, diags, where, later=all_attrs))
+        default = rewrite_expr(attr.default, _resolver({}, visible, diags, where, sites, later=all_attrs))
         attrs.append(attr if default is attr.default else replace(attr, default=default))
         declared.append(attr.name)
     if lazy:
@@ -38,7 +41,7 @@ def resolve_names(module: ir.Module, diags: Diagnostics) -> ir.Module:
             if name in all_attrs:
                 diags.warning("shadow", f"parameter `{name}` of `{rule.symbol}` hides the attribute `{name}`",
                               rule.span)
-        rules.append(rewrite_rule(rule, _resolver(params, all_attrs, diags, f"rule `{rule.symbol}`")))
+        rules.append(rewrite_rule(rule, _resolver(params, all_attrs, diags, f"rule `{rule.symbol}`", sites)))
         _check_set_targets(rule, module, diags)
     if all(a is b for a, b in zip(attrs, module.attrs)) and all(a is b for a, b in zip(rules, module.rules)):
         return module
@@ -74,7 +77,13 @@ def _check_cycles(attrs: list[ir.AttrDecl], diags: Diagnostics) -> None:
                     f"(attr {' -> '.join([attr.name, *cycle[:-1], attr.name])})", attr.span)
 
 
-def _resolver(params: dict[str, int], attrs: list[str], diags: Diagnostics, where: str,
+#: Built-in functions that take no argument and may be written without parentheses (after the rule's
+#: parameters and the attributes, which win over them).
+_BARE_CALLS = frozenset(name for name, sig in FUNCTIONS.items() if "." not in name and len(sig.params) == sig.optional)
+_BARE_SITES = 1 << 40
+
+
+def _resolver(params: dict[str, int], attrs: list[str], diags: Diagnostics, where: str, sites,
               later: list[str] | tuple[str, ...] = ()):
     """Name -> Param or AttrRef; ``later`` are attributes declared after the one being resolved."""
 
@@ -85,6 +94,8 @@ def _resolver(params: dict[str, int], attrs: list[str], diags: Diagnostics, wher
             return ir.Param(params[expr.name], expr.name, expr.span)
         if expr.name in attrs:
             return ir.AttrRef(expr.name, expr.span)
+        if expr.name in _BARE_CALLS:  # CityEngine reads a built-in without arguments written bare: `rand`
+            return ir.Call(expr.name, (), expr.span, next(sites))
         if expr.name in later:
             diags.error("attr-order", f"attribute `{expr.name}` is used in {where} before its declaration",
                         expr.span, hint=f"declare `{expr.name}` above the attributes that use it")

@@ -102,6 +102,7 @@ from .lowered import VERSION, assert_unsupported_at, body_of, compile_ir, errors
     ('texture("brick.jpg") A', 'set(material.colormap, "brick.jpg") A'),
     ("setupProjection(0, scope.xy, ~1.5, ~1) projectUV(0) A",
      "setupProjection(0, scope.xy, ~1.5, ~1, 0, 0) projectUV(0) A"),
+    ("setupProjection(0, scope.xy, 1.5, 1, 1) A", "setupProjection(0, scope.xy, 1.5, 1, 0, 0) A"),
     ("setupProjection(1, world.zx, '1, 2, 0.5, h) deleteUV(1) A",
      "setupProjection(1, world.zx, 1r, 2, 0.5, @h) deleteUV(1) A"),
     ("setupProjection(0, scope.xz, '1, '20, 0, '8) A", "setupProjection(0, scope.xz, 1r, 20r, 0, 8r) A"),
