@@ -120,12 +120,12 @@ def test_a_parameter_never_passed_a_value_is_a_number():
 
 def test_a_parameter_no_call_passes_takes_its_type_from_its_uses():
     # a library's rule, called only from the files that import it: CityEngine infers its parameters
-    text = ('version "2022.0"\nPlank(kind, name, big, n) -->\n    case kind == "nailed" && big :\n'
-            '        s(n, 1, 1) i(name)\n    else : X.\n')
+    text = ('version "2022.0"\nPlank(kind, name, big, n, skin) -->\n    case kind == "nailed" && big :\n'
+            '        s(n, 1, 1) texture(skin) i(name)\n    else : X.\n')
     diags = Diagnostics()
     module = run_passes(parse_source(text, FILE, diags, "cityengine"), diags, check=True, stop_after="types")
     assert not diags.has_errors
-    assert dict(module.param_types)["Plank"] == (T.STR, T.STR, T.BOOL, T.NUM)
+    assert dict(module.param_types)["Plank"] == (T.STR, T.STR, T.BOOL, T.NUM, T.STR)
 
 
 def test_a_parameter_only_passed_on_takes_the_type_of_the_parameter_it_is_passed_to():

@@ -151,7 +151,8 @@ def _infer_from_successors(calls, types) -> None:
 
 def _infer_from_uses(rule: ir.Rule, slots: list, attr_types) -> None:
     """A parameter that no call passes a value to (a library's rule, called from the files that import
-    it) takes its type from its rule's uses: given where a type is wanted (``i(name)``, ``s(n, 1, 1)``),
+    it) takes its type from its rule's uses: given where a type is wanted (``i(name)``, ``s(n, 1, 1)``,
+    ``texture(name)``, ``set(attribute, value)``),
     an operand of ``&&`` or ``||``, of ``-``, ``*``, ``/`` or ``%``, else compared with a typed value
     (``type == "nailed"``). Comparisons come last: CityEngine compares a number with a string too
     (``mix != ""``), so a parameter used as a number elsewhere stays a number."""
@@ -161,7 +162,7 @@ def _infer_from_uses(rule: ir.Rule, slots: list, attr_types) -> None:
             slots[expr.index] = want
 
     for node in iter_nodes(rule):
-        for expr, want, _ in _declared(node):
+        for expr, want, _ in _wanted(node, attr_types, {}):
             settle(expr, want)
     compared = []
     for expr in all_exprs(rule):
