@@ -84,18 +84,22 @@ _SPOOLED = {
     "mesh_color": ("|u1", (4,)),
     "material": ("<i4", ()),
     "mesh_material": ("<i4", ()),
+    "uv": ("<f4", (2, 4)),
+    "mesh_uv": ("<f4", (2,)),
 }
 #: The columns of a record whose grammar sets textures (``TerminalChunk.materials``), else left out.
 _MATERIAL_KEYS = ("materials", "material", "mesh_material")
+#: The columns of a record whose grammar has texture coordinates (``TerminalChunk.uv``, ``MeshChunk.uv``).
+_UV_KEYS = ("uv", "mesh_uv")
 _OFFSETS = ("mesh_ring_offsets", "mesh_face_offsets")
 # The column written straight into the output, as its first member; the others are spooled.
 _STREAMED = "xform"
 # Central directory order, the order of np.load(path).files: the record's table in the README, then the mesh
 # table. In the file, xform comes first and the others follow in this order.
 _KEYS = (
-    "assets", "asset", "xform", "lot", "symbols", "symbol", "color", "materials", "material", "meta",
+    "assets", "asset", "xform", "lot", "symbols", "symbol", "color", "materials", "material", "uv", "meta",
     "mesh_vertices", "mesh_ring_offsets", "mesh_face_offsets", "mesh_lot", "mesh_symbol", "mesh_color",
-    "mesh_material",
+    "mesh_material", "mesh_uv",
 )  # fmt: skip
 class InstanceWriter:
     """Streams TerminalChunks into an .npz; the output appears complete on close() or not at all.
@@ -147,6 +151,8 @@ class InstanceWriter:
         self._rows = dict.fromkeys(_SPOOLED, 0)
         #: The record's materials, once a chunk has textures (else None: no material columns).
         self._materials: MaterialTable | None = None
+        #: Whether a chunk had texture coordinates (else no uv columns).
+        self._textured = False
         self._counts: dict[str, int] = {}
         self._state = "open"
         tmpdir = tempfile.mkdtemp(prefix=f".{self.path.name}.tmp", dir=self.path.parent)
@@ -173,6 +179,7 @@ class InstanceWriter:
             raise ValueError(f"write to an InstanceWriter that is {self._state}")
         columns = _validate(chunk, len(self._assets), len(self._symbols))
         self._material_columns(chunk, columns)
+        self._uv_columns(chunk, columns)
         columns["mesh_ring_offsets"] = columns["mesh_ring_offsets"] + self._rows["mesh_vertices"]
         columns["mesh_face_offsets"] = columns["mesh_face_offsets"] + self._rows["mesh_ring_offsets"]
         try:
@@ -197,6 +204,22 @@ class InstanceWriter:
                   "mesh_material": self._rows["mesh_lot"] - self._rows["mesh_material"]}
         for key, own in zip(("material", "mesh_material"), self._materials.add(chunk)):
             columns[key] = np.concatenate([np.zeros(before[key], np.int32), own]) if before[key] else own
+
+    def _uv_columns(self, chunk: TerminalChunk, columns: dict[str, np.ndarray]) -> None:
+        """Add the chunk's texture coordinates of set 0, ``uv`` per instance (a map of its unit box) and
+        ``mesh_uv`` per mesh vertex, once any chunk has them: NaN for the rows of chunks without (and of
+        those written before the first with)."""
+        if chunk.uv is None and chunk.mesh.uv is None and not self._textured:
+            return
+        self._textured = True
+        own = {"uv": chunk.uv if chunk.uv is not None else np.full((len(chunk.asset), 2, 4), np.nan, np.float32),
+               "mesh_uv": chunk.mesh.texture()}
+        for key, rows in (("uv", "asset"), ("mesh_uv", "mesh_vertices")):
+            dtype, row_shape = _SPOOLED[key]
+            column = _column(f"texture coordinates ({key})", np.asarray(own[key], dtype), dtype, row_shape)
+            before = self._rows[rows] - self._rows[key]
+            columns[key] = np.concatenate([np.full((before, *row_shape), np.nan, dtype), column]) if before \
+                else column
 
     def close(self) -> dict:
         """Finish the npz next to the output, fsync it, and rename it onto ``path``.
@@ -263,7 +286,7 @@ class InstanceWriter:
             arrays["materials"] = self._materials.table()
         members = {}
         for key in _KEYS:
-            if key in _MATERIAL_KEYS and self._materials is None:
+            if (key in _MATERIAL_KEYS and self._materials is None) or (key in _UV_KEYS and not self._textured):
                 continue
             if key in arrays:
                 array = arrays[key]

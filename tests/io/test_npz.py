@@ -460,8 +460,9 @@ def test_zip_records(tmp_path, chunks):
         assert zf.testzip() is None  # every member's CRC and size
         infos = zf.infolist()
     # The central directory lists the record's table in order, whatever the members' order in the file.
-    # (the material columns only where a chunk has textures)
-    assert [info.filename for info in infos] == [f"{key}.npy" for key in npz._KEYS if key not in npz._MATERIAL_KEYS]
+    # (the material and texture coordinate columns only where a chunk has them)
+    assert [info.filename for info in infos] == [f"{key}.npy" for key in npz._KEYS
+                                                 if key not in npz._MATERIAL_KEYS + npz._UV_KEYS]
     unix_0644 = {(info.create_system, info.external_attr, info.flag_bits) for info in infos}
     assert unix_0644 == {(3, 0o644 << 16, 0)}
     # xform is streamed into the file first; the members do not overlap and leave no gaps.
@@ -636,3 +637,24 @@ def test_colours_default_to_white_and_round_trip(tmp_path):
     assert record["color"][4:].tolist() == [[1, 2, 3, 255]] * 4
     n = len(plain.mesh.lot)
     assert (record["mesh_color"][:n] == 255).all() and (record["mesh_color"][n:] == 7).all()
+
+
+def test_texture_coordinates_from_the_first_chunk_that_has_them(tmp_path, chunks):
+    """``uv`` per instance and ``mesh_uv`` per mesh vertex appear once a chunk has texture coordinates; the
+    rows of chunks without them, before or after, are NaN."""
+    first, second, third = chunks[0], chunks[2], chunks[5]
+    uv = np.arange(len(second.asset) * 8, dtype=np.float32).reshape(-1, 2, 4)
+    mesh_uv = np.ones((len(second.mesh.vertices), 2), np.float32)
+    textured = dataclasses.replace(second, uv=uv, mesh=dataclasses.replace(second.mesh, uv=mesh_uv))
+    path = tmp_path / "city.npz"
+    write(path, [first, textured, third])
+    record = read_instances(path)
+    n1, n2 = len(first.asset), len(second.asset)
+    assert record["uv"].shape == (n1 + n2 + len(third.asset), 2, 4)
+    assert np.isnan(record["uv"][:n1]).all() and np.isnan(record["uv"][n1 + n2:]).all()
+    np.testing.assert_array_equal(record["uv"][n1:n1 + n2], uv)
+    v1, v2 = len(first.mesh.vertices), len(second.mesh.vertices)
+    assert np.isnan(record["mesh_uv"][:v1]).all() and np.isnan(record["mesh_uv"][v1 + v2:]).all()
+    np.testing.assert_array_equal(record["mesh_uv"][v1:v1 + v2], mesh_uv)
+    write(path, chunks)
+    assert "uv" not in read_instances(path)
