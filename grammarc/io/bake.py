@@ -307,7 +307,7 @@ class BakedWriter(WriterBlock):
         if max_triangles is None:
             max_triangles = int(os.environ.get("GRAMMARC_MAX_TRIANGLES", MAX_TRIANGLES))
         self.max_triangles = max_triangles
-        self._chunks: list[tuple] = []  # (asset, xform, mesh table, looks, uv) of each chunk kept for close()
+        self._chunks: list[tuple[TerminalChunk, np.ndarray | None]] = []  # kept for close(), with their looks
         #: The record's materials, and the looks (``_looks``) met so far, each an OBJ material.
         self._materials = MaterialTable()
         self._look_ids: dict[int, int] = {}
@@ -361,7 +361,7 @@ class BakedWriter(WriterBlock):
                 self._file.write(self._obj_groups(mesh, source, np.concatenate([chunk.lot, chunk.mesh.lot]), looks))
                 self._count(mesh, chunk.mesh)
             else:
-                self._chunks.append((asset, xform, chunk.mesh, looks, chunk.uv))
+                self._chunks.append((chunk, looks))
         except BaseException:
             self.abort()
             raise
@@ -446,12 +446,11 @@ class BakedWriter(WriterBlock):
             if self._file is None:
                 self._open_file()
                 chunks, self._chunks = self._chunks, []
-                mesh_table = MeshChunk.concat([c[2] for c in chunks])
-                asset = np.concatenate([c[0] for c in chunks]) if chunks else np.zeros(0, np.int64)
-                xform = np.concatenate([c[1] for c in chunks]) if chunks else np.zeros((0, 3, 4), np.float32)
+                mesh_table = MeshChunk.concat([c.mesh for c, _ in chunks])
+                asset = np.concatenate([c.asset for c, _ in chunks]) if chunks else np.zeros(0, np.int64)
+                xform = np.concatenate([c.xform for c, _ in chunks]) if chunks else np.zeros((0, 3, 4), np.float32)
                 looks = _joined_looks(chunks)
-                uv = None if all(c[4] is None for c in chunks) else np.concatenate(
-                    [c[4] if c[4] is not None else np.full((len(c[0]), 2, 4), np.nan, np.float32) for c in chunks])
+                uv = None if all(c.uv is None for c, _ in chunks) else np.concatenate([c.texture() for c, _ in chunks])
                 del chunks
                 mesh, source = _bake(self._library, asset.astype(np.int64, copy=False), xform, mesh_table,
                                      self.max_triangles, uv)
@@ -519,11 +518,11 @@ class BakedWriter(WriterBlock):
 def _joined_looks(chunks: list) -> np.ndarray | None:
     """The looks of kept chunks (``BakedWriter._looks``), instances then faces as ``MeshChunk.concat`` and
     ``_bake`` order them; white without texture for chunks without any; None when no chunk has any."""
-    if all(c[3] is None for c in chunks):
+    if all(lk is None for _, lk in chunks):
         return None
     white = np.int64(0xFFFFFFFF)
-    looks = [np.full(len(c[0]) + len(c[2].lot), white) if c[3] is None else c[3] for c in chunks]
-    counts = [len(c[0]) for c in chunks]
+    looks = [np.full(len(c.asset) + len(c.mesh.lot), white) if lk is None else lk for c, lk in chunks]
+    counts = [len(c.asset) for c, _ in chunks]
     return np.concatenate([lk[:n] for lk, n in zip(looks, counts)] + [lk[n:] for lk, n in zip(looks, counts)])
 
 

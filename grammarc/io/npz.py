@@ -212,8 +212,7 @@ class InstanceWriter:
         if chunk.uv is None and chunk.mesh.uv is None and not self._textured:
             return
         self._textured = True
-        own = {"uv": chunk.uv if chunk.uv is not None else np.full((len(chunk.asset), 2, 4), np.nan, np.float32),
-               "mesh_uv": chunk.mesh.texture()}
+        own = {"uv": chunk.texture(), "mesh_uv": chunk.mesh.texture()}
         for key, rows in (("uv", "asset"), ("mesh_uv", "mesh_vertices")):
             dtype, row_shape = _SPOOLED[key]
             column = _column(f"texture coordinates ({key})", np.asarray(own[key], dtype), dtype, row_shape)

@@ -166,6 +166,10 @@ class TerminalChunk:
             return self.color
         return _white(len(self.asset))
 
+    def texture(self) -> np.ndarray:
+        """(n, 2, 4) float32: the instances' texture maps, NaN where none were given."""
+        return self.uv if self.uv is not None else np.full((len(self.asset), 2, 4), np.nan, np.float32)
+
 
 class MaterialTable:
     """A record's materials (texture paths per channel of ``MATERIAL_MAPS``) numbered as the writer meets
