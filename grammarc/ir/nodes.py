@@ -967,12 +967,31 @@ class NormalizeUV:
     mode: str
     span: Span = NO_SPAN
 
+@dataclass(frozen=True, slots=True)
+class SetbackToArea:
+    """CityEngine ``setbackToArea(area[, minDistances[, maxDistances]]) { sel: A | remainder: B }``: a
+    ``setback`` whose distances are found so that the remainder has ``area``. Every edge a part selects
+    moves by its minimum plus one offset common to the face, capped at its maximum (``minimum`` and
+    ``maximum`` are evaluated per edge, as ``Setback.distances`` are with ``per_edge``: 0 and no cap
+    where none is given); edges no part selects stay. Where no offset reaches the area the nearest one is
+    taken: none when the face is already smaller (or the minimums take more), all the way to the maximums
+    when they leave more."""
+
+    area: Expr = child(Type.NUM, "an area")
+    minimum: tuple[tuple[str, Expr], ...] = child(Type.NUM, "a setback distance")
+    maximum: tuple[tuple[str, Expr], ...] = child(Type.NUM, "a setback distance")
+    selectors: tuple[str, ...]
+    parts: tuple[Body, ...] = child(holds=Holds.BODIES)
+    span: Span = NO_SPAN
+    site: int = 0
+
+
 Op = (Symbol | Empty | Translate | Scale | Rotate | Push | Pop | Insert | Split | Repeat | Comp | Extrude
       | Center | UseAsset | Case | Stochastic | SetAttr | Report | NotApplied | GroupSplit | CompFaces
       | AlignScope | Mirror | Offset | SetColor | Setback | Roof | InnerRectangle | Convexify
       | CleanupGeometry | DeleteHoles | Snap | Label | Transform | Scatter | AlignToGeometry | Primitive
       | Trim | SplitArea | ReduceGeometry | MirrorScope | SetOpacity | SetupProjection | ProjectUV | TransformUV
-      | TileUV | NormalizeUV)
+      | TileUV | NormalizeUV | SetbackToArea)
 Body = tuple[Op, ...]
 
 

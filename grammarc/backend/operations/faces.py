@@ -37,7 +37,7 @@ from grammarc.geometry.inner_rectangle import largest_rectangles
 from grammarc.geometry.meshes import MESH_BASE, is_mesh, is_polygon
 from grammarc.geometry.polygons import PLANE_U, PLANE_V, plane_to_scope
 from grammarc.geometry.ridges import ridge_roofs
-from grammarc.geometry.setback import polygon_edges, setback_regions
+from grammarc.geometry.setback import distances_to_area, polygon_edges, setback_regions
 from grammarc.ir import nodes as ir
 from grammarc.ragged import ragged_take, rank_within
 
@@ -183,30 +183,66 @@ def offset_faces(ctx: Context, cursor: Shapes, op: ir.CompFaces) -> Parts:
 @operation(ir.Setback, consumes=True)
 def setback(ctx: Context, cursor: Shapes, op: ir.Setback) -> Parts:
     """``setback`` and ``shapeL/U/O``: the face's edge strips and its remainder to their parts."""
-    polygons, plane = face_polygons(ctx, cursor, "setback", op.span)
-    edges = polygon_edges(polygons)
-    m = len(cursor)
-    normal = plane_to_scope(-edges.inward, plane[edges.poly])
-    frames = selector_frames(ctx.chunk, normal, cursor, edges.poly, (*op.selectors, *(s for s, _ in op.distances)),
-                             _world_points(ctx, cursor, edges.poly, plane, (edges.start, edges.end)))
-    # distances per face, or per edge (setback(comp(fe){...}): each edge is comp.index of comp.total)
-    if op.per_edge:
-        index = rank_within(edges.poly)
-        shapes = with_context(ctx.plan, cursor.take(edges.poly), "comp", index, edges.poly, m)
-        column = np.arange(len(edges.poly))
-    else:
-        shapes, column = cursor, edges.poly
-    env = ctx.env(shapes)
-    table = np.zeros((len(op.distances) + 1, len(shapes)))
-    for k, (_, expr) in enumerate(op.distances):
-        table[k] = evaluate_array(expr, env)
-    distance = table[classify_faces(normal, tuple(s for s, _ in op.distances), frames), column]
-    owners = tuple(s for s in op.selectors if s != "remainder")
-    regions, remainder = setback_regions(polygons, edges, distance,
-                                         classify_faces(normal, owners, frames), len(owners))
-    by_owner = dict(zip(owners, regions))
-    return _regions(ctx, op, cursor, [by_owner[s] if s != "remainder" else remainder for s in op.selectors],
-                    plane, polygons)
+    face = _SetbackFaces(ctx, cursor, op, "setback", (*op.selectors, *(s for s, _ in op.distances)))
+    distance = face.distances(ctx, cursor, op.distances, op.per_edge, 0.0)
+    return face.parts(ctx, cursor, op, distance)
+
+
+@operation(ir.SetbackToArea, consumes=True)
+def setback_to_area(ctx: Context, cursor: Shapes, op: ir.SetbackToArea) -> Parts:
+    """``setbackToArea``: the setback of the selected edges whose remainder has the area asked
+    (``geometry.setback.distances_to_area``), its strips and remainder to the parts as ``setback``'s."""
+    names = (*op.selectors, *(s for s, _ in op.minimum), *(s for s, _ in op.maximum))
+    face = _SetbackFaces(ctx, cursor, op, "setbackToArea", names)
+    area = np.broadcast_to(np.asarray(evaluate_array(op.area, ctx.env(cursor)), float), (len(cursor),))
+    bad = ~(area > 0) | ~np.isfinite(area)
+    if bad.any():
+        ctx.fail(cursor, bad, "`setbackToArea` with an area that is not a positive number", op.span)
+    minimum = face.distances(ctx, cursor, op.minimum, True, 0.0)
+    maximum = face.distances(ctx, cursor, op.maximum, True, np.inf)
+    moving = face.owner < len(face.owners)
+    distance = distances_to_area(face.polygons, face.edges, np.where(moving, minimum, 0.0), maximum, moving,
+                                 area)
+    return face.parts(ctx, cursor, op, distance)
+
+
+class _SetbackFaces:
+    """What ``setback`` and ``setbackToArea`` find of a batch of faces: their polygons and planes, their
+    edges (``geometry.setback.Edges``) with their normals and the frames of the selectors ``names``, and
+    the part (``owners``) each edge's strip goes to (``owner``, len(owners) for none)."""
+
+    def __init__(self, ctx: Context, cursor: Shapes, op: ir.Setback | ir.SetbackToArea, what: str,
+                 names: tuple[str, ...]):
+        self.polygons, self.plane = face_polygons(ctx, cursor, what, op.span)
+        self.edges = edges = polygon_edges(self.polygons)
+        self.normal = plane_to_scope(-edges.inward, self.plane[edges.poly])
+        self.frames = selector_frames(ctx.chunk, self.normal, cursor, edges.poly, names,
+                                      _world_points(ctx, cursor, edges.poly, self.plane, (edges.start, edges.end)))
+        self.owners = tuple(s for s in op.selectors if s != "remainder")
+        self.owner = classify_faces(self.normal, self.owners, self.frames)
+
+    def distances(self, ctx: Context, cursor: Shapes, distances, per_edge: bool, fill: float) -> np.ndarray:
+        """(E,) each edge's distance: that of the first selector of ``distances`` (pairs of a selector and
+        an expression) it matches, ``fill`` where none does; the expressions evaluated per face, or per
+        edge (``comp.index`` of ``comp.total`` in the face's edges)."""
+        poly = self.edges.poly
+        if per_edge:
+            shapes = with_context(ctx.plan, cursor.take(poly), "comp", rank_within(poly), poly, len(cursor))
+            column = np.arange(len(poly))
+        else:
+            shapes, column = cursor, poly
+        env = ctx.env(shapes)
+        table = np.full((len(distances) + 1, len(shapes)), fill)
+        for k, (_, expr) in enumerate(distances):
+            table[k] = evaluate_array(expr, env)
+        return table[classify_faces(self.normal, tuple(s for s, _ in distances), self.frames), column]
+
+    def parts(self, ctx: Context, cursor: Shapes, op, distance: np.ndarray) -> Parts:
+        """The parts of ``op`` on the strips of the edges moved by ``distance`` (E,) and the remainder."""
+        regions, remainder = setback_regions(self.polygons, self.edges, distance, self.owner, len(self.owners))
+        by_owner = dict(zip(self.owners, regions))
+        return _regions(ctx, op, cursor, [by_owner[s] if s != "remainder" else remainder for s in op.selectors],
+                        self.plane, self.polygons)
 
 
 @operation(ir.InnerRectangle, consumes=True)
@@ -366,7 +402,7 @@ def _piece_shapes(ctx: Context, cursor: Shapes, pieces, site: int) -> Shapes:
                   child_keys(child.key, site, index), child.depth, child.params, child.dynamic)
 
 
-def _regions(ctx: Context, op: ir.Setback | ir.InnerRectangle, cursor: Shapes, regions: list, plane,
+def _regions(ctx: Context, op: ir.Setback | ir.SetbackToArea | ir.InnerRectangle, cursor: Shapes, regions: list, plane,
              polygons) -> Parts:
     """Part k of ``op`` on the pieces of ``regions[k]`` (n,) (polygons in the shapes' scope units, cut
     from ``polygons``), each parent's pieces together, numbered in stream ``op.site`` part by part."""

@@ -367,6 +367,45 @@ class OperationLowering:
             distances = tuple((s, exprs[0]) for s in selectors if s != "remainder")
         return ir.Setback(distances, selectors, chosen[1], span, self.site())
 
+    def op_setback_per_edge(self, op, args, parts, span):
+        """``setbackPerEdge(d[, uvSet]) { ... }``: the reference's shortcut for ``setback(comp(fe){ all: d
+        }) { ... }``, ``d`` evaluated for each edge. ``uvSet`` only matters to the uv selectors, which
+        grammarc's setbacks do not have: it is read and has no effect."""
+        if not self.arity(op, args, (1, 2), span):
+            return ir.Empty(span)
+        chosen = self.selector_parts(op, parts, SETBACK_SELECTORS)
+        if chosen is None:
+            return ir.Empty(span)
+        return ir.Setback((("all", self.expr(args[0])),), chosen[0], chosen[1], span, self.site(), per_edge=True)
+
+    def op_setback_to_area(self, op, args, parts, span):
+        """``setbackToArea(area[, minDistances[, maxDistances]][, uvSet]) { ... }``. A distance list is an
+        array (``[2, 0, 1]``: edge ``comp.index`` takes its element; a minimum past its end is 0, a maximum
+        none) or ``comp(fe){ sel: d | ... }``. The reference tells ``uvSet`` from a list only by its type:
+        a number written as such after the lists is ``uvSet`` (read, without effect as in
+        ``setbackPerEdge``), any other expression a list."""
+        if args and len(args) > 1 and isinstance(args[-1], ir.Num):
+            args = args[:-1]
+        if not self.arity(op, args, (1, 2, 3), span):
+            return ir.Empty(span)
+        chosen = self.selector_parts(op, parts, SETBACK_SELECTORS)
+        if chosen is None:
+            return ir.Empty(span)
+        index = ir.ContextRef("comp.index", span)
+        lists = []
+        for k, arg in enumerate(args[1:]):
+            if isinstance(arg, EdgeDistances):
+                lists.append(arg.values)
+                continue
+            array = self.expr(arg)
+            element = ir.Index(array, index, span=span)
+            if k == 1:  # past the end of the maximums: no cap
+                inside = ir.Binary("<", index, ir.Call("size", (array,), span, self.site()), span)
+                element = ir.Select(inside, element, ir.Num(float("inf"), span), span)
+            lists.append((("all", element),))
+        minimum, maximum = (*lists, (), ())[:2]
+        return ir.SetbackToArea(self.expr(args[0]), minimum, maximum, chosen[0], chosen[1], span, self.site())
+
     def op_setback_alone(self, op, args, span):
         """``setback(d)`` without parts (public files write it, as if it were an operation on its own):
         the reference knows only the form with parts, and a user who writes it means the face set back by
@@ -608,6 +647,8 @@ PART_OPERATIONS = {
     "shapeU": OperationLowering.op_setback,
     "shapeO": OperationLowering.op_setback,
     "innerRectangle": OperationLowering.op_inner_rectangle,
+    "setbackPerEdge": OperationLowering.op_setback_per_edge,
+    "setbackToArea": OperationLowering.op_setback_to_area,
 }
 REPEATING = frozenset({"split", "splitArea"})
 #: Operations with parts that may also come without them: name -> handler(lowering, op, args, span).
@@ -660,7 +701,7 @@ UNSUPPORTED_OPS = frozenset({
     "insertAlongUV", "footprint", "inline", "resetGeometry", "taper",
     "rectify", "semiPolygon",
     "alignScopeToGeometryBBox", "modify",
-    "setbackPerEdge", "setbackToArea", "splitAndSetbackPerimeter",
+    "splitAndSetbackPerimeter",
     "tag", "deleteTags", "setTagsFromEdgeAttrs", "union", "subtract", "intersect",
     "copyUV", "setMaterial", "resetMaterial",
 } - NOT_APPLIED)

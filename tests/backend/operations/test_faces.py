@@ -176,3 +176,48 @@ def test_offset_of_a_roof_fails_its_lot_by_name(write):
     records = run(write, "Lot --> roofHip(30) offset(-1, inside) X.\n", [rect(10, 8)])
     (bad,) = records["bad"]
     assert bad.reason.startswith("`offset` of a roof is not supported yet (only of faces in one plane")
+
+
+def test_setback_per_edge_evaluates_its_distance_for_each_edge(write):
+    """The reference's example: distances from an array by ``comp.index`` (edges in the face's order: the
+    lot's front first, then right, back, left), the same as ``setback(comp(fe){ all : ... })``."""
+    text = ("const ds = [3, 2, 1, 0]\nd = ds[comp.index]\n"
+            "Lot --> setbackPerEdge(d){ all : A | remainder : R }\n" + AREA_REPORTS)
+    t = totals(run(write, text, [rect(30, 20)]))
+    assert (t["a_sum"], t["r_sum"]) == (pytest.approx(600 - 28 * 16), pytest.approx(28 * 16))
+    same = text.replace("setbackPerEdge(d)", "setback(comp(fe){ all : d })")
+    same_records(run(write, text, [rect(30, 20)]), run(write, same, [rect(30, 20)]))
+
+
+def test_setback_to_area_leaves_the_remainder_its_area(write):
+    """The reference's examples: a square of 400 m2 set back to 100 (the same distance all round: a
+    square of 10), an area to set back instead of one to keep, and an L whose front and left edges move."""
+    text = 'Lot --> setbackToArea(100){ all : NIL | remainder : Q }\nQ --> report("q", geometry.area) report("x", scope.sx)\n'
+    t = totals(run(write, text, [rect(20, 20)]))
+    assert t["q_sum"] == pytest.approx(100, rel=1e-8) and t["x_sum"] == pytest.approx(10)
+    t = totals(run(write, "Lot --> setbackToArea(geometry.area - 300){ all : A }\n" + AREA_REPORTS, [rect(30, 20)]))
+    assert t["a_sum"] == pytest.approx(300, rel=1e-8)
+    t = totals(run(write, "Lot --> setbackToArea(150){ front : A | left : B | remainder : R }\n" + AREA_REPORTS,
+                   [LOT_ZOO["concave_L"]]))
+    assert t["r_sum"] == pytest.approx(150, rel=1e-8) and t["a_sum"] + t["b_sum"] == pytest.approx(250, rel=1e-8)
+
+
+def test_setback_to_area_raises_the_minimums_by_one_offset_up_to_the_maximums(write):
+    """Front (edge 0) at least 4: front and back move 4 + c and c, c = 3 leaving 30 x 10. Maximums of 1
+    leave more than the area asked, as does a face smaller than it (nothing moves but the minimums)."""
+    text = "Lot --> setbackToArea(300, [4, 0, 0, 0]){ front : F | back : B | remainder : R }\n" \
+        'F --> report("f", geometry.area)\nB --> report("b", geometry.area)\nR --> report("r", geometry.area)\n'
+    t = totals(run(write, text, [rect(30, 20)]))
+    assert (t["f_sum"], t["b_sum"], t["r_sum"]) == (pytest.approx(210), pytest.approx(90), pytest.approx(300))
+    t = totals(run(write, text.replace("[4, 0, 0, 0]", "[0], [1, 0, 1]"), [rect(30, 20)]))
+    assert (t["f_sum"], t["b_sum"], t["r_sum"]) == (pytest.approx(30), pytest.approx(30), pytest.approx(540))
+    t = totals(run(write, text.replace("300, [4, 0, 0, 0]", "700"), [rect(30, 20)]))
+    assert (t.get("f_n", 0), t["r_sum"]) == (0, pytest.approx(600))
+
+
+def test_setback_to_area_of_a_solid_or_a_roof_fails_its_lot_by_name(write):
+    for body, reason in [("extrude(3) setbackToArea(10)", "`setbackToArea` of a solid is not supported yet"),
+                         ("roofHip(30) setbackToArea(10)", "`setbackToArea` of a roof is not supported yet"),
+                         ("setbackToArea(-1)", "`setbackToArea` with an area that is not a positive number")]:
+        (bad,) = run(write, f"Lot --> {body}{{ all : A | remainder : R }}\n", [rect(10, 8)])["bad"]
+        assert bad.reason.startswith(reason), bad.reason

@@ -223,6 +223,33 @@ def test_setback_moves_the_edges_its_parts_select():
     assert op.selectors == ("front", "left", "remainder")
 
 
+@pytest.mark.parametrize("body, printed", [
+    # the reference's shortcut: setback(comp(fe){ all : d })
+    ("setbackPerEdge(ds[comp.index]){ front : A | remainder : B }",
+     "setback(comp(fe){ all=@ds[comp.index] }){ front: A | remainder: B }"),
+    ("setbackPerEdge(2, 0){ all = A }", "setback(comp(fe){ all=2 }){ all: A }"),
+    ("setbackToArea(100){ all : NIL | remainder : B }", "setbackToArea(100){ all: ε | remainder: B }"),
+    # a number after the lists is uvSet; an array gives edge comp.index its element
+    ("setbackToArea(100, ds, 0){ all : A }", "setbackToArea(100, comp(fe){ all=@ds[comp.index] }){ all: A }"),
+    ("setbackToArea(100, comp(fe){ front : 2 | all : 0 }, ds){ front : A | remainder : B }",
+     ("setbackToArea(100, comp(fe){ front=2, all=0 }, comp(fe){ all=((comp.index < size(@ds)) ? "
+      "@ds[comp.index] : inf) }){ front: A | remainder: B }")),
+])
+def test_setback_per_edge_and_to_area_lower_to_setbacks_of_distances_per_edge(body, printed):
+    assert body_of(f"{VERSION}const ds = [1, 2]\nLot --> {body}\n") == printed
+
+
+@pytest.mark.parametrize("line, at, message", [
+    ("Lot --> setbackToArea(1, [1], [2], [3]){ all : A }", "setbackToArea",
+     "`setbackToArea` takes 1 or 2 or 3 arguments, got 4"),
+    ("Lot --> setbackPerEdge(1){ side : A | frnt : B }", "frnt",
+     "unsupported: setbackPerEdge selector `frnt` (setbackPerEdge selects "),
+])
+def test_setback_per_edge_and_to_area_name_a_wrong_argument_count_or_selector(line, at, message):
+    (found,) = errors(VERSION + line + "\n")
+    assert found[:2] == (2, line.index(at) + 1) and found[2].startswith(message), found
+
+
 @pytest.mark.parametrize("line, at, message", [
     ("Lot --> cleanupGeometry(vertex, 0) A", "vertex",
      "`cleanupGeometry` cleans up all, edges, faces, vertices, got `vertex` (did you mean `vertices`?)"),
