@@ -986,12 +986,21 @@ class SetbackToArea:
     site: int = 0
 
 
+@dataclass(frozen=True, slots=True)
+class Taper:
+    """CityEngine ``taper(height)``: the face becomes a pyramid, its apex ``height`` along the face's normal
+    over the face's centre of gravity, its scope's y along that normal."""
+
+    height: Expr = child(Type.NUM, "a taper height")
+    span: Span = NO_SPAN
+
+
 Op = (Symbol | Empty | Translate | Scale | Rotate | Push | Pop | Insert | Split | Repeat | Comp | Extrude
       | Center | UseAsset | Case | Stochastic | SetAttr | Report | NotApplied | GroupSplit | CompFaces
       | AlignScope | Mirror | Offset | SetColor | Setback | Roof | InnerRectangle | Convexify
       | CleanupGeometry | DeleteHoles | Snap | Label | Transform | Scatter | AlignToGeometry | Primitive
       | Trim | SplitArea | ReduceGeometry | MirrorScope | SetOpacity | SetupProjection | ProjectUV | TransformUV
-      | TileUV | NormalizeUV | SetbackToArea)
+      | TileUV | NormalizeUV | SetbackToArea | Taper)
 Body = tuple[Op, ...]
 
 

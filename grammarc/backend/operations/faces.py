@@ -37,9 +37,10 @@ from grammarc.geometry.inner_rectangle import largest_rectangles
 from grammarc.geometry.meshes import MESH_BASE, is_mesh, is_polygon
 from grammarc.geometry.polygons import PLANE_U, PLANE_V, plane_to_scope
 from grammarc.geometry.ridges import ridge_roofs
+from grammarc.geometry.roofs import PYRAMID, roof_meshes
 from grammarc.geometry.setback import distances_to_area, polygon_edges, setback_regions
 from grammarc.ir import nodes as ir
-from grammarc.ragged import ragged_take, rank_within
+from grammarc.ragged import ragged_take, rank_within, segment_of
 
 
 @operation(ir.Roof, writes=("origin", "size", "geom"))
@@ -132,6 +133,50 @@ def _ridge_roofs(ctx: Context, cursor: Shapes, op: ir.Roof, ridge: np.ndarray, v
                                                      value[others], op.by_height, overhang[others],
                                                      np.zeros(len(others)), None)
     return Shapes.merge([roofed, gables], [rows, others]), failed
+
+
+@operation(ir.Taper, writes=("origin", "size", "frame", "geom"))
+def taper(ctx: Context, cursor: Shapes, op: ir.Taper) -> Shapes:
+    """``taper(height)``: each face becomes a pyramid, a triangle from each edge of its outline to the apex
+    ``height`` along the face's normal over the face's centre of gravity (holes stay in the bottom face, as
+    roofPyramid's, which lifts the vertices' average instead). The scope fits the pyramid, its x as it was
+    (projected into the face's plane), its y along the normal; a negative height tapers behind the face,
+    the scope's sizes staying positive as every scope's does in grammarc. A height of 0 leaves the face."""
+    n = len(cursor)
+    height = np.ascontiguousarray(np.broadcast_to(np.asarray(evaluate_array(op.height, ctx.env(cursor)), float),
+                                                  (n,)))
+    bad = ~np.isfinite(height)
+    if bad.any():
+        ctx.fail(cursor, bad, "`taper` with a height that is not finite", op.span)
+    polygons, plane = face_polygons(ctx, cursor, "taper", op.span)
+    rows = np.flatnonzero(np.abs(height) > TOL.zero)
+    sub, face = cursor.take(rows), plane[rows]
+    coords, ring_offsets, shape_offsets, _ = polygons_of(ctx.chunk, sub)
+    # behind the face: the pyramid of the face mirrored in u, turned a half turn about v (so its faces
+    # still face out)
+    behind = height[rows] < 0
+    mirror = np.where(behind[segment_of(shape_offsets)[segment_of(ring_offsets)]], -1.0, 1.0)
+    coords = np.column_stack([coords[:, 0] * mirror, coords[:, 1]])
+    k = np.arange(len(rows))
+    verts, rings, faces, meshes, _ = roof_meshes(
+        PYRAMID, coords, ring_offsets, shape_offsets, face.astype(np.int8), sub.size[k, PLANE_U[face]],
+        sub.size[k, PLANE_V[face]], np.abs(height[rows]), True, np.zeros(len(rows)),
+        np.zeros(len(rows), dtype=np.int64), np.full(len(rows), np.inf))
+    owner = segment_of(meshes)[segment_of(faces)[segment_of(rings)]]
+    verts[behind[owner]] *= np.array([-1.0, 1.0, -1.0])
+    apex = verts[:, 2] != 0
+    verts[apex, :2] = shapely.get_coordinates(shapely.centroid(polygons[rows]))[owner[apex]]
+    tapered = mesh_shapes.roof_shapes(ctx.chunk, sub, face, verts, rings, faces, meshes)
+    turn = face != 1
+    if turn.any():  # y along the normal: the scope turned about its x (about z where x is the normal)
+        axes = ctx.chunk.frames[tapered.frame[turn]]
+        normal = face[turn]
+        x = np.where((normal == 0)[:, None], axes[:, 1], axes[:, 0])
+        y = axes[np.arange(len(normal)), normal]
+        turned = mesh_shapes.reframe_meshes(ctx.chunk, tapered.take(turn), np.stack([x, y, np.cross(x, y)], axis=1))
+        tapered = Shapes.merge([tapered.take(~turn), turned], [k[~turn], k[turn]])
+    kept = np.setdiff1d(np.arange(n), rows)
+    return Shapes.merge([cursor.take(kept), tapered], [kept, rows])
 
 
 @operation(ir.Offset, writes=COLUMNS, meshes=True)

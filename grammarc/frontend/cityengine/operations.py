@@ -635,6 +635,7 @@ OPERATIONS = {
     "rotateUV": OperationLowering.op_transform_uv,
     "tileUV": OperationLowering.op_tile_uv,
     "normalizeUV": OperationLowering.op_normalize_uv,
+    "taper": direct(ir.Taper),
 }
 #: Operations with parts ``{ ... }``: name -> handler(lowering, op, args, parts, span); those of ``REPEATING``
 #: also repeat (``{ ... }*``), with ``repeat=True``.
@@ -698,7 +699,7 @@ NOT_APPLIED = frozenset({
 #: CGA reference, so that any other name called with parts, or a typo of one of them, is unknown.
 UNSUPPORTED_OPS = frozenset({
     "innerPolygon",
-    "insertAlongUV", "footprint", "inline", "resetGeometry", "taper",
+    "insertAlongUV", "footprint", "inline", "resetGeometry",
     "rectify", "semiPolygon",
     "alignScopeToGeometryBBox", "modify",
     "splitAndSetbackPerimeter",
