@@ -27,6 +27,7 @@ from grammarc.backend.kernels.order import group_by
 from grammarc.backend.operations.table import Parts, operation
 from grammarc.backend.outlines import flat_axis, polygons_of
 from grammarc.backend.random import child_keys
+from grammarc.backend.reframing import turned
 from grammarc.backend.selectors import classify_faces, selector_frames
 from grammarc.backend.shapes import COLUMNS, Shapes
 from grammarc.constants import TOL
@@ -36,6 +37,7 @@ from grammarc.geometry.convexify import convex_parts
 from grammarc.geometry.inner_rectangle import largest_rectangles
 from grammarc.geometry.meshes import MESH_BASE, is_mesh, is_polygon
 from grammarc.geometry.polygons import PLANE_U, PLANE_V, plane_to_scope
+from grammarc.geometry.reframe import NORMAL_UP
 from grammarc.geometry.ridges import ridge_roofs
 from grammarc.geometry.roofs import PYRAMID, roof_meshes
 from grammarc.geometry.setback import distances_to_area, polygon_edges, setback_regions
@@ -140,7 +142,7 @@ def taper(ctx: Context, cursor: Shapes, op: ir.Taper) -> Shapes:
     """``taper(height)``: each face becomes a pyramid, a triangle from each edge of its outline to the apex
     ``height`` along the face's normal over the face's centre of gravity (holes stay in the bottom face, as
     roofPyramid's, which lifts the vertices' average instead). The scope fits the pyramid, its x as it was
-    (projected into the face's plane), its y along the normal; a negative height tapers behind the face,
+    (projected into the face's plane), its y along the normal (``NORMAL_UP``, as ``extrude``'s); a negative height tapers behind the face,
     the scope's sizes staying positive as every scope's does in grammarc. A height of 0 leaves the face."""
     n = len(cursor)
     height = np.ascontiguousarray(np.broadcast_to(np.asarray(evaluate_array(op.height, ctx.env(cursor)), float),
@@ -167,14 +169,8 @@ def taper(ctx: Context, cursor: Shapes, op: ir.Taper) -> Shapes:
     apex = verts[:, 2] != 0
     verts[apex, :2] = shapely.get_coordinates(shapely.centroid(polygons[rows]))[owner[apex]]
     tapered = mesh_shapes.roof_shapes(ctx.chunk, sub, face, verts, rings, faces, meshes)
-    turn = face != 1
-    if turn.any():  # y along the normal: the scope turned about its x (about z where x is the normal)
-        axes = ctx.chunk.frames[tapered.frame[turn]]
-        normal = face[turn]
-        x = np.where((normal == 0)[:, None], axes[:, 1], axes[:, 0])
-        y = axes[np.arange(len(normal)), normal]
-        turned = mesh_shapes.reframe_meshes(ctx.chunk, tapered.take(turn), np.stack([x, y, np.cross(x, y)], axis=1))
-        tapered = Shapes.merge([tapered.take(~turn), turned], [k[~turn], k[turn]])
+    # y along the normal, x kept where it can be, as extrude turns a face's scope
+    tapered = turned(ctx, tapered, face != 1, NORMAL_UP, face, op.span)
     kept = np.setdiff1d(np.arange(n), rows)
     return Shapes.merge([cursor.take(kept), tapered], [kept, rows])
 
