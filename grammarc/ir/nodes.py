@@ -995,12 +995,20 @@ class Taper:
     span: Span = NO_SPAN
 
 
+@dataclass(frozen=True, slots=True)
+class ResetGeometry:
+    """CityEngine ``resetGeometry()``: the shape's geometry, scope and pivot become its lot's initial shape's
+    again and its trim planes go; its attributes (colour, material, texture space, ``set`` values) stay."""
+
+    span: Span = NO_SPAN
+
+
 Op = (Symbol | Empty | Translate | Scale | Rotate | Push | Pop | Insert | Split | Repeat | Comp | Extrude
       | Center | UseAsset | Case | Stochastic | SetAttr | Report | NotApplied | GroupSplit | CompFaces
       | AlignScope | Mirror | Offset | SetColor | Setback | Roof | InnerRectangle | Convexify
       | CleanupGeometry | DeleteHoles | Snap | Label | Transform | Scatter | AlignToGeometry | Primitive
       | Trim | SplitArea | ReduceGeometry | MirrorScope | SetOpacity | SetupProjection | ProjectUV | TransformUV
-      | TileUV | NormalizeUV | SetbackToArea | Taper)
+      | TileUV | NormalizeUV | SetbackToArea | Taper | ResetGeometry)
 Body = tuple[Op, ...]
 
 

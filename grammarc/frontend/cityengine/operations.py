@@ -636,6 +636,7 @@ OPERATIONS = {
     "tileUV": OperationLowering.op_tile_uv,
     "normalizeUV": OperationLowering.op_normalize_uv,
     "taper": direct(ir.Taper),
+    "resetGeometry": direct(ir.ResetGeometry),
 }
 #: Operations with parts ``{ ... }``: name -> handler(lowering, op, args, parts, span); those of ``REPEATING``
 #: also repeat (``{ ... }*``), with ``repeat=True``.
@@ -699,7 +700,7 @@ NOT_APPLIED = frozenset({
 #: CGA reference, so that any other name called with parts, or a typo of one of them, is unknown.
 UNSUPPORTED_OPS = frozenset({
     "innerPolygon",
-    "insertAlongUV", "footprint", "inline", "resetGeometry",
+    "insertAlongUV", "footprint", "inline",
     "rectify", "semiPolygon",
     "alignScopeToGeometryBBox", "modify",
     "splitAndSetbackPerimeter",
