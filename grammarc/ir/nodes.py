@@ -1003,12 +1003,22 @@ class ResetGeometry:
     span: Span = NO_SPAN
 
 
+@dataclass(frozen=True, slots=True)
+class AlignScopeToBBox:
+    """CityEngine ``alignScopeToGeometryBBox(xz|zx|xy|yx|yz|zy)``: the scope turned about its third axis so
+    that the two named span the smallest rectangle around the geometry seen along that axis, the first
+    (``axes[0]``, a scope axis number) along its longer side."""
+
+    axes: tuple[int, int]
+    span: Span = NO_SPAN
+
+
 Op = (Symbol | Empty | Translate | Scale | Rotate | Push | Pop | Insert | Split | Repeat | Comp | Extrude
       | Center | UseAsset | Case | Stochastic | SetAttr | Report | NotApplied | GroupSplit | CompFaces
       | AlignScope | Mirror | Offset | SetColor | Setback | Roof | InnerRectangle | Convexify
       | CleanupGeometry | DeleteHoles | Snap | Label | Transform | Scatter | AlignToGeometry | Primitive
       | Trim | SplitArea | ReduceGeometry | MirrorScope | SetOpacity | SetupProjection | ProjectUV | TransformUV
-      | TileUV | NormalizeUV | SetbackToArea | Taper | ResetGeometry)
+      | TileUV | NormalizeUV | SetbackToArea | Taper | ResetGeometry | AlignScopeToBBox)
 Body = tuple[Op, ...]
 
 

@@ -184,6 +184,7 @@ _OP_FORMATS = {
                               + f"comp({op.kind}){_selected(comp_selectors(op), op.parts)}"),
     ir.Setback: _setback,
     ir.SetbackToArea: _setback_to_area,
+    ir.AlignScopeToBBox: lambda op: f"alignScopeToGeometryBBox({''.join('xyz'[a] for a in op.axes)})",
     ir.Case: _branches,
     ir.Stochastic: _branches,
     ir.Extrude: lambda op: ("extrude(" + ("" if op.direction == "face.normal" else f"{op.direction}, ")

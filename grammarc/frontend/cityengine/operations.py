@@ -406,6 +406,17 @@ class OperationLowering:
         minimum, maximum = (*lists, (), ())[:2]
         return ir.SetbackToArea(self.expr(args[0]), minimum, maximum, chosen[0], chosen[1], span, self.site())
 
+    def op_align_scope_to_bbox(self, op, args, span):
+        """``alignScopeToGeometryBBox(alignAxes)``, the two scope axes it turns (``xz``: x along the longer
+        side, z across it, about y)."""
+        if not self.arity(op, args, (1,), span):
+            return ir.Empty(span)
+        axes = _selector(args[0])
+        if axes is None or len(axes) != 2 or set(axes) not in ({"x", "y"}, {"x", "z"}, {"y", "z"}):
+            return self.unsupported(f"{op} with these axes", getattr(args[0], "span", span),
+                                    "alignAxes is one of xy, yx, xz, zx, yz, zy")
+        return ir.AlignScopeToBBox(("xyz".index(axes[0]), "xyz".index(axes[1])), span)
+
     def op_setback_alone(self, op, args, span):
         """``setback(d)`` without parts (public files write it, as if it were an operation on its own):
         the reference knows only the form with parts, and a user who writes it means the face set back by
@@ -637,6 +648,7 @@ OPERATIONS = {
     "normalizeUV": OperationLowering.op_normalize_uv,
     "taper": direct(ir.Taper),
     "resetGeometry": direct(ir.ResetGeometry),
+    "alignScopeToGeometryBBox": OperationLowering.op_align_scope_to_bbox,
 }
 #: Operations with parts ``{ ... }``: name -> handler(lowering, op, args, parts, span); those of ``REPEATING``
 #: also repeat (``{ ... }*``), with ``repeat=True``.
@@ -702,7 +714,7 @@ UNSUPPORTED_OPS = frozenset({
     "innerPolygon",
     "insertAlongUV", "footprint", "inline",
     "rectify", "semiPolygon",
-    "alignScopeToGeometryBBox", "modify",
+    "modify",
     "splitAndSetbackPerimeter",
     "tag", "deleteTags", "setTagsFromEdgeAttrs", "union", "subtract", "intersect",
     "copyUV", "setMaterial", "resetMaterial",

@@ -239,13 +239,26 @@ def test_setback_per_edge_and_to_area_lower_to_setbacks_of_distances_per_edge(bo
     assert body_of(f"{VERSION}const ds = [1, 2]\nLot --> {body}\n") == printed
 
 
+@pytest.mark.parametrize("body, printed", [
+    ("taper(h * 2) A", "taper((@h * 2)) A"),
+    ("resetGeometry() A", "resetGeometry() A"),
+    ("alignScopeToGeometryBBox(zx) A", "alignScopeToGeometryBBox(zx) A"),
+    ('alignScopeToGeometryBBox("xy") A', "alignScopeToGeometryBBox(xy) A"),
+])
+def test_taper_reset_geometry_and_align_scope_to_geometry_bbox_lower_to_their_nodes(body, printed):
+    assert body_of(f"{VERSION}attr h = 2\nLot --> {body}\n") == printed
+
+
 @pytest.mark.parametrize("line, at, message", [
     ("Lot --> setbackToArea(1, [1], [2], [3]){ all : A }", "setbackToArea",
      "`setbackToArea` takes 1 or 2 or 3 arguments, got 4"),
     ("Lot --> setbackPerEdge(1){ side : A | frnt : B }", "frnt",
      "unsupported: setbackPerEdge selector `frnt` (setbackPerEdge selects "),
+    ("Lot --> alignScopeToGeometryBBox(xx) A", "xx",
+     "unsupported: alignScopeToGeometryBBox with these axes (alignAxes is one of xy, yx, xz, zx, yz, zy)"),
+    ("Lot --> resetGeometry(1) A", "resetGeometry", "`resetGeometry` takes 0 arguments, got 1"),
 ])
-def test_setback_per_edge_and_to_area_name_a_wrong_argument_count_or_selector(line, at, message):
+def test_new_operations_name_a_wrong_argument_count_or_selector(line, at, message):
     (found,) = errors(VERSION + line + "\n")
     assert found[:2] == (2, line.index(at) + 1) and found[2].startswith(message), found
 
