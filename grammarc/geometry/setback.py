@@ -93,7 +93,7 @@ def setback_regions(polygons: np.ndarray, edges: Edges, distance: np.ndarray, ow
         strips[folded] = shapely.polygons(np.stack(
             [edges.start[k], edges.end[k], edges.end[k] + shift, edges.start[k] + shift], axis=1))
     group = owner[idx] * m + edges.poly[idx]
-    united = _union_by_group(strips, group, n_owners * m).reshape(n_owners, m)
+    united = union_by_group(strips, group, n_owners * m).reshape(n_owners, m)
     regions, covered = [], np.full(m, shapely.Polygon(), dtype=object)
     for k in range(n_owners):
         region = shapely.difference(shapely.intersection(polygons, united[k]), covered)
@@ -188,7 +188,7 @@ def _mitres(edges: Edges, d: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return np.where(too_far[:, None], straight, corner), ~too_far
 
 
-def _union_by_group(geometries: np.ndarray, group: np.ndarray, n_groups: int) -> np.ndarray:
+def union_by_group(geometries: np.ndarray, group: np.ndarray, n_groups: int) -> np.ndarray:
     """The union of the geometries of each group (n_groups,), empty where a group has none."""
     rank = rank_within(group)
     grid = np.full((n_groups, int(rank.max(initial=0)) + 1), None, dtype=object)

@@ -1013,12 +1013,21 @@ class AlignScopeToBBox:
     span: Span = NO_SPAN
 
 
+@dataclass(frozen=True, slots=True)
+class Footprint:
+    """CityEngine ``footprint()``: the shape's geometry projected along its scope's y onto the plane y = 0
+    of its scope, a flat geometry."""
+
+    span: Span = NO_SPAN
+
+
 Op = (Symbol | Empty | Translate | Scale | Rotate | Push | Pop | Insert | Split | Repeat | Comp | Extrude
       | Center | UseAsset | Case | Stochastic | SetAttr | Report | NotApplied | GroupSplit | CompFaces
       | AlignScope | Mirror | Offset | SetColor | Setback | Roof | InnerRectangle | Convexify
       | CleanupGeometry | DeleteHoles | Snap | Label | Transform | Scatter | AlignToGeometry | Primitive
       | Trim | SplitArea | ReduceGeometry | MirrorScope | SetOpacity | SetupProjection | ProjectUV | TransformUV
-      | TileUV | NormalizeUV | SetbackToArea | Taper | ResetGeometry | AlignScopeToBBox)
+      | TileUV | NormalizeUV | SetbackToArea | Taper | ResetGeometry | AlignScopeToBBox
+      | Footprint)
 Body = tuple[Op, ...]
 
 

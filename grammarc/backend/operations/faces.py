@@ -1,15 +1,16 @@
-"""Operations on the outlines of faces: ``offset``, ``setback`` and ``shapeL/U/O``, ``innerRectangle``,
-``convexify``, the roofs, ``cleanupGeometry`` (and ``comp(f)`` after an ``offset``, for
-``operations.component_splits``).
+"""Operations on the outlines of faces: ``offset``, ``setback``, ``setbackPerEdge``, ``setbackToArea`` and
+``shapeL/U/O``, ``innerRectangle``, ``convexify``, the roofs and ``taper``, ``footprint``, ``cleanupGeometry``
+(and ``comp(f)`` after an ``offset``, for ``operations.component_splits``).
 
 They share one pattern: the batch's faces as shapely polygons in their scopes' units (``face_polygons``), one
 vectorized geometry step, then the pieces back as shapes (``Parts`` for the bodies of ``setback`` and
 ``innerRectangle``) or the face's geometry replaced (a mesh of pieces, a roof: ``backend.mesh_shapes``).
 Reads: the scope (``origin``, ``size``, ``frame``), ``geom``, ``lot`` (street selectors), and what their
-expressions read. Writes: the roofs ``origin``, ``size`` and ``geom``; ``convexify`` and ``cleanupGeometry``
-the ``geom``; ``offset`` every column, as it makes the shapes of its pieces anew (new keys; a face with no
-piece left goes). ``offset`` also takes a shape of several faces in one plane (a mesh of an earlier offset's
-pieces or of convexify's parts) and offsets each face.
+expressions read. Writes: the roofs ``origin``, ``size`` and ``geom`` (``taper`` the ``frame`` too: its y
+turns to the face's normal); ``convexify`` and ``cleanupGeometry`` the ``geom``; ``offset`` and ``footprint``
+every column, as they make the shapes of their pieces anew (new keys; a shape with no piece left goes).
+``offset`` also takes a shape of several faces in one plane (a mesh of an earlier offset's pieces or of
+convexify's parts) and offsets each face.
 """
 
 from __future__ import annotations
@@ -37,6 +38,8 @@ from grammarc.geometry.convexify import convex_parts
 from grammarc.geometry.inner_rectangle import largest_rectangles
 from grammarc.geometry.meshes import MESH_BASE, is_mesh, is_polygon
 from grammarc.geometry.polygons import PLANE_U, PLANE_V, plane_to_scope
+from grammarc.geometry.projection import projected_outlines
+from grammarc.geometry.queries import shape_faces
 from grammarc.geometry.reframe import NORMAL_UP
 from grammarc.geometry.ridges import ridge_roofs
 from grammarc.geometry.roofs import PYRAMID, roof_meshes
@@ -142,8 +145,9 @@ def taper(ctx: Context, cursor: Shapes, op: ir.Taper) -> Shapes:
     """``taper(height)``: each face becomes a pyramid, a triangle from each edge of its outline to the apex
     ``height`` along the face's normal over the face's centre of gravity (holes stay in the bottom face, as
     roofPyramid's, which lifts the vertices' average instead). The scope fits the pyramid, its x as it was
-    (projected into the face's plane), its y along the normal (``NORMAL_UP``, as ``extrude``'s); a negative height tapers behind the face,
-    the scope's sizes staying positive as every scope's does in grammarc. A height of 0 leaves the face."""
+    (projected into the face's plane), its y along the normal (``NORMAL_UP``, as ``extrude``'s); a negative
+    height tapers behind the face, the scope's sizes staying positive as every scope's does in grammarc. A
+    height of 0 leaves the face."""
     n = len(cursor)
     height = np.ascontiguousarray(np.broadcast_to(np.asarray(evaluate_array(op.height, ctx.env(cursor)), float),
                                                   (n,)))
@@ -190,6 +194,26 @@ def offset(ctx: Context, cursor: Shapes, op: ir.Offset) -> Shapes:
     else:
         inside, border = _offset_pieces(ctx, op.distance, cursor, op.span)
         pieces = inside if op.select == "inside" else border
+    return _shape_each(ctx, cursor, pieces)
+
+
+@operation(ir.Footprint, writes=COLUMNS, meshes=True)
+def footprint(ctx: Context, cursor: Shapes, op: ir.Footprint) -> Shapes:
+    """``footprint()``: each shape's geometry seen along its scope's y, flat in the plane y = 0 of its
+    scope (``geometry.projection``): a polygon, or a mesh of its parts where it falls apart, in a scope
+    fitted to it (x and z as they were). An inserted asset is its scope box here, as for ``geometry.area``;
+    a shape whose geometry covers no area seen from above (a wall) is left out, as ``offset`` leaves out a
+    face with nothing left."""
+    faces = shape_faces(cursor.size, cursor.geom, ctx.chunk.polygons, ctx.chunk.meshes)
+    outlines = projected_outlines(faces.verts[:, [0, 2]], faces.ring_offsets, faces.face_offsets,
+                                  faces.face_shape(), len(cursor))
+    flat = cursor.with_scope(cursor.origin, cursor.size * [1.0, 0.0, 1.0], cursor.frame, cursor.geom)
+    return _shape_each(ctx, flat, fit_pieces(outlines, np.ones(len(cursor), dtype=np.int8), flat.size))
+
+
+def _shape_each(ctx: Context, cursor: Shapes, pieces) -> Shapes:
+    """A shape for each row of ``cursor`` with ``pieces`` (``geometry.clip.Clipped``): its one piece, or a
+    mesh of its several in one fitted scope."""
     several = np.bincount(pieces.source, minlength=len(cursor)) > 1
     if not several.any():
         return _piece_shapes(ctx, cursor, pieces, 0)

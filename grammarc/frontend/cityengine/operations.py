@@ -648,6 +648,7 @@ OPERATIONS = {
     "normalizeUV": OperationLowering.op_normalize_uv,
     "taper": direct(ir.Taper),
     "resetGeometry": direct(ir.ResetGeometry),
+    "footprint": direct(ir.Footprint),
     "alignScopeToGeometryBBox": OperationLowering.op_align_scope_to_bbox,
 }
 #: Operations with parts ``{ ... }``: name -> handler(lowering, op, args, parts, span); those of ``REPEATING``
@@ -712,7 +713,7 @@ NOT_APPLIED = frozenset({
 #: CGA reference, so that any other name called with parts, or a typo of one of them, is unknown.
 UNSUPPORTED_OPS = frozenset({
     "innerPolygon",
-    "insertAlongUV", "footprint", "inline",
+    "insertAlongUV", "inline",
     "rectify", "semiPolygon",
     "modify",
     "splitAndSetbackPerimeter",

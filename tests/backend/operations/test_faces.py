@@ -255,3 +255,26 @@ def test_taper_of_a_solid_or_a_roof_fails_its_lot_by_name(write):
                          ("roofHip(30) taper(1)", "`taper` of a roof is not supported yet")]:
         (bad,) = run(write, f"Lot --> {body} X.\n", [rect(10, 8)])["bad"]
         assert bad.reason.startswith(reason), bad.reason
+
+
+def test_footprint_is_the_geometry_seen_from_above(write):
+    """The reference's example extrudes the footprint of an inserted building again: here of a hip roof
+    (its outline), of a holed solid (the courtyard keeps its hole), and of a cube (its box); a wall, seen
+    along its own scope y (up the wall), covers no area and is left out."""
+    text = ('Lot --> {} footprint() report("a", geometry.area) report("y", scope.sy) '
+            'extrude(3) report("v", geometry.volume) X.\n')
+    for before, lot, area in [("roofHip(30)", LOT_ZOO["concave_L"], 400), ("extrude(8)", LOT_ZOO["courtyard"], 1200),
+                              ('s(4, 5, 6) i("builtin:cube")', rect(10, 8), 24)]:
+        t = totals(run(write, text.format(before), [lot]))
+        assert (t["a_sum"], t["y_sum"], t["v_sum"]) == (pytest.approx(area), 0, pytest.approx(3 * area))
+    r = run(write, "Lot --> extrude(8) comp(f){ side : footprint() W. | top : T. }\n", [rect(10, 8)])
+    assert names(r) == ["T"]
+
+
+def test_footprint_that_falls_apart_is_one_shape_of_its_parts(write):
+    """A courtyard's offset border, two rings (around the lot and around the hole) of one shape, extruded:
+    its footprint is a mesh of the two rings in one scope."""
+    text = ('Lot --> offset(-2, border) extrude(1) footprint() report("n", geometry.nFaces) '
+            'report("a", geometry.area) comp(f){ all : F. }\n')
+    t = totals(run(write, text, [LOT_ZOO["courtyard"]]))
+    assert (t["n_sum"], t["a_sum"], t["a_n"]) == (2, pytest.approx(40 * 40 - 36 * 36 + 24 * 24 - 20 * 20), 1)

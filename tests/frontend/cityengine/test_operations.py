@@ -242,10 +242,11 @@ def test_setback_per_edge_and_to_area_lower_to_setbacks_of_distances_per_edge(bo
 @pytest.mark.parametrize("body, printed", [
     ("taper(h * 2) A", "taper((@h * 2)) A"),
     ("resetGeometry() A", "resetGeometry() A"),
+    ("footprint() extrude(2) A", "footprint() extrude(2) A"),
     ("alignScopeToGeometryBBox(zx) A", "alignScopeToGeometryBBox(zx) A"),
     ('alignScopeToGeometryBBox("xy") A', "alignScopeToGeometryBBox(xy) A"),
 ])
-def test_taper_reset_geometry_and_align_scope_to_geometry_bbox_lower_to_their_nodes(body, printed):
+def test_taper_reset_geometry_footprint_and_align_scope_to_geometry_bbox_lower_to_their_nodes(body, printed):
     assert body_of(f"{VERSION}attr h = 2\nLot --> {body}\n") == printed
 
 
