@@ -707,6 +707,9 @@ NOT_APPLIED = frozenset({
     "reverseNormals", "print", "setNormals", "softenNormals",
     # the pivot only moves the model's own origin in an export; scope.t* stay relative to the lot
     "setPivot",
+    # component tags name faces, edges and vertices for what reads them (inline, the boolean operations,
+    # geometry.hasTags and geometry.tags, tag selectors), each unsupported with its own error
+    "tag", "deleteTags", "setTagsFromEdgeAttrs",
 })
 #: CityEngine operations grammarc does not implement yet (the geometry and context issues bring most).
 #: With ``OPERATIONS``, ``PART_OPERATIONS`` and ``NOT_APPLIED`` they are every operation of CityEngine's
@@ -717,7 +720,7 @@ UNSUPPORTED_OPS = frozenset({
     "rectify", "semiPolygon",
     "modify",
     "splitAndSetbackPerimeter",
-    "tag", "deleteTags", "setTagsFromEdgeAttrs", "union", "subtract", "intersect",
+    "union", "subtract", "intersect",
     "copyUV", "setMaterial", "resetMaterial",
 } - NOT_APPLIED)
 #: Every operation name CityEngine knows: what a misspelt one is suggested from.

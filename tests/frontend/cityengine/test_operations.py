@@ -153,6 +153,17 @@ def test_not_applied_operations_are_listed_for_the_meta(tmp_path):
     assert make_plan(compile_grammar(path)).not_applied == ("print", "set(material.shininess)")
 
 
+def test_tags_are_accepted_without_effect_and_what_reads_them_is_unsupported(tmp_path):
+    """``tag``, ``deleteTags`` and ``setTagsFromEdgeAttrs`` name components for what reads the names; those
+    readers (here ``geometry.hasTags``) are refused at their line, so no tag is dropped silently."""
+    path = tmp_path / "g.cga"
+    path.write_text(VERSION + 'Lot --> extrude(3) tag("mass") tag("walls", faces) comp(f){ side : deleteTags() '
+                    "setTagsFromEdgeAttrs() W. }\n")
+    assert make_plan(compile_grammar(path)).not_applied == ("deleteTags", "setTagsFromEdgeAttrs", "tag")
+    line = 'Lot --> tag("mass") report("t", geometry.hasTags("mass"))'
+    assert_unsupported_at(line, "geometry.hasTags()", "geometry")
+
+
 
 # ------------------------------------------------------------------------------------- split and comp
 
