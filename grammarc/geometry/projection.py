@@ -26,14 +26,21 @@ def projected_outlines(points: np.ndarray, ring_offsets: np.ndarray, face_offset
     (R+1,) and face_offsets (F+1,) int64 their open rings and faces, as ``geometry.queries.Faces``;
     face_shape (F,) the shape of each face.
     """
+    faces = polygons_from_rings(points, ring_offsets, face_offsets)
+    faces = shapely.make_valid(faces)
+    keep = shapely.area(faces) > TOL.area_floor
+    return shapely.set_precision(union_by_group(faces[keep], face_shape[keep], n), _SNAP)
+
+
+def polygons_from_rings(points: np.ndarray, ring_offsets: np.ndarray, poly_offsets: np.ndarray) -> np.ndarray:
+    """Shapely polygons (P,) of open rings: points (V, 2), ring_offsets (R+1,) into them, poly_offsets (P+1,)
+    into the rings (each polygon's outer ring first); every ring has three points or more."""
+    if len(poly_offsets) < 2:
+        return np.empty(0, dtype=object)
     counts = np.diff(ring_offsets)
-    # close every ring: its vertices, then its first again
+    # close every ring: its points, then its first again
     closed_offsets = offsets_from_counts(counts + 1)
     ring = segment_of(closed_offsets)
     step = np.arange(len(ring)) - closed_offsets[ring]
     index = ring_offsets[ring] + np.where(step < counts[ring], step, 0)
-    faces = shapely.from_ragged_array(shapely.GeometryType.POLYGON, points[index], (closed_offsets, face_offsets)) \
-        if len(face_offsets) > 1 else np.empty(0, dtype=object)
-    faces = shapely.make_valid(faces)
-    keep = shapely.area(faces) > TOL.area_floor
-    return shapely.set_precision(union_by_group(faces[keep], face_shape[keep], n), _SNAP)
+    return shapely.from_ragged_array(shapely.GeometryType.POLYGON, points[index], (closed_offsets, poly_offsets))

@@ -1021,13 +1021,22 @@ class Footprint:
     span: Span = NO_SPAN
 
 
+@dataclass(frozen=True, slots=True)
+class Rectify:
+    """CityEngine ``rectify(angle)``: a face's edges within ``angle`` degrees of one of its scope axes made
+    parallel to it (``geometry.rectify``)."""
+
+    angle: Expr = child(Type.NUM, "an angle")
+    span: Span = NO_SPAN
+
+
 Op = (Symbol | Empty | Translate | Scale | Rotate | Push | Pop | Insert | Split | Repeat | Comp | Extrude
       | Center | UseAsset | Case | Stochastic | SetAttr | Report | NotApplied | GroupSplit | CompFaces
       | AlignScope | Mirror | Offset | SetColor | Setback | Roof | InnerRectangle | Convexify
       | CleanupGeometry | DeleteHoles | Snap | Label | Transform | Scatter | AlignToGeometry | Primitive
       | Trim | SplitArea | ReduceGeometry | MirrorScope | SetOpacity | SetupProjection | ProjectUV | TransformUV
       | TileUV | NormalizeUV | SetbackToArea | Taper | ResetGeometry | AlignScopeToBBox
-      | Footprint)
+      | Footprint | Rectify)
 Body = tuple[Op, ...]
 
 

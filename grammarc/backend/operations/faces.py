@@ -1,16 +1,16 @@
 """Operations on the outlines of faces: ``offset``, ``setback``, ``setbackPerEdge``, ``setbackToArea`` and
-``shapeL/U/O``, ``innerRectangle``, ``convexify``, the roofs and ``taper``, ``footprint``, ``cleanupGeometry``
-(and ``comp(f)`` after an ``offset``, for ``operations.component_splits``).
+``shapeL/U/O``, ``innerRectangle``, ``convexify``, the roofs and ``taper``, ``footprint``, ``rectify``,
+``cleanupGeometry`` (and ``comp(f)`` after an ``offset``, for ``operations.component_splits``).
 
 They share one pattern: the batch's faces as shapely polygons in their scopes' units (``face_polygons``), one
 vectorized geometry step, then the pieces back as shapes (``Parts`` for the bodies of ``setback`` and
 ``innerRectangle``) or the face's geometry replaced (a mesh of pieces, a roof: ``backend.mesh_shapes``).
 Reads: the scope (``origin``, ``size``, ``frame``), ``geom``, ``lot`` (street selectors), and what their
 expressions read. Writes: the roofs ``origin``, ``size`` and ``geom`` (``taper`` the ``frame`` too: its y
-turns to the face's normal); ``convexify`` and ``cleanupGeometry`` the ``geom``; ``offset`` and ``footprint``
-every column, as they make the shapes of their pieces anew (new keys; a shape with no piece left goes).
-``offset`` also takes a shape of several faces in one plane (a mesh of an earlier offset's pieces or of
-convexify's parts) and offsets each face.
+turns to the face's normal); ``convexify`` and ``cleanupGeometry`` the ``geom``; ``offset``, ``footprint``
+and ``rectify`` every column, as they make the shapes of their pieces anew (new keys; a shape with no piece
+left goes). ``offset`` also takes a shape of several faces in one plane (a mesh of an earlier offset's
+pieces or of convexify's parts) and offsets each face.
 """
 
 from __future__ import annotations
@@ -40,6 +40,7 @@ from grammarc.geometry.meshes import MESH_BASE, is_mesh, is_polygon
 from grammarc.geometry.polygons import PLANE_U, PLANE_V, plane_to_scope
 from grammarc.geometry.projection import projected_outlines
 from grammarc.geometry.queries import shape_faces
+from grammarc.geometry.rectify import rectified
 from grammarc.geometry.reframe import NORMAL_UP
 from grammarc.geometry.ridges import ridge_roofs
 from grammarc.geometry.roofs import PYRAMID, roof_meshes
@@ -209,6 +210,21 @@ def footprint(ctx: Context, cursor: Shapes, op: ir.Footprint) -> Shapes:
                                   faces.face_shape(), len(cursor))
     flat = cursor.with_scope(cursor.origin, cursor.size * [1.0, 0.0, 1.0], cursor.frame, cursor.geom)
     return _shape_each(ctx, flat, fit_pieces(outlines, np.ones(len(cursor), dtype=np.int8), flat.size))
+
+
+@operation(ir.Rectify, writes=COLUMNS)
+def rectify(ctx: Context, cursor: Shapes, op: ir.Rectify) -> Shapes:
+    """``rectify(angle)``: each face's edges within ``angle`` degrees (the reference's range [0, 45]; others
+    are taken as its nearer end) of one of the face's scope axes made parallel to it
+    (``geometry.rectify``), in a scope fitted to the result; a face that falls apart becomes a mesh of its
+    parts, as an offset's does, and one with nothing left goes."""
+    angle = np.clip(np.broadcast_to(np.asarray(evaluate_array(op.angle, ctx.env(cursor)), float), (len(cursor),)),
+                    0.0, 45.0)
+    bad = np.isnan(angle)
+    if bad.any():
+        ctx.fail(cursor, bad, "`rectify` with an angle that is not a number", op.span)
+    polygons, plane = face_polygons(ctx, cursor, "rectify", op.span)
+    return _shape_each(ctx, cursor, fit_pieces(rectified(polygons, angle), plane, cursor.size, polygons))
 
 
 def _shape_each(ctx: Context, cursor: Shapes, pieces) -> Shapes:

@@ -649,6 +649,7 @@ OPERATIONS = {
     "taper": direct(ir.Taper),
     "resetGeometry": direct(ir.ResetGeometry),
     "footprint": direct(ir.Footprint),
+    "rectify": direct(ir.Rectify),
     "alignScopeToGeometryBBox": OperationLowering.op_align_scope_to_bbox,
 }
 #: Operations with parts ``{ ... }``: name -> handler(lowering, op, args, parts, span); those of ``REPEATING``
@@ -717,7 +718,7 @@ NOT_APPLIED = frozenset({
 UNSUPPORTED_OPS = frozenset({
     "innerPolygon",
     "insertAlongUV", "inline",
-    "rectify", "semiPolygon",
+    "semiPolygon",
     "modify",
     "splitAndSetbackPerimeter",
     "union", "subtract", "intersect",

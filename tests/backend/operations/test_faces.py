@@ -278,3 +278,18 @@ def test_footprint_that_falls_apart_is_one_shape_of_its_parts(write):
             'report("a", geometry.area) comp(f){ all : F. }\n')
     t = totals(run(write, text, [LOT_ZOO["courtyard"]]))
     assert (t["n_sum"], t["a_sum"], t["a_n"]) == (2, pytest.approx(40 * 40 - 36 * 36 + 24 * 24 - 20 * 20), 1)
+
+
+def test_rectify_snaps_edges_near_the_scope_axes(write):
+    """The reference's example: a face whose edges lean a few degrees off its scope's axes becomes
+    rectangular with ``rectify(15)`` (the lot's scope runs along its first edge); with an angle below the
+    lean it stays as it was; a face that leans more is left out of the snap."""
+    lot = [np.array([[0, 0], [20, 0], [20.5, 12], [-0.4, 11.6]], float)]
+    text = ('Lot --> rectify({}) report("r", geometry.isRectangular(0.01)) report("n", geometry.nVertices) '
+            'report("x", scope.sx) X.\n')
+    t = totals(run(write, text.format(15), [lot]))
+    assert (t["r_sum"], t["n_sum"]) == (True, 4) and 20 < t["x_sum"] < 20.5
+    t = totals(run(write, text.format(1), [lot]))
+    assert (t["r_sum"], t["x_sum"]) == (False, pytest.approx(20.9))
+    (bad,) = run(write, "Lot --> extrude(3) rectify(10) X.\n", [rect(10, 8)])["bad"]
+    assert bad.reason.startswith("`rectify` of a solid is not supported yet")

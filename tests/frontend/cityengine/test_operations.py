@@ -254,6 +254,7 @@ def test_setback_per_edge_and_to_area_lower_to_setbacks_of_distances_per_edge(bo
     ("taper(h * 2) A", "taper((@h * 2)) A"),
     ("resetGeometry() A", "resetGeometry() A"),
     ("footprint() extrude(2) A", "footprint() extrude(2) A"),
+    ("rectify(h) A", "rectify(@h) A"),
     ("alignScopeToGeometryBBox(zx) A", "alignScopeToGeometryBBox(zx) A"),
     ('alignScopeToGeometryBBox("xy") A', "alignScopeToGeometryBBox(xy) A"),
 ])
