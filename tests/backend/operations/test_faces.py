@@ -203,12 +203,15 @@ def test_setback_to_area_leaves_the_remainder_its_area(write):
 
 
 def test_setback_to_area_raises_the_minimums_by_one_offset_up_to_the_maximums(write):
-    """Front (edge 0) at least 4: front and back move 4 + c and c, c = 3 leaving 30 x 10. Maximums of 1
-    leave more than the area asked, as does a face smaller than it (nothing moves but the minimums)."""
+    """Front (edge 0) at least 4 (by index or by selector): front and back move 4 + c and c, c = 3 leaving
+    30 x 10. Maximums of 1 leave more than the area asked, as does a face smaller than it (nothing moves
+    but the minimums)."""
     text = "Lot --> setbackToArea(300, [4, 0, 0, 0]){ front : F | back : B | remainder : R }\n" \
         'F --> report("f", geometry.area)\nB --> report("b", geometry.area)\nR --> report("r", geometry.area)\n'
     t = totals(run(write, text, [rect(30, 20)]))
     assert (t["f_sum"], t["b_sum"], t["r_sum"]) == (pytest.approx(210), pytest.approx(90), pytest.approx(300))
+    by_selector = text.replace("[4, 0, 0, 0]", "comp(fe){ front : 4 | all : 0 }")
+    same_records(run(write, text, [rect(30, 20)]), run(write, by_selector, [rect(30, 20)]))
     t = totals(run(write, text.replace("[4, 0, 0, 0]", "[0], [1, 0, 1]"), [rect(30, 20)]))
     assert (t["f_sum"], t["b_sum"], t["r_sum"]) == (pytest.approx(30), pytest.approx(30), pytest.approx(540))
     t = totals(run(write, text.replace("300, [4, 0, 0, 0]", "700"), [rect(30, 20)]))
