@@ -110,6 +110,9 @@ class Chunk:
     polygons: PolygonStore
     #: The occluders of every lot from a first pass (``inter`` queries), when there was one.
     foreign: Occluders | None = None
+    #: The lots' initial shapes' size (L, 3), frame (L,) and geom (L,), with ``lot_origin``:
+    #: what ``resetGeometry`` goes back to.
+    lot_shapes: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None
     outputs: Outputs = field(default_factory=Outputs)
     meshes: MeshStore = field(default_factory=MeshStore)
     #: Occluders made so far (``backend.occlusion``).

@@ -61,6 +61,7 @@ def initial_chunk(lots: Lots, seed: int, foreign: Occluders | None = None) -> tu
     n = len(lots)
     shapes = Shapes(origin, size, frames.add(axes), geom, np.arange(n, dtype=np.int32), key,
                     np.zeros(n, dtype=np.int32))
+    chunk.lot_shapes = (shapes.size, shapes.frame, shapes.geom)
     return chunk, shapes
 
 

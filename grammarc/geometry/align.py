@@ -14,6 +14,7 @@ of that index on the first face (the reference allows ``any`` only with an edge 
 from __future__ import annotations
 
 import numpy as np
+import shapely
 from numba import njit
 
 #: Face selectors of ``alignScopeToGeometry`` (codes of ``pick_edges``).
@@ -119,3 +120,28 @@ def aligned_axes(edge: np.ndarray, normal: np.ndarray, frame: np.ndarray, up: st
     if up == "yUp":
         return np.stack([x, normal, np.cross(x, normal)], axis=1), ok
     return np.stack([x, np.cross(normal, x), normal], axis=1), ok
+
+
+
+def bbox_turns(points: np.ndarray, owner: np.ndarray, n: int) -> tuple[np.ndarray, np.ndarray]:
+    """For ``alignScopeToGeometryBBox``: the turn of each of n shapes' first in-plane axis onto the longer
+    side of the smallest rectangle around its ``points`` (V, 2) (coordinates along the two axes; ``owner``
+    (V,) each one's shape, ascending), as (cos, sin) (n, 2) of the angle from the first axis towards the
+    second, and (n,) whether the shape has such a side. Of a side's two senses the one within a quarter
+    turn of the first axis is taken; points along a line give the line, a single point no side.
+    """
+    hulls = shapely.minimum_rotated_rectangle(
+        shapely.multipoints(points, indices=owner, out=np.empty(n, dtype=object)))
+    # a rectangle's ring (its first two sides follow each other), a line's two ends, a point, or nothing
+    coords, ring = shapely.get_coordinates(hulls, return_index=True)
+    counts = np.bincount(ring, minlength=n)
+    first = np.searchsorted(ring, np.arange(n))
+    at = np.minimum(first[:, None] + np.arange(3), max(len(coords) - 1, 0))
+    corner = coords[at] if len(coords) else np.zeros((n, 3, 2))
+    side = np.where((counts >= 2)[:, None], corner[:, 1] - corner[:, 0], 0.0)
+    across = np.where((counts >= 3)[:, None], corner[:, 2] - corner[:, 1], 0.0)
+    longer = np.where((np.hypot(*side.T) >= np.hypot(*across.T))[:, None], side, across)
+    length = np.hypot(*longer.T)
+    ok = length > 1e-12
+    turn = np.where(ok[:, None], longer / np.where(ok, length, 1.0)[:, None], [1.0, 0.0])
+    return turn * np.where(turn[:, :1] < 0, -1.0, 1.0), ok

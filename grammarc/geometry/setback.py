@@ -24,6 +24,8 @@ from grammarc.ragged import offsets_from_counts, rank_within
 _MITRE_LIMIT = 10.0
 #: The grid (scope units, metres) that setback regions are snapped to, collapsing zero-width spikes.
 _SNAP = 1e-9
+#: The most steps ``distances_to_area`` takes for one polygon.
+_AREA_STEPS = 64
 
 
 @dataclass(frozen=True)
@@ -91,13 +93,78 @@ def setback_regions(polygons: np.ndarray, edges: Edges, distance: np.ndarray, ow
         strips[folded] = shapely.polygons(np.stack(
             [edges.start[k], edges.end[k], edges.end[k] + shift, edges.start[k] + shift], axis=1))
     group = owner[idx] * m + edges.poly[idx]
-    united = _union_by_group(strips, group, n_owners * m).reshape(n_owners, m)
+    united = union_by_group(strips, group, n_owners * m).reshape(n_owners, m)
     regions, covered = [], np.full(m, shapely.Polygon(), dtype=object)
     for k in range(n_owners):
         region = shapely.difference(shapely.intersection(polygons, united[k]), covered)
         regions.append(_without_spikes(region))
         covered = shapely.union(covered, region)
     return regions, _without_spikes(shapely.difference(polygons, covered))
+
+
+def distances_to_area(polygons: np.ndarray, edges: Edges, minimum: np.ndarray, maximum: np.ndarray,
+                      moving: np.ndarray, area: np.ndarray) -> np.ndarray:
+    """The distances (E,) of CityEngine's ``setbackToArea``: each ``moving`` edge (E,) bool at its
+    ``minimum`` (E,) plus an offset common to its polygon, capped at its ``maximum`` (E,), the offset
+    chosen so that the remainder of ``setback_regions`` has ``area`` (m,) (the others stay).
+
+    The remainder's area falls as the offset grows, so the offset is bracketed between 0 and the
+    polygon's diagonal past its largest minimum (where nothing is left) and found by regula falsi with the
+    Illinois step, to a billionth of the area. Where no offset reaches the area the nearest end is taken:
+    0 when the polygon is smaller (or its minimums leave less), the bracket's end when the maximums leave
+    more. Each polygon iterates on its own, so its distances do not depend on the others of the batch.
+    """
+    m, poly = len(polygons), edges.poly
+    if not m:
+        return np.zeros(0)
+    low, high = shapely.bounds(polygons).reshape(m, 2, 2).transpose(1, 0, 2)
+    top = np.hypot(*(high - low).T)
+    np.maximum.at(top, poly, top[poly] + np.where(moving, np.abs(minimum), 0.0))
+    owner = np.where(moving, 0, 1)
+    tolerance = 1e-9 * np.maximum(area, 1.0)
+
+    def excess(offset, rows):
+        """The remainder's area over the target (k,) of the polygons ``rows`` (k,) at ``offset`` (k,)."""
+        chosen = np.zeros(m, dtype=bool)
+        chosen[rows] = True
+        sub, sub_edges = _edges_of(edges, chosen)
+        d = np.minimum(minimum[sub] + offset[sub_edges.poly], maximum[sub])
+        _, remainder = setback_regions(polygons[rows], sub_edges, d, owner[sub], 1)
+        return shapely.area(remainder) - area[rows]
+
+    everything = np.arange(m)
+    lo, hi = np.zeros(m), top.copy()
+    f_lo, f_hi = excess(lo, everything), excess(hi, everything)
+    offset = np.where(f_lo <= tolerance, 0.0, hi)
+    active = (f_lo > tolerance) & (f_hi < -tolerance)
+    side = np.zeros(m, dtype=np.int64)  # which end the last step replaced: -1 low, 1 high
+    for _ in range(_AREA_STEPS):
+        rows = np.flatnonzero(active)
+        if not len(rows):
+            break
+        a, b, fa, fb = lo[rows], hi[rows], f_lo[rows], f_hi[rows]
+        c = (a * fb - b * fa) / (fb - fa)
+        c = np.where((c > a) & (c < b), c, 0.5 * (a + b))
+        fc = excess(c, rows)
+        offset[rows] = c
+        below = fc > 0  # too much left: the offset goes up
+        lo[rows] = np.where(below, c, a)
+        f_lo[rows] = np.where(below, fc, fa * np.where(~below & (side[rows] == 1), 0.5, 1.0))
+        hi[rows] = np.where(below, b, c)
+        f_hi[rows] = np.where(below, fb * np.where(side[rows] == -1, 0.5, 1.0), fc)
+        side[rows] = np.where(below, -1, 1)
+        active[rows] = (np.abs(fc) > tolerance[rows]) & (hi[rows] - lo[rows] > 1e-12 * top[rows])
+    return np.where(moving, np.minimum(minimum + offset[poly], maximum), 0.0)
+
+
+def _edges_of(edges: Edges, chosen: np.ndarray) -> tuple[np.ndarray, Edges]:
+    """The edges (k,) of the polygons ``chosen`` (m,) bool, and they as ``Edges`` of those polygons alone."""
+    keep = np.flatnonzero(chosen[edges.poly])
+    renumber = np.full(len(edges.poly), -1, dtype=np.int64)
+    renumber[keep] = np.arange(len(keep))
+    polygon = np.cumsum(chosen) - 1
+    return keep, Edges(edges.start[keep], edges.end[keep], edges.inward[keep], polygon[edges.poly[keep]],
+                       renumber[edges.prev[keep]], renumber[edges.next[keep]])
 
 
 def _without_spikes(geometries: np.ndarray) -> np.ndarray:
@@ -121,7 +188,7 @@ def _mitres(edges: Edges, d: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return np.where(too_far[:, None], straight, corner), ~too_far
 
 
-def _union_by_group(geometries: np.ndarray, group: np.ndarray, n_groups: int) -> np.ndarray:
+def union_by_group(geometries: np.ndarray, group: np.ndarray, n_groups: int) -> np.ndarray:
     """The union of the geometries of each group (n_groups,), empty where a group has none."""
     rank = rank_within(group)
     grid = np.full((n_groups, int(rank.max(initial=0)) + 1), None, dtype=object)

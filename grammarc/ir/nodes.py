@@ -967,12 +967,76 @@ class NormalizeUV:
     mode: str
     span: Span = NO_SPAN
 
+@dataclass(frozen=True, slots=True)
+class SetbackToArea:
+    """CityEngine ``setbackToArea(area[, minDistances[, maxDistances]]) { sel: A | remainder: B }``: a
+    ``setback`` whose distances are found so that the remainder has ``area``. Every edge a part selects
+    moves by its minimum plus one offset common to the face, capped at its maximum (``minimum`` and
+    ``maximum`` are evaluated per edge, as ``Setback.distances`` are with ``per_edge``: 0 and no cap
+    where none is given); edges no part selects stay. Where no offset reaches the area the nearest one is
+    taken: none when the face is already smaller (or the minimums take more), all the way to the maximums
+    when they leave more."""
+
+    area: Expr = child(Type.NUM, "an area")
+    minimum: tuple[tuple[str, Expr], ...] = child(Type.NUM, "a setback distance")
+    maximum: tuple[tuple[str, Expr], ...] = child(Type.NUM, "a setback distance")
+    selectors: tuple[str, ...]
+    parts: tuple[Body, ...] = child(holds=Holds.BODIES)
+    span: Span = NO_SPAN
+    site: int = 0
+
+
+@dataclass(frozen=True, slots=True)
+class Taper:
+    """CityEngine ``taper(height)``: the face becomes a pyramid, its apex ``height`` along the face's normal
+    over the face's centre of gravity, its scope's y along that normal."""
+
+    height: Expr = child(Type.NUM, "a taper height")
+    span: Span = NO_SPAN
+
+
+@dataclass(frozen=True, slots=True)
+class ResetGeometry:
+    """CityEngine ``resetGeometry()``: the shape's geometry, scope and pivot become its lot's initial shape's
+    again and its trim planes go; its attributes (colour, material, texture space, ``set`` values) stay."""
+
+    span: Span = NO_SPAN
+
+
+@dataclass(frozen=True, slots=True)
+class AlignScopeToBBox:
+    """CityEngine ``alignScopeToGeometryBBox(xz|zx|xy|yx|yz|zy)``: the scope turned about its third axis so
+    that the two named span the smallest rectangle around the geometry seen along that axis, the first
+    (``axes[0]``, a scope axis number) along its longer side."""
+
+    axes: tuple[int, int]
+    span: Span = NO_SPAN
+
+
+@dataclass(frozen=True, slots=True)
+class Footprint:
+    """CityEngine ``footprint()``: the shape's geometry projected along its scope's y onto the plane y = 0
+    of its scope, a flat geometry."""
+
+    span: Span = NO_SPAN
+
+
+@dataclass(frozen=True, slots=True)
+class Rectify:
+    """CityEngine ``rectify(angle)``: a face's edges within ``angle`` degrees of one of its scope axes made
+    parallel to it (``geometry.rectify``)."""
+
+    angle: Expr = child(Type.NUM, "an angle")
+    span: Span = NO_SPAN
+
+
 Op = (Symbol | Empty | Translate | Scale | Rotate | Push | Pop | Insert | Split | Repeat | Comp | Extrude
       | Center | UseAsset | Case | Stochastic | SetAttr | Report | NotApplied | GroupSplit | CompFaces
       | AlignScope | Mirror | Offset | SetColor | Setback | Roof | InnerRectangle | Convexify
       | CleanupGeometry | DeleteHoles | Snap | Label | Transform | Scatter | AlignToGeometry | Primitive
       | Trim | SplitArea | ReduceGeometry | MirrorScope | SetOpacity | SetupProjection | ProjectUV | TransformUV
-      | TileUV | NormalizeUV)
+      | TileUV | NormalizeUV | SetbackToArea | Taper | ResetGeometry | AlignScopeToBBox
+      | Footprint | Rectify)
 Body = tuple[Op, ...]
 
 

@@ -132,6 +132,12 @@ def _setback(op: ir.Setback) -> str:
     return f"setback({moves}){_selected(op.selectors, op.parts)}"
 
 
+def _setback_to_area(op: ir.SetbackToArea) -> str:
+    bounds = "".join(f", comp(fe){{ {', '.join(f'{s}={print_expr(d)}' for s, d in side)} }}"
+                     for side in (op.minimum, op.maximum) if side)
+    return f"setbackToArea({print_expr(op.area)}{bounds}){_selected(op.selectors, op.parts)}"
+
+
 #: The axes of a snap plane, by the scope axis across it.
 _SNAP_AXES = {0: "Y", 1: "XZ", 2: "XY"}
 
@@ -177,6 +183,8 @@ _OP_FORMATS = {
     ir.CompFaces: lambda op: ((f"offset({print_expr(op.offset)}) " if op.offset is not None else "")
                               + f"comp({op.kind}){_selected(comp_selectors(op), op.parts)}"),
     ir.Setback: _setback,
+    ir.SetbackToArea: _setback_to_area,
+    ir.AlignScopeToBBox: lambda op: f"alignScopeToGeometryBBox({''.join('xyz'[a] for a in op.axes)})",
     ir.Case: _branches,
     ir.Stochastic: _branches,
     ir.Extrude: lambda op: ("extrude(" + ("" if op.direction == "face.normal" else f"{op.direction}, ")

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from grammarc.geometry.align import EDGE_MODES, FACE_MODES, aligned_axes, pick_edges
+from grammarc.geometry.align import EDGE_MODES, FACE_MODES, aligned_axes, bbox_turns, pick_edges
 
 # Shape 0: a 2 x 2 square on the ground (area 4, facing up) and a 3 x 1 upright quad between y = 1 and 2
 # (area 3, facing +z); shape 1 has no faces.
@@ -58,3 +58,14 @@ def test_aligned_axes_make_x_orthogonal_to_the_normal():
     assert ok.all()
     np.testing.assert_allclose(axes[0] @ axes[0].T, np.eye(3), atol=1e-12)
     assert np.linalg.det(axes[0]) == pytest.approx(1)
+
+
+def test_bbox_turns_onto_the_longer_side_of_the_smallest_rectangle():
+    """A 10 x 4 rectangle turned by 30 degrees, its points in any order: the first axis turns by 30 (not
+    by -150: the nearer sense); a line of points gives its line; one point none."""
+    c, s = np.cos(np.radians(30)), np.sin(np.radians(30))
+    box = np.array([[0, 0], [10, 0], [10, 4], [0, 4], [5, 2]], float) @ np.array([[c, s], [-s, c]])
+    points = np.concatenate([box[::-1], [[0, 0], [0, 3], [0, 1]], [[7, 7]]])
+    turn, ok = bbox_turns(points, np.array([0] * 5 + [1] * 3 + [2]), 3)
+    np.testing.assert_allclose(turn[:2], [[c, s], [0, 1]], atol=1e-9)
+    assert ok.tolist() == [True, True, False]

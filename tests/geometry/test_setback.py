@@ -8,7 +8,7 @@ import shapely
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from grammarc.geometry.setback import polygon_edges, setback_regions
+from grammarc.geometry.setback import distances_to_area, polygon_edges, setback_regions
 
 L_SHAPE = shapely.Polygon([(0, 0), (30, 0), (30, 10), (10, 10), (10, 20), (0, 20)])
 COURTYARD = shapely.Polygon([(0, 0), (40, 0), (40, 40), (0, 40)], [[(10, 10), (10, 30), (30, 30), (30, 10)]])
@@ -108,3 +108,21 @@ def test_remainder_shrinks_as_the_distance_grows(seed, d, factor):
     _, near = setback([polygon], d)
     _, far = setback([polygon], d * factor)
     assert shapely.area(far[0]) <= shapely.area(near[0]) + 1e-6 * polygon.area
+
+
+def test_distances_to_area_of_each_polygon_leave_its_area_whatever_the_batch():
+    """Each polygon finds its own offset: the remainders have the areas asked, alone or in a batch; a target
+    above a polygon's area moves nothing, and capped distances stop at their caps."""
+    polygons = np.array([L_SHAPE, COURTYARD, shapely.box(0, 0, 30, 20), shapely.box(0, 0, 10, 10)], dtype=object)
+    edges = polygon_edges(polygons)
+    e = len(edges.poly)
+    target = np.array([150.0, 700.0, 123.0, 500.0])
+    cap = np.where(edges.poly == 2, 2.0, np.inf)
+    d = distances_to_area(polygons, edges, np.zeros(e), cap, np.ones(e, dtype=bool), target)
+    _, remainder = setback_regions(polygons, edges, d, np.zeros(e, dtype=np.int64), 1)
+    np.testing.assert_allclose(shapely.area(remainder), [150, 700, 26 * 16, 100], rtol=1e-7)
+    for k in range(len(polygons)):
+        alone = polygon_edges(polygons[k:k + 1])
+        mine = edges.poly == k
+        np.testing.assert_array_equal(distances_to_area(polygons[k:k + 1], alone, np.zeros(mine.sum()), cap[mine],
+                                                        np.ones(mine.sum(), dtype=bool), target[k:k + 1]), d[mine])

@@ -10,7 +10,8 @@ columns:
 - ``scope``: ``T S R``, ``extrude``, the scope alignments, ``mirror``, ``center``;
 - ``splits``: ``Subdiv``/``Repeat``, CityEngine's ``split``, ``Snap``;
 - ``component_splits``: ``Comp``, ``comp(f|e|v)``;
-- ``faces``: ``offset``, ``setback``, ``innerRectangle``, ``convexify``, roofs, ``cleanupGeometry``;
+- ``faces``: ``offset``, ``setback``, ``setbackToArea``, ``innerRectangle``, ``convexify``, roofs, ``taper``,
+  ``cleanupGeometry``;
 - ``inserts``: ``I``, ``i``, ``label``;
 - ``primitives``: CityEngine's ``primitiveCube/Quad/Disk/Cylinder/Sphere/Cone``;
 - ``successors``: successor symbols, ``ε``/``NIL`` and operations without effect;
@@ -19,7 +20,8 @@ columns:
 - ``scatter``: ``scatter``, point shapes on, in or around the shape;
 - ``texture``: ``setupProjection``, ``projectUV`` and the other operations on texture coordinates.
 - ``trims``: ``trim()``, the shape's geometry cut by its trim planes;
-- ``simplify``: ``reduceGeometry``, polygons with fewer vertices.
+- ``simplify``: ``reduceGeometry``, polygons with fewer vertices;
+- ``reset``: ``resetGeometry``, the lot's initial shape again.
 
 A new operation is its IR node, its lowering and its function here: importing this package registers them.
 """
@@ -30,6 +32,7 @@ from grammarc.backend.operations import (  # noqa: F401 - each registers its ope
     faces,
     inserts,
     primitives,
+    reset,
     scatter,
     scope,
     simplify,

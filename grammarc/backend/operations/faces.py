@@ -1,14 +1,15 @@
-"""Operations on the outlines of faces: ``offset``, ``setback`` and ``shapeL/U/O``, ``innerRectangle``,
-``convexify``, the roofs, ``cleanupGeometry`` (and ``comp(f)`` after an ``offset``, for
-``operations.component_splits``).
+"""Operations on the outlines of faces: ``offset``, ``setback``, ``setbackPerEdge``, ``setbackToArea`` and
+``shapeL/U/O``, ``innerRectangle``, ``convexify``, the roofs and ``taper``, ``footprint``, ``rectify``,
+``cleanupGeometry`` (and ``comp(f)`` after an ``offset``, for ``operations.component_splits``).
 
 They share one pattern: the batch's faces as shapely polygons in their scopes' units (``face_polygons``), one
 vectorized geometry step, then the pieces back as shapes (``Parts`` for the bodies of ``setback`` and
 ``innerRectangle``) or the face's geometry replaced (a mesh of pieces, a roof: ``backend.mesh_shapes``).
 Reads: the scope (``origin``, ``size``, ``frame``), ``geom``, ``lot`` (street selectors), and what their
-expressions read. Writes: the roofs ``origin``, ``size`` and ``geom``; ``convexify`` and ``cleanupGeometry``
-the ``geom``; ``offset`` every column, as it makes the shapes of its pieces anew (new keys; a face with no
-piece left goes). ``offset`` also takes a shape of several faces in one plane (a mesh of an earlier offset's
+expressions read. Writes: the roofs ``origin``, ``size`` and ``geom`` (``taper`` the ``frame`` too: its y
+turns to the face's normal); ``convexify`` and ``cleanupGeometry`` the ``geom``; ``offset``, ``footprint``
+and ``rectify`` every column, as they make the shapes of their pieces anew (new keys; a shape with no piece
+left goes). ``offset`` also takes a shape of several faces in one plane (a mesh of an earlier offset's
 pieces or of convexify's parts) and offsets each face.
 """
 
@@ -27,6 +28,7 @@ from grammarc.backend.kernels.order import group_by
 from grammarc.backend.operations.table import Parts, operation
 from grammarc.backend.outlines import flat_axis, polygons_of
 from grammarc.backend.random import child_keys
+from grammarc.backend.reframing import turned
 from grammarc.backend.selectors import classify_faces, selector_frames
 from grammarc.backend.shapes import COLUMNS, Shapes
 from grammarc.constants import TOL
@@ -36,10 +38,15 @@ from grammarc.geometry.convexify import convex_parts
 from grammarc.geometry.inner_rectangle import largest_rectangles
 from grammarc.geometry.meshes import MESH_BASE, is_mesh, is_polygon
 from grammarc.geometry.polygons import PLANE_U, PLANE_V, plane_to_scope
+from grammarc.geometry.projection import projected_outlines
+from grammarc.geometry.queries import shape_faces
+from grammarc.geometry.rectify import rectified
+from grammarc.geometry.reframe import NORMAL_UP
 from grammarc.geometry.ridges import ridge_roofs
-from grammarc.geometry.setback import polygon_edges, setback_regions
+from grammarc.geometry.roofs import PYRAMID, roof_meshes
+from grammarc.geometry.setback import distances_to_area, polygon_edges, setback_regions
 from grammarc.ir import nodes as ir
-from grammarc.ragged import ragged_take, rank_within
+from grammarc.ragged import ragged_take, rank_within, segment_of
 
 
 @operation(ir.Roof, writes=("origin", "size", "geom"))
@@ -134,6 +141,45 @@ def _ridge_roofs(ctx: Context, cursor: Shapes, op: ir.Roof, ridge: np.ndarray, v
     return Shapes.merge([roofed, gables], [rows, others]), failed
 
 
+@operation(ir.Taper, writes=("origin", "size", "frame", "geom"))
+def taper(ctx: Context, cursor: Shapes, op: ir.Taper) -> Shapes:
+    """``taper(height)``: each face becomes a pyramid, a triangle from each edge of its outline to the apex
+    ``height`` along the face's normal over the face's centre of gravity (holes stay in the bottom face, as
+    roofPyramid's, which lifts the vertices' average instead). The scope fits the pyramid, its x as it was
+    (projected into the face's plane), its y along the normal (``NORMAL_UP``, as ``extrude``'s); a negative
+    height tapers behind the face, the scope's sizes staying positive as every scope's does in grammarc. A
+    height of 0 leaves the face."""
+    n = len(cursor)
+    height = np.ascontiguousarray(np.broadcast_to(np.asarray(evaluate_array(op.height, ctx.env(cursor)), float),
+                                                  (n,)))
+    bad = ~np.isfinite(height)
+    if bad.any():
+        ctx.fail(cursor, bad, "`taper` with a height that is not finite", op.span)
+    polygons, plane = face_polygons(ctx, cursor, "taper", op.span)
+    rows = np.flatnonzero(np.abs(height) > TOL.zero)
+    sub, face = cursor.take(rows), plane[rows]
+    coords, ring_offsets, shape_offsets, _ = polygons_of(ctx.chunk, sub)
+    # behind the face: the pyramid of the face mirrored in u, turned a half turn about v (so its faces
+    # still face out)
+    behind = height[rows] < 0
+    mirror = np.where(behind[segment_of(shape_offsets)[segment_of(ring_offsets)]], -1.0, 1.0)
+    coords = np.column_stack([coords[:, 0] * mirror, coords[:, 1]])
+    k = np.arange(len(rows))
+    verts, rings, faces, meshes, _ = roof_meshes(
+        PYRAMID, coords, ring_offsets, shape_offsets, face.astype(np.int8), sub.size[k, PLANE_U[face]],
+        sub.size[k, PLANE_V[face]], np.abs(height[rows]), True, np.zeros(len(rows)),
+        np.zeros(len(rows), dtype=np.int64), np.full(len(rows), np.inf))
+    owner = segment_of(meshes)[segment_of(faces)[segment_of(rings)]]
+    verts[behind[owner]] *= np.array([-1.0, 1.0, -1.0])
+    apex = verts[:, 2] != 0
+    verts[apex, :2] = shapely.get_coordinates(shapely.centroid(polygons[rows]))[owner[apex]]
+    tapered = mesh_shapes.roof_shapes(ctx.chunk, sub, face, verts, rings, faces, meshes)
+    # y along the normal, x kept where it can be, as extrude turns a face's scope
+    tapered = turned(ctx, tapered, face != 1, NORMAL_UP, face, op.span)
+    kept = np.setdiff1d(np.arange(n), rows)
+    return Shapes.merge([cursor.take(kept), tapered], [kept, rows])
+
+
 @operation(ir.Offset, writes=COLUMNS, meshes=True)
 def offset(ctx: Context, cursor: Shapes, op: ir.Offset) -> Shapes:
     """``offset(d, inside|border|all)``: the shape's face becomes its inset, the ring around it, or both
@@ -149,6 +195,41 @@ def offset(ctx: Context, cursor: Shapes, op: ir.Offset) -> Shapes:
     else:
         inside, border = _offset_pieces(ctx, op.distance, cursor, op.span)
         pieces = inside if op.select == "inside" else border
+    return _shape_each(ctx, cursor, pieces)
+
+
+@operation(ir.Footprint, writes=COLUMNS, meshes=True)
+def footprint(ctx: Context, cursor: Shapes, op: ir.Footprint) -> Shapes:
+    """``footprint()``: each shape's geometry seen along its scope's y, flat in the plane y = 0 of its
+    scope (``geometry.projection``): a polygon, or a mesh of its parts where it falls apart, in a scope
+    fitted to it (x and z as they were). An inserted asset is its scope box here, as for ``geometry.area``;
+    a shape whose geometry covers no area seen from above (a wall) is left out, as ``offset`` leaves out a
+    face with nothing left."""
+    faces = shape_faces(cursor.size, cursor.geom, ctx.chunk.polygons, ctx.chunk.meshes)
+    outlines = projected_outlines(faces.verts[:, [0, 2]], faces.ring_offsets, faces.face_offsets,
+                                  faces.face_shape(), len(cursor))
+    flat = cursor.with_scope(cursor.origin, cursor.size * [1.0, 0.0, 1.0], cursor.frame, cursor.geom)
+    return _shape_each(ctx, flat, fit_pieces(outlines, np.ones(len(cursor), dtype=np.int8), flat.size))
+
+
+@operation(ir.Rectify, writes=COLUMNS)
+def rectify(ctx: Context, cursor: Shapes, op: ir.Rectify) -> Shapes:
+    """``rectify(angle)``: each face's edges within ``angle`` degrees (the reference's range [0, 45]; others
+    are taken as its nearer end) of one of the face's scope axes made parallel to it
+    (``geometry.rectify``), in a scope fitted to the result; a face that falls apart becomes a mesh of its
+    parts, as an offset's does, and one with nothing left goes."""
+    angle = np.clip(np.broadcast_to(np.asarray(evaluate_array(op.angle, ctx.env(cursor)), float), (len(cursor),)),
+                    0.0, 45.0)
+    bad = np.isnan(angle)
+    if bad.any():
+        ctx.fail(cursor, bad, "`rectify` with an angle that is not a number", op.span)
+    polygons, plane = face_polygons(ctx, cursor, "rectify", op.span)
+    return _shape_each(ctx, cursor, fit_pieces(rectified(polygons, angle), plane, cursor.size, polygons))
+
+
+def _shape_each(ctx: Context, cursor: Shapes, pieces) -> Shapes:
+    """A shape for each row of ``cursor`` with ``pieces`` (``geometry.clip.Clipped``): its one piece, or a
+    mesh of its several in one fitted scope."""
     several = np.bincount(pieces.source, minlength=len(cursor)) > 1
     if not several.any():
         return _piece_shapes(ctx, cursor, pieces, 0)
@@ -183,30 +264,66 @@ def offset_faces(ctx: Context, cursor: Shapes, op: ir.CompFaces) -> Parts:
 @operation(ir.Setback, consumes=True)
 def setback(ctx: Context, cursor: Shapes, op: ir.Setback) -> Parts:
     """``setback`` and ``shapeL/U/O``: the face's edge strips and its remainder to their parts."""
-    polygons, plane = face_polygons(ctx, cursor, "setback", op.span)
-    edges = polygon_edges(polygons)
-    m = len(cursor)
-    normal = plane_to_scope(-edges.inward, plane[edges.poly])
-    frames = selector_frames(ctx.chunk, normal, cursor, edges.poly, (*op.selectors, *(s for s, _ in op.distances)),
-                             _world_points(ctx, cursor, edges.poly, plane, (edges.start, edges.end)))
-    # distances per face, or per edge (setback(comp(fe){...}): each edge is comp.index of comp.total)
-    if op.per_edge:
-        index = rank_within(edges.poly)
-        shapes = with_context(ctx.plan, cursor.take(edges.poly), "comp", index, edges.poly, m)
-        column = np.arange(len(edges.poly))
-    else:
-        shapes, column = cursor, edges.poly
-    env = ctx.env(shapes)
-    table = np.zeros((len(op.distances) + 1, len(shapes)))
-    for k, (_, expr) in enumerate(op.distances):
-        table[k] = evaluate_array(expr, env)
-    distance = table[classify_faces(normal, tuple(s for s, _ in op.distances), frames), column]
-    owners = tuple(s for s in op.selectors if s != "remainder")
-    regions, remainder = setback_regions(polygons, edges, distance,
-                                         classify_faces(normal, owners, frames), len(owners))
-    by_owner = dict(zip(owners, regions))
-    return _regions(ctx, op, cursor, [by_owner[s] if s != "remainder" else remainder for s in op.selectors],
-                    plane, polygons)
+    face = _SetbackFaces(ctx, cursor, op, "setback", (*op.selectors, *(s for s, _ in op.distances)))
+    distance = face.distances(ctx, cursor, op.distances, op.per_edge, 0.0)
+    return face.parts(ctx, cursor, op, distance)
+
+
+@operation(ir.SetbackToArea, consumes=True)
+def setback_to_area(ctx: Context, cursor: Shapes, op: ir.SetbackToArea) -> Parts:
+    """``setbackToArea``: the setback of the selected edges whose remainder has the area asked
+    (``geometry.setback.distances_to_area``), its strips and remainder to the parts as ``setback``'s."""
+    names = (*op.selectors, *(s for s, _ in op.minimum), *(s for s, _ in op.maximum))
+    face = _SetbackFaces(ctx, cursor, op, "setbackToArea", names)
+    area = np.broadcast_to(np.asarray(evaluate_array(op.area, ctx.env(cursor)), float), (len(cursor),))
+    bad = ~(area > 0) | ~np.isfinite(area)
+    if bad.any():
+        ctx.fail(cursor, bad, "`setbackToArea` with an area that is not a positive number", op.span)
+    minimum = face.distances(ctx, cursor, op.minimum, True, 0.0)
+    maximum = face.distances(ctx, cursor, op.maximum, True, np.inf)
+    moving = face.owner < len(face.owners)
+    distance = distances_to_area(face.polygons, face.edges, np.where(moving, minimum, 0.0), maximum, moving,
+                                 area)
+    return face.parts(ctx, cursor, op, distance)
+
+
+class _SetbackFaces:
+    """What ``setback`` and ``setbackToArea`` find of a batch of faces: their polygons and planes, their
+    edges (``geometry.setback.Edges``) with their normals and the frames of the selectors ``names``, and
+    the part (``owners``) each edge's strip goes to (``owner``, len(owners) for none)."""
+
+    def __init__(self, ctx: Context, cursor: Shapes, op: ir.Setback | ir.SetbackToArea, what: str,
+                 names: tuple[str, ...]):
+        self.polygons, self.plane = face_polygons(ctx, cursor, what, op.span)
+        self.edges = edges = polygon_edges(self.polygons)
+        self.normal = plane_to_scope(-edges.inward, self.plane[edges.poly])
+        self.frames = selector_frames(ctx.chunk, self.normal, cursor, edges.poly, names,
+                                      _world_points(ctx, cursor, edges.poly, self.plane, (edges.start, edges.end)))
+        self.owners = tuple(s for s in op.selectors if s != "remainder")
+        self.owner = classify_faces(self.normal, self.owners, self.frames)
+
+    def distances(self, ctx: Context, cursor: Shapes, distances, per_edge: bool, fill: float) -> np.ndarray:
+        """(E,) each edge's distance: that of the first selector of ``distances`` (pairs of a selector and
+        an expression) it matches, ``fill`` where none does; the expressions evaluated per face, or per
+        edge (``comp.index`` of ``comp.total`` in the face's edges)."""
+        poly = self.edges.poly
+        if per_edge:
+            shapes = with_context(ctx.plan, cursor.take(poly), "comp", rank_within(poly), poly, len(cursor))
+            column = np.arange(len(poly))
+        else:
+            shapes, column = cursor, poly
+        env = ctx.env(shapes)
+        table = np.full((len(distances) + 1, len(shapes)), fill)
+        for k, (_, expr) in enumerate(distances):
+            table[k] = evaluate_array(expr, env)
+        return table[classify_faces(self.normal, tuple(s for s, _ in distances), self.frames), column]
+
+    def parts(self, ctx: Context, cursor: Shapes, op, distance: np.ndarray) -> Parts:
+        """The parts of ``op`` on the strips of the edges moved by ``distance`` (E,) and the remainder."""
+        regions, remainder = setback_regions(self.polygons, self.edges, distance, self.owner, len(self.owners))
+        by_owner = dict(zip(self.owners, regions))
+        return _regions(ctx, op, cursor, [by_owner[s] if s != "remainder" else remainder for s in op.selectors],
+                        self.plane, self.polygons)
 
 
 @operation(ir.InnerRectangle, consumes=True)
@@ -366,7 +483,7 @@ def _piece_shapes(ctx: Context, cursor: Shapes, pieces, site: int) -> Shapes:
                   child_keys(child.key, site, index), child.depth, child.params, child.dynamic)
 
 
-def _regions(ctx: Context, op: ir.Setback | ir.InnerRectangle, cursor: Shapes, regions: list, plane,
+def _regions(ctx: Context, op: ir.Setback | ir.SetbackToArea | ir.InnerRectangle, cursor: Shapes, regions: list, plane,
              polygons) -> Parts:
     """Part k of ``op`` on the pieces of ``regions[k]`` (n,) (polygons in the shapes' scope units, cut
     from ``polygons``), each parent's pieces together, numbered in stream ``op.site`` part by part."""

@@ -28,7 +28,7 @@ from grammarc.backend.reframing import reframed, turned
 from grammarc.backend.shapes import Shapes, asset_geom, asset_of
 from grammarc.constants import TOL
 from grammarc.geometry import components as comp_kernels
-from grammarc.geometry.align import EDGE_MODES, FACE_MODES, aligned_axes, pick_edges
+from grammarc.geometry.align import EDGE_MODES, FACE_MODES, aligned_axes, bbox_turns, pick_edges
 from grammarc.geometry.clip import oriented_rings, scope_polygons
 from grammarc.geometry.extrusion import extruded_meshes
 from grammarc.geometry.meshes import MESH_BASE, face_vertices, is_mesh, is_polygon, ring_vector_areas
@@ -352,6 +352,25 @@ def align_to_geometry(ctx: Context, cursor: Shapes, op: ir.AlignToGeometry) -> S
         return reframed(ctx, cursor, new_axes, op.span)
     # no face with an area, or no edge with a length (a line, a point, a degenerate face): the scope stays,
     # as CityEngine leaves it rather than stopping the model
+    rows, others = np.flatnonzero(ok), np.flatnonzero(~ok)
+    return Shapes.merge([reframed(ctx, cursor.take(rows), new_axes[rows], op.span), cursor.take(others)],
+                        [rows, others])
+
+
+@operation(ir.AlignScopeToBBox, writes=_SCOPE, meshes=True)
+def align_scope_to_bbox(ctx: Context, cursor: Shapes, op: ir.AlignScopeToBBox) -> Shapes:
+    """``alignScopeToGeometryBBox``: each scope turned about its third axis so that the first of ``op.axes``
+    runs along the longer side of the smallest rectangle around the geometry's vertices seen along that
+    axis (``geometry.align.bbox_turns``), the nearer of its two senses; then fitted to the geometry. A shape
+    whose vertices all lie on that axis keeps its scope. The pivot is the scope's origin in CityEngine;
+    grammarc applies no pivot."""
+    a, b = op.axes
+    faces = shape_faces(cursor.size, cursor.geom, ctx.chunk.polygons, ctx.chunk.meshes)
+    turn, ok = bbox_turns(faces.verts[:, [a, b]], faces.vertex_shape(), len(cursor))
+    axes = ctx.chunk.frames[cursor.frame]
+    new_axes = axes.copy()
+    new_axes[:, a] = turn[:, :1] * axes[:, a] + turn[:, 1:] * axes[:, b]
+    new_axes[:, b] = turn[:, :1] * axes[:, b] - turn[:, 1:] * axes[:, a]
     rows, others = np.flatnonzero(ok), np.flatnonzero(~ok)
     return Shapes.merge([reframed(ctx, cursor.take(rows), new_axes[rows], op.span), cursor.take(others)],
                         [rows, others])

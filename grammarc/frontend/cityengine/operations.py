@@ -367,6 +367,56 @@ class OperationLowering:
             distances = tuple((s, exprs[0]) for s in selectors if s != "remainder")
         return ir.Setback(distances, selectors, chosen[1], span, self.site())
 
+    def op_setback_per_edge(self, op, args, parts, span):
+        """``setbackPerEdge(d[, uvSet]) { ... }``: the reference's shortcut for ``setback(comp(fe){ all: d
+        }) { ... }``, ``d`` evaluated for each edge. ``uvSet`` only matters to the uv selectors, which
+        grammarc's setbacks do not have: it is read and has no effect."""
+        if not self.arity(op, args, (1, 2), span):
+            return ir.Empty(span)
+        chosen = self.selector_parts(op, parts, SETBACK_SELECTORS)
+        if chosen is None:
+            return ir.Empty(span)
+        return ir.Setback((("all", self.expr(args[0])),), chosen[0], chosen[1], span, self.site(), per_edge=True)
+
+    def op_setback_to_area(self, op, args, parts, span):
+        """``setbackToArea(area[, minDistances[, maxDistances]][, uvSet]) { ... }``. A distance list is an
+        array (``[2, 0, 1]``: edge ``comp.index`` takes its element; a minimum past its end is 0, a maximum
+        none) or ``comp(fe){ sel: d | ... }``. The reference tells ``uvSet`` from a list only by its type:
+        a number written as such after the lists is ``uvSet`` (read, without effect as in
+        ``setbackPerEdge``), any other expression a list."""
+        if args and len(args) > 1 and isinstance(args[-1], ir.Num):
+            args = args[:-1]
+        if not self.arity(op, args, (1, 2, 3), span):
+            return ir.Empty(span)
+        chosen = self.selector_parts(op, parts, SETBACK_SELECTORS)
+        if chosen is None:
+            return ir.Empty(span)
+        index = ir.ContextRef("comp.index", span)
+        lists = []
+        for k, arg in enumerate(args[1:]):
+            if isinstance(arg, EdgeDistances):
+                lists.append(arg.values)
+                continue
+            array = self.expr(arg)
+            element = ir.Index(array, index, span=span)
+            if k == 1:  # past the end of the maximums: no cap
+                inside = ir.Binary("<", index, ir.Call("size", (array,), span, self.site()), span)
+                element = ir.Select(inside, element, ir.Num(float("inf"), span), span)
+            lists.append((("all", element),))
+        minimum, maximum = (*lists, (), ())[:2]
+        return ir.SetbackToArea(self.expr(args[0]), minimum, maximum, chosen[0], chosen[1], span, self.site())
+
+    def op_align_scope_to_bbox(self, op, args, span):
+        """``alignScopeToGeometryBBox(alignAxes)``, the two scope axes it turns (``xz``: x along the longer
+        side, z across it, about y)."""
+        if not self.arity(op, args, (1,), span):
+            return ir.Empty(span)
+        axes = _selector(args[0])
+        if axes is None or len(axes) != 2 or set(axes) not in ({"x", "y"}, {"x", "z"}, {"y", "z"}):
+            return self.unsupported(f"{op} with these axes", getattr(args[0], "span", span),
+                                    "alignAxes is one of xy, yx, xz, zx, yz, zy")
+        return ir.AlignScopeToBBox(("xyz".index(axes[0]), "xyz".index(axes[1])), span)
+
     def op_setback_alone(self, op, args, span):
         """``setback(d)`` without parts (public files write it, as if it were an operation on its own):
         the reference knows only the form with parts, and a user who writes it means the face set back by
@@ -596,6 +646,11 @@ OPERATIONS = {
     "rotateUV": OperationLowering.op_transform_uv,
     "tileUV": OperationLowering.op_tile_uv,
     "normalizeUV": OperationLowering.op_normalize_uv,
+    "taper": direct(ir.Taper),
+    "resetGeometry": direct(ir.ResetGeometry),
+    "footprint": direct(ir.Footprint),
+    "rectify": direct(ir.Rectify),
+    "alignScopeToGeometryBBox": OperationLowering.op_align_scope_to_bbox,
 }
 #: Operations with parts ``{ ... }``: name -> handler(lowering, op, args, parts, span); those of ``REPEATING``
 #: also repeat (``{ ... }*``), with ``repeat=True``.
@@ -608,6 +663,8 @@ PART_OPERATIONS = {
     "shapeU": OperationLowering.op_setback,
     "shapeO": OperationLowering.op_setback,
     "innerRectangle": OperationLowering.op_inner_rectangle,
+    "setbackPerEdge": OperationLowering.op_setback_per_edge,
+    "setbackToArea": OperationLowering.op_setback_to_area,
 }
 REPEATING = frozenset({"split", "splitArea"})
 #: Operations with parts that may also come without them: name -> handler(lowering, op, args, span).
@@ -651,17 +708,20 @@ NOT_APPLIED = frozenset({
     "reverseNormals", "print", "setNormals", "softenNormals",
     # the pivot only moves the model's own origin in an export; scope.t* stay relative to the lot
     "setPivot",
+    # component tags name faces, edges and vertices for what reads them (inline, the boolean operations,
+    # geometry.hasTags and geometry.tags, tag selectors), each unsupported with its own error
+    "tag", "deleteTags", "setTagsFromEdgeAttrs",
 })
 #: CityEngine operations grammarc does not implement yet (the geometry and context issues bring most).
 #: With ``OPERATIONS``, ``PART_OPERATIONS`` and ``NOT_APPLIED`` they are every operation of CityEngine's
 #: CGA reference, so that any other name called with parts, or a typo of one of them, is unknown.
 UNSUPPORTED_OPS = frozenset({
     "innerPolygon",
-    "insertAlongUV", "footprint", "inline", "resetGeometry", "taper",
-    "rectify", "semiPolygon",
-    "alignScopeToGeometryBBox", "modify",
-    "setbackPerEdge", "setbackToArea", "splitAndSetbackPerimeter",
-    "tag", "deleteTags", "setTagsFromEdgeAttrs", "union", "subtract", "intersect",
+    "insertAlongUV", "inline",
+    "semiPolygon",
+    "modify",
+    "splitAndSetbackPerimeter",
+    "union", "subtract", "intersect",
     "copyUV", "setMaterial", "resetMaterial",
 } - NOT_APPLIED)
 #: Every operation name CityEngine knows: what a misspelt one is suggested from.

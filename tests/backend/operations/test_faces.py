@@ -176,3 +176,123 @@ def test_offset_of_a_roof_fails_its_lot_by_name(write):
     records = run(write, "Lot --> roofHip(30) offset(-1, inside) X.\n", [rect(10, 8)])
     (bad,) = records["bad"]
     assert bad.reason.startswith("`offset` of a roof is not supported yet (only of faces in one plane")
+
+
+def test_setback_per_edge_evaluates_its_distance_for_each_edge(write):
+    """The reference's example: distances from an array by ``comp.index`` (edges in the face's order: the
+    lot's front first, then right, back, left), the same as ``setback(comp(fe){ all : ... })``."""
+    text = ("const ds = [3, 2, 1, 0]\nd = ds[comp.index]\n"
+            "Lot --> setbackPerEdge(d){ all : A | remainder : R }\n" + AREA_REPORTS)
+    t = totals(run(write, text, [rect(30, 20)]))
+    assert (t["a_sum"], t["r_sum"]) == (pytest.approx(600 - 28 * 16), pytest.approx(28 * 16))
+    same = text.replace("setbackPerEdge(d)", "setback(comp(fe){ all : d })")
+    same_records(run(write, text, [rect(30, 20)]), run(write, same, [rect(30, 20)]))
+
+
+def test_setback_to_area_leaves_the_remainder_its_area(write):
+    """The reference's examples: a square of 400 m2 set back to 100 (the same distance all round: a
+    square of 10), an area to set back instead of one to keep, and an L whose front and left edges move."""
+    text = 'Lot --> setbackToArea(100){ all : NIL | remainder : Q }\nQ --> report("q", geometry.area) report("x", scope.sx)\n'
+    t = totals(run(write, text, [rect(20, 20)]))
+    assert t["q_sum"] == pytest.approx(100, rel=1e-8) and t["x_sum"] == pytest.approx(10)
+    t = totals(run(write, "Lot --> setbackToArea(geometry.area - 300){ all : A }\n" + AREA_REPORTS, [rect(30, 20)]))
+    assert t["a_sum"] == pytest.approx(300, rel=1e-8)
+    t = totals(run(write, "Lot --> setbackToArea(150){ front : A | left : B | remainder : R }\n" + AREA_REPORTS,
+                   [LOT_ZOO["concave_L"]]))
+    assert t["r_sum"] == pytest.approx(150, rel=1e-8) and t["a_sum"] + t["b_sum"] == pytest.approx(250, rel=1e-8)
+
+
+def test_setback_to_area_raises_the_minimums_by_one_offset_up_to_the_maximums(write):
+    """Front (edge 0) at least 4 (by index or by selector): front and back move 4 + c and c, c = 3 leaving
+    30 x 10. Maximums of 1 leave more than the area asked, as does a face smaller than it (nothing moves
+    but the minimums)."""
+    text = "Lot --> setbackToArea(300, [4, 0, 0, 0]){ front : F | back : B | remainder : R }\n" \
+        'F --> report("f", geometry.area)\nB --> report("b", geometry.area)\nR --> report("r", geometry.area)\n'
+    t = totals(run(write, text, [rect(30, 20)]))
+    assert (t["f_sum"], t["b_sum"], t["r_sum"]) == (pytest.approx(210), pytest.approx(90), pytest.approx(300))
+    by_selector = text.replace("[4, 0, 0, 0]", "comp(fe){ front : 4 | all : 0 }")
+    same_records(run(write, text, [rect(30, 20)]), run(write, by_selector, [rect(30, 20)]))
+    t = totals(run(write, text.replace("[4, 0, 0, 0]", "[0], [1, 0, 1]"), [rect(30, 20)]))
+    assert (t["f_sum"], t["b_sum"], t["r_sum"]) == (pytest.approx(30), pytest.approx(30), pytest.approx(540))
+    t = totals(run(write, text.replace("300, [4, 0, 0, 0]", "700"), [rect(30, 20)]))
+    assert (t.get("f_n", 0), t["r_sum"]) == (0, pytest.approx(600))
+
+
+def test_setback_to_area_of_a_solid_or_a_roof_fails_its_lot_by_name(write):
+    for body, reason in [("extrude(3) setbackToArea(10)", "`setbackToArea` of a solid is not supported yet"),
+                         ("roofHip(30) setbackToArea(10)", "`setbackToArea` of a roof is not supported yet"),
+                         ("setbackToArea(-1)", "`setbackToArea` with an area that is not a positive number")]:
+        (bad,) = run(write, f"Lot --> {body}{{ all : A | remainder : R }}\n", [rect(10, 8)])["bad"]
+        assert bad.reason.startswith(reason), bad.reason
+
+
+def test_taper_makes_a_pyramid_over_the_faces_centre_of_gravity(write):
+    """The reference's ``Lot --> taper(10)``: a pyramid of the lot's area times a third of its height; the
+    apex over the L's centre of gravity (12.5, 7.5), not its vertices' average (13.3, 10)."""
+    text = ('Lot --> taper(10) report("v", geometry.volume) report("y", scope.sy) comp(f){ bottom : B | all : S }\n'
+            'B --> report("b", geometry.area) B.\nS --> report("s", geometry.nVertices) S.\n')
+    r = run(write, text, [LOT_ZOO["concave_L"]])
+    t = totals(r)
+    assert (t["v_sum"], t["y_sum"], t["b_sum"]) == (pytest.approx(400 * 10 / 3), 10, pytest.approx(400))
+    assert (t["s_n"], t["s_sum"]) == (6, 18)
+    apex = r["mesh"].vertices[np.argmax(r["mesh"].vertices[:, 1])]
+    np.testing.assert_allclose(apex, [12.5, 10, -7.5], atol=1e-6)
+
+
+def test_taper_of_a_facade_rises_along_its_normal_into_the_scopes_y(write):
+    """The scope's x stays along the facade, its y turns to the facade's normal: a height of 2 is scope.sy.
+    A height of 0 leaves the face; a negative one tapers behind it."""
+    text = ('Lot --> extrude(10) comp(f){ front : F }\nF --> taper(h) report("x", scope.sx) '
+            'report("y", scope.sy) report("z", scope.sz) report("v", geometry.volume) F.\n')
+    for h, front, sizes in [(2, 2, (30, 2, 10)), (-2, 0, (30, 2, 10)), (0, 0, (30, 10, 0))]:
+        r = run(write, f"const h = {h}\n" + text, [rect(30, 20)])
+        t = totals(r)
+        assert (t["x_sum"], t["y_sum"], t["z_sum"]) == pytest.approx(sizes)
+        assert t["v_sum"] == pytest.approx(30 * 10 * abs(h) / 3)
+        if h:
+            assert r["mesh"].vertices[:, 2].max() == pytest.approx(front)
+
+
+def test_taper_of_a_solid_or_a_roof_fails_its_lot_by_name(write):
+    for body, reason in [("extrude(3) taper(1)", "`taper` of a solid is not supported yet"),
+                         ("roofHip(30) taper(1)", "`taper` of a roof is not supported yet")]:
+        (bad,) = run(write, f"Lot --> {body} X.\n", [rect(10, 8)])["bad"]
+        assert bad.reason.startswith(reason), bad.reason
+
+
+def test_footprint_is_the_geometry_seen_from_above(write):
+    """The reference's example extrudes the footprint of an inserted building again: here of a hip roof
+    (its outline), of a holed solid (the courtyard keeps its hole), and of a cube (its box); a wall, seen
+    along its own scope y (up the wall), covers no area and is left out."""
+    text = ('Lot --> {} footprint() report("a", geometry.area) report("y", scope.sy) '
+            'extrude(3) report("v", geometry.volume) X.\n')
+    for before, lot, area in [("roofHip(30)", LOT_ZOO["concave_L"], 400), ("extrude(8)", LOT_ZOO["courtyard"], 1200),
+                              ('s(4, 5, 6) i("builtin:cube")', rect(10, 8), 24)]:
+        t = totals(run(write, text.format(before), [lot]))
+        assert (t["a_sum"], t["y_sum"], t["v_sum"]) == (pytest.approx(area), 0, pytest.approx(3 * area))
+    r = run(write, "Lot --> extrude(8) comp(f){ side : footprint() W. | top : T. }\n", [rect(10, 8)])
+    assert names(r) == ["T"]
+
+
+def test_footprint_that_falls_apart_is_one_shape_of_its_parts(write):
+    """A courtyard's offset border, two rings (around the lot and around the hole) of one shape, extruded:
+    its footprint is a mesh of the two rings in one scope."""
+    text = ('Lot --> offset(-2, border) extrude(1) footprint() report("n", geometry.nFaces) '
+            'report("a", geometry.area) comp(f){ all : F. }\n')
+    t = totals(run(write, text, [LOT_ZOO["courtyard"]]))
+    assert (t["n_sum"], t["a_sum"], t["a_n"]) == (2, pytest.approx(40 * 40 - 36 * 36 + 24 * 24 - 20 * 20), 1)
+
+
+def test_rectify_snaps_edges_near_the_scope_axes(write):
+    """The reference's example: a face whose edges lean a few degrees off its scope's axes becomes
+    rectangular with ``rectify(15)`` (the lot's scope runs along its first edge); with an angle below the
+    lean it stays as it was; a face that leans more is left out of the snap."""
+    lot = [np.array([[0, 0], [20, 0], [20.5, 12], [-0.4, 11.6]], float)]
+    text = ('Lot --> rectify({}) report("r", geometry.isRectangular(0.01)) report("n", geometry.nVertices) '
+            'report("x", scope.sx) X.\n')
+    t = totals(run(write, text.format(15), [lot]))
+    assert (t["r_sum"], t["n_sum"]) == (True, 4) and 20 < t["x_sum"] < 20.5
+    t = totals(run(write, text.format(1), [lot]))
+    assert (t["r_sum"], t["x_sum"]) == (False, pytest.approx(20.9))
+    (bad,) = run(write, "Lot --> extrude(3) rectify(10) X.\n", [rect(10, 8)])["bad"]
+    assert bad.reason.startswith("`rectify` of a solid is not supported yet")

@@ -535,6 +535,33 @@ def test_align_to_geometry_in_a_batch_equals_each_lot_alone(write):
                 mesh.ring_offsets[mesh.face_offsets]))== k], one.vertices)
 
 
+@pytest.mark.parametrize("axes, sizes", [("xz", (10, 0, 4)), ("zx", (4, 0, 10)), ("xy", (4, 0, 10))])
+def test_align_scope_to_geometry_bbox_puts_the_first_axis_along_the_longer_side(write, axes, sizes):
+    """The reference's example: a lot whose scope runs along its first, short edge; ``xz`` turns x (and z)
+    about y onto the smallest rectangle around it, x along its longer side; ``zx`` puts z there, as it was.
+    ``xy`` turns about z, across which the lot is flat: it keeps its scope."""
+    lot = [rotated_rectangle(30, 4, 10)[0]]
+    text = (f'Lot --> alignScopeToGeometryBBox({axes}) report("x", scope.sx) report("y", scope.sy) '
+            'report("z", scope.sz) report("a", geometry.area) X.\n')
+    t = totals(run(write, text, [lot]))
+    assert (t["x_sum"], t["y_sum"], t["z_sum"], t["a_sum"]) == pytest.approx((*sizes, 40))
+
+
+def test_align_scope_to_geometry_bbox_of_a_solid_and_a_batch(write):
+    """A box turned by a quarter turn stays a box; an L's rectangle is its own scope; each lot of a batch
+    gets what it gets alone."""
+    text = "Lot --> extrude(5) alignScopeToGeometryBBox(xz) X.\n"
+    r = run(write, text, [rect(10, 30)])
+    assert len(r["xform"]) == 1 and not len(r["mesh"].face_offsets) - 1
+    np.testing.assert_allclose(sorted(np.linalg.norm(r["xform"][0, :, :3], axis=0)), [5, 10, 30])
+    lots = [rect(10, 30), rotated_rectangle(30, 4, 10), LOT_ZOO["concave_L"], LOT_ZOO["courtyard"]]
+    text = "Lot --> alignScopeToGeometryBBox(xz) extrude(2) comp(f){ front : F. }\n"
+    batch = run(write, text, lots)
+    for k, lot in enumerate(lots):
+        alone = run(write, text, [lot])
+        np.testing.assert_array_equal(batch["xform"][batch["lot"] == k], alone["xform"])
+
+
 @pytest.mark.parametrize("axis, k", [("x", 0), ("world.z", 2), ("y", 1)])
 def test_align_scope_to_one_world_axis(write, axis, k):
     """alignScopeToAxes(x|y|z) of a turned box: that scope axis is the world's, the next one the old one

@@ -153,6 +153,17 @@ def test_not_applied_operations_are_listed_for_the_meta(tmp_path):
     assert make_plan(compile_grammar(path)).not_applied == ("print", "set(material.shininess)")
 
 
+def test_tags_are_accepted_without_effect_and_what_reads_them_is_unsupported(tmp_path):
+    """``tag``, ``deleteTags`` and ``setTagsFromEdgeAttrs`` name components for what reads the names; those
+    readers (here ``geometry.hasTags``) are refused at their line, so no tag is dropped silently."""
+    path = tmp_path / "g.cga"
+    path.write_text(VERSION + 'Lot --> extrude(3) tag("mass") tag("walls", faces) comp(f){ side : deleteTags() '
+                    "setTagsFromEdgeAttrs() W. }\n")
+    assert make_plan(compile_grammar(path)).not_applied == ("deleteTags", "setTagsFromEdgeAttrs", "tag")
+    line = 'Lot --> tag("mass") report("t", geometry.hasTags("mass"))'
+    assert_unsupported_at(line, "geometry.hasTags()", "geometry")
+
+
 
 # ------------------------------------------------------------------------------------- split and comp
 
@@ -223,6 +234,48 @@ def test_setback_moves_the_edges_its_parts_select():
     assert op.selectors == ("front", "left", "remainder")
 
 
+@pytest.mark.parametrize("body, printed", [
+    # the reference's shortcut: setback(comp(fe){ all : d })
+    ("setbackPerEdge(ds[comp.index]){ front : A | remainder : B }",
+     "setback(comp(fe){ all=@ds[comp.index] }){ front: A | remainder: B }"),
+    ("setbackPerEdge(2, 0){ all = A }", "setback(comp(fe){ all=2 }){ all: A }"),
+    ("setbackToArea(100){ all : NIL | remainder : B }", "setbackToArea(100){ all: ε | remainder: B }"),
+    # a number after the lists is uvSet; an array gives edge comp.index its element
+    ("setbackToArea(100, ds, 0){ all : A }", "setbackToArea(100, comp(fe){ all=@ds[comp.index] }){ all: A }"),
+    ("setbackToArea(100, comp(fe){ front : 2 | all : 0 }, ds){ front : A | remainder : B }",
+     ("setbackToArea(100, comp(fe){ front=2, all=0 }, comp(fe){ all=((comp.index < size(@ds)) ? "
+      "@ds[comp.index] : inf) }){ front: A | remainder: B }")),
+])
+def test_setback_per_edge_and_to_area_lower_to_setbacks_of_distances_per_edge(body, printed):
+    assert body_of(f"{VERSION}const ds = [1, 2]\nLot --> {body}\n") == printed
+
+
+@pytest.mark.parametrize("body, printed", [
+    ("taper(h * 2) A", "taper((@h * 2)) A"),
+    ("resetGeometry() A", "resetGeometry() A"),
+    ("footprint() extrude(2) A", "footprint() extrude(2) A"),
+    ("rectify(h) A", "rectify(@h) A"),
+    ("alignScopeToGeometryBBox(zx) A", "alignScopeToGeometryBBox(zx) A"),
+    ('alignScopeToGeometryBBox("xy") A', "alignScopeToGeometryBBox(xy) A"),
+])
+def test_taper_reset_geometry_footprint_and_align_scope_to_geometry_bbox_lower_to_their_nodes(body, printed):
+    assert body_of(f"{VERSION}attr h = 2\nLot --> {body}\n") == printed
+
+
+@pytest.mark.parametrize("line, at, message", [
+    ("Lot --> setbackToArea(1, [1], [2], [3]){ all : A }", "setbackToArea",
+     "`setbackToArea` takes 1 or 2 or 3 arguments, got 4"),
+    ("Lot --> setbackPerEdge(1){ side : A | frnt : B }", "frnt",
+     "unsupported: setbackPerEdge selector `frnt` (setbackPerEdge selects "),
+    ("Lot --> alignScopeToGeometryBBox(xx) A", "xx",
+     "unsupported: alignScopeToGeometryBBox with these axes (alignAxes is one of xy, yx, xz, zx, yz, zy)"),
+    ("Lot --> resetGeometry(1) A", "resetGeometry", "`resetGeometry` takes 0 arguments, got 1"),
+])
+def test_new_operations_name_a_wrong_argument_count_or_selector(line, at, message):
+    (found,) = errors(VERSION + line + "\n")
+    assert found[:2] == (2, line.index(at) + 1) and found[2].startswith(message), found
+
+
 @pytest.mark.parametrize("line, at, message", [
     ("Lot --> cleanupGeometry(vertex, 0) A", "vertex",
      "`cleanupGeometry` cleans up all, edges, faces, vertices, got `vertex` (did you mean `vertices`?)"),
@@ -281,7 +334,7 @@ def test_roof_gable_with_an_edge_index_and_roof_ridge_lower_to_roofs(call, kind,
      "innerRectangle"),
     ("Lot --> innerRectangle(scope){ front : A | remainder : NIL }", "innerRectangle selector `front`",
      "front"),
-    ("Lot --> taper(4) A", "taper", "taper"),
+    ("Lot --> modify(4) A", "modify", "modify"),
     ("Lot --> comp(x){ all : A }", "comp(x)", "comp"),
     ("Lot --> comp(f){ street.top : A }", "comp(f) selector `street.top`", "street"),
     ("Lot --> comp(f){ fornt : A }", "comp(f) selector `fornt`", "fornt"),
