@@ -183,10 +183,12 @@ def texture_sets(module: ir.Module, ops) -> list[int]:
     whole number)."""
     sets = {op.uv_set for op in ops if isinstance(op, TEXTURE_OPS) or (isinstance(op, ir.GroupSplit)
                                                                      and op.uv_set >= 0)}
+    sets |= {op.source for op in ops if isinstance(op, ir.CopyUV)}
     for expr in all_exprs(module):
         if isinstance(expr, ir.Call) and expr.func in UV_QUERIES:
             sets.add(int(expr.args[0].value) if expr.args and isinstance(expr.args[0], ir.Num) else 0)
     return sorted(sets)
 
 
-TEXTURE_OPS = (ir.SetupProjection, ir.ProjectUV, ir.TransformUV, ir.TileUV, ir.NormalizeUV)
+TEXTURE_OPS = (ir.SetupProjection, ir.ProjectUV, ir.TransformUV, ir.TileUV, ir.NormalizeUV, ir.CopyUV,
+               ir.InsertAlongUV)
