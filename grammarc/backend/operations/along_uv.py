@@ -188,7 +188,8 @@ def placements(world: np.ndarray, ring_offsets: np.ndarray, normal: np.ndarray, 
     return xform, _edge_planes(world, ring_offsets, normal, lift)[owner], owner
 
 
-def _edge_planes(world: np.ndarray, ring_offsets: np.ndarray, normal: np.ndarray, lift: np.ndarray) -> np.ndarray:
+def _edge_planes(world: np.ndarray, ring_offsets: np.ndarray, normal: np.ndarray,
+                 lift: np.ndarray) -> np.ndarray:
     """(P, 4 E): the planes through each piece's edges containing ``lift`` (P, 3), facing into the piece
     (its ring winds counter-clockwise around ``normal``); NaN where an edge runs along ``lift`` and past
     a piece's edges."""

@@ -1,4 +1,5 @@
-"""Asset resolution: every name ``I()``, ``i()`` and ``insertAlongUV()`` give resolved in the module's asset folders.
+"""Asset resolution: every name ``I()``, ``i()`` and ``insertAlongUV()`` give resolved in the module's asset
+folders.
 
 Assumes: a rule graph (a module without one fails to compile anyway, for the errors that stopped it) and
 ``Module.roots`` (a module lowered outside the compiler has none, and keeps its names unresolved).
