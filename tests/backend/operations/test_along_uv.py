@@ -7,6 +7,9 @@ lot's texture set 0 is metres along its x (u) and z (v).
 
 from __future__ import annotations
 
+import shutil
+from pathlib import Path
+
 import numpy as np
 import pytest
 from derivations import face_area, mesh_faces, names, rect, run
@@ -96,3 +99,26 @@ def test_copy_uv_gives_a_set_the_coordinates_of_another(write):
     assert areas == {"A": 20.0, "B": 20.0}
     r = run(write, "Lot --> scaleUV(0, 0.1, 0.25) split(u, uvSpace, 1){ 0.5 : A. | ~1 : B. }\n", [rect(10, 4)])
     assert len(r["bad"]) == 1
+
+
+def test_a_fence_of_posts_and_panels_along_a_strip(write, tmp_path):
+    """As ESRI.lib's fences do: the strip split along u into posts and panels, each normalized and given its
+    asset along u (the props example's GLB assets), the posts 1.2 m high, the panels 1 m."""
+    for name in ("post.glb", "panel.glb"):
+        shutil.copy(Path(__file__).parents[3] / "examples" / "props" / "assets" / "fence" / name, tmp_path / name)
+    r = run(write, "Lot --> split(u, unitSpace, 0){ { 0.2 : Post | ~2 : Panel }* | 0.2 : Post }\n"
+            "Post --> normalizeUV(0, uv, collectiveAllFaces) insertAlongUV(0, \"post.glb\", 1.2) Post.\n"
+            "Panel --> normalizeUV(0, uv, collectiveAllFaces) insertAlongUV(0, \"panel.glb\", 1) Panel.\n",
+            [rect(22.2, 0.2)])
+    mesh = r["mesh"]
+    face_symbol = np.array([str(s) for s in r["symbols"][mesh.symbol]])
+    v = vertices(r)
+    vertex_symbol = np.repeat(face_symbol, np.diff(mesh.ring_offsets[mesh.face_offsets]))
+    posts, panels = v[vertex_symbol == "Post"], v[vertex_symbol == "Panel"]
+    assert posts[:, 1].max() == pytest.approx(1.2, abs=1e-5) and panels[:, 1].max() == pytest.approx(1, abs=1e-5)
+    np.testing.assert_allclose(v.min(axis=0), [0, 0, -0.2], atol=1e-5)
+    np.testing.assert_allclose(v.max(axis=0), [22.2, 1.2, 0], atol=1e-5)
+    # ten panels of 2 m between eleven posts: each post's asset within its 0.2 m
+    cells = np.floor(posts[:, 0] / 2.2 + 1e-6)
+    assert set(cells.astype(int)) == set(range(11))
+    assert (posts[:, 0] - 2.2 * cells <= 0.2 + 1e-5).all()
