@@ -995,6 +995,14 @@ class InsertAlongUV:
     alignment: str = "alignPosition"
 
 
+@dataclass(frozen=True, slots=True)
+class ResetMaterial:
+    """CityEngine ``resetMaterial()`` and ``resetMaterial(shape|all)``: the shape's material back to
+    CityEngine's default (white, opaque, no texture channels)."""
+
+    span: Span = NO_SPAN
+
+
 #: ``insertAlongUV``'s height directions and alignments, the defaults first.
 ALONG_UV_DIRECTIONS = ("scope.y", "vertex.normal")
 ALONG_UV_ALIGNMENTS = ("alignPosition", "keepPosition")
@@ -1005,7 +1013,7 @@ Op = (Symbol | Empty | Translate | Scale | Rotate | Push | Pop | Insert | Split 
       | AlignScope | Mirror | Offset | SetColor | Setback | Roof | InnerRectangle | Convexify
       | CleanupGeometry | DeleteHoles | Snap | Label | Transform | Scatter | AlignToGeometry | Primitive
       | Trim | SplitArea | ReduceGeometry | MirrorScope | SetOpacity | SetupProjection | ProjectUV | TransformUV
-      | TileUV | NormalizeUV | CopyUV | InsertAlongUV)
+      | TileUV | NormalizeUV | CopyUV | InsertAlongUV | ResetMaterial)
 Body = tuple[Op, ...]
 
 

@@ -1,9 +1,11 @@
-"""Values a shape carries or reports: ``set(attr, value)``, ``color()``, the opacity and CityEngine's ``report``.
+"""Values a shape carries or reports: ``set(attr, value)``, ``color()``, the opacity, ``resetMaterial`` and
+CityEngine's ``report``.
 
 ``set``, ``color`` and ``set(material.opacity)`` give the shape (and so its successors and parts) a new
 value in its ``dynamic`` column (the colour and opacity share one: ``backend.materials``); ``report`` adds
 rows to the chunk's reports (``backend.report_rows``). Reads: what their expressions read, and ``lot``
-(reports). Writes: ``set``, ``color`` and the opacity the ``dynamic`` column of their value.
+(reports). Writes: ``set``, ``color`` and the opacity the ``dynamic`` column of their value,
+``resetMaterial`` the colour and texture channel columns.
 """
 
 from __future__ import annotations
@@ -17,6 +19,7 @@ from grammarc.backend.evaluate import evaluate, evaluate_array
 from grammarc.backend.materials import with_opacity, with_transparency_of
 from grammarc.backend.operations.table import operation
 from grammarc.backend.shapes import Shapes
+from grammarc.backend.slots import WHITE_RGB
 from grammarc.ir import nodes as ir
 
 
@@ -61,6 +64,20 @@ def set_opacity(ctx: Context, cursor: Shapes, op: ir.SetOpacity) -> Shapes:
     opacity = np.broadcast_to(evaluate_array(op.value, ctx.env(cursor)), (len(cursor),))
     dynamic = cursor.dynamic[:index] + (with_opacity(cursor.dynamic[index], opacity),) + cursor.dynamic[index + 1:]
     return replace(cursor, dynamic=dynamic)
+
+
+@operation(ir.ResetMaterial, writes=("dynamic",), meshes=True)
+def reset_material(ctx: Context, cursor: Shapes, op: ir.ResetMaterial) -> Shapes:
+    """The colour white and opaque, the texture channels none: the columns the grammar carries as a lot
+    starts them (a material attribute it carries no column of has its default already)."""
+    plan = ctx.plan
+    n = len(cursor)
+    dynamic = list(cursor.dynamic)
+    if plan.color_slot is not None:
+        dynamic[plan.color_slot] = np.full(n, WHITE_RGB)
+    for _, slot in plan.material_slots:
+        dynamic[slot] = np.full(n, plan.strings.ids[""], dtype=np.int32)
+    return replace(cursor, dynamic=tuple(dynamic))
 
 
 @operation(ir.Report, meshes=True)

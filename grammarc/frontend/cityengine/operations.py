@@ -525,6 +525,14 @@ class OperationLowering:
         asset, name = (args[1].value, None) if isinstance(args[1], ir.Str) else ("", self.expr(args[1]))
         return ir.InsertAlongUV(uv_set, asset, self.expr(args[2]), span, name, direction, alignment)
 
+    def op_reset_material(self, op, args, span):
+        """``resetMaterial([shape|geometry|all])``: ``geometry`` resets an inserted asset's own materials,
+        which grammarc does not keep, so it changes nothing in the record (its meta lists it)."""
+        target = args[0].name if len(args) == 1 and isinstance(args[0], ir.Name) else "shape" if not args else None
+        if target not in ("shape", "geometry", "all"):
+            return self.unsupported(f"{op} with these arguments", span, f"{op}() or {op}(shape|geometry|all)")
+        return ir.NotApplied(f"{op}(geometry)", span) if target == "geometry" else ir.ResetMaterial(span)
+
     def selector_parts(self, op, parts, known, named=None, noun="polygons", indices=None):
         """The selectors and bodies of ``{ sel: A | ... }`` parts, all among ``known`` (None after an
         error); ``sel=`` is derived as ``sel:``, with a warning. ``named`` is the operation as a selector
@@ -620,6 +628,7 @@ OPERATIONS = {
     "normalizeUV": OperationLowering.op_normalize_uv,
     "copyUV": OperationLowering.op_copy_uv,
     "insertAlongUV": OperationLowering.op_insert_along_uv,
+    "resetMaterial": OperationLowering.op_reset_material,
 }
 #: Operations with parts ``{ ... }``: name -> handler(lowering, op, args, parts, span); those of ``REPEATING``
 #: also repeat (``{ ... }*``), with ``repeat=True``.
@@ -686,7 +695,7 @@ UNSUPPORTED_OPS = frozenset({
     "alignScopeToGeometryBBox", "modify",
     "setbackPerEdge", "setbackToArea", "splitAndSetbackPerimeter",
     "tag", "deleteTags", "setTagsFromEdgeAttrs", "union", "subtract", "intersect",
-    "setMaterial", "resetMaterial",
+    "setMaterial",
 } - NOT_APPLIED)
 #: Every operation name CityEngine knows: what a misspelt one is suggested from.
 ALL_OPERATIONS = (frozenset(OPERATIONS) | frozenset(PART_OPERATIONS) | frozenset(BODY_OPERATIONS) | NOT_APPLIED

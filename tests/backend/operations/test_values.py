@@ -52,3 +52,14 @@ def test_reports_per_lot_and_totals(write):
     assert (t["name_n"], t["name_sum"], t["name_avg"]) == (2, "lot12", "lot12")
     assert (t["name_min"], t["name_max"]) == ("lot12", "lot6")
 
+
+
+def test_reset_material_makes_the_colour_white_and_opaque_and_drops_the_textures(write):
+    r = run(write, 'Lot --> color(1, 0, 0) set(material.opacity, 0.5) texture("a.png") [ Before ] resetMaterial() After\n'
+            'Before --> report("g0", material.color.g) report("o0", material.opacity) '
+            'report("m0", case material.colormap == "" : 1 else : 0)\n'
+            'After --> report("g1", material.color.g) report("o1", material.opacity) '
+            'report("m1", case material.colormap == "" : 1 else : 0)\n', [rect(2, 2)])
+    t = totals(r)
+    assert [t[f"{k}0_sum"] for k in "gom"] == [0, pytest.approx(0.5, abs=0.01), 0]
+    assert [t[f"{k}1_sum"] for k in "gom"] == [1, 1, 1]
