@@ -129,7 +129,9 @@ def make_plan(grammar: Grammar, *, load_asset: Callable = load_asset) -> Plan:
     ops = iter_ops(module)
     # the colour's components and the opacity are read from the colour column (``backend.materials``)
     context = [e.name for e in all_exprs(module) if isinstance(e, ir.ContextRef) and e.name not in COLOR_FIELDS]
-    colour = [COLOR_SLOT] if any(isinstance(op, (ir.SetColor, ir.SetOpacity)) for op in ops) else []
+    colour = [COLOR_SLOT] if any(isinstance(op, (ir.SetColor, ir.SetOpacity, ir.SetMaterial)) for op in ops) else []
+    # setMaterial's names are known per shape only: every texture channel gets its column
+    colour += list(MAP_FIELDS) if any(isinstance(op, ir.SetMaterial) for op in ops) else []
     # CityEngine trims inserted geometry at the planes a comp(f) leaves between neighbouring faces
     trims = list(TRIM_SLOTS) if module.dialect == "cityengine" and any(
         isinstance(op, ir.CompFaces) and op.kind == "f" for op in ops) and any(

@@ -1003,6 +1003,16 @@ class ResetMaterial:
     span: Span = NO_SPAN
 
 
+@dataclass(frozen=True, slots=True)
+class SetMaterial:
+    """CityEngine ``setMaterial(material)``: the material attributes named in the string array
+    ``[name0, value0, name1, value1, ...]`` (without the ``material.`` prefix; a table of two columns reads
+    alike) set as ``set(material.<name>, value)`` sets each."""
+
+    material: Expr = child(Type.STRS, "a material array")
+    span: Span = NO_SPAN
+
+
 #: ``insertAlongUV``'s height directions and alignments, the defaults first.
 ALONG_UV_DIRECTIONS = ("scope.y", "vertex.normal")
 ALONG_UV_ALIGNMENTS = ("alignPosition", "keepPosition")
@@ -1013,7 +1023,7 @@ Op = (Symbol | Empty | Translate | Scale | Rotate | Push | Pop | Insert | Split 
       | AlignScope | Mirror | Offset | SetColor | Setback | Roof | InnerRectangle | Convexify
       | CleanupGeometry | DeleteHoles | Snap | Label | Transform | Scatter | AlignToGeometry | Primitive
       | Trim | SplitArea | ReduceGeometry | MirrorScope | SetOpacity | SetupProjection | ProjectUV | TransformUV
-      | TileUV | NormalizeUV | CopyUV | InsertAlongUV | ResetMaterial)
+      | TileUV | NormalizeUV | CopyUV | InsertAlongUV | ResetMaterial | SetMaterial)
 Body = tuple[Op, ...]
 
 

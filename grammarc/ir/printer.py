@@ -204,6 +204,7 @@ _OP_FORMATS = {
     ir.NormalizeUV: lambda op: f"normalizeUV({op.uv_set}, {op.mode})",
     ir.CopyUV: lambda op: f"copyUV({op.source}, {op.uv_set})",
     ir.ResetMaterial: lambda op: "resetMaterial()",
+    ir.SetMaterial: lambda op: f"setMaterial({print_expr(op.material)})",
     ir.InsertAlongUV: lambda op: f"insertAlongUV({op.uv_set}, " + ", ".join([
         print_expr(op.name) if op.name is not None else f'"{op.asset}"', print_expr(op.height),
         *([op.direction, op.alignment] if (op.direction, op.alignment) != (

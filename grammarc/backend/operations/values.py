@@ -80,6 +80,60 @@ def reset_material(ctx: Context, cursor: Shapes, op: ir.ResetMaterial) -> Shapes
     return replace(cursor, dynamic=tuple(dynamic))
 
 
+@operation(ir.SetMaterial, writes=("dynamic",), meshes=True)
+def set_material(ctx: Context, cursor: Shapes, op: ir.SetMaterial) -> Shapes:
+    """Each name of the shapes' arrays set to the value after it, in the array's order (a later one wins):
+    ``color.r|g|b`` and ``opacity`` as numbers, a texture channel (``colormap``...) as its path. The other
+    attributes (``specular.r``, ``shininess``...) have no effect, as ``set`` of them has none. Each
+    distinct name and value is read once."""
+    plan = ctx.plan
+    array = evaluate(op.material, ctx.env(cursor))
+    texts = list(plan.strings.ids)
+    pairs = array.sizes // 2
+    owner = np.repeat(np.arange(len(cursor)), pairs)
+    at = array.offsets[:-1][owner] + 2 * (np.arange(len(owner)) - np.repeat(np.cumsum(pairs) - pairs, pairs))
+    names, values = array.values[at], array.values[at + 1]
+    dynamic = list(cursor.dynamic)
+    packed = dynamic[plan.color_slot].copy()
+    for name_id in np.unique(names).tolist():
+        name = texts[name_id]
+        rows = names == name_id
+        field = f"material.{name}"
+        if field in plan.dynamic and field.endswith("map"):
+            column = dynamic[plan.dynamic[field]].copy()
+            column[owner[rows]] = values[rows]  # later pairs are written last: they win
+            dynamic[plan.dynamic[field]] = column
+        elif name in ("color.r", "color.g", "color.b", "opacity"):
+            number = _numbers(texts, values[rows])
+            bad = np.isnan(number)
+            if bad.any():
+                ctx.fail(cursor, np.isin(np.arange(len(cursor)), owner[rows][bad]),
+                         f"setMaterial: `{name}` is not a number (`{texts[int(values[rows][bad][0])]}`)", op.span)
+            shapes = owner[rows]
+            if name == "opacity":
+                packed[shapes] = with_opacity(packed[shapes], number)
+            else:
+                shift = 16 - 8 * "rgb".index(name[-1])
+                value = packed[shapes].astype(np.int64)
+                byte = np.clip(np.round(number * 255), 0, 255).astype(np.int64)
+                packed[shapes] = (value & ~(255 << shift)) + (byte << shift)
+    dynamic[plan.color_slot] = packed
+    return replace(cursor, dynamic=tuple(dynamic))
+
+
+def _numbers(texts: list[str], ids: np.ndarray) -> np.ndarray:
+    """The numbers (k,) float64 that interned strings ``ids`` (k,) spell (NaN where one does not)."""
+    distinct, inverse = np.unique(ids, return_inverse=True)
+    return np.array([_number(texts[int(i)]) for i in distinct])[inverse.reshape(-1)]
+
+
+def _number(text: str) -> float:
+    try:
+        return float(text)
+    except ValueError:
+        return float("nan")
+
+
 @operation(ir.Report, meshes=True)
 def report(ctx: Context, cursor: Shapes, op: ir.Report) -> None:
     env = ctx.env(cursor)

@@ -629,6 +629,7 @@ OPERATIONS = {
     "copyUV": OperationLowering.op_copy_uv,
     "insertAlongUV": OperationLowering.op_insert_along_uv,
     "resetMaterial": OperationLowering.op_reset_material,
+    "setMaterial": direct(ir.SetMaterial),
 }
 #: Operations with parts ``{ ... }``: name -> handler(lowering, op, args, parts, span); those of ``REPEATING``
 #: also repeat (``{ ... }*``), with ``repeat=True``.
@@ -695,7 +696,6 @@ UNSUPPORTED_OPS = frozenset({
     "alignScopeToGeometryBBox", "modify",
     "setbackPerEdge", "setbackToArea", "splitAndSetbackPerimeter",
     "tag", "deleteTags", "setTagsFromEdgeAttrs", "union", "subtract", "intersect",
-    "setMaterial",
 } - NOT_APPLIED)
 #: Every operation name CityEngine knows: what a misspelt one is suggested from.
 ALL_OPERATIONS = (frozenset(OPERATIONS) | frozenset(PART_OPERATIONS) | frozenset(BODY_OPERATIONS) | NOT_APPLIED

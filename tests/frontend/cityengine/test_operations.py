@@ -111,6 +111,7 @@ from .lowered import VERSION, assert_unsupported_at, body_of, compile_ir, errors
     ("copyUV(0, 2) A", "copyUV(0, 2) A"),
     ("resetMaterial() resetMaterial(all) A", "resetMaterial() resetMaterial() A"),
     ("resetMaterial(geometry) A", "resetMaterial(geometry)(...) A"),
+    ('setMaterial(["color.r", "1"]) A', 'setMaterial(["color.r", "1"]) A'),
     ('insertAlongUV(0, "rail.obj", h) A', 'insertAlongUV(0, "rail.obj", @h) A'),
     ('insertAlongUV(1, "a/" + "rail.obj", 2, vertex.normal, keepPosition) A',
      'insertAlongUV(1, ("a/" + "rail.obj"), 2, vertex.normal, keepPosition) A'),
