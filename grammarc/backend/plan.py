@@ -129,7 +129,9 @@ def make_plan(grammar: Grammar, *, load_asset: Callable = load_asset) -> Plan:
     ops = iter_ops(module)
     # the colour's components and the opacity are read from the colour column (``backend.materials``)
     context = [e.name for e in all_exprs(module) if isinstance(e, ir.ContextRef) and e.name not in COLOR_FIELDS]
-    colour = [COLOR_SLOT] if any(isinstance(op, (ir.SetColor, ir.SetOpacity)) for op in ops) else []
+    colour = [COLOR_SLOT] if any(isinstance(op, (ir.SetColor, ir.SetOpacity, ir.SetMaterial)) for op in ops) else []
+    # setMaterial's names are known per shape only: every texture channel gets its column
+    colour += list(MAP_FIELDS) if any(isinstance(op, ir.SetMaterial) for op in ops) else []
     # CityEngine trims inserted geometry at the planes a comp(f) leaves between neighbouring faces
     trims = list(TRIM_SLOTS) if module.dialect == "cityengine" and any(
         isinstance(op, ir.CompFaces) and op.kind == "f" for op in ops) and any(
@@ -183,10 +185,12 @@ def texture_sets(module: ir.Module, ops) -> list[int]:
     whole number)."""
     sets = {op.uv_set for op in ops if isinstance(op, TEXTURE_OPS) or (isinstance(op, ir.GroupSplit)
                                                                      and op.uv_set >= 0)}
+    sets |= {op.source for op in ops if isinstance(op, ir.CopyUV)}
     for expr in all_exprs(module):
         if isinstance(expr, ir.Call) and expr.func in UV_QUERIES:
             sets.add(int(expr.args[0].value) if expr.args and isinstance(expr.args[0], ir.Num) else 0)
     return sorted(sets)
 
 
-TEXTURE_OPS = (ir.SetupProjection, ir.ProjectUV, ir.TransformUV, ir.TileUV, ir.NormalizeUV)
+TEXTURE_OPS = (ir.SetupProjection, ir.ProjectUV, ir.TransformUV, ir.TileUV, ir.NormalizeUV, ir.CopyUV,
+               ir.InsertAlongUV)

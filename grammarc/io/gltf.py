@@ -11,7 +11,9 @@ roots, PNG or JPEG) is embedded as its ``baseColorTexture``. A tile with more th
 ``MAX_GROUPS`` (asset, colour) groups, which a grammar colouring each shape at random makes, groups by
 asset only and draws them white: a node per colour would make the file a node per instance. Normals are
 left out: viewers compute flat normals, which is what the assets' polygons are. The mesh table's
-polygons are triangulated into one mesh per tile with per-vertex colours (``COLOR_0``).
+polygons are triangulated into one mesh per tile with per-vertex colours (``COLOR_0``) and, where the record
+has them, the texture coordinates of set 0 (``TEXCOORD_0``, v down the image as glTF has it), which the
+colour maps of its materials read.
 
 The extension is listed in ``extensionsUsed`` but not required: a viewer without it (trimesh, at the
 time of writing, among them) still opens the file and shows each group's mesh once.
@@ -289,6 +291,9 @@ class _Part:
         colors = np.repeat(triangles["color"], 3, axis=0)
         attributes = {"POSITION": self._accessor(points, "VEC3", _ARRAY_BUFFER, bounds=True),
                       "COLOR_0": self._accessor(colors, "VEC4", _ARRAY_BUFFER, normalized=True)}
+        uv = tile.texture_coordinates()
+        if uv is not None:
+            attributes["TEXCOORD_0"] = self._accessor(_gltf_uv(uv), "VEC2", _ARRAY_BUFFER)
         translucent = bool((colors[:, 3] < 255).any())
         primitives = [{"attributes": attributes, "material": self._material(_WHITE, translucent=translucent)}]
         if tile.triangle_material is not None:
@@ -333,8 +338,7 @@ def baked_glb(vertices: np.ndarray, faces: np.ndarray, looks: np.ndarray | None,
             attributes = {"POSITION": part._accessor(np.asarray(vertices, np.float32), "VEC3", _ARRAY_BUFFER,
                                                      bounds=True)}
             if uv is not None:
-                flipped = np.stack([uv[:, 0], 1 - uv[:, 1]], axis=1).astype(np.float32)
-                attributes["TEXCOORD_0"] = part._accessor(flipped, "VEC2", _ARRAY_BUFFER)
+                attributes["TEXCOORD_0"] = part._accessor(_gltf_uv(uv), "VEC2", _ARRAY_BUFFER)
             distinct, inverse = np.unique(looks, return_inverse=True)
             order = np.argsort(inverse.reshape(-1), kind="stable")
             bounds = np.searchsorted(inverse.reshape(-1)[order], np.arange(len(distinct) + 1))
@@ -354,6 +358,11 @@ def baked_glb(vertices: np.ndarray, faces: np.ndarray, looks: np.ndarray | None,
         out = Path(folder) / "baked.glb"
         part.finish(out)
         return out.read_bytes()
+
+
+def _gltf_uv(uv: np.ndarray) -> np.ndarray:
+    """(V, 2) float32: texture coordinates (u, v up the image) as glTF's, v down the image."""
+    return np.stack([uv[:, 0], 1 - uv[:, 1]], axis=1).astype(np.float32)
 
 
 def _groups(rows: np.ndarray, material: np.ndarray | None = None

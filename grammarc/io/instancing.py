@@ -45,8 +45,10 @@ TILE_SIZE = LIMITS.tile_size
 #: One instance row in a tile's spool.
 INSTANCE = np.dtype([("row", "<i8"), ("asset", "<i4"), ("lot", "<i4"), ("symbol", "<i4"), ("color", "u1", (4,)),
                      ("xform", "<f4", (3, 4))])
-#: One triangle of the mesh table in a tile's spool: world vertices, the face's colour and symbol.
-TRIANGLE = np.dtype([("vertices", "<f4", (3, 3)), ("color", "u1", (4,)), ("symbol", "<i4")])
+#: One triangle of the mesh table in a tile's spool: world vertices, the face's colour and symbol, and its
+#: vertices' texture coordinates of set 0 (NaN: none).
+TRIANGLE = np.dtype([("vertices", "<f4", (3, 3)), ("color", "u1", (4,)), ("symbol", "<i4"),
+                     ("uv", "<f4", (3, 2))])
 #: A column shorter than this (in world units) is a flat axis.
 _FLAT = 1e-9
 
@@ -161,6 +163,15 @@ class Tile:
     instance_material: np.ndarray | None = None
     triangle_material: np.ndarray | None = None
 
+    def texture_coordinates(self) -> np.ndarray | None:
+        """(3 t, 2) float32: the texture coordinates of set 0 of the triangles' vertices, 0 where a face
+        has none; None when none of the tile's faces has any (the writers then leave them out)."""
+        uv = self.triangles["uv"].reshape(-1, 2)
+        known = np.isfinite(uv).all(axis=1)
+        if not known.any():
+            return None
+        return np.where(known[:, None], uv, 0.0).astype(np.float32)
+
     @property
     def name(self) -> str:
         """A prim or node name: ``tile_<ix>_<iz>`` with ``m`` for a minus sign."""
@@ -220,6 +231,7 @@ class TileSpool:
             triangles["vertices"] = vertices[faces]
             triangles["color"] = mesh.colors()[face]
             triangles["symbol"] = np.asarray(mesh.symbol)[face]
+            triangles["uv"] = mesh.texture()[faces]
             first = vertices[np.asarray(mesh.ring_offsets)[mesh.face_offsets[:-1]]]
             keys = self._keys(first)[face]
             self._append("triangles", keys, triangles)

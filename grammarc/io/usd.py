@@ -21,7 +21,9 @@ The layout, for ``city.usdc``::
   through trimesh, built-ins generated), fitted to the unit box as CityEngine fits an inserted asset to its
   scope; ``subdivisionScheme`` is ``none`` (they are polygon models, not subdivision cages).
 * **Meshes**: the mesh table's polygons (leaves that are not instances) triangulated, one Mesh per
-  tile with a colour per face (and a ``GeomSubset`` per material bound to it where the record has textures).
+  tile with a colour per face (and a ``GeomSubset`` per material bound to it where the record has textures),
+  and the texture coordinates of set 0 as ``primvars:st`` (vertex interpolation: each triangle has its own
+  points) where the record has them, which the materials' ``UsdUVTexture`` reads.
 
 Writing streams: ``write`` sorts each chunk into tile spools on disk (``TileSpool``), and ``close``
 makes one tile layer at a time, so memory is bounded by the largest tile, not by the city. Everything
@@ -171,6 +173,10 @@ class UsdWriter(TiledWriter):
             mesh.CreateFaceVertexIndicesAttr(Vt.IntArray.FromNumpy(np.arange(len(points), dtype=np.int32)))
             mesh.CreateSubdivisionSchemeAttr(UsdGeom.Tokens.none)
             _colors(UsdGeom.PrimvarsAPI(mesh), triangles["color"], UsdGeom.Tokens.uniform)
+            uv = tile.texture_coordinates()
+            if uv is not None:  # the points are the triangles' own: a coordinate per point
+                UsdGeom.PrimvarsAPI(mesh).CreatePrimvar("st", Sdf.ValueTypeNames.TexCoord2fArray,
+                                                        UsdGeom.Tokens.vertex).Set(Vt.Vec2fArray.FromNumpy(uv))
             if tile.triangle_material is not None:
                 imageable = UsdGeom.Imageable(mesh)
                 for textures in np.unique(tile.triangle_material).tolist():

@@ -1030,13 +1030,64 @@ class Rectify:
     span: Span = NO_SPAN
 
 
+@dataclass(frozen=True, slots=True)
+class CopyUV:
+    """CityEngine ``copyUV(uvSetSource, uvSetDest)``: texture set ``uv_set`` takes the coordinates of set
+    ``source`` (its projection stays its own)."""
+
+    uv_set: int
+    source: int
+    span: Span = NO_SPAN
+
+
+@dataclass(frozen=True, slots=True)
+class InsertAlongUV:
+    """CityEngine ``insertAlongUV(uvSet, asset, height[, heightDirection, heightAlignment])``: the shape's
+    geometry becomes the asset laid along texture set ``uv_set``: the asset's x runs along u, one copy per
+    whole unit of u, its z against v over v in [0, 1], its y ``height`` metres along ``direction``
+    (``"scope.y"`` or ``"vertex.normal"``), cut to the shape's faces. ``alignment`` is ``"alignPosition"``
+    (the asset's lowest point on the faces) or ``"keepPosition"`` (its own origin on them). ``asset`` and
+    ``name`` as in ``UseAsset``."""
+
+    uv_set: int
+    asset: str
+    height: Expr = child(Type.NUM, "a height")
+    span: Span = NO_SPAN
+    name: Expr | None = child(Type.STR, "an asset name", default=None)
+    direction: str = "scope.y"
+    alignment: str = "alignPosition"
+
+
+@dataclass(frozen=True, slots=True)
+class ResetMaterial:
+    """CityEngine ``resetMaterial()`` and ``resetMaterial(shape|all)``: the shape's material back to
+    CityEngine's default (white, opaque, no texture channels)."""
+
+    span: Span = NO_SPAN
+
+
+@dataclass(frozen=True, slots=True)
+class SetMaterial:
+    """CityEngine ``setMaterial(material)``: the material attributes named in the string array
+    ``[name0, value0, name1, value1, ...]`` (without the ``material.`` prefix; a table of two columns reads
+    alike) set as ``set(material.<name>, value)`` sets each."""
+
+    material: Expr = child(Type.STRS, "a material array")
+    span: Span = NO_SPAN
+
+
+#: ``insertAlongUV``'s height directions and alignments, the defaults first.
+ALONG_UV_DIRECTIONS = ("scope.y", "vertex.normal")
+ALONG_UV_ALIGNMENTS = ("alignPosition", "keepPosition")
+
+
 Op = (Symbol | Empty | Translate | Scale | Rotate | Push | Pop | Insert | Split | Repeat | Comp | Extrude
       | Center | UseAsset | Case | Stochastic | SetAttr | Report | NotApplied | GroupSplit | CompFaces
       | AlignScope | Mirror | Offset | SetColor | Setback | Roof | InnerRectangle | Convexify
       | CleanupGeometry | DeleteHoles | Snap | Label | Transform | Scatter | AlignToGeometry | Primitive
       | Trim | SplitArea | ReduceGeometry | MirrorScope | SetOpacity | SetupProjection | ProjectUV | TransformUV
       | TileUV | NormalizeUV | SetbackToArea | Taper | ResetGeometry | AlignScopeToBBox
-      | Footprint | Rectify)
+      | Footprint | Rectify | CopyUV | InsertAlongUV | ResetMaterial | SetMaterial)
 Body = tuple[Op, ...]
 
 

@@ -210,6 +210,13 @@ _OP_FORMATS = {
     ir.TransformUV: lambda op: f"{op.kind}UV({op.uv_set}, {_list(op.values)})",
     ir.TileUV: lambda op: f"tileUV({op.uv_set}, {', '.join(_size(s) for s in op.sizes)})",
     ir.NormalizeUV: lambda op: f"normalizeUV({op.uv_set}, {op.mode})",
+    ir.CopyUV: lambda op: f"copyUV({op.source}, {op.uv_set})",
+    ir.ResetMaterial: lambda op: "resetMaterial()",
+    ir.SetMaterial: lambda op: f"setMaterial({print_expr(op.material)})",
+    ir.InsertAlongUV: lambda op: f"insertAlongUV({op.uv_set}, " + ", ".join([
+        print_expr(op.name) if op.name is not None else f'"{op.asset}"', print_expr(op.height),
+        *([op.direction, op.alignment] if (op.direction, op.alignment) != (
+            ir.ALONG_UV_DIRECTIONS[0], ir.ALONG_UV_ALIGNMENTS[0]) else [])]) + ")",
 }
 
 

@@ -73,7 +73,7 @@ def _asset_problems(module: ir.Module) -> list[str]:
         problems.append("module: assets 0 and 1 are not the leaf cube and quad")
     ids = dict(module.asset_ids)
     for op in iter_ops(module):
-        named = isinstance(op, (ir.Insert, ir.UseAsset)) and op.asset
+        named = isinstance(op, (ir.Insert, ir.UseAsset, ir.InsertAlongUV)) and op.asset
         if named and not 0 <= ids.get(op.asset, -1) < len(module.assets):
             problems.append(f"module: asset `{op.asset}` at {op.span} has no id")
     return problems

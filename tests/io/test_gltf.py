@@ -6,7 +6,7 @@ import json
 import numpy as np
 import pytest
 import trimesh
-from writers_city import TEXTURED, city, glb_city, textured_city, world
+from writers_city import TEXTURED, TEXTURED_GROUND, city, glb_city, nearest_uv, textured_city, world
 
 from grammarc.io.gltf import GltfWriter, _read_part, part_paths
 from grammarc.model.records import MeshChunk, TerminalChunk
@@ -18,7 +18,7 @@ def accessor(gltf, blob: bytes, index: int) -> np.ndarray:
     a = gltf.accessors[index]
     view = gltf.bufferViews[a.bufferView]
     dtype = {5126: np.float32, 5125: np.uint32, 5121: np.uint8}[a.componentType]
-    width = {"SCALAR": 1, "VEC3": 3, "VEC4": 4}[a.type]
+    width = {"SCALAR": 1, "VEC2": 2, "VEC3": 3, "VEC4": 4}[a.type]
     data = np.frombuffer(blob, dtype, a.count * width, view.byteOffset + (a.byteOffset or 0))
     return data.reshape(a.count, width) if width > 1 else data
 
@@ -97,3 +97,26 @@ def test_an_instanced_glb_embeds_its_textures(tmp_path):
     # the walls' mesh (an (asset, material) group) has the textured material
     used = {p["material"] for mesh in tree["meshes"] for p in mesh["primitives"]}
     assert tree["materials"].index(textured[0]) in used
+
+
+def test_the_polygons_carry_the_records_texture_coordinates(tmp_path):
+    """``TEXCOORD_0`` of each tile's polygon mesh: the record's, v turned down the image as glTF has it."""
+    record = np.load(textured_city(tmp_path, TEXTURED_GROUND, ".npz"))
+    path = textured_city(tmp_path, TEXTURED_GROUND, ".glb")
+    assert isinstance(trimesh.load(path), trimesh.Scene)
+    gltf = pygltflib.GLTF2().load(str(path))
+    blob = gltf.binary_blob()
+    checked = 0
+    for tile in gltf.scenes[0].nodes:
+        origin = np.array(gltf.nodes[tile].translation)
+        for child in gltf.nodes[tile].children:
+            mesh = gltf.meshes[gltf.nodes[child].mesh]
+            if not mesh.name.endswith("_polygons"):
+                continue
+            attributes = mesh.primitives[0].attributes
+            points = accessor(gltf, blob, attributes.POSITION) + origin
+            uv = accessor(gltf, blob, attributes.TEXCOORD_0).astype(float)
+            np.testing.assert_allclose(np.stack([uv[:, 0], 1 - uv[:, 1]], axis=1), nearest_uv(record, points),
+                                       atol=1e-5)
+            checked += len(points)
+    assert checked >= 2 * 8 * 3  # two rings with a hole: eight triangles each

@@ -2,7 +2,7 @@
 
 import numpy as np
 import pytest
-from writers_city import TEXTURED, city, glb_city, textured_city, world
+from writers_city import TEXTURED, TEXTURED_GROUND, city, glb_city, nearest_uv, textured_city, world
 
 pxr = pytest.importorskip("pxr")
 from pxr import Usd, UsdGeom
@@ -76,3 +76,25 @@ def test_instances_with_a_texture_are_bound_to_a_material_reading_it(tmp_path):
     assert files and all(f.resolvedPath == str(tmp_path / "tex" / "wall.png") for f in files)
     bound = [p for p in stage.Traverse() if UsdShade.MaterialBindingAPI(p).GetDirectBinding().GetMaterial()]
     assert bound and all("_m1" in str(p.GetPath()) for p in bound)
+
+
+def test_the_polygons_carry_the_records_texture_coordinates_as_st(tmp_path):
+    record = np.load(textured_city(tmp_path, TEXTURED_GROUND, ".npz"))
+    stage = Usd.Stage.Open(str(textured_city(tmp_path, TEXTURED_GROUND, ".usda")))
+    meshes = [UsdGeom.Mesh(p) for p in stage.Traverse() if p.IsA(UsdGeom.Mesh) and p.GetName() == "Meshes"]
+    assert meshes
+    for mesh in meshes:
+        st = UsdGeom.PrimvarsAPI(mesh).GetPrimvar("st")
+        assert st.GetInterpolation() == UsdGeom.Tokens.vertex
+        assert st.GetTypeName() == "texCoord2f[]"
+        tile = UsdGeom.Xformable(mesh.GetPrim()).ComputeLocalToWorldTransform(Usd.TimeCode.Default())
+        points = np.array(mesh.GetPointsAttr().Get(), float) + np.array(tile.ExtractTranslation())
+        np.testing.assert_allclose(np.array(st.Get(), float), nearest_uv(record, points), atol=1e-5)
+        assert np.ptp(np.array(st.Get(), float), axis=0).tolist() == pytest.approx([3.0, 3.0])  # 12 x 9 m
+
+
+def test_polygons_without_texture_coordinates_have_no_st(tmp_path):
+    untextured = TEXTURED_GROUND.replace("setupProjection(0, scope.xz, 4, 3) projectUV(0) ", "")
+    stage = Usd.Stage.Open(str(textured_city(tmp_path, untextured, ".usda")))
+    meshes = [UsdGeom.Mesh(p) for p in stage.Traverse() if p.IsA(UsdGeom.Mesh) and p.GetName() == "Meshes"]
+    assert meshes and not any(UsdGeom.PrimvarsAPI(m).HasPrimvar("st") for m in meshes)

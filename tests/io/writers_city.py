@@ -81,6 +81,11 @@ Facade --> color("#00ff00") set(material.opacity, 0.5) Wall.
 TEXTURED = """version "2023.0"
 Lot --> extrude(6) comp(f){ top : Roof. | side : texture("tex/wall.png") Wall. }
 """
+#: Textured lots whose leaves are polygons (the mesh table: rings with a hole) in 4 m by 3 m tiles of
+#: their texture.
+TEXTURED_GROUND = """version "2023.0"
+Lot --> setupProjection(0, scope.xz, 4, 3) projectUV(0) texture("tex/wall.png") offset(-2) comp(f){ border : Ground. }
+"""
 RED, SEE_THROUGH_GREEN = [255, 0, 0, 255], [0, 255, 0, 128]
 
 
@@ -95,6 +100,13 @@ def _png(width: int, height: int) -> bytes:
 
 
 PNG = _png(2, 2)
+
+
+def nearest_uv(record, points: np.ndarray) -> np.ndarray:
+    """(n, 2): the texture coordinates of the record's mesh vertices nearest to world ``points`` (n, 3)."""
+    vertices = record["mesh_vertices"].astype(float)
+    nearest = np.argmin(((points[:, None, :] - vertices[None]) ** 2).sum(axis=2), axis=1)
+    return record["mesh_uv"][nearest].astype(float)
 
 
 def textured_city(tmp_path: Path, text: str, suffix: str, bake: bool = False) -> Path:

@@ -164,8 +164,9 @@ def test_types_pass_fills_param_types_for_every_symbol():
 # ------------------------------------------------------------------------------- the declarations drive it
 
 #: A literal of each type, and one of another type.
-_RIGHT = {T.NUM: ir.Num(1.0), T.BOOL: ir.Bool(True), T.STR: ir.Str("x.obj"), None: ir.Num(1.0)}
-_WRONG = {T.NUM: ir.Str("x"), T.BOOL: ir.Num(1.0), T.STR: ir.Num(1.0)}
+_RIGHT = {T.NUM: ir.Num(1.0), T.BOOL: ir.Bool(True), T.STR: ir.Str("x.obj"), None: ir.Num(1.0),
+          T.STRS: ir.ArrayLit(((ir.Str("color.r"), ir.Str("1")),))}
+_WRONG = {T.NUM: ir.Str("x"), T.BOOL: ir.Num(1.0), T.STR: ir.Num(1.0), T.STRS: ir.Num(1.0)}
 
 
 def _wanted(node) -> dict[int, tuple[ir.Type | None, str]]:

@@ -13,6 +13,7 @@ columns:
 - ``faces``: ``offset``, ``setback``, ``setbackToArea``, ``innerRectangle``, ``convexify``, roofs, ``taper``,
   ``cleanupGeometry``;
 - ``inserts``: ``I``, ``i``, ``label``;
+- ``along_uv``: ``insertAlongUV``, an asset laid along texture coordinates as the shape's mesh;
 - ``primitives``: CityEngine's ``primitiveCube/Quad/Disk/Cylinder/Sphere/Cone``;
 - ``successors``: successor symbols, ``ε``/``NIL`` and operations without effect;
 - ``values``: ``set``, ``color``, the opacity, ``report``;
@@ -27,6 +28,7 @@ A new operation is its IR node, its lowering and its function here: importing th
 """
 
 from grammarc.backend.operations import (  # noqa: F401 - each registers its operations
+    along_uv,
     component_splits,
     control,
     faces,

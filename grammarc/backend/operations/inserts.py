@@ -30,21 +30,26 @@ def insert(ctx: Context, cursor: Shapes, op: ir.Insert) -> None:
 @operation(ir.UseAsset, writes=("origin", "size", "geom"), meshes=True)
 def use_asset(ctx: Context, cursor: Shapes, op: ir.UseAsset) -> Shapes:
     """The geometry becomes the asset placed by the insert mode (``placed``)."""
+    return placed(ctx, cursor, op, asset_ids(ctx, cursor, op, "i"))
+
+
+def asset_ids(ctx: Context, cursor: Shapes, op: ir.UseAsset | ir.InsertAlongUV, verb: str) -> np.ndarray:
+    """The asset ids (n,) int32 that ``op`` inserts: its asset's, or those its ``name`` computes per shape (a
+    shape whose name is no asset of the grammar fails, the error naming ``verb``)."""
     plan = ctx.plan
     if op.name is None:
-        asset = np.full(len(cursor), plan.grammar.asset_ids[op.asset], dtype=np.int32)
-    else:
-        names = evaluate_array(op.name, ctx.env(cursor), dtype=np.int32)
-        distinct, inverse = np.unique(names, return_inverse=True)
-        asset = np.array([plan.asset_of_string.get(int(s), -1) for s in distinct], dtype=np.int32)[inverse.reshape(-1)]
-        bad = asset < 0
-        if bad.any():
-            name = list(plan.strings.ids)[int(names[np.flatnonzero(bad)[0]])]
-            # the assets a computed name may take are found when compiling (``passes.assets``)
-            why = ("a file search that found nothing" if not name else "not an asset of the grammar: a computed "
-                   "name is a string constant of an asset file, or a file a search may find")
-            ctx.fail(cursor, bad, f"`i` of `{name}`, {why}", op.span)
-    return placed(ctx, cursor, op, asset)
+        return np.full(len(cursor), plan.grammar.asset_ids[op.asset], dtype=np.int32)
+    names = evaluate_array(op.name, ctx.env(cursor), dtype=np.int32)
+    distinct, inverse = np.unique(names, return_inverse=True)
+    asset = np.array([plan.asset_of_string.get(int(s), -1) for s in distinct], dtype=np.int32)[inverse.reshape(-1)]
+    bad = asset < 0
+    if bad.any():
+        name = list(plan.strings.ids)[int(names[np.flatnonzero(bad)[0]])]
+        # the assets a computed name may take are found when compiling (``passes.assets``)
+        why = ("a file search that found nothing" if not name else "not an asset of the grammar: a computed "
+               "name is a string constant of an asset file, or a file a search may find")
+        ctx.fail(cursor, bad, f"`{verb}` of `{name}`, {why}", op.span)
+    return asset
 
 
 def placed(ctx: Context, cursor: Shapes, op: ir.UseAsset, asset: np.ndarray) -> Shapes:

@@ -1,5 +1,5 @@
-"""Texture space: ``setupProjection``, ``projectUV``/``deleteUV``, ``translateUV``, ``scaleUV``, ``rotateUV``,
-``tileUV``, ``normalizeUV``, and the frame of a split in texture space (``split(u|v, ...)``).
+"""Texture space: ``setupProjection``, ``projectUV``/``deleteUV``, ``copyUV``, ``translateUV``, ``scaleUV``,
+``rotateUV``, ``tileUV``, ``normalizeUV``, and the frame of a split in texture space (``split(u|v, ...)``).
 
 A shape's projection and texture coordinates of a set are affine maps from world coordinates to (u, v) in
 its ``dynamic`` columns (``backend.texture_space``): each operation here computes new maps for the whole
@@ -64,6 +64,15 @@ def project_uv(ctx: Context, cursor: Shapes, op: ir.ProjectUV) -> Shapes:
     start = ctx.plan.uv_slots[op.uv_set]
     dynamic = list(cursor.dynamic)
     dynamic[start + COORDINATES] = np.zeros(len(cursor), np.int32) if op.delete else dynamic[start + PROJECTION]
+    return replace(cursor, dynamic=tuple(dynamic))
+
+
+@operation(ir.CopyUV, writes=("dynamic",), meshes=True)
+def copy_uv(ctx: Context, cursor: Shapes, op: ir.CopyUV) -> Shapes:
+    """Set ``uv_set`` takes set ``source``'s coordinates (their map's id: the table is not touched)."""
+    slots = ctx.plan.uv_slots
+    dynamic = list(cursor.dynamic)
+    dynamic[slots[op.uv_set] + COORDINATES] = dynamic[slots[op.source] + COORDINATES]
     return replace(cursor, dynamic=tuple(dynamic))
 
 

@@ -553,6 +553,36 @@ class OperationLowering:
                                     "normalizeUV(uvSet, uv|uvUniform|u|v, separatePerFace|collectiveAllFaces)")
         return ir.Empty(span) if uv_set is None else ir.NormalizeUV(uv_set, names[0], span)
 
+    def op_copy_uv(self, op, args, span):
+        """``copyUV(uvSetSource, uvSetDest)``."""
+        if not self.arity(op, args, (2,), span):
+            return ir.Empty(span)
+        source, dest = (self.uv_set(op, a, span) for a in args)
+        return ir.Empty(span) if source is None or dest is None else ir.CopyUV(dest, source, span)
+
+    def op_insert_along_uv(self, op, args, span):
+        """``insertAlongUV(uvSet, asset, height[, scope.y|vertex.normal, alignPosition|keepPosition])``."""
+        if not self.arity(op, args, (3, 5), span):
+            return ir.Empty(span)
+        uv_set = self.uv_set(op, args[0], span)
+        chosen = [a.name if isinstance(a, ir.Name) else None for a in args[3:]]
+        if chosen and (chosen[0] not in ir.ALONG_UV_DIRECTIONS or chosen[1] not in ir.ALONG_UV_ALIGNMENTS):
+            return self.unsupported(f"{op} with these selectors", span, f"{op}(uvSet, asset, height, "
+                                    "scope.y|vertex.normal, alignPosition|keepPosition)")
+        direction, alignment = chosen or (ir.ALONG_UV_DIRECTIONS[0], ir.ALONG_UV_ALIGNMENTS[0])
+        if uv_set is None:
+            return ir.Empty(span)
+        asset, name = (args[1].value, None) if isinstance(args[1], ir.Str) else ("", self.expr(args[1]))
+        return ir.InsertAlongUV(uv_set, asset, self.expr(args[2]), span, name, direction, alignment)
+
+    def op_reset_material(self, op, args, span):
+        """``resetMaterial([shape|geometry|all])``: ``geometry`` resets an inserted asset's own materials,
+        which grammarc does not keep, so it changes nothing in the record (its meta lists it)."""
+        target = args[0].name if len(args) == 1 and isinstance(args[0], ir.Name) else "shape" if not args else None
+        if target not in ("shape", "geometry", "all"):
+            return self.unsupported(f"{op} with these arguments", span, f"{op}() or {op}(shape|geometry|all)")
+        return ir.NotApplied(f"{op}(geometry)", span) if target == "geometry" else ir.ResetMaterial(span)
+
     def selector_parts(self, op, parts, known, named=None, noun="polygons", indices=None):
         """The selectors and bodies of ``{ sel: A | ... }`` parts, all among ``known`` (None after an
         error); ``sel=`` is derived as ``sel:``, with a warning. ``named`` is the operation as a selector
@@ -651,6 +681,10 @@ OPERATIONS = {
     "footprint": direct(ir.Footprint),
     "rectify": direct(ir.Rectify),
     "alignScopeToGeometryBBox": OperationLowering.op_align_scope_to_bbox,
+    "copyUV": OperationLowering.op_copy_uv,
+    "insertAlongUV": OperationLowering.op_insert_along_uv,
+    "resetMaterial": OperationLowering.op_reset_material,
+    "setMaterial": direct(ir.SetMaterial),
 }
 #: Operations with parts ``{ ... }``: name -> handler(lowering, op, args, parts, span); those of ``REPEATING``
 #: also repeat (``{ ... }*``), with ``repeat=True``.
@@ -717,12 +751,11 @@ NOT_APPLIED = frozenset({
 #: CGA reference, so that any other name called with parts, or a typo of one of them, is unknown.
 UNSUPPORTED_OPS = frozenset({
     "innerPolygon",
-    "insertAlongUV", "inline",
+    "inline",
     "semiPolygon",
     "modify",
     "splitAndSetbackPerimeter",
     "union", "subtract", "intersect",
-    "copyUV", "setMaterial", "resetMaterial",
 } - NOT_APPLIED)
 #: Every operation name CityEngine knows: what a misspelt one is suggested from.
 ALL_OPERATIONS = (frozenset(OPERATIONS) | frozenset(PART_OPERATIONS) | frozenset(BODY_OPERATIONS) | NOT_APPLIED

@@ -1,4 +1,5 @@
-"""Asset resolution: every name ``I()`` and ``i()`` give resolved in the module's asset folders.
+"""Asset resolution: every name ``I()``, ``i()`` and ``insertAlongUV()`` give resolved in the module's asset
+folders.
 
 Assumes: a rule graph (a module without one fails to compile anyway, for the errors that stopped it) and
 ``Module.roots`` (a module lowered outside the compiler has none, and keeps its names unresolved).
@@ -38,6 +39,8 @@ from grammarc.ir.traverse import all_exprs, iter_exprs, iter_ops
 #: Built-ins whose first argument is a file search whose matches ``i()`` may insert.
 SEARCHES = frozenset({"fileRandom", "fileSearch", "filesSearch", "assetBestSize", "assetApproxSize",
                       "assetFitSize", "assetBestRatio", "assetApproxRatio"})
+#: The operations that name an asset.
+ASSET_OPS = (ir.Insert, ir.UseAsset, ir.InsertAlongUV)
 #: The most asset files a computed search registers (every asset file under its constant folder).
 MAX_COMPUTED_MATCHES = 1000
 
@@ -46,9 +49,9 @@ def resolve_assets(module: ir.Module, diags: Diagnostics) -> ir.Module:
     if module.roots is None or module.graph is None:
         return module
     ops = list(iter_ops(module))
-    named = [(op.asset, op.span) for op in ops if isinstance(op, (ir.Insert, ir.UseAsset)) and op.asset]
+    named = [(op.asset, op.span) for op in ops if isinstance(op, ASSET_OPS) and op.asset]
     named.extend(_primitives(module, ops, diags))
-    if any(isinstance(op, ir.UseAsset) and op.name is not None for op in ops):
+    if any(isinstance(op, (ir.UseAsset, ir.InsertAlongUV)) and op.name is not None for op in ops):
         # a computed asset name: every string constant that looks like an asset may be one
         queries = _queries(module)
         named.extend((e.value, e.span) for e in all_exprs(module) if isinstance(e, ir.Str)

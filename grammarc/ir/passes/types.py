@@ -26,6 +26,10 @@ from grammarc.ir.traverse import all_exprs, expr_fields, field_exprs, iter_nodes
 T = ir.Type
 
 
+#: The operations whose backend takes an array where their node declares one.
+TAKE_ARRAYS = (ir.SetMaterial,)
+
+
 def infer_types(module: ir.Module, diags: Diagnostics) -> ir.Module:
     attr_types: dict[str, ir.Type] = {}
     attrs = []
@@ -45,7 +49,7 @@ def infer_types(module: ir.Module, diags: Diagnostics) -> ir.Module:
                     got = _expect(expr, want, what, attr_types, params, diags)
                 else:  # any type (its operands checked); an array where the backend takes a value is refused
                     got = type_of(expr, attr_types, params, diags)
-                if got.is_array and (want is None or want.is_array):
+                if got.is_array and (want is None or want.is_array) and type(node) not in TAKE_ARRAYS:
                     diags.error("unsupported", f"unsupported: an array as {what}", expr.span)
     return replace(module, attrs=tuple(attrs), param_types=tuple(sorted(param_types.items())))
 

@@ -52,3 +52,41 @@ def test_reports_per_lot_and_totals(write):
     assert (t["name_n"], t["name_sum"], t["name_avg"]) == (2, "lot12", "lot12")
     assert (t["name_min"], t["name_max"]) == ("lot12", "lot6")
 
+
+
+def test_reset_material_makes_the_colour_white_and_opaque_and_drops_the_textures(write):
+    r = run(write, 'Lot --> color(1, 0, 0) set(material.opacity, 0.5) texture("a.png") [ Before ] resetMaterial() After\n'
+            'Before --> report("g0", material.color.g) report("o0", material.opacity) '
+            'report("m0", case material.colormap == "" : 1 else : 0)\n'
+            'After --> report("g1", material.color.g) report("o1", material.opacity) '
+            'report("m1", case material.colormap == "" : 1 else : 0)\n', [rect(2, 2)])
+    t = totals(r)
+    assert [t[f"{k}0_sum"] for k in "gom"] == [0, pytest.approx(0.5, abs=0.01), 0]
+    assert [t[f"{k}1_sum"] for k in "gom"] == [1, 1, 1]
+
+
+MATERIAL_REPORTS = ('A --> report("r", material.color.r) report("g", material.color.g) '
+                    'report("o", material.opacity) report("c", case material.colormap == "a.png" : 1 else : 0)\n')
+
+
+def test_set_material_sets_each_named_attribute(write):
+    """The reference's form: names without ``material.``, values as texts; a later pair wins, and an
+    attribute grammarc does not carry (``shininess``) changes nothing."""
+    r = run(write, 'm = ["color.r", "1", "color.g", "0.2", "color.b", "0", "opacity", "0.5", "colormap", "b.png",\n'
+            '     "shininess", "3", "colormap", "a.png"]\nLot --> color(0, 0, 1) setMaterial(m) A\n'
+            + MATERIAL_REPORTS, [rect(2, 2)])
+    t = totals(r)
+    assert [t[f"{k}_sum"] for k in "rgoc"] == [1, pytest.approx(0.2, abs=0.01), pytest.approx(0.5, abs=0.01), 1]
+
+
+def test_set_material_reads_a_table_of_two_columns(write, tmp_path):
+    (tmp_path / "m.csv").write_text("color.r,0\ncolor.g,1\ncolormap,a.png\n")
+    r = run(write, 'Lot --> setMaterial(readStringTable("m.csv")) A\n' + MATERIAL_REPORTS, [rect(2, 2)])
+    t = totals(r)
+    assert [t[f"{k}_sum"] for k in "rgoc"] == [0, 1, 1, 1]
+
+
+def test_set_material_of_a_value_that_is_no_number_fails_its_lot(write):
+    r = run(write, 'Lot --> setMaterial(["opacity", "half"]) A.\n', [rect(2, 2)])
+    (bad,) = r["bad"]
+    assert "setMaterial: `opacity` is not a number (`half`)" in bad.reason

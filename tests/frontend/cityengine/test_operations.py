@@ -108,6 +108,13 @@ from .lowered import VERSION, assert_unsupported_at, body_of, compile_ir, errors
     ("setupProjection(0, scope.xz, '1, '20, 0, '8) A", "setupProjection(0, scope.xz, 1r, 20r, 0, 8r) A"),
     ("translateUV(0, 1, h) scaleUV(0, 2, 2) rotateUV(0, 90) A", "translateUV(0, 1, @h) scaleUV(0, 2, 2) rotateUV(0, 90) A"),
     ("tileUV(0, ~2, '1) normalizeUV(0, u, collectiveAllFaces) A", "tileUV(0, ~2, 1r) normalizeUV(0, u) A"),
+    ("copyUV(0, 2) A", "copyUV(0, 2) A"),
+    ("resetMaterial() resetMaterial(all) A", "resetMaterial() resetMaterial() A"),
+    ("resetMaterial(geometry) A", "resetMaterial(geometry)(...) A"),
+    ('setMaterial(["color.r", "1"]) A', 'setMaterial(["color.r", "1"]) A'),
+    ('insertAlongUV(0, "rail.obj", h) A', 'insertAlongUV(0, "rail.obj", @h) A'),
+    ('insertAlongUV(1, "a/" + "rail.obj", 2, vertex.normal, keepPosition) A',
+     'insertAlongUV(1, ("a/" + "rail.obj"), 2, vertex.normal, keepPosition) A'),
     ("split(u, uvSpace, 0){ 1 : A | ~1 : B }*", "split(u, uvSpace, 0){ 1: A | ~1: B }*"),
     ("split(v, unitSpace, 1){ 1 : A | { 2 : B }* }", "split(v, unitSpace, 1){ 1: A | { 2: B }* }"),
     ('print("h = " + h) A', "print(...) A"),
@@ -362,6 +369,10 @@ def test_roof_gable_with_an_edge_index_and_roof_ridge_lower_to_roofs(call, kind,
     ("Lot --> setupProjection(0, scope.xx, 1, 1) A", "setupProjection axes", "scope.xx"),
     ("Lot --> projectUV(uvSet) A", "projectUV with this uvSet", "uvSet"),
     ("Lot --> normalizeUV(0, w, collectiveAllFaces) A", "normalizeUV with these selectors", "normalizeUV"),
+    ("Lot --> copyUV(0, 12) A", "copyUV with this uvSet", "12"),
+    ("Lot --> resetMaterial(object) A", "resetMaterial with these arguments", "resetMaterial"),
+    ('Lot --> insertAlongUV(0, "a.obj", 1, world.up, alignPosition) A', "insertAlongUV with these selectors",
+     "insertAlongUV"),
     ("Lot --> r(scopeMiddle, 0, 45, 0) A", "r with 4 arguments", "r("),
 ])
 def test_unsupported_operation_is_named_at_its_span(line, name, at):
@@ -419,6 +430,7 @@ def test_each_operation_name_is_in_one_table():
     ("Lot --> primitiveCube(1, 2) A", "`primitiveCube` takes 0 or 3 arguments, got 2"),
     ("Lot --> primitiveCylinder(8, 1) A", "`primitiveCylinder` takes 0 or 1 or 3 arguments, got 2"),
     ("Lot --> primitiveSphere(8) A", "`primitiveSphere` takes 0 or 2 or 3 arguments, got 1"),
+    ('Lot --> insertAlongUV(0, "a.obj") A', "`insertAlongUV` takes 3 or 5 arguments, got 2"),
 ])
 def test_a_wrong_argument_count_is_an_arity_error_at_the_operation(line, message):
     assert errors(VERSION + line + "\n") == [(2, 9, message)]
