@@ -47,6 +47,8 @@ from .lowered import VERSION, assert_unsupported_at, body_of, compile_ir, errors
     ("set(scope.tx, h) A", "translate(abs, pivot, @h, Scope.ty, Scope.tz) A"),
     ("set(scope.sy, 2) A", "S(Scope.sx, 2, Scope.sz) A"),
     ("set(scope.rz, 45) A", "rotate(abs, pivot, Scope.rx, Scope.ry, 45) A"),
+    ("setPivot(yzx, 3) A", "setPivot(yzx, 3) A"),
+    ('setPivot("zxy", h + 1) A', "setPivot(zxy, (@h + 1)) A"),
     ("[ t(0, 3, 0) A ] B", "[ T(0, 3, 0) A ] B"),
     ("NIL", "\u03b5"),
     ("A.", "A."),
@@ -364,6 +366,8 @@ def test_each_operation_name_is_in_one_table():
      "`rotate` expects a coordinate system scope, pivot, object or world second"),
     ("Lot --> setback(1, 2){ front : A | remainder : B }", "`setback` takes 1 arguments, got 2"),
     ("Lot --> primitiveCube(1, 2) A", "`primitiveCube` takes 0 or 3 arguments, got 2"),
+    ("Lot --> setPivot(xyz) A", "`setPivot` takes 2 arguments, got 1"),
+    ("Lot --> setPivot(xzy, 0) A", "`setPivot` expects an axis map xyz, yzx or zxy first"),
     ("Lot --> primitiveCylinder(8, 1) A", "`primitiveCylinder` takes 0 or 1 or 3 arguments, got 2"),
     ("Lot --> primitiveSphere(8) A", "`primitiveSphere` takes 0 or 2 or 3 arguments, got 1"),
 ])
