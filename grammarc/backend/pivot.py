@@ -84,9 +84,10 @@ def initial_column(name: str, chunk: Chunk, shapes: Shapes) -> np.ndarray:
     return shapes.frame.copy() if k == 3 else shapes.origin[:, k].copy()
 
 
-def relative_angles(frames: np.ndarray, pivot_axes: np.ndarray, aligned_rows: np.ndarray) -> np.ndarray:
-    """The angles (n, 3) of scopes with axes ``frames`` (n, 3, 3) in their pivots' frames ``pivot_axes``:
-    ``scope.r``; exactly zero at ``aligned_rows`` (n,) bool, the scopes that share their pivot's frame."""
+def relative_angles(frames: np.ndarray, pivot_axes: np.ndarray, aligned_rows: np.ndarray | bool) -> np.ndarray:
+    """The angles (n, 3) of scopes with axes ``frames`` (n, 3, 3) in the frames ``pivot_axes`` (their pivots',
+    ``scope.r``, or another system's); exactly zero at ``aligned_rows`` (n,) bool (or False: none), the scopes
+    that share that frame."""
     angles = euler.angles(np.einsum("nij,nkj->nik", frames, pivot_axes))
     angles[aligned_rows] = 0.0
     return angles

@@ -81,6 +81,9 @@ def test_r_adds_to_the_angles_of_a_scope_turned_before(write):
     once = run(write, "Lot --> extrude(4) r(10, 20, 30) X\n", lot)["xform"]
     twice = run(write, "Lot --> extrude(4) r(0, 20, 0) r(10, 0, 30) X\n", lot)["xform"]
     np.testing.assert_allclose(twice, once, atol=1e-9)
+    rotated = run(write, "Lot --> extrude(4) rotate(rel, pivot, 0, 20, 0) rotate(rel, pivot, 10, 0, 30) X\n",
+                  lot)["xform"]
+    np.testing.assert_allclose(rotated, once, atol=1e-9)
     # a comp's face is its pivot: r adds to the face's own zero angles
     face = run(write, "Lot --> extrude(4) comp(f){ front : r(0, 10, 15) r(5, 0, 0) X }\n", lot)["xform"]
     direct = run(write, "Lot --> extrude(4) comp(f){ front : r(5, 10, 15) X }\n", lot)["xform"]

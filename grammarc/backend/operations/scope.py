@@ -18,7 +18,6 @@ import shapely
 
 from grammarc.backend import mesh_shapes
 from grammarc.backend.context import Context
-from grammarc.backend.euler import angles as euler_angles
 from grammarc.backend.euler import orientation, rotation
 from grammarc.backend.evaluate import evaluate, evaluate_array
 from grammarc.backend.functions.coordinates import system
@@ -103,9 +102,15 @@ def _about_pivot(ctx: Context, cursor: Shapes, angles) -> np.ndarray:
     slot = ctx.plan.pivot_slot
     _, pivot_axes = pivot_system(slot, ctx.chunk, cursor)
     added = np.stack([np.broadcast_to(np.asarray(a, np.float64), (n,)) for a in angles], axis=1)
-    added = added + relative_angles(ctx.chunk.frames[cursor.frame], pivot_axes,
-                                    cursor.frame == pivot_frames(slot, cursor))
-    return np.einsum("nij,njk->nik", orientation(*added.T), pivot_axes)
+    return _added_angles(ctx, cursor, pivot_axes, cursor.frame == pivot_frames(slot, cursor), added)
+
+
+def _added_angles(ctx: Context, cursor: Shapes, axes: np.ndarray, aligned: np.ndarray | bool,
+                  added: np.ndarray) -> np.ndarray:
+    """The axes (n, 3, 3) of the shapes' scopes whose angles in the frames ``axes`` (n, 3, 3) grow by ``added``
+    (n, 3) degrees; the scopes ``aligned`` (n,) bool share those frames (their angles are exactly zero)."""
+    angles = added + relative_angles(ctx.chunk.frames[cursor.frame], axes, aligned)
+    return np.einsum("nij,njk->nik", orientation(*angles.T), axes)
 
 
 @operation(ir.Transform, writes=("origin", "frame"), meshes=True)
@@ -133,9 +138,10 @@ def transform(ctx: Context, cursor: Shapes, op: ir.Transform) -> Shapes:
         new_origin = base + np.einsum("ni,nij->nj", values, axes)
         return cursor.with_scope(new_origin, cursor.size, cursor.frame, cursor.geom)
     if op.relative and op.system != "scope":
-        # rows: the scope's axes in the system's coordinates
-        values = values + euler_angles(np.einsum("nij,nkj->nik", frames[cursor.frame], axes))
-    frame = frames.add(np.einsum("nij,njk->nik", orientation(*values.T), axes))
+        ids = pivot_frames(ctx.plan.pivot_slot, cursor) if op.system == "pivot" else None
+        frame = frames.add(_added_angles(ctx, cursor, axes, False if ids is None else cursor.frame == ids, values))
+    else:
+        frame = frames.add(np.einsum("nij,njk->nik", orientation(*values.T), axes))
     return cursor.with_scope(cursor.origin, cursor.size, frame, cursor.geom)
 
 
