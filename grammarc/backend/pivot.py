@@ -38,9 +38,12 @@ if TYPE_CHECKING:
 #: order follows the Roman rule sets, which pick the corner of one compass direction as their scope turns in
 #: quarter turns (index plus one per quarter turn about y).
 CORNERS = np.array([(0, 0, 0), (1, 0, 0), (1, 0, 1), (0, 0, 1), (0, 1, 0), (1, 1, 0), (1, 1, 1), (0, 1, 1)])
-#: ``setPivot``'s axis maps: the old scope axes that become the pivot's x, y and z at corner 0 (the reference:
-#: ``yzx`` makes the old x the new y, ``zxy`` the old z the new y).
-AXIS_MAPS = {"xyz": (0, 1, 2), "yzx": (2, 0, 1), "zxy": (1, 2, 0)}
+#: ``setPivot``'s axis maps: the old scope axes that become the pivot's x, y and z at corner 0, as the names
+#: read (``yzx``: the old y is the new x, the old z the new y). The reference's text gives ``yzx`` what this
+#: gives ``zxy`` and the other way round (with a typo in one of them); the names' reading is the one public
+#: rule files rely on: the Paphos colonnade extrudes a piece of facade (its scope's y out of the wall, z down
+#: from the top) and stands a column's y upright from the ground with ``setPivot(yzx, 3)``.
+AXIS_MAPS = {"xyz": (0, 1, 2), "yzx": (1, 2, 0), "zxy": (2, 0, 1)}
 
 
 def sets_pivot(op) -> bool:

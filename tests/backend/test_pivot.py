@@ -28,7 +28,7 @@ def test_a_pivot_is_right_handed_and_points_into_the_scope_from_its_corner(axis_
     assert old[1] == AXIS_MAPS[axis_map][1]
 
 
-@pytest.mark.parametrize("axis_map, rows", [("xyz", [0, 1, 2]), ("yzx", [2, 0, 1]), ("zxy", [1, 2, 0])])
+@pytest.mark.parametrize("axis_map, rows", [("xyz", [0, 1, 2]), ("yzx", [1, 2, 0]), ("zxy", [2, 0, 1])])
 def test_at_corner_0_the_axis_map_renames_the_scope_axes(axis_map, rows):
     _, turn = corner_axes(axis_map, np.array([0, 8]))  # 8 is corner 0 again
     np.testing.assert_array_equal(turn[0], np.eye(3)[rows])
@@ -109,3 +109,13 @@ def test_a_pivot_corner_picked_by_the_compass_is_the_same_corner_of_every_lot(wr
     np.testing.assert_allclose(x[:, :, 3], [[0, 0, -8], [-8, 0, -12]], atol=1e-9)
     np.testing.assert_allclose(x[:, :, 0] / np.linalg.norm(x[:, :, 0], axis=1)[:, None], [[1, 0, 0]] * 2,
                                atol=1e-9)
+
+
+def test_yzx_at_corner_3_stands_an_extruded_facade_piece_upright(write):
+    """A piece of facade extruded out of the wall has its scope's y out of the wall and z down from the top;
+    setPivot(yzx, 3) makes the old z, reversed from the ground, the new y: a column 10 m tall."""
+    r = run(write, "Lot --> extrude(10) comp(f){ front : split(x){ ~1 : W. | 1 : C | ~1 : W. } }\n"
+                   "C --> extrude(1) setPivot(yzx, 3) s(0.5, '1, 0.5) X\n", [rect(12, 8)])
+    (x,) = r["xform"][np.array(r["symbols"][r["symbol"]]) == "X"].astype(float)
+    np.testing.assert_allclose(x[:, 1], [0, 10, 0], atol=1e-9)  # y: 10 m straight up
+    assert x[1, 3] == pytest.approx(0.0)  # from the ground

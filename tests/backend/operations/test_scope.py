@@ -379,9 +379,9 @@ def test_mirror_scope_reverses_two_axes_around_the_same_geometry(write):
 @pytest.mark.parametrize("ops, xform", [
     # corner 2, the far end of x and z at the bottom: x and z reversed, as a half turn about y
     ("setPivot(xyz, 2)", [[-12, 0, 0, 12], [0, 3, 0, 0], [0, 0, -8, 0]]),
-    # corner 0 of yzx: x along the old z, y along the old x, z along the old y
-    ("setPivot(yzx, 0)", [[0, 12, 0, 0], [0, 0, 3, 0], [8, 0, 0, -8]]),
-    ("setPivot(zxy, 0)", [[0, 0, 12, 0], [3, 0, 0, 0], [0, 8, 0, -8]]),
+    # corner 0 of yzx: x along the old y, y along the old z, z along the old x
+    ("setPivot(yzx, 0)", [[0, 0, 12, 0], [3, 0, 0, 0], [0, 8, 0, -8]]),
+    ("setPivot(zxy, 0)", [[0, 12, 0, 0], [0, 0, 3, 0], [8, 0, 0, -8]]),
     # corner 6, the far top corner: y down, x along the old -z, z along the old -x
     ("setPivot(xyz, 6)", [[0, 0, -12, 12], [0, -3, 0, 3], [-8, 0, 0, 0]]),
     # a split then runs from the pivot's corner: the first 2 m at the far end of x
