@@ -21,6 +21,7 @@ from grammarc.backend.execute import apply_pending
 from grammarc.backend.kernels.order import group_by, scatter_rows
 from grammarc.backend.materials import MAP_FIELDS, collect_materials
 from grammarc.backend.occlusion import Occluders
+from grammarc.backend.pivot import initial_column as initial_pivot
 from grammarc.backend.plan import Plan
 from grammarc.backend.random import lot_keys
 from grammarc.backend.report_rows import aggregate_chunk
@@ -30,6 +31,7 @@ from grammarc.backend.slots import (
     COLOR_SLOT,
     HORIZONTAL_SLOTS,
     HORIZONTAL_SWITCH,
+    PIVOT_SLOTS,
     TRIM_SLOTS,
     TRIM_SWITCH,
     WHITE_RGB,
@@ -122,6 +124,8 @@ def initial_dynamic(plan: Plan, name: str, chunk: Chunk, shapes: Shapes) -> np.n
         return np.ones(n)
     if name == HORIZONTAL_SWITCH:
         return np.zeros(n)
+    if name in PIVOT_SLOTS:
+        return initial_pivot(name, chunk, shapes)
     if plan.uv_slots:
         texture = initial_column(plan, name, chunk, shapes)
         if texture is not None:

@@ -15,6 +15,7 @@ from grammarc.backend.arrays import Arrays
 from grammarc.backend.env import Env
 from grammarc.backend.functions import FUNCTIONS
 from grammarc.backend.functions.strings import as_string, concatenate, is_string, string_ranks
+from grammarc.backend.pivot import pivot_frames, pivot_system, relative_angles
 from grammarc.errors import LotFailure
 from grammarc.ir import nodes as ir
 
@@ -195,20 +196,22 @@ def _scope_field(name: str, env: Env):
         return shapes.size[:, axis]
     if name[0] == "o":
         return env.chunk.lot_origin[shapes.lot, axis]
+    # Translation and angles relative to the pivot (``backend.pivot``): the lot's own scope, CityEngine's
+    # object coordinates, where the grammar keeps no pivot.
+    slot = env.plan.pivot_slot
+    origin, axes = pivot_system(slot, env.chunk, shapes)
     if name[0] == "r":
-        return _scope_angles(env)[:, axis]
-    # Translation relative to the lot's own scope, along the lot's axes (CityEngine's object coordinates).
-    lot = shapes.lot
-    offset = shapes.origin - env.chunk.lot_origin[lot]
-    return np.einsum("nj,nj->n", offset, env.chunk.lot_axes[lot, axis])
+        return _scope_angles(env, axes, pivot_frames(slot, shapes))[:, axis]
+    return np.einsum("nj,nj->n", shapes.origin - origin, axes[:, axis])
 
 
-def _scope_angles(env: Env) -> np.ndarray:
-    """The scope's rotation relative to its lot's scope, as angles (n, 3) in degrees about x, then y,
-    then z (the order of ``R``)."""
-    relative = np.einsum("nij,nkj->nik", env.chunk.frames[env.shapes.frame],
-                         env.chunk.lot_axes[env.shapes.lot])  # rows: new axes in the lot's frame
-    return euler.angles(relative)
+def _scope_angles(env: Env, axes: np.ndarray, frames: np.ndarray | None) -> np.ndarray:
+    """The scope's rotation relative to the pivot with ``axes`` (n, 3, 3) and frame ids ``frames`` (None: no
+    pivot is kept), as angles (n, 3) in degrees about x, then y, then z (``backend.euler``)."""
+    scope_axes = env.chunk.frames[env.shapes.frame]
+    if frames is None:
+        return euler.angles(np.einsum("nij,nkj->nik", scope_axes, axes))  # rows: new axes in the lot's frame
+    return relative_angles(scope_axes, axes, env.shapes.frame == frames)
 
 
 def _call(expr: ir.Call, env: Env):

@@ -11,6 +11,8 @@ batch, never per shape.
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 
 from grammarc.backend import terminals
@@ -20,6 +22,7 @@ from grammarc.backend.occlusion import add_occluders
 from grammarc.backend.operations import OPERATIONS, Parts
 from grammarc.backend.operations.scope import center
 from grammarc.backend.operations.table import check_writes
+from grammarc.backend.pivot import aligned, sets_pivot
 from grammarc.backend.plan import SymbolPlan
 from grammarc.backend.random import uniform
 from grammarc.backend.shapes import Shapes
@@ -139,15 +142,26 @@ def run(ctx: Context, body: ir.Body, cursor: Shapes, leaf_at_end: bool = False) 
             # an operation changes the cursor (returns it), makes shapes for its parts, or neither
             made = entry.function(ctx, cursor, op)
             if type(made) is Parts:
-                run_parts(ctx, made)
+                run_parts(ctx, _pivoted(ctx, op, made))
             elif made is not None:
                 if STRICT:
                     check_writes(op, entry.writes, cursor, made)
-                cursor = made
+                cursor = _pivoted(ctx, op, made)
     if leaf_at_end and ctx.plan.leaf_bodies and len(cursor) and not any(type(op) in _CONSUMING for op in body):
         if ctx.plan.occluders:
             add_occluders(ctx.chunk, cursor)  # a leaf solid occludes
         terminals.emit_leaves(ctx, cursor, ctx.symbol)
+
+
+def _pivoted(ctx: Context, op: ir.Op, made):
+    """``made`` (shapes or ``Parts``) with their scopes as their pivots where ``op`` sets the pivot and the
+    grammar keeps one (``backend.pivot``)."""
+    slot = ctx.plan.pivot_slot
+    if slot is None or not sets_pivot(op):
+        return made
+    if type(made) is Parts:
+        return replace(made, shapes=aligned(slot, made.shapes))
+    return aligned(slot, made)
 
 
 def run_parts(ctx: Context, parts: Parts) -> None:

@@ -15,6 +15,7 @@ from grammarc.backend.slots import (
     COLOR_SLOT,
     HORIZONTAL_SLOTS,
     HORIZONTAL_SWITCH,
+    PIVOT_SLOTS,
     TRIM_SLOTS,
     TRIM_SWITCH,
     uv_slots,
@@ -100,6 +101,9 @@ class Plan:
     #: Texture set -> index into ``Shapes.dynamic`` of its two columns (``slots.uv_slots``), for the sets
     #: the grammar's texture operations and queries name; empty: no shape carries texture coordinates.
     uv_slots: dict = field(default_factory=dict)
+    #: Index into ``Shapes.dynamic`` of the first of the pivot's columns (``backend.pivot``), None where the
+    #: grammar needs no pivot of its own.
+    pivot_slot: int | None = None
     #: ``load_asset(name, asset_roots) -> AssetMesh``: how trimmed inserts get their asset's triangles
     #: (the model's loader, or a test's stand-in).
     load_asset: Callable = load_asset
@@ -145,9 +149,10 @@ def make_plan(grammar: Grammar, *, load_asset: Callable = load_asset) -> Plan:
     occlusion = {k: v for k, v in occlusion.items() if v}
     ancestors = list(ANCESTORS) if occlusion or any(isinstance(op, ir.Label) for op in ops) else []
     uv_sets = texture_sets(module, ops)
+    pivot = list(PIVOT_SLOTS) if uses_pivot(module, ops, all_exprs(module)) else []
     dynamic = {name: i for i, name in enumerate(dict.fromkeys(
         [op.name for op in ops if isinstance(op, ir.SetAttr)] + sorted(set(context)) + colour + trims
-        + ancestors + [name for s in uv_sets for name in uv_slots(s)]))}
+        + ancestors + [name for s in uv_sets for name in uv_slots(s)] + pivot))}
     not_applied = tuple(sorted({op.name for op in ops if isinstance(op, ir.NotApplied)}))
     strings.intern("")
     for answer in ("none", "part", "full"):  # of Shape.occ
@@ -172,7 +177,7 @@ def make_plan(grammar: Grammar, *, load_asset: Callable = load_asset) -> Plan:
         trim_switch=dynamic.get(TRIM_SWITCH) if trim_slot is not None else None,
         horizontal_slot=dynamic.get(HORIZONTAL_SLOTS[0]), horizontal_switch=dynamic.get(HORIZONTAL_SWITCH),
         occluders=ANCESTORS[0] in dynamic, load_asset=load_asset,
-        uv_slots={s: dynamic[uv_slots(s)[0]] for s in uv_sets})
+        uv_slots={s: dynamic[uv_slots(s)[0]] for s in uv_sets}, pivot_slot=dynamic.get(PIVOT_SLOTS[0]))
     return replace(plan, leaf_inserts=leaf_inserts(plan))
 
 
@@ -190,6 +195,27 @@ def texture_sets(module: ir.Module, ops) -> list[int]:
         if isinstance(expr, ir.Call) and expr.func in UV_QUERIES:
             sets.add(int(expr.args[0].value) if expr.args and isinstance(expr.args[0], ir.Num) else 0)
     return sorted(sets)
+
+
+def uses_pivot(module: ir.Module, ops, exprs) -> bool:
+    """Whether the shapes of ``module`` (its operations ``ops``, its expressions ``exprs``) need pivots of their
+    own (``backend.pivot``)."""
+    if module.dialect != "cityengine":
+        return False
+    for op in ops:
+        if isinstance(op, ir.SetPivot) or (isinstance(op, ir.Transform) and op.system == "pivot"):
+            return True
+        angles = op.angles if isinstance(op, ir.Rotate) and op.fixed else \
+            op.angles if isinstance(op, ir.AlignScope) and op.mode == "rotate" else ()
+        if sum(not (isinstance(a, ir.Num) and a.value == 0) for a in angles) > 1:
+            return True
+    for expr in exprs:
+        if isinstance(expr, ir.ScopeRef) and expr.field[0] in "tr":
+            return True
+        if isinstance(expr, ir.Call) and expr.func == "convert" and any(
+                isinstance(a, ir.Str) and a.value == "pivot" for a in expr.args[1:3]):
+            return True
+    return False
 
 
 TEXTURE_OPS = (ir.SetupProjection, ir.ProjectUV, ir.TransformUV, ir.TileUV, ir.NormalizeUV, ir.CopyUV,

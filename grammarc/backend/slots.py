@@ -36,3 +36,7 @@ ANCESTORS = tuple(f"occluder.{k}" for k in range(4))
 def uv_slots(uv_set: int) -> tuple[str, str]:
     """The two per-shape columns of texture set ``uv_set``: its projection's map id, its coordinates'."""
     return f"uv{uv_set}.projection", f"uv{uv_set}.coordinates"
+
+#: A shape's pivot (``backend.pivot``): its origin in world coordinates (three float64 columns) and its axes,
+#: an id (int32) into the chunk's ``Frames``.
+PIVOT_SLOTS = ("pivot.px", "pivot.py", "pivot.pz", "pivot.frame")

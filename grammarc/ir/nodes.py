@@ -1081,13 +1081,25 @@ ALONG_UV_DIRECTIONS = ("scope.y", "vertex.normal")
 ALONG_UV_ALIGNMENTS = ("alignPosition", "keepPosition")
 
 
+@dataclass(frozen=True, slots=True)
+class SetPivot:
+    """CityEngine ``setPivot(xyz|yzx|zxy, corner)``: the shape's pivot moves to corner ``corner`` (0 to 7) of
+    its scope, its axes the scope's renamed by ``axes`` and turned to point into the scope, and the scope
+    takes the pivot's axes and origin around the unchanged geometry (``backend.pivot``)."""
+
+    axes: str
+    corner: Expr = child(Type.NUM, "a corner index")
+    span: Span = NO_SPAN
+
+
 Op = (Symbol | Empty | Translate | Scale | Rotate | Push | Pop | Insert | Split | Repeat | Comp | Extrude
       | Center | UseAsset | Case | Stochastic | SetAttr | Report | NotApplied | GroupSplit | CompFaces
       | AlignScope | Mirror | Offset | SetColor | Setback | Roof | InnerRectangle | Convexify
       | CleanupGeometry | DeleteHoles | Snap | Label | Transform | Scatter | AlignToGeometry | Primitive
       | Trim | SplitArea | ReduceGeometry | MirrorScope | SetOpacity | SetupProjection | ProjectUV | TransformUV
       | TileUV | NormalizeUV | SetbackToArea | Taper | ResetGeometry | AlignScopeToBBox
-      | Footprint | Rectify | CopyUV | InsertAlongUV | ResetMaterial | SetMaterial)
+      | Footprint | Rectify | CopyUV | InsertAlongUV | ResetMaterial | SetMaterial
+      | SetPivot)
 Body = tuple[Op, ...]
 
 

@@ -161,6 +161,7 @@ _OP_FORMATS = {
     ir.Scale: lambda op: f"S({', '.join(_size(s) for s in op.sizes)})",
     ir.Rotate: lambda op: f"{'r' if op.fixed else 'R'}({'scopeCenter, ' if op.center else ''}{_list(op.angles)})",
     ir.Transform: lambda op: f"{op.kind}({'rel' if op.relative else 'abs'}, {op.system}, {_list(op.values)})",
+    ir.SetPivot: lambda op: f"setPivot({op.axes}, {print_expr(op.corner)})",
     ir.Push: lambda op: "[",
     ir.Pop: lambda op: "]",
     ir.Insert: lambda op: f'I("{op.asset}")',

@@ -94,7 +94,7 @@ def env():
     strings = Strings()
     strings.intern("a")
     strings.intern("b")
-    return Env(shapes, chunk, SimpleNamespace(strings=strings, dynamic={}))
+    return Env(shapes, chunk, SimpleNamespace(strings=strings, dynamic={}, pivot_slot=None))
 
 
 def num(v):

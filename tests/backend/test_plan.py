@@ -5,7 +5,7 @@ from __future__ import annotations
 from operations.derivations import VERSION
 
 from grammarc.backend.plan import make_plan
-from grammarc.backend.slots import ANCESTORS, COLOR_SLOT, TRIM_SLOTS, TRIM_SWITCH, uv_slots
+from grammarc.backend.slots import ANCESTORS, COLOR_SLOT, PIVOT_SLOTS, TRIM_SLOTS, TRIM_SWITCH, uv_slots
 from grammarc.compiler import compile_grammar
 
 
@@ -35,3 +35,16 @@ def test_texture_columns_only_for_the_sets_the_grammar_names(write):
     assert sorted(plan.uv_slots) == [0, 2, 5]
     for uv_set, start in plan.uv_slots.items():
         assert [plan.dynamic[name] for name in uv_slots(uv_set)] == [start, start + 1]
+
+
+def test_pivot_columns_only_where_the_grammar_uses_the_pivot(write):
+    """The pivot rides with the shapes of a grammar that sets it, reads it (``scope.t*``, ``scope.r*``,
+    ``pivot.*``, ``convert``), moves in it or turns with an ``r`` of several angles; not with single turns."""
+    for text in ("Lot --> extrude(3) r(0, 30, 0) X\n", "Lot --> r(0, 0, 0) rotateScope(0, 90, 0) X\n",
+                 'Lot --> report("x", convert(x, scope, world, pos, 0, 0, 0)) X\n'):
+        assert plan_of(write, text).pivot_slot is None, text
+    for text in ("Lot --> setPivot(yzx, 2) X\n", "Lot --> r(10, 0, 20) X\n", "Lot --> rotateScope(0, 90, 5) X\n",
+                 'Lot --> report("t", scope.tx) X\n', 'Lot --> report("o", pivot.oy) X\n',
+                 "Lot --> set(scope.ry, 30) X\n", "Lot --> translate(rel, pivot, 1, 0, 0) X\n"):
+        plan = plan_of(write, text)
+        assert [plan.dynamic[name] - plan.pivot_slot for name in PIVOT_SLOTS] == [0, 1, 2, 3], text

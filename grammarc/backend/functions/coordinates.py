@@ -5,11 +5,9 @@ degrees, ``backend.euler``), from one of CityEngine's coordinate systems to anot
 components. The systems, as grammarc's shapes have them:
 
 - ``world``: the coordinates of the lots and the records (y up);
-- ``object``: the lot's own scope, which ``scope.t*``, ``scope.r*`` and ``initialShape.origin`` are
-  relative to (``evaluate._scope_field``);
-- ``pivot``: the object system. CityEngine places a shape's pivot where ``setPivot`` puts it, and an initial
-  shape's pivot is its object system; grammarc accepts ``setPivot`` without applying it (it moves only a
-  model's own origin in an export), so the pivot stays the object system;
+- ``object``: the lot's own scope, which ``initialShape.origin`` is relative to;
+- ``pivot``: the shape's pivot (``backend.pivot``), which ``scope.t*`` and ``scope.r*`` are relative to
+  (``evaluate._scope_field``): the object system where the grammar keeps no pivot;
 - ``scope``: the shape's scope, its origin and axes.
 
 A system is an origin and axes (rows, in world): a position p goes to world as ``origin + p @ axes`` and
@@ -24,7 +22,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from grammarc.backend import euler
+from grammarc.backend import euler, pivot
 from grammarc.backend.functions.table import distinct, function
 
 if TYPE_CHECKING:
@@ -56,7 +54,9 @@ def system(name: str, env: Env) -> tuple[np.ndarray, np.ndarray]:
     if name == "world":
         n = len(shapes)
         return np.zeros((n, 3)), np.broadcast_to(np.eye(3), (n, 3, 3))
-    return chunk.lot_origin[shapes.lot], chunk.lot_axes[shapes.lot]  # object, and the pivot that is it
+    if name == "pivot":
+        return pivot.pivot_system(env.plan.pivot_slot, chunk, shapes)
+    return chunk.lot_origin[shapes.lot], chunk.lot_axes[shapes.lot]
 
 
 @function("initialShape.name")

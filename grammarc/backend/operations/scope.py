@@ -1,13 +1,14 @@
 """Scope operations: ``T``/``S``/``R`` (``t s r``), CityEngine's ``translate`` and ``rotate`` in a coordinate
-system, ``extrude``, ``alignScopeToAxes``/``alignScopeToGeometry``/``rotateScope``, ``mirror`` and
-``mirrorScope``; and ``center``, which the body runner calls (it centres on the scope the body began with
-or last pushed, which only the runner holds).
+system, ``extrude``, ``alignScopeToAxes``/``alignScopeToGeometry``/``rotateScope``, ``mirror``,
+``mirrorScope`` and ``setPivot``; and ``center``, which the body runner calls (it centres on the scope the
+body began with or last pushed, which only the runner holds).
 
 They change the cursor's scope and return it. Reads: the scope (``origin``, ``size``, ``frame``), ``geom``
 (extrude, align, mirror), and what their expressions read. Writes: ``T``, ``translate`` and ``center`` the
 ``origin``, ``S`` the ``size``, ``R`` and ``rotate`` the ``frame`` (and ``r(scopeCenter, ...)`` the
-``origin``, to keep the centre), ``mirror`` the ``geom``; ``extrude``, the alignments and ``mirrorScope``
-all four of the scope and geometry, as they turn scopes around their geometry (``backend.reframing``).
+``origin``, to keep the centre), ``mirror`` the ``geom``; ``extrude``, the alignments, ``mirrorScope`` and
+``setPivot`` all four of the scope and geometry, as they turn scopes around their geometry
+(``backend.reframing``), and ``setPivot`` the pivot's columns too (``backend.pivot``).
 """
 
 from __future__ import annotations
@@ -17,13 +18,13 @@ import shapely
 
 from grammarc.backend import mesh_shapes
 from grammarc.backend.context import Context
-from grammarc.backend.euler import angles as euler_angles
 from grammarc.backend.euler import orientation, rotation
 from grammarc.backend.evaluate import evaluate, evaluate_array
 from grammarc.backend.functions.coordinates import system
 from grammarc.backend.mesh_shapes import store_fitted
 from grammarc.backend.operations.table import operation
 from grammarc.backend.outlines import flat_axis, polygons_of
+from grammarc.backend.pivot import corner_axes, pivot_frames, pivot_system, relative_angles, with_pivot
 from grammarc.backend.reframing import reframed, turned
 from grammarc.backend.shapes import Shapes, asset_geom, asset_of
 from grammarc.constants import TOL
@@ -64,18 +65,26 @@ def scale(ctx: Context, cursor: Shapes, op: ir.Scale) -> Shapes:
 def rotate(ctx: Context, cursor: Shapes, op: ir.Rotate) -> Shapes:
     """``R`` about the scope's own turning axes, CityEngine's ``r(x, y, z)`` about its axes as they were
     (``op.fixed``), around its origin; ``r(scopeCenter, x, y, z)`` turns the same way and moves the origin
-    so that the scope's centre stays where it was."""
+    so that the scope's centre stays where it was.
+
+    Where the grammar keeps pivots (``backend.pivot``), CityEngine's ``r`` is the reference's
+    ``rotate(rel, pivot, x, y, z)``: the angles are added to the scope's angles in its pivot's frame, so a
+    second ``r`` after a first adds to its angles; a scope aligned with its pivot (the same frame) has
+    angles exactly zero, and turns as without pivots."""
     env = ctx.env(cursor)
     angles = [evaluate(e, env) for e in op.angles]
     frames = ctx.chunk.frames
-    turn = orientation if op.fixed else rotation
-    if all(np.ndim(a) == 0 for a in angles):
+    if op.fixed and ctx.plan.pivot_slot is not None:
+        frame = frames.add(_about_pivot(ctx, cursor, angles))
+    elif all(np.ndim(a) == 0 for a in angles):
         # One rotation for all: rotate each distinct frame once.
+        turn = orientation if op.fixed else rotation
         unique, inverse = np.unique(cursor.frame, return_inverse=True)
         matrix = turn(*(np.full(1, a, dtype=np.float64) for a in angles))[0]
         new = frames.add(np.einsum("ij,fjk->fik", matrix, frames[unique]))
         frame = new[inverse.reshape(-1)]
     else:
+        turn = orientation if op.fixed else rotation
         n = len(cursor)
         matrices = turn(*(np.broadcast_to(np.asarray(a, np.float64), (n,)) for a in angles))
         frame = frames.add(np.einsum("nij,njk->nik", matrices, frames[cursor.frame]))
@@ -86,10 +95,28 @@ def rotate(ctx: Context, cursor: Shapes, op: ir.Rotate) -> Shapes:
     return cursor.with_scope(origin, cursor.size, frame, cursor.geom)
 
 
+def _about_pivot(ctx: Context, cursor: Shapes, angles) -> np.ndarray:
+    """The axes (n, 3, 3) of the shapes' scopes with ``angles`` (three scalars or (n,) arrays, degrees) added
+    to their angles in their pivots' frames (``backend.pivot``)."""
+    n = len(cursor)
+    slot = ctx.plan.pivot_slot
+    _, pivot_axes = pivot_system(slot, ctx.chunk, cursor)
+    added = np.stack([np.broadcast_to(np.asarray(a, np.float64), (n,)) for a in angles], axis=1)
+    return _added_angles(ctx, cursor, pivot_axes, cursor.frame == pivot_frames(slot, cursor), added)
+
+
+def _added_angles(ctx: Context, cursor: Shapes, axes: np.ndarray, aligned: np.ndarray | bool,
+                  added: np.ndarray) -> np.ndarray:
+    """The axes (n, 3, 3) of the shapes' scopes whose angles in the frames ``axes`` (n, 3, 3) grow by ``added``
+    (n, 3) degrees; the scopes ``aligned`` (n,) bool share those frames (their angles are exactly zero)."""
+    angles = added + relative_angles(ctx.chunk.frames[cursor.frame], axes, aligned)
+    return np.einsum("nij,njk->nik", orientation(*angles.T), axes)
+
+
 @operation(ir.Transform, writes=("origin", "frame"), meshes=True)
 def transform(ctx: Context, cursor: Shapes, op: ir.Transform) -> Shapes:
     """CityEngine ``translate`` and ``rotate`` in a coordinate system (``functions.coordinates.system``;
-    the pivot is the object system, as grammarc does not apply ``setPivot``).
+    the pivot is the shape's, ``backend.pivot``).
 
     ``translate``: ``rel`` adds the vector along the system's axes, ``abs`` puts the scope origin at the
     position in the system. ``rotate``: the scope's orientation in the system, as the angles ``scope.r``
@@ -98,8 +125,8 @@ def transform(ctx: Context, cursor: Shapes, op: ir.Transform) -> Shapes:
     around its origin. In the scope system the scope's own angles are 0, so ``rel`` and ``abs`` agree there:
     a turn about the scope's axes in that order.
 
-    The reference calls ``r(x, y, z)`` the same as ``rotate(rel, pivot, x, y, z)``; grammarc's ``r`` is
-    that where the scope's axes are its pivot's (``rotate`` above).
+    The reference calls ``r(x, y, z)`` the same as ``rotate(rel, pivot, x, y, z)``, which grammarc's ``r``
+    is where the grammar keeps pivots (``rotate`` above).
     """
     env = ctx.env(cursor)
     n = len(cursor)
@@ -111,9 +138,10 @@ def transform(ctx: Context, cursor: Shapes, op: ir.Transform) -> Shapes:
         new_origin = base + np.einsum("ni,nij->nj", values, axes)
         return cursor.with_scope(new_origin, cursor.size, cursor.frame, cursor.geom)
     if op.relative and op.system != "scope":
-        # rows: the scope's axes in the system's coordinates
-        values = values + euler_angles(np.einsum("nij,nkj->nik", frames[cursor.frame], axes))
-    frame = frames.add(np.einsum("nij,njk->nik", orientation(*values.T), axes))
+        ids = pivot_frames(ctx.plan.pivot_slot, cursor) if op.system == "pivot" else None
+        frame = frames.add(_added_angles(ctx, cursor, axes, False if ids is None else cursor.frame == ids, values))
+    else:
+        frame = frames.add(np.einsum("nij,njk->nik", orientation(*values.T), axes))
     return cursor.with_scope(cursor.origin, cursor.size, frame, cursor.geom)
 
 
@@ -289,10 +317,11 @@ def align_scope(ctx: Context, cursor: Shapes, op: ir.AlignScope) -> Shapes:
     n = len(cursor)
     if op.mode == "world":
         new_axes = np.broadcast_to(np.eye(3), (n, 3, 3))
-    elif op.mode == "rotate":  # rotateScope: in xyz order as r
+    elif op.mode == "rotate":  # rotateScope: in xyz order as r, about the pivot's axes where it is kept
         env = ctx.env(cursor)
         angles = [np.broadcast_to(evaluate_array(e, env), (n,)) for e in op.angles]
-        new_axes = np.einsum("nij,njk->nik", orientation(*angles), axes)
+        new_axes = _about_pivot(ctx, cursor, angles) if ctx.plan.pivot_slot is not None else \
+            np.einsum("nij,njk->nik", orientation(*angles), axes)
     else:
         new_axes = _world_axis(axes, "xyz".index(op.mode))
     return reframed(ctx, cursor, new_axes, op.span)
@@ -438,3 +467,29 @@ def mirror_scope(ctx: Context, cursor: Shapes, op: ir.MirrorScope) -> Shapes:
         return cursor
     new_axes = ctx.chunk.frames[cursor.frame] * np.where(flips, -1.0, 1.0)[:, :, None]
     return reframed(ctx, cursor, new_axes, op.span)
+
+
+@operation(ir.SetPivot, writes=(*_SCOPE, "dynamic"), meshes=True)
+def set_pivot(ctx: Context, cursor: Shapes, op: ir.SetPivot) -> Shapes:
+    """``setPivot(axisMap, cornerIndex)``: the pivot moves to the scope's corner ``cornerIndex`` (modulo 8:
+    ``backend.pivot.CORNERS``), its axes the scope's as ``axisMap`` renames them, each pointing into the
+    scope (``pivot.corner_axes``); the scope becomes the same box in the pivot's axes, from that corner (its
+    ``scope.t`` and ``scope.r`` zero), the geometry where it was. A box or rectangle keeps its scope exactly;
+    other geometry gets the scope fitted to it in the new axes (``backend.reframing``), which is the same box
+    where the geometry fills its scope."""
+    n = len(cursor)
+    corner = np.floor(np.broadcast_to(evaluate_array(op.corner, ctx.env(cursor)), (n,))).astype(np.int64)
+    ends, turn = corner_axes(op.axes, corner)
+    frames = ctx.chunk.frames
+    axes = frames[cursor.frame]
+    new_axes = np.einsum("nij,njk->nik", turn, axes)
+    box = cursor.geom == -1
+    origin = cursor.origin + np.einsum("ni,nij->nj", ends * cursor.size, axes)
+    # a new axis is an old one, reversed or not: its size is that one's
+    size = np.abs(np.einsum("nij,nj->ni", turn, cursor.size))
+    moved = cursor.with_scope(origin, size, frames.add(np.ascontiguousarray(new_axes)), cursor.geom)
+    if not box.all():
+        rows, others = np.flatnonzero(~box), np.flatnonzero(box)
+        moved = Shapes.merge([moved.take(others), reframed(ctx, cursor.take(rows), new_axes[rows], op.span)],
+                             [others, rows])
+    return with_pivot(ctx.plan.pivot_slot, moved, moved.origin, moved.frame)

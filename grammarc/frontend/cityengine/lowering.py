@@ -77,6 +77,8 @@ SELECTOR_ARGUMENTS = {
 }
 #: ``initialShape.origin.o{x|y|z}``: the lot's orientation, a component of ``convert``'s.
 INITIAL_ORIENTATION = {f"initialShape.origin.o{c}": c for c in "xyz"}
+#: ``pivot.p{x|y|z}`` and ``pivot.o{x|y|z}``: the pivot's origin and orientation in the object system.
+PIVOT_MEMBERS = frozenset(f"pivot.{k}{c}" for k in "po" for c in "xyz")
 #: The faces ``geometry.isOriented`` checks for, by their normals, as ``comp(f)`` selects them.
 _ORIENTATIONS = frozenset(
     {f"{frame}{s}" for frame in ("", "object.") for s in ("front", "back", "left", "right", "top", "bottom", "side")}
@@ -432,6 +434,11 @@ class Lowering(OperationLowering, LoweringBase):
             zero = ir.Num(0.0, span)
             return self.convert((ir.Name(INITIAL_ORIENTATION[text], span), ir.Name("object", span),
                                  ir.Name("world", span), ir.Name("orient", span), zero, zero, zero), span)
+        if text in PIVOT_MEMBERS:  # the pivot's origin and angles in the object system (``backend.pivot``)
+            zero = ir.Num(0.0, span)
+            kind = "pos" if names[1][0] == "p" else "orient"
+            return self.convert((ir.Name(names[1][1], span), ir.Name("pivot", span), ir.Name("object", span),
+                                 ir.Name(kind, span), zero, zero, zero), span)
         if names[0] in UNSUPPORTED_MEMBERS:
             self.unsupported(text, span)
             return ir.placeholder(span)

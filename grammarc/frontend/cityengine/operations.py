@@ -108,11 +108,10 @@ class OperationLowering:
         origin or centre (the reference spells the default ``scopeOrgin`` too).
 
         The reference's ``r`` adds the angles to ``scope.r``, the scope's angles about its pivot's x, then
-        y, then z. A component split aligns the pivot with each component's scope (its default ``zUp``),
-        and an initial shape's scope is its pivot, so where ``r`` mostly runs the scope's angles are 0 and
-        the turn is about the scope's x, then y, then z as they were: ``fixed``. grammarc keeps no pivot
-        per shape, so a second ``r`` with several angles turns from the first one's axes instead of adding
-        to its angles."""
+        y, then z: ``fixed``, which the derivation applies in the pivot's frame where the grammar keeps
+        pivots (``backend.pivot``: a grammar with an ``r`` of several angles does). Elsewhere it turns about
+        the scope's x, then y, then z as they were, the same where the scope is aligned with its pivot (on a
+        lot, after a ``comp``)."""
         center = False
         if len(args) == 4 and isinstance(args[0], ir.Name) \
                 and args[0].name in ("scopeOrigin", "scopeOrgin", "scopeCenter"):
@@ -136,6 +135,16 @@ class OperationLowering:
                              "second", span)
             return ir.Empty(span)
         return ir.Transform(op, mode.name == "rel", system.name, tuple(self.expr(a) for a in args[2:]), span)
+
+    def op_set_pivot(self, op, args, span):
+        """``setPivot(xyz|yzx|zxy, cornerIndex)``; older rule files quote the axis map (``"yzx"``)."""
+        if not self.arity(op, args, (2,), span):
+            return ir.Empty(span)
+        axes = _selector(args[0])
+        if axes not in PIVOT_AXES:
+            self.diags.error("selector", f"`{op}` expects an axis map xyz, yzx or zxy first", span)
+            return ir.Empty(span)
+        return ir.SetPivot(axes, self.expr(args[1]), span)
 
     def op_color(self, op, args, span):
         if len(args) not in (1, 3, 4):
@@ -643,6 +652,7 @@ OPERATIONS = {
     "r": OperationLowering.op_rotate,
     "translate": OperationLowering.op_transform,
     "rotate": OperationLowering.op_transform,
+    "setPivot": OperationLowering.op_set_pivot,
     "center": OperationLowering.op_center,
     "i": OperationLowering.op_insert,
     "primitiveCube": OperationLowering.op_cube,
@@ -740,8 +750,6 @@ UNSUPPORTED_MEMBERS = frozenset({"comp", "split", "initialShape", "geometry"})
 #: Operations that are parsed and accepted but do not change the record (listed in its meta).
 NOT_APPLIED = frozenset({
     "reverseNormals", "print", "setNormals", "softenNormals",
-    # the pivot only moves the model's own origin in an export; scope.t* stay relative to the lot
-    "setPivot",
     # component tags name faces, edges and vertices for what reads them (inline, the boolean operations,
     # geometry.hasTags and geometry.tags, tag selectors), each unsupported with its own error
     "tag", "deleteTags", "setTagsFromEdgeAttrs",
@@ -763,6 +771,8 @@ ALL_OPERATIONS = (frozenset(OPERATIONS) | frozenset(PART_OPERATIONS) | frozenset
 #: Face and edge selectors of ``alignScopeToGeometry``.
 ALIGN_FACES = frozenset({"largest", "world.lowest", "any"})
 ALIGN_EDGES = frozenset({"longest", "world.lowest"})
+#: ``setPivot``'s axis maps.
+PIVOT_AXES = frozenset({"xyz", "yzx", "zxy"})
 #: Axis selectors of ``center`` and ``alignScopeToAxes``.
 AXIS_NAMES = {"x": (0,), "y": (1,), "z": (2,), "xy": (0, 1), "xz": (0, 2), "yz": (1, 2), "xyz": (0, 1, 2)}
 

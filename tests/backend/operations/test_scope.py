@@ -376,6 +376,37 @@ def test_mirror_scope_reverses_two_axes_around_the_same_geometry(write):
     assert "`mirrorScope` of one or three axes is not supported yet" in bad.reason
 
 
+@pytest.mark.parametrize("ops, xform", [
+    # corner 2, the far end of x and z at the bottom: x and z reversed, as a half turn about y
+    ("setPivot(xyz, 2)", [[-12, 0, 0, 12], [0, 3, 0, 0], [0, 0, -8, 0]]),
+    # corner 0 of yzx: x along the old y, y along the old z, z along the old x
+    ("setPivot(yzx, 0)", [[0, 0, 12, 0], [3, 0, 0, 0], [0, 8, 0, -8]]),
+    ("setPivot(zxy, 0)", [[0, 12, 0, 0], [0, 0, 3, 0], [8, 0, 0, -8]]),
+    # corner 6, the far top corner: y down, x along the old -z, z along the old -x
+    ("setPivot(xyz, 6)", [[0, 0, -12, 12], [0, -3, 0, 3], [-8, 0, 0, 0]]),
+    # a split then runs from the pivot's corner: the first 2 m at the far end of x
+    ("setPivot(xyz, 2) split(x){ 2 : X | ~1 : NIL }", [[-2, 0, 0, 12], [0, 3, 0, 0], [0, 0, -8, 0]]),
+])
+def test_set_pivot_gives_the_scope_the_pivots_corner_and_axes(write, ops, xform):
+    """The reference: the pivot at the chosen corner of the 12 x 3 x 8 box, its axes the scope's renamed by
+    the axis map and pointing inside; the scope the same box in those axes, the geometry where it was."""
+    r = run(write, f"Lot --> extrude(3) {ops} X\n", [rect(12, 8)])
+    np.testing.assert_allclose(r["xform"][0], xform, atol=1e-6)
+
+
+@pytest.mark.parametrize("lot", ["concave_L", "courtyard"])
+def test_set_pivot_keeps_a_polygon_or_a_mesh_where_it_was(write, lot):
+    """A concave prism (mesh faces) and a lot's polygon keep their faces; only the scope turns."""
+    for body in ("extrude(2)", ""):
+        plain = run(write, f"Lot --> {body} X\n", [LOT_ZOO[lot]])
+        pivoted = run(write, f"Lot --> {body} setPivot(zxy, 5) X\n", [LOT_ZOO[lot]])
+        assert len(pivoted["bad"]) == 0
+        before = sorted(round(face_area(f), 6) for f in mesh_faces(plain))
+        assert sorted(round(face_area(f), 6) for f in mesh_faces(pivoted)) == before
+        np.testing.assert_allclose(np.sort(pivoted["mesh"].vertices, axis=0), np.sort(plain["mesh"].vertices, axis=0),
+                                   atol=1e-5)
+
+
 def test_mirror_of_a_roof_flips_its_mesh_and_keeps_its_faces_outward(write):
     """A shed roof rising along scope z, mirrored along z, rises the other way: the same volume, its
     highest vertices at the other edge, and every face still facing out (its signed volume positive)."""
