@@ -65,6 +65,12 @@ def test_a_component_and_an_aligned_scope_are_their_pivots(write):
     assert (got["px"], got["pz"], got["oy"]) == pytest.approx((12, 8, 90))
     got = _read(write, "r(0, 30, 0) t(1, 2, 3) alignScopeToAxes(y)")
     assert [got[k] for k in ("tx", "ty", "tz", "rx", "ry", "rz")] == pytest.approx([0] * 6, abs=1e-9)
+    got = _read(write, "r(0, 30, 0) t(1, 2, 3) alignScopeToGeometryBBox(xz)")
+    assert [got[k] for k in ("tx", "ty", "tz", "rx", "ry", "rz")] == pytest.approx([0] * 6, abs=1e-9)
+    # resetGeometry gives back the lot's scope, which is the lot's pivot
+    got = _read(write, "extrude(3) setPivot(xyz, 6) resetGeometry()")
+    assert [got[k] for k in ("tx", "ty", "tz", "rx", "ry", "rz", "px", "py", "pz")] == pytest.approx([0] * 9,
+                                                                                                  abs=1e-9)
     lot = [rotated_rectangle()]
     moved = run(write, "Lot --> extrude(3) comp(f){ front : translate(rel, pivot, 2, 0, 0) X }\n", lot)
     plain = run(write, "Lot --> extrude(3) comp(f){ front : t(2, 0, 0) X }\n", lot)
