@@ -754,17 +754,10 @@ NOT_APPLIED = frozenset({
     # geometry.hasTags and geometry.tags, tag selectors), each unsupported with its own error
     "tag", "deleteTags", "setTagsFromEdgeAttrs",
 })
-#: CityEngine operations grammarc does not implement yet (the geometry and context issues bring most).
+#: CityEngine operations grammarc does not implement yet (the README's operations table says why).
 #: With ``OPERATIONS``, ``PART_OPERATIONS`` and ``NOT_APPLIED`` they are every operation of CityEngine's
 #: CGA reference, so that any other name called with parts, or a typo of one of them, is unknown.
-UNSUPPORTED_OPS = frozenset({
-    "innerPolygon",
-    "inline",
-    "semiPolygon",
-    "modify",
-    "splitAndSetbackPerimeter",
-    "union", "subtract", "intersect",
-} - NOT_APPLIED)
+UNSUPPORTED_OPS = frozenset({"inline", "modify", "splitAndSetbackPerimeter", "union", "subtract", "intersect"})
 #: Every operation name CityEngine knows: what a misspelt one is suggested from.
 ALL_OPERATIONS = (frozenset(OPERATIONS) | frozenset(PART_OPERATIONS) | frozenset(BODY_OPERATIONS) | NOT_APPLIED
                   | UNSUPPORTED_OPS)
