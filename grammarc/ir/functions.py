@@ -171,7 +171,7 @@ ARRAY_FUNCTIONS = frozenset({"size", "nRows", "nColumns", "findFirst", "transpos
 #: Built-in functions of CityEngine's reference that grammarc does not compute: a call is ``unsupported``,
 #: not an unknown name (materials are not kept, context queries other than occlusion are not asked, lots
 #: carry no geographic frame, edge attributes or shape-tree keys).
-UNSUPPORTED_FUNCTIONS = frozenset({"getMaterial", "getGeoCoord", "getTreeKey", "minimumDistance", "contextCompare",
-                                   "contextCount", "sel"})
+UNSUPPORTED_FUNCTIONS = frozenset({"getMaterial", "getGeoCoord", "getTreeKey", "contextCompare", "contextCount",
+                                   "sel"})
 #: The array conversions and the scalar conversion each applies to every element.
 ARRAY_CONVERSIONS = {"floatArray": "float", "boolArray": "bool", "stringArray": "str"}

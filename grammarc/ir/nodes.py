@@ -256,8 +256,9 @@ class ContextRef:
     span: Span = NO_SPAN
 
 
-#: CityEngine's occlusion queries and their targets.
+#: CityEngine's occlusion queries, its context queries that give numbers, and their targets.
 OCCLUSION_KINDS = frozenset({"inside", "overlaps", "touches"})
+CONTEXT_KINDS = frozenset({"minimumDistance"})
 OCCLUSION_TARGETS = frozenset({"intra", "inter", "all"})
 
 
@@ -272,7 +273,10 @@ class Occlusion:
 
     CityEngine's target may be computed, ``inside(sel(text), ...)`` (``sel`` makes a selector of a
     string): ``which`` is that string per shape, in place of ``target``; a label may be any string
-    expression, ``named``, in place of the constant ``label``."""
+    expression, ``named``, in place of the constant ``label``.
+
+    Kind ``minimumDistance`` (``CONTEXT_KINDS``, a number) is the distance from the shape's scope to the
+    nearest scope labelled ``label`` (or ``named``) of the target's lots."""
 
     kind: str
     target: str
