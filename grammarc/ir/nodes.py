@@ -531,7 +531,8 @@ class UseAsset:
     ``asset`` is the name when it is written as a string; otherwise ``name`` computes it per shape (a
     parameter or constant holding an asset path). ``up`` is the asset's up axis, ``"yUp"`` or ``"zUp"``
     (turned -90 degrees about x); ``mode`` one of ``INSERT_MODES``: fitted to the scope, or the scope
-    made the asset's own size, at the asset's own position or centred on the scope's xz.
+    made the asset's own size, at the asset's own position or centred on the scope's xz. Either may be
+    computed, a string per shape (``up_by``, ``mode_by``, in place of ``up`` and ``mode``).
     """
 
     asset: str
@@ -539,9 +540,12 @@ class UseAsset:
     name: Expr | None = child(Type.STR, "an asset name", default=None)
     up: str = "yUp"
     mode: str = "alignSizeAndPosition"
+    up_by: Expr | None = child(Type.STR, "an up axis", default=None)
+    mode_by: Expr | None = child(Type.STR, "an insert mode", default=None)
 
 
-#: ``i()``'s insert modes, the default first.
+#: ``i()``'s up axes and insert modes, the default first.
+UP_AXES = ("yUp", "zUp")
 INSERT_MODES = ("alignSizeAndPosition", "keepSizeAndPosition", "keepSizeAlignPosition")
 
 
