@@ -6,8 +6,8 @@ apart (the mass a facade comes from), a leaf solid (a box, a prism, ``primitiveC
 times 2^24 plus its count in the lot: the same whatever the chunking) and its label. Roofs and other
 meshes do not occlude yet.
 
-``minimumDistance`` measures from the shape's scope to the scopes of labelled shapes (``label``), solid
-or not (``_minimum_distance``).
+``minimumDistance`` and ``contextCount`` look at labelled shapes (``label``), solid or not: the distance
+from the shape's scope to their scopes, their number (``_context``).
 
 A query (``inside``, ``overlaps``, ``touches``) of a shape tests its scope box (a solid's) or rectangle
 (a face's) against:
@@ -46,6 +46,7 @@ from grammarc.geometry.occlusion import (
     relations,
 )
 from grammarc.geometry.polygons import PLANE_U, PLANE_V
+from grammarc.ir.nodes import CONTEXT_KINDS
 
 #: Occluders per lot are numbered below this.
 _PER_LOT = 2 ** 24
@@ -64,7 +65,7 @@ class Occluders:
     scopes' sizes (the prisms hold the scopes' origins and axes), ``solid`` (k,) bool, and their ``prisms``.
 
     A labelled shape that is not a closed solid (a face, a roof) is a row too, not ``solid``: the occlusion
-    queries do not see it (``solids``), ``minimumDistance`` measures to its scope all the same."""
+    queries do not see it (``solids``), the context queries (``_context``) do."""
 
     lot: np.ndarray
     ident: np.ndarray
@@ -131,8 +132,8 @@ def add_occluders(chunk, shapes, label: str | np.ndarray | None = None, active: 
     """Store the closed solids among ``shapes`` (scope boxes and polygon prisms) as occluders of their
     lots (``active``: leaves, not shapes being taken apart), labelled ``label`` (one, or (n,) texts, one
     a shape); returns each shape's new id (NaN for a shape that is not a solid). With ``scopes`` (``label()``),
-    the other shapes are stored too, as scopes that do not occlude (``Occluders.solid``), for
-    ``minimumDistance``."""
+    the other shapes are stored too, as scopes that do not occlude (``Occluders.solid``), for the
+    context queries."""
     ident = np.full(len(shapes), np.nan)
     flat = (shapes.size <= 1e-9).any(axis=1)
     polygon = is_polygon(shapes.geom)
@@ -234,8 +235,8 @@ def query(expr, env, distance: np.ndarray | None = None, which: np.ndarray | Non
         named = np.broadcast_to(interned_texts(env.plan, named), (n,))
     if expr.kind == "visible":
         return _visible(shapes, chunk)
-    if expr.kind == "minimumDistance":
-        return _minimum_distance(expr, shapes, chunk, which, named)
+    if expr.kind in CONTEXT_KINDS:
+        return _context(expr, shapes, chunk, which, named)
     occ = expr.kind == "occ"
     kinds = ("inside", "touches") if occ else (expr.kind,)
     found = {kind: np.zeros(n, dtype=bool) for kind in kinds}
@@ -265,25 +266,43 @@ def query(expr, env, distance: np.ndarray | None = None, which: np.ndarray | Non
     return np.where(full, strings["full"], np.where(part, strings["part"], strings["none"])).astype(np.int32)
 
 
-#: At most this many (query, labelled scope) pairs of other lots are measured at once (``_minimum_distance``).
+#: At most this many (query, labelled scope) pairs of other lots are taken at once (``_labelled_pairs``).
 _PAIRS = 1 << 20
 
 
-def _minimum_distance(expr, shapes, chunk, which: np.ndarray | None, named: np.ndarray | None) -> np.ndarray:
-    """CityEngine's ``minimumDistance(target, label)`` (n,) float64: the least distance from each shape's
-    scope box to the scope of a shape labelled ``label`` (``geometry.box_distance``), infinity where there
-    is none (an empty label finds none, as the reference says).
+def _context(expr, shapes, chunk, which: np.ndarray | None, named: np.ndarray | None) -> np.ndarray:
+    """CityEngine's context queries over labelled shapes, (n,) float64 each:
 
-    Every ``label()`` makes a labelled shape of its own, so a shape's own label and its ancestors' count
-    (the reference's ``contextCount`` counts a tile's own label): a labelled shape is at distance 0 from
-    what follows it. ``intra`` measures to the labelled scopes of the shape's lot, ``inter`` to those of
-    the other lots (every other lot of the city, as CityEngine's context queries look at the whole scene
-    by default), taken in blocks of ``_PAIRS``."""
+    - ``minimumDistance(target, label)``: the least distance from the shape's scope box to the scope of a
+      shape labelled ``label`` (``geometry.box_distance``), infinity where there is none;
+    - ``contextCount(target, label)``: how many shapes are labelled ``label``.
+
+    An empty label finds none, as the reference says. Every ``label()`` makes a labelled shape of its
+    own, counted separately (the reference's ``contextCount`` example counts a tile's own label), so a
+    shape's own label and its ancestors' count: a labelled shape is at distance 0 from what follows it.
+    ``intra`` looks at the labelled shapes of the shape's lot, ``inter`` at those of the other lots (every
+    other lot of the city: CityEngine's context queries look at the whole scene by default)."""
+    n = len(shapes)
+    count = expr.kind == "contextCount"
+    found = np.zeros(n) if count else np.full(n, np.inf)
+    axes = chunk.frames[shapes.frame]
+    for table, rows, labelled in _labelled_pairs(expr, shapes, chunk, which, named):
+        if count:
+            found += np.bincount(rows, minlength=n)
+        else:
+            np.minimum.at(found, rows, box_distances(shapes.origin[rows], axes[rows], shapes.size[rows],
+                                                     table.prisms.origin[labelled], table.prisms.axes[labelled],
+                                                     table.size[labelled]))
+    return found
+
+
+def _labelled_pairs(expr, shapes, chunk, which, named):
+    """The (table, query rows (p,), table rows (p,)) of the shapes and the labelled shapes they look at
+    (``_context``): a join on the lot for ``intra``; all pairs of other lots for ``inter``, a block of
+    query rows at a time (at most ``_PAIRS`` pairs)."""
     n = len(shapes)
     label = np.broadcast_to(np.asarray(expr.label if named is None else named, dtype=object), (n,))
-    nearest = np.full(n, np.inf)
     own = chunk.lot_index[shapes.lot]
-    axes = chunk.frames[shapes.frame]
     for table, intra in _sources(chunk, expr.target if which is None else "all", solids=False):
         asked = np.zeros(len(table.lot), dtype=bool)
         for text in ({expr.label} if named is None else set(np.unique(named))) - {""}:  # (isin sorts None)
@@ -293,10 +312,10 @@ def _minimum_distance(expr, shapes, chunk, which: np.ndarray | None, named: np.n
             continue
         order = np.argsort(table.lot, kind="stable")
         sorted_lot = table.lot[order]
-        if intra:  # the labelled scopes of the shape's own lot: a join on the lot
+        if intra:
             first, last = np.searchsorted(sorted_lot, own, "left"), np.searchsorted(sorted_lot, own, "right")
             blocks = [np.arange(n)]
-        else:  # every other lot's: all pairs, a block of query rows at a time
+        else:
             first, last = np.zeros(n, np.int64), np.full(n, len(order))
             blocks = np.array_split(np.arange(n), max(1, n * len(order) // _PAIRS))
         for block in blocks:
@@ -304,17 +323,11 @@ def _minimum_distance(expr, shapes, chunk, which: np.ndarray | None, named: np.n
             rows = np.repeat(block, count)
             starts = np.cumsum(count) - count
             labelled = order[first[rows] + np.arange(len(rows)) - np.repeat(starts, count)]
-            keep = table.label[labelled] == label[rows]
-            keep &= (table.lot[labelled] == own[rows]) == intra
+            keep = (table.label[labelled] == label[rows]) & ((table.lot[labelled] == own[rows]) == intra)
             if which is not None:
                 keep &= which[rows] != ("inter" if intra else "intra")
-            rows, labelled = rows[keep], labelled[keep]
-            if len(rows):
-                found = box_distances(shapes.origin[rows], axes[rows], shapes.size[rows],
-                                      table.prisms.origin[labelled], table.prisms.axes[labelled],
-                                      table.size[labelled])
-                np.minimum.at(nearest, rows, found)
-    return nearest
+            if keep.any():
+                yield table, rows[keep], labelled[keep]
 
 
 #: A face sees street points more than this (metres) in front of its plane (``_visible``).

@@ -258,7 +258,7 @@ class ContextRef:
 
 #: CityEngine's occlusion queries, its context queries that give numbers, and their targets.
 OCCLUSION_KINDS = frozenset({"inside", "overlaps", "touches"})
-CONTEXT_KINDS = frozenset({"minimumDistance"})
+CONTEXT_KINDS = frozenset({"minimumDistance", "contextCount"})
 OCCLUSION_TARGETS = frozenset({"intra", "inter", "all"})
 
 
@@ -275,8 +275,9 @@ class Occlusion:
     string): ``which`` is that string per shape, in place of ``target``; a label may be any string
     expression, ``named``, in place of the constant ``label``.
 
-    Kind ``minimumDistance`` (``CONTEXT_KINDS``, a number) is the distance from the shape's scope to the
-    nearest scope labelled ``label`` (or ``named``) of the target's lots."""
+    The context queries (``CONTEXT_KINDS``) are numbers: ``minimumDistance`` the distance from the
+    shape's scope to the nearest scope labelled ``label`` (or ``named``) of the target's lots,
+    ``contextCount`` the number of shapes labelled so."""
 
     kind: str
     target: str

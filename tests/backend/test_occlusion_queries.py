@@ -257,3 +257,20 @@ def test_minimum_distance_to_the_labels_of_other_lots_whatever_the_chunking(writ
     np.testing.assert_allclose(sorted(r["xform"][posts][:, 1, 1]), [0, 0, 3, 3])
     r = run(write, TOWERS.replace("{target}", "all").replace('"tower")', '"")'), lots, lot_attrs=attrs)
     assert count(r, "Far") == 8  # an empty label finds nothing: infinity
+
+
+def test_context_count_counts_every_label_of_the_target(write):
+    """The reference's example: a lot cut into 1 m tiles, each labelled, then sized by how many tiles
+    are labelled; every label() counts, a tile's own included, ``inter`` the other lots' only."""
+    text = """
+Lot --> split(x){ ~1 : Strip }*
+Strip --> split(z){ ~1 : Tile }*
+Tile --> label("Tile") Count
+Count --> s(contextCount({target}, "Tile"), '1, '1) Counted.
+"""
+    lots = [rect(3, 3), [np.array([[10, 0], [12, 0], [12, 2], [10, 2]], float)]]  # 9 tiles and 4
+    for target, first, second in (("intra", 9, 4), ("inter", 4, 9), ("all", 13, 13)):
+        r = run(write, text.replace("{target}", target), lots)
+        assert r["bad"] == () and count(r, "Counted") == 13
+        np.testing.assert_array_equal(r["xform"][:, 0, 1], np.where(r["lot"] == 0, first, second))  # a quad: x
+    assert (run(write, text.replace("{target}", "all").replace('"Tile")', '"")'), lots)["xform"][:, 0, 1] == 0).all()

@@ -128,7 +128,7 @@ def _bounds(ctx: Context, cursor: Shapes, asset: np.ndarray, up, mode, span) -> 
 @operation(ir.Label, writes=("dynamic",), meshes=True)
 def label(ctx: Context, cursor: Shapes, op: ir.Label) -> Shapes:
     """``label(name)``: the shape's solid is an occluder with that label, and its own ancestor; any
-    shape's scope is a labelled scope that ``minimumDistance`` measures to."""
+    shape is a labelled shape that the context queries (``minimumDistance``, ``contextCount``) see."""
     name = op.name.value if isinstance(op.name, ir.Str) else \
         interned_texts(ctx.plan, evaluate_array(op.name, ctx.env(cursor), dtype=np.int32))
     return with_ancestor(ctx.plan, cursor, add_occluders(ctx.chunk, cursor, name, scopes=True))
