@@ -112,7 +112,8 @@ class Occluders:
 
 _COLUMNS = ("lot", "ident", "label", "active", "size", "solid")
 _EMPTY = Occluders(np.zeros(0, np.int64), np.zeros(0), np.zeros(0, dtype=object), np.zeros(0, dtype=bool),
-                   np.zeros((0, 3)), np.zeros(0, dtype=bool), prisms(np.zeros((0, 3)), np.zeros((0, 3, 3)), np.zeros(0, np.int64), np.zeros(0),
+                   np.zeros((0, 3)), np.zeros(0, dtype=bool),
+                   prisms(np.zeros((0, 3)), np.zeros((0, 3, 3)), np.zeros(0, np.int64), np.zeros(0),
                           np.zeros(0, dtype=object)))
 
 

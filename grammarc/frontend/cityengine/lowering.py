@@ -508,9 +508,9 @@ class Lowering(OperationLowering, LoweringBase):
                                   for c in "xyz"),), span)
 
     def occlusion(self, kind: str, args, span) -> ir.Expr:
-        """``inside`` / ``overlaps`` / ``touches([target[, label]])`` and ``minimumDistance(target,
-        label)``: the target ``intra``, ``inter`` or ``all``, or ``sel(text)`` computed; the label a
-        string, constant or computed."""
+        """``inside`` / ``overlaps`` / ``touches([target[, label]])`` and the context queries
+        ``minimumDistance`` / ``contextCount(target, label)``: the target ``intra``, ``inter`` or ``all``,
+        or ``sel(text)`` computed; the label a string, constant or computed."""
         args = tuple(self.expr(a) for a in args)
         target = args[0].name if args and isinstance(args[0], ir.Name) else None
         chosen = args[0].args[0] if args and isinstance(args[0], ir.Call) and args[0].func == "sel" \
