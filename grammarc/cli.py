@@ -186,6 +186,7 @@ def _warn(grammar) -> None:
 
 def _check(args) -> int:
     from grammarc.build import BuildOptions, compile_source, grammar_source
+    from grammarc.ir.nodes import RuleGraph
     from grammarc.ir.printer import print_module
 
     options = BuildOptions(start=args.start, dialect=args.dialect, workspace=args.workspace,
@@ -193,7 +194,7 @@ def _check(args) -> int:
     with grammar_source(args.grammar, options) as (source, display, resolved):
         grammar = compile_source(source, display, resolved, derive=False)
     _warn(grammar)
-    graph = grammar.graph
+    graph = grammar.graph or RuleGraph("-", (), (), frozenset(), frozenset(), {})  # a file without rules
     if args.dump_ir:
         print(print_module(grammar.module))
     print(f"{args.grammar}: ok")

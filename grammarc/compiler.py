@@ -36,8 +36,9 @@ def compile_grammar(path: str | Path, *, text: str | None = None, start: str | N
     (``workspace``, a folder of CityEngine projects, or the folder holding the grammar's project), where
     imports are looked up too (``frontend.imports``). ``display`` names the file in diagnostics (a rule
     file inside a package: ``candler.rpk/rules/x.cga``). A file that is not UTF-8 is read as
-    Windows-1252, with a warning (``frontend.source``). A grammar to ``derive`` needs the arguments of a
-    start rule with parameters (``UsageError`` without them); ``grammarc check`` checks it without. With
+    Windows-1252, with a warning (``frontend.source``). A grammar to ``derive`` needs rules and the
+    arguments of a start rule with parameters (``UsageError`` without them); ``grammarc check`` checks a
+    file of declarations only, or one whose start rule takes parameters, with a warning. With
     ``warnings_as_errors`` every warning is an error (``--warnings-as-errors``).
     """
     path = Path(path)
@@ -61,7 +62,7 @@ def compile_grammar(path: str | Path, *, text: str | None = None, start: str | N
         diags = Diagnostics(replace(d, severity=Severity.ERROR) for d in diags)
     if diags.has_errors:
         raise GrammarError(diags, sources)
-    unfed = next((d for d in diags if d.code == "start-params"), None)
+    unfed = next((d for d in diags if d.code in ("start-params", "no-rules")), None)
     if derive and unfed is not None:
         raise UsageError(unfed.message)
     return Grammar(path=file, digest=hashlib.sha256(text.encode()).hexdigest(), module=module,

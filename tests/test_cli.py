@@ -209,6 +209,20 @@ def test_a_start_rule_with_parameters_checks_with_a_warning_and_does_not_build_w
     assert not out.exists()
 
 
+def test_a_cityengine_file_of_constants_only_checks_with_a_warning_and_does_not_build(write, tmp_path, capsys):
+    grammar = write("config.cga", 'version "2023.1"\nconst storey = 3.2\nattr coverage = 0.7\n'
+                                  "getHeight(n) = n * storey\n")
+    assert main(["check", str(grammar)]) == 0
+    captured = capsys.readouterr()
+    assert "warning: the grammar has no rules: a file of attributes, constants and functions to import" \
+        in captured.err
+    assert "start:     -" in captured.out and "attrs:     storey, coverage" in captured.out
+    out = tmp_path / "out.npz"
+    assert main(["build", str(grammar), "--emit", str(out)]) == 2
+    assert "error: the grammar has no rules" in capsys.readouterr().err
+    assert not out.exists()
+
+
 def test_check_says_which_rule_starts_without_start_rule(write, capsys):
     assert main(["check", str(write("g.cga", 'version "2022.0"\nLot --> extrude(3) Mass\nMass --> X\n'))]) == 0
     assert "warning: no @StartRule: starting with `Lot`, the first rule" in capsys.readouterr().err

@@ -6,6 +6,9 @@ apart (the mass a facade comes from), a leaf solid (a box, a prism, ``primitiveC
 times 2^24 plus its count in the lot: the same whatever the chunking) and its label. Roofs and other
 meshes do not occlude yet.
 
+``minimumDistance`` and ``contextCount`` look at labelled shapes (``label``), solid or not: the distance
+from the shape's scope to their scopes, their number (``_context``).
+
 A query (``inside``, ``overlaps``, ``touches``) of a shape tests its scope box (a solid's) or rectangle
 (a face's) against:
 
@@ -30,6 +33,7 @@ import shapely
 from grammarc.backend.shapes import asset_geom, face_axes
 from grammarc.backend.slots import ANCESTORS
 from grammarc.constants import TOL
+from grammarc.geometry.box_distance import box_distances
 from grammarc.geometry.clip import scope_polygons
 from grammarc.geometry.meshes import is_polygon
 from grammarc.geometry.occlusion import (
@@ -42,6 +46,7 @@ from grammarc.geometry.occlusion import (
     relations,
 )
 from grammarc.geometry.polygons import PLANE_U, PLANE_V
+from grammarc.ir.nodes import CONTEXT_KINDS
 
 #: Occluders per lot are numbered below this.
 _PER_LOT = 2 ** 24
@@ -56,12 +61,18 @@ _CUBE = int(asset_geom(np.array([0]))[0])
 @dataclass(frozen=True)
 class Occluders:
     """A table of occluders: ``lot`` (k,) global lot numbers, ``ident`` (k,) float64 ids, ``label`` (k,)
-    object (str or None), ``active`` (k,) bool (a leaf, not a shape taken apart), and their ``prisms``."""
+    object (str or None), ``active`` (k,) bool (a leaf, not a shape taken apart), ``size`` (k, 3) their
+    scopes' sizes (the prisms hold the scopes' origins and axes), ``solid`` (k,) bool, and their ``prisms``.
+
+    A labelled shape that is not a closed solid (a face, a roof) is a row too, not ``solid``: the occlusion
+    queries do not see it (``solids``), the context queries (``_context``) do."""
 
     lot: np.ndarray
     ident: np.ndarray
     label: np.ndarray
     active: np.ndarray
+    size: np.ndarray
+    solid: np.ndarray
     prisms: Prisms
 
     @staticmethod
@@ -69,12 +80,16 @@ class Occluders:
         tables = [t for t in tables if len(t.lot)] or [_EMPTY]
         if len(tables) == 1:
             return tables[0]
-        return Occluders(*(np.concatenate([getattr(t, f) for t in tables]) for f in ("lot", "ident", "label", "active")),
+        return Occluders(*(np.concatenate([getattr(t, f) for t in tables]) for f in _COLUMNS),
                          Prisms.concat([t.prisms for t in tables]))
 
     def take(self, rows: np.ndarray) -> Occluders:
-        return Occluders(self.lot[rows], self.ident[rows], self.label[rows], self.active[rows],
-                         self.prisms.take(rows))
+        return Occluders(*(getattr(self, f)[rows] for f in _COLUMNS), self.prisms.take(rows))
+
+    @cached_property
+    def solids(self) -> Occluders:
+        """The rows that occlude (closed solids), for ``inside``, ``overlaps``, ``touches``."""
+        return self if self.solid.all() else self.take(np.flatnonzero(self.solid))
 
     @cached_property
     def index(self):
@@ -95,7 +110,9 @@ class Occluders:
         return o_low, o_high, tree
 
 
+_COLUMNS = ("lot", "ident", "label", "active", "size", "solid")
 _EMPTY = Occluders(np.zeros(0, np.int64), np.zeros(0), np.zeros(0, dtype=object), np.zeros(0, dtype=bool),
+                   np.zeros((0, 3)), np.zeros(0, dtype=bool),
                    prisms(np.zeros((0, 3)), np.zeros((0, 3, 3)), np.zeros(0, np.int64), np.zeros(0),
                           np.zeros(0, dtype=object)))
 
@@ -111,14 +128,20 @@ class OccluderStore:
         return Occluders.concat(self.tables)
 
 
-def add_occluders(chunk, shapes, label: str | np.ndarray | None = None, active: bool = True) -> np.ndarray:
+def add_occluders(chunk, shapes, label: str | np.ndarray | None = None, active: bool = True,
+                  scopes: bool = False) -> np.ndarray:
     """Store the closed solids among ``shapes`` (scope boxes and polygon prisms) as occluders of their
     lots (``active``: leaves, not shapes being taken apart), labelled ``label`` (one, or (n,) texts, one
-    a shape); returns each shape's new id (NaN for a shape that is not a solid)."""
+    a shape); returns each shape's new id (NaN for a shape that is not a solid). With ``scopes`` (``label()``),
+    the other shapes are stored too, as scopes that do not occlude (``Occluders.solid``), for the
+    context queries."""
     ident = np.full(len(shapes), np.nan)
     flat = (shapes.size <= 1e-9).any(axis=1)
     polygon = is_polygon(shapes.geom)
     solid = ~flat & ((shapes.geom == -1) | (shapes.geom == _CUBE) | polygon)
+    if scopes:
+        _add_scopes(chunk, shapes.take(np.flatnonzero(~solid)), label[~solid] if isinstance(label, np.ndarray)
+                    else label)
     rows = np.flatnonzero(solid)
     if not len(rows):
         return ident
@@ -143,10 +166,24 @@ def add_occluders(chunk, shapes, label: str | np.ndarray | None = None, active: 
     if is_poly.any():
         polygons[is_poly] = scope_polygons(chunk.polygons, sub.geom[is_poly], sub.size[is_poly])
     labels = label[rows] if isinstance(label, np.ndarray) else np.full(len(rows), label, dtype=object)
-    store.tables.append(Occluders(chunk.lot_index[lot], ident[rows], labels,
-                                  np.full(len(rows), active),
+    store.tables.append(Occluders(chunk.lot_index[lot], ident[rows], labels, np.full(len(rows), active),
+                                  sub.size.copy(), np.ones(len(rows), dtype=bool),
                                   prisms(sub.origin.copy(), chunk.frames[sub.frame], plane, sub.size[k, plane], polygons)))
     return ident
+
+
+def _add_scopes(chunk, shapes, label: str | np.ndarray) -> None:
+    """Store labelled ``shapes`` that are not closed solids as scopes (their boxes as prisms, never tested
+    by an occlusion query) without ids: they are nobody's occluding ancestor."""
+    n = len(shapes)
+    if not n:
+        return
+    size = shapes.size.copy()
+    labels = label if isinstance(label, np.ndarray) else np.full(n, label, dtype=object)
+    chunk.occluders.tables.append(Occluders(
+        chunk.lot_index[shapes.lot], np.full(n, np.nan), labels, np.ones(n, dtype=bool), size,
+        np.zeros(n, dtype=bool), prisms(shapes.origin.copy(), chunk.frames[shapes.frame], np.ones(n, dtype=np.int64),
+                                        size[:, 1], shapely.box(0, 0, size[:, 0], size[:, 2]))))
 
 
 def with_ancestor(plan, shapes, ident: np.ndarray):
@@ -199,6 +236,8 @@ def query(expr, env, distance: np.ndarray | None = None, which: np.ndarray | Non
         named = np.broadcast_to(interned_texts(env.plan, named), (n,))
     if expr.kind == "visible":
         return _visible(shapes, chunk)
+    if expr.kind in CONTEXT_KINDS:
+        return _context(expr, shapes, chunk, which, named)
     occ = expr.kind == "occ"
     kinds = ("inside", "touches") if occ else (expr.kind,)
     found = {kind: np.zeros(n, dtype=bool) for kind in kinds}
@@ -226,6 +265,70 @@ def query(expr, env, distance: np.ndarray | None = None, which: np.ndarray | Non
     full, part = found["inside"], found["touches"] & ~found["inside"]
     strings = env.strings
     return np.where(full, strings["full"], np.where(part, strings["part"], strings["none"])).astype(np.int32)
+
+
+#: At most this many (query, labelled scope) pairs of other lots are taken at once (``_labelled_pairs``).
+_PAIRS = 1 << 20
+
+
+def _context(expr, shapes, chunk, which: np.ndarray | None, named: np.ndarray | None) -> np.ndarray:
+    """CityEngine's context queries over labelled shapes, (n,) float64 each:
+
+    - ``minimumDistance(target, label)``: the least distance from the shape's scope box to the scope of a
+      shape labelled ``label`` (``geometry.box_distance``), infinity where there is none;
+    - ``contextCount(target, label)``: how many shapes are labelled ``label``.
+
+    An empty label finds none, as the reference says. Every ``label()`` makes a labelled shape of its
+    own, counted separately (the reference's ``contextCount`` example counts a tile's own label), so a
+    shape's own label and its ancestors' count: a labelled shape is at distance 0 from what follows it.
+    ``intra`` looks at the labelled shapes of the shape's lot, ``inter`` at those of the other lots (every
+    other lot of the city: CityEngine's context queries look at the whole scene by default)."""
+    n = len(shapes)
+    count = expr.kind == "contextCount"
+    found = np.zeros(n) if count else np.full(n, np.inf)
+    axes = chunk.frames[shapes.frame]
+    for table, rows, labelled in _labelled_pairs(expr, shapes, chunk, which, named):
+        if count:
+            found += np.bincount(rows, minlength=n)
+        else:
+            np.minimum.at(found, rows, box_distances(shapes.origin[rows], axes[rows], shapes.size[rows],
+                                                     table.prisms.origin[labelled], table.prisms.axes[labelled],
+                                                     table.size[labelled]))
+    return found
+
+
+def _labelled_pairs(expr, shapes, chunk, which, named):
+    """The (table, query rows (p,), table rows (p,)) of the shapes and the labelled shapes they look at
+    (``_context``): a join on the lot for ``intra``; all pairs of other lots for ``inter``, a block of
+    query rows at a time (at most ``_PAIRS`` pairs)."""
+    n = len(shapes)
+    label = np.broadcast_to(np.asarray(expr.label if named is None else named, dtype=object), (n,))
+    own = chunk.lot_index[shapes.lot]
+    for table, intra in _sources(chunk, expr.target if which is None else "all", solids=False):
+        asked = np.zeros(len(table.lot), dtype=bool)
+        for text in ({expr.label} if named is None else set(np.unique(named))) - {""}:  # (isin sorts None)
+            asked |= table.label == text
+        table = table.take(np.flatnonzero(asked))
+        if not len(table.lot):
+            continue
+        order = np.argsort(table.lot, kind="stable")
+        sorted_lot = table.lot[order]
+        if intra:
+            first, last = np.searchsorted(sorted_lot, own, "left"), np.searchsorted(sorted_lot, own, "right")
+            blocks = [np.arange(n)]
+        else:
+            first, last = np.zeros(n, np.int64), np.full(n, len(order))
+            blocks = np.array_split(np.arange(n), max(1, n * len(order) // _PAIRS))
+        for block in blocks:
+            count = last[block] - first[block]
+            rows = np.repeat(block, count)
+            starts = np.cumsum(count) - count
+            labelled = order[first[rows] + np.arange(len(rows)) - np.repeat(starts, count)]
+            keep = (table.label[labelled] == label[rows]) & ((table.lot[labelled] == own[rows]) == intra)
+            if which is not None:
+                keep &= which[rows] != ("inter" if intra else "intra")
+            if keep.any():
+                yield table, rows[keep], labelled[keep]
 
 
 #: A face sees street points more than this (metres) in front of its plane (``_visible``).
@@ -291,15 +394,16 @@ def _visible(shapes, chunk) -> np.ndarray:
     return ~blocked
 
 
-def _sources(chunk, target: str) -> list[tuple[Occluders, bool]]:
-    """The occluders a query of ``target`` tests, each table with whether it is for the shape's own lot
-    (the chunk's, as they are now) or for the other lots (the first pass's)."""
+def _sources(chunk, target: str, solids: bool = True) -> list[tuple[Occluders, bool]]:
+    """The occluders a query of ``target`` tests (the ``solids`` only, or every labelled scope too), each
+    table with whether it is for the shape's own lot (the chunk's, as they are now) or for the other lots
+    (the first pass's)."""
     sources = []
     if target in ("intra", "all"):
         sources.append((chunk.occluders.table(), True))
     if target in ("inter", "all") and chunk.foreign is not None:
         sources.append((chunk.foreign, False))
-    return sources
+    return [(table.solids, intra) for table, intra in sources] if solids else sources
 
 
 def _relations(kinds, shapes, chunk, rows: np.ndarray, occluders: Occluders, distance: np.ndarray):

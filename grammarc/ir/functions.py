@@ -169,9 +169,8 @@ FUNCTIONS: dict[str, Signature] = {
 ARRAY_FUNCTIONS = frozenset({"size", "nRows", "nColumns", "findFirst", "transpose", "sortIndices",
                              "sortRowIndices", "isNull", "sum", "floatArray", "boolArray", "stringArray"})
 #: Built-in functions of CityEngine's reference that grammarc does not compute: a call is ``unsupported``,
-#: not an unknown name (materials are not kept, context queries other than occlusion are not asked, lots
+#: not an unknown name (materials are not kept, shapes are not ranked by `contextCompare`, lots
 #: carry no geographic frame, edge attributes or shape-tree keys).
-UNSUPPORTED_FUNCTIONS = frozenset({"getMaterial", "getGeoCoord", "getTreeKey", "minimumDistance", "contextCompare",
-                                   "contextCount", "sel"})
+UNSUPPORTED_FUNCTIONS = frozenset({"getMaterial", "getGeoCoord", "getTreeKey", "contextCompare", "sel"})
 #: The array conversions and the scalar conversion each applies to every element.
 ARRAY_CONVERSIONS = {"floatArray": "float", "boolArray": "bool", "stringArray": "str"}

@@ -256,8 +256,9 @@ class ContextRef:
     span: Span = NO_SPAN
 
 
-#: CityEngine's occlusion queries and their targets.
+#: CityEngine's occlusion queries, its context queries that give numbers, and their targets.
 OCCLUSION_KINDS = frozenset({"inside", "overlaps", "touches"})
+CONTEXT_KINDS = frozenset({"minimumDistance", "contextCount"})
 OCCLUSION_TARGETS = frozenset({"intra", "inter", "all"})
 
 
@@ -272,7 +273,11 @@ class Occlusion:
 
     CityEngine's target may be computed, ``inside(sel(text), ...)`` (``sel`` makes a selector of a
     string): ``which`` is that string per shape, in place of ``target``; a label may be any string
-    expression, ``named``, in place of the constant ``label``."""
+    expression, ``named``, in place of the constant ``label``.
+
+    The context queries (``CONTEXT_KINDS``) are numbers: ``minimumDistance`` the distance from the
+    shape's scope to the nearest scope labelled ``label`` (or ``named``) of the target's lots,
+    ``contextCount`` the number of shapes labelled so."""
 
     kind: str
     target: str
@@ -527,7 +532,8 @@ class UseAsset:
     ``asset`` is the name when it is written as a string; otherwise ``name`` computes it per shape (a
     parameter or constant holding an asset path). ``up`` is the asset's up axis, ``"yUp"`` or ``"zUp"``
     (turned -90 degrees about x); ``mode`` one of ``INSERT_MODES``: fitted to the scope, or the scope
-    made the asset's own size, at the asset's own position or centred on the scope's xz.
+    made the asset's own size, at the asset's own position or centred on the scope's xz. Either may be
+    computed, a string per shape (``up_by``, ``mode_by``, in place of ``up`` and ``mode``).
     """
 
     asset: str
@@ -535,9 +541,12 @@ class UseAsset:
     name: Expr | None = child(Type.STR, "an asset name", default=None)
     up: str = "yUp"
     mode: str = "alignSizeAndPosition"
+    up_by: Expr | None = child(Type.STR, "an up axis", default=None)
+    mode_by: Expr | None = child(Type.STR, "an insert mode", default=None)
 
 
-#: ``i()``'s insert modes, the default first.
+#: ``i()``'s up axes and insert modes, the default first.
+UP_AXES = ("yUp", "zUp")
 INSERT_MODES = ("alignSizeAndPosition", "keepSizeAndPosition", "keepSizeAlignPosition")
 
 

@@ -50,15 +50,15 @@ def verify(module: ir.Module, stage: str) -> list[str]:
                 problems.append(f"{where}: span from another file {sub.span}")
     if "rulegraph" in done:
         problems += _graph_problems(module)
-    if "assets" in done and module.roots is not None:
+    if "assets" in done and module.roots is not None and module.graph is not None:  # no rules: no assets
         problems += _asset_problems(module)
     return problems
 
 
 def _graph_problems(module: ir.Module) -> list[str]:
     graph = module.graph
-    if graph is None:
-        return ["module: no rule graph"]
+    if graph is None:  # a CityEngine file of declarations only has none (``passes.rulegraph``)
+        return [] if not module.rules and module.dialect == "cityengine" else ["module: no rule graph"]
     problems = []
     if graph.start != module.start:
         problems.append(f"module: the graph starts at `{graph.start}`, the module at `{module.start}`")

@@ -4,7 +4,7 @@ building meets its neighbour (inter, the same whatever the chunking), and labell
 from __future__ import annotations
 
 import numpy as np
-from operations.derivations import names, rect, run
+from operations.derivations import names, of_symbol, rect, run
 
 MASSES = """
 Lot --> [ s('0.6, '1, '1) Mass ] t('0.4, 0, 0) s('0.6, '1, '1) Mass
@@ -208,3 +208,69 @@ a ~> free
 """
     r = run(write, text, [rect(20, 20)], version=False)
     assert count(r, "free") == 2 and count(r, "hit") == 0
+
+
+SPREAD = """
+Lot --> split(x){ ~2 : Strip(split.index) }*
+Strip(i) --> split(z){ ~2 : Cell(i, split.index) }*
+Cell(i, j) --> [ case i == 2 && j == 2 : label("centre") else : NIL ] Rise(minimumDistance(intra, "centre"))
+Rise(d) --> case d < 5 : extrude(5 - d) Block. else : NIL
+"""
+
+
+def test_minimum_distance_raises_the_cells_near_a_labelled_one(write):
+    """The reference's example: a grid of 2 m cells, the one at (2, 2) labelled (a face: its scope counts),
+    each cell extruded by 5 minus its distance to it, the gap between their rectangles."""
+    r = run(write, SPREAD, [rect(30, 20)])
+    blocks = of_symbol(r, "Block")
+    xform = r["xform"][blocks]
+    i, j = np.rint(xform[:, 0, 3] / 2).astype(int), np.rint((xform[:, 2, 3] + 20) / 2).astype(int)
+    gap = np.hypot(2 * np.maximum(np.abs(i - 2) - 1, 0), 2 * np.maximum(np.abs(j - 2) - 1, 0))
+    np.testing.assert_allclose(xform[:, 1, 1], 5 - gap)  # the cell and its neighbours (gap 0) rise 5 m
+    assert sorted(set(np.round(5 - gap, 3))) == [0.528, 1.0, 2.172, 3.0, 5.0]
+    assert blocks.sum() == 35 and count(r, "Cell") == 1  # the labelled face is a leaf of its own
+
+
+TOWERS = """
+attr mark = "tower"
+Lot --> [ s(4, 0, 4) center(xz) extrude(30) label(mark) Tower. ] split(x){ ~5 : Plot }*
+Plot --> Post(minimumDistance({target}, "tower"))
+Post(d) --> case isinf(d) : Far. else : s(1, d, 1) Post.
+"""
+
+
+def test_minimum_distance_to_the_labels_of_other_lots_whatever_the_chunking(write):
+    """Two 20 m lots 10 m apart, a tower labelled at the centre of the first (x 8..12) only: the plots
+    of the second (x 30..50) measure the distance to it with ``inter``, their own lot's with ``intra``."""
+    lots = [rect(20, 20), [np.array([[30, 0], [50, 0], [50, 20], [30, 20]], float)]]
+    attrs = {"mark": ["tower", "none"]}
+    r = run(write, TOWERS.replace("{target}", "inter"), lots, lot_attrs=attrs)
+    posts = of_symbol(r, "Post")
+    assert (r["lot"][posts] == 1).all() and count(r, "Far") == 4  # the first lot sees no other tower
+    np.testing.assert_allclose(sorted(r["xform"][posts][:, 1, 1]), [18, 23, 28, 33])
+    again = run(write, TOWERS.replace("{target}", "inter"), lots, lot_attrs=attrs, chunk_size=1)
+    np.testing.assert_array_equal(r["xform"], again["xform"])
+    r = run(write, TOWERS.replace("{target}", "intra"), lots, lot_attrs=attrs)
+    posts = of_symbol(r, "Post")
+    # the first lot's plots: x 0..5 and 15..20 are 3 m from the tower, 5..10 and 10..15 under it
+    assert (r["lot"][posts] == 0).all() and count(r, "Far") == 4
+    np.testing.assert_allclose(sorted(r["xform"][posts][:, 1, 1]), [0, 0, 3, 3])
+    r = run(write, TOWERS.replace("{target}", "all").replace('"tower")', '"")'), lots, lot_attrs=attrs)
+    assert count(r, "Far") == 8  # an empty label finds nothing: infinity
+
+
+def test_context_count_counts_every_label_of_the_target(write):
+    """The reference's example: a lot cut into 1 m tiles, each labelled, then sized by how many tiles
+    are labelled; every label() counts, a tile's own included, ``inter`` the other lots' only."""
+    text = """
+Lot --> split(x){ ~1 : Strip }*
+Strip --> split(z){ ~1 : Tile }*
+Tile --> label("Tile") Count
+Count --> s(contextCount({target}, "Tile"), '1, '1) Counted.
+"""
+    lots = [rect(3, 3), [np.array([[10, 0], [12, 0], [12, 2], [10, 2]], float)]]  # 9 tiles and 4
+    for target, first, second in (("intra", 9, 4), ("inter", 4, 9), ("all", 13, 13)):
+        r = run(write, text.replace("{target}", target), lots)
+        assert r["bad"] == () and count(r, "Counted") == 13
+        np.testing.assert_array_equal(r["xform"][:, 0, 1], np.where(r["lot"] == 0, first, second))  # a quad: x
+    assert (run(write, text.replace("{target}", "all").replace('"Tile")', '"")'), lots)["xform"][:, 0, 1] == 0).all()

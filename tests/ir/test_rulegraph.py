@@ -131,6 +131,13 @@ def test_a_start_rule_with_parameters_in_a_module_to_derive_warns():
     assert not diags
 
 
+def test_a_cityengine_file_without_rules_is_a_warning():
+    diags = Diagnostics()
+    text = 'version "2023.1"\nconst h = 1\n'
+    assert run_passes(parse_source(text, FILE, diags), diags, check=True).graph is None
+    assert [(d.code, d.severity.name, d.span.line) for d in diags] == [("no-rules", "WARNING", 1)]
+
+
 def test_no_rules_is_an_error_unless_rules_failed_to_parse():
     diags = Diagnostics()
     assert run_passes(parse_source("attr h = 1\n", FILE, diags), diags).graph is None

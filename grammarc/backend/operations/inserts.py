@@ -29,8 +29,13 @@ def insert(ctx: Context, cursor: Shapes, op: ir.Insert) -> None:
 
 @operation(ir.UseAsset, writes=("origin", "size", "geom"), meshes=True)
 def use_asset(ctx: Context, cursor: Shapes, op: ir.UseAsset) -> Shapes:
-    """The geometry becomes the asset placed by the insert mode (``placed``)."""
-    return placed(ctx, cursor, op, asset_ids(ctx, cursor, op, "i"))
+    """The geometry becomes the asset placed by the insert mode (``placed``); a computed up axis or
+    mode is read per shape."""
+    asset = asset_ids(ctx, cursor, op, "i")
+    up = op.up == "zUp" if op.up_by is None else _chosen(ctx, cursor, op.up_by, ir.UP_AXES, "up axis", op) == 1
+    mode = ir.INSERT_MODES.index(op.mode) if op.mode_by is None else \
+        _chosen(ctx, cursor, op.mode_by, ir.INSERT_MODES, "insert mode", op)
+    return placed(ctx, cursor, asset, up, mode, op.span)
 
 
 def asset_ids(ctx: Context, cursor: Shapes, op: ir.UseAsset | ir.InsertAlongUV, verb: str) -> np.ndarray:
@@ -52,9 +57,25 @@ def asset_ids(ctx: Context, cursor: Shapes, op: ir.UseAsset | ir.InsertAlongUV, 
     return asset
 
 
-def placed(ctx: Context, cursor: Shapes, op: ir.UseAsset, asset: np.ndarray) -> Shapes:
-    """The shapes with asset ids ``asset`` (n,) int32 as their geometry, and their scopes as
-    ``op.mode`` makes them (CityEngine's reference of ``i``):
+def _chosen(ctx: Context, cursor: Shapes, expr: ir.Expr, allowed: tuple[str, ...], what: str,
+            op: ir.UseAsset) -> np.ndarray:
+    """The index (n,) int64 in ``allowed`` of each shape's value of the string ``expr``; a shape whose
+    value is none of them fails."""
+    ids = np.broadcast_to(evaluate_array(expr, ctx.env(cursor), dtype=np.int32), (len(cursor),))
+    distinct, inverse = np.unique(ids, return_inverse=True)
+    texts = interned_texts(ctx.plan, distinct)
+    index = np.array([allowed.index(t) if t in allowed else -1 for t in texts], dtype=np.int64)[inverse.reshape(-1)]
+    bad = index < 0
+    if bad.any():
+        text = texts[inverse.reshape(-1)[np.flatnonzero(bad)[0]]]
+        ctx.fail(cursor, bad, f"`i` with {what} `{text}`, not one of {', '.join(allowed)}", op.span)
+    return np.maximum(index, 0)
+
+
+def placed(ctx: Context, cursor: Shapes, asset: np.ndarray, up, mode, span) -> Shapes:
+    """The shapes with asset ids ``asset`` (n,) int32 as their geometry, and their scopes as the insert
+    mode makes them (CityEngine's reference of ``i``): ``mode`` an index into ``ir.INSERT_MODES``, one or
+    (n,) one a shape;
 
     - ``alignSizeAndPosition``: the asset fitted to the scope, which is unchanged (a cube is the scope box
       itself);
@@ -63,19 +84,18 @@ def placed(ctx: Context, cursor: Shapes, op: ir.UseAsset, asset: np.ndarray) -> 
     - ``keepSizeAlignPosition``: the scope gets the asset's size, centred on the old scope in x and z and
       standing on its y = 0.
 
-    ``zUp``: the asset turns -90 degrees about x before it is placed (its z is the scope's y), so its
-    bounding box does too.
+    ``up`` (a bool, or (n,) one a shape) is ``zUp``: the asset turns -90 degrees about x before it is
+    placed (its z is the scope's y), so its bounding box does too.
     """
-    up = Z_UP if op.up == "zUp" else 0
-    geom = np.where(asset == 0, -1, asset_geom(asset, up)).astype(np.int32)  # asset 0 is builtin:cube
-    if op.mode == ir.INSERT_MODES[0]:
+    geom = np.where(asset == 0, -1, asset_geom(asset, np.where(up, Z_UP, 0))).astype(np.int32)  # 0: builtin:cube
+    if np.all(mode == 0):
         return cursor.with_scope(cursor.origin, cursor.size, cursor.frame, geom)
-    low, high = _bounds(ctx, cursor, op, asset)
+    low, high = _bounds(ctx, cursor, asset, up, mode, span)
     size = high - low
-    if op.mode == "keepSizeAndPosition":
-        offset = low
-    else:
-        offset = (cursor.size - size) * np.array([0.5, 0.0, 0.5])
+    offset = np.where(np.reshape(mode == 1, (-1, 1)), low, (cursor.size - size) * np.array([0.5, 0.0, 0.5]))
+    if np.any(mode == 0):  # modes chosen per shape: the aligned ones keep their scopes
+        fitted = np.reshape(mode == 0, (-1, 1))
+        offset, size = np.where(fitted, 0.0, offset), np.where(fitted, cursor.size, size)
     return scope_at(ctx, cursor, offset, size, geom)
 
 
@@ -87,28 +107,34 @@ def scope_at(ctx: Context, cursor: Shapes, offset: np.ndarray, size: np.ndarray,
     return cursor.with_scope(origin, size, cursor.frame, geom)
 
 
-def _bounds(ctx: Context, cursor: Shapes, op: ir.UseAsset, asset: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def _bounds(ctx: Context, cursor: Shapes, asset: np.ndarray, up, mode, span) -> tuple[np.ndarray, np.ndarray]:
     """The lowest and highest corners (n, 3) of the shapes' assets' bounding boxes in their own units,
-    turned z-up where ``op`` says; each asset read once. A shape whose asset cannot be loaded fails."""
-    ids, inverse = np.unique(asset, return_inverse=True)
-    table = np.empty((len(ids), 2, 3))
+    turned z-up where ``up`` (one, or (n,)) says; each asset read once. A shape whose asset cannot be
+    loaded fails, unless its ``mode`` (one, or (n,)) fits the asset to the scope (its row stays 0)."""
+    need = np.broadcast_to(mode != 0, asset.shape)
+    ids, inverse = np.unique(np.where(need, asset, -1), return_inverse=True)
+    table = np.zeros((len(ids), 2, 3))
     for k, a in enumerate(ids.tolist()):
-        mesh = ctx.asset_mesh(a)
-        if mesh is None:
-            ctx.fail(cursor, asset == a, f"`i(..., {op.mode})` needs the asset's size: {ctx.asset_problem(a)}",
-                     op.span)
-        table[k] = mesh.bounds
-    low, high = table[:, 0], table[:, 1]
-    if op.up == "zUp":  # (x, y, z) -> (x, z, -y): the highest y becomes the lowest z
-        low, high = (np.stack([low[:, 0], low[:, 2], -high[:, 1]], axis=1),
-                     np.stack([high[:, 0], high[:, 2], -low[:, 1]], axis=1))
+        mesh = None if a < 0 else ctx.asset_mesh(a)
+        if a >= 0 and mesh is None:
+            failing = need & (asset == a)
+            name = ir.INSERT_MODES[int(np.broadcast_to(mode, asset.shape)[np.flatnonzero(failing)[0]])]
+            ctx.fail(cursor, failing, f"`i(..., {name})` needs the asset's size: {ctx.asset_problem(a)}", span)
+        if mesh is not None:
+            table[k] = mesh.bounds
     rows = inverse.reshape(-1)
-    return low[rows], high[rows]
+    low, high = table[rows, 0], table[rows, 1]
+    if np.any(up):  # (x, y, z) -> (x, z, -y): the highest y becomes the lowest z
+        turned = np.reshape(up, (-1, 1))
+        low, high = (np.where(turned, np.stack([low[:, 0], low[:, 2], -high[:, 1]], axis=1), low),
+                     np.where(turned, np.stack([high[:, 0], high[:, 2], -low[:, 1]], axis=1), high))
+    return low, high
 
 
 @operation(ir.Label, writes=("dynamic",), meshes=True)
 def label(ctx: Context, cursor: Shapes, op: ir.Label) -> Shapes:
-    """``label(name)``: the shape's solid is an occluder with that label, and its own ancestor."""
+    """``label(name)``: the shape's solid is an occluder with that label, and its own ancestor; any
+    shape is a labelled shape that the context queries (``minimumDistance``, ``contextCount``) see."""
     name = op.name.value if isinstance(op.name, ir.Str) else \
         interned_texts(ctx.plan, evaluate_array(op.name, ctx.env(cursor), dtype=np.int32))
-    return with_ancestor(ctx.plan, cursor, add_occluders(ctx.chunk, cursor, name))
+    return with_ancestor(ctx.plan, cursor, add_occluders(ctx.chunk, cursor, name, scopes=True))

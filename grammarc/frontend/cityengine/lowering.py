@@ -483,7 +483,7 @@ class Lowering(OperationLowering, LoweringBase):
 
     def function(self, meta, name, args):
         span = self.token_span(name)
-        if str(name) in ir.OCCLUSION_KINDS:
+        if str(name) in ir.OCCLUSION_KINDS | ir.CONTEXT_KINDS:
             return self.occlusion(str(name), args or (), span)
         func = FUNCTION_NAMES.get(str(name), str(name))
         args = tuple(self.expr(a) for a in (args or ()))
@@ -515,17 +515,21 @@ class Lowering(OperationLowering, LoweringBase):
                                   for c in "xyz"),), span)
 
     def occlusion(self, kind: str, args, span) -> ir.Expr:
-        """``inside`` / ``overlaps`` / ``touches([target[, label]])``: the target ``intra``, ``inter`` or
-        ``all``, or ``sel(text)`` computed; the label a string, constant or computed."""
+        """``inside`` / ``overlaps`` / ``touches([target[, label]])`` and the context queries
+        ``minimumDistance`` / ``contextCount(target, label)``: the target ``intra``, ``inter`` or ``all``,
+        or ``sel(text)`` computed; the label a string, constant or computed."""
         args = tuple(self.expr(a) for a in args)
         target = args[0].name if args and isinstance(args[0], ir.Name) else None
         chosen = args[0].args[0] if args and isinstance(args[0], ir.Call) and args[0].func == "sel" \
             and len(args[0].args) == 1 else None
         if isinstance(chosen, ir.Str) and chosen.value in ir.OCCLUSION_TARGETS:
             target, chosen = chosen.value, None
-        if len(args) > 2 or (args and target not in ir.OCCLUSION_TARGETS and chosen is None):
-            self.unsupported(f"{kind} with these arguments", span,
-                             f"{kind}(), {kind}(intra|inter|all[, label]) and {kind}(sel(text)[, label])")
+        context = kind in ir.CONTEXT_KINDS  # a context query takes both arguments
+        if len(args) not in ((2,) if context else (0, 1, 2)) or (args and target not in ir.OCCLUSION_TARGETS
+                                                                 and chosen is None):
+            forms = f"{kind}(intra|inter|all|sel(text), label)" if context else \
+                f"{kind}(), {kind}(intra|inter|all[, label]) and {kind}(sel(text)[, label])"
+            self.unsupported(f"{kind} with these arguments", span, forms)
             return ir.placeholder(span)
         label = args[1] if len(args) == 2 else None
         constant = label.value if isinstance(label, ir.Str) else None

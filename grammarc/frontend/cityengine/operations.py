@@ -207,22 +207,28 @@ class OperationLowering:
 
     def op_insert(self, op, args, span):
         """``i(asset[, yUp|zUp[, insertMode[, cleanupMode]]])``; a selector may be written as a string
-        (``"zUp"``), as older rule files do. The cleanup mode changes nothing here: grammarc does not
-        clean up an inserted asset's geometry."""
+        (``"zUp"``), as older rule files do, or computed: any other expression, a string per shape (the
+        reference's ``i(geometryPath, upAxisOfGeometry, insertMode)`` takes strings; ce.lib's static
+        model computes its up axis). The cleanup mode changes nothing here: grammarc does not clean up an
+        inserted asset's geometry."""
         if not 1 <= len(args) <= 4:
             return self.unsupported(f"i with {len(args)} arguments", span,
                                     "i(asset[, upAxis[, insertMode[, cleanupMode]]])")
-        choices = (("yUp", "zUp"), ir.INSERT_MODES, ("numericalCleanup", "noCleanup"))
-        chosen = [c[0] for c in choices]  # the defaults
+        choices = (ir.UP_AXES, ir.INSERT_MODES, ("numericalCleanup", "noCleanup"))
+        chosen: list = [c[0] for c in choices]  # the defaults
         for k, (arg, allowed) in enumerate(zip(args[1:], choices)):
-            chosen[k] = arg.name if isinstance(arg, ir.Name) else arg.value if isinstance(arg, ir.Str) else None
-            if chosen[k] not in allowed:
-                return self.unsupported("i with this selector", arg.span, f"one of {', '.join(allowed)} "
-                                        "written out (a computed selector is not supported)")
-        up, mode, _ = chosen
+            written = arg.name if isinstance(arg, ir.Name) else arg.value if isinstance(arg, ir.Str) else None
+            if written in allowed:
+                chosen[k] = written
+            elif isinstance(arg, ir.Str):
+                return self.unsupported("i with this selector", arg.span, f"one of {', '.join(allowed)}")
+            else:  # computed: checked per shape
+                chosen[k] = self.expr(arg)
+        (up, up_by), (mode, mode_by) = ((c, None) if isinstance(c, str) else (d[0], c)
+                                        for c, d in zip(chosen[:2], choices))
         if isinstance(args[0], ir.Str):
-            return ir.UseAsset(args[0].value, span, up=up, mode=mode)
-        return ir.UseAsset("", span, name=self.expr(args[0]), up=up, mode=mode)
+            return ir.UseAsset(args[0].value, span, up=up, mode=mode, up_by=up_by, mode_by=mode_by)
+        return ir.UseAsset("", span, name=self.expr(args[0]), up=up, mode=mode, up_by=up_by, mode_by=mode_by)
 
     def op_cube(self, op, args, span):
         """``primitiveCube()`` is ``i("builtin:cube")``; with its sizes a ``Primitive``."""

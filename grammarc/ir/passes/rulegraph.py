@@ -2,7 +2,10 @@
 
 Assumes: names resolved and types checked. Guarantees: the grammar has rules, its start symbol has one,
 and ``Module.graph`` holds the ``RuleGraph`` from it; rules the start symbol never reaches are warned
-about. A module without a start symbol (a CityEngine file without ``@StartRule``) starts with its first
+about. Only a CityEngine file may have no rules (then its graph is None): it is a library of attributes,
+constants and functions that other files import (``00_config.cga``), which CityEngine reads without
+complaint; ``check`` warns that it has nothing to build and ``build`` refuses it (``compiler``). In the
+paper's notation a file without rules is an error. A module without a start symbol (a CityEngine file without ``@StartRule``) starts with its first
 rule, as CityEngine's inspector does, and says so. A start rule with parameters in a module to derive (one
 with asset folders, ``roots``, as the compiler makes it) is a warning here: the grammar is sound, but a lot
 has no arguments to pass, so ``build`` needs them from the command line (``--start 'Lot(10)'``, which
@@ -37,8 +40,13 @@ from grammarc.ir.traverse import iter_ops
 def rule_graph(module: ir.Module, diags: Diagnostics) -> ir.Module:
     """The pass: the module with ``graph`` from its start symbol, which must have a rule."""
     if not module.rules:
-        if not diags.has_errors:  # rules that failed to parse are not "no rules"
-            diags.error("empty", "the grammar has no rules", Span(module.file, 1, 1, 1, 1))
+        if diags.has_errors:  # rules that failed to parse are not "no rules"
+            return module
+        where = Span(module.file, 1, 1, 1, 1)
+        if module.dialect == "cityengine":
+            diags.warning("no-rules", NO_RULES, where, hint="import it from a file with rules")
+        else:
+            diags.error("empty", "the grammar has no rules", where)
         return module
     if module.start is None:
         first = module.rules[0]
@@ -54,6 +62,10 @@ def rule_graph(module: ir.Module, diags: Diagnostics) -> ir.Module:
     if start.params and module.roots is not None:  # a module to derive: lots pass no arguments
         diags.warning("start-params", start_params_message(start), start.span)
     return replace(module, graph=analyze_rules(module, start.symbol, diags))
+
+
+#: What a CityEngine file without rules is told (``check`` warns, ``build`` refuses: ``compiler``).
+NO_RULES = "the grammar has no rules: a file of attributes, constants and functions to import, nothing to build"
 
 
 def start_params_message(start: ir.Rule) -> str:

@@ -370,7 +370,8 @@ def _call(expr: ir.Call, got: list[ir.Type], diags: Diagnostics) -> ir.Type:
 
 #: The types of expressions with children, from the children's types.
 _RESULTS = {
-    ir.Occlusion: lambda e, got, diags: T.STR if e.kind == "occ" else T.BOOL,  # inside, overlaps, touches, visible
+    ir.Occlusion: lambda e, got, diags: T.STR if e.kind == "occ" else T.NUM if e.kind in ir.CONTEXT_KINDS \
+    else T.BOOL,  # inside, overlaps, touches, visible; minimumDistance, contextCount
     ir.Select: _select,
     ir.Call: _call,
     ir.ArrayLit: _array,

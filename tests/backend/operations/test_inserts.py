@@ -64,6 +64,24 @@ def test_insert_modes_place_the_asset_as_the_reference_says(write, mode, xform):
     np.testing.assert_allclose(r["xform"][0], xform, atol=1e-6)
 
 
+def test_up_axis_and_mode_computed_per_lot_place_as_written_ones_do(write):
+    """ce.lib's static model computes its up axis (``upMode = case Pos_zUp : "zUp" else : "yUp"``): each
+    lot's post is placed as the written selectors place it, a mode chosen per lot too."""
+    write("post.obj", POST)
+    text = ('attr tall = false\nattr how = "keepSizeAndPosition"\nupMode = case tall : "zUp" else : "yUp"\n'
+            'Lot --> extrude(4) i("post.obj", upMode, how) Post\n')
+    lots = [[np.array([[x, 0], [x + 12, 0], [x + 12, 8], [x, 8]], float)] for x in (0, 100, 200)]
+    r = run(write, text, lots, lot_attrs={"tall": [False, True, True],
+                                          "how": ["keepSizeAndPosition", "keepSizeAndPosition",
+                                                  "alignSizeAndPosition"]})
+    assert r["bad"] == ()
+    np.testing.assert_allclose(r["xform"], [[[2, 0, 0, -1], [0, 3, 0, 0], [0, 0, 0.5, -6]],
+                                            [[2, 0, 0, 99], [0, 0, 0.5, 2], [0, -3, 0, -8]],
+                                            [[12, 0, 0, 200], [0, 0, 4, 0], [0, -8, 0, 0]]], atol=1e-6)
+    bad = run(write, text, lots[:1], lot_attrs={"how": ["fitScope"]})["bad"]
+    assert "`i` with insert mode `fitScope`, not one of alignSizeAndPosition, keepSizeAndPosition" in bad[0].reason
+
+
 def test_the_scope_after_a_mode_that_keeps_the_size_is_the_asset_box(write):
     """Operations after ``i`` see the new scope: a split of the post's own 2 m width."""
     write("post.obj", POST)

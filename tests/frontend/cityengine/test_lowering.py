@@ -235,6 +235,7 @@ def test_unknown_queries_and_their_arguments_are_named(line, message):
 @pytest.mark.parametrize("line, name, at", [
     ("Lot --> case inside(near) : A else : B", "inside with these arguments", "inside"),
     ("Lot --> case touches(sel(1, 2)) : A else : B", "touches with these arguments", "touches"),
+    ("Lot --> extrude(minimumDistance(intra)) A", "minimumDistance with these arguments", "minimumDistance"),
     ("Lot --> extrude(initialShape.origin.qx) A", "initialShape.origin.qx", "initialShape"),
     ("Lot --> extrude(geometry.du(0, area)) A", "geometry.du in this space", "geometry"),
     ("Lot --> extrude(geometry.area(north)) A", "geometry.area selector `north`", "north"),
@@ -403,3 +404,11 @@ def test_occlusion_targets_and_labels_may_be_computed():
     assert print_expr(case.branches[0][0]) == '(inside(sel(@where), @seek) || overlaps(inter, ("k" + @seek)))'
     assert errors(VERSION + "Lot --> case touches(all, 3) : A else : B\n") == [
         (2, 27, "an occlusion label must be a str, got a num")]
+
+
+def test_minimum_distance_is_a_number_with_a_target_and_a_label():
+    module = module_of(VERSION + 'attr seek = "k"\nLot --> extrude(minimumDistance(sel("in" + "tra"), seek) + 1) A\n')
+    [extrude] = [op for op in iter_ops(module.rules[0].alternatives[0].body) if isinstance(op, ir.Extrude)]
+    assert print_expr(extrude.height) == '(minimumDistance(sel(("in" + "tra")), @seek) + 1)'
+    assert errors(VERSION + 'Lot --> case minimumDistance(all, "k") : A else : B\n') == [
+        (2, 14, "a case condition must be a bool, got a num")]
