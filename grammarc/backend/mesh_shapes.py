@@ -50,18 +50,24 @@ def store_fitted(chunk: Chunk, verts: np.ndarray, ring_offsets, face_offsets, me
 
 
 def build_roofs(chunk: Chunk, shapes: Shapes, kind: str, polygons, value, by_height: bool, overhang,
-                index, cap=None) -> tuple[Shapes, np.ndarray]:
+                index, cap=None, even=None, edges=None) -> tuple[Shapes, np.ndarray]:
     """Roof shapes over ``shapes``' polygons (``polygons``: coords, ring_offsets, shape_offsets and the
     plane of each, as ``outlines.polygons_of`` gives them) and a mask (n,) of the shapes whose roof
-    could not be built (their shapes keep their old geometry and must be reported)."""
+    could not be built (their shapes keep their old geometry and must be reported). ``even`` (n,) bool
+    levels the ridges of hip and gable roofs; ``edges``, an envelope's base height and angle under the
+    edge from each vertex of ``polygons`` (two (V,) arrays), where they differ by side."""
     coords, ring_offsets, shape_offsets, plane = polygons
-    rows = np.arange(len(shapes))
+    n = len(shapes)
+    rows = np.arange(n)
     size_a = shapes.size[rows, PLANE_U[plane]]
     size_b = shapes.size[rows, PLANE_V[plane]]
+    no_edges = np.zeros(len(coords))
+    edge_base, edge_angle = (no_edges, no_edges) if edges is None else edges
     verts, rings, faces, meshes, ok = roof_meshes(
         ROOF_KINDS[kind], coords, ring_offsets, shape_offsets, plane.astype(np.int8), size_a, size_b,
         value, by_height, overhang, index.astype(np.int64),
-        np.full(len(shapes), np.inf) if cap is None else np.asarray(cap, dtype=np.float64))
+        np.full(n, np.inf) if cap is None else np.asarray(cap, dtype=np.float64),
+        np.zeros(n, dtype=bool) if even is None else even, edge_base, edge_angle)
     return roof_shapes(chunk, shapes, plane, verts, rings, faces, meshes), ~ok
 
 

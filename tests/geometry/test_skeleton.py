@@ -20,10 +20,11 @@ COURTYARD = [[(0, 0), (40, 0), (40, 40), (0, 40)], [(10, 10), (10, 30), (30, 30)
 OCTAGON = [[(10 * np.cos(a), 10 * np.sin(a)) for a in np.arange(8) * np.pi / 4]]
 
 
-def skeleton(rings, start_time=0.0):
+def skeleton(rings, start_time=0.0, speed=None):
     xy = np.concatenate([np.asarray(r, dtype=float) for r in rings])
     ring_offsets = np.cumsum([0] + [len(r) for r in rings]).astype(np.int64)
-    node_xy, node_t, nodes, offsets, ok = skeleton_faces(xy, ring_offsets, start_time)
+    speed = np.ones(len(xy)) if speed is None else np.asarray(speed, float)
+    node_xy, node_t, nodes, offsets, ok = skeleton_faces(xy, ring_offsets, start_time, speed)
     faces = [nodes[offsets[k]:offsets[k + 1]] for k in range(len(xy))]
     return xy, node_xy, node_t, faces, ok
 
