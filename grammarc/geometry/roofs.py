@@ -20,7 +20,10 @@ its normal. Face 0 of every mesh is the original polygon seen from below (CityEn
   ``angle`` above. A gambrel's gable ends are vertical pentagons;
 - ``envelope`` (CityEngine's building envelope): walls ``overhang`` high under every edge, the hip
   roof's planes from their tops, cut flat at height ``cap``: what is left of each plane above the cut
-  lies in the flat top.
+  lies in the flat top. Where the sides differ (a base height and an angle per edge), or a side is
+  vertical, the planes are those of a weighted skeleton (``_envelope``);
+- ``even`` (hip and gable): every node above the eaves takes their mean height, so the ridges are level
+  and the faces by them no longer planar, as CityEngine's ``even`` does.
 
 ``roofRidge`` and ``roofGable`` with an edge index, two planes under one ridge in a given direction, are
 ``ridges.py``'s.
