@@ -117,9 +117,16 @@ def test_split_of_a_concave_roof_cuts_it_into_closed_slabs(write, lot, axis):
     assert t["v_n"] > 2 and t["v_sum"] == pytest.approx(t["whole_sum"], rel=1e-9)
 
 
-def test_a_roof_that_cannot_be_extruded_is_reported(write):
-    r = run(write, "Lot --> roofHip(30) extrude(3)\n", [rect(12, 8)])
-    assert "`extrude` of a roof is not supported yet" in r["bad"][0].reason
+def test_extrude_of_a_roof_makes_a_solid_of_each_face_along_its_normal(write):
+    """As the reference's face.normal: the bottom slab hangs below the footprint, the planes' slabs stand
+    out of them, each face's area times the height; the scope keeps its axes, fitted to the solids."""
+    r = run(write, 'Lot --> roofHip(30) extrude(0.5) report("v", geometry.volume) report("y", scope.ty) '
+                   'report("sx", scope.sx)\n', [rect(12, 8)])
+    t = totals(r)
+    assert r["bad"] == () and t["v_sum"] == pytest.approx(0.5 * (96 + 96 / np.cos(np.radians(30))))
+    assert t["y_sum"] == pytest.approx(-0.5) and t["sx_sum"] > 12
+    r = run(write, "Lot --> roofHip(30) extrude(world.up, 3)\n", [rect(12, 8)])
+    assert "`extrude` along world.up of a roof is not supported yet" in r["bad"][0].reason
 
 
 def test_split_of_a_convex_roof_cuts_it_into_closed_slabs(write):
