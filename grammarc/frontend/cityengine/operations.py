@@ -62,6 +62,9 @@ class OperationLowering:
         if not isinstance(args[0], ir.Name) or args[0].name not in ("normal", "world.up", "face.normal"):
             return self.unsupported("envelope with this direction", span, "normal or world.up")
         pairs = [(self.expr(args[k]), self.expr(args[k + 1])) for k in range(2, len(args), 2)]
+        if any(isinstance(e, ir.ArrayLit) for pair in pairs for e in pair):
+            return self.unsupported("envelope with arrays per edge", span,
+                                    "a base height and an angle per side: front, back, sides or right and left")
         (base, angle), others = pairs[0], tuple(pairs[1:])
         zero = ir.Num(0.0, span)
         return ir.Roof("envelope", angle, False, base, None, zero, span, cap=self.expr(args[1]), sides=others)

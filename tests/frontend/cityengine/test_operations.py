@@ -291,6 +291,7 @@ def test_even_ridges_lower_to_the_roofs_even_expression(call, even):
     ("Lot --> shapeL(3, 2) Garden", "shapeL without selector parts", "shapeL"),
     ("Lot --> setback(3){ 2 : Garden }", "this setback selector", "2"),
     ("Lot --> envelope(normal, 10, 45) Roof", "envelope with 3 arguments", "envelope"),
+    ("Lot --> envelope(normal, 10, [1, 2], [45, 30]) Roof", "envelope with arrays per edge", "envelope"),
     ("Lot --> shapeL(4, 4){ front : A | remainder : NIL }", "shapeL selector `front`", "front"),
     ("Lot --> innerRectangle(world){ shape : A | remainder : NIL }", "innerRectangle with these arguments",
      "innerRectangle"),
