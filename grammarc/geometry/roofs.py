@@ -425,7 +425,7 @@ def roof_meshes(kind, coords, ring_offsets, poly_offsets, plane, size_a, size_b,
         elif kind == HIP or kind == GABLE or kind == MANSARD or kind == GAMBREL or kind == ENVELOPE:
             wall = overhang[g] if kind == ENVELOPE else 0.0
             start_time = 0.0 if kind == ENVELOPE else -overhang[g] * (1.0 if by_height else np.cos(angle))
-            node_xy, node_t, fnodes, foff, done = skeleton_faces(pts, pring, start_time, np.ones(n))
+            node_xy, node_t, fnodes, foff, done = skeleton_faces(pts, pring, start_time, None)
             if not done:
                 ok[g] = False
                 mesh_offsets[g + 1] = n_f

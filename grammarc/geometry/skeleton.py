@@ -49,13 +49,21 @@ def _solve3(a0, a1, a2, aw, b0, b1, b2, bw, c0, c1, c2, cw):
 
 
 @njit(cache=True, nogil=True)
+def _speed(speed, e):
+    """Edge e's speed: 1 where ``speed`` is None (numba prunes the branch in that specialization)."""
+    if speed is None:
+        return 1.0
+    return speed[e]
+
+
+@njit(cache=True, nogil=True)
 def _vertex_at(nrm, c, w, e0, e1, t):
     """Where the lines of edges e0 and e1 cross at time t; ok False when they are parallel."""
     a0, a1, b0, b1 = nrm[e0, 0], nrm[e0, 1], nrm[e1, 0], nrm[e1, 1]
     det = a0 * b1 - a1 * b0
     if abs(det) < 1e-12:
         return 0.0, 0.0, False
-    r0, r1 = c[e0] + w[e0] * t, c[e1] + w[e1] * t
+    r0, r1 = c[e0] + _speed(w, e0) * t, c[e1] + _speed(w, e1) * t
     return (r0 * b1 - a1 * r1) / det, (a0 * r1 - r0 * b0) / det, True
 
 
@@ -76,7 +84,8 @@ def skeleton_faces(xy, ring_offsets, start_time, speed):
     xy : (n, 2) float64, the polygon's vertices, exterior counter-clockwise then holes clockwise (ring
     ``r`` is ``ring_offsets[r]:ring_offsets[r+1]``), without repeated or collinear consecutive vertices.
     start_time : <= 0; the wavefront starts from the edges moved out by -start_time (an overhang).
-    speed : (n,) float64 >= 0, how fast each edge's line moves in (1 everywhere: the plain skeleton).
+    speed : (n,) float64 >= 0, how fast each edge's line moves in, or None: 1 everywhere, the plain
+    skeleton (numba compiles it apart, without the speeds).
     Returns node_xy (N, 2), node_t (N,), face_nodes (ragged node ids of each edge's face, starting with
     the edge's two ends), face_offsets (n+1,) and ok.
     """
@@ -168,8 +177,9 @@ def skeleton_faces(xy, ring_offsets, start_time, speed):
                 w = nxt[v]
                 a, e, b = in_edge[v], out_edge[v], out_edge[w]
                 if not (_spike(direction, v, in_edge, out_edge) or _spike(direction, w, in_edge, out_edge)):
-                    x, y, t, solved = _solve3(nrm[a, 0], nrm[a, 1], c[a], speed[a], nrm[e, 0], nrm[e, 1],
-                                              c[e], speed[e], nrm[b, 0], nrm[b, 1], c[b], speed[b])
+                    x, y, t, solved = _solve3(nrm[a, 0], nrm[a, 1], c[a], _speed(speed, a), nrm[e, 0],
+                                              nrm[e, 1], c[e], _speed(speed, e), nrm[b, 0], nrm[b, 1], c[b],
+                                              _speed(speed, b))
                     if solved:
                         edge_t[v], edge_x[v], edge_y[v] = t, x, y
             t = edge_t[v]
@@ -276,7 +286,7 @@ def skeleton_faces(xy, ring_offsets, start_time, speed):
         ok = False
     # the wavefront reaches every point no later than the boundary's offset at the slowest speed does:
     # a node later than its distance to the (moved-out) boundary over that speed is a wrong event order
-    slowest = speed.min()
+    slowest = 1.0 if speed is None else speed.min()
     for q in range(n_nodes if slowest > 0.0 else 0):
         reach = np.inf
         for k in range(n):
@@ -322,10 +332,10 @@ def _split_candidates(v, nrm, c, speed, direction, node_xy, node_t, start, in_ed
     for e in range(len(c)):
         if not present[e] or e == a or e == b:
             continue
-        if nrm[e, 0] * px + nrm[e, 1] * py - c[e] - speed[e] * t0 < -eps:
+        if nrm[e, 0] * px + nrm[e, 1] * py - c[e] - _speed(speed, e) * t0 < -eps:
             continue  # behind the line: moving away from it
-        x, y, t, solved = _solve3(nrm[a, 0], nrm[a, 1], c[a], speed[a], nrm[b, 0], nrm[b, 1], c[b], speed[b],
-                                  nrm[e, 0], nrm[e, 1], c[e], speed[e])
+        x, y, t, solved = _solve3(nrm[a, 0], nrm[a, 1], c[a], _speed(speed, a), nrm[b, 0], nrm[b, 1], c[b],
+                                  _speed(speed, b), nrm[e, 0], nrm[e, 1], c[e], _speed(speed, e))
         if not solved or t < t0 - eps:
             continue
         cand_t[v, count], cand_x[v, count], cand_y[v, count], cand_e[v, count] = t, x, y, e
