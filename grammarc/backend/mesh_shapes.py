@@ -19,6 +19,7 @@ from grammarc.geometry.cleanup import cleanup_meshes
 from grammarc.geometry.clip import oriented_rings
 from grammarc.geometry.meshes import (
     MESH_BASE,
+    border_ring_edges,
     clip_slabs,
     face_frames,
     face_vertices,
@@ -50,18 +51,24 @@ def store_fitted(chunk: Chunk, verts: np.ndarray, ring_offsets, face_offsets, me
 
 
 def build_roofs(chunk: Chunk, shapes: Shapes, kind: str, polygons, value, by_height: bool, overhang,
-                index, cap=None) -> tuple[Shapes, np.ndarray]:
+                index, cap=None, even=None, edges=None) -> tuple[Shapes, np.ndarray]:
     """Roof shapes over ``shapes``' polygons (``polygons``: coords, ring_offsets, shape_offsets and the
     plane of each, as ``outlines.polygons_of`` gives them) and a mask (n,) of the shapes whose roof
-    could not be built (their shapes keep their old geometry and must be reported)."""
+    could not be built (their shapes keep their old geometry and must be reported). ``even`` (n,) bool
+    levels the ridges of hip and gable roofs; ``edges``, an envelope's base height and angle under the
+    edge from each vertex of ``polygons`` (two (V,) arrays), where they differ by side."""
     coords, ring_offsets, shape_offsets, plane = polygons
-    rows = np.arange(len(shapes))
+    n = len(shapes)
+    rows = np.arange(n)
     size_a = shapes.size[rows, PLANE_U[plane]]
     size_b = shapes.size[rows, PLANE_V[plane]]
+    no_edges = np.zeros(len(coords))
+    edge_base, edge_angle = (no_edges, no_edges) if edges is None else edges
     verts, rings, faces, meshes, ok = roof_meshes(
         ROOF_KINDS[kind], coords, ring_offsets, shape_offsets, plane.astype(np.int8), size_a, size_b,
         value, by_height, overhang, index.astype(np.int64),
-        np.full(len(shapes), np.inf) if cap is None else np.asarray(cap, dtype=np.float64))
+        np.full(n, np.inf) if cap is None else np.asarray(cap, dtype=np.float64),
+        np.zeros(n, dtype=bool) if even is None else even, edge_base, edge_angle)
     return roof_shapes(chunk, shapes, plane, verts, rings, faces, meshes), ~ok
 
 
@@ -144,25 +151,26 @@ MESH_KINDS = frozenset({FACES, SIDEFACES, BOTTOM, EDGES, SIDEEDGES, TOPEDGES, BO
 _EDGE_KINDS = {EDGES: (0, 1, 2), BOTTOMEDGES: (0,), SIDEEDGES: (1,), TOPEDGES: (2,)}
 
 
-def mesh_components(chunk: Chunk, shapes: Shapes, kind: int):
+def mesh_components(chunk: Chunk, shapes: Shapes, kind: int, borders: bool = False):
     """Components of mesh shapes: parent (m,), index (m,) among the parent's components of this kind,
     origin (m, 3) and axes (m, 3, 3) in the parent's frame, size (m, 3), geom (m,): faces become
     polygons (plane z) with CityEngine's face scopes, edges scope edges (``meshes.mesh_edges``),
-    vertices points (``meshes.mesh_corners``); and roof (m,) int32, each edge's place on the roof
-    (``meshes.roof_edge_kinds``; -1 for faces and vertices)."""
+    vertices points (``meshes.mesh_corners``); roof (m,) int32, each edge's place on the roof
+    (``meshes.roof_edge_kinds``; -1 for faces and vertices); and border (m,) bool, with ``borders`` the
+    components on the mesh's border (``meshes.border_ring_edges``: none on a closed mesh), else none."""
     verts, ring_offsets, face_offsets, mesh_offsets, _ = face_vertices(
         chunk.meshes, shapes.geom - MESH_BASE, shapes.size)
     if kind == VERTICES:
-        parent, origin, axes = mesh_corners(verts, ring_offsets, face_offsets, mesh_offsets, TOL.zero)
+        parent, origin, axes, border = mesh_corners(verts, ring_offsets, face_offsets, mesh_offsets, TOL.zero)
         none = np.full(len(parent), -1, dtype=np.int32)
-        return parent, rank_within(parent), origin, axes, np.zeros((len(parent), 3)), none, none
+        return parent, rank_within(parent), origin, axes, np.zeros((len(parent), 3)), none, none, border
     if kind in _EDGE_KINDS:
-        parent, origin, axes, size, edge_kind, roof = mesh_edges(verts, ring_offsets, face_offsets, mesh_offsets,
-                                                                 TOL.zero)
+        parent, origin, axes, size, edge_kind, roof, border = mesh_edges(verts, ring_offsets, face_offsets,
+                                                                         mesh_offsets, TOL.zero)
         keep = np.isin(edge_kind, _EDGE_KINDS[kind])
         parent, origin, axes, size, roof = parent[keep], origin[keep], axes[keep], size[keep], roof[keep]
         return (parent, rank_within(parent), origin, axes, size, np.full(len(parent), -1, dtype=np.int32),
-                roof.astype(np.int32))
+                roof.astype(np.int32), border[keep])
     origin, axes, size, uv, ok = face_frames(verts, ring_offsets, face_offsets, TOL.zero)
     face_mesh = segment_of(mesh_offsets)
     index = np.arange(len(face_mesh)) - mesh_offsets[face_mesh]
@@ -170,8 +178,13 @@ def mesh_components(chunk: Chunk, shapes: Shapes, kind: int):
     keep = ok & {FACES: index >= 0, SIDEFACES: index > 0, BOTTOM: index == 0}[kind]
     if kind == SIDEFACES:
         index = index - 1
+    border = np.zeros(len(face_mesh), dtype=bool)
+    if borders:
+        edges = border_ring_edges(verts, ring_offsets, face_offsets, mesh_offsets, TOL.zero)
+        border = np.bincount(segment_of(face_offsets)[segment_of(ring_offsets)], weights=edges,
+                             minlength=len(face_mesh)) > 0
     return (face_mesh[keep], index[keep], origin[keep], axes[keep], size[keep], geom[keep],
-            np.full(int(keep.sum()), -1, dtype=np.int32))
+            np.full(int(keep.sum()), -1, dtype=np.int32), border[keep])
 
 
 def clip_meshes(chunk: Chunk, shapes: Shapes, parent: np.ndarray, axis: int, pos: np.ndarray,

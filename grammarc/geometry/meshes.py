@@ -164,19 +164,14 @@ def mesh_edges(verts, ring_offsets, face_offsets, mesh_offsets, eps: float):
     verts (V, 3) in the scopes' units, with y the roof's up. Returns mesh (E,), origin (E, 3), axes
     (E, 3, 3), size (E, 3), kind (E,): 0 for bottom edges (horizontal, at or below the base: the
     footprint and the eaves), 1 for side edges (sloped: hips and valleys), 2 for top edges (horizontal
-    above the base: ridges), and roof (E,) int8, the edge's place on a roof (``roof_edge_kinds``); each
-    mesh's edges in the order they first appear in its faces.
+    above the base: ridges), roof (E,) int8, the edge's place on a roof (``roof_edge_kinds``), and
+    border (E,) bool, whether one face only has the edge (``comp(e){ border }``); each mesh's edges in
+    the order they first appear in its faces.
     """
     face, mesh, nxt, face_normal = _ring_walk(verts, ring_offsets, face_offsets, mesh_offsets)
     p, q = verts, verts[nxt]
-    # an undirected edge is its mesh and its endpoints in lexicographic order, on a grid of eps
-    a, b = np.round(p / eps), np.round(q / eps)
-    step = b - a
-    swap = step[np.arange(len(step)), np.argmax(step != 0, axis=1)] < 0
-    lo, hi = np.where(swap[:, None], b, a), np.where(swap[:, None], a, b)
-    keep = (lo != hi).any(axis=1)
-    key = np.column_stack([mesh, lo, hi])[keep]
-    inverse, first = row_groups(key)
+    key, keep = _undirected_edges(verts, nxt, mesh, eps)
+    inverse, first = row_groups(key[keep])
     order = np.argsort(first, kind="stable")  # first appearance, which keeps meshes in order
     rank = np.empty(len(order), dtype=np.int64)
     rank[order] = np.arange(len(order))
@@ -203,7 +198,7 @@ def mesh_edges(verts, ring_offsets, face_offsets, mesh_offsets, eps: float):
     kind = np.where(~horizontal, 1, np.where(low, 0, 2))
     roof = roof_edge_kinds(verts, ring_offsets, face_offsets, mesh_offsets, face[kept], rank[inverse], face_normal,
                            mesh[edge], start, end, eps)
-    return mesh[edge], start, axes, size, kind, roof
+    return mesh[edge], start, axes, size, kind, roof, np.bincount(rank[inverse], minlength=len(order)) == 1
 
 
 #: The sine of the slope below which a face counts as flat, or above which as vertical, for a roof's edges.
@@ -265,11 +260,34 @@ def roof_edge_kinds(verts, ring_offsets, face_offsets, mesh_offsets, edge_face, 
     return roof
 
 
+def border_ring_edges(verts, ring_offsets, face_offsets, mesh_offsets, eps: float) -> np.ndarray:
+    """Whether the ring edge from each ring vertex (V,) is on its mesh's border: no other face of the
+    mesh has it (the reference's border edge, which meets one face only). A closed mesh (a roof with
+    its bottom, an envelope, a split's slab) has none."""
+    _, mesh, nxt, _ = _ring_walk(verts, ring_offsets, face_offsets, mesh_offsets)
+    key, keep = _undirected_edges(verts, nxt, mesh, eps)
+    inverse, _ = row_groups(key[keep])
+    border = np.zeros(len(verts), dtype=bool)
+    border[keep] = np.bincount(inverse)[inverse] == 1
+    return border
+
+
+def _undirected_edges(verts, nxt, mesh, eps: float):
+    """Each ring edge (from each vertex to ``nxt``) as an undirected key (V, 7): its mesh and its
+    endpoints in lexicographic order, on a grid of eps; and whether it has a length (V,)."""
+    a, b = np.round(verts / eps), np.round(verts[nxt] / eps)
+    step = b - a
+    swap = step[np.arange(len(step)), np.argmax(step != 0, axis=1)] < 0
+    lo, hi = np.where(swap[:, None], b, a), np.where(swap[:, None], a, b)
+    return np.column_stack([mesh, lo, hi]), (lo != hi).any(axis=1)
+
+
 def mesh_corners(verts, ring_offsets, face_offsets, mesh_offsets, eps: float):
     """The distinct vertices of meshes (a vertex its faces share counts once), as ``comp(v)`` places
     them: y the mean of the normals of the faces that meet there, x along the first edge that leaves
-    it (across y), size 0. Returns mesh (K,), origin (K, 3), axes (K, 3, 3), each mesh's vertices in
-    the order they first appear in its faces."""
+    it (across y), size 0. Returns mesh (K,), origin (K, 3), axes (K, 3, 3) and border (K,) bool, whether
+    a border edge (``border_ring_edges``) touches it, each mesh's vertices in the order they first
+    appear in its faces."""
     face, mesh, nxt, face_normal = _ring_walk(verts, ring_offsets, face_offsets, mesh_offsets)
     inverse, first = row_groups(np.column_stack([mesh, np.round(verts / eps)]).astype(np.int64))
     order = np.argsort(first, kind="stable")
@@ -286,7 +304,11 @@ def mesh_corners(verts, ring_offsets, face_offsets, mesh_offsets, eps: float):
     fallback -= np.einsum("ij,ij->i", fallback, y)[:, None] * y
     x = np.where((norm > 1e-9)[:, None], x, fallback)
     x /= np.linalg.norm(x, axis=1, keepdims=True)
-    return mesh[corner], verts[corner], np.stack([x, y, np.cross(x, y)], axis=1)
+    border = border_ring_edges(verts, ring_offsets, face_offsets, mesh_offsets, eps)
+    touches = np.zeros(len(order), dtype=bool)
+    np.logical_or.at(touches, rank[inverse], border)  # the edge that leaves the vertex
+    np.logical_or.at(touches, rank[inverse[nxt]], border)  # and the one that arrives
+    return mesh[corner], verts[corner], np.stack([x, y, np.cross(x, y)], axis=1), touches
 
 
 def _ring_walk(verts, ring_offsets, face_offsets, mesh_offsets):

@@ -20,7 +20,10 @@ its normal. Face 0 of every mesh is the original polygon seen from below (CityEn
   ``angle`` above. A gambrel's gable ends are vertical pentagons;
 - ``envelope`` (CityEngine's building envelope): walls ``overhang`` high under every edge, the hip
   roof's planes from their tops, cut flat at height ``cap``: what is left of each plane above the cut
-  lies in the flat top.
+  lies in the flat top. Where the sides differ (a base height and an angle per edge), or a side is
+  vertical, the planes are those of a weighted skeleton (``_envelope``);
+- ``even`` (hip and gable): every node above the eaves takes their mean height, so the ridges are level
+  and the faces by them no longer planar, as CityEngine's ``even`` does.
 
 ``roofRidge`` and ``roofGable`` with an edge index, two planes under one ridge in a given direction, are
 ``ridges.py``'s.
@@ -50,8 +53,10 @@ BREAK_SHARE = 1.0 / 3.0
 @njit(cache=True, nogil=True)
 def _clean_rings(pts, ring_offsets, eps):
     """Rings without repeated vertices and without vertices between collinear edges; rings left with
-    fewer than three vertices are dropped (the exterior too: then nothing is left)."""
+    fewer than three vertices are dropped (the exterior too: then nothing is left). Also returns each
+    kept vertex's index in ``pts``."""
     out = np.empty_like(pts)
+    kept = np.empty(len(pts), np.int64)
     offsets = np.zeros(len(ring_offsets), np.int64)
     n_out = 0
     n_rings = 0
@@ -86,14 +91,15 @@ def _clean_rings(pts, ring_offsets, eps):
         for j in range(r1 - r0):
             if keep[j]:
                 out[n_out + count] = pts[r0 + j]
+                kept[n_out + count] = r0 + j
                 count += 1
         if count >= 3:
             n_out += count
             n_rings += 1
             offsets[n_rings] = n_out
         elif r == 0:
-            return out[:0], offsets[:1]
-    return out[:n_out], offsets[: n_rings + 1]
+            return out[:0], offsets[:1], kept[:0]
+    return out[:n_out], offsets[: n_rings + 1], kept[:n_out]
 
 
 @njit(cache=True, nogil=True)
@@ -151,10 +157,12 @@ def _move_gable_ends(node_xy, node_t, faces, face_offsets, origin, ends, xy, suc
 
 
 @njit(cache=True, nogil=True)
-def _split_at(node_xy, node_t, faces, face_offsets, knee, eps):
-    """Each face cut where its inset reaches ``knee``: its part below, then its part above (either may
-    be missing), new nodes where face boundaries cross the knee, shared by the faces that meet there.
-    Returns nodes (xy, t), faces, offsets and each new face's original face."""
+def _split_at(node_xy, node_t, faces, face_offsets, knees, eave_above, eps):
+    """Each face f cut where its inset reaches ``knees[f]``: its part below, then its part above (either
+    may be missing), new nodes where face boundaries cross the knee, shared by the faces that meet there
+    at the same knee. With ``eave_above`` the part above starts with its cut edge, as the part below
+    starts with the face's eave. Returns nodes (xy, t), faces, offsets and each new face's original
+    face."""
     n_faces = len(face_offsets) - 1
     m = len(faces)
     xy = np.empty((len(node_xy) + m, 2))
@@ -172,6 +180,7 @@ def _split_at(node_xy, node_t, faces, face_offsets, knee, eps):
     for f in range(n_faces):
         f0, f1 = face_offsets[f], face_offsets[f + 1]
         size = f1 - f0
+        knee = knees[f]
         for upper in (False, True):
             start = count
             for j in range(size):
@@ -183,7 +192,7 @@ def _split_at(node_xy, node_t, faces, face_offsets, knee, eps):
                     lo, hi = min(a, b), max(a, b)
                     found = -1
                     for q in range(n_breaks):
-                        if break_key[q, 0] == lo and break_key[q, 1] == hi:
+                        if break_key[q, 0] == lo and break_key[q, 1] == hi and t[len(node_t) + q] == knee:
                             found = q
                             break
                     if found < 0:
@@ -206,6 +215,15 @@ def _split_at(node_xy, node_t, faces, face_offsets, knee, eps):
                         rolled = np.concatenate((out[j:count], out[start:j]))
                         out[start:count] = rolled
                         break
+            elif eave_above:  # the part above from the cut node followed by the other cut node
+                for j in range(start, count):
+                    nxt = start + (j - start + 1) % (count - start)
+                    if out[j] >= len(node_t) and out[nxt] >= len(node_t):
+                        if j == start:
+                            break
+                        rolled = np.concatenate((out[j:count], out[start:j]))
+                        out[start:count] = rolled
+                        break
             if count - start >= 3:
                 origin[n_out] = f
                 n_out += 1
@@ -216,14 +234,137 @@ def _split_at(node_xy, node_t, faces, face_offsets, knee, eps):
 
 
 @njit(cache=True, nogil=True)
+def _envelope(pts, pring, succ, base, speed, cap, eps):
+    """An envelope whose sides differ: walls ``base`` (n,) high under each edge, then each edge's plane
+    rising at ``speed`` (n,) (horizontal run per height: 0 is a wall up to the cap), cut flat at ``cap``.
+
+    Heights are the times of a weighted skeleton. Until ``t0``, the highest base of a moving edge, the
+    edges' lines are moved in by ``speed * max(h - base, 0)`` and each vertex runs along the meeting of
+    its two edges' planes (a corner node where one of them starts to slope); from ``t0`` on every line
+    moves linearly, and the weighted skeleton of the outline at ``t0`` gives the rest. Edge k's face
+    is its wall and its slope in one ring, then cut at ``base[k]`` into the two, and every face at the
+    cap. Returns points (P, 3) as (x, y, h), faces (ragged point ids, each starting with its eave or its
+    cut edge) and ok: False where an edge vanished before ``t0`` (bases too far apart for the outline),
+    the skeleton did not close, or no edge moves (a prism) and the outline has holes or no cap."""
+    n = len(pts)
+    pred = np.empty(n, np.int64)
+    for k in range(n):
+        pred[succ[k]] = k
+    moving = speed > 0.0
+    if not moving.any():  # walls all round: a prism up to the cap, its top the outline (without holes)
+        if len(pring) > 2 or not np.isfinite(cap):
+            return np.empty((0, 3)), np.empty(0, np.int64), np.zeros(1, np.int64), False
+        point = np.empty((2 * n, 3))
+        point[:n, :2], point[n:, :2] = pts, pts
+        point[:n, 2], point[n:, 2] = 0.0, cap
+        out = np.empty(5 * n, np.int64)
+        for k in range(n):
+            out[4 * k], out[4 * k + 1], out[4 * k + 2], out[4 * k + 3] = k, succ[k], n + succ[k], n + k
+        out[4 * n:] = n + np.arange(n)
+        offsets = np.append(4 * np.arange(n + 1), 5 * n)
+        return point, out, offsets, True
+    t0 = 0.0
+    for k in range(n):
+        if moving[k]:
+            t0 = max(t0, base[k])
+    nrm = np.empty((n, 2))
+    c = np.empty(n)
+    for k in range(n):
+        dx, dy = pts[succ[k], 0] - pts[k, 0], pts[succ[k], 1] - pts[k, 1]
+        length = np.sqrt(dx * dx + dy * dy)
+        nrm[k, 0], nrm[k, 1] = -dy / length, dx / length
+        c[k] = nrm[k, 0] * pts[k, 0] + nrm[k, 1] * pts[k, 1]
+    # each vertex's path up to t0: its heights (0, the bases of its edges below t0, t0) and points
+    path_h = np.empty((n, 4))
+    path_xy = np.empty((n, 4, 2))
+    path_len = np.zeros(n, np.int64)
+    for k in range(n):
+        a = pred[k]
+        hs = np.array([0.0, base[a] if moving[a] else 0.0, base[k] if moving[k] else 0.0, t0])
+        hs.sort()
+        for h in hs:
+            if path_len[k] > 0 and h <= path_h[k, path_len[k] - 1] + eps:
+                continue
+            ra = c[a] + speed[a] * max(h - base[a], 0.0)
+            rk = c[k] + speed[k] * max(h - base[k], 0.0)
+            det = nrm[a, 0] * nrm[k, 1] - nrm[a, 1] * nrm[k, 0]
+            path_h[k, path_len[k]] = h
+            path_xy[k, path_len[k], 0] = (ra * nrm[k, 1] - nrm[a, 1] * rk) / det
+            path_xy[k, path_len[k], 1] = (nrm[a, 0] * rk - ra * nrm[k, 0]) / det
+            path_len[k] += 1
+    top = np.empty((n, 2))
+    for k in range(n):
+        top[k] = path_xy[k, path_len[k] - 1]
+    for k in range(n):  # every edge keeps its direction up to t0
+        if (top[succ[k], 0] - top[k, 0]) * nrm[k, 1] - (top[succ[k], 1] - top[k, 1]) * nrm[k, 0] <= eps:
+            return np.empty((0, 3)), np.empty(0, np.int64), np.zeros(1, np.int64), False
+    node_xy, node_t, fnodes, foff, done = skeleton_faces(top, pring, 0.0, speed)
+    if not done:
+        return np.empty((0, 3)), np.empty(0, np.int64), np.zeros(1, np.int64), False
+    # nodes: the skeleton's (from t0), then each vertex's path below t0
+    first = np.zeros(n + 1, np.int64)
+    for k in range(n):
+        first[k + 1] = first[k] + path_len[k] - 1
+    n_skel = len(node_t)
+    all_xy = np.empty((n_skel + first[n], 2))
+    all_t = np.empty(n_skel + first[n])
+    all_xy[:n_skel] = node_xy
+    all_t[:n_skel] = node_t + t0
+    for k in range(n):
+        for j in range(path_len[k] - 1):
+            all_xy[n_skel + first[k] + j] = path_xy[k, j]
+            all_t[n_skel + first[k] + j] = path_h[k, j]
+    # edge k's face: up the path of succ[k] from its foot, the skeleton's face from succ[k] round to k,
+    # then down the path of k to its foot
+    out = np.empty(len(fnodes) + 2 * first[n], np.int64)
+    offsets = np.zeros(n + 1, np.int64)
+    count = 0
+    for k in range(n):
+        q = succ[k]
+        for j in range(path_len[q] - 1):
+            out[count] = n_skel + first[q] + j
+            count += 1
+        f0, f1 = foff[k], foff[k + 1]
+        for j in range(f0 + 1, f1):
+            out[count] = fnodes[j]
+            count += 1
+        out[count] = fnodes[f0]
+        count += 1
+        for j in range(path_len[k] - 2, -1, -1):
+            out[count] = n_skel + first[k] + j
+            count += 1
+        # the eave first: the foot of k, then the foot of succ[k]
+        ring = np.concatenate((out[count - 1:count], out[offsets[k]:count - 1]))
+        out[offsets[k]:count] = ring
+        offsets[k + 1] = count
+    knees = np.full(n, np.inf)
+    for k in range(n):
+        if moving[k] and base[k] > eps:
+            knees[k] = base[k]
+    all_xy, all_t, out, offsets, _ = _split_at(all_xy, all_t, out, offsets, knees, True, eps)
+    if np.isfinite(cap) and cap < all_t.max():
+        all_xy, all_t, out, offsets, _ = _split_at(all_xy, all_t, out, offsets, np.full(len(offsets) - 1, cap),
+                                                   True, eps)
+    point = np.empty((len(all_t), 3))
+    point[:, 0] = all_xy[:, 0]
+    point[:, 1] = all_xy[:, 1]
+    point[:, 2] = np.minimum(all_t, cap)
+    return point, out, offsets, True
+
+
+@njit(cache=True, nogil=True)
 def roof_meshes(kind, coords, ring_offsets, poly_offsets, plane, size_a, size_b, value, by_height,
-                overhang, index, cap):
+                overhang, index, cap, even, edge_base, edge_angle):
     """Roof meshes of k polygons.
 
     kind : HIP, GABLE, SHED or PYRAMID. coords (V, 2), ring_offsets, poly_offsets : the polygons in the
     store's layout; plane (k,) int8 their plane codes; size_a, size_b (k,) their sizes along u and v;
     value (k,) the angle in degrees or (``by_height``) the height; overhang (k,) for hip and gable;
-    index (k,) int64 the shed's edge; cap (k,) the envelope's height (its walls' is ``overhang``).
+    index (k,) int64 the shed's edge; cap (k,) the envelope's height (its walls' is ``overhang``); even
+    (k,) bool: a hip or gable roof whose ridge nodes all take their mean height (CityEngine's ``even``:
+    level ridges, faces no longer planar). edge_base, edge_angle (V,): an envelope's base height and
+    angle under the edge from each vertex of ``coords``, used where they differ round a polygon or an
+    angle is 90 degrees (``_envelope``; else ``overhang`` and ``value`` serve all round).
     Returns verts (V', 3) as (a, b, h), ring_offsets (R'+1,), face_offsets (F'+1,) into rings,
     mesh_offsets (k+1,) into faces, and ok (k,): False where the roof could not be made.
     """
@@ -252,9 +393,17 @@ def roof_meshes(kind, coords, ring_offsets, poly_offsets, plane, size_a, size_b,
             pts[:, 1] = -pts[:, 1]
         scale = max(size_a[g], size_b[g], 1e-300)
         eps = 1e-9 * max(scale, 1.0)
-        pts, pring = _clean_rings(pts, ring_offsets[r_first:r_last + 1] - v0, eps)
+        pts, pring, kept = _clean_rings(pts, ring_offsets[r_first:r_last + 1] - v0, eps)
         angle = np.radians(value[g])
-        if len(pring) < 2 or (not by_height and not (-np.pi / 2 < angle < np.pi / 2)):
+        weighted = False
+        if kind == ENVELOPE and len(pring) >= 2:
+            e_base, e_angle = edge_base[v0 + kept], edge_angle[v0 + kept]
+            weighted = (e_base.max() - e_base.min() > eps or e_angle.max() - e_angle.min() > 1e-9
+                        or e_angle.max() >= 90.0)
+            if weighted and not (e_angle.min() > 0.0 and e_angle.max() <= 90.0):
+                weighted = False
+                angle = np.pi  # refused below
+        if len(pring) < 2 or (not by_height and not weighted and not (-np.pi / 2 < angle < np.pi / 2)):
             ok[g] = False
             mesh_offsets[g + 1] = n_f
             continue
@@ -265,10 +414,18 @@ def roof_meshes(kind, coords, ring_offsets, poly_offsets, plane, size_a, size_b,
             for j in range(pring[r], pring[r + 1]):
                 succ[j] = pring[r] + (j - pring[r] + 1) % (pring[r + 1] - pring[r])
         # ---- the roof's points (x, y, h) and its faces as rings of point ids
-        if kind == HIP or kind == GABLE or kind == MANSARD or kind == GAMBREL or kind == ENVELOPE:
+        if weighted:
+            e_speed = np.where(e_angle >= 90.0, 0.0, 1.0 / np.tan(np.radians(e_angle)))
+            point, face_ids, face_off, done = _envelope(pts, pring, succ, e_base, e_speed, cap[g], eps)
+            if not done:
+                ok[g] = False
+                mesh_offsets[g + 1] = n_f
+                continue
+            lifted = np.empty(0)
+        elif kind == HIP or kind == GABLE or kind == MANSARD or kind == GAMBREL or kind == ENVELOPE:
             wall = overhang[g] if kind == ENVELOPE else 0.0
             start_time = 0.0 if kind == ENVELOPE else -overhang[g] * (1.0 if by_height else np.cos(angle))
-            node_xy, node_t, fnodes, foff, done = skeleton_faces(pts, pring, start_time)
+            node_xy, node_t, fnodes, foff, done = skeleton_faces(pts, pring, start_time, None)
             if not done:
                 ok[g] = False
                 mesh_offsets[g + 1] = n_f
@@ -280,10 +437,12 @@ def roof_meshes(kind, coords, ring_offsets, poly_offsets, plane, size_a, size_b,
             if kind == MANSARD or kind == GAMBREL:
                 knee = BREAK_SHARE * node_t.max()
                 lower = np.tan(np.radians(90.0 - (90.0 - value[g]) / 3.0))
-                node_xy, node_t, fnodes, foff, origin = _split_at(node_xy, node_t, fnodes, foff, knee, eps)
+                node_xy, node_t, fnodes, foff, origin = _split_at(node_xy, node_t, fnodes, foff,
+                                                                  np.full(n, knee), False, eps)
             elif kind == ENVELOPE and slope > 0 and (cap[g] - wall) / slope < node_t.max():
                 knee = max(cap[g] - wall, 0.0) / slope
-                node_xy, node_t, fnodes, foff, origin = _split_at(node_xy, node_t, fnodes, foff, knee, eps)
+                node_xy, node_t, fnodes, foff, origin = _split_at(node_xy, node_t, fnodes, foff,
+                                                                  np.full(n, knee), False, eps)
             else:
                 origin = np.arange(n)
             _move_gable_ends(node_xy, node_t, fnodes, foff, origin, ends, pts, succ, start_time)
@@ -297,6 +456,11 @@ def roof_meshes(kind, coords, ring_offsets, poly_offsets, plane, size_a, size_b,
             point[: len(node_xy), 1] = node_xy[:, 1]
             point[: len(node_xy), 2] = wall + np.where(node_t <= knee, node_t * lower,
                                                        knee * lower + (node_t - knee) * flat_top)
+            if even[g] and (kind == HIP or kind == GABLE):
+                ridge = node_t > start_time + eps
+                if ridge.any():
+                    heights = point[: len(node_xy), 2]
+                    heights[ridge] = heights[ridge].mean()
             face_ids = fnodes
             face_off = foff
             if kind == ENVELOPE:

@@ -1,7 +1,8 @@
 """Straight skeletons of many polygons with holes, in one numba pass: the faces of hip roofs.
 
-Every edge line moves inward at unit speed (``n . x = c + t``, n the inward normal), and the wavefront
-polygon is the set of the moved lines between its vertices. Its vertices live in a circular doubly
+Every edge line moves inward at its own speed (``n . x = c + w t``, n the inward normal; ``w`` is 1 for
+roofs of one slope, and an envelope's sides of other slopes or vertical walls move at other speeds, down
+to 0: a weighted skeleton), and the wavefront polygon is the set of the moved lines between its vertices. Its vertices live in a circular doubly
 linked list (``prev``/``next``) over all rings at once, so a split event that joins a hole to the outer
 ring and one that cuts a ring in two are the same relinking. Events, the earliest first:
 
@@ -34,47 +35,57 @@ _EPS = 1e-9
 
 
 @njit(cache=True, nogil=True)
-def _solve3(a0, a1, a2, b0, b1, b2, c0, c1, c2):
-    """The point (x, y) and time t where three moving lines (nx, ny, c: n . x = c + t) meet; ok False
+def _solve3(a0, a1, a2, aw, b0, b1, b2, bw, c0, c1, c2, cw):
+    """The point (x, y) and time t where three moving lines (nx, ny, c, w: n . x = c + w t) meet; ok False
     when they never meet in one point (two of them parallel and apart, or all concurrent always)."""
-    det = a0 * (b1 * -1.0 - (-1.0) * c1) - a1 * (b0 * -1.0 - (-1.0) * c0) + (-1.0) * (b0 * c1 - b1 * c0)
+    det = a0 * (b1 * -cw - (-bw) * c1) - a1 * (b0 * -cw - (-bw) * c0) + (-aw) * (b0 * c1 - b1 * c0)
     if abs(det) < 1e-12:
         return 0.0, 0.0, 0.0, False
-    # Cramer's rule on [[a0, a1, -1], [b0, b1, -1], [c0, c1, -1]] (x, y, t) = (a2, b2, c2)
-    dx = a2 * (b1 * -1.0 - (-1.0) * c1) - a1 * (b2 * -1.0 - (-1.0) * c2) + (-1.0) * (b2 * c1 - b1 * c2)
-    dy = a0 * (b2 * -1.0 - (-1.0) * c2) - a2 * (b0 * -1.0 - (-1.0) * c0) + (-1.0) * (b0 * c2 - b2 * c0)
+    # Cramer's rule on [[a0, a1, -aw], [b0, b1, -bw], [c0, c1, -cw]] (x, y, t) = (a2, b2, c2)
+    dx = a2 * (b1 * -cw - (-bw) * c1) - a1 * (b2 * -cw - (-bw) * c2) + (-aw) * (b2 * c1 - b1 * c2)
+    dy = a0 * (b2 * -cw - (-bw) * c2) - a2 * (b0 * -cw - (-bw) * c0) + (-aw) * (b0 * c2 - b2 * c0)
     dt = a0 * (b1 * c2 - b2 * c1) - a1 * (b0 * c2 - b2 * c0) + a2 * (b0 * c1 - b1 * c0)
     return dx / det, dy / det, dt / det, True
 
 
 @njit(cache=True, nogil=True)
-def _vertex_at(nrm, c, e0, e1, t):
+def _speed(speed, e):
+    """Edge e's speed: 1 where ``speed`` is None (numba prunes the branch in that specialization)."""
+    if speed is None:
+        return 1.0
+    return speed[e]
+
+
+@njit(cache=True, nogil=True)
+def _vertex_at(nrm, c, w, e0, e1, t):
     """Where the lines of edges e0 and e1 cross at time t; ok False when they are parallel."""
     a0, a1, b0, b1 = nrm[e0, 0], nrm[e0, 1], nrm[e1, 0], nrm[e1, 1]
     det = a0 * b1 - a1 * b0
     if abs(det) < 1e-12:
         return 0.0, 0.0, False
-    r0, r1 = c[e0] + t, c[e1] + t
+    r0, r1 = c[e0] + _speed(w, e0) * t, c[e1] + _speed(w, e1) * t
     return (r0 * b1 - a1 * r1) / det, (a0 * r1 - r0 * b0) / det, True
 
 
 @njit(cache=True, nogil=True)
-def _position(nrm, c, node_xy, node_t, start, e0, e1, v, t, eps):
+def _position(nrm, c, w, node_xy, node_t, start, e0, e1, v, t, eps):
     """Where vertex v (between edges e0 and e1) is at time t; a spike tip, whose lines are parallel,
     is only anywhere at the time it was made."""
-    x, y, ok = _vertex_at(nrm, c, e0, e1, t)
+    x, y, ok = _vertex_at(nrm, c, w, e0, e1, t)
     if not ok and abs(t - node_t[start[v]]) <= eps:
         return node_xy[start[v], 0], node_xy[start[v], 1], True
     return x, y, ok
 
 
 @njit(cache=True, nogil=True)
-def skeleton_faces(xy, ring_offsets, start_time):
+def skeleton_faces(xy, ring_offsets, start_time, speed):
     """Faces of the straight skeleton of one polygon with holes.
 
     xy : (n, 2) float64, the polygon's vertices, exterior counter-clockwise then holes clockwise (ring
     ``r`` is ``ring_offsets[r]:ring_offsets[r+1]``), without repeated or collinear consecutive vertices.
     start_time : <= 0; the wavefront starts from the edges moved out by -start_time (an overhang).
+    speed : (n,) float64 >= 0, how fast each edge's line moves in, or None: 1 everywhere, the plain
+    skeleton (numba compiles it apart, without the speeds).
     Returns node_xy (N, 2), node_t (N,), face_nodes (ragged node ids of each edge's face, starting with
     the edge's two ends), face_offsets (n+1,) and ok.
     """
@@ -132,7 +143,7 @@ def skeleton_faces(xy, ring_offsets, start_time):
         if start_time == 0.0:
             node_xy[k, 0], node_xy[k, 1] = xy[k, 0], xy[k, 1]
         else:
-            px, py, ok = _vertex_at(nrm, c, pred[k], k, start_time)
+            px, py, ok = _vertex_at(nrm, c, speed, pred[k], k, start_time)
             if not ok:
                 px, py = xy[k, 0] - nrm[k, 0] * start_time, xy[k, 1] - nrm[k, 1] * start_time
             node_xy[k, 0], node_xy[k, 1] = px, py
@@ -140,7 +151,7 @@ def skeleton_faces(xy, ring_offsets, start_time):
     n_nodes = n
     n_verts = n
     for k in range(n):
-        _split_candidates(k, nrm, c, direction, node_xy, node_t, start, in_edge, out_edge, alive, n, eps,
+        _split_candidates(k, nrm, c, speed, direction, node_xy, node_t, start, in_edge, out_edge, alive, n, eps,
                           cand_t, cand_x, cand_y, cand_e, n_cand, cand_first)
     now = start_time
     ok = True
@@ -166,8 +177,9 @@ def skeleton_faces(xy, ring_offsets, start_time):
                 w = nxt[v]
                 a, e, b = in_edge[v], out_edge[v], out_edge[w]
                 if not (_spike(direction, v, in_edge, out_edge) or _spike(direction, w, in_edge, out_edge)):
-                    x, y, t, solved = _solve3(nrm[a, 0], nrm[a, 1], c[a], nrm[e, 0], nrm[e, 1], c[e],
-                                              nrm[b, 0], nrm[b, 1], c[b])
+                    x, y, t, solved = _solve3(nrm[a, 0], nrm[a, 1], c[a], _speed(speed, a), nrm[e, 0],
+                                              nrm[e, 1], c[e], _speed(speed, e), nrm[b, 0], nrm[b, 1], c[b],
+                                              _speed(speed, b))
                     if solved:
                         edge_t[v], edge_x[v], edge_y[v] = t, x, y
             t = edge_t[v]
@@ -191,8 +203,8 @@ def skeleton_faces(xy, ring_offsets, start_time):
                     if not alive[u] or out_edge[u] != e or u == v or nxt[u] == v:
                         continue
                     w = nxt[u]
-                    ux, uy, ok_u = _position(nrm, c, node_xy, node_t, start, in_edge[u], e, u, t, eps)
-                    wx, wy, ok_w = _position(nrm, c, node_xy, node_t, start, e, out_edge[w], w, t, eps)
+                    ux, uy, ok_u = _position(nrm, c, speed, node_xy, node_t, start, in_edge[u], e, u, t, eps)
+                    wx, wy, ok_w = _position(nrm, c, speed, node_xy, node_t, start, e, out_edge[w], w, t, eps)
                     if not (ok_u and ok_w):
                         continue
                     along = (x - ux) * direction[e, 0] + (y - uy) * direction[e, 1]
@@ -237,7 +249,7 @@ def skeleton_faces(xy, ring_offsets, start_time):
             n_arcs, alive_count = _close_pair(z, nxt, in_edge, out_edge, start, alive, arcs, n_arcs,
                                               alive_count)
             if alive[z]:
-                _split_candidates(z, nrm, c, direction, node_xy, node_t, start, in_edge, out_edge, alive,
+                _split_candidates(z, nrm, c, speed, direction, node_xy, node_t, start, in_edge, out_edge, alive,
                                   n_verts, eps, cand_t, cand_x, cand_y, cand_e, n_cand, cand_first)
         else:
             # ---- split event: v reaches edge u -> w; X ends the ring before v, Y starts the one after
@@ -268,13 +280,14 @@ def skeleton_faces(xy, ring_offsets, start_time):
                                                       n_arcs, alive_count)
             for q in (x_v, y_v):
                 if alive[q]:
-                    _split_candidates(q, nrm, c, direction, node_xy, node_t, start, in_edge, out_edge,
+                    _split_candidates(q, nrm, c, speed, direction, node_xy, node_t, start, in_edge, out_edge,
                                       alive, n_verts, eps, cand_t, cand_x, cand_y, cand_e, n_cand, cand_first)
     if alive_count != 0:
         ok = False
-    # the wavefront reaches every point no later than the boundary's offset does: a node later than
-    # its distance to the (moved-out) boundary is a wrong event order
-    for q in range(n_nodes):
+    # the wavefront reaches every point no later than the boundary's offset at the slowest speed does:
+    # a node later than its distance to the (moved-out) boundary over that speed is a wrong event order
+    slowest = 1.0 if speed is None else speed.min()
+    for q in range(n_nodes if slowest > 0.0 else 0):
         reach = np.inf
         for k in range(n):
             ax, ay = node_xy[k, 0], node_xy[k, 1]
@@ -282,7 +295,7 @@ def skeleton_faces(xy, ring_offsets, start_time):
             px, py = node_xy[q, 0] - ax, node_xy[q, 1] - ay
             f = min(max((px * bx + py * by) / max(bx * bx + by * by, 1e-300), 0.0), 1.0)
             reach = min(reach, np.sqrt((px - f * bx) ** 2 + (py - f * by) ** 2))
-        if node_t[q] - start_time > reach + 1e3 * eps:
+        if node_t[q] - start_time > reach / slowest + 1e3 * eps:
             ok = False
     face_nodes, face_offsets, faces_ok = _faces(arcs[:n_arcs], n, succ)
     return node_xy[:n_nodes], node_t[:n_nodes], face_nodes, face_offsets, ok and faces_ok
@@ -298,7 +311,7 @@ def _spike(direction, v, in_edge, out_edge):
 
 
 @njit(cache=True, nogil=True)
-def _split_candidates(v, nrm, c, direction, node_xy, node_t, start, in_edge, out_edge, alive, n_verts, eps,
+def _split_candidates(v, nrm, c, speed, direction, node_xy, node_t, start, in_edge, out_edge, alive, n_verts, eps,
                       cand_t, cand_x, cand_y, cand_e, n_cand, cand_first):
     """Where and when a reflex vertex v, from where it was made, would meet each line of the wavefront's
     edges that it moves towards: its split event candidates, in time order (row v of the cand_*
@@ -319,10 +332,10 @@ def _split_candidates(v, nrm, c, direction, node_xy, node_t, start, in_edge, out
     for e in range(len(c)):
         if not present[e] or e == a or e == b:
             continue
-        if nrm[e, 0] * px + nrm[e, 1] * py - c[e] - t0 < -eps:
+        if nrm[e, 0] * px + nrm[e, 1] * py - c[e] - _speed(speed, e) * t0 < -eps:
             continue  # behind the line: moving away from it
-        x, y, t, solved = _solve3(nrm[a, 0], nrm[a, 1], c[a], nrm[b, 0], nrm[b, 1], c[b],
-                                  nrm[e, 0], nrm[e, 1], c[e])
+        x, y, t, solved = _solve3(nrm[a, 0], nrm[a, 1], c[a], _speed(speed, a), nrm[b, 0], nrm[b, 1], c[b],
+                                  _speed(speed, b), nrm[e, 0], nrm[e, 1], c[e], _speed(speed, e))
         if not solved or t < t0 - eps:
             continue
         cand_t[v, count], cand_x[v, count], cand_y[v, count], cand_e[v, count] = t, x, y, e

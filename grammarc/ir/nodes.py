@@ -752,11 +752,14 @@ class Roof:
     overhang_y: Expr | None = child(Type.NUM, "an overhang")
     index: Expr = child(Type.NUM, "an edge index")
     span: Span = NO_SPAN
-    #: ``envelope(dir, maxHeight, baseHeight, angle, ...)``: the height where it is cut flat, and the other
-    #: sides' (baseHeight, angle) pairs, which must equal the first (``overhang``, ``value``).
+    #: ``envelope(dir, maxHeight, baseHeight, angle, ...)``: the height where it is cut flat, and the
+    #: (baseHeight, angle) pairs after the front's (``overhang``, ``value``): back; back and sides; or back,
+    #: right and left.
     cap: Expr | None = child(Type.NUM, "a height", default=None)
     sides: tuple[tuple[Expr, Expr], ...] = child(Type.NUM, ("a base height", "an angle"), default=())
     indexed: bool = False
+    #: ``roofHip(angle, overhang, even)``, ``roofGable(angle, overhangX, overhangY, even)``: level ridges.
+    even: Expr | None = child(Type.BOOL, "even", default=None)
 
 
 #: Selectors of the faces an ``offset`` makes.

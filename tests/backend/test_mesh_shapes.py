@@ -117,9 +117,16 @@ def test_split_of_a_concave_roof_cuts_it_into_closed_slabs(write, lot, axis):
     assert t["v_n"] > 2 and t["v_sum"] == pytest.approx(t["whole_sum"], rel=1e-9)
 
 
-def test_a_roof_that_cannot_be_extruded_is_reported(write):
-    r = run(write, "Lot --> roofHip(30) extrude(3)\n", [rect(12, 8)])
-    assert "`extrude` of a roof is not supported yet" in r["bad"][0].reason
+def test_extrude_of_a_roof_makes_a_solid_of_each_face_along_its_normal(write):
+    """As the reference's face.normal: the bottom slab hangs below the footprint, the planes' slabs stand
+    out of them, each face's area times the height; the scope keeps its axes, fitted to the solids."""
+    r = run(write, 'Lot --> roofHip(30) extrude(0.5) report("v", geometry.volume) report("y", scope.ty) '
+                   'report("sx", scope.sx)\n', [rect(12, 8)])
+    t = totals(r)
+    assert r["bad"] == () and t["v_sum"] == pytest.approx(0.5 * (96 + 96 / np.cos(np.radians(30))))
+    assert t["y_sum"] == pytest.approx(-0.5) and t["sx_sum"] > 12
+    r = run(write, "Lot --> roofHip(30) extrude(world.up, 3)\n", [rect(12, 8)])
+    assert "`extrude` along world.up of a roof is not supported yet" in r["bad"][0].reason
 
 
 def test_split_of_a_convex_roof_cuts_it_into_closed_slabs(write):
@@ -145,8 +152,28 @@ def test_envelope_is_walls_and_slopes_cut_flat(write):
     frustum = sum((10 - 2 * s) * (4 - 2 * s) * 0.0015 for s in np.arange(0.00075, 0.15, 0.0015))
     assert t["v_sum"] == pytest.approx(18 + frustum, rel=1e-6) and t["sy_sum"] == pytest.approx(0.6)
     assert t["top_sum"] == pytest.approx(9.7 * 3.7)
-    r = run(write, "Lot --> envelope(normal, 5, 1, 45, 2, 30)\n", [rect(10, 4)])
-    assert "different heights or angles per side" in r["bad"][0].reason
+
+
+def test_envelope_per_side_classifies_the_lots_edges(write):
+    """The reference's forms: front and back (the sides as the front), front, back and sides, and
+    front, back, right, left, on a 10 x 4 lot: 3 m walls at 45 degrees in front, 1 m at the back, and
+    vertical sides give the profile (0, 0) (4, 0) (4, 1) (1, 4) (0, 3) of 11 m2 along 10 m."""
+    def volume(call):
+        r = run(write, f'Lot --> {call} report("v", geometry.volume) report("h", scope.sy)\n', [rect(10, 4)])
+        assert not r["bad"]
+        return totals(r)["v_sum"], totals(r)["h_sum"]
+
+    assert volume("envelope(world.up, 20, 3, 45, 1, 45, 0, 90)") == (pytest.approx(110), pytest.approx(4))
+    assert volume("envelope(normal, 20, 1, 45, 3, 45, 0, 90, 0, 90)") == (pytest.approx(110), pytest.approx(4))
+    # front and back alike, the sides taking the front's: the one-pair form
+    assert volume("envelope(world.up, 20, 2, 45, 2, 45)") == volume("envelope(world.up, 20, 2, 45)")
+    # cut flat at 3 m: the profile's part below, (0, 0) (4, 0) (4, 1) (2, 3) (0, 3): 10 m2
+    assert volume("envelope(world.up, 3, 3, 45, 1, 45, 0, 90)") == (pytest.approx(100), pytest.approx(3))
+
+
+def test_envelope_angles_outside_0_to_90_are_reported(write):
+    r = run(write, "Lot --> envelope(normal, 5, 1, 45, 2, 0)\n", [rect(10, 4)])
+    assert "`envelope` with an angle outside (0, 90]" in r["bad"][0].reason
 
 
 def test_rotate_scope_of_a_roof_turns_its_scope_around_the_same_mesh(write):

@@ -46,7 +46,7 @@ def comp(ctx: Context, cursor: Shapes, op: ir.Comp) -> Parts:
     index_of = None
     if op.index is not None:
         index_of = evaluate_array(op.index, ctx.env(cursor))
-    shapes, _, index, parent, _ = components(ctx, comp_kernels.KIND_CODES[op.kind], cursor, op.site, index_of)
+    shapes, _, index, parent, _, _ = components(ctx, comp_kernels.KIND_CODES[op.kind], cursor, op.site, index_of)
     shapes = take_apart(ctx, cursor, shapes, parent)
     ctx.count(shapes, op.span)
     order, offsets = group_by(index % len(op.parts), len(op.parts))
@@ -64,7 +64,9 @@ def comp_faces(ctx: Context, cursor: Shapes, op: ir.CompFaces) -> Parts:
         ctx.fail(cursor, bad, "`comp` of an inserted asset is not supported yet", op.span)
     chunk = ctx.chunk
     kind = {"f": "faces", "e": "edges", "v": "vertices"}[op.kind]
-    shapes, normal, _, parent, roof = components(ctx, comp_kernels.KIND_CODES[kind], cursor, op.site)
+    borders = bool({"border", "inside"} & set(op.selectors))
+    shapes, normal, _, parent, roof, border = components(ctx, comp_kernels.KIND_CODES[kind], cursor, op.site,
+                                                         borders=borders)
     shapes = take_apart(ctx, cursor, shapes, parent)
     if op.kind == "f":
         shapes = _face_scopes(ctx, shapes, cursor, parent, op.span)
@@ -90,8 +92,8 @@ def comp_faces(ctx: Context, cursor: Shapes, op: ir.CompFaces) -> Parts:
     picks = [np.broadcast_to(np.asarray(evaluate_array(e, env), dtype=np.float64), (len(cursor),))
              for e in op.picks]
     picked = index_masks(op.selectors, parent, picks)
-    if {"border", "inside"} & set(op.selectors):
-        picked.update(_border_masks(ctx, cursor, parent, op))
+    if borders:
+        picked.update({"border": border, "inside": ~border})
     if op.kind == "f":
         axes = chunk.frames[shapes.frame]
         base = (shapes.origin, shapes.origin + axes[:, 0] * shapes.size[:, :1])  # each face's bottom edge
@@ -114,24 +116,16 @@ def comp_faces(ctx: Context, cursor: Shapes, op: ir.CompFaces) -> Parts:
     return Parts(op.parts, shapes.take(order), offsets)
 
 
-def _border_masks(ctx: Context, cursor: Shapes, parent: np.ndarray, op: ir.CompFaces) -> dict[str, np.ndarray]:
-    """The components (m,) of parents ``parent`` that ``border`` and ``inside`` take on shapes no
-    ``offset`` made, as the reference defines them: a border edge meets one face, a border face or vertex
-    touches a border edge. A flat shape is one face, all of it border; a solid (a box, a prism) is closed,
-    all of it inside. The edges of meshes (roofs) are not counted yet: refused."""
-    mesh = is_mesh(cursor.geom)
-    if mesh.any():
-        ctx.fail(cursor, mesh, f"`comp({op.kind})` border and inside on a roof are not supported yet", op.span)
-    flat = ((cursor.size <= TOL.zero).sum(axis=1) >= 1)[parent]
-    return {"border": flat, "inside": ~flat}
-
-
-def components(ctx: Context, kind: int, cursor: Shapes, site: int, wanted=None):
+def components(ctx: Context, kind: int, cursor: Shapes, site: int, wanted=None, borders: bool = False):
     """Component shapes of ``cursor``, their normals in the parents' frames (m, 3), their indices
-    among their parent's components (m,), their parents (m,) and each one's place on a roof (m,)
-    (``geometry.meshes.roof_edge_kinds``: an edge of a roof's mesh; -1 for the rest); ``wanted`` (n,)
-    keeps, per shape, only that index. Roofs (meshes) have faces and edges (``comp_faces`` and ``comp``
-    check)."""
+    among their parent's components (m,), their parents (m,), each one's place on a roof (m,)
+    (``geometry.meshes.roof_edge_kinds``: an edge of a roof's mesh; -1 for the rest) and whether it is
+    on its shape's border (m,), as the reference defines ``border`` and ``inside`` for shapes no
+    ``offset`` made: a border edge meets one face, a border face or vertex touches a border edge. A flat
+    shape is one face, all of it border; a solid (a box, a prism) and a roof or other mesh that is
+    closed have no border, all of them inside (found only with ``borders``; else no component is on a
+    border). ``wanted`` (n,) keeps, per shape, only that index. Roofs (meshes) have faces and edges
+    (``comp_faces`` and ``comp`` check)."""
     chunk = ctx.chunk
     mesh = is_mesh(cursor.geom)
     pieces = []
@@ -139,32 +133,34 @@ def components(ctx: Context, kind: int, cursor: Shapes, site: int, wanted=None):
         pieces.append(_solid_components(chunk, kind, cursor, np.flatnonzero(~mesh)))
     if mesh.any():
         which = np.flatnonzero(mesh)
-        parent, index, origin, axes, size, geom, roof = mesh_shapes.mesh_components(chunk, cursor.take(which),
-                                                                                    kind)
-        pieces.append((which[parent], index, origin, axes, size, geom, axes[:, 2], roof))
-    parent, index, origin, axes, size, geom, normal, roof = (
+        parent, index, origin, axes, size, geom, roof, border = mesh_shapes.mesh_components(
+            chunk, cursor.take(which), kind, borders)
+        pieces.append((which[parent], index, origin, axes, size, geom, axes[:, 2], roof, border))
+    parent, index, origin, axes, size, geom, normal, roof, border = (
         pieces[0] if len(pieces) == 1 else
         (np.concatenate(columns) for columns in zip(*pieces)))
     if len(pieces) > 1:
         order = np.argsort(parent, kind="stable")
-        parent, index, origin, axes, size, geom, normal, roof = (
-            a[order] for a in (parent, index, origin, axes, size, geom, normal, roof))
+        parent, index, origin, axes, size, geom, normal, roof, border = (
+            a[order] for a in (parent, index, origin, axes, size, geom, normal, roof, border))
     if wanted is not None:
         keep = index == np.round(wanted[parent])
-        parent, index, origin, axes, size, geom, normal, roof = (
-            a[keep] for a in (parent, index, origin, axes, size, geom, normal, roof))
+        parent, index, origin, axes, size, geom, normal, roof, border = (
+            a[keep] for a in (parent, index, origin, axes, size, geom, normal, roof, border))
     child = cursor.take(parent)
     parent_axes = chunk.frames[child.frame]
     world_origin = child.origin + np.einsum("ni,nij->nj", origin, parent_axes)
     frame = chunk.frames.add(np.einsum("nij,njk->nik", axes, parent_axes))
     shapes = Shapes(world_origin, size, frame, geom.astype(np.int32), child.lot,
                     child_keys(child.key, site, index), child.depth, child.params, child.dynamic)
-    return with_context(ctx.plan, shapes, "comp", index, parent, len(cursor)), normal, index, parent, roof
+    return (with_context(ctx.plan, shapes, "comp", index, parent, len(cursor)), normal, index, parent, roof,
+            border)
 
 
 def _solid_components(chunk, kind: int, cursor: Shapes, which: np.ndarray):
     """Components of the boxes, polygons and prisms ``which`` of ``cursor``: parent (into cursor),
-    index, origin, axes, size (in the parents' frames), geom, normal, roof (-1: no roof edges)."""
+    index, origin, axes, size (in the parents' frames), geom, normal, roof (-1: no roof edges), border
+    (the components of flat shapes)."""
     shapes = cursor.take(which)
     coords, ring_offsets, shape_offsets, plane = polygons_of(chunk, shapes)
     parent, index, origin, axes, size, poly = comp_kernels.components(
@@ -179,7 +175,8 @@ def _solid_components(chunk, kind: int, cursor: Shapes, which: np.ndarray):
     # a flat shape's only face is itself: its normal is its plane's axis, not its frame's z
     normal = axes[:, 2].copy()
     normal[same] = np.eye(3)[plane[parent[same]]]
-    return which[parent], index, origin, axes, size, geom, normal, np.full(len(parent), -1, dtype=np.int32)
+    border = ((shapes.size <= TOL.zero).sum(axis=1) >= 1)[parent]
+    return which[parent], index, origin, axes, size, geom, normal, np.full(len(parent), -1, dtype=np.int32), border
 
 
 def _cap_polygons(chunk, geom: np.ndarray, which: str) -> np.ndarray:

@@ -66,14 +66,17 @@ def roof(ctx: Context, cursor: Shapes, op: ir.Roof) -> Shapes:
     # box here: an envelope (candler sizes its ventilation faces so) takes the box's base
     if ctx.plan.leaf_bodies and op.kind != "envelope":
         checks.append((flat_axis(ctx.chunk, cursor) < 0, "of a solid (CityEngine roofs faces)"))
-    cap = None
+    cap = edges = even = None
+    polygons = polygons_of(ctx.chunk, cursor)
     if op.cap is not None:
         cap = np.broadcast_to(np.asarray(evaluate_array(op.cap, env), float), (n,))
-        for height, angle in op.sides:
-            differs = (np.abs(evaluate_array(height, env) - overhang) > TOL.zero) | (
-                np.abs(evaluate_array(angle, env) - value) > TOL.zero)
-            why = "with different heights or angles per side (one slope all round is supported)"
-            checks.append((differs, why))
+        sides = [(overhang, value), *((evaluate_array(h, env), evaluate_array(a, env)) for h, a in op.sides)]
+        checks[2] = (np.any([(a <= 0) | (a > 90) for _, a in sides], axis=0), "with an angle outside (0, 90]")
+        checks.append((np.any([~np.isfinite(h) | ~np.isfinite(a) for h, a in sides], axis=0),
+                       "with a base height or angle that is not finite"))
+        edges = envelope_edges(ctx, cursor, polygons, sides)
+    if op.even is not None:
+        even = np.ascontiguousarray(np.broadcast_to(np.asarray(evaluate_array(op.even, env), bool), (n,)))
     if op.overhang_y is not None and not op.indexed:
         overhang_y = evaluate_array(op.overhang_y, env)
         checks.append((np.abs(overhang_y - overhang) > TOL.zero,
@@ -87,12 +90,49 @@ def roof(ctx: Context, cursor: Shapes, op: ir.Roof) -> Shapes:
     if ridge.any():
         roofed, failed = _ridge_roofs(ctx, cursor, op, ridge, value, overhang, index)
     else:
-        roofed, failed = mesh_shapes.build_roofs(ctx.chunk, cursor, op.kind, polygons_of(ctx.chunk, cursor),
-                                                 value, op.by_height, overhang, index, cap)
+        roofed, failed = mesh_shapes.build_roofs(ctx.chunk, cursor, op.kind, polygons, value, op.by_height,
+                                                 overhang, index, cap, even, edges)
     if failed.any():
         ctx.fail(cursor, failed, f"`{op.kind}` found no roof for this polygon (its straight skeleton "
                  "did not close, or the overhang's outline crosses itself at a sharp corner)", op.span)
     return roofed
+
+
+def envelope_edges(ctx: Context, cursor: Shapes, polygons, sides: list) -> tuple[np.ndarray, np.ndarray]:
+    """An envelope's base height and angle (V,) under the edge from each vertex of ``polygons``
+    (``outlines.polygons_of``), from ``sides``: the (baseHeight, angle) pairs (each (n,) or a scalar) of
+    front; front and back; front, back and sides; or front, back, right and left. Edges are classified
+    by their outward normals as ``street.front``, ``street.back``, ``street.right`` and ``street.left``
+    (which fall back to ``object.`` on lots without streets), as the reference says. Where a side is not
+    given (the sides of ``envelope(dir, h, front, angle, back, angle)``), and on edges that face up or
+    down (an envelope on a wall), the front's pair serves: one pair means the same all round."""
+    coords, ring_offsets, shape_offsets, plane = polygons
+    n = len(cursor)
+    ring_shape = segment_of(shape_offsets)
+    vertex_ring = segment_of(ring_offsets)
+    owner = ring_shape[vertex_ring]
+    rows = np.arange(n)
+    scale = np.stack([cursor.size[rows, PLANE_U[plane]], cursor.size[rows, PLANE_V[plane]]], axis=1)
+    points = coords * scale[owner]
+    after = np.arange(len(coords)) + 1
+    ends = ring_offsets[vertex_ring + 1]
+    after[after == ends] = ring_offsets[vertex_ring[after == ends]]
+    step = points[after] - points
+    cross = points[:, 0] * points[after, 1] - points[after, 0] * points[:, 1]
+    exterior = vertex_ring == shape_offsets[:-1][owner]
+    turn = np.sign(np.bincount(owner[exterior], weights=cross[exterior], minlength=n))
+    # the interior lies left of the exterior ring where it turns counter-clockwise in (u, v)
+    normal = plane_to_scope(turn[owner][:, None] * np.stack([step[:, 1], -step[:, 0]], axis=1), plane[owner])
+    names = ("street.front", "street.back", "street.right", "street.left")
+    frames = selector_frames(ctx.chunk, normal, cursor, owner, names,
+                             _world_points(ctx, cursor, owner, plane, (points, points[after])))
+    which = classify_faces(normal, names, frames)
+    order = {1: (0, 0, 0, 0, 0), 2: (0, 1, 0, 0, 0), 3: (0, 1, 2, 2, 0), 4: (0, 1, 2, 3, 0)}[len(sides)]
+    pick = np.asarray(order)[which]
+    base = np.stack([np.broadcast_to(h, (n,)) for h, _ in sides])
+    angle = np.stack([np.broadcast_to(a, (n,)) for _, a in sides])
+    return (np.ascontiguousarray(base[pick, owner], dtype=np.float64),
+            np.ascontiguousarray(angle[pick, owner], dtype=np.float64))
 
 
 def _convex_faces(ctx: Context, cursor: Shapes, op: ir.Roof) -> np.ndarray:

@@ -174,16 +174,24 @@ def extrude(ctx: Context, cursor: Shapes, op: ir.Extrude) -> Shapes:
     highest; with a negative ``h`` down from the highest, at least to the lowest.
 
     A shape of several faces in one plane (an offset's pieces, convexify's parts) becomes a mesh of
-    their solids, each face extruded along its own normal (``_extruded_faces``)."""
+    their solids, each face extruded along its own normal (``_extruded_faces``); so does a roof, whose
+    faces lie in several planes (``_extruded_roofs``)."""
     height = np.broadcast_to(evaluate_array(op.height, ctx.env(cursor)), (len(cursor),))
     axis = flat_axis(ctx.chunk, cursor)
     mesh = is_mesh(cursor.geom)
+    roofs = np.zeros(len(cursor), dtype=bool)
     if mesh.any():  # a flat mesh is extruded across its plane; a roof's faces lie in several planes
         flat = cursor.size <= TOL.zero
         axis[mesh] = np.where(flat[mesh].sum(axis=1) == 1, np.argmax(flat[mesh], axis=1), -1)
-        if (axis[mesh] < 0).any():
-            ctx.fail(cursor, mesh & (axis < 0), "`extrude` of a roof is not supported yet (only of faces in one "
-                     "plane; split the roof into faces with comp(f) first)", op.span)
+        roofs = mesh & (axis < 0)
+        if roofs.any() and op.direction != "face.normal":
+            ctx.fail(cursor, roofs, f"`extrude` along {op.direction} of a roof is not supported yet (only "
+                     "along each face's normal; split the roof into faces with comp(f) first)", op.span)
+        elif roofs.any():
+            rows, others = np.flatnonzero(roofs), np.flatnonzero(~roofs)
+            solids = _extruded_roofs(ctx, cursor.take(rows), height[rows])
+            rest = extrude(ctx, cursor.take(others), op) if len(others) else solids.take([])
+            return Shapes.merge([rest, solids], [others, rows])
     bad = (axis < 0) | ~np.isfinite(height)
     if bad.any():
         ctx.fail(cursor, bad, "`extrude` needs a face (a flat shape) and a finite height", op.span)
@@ -261,6 +269,27 @@ def _extruded_faces(ctx: Context, cursor: Shapes, height: np.ndarray) -> Shapes:
     owners = np.r_[face_mesh[segment_of(caps[3])[cap_faces]], owner[segment_of(walls[3])[wall_faces]]]
     merged = _merged_faces(caps, walls, cap_faces, wall_faces, np.argsort(owners, kind="stable"))
     geom, low, size = store_fitted(chunk, *merged, np.r_[0, np.cumsum(np.bincount(owners, minlength=n))])
+    origin = cursor.origin + np.einsum("ni,nij->nj", low, chunk.frames[cursor.frame])
+    return cursor.with_scope(origin, size, cursor.frame, geom)
+
+
+def _extruded_roofs(ctx: Context, cursor: Shapes, height: np.ndarray) -> Shapes:
+    """Roofs (meshes whose faces lie in several planes) made into meshes of solids: each face extruded
+    by ``height`` along its own normal, as CityEngine's default ``face.normal`` extrudes every face of a
+    geometry (the bottom face downwards, the roof's planes outwards). Faces that meet at an angle keep
+    their own walls, so neighbouring solids overlap or open along the edge they shared. The scope keeps
+    its axes and is fitted to the solids."""
+    chunk = ctx.chunk
+    verts, ring_offsets, face_offsets, mesh_offsets, _ = face_vertices(chunk.meshes, cursor.geom - MESH_BASE,
+                                                                       cursor.size)
+    face_mesh = segment_of(mesh_offsets)
+    vertex_face = segment_of(face_offsets)[segment_of(ring_offsets)]
+    normal = ring_vector_areas(verts, ring_offsets)[face_offsets[:-1]]
+    normal /= np.maximum(np.linalg.norm(normal, axis=1, keepdims=True), 1e-300)
+    top = verts + (height[face_mesh][:, None] * normal)[vertex_face]
+    solid_verts, solid_rings, solid_faces, solid_meshes = extruded_meshes(verts, top, ring_offsets, face_offsets,
+                                                                          height[face_mesh] >= 0)
+    geom, low, size = store_fitted(chunk, solid_verts, solid_rings, solid_faces, solid_meshes[mesh_offsets])
     origin = cursor.origin + np.einsum("ni,nij->nj", low, chunk.frames[cursor.frame])
     return cursor.with_scope(origin, size, cursor.frame, geom)
 

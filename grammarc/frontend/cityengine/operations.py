@@ -30,7 +30,8 @@ class OperationLowering:
         """``roofHip``, ``roofGable``, ``roofShed``, ``roofPyramid``, ``roofRidge``: by angle, or with a
         leading ``byAngle``/``byHeight`` selector. The arguments after the value, in CityEngine's order:
         hip (overhang, even), gable (overhangX, overhangY, even, index), shed (index), pyramid and ridge
-        none. With an edge index a gable's ``even`` is ignored, as the reference says."""
+        none. ``even`` levels the ridges (``geometry.roofs``); with an edge index a gable's ``even`` is
+        ignored, as the reference says."""
         by_height = False
         if args and isinstance(args[0], ir.Name) and args[0].name in ("byAngle", "byHeight"):
             by_height = args[0].name == "byHeight"
@@ -43,24 +44,27 @@ class OperationLowering:
         given = dict(zip(names, (self.expr(a) for a in args[1:])))
         even = given.get("even")
         indexed = op == "roofGable" and "index" in given
-        if even is not None and not indexed and not (isinstance(even, ir.Bool) and not even.value):
-            return self.unsupported(f"{op} with even ridges", even.span,
-                                    "only even = false: even ridges make non-planar faces")
+        if indexed or (isinstance(even, ir.Bool) and not even.value):
+            even = None
         zero = ir.Num(0.0, span)
         overhang = given.get("overhang", given.get("overhangX", zero))
         index = given.get("index", zero) if op == "roofShed" or indexed else zero
         return ir.Roof(op, self.expr(args[0]), by_height, overhang, given.get("overhangY"), index, span,
-                       indexed=indexed)
+                       indexed=indexed, even=even)
 
     def op_envelope(self, op, args, span):
-        """``envelope(normal|world.up, maxHeight, baseHeight, angle, ...)``: one (baseHeight, angle) pair,
-        or the pairs for front, back, sides (or right and left), which must come out equal."""
+        """``envelope(normal|world.up, maxHeight, baseHeight, angle, ...)``: one (baseHeight, angle) pair
+        all round, or the pairs for front and back, front, back and sides, or front, back, right and left
+        (``operations.faces.envelope_edges``)."""
         if len(args) not in (4, 6, 8, 10):
             return self.unsupported(f"envelope with {len(args)} arguments", span,
                                     "envelope(direction, maxHeight, baseHeight, angle, ...) with 1 to 4 sides")
         if not isinstance(args[0], ir.Name) or args[0].name not in ("normal", "world.up", "face.normal"):
             return self.unsupported("envelope with this direction", span, "normal or world.up")
         pairs = [(self.expr(args[k]), self.expr(args[k + 1])) for k in range(2, len(args), 2)]
+        if any(isinstance(e, ir.ArrayLit) for pair in pairs for e in pair):
+            return self.unsupported("envelope with arrays per edge", span,
+                                    "a base height and an angle per side: front, back, sides or right and left")
         (base, angle), others = pairs[0], tuple(pairs[1:])
         zero = ir.Num(0.0, span)
         return ir.Roof("envelope", angle, False, base, None, zero, span, cap=self.expr(args[1]), sides=others)

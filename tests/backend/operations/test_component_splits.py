@@ -218,11 +218,15 @@ def test_comp_sel_names_every_kind_of_selector_as_written(write):
     ("comp(v){ border : B }", {"B": 4}),
     ("extrude(3) comp(f){ border : B | inside : I }", {"I": 6}),  # a closed solid: all inside
     ("extrude(3) comp(e){ border : B | inside : I }", {"I": 12}),
+    # a roof is closed by its bottom face: its 5 faces, 9 edges (4 eaves, 4 hips, a ridge), 6 vertices
+    ("roofHip(30) comp(f){ border : B | inside : I }", {"I": 5}),
+    ("roofHip(30) comp(e){ border : B | inside : I }", {"I": 9}),
+    ("roofHip(30) comp(v){ border : B | inside : I }", {"I": 6}),
+    # an envelope is closed too: its bottom, 4 walls and 4 slopes (the sides as the front)
+    ("envelope(world.up, 20, 2, 45, 1, 30) comp(f){ border : B | inside : I }", {"I": 9}),
 ])
 def test_border_and_inside_of_shapes_no_offset_made(write, body, want):
     """The reference's ``border`` (an edge meeting one face, a face or vertex touching such an edge) and
-    ``inside`` on faces and solids; on a roof they are refused by name."""
+    ``inside`` on faces, solids and roofs."""
     r = run(write, f"Lot --> {body}\n" + "".join(f'{n} --> report("{n}", 1)\n' for n in "IB"), [rect(12, 8)])
     assert {k[:-2]: v for k, v in totals(r).items() if k.endswith("_n")} == want
-    r = run(write, "Lot --> roofHip(30) comp(e){ border : B }\n", [rect(12, 8)])
-    assert len(r["bad"]) == 1 and "border and inside on a roof" in r["bad"][0].reason

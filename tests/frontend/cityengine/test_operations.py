@@ -327,6 +327,22 @@ def test_roof_gable_with_an_edge_index_and_roof_ridge_lower_to_roofs(call, kind,
         assert roof.index.value in (2, 0)
 
 
+@pytest.mark.parametrize("call, even", [
+    ("roofHip(30, 1, true)", True), ("roofHip(byHeight, 3, 1, level)", "level"),
+    ("roofGable(30, 1, 1, true)", True), ("roofHip(30, 1, false)", None), ("roofGable(30, 1, 1, true, 2)", None),
+])
+def test_even_ridges_lower_to_the_roofs_even_expression(call, even):
+    module = module_of(VERSION + f"attr level = true\nLot --> {call} Roof\nRoof --> X.\n")
+    (roof,) = [op for op in iter_ops(module) if isinstance(op, ir.Roof)]
+    if even is None:
+        assert roof.even is None
+    elif even is True:
+        assert roof.even == ir.Bool(True, roof.even.span)
+    else:
+        assert roof.even.name == even
+
+
+
 # ------------------------------------------------------------------------------------ the unsupported
 
 
@@ -336,8 +352,8 @@ def test_roof_gable_with_an_edge_index_and_roof_ridge_lower_to_roofs(call, kind,
      "street"),
     ("Lot --> shapeL(3, 2) Garden", "shapeL without selector parts", "shapeL"),
     ("Lot --> setback(3){ 2 : Garden }", "this setback selector", "2"),
-    ("Lot --> roofHip(30, 1, true) Roof", "roofHip with even ridges", "true"),
     ("Lot --> envelope(normal, 10, 45) Roof", "envelope with 3 arguments", "envelope"),
+    ("Lot --> envelope(normal, 10, [1, 2], [45, 30]) Roof", "envelope with arrays per edge", "envelope"),
     ("Lot --> shapeL(4, 4){ front : A | remainder : NIL }", "shapeL selector `front`", "front"),
     ("Lot --> innerRectangle(world){ shape : A | remainder : NIL }", "innerRectangle with these arguments",
      "innerRectangle"),
