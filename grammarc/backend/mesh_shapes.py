@@ -62,8 +62,7 @@ def build_roofs(chunk: Chunk, shapes: Shapes, kind: str, polygons, value, by_hei
     rows = np.arange(n)
     size_a = shapes.size[rows, PLANE_U[plane]]
     size_b = shapes.size[rows, PLANE_V[plane]]
-    no_edges = np.zeros(len(coords))
-    edge_base, edge_angle = (no_edges, no_edges) if edges is None else edges
+    edge_base, edge_angle = (None, None) if edges is None else edges
     verts, rings, faces, meshes, ok = roof_meshes(
         ROOF_KINDS[kind], coords, ring_offsets, shape_offsets, plane.astype(np.int8), size_a, size_b,
         value, by_height, overhang, index.astype(np.int64),

@@ -208,7 +208,8 @@ def taper(ctx: Context, cursor: Shapes, op: ir.Taper) -> Shapes:
     verts, rings, faces, meshes, _ = roof_meshes(
         PYRAMID, coords, ring_offsets, shape_offsets, face.astype(np.int8), sub.size[k, PLANE_U[face]],
         sub.size[k, PLANE_V[face]], np.abs(height[rows]), True, np.zeros(len(rows)),
-        np.zeros(len(rows), dtype=np.int64), np.full(len(rows), np.inf))
+        np.zeros(len(rows), dtype=np.int64), np.full(len(rows), np.inf), np.zeros(len(rows), dtype=bool),
+        None, None)
     owner = segment_of(meshes)[segment_of(faces)[segment_of(rings)]]
     verts[behind[owner]] *= np.array([-1.0, 1.0, -1.0])
     apex = verts[:, 2] != 0
