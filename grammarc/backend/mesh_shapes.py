@@ -104,6 +104,22 @@ def flat_meshes(chunk: Chunk, shapes: Shapes, parts: np.ndarray, source: np.ndar
     return shapes.with_scope(shapes.origin, shapes.size, shapes.frame, geom)
 
 
+def face_piece_meshes(chunk: Chunk, shapes: Shapes, parts: np.ndarray, source: np.ndarray, origin: np.ndarray,
+                      axes: np.ndarray) -> Shapes:
+    """One mesh shape per row of ``shapes`` from ``parts``: shapely polygons (k,) each in the x-y plane of
+    its own face scope (``origin`` (k, 3) and ``axes`` (k, 3, 3) in the frame of its shape ``source``
+    (k,), grouped by row), as ``offset`` cuts a roof's faces; the scope fitted around each row's parts
+    (a row without parts gets an empty mesh)."""
+    _, coords, ring_offsets, part_offsets = oriented_rings(parts, np.full(len(parts), 2, dtype=np.int8))
+    vertex_part = segment_of(part_offsets)[segment_of(ring_offsets)]
+    local = (origin[vertex_part] + coords[:, :1] * axes[vertex_part, 0]
+             + coords[:, 1:] * axes[vertex_part, 1])
+    mesh_offsets = np.r_[0, np.cumsum(np.bincount(source, minlength=len(shapes)))]
+    geom, low, size = store_fitted(chunk, local, ring_offsets, part_offsets, mesh_offsets)
+    return shapes.with_scope(shapes.origin + np.einsum("ni,nij->nj", low, chunk.frames[shapes.frame]), size,
+                             shapes.frame, geom)
+
+
 def flat_mesh_faces(chunk: Chunk, shapes: Shapes) -> tuple[np.ndarray, np.ndarray]:
     """The faces of flat mesh shapes (each with one scope size 0) stored as polygons in that plane of
     their scopes: the polygons' ids (F,), mesh by mesh, and each mesh's number of faces (n,)."""
