@@ -511,7 +511,7 @@ def _offset_polygons(ctx: Context, distance: ir.Expr, cursor: Shapes, span):
     (k,) (shapely, in the scopes' units), the faces' planes (k,) and polygons (k,), the faces as shapes and
     each face's row in ``cursor``."""
     d = np.broadcast_to(evaluate_array(distance, ctx.env(cursor)), (len(cursor),))
-    faces, owner = _faces_in_plane(ctx, cursor, "offset", span)
+    faces, owner = _faces_in_plane(cursor, ctx.chunk)
     polygons, plane = face_polygons(ctx, faces, "offset", span)
     inset = shapely.buffer(polygons, d[owner], join_style="mitre", mitre_limit=1e6)
     return inset, shapely.difference(polygons, inset), plane, polygons, faces, owner
@@ -525,19 +525,15 @@ def _offset_pieces(ctx: Context, distance: ir.Expr, cursor: Shapes, span):
         fit_pieces(inset, plane, faces.size, polygons), fit_pieces(border, plane, faces.size, polygons)))
 
 
-def _faces_in_plane(ctx: Context, cursor: Shapes, what: str, span) -> tuple[Shapes, np.ndarray]:
-    """Each shape's faces as shapes in its scope: a flat mesh's faces each a polygon shape, any other
-    shape itself; and each face's row in ``cursor`` (ascending). Fails the lots of meshes that are not
-    flat (a roof's faces lie in several planes)."""
+def _faces_in_plane(cursor: Shapes, chunk) -> tuple[Shapes, np.ndarray]:
+    """Each flat shape's faces as shapes in its scope: a flat mesh's faces each a polygon shape, any other
+    shape itself; and each face's row in ``cursor`` (ascending). Roofs do not get here: ``offset`` takes
+    them apart (``_roof_offsets``), and its comp(f) form refuses meshes."""
     mesh = is_mesh(cursor.geom)
     if not mesh.any():
         return cursor, np.arange(len(cursor))
-    flat = (cursor.size <= TOL.zero).sum(axis=1) == 1
-    if (mesh & ~flat).any():
-        ctx.fail(cursor, mesh & ~flat, f"`{what}` of a roof is not supported yet (only of faces in one plane; "
-                 "split the roof into faces with comp(f) first)", span)
     rows = np.flatnonzero(mesh)
-    geom, counts = mesh_shapes.flat_mesh_faces(ctx.chunk, cursor.take(rows))
+    geom, counts = mesh_shapes.flat_mesh_faces(chunk, cursor.take(rows))
     per_shape = np.ones(len(cursor), dtype=np.int64)
     per_shape[rows] = counts
     owner = np.repeat(np.arange(len(cursor)), per_shape)
