@@ -62,8 +62,7 @@ def build_roofs(chunk: Chunk, shapes: Shapes, kind: str, polygons, value, by_hei
     rows = np.arange(n)
     size_a = shapes.size[rows, PLANE_U[plane]]
     size_b = shapes.size[rows, PLANE_V[plane]]
-    no_edges = np.zeros(len(coords))
-    edge_base, edge_angle = (no_edges, no_edges) if edges is None else edges
+    edge_base, edge_angle = (None, None) if edges is None else edges
     verts, rings, faces, meshes, ok = roof_meshes(
         ROOF_KINDS[kind], coords, ring_offsets, shape_offsets, plane.astype(np.int8), size_a, size_b,
         value, by_height, overhang, index.astype(np.int64),
@@ -103,6 +102,22 @@ def flat_meshes(chunk: Chunk, shapes: Shapes, parts: np.ndarray, source: np.ndar
     geom = shapes.geom.copy()
     geom[several] = (MESH_BASE + ids).astype(np.int32)
     return shapes.with_scope(shapes.origin, shapes.size, shapes.frame, geom)
+
+
+def face_piece_meshes(chunk: Chunk, shapes: Shapes, parts: np.ndarray, source: np.ndarray, origin: np.ndarray,
+                      axes: np.ndarray) -> Shapes:
+    """One mesh shape per row of ``shapes`` from ``parts``: shapely polygons (k,) each in the x-y plane of
+    its own face scope (``origin`` (k, 3) and ``axes`` (k, 3, 3) in the frame of its shape ``source``
+    (k,), grouped by row), as ``offset`` cuts a roof's faces; the scope fitted around each row's parts
+    (a row without parts gets an empty mesh)."""
+    _, coords, ring_offsets, part_offsets = oriented_rings(parts, np.full(len(parts), 2, dtype=np.int8))
+    vertex_part = segment_of(part_offsets)[segment_of(ring_offsets)]
+    local = (origin[vertex_part] + coords[:, :1] * axes[vertex_part, 0]
+             + coords[:, 1:] * axes[vertex_part, 1])
+    mesh_offsets = np.r_[0, np.cumsum(np.bincount(source, minlength=len(shapes)))]
+    geom, low, size = store_fitted(chunk, local, ring_offsets, part_offsets, mesh_offsets)
+    return shapes.with_scope(shapes.origin + np.einsum("ni,nij->nj", low, chunk.frames[shapes.frame]), size,
+                             shapes.frame, geom)
 
 
 def flat_mesh_faces(chunk: Chunk, shapes: Shapes) -> tuple[np.ndarray, np.ndarray]:

@@ -353,6 +353,32 @@ def _envelope(pts, pring, succ, base, speed, cap, eps):
 
 
 @njit(cache=True, nogil=True)
+def _weighted_sides(edge_base, edge_angle, edges, eps):
+    """Whether an envelope's sides ``edges`` (indices into edge_base and edge_angle) differ or one is
+    vertical, so that its planes are a weighted skeleton's, and whether their angles are all in (0, 90]
+    (valid False refuses the roof). Sides of None (not an envelope) are the same all round."""
+    if edge_base is None:
+        return False, True
+    base, angle = edge_base[edges], edge_angle[edges]
+    weighted = base.max() - base.min() > eps or angle.max() - angle.min() > 1e-9 or angle.max() >= 90.0
+    if weighted and not (angle.min() > 0.0 and angle.max() <= 90.0):
+        return False, False
+    return weighted, True
+
+
+@njit(cache=True, nogil=True)
+def _side_envelope(pts, pring, succ, edge_base, edge_angle, edges, cap, eps):
+    """``_envelope`` with the sides ``edges`` of edge_base and edge_angle, their angles as speeds (0 for a
+    wall). Sides of None never get here; numba prunes the branch, so the roofs other than envelopes
+    compile without the weighted skeleton."""
+    if edge_base is None:
+        return np.empty((0, 3)), np.empty(0, np.int64), np.zeros(1, np.int64), False
+    angle = edge_angle[edges]
+    speed = np.where(angle >= 90.0, 0.0, 1.0 / np.tan(np.radians(angle)))
+    return _envelope(pts, pring, succ, edge_base[edges], speed, cap, eps)
+
+
+@njit(cache=True, nogil=True)
 def roof_meshes(kind, coords, ring_offsets, poly_offsets, plane, size_a, size_b, value, by_height,
                 overhang, index, cap, even, edge_base, edge_angle):
     """Roof meshes of k polygons.
@@ -364,7 +390,9 @@ def roof_meshes(kind, coords, ring_offsets, poly_offsets, plane, size_a, size_b,
     (k,) bool: a hip or gable roof whose ridge nodes all take their mean height (CityEngine's ``even``:
     level ridges, faces no longer planar). edge_base, edge_angle (V,): an envelope's base height and
     angle under the edge from each vertex of ``coords``, used where they differ round a polygon or an
-    angle is 90 degrees (``_envelope``; else ``overhang`` and ``value`` serve all round).
+    angle is 90 degrees (``_envelope``; else ``overhang`` and ``value`` serve all round); both None for
+    the other roofs, whose specialization numba compiles (and caches) without the weighted envelope and its
+    skeleton, so that they load no more code than they run.
     Returns verts (V', 3) as (a, b, h), ring_offsets (R'+1,), face_offsets (F'+1,) into rings,
     mesh_offsets (k+1,) into faces, and ok (k,): False where the roof could not be made.
     """
@@ -397,11 +425,8 @@ def roof_meshes(kind, coords, ring_offsets, poly_offsets, plane, size_a, size_b,
         angle = np.radians(value[g])
         weighted = False
         if kind == ENVELOPE and len(pring) >= 2:
-            e_base, e_angle = edge_base[v0 + kept], edge_angle[v0 + kept]
-            weighted = (e_base.max() - e_base.min() > eps or e_angle.max() - e_angle.min() > 1e-9
-                        or e_angle.max() >= 90.0)
-            if weighted and not (e_angle.min() > 0.0 and e_angle.max() <= 90.0):
-                weighted = False
+            weighted, valid = _weighted_sides(edge_base, edge_angle, v0 + kept, eps)
+            if not valid:
                 angle = np.pi  # refused below
         if len(pring) < 2 or (not by_height and not weighted and not (-np.pi / 2 < angle < np.pi / 2)):
             ok[g] = False
@@ -415,8 +440,8 @@ def roof_meshes(kind, coords, ring_offsets, poly_offsets, plane, size_a, size_b,
                 succ[j] = pring[r] + (j - pring[r] + 1) % (pring[r + 1] - pring[r])
         # ---- the roof's points (x, y, h) and its faces as rings of point ids
         if weighted:
-            e_speed = np.where(e_angle >= 90.0, 0.0, 1.0 / np.tan(np.radians(e_angle)))
-            point, face_ids, face_off, done = _envelope(pts, pring, succ, e_base, e_speed, cap[g], eps)
+            point, face_ids, face_off, done = _side_envelope(pts, pring, succ, edge_base, edge_angle, v0 + kept,
+                                                             cap[g], eps)
             if not done:
                 ok[g] = False
                 mesh_offsets[g + 1] = n_f

@@ -19,11 +19,12 @@ TAN30 = np.tan(np.radians(30))
 def roof(kind, rings, value=30.0, *, plane=2, by_height=False, overhang=0.0, index=0, cap=np.inf, even=False,
          edges=None):
     """The roof mesh of one polygon given in real units: faces as lists of (V, 3) rings in (a, b, h).
-    ``edges``: an envelope's (base height, angle) under the edge from each vertex."""
+    ``edges``: an envelope's (base height, angle) under the edge from each vertex; else sides of None, as
+    the backend gives the other roofs."""
     pts = np.concatenate([np.asarray(r, dtype=float) for r in rings])
     low, size = pts.min(axis=0), np.ptp(pts, axis=0)
     ring_offsets = np.cumsum([0] + [len(r) for r in rings]).astype(np.int64)
-    edge_base, edge_angle = np.zeros((2, len(pts))) if edges is None else np.asarray(edges, float).T.copy()
+    edge_base, edge_angle = (None, None) if edges is None else np.asarray(edges, float).T.copy()
     verts, ro, fo, mo, ok = roof_meshes(
         kind, (pts - low) / size, ring_offsets, np.array([0, len(rings)]), np.array([plane], np.int8),
         size[:1], size[1:], np.array([value]), by_height, np.array([overhang]), np.array([index]),
@@ -201,6 +202,19 @@ def test_envelope_with_one_slope_all_round_by_edges_is_the_hip_envelope(rings):
     weighted = envelope(rings, [(1.0, 40.0)] * (n - 1) + [(1.0, 40.000001)], cap=2.0)
     assert volume(weighted) == pytest.approx(volume(hip), rel=1e-5)
     assert unmatched_edges(weighted) == 0
+
+
+@pytest.mark.parametrize("kind", [HIP, GABLE, PYRAMID, ENVELOPE])
+def test_sides_of_none_are_the_same_all_round(kind):
+    """Sides of None (the roofs other than envelopes, compiled without the weighted envelope) give the
+    roof that sides of one base height and angle all round give."""
+    cap = 2.0 if kind == ENVELOPE else np.inf
+    same = [(0.0, 30.0)] * sum(map(len, COURTYARD))
+    plain = roof(kind, COURTYARD, cap=cap)
+    sided = roof(kind, COURTYARD, cap=cap, edges=same)
+    assert len(plain) == len(sided)
+    for a, b in zip(plain, sided):
+        assert all(np.array_equal(p, q) for p, q in zip(a, b))
 
 
 def test_envelope_of_vertical_sides_is_the_prism_up_to_the_cap():

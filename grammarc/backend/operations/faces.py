@@ -10,7 +10,7 @@ expressions read. Writes: the roofs ``origin``, ``size`` and ``geom`` (``taper``
 turns to the face's normal); ``convexify`` and ``cleanupGeometry`` the ``geom``; ``offset``, ``footprint``
 and ``rectify`` every column, as they make the shapes of their pieces anew (new keys; a shape with no piece
 left goes). ``offset`` also takes a shape of several faces in one plane (a mesh of an earlier offset's
-pieces or of convexify's parts) and offsets each face.
+pieces or of convexify's parts) or a roof, and offsets each face.
 """
 
 from __future__ import annotations
@@ -209,7 +209,7 @@ def taper(ctx: Context, cursor: Shapes, op: ir.Taper) -> Shapes:
         PYRAMID, coords, ring_offsets, shape_offsets, face.astype(np.int8), sub.size[k, PLANE_U[face]],
         sub.size[k, PLANE_V[face]], np.abs(height[rows]), True, np.zeros(len(rows)),
         np.zeros(len(rows), dtype=np.int64), np.full(len(rows), np.inf), np.zeros(len(rows), dtype=bool),
-        np.zeros(len(coords)), np.zeros(len(coords)))
+        None, None)
     owner = segment_of(meshes)[segment_of(faces)[segment_of(rings)]]
     verts[behind[owner]] *= np.array([-1.0, 1.0, -1.0])
     apex = verts[:, 2] != 0
@@ -225,7 +225,22 @@ def taper(ctx: Context, cursor: Shapes, op: ir.Taper) -> Shapes:
 def offset(ctx: Context, cursor: Shapes, op: ir.Offset) -> Shapes:
     """``offset(d, inside|border|all)``: the shape's face becomes its inset, the ring around it, or both
     (the faces of one shape); a shape of several faces in one plane (an earlier offset's pieces,
-    convexify's parts) has each face offset, as CityEngine offsets every face of a geometry."""
+    convexify's parts) has each face offset, as CityEngine offsets every face of a geometry, and so has
+    a roof, each face in its own plane (``_roof_offsets``)."""
+    roof = is_mesh(cursor.geom) & ((cursor.size <= TOL.zero).sum(axis=1) != 1)
+    if roof.any():
+        flat_rows, roof_rows = np.flatnonzero(~roof), np.flatnonzero(roof)
+        flat = cursor.take(flat_rows)
+        pieces = _offset_selected(ctx, flat, op)
+        roofs, kept = _roof_offsets(ctx, cursor.take(roof_rows), op)
+        return Shapes.merge([_shape_each(ctx, flat, pieces), roofs],
+                            [flat_rows[np.unique(pieces.source)], roof_rows[kept]])
+    return _shape_each(ctx, cursor, _offset_selected(ctx, cursor, op))
+
+
+def _offset_selected(ctx: Context, cursor: Shapes, op: ir.Offset):
+    """The pieces ``offset`` keeps of flat shapes: their insets, borders or both, each shape's inside
+    pieces before its border's."""
     if op.select == "all":
         inset, border, plane, polygons, faces, owner = _offset_polygons(ctx, op.distance, cursor, op.span)
         pieces = fit_pieces(np.concatenate([inset, border]), np.tile(plane, 2), np.tile(faces.size, (2, 1)),
@@ -236,7 +251,31 @@ def offset(ctx: Context, cursor: Shapes, op: ir.Offset) -> Shapes:
     else:
         inside, border = _offset_pieces(ctx, op.distance, cursor, op.span)
         pieces = inside if op.select == "inside" else border
-    return _shape_each(ctx, cursor, pieces)
+    return pieces
+
+
+def _roof_offsets(ctx: Context, roofs: Shapes, op: ir.Offset) -> tuple[Shapes, np.ndarray]:
+    """``offset`` of roofs (meshes whose faces lie in several planes): every face, the bottom too, offset
+    in its own plane (its comp(f) scope), as CityEngine offsets each face of a geometry; the pieces
+    ``op.select`` keeps (each roof's inside pieces face by face, then its border's) become one mesh in a
+    scope fitted to them. Returns the shapes and the mask (n,) of the roofs with any piece left."""
+    n = len(roofs)
+    d = np.broadcast_to(np.asarray(evaluate_array(op.distance, ctx.env(roofs)), float), (n,))
+    parent, _, origin, axes, size, geom, _, _ = mesh_shapes.mesh_components(ctx.chunk, roofs, mesh_shapes.FACES)
+    polygons = scope_polygons(ctx.chunk.polygons, geom, size)
+    inset = shapely.buffer(polygons, d[parent], join_style="mitre", mitre_limit=1e6)
+    chosen = {"inside": [inset], "border": [shapely.difference(polygons, inset)]}
+    chosen["all"] = chosen["inside"] + chosen["border"]
+    parts, which = shapely.get_parts(np.concatenate(chosen[op.select]), return_index=True)
+    face = which % len(polygons)
+    keep = shapely.area(parts) > TOL.zero
+    parts, face = parts[keep], face[keep]
+    order = np.argsort(parent[face], kind="stable")
+    shapes = mesh_shapes.face_piece_meshes(ctx.chunk, roofs, parts[order], parent[face[order]],
+                                           origin[face[order]], axes[face[order]])
+    kept = np.bincount(parent[face], minlength=n) > 0
+    shapes = shapes.take(kept)
+    return replace(shapes, key=child_keys(shapes.key, 0, np.zeros(len(shapes), dtype=np.int64))), kept
 
 
 @operation(ir.Footprint, writes=COLUMNS, meshes=True)
@@ -472,7 +511,7 @@ def _offset_polygons(ctx: Context, distance: ir.Expr, cursor: Shapes, span):
     (k,) (shapely, in the scopes' units), the faces' planes (k,) and polygons (k,), the faces as shapes and
     each face's row in ``cursor``."""
     d = np.broadcast_to(evaluate_array(distance, ctx.env(cursor)), (len(cursor),))
-    faces, owner = _faces_in_plane(ctx, cursor, "offset", span)
+    faces, owner = _faces_in_plane(cursor, ctx.chunk)
     polygons, plane = face_polygons(ctx, faces, "offset", span)
     inset = shapely.buffer(polygons, d[owner], join_style="mitre", mitre_limit=1e6)
     return inset, shapely.difference(polygons, inset), plane, polygons, faces, owner
@@ -486,19 +525,15 @@ def _offset_pieces(ctx: Context, distance: ir.Expr, cursor: Shapes, span):
         fit_pieces(inset, plane, faces.size, polygons), fit_pieces(border, plane, faces.size, polygons)))
 
 
-def _faces_in_plane(ctx: Context, cursor: Shapes, what: str, span) -> tuple[Shapes, np.ndarray]:
-    """Each shape's faces as shapes in its scope: a flat mesh's faces each a polygon shape, any other
-    shape itself; and each face's row in ``cursor`` (ascending). Fails the lots of meshes that are not
-    flat (a roof's faces lie in several planes)."""
+def _faces_in_plane(cursor: Shapes, chunk) -> tuple[Shapes, np.ndarray]:
+    """Each flat shape's faces as shapes in its scope: a flat mesh's faces each a polygon shape, any other
+    shape itself; and each face's row in ``cursor`` (ascending). Roofs do not get here: ``offset`` takes
+    them apart (``_roof_offsets``), and its comp(f) form refuses meshes."""
     mesh = is_mesh(cursor.geom)
     if not mesh.any():
         return cursor, np.arange(len(cursor))
-    flat = (cursor.size <= TOL.zero).sum(axis=1) == 1
-    if (mesh & ~flat).any():
-        ctx.fail(cursor, mesh & ~flat, f"`{what}` of a roof is not supported yet (only of faces in one plane; "
-                 "split the roof into faces with comp(f) first)", span)
     rows = np.flatnonzero(mesh)
-    geom, counts = mesh_shapes.flat_mesh_faces(ctx.chunk, cursor.take(rows))
+    geom, counts = mesh_shapes.flat_mesh_faces(chunk, cursor.take(rows))
     per_shape = np.ones(len(cursor), dtype=np.int64)
     per_shape[rows] = counts
     owner = np.repeat(np.arange(len(cursor)), per_shape)

@@ -172,10 +172,41 @@ def test_offset_border_of_several_pieces_rings_each(write):
     assert totals(r)["a_sum"] == pytest.approx(2 * (49 - 25))
 
 
-def test_offset_of_a_roof_fails_its_lot_by_name(write):
-    records = run(write, "Lot --> roofHip(30) offset(-1, inside) X.\n", [rect(10, 8)])
+def _pyramid_offsets(d):
+    """A 45-degree pyramid roof over a 10 m square offset by -d, face by face in its own plane: the
+    bottom's inset and each triangle's (a similar triangle, scaled by (r - d) / r for its inradius r)."""
+    side, slant = 10.0, 5.0 * np.sqrt(2)
+    triangle, edge = side * slant / 2, np.sqrt(3 * 5.0 ** 2)
+    r = triangle / ((side + 2 * edge) / 2)
+    inside = (side - 2 * d) ** 2 + 4 * triangle * ((r - d) / r) ** 2
+    return inside, side ** 2 + 4 * triangle - inside
+
+
+@pytest.mark.parametrize("select", ["inside", "border", "all"])
+def test_offset_of_a_roof_offsets_each_face_in_its_plane(write, select):
+    """CityEngine offsets every face of a geometry: a roof's faces each in its own plane, one shape of
+    them all."""
+    t = totals(run(write, f'Lot --> roofPyramid(45) offset(-1, {select}) report("a", geometry.area) X.\n',
+                   [rect(10, 10)]))
+    inside, border = _pyramid_offsets(1.0)
+    assert t["a_n"] == 1
+    assert t["a_sum"] == pytest.approx({"inside": inside, "border": border, "all": inside + border}[select])
+
+
+def test_offset_of_a_roof_with_comp_of_its_pieces_fails_its_lot_by_name(write):
+    records = run(write, "Lot --> roofHip(30) offset(-1) comp(f){ inside: I. | border: B. }\n", [rect(10, 8)])
     (bad,) = records["bad"]
-    assert bad.reason.startswith("`offset` of a roof is not supported yet (only of faces in one plane")
+    assert bad.reason.startswith("`offset` of a roof is not supported yet (split the roof into faces")
+
+
+def test_offset_of_roofs_and_faces_in_one_batch(write):
+    """A roof and a face at the same offset: each offset its way, each lot's shapes in their order."""
+    text = ('Lot --> split(x){ 10: roofPyramid(45) A | ~1: A }\n'
+            'A --> offset(-1, inside) report("a", geometry.area) X.\n')
+    lots = per_lot(run(write, text, [rect(20, 10), rect(25, 10)]))
+    inside, _ = _pyramid_offsets(1.0)
+    assert [(t["a_n"], t["a_sum"]) for _, t in sorted(lots.items())] == [
+        (2, pytest.approx(inside + 8 * 8)), (2, pytest.approx(inside + 13 * 8))]
 
 
 def test_setback_per_edge_evaluates_its_distance_for_each_edge(write):
