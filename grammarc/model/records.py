@@ -173,7 +173,12 @@ class TerminalChunk:
 
 class MaterialTable:
     """A record's materials (texture paths per channel of ``MATERIAL_MAPS``) numbered as the writer meets
-    them, row 0 none: what a writer merges its chunks' own tables into."""
+    them, row 0 none: what a writer merges its chunks' own tables into.
+
+    A chunk's own table is in the order its derivation met the materials, which depends on which lots
+    share the chunk; the writer numbers them by their first use instead (the lowest lot, its instances
+    before its faces, then their order), which is the same however the lots are chunked, as the chunks
+    come in the order of their lots and each lot's records are in an order of their own."""
 
     def __init__(self) -> None:
         self.rows: dict[tuple[str, ...], int] = {("",) * len(MATERIAL_MAPS): 0}
@@ -182,8 +187,14 @@ class MaterialTable:
         """(n,) and (F,) int32: the rows of the chunk's instances and faces in this table (0 without textures)."""
         if chunk.materials is None:
             return np.zeros(len(chunk.asset), np.int32), np.zeros(len(chunk.mesh.lot), np.int32)
-        lookup = np.array([self.rows.setdefault(tuple(map(str, row)), len(self.rows)) for row in chunk.materials],
-                          np.int32)
+        used = np.concatenate([chunk.material, chunk.mesh.material])
+        lot = np.concatenate([chunk.lot, chunk.mesh.lot])
+        kind = np.repeat(np.array([0, 1], np.int8), [len(chunk.material), len(chunk.mesh.material)])
+        order = np.lexsort((np.arange(len(used)), kind, lot))  # rows of each lot in their own order
+        first, at = np.unique(used[order], return_index=True)
+        lookup = np.zeros(len(chunk.materials), np.int32)
+        for row in first[np.argsort(at)]:
+            lookup[row] = self.rows.setdefault(tuple(map(str, chunk.materials[row])), len(self.rows))
         return lookup[chunk.material], lookup[chunk.mesh.material]
 
     def table(self) -> np.ndarray:

@@ -61,14 +61,36 @@ def test_concat_joins_the_tables_of_materials():
     assert MeshChunk.concat([triangle(), triangle()]).materials is None
 
 
-def test_a_material_table_numbers_the_materials_of_chunks_as_met():
+def _lots(lots: list[int], material: list[int], face_lot: int, face_material: int,
+          maps: tuple[str, ...]) -> TerminalChunk:
+    """Instances of ``lots`` with rows ``material`` of the table ``maps``, and one face of lot ``face_lot``
+    with row ``face_material``."""
+    n = len(lots)
+    mesh = dataclasses.replace(textured(triangle(), *maps), lot=np.array([face_lot], np.int32),
+                               material=np.array([face_material], np.int32))
+    return TerminalChunk(asset=np.zeros(n, np.int32), xform=np.zeros((n, 3, 4), np.float32),
+                         lot=np.array(lots, np.int32), symbol=np.zeros(n, np.int32), mesh=mesh,
+                         material=np.array(material, np.int32), materials=mesh.materials)
+
+
+def test_a_material_table_numbers_the_materials_by_their_first_use():
+    """By lot, a lot's instances before its faces, not by the chunk's own table (the order its derivation met
+    them): the instances use a.jpg first, the face b.jpg."""
     table = MaterialTable()
-    first = TerminalChunk(asset=np.zeros(2, np.int32), xform=np.zeros((2, 3, 4), np.float32),
-                          lot=np.zeros(2, np.int32), symbol=np.zeros(2, np.int32),
-                          mesh=textured(triangle(), "b.jpg"), material=np.array([1, 0], np.int32),
-                          materials=textured(triangle(), "b.jpg", "a.jpg").materials)
-    rows, faces = table.add(first)
-    assert (rows.tolist(), faces.tolist()) == ([2, 1], [1])
-    plain = dataclasses.replace(first, material=None, materials=None, mesh=triangle())
+    rows, faces = table.add(_lots([0, 0], [1, 0], 0, 0, ("b.jpg", "a.jpg")))
+    assert (rows.tolist(), faces.tolist()) == ([1, 2], [2])
+    plain = TerminalChunk(asset=np.zeros(2, np.int32), xform=np.zeros((2, 3, 4), np.float32),
+                          lot=np.zeros(2, np.int32), symbol=np.zeros(2, np.int32), mesh=triangle())
     assert [r.tolist() for r in table.add(plain)] == [[0, 0], [0]]
-    assert table.table()[:, 0].tolist() == ["", "b.jpg", "a.jpg"]
+    assert table.table()[:, 0].tolist() == ["", "a.jpg", "b.jpg"]
+
+
+def test_a_material_table_does_not_depend_on_the_chunks():
+    """Lot 0's face uses c.jpg, lot 1's instance d.jpg: one chunk of both, whose derivation met d.jpg first,
+    numbers them as a chunk per lot does."""
+    together = MaterialTable()
+    together.add(_lots([1], [0], 0, 1, ("d.jpg", "c.jpg")))
+    apart = MaterialTable()
+    apart.add(_lots([], [], 0, 0, ("c.jpg",)))
+    apart.add(_lots([1], [0], 1, 0, ("d.jpg",)))
+    assert together.table()[:, 0].tolist() == apart.table()[:, 0].tolist() == ["", "c.jpg", "d.jpg"]
