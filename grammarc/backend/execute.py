@@ -124,8 +124,6 @@ def run(ctx: Context, body: ir.Body, cursor: Shapes, leaf_at_end: bool = False) 
     stack: list[tuple] = []
     base = (cursor.origin, cursor.size, cursor.frame)  # what `center` centres on
     for op in body:
-        if not len(cursor):
-            return
         if isinstance(op, ir.Push):
             # the whole shape: its scope, its geometry and the attributes `set` gives it
             stack.append((cursor, base))
@@ -133,6 +131,11 @@ def run(ctx: Context, body: ir.Body, cursor: Shapes, leaf_at_end: bool = False) 
         elif isinstance(op, ir.Pop):
             if stack:
                 cursor, base = stack.pop()
+        elif not len(cursor):
+            if not stack:
+                return
+            # nothing left inside the brackets (an offset's inside of a small face): the shapes come
+            # back at their `]`
         elif isinstance(op, ir.Center):
             cursor = center(ctx, cursor, op, base)
         else:
