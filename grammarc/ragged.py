@@ -47,6 +47,14 @@ def segment_of(offsets: np.ndarray) -> np.ndarray:
     return np.repeat(np.arange(len(offsets) - 1), np.diff(offsets))
 
 
+def next_in_segment(offsets: np.ndarray) -> np.ndarray:
+    """(N,) int64: the item after each in its segment, the segment's first after its last: a ring's next
+    vertex. offsets [0, 3, 5] -> [1, 2, 0, 4, 3]."""
+    seg = segment_of(offsets)
+    at = np.arange(len(seg))
+    return np.where(at + 1 < offsets[1:][seg], at + 1, offsets[:-1][seg])
+
+
 def segment_reduce(ufunc: np.ufunc, values: np.ndarray, offsets: np.ndarray, empty) -> np.ndarray:
     """``ufunc.reduce`` over each segment (sum with np.add, min with np.minimum, ...).
 

@@ -7,6 +7,7 @@ import pytest
 
 from grammarc.ragged import (
     fan_out,
+    next_in_segment,
     offsets_from_counts,
     ragged_take,
     rank_within,
@@ -123,3 +124,8 @@ def test_row_groups_number_equal_rows_as_unique_does():
     assert groups.tolist() == want_groups.reshape(-1).tolist() and first.tolist() == want_first.tolist()
     empty_groups, empty_first = row_groups(np.zeros((0, 2), dtype=np.int64))
     assert len(empty_groups) == len(empty_first) == 0
+
+
+def test_next_in_segment_wraps_each_ring():
+    assert next_in_segment(np.array([0, 3, 5, 6])).tolist() == [1, 2, 0, 4, 3, 5]
+    assert next_in_segment(np.array([0])).tolist() == []

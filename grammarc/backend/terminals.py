@@ -33,7 +33,7 @@ from grammarc.geometry.meshes import is_mesh, is_polygon
 from grammarc.geometry.polygons import PLANE_U, PLANE_V
 from grammarc.geometry.trim import boxes_crossing, trim_triangles
 from grammarc.model.records import MeshChunk
-from grammarc.ragged import offsets_from_counts, segment_of
+from grammarc.ragged import next_in_segment, offsets_from_counts, segment_of
 
 CUBE, QUAD = 0, 1  # asset ids of the leaf built-ins (see ir.passes.assets)
 
@@ -243,10 +243,8 @@ def polygon_meshes(ctx: Context, shapes: Shapes, symbol: int) -> tuple[MeshChunk
         faces_shape.append(n_rings[which])
     # Side quads of solids: vertex j, its successor, both lifted.
     side = solid[s]
-    at = np.arange(len(coords))
-    ring = segment_of(ring_offsets)
-    nxt = np.where(at + 1 < ring_offsets[1:][ring], at + 1, ring_offsets[:-1][ring])
-    j = at[side]
+    nxt = next_in_segment(ring_offsets)
+    j = np.flatnonzero(side)
     quads = np.stack([base[j], base[nxt[j]], base[nxt[j]] + lift[j], base[j] + lift[j]], axis=1)
     faces_v.append(quads.reshape(-1, 3))
     faces_rings.append(np.full(len(j), 4, dtype=np.int64))

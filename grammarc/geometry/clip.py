@@ -19,7 +19,7 @@ from grammarc.constants import TOL
 from grammarc.geometry.polygons import PLANE_U as _A
 from grammarc.geometry.polygons import PLANE_V as _B
 from grammarc.geometry.polygons import PolygonStore
-from grammarc.ragged import offsets_from_counts, ragged_take, segment_of, segment_reduce
+from grammarc.ragged import next_in_segment, offsets_from_counts, ragged_take, segment_of, segment_reduce
 
 
 @dataclass(frozen=True)
@@ -238,7 +238,5 @@ def _open_rings(coords: np.ndarray, closed_offsets: np.ndarray) -> tuple[np.ndar
 
 def _cross(coords: np.ndarray, ring_offsets: np.ndarray) -> np.ndarray:
     """Shoelace terms u_i v_{i+1} - u_{i+1} v_i of open rings."""
-    ring = segment_of(ring_offsets)
-    at = np.arange(len(coords))
-    nxt = np.where(at + 1 < ring_offsets[1:][ring], at + 1, ring_offsets[:-1][ring])
+    nxt = next_in_segment(ring_offsets)
     return coords[:, 0] * coords[nxt, 1] - coords[nxt, 0] * coords[:, 1]

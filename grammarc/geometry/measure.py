@@ -15,7 +15,7 @@ from grammarc.constants import TOL
 from grammarc.geometry import meshes as mesh_store
 from grammarc.geometry.meshes import MESH_BASE, MeshStore, is_mesh, is_polygon
 from grammarc.geometry.polygons import PLANE_U, PLANE_V, PolygonStore
-from grammarc.ragged import segment_of, segment_reduce
+from grammarc.ragged import next_in_segment, segment_of, segment_reduce
 
 
 def area_and_volume(size: np.ndarray, geom: np.ndarray, store: PolygonStore,
@@ -37,8 +37,7 @@ def area_and_volume(size: np.ndarray, geom: np.ndarray, store: PolygonStore,
         sa, sb, h = size[poly, a_axis], size[poly, b_axis], size[poly, plane]
         vertex_ring = segment_of(ring_offsets)
         vertex_poly = segment_of(poly_offsets)[vertex_ring]
-        at = np.arange(len(coords))
-        nxt = np.where(at + 1 < ring_offsets[1:][vertex_ring], at + 1, ring_offsets[:-1][vertex_ring])
+        nxt = next_in_segment(ring_offsets)
         u = coords[:, 0] * sa[vertex_poly]
         v = coords[:, 1] * sb[vertex_poly]
         cross = u * v[nxt] - u[nxt] * v

@@ -16,7 +16,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from grammarc.ragged import grow, ragged_take, row_groups, segment_of, segment_reduce
+from grammarc.ragged import grow, next_in_segment, ragged_take, row_groups, segment_of, segment_reduce
 
 #: ``geom`` codes from here up are meshes; polygons of the store are 0 .. MESH_BASE - 1.
 MESH_BASE = 1 << 30
@@ -90,10 +90,7 @@ def area_and_volume(store: MeshStore, ids: np.ndarray, size: np.ndarray):
 def ring_vector_areas(verts: np.ndarray, ring_offsets: np.ndarray) -> np.ndarray:
     """Vector area (R, 3) of each ring of points (V, 3) in space (Newell): its length is the ring's
     area, its direction the normal the ring winds counter-clockwise around."""
-    ring = segment_of(ring_offsets)
-    at = np.arange(len(verts))
-    nxt = np.where(at + 1 < ring_offsets[1:][ring], at + 1, ring_offsets[:-1][ring])
-    cross = np.cross(verts, verts[nxt])
+    cross = np.cross(verts, verts[next_in_segment(ring_offsets)])
     return np.stack([segment_reduce(np.add, cross[:, j], ring_offsets, 0.0) for j in range(3)], 1) / 2
 
 
@@ -317,8 +314,7 @@ def _ring_walk(verts, ring_offsets, face_offsets, mesh_offsets):
     ring = segment_of(ring_offsets)
     face = segment_of(face_offsets)[ring]
     mesh = segment_of(mesh_offsets)[face]
-    at = np.arange(len(verts))
-    nxt = np.where(at + 1 < ring_offsets[1:][ring], at + 1, ring_offsets[:-1][ring])
+    nxt = next_in_segment(ring_offsets)
     cross = np.cross(verts, verts[nxt])
     face_normal = np.stack([segment_reduce(np.add, cross[:, j], ring_offsets[face_offsets], 0.0)
                             for j in range(3)], 1)

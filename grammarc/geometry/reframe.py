@@ -14,7 +14,7 @@ import numpy as np
 
 from grammarc.constants import TOL
 from grammarc.geometry.polygons import PLANE_U, PLANE_V
-from grammarc.ragged import segment_of, segment_reduce
+from grammarc.ragged import next_in_segment, segment_of, segment_reduce
 
 #: Per normal axis n: new scope axes, as rows in the old frame, that put y along axis n and keep x where
 #: they can (CityEngine's extrude and roofs: "x kept, y along the normal, z = x cross y").
@@ -70,9 +70,7 @@ def reframe(origin, size, axes, coords, ring_offsets, shape_offsets, plane, new_
     extent_b = np.where(new_size[rows, b] > TOL.zero, new_size[rows, b], 1.0)
     new_coords = np.stack([u / extent_a[s], v / extent_b[s]], axis=1)
     # a rectangle lined up with the new axes: one ring of 4 vertices filling its box
-    at = np.arange(len(coords))
-    ring = segment_of(ring_offsets)
-    nxt = np.where(at + 1 < ring_offsets[1:][ring], at + 1, ring_offsets[:-1][ring])
+    nxt = next_in_segment(ring_offsets)
     cross = new_coords[:, 0] * new_coords[nxt, 1] - new_coords[nxt, 0] * new_coords[:, 1]
     area = np.abs(segment_reduce(np.add, cross, vertex_offsets, 0.0)) / 2
     one_ring = np.diff(shape_offsets) == 1

@@ -18,7 +18,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from grammarc.ragged import offsets_from_counts, ragged_take, segment_of
+from grammarc.ragged import next_in_segment, offsets_from_counts, ragged_take, segment_of
 
 #: How far (metres) an edge may lie from a street edge and still lie along it.
 ALONG = 0.01
@@ -51,8 +51,7 @@ def lot_streets(vertices: np.ndarray, ring_offsets: np.ndarray, lot_offsets: np.
     """The street edges and frames of lots given as ``model.lots.Lots`` arrays (exterior rings wind
     counter-clockwise seen from above, so an edge's outward normal is its direction turned clockwise)."""
     ring = segment_of(ring_offsets)
-    at = np.arange(len(vertices))
-    nxt = np.where(at + 1 < ring_offsets[1:][ring], at + 1, ring_offsets[:-1][ring])
+    nxt = next_in_segment(ring_offsets)
     edge = np.flatnonzero(street)
     lot = segment_of(lot_offsets)[ring[edge]]
     start, end = vertices[edge], vertices[nxt[edge]]

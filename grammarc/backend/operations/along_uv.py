@@ -40,11 +40,19 @@ from grammarc.backend.shapes import Shapes
 from grammarc.backend.texture_space import texture_maps
 from grammarc.constants import TOL
 from grammarc.geometry.components import reverse_rings
+from grammarc.geometry.meshes import ring_vector_areas
 from grammarc.geometry.queries import shape_faces
 from grammarc.geometry.triangulation import triangulate_polygons
 from grammarc.geometry.trim import trim_triangles
 from grammarc.ir import nodes as ir
-from grammarc.ragged import fan_out, offsets_from_counts, ragged_take, segment_of, segment_reduce
+from grammarc.ragged import (
+    fan_out,
+    next_in_segment,
+    offsets_from_counts,
+    ragged_take,
+    segment_of,
+    segment_reduce,
+)
 
 
 @operation(ir.InsertAlongUV, writes=("origin", "size", "geom"), meshes=True)
@@ -106,7 +114,7 @@ def _pieces(chunk, shapes: Shapes, axes: np.ndarray) -> tuple[np.ndarray, np.nda
     outline = face_offsets[:-1]
     at = np.arange(len(world))
     ring = segment_of(ring_offsets)
-    after = np.where(at + 1 < ring_offsets[1:][ring], at + 1, ring_offsets[:-1][ring])
+    after = next_in_segment(ring_offsets)
     before = np.where(at > ring_offsets[:-1][ring], at - 1, ring_offsets[1:][ring] - 1)
     normal = _ring_normals(world, ring_offsets)[ring]
     turn = np.einsum("vi,vi->v", np.cross(world - world[before], world[after] - world), normal)
@@ -122,12 +130,9 @@ def _pieces(chunk, shapes: Shapes, axes: np.ndarray) -> tuple[np.ndarray, np.nda
 
 
 def _ring_normals(world: np.ndarray, ring_offsets: np.ndarray) -> np.ndarray:
-    """(R, 3) unit Newell normals of rings (zero for a ring without area)."""
-    ring = segment_of(ring_offsets)
-    at = np.arange(len(world))
-    after = np.where(at + 1 < ring_offsets[1:][ring], at + 1, ring_offsets[:-1][ring])
-    local = world - world[ring_offsets[:-1][ring]]
-    normal = segment_reduce(np.add, np.cross(local, local[after]), ring_offsets, 0.0)
+    """(R, 3) unit Newell normals of rings (zero for a ring without area), each ring taken from its first
+    vertex (world coordinates lose their digits far from the origin)."""
+    normal = ring_vector_areas(world - world[ring_offsets[:-1][segment_of(ring_offsets)]], ring_offsets)
     length = np.linalg.norm(normal, axis=1, keepdims=True)
     return np.divide(normal, length, out=np.zeros_like(normal), where=length > 0)
 
@@ -195,8 +200,7 @@ def _edge_planes(world: np.ndarray, ring_offsets: np.ndarray, normal: np.ndarray
     a piece's edges."""
     ring = segment_of(ring_offsets)
     at = np.arange(len(world))
-    after = np.where(at + 1 < ring_offsets[1:][ring], at + 1, ring_offsets[:-1][ring])
-    edge = world[after] - world
+    edge = world[next_in_segment(ring_offsets)] - world
     m = np.cross(edge, lift[ring])
     m *= np.sign(np.einsum("vi,vi->v", m, np.cross(normal[ring], edge)))[:, None]  # towards the inside
     length = np.linalg.norm(m, axis=1)
