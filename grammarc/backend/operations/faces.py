@@ -46,7 +46,7 @@ from grammarc.geometry.ridges import ridge_roofs
 from grammarc.geometry.roofs import PYRAMID, roof_meshes
 from grammarc.geometry.setback import distances_to_area, polygon_edges, setback_regions
 from grammarc.ir import nodes as ir
-from grammarc.ragged import ragged_take, rank_within, segment_of
+from grammarc.ragged import next_in_segment, ragged_take, rank_within, segment_of
 
 
 @operation(ir.Roof, writes=("origin", "size", "geom"))
@@ -114,9 +114,7 @@ def envelope_edges(ctx: Context, cursor: Shapes, polygons, sides: list) -> tuple
     rows = np.arange(n)
     scale = np.stack([cursor.size[rows, PLANE_U[plane]], cursor.size[rows, PLANE_V[plane]]], axis=1)
     points = coords * scale[owner]
-    after = np.arange(len(coords)) + 1
-    ends = ring_offsets[vertex_ring + 1]
-    after[after == ends] = ring_offsets[vertex_ring[after == ends]]
+    after = next_in_segment(ring_offsets)
     step = points[after] - points
     cross = points[:, 0] * points[after, 1] - points[after, 0] * points[:, 1]
     exterior = vertex_ring == shape_offsets[:-1][owner]
@@ -263,8 +261,8 @@ def _roof_offsets(ctx: Context, roofs: Shapes, op: ir.Offset) -> tuple[Shapes, n
     d = np.broadcast_to(np.asarray(evaluate_array(op.distance, ctx.env(roofs)), float), (n,))
     parent, _, origin, axes, size, geom, _, _ = mesh_shapes.mesh_components(ctx.chunk, roofs, mesh_shapes.FACES)
     polygons = scope_polygons(ctx.chunk.polygons, geom, size)
-    inset = shapely.buffer(polygons, d[parent], join_style="mitre", mitre_limit=1e6)
-    chosen = {"inside": [inset], "border": [shapely.difference(polygons, inset)]}
+    inset, border = _inset_and_border(polygons, d[parent])
+    chosen = {"inside": [inset], "border": [border]}
     chosen["all"] = chosen["inside"] + chosen["border"]
     parts, which = shapely.get_parts(np.concatenate(chosen[op.select]), return_index=True)
     face = which % len(polygons)
@@ -513,8 +511,14 @@ def _offset_polygons(ctx: Context, distance: ir.Expr, cursor: Shapes, span):
     d = np.broadcast_to(evaluate_array(distance, ctx.env(cursor)), (len(cursor),))
     faces, owner = _faces_in_plane(cursor, ctx.chunk)
     polygons, plane = face_polygons(ctx, faces, "offset", span)
-    inset = shapely.buffer(polygons, d[owner], join_style="mitre", mitre_limit=1e6)
-    return inset, shapely.difference(polygons, inset), plane, polygons, faces, owner
+    return *_inset_and_border(polygons, d[owner]), plane, polygons, faces, owner
+
+
+def _inset_and_border(polygons: np.ndarray, distance: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """``offset``'s two regions of each face (k,) (shapely): its outline moved by ``distance`` (k,) (in
+    when negative) with sharp corners kept, and the ring between that and the face."""
+    inset = shapely.buffer(polygons, distance, join_style="mitre", mitre_limit=1e6)
+    return inset, shapely.difference(polygons, inset)
 
 
 def _offset_pieces(ctx: Context, distance: ir.Expr, cursor: Shapes, span):
