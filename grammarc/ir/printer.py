@@ -148,6 +148,11 @@ def _align_scope(op: ir.AlignScope) -> str:
     return "alignScopeToAxes()" if op.mode == "world" else f"alignScopeToAxes({op.mode})"
 
 
+def _asset(op: ir.UseAsset | ir.InsertAlongUV) -> str:
+    """An inserted asset as written: its computed name, or its path quoted."""
+    return print_expr(op.name) if op.name is not None else f'"{op.asset}"'
+
+
 def _scatter(op: ir.Scatter) -> str:
     spread = (f"gaussian, {op.mean}, {print_expr(op.stddev)}{'r' if op.relative else ''}" if op.gaussian
               else "uniform")
@@ -192,8 +197,7 @@ _OP_FORMATS = {
                             + f"{print_expr(op.height)})"),
     ir.Center: lambda op: f"center({''.join('xyz'[a] for a in op.axes)})",
     ir.UseAsset: lambda op: "i(" + ", ".join([
-        print_expr(op.name) if op.name is not None else f'"{op.asset}"',
-        *([op.up, op.mode] if (op.up, op.mode) != ("yUp", ir.INSERT_MODES[0]) else [])]) + ")",
+        _asset(op), *([op.up, op.mode] if (op.up, op.mode) != ("yUp", ir.INSERT_MODES[0]) else [])]) + ")",
     ir.SetAttr: lambda op: f"set({op.name}, {print_expr(op.value)})",
     ir.Report: lambda op: f"report({print_expr(op.key)}, {print_expr(op.value)})",
     ir.Mirror: lambda op: f"mirror({_list(op.axes)})",
@@ -215,7 +219,7 @@ _OP_FORMATS = {
     ir.ResetMaterial: lambda op: "resetMaterial()",
     ir.SetMaterial: lambda op: f"setMaterial({print_expr(op.material)})",
     ir.InsertAlongUV: lambda op: f"insertAlongUV({op.uv_set}, " + ", ".join([
-        print_expr(op.name) if op.name is not None else f'"{op.asset}"', print_expr(op.height),
+        _asset(op), print_expr(op.height),
         *([op.direction, op.alignment] if (op.direction, op.alignment) != (
             ir.ALONG_UV_DIRECTIONS[0], ir.ALONG_UV_ALIGNMENTS[0]) else [])]) + ")",
 }
