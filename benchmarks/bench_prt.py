@@ -10,31 +10,23 @@ beside the repository (the kit's README says how to make it).
 
 from __future__ import annotations
 
-import os
 import statistics
 import subprocess
 import time
-from pathlib import Path
 
 import pytest
-from conftest import HERE, grid_lots, run_build
+from conftest import grid_lots, run_build
 
-from grammarc.conform import kit_dir
+from grammarc.conform import kit_dir, prt_python
 from grammarc.io.npz import read_instances
 
 ROUNDS = 3
 
 
-def _prt_python() -> Path | None:
-    configured = os.environ.get("GRAMMARC_PRT_PYTHON")
-    python = Path(configured) if configured else HERE.parent / ".prt-venv" / "bin" / "python"
-    return python if python.is_file() else None
-
-
 @pytest.mark.parametrize("n_lots", [100, 500], ids=["100", "500"])
 @pytest.mark.parametrize("package", ["candler", "massing"])
 def test_against_prt(benchmark, lots_dir, tmp_path, package, n_lots):
-    kit, python = kit_dir(), _prt_python()
+    kit, python = kit_dir(), prt_python()
     if not kit.is_dir() or python is None:
         pytest.skip("needs the PRT kit (../shared/prt) and PyPRT's side environment (.prt-venv or "
                     "GRAMMARC_PRT_PYTHON)")

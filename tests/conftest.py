@@ -10,6 +10,7 @@ import os
 
 os.environ.setdefault("GRAMMARC_STRICT", "1")
 
+import importlib.util
 from pathlib import Path
 
 import numpy as np
@@ -18,6 +19,12 @@ import pytest
 from grammarc.io.lots import lots_from_polygons
 
 PRT_KIT = Path(__file__).resolve().parents[1].parent / "shared" / "prt"
+#: Tests of conformance with PRT: the kit's records, and PyPRT's side environment for the live harness.
+needs_kit = pytest.mark.skipif(not (PRT_KIT / "reference.json").is_file(),
+                               reason="PRT kit (../shared/prt) absent")
+needs_scipy = pytest.mark.skipif(importlib.util.find_spec("scipy") is None, reason="scipy not installed")
+needs_earcut = pytest.mark.skipif(importlib.util.find_spec("mapbox_earcut") is None,
+                                  reason="mapbox-earcut not installed")
 
 #: Footprints in map coordinates (x east, y north), exterior counter-clockwise, holes clockwise.
 LOT_ZOO = {

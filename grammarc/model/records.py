@@ -15,6 +15,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from grammarc.ir.nodes import MATERIAL_MAPS
+from grammarc.ragged import ragged_take
 
 __all__ = ["WHITE", "MaterialTable", "MeshChunk", "TerminalChunk"]
 
@@ -99,6 +100,20 @@ class MeshChunk:
     def texture(self) -> np.ndarray:
         """(V, 2) float32: the vertices' texture coordinates, NaN where none were given."""
         return self.uv if self.uv is not None else np.full((len(self.vertices), 2), np.nan, np.float32)
+
+    def take(self, faces: np.ndarray) -> MeshChunk:
+        """The faces numbered ``faces`` (F',) int, in that order, with their rings and vertices; the
+        material table stays whole."""
+        faces = np.asarray(faces, np.int64)
+        rings, face_offsets = ragged_take(self.face_offsets, faces)
+        vertices, ring_offsets = ragged_take(self.ring_offsets, rings)
+        return MeshChunk(
+            vertices=self.vertices[vertices], ring_offsets=ring_offsets, face_offsets=face_offsets,
+            lot=self.lot[faces], symbol=self.symbol[faces],
+            color=None if self.color is None else self.color[faces],
+            material=None if self.material is None else self.material[faces], materials=self.materials,
+            uv=None if self.uv is None else self.uv[vertices],
+        )
 
 
 def _joined_materials(chunks: Sequence, material: list, materials: list) -> dict:

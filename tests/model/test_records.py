@@ -36,6 +36,24 @@ def test_concat_shifts_offsets():
     assert empty.ring_offsets.tolist() == [0] and empty.face_offsets.tolist() == [0]
 
 
+def test_take_selects_faces_with_their_rings_and_vertices():
+    holed = MeshChunk(
+        vertices=np.arange(21, dtype=np.float32).reshape(7, 3) + 100,
+        ring_offsets=np.array([0, 4, 7], np.int64),
+        face_offsets=np.array([0, 2], np.int64),
+        lot=np.array([1], np.int32),
+        symbol=np.array([2], np.int32),
+    )
+    joined = MeshChunk.concat([triangle(), holed, triangle()])
+    taken = joined.take(np.array([1, 0]))
+    assert taken.face_offsets.tolist() == [0, 2, 3] and taken.ring_offsets.tolist() == [0, 4, 7, 10]
+    np.testing.assert_array_equal(taken.vertices[:7], holed.vertices)
+    assert taken.lot.tolist() == [1, 0] and taken.symbol.tolist() == [2, 0]
+    assert taken.colors().tolist() == [list(WHITE)] * 2
+    none = joined.take(np.zeros(0, np.int64))
+    assert none.face_offsets.tolist() == [0] and len(none.vertices) == 0
+
+
 def test_colours_default_to_white():
     plain = TerminalChunk(asset=np.zeros(3, np.int32), xform=np.zeros((3, 3, 4), np.float32),
                           lot=np.zeros(3, np.int32), symbol=np.zeros(3, np.int32), mesh=triangle())

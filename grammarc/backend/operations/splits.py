@@ -154,9 +154,16 @@ def snap(ctx: Context, cursor: Shapes, op: ir.Snap) -> None:
 
 
 def _split_sizes(ctx: Context, cursor: Shapes, op: ir.Split | ir.GroupSplit, what: str) -> np.ndarray:
-    """The parts' sizes, (n, P) or (1, P) when the same for all shapes; a negative or NaN one fails."""
+    """The parts' sizes, (n, P) or (1, P) when the same for all shapes; a NaN one fails.
+
+    CityEngine's ``split`` and ``splitArea`` take a negative size as 0, as PRT does (candler's
+    ``winSideW = (TileWidth - FrontWindowWidth) / 2`` goes below 0 for a window wider than its tile, and
+    PRT's model is then the one of a window as wide as the tile); the paper's ``Subdiv`` fails the shape.
+    """
     env = ctx.env(cursor)
     values = _size_matrix([evaluate(s.value, env) for s in op.sizes], len(cursor))
+    if isinstance(op, ir.GroupSplit):
+        values = np.where(values < 0, 0.0, values)
     ctx.fail_negative(cursor, values, f"`{what}` has a negative or NaN size", op.span)
     return values
 

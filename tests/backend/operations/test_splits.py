@@ -179,3 +179,14 @@ def test_split_area_of_a_roof_is_refused(write):
     records = run(write, "Lot --> roofHip(30) splitArea(x){ '0.5 : A }*\nA --> A.\n", [rect(12, 8)])
     (bad,) = records["bad"]
     assert bad.reason.startswith("`splitArea` of a roof is not supported yet")
+
+
+def test_a_negative_split_size_counts_as_zero_as_in_prt(write):
+    """PRT builds candler's tiles whose ``winSideW = (TileWidth - FrontWindowWidth) / 2`` is negative as if
+    it were 0 (the same model for a window as wide as the tile and wider); so does ``split`` here, where a
+    part of size 0 makes no shape."""
+    r = run(write, "Lot --> extrude(3) split(x){ (-0.5) : A | ~1 : B | -1 : C }\n", [rect(4, 10)])
+    assert not r["bad"] and names(r) == ["B"]
+    np.testing.assert_allclose(r["xform"][:, 0, 0], [4], atol=1e-6)
+    zero = run(write, "Lot --> extrude(3) split(x){ 0 : A | ~1 : B | 0 : C }\n", [rect(4, 10)])
+    same_records(r, zero)

@@ -1,10 +1,4 @@
-"""Conformance with Esri's Procedural Runtime (PRT): grammarc's geometry measured against PRT's records.
-
-The PRT conformance kit (``../shared/prt`` from the repository root, see its README) holds rule packages,
-footprints and ``reference.json``: one record per (rule package, footprint, attributes, seed) as PRT made
-it, with the fields described in the file's ``meta.fields``. A record is found by those four keys
-(``rpk`` and ``footprint`` are names without folder or extension, ``attrs`` the attributes that were set,
-``seed`` the shape's seed, 0 in every record).
+"""grammarc's geometry measured as PRT's records are, and the two compared.
 
 The checks follow the kit's README, in its order:
 
@@ -12,11 +6,12 @@ The checks follow the kit's README, in its order:
 2. surface area (``surface_area``, the sum of PRT's triangle areas, holes handled), to a relative 1e-4;
 3. face counts (``n_faces``, polygons as PRT's encoder returns them, a hole ring counting as a face;
    ``n_triangles``), reported, and checked only when asked: grammarc's assets and splits need not
-   cut faces as PRT does.
+   cut faces as PRT does;
+4. reports, key by key (``compare_reports``).
 
 ``measure`` takes a baked mesh (``grammarc.io.bake.bake``), whose ``metadata`` carries the polygon
-counts; ``surface_distance`` compares two meshes point by point, for when a PRT OBJ export
-(``prt_reference.py --obj``) is at hand.
+counts; ``surface_distance`` compares two meshes point by point (a PRT export, or the triangles the
+differential harness gets from PRT).
 
 Example, from the repository root::
 
@@ -28,29 +23,16 @@ Example, from the repository root::
 
 from __future__ import annotations
 
-import json
 import math
 import os
 from collections.abc import Mapping
 from dataclasses import dataclass
-from pathlib import Path, PurePath
 
 import numpy as np
 
 from grammarc.errors import UsageError
 
-__all__ = [
-    "Conformance",
-    "Verdict",
-    "compare",
-    "find_record",
-    "footprint_geojson",
-    "kit_dir",
-    "load_reference",
-    "measure",
-    "run_conformance",
-    "surface_distance",
-]
+__all__ = ["Verdict", "compare", "compare_reports", "measure", "surface_distance"]
 
 #: The README's tolerances: coordinates to 0.1 mm, areas to a relative 1e-4.
 BBOX_TOL = 1e-4
@@ -59,104 +41,8 @@ AREA_REL_TOL = 1e-4
 #: diagonal of a large quad sometimes had only sites of the quad's other triangle (a 1e-5 m mean error
 #: on a 10 m cube); 16 was exact there.
 _CANDIDATES = 16
-
-
-def kit_dir() -> Path:
-    """The PRT conformance kit: ``$GRAMMARC_PRT_KIT``, else ``shared/prt`` beside the repository.
-
-    The folder need not exist; callers check (tests skip when it is absent).
-    """
-    override = os.environ.get("GRAMMARC_PRT_KIT")
-    if override:
-        return Path(override)
-    return Path(__file__).resolve().parents[1].parent / "shared" / "prt"
-
-
-def load_reference(path: str | os.PathLike | None = None) -> dict:
-    """Load PRT's reference records.
-
-    Parameters
-    ----------
-    path : path-like, optional
-        ``reference.json``, or the kit folder holding it; ``kit_dir()`` by default.
-
-    Returns
-    -------
-    dict
-        ``{"meta": ..., "rpks": {name: ...}, "records": [record, ...]}`` as stored.
-
-    Raises
-    ------
-    UsageError
-        If the file does not exist.
-    """
-    path = Path(path) if path is not None else kit_dir()
-    if path.is_dir():
-        path = path / "reference.json"
-    if not path.is_file():
-        raise UsageError(f"PRT reference records `{path}` not found (the PRT kit is ../shared/prt from "
-                         "the repository root; set GRAMMARC_PRT_KIT to use another)")
-    with open(path, encoding="utf-8") as file:
-        return json.load(file)
-
-
-def find_record(
-    reference: Mapping,
-    rpk_name: str,
-    footprint_name: str,
-    attrs: Mapping | None = None,
-    *,
-    seed: int = 0,
-) -> dict | None:
-    """The reference record of a rule package on a footprint with attributes, or None.
-
-    Parameters
-    ----------
-    reference : mapping
-        As returned by ``load_reference``.
-    rpk_name : str
-        ``"candler"``; a file name or path (``"rpk/candler.rpk"``) is reduced to its stem.
-    footprint_name : str
-        ``"rect_30x20"``; likewise reduced to its stem.
-    attrs : mapping, optional
-        The attributes set. Numbers compare as floats (``40`` matches ``40.0``). A record with exactly
-        these attributes is preferred; else a record whose attributes, with the defaults PRT used
-        (``attributes_used``), give the same values (``{"BuildingHeight": 62.0}`` finds candler's
-        default record, whose ``BuildingHeight`` is 62).
-    seed : int
-        The shape's seed; 0 in every record of the kit.
-
-    Examples
-    --------
-    >>> reference = load_reference()                                              # doctest: +SKIP
-    >>> find_record(reference, "extrude_color", "rect_30x20")["surface_area"]     # doctest: +SKIP
-    1700.0
-    """
-    rpk = PurePath(rpk_name).stem if rpk_name.endswith(".rpk") else PurePath(rpk_name).name
-    footprint = PurePath(footprint_name).name
-    if PurePath(footprint).suffix in (".obj", ".json", ".geojson"):
-        footprint = PurePath(footprint).stem
-    wanted = _values(attrs or {})
-    candidates = [
-        r for r in reference.get("records", ())
-        if r.get("rpk") == rpk and r.get("footprint") == footprint and r.get("seed", 0) == seed
-    ]  # fmt: skip
-    for record in candidates:
-        if _values(record.get("attrs", {})) == wanted:
-            return record
-    for record in sorted(candidates, key=lambda r: len(r.get("attrs", {}))):
-        used = _values(record.get("attributes_used", {}))
-        if {**used, **_values(record.get("attrs", {}))} == {**used, **wanted}:
-            return record
-    return None
-
-
-def _values(attrs: Mapping) -> dict:
-    """Attributes with numbers as floats (bools kept), so that 40 and 40.0 compare equal."""
-    return {
-        str(k): float(v) if isinstance(v, (int, float)) and not isinstance(v, bool) else v
-        for k, v in attrs.items()
-    }
+#: Record fields of a report that are compared: numbers to a relative 1e-9, the rest exactly.
+_REPORT_REL_TOL = 1e-9
 
 
 def measure(mesh, polygons: int | None = None) -> dict:
@@ -397,78 +283,6 @@ def _as_mesh(mesh):
     return mesh
 
 
-def footprint_geojson(name: str, kit: str | os.PathLike | None = None) -> dict:
-    """A kit footprint as a GeoJSON FeatureCollection of one feature, from ``footprints/all.geojson``.
-
-    Write it to a file to build with ``--lots``: grammarc maps it to PRT's world as the kit does
-    (world x = x, world z = -y). ``name`` is a ``properties.name``, e.g. ``"courtyard_40x40"``.
-
-    Raises
-    ------
-    UsageError
-        If the kit or the footprint is missing.
-    """
-    path = Path(kit) if kit is not None else kit_dir()
-    path = path / "footprints" / "all.geojson"
-    if not path.is_file():
-        raise UsageError(f"PRT kit footprints `{path}` not found")
-    with open(path, encoding="utf-8") as file:
-        collection = json.load(file)
-    features = [f for f in collection["features"] if f.get("properties", {}).get("name") == name]
-    if not features:
-        names = ", ".join(f.get("properties", {}).get("name", "?") for f in collection["features"])
-        raise UsageError(f"no footprint `{name}` in {path} (footprints: {names})")
-    return {"type": "FeatureCollection", "features": features}
-
-
-# ------------------------------------------------------------------------------------------ the runner
-
-#: The issue's targets: rule packages with simple geometry must match to the README's tolerances; the
-#: large facade packages to 2 cm and 1 % of the area.
-TOLERANCES = {"candler": (0.02, 0.01), "complexpatterns": (0.02, 0.01)}
-#: Record fields of a report that are compared: numbers to a relative 1e-9, the rest exactly.
-_REPORT_REL_TOL = 1e-9
-
-
-@dataclass(frozen=True)
-class Conformance:
-    """grammarc against PRT on one (rule package, footprint, attributes): geometry and reports."""
-
-    rpk: str
-    footprint: str
-    attrs: dict
-    verdict: Verdict | None
-    reports_ok: bool | None
-    report_differences: tuple[str, ...]
-    error: str = ""
-
-    @property
-    def passed(self) -> bool:
-        return self.verdict is not None and self.verdict.passed and self.reports_ok is not False
-
-    @property
-    def summary(self) -> str:
-        if self.error:
-            return f"ERROR {self.error}"
-        text = self.verdict.summary if self.verdict is not None else "no reference record"
-        if self.reports_ok is not None:
-            text += ", reports " + ("equal" if self.reports_ok else
-                                    "differ: " + "; ".join(self.report_differences[:3]))
-        return text
-
-
-def footprint_path(name: str, kit: Path | None = None) -> Path:
-    """A kit footprint by name (``rect_30x20``; the courtyard is its PRT JSON), or a path as given."""
-    path = Path(name)
-    if path.suffix:
-        return path
-    folder = (kit or kit_dir()) / "footprints"
-    for suffix in (".obj", ".json"):
-        candidate = folder / f"{name}{suffix}"
-        if candidate.is_file():
-            return candidate
-    raise UsageError(f"no footprint `{name}` in {folder}")
-
 
 def compare_reports(ours: Mapping, theirs: Mapping) -> tuple[bool, tuple[str, ...]]:
     """PRT's flat report (``key_n``, ``key_sum``...) against grammarc's totals for the same model."""
@@ -484,41 +298,3 @@ def compare_reports(ours: Mapping, theirs: Mapping) -> tuple[bool, tuple[str, ..
             differences.append(f"{key}: {a} vs {b}")
     return not differences, tuple(differences)
 
-
-def run_conformance(rpk: str | os.PathLike, footprint: str, attrs: Mapping | None = None, *,
-                    seed: int = 0, reference: Mapping | None = None) -> Conformance:
-    """Derive ``rpk`` on a kit footprint with grammarc, bake it, and compare with PRT's record."""
-    from grammarc.build import BuildOptions, derive, grammar_source
-    from grammarc.compiler import compile_grammar
-    from grammarc.errors import GrammarcError
-    from grammarc.io.bake import bake
-    from grammarc.io.lots import read_lots
-
-    rpk = Path(rpk)
-    attrs = dict(attrs or {})
-    reference = reference if reference is not None else load_reference()
-    expected = find_record(reference, rpk.stem, footprint, attrs, seed=seed)
-    options = BuildOptions(seed=seed, attrs={k: float(v) if isinstance(v, int) else v
-                                             for k, v in attrs.items()})
-    try:
-        with grammar_source(rpk, options) as (source, display, resolved):
-            grammar = compile_grammar(source, start=resolved.start, asset_roots=resolved.asset_roots,
-                                      display=display)
-            record = derive(grammar, read_lots(footprint_path(footprint)), resolved)
-            mesh = bake(record, resolved.asset_roots)
-    except GrammarcError as error:
-        diagnostics = [d for d in getattr(error, "diagnostics", ()) if d.is_error]
-        first = f"{diagnostics[0].span}: {diagnostics[0].message}" if diagnostics else str(error)
-        return Conformance(rpk.stem, footprint, attrs, None, None, (), error=first.splitlines()[0])
-    if record["bad"]:
-        return Conformance(rpk.stem, footprint, attrs, None, None, (),
-                           error=f"lot skipped: {record['bad'][0].reason}")
-    if expected is None:
-        return Conformance(rpk.stem, footprint, attrs, None, None, ())
-    bbox_tol, area_tol = TOLERANCES.get(rpk.stem, (BBOX_TOL, AREA_REL_TOL))
-    verdict = compare(measure(mesh), expected, bbox_tol=bbox_tol, area_rel_tol=area_tol)
-    reports_ok, differences = None, ()
-    if expected.get("report") or record["reports"]:
-        ours = record["reports"].table(record["reports"].totals())
-        reports_ok, differences = compare_reports(ours, expected.get("report") or {})
-    return Conformance(rpk.stem, footprint, attrs, verdict, reports_ok, differences)

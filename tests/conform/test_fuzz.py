@@ -1,0 +1,109 @@
+"""The differential harness: lot records, judging a batch against PRT's figures, the table, and (with
+PyPRT's side environment) a live run."""
+
+import json
+from dataclasses import replace
+
+import numpy as np
+import pytest
+from conftest import PRT_KIT as KIT
+from conftest import needs_kit
+
+from grammarc.build import derive
+from grammarc.conform import measure, prt_python
+from grammarc.conform.cases import make_case, write_lots
+from grammarc.conform.fuzz import (
+    fuzz,
+    judge_batch,
+    lot_record,
+    open_packages,
+    read_results,
+    same_lot_records,
+    table,
+)
+from grammarc.io.bake import bake
+from grammarc.io.lots import read_lots
+
+needs_prt = pytest.mark.skipif(prt_python() is None or not KIT.is_dir(),
+                               reason="PyPRT's side environment (.prt-venv or GRAMMARC_PRT_PYTHON) absent")
+
+
+@pytest.fixture(scope="module")
+def massing():
+    with open_packages(["massing"], KIT) as packages:
+        yield packages["massing"]
+
+
+def _batch(package, tmp_path, kinds=("convex", "courtyard", "L")):
+    cases = [make_case(package.name, package.grammar.module, kind, seed) for seed, kind in enumerate(kinds)]
+    lots = tmp_path / "lots.geojson"
+    write_lots(lots, cases, 2000)
+    return cases, lots
+
+
+def _as_prt(package, lots):
+    """PRT's figures as grammarc itself measures its lots: what a perfect match looks like."""
+    record = derive(package.grammar, read_lots(lots), package.options)
+    out = {}
+    for lot, feature in enumerate(json.loads(lots.read_text())["features"]):
+        mesh = bake(lot_record(record, lot), package.options.asset_roots)
+        figures = measure(mesh)
+        figures["triangles"] = np.asarray(mesh.triangles)
+        figures["report"] = record["reports"].table(record["reports"].lots.get(lot, {}))
+        out[feature["properties"]["name"]] = figures
+    return out
+
+
+@needs_kit
+def test_lot_records_split_a_record_by_lot_and_do_not_depend_on_chunking(massing, tmp_path):
+    _, lots = _batch(massing, tmp_path)
+    whole = derive(massing.grammar, read_lots(lots), massing.options)
+    single = derive(massing.grammar, read_lots(lots), replace(massing.options, chunk_size=1))
+    parts = [lot_record(whole, lot) for lot in range(3)]
+    assert sum(len(p["asset"]) for p in parts) == len(whole["asset"])
+    assert sum(len(p["mesh"].lot) for p in parts) == len(whole["mesh"].lot)
+    assert all((p["lot"] == lot).all() and (p["mesh"].lot == lot).all() for lot, p in enumerate(parts))
+    assert all(same_lot_records(p, lot_record(single, lot)) for lot, p in enumerate(parts))
+    assert not same_lot_records(parts[0], parts[1])
+
+
+@needs_kit
+def test_judging_a_batch_names_each_failed_check(massing, tmp_path):
+    cases, lots = _batch(massing, tmp_path)
+    prt = _as_prt(massing, lots)
+    results = judge_batch(massing, cases, lots, prt)
+    assert [r["failed"] for r in results] == [[], [], []]
+    assert all(r["distance"] < 1e-3 and r["area_rel"] < 1e-9 for r in results)
+
+    names = [c.name for c in cases]
+    prt[names[0]] = dict(prt[names[0]], surface_area=prt[names[0]]["surface_area"] * 1.02)
+    prt[names[1]] = dict(prt[names[1]], bbox_max=[x + 0.05 for x in prt[names[1]]["bbox_max"]],
+                         report={"extra_n": 1.0})
+    prt[names[2]] = {"error": "PRT generated no model"}
+    first, second, third = judge_batch(massing, cases, lots, prt)
+    assert first["failed"] == ["area"] and "area" in first["detail"]
+    assert second["failed"] == ["bbox", "reports"] and "extra_n" in second["detail"]
+    assert third["failed"] == [] and third["prt_error"] == "PRT generated no model"
+
+
+def test_table_counts_matches_and_failures_per_package_and_class():
+    results = [
+        {"package": "massing", "kind": "L", "failed": [], "distance": 0.001},
+        {"package": "massing", "kind": "L", "failed": ["area"], "distance": 0.5},
+        {"package": "massing", "kind": "convex", "failed": ["skipped"]},
+        {"package": "candler", "kind": "L", "failed": ["bbox", "chunking"], "distance": 0.1},
+    ]
+    lines = table(results).splitlines()
+    assert lines[0].startswith("| package | footprints | cases | match | skipped | bbox | area | reports | chunking")
+    assert lines[2] == "| candler | L | 1 | 0.0 % |  | 1 |  |  | 1 | 0.1 |"
+    assert lines[3] == "| massing | convex | 1 | 0.0 % | 1 |  |  |  |  | - |"  # classes in their order
+    assert lines[4] == "| massing | L | 2 | 50.0 % |  |  | 1 |  |  | 0.251 |"
+    assert "| **massing** | all | 3 | 33.3 % |" in lines[-1]
+
+
+@needs_prt
+def test_a_live_run_against_prt(tmp_path):
+    results = fuzz(4, tmp_path, packages=["extrude_color"], kinds=["convex", "courtyard"], batch=2,
+                   progress=lambda line: None)
+    assert len(results) == 4 and all(not r["failed"] for r in results), results
+    assert [r["name"] for r in read_results(tmp_path)] == [r["name"] for r in results]
