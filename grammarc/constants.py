@@ -16,8 +16,8 @@ class Tol:
     #: Footprints come in metres; 1e-9 m is far below any modelled feature and above float64 noise
     #: of coordinates up to ~1e6 m.
     zero: float = 1e-9
-    #: Lot rings: consecutive vertices closer than this are merged (duplicate points in GIS data).
-    merge: float = 1e-7
+    #: Lot rings: edges shorter than this collapse (near-duplicate points in GIS data), PRT's limit.
+    merge: float = 8e-4
     #: Lots with a smaller area (m^2) are reported as bad lots: they cannot carry a building.
     area_floor: float = 1e-6
     #: A footprint is its own scope rectangle when its area differs from sx*sz by less than this

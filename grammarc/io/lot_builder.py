@@ -15,8 +15,8 @@ Conventions, those of CityEngine and Esri PRT:
 - The exterior ring of a lot has a +Y Newell normal (counter-clockwise on the map, as RFC 7946 wants),
   holes a -Y normal. A ring wound the other way is reversed keeping its first vertex first
   (v0, v_{n-1}, ..., v1): the first edge v0 -> v1 is the lot's scope x axis downstream.
-- Rings are open (the first vertex is not repeated); consecutive vertices closer than ``TOL.merge`` are
-  merged, and lots with less area than ``TOL.area_floor`` are bad.
+- Rings are open (the first vertex is not repeated); edges shorter than ``TOL.merge`` (0.8 mm) collapse
+  as in PRT (``geometry.short_edges``), and lots with less area than ``TOL.area_floor`` are bad.
 """
 
 from __future__ import annotations
@@ -31,6 +31,7 @@ import shapely
 
 from grammarc.constants import TOL
 from grammarc.errors import LotsError
+from grammarc.geometry.short_edges import collapse_short_edges
 from grammarc.model.lots import BadLot, Lots
 from grammarc.ragged import offsets_from_counts, segment_reduce
 
@@ -122,8 +123,8 @@ class LotBuilder:
             # world (x, 0, -y); 0.0 - y keeps z = +0.0 where y = 0
             x, y = vertices.T
             vertices = np.column_stack([x, np.zeros_like(x), np.subtract(0.0, y)])
-        keep, owner, ring_offsets = _clean(vertices, offsets_from_counts(counts))
-        vertices = vertices[keep]
+        order, owner, ring_offsets = _clean(vertices, offsets_from_counts(counts))
+        vertices = vertices[order]
         street = np.zeros(len(vertices), dtype=bool)
         np.logical_or.at(street, owner, np.concatenate([np.zeros(0, dtype=bool), *self.street]))
         lot_offsets = offsets_from_counts(np.array(self.ring_counts, dtype=np.int64))
@@ -275,28 +276,11 @@ def _successor(start: np.ndarray, count: np.ndarray) -> np.ndarray:
 
 
 def _clean(vertices: np.ndarray, ring_offsets: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Merge consecutive vertices closer than ``TOL.merge``, keeping the first of each run: which
-    vertices stay (V,) bool, the kept vertex each one merges into (V,) int64 (numbered among the kept),
-    and the kept rings' offsets.
-
-    A run may wrap around the ring's end (a closing vertex equal to the first, or a duplicated last
-    vertex): it belongs to the first vertex, which always stays first.
-    """
-    ring, start, count = _ring_positions(ring_offsets)
-    at = np.arange(len(vertices))
-    close_next = np.linalg.norm(vertices[_successor(start, count)] - vertices, axis=1) < TOL.merge
-    close_prev = np.zeros(len(vertices), dtype=bool)
-    close_prev[1:] = close_next[:-1]
-    first = at == start
-    # the last vertex of each ring that is not close to its successor: vertices after it chain into v0
-    last_far = np.full(len(ring_offsets) - 1, -1, dtype=np.int64)
-    np.maximum.at(last_far, ring, np.where(close_next, -1, at))
-    keep = first | (~close_prev & (at <= last_far[ring]))
-    kept = segment_reduce(np.add, keep.astype(np.int64), ring_offsets, 0)
-    owner = np.cumsum(keep) - 1
-    wraps = at > last_far[ring]
-    owner[wraps] = owner[start[wraps]]
-    return keep, owner, offsets_from_counts(kept)
+    """Collapse the rings' edges shorter than ``TOL.merge`` as PRT does (``geometry.short_edges``): the
+    staying vertices in order (K,) int64, the position among them of the vertex whose edge absorbs each
+    vertex's edge (V,) int64, and the rings' new offsets."""
+    order, counts, owner = collapse_short_edges(vertices, ring_offsets, TOL.merge)
+    return order, owner, offsets_from_counts(counts)
 
 
 def _newell(vertices: np.ndarray, ring_offsets: np.ndarray) -> np.ndarray:

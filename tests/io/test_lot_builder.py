@@ -133,7 +133,7 @@ def test_bad_lots_are_reported_and_the_others_keep_their_numbers(tmp_path):
 
 
 def test_tiny_triangle_is_zero_area_and_hole_outside_shell_is_invalid(tmp_path):
-    tiny = [[0, 0], [1e-4, 0], [0, 1e-4]]
+    tiny = [[0, 0], [1.2e-3, 0], [0, 1.2e-3]]  # edges over 0.8 mm (they stay), 0.72 mm^2
     outside = [SQUARE, [[20, 20], [20, 21], [21, 21], [21, 20]]]
     lots = read_lots(write_geojson(tmp_path, [feature([tiny]), feature(outside), feature([SQUARE])]))
     assert lots.index.tolist() == [2]
@@ -167,10 +167,42 @@ def test_duplicate_and_closing_vertices_are_removed(tmp_path):
     np.testing.assert_array_equal(lots.vertices, [[0, 0, 0], [10, 0, 0], [10, 0, -10], [0, 0, -10]])
 
 
-def test_run_of_near_duplicates_wrapping_around_the_end_belongs_to_the_first_vertex():
+def test_a_run_of_near_duplicates_around_the_end_collapses_into_the_first_edge_as_in_prt():
+    """PRT (genattrs, whose second box goes 50 m along the first edge) keeps this lot's first edge along
+    +x: the run (5e-8, 0), (0, 5e-8), (0, 0) and the first vertex collapse into one vertex that starts
+    the ring."""
     ring = np.array([[0, 0], [10, 0], [10, 10], [0, 10], [5e-8, 0], [0, 5e-8], [0, 0]])
     lots = lots_from_polygons([[ring]])
-    np.testing.assert_array_equal(lots.vertices[:, [0, 2]], [[0, 0], [10, 0], [10, -10], [0, -10]])
+    np.testing.assert_allclose(lots.vertices[:, [0, 2]], [[0, 0], [10, 0], [10, -10], [0, -10]], atol=1e-7)
+
+
+def test_short_edges_collapse_as_in_prt():
+    """Edges under 0.8 mm lose the end whose removal changes the ring less, as PRT does (measured with
+    extrude_color: face counts and bounding boxes), and the lot starts where its first vertex went."""
+    def collapsed(ring):
+        return lots_from_polygons([[np.array(ring)]]).vertices[:, [0, 2]]
+
+    # a collinear vertex on an edge of 0.7999 mm goes, one of 0.8 mm stays
+    assert len(collapsed([[0, 0], [7.999e-4, 0], [10, 0], [10, 10], [0, 10]])) == 4
+    assert len(collapsed([[0, 0], [8e-4, 0], [10, 0], [10, 10], [0, 10]])) == 5
+    # the first vertex lies on the line of its neighbours: it goes, its successor starts the ring
+    np.testing.assert_allclose(collapsed([[0, 0], [0, -5e-4], [10, 0], [10, 10], [0, 10]])[0], [0, 5e-4])
+    # the last vertex sticks out: it stays and starts the ring
+    np.testing.assert_allclose(collapsed([[0, 0], [10, 0], [10, 10], [0, 10], [-5e-4, 0]])[0], [-5e-4, 0])
+    # a spike of 0.5 mm goes, whichever side of the corner it is
+    assert collapsed([[0, 0], [10, 0], [10, 10], [10 + 5e-4, 10 + 1e-4], [0, 10]]).max() == 10
+    np.testing.assert_allclose(collapsed([[0, 0], [10, 0], [10 + 5e-4, 10 + 1e-4], [10, 10], [0, 10]]),
+                               [[0, 0], [10, 0], [10 + 5e-4, -10 - 1e-4], [0, -10]])
+    # three on a line 0.5 mm apart: the middle one goes, the far one stays (1 mm from the first)
+    assert collapsed([[0, 0], [0, -5e-4], [0, -1e-3], [10, 0], [10, 10], [0, 10]]).tolist()[:2] == [
+        [0, 0], [0, 1e-3]]
+
+
+def test_an_arc_of_short_edges_loses_every_other_vertex():
+    angle = np.linspace(0, 2 * np.pi, 100_000, endpoint=False)
+    circle = np.column_stack([10 * np.cos(angle), 10 * np.sin(angle)])  # edges of 0.63 mm
+    lots = lots_from_polygons([[circle]])
+    assert not lots.bad and len(lots.vertices) == 50_000
 
 
 def test_fewer_than_three_distinct_vertices_is_bad():
