@@ -247,7 +247,7 @@ def roof_edge_kinds(verts, ring_offsets, face_offsets, mesh_offsets, edge_face, 
     between_slopes = two & sloped[a] & sloped[b]
     # convex: each face's centroid behind the other's plane (the edge's start lies on both planes)
     behind = np.einsum("ij,ij->i", face_normal[a], centroid[b] - start)
-    scale = max(float(np.abs(verts).max(initial=0.0)), 1.0)
+    scale = mesh_magnitudes(verts, ring_offsets, face_offsets, mesh_offsets)[edge_mesh]
     convex, concave = behind < -eps * scale, behind > eps * scale
     roof = np.full(n_edges, -1, dtype=np.int8)
     roof[horizontal & low & along_slope] = 0
@@ -325,8 +325,19 @@ def _ring_walk(verts, ring_offsets, face_offsets, mesh_offsets):
 def is_convex(verts, ring_offsets, face_offsets, mesh_offsets) -> np.ndarray:
     """Whether each mesh (gathered, in its scope's units: ``face_vertices``) is convex: all its vertices
     lie behind the plane of every one of its faces."""
-    scale = max(float(np.abs(verts).max(initial=0.0)), 1.0)
-    return _convex(verts, ring_offsets, face_offsets, mesh_offsets, scale)
+    return _convex(verts, ring_offsets, face_offsets, mesh_offsets,
+                   mesh_magnitudes(verts, ring_offsets, face_offsets, mesh_offsets))
+
+
+def mesh_magnitudes(verts, ring_offsets, face_offsets, mesh_offsets) -> np.ndarray:
+    """(M,) the largest coordinate (absolute) of each mesh, 1 at least: the scale of its tolerances.
+
+    Per mesh, never over the batch: a batch holds the meshes of several lots, and a large or far one
+    must not coarsen the tolerances of the others (their records would depend on the chunking)."""
+    vertex_mesh = segment_of(mesh_offsets)[segment_of(face_offsets)[segment_of(ring_offsets)]]
+    out = np.ones(len(mesh_offsets) - 1)
+    np.maximum.at(out, vertex_mesh, np.abs(verts).max(axis=1, initial=0.0))
+    return out
 
 
 @njit(cache=True, nogil=True)
@@ -347,7 +358,7 @@ def _convex(verts, ring_offsets, face_offsets, mesh_offsets, scale):
                 continue
             normal /= length
             for v in range(v0, v1):
-                if ((verts[v] - verts[o0]) * normal).sum() > 1e-9 * scale:
+                if ((verts[v] - verts[o0]) * normal).sum() > 1e-9 * scale[g]:
                     out[g] = False
                     break
             if not out[g]:

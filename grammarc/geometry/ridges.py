@@ -40,7 +40,12 @@ def ridge_roofs(polygons, plane, direction, value, by_height, overhang_x, overha
     valid = shapely.is_valid(polygons) & ~shapely.is_empty(polygons)
     polygons = np.where(valid, polygons, shapely.Polygon([(0, 0), (1, 0), (0, 1)]))
     pts, vertex_poly = shapely.get_coordinates(polygons, return_index=True)
-    size = np.ptp(pts, axis=0).max() if len(pts) else 1.0
+    # each polygon's own extent: a chunk-wide one would cut a small roof with other half-planes when a
+    # large lot shares its chunk, and its vertices would differ in the last bits with the chunking
+    low_pt, high_pt = np.full((k, 2), np.inf), np.full((k, 2), -np.inf)
+    np.minimum.at(low_pt, vertex_poly, pts)
+    np.maximum.at(high_pt, vertex_poly, pts)
+    size = (high_pt - low_pt).max(axis=1) if k else np.zeros(0)
     d = direction / np.maximum(np.linalg.norm(direction, axis=1, keepdims=True), 1e-300)
     n = np.stack([-d[:, 1], d[:, 0]], axis=1)
     across = np.einsum("vi,vi->v", pts, n[vertex_poly])

@@ -45,7 +45,11 @@ def side_face_planes(axes: np.ndarray, origin: np.ndarray, size: np.ndarray, par
     steep = (np.abs(np.einsum("ij,ij->i", y, up)) >= np.sin(np.radians(VERTICAL_DEGREES))) & (size[:, 0] > 0) & (size[:, 1] > 0)
     start = origin
     end = origin + size[:, 0:1] * x
-    scale = max(float(np.abs(origin).max()), 1.0) * 1e-7
+    # corners are matched to 1e-7 of their parent's coordinates: per parent, so that a lot far from the
+    # origin (national-grid coordinates) coarsens no other lot's matching in its chunk
+    magnitude = np.ones(int(parent.max()) + 1)
+    np.maximum.at(magnitude, parent, np.abs(origin).max(axis=1))
+    scale = (magnitude * 1e-7)[parent][:, None]
     keys = np.concatenate([np.column_stack([parent, np.round(start / scale)]),
                            np.column_stack([parent, np.round(end / scale)])]).astype(np.int64)
     inverse, _ = row_groups(keys)  # the same corner of the same parent: one id
@@ -98,7 +102,10 @@ def shallow_edge_planes(verts: np.ndarray, ring_offsets: np.ndarray, face_offset
     edge = q - p
     length = np.linalg.norm(edge, axis=1)
     direction = edge / np.maximum(length, 1e-300)[:, None]
-    scale = max(float(np.abs(verts).max(initial=0.0)), 1.0) * 1e-7
+    # corners matched to 1e-7 of their parent's coordinates, per parent as in ``side_face_planes``
+    magnitude = np.ones(int(parent.max()) + 1)
+    np.maximum.at(magnitude, parent[face], np.abs(p).max(axis=1))
+    scale = (magnitude * 1e-7)[parent[face]][:, None]
     ends = [np.round(x / scale).astype(np.int64) for x in (p, q)]
     keys = np.concatenate([np.column_stack([parent[face], ends[0], ends[1]]),
                            np.column_stack([parent[face], ends[1], ends[0]])])
@@ -108,7 +115,7 @@ def shallow_edge_planes(verts: np.ndarray, ring_offsets: np.ndarray, face_offset
     forward[group[:n_edges]] = np.arange(n_edges)
     neighbour = forward[group[n_edges:]]  # the edge running the other way along the same two corners
     shallow = np.abs(np.einsum("ij,ij->i", direction, up[face])) < np.sin(np.radians(VERTICAL_DEGREES))
-    ok = (neighbour >= 0) & shallow & (length > scale)
+    ok = (neighbour >= 0) & shallow & (length > scale[:, 0])
     ok[ok] &= face[neighbour[ok]] != face[ok]
     rows = np.flatnonzero(ok)
     # into each face across the edge: its normal cross the edge (outlines wind counter-clockwise)
