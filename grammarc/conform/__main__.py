@@ -2,6 +2,7 @@
 
     python -m grammarc.conform --fuzz N [--packages candler,massing] [--classes L,concave] [--seed S]
                                [--out DIR] [--batch B]
+    python -m grammarc.conform --fuzz N --footprints LOTS.geojson ...   # real lots (metres) instead
     python -m grammarc.conform --table DIR          # the table of every run into DIR
     python -m grammarc.conform --case FILE          # a saved mismatch, run again on both engines
 
@@ -31,6 +32,8 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--seed", type=int, default=0, help="seed of the first case (cases use seed, seed+1...)")
     parser.add_argument("--out", type=Path, default=Path("conform-out"), help="results and mismatch cases")
     parser.add_argument("--batch", type=int, default=64, help="lots per PRT call and grammarc derivation")
+    parser.add_argument("--footprints", type=Path, metavar="LOTS",
+                        help="take the lots of this GeoJSON file (metres) instead of generated footprints")
     args = parser.parse_args(argv)
     try:
         if args.table:
@@ -42,7 +45,7 @@ def main(argv: list[str] | None = None) -> int:
             return 1 if result["failed"] else 0
         results = fuzz(args.fuzz, args.out, packages=[p for p in args.packages.split(",") if p],
                        kinds=[k for k in args.classes.split(",") if k], seed=args.seed, batch=args.batch,
-                       progress=lambda line: print(line, file=sys.stderr, flush=True))
+                       footprints=args.footprints, progress=lambda line: print(line, file=sys.stderr, flush=True))
     except UsageError as error:
         print(f"grammarc conform: {error}", file=sys.stderr)
         return 2

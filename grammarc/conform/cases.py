@@ -20,6 +20,7 @@ import math
 import os
 import zlib
 from dataclasses import dataclass, field
+from pathlib import Path
 
 import numpy as np
 from shapely.geometry import Polygon, mapping
@@ -27,7 +28,7 @@ from shapely.geometry import Polygon, mapping
 from grammarc.conform.footprints import footprint
 from grammarc.ir import nodes as ir
 
-__all__ = ["Case", "make_case", "sample_attrs", "write_lots"]
+__all__ = ["Case", "cases_from_file", "make_case", "sample_attrs", "write_lots"]
 
 
 @dataclass(frozen=True)
@@ -49,6 +50,20 @@ def make_case(package: str, module: ir.Module, kind: str, seed: int) -> Case:
     """The case of ``package`` (its checked ``module``) on a footprint of class ``kind`` from ``seed``."""
     rng = np.random.default_rng([seed, zlib.crc32(package.encode())])
     return Case(package, kind, seed, sample_attrs(module, rng), footprint(kind, seed))
+
+
+def cases_from_file(package: str, module: ir.Module, path: str | os.PathLike) -> list[Case]:
+    """Cases of ``package`` on the footprints of a GeoJSON file (real lots, in metres): one case per
+    polygon, of the class named by the file's stem, numbered (its seed) in the file's order; attributes
+    sampled as for generated footprints. A MultiPolygon gives a case per part."""
+    from shapely.geometry import shape
+
+    kind = Path(path).stem
+    with open(path, encoding="utf-8") as file:
+        features = json.load(file)["features"]
+    polygons = [part for f in features for part in getattr(shape(f["geometry"]), "geoms", [shape(f["geometry"])])]
+    return [Case(package, kind, i, sample_attrs(module, np.random.default_rng([i, zlib.crc32(package.encode())])),
+                 polygon) for i, polygon in enumerate(polygons)]
 
 
 def sample_attrs(module: ir.Module, rng: np.random.Generator) -> dict:

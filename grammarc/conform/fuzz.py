@@ -35,7 +35,7 @@ from pathlib import Path
 
 import numpy as np
 
-from grammarc.conform.cases import Case, make_case, write_lots
+from grammarc.conform.cases import Case, cases_from_file, make_case, write_lots
 from grammarc.conform.footprints import CLASSES
 from grammarc.conform.kit import kit_dir, prt_python
 from grammarc.conform.measure import compare, compare_reports, measure, surface_distance
@@ -243,9 +243,10 @@ def save_case(folder: Path, case: Case, result: dict, prt_record: dict) -> Path:
 
 
 def fuzz(n: int, out: Path, *, packages: Iterable[str] = PACKAGES, kinds: Iterable[str] = tuple(CLASSES),
-         seed: int = 0, batch: int = 64, progress=print) -> list[dict]:
-    """Run ``n`` cases per package, classes in turn, seeds from ``seed``; results appended to
-    ``out/results.jsonl``, mismatches saved under ``out/cases``. Returns this run's results."""
+         seed: int = 0, batch: int = 64, footprints: Path | None = None, progress=print) -> list[dict]:
+    """Run ``n`` cases per package, classes in turn, seeds from ``seed`` (or the first ``n`` lots of the
+    file ``footprints``, from the ``seed``-th on); results appended to ``out/results.jsonl``, mismatches
+    saved under ``out/cases``. Returns this run's results."""
     python, kit = prt_python(), kit_dir()
     if python is None or not kit.is_dir():
         raise UsageError("the differential harness needs the PRT kit (../shared/prt, or GRAMMARC_PRT_KIT) "
@@ -260,9 +261,13 @@ def fuzz(n: int, out: Path, *, packages: Iterable[str] = PACKAGES, kinds: Iterab
             ThreadPoolExecutor(1) as prt_pool, open(out / "results.jsonl", "a", encoding="utf-8") as log:
         jobs = []
         for package in compiled.values():
-            for start in range(0, n, batch):
-                cases = [make_case(package.name, package.grammar.module, kinds[k % len(kinds)], seed + k)
-                         for k in range(start, min(n, start + batch))]
+            if footprints is not None:
+                given = cases_from_file(package.name, package.grammar.module, footprints)[seed:seed + n]
+            else:
+                given = [make_case(package.name, package.grammar.module, kinds[k % len(kinds)], seed + k)
+                         for k in range(n)]
+            for start in range(0, len(given), batch):
+                cases = given[start:start + batch]
                 lots = Path(tmp) / f"{package.name}-{start}.geojson"
                 write_lots(lots, cases, SPACING)
                 jobs.append((package, cases, lots))

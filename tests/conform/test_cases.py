@@ -64,3 +64,20 @@ def test_lots_file_names_each_case_and_spreads_them(tmp_path):
     assert len(features[1]["geometry"]["coordinates"]) == 2  # the courtyard's hole
     first = np.array(features[1]["geometry"]["coordinates"][0])
     np.testing.assert_allclose(first - np.asarray(cases[1].polygon.exterior.coords), [[1000, 0]] * len(first))
+
+
+def test_cases_from_a_file_of_real_lots(tmp_path):
+    from grammarc.conform.cases import cases_from_file
+
+    module = compile_grammar("g.cga", text=GRAMMAR).module
+    square = [[0, 0], [10, 0], [10, 10], [0, 10], [0, 0]]
+    far = [[[x + 100, y] for x, y in square]]
+    collection = {"type": "FeatureCollection", "features": [
+        {"type": "Feature", "properties": {"name": "a"}, "geometry": {"type": "Polygon", "coordinates": [square]}},
+        {"type": "Feature", "properties": {}, "geometry": {"type": "MultiPolygon", "coordinates": [[square], far]}},
+    ]}
+    path = tmp_path / "pompeii.geojson"
+    path.write_text(json.dumps(collection))
+    cases = cases_from_file("p", module, path)
+    assert [c.name for c in cases] == ["p.pompeii.0", "p.pompeii.1", "p.pompeii.2"]
+    assert cases[2].polygon.bounds == (100, 0, 110, 10) and cases[0].attrs != cases[1].attrs
