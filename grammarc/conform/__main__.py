@@ -17,7 +17,7 @@ import sys
 from pathlib import Path
 
 from grammarc.conform.footprints import CLASSES
-from grammarc.conform.fuzz import PACKAGES, fuzz, read_results, rerun_case, table
+from grammarc.conform.fuzz import PACKAGES, distributions, fuzz, read_results, rerun_case, table
 from grammarc.errors import UsageError
 
 
@@ -37,7 +37,8 @@ def main(argv: list[str] | None = None) -> int:
     args = parser.parse_args(argv)
     try:
         if args.table:
-            print(table(read_results(args.table)))
+            results = read_results(args.table)
+            print(table(results), distributions(results), sep="\n\n")
             return 0
         if args.case:
             result = rerun_case(args.case)
@@ -49,7 +50,7 @@ def main(argv: list[str] | None = None) -> int:
     except UsageError as error:
         print(f"grammarc conform: {error}", file=sys.stderr)
         return 2
-    print(table(results))
+    print(table(results), distributions(results), sep="\n\n")
     return 1 if any(r["failed"] for r in results) else 0
 
 

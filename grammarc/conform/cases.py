@@ -45,6 +45,12 @@ class Case:
     def name(self) -> str:
         return f"{self.package}.{self.kind}.{self.seed}"
 
+    @property
+    def prt_seed(self) -> int:
+        """PRT's seed of the lot, from its name: PRT's streams of consecutive seeds are almost the same
+        (its generator is a small linear congruential one), so the cases' seeds are spread over it."""
+        return zlib.crc32(self.name.encode()) % 714025
+
 
 def make_case(package: str, module: ir.Module, kind: str, seed: int) -> Case:
     """The case of ``package`` (its checked ``module``) on a footprint of class ``kind`` from ``seed``."""
@@ -116,7 +122,7 @@ def write_lots(path: str | os.PathLike, cases: list[Case], spacing: float = 0.0)
         dx, dy = (i % columns) * spacing, (i // columns) * spacing
         geometry = mapping(Polygon(np.asarray(case.polygon.exterior.coords) + (dx, dy),
                                    [np.asarray(h.coords) + (dx, dy) for h in case.polygon.interiors]))
-        features.append({"type": "Feature", "properties": {"name": case.name, **case.attrs},
+        features.append({"type": "Feature", "properties": {"name": case.name, **case.attrs, "seed": case.prt_seed},
                          "geometry": {"type": "Polygon", "coordinates": [[list(p) for p in ring]
                                                                          for ring in geometry["coordinates"]]}})
     with open(path, "w", encoding="utf-8") as file:

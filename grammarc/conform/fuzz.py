@@ -41,7 +41,7 @@ from grammarc.conform.kit import kit_dir, prt_python
 from grammarc.conform.measure import compare, compare_reports, measure, surface_distance
 from grammarc.errors import UsageError
 
-__all__ = ["PACKAGES", "fuzz", "judge_batch", "lot_record", "read_results", "rerun_case", "same_lot_records", "table"]
+__all__ = ["PACKAGES", "distributions", "fuzz", "judge_batch", "lot_record", "read_results", "rerun_case", "same_lot_records", "table"]
 
 #: The kit's rule packages, in the issue's order.
 PACKAGES = ("candler", "massing", "complexpatterns", "extrude_color", "extrusion_rule", "translateModel",
@@ -164,7 +164,14 @@ def _triangles_mesh(triangles: np.ndarray):
 
 
 def judge_batch(package: Package, cases: list[Case], lots: Path, prt: dict) -> list[dict]:
-    """Derive ``lots`` (the cases' lots file) with grammarc, twice, and judge each case against ``prt``."""
+    """Derive ``lots`` (the cases' lots file) with grammarc and judge each case against ``prt``.
+
+    The lots are derived with the default chunking, with one lot per chunk (the records must be the
+    same), and with other seeds (``_random_lots``). A lot whose records change with the seed draws random
+    numbers, which grammarc draws from other streams than PRT (README, "Conformance with PRT"): it is
+    judged on what does not depend on them (skipped, chunking) and its figures are kept for the
+    comparison of distributions (``distributions``), not compared value for value.
+    """
     from dataclasses import replace
 
     from grammarc.build import derive
@@ -173,6 +180,7 @@ def judge_batch(package: Package, cases: list[Case], lots: Path, prt: dict) -> l
     lots_read = read_lots(lots)
     record = derive(package.grammar, lots_read, package.options)
     one_by_one = derive(package.grammar, lots_read, replace(package.options, chunk_size=1))
+    random = _random_lots(package, lots_read, record, len(cases))
     bad = {b.index: b.reason for b in record["bad"]}
     reports = record["reports"]
     results = []
@@ -189,6 +197,9 @@ def judge_batch(package: Package, cases: list[Case], lots: Path, prt: dict) -> l
         elif lot in bad:
             failed.add("skipped")
             details.append(bad[lot])
+        elif random[lot]:
+            result["random"] = True
+            _random_figures(package, case, ours, theirs, result)
         else:
             _judge_geometry(package, case, ours, theirs, result, failed, details)
             same, differences = compare_reports(reports.table(reports.lots.get(lot, {})), theirs.get("report") or {})
@@ -199,6 +210,36 @@ def judge_batch(package: Package, cases: list[Case], lots: Path, prt: dict) -> l
         result["detail"] = " | ".join(details)
         results.append(result)
     return results
+
+
+def _random_lots(package: Package, lots, record: dict, n: int) -> np.ndarray:
+    """(n,) bool: the lots whose records change with the seed. One other seed tells a package that draws
+    no random number; where one does, two more catch the lots that drew the same choices twice (a
+    30 % case is the same for two seeds one time in ten)."""
+    from dataclasses import replace
+
+    from grammarc.build import derive
+
+    random = np.zeros(n, bool)
+    for step in (1, 2, 3):
+        other = derive(package.grammar, lots, replace(package.options, seed=package.options.seed + step))
+        random |= [not same_lot_records(lot_record(record, lot), lot_record(other, lot)) for lot in range(n)]
+        if not random.any():
+            break
+    return random
+
+
+def _random_figures(package: Package, case: Case, ours: dict, theirs: dict, result: dict) -> None:
+    """A random lot's figures, for the distributions: its height and its surface over its footprint's area
+    (so that lots of different sizes compare), grammarc's and PRT's."""
+    from grammarc.io.bake import bake
+
+    measured = measure(bake(ours, package.options.asset_roots))
+    for who, figures in (("ours", measured), ("prt", theirs)):
+        low, high = figures.get("bbox_min"), figures.get("bbox_max")
+        height = high[1] - low[1] if low is not None and math.isfinite(low[1]) else 0.0
+        result[f"{who}_height"] = height
+        result[f"{who}_surface_ratio"] = figures.get("surface_area", 0.0) / case.polygon.area
 
 
 def _judge_geometry(package: Package, case: Case, ours: dict, theirs: dict, result: dict, failed: set,
@@ -302,7 +343,7 @@ def rerun_case(path: Path) -> dict:
     with open(path, encoding="utf-8") as file:
         collection = json.load(file)
     saved, (feature,) = collection["grammarc_conform"], collection["features"]
-    attrs = {k: v for k, v in feature["properties"].items() if k != "name"}
+    attrs = {k: v for k, v in feature["properties"].items() if k not in ("name", "seed")}
     python, kit = prt_python(), kit_dir()
     if python is None:
         raise UsageError("--case needs PyPRT's side environment (.prt-venv, or GRAMMARC_PRT_PYTHON)")
@@ -327,17 +368,17 @@ def read_results(folder: Path) -> list[dict]:
 
 
 def table(results: list[dict]) -> str:
-    """Markdown: per package and footprint class, the cases, the share that match, each check's failures
-    and the median surface distance."""
+    """Markdown: per package and footprint class, the cases, the share that match, each check's failures,
+    the random lots (judged on skipping and chunking only, see ``judge_batch``) and the median surface
+    distance."""
     groups = defaultdict(list)
     for r in results:
         groups[(r["package"], r["kind"])].append(r)
     order = {k: i for i, k in enumerate(CLASSES)}
-    lines = ["| package | footprints | cases | match | " + " | ".join(CHECKS) + " | median distance (m) |",
-             "|---|---|---:|---:|" + "---:|" * len(CHECKS) + "---:|"]
+    lines = ["| package | footprints | cases | match | " + " | ".join(CHECKS) + " | random | median distance (m) |",
+             "|---|---|---:|---:|" + "---:|" * len(CHECKS) + "---:|---:|"]
     totals = defaultdict(list)
-    for (package, kind) in sorted(groups, key=lambda g: (PACKAGES.index(g[0]) if g[0] in PACKAGES else 99,
-                                                          order.get(g[1], 99))):
+    for (package, kind) in sorted(groups, key=lambda g: (_package_order(g[0]), order.get(g[1], 99))):
         rows = groups[(package, kind)]
         totals[package] += rows
         lines.append(_row(package, kind, rows))
@@ -346,10 +387,32 @@ def table(results: list[dict]) -> str:
     return "\n".join(lines)
 
 
+def distributions(results: list[dict]) -> str:
+    """Markdown: per package, its random lots' heights and surface ratios, grammarc's against PRT's, with
+    the two-sample Kolmogorov-Smirnov test's p-value (a small one: the distributions differ)."""
+    from scipy.stats import ks_2samp
+
+    lines = ["| package | random lots | height: median ours / PRT | p | surface / footprint: median ours / PRT | p |",
+             "|---|---:|---|---:|---|---:|"]
+    for package in sorted({r["package"] for r in results if r.get("random")}, key=_package_order):
+        rows = [r for r in results if r.get("random") and r["package"] == package]
+        cells = []
+        for figure in ("height", "surface_ratio"):
+            ours, theirs = [r[f"ours_{figure}"] for r in rows], [r[f"prt_{figure}"] for r in rows]
+            cells.append(f"{np.median(ours):.3g} / {np.median(theirs):.3g} | {ks_2samp(ours, theirs).pvalue:.2g}")
+        lines.append(f"| {package} | {len(rows)} | " + " | ".join(cells) + " |")
+    return "\n".join(lines)
+
+
+def _package_order(package: str) -> int:
+    return PACKAGES.index(package) if package in PACKAGES else len(PACKAGES)
+
+
 def _row(package: str, kind: str, rows: list[dict]) -> str:
     match = sum(not r["failed"] for r in rows)
     counts = [sum(check in r["failed"] for r in rows) for check in CHECKS]
     distances = [r["distance"] for r in rows if "distance" in r and math.isfinite(r["distance"])]
     distance = f"{np.median(distances):.3g}" if distances else "-"
+    random = sum(bool(r.get("random")) for r in rows)
     return (f"| {package} | {kind} | {len(rows)} | {100 * match / len(rows):.1f} % | "
-            + " | ".join(str(c) if c else "" for c in counts) + f" | {distance} |")
+            + " | ".join(str(c) if c else "" for c in counts) + f" | {random or ''} | {distance} |")

@@ -13,6 +13,7 @@ from grammarc.build import derive
 from grammarc.conform import measure, prt_python
 from grammarc.conform.cases import make_case, write_lots
 from grammarc.conform.fuzz import (
+    distributions,
     fuzz,
     judge_batch,
     lot_record,
@@ -72,7 +73,7 @@ def test_judging_a_batch_names_each_failed_check(massing, tmp_path):
     cases, lots = _batch(massing, tmp_path)
     prt = _as_prt(massing, lots)
     results = judge_batch(massing, cases, lots, prt)
-    assert [r["failed"] for r in results] == [[], [], []]
+    assert [r["failed"] for r in results] == [[], [], []] and not any(r.get("random") for r in results)
     assert all(r["distance"] < 1e-3 and r["area_rel"] < 1e-9 for r in results)
 
     names = [c.name for c in cases]
@@ -86,19 +87,48 @@ def test_judging_a_batch_names_each_failed_check(massing, tmp_path):
     assert third["failed"] == [] and third["prt_error"] == "PRT generated no model"
 
 
+@needs_kit
+def test_lots_that_draw_random_numbers_are_kept_for_the_distributions(tmp_path):
+    """extrusion_rule extrudes by ``rand(min, max)``: every lot is random, and its figures (height, surface
+    over footprint) are kept, not compared with PRT's value for value."""
+    with open_packages(["extrusion_rule"], KIT) as packages:
+        package = packages["extrusion_rule"]
+        cases, lots = _batch(package, tmp_path)
+        prt = _as_prt(package, lots)
+        for name in prt:  # PRT drew other heights
+            prt[name]["bbox_max"] = [prt[name]["bbox_max"][0], 99.0, prt[name]["bbox_max"][2]]
+        results = judge_batch(package, cases, lots, prt)
+    assert all(r["random"] and r["failed"] == [] for r in results)
+    assert all(10 <= r["ours_height"] <= 30 and r["prt_height"] == 99 for r in results)
+    assert all(r["ours_surface_ratio"] > 2 for r in results)  # two footprints and the walls
+
+
 def test_table_counts_matches_and_failures_per_package_and_class():
     results = [
         {"package": "massing", "kind": "L", "failed": [], "distance": 0.001},
         {"package": "massing", "kind": "L", "failed": ["area"], "distance": 0.5},
         {"package": "massing", "kind": "convex", "failed": ["skipped"]},
         {"package": "candler", "kind": "L", "failed": ["bbox", "chunking"], "distance": 0.1},
+        {"package": "candler", "kind": "L", "failed": [], "random": True},
     ]
     lines = table(results).splitlines()
-    assert lines[0].startswith("| package | footprints | cases | match | skipped | bbox | area | reports | chunking")
-    assert lines[2] == "| candler | L | 1 | 0.0 % |  | 1 |  |  | 1 | 0.1 |"
-    assert lines[3] == "| massing | convex | 1 | 0.0 % | 1 |  |  |  |  | - |"  # classes in their order
-    assert lines[4] == "| massing | L | 2 | 50.0 % |  |  | 1 |  |  | 0.251 |"
+    assert lines[0].startswith("| package | footprints | cases | match | skipped | bbox | area | reports | chunking"
+                               " | random |")
+    assert lines[2] == "| candler | L | 2 | 50.0 % |  | 1 |  |  | 1 | 1 | 0.1 |"
+    assert lines[3] == "| massing | convex | 1 | 0.0 % | 1 |  |  |  |  |  | - |"  # classes in their order
+    assert lines[4] == "| massing | L | 2 | 50.0 % |  |  | 1 |  |  |  | 0.251 |"
     assert "| **massing** | all | 3 | 33.3 % |" in lines[-1]
+
+
+def test_distributions_of_random_lots():
+    rng = np.random.default_rng(0)
+    same = [{"package": "reporting", "random": True, "ours_height": a, "prt_height": b, "ours_surface_ratio": 1.0,
+             "prt_surface_ratio": 1.0} for a, b in rng.uniform(10, 30, (200, 2))]
+    shifted = [dict(r, package="extrusion_rule", prt_height=r["prt_height"] + 5) for r in same]
+    lines = distributions(same + shifted).splitlines()
+    assert lines[2].startswith("| extrusion_rule | 200 |") and lines[3].startswith("| reporting | 200 |")
+    p_shifted, p_same = (float(line.split("|")[4]) for line in lines[2:4])
+    assert p_shifted < 1e-6 and p_same > 0.01
 
 
 @needs_prt
