@@ -38,7 +38,7 @@ def main(argv: list[str] | None = None) -> int:
     try:
         if args.table:
             results = read_results(args.table)
-            print(table(results), distributions(results), sep="\n\n")
+            print("\n\n".join(filter(None, [table(results), distributions(results)])))
             return 0
         if args.case:
             result = rerun_case(args.case)
@@ -50,7 +50,7 @@ def main(argv: list[str] | None = None) -> int:
     except UsageError as error:
         print(f"grammarc conform: {error}", file=sys.stderr)
         return 2
-    print(table(results), distributions(results), sep="\n\n")
+    print("\n\n".join(filter(None, [table(results), distributions(results)])))
     return 1 if any(r["failed"] for r in results) else 0
 
 

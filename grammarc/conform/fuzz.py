@@ -389,9 +389,12 @@ def table(results: list[dict]) -> str:
 
 def distributions(results: list[dict]) -> str:
     """Markdown: per package, its random lots' heights and surface ratios, grammarc's against PRT's, with
-    the two-sample Kolmogorov-Smirnov test's p-value (a small one: the distributions differ)."""
+    the two-sample Kolmogorov-Smirnov test's p-value (a small one: the distributions differ); "" when no
+    lot is random."""
     from scipy.stats import ks_2samp
 
+    if not any(r.get("random") for r in results):
+        return ""
     lines = ["| package | random lots | height: median ours / PRT | p | surface / footprint: median ours / PRT | p |",
              "|---|---:|---|---:|---|---:|"]
     for package in sorted({r["package"] for r in results if r.get("random")}, key=_package_order):
