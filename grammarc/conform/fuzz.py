@@ -26,6 +26,7 @@ import subprocess
 import sys
 import tempfile
 import time
+import zlib
 from array import array
 from collections import defaultdict
 from collections.abc import Iterable, Iterator
@@ -178,6 +179,8 @@ def judge_batch(package: Package, cases: list[Case], lots: Path, prt: dict) -> l
     from grammarc.io.lots import read_lots
 
     lots_read = read_lots(lots)
+    # a seed per batch: its lots are numbered from 0 as every batch's are, and would draw the same numbers
+    package = replace(package, options=replace(package.options, seed=zlib.crc32(cases[0].name.encode())))
     record = derive(package.grammar, lots_read, package.options)
     one_by_one = derive(package.grammar, lots_read, replace(package.options, chunk_size=1))
     random = _random_lots(package, lots_read, record, len(cases))
