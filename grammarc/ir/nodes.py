@@ -387,10 +387,12 @@ class Translate:
 
 @dataclass(frozen=True, slots=True)
 class Scale:
-    """``S(x,y,z)``: set the scope size; relative sizes scale the current size."""
+    """``S(x,y,z)``: set the scope size; relative sizes scale the current size. A negative size fails the
+    shape, or, when ``mirrors`` (CityEngine's ``s``), mirrors it along that axis (``operations.scope``)."""
 
     sizes: tuple[Size, Size, Size] = child(Type.NUM, "a size")
     span: Span = NO_SPAN
+    mirrors: bool = False
 
 
 @dataclass(frozen=True, slots=True)

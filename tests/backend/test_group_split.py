@@ -2,8 +2,9 @@
 
 Layouts are computed by hand from the kernel's rule (its docstring): fixed parts and floating parts outside
 groups keep their written sizes while the groups share what is left in proportion to one repetition's
-size, in order, each from what the earlier ones left; a group with floating parts repeats round(share /
-repetition) times (at least once when room is left and no floating part outside the groups), a group of fixed sizes floor(share / repetition) times with the rest of its share left empty; then
+size, in order, each from what the earlier ones left; a group with floating parts repeats as often as
+brings the floating parts' stretch nearest 1 (at least once when room is left and no floating part outside
+the groups), a group of fixed sizes floor(share / repetition) times with the rest of its share left empty; then
 one factor scales every floating size so that the parts fill the extent. A plain Python reference of the
 same rule checks random batches.
 """
@@ -109,10 +110,12 @@ def test_floating_sizes_vanish_when_the_fixed_parts_fill_the_extent():
 # ------------------------------------------------------------------------------------------ repeat groups
 
 
-@pytest.mark.parametrize("extent, reps", [(10, 3), (11, 4), (9, 3), (4.4, 2), (4.2, 1), (7.3, 2), (7.4, 3), (1, 1)])
+@pytest.mark.parametrize("extent, reps", [(10, 3), (11, 4), (9, 3), (3.9, 1), (4.1, 2), (7.1, 2), (7.3, 3),
+                                          (1, 1)])
 def test_floating_repeat_group_rounds_and_fills(extent, reps):
-    """{ ~3 : A }*: the count whose stretch is nearest 1 as a ratio (at least one), stretched to fill
-    the extent: 4.4 m is 1.47 repetitions, nearer 2 (x 0.73) than 1 (x 1.47)."""
+    """{ ~3 : A }*: the count whose stretch is nearest 1 (at least one), stretched to fill the extent, as
+    PRT counts: 4.1 m is 1.37 repetitions, 2 stretched by 0.68 (0.32 from 1) rather than 1 by 1.37 (0.37
+    from 1); from r to r + 1 at 2r(r + 1) / (2r + 1) repetitions: 4/3, 12/5 (7.2 m)."""
     got = layout(extent, ["~3"], groups=[0])
     assert_layout(got, [(0, extent / reps)] * reps)
 
@@ -136,11 +139,24 @@ def test_floating_repeat_group_may_vanish_beside_a_floating_part():
 def test_floating_repeat_groups_take_their_shares_in_order():
     # candler's wide floor, 1 | 3.55 | {~3.55}* | 3.55 | {~3.55}* | 3.55 | 1, as PRT lays it: on 15 m
     # one repetition, in the first group (six windows a floor on the triangle's front); on 20 m one in
-    # each; on 30 m two, then three from the 10.25 m the first left
+    # each; on 25 m two in each; on 30 m three (2.44 repetitions' share), then two from the 6.7 m the
+    # first left (PRT's centre tile from 14.96 to 18.51 m)
     parts, groups = [1, 3.55, "~3.55", 3.55, "~3.55", 3.55, 1], [-1, -1, 0, -1, 1, -1, -1]
     assert [p for p, *_ in layout(15, parts, groups=groups)] == [0, 1, 2, 3, 5, 6]
     assert [p for p, *_ in layout(20, parts, groups=groups)] == [0, 1, 2, 3, 4, 5, 6]
-    assert [p for p, *_ in layout(30, parts, groups=groups)] == [0, 1, 2, 2, 3, 4, 4, 4, 5, 6]
+    assert [p for p, *_ in layout(25, parts, groups=groups)] == [0, 1, 2, 2, 3, 4, 4, 5, 6]
+    thirty = layout(30, parts, groups=groups)
+    assert [p for p, *_ in thirty] == [0, 1, 2, 2, 2, 3, 4, 4, 5, 6]
+    assert thirty[5][1] == pytest.approx(14.96)
+
+
+def test_floating_repeat_group_beside_a_floating_part_takes_the_count_nearest_its_size():
+    """complexpatterns' facade, ~g | {~f}*: none or one repetition, whichever stretches every floating
+    part nearer 1; PRT's threshold is where E / g - 1 = 1 - E / (g + f), 4 m for g = f = 3."""
+    assert [p for p, *_ in layout(3.95, ["~3", "~3"], groups=[-1, 0])] == [0]
+    assert_layout(layout(4.05, ["~3", "~3"], groups=[-1, 0]), [(0, 2.025), (1, 2.025)])
+    # the conformance case: 5.759 m, g = 4.182, f = 4.358 gives two floors (one would stretch by 1.377)
+    assert [p for p, *_ in layout(5.759, ["~4.182", "~4.358"], groups=[-1, 0])] == [0, 1]
 
 
 def test_absolute_repeat_group_floors_and_leaves_the_rest_empty():
@@ -218,15 +234,15 @@ def test_values_per_shape_are_read_per_row():
 
 
 def stretch_nearest_one(share, nominal, g_fixed, g_float, loose, tol):
-    """The repetition count whose stretch is nearest 1 as a ratio, by search: the group's own
-    (share / (n nominal)) from one repetition up; below one repetition, with floating parts outside
-    the groups, that of all floating parts with and without the repetition."""
+    """The repetition count whose floating parts' stretch is nearest 1, by search over every count (none
+    only beside floating parts outside the groups)."""
     if share <= tol:
         return 0
-    if share < nominal and loose > 0:
-        stretch = [(share + loose) / loose, max(share + loose - g_fixed, tol) / (loose + g_float)]
-        return min((0, 1), key=lambda n: abs(np.log(stretch[n])))
-    return min(range(1, int(share / nominal) + 3), key=lambda n: abs(np.log(share / (n * nominal))))
+
+    def off(n):
+        return abs((share + loose - n * g_fixed) / (loose + n * g_float) - 1)
+
+    return min(range(0 if loose > 0 else 1, int(share / nominal) + 3), key=off)
 
 
 def reference(extent, values, kind, group, n_groups, tol):

@@ -127,9 +127,9 @@ def group_split(extent, values, kind, group, n_groups, tol):
     The rule (grammarc's reading of CityEngine's, fitted to PRT): what the fixed parts and the floating
     parts outside groups leave at their written sizes goes to the groups in order, each taking a share
     of what the earlier ones left in proportion to its repetition's size among the groups still to
-    come. A group with floating parts repeats as often as stretches it least as a ratio
-    (``_repetitions``) and uses that many repetitions' room. PRT lays candler's
-    ``1 | 3.55 | {~3.55}* | 3.55 | {~3.55}* | 3.55 | 1`` with 2 then 3 repetitions on 30 m, 2 and 2 on
+    come. A group with floating parts repeats as often as brings the floating parts nearest their
+    written sizes (``_repetitions``) and uses that many repetitions' room. PRT lays candler's
+    ``1 | 3.55 | {~3.55}* | 3.55 | {~3.55}* | 3.55 | 1`` with 3 then 2 repetitions on 30 m, 2 and 2 on
     25 m, 1 and 1 on 20 m, 1 then 0 on 15 m, and ``{ ~w: A | d: B }* | ~w: A`` on an extent of w as one
     A. A group of fixed sizes repeats floor(share / repetition) times, the rest of its share left empty
     at its end. Then every floating size, in groups or not, is scaled by one factor so that the parts
@@ -230,21 +230,24 @@ def group_split(extent, values, kind, group, n_groups, tol):
 
 @njit(cache=True, nogil=True)
 def _repetitions(share, nominal, fixed, floating, loose, tol):
-    """How often a group with floating parts repeats in ``share``: the count whose stretch (share over
-    the repetitions' nominal size) is nearest 1 as a ratio, so 1.74 rounds to 2 and 2.44 to 2
-    (sqrt(2) and sqrt(6) are the thresholds). Below one repetition the group repeats once, unless
-    floating parts outside the groups (``loose``, their nominal size) stretch less without it."""
-    x = share / nominal
-    if x >= 1.0:
-        r = int(np.floor(x))
-        return r + 1 if x * x > r * (r + 1) else r
+    """How often a group with floating parts repeats in ``share``: the count that brings the floating
+    parts nearest their written sizes, as the reference has a floating repeat come "closest" to them.
+    With r repetitions every floating part, in the group (``floating`` of its ``nominal`` size, ``fixed``
+    the rest) or outside the groups (``loose``, their written size), stretches by
+    (share + loose - r fixed) / (loose + r floating), which is 1 at r = share / nominal; of the counts
+    either side, the one whose stretch is nearer 1 (the difference, not the ratio) wins. PRT's
+    thresholds: ``{~f}*`` goes from r to r + 1 repetitions at 2r(r + 1) / (2r + 1) repetitions' room
+    (4/3, 12/5, 24/7), complexpatterns' ``~g | {~f}*`` from none to one where E / g - 1 = 1 - E / (g + f).
+    Without floating parts outside the groups it repeats at least once where there is room."""
     if share <= tol:
         return 0
-    if loose <= 0.0:
+    r = int(np.floor(share / nominal))
+    if r == 0 and loose <= 0.0:
         return 1
-    without = (share + loose) / loose
-    with_one = max(share + loose - fixed, tol) / (loose + floating)
-    return 1 if abs(np.log(with_one)) < abs(np.log(without)) else 0
+    room = share + loose
+    below = abs((room - r * fixed) / (loose + r * floating) - 1.0)
+    above = abs((room - (r + 1) * fixed) / (loose + (r + 1) * floating) - 1.0)
+    return r + 1 if above < below else r
 
 
 @njit(cache=True, nogil=True)

@@ -5,10 +5,11 @@ body began with or last pushed, which only the runner holds).
 
 They change the cursor's scope and return it. Reads: the scope (``origin``, ``size``, ``frame``), ``geom``
 (extrude, align, mirror), and what their expressions read. Writes: ``T``, ``translate`` and ``center`` the
-``origin``, ``S`` the ``size``, ``R`` and ``rotate`` the ``frame`` (and ``r(scopeCenter, ...)`` the
-``origin``, to keep the centre), ``mirror`` the ``geom``; ``extrude``, the alignments, ``mirrorScope`` and
-``setPivot`` all four of the scope and geometry, as they turn scopes around their geometry
-(``backend.reframing``), and ``setPivot`` the pivot's columns too (``backend.pivot``).
+``origin``, ``S`` the ``size`` (CityEngine's ``s`` of a negative size the ``origin`` and ``geom`` too),
+``R`` and ``rotate`` the ``frame`` (and ``r(scopeCenter, ...)`` the ``origin``, to keep the centre),
+``mirror`` the ``geom``; ``extrude``, the alignments, ``mirrorScope`` and ``setPivot`` all four of the scope
+and geometry, as they turn scopes around their geometry (``backend.reframing``), and ``setPivot`` the
+pivot's columns too (``backend.pivot``).
 """
 
 from __future__ import annotations
@@ -50,15 +51,53 @@ def translate(ctx: Context, cursor: Shapes, op: ir.Translate) -> Shapes:
     return cursor.with_scope(cursor.origin + delta, cursor.size, cursor.frame, cursor.geom)
 
 
-@operation(ir.Scale, writes=("size",), meshes=True)
+@operation(ir.Scale, writes=("origin", "size", "geom"), meshes=True)
 def scale(ctx: Context, cursor: Shapes, op: ir.Scale) -> Shapes:
+    """``S``: the scope's new size. CityEngine's ``s`` mirrors the shape along an axis given a negative size,
+    its normals inverted, as the reference says (``_inside_out``); the paper's ``S`` fails the shape."""
     env = ctx.env(cursor)
     size = np.empty_like(cursor.size)
     for axis, s in enumerate(op.sizes):
         value = evaluate_array(s.value, env)
         size[:, axis] = value * cursor.size[:, axis] if s.kind is ir.SizeKind.RELATIVE else value
+    flips = size < 0
+    if op.mirrors and flips.any():
+        return _inside_out(ctx, cursor.with_scope(cursor.origin, np.abs(size), cursor.frame, cursor.geom), flips)
     ctx.fail_negative(cursor, size, "`S` gives a negative or NaN size", op.span)
     return cursor.with_scope(cursor.origin, size, cursor.frame, cursor.geom)
+
+
+def _inside_out(ctx: Context, shapes: Shapes, flips: np.ndarray) -> Shapes:
+    """``shapes`` mirrored along their scope axes ``flips`` (n, 3) bool through their scopes' origins, as
+    CityEngine's ``s`` mirrors a shape given a negative size: each flipped axis runs from the origin
+    backwards, so the scope's origin moves to that far end and its size stays the absolute value (grammarc's
+    scopes have no negative sizes: ``scope.sx`` reads it, where CityEngine's would read the negative size).
+    The faces keep their vertex order, so they wind around inward normals: "the normals are inverted", and a
+    box's back face is the mirrored box's ``front`` for ``comp(f)``. Such faces are stored as a mesh (the
+    polygon store keeps outward faces; a scope box or a polygon becomes its faces); an asset is mirrored as
+    ``mirror`` mirrors it; a line or a point keeps its scope box.
+
+    Parameters
+    ----------
+    shapes : Shapes
+        n shapes whose ``size`` (n, 3) is already the absolute value of the sizes given.
+    flips : (n, 3) bool
+        The axes whose size was negative.
+    """
+    axes = ctx.chunk.frames[shapes.frame]
+    origin = shapes.origin - np.einsum("ni,nij->nj", np.where(flips, shapes.size, 0.0), axes)
+    bits = (flips * np.array([1, 2, 4])).sum(axis=1)
+    geom = _mirrored_assets(shapes.geom, bits)
+    solid = np.flatnonzero((geom >= -1) & (bits > 0))
+    faces = shape_faces(shapes.size[solid], geom[solid], ctx.chunk.polygons, ctx.chunk.meshes)
+    vertex_shape = faces.vertex_shape()
+    size = shapes.size[solid][vertex_shape]
+    verts = np.where(flips[solid][vertex_shape], size - faces.verts, faces.verts)
+    ids = ctx.chunk.meshes.add(verts / np.where(size > TOL.zero, size, np.inf), faces.ring_offsets,
+                               faces.face_offsets, faces.shape_offsets)
+    has_faces = np.diff(faces.shape_offsets) > 0
+    geom[solid[has_faces]] = (MESH_BASE + ids[has_faces]).astype(np.int32)
+    return shapes.with_scope(origin, shapes.size, shapes.frame, geom)
 
 
 @operation(ir.Rotate, writes=("origin", "frame"), meshes=True)
@@ -442,11 +481,7 @@ def mirror(ctx: Context, cursor: Shapes, op: ir.Mirror) -> Shapes:
     env = ctx.env(cursor)
     flips = [np.broadcast_to(evaluate_array(f, env, dtype=bool), (len(cursor),)) for f in op.axes]
     bits = flips[0] * 1 + flips[1] * 2 + flips[2] * 4
-    geom = cursor.geom.copy()
-    assets = (geom < -1) & (bits > 0)
-    if assets.any():
-        asset, mirrored = asset_of(geom[assets])
-        geom[assets] = asset_geom(asset, mirrored ^ bits[assets])
+    geom = _mirrored_assets(cursor.geom, bits)
     poly = np.flatnonzero(is_polygon(geom) & (bits > 0))
     if len(poly):
         store = ctx.chunk.polygons
@@ -478,6 +513,17 @@ def mirror(ctx: Context, cursor: Shapes, op: ir.Mirror) -> Shapes:
         coords = np.where(odd[:, None], comp_kernels.reverse_rings(coords, ring_offsets), coords)
         geom[mesh] = (MESH_BASE + meshes.add(coords, ring_offsets, face_offsets, mesh_offsets)).astype(np.int32)
     return cursor.with_scope(cursor.origin, cursor.size, cursor.frame, geom)
+
+
+def _mirrored_assets(geom: np.ndarray, bits: np.ndarray) -> np.ndarray:
+    """A copy of the ``geom`` codes (n,) with the inserted assets' mirror bits flipped by ``bits`` (n,) (1: x,
+    2: y, 4: z)."""
+    geom = geom.copy()
+    assets = (geom < -1) & (bits > 0)
+    if assets.any():
+        asset, mirrored = asset_of(geom[assets])
+        geom[assets] = asset_geom(asset, mirrored ^ bits[assets])
+    return geom
 
 
 @operation(ir.MirrorScope, writes=_SCOPE, meshes=True)

@@ -105,7 +105,7 @@ class OperationLowering:
             else:
                 value = self.expr(a)
                 sizes.append(ir.Size(ir.SizeKind.ABSOLUTE, value, getattr(value, "span", span)))
-        return ir.Scale(tuple(sizes), span)
+        return ir.Scale(tuple(sizes), span, mirrors=True)
 
     def op_rotate(self, op, args, span):
         """``r(x, y, z)`` and ``r(scopeOrigin|scopeCenter, x, y, z)``: the same turn, around the scope's
@@ -296,7 +296,8 @@ class OperationLowering:
         kind, axis = target.field[0], "xyz".index(target.field[1])
         values = tuple(value if k == axis else ir.ScopeRef(kind + "xyz"[k], target.span) for k in range(3))
         if kind == "s":
-            return ir.Scale(tuple(ir.Size(ir.SizeKind.ABSOLUTE, v, getattr(v, "span", span)) for v in values), span)
+            return ir.Scale(tuple(ir.Size(ir.SizeKind.ABSOLUTE, v, getattr(v, "span", span)) for v in values), span,
+                            mirrors=True)
         return ir.Transform("translate" if kind == "t" else "rotate", False, "pivot", values, span)
 
     def op_split(self, op, args, parts, span, repeat=False):

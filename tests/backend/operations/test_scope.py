@@ -431,10 +431,12 @@ def test_mirror_of_a_roof_flips_its_mesh_and_keeps_its_faces_outward(write):
 
 
 @pytest.mark.parametrize(("given", "op"), [("", "rotateScope(0, 90, 0)"), ("", "mirror(true, false, true)"),
-                                           ("s('0.5, '1, '0.5) ", "center(xz)"), ("", "mirrorScope(true, true, false)")])
+                                           ("s('0.5, '1, '0.5) ", "center(xz)"), ("", "mirrorScope(true, true, false)"),
+                                           ("", "s(-scope.sx, scope.sy, -scope.sz)")])
 def test_scope_operations_take_every_shape_kind(write, given, op):
-    """rotateScope, mirror, center and mirrorScope on a rectangle, a concave polygon, a box, a prism, a
-    roof, an inserted asset, a face, an edge and a roof face: no lot fails, and the area stays."""
+    """rotateScope, mirror, center, mirrorScope and negative sizes on a rectangle, a concave polygon, a box,
+    a prism, a roof, an inserted asset, a face, an edge and a roof face: no lot fails, and the area
+    stays."""
     kinds = ["", "extrude(3) ", "roofHip(30) ", 'i("builtin:cube") ', "extrude(3) comp(f){ front : F }\nF --> ",
              "extrude(3) comp(e){ all : F }\nF --> ", "roofHip(30) comp(f){ all : F }\nF --> "]
     for lot in (rect(12, 8), LOT_ZOO["concave_L"]):
@@ -455,6 +457,34 @@ def test_negative_size_lot_is_reported_and_skipped(write):
     assert len(r["bad"]) == 1 and r["bad"][0].index == 1
     assert "negative or NaN size" in r["bad"][0].reason and "g.cga:1" in r["bad"][0].reason
 
+
+
+def test_negative_size_mirrors_the_shape_and_inverts_its_normals(write):
+    """CityEngine's ``s`` mirrors along an axis given a negative size (the reference: "the normals are
+    inverted"). complexpatterns' ``Balcony`` on a tiny lot, a parallelogram: its box narrower than its two
+    border walls, ``s(scope.sx - 1.312, ..)`` is negative. PRT centres it and puts the front railing at the
+    lot's far edge, 3.344 m from its first edge (the mirrored box's back face, facing in), its ends where
+    PRT's railing ends (its OBJ, to the millimetre), and the side railings from 0.656 to 3.344 m."""
+    lot = [np.array([[1.361, -1.068], [1.711, -0.252], [-1.361, 1.068], [-1.711, 0.252]])]
+    text = ("Lot --> extrude(0.7) s(scope.sx - 1.312, '1, scope.sz - 0.656) center(x)\n"
+            "    comp(f){ front : Front | left : Side | right : Side }\n")
+    r = run(write, text, [lot])
+    assert not r["bad"]
+    # world x = map x, world z = -map y: the first edge's start, and the unit vector across the lot
+    first, depth = np.array([1.361, 0, 1.068]), np.array([-0.816, 0, -0.35]) / np.hypot(0.816, 0.35)
+    names_of = [str(r["symbols"][s]) for s in r["mesh"].symbol]
+    assert sorted(names_of) == ["Front", "Side", "Side"]
+    for name, (ring, *_) in zip(names_of, mesh_faces(r), strict=True):
+        along = (ring - first) @ depth
+        if name == "Front":
+            ends = ring[ring[:, 1] < 0.35][:, [0, 2]]
+            np.testing.assert_allclose(ends[np.argsort(ends[:, 0])], [[-1.620, -0.465], [-1.454, -0.852]],
+                                       atol=2e-3)
+            np.testing.assert_allclose(along, 3.344, atol=1e-3)
+            normal = np.cross(ring[1] - ring[0], ring[2] - ring[1])
+            assert normal @ depth < 0  # it faces into the box, towards the first edge
+        else:
+            assert (along.min(), along.max()) == pytest.approx((0.656, 3.344), abs=1e-3)
 
 
 def _cube(r):

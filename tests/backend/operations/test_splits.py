@@ -190,3 +190,22 @@ def test_a_negative_split_size_counts_as_zero_as_in_prt(write):
     np.testing.assert_allclose(r["xform"][:, 0, 0], [4], atol=1e-6)
     zero = run(write, "Lot --> extrude(3) split(x){ 0 : A | ~1 : B | 0 : C }\n", [rect(4, 10)])
     same_records(r, zero)
+
+
+def test_a_floating_ground_floor_and_repeated_floors_take_the_count_nearest_their_heights(write):
+    """complexpatterns' ``Facade`` on the U lot of a conformance case: ``split(y){ ~4.182 : Floor |
+    { ~4.358 : Floor }* }`` on 5.759 m. PRT makes two floors, 2.820 and 2.939 m (stretched by 0.674,
+    0.326 from 1), where one floor alone would be stretched by 1.377; grammarc made one."""
+    text = "Lot --> extrude(5.759) split(y){ ~4.182 : Floor | { ~4.358 : Floor }* }\n"
+    r = run(write, text, [rect(10, 6)])
+    np.testing.assert_allclose(r["xform"][:, 1, 1], [2.820, 2.939], atol=1e-3)
+    np.testing.assert_allclose(r["xform"][:, 1, 3], [0, 2.820], atol=1e-3)
+
+
+@pytest.mark.parametrize("width, bars", [(1.3, 1), (1.36, 2), (2.38, 2), (2.42, 3)])
+def test_a_floating_repeat_takes_the_count_whose_parts_come_closest_to_their_size(write, width, bars):
+    """complexpatterns' railing, ``split(x){ ~1 : VBar }*``: PRT goes from one bar to two at 4/3 m and
+    from two to three at 12/5 m, where each part comes as close to 1 m with one count as with the
+    other (1.36 m: two of 0.68 rather than one of 1.36; a ratio would have chosen one)."""
+    r = run(write, "Lot --> extrude(1) split(x){ ~1 : Bar }*\n", [rect(width, 2)])
+    np.testing.assert_allclose(r["xform"][:, 0, 0], [width / bars] * bars, rtol=1e-6)
