@@ -11,8 +11,9 @@ Component scopes follow the paper (section 2, "Component split") and CityEngine:
   out of the solid, origin at p on the base, size (|q - p|, height, 0);
 - top face: z along the extrusion axis, x along the polygon's first axis; bottom face: z against it;
 - ring edge: x along the edge, y the polygon's normal, z outward in the polygon's plane, size (|q-p|, 0, 0);
-- side edge at a ring vertex: x along the extrusion axis, z the outward normal of the side face that
-  starts there; vertex: the frame of the ring edge that starts there, size 0.
+- side edge at a ring vertex: x along the extrusion axis, z the mean of the outward normals of the two
+  side faces that meet there (the reference: "the average of the neighboring face normals"); vertex: the
+  frame of the ring edge that starts there, size 0.
 
 Order: faces are bottom, side faces in ring order (exterior ring first, then holes), top; edges are
 bottom ring, top ring, side edges; vertices are bottom ring, then top ring.
@@ -64,6 +65,23 @@ def _edge(coords, j, r0, count, a, b, size_row):
     if length > 0.0:
         d = d / length
     return p, d, length
+
+
+@njit(cache=True, nogil=True)
+def _side_edge_normal(coords, j, r0, count, a, b, size_row, d, nvec, tol):
+    """The z axis of the side edge at ring vertex j, whose outgoing edge has direction ``d``: the mean of
+    the outward normals of the side faces before and after it, as CityEngine points an edge's z along the
+    mean of its faces' normals (PRT: a prism's corner edges look along the corner's bisector); the normal
+    after it where the two cancel (a spike) or no edge before it has a length."""
+    after = _cross(d, nvec)
+    for back in range(1, count):
+        q = r0 + (j - r0 - back) % count
+        _, before, length = _edge(coords, q, r0, count, a, b, size_row)
+        if length > tol:
+            mean = _cross(before, nvec) + after
+            norm = np.sqrt(mean[0] * mean[0] + mean[1] * mean[1] + mean[2] * mean[2])
+            return mean / norm if norm > tol else after
+    return after
 
 
 @njit(cache=True, nogil=True)
@@ -188,7 +206,7 @@ def components(kind, coords, ring_offsets, shape_offsets, plane, size, tol):
                     m = _put(out, m, i, p + nvec * h, d, nvec, _cross(d, nvec), _sizes(edge_length, 0.0),
                              RECT)
         if volume and (kind == 4 or kind == 5):
-            # side edges: x up the extrusion, z the outward normal of the side face starting there
+            # side edges: x up the extrusion, z between the normals of the two side faces that meet there
             for ring in range(shape_offsets[i], shape_offsets[i + 1]):
                 r0 = ring_offsets[ring]
                 count = ring_offsets[ring + 1] - r0
@@ -196,8 +214,8 @@ def components(kind, coords, ring_offsets, shape_offsets, plane, size, tol):
                     p, d, length = _edge(coords, j, r0, count, a, b, size[i])
                     if length <= tol:
                         continue
-                    outward = _cross(d, nvec)
-                    m = _put(out, m, i, p, nvec, _cross(outward, nvec), outward, _sizes(h, 0.0), RECT)
+                    z = _side_edge_normal(coords, j, r0, count, a, b, size[i], d, nvec, tol)
+                    m = _put(out, m, i, p, nvec, _cross(z, nvec), z, _sizes(h, 0.0), RECT)
         if volume and (kind == 0 or kind == 2):
             # top: z = n, x = a, y = z cross x
             y = _cross(nvec, avec)

@@ -36,9 +36,11 @@ def test_nil_and_a_pushed_successor(write):
 
 
 def test_brackets_whose_shapes_all_vanish_give_the_shapes_back_at_their_end(write):
-    """An offset's inside of a small face is empty; the shape comes back at `]` and goes on, alone in its
-    chunk as among others (candler's roof pipes were lost on small lots derived alone)."""
-    text = "Lot --> [ offset(-100, inside) A ] [ offset(-100, inside) [ B ] C ] s('1, 0, '1) Roof\n"
+    """The footprint of a face seen edge-on (its scope turned upright) is empty; the shape comes back at
+    `]` and goes on, alone in its chunk as among others (candler's roof pipes were lost on small lots
+    derived alone)."""
+    text = ("Lot --> case scope.sx < 10 : rotateScope(90, 0, 0) X else : X\n"
+            "X --> [ footprint() A ] [ footprint() [ B ] C ] Roof\n")
     assert names(run(write, text, [rect(2, 2)])) == ["Roof"]
     assert names(run(write, text, [rect(2, 2), rect(300, 300)])) == ["Roof", "A", "B", "C", "Roof"]
 

@@ -154,9 +154,11 @@ def test_box_edges_and_vertices():
     assert np.all(origin[:4, 1] == 0) and np.allclose(origin[4:8, 1], SIZE[1])
     np.testing.assert_allclose(axes[8:, 0], np.tile([0, 1, 0], (4, 1)))
     np.testing.assert_allclose(csize[8:, 0], SIZE[1])
-    # a side edge's z is the outward normal of the side face starting there
+    # a side edge's z is the mean of the outward normals of the side faces meeting there (the one ending
+    # there and the one starting there), as CityEngine's edges look along their faces' mean normal
     side = run("sidefaces", [box(SIZE)])
-    np.testing.assert_allclose(axes[8:, 2], side[3][:, 2], atol=1e-12)
+    mean = side[3][:, 2] + np.roll(side[3][:, 2], 1, axis=0)
+    np.testing.assert_allclose(axes[8:, 2], mean / np.sqrt(2), atol=1e-12)
     np.testing.assert_allclose(origin[8:], side[2])
 
     parent, index, origin, axes, csize, _ = run("vertices", [box(SIZE)])

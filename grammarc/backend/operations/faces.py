@@ -9,7 +9,7 @@ Reads: the scope (``origin``, ``size``, ``frame``), ``geom``, ``lot`` (street se
 expressions read. Writes: the roofs ``origin``, ``size`` and ``geom`` (``taper`` the ``frame`` too: its y
 turns to the face's normal); ``convexify`` and ``cleanupGeometry`` the ``geom``; ``offset``, ``footprint``
 and ``rectify`` every column, as they make the shapes of their pieces anew (new keys; a shape with no piece
-left goes). ``offset`` also takes a shape of several faces in one plane (a mesh of an earlier offset's
+left goes, but ``offset`` keeps it as it was). ``offset`` also takes a shape of several faces in one plane (a mesh of an earlier offset's
 pieces or of convexify's parts) or a roof, and offsets each face.
 """
 
@@ -224,16 +224,27 @@ def offset(ctx: Context, cursor: Shapes, op: ir.Offset) -> Shapes:
     """``offset(d, inside|border|all)``: the shape's face becomes its inset, the ring around it, or both
     (the faces of one shape); a shape of several faces in one plane (an earlier offset's pieces,
     convexify's parts) has each face offset, as CityEngine offsets every face of a geometry, and so has
-    a roof, each face in its own plane (``_roof_offsets``)."""
+    a roof, each face in its own plane (``_roof_offsets``).
+
+    A shape of which nothing is left (``inside`` of a face narrower than twice the distance) stays as it
+    was: PRT warns "no face selected, ignoring operation" and goes on with the shape unchanged, so
+    candler's ``offset(-1.4, inside) PipeEdges`` rims a small roof's whole outline."""
     roof = is_mesh(cursor.geom) & ((cursor.size <= TOL.zero).sum(axis=1) != 1)
     if roof.any():
         flat_rows, roof_rows = np.flatnonzero(~roof), np.flatnonzero(roof)
         flat = cursor.take(flat_rows)
         pieces = _offset_selected(ctx, flat, op)
         roofs, kept = _roof_offsets(ctx, cursor.take(roof_rows), op)
-        return Shapes.merge([_shape_each(ctx, flat, pieces), roofs],
-                            [flat_rows[np.unique(pieces.source)], roof_rows[kept]])
-    return _shape_each(ctx, cursor, _offset_selected(ctx, cursor, op))
+        made = [flat_rows[np.unique(pieces.source)], roof_rows[kept]]
+        shapes = Shapes.merge([_shape_each(ctx, flat, pieces), roofs], made)
+        made = np.sort(np.concatenate(made))
+    else:
+        pieces = _offset_selected(ctx, cursor, op)
+        shapes, made = _shape_each(ctx, cursor, pieces), np.unique(pieces.source)
+    if len(made) == len(cursor):
+        return shapes
+    ignored = np.setdiff1d(np.arange(len(cursor)), made)
+    return Shapes.merge([shapes, cursor.take(ignored)], [made, ignored])
 
 
 def _offset_selected(ctx: Context, cursor: Shapes, op: ir.Offset):

@@ -123,6 +123,23 @@ def test_index_selectors_take_the_component_of_that_number(write):
     assert (totals(r)["v_n"], totals(r)["w_n"]) == (1, 1)
 
 
+def test_vertical_edges_of_a_prism_look_along_the_corners_bisector(write):
+    """The reference: an edge's z points along the mean of its faces' normals, so a prism's corner edge
+    looks out along the corner's bisector. Candler's pipe edges on a roof 1.2 m square: cubes 2.9 deep
+    along z, shifted 0.13 in, reach 1.62 / sqrt(2) beyond each side, as in PRT (along the side faces'
+    normals they reached 1.32)."""
+    text = ("Lot --> extrude(0.7) comp(e){ vertical : s('1, 0.6, 2.9) center(yz) t(0, 0, -0.13) "
+            "primitiveCube() C. }\n")
+    r = run(write, text, [rect(1.2, 1.2)])
+    x = r["xform"].astype(float)
+    assert len(x) == 4
+    corners = np.array(list(np.ndindex(2, 2, 2)), float)
+    world = np.einsum("nij,kj->nki", x[:, :, :3], corners) + x[:, None, :, 3]
+    reach = 1.62 / np.sqrt(2)
+    np.testing.assert_allclose(world.min(axis=(0, 1))[[0, 2]], [-reach, -1.2 - reach], atol=1e-6)
+    np.testing.assert_allclose(world.max(axis=(0, 1))[[0, 2]], [1.2 + reach, reach], atol=1e-6)
+
+
 def _face_area_normal(mesh, face):
     """Signed area vector (Newell) of a mesh face: its outline minus its holes."""
     total = np.zeros(3)

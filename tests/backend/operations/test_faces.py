@@ -172,6 +172,18 @@ def test_offset_border_of_several_pieces_rings_each(write):
     assert totals(r)["a_sum"] == pytest.approx(2 * (49 - 25))
 
 
+def test_offset_that_leaves_nothing_keeps_the_shape_as_it_was(write):
+    """An inset of 1.4 of a face 2.4 wide leaves nothing: PRT ignores such an offset ("no face selected,
+    ignoring operation") and goes on with the face (candler's roof pipes on a tiny lot, 2160.7 m2 in PRT
+    where dropping the roof gave 1141.5); in one batch with a face wide enough, each shape its own way."""
+    text = 'Lot --> offset(-1.4, inside) report("a", geometry.area) report("x", scope.sx) extrude(0.7) X.\n'
+    lots = per_lot(run(write, text, [rect(2.4, 6), rect(12, 8)]))
+    assert [(t["a_sum"], t["x_sum"]) for _, t in sorted(lots.items())] == [
+        (pytest.approx(2.4 * 6), pytest.approx(2.4)), (pytest.approx(9.2 * 5.2), pytest.approx(9.2))]
+    roofs = per_lot(run(write, text.replace("Lot --> ", "Lot --> roofPyramid(45) "), [rect(2.4, 2.4)]))
+    assert roofs[0]["a_sum"] == pytest.approx(2.4 ** 2 * (1 + np.sqrt(2)))
+
+
 def _pyramid_offsets(d):
     """A 45-degree pyramid roof over a 10 m square offset by -d, face by face in its own plane: the
     bottom's inset and each triangle's (a similar triangle, scaled by (r - d) / r for its inradius r)."""
