@@ -28,7 +28,7 @@ from grammarc.backend.kernels.order import group_by
 from grammarc.backend.operations.table import Parts, operation
 from grammarc.backend.outlines import flat_axis, polygons_of
 from grammarc.backend.random import child_keys
-from grammarc.backend.reframing import turned
+from grammarc.backend.reframing import reframed, turned
 from grammarc.backend.selectors import classify_faces, selector_frames
 from grammarc.backend.shapes import COLUMNS, Shapes
 from grammarc.constants import TOL
@@ -327,6 +327,7 @@ def offset_faces(ctx: Context, cursor: Shapes, op: ir.CompFaces) -> Parts:
     pieces = _offset_pieces(ctx, op.offset, cursor, op.span)
     border_site = (op.site << 20) + 1  # another stream than the inside faces'
     shapes, kind = _pieces_by_parent(ctx, cursor, pieces, [op.site, border_site])
+    shapes = _along_first_edges(ctx, shapes, op.span)
     names = ("inside", "border")
     which = np.full(len(kind), len(op.selectors), dtype=np.int64)
     for i in range(len(op.selectors) - 1, -1, -1):
@@ -337,6 +338,34 @@ def offset_faces(ctx: Context, cursor: Shapes, op: ir.CompFaces) -> Parts:
     ctx.count(shapes, op.span)
     order, offsets = group_by(which, len(op.parts))
     return Parts(op.parts, shapes.take(order), offsets)
+
+
+def _along_first_edges(ctx: Context, shapes: Shapes, span) -> Shapes:
+    """Face components whose scope x runs along their first edge, as the reference gives every ``comp(f)``
+    face: the scopes of polygons turned about their normal where their first edge leaves the x axis (an
+    inset whose edge 0 the offset made vanish starts at the next one, and PRT's massing splits it along
+    that). Rectangles lie along their box already."""
+    chunk = ctx.chunk
+    poly = np.flatnonzero(shapes.geom >= 0)
+    coords, ring_offsets, poly_offsets = chunk.polygons.gather(shapes.geom[poly])
+    first = ring_offsets[poly_offsets[:-1]]
+    plane = chunk.polygons.plane[shapes.geom[poly]]
+    u, v = PLANE_U[plane], PLANE_V[plane]
+    scale = np.stack([shapes.size[poly, u], shapes.size[poly, v]], axis=1)
+    step = (coords[first + 1] - coords[first]) * scale
+    angle = np.arctan2(step[:, 1], step[:, 0])
+    turn = np.abs(angle) > 1e-9
+    if not turn.any():
+        return shapes
+    rows, u, v, angle = poly[turn], u[turn], v[turn], angle[turn]
+    others = np.setdiff1d(np.arange(len(shapes)), rows)
+    axes = chunk.frames[shapes.frame[rows]]
+    k = np.arange(len(rows))
+    cos, sin = np.cos(angle)[:, None], np.sin(angle)[:, None]
+    new_axes = axes.copy()
+    new_axes[k, u] = cos * axes[k, u] + sin * axes[k, v]
+    new_axes[k, v] = cos * axes[k, v] - sin * axes[k, u]
+    return Shapes.merge([shapes.take(others), reframed(ctx, shapes.take(rows), new_axes, span)], [others, rows])
 
 
 @operation(ir.Setback, consumes=True)
