@@ -100,7 +100,7 @@ def setback_regions(polygons: np.ndarray, edges: Edges, distance: np.ndarray, ow
     regions, covered = [], np.full(m, shapely.Polygon(), dtype=object)
     for k in range(n_owners):
         region = shapely.difference(shapely.intersection(polygons, united[k]), covered)
-        regions.append(_without_spikes(region))
+        regions.append(_without_seams(_without_spikes(region), polygons))
         covered = shapely.union(covered, region)
     return regions, _without_spikes(shapely.difference(polygons, covered))
 
@@ -168,6 +168,45 @@ def _edges_of(edges: Edges, chosen: np.ndarray) -> tuple[np.ndarray, Edges]:
     polygon = np.cumsum(chosen) - 1
     return keep, Edges(edges.start[keep], edges.end[keep], edges.inward[keep], polygon[edges.poly[keep]],
                        renumber[edges.prev[keep]], renumber[edges.next[keep]])
+
+
+def _without_seams(regions: np.ndarray, polygons: np.ndarray) -> np.ndarray:
+    """Regions (m,) without the vertices where two strips of their owner meet on a straight line: a
+    vertex between two collinear edges of a region that is not a vertex of its polygon (m,) goes. PRT's
+    shapeO whose strips cover the whole face is the face itself, its edges numbered as the face's."""
+    parts, part_of = shapely.get_parts(regions, return_index=True)
+    if not len(parts):
+        return regions
+    kind, coords, (ring_offsets, poly_offsets) = shapely.to_ragged_array(parts)
+    coords, ring_offsets = np.asarray(coords)[:, :2], np.asarray(ring_offsets, dtype=np.int64)
+    ring = np.repeat(np.arange(len(ring_offsets) - 1), np.diff(ring_offsets))
+    index = np.arange(len(coords))
+    first, last = ring_offsets[:-1][ring], ring_offsets[1:][ring] - 2  # rings repeat their first vertex
+    a = coords - coords[np.where(index == first, last, index - 1)]
+    b = coords[np.where(index >= last, first, index + 1)] - coords  # (the closing repeats are left alone)
+    cross = a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0]
+    straight = (np.abs(cross) <= 1e-9 * np.hypot(*a.T) * np.hypot(*b.T)) & (np.einsum("ij,ij->i", a, b) > 0)
+    straight &= (index <= last) & (last - first >= 3)
+    rows = np.flatnonzero(straight)
+    if not len(rows):
+        return regions
+    corners, owner = shapely.get_coordinates(polygons, return_index=True)
+    corners = shapely.multipoints(corners, indices=owner)
+    part = np.searchsorted(np.asarray(poly_offsets), ring[rows], side="right") - 1
+    seam = shapely.distance(shapely.points(coords[rows]), corners[part_of[part]]) > 1e-9
+    if not seam.any():
+        return regions
+    keep = np.ones(len(coords), dtype=bool)
+    keep[rows[seam]] = False
+    keep[ring_offsets[1:] - 1] = keep[ring_offsets[:-1]]  # the closing repeat goes with the first
+    counts = np.add.reduceat(keep.astype(np.int64), ring_offsets[:-1])
+    rebuilt = shapely.from_ragged_array(kind, coords[keep], (offsets_from_counts(counts),
+                                                             np.asarray(poly_offsets)))
+    out = regions.copy()
+    touched = np.unique(part_of[part[seam]])
+    mine = np.isin(part_of, touched)
+    out[touched] = shapely.multipolygons(rebuilt[mine], indices=np.searchsorted(touched, part_of[mine]))
+    return out
 
 
 def _without_spikes(geometries: np.ndarray) -> np.ndarray:

@@ -142,3 +142,13 @@ def test_a_moved_edge_steps_next_to_a_kept_one_it_turns_little_from(turn, meets)
                                    np.zeros(len(edges.poly), dtype=np.int64), 1)
     bottom = [x for x, y in remainder[0].exterior.coords if abs(y) < 1e-9]
     assert (max(bottom) < 29.0) == meets
+
+
+def test_strips_that_cover_the_face_leave_no_seam_vertices():
+    """PRT's shapeO whose widths cover the whole face is the face itself: where two strips meet on an
+    edge no vertex is left, so the face's edges keep their numbers (as its tiers' setbacks count them)."""
+    polygon = shapely.Polygon([(0, 0), (10, 0), (12, 4), (10, 8), (0, 8)])
+    (strips,), remainder = setback([polygon], 5.0)
+    assert shapely.area(remainder[0]) == pytest.approx(0.0)
+    assert shapely.equals(strips[0], polygon)
+    assert len(shapely.get_coordinates(strips[0])) == 6  # the five vertices, the first repeated
