@@ -172,9 +172,12 @@ def _edges_of(edges: Edges, chosen: np.ndarray) -> tuple[np.ndarray, Edges]:
 
 def _without_seams(regions: np.ndarray, polygons: np.ndarray) -> np.ndarray:
     """Regions (m,) without the vertices where two strips of their owner meet on a straight line: a
-    vertex between two collinear edges of a region that is not a vertex of its polygon (m,) goes. PRT's
+    vertex between two collinear edges of a region that is not a vertex of its polygon (m,) goes (a region
+    it changes keeps its polygons only: lines and points would go with its pieces anyway). PRT's
     shapeO whose strips cover the whole face is the face itself, its edges numbered as the face's."""
     parts, part_of = shapely.get_parts(regions, return_index=True)
+    polygon = shapely.get_type_id(parts) == shapely.GeometryType.POLYGON  # (not a collapsed sliver's line)
+    parts, part_of = parts[polygon], part_of[polygon]
     if not len(parts):
         return regions
     kind, coords, (ring_offsets, poly_offsets) = shapely.to_ragged_array(parts)

@@ -152,3 +152,15 @@ def test_strips_that_cover_the_face_leave_no_seam_vertices():
     assert shapely.area(remainder[0]) == pytest.approx(0.0)
     assert shapely.equals(strips[0], polygon)
     assert len(shapely.get_coordinates(strips[0])) == 6  # the five vertices, the first repeated
+
+
+def test_seams_go_from_regions_that_also_hold_lines():
+    """A region that snapping left with a line beside its polygon (a strip's zero-wide spike) loses its
+    seams as well."""
+    from grammarc.geometry.setback import _without_seams
+
+    polygon = shapely.box(0, 0, 10, 4)
+    seamed = shapely.Polygon([(0, 0), (5, 0), (10, 0), (10, 4), (0, 4)])
+    region = shapely.GeometryCollection([seamed, shapely.LineString([(10, 4), (12, 6)])])
+    out = _without_seams(np.array([region]), np.array([polygon]))
+    assert len(shapely.get_coordinates(out[0])) == 5
