@@ -106,14 +106,18 @@ def oriented_rings(parts: np.ndarray, part_plane: np.ndarray):
 
 
 def fit_pieces(geometries: np.ndarray, plane: np.ndarray, size: np.ndarray,
-               parents: np.ndarray | None = None, cut_sides: np.ndarray | None = None) -> Clipped:
+               parents: np.ndarray | None = None, cut_sides: np.ndarray | None = None,
+               start_edges: np.ndarray | None = None) -> Clipped:
     """Polygons (or multipolygons) in scope units, one per source row, as pieces with fitted boxes.
 
     ``parents`` (one polygon per source row, the polygons the pieces were cut or moved in from): each
     piece's rings then start where CityEngine's do (``ring_starts``), so that edge numbers
     (``comp.index`` of ``comp(fe)``) follow the parent's. ``cut_sides`` (one bool per source row) when the
     pieces were cut from their parents (a split): whether the row's pieces lie on a side of the cut that
-    holds the parent's vertex 0 or 1; None when they were moved in from them (an offset, a setback)."""
+    holds the parent's vertex 0 or 1; None when they were moved in from them (an offset, a setback).
+    ``start_edges`` (one bool per vertex of the parents' open rings, all rings one after the other): the
+    parent edges (from that vertex) where pieces moved in start when they run along one (a setback's
+    strips start at the first edge they set back)."""
     parts, source = shapely.get_parts(geometries, return_index=True)
     keep = (shapely.get_type_id(parts) == shapely.GeometryType.POLYGON) & (
         shapely.area(parts) > TOL.area_floor)
@@ -128,7 +132,8 @@ def fit_pieces(geometries: np.ndarray, plane: np.ndarray, size: np.ndarray,
                                                 np.asarray(parent_closed, dtype=np.int64))
         cut = cut_sides is not None
         side = cut_sides if cut else np.ones(len(geometries), dtype=np.bool_)
-        flat = ring_starts(flat, ring_offsets, part_offsets, source, side[source], cut, parent_flat,
+        allowed = np.zeros(0, dtype=np.bool_) if start_edges is None else start_edges
+        flat = ring_starts(flat, ring_offsets, part_offsets, source, side[source], cut, allowed, parent_flat,
                            parent_rings, np.asarray(parent_offsets, dtype=np.int64))
     vertex_part = segment_of(part_offsets)[segment_of(ring_offsets)]
     low2 = bounds[:, :2]
@@ -151,8 +156,8 @@ def fit_pieces(geometries: np.ndarray, plane: np.ndarray, size: np.ndarray,
 
 
 @njit(cache=True, nogil=True)
-def ring_starts(coords, ring_offsets, part_offsets, part_source, part_with_start, cut, parent_coords,
-                parent_rings, parent_offsets):
+def ring_starts(coords, ring_offsets, part_offsets, part_source, part_with_start, cut, start_edges,
+                parent_coords, parent_rings, parent_offsets):
     """Each ring of each piece turned to start where CityEngine's clipping and offsets start it.
 
     Every piece vertex gets its place along the parent's boundary: i for the parent's vertex i (ring
@@ -168,7 +173,9 @@ def ring_starts(coords, ring_offsets, part_offsets, part_source, part_with_start
     parent's vertex 0 or 1 (``part_with_start``) at its first place: vertex 0 itself, or the crossing
     where the boundary enters it. A piece on another side starts with its cut edge: at its last place
     on the parent's outer ring, the crossing where that ring leaves it. Holes start at their first
-    place. Returns the coords (V, 2) with every ring turned.
+    place. Where ``start_edges`` (per parent vertex, empty for none) marks edges, an outer ring that runs
+    along some of them starts at the first place among its vertices that do. Returns the coords (V, 2)
+    with every ring turned.
     """
     out = np.empty_like(coords)
     for p in range(len(part_offsets) - 1):
@@ -177,6 +184,7 @@ def ring_starts(coords, ring_offsets, part_offsets, part_source, part_with_start
             r0, r1 = ring_offsets[r], ring_offsets[r + 1]
             n = r1 - r0
             keys = np.empty(n)
+            marked = np.zeros(n, np.bool_)
             for j in range(n):
                 near, key, vertex_key, scale = _boundary_place(coords[r0 + j, 0], coords[r0 + j, 1], g,
                                                                parent_coords, parent_rings, parent_offsets)
@@ -186,6 +194,8 @@ def ring_starts(coords, ring_offsets, part_offsets, part_source, part_with_start
                     edge, away = _edge_place(coords[r0 + j, 0], coords[r0 + j, 1], coords[k, 0], coords[k, 1],
                                              g, parent_coords, parent_rings, parent_offsets)
                 tolerance = 1e-6 * max(scale, 1.0) ** 0.5
+                if np.isfinite(edge) and away <= tolerance and len(start_edges):
+                    marked[j] = start_edges[parent_rings[parent_offsets[g]] + int(edge)]
                 if np.isfinite(edge) and away > tolerance:
                     keys[j] = edge  # its outgoing edge was moved in from that edge (an offset, a setback)
                 elif near <= tolerance * tolerance:
@@ -193,6 +203,8 @@ def ring_starts(coords, ring_offsets, part_offsets, part_source, part_with_start
                 else:
                     keys[j] = vertex_key
             best = int(np.argmin(keys))
+            if r == part_offsets[p] and marked.any():
+                best = int(np.argmin(np.where(marked, keys, np.inf)))
             if r == part_offsets[p] and not part_with_start[p]:
                 # the last place on the parent's outer ring (a piece may run along its holes too)
                 outer = parent_rings[parent_offsets[g] + 1] - parent_rings[parent_offsets[g]]

@@ -35,7 +35,8 @@ _AREA_STEPS = 64
 class Edges:
     """The boundary edges of m polygons: ``start``, ``end`` (E, 2); ``inward`` (E, 2) unit normals
     pointing into the polygon; ``poly`` (E,) the polygon of each edge; ``prev``, ``next`` (E,) the
-    neighbouring edges along the same ring."""
+    neighbouring edges along the same ring; ``vertex`` (E,) each one's start among the vertices of the
+    polygons' open rings, all rings one after the other (as ``shapely.to_ragged_array`` lists them)."""
 
     start: np.ndarray
     end: np.ndarray
@@ -43,6 +44,7 @@ class Edges:
     poly: np.ndarray
     prev: np.ndarray
     next: np.ndarray
+    vertex: np.ndarray
 
 
 def polygon_edges(polygons: np.ndarray) -> Edges:
@@ -68,7 +70,7 @@ def polygon_edges(polygons: np.ndarray) -> Edges:
     local = np.arange(len(ring)) - offsets[ring]
     size = np.maximum(counts[ring], 1)
     return Edges(start, end, inward, ring_poly[ring], offsets[ring] + (local - 1) % size,
-                 offsets[ring] + (local + 1) % size)
+                 offsets[ring] + (local + 1) % size, first - ring)
 
 
 def setback_regions(polygons: np.ndarray, edges: Edges, distance: np.ndarray, owner: np.ndarray,
@@ -167,7 +169,7 @@ def _edges_of(edges: Edges, chosen: np.ndarray) -> tuple[np.ndarray, Edges]:
     renumber[keep] = np.arange(len(keep))
     polygon = np.cumsum(chosen) - 1
     return keep, Edges(edges.start[keep], edges.end[keep], edges.inward[keep], polygon[edges.poly[keep]],
-                       renumber[edges.prev[keep]], renumber[edges.next[keep]])
+                       renumber[edges.prev[keep]], renumber[edges.next[keep]], edges.vertex[keep])
 
 
 def _without_seams(regions: np.ndarray, polygons: np.ndarray) -> np.ndarray:

@@ -150,7 +150,7 @@ def test_cut_pieces_start_as_prt_starts_them():
     edge, where the boundary leaves it."""
     import shapely
 
-    square = shapely.Polygon([(10, 10), (-10, 10), (-10, -10), (10, -10)])  # clockwise in (x, z)
+    square = shapely.Polygon([(10, 10), (-10, 10), (-10, -10), (10, -10)])
     # a cut across edges 1 and 3: vertices 0 and 1 on one side
     low, high = shapely.box(-20, -20, 20, 0), shapely.box(-20, 0, 20, 20)
     assert _first_vertices(square, [square.intersection(high), square.intersection(low)], [True, False]) == [
@@ -159,3 +159,22 @@ def test_cut_pieces_start_as_prt_starts_them():
     left, right = shapely.box(-20, -20, 0, 20), shapely.box(0, -20, 20, 20)
     assert _first_vertices(square, [square.intersection(right), square.intersection(left)], [True, True]) == [
         (10, 10), (0, 10)]
+
+
+def test_strips_start_at_the_first_edge_they_set_back():
+    """PRT's shapeL and shapeU: the strips' region starts at the first parent edge it sets back, though it
+    holds vertex 0 (an L along the left and top edges, 2 and 3, of the square)."""
+    import shapely
+
+    from grammarc.geometry.clip import fit_pieces
+
+    square = shapely.Polygon([(10, 10), (10, -10), (-10, -10), (-10, 10)])  # clockwise in (x, z)
+    strips = shapely.union(shapely.box(-10, -10, -5, 10), shapely.box(-10, 5, 10, 10))
+
+    def first_vertex(start_edges):
+        fitted = fit_pieces(np.array([strips]), np.ones(1, np.int8), np.array([[20.0, 0.0, 20.0]]),
+                            np.array([square]), start_edges=start_edges)
+        return tuple(np.round(fitted.coords[0] * fitted.extent[0, [0, 2]] + fitted.low[0, [0, 2]], 9))
+
+    assert first_vertex(None) == (10, 10)
+    assert first_vertex(np.array([False, False, True, True])) == (-10, -10)

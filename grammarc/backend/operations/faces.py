@@ -429,8 +429,15 @@ class _SetbackFaces:
         """The parts of ``op`` on the strips of the edges moved by ``distance`` (E,) and the remainder."""
         regions, remainder = setback_regions(self.polygons, self.edges, distance, self.owner, len(self.owners))
         by_owner = dict(zip(self.owners, regions))
+        # a region of strips starts at the first edge it sets back, as PRT's shapeL and shapeU
+        vertices = len(shapely.get_coordinates(self.polygons)) - len(shapely.get_rings(self.polygons))
+        moved = (distance > 0) & np.isfinite(distance)
+        starts = {}
+        for k, owner in enumerate(self.owners):
+            starts[owner] = np.zeros(vertices, dtype=bool)
+            starts[owner][self.edges.vertex[moved & (self.owner == k)]] = True
         return _regions(ctx, op, cursor, [by_owner[s] if s != "remainder" else remainder for s in op.selectors],
-                        self.plane, self.polygons)
+                        self.plane, self.polygons, [starts.get(s) for s in op.selectors])
 
 
 @operation(ir.InnerRectangle, consumes=True)
@@ -593,10 +600,13 @@ def _piece_shapes(ctx: Context, cursor: Shapes, pieces, site: int) -> Shapes:
 
 
 def _regions(ctx: Context, op: ir.Setback | ir.SetbackToArea | ir.InnerRectangle, cursor: Shapes, regions: list, plane,
-             polygons) -> Parts:
+             polygons, start_edges: list | None = None) -> Parts:
     """Part k of ``op`` on the pieces of ``regions[k]`` (n,) (polygons in the shapes' scope units, cut
-    from ``polygons``), each parent's pieces together, numbered in stream ``op.site`` part by part."""
-    pieces = [fit_pieces(region, plane, cursor.size, polygons) for region in regions]
+    from ``polygons``), each parent's pieces together, numbered in stream ``op.site`` part by part;
+    ``start_edges[k]``: the parent edges its pieces start at (``fit_pieces``), or None."""
+    starts = start_edges or [None] * len(regions)
+    pieces = [fit_pieces(region, plane, cursor.size, polygons, start_edges=edges)
+              for region, edges in zip(regions, starts)]
     shapes, kind = _pieces_by_parent(ctx, cursor, pieces, [(op.site << 20) + k for k in range(len(pieces))])
     ctx.count(shapes, op.span)
     order, offsets = group_by(kind, len(op.parts))
