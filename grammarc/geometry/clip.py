@@ -164,7 +164,7 @@ def ring_starts(coords, ring_offsets, part_offsets, part_source, part_with_start
     after ring), i + f for a point a fraction f along the edge from vertex i to vertex i + 1 (a cut's
     crossing); but in pieces moved in (not ``cut``) a vertex whose outgoing edge was moved in from parent
     edge i (an offset's, a setback's: parallel to it, in the same direction, the nearest such,
-    ``_edge_place``) gets i; one inside with neither gets the place of the nearest parent vertex.
+    ``_places``) gets i; one inside with neither gets the place of the nearest parent vertex.
 
     CityEngine keeps a polygon's vertex order through offsets, setbacks and cuts: an inset or a
     setback's remainder starts at the edge moved in from the first parent edge that is left (edge 0,
@@ -186,13 +186,12 @@ def ring_starts(coords, ring_offsets, part_offsets, part_source, part_with_start
             keys = np.empty(n)
             marked = np.zeros(n, np.bool_)
             for j in range(n):
-                near, key, vertex_key, scale = _boundary_place(coords[r0 + j, 0], coords[r0 + j, 1], g,
-                                                               parent_coords, parent_rings, parent_offsets)
-                edge, away = np.inf, 0.0
-                if not cut:
-                    k = r0 + (j + 1) % n
-                    edge, away = _edge_place(coords[r0 + j, 0], coords[r0 + j, 1], coords[k, 0], coords[k, 1],
-                                             g, parent_coords, parent_rings, parent_offsets)
+                k = r0 + (j + 1) % n
+                near, key, vertex_key, scale, edge, away = _places(
+                    coords[r0 + j, 0], coords[r0 + j, 1], coords[k, 0], coords[k, 1], g, parent_coords,
+                    parent_rings, parent_offsets)
+                if cut:
+                    edge = np.inf  # a cut's crossings keep their places: their chords run along no edge
                 tolerance = 1e-6 * max(scale, 1.0) ** 0.5
                 if np.isfinite(edge) and away <= tolerance and len(start_edges):
                     marked[j] = start_edges[parent_rings[parent_offsets[g]] + int(edge)]
@@ -216,12 +215,18 @@ def ring_starts(coords, ring_offsets, part_offsets, part_source, part_with_start
 
 
 @njit(cache=True, nogil=True)
-def _boundary_place(px, py, g, parent_coords, parent_rings, parent_offsets):
-    """The nearest point of polygon g's boundary to (px, py): its squared distance, its place (i + f a
-    fraction f along the edge from vertex i to vertex i + 1, ring after ring), the place of the nearest
-    vertex, and the largest squared edge length (a scale for tolerances)."""
+def _places(px, py, qx, qy, g, parent_coords, parent_rings, parent_offsets):
+    """Where the point p and the edge (p, q) of a piece lie on polygon g: the squared distance to the
+    nearest point of its boundary and that point's place (i + f a fraction f along the edge from vertex
+    i to vertex i + 1, ring after ring), the place of the nearest vertex, the largest squared edge length
+    (a scale for tolerances); and the place i of the edge (p, q) runs along or was moved in from
+    (parallel to it, in the same direction, the nearest such; inf when there is none) with the distance
+    between their lines."""
     near, key = np.inf, np.inf
     near_vertex, vertex_key = np.inf, np.inf
+    away, edge = np.inf, np.inf
+    dx, dy = qx - px, qy - py
+    length = np.sqrt(dx * dx + dy * dy)
     scale = 0.0
     base = 0
     for q in range(parent_offsets[g], parent_offsets[g + 1]):
@@ -242,35 +247,13 @@ def _boundary_place(px, py, g, parent_coords, parent_rings, parent_offsets):
             dv = (px - ax) ** 2 + (py - ay) ** 2  # to vertex i
             if dv < near_vertex:
                 near_vertex, vertex_key = dv, base + i
+            u = np.sqrt(length2)
+            if u > 0.0 and length > 0.0 and abs(bx * dy - by * dx) <= 1e-9 * u * length and bx * dx + by * dy > 0.0:
+                distance = abs(bx * (py - ay) - by * (px - ax)) / u
+                if distance < away:
+                    away, edge = distance, base + i
         base += m
-    return near, key, vertex_key, scale
-
-
-@njit(cache=True, nogil=True)
-def _edge_place(px, py, qx, qy, g, parent_coords, parent_rings, parent_offsets):
-    """The place (its index, ring after ring) of the edge of polygon g that the segment (p, q) runs along
-    or was moved in from: parallel to it, in the same direction, the nearest such (inf when there is
-    none); and the distance between their lines."""
-    dx, dy = qx - px, qy - py
-    length = np.sqrt(dx * dx + dy * dy)
-    best, key = np.inf, np.inf
-    if length == 0.0:
-        return key, best
-    base = 0
-    for r in range(parent_offsets[g], parent_offsets[g + 1]):
-        r0, r1 = parent_rings[r], parent_rings[r + 1]
-        m = r1 - r0
-        for i in range(m):
-            ax, ay = parent_coords[r0 + i, 0], parent_coords[r0 + i, 1]
-            ux, uy = parent_coords[r0 + (i + 1) % m, 0] - ax, parent_coords[r0 + (i + 1) % m, 1] - ay
-            u = np.sqrt(ux * ux + uy * uy)
-            if u == 0.0 or abs(ux * dy - uy * dx) > 1e-9 * u * length or ux * dx + uy * dy <= 0.0:
-                continue
-            distance = abs(ux * (py - ay) - uy * (px - ax)) / u
-            if distance < best:
-                best, key = distance, base + i
-        base += m
-    return key, best
+    return near, key, vertex_key, scale, edge, away
 
 
 def _polygons(coords: np.ndarray, ring_offsets: np.ndarray, poly_offsets: np.ndarray) -> np.ndarray:
