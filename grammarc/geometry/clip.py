@@ -79,7 +79,14 @@ def clip_to_slabs(store: PolygonStore, geom: np.ndarray, size: np.ndarray, axis:
     ymin = np.where(along_a, -big, pos)
     ymax = np.where(along_a, big, pos + length)
     pieces = shapely.intersection(polygons, shapely.box(xmin, ymin, xmax, ymax))
-    return fit_pieces(pieces, plane, size, polygons)
+    # the slabs that hold the parent's vertex 0 or 1 (their pieces start differently, ``ring_starts``)
+    slack = TOL.zero * np.maximum(np.maximum(sa, sb), 1.0)
+    with_start = np.zeros(len(geom), dtype=bool)
+    for vertex in (0, 1):
+        point = shapely.get_coordinates(shapely.get_point(shapely.get_exterior_ring(polygons), vertex))
+        at = np.where(along_a, point[:, 0], point[:, 1])
+        with_start |= (at >= pos - slack) & (at <= pos + length + slack)
+    return fit_pieces(pieces, plane, size, polygons, cut_sides=with_start)
 
 
 def oriented_rings(parts: np.ndarray, part_plane: np.ndarray):
@@ -99,12 +106,18 @@ def oriented_rings(parts: np.ndarray, part_plane: np.ndarray):
 
 
 def fit_pieces(geometries: np.ndarray, plane: np.ndarray, size: np.ndarray,
-               parents: np.ndarray | None = None) -> Clipped:
+               parents: np.ndarray | None = None, cut_sides: np.ndarray | None = None,
+               start_edges: np.ndarray | None = None) -> Clipped:
     """Polygons (or multipolygons) in scope units, one per source row, as pieces with fitted boxes.
 
     ``parents`` (one polygon per source row, the polygons the pieces were cut or moved in from): each
     piece's rings then start where CityEngine's do (``ring_starts``), so that edge numbers
-    (``comp.index`` of ``comp(fe)``) follow the parent's."""
+    (``comp.index`` of ``comp(fe)``) follow the parent's. ``cut_sides`` (one bool per source row) when the
+    pieces were cut from their parents (a split): whether the row's pieces lie on a side of the cut that
+    holds the parent's vertex 0 or 1; None when they were moved in from them (an offset, a setback).
+    ``start_edges`` (one bool per vertex of the parents' open rings, all rings one after the other): the
+    parent edges (from that vertex) where pieces moved in start when they run along one (a setback's
+    strips start at the first edge they set back)."""
     parts, source = shapely.get_parts(geometries, return_index=True)
     keep = (shapely.get_type_id(parts) == shapely.GeometryType.POLYGON) & (
         shapely.area(parts) > TOL.area_floor)
@@ -117,8 +130,11 @@ def fit_pieces(geometries: np.ndarray, plane: np.ndarray, size: np.ndarray,
         _, parent_flat, (parent_closed, parent_offsets) = shapely.to_ragged_array(parents)
         parent_flat, parent_rings = _open_rings(np.asarray(parent_flat)[:, :2],
                                                 np.asarray(parent_closed, dtype=np.int64))
-        flat = ring_starts(flat, ring_offsets, segment_of(part_offsets), source, parent_flat, parent_rings,
-                           np.asarray(parent_offsets, dtype=np.int64))
+        cut = cut_sides is not None
+        side = cut_sides if cut else np.ones(len(geometries), dtype=np.bool_)
+        allowed = np.zeros(0, dtype=np.bool_) if start_edges is None else start_edges
+        flat = ring_starts(flat, ring_offsets, part_offsets, source, side[source], cut, allowed, parent_flat,
+                           parent_rings, np.asarray(parent_offsets, dtype=np.int64))
     vertex_part = segment_of(part_offsets)[segment_of(ring_offsets)]
     low2 = bounds[:, :2]
     extent2 = bounds[:, 2:] - bounds[:, :2]
@@ -140,81 +156,104 @@ def fit_pieces(geometries: np.ndarray, plane: np.ndarray, size: np.ndarray,
 
 
 @njit(cache=True, nogil=True)
-def ring_starts(coords, ring_offsets, ring_part, part_source, parent_coords, parent_rings, parent_offsets):
+def ring_starts(coords, ring_offsets, part_offsets, part_source, part_with_start, cut, start_edges,
+                parent_coords, parent_rings, parent_offsets):
     """Each ring of each piece turned to start where CityEngine's clipping and offsets start it.
 
-    A ring a cut made starts with its cut edge (a chord: an edge between two boundary points of the
-    parent that runs inside it), at the point where the parent's boundary leaves the piece: PRT's half
-    of massing's octagon starts with its cut edge whichever vertex the octagon starts at. With several
-    chords, or none, CityEngine keeps a polygon's vertex order through offsets (vertex i of the inset
-    is the mitre of vertex i) and clips it Sutherland-Hodgman fashion (the edges in order, from the one
-    that arrives at vertex 0; a crossing point before the vertex that ends its edge). So every piece
-    vertex gets the position along the parent's boundary of the nearest point on it: edge i (into
-    vertex i, ring after ring) plus the fraction along it, vertex 0 counting as the end of the last
-    edge; the ring starts at the chord whose start has the smallest position, else at its smallest
-    position. Returns the coords (V, 2) with every ring turned.
+    Every piece vertex gets its place along the parent's boundary: i for the parent's vertex i (ring
+    after ring), i + f for a point a fraction f along the edge from vertex i to vertex i + 1 (a cut's
+    crossing); but in pieces moved in (not ``cut``) a vertex whose outgoing edge was moved in from parent
+    edge i (an offset's, a setback's: parallel to it, in the same direction, the nearest such,
+    ``_places``) gets i; one inside with neither gets the place of the nearest parent vertex.
+
+    CityEngine keeps a polygon's vertex order through offsets, setbacks and cuts: an inset or a
+    setback's remainder starts at the edge moved in from the first parent edge that is left (edge 0,
+    unless the offset made it vanish). PRT (measured through PyPRT on some 700 pieces of convex and
+    concave lots cut by ``split``) starts the outline of a piece on a side of the cut that holds the
+    parent's vertex 0 or 1 (``part_with_start``) at its first place: vertex 0 itself, or the crossing
+    where the boundary enters it. A piece on another side starts with its cut edge: at its last place
+    on the parent's outer ring, the crossing where that ring leaves it. Holes start at their first
+    place. Where ``start_edges`` (per parent vertex, empty for none) marks edges, an outer ring that runs
+    along some of them starts at the first place among its vertices that do. Returns the coords (V, 2)
+    with every ring turned.
     """
     out = np.empty_like(coords)
-    for r in range(len(ring_offsets) - 1):
-        r0, r1 = ring_offsets[r], ring_offsets[r + 1]
-        n = r1 - r0
-        g = part_source[ring_part[r]]
-        keys = np.empty(n)
-        on = np.empty(n, np.bool_)
-        for j in range(n):
-            near, key, vertex_key, scale = _boundary_place(coords[r0 + j, 0], coords[r0 + j, 1], g,
-                                                           parent_coords, parent_rings, parent_offsets)
-            # on the boundary (a cut's crossing, an unmoved vertex): its place there; moved in (an
-            # offset's mitre): the place of the vertex it came from
-            on[j] = near <= 1e-12 * max(scale, 1.0)
-            keys[j] = key if on[j] else vertex_key
-        best = -1
-        for j in range(n):
-            k = (j + 1) % n
-            if not (on[j] and on[k]) or (best >= 0 and keys[j] >= keys[best]):
-                continue
-            near, _, _, scale = _boundary_place(0.5 * (coords[r0 + j, 0] + coords[r0 + k, 0]),
-                                                0.5 * (coords[r0 + j, 1] + coords[r0 + k, 1]), g,
-                                                parent_coords, parent_rings, parent_offsets)
-            if near > 1e-12 * max(scale, 1.0):
-                best = j
-        if best < 0:
+    for p in range(len(part_offsets) - 1):
+        g = part_source[p]
+        for r in range(part_offsets[p], part_offsets[p + 1]):
+            r0, r1 = ring_offsets[r], ring_offsets[r + 1]
+            n = r1 - r0
+            keys = np.empty(n)
+            marked = np.zeros(n, np.bool_)
+            for j in range(n):
+                k = r0 + (j + 1) % n
+                near, key, vertex_key, scale, edge, away = _places(
+                    coords[r0 + j, 0], coords[r0 + j, 1], coords[k, 0], coords[k, 1], g, parent_coords,
+                    parent_rings, parent_offsets)
+                if cut:
+                    edge = np.inf  # a cut's crossings keep their places: their chords run along no edge
+                tolerance = 1e-6 * max(scale, 1.0) ** 0.5
+                if np.isfinite(edge) and away <= tolerance and len(start_edges):
+                    marked[j] = start_edges[parent_rings[parent_offsets[g]] + int(edge)]
+                if np.isfinite(edge) and away > tolerance:
+                    keys[j] = edge  # its outgoing edge was moved in from that edge (an offset, a setback)
+                elif near <= tolerance * tolerance:
+                    keys[j] = key  # on the boundary: a kept vertex, a cut's crossing
+                else:
+                    keys[j] = vertex_key
             best = int(np.argmin(keys))
-        for j in range(n):
-            k = r0 + (best + j) % n
-            out[r0 + j, 0], out[r0 + j, 1] = coords[k, 0], coords[k, 1]
+            if r == part_offsets[p] and marked.any():
+                best = int(np.argmin(np.where(marked, keys, np.inf)))
+            if r == part_offsets[p] and not part_with_start[p]:
+                # the last place on the parent's outer ring (a piece may run along its holes too)
+                outer = parent_rings[parent_offsets[g] + 1] - parent_rings[parent_offsets[g]]
+                best = int(np.argmax(np.where(keys < outer, keys, -1.0)))
+            for j in range(n):
+                k = r0 + (best + j) % n
+                out[r0 + j, 0], out[r0 + j, 1] = coords[k, 0], coords[k, 1]
     return out
 
 
 @njit(cache=True, nogil=True)
-def _boundary_place(px, py, g, parent_coords, parent_rings, parent_offsets):
-    """The nearest point of polygon g's boundary to (px, py): its squared distance, its position (edge
-    i into vertex i, ring after ring, plus the fraction along it; vertex 0 ends the last edge), the
-    position of the nearest vertex, and the largest squared edge length (a scale for tolerances)."""
+def _places(px, py, qx, qy, g, parent_coords, parent_rings, parent_offsets):
+    """Where the point p and the edge (p, q) of a piece lie on polygon g: the squared distance to the
+    nearest point of its boundary and that point's place (i + f a fraction f along the edge from vertex
+    i to vertex i + 1, ring after ring), the place of the nearest vertex, the largest squared edge length
+    (a scale for tolerances); and the place i of the edge (p, q) runs along or was moved in from
+    (parallel to it, in the same direction, the nearest such; inf when there is none) with the distance
+    between their lines."""
     near, key = np.inf, np.inf
     near_vertex, vertex_key = np.inf, np.inf
+    away, edge = np.inf, np.inf
+    dx, dy = qx - px, qy - py
+    length = np.sqrt(dx * dx + dy * dy)
     scale = 0.0
     base = 0
     for q in range(parent_offsets[g], parent_offsets[g + 1]):
         q0, q1 = parent_rings[q], parent_rings[q + 1]
         m = q1 - q0
-        for i in range(m):  # edge i runs from vertex i - 1 into vertex i: positions base + [i, i + 1]
-            ax, ay = parent_coords[q0 + (i - 1) % m, 0], parent_coords[q0 + (i - 1) % m, 1]
-            bx, by = parent_coords[q0 + i, 0] - ax, parent_coords[q0 + i, 1] - ay
+        for i in range(m):
+            ax, ay = parent_coords[q0 + i, 0], parent_coords[q0 + i, 1]
+            bx, by = parent_coords[q0 + (i + 1) % m, 0] - ax, parent_coords[q0 + (i + 1) % m, 1] - ay
             length2 = bx * bx + by * by
             scale = max(scale, length2)
             f = 0.0 if length2 == 0.0 else min(max(((px - ax) * bx + (py - ay) * by) / length2, 0.0), 1.0)
             d = (px - ax - f * bx) ** 2 + (py - ay - f * by) ** 2
             position = base + i + f
-            if i == 0 and f < 1e-9:
-                position = base + m  # vertex 0's predecessor ends the last edge
+            if f > 1.0 - 1e-9:
+                position = base + (i + 1) % m  # the edge's end is the next vertex
             if d < near - 1e-18 or (d <= near + 1e-18 and position < key):
                 near, key = d, position
-            dv = (px - ax - bx) ** 2 + (py - ay - by) ** 2  # to vertex i
+            dv = (px - ax) ** 2 + (py - ay) ** 2  # to vertex i
             if dv < near_vertex:
-                near_vertex, vertex_key = dv, base + i + 1.0
+                near_vertex, vertex_key = dv, base + i
+            u = np.sqrt(length2)
+            if u > 0.0 and length > 0.0 and abs(bx * dy - by * dx) <= 1e-9 * u * length and bx * dx + by * dy > 0.0:
+                distance = abs(bx * (py - ay) - by * (px - ax)) / u
+                if distance < away:
+                    away, edge = distance, base + i
         base += m
-    return near, key, vertex_key, scale
+    return near, key, vertex_key, scale, edge, away
 
 
 def _polygons(coords: np.ndarray, ring_offsets: np.ndarray, poly_offsets: np.ndarray) -> np.ndarray:

@@ -92,9 +92,9 @@ def test_paper_notation_splits_a_concave_lot(write):
 
 
 def test_pieces_start_where_cityengine_starts_them():
-    """Offsets keep vertex i at the mitre of vertex i; a cut keeps the parent's order from the edge that
-    arrives at vertex 0 (Sutherland-Hodgman), so edge numbers follow the parent's. The U lot of the PRT
-    kit in its footprint plane (x, z), clockwise there: counter-clockwise seen from +y."""
+    """Offsets keep vertex i at the mitre of vertex i, so edge numbers follow the parent's; a cut piece
+    on the side without vertex 0 and 1 starts with its cut edge. The U lot of the PRT kit in its
+    footprint plane (x, z), clockwise there: counter-clockwise seen from +y."""
     import shapely
 
     from grammarc.geometry.clip import fit_pieces
@@ -110,8 +110,9 @@ def test_pieces_start_where_cityengine_starts_them():
                                [3, 3])  # vertex 0's mitre
     ordered = shapely.Polygon([(3, 3), (3, 27), (7, 27), (7, 12), (33, 12), (33, 27), (37, 27), (37, 3)])
     cut = shapely.intersection(ordered, shapely.box(20, -1, 50, 40))
-    np.testing.assert_allclose(first_vertex(fit_pieces(np.array([cut]), plane, size, np.array([ordered]))),
-                               [20, 3])  # where the edge into vertex 0 crosses the cut
+    # the side of the cut without vertex 0 and 1: where the boundary leaves the piece, on the edge into vertex 0
+    np.testing.assert_allclose(first_vertex(fit_pieces(np.array([cut]), plane, size, np.array([ordered]),
+                                                       cut_sides=np.array([False]))), [20, 3])
 
 
 def test_a_cut_piece_starts_with_its_cut_edge():
@@ -125,6 +126,55 @@ def test_a_cut_piece_starts_with_its_cut_edge():
     a, b = 11.08655439, 4.592201188
     octagon = shapely.Polygon([(-a, -b), (-a, b), (-b, a), (b, a), (a, b), (a, -b), (b, -a), (-b, -a)])
     half = shapely.intersection(octagon, shapely.box(0, -20, 20, 20))
-    pieces = fit_pieces(np.array([half]), np.array([1]), np.array([[2 * a, 0.0, 2 * a]]), np.array([octagon]))
+    pieces = fit_pieces(np.array([half]), np.array([1]), np.array([[2 * a, 0.0, 2 * a]]), np.array([octagon]),
+                        cut_sides=np.array([False]))
     ring = pieces.coords[:6] * pieces.extent[0, [0, 2]] + pieces.low[0, [0, 2]]
     np.testing.assert_allclose(ring[:3], [[0, -a], [0, a], [b, a]], atol=1e-9)
+
+
+def _first_vertices(parent, pieces, cut_sides):
+    """The first vertex of each piece of ``parent`` (shapely polygons) as ``fit_pieces`` turns them."""
+    from grammarc.geometry.clip import fit_pieces
+
+    fitted = fit_pieces(np.array(pieces), np.ones(len(pieces), np.int8), np.array([[40.0, 0.0, 40.0]] * len(pieces)),
+                        np.array([parent] * len(pieces)), cut_sides=np.array(cut_sides))
+    starts = fitted.ring_offsets[fitted.poly_offsets[:-1]]
+    return [tuple(np.round(fitted.coords[k] * fitted.extent[i, [0, 2]] + fitted.low[i, [0, 2]], 9))
+            for i, k in enumerate(starts)]
+
+
+def test_cut_pieces_start_as_prt_starts_them():
+    """PRT's pieces of a split (massing's footprint split, measured through PyPRT on a square and on
+    convex and concave lots): the piece with vertex 0 starts there; a piece on the side of vertex 1
+    starts where the boundary enters it (edge 0's crossing); a piece on neither side starts with its cut
+    edge, where the boundary leaves it."""
+    import shapely
+
+    square = shapely.Polygon([(10, 10), (-10, 10), (-10, -10), (10, -10)])
+    # a cut across edges 1 and 3: vertices 0 and 1 on one side
+    low, high = shapely.box(-20, -20, 20, 0), shapely.box(-20, 0, 20, 20)
+    assert _first_vertices(square, [square.intersection(high), square.intersection(low)], [True, False]) == [
+        (10, 10), (10, 0)]
+    # a cut across edges 0 and 2: vertex 0 on one side, vertex 1 on the other
+    left, right = shapely.box(-20, -20, 0, 20), shapely.box(0, -20, 20, 20)
+    assert _first_vertices(square, [square.intersection(right), square.intersection(left)], [True, True]) == [
+        (10, 10), (0, 10)]
+
+
+def test_strips_start_at_the_first_edge_they_set_back():
+    """PRT's shapeL and shapeU: the strips' region starts at the first parent edge it sets back, though it
+    holds vertex 0 (an L along the left and top edges, 2 and 3, of the square)."""
+    import shapely
+
+    from grammarc.geometry.clip import fit_pieces
+
+    square = shapely.Polygon([(10, 10), (10, -10), (-10, -10), (-10, 10)])  # clockwise in (x, z)
+    strips = shapely.union(shapely.box(-10, -10, -5, 10), shapely.box(-10, 5, 10, 10))
+
+    def first_vertex(start_edges):
+        fitted = fit_pieces(np.array([strips]), np.ones(1, np.int8), np.array([[20.0, 0.0, 20.0]]),
+                            np.array([square]), start_edges=start_edges)
+        return tuple(np.round(fitted.coords[0] * fitted.extent[0, [0, 2]] + fitted.low[0, [0, 2]], 9))
+
+    assert first_vertex(None) == (10, 10)
+    assert first_vertex(np.array([False, False, True, True])) == (-10, -10)

@@ -126,3 +126,41 @@ def test_distances_to_area_of_each_polygon_leave_its_area_whatever_the_batch():
         mine = edges.poly == k
         np.testing.assert_array_equal(distances_to_area(polygons[k:k + 1], alone, np.zeros(mine.sum()), cap[mine],
                                                         np.ones(mine.sum(), dtype=bool), target[k:k + 1]), d[mine])
+
+
+@pytest.mark.parametrize("turn, meets", [(10.0, False), (14.9, False), (15.1, True), (20.0, True)])
+def test_a_moved_edge_steps_next_to_a_kept_one_it_turns_little_from(turn, meets):
+    """PRT's massing: a kept edge (bottom, 30 m) then an edge set back 4 that turns from it by less than
+    15 degrees: the strip ends at the 4 m mitre point of the vertex, so the remainder keeps the bottom edge
+    to (30, 0); turned by more, the moved line runs on to the bottom edge and meets it before (30, 0)."""
+    a = np.radians(turn)
+    v3 = (30 + 15 * np.cos(a), 15 * np.sin(a))
+    polygon = shapely.Polygon([(0, 20), (0, 0), (30, 0), v3, (v3[0] - 5, 25)])
+    edges = polygon_edges(np.array([polygon]))
+    along = (np.abs(edges.start[:, 1]) < 1e-9) & (np.abs(edges.end[:, 1]) < 1e-9)  # the bottom edge stays
+    _, remainder = setback_regions(np.array([polygon]), edges, np.where(along, 0.0, 4.0),
+                                   np.zeros(len(edges.poly), dtype=np.int64), 1)
+    bottom = [x for x, y in remainder[0].exterior.coords if abs(y) < 1e-9]
+    assert (max(bottom) < 29.0) == meets
+
+
+def test_strips_that_cover_the_face_leave_no_seam_vertices():
+    """PRT's shapeO whose widths cover the whole face is the face itself: where two strips meet on an
+    edge no vertex is left, so the face's edges keep their numbers (as its tiers' setbacks count them)."""
+    polygon = shapely.Polygon([(0, 0), (10, 0), (12, 4), (10, 8), (0, 8)])
+    (strips,), remainder = setback([polygon], 5.0)
+    assert shapely.area(remainder[0]) == pytest.approx(0.0)
+    assert shapely.equals(strips[0], polygon)
+    assert len(shapely.get_coordinates(strips[0])) == 6  # the five vertices, the first repeated
+
+
+def test_seams_go_from_regions_that_also_hold_lines():
+    """A region that snapping left with a line beside its polygon (a strip's zero-wide spike) loses its
+    seams as well."""
+    from grammarc.geometry.setback import _without_seams
+
+    polygon = shapely.box(0, 0, 10, 4)
+    seamed = shapely.Polygon([(0, 0), (5, 0), (10, 0), (10, 4), (0, 4)])
+    region = shapely.GeometryCollection([seamed, shapely.LineString([(10, 4), (12, 6)])])
+    out = _without_seams(np.array([region]), np.array([polygon]))
+    assert len(shapely.get_coordinates(out[0])) == 5

@@ -28,7 +28,7 @@ from grammarc.backend.kernels.order import group_by
 from grammarc.backend.operations.table import Parts, operation
 from grammarc.backend.outlines import flat_axis, polygons_of
 from grammarc.backend.random import child_keys
-from grammarc.backend.reframing import turned
+from grammarc.backend.reframing import reframed, turned
 from grammarc.backend.selectors import classify_faces, selector_frames
 from grammarc.backend.shapes import COLUMNS, Shapes
 from grammarc.constants import TOL
@@ -338,6 +338,7 @@ def offset_faces(ctx: Context, cursor: Shapes, op: ir.CompFaces) -> Parts:
     pieces = _offset_pieces(ctx, op.offset, cursor, op.span)
     border_site = (op.site << 20) + 1  # another stream than the inside faces'
     shapes, kind = _pieces_by_parent(ctx, cursor, pieces, [op.site, border_site])
+    shapes = _along_first_edges(ctx, shapes, op.span)
     names = ("inside", "border")
     which = np.full(len(kind), len(op.selectors), dtype=np.int64)
     for i in range(len(op.selectors) - 1, -1, -1):
@@ -348,6 +349,34 @@ def offset_faces(ctx: Context, cursor: Shapes, op: ir.CompFaces) -> Parts:
     ctx.count(shapes, op.span)
     order, offsets = group_by(which, len(op.parts))
     return Parts(op.parts, shapes.take(order), offsets)
+
+
+def _along_first_edges(ctx: Context, shapes: Shapes, span) -> Shapes:
+    """Face components whose scope x runs along their first edge, as the reference gives every ``comp(f)``
+    face: the scopes of polygons turned about their normal where their first edge leaves the x axis (an
+    inset whose edge 0 the offset made vanish starts at the next one, and PRT's massing splits it along
+    that). Rectangles lie along their box already."""
+    chunk = ctx.chunk
+    poly = np.flatnonzero(shapes.geom >= 0)
+    coords, ring_offsets, poly_offsets = chunk.polygons.gather(shapes.geom[poly])
+    first = ring_offsets[poly_offsets[:-1]]
+    plane = chunk.polygons.plane[shapes.geom[poly]]
+    u, v = PLANE_U[plane], PLANE_V[plane]
+    scale = np.stack([shapes.size[poly, u], shapes.size[poly, v]], axis=1)
+    step = (coords[first + 1] - coords[first]) * scale
+    angle = np.arctan2(step[:, 1], step[:, 0])
+    turn = np.abs(angle) > 1e-9
+    if not turn.any():
+        return shapes
+    rows, u, v, angle = poly[turn], u[turn], v[turn], angle[turn]
+    others = np.setdiff1d(np.arange(len(shapes)), rows)
+    axes = chunk.frames[shapes.frame[rows]]
+    k = np.arange(len(rows))
+    cos, sin = np.cos(angle)[:, None], np.sin(angle)[:, None]
+    new_axes = axes.copy()
+    new_axes[k, u] = cos * axes[k, u] + sin * axes[k, v]
+    new_axes[k, v] = cos * axes[k, v] - sin * axes[k, u]
+    return Shapes.merge([shapes.take(others), reframed(ctx, shapes.take(rows), new_axes, span)], [others, rows])
 
 
 @operation(ir.Setback, consumes=True)
@@ -411,8 +440,15 @@ class _SetbackFaces:
         """The parts of ``op`` on the strips of the edges moved by ``distance`` (E,) and the remainder."""
         regions, remainder = setback_regions(self.polygons, self.edges, distance, self.owner, len(self.owners))
         by_owner = dict(zip(self.owners, regions))
+        # a region of strips starts at the first edge it sets back, as PRT's shapeL and shapeU
+        vertices = len(shapely.get_coordinates(self.polygons)) - len(shapely.get_rings(self.polygons))
+        moved = (distance > 0) & np.isfinite(distance)
+        starts = {}
+        for k, owner in enumerate(self.owners):
+            starts[owner] = np.zeros(vertices, dtype=bool)
+            starts[owner][self.edges.vertex[moved & (self.owner == k)]] = True
         return _regions(ctx, op, cursor, [by_owner[s] if s != "remainder" else remainder for s in op.selectors],
-                        self.plane, self.polygons)
+                        self.plane, self.polygons, [starts.get(s) for s in op.selectors])
 
 
 @operation(ir.InnerRectangle, consumes=True)
@@ -575,10 +611,13 @@ def _piece_shapes(ctx: Context, cursor: Shapes, pieces, site: int) -> Shapes:
 
 
 def _regions(ctx: Context, op: ir.Setback | ir.SetbackToArea | ir.InnerRectangle, cursor: Shapes, regions: list, plane,
-             polygons) -> Parts:
+             polygons, start_edges: list | None = None) -> Parts:
     """Part k of ``op`` on the pieces of ``regions[k]`` (n,) (polygons in the shapes' scope units, cut
-    from ``polygons``), each parent's pieces together, numbered in stream ``op.site`` part by part."""
-    pieces = [fit_pieces(region, plane, cursor.size, polygons) for region in regions]
+    from ``polygons``), each parent's pieces together, numbered in stream ``op.site`` part by part;
+    ``start_edges[k]``: the parent edges its pieces start at (``fit_pieces``), or None."""
+    starts = start_edges or [None] * len(regions)
+    pieces = [fit_pieces(region, plane, cursor.size, polygons, start_edges=edges)
+              for region, edges in zip(regions, starts)]
     shapes, kind = _pieces_by_parent(ctx, cursor, pieces, [(op.site << 20) + k for k in range(len(pieces))])
     ctx.count(shapes, op.span)
     order, offsets = group_by(kind, len(op.parts))

@@ -76,6 +76,16 @@ def test_setback_leaves_its_parts_to_cityengine_leaf_rules(write):
     assert sorted(names(r)) == ["Mass", "Yard"]
 
 
+def test_offset_inside_face_runs_along_its_first_edge(write):
+    """comp(f)'s faces of an offset get x along their first edge: a lot whose edge 0 (a 0.42 m chamfer,
+    at 45 degrees) the offset makes vanish has its inset start at the next edge, and its scope turns
+    with it (PRT turned massing's footprint split so on such a lot)."""
+    chamfered = [np.array([[0, 0.3], [0.3, 0], [20, 0], [20, 10], [0, 10]], float)]
+    text = 'Lot --> offset(-1) comp(f){ inside : I }\nI --> report("x", scope.sx) report("z", scope.sz)\n'
+    t = totals(run(write, text, [chamfered]))
+    assert (t["x_sum"], t["z_sum"]) == (pytest.approx(18), pytest.approx(8))
+
+
 def test_offset_inside_of_a_rectangle_stays_a_box_path_rectangle(write):
     r = run(write, "Lot --> offset(-1, inside) extrude(2) X.\n", [rect(12, 8)])
     np.testing.assert_allclose(np.diagonal(np.abs(r["xform"][0, :, :3])), [10, 2, 6])
