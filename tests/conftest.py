@@ -26,6 +26,14 @@ needs_scipy = pytest.mark.skipif(importlib.util.find_spec("scipy") is None, reas
 needs_earcut = pytest.mark.skipif(importlib.util.find_spec("mapbox_earcut") is None,
                                   reason="mapbox-earcut not installed")
 
+
+@pytest.fixture(scope="session")
+def prt_reference():
+    """The PRT kit's reference records (``grammarc.conform.load_reference``)."""
+    from grammarc.conform import load_reference
+
+    return load_reference(PRT_KIT)
+
 #: Footprints in map coordinates (x east, y north), exterior counter-clockwise, holes clockwise.
 LOT_ZOO = {
     "square": [np.array([[0, 0], [10, 0], [10, 10], [0, 10]], float)],

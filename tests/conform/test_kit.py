@@ -15,30 +15,25 @@ from grammarc.conform import (
 from grammarc.errors import UsageError
 
 
-@pytest.fixture(scope="module")
-def reference():
-    return load_reference(KIT)
-
-
 @needs_kit
-def test_find_record(reference):
-    record = find_record(reference, "extrude_color", "rect_30x20", {})
+def test_find_record(prt_reference):
+    record = find_record(prt_reference, "extrude_color", "rect_30x20", {})
     assert record["bbox_min"] == [0, 0, 0] and record["bbox_max"] == [30, 5, 20]
     assert record["surface_area"] == 1700
-    assert find_record(reference, "rpk/extrude_color.rpk", "footprints/rect_30x20.obj") is record
+    assert find_record(prt_reference, "rpk/extrude_color.rpk", "footprints/rect_30x20.obj") is record
     # Integers match the stored floats; the attributes' order does not matter.
-    variant = find_record(reference, "candler", "rect_30x20",
+    variant = find_record(prt_reference, "candler", "rect_30x20",
                           {"TileWidth": 3, "FloorHeight": 3.2, "BuildingHeight": 40})
     assert variant["attrs"] == {"BuildingHeight": 40.0, "FloorHeight": 3.2, "TileWidth": 3.0}
-    assert find_record(reference, "candler", "rect_30x20", {"BuildingHeight": 40})["attrs"] == {
+    assert find_record(prt_reference, "candler", "rect_30x20", {"BuildingHeight": 40})["attrs"] == {
         "BuildingHeight": 40.0
     }
     # Attributes set to the defaults PRT used find the default record.
-    default = find_record(reference, "candler", "octagon", {"BuildingHeight": 62})
-    assert default is find_record(reference, "candler", "octagon", None) and default["attrs"] == {}
-    assert find_record(reference, "candler", "rect_30x20", {"BuildingHeight": 41}) is None
-    assert find_record(reference, "candler", "rect_30x20", seed=1) is None
-    assert find_record(reference, "nosuch", "rect_30x20") is None
+    default = find_record(prt_reference, "candler", "octagon", {"BuildingHeight": 62})
+    assert default is find_record(prt_reference, "candler", "octagon", None) and default["attrs"] == {}
+    assert find_record(prt_reference, "candler", "rect_30x20", {"BuildingHeight": 41}) is None
+    assert find_record(prt_reference, "candler", "rect_30x20", seed=1) is None
+    assert find_record(prt_reference, "nosuch", "rect_30x20") is None
 
 
 @needs_kit

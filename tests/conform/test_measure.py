@@ -5,23 +5,16 @@ import math
 import numpy as np
 import pytest
 import trimesh
-from conftest import PRT_KIT as KIT
 from conftest import needs_earcut, needs_kit, needs_scipy
 
 from grammarc.conform import (
     compare,
     find_record,
-    load_reference,
     measure,
     surface_distance,
 )
 from grammarc.io.bake import bake
 from grammarc.model.records import MeshChunk
-
-
-@pytest.fixture(scope="module")
-def reference():
-    return load_reference(KIT)
 
 
 def box(size, origin=(0, 0, 0)):
@@ -94,8 +87,8 @@ def test_measure_empty_and_unknown_polygons():
 
 
 @needs_kit
-def test_box_conforms_to_extrude_color(reference):
-    verdict = compare(measure(box([30, 5, 20])), find_record(reference, "extrude_color", "rect_30x20"),
+def test_box_conforms_to_extrude_color(prt_reference):
+    verdict = compare(measure(box([30, 5, 20])), find_record(prt_reference, "extrude_color", "rect_30x20"),
                       faces_tol=0)
     assert verdict.passed, verdict.summary
     assert verdict.triangle_difference == 0
@@ -103,11 +96,11 @@ def test_box_conforms_to_extrude_color(reference):
 
 @needs_kit
 @needs_earcut
-def test_holed_prism_counts_faces_as_prt(reference):
+def test_holed_prism_counts_faces_as_prt(prt_reference):
     # PRT returns a face with holes as its outline plus a face per hole: 12 faces, 32 triangles, 3600 m2.
     mesh = courtyard_prism(5)
     assert mesh.metadata["n_polygons"] == 12 and mesh.metadata["n_holes"] == 2
-    expected = find_record(reference, "extrude_color", "courtyard_40x40")
+    expected = find_record(prt_reference, "extrude_color", "courtyard_40x40")
     verdict = compare(measure(mesh), expected, faces_tol=0)
     assert verdict.passed, verdict.summary
     assert verdict.triangle_difference == 0

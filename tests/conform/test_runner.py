@@ -10,14 +10,7 @@ from conftest import needs_earcut, needs_kit
 
 from grammarc.conform import (
     footprint_geojson,
-    load_reference,
 )
-
-
-@pytest.fixture(scope="module")
-def reference():
-    return load_reference(KIT)
-
 
 FOOTPRINTS = ["rect_30x20", "rect_12x8", "L_30x20", "U_40x30", "courtyard_40x40", "rotated_25x15",
               "triangle", "octagon"]
@@ -53,10 +46,10 @@ PASSING = [
 ])
 
 
-def test_grammarc_matches_prt(reference, rpk, footprint, attrs):
+def test_grammarc_matches_prt(prt_reference, rpk, footprint, attrs):
     from grammarc.conform import run_conformance
 
-    result = run_conformance(KIT / "rpk" / f"{rpk}.rpk", footprint, attrs, reference=reference)
+    result = run_conformance(KIT / "rpk" / f"{rpk}.rpk", footprint, attrs, reference=prt_reference)
     assert result.passed, result.summary
 
 
