@@ -141,16 +141,21 @@ def lot_record(record: dict, lot: int) -> dict:
     return part
 
 
-def same_lot_records(a: dict, b: dict) -> bool:
-    """Byte-identical lot records (instances, their uv, and the mesh table's arrays)."""
-    for name in ("asset", "xform", "symbol", "uv"):
+def same_lot_records(a: dict, b: dict, geometry_only: bool = False) -> bool:
+    """Byte-identical lot records: instances, their uv, and the mesh table's arrays; with
+    ``geometry_only``, the assets, transforms and polygons alone (not colours, textures or uv)."""
+    instance_fields = ("asset", "xform") if geometry_only else ("asset", "xform", "symbol", "uv")
+    for name in instance_fields:
         if (name in a) != (name in b) or (name in a and a[name].tobytes() != b[name].tobytes()):
             return False
     ma, mb = a["mesh"], b["mesh"]
-    arrays = [(getattr(ma, name), getattr(mb, name))
-              for name in ("vertices", "ring_offsets", "face_offsets", "symbol", "color", "uv")]
-    # ``derive`` joins the chunks' material tables: compare the faces' textures, not their row numbers
-    arrays.append(tuple(None if m.material is None else m.materials[m.material] for m in (ma, mb)))
+    mesh_fields = ("vertices", "ring_offsets", "face_offsets")
+    if not geometry_only:
+        mesh_fields += ("symbol", "color", "uv")
+    arrays = [(getattr(ma, name), getattr(mb, name)) for name in mesh_fields]
+    if not geometry_only:
+        # ``derive`` joins the chunks' material tables: compare the faces' textures, not their row numbers
+        arrays.append(tuple(None if m.material is None else m.materials[m.material] for m in (ma, mb)))
     return all((x is None) == (y is None) and (x is None or np.asarray(x).tobytes() == np.asarray(y).tobytes())
                for x, y in arrays)
 
@@ -216,9 +221,10 @@ def judge_batch(package: Package, cases: list[Case], lots: Path, prt: dict) -> l
 
 
 def _random_lots(package: Package, lots, record: dict, n: int) -> np.ndarray:
-    """(n,) bool: the lots whose records change with the seed. One other seed tells a package that draws
-    no random number; where one does, six more catch the lots that drew the same choices every time (a
-    lot that takes a 30 % case's empty branch for seven seeds: one in 4,500)."""
+    """(n,) bool: the lots whose geometry changes with the seed (candler draws its texture tiles at random,
+    which the compared figures do not show: its lots are judged on their geometry). One other seed tells
+    a package that draws no random number; where one does, six more catch the lots that drew the same
+    choices every time (a lot that takes a 30 % case's empty branch for seven seeds: one in 4,500)."""
     from dataclasses import replace
 
     from grammarc.build import derive
@@ -226,7 +232,8 @@ def _random_lots(package: Package, lots, record: dict, n: int) -> np.ndarray:
     random = np.zeros(n, bool)
     for step in range(1, 8):
         other = derive(package.grammar, lots, replace(package.options, seed=package.options.seed + step))
-        random |= [not same_lot_records(lot_record(record, lot), lot_record(other, lot)) for lot in range(n)]
+        random |= [not same_lot_records(lot_record(record, lot), lot_record(other, lot), geometry_only=True)
+                   for lot in range(n)]
         if not random.any():
             break
     return random

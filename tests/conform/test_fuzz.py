@@ -66,6 +66,9 @@ def test_lot_records_split_a_record_by_lot_and_do_not_depend_on_chunking(massing
     assert all((p["lot"] == lot).all() and (p["mesh"].lot == lot).all() for lot, p in enumerate(parts))
     assert all(same_lot_records(p, lot_record(single, lot)) for lot, p in enumerate(parts))
     assert not same_lot_records(parts[0], parts[1])
+    recoloured = dict(parts[0], mesh=replace(parts[0]["mesh"], color=parts[0]["mesh"].colors() // 2))
+    assert not same_lot_records(parts[0], recoloured)
+    assert same_lot_records(parts[0], recoloured, geometry_only=True)
 
 
 @needs_kit
