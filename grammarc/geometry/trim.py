@@ -45,11 +45,7 @@ def side_face_planes(axes: np.ndarray, origin: np.ndarray, size: np.ndarray, par
     steep = (np.abs(np.einsum("ij,ij->i", y, up)) >= np.sin(np.radians(VERTICAL_DEGREES))) & (size[:, 0] > 0) & (size[:, 1] > 0)
     start = origin
     end = origin + size[:, 0:1] * x
-    # corners are matched to 1e-7 of their parent's coordinates: per parent, so that a lot far from the
-    # origin (national-grid coordinates) coarsens no other lot's matching in its chunk
-    magnitude = np.ones(int(parent.max()) + 1)
-    np.maximum.at(magnitude, parent, np.abs(origin).max(axis=1))
-    scale = (magnitude * 1e-7)[parent][:, None]
+    scale = _corner_scale(parent, origin)
     keys = np.concatenate([np.column_stack([parent, np.round(start / scale)]),
                            np.column_stack([parent, np.round(end / scale)])]).astype(np.int64)
     inverse, _ = row_groups(keys)  # the same corner of the same parent: one id
@@ -102,10 +98,7 @@ def shallow_edge_planes(verts: np.ndarray, ring_offsets: np.ndarray, face_offset
     edge = q - p
     length = np.linalg.norm(edge, axis=1)
     direction = edge / np.maximum(length, 1e-300)[:, None]
-    # corners matched to 1e-7 of their parent's coordinates, per parent as in ``side_face_planes``
-    magnitude = np.ones(int(parent.max()) + 1)
-    np.maximum.at(magnitude, parent[face], np.abs(p).max(axis=1))
-    scale = (magnitude * 1e-7)[parent[face]][:, None]
+    scale = _corner_scale(parent[face], p)
     ends = [np.round(x / scale).astype(np.int64) for x in (p, q)]
     keys = np.concatenate([np.column_stack([parent[face], ends[0], ends[1]]),
                            np.column_stack([parent[face], ends[1], ends[0]])])
@@ -132,6 +125,15 @@ def shallow_edge_planes(verts: np.ndarray, ring_offsets: np.ndarray, face_offset
     out[face[rows, None], columns] = plane
     out[face[rows], 4 * rank + 3] = -np.einsum("ij,ij->i", plane, p[rows])
     return out
+
+
+def _corner_scale(parent: np.ndarray, points: np.ndarray) -> np.ndarray:
+    """(k, 1) the grid that corners ``points`` (k, 3) of parents ``parent`` (k,) are matched on: 1e-7 of
+    their parent's largest coordinate (1 at least). Per parent, so that a lot far from the origin
+    (national-grid coordinates) coarsens no other lot's matching in its chunk."""
+    magnitude = np.ones(int(parent.max()) + 1)
+    np.maximum.at(magnitude, parent, np.abs(points).max(axis=1))
+    return (magnitude * 1e-7)[parent][:, None]
 
 
 def plane_coordinates(normal: np.ndarray) -> np.ndarray:

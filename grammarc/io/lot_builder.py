@@ -31,6 +31,7 @@ import shapely
 
 from grammarc.constants import TOL
 from grammarc.errors import LotsError
+from grammarc.geometry.meshes import ring_vector_areas
 from grammarc.geometry.short_edges import collapse_short_edges
 from grammarc.model.lots import BadLot, Lots
 from grammarc.ragged import offsets_from_counts, segment_reduce
@@ -123,8 +124,9 @@ class LotBuilder:
             # world (x, 0, -y); 0.0 - y keeps z = +0.0 where y = 0
             x, y = vertices.T
             vertices = np.column_stack([x, np.zeros_like(x), np.subtract(0.0, y)])
-        order, owner, ring_offsets = _clean(vertices, offsets_from_counts(counts))
-        vertices = vertices[order]
+        # edges shorter than TOL.merge collapse as PRT collapses them (geometry.short_edges)
+        order, kept, owner = collapse_short_edges(vertices, offsets_from_counts(counts), TOL.merge)
+        vertices, ring_offsets = vertices[order], offsets_from_counts(kept)
         street = np.zeros(len(vertices), dtype=bool)
         np.logical_or.at(street, owner, np.concatenate([np.zeros(0, dtype=bool), *self.street]))
         lot_offsets = offsets_from_counts(np.array(self.ring_counts, dtype=np.int64))
@@ -269,28 +271,13 @@ def _ring_positions(ring_offsets: np.ndarray) -> tuple[np.ndarray, np.ndarray, n
     return ring, ring_offsets[:-1][ring], counts[ring]
 
 
-def _successor(start: np.ndarray, count: np.ndarray) -> np.ndarray:
-    """(V,) int64 index of each vertex's successor in its ring; the last vertex wraps to the first."""
-    at = np.arange(len(start))
-    return np.where(at + 1 < start + count, at + 1, start)
-
-
-def _clean(vertices: np.ndarray, ring_offsets: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Collapse the rings' edges shorter than ``TOL.merge`` as PRT does (``geometry.short_edges``): the
-    staying vertices in order (K,) int64, the position among them of the vertex whose edge absorbs each
-    vertex's edge (V,) int64, and the rings' new offsets."""
-    order, counts, owner = collapse_short_edges(vertices, ring_offsets, TOL.merge)
-    return order, owner, offsets_from_counts(counts)
-
-
 def _newell(vertices: np.ndarray, ring_offsets: np.ndarray) -> np.ndarray:
     """(R, 3) float64 Newell normals, twice the vector area; ``normal[:, 1]`` = 2 x the map signed area.
 
     The ring's first vertex is subtracted first, so large world coordinates lose no precision.
     """
-    _, start, count = _ring_positions(ring_offsets)
-    local = vertices - vertices[start]
-    return segment_reduce(np.add, np.cross(local, local[_successor(start, count)]), ring_offsets, 0.0)
+    _, start, _ = _ring_positions(ring_offsets)
+    return 2 * ring_vector_areas(vertices - vertices[start], ring_offsets)
 
 
 def _orient(ring_offsets, exterior, normal_y) -> tuple[np.ndarray, np.ndarray]:
