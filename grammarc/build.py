@@ -38,7 +38,7 @@ from grammarc.io.lots import default_lot, read_lots
 from grammarc.io.reports import write_reports
 from grammarc.model.grammar import Grammar
 from grammarc.model.lots import BadLot, Lots
-from grammarc.model.records import MeshChunk
+from grammarc.model.records import LotOrigins, MeshChunk
 from grammarc.model.reports import Reports
 from grammarc.workers import worker_pool
 
@@ -213,6 +213,7 @@ def derive(grammar: Grammar, lots: Lots, options: BuildOptions = BuildOptions())
                                         for c in chunks])
     columns.update(
         assets=np.array(grammar.assets), symbols=np.array(plan.symbol_names), mesh=mesh,
+        lot_origin=LotOrigins.concat([c.origins for c in chunks]).table(),
         bad=tuple(sorted((*lots.bad, *failed), key=lambda b: b.index)), reports=reports,
     )
     return columns

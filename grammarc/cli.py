@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import argparse
 import gc
+import math
 import os
 import sys
 from dataclasses import replace
@@ -95,6 +96,9 @@ def _parser() -> argparse.ArgumentParser:
     build.add_argument("--lod", metavar="NAME",
                        help="level of detail: asset `x.obj` is drawn as `x.NAME.obj` where that file exists; "
                             "`builtin`: a cube stands in for a missing asset file")
+    build.add_argument("--bake-origin", type=_point, metavar="X,Y,Z",
+                       help="world point subtracted from a baked mesh's coordinates (default: world coordinates, "
+                            "or the middle of the city in float32 formats far from the origin; the file says which)")
     build.add_argument("--tile-size", type=float, metavar="M",
                        help=f"edge of the tiles of .usd*/.glb outputs in metres (default {LIMITS.tile_size:g})")
     build.add_argument("--select", metavar="IDS",
@@ -170,6 +174,17 @@ def _positive(text: str) -> int:
     if value <= 0:
         raise argparse.ArgumentTypeError(f"must be positive, got {value}")
     return value
+
+
+def _point(text: str) -> tuple[float, float, float]:
+    """``X,Y,Z`` world coordinates, finite."""
+    try:
+        point = tuple(float(v) for v in text.split(","))
+    except ValueError:
+        point = ()
+    if len(point) != 3 or not all(math.isfinite(v) for v in point):
+        raise argparse.ArgumentTypeError(f"must be three numbers X,Y,Z, got `{text}`")
+    return point
 
 
 def _workspace_option(command) -> None:
@@ -349,7 +364,7 @@ def _build(args) -> int:
         else:
             result = build(args.grammar, args.emit, lots_path=args.lots, options=options, progress=bar,
                            output_options=OutputOptions(bake=args.bake, lod=args.lod, tile_size=args.tile_size,
-                                                        max_triangles=args.max_triangles),
+                                                        max_triangles=args.max_triangles, bake_origin=args.bake_origin),
                            select=None if args.select is None else [i for i in args.select.split(",") if i],
                            reports_to=args.reports)
     finally:

@@ -323,10 +323,11 @@ class _Bounded:
         self.high = np.full(3, -np.inf)
 
     def write(self, records) -> None:
-        instance_box(records.xform, self.low, self.high)
+        instance_box(records.world_xform(), self.low, self.high)
         if len(records.mesh.vertices):
-            self.low = np.minimum(self.low, records.mesh.vertices.min(axis=0))
-            self.high = np.maximum(self.high, records.mesh.vertices.max(axis=0))
+            vertices = records.mesh.world(records.origins)
+            self.low = np.minimum(self.low, vertices.min(axis=0))
+            self.high = np.maximum(self.high, vertices.max(axis=0))
         self.writer.write(records)
 
     def box(self) -> dict | None:

@@ -11,12 +11,14 @@ import os
 os.environ.setdefault("GRAMMARC_STRICT", "1")
 
 import importlib.util
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
 import pytest
 
 from grammarc.io.lots import lots_from_polygons
+from grammarc.model.records import world_columns
 
 PRT_KIT = Path(__file__).resolve().parents[1].parent / "shared" / "prt"
 #: Tests of conformance with PRT: the kit's records, and PyPRT's side environment for the live harness.
@@ -45,6 +47,20 @@ LOT_ZOO = {
     ],
     "sliver": [np.array([[0, 0], [50, 0], [50, 0.05], [0, 0.05]], float)],
 }
+
+
+def in_world(record: dict) -> dict:
+    """``record`` (of ``build.derive`` or ``read_instances``) with its transforms and mesh vertices in world
+    coordinates, float64 (``model.records.LotOrigins`` added): how the tests that place things on their
+    lots read a record."""
+    xform, vertices = world_columns(record)
+    out = {key: value for key, value in record.items() if key != "lot_origin"}
+    out["xform"] = xform
+    if "mesh" in record:
+        out["mesh"] = replace(record["mesh"], vertices=vertices)
+    elif "mesh_vertices" in record:
+        out["mesh_vertices"] = vertices
+    return out
 
 
 def make_lots(*names: str, attrs: dict | None = None):

@@ -17,6 +17,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from conftest import in_world
 from test_examples import record_digest
 
 from grammarc.build import build
@@ -35,7 +36,7 @@ def records(tmp_path_factory):
     out = {}
     for name in GRAMMARS:
         path = folder / f"{name}.npz"
-        out[name] = (build(EXAMPLE / f"{name}.cga", path), path, read_instances(path))
+        out[name] = (build(EXAMPLE / f"{name}.cga", path), path, in_world(read_instances(path)))
     return out
 
 

@@ -22,7 +22,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 import trimesh
-from conftest import example_script
+from conftest import example_script, in_world
 from test_examples import record_digest
 
 from grammarc.build import build
@@ -41,7 +41,7 @@ def site(tmp_path_factory):
     out = tmp_path_factory.mktemp("props") / "props.npz"
     result = build(GRAMMAR, out)
     features = json.loads((PROPS / "props.geojson").read_text())["features"]
-    return result, out, read_instances(out), features
+    return result, out, in_world(read_instances(out)), features
 
 
 def instances(record, symbol):

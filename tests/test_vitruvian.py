@@ -21,7 +21,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from conftest import example_script
+from conftest import example_script, in_world
 from test_examples import record_digest
 
 from grammarc.build import build
@@ -42,7 +42,7 @@ def town(tmp_path_factory):
     """The example built whole: the build result, the record's path, its instances and the lots."""
     out = tmp_path_factory.mktemp("vitruvian") / "vitruvian.npz"
     result = build(GRAMMAR, out)
-    record = read_instances(out)
+    record = in_world(read_instances(out))
     mesh_lot = record["mesh_lot"]
     features = json.loads((VITRUVIAN / "lots.geojson").read_text())["features"]
     return result, out, record, mesh_lot, features

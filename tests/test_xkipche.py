@@ -21,7 +21,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from conftest import example_script
+from conftest import example_script, in_world
 from test_examples import record_digest
 
 from grammarc.build import build
@@ -46,7 +46,7 @@ def site(tmp_path_factory):
     out = tmp_path_factory.mktemp("xkipche") / "xkipche.npz"
     result = build(GRAMMAR, out)
     features = json.loads((XKIPCHE / "lots.geojson").read_text())["features"]
-    return result, out, read_instances(out), features
+    return result, out, in_world(read_instances(out)), features
 
 
 def buildings(site):

@@ -95,7 +95,8 @@ class Chunk:
     (L,) their identifiers, ``lot_key`` (L,) uint64 their root random keys (``fileRandom`` draws from them),
     ``attrs`` the per-lot attribute columns (L,) after overrides (evaluated into it in dependency order, as
     a default may read the attributes before it), ``lot_origin`` (L, 3) and ``lot_axes`` (L, 3, 3) the
-    lots' own scopes (``Scope.tx`` is relative to them), ``streets`` their street edges and street frames
+    lots' own scopes (``Scope.tx`` is relative to them; the records are, too: ``model.records.LotOrigins``),
+    ``streets`` their street edges and street frames
     (``geometry.streets``). The stores, outputs and counters grow as the derivation goes.
     """
 

@@ -42,7 +42,7 @@ from grammarc.geometry.footprint import footprint_polygons, lot_scopes
 from grammarc.geometry.polygons import PolygonStore
 from grammarc.geometry.streets import lot_streets
 from grammarc.model.lots import Lots
-from grammarc.model.records import MeshChunk, TerminalChunk
+from grammarc.model.records import LotOrigins, MeshChunk, TerminalChunk
 from grammarc.ragged import ragged_take
 
 
@@ -134,7 +134,8 @@ def initial_dynamic(plan: Plan, name: str, chunk: Chunk, shapes: Shapes) -> np.n
 
 
 def collect(chunk: Chunk, plan: Plan) -> TerminalChunk:
-    """The chunk's records, sorted stably by lot, with lots numbered as in the input.
+    """The chunk's records, sorted stably by lot, with lots numbered as in the input, relative to their lots'
+    scope origins (``LotOrigins``).
 
     Rows are scattered straight from the pieces the operations emitted into their sorted places, so each
     column is copied once. Texture channels become the chunk's table of materials (``backend.materials``).
@@ -178,7 +179,8 @@ def collect(chunk: Chunk, plan: Plan) -> TerminalChunk:
                      mesh.color, mesh_material, materials, mesh.uv)
     return TerminalChunk(asset=columns["asset"], xform=columns["xform"], lot=index[lot[order]],
                          symbol=columns["symbol"], mesh=mesh, color=columns.get("color"), material=material,
-                         materials=materials, uv=columns.get("uv"))
+                         materials=materials, uv=columns.get("uv"),
+                         origins=LotOrigins.of_lots(index, chunk.lot_origin))
 
 
 def _sort_mesh(mesh: MeshChunk, order: np.ndarray) -> MeshChunk:

@@ -174,7 +174,7 @@ def run_parts(ctx: Context, parts: Parts) -> None:
     for i, body in enumerate(parts.bodies):
         leaf = parts.leaves[i] if parts.leaves else None
         if leaf is not None:
-            records = leaf.records(ctx.chunk.frames.data)
+            records = leaf.records(ctx.chunk.frames.data, ctx.chunk.lot_origin)
             ctx.add_counts(np.bincount(records.lot, minlength=len(ctx.chunk.shape_count)), body[0].span)
             ctx.pending[records.symbol].append(records)
         elif offsets[i + 1] > offsets[i]:

@@ -69,10 +69,11 @@ class LeafPart:
     pos: np.ndarray
     length: np.ndarray
 
-    def records(self, frames: np.ndarray) -> LeafRecords:
-        """The part's records from the chunk's frame table ``frames`` (F, 3, 3) (``kernels.scope.leaf_xforms``)."""
+    def records(self, frames: np.ndarray, lot_origin: np.ndarray) -> LeafRecords:
+        """The part's records from the chunk's frame table ``frames`` (F, 3, 3) and its lots' origins
+        ``lot_origin`` (L, 3) (``kernels.scope.leaf_xforms``)."""
         leaf, shapes = self.leaf, self.shapes
-        xform = leaf_xforms(shapes.origin, shapes.size, shapes.frame, frames, self.axis, self.rows, self.parent,
+        xform = leaf_xforms(shapes.origin, lot_origin[shapes.lot], shapes.size, shapes.frame, frames, self.axis, self.rows, self.parent,
                             self.pos, self.length, leaf.size, leaf.relative,
                             leaf.offset if leaf.offset is not None else np.zeros(0))
         return LeafRecords(leaf.symbol, xform, shapes.lot[self.parent[self.rows]])

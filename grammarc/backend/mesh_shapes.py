@@ -326,15 +326,16 @@ def _add_polygons(chunk: Chunk, normalized, ring_offsets, face_offsets, faces, p
 
 
 def mesh_leaves(chunk: Chunk, shapes: Shapes, symbol: int, colors) -> tuple[MeshChunk, np.ndarray]:
-    """The faces of leaf mesh shapes in world coordinates, and the shape each face comes from."""
+    """The faces of leaf mesh shapes relative to their lots' origins (``model.records.LotOrigins``), and the
+    shape each face comes from."""
     verts, ring_offsets, face_offsets, mesh_offsets, vertex_shape = face_vertices(
         chunk.meshes, shapes.geom - MESH_BASE, shapes.size)
     axes = chunk.frames[shapes.frame][vertex_shape]
-    world = shapes.origin[vertex_shape]
+    placed = (shapes.origin - chunk.lot_origin[shapes.lot])[vertex_shape]
     for j in range(3):
-        world += verts[:, j, None] * axes[:, j]
+        placed += verts[:, j, None] * axes[:, j]
     face_shape = segment_of(mesh_offsets)
     return MeshChunk(
-        vertices=world.astype(np.float32), ring_offsets=ring_offsets, face_offsets=face_offsets,
+        vertices=placed.astype(np.float32), ring_offsets=ring_offsets, face_offsets=face_offsets,
         lot=shapes.lot[face_shape].astype(np.int32), symbol=np.full(len(face_shape), symbol, dtype=np.int32),
         color=colors[face_shape] if colors is not None else None), face_shape

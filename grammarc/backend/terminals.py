@@ -1,7 +1,8 @@
 """Terminal records: instances mapping an asset's unit box onto a scope, and leaf geometry.
 
 ``instance_xform`` builds the (n, 3, 4) record transform (README, "The record"): column j is scope axis j times
-scope size j, column 3 the scope origin. ``emit_leaves`` turns shapes whose symbol has no rule (or to which
+scope size j, column 3 the scope origin relative to its lot's origin (``model.records.LotOrigins``: records
+and mesh vertices are float32 relative to it, the derivation is float64 in world). ``emit_leaves`` turns shapes whose symbol has no rule (or to which
 no rule applied) into output, as CityEngine emits leaf geometry:
 
 - a box scope -> ``builtin:cube``;
@@ -56,7 +57,8 @@ def emit_instances(ctx: Context, shapes: Shapes, asset: int, symbol: int, mirror
     if not len(shapes):
         return
     chunk = ctx.chunk
-    xform = xforms(chunk.frames.data, shapes.frame, shapes.size, shapes.origin)
+    base = chunk.lot_origin[shapes.lot]
+    xform = xforms(chunk.frames.data, shapes.frame, shapes.size, shapes.origin, base)
     for axis in range(3):
         if mirrored >> axis & 1:
             xform[:, :, 3] += xform[:, :, axis]
@@ -65,11 +67,13 @@ def emit_instances(ctx: Context, shapes: Shapes, asset: int, symbol: int, mirror
         xform = z_up(xform)
     if ctx.plan.trim_slot is not None:
         planes = trim_planes(ctx.plan, shapes)
-        cut = boxes_crossing(planes, xform.astype(np.float64), TOL.zero)
+        world = xform.astype(np.float64)  # the trim planes are in world coordinates
+        world[:, :, 3] += base
+        cut = boxes_crossing(planes, world, TOL.zero)
         mesh = ctx.asset_mesh(asset) if cut.any() else None
         if mesh is not None:
             crossing = shapes.take(cut)
-            trimmed, owner = _trimmed(ctx.plan, crossing, xform[cut], planes[cut], mesh, symbol)
+            trimmed, owner = _trimmed(ctx.plan, crossing, world[cut], base[cut], planes[cut], mesh, symbol)
             append_mesh(ctx, _with_uv(ctx, crossing, owner, trimmed) if textured else trimmed, crossing, owner)
             shapes, xform = shapes.take(~cut), xform[~cut]
     _append(ctx, shapes, xform, asset, symbol, textured)
@@ -100,12 +104,13 @@ def trim_planes(plan, shapes: Shapes) -> np.ndarray:
     return np.concatenate([planes, shallow], axis=1)
 
 
-def _trimmed(plan, shapes: Shapes, xform: np.ndarray, planes: np.ndarray, mesh,
+def _trimmed(plan, shapes: Shapes, world: np.ndarray, base: np.ndarray, planes: np.ndarray, mesh,
              symbol: int) -> tuple[MeshChunk, np.ndarray]:
-    """The asset's triangles placed by ``xform`` and cut by the shapes' trim ``planes``, as mesh faces, and
-    the row of ``shapes`` each face comes from."""
-    vertices, ring_offsets, owner = trim_triangles(mesh.vertices, mesh.faces, xform.astype(np.float64),
-                                                   planes, TOL.zero)
+    """The asset's triangles placed by ``world`` (n, 3, 4) float64 and cut by the shapes' trim ``planes``,
+    as mesh faces relative to their lot origins ``base`` (n, 3), and the row of ``shapes`` each face comes
+    from."""
+    vertices, ring_offsets, owner = trim_triangles(mesh.vertices, mesh.faces, world, planes, TOL.zero)
+    vertices -= base[owner][segment_of(ring_offsets)]
     return MeshChunk(
         vertices=vertices.astype(np.float32), ring_offsets=ring_offsets,
         face_offsets=np.arange(len(owner) + 1, dtype=np.int64), lot=shapes.lot[owner].astype(np.int32),
@@ -161,7 +166,7 @@ def _instance_uv(ctx: Context, shapes: Shapes, xform: np.ndarray, textured: bool
         return None
     if not textured:
         return np.full((len(shapes), 2, 4), np.nan, np.float32)
-    maps = texture_maps(ctx.plan, ctx.chunk, shapes, 0)
+    maps = _record_maps(ctx, shapes)
     placed = maps[:, :, :3] @ xform
     placed[:, :, 3] += maps[:, :, 3]
     return placed.astype(np.float32)
@@ -172,10 +177,18 @@ def _with_uv(ctx: Context, shapes: Shapes, owner: np.ndarray, mesh: MeshChunk) -
     of ``shapes`` rows ``owner``, where the grammar has texture coordinates."""
     if 0 not in ctx.plan.uv_slots:
         return mesh
-    maps = texture_maps(ctx.plan, ctx.chunk, shapes, 0)[owner][segment_of(mesh.face_offsets)]
+    maps = _record_maps(ctx, shapes)[owner][segment_of(mesh.face_offsets)]
     maps = maps[segment_of(mesh.ring_offsets)]
     uv = np.einsum("vij,vj->vi", maps[:, :, :3], mesh.vertices.astype(np.float64)) + maps[:, :, 3]
     return replace(mesh, uv=uv.astype(np.float32))
+
+
+def _record_maps(ctx: Context, shapes: Shapes) -> np.ndarray:
+    """(n, 2, 4): the shapes' texture maps of set 0 (``texture_space.texture_maps``, of world points) as
+    maps of points relative to their lots' origins, the frame of their records."""
+    maps = texture_maps(ctx.plan, ctx.chunk, shapes, 0).copy()
+    maps[:, :, 3] += np.einsum("nij,nj->ni", maps[:, :, :3], ctx.chunk.lot_origin[shapes.lot])
+    return maps
 
 
 def emit_leaves(ctx: Context, shapes: Shapes, symbol: int) -> None:
@@ -198,7 +211,8 @@ def emit_leaves(ctx: Context, shapes: Shapes, symbol: int) -> None:
         permuted_axes, permuted_size = face_axes(chunk.frames[quads.frame], quads.size,
                                                  np.argmax(flat[is_quad], axis=1))
         permuted_size[:, 2] = 0.0
-        _append(ctx, quads, instance_xform(permuted_axes, permuted_size, quads.origin), QUAD, symbol)
+        _append(ctx, quads, instance_xform(permuted_axes, permuted_size, quads.origin - chunk.lot_origin[quads.lot]),
+                QUAD, symbol)
     polygons = shapes.take(is_polygon(shapes.geom))
     if len(polygons):
         faces, owner = polygon_meshes(ctx, polygons, symbol)
@@ -210,8 +224,8 @@ def emit_leaves(ctx: Context, shapes: Shapes, symbol: int) -> None:
 
 
 def polygon_meshes(ctx: Context, shapes: Shapes, symbol: int) -> tuple[MeshChunk, np.ndarray]:
-    """Faces of polygon shapes in world coordinates: the polygon, or a prism's bottom, top and sides; and
-    the shape each face comes from."""
+    """Faces of polygon shapes relative to their lots' origins: the polygon, or a prism's bottom, top and
+    sides; and the shape each face comes from."""
     chunk = ctx.chunk
     coords, ring_offsets, poly_offsets = chunk.polygons.gather(shapes.geom)
     plane = chunk.polygons.plane[shapes.geom]
@@ -222,7 +236,7 @@ def polygon_meshes(ctx: Context, shapes: Shapes, symbol: int) -> tuple[MeshChunk
     vertex_shape = segment_of(ring_offsets)
     vertex_shape = segment_of(poly_offsets)[vertex_shape]
     s = vertex_shape
-    base = (shapes.origin[s]
+    base = ((shapes.origin - chunk.lot_origin[shapes.lot])[s]
             + (coords[:, 0] * shapes.size[s, a_axis[s]])[:, None] * axes[s, a_axis[s]]
             + (coords[:, 1] * shapes.size[s, b_axis[s]])[:, None] * axes[s, b_axis[s]])
     lift = height[s, None] * axes[s, plane[s]]

@@ -136,7 +136,9 @@ def lot_record(record: dict, lot: int) -> dict:
     """The rows of lot number ``lot`` in a record of ``build.derive``: its instances and mesh faces."""
     rows = np.flatnonzero(record["lot"] == lot)
     part = {name: record[name][rows] for name in ("asset", "xform", "lot", "symbol", "uv") if name in record}
-    part.update(assets=record["assets"], symbols=record["symbols"],
+    origin = np.full((lot + 1, 3), np.nan)  # the record's lot_origin table, this lot's row alone
+    origin[lot] = record["lot_origin"][lot]
+    part.update(assets=record["assets"], symbols=record["symbols"], lot_origin=origin,
                 mesh=record["mesh"].take(np.flatnonzero(record["mesh"].lot == lot)))
     return part
 
@@ -144,7 +146,7 @@ def lot_record(record: dict, lot: int) -> dict:
 def same_lot_records(a: dict, b: dict, geometry_only: bool = False) -> bool:
     """Byte-identical lot records: instances, their uv, and the mesh table's arrays; with
     ``geometry_only``, the assets, transforms and polygons alone (not colours, textures or uv)."""
-    instance_fields = ("asset", "xform") if geometry_only else ("asset", "xform", "symbol", "uv")
+    instance_fields = ("lot_origin", "asset", "xform") + (() if geometry_only else ("symbol", "uv"))
     for name in instance_fields:
         if (name in a) != (name in b) or (name in a and a[name].tobytes() != b[name].tobytes()):
             return False

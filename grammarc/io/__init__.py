@@ -50,13 +50,15 @@ class OutputOptions:
     """How a record is written, beyond its rows: ``bake`` instances into meshes (at most ``max_triangles``),
     the level of detail of assets (``model.assets.load_asset``), the tile edge of the instanced formats
     (``io.instancing``), the folders assets are loaded from (the build gives the grammar's, a rule
-    package's while it is extracted, and ``--assets``). None: the writer's default."""
+    package's while it is extracted, and ``--assets``), the world point baked meshes are relative to
+    (``io.bake.BakedWriter``). None: the writer's default."""
 
     bake: bool = False
     lod: str | None = None
     tile_size: float | None = None
     max_triangles: int | None = None
     asset_roots: tuple | None = None
+    bake_origin: tuple | None = None
 
 
 def _declared():

@@ -34,6 +34,7 @@ import os
 import shutil
 import tempfile
 from collections.abc import Mapping, Sequence
+from dataclasses import replace
 from pathlib import Path
 from typing import ClassVar
 
@@ -48,7 +49,7 @@ from grammarc.io.obj import obj_bytes, with_lines
 from grammarc.ir.asset_names import locate
 from grammarc.ir.nodes import MATERIAL_MAPS
 from grammarc.model.assets import AssetLibrary, AssetMesh, asset_library
-from grammarc.model.records import MaterialTable, MeshChunk, TerminalChunk
+from grammarc.model.records import LotOrigins, MaterialTable, MeshChunk, TerminalChunk, record_mesh
 from grammarc.ragged import offsets_from_counts, segment_of
 
 __all__ = ["MAX_TRIANGLES", "WRITERS", "BakedWriter", "bake", "count_triangles"]
@@ -67,7 +68,7 @@ def count_triangles(record: Mapping, asset_roots: Sequence[str | os.PathLike] | 
     Loads the assets the record uses (not the mesh). Faces of the mesh table count ``V + 2H - 2``
     triangles (V vertices in all rings, H holes), what earcut makes of a simple polygon.
     """
-    names, asset, _, mesh = _columns(record)
+    names, asset, _, mesh, _ = _columns(record)
     library = asset_library(names, record, asset_roots, lod)
     return library.triangles(np.bincount(asset, minlength=len(names))) + _mesh_triangles(mesh)
 
@@ -117,16 +118,18 @@ def bake(
     >>> len(mesh.faces), float(mesh.area), mesh.bounds.tolist()
     (12, 52.0, [[1.0, 0.0, 0.0], [3.0, 3.0, 4.0]])
     """
-    names, asset, xform, mesh = _columns(record)
-    return _bake(asset_library(names, record, asset_roots), asset, xform, mesh, max_triangles)[0]
+    names, asset, xform, mesh, origins = _columns(record)
+    return _bake(asset_library(names, record, asset_roots), asset, xform, mesh, max_triangles,
+                 origins=origins, lot=record.get("lot"))[0]
 
 
 def _bake(library: AssetLibrary, asset: np.ndarray, xform: np.ndarray, mesh: MeshChunk, max_triangles: int,
-          uv: np.ndarray | None = None):
+          uv: np.ndarray | None = None, origins: LotOrigins | None = None, lot: np.ndarray | None = None):
     """``bake`` of a record's columns, its assets in ``library``; and the source of each triangle (T,) int64:
     its instance's row, or ``len(asset)`` plus its face in the mesh table. The mesh has texture coordinates
     (0 where a vertex has none) where the instances' ``uv`` (``TerminalChunk.uv``) or the mesh table's are
-    given."""
+    given. The mesh is in world coordinates: the ``origins`` of the rows' ``lot`` (N,) and of the mesh's
+    faces' lots are added (``model.records.LotOrigins``; None: the rows are in world coordinates)."""
     import trimesh
 
     used = np.bincount(asset, minlength=len(library.names)).astype(np.int64)
@@ -137,6 +140,8 @@ def _bake(library: AssetLibrary, asset: np.ndarray, xform: np.ndarray, mesh: Mes
             f"{max_triangles:,}; raise it (bake(..., max_triangles=N), or GRAMMARC_MAX_TRIANGLES=N for "
             "the mesh writers) or write an instance record (.npz) instead"
         )
+    origins = origins if origins is not None else LotOrigins.empty()
+    mesh = _world_mesh(mesh, origins)
     assets = np.flatnonzero(used)
     n_vertices = sum(int(used[a]) * len(library[a].vertices) for a in assets) + len(mesh.vertices)
     vertices = np.empty((n_vertices, 3), np.float64)
@@ -155,7 +160,8 @@ def _bake(library: AssetLibrary, asset: np.ndarray, xform: np.ndarray, mesh: Mes
         if texture is not None and uv is not None:  # the instances' maps of their unit box, per vertex
             placed = np.einsum("kij,vj->kvi", uv[rows, :, :3].astype(np.float64), shape.vertices)
             texture[v0 : v0 + placed.shape[0] * placed.shape[1]] = (placed + uv[rows, None, :, 3]).reshape(-1, 2)
-        v0, t0 = _expand(shape, xform, rows, vertices, faces, v0, t0)
+        offset = origins.of(lot[rows]) if len(origins.lot) else None
+        v0, t0 = _expand(shape, xform, rows, offset, vertices, faces, v0, t0)
         source[first:t0] = np.repeat(rows, (t0 - first) // max(len(rows), 1))
         face_sizes = _add_counts(face_sizes, shape.polygon_sizes, int(used[a]))
         n_polygons += int(used[a]) * shape.n_polygons
@@ -184,15 +190,18 @@ def _bake(library: AssetLibrary, asset: np.ndarray, xform: np.ndarray, mesh: Mes
     return mesh, source[:t0]
 
 
-def _expand(shape: AssetMesh, xform: np.ndarray, rows: np.ndarray, vertices: np.ndarray,
+def _expand(shape: AssetMesh, xform: np.ndarray, rows: np.ndarray, offset: np.ndarray | None, vertices: np.ndarray,
             faces: np.ndarray, v0: int, t0: int) -> tuple[int, int]:
-    """Write the instances ``rows`` of one asset at ``vertices[v0:]``, ``faces[t0:]``; the new ends."""
+    """Write the instances ``rows`` of one asset at ``vertices[v0:]``, ``faces[t0:]``, moved by ``offset``
+    (len(rows), 3) (their lots' origins) where given; the new ends."""
     nv, nt = len(shape.vertices), len(shape.faces)
     if nv == 0:
         return v0, t0
     block = max(1, _BLOCK_VERTICES // nv)
     for b in range(0, len(rows), block):
         part = xform[rows[b : b + block]].astype(np.float64)  # (n, 3, 4)
+        if offset is not None:
+            part[:, :, 3] += offset[b : b + block]
         n = len(part)
         out = vertices[v0 : v0 + n * nv].reshape(n, nv, 3)
         # world[k, v, i] = sum_j linear[k, i, j] * p[v, j] + offset[k, i]
@@ -227,8 +236,9 @@ def _mesh_triangles(mesh: MeshChunk) -> int:
     return max(0, int(mesh.ring_offsets[-1]) + 2 * n_rings - 4 * n_faces) if n_faces else 0
 
 
-def _columns(record: Mapping) -> tuple[list[str], np.ndarray, np.ndarray, MeshChunk]:
-    """Asset names, ``asset`` (N,) int64, ``xform`` (N, 3, 4) and the mesh table of a record."""
+def _columns(record: Mapping) -> tuple[list[str], np.ndarray, np.ndarray, MeshChunk, LotOrigins]:
+    """Asset names, ``asset`` (N,) int64, ``xform`` (N, 3, 4), the mesh table of a record and the lot origins
+    they are relative to (its ``lot_origin``, ``model.records.LotOrigins``)."""
     names = [str(n) for n in np.asarray(record["assets"]).reshape(-1)]
     asset = np.asarray(record.get("asset", np.zeros(0)), np.int64).reshape(-1)
     xform = np.asarray(record.get("xform", np.zeros((0, 3, 4))), np.float32)
@@ -236,18 +246,12 @@ def _columns(record: Mapping) -> tuple[list[str], np.ndarray, np.ndarray, MeshCh
         raise ValueError(f"xform: expected ({len(asset)}, 3, 4), got {xform.shape}")
     if len(asset) and (asset.min() < 0 or asset.max() >= len(names)):
         raise ValueError(f"asset: index out of range [0, {len(names)})")
-    mesh = record.get("mesh")
-    if mesh is None and "mesh_face_offsets" in record:
-        mesh = MeshChunk(
-            vertices=np.asarray(record["mesh_vertices"]),
-            ring_offsets=np.asarray(record["mesh_ring_offsets"], np.int64),
-            face_offsets=np.asarray(record["mesh_face_offsets"], np.int64),
-            lot=np.asarray(record.get("mesh_lot", np.zeros(0, np.int32))),
-            symbol=np.asarray(record.get("mesh_symbol", np.zeros(0, np.int32))),
-        )
-    if mesh is None:
-        mesh = MeshChunk.empty()
-    return names, asset, xform, mesh
+    return names, asset, xform, record_mesh(record) or MeshChunk.empty(), LotOrigins.from_table(record.get("lot_origin"))
+
+
+def _world_mesh(mesh: MeshChunk, origins: LotOrigins) -> MeshChunk:
+    """``mesh`` with its vertices in world coordinates (float64), its lots' ``origins`` added."""
+    return replace(mesh, vertices=mesh.world(origins)) if len(origins.lot) else mesh
 
 
 # -------------------------------------------------------------------------------------------- writers
@@ -283,6 +287,13 @@ class BakedWriter(WriterBlock):
         The limit; by default ``GRAMMARC_MAX_TRIANGLES`` or ``MAX_TRIANGLES``.
     lod : str, optional
         Level of detail of the assets (``load_asset``).
+    bake_origin : (3,) float, optional
+        World point subtracted from every baked vertex (``--bake-origin``). By default OBJ (text with every
+        digit) is in world coordinates, and the float32 formats (PLY, STL, GLB) are too when the mesh lies
+        within ``FLOAT32_EXACT`` of the world's origin, else relative to the middle of its box in whole
+        metres (a float32 step is 0.5 m at a UTM northing). The origin is written into the file: OBJ, PLY and
+        STL headers say ``origin X Y Z``; a GLB's node is translated to it (JSON numbers are double), so
+        viewers place the city in world coordinates.
     """
 
     FORMATS: ClassVar[dict[str, str]] = {".obj": "obj", ".ply": "ply", ".stl": "stl", ".glb": "glb"}
@@ -291,7 +302,8 @@ class BakedWriter(WriterBlock):
 
     def __init__(self, path: str | os.PathLike, *, assets: Sequence[str], symbols: Sequence[str],
                  meta: dict, asset_roots: Sequence[str | os.PathLike] | None = None,
-                 max_triangles: int | None = None, lod: str | None = None):
+                 max_triangles: int | None = None, lod: str | None = None,
+                 bake_origin: Sequence[float] | None = None):
         self.path = Path(path)
         suffix = self.path.suffix.lower()
         if suffix not in self.FORMATS:
@@ -307,6 +319,7 @@ class BakedWriter(WriterBlock):
         if max_triangles is None:
             max_triangles = int(os.environ.get("GRAMMARC_MAX_TRIANGLES", MAX_TRIANGLES))
         self.max_triangles = max_triangles
+        self._origin = None if bake_origin is None else np.asarray(bake_origin, np.float64).reshape(3)
         self._chunks: list[tuple[TerminalChunk, np.ndarray | None]] = []  # kept for close(), with their looks
         #: The record's materials, and the looks (``_looks``) met so far, each an OBJ material.
         self._materials = MaterialTable()
@@ -322,7 +335,8 @@ class BakedWriter(WriterBlock):
         if self._file_type == "obj":
             self._open_file()
             header = f"grammarc {self._meta.get('grammarc', '')} bake of {self._meta.get('grammar', '')}"
-            self._file.write(f"# {' '.join(header.split())}\nmtllib {self._mtl_path.name}\n".encode())
+            origin = "" if self._origin is None else f"# {_origin_text(self._origin)}\n"
+            self._file.write(f"# {' '.join(header.split())}\n{origin}mtllib {self._mtl_path.name}\n".encode())
 
     def write(self, chunk: TerminalChunk) -> None:
         """Bake a chunk into the OBJ, or keep it for ``close()`` (not copied: do not modify it).
@@ -339,9 +353,8 @@ class BakedWriter(WriterBlock):
         if self._state != "open":
             raise ValueError(f"write to a BakedWriter that is {self._state}")
         asset = np.asarray(chunk.asset)
-        xform = np.asarray(chunk.xform)
-        if asset.ndim != 1 or xform.shape != (len(asset), 3, 4):
-            raise ValueError(f"TerminalChunk: asset {asset.shape} and xform {xform.shape} disagree")
+        if asset.ndim != 1 or np.shape(chunk.xform) != (len(asset), 3, 4):
+            raise ValueError(f"TerminalChunk: asset {asset.shape} and xform {np.shape(chunk.xform)} disagree")
         if len(asset) and (asset.min() < 0 or asset.max() >= len(self._library.names)):
             raise ValueError(f"TerminalChunk.asset: index out of range [0, {len(self._library.names)})")
         try:
@@ -356,8 +369,8 @@ class BakedWriter(WriterBlock):
                 )
             looks = self._looks(chunk)
             if self._file is not None:
-                mesh, source = _bake(self._library, asset.astype(np.int64, copy=False), xform, chunk.mesh,
-                                     self.max_triangles, chunk.uv)
+                mesh, source = _bake(self._library, asset.astype(np.int64, copy=False), chunk.xform, chunk.mesh,
+                                     self.max_triangles, chunk.uv, chunk.origins, chunk.lot)
                 self._file.write(self._obj_groups(mesh, source, np.concatenate([chunk.lot, chunk.mesh.lot]), looks))
                 self._count(mesh, chunk.mesh)
             else:
@@ -402,7 +415,8 @@ class BakedWriter(WriterBlock):
         faces = obj_bytes(np.zeros((0, 3)), mesh.faces[order] + self._made["vertices"],
                           uv=None if uv is None else np.zeros((0, 2)), uv_shift=shift)
         self._uv_vertices += len(mesh.vertices) if uv is not None else 0
-        return obj_bytes(mesh.vertices, np.zeros((0, 3), np.int64), uv=uv) + with_lines(faces, starts, lines)
+        vertices = mesh.vertices if self._origin is None else mesh.vertices - self._origin
+        return obj_bytes(vertices, np.zeros((0, 3), np.int64), uv=uv) + with_lines(faces, starts, lines)
 
     def _mtl(self) -> bytes:
         """The OBJ's material library: per look its colour (``Kd``, ``d``) and texture maps, the paths
@@ -447,14 +461,16 @@ class BakedWriter(WriterBlock):
                 self._open_file()
                 chunks, self._chunks = self._chunks, []
                 mesh_table = MeshChunk.concat([c.mesh for c, _ in chunks])
+                origins = LotOrigins.concat([c.origins for c, _ in chunks])
+                lot = np.concatenate([c.lot for c, _ in chunks]) if chunks else np.zeros(0, np.int32)
                 asset = np.concatenate([c.asset for c, _ in chunks]) if chunks else np.zeros(0, np.int64)
                 xform = np.concatenate([c.xform for c, _ in chunks]) if chunks else np.zeros((0, 3, 4), np.float32)
                 looks = _joined_looks(chunks)
                 uv = None if all(c.uv is None for c, _ in chunks) else np.concatenate([c.texture() for c, _ in chunks])
                 del chunks
                 mesh, source = _bake(self._library, asset.astype(np.int64, copy=False), xform, mesh_table,
-                                     self.max_triangles, uv)
-                del asset, xform
+                                     self.max_triangles, uv, origins, lot)
+                del asset, xform, lot
                 self._count(mesh, mesh_table)
                 self._file.write(self._export(mesh, looks[source] if looks is not None else None))
                 del mesh
@@ -498,11 +514,14 @@ class BakedWriter(WriterBlock):
 
     def _export(self, mesh, looks: np.ndarray | None) -> bytes:
         """The bytes of a PLY (with vertex colours where the record has colours) or STL (binary), or a GLB
-        with a material per look (``io.gltf.baked_glb``); ``looks`` (T,) int64 per triangle (``_looks``)."""
+        with a material per look (``io.gltf.baked_glb``); ``looks`` (T,) int64 per triangle (``_looks``).
+        The vertices are moved to the bake origin (the class docstring) first."""
+        origin = self._origin if self._origin is not None else float32_origin(mesh.vertices)
+        mesh.vertices = mesh.vertices - origin
         if self._file_type == "glb":
             materials = self._materials.table()
             return baked_glb(mesh.vertices, mesh.faces, looks, materials, self._library.roots, self._meta,
-                             _texture(mesh))
+                             _texture(mesh), origin=origin)
         if self._file_type == "ply" and looks is not None:
             import trimesh
 
@@ -511,8 +530,31 @@ class BakedWriter(WriterBlock):
             colors[mesh.faces.reshape(-1)] = np.repeat(rgba, 3, axis=0)
             mesh.visual = trimesh.visual.ColorVisuals(mesh, vertex_colors=colors)
         mesh.metadata = {}
+        if self._file_type == "stl":
+            data = bytearray(mesh.export(file_type="stl"))
+            data[:80] = f"grammarc {_origin_text(origin)}".encode().ljust(80)[:80]  # the header: free text
+            return bytes(data)
         data = mesh.export(file_type=self._file_type)
-        return data if isinstance(data, bytes) else data.encode("utf-8")
+        # a comment line in the header, after the format line (PLY allows comments anywhere in the header)
+        head, _, rest = data.partition(b"\n")
+        return head + f"\ncomment grammarc {_origin_text(origin)}".encode() + b"\n" + rest
+
+
+#: Metres from the world's origin within which float32 coordinates keep a step of 1 mm or less (2^13).
+FLOAT32_EXACT = 8192.0
+
+
+def float32_origin(vertices: np.ndarray) -> np.ndarray:
+    """(3,) float64: where float32 vertices keep millimetres: 0 when all lie within ``FLOAT32_EXACT`` of the
+    world's origin, else the middle of their box in whole metres."""
+    if not len(vertices) or np.abs(vertices).max() <= FLOAT32_EXACT:
+        return np.zeros(3)
+    return np.round((vertices.min(axis=0) + vertices.max(axis=0)) / 2)
+
+
+def _origin_text(origin: np.ndarray) -> str:
+    """``origin X Y Z``: the world point a baked file's coordinates are relative to."""
+    return "origin " + " ".join(f"{v:.17g}" for v in np.asarray(origin, np.float64))
 
 
 def _joined_looks(chunks: list) -> np.ndarray | None:

@@ -167,7 +167,7 @@ class _Part:
         nodes = []
         rows = tile.instances
         if len(rows):
-            positions, orientations, scales = decompose(rows["xform"], tile.origin)
+            positions, orientations, scales = decompose(rows["xform"])
             for asset, color, material, members in groups:
                 nodes.append({
                     "name": self.library.names[asset],
@@ -287,7 +287,7 @@ class _Part:
         """The tile's mesh-table triangles as one mesh with per-vertex colours, a primitive per colour map
         where the record has textures."""
         triangles = tile.triangles
-        points = (triangles["vertices"].reshape(-1, 3).astype(np.float64) - tile.origin).astype(np.float32)
+        points = np.ascontiguousarray(triangles["vertices"].reshape(-1, 3))
         colors = np.repeat(triangles["color"], 3, axis=0)
         attributes = {"POSITION": self._accessor(points, "VEC3", _ARRAY_BUFFER, bounds=True),
                       "COLOR_0": self._accessor(colors, "VEC4", _ARRAY_BUFFER, normalized=True)}
@@ -310,13 +310,14 @@ class _Part:
 
 
 def baked_glb(vertices: np.ndarray, faces: np.ndarray, looks: np.ndarray | None, materials: np.ndarray,
-              roots: Sequence[Path], meta: dict, uv: np.ndarray | None = None) -> bytes:
+              roots: Sequence[Path], meta: dict, uv: np.ndarray | None = None,
+              origin: np.ndarray | None = None) -> bytes:
     """A baked mesh as a GLB: one mesh, a primitive (and a material) per look of its triangles.
 
     Parameters
     ----------
     vertices : (V, 3) float
-        World coordinates (written as float32).
+        Coordinates relative to ``origin`` (written as float32).
     faces : (T, 3) int
         Triangles.
     looks : (T,) int64 or None
@@ -327,6 +328,8 @@ def baked_glb(vertices: np.ndarray, faces: np.ndarray, looks: np.ndarray | None,
         the primitive's ``baseColorTexture``.
     uv : (V, 2) float, optional
         Texture coordinates of the vertices (``TEXCOORD_0``, v turned to glTF's, down the image).
+    origin : (3,) float, optional
+        World point of the vertices' zero: the node's translation (and ``extras.origin``).
     """
     with tempfile.TemporaryDirectory() as folder:
         part = _Part(Path(folder) / "part.bin", None, meta)
@@ -353,7 +356,10 @@ def baked_glb(vertices: np.ndarray, faces: np.ndarray, looks: np.ndarray | None,
                                               _ELEMENT_ARRAY_BUFFER),
                     "material": part._material(rgba, colormap=found[1] if found else None)})
             part.json["meshes"].append({"name": "city", "primitives": primitives})
-            part.json["nodes"].append({"name": "city", "mesh": 0})
+            node = {"name": "city", "mesh": 0}
+            if origin is not None and np.any(origin):
+                node.update(translation=[float(v) for v in origin], extras={"origin": [float(v) for v in origin]})
+            part.json["nodes"].append(node)
             part.json["scenes"][0]["nodes"].append(0)
         out = Path(folder) / "baked.glb"
         part.finish(out)

@@ -13,8 +13,9 @@ normalized columns as the rotation. Two cases need care:
 
 Tiles: a city spans kilometres, and both formats store positions as float32, which at 10 km from the
 origin is a millimetre step. So instances are grouped in square tiles of the ground plane (world x and
-z) by the centre of their box, and positions are stored relative to the tile's corner: within a 500 m
-tile float32 is exact to about 30 micrometres. ``TileSpool`` sorts a stream of chunks into tiles on
+z) by the centre of their box, and positions are stored relative to the tile's corner, computed in float64
+from the record's lot origins (``model.records.LotOrigins``): within a 500 m tile float32 is exact to about
+30 micrometres. ``TileSpool`` sorts a stream of chunks into tiles on
 disk, so a writer can then make one tile at a time with bounded memory (the record may have 10^8 rows).
 Within a tile, rows keep the record's order, so the output does not depend on the chunking.
 """
@@ -42,10 +43,11 @@ __all__ = ["INSTANCE", "TRIANGLE", "Tile", "TileSpool", "TiledWriter", "decompos
 
 #: Default tile edge (metres): see the module docstring.
 TILE_SIZE = LIMITS.tile_size
-#: One instance row in a tile's spool.
+#: One instance row in a tile's spool, its transform relative to the tile's corner.
 INSTANCE = np.dtype([("row", "<i8"), ("asset", "<i4"), ("lot", "<i4"), ("symbol", "<i4"), ("color", "u1", (4,)),
                      ("xform", "<f4", (3, 4))])
-#: One triangle of the mesh table in a tile's spool: world vertices, the face's colour and symbol, and its
+#: One triangle of the mesh table in a tile's spool: vertices relative to the tile's corner, the face's colour
+#: and symbol, and its
 #: vertices' texture coordinates of set 0 (NaN: none).
 TRIANGLE = np.dtype([("vertices", "<f4", (3, 3)), ("color", "u1", (4,)), ("symbol", "<i4"),
                      ("uv", "<f4", (3, 2))])
@@ -53,16 +55,13 @@ TRIANGLE = np.dtype([("vertices", "<f4", (3, 3)), ("color", "u1", (4,)), ("symbo
 _FLAT = 1e-9
 
 
-def decompose(xform: np.ndarray, origin: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray,
-                                                                             np.ndarray]:
+def decompose(xform: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Positions, orientations and scales of instances (see the module docstring).
 
     Parameters
     ----------
     xform : (n, 3, 4) float
-        The record's transforms.
-    origin : (3,) float, optional
-        Subtracted from the positions (a tile's corner), in float64 before rounding to float32.
+        Transforms (a tile's, relative to its corner).
 
     Returns
     -------
@@ -72,8 +71,7 @@ def decompose(xform: np.ndarray, origin: np.ndarray | None = None) -> tuple[np.n
     scales : (n, 3) float32
     """
     xform = np.asarray(xform, np.float64)
-    origin = np.zeros(3) if origin is None else np.asarray(origin, np.float64)
-    positions = (xform[:, :, 3] - origin).astype(np.float32)
+    positions = xform[:, :, 3].astype(np.float32)
     orientations = np.empty((len(xform), 4), np.float32)
     scales = np.empty((len(xform), 3), np.float32)
     _decompose(np.ascontiguousarray(xform[:, :, :3]), orientations, scales)
@@ -210,11 +208,11 @@ class TileSpool:
         rows = np.empty(len(chunk.asset), INSTANCE)
         rows["asset"], rows["lot"], rows["symbol"] = chunk.asset, chunk.lot, chunk.symbol
         rows["color"] = WHITE if chunk.color is None else chunk.color
-        rows["xform"] = chunk.xform
         rows["row"] = np.arange(self.instances, self.instances + len(rows))
-        xform = np.asarray(chunk.xform, np.float64)
-        centre = xform[:, :, 3] + 0.5 * xform[:, :, :3].sum(axis=2)
-        keys = self._keys(centre)
+        xform = chunk.world_xform()
+        keys = self._keys(xform[:, :, 3] + 0.5 * xform[:, :, :3].sum(axis=2))  # the boxes' centres
+        xform[:, :, 3] -= self._corners(keys)
+        rows["xform"] = xform
         self._append("instances", keys, rows)
         if material is not None:
             self._append("instance_materials", keys, material.astype(np.int32))
@@ -222,18 +220,18 @@ class TileSpool:
 
         mesh = chunk.mesh
         if len(mesh.face_offsets) > 1:
-            vertices = np.asarray(mesh.vertices, np.float64)
-            faces = triangulate_polygons(vertices, mesh.ring_offsets, mesh.face_offsets)
+            # triangulated near the lots' origins, where the float32 vertices are exact
+            faces = triangulate_polygons(np.asarray(mesh.vertices, np.float64), mesh.ring_offsets, mesh.face_offsets)
             face_of_vertex = np.repeat(np.arange(len(mesh.face_offsets) - 1),
                                        np.diff(np.asarray(mesh.ring_offsets)[mesh.face_offsets]))
             face = face_of_vertex[faces[:, 0]]
+            vertices = mesh.world(chunk.origins)
+            keys = self._keys(vertices[np.asarray(mesh.ring_offsets)[mesh.face_offsets[:-1]]])[face]
             triangles = np.empty(len(faces), TRIANGLE)
-            triangles["vertices"] = vertices[faces]
+            triangles["vertices"] = vertices[faces] - self._corners(keys)[:, None]
             triangles["color"] = mesh.colors()[face]
             triangles["symbol"] = np.asarray(mesh.symbol)[face]
             triangles["uv"] = mesh.texture()[faces]
-            first = vertices[np.asarray(mesh.ring_offsets)[mesh.face_offsets[:-1]]]
-            keys = self._keys(first)[face]
             self._append("triangles", keys, triangles)
             if mesh_material is not None:
                 self._append("triangle_materials", keys, mesh_material[face].astype(np.int32))
@@ -243,7 +241,7 @@ class TileSpool:
     def tiles(self):
         """Each tile, in key order, read back from its files."""
         for key in sorted(self.keys):
-            origin = np.array([key[0] * self.tile_size, 0.0, key[1] * self.tile_size])
+            origin = self._corners(np.array([key]))[0]
             materials = [self._read(f"{kind}_materials", key, np.dtype("<i4")) if self.materials else None
                          for kind in ("instance", "triangle")]
             yield Tile(key, origin, self._read("instances", key, INSTANCE), self._read("triangles", key, TRIANGLE),
@@ -252,6 +250,12 @@ class TileSpool:
     def _keys(self, points: np.ndarray) -> np.ndarray:
         """(n, 2) int64 tile keys of world points."""
         return np.floor(points[:, [0, 2]] / self.tile_size).astype(np.int64)
+
+    def _corners(self, keys: np.ndarray) -> np.ndarray:
+        """(n, 3) float64: the world corners of tiles ``keys`` (n, 2), at height 0."""
+        corners = np.zeros((len(keys), 3))
+        corners[:, [0, 2]] = keys * self.tile_size
+        return corners
 
     def _path(self, kind: str, key: tuple[int, int]) -> Path:
         return self.directory / f"{kind}_{key[0]}_{key[1]}.bin"

@@ -55,14 +55,16 @@ import numpy as np
 from zlib_ng.zlib_ng import crc32, crc32_combine
 
 from grammarc.errors import UsageError
-from grammarc.model.records import MaterialTable, TerminalChunk
+from grammarc.model.records import LotOrigins, MaterialTable, TerminalChunk
 
 if TYPE_CHECKING:
     from typing_extensions import Self
 
 __all__ = ["WRITERS", "InstanceWriter", "load_record", "read_instances"]
 
-_FORMAT = "grammarc.instances/1"
+_FORMAT = "grammarc.instances/2"
+#: Formats this version reads: /1 has no ``lot_origin`` (its transforms and vertices are in world coordinates).
+_READS = ("grammarc.instances/1", _FORMAT)
 _FADVISE = hasattr(os, "posix_fadvise")  # Linux: DONTNEED starts the writeback of a range, drops clean pages
 _QUEUE_DEPTH = 2  # chunks waiting for the background thread: bounds the memory of write()
 _BLOCK = 16 << 20  # bytes per copy call from a spool into the npz (and the buffer of the fallback copy)
@@ -97,7 +99,7 @@ _STREAMED = "xform"
 # Central directory order, the order of np.load(path).files: the record's table in the README, then the mesh
 # table. In the file, xform comes first and the others follow in this order.
 _KEYS = (
-    "assets", "asset", "xform", "lot", "symbols", "symbol", "color", "materials", "material", "uv", "meta",
+    "assets", "asset", "xform", "lot", "lot_origin", "symbols", "symbol", "color", "materials", "material", "uv", "meta",
     "mesh_vertices", "mesh_ring_offsets", "mesh_face_offsets", "mesh_lot", "mesh_symbol", "mesh_color",
     "mesh_material", "mesh_uv",
 )  # fmt: skip
@@ -153,6 +155,8 @@ class InstanceWriter:
         self._materials: MaterialTable | None = None
         #: Whether a chunk had texture coordinates (else no uv columns).
         self._textured = False
+        #: The chunks' lot origins (``LotOrigins``); None until the first chunk, [] if they have none.
+        self._origins: list[LotOrigins] | None = None
         self._counts: dict[str, int] = {}
         self._state = "open"
         tmpdir = tempfile.mkdtemp(prefix=f".{self.path.name}.tmp", dir=self.path.parent)
@@ -178,6 +182,9 @@ class InstanceWriter:
         if self._state != "open":
             raise ValueError(f"write to an InstanceWriter that is {self._state}")
         columns = _validate(chunk, len(self._assets), len(self._symbols))
+        has_origins = len(chunk.origins.lot) > 0
+        if self._origins is not None and has_origins != bool(self._origins):
+            raise ValueError("TerminalChunk.origins: a record's chunks all carry lot origins or none do")
         self._material_columns(chunk, columns)
         self._uv_columns(chunk, columns)
         columns["mesh_ring_offsets"] = columns["mesh_ring_offsets"] + self._rows["mesh_vertices"]
@@ -191,6 +198,9 @@ class InstanceWriter:
             raise
         for key, column in columns.items():
             self._rows[key] += len(column)
+        self._origins = self._origins if self._origins is not None else []
+        if has_origins:
+            self._origins.append(chunk.origins)
 
     def _material_columns(self, chunk: TerminalChunk, columns: dict[str, np.ndarray]) -> None:
         """Add the chunk's ``material`` and ``mesh_material`` columns, indexing the record's ``materials``,
@@ -281,11 +291,14 @@ class InstanceWriter:
         # Sorted keys: the bytes must not depend on the order in which meta was built.
         meta = json.dumps({**self._meta, "counts": counts, "format": _FORMAT}, sort_keys=True)
         arrays = {"assets": self._assets, "symbols": self._symbols, "meta": np.array(meta)}
+        if self._origins:
+            arrays["lot_origin"] = LotOrigins.concat(self._origins).table()
         if self._materials is not None:
             arrays["materials"] = self._materials.table()
         members = {}
         for key in _KEYS:
-            if (key in _MATERIAL_KEYS and self._materials is None) or (key in _UV_KEYS and not self._textured):
+            if (key in _MATERIAL_KEYS and self._materials is None) or (key in _UV_KEYS and not self._textured) \
+                    or (key == "lot_origin" and "lot_origin" not in arrays):
                 continue
             if key in arrays:
                 array = arrays[key]
@@ -317,7 +330,7 @@ def read_instances(path: str | os.PathLike) -> dict[str, np.ndarray | dict]:
     if "meta" not in record:
         raise ValueError(f"{os.fspath(path)}: no 'meta' member, not a grammarc instance record")
     meta = json.loads(record["meta"].item())
-    if meta.get("format") != _FORMAT:
+    if meta.get("format") not in _READS:
         raise ValueError(f"{os.fspath(path)}: format {meta.get('format')!r}, expected {_FORMAT!r}")
     record["meta"] = meta
     return record

@@ -27,6 +27,7 @@ from grammarc.io.npz import read_instances
 from grammarc.io.rpk import record_asset_roots
 from grammarc.io.shards import is_manifest, manifest_path, shard_outputs
 from grammarc.model.assets import asset_library
+from grammarc.model.records import world_columns
 
 __all__ = ["format_summary", "summarize"]
 
@@ -106,8 +107,8 @@ def _tally(record: dict, files: list[Path], asset_roots, lod: str | None) -> dic
         else np.zeros(0, np.int64)
     per_lot = np.bincount(record["lot"].astype(np.int64)) if len(asset) and "lot" in record \
         else np.zeros(0, np.int64)
-    corners = _corners(record["xform"].astype(np.float64))
-    mesh_vertices = record["mesh_vertices"].astype(np.float64)
+    xform, mesh_vertices = world_columns(record)
+    corners = _corners(xform)
     points = np.concatenate([corners, mesh_vertices]) if len(mesh_vertices) else corners
     return {
         "meta": record["meta"],

@@ -154,7 +154,7 @@ class UsdWriter(TiledWriter):
                 self._bind(stage, child, textures)
                 targets.append(child.GetPath())
             instancer.CreatePrototypesRel().SetTargets(targets)
-            positions, orientations, scales = decompose(rows["xform"], tile.origin)
+            positions, orientations, scales = decompose(rows["xform"])
             instancer.CreateProtoIndicesAttr(Vt.IntArray.FromNumpy(local.astype(np.int32).reshape(-1)))
             instancer.CreatePositionsAttr(Vt.Vec3fArray.FromNumpy(positions))
             instancer.CreateOrientationsAttr(Vt.QuathArray.FromNumpy(orientations.astype(np.float16)))
@@ -167,7 +167,7 @@ class UsdWriter(TiledWriter):
         triangles = tile.triangles
         if len(triangles):
             mesh = UsdGeom.Mesh.Define(stage, "/Tile/Meshes")
-            points = (triangles["vertices"].reshape(-1, 3).astype(np.float64) - tile.origin).astype(np.float32)
+            points = np.ascontiguousarray(triangles["vertices"].reshape(-1, 3))
             mesh.CreatePointsAttr(Vt.Vec3fArray.FromNumpy(points))
             mesh.CreateFaceVertexCountsAttr(Vt.IntArray.FromNumpy(np.full(len(triangles), 3, np.int32)))
             mesh.CreateFaceVertexIndicesAttr(Vt.IntArray.FromNumpy(np.arange(len(points), dtype=np.int32)))

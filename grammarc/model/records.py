@@ -9,15 +9,15 @@ convention (offsets starting at 0).
 
 from __future__ import annotations
 
-from collections.abc import Sequence
-from dataclasses import dataclass
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
 
 import numpy as np
 
 from grammarc.ir.nodes import MATERIAL_MAPS
 from grammarc.ragged import ragged_take
 
-__all__ = ["WHITE", "MaterialTable", "MeshChunk", "TerminalChunk"]
+__all__ = ["WHITE", "LotOrigins", "MaterialTable", "MeshChunk", "TerminalChunk", "record_mesh", "world_columns"]
 
 #: Colour of rows that carry none: opaque white (RGBA).
 WHITE = np.array([255, 255, 255, 255], np.uint8)
@@ -25,13 +25,93 @@ WHITE = np.array([255, 255, 255, 255], np.uint8)
 
 # eq=False: the generated __eq__ would compare arrays elementwise and fail on truth testing.
 @dataclass(frozen=True, eq=False)
+class LotOrigins:
+    """Where each lot's records are placed: ``world = origin of the row's lot + xform @ p`` (float64).
+
+    A record's transforms and mesh vertices are float32, which keeps 1 mm only within about 16 km of
+    their zero (a float32 step is 0.5 m at a UTM northing of 5.75 million metres). So they are relative
+    to their lot's origin, its initial shape's scope origin, kept here in float64: a lot spans metres to
+    a few kilometres, and its rows keep sub-millimetre positions wherever it lies on Earth. No origins
+    (``empty()``) means the rows are in world coordinates, as in a hand-made chunk.
+
+    Attributes
+    ----------
+    lot : (k,) int32
+        The lots' numbers in the input, ascending.
+    origin : (k, 3) float64
+        Their origins in world coordinates.
+    """
+
+    lot: np.ndarray
+    origin: np.ndarray
+
+    @staticmethod
+    def empty() -> LotOrigins:
+        """No origins: rows are in world coordinates."""
+        return LotOrigins(np.zeros(0, np.int32), np.zeros((0, 3)))
+
+    @staticmethod
+    def of_lots(lot: np.ndarray, origin: np.ndarray) -> LotOrigins:
+        """The origins ``origin`` (k, 3) of lots ``lot`` (k,) in any order."""
+        order = np.argsort(lot, kind="stable")
+        return LotOrigins(np.asarray(lot, np.int32)[order], np.asarray(origin, np.float64).reshape(-1, 3)[order])
+
+    @staticmethod
+    def from_table(table: np.ndarray | None) -> LotOrigins:
+        """The origins of a record's ``lot_origin`` table (L, 3), row = lot, NaN for lots without records;
+        None (a record written before origins) is ``empty()``."""
+        if table is None:
+            return LotOrigins.empty()
+        table = np.asarray(table, np.float64).reshape(-1, 3)
+        lots = np.flatnonzero(np.isfinite(table).all(axis=1)).astype(np.int32)
+        return LotOrigins(lots, table[lots])
+
+    @staticmethod
+    def concat(parts: Sequence[LotOrigins]) -> LotOrigins:
+        """The origins of ``parts`` together (a lot in several parts has the same origin in each)."""
+        if not parts:
+            return LotOrigins.empty()
+        lot, first = np.unique(np.concatenate([p.lot for p in parts]), return_index=True)
+        return LotOrigins(lot.astype(np.int32), np.concatenate([p.origin for p in parts])[first])
+
+    def table(self) -> np.ndarray:
+        """(L, 3) float64, row = lot, L the highest lot plus one: a record's ``lot_origin``, NaN for lots
+        without an origin."""
+        out = np.full((int(self.lot[-1]) + 1 if len(self.lot) else 0, 3), np.nan)
+        out[self.lot] = self.origin
+        return out
+
+    def world_xform(self, xform: np.ndarray, lot: np.ndarray | None) -> np.ndarray:
+        """(n, 3, 4) float64: transforms ``xform`` (n, 3, 4) of rows of lots ``lot`` (n,) in world
+        coordinates (``lot`` may be None where there are no origins)."""
+        out = np.array(xform, np.float64)
+        if len(self.lot):
+            out[:, :, 3] += self.of(lot)
+        return out
+
+    def of(self, lot: np.ndarray) -> np.ndarray:
+        """(m, 3) float64: the origins of lots ``lot`` (m,) int; zeros when there are none (``empty()``).
+
+        Raises ``ValueError`` if some lot has none."""
+        lot = np.asarray(lot)
+        if not len(self.lot):
+            return np.zeros((len(lot), 3))
+        at = np.minimum(np.searchsorted(self.lot, lot), len(self.lot) - 1)
+        if len(lot) and (self.lot[at] != lot).any():
+            missing = lot[self.lot[at] != lot][0]
+            raise ValueError(f"LotOrigins: lot {int(missing)} has records but no origin")
+        return self.origin[at]
+
+
+@dataclass(frozen=True, eq=False)
 class MeshChunk:
-    """Leaf polygons that cannot be instances: faces with holes, in world coordinates.
+    """Leaf polygons that cannot be instances: faces with holes, relative to their lot's origin
+    (``LotOrigins``).
 
     Attributes
     ----------
     vertices : (V, 3) float32
-        Ring vertices, ring after ring.
+        Ring vertices, ring after ring, relative to the origin of their face's lot.
     ring_offsets : (R+1,) int64
         Ring ``r`` is ``vertices[ring_offsets[r]:ring_offsets[r+1]]`` (Arrow-style, starts at 0).
     face_offsets : (F+1,) int64
@@ -97,6 +177,15 @@ class MeshChunk:
             uv=None if all(c.uv is None for c in chunks) else np.concatenate([c.texture() for c in chunks]),
         )
 
+    def vertex_lots(self) -> np.ndarray:
+        """(V,) int32: the lot of each vertex (its face's)."""
+        return np.repeat(self.lot, np.diff(self.ring_offsets[self.face_offsets]))
+
+    def world(self, origins: LotOrigins) -> np.ndarray:
+        """(V, 3) float64: the vertices in world coordinates, their lots' ``origins`` added."""
+        vertices = np.asarray(self.vertices, np.float64)
+        return vertices + origins.of(self.vertex_lots()) if len(origins.lot) else vertices.copy()
+
     def texture(self) -> np.ndarray:
         """(V, 2) float32: the vertices' texture coordinates, NaN where none were given."""
         return self.uv if self.uv is not None else np.full((len(self.vertices), 2), np.nan, np.float32)
@@ -147,7 +236,8 @@ class TerminalChunk:
     asset : (n,) int32
         Index into the writer's ``assets``.
     xform : (n, 3, 4) float32
-        Affine map from the asset's unit box to world: ``world = xform[:, :, :3] @ p + xform[:, :, 3]``.
+        Affine map from the asset's unit box to its lot's frame: ``world = origin + xform[:, :, :3] @ p +
+        xform[:, :, 3]``, ``origin`` the lot's in ``origins``.
     lot : (n,) int32
         Lot (initial shape) of each instance.
     symbol : (n,) int32
@@ -160,6 +250,9 @@ class TerminalChunk:
         Each instance's row of ``materials``; None (and ``materials`` None) where the grammar sets no texture.
     materials : (M, len(MATERIAL_MAPS)) str, optional
         The texture paths of each material (as ``MeshChunk.materials``; the mesh's table is the same).
+    origins : LotOrigins
+        The origins of the chunk's lots, which its transforms and mesh vertices are relative to; empty:
+        they are in world coordinates.
     uv : (n, 2, 4) float32, optional
         Texture coordinates of set 0 of each instance as an affine map of its asset's unit box:
         ``uv = uv[:, :, :3] @ p + uv[:, :, 3]`` (NaN: none); None: no instance has any.
@@ -174,6 +267,7 @@ class TerminalChunk:
     material: np.ndarray | None = None
     materials: np.ndarray | None = None
     uv: np.ndarray | None = None
+    origins: LotOrigins = field(default_factory=LotOrigins.empty)
 
     def colors(self) -> np.ndarray:
         """(n, 4) uint8: the instances' colours, white where none was given."""
@@ -181,9 +275,38 @@ class TerminalChunk:
             return self.color
         return _white(len(self.asset))
 
+    def world_xform(self) -> np.ndarray:
+        """(n, 3, 4) float64: the transforms in world coordinates, their lots' origins added."""
+        return self.origins.world_xform(self.xform, self.lot)
+
     def texture(self) -> np.ndarray:
         """(n, 2, 4) float32: the instances' texture maps, NaN where none were given."""
         return self.uv if self.uv is not None else np.full((len(self.asset), 2, 4), np.nan, np.float32)
+
+
+def world_columns(record: Mapping) -> tuple[np.ndarray, np.ndarray]:
+    """A record's transforms (N, 3, 4) and mesh vertices (V, 3) in world coordinates, float64: its
+    ``lot_origin`` table added (``LotOrigins``; a record without one is in world coordinates already).
+
+    ``record`` is the dict of ``io.npz.read_instances`` (``mesh_vertices``, ``mesh_lot`` and the offsets)
+    or of ``build.derive`` (the mesh table as ``"mesh"``, a ``MeshChunk``); either may lack the mesh."""
+    origins = LotOrigins.from_table(record.get("lot_origin"))
+    xform = origins.world_xform(record.get("xform", np.zeros((0, 3, 4))), record.get("lot"))
+    mesh = record_mesh(record)
+    return xform, mesh.world(origins) if mesh is not None else np.zeros((0, 3))
+
+
+def record_mesh(record: Mapping) -> MeshChunk | None:
+    """The mesh table of a record (``world_columns``), None without one."""
+    if record.get("mesh") is not None or "mesh_face_offsets" not in record:
+        return record.get("mesh")
+    return MeshChunk(
+        vertices=np.asarray(record["mesh_vertices"]).reshape(-1, 3),
+        ring_offsets=np.asarray(record["mesh_ring_offsets"], np.int64),
+        face_offsets=np.asarray(record["mesh_face_offsets"], np.int64),
+        lot=np.asarray(record.get("mesh_lot", np.zeros(0, np.int32))),
+        symbol=np.asarray(record.get("mesh_symbol", np.zeros(0, np.int32))),
+    )
 
 
 class MaterialTable:

@@ -28,6 +28,7 @@ from grammarc.atomic import replacing
 from grammarc.errors import AssetError, UsageError
 from grammarc.geometry.triangulation import triangulate_polygons
 from grammarc.model.assets import asset_library, builtin_mesh
+from grammarc.model.records import record_mesh, world_columns
 from grammarc.render.camera import VIEWS, Camera, fit_camera
 from grammarc.render.raster import draw_instances, draw_triangles
 
@@ -185,7 +186,8 @@ def _checked_size(size) -> tuple[int, int]:
 
 def _columns(record: Mapping) -> dict:
     """The columns ``render`` draws, checked: ``assets`` (list of str), ``asset`` (N,) int32, ``xform``
-    (N, 3, 4) float32, ``mesh`` (vertices (V, 3) float64, ring and face offsets int64), ``meta``, and
+    (N, 3, 4) float32, ``mesh`` (vertices (V, 3) float64, ring and face offsets int64), both moved from world
+    coordinates by the same whole metres to the city's middle (the picture does not change), ``meta``, and
     ``color``, ``symbol``, ``symbols``, ``mesh_color``, ``mesh_symbol`` where the record has them."""
     if not isinstance(record, Mapping):
         raise TypeError(f"render takes a record's columns (a mapping, as io.npz.read_instances returns), "
@@ -196,19 +198,26 @@ def _columns(record: Mapping) -> dict:
     out = dict(record)
     out["assets"] = [str(n) for n in np.asarray(record["assets"]).reshape(-1)]
     out["asset"] = np.ascontiguousarray(record["asset"], np.int32).reshape(-1)
-    out["xform"] = np.ascontiguousarray(record["xform"], np.float32)
     n = len(out["asset"])
-    if out["xform"].shape != (n, 3, 4):
-        raise UsageError(f"not an instance record: xform is {out['xform'].shape}, expected ({n}, 3, 4)")
+    if np.shape(record["xform"]) != (n, 3, 4):
+        raise UsageError(f"not an instance record: xform is {np.shape(record['xform'])}, expected ({n}, 3, 4)")
     if n and (out["asset"].min() < 0 or out["asset"].max() >= len(out["assets"])):
         raise UsageError(f"not an instance record: asset index out of range [0, {len(out['assets'])})")
-    if "mesh_face_offsets" in record:
-        out["mesh"] = (np.asarray(record["mesh_vertices"], np.float64).reshape(-1, 3),
-                       np.asarray(record["mesh_ring_offsets"], np.int64),
-                       np.asarray(record["mesh_face_offsets"], np.int64))
-    else:
-        out["mesh"] = (np.zeros((0, 3)), np.zeros(1, np.int64), np.zeros(1, np.int64))
+    # drawn around the middle of the city, where float32 keeps its detail wherever the city lies
+    xform, vertices = world_columns(record)
+    middle = np.round(_middle(xform, vertices))
+    xform[:, :, 3] -= middle
+    out["xform"] = np.ascontiguousarray(xform, np.float32)
+    mesh = record_mesh(record)
+    out["mesh"] = (vertices - middle, mesh.ring_offsets, mesh.face_offsets) if mesh is not None else \
+        (np.zeros((0, 3)), np.zeros(1, np.int64), np.zeros(1, np.int64))
     return out
+
+
+def _middle(xform: np.ndarray, vertices: np.ndarray) -> np.ndarray:
+    """(3,) float64: the middle of the instances' origins and the mesh vertices (0 for an empty record)."""
+    points = np.concatenate([xform[:, :, 3], vertices])
+    return (points.min(axis=0) + points.max(axis=0)) / 2 if len(points) else np.zeros(3)
 
 
 def _bounds(xform: np.ndarray, vertices: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

@@ -4,6 +4,7 @@ building meets its neighbour (inter, the same whatever the chunking), and labell
 from __future__ import annotations
 
 import numpy as np
+from conftest import in_world
 from operations.derivations import names, of_symbol, rect, run
 
 MASSES = """
@@ -135,7 +136,8 @@ facade ~> hidden
         from grammarc.compiler import compile_grammar
         from grammarc.io.lots import lots_from_polygons
 
-        r = derive(compile_grammar(write("v.cga", text)), lots_from_polygons([lot], street=[street]), BuildOptions())
+        r = in_world(derive(compile_grammar(write("v.cga", text)), lots_from_polygons([lot], street=[street]),
+                            BuildOptions()))
         seen = r["xform"][np.array(names(r)) == "seen"].astype(float)
         assert len(seen) == 1 and count(r, "hidden") == 3
         np.testing.assert_allclose(seen[0, 2, 3], 0)  # the south facade (map y = 0: world z = 0)

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from conftest import in_world
 from operations.derivations import VERSION, names, rect, totals
 
 from grammarc.build import BuildOptions, derive
@@ -17,7 +18,7 @@ CORNER = [0, 8, 8, 0]  # east and north
 
 def run(write, text, street):
     grammar = compile_grammar(write("g.cga", VERSION + text))
-    return derive(grammar, lots_from_polygons([rect(30, 20)], street=[street]), BuildOptions())
+    return in_world(derive(grammar, lots_from_polygons([rect(30, 20)], street=[street]), BuildOptions()))
 
 
 def box_bounds(record, name):

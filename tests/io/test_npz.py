@@ -19,14 +19,16 @@ import pytest
 from grammarc.errors import UsageError
 from grammarc.io import npz
 from grammarc.io.npz import InstanceWriter, load_record, read_instances
-from grammarc.model.records import MeshChunk, TerminalChunk
+from grammarc.model.records import LotOrigins, MeshChunk, TerminalChunk
 
 ASSETS = ["builtin:cube", "builtin:quad", "facade/window.obj"]
 SYMBOLS = ["Wall", "Window", "Roof", "Ledge"]
 KEYS = {
-    "assets", "asset", "xform", "lot", "symbols", "symbol", "color", "meta",
+    "assets", "asset", "xform", "lot", "lot_origin", "symbols", "symbol", "color", "meta",
     "mesh_vertices", "mesh_ring_offsets", "mesh_face_offsets", "mesh_lot", "mesh_symbol", "mesh_color",
 }  # fmt: skip
+#: The lots' origins (a UTM-like grid position each), the same in every chunk, as the derivation gives them.
+ORIGINS = LotOrigins.of_lots(np.arange(100), np.random.default_rng(1).uniform(0, 6e6, (100, 3)).round(3))
 
 
 def random_mesh(rng, n_faces):
@@ -49,6 +51,7 @@ def random_chunk(rng, n, n_faces):
         lot=rng.integers(0, 100, n).astype(np.int32),
         symbol=rng.integers(0, len(SYMBOLS), n).astype(np.int32),
         mesh=random_mesh(rng, n_faces),
+        origins=ORIGINS,
     )
 
 
@@ -74,6 +77,7 @@ def slice_chunk(chunk, i0, i1, f0, f1):
         chunk.lot[rows],
         chunk.symbol[rows],
         slice_mesh(chunk.mesh, f0, f1),
+        origins=chunk.origins,
     )
 
 
@@ -116,14 +120,27 @@ def test_round_trip(tmp_path, chunks):
         np.testing.assert_array_equal(record[key], expected)
     np.testing.assert_array_equal(record["mesh_lot"], np.concatenate([c.mesh.lot for c in chunks]))
     np.testing.assert_array_equal(record["mesh_symbol"], np.concatenate([c.mesh.symbol for c in chunks]))
+    assert record["lot_origin"].dtype == np.float64
+    np.testing.assert_array_equal(record["lot_origin"], ORIGINS.table())
 
     assert counts == {"instances": 32, "mesh_faces": 15, "mesh_vertices": len(record["mesh_vertices"])}
     assert record["meta"] == {
         "seed": 7,
         "grammar": "city.cga",
         "counts": counts,
-        "format": "grammarc.instances/1",
+        "format": "grammarc.instances/2",
     }
+
+
+def test_chunks_all_carry_lot_origins_or_none(tmp_path, chunks):
+    plain = dataclasses.replace(chunks[0], origins=LotOrigins.empty())
+    with InstanceWriter(tmp_path / "a.npz", assets=ASSETS, symbols=SYMBOLS, meta={}) as out:
+        out.write(chunks[0])
+        with pytest.raises(ValueError, match="all carry lot origins or none"):
+            out.write(plain)
+    with InstanceWriter(tmp_path / "b.npz", assets=ASSETS, symbols=SYMBOLS, meta={}) as out:
+        out.write(plain)
+    assert "lot_origin" not in read_instances(tmp_path / "b.npz")  # rows in world coordinates
 
 
 def test_mesh_offsets_are_rebased_across_chunks(tmp_path, chunks):
@@ -628,7 +645,7 @@ def test_colours_default_to_white_and_round_trip(tmp_path):
                              MeshChunk(*(getattr(plain.mesh, f) for f in ("vertices", "ring_offsets",
                                                                           "face_offsets", "lot", "symbol")),
                                        color=np.full((len(plain.mesh.lot), 4), 7, np.uint8)),
-                             color=np.tile(np.array([[1, 2, 3, 255]], np.uint8), (4, 1)))
+                             color=np.tile(np.array([[1, 2, 3, 255]], np.uint8), (4, 1)), origins=ORIGINS)
     with InstanceWriter(tmp_path / "c.npz", assets=ASSETS, symbols=SYMBOLS, meta={}) as writer:
         writer.write(plain)
         writer.write(coloured)

@@ -9,10 +9,12 @@ import zlib
 from pathlib import Path
 
 import numpy as np
+from conftest import in_world
 
 from grammarc.build import build
 from grammarc.io import OutputOptions
 from grammarc.io.npz import read_instances
+from grammarc.model.records import world_columns
 
 GRAMMAR = """
 Lot --> extrude(9) comp(f){ side : Facade | top : Roof }
@@ -25,7 +27,8 @@ Roof --> roofHip(25)
 
 
 def city(tmp_path: Path, output: str, **options) -> tuple[dict, Path, dict]:
-    """(the npz record, the output path, the writer's counts) of the city written as ``output``."""
+    """(the npz record in world coordinates, the output path, the writer's counts) of the city written as
+    ``output``."""
     lots = {"type": "FeatureCollection", "features": [
         {"type": "Feature", "id": f"lot{k}", "properties": {},
          "geometry": {"type": "Polygon", "coordinates": [[[x, y], [x + w, y], [x + w, y + 12], [x, y + 12],
@@ -36,7 +39,7 @@ def city(tmp_path: Path, output: str, **options) -> tuple[dict, Path, dict]:
     build(tmp_path / "g.cga", tmp_path / "city.npz", lots_path=tmp_path / "lots.geojson")
     result = build(tmp_path / "g.cga", tmp_path / output, lots_path=tmp_path / "lots.geojson",
                    output_options=OutputOptions(**options))
-    return read_instances(tmp_path / "city.npz"), tmp_path / output, result.counts
+    return in_world(read_instances(tmp_path / "city.npz")), tmp_path / output, result.counts
 
 
 def world(position, orientation_xyzw, scale) -> np.ndarray:
@@ -70,7 +73,7 @@ def glb_city(tmp_path: Path, output: str) -> tuple[dict, Path, int]:
     (tmp_path / "lots.geojson").write_text(json.dumps(lots))
     build(tmp_path / "g.cga", tmp_path / "city.npz", lots_path=tmp_path / "lots.geojson")
     build(tmp_path / "g.cga", tmp_path / output, lots_path=tmp_path / "lots.geojson")
-    return read_instances(tmp_path / "city.npz"), tmp_path / output, len(scene.to_geometry().faces)
+    return in_world(read_instances(tmp_path / "city.npz")), tmp_path / output, len(scene.to_geometry().faces)
 
 
 #: A red roof and half transparent green walls, on two lots; a textured facade.
@@ -104,7 +107,7 @@ PNG = _png(2, 2)
 
 def nearest_uv(record, points: np.ndarray) -> np.ndarray:
     """(n, 2): the texture coordinates of the record's mesh vertices nearest to world ``points`` (n, 3)."""
-    vertices = record["mesh_vertices"].astype(float)
+    vertices = world_columns(record)[1]
     nearest = np.argmin(((points[:, None, :] - vertices[None]) ** 2).sum(axis=2), axis=1)
     return record["mesh_uv"][nearest].astype(float)
 

@@ -1,11 +1,13 @@
-"""The record's chunks: joined meshes shift their offsets, colours default to white."""
+"""The record's chunks: joined meshes shift their offsets, colours default to white, rows and vertices are
+placed by their lots' origins."""
 
 import dataclasses
 
 import numpy as np
+import pytest
 
 from grammarc.ir.nodes import MATERIAL_MAPS
-from grammarc.model.records import WHITE, MaterialTable, MeshChunk, TerminalChunk
+from grammarc.model.records import WHITE, LotOrigins, MaterialTable, MeshChunk, TerminalChunk, world_columns
 
 
 def triangle() -> MeshChunk:
@@ -112,3 +114,41 @@ def test_a_material_table_does_not_depend_on_the_chunks():
     apart.add(_lots([], [], 0, 0, ("c.jpg",)))
     apart.add(_lots([1], [0], 1, 0, ("d.jpg",)))
     assert together.table()[:, 0].tolist() == apart.table()[:, 0].tolist() == ["", "c.jpg", "d.jpg"]
+
+
+def test_lot_origins_place_rows_and_vertices_in_world_coordinates():
+    origins = LotOrigins.of_lots(np.array([7, 2]), np.array([[5e5, 0, -5.75e6], [1.0, 2.0, 3.0]]))
+    assert origins.lot.tolist() == [2, 7]  # ascending, whatever the order given
+    xform = np.zeros((2, 3, 4), np.float32)
+    xform[:, :, 3] = [[0.25, 0, 0], [0, 0, 0.125]]
+    chunk = TerminalChunk(asset=np.zeros(2, np.int32), xform=xform, lot=np.array([7, 2], np.int32),
+                          symbol=np.zeros(2, np.int32), mesh=triangle(), origins=origins)
+    world = chunk.world_xform()
+    assert world.dtype == np.float64
+    assert world[:, :, 3].tolist() == [[500000.25, 0, -5750000.0], [1.0, 2.0, 3.125]]
+    mesh = dataclasses.replace(triangle(), lot=np.array([7], np.int32))
+    assert mesh.world(origins).tolist() == [[5e5, 0, -5.75e6]] * 3
+    with pytest.raises(ValueError, match="lot 0 has records but no origin"):
+        triangle().world(origins)
+    assert TerminalChunk(np.zeros(1, np.int32), xform[:1], np.array([3], np.int32), np.zeros(1, np.int32),
+                         triangle()).world_xform()[0, 0, 3] == 0.25  # no origins: world coordinates
+
+
+def test_lot_origins_round_trip_through_a_records_table():
+    a = LotOrigins.of_lots(np.array([0, 3]), np.array([[1.0, 0, 1], [2.0, 0, 2]]))
+    b = LotOrigins.of_lots(np.array([3, 5]), np.array([[2.0, 0, 2], [4.0, 0, 4]]))
+    table = LotOrigins.concat([a, b]).table()
+    assert table.shape == (6, 3) and np.isnan(table[[1, 2, 4]]).all()  # lots without records
+    again = LotOrigins.from_table(table)
+    assert again.lot.tolist() == [0, 3, 5] and again.origin[:, 0].tolist() == [1.0, 2.0, 4.0]
+    assert LotOrigins.from_table(None).lot.size == 0
+
+
+def test_world_columns_of_a_read_record():
+    record = {"xform": np.zeros((1, 3, 4), np.float32), "lot": np.array([1], np.int32),
+              "lot_origin": np.array([[np.nan] * 3, [10.0, 0, -20.0]]),
+              "mesh_vertices": np.ones((3, 3), np.float32), "mesh_ring_offsets": np.array([0, 3]),
+              "mesh_face_offsets": np.array([0, 1]), "mesh_lot": np.array([1], np.int32)}
+    xform, vertices = world_columns(record)
+    assert xform[0, :, 3].tolist() == [10.0, 0, -20.0]
+    assert vertices.tolist() == [[11.0, 1.0, -19.0]] * 3

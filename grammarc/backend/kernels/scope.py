@@ -51,8 +51,9 @@ def place_children(origin, size, key, frame, geom, lot, depth, frames, axis, ord
 
 
 @njit(cache=True, nogil=True)
-def xforms(frames, frame, size, origin):
-    """Record transforms (n, 3, 4) float32: column j = scope axis j * size j, column 3 = origin."""
+def xforms(frames, frame, size, origin, base):
+    """Record transforms (n, 3, 4) float32: column j = scope axis j * size j, column 3 = origin - base
+    (``base`` (n, 3): each row's lot origin, ``model.records.LotOrigins``)."""
     n = len(frame)
     out = np.empty((n, 3, 4), np.float32)
     for i in range(n):
@@ -60,17 +61,18 @@ def xforms(frames, frame, size, origin):
         for r in range(3):
             for j in range(3):
                 out[i, r, j] = frames[f, j, r] * size[i, j]
-            out[i, r, 3] = origin[i, r]
+            out[i, r, 3] = origin[i, r] - base[i, r]
     return out
 
 
 @njit(cache=True, nogil=True)
-def leaf_xforms(origin, size, frame, frames, axis, rows, parent, pos, length, new_size, relative, offset):
+def leaf_xforms(origin, base, size, frame, frames, axis, rows, parent, pos, length, new_size, relative, offset):
     """Record transforms (m, 3, 4) float32 of split children ``rows`` whose symbol only places an asset
     after a constant ``S`` and ``T`` (``leaf_parts``): the child's scope as ``place_children`` makes it,
     sized as ``operations.scope.scale`` and moved as ``operations.scope.translate`` would (the same
     operations in the same order, so the same bits), then as ``xforms``. ``new_size`` (3,): NaN keeps the axis' size, else an
-    absolute size or, where ``relative``, a factor; ``offset`` (3,) along the scope axes, or empty."""
+    absolute size or, where ``relative``, a factor; ``offset`` (3,) along the scope axes, or empty;
+    ``base`` (n, 3) the parents' lot origins."""
     m = len(rows)
     out = np.empty((m, 3, 4), np.float32)
     o = np.empty(3)
@@ -95,5 +97,5 @@ def leaf_xforms(origin, size, frame, frames, axis, rows, parent, pos, length, ne
         for r in range(3):
             for j in range(3):
                 out[c, r, j] = frames[f, j, r] * s[j]
-            out[c, r, 3] = o[r]
+            out[c, r, 3] = o[r] - base[p, r]
     return out

@@ -6,6 +6,7 @@ from __future__ import annotations
 from pathlib import Path
 
 import numpy as np
+from conftest import in_world
 
 from grammarc.build import BuildOptions, derive
 from grammarc.compiler import compile_grammar
@@ -42,10 +43,11 @@ def rectangles(*sizes) -> list:
 
 
 def derived(root: Path, text: str, lots: list, **options):
-    """The records of the CityEngine grammar ``text`` written in ``root`` and derived on ``lots``."""
+    """The records of the CityEngine grammar ``text`` written in ``root`` and derived on ``lots``, in world
+    coordinates."""
     path = root / "g.cga"
     path.write_text(VERSION + "@StartRule\n" + text)
-    return derive(compile_grammar(path), lots_from_polygons(lots), BuildOptions(**options))
+    return in_world(derive(compile_grammar(path), lots_from_polygons(lots), BuildOptions(**options)))
 
 
 def reported(records, key: str) -> list:

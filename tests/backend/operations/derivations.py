@@ -13,7 +13,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from conftest import LOT_ZOO
+from conftest import LOT_ZOO, in_world
 
 from grammarc.build import BuildOptions, derive
 from grammarc.compiler import compile_grammar
@@ -37,9 +37,10 @@ def make_lots_polys(*names):
 
 
 def run(write, text, polygons, *, lot_attrs=None, version=True, **options):
-    """The records of ``text`` (CityEngine's, unless ``version`` is false) derived on ``polygons``."""
+    """The records of ``text`` (CityEngine's, unless ``version`` is false) derived on ``polygons``, in world
+    coordinates."""
     grammar = compile_grammar(write("g.cga", (VERSION if version else "") + text))
-    return derive(grammar, lots_from_polygons(polygons, attrs=lot_attrs), BuildOptions(**options))
+    return in_world(derive(grammar, lots_from_polygons(polygons, attrs=lot_attrs), BuildOptions(**options)))
 
 
 def paper(write, text, polygons, **options):
