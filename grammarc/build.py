@@ -34,6 +34,7 @@ from grammarc.compiler import compile_grammar
 from grammarc.constants import LIMITS, Limits
 from grammarc.errors import ChunkTooLarge, LotFailure, UsageError
 from grammarc.io import OutputOptions, writer_for
+from grammarc.io.crs import CrsChoice
 from grammarc.io.lots import default_lot, read_lots
 from grammarc.io.reports import write_reports
 from grammarc.model.grammar import Grammar
@@ -68,6 +69,9 @@ class BuildOptions:
     workspace: Path | None = None
     #: Whether a warning of the grammar stops the build as an error would (``--warnings-as-errors``).
     warnings_as_errors: bool = False
+    #: The lots' coordinate system where their file names none or the wrong one, and the metric one to
+    #: reproject lots in longitude/latitude to (``--lots-crs``, ``--crs``; ``io.crs``).
+    crs: CrsChoice | None = None
 
 
 @dataclass(frozen=True)
@@ -79,6 +83,8 @@ class BuildResult:
     counts: dict
     seconds: float
     grammar: Grammar
+    #: How the lots came to metres where they were reprojected (``Lots.crs_note``), for the build to say.
+    crs_note: str | None = None
 
 
 def find_lots(grammar_path: Path) -> Path | None:
@@ -90,9 +96,9 @@ def find_lots(grammar_path: Path) -> Path | None:
     return None
 
 
-def load_lots(grammar_path: Path, lots_path: Path | None) -> Lots:
+def load_lots(grammar_path: Path, lots_path: Path | None, crs: CrsChoice | None = None) -> Lots:
     path = lots_path or find_lots(grammar_path)
-    return read_lots(path) if path is not None else default_lot()
+    return read_lots(path, crs) if path is not None else default_lot()
 
 
 def build(grammar_path, output, *, lots_path=None, options: BuildOptions = BuildOptions(),
@@ -148,11 +154,11 @@ def _build(source: Path, display: str | None, grammar_path: Path, output, lots_p
     check_overrides(grammar.module, options.attrs)
     writer_class = writer_for(output, replace(output_options, asset_roots=tuple(grammar.asset_roots)))
     Path(output).parent.mkdir(parents=True, exist_ok=True)
-    every = load_lots(grammar_path, Path(lots_path) if lots_path else None)
+    every = load_lots(grammar_path, Path(lots_path) if lots_path else None, options.crs)
     lots = every if select is None else every.select(select)
     if display is None:  # a rule file on disk: its CityEngine project's folders too, for a later render
         recorded_roots = (*recorded_roots, *(r for r in grammar.asset_roots[1:] if r not in recorded_roots))
-    meta = record_meta(grammar_path, grammar, plan, options, lots.source, recorded_roots)
+    meta = record_meta(grammar_path, grammar, plan, options, lots.source, recorded_roots, lots.crs)
     failed: list[BadLot] = []
     reports = Reports()
     with writer_class(output, assets=grammar.assets, symbols=plan.symbol_names, meta=meta) as writer:
@@ -163,12 +169,13 @@ def _build(source: Path, display: str | None, grammar_path: Path, output, lots_p
                       dict(zip(every.index.tolist(), every.ids.tolist())))
     bad = tuple(sorted((*lots.bad, *failed), key=lambda b: b.index))
     return BuildResult(Path(output), len(lots) + len(lots.bad), derived, bad, counts,
-                       time.perf_counter() - started, grammar)
+                       time.perf_counter() - started, grammar, lots.crs_note)
 
 
 def record_meta(grammar_path: Path, grammar: Grammar, plan, options: BuildOptions, lots_source: str,
-                recorded_roots: tuple[Path, ...]) -> dict:
-    """The ``meta`` of a build's record: what it was made from."""
+                recorded_roots: tuple[Path, ...], crs: str | None) -> dict:
+    """The ``meta`` of a build's record: what it was made from, and the coordinate system of its world
+    (``crs``: the lots', after any reprojection; None for metres of a local scene)."""
     return {
         "grammar": str(grammar_path),
         "grammar_sha256": grammar.digest,
@@ -177,6 +184,7 @@ def record_meta(grammar_path: Path, grammar: Grammar, plan, options: BuildOption
         "start": plan.symbols[plan.start].name,
         "attrs": {k: v for k, v in sorted(options.attrs.items())},
         "lots_source": lots_source,
+        "crs": crs,
         "dialect": grammar.module.dialect,
         # the user's asset folders (baking); a package's own are left out: extracted to a fresh temporary
         # folder for this build only, their names would make each run's record differ

@@ -96,6 +96,7 @@ def _parser() -> argparse.ArgumentParser:
     build.add_argument("--lod", metavar="NAME",
                        help="level of detail: asset `x.obj` is drawn as `x.NAME.obj` where that file exists; "
                             "`builtin`: a cube stands in for a missing asset file")
+    _crs_options(build)
     build.add_argument("--bake-origin", type=_point, metavar="X,Y,Z",
                        help="world point subtracted from a baked mesh's coordinates (default: world coordinates, "
                             "or the middle of the city in float32 formats far from the origin; the file says which)")
@@ -140,6 +141,7 @@ def _parser() -> argparse.ArgumentParser:
                                               "shape JSON")
     lots.add_argument("--to", type=Path, metavar="OUT.parquet",
                       help="write the good lots as GeoParquet (extra `parquet`), which reads faster")
+    _crs_options(lots)
     lots.set_defaults(run=_lots)
 
     info = sub.add_parser("info", help="what a city holds: counts, lots, bbox, polygons")
@@ -185,6 +187,22 @@ def _point(text: str) -> tuple[float, float, float]:
     if len(point) != 3 or not all(math.isfinite(v) for v in point):
         raise argparse.ArgumentTypeError(f"must be three numbers X,Y,Z, got `{text}`")
     return point
+
+
+def _crs_options(command) -> None:
+    command.add_argument("--crs", metavar="CRS",
+                         help="metric coordinate system to reproject lots in longitude/latitude to (e.g. "
+                              "EPSG:2056; default: the UTM zone of their centre)")
+    command.add_argument("--lots-crs", metavar="CRS",
+                         help="coordinate system of the lots' file where it names none or the wrong one "
+                              "(e.g. EPSG:4326)")
+
+
+def _crs_choice(args):
+    """The ``io.crs.CrsChoice`` of ``--lots-crs`` and ``--crs``, None without either."""
+    from grammarc.io.crs import CrsChoice
+
+    return CrsChoice(declared=args.lots_crs, target=args.crs) if args.crs or args.lots_crs else None
 
 
 def _workspace_option(command) -> None:
@@ -252,11 +270,13 @@ def _lots(args) -> int:
     from grammarc.errors import UsageError
     from grammarc.io.lots import read_lots
 
-    lots = read_lots(args.path)
+    lots = read_lots(args.path, _crs_choice(args))
     for bad in lots.bad:
         print(f"grammarc: lot {bad.id} (#{bad.index}) is bad: {bad.reason}", file=sys.stderr)
     print(f"{args.path}: {len(lots):,} lots, {len(lots.bad):,} bad, {len(lots.vertices):,} vertices, "
           f"properties: {', '.join(lots.attrs) or '-'}")
+    where = lots.crs_note or lots.crs or "none named (metres of a local scene)"
+    print(f"coordinate system: {where if len(where) < 200 else where[:197] + '...'}")
     if args.to is not None:
         if args.to.suffix.lower() != ".parquet":
             raise UsageError(f"--to writes GeoParquet: give a .parquet path, not `{args.to}`")
@@ -356,6 +376,7 @@ def _build(args) -> int:
         workers=args.workers,
         workspace=args.workspace,
         warnings_as_errors=args.warnings_as_errors,
+        crs=_crs_choice(args),
     )
     bar = _ProgressBar() if not args.quiet else None
     try:
@@ -370,6 +391,8 @@ def _build(args) -> int:
     finally:
         if bar is not None:
             bar.close()
+    if result.crs_note is not None:  # said even with --quiet: the output is not where the file's numbers are
+        print(f"grammarc: lots in {result.crs_note}", file=sys.stderr)
     if not args.quiet:
         _warn(result.grammar)
         for bad in result.bad:

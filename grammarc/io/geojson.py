@@ -1,7 +1,8 @@
 """Lots of a GeoJSON document (``.geojson``, ``.json``), or of a PRT initial shape as JSON.
 
-GeoJSON may be a FeatureCollection, a single Feature or a bare Polygon / MultiPolygon geometry, in map
-coordinates taken as metres (longitude/latitude is not reprojected). Features become lots as
+GeoJSON may be a FeatureCollection, a single Feature or a bare Polygon / MultiPolygon geometry. Its
+coordinates are longitude and latitude (RFC 7946) where they are degrees, else metres of a local scene,
+unless a legacy ``crs`` member names their coordinate system (``io.crs``). Features become lots as
 ``io.lot_builder.parse_features`` says (a MultiPolygon a lot per polygon, other geometries bad lots), and
 their properties ``attrs`` columns, typed over all polygon lots of the file.
 
@@ -21,6 +22,7 @@ import numpy as np
 import orjson
 
 from grammarc.errors import LotsError
+from grammarc.io.crs import CRS84, CrsChoice
 from grammarc.io.lot_builder import LotBuilder, parse_features, property_columns
 from grammarc.io.lot_format import LotsFormat, read_text
 from grammarc.model.lots import Lots
@@ -28,7 +30,7 @@ from grammarc.model.lots import Lots
 __all__ = ["FORMAT", "read_geojson"]
 
 
-def read_geojson(path: Path) -> Lots:
+def read_geojson(path: Path, crs: CrsChoice | None = None) -> Lots:
     """All lots of a GeoJSON document or a PRT initial shape as JSON (see the module docstring).
 
     Raises
@@ -42,9 +44,24 @@ def read_geojson(path: Path) -> Lots:
     except orjson.JSONDecodeError as error:
         raise LotsError(f"{path}:{error.lineno}:{error.colno}: not valid JSON: {error.msg}") from error
     if isinstance(data, dict) and "face_counts" in data and "type" not in data:
-        return _prt_shape(data, path).finish_file({}, path)
+        return _prt_shape(data, path).finish_file({}, path, crs)
     builder = parse_features(_features(data))
-    return builder.finish_file(property_columns(builder.props), path)
+    builder.declared, builder.implied = _declared_crs(data, path), CRS84
+    return builder.finish_file(property_columns(builder.props), path, crs)
+
+
+def _declared_crs(data, path: Path) -> str | None:
+    """The coordinate system a GeoJSON document names in its ``crs`` member (the 2008 specification's:
+    ``{"type": "name", "properties": {"name": "urn:ogc:def:crs:EPSG::2056"}}``), None without one."""
+    member = data.get("crs") if isinstance(data, dict) else None
+    if member is None:
+        return None
+    properties = member.get("properties") if isinstance(member, dict) else None
+    if isinstance(properties, dict) and isinstance(properties.get("name"), str):
+        return properties["name"]
+    if isinstance(properties, dict) and member.get("type") == "EPSG" and "code" in properties:
+        return f"EPSG:{properties['code']}"
+    raise LotsError(f"{path}: its `crs` member names no coordinate system: {orjson.dumps(member).decode()[:80]}")
 
 
 def _features(data) -> list:

@@ -20,6 +20,7 @@ import shapely
 from grammarc.atomic import replacing
 from grammarc.errors import LotsError
 from grammarc.io.arrow_lots import import_pyarrow, lots_from_table, table_lot_numbers
+from grammarc.io.crs import CRS84, CrsChoice, projjson
 from grammarc.io.lot_builder import STREET_WIDTH, LotBuilder
 from grammarc.io.lot_format import LotsFormat, Partition, partitions_at
 from grammarc.model.lots import Lots
@@ -33,11 +34,11 @@ __all__ = [
 ROW_GROUP = 16384
 
 
-def read_geoparquet(path: Path) -> Lots:
+def read_geoparquet(path: Path, crs: CrsChoice | None = None) -> Lots:
     """All lots of a GeoParquet file; a ``LotsError`` if it cannot be read, has no WKB geometry column, or
     holds no polygon."""
     builder, attrs = _lots(path, None, 0)
-    return builder.finish_file(attrs, path)
+    return builder.finish_file(attrs, path, crs)
 
 
 def geoparquet_partitions(path: Path, size: int) -> list[Partition]:
@@ -52,18 +53,38 @@ def count_geoparquet(part: Partition) -> int:
     return table_lot_numbers(table, _geometry_column(table, part.path), part.path)
 
 
-def read_geoparquet_partition(part: Partition, first_index: int) -> Lots:
+def read_geoparquet_partition(part: Partition, first_index: int, crs: CrsChoice | None = None) -> Lots:
     """The lots of a partition's rows (only the row groups that hold them are read), the first numbered
     ``first_index``."""
     builder, attrs = _lots(part.path, (part.start, part.stop), first_index)
-    return builder.finish(attrs, part.path)
+    return builder.finish(attrs, part.path, crs)
 
 
 def _lots(path: str | os.PathLike, rows: tuple[int, int] | None,
           first_index: int) -> tuple[LotBuilder, dict[str, np.ndarray]]:
-    """The lots of a GeoParquet file or of its rows ``(start, stop)``, to finish, and their properties."""
+    """The lots of a GeoParquet file or of its rows ``(start, stop)``, to finish, and their properties; the
+    coordinate system is the geometry column's ``crs`` (PROJJSON; absent: OGC:CRS84 where the coordinates
+    are degrees, the specification's default; null: none)."""
     table = _read_table(path, rows)
-    return lots_from_table(table, _geometry_column(table, path), path, rows[0] if rows else 0, first_index)
+    column = _geometry_column(table, path)
+    builder, attrs = lots_from_table(table, column, path, rows[0] if rows else 0, first_index)
+    described = json.loads((table.schema.metadata or {}).get(b"geo", b"{}")).get("columns", {}).get(column, {})
+    if "crs" not in described:
+        builder.implied = CRS84
+    elif described["crs"] is not None:
+        builder.declared = _crs_name(described["crs"])
+    return builder, attrs
+
+
+def _crs_name(crs) -> str:
+    """A GeoParquet ``crs`` as ``AUTHORITY:CODE`` where its PROJJSON has an ``id``, else as given (a
+    string, or the PROJJSON as JSON text)."""
+    if isinstance(crs, str):
+        return crs
+    code = crs.get("id") if isinstance(crs, dict) else None
+    if isinstance(code, dict) and "authority" in code and "code" in code:
+        return f"{code['authority']}:{code['code']}"
+    return json.dumps(crs)
 
 
 def _row_group_bounds(path: Path) -> np.ndarray:
@@ -125,7 +146,8 @@ def _geometry_column(table, path) -> str:
 
 def write_geoparquet(lots: Lots, path: str | os.PathLike) -> None:
     """Write lots as GeoParquet (WKB polygons in map coordinates, ids, properties, street widths 1/0),
-    atomically."""
+    atomically. Its ``crs`` is the lots' as PROJJSON, or null where they have none (metres of a local
+    scene): a GeoParquet without ``crs`` would mean longitude and latitude."""
     pa, pq = import_pyarrow()
     path = Path(path)
     xy = np.column_stack([lots.vertices[:, 0], np.subtract(0.0, lots.vertices[:, 2])])
@@ -146,7 +168,7 @@ def write_geoparquet(lots: Lots, path: str | os.PathLike) -> None:
     if lots.street.any():
         columns[STREET_WIDTH] = pa.array(widths, type=pa.list_(pa.float64()))
     geo = {"version": "1.0.0", "primary_column": "geometry",
-           "columns": {"geometry": {"encoding": "WKB", "geometry_types": ["Polygon"]}}}
+           "columns": {"geometry": {"encoding": "WKB", "geometry_types": ["Polygon"], "crs": projjson(lots.crs)}}}
     table = pa.table(columns).replace_schema_metadata({"geo": json.dumps(geo)})
     with replacing(path) as tmp:
         # row groups of 2^14 lots: a partition of a cluster build reads only the groups that hold its rows

@@ -16,6 +16,7 @@ from pathlib import Path
 
 from grammarc.errors import LotsError, UsageError
 from grammarc.io.arrow_lots import lots_from_table, table_lot_numbers
+from grammarc.io.crs import CrsChoice
 from grammarc.io.lot_format import LotsFormat, Partition, partitions_at
 from grammarc.model.lots import Lots
 
@@ -34,12 +35,13 @@ def _pyogrio():
     return pyogrio
 
 
-def read_gis(path: Path) -> Lots:
-    """All lots of a GIS file's first layer; a ``LotsError`` if GDAL cannot read it, it has no geometry,
-    or it holds no polygon."""
-    table, column = _table(path, None)
+def read_gis(path: Path, crs: CrsChoice | None = None) -> Lots:
+    """All lots of a GIS file's first layer, in the coordinate system GDAL gives it; a ``LotsError`` if GDAL
+    cannot read it, it has no geometry, or it holds no polygon."""
+    table, column, declared = _table(path, None)
     builder, attrs = lots_from_table(table, column, path)
-    return builder.finish_file(attrs, path)
+    builder.declared = declared
+    return builder.finish_file(attrs, path, crs)
 
 
 def gis_partitions(path: Path, size: int) -> list[Partition]:
@@ -50,15 +52,16 @@ def gis_partitions(path: Path, size: int) -> list[Partition]:
 
 def count_gis(part: Partition) -> int:
     """The lot numbers a partition's features take (``arrow_lots.table_lot_numbers``); no fields read."""
-    table, column = _table(part.path, (part.start, part.stop), columns=[])
+    table, column, _ = _table(part.path, (part.start, part.stop), columns=[])
     return table_lot_numbers(table, column, part.path)
 
 
-def read_gis_partition(part: Partition, first_index: int) -> Lots:
+def read_gis_partition(part: Partition, first_index: int, crs: CrsChoice | None = None) -> Lots:
     """The lots of a partition's features, the first numbered ``first_index``."""
-    table, column = _table(part.path, (part.start, part.stop))
+    table, column, declared = _table(part.path, (part.start, part.stop))
     builder, attrs = lots_from_table(table, column, part.path, part.start, first_index)
-    return builder.finish(attrs, part.path)
+    builder.declared = declared
+    return builder.finish(attrs, part.path, crs)
 
 
 def _features(path: str | os.PathLike) -> int:
@@ -71,6 +74,8 @@ def _features(path: str | os.PathLike) -> int:
 
 
 def _table(path, rows, columns=None):
+    """The first layer's features ``rows`` (all for None) as an Arrow table, its geometry column and its
+    coordinate system (GDAL's name for it, None without one)."""
     pyogrio = _pyogrio()
     skip, count = (rows[0], rows[1] - rows[0]) if rows else (0, None)
     try:
@@ -80,7 +85,7 @@ def _table(path, rows, columns=None):
     column = meta.get("geometry_name") or "wkb_geometry"
     if column not in table.column_names:
         raise LotsError(f"{path}: no geometry in its first layer")
-    return table, column
+    return table, column, meta.get("crs")
 
 
 FORMAT = LotsFormat(kind="gis", suffixes=SUFFIXES, title="a GIS file", read=read_gis,

@@ -10,8 +10,9 @@ the other lots load.
 
 Conventions, those of CityEngine and Esri PRT:
 
-- Map to world: world x = map x, world y = 0, world z = -map y (north is -z). Coordinates are taken as
-  metres as they are: longitude/latitude is not reprojected (project the file first, e.g. to UTM).
+- Map to world: world x = map x, world y = 0, world z = -map y (north is -z), in metres: lots in
+  longitude/latitude are reprojected first (``io.crs``: the coordinate system the file declares, a
+  format's default, the user's ``--lots-crs`` and ``--crs``).
 - The exterior ring of a lot has a +Y Newell normal (counter-clockwise on the map, as RFC 7946 wants),
   holes a -Y normal. A ring wound the other way is reversed keeping its first vertex first
   (v0, v_{n-1}, ..., v1): the first edge v0 -> v1 is the lot's scope x axis downstream.
@@ -33,6 +34,7 @@ from grammarc.constants import TOL
 from grammarc.errors import LotsError
 from grammarc.geometry.meshes import ring_vector_areas
 from grammarc.geometry.short_edges import collapse_short_edges
+from grammarc.io.crs import CrsChoice, georeference
 from grammarc.model.lots import BadLot, Lots
 from grammarc.ragged import offsets_from_counts, segment_reduce
 
@@ -49,11 +51,15 @@ _GEOS_REASON = re.compile(r"^(?P<what>.*)\[(?P<x>\S+) (?P<y>\S+)\]$")
 class LotBuilder:
     """Collects lots while a file is parsed; ``finish`` cleans, orients and validates them all at once.
 
-    Rings are (k, 3) float64 world coordinates if ``world``, else (k, 2) float64 map coordinates.
+    Rings are (k, 3) float64 world coordinates if ``world``, else (k, 2) float64 map coordinates. A format
+    sets ``declared``, the coordinate system its file names, and ``implied``, its default where the file names
+    none (``io.crs``).
     """
 
     def __init__(self, world: bool):
         self.world = world
+        self.declared: str | None = None
+        self.implied: str | None = None
         self.rings: list[np.ndarray] = []  # rings, or a block of rings (``add_block``)
         self.sizes: list[np.ndarray] = []  # vertices per ring, an array per lot or block
         self.ring_counts: list[int] = []  # rings per lot
@@ -116,14 +122,20 @@ class LotBuilder:
             return
         self.add(index, lot_id, xy, props)
 
-    def finish(self, attrs: dict[str, np.ndarray], source: str) -> Lots:
-        """Clean, orient and validate every lot at once; ``attrs`` are columns over all added lots."""
+    def finish(self, attrs: dict[str, np.ndarray], source: str, crs: CrsChoice | None = None) -> Lots:
+        """Bring every lot to metres (``io.crs.georeference``, with the user's ``crs`` choice), then clean,
+        orient and validate them all at once; ``attrs`` are columns over all added lots."""
         counts = np.concatenate([np.zeros(0, dtype=np.int64), *self.sizes])
         vertices = np.concatenate([np.zeros((0, 3 if self.world else 2)), *self.rings])
-        if not self.world:
-            # world (x, 0, -y); 0.0 - y keeps z = +0.0 where y = 0
-            x, y = vertices.T
-            vertices = np.column_stack([x, np.zeros_like(x), np.subtract(0.0, y)])
+        xy = np.column_stack([vertices[:, 0], np.subtract(0.0, vertices[:, 2])]) if self.world else vertices
+        lot_counts = np.add.reduceat(counts, offsets_from_counts(np.array(self.ring_counts, np.int64))[:-1]) \
+            if len(counts) else counts
+        xy, crs_name, note = georeference(xy, lot_counts, self.declared, self.implied, crs or CrsChoice(), source)
+        if not self.world or note is not None:
+            # world (x, height, -y); 0.0 - y keeps z = +0.0 where y = 0
+            x, y = xy.T
+            height = vertices[:, 1] if self.world else np.zeros_like(x)
+            vertices = np.column_stack([x, height, np.subtract(0.0, y)])
         # edges shorter than TOL.merge collapse as PRT collapses them (geometry.short_edges)
         order, kept, owner = collapse_short_edges(vertices, offsets_from_counts(counts), TOL.merge)
         vertices, ring_offsets = vertices[order], offsets_from_counts(kept)
@@ -145,6 +157,8 @@ class LotBuilder:
             attrs=attrs,
             bad=(),
             source=source,
+            crs=crs_name,
+            crs_note=note,
         )
         reasons = _validate(lots, normals, self.world)
         rejected = np.flatnonzero(reasons != "")
@@ -152,11 +166,11 @@ class LotBuilder:
         good = lots.take(np.flatnonzero(reasons == "")) if len(rejected) else lots  # a copy only to drop some
         return replace(good, bad=tuple(sorted(bad, key=lambda b: b.index)))
 
-    def finish_file(self, attrs: dict[str, np.ndarray], path) -> Lots:
+    def finish_file(self, attrs: dict[str, np.ndarray], path, crs: CrsChoice | None = None) -> Lots:
         """``finish`` for a whole lots file, which must hold a polygon (a good or a bad one)."""
         if self.polygons == 0:
             raise LotsError(f"no polygon in lots file {path}")
-        return self.finish(attrs, str(path))
+        return self.finish(attrs, str(path), crs)
 
 
 def street_flags(widths, ring: np.ndarray) -> np.ndarray | str:

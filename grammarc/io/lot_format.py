@@ -49,14 +49,15 @@ class LotsFormat:
     title : str or None
       How the error for an unknown suffix names the format, before its suffixes (``"a GIS file"``);
       None lists the suffixes alone.
-    read : callable (Path) -> Lots
-      All lots of a file, which exists; a ``LotsError`` if the file cannot be read or holds no polygon.
+    read : callable (Path, CrsChoice or None) -> Lots
+      All lots of a file, which exists, in metres (``io.crs``, the user's choice of coordinate systems); a
+      ``LotsError`` if the file cannot be read or holds no polygon.
     partitions : callable (Path, int) -> list of Partition, or None
       The partitions of a file, about ``size`` features each, their features in file order; None: the
       file is read whole.
     count : callable (Partition) -> int, or None
       The lot numbers a partition's features take (a MultiPolygon takes one per part).
-    read_partition : callable (Partition, int) -> Lots, or None
+    read_partition : callable (Partition, int, CrsChoice or None) -> Lots, or None
       A partition's lots, the first numbered as given (the ``count`` of the partitions before it).
     """
 

@@ -79,6 +79,7 @@ def _summary(path: Path, tallies: list[dict], asset_roots, lod: str | None) -> d
         "bytes": sum(t["bytes"] for t in tallies) + (path.stat().st_size if is_manifest(path) else 0),
         "grammar": meta.get("grammar"),
         "seed": meta.get("seed"),
+        "crs": meta.get("crs"),
         "instances": sum(per_asset.values()),
         "mesh_faces": sum(t["mesh_faces"] for t in tallies),
         "lots": len(per_lot),
@@ -162,7 +163,11 @@ def format_summary(info: dict) -> str:
                      f"{p['median']:,.1f} max {p['max']:,}")
     if info["bbox"]:
         low, high = (np.array(info["bbox"][k]) for k in ("min", "max"))
-        lines.append(f"  bbox        {_xyz(low)} .. {_xyz(high)} (size {_xyz(high - low)})")
+        lines.append(f"  bbox        {_xyz(low)} .. {_xyz(high)} (size {_xyz(high - low)}, world: x east, "
+                     "y up, z south)")
+    crs = info.get("crs")
+    lines.append(f"  crs         {crs if crs is None or len(crs) < 100 else crs[:97] + '...'}"
+                 if crs else "  crs         none (metres of a local scene)")
     poly = info["polygons"]
     triangles = "" if poly["baked_triangles"] is None else f" ({poly['baked_triangles']:,} triangles)"
     lines.append(f"  polygons    {poly['instanced']:,} instanced, {poly['baked']:,} baked{triangles}")

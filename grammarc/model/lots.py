@@ -55,6 +55,11 @@ class Lots:
       Lots of the input that were skipped, ordered by ``index``.
     source : str
       The path read, or ``"<memory>"``.
+    crs : str or None
+      The coordinate system of the vertices (``EPSG:<code>``, WKT or PROJJSON, as read or reprojected to;
+      ``io.crs``); None: metres with no coordinate system.
+    crs_note : str or None
+      How the lots came to ``crs`` where they were reprojected, for the build to say.
     """
 
     ids: np.ndarray
@@ -66,6 +71,8 @@ class Lots:
     attrs: dict[str, np.ndarray]
     bad: tuple[BadLot, ...]
     source: str
+    crs: str | None = None
+    crs_note: str | None = None
 
     def __len__(self) -> int:
         return len(self.ids)
@@ -96,6 +103,8 @@ class Lots:
             attrs={name: column[lot] for name, column in self.attrs.items()},
             bad=self.bad,
             source=self.source,
+            crs=self.crs,
+            crs_note=self.crs_note,
         )
 
     def select(self, ids) -> Lots:
