@@ -34,7 +34,7 @@ from grammarc.compiler import compile_grammar
 from grammarc.constants import LIMITS, Limits
 from grammarc.errors import ChunkTooLarge, LotFailure, UsageError
 from grammarc.io import OutputOptions, writer_for
-from grammarc.io.crs import CrsChoice
+from grammarc.io.lot_format import LotsOptions
 from grammarc.io.lots import default_lot, read_lots
 from grammarc.io.reports import write_reports
 from grammarc.model.grammar import Grammar
@@ -69,9 +69,9 @@ class BuildOptions:
     workspace: Path | None = None
     #: Whether a warning of the grammar stops the build as an error would (``--warnings-as-errors``).
     warnings_as_errors: bool = False
-    #: The lots' coordinate system where their file names none or the wrong one, and the metric one to
-    #: reproject lots in longitude/latitude to (``--lots-crs``, ``--crs``; ``io.crs``).
-    crs: CrsChoice | None = None
+    #: What the user asks of the lots file: its coordinate system and the one to reproject to, the id
+    #: field, the least area (``--lots-crs``, ``--crs``, ``--id-field``, ``--min-area``).
+    lots: LotsOptions | None = None
 
 
 @dataclass(frozen=True)
@@ -85,6 +85,9 @@ class BuildResult:
     grammar: Grammar
     #: How the lots came to metres where they were reprojected (``Lots.crs_note``), for the build to say.
     crs_note: str | None = None
+    #: The lots file read (or the built-in lot's description), and ids that more than one lot has.
+    lots_source: str = ""
+    duplicate_ids: tuple[str, ...] = ()
 
 
 def find_lots(grammar_path: Path) -> Path | None:
@@ -96,9 +99,9 @@ def find_lots(grammar_path: Path) -> Path | None:
     return None
 
 
-def load_lots(grammar_path: Path, lots_path: Path | None, crs: CrsChoice | None = None) -> Lots:
+def load_lots(grammar_path: Path, lots_path: Path | None, options: LotsOptions | None = None) -> Lots:
     path = lots_path or find_lots(grammar_path)
-    return read_lots(path, crs) if path is not None else default_lot()
+    return read_lots(path, options) if path is not None else default_lot()
 
 
 def build(grammar_path, output, *, lots_path=None, options: BuildOptions = BuildOptions(),
@@ -154,7 +157,7 @@ def _build(source: Path, display: str | None, grammar_path: Path, output, lots_p
     check_overrides(grammar.module, options.attrs)
     writer_class = writer_for(output, replace(output_options, asset_roots=tuple(grammar.asset_roots)))
     Path(output).parent.mkdir(parents=True, exist_ok=True)
-    every = load_lots(grammar_path, Path(lots_path) if lots_path else None, options.crs)
+    every = load_lots(grammar_path, Path(lots_path) if lots_path else None, options.lots)
     lots = every if select is None else every.select(select)
     if display is None:  # a rule file on disk: its CityEngine project's folders too, for a later render
         recorded_roots = (*recorded_roots, *(r for r in grammar.asset_roots[1:] if r not in recorded_roots))
@@ -168,8 +171,10 @@ def _build(source: Path, display: str | None, grammar_path: Path, output, lots_p
         write_reports(reports, Path(reports_to) if reports_to else reports_path(Path(output)),
                       dict(zip(every.index.tolist(), every.ids.tolist())))
     bad = tuple(sorted((*lots.bad, *failed), key=lambda b: b.index))
+    ids, times = np.unique(every.ids.astype(str), return_counts=True)
     return BuildResult(Path(output), len(lots) + len(lots.bad), derived, bad, counts,
-                       time.perf_counter() - started, grammar, lots.crs_note)
+                       time.perf_counter() - started, grammar, lots.crs_note, every.source,
+                       tuple(ids[times > 1].tolist()))
 
 
 def record_meta(grammar_path: Path, grammar: Grammar, plan, options: BuildOptions, lots_source: str,

@@ -12,6 +12,7 @@ import gc
 import math
 import os
 import sys
+from collections import Counter
 from dataclasses import replace
 from pathlib import Path
 
@@ -96,7 +97,9 @@ def _parser() -> argparse.ArgumentParser:
     build.add_argument("--lod", metavar="NAME",
                        help="level of detail: asset `x.obj` is drawn as `x.NAME.obj` where that file exists; "
                             "`builtin`: a cube stands in for a missing asset file")
-    _crs_options(build)
+    _lots_options_arguments(build)
+    build.add_argument("--strict", action="store_true",
+                       help="exit 1 when any lot is bad or fails to derive (its output is still written)")
     build.add_argument("--bake-origin", type=_point, metavar="X,Y,Z",
                        help="world point subtracted from a baked mesh's coordinates (default: world coordinates, "
                             "or the middle of the city in float32 formats far from the origin; the file says which)")
@@ -141,7 +144,7 @@ def _parser() -> argparse.ArgumentParser:
                                               "shape JSON")
     lots.add_argument("--to", type=Path, metavar="OUT.parquet",
                       help="write the good lots as GeoParquet (extra `parquet`), which reads faster")
-    _crs_options(lots)
+    _lots_options_arguments(lots)
     lots.set_defaults(run=_lots)
 
     info = sub.add_parser("info", help="what a city holds: counts, lots, bbox, polygons")
@@ -189,20 +192,27 @@ def _point(text: str) -> tuple[float, float, float]:
     return point
 
 
-def _crs_options(command) -> None:
+def _lots_options_arguments(command) -> None:
     command.add_argument("--crs", metavar="CRS",
                          help="metric coordinate system to reproject lots in longitude/latitude to (e.g. "
                               "EPSG:2056; default: the UTM zone of their centre)")
     command.add_argument("--lots-crs", metavar="CRS",
                          help="coordinate system of the lots' file where it names none or the wrong one "
                               "(e.g. EPSG:4326)")
+    command.add_argument("--id-field", metavar="NAME",
+                         help="the lots' property that holds their ids (e.g. osm_id; default: a feature's id, "
+                              "else its `id` or `name` property, else its number)")
+    command.add_argument("--min-area", type=float, metavar="M2",
+                         help="lots of less area (square metres) are bad: slivers")
 
 
-def _crs_choice(args):
-    """The ``io.crs.CrsChoice`` of ``--lots-crs`` and ``--crs``, None without either."""
-    from grammarc.io.crs import CrsChoice
+def _lots_options(args):
+    """The ``io.lot_format.LotsOptions`` of ``--lots-crs``, ``--crs``, ``--id-field`` and ``--min-area``;
+    None without any."""
+    from grammarc.io.lot_format import LotsOptions
 
-    return CrsChoice(declared=args.lots_crs, target=args.crs) if args.crs or args.lots_crs else None
+    options = LotsOptions(lots_crs=args.lots_crs, crs=args.crs, id_field=args.id_field, min_area=args.min_area)
+    return options if options != LotsOptions() else None
 
 
 def _workspace_option(command) -> None:
@@ -270,7 +280,7 @@ def _lots(args) -> int:
     from grammarc.errors import UsageError
     from grammarc.io.lots import read_lots
 
-    lots = read_lots(args.path, _crs_choice(args))
+    lots = read_lots(args.path, _lots_options(args))
     for bad in lots.bad:
         print(f"grammarc: lot {bad.id} (#{bad.index}) is bad: {bad.reason}", file=sys.stderr)
     print(f"{args.path}: {len(lots):,} lots, {len(lots.bad):,} bad, {len(lots.vertices):,} vertices, "
@@ -376,7 +386,7 @@ def _build(args) -> int:
         workers=args.workers,
         workspace=args.workspace,
         warnings_as_errors=args.warnings_as_errors,
-        crs=_crs_choice(args),
+        lots=_lots_options(args),
     )
     bar = _ProgressBar() if not args.quiet else None
     try:
@@ -391,10 +401,18 @@ def _build(args) -> int:
     finally:
         if bar is not None:
             bar.close()
-    if result.crs_note is not None:  # said even with --quiet: the output is not where the file's numbers are
+    # said even with --quiet: which lots were built where none were named, and where a file's numbers went
+    if args.lots is None and not args.dask:
+        print(f"grammarc: no --lots: built {result.lots_source}", file=sys.stderr)
+    if result.crs_note is not None:
         print(f"grammarc: lots in {result.crs_note}", file=sys.stderr)
     if not args.quiet:
         _warn(result.grammar)
+        if result.duplicate_ids:
+            shown = ", ".join(repr(i) for i in result.duplicate_ids[:5])
+            print(f"grammarc: warning: {len(result.duplicate_ids):,} lot ids belong to more than one lot ({shown}"
+                  f"{', ...' if len(result.duplicate_ids) > 5 else ''}): --id-field names the field of unique "
+                  "ids", file=sys.stderr)
         for bad in result.bad:
             print(f"grammarc: lot {bad.id} (#{bad.index}) skipped: {bad.reason}", file=sys.stderr)
         n = result.counts.get("instances", 0)
@@ -402,7 +420,14 @@ def _build(args) -> int:
         print(f"{result.output}: {n:,} instances, {result.counts.get('mesh_faces', 0):,} mesh faces from "
               f"{result.derived:,} lots ({len(result.bad)} skipped) in {result.seconds:.2f} s "
               f"({rate:,.0f} terminals/s)", file=sys.stderr)
-    return 0
+    if result.bad and result.derived == 0:
+        reasons = Counter(b.reason for b in result.bad).most_common(3)
+        print(f"grammarc: none of the {result.lots:,} lots could be built ("
+              + "; ".join(f"{n:,} {reason}" for reason, n in reasons) + ")", file=sys.stderr)
+        return 1
+    if result.bad:
+        print(f"grammarc: {len(result.bad):,} of {result.lots:,} lots skipped", file=sys.stderr)
+    return 1 if result.bad and args.strict else 0
 
 
 if __name__ == "__main__":

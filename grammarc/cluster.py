@@ -118,10 +118,10 @@ def build_on_dask(grammar_path, output, *, dask: str, lots_path=None, options: B
         check_overrides(grammar.module, resolved.attrs)
         output_options = replace(output_options or OutputOptions(), asset_roots=tuple(grammar.asset_roots))
         writer_for(output, output_options)  # refuses a format it cannot write before the cluster starts
-        partitions = partition_lots(lots_path, partition_size, options.crs)
+        partitions = partition_lots(lots_path, partition_size, options.lots)
         # the lots' own coordinate system is known to the workers only; a reprojection's is --crs
         meta = record_meta(Path(grammar_path), grammar, plan, options, str(lots_path), options.asset_roots,
-                           options.crs.target if options.crs is not None else None)
+                           options.lots.crs if options.lots is not None else None)
         files = _asset_files(grammar, output_options.lod)
         assets_digest = _digest(files)
         key = run_key({"meta": meta, "lots": file_stamp(lots_path), "partition_size": partition_size,
@@ -230,7 +230,7 @@ def _derive_partitions(client, plan, files, partitions, firsts, job: _Job, resum
 
 def _occluders_task(plan, part: Partition, first: int, options: BuildOptions) -> Occluders:
     """On a worker: the occluders of a partition's lots (``build.occluders``)."""
-    return occluders(plan, read_partition(part, first, options.crs), options)
+    return occluders(plan, read_partition(part, first, options.lots), options)
 
 
 def _shard_task(plan, part: Partition, first: int, job: _Job, foreign, files: dict[str, bytes]) -> dict:
@@ -238,7 +238,7 @@ def _shard_task(plan, part: Partition, first: int, job: _Job, foreign, files: di
     roots = (_asset_root(files, job.assets_digest),)
     plan = replace(plan, grammar=replace(plan.grammar, asset_roots=roots))
     job = replace(job, output_options=replace(job.output_options, asset_roots=roots))
-    lots = read_partition(part, first, job.options.crs)
+    lots = read_partition(part, first, job.options.lots)
     path = job.folder / shard_name(part.number, job.suffix)
     failed: list[BadLot] = []
     reports = Reports()

@@ -85,6 +85,57 @@ def test_bad_lots_reported_and_skipped(write, tmp_path, capsys):
     assert list(np.unique(read_instances(out)["lot"])) == [0, 2]
 
 
+def test_a_build_says_how_many_lots_were_bad_and_exit_codes_tell_the_truth(write, tmp_path, capsys):
+    grammar = str(write("g.cga", GOOD))
+    some = geojson(tmp_path / "some.geojson", [SQUARE, BOWTIE])
+    assert main(["build", grammar, "--lots", str(some), "--emit", str(tmp_path / "a.npz"), "--quiet"]) == 0
+    assert capsys.readouterr().err == "grammarc: 1 of 2 lots skipped\n"
+    assert main(["build", grammar, "--lots", str(some), "--emit", str(tmp_path / "b.npz"), "--quiet",
+                 "--strict"]) == 1
+    capsys.readouterr()
+    none = geojson(tmp_path / "none.geojson", [BOWTIE, FLAT, BOWTIE])
+    assert main(["build", grammar, "--lots", str(none), "--emit", str(tmp_path / "c.npz"), "--quiet"]) == 1
+    err = capsys.readouterr().err
+    assert "grammarc: none of the 3 lots could be built (2 self-intersection at (5.0, 5.0); 1 zero area)" in err
+
+
+def test_a_build_without_lots_says_which_it_built_even_when_quiet(write, tmp_path, capsys):
+    grammar = write("g.cga", GOOD)
+    assert main(["build", str(grammar), "--emit", str(tmp_path / "a.npz"), "--quiet"]) == 0
+    assert capsys.readouterr().err == "grammarc: no --lots: built one built-in 30 x 20 m lot\n"
+    own = geojson(tmp_path / "g.geojson", [SQUARE])
+    assert main(["build", str(grammar), "--emit", str(tmp_path / "b.npz"), "--quiet"]) == 0
+    assert capsys.readouterr().err == f"grammarc: no --lots: built {own}\n"
+
+
+def test_id_field_names_the_lots_and_repeated_ids_warn(write, tmp_path, capsys):
+    lots = geojson(tmp_path / "osm.geojson", [SQUARE, SQUARE, SQUARE],
+                   [{"osm_id": 11, "name": "Mill"}, {"osm_id": 12, "name": "Mill"}, {"osm_id": 13}])
+    for path in lots.parent.glob("osm.geojson"):
+        text = json.loads(path.read_text())
+        for feature in text["features"]:
+            del feature["id"]
+        path.write_text(json.dumps(text))
+    grammar = str(write("g.cga", GOOD))
+    assert main(["build", grammar, "--lots", str(lots), "--emit", str(tmp_path / "a.npz")]) == 0
+    assert ("warning: 1 lot ids belong to more than one lot ('Mill'): --id-field names the field of unique ids"
+            in capsys.readouterr().err)
+    assert main(["build", grammar, "--lots", str(lots), "--emit", str(tmp_path / "b.npz"), "--id-field",
+                 "osm_id", "--select", "12,13"]) == 0
+    assert "warning" not in capsys.readouterr().err
+    assert list(np.unique(read_instances(tmp_path / "b.npz")["lot"])) == [1, 2]
+
+
+def test_min_area_makes_slivers_bad_lots(write, tmp_path, capsys):
+    sliver = [[[0, 0], [10, 0], [10, 0.002], [0, 0.002]]]  # 2 mm wide
+    lots = geojson(tmp_path / "lots.geojson", [SQUARE, sliver])
+    out = tmp_path / "out.npz"
+    assert main(["build", str(write("g.cga", GOOD)), "--lots", str(lots), "--emit", str(out), "--min-area",
+                 "1"]) == 0
+    assert "lot lot1 (#1) skipped: area 0.02 m2 under --min-area 1" in capsys.readouterr().err
+    assert list(np.unique(read_instances(out)["lot"])) == [0]
+
+
 def test_negative_size_lot_skipped_by_id(write, tmp_path, capsys):
     grammar = write("g.cga", "lot ~> S(Scope.sx - 10.5, 3, 1r) I(\"cube\")\n")
     lots = geojson(tmp_path / "lots.geojson", [SQUARE, [[[0, 0], [12, 0], [12, 5], [0, 5]]]])

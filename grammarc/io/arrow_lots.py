@@ -17,7 +17,7 @@ import numpy as np
 import shapely
 
 from grammarc.errors import LotsError, UsageError
-from grammarc.io.lot_builder import STREET_WIDTH, LotBuilder, property_column, street_flags
+from grammarc.io.lot_builder import STREET_WIDTH, LotBuilder, id_text, property_column, street_flags
 
 __all__ = ["import_pyarrow", "lots_from_table", "table_lot_numbers"]
 
@@ -36,8 +36,8 @@ def import_pyarrow():
     return pa, pq
 
 
-def lots_from_table(table, column: str, path, first_row: int = 0,
-                    first_index: int = 0) -> tuple[LotBuilder, dict[str, np.ndarray]]:
+def lots_from_table(table, column: str, path, first_row: int = 0, first_index: int = 0,
+                    id_field: str | None = None) -> tuple[LotBuilder, dict[str, np.ndarray]]:
     """The lots of an Arrow table with WKB footprints in ``column``.
 
     Parameters
@@ -64,7 +64,7 @@ def lots_from_table(table, column: str, path, first_row: int = 0,
     geometry = _geometry(table, column, path)
     n = len(geometry)
     names = [c for c in table.column_names if c != column]
-    ids = _ids(table, names, n, first_row)
+    ids = _ids(table, names, n, first_row, id_field)
     kind, good, parts, feature, per_feature = _parts(geometry)
     first = np.cumsum(per_feature) - per_feature + first_index
     k = np.arange(len(parts)) - np.searchsorted(feature, feature)  # part number within its feature
@@ -155,11 +155,15 @@ def _column(values, pa) -> np.ndarray:
     return property_column(values.to_pylist())
 
 
-def _ids(table, names: list[str], n: int, first_row: int) -> list[str]:
-    for name in ("id", "name"):
+def _ids(table, names: list[str], n: int, first_row: int, id_field: str | None) -> list[str]:
+    """The rows' ids: column ``id_field`` where given (``--id-field``), else ``id``, else ``name``; a row
+    without one is its number."""
+    if id_field is not None and id_field not in names:
+        raise LotsError(f"--id-field {id_field}: the lots have no such field (they have {', '.join(names) or 'none'})")
+    for name in (id_field,) if id_field is not None else ("id", "name"):
         if name in names:
             values = table.column(name).to_pylist()
-            return [str(v) if v is not None else str(i) for i, v in enumerate(values, first_row)]
+            return [id_text(v) if v is not None else str(i) for i, v in enumerate(values, first_row)]
     return [str(i) for i in range(first_row, first_row + n)]
 
 

@@ -23,35 +23,18 @@ extent is under ``DEGREE_EXTENT``: a building is 1e-4 degrees wide, and no lot i
 from __future__ import annotations
 
 import json
-from dataclasses import dataclass
 
 import numpy as np
 
 from grammarc.errors import LotsError, UsageError
+from grammarc.io.lot_format import LotsOptions
 
-__all__ = ["CRS84", "CrsChoice", "georeference", "looks_like_degrees", "projjson"]
+__all__ = ["CRS84", "georeference", "looks_like_degrees", "projjson"]
 
 #: Longitude and latitude on WGS 84, in that order: GeoJSON's and GeoParquet's default.
 CRS84 = "OGC:CRS84"
 #: Median lot extent (in the file's units) below which coordinates within lon/lat ranges are degrees.
 DEGREE_EXTENT = 0.01
-
-
-@dataclass(frozen=True)
-class CrsChoice:
-    """What the user asks of the lots' coordinate systems.
-
-    Attributes
-    ----------
-    declared : str, optional
-        The coordinate system of the lots' file, for a file that names none or names the wrong one
-        (``--lots-crs``, any text pyproj reads: ``EPSG:4326``, WKT, PROJJSON).
-    target : str, optional
-        The metric coordinate system to reproject geographic lots to (``--crs``), instead of their UTM zone.
-    """
-
-    declared: str | None = None
-    target: str | None = None
 
 
 def looks_like_degrees(xy: np.ndarray, counts: np.ndarray) -> bool:
@@ -67,7 +50,7 @@ def looks_like_degrees(xy: np.ndarray, counts: np.ndarray) -> bool:
 
 
 def georeference(xy: np.ndarray, counts: np.ndarray, declared: str | None, implied: str | None,
-                 choice: CrsChoice, source: str) -> tuple[np.ndarray, str | None, str | None]:
+                 options: LotsOptions, source: str) -> tuple[np.ndarray, str | None, str | None]:
     """Lots' map coordinates in metres, their coordinate system, and what was done (see the module docstring).
 
     Parameters
@@ -80,7 +63,7 @@ def georeference(xy: np.ndarray, counts: np.ndarray, declared: str | None, impli
         The coordinate system the file names.
     implied : str or None
         The format's default where the file names none (``CRS84``), taken where the coordinates are degrees.
-    choice : CrsChoice
+    options : LotsOptions
         The user's ``--lots-crs`` (overrides ``declared``) and ``--crs``.
     source : str
         The file, for messages.
@@ -103,7 +86,7 @@ def georeference(xy: np.ndarray, counts: np.ndarray, declared: str | None, impli
     UsageError
         pyproj is needed (a coordinate system to interpret or reproject) and not installed.
     """
-    crs = choice.declared or declared
+    crs = options.lots_crs or declared
     degrees = looks_like_degrees(xy, counts)
     if crs is None and implied is not None and degrees:
         crs = implied
@@ -112,25 +95,25 @@ def georeference(xy: np.ndarray, counts: np.ndarray, declared: str | None, impli
             raise LotsError(f"{source}: the lots look like longitude/latitude degrees but the file names no "
                             "coordinate system: declare it with --lots-crs (e.g. --lots-crs EPSG:4326), and "
                             "grammarc reprojects them to metres")
-        if choice.target is not None:
-            raise LotsError(f"{source}: --crs {choice.target} asks to reproject lots that name no coordinate "
+        if options.crs is not None:
+            raise LotsError(f"{source}: --crs {options.crs} asks to reproject lots that name no coordinate "
                             "system: declare theirs with --lots-crs")
         return xy, None, None
-    if not degrees and choice.target is None and not _has_pyproj():
+    if not degrees and options.crs is None and not _has_pyproj():
         return xy, crs, None  # projected, as its coordinates say: nothing to do, nothing to check it with
     pyproj = _pyproj(f"lots in {_short(crs)}")
     try:
         given = pyproj.CRS.from_user_input(crs)
     except pyproj.exceptions.CRSError as error:
         raise LotsError(f"{source}: unknown coordinate system {_short(crs)}: {error}") from error
-    if not given.is_geographic and choice.target is None:
+    if not given.is_geographic and options.crs is None:
         return xy, crs, None
     if given.is_geographic and not degrees:
         raise LotsError(f"{source}: the lots name {_name(given)} (longitude/latitude) but their coordinates are "
                         "not degrees: declare their coordinate system with --lots-crs")
-    target = pyproj.CRS.from_user_input(choice.target) if choice.target is not None else _utm(pyproj, xy)
+    target = pyproj.CRS.from_user_input(options.crs) if options.crs is not None else _utm(pyproj, xy)
     if target.is_geographic:
-        raise UsageError(f"--crs {choice.target}: {_name(target)} is not in metres; give a projected one "
+        raise UsageError(f"--crs {options.crs}: {_name(target)} is not in metres; give a projected one "
                          "(e.g. a UTM zone or a national grid)")
     transformer = pyproj.Transformer.from_crs(given, target, always_xy=True)
     x, y = transformer.transform(xy[:, 0], xy[:, 1])

@@ -15,9 +15,9 @@ import numpy as np
 import orjson
 
 from grammarc.errors import LotsError
-from grammarc.io.crs import CRS84, CrsChoice
+from grammarc.io.crs import CRS84
 from grammarc.io.lot_builder import parse_features, property_columns
-from grammarc.io.lot_format import LotsFormat, Partition, partitions_at
+from grammarc.io.lot_format import LotsFormat, LotsOptions, Partition, partitions_at
 from grammarc.model.lots import Lots
 
 __all__ = [
@@ -30,12 +30,12 @@ SUFFIXES = (".geojsonl", ".geojsons", ".geojsonseq", ".jsonl", ".ndjson")
 _SCAN_BLOCK = 1 << 26
 
 
-def read_sequence(path: Path, crs: CrsChoice | None = None) -> Lots:
+def read_sequence(path: Path, options: LotsOptions | None = None) -> Lots:
     """All lots of a GeoJSON sequence; a ``LotsError`` if it cannot be read, has a line that is not JSON,
     or holds no polygon. Longitude and latitude where the coordinates are degrees (RFC 8142)."""
-    builder = parse_features(_features(path, 0, 0, path.stat().st_size), 0)
+    builder = parse_features(_features(path, 0, 0, path.stat().st_size), 0, (options or LotsOptions()).id_field)
     builder.implied = CRS84
-    return builder.finish_file(property_columns(builder.props), path, crs)
+    return builder.finish_file(property_columns(builder.props), path, options)
 
 
 def sequence_partitions(path: Path, size: int) -> list[Partition]:
@@ -50,11 +50,12 @@ def count_sequence(part: Partition) -> int:
     return parse_features(_features(Path(part.path), part.start, part.offset, part.end), 0).end
 
 
-def read_sequence_partition(part: Partition, first_index: int, crs: CrsChoice | None = None) -> Lots:
+def read_sequence_partition(part: Partition, first_index: int, options: LotsOptions | None = None) -> Lots:
     """The lots of a partition, the first numbered ``first_index``."""
-    builder = parse_features(_features(Path(part.path), part.start, part.offset, part.end), first_index)
+    builder = parse_features(_features(Path(part.path), part.start, part.offset, part.end), first_index,
+                             (options or LotsOptions()).id_field)
     builder.implied = CRS84
-    return builder.finish(property_columns(builder.props), part.path, crs)
+    return builder.finish(property_columns(builder.props), part.path, options)
 
 
 def _features(path: Path, first_line: int, offset: int, end: int) -> list:

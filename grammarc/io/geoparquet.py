@@ -20,9 +20,9 @@ import shapely
 from grammarc.atomic import replacing
 from grammarc.errors import LotsError
 from grammarc.io.arrow_lots import import_pyarrow, lots_from_table, table_lot_numbers
-from grammarc.io.crs import CRS84, CrsChoice, projjson
+from grammarc.io.crs import CRS84, projjson
 from grammarc.io.lot_builder import STREET_WIDTH, LotBuilder
-from grammarc.io.lot_format import LotsFormat, Partition, partitions_at
+from grammarc.io.lot_format import LotsFormat, LotsOptions, Partition, partitions_at
 from grammarc.model.lots import Lots
 
 __all__ = [
@@ -34,11 +34,11 @@ __all__ = [
 ROW_GROUP = 16384
 
 
-def read_geoparquet(path: Path, crs: CrsChoice | None = None) -> Lots:
+def read_geoparquet(path: Path, options: LotsOptions | None = None) -> Lots:
     """All lots of a GeoParquet file; a ``LotsError`` if it cannot be read, has no WKB geometry column, or
     holds no polygon."""
-    builder, attrs = _lots(path, None, 0)
-    return builder.finish_file(attrs, path, crs)
+    builder, attrs = _lots(path, None, 0, (options or LotsOptions()).id_field)
+    return builder.finish_file(attrs, path, options)
 
 
 def geoparquet_partitions(path: Path, size: int) -> list[Partition]:
@@ -53,21 +53,21 @@ def count_geoparquet(part: Partition) -> int:
     return table_lot_numbers(table, _geometry_column(table, part.path), part.path)
 
 
-def read_geoparquet_partition(part: Partition, first_index: int, crs: CrsChoice | None = None) -> Lots:
+def read_geoparquet_partition(part: Partition, first_index: int, options: LotsOptions | None = None) -> Lots:
     """The lots of a partition's rows (only the row groups that hold them are read), the first numbered
     ``first_index``."""
-    builder, attrs = _lots(part.path, (part.start, part.stop), first_index)
-    return builder.finish(attrs, part.path, crs)
+    builder, attrs = _lots(part.path, (part.start, part.stop), first_index, (options or LotsOptions()).id_field)
+    return builder.finish(attrs, part.path, options)
 
 
-def _lots(path: str | os.PathLike, rows: tuple[int, int] | None,
-          first_index: int) -> tuple[LotBuilder, dict[str, np.ndarray]]:
+def _lots(path: str | os.PathLike, rows: tuple[int, int] | None, first_index: int,
+          id_field: str | None) -> tuple[LotBuilder, dict[str, np.ndarray]]:
     """The lots of a GeoParquet file or of its rows ``(start, stop)``, to finish, and their properties; the
     coordinate system is the geometry column's ``crs`` (PROJJSON; absent: OGC:CRS84 where the coordinates
     are degrees, the specification's default; null: none)."""
     table = _read_table(path, rows)
     column = _geometry_column(table, path)
-    builder, attrs = lots_from_table(table, column, path, rows[0] if rows else 0, first_index)
+    builder, attrs = lots_from_table(table, column, path, rows[0] if rows else 0, first_index, id_field)
     described = json.loads((table.schema.metadata or {}).get(b"geo", b"{}")).get("columns", {}).get(column, {})
     if "crs" not in described:
         builder.implied = CRS84

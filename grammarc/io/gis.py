@@ -16,8 +16,7 @@ from pathlib import Path
 
 from grammarc.errors import LotsError, UsageError
 from grammarc.io.arrow_lots import lots_from_table, table_lot_numbers
-from grammarc.io.crs import CrsChoice
-from grammarc.io.lot_format import LotsFormat, Partition, partitions_at
+from grammarc.io.lot_format import LotsFormat, LotsOptions, Partition, partitions_at
 from grammarc.model.lots import Lots
 
 __all__ = ["FORMAT", "SUFFIXES", "count_gis", "gis_partitions", "read_gis", "read_gis_partition"]
@@ -35,13 +34,13 @@ def _pyogrio():
     return pyogrio
 
 
-def read_gis(path: Path, crs: CrsChoice | None = None) -> Lots:
+def read_gis(path: Path, options: LotsOptions | None = None) -> Lots:
     """All lots of a GIS file's first layer, in the coordinate system GDAL gives it; a ``LotsError`` if GDAL
     cannot read it, it has no geometry, or it holds no polygon."""
     table, column, declared = _table(path, None)
-    builder, attrs = lots_from_table(table, column, path)
+    builder, attrs = lots_from_table(table, column, path, id_field=(options or LotsOptions()).id_field)
     builder.declared = declared
-    return builder.finish_file(attrs, path, crs)
+    return builder.finish_file(attrs, path, options)
 
 
 def gis_partitions(path: Path, size: int) -> list[Partition]:
@@ -56,12 +55,13 @@ def count_gis(part: Partition) -> int:
     return table_lot_numbers(table, column, part.path)
 
 
-def read_gis_partition(part: Partition, first_index: int, crs: CrsChoice | None = None) -> Lots:
+def read_gis_partition(part: Partition, first_index: int, options: LotsOptions | None = None) -> Lots:
     """The lots of a partition's features, the first numbered ``first_index``."""
     table, column, declared = _table(part.path, (part.start, part.stop))
-    builder, attrs = lots_from_table(table, column, part.path, part.start, first_index)
+    builder, attrs = lots_from_table(table, column, part.path, part.start, first_index,
+                                     (options or LotsOptions()).id_field)
     builder.declared = declared
-    return builder.finish(attrs, part.path, crs)
+    return builder.finish(attrs, part.path, options)
 
 
 def _features(path: str | os.PathLike) -> int:

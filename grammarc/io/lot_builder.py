@@ -34,12 +34,13 @@ from grammarc.constants import TOL
 from grammarc.errors import LotsError
 from grammarc.geometry.meshes import ring_vector_areas
 from grammarc.geometry.short_edges import collapse_short_edges
-from grammarc.io.crs import CrsChoice, georeference
+from grammarc.io.crs import georeference
+from grammarc.io.lot_format import LotsOptions
 from grammarc.model.lots import BadLot, Lots
 from grammarc.ragged import offsets_from_counts, segment_reduce
 
 __all__ = [
-    "STREET_WIDTH", "LotBuilder", "parse_features", "property_column", "property_columns", "street_flags",
+    "STREET_WIDTH", "LotBuilder", "id_text", "parse_features", "property_column", "property_columns", "street_flags",
 ]
 
 #: The lot property that marks street edges, as CityEngine's object attribute.
@@ -122,7 +123,7 @@ class LotBuilder:
             return
         self.add(index, lot_id, xy, props)
 
-    def finish(self, attrs: dict[str, np.ndarray], source: str, crs: CrsChoice | None = None) -> Lots:
+    def finish(self, attrs: dict[str, np.ndarray], source: str, options: LotsOptions | None = None) -> Lots:
         """Bring every lot to metres (``io.crs.georeference``, with the user's ``crs`` choice), then clean,
         orient and validate them all at once; ``attrs`` are columns over all added lots."""
         counts = np.concatenate([np.zeros(0, dtype=np.int64), *self.sizes])
@@ -130,7 +131,7 @@ class LotBuilder:
         xy = np.column_stack([vertices[:, 0], np.subtract(0.0, vertices[:, 2])]) if self.world else vertices
         lot_counts = np.add.reduceat(counts, offsets_from_counts(np.array(self.ring_counts, np.int64))[:-1]) \
             if len(counts) else counts
-        xy, crs_name, note = georeference(xy, lot_counts, self.declared, self.implied, crs or CrsChoice(), source)
+        xy, crs_name, note = georeference(xy, lot_counts, self.declared, self.implied, options or LotsOptions(), source)
         if not self.world or note is not None:
             # world (x, height, -y); 0.0 - y keeps z = +0.0 where y = 0
             x, y = xy.T
@@ -160,17 +161,17 @@ class LotBuilder:
             crs=crs_name,
             crs_note=note,
         )
-        reasons = _validate(lots, normals, self.world)
+        reasons = _validate(lots, normals, self.world, (options or LotsOptions()).min_area)
         rejected = np.flatnonzero(reasons != "")
         bad = self.bad + [BadLot(int(lots.index[i]), lots.ids[i], reasons[i]) for i in rejected]
         good = lots.take(np.flatnonzero(reasons == "")) if len(rejected) else lots  # a copy only to drop some
         return replace(good, bad=tuple(sorted(bad, key=lambda b: b.index)))
 
-    def finish_file(self, attrs: dict[str, np.ndarray], path, crs: CrsChoice | None = None) -> Lots:
+    def finish_file(self, attrs: dict[str, np.ndarray], path, options: LotsOptions | None = None) -> Lots:
         """``finish`` for a whole lots file, which must hold a polygon (a good or a bad one)."""
         if self.polygons == 0:
             raise LotsError(f"no polygon in lots file {path}")
-        return self.finish(attrs, str(path), crs)
+        return self.finish(attrs, str(path), options)
 
 
 def street_flags(widths, ring: np.ndarray) -> np.ndarray | str:
@@ -211,20 +212,28 @@ def _ring_xy(ring) -> np.ndarray:
     return array[:, :2]
 
 
-def _feature_id(feature: dict, props: dict, index: int) -> str:
-    for value in (feature.get("id"), props.get("id"), props.get("name")):
+def _feature_id(feature: dict, props: dict, index: int, id_field: str | None) -> str:
+    for value in (props.get(id_field),) if id_field is not None else \
+            (feature.get("id"), props.get("id"), props.get("name")):
         if value is not None:
-            return str(value)
+            return id_text(value)
     return str(index)
 
 
-def parse_features(features, first_index: int = 0) -> LotBuilder:
+def id_text(value) -> str:
+    """A lot id as text: a whole number stored as a float (an ``osm_id`` column of a GIS file) without its
+    ``.0``, so that a file's ids are the same in every format."""
+    return str(int(value)) if isinstance(value, float) and value.is_integer() else str(value)
+
+
+def parse_features(features, first_index: int = 0, id_field: str | None = None) -> LotBuilder:
     """The lots of GeoJSON features, whose first polygon is number ``first_index`` of its file (a
     partition of a GeoJSON sequence starts where the polygons before it end).
 
     A Polygon is one lot and a MultiPolygon one lot per polygon (ids ``"<feature id>:<k>"``, each with
-    the feature's properties); other geometries are bad lots. A lot's id is the feature's ``id``, else its
-    property ``id``, else ``name``, else its number. The builder's ``end`` is the count of lot numbers
+    the feature's properties); other geometries are bad lots. A lot's id is its property ``id_field``
+    where one is given (``--id-field``), else the feature's ``id``, else its property ``id``, else
+    ``name``; without any, its number. The builder's ``end`` is the count of lot numbers
     the features took, its ``props`` the properties of its lots (``property_columns``).
     """
     builder = LotBuilder(world=False)
@@ -235,7 +244,7 @@ def parse_features(features, first_index: int = 0) -> LotBuilder:
         props = feature.get("properties") if isinstance(feature.get("properties"), dict) else {}
         geometry = feature.get("geometry") if isinstance(feature.get("geometry"), dict) else {}
         kind = geometry.get("type")
-        lot_id = _feature_id(feature, props, index)
+        lot_id = _feature_id(feature, props, index, id_field)
         if kind == "Polygon":
             builder.add_positions(index, lot_id, geometry.get("coordinates") or [], props)
             index += 1
@@ -308,8 +317,9 @@ def _orient(ring_offsets, exterior, normal_y) -> tuple[np.ndarray, np.ndarray]:
             start + np.where(flip, (count - position - 1) % count, position))
 
 
-def _validate(lots: Lots, normals: np.ndarray, world: bool) -> np.ndarray:
-    """(L,) object: why each lot is bad, "" for a good lot; the first failed check gives the reason."""
+def _validate(lots: Lots, normals: np.ndarray, world: bool, min_area: float | None) -> np.ndarray:
+    """(L,) object: why each lot is bad, "" for a good lot; the first failed check gives the reason (a lot of
+    less area than ``min_area``, ``--min-area``, is a sliver)."""
     reasons = np.full(len(lots), "", dtype=object)
     short_ring = (np.diff(lots.ring_offsets) < 3).astype(np.int64)
     short = segment_reduce(np.add, short_ring, lots.lot_offsets, 0) > 0
@@ -332,6 +342,9 @@ def _validate(lots: Lots, normals: np.ndarray, world: bool) -> np.ndarray:
     reasons[candidates[zero]] = "zero area"
     invalid = ~valid & ~zero
     reasons[candidates[invalid]] = [_geos_reason(text, world) for text in why[invalid]]
+    if min_area is not None:
+        sliver = np.flatnonzero((area < min_area) & (reasons[candidates] == ""))
+        reasons[candidates[sliver]] = [f"area {a:.3g} m2 under --min-area {min_area:g}" for a in area[sliver]]
     return reasons
 
 

@@ -19,7 +19,33 @@ import numpy as np
 from grammarc.errors import LotsError
 from grammarc.model.lots import Lots
 
-__all__ = ["LotsFormat", "Partition", "partitions_at", "read_text"]
+__all__ = ["LotsFormat", "LotsOptions", "Partition", "partitions_at", "read_text"]
+
+
+@dataclass(frozen=True)
+class LotsOptions:
+    """What the user asks of a lots file beyond what it holds.
+
+    Attributes
+    ----------
+    lots_crs : str, optional
+        The file's coordinate system where it names none or the wrong one (``--lots-crs``, any text pyproj
+        reads: ``EPSG:4326``, WKT, PROJJSON; ``io.crs``).
+    crs : str, optional
+        The metric coordinate system to reproject lots in longitude/latitude to (``--crs``), instead of the
+        UTM zone of their centre.
+    id_field : str, optional
+        The property that holds the lots' ids (``--id-field``, e.g. OpenStreetMap's ``osm_id``), instead
+        of a feature's ``id``, else its ``id`` or ``name`` property, else its number. A lot without a value
+        there is numbered.
+    min_area : float, optional
+        Lots of a smaller area (square metres, after any reprojection) are bad (``--min-area``): slivers.
+    """
+
+    lots_crs: str | None = None
+    crs: str | None = None
+    id_field: str | None = None
+    min_area: float | None = None
 
 
 @dataclass(frozen=True)
@@ -49,15 +75,15 @@ class LotsFormat:
     title : str or None
       How the error for an unknown suffix names the format, before its suffixes (``"a GIS file"``);
       None lists the suffixes alone.
-    read : callable (Path, CrsChoice or None) -> Lots
-      All lots of a file, which exists, in metres (``io.crs``, the user's choice of coordinate systems); a
+    read : callable (Path, LotsOptions or None) -> Lots
+      All lots of a file, which exists, in metres (``io.crs``), as the user's ``LotsOptions`` ask; a
       ``LotsError`` if the file cannot be read or holds no polygon.
     partitions : callable (Path, int) -> list of Partition, or None
       The partitions of a file, about ``size`` features each, their features in file order; None: the
       file is read whole.
     count : callable (Partition) -> int, or None
       The lot numbers a partition's features take (a MultiPolygon takes one per part).
-    read_partition : callable (Partition, int, CrsChoice or None) -> Lots, or None
+    read_partition : callable (Partition, int, LotsOptions or None) -> Lots, or None
       A partition's lots, the first numbered as given (the ``count`` of the partitions before it).
     """
 

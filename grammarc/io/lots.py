@@ -40,9 +40,8 @@ import numpy as np
 
 from grammarc.errors import LotsError
 from grammarc.io import geojson, geojson_sequence, geoparquet, gis, obj_lots
-from grammarc.io.crs import CrsChoice
 from grammarc.io.lot_builder import STREET_WIDTH, LotBuilder, property_column
-from grammarc.io.lot_format import LotsFormat, Partition, partitions_at
+from grammarc.io.lot_format import LotsFormat, LotsOptions, Partition, partitions_at
 from grammarc.model.lots import Lots
 
 __all__ = [
@@ -58,15 +57,16 @@ _BY_SUFFIX = {suffix: form for form in FORMATS for suffix in form.suffixes}
 _BY_KIND = {form.kind: form for form in FORMATS}
 
 
-def read_lots(path: str | os.PathLike, crs: CrsChoice | None = None) -> Lots:
+def read_lots(path: str | os.PathLike, options: LotsOptions | None = None) -> Lots:
     """Read all lots of a file, of any format of ``FORMATS`` (by its suffix; see the format's module).
 
     Parameters
     ----------
     path : str or os.PathLike
       The lots file.
-    crs : CrsChoice, optional
-      The user's ``--lots-crs`` and ``--crs`` (``io.crs``): lots in longitude/latitude are reprojected.
+    options : LotsOptions, optional
+      What the user asks of the file: ``--lots-crs`` and ``--crs`` (lots in longitude/latitude are
+      reprojected, ``io.crs``), ``--id-field``, ``--min-area``.
 
     Returns
     -------
@@ -88,10 +88,10 @@ def read_lots(path: str | os.PathLike, crs: CrsChoice | None = None) -> Lots:
     if form is None:
         raise LotsError(f"unknown lots file type {path.suffix.lower()!r} (expected {_expected()}): {path}")
     with _no_cycle_collection():
-        return form.read(path, crs)
+        return form.read(path, options)
 
 
-def partition_lots(path: str | os.PathLike, size: int, crs: CrsChoice | None = None) -> list[Partition]:
+def partition_lots(path: str | os.PathLike, size: int, options: LotsOptions | None = None) -> list[Partition]:
     """The partitions of a lots file, about ``size`` features each (GeoParquet's follow its row groups).
 
     Returns
@@ -106,7 +106,7 @@ def partition_lots(path: str | os.PathLike, size: int, crs: CrsChoice | None = N
     form = _BY_SUFFIX.get(path.suffix.lower())
     if form is not None and form.partitions is not None:
         return form.partitions(path, size)
-    lots = _whole(str(path), *file_stamp(path), crs)
+    lots = _whole(str(path), *file_stamp(path), options)
     n = 1 + max([int(lots.index.max()) if len(lots) else -1, *(b.index for b in lots.bad)])
     return partitions_at(path, "whole", [*range(0, n, size), n])
 
@@ -118,20 +118,20 @@ def count_lots(part: Partition) -> int:
     return _BY_KIND[part.kind].count(part)
 
 
-def read_partition(part: Partition, first_index: int, crs: CrsChoice | None = None) -> Lots:
+def read_partition(part: Partition, first_index: int, options: LotsOptions | None = None) -> Lots:
     """The lots of ``part``, the first numbered ``first_index`` (``count_lots`` of the partitions before;
     ignored for a file read whole, whose lots keep their numbers).
 
-    Raises ``LotsError`` for lots in longitude/latitude without ``crs.target``: each partition would
+    Raises ``LotsError`` for lots in longitude/latitude without ``options.crs``: each partition would
     reproject them to the UTM zone of its own lots, not of the file's."""
     if part.kind != "whole":
         with _no_cycle_collection():
-            lots = _BY_KIND[part.kind].read_partition(part, first_index, crs)
-        if lots.crs_note is not None and (crs is None or crs.target is None):
+            lots = _BY_KIND[part.kind].read_partition(part, first_index, options)
+        if lots.crs_note is not None and (options is None or options.crs is None):
             raise LotsError(f"{part.path}: its lots are {lots.crs_note.split(',')[0]}: a partitioned build "
                             "needs --crs to reproject them (e.g. the UTM zone or national grid of the city)")
         return lots
-    lots = _whole(part.path, *file_stamp(Path(part.path)), crs)
+    lots = _whole(part.path, *file_stamp(Path(part.path)), options)
     inside = (lots.index >= part.start) & (lots.index < part.stop)
     return replace(lots.take(np.flatnonzero(inside)),
                    bad=tuple(b for b in lots.bad if part.start <= b.index < part.stop))
@@ -194,6 +194,10 @@ def lots_from_polygons(
     return builder.finish({name: property_column(list(values)) for name, values in attrs.items()}, source)
 
 
+#: ``Lots.source`` of ``default_lot``: what a build without lots says it built.
+DEFAULT_LOT = "one built-in 30 x 20 m lot"
+
+
 def default_lot() -> Lots:
     """One 30 x 20 m rectangle, id ``"default"``: map corners (0, 0), (30, 0), (30, 20), (0, 20).
 
@@ -203,7 +207,7 @@ def default_lot() -> Lots:
       A single lot whose first edge runs 30 m along world +x.
     """
     rectangle = np.array([[0.0, 0.0], [30.0, 0.0], [30.0, 20.0], [0.0, 20.0]])
-    return lots_from_polygons([[rectangle]], ids=["default"])
+    return lots_from_polygons([[rectangle]], ids=["default"], source=DEFAULT_LOT)
 
 
 def _expected() -> str:
@@ -229,6 +233,6 @@ def _no_cycle_collection():
 
 
 @functools.lru_cache(maxsize=1)
-def _whole(path: str, mtime_ns: int, size: int, crs: CrsChoice | None) -> Lots:
+def _whole(path: str, mtime_ns: int, size: int, options: LotsOptions | None) -> Lots:
     """A lots file read whole, once per process while it is unchanged (its stamp is in the key)."""
-    return read_lots(path, crs)
+    return read_lots(path, options)

@@ -12,16 +12,15 @@ from pathlib import Path
 import numpy as np
 
 from grammarc.errors import LotsError
-from grammarc.io.crs import CrsChoice
 from grammarc.io.lot_builder import LotBuilder
-from grammarc.io.lot_format import LotsFormat, read_text
+from grammarc.io.lot_format import LotsFormat, LotsOptions, read_text
 from grammarc.model.lots import Lots
 from grammarc.model.obj import ObjError, read_obj
 
 __all__ = ["FORMAT", "read_obj_lots"]
 
 
-def read_obj_lots(path: Path, crs: CrsChoice | None = None) -> Lots:
+def read_obj_lots(path: Path, options: LotsOptions | None = None) -> Lots:
     """All lots of an OBJ file; a ``LotsError`` names a malformed line (``path:line:``), or says the
     file holds no face."""
     try:
@@ -34,7 +33,7 @@ def read_obj_lots(path: Path, crs: CrsChoice | None = None) -> Lots:
             builder.reject(k, f"face{k}", "vertex index out of range")
         else:
             builder.add(k, f"face{k}", [vertices[face]], {})
-    return builder.finish_file({}, path, crs)
+    return builder.finish_file({}, path, options)
 
 
 FORMAT = LotsFormat(kind="obj", suffixes=(".obj",), title=None, read=read_obj_lots)

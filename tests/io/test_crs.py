@@ -16,7 +16,8 @@ import shapely
 
 from grammarc.build import BuildOptions, build
 from grammarc.errors import LotsError
-from grammarc.io.crs import CrsChoice, georeference, looks_like_degrees
+from grammarc.io.crs import georeference, looks_like_degrees
+from grammarc.io.lot_format import LotsOptions
 from grammarc.io.lots import partition_lots, read_lots, read_partition
 from grammarc.io.npz import read_instances
 from grammarc.model.records import world_columns
@@ -97,7 +98,7 @@ def test_three_files_of_one_block_build_the_same_buildings(tmp_path):
     worlds = []
     for k, path in enumerate(files):
         out = tmp_path / f"city{k}.npz"
-        build(tmp_path / "g.cga", out, lots_path=path, options=BuildOptions(crs=CrsChoice(target="EPSG:2056")))
+        build(tmp_path / "g.cga", out, lots_path=path, options=BuildOptions(lots=LotsOptions(crs="EPSG:2056")))
         record = read_instances(out)
         assert record["meta"]["crs"] == "EPSG:2056"
         assert np.isfinite(record["lot_origin"]).all()
@@ -127,7 +128,7 @@ def test_degrees_without_a_coordinate_system_are_an_error_that_says_how(tmp_path
     with pytest.raises(LotsError, match="look like longitude/latitude degrees but the file names no coordinate "
                                         "system: declare it with --lots-crs"):
         read_lots(tmp_path / "lots.parquet")
-    assert read_lots(tmp_path / "lots.parquet", CrsChoice(declared="EPSG:4326")).crs == "EPSG:32632"
+    assert read_lots(tmp_path / "lots.parquet", LotsOptions(lots_crs="EPSG:4326")).crs == "EPSG:32632"
 
 
 def test_lots_that_say_degrees_but_are_metres_are_an_error(tmp_path):
@@ -142,7 +143,7 @@ def test_a_target_that_is_not_metric_is_refused():
 
     xy = np.array(RINGS[0], float)
     with pytest.raises(UsageError, match="--crs EPSG:4258: .* is not in metres"):
-        georeference(xy, np.array([4]), "EPSG:4326", None, CrsChoice(target="EPSG:4258"), "x")
+        georeference(xy, np.array([4]), "EPSG:4326", None, LotsOptions(crs="EPSG:4258"), "x")
 
 
 def test_geoparquet_written_by_grammarc_names_its_coordinate_system(tmp_path):
@@ -170,7 +171,7 @@ def test_a_partitioned_build_of_lon_lat_lots_needs_a_crs(tmp_path):
     part = partition_lots(path, 2)[0]
     with pytest.raises(LotsError, match="a partitioned build needs --crs"):
         read_partition(part, 0)
-    assert read_partition(part, 0, CrsChoice(target="EPSG:2056")).crs == "EPSG:2056"
+    assert read_partition(part, 0, LotsOptions(crs="EPSG:2056")).crs == "EPSG:2056"
 
 
 def test_the_build_says_how_it_reprojected_even_when_quiet(tmp_path):

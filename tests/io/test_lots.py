@@ -97,3 +97,16 @@ def test_partitions_together_are_the_whole_file(tmp_path, kind, size):
     heights = np.concatenate([p.attrs.get("h", np.full(len(p), np.nan)) for p in lots])
     np.testing.assert_array_equal(heights.astype(float), whole.attrs["h"].astype(float))
     assert {p.kind for p in parts} == {"whole" if kind == "geojson" else "gis" if kind == "gpkg" else kind}
+
+
+def test_id_field_picks_the_ids_in_every_format(tmp_path):
+    """``--id-field h``: the property ``h`` names the lots (as text); a lot without a value is numbered, and a
+    columnar file without the field is an error that lists the fields it has."""
+    from grammarc.io.lot_format import LotsOptions
+
+    options = LotsOptions(id_field="h")
+    whole, sequence, parquet = lot_files(tmp_path)
+    ids = [read_lots(path, options).ids.tolist() for path in (whole, sequence, parquet)]
+    assert ids[0] == ids[1] == ids[2] and ids[0][:3] == ["12", "7.5:0", "7.5:1"]
+    with pytest.raises(LotsError, match=r"--id-field osm_id: the lots have no such field \(they have id, h,"):
+        read_lots(parquet, LotsOptions(id_field="osm_id"))
