@@ -162,6 +162,7 @@ def _build(source: Path, display: str | None, grammar_path: Path, output, lots_p
     if display is None:  # a rule file on disk: its CityEngine project's folders too, for a later render
         recorded_roots = (*recorded_roots, *(r for r in grammar.asset_roots[1:] if r not in recorded_roots))
     meta = record_meta(grammar_path, grammar, plan, options, lots.source, recorded_roots, lots.crs)
+    writer_class = writer_for(output, replace(output_options, asset_roots=tuple(grammar.asset_roots), lots=every))
     failed: list[BadLot] = []
     reports = Reports()
     with writer_class(output, assets=grammar.assets, symbols=plan.symbol_names, meta=meta) as writer:

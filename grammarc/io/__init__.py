@@ -7,7 +7,8 @@ their exporters: each writer module has ``WRITERS``, the extensions it writes ->
 * ``.npz``: the instance record (``io/npz.py``);
 * ``.usda``, ``.usdc``, ``.usd``: instanced USD, one PointInstancer per tile (``io/usd.py``);
 * ``.glb``: glTF with GPU instancing (``io/gltf.py``), or baked with ``--bake``;
-* ``.obj``, ``.ply``, ``.stl``: the record baked into one mesh (``io/bake.py``), as a .glb with ``--bake``.
+* ``.obj``, ``.ply``, ``.stl``: the record baked into one mesh (``io/bake.py``), as a .glb with ``--bake``;
+* ``.json`` (``city.city.json``): CityJSON 2.0, a Building per lot (``io/cityjson.py``).
 
 A writer class whose ``bakes`` is true writes baked meshes: ``--bake`` asks for it, and an extension that
 no other writer takes is written baked anyway. A writer takes the ``OutputOptions`` its constructor names.
@@ -24,11 +25,15 @@ import inspect
 from dataclasses import dataclass
 from importlib import import_module
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from grammarc.errors import UsageError
 
+if TYPE_CHECKING:
+    from grammarc.model.lots import Lots
+
 #: The modules that declare ``WRITERS``, in the order ``writer_for``'s messages list their extensions.
-WRITER_MODULES = ("grammarc.io.npz", "grammarc.io.usd", "grammarc.io.gltf", "grammarc.io.bake")
+WRITER_MODULES = ("grammarc.io.npz", "grammarc.io.usd", "grammarc.io.gltf", "grammarc.io.bake", "grammarc.io.cityjson")
 
 
 class WriterBlock:
@@ -51,7 +56,8 @@ class OutputOptions:
     the level of detail of assets (``model.assets.load_asset``), the tile edge of the instanced formats
     (``io.instancing``), the folders assets are loaded from (the build gives the grammar's, a rule
     package's while it is extracted, and ``--assets``), the world point baked meshes are relative to
-    (``io.bake.BakedWriter``). None: the writer's default."""
+    (``io.bake.BakedWriter``), the build's lots (``io.cityjson``: Buildings' ids and attributes). None: the
+    writer's default."""
 
     bake: bool = False
     lod: str | None = None
@@ -59,6 +65,7 @@ class OutputOptions:
     max_triangles: int | None = None
     asset_roots: tuple | None = None
     bake_origin: tuple | None = None
+    lots: Lots | None = None
 
 
 def _declared():

@@ -52,7 +52,7 @@ from grammarc.model.assets import AssetLibrary, AssetMesh, asset_library
 from grammarc.model.records import LotOrigins, MaterialTable, MeshChunk, TerminalChunk, record_mesh
 from grammarc.ragged import offsets_from_counts, segment_of
 
-__all__ = ["MAX_TRIANGLES", "WRITERS", "BakedWriter", "bake", "count_triangles"]
+__all__ = ["MAX_TRIANGLES", "WRITERS", "BakedWriter", "bake", "bake_mesh", "count_triangles", "mesh_triangles"]
 
 #: Default limit of ``bake`` (``constants.Limits.max_triangles``).
 MAX_TRIANGLES = LIMITS.max_triangles
@@ -70,7 +70,7 @@ def count_triangles(record: Mapping, asset_roots: Sequence[str | os.PathLike] | 
     """
     names, asset, _, mesh, _ = _columns(record)
     library = asset_library(names, record, asset_roots, lod)
-    return library.triangles(np.bincount(asset, minlength=len(names))) + _mesh_triangles(mesh)
+    return library.triangles(np.bincount(asset, minlength=len(names))) + mesh_triangles(mesh)
 
 
 def bake(
@@ -119,11 +119,11 @@ def bake(
     (12, 52.0, [[1.0, 0.0, 0.0], [3.0, 3.0, 4.0]])
     """
     names, asset, xform, mesh, origins = _columns(record)
-    return _bake(asset_library(names, record, asset_roots), asset, xform, mesh, max_triangles,
+    return bake_mesh(asset_library(names, record, asset_roots), asset, xform, mesh, max_triangles,
                  origins=origins, lot=record.get("lot"))[0]
 
 
-def _bake(library: AssetLibrary, asset: np.ndarray, xform: np.ndarray, mesh: MeshChunk, max_triangles: int,
+def bake_mesh(library: AssetLibrary, asset: np.ndarray, xform: np.ndarray, mesh: MeshChunk, max_triangles: int,
           uv: np.ndarray | None = None, origins: LotOrigins | None = None, lot: np.ndarray | None = None):
     """``bake`` of a record's columns, its assets in ``library``; and the source of each triangle (T,) int64:
     its instance's row, or ``len(asset)`` plus its face in the mesh table. The mesh has texture coordinates
@@ -133,7 +133,7 @@ def _bake(library: AssetLibrary, asset: np.ndarray, xform: np.ndarray, mesh: Mes
     import trimesh
 
     used = np.bincount(asset, minlength=len(library.names)).astype(np.int64)
-    n_triangles = library.triangles(used) + _mesh_triangles(mesh)
+    n_triangles = library.triangles(used) + mesh_triangles(mesh)
     if n_triangles > max_triangles:
         raise UsageError(
             f"baking this record makes {n_triangles:,} triangles, more than the limit of "
@@ -229,7 +229,7 @@ def _add_counts(histogram: np.ndarray, sizes: np.ndarray, times: int) -> np.ndar
     return histogram
 
 
-def _mesh_triangles(mesh: MeshChunk) -> int:
+def mesh_triangles(mesh: MeshChunk) -> int:
     """Triangles of the mesh table's faces: V + 2R - 4F (each face V_f + 2 H_f - 2, R_f = H_f + 1)."""
     n_faces = len(mesh.face_offsets) - 1
     n_rings = len(mesh.ring_offsets) - 1
@@ -359,7 +359,7 @@ class BakedWriter(WriterBlock):
             raise ValueError(f"TerminalChunk.asset: index out of range [0, {len(self._library.names)})")
         try:
             used = np.bincount(asset, minlength=len(self._library.names))
-            triangles = self._library.triangles(used) + _mesh_triangles(chunk.mesh)
+            triangles = self._library.triangles(used) + mesh_triangles(chunk.mesh)
             if self._triangles + triangles > self.max_triangles:
                 raise UsageError(
                     f"{self.path}: the baked mesh passes {self.max_triangles:,} triangles after "
@@ -369,7 +369,7 @@ class BakedWriter(WriterBlock):
                 )
             looks = self._looks(chunk)
             if self._file is not None:
-                mesh, source = _bake(self._library, asset.astype(np.int64, copy=False), chunk.xform, chunk.mesh,
+                mesh, source = bake_mesh(self._library, asset.astype(np.int64, copy=False), chunk.xform, chunk.mesh,
                                      self.max_triangles, chunk.uv, chunk.origins, chunk.lot)
                 self._file.write(self._obj_groups(mesh, source, np.concatenate([chunk.lot, chunk.mesh.lot]), looks))
                 self._count(mesh, chunk.mesh)
@@ -468,7 +468,7 @@ class BakedWriter(WriterBlock):
                 looks = _joined_looks(chunks)
                 uv = None if all(c.uv is None for c, _ in chunks) else np.concatenate([c.texture() for c, _ in chunks])
                 del chunks
-                mesh, source = _bake(self._library, asset.astype(np.int64, copy=False), xform, mesh_table,
+                mesh, source = bake_mesh(self._library, asset.astype(np.int64, copy=False), xform, mesh_table,
                                      self.max_triangles, uv, origins, lot)
                 del asset, xform, lot
                 self._count(mesh, mesh_table)

@@ -45,14 +45,14 @@ def test_options_left_unset_are_not_passed():
     assert made("city.usdc", OutputOptions(lod="low")) == (UsdWriter, {"lod": "low"})
 
 
-SUPPORTED = "(supported: .npz, .usda, .usdc, .usd, .glb, .obj, .ply, .stl)"
+SUPPORTED = "(supported: .npz, .usda, .usdc, .usd, .glb, .obj, .ply, .stl, .json)"
 
 
 @pytest.mark.parametrize(("path", "bake", "message"), [
     ("city.fbx", False, f"cannot write `city.fbx`: output format `.fbx` is not supported {SUPPORTED}"),
     ("city", True, f"cannot write `city`: output format `(none)` is not supported {SUPPORTED}"),
-    ("city.npz", True, "--bake writes meshes (.obj, .ply, .stl, .glb), not `.npz`"),
-    ("city.usdc", True, "--bake writes meshes (.obj, .ply, .stl, .glb), not `.usdc`"),
+    ("city.npz", True, "--bake writes meshes (.obj, .ply, .stl, .glb, .json), not `.npz`"),
+    ("city.usdc", True, "--bake writes meshes (.obj, .ply, .stl, .glb, .json), not `.usdc`"),
 ])
 def test_a_format_nothing_writes_names_those_that_are(path, bake, message):
     with pytest.raises(UsageError) as error:
@@ -64,7 +64,7 @@ def test_each_extension_is_declared_once_baked_and_once_not():
     declared = Counter(key for key, _ in _declared())
     assert declared and max(declared.values()) == 1
     assert list(writers()) == list(dict(_declared()))  # the table keeps the declaration order
-    assert [key for key in writers() if key[1]] == [(s, True) for s in (".obj", ".ply", ".stl", ".glb")]
+    assert [key for key in writers() if key[1]] == [(s, True) for s in (".obj", ".ply", ".stl", ".glb", ".json")]
 
 
 def test_importing_grammarc_loads_no_writer_and_an_npz_lookup_only_its_own():
