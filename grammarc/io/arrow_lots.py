@@ -98,7 +98,7 @@ def lots_from_table(table, column: str, path, first_row: int = 0, first_index: i
                 value = widths[feature[lot]]
                 if value is not None:
                     street[start:start + len(value)] = np.asarray(value, dtype=np.float64) > 0
-        builder.add_block(index, lot_ids, coords[:, :2], np.diff(ring_offsets), np.diff(lot_offsets), street)
+        builder.add_block(index, lot_ids, coords[:, :3], np.diff(ring_offsets), np.diff(lot_offsets), street)
     return builder, attrs
 
 

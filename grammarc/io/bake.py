@@ -335,7 +335,8 @@ class BakedWriter(WriterBlock):
         if self._file_type == "obj":
             self._open_file()
             header = f"grammarc {self._meta.get('grammarc', '')} bake of {self._meta.get('grammar', '')}"
-            origin = "" if self._origin is None else f"# {_origin_text(self._origin)}\n"
+            origin = "" if self._origin is None and not self._meta.get("crs") else \
+                f"# {_origin_text(self._origin if self._origin is not None else np.zeros(3), self._meta.get('crs'))}\n"
             self._file.write(f"# {' '.join(header.split())}\n{origin}mtllib {self._mtl_path.name}\n".encode())
 
     def write(self, chunk: TerminalChunk) -> None:
@@ -532,12 +533,12 @@ class BakedWriter(WriterBlock):
         mesh.metadata = {}
         if self._file_type == "stl":
             data = bytearray(mesh.export(file_type="stl"))
-            data[:80] = f"grammarc {_origin_text(origin)}".encode().ljust(80)[:80]  # the header: free text
+            data[:80] = f"grammarc {_origin_text(origin, self._meta.get('crs'))}".encode().ljust(80)[:80]  # free text
             return bytes(data)
         data = mesh.export(file_type=self._file_type)
         # a comment line in the header, after the format line (PLY allows comments anywhere in the header)
         head, _, rest = data.partition(b"\n")
-        return head + f"\ncomment grammarc {_origin_text(origin)}".encode() + b"\n" + rest
+        return head + f"\ncomment grammarc {_origin_text(origin, self._meta.get('crs'))}".encode() + b"\n" + rest
 
 
 #: Metres from the world's origin within which float32 coordinates keep a step of 1 mm or less (2^13).
@@ -552,9 +553,11 @@ def float32_origin(vertices: np.ndarray) -> np.ndarray:
     return np.round((vertices.min(axis=0) + vertices.max(axis=0)) / 2)
 
 
-def _origin_text(origin: np.ndarray) -> str:
-    """``origin X Y Z``: the world point a baked file's coordinates are relative to."""
-    return "origin " + " ".join(f"{v:.17g}" for v in np.asarray(origin, np.float64))
+def _origin_text(origin: np.ndarray, crs: str | None) -> str:
+    """``origin X Y Z``: the world point a baked file's coordinates are relative to, and ``crs NAME``, the
+    coordinate system of its world, where the lots had one with a short name (an EPSG code)."""
+    text = "origin " + " ".join(f"{v:.17g}" for v in np.asarray(origin, np.float64))
+    return text + (f" crs {crs}" if crs and len(crs) <= 32 and "\n" not in crs else "")
 
 
 def _joined_looks(chunks: list) -> np.ndarray | None:

@@ -10,7 +10,9 @@ the other lots load.
 
 Conventions, those of CityEngine and Esri PRT:
 
-- Map to world: world x = map x, world y = 0, world z = -map y (north is -z), in metres: lots in
+- Map to world: world x = map x, world y = the lot's base height, world z = -map y (north is -z): the
+  base is the lowest z of the lot's vertices where the file gives them (a 3D GeoJSON, a footprint draped
+  on terrain: the building stands on its lowest corner, its lot flat), else 0. In metres: lots in
   longitude/latitude are reprojected first (``io.crs``: the coordinate system the file declares, a
   format's default, the user's ``--lots-crs`` and ``--crs``).
 - The exterior ring of a lot has a +Y Newell normal (counter-clockwise on the map, as RFC 7946 wants),
@@ -52,7 +54,8 @@ _GEOS_REASON = re.compile(r"^(?P<what>.*)\[(?P<x>\S+) (?P<y>\S+)\]$")
 class LotBuilder:
     """Collects lots while a file is parsed; ``finish`` cleans, orients and validates them all at once.
 
-    Rings are (k, 3) float64 world coordinates if ``world``, else (k, 2) float64 map coordinates. A format
+    Rings are (k, 3) float64 world coordinates if ``world``, else (k, 2) or (k, 3) float64 map coordinates
+    (x, y and an elevation z, NaN where a position has none). A format
     sets ``declared``, the coordinate system its file names, and ``implied``, its default where the file names
     none (``io.crs``).
     """
@@ -84,6 +87,8 @@ class LotBuilder:
             self.reject(index, lot_id, "empty polygon")
             return
         street = [np.zeros(len(ring), dtype=bool) for ring in rings]
+        if not self.world:
+            rings = [_with_z(ring) for ring in rings]
         widths = props.get(STREET_WIDTH)
         if widths is not None:
             flags = street_flags(widths, rings[0])
@@ -107,7 +112,7 @@ class LotBuilder:
         ``sizes`` vertices per ring, ``ring_counts`` rings per lot, ``street`` a flag per vertex. Their
         properties are not kept here: the caller passes them to ``finish`` as columns."""
         self.polygons += len(ids)
-        self.rings.append(vertices)
+        self.rings.append(vertices if self.world else _with_z(vertices))
         self.sizes.append(np.asarray(sizes, dtype=np.int64))
         self.street.append(street)
         self.ring_counts.extend(np.asarray(ring_counts).tolist())
@@ -115,9 +120,10 @@ class LotBuilder:
         self.ids.extend(ids)
 
     def add_positions(self, index: int, lot_id: str, rings, props: dict) -> None:
-        """Add a lot given as lists of map positions (GeoJSON); extra components are ignored."""
+        """Add a lot given as lists of map positions (GeoJSON): x, y and an optional elevation; further
+        components are ignored."""
         try:
-            xy = [_ring_xy(ring) for ring in rings]
+            xy = [_ring_xyz(ring) for ring in rings]
         except (TypeError, ValueError, IndexError):
             self.reject(index, lot_id, "malformed coordinates")
             return
@@ -127,15 +133,15 @@ class LotBuilder:
         """Bring every lot to metres (``io.crs.georeference``, with the user's ``crs`` choice), then clean,
         orient and validate them all at once; ``attrs`` are columns over all added lots."""
         counts = np.concatenate([np.zeros(0, dtype=np.int64), *self.sizes])
-        vertices = np.concatenate([np.zeros((0, 3 if self.world else 2)), *self.rings])
-        xy = np.column_stack([vertices[:, 0], np.subtract(0.0, vertices[:, 2])]) if self.world else vertices
+        vertices = np.concatenate([np.zeros((0, 3)), *self.rings])
+        xy = np.column_stack([vertices[:, 0], np.subtract(0.0, vertices[:, 2])]) if self.world else vertices[:, :2]
         lot_counts = np.add.reduceat(counts, offsets_from_counts(np.array(self.ring_counts, np.int64))[:-1]) \
             if len(counts) else counts
         xy, crs_name, note = georeference(xy, lot_counts, self.declared, self.implied, options or LotsOptions(), source)
         if not self.world or note is not None:
             # world (x, height, -y); 0.0 - y keeps z = +0.0 where y = 0
             x, y = xy.T
-            height = vertices[:, 1] if self.world else np.zeros_like(x)
+            height = vertices[:, 1] if self.world else _base_heights(vertices[:, 2], lot_counts)
             vertices = np.column_stack([x, height, np.subtract(0.0, y)])
         # edges shorter than TOL.merge collapse as PRT collapses them (geometry.short_edges)
         order, kept, owner = collapse_short_edges(vertices, offsets_from_counts(counts), TOL.merge)
@@ -192,24 +198,40 @@ def street_flags(widths, ring: np.ndarray) -> np.ndarray | str:
     """
     if not isinstance(widths, list) or not all(isinstance(w, numbers.Real) for w in widths):
         return f"{STREET_WIDTH} is not a list of numbers"
-    closed = len(ring) > 1 and np.array_equal(ring[0], ring[-1])
+    closed = len(ring) > 1 and np.array_equal(ring[0], ring[-1], equal_nan=True)
     edges = len(ring) - 1 if closed else len(ring)
     if len(widths) != edges:
         return f"{STREET_WIDTH} has {len(widths)} values for {edges} edges"
     return np.r_[np.asarray(widths, dtype=np.float64) > 0, np.zeros(int(closed), dtype=bool)]
 
 
-def _ring_xy(ring) -> np.ndarray:
-    """A ring's positions as (k, 2) float64; a third component (elevation) is dropped."""
+def _ring_xyz(ring) -> np.ndarray:
+    """A ring's positions as (k, 3) float64: x, y and the elevation, NaN where a position has none."""
     try:
         array = np.asarray(ring, dtype=np.float64)
     except ValueError:  # positions of mixed length, e.g. some with an elevation
-        array = np.array([position[:2] for position in ring], dtype=np.float64)
+        array = np.array([[*position[:3], *[np.nan] * (3 - len(position[:3]))] for position in ring],
+                         dtype=np.float64)
     if array.size == 0:
-        return np.zeros((0, 2))
+        return np.zeros((0, 3))
     if array.ndim != 2 or array.shape[1] < 2:
         raise ValueError("a ring is a list of positions")
-    return array[:, :2]
+    return _with_z(array[:, :3])
+
+
+def _with_z(ring: np.ndarray) -> np.ndarray:
+    """Map positions (k, 2) or (k, 3) as (k, 3), the elevation NaN where there is none."""
+    ring = np.asarray(ring, dtype=np.float64)
+    return ring if ring.shape[1] == 3 else np.column_stack([ring, np.full(len(ring), np.nan)])
+
+
+def _base_heights(z: np.ndarray, lot_counts: np.ndarray) -> np.ndarray:
+    """(V,) float64: each vertex's lot's base height, the lowest elevation ``z`` (V,) of the lot's vertices
+    (``lot_counts`` (L,) of them each), 0 where it has none."""
+    if not len(z) or np.isnan(z).all():
+        return np.zeros(len(z))
+    lowest = np.fmin.reduceat(z, offsets_from_counts(lot_counts)[:-1])  # fmin: NaN only where all are
+    return np.repeat(np.nan_to_num(lowest, nan=0.0), lot_counts)
 
 
 def _feature_id(feature: dict, props: dict, index: int, id_field: str | None) -> str:

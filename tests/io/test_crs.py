@@ -185,3 +185,12 @@ def test_the_build_says_how_it_reprojected_even_when_quiet(tmp_path):
     info = subprocess.run([sys.executable, "-m", "grammarc.cli", "info", str(tmp_path / "c.npz")],
                           capture_output=True, text=True, check=True).stdout
     assert "  crs         EPSG:32632" in info
+
+
+@pytest.mark.parametrize("suffix", [".ply", ".stl", ".obj"])
+def test_baked_meshes_name_their_coordinate_system(tmp_path, suffix):
+    (tmp_path / "g.cga").write_text(GRAMMAR)
+    out = tmp_path / f"city{suffix}"
+    build(tmp_path / "g.cga", out, lots_path=geojson(tmp_path / "osm.geojson", RINGS))
+    head = out.read_bytes()[:300]
+    assert b" crs EPSG:32632" in head and b"origin " in head

@@ -155,10 +155,15 @@ def test_non_polygon_features_are_reported(tmp_path):
     )
 
 
-def test_third_coordinate_is_ignored(tmp_path):
-    square_3d = [[x, y, 99.0] for x, y in SQUARE]
-    lots = read_lots(write_geojson(tmp_path, [feature([square_3d])]))
-    assert np.all(lots.vertices[:, 1] == 0) and lot_area(lots, 0) == pytest.approx(100.0)
+def test_an_elevation_is_the_lots_base_height_its_lowest_corner(tmp_path):
+    """A 3D footprint (draped on terrain) stands flat on its lowest corner; positions without an elevation
+    do not count, and a lot without any stands at 0."""
+    draped = [[x, y, 99.0 + k] for k, (x, y) in enumerate(SQUARE)]
+    mixed = [[x + 20, y, 7.5] if k == 2 else [x + 20, y] for k, (x, y) in enumerate(SQUARE)]
+    flat = [[x + 40, y] for x, y in SQUARE]
+    lots = read_lots(write_geojson(tmp_path, [feature([draped]), feature([mixed]), feature([flat])]))
+    heights = [np.unique(lots.vertices[lots.ring_offsets[k]:lots.ring_offsets[k + 1], 1]).tolist() for k in range(3)]
+    assert heights == [[99.0], [7.5], [0.0]] and lot_area(lots, 0) == pytest.approx(100.0)
 
 
 def test_duplicate_and_closing_vertices_are_removed(tmp_path):

@@ -110,3 +110,19 @@ def test_id_field_picks_the_ids_in_every_format(tmp_path):
     assert ids[0] == ids[1] == ids[2] and ids[0][:3] == ["12", "7.5:0", "7.5:1"]
     with pytest.raises(LotsError, match=r"--id-field osm_id: the lots have no such field \(they have id, h,"):
         read_lots(parquet, LotsOptions(id_field="osm_id"))
+
+
+def test_elevations_of_a_columnar_file_are_base_heights_too(tmp_path):
+    pa = pytest.importorskip("pyarrow")
+    import json
+
+    import pyarrow.parquet as pq
+    import shapely
+
+    polygons = [shapely.Polygon([(0, 0, 12.0), (10, 0, 12.5), (10, 10, 13.0), (0, 10, 12.0)]),
+                shapely.Polygon([(20, 0), (30, 0), (30, 10), (20, 10)])]
+    geo = {"version": "1.0.0", "primary_column": "geometry", "columns": {"geometry": {"encoding": "WKB"}}}
+    table = pa.table({"geometry": shapely.to_wkb(polygons)}).replace_schema_metadata({"geo": json.dumps(geo)})
+    pq.write_table(table, tmp_path / "lots.parquet")
+    lots = read_lots(tmp_path / "lots.parquet")
+    assert lots.vertices[:4, 1].tolist() == [12.0] * 4 and lots.vertices[4:, 1].tolist() == [0.0] * 4
