@@ -143,7 +143,8 @@ class _Part:
         self.instances = 0
         self.json: dict = {
             "asset": {"version": "2.0", "generator": f"grammarc {meta.get('grammarc', '')}".strip(),
-                      "extras": {"grammarc": meta}},
+                      # world = a node's translation (double) + its positions; the world's coordinate system
+                      "extras": {"grammarc": meta, "origin": [0.0, 0.0, 0.0], "crs": meta.get("crs")}},
             "extensionsUsed": [_EXTENSION],
             "scene": 0, "scenes": [{"nodes": []}],
             "nodes": [], "meshes": [], "materials": [], "accessors": [], "bufferViews": [],

@@ -223,8 +223,10 @@ class UsdWriter(TiledWriter):
             xform.AddTranslateOp().Set(Gf.Vec3d(*map(float, origin)))
             xform.GetPrim().GetReferences().AddReference(f"./{folder}/{name}{self._ext}")
         layer = stage.GetRootLayer()
+        # the coordinate system of the world the tiles are placed in (null for a local scene), by itself too
         layer.customLayerData = {"grammarc": json.dumps(self._meta, sort_keys=True),
-                                 "grammarc:symbols": json.dumps(self._symbols)}
+                                 "grammarc:symbols": json.dumps(self._symbols),
+                                 "grammarc:crs": self._meta.get("crs") or ""}
         layer.Save()
 
     def _move_into_place(self, out: Path) -> None:

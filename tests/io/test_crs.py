@@ -194,3 +194,16 @@ def test_baked_meshes_name_their_coordinate_system(tmp_path, suffix):
     build(tmp_path / "g.cga", out, lots_path=geojson(tmp_path / "osm.geojson", RINGS))
     head = out.read_bytes()[:300]
     assert b" crs EPSG:32632" in head and b"origin " in head
+
+
+def test_instanced_outputs_name_their_coordinate_system(tmp_path):
+    (tmp_path / "g.cga").write_text(GRAMMAR)
+    lots = geojson(tmp_path / "osm.geojson", RINGS)
+    build(tmp_path / "g.cga", tmp_path / "city.glb", lots_path=lots)
+    gltf = json.loads((tmp_path / "city.glb").read_bytes()[20:20 + int.from_bytes(
+        (tmp_path / "city.glb").read_bytes()[12:16], "little")])
+    assert gltf["asset"]["extras"]["crs"] == "EPSG:32632" and gltf["asset"]["extras"]["origin"] == [0, 0, 0]
+    pxr = pytest.importorskip("pxr")
+    build(tmp_path / "g.cga", tmp_path / "city.usdc", lots_path=lots)
+    layer = pxr.Sdf.Layer.FindOrOpen(str(tmp_path / "city.usdc"))
+    assert layer.customLayerData["grammarc:crs"] == "EPSG:32632"
