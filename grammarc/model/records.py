@@ -28,7 +28,7 @@ WHITE = np.array([255, 255, 255, 255], np.uint8)
 class LotOrigins:
     """Where each lot's records are placed: ``world = origin of the row's lot + xform @ p`` (float64).
 
-    A record's transforms and mesh vertices are float32, which keeps 1 mm only within about 16 km of
+    A record's transforms and mesh vertices are float32, which has steps of 1 mm or less only within 8 km of
     their zero (a float32 step is 0.5 m at a UTM northing of 5.75 million metres). So they are relative
     to their lot's origin, its initial shape's scope origin, kept here in float64: a lot spans metres to
     a few kilometres, and its rows keep sub-millimetre positions wherever it lies on Earth. No origins
