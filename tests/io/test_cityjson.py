@@ -119,6 +119,8 @@ CJIO = Path(sys.executable).parent / "cjio"
 
 @pytest.mark.skipif(not CJIO.is_file(), reason="cjio not installed")
 def test_cjio_reads_it(tmp_path):
-    done = subprocess.run([str(CJIO), str(city(tmp_path)), "info"], capture_output=True, text=True, check=True)
+    done = subprocess.run([str(CJIO), str(city(tmp_path)), "info", "--long"], capture_output=True, text=True,
+                          check=True)
     assert "CityJSON version = 2.0" in done.stdout and "EPSG = 2056" in done.stdout
-    assert "Building (3)" in done.stdout
+    assert "Building (3)" in done.stdout and "attributes = ['storeys', 'use']" in done.stdout
+    assert "semantics surfaces = ['GroundSurface', 'RoofSurface', 'WallSurface']" in done.stdout

@@ -115,6 +115,14 @@ def test_a_bake_origin_chosen_by_the_user_is_subtracted_and_named(tmp_path):
     np.testing.assert_allclose(np.sort(b.vertices, axis=0), np.sort(a.vertices, axis=0), atol=MM, rtol=0)
 
 
+def test_cityjson_keeps_millimetres_in_its_integers(tmp_path):
+    near, far = (json.loads(p.read_text()) for p in both(tmp_path, "city.city.json"))
+    a, b = ((np.array(d["vertices"]) * d["transform"]["scale"] + d["transform"]["translate"]) for d in (near, far))
+    shift = np.array([OFFSET[0], OFFSET[1], 0.0])  # easting, northing, height
+    assert len(a) == len(b) > 100
+    np.testing.assert_allclose(np.sort(b - shift, axis=0), np.sort(a, axis=0), atol=MM, rtol=0)
+
+
 def test_the_far_city_renders_as_the_city_at_the_origin(tmp_path):
     near, far = (read_instances(p) for p in both(tmp_path, "city.npz"))
     render(near, tmp_path / "near.png", size=(320, 200))
