@@ -167,8 +167,12 @@ def ring_starts(coords, ring_offsets, part_offsets, part_source, part_with_start
     ``_places``) gets i; one inside with neither gets the place of the nearest parent vertex.
 
     CityEngine keeps a polygon's vertex order through offsets, setbacks and cuts: an inset or a
-    setback's remainder starts at the edge moved in from the first parent edge that is left (edge 0,
-    unless the offset made it vanish). PRT (measured through PyPRT on some 700 pieces of convex and
+    setback's remainder starts where the first outer parent edge that is left ends, counting from the
+    last: at vertex 0's mitre where the last edge and edge 0 are left. Where the offset took the last
+    edge (and vertex 0 with it) the ring starts at the end of edge 0 (PRT on massing's H and L lots
+    whose arms an offset closed), where it took edge 0 at the start of edge 1, and where holes grown
+    into the outline cut the last edge off from the next one, at the end of the last edge (PRT on
+    massing's holes.7039). PRT (measured through PyPRT on some 700 pieces of convex and
     concave lots cut by ``split``) starts the outline of a piece on a side of the cut that holds the
     parent's vertex 0 or 1 (``part_with_start``) at its first place: vertex 0 itself, or the crossing
     where the boundary enters it. A piece on another side starts with its cut edge: at its last place
@@ -185,6 +189,7 @@ def ring_starts(coords, ring_offsets, part_offsets, part_source, part_with_start
             n = r1 - r0
             keys = np.empty(n)
             marked = np.zeros(n, np.bool_)
+            moved_from = np.full(n, np.inf)  # the parent edge each outgoing edge runs along or came from
             for j in range(n):
                 k = r0 + (j + 1) % n
                 near, key, vertex_key, scale, edge, away = _places(
@@ -192,6 +197,7 @@ def ring_starts(coords, ring_offsets, part_offsets, part_source, part_with_start
                     parent_rings, parent_offsets)
                 if cut:
                     edge = np.inf  # a cut's crossings keep their places: their chords run along no edge
+                moved_from[j] = edge
                 tolerance = 1e-6 * max(scale, 1.0) ** 0.5
                 if np.isfinite(edge) and away <= tolerance and len(start_edges):
                     marked[j] = start_edges[parent_rings[parent_offsets[g]] + int(edge)]
@@ -202,11 +208,21 @@ def ring_starts(coords, ring_offsets, part_offsets, part_source, part_with_start
                 else:
                     keys[j] = vertex_key
             best = int(np.argmin(keys))
+            outer = parent_rings[parent_offsets[g] + 1] - parent_rings[parent_offsets[g]]
+            if r == part_offsets[p] and not cut:
+                # where the first outer edge left, counting from the last, ends (vertex 0's mitre when the
+                # last edge and edge 0 are left)
+                rank = np.full(n, np.inf)
+                for j in range(n):
+                    incoming = moved_from[(j - 1) % n]
+                    if incoming < outer and moved_from[j] != incoming:  # (the end of a run along it)
+                        rank[j] = (incoming + 1) % outer
+                if np.isfinite(rank).any():
+                    best = int(np.argmin(rank))
             if r == part_offsets[p] and marked.any():
                 best = int(np.argmin(np.where(marked, keys, np.inf)))
             if r == part_offsets[p] and not part_with_start[p]:
                 # the last place on the parent's outer ring (a piece may run along its holes too)
-                outer = parent_rings[parent_offsets[g] + 1] - parent_rings[parent_offsets[g]]
                 best = int(np.argmax(np.where(keys < outer, keys, -1.0)))
             for j in range(n):
                 k = r0 + (best + j) % n
