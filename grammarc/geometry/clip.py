@@ -236,11 +236,12 @@ def _places(px, py, qx, qy, g, parent_coords, parent_rings, parent_offsets):
     nearest point of its boundary and that point's place (i + f a fraction f along the edge from vertex
     i to vertex i + 1, ring after ring), the place of the nearest vertex, the largest squared edge length
     (a scale for tolerances); and the place i of the edge (p, q) runs along or was moved in from
-    (parallel to it, in the same direction, the nearest such; inf when there is none) with the distance
-    between their lines."""
+    (parallel to it to a millionth, as GEOS's mitres between near-collinear edges turn an inset's edges a
+    little; in the same direction; the nearest such, and of collinear ones the one whose span is nearest
+    the edge's: an H's inner sides; inf when there is none) with the distance between their lines."""
     near, key = np.inf, np.inf
     near_vertex, vertex_key = np.inf, np.inf
-    away, edge = np.inf, np.inf
+    away, edge, gap = np.inf, np.inf, np.inf
     dx, dy = qx - px, qy - py
     length = np.sqrt(dx * dx + dy * dy)
     scale = 0.0
@@ -264,10 +265,14 @@ def _places(px, py, qx, qy, g, parent_coords, parent_rings, parent_offsets):
             if dv < near_vertex:
                 near_vertex, vertex_key = dv, base + i
             u = np.sqrt(length2)
-            if u > 0.0 and length > 0.0 and abs(bx * dy - by * dx) <= 1e-9 * u * length and bx * dx + by * dy > 0.0:
+            if u > 0.0 and length > 0.0 and abs(bx * dy - by * dx) <= 1e-6 * u * length and bx * dx + by * dy > 0.0:
                 distance = abs(bx * (py - ay) - by * (px - ax)) / u
-                if distance < away:
-                    away, edge = distance, base + i
+                # how far the edge's span along the line lies from the parent edge's [0, u]
+                low, high = ((px - ax) * bx + (py - ay) * by) / u, ((qx - ax) * bx + (qy - ay) * by) / u
+                apart = max(0.0, low - u, -high)
+                same = abs(distance - away) <= 1e-9 * max(u, 1.0)
+                if (distance < away and not same) or (same and apart < gap):
+                    away, edge, gap = distance, base + i, apart
         base += m
     return near, key, vertex_key, scale, edge, away
 

@@ -146,6 +146,29 @@ def test_an_inset_whose_hole_cuts_the_last_edge_off_starts_at_its_end():
                                [[3, -13], [13, -13]])
 
 
+def test_an_inset_edge_comes_from_the_collinear_edge_it_runs_beside():
+    """An H's inner sides lie on one line (edges 4 and 11, in one direction): the inset's side beside the
+    last edge is moved in from that edge, not from edge 4, so the inset starts at vertex 0's mitre (PRT on
+    massing's H.7048), and the near-collinear left sides of a lot (edges 6 and 7, 0.001 m off one line),
+    whose mitre GEOS places a little off, are told apart (near_degenerate.7110)."""
+    import shapely
+
+    from grammarc.geometry.clip import fit_pieces
+
+    h = shapely.Polygon([(15, 41), (20, 41), (20, 0), (15, 0), (15, 18), (5, 18), (5, 0), (0, 0), (0, 41), (5, 41),
+                         (5, 23), (15, 23)])
+    bent = shapely.Polygon([(0, 30), (10, 30), (10, 0), (0, 0.001), (0.001, 18.107)])
+
+    def start(parent, d):
+        inset = shapely.buffer(parent, d, join_style="mitre", mitre_limit=1e6)
+        bounds = np.array([[*np.ptp(np.asarray(parent.exterior.coords), axis=0)]])
+        pieces = fit_pieces(np.array([inset]), np.array([1]), np.insert(bounds, 1, 0.0, axis=1), np.array([parent]))
+        return np.round(pieces.coords[:2] * pieces.extent[0, [0, 2]] + pieces.low[0, [0, 2]], 6)
+
+    np.testing.assert_allclose(start(h, -2), [[17, 39], [18, 39]])
+    np.testing.assert_allclose(start(bent, -3.915)[0], [3.915, 26.085], atol=1e-3)
+
+
 def test_a_cut_piece_starts_with_its_cut_edge():
     """PRT's half of massing's octagon starts with the cut edge, at the point where the octagon's
     boundary leaves the half, though Sutherland-Hodgman from vertex 0 (in the other half) would
