@@ -107,7 +107,7 @@ def oriented_rings(parts: np.ndarray, part_plane: np.ndarray):
 
 def fit_pieces(geometries: np.ndarray, plane: np.ndarray, size: np.ndarray,
                parents: np.ndarray | None = None, cut_sides: np.ndarray | None = None,
-               start_edges: np.ndarray | None = None) -> Clipped:
+               start_edges: np.ndarray | None = None, insets: np.ndarray | None = None) -> Clipped:
     """Polygons (or multipolygons) in scope units, one per source row, as pieces with fitted boxes.
 
     ``parents`` (one polygon per source row, the polygons the pieces were cut or moved in from): each
@@ -117,7 +117,9 @@ def fit_pieces(geometries: np.ndarray, plane: np.ndarray, size: np.ndarray,
     holds the parent's vertex 0 or 1; None when they were moved in from them (an offset, a setback).
     ``start_edges`` (one bool per vertex of the parents' open rings, all rings one after the other): the
     parent edges (from that vertex) where pieces moved in start when they run along one (a setback's
-    strips start at the first edge they set back)."""
+    strips start at the first edge they set back). ``insets`` (one bool per source row, None for none):
+    the rows whose pieces are an offset's insets, which start otherwise than a setback's remainder where
+    the offset took edges (``ring_starts``)."""
     parts, source = shapely.get_parts(geometries, return_index=True)
     keep = (shapely.get_type_id(parts) == shapely.GeometryType.POLYGON) & (
         shapely.area(parts) > TOL.area_floor)
@@ -133,8 +135,9 @@ def fit_pieces(geometries: np.ndarray, plane: np.ndarray, size: np.ndarray,
         cut = cut_sides is not None
         side = cut_sides if cut else np.ones(len(geometries), dtype=np.bool_)
         allowed = np.zeros(0, dtype=np.bool_) if start_edges is None else start_edges
-        flat = ring_starts(flat, ring_offsets, part_offsets, source, side[source], cut, allowed, parent_flat,
-                           parent_rings, np.asarray(parent_offsets, dtype=np.int64))
+        inset = np.zeros(len(geometries), dtype=np.bool_) if insets is None else insets
+        flat = ring_starts(flat, ring_offsets, part_offsets, source, side[source], cut, inset[source],
+                           allowed, parent_flat, parent_rings, np.asarray(parent_offsets, dtype=np.int64))
     vertex_part = segment_of(part_offsets)[segment_of(ring_offsets)]
     low2 = bounds[:, :2]
     extent2 = bounds[:, 2:] - bounds[:, :2]
@@ -156,8 +159,8 @@ def fit_pieces(geometries: np.ndarray, plane: np.ndarray, size: np.ndarray,
 
 
 @njit(cache=True, nogil=True)
-def ring_starts(coords, ring_offsets, part_offsets, part_source, part_with_start, cut, start_edges,
-                parent_coords, parent_rings, parent_offsets):
+def ring_starts(coords, ring_offsets, part_offsets, part_source, part_with_start, cut, part_inset,
+                start_edges, parent_coords, parent_rings, parent_offsets):
     """Each ring of each piece turned to start where CityEngine's clipping and offsets start it.
 
     Every piece vertex gets its place along the parent's boundary: i for the parent's vertex i (ring
@@ -166,14 +169,15 @@ def ring_starts(coords, ring_offsets, part_offsets, part_source, part_with_start
     edge i (an offset's, a setback's: parallel to it, in the same direction, the nearest such,
     ``_places``) gets i; one inside with neither gets the place of the nearest parent vertex.
 
-    CityEngine keeps a polygon's vertex order through offsets, setbacks and cuts: an inset or a
-    setback's remainder starts where the first outer parent edge that is left ends, counting from the
-    last: at vertex 0's mitre where the last edge and edge 0 are left. Where the offset took the last
-    edge (and vertex 0 with it) the ring starts at the end of edge 0 (PRT on massing's H and L lots
-    whose arms an offset closed), where it took edge 0 at the start of edge 1, and where holes grown
-    into the outline cut the last edge off from the next one, at the end of the last edge (PRT on
-    massing's holes.7039). PRT (measured through PyPRT on some 700 pieces of convex and
-    concave lots cut by ``split``) starts the outline of a piece on a side of the cut that holds the
+    CityEngine keeps a polygon's vertex order through offsets, setbacks and cuts: a setback's remainder
+    starts at the edge moved in from the first parent edge that is left; an inset (an offset's,
+    ``part_inset``) where the first outer parent edge that is left ends, counting from the last: at
+    vertex 0's mitre where the last edge and edge 0 are left. Where the offset took the last edge (and
+    vertex 0 with it) the inset starts at the end of edge 0 (PRT on massing's H and L lots whose arms an
+    offset closed), where it took edge 0 at the start of edge 1, and where holes grown into the outline
+    cut the last edge off from the next one, at the end of the last edge (PRT on massing's holes.7039;
+    a setback's remainder there keeps the first rule: H.7006). PRT (measured through PyPRT on some 700
+    pieces of convex and concave lots cut by ``split``) starts the outline of a piece on a side of the cut that holds the
     parent's vertex 0 or 1 (``part_with_start``) at its first place: vertex 0 itself, or the crossing
     where the boundary enters it. A piece on another side starts with its cut edge: at its last place
     on the parent's outer ring, the crossing where that ring leaves it. Holes start at their first
@@ -209,7 +213,7 @@ def ring_starts(coords, ring_offsets, part_offsets, part_source, part_with_start
                     keys[j] = vertex_key
             best = int(np.argmin(keys))
             outer = parent_rings[parent_offsets[g] + 1] - parent_rings[parent_offsets[g]]
-            if r == part_offsets[p] and not cut:
+            if r == part_offsets[p] and part_inset[p]:
                 # where the first outer edge left, counting from the last, ends (vertex 0's mitre when the
                 # last edge and edge 0 are left)
                 rank = np.full(n, np.inf)

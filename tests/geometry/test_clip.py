@@ -126,7 +126,8 @@ def test_an_inset_without_the_last_edge_starts_where_edge_0_ends():
     # an L whose arm (edges 4 and 5, the last) is narrower than twice the offset; clockwise in (x, z)
     arm = shapely.Polygon([(-30, 0), (0, 0), (0, -12), (-7, -12), (-7, -4), (-30, -4)])
     inset = shapely.buffer(arm, -2.5, join_style="mitre")
-    pieces = fit_pieces(np.array([inset]), np.array([1]), np.array([[30.0, 0.0, 12.0]]), np.array([arm]))
+    pieces = fit_pieces(np.array([inset]), np.array([1]), np.array([[30.0, 0.0, 12.0]]), np.array([arm]),
+                        insets=np.array([True]))
     np.testing.assert_allclose(pieces.coords[:2] * pieces.extent[0, [0, 2]] + pieces.low[0, [0, 2]],
                                [[-2.5, -2.5], [-2.5, -9.5]])
 
@@ -141,7 +142,8 @@ def test_an_inset_whose_hole_cuts_the_last_edge_off_starts_at_its_end():
 
     square = shapely.Polygon([(0, 0), (30, 0), (30, -30), (0, -30)], [[(1, -1), (1, -10), (10, -10), (10, -1)]])
     inset = shapely.buffer(square, -3, join_style="mitre")
-    pieces = fit_pieces(np.array([inset]), np.array([1]), np.array([[30.0, 0.0, 30.0]]), np.array([square]))
+    pieces = fit_pieces(np.array([inset]), np.array([1]), np.array([[30.0, 0.0, 30.0]]), np.array([square]),
+                        insets=np.array([True]))
     np.testing.assert_allclose(pieces.coords[:2] * pieces.extent[0, [0, 2]] + pieces.low[0, [0, 2]],
                                [[3, -13], [13, -13]])
 
@@ -162,7 +164,8 @@ def test_an_inset_edge_comes_from_the_collinear_edge_it_runs_beside():
     def start(parent, d):
         inset = shapely.buffer(parent, d, join_style="mitre", mitre_limit=1e6)
         bounds = np.array([[*np.ptp(np.asarray(parent.exterior.coords), axis=0)]])
-        pieces = fit_pieces(np.array([inset]), np.array([1]), np.insert(bounds, 1, 0.0, axis=1), np.array([parent]))
+        pieces = fit_pieces(np.array([inset]), np.array([1]), np.insert(bounds, 1, 0.0, axis=1), np.array([parent]),
+                            insets=np.array([True]))
         return np.round(pieces.coords[:2] * pieces.extent[0, [0, 2]] + pieces.low[0, [0, 2]], 6)
 
     np.testing.assert_allclose(start(h, -2), [[17, 39], [18, 39]])
