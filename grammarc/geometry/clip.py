@@ -107,7 +107,7 @@ def oriented_rings(parts: np.ndarray, part_plane: np.ndarray):
 
 def fit_pieces(geometries: np.ndarray, plane: np.ndarray, size: np.ndarray,
                parents: np.ndarray | None = None, cut_sides: np.ndarray | None = None,
-               start_edges: np.ndarray | None = None) -> Clipped:
+               start_edges: np.ndarray | None = None, insets: np.ndarray | None = None) -> Clipped:
     """Polygons (or multipolygons) in scope units, one per source row, as pieces with fitted boxes.
 
     ``parents`` (one polygon per source row, the polygons the pieces were cut or moved in from): each
@@ -117,7 +117,9 @@ def fit_pieces(geometries: np.ndarray, plane: np.ndarray, size: np.ndarray,
     holds the parent's vertex 0 or 1; None when they were moved in from them (an offset, a setback).
     ``start_edges`` (one bool per vertex of the parents' open rings, all rings one after the other): the
     parent edges (from that vertex) where pieces moved in start when they run along one (a setback's
-    strips start at the first edge they set back)."""
+    strips start at the first edge they set back). ``insets`` (one bool per source row, None for none):
+    the rows whose pieces are an offset's insets, which start otherwise than a setback's remainder where
+    the offset took edges (``ring_starts``)."""
     parts, source = shapely.get_parts(geometries, return_index=True)
     keep = (shapely.get_type_id(parts) == shapely.GeometryType.POLYGON) & (
         shapely.area(parts) > TOL.area_floor)
@@ -133,8 +135,9 @@ def fit_pieces(geometries: np.ndarray, plane: np.ndarray, size: np.ndarray,
         cut = cut_sides is not None
         side = cut_sides if cut else np.ones(len(geometries), dtype=np.bool_)
         allowed = np.zeros(0, dtype=np.bool_) if start_edges is None else start_edges
-        flat = ring_starts(flat, ring_offsets, part_offsets, source, side[source], cut, allowed, parent_flat,
-                           parent_rings, np.asarray(parent_offsets, dtype=np.int64))
+        inset = np.zeros(len(geometries), dtype=np.bool_) if insets is None else insets
+        flat = ring_starts(flat, ring_offsets, part_offsets, source, side[source], cut, inset[source],
+                           allowed, parent_flat, parent_rings, np.asarray(parent_offsets, dtype=np.int64))
     vertex_part = segment_of(part_offsets)[segment_of(ring_offsets)]
     low2 = bounds[:, :2]
     extent2 = bounds[:, 2:] - bounds[:, :2]
@@ -156,8 +159,8 @@ def fit_pieces(geometries: np.ndarray, plane: np.ndarray, size: np.ndarray,
 
 
 @njit(cache=True, nogil=True)
-def ring_starts(coords, ring_offsets, part_offsets, part_source, part_with_start, cut, start_edges,
-                parent_coords, parent_rings, parent_offsets):
+def ring_starts(coords, ring_offsets, part_offsets, part_source, part_with_start, cut, part_inset,
+                start_edges, parent_coords, parent_rings, parent_offsets):
     """Each ring of each piece turned to start where CityEngine's clipping and offsets start it.
 
     Every piece vertex gets its place along the parent's boundary: i for the parent's vertex i (ring
@@ -166,10 +169,15 @@ def ring_starts(coords, ring_offsets, part_offsets, part_source, part_with_start
     edge i (an offset's, a setback's: parallel to it, in the same direction, the nearest such,
     ``_places``) gets i; one inside with neither gets the place of the nearest parent vertex.
 
-    CityEngine keeps a polygon's vertex order through offsets, setbacks and cuts: an inset or a
-    setback's remainder starts at the edge moved in from the first parent edge that is left (edge 0,
-    unless the offset made it vanish). PRT (measured through PyPRT on some 700 pieces of convex and
-    concave lots cut by ``split``) starts the outline of a piece on a side of the cut that holds the
+    CityEngine keeps a polygon's vertex order through offsets, setbacks and cuts: a setback's remainder
+    starts at the edge moved in from the first parent edge that is left; an inset (an offset's,
+    ``part_inset``) where the first outer parent edge that is left ends, counting from the last: at
+    vertex 0's mitre where the last edge and edge 0 are left. Where the offset took the last edge (and
+    vertex 0 with it) the inset starts at the end of edge 0 (PRT on massing's H and L lots whose arms an
+    offset closed), where it took edge 0 at the start of edge 1, and where holes grown into the outline
+    cut the last edge off from the next one, at the end of the last edge (PRT on massing's holes.7039;
+    a setback's remainder there keeps the first rule: H.7006). PRT (measured through PyPRT on some 700
+    pieces of convex and concave lots cut by ``split``) starts the outline of a piece on a side of the cut that holds the
     parent's vertex 0 or 1 (``part_with_start``) at its first place: vertex 0 itself, or the crossing
     where the boundary enters it. A piece on another side starts with its cut edge: at its last place
     on the parent's outer ring, the crossing where that ring leaves it. Holes start at their first
@@ -185,6 +193,7 @@ def ring_starts(coords, ring_offsets, part_offsets, part_source, part_with_start
             n = r1 - r0
             keys = np.empty(n)
             marked = np.zeros(n, np.bool_)
+            moved_from = np.full(n, np.inf)  # the parent edge each outgoing edge runs along or came from
             for j in range(n):
                 k = r0 + (j + 1) % n
                 near, key, vertex_key, scale, edge, away = _places(
@@ -192,6 +201,7 @@ def ring_starts(coords, ring_offsets, part_offsets, part_source, part_with_start
                     parent_rings, parent_offsets)
                 if cut:
                     edge = np.inf  # a cut's crossings keep their places: their chords run along no edge
+                moved_from[j] = edge
                 tolerance = 1e-6 * max(scale, 1.0) ** 0.5
                 if np.isfinite(edge) and away <= tolerance and len(start_edges):
                     marked[j] = start_edges[parent_rings[parent_offsets[g]] + int(edge)]
@@ -202,11 +212,21 @@ def ring_starts(coords, ring_offsets, part_offsets, part_source, part_with_start
                 else:
                     keys[j] = vertex_key
             best = int(np.argmin(keys))
+            outer = parent_rings[parent_offsets[g] + 1] - parent_rings[parent_offsets[g]]
+            if r == part_offsets[p] and part_inset[p]:
+                # where the first outer edge left, counting from the last, ends (vertex 0's mitre when the
+                # last edge and edge 0 are left)
+                rank = np.full(n, np.inf)
+                for j in range(n):
+                    incoming = moved_from[(j - 1) % n]
+                    if incoming < outer and moved_from[j] != incoming:  # (the end of a run along it)
+                        rank[j] = (incoming + 1) % outer
+                if np.isfinite(rank).any():
+                    best = int(np.argmin(rank))
             if r == part_offsets[p] and marked.any():
                 best = int(np.argmin(np.where(marked, keys, np.inf)))
             if r == part_offsets[p] and not part_with_start[p]:
                 # the last place on the parent's outer ring (a piece may run along its holes too)
-                outer = parent_rings[parent_offsets[g] + 1] - parent_rings[parent_offsets[g]]
                 best = int(np.argmax(np.where(keys < outer, keys, -1.0)))
             for j in range(n):
                 k = r0 + (best + j) % n
@@ -220,11 +240,12 @@ def _places(px, py, qx, qy, g, parent_coords, parent_rings, parent_offsets):
     nearest point of its boundary and that point's place (i + f a fraction f along the edge from vertex
     i to vertex i + 1, ring after ring), the place of the nearest vertex, the largest squared edge length
     (a scale for tolerances); and the place i of the edge (p, q) runs along or was moved in from
-    (parallel to it, in the same direction, the nearest such; inf when there is none) with the distance
-    between their lines."""
+    (parallel to it to a millionth, as GEOS's mitres between near-collinear edges turn an inset's edges a
+    little; in the same direction; the nearest such, and of collinear ones the one whose span is nearest
+    the edge's: an H's inner sides; inf when there is none) with the distance between their lines."""
     near, key = np.inf, np.inf
     near_vertex, vertex_key = np.inf, np.inf
-    away, edge = np.inf, np.inf
+    away, edge, gap = np.inf, np.inf, np.inf
     dx, dy = qx - px, qy - py
     length = np.sqrt(dx * dx + dy * dy)
     scale = 0.0
@@ -248,10 +269,14 @@ def _places(px, py, qx, qy, g, parent_coords, parent_rings, parent_offsets):
             if dv < near_vertex:
                 near_vertex, vertex_key = dv, base + i
             u = np.sqrt(length2)
-            if u > 0.0 and length > 0.0 and abs(bx * dy - by * dx) <= 1e-9 * u * length and bx * dx + by * dy > 0.0:
+            if u > 0.0 and length > 0.0 and abs(bx * dy - by * dx) <= 1e-6 * u * length and bx * dx + by * dy > 0.0:
                 distance = abs(bx * (py - ay) - by * (px - ax)) / u
-                if distance < away:
-                    away, edge = distance, base + i
+                # how far the edge's span along the line lies from the parent edge's [0, u]
+                low, high = ((px - ax) * bx + (py - ay) * by) / u, ((qx - ax) * bx + (qy - ay) * by) / u
+                apart = max(0.0, low - u, -high)
+                same = abs(distance - away) <= 1e-9 * max(u, 1.0)
+                if (distance < away and not same) or (same and apart < gap):
+                    away, edge, gap = distance, base + i, apart
         base += m
     return near, key, vertex_key, scale, edge, away
 

@@ -4,10 +4,11 @@ Each edge moves into the polygon by its own distance (0 keeps it). The strip it 
 between the edge and its moved copy, whose ends are the mitre points where the moved lines of
 neighbouring edges meet: a strip stops at an unmoved neighbour's line (unless the boundary turns there by
 less than 15 degrees: then it steps across at the vertex), and two moved neighbours share their corner,
-as in CityEngine. A quad that folds over itself (a distance longer than the edge allows)
-falls back to the edge's rectangle. The strips of each owner (a selector of the operation) are united and
-clipped to the polygon; an edge belongs to the first owner that claims it, and the remainder is what no
-strip covers. All of it runs on whole batches: numpy over the ragged edges, GEOS over arrays of quads.
+as in CityEngine. A quad that folds over itself (a distance longer than the edge allows) is cut to the
+triangle of its edge and its end lines, as a straight skeleton's face ends. The strips of each owner (a
+selector of the operation) are united and clipped to the polygon; an edge belongs to the first owner that
+claims it, and the remainder is what no strip covers. All of it runs on whole batches: numpy over the
+ragged edges, GEOS over arrays of quads.
 """
 
 from __future__ import annotations
@@ -93,10 +94,7 @@ def setback_regions(polygons: np.ndarray, edges: Edges, distance: np.ndarray, ow
     strips = shapely.polygons(quads) if len(idx) else np.empty(0, dtype=object)
     folded = ~shapely.is_valid(strips)
     if folded.any():
-        k = idx[folded]
-        shift = edges.inward[k] * d[k, None]
-        strips[folded] = shapely.polygons(np.stack(
-            [edges.start[k], edges.end[k], edges.end[k] + shift, edges.start[k] + shift], axis=1))
+        strips[folded] = _folded_strips(quads[folded])
     group = owner[idx] * m + edges.poly[idx]
     united = union_by_group(strips, group, n_owners * m).reshape(n_owners, m)
     regions, covered = [], np.full(m, shapely.Polygon(), dtype=object)
@@ -105,6 +103,20 @@ def setback_regions(polygons: np.ndarray, edges: Edges, distance: np.ndarray, ow
         regions.append(_without_seams(_without_spikes(region), polygons))
         covered = shapely.union(covered, region)
     return regions, _without_spikes(shapely.difference(polygons, covered))
+
+
+def _folded_strips(quads: np.ndarray) -> np.ndarray:
+    """The strips (k,) of edges whose quads (k, 4, 2) (start, end, moved end, moved start) fold over
+    themselves: their end lines cross before the moved line (a distance longer than the edge allows). The
+    strip is then the triangle of the edge and that crossing, where its neighbours' strips take over,
+    as a straight skeleton's face of the edge ends (PRT's terraces on massing's narrow shapeL arms: the
+    end's strip reaches the kept edge beside it)."""
+    start, end, moved_end, moved_start = quads.transpose(1, 0, 2)
+    a, b = moved_start - start, moved_end - end
+    det = a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0]
+    gap = end - start
+    t = (gap[:, 0] * b[:, 1] - gap[:, 1] * b[:, 0]) / np.where(np.abs(det) > 1e-300, det, 1.0)
+    return shapely.polygons(np.stack([start, end, start + t[:, None] * a], axis=1))
 
 
 def distances_to_area(polygons: np.ndarray, edges: Edges, minimum: np.ndarray, maximum: np.ndarray,

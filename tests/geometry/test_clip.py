@@ -115,6 +115,63 @@ def test_pieces_start_where_cityengine_starts_them():
                                                        cut_sides=np.array([False]))), [20, 3])
 
 
+def test_an_inset_without_the_last_edge_starts_where_edge_0_ends():
+    """An offset that makes the parent's last edge vanish takes vertex 0 with it: PRT's inset starts at
+    the end of the first edge left (vertex 1's mitre, edge 0 left), not at its start (measured through
+    PyPRT on massing's H and L footprints whose arms the offset closed)."""
+    import shapely
+
+    from grammarc.geometry.clip import fit_pieces
+
+    # an L whose arm (edges 4 and 5, the last) is narrower than twice the offset; clockwise in (x, z)
+    arm = shapely.Polygon([(-30, 0), (0, 0), (0, -12), (-7, -12), (-7, -4), (-30, -4)])
+    inset = shapely.buffer(arm, -2.5, join_style="mitre")
+    pieces = fit_pieces(np.array([inset]), np.array([1]), np.array([[30.0, 0.0, 12.0]]), np.array([arm]),
+                        insets=np.array([True]))
+    np.testing.assert_allclose(pieces.coords[:2] * pieces.extent[0, [0, 2]] + pieces.low[0, [0, 2]],
+                               [[-2.5, -2.5], [-2.5, -9.5]])
+
+
+def test_an_inset_whose_hole_cuts_the_last_edge_off_starts_at_its_end():
+    """A hole grown by the offset into the outline's corner between the last edge and edge 0: the inset
+    starts where the last edge ends, at the hole's edge, not where edge 0 starts (PRT on massing's
+    holes.7039, whose footprint split ran along that hole's edge)."""
+    import shapely
+
+    from grammarc.geometry.clip import fit_pieces
+
+    square = shapely.Polygon([(0, 0), (30, 0), (30, -30), (0, -30)], [[(1, -1), (1, -10), (10, -10), (10, -1)]])
+    inset = shapely.buffer(square, -3, join_style="mitre")
+    pieces = fit_pieces(np.array([inset]), np.array([1]), np.array([[30.0, 0.0, 30.0]]), np.array([square]),
+                        insets=np.array([True]))
+    np.testing.assert_allclose(pieces.coords[:2] * pieces.extent[0, [0, 2]] + pieces.low[0, [0, 2]],
+                               [[3, -13], [13, -13]])
+
+
+def test_an_inset_edge_comes_from_the_collinear_edge_it_runs_beside():
+    """An H's inner sides lie on one line (edges 4 and 11, in one direction): the inset's side beside the
+    last edge is moved in from that edge, not from edge 4, so the inset starts at vertex 0's mitre (PRT on
+    massing's H.7048), and the near-collinear left sides of a lot (edges 6 and 7, 0.001 m off one line),
+    whose mitre GEOS places a little off, are told apart (near_degenerate.7110)."""
+    import shapely
+
+    from grammarc.geometry.clip import fit_pieces
+
+    h = shapely.Polygon([(15, 41), (20, 41), (20, 0), (15, 0), (15, 18), (5, 18), (5, 0), (0, 0), (0, 41), (5, 41),
+                         (5, 23), (15, 23)])
+    bent = shapely.Polygon([(0, 30), (10, 30), (10, 0), (0, 0.001), (0.001, 18.107)])
+
+    def start(parent, d):
+        inset = shapely.buffer(parent, d, join_style="mitre", mitre_limit=1e6)
+        bounds = np.array([[*np.ptp(np.asarray(parent.exterior.coords), axis=0)]])
+        pieces = fit_pieces(np.array([inset]), np.array([1]), np.insert(bounds, 1, 0.0, axis=1), np.array([parent]),
+                            insets=np.array([True]))
+        return np.round(pieces.coords[:2] * pieces.extent[0, [0, 2]] + pieces.low[0, [0, 2]], 6)
+
+    np.testing.assert_allclose(start(h, -2), [[17, 39], [18, 39]])
+    np.testing.assert_allclose(start(bent, -3.915)[0], [3.915, 26.085], atol=1e-3)
+
+
 def test_a_cut_piece_starts_with_its_cut_edge():
     """PRT's half of massing's octagon starts with the cut edge, at the point where the octagon's
     boundary leaves the half, though Sutherland-Hodgman from vertex 0 (in the other half) would

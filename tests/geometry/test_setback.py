@@ -53,6 +53,19 @@ def test_moved_neighbours_share_their_corner_along_the_mitre():
     assert shapely.area(remainder[0]) == pytest.approx(20 * 10)
 
 
+def test_a_strip_longer_than_its_edge_allows_ends_where_its_end_lines_cross():
+    """A short edge (1.5 m) set back 4 between a moved edge and a kept one it meets at 81 degrees (the end
+    of massing's narrow shapeL arm): its quad folds, and its strip is the triangle of the edge, the
+    corner's mitre line and the kept edge's line, so the two strips cover the arm to the kept edge, as
+    PRT's terrace does (was: the edge's rectangle, which left a sliver beside the kept edge)."""
+    arm = shapely.Polygon([(10, 0), (0, 0), (0, 1.5), (10, 3)])
+    edges = polygon_edges(np.array([arm]))
+    d = np.array([4.0, 4.0, 0.0, 0.0])  # the edges from (10, 0) and (0, 0)
+    (strips,), remainder = setback_regions(np.array([arm]), edges, d, np.zeros(len(d), np.int64), 1)
+    assert shapely.area(remainder[0]) == pytest.approx(0, abs=1e-9)
+    assert shapely.area(strips[0]) == pytest.approx(22.5)
+
+
 def test_collinear_edges_with_different_distances_step_instead_of_slanting():
     """A top edge in two collinear pieces set back 4 and 3 (as a second setback meets the edges a first
     one left, massing's U): the remainder steps at the shared vertex, 10 x 6 + 10 x 7."""

@@ -253,7 +253,7 @@ def _offset_selected(ctx: Context, cursor: Shapes, op: ir.Offset):
     if op.select == "all":
         inset, border, plane, polygons, faces, owner = _offset_polygons(ctx, op.distance, cursor, op.span)
         pieces = fit_pieces(np.concatenate([inset, border]), np.tile(plane, 2), np.tile(faces.size, (2, 1)),
-                            np.tile(polygons, 2))
+                            np.tile(polygons, 2), insets=np.arange(2 * len(inset)) < len(inset))
         # each shape's inside pieces, then its border's
         pieces = replace(pieces, source=owner[pieces.source % len(faces)])
         pieces = pieces.take(np.argsort(pieces.source, kind="stable"))
@@ -338,7 +338,7 @@ def offset_faces(ctx: Context, cursor: Shapes, op: ir.CompFaces) -> Parts:
     pieces = _offset_pieces(ctx, op.offset, cursor, op.span)
     border_site = (op.site << 20) + 1  # another stream than the inside faces'
     shapes, kind = _pieces_by_parent(ctx, cursor, pieces, [op.site, border_site])
-    shapes = _along_first_edges(ctx, shapes, op.span)
+    shapes = _along_first_edges(ctx, shapes, pieces, op.span)
     names = ("inside", "border")
     which = np.full(len(kind), len(op.selectors), dtype=np.int64)
     for i in range(len(op.selectors) - 1, -1, -1):
@@ -351,26 +351,30 @@ def offset_faces(ctx: Context, cursor: Shapes, op: ir.CompFaces) -> Parts:
     return Parts(op.parts, shapes.take(order), offsets)
 
 
-def _along_first_edges(ctx: Context, shapes: Shapes, span) -> Shapes:
+def _along_first_edges(ctx: Context, shapes: Shapes, pieces: list, span) -> Shapes:
     """Face components whose scope x runs along their first edge, as the reference gives every ``comp(f)``
-    face: the scopes of polygons turned about their normal where their first edge leaves the x axis (an
-    inset whose edge 0 the offset made vanish starts at the next one, and PRT's massing splits it along
-    that). Rectangles lie along their box already."""
-    chunk = ctx.chunk
-    poly = np.flatnonzero(shapes.geom >= 0)
-    coords, ring_offsets, poly_offsets = chunk.polygons.gather(shapes.geom[poly])
-    first = ring_offsets[poly_offsets[:-1]]
-    plane = chunk.polygons.plane[shapes.geom[poly]]
-    u, v = PLANE_U[plane], PLANE_V[plane]
-    scale = np.stack([shapes.size[poly, u], shapes.size[poly, v]], axis=1)
-    step = (coords[first + 1] - coords[first]) * scale
+    face: the scopes of ``shapes`` (the ``pieces`` (``Clipped``) in ``_pieces_by_parent``'s order) turned
+    about their normal where their first edge leaves the x axis (an inset whose vertex 0 the offset made
+    vanish starts further on, and PRT's massing splits it along that edge). A rectangle keeps no vertex
+    order in its shape, so its first edge is read off its piece: one that starts elsewhere than its box's
+    implicit ring turns by quarter turns and stays a box."""
+    step, plane = [], []
+    for p in pieces:
+        first = p.ring_offsets[p.poly_offsets[:-1]]
+        u, v = PLANE_U[p.plane], PLANE_V[p.plane]
+        k = np.arange(len(first))
+        scale = np.stack([p.extent[k, u], p.extent[k, v]], axis=1)
+        step.append((p.coords[first + 1] - p.coords[first]) * scale)
+        plane.append(p.plane)
+    order = np.argsort(np.concatenate([p.source for p in pieces]), kind="stable")
+    step, plane = np.concatenate(step)[order], np.concatenate(plane)[order]
     angle = np.arctan2(step[:, 1], step[:, 0])
     turn = np.abs(angle) > 1e-9
     if not turn.any():
         return shapes
-    rows, u, v, angle = poly[turn], u[turn], v[turn], angle[turn]
+    rows, u, v, angle = np.flatnonzero(turn), PLANE_U[plane[turn]], PLANE_V[plane[turn]], angle[turn]
     others = np.setdiff1d(np.arange(len(shapes)), rows)
-    axes = chunk.frames[shapes.frame[rows]]
+    axes = ctx.chunk.frames[shapes.frame[rows]]
     k = np.arange(len(rows))
     cos, sin = np.cos(angle)[:, None], np.sin(angle)[:, None]
     new_axes = axes.copy()
@@ -573,7 +577,8 @@ def _offset_pieces(ctx: Context, distance: ir.Expr, cursor: Shapes, span):
     ``source`` its shape's row."""
     inset, border, plane, polygons, faces, owner = _offset_polygons(ctx, distance, cursor, span)
     return tuple(replace(p, source=owner[p.source]) for p in (
-        fit_pieces(inset, plane, faces.size, polygons), fit_pieces(border, plane, faces.size, polygons)))
+        fit_pieces(inset, plane, faces.size, polygons, insets=np.ones(len(inset), dtype=bool)),
+        fit_pieces(border, plane, faces.size, polygons)))
 
 
 def _faces_in_plane(cursor: Shapes, chunk) -> tuple[Shapes, np.ndarray]:

@@ -86,6 +86,29 @@ def test_offset_inside_face_runs_along_its_first_edge(write):
     assert (t["x_sum"], t["z_sum"]) == (pytest.approx(18), pytest.approx(8))
 
 
+def test_offset_inset_without_the_last_edge_starts_where_edge_0_ends(write):
+    """An L whose arm, and with it the last edge (the arm's end) and vertex 0, the offset makes vanish:
+    PRT starts the inset where edge 0's moved line ends (vertex 1's mitre), so its first edge is the
+    moved edge 1 and comp(f) turns the scope along it, though the inset is a rectangle (massing's
+    footprints on the harness's L.7030 and H.3034 split along that edge)."""
+    arm = [np.array([[-30, 0], [0, 0], [0, 12], [-7, 12], [-7, 4], [-30, 4]], float)]
+    text = 'Lot --> offset(-2.5) comp(f){ inside : I }\nI --> report("x", scope.sx) report("z", scope.sz)\n'
+    t = totals(run(write, text, [arm]))
+    assert (t["x_sum"], t["z_sum"]) == (pytest.approx(7), pytest.approx(2))
+
+
+def test_setback_of_an_edge_shorter_than_its_distance_reaches_the_kept_edge_beside_it(write):
+    """massing's terrace on the end of a narrow arm: edges 0 and 1 set back 4 m, edge 1 only 1.5 m long
+    and meeting the kept edge 2 at 81 degrees. Its strip ends where its end lines cross, and the two
+    strips cover the whole lot as PRT's terrace does (was: a sliver of remainder beside edge 2)."""
+    arm = [np.array([[10, 0], [0, 0], [0, -1.5], [10, -3]], float)]
+    text = ('Lot --> setback(comp(fe){ all : float(listItem("4;4;0;0", comp.index)) }) { all : T | remainder : R }\n'
+            'T --> report("t", geometry.area)\nR --> report("r", geometry.area)\n')
+    t = totals(run(write, text, [arm]))
+    assert t["t_sum"] == pytest.approx(22.5)
+    assert t.get("r_sum", 0.0) == pytest.approx(0.0, abs=1e-9)
+
+
 def test_offset_inside_of_a_rectangle_stays_a_box_path_rectangle(write):
     r = run(write, "Lot --> offset(-1, inside) extrude(2) X.\n", [rect(12, 8)])
     np.testing.assert_allclose(np.diagonal(np.abs(r["xform"][0, :, :3])), [10, 2, 6])
