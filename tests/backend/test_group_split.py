@@ -3,8 +3,8 @@
 Layouts are computed by hand from the kernel's rule (its docstring): fixed parts and floating parts outside
 groups keep their written sizes while the groups share what is left in proportion to one repetition's
 size, in order, each from what the earlier ones left; a group with floating parts repeats as often as
-brings the floating parts' stretch nearest 1 (at least once when room is left and no floating part outside
-the groups), a group of fixed sizes floor(share / repetition) times with the rest of its share left empty; then
+brings the floating parts' stretch nearest 1 (those outside the groups, the earlier groups' repetitions and
+its own; at least once when room is left and no floating part is laid before it), a group of fixed sizes floor(share / repetition) times with the rest of its share left empty; then
 one factor scales every floating size so that the parts fill the extent. A plain Python reference of the
 same rule checks random batches.
 """
@@ -150,6 +150,17 @@ def test_floating_repeat_groups_take_their_shares_in_order():
     assert thirty[5][1] == pytest.approx(14.96)
 
 
+def test_floating_repeat_group_after_one_that_rounded_up_stretches_its_floating_parts_too():
+    """candler's wide floor on a 17.21 m facade (the conformance case candler.convex.3084: corner walls of
+    1.811 m, tiles of 3.293 m) leaves 3.709 m, 1.13 repetitions, to the two groups. The first takes its
+    1.85 m share as one tile; the second would stretch that tile and its own to 0.56 of their size with a
+    repetition, to 1.13 without: PRT lays four tiles, not five."""
+    parts = [1.811, 3.293, "~3.293", 3.293, "~3.293", 3.293, 1.811]
+    got = layout(17.2103, parts, groups=[-1, -1, 0, -1, 1, -1, -1])
+    assert [p for p, *_ in got] == [0, 1, 2, 3, 5, 6]
+    assert got[2][2] == pytest.approx(17.2103 - 2 * 1.811 - 3 * 3.293)
+
+
 def test_floating_repeat_group_beside_a_floating_part_takes_the_count_nearest_its_size():
     """complexpatterns' facade, ~g | {~f}*: none or one repetition, whichever stretches every floating
     part nearer 1; PRT's threshold is where E / g - 1 = 1 - E / (g + f), 4 m for g = f = 3."""
@@ -256,7 +267,6 @@ def reference(extent, values, kind, group, n_groups, tol):
         nominal = [sum(s for s, g in zip(size, group) if g == gi) for gi in range(n_groups)]
         room = e - fixed
         avail = max(room - floating, 0.0)
-        loose = floating
         reps, gaps = [0] * n_groups, [0.0] * n_groups
         for gi in range(n_groups):
             if nominal[gi] <= tol:
@@ -265,7 +275,8 @@ def reference(extent, values, kind, group, n_groups, tol):
             members = [(s, k) for s, k, g in zip(size, kind, group) if g == gi]
             g_float = sum(s for s, k in members if k == FLT)
             if g_float > 0:
-                reps[gi] = stretch_nearest_one(share, nominal[gi], nominal[gi] - g_float, g_float, loose, tol)
+                reps[gi] = stretch_nearest_one(share, nominal[gi], nominal[gi] - g_float, g_float, floating,
+                                               tol)
                 avail = max(avail - reps[gi] * nominal[gi], 0.0)
             else:
                 reps[gi] = int(np.floor(share / nominal[gi] + 1e-9))

@@ -130,8 +130,10 @@ def group_split(extent, values, kind, group, n_groups, tol):
     come. A group with floating parts repeats as often as brings the floating parts nearest their
     written sizes (``_repetitions``) and uses that many repetitions' room. PRT lays candler's
     ``1 | 3.55 | {~3.55}* | 3.55 | {~3.55}* | 3.55 | 1`` with 3 then 2 repetitions on 30 m, 2 and 2 on
-    25 m, 1 and 1 on 20 m, 1 then 0 on 15 m, and ``{ ~w: A | d: B }* | ~w: A`` on an extent of w as one
-    A. A group of fixed sizes repeats floor(share / repetition) times, the rest of its share left empty
+    25 m, 1 and 1 on 20 m, 1 then 0 on 15 m and on 1.13 repetitions' room, and ``{ ~w: A | d: B }* | ~w: A``
+    on an extent of w as one A. The floating parts a group stretches along with its own are those outside
+    the groups and the repetitions of the groups before it, so that a group after one that rounded up
+    repeats only where that brings all of them nearer their sizes. A group of fixed sizes repeats floor(share / repetition) times, the rest of its share left empty
     at its end. Then every floating size, in groups or not, is scaled by one factor so that the parts
     fill the extent. Parts are laid end to end; parts beyond the extent are dropped, the last one cut;
     parts of length <= tol are dropped.
@@ -168,9 +170,7 @@ def group_split(extent, values, kind, group, n_groups, tol):
                     group_float[g] += size
                 else:
                     group_fixed[g] += size
-        room = extent[i] - fixed
-        avail = room - floating
-        loose = floating
+        avail = extent[i] - fixed - floating
         # the groups in order, each sharing what the earlier ones left with the later ones
         left = max(avail, 0.0)
         later = 0.0
@@ -182,7 +182,7 @@ def group_split(extent, values, kind, group, n_groups, tol):
             share = left * nominal[g] / later
             later -= nominal[g]
             if group_float[g] > 0.0:
-                r = _repetitions(share, nominal[g], group_fixed[g], group_float[g], loose, tol)
+                r = _repetitions(share, nominal[g], group_fixed[g], group_float[g], floating, tol)
                 left = max(left - r * nominal[g], 0.0)
             else:
                 r = int(np.floor(share / nominal[g] + 1e-9))
@@ -233,12 +233,13 @@ def _repetitions(share, nominal, fixed, floating, loose, tol):
     """How often a group with floating parts repeats in ``share``: the count that brings the floating
     parts nearest their written sizes, as the reference has a floating repeat come "closest" to them.
     With r repetitions every floating part, in the group (``floating`` of its ``nominal`` size, ``fixed``
-    the rest) or outside the groups (``loose``, their written size), stretches by
+    the rest) or already laid (``loose``, the written sizes of those outside the groups and of the earlier
+    groups' repetitions), stretches by
     (share + loose - r fixed) / (loose + r floating), which is 1 at r = share / nominal; of the counts
     either side, the one whose stretch is nearer 1 (the difference, not the ratio) wins. PRT's
     thresholds: ``{~f}*`` goes from r to r + 1 repetitions at 2r(r + 1) / (2r + 1) repetitions' room
     (4/3, 12/5, 24/7), complexpatterns' ``~g | {~f}*`` from none to one where E / g - 1 = 1 - E / (g + f).
-    Without floating parts outside the groups it repeats at least once where there is room."""
+    Without floating parts laid before it repeats at least once where there is room."""
     if share <= tol:
         return 0
     r = int(np.floor(share / nominal))
