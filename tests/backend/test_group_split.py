@@ -161,6 +161,13 @@ def test_floating_repeat_group_after_one_that_rounded_up_stretches_its_floating_
     assert got[2][2] == pytest.approx(17.2103 - 2 * 1.811 - 3 * 3.293)
 
 
+def test_floating_repeat_group_on_a_tie_takes_the_more_repetitions():
+    """The kit's rotated 25 x 15 lot with tiles of 3 m: the 15 m side leaves 4 m, 4/3 repetitions; the
+    second group stretches by 4/3 without a repetition and by 2/3 with one, and PRT lays one in each."""
+    parts, groups = [1, 3, "~3", 3, "~3", 3, 1], [-1, -1, 0, -1, 1, -1, -1]
+    assert [p for p, *_ in layout(15, parts, groups=groups)] == [0, 1, 2, 3, 4, 5, 6]
+
+
 def test_floating_repeat_group_beside_a_floating_part_takes_the_count_nearest_its_size():
     """complexpatterns' facade, ~g | {~f}*: none or one repetition, whichever stretches every floating
     part nearer 1; PRT's threshold is where E / g - 1 = 1 - E / (g + f), 4 m for g = f = 3."""
@@ -253,7 +260,7 @@ def stretch_nearest_one(share, nominal, g_fixed, g_float, loose, tol):
     def off(n):
         return abs((share + loose - n * g_fixed) / (loose + n * g_float) - 1)
 
-    return min(range(0 if loose > 0 else 1, int(share / nominal) + 3), key=off)
+    return min(reversed(range(0 if loose > 0 else 1, int(share / nominal) + 3)), key=off)
 
 
 def reference(extent, values, kind, group, n_groups, tol):

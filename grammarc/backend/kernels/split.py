@@ -248,7 +248,7 @@ def _repetitions(share, nominal, fixed, floating, loose, tol):
     room = share + loose
     below = abs((room - r * fixed) / (loose + r * floating) - 1.0)
     above = abs((room - (r + 1) * fixed) / (loose + (r + 1) * floating) - 1.0)
-    return r + 1 if above < below else r
+    return r + 1 if above < below + 1e-9 else r  # on a tie (4/3 repetitions' room) the more
 
 
 @njit(cache=True, nogil=True)
