@@ -101,6 +101,8 @@ def _cut_vertices(pieces: np.ndarray, limit: np.ndarray | None, across: np.ndarr
     reflex = real & (cross < -1e-9 * np.maximum(scale, TOL.zero))
     piece = segment_of(np.asarray(part_offsets, dtype=np.int64))[ring]
     candidates = np.flatnonzero(reflex)
+    if limit is None and len(candidates):  # only each piece's first reflex vertex is cut
+        candidates = candidates[np.r_[True, piece[candidates][1:] != piece[candidates][:-1]]]
     a = d_in[candidates] / np.hypot(d_in[candidates, 0], d_in[candidates, 1])[:, None]
     b = d_out[candidates] / np.hypot(d_out[candidates, 0], d_out[candidates, 1])[:, None]
     # a clear corner is cut along the line of one of its edges, the one whose run into the piece from the
@@ -114,8 +116,9 @@ def _cut_vertices(pieces: np.ndarray, limit: np.ndarray | None, across: np.ndarr
     along = sharp & ~across[piece[candidates]]
     edge = b.copy()
     if along.any():
-        owner, point = pieces[piece[candidates[along]]], coords[candidates[along]]
-        run_in, run_out = _run(owner, point, a[along]), _run(owner, point, -b[along])
+        owner, point = piece[candidates[along]], coords[candidates[along]]
+        run_in, run_out = np.split(_runs(pieces, np.r_[owner, owner], np.r_[point, point],
+                                         np.r_[a[along], -b[along]]), 2)
         shorter = run_in < run_out * (1.0 - 1e-9)
         edge[np.flatnonzero(along)[shorter]] = a[along][shorter]
     direction = np.where(along[:, None], edge, normal)
@@ -132,19 +135,22 @@ def _cut_vertices(pieces: np.ndarray, limit: np.ndarray | None, across: np.ndarr
     return vertex, chosen
 
 
-def _run(pieces: np.ndarray, point: np.ndarray, direction: np.ndarray) -> np.ndarray:
-    """How far the half-line from each piece's boundary ``point`` along ``direction`` runs inside before
-    it comes to the boundary again (0 where it does not run inside): the length of a cut from there. The
-    piece is taken shrunk by a hair, so that a line through one of its corners (an H's bar, cut along
-    its arms' inner edges) ends there and does not run on along the edge beyond."""
-    reach = _reach(pieces)
-    ray = shapely.linestrings(np.stack([point, point + direction * reach[:, None]], axis=1))
-    parts, index = shapely.get_parts(shapely.intersection(ray, shapely.buffer(pieces, -1e-9 * reach,
-                                                                              join_style="mitre")),
-                                     return_index=True)
+def _runs(pieces: np.ndarray, owner: np.ndarray, point: np.ndarray, direction: np.ndarray) -> np.ndarray:
+    """How far the half-line from each ``point`` (k, 2) on the boundary of ``pieces[owner]`` along
+    ``direction`` (k, 2) runs inside before it comes to the boundary again (0 where it does not run
+    inside): the length of a cut from there. The pieces are taken shrunk by a hair, so that a line
+    through one of their corners (an H's bar, cut along its arms' inner edges) ends there and does not
+    run on along the edge beyond."""
+    used = np.unique(owner)
+    reach = np.zeros(len(pieces))
+    reach[used] = _reach(pieces[used])
+    shrunk = np.empty(len(pieces), dtype=object)
+    shrunk[used] = shapely.buffer(pieces[used], -1e-9 * reach[used], join_style="mitre")
+    ray = shapely.linestrings(np.stack([point, point + direction * reach[owner][:, None]], axis=1))
+    parts, index = shapely.get_parts(shapely.intersection(ray, shrunk[owner]), return_index=True)
     line = (shapely.get_type_id(parts) == shapely.GeometryType.LINESTRING) & ~shapely.is_empty(parts)
     parts, index = parts[line], index[line]
-    length = np.full(len(pieces), np.inf)
+    length = np.full(len(owner), np.inf)
     np.minimum.at(length, index, shapely.distance(shapely.points(point[index]), parts) + shapely.length(parts))
     return np.where(np.isfinite(length), length, 0.0)
 
