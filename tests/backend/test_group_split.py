@@ -161,6 +161,15 @@ def test_floating_repeat_group_after_one_that_rounded_up_stretches_its_floating_
     assert got[2][2] == pytest.approx(17.2103 - 2 * 1.811 - 3 * 3.293)
 
 
+def test_floating_repeat_group_after_one_that_rounded_up_keeps_its_own_count():
+    """candler.L.7086's 27.66 m rear facade (corner walls of 1.582 m, tiles of 3.815 m) leaves 3.42
+    repetitions: the first group rounds its 1.71 up to 2, the second its 1.42 up to 2 as well (PRT lays
+    seven tiles), though the four repetitions stretch all tiles further from their size than three."""
+    parts = [1.582, 3.815, "~3.815", 3.815, "~3.815", 3.815, 1.582]
+    got = layout(27.66, parts, groups=[-1, -1, 0, -1, 1, -1, -1])
+    assert [p for p, *_ in got] == [0, 1, 2, 2, 3, 4, 4, 5, 6]
+
+
 def test_floating_repeat_group_on_a_tie_takes_the_more_repetitions():
     """The kit's rotated 25 x 15 lot with tiles of 3 m: the 15 m side leaves 4 m, 4/3 repetitions; the
     second group stretches by 4/3 without a repetition and by 2/3 with one, and PRT lays one in each."""
@@ -251,11 +260,13 @@ def test_values_per_shape_are_read_per_row():
     np.testing.assert_array_equal(index, [0, 1, 0, 1])
 
 
-def stretch_nearest_one(share, nominal, g_fixed, g_float, loose, tol):
+def stretch_nearest_one(share, nominal, g_fixed, g_float, loose, laid, tol):
     """The repetition count whose floating parts' stretch is nearest 1, by search over every count (none
-    only beside floating parts outside the groups)."""
+    only beside floating parts laid before; below one repetition's room those count with theirs)."""
     if share <= tol:
         return 0
+    if share < nominal:
+        loose = laid
 
     def off(n):
         return abs((share + loose - n * g_fixed) / (loose + n * g_float) - 1)
@@ -274,6 +285,7 @@ def reference(extent, values, kind, group, n_groups, tol):
         nominal = [sum(s for s, g in zip(size, group) if g == gi) for gi in range(n_groups)]
         room = e - fixed
         avail = max(room - floating, 0.0)
+        loose = floating
         reps, gaps = [0] * n_groups, [0.0] * n_groups
         for gi in range(n_groups):
             if nominal[gi] <= tol:
@@ -282,8 +294,8 @@ def reference(extent, values, kind, group, n_groups, tol):
             members = [(s, k) for s, k, g in zip(size, kind, group) if g == gi]
             g_float = sum(s for s, k in members if k == FLT)
             if g_float > 0:
-                reps[gi] = stretch_nearest_one(share, nominal[gi], nominal[gi] - g_float, g_float, floating,
-                                               tol)
+                reps[gi] = stretch_nearest_one(share, nominal[gi], nominal[gi] - g_float, g_float, loose,
+                                               floating, tol)
                 avail = max(avail - reps[gi] * nominal[gi], 0.0)
             else:
                 reps[gi] = int(np.floor(share / nominal[gi] + 1e-9))
