@@ -1,13 +1,15 @@
 """Convex parts of polygons with holes (CityEngine's ``convexify``), all polygons of a batch at once.
 
 Each round cuts every piece that still has a reflex vertex along a line through its first one: the line
-of the edge that leaves it (on one side the vertex becomes straight, on the other its angle drops
-below 180 degrees), or, where the corner turns by less than ``SHARP_DEGREES``, the line across the
-boundary (a cut along a nearly straight edge would shave off slivers). A cut never makes a reflex
-vertex, so the reflex vertices of a lineage strictly decrease. A hole's
-corners are reflex too, so holes are cut open. Rectilinear footprints come out as rectangles (an L in
-two, a U in three). The cut is the whole line through the piece: a concave piece may be cut in more
-places than the reflex vertex needs.
+of one of the two edges that meet there, the one that runs a shorter way into the piece from the
+vertex (on one side the vertex becomes straight, on the other its angle drops below 180 degrees), or,
+where the corner turns by less than ``SHARP_DEGREES``, the line across the boundary (a cut along a
+nearly straight edge would shave off slivers). A cut never makes a reflex vertex, so the reflex
+vertices of a lineage strictly decrease. A hole's corners are reflex too, so holes are cut open.
+Rectilinear footprints come out as rectangles (an L in two, a U in three) whose corners where a cut
+ends on an edge stay: PRT's pieces keep them, and ``geometry.isRectangular`` tells such a piece from a
+rectangle (candler's roofs). Each piece starts at the corner it was last cut at. The cut is the whole
+line through the piece: a concave piece may be cut in more places than the reflex vertex needs.
 
 A cut that only shaves off a sliver (below the area floor) is tried again across the boundary; if that
 fails too, the piece stays concave (about one piece in 10^4 on random star-shaped footprints).
@@ -64,6 +66,7 @@ def convex_parts(polygons: np.ndarray, max_length: np.ndarray | None = None) -> 
         done_source.append(source[given_up])
         retry = np.flatnonzero(stuck & ~across)
         parts, parent = parts[keep][~stuck[parent]], parent[~stuck[parent]]
+        parts = _starting_at(parts, vertex[parent])
         order = np.argsort(np.concatenate([parent, retry]), kind="stable")
         pieces = shapely.orient_polygons(np.concatenate([parts, pieces[retry]])[order], exterior_cw=False)
         across = np.concatenate([np.zeros(len(parts), dtype=bool), np.ones(len(retry), dtype=bool)])[order]
@@ -98,16 +101,27 @@ def _cut_vertices(pieces: np.ndarray, limit: np.ndarray | None, across: np.ndarr
     reflex = real & (cross < -1e-9 * np.maximum(scale, TOL.zero))
     piece = segment_of(np.asarray(part_offsets, dtype=np.int64))[ring]
     candidates = np.flatnonzero(reflex)
+    if limit is None and len(candidates):  # only each piece's first reflex vertex is cut
+        candidates = candidates[np.r_[True, piece[candidates][1:] != piece[candidates][:-1]]]
     a = d_in[candidates] / np.hypot(d_in[candidates, 0], d_in[candidates, 1])[:, None]
     b = d_out[candidates] / np.hypot(d_out[candidates, 0], d_out[candidates, 1])[:, None]
-    # a clear corner is cut along its outgoing edge (rectilinear footprints into rectangles, as PRT's
-    # candler roofs show: an L into two 10 m arms); a nearly
-    # straight one across the boundary, which no edge's line runs close to
+    # a clear corner is cut along the line of one of its edges, the one whose run into the piece from the
+    # corner is shorter (PRT's candler roofs: an H's bar, a Z's middle and a U's arms come out as
+    # rectangles, the rest keeping the cut's ends); the outgoing edge's on a tie (an L into two 10 m
+    # arms). A nearly straight corner is cut across the boundary, which no edge's line runs close to.
     sharp = (a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0]) < -np.sin(np.radians(SHARP_DEGREES))
     tangent = a + b
     normal = np.stack([-tangent[:, 1], tangent[:, 0]], axis=1)
     normal /= np.maximum(np.hypot(normal[:, 0], normal[:, 1]), 1e-300)[:, None]
-    direction = np.where((sharp & ~across[piece[candidates]])[:, None], b, normal)
+    along = sharp & ~across[piece[candidates]]
+    edge = b.copy()
+    if along.any():
+        owner, point = piece[candidates[along]], coords[candidates[along]]
+        run_in, run_out = np.split(_runs(pieces, np.r_[owner, owner], np.r_[point, point],
+                                         np.r_[a[along], -b[along]]), 2)
+        shorter = run_in < run_out * (1.0 - 1e-9)
+        edge[np.flatnonzero(along)[shorter]] = a[along][shorter]
+    direction = np.where(along[:, None], edge, normal)
     if limit is not None and len(candidates):
         chord = _chords(pieces[piece[candidates]], coords[candidates], direction)
         keep = chord < limit[piece[candidates]]
@@ -119,6 +133,26 @@ def _cut_vertices(pieces: np.ndarray, limit: np.ndarray | None, across: np.ndarr
     vertex[piece[candidates[first]]] = coords[candidates[first]]
     chosen[piece[candidates[first]]] = direction[first]
     return vertex, chosen
+
+
+def _runs(pieces: np.ndarray, owner: np.ndarray, point: np.ndarray, direction: np.ndarray) -> np.ndarray:
+    """How far the half-line from each ``point`` (k, 2) on the boundary of ``pieces[owner]`` along
+    ``direction`` (k, 2) runs inside before it comes to the boundary again (0 where it does not run
+    inside): the length of a cut from there. The pieces are taken shrunk by a hair, so that a line
+    through one of their corners (an H's bar, cut along its arms' inner edges) ends there and does not
+    run on along the edge beyond."""
+    used = np.unique(owner)
+    reach = np.zeros(len(pieces))
+    reach[used] = _reach(pieces[used])
+    shrunk = np.empty(len(pieces), dtype=object)
+    shrunk[used] = shapely.buffer(pieces[used], -1e-9 * reach[used], join_style="mitre")
+    ray = shapely.linestrings(np.stack([point, point + direction * reach[owner][:, None]], axis=1))
+    parts, index = shapely.get_parts(shapely.intersection(ray, shrunk[owner]), return_index=True)
+    line = (shapely.get_type_id(parts) == shapely.GeometryType.LINESTRING) & ~shapely.is_empty(parts)
+    parts, index = parts[line], index[line]
+    length = np.full(len(owner), np.inf)
+    np.minimum.at(length, index, shapely.distance(shapely.points(point[index]), parts) + shapely.length(parts))
+    return np.where(np.isfinite(length), length, 0.0)
 
 
 def _chords(pieces: np.ndarray, point: np.ndarray, direction: np.ndarray) -> np.ndarray:
@@ -134,8 +168,10 @@ def _chords(pieces: np.ndarray, point: np.ndarray, direction: np.ndarray) -> np.
 
 
 def _without_spikes(pieces: np.ndarray) -> np.ndarray:
-    """Pieces without repeated vertices and the vertices where the boundary runs straight on or turns
-    straight back (a cut along a line nearly collinear with an edge leaves such zero-width spikes)."""
+    """Pieces without repeated vertices and the vertices where the boundary turns straight back (a cut
+    along a line nearly collinear with an edge leaves such zero-width spikes). A vertex where it runs
+    straight on stays: where a cut ends on an edge, PRT's piece keeps the point as a corner (candler's
+    ``geometry.isRectangular`` is false for an arm whose side the cut of a bar ends on)."""
     if not len(pieces):
         return pieces
     _, coords, (ring_offsets, part_offsets) = shapely.to_ragged_array(pieces)
@@ -158,9 +194,11 @@ def _without_spikes(pieces: np.ndarray) -> np.ndarray:
         out_length = np.hypot(d_out[:, 0], d_out[:, 1])
         cross = d_in[:, 0] * d_out[:, 1] - d_in[:, 1] * d_out[:, 0]
         repeated = out_length <= 1e-9 * (1.0 + np.abs(coords).max(axis=1))
-        straight = repeated | (np.abs(cross) <= 1e-9 * np.hypot(d_in[:, 0], d_in[:, 1]) * out_length)
-        # never below a triangle; of two neighbours both straight, the first goes this time
-        drop = straight & (counts[ring] > 3) & ~(straight[prev] & (prev != at) & (at > start))
+        back = (np.abs(cross) <= 1e-9 * np.hypot(d_in[:, 0], d_in[:, 1]) * out_length) & (
+            d_in[:, 0] * d_out[:, 0] + d_in[:, 1] * d_out[:, 1] <= 0.0)
+        spike = repeated | back
+        # never below a triangle; of two neighbours both spikes, the first goes this time
+        drop = spike & (counts[ring] > 3) & ~(spike[prev] & (prev != at) & (at > start))
         if not drop.any():
             break
         coords, ring = coords[~drop], ring[~drop]
@@ -171,6 +209,29 @@ def _without_spikes(pieces: np.ndarray) -> np.ndarray:
     order = order[np.argsort(np.concatenate([ring, np.arange(n_rings)]), kind="stable")]
     return shapely.from_ragged_array(shapely.GeometryType.POLYGON, coords[order],
                                      (np.r_[0, np.cumsum(counts + 1)], part_offsets))
+
+
+def _starting_at(pieces: np.ndarray, point: np.ndarray) -> np.ndarray:
+    """Pieces (k,) whose outer rings start at their vertex nearest ``point`` (k, 2), the corner they
+    were cut at: PRT's pieces start there (the scope of candler's roof parts lies along the edge that
+    leaves the cut corner)."""
+    if not len(pieces):
+        return pieces
+    _, coords, (ring_offsets, part_offsets) = shapely.to_ragged_array(pieces)
+    coords = np.asarray(coords)[:, :2].copy()
+    ring_offsets = np.asarray(ring_offsets, dtype=np.int64)
+    outer = np.asarray(part_offsets, dtype=np.int64)[:-1]
+    start, stop = ring_offsets[outer], ring_offsets[outer + 1] - 1  # open rings: without the closing point
+    length = stop - start
+    open_offsets = np.r_[0, np.cumsum(length)]
+    ring = segment_of(open_offsets)
+    at = np.arange(open_offsets[-1]) + (start - open_offsets[:-1])[ring]
+    distance = np.hypot(*(coords[at] - point[ring]).T)
+    order = np.lexsort((distance, ring))
+    shift = at[order][open_offsets[:-1]] - start
+    coords[at] = coords[start[ring] + (at - start[ring] + shift[ring]) % length[ring]]
+    coords[stop] = coords[start]
+    return shapely.from_ragged_array(shapely.GeometryType.POLYGON, coords, (ring_offsets, part_offsets))
 
 
 def _reach(pieces: np.ndarray) -> np.ndarray:

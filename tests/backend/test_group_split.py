@@ -3,8 +3,8 @@
 Layouts are computed by hand from the kernel's rule (its docstring): fixed parts and floating parts outside
 groups keep their written sizes while the groups share what is left in proportion to one repetition's
 size, in order, each from what the earlier ones left; a group with floating parts repeats as often as
-brings the floating parts' stretch nearest 1 (at least once when room is left and no floating part outside
-the groups), a group of fixed sizes floor(share / repetition) times with the rest of its share left empty; then
+brings the floating parts' stretch nearest 1 (those outside the groups, the earlier groups' repetitions and
+its own; at least once when room is left and no floating part is laid before it), a group of fixed sizes floor(share / repetition) times with the rest of its share left empty; then
 one factor scales every floating size so that the parts fill the extent. A plain Python reference of the
 same rule checks random batches.
 """
@@ -150,6 +150,33 @@ def test_floating_repeat_groups_take_their_shares_in_order():
     assert thirty[5][1] == pytest.approx(14.96)
 
 
+def test_floating_repeat_group_after_one_that_rounded_up_stretches_its_floating_parts_too():
+    """candler's wide floor on a 17.21 m facade (the conformance case candler.convex.3084: corner walls of
+    1.811 m, tiles of 3.293 m) leaves 3.709 m, 1.13 repetitions, to the two groups. The first takes its
+    1.85 m share as one tile; the second would stretch that tile and its own to 0.56 of their size with a
+    repetition, to 1.13 without: PRT lays four tiles, not five."""
+    parts = [1.811, 3.293, "~3.293", 3.293, "~3.293", 3.293, 1.811]
+    got = layout(17.2103, parts, groups=[-1, -1, 0, -1, 1, -1, -1])
+    assert [p for p, *_ in got] == [0, 1, 2, 3, 5, 6]
+    assert got[2][2] == pytest.approx(17.2103 - 2 * 1.811 - 3 * 3.293)
+
+
+def test_floating_repeat_group_after_one_that_rounded_up_keeps_its_own_count():
+    """candler.L.7086's 27.66 m rear facade (corner walls of 1.582 m, tiles of 3.815 m) leaves 3.42
+    repetitions: the first group rounds its 1.71 up to 2, the second its 1.42 up to 2 as well (PRT lays
+    seven tiles), though the four repetitions stretch all tiles further from their size than three."""
+    parts = [1.582, 3.815, "~3.815", 3.815, "~3.815", 3.815, 1.582]
+    got = layout(27.66, parts, groups=[-1, -1, 0, -1, 1, -1, -1])
+    assert [p for p, *_ in got] == [0, 1, 2, 2, 3, 4, 4, 5, 6]
+
+
+def test_floating_repeat_group_on_a_tie_takes_the_more_repetitions():
+    """The kit's rotated 25 x 15 lot with tiles of 3 m: the 15 m side leaves 4 m, 4/3 repetitions; the
+    second group stretches by 4/3 without a repetition and by 2/3 with one, and PRT lays one in each."""
+    parts, groups = [1, 3, "~3", 3, "~3", 3, 1], [-1, -1, 0, -1, 1, -1, -1]
+    assert [p for p, *_ in layout(15, parts, groups=groups)] == [0, 1, 2, 3, 4, 5, 6]
+
+
 def test_floating_repeat_group_beside_a_floating_part_takes_the_count_nearest_its_size():
     """complexpatterns' facade, ~g | {~f}*: none or one repetition, whichever stretches every floating
     part nearer 1; PRT's threshold is where E / g - 1 = 1 - E / (g + f), 4 m for g = f = 3."""
@@ -233,16 +260,18 @@ def test_values_per_shape_are_read_per_row():
     np.testing.assert_array_equal(index, [0, 1, 0, 1])
 
 
-def stretch_nearest_one(share, nominal, g_fixed, g_float, loose, tol):
+def stretch_nearest_one(share, nominal, g_fixed, g_float, loose, laid, tol):
     """The repetition count whose floating parts' stretch is nearest 1, by search over every count (none
-    only beside floating parts outside the groups)."""
+    only beside floating parts laid before; below one repetition's room those count with theirs)."""
     if share <= tol:
         return 0
+    if share < nominal:
+        loose = laid
 
     def off(n):
         return abs((share + loose - n * g_fixed) / (loose + n * g_float) - 1)
 
-    return min(range(0 if loose > 0 else 1, int(share / nominal) + 3), key=off)
+    return min(reversed(range(0 if loose > 0 else 1, int(share / nominal) + 3)), key=off)
 
 
 def reference(extent, values, kind, group, n_groups, tol):
@@ -265,7 +294,8 @@ def reference(extent, values, kind, group, n_groups, tol):
             members = [(s, k) for s, k, g in zip(size, kind, group) if g == gi]
             g_float = sum(s for s, k in members if k == FLT)
             if g_float > 0:
-                reps[gi] = stretch_nearest_one(share, nominal[gi], nominal[gi] - g_float, g_float, loose, tol)
+                reps[gi] = stretch_nearest_one(share, nominal[gi], nominal[gi] - g_float, g_float, loose,
+                                               floating, tol)
                 avail = max(avail - reps[gi] * nominal[gi], 0.0)
             else:
                 reps[gi] = int(np.floor(share / nominal[gi] + 1e-9))

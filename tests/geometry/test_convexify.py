@@ -32,6 +32,37 @@ def test_rectilinear_footprints_become_rectangles(polygon, areas):
     assert np.allclose(shapely.area(shapely.oriented_envelope(pieces)), shapely.area(pieces))
 
 
+def corners(piece):
+    return len(piece.exterior.coords) - 1
+
+
+def test_a_corner_is_cut_along_the_edge_whose_run_into_the_piece_is_shorter():
+    """PRT's candler roofs (one ventilation, on the rectangles of 4 corners only): an H whose bar is
+    narrower than its arms is cut across the bar's ends, along the arms' inner edges, into the bar and
+    two arms that keep the cuts' ends as corners; a Z's middle likewise; a U deeper than its arms are
+    wide is cut below its arms (the kit's U: two ventilations, on the arms)."""
+    h = shapely.Polygon([(0, 0), (4, 0), (4, 3.5), (8, 3.5), (8, 0), (12, 0), (12, 10), (8, 10), (8, 6.5),
+                         (4, 6.5), (4, 10), (0, 10)])
+    pieces, _ = convex_parts(np.array([h]))
+    assert sorted(shapely.area(pieces).round(9)) == [12, 40, 40]
+    assert sorted(corners(p) for p in pieces) == [4, 6, 6]
+    z = shapely.Polygon([(0, 0), (10, 0), (10, 10), (28, 10), (28, 25), (18, 25), (18, 15), (0, 15)])
+    pieces, _ = convex_parts(np.array([z]))
+    assert sorted(zip(shapely.area(pieces).round(9), (corners(p) for p in pieces))) == [(40, 4), (150, 5),
+                                                                                         (150, 5)]
+    pieces, _ = convex_parts(np.array([shapely.Polygon([(0, 0), (40, 0), (40, 30), (30, 30), (30, 15), (10, 15),
+                                                       (10, 30), (0, 30)])]))
+    assert sorted(zip(shapely.area(pieces).round(9), (corners(p) for p in pieces))) == [(150, 4), (150, 4),
+                                                                                         (600, 6)]
+
+
+def test_pieces_start_at_the_corner_they_were_cut_at():
+    """The scope of a part lies along the edge from that corner (the kit's L: PRT's ventilation on the
+    20 m arm runs along it)."""
+    pieces, _ = convex_parts(np.array([L_SHAPE]))
+    assert all(p.exterior.coords[0] == (10, 10) for p in pieces)
+
+
 def test_split_lines_longer_than_max_length_are_not_cut():
     # the split lines at the L's and the U's inner corners cross their 10 m deep foot
     _, source = convex_parts(np.array([L_SHAPE, U_SHAPE, L_SHAPE, U_SHAPE]), np.array([5.0, 8.0, 12.0, 12.0]))

@@ -130,9 +130,9 @@ def group_split(extent, values, kind, group, n_groups, tol):
     come. A group with floating parts repeats as often as brings the floating parts nearest their
     written sizes (``_repetitions``) and uses that many repetitions' room. PRT lays candler's
     ``1 | 3.55 | {~3.55}* | 3.55 | {~3.55}* | 3.55 | 1`` with 3 then 2 repetitions on 30 m, 2 and 2 on
-    25 m, 1 and 1 on 20 m, 1 then 0 on 15 m, and ``{ ~w: A | d: B }* | ~w: A`` on an extent of w as one
-    A. A group of fixed sizes repeats floor(share / repetition) times, the rest of its share left empty
-    at its end. Then every floating size, in groups or not, is scaled by one factor so that the parts
+    25 m and on 3.42 repetitions' room, 1 and 1 on 20 m and on 4/3 repetitions' room, 1 then 0 on 15 m
+    and on 1.13 repetitions' room, and ``{ ~w: A | d: B }* | ~w: A`` on an extent of w as one A. A group
+    of fixed sizes repeats floor(share / repetition) times, the rest of its share left empty at its end. Then every floating size, in groups or not, is scaled by one factor so that the parts
     fill the extent. Parts are laid end to end; parts beyond the extent are dropped, the last one cut;
     parts of length <= tol are dropped.
 
@@ -168,8 +168,7 @@ def group_split(extent, values, kind, group, n_groups, tol):
                     group_float[g] += size
                 else:
                     group_fixed[g] += size
-        room = extent[i] - fixed
-        avail = room - floating
+        avail = extent[i] - fixed - floating
         loose = floating
         # the groups in order, each sharing what the earlier ones left with the later ones
         left = max(avail, 0.0)
@@ -182,7 +181,7 @@ def group_split(extent, values, kind, group, n_groups, tol):
             share = left * nominal[g] / later
             later -= nominal[g]
             if group_float[g] > 0.0:
-                r = _repetitions(share, nominal[g], group_fixed[g], group_float[g], loose, tol)
+                r = _repetitions(share, nominal[g], group_fixed[g], group_float[g], loose, floating, tol)
                 left = max(left - r * nominal[g], 0.0)
             else:
                 r = int(np.floor(share / nominal[g] + 1e-9))
@@ -229,25 +228,30 @@ def group_split(extent, values, kind, group, n_groups, tol):
 
 
 @njit(cache=True, nogil=True)
-def _repetitions(share, nominal, fixed, floating, loose, tol):
+def _repetitions(share, nominal, fixed, floating, loose, laid, tol):
     """How often a group with floating parts repeats in ``share``: the count that brings the floating
     parts nearest their written sizes, as the reference has a floating repeat come "closest" to them.
     With r repetitions every floating part, in the group (``floating`` of its ``nominal`` size, ``fixed``
     the rest) or outside the groups (``loose``, their written size), stretches by
     (share + loose - r fixed) / (loose + r floating), which is 1 at r = share / nominal; of the counts
-    either side, the one whose stretch is nearer 1 (the difference, not the ratio) wins. PRT's
-    thresholds: ``{~f}*`` goes from r to r + 1 repetitions at 2r(r + 1) / (2r + 1) repetitions' room
-    (4/3, 12/5, 24/7), complexpatterns' ``~g | {~f}*`` from none to one where E / g - 1 = 1 - E / (g + f).
-    Without floating parts outside the groups it repeats at least once where there is room."""
+    either side, the one whose stretch is nearer 1 (the difference, not the ratio) wins, the more on a
+    tie. PRT's thresholds: ``{~f}*`` goes from r to r + 1 repetitions at 2r(r + 1) / (2r + 1)
+    repetitions' room (4/3, 12/5, 24/7), complexpatterns' ``~g | {~f}*`` from none to one where
+    E / g - 1 = 1 - E / (g + f). A share of less than one repetition gives one where no floating part was
+    laid before the group; where some were (``laid``: those outside the groups and the earlier groups'
+    repetitions), one only if that stretches them and the group's own nearer 1 than none: candler's
+    second tile group takes none of 0.13 repetitions' room after the first took one (PRT)."""
     if share <= tol:
         return 0
     r = int(np.floor(share / nominal))
-    if r == 0 and loose <= 0.0:
-        return 1
+    if r == 0:
+        if laid <= 0.0:
+            return 1
+        loose = laid
     room = share + loose
     below = abs((room - r * fixed) / (loose + r * floating) - 1.0)
     above = abs((room - (r + 1) * fixed) / (loose + (r + 1) * floating) - 1.0)
-    return r + 1 if above < below else r
+    return r + 1 if above < below + 1e-9 else r
 
 
 @njit(cache=True, nogil=True)
