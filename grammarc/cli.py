@@ -11,7 +11,9 @@ import argparse
 import gc
 import math
 import os
+import signal
 import sys
+import threading
 from collections import Counter
 from dataclasses import replace
 from pathlib import Path
@@ -26,6 +28,20 @@ _START_HELP = ("the start rule (default: @StartRule, else the first rule); a cal
 _WARNINGS_HELP = "treat the grammar's warnings as errors: exit 2, nothing written"
 
 
+class Stopped(KeyboardInterrupt):
+    """SIGTERM or SIGHUP (what ``timeout``, docker, systemd, Slurm and a closed terminal send), raised where
+    the program is, so that it unwinds as from Ctrl-C: writers abort, temporary files and the workers'
+    shared memory go, the pool's workers end."""
+
+    def __init__(self, signum: int):
+        super().__init__(signum)
+        self.signum = signum
+
+
+def _stop(signum, frame) -> None:
+    raise Stopped(signum)
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = _parser()
     args = parser.parse_args(argv)
@@ -33,6 +49,8 @@ def main(argv: list[str] | None = None) -> int:
     # (README, "Figures"). ``build.derive_all`` turns it on while chunks are derived.
     collecting = gc.isenabled()
     gc.disable()
+    handlers = {s: signal.signal(s, _stop) for s in (signal.SIGTERM, signal.SIGHUP)} \
+        if threading.current_thread() is threading.main_thread() else {}
     try:
         return args.run(args)
     except GrammarError as error:
@@ -43,6 +61,9 @@ def main(argv: list[str] | None = None) -> int:
     except GrammarcError as error:
         print(f"grammarc: error: {error}", file=sys.stderr)
         return error.exit_code
+    except Stopped as stop:
+        print(f"grammarc: {signal.Signals(stop.signum).name}: stopped; nothing was written", file=sys.stderr)
+        return 128 + stop.signum
     except KeyboardInterrupt:
         print("grammarc: interrupted; nothing was written", file=sys.stderr)
         return 130
@@ -51,6 +72,8 @@ def main(argv: list[str] | None = None) -> int:
         os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
         return 0
     finally:
+        for signum, handler in handlers.items():
+            signal.signal(signum, handler)
         if collecting:
             gc.enable()
 

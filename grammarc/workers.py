@@ -22,6 +22,8 @@ import itertools
 import multiprocessing
 import os
 import shutil
+import signal
+import sys
 import tempfile
 from collections.abc import Callable
 from concurrent.futures import Future, ProcessPoolExecutor
@@ -59,7 +61,8 @@ def worker_pool(work: Callable, workers: int):
     folder = Path(tempfile.mkdtemp(prefix="grammarc-records-", dir=memory))
     _SHARED.update(work=work, folder=folder)
     try:
-        with ProcessPoolExecutor(workers, mp_context=multiprocessing.get_context("fork")) as pool:
+        with ProcessPoolExecutor(workers, mp_context=multiprocessing.get_context("fork"),
+                                 initializer=_die_with_parent) as pool:
             def submit(lots) -> Future:
                 shipped = pool.submit(_run, lots)
                 received: Future = Future()
@@ -70,6 +73,20 @@ def worker_pool(work: Callable, workers: int):
     finally:
         _SHARED.clear()
         shutil.rmtree(folder, ignore_errors=True)
+
+
+def _die_with_parent() -> None:
+    """In a new worker: the kernel kills it when the parent dies however it dies (Linux's
+    ``PR_SET_PDEATHSIG``; a SIGKILL of the parent runs no code of ours), and SIGTERM and SIGHUP end it
+    as by default rather than unwind it as they do the parent (``cli.Stopped``)."""
+    signal.signal(signal.SIGTERM, signal.SIG_DFL)
+    signal.signal(signal.SIGHUP, signal.SIG_DFL)
+    if sys.platform.startswith("linux"):
+        import ctypes
+
+        ctypes.CDLL(None, use_errno=True).prctl(1, signal.SIGKILL)  # 1: PR_SET_PDEATHSIG
+        if os.getppid() == 1:  # the parent died before the call: go now
+            os._exit(1)
 
 
 def _run(lots):

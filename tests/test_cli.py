@@ -3,6 +3,11 @@
 from __future__ import annotations
 
 import json
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -296,3 +301,40 @@ def test_a_cycle_of_attributes_is_an_error_not_a_crash(write, tmp_path, capsys):
     grammar = write("g.cga", 'version "2022.0"\nattr a = b\nattr b = a\n@StartRule\nLot --> extrude(a) X\n')
     assert main(["build", str(grammar), "--emit", str(tmp_path / "out.npz")]) == 2
     assert "attribute `a` has no value: its default uses itself (attr a -> b -> a)" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("signum", [signal.SIGTERM, signal.SIGHUP])
+def test_sigterm_and_sighup_stop_a_build_as_ctrl_c_does(tmp_path, signum):
+    """What `timeout`, docker, systemd and Slurm send: the build unwinds, exits 128 + the signal, and leaves
+    no output, no temporary folder, no shared memory and no worker process behind."""
+    lots = [[[[x * 25, y * 25], [x * 25 + 20, y * 25], [x * 25 + 20, y * 25 + 15], [x * 25, y * 25 + 15]]]
+            for x in range(120) for y in range(100)]
+    geojson(tmp_path / "lots.geojson", lots)
+    shm = Path("/dev/shm")
+    before = set(shm.glob("grammarc-records-*")) if shm.is_dir() else set()
+    out = tmp_path / "out" / "city.npz"
+    out.parent.mkdir()
+    grammar = Path(__file__).resolve().parents[1] / "benchmarks" / "facade.cga"
+    build = subprocess.Popen([sys.executable, "-m", "grammarc.cli", "build", str(grammar), "--lots",
+                              str(tmp_path / "lots.geojson"), "--emit", str(out), "--workers", "2", "--quiet"],
+                             stderr=subprocess.PIPE, text=True)
+    deadline = time.monotonic() + 120
+    while not list(out.parent.glob(".city.npz.tmp*")) and build.poll() is None and time.monotonic() < deadline:
+        time.sleep(0.05)
+    assert build.poll() is None, "the build ended before it could be stopped"
+    time.sleep(0.5)  # into the derivation
+    build.send_signal(signum)
+    _, err = build.communicate(timeout=120)
+    assert build.returncode == 128 + signum
+    assert err.endswith(f"grammarc: {signal.Signals(signum).name}: stopped; nothing was written\n")
+    assert list(out.parent.iterdir()) == []
+    assert (set(shm.glob("grammarc-records-*")) if shm.is_dir() else set()) <= before
+    left = [p for p in Path("/proc").glob("[0-9]*") if _cmdline(p).find(str(out)) >= 0]
+    assert left == []
+
+
+def _cmdline(process: Path) -> str:
+    try:
+        return (process / "cmdline").read_bytes().decode(errors="replace")
+    except OSError:  # gone meanwhile
+        return ""
