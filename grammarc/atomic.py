@@ -12,7 +12,34 @@ import shutil
 import tempfile
 from pathlib import Path
 
-__all__ = ["replacing"]
+__all__ = ["private_folder", "remove_stale", "replacing"]
+
+
+def private_folder(path: Path) -> str:
+    """A new private folder beside ``path`` for the temporary files of its writing (the same filesystem,
+    for the rename): ``.<name>.tmp<pid>-<random>``. The folders that runs which died (a SIGKILL, a power
+    cut: their process is gone) left for the same output are removed first."""
+    path = Path(path)
+    remove_stale(path.parent, f".{path.name}.tmp")
+    return tempfile.mkdtemp(prefix=f".{path.name}.tmp{os.getpid()}-", dir=path.parent)
+
+
+def remove_stale(folder: Path, prefix: str) -> None:
+    """Remove the entries ``<prefix><pid>-...`` of ``folder`` whose process ``pid`` no longer runs."""
+    for entry in Path(folder).glob(f"{prefix}*-*"):
+        pid = entry.name[len(prefix):].split("-", 1)[0]
+        if pid.isdigit() and not _running(int(pid)):
+            shutil.rmtree(entry, ignore_errors=True)
+
+
+def _running(pid: int) -> bool:
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except PermissionError:  # another user's: alive
+        return True
+    return True
 
 
 @contextlib.contextmanager
@@ -21,7 +48,7 @@ def replacing(path: Path):
     (the same filesystem, for the rename; the umask's permissions, which ``mkstemp`` would not give; the
     suffix kept, for writers that pick a format by it). When the block ends the file is fsynced and moved
     onto ``path``; the folder goes whatever happens, so a failed write leaves ``path`` as it was."""
-    folder = tempfile.mkdtemp(prefix=f".{path.name}.tmp", dir=path.parent)
+    folder = private_folder(path)
     try:
         tmp = Path(folder) / path.name
         yield tmp

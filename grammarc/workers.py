@@ -31,6 +31,8 @@ from pathlib import Path
 
 import numpy as np
 
+from grammarc.atomic import remove_stale
+
 __all__ = ["worker_pool"]
 
 #: What the workers run, set in the parent before they are forked: ``work``, the shipping folder.
@@ -58,7 +60,9 @@ def worker_pool(work: Callable, workers: int):
         yield at_once
         return
     memory = "/dev/shm" if os.path.isdir("/dev/shm") and os.access("/dev/shm", os.W_OK) else None
-    folder = Path(tempfile.mkdtemp(prefix="grammarc-records-", dir=memory))
+    shared = Path(memory if memory is not None else tempfile.gettempdir())
+    remove_stale(shared, "grammarc-records-")  # what builds that were killed left
+    folder = Path(tempfile.mkdtemp(prefix=f"grammarc-records-{os.getpid()}-", dir=shared))
     _SHARED.update(work=work, folder=folder)
     try:
         with ProcessPoolExecutor(workers, mp_context=multiprocessing.get_context("fork"),

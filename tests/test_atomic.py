@@ -24,3 +24,23 @@ def test_a_failed_write_leaves_the_file_as_it_was(tmp_path):
         tmp.write_text("half")
         raise RuntimeError("the writer failed")
     assert path.read_text() == "old" and [p.name for p in tmp_path.iterdir()] == ["city.png"]
+
+
+#: Above Linux's largest process id (2^22): never a running process.
+GONE = 4_194_305
+
+
+def test_the_temporary_folders_of_dead_runs_go_at_the_next_run(tmp_path):
+    import os
+
+    from grammarc.atomic import private_folder
+
+    dead = tmp_path / f".city.npz.tmp{GONE}-abc"
+    alive = tmp_path / f".city.npz.tmp{os.getpid()}-def"
+    other = tmp_path / f".town.npz.tmp{GONE}-ghi"  # another output's: not this one's to judge
+    for folder in (dead, alive, other):
+        folder.mkdir()
+        (folder / "part").write_bytes(b"x")
+    new = private_folder(tmp_path / "city.npz")
+    assert not dead.exists() and alive.exists() and other.exists()
+    assert new.startswith(str(tmp_path / f".city.npz.tmp{os.getpid()}-"))

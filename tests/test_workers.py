@@ -31,3 +31,18 @@ def test_a_limit_reached_in_a_worker_stops_the_build(write):
     lots = lots_from_polygons([[np.array([[0, 0], [10, 0], [10, 10], [0, 10]], float)]] * 4)
     with pytest.raises(LimitError, match="max-depth"):
         derive(grammar, lots, BuildOptions(workers=2, chunk_size=1))
+
+
+def test_a_pool_removes_the_shared_memory_that_killed_builds_left():
+    import tempfile
+    from pathlib import Path
+
+    from grammarc.workers import worker_pool
+
+    shared = Path("/dev/shm") if Path("/dev/shm").is_dir() else Path(tempfile.gettempdir())
+    stale = shared / "grammarc-records-4194305-zz"  # above Linux's largest pid: a dead run's
+    stale.mkdir(exist_ok=True)
+    (stale / "0.bin").write_bytes(b"records")
+    with worker_pool(lambda lots: ([], []), 2) as submit:
+        assert not stale.exists()
+        assert submit([]).result() == ([], [])

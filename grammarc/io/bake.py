@@ -32,7 +32,6 @@ from __future__ import annotations
 
 import os
 import shutil
-import tempfile
 from collections.abc import Mapping, Sequence
 from dataclasses import replace
 from pathlib import Path
@@ -40,6 +39,7 @@ from typing import ClassVar
 
 import numpy as np
 
+from grammarc.atomic import private_folder
 from grammarc.constants import LIMITS
 from grammarc.errors import UsageError
 from grammarc.geometry.triangulation import triangulate_polygons
@@ -505,7 +505,7 @@ class BakedWriter(WriterBlock):
     def _open_file(self) -> None:
         """The output's file, in a private directory next to it (same filesystem, for the rename), with
         the umask's permissions as the npz writer's output has (mkstemp would give 0600)."""
-        self._tmpdir = tempfile.mkdtemp(prefix=f".{self.path.name}.tmp", dir=self.path.parent)
+        self._tmpdir = private_folder(self.path)
         self._file = open(os.path.join(self._tmpdir, self.path.name), "xb")  # noqa: SIM115 - closed by close/abort
 
     @property

@@ -25,7 +25,6 @@ from __future__ import annotations
 import math
 import os
 import shutil
-import tempfile
 from collections.abc import Sequence
 from pathlib import Path
 from typing import ClassVar
@@ -33,7 +32,7 @@ from typing import ClassVar
 import numpy as np
 import orjson
 
-from grammarc.atomic import replacing
+from grammarc.atomic import private_folder, replacing
 from grammarc.errors import UsageError
 from grammarc.io import WriterBlock
 from grammarc.io.bake import MAX_TRIANGLES, bake_mesh, mesh_triangles
@@ -84,7 +83,7 @@ class CityJsonWriter(WriterBlock):
             int(os.environ.get("GRAMMARC_MAX_TRIANGLES", MAX_TRIANGLES))
         self._names = _building_names(lots)
         self._attributes = _attribute_rows(lots)
-        self._tmp = Path(tempfile.mkdtemp(prefix=f".{self.path.name}.tmp", dir=self.path.parent))
+        self._tmp = Path(private_folder(self.path))
         self._objects = open(self._tmp / "objects.json", "wb")  # noqa: SIM115 - closed by close/abort
         self._vertices = open(self._tmp / "vertices.bin", "wb")  # noqa: SIM115
         self._n_vertices = 0

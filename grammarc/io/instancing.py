@@ -24,7 +24,6 @@ from __future__ import annotations
 
 import os
 import shutil
-import tempfile
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -32,6 +31,7 @@ from pathlib import Path
 import numba as nb
 import numpy as np
 
+from grammarc.atomic import private_folder
 from grammarc.constants import LIMITS
 from grammarc.geometry.triangulation import triangulate_polygons
 from grammarc.io import WriterBlock
@@ -293,7 +293,7 @@ class TiledWriter(WriterBlock):
         self.path = Path(path)
         self._meta = dict(meta)
         self._library = asset_library(assets, {"meta": self._meta}, asset_roots, lod=lod)
-        self._tmp = Path(tempfile.mkdtemp(prefix=f".{self.path.name}.tmp", dir=self.path.parent))
+        self._tmp = Path(private_folder(self.path))
         (self._tmp / "spool").mkdir()
         self._spool = TileSpool(self._tmp / "spool", tile_size)
         self._used = np.zeros(len(self._library.names), np.int64)  # instances of each asset

@@ -41,7 +41,6 @@ import os
 import queue
 import shutil
 import struct
-import tempfile
 import threading
 import weakref
 import zipfile
@@ -54,6 +53,7 @@ import numpy as np
 # zlib's CRC-32 with SIMD (every record byte passes it), and its crc32_combine
 from zlib_ng.zlib_ng import crc32, crc32_combine
 
+from grammarc.atomic import private_folder
 from grammarc.errors import UsageError
 from grammarc.model.records import LotOrigins, MaterialTable, TerminalChunk
 
@@ -159,7 +159,7 @@ class InstanceWriter:
         self._origins: list[LotOrigins] | None = None
         self._counts: dict[str, int] = {}
         self._state = "open"
-        tmpdir = tempfile.mkdtemp(prefix=f".{self.path.name}.tmp", dir=self.path.parent)
+        tmpdir = private_folder(self.path)
         self._sink = _Sink(tmpdir, self.path.name)  # removes tmpdir itself if it fails
         # Stops the thread and removes the temporaries on abort(), after close(), or when a writer is dropped
         # unclosed. Neither the sink nor its thread refers to the writer, so a dropped writer is collected.
