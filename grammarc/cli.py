@@ -232,10 +232,10 @@ def _lots_options_arguments(command) -> None:
 def _lots_options(args):
     """The ``io.lot_format.LotsOptions`` of ``--lots-crs``, ``--crs``, ``--id-field`` and ``--min-area``;
     None without any."""
-    from grammarc.io.lot_format import LotsOptions
+    from grammarc.io.lot_format import NO_OPTIONS, LotsOptions
 
     options = LotsOptions(lots_crs=args.lots_crs, crs=args.crs, id_field=args.id_field, min_area=args.min_area)
-    return options if options != LotsOptions() else None
+    return options if options != NO_OPTIONS else None
 
 
 def _workspace_option(command) -> None:

@@ -52,7 +52,8 @@ from grammarc.model.assets import AssetLibrary, AssetMesh, asset_library
 from grammarc.model.records import LotOrigins, MaterialTable, MeshChunk, TerminalChunk, record_mesh
 from grammarc.ragged import offsets_from_counts, segment_of
 
-__all__ = ["MAX_TRIANGLES", "WRITERS", "BakedWriter", "bake", "bake_mesh", "count_triangles", "mesh_triangles"]
+__all__ = ["MAX_TRIANGLES", "WRITERS", "BakedWriter", "bake", "bake_mesh", "count_triangles", "made_triangles",
+           "mesh_triangles", "triangle_limit"]
 
 #: Default limit of ``bake`` (``constants.Limits.max_triangles``).
 MAX_TRIANGLES = LIMITS.max_triangles
@@ -69,8 +70,7 @@ def count_triangles(record: Mapping, asset_roots: Sequence[str | os.PathLike] | 
     triangles (V vertices in all rings, H holes), what earcut makes of a simple polygon.
     """
     names, asset, _, mesh, _ = _columns(record)
-    library = asset_library(names, record, asset_roots, lod)
-    return library.triangles(np.bincount(asset, minlength=len(names))) + mesh_triangles(mesh)
+    return made_triangles(asset_library(names, record, asset_roots, lod), asset, mesh)
 
 
 def bake(
@@ -120,11 +120,11 @@ def bake(
     """
     names, asset, xform, mesh, origins = _columns(record)
     return bake_mesh(asset_library(names, record, asset_roots), asset, xform, mesh, max_triangles,
-                 origins=origins, lot=record.get("lot"))[0]
+                     origins=origins, lot=record.get("lot"))[0]
 
 
 def bake_mesh(library: AssetLibrary, asset: np.ndarray, xform: np.ndarray, mesh: MeshChunk, max_triangles: int,
-          uv: np.ndarray | None = None, origins: LotOrigins | None = None, lot: np.ndarray | None = None):
+              uv: np.ndarray | None = None, origins: LotOrigins | None = None, lot: np.ndarray | None = None):
     """``bake`` of a record's columns, its assets in ``library``; and the source of each triangle (T,) int64:
     its instance's row, or ``len(asset)`` plus its face in the mesh table. The mesh has texture coordinates
     (0 where a vertex has none) where the instances' ``uv`` (``TerminalChunk.uv``) or the mesh table's are
@@ -229,6 +229,19 @@ def _add_counts(histogram: np.ndarray, sizes: np.ndarray, times: int) -> np.ndar
     return histogram
 
 
+def made_triangles(library: AssetLibrary, asset: np.ndarray, mesh: MeshChunk) -> int:
+    """The triangles a bake makes of instances of ``asset`` (N,) int of ``library`` and of ``mesh``, the mesh
+    table, counted without baking (the assets are loaded)."""
+    return library.triangles(np.bincount(asset, minlength=len(library.names))) + mesh_triangles(mesh)
+
+
+def triangle_limit(max_triangles: int | None) -> int:
+    """The most triangles a baked output may have: ``max_triangles``, else ``GRAMMARC_MAX_TRIANGLES``, else
+    ``MAX_TRIANGLES``."""
+    return max_triangles if max_triangles is not None else int(os.environ.get("GRAMMARC_MAX_TRIANGLES",
+                                                                              MAX_TRIANGLES))
+
+
 def mesh_triangles(mesh: MeshChunk) -> int:
     """Triangles of the mesh table's faces: V + 2R - 4F (each face V_f + 2 H_f - 2, R_f = H_f + 1)."""
     n_faces = len(mesh.face_offsets) - 1
@@ -316,9 +329,7 @@ class BakedWriter(WriterBlock):
         self._symbols = list(symbols)
         self._meta = dict(meta)
         self._library = asset_library(names, {"meta": self._meta}, asset_roots, lod)
-        if max_triangles is None:
-            max_triangles = int(os.environ.get("GRAMMARC_MAX_TRIANGLES", MAX_TRIANGLES))
-        self.max_triangles = max_triangles
+        self.max_triangles = triangle_limit(max_triangles)
         self._origin = None if bake_origin is None else np.asarray(bake_origin, np.float64).reshape(3)
         self._chunks: list[tuple[TerminalChunk, np.ndarray | None]] = []  # kept for close(), with their looks
         #: The record's materials, and the looks (``_looks``) met so far, each an OBJ material.
@@ -335,9 +346,12 @@ class BakedWriter(WriterBlock):
         if self._file_type == "obj":
             self._open_file()
             header = f"grammarc {self._meta.get('grammarc', '')} bake of {self._meta.get('grammar', '')}"
-            origin = "" if self._origin is None and not self._meta.get("crs") else \
-                f"# {_origin_text(self._origin if self._origin is not None else np.zeros(3), self._meta.get('crs'))}\n"
-            self._file.write(f"# {' '.join(header.split())}\n{origin}mtllib {self._mtl_path.name}\n".encode())
+            # an OBJ is in world coordinates unless --bake-origin moved it: it names an origin only then, or
+            # for its coordinate system
+            origin = self._origin if self._origin is not None else np.zeros(3)
+            named = f"# {_origin_text(origin, self._meta.get('crs'))}\n" \
+                if self._origin is not None or self._meta.get("crs") else ""
+            self._file.write(f"# {' '.join(header.split())}\n{named}mtllib {self._mtl_path.name}\n".encode())
 
     def write(self, chunk: TerminalChunk) -> None:
         """Bake a chunk into the OBJ, or keep it for ``close()`` (not copied: do not modify it).
@@ -359,8 +373,7 @@ class BakedWriter(WriterBlock):
         if len(asset) and (asset.min() < 0 or asset.max() >= len(self._library.names)):
             raise ValueError(f"TerminalChunk.asset: index out of range [0, {len(self._library.names)})")
         try:
-            used = np.bincount(asset, minlength=len(self._library.names))
-            triangles = self._library.triangles(used) + mesh_triangles(chunk.mesh)
+            triangles = made_triangles(self._library, asset, chunk.mesh)
             if self._triangles + triangles > self.max_triangles:
                 raise UsageError(
                     f"{self.path}: the baked mesh passes {self.max_triangles:,} triangles after "
@@ -371,7 +384,7 @@ class BakedWriter(WriterBlock):
             looks = self._looks(chunk)
             if self._file is not None:
                 mesh, source = bake_mesh(self._library, asset.astype(np.int64, copy=False), chunk.xform, chunk.mesh,
-                                     self.max_triangles, chunk.uv, chunk.origins, chunk.lot)
+                                         self.max_triangles, chunk.uv, chunk.origins, chunk.lot)
                 self._file.write(self._obj_groups(mesh, source, np.concatenate([chunk.lot, chunk.mesh.lot]), looks))
                 self._count(mesh, chunk.mesh)
             else:
@@ -470,7 +483,7 @@ class BakedWriter(WriterBlock):
                 uv = None if all(c.uv is None for c, _ in chunks) else np.concatenate([c.texture() for c, _ in chunks])
                 del chunks
                 mesh, source = bake_mesh(self._library, asset.astype(np.int64, copy=False), xform, mesh_table,
-                                     self.max_triangles, uv, origins, lot)
+                                         self.max_triangles, uv, origins, lot)
                 del asset, xform, lot
                 self._count(mesh, mesh_table)
                 self._file.write(self._export(mesh, looks[source] if looks is not None else None))

@@ -35,7 +35,7 @@ import orjson
 from grammarc.atomic import private_folder, replacing
 from grammarc.errors import UsageError
 from grammarc.io import WriterBlock
-from grammarc.io.bake import MAX_TRIANGLES, bake_mesh, mesh_triangles
+from grammarc.io.bake import bake_mesh, made_triangles, triangle_limit
 from grammarc.model.assets import asset_library
 from grammarc.model.lots import Lots
 from grammarc.model.records import TerminalChunk
@@ -79,8 +79,7 @@ class CityJsonWriter(WriterBlock):
             raise UsageError(f"cannot write `{path}` as CityJSON: give a .json path (city.city.json)")
         self._meta = dict(meta)
         self._library = asset_library([str(n) for n in assets], {"meta": self._meta}, asset_roots, lod)
-        self.max_triangles = max_triangles if max_triangles is not None else \
-            int(os.environ.get("GRAMMARC_MAX_TRIANGLES", MAX_TRIANGLES))
+        self.max_triangles = triangle_limit(max_triangles)
         self._names = _building_names(lots)
         self._attributes = _attribute_rows(lots)
         self._tmp = Path(private_folder(self.path))
@@ -100,14 +99,13 @@ class CityJsonWriter(WriterBlock):
             raise ValueError(f"write to a CityJsonWriter that is {self._state}")
         asset = np.asarray(chunk.asset, np.int64)
         try:
-            triangles = self._library.triangles(np.bincount(asset, minlength=len(self._library.names))) \
-                + mesh_triangles(chunk.mesh)
+            triangles = made_triangles(self._library, asset, chunk.mesh)
             if self._triangles + triangles > self.max_triangles:
                 raise UsageError(f"{self.path}: CityJSON surfaces pass {self.max_triangles:,} triangles after "
                                  f"{self._rows + len(asset):,} instances; raise the limit with --max-triangles N, "
                                  "or write an instance record (.npz) or instanced .glb/.usdc instead")
             mesh, source = bake_mesh(self._library, asset, chunk.xform, chunk.mesh, self.max_triangles,
-                                 origins=chunk.origins, lot=chunk.lot)
+                                     origins=chunk.origins, lot=chunk.lot)
             self._add(chunk, np.asarray(mesh.vertices), np.asarray(mesh.faces),
                       np.concatenate([chunk.lot, chunk.mesh.lot]).astype(np.int64)[source])
         except BaseException:

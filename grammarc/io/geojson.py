@@ -24,13 +24,13 @@ import orjson
 from grammarc.errors import LotsError
 from grammarc.io.crs import CRS84
 from grammarc.io.lot_builder import LotBuilder, parse_features, property_columns
-from grammarc.io.lot_format import LotsFormat, LotsOptions, read_text
+from grammarc.io.lot_format import NO_OPTIONS, LotsFormat, LotsOptions, read_text
 from grammarc.model.lots import Lots
 
 __all__ = ["FORMAT", "read_geojson"]
 
 
-def read_geojson(path: Path, options: LotsOptions | None = None) -> Lots:
+def read_geojson(path: Path, options: LotsOptions = NO_OPTIONS) -> Lots:
     """All lots of a GeoJSON document or a PRT initial shape as JSON (see the module docstring).
 
     Raises
@@ -45,7 +45,7 @@ def read_geojson(path: Path, options: LotsOptions | None = None) -> Lots:
         raise LotsError(f"{path}:{error.lineno}:{error.colno}: not valid JSON: {error.msg}") from error
     if isinstance(data, dict) and "face_counts" in data and "type" not in data:
         return _prt_shape(data, path).finish_file({}, path, options)
-    builder = parse_features(_features(data), 0, (options or LotsOptions()).id_field)
+    builder = parse_features(_features(data), 0, options.id_field)
     builder.declared, builder.implied = _declared_crs(data, path), CRS84
     return builder.finish_file(property_columns(builder.props), path, options)
 

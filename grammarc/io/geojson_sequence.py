@@ -17,7 +17,7 @@ import orjson
 from grammarc.errors import LotsError
 from grammarc.io.crs import CRS84
 from grammarc.io.lot_builder import parse_features, property_columns
-from grammarc.io.lot_format import LotsFormat, LotsOptions, Partition, partitions_at
+from grammarc.io.lot_format import NO_OPTIONS, LotsFormat, LotsOptions, Partition, partitions_at
 from grammarc.model.lots import Lots
 
 __all__ = [
@@ -30,10 +30,10 @@ SUFFIXES = (".geojsonl", ".geojsons", ".geojsonseq", ".jsonl", ".ndjson")
 _SCAN_BLOCK = 1 << 26
 
 
-def read_sequence(path: Path, options: LotsOptions | None = None) -> Lots:
+def read_sequence(path: Path, options: LotsOptions = NO_OPTIONS) -> Lots:
     """All lots of a GeoJSON sequence; a ``LotsError`` if it cannot be read, has a line that is not JSON,
     or holds no polygon. Longitude and latitude where the coordinates are degrees (RFC 8142)."""
-    builder = parse_features(_features(path, 0, 0, path.stat().st_size), 0, (options or LotsOptions()).id_field)
+    builder = parse_features(_features(path, 0, 0, path.stat().st_size), 0, options.id_field)
     builder.implied = CRS84
     return builder.finish_file(property_columns(builder.props), path, options)
 
@@ -50,10 +50,10 @@ def count_sequence(part: Partition) -> int:
     return parse_features(_features(Path(part.path), part.start, part.offset, part.end), 0).end
 
 
-def read_sequence_partition(part: Partition, first_index: int, options: LotsOptions | None = None) -> Lots:
+def read_sequence_partition(part: Partition, first_index: int, options: LotsOptions = NO_OPTIONS) -> Lots:
     """The lots of a partition, the first numbered ``first_index``."""
     builder = parse_features(_features(Path(part.path), part.start, part.offset, part.end), first_index,
-                             (options or LotsOptions()).id_field)
+                             options.id_field)
     builder.implied = CRS84
     return builder.finish(property_columns(builder.props), part.path, options)
 

@@ -22,7 +22,7 @@ from grammarc.errors import LotsError
 from grammarc.io.arrow_lots import import_pyarrow, lots_from_table, table_lot_numbers
 from grammarc.io.crs import CRS84, projjson
 from grammarc.io.lot_builder import STREET_WIDTH, LotBuilder
-from grammarc.io.lot_format import LotsFormat, LotsOptions, Partition, partitions_at
+from grammarc.io.lot_format import NO_OPTIONS, LotsFormat, LotsOptions, Partition, partitions_at
 from grammarc.model.lots import Lots
 
 __all__ = [
@@ -34,10 +34,10 @@ __all__ = [
 ROW_GROUP = 16384
 
 
-def read_geoparquet(path: Path, options: LotsOptions | None = None) -> Lots:
+def read_geoparquet(path: Path, options: LotsOptions = NO_OPTIONS) -> Lots:
     """All lots of a GeoParquet file; a ``LotsError`` if it cannot be read, has no WKB geometry column, or
     holds no polygon."""
-    builder, attrs = _lots(path, None, 0, (options or LotsOptions()).id_field)
+    builder, attrs = _lots(path, None, 0, options.id_field)
     return builder.finish_file(attrs, path, options)
 
 
@@ -53,10 +53,10 @@ def count_geoparquet(part: Partition) -> int:
     return table_lot_numbers(table, _geometry_column(table, part.path), part.path)
 
 
-def read_geoparquet_partition(part: Partition, first_index: int, options: LotsOptions | None = None) -> Lots:
+def read_geoparquet_partition(part: Partition, first_index: int, options: LotsOptions = NO_OPTIONS) -> Lots:
     """The lots of a partition's rows (only the row groups that hold them are read), the first numbered
     ``first_index``."""
-    builder, attrs = _lots(part.path, (part.start, part.stop), first_index, (options or LotsOptions()).id_field)
+    builder, attrs = _lots(part.path, (part.start, part.stop), first_index, options.id_field)
     return builder.finish(attrs, part.path, options)
 
 

@@ -16,7 +16,7 @@ from pathlib import Path
 
 from grammarc.errors import LotsError, UsageError
 from grammarc.io.arrow_lots import lots_from_table, table_lot_numbers
-from grammarc.io.lot_format import LotsFormat, LotsOptions, Partition, partitions_at
+from grammarc.io.lot_format import NO_OPTIONS, LotsFormat, LotsOptions, Partition, partitions_at
 from grammarc.model.lots import Lots
 
 __all__ = ["FORMAT", "SUFFIXES", "count_gis", "gis_partitions", "read_gis", "read_gis_partition"]
@@ -34,11 +34,11 @@ def _pyogrio():
     return pyogrio
 
 
-def read_gis(path: Path, options: LotsOptions | None = None) -> Lots:
+def read_gis(path: Path, options: LotsOptions = NO_OPTIONS) -> Lots:
     """All lots of a GIS file's first layer, in the coordinate system GDAL gives it; a ``LotsError`` if GDAL
     cannot read it, it has no geometry, or it holds no polygon."""
     table, column, declared = _table(path, None)
-    builder, attrs = lots_from_table(table, column, path, id_field=(options or LotsOptions()).id_field)
+    builder, attrs = lots_from_table(table, column, path, id_field=options.id_field)
     builder.declared = declared
     return builder.finish_file(attrs, path, options)
 
@@ -55,11 +55,11 @@ def count_gis(part: Partition) -> int:
     return table_lot_numbers(table, column, part.path)
 
 
-def read_gis_partition(part: Partition, first_index: int, options: LotsOptions | None = None) -> Lots:
+def read_gis_partition(part: Partition, first_index: int, options: LotsOptions = NO_OPTIONS) -> Lots:
     """The lots of a partition's features, the first numbered ``first_index``."""
     table, column, declared = _table(part.path, (part.start, part.stop))
     builder, attrs = lots_from_table(table, column, part.path, part.start, first_index,
-                                     (options or LotsOptions()).id_field)
+                                     options.id_field)
     builder.declared = declared
     return builder.finish(attrs, part.path, options)
 

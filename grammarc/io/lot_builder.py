@@ -37,7 +37,7 @@ from grammarc.errors import LotsError
 from grammarc.geometry.meshes import ring_vector_areas
 from grammarc.geometry.short_edges import collapse_short_edges
 from grammarc.io.crs import georeference
-from grammarc.io.lot_format import LotsOptions
+from grammarc.io.lot_format import NO_OPTIONS, LotsOptions
 from grammarc.model.lots import BadLot, Lots
 from grammarc.ragged import offsets_from_counts, segment_reduce
 
@@ -129,15 +129,15 @@ class LotBuilder:
             return
         self.add(index, lot_id, xy, props)
 
-    def finish(self, attrs: dict[str, np.ndarray], source: str, options: LotsOptions | None = None) -> Lots:
-        """Bring every lot to metres (``io.crs.georeference``, with the user's ``crs`` choice), then clean,
+    def finish(self, attrs: dict[str, np.ndarray], source: str, options: LotsOptions = NO_OPTIONS) -> Lots:
+        """Bring every lot to metres (``io.crs.georeference``, as the user's ``options`` ask), then clean,
         orient and validate them all at once; ``attrs`` are columns over all added lots."""
         counts = np.concatenate([np.zeros(0, dtype=np.int64), *self.sizes])
         vertices = np.concatenate([np.zeros((0, 3)), *self.rings])
         xy = np.column_stack([vertices[:, 0], np.subtract(0.0, vertices[:, 2])]) if self.world else vertices[:, :2]
         lot_counts = np.add.reduceat(counts, offsets_from_counts(np.array(self.ring_counts, np.int64))[:-1]) \
             if len(counts) else counts
-        xy, crs_name, note = georeference(xy, lot_counts, self.declared, self.implied, options or LotsOptions(), source)
+        xy, crs_name, note = georeference(xy, lot_counts, self.declared, self.implied, options, source)
         if not self.world or note is not None:
             # world (x, height, -y); 0.0 - y keeps z = +0.0 where y = 0
             x, y = xy.T
@@ -167,13 +167,13 @@ class LotBuilder:
             crs=crs_name,
             crs_note=note,
         )
-        reasons = _validate(lots, normals, self.world, (options or LotsOptions()).min_area)
+        reasons = _validate(lots, normals, self.world, options.min_area)
         rejected = np.flatnonzero(reasons != "")
         bad = self.bad + [BadLot(int(lots.index[i]), lots.ids[i], reasons[i]) for i in rejected]
         good = lots.take(np.flatnonzero(reasons == "")) if len(rejected) else lots  # a copy only to drop some
         return replace(good, bad=tuple(sorted(bad, key=lambda b: b.index)))
 
-    def finish_file(self, attrs: dict[str, np.ndarray], path, options: LotsOptions | None = None) -> Lots:
+    def finish_file(self, attrs: dict[str, np.ndarray], path, options: LotsOptions = NO_OPTIONS) -> Lots:
         """``finish`` for a whole lots file, which must hold a polygon (a good or a bad one)."""
         if self.polygons == 0:
             raise LotsError(f"no polygon in lots file {path}")

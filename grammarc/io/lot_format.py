@@ -19,7 +19,7 @@ import numpy as np
 from grammarc.errors import LotsError
 from grammarc.model.lots import Lots
 
-__all__ = ["LotsFormat", "LotsOptions", "Partition", "partitions_at", "read_text"]
+__all__ = ["NO_OPTIONS", "LotsFormat", "LotsOptions", "Partition", "partitions_at", "read_text"]
 
 
 @dataclass(frozen=True)
@@ -46,6 +46,10 @@ class LotsOptions:
     crs: str | None = None
     id_field: str | None = None
     min_area: float | None = None
+
+
+#: What a lots file is read with when the user asks nothing of it.
+NO_OPTIONS = LotsOptions()
 
 
 @dataclass(frozen=True)

@@ -41,7 +41,7 @@ import numpy as np
 from grammarc.errors import LotsError
 from grammarc.io import geojson, geojson_sequence, geoparquet, gis, obj_lots
 from grammarc.io.lot_builder import STREET_WIDTH, LotBuilder, property_column
-from grammarc.io.lot_format import LotsFormat, LotsOptions, Partition, partitions_at
+from grammarc.io.lot_format import NO_OPTIONS, LotsFormat, LotsOptions, Partition, partitions_at
 from grammarc.model.lots import Lots
 
 __all__ = [
@@ -88,7 +88,7 @@ def read_lots(path: str | os.PathLike, options: LotsOptions | None = None) -> Lo
     if form is None:
         raise LotsError(f"unknown lots file type {path.suffix.lower()!r} (expected {_expected()}): {path}")
     with _no_cycle_collection():
-        return form.read(path, options)
+        return form.read(path, options or NO_OPTIONS)
 
 
 def partition_lots(path: str | os.PathLike, size: int, options: LotsOptions | None = None) -> list[Partition]:
@@ -126,7 +126,7 @@ def read_partition(part: Partition, first_index: int, options: LotsOptions | Non
     reproject them to the UTM zone of its own lots, not of the file's."""
     if part.kind != "whole":
         with _no_cycle_collection():
-            lots = _BY_KIND[part.kind].read_partition(part, first_index, options)
+            lots = _BY_KIND[part.kind].read_partition(part, first_index, options or NO_OPTIONS)
         if lots.crs_note is not None and (options is None or options.crs is None):
             raise LotsError(f"{part.path}: its lots are {lots.crs_note.split(',')[0]}: a partitioned build "
                             "needs --crs to reproject them (e.g. the UTM zone or national grid of the city)")

@@ -13,14 +13,14 @@ import numpy as np
 
 from grammarc.errors import LotsError
 from grammarc.io.lot_builder import LotBuilder
-from grammarc.io.lot_format import LotsFormat, LotsOptions, read_text
+from grammarc.io.lot_format import NO_OPTIONS, LotsFormat, LotsOptions, read_text
 from grammarc.model.lots import Lots
 from grammarc.model.obj import ObjError, read_obj
 
 __all__ = ["FORMAT", "read_obj_lots"]
 
 
-def read_obj_lots(path: Path, options: LotsOptions | None = None) -> Lots:
+def read_obj_lots(path: Path, options: LotsOptions = NO_OPTIONS) -> Lots:
     """All lots of an OBJ file; a ``LotsError`` names a malformed line (``path:line:``), or says the
     file holds no face."""
     try:
