@@ -338,3 +338,11 @@ def _cmdline(process: Path) -> str:
         return (process / "cmdline").read_bytes().decode(errors="replace")
     except OSError:  # gone meanwhile
         return ""
+
+
+def test_a_bake_origin_that_is_not_three_numbers_is_refused(write, tmp_path, capsys):
+    with pytest.raises(SystemExit) as stop:
+        main(["build", str(write("g.cga", GOOD)), "--emit", str(tmp_path / "c.ply"), "--bake-origin", "1,2"])
+    assert stop.value.code == 2
+    assert "--bake-origin: must be three numbers X,Y,Z, got `1,2`" in capsys.readouterr().err
+    assert not (tmp_path / "c.ply").exists()
