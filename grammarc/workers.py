@@ -27,11 +27,13 @@ import sys
 import tempfile
 from collections.abc import Callable
 from concurrent.futures import Future, ProcessPoolExecutor
+from concurrent.futures.process import BrokenProcessPool
 from pathlib import Path
 
 import numpy as np
 
 from grammarc.atomic import remove_stale
+from grammarc.errors import DerivationError
 
 __all__ = ["worker_pool"]
 
@@ -70,7 +72,7 @@ def worker_pool(work: Callable, workers: int):
             def submit(lots) -> Future:
                 shipped = pool.submit(_run, lots)
                 received: Future = Future()
-                shipped.add_done_callback(lambda done: _receive(done, received))
+                shipped.add_done_callback(lambda done: _receive(done, received, lots))
                 return received
 
             yield submit
@@ -103,12 +105,24 @@ def _run(lots):
     return shipped, failed
 
 
-def _receive(done: Future, received: Future) -> None:
+def _receive(done: Future, received: Future, lots) -> None:
     try:
         shipped, failed = done.result()
         received.set_result(([(n, (_unship(layout), per_lot)) for n, (layout, per_lot) in shipped], failed))
+    except BrokenProcessPool:
+        # A worker was killed (most often by the kernel's out-of-memory killer: SIGKILL runs no code of
+        # ours). Deriving its lots again would most likely kill again, so the build stops as after any
+        # failure: the writer aborts and nothing is written.
+        received.set_exception(DerivationError(
+            f"a worker process was killed while deriving lots {_span(lots)} (out of memory?); "
+            "nothing was written: rerun with fewer --workers or a smaller --chunk-size"))
     except BaseException as error:  # noqa: BLE001 - handed to the caller by received.result()
         received.set_exception(error)
+
+
+def _span(lots) -> str:
+    """``#first-#last`` of a chunk of lots, by their numbers in the input."""
+    return f"#{lots.index[0]}-#{lots.index[-1]}" if len(lots) else "(none)"
 
 
 def _ship(records, path: Path) -> tuple:

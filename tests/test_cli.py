@@ -2,7 +2,10 @@
 
 from __future__ import annotations
 
+import contextlib
 import json
+import os
+import re
 import signal
 import subprocess
 import sys
@@ -307,6 +310,31 @@ def test_a_cycle_of_attributes_is_an_error_not_a_crash(write, tmp_path, capsys):
 def test_sigterm_and_sighup_stop_a_build_as_ctrl_c_does(tmp_path, signum):
     """What `timeout`, docker, systemd and Slurm send: the build unwinds, exits 128 + the signal, and leaves
     no output, no temporary folder, no shared memory and no worker process behind."""
+    with _a_build_under_way(tmp_path) as build:
+        build.send_signal(signum)
+        _, err = build.communicate(timeout=120)
+    assert build.returncode == 128 + signum
+    assert err.endswith(f"grammarc: {signal.Signals(signum).name}: stopped; nothing was written\n")
+
+
+def test_a_worker_killed_by_sigkill_fails_the_build_cleanly(tmp_path):
+    """What the out-of-memory killer does to a worker: one line, exit 1, and nothing left behind."""
+    with _a_build_under_way(tmp_path) as build:
+        workers = Path(f"/proc/{build.pid}/task/{build.pid}/children").read_text().split()
+        assert workers, "the build has no worker process"
+        os.kill(int(workers[0]), signal.SIGKILL)
+        _, err = build.communicate(timeout=120)
+    assert build.returncode == 1
+    assert re.fullmatch(r"grammarc: error: a worker process was killed while deriving lots #\d+-#\d+ "
+                        r"\(out of memory\?\); nothing was written: rerun with fewer --workers or a smaller "
+                        r"--chunk-size\n", err)
+
+
+@contextlib.contextmanager
+def _a_build_under_way(tmp_path):
+    """A two-worker build of 12,000 lots in a subprocess, caught in its derivation: the process.
+    After the caller has stopped it, nothing may be left: no output, no temporary folder, no shared
+    memory, no process."""
     lots = [[[[x * 25, y * 25], [x * 25 + 20, y * 25], [x * 25 + 20, y * 25 + 15], [x * 25, y * 25 + 15]]]
             for x in range(120) for y in range(100)]
     geojson(tmp_path / "lots.geojson", lots)
@@ -323,10 +351,7 @@ def test_sigterm_and_sighup_stop_a_build_as_ctrl_c_does(tmp_path, signum):
         time.sleep(0.05)
     assert build.poll() is None, "the build ended before it could be stopped"
     time.sleep(0.5)  # into the derivation
-    build.send_signal(signum)
-    _, err = build.communicate(timeout=120)
-    assert build.returncode == 128 + signum
-    assert err.endswith(f"grammarc: {signal.Signals(signum).name}: stopped; nothing was written\n")
+    yield build
     assert list(out.parent.iterdir()) == []
     assert (set(shm.glob("grammarc-records-*")) if shm.is_dir() else set()) <= before
     left = [p for p in Path("/proc").glob("[0-9]*") if _cmdline(p).find(str(out)) >= 0]

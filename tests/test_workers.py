@@ -46,3 +46,17 @@ def test_a_pool_removes_the_shared_memory_that_killed_builds_left():
     with worker_pool(lambda lots: ([], []), 2) as submit:
         assert not stale.exists()
         assert submit([]).result() == ([], [])
+
+
+def test_a_worker_killed_by_sigkill_fails_the_build_with_one_line():
+    """What the out-of-memory killer does: no traceback, a DerivationError naming the lots in flight."""
+    import os
+    import signal
+
+    from grammarc.errors import DerivationError
+    from grammarc.workers import worker_pool
+
+    lots = lots_from_polygons([[np.array([[0, 0], [10, 0], [10, 10], [0, 10]], float)]] * 3)
+    with (worker_pool(lambda lots: os.kill(os.getpid(), signal.SIGKILL), 2) as submit,
+          pytest.raises(DerivationError, match=r"worker process was killed while deriving lots #0-#2")):
+        submit(lots).result(timeout=60)
