@@ -64,30 +64,62 @@ class Diagnostics(list):
         return any(d.is_error for d in self)
 
 
+#: Columns of a source line shown under a message: a longer line is cut to a window around the span, so
+#: that thousands of errors on one long line (a minified or generated file) cost a screenful each, not the
+#: line each.
+SHOWN_COLUMNS = 120
+
+
 def render(diag: Diagnostic, sources: dict[str, str]) -> str:
     """Render one diagnostic with the offending line and a caret under the span."""
-    head = f"{diag.span}: {diag.severity.value}: {diag.message}"
-    text = sources.get(diag.span.file)
-    lines = [head]
-    if text is not None and diag.span.line > 0:
-        src_lines = text.splitlines()
-        if diag.span.line <= len(src_lines):
-            src = src_lines[diag.span.line - 1].expandtabs(1)
-            width = 1
-            if diag.span.end_line == diag.span.line and diag.span.end_col > diag.span.col:
-                width = diag.span.end_col - diag.span.col
-            num = str(diag.span.line)
-            pad = " " * len(num)
-            lines.append(f" {num} | {src}")
-            lines.append(f" {pad} | {' ' * (diag.span.col - 1)}{'^' * width}")
-    if diag.hint:
-        lines.append(f"  hint: {diag.hint}")
-    return "\n".join(lines)
+    return _render(diag, _Lines(sources))
 
 
 def render_all(diags: list[Diagnostic], sources: dict[str, str]) -> str:
+    """Render every diagnostic, ordered by place; each file's text is cut into lines once."""
+    lines = _Lines(sources)
     ordered = sorted(diags, key=lambda d: (d.span.file, d.span.line, d.span.col))
-    return "\n".join(render(d, sources) for d in ordered)
+    return "\n".join(_render(d, lines) for d in ordered)
+
+
+class _Lines:
+    """The lines of each source, cut when first asked for."""
+
+    def __init__(self, sources: dict[str, str]):
+        self.sources = sources
+        self.cut: dict[str, list[str]] = {}
+
+    def line(self, span: Span) -> str | None:
+        if span.file not in self.cut:
+            text = self.sources.get(span.file)
+            self.cut[span.file] = [] if text is None else text.splitlines()
+        lines = self.cut[span.file]
+        return lines[span.line - 1] if 0 < span.line <= len(lines) else None
+
+
+def _render(diag: Diagnostic, lines: _Lines) -> str:
+    head = f"{diag.span}: {diag.severity.value}: {diag.message}"
+    shown = [head]
+    src = lines.line(diag.span)
+    if src is not None:
+        src = src.expandtabs(1)
+        width = 1
+        if diag.span.end_line == diag.span.line and diag.span.end_col > diag.span.col:
+            width = diag.span.end_col - diag.span.col
+        col = diag.span.col - 1
+        if len(src) > SHOWN_COLUMNS:  # a window around the span, the cuts marked
+            start = max(0, min(col - SHOWN_COLUMNS // 3, len(src) - SHOWN_COLUMNS))
+            window = src[start:start + SHOWN_COLUMNS]
+            width = max(1, min(width, SHOWN_COLUMNS - (col - start)))
+            src = ("..." if start else "") + window + ("..." if start + SHOWN_COLUMNS < len(src) else "")
+            col = col - start + (3 if start else 0)
+        num = str(diag.span.line)
+        pad = " " * len(num)
+        shown.append(f" {num} | {src}")
+        shown.append(f" {pad} | {' ' * col}{'^' * width}")
+    if diag.hint:
+        shown.append(f"  hint: {diag.hint}")
+    return "\n".join(shown)
 
 
 def suggest(name: str, candidates) -> str:

@@ -6,7 +6,17 @@ import random
 
 import pytest
 
-from grammarc.diagnostics import Diagnostics, Span, Typos, _edits, render, suggest, typo_of
+from grammarc.diagnostics import (
+    SHOWN_COLUMNS,
+    Diagnostics,
+    Span,
+    Typos,
+    _edits,
+    render,
+    render_all,
+    suggest,
+    typo_of,
+)
 
 
 def test_render_shows_the_line_and_a_caret_under_the_span():
@@ -14,6 +24,31 @@ def test_render_shows_the_line_and_a_caret_under_the_span():
     diags.error("unknown-op", "unknown operation `Subdv`", Span("g.cga", 1, 6, 1, 11), hint="check it")
     assert render(diags[0], {"g.cga": "a ~> Subdv(1)\n"}) == (
         "g.cga:1:6: error: unknown operation `Subdv`\n 1 | a ~> Subdv(1)\n   |      ^^^^^\n  hint: check it")
+
+
+def test_a_long_line_is_shown_as_a_window_around_the_span():
+    line = " ".join(f"extrude(u{i})" for i in range(400))
+    col = line.index("u200") + 1
+    diags = Diagnostics()
+    diags.error("unknown-name", "unknown identifier `u200`", Span("g.cga", 1, col, 1, col + 4))
+    _, shown, caret = render(diags[0], {"g.cga": line}).split("\n")
+    assert shown.startswith(" 1 | ...") and shown.endswith("...")
+    assert len(shown) <= len(" 1 | ") + SHOWN_COLUMNS + 6
+    start = caret.index("^")
+    assert caret.count("^") == 4 and shown[start:start + 4] == "u200"
+
+
+def test_thousands_of_errors_on_one_line_cost_a_few_lines_each():
+    """A generated one-line file with an error per word: the line is cut into lines once, and each message
+    shows a window of it, not the whole line again."""
+    line = " ".join(f"extrude(u{i})" for i in range(5000))
+    diags = Diagnostics()
+    for i in range(5000):
+        col = line.index(f"(u{i})") + 2
+        diags.error("unknown-name", f"unknown identifier `u{i}`", Span("g.cga", 1, col, 1, col + len(f"u{i}")))
+    text = render_all(diags, {"g.cga": line})
+    assert text.count("\n") == 3 * 5000 - 1
+    assert len(text) < 5000 * (2 * SHOWN_COLUMNS + 100)
 
 
 def test_suggest_the_likeliest_name():
