@@ -26,6 +26,9 @@ class Tol:
     rect: float = 1e-7
     #: Probabilities of a stochastic rule must sum to 1 within this.
     probability: float = 1e-6
+    #: Lot coordinates (metres, or degrees before reprojection) beyond this in magnitude are no place on
+    #: Earth (its circumference is 4e7 m): such a lot is bad, before squares of its lengths overflow.
+    coordinate: float = 1e8
 
 
 @dataclass(frozen=True)

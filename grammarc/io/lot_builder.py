@@ -137,7 +137,15 @@ class LotBuilder:
         xy = np.column_stack([vertices[:, 0], np.subtract(0.0, vertices[:, 2])]) if self.world else vertices[:, :2]
         lot_counts = np.add.reduceat(counts, offsets_from_counts(np.array(self.ring_counts, np.int64))[:-1]) \
             if len(counts) else counts
-        xy, crs_name, note = georeference(xy, lot_counts, self.declared, self.implied, options, source)
+        beyond = _beyond_the_earth(vertices, lot_counts)
+        if beyond.any():  # points at 0 that _validate rejects with their reason; the CRS is judged without them
+            on_earth = ~np.repeat(beyond, lot_counts)
+            moved, crs_name, note = georeference(xy[on_earth], lot_counts[~beyond], self.declared, self.implied,
+                                                 options, source)
+            vertices, xy = np.where(on_earth[:, None], vertices, 0.0), np.zeros_like(moved, shape=xy.shape)
+            xy[on_earth] = moved
+        else:
+            xy, crs_name, note = georeference(xy, lot_counts, self.declared, self.implied, options, source)
         if not self.world or note is not None:
             # world (x, height, -y); 0.0 - y keeps z = +0.0 where y = 0
             x, y = xy.T
@@ -167,7 +175,7 @@ class LotBuilder:
             crs=crs_name,
             crs_note=note,
         )
-        reasons = _validate(lots, normals, self.world, options.min_area)
+        reasons = _validate(lots, normals, self.world, options.min_area, beyond)
         rejected = np.flatnonzero(reasons != "")
         bad = self.bad + [BadLot(int(lots.index[i]), lots.ids[i], reasons[i]) for i in rejected]
         good = lots.take(np.flatnonzero(reasons == "")) if len(rejected) else lots  # a copy only to drop some
@@ -339,13 +347,25 @@ def _orient(ring_offsets, exterior, normal_y) -> tuple[np.ndarray, np.ndarray]:
             start + np.where(flip, (count - position - 1) % count, position))
 
 
-def _validate(lots: Lots, normals: np.ndarray, world: bool, min_area: float | None) -> np.ndarray:
+def _beyond_the_earth(vertices: np.ndarray, lot_counts: np.ndarray) -> np.ndarray:
+    """(L,) bool: the lots with a coordinate that is not finite or beyond ``TOL.coordinate`` (an elevation
+    may be NaN: a position without one)."""
+    z = vertices[:, 2]
+    bad = ~np.isfinite(vertices[:, :2]).all(axis=1) | (np.abs(vertices[:, :2]) > TOL.coordinate).any(axis=1) \
+        | np.isinf(z) | (np.abs(np.nan_to_num(z)) > TOL.coordinate)
+    return segment_reduce(np.add, bad.astype(np.int64), offsets_from_counts(lot_counts), 0) > 0
+
+
+def _validate(lots: Lots, normals: np.ndarray, world: bool, min_area: float | None,
+              beyond: np.ndarray) -> np.ndarray:
     """(L,) object: why each lot is bad, "" for a good lot; the first failed check gives the reason (a lot of
-    less area than ``min_area``, ``--min-area``, is a sliver)."""
+    less area than ``min_area``, ``--min-area``, is a sliver; ``beyond`` (L,) bool marks the lots with a
+    coordinate that is no place on Earth)."""
     reasons = np.full(len(lots), "", dtype=object)
+    reasons[beyond] = f"a coordinate is not finite or beyond {TOL.coordinate:g}"
     short_ring = (np.diff(lots.ring_offsets) < 3).astype(np.int64)
     short = segment_reduce(np.add, short_ring, lots.lot_offsets, 0) > 0
-    reasons[short] = "fewer than 3 distinct vertices"
+    reasons[short & (reasons == "")] = "fewer than 3 distinct vertices"
     norm = np.linalg.norm(normals, axis=1)
     wall_ring = (norm >= 2 * TOL.area_floor) & (np.abs(normals[:, 1]) < 0.5 * norm)
     wall = segment_reduce(np.add, wall_ring.astype(np.int64), lots.lot_offsets, 0) > 0

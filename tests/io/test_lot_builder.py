@@ -132,6 +132,19 @@ def test_bad_lots_are_reported_and_the_others_keep_their_numbers(tmp_path):
     assert bowtie.reason == "self-intersection at (1.0, 1.0)"
 
 
+def test_a_lot_with_a_coordinate_that_is_no_place_on_earth_is_bad(tmp_path):
+    """Squares of its lengths would overflow: the lot is bad, named with the reason, the others build."""
+    huge = [[0, 0], [1, 0], [1, 1e308], [0, 1e308]]
+    lots = read_lots(write_geojson(tmp_path, [feature([huge]), feature([SQUARE])]))
+    assert lots.index.tolist() == [1]
+    assert lots.bad == (BadLot(0, "0", "a coordinate is not finite or beyond 1e+08"),)
+    not_finite = np.array([[0, 0], [1, 0], [1, np.nan], [0, 1]])
+    high = np.array([[0, 0, 0], [1, 0, 0], [1, 1, np.inf], [0, 1, 0]])
+    lots = lots_from_polygons([[not_finite], [np.array(SQUARE, float)], [high]])
+    assert lots.index.tolist() == [1]
+    assert [(b.index, b.reason) for b in lots.bad] == [(i, "a coordinate is not finite or beyond 1e+08") for i in (0, 2)]
+
+
 def test_tiny_triangle_is_zero_area_and_hole_outside_shell_is_invalid(tmp_path):
     tiny = [[0, 0], [1.2e-3, 0], [0, 1.2e-3]]  # edges over 0.8 mm (they stay), 0.72 mm^2
     outside = [SQUARE, [[20, 20], [20, 21], [21, 21], [21, 20]]]
