@@ -44,7 +44,7 @@ def looks_like_degrees(xy: np.ndarray, counts: np.ndarray) -> bool:
         return False
     if np.abs(xy[:, 0]).max() > 180 or np.abs(xy[:, 1]).max() > 90:
         return False
-    starts = np.concatenate([[0], np.cumsum(counts)[:-1]]).astype(np.int64)
+    starts = np.concatenate([[0], np.cumsum(counts)[:-1]]).astype(np.int64)[counts > 0]  # a lot may have none
     extent = np.maximum.reduceat(xy, starts) - np.minimum.reduceat(xy, starts)
     return float(np.median(extent.max(axis=1))) < DEGREE_EXTENT
 

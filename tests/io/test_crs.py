@@ -69,6 +69,7 @@ def test_degrees_are_told_from_metres_by_the_lots_extent():
     square = np.array([[0, 0], [10, 0], [10, 10], [0, 10]] * 2, float)
     assert not looks_like_degrees(square, counts)  # a 10 m lot near the origin is metres
     assert not looks_like_degrees(square + [500_000, 5_000_000], counts)
+    assert not looks_like_degrees(square, np.array([4, 4, 0]))  # a lot without a vertex (an empty ring)
 
 
 def test_lon_lat_geojson_is_reprojected_to_the_utm_zone_of_its_centre(tmp_path):
