@@ -238,8 +238,9 @@ def _base_heights(z: np.ndarray, lot_counts: np.ndarray) -> np.ndarray:
     (``lot_counts`` (L,) of them each), 0 where it has none."""
     if not len(z) or np.isnan(z).all():
         return np.zeros(len(z))
-    lowest = np.fmin.reduceat(z, offsets_from_counts(lot_counts)[:-1])  # fmin: NaN only where all are
-    return np.repeat(np.nan_to_num(lowest, nan=0.0), lot_counts)
+    has = lot_counts > 0  # a lot may have no vertex (an empty ring): reduceat cannot start past the end
+    lowest = np.fmin.reduceat(z, offsets_from_counts(lot_counts)[:-1][has])  # fmin: NaN only where all are
+    return np.repeat(np.nan_to_num(lowest, nan=0.0), lot_counts[has])
 
 
 def _feature_id(feature: dict, props: dict, index: int, id_field: str | None) -> str:

@@ -177,6 +177,9 @@ def test_an_elevation_is_the_lots_base_height_its_lowest_corner(tmp_path):
     lots = read_lots(write_geojson(tmp_path, [feature([draped]), feature([mixed]), feature([flat])]))
     heights = [np.unique(lots.vertices[lots.ring_offsets[k]:lots.ring_offsets[k + 1], 1]).tolist() for k in range(3)]
     assert heights == [[99.0], [7.5], [0.0]] and lot_area(lots, 0) == pytest.approx(100.0)
+    empty = {"type": "Feature", "properties": {}, "geometry": {"type": "Polygon", "coordinates": [[]]}}
+    lots = read_lots(write_geojson(tmp_path, [feature([draped]), empty]))  # the last lot without a vertex
+    assert lots.index.tolist() == [0] and lots.bad == (BadLot(1, "1", "fewer than 3 distinct vertices"),)
 
 
 def test_duplicate_and_closing_vertices_are_removed(tmp_path):
