@@ -16,9 +16,14 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from hypothesis import settings
 
 from grammarc.io.lots import lots_from_polygons
 from grammarc.model.records import world_columns
+
+#: ``pytest --hypothesis-profile long``: the property tests that do not fix their number of examples (the
+#: fuzz of ``test_fuzz.py``) run for hours rather than a hundred examples each.
+settings.register_profile("long", max_examples=20_000)
 
 PRT_KIT = Path(__file__).resolve().parents[1].parent / "shared" / "prt"
 #: Tests of conformance with PRT: the kit's records, and PyPRT's side environment for the live harness.
