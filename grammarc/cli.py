@@ -1,8 +1,10 @@
 """The ``grammarc`` command: ``build`` derives a city, ``check`` reports on a grammar, ``conform`` compares
 with Esri's PRT.
 
-Exit codes: 0 success; 1 a build failed (unreadable lots, a derivation limit reached); 2 the grammar has
-errors or the command line is wrong. Errors go to stderr; no output file is left by a failed build.
+Exit codes: 0 success; 1 a build failed (unreadable lots, a derivation limit reached, a file system error
+while it ran); 2 the grammar has errors or the command line is wrong (an output path that cannot be written
+included, found before anything is derived). Errors go to stderr in one line each; no output file is left
+by a failed build.
 """
 
 from __future__ import annotations
@@ -71,11 +73,21 @@ def main(argv: list[str] | None = None) -> int:
         # the reader of our output went away (`grammarc info city.npz | head`): not an error of ours
         os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
         return 0
+    except OSError as error:  # the disk filled, a folder's permissions changed: said as a failure, no traceback
+        print(f"grammarc: error: {_os_error(error)}; nothing was written", file=sys.stderr)
+        return 1
     finally:
         for signum, handler in handlers.items():
             signal.signal(signum, handler)
         if collecting:
             gc.enable()
+
+
+def _os_error(error: OSError) -> str:
+    """An OSError in one line: the file it concerns and the system's reason (``[Errno 28] No space left on
+    device: 'x'`` -> ``x: No space left on device``)."""
+    reason = error.strerror or str(error) or type(error).__name__
+    return f"{error.filename}: {reason}" if error.filename is not None else reason
 
 
 def _parser() -> argparse.ArgumentParser:

@@ -15,6 +15,7 @@ loaded is reported and left out of the polygon counts rather than failing the su
 from __future__ import annotations
 
 import contextlib
+import glob
 import os
 from collections import Counter
 from pathlib import Path
@@ -40,7 +41,7 @@ def summarize(path: str | os.PathLike, asset_roots=None, lod: str | None = None)
     """
     path = Path(path)
     if (path.suffix.lower() in (".usd", ".usda", ".usdc") and manifest_path(path).is_file()
-            and not path.with_name(f"{path.name}.tiles").exists()):
+            and not any(path.parent.glob(f"{glob.escape(path.name)}.tiles*"))):
         path = manifest_path(path)  # the root layer of a cluster build's shards
     with contextlib.ExitStack() as package:
         tallies = []
