@@ -336,12 +336,14 @@ def _info(args) -> int:
     import json
 
     from grammarc.errors import UsageError
-    from grammarc.io.summary import format_summary, summarize
+    from grammarc.io.summary import READS, format_summary, summarize, what_file
 
     try:
         summary = summarize(args.record, args.assets, args.lod)
-    except (OSError, ValueError, KeyError) as error:
-        raise UsageError(f"{args.record}: not an output of grammarc build ({error})") from error
+    except OSError as error:
+        raise UsageError(f"{args.record}: {error.strerror or error}") from error
+    except (ValueError, KeyError) as error:
+        raise UsageError(f"{args.record}: not a file info reads ({READS}): {what_file(args.record)}") from error
     print(json.dumps(summary, indent=1) if args.json else format_summary(summary))
     return 0
 

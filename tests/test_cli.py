@@ -407,3 +407,22 @@ def test_a_build_whose_reports_cannot_be_written_leaves_no_new_output(write, tmp
     assert main(["build", str(grammar), "--emit", str(out), "--quiet", "--workers", "1", "--seed", "2"]) == 1
     assert "No space left on device" in capsys.readouterr().err
     assert (out.read_bytes(), (tmp_path / "out.reports.json").read_text()) == before
+
+
+@pytest.mark.parametrize("name, content, seems", [
+    ("x.obj", b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n", "a baked mesh"),
+    ("x.npz", np.lib.format.magic(1, 0) + b"{'descr': '<f8'}", "a single numpy array"),
+    ("notes.txt", b"hello\n", "a text file"),
+])
+def test_info_on_a_file_that_is_not_a_record_says_what_it_reads_and_what_the_file_seems(tmp_path, capsys, name,
+                                                                                       content, seems):
+    (tmp_path / name).write_bytes(content)
+    assert main(["info", str(tmp_path / name)]) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and ".npz instance records" in err and f"): {seems}" in err
+    assert "pickled" not in err
+
+
+def test_info_on_a_missing_file_says_so(tmp_path, capsys):
+    assert main(["info", str(tmp_path / "city.npz")]) == 2
+    assert capsys.readouterr().err.strip().endswith("city.npz: No such file or directory")
