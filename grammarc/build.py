@@ -38,6 +38,7 @@ from grammarc.io.lot_format import LotsOptions
 from grammarc.io.lots import default_lot, read_lots
 from grammarc.io.output_paths import check_writable
 from grammarc.io.reports import staged_reports
+from grammarc.io.rpk import MAX_PACKAGE_SIZE
 from grammarc.ir import nodes as ir
 from grammarc.ir.traverse import iter_ops
 from grammarc.model.grammar import Grammar
@@ -75,6 +76,8 @@ class BuildOptions:
     #: What the user asks of the lots file: its coordinate system and the one to reproject to, the id
     #: field, the least area (``--lots-crs``, ``--crs``, ``--id-field``, ``--min-area``).
     lots: LotsOptions | None = None
+    #: The most bytes a rule package may extract to (``--max-package-size``; ``io.rpk``).
+    max_package_size: int = MAX_PACKAGE_SIZE
 
 
 @dataclass(frozen=True)
@@ -134,7 +137,7 @@ def grammar_source(path: Path, options: BuildOptions):
         return
     from grammarc.io.rpk import open_rpk
 
-    with open_rpk(path) as package:
+    with open_rpk(path, max_size=options.max_package_size) as package:
         if package.main_rule_file is None:
             raise UsageError(f"{path}: the rule package holds no CGA rule file")
         inside = package.main_rule_file.relative_to(package.root).as_posix()

@@ -117,6 +117,7 @@ def _parser() -> argparse.ArgumentParser:
     build.add_argument("--max-shapes", type=_positive, default=LIMITS.max_shapes, metavar="N",
                        help=f"shapes made from one lot (default {LIMITS.max_shapes:,})")
     _workspace_option(build)
+    _package_size_option(build)
     build.add_argument("--assets", type=Path, action="append", default=[], metavar="DIR",
                        help="a further folder for I() assets (the grammar's folder comes first)")
     build.add_argument("--dialect", choices=("cga2006", "cityengine"),
@@ -170,6 +171,7 @@ def _parser() -> argparse.ArgumentParser:
     check.add_argument("--warnings-as-errors", action="store_true", help=_WARNINGS_HELP)
     check.add_argument("--dump-ir", action="store_true", help="print the IR after the passes")
     _workspace_option(check)
+    _package_size_option(check)
     check.add_argument("--dialect", choices=("cga2006", "cityengine"),
                        help="the grammar's notation (default: detected from its text)")
     check.set_defaults(run=_check)
@@ -257,6 +259,28 @@ def _workspace_option(command) -> None:
                               "folder holding the grammar's project)")
 
 
+def _package_size_option(command) -> None:
+    from grammarc.io.rpk import MAX_PACKAGE_SIZE, MAX_RATIO
+
+    command.add_argument("--max-package-size", type=_size, default=MAX_PACKAGE_SIZE, metavar="BYTES",
+                         help=f"refuse a rule package (.rpk) that extracts to more (default "
+                              f"{MAX_PACKAGE_SIZE >> 30}G; K, M and G are binary units; also never more than "
+                              f"{MAX_RATIO} times the package's size)")
+
+
+def _size(text: str) -> int:
+    """A positive number of bytes, with an optional K, M or G (binary units): ``2G``, ``500M``."""
+    units = {"K": 1 << 10, "M": 1 << 20, "G": 1 << 30}
+    scale = units.get(text[-1:].upper(), 1)
+    try:
+        value = int(float(text[:-1] if scale > 1 else text) * scale)
+    except (ValueError, OverflowError):
+        value = 0
+    if value <= 0:
+        raise argparse.ArgumentTypeError(f"must be a positive size in bytes (or with K, M, G), got `{text}`")
+    return value
+
+
 def _warn(grammar) -> None:
     if grammar.warnings:
         print(render_all(list(grammar.warnings), grammar.sources), file=sys.stderr)
@@ -268,7 +292,7 @@ def _check(args) -> int:
     from grammarc.ir.printer import print_module
 
     options = BuildOptions(start=args.start, dialect=args.dialect, workspace=args.workspace,
-                           warnings_as_errors=args.warnings_as_errors)
+                           warnings_as_errors=args.warnings_as_errors, max_package_size=args.max_package_size)
     with grammar_source(args.grammar, options) as (source, display, resolved):
         grammar = compile_source(source, display, resolved, derive=False)
     _warn(grammar)
@@ -424,6 +448,7 @@ def _build(args) -> int:
         workspace=args.workspace,
         warnings_as_errors=args.warnings_as_errors,
         lots=_lots_options(args),
+        max_package_size=args.max_package_size,
     )
     bar = _ProgressBar() if not args.quiet else None
     try:
