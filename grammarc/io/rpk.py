@@ -53,6 +53,8 @@ __all__ = ["MAX_PACKAGE_SIZE", "MAX_RATIO", "RulePackage", "open_rpk", "record_a
 MAX_PACKAGE_SIZE = 2 << 30
 #: The most bytes a package may extract to per byte of the archive.
 MAX_RATIO = 1000
+#: The bytes py7zr decompresses at a time (``_small_blocks``).
+_BLOCK = 4 << 20
 
 _INSTALL_HINT = "pip install 'grammarc[rpk]' (or pip install py7zr)"
 
@@ -180,7 +182,8 @@ def open_rpk(path: str | os.PathLike, *, tmpdir: str | os.PathLike | None = None
                 folder.mkdir(parents=True, exist_ok=True)
             extracted = _Extracted(root, _Budget(path, min(max_size, MAX_RATIO * path.stat().st_size)))
             try:
-                archive.extractall(factory=extracted)
+                with _small_blocks(py7zr):
+                    archive.extractall(factory=extracted)
             finally:
                 extracted.close()
         return RulePackage(path, root)
@@ -224,6 +227,20 @@ def _check_member(archive: Path, info) -> None:
         raise UsageError(f"rule package `{archive}`: member `{info.filename}` leaves the package")
     if getattr(info, "is_symlink", False):
         raise UsageError(f"rule package `{archive}`: member `{info.filename}` is a link")
+
+
+@contextlib.contextmanager
+def _small_blocks(py7zr):
+    """py7zr decompressed in blocks of ``_BLOCK`` bytes: its own are up to 128 MB (a quarter of the free
+    memory), each held twice before a byte of it is written, so a bomb would take that much memory before
+    the budget sees it. Its block size is a function of its module, set back when the block ends."""
+    module = py7zr.py7zr
+    own = module.get_memory_limit
+    module.get_memory_limit = lambda: _BLOCK
+    try:
+        yield
+    finally:
+        module.get_memory_limit = own
 
 
 class _Budget:

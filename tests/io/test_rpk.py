@@ -217,3 +217,17 @@ def test_the_command_refuses_a_bomb_in_one_line_exit_2(bomb, tmp_path, capsys):
     err = capsys.readouterr().err.strip()
     assert len(err.splitlines()) == 1 and "extracts to more than" in err and "--max-package-size" in err
     assert main(["check", str(bomb), "--max-package-size", "1K"]) == 2
+
+
+def test_a_bomb_is_refused_with_little_memory(bomb, tmp_path):
+    """Decompressed a few MiB at a time: the 32 MiB member is not held whole before it is refused."""
+    import subprocess
+
+    # the peak resident memory of the process (VmHWM: ru_maxrss would be the forking pytest's), in KiB
+    peak = "int(open('/proc/self/status').read().split('VmHWM:')[1].split()[0])"
+    script = ("import py7zr\nfrom grammarc.io.rpk import open_rpk\n"
+              f"before = {peak}\n"
+              f"try:\n    open_rpk({str(bomb)!r}, tmpdir={str(tmp_path)!r})\nexcept Exception:\n    pass\n"
+              f"print({peak} - before)")
+    grown = int(subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, check=True).stdout)
+    assert grown < 24 << 10
