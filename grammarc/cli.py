@@ -1,6 +1,9 @@
 """The ``grammarc`` command: ``build`` derives a city, ``check`` reports on a grammar, ``conform`` compares
 with Esri's PRT.
 
+Warnings of the libraries grammarc uses are not shown (unless asked for with Python's ``-W``): what the
+user should know, grammarc says in its own words.
+
 Exit codes: 0 success; 1 a build failed (unreadable lots, a derivation limit reached, a file system error
 while it ran); 2 the grammar has errors or the command line is wrong (an output path that cannot be written
 included, found before anything is derived). Errors go to stderr in one line each; no output file is left
@@ -16,6 +19,7 @@ import os
 import signal
 import sys
 import threading
+import warnings
 from collections import Counter
 from dataclasses import replace
 from pathlib import Path
@@ -54,7 +58,13 @@ def main(argv: list[str] | None = None) -> int:
     handlers = {s: signal.signal(s, _stop) for s in (signal.SIGTERM, signal.SIGHUP)} \
         if threading.current_thread() is threading.main_thread() else {}
     try:
-        return args.run(args)
+        with warnings.catch_warnings():
+            # grammarc says what concerns the user itself; the libraries' warnings (numpy's "invalid value
+            # in divide" of a value grammarc handles) are not the user's to read, unless asked for with
+            # Python's -W or PYTHONWARNINGS. The workers are forked with this filter.
+            if not sys.warnoptions:
+                warnings.simplefilter("ignore")
+            return args.run(args)
     except GrammarError as error:
         print(str(error), file=sys.stderr)
         n = sum(d.is_error for d in error.diagnostics)
@@ -320,11 +330,12 @@ def _listed(names, most: int = 40) -> str:
 
 def _render(args) -> int:
     from grammarc.io.npz import load_record
+    from grammarc.io.output_paths import check_writable
     from grammarc.io.rpk import record_asset_roots
     from grammarc.render.picture import parse_size, png_path, render
 
     size = parse_size(args.size)
-    png_path(args.output)  # before the record is read, which may be large
+    check_writable([png_path(args.output)])  # before the record is read, which may be large
     record = load_record(args.record)
     with record_asset_roots(record.get("meta"), args.assets or None) as roots:
         result = render(record, args.output, size=size, view=args.view, color=args.color, asset_roots=roots)
@@ -338,7 +349,12 @@ def _render(args) -> int:
 def _lots(args) -> int:
     from grammarc.errors import UsageError
     from grammarc.io.lots import read_lots
+    from grammarc.io.output_paths import check_writable
 
+    if args.to is not None:
+        if args.to.suffix.lower() != ".parquet":
+            raise UsageError(f"--to writes GeoParquet: give a .parquet path, not `{args.to}`")
+        check_writable([args.to])  # before the lots are read, which may take long
     lots = read_lots(args.path, _lots_options(args))
     for bad in lots.bad:
         print(f"grammarc: lot {bad.id} (#{bad.index}) is bad: {bad.reason}", file=sys.stderr)
@@ -347,8 +363,6 @@ def _lots(args) -> int:
     where = lots.crs_note or lots.crs or "none named (metres of a local scene)"
     print(f"coordinate system: {where if len(where) < 200 else where[:197] + '...'}")
     if args.to is not None:
-        if args.to.suffix.lower() != ".parquet":
-            raise UsageError(f"--to writes GeoParquet: give a .parquet path, not `{args.to}`")
         from grammarc.io.geoparquet import write_geoparquet
 
         write_geoparquet(lots, args.to)
@@ -395,12 +409,16 @@ def _build_on_dask(args, options, bar):
     from grammarc.cluster import build_on_dask
     from grammarc.errors import UsageError
     from grammarc.io import OutputOptions
+    from grammarc.io.output_paths import check_writable
+    from grammarc.io.shards import manifest_path, shards_folder
 
     refused = [flag for flag, given in (("--select", args.select is not None), ("--reports", args.reports),
                                         ("--bake", args.bake)) if given]
     if refused:
         raise UsageError(f"{', '.join(refused)} cannot go with --dask: a cluster build writes shards (with "
                          "their reports beside them); select, bake or convert from them")
+    output = Path(args.emit)
+    check_writable([output, manifest_path(output)], [shards_folder(output)])
     return build_on_dask(args.grammar, args.emit, dask=args.dask, lots_path=args.lots, options=options,
                          output_options=OutputOptions(lod=args.lod, tile_size=args.tile_size),
                          partition_size=args.partition_size, resume=args.resume, progress=bar)

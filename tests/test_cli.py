@@ -426,3 +426,11 @@ def test_info_on_a_file_that_is_not_a_record_says_what_it_reads_and_what_the_fil
 def test_info_on_a_missing_file_says_so(tmp_path, capsys):
     assert main(["info", str(tmp_path / "city.npz")]) == 2
     assert capsys.readouterr().err.strip().endswith("city.npz: No such file or directory")
+
+
+def test_lots_to_a_path_that_cannot_be_written_is_refused_before_reading(tmp_path, capsys):
+    lots = geojson(tmp_path / "lots.geojson", [SQUARE])
+    (tmp_path / "out.parquet").mkdir()
+    assert main(["lots", str(lots), "--to", str(tmp_path / "out.parquet")]) == 2
+    err = capsys.readouterr()
+    assert err.out == "" and err.err.strip().endswith("out.parquet`: it is a folder")
