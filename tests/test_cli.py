@@ -434,3 +434,15 @@ def test_lots_to_a_path_that_cannot_be_written_is_refused_before_reading(tmp_pat
     assert main(["lots", str(lots), "--to", str(tmp_path / "out.parquet")]) == 2
     err = capsys.readouterr()
     assert err.out == "" and err.err.strip().endswith("out.parquet`: it is a folder")
+
+
+def test_the_libraries_warnings_do_not_reach_the_user(write, tmp_path):
+    """numpy's overflow in an attribute's arithmetic (which it warns of) is not shown beside grammarc's
+    messages; Python's -W still shows it to whom asks."""
+    grammar = write("g.cga", 'version "2023.0"\nattr z = 0\n@StartRule\nLot --> report("big", 1e308 * (10 + z)) X.\n')
+    command = ["-m", "grammarc.cli", "build", str(grammar), "--emit", str(tmp_path / "c.npz"), "--workers", "1"]
+    err = subprocess.run([sys.executable, *command], capture_output=True, text=True, check=True).stderr
+    assert "Warning" not in err and all(line.startswith(("grammarc:", str(tmp_path))) for line in err.splitlines())
+    asked = subprocess.run([sys.executable, "-W", "always::RuntimeWarning", *command], capture_output=True, text=True,
+                           check=True)
+    assert "RuntimeWarning: overflow" in asked.stderr
