@@ -175,7 +175,9 @@ def open_rpk(path: str | os.PathLike, *, tmpdir: str | os.PathLike | None = None
         raise UsageError(f"rule package `{path}` does not exist")
     root = Path(tempfile.mkdtemp(prefix=f"grammarc-rpk-{path.stem}-", dir=tmpdir))
     try:
-        with py7zr.SevenZipFile(path, mode="r") as archive:
+        # an open file, not its path: py7zr then extracts in this thread (with a path, it extracts an
+        # archive's blocks in threads that each open the file and leave it open)
+        with open(path, "rb") as file, py7zr.SevenZipFile(file, mode="r") as archive:
             for info in archive.list():
                 _check_member(path, info)
                 folder = root / info.filename if info.is_directory else (root / info.filename).parent

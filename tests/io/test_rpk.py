@@ -231,3 +231,17 @@ def test_a_bomb_is_refused_with_little_memory(bomb, tmp_path):
               f"print({peak} - before)")
     grown = int(subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, check=True).stdout)
     assert grown < 24 << 10
+
+
+@needs_kit
+def test_extracting_a_package_leaves_no_file_open():
+    """py7zr given the archive's path extracts the blocks of an archive of several (candler's) in threads
+    that each leave it open: a ResourceWarning each."""
+    import warnings
+
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        with open_rpk(KIT / "rpk" / "candler.rpk"):
+            pass
+        gc.collect()
+    assert [w for w in caught if issubclass(w.category, ResourceWarning)] == []
