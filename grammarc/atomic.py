@@ -12,16 +12,29 @@ import shutil
 import tempfile
 from pathlib import Path
 
-__all__ = ["private_folder", "remove_stale", "replacing"]
+__all__ = ["NAME_MAX", "private_folder", "remove_stale", "replacing"]
+
+#: The longest file name, in bytes, of the file systems grammarc writes to (Linux, macOS and Windows alike).
+NAME_MAX = 255
+#: The bytes of an output's name its temporary folder keeps: with ``.``, ``.tmp``, a process id and
+#: ``mkdtemp``'s eight characters the folder's name stays under ``NAME_MAX`` whatever the output's is.
+_NAME_KEPT = 200
 
 
 def private_folder(path: Path) -> str:
     """A new private folder beside ``path`` for the temporary files of its writing (the same filesystem,
-    for the rename): ``.<name>.tmp<pid>-<random>``. The folders that runs which died (a SIGKILL, a power
-    cut: their process is gone) left for the same output are removed first."""
+    for the rename): ``.<name>.tmp<pid>-<random>``, the name cut to its first 200 bytes so that an output
+    whose name is legal has a legal temporary folder too. The folders that runs which died (a SIGKILL, a
+    power cut: their process is gone) left for the same output are removed first."""
     path = Path(path)
-    remove_stale(path.parent, f".{path.name}.tmp")
-    return tempfile.mkdtemp(prefix=f".{path.name}.tmp{os.getpid()}-", dir=path.parent)
+    prefix = f".{_kept(path.name)}.tmp"
+    remove_stale(path.parent, prefix)
+    return tempfile.mkdtemp(prefix=f"{prefix}{os.getpid()}-", dir=path.parent)
+
+
+def _kept(name: str) -> str:
+    """``name`` cut to its first ``_NAME_KEPT`` bytes."""
+    return os.fsdecode(os.fsencode(name)[:_NAME_KEPT])
 
 
 def remove_stale(folder: Path, prefix: str) -> None:

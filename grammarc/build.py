@@ -33,10 +33,14 @@ from grammarc.backend.plan import make_plan
 from grammarc.compiler import compile_grammar
 from grammarc.constants import LIMITS, Limits
 from grammarc.errors import ChunkTooLarge, LotFailure, UsageError
-from grammarc.io import OutputOptions, writer_for
+from grammarc.io import OutputOptions, writer_for, written_paths
 from grammarc.io.lot_format import LotsOptions
 from grammarc.io.lots import default_lot, read_lots
-from grammarc.io.reports import write_reports
+from grammarc.io.output_paths import check_writable
+from grammarc.io.reports import staged_reports
+from grammarc.io.rpk import MAX_PACKAGE_SIZE
+from grammarc.ir import nodes as ir
+from grammarc.ir.traverse import iter_ops
 from grammarc.model.grammar import Grammar
 from grammarc.model.lots import BadLot, Lots
 from grammarc.model.records import LotOrigins, MeshChunk
@@ -72,6 +76,8 @@ class BuildOptions:
     #: What the user asks of the lots file: its coordinate system and the one to reproject to, the id
     #: field, the least area (``--lots-crs``, ``--crs``, ``--id-field``, ``--min-area``).
     lots: LotsOptions | None = None
+    #: The most bytes a rule package may extract to (``--max-package-size``; ``io.rpk``).
+    max_package_size: int = MAX_PACKAGE_SIZE
 
 
 @dataclass(frozen=True)
@@ -131,7 +137,7 @@ def grammar_source(path: Path, options: BuildOptions):
         return
     from grammarc.io.rpk import open_rpk
 
-    with open_rpk(path) as package:
+    with open_rpk(path, max_size=options.max_package_size) as package:
         if package.main_rule_file is None:
             raise UsageError(f"{path}: the rule package holds no CGA rule file")
         inside = package.main_rule_file.relative_to(package.root).as_posix()
@@ -156,6 +162,10 @@ def _build(source: Path, display: str | None, grammar_path: Path, output, lots_p
     plan = make_plan(grammar)
     check_overrides(grammar.module, options.attrs)
     writer_class = writer_for(output, replace(output_options, asset_roots=tuple(grammar.asset_roots)))
+    reports_file = Path(reports_to) if reports_to else reports_path(Path(output))
+    files, folders = written_paths(output, output_options)
+    reporting = reports_to is not None or any(isinstance(op, ir.Report) for op in iter_ops(grammar.module))
+    check_writable([*files, *([reports_file] if reporting else [])], folders)
     Path(output).parent.mkdir(parents=True, exist_ok=True)
     every = load_lots(grammar_path, Path(lots_path) if lots_path else None, options.lots)
     lots = every if select is None else every.select(select)
@@ -167,10 +177,11 @@ def _build(source: Path, display: str | None, grammar_path: Path, output, lots_p
     reports = Reports()
     with writer_class(output, assets=grammar.assets, symbols=plan.symbol_names, meta=meta) as writer:
         derived = derive_all(plan, lots, options, writer, failed, reports, progress, every)
-        counts = writer.close()
-    if reports:
-        write_reports(reports, Path(reports_to) if reports_to else reports_path(Path(output)),
-                      dict(zip(every.index.tolist(), every.ids.tolist())))
+        # the reports are written before the output is put in place and renamed after it: a build whose
+        # reports cannot be written leaves no new output
+        with (staged_reports(reports, reports_file, dict(zip(every.index.tolist(), every.ids.tolist())))
+              if reports else contextlib.nullcontext()):
+            counts = writer.close()
     bad = tuple(sorted((*lots.bad, *failed), key=lambda b: b.index))
     ids, times = np.unique(every.ids.astype(str), return_counts=True)
     return BuildResult(Path(output), len(lots) + len(lots.bad), derived, bad, counts,

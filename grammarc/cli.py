@@ -1,8 +1,13 @@
 """The ``grammarc`` command: ``build`` derives a city, ``check`` reports on a grammar, ``conform`` compares
 with Esri's PRT.
 
-Exit codes: 0 success; 1 a build failed (unreadable lots, a derivation limit reached); 2 the grammar has
-errors or the command line is wrong. Errors go to stderr; no output file is left by a failed build.
+Warnings of the libraries grammarc uses are not shown (unless asked for with Python's ``-W``): what the
+user should know, grammarc says in its own words.
+
+Exit codes: 0 success; 1 a build failed (unreadable lots, a derivation limit reached, a file system error
+while it ran); 2 the grammar has errors or the command line is wrong (an output path that cannot be written
+included, found before anything is derived). Errors go to stderr in one line each; no output file is left
+by a failed build.
 """
 
 from __future__ import annotations
@@ -14,6 +19,7 @@ import os
 import signal
 import sys
 import threading
+import warnings
 from collections import Counter
 from dataclasses import replace
 from pathlib import Path
@@ -52,7 +58,13 @@ def main(argv: list[str] | None = None) -> int:
     handlers = {s: signal.signal(s, _stop) for s in (signal.SIGTERM, signal.SIGHUP)} \
         if threading.current_thread() is threading.main_thread() else {}
     try:
-        return args.run(args)
+        with warnings.catch_warnings():
+            # grammarc says what concerns the user itself; the libraries' warnings (numpy's "invalid value
+            # in divide" of a value grammarc handles) are not the user's to read, unless asked for with
+            # Python's -W or PYTHONWARNINGS. The workers are forked with this filter.
+            if not sys.warnoptions:
+                warnings.simplefilter("ignore")
+            return args.run(args)
     except GrammarError as error:
         print(str(error), file=sys.stderr)
         n = sum(d.is_error for d in error.diagnostics)
@@ -71,11 +83,21 @@ def main(argv: list[str] | None = None) -> int:
         # the reader of our output went away (`grammarc info city.npz | head`): not an error of ours
         os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
         return 0
+    except OSError as error:  # the disk filled, a folder's permissions changed: said as a failure, no traceback
+        print(f"grammarc: error: {_os_error(error)}; nothing was written", file=sys.stderr)
+        return 1
     finally:
         for signum, handler in handlers.items():
             signal.signal(signum, handler)
         if collecting:
             gc.enable()
+
+
+def _os_error(error: OSError) -> str:
+    """An OSError in one line: the file it concerns and the system's reason (``[Errno 28] No space left on
+    device: 'x'`` -> ``x: No space left on device``)."""
+    reason = error.strerror or str(error) or type(error).__name__
+    return f"{error.filename}: {reason}" if error.filename is not None else reason
 
 
 def _parser() -> argparse.ArgumentParser:
@@ -105,6 +127,7 @@ def _parser() -> argparse.ArgumentParser:
     build.add_argument("--max-shapes", type=_positive, default=LIMITS.max_shapes, metavar="N",
                        help=f"shapes made from one lot (default {LIMITS.max_shapes:,})")
     _workspace_option(build)
+    _package_size_option(build)
     build.add_argument("--assets", type=Path, action="append", default=[], metavar="DIR",
                        help="a further folder for I() assets (the grammar's folder comes first)")
     build.add_argument("--dialect", choices=("cga2006", "cityengine"),
@@ -158,6 +181,7 @@ def _parser() -> argparse.ArgumentParser:
     check.add_argument("--warnings-as-errors", action="store_true", help=_WARNINGS_HELP)
     check.add_argument("--dump-ir", action="store_true", help="print the IR after the passes")
     _workspace_option(check)
+    _package_size_option(check)
     check.add_argument("--dialect", choices=("cga2006", "cityengine"),
                        help="the grammar's notation (default: detected from its text)")
     check.set_defaults(run=_check)
@@ -245,6 +269,28 @@ def _workspace_option(command) -> None:
                               "folder holding the grammar's project)")
 
 
+def _package_size_option(command) -> None:
+    from grammarc.io.rpk import MAX_PACKAGE_SIZE, MAX_RATIO
+
+    command.add_argument("--max-package-size", type=_size, default=MAX_PACKAGE_SIZE, metavar="BYTES",
+                         help=f"refuse a rule package (.rpk) that extracts to more (default "
+                              f"{MAX_PACKAGE_SIZE >> 30}G; K, M and G are binary units; also never more than "
+                              f"{MAX_RATIO} times the package's size)")
+
+
+def _size(text: str) -> int:
+    """A positive number of bytes, with an optional K, M or G (binary units): ``2G``, ``500M``."""
+    units = {"K": 1 << 10, "M": 1 << 20, "G": 1 << 30}
+    scale = units.get(text[-1:].upper(), 1)
+    try:
+        value = int(float(text[:-1] if scale > 1 else text) * scale)
+    except (ValueError, OverflowError):
+        value = 0
+    if value <= 0:
+        raise argparse.ArgumentTypeError(f"must be a positive size in bytes (or with K, M, G), got `{text}`")
+    return value
+
+
 def _warn(grammar) -> None:
     if grammar.warnings:
         print(render_all(list(grammar.warnings), grammar.sources), file=sys.stderr)
@@ -256,7 +302,7 @@ def _check(args) -> int:
     from grammarc.ir.printer import print_module
 
     options = BuildOptions(start=args.start, dialect=args.dialect, workspace=args.workspace,
-                           warnings_as_errors=args.warnings_as_errors)
+                           warnings_as_errors=args.warnings_as_errors, max_package_size=args.max_package_size)
     with grammar_source(args.grammar, options) as (source, display, resolved):
         grammar = compile_source(source, display, resolved, derive=False)
     _warn(grammar)
@@ -284,11 +330,12 @@ def _listed(names, most: int = 40) -> str:
 
 def _render(args) -> int:
     from grammarc.io.npz import load_record
+    from grammarc.io.output_paths import check_writable
     from grammarc.io.rpk import record_asset_roots
     from grammarc.render.picture import parse_size, png_path, render
 
     size = parse_size(args.size)
-    png_path(args.output)  # before the record is read, which may be large
+    check_writable([png_path(args.output)])  # before the record is read, which may be large
     record = load_record(args.record)
     with record_asset_roots(record.get("meta"), args.assets or None) as roots:
         result = render(record, args.output, size=size, view=args.view, color=args.color, asset_roots=roots)
@@ -302,7 +349,12 @@ def _render(args) -> int:
 def _lots(args) -> int:
     from grammarc.errors import UsageError
     from grammarc.io.lots import read_lots
+    from grammarc.io.output_paths import check_writable
 
+    if args.to is not None:
+        if args.to.suffix.lower() != ".parquet":
+            raise UsageError(f"--to writes GeoParquet: give a .parquet path, not `{args.to}`")
+        check_writable([args.to])  # before the lots are read, which may take long
     lots = read_lots(args.path, _lots_options(args))
     for bad in lots.bad:
         print(f"grammarc: lot {bad.id} (#{bad.index}) is bad: {bad.reason}", file=sys.stderr)
@@ -311,8 +363,6 @@ def _lots(args) -> int:
     where = lots.crs_note or lots.crs or "none named (metres of a local scene)"
     print(f"coordinate system: {where if len(where) < 200 else where[:197] + '...'}")
     if args.to is not None:
-        if args.to.suffix.lower() != ".parquet":
-            raise UsageError(f"--to writes GeoParquet: give a .parquet path, not `{args.to}`")
         from grammarc.io.geoparquet import write_geoparquet
 
         write_geoparquet(lots, args.to)
@@ -324,12 +374,14 @@ def _info(args) -> int:
     import json
 
     from grammarc.errors import UsageError
-    from grammarc.io.summary import format_summary, summarize
+    from grammarc.io.summary import READS, format_summary, summarize, what_file
 
     try:
         summary = summarize(args.record, args.assets, args.lod)
-    except (OSError, ValueError, KeyError) as error:
-        raise UsageError(f"{args.record}: not an output of grammarc build ({error})") from error
+    except OSError as error:
+        raise UsageError(f"{args.record}: {error.strerror or error}") from error
+    except (ValueError, KeyError) as error:
+        raise UsageError(f"{args.record}: not a file info reads ({READS}): {what_file(args.record)}") from error
     print(json.dumps(summary, indent=1) if args.json else format_summary(summary))
     return 0
 
@@ -357,12 +409,16 @@ def _build_on_dask(args, options, bar):
     from grammarc.cluster import build_on_dask
     from grammarc.errors import UsageError
     from grammarc.io import OutputOptions
+    from grammarc.io.output_paths import check_writable
+    from grammarc.io.shards import manifest_path, shards_folder
 
     refused = [flag for flag, given in (("--select", args.select is not None), ("--reports", args.reports),
                                         ("--bake", args.bake)) if given]
     if refused:
         raise UsageError(f"{', '.join(refused)} cannot go with --dask: a cluster build writes shards (with "
                          "their reports beside them); select, bake or convert from them")
+    output = Path(args.emit)
+    check_writable([output, manifest_path(output)], [shards_folder(output)])
     return build_on_dask(args.grammar, args.emit, dask=args.dask, lots_path=args.lots, options=options,
                          output_options=OutputOptions(lod=args.lod, tile_size=args.tile_size),
                          partition_size=args.partition_size, resume=args.resume, progress=bar)
@@ -410,6 +466,7 @@ def _build(args) -> int:
         workspace=args.workspace,
         warnings_as_errors=args.warnings_as_errors,
         lots=_lots_options(args),
+        max_package_size=args.max_package_size,
     )
     bar = _ProgressBar() if not args.quiet else None
     try:

@@ -44,3 +44,10 @@ def test_the_temporary_folders_of_dead_runs_go_at_the_next_run(tmp_path):
     new = private_folder(tmp_path / "city.npz")
     assert not dead.exists() and alive.exists() and other.exists()
     assert new.startswith(str(tmp_path / f".city.npz.tmp{os.getpid()}-"))
+
+
+def test_an_output_of_the_longest_legal_name_has_a_legal_temporary_folder(tmp_path):
+    path = tmp_path / ("x" * 251 + ".npz")  # 255 bytes, the longest name Linux allows
+    with replacing(path) as tmp:
+        tmp.write_text("new")
+    assert path.read_text() == "new" and [p.name for p in tmp_path.iterdir()] == [path.name]

@@ -369,3 +369,103 @@ def test_a_bake_origin_that_is_not_three_numbers_is_refused(write, tmp_path, cap
     assert stop.value.code == 2
     assert "--bake-origin: must be three numbers X,Y,Z, got `1,2`" in capsys.readouterr().err
     assert not (tmp_path / "c.ply").exists()
+
+
+@pytest.mark.parametrize("paths, reason", [
+    (["--emit", "out.npz"], "it is a folder"),
+    (["--emit", "file/out.npz"], "is a file, not a folder"),
+    (["--emit", "x" * 250 + ".usdc"], "longer than the 255 a file name may have"),  # legal; its tile folder's is not
+    (["--emit", "city.npz", "--reports", "out.npz"], "it is a folder"),
+])
+def test_an_output_path_that_cannot_be_written_is_one_line_exit_2_before_deriving(write, tmp_path, capsys,
+                                                                                   monkeypatch, paths, reason):
+    grammar = write("g.cga", GOOD)
+    (tmp_path / "out.npz").mkdir()
+    (tmp_path / "file").write_text("x")
+    monkeypatch.setattr("grammarc.build.derive_all", lambda *a, **k: pytest.fail("derived before the check"))
+    assert main(["build", str(grammar), *(p if p.startswith("--") else str(tmp_path / p) for p in paths)]) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and err.startswith("grammarc: error: cannot write `") and reason in err
+
+
+def test_an_output_of_the_longest_legal_name_is_written(write, tmp_path):
+    out = tmp_path / ("x" * 251 + ".npz")  # 255 bytes: its temporary folder's name must be shorter
+    assert main(["build", str(write("g.cga", GOOD)), "--emit", str(out), "--quiet"]) == 0
+    assert len(read_instances(out)["asset"]) == 4 and sorted(p.name for p in tmp_path.iterdir()) == ["g.cga", out.name]
+
+
+def test_a_disk_that_fills_during_a_build_is_one_line_exit_1(write, tmp_path, capsys, monkeypatch):
+    import errno
+
+    import grammarc.io.npz
+
+    def full(path):
+        raise OSError(errno.ENOSPC, "No space left on device", path)
+
+    monkeypatch.setattr(grammarc.io.npz, "_create", full)
+    out = tmp_path / "out.npz"
+    assert main(["build", str(write("g.cga", GOOD)), "--emit", str(out), "--quiet", "--workers", "1"]) == 1
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and "No space left on device; nothing was written" in err
+    assert [p.name for p in tmp_path.iterdir()] == ["g.cga"]
+
+
+REPORTING = 'Lot --> report("area", geometry.area()) extrude(6) comp(f){ side : Wall. }\n'
+
+
+def test_a_build_whose_reports_cannot_be_written_leaves_no_new_output(write, tmp_path, capsys, monkeypatch):
+    import errno
+
+    import grammarc.io.reports
+
+    grammar = write("g.cga", REPORTING)
+    out = tmp_path / "out.npz"
+    assert main(["build", str(grammar), "--emit", str(out), "--quiet", "--workers", "1"]) == 0
+    before = out.read_bytes(), (tmp_path / "out.reports.json").read_text()
+
+    def full(*args, **kwargs):
+        raise OSError(errno.ENOSPC, "No space left on device")
+
+    monkeypatch.setattr(grammarc.io.reports.json, "dumps", full)
+    assert main(["build", str(grammar), "--emit", str(out), "--quiet", "--workers", "1", "--seed", "2"]) == 1
+    assert "No space left on device" in capsys.readouterr().err
+    assert (out.read_bytes(), (tmp_path / "out.reports.json").read_text()) == before
+
+
+@pytest.mark.parametrize("name, content, seems", [
+    ("x.obj", b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n", "a baked mesh"),
+    ("x.npz", np.lib.format.magic(1, 0) + b"{'descr': '<f8'}", "a single numpy array"),
+    ("notes.txt", b"hello\n", "a text file"),
+])
+def test_info_on_a_file_that_is_not_a_record_says_what_it_reads_and_what_the_file_seems(tmp_path, capsys, name,
+                                                                                       content, seems):
+    (tmp_path / name).write_bytes(content)
+    assert main(["info", str(tmp_path / name)]) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and ".npz instance records" in err and f"): {seems}" in err
+    assert "pickled" not in err
+
+
+def test_info_on_a_missing_file_says_so(tmp_path, capsys):
+    assert main(["info", str(tmp_path / "city.npz")]) == 2
+    assert capsys.readouterr().err.strip().endswith("city.npz: No such file or directory")
+
+
+def test_lots_to_a_path_that_cannot_be_written_is_refused_before_reading(tmp_path, capsys):
+    lots = geojson(tmp_path / "lots.geojson", [SQUARE])
+    (tmp_path / "out.parquet").mkdir()
+    assert main(["lots", str(lots), "--to", str(tmp_path / "out.parquet")]) == 2
+    err = capsys.readouterr()
+    assert err.out == "" and err.err.strip().endswith("out.parquet`: it is a folder")
+
+
+def test_the_libraries_warnings_do_not_reach_the_user(write, tmp_path):
+    """numpy's overflow in an attribute's arithmetic (which it warns of) is not shown beside grammarc's
+    messages; Python's -W still shows it to whom asks."""
+    grammar = write("g.cga", 'version "2023.0"\nattr z = 0\n@StartRule\nLot --> report("big", 1e308 * (10 + z)) X.\n')
+    command = ["-m", "grammarc.cli", "build", str(grammar), "--emit", str(tmp_path / "c.npz"), "--workers", "1"]
+    err = subprocess.run([sys.executable, *command], capture_output=True, text=True, check=False).stderr
+    assert "Warning" not in err and all(line.startswith(("grammarc:", str(tmp_path))) for line in err.splitlines())
+    asked = subprocess.run([sys.executable, "-W", "always::RuntimeWarning", *command], capture_output=True, text=True,
+                           check=False)
+    assert "RuntimeWarning: overflow" in asked.stderr

@@ -85,6 +85,24 @@ def writers() -> dict[tuple[str, bool], type]:
 def writer_for(path: str | Path, options: OutputOptions = OutputOptions()):
     """The writer factory for an output path: ``factory(path, assets=, symbols=, meta=)``, with the
     options its constructor takes; a UsageError names the supported extensions."""
+    writer = _writer_class(path, options)
+    given = _taken(writer, options)
+    return functools.partial(writer, **given) if given else writer
+
+
+def written_paths(path: str | Path, options: OutputOptions = OutputOptions()) -> tuple[list[Path], list[Path]]:
+    """The files and the folders that writing ``path`` makes: the output, and what its writer class puts
+    beside it (its ``beside(path)``: ``(files, folders)``, the longest names they may have), for
+    ``io.output_paths.check_writable`` to check before a build derives anything."""
+    path = Path(path)
+    beside = getattr(_writer_class(path, options), "beside", None)
+    files, folders = beside(path) if beside is not None else ([], [])
+    return [path, *files], list(folders)
+
+
+def _writer_class(path: str | Path, options: OutputOptions) -> type:
+    """The writer class of ``path``'s extension (and ``options.bake``); a UsageError names the supported
+    extensions."""
     suffix = Path(path).suffix.lower()
     # --bake: the extension's baked writer; else its instanced writer, or the baked one if it has none.
     writer = _first((suffix, options.bake)) or (None if options.bake else _first((suffix, True)))
@@ -96,8 +114,7 @@ def writer_for(path: str | Path, options: OutputOptions = OutputOptions()):
                              f"(supported: {supported})")
         bakeable = ", ".join(s for s, bakes in table if bakes)
         raise UsageError(f"--bake writes meshes ({bakeable}), not `{suffix}`")
-    given = _taken(writer, options)
-    return functools.partial(writer, **given) if given else writer
+    return writer
 
 
 def _first(key: tuple[str, bool]) -> type | None:

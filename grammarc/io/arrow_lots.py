@@ -61,7 +61,7 @@ def lots_from_table(table, column: str, path, first_row: int = 0, first_index: i
       The property columns over the builder's lots.
     """
     pa, _ = import_pyarrow()
-    geometry = _geometry(table, column, path)
+    geometry, unreadable = _geometry(table, column)
     n = len(geometry)
     names = [c for c in table.column_names if c != column]
     ids = _ids(table, names, n, first_row, id_field)
@@ -75,7 +75,7 @@ def lots_from_table(table, column: str, path, first_row: int = 0, first_index: i
     builder = LotBuilder(world=False)
     for f in np.flatnonzero(~good):
         what = "empty polygon" if kind[f] in (_POLYGON, _MULTIPOLYGON) else f"not a polygon ({_type_name(kind[f])})"
-        builder.reject(int(first[f]), ids[f], what)
+        builder.reject(int(first[f]), ids[f], unreadable.get(int(f), what))
     columns = {name: _column(table.column(name), pa) for name in names if name not in ("id", STREET_WIDTH)}
     widths = [_text_list(w) for w in table.column(STREET_WIDTH).to_pylist()] if STREET_WIDTH in names else None
     if widths is not None:  # only files with street widths pay a loop over their lots
@@ -105,20 +105,31 @@ def lots_from_table(table, column: str, path, first_row: int = 0, first_index: i
 def table_lot_numbers(table, column: str, path) -> int:
     """The lot numbers the rows of a table take: a polygon one, a multipolygon one per part, anything else
     one (a bad lot)."""
-    return int(_parts(_geometry(table, column, path))[4].sum())
+    return int(_parts(_geometry(table, column)[0])[4].sum())
 
 
-def _geometry(table, column: str, path) -> np.ndarray:
+def _geometry(table, column: str) -> tuple[np.ndarray, dict[int, str]]:
+    """The rows' geometries (None where null or unreadable), and why each unreadable row's WKB is (by row
+    of the table): such a row is a bad lot, as a GeoJSON feature whose geometry is not one."""
     values = table.column(column)
+    present = ~values.is_null().to_numpy(zero_copy_only=False)
     if hasattr(values.type, "storage_type"):  # an extension type (geoarrow.wkb): its WKB bytes
         values = [chunk.storage for chunk in values.chunks]
         values = np.concatenate([v.to_numpy(zero_copy_only=False) for v in values]) if values else np.zeros(0, object)
     else:
         values = values.to_numpy(zero_copy_only=False)
+    geometry = shapely.from_wkb(values, on_invalid="ignore")
+    return geometry, {int(row): f"bad WKB in column {column!r}: {_wkb_error(values[row])}"
+                      for row in np.flatnonzero(present & shapely.is_missing(geometry))}
+
+
+def _wkb_error(value) -> str:
+    """What GEOS says of one unreadable WKB value."""
     try:
-        return shapely.from_wkb(values)
-    except shapely.errors.GEOSException as error:
-        raise LotsError(f"{path}: bad WKB in column {column!r}: {error}") from error
+        shapely.from_wkb(value)
+    except (shapely.errors.GEOSException, TypeError, ValueError) as error:
+        return str(error)
+    return "unreadable"
 
 
 def _parts(geometry: np.ndarray):

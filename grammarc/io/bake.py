@@ -524,7 +524,12 @@ class BakedWriter(WriterBlock):
     @property
     def _mtl_path(self) -> Path:
         """The OBJ's material library, beside it: ``city.obj`` -> ``city.mtl``."""
-        return self.path.with_suffix(".mtl")
+        return self.beside(self.path)[0][0]
+
+    @staticmethod
+    def beside(path: Path) -> tuple[list[Path], list[Path]]:
+        """The files written beside ``path`` (``io.written_paths``): an OBJ's material library."""
+        return ([path.with_suffix(".mtl")] if path.suffix.lower() == ".obj" else []), []
 
     def _export(self, mesh, looks: np.ndarray | None) -> bytes:
         """The bytes of a PLY (with vertex colours where the record has colours) or STL (binary), or a GLB

@@ -22,13 +22,16 @@ GLB keeps sizes in 32-bit fields, so a file holds at most 4 GiB. Tiles are writt
 part's binary chunk; a tile that would pass ``max_bytes`` starts a new part. One part is ``city.glb``;
 more are ``city.glb``, ``city.1.glb``, ... with ``city.glb.json`` listing them. Memory is bounded by a
 tile (the binary chunk goes to a temporary file, and the JSON is small), and nothing is moved into
-place before every part is complete.
+place before every part is complete: then the parts after the first, the index, and ``city.glb`` last;
+an earlier build's index or parts that the new output does not have are removed.
 """
 
 from __future__ import annotations
 
+import glob
 import json
 import os
+import re
 import shutil
 import struct
 import tempfile
@@ -104,6 +107,12 @@ class GltfWriter(TiledWriter):
         super().__init__(path, assets=assets, meta=meta, asset_roots=asset_roots, tile_size=tile_size, lod=lod)
         self.max_bytes = int(max_bytes)
 
+    @staticmethod
+    def beside(path: Path) -> tuple[list[Path], list[Path]]:
+        """The files written beside ``path`` (``io.written_paths``): the index, and the parts after the
+        first, named as a ten-thousandth would be."""
+        return [index_path(path), path.with_name(f"{path.stem}.9999{path.suffix}")], []
+
     def _finish(self) -> dict:
         """The parts (``parts`` in the counts), the index when there are several."""
         parts = [_Part(self._tmp / "part0.bin", self._library, self._meta, self._colormap)]
@@ -117,13 +126,19 @@ class GltfWriter(TiledWriter):
         staged = [self._tmp / f"part{k}.glb" for k in range(len(parts))]
         for part, out in zip(parts, staged):
             part.finish(out)
+        for out, path in list(zip(staged, paths))[1:]:
+            os.replace(out, path)
         if len(parts) > 1:
             index = self._tmp / "index.json"
             index.write_text(json.dumps({"parts": [p.name for p in paths],
                                          "instances": [p.instances for p in parts]}, indent=1))
             os.replace(index, index_path(self.path))
-        for out, path in zip(staged, paths):
-            os.replace(out, path)
+        else:
+            index_path(self.path).unlink(missing_ok=True)  # an earlier build's, which would name its parts
+        os.replace(staged[0], self.path)
+        for stale in self.path.parent.glob(f"{glob.escape(self.path.stem)}.*{self.path.suffix}"):
+            if stale not in paths and re.fullmatch(r"\d+", stale.name[len(self.path.stem) + 1:-len(self.path.suffix)]):
+                stale.unlink()  # a part of an earlier build of more parts
         return {"parts": len(parts)}
 
 

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import contextlib
 import csv
 import json
 from pathlib import Path
@@ -9,7 +10,7 @@ from pathlib import Path
 from grammarc.atomic import replacing
 from grammarc.model.reports import Reports
 
-__all__ = ["write_reports"]
+__all__ = ["staged_reports", "write_reports"]
 
 
 def write_reports(reports: Reports, path: Path, ids: dict[int, str] | None = None) -> None:
@@ -17,6 +18,15 @@ def write_reports(reports: Reports, path: Path, ids: dict[int, str] | None = Non
     "ids": {index: id}}``) or, for a ``.csv`` path, as one table: a row per lot (its input number and
     id) and a last row ``total``, a column per ``key_n``/``_sum``/``_avg``/``_min``/``_max``, empty where
     a lot did not report the key. Written atomically."""
+    with staged_reports(reports, path, ids):
+        pass
+
+
+@contextlib.contextmanager
+def staged_reports(reports: Reports, path: Path, ids: dict[int, str] | None = None):
+    """``write_reports`` for a block that puts the output in place: the reports are written under a
+    temporary name before it runs (a failure to write them raises before the output is in place) and
+    renamed onto ``path`` when it ends; a block that raises leaves ``path`` as it was."""
     ids = ids or {}
     lots = {lot: reports.table(reports.lots[lot]) for lot in sorted(reports.lots)}
     total = reports.table(reports.totals())
@@ -32,6 +42,7 @@ def write_reports(reports: Reports, path: Path, ids: dict[int, str] | None = Non
             data = {"total": total, "lots": {str(lot): row for lot, row in lots.items()},
                     "ids": {str(lot): ids[lot] for lot in lots if lot in ids}}
             tmp.write_text(json.dumps(data, indent=1, sort_keys=False) + "\n")
+        yield
 
 
 def _cell(value) -> str:

@@ -12,6 +12,12 @@ A rule package is a 7-zip archive as CityEngine exports it::
 ``RulePackage`` (use it as a context manager, or call ``close()``), so rule files and assets are plain
 paths the compiler and the baker read as they read any other.
 
+An archive is untrusted input: a few kilobytes may decompress to gigabytes (a "zip bomb"). Extraction
+counts the bytes as they are decompressed, not as the archive's headers claim, and stops at the first of
+two limits: ``max_size`` bytes in all (``--max-package-size``, default ``MAX_PACKAGE_SIZE``, 2 GiB), and
+``MAX_RATIO`` times the archive's own size (packages of textures and rules compress a few times; a
+thousandfold is a bomb). Each member goes straight to its file, so memory stays small whatever the sizes.
+
 Assets are resolved as CityEngine resolves a relative ``i("facade/windows/x.obj")`` of a rule file: first
 in the ``assets`` folder of the project the rule file is in, then in that project's root
 (CityEngine manual, "Asset and texture search"). ``RulePackage.asset_roots`` lists those folders in that
@@ -41,7 +47,14 @@ from grammarc.model.assets import record_roots
 if TYPE_CHECKING:
     from typing_extensions import Self
 
-__all__ = ["RulePackage", "open_rpk", "record_asset_roots", "start_rule_of"]
+__all__ = ["MAX_PACKAGE_SIZE", "MAX_RATIO", "RulePackage", "open_rpk", "record_asset_roots", "start_rule_of"]
+
+#: The most bytes a package may extract to (``--max-package-size``).
+MAX_PACKAGE_SIZE = 2 << 30
+#: The most bytes a package may extract to per byte of the archive.
+MAX_RATIO = 1000
+#: The bytes py7zr decompresses at a time (``_small_blocks``).
+_BLOCK = 4 << 20
 
 _INSTALL_HINT = "pip install 'grammarc[rpk]' (or pip install py7zr)"
 
@@ -128,7 +141,8 @@ class RulePackage:
         return f"RulePackage({self.path.name!r}, main={main!r}, start={self.start_rule!r}, {state})"
 
 
-def open_rpk(path: str | os.PathLike, *, tmpdir: str | os.PathLike | None = None) -> RulePackage:
+def open_rpk(path: str | os.PathLike, *, tmpdir: str | os.PathLike | None = None,
+             max_size: int = MAX_PACKAGE_SIZE) -> RulePackage:
     """Extract a CityEngine rule package and describe it.
 
     Parameters
@@ -137,6 +151,8 @@ def open_rpk(path: str | os.PathLike, *, tmpdir: str | os.PathLike | None = None
         The ``.rpk`` file (a 7-zip archive).
     tmpdir : str or os.PathLike, optional
         Where to create the extraction directory; the system's temporary folder by default.
+    max_size : int
+        The most bytes the package may extract to (module docstring: this and ``MAX_RATIO``).
 
     Returns
     -------
@@ -146,8 +162,9 @@ def open_rpk(path: str | os.PathLike, *, tmpdir: str | os.PathLike | None = None
     Raises
     ------
     UsageError
-        If py7zr is missing (naming the ``rpk`` extra), the file is missing or not a 7-zip archive, or a
-        member's path is absolute, leaves the package or is a link.
+        If py7zr is missing (naming the ``rpk`` extra), the file is missing or not a 7-zip archive, a
+        member's path is absolute, leaves the package or is a link, or the package extracts to more than
+        its limits.
     """
     try:
         import py7zr
@@ -158,10 +175,19 @@ def open_rpk(path: str | os.PathLike, *, tmpdir: str | os.PathLike | None = None
         raise UsageError(f"rule package `{path}` does not exist")
     root = Path(tempfile.mkdtemp(prefix=f"grammarc-rpk-{path.stem}-", dir=tmpdir))
     try:
-        with py7zr.SevenZipFile(path, mode="r") as archive:
+        # an open file, not its path: py7zr then extracts in this thread (with a path, it extracts an
+        # archive's blocks in threads that each open the file and leave it open)
+        with open(path, "rb") as file, py7zr.SevenZipFile(file, mode="r") as archive:
             for info in archive.list():
                 _check_member(path, info)
-            archive.extractall(path=root)
+                folder = root / info.filename if info.is_directory else (root / info.filename).parent
+                folder.mkdir(parents=True, exist_ok=True)
+            extracted = _Extracted(root, _Budget(path, min(max_size, MAX_RATIO * path.stat().st_size)))
+            try:
+                with _small_blocks(py7zr):
+                    archive.extractall(factory=extracted)
+            finally:
+                extracted.close()
         return RulePackage(path, root)
     except (py7zr.exceptions.ArchiveError, EOFError) as error:
         shutil.rmtree(root, ignore_errors=True)
@@ -203,6 +229,84 @@ def _check_member(archive: Path, info) -> None:
         raise UsageError(f"rule package `{archive}`: member `{info.filename}` leaves the package")
     if getattr(info, "is_symlink", False):
         raise UsageError(f"rule package `{archive}`: member `{info.filename}` is a link")
+
+
+@contextlib.contextmanager
+def _small_blocks(py7zr):
+    """py7zr decompressed in blocks of ``_BLOCK`` bytes: its own are up to 128 MB (a quarter of the free
+    memory), each held twice before a byte of it is written, so a bomb would take that much memory before
+    the budget sees it. Its block size is a function of its module, set back when the block ends."""
+    module = py7zr.py7zr
+    own = module.get_memory_limit
+    module.get_memory_limit = lambda: _BLOCK
+    try:
+        yield
+    finally:
+        module.get_memory_limit = own
+
+
+class _Budget:
+    """The bytes a package may still extract to; ``take`` refuses the bytes past it."""
+
+    def __init__(self, archive: Path, limit: int):
+        self.archive = archive
+        self.limit = self.left = limit
+
+    def take(self, member: str, size: int) -> None:
+        self.left -= size
+        if self.left < 0:
+            raise UsageError(f"rule package `{self.archive}` extracts to more than {self.limit:,} bytes (at "
+                             f"`{member}`): at most {MAX_RATIO} times its size and --max-package-size")
+
+
+class _Extracted:
+    """py7zr's ``WriterFactory``: each member written to its file under ``root`` as it is decompressed,
+    its bytes taken from the package's budget."""
+
+    def __init__(self, root: Path, budget: _Budget):
+        self.root = root
+        self.budget = budget
+        self.files: list[_MemberFile] = []
+
+    def create(self, filename: str):
+        self.files.append(_MemberFile(self.root / filename, filename, self.budget))
+        return self.files[-1]
+
+    def close(self) -> None:
+        """Close every member's file (py7zr closes those it finished, not one a refusal stopped)."""
+        for member in self.files:
+            member.close()
+
+
+class _MemberFile:
+    """One member's file, as py7zr's ``Py7zIO`` (which it duck-types: py7zr is imported when a package is
+    opened, not with this module)."""
+
+    def __init__(self, path: Path, name: str, budget: _Budget):
+        self.name = name
+        self.budget = budget
+        self.file = open(path, "wb")  # noqa: SIM115 - closed by py7zr through close()
+        self.written = 0
+
+    def write(self, data) -> int:
+        self.budget.take(self.name, len(data))
+        self.written += len(data)
+        return self.file.write(data)
+
+    def read(self, size: int | None = None) -> bytes:
+        return b""
+
+    def seek(self, offset: int, whence: int = 0) -> int:
+        return self.file.seek(offset, whence)
+
+    def flush(self) -> None:
+        self.file.flush()
+
+    def size(self) -> int:
+        return self.written
+
+    def close(self) -> None:
+        self.file.close()
 
 
 def _main_rule_file(rules: dict[str, Path], compiled: list[str]) -> Path | None:

@@ -15,6 +15,7 @@ loaded is reported and left out of the polygon counts rather than failing the su
 from __future__ import annotations
 
 import contextlib
+import glob
 import os
 from collections import Counter
 from pathlib import Path
@@ -29,7 +30,20 @@ from grammarc.io.shards import is_manifest, manifest_path, shard_outputs
 from grammarc.model.assets import asset_library
 from grammarc.model.records import world_columns
 
-__all__ = ["format_summary", "summarize"]
+__all__ = ["READS", "format_summary", "summarize", "what_file"]
+
+#: What ``summarize`` reads, for the message about a file it cannot.
+READS = ".npz instance records, .usda/.usdc/.usd and .glb outputs of build, a cluster build's .manifest.json"
+#: A file's first bytes -> what it is, for a file ``summarize`` cannot read.
+_MAGIC = {b"PK\x03\x04": "a zip archive that is not an instance record", b"\x93NUMPY": "a single numpy array (.npy)",
+          b"glTF": "a glTF file that is not an output of build", b"#usda": "a USD layer that is not an output of build",
+          b"PXR-USDC": "a USD layer that is not an output of build", b"ply": "a PLY mesh", b"\x89PNG": "a PNG picture",
+          b"PAR1": "a Parquet file (lots? `grammarc lots` reads them)", b"SQLite": "a database (a GeoPackage?)"}
+#: Suffixes of files build writes that are not records: what they are.
+_MESHES = "a baked mesh, which build writes but info does not read (build --emit city.npz writes the record)"
+_WRITTEN = {".obj": _MESHES, ".ply": _MESHES, ".stl": _MESHES, ".json": "JSON (CityJSON? reports?)",
+            ".geojson": "GeoJSON (lots? `grammarc lots` reads them)", ".cga": "a grammar (`grammarc check` reads it)",
+            ".rpk": "a rule package (`grammarc check` reads it)"}
 
 
 def summarize(path: str | os.PathLike, asset_roots=None, lod: str | None = None) -> dict:
@@ -40,7 +54,7 @@ def summarize(path: str | os.PathLike, asset_roots=None, lod: str | None = None)
     """
     path = Path(path)
     if (path.suffix.lower() in (".usd", ".usda", ".usdc") and manifest_path(path).is_file()
-            and not path.with_name(f"{path.name}.tiles").exists()):
+            and not any(path.parent.glob(f"{glob.escape(path.name)}.tiles*"))):
         path = manifest_path(path)  # the root layer of a cluster build's shards
     with contextlib.ExitStack() as package:
         tallies = []
@@ -50,6 +64,24 @@ def summarize(path: str | os.PathLike, asset_roots=None, lod: str | None = None)
                 asset_roots = package.enter_context(record_asset_roots(record["meta"], asset_roots))
             tallies.append(_tally(record, files, asset_roots, lod))
         return _summary(path, tallies, asset_roots, lod)
+
+
+def what_file(path: str | os.PathLike) -> str:
+    """What a file that ``summarize`` cannot read seems to be: by its first bytes, else its suffix, else
+    text or not."""
+    path = Path(path)
+    with open(path, "rb") as file:
+        head = file.read(64)
+    found = next((what for magic, what in _MAGIC.items() if head.startswith(magic)), None)
+    if found is None and path.suffix.lower() in _WRITTEN:
+        found = _WRITTEN[path.suffix.lower()]
+    if found is None:
+        try:
+            head.decode()
+        except UnicodeDecodeError:
+            return "a binary file of another kind"
+        return "a text file" if head else "an empty file"
+    return found
 
 
 def _summary(path: Path, tallies: list[dict], asset_roots, lod: str | None) -> dict:

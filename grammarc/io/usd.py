@@ -27,21 +27,28 @@ The layout, for ``city.usdc``::
 
 Writing streams: ``write`` sorts each chunk into tile spools on disk (``TileSpool``), and ``close``
 makes one tile layer at a time, so memory is bounded by the largest tile, not by the city. Everything
-is written in a temporary folder next to the output; ``close`` moves the tile folder and then the root
-layer into place, so the root never names a tile layer that is not complete. ``.usda`` writes text
+is written in a temporary folder next to the output. The tile folder is named by a digest of its layers
+(``city.usdc.tiles-<12 hex>``, the root keeps the name as ``grammarc:tiles``), so a new build's tiles never
+take the place of those the old root names: ``close`` moves the new tile folder in beside the old one, then
+the root layer onto the old root, and only then removes the old tiles. A build stopped anywhere leaves the
+old root with its own tiles, or the new root with its own; the tile folders no root names (a stopped
+build's) go at the next build of the same output. ``.usda`` writes text
 layers throughout (small cities, for reading); ``.usdc`` and ``.usd`` write crate layers.
 """
 
 from __future__ import annotations
 
+import hashlib
 import json
 import os
+import re
 import shutil
 from collections.abc import Sequence
 from pathlib import Path
 
 import numpy as np
 
+from grammarc.atomic import replacing
 from grammarc.errors import UsageError
 from grammarc.io.instancing import TILE_SIZE, Tile, TiledWriter, compose, decompose
 
@@ -52,11 +59,34 @@ Gf = Sdf = Tf = Usd = UsdGeom = UsdShade = Vt = None
 __all__ = ["WRITERS", "UsdWriter", "read_usd", "tiles_folder", "write_shards_root"]
 
 
+#: The hexadecimal digits of the digest that names a tile folder.
+_DIGEST = 12
+
+
 def tiles_folder(path: str | os.PathLike) -> Path:
-    """The folder of a root layer's tile layers: ``city.usdc`` -> ``city.usdc.tiles`` (so ``city.usda`` and
-    ``city.usdc`` side by side do not share one)."""
+    """The folder of a root layer's tile layers, as the root names it: ``city.usdc`` ->
+    ``city.usdc.tiles-<digest>`` (so ``city.usda`` and ``city.usdc`` side by side do not share one)."""
+    _require_pxr()
     path = Path(path)
+    layer = Sdf.Layer.OpenAsAnonymous(str(path))  # not a layer of the registry, which may hold an older root
+    if layer is None:
+        raise ValueError(f"{path}: not a USD layer")
+    return path.with_name(layer.customLayerData.get("grammarc:tiles", _tiles_base(path).name))
+
+
+def _tiles_base(path: Path) -> Path:
+    """``city.usdc`` -> ``city.usdc.tiles``: the tile folders' names begin so."""
     return path.with_name(f"{path.name}.tiles")
+
+
+def _digest_folder(path: Path, staged: Path) -> Path:
+    """The tile folder of root ``path`` named by the SHA-256 of the layers in ``staged`` (names and
+    bytes, in name order)."""
+    digest = hashlib.sha256()
+    for layer in sorted(staged.iterdir()):
+        with open(layer, "rb") as file:
+            digest.update(layer.name.encode() + b"\0" + hashlib.file_digest(file, "sha256").digest())
+    return path.with_name(f"{_tiles_base(path).name}-{digest.hexdigest()[:_DIGEST]}")
 
 
 def _require_pxr() -> None:
@@ -101,15 +131,22 @@ class UsdWriter(TiledWriter):
         self._ext = ".usda" if self.path.suffix.lower() == ".usda" else ".usdc"
         self._symbols = list(symbols)
 
+    @staticmethod
+    def beside(path: Path) -> tuple[list[Path], list[Path]]:
+        """The folders written beside ``path`` (``io.written_paths``): the tile folder."""
+        return [], [path.with_name(f"{_tiles_base(path).name}-{'0' * _DIGEST}")]
+
     def _finish(self) -> dict:
         """The prototype, tile and root layers, moved into place."""
-        out = self._tmp / "out"
-        folder = out / tiles_folder(self.path).name
-        folder.mkdir(parents=True)
-        prototypes = self._write_prototypes(folder / f"prototypes{self._ext}")
-        tiles = [self._write_tile(folder, tile, prototypes) for tile in self._spool.tiles()]  # (name, origin)
-        self._write_root(out / self.path.name, tiles)
-        self._move_into_place(out)
+        staged = self._tmp / "tiles"
+        staged.mkdir()
+        prototypes = self._write_prototypes(staged / f"prototypes{self._ext}")
+        tiles = [self._write_tile(staged, tile, prototypes) for tile in self._spool.tiles()]  # (name, origin)
+        folder = _digest_folder(self.path, staged)
+        staged = staged.rename(self._tmp / folder.name)  # beside the new root as beside the output (composed)
+        root = self._tmp / self.path.name
+        self._write_root(root, tiles, folder.name)
+        self._move_into_place(staged, folder, root)
         return {}
 
     # ------------------------------------------------------------------------------------------ layers
@@ -207,7 +244,7 @@ class UsdWriter(TiledWriter):
             texture = UsdShade.Shader.Define(stage, f"{path}/Colormap")
             texture.CreateIdAttr("UsdUVTexture")
             texture.CreateInput("file", Sdf.ValueTypeNames.Asset).Set(
-                Sdf.AssetPath(os.path.relpath(colormap, tiles_folder(self.path).resolve())))
+                Sdf.AssetPath(os.path.relpath(colormap, _tiles_base(self.path).resolve())))
             texture.CreateInput("st", Sdf.ValueTypeNames.Float2).ConnectToSource(
                 reader.ConnectableAPI(), "result")
             surface.CreateInput("diffuseColor", Sdf.ValueTypeNames.Color3f).ConnectToSource(
@@ -215,9 +252,8 @@ class UsdWriter(TiledWriter):
             material.CreateSurfaceOutput().ConnectToSource(surface.ConnectableAPI(), "surface")
         UsdShade.MaterialBindingAPI.Apply(prim).Bind(material)
 
-    def _write_root(self, path: Path, tiles: list[tuple[str, np.ndarray]]) -> None:
+    def _write_root(self, path: Path, tiles: list[tuple[str, np.ndarray]], folder: str) -> None:
         stage = _new_stage(path, UsdGeom.Xform, "/City")
-        folder = tiles_folder(self.path).name
         for name, origin in tiles:
             xform = UsdGeom.Xform.Define(stage, f"/City/{name}")
             xform.AddTranslateOp().Set(Gf.Vec3d(*map(float, origin)))
@@ -226,20 +262,23 @@ class UsdWriter(TiledWriter):
         # the coordinate system of the world the tiles are placed in (null for a local scene), by itself too
         layer.customLayerData = {"grammarc": json.dumps(self._meta, sort_keys=True),
                                  "grammarc:symbols": json.dumps(self._symbols),
-                                 "grammarc:crs": self._meta.get("crs") or ""}
+                                 "grammarc:crs": self._meta.get("crs") or "",
+                                 "grammarc:tiles": folder}
         layer.Save()
 
-    def _move_into_place(self, out: Path) -> None:
-        """The tile folder first (an older one moved aside, then removed), the root layer last."""
-        folder = tiles_folder(self.path)
-        old = None
-        if folder.exists():
-            old = self._tmp / "old_tiles"
-            os.replace(folder, old)
-        os.replace(out / folder.name, folder)
-        os.replace(out / self.path.name, self.path)
-        if old is not None:
-            shutil.rmtree(old, ignore_errors=True)
+    def _move_into_place(self, staged: Path, folder: Path, root: Path) -> None:
+        """The new tile folder beside the old one, the root layer onto the old root, then the tile folders
+        the root does not name (the old root's, a stopped build's) removed. A folder of the new tiles'
+        name already there holds the same layers (an earlier build of the same city) and is kept."""
+        if not folder.exists():
+            os.replace(staged, folder)
+        with open(root, "rb") as file:
+            os.fsync(file.fileno())
+        os.replace(root, self.path)
+        pattern = re.compile(rf"{re.escape(_tiles_base(self.path).name)}(-[0-9a-f]{{{_DIGEST}}})?")
+        for old in self.path.parent.iterdir():
+            if old != folder and pattern.fullmatch(old.name) and old.is_dir():
+                shutil.rmtree(old, ignore_errors=True)
 
 
 #: The extensions this module writes (``grammarc.io.writers``).
@@ -250,17 +289,16 @@ def write_shards_root(output: Path, manifest: dict) -> None:
     """The root layer of a cluster build (``io.shards``): ``/City`` with a child per shard the manifest
     lists, referencing the shard's own root layer (whose tiles it places). Written atomically."""
     _require_pxr()
-    tmp = output.with_name(f".{output.name}.tmp{os.getpid()}{output.suffix}")
-    stage = _new_stage(tmp, UsdGeom.Xform, "/City")
-    for shard in manifest["shards"]:
-        name = Path(shard["path"]).name.split(".")[0].replace("-", "_")
-        UsdGeom.Xform.Define(stage, f"/City/{name}").GetPrim().GetReferences().AddReference(f"./{shard['path']}")
-    layer = stage.GetRootLayer()
-    layer.customLayerData = {"grammarc": json.dumps(manifest["meta"], sort_keys=True),
-                             "grammarc:symbols": json.dumps(manifest["symbols"]),
-                             "grammarc:manifest": output.stem + ".manifest.json"}
-    layer.Save()
-    os.replace(tmp, output)
+    with replacing(output) as tmp:
+        stage = _new_stage(tmp, UsdGeom.Xform, "/City")
+        for shard in manifest["shards"]:
+            name = Path(shard["path"]).name.split(".")[0].replace("-", "_")
+            UsdGeom.Xform.Define(stage, f"/City/{name}").GetPrim().GetReferences().AddReference(f"./{shard['path']}")
+        layer = stage.GetRootLayer()
+        layer.customLayerData = {"grammarc": json.dumps(manifest["meta"], sort_keys=True),
+                                 "grammarc:symbols": json.dumps(manifest["symbols"]),
+                                 "grammarc:manifest": output.stem + ".manifest.json"}
+        layer.Save()
 
 
 def _new_stage(path: Path, kind, root: str):

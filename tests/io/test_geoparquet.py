@@ -69,9 +69,23 @@ def test_a_parquet_file_without_footprints_is_refused_by_name(tmp_path):
     pq.write_table(pa.table({"id": ["a"], "height": [3.0]}), tmp_path / "plain.parquet")
     with pytest.raises(LotsError, match="plain.parquet: no WKB geometry column"):
         read_lots(tmp_path / "plain.parquet")
-    pq.write_table(pa.table({"id": ["a"], "geometry": [b"not wkb"]}), tmp_path / "bad.parquet")
-    with pytest.raises(LotsError, match="bad.parquet: bad WKB in column 'geometry'"):
-        read_lots(tmp_path / "bad.parquet")
+    (tmp_path / "broken.parquet").write_bytes(b"PAR1 not a parquet file")
+    with pytest.raises(LotsError, match="broken.parquet"):
+        read_lots(tmp_path / "broken.parquet")
+
+
+def test_a_bad_row_is_a_bad_lot_by_its_number_and_id_and_the_other_rows_are_read(tmp_path, capsys):
+    """Unreadable WKB (garbage, cut short), a null geometry and a point: four bad lots, one good."""
+    square = shapely.to_wkb(shapely.box(0, 0, 10, 10))
+    pq.write_table(pa.table({"id": ["a", "b", "c", "d", "e"], "geometry": [
+        square, b"not wkb", None, shapely.to_wkb(shapely.Point(1, 2)), square[:10]]}), tmp_path / "rows.parquet")
+    lots = read_lots(tmp_path / "rows.parquet")
+    assert lots.ids.tolist() == ["a"] and lots.index.tolist() == [0]
+    assert [(b.index, b.id) for b in lots.bad] == [(1, "b"), (2, "c"), (3, "d"), (4, "e")]
+    assert [b.reason.split(":")[0] for b in lots.bad] == ["bad WKB in column 'geometry'", "not a polygon (null geometry)",
+                                                         "not a polygon (Point)", "bad WKB in column 'geometry'"]
+    assert main(["lots", str(tmp_path / "rows.parquet")]) == 0
+    assert "lot b (#1) is bad: bad WKB in column 'geometry': ParseException" in capsys.readouterr().err
 
 
 def test_parquet_partitions_follow_row_groups_near_their_size(tmp_path):

@@ -8,7 +8,7 @@ import pytest
 import trimesh
 from writers_city import TEXTURED, TEXTURED_GROUND, city, glb_city, nearest_uv, textured_city, world
 
-from grammarc.io.gltf import GltfWriter, _read_part, part_paths
+from grammarc.io.gltf import MAX_BYTES, GltfWriter, _read_part, part_paths, written_parts
 from grammarc.model.records import MeshChunk, TerminalChunk
 
 pygltflib = pytest.importorskip("pygltflib")
@@ -120,3 +120,16 @@ def test_the_polygons_carry_the_records_texture_coordinates(tmp_path):
                                        atol=1e-5)
             checked += len(points)
     assert checked >= 2 * 8 * 3  # two rings with a hole: eight triangles each
+
+
+def test_a_city_of_one_part_replaces_one_of_many_without_leaving_its_index_or_parts(tmp_path):
+    record, _, _ = city(tmp_path, "city.npz")
+    path = tmp_path / "small.glb"
+    for max_bytes in (3000, MAX_BYTES):
+        with GltfWriter(path, assets=list(record["assets"]), symbols=list(record["symbols"]), meta=record["meta"],
+                        tile_size=10.0, max_bytes=max_bytes) as writer:
+            writer.write(TerminalChunk(asset=record["asset"], xform=record["xform"], lot=record["lot"],
+                                       symbol=record["symbol"], mesh=MeshChunk.empty(), color=record["color"]))
+            parts = writer.close()["parts"]
+    assert parts == 1 and sorted(p.name for p in tmp_path.glob("small*")) == ["small.glb"]
+    assert written_parts(path) == [path] and len(instances(path)[0]) == len(record["asset"])

@@ -183,3 +183,65 @@ def test_a_record_of_a_package_loads_the_package_assets_again(tmp_path, capsys):
     assert not info["problems"]
     assert main(["render", str(tmp_path / "posts.npz"), "-o", str(tmp_path / "posts.png")]) == 0
     assert "drawn as boxes" not in capsys.readouterr().err
+
+
+@pytest.fixture(scope="module")
+def bomb(tmp_path_factory):
+    """A package of 5 KB whose asset decompresses to 32 MiB of zeros (a zip bomb, small)."""
+    path = tmp_path_factory.mktemp("bomb") / "bomb.rpk"
+    with py7zr.SevenZipFile(path, "w", filters=[{"id": py7zr.FILTER_LZMA2, "preset": 1}]) as archive:
+        archive.writestr(b"Lot --> X\n", "rules/a.cga")
+        archive.writestr(b"\0" * (32 << 20), "assets/zero.bin")
+    return path
+
+
+def test_a_package_that_extracts_to_more_than_a_thousand_times_its_size_is_refused(bomb, tmp_path):
+    assert bomb.stat().st_size < 10_000
+    with pytest.raises(UsageError, match=r"bomb.rpk` extracts to more than [\d,]+ bytes \(at `assets/zero.bin`\)"):
+        open_rpk(bomb, tmpdir=tmp_path)
+    assert list(tmp_path.iterdir()) == []  # nothing left of the extraction
+
+
+def test_a_package_past_max_package_size_is_refused(tmp_path):
+    package = make_rpk(tmp_path / "p.rpk", {"rules/a.cga": "Lot --> X\n" * 10, "assets/a.obj": "v 0 0 0\n" * 50})
+    with open_rpk(package, max_size=600) as rpk:
+        assert rpk.main_rule_file.read_text() == "Lot --> X\n" * 10
+    with pytest.raises(UsageError, match="extracts to more than 499 bytes"):  # 100 + 400
+        open_rpk(package, max_size=499)
+
+
+def test_the_command_refuses_a_bomb_in_one_line_exit_2(bomb, tmp_path, capsys):
+    from grammarc.cli import main
+
+    assert main(["build", str(bomb), "--emit", str(tmp_path / "c.npz"), "--quiet"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and "extracts to more than" in err and "--max-package-size" in err
+    assert main(["check", str(bomb), "--max-package-size", "1K"]) == 2
+
+
+def test_a_bomb_is_refused_with_little_memory(bomb, tmp_path):
+    """Decompressed a few MiB at a time: the 32 MiB member is not held whole before it is refused."""
+    import subprocess
+
+    # the peak resident memory of the process (VmHWM: ru_maxrss would be the forking pytest's), in KiB
+    peak = "int(open('/proc/self/status').read().split('VmHWM:')[1].split()[0])"
+    script = ("import py7zr\nfrom grammarc.io.rpk import open_rpk\n"
+              f"before = {peak}\n"
+              f"try:\n    open_rpk({str(bomb)!r}, tmpdir={str(tmp_path)!r})\nexcept Exception:\n    pass\n"
+              f"print({peak} - before)")
+    grown = int(subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, check=True).stdout)
+    assert grown < 24 << 10
+
+
+@needs_kit
+def test_extracting_a_package_leaves_no_file_open():
+    """py7zr given the archive's path extracts the blocks of an archive of several (candler's) in threads
+    that each leave it open: a ResourceWarning each."""
+    import warnings
+
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        with open_rpk(KIT / "rpk" / "candler.rpk"):
+            pass
+        gc.collect()
+    assert [w for w in caught if issubclass(w.category, ResourceWarning)] == []

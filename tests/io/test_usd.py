@@ -98,3 +98,32 @@ def test_polygons_without_texture_coordinates_have_no_st(tmp_path):
     stage = Usd.Stage.Open(str(textured_city(tmp_path, untextured, ".usda")))
     meshes = [UsdGeom.Mesh(p) for p in stage.Traverse() if p.IsA(UsdGeom.Mesh) and p.GetName() == "Meshes"]
     assert meshes and not any(UsdGeom.PrimvarsAPI(m).HasPrimvar("st") for m in meshes)
+
+
+def test_a_build_stopped_before_its_root_is_in_place_leaves_the_old_root_with_its_old_tiles(tmp_path, monkeypatch):
+    """The new tiles go to a folder of their own that the new root names: until the root is renamed, the
+    old root keeps its tiles; the next build removes the stopped one's folder."""
+    import os
+
+    from grammarc.io.usd import read_usd
+
+    record, path, counts = city(tmp_path, "city.usdc", tile_size=100.0)
+    before = read_usd(path)
+    assert len(before["asset"]) == counts["instances"] == len(record["asset"])
+    replace = os.replace
+
+    def stop_at_the_root(source, target):
+        if os.fspath(target) == os.fspath(path):
+            raise KeyboardInterrupt  # stopped between the tiles and the root
+        replace(source, target)
+
+    monkeypatch.setattr(os, "replace", stop_at_the_root)
+    with pytest.raises(KeyboardInterrupt):
+        city(tmp_path, "city.usdc", tile_size=1000.0)
+    monkeypatch.setattr(os, "replace", replace)
+    after = read_usd(path)
+    assert len(after["asset"]) == len(before["asset"]) and np.array_equal(after["xform"], before["xform"])
+    assert tiles_folder(path).is_dir() and len(list(tmp_path.glob("city.usdc.tiles*"))) == 2  # and the orphan
+    city(tmp_path, "city.usdc", tile_size=1000.0)
+    assert [p.name for p in tmp_path.glob("city.usdc.tiles*")] == [tiles_folder(path).name]
+    assert len(read_usd(path)["asset"]) == len(before["asset"])
