@@ -94,6 +94,8 @@ class BuildResult:
     #: The lots file read (or the built-in lot's description), and ids that more than one lot has.
     lots_source: str = ""
     duplicate_ids: tuple[str, ...] = ()
+    #: False when no lot could be built: the build failed, and the output (an older one too) is untouched.
+    written: bool = True
 
 
 def find_lots(grammar_path: Path) -> Path | None:
@@ -175,8 +177,12 @@ def _build(source: Path, display: str | None, grammar_path: Path, output, lots_p
     writer_class = writer_for(output, replace(output_options, asset_roots=tuple(grammar.asset_roots), lots=every))
     failed: list[BadLot] = []
     reports = Reports()
-    with writer_class(output, assets=grammar.assets, symbols=plan.symbol_names, meta=meta) as writer:
+    counts: dict = {}
+    with contextlib.suppress(_NothingBuilt), \
+            writer_class(output, assets=grammar.assets, symbols=plan.symbol_names, meta=meta) as writer:
         derived = derive_all(plan, lots, options, writer, failed, reports, progress, every)
+        if not derived and (lots.bad or failed):
+            raise _NothingBuilt  # a failed build: the writer aborts, an older output stays as it was
         # the reports are written before the output is put in place and renamed after it: a build whose
         # reports cannot be written leaves no new output
         with (staged_reports(reports, reports_file, dict(zip(every.index.tolist(), every.ids.tolist())))
@@ -186,7 +192,11 @@ def _build(source: Path, display: str | None, grammar_path: Path, output, lots_p
     ids, times = np.unique(every.ids.astype(str), return_counts=True)
     return BuildResult(Path(output), len(lots) + len(lots.bad), derived, bad, counts,
                        time.perf_counter() - started, grammar, lots.crs_note, every.source,
-                       tuple(ids[times > 1].tolist()))
+                       tuple(ids[times > 1].tolist()), written=bool(counts))
+
+
+class _NothingBuilt(Exception):
+    """Every lot of a build was bad or failed: raised inside the writer so that it writes nothing."""
 
 
 def record_meta(grammar_path: Path, grammar: Grammar, plan, options: BuildOptions, lots_source: str,

@@ -495,15 +495,17 @@ def _build(args) -> int:
                   "ids", file=sys.stderr)
         for bad in result.bad:
             print(f"grammarc: lot {bad.id} (#{bad.index}) skipped: {bad.reason}", file=sys.stderr)
-        n = result.counts.get("instances", 0)
-        rate = n / result.seconds if result.seconds > 0 else 0.0
-        print(f"{result.output}: {n:,} instances, {result.counts.get('mesh_faces', 0):,} mesh faces from "
-              f"{result.derived:,} lots ({len(result.bad)} skipped) in {result.seconds:.2f} s "
-              f"({rate:,.0f} terminals/s)", file=sys.stderr)
+        if result.written:
+            n = result.counts.get("instances", 0)
+            rate = n / result.seconds if result.seconds > 0 else 0.0
+            print(f"{result.output}: {n:,} instances, {result.counts.get('mesh_faces', 0):,} mesh faces from "
+                  f"{result.derived:,} lots ({len(result.bad)} skipped) in {result.seconds:.2f} s "
+                  f"({rate:,.0f} terminals/s)", file=sys.stderr)
     if result.bad and result.derived == 0:
         reasons = Counter(b.reason for b in result.bad).most_common(3)
         print(f"grammarc: none of the {result.lots:,} lots could be built ("
-              + "; ".join(f"{n:,} {reason}" for reason, n in reasons) + ")", file=sys.stderr)
+              + "; ".join(f"{n:,} {reason}" for reason, n in reasons) + ")"
+              + ("" if result.written else "; nothing was written"), file=sys.stderr)
         return 1
     if result.bad:
         print(f"grammarc: {len(result.bad):,} of {result.lots:,} lots skipped", file=sys.stderr)

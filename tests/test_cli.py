@@ -102,9 +102,11 @@ def test_a_build_says_how_many_lots_were_bad_and_exit_codes_tell_the_truth(write
                  "--strict"]) == 1
     capsys.readouterr()
     none = geojson(tmp_path / "none.geojson", [BOWTIE, FLAT, BOWTIE])
-    assert main(["build", grammar, "--lots", str(none), "--emit", str(tmp_path / "c.npz"), "--quiet"]) == 1
+    assert main(["build", grammar, "--lots", str(none), "--emit", str(tmp_path / "a.npz"), "--quiet"]) == 1
     err = capsys.readouterr().err
-    assert "grammarc: none of the 3 lots could be built (2 self-intersection at (5.0, 5.0); 1 zero area)" in err
+    assert err == ("grammarc: none of the 3 lots could be built (2 self-intersection at (5.0, 5.0); 1 zero area); "
+                   "nothing was written\n")
+    assert set(read_instances(tmp_path / "a.npz")["lot"].tolist()) == {0}  # the failed build left the older city
 
 
 def test_a_build_without_lots_says_which_it_built_even_when_quiet(write, tmp_path, capsys):
