@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import re
 import signal
 import subprocess
 import sys
@@ -150,15 +151,22 @@ def test_negative_size_lot_skipped_by_id(write, tmp_path, capsys):
     assert list(read_instances(out)["lot"]) == [1]
 
 
-def test_runaway_recursion_fails_and_leaves_existing_output(write, tmp_path, capsys):
+def test_a_runaway_lot_is_skipped_by_name_and_the_others_built(write, tmp_path, capsys):
+    """--max-shapes and --max-depth are limits per lot: the lot over one is a bad lot named with the rule
+    and its place, the good ones are written, exit 0; where every lot runs away, exit 1 with the reason."""
     out = tmp_path / "out.npz"
-    out.write_bytes(b"previous")
-    grammar = write("g.cga", "grow ~> T(0, 1, 0) grow grow\n")
-    assert main(["build", str(grammar), "--emit", str(out), "--max-shapes", "100000"]) == 1
+    grammar = write("g.cga", "attr n = 0\nlot : n > 0 ~> grow\nlot ~> I(\"cube\")\n"
+                             "grow ~> T(0, 1, 0) grow grow\n")
+    lots = geojson(tmp_path / "city.geojson", [SQUARE] * 3, [{"n": 0}, {"n": 1}, {"n": 0}])
+    assert main(["build", str(grammar), "--lots", str(lots), "--emit", str(out), "--max-shapes", "100000"]) == 0
     err = capsys.readouterr().err
-    assert "rule `grow`" in err and "--max-shapes" in err
-    assert out.read_bytes() == b"previous"
-    assert sorted(p.name for p in tmp_path.iterdir()) == ["g.cga", "out.npz"]
+    assert re.search(r"grammarc: lot lot1 \(#1\) skipped: more than 100,000 shapes \(131,071\) in rule `grow` at "
+                     r"\S*g\.cga:4:\d+: a runaway grammar\? Raise the limit with --max-shapes N\.\n", err)
+    assert err.endswith("grammarc: 1 of 3 lots skipped\n")
+    assert list(read_instances(out)["lot"]) == [0, 2]
+    assert main(["build", str(grammar), "--emit", str(out), "--attr", "n=1", "--max-depth", "10"]) == 1
+    assert "none of the 1 lots could be built (1 reached --max-depth 10 in rule `grow`" in capsys.readouterr().err
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["city.geojson", "g.cga", "out.npz"]
 
 
 def test_depth_limit_can_be_raised(write, tmp_path):
