@@ -4,7 +4,6 @@ bodies run (push and pop; in CityEngine a body without a successor leaves its sh
 from __future__ import annotations
 
 import numpy as np
-import pytest
 from operations.derivations import (
     assets,
     names,
@@ -13,7 +12,6 @@ from operations.derivations import (
     rect,
     run,
 )
-
 
 
 def test_paper_notation_scale_alone_emits_nothing(write):
