@@ -55,13 +55,18 @@ class Context:
     # ------------------------------------------------------------------------------------------- failures
     def fail(self, shapes: Shapes, bad: np.ndarray, message: str, span) -> None:
         """Report the lots of shapes ``bad`` (n,) bool as failed: raises ``LotFailure``."""
-        lots = np.unique(shapes.lot[bad])
+        self.fail_lots(shapes.lot[bad], message, span)
+
+    def fail_lots(self, lots: np.ndarray, message: str, span) -> None:
+        """Report ``lots`` (chunk-local numbers, repeats allowed) as failed in the rule being applied, at
+        ``span`` (None: a symbol without rules, whose leaves are being emitted): raises ``LotFailure``."""
         rule = self.plan.symbols[self.symbol].name
-        raise LotFailure(f"{message} in rule `{rule}` at {span}", lots)
+        where = f" at {span}" if span is not None else ""
+        raise LotFailure(f"{message} in rule `{rule}`{where}", np.unique(lots))
 
     def fail_negative(self, shapes: Shapes, values: np.ndarray, message: str, span) -> None:
         """Fail the shapes whose sizes (n, k), or (1, k) for all, are negative or NaN, quoting the first."""
-        bad = ~(values >= 0).all(axis=1)
+        bad = np.broadcast_to(~(values >= 0).all(axis=1), (len(shapes),))
         if bad.any():
             row = values[np.flatnonzero(bad)[0]]
             self.fail(shapes, bad, f"{message} ({', '.join(f'{v:g}' for v in np.atleast_1d(row))})", span)

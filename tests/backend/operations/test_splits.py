@@ -97,6 +97,15 @@ def test_nan_split_size_lot_is_reported(write):
     assert r["bad"][0].index == 1 and "Subdiv" in r["bad"][0].reason
 
 
+def test_a_negative_subdiv_size_of_every_shape_fails_their_lots(write):
+    """A size negative for every shape (a constant, one row for the batch) fails the lots of all of them:
+    it gave an IndexError where the batch held more than one shape (a facade's four sides)."""
+    r = paper(write, 'attr w = 2\nlot ~> S(1r, 3, 1r) Comp("sidefaces"){ f }\nf ~> Subdiv("X", -2, 1r){ a | b }\n'
+                     'a ~> I("cube")\nb ~> I("cube")\n', [rect(10, 10)] * 2)
+    assert len(r["lot"]) == 0
+    assert [b.reason.split(" in rule")[0] for b in r["bad"]] == ["`Subdiv` has a negative or NaN size (-2, 1)"] * 2
+
+
 @pytest.mark.parametrize("text", [
     'Lot --> split(x){ tile : A. }*\n',
     'Lot --> split(x){ ~tile : A. }*\n',
