@@ -151,8 +151,9 @@ def group_counts(extent, values, kind, group, n_groups, tol):
 
     Returns reps (n, max(n_groups, 1)) int64 each group's repetitions (``MAX_COUNT`` beyond int64), gap
     (n, max(n_groups, 1)) float64 the room left at a group's end, scale (n,) float64 the floating sizes'
-    factor, and count (n,) float64 the parts each shape lays (some may be dropped as empty): what the
-    caller checks against --max-shapes before ``group_split`` allocates them.
+    factor, and count (n,) float64 the parts each shape lays, and those a repetition too small to lay
+    (of at most ``tol``) would make: what the caller checks against --max-shapes before ``group_split``
+    allocates them (an upper bound: parts of length <= tol are dropped).
     """
     n = len(extent)
     count = values.shape[1]
@@ -192,8 +193,10 @@ def group_counts(extent, values, kind, group, n_groups, tol):
             later += nominal[g]
         for g in range(n_groups):
             if nominal[g] <= tol:
-                # a repetition of no size repeats nothing; one too small to lay would repeat beyond count
-                reps[i, g] = MAX_COUNT if nominal[g] > 0.0 and left > tol else 0
+                # a repetition too small to lay repeats nothing, but counts as the parts it would make:
+                # its lot fails if they are more than --max-shapes (one of no size makes none)
+                if nominal[g] > 0.0 and left > tol:
+                    total[i] += left / nominal[g]
                 continue
             share = left * nominal[g] / later
             later -= nominal[g]
