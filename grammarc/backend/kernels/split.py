@@ -199,6 +199,8 @@ def group_counts(extent, values, kind, group, n_groups, tol):
                     total[i] += left / nominal[g]
                 continue
             share = left * nominal[g] / later
+            if share == np.inf:  # left * nominal overflowed (a size near float64's largest)
+                share = left * (nominal[g] / later)
             later -= nominal[g]
             if group_float[g] > 0.0:
                 r = _repetitions(share, nominal[g], group_fixed[g], group_float[g], loose, floating, tol)

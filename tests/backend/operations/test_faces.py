@@ -385,14 +385,15 @@ def test_a_roof_of_90_degrees_or_more_fails_its_lot_by_name(write, op, angle):
     assert bad.index == 1 and bad.reason.startswith(f"`{op}` with an angle of 90 degrees or more in rule `Lot` at ")
 
 
-@pytest.mark.parametrize("select", ["", "comp(f){ inside : I. | border : B. }", "Roof."])
-def test_an_offset_beyond_any_coordinate_fails_its_lot(write, select):
+@pytest.mark.parametrize("select", ["", "comp(f){ inside : I. | border : B. }", "Roof.", "setback", "shapeL"])
+def test_an_offset_or_setback_beyond_any_coordinate_fails_its_lot(write, select):
     """An outline moved out by more than float32 holds (GEOS raised on 1e308) fails its lot; moved in that
     far, nothing is left of it, which is no error."""
-    body = f"offset(d) {select or 'A.'}"
-    if select == "Roof.":
-        body = "extrude(3) comp(f){ top : roofHip(30) offset(d) Roof. }"
+    body = {"Roof.": "extrude(3) comp(f){ top : roofHip(30) offset(d) Roof. }",
+            "setback": "setback(d){ front : A. | remainder : B. }",
+            "shapeL": "shapeL(d, 2){ shape : A. | remainder : B. }"}.get(select, f"offset(d) {select or 'A.'}")
+    what = "setback" if select in ("setback", "shapeL") else "offset"
     r = run(write, f"attr d = -1\nLot --> {body}\n", [rect(10, 10)] * 3,
             lot_attrs={"d": np.array([-1.0, 1e308, -1e308])})
     reasons = [(b.index, b.reason.split(" in rule")[0]) for b in r["bad"]]
-    assert reasons == [(1, "`offset` by 1e+308, beyond any coordinate")]
+    assert reasons == [(1, f"`{what}` by 1e+308, beyond any coordinate")]

@@ -126,6 +126,13 @@ def test_a_split_of_too_many_or_too_small_parts_fails_its_lot_only(write, text):
     assert "(beyond counting)" in r["bad"][1].reason
 
 
+def test_a_repeat_of_a_size_near_float64s_largest_fits_no_time(write):
+    """A repetition of 1e308 m fits no time into 10 m: its share of the room overflowed (``left *
+    nominal``) to inf, which counted beyond any --max-shapes and failed the lot."""
+    r = run(write, 'Lot --> extrude(10) split(y){ 1e308 : A. | ~1 : B. }*\n', [rect(10, 10)])
+    assert r["bad"] == () and len(r["xform"]) == 1
+
+
 def test_a_repeat_whose_count_overflows_fails_its_lot(write):
     """``Repeat("X", 1e-18)`` makes 3e19 elements: more than int64 counts (it gave one element spanning
     the facade), so its lot fails, before anything is allocated."""
