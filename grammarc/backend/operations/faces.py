@@ -49,7 +49,8 @@ from grammarc.ir import nodes as ir
 from grammarc.ragged import next_in_segment, ragged_take, rank_within, segment_of
 
 #: A distance that moves an outline out beyond this (float32's largest number) makes no record, and beyond
-#: float64's GEOS raises: ``offset`` and ``setback`` fail the lots of such distances, and of NaN ones.
+#: float64's GEOS raises: ``offset`` and ``setback`` fail the lots of such distances (a NaN one stays what
+#: it was: no setback, as PRT takes massing's; ``setbackToArea``'s maximums may be inf: none).
 FAR = float(np.finfo(np.float32).max)
 
 @operation(ir.Roof, writes=("origin", "size", "geom"))
@@ -391,6 +392,10 @@ def setback(ctx: Context, cursor: Shapes, op: ir.Setback) -> Parts:
     """``setback`` and ``shapeL/U/O``: the face's edge strips and its remainder to their parts."""
     face = _SetbackFaces(ctx, cursor, op, "setback", (*op.selectors, *(s for s, _ in op.distances)))
     distance = face.distances(ctx, cursor, op.distances, op.per_edge, 0.0)
+    far = distance > FAR
+    if far.any():
+        ctx.fail_lots(cursor.lot[face.edges.poly[far]], f"`setback` by {distance[far][0]:g}, beyond any coordinate",
+                      op.span)
     return face.parts(ctx, cursor, op, distance)
 
 
@@ -419,7 +424,6 @@ class _SetbackFaces:
 
     def __init__(self, ctx: Context, cursor: Shapes, op: ir.Setback | ir.SetbackToArea, what: str,
                  names: tuple[str, ...]):
-        self.what, self.span = what, op.span
         self.polygons, self.plane = face_polygons(ctx, cursor, what, op.span)
         self.edges = edges = polygon_edges(self.polygons)
         self.normal = plane_to_scope(-edges.inward, self.plane[edges.poly])
@@ -442,13 +446,7 @@ class _SetbackFaces:
         table = np.full((len(distances) + 1, len(shapes)), fill)
         for k, (_, expr) in enumerate(distances):
             table[k] = evaluate_array(expr, env)
-        which = classify_faces(self.normal, tuple(s for s, _ in distances), self.frames)
-        distance = table[which, column]
-        far = (which < len(distances)) & ~(distance <= FAR)  # the fill may be inf (no maximum)
-        if far.any():
-            ctx.fail_lots(cursor.lot[poly[far]], f"`{self.what}` by {distance[far][0]:g}, beyond any coordinate",
-                          self.span)
-        return distance
+        return table[classify_faces(self.normal, tuple(s for s, _ in distances), self.frames), column]
 
     def parts(self, ctx: Context, cursor: Shapes, op, distance: np.ndarray) -> Parts:
         """The parts of ``op`` on the strips of the edges moved by ``distance`` (E,) and the remainder."""
@@ -576,10 +574,10 @@ def _offset_polygons(ctx: Context, distance: ir.Expr, cursor: Shapes, span):
 
 
 def _distances(ctx: Context, distance: ir.Expr, cursor: Shapes, span) -> np.ndarray:
-    """``offset``'s distance (n,) float64 per shape; a lot whose outline it moves out beyond ``FAR`` fails,
-    as does a NaN one. Moved in that far, nothing is left of an outline: that is no error."""
+    """``offset``'s distance (n,) float64 per shape; a lot whose outline it moves out beyond ``FAR`` fails.
+    Moved in that far, nothing is left of an outline: that is no error."""
     d = np.broadcast_to(np.asarray(evaluate_array(distance, ctx.env(cursor)), float), (len(cursor),))
-    far = ~(d <= FAR)
+    far = d > FAR
     if far.any():
         ctx.fail(cursor, far, f"`offset` by {d[far][0]:g}, beyond any coordinate", span)
     return d
