@@ -3,13 +3,11 @@
 Lots are derived in chunks of ``chunk_size`` and each chunk's records are streamed to the writer, so memory
 is bounded by a chunk (docs/architecture.md, invariant 3). A chunk that cannot be derived whole is not lost:
 
-- lots that fail (a negative size, an unsupported geometry) are reported by id and skipped, and the chunk
-  is derived again without them;
+- lots that fail (a negative size, an unsupported geometry, more shapes than --max-shapes, a recursion
+  deeper than --max-depth) are reported by id and skipped, and the chunk is derived again without them;
 - a chunk that makes more shapes than its memory budget is split in halves, derived one after the other.
 
-Neither changes the output of the other lots, because a lot's records do not depend on its chunk. A
-``LimitError`` (runaway recursion or shape explosion) stops the build: it names the rule, and nothing is
-written.
+Neither changes the output of the other lots, because a lot's records do not depend on its chunk.
 """
 
 from __future__ import annotations
@@ -361,8 +359,8 @@ def _attempts(lots: Lots, derive_part, failed: list[BadLot] | None):
             skip = np.zeros(len(part), dtype=bool)
             skip[failure.lots] = True
             if failed is not None:
-                failed.extend(BadLot(int(part.index[i]), str(part.ids[i]), str(failure))
-                              for i in np.flatnonzero(skip))
+                failed.extend(BadLot(int(part.index[i]), str(part.ids[i]), failure.reason(k))
+                              for k, i in enumerate(failure.lots))
             queue.insert(0, part.take(~skip))
             continue
         except ChunkTooLarge:

@@ -32,10 +32,6 @@ class LotsError(GrammarcError):
     """The lots file cannot be read at all (missing, not GeoJSON/OBJ, no polygon)."""
 
 
-class LimitError(GrammarcError):
-    """A derivation limit was reached: runaway recursion or a shape explosion."""
-
-
 class DerivationError(GrammarcError):
     """A rule cannot be applied to a shape (NaN or negative size, an unsupported geometry)."""
 
@@ -45,15 +41,21 @@ class AssetError(GrammarcError):
 
 
 class LotFailure(DerivationError):
-    """Some lots of a chunk cannot be derived (a negative size, an unsupported geometry).
+    """Some lots of a chunk cannot be derived (a negative size, an unsupported geometry, a limit reached).
 
     ``lots`` holds their chunk-local indices: the build reports them as bad lots and derives the chunk
-    again without them, so the other lots are not lost.
+    again without them, so the other lots are not lost. ``reasons``, when given, is one message per lot
+    of ``lots`` (a limit names each lot's own count); otherwise ``message`` is every lot's reason.
     """
 
-    def __init__(self, message: str, lots):
+    def __init__(self, message: str, lots, reasons=None):
         super().__init__(message)
         self.lots = lots
+        self.reasons = reasons
+
+    def reason(self, k: int) -> str:
+        """Why the ``k``-th lot of ``lots`` failed."""
+        return str(self) if self.reasons is None else self.reasons[k]
 
 
 class ChunkTooLarge(GrammarcError):

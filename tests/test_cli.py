@@ -155,15 +155,43 @@ def test_negative_size_lot_skipped_by_id(write, tmp_path, capsys):
     assert list(read_instances(out)["lot"]) == [1]
 
 
-def test_runaway_recursion_fails_and_leaves_existing_output(write, tmp_path, capsys):
+def test_a_runaway_lot_is_skipped_by_name_and_the_others_built(write, tmp_path, capsys):
+    """--max-shapes and --max-depth are limits per lot: the lot over one is a bad lot named with the rule
+    and its place, the good ones are written, exit 0; where every lot runs away, exit 1 with the reason."""
     out = tmp_path / "out.npz"
-    out.write_bytes(b"previous")
-    grammar = write("g.cga", "grow ~> T(0, 1, 0) grow grow\n")
-    assert main(["build", str(grammar), "--emit", str(out), "--max-shapes", "100000"]) == 1
+    grammar = write("g.cga", "attr n = 0\nlot : n > 0 ~> grow\nlot ~> I(\"cube\")\n"
+                             "grow ~> T(0, 1, 0) grow grow\n")
+    lots = geojson(tmp_path / "city.geojson", [SQUARE] * 3, [{"n": 0}, {"n": 1}, {"n": 0}])
+    assert main(["build", str(grammar), "--lots", str(lots), "--emit", str(out), "--max-shapes", "100000"]) == 0
     err = capsys.readouterr().err
-    assert "rule `grow`" in err and "--max-shapes" in err
-    assert out.read_bytes() == b"previous"
-    assert sorted(p.name for p in tmp_path.iterdir()) == ["g.cga", "out.npz"]
+    assert re.search(r"grammarc: lot lot1 \(#1\) skipped: more than 100,000 shapes \(131,071\) in rule `grow` at "
+                     r"\S*g\.cga:4:\d+: a runaway grammar\? Raise the limit with --max-shapes N\.\n", err)
+    assert err.endswith("grammarc: 1 of 3 lots skipped\n")
+    assert list(read_instances(out)["lot"]) == [0, 2]
+    assert main(["build", str(grammar), "--emit", str(out), "--attr", "n=1", "--max-depth", "10"]) == 1
+    assert "none of the 1 lots could be built (1 reached --max-depth 10 in rule `grow`" in capsys.readouterr().err
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["city.geojson", "g.cga", "out.npz"]
+
+
+def test_bad_lots_of_the_derivation_are_named_and_the_good_ones_written(write, tmp_path, capsys):
+    """One lot of a facade's tile 1e-9 m wide (3e10 tiles), one of a height of 1e308 (no float32 holds it),
+    one of ``height: true`` (a boolean for a number): each is named on stderr with why, the good lots are
+    written, exit 0."""
+    grammar = write("g.cga", 'version "2022.0"\nattr height = 9\nattr tile_w = 3\n@StartRule\n'
+                             'Lot --> extrude(height) comp(f){ side : Facade }\n'
+                             'Facade --> split(x){ tile_w : Tile }*\nTile --> i("builtin:cube")\n')
+    lots = geojson(tmp_path / "city.geojson", [SQUARE] * 5,
+                   [{}, {"tile_w": 1e-9}, {"height": 1e308}, {"height": True}, {"tile_w": 2}])
+    out = tmp_path / "out.npz"
+    assert main(["build", str(grammar), "--lots", str(lots), "--emit", str(out)]) == 0
+    err = capsys.readouterr().err
+    assert re.search(r"lot lot1 \(#1\) skipped: more than 2,000,000 shapes \(\d[\d,]*\) in rule `Facade` at "
+                     r"\S*g\.cga:6:12: a runaway grammar\? Raise the limit with --max-shapes N\.\n", err)
+    assert re.search(r"lot lot2 \(#2\) skipped: an instance with a coordinate of inf \(not finite as float32\) "
+                     r"in rule `Tile` at \S*g\.cga:7:1\n", err)
+    assert 'lot lot3 (#3) skipped: attribute `height` is "true", not a num\n' in err
+    assert err.endswith("grammarc: 3 of 5 lots skipped\n")
+    assert np.unique(read_instances(out)["lot"]).tolist() == [0, 4]
 
 
 def test_depth_limit_can_be_raised(write, tmp_path):

@@ -1,11 +1,9 @@
-"""Worker processes: records shipped through memory files come back equal; errors come back raised."""
+"""Worker processes: records shipped through memory files come back equal; bad lots come back named."""
 
 import numpy as np
-import pytest
 
 from grammarc.build import BuildOptions, derive
 from grammarc.compiler import compile_grammar
-from grammarc.errors import LimitError
 from grammarc.io.lots import lots_from_polygons
 from grammarc.model.records import MeshChunk, TerminalChunk
 from grammarc.workers import _ship, _unship
@@ -26,11 +24,11 @@ def test_a_shipped_chunk_comes_back_equal(tmp_path):
         np.testing.assert_array_equal(getattr(back.mesh, name), getattr(mesh, name))
 
 
-def test_a_limit_reached_in_a_worker_stops_the_build(write):
+def test_lots_failed_in_a_worker_come_back_as_bad_lots(write):
     grammar = compile_grammar(write("g.cga", "lot ~> grow\ngrow ~> S(1r, 1r, 1r) grow\n"))
     lots = lots_from_polygons([[np.array([[0, 0], [10, 0], [10, 10], [0, 10]], float)]] * 4)
-    with pytest.raises(LimitError, match="max-depth"):
-        derive(grammar, lots, BuildOptions(workers=2, chunk_size=1))
+    bad = derive(grammar, lots, BuildOptions(workers=2, chunk_size=1))["bad"]
+    assert [b.index for b in bad] == [0, 1, 2, 3] and all("--max-depth 256 in rule `grow`" in b.reason for b in bad)
 
 
 def test_a_pool_removes_the_shared_memory_that_killed_builds_left():

@@ -133,11 +133,11 @@ def stack_rows(rows: list[Arrays]) -> tuple[Arrays, np.ndarray]:
 def colon(base, step, limit, n: int) -> tuple[Arrays, np.ndarray]:
     """``[base : step : limit]`` per shape: base, base + step, ... not beyond ``limit``; empty when
     ``step`` is 0 or leads away from ``limit``. Returns the arrays and (n,) bool the shapes whose range
-    would exceed ``MAX_ELEMENTS``."""
+    would exceed ``MAX_ELEMENTS`` (a range to infinity, or of a step too small for a float's count, too)."""
     base, step, limit = (np.asarray(_column(v, n), dtype=np.float64) for v in (base, step, limit))
-    with np.errstate(divide="ignore", invalid="ignore"):
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
         count = np.floor((limit - base) / step) + 1
-    count = np.where((step != 0) & np.isfinite(count) & (count > 0), count, 0)
+    count = np.where((step != 0) & (count > 0), count, 0)  # NaN is not > 0
     bad = count > MAX_ELEMENTS
     sizes = np.where(bad, 0, count).astype(np.int64)
     offsets = _offsets(sizes)

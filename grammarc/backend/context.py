@@ -16,10 +16,11 @@ import numpy as np
 
 from grammarc.backend.chunk import Chunk
 from grammarc.backend.evaluate import Env
+from grammarc.backend.kernels.split import MAX_COUNT
 from grammarc.backend.plan import Plan
 from grammarc.backend.shapes import Shapes
 from grammarc.constants import Limits
-from grammarc.errors import AssetError, ChunkTooLarge, LimitError, LotFailure
+from grammarc.errors import AssetError, ChunkTooLarge, LotFailure
 from grammarc.geometry.meshes import is_mesh
 from grammarc.ir import nodes as ir
 from grammarc.ir.printer import print_op
@@ -54,13 +55,18 @@ class Context:
     # ------------------------------------------------------------------------------------------- failures
     def fail(self, shapes: Shapes, bad: np.ndarray, message: str, span) -> None:
         """Report the lots of shapes ``bad`` (n,) bool as failed: raises ``LotFailure``."""
-        lots = np.unique(shapes.lot[bad])
+        self.fail_lots(shapes.lot[bad], message, span)
+
+    def fail_lots(self, lots: np.ndarray, message: str, span) -> None:
+        """Report ``lots`` (chunk-local numbers, repeats allowed) as failed in the rule being applied, at
+        ``span`` (None: a symbol without rules, whose leaves are being emitted): raises ``LotFailure``."""
         rule = self.plan.symbols[self.symbol].name
-        raise LotFailure(f"{message} in rule `{rule}` at {span}", lots)
+        where = f" at {span}" if span is not None else ""
+        raise LotFailure(f"{message} in rule `{rule}`{where}", np.unique(lots))
 
     def fail_negative(self, shapes: Shapes, values: np.ndarray, message: str, span) -> None:
         """Fail the shapes whose sizes (n, k), or (1, k) for all, are negative or NaN, quoting the first."""
-        bad = ~(values >= 0).all(axis=1)
+        bad = np.broadcast_to(~(values >= 0).all(axis=1), (len(shapes),))
         if bad.any():
             row = values[np.flatnonzero(bad)[0]]
             self.fail(shapes, bad, f"{message} ({', '.join(f'{v:g}' for v in np.atleast_1d(row))})", span)
@@ -88,21 +94,31 @@ class Context:
             raise ChunkTooLarge()
 
     def check_fan_out(self, shapes: Shapes, counts: np.ndarray, span) -> None:
-        """Refuse a fan-out of ``counts`` (n,) children per shape that would exceed --max-shapes, before
-        allocating them."""
+        """Refuse a fan-out of ``counts`` (n,) children per shape (int64, or float64 where a count may be
+        beyond int64) that would take a lot over --max-shapes, before allocating them."""
         per_lot = np.bincount(shapes.lot, weights=counts, minlength=len(self.chunk.shape_count))
         self.check_shape_limit(per_lot + self.chunk.shape_count, span)
 
     def check_shape_limit(self, counts: np.ndarray, span) -> None:
-        """LimitError naming the rule if a lot's shape count (made or about to be) exceeds --max-shapes."""
-        worst = int(np.argmax(counts))
-        if counts[worst] > self.limits.max_shapes:
+        """Fail the lots whose shape count (L,), made or about to be, exceeds --max-shapes (``LotFailure``,
+        each lot's message with its own count): the other lots of the chunk derive."""
+        over = ~(counts <= self.limits.max_shapes)  # a NaN count (an inf - inf fan-out) is over too
+        if over.any():
+            lots = np.flatnonzero(over)
             rule = self.plan.symbols[self.symbol].name
-            raise LimitError(
-                f"lot {self.chunk.lot_ids[worst]} makes more than {self.limits.max_shapes:,} shapes "
-                f"({int(counts[worst]):,}) in rule `{rule}` at {span}: a runaway grammar? "
-                "Raise the limit with --max-shapes N."
-            )
+            limit = f"{self.limits.max_shapes:,}"
+            reasons = [f"more than {limit} shapes ({_count(c)}) in rule `{rule}` at {span}: a runaway "
+                       "grammar? Raise the limit with --max-shapes N." for c in counts[lots]]
+            raise LotFailure(reasons[0], lots, reasons)
+
+    def check_depth(self, shapes: Shapes, span) -> None:
+        """Fail the lots of ``shapes`` that reached --max-depth rule applications on one path (a runaway
+        recursion): their shapes are still pending, the other lots derive."""
+        deep = shapes.depth >= self.limits.max_depth
+        if deep.any():
+            rule = self.plan.symbols[self.symbol].name
+            raise LotFailure(f"reached --max-depth {self.limits.max_depth} in rule `{rule}` at {span}: a runaway "
+                             "recursion? Raise the limit with --max-depth N.", np.unique(shapes.lot[deep]))
 
     # -------------------------------------------------------------------------------------------- assets
     def asset_mesh(self, asset: int):
@@ -121,3 +137,12 @@ class Context:
     def asset_problem(self, asset: int) -> str:
         """Why ``asset_mesh(asset)`` is None (after it was asked)."""
         return str(self._asset_meshes[asset])
+
+
+def _count(value: float) -> str:
+    """A shape count for a message: exact while it is a float's integer, in powers of ten beyond, and
+    "beyond counting" where a fan-out's count overflowed (``kernels.split.MAX_COUNT``: a size of almost
+    nothing, a non-finite one)."""
+    if value < 2.0**53:
+        return f"{int(value):,}"
+    return f"{value:.3g}" if value < MAX_COUNT else "beyond counting"

@@ -76,7 +76,7 @@ def derive_chunk(plan: Plan, lots: Lots, *, seed: int, limits: Limits, overrides
     ``occluders_only`` this is that first pass: the derivation stops where the first query would run
     and returns the occluders made up to there.
 
-    Raises ``LotFailure`` naming lots to skip, ``ChunkTooLarge``, or ``LimitError``.
+    Raises ``LotFailure`` naming lots to skip (a limit reached among them), or ``ChunkTooLarge``.
     """
     chunk, shapes = initial_chunk(lots, seed, foreign)
     attribute_columns(plan.grammar.module, Env(shapes, chunk, plan), lots.attrs, overrides, plan.strings)

@@ -27,7 +27,6 @@ from grammarc.backend.plan import SymbolPlan
 from grammarc.backend.random import uniform
 from grammarc.backend.shapes import Shapes
 from grammarc.constants import STRICT, TOL
-from grammarc.errors import LimitError
 from grammarc.ir import nodes as ir
 from grammarc.ragged import rank_within
 
@@ -72,15 +71,7 @@ def apply(ctx: Context, sym: SymbolPlan, shapes: Shapes) -> None:
 
 def apply_all(ctx: Context, sym: SymbolPlan, shapes: Shapes) -> None:
     """``apply`` on all of ``shapes`` at once."""
-    limits = ctx.limits
-    deepest = int(np.argmax(shapes.depth))
-    if shapes.depth[deepest] >= limits.max_depth:
-        rule = sym.rules[0]
-        raise LimitError(
-            f"derivation of lot {ctx.chunk.lot_ids[shapes.lot[deepest]]} reached --max-depth "
-            f"{limits.max_depth} at rule `{sym.name}` ({rule.span}): runaway recursion? "
-            "Raise the limit with --max-depth N."
-        )
+    ctx.check_depth(shapes, sym.rules[0].span)
     remaining = shapes
     for rule in sym.rules:
         if rule.guard is not None:

@@ -126,6 +126,11 @@ def _colors(plan, shapes: Shapes, rows=slice(None)) -> np.ndarray | None:
 def append_mesh(ctx: Context, mesh: MeshChunk, shapes: Shapes, rows=slice(None)) -> None:
     """Add leaf faces, made of ``shapes`` rows ``rows`` face by face, with their texture channels where the
     grammar carries them (``backend.materials``)."""
+    vertices = mesh.vertices
+    if not np.isfinite(vertices).all():
+        face = segment_of(mesh.face_offsets)[segment_of(mesh.ring_offsets)]
+        bad = ~np.isfinite(vertices).all(axis=1)
+        _fail_non_finite(ctx, mesh.lot[face[bad]], vertices[bad], "a mesh vertex")
     out = ctx.chunk.outputs
     out.meshes.append(mesh)
     if ctx.plan.material_slots:
@@ -145,6 +150,9 @@ def append_records(ctx: Context, xform: np.ndarray, lot: np.ndarray, asset: int,
     """Add instance records: transforms, lots, and colours (packed floats) and texture channels (string ids
     (n, k)) where the grammar sets them (``backend.materials``), and texture maps (``TerminalChunk.uv``)
     where it has texture coordinates."""
+    if not np.isfinite(xform).all():
+        bad = ~np.isfinite(xform).all(axis=(1, 2))
+        _fail_non_finite(ctx, lot[bad], xform[bad], "an instance")
     out = ctx.chunk.outputs
     if uv is not None:
         out.uv.append(uv)
@@ -156,6 +164,17 @@ def append_records(ctx: Context, xform: np.ndarray, lot: np.ndarray, asset: int,
         out.color.append(rgba(color))
     if material is not None:
         out.material.append(material)
+
+
+def _fail_non_finite(ctx: Context, lots: np.ndarray, rows: np.ndarray, what: str) -> None:
+    """Fail ``lots``, whose record ``rows`` (float32) have a coordinate that is not finite: beyond 3.4e38
+    (a size or a move far beyond any city) or made of inf and NaN (attributes such as ``height=inf``).
+    The last guard before records are written, wherever the value came from; the message quotes the
+    first such value."""
+    value = rows[~np.isfinite(rows)].flat[0]
+    sym = ctx.plan.symbols[ctx.symbol]
+    ctx.fail_lots(lots, f"{what} with a coordinate of {value} (not finite as float32)",
+                  sym.rules[0].span if sym.rules else None)
 
 
 def _instance_uv(ctx: Context, shapes: Shapes, xform: np.ndarray, textured: bool) -> np.ndarray | None:

@@ -155,11 +155,10 @@ def _text_list(value):
 
 
 def _column(values, pa) -> np.ndarray:
-    """A property column as GeoJSON's are typed (``io.lot_builder.property_column``): numbers and booleans
-    float64 with nan for nulls, anything else text (object, None for nulls); read by type, not value by
-    value."""
+    """A property column as GeoJSON's are typed (``io.lot_builder.property_column``): numbers float64 with
+    nan for nulls, anything else text (object, None for nulls); read by type, not value by value."""
     kind = values.type
-    if pa.types.is_integer(kind) or pa.types.is_floating(kind) or pa.types.is_boolean(kind) or pa.types.is_null(kind):
+    if pa.types.is_integer(kind) or pa.types.is_floating(kind) or pa.types.is_null(kind):
         return values.cast(pa.float64()).to_numpy(zero_copy_only=False).astype(np.float64)
     if pa.types.is_string(kind) or pa.types.is_large_string(kind):
         return values.to_numpy(zero_copy_only=False).astype(object)

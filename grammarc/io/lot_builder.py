@@ -299,13 +299,15 @@ def property_column(values: list) -> np.ndarray:
     Returns
     -------
     column : (n,) float64 or object
-      float64 with nan for None if every value is a number (bools too) or None, else object: ``str``
-      values as they are, None kept, anything else as its JSON text.
+      float64 with nan for None if every value is a number or None, else object: ``str`` values as they
+      are, None kept, anything else as its JSON text (booleans ``true`` and ``false``: a boolean is no
+      number, and an attribute of numbers given one makes its lot bad, ``backend.attributes``).
     """
-    if all(v is None or isinstance(v, (numbers.Real, np.bool_)) for v in values):
+    if all(v is None or (isinstance(v, numbers.Real) and not isinstance(v, bool)) for v in values):
         return np.array([np.nan if v is None else float(v) for v in values], dtype=np.float64)
     column = np.empty(len(values), dtype=object)
-    column[:] = [v if v is None or isinstance(v, str) else json.dumps(v) for v in values]
+    column[:] = [v if v is None or isinstance(v, str) else json.dumps(v.item() if isinstance(v, np.generic) else v)
+                 for v in values]
     return column
 
 

@@ -189,6 +189,10 @@ def test_mismatched_dimensions_fail_the_lots_they_happen_on(write):
         values(write, "attr n = 2\nconst v = [0 : n] .+ [1, 2]", lot_attrs={"n": np.array([1.0, 2.0])})
     with pytest.raises(LotFailure, match="more than 100000 elements"):
         values(write, "const v = [0 : 1e6]")
+    # a count beyond any float (it was taken as none, silently) is more, too
+    for text in ("const v = [0 : 1e-320 : 1]", "attr top = 1\nconst v = [0 : top * 1e308 * 10]"):
+        with pytest.raises(LotFailure, match="more than 100000 elements"):
+            values(write, text)
 
 
 # ------------------------------------------------------------------------------------------------ kernels

@@ -82,6 +82,22 @@ def test_lot_attribute_of_the_wrong_type_makes_its_lot_bad(write):
     assert 'attribute `height` is "tall", not a num' in r["bad"][0].reason
 
 
+def test_a_boolean_property_is_a_bool_and_makes_a_lot_of_a_number_attribute_bad(write, tmp_path):
+    """GeoJSON's ``true`` for ``attr height = 10`` makes its lot bad, as the README says of a property of
+    the wrong type (it was taken as 1); for ``attr flat = false`` it is the boolean it says."""
+    path = tmp_path / "lots.geojson"
+    path.write_text(json.dumps({"type": "FeatureCollection", "features": [
+        {"type": "Feature", "id": f"lot{i}", "properties": props, "geometry": {"type": "Polygon", "coordinates": [
+            [[0, 0], [5, 0], [5, 5], [0, 5], [0, 0]]]}}
+        for i, props in enumerate([{"height": 12, "flat": True}, {"height": True}, {"flat": False}])]}))
+    grammar = compile_grammar(write("g.cga", 'attr height = 10\nattr flat = false\n'
+                                             'lot : flat ~> S(1r, 1, 1r) I("cube")\n'
+                                             'lot ~> S(1r, height, 1r) I("cube")\n'))
+    r = derive(grammar, read_lots(path))
+    np.testing.assert_allclose(r["xform"][:, 1, 1], [1, 10])
+    assert [(b.index, b.reason) for b in r["bad"]] == [(1, 'attribute `height` is "true", not a num')]
+
+
 
 # --------------------------------------------------------------------------------------------------- arrays
 

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import re
+
 import numpy as np
 import pytest
 from conftest import make_lots
@@ -12,7 +14,7 @@ from grammarc.backend.derive import initial_chunk
 from grammarc.backend.plan import make_plan
 from grammarc.compiler import compile_grammar
 from grammarc.constants import LIMITS
-from grammarc.errors import AssetError, LimitError, LotFailure
+from grammarc.errors import AssetError, LotFailure
 
 
 def context(write, load_asset=None) -> Context:
@@ -48,7 +50,27 @@ def test_asset_meshes_come_from_the_plans_loader_once_each(write):
     assert calls == ["builtin:cube", "window.obj"]
 
 
-def test_runaway_branching_recursion_stops_with_the_rule(write):
-    with pytest.raises(LimitError, match=r"`grow`.*--max-shapes"):
-        paper(write, "grow ~> T(0,1,0) grow grow\n", [rect(5, 5)])
+def test_runaway_branching_recursion_fails_its_lot_only_with_the_rule_and_count(write):
+    """--max-shapes is a limit per lot: the lot over it is bad (its message with the rule, its place and
+    its own count), the others derive as they would alone."""
+    text = "attr n = 0\nlot : n > 0 ~> T(0,1,0) lot lot\nlot ~> I(\"cube\")\n"
+    r = paper(write, text, [rect(5, 5)] * 3, limits=LIMITS.__class__(max_shapes=1000),
+              lot_attrs={"n": np.array([0.0, 1.0, 0.0])})
+    assert r["lot"].tolist() == [0, 2]
+    [bad] = r["bad"]
+    assert bad.index == 1
+    assert re.fullmatch(r"more than 1,000 shapes \(1,022\) in rule `lot` at \S*/g\.cga:2:29: a runaway grammar\? "
+                        r"Raise the limit with --max-shapes N\.", bad.reason), bad.reason
+
+
+def test_the_shape_limit_fails_each_lot_over_it_with_its_own_count(write):
+    ctx = context(write)
+    ctx.symbol = ctx.plan.symbol_ids["Lot"]
+    ctx.limits = LIMITS.__class__(max_shapes=10)
+    with pytest.raises(LotFailure) as failure:
+        ctx.check_shape_limit(np.array([11.0, 10.0, 2.0**63]), "g.cga:2:1")
+    assert failure.value.lots.tolist() == [0, 2]
+    assert [failure.value.reason(k) for k in range(2)] == [
+        f"more than 10 shapes ({n}) in rule `Lot` at g.cga:2:1: a runaway grammar? Raise the limit with "
+        "--max-shapes N." for n in ("11", "beyond counting")]
 

@@ -4,7 +4,6 @@ bodies run (push and pop; in CityEngine a body without a successor leaves its sh
 from __future__ import annotations
 
 import numpy as np
-import pytest
 from operations.derivations import (
     assets,
     names,
@@ -13,8 +12,6 @@ from operations.derivations import (
     rect,
     run,
 )
-
-from grammarc.errors import LimitError
 
 
 def test_paper_notation_scale_alone_emits_nothing(write):
@@ -80,9 +77,15 @@ def test_stochastic_frequencies_over_10k_lots(write):
     assert 2 <= widths.min() and widths.max() <= 4 and abs(widths.mean() - 3) < 0.05
 
 
-def test_runaway_linear_recursion_stops_at_depth(write):
-    with pytest.raises(LimitError, match=r"--max-depth 256 at rule `grow`"):
-        paper(write, "grow ~> T(0,1,0) grow\n", [rect(5, 5)])
+def test_runaway_linear_recursion_fails_its_lot_at_depth(write):
+    """--max-depth fails the lots whose shapes are still pending there; the others derive."""
+    text = "attr n = 0\nlot : n > 0 ~> T(0,1,0) lot\nlot ~> I(\"cube\")\n"
+    r = paper(write, text, [rect(5, 5)] * 3, lot_attrs={"n": np.array([1.0, 0.0, 0.0])})
+    assert r["lot"].tolist() == [1, 2]
+    [bad] = r["bad"]
+    assert bad.index == 0 and bad.reason.endswith(
+        "/g.cga:2:1: a runaway recursion? Raise the limit with --max-depth N.")
+    assert bad.reason.startswith("reached --max-depth 256 in rule `lot` at ")
 
 
 def test_push_pop_and_rotation(write):

@@ -1,4 +1,4 @@
-"""backend/kernels/split.py ``group_split``: CityEngine's split with ``'``, ``~`` sizes and repeat groups.
+"""backend/kernels/split.py ``group_counts`` and ``group_split``: CityEngine's split with ``'``, ``~`` sizes and repeat groups.
 
 Layouts are computed by hand from the kernel's rule (its docstring): fixed parts and floating parts outside
 groups keep their written sizes while the groups share what is left in proportion to one repetition's
@@ -14,10 +14,15 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from grammarc.backend.kernels.split import group_split
+from grammarc.backend.kernels.split import MAX_COUNT, group_counts, group_split
 
 ABS, REL, FLT = 0, 1, 2
 TOL = 1e-9
+
+
+def split_parts(extent, values, kind, group, n_groups, tol):
+    """The parts as the operation makes them: counted (``group_counts``), then laid (``group_split``)."""
+    return group_split(extent, values, kind, group, *group_counts(extent, values, kind, group, n_groups, tol), tol)
 
 
 def layout(extent, sizes, groups=None, kinds=None, rows=None):
@@ -31,7 +36,7 @@ def layout(extent, sizes, groups=None, kinds=None, rows=None):
         kind = np.array(kinds, np.int64)
     group = np.array([-1 if g is None else g for g in (groups or [-1] * len(sizes))], np.int64)
     n_groups = int(group.max()) + 1 if len(group) else 0
-    parent, part, pos, length, index = group_split(np.array([extent], float), values[None, :], kind,
+    parent, part, pos, length, index = split_parts(np.array([extent], float), values[None, :], kind,
                                                    group, n_groups, TOL)
     assert (parent == 0).all()
     return list(zip(part.tolist(), pos.tolist(), length.tolist(), index.tolist()))
@@ -225,14 +230,14 @@ def test_whole_split_repeat_is_one_group():
 
 
 def test_no_shapes():
-    out = group_split(np.zeros(0), np.ones((1, 2)), np.array([ABS, FLT], np.int64),
+    out = split_parts(np.zeros(0), np.ones((1, 2)), np.array([ABS, FLT], np.int64),
                       np.array([-1, 0], np.int64), 1, TOL)
     assert [len(a) for a in out] == [0] * 5
     assert out[0].dtype == np.int64 and out[2].dtype == np.float64 and out[4].dtype == np.int64
 
 
 def test_one_shape_and_no_parts():
-    out = group_split(np.array([10.0]), np.zeros((1, 0)), np.zeros(0, np.int64), np.zeros(0, np.int64), 0,
+    out = split_parts(np.array([10.0]), np.zeros((1, 0)), np.zeros(0, np.int64), np.zeros(0, np.int64), 0,
                       TOL)
     assert [len(a) for a in out] == [0] * 5
 
@@ -241,8 +246,8 @@ def test_one_row_of_values_serves_every_shape_like_one_row_each():
     extent = np.array([10.0, 11.0, 4.4, 0.0, 30.0])
     kind = np.array([ABS, FLT, ABS], np.int64)
     group = np.array([-1, 0, -1], np.int64)
-    shared = group_split(extent, np.array([[1.0, 3.0, 1.0]]), kind, group, 1, TOL)
-    per_shape = group_split(extent, np.tile([1.0, 3.0, 1.0], (5, 1)), kind, group, 1, TOL)
+    shared = split_parts(extent, np.array([[1.0, 3.0, 1.0]]), kind, group, 1, TOL)
+    per_shape = split_parts(extent, np.tile([1.0, 3.0, 1.0], (5, 1)), kind, group, 1, TOL)
     for a, b in zip(shared, per_shape):
         np.testing.assert_array_equal(a, b)
     # the shape of zero extent makes nothing; the others are in parent order
@@ -252,7 +257,7 @@ def test_one_row_of_values_serves_every_shape_like_one_row_each():
 def test_values_per_shape_are_read_per_row():
     extent = np.array([10.0, 10.0])
     values = np.array([[2.0, 1.0], [5.0, 1.0]])
-    parent, _, pos, length, index = group_split(extent, values, np.array([ABS, FLT], np.int64),
+    parent, _, pos, length, index = split_parts(extent, values, np.array([ABS, FLT], np.int64),
                                                 np.array([-1, -1], np.int64), 0, TOL)
     np.testing.assert_array_equal(parent, [0, 0, 1, 1])
     np.testing.assert_allclose(length, [2, 8, 5, 5])
@@ -348,8 +353,28 @@ def test_random_batches_match_the_reference(seed):
         values = values[:1]
     extent = rng.uniform(0, 30, n)
     extent[0] = 0.0
-    got = group_split(extent, values, kind, group, g, TOL)
+    got = split_parts(extent, values, kind, group, g, TOL)
     want = reference(extent, values, kind, group, g, TOL)
     assert len(got[0]) == len(want)
     for column, expected in zip(got, zip(*want)):
         np.testing.assert_allclose(column, expected, atol=1e-9)
+
+
+def test_counts_come_first_and_saturate_where_int64_overflows():
+    """``group_counts`` says how many parts each shape lays before any is made (the operation checks them
+    against --max-shapes in between): a repetition too small to lay (which made nothing and said nothing)
+    counts the parts it would make, and one whose count int64 cannot hold is ``MAX_COUNT``, never a
+    wrapped-around number of none or one."""
+    kind = np.array([ABS, FLT, ABS], np.int64)
+    group = np.array([-1, 0, -1], np.int64)
+    *_, count = group_counts(np.array([10.0, 11.0, 0.0]), np.array([[1.0, 3.0, 1.0]]), kind, group, 1, TOL)
+    np.testing.assert_array_equal(count, [5, 5, 2])
+    assert (count >= [len(split_parts(np.array([e]), np.array([[1.0, 3.0, 1.0]]), kind, group, 1, TOL)[0])
+                      for e in (10.0, 11.0, 0.0)]).all()
+    for sizes, least in (([1e-18], 3e19), (["~1e-18"], 3e19), ([1e-9, "~1e-9"], 1.5e10), ([5e-10], 6e10)):
+        values, kinds = _parse(sizes)
+        *_, count = group_counts(np.array([30.0]), values[None, :], kinds, np.zeros(len(sizes), np.int64), 1, TOL)
+        assert count[0] >= least * 0.999, sizes
+    reps, _, _, count = group_counts(np.array([1e12]), np.array([[1e-8]]), np.array([ABS], np.int64),
+                                     np.zeros(1, np.int64), 1, TOL)
+    assert reps[0, 0] == MAX_COUNT and count[0] == float(MAX_COUNT)

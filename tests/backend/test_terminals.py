@@ -92,3 +92,24 @@ def test_inserted_geometry_carries_no_texture_coordinates(write):
     assert np.isnan(r["uv"][~top]).all() and not np.isnan(r["uv"][top]).any()
     trimmed = r["mesh"]
     assert len(trimmed.lot) and trimmed.uv is None
+
+
+@pytest.mark.parametrize("height", [1e308, np.inf, 1e39])
+def test_a_record_with_a_coordinate_that_is_not_finite_fails_its_lot_with_the_rule(write, height):
+    """The last guard before records are made: an instance whose transform is not finite as float32 (a
+    height of 1e308 or inf) fails its lot, named with the rule; the others are written."""
+    text = 'attr height = 9\nlot ~> S(1r, height, 1r) Repeat("X", 2){ I("cube") }\n'
+    r = paper(write, text, [rect(4, 4)] * 2, lot_attrs={"height": np.array([9.0, height])})
+    assert np.isfinite(r["xform"]).all() and r["lot"].tolist() == [0, 0]
+    [bad] = r["bad"]
+    assert bad.index == 1 and bad.reason.startswith("an instance with a coordinate of ")
+    assert "(not finite as float32) in rule `lot` at " in bad.reason
+
+
+def test_a_mesh_vertex_that_is_not_finite_fails_its_lot_with_the_rule(write):
+    r = run(write, "attr h = 3\nLot --> roofHip(byHeight, h) Roof.\n", [rect(10, 10)] * 2,
+            lot_attrs={"h": np.array([3.0, 1e39])})
+    assert np.isfinite(r["mesh"].vertices).all() and np.unique(r["mesh"].lot).tolist() == [0]
+    [bad] = r["bad"]
+    assert bad.index == 1 and bad.reason.startswith("a mesh vertex with a coordinate of ")
+    assert "(not finite as float32) in rule `Lot` at " in bad.reason

@@ -71,9 +71,23 @@ def subdiv(extent, values, relative, tol):
     return parent, part, out_pos, out_len
 
 
+#: The count a fan-out reports for more elements than int64 holds (or a NaN number of them): far beyond
+#: any --max-shapes, so the caller's limit check fails the shape's lot before anything is allocated.
+MAX_COUNT = 2**62
+
+
+@njit(cache=True, nogil=True)
+def _count(x):
+    """floor(x) as an int64 count, ``MAX_COUNT`` for more (or NaN): casting those is undefined."""
+    if x < MAX_COUNT:
+        return int(x)
+    return MAX_COUNT
+
+
 @njit(cache=True, nogil=True)
 def repeat_counts(extent, size, tol):
-    """Elements of ``Repeat``: ceil(extent / size) per shape (paper section 2, "Repeat"), (n,) int64.
+    """Elements of ``Repeat``: ceil(extent / size) per shape (paper section 2, "Repeat"), (n,) int64,
+    ``MAX_COUNT`` where that overflows.
 
     A scope of zero extent has no element. ``size`` must be positive (the caller checks).
     """
@@ -81,8 +95,7 @@ def repeat_counts(extent, size, tol):
     counts = np.zeros(n, np.int64)
     for i in range(n):
         if extent[i] > tol:
-            c = np.ceil(extent[i] / size[i] - 1e-9)
-            counts[i] = max(int(c), 1)
+            counts[i] = max(_count(np.ceil(extent[i] / size[i] - 1e-9)), 1)
     return counts
 
 
@@ -117,8 +130,9 @@ def repeat(extent, counts):
 
 
 @njit(cache=True, nogil=True)
-def group_split(extent, values, kind, group, n_groups, tol):
-    """Parts of CityEngine's ``split`` with absolute, relative and floating sizes and repeat groups.
+def group_counts(extent, values, kind, group, n_groups, tol):
+    """How CityEngine's ``split`` with absolute, relative and floating sizes and repeat groups lays its
+    parts, before any child is made: the first half of ``group_split``.
 
     extent : (n,) float64; values : (n, P) or (1, P) float64 the sizes as written; kind : (P,) int64,
     0 absolute, 1 relative (a fraction of the extent), 2 floating (``~``); group : (P,) int64 the repeat
@@ -132,12 +146,14 @@ def group_split(extent, values, kind, group, n_groups, tol):
     ``1 | 3.55 | {~3.55}* | 3.55 | {~3.55}* | 3.55 | 1`` with 3 then 2 repetitions on 30 m, 2 and 2 on
     25 m and on 3.42 repetitions' room, 1 and 1 on 20 m and on 4/3 repetitions' room, 1 then 0 on 15 m
     and on 1.13 repetitions' room, and ``{ ~w: A | d: B }* | ~w: A`` on an extent of w as one A. A group
-    of fixed sizes repeats floor(share / repetition) times, the rest of its share left empty at its end. Then every floating size, in groups or not, is scaled by one factor so that the parts
-    fill the extent. Parts are laid end to end; parts beyond the extent are dropped, the last one cut;
-    parts of length <= tol are dropped.
+    of fixed sizes repeats floor(share / repetition) times, the rest of its share left empty at its end.
+    Then every floating size, in groups or not, is scaled by one factor so that the parts fill the extent.
 
-    Returns parent, part (index into the P parts), position, length (m,) and index (m,) int64, the
-    child's number within its parent.
+    Returns reps (n, max(n_groups, 1)) int64 each group's repetitions (``MAX_COUNT`` beyond int64), gap
+    (n, max(n_groups, 1)) float64 the room left at a group's end, scale (n,) float64 the floating sizes'
+    factor, and count (n,) float64 the parts each shape lays, and those a repetition too small to lay
+    (of at most ``tol``) would make: what the caller checks against --max-shapes before ``group_split``
+    allocates them (an upper bound: parts of length <= tol are dropped).
     """
     n = len(extent)
     count = values.shape[1]
@@ -146,7 +162,7 @@ def group_split(extent, values, kind, group, n_groups, tol):
     reps = np.zeros((n, slots), np.int64)
     gap = np.zeros((n, slots))
     scale = np.ones(n)
-    total = 0
+    total = np.zeros(n)
     for i in range(n):
         row = 0 if shared else i
         fixed = 0.0
@@ -177,14 +193,20 @@ def group_split(extent, values, kind, group, n_groups, tol):
             later += nominal[g]
         for g in range(n_groups):
             if nominal[g] <= tol:
+                # a repetition too small to lay repeats nothing, but counts as the parts it would make:
+                # its lot fails if they are more than --max-shapes (one of no size makes none)
+                if nominal[g] > 0.0 and left > tol:
+                    total[i] += left / nominal[g]
                 continue
             share = left * nominal[g] / later
+            if share == np.inf:  # left * nominal overflowed (a size near float64's largest)
+                share = left * (nominal[g] / later)
             later -= nominal[g]
             if group_float[g] > 0.0:
                 r = _repetitions(share, nominal[g], group_fixed[g], group_float[g], loose, floating, tol)
                 left = max(left - r * nominal[g], 0.0)
             else:
-                r = int(np.floor(share / nominal[g] + 1e-9))
+                r = _count(np.floor(share / nominal[g] + 1e-9))
                 gap[i, g] = share - r * nominal[g]
                 left -= share
             reps[i, g] = r
@@ -194,7 +216,25 @@ def group_split(extent, values, kind, group, n_groups, tol):
             scale[i] = max(extent[i] - fixed, 0.0) / floating
         for j in range(count):
             g = group[j]
-            total += 1 if g < 0 else reps[i, g]
+            total[i] += 1.0 if g < 0 else float(reps[i, g])
+    return reps, gap, scale, total
+
+
+@njit(cache=True, nogil=True)
+def group_split(extent, values, kind, group, reps, gap, scale, count, tol):
+    """Parts of CityEngine's ``split``, laid as ``group_counts`` planned them (its ``reps``, ``gap``,
+    ``scale`` and ``count``; the other arguments as it was given). Parts are laid end to end; parts
+    beyond the extent are dropped, the last one cut; parts of length <= tol are dropped.
+
+    Returns parent, part (index into the P parts), position, length (m,) and index (m,) int64, the
+    child's number within its parent.
+    """
+    n = len(extent)
+    parts = values.shape[1]
+    shared = values.shape[0] == 1
+    total = 0
+    for i in range(n):
+        total += int(count[i])
     parent = np.empty(total, np.int64)
     part = np.empty(total, np.int64)
     pos = np.empty(total)
@@ -206,7 +246,7 @@ def group_split(extent, values, kind, group, n_groups, tol):
         at = 0.0
         child = 0
         j = 0
-        while j < count:
+        while j < parts:
             g = group[j]
             if g < 0:
                 size = _part_size(values[row, j], kind[j], extent[i], scale[i])
@@ -215,7 +255,7 @@ def group_split(extent, values, kind, group, n_groups, tol):
                 j += 1
                 continue
             end = j
-            while end < count and group[end] == g:
+            while end < parts and group[end] == g:
                 end += 1
             for _ in range(reps[i, g]):
                 for k in range(j, end):
@@ -243,7 +283,9 @@ def _repetitions(share, nominal, fixed, floating, loose, laid, tol):
     second tile group takes none of 0.13 repetitions' room after the first took one (PRT)."""
     if share <= tol:
         return 0
-    r = int(np.floor(share / nominal))
+    r = _count(np.floor(share / nominal))
+    if r == MAX_COUNT:
+        return r
     if r == 0:
         if laid <= 0.0:
             return 1

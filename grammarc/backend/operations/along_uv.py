@@ -72,7 +72,9 @@ def insert_along_uv(ctx: Context, cursor: Shapes, op: ir.InsertAlongUV) -> Shape
     world, ring_offsets, shape = _pieces(chunk, cursor, axes)
     normal = _ring_normals(world, ring_offsets)
     lift = axes[shape, 1] if op.direction == "scope.y" else normal
-    xform, planes, owner = placements(world, ring_offsets, normal, maps[shape], lift * height[shape, None])
+    xform, planes, owner = placements(world, ring_offsets, normal, maps[shape], lift * height[shape, None],
+                                      lambda count: ctx.check_fan_out(cursor, np.bincount(
+                                          shape, weights=count, minlength=n), op.span))
     owner = shape[owner]
     order = np.argsort(owner, kind="stable")  # by shape, so that the pieces come grouped by shape
     xform, planes, owner = xform[order], planes[order], owner[order]
@@ -138,7 +140,7 @@ def _ring_normals(world: np.ndarray, ring_offsets: np.ndarray) -> np.ndarray:
 
 
 def placements(world: np.ndarray, ring_offsets: np.ndarray, normal: np.ndarray, maps: np.ndarray,
-               lift: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+               lift: np.ndarray, check=None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The asset's placements over convex pieces, one per whole unit of u each crosses where its v meets
     [0, 1].
 
@@ -155,6 +157,9 @@ def placements(world: np.ndarray, ring_offsets: np.ndarray, normal: np.ndarray, 
         Each piece's texture map (u and v of a world point ``X``: ``maps[:, :, :3] @ X + maps[:, :, 3]``).
     lift : (P, 3) float64
         The asset's height as a vector: where its unit box's y = 1 goes from the surface.
+    check : callable, optional
+        Given the placements per piece (P,) float64 before they are made: it raises to refuse them (a
+        texture scale of almost nothing would lay billions, or more than int64 counts).
 
     Returns
     -------
@@ -177,9 +182,11 @@ def placements(world: np.ndarray, ring_offsets: np.ndarray, normal: np.ndarray, 
     low = np.stack([segment_reduce(np.minimum, uv[:, j], ring_offsets, 0.0) for j in range(2)], axis=1)
     high = np.stack([segment_reduce(np.maximum, uv[:, j], ring_offsets, 0.0) for j in range(2)], axis=1)
     start = np.floor(low[:, 0] + TOL.zero)
-    count = np.maximum(np.ceil(high[:, 0] - TOL.zero) - start, 0).astype(np.int64)
+    count = np.maximum(np.ceil(high[:, 0] - TOL.zero) - start, 0)
     count[~usable | (high[:, 1] <= TOL.zero) | (low[:, 1] >= 1 - TOL.zero)] = 0
-    owner, index = fan_out(count)
+    if check is not None:
+        check(count)
+    owner, index = fan_out(count.astype(np.int64))
     inv = inverse[owner]
     along_u, along_v = inv[:, :, 0], inv[:, :, 1]
     # the point of (u, v) = (0, 0): the inverse applied to (-u0, -v0, n . X0)

@@ -48,6 +48,10 @@ from grammarc.geometry.setback import distances_to_area, polygon_edges, setback_
 from grammarc.ir import nodes as ir
 from grammarc.ragged import next_in_segment, ragged_take, rank_within, segment_of
 
+#: A distance that moves an outline out beyond this (float32's largest number) makes no record, and beyond
+#: float64's GEOS raises: ``offset`` and ``setback`` fail the lots of such distances (a NaN one stays what
+#: it was: no setback, as PRT takes massing's; ``setbackToArea``'s maximums may be inf: none).
+FAR = float(np.finfo(np.float32).max)
 
 @operation(ir.Roof, writes=("origin", "size", "geom"))
 def roof(ctx: Context, cursor: Shapes, op: ir.Roof) -> Shapes:
@@ -60,7 +64,8 @@ def roof(ctx: Context, cursor: Shapes, op: ir.Roof) -> Shapes:
     checks = [
         (cursor.geom < -1, "of an inserted asset"),
         (~np.isfinite(value) | ~np.isfinite(overhang) | ~np.isfinite(index), "with a value that is not finite"),
-        (~op.by_height & (np.abs(value) >= 90), "with an angle of 90 degrees or more"),
+        # (``by_height`` is a bool of the node, not of the shapes: ``~`` of it would be -1 or -2)
+        ((not op.by_height) & (np.abs(value) >= 90), "with an angle of 90 degrees or more"),
     ]
     # CityEngine roofs faces. A face that ``s`` gave a size across it stays flat in CityEngine but is a
     # box here: an envelope (candler sizes its ventilation faces so) takes the box's base
@@ -268,8 +273,7 @@ def _roof_offsets(ctx: Context, roofs: Shapes, op: ir.Offset) -> tuple[Shapes, n
     in its own plane (its comp(f) scope), as CityEngine offsets each face of a geometry; the pieces
     ``op.select`` keeps (each roof's inside pieces face by face, then its border's) become one mesh in a
     scope fitted to them. Returns the shapes and the mask (n,) of the roofs with any piece left."""
-    n = len(roofs)
-    d = np.broadcast_to(np.asarray(evaluate_array(op.distance, ctx.env(roofs)), float), (n,))
+    d = _distances(ctx, op.distance, roofs, op.span)
     parent, _, origin, axes, size, geom, _, _ = mesh_shapes.mesh_components(ctx.chunk, roofs, mesh_shapes.FACES)
     polygons = scope_polygons(ctx.chunk.polygons, geom, size)
     inset, border = _inset_and_border(polygons, d[parent])
@@ -282,7 +286,7 @@ def _roof_offsets(ctx: Context, roofs: Shapes, op: ir.Offset) -> tuple[Shapes, n
     order = np.argsort(parent[face], kind="stable")
     shapes = mesh_shapes.face_piece_meshes(ctx.chunk, roofs, parts[order], parent[face[order]],
                                            origin[face[order]], axes[face[order]])
-    kept = np.bincount(parent[face], minlength=n) > 0
+    kept = np.bincount(parent[face], minlength=len(roofs)) > 0
     shapes = shapes.take(kept)
     return replace(shapes, key=child_keys(shapes.key, 0, np.zeros(len(shapes), dtype=np.int64))), kept
 
@@ -388,6 +392,10 @@ def setback(ctx: Context, cursor: Shapes, op: ir.Setback) -> Parts:
     """``setback`` and ``shapeL/U/O``: the face's edge strips and its remainder to their parts."""
     face = _SetbackFaces(ctx, cursor, op, "setback", (*op.selectors, *(s for s, _ in op.distances)))
     distance = face.distances(ctx, cursor, op.distances, op.per_edge, 0.0)
+    far = distance > FAR
+    if far.any():
+        ctx.fail_lots(cursor.lot[face.edges.poly[far]], f"`setback` by {distance[far][0]:g}, beyond any coordinate",
+                      op.span)
     return face.parts(ctx, cursor, op, distance)
 
 
@@ -559,10 +567,20 @@ def _offset_polygons(ctx: Context, distance: ir.Expr, cursor: Shapes, span):
     """Each flat shape's faces (``_faces_in_plane``) offset by ``distance``: the insets and the borders
     (k,) (shapely, in the scopes' units), the faces' planes (k,) and polygons (k,), the faces as shapes and
     each face's row in ``cursor``."""
-    d = np.broadcast_to(evaluate_array(distance, ctx.env(cursor)), (len(cursor),))
+    d = _distances(ctx, distance, cursor, span)
     faces, owner = _faces_in_plane(cursor, ctx.chunk)
     polygons, plane = face_polygons(ctx, faces, "offset", span)
     return *_inset_and_border(polygons, d[owner]), plane, polygons, faces, owner
+
+
+def _distances(ctx: Context, distance: ir.Expr, cursor: Shapes, span) -> np.ndarray:
+    """``offset``'s distance (n,) float64 per shape; a lot whose outline it moves out beyond ``FAR`` fails.
+    Moved in that far, nothing is left of an outline: that is no error."""
+    d = np.broadcast_to(np.asarray(evaluate_array(distance, ctx.env(cursor)), float), (len(cursor),))
+    far = d > FAR
+    if far.any():
+        ctx.fail(cursor, far, f"`offset` by {d[far][0]:g}, beyond any coordinate", span)
+    return d
 
 
 def _inset_and_border(polygons: np.ndarray, distance: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

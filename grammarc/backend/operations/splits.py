@@ -96,7 +96,7 @@ def group_split(ctx: Context, cursor: Shapes, op: ir.GroupSplit) -> Parts:
         values = np.where(_kinds(op) == _SIZE_KIND[ir.SizeKind.RELATIVE], values, values * metres[:, None])
         axis = 0
     extent = np.ascontiguousarray(cursor.size[:, axis])
-    parent, part, pos, length, index = _group_layout(op, values, extent)
+    parent, part, pos, length, index = _group_layout(ctx, cursor, op, values, extent)
     return _group_children(ctx, cursor, op, axis, parent, part, pos, length, index, axes)
 
 
@@ -109,22 +109,25 @@ def split_area(ctx: Context, cursor: Shapes, op: ir.SplitArea) -> Parts:
     rings, offsets = (faces.verts, faces.ring_offsets, faces.face_offsets), faces.shape_offsets
     total = total_areas(*rings, offsets)
     values = _split_sizes(ctx, cursor, op, "splitArea")
-    parent, part, start, area, index = _group_layout(op, values, total)
+    parent, part, start, area, index = _group_layout(ctx, cursor, op, values, total)
     extent = cursor.size[parent, op.axis]
     ends = [area_positions(*rings, offsets, op.axis, parent, a, extent, total[parent])
             for a in (start, start + area)]
     return _group_children(ctx, cursor, op, op.axis, parent, part, ends[0], ends[1] - ends[0], index)
 
 
-def _group_layout(op: ir.GroupSplit, values: np.ndarray, extent: np.ndarray):
-    """The parts of CityEngine's split of sizes ``values`` (n, P) or (1, P) over ``extent`` (n,): parent,
-    part, position, length and index of each (``kernels.split.group_split``)."""
+def _group_layout(ctx: Context, cursor: Shapes, op: ir.GroupSplit, values: np.ndarray, extent: np.ndarray):
+    """The parts of CityEngine's split of sizes ``values`` (n, P) or (1, P) over ``extent`` (n,) of
+    ``cursor``'s shapes: parent, part, position, length and index of each (``kernels.split.group_split``),
+    counted first: a lot they would take over --max-shapes fails before they are made."""
     kind = _kinds(op)
     groups = np.array(op.groups, dtype=np.int64)
     if op.repeat:
         groups = np.zeros_like(groups)
     n_groups = int(groups.max()) + 1 if len(groups) else 0
-    return split_kernels.group_split(extent, values, kind, groups, n_groups, TOL.zero)
+    plan = split_kernels.group_counts(extent, values, kind, groups, n_groups, TOL.zero)
+    ctx.check_fan_out(cursor, plan[-1], op.span)
+    return split_kernels.group_split(extent, values, kind, groups, *plan, TOL.zero)
 
 
 def _group_children(ctx: Context, cursor: Shapes, op: ir.GroupSplit, axis: int, parent, part, pos, length, index,

@@ -122,3 +122,13 @@ def test_a_fence_of_posts_and_panels_along_a_strip(write, tmp_path):
     cells = np.floor(posts[:, 0] / 2.2 + 1e-6)
     assert set(cells.astype(int)) == set(range(11))
     assert (posts[:, 0] - 2.2 * cells <= 0.2 + 1e-5).all()
+
+
+def test_a_texture_scale_of_billions_of_copies_fails_its_lot_before_they_are_made(write):
+    """``scaleUV`` by 1e9 lays 3e10 copies along a 30 m lot (1e30: more than int64 counts): its lot fails
+    with the count, the copies counted before any is made; the other lots derive."""
+    text = 'attr k = 0.5\nLot --> scaleUV(0, k, 0.25) insertAlongUV(0, "builtin:cube", 2) Fence.\n'
+    r = run(write, text, [rect(30, 4)] * 3, lot_attrs={"k": np.array([0.5, 1e9, 1e30])})
+    assert np.unique(r["mesh"].lot).tolist() == [0]
+    assert [(b.index, b.reason.split(" in rule")[0]) for b in r["bad"]] == [
+        (1, "more than 2,000,000 shapes (30,000,000,000)"), (2, "more than 2,000,000 shapes (beyond counting)")]

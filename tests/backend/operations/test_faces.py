@@ -372,3 +372,28 @@ def test_rectify_snaps_edges_near_the_scope_axes(write):
     assert (t["r_sum"], t["x_sum"]) == (False, pytest.approx(20.9))
     (bad,) = run(write, "Lot --> extrude(3) rectify(10) X.\n", [rect(10, 8)])["bad"]
     assert bad.reason.startswith("`rectify` of a solid is not supported yet")
+
+
+@pytest.mark.parametrize("op", ["roofHip", "roofGable", "roofShed", "roofPyramid"])
+@pytest.mark.parametrize("angle", [90.0, 180.0, 1e9, -90.0])
+def test_a_roof_of_90_degrees_or_more_fails_its_lot_by_name(write, op, angle):
+    """The reference gives no roof for a plane of 90 degrees or more (its roof planes never meet): the
+    lot is bad, named with the operation, where this gave an IndexError that stopped the build."""
+    r = run(write, f"attr a = 30\nLot --> {op}(a) Roof.\n", [rect(30, 20)] * 2, lot_attrs={"a": np.array([30.0, angle])})
+    assert np.unique(r["mesh"].lot).tolist() == [0]
+    [bad] = r["bad"]
+    assert bad.index == 1 and bad.reason.startswith(f"`{op}` with an angle of 90 degrees or more in rule `Lot` at ")
+
+
+@pytest.mark.parametrize("select", ["", "comp(f){ inside : I. | border : B. }", "Roof.", "setback", "shapeL"])
+def test_an_offset_or_setback_beyond_any_coordinate_fails_its_lot(write, select):
+    """An outline moved out by more than float32 holds (GEOS raised on 1e308) fails its lot; moved in that
+    far, nothing is left of it, which is no error."""
+    body = {"Roof.": "extrude(3) comp(f){ top : roofHip(30) offset(d) Roof. }",
+            "setback": "setback(d){ front : A. | remainder : B. }",
+            "shapeL": "shapeL(d, 2){ shape : A. | remainder : B. }"}.get(select, f"offset(d) {select or 'A.'}")
+    what = "setback" if select in ("setback", "shapeL") else "offset"
+    r = run(write, f"attr d = -1\nLot --> {body}\n", [rect(10, 10)] * 3,
+            lot_attrs={"d": np.array([-1.0, 1e308, -1e308])})
+    reasons = [(b.index, b.reason.split(" in rule")[0]) for b in r["bad"]]
+    assert reasons == [(1, f"`{what}` by 1e+308, beyond any coordinate")]

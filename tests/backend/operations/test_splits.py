@@ -4,6 +4,8 @@ layouts of CityEngine's split: test_group_split.py)."""
 
 from __future__ import annotations
 
+import subprocess
+import sys
 from collections import Counter
 
 import numpy as np
@@ -93,6 +95,74 @@ def test_nan_split_size_lot_is_reported(write):
             [rect(12, 5), rect(10, 5)])
     assert list(np.unique(r["lot"])) == [0]
     assert r["bad"][0].index == 1 and "Subdiv" in r["bad"][0].reason
+
+
+def test_a_negative_subdiv_size_of_every_shape_fails_their_lots(write):
+    """A size negative for every shape (a constant, one row for the batch) fails the lots of all of them:
+    it gave an IndexError where the batch held more than one shape (a facade's four sides)."""
+    r = paper(write, 'attr w = 2\nlot ~> S(1r, 3, 1r) Comp("sidefaces"){ f }\nf ~> Subdiv("X", -2, 1r){ a | b }\n'
+                     'a ~> I("cube")\nb ~> I("cube")\n', [rect(10, 10)] * 2)
+    assert len(r["lot"]) == 0
+    assert [b.reason.split(" in rule")[0] for b in r["bad"]] == ["`Subdiv` has a negative or NaN size (-2, 1)"] * 2
+
+
+@pytest.mark.parametrize("text", [
+    'Lot --> split(x){ tile : A. }*\n',
+    'Lot --> split(x){ ~tile : A. }*\n',
+    'Lot --> split(x){ 1 : A. | { tile : B. | ~tile : C. }* | 1 : A. }\n',
+    'Lot --> splitArea(x){ tile : A. }*\n',
+])
+def test_a_split_of_too_many_or_too_small_parts_fails_its_lot_only(write, text):
+    """A repeat of a size too small for --max-shapes (or for int64's count, or too small to lay at all,
+    which made nothing and said nothing) fails its lot, counted before anything is made; the others
+    derive as they would alone."""
+    tiles = np.array([2.0, 1e-7, 2.0, 1e-18, 1e-9])
+    r = run(write, "attr tile = 2\n" + text, [rect(30, 20)] * 5, lot_attrs={"tile": tiles})
+    alone = run(write, "attr tile = 2\n" + text, [rect(30, 20)])
+    assert np.unique(r["lot"]).tolist() == [0, 2] and (r["lot"] == 0).sum() == len(alone["lot"])
+    assert [b.index for b in r["bad"]] == [1, 3, 4]
+    assert all(b.reason.startswith("more than 2,000,000 shapes (") and "in rule `Lot` at" in b.reason
+               for b in r["bad"])
+    assert "(beyond counting)" in r["bad"][1].reason
+
+
+def test_a_repeat_of_a_size_near_float64s_largest_fits_no_time(write):
+    """A repetition of 1e308 m fits no time into 10 m: its share of the room overflowed (``left *
+    nominal``) to inf, which counted beyond any --max-shapes and failed the lot."""
+    r = run(write, 'Lot --> extrude(10) split(y){ 1e308 : A. | ~1 : B. }*\n', [rect(10, 10)])
+    assert r["bad"] == () and len(r["xform"]) == 1
+
+
+def test_a_repeat_whose_count_overflows_fails_its_lot(write):
+    """``Repeat("X", 1e-18)`` makes 3e19 elements: more than int64 counts (it gave one element spanning
+    the facade), so its lot fails, before anything is allocated."""
+    r = paper(write, 'attr w = 2\nlot ~> S(1r, 3, 1r) Repeat("X", w){ tile }\ntile ~> I("cube")\n',
+              [rect(30, 20)] * 3, lot_attrs={"w": np.array([2.0, 1e-18, 1e-7])})
+    assert np.unique(r["lot"]).tolist() == [0]
+    assert [(b.index, b.reason.split(" in rule")[0]) for b in r["bad"]] == [
+        (1, "more than 2,000,000 shapes (beyond counting)"), (2, "more than 2,000,000 shapes (300,000,000)")]
+
+
+def test_a_split_of_a_billion_parts_is_refused_in_little_time_and_memory(write, tmp_path):
+    """The fuzz's ``split(x){ 1e-7 : A. }*`` on a 30 x 20 lot passed 4 GiB in 10 s: the parts are counted
+    and checked against --max-shapes before they are made. Measured in a process of its own (the kernels
+    allocate outside tracemalloc's sight)."""
+    grammar = write("g.cga", 'version "2022.0"\n@StartRule\nLot --> split(x){ 1e-7 : A. }*\n')
+    script = f"""
+import resource, sys, time
+from grammarc.build import BuildOptions, derive
+from grammarc.compiler import compile_grammar
+from grammarc.io.lots import default_lot
+grammar = compile_grammar({str(grammar)!r})
+derive(grammar, default_lot())  # the kernels loaded
+before = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
+started = time.perf_counter()
+r = derive(grammar, default_lot())
+print(time.perf_counter() - started, resource.getrusage(resource.RUSAGE_SELF).ru_maxrss - before, len(r["bad"]))
+"""
+    seconds, grown_kb, bad = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True,
+                                            timeout=120, check=True).stdout.split()
+    assert bad == "1" and float(seconds) < 1.0 and int(grown_kb) < 50_000
 
 
 
