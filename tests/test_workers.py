@@ -1,6 +1,7 @@
 """Worker processes: records shipped through memory files come back equal; bad lots come back named."""
 
 import numpy as np
+import pytest
 
 from grammarc.build import BuildOptions, derive
 from grammarc.compiler import compile_grammar
