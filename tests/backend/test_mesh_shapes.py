@@ -276,6 +276,18 @@ def test_convexify_makes_one_shape_whose_faces_are_the_convex_parts(write):
     assert t[1]["n_sum"] == 1 and t[1]["a_sum"] == pytest.approx(96)  # a convex face stays itself
 
 
+def test_convexified_roof_of_a_z_lays_its_arms_along_their_long_sides(write):
+    """candler.Z.11103's roof (inset by 0.8 m; arms of 3.27 by 13.48 m): PRT's ventilations run along the
+    arms, whose scopes lie along their long sides (from where the cut of the Z's middle ends on them)."""
+    z = [np.array([[8.1, 14.81], [5.61, 1.56], [-7.87, 4.1], [-11.32, -14.2], [-8.1, -14.81], [-5.61, -1.56],
+                   [7.87, -4.1], [11.32, 14.2]])]
+    text = ("Lot --> extrude(10) comp(f){ top : alignScopeToGeometry(yUp, 0, 0) convexify comp(f){ all : Part } }\n"
+            'Part --> case geometry.isRectangular(1) : report("sx", scope.sx) report("sy", scope.sy)\n'
+            "        else : NIL\n")
+    t = per_lot(run(write, text, [z]))[0]
+    assert t["sx_n"] == 2 and t["sx_sum"] == pytest.approx(2 * 13.48, abs=0.02)
+
+
 def test_convexified_leaf_emits_its_parts(write):
     r = run(write, "Lot --> convexify()\n", [LOT_ZOO["courtyard"]])
     faces = mesh_faces(r)
