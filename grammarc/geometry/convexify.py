@@ -2,10 +2,11 @@
 
 Each round cuts every piece that still has a reflex vertex along a line through its first one: the line
 of one of the two edges that meet there, the one that runs a shorter way into the piece from the
-vertex (on one side the vertex becomes straight, on the other its angle drops below 180 degrees), or,
-where the corner turns by less than ``SHARP_DEGREES``, the line across the boundary (a cut along a
-nearly straight edge would shave off slivers). A cut never makes a reflex vertex, so the reflex
-vertices of a lineage strictly decrease. A hole's corners are reflex too, so holes are cut open.
+vertex (on one side the vertex becomes straight, on the other its angle drops below 180 degrees). A
+nearly straight corner too: the cut shaves a sliver off along the edge, and the rest of the piece stays
+whole (PRT's candler roofs keep a roof access on pieces with corners of a few degrees, candler.yverdon.10,
+concave.11029). A cut never makes a reflex vertex, so the reflex vertices of a lineage strictly
+decrease. A hole's corners are reflex too, so holes are cut open.
 Rectilinear footprints come out as rectangles (an L in two, a U in three) whose corners where a cut
 ends on an edge stay: PRT's pieces keep them, and ``geometry.isRectangular`` tells such a piece from a
 rectangle (candler's roofs). Each piece starts where its boundary leaves the last cut: at the corner
@@ -28,8 +29,6 @@ import shapely
 from grammarc.constants import TOL
 from grammarc.ragged import segment_of
 
-#: Reflex corners turning more than this are cut along their outgoing edge, flatter ones across.
-SHARP_DEGREES = 20.0
 #: Cutting rounds at most (each removes at least one reflex vertex from every piece it cuts).
 MAX_ROUNDS = 256
 
@@ -107,8 +106,8 @@ def _convex_parts(polygons: np.ndarray, max_length: np.ndarray | None) -> tuple[
 
 def _cut_vertices(pieces: np.ndarray, limit: np.ndarray | None, across: np.ndarray):
     """Per piece, its first reflex vertex that may be cut (k, 2), the cut's direction (k, 2): along the
-    line of one of the edges that meet there, or across the boundary (flat corners, and pieces flagged
-    ``across``), and where the parts on its left and on its right start (k, 2) each; NaN where there is
+    line of one of the edges that meet there, or across the boundary (pieces flagged ``across``), and
+    where the parts on its left and on its right start (k, 2) each; NaN where there is
     none (the piece is convex, or every cut is too long).
 
     The ring of the piece cut off along an edge's line runs from the vertex on along the boundary to the
@@ -141,12 +140,12 @@ def _cut_vertices(pieces: np.ndarray, limit: np.ndarray | None, across: np.ndarr
     # a clear corner is cut along the line of one of its edges, the one whose run into the piece from the
     # corner is shorter (PRT's candler roofs: an H's bar, a Z's middle and a U's arms come out as
     # rectangles, the rest keeping the cut's ends); the incoming edge's on a tie (the kit's L into its
-    # two 10 m arms, the boundary running forward about the roof's normal). A nearly straight corner is cut across the boundary, which no edge's line runs close to.
-    sharp = (a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0]) < -np.sin(np.radians(SHARP_DEGREES))
+    # two 10 m arms, the boundary running forward about the roof's normal). A piece whose cut only shaved
+    # off a sliver below the area floor is cut across the boundary, which no edge's line runs close to.
     tangent = a + b
     normal = np.stack([-tangent[:, 1], tangent[:, 0]], axis=1)
     normal /= np.maximum(np.hypot(normal[:, 0], normal[:, 1]), 1e-300)[:, None]
-    along = sharp & ~across[piece[candidates]]
+    along = ~across[piece[candidates]]
     edge = b.copy()
     point = coords[candidates]
     left, right = point.copy(), point.copy()
