@@ -2,14 +2,16 @@
 
 Each round cuts every piece that still has a reflex vertex along a line through its first one: the line
 of one of the two edges that meet there, the one that runs a shorter way into the piece from the
-vertex (on one side the vertex becomes straight, on the other its angle drops below 180 degrees), or,
-where the corner turns by less than ``SHARP_DEGREES``, the line across the boundary (a cut along a
-nearly straight edge would shave off slivers). A cut never makes a reflex vertex, so the reflex
-vertices of a lineage strictly decrease. A hole's corners are reflex too, so holes are cut open.
+vertex (on one side the vertex becomes straight, on the other its angle drops below 180 degrees). A
+nearly straight corner too: the cut shaves a sliver off along the edge, and the rest of the piece stays
+whole (PRT's candler roofs keep a roof access on pieces with corners of a few degrees, candler.yverdon.10,
+concave.11029). A cut never makes a reflex vertex, so the reflex vertices of a lineage strictly
+decrease. A hole's corners are reflex too, so holes are cut open.
 Rectilinear footprints come out as rectangles (an L in two, a U in three) whose corners where a cut
 ends on an edge stay: PRT's pieces keep them, and ``geometry.isRectangular`` tells such a piece from a
-rectangle (candler's roofs). Each piece starts at the corner it was last cut at. The cut is the whole
-line through the piece: a concave piece may be cut in more places than the reflex vertex needs.
+rectangle (candler's roofs). Each piece starts where its boundary leaves the last cut: at the corner
+cut, or where the cut ends on the boundary (``_cut_vertices``). The cut is the whole line through the
+piece: a concave piece may be cut in more places than the reflex vertex needs.
 
 A cut that only shaves off a sliver (below the area floor) is tried again across the boundary; if that
 fails too, the piece stays concave (about one piece in 10^4 on random star-shaped footprints).
@@ -27,16 +29,37 @@ import shapely
 from grammarc.constants import TOL
 from grammarc.ragged import segment_of
 
-#: Reflex corners turning more than this are cut along their outgoing edge, flatter ones across.
-SHARP_DEGREES = 20.0
 #: Cutting rounds at most (each removes at least one reflex vertex from every piece it cuts).
 MAX_ROUNDS = 256
 
 
-def convex_parts(polygons: np.ndarray, max_length: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
+def convex_parts(polygons: np.ndarray, max_length: np.ndarray | None = None,
+                 mirrored: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
     """Convex pieces of shapely polygons (m,): (pieces (k,), source (k,)), each source's pieces together
-    in cutting order. ``max_length`` (m,): longest chord to cut along, per polygon (None: no limit)."""
-    pieces = shapely.orient_polygons(np.asarray(polygons, dtype=object), exterior_cw=False)
+    in cutting order. ``max_length`` (m,): longest chord to cut along, per polygon (None: no limit).
+    ``mirrored`` (m,) bool: the polygons given in a left-handed pair of axes (a scope's x-z plane), whose
+    boundary runs forward (counter-clockwise about the face's normal) clockwise; a piece's start depends on
+    which way its boundary runs forward from the cut (None: all right-handed)."""
+    polygons = np.asarray(polygons, dtype=object)
+    flip = np.zeros(len(polygons), dtype=bool) if mirrored is None else np.asarray(mirrored, dtype=bool)
+    if flip.any():
+        polygons = polygons.copy()
+        polygons[flip] = _mirrored(polygons[flip])
+    pieces, source = _convex_parts(polygons, max_length)
+    if flip.any():
+        back = flip[source]
+        pieces[back] = _mirrored(pieces[back])
+    return pieces, source
+
+
+def _mirrored(polygons: np.ndarray) -> np.ndarray:
+    """Polygons (k,) with their x negated: the same rings in the other handedness."""
+    return shapely.transform(polygons, lambda xy: xy * np.array([-1.0, 1.0]))
+
+
+def _convex_parts(polygons: np.ndarray, max_length: np.ndarray | None) -> tuple[np.ndarray, np.ndarray]:
+    """``convex_parts`` of polygons in a right-handed pair of axes."""
+    pieces = shapely.orient_polygons(polygons, exterior_cw=False)
     source = np.arange(len(pieces))
     across = np.zeros(len(pieces), dtype=bool)  # cut across the boundary this time
     done_pieces, done_source = [], []
@@ -45,12 +68,13 @@ def convex_parts(polygons: np.ndarray, max_length: np.ndarray | None = None) -> 
             break
         pieces = _without_spikes(pieces)
         limit = None if max_length is None else max_length[source]
-        vertex, direction = _cut_vertices(pieces, limit, across)
+        vertex, direction, starts = _cut_vertices(pieces, limit, across)
         finished = np.isnan(vertex[:, 0])
         done_pieces.append(pieces[finished])
         done_source.append(source[finished])
-        pieces, source, vertex, direction, across = (pieces[~finished], source[~finished], vertex[~finished],
-                                                     direction[~finished], across[~finished])
+        pieces, source, vertex, direction, starts, across = (
+            pieces[~finished], source[~finished], vertex[~finished], direction[~finished], starts[~finished],
+            across[~finished])
         if not len(pieces):
             break
         left, right = _half_planes(vertex, direction, _reach(pieces))
@@ -58,6 +82,7 @@ def convex_parts(polygons: np.ndarray, max_length: np.ndarray | None = None) -> 
         parts, index = shapely.get_parts(cut, return_index=True)
         keep = (shapely.get_type_id(parts) == shapely.GeometryType.POLYGON) & (shapely.area(parts) > TOL.area_floor)
         parent = np.concatenate([np.arange(len(pieces))] * 2)[index[keep]]
+        side = (index[keep] >= len(pieces)).astype(np.int64)  # 0: on the cut's left, 1: on its right
         # a cut that only shaves off a sliver (an edge's line running close to another edge) is tried
         # again across the boundary; if that fails too, the piece stays as it is
         stuck = np.bincount(parent, minlength=len(pieces)) < 2
@@ -65,8 +90,8 @@ def convex_parts(polygons: np.ndarray, max_length: np.ndarray | None = None) -> 
         done_pieces.append(pieces[given_up])
         done_source.append(source[given_up])
         retry = np.flatnonzero(stuck & ~across)
-        parts, parent = parts[keep][~stuck[parent]], parent[~stuck[parent]]
-        parts = _starting_at(parts, vertex[parent])
+        parts, parent, side = parts[keep][~stuck[parent]], parent[~stuck[parent]], side[~stuck[parent]]
+        parts = _starting_at(parts, starts[parent, side])
         order = np.argsort(np.concatenate([parent, retry]), kind="stable")
         pieces = shapely.orient_polygons(np.concatenate([parts, pieces[retry]])[order], exterior_cw=False)
         across = np.concatenate([np.zeros(len(parts), dtype=bool), np.ones(len(retry), dtype=bool)])[order]
@@ -80,9 +105,16 @@ def convex_parts(polygons: np.ndarray, max_length: np.ndarray | None = None) -> 
 
 
 def _cut_vertices(pieces: np.ndarray, limit: np.ndarray | None, across: np.ndarray):
-    """Per piece, its first reflex vertex that may be cut (k, 2) and the cut's direction (k, 2): along
-    the edge leaving it, or across the boundary (flat corners, and pieces flagged ``across``); NaN
-    where there is none (the piece is convex, or every cut is too long)."""
+    """Per piece, its first reflex vertex that may be cut (k, 2), the cut's direction (k, 2): along the
+    line of one of the edges that meet there, or across the boundary (pieces flagged ``across``), and
+    where the parts on its left and on its right start (k, 2) each; NaN where there is
+    none (the piece is convex, or every cut is too long).
+
+    The ring of the piece cut off along an edge's line runs from the vertex on along the boundary to the
+    cut's far end and back along the cut; the other part's ring runs from that far end on to the vertex:
+    the one part starts at the vertex, the other where the cut ends on the boundary (PRT's pieces: the
+    scope of a Z's arm lies along its long side, from the cut's end, not along the cut). A part cut
+    across the boundary starts at the vertex."""
     _, coords, (ring_offsets, part_offsets) = shapely.to_ragged_array(pieces)
     coords = np.asarray(coords)[:, :2]
     ring_offsets = np.asarray(ring_offsets, dtype=np.int64)
@@ -107,32 +139,42 @@ def _cut_vertices(pieces: np.ndarray, limit: np.ndarray | None, across: np.ndarr
     b = d_out[candidates] / np.hypot(d_out[candidates, 0], d_out[candidates, 1])[:, None]
     # a clear corner is cut along the line of one of its edges, the one whose run into the piece from the
     # corner is shorter (PRT's candler roofs: an H's bar, a Z's middle and a U's arms come out as
-    # rectangles, the rest keeping the cut's ends); the outgoing edge's on a tie (an L into two 10 m
-    # arms). A nearly straight corner is cut across the boundary, which no edge's line runs close to.
-    sharp = (a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0]) < -np.sin(np.radians(SHARP_DEGREES))
+    # rectangles, the rest keeping the cut's ends); the incoming edge's on a tie (the kit's L into its
+    # two 10 m arms, the boundary running forward about the roof's normal). A piece whose cut only shaved
+    # off a sliver below the area floor is cut across the boundary, which no edge's line runs close to.
     tangent = a + b
     normal = np.stack([-tangent[:, 1], tangent[:, 0]], axis=1)
     normal /= np.maximum(np.hypot(normal[:, 0], normal[:, 1]), 1e-300)[:, None]
-    along = sharp & ~across[piece[candidates]]
+    along = ~across[piece[candidates]]
     edge = b.copy()
+    point = coords[candidates]
+    left, right = point.copy(), point.copy()
     if along.any():
-        owner, point = piece[candidates[along]], coords[candidates[along]]
-        run_in, run_out = np.split(_runs(pieces, np.r_[owner, owner], np.r_[point, point],
+        owner = piece[candidates[along]]
+        run_in, run_out = np.split(_runs(pieces, np.r_[owner, owner], np.r_[point[along], point[along]],
                                          np.r_[a[along], -b[along]]), 2)
-        shorter = run_in < run_out * (1.0 - 1e-9)
+        shorter = run_in <= run_out * (1.0 + 1e-9)
         edge[np.flatnonzero(along)[shorter]] = a[along][shorter]
+        # the far end: on the right of the outgoing edge's line (the incoming edge's side), on the left of
+        # the incoming edge's line
+        far = point[along] + np.where(shorter[:, None], a[along] * run_in[:, None], -b[along] * run_out[:, None])
+        rows = np.flatnonzero(along)
+        left[rows[shorter]] = far[shorter]
+        right[rows[~shorter]] = far[~shorter]
     direction = np.where(along[:, None], edge, normal)
     if limit is not None and len(candidates):
-        chord = _chords(pieces[piece[candidates]], coords[candidates], direction)
+        chord = _chords(pieces[piece[candidates]], point, direction)
         keep = chord < limit[piece[candidates]]
-        candidates, direction = candidates[keep], direction[keep]
-    vertex = np.full((len(pieces), 2), np.nan)
-    chosen = np.full((len(pieces), 2), np.nan)
+        candidates, direction, left, right = candidates[keep], direction[keep], left[keep], right[keep]
+    vertex, chosen = np.full((len(pieces), 2), np.nan), np.full((len(pieces), 2), np.nan)
+    starts = np.full((len(pieces), 2, 2), np.nan)
     # the first candidate of each piece (candidates are in vertex order)
     first = np.r_[True, piece[candidates][1:] != piece[candidates][:-1]] if len(candidates) else np.zeros(0, bool)
     vertex[piece[candidates[first]]] = coords[candidates[first]]
     chosen[piece[candidates[first]]] = direction[first]
-    return vertex, chosen
+    starts[piece[candidates[first]], 0] = left[first]
+    starts[piece[candidates[first]], 1] = right[first]
+    return vertex, chosen, starts
 
 
 def _runs(pieces: np.ndarray, owner: np.ndarray, point: np.ndarray, direction: np.ndarray) -> np.ndarray:

@@ -276,6 +276,32 @@ def test_convexify_makes_one_shape_whose_faces_are_the_convex_parts(write):
     assert t[1]["n_sum"] == 1 and t[1]["a_sum"] == pytest.approx(96)  # a convex face stays itself
 
 
+def test_convexified_roof_of_a_z_lays_its_arms_along_their_long_sides(write):
+    """candler.Z.11103's roof (inset by 0.8 m; arms of 3.27 by 13.48 m): PRT's ventilations run along the
+    arms, whose scopes lie along their long sides (from where the cut of the Z's middle ends on them)."""
+    z = [np.array([[8.1, 14.81], [5.61, 1.56], [-7.87, 4.1], [-11.32, -14.2], [-8.1, -14.81], [-5.61, -1.56],
+                   [7.87, -4.1], [11.32, 14.2]])]
+    text = ("Lot --> extrude(10) comp(f){ top : alignScopeToGeometry(yUp, 0, 0) convexify comp(f){ all : Part } }\n"
+            'Part --> case geometry.isRectangular(1) : report("sx", scope.sx) report("sy", scope.sy)\n'
+            "        else : NIL\n")
+    t = per_lot(run(write, text, [z]))[0]
+    assert t["sx_n"] == 2 and t["sx_sum"] == pytest.approx(2 * 13.48, abs=0.02)
+
+
+@pytest.mark.parametrize("turn", [0.02, 8.0, 20.0])
+def test_convexified_roof_with_a_nearly_straight_corner_keeps_its_large_piece(write, turn):
+    """A 30 x 20 m lot dented at the middle of a long side by a corner turning a few degrees, as candler
+    cuts its roof: PRT keeps one piece of over 200 m2 (one roof access) at 0.02, 8 and 20 degrees; the cut
+    along an edge's line only shaves a sliver off it, where a cut across would halve it."""
+    dent = 15 * np.tan(np.radians(turn / 2))
+    lot = [np.array([[0, 0], [15, dent], [30, 0], [30, 20], [0, 20]])]
+    text = ("Lot --> extrude(10) comp(f){ top : offset(-0.8) comp(f){ inside : alignScopeToGeometry(yUp, 0, 0) "
+            "convexify comp(f){ all : Part } } }\n"
+            'Part --> case geometry.area > 200 : report("large", 1)\n        else : report("small", 1)\n')
+    t = per_lot(run(write, text, [lot]))[0]
+    assert t["large_n"] == 1
+
+
 def test_convexified_leaf_emits_its_parts(write):
     r = run(write, "Lot --> convexify()\n", [LOT_ZOO["courtyard"]])
     faces = mesh_faces(r)

@@ -22,11 +22,14 @@ def is_convex(pieces):
 
 
 @pytest.mark.parametrize("polygon, areas", [
-    (L_SHAPE, [200, 200]), (U_SHAPE, [400, 200, 200]), (COURTYARD, [400, 400, 200, 200]),
+    (L_SHAPE, [200, 200]), (U_SHAPE, [300, 300, 200]), (COURTYARD, [400, 300, 300, 200]),
     (shapely.box(0, 0, 5, 3), [15]),
 ])
 def test_rectilinear_footprints_become_rectangles(polygon, areas):
-    pieces, source = convex_parts(np.array([polygon]))
+    """In a roof's x-z plane (left-handed, as candler's roofs are cut), where the kit's L comes out as its
+    two 10 m arms: a tie between a corner's two edges goes to the one coming in, the boundary running
+    forward about the face's normal."""
+    pieces, source = convex_parts(np.array([polygon]), None, np.array([True]))
     assert sorted(shapely.area(pieces).round(9), reverse=True) == sorted(areas, reverse=True)
     assert (source == 0).all() and is_convex(pieces).all()
     assert np.allclose(shapely.area(shapely.oriented_envelope(pieces)), shapely.area(pieces))
@@ -56,11 +59,34 @@ def test_a_corner_is_cut_along_the_edge_whose_run_into_the_piece_is_shorter():
                                                                                          (600, 6)]
 
 
-def test_pieces_start_at_the_corner_they_were_cut_at():
-    """The scope of a part lies along the edge from that corner (the kit's L: PRT's ventilation on the
-    20 m arm runs along it)."""
+def test_pieces_start_where_their_boundary_leaves_the_cut():
+    """The part whose boundary runs on from the cut corner starts there, the other where the cut ends on
+    the boundary, so that each part's first edge is one of the polygon's (the kit's L: PRT's ventilation
+    on the arm runs along it)."""
     pieces, _ = convex_parts(np.array([L_SHAPE]))
-    assert all(p.exterior.coords[0] == (10, 10) for p in pieces)
+    assert sorted(p.exterior.coords[0] for p in pieces) == [(0, 10), (10, 10)]
+    assert all(p.exterior.is_ccw for p in pieces)
+
+
+# candler.Z.11103's roof (inset by 0.8 m), a Z turned by 10.7 degrees whose arms are 3.3 m by 13.5 m
+Z_ROOF = shapely.Polygon([(8.1, 14.81), (5.61, 1.56), (-7.87, 4.1), (-11.32, -14.2), (-8.1, -14.81),
+                          (-5.61, -1.56), (7.87, -4.1), (11.32, 14.2)])
+
+
+@pytest.mark.parametrize("mirrored", [False, True])
+def test_the_arms_of_a_z_start_along_their_long_side(mirrored):
+    """PRT lays the ventilations of candler.Z.11103 along the Z's arms: each arm, cut off along the line of
+    the middle's long edge, starts where that cut ends and runs along its long side first. The same in a
+    left-handed frame (a roof's x-z plane), where the boundary runs forward clockwise."""
+    polygon = shapely.transform(Z_ROOF, lambda xy: xy * [-1, 1]) if mirrored else Z_ROOF
+    pieces, _ = convex_parts(np.array([polygon]), None, np.array([True])) if mirrored else convex_parts(
+        np.array([polygon]))
+    arms = [p for p in pieces if corners(p) == 4]
+    assert len(arms) == 2
+    for arm in arms:
+        xy = np.asarray(arm.exterior.coords)
+        assert arm.exterior.is_ccw != mirrored
+        assert np.hypot(*(xy[1] - xy[0])) == pytest.approx(13.48, abs=0.02)
 
 
 def test_split_lines_longer_than_max_length_are_not_cut():

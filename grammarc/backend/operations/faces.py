@@ -483,7 +483,7 @@ def convexify(ctx: Context, cursor: Shapes, op: ir.Convexify) -> Shapes:
     if op.max_length is not None:
         limit = np.broadcast_to(np.asarray(evaluate_array(op.max_length, ctx.env(cursor)), float),
                                 (len(cursor),))
-    parts, source = convex_parts(polygons, limit)
+    parts, source = convex_parts(polygons, limit, plane == 1)
     return mesh_shapes.flat_meshes(ctx.chunk, cursor, parts, source, plane)
 
 
