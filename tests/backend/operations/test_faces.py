@@ -97,6 +97,31 @@ def test_offset_inset_without_the_last_edge_starts_where_edge_0_ends(write):
     assert (t["x_sum"], t["z_sum"]) == (pytest.approx(7), pytest.approx(2))
 
 
+def test_offset_inset_beside_a_thin_hole_starts_at_vertex_0s_mitre(write):
+    """A thin hole near edge 3 whose far side lies nearer the inset's left side than edge 3 does: that
+    side is still edge 3 moved in (the hole's side lies beyond it, on the hole's side), so the inset
+    starts at vertex 0's mitre and split(x) cuts a strip along edge 3's side, in two by the grown hole's
+    notch, as PRT's massing splits its footprint on such lots (holes.11067; was: the inset started at
+    vertex 1's mitre and the strip ran along edge 0)."""
+    lot = [np.array([[0, 0], [30, 0], [30, 30], [0, 30]], float),
+           np.array([[4, 10], [4, 20], [5.5, 20], [5.5, 10]], float)]
+    text = ('Lot --> offset(-3) comp(f){ inside : I }\nI --> split(x){ 1 : A | ~1 : B }\n'
+            'A --> report("a", geometry.area)\n')
+    assert totals(run(write, text, [lot]))["a_sum"] == pytest.approx(8)
+
+
+def test_offset_inset_that_a_hole_cuts_in_two_starts_each_piece_at_its_first_edges_end(write):
+    """A hole across the lot parts the inset in two: the piece with vertex 0's mitre starts there, the
+    other where its first outer edge left ends (vertex 2's mitre, so its scope x runs along the slanted
+    edge 2), though a run along the last edge ends in it too, at the hole: PRT on massing's courtyards
+    and holes.11067 (was: that end, with x along the hole's side)."""
+    lot = [np.array([[0, 0], [30, 0], [30, 30], [0, 40]], float),
+           np.array([[2, 12], [2, 18], [28, 18], [28, 12]], float)]
+    text = 'Lot --> offset(-3) comp(f){ inside : I }\nI --> report("x", scope.sx)\n'
+    # the bottom piece 24 m along edge 0, the top one 27.46 m along edge 2 (were 24 m along the hole)
+    assert totals(run(write, text, [lot]))["x_sum"] == pytest.approx(24 + 27.4605, abs=1e-4)
+
+
 def test_setback_of_an_edge_shorter_than_its_distance_reaches_the_kept_edge_beside_it(write):
     """massing's terrace on the end of a narrow arm: edges 0 and 1 set back 4 m, edge 1 only 1.5 m long
     and meeting the kept edge 2 at 81 degrees. Its strip ends where its end lines cross, and the two
