@@ -38,7 +38,8 @@ class Edges:
     """The boundary edges of m polygons: ``start``, ``end`` (E, 2); ``inward`` (E, 2) unit normals
     pointing into the polygon; ``poly`` (E,) the polygon of each edge; ``prev``, ``next`` (E,) the
     neighbouring edges along the same ring; ``vertex`` (E,) each one's start among the vertices of the
-    polygons' open rings, all rings one after the other (as ``shapely.to_ragged_array`` lists them)."""
+    polygons' open rings, all rings one after the other (as ``shapely.to_ragged_array`` lists them);
+    ``hole`` (E,) whether the edge lies on a hole."""
 
     start: np.ndarray
     end: np.ndarray
@@ -47,6 +48,7 @@ class Edges:
     prev: np.ndarray
     next: np.ndarray
     vertex: np.ndarray
+    hole: np.ndarray
 
 
 def polygon_edges(polygons: np.ndarray) -> Edges:
@@ -72,7 +74,7 @@ def polygon_edges(polygons: np.ndarray) -> Edges:
     local = np.arange(len(ring)) - offsets[ring]
     size = np.maximum(counts[ring], 1)
     return Edges(start, end, inward, ring_poly[ring], offsets[ring] + (local - 1) % size,
-                 offsets[ring] + (local + 1) % size, first - ring)
+                 offsets[ring] + (local + 1) % size, first - ring, hole[ring])
 
 
 def setback_regions(polygons: np.ndarray, edges: Edges, distance: np.ndarray, owner: np.ndarray,
@@ -183,7 +185,8 @@ def _edges_of(edges: Edges, chosen: np.ndarray) -> tuple[np.ndarray, Edges]:
     renumber[keep] = np.arange(len(keep))
     polygon = np.cumsum(chosen) - 1
     return keep, Edges(edges.start[keep], edges.end[keep], edges.inward[keep], polygon[edges.poly[keep]],
-                       renumber[edges.prev[keep]], renumber[edges.next[keep]], edges.vertex[keep])
+                       renumber[edges.prev[keep]], renumber[edges.next[keep]], edges.vertex[keep],
+                       edges.hole[keep])
 
 
 def _without_seams(regions: np.ndarray, polygons: np.ndarray) -> np.ndarray:

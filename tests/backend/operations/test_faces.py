@@ -56,12 +56,29 @@ def test_shape_l_u_o_on_a_rectangle(write, op, strips, remainder):
 
 
 def test_setback_of_all_edges_on_concave_and_holed_lots(write):
-    """The L's strip is one piece; the courtyard's are two rings, around the lot and around the hole."""
+    """The L's strip is one piece; the courtyard's one ring around the lot: a hole's edges do not move, as
+    PRT sets back none (massing's shapeL/U and tier setbacks on holed faces), and the remainder keeps
+    the hole (was: a second ring around the hole)."""
     r = run(write, "Lot --> setback(2){ all : A | remainder : R }\n" + AREA_REPORTS,
             [LOT_ZOO["concave_L"], LOT_ZOO["courtyard"]])
     lots = per_lot(r)
     assert lots[0]["a_sum"] == pytest.approx(400 - 216) and lots[0]["r_sum"] == pytest.approx(216)
-    assert lots[1]["a_n"] == 2 and lots[1]["a_sum"] + lots[1]["r_sum"] == pytest.approx(1200)
+    assert lots[1]["a_n"] == 1 and lots[1]["a_sum"] == pytest.approx(1600 - 36 * 36)
+    assert lots[1]["r_sum"] == pytest.approx(36 * 36 - 400)
+
+
+def test_shape_l_and_tier_setbacks_of_a_holed_face_leave_the_hole_alone(write):
+    """PRT's massing on a 30 m square with a 10 m courtyard: shapeL's strips (12 m) run along the outline
+    only and the hole cuts them (the L is 576 - 36 m²: the hole's corner inside it); per-edge distances
+    past the outline's edges (comp.index 4..7, "0;0;4;3") move none of the hole's, so the tier top keeps
+    a 23 x 23 m remainder around the courtyard (was: every edge facing front or left moved, the hole's
+    too, and the L took the whole face; two of the hole's edges moved 4 and 3 m)."""
+    lot = [np.array([[0, 0], [30, 0], [30, 30], [0, 30]], float),
+           np.array([[10, 10], [10, 20], [20, 20], [20, 10]], float)]
+    t = totals(run(write, "Lot --> shapeL(12, 12){ shape : A | remainder : R }\n" + AREA_REPORTS, [lot]))
+    assert t["a_sum"] == pytest.approx(576 - 36) and t["r_sum"] == pytest.approx(18 * 18 - 64)
+    tier = 'Lot --> setback(comp(fe){ all : float(listItem("4;4;3;3;0;0;4;3", comp.index)) }) { all : A | remainder : R }\n'
+    assert totals(run(write, tier + AREA_REPORTS, [lot]))["r_sum"] == pytest.approx(23 * 23 - 100)
 
 
 def test_setback_of_a_facade_selects_its_top_and_bottom_edges(write):
