@@ -176,7 +176,9 @@ def ring_starts(coords, ring_offsets, part_offsets, part_source, part_with_start
     vertex 0 with it) the inset starts at the end of edge 0 (PRT on massing's H and L lots whose arms an
     offset closed), where it took edge 0 at the start of edge 1, and where holes grown into the outline
     cut the last edge off from the next one, at the end of the last edge (PRT on massing's holes.7039;
-    a setback's remainder there keeps the first rule: H.7006). PRT (measured through PyPRT on some 700
+    a setback's remainder there keeps the first rule: H.7006); of an inset a hole parts in pieces, only
+    the run along the last edge that ends nearest vertex 0 counts from the last, and the other pieces
+    start where their first outer edge left ends (``_last_edge_ends``). PRT (measured through PyPRT on some 700
     pieces of convex and concave lots cut by ``split``) starts the outline of a piece on a side of the cut that holds the
     parent's vertex 0 or 1 (``part_with_start``) at its first place: vertex 0 itself, or the crossing
     where the boundary enters it. A piece on another side starts with its cut edge: at its last place
@@ -186,19 +188,21 @@ def ring_starts(coords, ring_offsets, part_offsets, part_source, part_with_start
     with every ring turned.
     """
     out = np.empty_like(coords)
+    material = _material_sides(parent_coords, parent_rings, parent_offsets)
+    # each vertex's key (its place) and the parent edge its outgoing edge runs along or came from
+    keys = np.empty(len(coords))
+    marked = np.zeros(len(coords), np.bool_)
+    moved_from = np.full(len(coords), np.inf)
     for p in range(len(part_offsets) - 1):
         g = part_source[p]
         for r in range(part_offsets[p], part_offsets[p + 1]):
             r0, r1 = ring_offsets[r], ring_offsets[r + 1]
             n = r1 - r0
-            keys = np.empty(n)
-            marked = np.zeros(n, np.bool_)
-            moved_from = np.full(n, np.inf)  # the parent edge each outgoing edge runs along or came from
-            for j in range(n):
-                k = r0 + (j + 1) % n
+            for j in range(r0, r1):
+                k = r0 + (j - r0 + 1) % n
                 near, key, vertex_key, scale, edge, away = _places(
-                    coords[r0 + j, 0], coords[r0 + j, 1], coords[k, 0], coords[k, 1], g, parent_coords,
-                    parent_rings, parent_offsets)
+                    coords[j, 0], coords[j, 1], coords[k, 0], coords[k, 1], g, parent_coords,
+                    parent_rings, parent_offsets, material)
                 if cut:
                     edge = np.inf  # a cut's crossings keep their places: their chords run along no edge
                 moved_from[j] = edge
@@ -211,23 +215,33 @@ def ring_starts(coords, ring_offsets, part_offsets, part_source, part_with_start
                     keys[j] = key  # on the boundary: a kept vertex, a cut's crossing
                 else:
                     keys[j] = vertex_key
-            best = int(np.argmin(keys))
-            outer = parent_rings[parent_offsets[g] + 1] - parent_rings[parent_offsets[g]]
+    last_end = _last_edge_ends(coords, ring_offsets, part_offsets, part_source, part_inset, moved_from,
+                               parent_coords, parent_rings, parent_offsets)
+    for p in range(len(part_offsets) - 1):
+        g = part_source[p]
+        outer = parent_rings[parent_offsets[g] + 1] - parent_rings[parent_offsets[g]]
+        for r in range(part_offsets[p], part_offsets[p + 1]):
+            r0, r1 = ring_offsets[r], ring_offsets[r + 1]
+            n = r1 - r0
+            best = int(np.argmin(keys[r0:r1]))
             if r == part_offsets[p] and part_inset[p]:
-                # where the first outer edge left, counting from the last, ends (vertex 0's mitre when the
-                # last edge and edge 0 are left)
+                # where the first outer edge left, counting from the last, ends: vertex 0's mitre when the
+                # last edge and edge 0 are left; the end of the last edge's run nearest vertex 0 of all
+                # the inset's pieces (``_last_edge_ends``) counts as the last one's end
                 rank = np.full(n, np.inf)
                 for j in range(n):
-                    incoming = moved_from[(j - 1) % n]
-                    if incoming < outer and moved_from[j] != incoming:  # (the end of a run along it)
-                        rank[j] = (incoming + 1) % outer
+                    incoming = moved_from[r0 + (j - 1) % n]
+                    if incoming < outer and moved_from[r0 + j] != incoming:  # (the end of a run along it)
+                        rank[j] = incoming + 1
+                        if incoming == outer - 1 and last_end[g] == r0 + j:
+                            rank[j] = 0
                 if np.isfinite(rank).any():
                     best = int(np.argmin(rank))
-            if r == part_offsets[p] and marked.any():
-                best = int(np.argmin(np.where(marked, keys, np.inf)))
+            if r == part_offsets[p] and marked[r0:r1].any():
+                best = int(np.argmin(np.where(marked[r0:r1], keys[r0:r1], np.inf)))
             if r == part_offsets[p] and not part_with_start[p]:
                 # the last place on the parent's outer ring (a piece may run along its holes too)
-                best = int(np.argmax(np.where(keys < outer, keys, -1.0)))
+                best = int(np.argmax(np.where(keys[r0:r1] < outer, keys[r0:r1], -1.0)))
             for j in range(n):
                 k = r0 + (best + j) % n
                 out[r0 + j, 0], out[r0 + j, 1] = coords[k, 0], coords[k, 1]
@@ -235,14 +249,64 @@ def ring_starts(coords, ring_offsets, part_offsets, part_source, part_with_start
 
 
 @njit(cache=True, nogil=True)
-def _places(px, py, qx, qy, g, parent_coords, parent_rings, parent_offsets):
+def _last_edge_ends(coords, ring_offsets, part_offsets, part_source, part_inset, moved_from, parent_coords,
+                    parent_rings, parent_offsets):
+    """Per parent (G,): the vertex of its inset's outer rings (pieces ``part_inset``) where a run along its
+    last outer edge ends nearest that edge's end (vertex 0), -1 for none. An inset counts from the last
+    edge there alone: vertex 0's mitre, or where a hole grown over vertex 0 cuts the last edge off (PRT
+    starts that piece there, holes.7039); a hole grown across the inset also ends runs along the last
+    edge in pieces that lie before it, and PRT starts those at their first outer edge's end (massing's
+    courtyards and holes.11067, whose inset falls apart)."""
+    last = np.full(len(parent_offsets) - 1, -1, np.int64)
+    reach = np.full(len(parent_offsets) - 1, -np.inf)
+    for p in range(len(part_offsets) - 1):
+        if not part_inset[p]:
+            continue
+        g = part_source[p]
+        q0, q1 = parent_rings[parent_offsets[g]], parent_rings[parent_offsets[g] + 1]
+        outer = q1 - q0
+        ax, ay = parent_coords[q1 - 1, 0], parent_coords[q1 - 1, 1]
+        bx, by = parent_coords[q0, 0] - ax, parent_coords[q0, 1] - ay
+        r0, r1 = ring_offsets[part_offsets[p]], ring_offsets[part_offsets[p] + 1]
+        n = r1 - r0
+        for j in range(n):
+            incoming = moved_from[r0 + (j - 1) % n]
+            if incoming == outer - 1 and moved_from[r0 + j] != incoming:
+                along = (coords[r0 + j, 0] - ax) * bx + (coords[r0 + j, 1] - ay) * by
+                if along > reach[g]:
+                    reach[g], last[g] = along, r0 + j
+    return last
+
+
+@njit(cache=True, nogil=True)
+def _material_sides(parent_coords, parent_rings, parent_offsets):
+    """Per parent ring (R,): 1.0 where the polygon lies to the left of its edges, -1.0 where it lies to their
+    right (an outer ring winding clockwise, a hole counter-clockwise)."""
+    side = np.empty(len(parent_rings) - 1)
+    for g in range(len(parent_offsets) - 1):
+        for q in range(parent_offsets[g], parent_offsets[g + 1]):
+            q0, q1 = parent_rings[q], parent_rings[q + 1]
+            twice_area = 0.0
+            for i in range(q0, q1):
+                k = q0 + (i - q0 + 1) % (q1 - q0)
+                twice_area += parent_coords[i, 0] * parent_coords[k, 1] - parent_coords[k, 0] * parent_coords[i, 1]
+            counter_clockwise = twice_area > 0.0
+            side[q] = 1.0 if counter_clockwise == (q == parent_offsets[g]) else -1.0
+    return side
+
+
+@njit(cache=True, nogil=True)
+def _places(px, py, qx, qy, g, parent_coords, parent_rings, parent_offsets, material):
     """Where the point p and the edge (p, q) of a piece lie on polygon g: the squared distance to the
     nearest point of its boundary and that point's place (i + f a fraction f along the edge from vertex
     i to vertex i + 1, ring after ring), the place of the nearest vertex, the largest squared edge length
     (a scale for tolerances); and the place i of the edge (p, q) runs along or was moved in from
     (parallel to it to a millionth, as GEOS's mitres between near-collinear edges turn an inset's edges a
-    little; in the same direction; the nearest such, and of collinear ones the one whose span is nearest
-    the edge's: an H's inner sides; inf when there is none) with the distance between their lines."""
+    little; in the same direction; on the polygon's side of it (``material`` (R,), ``_material_sides``),
+    as an offset or a setback moves edges in, so that a hole's edge beside an inset edge is not taken for
+    its source: massing's holes.11067; the nearest such, and of collinear ones the one whose span is
+    nearest the edge's: an H's inner sides; inf when there is none) with the distance between their
+    lines."""
     near, key = np.inf, np.inf
     near_vertex, vertex_key = np.inf, np.inf
     away, edge, gap = np.inf, np.inf, np.inf
@@ -270,7 +334,10 @@ def _places(px, py, qx, qy, g, parent_coords, parent_rings, parent_offsets):
                 near_vertex, vertex_key = dv, base + i
             u = np.sqrt(length2)
             if u > 0.0 and length > 0.0 and abs(bx * dy - by * dx) <= 1e-6 * u * length and bx * dx + by * dy > 0.0:
-                distance = abs(bx * (py - ay) - by * (px - ax)) / u
+                left = (bx * (py - ay) - by * (px - ax)) / u  # how far the edge lies left of the parent's
+                if material[q] * left < -1e-9 * max(u, 1.0):
+                    continue  # outside the polygon's side of it: not moved in from it
+                distance = abs(left)
                 # how far the edge's span along the line lies from the parent edge's [0, u]
                 low, high = ((px - ax) * bx + (py - ay) * by) / u, ((qx - ax) * bx + (qy - ay) * by) / u
                 apart = max(0.0, low - u, -high)

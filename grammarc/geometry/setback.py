@@ -2,9 +2,10 @@
 
 Each edge moves into the polygon by its own distance (0 keeps it). The strip it sweeps is the quad
 between the edge and its moved copy, whose ends are the mitre points where the moved lines of
-neighbouring edges meet: a strip stops at an unmoved neighbour's line (unless the boundary turns there by
-less than 15 degrees: then it steps across at the vertex), and two moved neighbours share their corner,
-as in CityEngine. A quad that folds over itself (a distance longer than the edge allows) is cut to the
+neighbouring edges meet: a strip stops at an unmoved neighbour's line, and two moved neighbours share their
+corner, as in CityEngine; where the boundary turns by less than 15 degrees between edges moved by
+different distances (one of them 0, or not), each strip ends at its own distance's mitre point instead
+and the remainder steps across at the vertex. A quad that folds over itself (a distance longer than the edge allows) is cut to the
 triangle of its edge and its end lines, as a straight skeleton's face ends. The strips of each owner (a
 selector of the operation) are united and clipped to the polygon; an edge belongs to the first owner that
 claims it, and the remainder is what no strip covers. All of it runs on whole batches: numpy over the
@@ -24,7 +25,7 @@ from grammarc.ragged import offsets_from_counts, rank_within
 #: A mitre longer than this many setback distances (a near-reversal of the boundary) is cut to the
 #: edge's rectangle.
 _MITRE_LIMIT = 10.0
-#: The turn (degrees) of the boundary below which a moved edge next to a kept one steps (``_mitres``).
+#: The turn (degrees) of the boundary below which edges moved by different distances step (``_mitres``).
 _STEP_TURN = 15.0
 #: The grid (scope units, metres) that setback regions are snapped to, collapsing zero-width spikes.
 _SNAP = 1e-9
@@ -37,7 +38,8 @@ class Edges:
     """The boundary edges of m polygons: ``start``, ``end`` (E, 2); ``inward`` (E, 2) unit normals
     pointing into the polygon; ``poly`` (E,) the polygon of each edge; ``prev``, ``next`` (E,) the
     neighbouring edges along the same ring; ``vertex`` (E,) each one's start among the vertices of the
-    polygons' open rings, all rings one after the other (as ``shapely.to_ragged_array`` lists them)."""
+    polygons' open rings, all rings one after the other (as ``shapely.to_ragged_array`` lists them);
+    ``hole`` (E,) whether the edge lies on a hole."""
 
     start: np.ndarray
     end: np.ndarray
@@ -46,6 +48,7 @@ class Edges:
     prev: np.ndarray
     next: np.ndarray
     vertex: np.ndarray
+    hole: np.ndarray
 
 
 def polygon_edges(polygons: np.ndarray) -> Edges:
@@ -71,7 +74,7 @@ def polygon_edges(polygons: np.ndarray) -> Edges:
     local = np.arange(len(ring)) - offsets[ring]
     size = np.maximum(counts[ring], 1)
     return Edges(start, end, inward, ring_poly[ring], offsets[ring] + (local - 1) % size,
-                 offsets[ring] + (local + 1) % size, first - ring)
+                 offsets[ring] + (local + 1) % size, first - ring, hole[ring])
 
 
 def setback_regions(polygons: np.ndarray, edges: Edges, distance: np.ndarray, owner: np.ndarray,
@@ -83,10 +86,11 @@ def setback_regions(polygons: np.ndarray, edges: Edges, distance: np.ndarray, ow
     m = len(polygons)
     # a distance that is not a number (``float("")`` of a missing list item) moves nothing
     d = np.where((owner < n_owners) & np.isfinite(distance), np.maximum(distance, 0.0), 0.0)
-    corner, mitred = _mitres(edges, d)
-    # a strip ends at its next edge's mitre; where the two do not meet in one (a straight vertex, as
-    # between the collinear edges a setback leaves, or a spike), at its own moved end
-    end_corner = np.where(mitred[edges.next][:, None], corner[edges.next], edges.inward * d[:, None])
+    corner, ends, mitred = _mitres(edges, d)
+    # a strip ends at its next edge's mitre (its own, where the two step); where the two do not meet in
+    # one (a straight vertex, as between the collinear edges a setback leaves, or a spike), at its own
+    # moved end
+    end_corner = np.where(mitred[edges.next][:, None], ends[edges.next], edges.inward * d[:, None])
     moved = d > TOL.zero
     idx = np.flatnonzero(moved)
     quads = np.stack([edges.start[idx], edges.end[idx], edges.end[idx] + end_corner[idx],
@@ -181,7 +185,8 @@ def _edges_of(edges: Edges, chosen: np.ndarray) -> tuple[np.ndarray, Edges]:
     renumber[keep] = np.arange(len(keep))
     polygon = np.cumsum(chosen) - 1
     return keep, Edges(edges.start[keep], edges.end[keep], edges.inward[keep], polygon[edges.poly[keep]],
-                       renumber[edges.prev[keep]], renumber[edges.next[keep]], edges.vertex[keep])
+                       renumber[edges.prev[keep]], renumber[edges.next[keep]], edges.vertex[keep],
+                       edges.hole[keep])
 
 
 def _without_seams(regions: np.ndarray, polygons: np.ndarray) -> np.ndarray:
@@ -233,15 +238,17 @@ def _without_spikes(geometries: np.ndarray) -> np.ndarray:
     return shapely.set_precision(geometries, _SNAP)
 
 
-def _mitres(edges: Edges, d: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """(E, 2): where the moved line of each edge meets its previous edge's, relative to the shared vertex
-    (the edge's own move where they do not meet near it), and (E,) whether they do.
+def _mitres(edges: Edges, d: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(E, 2) twice: where the strip of each edge starts and where its previous edge's strip ends, relative
+    to the vertex they share: where their moved lines meet (the edge's own move where they do not meet
+    near it); and (E,) whether they do.
 
-    Where one of the two edges stays (distance 0) and the boundary turns there by less than
-    ``_STEP_TURN``, PRT steps instead of running the moved line out to the kept one: the moved edge's
-    strip ends at the mitre point of its own distance on both edges, so the remainder runs along the kept
-    edge to the vertex and across to the moved line (measured through PyPRT on massing's tiers: a kept
-    edge then a moved one, turned by 14.99 degrees steps, by 15.01 meets)."""
+    Where the two distances differ (one edge stays, or both move by different distances) and the
+    boundary turns there by less than ``_STEP_TURN``, PRT steps instead of running the moved lines out to
+    where they meet, far off: each strip ends at the mitre point of its own distance on both edges, and
+    the remainder steps across between them (measured through PyPRT on massing's tiers: a kept edge then
+    a moved one, turned by 14.99 degrees steps, by 15.01 meets; edges set back 4 and 3 m turned by 7
+    degrees step by 1 m on convex.11084)."""
     a, b = edges.inward[edges.prev], edges.inward
     da, db = d[edges.prev], d
     det = a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0]
@@ -251,10 +258,13 @@ def _mitres(edges: Edges, d: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     reach = np.hypot(corner[:, 0], corner[:, 1])
     far = np.maximum(da, db)
     cosine = np.einsum("ij,ij->i", a, b)
-    step = ((da <= TOL.zero) != (db <= TOL.zero)) & (cosine > np.cos(np.radians(_STEP_TURN)))
-    corner[step] = (a[step] + b[step]) * (far[step] / (1.0 + cosine[step]))[:, None]
+    step = (np.abs(da - db) > TOL.zero) & (cosine > np.cos(np.radians(_STEP_TURN)))
     too_far = ~step & ((np.abs(det) <= 1e-9) | (reach > _MITRE_LIMIT * np.maximum(far, TOL.zero)))
-    return np.where(too_far[:, None], straight, corner), ~too_far
+    corner = np.where(too_far[:, None], straight, corner)
+    ends = corner.copy()
+    bisector = (a[step] + b[step]) / (1.0 + cosine[step])[:, None]
+    corner[step], ends[step] = bisector * db[step, None], bisector * da[step, None]
+    return corner, ends, ~too_far
 
 
 def union_by_group(geometries: np.ndarray, group: np.ndarray, n_groups: int) -> np.ndarray:

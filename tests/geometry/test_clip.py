@@ -148,6 +148,32 @@ def test_an_inset_whose_hole_cuts_the_last_edge_off_starts_at_its_end():
                                [[3, -13], [13, -13]])
 
 
+def test_inset_pieces_of_a_hole_across_the_lot_start_at_their_first_edges_end():
+    """A hole grown across the inset parts it in two; a run along the last edge ends at the hole in both,
+    but only the one nearest vertex 0 (its mitre, in the lower piece) counts from the last: the upper
+    piece starts at vertex 2's mitre, where its first outer edge left (edge 1) ends (PRT on massing's
+    courtyards and holes.11067). A thin hole's far side nearer the inset's left side than edge 3 does not
+    take it over: it lies beyond the side, on the hole's side (the inset of the second lot starts at
+    vertex 0's mitre, not vertex 1's)."""
+    import shapely
+
+    from grammarc.geometry.clip import fit_pieces
+
+    def first_vertices(parent):
+        inset = shapely.buffer(parent, -3, join_style="mitre", mitre_limit=1e6)
+        pieces = fit_pieces(np.array([inset]), np.array([1]), np.array([[30.0, 0.0, 40.0]]), np.array([parent]),
+                            insets=np.array([True]))
+        starts = pieces.ring_offsets[pieces.poly_offsets[:-1]]
+        return sorted(tuple(np.round(pieces.coords[k] * pieces.extent[i, [0, 2]] + pieces.low[i, [0, 2]], 6))
+                      for i, k in enumerate(starts))
+
+    # clockwise in (x, z) as the lots' footprints are
+    across = shapely.Polygon([(0, 0), (30, 0), (30, -30), (0, -40)], [[(2, -12), (2, -18), (28, -18), (28, -12)]])
+    assert first_vertices(across) == [(3, -3), (27, -27.837722)]
+    thin = shapely.Polygon([(0, 0), (30, 0), (30, -30), (0, -30)], [[(4, -10), (4, -20), (5.5, -20), (5.5, -10)]])
+    assert first_vertices(thin) == [(3, -3)]
+
+
 def test_an_inset_edge_comes_from_the_collinear_edge_it_runs_beside():
     """An H's inner sides lie on one line (edges 4 and 11, in one direction): the inset's side beside the
     last edge is moved in from that edge, not from edge 4, so the inset starts at vertex 0's mitre (PRT on

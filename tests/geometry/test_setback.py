@@ -157,6 +157,24 @@ def test_a_moved_edge_steps_next_to_a_kept_one_it_turns_little_from(turn, meets)
     assert (max(bottom) < 29.0) == meets
 
 
+def test_edges_moved_by_different_distances_step_where_they_turn_little():
+    """PRT's massing (convex.11084): edges set back 4 and 3 m that turn by 7 degrees do not run their moved
+    lines out to where they meet, far off: each strip ends at the mitre point of its own distance, and the
+    remainder steps from the one to the other across the vertex, 1 m along its bisector."""
+    a = np.radians(7.0)
+    v2 = (30 + 20 * np.cos(a), 20 * np.sin(a))
+    polygon = shapely.Polygon([(0, 0), (30, 0), v2, (v2[0], 20), (0, 20)])
+    edges = polygon_edges(np.array([polygon]))
+    d = np.zeros(len(edges.poly))
+    d[np.flatnonzero(np.all(np.isclose(edges.start, [0, 0]), axis=1))] = 4.0
+    d[np.flatnonzero(np.all(np.isclose(edges.start, [30, 0]), axis=1))] = 3.0
+    _, remainder = setback_regions(np.array([polygon]), edges, d, np.zeros(len(d), dtype=np.int64), 1)
+    bisector = (np.array([0.0, 1.0]) + [-np.sin(a), np.cos(a)]) / (1 + np.cos(a))
+    corners = np.asarray(remainder[0].exterior.coords)
+    for distance in (4.0, 3.0):
+        assert np.min(np.linalg.norm(corners - ([30, 0] + distance * bisector), axis=1)) < 1e-6
+
+
 def test_strips_that_cover_the_face_leave_no_seam_vertices():
     """PRT's shapeO whose widths cover the whole face is the face itself: where two strips meet on an
     edge no vertex is left, so the face's edges keep their numbers (as its tiers' setbacks count them)."""

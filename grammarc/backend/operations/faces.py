@@ -430,7 +430,10 @@ class _SetbackFaces:
         self.frames = selector_frames(ctx.chunk, self.normal, cursor, edges.poly, names,
                                       _world_points(ctx, cursor, edges.poly, self.plane, (edges.start, edges.end)))
         self.owners = tuple(s for s in op.selectors if s != "remainder")
-        self.owner = classify_faces(self.normal, self.owners, self.frames)
+        # only the outline's edges move: PRT sets back no hole edge of a courtyard, whatever the selectors
+        # or the per-edge distances (measured through PyPRT on massing's shapeL/U on holed faces and
+        # tiers on holed footprints), and its strips stop at the holes
+        self.owner = np.where(edges.hole, len(self.owners), classify_faces(self.normal, self.owners, self.frames))
 
     def distances(self, ctx: Context, cursor: Shapes, distances, per_edge: bool, fill: float) -> np.ndarray:
         """(E,) each edge's distance: that of the first selector of ``distances`` (pairs of a selector and

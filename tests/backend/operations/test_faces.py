@@ -56,12 +56,29 @@ def test_shape_l_u_o_on_a_rectangle(write, op, strips, remainder):
 
 
 def test_setback_of_all_edges_on_concave_and_holed_lots(write):
-    """The L's strip is one piece; the courtyard's are two rings, around the lot and around the hole."""
+    """The L's strip is one piece; the courtyard's one ring around the lot: a hole's edges do not move, as
+    PRT sets back none (massing's shapeL/U and tier setbacks on holed faces), and the remainder keeps
+    the hole (was: a second ring around the hole)."""
     r = run(write, "Lot --> setback(2){ all : A | remainder : R }\n" + AREA_REPORTS,
             [LOT_ZOO["concave_L"], LOT_ZOO["courtyard"]])
     lots = per_lot(r)
     assert lots[0]["a_sum"] == pytest.approx(400 - 216) and lots[0]["r_sum"] == pytest.approx(216)
-    assert lots[1]["a_n"] == 2 and lots[1]["a_sum"] + lots[1]["r_sum"] == pytest.approx(1200)
+    assert lots[1]["a_n"] == 1 and lots[1]["a_sum"] == pytest.approx(1600 - 36 * 36)
+    assert lots[1]["r_sum"] == pytest.approx(36 * 36 - 400)
+
+
+def test_shape_l_and_tier_setbacks_of_a_holed_face_leave_the_hole_alone(write):
+    """PRT's massing on a 30 m square with a 10 m courtyard: shapeL's strips (12 m) run along the outline
+    only and the hole cuts them (the L is 576 - 36 m²: the hole's corner inside it); per-edge distances
+    past the outline's edges (comp.index 4..7, "0;0;4;3") move none of the hole's, so the tier top keeps
+    a 23 x 23 m remainder around the courtyard (was: every edge facing front or left moved, the hole's
+    too, and the L took the whole face; two of the hole's edges moved 4 and 3 m)."""
+    lot = [np.array([[0, 0], [30, 0], [30, 30], [0, 30]], float),
+           np.array([[10, 10], [10, 20], [20, 20], [20, 10]], float)]
+    t = totals(run(write, "Lot --> shapeL(12, 12){ shape : A | remainder : R }\n" + AREA_REPORTS, [lot]))
+    assert t["a_sum"] == pytest.approx(576 - 36) and t["r_sum"] == pytest.approx(18 * 18 - 64)
+    tier = 'Lot --> setback(comp(fe){ all : float(listItem("4;4;3;3;0;0;4;3", comp.index)) }) { all : A | remainder : R }\n'
+    assert totals(run(write, tier + AREA_REPORTS, [lot]))["r_sum"] == pytest.approx(23 * 23 - 100)
 
 
 def test_setback_of_a_facade_selects_its_top_and_bottom_edges(write):
@@ -95,6 +112,31 @@ def test_offset_inset_without_the_last_edge_starts_where_edge_0_ends(write):
     text = 'Lot --> offset(-2.5) comp(f){ inside : I }\nI --> report("x", scope.sx) report("z", scope.sz)\n'
     t = totals(run(write, text, [arm]))
     assert (t["x_sum"], t["z_sum"]) == (pytest.approx(7), pytest.approx(2))
+
+
+def test_offset_inset_beside_a_thin_hole_starts_at_vertex_0s_mitre(write):
+    """A thin hole near edge 3 whose far side lies nearer the inset's left side than edge 3 does: that
+    side is still edge 3 moved in (the hole's side lies beyond it, on the hole's side), so the inset
+    starts at vertex 0's mitre and split(x) cuts a strip along edge 3's side, in two by the grown hole's
+    notch, as PRT's massing splits its footprint on such lots (holes.11067; was: the inset started at
+    vertex 1's mitre and the strip ran along edge 0)."""
+    lot = [np.array([[0, 0], [30, 0], [30, 30], [0, 30]], float),
+           np.array([[4, 10], [4, 20], [5.5, 20], [5.5, 10]], float)]
+    text = ('Lot --> offset(-3) comp(f){ inside : I }\nI --> split(x){ 1 : A | ~1 : B }\n'
+            'A --> report("a", geometry.area)\n')
+    assert totals(run(write, text, [lot]))["a_sum"] == pytest.approx(8)
+
+
+def test_offset_inset_that_a_hole_cuts_in_two_starts_each_piece_at_its_first_edges_end(write):
+    """A hole across the lot parts the inset in two: the piece with vertex 0's mitre starts there, the
+    other where its first outer edge left ends (vertex 2's mitre, so its scope x runs along the slanted
+    edge 2), though a run along the last edge ends in it too, at the hole: PRT on massing's courtyards
+    and holes.11067 (was: that end, with x along the hole's side)."""
+    lot = [np.array([[0, 0], [30, 0], [30, 30], [0, 40]], float),
+           np.array([[2, 12], [2, 18], [28, 18], [28, 12]], float)]
+    text = 'Lot --> offset(-3) comp(f){ inside : I }\nI --> report("x", scope.sx)\n'
+    # the bottom piece 24 m along edge 0, the top one 27.46 m along edge 2 (were 24 m along the hole)
+    assert totals(run(write, text, [lot]))["x_sum"] == pytest.approx(24 + 27.4605, abs=1e-4)
 
 
 def test_setback_of_an_edge_shorter_than_its_distance_reaches_the_kept_edge_beside_it(write):
