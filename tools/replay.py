@@ -71,11 +71,13 @@ def digest(grammar: Path, lots: Path | None, options: BuildOptions, folder: Path
     out = folder / "out.npz"
     reports = folder / "out.reports.json"
     reports.unlink(missing_ok=True)
+    out.unlink(missing_ok=True)
     try:
         result = build(grammar, out, lots_path=lots, options=options, reports_to=reports)
     except Exception as error:  # noqa: BLE001 - a build that fails is a result to compare too
         return "error:" + hashlib.sha256(f"{type(error).__name__}: {error}".encode()).hexdigest()[:16]
-    h = hashlib.sha256(record_digest(out).encode())
+    # a build where no lot could be built writes nothing: its bad lots are the result
+    h = hashlib.sha256(record_digest(out).encode() if result.written else b"nothing written")
     if reports.exists():
         h.update(reports.read_bytes())
     # a reason may name the grammar by its path: the checkout's folder is left out of the digest
