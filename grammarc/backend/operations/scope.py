@@ -112,6 +112,9 @@ def rotate(ctx: Context, cursor: Shapes, op: ir.Rotate) -> Shapes:
     angles exactly zero, and turns as without pivots."""
     env = ctx.env(cursor)
     angles = [evaluate(e, env) for e in op.angles]
+    bad = ~np.logical_and.reduce([np.isfinite(np.broadcast_to(a, (len(cursor),))) for a in angles])
+    if bad.any():  # a NaN or infinite angle turns a scope into no frame at all
+        ctx.fail(cursor, bad, "a rotation by an angle that is not finite", op.span)
     frames = ctx.chunk.frames
     if op.fixed and ctx.plan.pivot_slot is not None:
         frame = frames.add(_about_pivot(ctx, cursor, angles))

@@ -365,6 +365,15 @@ def test_rotate_scope_turns_the_axes_around_the_same_geometry(write):
     np.testing.assert_allclose(r["xform"][0], [[0, 0, 12, 0], [0, 2, 0, 0], [-8, 0, 0, 0]], atol=1e-6)
 
 
+def test_a_rotation_by_an_angle_that_is_not_finite_fails_its_lot(write):
+    """``h / w`` of two zero attributes is NaN: the lot that gives it fails by name, the other turns."""
+    r = run(write, "attr h = 0\nattr w = 0\nLot --> extrude(3) r(0, h / w, 0) X\n", [rect(12, 8), rect(12, 8)],
+            lot_attrs={"w": [np.nan, 2.0]})
+    (bad,) = r["bad"]
+    assert bad.index == 0 and bad.reason.startswith("a rotation by an angle that is not finite in rule `Lot`")
+    assert len(r["asset"]) == 1 and np.isfinite(r["xform"]).all()
+
+
 def test_mirror_scope_reverses_two_axes_around_the_same_geometry(write):
     """mirrorScope(true, false, true): the 12 x 3 x 8 box keeps its place and sizes, its scope starts at the
     far corner with x and z reversed (a half turn about y); one axis alone would be left-handed and fails
