@@ -22,7 +22,7 @@ from grammarc.io.lots import lots_from_polygons
 from grammarc.model.records import world_columns
 
 #: ``pytest --hypothesis-profile long``: the property tests that do not fix their number of examples (the
-#: fuzz of ``test_fuzz.py``) run for hours rather than a hundred examples each.
+#: fuzz of ``test_build_fuzz.py``) run for hours rather than a hundred examples each.
 settings.register_profile("long", max_examples=20_000)
 
 PRT_KIT = Path(__file__).resolve().parents[1].parent / "shared" / "prt"

@@ -11,7 +11,7 @@ The grammars are drawn from a small generator of CityEngine CGA and of the paper
 come from a list of hostile values (zero, negative, 1e-9, 1e308, a division by zero) beside ordinary ones;
 the lots from rectangles of extreme sizes and places, random polygons (self-intersecting, degenerate),
 holes, and attributes of the wrong type. In CI the default profile runs a few hundred examples; run it long
-with `pytest tests/test_fuzz.py --hypothesis-profile long`.
+with `pytest tests/test_build_fuzz.py --hypothesis-profile long`.
 """
 
 from __future__ import annotations
