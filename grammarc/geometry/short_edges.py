@@ -117,10 +117,12 @@ def _collapse(vertices, ring_offsets, tol):
             position[v] = k
             k += 1
             v = following[v]
-    # a vertex that went may have gone into one that went later: follow to the one that stays
+    # a vertex that went may have gone into one that went later: follow to the one that stays (into a new
+    # array: positions written over ``owner`` would be followed as vertices by the vertices after)
+    absorbed = np.empty(n_vertices, dtype=np.int64)
     for v in range(n_vertices):
         o = owner[v]
         while not keep[o]:
             o = owner[o]
-        owner[v] = position[o]
-    return order, counts, owner
+        absorbed[v] = position[o]
+    return order, counts, absorbed

@@ -33,3 +33,14 @@ def test_exact_duplicates_keep_the_first_and_too_few_vertices_are_left_as_they_a
     flat = xz([(0, 0), (1, 0), (1, 0), (0, 0)])
     _, counts, _ = collapse_short_edges(flat, np.array([0, 4]), 8e-4)
     assert counts.tolist() == [2]  # fewer than 3 distinct vertices: the caller's to report
+
+
+def test_vertices_that_went_into_vertices_that_went_later_are_owned_by_the_one_that_stays():
+    """A ring after another, whose vertices go in a chain (10 into 9 into 8): each is owned by the vertex
+    that stays, at its position in ``order``; positions of the first vertices were followed as vertices,
+    and the walk went round for ever."""
+    pentagon = [(31.39, -46.35), (48.19, -3.71), (0.0, -40.52), (-34.39, -20.0), (-30.98, -28.57), (31.39, -46.35)]
+    sliver = [(5e5, -5e6), (5e5 + 1e-9, -5e6), (5e5 + 1e-9, -5000010.0), (5e5, -5000010.0), (5e5, -5e6)]
+    order, counts, owner = collapse_short_edges(xz(pentagon + sliver), np.array([0, 6, 11]), 8e-4)
+    assert counts.tolist() == [5, 2] and order.tolist() == [0, 1, 2, 3, 4, 7, 8]
+    assert owner.tolist() == [0, 1, 2, 3, 4, 4, 6, 5, 6, 6, 6]
