@@ -46,7 +46,8 @@ def comp(ctx: Context, cursor: Shapes, op: ir.Comp) -> Parts:
     index_of = None
     if op.index is not None:
         index_of = evaluate_array(op.index, ctx.env(cursor))
-    shapes, _, index, parent, _, _ = components(ctx, comp_kernels.KIND_CODES[op.kind], cursor, op.site, index_of)
+    shapes, _, index, parent, _, _ = components(ctx, comp_kernels.KIND_CODES[op.kind], cursor, op.site, op.span,
+                                                index_of)
     shapes = take_apart(ctx, cursor, shapes, parent)
     ctx.count(shapes, op.span)
     order, offsets = group_by(index % len(op.parts), len(op.parts))
@@ -66,7 +67,7 @@ def comp_faces(ctx: Context, cursor: Shapes, op: ir.CompFaces) -> Parts:
     kind = {"f": "faces", "e": "edges", "v": "vertices"}[op.kind]
     borders = bool({"border", "inside"} & set(op.selectors))
     shapes, normal, _, parent, roof, border = components(ctx, comp_kernels.KIND_CODES[kind], cursor, op.site,
-                                                         borders=borders)
+                                                         op.span, borders=borders)
     shapes = take_apart(ctx, cursor, shapes, parent)
     if op.kind == "f":
         shapes = _face_scopes(ctx, shapes, cursor, parent, op.span)
@@ -116,7 +117,7 @@ def comp_faces(ctx: Context, cursor: Shapes, op: ir.CompFaces) -> Parts:
     return Parts(op.parts, shapes.take(order), offsets)
 
 
-def components(ctx: Context, kind: int, cursor: Shapes, site: int, wanted=None, borders: bool = False):
+def components(ctx: Context, kind: int, cursor: Shapes, site: int, span, wanted=None, borders: bool = False):
     """Component shapes of ``cursor``, their normals in the parents' frames (m, 3), their indices
     among their parent's components (m,), their parents (m,), each one's place on a roof (m,)
     (``geometry.meshes.roof_edge_kinds``: an edge of a roof's mesh; -1 for the rest) and whether it is
@@ -148,6 +149,10 @@ def components(ctx: Context, kind: int, cursor: Shapes, site: int, wanted=None, 
         parent, index, origin, axes, size, geom, normal, roof, border = (
             a[keep] for a in (parent, index, origin, axes, size, geom, normal, roof, border))
     child = cursor.take(parent)
+    gram = np.einsum("nij,nkj->nik", axes, axes)
+    bad = ~(np.abs(gram - np.eye(3)) < 1e-6).all(axis=(1, 2))
+    if bad.any():  # a scope of sizes no float can square (s(0, 0, 1e290)) has no component frames
+        ctx.fail_lots(child.lot[bad], "a component of a scope whose size is beyond any geometry", span)
     parent_axes = chunk.frames[child.frame]
     world_origin = child.origin + np.einsum("ni,nij->nj", origin, parent_axes)
     frame = chunk.frames.add(np.einsum("nij,njk->nik", axes, parent_axes))
