@@ -176,6 +176,7 @@ def _build(source: Path, display: str | None, grammar_path: Path, output, lots_p
     failed: list[BadLot] = []
     reports = Reports()
     counts: dict = {}
+    written = False
     with contextlib.suppress(_NothingBuilt), \
             writer_class(output, assets=grammar.assets, symbols=plan.symbol_names, meta=meta) as writer:
         derived = derive_all(plan, lots, options, writer, failed, reports, progress, every)
@@ -186,11 +187,12 @@ def _build(source: Path, display: str | None, grammar_path: Path, output, lots_p
         with (staged_reports(reports, reports_file, dict(zip(every.index.tolist(), every.ids.tolist())))
               if reports else contextlib.nullcontext()):
             counts = writer.close()
+        written = True
     bad = tuple(sorted((*lots.bad, *failed), key=lambda b: b.index))
     ids, times = np.unique(every.ids.astype(str), return_counts=True)
     return BuildResult(Path(output), len(lots) + len(lots.bad), derived, bad, counts,
                        time.perf_counter() - started, grammar, lots.crs_note, every.source,
-                       tuple(ids[times > 1].tolist()), written=bool(counts))
+                       tuple(ids[times > 1].tolist()), written=written)
 
 
 class _NothingBuilt(Exception):
