@@ -307,11 +307,13 @@ def _derive_chunks(plan, lots: Lots, options: BuildOptions, writer, failed: list
     size = min(options.chunk_size, 64)
     rows = 0
     written = 0
-    with worker_pool(functools.partial(_derive, plan, options=options, foreign=foreign), options.workers) as submit:
+    # lots that make one chunk are derived in this process: forked workers would only wait for it
+    workers = options.workers if len(lots) > size else 1
+    with worker_pool(functools.partial(_derive, plan, options=options, foreign=foreign), workers) as submit:
         window: deque = deque()
         try:
             while first < len(lots) or window:
-                while first < len(lots) and len(window) <= options.workers:
+                while first < len(lots) and len(window) <= workers:
                     part = lots.take(slice(first, first + size))
                     window.append((len(part), submit(part)))
                     first += len(part)

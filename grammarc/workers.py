@@ -106,6 +106,8 @@ def _run(lots):
 
 
 def _receive(done: Future, received: Future, lots) -> None:
+    if not received.set_running_or_notify_cancel():  # the build stopped (Ctrl-C) and gave this chunk up
+        return
     try:
         shipped, failed = done.result()
         received.set_result(([(n, (_unship(layout), per_lot)) for n, (layout, per_lot) in shipped], failed))

@@ -59,3 +59,30 @@ def test_a_worker_killed_by_sigkill_fails_the_build_with_one_line():
     with (worker_pool(lambda lots: os.kill(os.getpid(), signal.SIGKILL), 2) as submit,
           pytest.raises(DerivationError, match=r"worker process was killed while deriving lots #0-#2")):
         submit(lots).result(timeout=60)
+
+
+def test_a_chunk_given_up_by_a_stopped_build_is_dropped_without_a_traceback(caplog):
+    """Ctrl-C cancels the chunks in flight; when their workers finish later, nothing is logged (it was a
+    traceback from the pool's callback)."""
+    import time
+
+    from grammarc.workers import worker_pool
+
+    with worker_pool(lambda lots: (time.sleep(0.5), ([], []))[1], 2) as submit:
+        in_flight = submit([])
+        assert in_flight.cancel()
+    assert in_flight.cancelled() and not [r for r in caplog.records if r.levelname == "ERROR"]
+
+
+@pytest.mark.parametrize(("lots", "chunk_size", "forked"), [(3, 16384, False), (3, 2, True), (65, 16384, True)])
+def test_only_builds_of_more_than_one_chunk_fork_workers(monkeypatch, write, lots, chunk_size, forked):
+    """Forking workers for one chunk only makes it wait for them (the first chunk holds up to 64 lots)."""
+    from grammarc import build
+
+    asked = []
+    real = build.worker_pool
+    monkeypatch.setattr(build, "worker_pool", lambda work, workers: (asked.append(workers), real(work, workers))[1])
+    grammar = compile_grammar(write("g.cga", "Lot --> extrude(3)\n"))
+    square = [[np.array([[0, 0], [10, 0], [10, 10], [0, 10]], float)]]
+    derive(grammar, lots_from_polygons(square * lots), BuildOptions(workers=2, chunk_size=chunk_size))
+    assert asked == [2 if forked else 1]
