@@ -27,25 +27,11 @@ from pathlib import Path
 from grammarc import __version__
 from grammarc.constants import LIMITS, PARTITION_SIZE
 from grammarc.diagnostics import render_all
-from grammarc.errors import GrammarcError, GrammarError
+from grammarc.errors import GrammarcError, GrammarError, raise_stopped, stopped
 
 _START_HELP = ("the start rule (default: @StartRule, else the first rule); a call `Lot(10, \"a\", true)` "
               "gives the arguments of a start rule with parameters")
 _WARNINGS_HELP = "treat the grammar's warnings as errors: exit 2, nothing written"
-
-
-class Stopped(KeyboardInterrupt):
-    """SIGTERM or SIGHUP (what ``timeout``, docker, systemd, Slurm and a closed terminal send), raised where
-    the program is, so that it unwinds as from Ctrl-C: writers abort, temporary files and the workers'
-    shared memory go, the pool's workers end."""
-
-    def __init__(self, signum: int):
-        super().__init__(signum)
-        self.signum = signum
-
-
-def _stop(signum, frame) -> None:
-    raise Stopped(signum)
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -55,7 +41,7 @@ def main(argv: list[str] | None = None) -> int:
     # (README, "Figures"). ``build.derive_all`` turns it on while chunks are derived.
     collecting = gc.isenabled()
     gc.disable()
-    handlers = {s: signal.signal(s, _stop) for s in (signal.SIGTERM, signal.SIGHUP)} \
+    handlers = {s: signal.signal(s, raise_stopped) for s in (signal.SIGTERM, signal.SIGHUP)} \
         if threading.current_thread() is threading.main_thread() else {}
     try:
         with warnings.catch_warnings():
@@ -73,12 +59,8 @@ def main(argv: list[str] | None = None) -> int:
     except GrammarcError as error:
         print(f"grammarc: error: {error}", file=sys.stderr)
         return error.exit_code
-    except Stopped as stop:
-        print(f"grammarc: {signal.Signals(stop.signum).name}: stopped; nothing was written", file=sys.stderr)
-        return 128 + stop.signum
-    except KeyboardInterrupt:
-        print("grammarc: interrupted; nothing was written", file=sys.stderr)
-        return 130
+    except KeyboardInterrupt as stop:  # Ctrl-C, or SIGTERM / SIGHUP (``Stopped``)
+        return stopped(stop)
     except BrokenPipeError:
         # the reader of our output went away (`grammarc info city.npz | head`): not an error of ours
         os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
@@ -213,7 +195,107 @@ def _parser() -> argparse.ArgumentParser:
     render.add_argument("--assets", type=Path, action="append", default=[], metavar="DIR",
                         help="a folder for file assets, instead of the grammar's folder (repeatable)")
     render.set_defaults(run=_render)
+
+    serve = sub.add_parser("server", help="a resident grammarc that starts each command warm: start it, "
+                                          "stop (every server of this user), status")
+    serve.add_argument("action", choices=("start", "stop", "status"))
+    serve.add_argument("--idle-timeout", type=_positive, default=60, metavar="MIN",
+                       help="stop after MIN minutes without a command (default 60)")
+    serve.add_argument("--foreground", action="store_true", help="serve from this process, logging to stderr")
+    serve.set_defaults(run=_server)
     return parser
+
+
+def _server(args) -> int:
+    from grammarc import server
+
+    found = server.servers()
+    if args.action == "status":
+        for path, pid in found.items():
+            print(f"grammarc server {pid} at {path}" + (" (this grammarc's)" if path == server.address() else ""))
+        if server.address() not in found:
+            print("no grammarc server runs this grammarc")
+        return 0
+    if args.action == "stop":
+        for path, pid in found.items():
+            os.kill(pid, signal.SIGTERM)
+            print(f"grammarc server {pid} at {path} stopped")
+        return 0
+    if server.address() in found:
+        print(f"grammarc server {found[server.address()]} already running at {server.address()}")
+        return 0
+
+    def ready(seconds: float) -> None:
+        print(f"grammarc server {os.getpid()} ready at {server.address()} (warmed up in {seconds:.1f} s; "
+              f"stops after {args.idle_timeout} min without a command)", flush=True)
+
+    def serve(ready) -> None:
+        server.serve(main, _warm, idle_timeout=60.0 * args.idle_timeout, ready=ready)
+
+    if args.foreground:
+        serve(ready)
+        return 0
+    return _detached(serve, ready)
+
+
+def _detached(serve, ready) -> int:
+    """Run ``serve(ready)`` in a daemon (a grandchild in its own session, its output in a log beside its
+    socket); return once it says it is ready (its line printed here), or that it failed."""
+    from grammarc import server
+
+    read, write = os.pipe()
+    if os.fork():
+        os.close(write)
+        with os.fdopen(read) as said:
+            line = said.read().strip()
+        if line.startswith("grammarc server"):
+            print(line)
+            return 0
+        print(line or f"grammarc: error: the server did not start (its log: {server.folder()})", file=sys.stderr)
+        return 1
+    os.close(read)
+    os.setsid()
+    if os.fork():
+        os._exit(0)
+    server.folder().mkdir(mode=0o700, parents=True, exist_ok=True)
+    log = os.open(server.address().with_suffix(".log"), os.O_WRONLY | os.O_CREAT | os.O_TRUNC, 0o600)
+    os.dup2(os.open(os.devnull, os.O_RDONLY), 0)
+    os.dup2(write, 1)  # what it says until it is ready goes to the waiting parent, the rest to the log
+    os.close(write)
+    os.dup2(log, 2)
+
+    def said(seconds: float) -> None:
+        ready(seconds)
+        os.dup2(log, 1)  # the pipe's last end closes: the parent reads its line and returns
+
+    try:
+        serve(said)
+    except BaseException as error:  # noqa: BLE001 - a daemon has no one but its log and its parent to tell
+        print(f"grammarc: error: {error}", flush=True)
+        os._exit(1)
+    os.unlink(server.address().with_suffix(".log"))  # it stopped as it should: nothing to look into
+    os._exit(0)
+
+
+def _warm() -> None:
+    """What a server loads before serving: every module of grammarc (those of extras not installed
+    excepted), the dialects' parsers, and the machine code of every kernel numba has cached."""
+    import importlib
+    import pkgutil
+
+    import grammarc
+    from grammarc import server
+    from grammarc.frontend.parse import DIALECTS
+    from grammarc.frontend.parsers import parser_for
+
+    for module in pkgutil.walk_packages(grammarc.__path__, "grammarc."):
+        try:
+            importlib.import_module(module.name)
+        except ImportError:  # an optional extra's module (USD, Dask, ...) whose library is missing
+            continue
+    for dialect in DIALECTS.values():
+        parser_for(dialect.grammar)
+    server.load_cached_kernels()
 
 
 def _cores() -> int:

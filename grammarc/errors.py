@@ -2,6 +2,9 @@
 
 from __future__ import annotations
 
+import signal
+import sys
+
 
 class GrammarcError(Exception):
     """Base class of every error grammarc raises on purpose."""
@@ -60,3 +63,26 @@ class LotFailure(DerivationError):
 
 class ChunkTooLarge(GrammarcError):
     """A chunk made more shapes than its memory budget; the build splits it and derives the halves."""
+
+
+class Stopped(KeyboardInterrupt):
+    """SIGTERM or SIGHUP (what ``timeout``, docker, systemd, Slurm and a closed terminal send), raised where
+    the program is, so that it unwinds as from Ctrl-C: writers abort, temporary files and the workers'
+    shared memory go, the pool's workers end."""
+
+    def __init__(self, signum: int):
+        super().__init__(signum)
+        self.signum = signum
+
+
+def raise_stopped(signum, frame) -> None:
+    """The handler of SIGTERM and SIGHUP while a command runs."""
+    raise Stopped(signum)
+
+
+def stopped(stop: KeyboardInterrupt) -> int:
+    """Say that a command was stopped (Ctrl-C or ``Stopped``); its exit status (128 + the signal)."""
+    signum = stop.signum if isinstance(stop, Stopped) else signal.SIGINT
+    said = "interrupted" if signum == signal.SIGINT else f"{signal.Signals(signum).name}: stopped"
+    print(f"grammarc: {said}; nothing was written", file=sys.stderr)
+    return 128 + signum

@@ -84,7 +84,7 @@ def worker_pool(work: Callable, workers: int):
 def _die_with_parent() -> None:
     """In a new worker: the kernel kills it when the parent dies however it dies (Linux's
     ``PR_SET_PDEATHSIG``; a SIGKILL of the parent runs no code of ours), and SIGTERM and SIGHUP end it
-    as by default rather than unwind it as they do the parent (``cli.Stopped``)."""
+    as by default rather than unwind it as they do the parent (``errors.Stopped``)."""
     signal.signal(signal.SIGTERM, signal.SIG_DFL)
     signal.signal(signal.SIGHUP, signal.SIG_DFL)
     if sys.platform.startswith("linux"):

@@ -22,10 +22,11 @@ FLOORS = (
     ("frontend", "geometry"),
     ("compiler", "backend"),
     ("io", "render"),
-    ("workers",),
+    ("workers", "server"),
     ("build",),
     ("cluster", "conform"),
     ("cli",),
+    ("client",),
 )
 FLOOR = {room: level for level, rooms in enumerate(FLOORS) for room in rooms}
 

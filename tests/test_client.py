@@ -1,0 +1,35 @@
+"""The ``grammarc`` entry point: a server runs the command when one serves this grammarc, else this
+process does; ``GRAMMARC_SERVER=off`` and ``grammarc server`` always run here."""
+
+from __future__ import annotations
+
+import pytest
+
+from grammarc import client, server
+
+
+@pytest.fixture
+def asked(monkeypatch):
+    """The requests made of a server that takes every command (status 7)."""
+    made = []
+    monkeypatch.setattr(server, "request", lambda argv: (made.append(argv), 7)[1])
+    return made
+
+
+def test_a_server_that_takes_the_command_gives_its_status(asked, monkeypatch):
+    monkeypatch.delenv("GRAMMARC_SERVER", raising=False)
+    assert client.main(["check", "g.cga"]) == 7 and asked == [["check", "g.cga"]]
+
+
+def test_without_a_server_this_process_runs_the_command(monkeypatch, write):
+    monkeypatch.setattr(server, "request", lambda argv: None)
+    assert client.main(["check", str(write("g.cga", "Lot --> extrude(3)\n"))]) == 0
+
+
+@pytest.mark.parametrize("argv", [["server", "status"], ["check", "g.cga"]])
+def test_off_and_the_server_command_never_ask_a_server(asked, monkeypatch, write, tmp_path, argv):
+    monkeypatch.setenv("XDG_RUNTIME_DIR", str(tmp_path))
+    if argv[0] == "check":
+        monkeypatch.setenv("GRAMMARC_SERVER", "off")
+        argv = ["check", str(write("g.cga", "Lot --> extrude(3)\n"))]
+    assert client.main(argv) == 0 and asked == []
