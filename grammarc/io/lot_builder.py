@@ -65,12 +65,15 @@ class LotBuilder:
         self.declared: str | None = None
         self.implied: str | None = None
         self.rings: list[np.ndarray] = []  # rings, or a block of rings (``add_block``)
-        self.sizes: list[np.ndarray] = []  # vertices per ring, an array per lot or block
+        self.sizes: list[int] = []  # vertices per ring
         self.ring_counts: list[int] = []  # rings per lot
         self.index: list[int] = []
         self.ids: list[str] = []
         self.props: list[dict] = []
-        self.street: list[np.ndarray] = []  # per ring, a flag per position: its edge faces a street
+        self.vertices = 0  # positions added so far
+        #: (first position, flags) of the lots or blocks that have street edges: a flag per position, its
+        #: edge faces a street
+        self.street: list[tuple[int, np.ndarray]] = []
         self.bad: list[BadLot] = []
         self.polygons = 0  # lots added or rejected; a file without any has "no polygon"
         self.end = 0  # lot numbers the parsed features took (GeoJSON)
@@ -86,7 +89,6 @@ class LotBuilder:
         if not rings:
             self.reject(index, lot_id, "empty polygon")
             return
-        street = [np.zeros(len(ring), dtype=bool) for ring in rings]
         if not self.world:
             rings = [_with_z(ring) for ring in rings]
         widths = props.get(STREET_WIDTH)
@@ -95,12 +97,13 @@ class LotBuilder:
             if isinstance(flags, str):
                 self.reject(index, lot_id, flags)
                 return
-            street[0] = flags
+            self.street.append((self.vertices, flags))
             props = {name: value for name, value in props.items() if name != STREET_WIDTH}
         self.polygons += 1
         self.rings.extend(rings)
-        self.sizes.append(np.array([len(ring) for ring in rings], dtype=np.int64))
-        self.street.extend(street)
+        sizes = [len(ring) for ring in rings]
+        self.sizes.extend(sizes)
+        self.vertices += sum(sizes)
         self.ring_counts.append(len(rings))
         self.index.append(index)
         self.ids.append(lot_id)
@@ -113,8 +116,9 @@ class LotBuilder:
         properties are not kept here: the caller passes them to ``finish`` as columns."""
         self.polygons += len(ids)
         self.rings.append(vertices if self.world else _with_z(vertices))
-        self.sizes.append(np.asarray(sizes, dtype=np.int64))
-        self.street.append(street)
+        self.sizes.extend(np.asarray(sizes, dtype=np.int64).tolist())
+        self.street.append((self.vertices, street))
+        self.vertices += len(vertices)
         self.ring_counts.extend(np.asarray(ring_counts).tolist())
         self.index.extend(np.asarray(index).tolist())
         self.ids.extend(ids)
@@ -132,7 +136,7 @@ class LotBuilder:
     def finish(self, attrs: dict[str, np.ndarray], source: str, options: LotsOptions = NO_OPTIONS) -> Lots:
         """Bring every lot to metres (``io.crs.georeference``, as the user's ``options`` ask), then clean,
         orient and validate them all at once; ``attrs`` are columns over all added lots."""
-        counts = np.concatenate([np.zeros(0, dtype=np.int64), *self.sizes])
+        counts = np.array(self.sizes, dtype=np.int64)
         vertices = np.concatenate([np.zeros((0, 3)), *self.rings])
         xy = np.column_stack([vertices[:, 0], np.subtract(0.0, vertices[:, 2])]) if self.world else vertices[:, :2]
         lot_counts = np.add.reduceat(counts, offsets_from_counts(np.array(self.ring_counts, np.int64))[:-1]) \
@@ -154,8 +158,11 @@ class LotBuilder:
         # edges shorter than TOL.merge collapse as PRT collapses them (geometry.short_edges)
         order, kept, owner = collapse_short_edges(vertices, offsets_from_counts(counts), TOL.merge)
         vertices, ring_offsets = vertices[order], offsets_from_counts(kept)
+        given = np.zeros(self.vertices, dtype=bool)
+        for start, flags in self.street:
+            given[start:start + len(flags)] = flags
         street = np.zeros(len(vertices), dtype=bool)
-        np.logical_or.at(street, owner, np.concatenate([np.zeros(0, dtype=bool), *self.street]))
+        np.logical_or.at(street, owner, given)
         lot_offsets = offsets_from_counts(np.array(self.ring_counts, dtype=np.int64))
         normals = _newell(vertices, ring_offsets)
         exterior = np.zeros(len(normals), dtype=bool)
@@ -230,7 +237,12 @@ def _ring_xyz(ring) -> np.ndarray:
 def _with_z(ring: np.ndarray) -> np.ndarray:
     """Map positions (k, 2) or (k, 3) as (k, 3), the elevation NaN where there is none."""
     ring = np.asarray(ring, dtype=np.float64)
-    return ring if ring.shape[1] == 3 else np.column_stack([ring, np.full(len(ring), np.nan)])
+    if ring.shape[1] == 3:
+        return ring
+    out = np.empty((len(ring), 3))
+    out[:, :2] = ring
+    out[:, 2] = np.nan
+    return out
 
 
 def _base_heights(z: np.ndarray, lot_counts: np.ndarray) -> np.ndarray:
