@@ -40,8 +40,8 @@ import time
 from collections.abc import Callable
 from pathlib import Path
 
-import grammarc
 from grammarc.errors import raise_stopped, stopped
+from grammarc.frontend.user_cache import code_stamp
 
 #: Environment variables that change what the imported code does (read at import time).
 _KEYED_ENV = ("GRAMMARC_", "NUMBA_", "PYTHON", "LANG", "LC_")
@@ -70,15 +70,8 @@ def _private(path: Path) -> bool:
 
 def key() -> str:
     """The digest that names the server this process may use: same code, same Python, same settings."""
-    digest = hashlib.sha256()
-    package = Path(grammarc.__file__).parent
-    for path in sorted(package.rglob("*.py")):
-        info = path.stat()
-        digest.update(f"{path.relative_to(package)}\0{info.st_mtime_ns}\0{info.st_size}\0".encode())
     settings = sorted((k, v) for k, v in os.environ.items() if k.startswith(_KEYED_ENV) and k != "GRAMMARC_SERVER")
-    digest.update(json.dumps([grammarc.__version__, sys.executable, sys.version, sys.warnoptions,
-                              settings]).encode())
-    return digest.hexdigest()[:16]
+    return hashlib.sha256(json.dumps([code_stamp(), sys.warnoptions, settings]).encode()).hexdigest()[:16]
 
 
 def address(digest: str | None = None) -> Path:

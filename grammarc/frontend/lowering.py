@@ -19,6 +19,18 @@ from grammarc.diagnostics import Diagnostics, Span
 from grammarc.ir import nodes as ir
 
 
+class Sites:
+    """The numbers of random-stream sites, given out in source order across a grammar's files
+    (``next(sites)``); ``next_site`` is the number the next one gets."""
+
+    def __init__(self, next_site: int = 1):
+        self.next_site = next_site
+
+    def __next__(self) -> int:
+        self.next_site += 1
+        return self.next_site - 1
+
+
 @v_args(inline=True, meta=True)
 class LoweringBase(Transformer):
     """Parse tree of one statement -> IR pieces. ``sites`` numbers random-stream sites in source order."""

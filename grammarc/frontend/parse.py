@@ -11,7 +11,6 @@ assembled into a module by its ``assemble``.
 
 from __future__ import annotations
 
-import itertools
 import re
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -21,10 +20,10 @@ from lark import Tree
 from lark.exceptions import UnexpectedCharacters, UnexpectedEOF, UnexpectedInput, UnexpectedToken
 
 from grammarc.diagnostics import Diagnostics, Span
-from grammarc.frontend import cga2006, cityengine
+from grammarc.frontend import cga2006, cityengine, lowered_cache
 from grammarc.frontend.cityengine.nodes import Import
 from grammarc.frontend.imports import Roots, find_roots, load_import
-from grammarc.frontend.lowering import LoweringBase
+from grammarc.frontend.lowering import LoweringBase, Sites
 from grammarc.frontend.parsers import parser_for
 from grammarc.frontend.statements import Statement, split_cityengine, split_paper
 from grammarc.ir import nodes as ir
@@ -91,9 +90,34 @@ def parse_source(text: str, file: str, diags: Diagnostics, dialect: str | None =
     functions, which an importing file calls as ``prefix.name(...)``, go to ``exports`` (``assemble``).
     """
     text = text.removeprefix("\ufeff")  # a UTF-8 byte order mark, read as text
-    spec = DIALECTS[dialect or detect_dialect(text)]
+    name = dialect or detect_dialect(text)
+    spec = DIALECTS[name]
+    sites = sites if sites is not None else Sites()
+    first_site = sites.next_site
+    kept = lowered_cache.lookup(name, file, text, first_site)
+    if kept is not None:
+        lowered, warnings, sites.next_site = kept
+        diags.extend(warnings)
+    else:
+        said = len(diags)
+        lowered = _lower(spec, text, file, diags, sites)
+        if not any(d.is_error for d in diags[said:]):
+            lowered_cache.keep(name, file, text, first_site, lowered, diags[said:], sites.next_site)
+    if spec is not DIALECTS["cityengine"]:  # the paper notation imports no files
+        return spec.assemble(file, lowered, diags)
+    imports = []
+    for st in lowered:
+        declaration = getattr(st, "declaration", st)
+        if isinstance(declaration, Import):
+            imported = _import(declaration, file, path, diags, sources, sites, importing, roots)
+            if imported is not None:
+                imports.append((declaration, *imported))
+    return spec.assemble(file, lowered, diags, imports, exports)
+
+
+def _lower(spec: Dialect, text: str, file: str, diags: Diagnostics, sites: Sites) -> list:
+    """Each statement of ``text`` parsed and lowered on its own (an error in one leaves the others)."""
     parser = parser_for(spec.grammar)
-    sites = sites if sites is not None else itertools.count(1)
     lowered = []
     for statement in spec.split(text):
         try:
@@ -108,16 +132,7 @@ def parse_source(text: str, file: str, diags: Diagnostics, dialect: str | None =
                                                                  statement.line, column + 1))
             continue
         lowered.append(spec.lowering(file, diags, sites).transform(tree))
-    if spec is not DIALECTS["cityengine"]:  # the paper notation imports no files
-        return spec.assemble(file, lowered, diags)
-    imports = []
-    for st in lowered:
-        declaration = getattr(st, "declaration", st)
-        if isinstance(declaration, Import):
-            imported = _import(declaration, file, path, diags, sources, sites, importing, roots)
-            if imported is not None:
-                imports.append((declaration, *imported))
-    return spec.assemble(file, lowered, diags, imports, exports)
+    return lowered
 
 
 #: The deepest parse tree a statement may have. Lowering, the IR passes and the derivation walk a

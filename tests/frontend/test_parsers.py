@@ -1,4 +1,4 @@
-"""frontend/parsers.py: the parsers' tables are cached in the user's own cache folder, never as a pickle in
+"""frontend/parsers.py and user_cache.py: the parsers' tables are cached in the user's own cache folder, never as a pickle in
 the shared temp folder, and a cache that others could have written is not loaded."""
 
 from __future__ import annotations
@@ -32,7 +32,7 @@ def test_no_pickle_in_the_temp_folder_and_a_private_cache(tmp_path):
     assert list((tmp_path / "tmp").iterdir()) == []  # lark's cache=True writes .lark_cache_*.tmp here
     folder = tmp_path / "cache" / "grammarc"
     assert folder.stat().st_mode & 0o777 == 0o700
-    (cached,) = folder.iterdir()
+    (cached,) = folder.glob("*.lark")
     assert cached.name.startswith("cityengine-") and cached.stat().st_mode & 0o077 == 0
     # the second process loads it, and parses alike
     before = cached.stat().st_mtime_ns
@@ -53,7 +53,7 @@ def _plant(path: Path) -> Path:
 def test_a_cache_folder_others_can_write_is_not_used(tmp_path, mode):
     _run(PARSE, tmp_path)  # the cache file's name
     folder = tmp_path / "cache" / "grammarc"
-    (cached,) = folder.iterdir()
+    (cached,) = folder.glob("*.lark")
     proof = _plant(cached)
     folder.chmod(mode)
     assert _run(PARSE, tmp_path).stdout.strip() == "Lot"
@@ -62,7 +62,7 @@ def test_a_cache_folder_others_can_write_is_not_used(tmp_path, mode):
 
 def test_a_cache_file_others_can_write_is_not_loaded(tmp_path):
     _run(PARSE, tmp_path)
-    (cached,) = (tmp_path / "cache" / "grammarc").iterdir()
+    (cached,) = (tmp_path / "cache" / "grammarc").glob("*.lark")
     proof = _plant(cached)
     cached.chmod(0o666)
     assert _run(PARSE, tmp_path).stdout.strip() == "Lot"
@@ -71,6 +71,6 @@ def test_a_cache_file_others_can_write_is_not_loaded(tmp_path):
 
 def test_a_broken_cache_file_is_rebuilt(tmp_path):
     _run(PARSE, tmp_path)
-    (cached,) = (tmp_path / "cache" / "grammarc").iterdir()
+    (cached,) = (tmp_path / "cache" / "grammarc").glob("*.lark")
     cached.write_bytes(b"\x80\x05 not a pickle")
     assert _run(PARSE, tmp_path).stdout.strip() == "Lot"
