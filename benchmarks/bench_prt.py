@@ -3,7 +3,8 @@
 Each round runs PRT (``prt_reference.py RPK rect_30x20.obj --batch N --processes 2``: PyPRT in its side
 environment, N copies of the footprint on a grid, two processes as grammarc's two workers) and then
 ``grammarc build RPK`` on N such lots (``conftest.grid_lots``), both as whole processes, start-up included; the ratio is PRT's
-median over grammarc's, so a noisy machine slows both alike. Skipped without the PRT kit
+median over grammarc's, so a noisy machine slows both alike. The same build is also timed as the ``grammarc``
+command runs it with a warm server up (``grammarc server``): ``served_median_s``, ``prt_over_served``. Skipped without the PRT kit
 (``../shared/prt``) or its side environment: ``$GRAMMARC_PRT_PYTHON``, else ``.prt-venv/bin/python``
 beside the repository (the kit's README says how to make it).
 """
@@ -12,6 +13,7 @@ from __future__ import annotations
 
 import statistics
 import subprocess
+import sys
 import time
 
 import pytest
@@ -25,7 +27,7 @@ ROUNDS = 3
 
 @pytest.mark.parametrize("n_lots", [100, 500], ids=["100", "500"])
 @pytest.mark.parametrize("package", ["candler", "massing"])
-def test_against_prt(benchmark, lots_dir, tmp_path, package, n_lots):
+def test_against_prt(benchmark, lots_dir, served_env, tmp_path, package, n_lots):
     kit, python = kit_dir(), prt_python()
     if not kit.is_dir() or python is None:
         pytest.skip("needs the PRT kit (../shared/prt) and PyPRT's side environment (.prt-venv or "
@@ -39,20 +41,26 @@ def test_against_prt(benchmark, lots_dir, tmp_path, package, n_lots):
     prt = [str(python), str(kit / "prt_reference.py"), str(rpk), str(kit / "footprints" / "rect_30x20.obj"),
            "--batch", str(n_lots), "--processes", "2"]
     run_build(args)  # the numba cache filled outside the timed rounds
-    prt_seconds, result = [], {}
+    served = [sys.executable, "-m", "grammarc.client", "build", *args]
+    prt_seconds, served_seconds, result = [], [], {}
 
-    def run_prt():
-        start = time.perf_counter()
-        subprocess.run(prt, check=True, capture_output=True)
-        prt_seconds.append(time.perf_counter() - start)
+    def others():
+        """PRT, then the same build as the ``grammarc`` command runs it when a server is up."""
+        for command, env, seconds in ((prt, None, prt_seconds), (served, served_env, served_seconds)):
+            start = time.perf_counter()
+            subprocess.run(command, env=env, check=True, capture_output=True)
+            seconds.append(time.perf_counter() - start)
 
-    benchmark.pedantic(lambda: result.update(run_build(args)), setup=run_prt, rounds=ROUNDS, iterations=1)
+    benchmark.pedantic(lambda: result.update(run_build(args)), setup=others, rounds=ROUNDS, iterations=1)
     terminals = len(read_instances(out)["asset"])
     ours = statistics.median(benchmark.stats.stats.data)
+    prt_median, served_median = statistics.median(prt_seconds), statistics.median(served_seconds)
     benchmark.extra_info.update(
         terminals=terminals,
         terminals_per_s=round(terminals / ours),
         peak_rss_mib=round(result["peak_rss_kib"] / 1024, 1),
-        prt_median_s=round(statistics.median(prt_seconds), 3),
-        prt_over_grammarc=round(statistics.median(prt_seconds) / ours, 2),
+        prt_median_s=round(prt_median, 3),
+        prt_over_grammarc=round(prt_median / ours, 2),
+        served_median_s=round(served_median, 3),
+        prt_over_served=round(prt_median / served_median, 2),
     )

@@ -8,7 +8,6 @@ kit (skipped without the kit), and the example city's grammar, each on one 30 x 
 
 from __future__ import annotations
 
-import os
 import statistics
 import subprocess
 import sys
@@ -22,20 +21,6 @@ from grammarc.conform import kit_dir
 
 ROOT = Path(__file__).resolve().parents[1]
 ROUNDS = 7
-
-
-@pytest.fixture(scope="module")
-def served_env(tmp_path_factory):
-    """The environment of commands that a server (started here, stopped at the end) runs."""
-    folder = tmp_path_factory.mktemp("run")
-    folder.chmod(0o700)
-    env = {**os.environ, "XDG_RUNTIME_DIR": str(folder)}
-    server = subprocess.Popen([sys.executable, "-m", "grammarc.client", "server", "start", "--foreground",
-                               "--idle-timeout", "30"], env=env, stdout=subprocess.PIPE, text=True)
-    assert server.stdout.readline().startswith("grammarc server"), "the server did not start"
-    yield env
-    server.terminate()
-    server.wait(timeout=60)
 
 
 def _timed(args: list[str], env: dict) -> float:

@@ -77,3 +77,17 @@ def run_build(args: list[str], env: dict | None = None) -> dict:
 @pytest.fixture(scope="session")
 def lots_dir(tmp_path_factory):
     return tmp_path_factory.mktemp("lots")
+
+
+@pytest.fixture(scope="session")
+def served_env(tmp_path_factory):
+    """The environment of commands that a server (started here, stopped at the end) runs."""
+    folder = tmp_path_factory.mktemp("run")
+    folder.chmod(0o700)
+    env = {**os.environ, "XDG_RUNTIME_DIR": str(folder)}
+    server = subprocess.Popen([sys.executable, "-m", "grammarc.client", "server", "start", "--foreground",
+                               "--idle-timeout", "30"], env=env, stdout=subprocess.PIPE, text=True)
+    assert server.stdout.readline().startswith("grammarc server"), "the server did not start"
+    yield env
+    server.terminate()
+    server.wait(timeout=60)
