@@ -6,7 +6,7 @@ its text and the number its first random-stream site gets (sites are numbered ac
 Those are the key; what a file imports, and everything the passes look up (assets, file searches), is
 read again on every compile. A file whose lowering found an error is not kept (its diagnostics are
 rendered from the live text anyway); its warnings are kept with its statements. The folder keeps the
-``MAX_FILES`` files used last.
+``MAX_FILES`` files used last, and loses the temporary files of stores that were killed.
 """
 
 from __future__ import annotations
@@ -14,6 +14,7 @@ from __future__ import annotations
 import hashlib
 import os
 import pickle
+import time
 
 from grammarc.diagnostics import Diagnostic
 from grammarc.frontend.user_cache import cache_folder, code_stamp, load, store
@@ -43,7 +44,9 @@ def keep(dialect: str, file: str, text: str, first_site: int, statements: list, 
     data = pickle.dumps((statements, warnings, next_site), protocol=pickle.HIGHEST_PROTOCOL)
     store(folder / _name(dialect, file, text, first_site), lambda f: f.write(data))
     kept = sorted(folder.glob("*.pickle"), key=_used, reverse=True)
-    for stale in kept[MAX_FILES:]:
+    # beyond the last MAX_FILES, and temporary files of stores that a killed process left (an hour old)
+    hour_ago = time.time_ns() - 3600 * 10**9
+    for stale in [*kept[MAX_FILES:], *(t for t in folder.glob("*.tmp") if _used(t) < hour_ago)]:
         stale.unlink(missing_ok=True)
 
 

@@ -52,8 +52,15 @@ def test_a_file_with_an_error_is_not_kept(cache_home):
     assert said.has_errors and not list(cache_home.iterdir())
 
 
-def test_the_files_used_last_are_kept(monkeypatch, cache_home):
+def test_the_files_used_last_are_kept_and_old_temporary_files_go(monkeypatch, cache_home):
+    import os
+
     monkeypatch.setattr(lowered_cache, "MAX_FILES", 2)
+    _parse()
+    left, fresh = cache_home / "x.pickle123.tmp", cache_home / "y.pickle456.tmp"  # a killed store's, another's
+    left.write_bytes(b"")
+    fresh.write_bytes(b"")
+    os.utime(left, (0, 0))
     for k in range(3):
         _parse(TEXT + f"A{k} --> X\n")
-    assert len(list(cache_home.iterdir())) == 2
+    assert len(list(cache_home.glob("*.pickle"))) == 2 and not left.exists() and fresh.exists()
