@@ -81,13 +81,12 @@ def lots_dir(tmp_path_factory):
 
 @pytest.fixture(scope="session")
 def served_env(tmp_path_factory):
-    """The environment of commands that a server (started here, stopped at the end) runs."""
+    """The environment of commands that a server (started here as a user starts one, stopped at the end)
+    runs."""
     folder = tmp_path_factory.mktemp("run")
     folder.chmod(0o700)
     env = {**os.environ, "XDG_RUNTIME_DIR": str(folder)}
-    server = subprocess.Popen([sys.executable, "-m", "grammarc.client", "server", "start", "--foreground",
-                               "--idle-timeout", "30"], env=env, stdout=subprocess.PIPE, text=True)
-    assert server.stdout.readline().startswith("grammarc server"), "the server did not start"
+    command = [sys.executable, "-m", "grammarc.client", "server"]
+    subprocess.run([*command, "start", "--idle-timeout", "30"], env=env, check=True, capture_output=True)
     yield env
-    server.terminate()
-    server.wait(timeout=60)
+    subprocess.run([*command, "stop"], env=env, check=True, capture_output=True)

@@ -133,6 +133,24 @@ def test_status_names_the_servers_and_which_serves_this_grammarc(served):
     assert out == f"grammarc server {served.pid} at {server.address()} (this grammarc's)\n"
 
 
+def test_a_started_server_runs_detached_until_it_is_stopped(tmp_path):
+    """``grammarc server start`` returns once its daemon is ready; ``stop`` ends it and its files go."""
+    tmp_path.chmod(0o700)
+    env = {**os.environ, "XDG_RUNTIME_DIR": str(tmp_path)}
+    start = subprocess.run([sys.executable, "-m", "grammarc.client", "server", "start"], env=env,
+                           capture_output=True, text=True, timeout=300, check=True)
+    pid = int(start.stdout.split()[2])
+    assert "ready at" in start.stdout and os.getpgid(pid) != os.getpgid(0)
+    again = subprocess.run([sys.executable, "-m", "grammarc.client", "server", "start"], env=env,
+                           capture_output=True, text=True, timeout=300, check=True)
+    assert again.stdout.startswith(f"grammarc server {pid} already running")
+    stop = subprocess.run([sys.executable, "-m", "grammarc.client", "server", "stop"], env=env,
+                          capture_output=True, text=True, timeout=60, check=True)
+    assert stop.stdout.startswith(f"grammarc server {pid} at ") and stop.stdout.endswith(" stopped\n")
+    _wait_for(lambda: not list((tmp_path / "grammarc").iterdir()))  # socket, pid file and log gone
+    _wait_for(lambda: not Path(f"/proc/{pid}").exists())
+
+
 def test_without_a_server_a_request_is_not_taken(tmp_path, monkeypatch):
     monkeypatch.setenv("XDG_RUNTIME_DIR", str(tmp_path))
     assert server.request(["--version"]) is None
