@@ -25,6 +25,7 @@ This module is imported by the client on every command: it imports nothing heavy
 from __future__ import annotations
 
 import contextlib
+import gc
 import hashlib
 import io
 import json
@@ -205,6 +206,8 @@ def serve(run: Callable[[list[str]], int], warm: Callable[[], None], *, idle_tim
     """
     started = time.perf_counter()
     warm()
+    gc.collect()
+    gc.freeze()  # what warm-up made stays out of the children's collections: their pages stay shared
     home = folder()
     home.mkdir(mode=0o700, parents=True, exist_ok=True)
     if not _private(home):
