@@ -86,11 +86,13 @@ class LotBuilder:
     def add(self, index: int, lot_id: str, rings: list[np.ndarray], props: dict) -> None:
         """Add a lot: its exterior ring, then its holes. A ``streetWidth`` property (CityEngine's: a
         number per edge of the exterior ring, > 0 where a street runs) marks its street edges."""
+        self._add(index, lot_id, rings if self.world else [_with_z(ring) for ring in rings], props)
+
+    def _add(self, index: int, lot_id: str, rings: list[np.ndarray], props: dict) -> None:
+        """``add`` of rings already (k, 3): world positions, or map positions with their elevation."""
         if not rings:
             self.reject(index, lot_id, "empty polygon")
             return
-        if not self.world:
-            rings = [_with_z(ring) for ring in rings]
         widths = props.get(STREET_WIDTH)
         if widths is not None:
             flags = street_flags(widths, rings[0])
@@ -127,11 +129,11 @@ class LotBuilder:
         """Add a lot given as lists of map positions (GeoJSON): x, y and an optional elevation; further
         components are ignored."""
         try:
-            xy = [_ring_xyz(ring) for ring in rings]
+            xyz = [_ring_xyz(ring) for ring in rings]
         except (TypeError, ValueError, IndexError):
             self.reject(index, lot_id, "malformed coordinates")
             return
-        self.add(index, lot_id, xy, props)
+        self._add(index, lot_id, xyz, props)
 
     def finish(self, attrs: dict[str, np.ndarray], source: str, options: LotsOptions = NO_OPTIONS) -> Lots:
         """Bring every lot to metres (``io.crs.georeference``, as the user's ``options`` ask), then clean,
@@ -305,6 +307,10 @@ def parse_features(features, first_index: int = 0, id_field: str | None = None) 
     return builder
 
 
+#: The types of a property column that is numbers as it is (``bool`` is not ``int`` here).
+_PLAIN_NUMBERS = {int, float, type(None)}
+
+
 def property_column(values: list) -> np.ndarray:
     """One property column, typed over all its values.
 
@@ -315,6 +321,8 @@ def property_column(values: list) -> np.ndarray:
       are, None kept, anything else as its JSON text (booleans ``true`` and ``false``: a boolean is no
       number, and an attribute of numbers given one makes its lot bad, ``backend.attributes``).
     """
+    if set(map(type, values)) <= _PLAIN_NUMBERS:  # what JSON gives: one pass in C, None is nan
+        return np.array(values, dtype=np.float64)
     if all(v is None or (isinstance(v, numbers.Real) and not isinstance(v, bool)) for v in values):
         return np.array([np.nan if v is None else float(v) for v in values], dtype=np.float64)
     column = np.empty(len(values), dtype=object)

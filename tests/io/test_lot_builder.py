@@ -273,3 +273,22 @@ def test_star_polygons_keep_first_vertex_and_area(n, seed, clockwise, offset):
     area = 0.5 * abs(np.sum(x * np.roll(y, -1) - np.roll(x, -1) * y))
     assert map_area(out - out[0]) == pytest.approx(area, rel=1e-9)
 
+
+
+@pytest.mark.parametrize(("values", "want"), [
+    ([1, 2.5, None], [1.0, 2.5, np.nan]),
+    ([2**53 + 1, -3], [float(2**53 + 1), -3.0]),
+    ([1, True], ["1", "true"]),
+    ([1.5, "2"], ["1.5", "2"]),
+    ([None, None], [np.nan, np.nan]),
+])
+def test_a_property_column_is_numbers_only_where_every_value_is_a_number(values, want):
+    """JSON's numbers take one pass in C; a boolean or a string among them makes a column of text."""
+    from grammarc.io.lot_builder import property_column
+
+    column = property_column(values)
+    if isinstance(want[0], float):
+        assert column.dtype == np.float64
+        np.testing.assert_array_equal(column, want)
+    else:
+        assert column.dtype == object and column.tolist() == want
