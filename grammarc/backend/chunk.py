@@ -122,8 +122,9 @@ class Chunk:
     snaps: SnapStore = field(default_factory=SnapStore)
     #: Texture maps the shapes' texture columns name (``backend.texture_space``).
     texture_maps: TextureMaps = field(default_factory=TextureMaps)
-    #: Shapes created so far per lot, for the ``max_shapes`` limit.
+    #: Shapes created so far per lot, for the ``max_shapes`` limit, and in all.
     shape_count: np.ndarray = field(init=False)
+    shape_total: int = field(init=False, default=0)
 
     def __post_init__(self) -> None:
         self.shape_count = np.zeros(len(self.lot_index), dtype=np.int64)

@@ -16,6 +16,7 @@ import numpy as np
 
 from grammarc.backend.chunk import Chunk
 from grammarc.backend.evaluate import Env
+from grammarc.backend.kernels.order import tally
 from grammarc.backend.kernels.split import MAX_COUNT
 from grammarc.backend.plan import Plan
 from grammarc.backend.shapes import Shapes
@@ -24,6 +25,9 @@ from grammarc.errors import AssetError, ChunkTooLarge, LotFailure
 from grammarc.geometry.meshes import is_mesh
 from grammarc.ir import nodes as ir
 from grammarc.ir.printer import print_op
+
+#: ``tally``'s weights when every row is one shape.
+_NO_WEIGHTS = np.zeros(0, dtype=np.int64)
 
 
 class Context:
@@ -66,7 +70,10 @@ class Context:
 
     def fail_negative(self, shapes: Shapes, values: np.ndarray, message: str, span) -> None:
         """Fail the shapes whose sizes (n, k), or (1, k) for all, are negative or NaN, quoting the first."""
-        bad = np.broadcast_to(~(values >= 0).all(axis=1), (len(shapes),))
+        fine = values >= 0  # False for NaN too
+        if fine.all():
+            return
+        bad = np.broadcast_to(~fine.all(axis=1), (len(shapes),))
         if bad.any():
             row = values[np.flatnonzero(bad)[0]]
             self.fail(shapes, bad, f"{message} ({', '.join(f'{v:g}' for v in np.atleast_1d(row))})", span)
@@ -82,20 +89,26 @@ class Context:
     # ------------------------------------------------------------------------------------------ the limits
     def count(self, shapes: Shapes, span) -> None:
         """Add new shapes to the per-lot counters and enforce the shape limits."""
-        if len(shapes):
-            self.add_counts(np.bincount(shapes.lot, minlength=len(self.chunk.shape_count)), span)
+        self.count_lots(shapes.lot, span)
 
-    def add_counts(self, per_lot: np.ndarray, span) -> None:
-        """``count`` of new shapes given as their number per lot (L,) int64."""
-        counts = self.chunk.shape_count
-        counts += per_lot
-        self.check_shape_limit(counts, span)
-        if counts.sum() > self.chunk_budget and len(counts) > 1:
+    def count_lots(self, lot: np.ndarray, span, per_row: np.ndarray | None = None) -> None:
+        """``count`` of new shapes given by their lots (n,), ``per_row`` (n,) int64 shapes each (default 1).
+
+        The per-lot counts are checked against --max-shapes only once the chunk has made more shapes than
+        the limit in all (no lot can be over before): a small batch costs its own length, not the chunk's
+        number of lots."""
+        chunk = self.chunk
+        chunk.shape_total += tally(chunk.shape_count, lot, _NO_WEIGHTS if per_row is None else per_row)
+        if chunk.shape_total > self.limits.max_shapes:
+            self.check_shape_limit(chunk.shape_count, span)
+        if chunk.shape_total > self.chunk_budget and len(chunk.shape_count) > 1:
             raise ChunkTooLarge()
 
     def check_fan_out(self, shapes: Shapes, counts: np.ndarray, span) -> None:
         """Refuse a fan-out of ``counts`` (n,) children per shape (int64, or float64 where a count may be
         beyond int64) that would take a lot over --max-shapes, before allocating them."""
+        if self.chunk.shape_total + counts.sum() <= self.limits.max_shapes:  # no lot can be over (NaN: check)
+            return
         per_lot = np.bincount(shapes.lot, weights=counts, minlength=len(self.chunk.shape_count))
         self.check_shape_limit(per_lot + self.chunk.shape_count, span)
 

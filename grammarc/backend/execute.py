@@ -166,7 +166,7 @@ def run_parts(ctx: Context, parts: Parts) -> None:
         leaf = parts.leaves[i] if parts.leaves else None
         if leaf is not None:
             records = leaf.records(ctx.chunk.frames.data, ctx.chunk.lot_origin)
-            ctx.add_counts(np.bincount(records.lot, minlength=len(ctx.chunk.shape_count)), body[0].span)
+            ctx.count_lots(records.lot, body[0].span)
             ctx.pending[records.symbol].append(records)
         elif offsets[i + 1] > offsets[i]:
             run(ctx, body, parts.shapes.take(slice(offsets[i], offsets[i + 1])), leaf_at_end=True)

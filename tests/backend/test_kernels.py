@@ -7,7 +7,7 @@ import math
 import numpy as np
 import pytest
 
-from grammarc.backend.kernels.order import group_by, scatter_rows
+from grammarc.backend.kernels.order import group_by, scatter_rows, tally
 from grammarc.backend.kernels.scope import place_children, xforms
 from grammarc.backend.kernels.split import repeat, repeat_counts, subdiv
 from grammarc.backend.random import child_keys
@@ -248,3 +248,14 @@ def test_xforms_maps_unit_box_corners_to_scope_corners():
         c = np.array(corner, float)
         world = x[:, :3] @ c + x[:, 3]
         np.testing.assert_allclose(world, origin[0] + (c * size[0]) @ frames[0], atol=1e-5)
+
+
+@pytest.mark.parametrize("n", SIZES)
+@pytest.mark.parametrize("weighted", [False, True])
+def test_tally_adds_what_bincount_counts(n, weighted):
+    rng = np.random.default_rng(n)
+    lot, weights = rng.integers(0, 7, n).astype(np.int32), rng.integers(0, 5, n)
+    counts = rng.integers(0, 3, 7)
+    want = counts + np.bincount(lot, weights=weights if weighted else None, minlength=7).astype(np.int64)
+    added = tally(counts, lot, weights if weighted else np.zeros(0, np.int64))
+    assert np.array_equal(counts, want) and added == (weights.sum() if weighted else n)

@@ -34,3 +34,15 @@ def scatter_rows(src, dest, out):
         d = dest[i]
         for j in range(src.shape[1]):
             out[d, j] = src[i, j]
+
+
+@njit(cache=True, nogil=True)
+def tally(counts, lot, weights):
+    """``counts[lot[i]] += weights[i]`` (1 each where ``weights`` is empty) for counts (L,) int64, lot (n,)
+    integers, weights (n,) or (0,) int64; returns the sum added. O(n), whatever L is."""
+    added = 0
+    for i in range(len(lot)):
+        w = weights[i] if len(weights) else 1
+        counts[lot[i]] += w
+        added += w
+    return added

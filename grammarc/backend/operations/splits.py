@@ -227,10 +227,8 @@ def _fan_out_leaves(ctx: Context, op, shapes: Shapes, axis: int, parent, cell, p
     are made as usual. Shape counts are kept as the general path keeps them."""
     n_parts = len(op.parts)
     order, offsets = by_part(cell, n_parts)
-    # the children, as `_fan_out` counts them: per parent, then per lot (fewer rows to gather)
-    n_lots = len(ctx.chunk.shape_count)
-    per_parent = np.bincount(parent, minlength=len(shapes))
-    ctx.add_counts(np.bincount(shapes.lot, weights=per_parent, minlength=n_lots).astype(np.int64), op.span)
+    # the children, as `_fan_out` counts them: per parent, each in its lot
+    ctx.count_lots(shapes.lot, op.span, np.bincount(parent, minlength=len(shapes)))
     rows = [order[offsets[i]:offsets[i + 1]] for i in range(n_parts)]
     general = [i for i, leaf in enumerate(leaves) if leaf is None]
     kept = np.concatenate([rows[i] for i in general]) if general else order[:0]
