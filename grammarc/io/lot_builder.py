@@ -77,6 +77,7 @@ class LotBuilder:
         self.bad: list[BadLot] = []
         self.polygons = 0  # lots added or rejected; a file without any has "no polygon"
         self.end = 0  # lot numbers the parsed features took (GeoJSON)
+        self.queued: list[tuple] = []  # lots of map positions not converted yet (``add_positions``)
 
     def reject(self, index: int, lot_id: str, reason: str) -> None:
         """A polygon that is bad before any geometry check (malformed, empty)."""
@@ -86,6 +87,7 @@ class LotBuilder:
     def add(self, index: int, lot_id: str, rings: list[np.ndarray], props: dict) -> None:
         """Add a lot: its exterior ring, then its holes. A ``streetWidth`` property (CityEngine's: a
         number per edge of the exterior ring, > 0 where a street runs) marks its street edges."""
+        self._convert()  # lots come in order
         self._add(index, lot_id, rings if self.world else [_with_z(ring) for ring in rings], props)
 
     def _add(self, index: int, lot_id: str, rings: list[np.ndarray], props: dict) -> None:
@@ -116,6 +118,7 @@ class LotBuilder:
         """Add many lots at once from columns (a columnar file): ``vertices`` of all their rings,
         ``sizes`` vertices per ring, ``ring_counts`` rings per lot, ``street`` a flag per vertex. Their
         properties are not kept here: the caller passes them to ``finish`` as columns."""
+        self._convert()
         self.polygons += len(ids)
         self.rings.append(vertices if self.world else _with_z(vertices))
         self.sizes.extend(np.asarray(sizes, dtype=np.int64).tolist())
@@ -127,7 +130,38 @@ class LotBuilder:
 
     def add_positions(self, index: int, lot_id: str, rings, props: dict) -> None:
         """Add a lot given as lists of map positions (GeoJSON): x, y and an optional elevation; further
-        components are ignored."""
+        components are ignored. Lots are queued and their positions made into one array per
+        ``POSITION_BATCH`` lots (``_convert``), rather than an array per ring."""
+        self.queued.append((index, lot_id, rings, props))
+        if len(self.queued) >= POSITION_BATCH:
+            self._convert()
+
+    def _convert(self) -> None:
+        """Add the queued lots: all their positions in one conversion, when they are all alike (numbers,
+        two or more per position, the same number of them); else lot by lot, ring by ring."""
+        queued, self.queued = self.queued, []
+        flat: list = []
+        offsets = [0]
+        try:
+            for _, _, rings, _ in queued:
+                for ring in rings:
+                    flat.extend(ring)
+                    offsets.append(len(flat))
+            positions = np.array(flat, dtype=np.float64) if flat else np.zeros((0, 3))
+        except (TypeError, ValueError):
+            positions = None
+        if positions is None or positions.ndim != 2 or positions.shape[1] < 2:
+            for entry in queued:
+                self._add_one(*entry)
+            return
+        xyz = _with_z(positions[:, :3])
+        k = 0
+        for index, lot_id, rings, props in queued:
+            self._add(index, lot_id, [xyz[offsets[j]:offsets[j + 1]] for j in range(k, k + len(rings))], props)
+            k += len(rings)
+
+    def _add_one(self, index: int, lot_id: str, rings, props: dict) -> None:
+        """``add_positions`` of one lot, ring by ring (positions of mixed length; malformed ones)."""
         try:
             xyz = [_ring_xyz(ring) for ring in rings]
         except (TypeError, ValueError, IndexError):
@@ -138,6 +172,7 @@ class LotBuilder:
     def finish(self, attrs: dict[str, np.ndarray], source: str, options: LotsOptions = NO_OPTIONS) -> Lots:
         """Bring every lot to metres (``io.crs.georeference``, as the user's ``options`` ask), then clean,
         orient and validate them all at once; ``attrs`` are columns over all added lots."""
+        self._convert()
         counts = np.array(self.sizes, dtype=np.int64)
         vertices = np.concatenate([np.zeros((0, 3)), *self.rings])
         xy = np.column_stack([vertices[:, 0], np.subtract(0.0, vertices[:, 2])]) if self.world else vertices[:, :2]
@@ -192,6 +227,7 @@ class LotBuilder:
 
     def finish_file(self, attrs: dict[str, np.ndarray], path, options: LotsOptions = NO_OPTIONS) -> Lots:
         """``finish`` for a whole lots file, which must hold a polygon (a good or a bad one)."""
+        self._convert()
         if self.polygons == 0:
             raise LotsError(f"no polygon in lots file {path}")
         return self.finish(attrs, str(path), options)
@@ -304,8 +340,12 @@ def parse_features(features, first_index: int = 0, id_field: str | None = None) 
             builder.bad.append(BadLot(index, lot_id, f"not a polygon ({kind or 'null geometry'})"))
             index += 1
     builder.end = index - first_index
+    builder._convert()  # the last lots, whose properties the caller reads
     return builder
 
+
+#: Lots of GeoJSON positions converted together (``LotBuilder.add_positions``).
+POSITION_BATCH = 4096
 
 #: The types of a property column that is numbers as it is (``bool`` is not ``int`` here).
 _PLAIN_NUMBERS = {int, float, type(None)}
