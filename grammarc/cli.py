@@ -209,6 +209,9 @@ def _parser() -> argparse.ArgumentParser:
 def _server(args) -> int:
     from grammarc import server
 
+    if not server.AVAILABLE:
+        raise UsageError("grammarc server needs a system that forks and passes descriptors over Unix sockets "
+                         "(Linux, macOS)")
     found = server.servers()
     if args.action == "status":
         for path, pid in found.items():

@@ -17,7 +17,7 @@ from grammarc import server
 
 def main(argv: list[str] | None = None) -> int:
     argv = sys.argv[1:] if argv is None else argv
-    if os.environ.get("GRAMMARC_SERVER") != "off" and argv[:1] != ["server"]:
+    if server.AVAILABLE and os.environ.get("GRAMMARC_SERVER") != "off" and argv[:1] != ["server"]:
         status = server.request(argv)
         if status is not None:
             return status

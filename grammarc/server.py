@@ -50,7 +50,9 @@ _KEYED_ENV = ("GRAMMARC_", "NUMBA_", "PYTHON", "LANG", "LC_")
 _LENGTH = struct.Struct("!I")
 #: Server to client: the command's exit status.
 _STATUS = struct.Struct("!i")
-_FORWARDED = (signal.SIGINT, signal.SIGTERM, signal.SIGHUP)
+_FORWARDED = (signal.SIGINT, signal.SIGTERM, getattr(signal, "SIGHUP", signal.SIGTERM))
+#: Whether this system can run a server: it forks, and passes descriptors over Unix sockets (not Windows).
+AVAILABLE = hasattr(os, "fork") and hasattr(socket, "send_fds") and hasattr(signal, "pthread_sigmask")
 
 
 def folder() -> Path:

@@ -33,3 +33,12 @@ def test_off_and_the_server_command_never_ask_a_server(asked, monkeypatch, write
         monkeypatch.setenv("GRAMMARC_SERVER", "off")
         argv = ["check", str(write("g.cga", "Lot --> extrude(3)\n"))]
     assert client.main(argv) == 0 and asked == []
+
+
+def test_where_no_server_can_run_commands_run_here_and_server_says_why(asked, monkeypatch, write, capsys):
+    """Windows has no fork: every command runs in its own process, and ``grammarc server`` is refused."""
+    monkeypatch.setattr(server, "AVAILABLE", False)
+    monkeypatch.delenv("GRAMMARC_SERVER", raising=False)
+    assert client.main(["check", str(write("g.cga", "Lot --> extrude(3)\n"))]) == 0 and asked == []
+    assert client.main(["server", "start"]) == 2
+    assert "grammarc server needs a system that forks" in capsys.readouterr().err
