@@ -7,7 +7,7 @@ one does (a short edge moved further than its neighbours' lines allow, a strip o
 end lines cross before its moved line), PRT lets that edge vanish where its end lines cross and its
 neighbours' moved lines meet from there on, as in a weighted straight skeleton whose edges move at their
 own distances: its remainder runs along the neighbours' moved lines, where the folded quads would leave
-a notch (measured through PyPRT on massing's harness lots convex.15000 and T.15059, and on a 9 x 5 m L
+a notch (measured through PyPRT on massing's harness lot convex.15000, four real lots, and a 9 x 5 m L
 whose 3 m end moves 4 m: PRT's remainder is the 5.4 x 1 m rectangle past the moved front).
 
 The wavefront is a ring of lines ``n . x = c + w t`` (n the inward normal, w the distance, t from 0 to 1).
@@ -17,8 +17,10 @@ of its own here (through the vertex, along the step, moving so that its ends sta
 lines), so the steps stay PRT's. An edge event (an edge's segment shrinks to nothing) removes the edge;
 its neighbours then meet. Neighbours whose lines are parallel meet only where they coincide (two facing
 edges passing each other): the slower one goes too and the faster sweeps on, as PRT's front strip runs on
-past the kept end of an L's arm. Split events (a reflex vertex reaching another edge) are not looked for:
-the strips are clipped to the face afterwards. A ring that falls below three lines has nothing left.
+past the kept end of an L's arm; a kept edge between parallel neighbours does not vanish (PRT's strip
+ends at its line: massing.H.15118). Split events (an arm that closes parts the wavefront) are not
+followed: where two parallel lines apart become neighbours, or the wavefront ends outside its face, the
+caller keeps the folded quads' strips. A ring that falls below three lines has nothing left.
 """
 
 from __future__ import annotations
