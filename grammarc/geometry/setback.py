@@ -6,7 +6,9 @@ neighbouring edges meet: a strip stops at an unmoved neighbour's line, and two m
 corner, as in CityEngine; where the boundary turns by less than 15 degrees between edges moved by
 different distances (one of them 0, or not), each strip ends at its own distance's mitre point instead
 and the remainder steps across at the vertex. A quad that folds over itself (a distance longer than the edge allows) is cut to the
-triangle of its edge and its end lines, as a straight skeleton's face ends. The strips of each owner (a
+triangle of its edge and its end lines, as a straight skeleton's face ends; on a face without holes
+the folded edge then vanishes and its neighbours' moved lines meet, the face's edges swept as a
+wavefront (``geometry.wavefront``). The strips of each owner (a
 selector of the operation) are united and clipped to the polygon; an edge belongs to the first owner that
 claims it, and the remainder is what no strip covers. All of it runs on whole batches: numpy over the
 ragged edges, GEOS over arrays of quads.
@@ -20,6 +22,7 @@ import numpy as np
 import shapely
 
 from grammarc.constants import TOL
+from grammarc.geometry.wavefront import swept_strips
 from grammarc.ragged import offsets_from_counts, rank_within
 
 #: A mitre longer than this many setback distances (a near-reversal of the boundary) is cut to the
@@ -100,6 +103,12 @@ def setback_regions(polygons: np.ndarray, edges: Edges, distance: np.ndarray, ow
     if folded.any():
         strips[folded] = _folded_strips(quads[folded])
     group = owner[idx] * m + edges.poly[idx]
+    # a face without holes whose strips fold: its strips swept by its edges as a wavefront
+    swept = np.zeros(m, dtype=bool)
+    swept[edges.poly[idx[folded]]] = True
+    swept[edges.poly[edges.hole]] = False
+    if swept.any():
+        strips, group = _swept(polygons, edges, d, corner, ends, owner, swept, strips, group, idx)
     united = union_by_group(strips, group, n_owners * m).reshape(n_owners, m)
     regions, covered = [], np.full(m, shapely.Polygon(), dtype=object)
     for k in range(n_owners):
@@ -107,6 +116,43 @@ def setback_regions(polygons: np.ndarray, edges: Edges, distance: np.ndarray, ow
         regions.append(_without_seams(_without_spikes(region), polygons))
         covered = shapely.union(covered, region)
     return regions, _without_spikes(shapely.difference(polygons, covered))
+
+
+def _swept(polygons: np.ndarray, edges: Edges, d, corner, ends, owner, swept, strips, group, idx):
+    """The strips (k,) of the moved edges ``idx`` (k,) and their groups (owner * m + polygon), those of the
+    polygons ``swept`` (m,) bool replaced by the regions their edges sweep as a wavefront
+    (``geometry.wavefront``); a polygon of which nothing is left goes whole to the owner of its
+    furthest-moved edge (what no strip reaches of it is no remainder either). A wavefront that ends
+    outside its polygon missed a split event (an arm that closed parts it): that polygon keeps its
+    strips."""
+    m = len(polygons)
+    faces = np.flatnonzero(swept)
+    rows = np.flatnonzero(swept[edges.poly])  # (their outer rings, one after the other)
+    ring_offsets = offsets_from_counts(np.bincount(edges.poly[rows], minlength=m)[faces])
+    coords, offsets, collapsed, followed, left, left_ring = swept_strips(
+        edges.start[rows], edges.end[rows], edges.inward[rows], d[rows], corner[rows], ends[rows], ring_offsets)
+    scale = max(float(np.abs(edges.start[rows]).max(initial=1.0)), 1.0)
+    outside = shapely.distance(shapely.points(left), polygons[faces[left_ring]]) > 1e-9 * scale
+    trusted = np.zeros(m, dtype=bool)
+    trusted[faces[followed]] = True
+    trusted[faces[left_ring[outside]]] = False
+    swept = swept & trusted
+    has = (np.diff(offsets) > 0) & swept[edges.poly[rows]]
+    counts = np.diff(offsets)
+    vertex_edge = np.repeat(np.arange(len(rows)), counts)
+    mine = has[vertex_edge]
+    made = shapely.make_valid(shapely.polygons(shapely.linearrings(
+        coords[mine], indices=np.cumsum(has)[vertex_edge[mine]] - 1)))
+    made_group = owner[rows[has]] * m + edges.poly[rows[has]]
+    gone = faces[collapsed & swept[faces]]
+    if len(gone):
+        sub = rows[np.isin(edges.poly[rows], gone)]
+        order = np.lexsort((-d[sub], edges.poly[sub]))
+        furthest = sub[order][np.r_[True, np.diff(edges.poly[sub][order]) != 0]]
+        made = np.concatenate([made, polygons[gone]])
+        made_group = np.concatenate([made_group, owner[furthest] * m + gone])
+    kept = ~swept[edges.poly[idx]]
+    return np.concatenate([strips[kept], made]), np.concatenate([group[kept], made_group])
 
 
 def _folded_strips(quads: np.ndarray) -> np.ndarray:

@@ -66,6 +66,33 @@ def test_a_strip_longer_than_its_edge_allows_ends_where_its_end_lines_cross():
     assert shapely.area(strips[0]) == pytest.approx(22.5)
 
 
+@pytest.mark.parametrize("ring, d, remainder", [
+    # a 9 x 5 m L whose front (9 m) and 3 m end move 4 m: the end's strip folds and the front's moved line
+    # runs on to the kept edge beyond the arm (PRT on massing's tiers: the 5.4 x 1 m rectangle; was 5.48,
+    # a corner of it cut off by the folded quad's triangle)
+    ([(0, 0), (9, 0), (9, 3), (5.4, 3), (5.4, 5), (0, 5)], [4, 4, 0, 0, 0, 0], 5.4 * 1),
+    # the same L whose end (1.58 m) folds between the moved front and a kept edge parallel to it: the kept
+    # edge stays and the arm past it is left (PRT on the harness's massing.H.15118: 1.755 m2)
+    ([(0, 0), (1.58, 0), (1.58, 4.07), (1.15, 4.07), (1.15, 5.59), (0, 5.59)], [4, 4, 0, 0, 0, 0],
+     1.15 * 1.52),
+    # a U whose arms both close (their sides moved 4 m toward each other): the wavefront parts, which the
+    # sweep does not follow; the strips are the folded quads' (PRT on the real lot massing.mumbai.43)
+    ([(0, 0), (21, 0), (21, 10), (18, 10), (18, 1.6), (3.2, 1.6), (3.2, 10), (0, 10)],
+     [4, 4, 3, 3, 0, 0, 4, 3], None),
+])
+def test_an_edge_whose_strip_folds_vanishes_and_its_neighbours_meet(ring, d, remainder):
+    """A face whose strips fold is swept as a wavefront (``geometry.wavefront``): the folded edge vanishes
+    where its end lines cross and its neighbours' moved lines meet from there on."""
+    face = np.array([shapely.Polygon(ring)])
+    edges = polygon_edges(face)
+    (strips,), rest = setback_regions(face, edges, np.array(d, float), np.zeros(len(d), np.int64), 1)
+    assert shapely.area(strips[0]) + shapely.area(rest[0]) == pytest.approx(face[0].area)
+    if remainder is not None:
+        assert shapely.area(rest[0]) == pytest.approx(remainder, rel=1e-9)
+    else:
+        assert shapely.area(rest[0]) > 0
+
+
 def test_collinear_edges_with_different_distances_step_instead_of_slanting():
     """A top edge in two collinear pieces set back 4 and 3 (as a second setback meets the edges a first
     one left, massing's U): the remainder steps at the shared vertex, 10 x 6 + 10 x 7."""

@@ -81,6 +81,16 @@ def test_shape_l_and_tier_setbacks_of_a_holed_face_leave_the_hole_alone(write):
     assert totals(run(write, tier + AREA_REPORTS, [lot]))["r_sum"] == pytest.approx(23 * 23 - 100)
 
 
+def test_tier_setback_of_an_l_whose_short_end_folds(write):
+    """massing's tier setback ("4;4;0;0;0;0") on its shapeL of a 10 x 6 m lot offset by 0.5: the L's 3 m
+    end moves 4 m, its strip folds, and the front's moved line runs on to the arm past the kept edge: PRT
+    leaves the 5.4 x 1 m rectangle (was 5.48: the folded quad's triangle cut a corner off the terrace)."""
+    lot = [np.array([[0, 0], [9, 0], [9, 3], [5.4, 3], [5.4, 5], [0, 5]], float)]
+    tier = 'Lot --> setback(comp(fe){ all : float(listItem("4;4;0;0;0;0", comp.index)) }) { all : A | remainder : R }\n'
+    t = totals(run(write, tier + AREA_REPORTS, [lot]))
+    assert (t["a_sum"], t["r_sum"]) == (pytest.approx(37.8 - 5.4), pytest.approx(5.4))
+
+
 def test_setback_of_a_facade_selects_its_top_and_bottom_edges(write):
     r = run(write, "Lot --> extrude(10) comp(f){ front : F }\n"
                    "F --> setback(1){ top : A | bottom : B | remainder : R }\n" + AREA_REPORTS, [rect(30, 20)])
