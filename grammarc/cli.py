@@ -27,7 +27,7 @@ from pathlib import Path
 from grammarc import __version__
 from grammarc.constants import LIMITS, PARTITION_SIZE
 from grammarc.diagnostics import render_all
-from grammarc.errors import GrammarcError, GrammarError, raise_stopped, stopped
+from grammarc.errors import GrammarcError, GrammarError, UsageError, raise_stopped, stopped
 
 _START_HELP = ("the start rule (default: @StartRule, else the first rule); a call `Lot(10, \"a\", true)` "
               "gives the arguments of a start rule with parameters")
@@ -432,7 +432,6 @@ def _render(args) -> int:
 
 
 def _lots(args) -> int:
-    from grammarc.errors import UsageError
     from grammarc.io.lots import read_lots
     from grammarc.io.output_paths import check_writable
 
@@ -458,7 +457,6 @@ def _lots(args) -> int:
 def _info(args) -> int:
     import json
 
-    from grammarc.errors import UsageError
     from grammarc.io.summary import READS, format_summary, summarize, what_file
 
     try:
@@ -492,7 +490,6 @@ class _ProgressBar:
 
 def _build_on_dask(args, options, bar):
     from grammarc.cluster import build_on_dask
-    from grammarc.errors import UsageError
     from grammarc.io import OutputOptions
     from grammarc.io.output_paths import check_writable
     from grammarc.io.shards import manifest_path, shards_folder
@@ -512,7 +509,6 @@ def _build_on_dask(args, options, bar):
 def _conform(args) -> int:
     from grammarc.backend.attributes import parse_override
     from grammarc.conform import kit_dir, load_reference, run_conformance
-    from grammarc.errors import UsageError
 
     reference = load_reference()
     if args.all:
