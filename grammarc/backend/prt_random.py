@@ -11,7 +11,7 @@ compares one draw with the running sums of its percentages. Which shape draws wh
   rule evaluates them;
 - a shape made by the rule (a successor, or the copy that ``[`` pushes) starts from
   ``(4096 x + 339068) mod 714025`` of its parent's state ``x``, and the parent's state advances by one
-  draw: the child starts where the parent's draw lands, plus 188179;
+  draw: the child starts where the parent's draw lands, plus 188179 (``NIL`` moves the parent on too);
 - the pieces of a split, a component split or a setback are made the same way, one after the other in the
   order PRT makes them (split order; for ``comp`` the order of the faces; for ``setback`` the edge pieces
   before the remainder, pieces that come out empty make none), and each piece spends one draw before its
@@ -20,7 +20,8 @@ compares one draw with the running sums of its percentages. Which shape draws wh
   ``(seed + h(name)) mod 714025`` where ``h`` is a hash of the attribute's name that is not identified
   (``h`` is a string hash whose last character moves it by about 64 per code point).
 
-Operations that make no shape (``extrude``, ``t``, ``s``, ``color``...) draw nothing. Everything here is
+Operations that make no shape (``extrude``, ``t``, ``s``, ``i``, ``color``, ``texture``, ``set``...) draw
+nothing; ``listRandom`` (and ``fileRandom`` over ``fileSearch``) is one draw, item ``floor(u (n - 1e-7))``. Everything here is
 closed form over batches: ``k`` draws at once are ``x -> A_k x + C_k`` with the powers tabulated once.
 """
 
