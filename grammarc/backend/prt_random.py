@@ -3,8 +3,9 @@
 Every shape owns a linear congruential generator, the one of Numerical Recipes' table of quick
 generators: ``x <- (4096 x + 150889) mod 714025``. A draw advances the state and returns
 ``float32(x) / float32(714024)`` (a float32, so 1.0 is possible); ``rand(lo, hi)`` is
-``lo + (hi - lo) * u`` in float64, ``p(q)`` is ``u < q`` and a stochastic case ``30%: A 20%: B else: C``
-compares one draw with the running sums of its percentages. Which shape draws what, in PRT's order:
+``lo + (hi - lo) * u`` in float64 and ``p(q)`` is ``u < q``; a two-way stochastic case ``20%: A else: B``
+is compiled to ``p(0.2)`` (how CityEngine's compiler turns three or more percentages into draws is not
+known: compiled rules with them were not at hand). Which shape draws what, in PRT's order:
 
 - a start shape's state is its ``seed`` taken as an unsigned 32-bit integer (seed -1 is 2**32 - 1);
 - each ``rand``, ``p`` or stochastic case evaluated on a shape is one draw of that shape, in the order the
@@ -21,8 +22,8 @@ compares one draw with the running sums of its percentages. Which shape draws wh
   (``h`` is a string hash whose last character moves it by about 64 per code point).
 
 Operations that make no shape (``extrude``, ``t``, ``s``, ``i``, ``color``, ``texture``, ``set``...) draw
-nothing; ``listRandom`` (and ``fileRandom`` over ``fileSearch``) is one draw, item ``floor(u (n - 1e-7))``. Everything here is
-closed form over batches: ``k`` draws at once are ``x -> A_k x + C_k`` with the powers tabulated once.
+nothing; ``listRandom`` (and ``fileRandom`` over ``fileSearch``) is one draw, item ``floor(u (n - 1e-7))``.
+Everything here is closed form over batches: ``k`` draws at once are ``x -> A_k x + C_k``.
 """
 
 from __future__ import annotations
