@@ -1,0 +1,113 @@
+"""CityEngine's random stream as Esri's Procedural Runtime (PRT) draws it, measured against PRT.
+
+Every shape owns a linear congruential generator, the one of Numerical Recipes' table of quick
+generators: ``x <- (4096 x + 150889) mod 714025``. A draw advances the state and returns
+``float32(x) / float32(714024)`` (a float32, so 1.0 is possible); ``rand(lo, hi)`` is
+``lo + (hi - lo) * u`` in float64 and ``p(q)`` is ``u < q``; a two-way stochastic case ``20%: A else: B``
+is compiled to ``p(0.2)`` (how CityEngine's compiler turns three or more percentages into draws is not
+known: compiled rules with them were not at hand). Which shape draws what, in PRT's order:
+
+- a start shape's state is its ``seed`` taken as an unsigned 32-bit integer (seed -1 is 2**32 - 1);
+- each ``rand``, ``p`` or stochastic case evaluated on a shape is one draw of that shape, in the order the
+  rule evaluates them;
+- a shape made by the rule (a successor, or the copy that ``[`` pushes) starts from
+  ``(4096 x + 339068) mod 714025`` of its parent's state ``x``, and the parent's state advances by one
+  draw: the child starts where the parent's draw lands, plus 188179 (``NIL`` moves the parent on too);
+- the pieces of a split, a component split or a setback are made the same way, one after the other in the
+  order PRT makes them (split order; for ``comp`` the order of the faces; for ``setback`` the edge pieces
+  before the remainder, pieces that come out empty make none), and each piece spends one draw before its
+  operations run;
+- an attribute's default expression draws from its own stream, started at
+  ``(seed + h(name)) mod 714025`` where ``h`` is a hash of the attribute's name that is not identified
+  (``h`` is a string hash whose last character moves it by about 64 per code point).
+
+Operations that make no shape (``extrude``, ``t``, ``s``, ``i``, ``color``, ``texture``, ``set``...) draw
+nothing; ``listRandom`` (and ``fileRandom`` over ``fileSearch``) is one draw, item ``floor(u (n - 1e-7))``.
+Everything here is closed form over batches: ``k`` draws at once are ``x -> A_k x + C_k``.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+MODULUS = 714025
+MULTIPLIER = 4096
+INCREMENT = 150889
+CHILD_INCREMENT = 339068  # INCREMENT + 188179: a child starts 188179 after its parent's draw
+
+
+def start_states(seed: np.ndarray) -> np.ndarray:
+    """The states (n,) int64 of start shapes whose ``seed`` attributes are ``seed`` (n,) integers."""
+    return (np.asarray(seed, dtype=np.int64) & 0xFFFFFFFF) % MODULUS
+
+
+def jump(k: int) -> tuple[int, int]:
+    """``(A_k, C_k)``: ``k`` draws take a state ``x`` to ``(A_k x + C_k) mod 714025``."""
+    return pow(MULTIPLIER, k, MODULUS), INCREMENT * _geometric(k) % MODULUS
+
+
+def _geometric(k: int) -> int:
+    """``1 + 4096 + ... + 4096**(k-1)`` mod 714025, by halving (no inverse: 4095 and 714025 share 5)."""
+    if k == 0:
+        return 0
+    if k % 2:
+        return (1 + MULTIPLIER * _geometric(k - 1)) % MODULUS
+    half = _geometric(k // 2)
+    return half * (1 + pow(MULTIPLIER, k // 2, MODULUS)) % MODULUS
+
+
+def advance(state: np.ndarray, k: np.ndarray | int) -> np.ndarray:
+    """The states (n,) int64 after ``k`` draws (scalar or (n,) non-negative integers) from ``state`` (n,)."""
+    state = np.asarray(state, dtype=np.int64)
+    k = np.broadcast_to(np.asarray(k, dtype=np.int64), state.shape)
+    out = np.empty_like(state)
+    for steps in np.unique(k):  # one pass per distinct count, not per shape
+        mul, add = jump(int(steps))
+        sel = k == steps
+        out[sel] = (mul * state[sel] + add) % MODULUS
+    return out
+
+
+def uniform(state: np.ndarray) -> np.ndarray:
+    """The value (n,) float64 of a draw that landed on ``state`` (n,): float32(x) / float32(714024)."""
+    return (np.asarray(state).astype(np.float32) / np.float32(MODULUS - 1)).astype(np.float64)
+
+
+def draw(state: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """One draw per shape: the advanced states (n,) int64 and the values (n,) float64 in [0, 1]."""
+    state = advance(state, 1)
+    return state, uniform(state)
+
+
+def child(state: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """A shape made by the rule from parents in ``state`` (n,): the child's states and the parents'."""
+    state = np.asarray(state, dtype=np.int64)
+    return (MULTIPLIER * state + CHILD_INCREMENT) % MODULUS, advance(state, 1)
+
+
+def pieces(state: np.ndarray, count: np.ndarray | int) -> tuple[np.ndarray, np.ndarray]:
+    """The pieces of a split made from parents in ``state`` (n,), ``count`` (scalar or (n,)) per parent.
+
+    A split ends its shape's operations, so the parent's own state after it is never read again.
+
+    Returns
+    -------
+    piece_state : (sum of counts,) int64
+        Each piece's state when its operations start (after the draw every piece spends), parent by
+        parent, pieces in order.
+    parent : (sum of counts,) int64
+        The index of each piece's parent.
+    """
+    state = np.asarray(state, dtype=np.int64)
+    count = np.broadcast_to(np.asarray(count, dtype=np.int64), state.shape)
+    parent = np.repeat(np.arange(len(state)), count)
+    starts = np.cumsum(count) - count
+    index = np.arange(len(parent)) - np.repeat(starts, count)
+    made, _ = child(advance(state[parent], index))
+    return advance(made, 1), parent
+
+
+def rand(u: np.ndarray, lo, hi) -> np.ndarray:
+    """``rand(lo, hi)`` from draws ``u`` (n,) float64: ``lo + (hi - lo) * u`` as PRT computes it."""
+    lo = np.asarray(lo, dtype=np.float64)
+    return lo + (np.asarray(hi, dtype=np.float64) - lo) * u
