@@ -85,26 +85,14 @@ def child(state: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return (MULTIPLIER * state + CHILD_INCREMENT) % MODULUS, advance(state, 1)
 
 
-def pieces(state: np.ndarray, count: np.ndarray | int) -> tuple[np.ndarray, np.ndarray]:
-    """The pieces of a split made from parents in ``state`` (n,), ``count`` (scalar or (n,)) per parent.
-
-    A split ends its shape's operations, so the parent's own state after it is never read again.
-
-    Returns
-    -------
-    piece_state : (sum of counts,) int64
-        Each piece's state when its operations start (after the draw every piece spends), parent by
-        parent, pieces in order.
-    parent : (sum of counts,) int64
-        The index of each piece's parent.
-    """
-    state = np.asarray(state, dtype=np.int64)
-    count = np.broadcast_to(np.asarray(count, dtype=np.int64), state.shape)
-    parent = np.repeat(np.arange(len(state)), count)
-    starts = np.cumsum(count) - count
-    index = np.arange(len(parent)) - np.repeat(starts, count)
-    made, _ = child(advance(state[parent], index))
-    return advance(made, 1), parent
+def pieces(state: np.ndarray, index: np.ndarray | int) -> np.ndarray:
+    """The states (m,) int64 of pieces of a split, a component split or a setback when their operations
+    start: ``state`` (m,) each piece's parent's state before the operation, ``index`` (scalar or (m,)) its
+    number among the parent's pieces. Piece ``i`` starts where the parent's stream stands after the ``i``
+    pieces before it, and spends one draw. A split ends its shape's operations, so the parent's own state
+    after it is never read again."""
+    made, _ = child(advance(state, index))
+    return advance(made, 1)
 
 
 def rand(u: np.ndarray, lo, hi) -> np.ndarray:

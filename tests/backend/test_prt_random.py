@@ -75,15 +75,14 @@ def test_rand_is_lo_plus_range_times_the_float32_draw():
 
 def test_split_pieces_are_seeded_in_order_and_spend_one_draw():
     seeds = _seeds(SPLIT3)
-    piece, parent = pr.pieces(pr.start_states(seeds), 3)
-    assert parent.tolist() == [0, 0, 0, 1, 1, 1]
+    piece = pr.pieces(np.repeat(pr.start_states(seeds), 3), np.tile(np.arange(3), 2))
     got = _first_draw_of_successor(piece).reshape(2, 3)
     assert np.array_equal(got, np.array(list(SPLIT3.values())))
 
 
 def test_component_split_seeds_its_faces_like_split_pieces():
     seeds = _seeds(COMP)
-    piece, _ = pr.pieces(pr.start_states(seeds), 5)  # front, three sides, top: the unselected bottom makes none
+    piece = pr.pieces(np.repeat(pr.start_states(seeds), 5), np.tile(np.arange(5), 2))  # front, three sides, top: the unselected bottom makes none
     got = _first_draw_of_successor(piece).reshape(2, 5)
     for row, (front, sides, top) in zip(got, COMP.values()):
         assert row[0] == front[0] and row[4] == top[0]
