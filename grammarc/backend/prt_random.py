@@ -23,12 +23,14 @@ known: compiled rules with them were not at hand). Which shape draws what, in PR
 
 Operations that make no shape (``extrude``, ``t``, ``s``, ``i``, ``color``, ``texture``, ``set``...) draw
 nothing; ``listRandom`` (and ``fileRandom`` over ``fileSearch``) is one draw, item ``floor(u (n - 1e-7))``.
-Everything here is closed form over batches: ``k`` draws at once are ``x -> A_k x + C_k``.
+Everything here is closed form over batches: ``k`` draws at once are ``x -> A_k x + C_k``. The kernels at
+the end work on a derivation's key columns (uint64 states) in one pass each (``backend.streams``).
 """
 
 from __future__ import annotations
 
 import numpy as np
+from numba import njit
 
 MODULUS = 714025
 MULTIPLIER = 4096
@@ -59,13 +61,10 @@ def _geometric(k: int) -> int:
 def advance(state: np.ndarray, k: np.ndarray | int) -> np.ndarray:
     """The states (n,) int64 after ``k`` draws (scalar or (n,) non-negative integers) from ``state`` (n,)."""
     state = np.asarray(state, dtype=np.int64)
-    k = np.broadcast_to(np.asarray(k, dtype=np.int64), state.shape)
-    out = np.empty_like(state)
-    for steps in np.unique(k):  # one pass per distinct count, not per shape
-        mul, add = jump(int(steps))
-        sel = k == steps
-        out[sel] = (mul * state[sel] + add) % MODULUS
-    return out
+    if np.ndim(k) == 0:
+        mul, add = jump(int(k))
+        return (mul * state + add) % MODULUS
+    return _advanced(state.astype(np.uint64), np.asarray(k, dtype=np.int64)).astype(np.int64)
 
 
 def uniform(state: np.ndarray) -> np.ndarray:
@@ -91,11 +90,73 @@ def pieces(state: np.ndarray, index: np.ndarray | int) -> np.ndarray:
     number among the parent's pieces. Piece ``i`` starts where the parent's stream stands after the ``i``
     pieces before it, and spends one draw. A split ends its shape's operations, so the parent's own state
     after it is never read again."""
-    made, _ = child(advance(state, index))
-    return advance(made, 1)
+    state = np.asarray(state, dtype=np.int64)
+    index = np.broadcast_to(np.asarray(index, dtype=np.int64), state.shape)
+    return piece_states(state.astype(np.uint64), np.ascontiguousarray(index)).astype(np.int64)
 
 
 def rand(u: np.ndarray, lo, hi) -> np.ndarray:
     """``rand(lo, hi)`` from draws ``u`` (n,) float64: ``lo + (hi - lo) * u`` as PRT computes it."""
     lo = np.asarray(lo, dtype=np.float64)
     return lo + (np.asarray(hi, dtype=np.float64) - lo) * u
+
+
+# ------------------------------------------------------------------------------------- kernels on key columns
+
+
+@njit(cache=True, nogil=True)
+def _jumps(k_max):
+    """``(A_k, C_k)`` (k_max + 1,) uint64 each, for k = 0 .. k_max."""
+    mul = np.empty(k_max + 1, np.uint64)
+    add = np.empty(k_max + 1, np.uint64)
+    mul[0], add[0] = 1, 0
+    for k in range(k_max):
+        mul[k + 1] = mul[k] * np.uint64(MULTIPLIER) % np.uint64(MODULUS)
+        add[k + 1] = (add[k] * np.uint64(MULTIPLIER) + np.uint64(INCREMENT)) % np.uint64(MODULUS)
+    return mul, add
+
+
+@njit(cache=True, nogil=True)
+def _advanced(state, k):
+    """The states (n,) uint64 after ``k`` (n,) int64 draws from ``state`` (n,) uint64."""
+    mul, add = _jumps(k.max() if len(k) else 0)
+    out = np.empty_like(state)
+    for i in range(len(state)):
+        out[i] = (mul[k[i]] * state[i] + add[k[i]]) % np.uint64(MODULUS)
+    return out
+
+
+@njit(cache=True, nogil=True)
+def piece_states(state, index):
+    """``pieces`` on uint64 states (m,) and int64 numbers (m,): the pieces' states (m,) uint64."""
+    mul, add = _jumps(index.max() if len(index) else 0)
+    out = np.empty_like(state)
+    for i in range(len(state)):
+        x = (mul[index[i]] * state[i] + add[index[i]]) % np.uint64(MODULUS)
+        x = (np.uint64(MULTIPLIER) * x + np.uint64(CHILD_INCREMENT)) % np.uint64(MODULUS)
+        out[i] = (np.uint64(MULTIPLIER) * x + np.uint64(INCREMENT)) % np.uint64(MODULUS)
+    return out
+
+
+@njit(cache=True, nogil=True)
+def draw_in_place(state):
+    """One draw per shape from the states ``state`` (n,) uint64, which it advances in place: the values (n,)
+    float64, as ``draw`` gives them."""
+    out = np.empty(len(state))
+    for i in range(len(state)):
+        x = (np.uint64(MULTIPLIER) * state[i] + np.uint64(INCREMENT)) % np.uint64(MODULUS)
+        state[i] = x
+        out[i] = np.float32(x) / np.float32(MODULUS - 1)
+    return out
+
+
+@njit(cache=True, nogil=True)
+def child_in_place(state):
+    """``child`` of the states ``state`` (n,) uint64: the children's states (n,) uint64; the parents' move
+    on in place."""
+    made = np.empty_like(state)
+    for i in range(len(state)):
+        x = state[i]
+        made[i] = (np.uint64(MULTIPLIER) * x + np.uint64(CHILD_INCREMENT)) % np.uint64(MODULUS)
+        state[i] = (np.uint64(MULTIPLIER) * x + np.uint64(INCREMENT)) % np.uint64(MODULUS)
+    return made

@@ -58,9 +58,7 @@ def draw(sequential: bool, key: np.ndarray, site: int) -> np.ndarray:
     """One draw per shape (n,) float64 in [0, 1]; a sequential draw advances ``key`` (n,) in place."""
     if not sequential:
         return random.uniform(key, site)
-    state, u = prt.draw(key.astype(np.int64))
-    key[:] = state
-    return u
+    return prt.draw_in_place(key)
 
 
 def successor_keys(sequential: bool, key: np.ndarray, site: int) -> np.ndarray:
@@ -68,9 +66,7 @@ def successor_keys(sequential: bool, key: np.ndarray, site: int) -> np.ndarray:
     parent moves one draw on, in place."""
     if not sequential:
         return random.child_keys(key, site)
-    made, moved = prt.child(key.astype(np.int64))
-    key[:] = moved
-    return made.astype(np.uint64)
+    return prt.child_in_place(key)
 
 
 def bracket(sequential: bool, key: np.ndarray) -> np.ndarray | None:
@@ -79,15 +75,16 @@ def bracket(sequential: bool, key: np.ndarray) -> np.ndarray | None:
     None for the counter-based copy, which keeps its parent's key."""
     if not sequential:
         return None
-    made, moved = prt.child(key.astype(np.int64))
+    made = prt.child_in_place(key)
+    moved = key.copy()
     key[:] = made
-    return moved.astype(np.uint64)
+    return moved
 
 
 def skip(sequential: bool, key: np.ndarray) -> None:
     """``NIL``: a sequential shape's state moves one draw on, as PRT's does, in place."""
     if sequential:
-        key[:] = prt.advance(key.astype(np.int64), 1)
+        prt.draw_in_place(key)
 
 
 def piece_keys(sequential: bool, parent_key: np.ndarray, index: np.ndarray, site: int) -> np.ndarray:
@@ -97,7 +94,7 @@ def piece_keys(sequential: bool, parent_key: np.ndarray, index: np.ndarray, site
     starts where its parent's stream stands after the pieces before it, and spends one draw."""
     if not sequential:
         return random.child_keys(parent_key, site, index)
-    return prt.pieces(parent_key.astype(np.int64), index).astype(np.uint64)
+    return prt.piece_states(np.ascontiguousarray(parent_key), np.ascontiguousarray(index, dtype=np.int64))
 
 
 def remade_keys(sequential: bool, key: np.ndarray) -> np.ndarray:
