@@ -18,8 +18,13 @@ known: compiled rules with them were not at hand). Which shape draws what, in PR
   before the remainder, pieces that come out empty make none), and each piece spends one draw before its
   operations run;
 - an attribute's default expression draws from its own stream, started at
-  ``(seed + h(name)) mod 714025`` where ``h`` is a hash of the attribute's name that is not identified
-  (``h`` is a string hash whose last character moves it by about 64 per code point).
+  ``(seed mod 714025 + h(name)) mod 714025`` (the seed again as an unsigned 32-bit integer), where ``h``
+  is a hash of the attribute's name as the compiled rule spells it (``Default$floorHeight``: 673492,
+  ``Default$nFloor``: 207149) that is not identified. It is none of Java's ``String.hashCode``, FNV-1 and
+  FNV-1a (32 and 64 bits), djb2, sdbm, CRC-32, Adler-32, libstdc++'s ``std::hash`` (murmur2) or boost's
+  ``hash_range``, on UTF-8 or UTF-16, reduced modulo 714025 or 2**32 first, signed or not: the last
+  character moves it by about 64 per code point with jumps (an exclusive or), the one before by about 64
+  times as much, and no polynomial hash of base 1 to 93 gives it.
 
 Operations that make no shape (``extrude``, ``t``, ``s``, ``i``, ``color``, ``texture``, ``set``...) draw
 nothing; ``listRandom`` (and ``fileRandom`` over ``fileSearch``) is one draw, item ``floor(u (n - 1e-7))``.

@@ -25,8 +25,14 @@ EXTRUSION = {0: 0.2728087604045868, 1: 0.7694881558418274, 2: 0.2661661207675934
              -2: 0.6614217162132263, 2147483647: 0.9671159386634827, 123456789: 0.223579317331314}
 P_BRACKETS = {0: (0.21132202446460724, 0.21132203936576843), 1: (0.21705852448940277, 0.21705853939056396),
               2: (0.2227950394153595, 0.2227950543165207), 499: (0.07383224368095398, 0.07383225858211517)}
-FLOOR_HEIGHT = {0: 4.694018661975861, 1: 4.6997551918029785, 2: 4.705491721630096, 1999: 4.161269083619118}
+FLOOR_HEIGHT = {0: 4.694018661975861, 1: 4.6997551918029785, 2: 4.705491721630096, 1999: 4.161269083619118,
+                65536: 4.640877604484558, 714024: 4.6882821917533875, 2147483647: 4.364109605550766,
+                -1: 4.039937034249306}
 FLOOR_HEIGHT_OFFSET = 673492  # h("floorHeight") measured: the attribute's stream starts at seed + 673492
+# reporting's nFloor = ceil(rand(1, 15) * buildingHeightFactor) with buildingHeightFactor 1e6: the draw to 1e-6
+N_FLOOR = {0: 8283932.0, 1: 8364243.0, 1999: 14825457.0, 65536: 7539957.0, 714024: 8203621.0,
+           2147483647: 3665205.0, -1: 13126808.0}
+N_FLOOR_OFFSET = 207149
 SPLIT3 = {0: [0.30774736404418945, 0.0696377158164978, 0.773905336856842],
           1: [0.9342402815818787, 0.1811549812555313, 0.547961950302124]}
 COMP = {0: ([0.30774736404418945], [0.0696377158164978, 0.4501333236694336, 0.773905336856842],
@@ -63,8 +69,14 @@ def test_start_shape_draws_the_p_of_reporting_first():
 
 def test_attribute_streams_start_at_seed_plus_the_name_hash():
     seeds = _seeds(FLOOR_HEIGHT)
-    _, u = pr.draw(pr.start_states(seeds + FLOOR_HEIGHT_OFFSET))
+    _, u = pr.draw((pr.start_states(seeds) + FLOOR_HEIGHT_OFFSET) % pr.MODULUS)
     assert np.array_equal(pr.rand(u, 4.0, 5.0), np.array(list(FLOOR_HEIGHT.values())))
+
+
+def test_attribute_streams_take_the_seed_as_an_unsigned_32_bit_integer():
+    seeds = _seeds(N_FLOOR)
+    _, u = pr.draw((pr.start_states(seeds) + N_FLOOR_OFFSET) % pr.MODULUS)
+    assert np.array_equal(np.ceil(pr.rand(u, 1.0, 15.0) * 1e6), np.array(list(N_FLOOR.values())))
 
 
 def test_rand_is_lo_plus_range_times_the_float32_draw():
