@@ -244,8 +244,9 @@ def _random_lots(package: Package, lots, record: dict, n: int) -> np.ndarray:
 
     random = np.zeros(n, bool)
     for step in range(1, 8):
+        # far apart: PRT's streams of near seeds start a few steps apart and draw almost the same numbers
         moved = lots if "seed" not in lots.attrs else replace(
-            lots, attrs={**lots.attrs, "seed": lots.attrs["seed"] + step})
+            lots, attrs={**lots.attrs, "seed": lots.attrs["seed"] + step * 100_003})
         other = derive(package.grammar, moved, replace(package.options, seed=package.options.seed + step))
         random |= [not same_lot_records(lot_record(record, lot), lot_record(other, lot), geometry_only=True)
                    for lot in range(n)]
