@@ -3,7 +3,8 @@
 The Puuc paper reads its 20-30 parameters per building from GIS; so does grammarc. For each attribute, in
 declaration order, the value of a lot is: the ``--attr`` override if one was given (it holds for every
 lot), else the lot's property of the same name where the lot has one, else the default expression,
-evaluated on the lot's own shape (defaults may use earlier attributes, ``rand`` and ``Scope``).
+evaluated on the lot's own shape (defaults may use earlier attributes, ``rand`` and ``Scope``; in
+CityEngine's dialect a default draws from a stream of its own, as PRT's do: ``backend.streams``).
 A property of the wrong type (text for a numeric attribute) makes its lot bad, with the value named.
 
 An array attribute (``attr heights = [10, 20]``) is a column of ``backend.arrays.Arrays``, one array per
@@ -14,11 +15,13 @@ lot. A lot overrides it with a JSON array property (GeoJSON ``"heights": [10, 20
 from __future__ import annotations
 
 import json
+from dataclasses import replace
 
 import numpy as np
 
 from grammarc.backend.arrays import Arrays
 from grammarc.backend.evaluate import Env, evaluate, evaluate_array
+from grammarc.backend.streams import attribute_keys
 from grammarc.errors import LotFailure, UsageError
 from grammarc.ir import nodes as ir
 from grammarc.ir.traverse import iter_exprs
@@ -63,7 +66,9 @@ def attribute_columns(module: ir.Module, env: Env, lot_attrs: dict[str, np.ndarr
     """Fill ``env.chunk.attrs`` with one (L,) column per attribute; ``env.shapes`` are the lots' shapes."""
     columns = env.chunk.attrs
     n = len(env.shapes)
+    lots = env
     for attr in dependency_order(module.attrs):
+        env = _drawing(lots, attr.name)
         if attr.type.is_array:
             column = evaluate(attr.default, env)
             if attr.name in lot_attrs and not attr.const:
@@ -82,6 +87,14 @@ def attribute_columns(module: ir.Module, env: Env, lot_attrs: dict[str, np.ndarr
             column = _from_lots(attr, lot_attrs[attr.name], column.copy(), strings, env)
         columns[attr.name] = column
     return columns
+
+
+def _drawing(env: Env, name: str) -> Env:
+    """``env`` whose shapes draw from the stream of attribute ``name``'s default (``streams.attribute_keys``:
+    PRT's defaults draw from a stream of their own, not from the lot's)."""
+    if not env.plan.sequential_random:
+        return env
+    return replace(env, shapes=replace(env.shapes, key=attribute_keys(env.shapes.key, name)))
 
 
 def dependency_order(attrs: tuple[ir.AttrDecl, ...]) -> list[ir.AttrDecl]:

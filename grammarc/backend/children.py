@@ -20,6 +20,7 @@ from grammarc.backend.kernels import scope as scope_kernels
 from grammarc.backend.kernels.order import group_by
 from grammarc.backend.plan import Plan
 from grammarc.backend.shapes import Shapes
+from grammarc.backend.streams import piece_keys
 from grammarc.constants import TOL
 from grammarc.geometry.clip import clip_to_slabs
 from grammarc.geometry.components import rect_rings
@@ -49,6 +50,8 @@ def children(ctx: Context, shapes: Shapes, axis: int, parent, index, pos, length
         origin[rows] = shapes.origin[parents[rows]] + np.einsum("ni,nij->nj", low[rows], axes)
         size[rows] = extent[rows]
         geom[rows] = piece_geom[rows]
+    if ctx.plan.sequential_random:  # PRT's stream: the child's state from its parent's and its number
+        key = piece_keys(True, shapes.key[parents], index[order], site)
     made = Shapes(origin, size, frame, geom, lot, key, depth, tuple(p[parents] for p in shapes.params),
                   tuple(d[parents] for d in shapes.dynamic))
     return with_context(ctx.plan, made, "split", index[order], parents, len(shapes))

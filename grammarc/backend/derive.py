@@ -23,7 +23,6 @@ from grammarc.backend.materials import MAP_FIELDS, collect_materials
 from grammarc.backend.occlusion import Occluders
 from grammarc.backend.pivot import initial_column as initial_pivot
 from grammarc.backend.plan import Plan
-from grammarc.backend.random import lot_keys
 from grammarc.backend.report_rows import aggregate_chunk
 from grammarc.backend.shapes import Shapes
 from grammarc.backend.slots import (
@@ -36,6 +35,7 @@ from grammarc.backend.slots import (
     TRIM_SWITCH,
     WHITE_RGB,
 )
+from grammarc.backend.streams import lot_keys
 from grammarc.backend.texture_space import initial_column
 from grammarc.constants import Limits
 from grammarc.geometry.footprint import footprint_polygons, lot_scopes
@@ -46,8 +46,10 @@ from grammarc.model.records import LotOrigins, MeshChunk, TerminalChunk
 from grammarc.ragged import ragged_take
 
 
-def initial_chunk(lots: Lots, seed: int, foreign: Occluders | None = None) -> tuple[Chunk, Shapes]:
-    """The chunk state and initial shapes (one per lot) of ``lots``, their random keys from ``seed``;
+def initial_chunk(lots: Lots, seed: int, foreign: Occluders | None = None,
+                  sequential: bool = False) -> tuple[Chunk, Shapes]:
+    """The chunk state and initial shapes (one per lot) of ``lots``, their random keys from ``seed`` (and
+    the lots' ``seed`` properties where they draw from a ``sequential`` stream, ``backend.streams``);
     ``foreign`` the occluders of every lot from a first pass (``derive_chunk``)."""
     origin, axes, size, local = lot_scopes(lots)
     is_rect, coords, ring_offsets, poly_offsets = footprint_polygons(lots, size, local)
@@ -56,13 +58,13 @@ def initial_chunk(lots: Lots, seed: int, foreign: Occluders | None = None) -> tu
     geom = np.full(len(lots), -1, dtype=np.int32)
     geom[~is_rect] = polygons.add(coords, ring_offsets, poly_offsets,
                                   np.ones(int((~is_rect).sum()), dtype=np.int8))
-    key = lot_keys(seed, lots.index)
+    key = lot_keys(sequential, seed, lots.index, lots.attrs.get("seed"))
     chunk = Chunk(lot_index=lots.index, lot_ids=lots.ids, lot_key=key, attrs={}, lot_origin=origin, lot_axes=axes,
                   streets=lot_streets(lots.vertices, lots.ring_offsets, lots.lot_offsets, lots.street, axes),
                   frames=frames, polygons=polygons, foreign=foreign)
     n = len(lots)
-    shapes = Shapes(origin, size, frames.add(axes), geom, np.arange(n, dtype=np.int32), key,
-                    np.zeros(n, dtype=np.int32))
+    shapes = Shapes(origin, size, frames.add(axes), geom, np.arange(n, dtype=np.int32), key.copy(),
+                    np.zeros(n, dtype=np.int32))  # a sequential stream's draws advance the copy
     chunk.lot_shapes = (shapes.size, shapes.frame, shapes.geom)
     return chunk, shapes
 
@@ -78,7 +80,7 @@ def derive_chunk(plan: Plan, lots: Lots, *, seed: int, limits: Limits, overrides
 
     Raises ``LotFailure`` naming lots to skip (a limit reached among them), or ``ChunkTooLarge``.
     """
-    chunk, shapes = initial_chunk(lots, seed, foreign)
+    chunk, shapes = initial_chunk(lots, seed, foreign, plan.sequential_random)
     attribute_columns(plan.grammar.module, Env(shapes, chunk, plan), lots.attrs, overrides, plan.strings)
     shapes = replace(shapes, dynamic=tuple(initial_dynamic(plan, name, chunk, shapes) for name in plan.dynamic))
     ctx = Context(plan, chunk, limits, chunk_budget)

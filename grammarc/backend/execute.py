@@ -24,8 +24,8 @@ from grammarc.backend.operations.scope import center
 from grammarc.backend.operations.table import check_writes
 from grammarc.backend.pivot import aligned, sets_pivot
 from grammarc.backend.plan import SymbolPlan
-from grammarc.backend.random import uniform
 from grammarc.backend.shapes import Shapes
+from grammarc.backend.streams import bracket, draw
 from grammarc.constants import STRICT, TOL
 from grammarc.ir import nodes as ir
 from grammarc.ragged import rank_within
@@ -98,8 +98,8 @@ def apply_rule(ctx: Context, rule: ir.Rule, shapes: Shapes) -> None:
     if bad.any():
         ctx.fail(shapes, bad, "probabilities do not sum to 1", rule.span)
     cumulative = np.cumsum(probs, axis=1)
-    draw = uniform(shapes.key, rule.site)
-    choice = np.minimum((draw[:, None] >= cumulative).sum(axis=1), len(alts) - 1)
+    u = draw(ctx.plan.sequential_random, shapes.key, rule.site)
+    choice = np.minimum((u[:, None] >= cumulative).sum(axis=1), len(alts) - 1)
     for i, alt in enumerate(alts):
         picked = shapes.take(choice == i)
         if len(picked):
@@ -116,12 +116,16 @@ def run(ctx: Context, body: ir.Body, cursor: Shapes, leaf_at_end: bool = False) 
     base = (cursor.origin, cursor.size, cursor.frame)  # what `center` centres on
     for op in body:
         if isinstance(op, ir.Push):
-            # the whole shape: its scope, its geometry and the attributes `set` gives it
-            stack.append((cursor, base))
+            # the whole shape: its scope, its geometry and the attributes `set` gives it; with PRT's
+            # stream, the copy is a new shape whose state is a child's (in place: the batch stays the
+            # object it was) and the shape that waits for `]` has moved on
+            stack.append((cursor, base, bracket(ctx.plan.sequential_random, cursor.key)))
             base = (cursor.origin, cursor.size, cursor.frame)
         elif isinstance(op, ir.Pop):
             if stack:
-                cursor, base = stack.pop()
+                cursor, base, waiting = stack.pop()
+                if waiting is not None:
+                    cursor.key[:] = waiting
         elif not len(cursor):
             if not stack:
                 return

@@ -107,6 +107,9 @@ class Plan:
     #: ``load_asset(name, asset_roots) -> AssetMesh``: how trimmed inserts get their asset's triangles
     #: (the model's loader, or a test's stand-in).
     load_asset: Callable = load_asset
+    #: CityEngine semantics: shapes draw from PRT's sequential stream, not from counter-based keys
+    #: (``backend.streams``).
+    sequential_random: bool = False
 
     @property
     def symbol_names(self) -> tuple[str, ...]:
@@ -168,6 +171,7 @@ def make_plan(grammar: Grammar, *, load_asset: Callable = load_asset) -> Plan:
     plan = Plan(
         grammar=grammar, symbols=tuple(symbols), symbol_ids=ids, start=ids[grammar.graph.start], strings=strings,
         stages=stages, dynamic=dynamic, leaf_bodies=module.dialect == "cityengine", not_applied=not_applied,
+        sequential_random=module.dialect == "cityengine",
         asset_of_string=asset_of_string, queries=frozenset(occlusion),
         inter=any(e.target != "intra" for found in occlusion.values() for e in found),
         snapping=frozenset(s.id for s in symbols if any(getattr(op, "snap", False) for rule in s.rules

@@ -19,7 +19,7 @@ import numpy as np
 
 from grammarc.backend.functions.strings import string_arrays
 from grammarc.backend.functions.table import distinct, function, groups
-from grammarc.backend.random import uniform
+from grammarc.backend.streams import draw
 from grammarc.ir.asset_names import resolve_asset
 from grammarc.ir.file_search import search
 
@@ -45,7 +45,7 @@ def pick(choices: Callable[[tuple[int, ...], np.ndarray], np.ndarray], keys: lis
     ((k, c) or (1, c) int32, a row's candidates first and -1 after them where a shape has fewer); a shape
     picks uniformly among its own, ``""`` when it has none."""
     n = len(env.shapes)
-    u = uniform(env.shapes.key, call.site)
+    u = draw(env.plan.sequential_random, env.shapes.key, call.site)
     out = np.full(n, env.plan.strings.intern(""), dtype=np.int32)
     for key, rows in groups(n, *keys):
         options = np.asarray(choices(key, rows))

@@ -24,7 +24,7 @@ import numpy as np
 
 from grammarc.backend.functions.strings import count, find, find_last, on_texts, prefix, substring, texts
 from grammarc.backend.functions.table import function
-from grammarc.backend.random import uniform
+from grammarc.backend.streams import draw
 
 if TYPE_CHECKING:
     from grammarc.backend.env import Env
@@ -154,7 +154,7 @@ def list_random(call, args, env: Env):
     list), from the shape's stream at the call's site as ``rand`` draws. Each distinct list is cut into its
     items once; the items are gathered per shape by the drawn index."""
     strings, known = env.plan.strings, texts(env)
-    u = uniform(env.shapes.key, call.site)
+    u = draw(env.plan.sequential_random, env.shapes.key, call.site)
     lists, which = np.unique(np.broadcast_to(args[0], u.shape), return_inverse=True)
     items = [[strings.intern(item(known[text], k)) for k in range(size(known[text]))] for text in lists.tolist()]
     sizes = np.array([len(i) for i in items], dtype=np.int64)

@@ -12,7 +12,7 @@ import numpy as np
 from numba import njit
 
 from grammarc.backend.functions.table import function
-from grammarc.backend.random import uniform
+from grammarc.backend.streams import draw
 
 if TYPE_CHECKING:
     from grammarc.backend.env import Env
@@ -23,7 +23,7 @@ _MATH = {"sin": 0, "cos": 1, "tan": 2, "asin": 3, "acos": 4, "atan": 5, "exp": 6
 
 @function("rand")
 def rand(call, args, env: Env):
-    u = uniform(env.shapes.key, call.site)
+    u = draw(env.plan.sequential_random, env.shapes.key, call.site)
     if not args:
         return u
     low, high = (0.0, args[0]) if len(args) == 1 else args
@@ -32,7 +32,7 @@ def rand(call, args, env: Env):
 
 @function("p")
 def probability(call, args, env: Env):
-    return uniform(env.shapes.key, call.site) < np.asarray(args[0], dtype=np.float64)
+    return draw(env.plan.sequential_random, env.shapes.key, call.site) < np.asarray(args[0], dtype=np.float64)
 
 
 @function("isnan", "isinf")

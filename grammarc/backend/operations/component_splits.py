@@ -24,10 +24,10 @@ from grammarc.backend.occlusion import take_apart
 from grammarc.backend.operations.faces import offset_faces
 from grammarc.backend.operations.table import Parts, operation
 from grammarc.backend.outlines import flat_axis, polygons_of
-from grammarc.backend.random import child_keys
 from grammarc.backend.reframing import turned
 from grammarc.backend.selectors import classify_edges, classify_faces, index_masks, selector_frames
 from grammarc.backend.shapes import Shapes
+from grammarc.backend.streams import piece_keys
 from grammarc.constants import TOL
 from grammarc.geometry import components as comp_kernels
 from grammarc.geometry.meshes import is_mesh, is_polygon
@@ -105,6 +105,8 @@ def comp_faces(ctx: Context, cursor: Shapes, op: ir.CompFaces) -> Parts:
         which = classify_edges(direction, op.selectors, len(shapes), picked, roof)
     keep = which < len(op.selectors)
     shapes, which, parent = shapes.take(keep), which[keep], parent[keep]
+    if ctx.plan.sequential_random:  # PRT makes shapes of the selected faces only, numbered in face order
+        shapes = replace(shapes, key=piece_keys(True, cursor.key[parent], rank_within(parent), op.site))
     if {"comp.index", "comp.total", "comp.sel"} & set(ctx.plan.dynamic):
         # CityEngine numbers the components of each selector: the front face is 0 of 1
         group = parent * (len(op.selectors) + 1) + which
@@ -157,7 +159,8 @@ def components(ctx: Context, kind: int, cursor: Shapes, site: int, span, wanted=
     world_origin = child.origin + np.einsum("ni,nij->nj", origin, parent_axes)
     frame = chunk.frames.add(np.einsum("nij,njk->nik", axes, parent_axes))
     shapes = Shapes(world_origin, size, frame, geom.astype(np.int32), child.lot,
-                    child_keys(child.key, site, index), child.depth, child.params, child.dynamic)
+                    piece_keys(ctx.plan.sequential_random, child.key, index, site), child.depth, child.params,
+                    child.dynamic)
     return (with_context(ctx.plan, shapes, "comp", index, parent, len(cursor)), normal, index, parent, roof,
             border)
 

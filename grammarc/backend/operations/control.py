@@ -12,8 +12,8 @@ from grammarc.backend.context import Context
 from grammarc.backend.evaluate import evaluate_array
 from grammarc.backend.kernels.order import group_by
 from grammarc.backend.operations.table import Parts, operation
-from grammarc.backend.random import uniform
 from grammarc.backend.shapes import Shapes
+from grammarc.backend.streams import draw, draws
 from grammarc.ir import nodes as ir
 
 
@@ -23,15 +23,35 @@ def branch(ctx: Context, cursor: Shapes, op: ir.Case | ir.Stochastic) -> Parts:
     env = ctx.env(cursor)
     n = len(cursor)
     taken = np.full(n, len(op.branches), dtype=np.int64)
-    if isinstance(op, ir.Case):
+    sequential = ctx.plan.sequential_random
+    if isinstance(op, ir.Case) and sequential and any(draws(cond) for cond, _ in op.branches):
+        taken = _taken_in_order(ctx, cursor, op)
+    elif isinstance(op, ir.Case):
         for i in range(len(op.branches) - 1, -1, -1):
             holds = evaluate_array(op.branches[i][0], env, dtype=bool)
             taken[holds] = i
     else:
         percent = np.stack([evaluate_array(c, env) for c, _ in op.branches], axis=1)
         cumulative = np.cumsum(percent, axis=1) / 100.0
-        draw = uniform(cursor.key, op.site)
-        taken = (draw[:, None] >= cumulative).sum(axis=1)
+        u = draw(sequential, cursor.key, op.site)
+        taken = (u[:, None] >= cumulative).sum(axis=1)
     bodies = [body for _, body in op.branches] + [op.default]
     order, offsets = group_by(taken, len(bodies))
     return Parts(tuple(bodies), cursor.take(order), offsets)
+
+
+def _taken_in_order(ctx: Context, cursor: Shapes, op: ir.Case) -> np.ndarray:
+    """The branch (n,) int64 each shape takes, its conditions evaluated in order and each only on the
+    shapes no earlier one took, as PRT evaluates them: conditions that draw then draw only there, and the
+    draws they made stay in ``cursor.key``."""
+    taken = np.full(len(cursor), len(op.branches), dtype=np.int64)
+    open_rows = np.arange(len(cursor))
+    for i, (cond, _) in enumerate(op.branches):
+        if not len(open_rows):
+            break
+        undecided = cursor.take(open_rows)
+        holds = np.broadcast_to(evaluate_array(cond, ctx.env(undecided), dtype=bool), open_rows.shape)
+        cursor.key[open_rows] = undecided.key
+        taken[open_rows[holds]] = i
+        open_rows = open_rows[~holds]
+    return taken

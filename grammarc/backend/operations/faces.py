@@ -27,10 +27,10 @@ from grammarc.backend.evaluate import evaluate_array
 from grammarc.backend.kernels.order import group_by
 from grammarc.backend.operations.table import Parts, operation
 from grammarc.backend.outlines import flat_axis, polygons_of
-from grammarc.backend.random import child_keys
 from grammarc.backend.reframing import reframed, turned
 from grammarc.backend.selectors import classify_faces, selector_frames
 from grammarc.backend.shapes import COLUMNS, Shapes
+from grammarc.backend.streams import piece_keys, remade_keys
 from grammarc.constants import TOL
 from grammarc.geometry import components as comp_kernels
 from grammarc.geometry.clip import fit_pieces, scope_polygons
@@ -288,7 +288,7 @@ def _roof_offsets(ctx: Context, roofs: Shapes, op: ir.Offset) -> tuple[Shapes, n
                                            origin[face[order]], axes[face[order]])
     kept = np.bincount(parent[face], minlength=len(roofs)) > 0
     shapes = shapes.take(kept)
-    return replace(shapes, key=child_keys(shapes.key, 0, np.zeros(len(shapes), dtype=np.int64))), kept
+    return replace(shapes, key=remade_keys(ctx.plan.sequential_random, shapes.key)), kept
 
 
 @operation(ir.Footprint, writes=COLUMNS, meshes=True)
@@ -325,15 +325,15 @@ def _shape_each(ctx: Context, cursor: Shapes, pieces) -> Shapes:
     mesh of its several in one fitted scope."""
     several = np.bincount(pieces.source, minlength=len(cursor)) > 1
     if not several.any():
-        return _piece_shapes(ctx, cursor, pieces, 0)
+        return _piece_shapes(ctx, cursor, pieces, 0, remade=True)
     # a face the offset parts into pieces stays one shape: a mesh of the pieces in one fitted scope
     rows = np.flatnonzero(several)
     mine = several[pieces.source]
-    single = _piece_shapes(ctx, cursor, pieces.take(~mine), 0)
+    single = _piece_shapes(ctx, cursor, pieces.take(~mine), 0, remade=True)
     grouped = pieces.take(mine)
     grouped = replace(grouped, source=np.searchsorted(rows, grouped.source))
     meshes = mesh_shapes.piece_meshes(ctx.chunk, cursor.take(rows), grouped)
-    meshes = replace(meshes, key=child_keys(meshes.key, 0, np.zeros(len(rows), dtype=np.int64)))
+    meshes = replace(meshes, key=remade_keys(ctx.plan.sequential_random, meshes.key))
     return Shapes.merge([single, meshes], [pieces.source[~mine], rows])
 
 
@@ -620,8 +620,9 @@ def _faces_in_plane(cursor: Shapes, chunk) -> tuple[Shapes, np.ndarray]:
     return faces.with_scope(faces.origin, faces.size, faces.frame, face_geom), owner
 
 
-def _piece_shapes(ctx: Context, cursor: Shapes, pieces, site: int) -> Shapes:
-    """Shapes of clipped or offset pieces: the parent's frame, the piece's box and polygon."""
+def _piece_shapes(ctx: Context, cursor: Shapes, pieces, site: int, remade: bool = False) -> Shapes:
+    """Shapes of clipped or offset pieces: the parent's frame, the piece's box and polygon; the keys of
+    pieces made at ``site``, numbered per parent, or of a shape ``remade`` as its one piece."""
     chunk = ctx.chunk
     child = cursor.take(pieces.source)
     geom = np.full(len(pieces.source), -1, dtype=np.int32)
@@ -631,9 +632,11 @@ def _piece_shapes(ctx: Context, cursor: Shapes, pieces, site: int) -> Shapes:
         vertices, ring_offsets = ragged_take(pieces.ring_offsets, rings)
         geom[shaped] = chunk.polygons.add(pieces.coords[vertices], ring_offsets, poly_offsets, pieces.plane[shaped])
     origin = child.origin + np.einsum("ni,nij->nj", pieces.low, chunk.frames[child.frame])
-    index = rank_within(pieces.source)
-    return Shapes(origin, pieces.extent, child.frame, geom, child.lot,
-                  child_keys(child.key, site, index), child.depth, child.params, child.dynamic)
+    sequential = ctx.plan.sequential_random
+    key = remade_keys(sequential, child.key) if remade else piece_keys(sequential, child.key,
+                                                                         rank_within(pieces.source), site)
+    return Shapes(origin, pieces.extent, child.frame, geom, child.lot, key, child.depth, child.params,
+                  child.dynamic)
 
 
 def _regions(ctx: Context, op: ir.Setback | ir.SetbackToArea | ir.InnerRectangle, cursor: Shapes, regions: list, plane,
@@ -655,8 +658,13 @@ def _pieces_by_parent(ctx: Context, cursor: Shapes, pieces, sites) -> tuple[Shap
     each parent's pieces together in kind order, and each shape's kind."""
     shapes = Shapes.concat([_piece_shapes(ctx, cursor, p, site) for p, site in zip(pieces, sites)])
     kind = np.concatenate([np.full(len(p.source), k, dtype=np.int64) for k, p in enumerate(pieces)])
-    order = np.argsort(np.concatenate([p.source for p in pieces]), kind="stable")
-    return shapes.take(order), kind[order]
+    source = np.concatenate([p.source for p in pieces])
+    order = np.argsort(source, kind="stable")
+    shapes = shapes.take(order)
+    if ctx.plan.sequential_random:  # PRT numbers a parent's pieces over all kinds, in kind order
+        parent = source[order]
+        shapes = replace(shapes, key=piece_keys(True, cursor.key[parent], rank_within(parent), 0))
+    return shapes, kind[order]
 
 
 def _world_points(ctx: Context, cursor: Shapes, row: np.ndarray, plane: np.ndarray, points) -> tuple:

@@ -2,7 +2,8 @@
 that leave nothing (``ε``, ``NIL``, and those accepted without effect on the record).
 
 Reads: every column (a successor is the cursor's shape, one rule application deeper, with a new key and
-its own parameters). Writes: no column of the cursor.
+its own parameters). Writes: no column of the cursor, but for the state of a sequential stream, which a
+successor and ``NIL`` move on in place (``backend.streams``).
 """
 
 from __future__ import annotations
@@ -14,8 +15,8 @@ from grammarc.backend.context import Context
 from grammarc.backend.evaluate import evaluate_array
 from grammarc.backend.occlusion import add_occluders, occluder_label
 from grammarc.backend.operations.table import operation
-from grammarc.backend.random import child_keys
 from grammarc.backend.shapes import Shapes
+from grammarc.backend.streams import skip, successor_keys
 from grammarc.ir import nodes as ir
 
 
@@ -30,7 +31,8 @@ def successor(ctx: Context, cursor: Shapes, op: ir.Symbol) -> None:
         for arg, t in zip(op.args, sym.param_types)
     )
     shapes = Shapes(cursor.origin, cursor.size, cursor.frame, cursor.geom, cursor.lot,
-                    child_keys(cursor.key, op.site), cursor.depth + 1, params, cursor.dynamic)
+                    successor_keys(plan.sequential_random, cursor.key, op.site), cursor.depth + 1, params,
+                    cursor.dynamic)
     ctx.count(shapes, op.span)
     if sym.terminal or op.leaf:
         if plan.occluders:
@@ -43,4 +45,6 @@ def successor(ctx: Context, cursor: Shapes, op: ir.Symbol) -> None:
 @operation(ir.Empty, meshes=True, consumes=True)
 @operation(ir.NotApplied, meshes=True)
 def nothing(ctx: Context, cursor: Shapes, op: ir.Empty | ir.NotApplied) -> None:
-    """``ε``, ``NIL``, and operations without effect on the record."""
+    """``ε``, ``NIL``, and operations without effect on the record; ``NIL`` moves PRT's stream on."""
+    if isinstance(op, ir.Empty):
+        skip(ctx.plan.sequential_random, cursor.key)

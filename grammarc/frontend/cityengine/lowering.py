@@ -391,16 +391,19 @@ class Lowering(OperationLowering, LoweringBase):
 
     def value_stochastic(self, meta, *items):
         *pairs, default = [i for i in items if not (isinstance(i, Token) and i.type == "PERCENT_COLON")]
-        # p% : a  q% : b  else : c  ->  draw u once; u < p -> a, u < p + q -> b, else c
-        site = self.site()
-        u = ir.Call("rand", (), self.span(meta), site)
-        result, bounds, total = default, [], None
+        # p% : a  q% : b  else : c  ->  p(p / 100) ? a : p(q / 100 / (1 - p / 100)) ? b : c: one draw per
+        # percentage, in turn, each given that none before was taken (the frequencies stay p, q and the
+        # rest); a two-way one is p(p / 100), as PRT draws it
+        span = self.span(meta)
+        chances, before = [], None
         for i in range(0, len(pairs), 2):
             share = ir.Binary("/", pairs[i], ir.Num(100.0), pairs[i].span)
-            total = share if total is None else ir.Binary("+", total, share, share.span)
-            bounds.append((total, pairs[i + 1]))
-        for bound, value in reversed(bounds):
-            result = ir.Select(ir.Binary("<", u, bound, self.span(meta)), value, result, self.span(meta))
+            chances.append(share if before is None else
+                           ir.Binary("/", share, ir.Binary("-", ir.Num(1.0), before, span), span))
+            before = share if before is None else ir.Binary("+", before, share, share.span)
+        result = default
+        for chance, value in reversed(list(zip(chances, pairs[1::2]))):
+            result = ir.Select(ir.Call("p", (chance,), span, self.site()), value, result, span)
         return result
 
     def string(self, meta, tok):

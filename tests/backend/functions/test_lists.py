@@ -153,7 +153,7 @@ def test_list_random_is_the_item_at_the_drawn_index_shape_by_shape():
     rng = np.random.default_rng(5)
     key = rng.integers(0, 2**63, 500, dtype=np.uint64)
     which = rng.integers(0, len(texts), 500)
-    env = SimpleNamespace(shapes=SimpleNamespace(key=key), plan=SimpleNamespace(strings=strings))
+    env = SimpleNamespace(shapes=SimpleNamespace(key=key), plan=SimpleNamespace(strings=strings, sequential_random=False))
     got = FUNCTIONS["listRandom"](SimpleNamespace(site=9, func="listRandom"), [ids[which]], env)
     u = uniform(key, 9)
     names = list(strings.ids)

@@ -131,10 +131,11 @@ Lot --> A
     defaults = {a.name: print_expr(a.default) for a in module.attrs}
     assert defaults["style"] == '((@h > 30) ? "tower" : ((@h > 10) ? "block" : "house"))'
     assert defaults["floors"] == "((@h > 10) ? ((@h > 20) ? 6 : 4) : 1)"
-    # one draw per shape, compared with the cumulative shares
+    # one p() per share, in turn, each given that none before was taken: 0.2 of what 0.3 leaves
     roof = module.attrs[3].default
-    assert print_expr(roof) == '((rand() < 0.3) ? "flat" : ((rand() < 0.5) ? "gable" : "hip"))'
-    assert roof.cond.left.site == roof.other.cond.left.site
+    assert print_expr(roof) == '(p(0.3) ? "flat" : (p(0.285714) ? "gable" : "hip"))'
+    assert roof.other.cond.args[0].value == pytest.approx(0.2 / 0.7)
+    assert roof.cond.site != roof.other.cond.site
     assert {a.name: a.type for a in module.attrs}["roof"] is ir.Type.STR
 
 
@@ -359,7 +360,7 @@ A(x) --> X.
 """
     assert body_of(text) == ("extrude(((@h > 10) ? @h : 10)) "
                              "color(((@h > 1) ? 0.5 : 1), material.color.g, material.color.b) "
-                             "S(1r, (((@h > 12) ? 1 : 0.8) * Scope.sy), 1r) A(((rand() < 0.3) ? 1 : 2))")
+                             "S(1r, (((@h > 12) ? 1 : 0.8) * Scope.sy), 1r) A((p(0.3) ? 1 : 2))")
 
 
 def test_value_case_needs_else():
