@@ -180,7 +180,11 @@ def clip_pieces(chunk: Chunk, shapes: Shapes, axis: int, parent, step, pos, leng
     pos, length = pos[rows].copy(), length[rows].copy()
     pos[is_piece] = clipped.low[piece[is_piece], axis]
     length[is_piece] = clipped.extent[piece[is_piece], axis]
-    geometry = (is_piece, new_geom[piece], clipped.low[piece], clipped.extent[piece])
+    if len(clipped.source):
+        geometry = (is_piece, new_geom[piece], clipped.low[piece], clipped.extent[piece])
+    else:  # every slab missed its polygon (the parents' holes): only the other children are left
+        geometry = (is_piece, np.full(len(rows), -1, dtype=np.int32), np.zeros((len(rows), 3)),
+                    np.zeros((len(rows), 3)))
     if meshes is not None:  # the mesh children keep their cut meshes
         from_mesh = ~is_piece & meshes[0][rows]
         for mine, theirs in zip(geometry, meshes):

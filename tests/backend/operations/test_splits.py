@@ -279,3 +279,13 @@ def test_a_floating_repeat_takes_the_count_whose_parts_come_closest_to_their_siz
     other (1.36 m: two of 0.68 rather than one of 1.36; a ratio would have chosen one)."""
     r = run(write, "Lot --> extrude(1) split(x){ ~1 : Bar }*\n", [rect(width, 2)])
     np.testing.assert_allclose(r["xform"][:, 0, 0], [width / bars] * bars, rtol=1e-6)
+
+
+def test_a_recursive_subdiv_into_a_lots_hole_leaves_the_pieces_that_are_not_in_it(write):
+    """Slabs of a holed lot whose every piece is empty (inside the hole) made an IndexError (found by the
+    build fuzz): the split keeps the children that have pieces, on both lots."""
+    square = np.array([[0, 0], [1, 0], [1, 1], [0, 1]], float)
+    hole = np.array([[0.25, 0.25], [0.25, 0.75], [0.75, 0.75], [0.75, 0.25]])
+    r = paper(write, 'lot ~> Subdiv("X", 3r, 1r, 1r){ r1 | lot | r1 }\nr1 ~> Subdiv("X", 1r){ I("cube") }\n',
+              [[square], [square, hole]])
+    assert not r["bad"] and set(np.unique(r["lot"]).tolist()) == {0, 1}
