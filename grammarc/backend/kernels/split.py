@@ -192,7 +192,7 @@ def group_counts(extent, values, kind, group, n_groups, tol):
             for j in range(count):
                 size = values[row, j] * extent[i] if kind[j] == 1 else values[row, j]
                 parts += size > tol
-            _turns(max(avail, 0.0), loose, nominal, group_fixed, group_float, n_groups, parts, tol, reps[i])
+            _turns(max(avail, 0.0), loose, nominal, group_fixed, group_float, n_groups, parts, tol, reps, i)
             for g in range(n_groups):
                 fixed += reps[i, g] * group_fixed[g]
                 floating += reps[i, g] * group_float[g]
@@ -296,7 +296,7 @@ def _in_turns(nominal, group_float, n_groups, tol):
 
 
 @njit(cache=True, nogil=True)
-def _turns(room, loose, nominal, fixed, floating, n_groups, parts, tol, reps):
+def _turns(room, loose, nominal, fixed, floating, n_groups, parts, tol, reps, i):
     """Repetitions of two or more floating repeat groups that share ``room`` (what the parts outside the
     groups leave at their written sizes; ``loose`` the floating ones among those), written into ``reps``.
 
@@ -310,7 +310,7 @@ def _turns(room, loose, nominal, fixed, floating, n_groups, parts, tol, reps):
     int64 are ``MAX_COUNT`` (the caller fails the lot).
     """
     for g in range(n_groups):
-        reps[g] = 0
+        reps[i, g] = 0
     if room <= tol:
         return
     cycle = 0.0
@@ -319,41 +319,41 @@ def _turns(room, loose, nominal, fixed, floating, n_groups, parts, tol, reps):
     rounds = np.floor(room / cycle) - 1.0
     if rounds >= MAX_COUNT:
         for g in range(n_groups):
-            reps[g] = MAX_COUNT
+            reps[i, g] = MAX_COUNT
         return
     turn = 0
     if rounds >= 1.0:
         for g in range(n_groups):
-            reps[g] = int(rounds)
+            reps[i, g] = int(rounds)
     elif loose <= 0.0:
-        reps[0] = 1
+        reps[i, 0] = 1
         turn = 1
-    best = _unevenness(room, loose, nominal, fixed, floating, n_groups, parts, reps)
+    best = _unevenness(room, loose, nominal, fixed, floating, n_groups, parts, reps, i)
     while True:
-        reps[turn] += 1
-        off = _unevenness(room, loose, nominal, fixed, floating, n_groups, parts, reps)
+        reps[i, turn] += 1
+        off = _unevenness(room, loose, nominal, fixed, floating, n_groups, parts, reps, i)
         if off > best + 1e-9:
-            reps[turn] -= 1
+            reps[i, turn] -= 1
             return
         best = off
         turn = (turn + 1) % n_groups
 
 
 @njit(cache=True, nogil=True)
-def _unevenness(room, loose, nominal, fixed, floating, n_groups, parts, reps):
-    """How far the repetitions ``reps`` leave the floating parts from their written sizes: |stretch - 1|,
+def _unevenness(room, loose, nominal, fixed, floating, n_groups, parts, reps, i):
+    """How far the repetitions in row i of ``reps`` leave the floating parts from their written sizes: |stretch - 1|,
     plus, where the groups' counts differ, a share of a repetition (of the first group) per floating
     length, 1 / parts of it, or 1 / (2 (parts - 1)) where a group has none (PRT, measured on candler;
     ``parts`` the split's parts of positive size). Infinite where no floating part is laid."""
     laid = loose
     kept = 0.0
-    low = reps[0]
-    high = reps[0]
+    low = reps[i, 0]
+    high = reps[i, 0]
     for g in range(n_groups):
-        laid += reps[g] * floating[g]
-        kept += reps[g] * fixed[g]
-        low = min(low, reps[g])
-        high = max(high, reps[g])
+        laid += reps[i, g] * floating[g]
+        kept += reps[i, g] * fixed[g]
+        low = min(low, reps[i, g])
+        high = max(high, reps[i, g])
     if laid <= 0.0:
         return np.inf
     off = abs((room + loose - kept) / laid - 1.0)
