@@ -1,7 +1,8 @@
 """backend/kernels/split.py ``group_counts`` and ``group_split``: CityEngine's split with ``'``, ``~`` sizes and repeat groups.
 
 Layouts are computed by hand from the kernel's rule (its docstring): fixed parts and floating parts outside
-groups keep their written sizes while the groups share what is left in proportion to one repetition's
+groups keep their written sizes while the groups share what is left: two or more floating groups take
+repetitions in turns (PRT's counts on candler's wide floor), otherwise in proportion to one repetition's
 size, in order, each from what the earlier ones left; a group with floating parts repeats as often as
 brings the floating parts' stretch nearest 1 (those outside the groups, the earlier groups' repetitions and
 its own; at least once when room is left and no floating part is laid before it), a group of fixed sizes floor(share / repetition) times with the rest of its share left empty; then
