@@ -1,7 +1,8 @@
 """backend/kernels/split.py ``group_counts`` and ``group_split``: CityEngine's split with ``'``, ``~`` sizes and repeat groups.
 
 Layouts are computed by hand from the kernel's rule (its docstring): fixed parts and floating parts outside
-groups keep their written sizes while the groups share what is left in proportion to one repetition's
+groups keep their written sizes while the groups share what is left: two or more floating groups take
+repetitions in turns (PRT's counts on candler's wide floor), otherwise in proportion to one repetition's
 size, in order, each from what the earlier ones left; a group with floating parts repeats as often as
 brings the floating parts' stretch nearest 1 (those outside the groups, the earlier groups' repetitions and
 its own; at least once when room is left and no floating part is laid before it), a group of fixed sizes floor(share / repetition) times with the rest of its share left empty; then
@@ -175,6 +176,33 @@ def test_floating_repeat_group_after_one_that_rounded_up_keeps_its_own_count():
     assert [p for p, *_ in got] == [0, 1, 2, 2, 3, 4, 4, 5, 6]
 
 
+@pytest.mark.parametrize("corner, thresholds", [
+    # PRT's counts on candler's wide floor swept finely (tiles of 3.55 m, 5 m; corner walls of 1 m, 2.5 m:
+    # the same rooms in repetitions), each threshold the room where the next repetition comes
+    (1.0, [(0.1667, (1, 1), (1, 0)), (23 / 18, (1, 0), (1, 1)), (86 / 35, (1, 1), (2, 1)),
+           (164 / 49, (2, 1), (2, 2)), (284 / 63, (2, 2), (3, 2)), (414 / 77, (3, 2), (3, 3)),
+           (594 / 91, (3, 3), (4, 3)), (776 / 105, (4, 3), (4, 4)), (1250 / 133, (5, 4), (5, 5))]),
+    # without corner walls the split has five parts of positive size, not seven
+    (0.0, [(5 / 4, (1, 0), (1, 1)), (62 / 25, (1, 1), (2, 1)), (116 / 35, (2, 1), (2, 2)),
+           (68 / 15, (2, 2), (3, 2))]),
+])
+def test_floating_repeat_groups_take_repetitions_in_turns(corner, thresholds):
+    """Two floating groups in one split, ``c | t | {~t}* | t | {~t}* | t | c``: the groups take the
+    repetitions in turns, the first group first, as PRT lays them (the fixed tiles and corner walls do not
+    change where, only the room R left to the groups in repetitions of t and the number of parts)."""
+    tile = 3.55
+    parts, groups = [corner, tile, f"~{tile}", tile, f"~{tile}", tile, corner], [-1, -1, 0, -1, 1, -1, -1]
+
+    def counts(room):
+        got = [p for p, *_ in layout(2 * corner + 3 * tile + room * tile, parts, groups=groups)]
+        return got.count(2), got.count(4)
+
+    for room, below, above in thresholds:
+        assert counts(room - 1e-4) == below, room
+        assert counts(room + 1e-4) == above, room
+    assert counts(40.6) == (21, 20)  # PRT: the 41st repetition at R = 40.5644
+
+
 def test_floating_repeat_group_on_a_tie_takes_the_more_repetitions():
     """The kit's rotated 25 x 15 lot with tiles of 3 m: the 15 m side leaves 4 m, 4/3 repetitions; the
     second group stretches by 4/3 without a repetition and by 2/3 with one, and PRT lays one in each."""
@@ -279,6 +307,31 @@ def stretch_nearest_one(share, nominal, g_fixed, g_float, loose, laid, tol):
     return min(reversed(range(0 if loose > 0 else 1, int(share / nominal) + 3)), key=off)
 
 
+def turns(room, loose, nominal, g_fixed, g_float, parts, tol):
+    """Repetitions of two or more floating groups: the chain (1, 0, ..), (1, 1, ..), (2, 1, ..) .. (from
+    (0, 0, ..) beside floating parts outside the groups) walked while the stretch's distance from 1, plus
+    the uneven counts' share of the first group's repetition, does not grow."""
+    if room <= tol:
+        return [0] * len(nominal)
+
+    def off(reps):
+        laid = loose + sum(r * f for r, f in zip(reps, g_float))
+        if laid <= 0:
+            return np.inf
+        uneven = 0.0 if min(reps) == max(reps) else nominal[0] / (2 * (parts - 1) if min(reps) == 0 else parts)
+        return abs((room + loose - sum(r * f for r, f in zip(reps, g_fixed))) / laid - 1) + uneven / laid
+
+    reps, turn = [0] * len(nominal), 0
+    if loose <= 0:
+        reps[0], turn = 1, 1 % len(nominal)
+    while True:
+        more = list(reps)
+        more[turn] += 1
+        if off(more) > off(reps) + 1e-9:
+            return reps
+        reps, turn = more, (turn + 1) % len(nominal)
+
+
 def reference(extent, values, kind, group, n_groups, tol):
     """The docstring's rule in plain Python, one shape at a time."""
     out = []
@@ -292,7 +345,14 @@ def reference(extent, values, kind, group, n_groups, tol):
         avail = max(room - floating, 0.0)
         loose = floating
         reps, gaps = [0] * n_groups, [0.0] * n_groups
-        for gi in range(n_groups):
+        fixed_of = [sum(s for s, k, g in zip(size, kind, group) if g == gi and k != FLT) for gi in range(n_groups)]
+        float_of = [n - f for n, f in zip(nominal, fixed_of)]
+        in_turns = n_groups >= 2 and all(f > 0 for f in float_of) and all(n > tol for n in nominal)
+        if in_turns:
+            reps = turns(avail, loose, nominal, fixed_of, float_of, sum(s > tol for s in size), tol)
+            fixed += sum(r * f for r, f in zip(reps, fixed_of))
+            floating += sum(r * f for r, f in zip(reps, float_of))
+        for gi in range(0 if in_turns else n_groups):
             if nominal[gi] <= tol:
                 continue
             share = avail * nominal[gi] / sum(nominal[gi:])
@@ -333,7 +393,7 @@ def reference(extent, values, kind, group, n_groups, tol):
     return out
 
 
-@pytest.mark.parametrize("seed", range(5))
+@pytest.mark.parametrize("seed", [*range(5), 12, 40, 50, 55, 57])  # the last: floating groups in turns
 def test_random_batches_match_the_reference(seed):
     rng = np.random.default_rng(seed)
     n = int(rng.integers(1, 40))

@@ -139,15 +139,16 @@ def group_counts(extent, values, kind, group, n_groups, tol):
     group of each part, -1 for none; n_groups : int.
 
     The rule (grammarc's reading of CityEngine's, fitted to PRT): what the fixed parts and the floating
-    parts outside groups leave at their written sizes goes to the groups in order, each taking a share
-    of what the earlier ones left in proportion to its repetition's size among the groups still to
-    come. A group with floating parts repeats as often as brings the floating parts nearest their
-    written sizes (``_repetitions``) and uses that many repetitions' room. PRT lays candler's
+    parts outside groups leave at their written sizes goes to the groups. Two or more groups, each with
+    floating parts, take repetitions in turns (``_turns``: PRT lays candler's
     ``1 | 3.55 | {~3.55}* | 3.55 | {~3.55}* | 3.55 | 1`` with 3 then 2 repetitions on 30 m, 2 and 2 on
-    25 m and on 3.42 repetitions' room, 1 and 1 on 20 m and on 4/3 repetitions' room, 1 then 0 on 15 m
-    and on 1.13 repetitions' room, and ``{ ~w: A | d: B }* | ~w: A`` on an extent of w as one A. A group
-    of fixed sizes repeats floor(share / repetition) times, the rest of its share left empty at its end.
-    Then every floating size, in groups or not, is scaled by one factor so that the parts fill the extent.
+    25 m, 1 and 1 on 20 m, 1 then 0 on 15 m). Otherwise the groups take it in order, each a share of what
+    the earlier ones left in proportion to its repetition's size among the groups still to come. A
+    group with floating parts repeats as often as brings the floating parts nearest their written sizes
+    (``_repetitions``) and uses that many repetitions' room (``{ ~w: A | d: B }* | ~w: A`` on an extent
+    of w is one A). A group of fixed sizes repeats floor(share / repetition) times, the rest of its share
+    left empty at its end. Then every floating size, in groups or not, is scaled by one factor so that
+    the parts fill the extent.
 
     Returns reps (n, max(n_groups, 1)) int64 each group's repetitions (``MAX_COUNT`` beyond int64), gap
     (n, max(n_groups, 1)) float64 the room left at a group's end, scale (n,) float64 the floating sizes'
@@ -186,6 +187,21 @@ def group_counts(extent, values, kind, group, n_groups, tol):
                     group_fixed[g] += size
         avail = extent[i] - fixed - floating
         loose = floating
+        if _in_turns(nominal, group_float, n_groups, tol):
+            parts = 0
+            for j in range(count):
+                size = values[row, j] * extent[i] if kind[j] == 1 else values[row, j]
+                parts += size > tol
+            _turns(max(avail, 0.0), loose, nominal, group_fixed, group_float, n_groups, parts, tol, reps, i)
+            for g in range(n_groups):
+                fixed += reps[i, g] * group_fixed[g]
+                floating += reps[i, g] * group_float[g]
+            if floating > 0.0:
+                scale[i] = max(extent[i] - fixed, 0.0) / floating
+            for j in range(count):
+                g = group[j]
+                total[i] += 1.0 if g < 0 else float(reps[i, g])
+            continue
         # the groups in order, each sharing what the earlier ones left with the later ones
         left = max(avail, 0.0)
         later = 0.0
@@ -268,6 +284,85 @@ def group_split(extent, values, kind, group, reps, gap, scale, count, tol):
 
 
 @njit(cache=True, nogil=True)
+def _in_turns(nominal, group_float, n_groups, tol):
+    """Whether a split's groups take their repetitions in turns (``_turns``): two or more groups, each
+    with floating parts and a repetition longer than ``tol``."""
+    if n_groups < 2:
+        return False
+    for g in range(n_groups):
+        if group_float[g] <= 0.0 or nominal[g] <= tol:
+            return False
+    return True
+
+
+@njit(cache=True, nogil=True)
+def _turns(room, loose, nominal, fixed, floating, n_groups, parts, tol, reps, i):
+    """Repetitions of two or more floating repeat groups that share ``room`` (what the parts outside the
+    groups leave at their written sizes; ``loose`` the floating ones among those), written into ``reps``.
+
+    The groups take repetitions in turns, in written order, the first group the first one (or, beside
+    floating parts outside the groups, none until it is worth it); the next one is taken while it leaves
+    the floating parts' stretch nearer 1 than before, measured as ``_unevenness`` says. This is PRT's
+    rule as measured on candler's ``1 | t | {~t}* | t | {~t}* | t | 1`` (the counts depend only on the
+    room in repetitions, R): the n-th repetition over 2m comes at R = n + (8/7) n / (2n + 1) and the one
+    that evens the groups at R = n + (6n - 1) / (7 (2n + 1)), thresholds 23/18, 86/35, 164/49, 284/63,
+    ...; without the corner walls the 7 becomes 5, the split's parts of positive size. Counts beyond
+    int64 are ``MAX_COUNT`` (the caller fails the lot).
+    """
+    for g in range(n_groups):
+        reps[i, g] = 0
+    if room <= tol:
+        return
+    cycle = 0.0
+    for g in range(n_groups):
+        cycle += nominal[g]
+    rounds = np.floor(room / cycle) - 1.0
+    if rounds >= MAX_COUNT:
+        for g in range(n_groups):
+            reps[i, g] = MAX_COUNT
+        return
+    turn = 0
+    if rounds >= 1.0:
+        for g in range(n_groups):
+            reps[i, g] = int(rounds)
+    elif loose <= 0.0:
+        reps[i, 0] = 1
+        turn = 1
+    best = _unevenness(room, loose, nominal, fixed, floating, n_groups, parts, reps, i)
+    while True:
+        reps[i, turn] += 1
+        off = _unevenness(room, loose, nominal, fixed, floating, n_groups, parts, reps, i)
+        if off > best + 1e-9:
+            reps[i, turn] -= 1
+            return
+        best = off
+        turn = (turn + 1) % n_groups
+
+
+@njit(cache=True, nogil=True)
+def _unevenness(room, loose, nominal, fixed, floating, n_groups, parts, reps, i):
+    """How far the repetitions in row i of ``reps`` leave the floating parts from their written sizes: |stretch - 1|,
+    plus, where the groups' counts differ, a share of a repetition (of the first group) per floating
+    length, 1 / parts of it, or 1 / (2 (parts - 1)) where a group has none (PRT, measured on candler;
+    ``parts`` the split's parts of positive size). Infinite where no floating part is laid."""
+    laid = loose
+    kept = 0.0
+    low = reps[i, 0]
+    high = reps[i, 0]
+    for g in range(n_groups):
+        laid += reps[i, g] * floating[g]
+        kept += reps[i, g] * fixed[g]
+        low = min(low, reps[i, g])
+        high = max(high, reps[i, g])
+    if laid <= 0.0:
+        return np.inf
+    off = abs((room + loose - kept) / laid - 1.0)
+    if high > low:
+        off += nominal[0] / (2.0 * (parts - 1) if low == 0 else float(parts)) / laid
+    return off
+
+
+@njit(cache=True, nogil=True)
 def _repetitions(share, nominal, fixed, floating, loose, laid, tol):
     """How often a group with floating parts repeats in ``share``: the count that brings the floating
     parts nearest their written sizes, as the reference has a floating repeat come "closest" to them.
@@ -279,8 +374,7 @@ def _repetitions(share, nominal, fixed, floating, loose, laid, tol):
     repetitions' room (4/3, 12/5, 24/7), complexpatterns' ``~g | {~f}*`` from none to one where
     E / g - 1 = 1 - E / (g + f). A share of less than one repetition gives one where no floating part was
     laid before the group; where some were (``laid``: those outside the groups and the earlier groups'
-    repetitions), one only if that stretches them and the group's own nearer 1 than none: candler's
-    second tile group takes none of 0.13 repetitions' room after the first took one (PRT)."""
+    repetitions), one only if that stretches them and the group's own nearer 1 than none."""
     if share <= tol:
         return 0
     r = _count(np.floor(share / nominal))
