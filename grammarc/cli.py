@@ -212,11 +212,11 @@ def _server(args) -> int:
     if not server.AVAILABLE:
         raise UsageError("grammarc server needs a system that forks and passes descriptors over Unix sockets "
                          "(Linux, macOS)")
-    found = server.servers()
+    found, mine = server.servers(), server.address()
     if args.action == "status":
         for path, pid in found.items():
-            print(f"grammarc server {pid} at {path}" + (" (this grammarc's)" if path == server.address() else ""))
-        if server.address() not in found:
+            print(f"grammarc server {pid} at {path}" + (" (this grammarc's)" if path == mine else ""))
+        if mine not in found:
             print("no grammarc server runs this grammarc")
         return 0
     if args.action == "stop":
@@ -224,12 +224,12 @@ def _server(args) -> int:
             os.kill(pid, signal.SIGTERM)
             print(f"grammarc server {pid} at {path} stopped")
         return 0
-    if server.address() in found:
-        print(f"grammarc server {found[server.address()]} already running at {server.address()}")
+    if mine in found:
+        print(f"grammarc server {found[mine]} already running at {mine}")
         return 0
 
     def ready(seconds: float) -> None:
-        print(f"grammarc server {os.getpid()} ready at {server.address()} (warmed up in {seconds:.1f} s; "
+        print(f"grammarc server {os.getpid()} ready at {mine} (warmed up in {seconds:.1f} s; "
               f"stops after {args.idle_timeout} min without a command)", flush=True)
 
     def serve(ready) -> None:
@@ -261,7 +261,8 @@ def _detached(serve, ready) -> int:
     if os.fork():
         os._exit(0)
     server.folder().mkdir(mode=0o700, parents=True, exist_ok=True)
-    log = os.open(server.address().with_suffix(".log"), os.O_WRONLY | os.O_CREAT | os.O_TRUNC, 0o600)
+    log_path = server.address().with_suffix(".log")
+    log = os.open(log_path, os.O_WRONLY | os.O_CREAT | os.O_TRUNC, 0o600)
     os.dup2(os.open(os.devnull, os.O_RDONLY), 0)
     os.dup2(write, 1)  # what it says until it is ready goes to the waiting parent, the rest to the log
     os.close(write)
@@ -276,7 +277,7 @@ def _detached(serve, ready) -> int:
     except BaseException as error:  # noqa: BLE001 - a daemon has no one but its log and its parent to tell
         print(f"grammarc: error: {error}", flush=True)
         os._exit(1)
-    os.unlink(server.address().with_suffix(".log"))  # it stopped as it should: nothing to look into
+    os.unlink(log_path)  # it stopped as it should: nothing to look into
     os._exit(0)
 
 

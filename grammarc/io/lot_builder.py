@@ -139,6 +139,8 @@ class LotBuilder:
     def _convert(self) -> None:
         """Add the queued lots: all their positions in one conversion, when they are all alike (numbers,
         two or more per position, the same number of them); else lot by lot, ring by ring."""
+        if not self.queued:  # lots added otherwise (``add``, ``add_block``) queue nothing
+            return
         queued, self.queued = self.queued, []
         flat: list = []
         offsets = [0]
