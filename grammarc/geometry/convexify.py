@@ -91,7 +91,7 @@ def _convex_parts(polygons: np.ndarray, max_length: np.ndarray | None) -> tuple[
         done_source.append(source[given_up])
         retry = np.flatnonzero(stuck & ~across)
         parts, parent, side = parts[keep][~stuck[parent]], parent[~stuck[parent]], side[~stuck[parent]]
-        parts = _starting_at(parts, starts[parent, side])
+        parts = _starting_at(parts, _kept_start(parts, _first_vertices(pieces)[parent], starts[parent, side]))
         order = np.argsort(np.concatenate([parent, retry]), kind="stable")
         pieces = shapely.orient_polygons(np.concatenate([parts, pieces[retry]])[order], exterior_cw=False)
         across = np.concatenate([np.zeros(len(parts), dtype=bool), np.ones(len(retry), dtype=bool)])[order]
@@ -251,6 +251,34 @@ def _without_spikes(pieces: np.ndarray) -> np.ndarray:
     order = order[np.argsort(np.concatenate([ring, np.arange(n_rings)]), kind="stable")]
     return shapely.from_ragged_array(shapely.GeometryType.POLYGON, coords[order],
                                      (np.r_[0, np.cumsum(counts + 1)], part_offsets))
+
+
+def _first_vertices(pieces: np.ndarray) -> np.ndarray:
+    """The first vertex of each piece's outer ring (k, 2)."""
+    return shapely.get_coordinates(shapely.get_point(shapely.get_exterior_ring(pieces), 0))
+
+
+def _kept_start(parts: np.ndarray, first: np.ndarray, cut: np.ndarray) -> np.ndarray:
+    """Where each part's ring starts (k, 2): at its parent's first vertex ``first`` where the part keeps it,
+    else at its end of the cut ``cut``. A part is a run of its parent's ring closed by the cut, kept in
+    the parent's order: the run that goes round the parent's start begins there (PRT's pieces: of an H's
+    four arms, the one whose run holds the roof's first corner has its scope along the cut, and candler's
+    ventilator on it lies across the arm)."""
+    if not len(parts):
+        return cut
+    _, coords, (ring_offsets, part_offsets) = shapely.to_ragged_array(parts)
+    ring = segment_of(np.asarray(ring_offsets, dtype=np.int64))
+    outer_rings = np.asarray(part_offsets, dtype=np.int64)[:-1]
+    which = np.full(len(ring_offsets) - 1, -1)
+    which[outer_rings] = np.arange(len(parts))
+    which = which[ring]
+    at = np.flatnonzero(which >= 0)
+    which = which[at]
+    coords = np.asarray(coords)[:, :2]
+    scale = 1e-9 * (1.0 + np.abs(first).max(axis=1))
+    kept = np.zeros(len(parts), dtype=bool)
+    np.logical_or.at(kept, which, np.hypot(*(coords[at] - first[which]).T) <= scale[which])
+    return np.where(kept[:, None], first, cut)
 
 
 def _starting_at(pieces: np.ndarray, point: np.ndarray) -> np.ndarray:

@@ -62,10 +62,35 @@ def test_a_corner_is_cut_along_the_edge_whose_run_into_the_piece_is_shorter():
 def test_pieces_start_where_their_boundary_leaves_the_cut():
     """The part whose boundary runs on from the cut corner starts there, the other where the cut ends on
     the boundary, so that each part's first edge is one of the polygon's (the kit's L: PRT's ventilation
-    on the arm runs along it)."""
+    on the arm runs along it); but a part that keeps its parent's first vertex starts there."""
     pieces, _ = convex_parts(np.array([L_SHAPE]))
-    assert sorted(p.exterior.coords[0] for p in pieces) == [(0, 10), (10, 10)]
+    assert sorted(p.exterior.coords[0] for p in pieces) == [(0, 0), (10, 10)]
     assert all(p.exterior.is_ccw for p in pieces)
+
+
+# candler.H.31062's footprint: an H turned by 5 degrees, its bars 27 m by 4.5 m; its roof is inset by 0.8 m
+H_LOT = shapely.Polygon([(13.13, 4.42), (12.73, 8.96), (-14.09, 6.63), (-13.7, 2.09), (-3.7, 2.96), (-3.14, -3.56),
+                         (-13.13, -4.42), (-12.73, -8.96), (14.09, -6.63), (13.7, -2.09), (3.7, -2.96),
+                         (3.14, 3.56)])
+
+
+def test_the_arm_that_keeps_the_roofs_first_corner_starts_there():
+    """PRT's ventilation on candler.H.31062's arm beside the roof's first corner lies across the arm (its
+    scope runs along the short side from that corner), the other three along their arms: a part is a run
+    of its parent's ring, kept in the parent's order."""
+    roof = shapely.buffer(H_LOT, -0.8, join_style="mitre")
+    first = roof.exterior.coords[0]
+    pieces, _ = convex_parts(np.array([roof]))
+    arms = [p for p in pieces if corners(p) == 4]
+    assert len(arms) == 4
+    starting = [p for p in arms if np.allclose(p.exterior.coords[0], first)]
+    assert len(starting) == 1
+    ring = np.asarray(starting[0].exterior.coords)
+    assert np.hypot(*(ring[1] - ring[0])) < 3.5  # its first edge: the arm's short end
+    for arm in arms:
+        if arm is not starting[0]:
+            ring = np.asarray(arm.exterior.coords)
+            assert np.hypot(*(ring[1] - ring[0])) > 9.0
 
 
 # candler.Z.11103's roof (inset by 0.8 m), a Z turned by 10.7 degrees whose arms are 3.3 m by 13.5 m
