@@ -82,6 +82,8 @@ def _convex_parts(polygons: np.ndarray, max_length: np.ndarray | None) -> tuple[
         parts, index = shapely.get_parts(cut, return_index=True)
         keep = (shapely.get_type_id(parts) == shapely.GeometryType.POLYGON) & (shapely.area(parts) > TOL.area_floor)
         parent = np.concatenate([np.arange(len(pieces))] * 2)[index[keep]]
+        parts = parts.copy()
+        parts[keep] = _keeping_vertex(parts[keep], vertex[parent], _reach(pieces)[parent])
         side = (index[keep] >= len(pieces)).astype(np.int64)  # 0: on the cut's left, 1: on its right
         # a cut that only shaves off a sliver (an edge's line running close to another edge) is tried
         # again across the boundary; if that fails too, the piece stays as it is
@@ -251,6 +253,14 @@ def _without_spikes(pieces: np.ndarray) -> np.ndarray:
     order = order[np.argsort(np.concatenate([ring, np.arange(n_rings)]), kind="stable")]
     return shapely.from_ragged_array(shapely.GeometryType.POLYGON, coords[order],
                                      (np.r_[0, np.cumsum(counts + 1)], part_offsets))
+
+
+def _keeping_vertex(parts: np.ndarray, vertex: np.ndarray, reach: np.ndarray) -> np.ndarray:
+    """Parts (k,) with the corner they were cut at (k, 2) on their boundary as a vertex. Where the cut runs on
+    along an edge from that corner, GEOS's overlay may take the cut's line for the edge and leave the
+    corner out, depending on the last bits of the coordinates (a lot 8 km from the origin lost it where
+    the same lot at the origin kept it); PRT's pieces keep it."""
+    return shapely.snap(parts, shapely.points(vertex), 1e-9 * reach)
 
 
 def _first_vertices(pieces: np.ndarray) -> np.ndarray:

@@ -141,3 +141,15 @@ def test_random_polygons_are_tiled_by_convex_pieces(seed, hole):
     assert sum(shapely.area(pieces)) == pytest.approx(polygon.area, rel=1e-9)
     assert shapely.area(shapely.union_all(pieces, grid_size=1e-9)) == pytest.approx(polygon.area, rel=1e-6)
     assert is_convex(pieces).all()
+
+
+def test_the_cut_corner_stays_a_vertex_whatever_the_last_bits():
+    """candler.L.31352's roof as it comes out 8 km from the origin, where the corner at (12.47, 3.68) and
+    the edge above it are off the cut's line by 1e-13 m: GEOS's overlay took the cut's line for the edge
+    and dropped the corner, which the same lot at the origin kept (its roof part rectangular there, and
+    not here); the corner stays."""
+    roof = shapely.Polygon([(12.473032481078317, 18.491418641666332), (17.313648359239465, 18.491418641666332),
+                            (17.313648359239508, 2.9132252166164103e-13), (0.0, 0.0),
+                            (5.2937169036571445e-14, 3.680220508187176), (12.473032481078445, 3.680220508187494)])
+    pieces, _ = convex_parts(np.array([roof]), None, np.array([True]))
+    assert sorted(corners(p) for p in pieces) == [4, 5]
