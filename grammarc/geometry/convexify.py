@@ -1,6 +1,7 @@
 """Convex parts of polygons with holes (CityEngine's ``convexify``), all polygons of a batch at once.
 
-Each round cuts every piece that still has a reflex vertex along a line through its first one: the line
+Each round cuts every piece that still has a reflex vertex along a line through its first one (one that
+is nearly straight only when it has no other): the line
 of one of the two edges that meet there, the one that runs a shorter way into the piece from the
 vertex (on one side the vertex becomes straight, on the other its angle drops below 180 degrees). A
 nearly straight corner too: the cut shaves a sliver off along the edge, and the rest of the piece stays
@@ -31,6 +32,8 @@ from grammarc.ragged import segment_of
 
 #: Cutting rounds at most (each removes at least one reflex vertex from every piece it cuts).
 MAX_ROUNDS = 256
+#: A reflex corner that turns less than this (radians: one degree) is cut after the piece's others.
+NEARLY_STRAIGHT = np.radians(1.0)
 
 
 def convex_parts(polygons: np.ndarray, max_length: np.ndarray | None = None,
@@ -135,6 +138,11 @@ def _cut_vertices(pieces: np.ndarray, limit: np.ndarray | None, across: np.ndarr
     reflex = real & (cross < -1e-9 * np.maximum(scale, TOL.zero))
     piece = segment_of(np.asarray(part_offsets, dtype=np.int64))[ring]
     candidates = np.flatnonzero(reflex)
+    # a corner that is nearly straight (under a degree) waits until the piece has no other: an L's
+    # corner is cut across its bar, not after a cut at a bump in the bar took the whole bar off
+    # (candler.near_degenerate.31488: PRT's parts of the bar are too small for a roof access)
+    turn = np.arctan2(cross, d_in[:, 0] * d_out[:, 0] + d_in[:, 1] * d_out[:, 1])
+    candidates = candidates[np.lexsort((candidates, turn[candidates] > -NEARLY_STRAIGHT, piece[candidates]))]
     if limit is None and len(candidates):  # only each piece's first reflex vertex is cut
         candidates = candidates[np.r_[True, piece[candidates][1:] != piece[candidates][:-1]]]
     a = d_in[candidates] / np.hypot(d_in[candidates, 0], d_in[candidates, 1])[:, None]

@@ -153,3 +153,14 @@ def test_the_cut_corner_stays_a_vertex_whatever_the_last_bits():
                             (5.2937169036571445e-14, 3.680220508187176), (12.473032481078445, 3.680220508187494)])
     pieces, _ = convex_parts(np.array([roof]), None, np.array([True]))
     assert sorted(corners(p) for p in pieces) == [4, 5]
+
+
+def test_a_nearly_straight_corner_waits_for_the_real_one():
+    """candler.near_degenerate.31488's roof: an L whose bar has a bump of 1 cm at (18.79, 16.3), before the
+    L's corner in the boundary's order. Cut there first, the bar came off whole (202 m^2, a roof access);
+    PRT cuts the L's corner across the bar, and neither part is large enough for one."""
+    roof = shapely.Polygon([(0.0, 21.07), (42.3, 21.07), (42.3, 16.29), (18.79, 16.3), (7.57, 16.29), (7.57, 0.0),
+                            (2.32, 0.0), (0.0, 0.0)])
+    pieces, _ = convex_parts(np.array([roof]), None, np.array([True]))
+    assert shapely.area(pieces).max() < 170
+    assert np.isclose(shapely.area(pieces).sum(), roof.area)
