@@ -1,0 +1,129 @@
+"""Which symbols a fused kernel derives: the whitelist of operations and expressions, and where a region ends.
+
+A region is a symbol (its *root*) with the symbols its rules lead to, all derived by one generated kernel
+(``codegen``) from the root's pending shapes: no intermediate shape columns, the terminals written straight
+into the records. It covers what needs no context: the scope operations ``S`` and ``T``, single-axis
+``Subdiv`` and ``Repeat`` (no snapping), ``I``, ``ε``, successor symbols, guards and sizes made of numbers,
+attributes, ``scope.sx|sy|sz`` and arithmetic. Anything else - another operation, a stochastic rule, a
+parameter, a function call - keeps the symbol for the interpreter (``backend.execute``), which remains the
+reference: both give the same records, bit for bit (``tests/backend/fusion``).
+
+A successor symbol is derived inside the region (*inlined*) only where the interpreter's record order can be
+kept (``backend.fusion`` explains the order): when the symbol is named once in the whole grammar (its
+pending shapes then come from this one place), or when its rule only places an asset (``leaf_parts``: its
+shapes' records are the same however its batches are concatenated). A region whose successors cannot all
+be inlined is no region. The whole grammar is left to the interpreter where records carry more than an
+asset and a transform (colours, texture channels or coordinates, trims), where shapes carry per-shape
+state (``set``, ``split.index``, a pivot), where an insert occludes, and in CityEngine's dialect (a body's
+end is a leaf, and shapes draw from PRT's sequential stream, which successors move on in place).
+``GRAMMARC_FUSION=off`` turns fusion off.
+"""
+
+from __future__ import annotations
+
+import os
+from collections import Counter
+
+from grammarc.ir import nodes as ir
+from grammarc.ir.traverse import iter_ops
+
+#: The environment switch: ``off`` derives everything with the interpreter.
+SWITCH = "GRAMMARC_FUSION"
+
+#: Operators a fused expression may use: arithmetic of numbers, comparisons of numbers, logic.
+ARITHMETIC = frozenset({"+", "-", "*", "/"})
+COMPARE = frozenset({"<", "<=", ">", ">=", "==", "!="})
+LOGIC = frozenset({"&&", "||"})
+#: The scope fields a fused expression may read: the scope's size.
+SIZES = {"sx": 0, "sy": 1, "sz": 2}
+#: Operations that end a body (nothing of the body may follow them).
+ENDING = (ir.Split, ir.Repeat, ir.Insert, ir.Symbol, ir.Empty)
+
+
+def enabled() -> bool:
+    """Whether fusion is on (``GRAMMARC_FUSION`` is not ``off``)."""
+    return os.environ.get(SWITCH, "").strip().lower() not in ("off", "0", "false", "no")
+
+
+def grammar_allows(plan) -> bool:
+    """Whether ``plan``'s grammar may be fused at all (see the module docstring)."""
+    return not (plan.leaf_bodies or plan.sequential_random or plan.queries or plan.occluders or plan.dynamic
+                or plan.color_slot is not None or plan.material_slots or plan.uv_slots
+                or plan.trim_slot is not None or plan.pivot_slot is not None)
+
+
+class Fusible:
+    """The answers of one plan: which symbols' rules may be fused, which may be inlined (memoized)."""
+
+    def __init__(self, plan) -> None:
+        self.plan = plan
+        self.uses = Counter(op.name for op in iter_ops(plan.grammar.module) if isinstance(op, ir.Symbol))
+        self._fusible: dict[int, bool] = {}
+
+    def symbol(self, sym_id: int) -> bool:
+        """Whether every rule of symbol ``sym_id`` and every symbol it leads to can be fused."""
+        if sym_id not in self._fusible:
+            self._fusible[sym_id] = False  # a symbol that leads back to itself is not fused
+            self._fusible[sym_id] = self._rules(self.plan.symbols[sym_id])
+        return self._fusible[sym_id]
+
+    def inlined(self, name: str) -> bool:
+        """Whether the successor symbol ``name`` is derived inside its region (module docstring)."""
+        plan = self.plan
+        sym_id = plan.symbol_ids[name]
+        alone = self.uses[name] == 1 and sym_id != plan.start
+        return bool(plan.symbols[sym_id].rules) and (alone or sym_id in plan.leaf_inserts) and self.symbol(sym_id)
+
+    def _rules(self, sym) -> bool:
+        if not sym.rules or sym.param_types or sym.id in self.plan.snapping:
+            return False
+        for rule in applied_rules(sym):
+            if len(rule.alternatives) != 1 or (rule.guard is not None and not self.expr(rule.guard)):
+                return False
+            if not self.body(rule.alternatives[0].body):
+                return False
+        return applied_rules(sym)[-1].guard is None  # shapes no rule applies to would be leaves
+
+    def body(self, body: ir.Body) -> bool:
+        for k, op in enumerate(body):
+            if isinstance(op, ENDING) and k != len(body) - 1:
+                return False
+            if not self.op(op):
+                return False
+        return True
+
+    def op(self, op: ir.Op) -> bool:
+        if isinstance(op, ir.Scale):
+            return not op.mirrors and all(self.expr(s.value) for s in op.sizes)
+        if isinstance(op, ir.Translate):
+            return all(self.expr(e) for e in op.vector)
+        if isinstance(op, ir.Split):
+            return (len(op.axes) == 1 and not op.snap and all(self.expr(s.value) for s in op.sizes)
+                    and all(self.body(part) for part in op.parts))
+        if isinstance(op, ir.Repeat):
+            return (len(op.axes) == 1 and not op.snap and all(self.expr(e) for e in op.sizes)
+                    and all(self.body(part) for part in op.parts))
+        if isinstance(op, ir.Symbol):
+            return not op.args and not op.leaf and self.inlined(op.name)
+        return isinstance(op, (ir.Insert, ir.Empty))
+
+    def expr(self, expr: ir.Expr) -> bool:
+        if isinstance(expr, (ir.Num, ir.Bool)):
+            return True
+        if isinstance(expr, ir.AttrRef):
+            return True  # a column of numbers, which the runner checks (``run.attribute_columns``)
+        if isinstance(expr, ir.ScopeRef):
+            return expr.field in SIZES
+        if isinstance(expr, ir.Unary):
+            return expr.op in ("-", "!") and self.expr(expr.operand)
+        if isinstance(expr, ir.Binary):
+            return expr.op in ARITHMETIC | COMPARE | LOGIC and self.expr(expr.left) and self.expr(expr.right)
+        return False
+
+
+def applied_rules(sym) -> tuple[ir.Rule, ...]:
+    """The rules of ``sym`` that may apply: up to the first without a guard (``execute.apply_all``)."""
+    for k, rule in enumerate(sym.rules):
+        if rule.guard is None:
+            return sym.rules[:k + 1]
+    return sym.rules
