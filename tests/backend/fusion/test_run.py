@@ -1,0 +1,76 @@
+"""Deriving with fused kernels: the records, their order and the failures are the interpreter's
+(``GRAMMARC_FUSION=off``), where fused and interpreted symbols meet, where kernels decline a batch, and at
+the shape limit."""
+
+from __future__ import annotations
+
+from dataclasses import replace
+
+import numpy as np
+import pytest
+from conftest import make_lots
+
+from grammarc.backend.fusion.regions import SWITCH
+from grammarc.backend.plan import make_plan
+from grammarc.build import BuildOptions, derive
+from grammarc.compiler import compile_grammar
+from grammarc.constants import LIMITS
+
+#: ``side`` turns its scope (no kernel does) and hands shapes to ``pane``, a leaf insert that the fused
+#: ``bay`` inlines too: pane's pending list mixes both; ``bay``'s guards pick rules per shape.
+MIXED = """
+attr bay_w = 2.5
+lot ~> S(1r, 7, 1r) Comp("sidefaces"){ side }
+side ~> Subdiv("X", 1r, 2, 1r){ bay | R(0, 0, 0) pane | bay }
+bay : Scope.sx > 3 ~> Repeat("X", bay_w){ Subdiv("Y", 1r, 1.2, 0.4){ pane | glass | pane } }
+bay : Scope.sx > 1 ~> Subdiv("Y", 2, 1r){ glass | T(0, 0, 0.1) pane }
+bay ~> I("cube")
+glass ~> S(1r, 1r, 0.05) T(0, 0, -0.05) I("cube")
+pane ~> I("quad")
+"""
+
+#: ``Subdiv`` of a computed size that goes negative on narrow facades: the interpreter fails those lots.
+NEGATIVE = """
+lot ~> S(1r, 6, 1r) Comp("sidefaces"){ facade }
+facade ~> Subdiv("X", Scope.sx - 9, 1r){ part | part }
+part ~> Repeat("Y", 3){ I("quad") }
+"""
+
+
+def both(write, monkeypatch, text: str, lots, **options) -> tuple[dict, dict]:
+    path = write("g.cga", text)
+    fused = derive(compile_grammar(path), lots, BuildOptions(**options))
+    monkeypatch.setenv(SWITCH, "off")
+    interpreted = derive(compile_grammar(path), lots, BuildOptions(**options))
+    monkeypatch.delenv(SWITCH)
+    return fused, interpreted
+
+
+def assert_same(fused: dict, interpreted: dict) -> None:
+    for column in ("asset", "xform", "lot", "symbol"):
+        np.testing.assert_array_equal(fused[column], interpreted[column], err_msg=column)
+    assert [(b.id, b.reason) for b in fused["bad"]] == [(b.id, b.reason) for b in interpreted["bad"]]
+
+
+def test_fused_and_interpreted_symbols_meet_in_the_interpreter_order(write, monkeypatch):
+    plan = make_plan(compile_grammar(write("g.cga", MIXED)))
+    assert {plan.symbols[k].name for k in plan.fused} == {"bay", "glass", "pane"}
+    fused, interpreted = both(write, monkeypatch, MIXED, make_lots("square", "rect_12x8", "concave_L", "courtyard"))
+    assert len(fused["asset"]) > 200
+    assert_same(fused, interpreted)
+
+
+def test_a_batch_the_interpreter_would_fail_is_left_to_it(write, monkeypatch):
+    fused, interpreted = both(write, monkeypatch, NEGATIVE, make_lots("square", "rect_12x8", "concave_L"))
+    assert fused["bad"] and "negative" in fused["bad"][0].reason
+    assert len(fused["asset"])
+    assert_same(fused, interpreted)
+
+
+@pytest.mark.parametrize("max_shapes", [40, 5000])
+def test_shapes_count_as_the_interpreter_counts_them(write, monkeypatch, max_shapes):
+    text = NEGATIVE.replace("Scope.sx - 9", "1")
+    fused, interpreted = both(write, monkeypatch, text, make_lots("square", "concave_L"),
+                             limits=replace(LIMITS, max_shapes=max_shapes))
+    assert_same(fused, interpreted)
+    assert bool(fused["bad"]) == (max_shapes == 40)
