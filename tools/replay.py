@@ -38,7 +38,7 @@ def _benchmark_lots():
 
 concave_lots, grid_lots = _benchmark_lots()
 
-from test_examples import record_digest  # noqa: E402
+from test_examples import record_digest
 
 from grammarc.build import BuildOptions, build
 from grammarc.conform import kit_dir

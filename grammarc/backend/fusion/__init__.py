@@ -3,9 +3,10 @@ records, with no shape columns between their operations ("compile, don't interpr
 
 ``regions`` finds the symbols whose rules need no context (scope operations, splits, repeats, guards,
 inserts: the whitelist) and which of their successors can be derived with them; ``codegen`` writes a
-region's two passes (count the records each site makes; write them at offsets from a cumulative sum) and
-the order its records are due in; ``compiled`` keeps the generated modules in the user's cache folder, so
-that numba's cache keeps their machine code; ``run`` derives a root's pending batch with them.
+region's kernel, run in two passes (count the records each site makes; write them at offsets from a
+cumulative sum), and the order its records are due in; ``compiled`` keeps the generated modules in the
+user's cache folder, so that numba's cache keeps their machine code; ``run`` derives a root's pending batch
+with them.
 ``backend.plan`` finds the regions (this module: nothing here imports the derivation, which imports the
 plan); ``backend.execute`` hands a region root's shapes to ``run.derive`` and falls back to the interpreter
 where it declines; the interpreter derives everything else.
@@ -28,6 +29,7 @@ from dataclasses import dataclass
 
 from grammarc.backend.fusion.codegen import Block, generate
 from grammarc.backend.fusion.regions import Fusible, enabled, grammar_allows
+
 __all__ = ["Region", "fused_regions"]
 
 

@@ -1,13 +1,14 @@
-"""The numba source of a region's two passes, written from its IR, and the order its records are emitted in.
+"""The numba source of a region's kernel, written from its IR, and the order its records are emitted in.
 
-A region (``regions``) becomes two functions over its root's batch, one loop over the parent shapes each,
-the rules of the root and of the symbols it inlines written out as nested code: a split is a loop over its
+A region (``regions``) becomes one function over its root's batch, a loop over the parent shapes with the
+rules of the root and of the symbols it inlines written out as nested code: a split is a loop over its
 children (or one block per ``Subdiv`` part), a guard an ``if``, a successor the code of its symbol's rules,
 an ``I`` an *emission site*. The scope travels in local variables (origin and size per axis; the frame stays
-the parent's: no operation of a region turns it). ``count`` adds up the records each site makes and the
-shapes each parent makes (as the interpreter counts them for --max-shapes), and flags parents the
-interpreter would fail (a negative size, a repeat beyond the limit); ``write`` writes each record at its
-site's next row. Records of one site thus come in the parents' order and, within a parent, in the order of
+the parent's: no operation of a region turns it). The runner calls it twice (one function compiles in half
+the time of two). Counting, ``sites[k]`` adds up the records site k makes; ``made`` the shapes each parent
+makes (as the interpreter counts them for --max-shapes), and ``bad`` flags parents the interpreter would
+fail (a negative size, a repeat beyond the limit). Writing, ``sites[k]`` is site k's next row, where its
+record goes. Records of one site thus come in the parents' order and, within a parent, in the order of
 its children: the order the interpreter gives them (``backend.fusion``).
 
 The arithmetic is the interpreter's, operation by operation, in the same order (``kernels.split`` lays
@@ -18,6 +19,7 @@ due: a site of the root at once, a site of an inlined symbol when that symbol's 
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 from itertools import count
 
@@ -68,21 +70,18 @@ from numba import njit
 
 def generate(plan, root: int) -> Source:
     """The source of the region rooted at symbol ``root`` (which ``regions.Fusible`` accepted)."""
-    passes = [_Writer(plan, counting) for counting in (True, False)]
-    for writer in passes:
-        writer.function(root)
-    first = passes[0]
-    text = HEADER + "".join("\n".join(w.lines) + "\n\n\n" for w in passes)
-    return Source(text, first.block, tuple(first.attrs), first.sites, first.depth)
+    writer = _Writer(plan)
+    writer.function(root)
+    return Source(HEADER + "\n".join(writer.lines) + "\n", writer.block, tuple(writer.attrs), writer.sites,
+                  writer.depth)
 
 
 class _Writer:
-    """One pass's function: the walk over the region's IR that writes its lines (``count`` or ``write``),
-    numbering sites and attributes as it meets them (both passes meet them in the same order)."""
+    """The walk over the region's IR that writes the kernel's lines, numbering sites and attributes as it
+    meets them."""
 
-    def __init__(self, plan, counting: bool) -> None:
+    def __init__(self, plan) -> None:
         self.plan = plan
-        self.counting = counting
         self.lines: list[str] = []
         self.attrs: list[str] = []
         self.names = count()
@@ -92,26 +91,21 @@ class _Writer:
 
     # ------------------------------------------------------------------------------------------ framing
     def function(self, root: int) -> None:
-        attrs_at = len(self.lines)
-        head = "count" if self.counting else "write"
         self.lines += ["@njit(cache=True, nogil=True, error_model='numpy')", ""]
-        tail = "limit, sites, made, bad" if self.counting else "base, cursor, xform, record_lot"
         body = [
             "for i in range(len(lot)):",
             "    f = frame[i]",
             "    l = lot[i]",
             "    o0, o1, o2 = origin[i, 0], origin[i, 1], origin[i, 2]",
             "    s0, s1, s2 = size[i, 0], size[i, 1], size[i, 2]",
+            "    n = 0.0",
         ]
-        if self.counting:
-            body.append("    n = 0.0")
         self.lines += ["    " + line for line in body]
         self.block = self.symbol(root, ("o0", "o1", "o2"), ("s0", "s1", "s2"), 2, 0)
-        if self.counting:
-            self.lines += ["        made[i] = n", "        if n > limit:", "            bad[i] = True"]
-        args = ", ".join(["origin", "size", "frame", "lot", "frames", *(f"a{k}" for k in range(len(self.attrs))),
-                          tail])
-        self.lines[attrs_at + 1] = f"def {head}({args}):"
+        self.lines += ["        made[i] = n", "        if n > limit:", "            bad[i] = True"]
+        attrs = "".join(f"a{k}, " for k in range(len(self.attrs)))
+        self.lines[1] = (f"def derive(origin, size, frame, lot, frames, {attrs}base, limit, writing, sites, made, "
+                         "bad, xform, record_lot):")
 
     def put(self, level: int, line: str) -> None:
         self.lines.append("    " * level + line)
@@ -228,15 +222,13 @@ class _Writer:
         self.put(level, f"if {value} > 0.0 and {extent} > {TOL.zero!r}:")
         self.put(level + 1, f"{ceiling} = np.ceil({extent} / {value} - 1e-9)")
         self.put(level + 1, f"{times} = max(int({ceiling}) if {ceiling} < {MAX_COUNT} else {MAX_COUNT}, 1)")
-        if self.counting:  # beyond --max-shapes: the interpreter fails the lot
-            self.put(level, f"if {times} > limit:")
-            self.put(level + 1, "bad[i] = True")
-            self.put(level + 1, f"{times} = 0")
+        self.put(level, f"if {times} > limit:")  # beyond --max-shapes: the interpreter fails the lot
+        self.put(level + 1, "bad[i] = True")
+        self.put(level + 1, f"{times} = 0")
         self.put(level, f"{step} = {extent} / {times} if {times} > 0 else 0.0")
         self.put(level, f"for {j} in range({times}):")
-        if self.counting:
-            self.put(level + 1, "if n > limit:")
-            self.put(level + 2, "break")
+        self.put(level + 1, "if n > limit:")
+        self.put(level + 2, "break")
         self.put(level + 1, f"{pos} = {j} * {step}")
         parts = len(op.parts)
         for k, part in enumerate(op.parts):
@@ -260,32 +252,29 @@ class _Writer:
         self.body(part, block, tuple(moved), cut, level, depth)
 
     def emit(self, block: Block, asset: int, origin: tuple, size: tuple, level: int) -> None:
-        """An emission site: a record of the scope (``kernels.scope.xforms``), at the site's next row."""
+        """An emission site: counted, or a record of the scope (``kernels.scope.xforms``) at the site's next
+        row."""
         site = self.sites
         self.sites += 1
         block.events.append(Emit(site, asset))
-        if self.counting:
-            self.put(level, f"sites[{site}] += 1")
-            return
+        self.put(level, "if writing:")
         row = self.fresh("w")
-        self.put(level, f"{row} = cursor[{site}]")
-        self.put(level, f"cursor[{site}] = {row} + 1")
+        self.put(level + 1, f"{row} = sites[{site}]")
         for r in range(3):
             for j in range(3):
-                self.put(level, f"xform[{row}, {r}, {j}] = frames[f, {j}, {r}] * {size[j]}")
-            self.put(level, f"xform[{row}, {r}, 3] = {origin[r]} - base[l, {r}]")
-        self.put(level, f"record_lot[{row}] = l")
+                self.put(level + 1, f"xform[{row}, {r}, {j}] = frames[f, {j}, {r}] * {size[j]}")
+            self.put(level + 1, f"xform[{row}, {r}, 3] = {origin[r]} - base[l, {r}]")
+        self.put(level + 1, f"record_lot[{row}] = l")
+        self.put(level, f"sites[{site}] += 1")
 
     def made(self, level: int) -> None:
         """One more shape of the parent (a split child, a successor), as ``Context.count`` counts them."""
-        if self.counting:
-            self.put(level, "n += 1.0")
+        self.put(level, "n += 1.0")
 
     def check(self, level: int, holds: str) -> None:
         """Flag the parent where ``holds`` does not: the interpreter fails its lot (and derives the batch)."""
-        if self.counting:
-            self.put(level, f"if not ({holds}):")
-            self.put(level + 1, "bad[i] = True")
+        self.put(level, f"if not ({holds}):")
+        self.put(level + 1, "bad[i] = True")
 
     # ------------------------------------------------------------------------------------------ expressions
     def expr(self, expr: ir.Expr, size: tuple) -> str:
@@ -295,7 +284,7 @@ class _Writer:
             return repr(bool(expr.value))
         if isinstance(expr, ir.Num):
             value = float(expr.value)
-            return repr(value) if value == value and abs(value) != float("inf") else f"np.float64({str(value)!r})"
+            return repr(value) if math.isfinite(value) else f"np.float64({str(value)!r})"
         if isinstance(expr, ir.AttrRef):
             if expr.name not in self.attrs:
                 self.attrs.append(expr.name)

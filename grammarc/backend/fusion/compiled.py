@@ -27,7 +27,7 @@ def digest(text: str) -> str:
 
 @cache
 def load(text: str):
-    """The module of ``text`` (its ``count`` and ``write`` functions), once per process."""
+    """The module of ``text`` (its kernel, ``derive``), once per process."""
     key = digest(text)
     folder = user_cache.cache_folder("fusion") or _private_folder()
     path = folder / f"region_{key}.py"
