@@ -22,6 +22,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field
 from itertools import count
+from typing import NamedTuple
 
 from grammarc.backend.fusion.regions import SIZES, applied_rules
 from grammarc.backend.kernels.split import MAX_COUNT
@@ -47,6 +48,15 @@ class Block:
     events: list = field(default_factory=list)
     first: int = 0
     last: int = 0
+
+
+class Scope(NamedTuple):
+    """Where the generated code holds a shape: the names of its origin's and size's variables (per axis)
+    and of its parameters' values."""
+
+    origin: tuple[str, str, str]
+    size: tuple[str, str, str]
+    params: tuple[str, ...]
 
 
 @dataclass(frozen=True)
@@ -101,10 +111,12 @@ class _Writer:
             "    n = 0.0",
         ]
         self.lines += ["    " + line for line in body]
-        self.block = self.symbol(root, ("o0", "o1", "o2"), ("s0", "s1", "s2"), 2, 0)
+        root_params = tuple(f"q{k}[i]" for k in range(len(self.plan.symbols[root].param_types)))
+        self.block = self.symbol(root, Scope(("o0", "o1", "o2"), ("s0", "s1", "s2"), root_params), 2, 0)
         self.lines += ["        made[i] = n", "        if n > limit:", "            bad[i] = True"]
-        attrs = "".join(f"a{k}, " for k in range(len(self.attrs)))
-        self.lines[1] = (f"def derive(origin, size, frame, lot, frames, {attrs}base, limit, writing, sites, made, "
+        columns = "".join(f"q{k}, " for k in range(len(root_params))) + "".join(
+            f"a{k}, " for k in range(len(self.attrs)))
+        self.lines[1] = (f"def derive(origin, size, frame, lot, frames, {columns}base, limit, writing, sites, made, "
                          "bad, xform, record_lot):")
 
     def put(self, level: int, line: str) -> None:
@@ -114,8 +126,8 @@ class _Writer:
         return f"{stem}_{next(self.names)}"
 
     # ------------------------------------------------------------------------------------------ symbols
-    def symbol(self, sym_id: int, origin: tuple, size: tuple, level: int, depth: int) -> Block:
-        """The code of symbol ``sym_id``'s rules on the scope in ``origin``/``size`` (variable names)."""
+    def symbol(self, sym_id: int, scope: Scope, level: int, depth: int) -> Block:
+        """The code of symbol ``sym_id``'s rules on ``scope``."""
         self.depth = max(self.depth, depth)
         block = Block(sym_id, first=self.sites)
         rules = applied_rules(self.plan.symbols[sym_id])
@@ -125,52 +137,63 @@ class _Writer:
                     self.put(level, "else:")
                 inner = level + 1 if k else level
             else:
-                self.put(level, f"{'el' if k else ''}if {self.expr(rule.guard, size)}:")
+                self.put(level, f"{'el' if k else ''}if {self.expr(rule.guard, scope)}:")
                 inner = level + 1
             self.put(inner, "pass")
-            self.body(rule.alternatives[0].body, block, origin, size, inner, depth)
+            self.body(rule.alternatives[0].body, block, scope, inner, depth)
         block.last = self.sites
         return block
 
-    def body(self, body: ir.Body, block: Block, origin: tuple, size: tuple, level: int, depth: int) -> None:
+    def body(self, body: ir.Body, block: Block, scope: Scope, level: int, depth: int) -> None:
+        """``execute.run``: the operations in order on one scope; ``[`` keeps it, ``]`` takes it back; an
+        operation that makes shapes or records leaves it as it was."""
+        stack = []
         for op in body:
-            if isinstance(op, ir.Scale):
-                size = self.scale(op, size, level)
+            if isinstance(op, ir.Push):
+                stack.append(scope)
+            elif isinstance(op, ir.Pop):
+                scope = stack.pop() if stack else scope
+            elif isinstance(op, ir.Scale):
+                scope = scope._replace(size=self.scale(op, scope, level))
             elif isinstance(op, ir.Translate):
-                origin = self.translate(op, origin, size, level)
+                scope = scope._replace(origin=self.translate(op, scope, level))
             elif isinstance(op, ir.Split):
-                self.split(op, block, origin, size, level, depth)
+                self.split(op, block, scope, level, depth)
             elif isinstance(op, ir.Repeat):
-                self.repeat(op, block, origin, size, level, depth)
+                self.repeat(op, block, scope, level, depth)
             elif isinstance(op, ir.Insert):
-                self.emit(block, self.plan.grammar.asset_ids[op.asset], origin, size, level)
+                self.emit(block, self.plan.grammar.asset_ids[op.asset], scope, level)
             elif isinstance(op, ir.Symbol):
                 self.made(level)
+                args = []
+                for arg in op.args:  # ``operations.successors``: evaluated on the caller's scope
+                    args.append(self.fresh("p"))
+                    self.put(level, f"{args[-1]} = {self.expr(arg, scope)}")
                 target = self.plan.symbol_ids[op.name]
-                block.events.append(self.symbol(target, origin, size, level, depth + 1))
+                block.events.append(self.symbol(target, scope._replace(params=tuple(args)), level, depth + 1))
             # ``ε``: nothing
 
     # ------------------------------------------------------------------------------------------ operations
-    def scale(self, op: ir.Scale, size: tuple, level: int) -> tuple:
+    def scale(self, op: ir.Scale, scope: Scope, level: int) -> tuple:
         """``operations.scope.scale``: each axis' value, times the size where relative; the paper's ``S``
         fails a negative or NaN size."""
         new = []
         for axis, s in enumerate(op.sizes):
             name = self.fresh("s")
-            value = self.expr(s.value, size)
-            self.put(level, f"{name} = ({value}) * {size[axis]}" if s.kind is ir.SizeKind.RELATIVE
+            value = self.expr(s.value, scope)
+            self.put(level, f"{name} = ({value}) * {scope.size[axis]}" if s.kind is ir.SizeKind.RELATIVE
                      else f"{name} = {value}")
             new.append(name)
         self.check(level, " and ".join(f"{name} >= 0.0" for name in new))
         return tuple(new)
 
-    def translate(self, op: ir.Translate, origin: tuple, size: tuple, level: int) -> tuple:
+    def translate(self, op: ir.Translate, scope: Scope, level: int) -> tuple:
         """``operations.scope.translate``: the vector along the scope axes, summed axis by axis from zero
         (as ``kernels.scope.leaf_xforms`` and the interpreter's product sum it), added to the origin."""
         local = []
         for e in op.vector:
             local.append(self.fresh("t"))
-            self.put(level, f"{local[-1]} = {self.expr(e, size)}")
+            self.put(level, f"{local[-1]} = {self.expr(e, scope)}")
         new = []
         for j in range(3):
             delta = self.fresh("d")
@@ -178,16 +201,16 @@ class _Writer:
             for i in range(3):
                 self.put(level, f"{delta} += {local[i]} * frames[f, {i}, {j}]")
             new.append(self.fresh("o"))
-            self.put(level, f"{new[-1]} = {origin[j]} + {delta}")
+            self.put(level, f"{new[-1]} = {scope.origin[j]} + {delta}")
         return tuple(new)
 
-    def split(self, op: ir.Split, block: Block, origin: tuple, size: tuple, level: int, depth: int) -> None:
+    def split(self, op: ir.Split, block: Block, scope: Scope, level: int, depth: int) -> None:
         """``kernels.split.subdiv`` for one parent: relative sizes share what the absolute ones leave, parts
         laid end to end, cut at the scope's end, those of length ``TOL.zero`` or less dropped."""
-        axis, extent = op.axes[0], size[op.axes[0]]
+        axis, extent = op.axes[0], scope.size[op.axes[0]]
         values = [self.fresh("v") for _ in op.sizes]
         for name, s in zip(values, op.sizes):
-            self.put(level, f"{name} = {self.expr(s.value, size)}")
+            self.put(level, f"{name} = {self.expr(s.value, scope)}")
         self.check(level, " and ".join(f"{name} >= 0.0" for name in values))
         absolute, relative, free, at = (self.fresh(stem) for stem in ("ab", "rl", "fr", "at"))
         self.put(level, f"{absolute} = 0.0")
@@ -208,15 +231,15 @@ class _Writer:
             self.put(level, f"{end} = min({end}, {extent})")
             self.put(level, f"if {end} - {at} > {TOL.zero!r}:")
             self.put(level + 1, f"{length} = {end} - {at}")
-            self.child(part, block, origin, size, axis, at, length, level + 1, depth)
+            self.child(part, block, scope, axis, at, length, level + 1, depth)
             self.put(level, f"{at} = {at} + {step}")
 
-    def repeat(self, op: ir.Repeat, block: Block, origin: tuple, size: tuple, level: int, depth: int) -> None:
+    def repeat(self, op: ir.Repeat, block: Block, scope: Scope, level: int, depth: int) -> None:
         """``kernels.split.repeat_counts`` and ``repeat`` for one parent: ceil(extent / size) equal
         elements (at least one on a scope longer than ``TOL.zero``), element j in part j mod parts."""
-        axis, extent = op.axes[0], size[op.axes[0]]
+        axis, extent = op.axes[0], scope.size[op.axes[0]]
         value, times, ceiling, step, j, pos = (self.fresh(s) for s in ("rv", "c", "x", "st", "j", "ps"))
-        self.put(level, f"{value} = {self.expr(op.sizes[0], size)}")
+        self.put(level, f"{value} = {self.expr(op.sizes[0], scope)}")
         self.check(level, f"{value} > 0.0")
         self.put(level, f"{times} = 0")
         self.put(level, f"if {value} > 0.0 and {extent} > {TOL.zero!r}:")
@@ -236,22 +259,22 @@ class _Writer:
             if parts > 1:
                 self.put(level + 1, f"{'if' if k == 0 else 'elif'} {j} % {parts} == {k}:")
                 inner = level + 2
-            self.child(part, block, origin, size, axis, pos, step, inner, depth)
+            self.child(part, block, scope, axis, pos, step, inner, depth)
 
-    def child(self, part: ir.Body, block: Block, origin: tuple, size: tuple, axis: int, pos: str, length: str,
-              level: int, depth: int) -> None:
+    def child(self, part: ir.Body, block: Block, scope: Scope, axis: int, pos: str, length: str, level: int,
+              depth: int) -> None:
         """A split child (``kernels.scope.place_children``: the origin moved by ``pos`` along the split
         axis, the size cut to ``length``) and its part's body."""
         moved = []
         for j in range(3):
             moved.append(self.fresh("o"))
-            self.put(level, f"{moved[-1]} = {origin[j]} + {pos} * frames[f, {axis}, {j}]")
-        cut = tuple(length if k == axis else size[k] for k in range(3))
+            self.put(level, f"{moved[-1]} = {scope.origin[j]} + {pos} * frames[f, {axis}, {j}]")
+        cut = tuple(length if k == axis else scope.size[k] for k in range(3))
         self.made(level)
         self.put(level, "pass")
-        self.body(part, block, tuple(moved), cut, level, depth)
+        self.body(part, block, scope._replace(origin=tuple(moved), size=cut), level, depth)
 
-    def emit(self, block: Block, asset: int, origin: tuple, size: tuple, level: int) -> None:
+    def emit(self, block: Block, asset: int, scope: Scope, level: int) -> None:
         """An emission site: counted, or a record of the scope (``kernels.scope.xforms``) at the site's next
         row."""
         site = self.sites
@@ -262,8 +285,8 @@ class _Writer:
         self.put(level + 1, f"{row} = sites[{site}]")
         for r in range(3):
             for j in range(3):
-                self.put(level + 1, f"xform[{row}, {r}, {j}] = frames[f, {j}, {r}] * {size[j]}")
-            self.put(level + 1, f"xform[{row}, {r}, 3] = {origin[r]} - base[l, {r}]")
+                self.put(level + 1, f"xform[{row}, {r}, {j}] = frames[f, {j}, {r}] * {scope.size[j]}")
+            self.put(level + 1, f"xform[{row}, {r}, 3] = {scope.origin[r]} - base[l, {r}]")
         self.put(level + 1, f"record_lot[{row}] = l")
         self.put(level, f"sites[{site}] += 1")
 
@@ -277,9 +300,10 @@ class _Writer:
         self.put(level + 1, "bad[i] = True")
 
     # ------------------------------------------------------------------------------------------ expressions
-    def expr(self, expr: ir.Expr, size: tuple) -> str:
-        """``expr`` as numba source: numbers as float64 literals, attributes read by lot, ``scope.s*`` from
-        the scope's variables, operators as ``backend.evaluate`` applies them (float64, IEEE division)."""
+    def expr(self, expr: ir.Expr, scope: Scope) -> str:
+        """``expr`` as numba source: numbers as float64 literals, attributes read by lot, parameters and
+        ``scope.s*`` from the scope's variables, operators as ``backend.evaluate`` applies them (float64,
+        IEEE division)."""
         if isinstance(expr, ir.Bool):
             return repr(bool(expr.value))
         if isinstance(expr, ir.Num):
@@ -289,9 +313,11 @@ class _Writer:
             if expr.name not in self.attrs:
                 self.attrs.append(expr.name)
             return f"a{self.attrs.index(expr.name)}[l]"
+        if isinstance(expr, ir.Param):
+            return scope.params[expr.index]
         if isinstance(expr, ir.ScopeRef):
-            return size[SIZES[expr.field]]
+            return scope.size[SIZES[expr.field]]
         if isinstance(expr, ir.Unary):
-            return f"({'not ' if expr.op == '!' else '-'}{self.expr(expr.operand, size)})"
+            return f"({'not ' if expr.op == '!' else '-'}{self.expr(expr.operand, scope)})"
         operator = {"&&": "and", "||": "or"}.get(expr.op, expr.op)
-        return f"({self.expr(expr.left, size)} {operator} {self.expr(expr.right, size)})"
+        return f"({self.expr(expr.left, scope)} {operator} {self.expr(expr.right, scope)})"

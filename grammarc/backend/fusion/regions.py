@@ -3,9 +3,9 @@
 A region is a symbol (its *root*) with the symbols its rules lead to, all derived by one generated kernel
 (``codegen``) from the root's pending shapes: no intermediate shape columns, the terminals written straight
 into the records. It covers what needs no context: the scope operations ``S`` and ``T``, single-axis
-``Subdiv`` and ``Repeat`` (no snapping), ``I``, ``ε``, successor symbols, guards and sizes made of numbers,
-attributes, ``scope.sx|sy|sz`` and arithmetic. Anything else - another operation, a stochastic rule, a
-parameter, a function call - keeps the symbol for the interpreter (``backend.execute``), which remains the
+``Subdiv`` and ``Repeat`` (no snapping), ``I``, ``ε``, ``[ ]``, successor symbols (with arguments), guards
+and sizes made of numbers, attributes, parameters (numbers), ``scope.sx|sy|sz`` and arithmetic. Anything
+else - another operation, a stochastic rule, a function call - keeps the symbol for the interpreter (``backend.execute``), which remains the
 reference: both give the same records, bit for bit (``tests/backend/fusion``).
 
 A successor symbol is derived inside the region (*inlined*) only where the interpreter's record order can be
@@ -36,8 +36,6 @@ COMPARE = frozenset({"<", "<=", ">", ">=", "==", "!="})
 LOGIC = frozenset({"&&", "||"})
 #: The scope fields a fused expression may read: the scope's size.
 SIZES = {"sx": 0, "sy": 1, "sz": 2}
-#: Operations that end a body (nothing of the body may follow them).
-ENDING = (ir.Split, ir.Repeat, ir.Insert, ir.Symbol, ir.Empty)
 
 
 def enabled() -> bool:
@@ -75,7 +73,7 @@ class Fusible:
         return bool(plan.symbols[sym_id].rules) and (alone or sym_id in plan.leaf_inserts) and self.symbol(sym_id)
 
     def _rules(self, sym) -> bool:
-        if not sym.rules or sym.param_types or sym.id in self.plan.snapping:
+        if not sym.rules or any(t is not ir.Type.NUM for t in sym.param_types) or sym.id in self.plan.snapping:
             return False
         for rule in applied_rules(sym):
             if len(rule.alternatives) != 1 or (rule.guard is not None and not self.expr(rule.guard)):
@@ -85,12 +83,7 @@ class Fusible:
         return applied_rules(sym)[-1].guard is None  # shapes no rule applies to would be leaves
 
     def body(self, body: ir.Body) -> bool:
-        for k, op in enumerate(body):
-            if isinstance(op, ENDING) and k != len(body) - 1:
-                return False
-            if not self.op(op):
-                return False
-        return True
+        return all(self.op(op) for op in body)
 
     def op(self, op: ir.Op) -> bool:
         if isinstance(op, ir.Scale):
@@ -104,11 +97,11 @@ class Fusible:
             return (len(op.axes) == 1 and not op.snap and all(self.expr(e) for e in op.sizes)
                     and all(self.body(part) for part in op.parts))
         if isinstance(op, ir.Symbol):
-            return not op.args and not op.leaf and self.inlined(op.name)
-        return isinstance(op, (ir.Insert, ir.Empty))
+            return not op.leaf and self.inlined(op.name) and all(self.expr(arg) for arg in op.args)
+        return isinstance(op, (ir.Insert, ir.Empty, ir.Push, ir.Pop))
 
     def expr(self, expr: ir.Expr) -> bool:
-        if isinstance(expr, (ir.Num, ir.Bool)):
+        if isinstance(expr, (ir.Num, ir.Bool, ir.Param)):  # parameters: numbers (``_rules``)
             return True
         if isinstance(expr, ir.AttrRef):
             return True  # a column of numbers, which the runner checks (``run.attribute_columns``)

@@ -52,12 +52,12 @@ class FusedBatch:
 
 def derive(ctx, region, shapes: Shapes) -> bool:
     """Derive ``shapes`` of ``region``'s root with its kernels; False (nothing done) where the interpreter
-    must: a shape with geometry of its own, a depth within reach of --max-depth, an attribute that is not a
-    number column, or a shape that would fail."""
+    must: a shape with geometry of its own, a depth within reach of --max-depth, a parameter or attribute
+    that is not a column of numbers, or a shape that would fail."""
     chunk, limits = ctx.chunk, ctx.limits
     if (shapes.geom != -1).any() or int(shapes.depth.max()) + region.depth >= limits.max_depth:
         return False
-    attrs = [chunk.attrs.get(name) for name in region.attrs]
+    attrs = [*shapes.params, *(chunk.attrs.get(name) for name in region.attrs)]
     if not all(isinstance(a, np.ndarray) and a.dtype == np.float64 for a in attrs):
         return False
     kernel = load(region.text).derive

@@ -47,13 +47,13 @@ x ~> S(1r, 1r, 0.2) I("cube")
 """) == {"lot", "a", "b", "x"}
 
 
-def test_parameters_functions_random_choices_and_recursion_are_not_fused(write):
+def test_functions_random_choices_and_recursion_are_not_fused_parameters_are(write):
     assert fused(write, """
 lot ~> Subdiv("X", 1r, rand(1, 2)){ a(2) | b }
-a(k) ~> S(k, 1r, 1r) I("cube")
+a(k) ~> S(k, 1r, 1r) [ T(0, k, 0) I("quad") ] I("cube")
 b ~> I("cube") : 0.5
   ~> I("quad") : 0.5
-""") == set()
+""") == {"a"}
     assert fused(write, """
 lot ~> Subdiv("X", 1r, 1r){ lot | I("cube") }
 """) == set()

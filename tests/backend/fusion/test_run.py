@@ -10,7 +10,9 @@ import numpy as np
 import pytest
 from conftest import make_lots
 
+from grammarc.backend import execute
 from grammarc.backend.fusion.regions import SWITCH
+from grammarc.backend.fusion.run import derive as derive_fused
 from grammarc.backend.plan import make_plan
 from grammarc.build import BuildOptions, derive
 from grammarc.compiler import compile_grammar
@@ -29,6 +31,15 @@ glass ~> S(1r, 1r, 0.05) T(0, 0, -0.05) I("cube")
 pane ~> I("quad")
 """
 
+#: Parameters (of the root, and passed on) and brackets: the root ``facade`` takes its storeys from ``lot``.
+PASSED_ON = """
+attr sill = 0.9
+lot ~> S(1r, 9, 1r) Comp("sidefaces"){ facade(3) }
+facade(floors) ~> Repeat("Y", Scope.sy / floors){ storey(floors, 0.6) }
+storey(k, w) ~> [ T(0, 0, w * 0.1) S(1r, 0.2, 0.3) I("cube") ] Subdiv("X", 1r, k * 0.4, 1r){ I("quad") | bay(w + sill) | I("quad") }
+bay(h) ~> Subdiv("Y", h, 1r){ I("quad") | [ S(1r, 1r, 0.1) I("cube") ] T(0, 0, -0.1) I("quad") }
+"""
+
 #: ``Subdiv`` of a computed size that goes negative on narrow facades: the interpreter fails those lots.
 NEGATIVE = """
 lot ~> S(1r, 6, 1r) Comp("sidefaces"){ facade }
@@ -38,8 +49,17 @@ part ~> Repeat("Y", 3){ I("quad") }
 
 
 def both(write, monkeypatch, text: str, lots, **options) -> tuple[dict, dict]:
+    """The records fused and interpreted; the fused ones with ``"kernels"``: how many batches kernels derived."""
     path = write("g.cga", text)
+    taken = []
+
+    def counted(ctx, region, shapes):
+        taken.append(derive_fused(ctx, region, shapes))
+        return taken[-1]
+
+    monkeypatch.setattr(execute, "derive_fused", counted)
     fused = derive(compile_grammar(path), lots, BuildOptions(**options))
+    fused["kernels"] = sum(taken)
     monkeypatch.setenv(SWITCH, "off")
     interpreted = derive(compile_grammar(path), lots, BuildOptions(**options))
     monkeypatch.delenv(SWITCH)
@@ -56,14 +76,22 @@ def test_fused_and_interpreted_symbols_meet_in_the_interpreter_order(write, monk
     plan = make_plan(compile_grammar(write("g.cga", MIXED)))
     assert {plan.symbols[k].name for k in plan.fused} == {"bay", "glass", "pane"}
     fused, interpreted = both(write, monkeypatch, MIXED, make_lots("square", "rect_12x8", "concave_L", "courtyard"))
-    assert len(fused["asset"]) > 200
+    assert len(fused["asset"]) > 200 and fused["kernels"]
+    assert_same(fused, interpreted)
+
+
+def test_parameters_and_brackets(write, monkeypatch):
+    plan = make_plan(compile_grammar(write("g.cga", PASSED_ON)))
+    assert {plan.symbols[k].name for k in plan.fused} == {"facade", "storey", "bay"}
+    fused, interpreted = both(write, monkeypatch, PASSED_ON, make_lots("square", "concave_L", "courtyard"))
+    assert len(fused["asset"]) > 100 and fused["kernels"]
     assert_same(fused, interpreted)
 
 
 def test_a_batch_the_interpreter_would_fail_is_left_to_it(write, monkeypatch):
     fused, interpreted = both(write, monkeypatch, NEGATIVE, make_lots("square", "rect_12x8", "concave_L"))
     assert fused["bad"] and "negative" in fused["bad"][0].reason
-    assert len(fused["asset"])
+    assert len(fused["asset"]) and fused["kernels"]
     assert_same(fused, interpreted)
 
 
