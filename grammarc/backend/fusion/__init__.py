@@ -47,14 +47,14 @@ class Region:
 
 
 def fused_regions(plan) -> dict[int, Region]:
-    """The regions of ``plan`` by root symbol id: every symbol ``regions.Fusible`` accepts (none where
-    fusion is off or the grammar needs what no kernel carries)."""
+    """The regions of ``plan`` by root symbol id: every symbol ``regions.Fusible`` accepts whose shapes fan
+    out (none where fusion is off or the grammar needs what no kernel carries)."""
     if not enabled() or not grammar_allows(plan):
         return {}
     fusible = Fusible(plan)
     found = {}
     for sym in plan.symbols:
-        if fusible.symbol(sym.id):
+        if fusible.symbol(sym.id) and fusible.worth_a_kernel(sym.id):
             source = generate(plan, sym.id)
             found[sym.id] = Region(sym.id, source.text, source.block, source.attrs, source.sites, source.depth)
     return found

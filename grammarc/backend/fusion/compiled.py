@@ -12,10 +12,19 @@ from __future__ import annotations
 
 import hashlib
 import importlib.util
+import os
 import sys
 import tempfile
+from contextlib import contextmanager
 from functools import cache
 from pathlib import Path
+
+import numpy as np
+
+try:
+    import fcntl
+except ImportError:  # Windows: no forked workers to wait for
+    fcntl = None
 
 from grammarc.frontend import user_cache
 
@@ -26,8 +35,41 @@ def digest(text: str) -> str:
 
 
 @cache
+def kernel(text: str, columns: int):
+    """The compiled kernel (``derive``) of a region's source ``text`` whose parameters and attributes are
+    ``columns`` arrays, once per process.
+
+    It is compiled (or its machine code loaded from numba's cache) here, on empty arrays of the types the
+    runner passes, holding a lock beside the file: forked workers that start on the same grammar wait for
+    the first one's compilation and load its machine code, instead of each compiling the same kernel.
+    """
+    module, path = load(text)
+    rows = [np.zeros((0, 3)), np.zeros((0, 3)), np.zeros(0, np.int32), np.zeros(0, np.int32), np.zeros((1, 3, 3)),
+            *(np.zeros(0) for _ in range(columns)), np.zeros((0, 3)), 0.0, False, np.zeros(0, np.int64),
+            np.zeros(0), np.zeros(0, np.bool_), np.zeros((0, 3, 4), np.float32), np.zeros(0, np.int32)]
+    with _locked(path.with_suffix(".lock")):
+        module.derive(*rows)
+    return module.derive
+
+
+@contextmanager
+def _locked(path: Path):
+    """An exclusive lock on the file at ``path`` (none where files cannot be locked or made)."""
+    try:
+        fd = os.open(path, os.O_RDWR | os.O_CREAT | os.O_NOFOLLOW, 0o600)
+    except OSError:
+        yield
+        return
+    try:
+        if fcntl is not None:
+            fcntl.flock(fd, fcntl.LOCK_EX)
+        yield
+    finally:
+        os.close(fd)  # releases the lock
+
+
 def load(text: str):
-    """The module of ``text`` (its kernel, ``derive``), once per process."""
+    """The module of ``text`` and the file it was imported from."""
     key = digest(text)
     folder = user_cache.cache_folder("fusion") or _private_folder()
     path = folder / f"region_{key}.py"
@@ -41,7 +83,7 @@ def load(text: str):
     module = importlib.util.module_from_spec(spec)
     sys.modules[name] = module  # numba's cache finds the functions' globals by the module's name
     spec.loader.exec_module(module)
-    return module
+    return module, path
 
 
 @cache

@@ -65,6 +65,17 @@ class Fusible:
             self._fusible[sym_id] = self._rules(self.plan.symbols[sym_id])
         return self._fusible[sym_id]
 
+    def worth_a_kernel(self, sym_id: int) -> bool:
+        """Whether the region of fusible symbol ``sym_id`` splits or repeats: a kernel's compilation pays off
+        where shapes fan out (one of scope operations and inserts alone the interpreter runs as fast)."""
+        for rule in applied_rules(self.plan.symbols[sym_id]):
+            for op in iter_ops(rule):
+                if isinstance(op, (ir.Split, ir.Repeat)):
+                    return True
+                if isinstance(op, ir.Symbol) and self.worth_a_kernel(self.plan.symbol_ids[op.name]):
+                    return True
+        return False
+
     def inlined(self, name: str) -> bool:
         """Whether the successor symbol ``name`` is derived inside its region (module docstring)."""
         plan = self.plan

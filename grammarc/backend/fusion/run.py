@@ -3,8 +3,8 @@ would have.
 
 ``derive`` runs the kernel over the batch counting, checks what the interpreter would refuse (then it hands
 the whole batch back, and the interpreter derives it, failing what it fails), counts the shapes for
---max-shapes as the interpreter does, allocates the records once and runs the kernel again, writing. The root's own records are emitted at
-once; those of each inlined symbol wait in that symbol's pending list as a ``FusedBatch`` until the
+--max-shapes as the interpreter does, allocates the records once and runs the kernel again, writing. The
+root's own records are emitted at once; those of each inlined symbol wait in that symbol's pending list as a ``FusedBatch`` until the
 schedule reaches it, where the interpreter would have run its rules on the shapes handed to it.
 """
 
@@ -16,7 +16,7 @@ import numpy as np
 
 from grammarc.backend import terminals
 from grammarc.backend.fusion.codegen import Block, Emit
-from grammarc.backend.fusion.compiled import load
+from grammarc.backend.fusion.compiled import kernel
 from grammarc.backend.shapes import Shapes
 from grammarc.ragged import offsets_from_counts
 
@@ -60,19 +60,20 @@ def derive(ctx, region, shapes: Shapes) -> bool:
     attrs = [*shapes.params, *(chunk.attrs.get(name) for name in region.attrs)]
     if not all(isinstance(a, np.ndarray) and a.dtype == np.float64 for a in attrs):
         return False
-    kernel = load(region.text).derive
+    derive_batch = kernel(region.text, len(attrs))
     n = len(shapes)
     sites, made, bad = np.zeros(region.sites, np.int64), np.empty(n), np.zeros(n, np.bool_)
-    columns = (shapes.origin, shapes.size, shapes.frame, shapes.lot, chunk.frames.data, *attrs, chunk.lot_origin,
-               float(limits.max_shapes))
-    kernel(*columns, False, sites, made, bad, np.empty((0, 3, 4), np.float32), np.empty(0, np.int32))
+    # contiguous, as the kernel was compiled for (``compiled.kernel``): a copy only where one is not
+    columns = (*map(np.ascontiguousarray, (shapes.origin, shapes.size, shapes.frame, shapes.lot, chunk.frames.data,
+                                           *attrs, chunk.lot_origin)), float(limits.max_shapes))
+    derive_batch(*columns, False, sites, made, bad, np.empty((0, 3, 4), np.float32), np.empty(0, np.int32))
     if bad.any() or not _within_limit(ctx, shapes.lot, made):
         return False
     ctx.count_lots(shapes.lot, ctx.plan.symbols[region.root].rules[0].span, made.astype(np.int64))
     starts = offsets_from_counts(sites)
     total = int(starts[-1])
     xform, lot = np.empty((total, 3, 4), np.float32), np.empty(total, np.int32)
-    kernel(*columns, True, starts[:-1].copy(), made, bad, xform, lot)
+    derive_batch(*columns, True, starts[:-1].copy(), made, bad, xform, lot)
     FusedBatch(FusedRecords(xform, lot, starts), region.block).emit(ctx)
     return True
 

@@ -36,5 +36,5 @@ def test_the_source_is_a_function_of_the_region():
     assert len(texts) == 1
     text = texts.pop()
     assert digest(text) != digest(generate(plan, plan.symbol_ids["floor"]).text)
-    module = load(text)
-    assert callable(module.derive)
+    module, path = load(text)
+    assert path.read_text() == text and callable(module.derive)

@@ -74,7 +74,7 @@ def assert_same(fused: dict, interpreted: dict) -> None:
 
 def test_fused_and_interpreted_symbols_meet_in_the_interpreter_order(write, monkeypatch):
     plan = make_plan(compile_grammar(write("g.cga", MIXED)))
-    assert {plan.symbols[k].name for k in plan.fused} == {"bay", "glass", "pane"}
+    assert {plan.symbols[k].name for k in plan.fused} == {"bay"}
     fused, interpreted = both(write, monkeypatch, MIXED, make_lots("square", "rect_12x8", "concave_L", "courtyard"))
     assert len(fused["asset"]) > 200 and fused["kernels"]
     assert_same(fused, interpreted)
