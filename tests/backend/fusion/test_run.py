@@ -40,6 +40,17 @@ storey(k, w) ~> [ T(0, 0, w * 0.1) S(1r, 0.2, 0.3) I("cube") ] Subdiv("X", 1r, k
 bay(h) ~> Subdiv("Y", h, 1r){ I("quad") | [ S(1r, 1r, 0.1) I("cube") ] T(0, 0, -0.1) I("quad") }
 """
 
+#: The layouts' edges: absolute parts longer than the scope (cut, then dropped), relative parts left nothing,
+#: a repeat of two parts, flat scopes (no repeat element on a zero extent), attribute sizes.
+EDGES = """
+attr pier = 4
+lot ~> S(1r, 6, 1r) Comp("sidefaces"){ facade }
+facade ~> Subdiv("X", pier, 1r, pier, 1r){ Repeat("Y", 1.1){ a | b } | S(1r, 1r, 0) Repeat("Z", 1){ I("cube") } | c | I("quad") }
+a ~> S(1r, 0.5r, 1r) I("cube")
+b ~> T(0, 0, 0.3) I("quad")
+c ~> Subdiv("Y", 5, 0.5, 1r, 2){ I("cube") | I("quad") | I("cube") | I("quad") }
+"""
+
 #: ``Subdiv`` of a computed size that goes negative on narrow facades: the interpreter fails those lots.
 NEGATIVE = """
 lot ~> S(1r, 6, 1r) Comp("sidefaces"){ facade }
@@ -84,6 +95,12 @@ def test_parameters_and_brackets(write, monkeypatch):
     plan = make_plan(compile_grammar(write("g.cga", PASSED_ON)))
     assert {plan.symbols[k].name for k in plan.fused} == {"facade", "storey", "bay"}
     fused, interpreted = both(write, monkeypatch, PASSED_ON, make_lots("square", "concave_L", "courtyard"))
+    assert len(fused["asset"]) > 100 and fused["kernels"]
+    assert_same(fused, interpreted)
+
+
+def test_the_edges_of_the_layouts(write, monkeypatch):
+    fused, interpreted = both(write, monkeypatch, EDGES, make_lots("square", "rect_12x8", "concave_L", "courtyard"))
     assert len(fused["asset"]) > 100 and fused["kernels"]
     assert_same(fused, interpreted)
 
