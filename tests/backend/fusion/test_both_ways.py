@@ -4,7 +4,9 @@ which is not fused) is derived both ways and its digest compared (records, repor
 
 from __future__ import annotations
 
+import atexit
 import importlib.util
+import shutil
 import tempfile
 from pathlib import Path
 
@@ -25,7 +27,9 @@ def _replay():
 
 
 REPLAY = _replay()
+#: The replay's lots, written when the cases are collected (the parameters need them), removed at exit.
 LOTS = Path(tempfile.mkdtemp(prefix="grammarc-fusion-lots-"))
+atexit.register(shutil.rmtree, LOTS, True)
 
 
 def _fused_cases():
