@@ -27,7 +27,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from grammarc.backend.fusion.codegen import Block, generate
+from grammarc.backend.fusion.codegen import Source, generate
 from grammarc.backend.fusion.regions import Fusible, enabled, grammar_allows
 
 __all__ = ["Region", "fused_regions"]
@@ -35,15 +35,10 @@ __all__ = ["Region", "fused_regions"]
 
 @dataclass(frozen=True)
 class Region:
-    """A fused region: its root symbol, its generated module's ``text``, the root's ``Block``, the
-    attributes its kernels take, its emission sites, and how deep below the root it derives."""
+    """A fused region: its root symbol and its generated kernel (``codegen.Source``)."""
 
     root: int
-    text: str
-    block: Block
-    attrs: tuple[str, ...]
-    sites: int
-    depth: int
+    source: Source
 
 
 def fused_regions(plan) -> dict[int, Region]:
@@ -52,9 +47,5 @@ def fused_regions(plan) -> dict[int, Region]:
     if not enabled() or not grammar_allows(plan):
         return {}
     fusible = Fusible(plan)
-    found = {}
-    for sym in plan.symbols:
-        if fusible.symbol(sym.id) and fusible.worth_a_kernel(sym.id):
-            source = generate(plan, sym.id)
-            found[sym.id] = Region(sym.id, source.text, source.block, source.attrs, source.sites, source.depth)
-    return found
+    return {sym.id: Region(sym.id, generate(plan, sym.id)) for sym in plan.symbols
+            if fusible.symbol(sym.id) and fusible.worth_a_kernel(sym.id)}

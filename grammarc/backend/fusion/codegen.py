@@ -4,8 +4,8 @@ A region (``regions``) becomes one function over its root's batch, a loop over t
 rules of the root and of the symbols it inlines written out as nested code: a split is a loop over its
 children (or one block per ``Subdiv`` part), a guard an ``if``, a successor the code of its symbol's rules,
 an ``I`` an *emission site*. The scope travels in local variables (origin and size per axis; the frame stays
-the parent's: no operation of a region turns it). The runner calls it twice (one function compiles in half
-the time of two). Counting, ``sites[k]`` adds up the records site k makes; ``made`` the shapes each parent
+the parent's: no operation of a region turns it). The runner calls it twice (one function to compile, not
+two). Counting, ``sites[k]`` adds up the records site k makes; ``made`` the shapes each parent
 makes (as the interpreter counts them for --max-shapes), and ``bad`` flags parents the interpreter would
 fail (a negative size, a repeat beyond the limit). Writing, ``sites[k]`` is site k's next row, where its
 record goes. Records of one site thus come in the parents' order and, within a parent, in the order of

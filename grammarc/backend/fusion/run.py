@@ -55,14 +55,14 @@ def derive(ctx, region, shapes: Shapes) -> bool:
     must: a shape with geometry of its own, a depth within reach of --max-depth, a parameter or attribute
     that is not a column of numbers, or a shape that would fail."""
     chunk, limits = ctx.chunk, ctx.limits
-    if (shapes.geom != -1).any() or int(shapes.depth.max()) + region.depth >= limits.max_depth:
+    if (shapes.geom != -1).any() or int(shapes.depth.max()) + region.source.depth >= limits.max_depth:
         return False
-    attrs = [*shapes.params, *(chunk.attrs.get(name) for name in region.attrs)]
+    attrs = [*shapes.params, *(chunk.attrs.get(name) for name in region.source.attrs)]
     if not all(isinstance(a, np.ndarray) and a.dtype == np.float64 for a in attrs):
         return False
-    derive_batch = kernel(region.text, len(attrs))
+    derive_batch = kernel(region.source.text, len(attrs))
     n = len(shapes)
-    sites, made, bad = np.zeros(region.sites, np.int64), np.empty(n), np.zeros(n, np.bool_)
+    sites, made, bad = np.zeros(region.source.sites, np.int64), np.empty(n), np.zeros(n, np.bool_)
     # contiguous, as the kernel was compiled for (``compiled.kernel``): a copy only where one is not
     columns = (*map(np.ascontiguousarray, (shapes.origin, shapes.size, shapes.frame, shapes.lot, chunk.frames.data,
                                            *attrs, chunk.lot_origin)), float(limits.max_shapes))
@@ -74,7 +74,7 @@ def derive(ctx, region, shapes: Shapes) -> bool:
     total = int(starts[-1])
     xform, lot = np.empty((total, 3, 4), np.float32), np.empty(total, np.int32)
     derive_batch(*columns, True, starts[:-1].copy(), made, bad, xform, lot)
-    FusedBatch(FusedRecords(xform, lot, starts), region.block).emit(ctx)
+    FusedBatch(FusedRecords(xform, lot, starts), region.source.block).emit(ctx)
     return True
 
 
