@@ -20,7 +20,8 @@ order of the batch, which is the order of the root's shapes and, within one, of 
 (a split's part holds its children in their parents' order). The kernel writes site by site in that order;
 the records of a site in an inlined symbol's rules are emitted when the schedule reaches that symbol
 (``run.FusedBatch``), where the interpreter would have emitted them. ``GRAMMARC_FUSION=off`` derives with
-the interpreter alone.
+the interpreter alone. A kernel is compiled once (numba's cache keeps it), for a batch large enough to pay
+for its compilation; a compiled one then serves every batch.
 """
 
 from __future__ import annotations
@@ -28,24 +29,27 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from grammarc.backend.fusion.codegen import Source, generate
-from grammarc.backend.fusion.regions import Fusible, enabled, grammar_allows
+from grammarc.backend.fusion.regions import Fusible, compile_at, grammar_allows
 
 __all__ = ["Region", "fused_regions"]
 
 
 @dataclass(frozen=True)
 class Region:
-    """A fused region: its root symbol and its generated kernel (``codegen.Source``)."""
+    """A fused region: its root symbol, its generated kernel (``codegen.Source``), and the batch size from
+    which its kernel is compiled if it is not yet (``regions.COMPILE_AT``)."""
 
     root: int
     source: Source
+    compile_at: int
 
 
 def fused_regions(plan) -> dict[int, Region]:
     """The regions of ``plan`` by root symbol id: every symbol ``regions.Fusible`` accepts whose shapes fan
     out (none where fusion is off or the grammar needs what no kernel carries)."""
-    if not enabled() or not grammar_allows(plan):
+    threshold = compile_at()
+    if threshold is None or not grammar_allows(plan):
         return {}
     fusible = Fusible(plan)
-    return {sym.id: Region(sym.id, generate(plan, sym.id)) for sym in plan.symbols
+    return {sym.id: Region(sym.id, generate(plan, sym.id), threshold) for sym in plan.symbols
             if fusible.symbol(sym.id) and fusible.worth_a_kernel(sym.id)}

@@ -34,22 +34,39 @@ def digest(text: str) -> str:
     return hashlib.sha256(text.encode()).hexdigest()[:24]
 
 
-@cache
+#: The kernels compiled or loaded in this process, by source text.
+_KERNELS: dict[str, object] = {}
+
+
 def kernel(text: str, columns: int):
     """The compiled kernel (``derive``) of a region's source ``text`` whose parameters and attributes are
     ``columns`` arrays, once per process.
 
     It is compiled (or its machine code loaded from numba's cache) here, on empty arrays of the types the
     runner passes, holding a lock beside the file: forked workers that start on the same grammar wait for
-    the first one's compilation and load its machine code, instead of each compiling the same kernel.
+    the first one's compilation and load its machine code, instead of each compiling the same kernel. A
+    mark beside the file then says it is compiled (``compiled``).
     """
+    if text in _KERNELS:
+        return _KERNELS[text]
     module, path = load(text)
     rows = [np.zeros((0, 3)), np.zeros((0, 3)), np.zeros(0, np.int32), np.zeros(0, np.int32), np.zeros((1, 3, 3)),
             *(np.zeros(0) for _ in range(columns)), np.zeros((0, 3)), 0.0, False, np.zeros(0, np.int64),
             np.zeros(0), np.zeros(0, np.bool_), np.zeros((0, 3, 4), np.float32), np.zeros(0, np.int32)]
     with _locked(path.with_suffix(".lock")):
         module.derive(*rows)
+    user_cache.store(path.with_suffix(".compiled"), lambda f: None)
+    _KERNELS[text] = module.derive
     return module.derive
+
+
+def compiled(text: str) -> bool:
+    """Whether the kernel of ``text`` was compiled before: in this process, or by an earlier one into the
+    cache folder (its mark is there), whence numba loads its machine code."""
+    if text in _KERNELS:
+        return True
+    folder = user_cache.cache_folder("fusion")
+    return folder is not None and user_cache.load(folder / f"region_{digest(text)}.compiled", lambda f: True) is True
 
 
 @contextmanager

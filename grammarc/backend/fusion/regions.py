@@ -16,7 +16,8 @@ be inlined is no region. The whole grammar is left to the interpreter where reco
 asset and a transform (colours, texture channels or coordinates, trims), where shapes carry per-shape
 state (``set``, ``split.index``, a pivot), where an insert occludes, and in CityEngine's dialect (a body's
 end is a leaf, and shapes draw from PRT's sequential stream, which successors move on in place).
-``GRAMMARC_FUSION=off`` turns fusion off.
+``GRAMMARC_FUSION=off`` turns fusion off; ``GRAMMARC_FUSION=always`` compiles a kernel for any batch, however
+small (``COMPILE_AT``).
 """
 
 from __future__ import annotations
@@ -38,9 +39,18 @@ LOGIC = frozenset({"&&", "||"})
 SIZES = {"sx": 0, "sy": 1, "sz": 2}
 
 
-def enabled() -> bool:
-    """Whether fusion is on (``GRAMMARC_FUSION`` is not ``off``)."""
-    return os.environ.get(SWITCH, "").strip().lower() not in ("off", "0", "false", "no")
+#: A kernel that is not compiled yet is compiled for a batch of at least this many shapes: compiling one
+#: costs seconds, which a build of a few lots would not win back (a compiled one serves every batch).
+COMPILE_AT = 10_000
+
+
+def compile_at() -> int | None:
+    """The batch size from which a kernel is compiled (``COMPILE_AT``; 0 with ``GRAMMARC_FUSION=always``, as
+    the tests run), or None where fusion is ``off``."""
+    value = os.environ.get(SWITCH, "").strip().lower()
+    if value in ("off", "0", "false", "no"):
+        return None
+    return 0 if value == "always" else COMPILE_AT
 
 
 def grammar_allows(plan) -> bool:

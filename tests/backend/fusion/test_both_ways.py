@@ -43,6 +43,12 @@ def _fused_cases():
             yield pytest.param(grammar, lots, options, id=name)
 
 
+
+@pytest.fixture(autouse=True)
+def fused_always(monkeypatch):
+    """Kernels for every batch, however small (``regions.COMPILE_AT``)."""
+    monkeypatch.setenv(SWITCH, "always")
+
 @pytest.mark.parametrize(("grammar", "lots", "options"), list(_fused_cases()))
 def test_fused_and_interpreted_records_are_the_same(grammar, lots, options, tmp_path, monkeypatch):
     fused = REPLAY.digest(grammar, lots, options, tmp_path)

@@ -59,6 +59,12 @@ part ~> Repeat("Y", 3){ I("quad") }
 """
 
 
+
+@pytest.fixture(autouse=True)
+def fused_always(monkeypatch):
+    """Kernels for every batch, however small (``regions.COMPILE_AT``)."""
+    monkeypatch.setenv(SWITCH, "always")
+
 def both(write, monkeypatch, text: str, lots, **options) -> tuple[dict, dict]:
     """The records fused and interpreted; the fused ones with ``"kernels"``: how many batches kernels derived."""
     path = write("g.cga", text)
