@@ -20,8 +20,8 @@ order of the batch, which is the order of the root's shapes and, within one, of 
 (a split's part holds its children in their parents' order). The kernel writes site by site in that order;
 the records of a site in an inlined symbol's rules are emitted when the schedule reaches that symbol
 (``run.FusedBatch``), where the interpreter would have emitted them. ``GRAMMARC_FUSION=off`` derives with
-the interpreter alone. A kernel is compiled once (numba's cache keeps it), for a batch large enough to pay
-for its compilation; a compiled one then serves every batch.
+the interpreter alone. A kernel is compiled once (numba's cache keeps it), when enough shapes have come to
+pay for its compilation; a compiled one then serves every batch.
 """
 
 from __future__ import annotations
@@ -36,8 +36,8 @@ __all__ = ["Region", "fused_regions"]
 
 @dataclass(frozen=True)
 class Region:
-    """A fused region: its root symbol, its generated kernel (``codegen.Source``), and the batch size from
-    which its kernel is compiled if it is not yet (``regions.COMPILE_AT``)."""
+    """A fused region: its root symbol, its generated kernel (``codegen.Source``), and how many shapes of its
+    root a process meets before it compiles the kernel if it is not yet (``regions.COMPILE_AT``)."""
 
     root: int
     source: Source

@@ -45,7 +45,7 @@ def kernel(text: str, columns: int):
     It is compiled (or its machine code loaded from numba's cache) here, on empty arrays of the types the
     runner passes, holding a lock beside the file: forked workers that start on the same grammar wait for
     the first one's compilation and load its machine code, instead of each compiling the same kernel. A
-    mark beside the file then says it is compiled (``compiled``).
+    mark beside the file then says it is compiled (``ready``).
     """
     if text in _KERNELS:
         return _KERNELS[text]
@@ -60,13 +60,21 @@ def kernel(text: str, columns: int):
     return module.derive
 
 
-def compiled(text: str) -> bool:
-    """Whether the kernel of ``text`` was compiled before: in this process, or by an earlier one into the
-    cache folder (its mark is there), whence numba loads its machine code."""
+#: Shapes this process derived without the kernel of a source text, because it was not compiled yet.
+_WAITED: dict[str, int] = {}
+
+
+def ready(text: str, shapes: int, compile_at: int) -> bool:
+    """Whether to derive ``shapes`` more shapes with the kernel of ``text``: it is compiled (in this process,
+    or by an earlier one into the cache folder: its mark is there, whence numba loads its machine code), or
+    this process has now met ``compile_at`` shapes for it, enough to pay for compiling it."""
     if text in _KERNELS:
         return True
     folder = user_cache.cache_folder("fusion")
-    return folder is not None and user_cache.load(folder / f"region_{digest(text)}.compiled", lambda f: True) is True
+    if folder is not None and user_cache.load(folder / f"region_{digest(text)}.compiled", lambda f: True):
+        return True
+    _WAITED[text] = _WAITED.get(text, 0) + shapes
+    return _WAITED[text] >= compile_at
 
 
 @contextmanager

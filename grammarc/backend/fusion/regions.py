@@ -39,14 +39,15 @@ LOGIC = frozenset({"&&", "||"})
 SIZES = {"sx": 0, "sy": 1, "sz": 2}
 
 
-#: A kernel that is not compiled yet is compiled for a batch of at least this many shapes: compiling one
-#: costs seconds, which a build of a few lots would not win back (a compiled one serves every batch).
+#: A kernel that is not compiled yet is compiled once a process has met this many shapes of its root:
+#: compiling one costs seconds, which a build of a few lots would not win back (a compiled one serves
+#: every batch).
 COMPILE_AT = 10_000
 
 
 def compile_at() -> int | None:
-    """The batch size from which a kernel is compiled (``COMPILE_AT``; 0 with ``GRAMMARC_FUSION=always``, as
-    the tests run), or None where fusion is ``off``."""
+    """The shapes from which a kernel is compiled (``COMPILE_AT``; 0 with ``GRAMMARC_FUSION=always``, as the
+    tests run), or None where fusion is ``off``."""
     value = os.environ.get(SWITCH, "").strip().lower()
     if value in ("off", "0", "false", "no"):
         return None

@@ -16,7 +16,7 @@ import numpy as np
 
 from grammarc.backend import terminals
 from grammarc.backend.fusion.codegen import Block, Emit
-from grammarc.backend.fusion.compiled import compiled, kernel
+from grammarc.backend.fusion.compiled import kernel, ready
 from grammarc.backend.shapes import Shapes
 from grammarc.ragged import offsets_from_counts
 
@@ -52,10 +52,10 @@ class FusedBatch:
 
 def derive(ctx, region, shapes: Shapes) -> bool:
     """Derive ``shapes`` of ``region``'s root with its kernels; False (nothing done) where the interpreter
-    must: a batch too small to pay for compiling a kernel not compiled yet, a shape with geometry of its own, a depth within reach of --max-depth, a parameter or attribute
+    must: a kernel not compiled yet for which too few shapes came, a shape with geometry of its own, a depth within reach of --max-depth, a parameter or attribute
     that is not a column of numbers, or a shape that would fail."""
     chunk, limits = ctx.chunk, ctx.limits
-    if len(shapes) < region.compile_at and not compiled(region.source.text):
+    if not ready(region.source.text, len(shapes), region.compile_at):
         return False  # a few shapes do not pay for compiling a kernel; the interpreter derives them
     if (shapes.geom != -1).any() or int(shapes.depth.max()) + region.source.depth >= limits.max_depth:
         return False
