@@ -17,15 +17,27 @@ from __future__ import annotations
 
 import argparse
 import hashlib
+import importlib.util
 import json
 import sys
 import tempfile
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
-sys.path[:0] = [str(ROOT / "benchmarks"), str(ROOT / "tests")]
+sys.path[:0] = [str(ROOT / "tests")]
 
-from conftest import concave_lots, grid_lots
+
+def _benchmark_lots():
+    """The benchmarks' lot makers (their ``conftest``, loaded by path: under pytest, ``conftest`` is the
+    tests' own)."""
+    spec = importlib.util.spec_from_file_location("benchmark_lots", ROOT / "benchmarks" / "conftest.py")
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module.concave_lots, module.grid_lots
+
+
+concave_lots, grid_lots = _benchmark_lots()
+
 from test_examples import record_digest
 
 from grammarc.build import BuildOptions, build

@@ -18,6 +18,8 @@ import numpy as np
 from grammarc.backend import terminals
 from grammarc.backend.context import Context
 from grammarc.backend.evaluate import evaluate_array
+from grammarc.backend.fusion.run import FusedBatch
+from grammarc.backend.fusion.run import derive as derive_fused
 from grammarc.backend.occlusion import add_occluders
 from grammarc.backend.operations import OPERATIONS, Parts
 from grammarc.backend.operations.scope import center
@@ -37,7 +39,8 @@ _CONSUMING = frozenset(node for node, entry in OPERATIONS.items() if entry.consu
 
 def apply_pending(ctx: Context, sym: SymbolPlan, batches: list) -> None:
     """``apply`` to a symbol's pending batches, in order: shapes, and records of a leaf-insert symbol
-    made ahead of its turn (``leaf_parts``), emitted now, where its rule would have emitted them."""
+    made ahead of its turn (``leaf_parts``) or by a fused kernel (``fusion.FusedBatch``), emitted now,
+    where its rule would have emitted them."""
     ctx.symbol = sym.id
     shapes: list[Shapes] = []
     for batch in [*batches, None]:
@@ -47,7 +50,9 @@ def apply_pending(ctx: Context, sym: SymbolPlan, batches: list) -> None:
         if shapes:
             apply(ctx, sym, Shapes.concat(shapes))
             shapes = []
-        if batch is not None:
+        if isinstance(batch, FusedBatch):
+            batch.emit(ctx)
+        elif batch is not None:
             terminals.append_records(ctx, batch.xform, batch.lot, ctx.plan.leaf_inserts[sym.id].asset, sym.id,
                                      None)
 
@@ -58,8 +63,12 @@ def apply(ctx: Context, sym: SymbolPlan, shapes: Shapes) -> None:
     A symbol whose rules split on snap planes (``Repeat("YS", ...)``) takes a lot's shapes one after
     the other, as the paper derives: its first shape's snaps are there when its second one splits
     (the front volume's floors set the levels of the wings'). All lots still go together: the k-th
-    shape of every lot in one batch.
+    shape of every lot in one batch. A symbol that roots a fused region is derived by its kernels
+    (``backend.fusion``) unless they decline the batch.
     """
+    region = ctx.plan.fused.get(sym.id)
+    if region is not None and derive_fused(ctx, region, shapes):
+        return
     if sym.id in ctx.plan.snapping and len(shapes) > 1:
         rank = rank_within(shapes.lot)
         if rank.max() > 0:

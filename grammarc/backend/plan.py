@@ -8,6 +8,7 @@ from __future__ import annotations
 from collections.abc import Callable
 from dataclasses import dataclass, field, replace
 
+from grammarc.backend.fusion import fused_regions
 from grammarc.backend.leaf_parts import leaf_inserts
 from grammarc.backend.materials import COLOR_FIELDS, MAP_FIELDS
 from grammarc.backend.slots import (
@@ -83,6 +84,8 @@ class Plan:
     #: Symbols whose rule only places an asset, by id: split parts naming them skip the shape stage
     #: (``backend.leaf_parts``).
     leaf_inserts: dict = field(default_factory=dict)
+    #: Symbols whose pending shapes fused kernels derive, by id: their ``backend.fusion.Region``.
+    fused: dict = field(default_factory=dict)
     #: Indices into ``Shapes.dynamic`` of the columns the derivation adds (``backend.slots``), None where
     #: the grammar needs none: the colour (else no colours are recorded and the rows are white), the first
     #: of the trim planes (when inserted geometry is trimmed) and ``trim.vertical`` (when the grammar sets it).
@@ -182,7 +185,8 @@ def make_plan(grammar: Grammar, *, load_asset: Callable = load_asset) -> Plan:
         horizontal_slot=dynamic.get(HORIZONTAL_SLOTS[0]), horizontal_switch=dynamic.get(HORIZONTAL_SWITCH),
         occluders=ANCESTORS[0] in dynamic, load_asset=load_asset,
         uv_slots={s: dynamic[uv_slots(s)[0]] for s in uv_sets}, pivot_slot=dynamic.get(PIVOT_SLOTS[0]))
-    return replace(plan, leaf_inserts=leaf_inserts(plan))
+    plan = replace(plan, leaf_inserts=leaf_inserts(plan))
+    return replace(plan, fused=fused_regions(plan))
 
 
 #: CityEngine's queries of texture coordinates, whose first argument (0 when left out) names the set.

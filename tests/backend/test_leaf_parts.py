@@ -10,6 +10,7 @@ import numpy as np
 import pytest
 from conftest import LOT_ZOO, make_lots
 
+from grammarc.backend.fusion.regions import SWITCH
 from grammarc.backend.plan import make_plan
 from grammarc.build import BuildOptions, derive
 from grammarc.compiler import compile_grammar
@@ -24,6 +25,12 @@ sill ~> T(0.1, 0, -0.3) S(1r, 0.7r, 0.3) I("cube")
 wall ~> S(1r, 1r, 0) I("quad")
 pier(k) ~> S(1r, 1r, k * 0.1) I("cube")
 """
+
+@pytest.fixture(autouse=True)
+def interpreted(monkeypatch):
+    """The interpreter's own paths are compared here: fused kernels would derive both grammars."""
+    monkeypatch.setenv(SWITCH, "off")
+
 
 def guarded(text: str) -> str:
     """The grammar with a guard that always holds on each rule that only places an asset."""

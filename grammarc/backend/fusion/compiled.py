@@ -1,0 +1,116 @@
+"""A region's generated module, written to the user's cache folder and imported from there, so that numba's
+``cache=True`` keeps its machine code between runs.
+
+The file is named by a digest of its text (the text is a function of the region's IR, so the digest is
+the region's key): an unchanged grammar finds its kernels compiled; a changed one writes a new file. A file
+is imported only if it is the user's own, writable by nobody else, and holds exactly the text expected
+(``frontend.user_cache``); where the cache folder cannot be used, the module goes to a private temporary
+folder of this process, and is compiled again in the next.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import importlib.util
+import os
+import sys
+import tempfile
+from contextlib import contextmanager
+from functools import cache
+from pathlib import Path
+
+import numpy as np
+
+try:
+    import fcntl
+except ImportError:  # Windows: no forked workers to wait for
+    fcntl = None
+
+from grammarc.frontend import user_cache
+
+
+def digest(text: str) -> str:
+    """The key of a region's source ``text``."""
+    return hashlib.sha256(text.encode()).hexdigest()[:24]
+
+
+#: The kernels compiled or loaded in this process, by source text.
+_KERNELS: dict[str, object] = {}
+
+
+def kernel(text: str, columns: int):
+    """The compiled kernel (``derive``) of a region's source ``text`` whose parameters and attributes are
+    ``columns`` arrays, once per process.
+
+    It is compiled (or its machine code loaded from numba's cache) here, on empty arrays of the types the
+    runner passes, holding a lock beside the file: forked workers that start on the same grammar wait for
+    the first one's compilation and load its machine code, instead of each compiling the same kernel. A
+    mark beside the file then says it is compiled (``ready``).
+    """
+    if text in _KERNELS:
+        return _KERNELS[text]
+    module, path = load(text)
+    rows = [np.zeros((0, 3)), np.zeros((0, 3)), np.zeros(0, np.int32), np.zeros(0, np.int32), np.zeros((1, 3, 3)),
+            *(np.zeros(0) for _ in range(columns)), np.zeros((0, 3)), 0.0, False, np.zeros(0, np.int64),
+            np.zeros(0), np.zeros(0, np.bool_), np.zeros((0, 3, 4), np.float32), np.zeros(0, np.int32)]
+    with _locked(path.with_suffix(".lock")):
+        module.derive(*rows)
+    user_cache.store(path.with_suffix(".compiled"), lambda f: None)
+    _KERNELS[text] = module.derive
+    return module.derive
+
+
+#: Shapes this process derived without the kernel of a source text, because it was not compiled yet.
+_WAITED: dict[str, int] = {}
+
+
+def ready(text: str, shapes: int, compile_at: int) -> bool:
+    """Whether to derive ``shapes`` more shapes with the kernel of ``text``: it is compiled (in this process,
+    or by an earlier one into the cache folder: its mark is there, whence numba loads its machine code), or
+    this process has now met ``compile_at`` shapes for it, enough to pay for compiling it."""
+    if text in _KERNELS:
+        return True
+    folder = user_cache.cache_folder("fusion")
+    if folder is not None and user_cache.load(folder / f"region_{digest(text)}.compiled", lambda f: True):
+        return True
+    _WAITED[text] = _WAITED.get(text, 0) + shapes
+    return _WAITED[text] >= compile_at
+
+
+@contextmanager
+def _locked(path: Path):
+    """An exclusive lock on the file at ``path`` (none where files cannot be locked or made)."""
+    try:
+        fd = os.open(path, os.O_RDWR | os.O_CREAT | os.O_NOFOLLOW, 0o600)
+    except OSError:
+        yield
+        return
+    try:
+        if fcntl is not None:
+            fcntl.flock(fd, fcntl.LOCK_EX)
+        yield
+    finally:
+        os.close(fd)  # releases the lock
+
+
+def load(text: str):
+    """The module of ``text`` and the file it was imported from."""
+    key = digest(text)
+    folder = user_cache.cache_folder("fusion") or _private_folder()
+    path = folder / f"region_{key}.py"
+    if user_cache.load(path, lambda f: f.read().decode()) != text:
+        user_cache.store(path, lambda f: f.write(text.encode()))
+        if user_cache.load(path, lambda f: f.read().decode()) != text:  # a folder that cannot be written
+            path = _private_folder() / path.name
+            path.write_text(text)
+    name = f"grammarc_fused_{key}"
+    spec = importlib.util.spec_from_file_location(name, path)
+    module = importlib.util.module_from_spec(spec)
+    sys.modules[name] = module  # numba's cache finds the functions' globals by the module's name
+    spec.loader.exec_module(module)
+    return module, path
+
+
+@cache
+def _private_folder() -> Path:
+    return Path(tempfile.mkdtemp(prefix="grammarc-fusion-"))

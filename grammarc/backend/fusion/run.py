@@ -1,0 +1,89 @@
+"""Deriving a region root's pending shapes with its kernels, and emitting the records where the interpreter
+would have.
+
+``derive`` runs the kernel over the batch counting, checks what the interpreter would refuse (then it hands
+the whole batch back, and the interpreter derives it, failing what it fails), counts the shapes for
+--max-shapes as the interpreter does, allocates the records once and runs the kernel again, writing. The
+root's own records are emitted at once; those of each inlined symbol wait in that symbol's pending list as a ``FusedBatch`` until the
+schedule reaches it, where the interpreter would have run its rules on the shapes handed to it.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from grammarc.backend import terminals
+from grammarc.backend.fusion.codegen import Block, Emit
+from grammarc.backend.fusion.compiled import kernel, ready
+from grammarc.backend.shapes import Shapes
+from grammarc.ragged import offsets_from_counts
+
+
+@dataclass(frozen=True, eq=False)
+class FusedRecords:
+    """The records a region's kernel wrote, by site: site k's are rows ``starts[k]`` to ``starts[k + 1]``."""
+
+    xform: np.ndarray  # (m, 3, 4) float32
+    lot: np.ndarray  # (m,) int32
+    starts: np.ndarray  # (sites + 1,) int64
+
+
+@dataclass(frozen=True, eq=False)
+class FusedBatch:
+    """An inlined symbol's share of a region's records, pending until its turn (``emit``)."""
+
+    records: FusedRecords
+    block: Block
+
+    def emit(self, ctx) -> None:
+        """Append this block's records and queue its symbols' blocks, in the interpreter's order."""
+        records, starts = self.records, self.records.starts
+        for event in self.block.events:
+            if type(event) is Emit:
+                a, b = starts[event.site], starts[event.site + 1]
+                if b > a:
+                    terminals.append_records(ctx, records.xform[a:b], records.lot[a:b], event.asset,
+                                             self.block.symbol, None)
+            elif starts[event.last] > starts[event.first]:
+                ctx.pending[event.symbol].append(FusedBatch(records, event))
+
+
+def derive(ctx, region, shapes: Shapes) -> bool:
+    """Derive ``shapes`` of ``region``'s root with its kernels; False (nothing done) where the interpreter
+    must: a kernel not compiled yet for which too few shapes came, a shape with geometry of its own, a depth within reach of --max-depth, a parameter or attribute
+    that is not a column of numbers, or a shape that would fail."""
+    chunk, limits = ctx.chunk, ctx.limits
+    if not ready(region.source.text, len(shapes), region.compile_at):
+        return False  # a few shapes do not pay for compiling a kernel; the interpreter derives them
+    if (shapes.geom != -1).any() or int(shapes.depth.max()) + region.source.depth >= limits.max_depth:
+        return False
+    attrs = [*shapes.params, *(chunk.attrs.get(name) for name in region.source.attrs)]
+    if not all(isinstance(a, np.ndarray) and a.dtype == np.float64 for a in attrs):
+        return False
+    derive_batch = kernel(region.source.text, len(attrs))
+    n = len(shapes)
+    sites, made, bad = np.zeros(region.source.sites, np.int64), np.empty(n), np.zeros(n, np.bool_)
+    # contiguous, as the kernel was compiled for (``compiled.kernel``): a copy only where one is not
+    columns = (*map(np.ascontiguousarray, (shapes.origin, shapes.size, shapes.frame, shapes.lot, chunk.frames.data,
+                                           *attrs, chunk.lot_origin)), float(limits.max_shapes))
+    derive_batch(*columns, False, sites, made, bad, np.empty((0, 3, 4), np.float32), np.empty(0, np.int32))
+    if bad.any() or not _within_limit(ctx, shapes.lot, made):
+        return False
+    ctx.count_lots(shapes.lot, ctx.plan.symbols[region.root].rules[0].span, made.astype(np.int64))
+    starts = offsets_from_counts(sites)
+    total = int(starts[-1])
+    xform, lot = np.empty((total, 3, 4), np.float32), np.empty(total, np.int32)
+    derive_batch(*columns, True, starts[:-1].copy(), made, bad, xform, lot)
+    FusedBatch(FusedRecords(xform, lot, starts), region.source.block).emit(ctx)
+    return True
+
+
+def _within_limit(ctx, lot: np.ndarray, made: np.ndarray) -> bool:
+    """Whether no lot goes over --max-shapes with ``made`` (n,) more shapes of rows of lots ``lot`` (n,)."""
+    chunk, limit = ctx.chunk, ctx.limits.max_shapes
+    if chunk.shape_total + made.sum() <= limit:
+        return True
+    return bool((np.bincount(lot, weights=made, minlength=len(chunk.shape_count)) + chunk.shape_count
+                 <= limit).all())

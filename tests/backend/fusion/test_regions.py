@@ -1,0 +1,80 @@
+"""Which symbols fused kernels derive: the whitelist, inlining, and what turns fusion off."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from grammarc.backend.fusion.regions import SWITCH
+from grammarc.backend.plan import make_plan
+from grammarc.compiler import compile_grammar
+
+ROOT = Path(__file__).resolve().parents[3]
+
+
+def fused(write, text: str) -> set[str]:
+    plan = make_plan(compile_grammar(write("g.cga", text)))
+    return {plan.symbols[k].name for k in plan.fused}
+
+
+def test_symbols_whose_shapes_do_not_fan_out_are_left_to_the_interpreter(write):
+    assert fused(write, """
+lot ~> S(1r, 3, 1r) T(0, 1, 0) box
+box ~> [ S(1r, 1r, 0.5) I("cube") ] I("quad")
+""") == set()
+
+
+def test_the_facade_benchmark_is_fused_below_its_component_split():
+    plan = make_plan(compile_grammar(ROOT / "benchmarks" / "facade.cga"))
+    assert {plan.symbols[k].name for k in plan.fused} == {"facade", "floor", "tile"}
+
+
+def test_an_operation_off_the_whitelist_keeps_its_symbol_and_those_leading_to_it(write):
+    assert fused(write, """
+lot ~> Subdiv("X", 1r, 1r){ a | b }
+a ~> Repeat("Y", 2){ c }
+b ~> R(0, 30, 0) I("cube")
+c ~> I("quad")
+""") == {"a"}
+
+
+def test_a_symbol_named_twice_is_inlined_only_if_it_only_places_an_asset(write):
+    # ``x`` is named by ``a`` and ``b`` and splits: ``a`` and ``b`` would not keep its order
+    assert fused(write, """
+lot ~> Subdiv("X", 1r, 1r){ a | b }
+a ~> T(1, 0, 0) x
+b ~> S(1r, 2, 1r) x
+x ~> Subdiv("Y", 1r, 1r){ I("cube") | I("quad") }
+""") == {"x"}
+    # a leaf insert is the same however its batches come
+    assert fused(write, """
+lot ~> Subdiv("X", 1r, 1r){ a | b }
+a ~> T(1, 0, 0) x
+b ~> S(1r, 2, 1r) x
+x ~> S(1r, 1r, 0.2) I("cube")
+""") == {"lot"}
+
+
+def test_functions_random_choices_and_recursion_are_not_fused_parameters_are(write):
+    assert fused(write, """
+lot ~> Subdiv("X", 1r, rand(1, 2)){ a(2) | b }
+a(k) ~> S(k, 1r, 1r) Repeat("Y", k){ [ T(0, 0, k) I("quad") ] I("cube") }
+b ~> I("cube") : 0.5
+  ~> I("quad") : 0.5
+""") == {"a"}
+    assert fused(write, """
+lot ~> Subdiv("X", 1r, 1r){ lot | I("cube") }
+""") == set()
+
+
+def test_the_switch_turns_fusion_off(write, monkeypatch):
+    monkeypatch.setenv(SWITCH, "off")
+    assert not make_plan(compile_grammar(ROOT / "benchmarks" / "facade.cga")).fused
+
+
+def test_cityengine_grammars_are_not_fused(write):
+    assert fused(write, """
+version "2023.0"
+Lot --> split(x){ 2: A | ~1: B }*
+A --> s('1, '1, 2) i("builtin:cube")
+B --> color(1, 0, 0)
+""") == set()

@@ -1,0 +1,127 @@
+"""Deriving with fused kernels: the records, their order and the failures are the interpreter's
+(``GRAMMARC_FUSION=off``), where fused and interpreted symbols meet, where kernels decline a batch, and at
+the shape limit."""
+
+from __future__ import annotations
+
+from dataclasses import replace
+
+import numpy as np
+import pytest
+from conftest import make_lots
+
+from grammarc.backend import execute
+from grammarc.backend.fusion.regions import SWITCH
+from grammarc.backend.fusion.run import derive as derive_fused
+from grammarc.backend.plan import make_plan
+from grammarc.build import BuildOptions, derive
+from grammarc.compiler import compile_grammar
+from grammarc.constants import LIMITS
+
+#: ``side`` turns its scope (no kernel does) and hands shapes to ``pane``, a leaf insert that the fused
+#: ``bay`` inlines too: pane's pending list mixes both; ``bay``'s guards pick rules per shape.
+MIXED = """
+attr bay_w = 2.5
+lot ~> S(1r, 7, 1r) Comp("sidefaces"){ side }
+side ~> Subdiv("X", 1r, 2, 1r){ bay | R(0, 0, 0) pane | bay }
+bay : Scope.sx > 3 ~> Repeat("X", bay_w){ Subdiv("Y", 1r, 1.2, 0.4){ pane | glass | pane } }
+bay : Scope.sx > 1 ~> Subdiv("Y", 2, 1r){ glass | T(0, 0, 0.1) pane }
+bay ~> I("cube")
+glass ~> S(1r, 1r, 0.05) T(0, 0, -0.05) I("cube")
+pane ~> I("quad")
+"""
+
+#: Parameters (of the root, and passed on) and brackets: the root ``facade`` takes its storeys from ``lot``.
+PASSED_ON = """
+attr sill = 0.9
+lot ~> S(1r, 9, 1r) Comp("sidefaces"){ facade(3) }
+facade(floors) ~> Repeat("Y", Scope.sy / floors){ storey(floors, 0.6) }
+storey(k, w) ~> [ T(0, 0, w * 0.1) S(1r, 0.2, 0.3) I("cube") ] Subdiv("X", 1r, k * 0.4, 1r){ I("quad") | bay(w + sill) | I("quad") }
+bay(h) ~> Subdiv("Y", h, 1r){ I("quad") | [ S(1r, 1r, 0.1) I("cube") ] T(0, 0, -0.1) I("quad") }
+"""
+
+#: The layouts' edges: absolute parts longer than the scope (cut, then dropped), relative parts left nothing,
+#: a repeat of two parts, flat scopes (no repeat element on a zero extent), attribute sizes.
+EDGES = """
+attr pier = 4
+lot ~> S(1r, 6, 1r) Comp("sidefaces"){ facade }
+facade ~> Subdiv("X", pier, 1r, pier, 1r){ Repeat("Y", 1.1){ a | b } | S(1r, 1r, 0) Repeat("Z", 1){ I("cube") } | c | I("quad") }
+a ~> S(1r, 0.5r, 1r) I("cube")
+b ~> T(0, 0, 0.3) I("quad")
+c ~> Subdiv("Y", 5, 0.5, 1r, 2){ I("cube") | I("quad") | I("cube") | I("quad") }
+"""
+
+#: ``Subdiv`` of a computed size that goes negative on narrow facades: the interpreter fails those lots.
+NEGATIVE = """
+lot ~> S(1r, 6, 1r) Comp("sidefaces"){ facade }
+facade ~> Subdiv("X", Scope.sx - 9, 1r){ part | part }
+part ~> Repeat("Y", 3){ I("quad") }
+"""
+
+
+
+@pytest.fixture(autouse=True)
+def fused_always(monkeypatch):
+    """Kernels for every batch, however small (``regions.COMPILE_AT``)."""
+    monkeypatch.setenv(SWITCH, "always")
+
+def both(write, monkeypatch, text: str, lots, **options) -> tuple[dict, dict]:
+    """The records fused and interpreted; the fused ones with ``"kernels"``: how many batches kernels derived."""
+    path = write("g.cga", text)
+    taken = []
+
+    def counted(ctx, region, shapes):
+        taken.append(derive_fused(ctx, region, shapes))
+        return taken[-1]
+
+    monkeypatch.setattr(execute, "derive_fused", counted)
+    fused = derive(compile_grammar(path), lots, BuildOptions(**options))
+    fused["kernels"] = sum(taken)
+    monkeypatch.setenv(SWITCH, "off")
+    interpreted = derive(compile_grammar(path), lots, BuildOptions(**options))
+    monkeypatch.delenv(SWITCH)
+    return fused, interpreted
+
+
+def assert_same(fused: dict, interpreted: dict) -> None:
+    for column in ("asset", "xform", "lot", "symbol"):
+        np.testing.assert_array_equal(fused[column], interpreted[column], err_msg=column)
+    assert [(b.id, b.reason) for b in fused["bad"]] == [(b.id, b.reason) for b in interpreted["bad"]]
+
+
+def test_fused_and_interpreted_symbols_meet_in_the_interpreter_order(write, monkeypatch):
+    plan = make_plan(compile_grammar(write("g.cga", MIXED)))
+    assert {plan.symbols[k].name for k in plan.fused} == {"bay"}
+    fused, interpreted = both(write, monkeypatch, MIXED, make_lots("square", "rect_12x8", "concave_L", "courtyard"))
+    assert len(fused["asset"]) > 200 and fused["kernels"]
+    assert_same(fused, interpreted)
+
+
+def test_parameters_and_brackets(write, monkeypatch):
+    plan = make_plan(compile_grammar(write("g.cga", PASSED_ON)))
+    assert {plan.symbols[k].name for k in plan.fused} == {"facade", "storey", "bay"}
+    fused, interpreted = both(write, monkeypatch, PASSED_ON, make_lots("square", "concave_L", "courtyard"))
+    assert len(fused["asset"]) > 100 and fused["kernels"]
+    assert_same(fused, interpreted)
+
+
+def test_the_edges_of_the_layouts(write, monkeypatch):
+    fused, interpreted = both(write, monkeypatch, EDGES, make_lots("square", "rect_12x8", "concave_L", "courtyard"))
+    assert len(fused["asset"]) > 100 and fused["kernels"]
+    assert_same(fused, interpreted)
+
+
+def test_a_batch_the_interpreter_would_fail_is_left_to_it(write, monkeypatch):
+    fused, interpreted = both(write, monkeypatch, NEGATIVE, make_lots("square", "rect_12x8", "concave_L"))
+    assert fused["bad"] and "negative" in fused["bad"][0].reason
+    assert len(fused["asset"]) and fused["kernels"]
+    assert_same(fused, interpreted)
+
+
+@pytest.mark.parametrize("max_shapes", [40, 5000])
+def test_shapes_count_as_the_interpreter_counts_them(write, monkeypatch, max_shapes):
+    text = NEGATIVE.replace("Scope.sx - 9", "1")
+    fused, interpreted = both(write, monkeypatch, text, make_lots("square", "concave_L"),
+                             limits=replace(LIMITS, max_shapes=max_shapes))
+    assert_same(fused, interpreted)
+    assert bool(fused["bad"]) == (max_shapes == 40)
