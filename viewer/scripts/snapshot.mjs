@@ -1,0 +1,33 @@
+// Loads the page of `grammarc view` in headless Chromium and reports what it shows:
+//   node snapshot.mjs URL OUT.png [SECONDS]
+// waits until the page's tiles have settled (or 120 s), counts frames for SECONDS (default 3), takes a
+// screenshot, and prints one JSON line: tilesLoaded, tilesVisible, loadSeconds (from navigation to the
+// last tile loaded), fps, error. The browser is CHROMIUM, else /usr/bin/chromium (Debian's package).
+import { chromium } from "playwright-core";
+
+const [url, out, seconds = "3"] = process.argv.slice(2);
+const browser = await chromium.launch({
+  executablePath: process.env.CHROMIUM ?? "/usr/bin/chromium",
+  // WebGL on the CPU (SwiftShader): CI machines have no GPU
+  args: ["--no-sandbox", "--use-angle=swiftshader", "--enable-unsafe-swiftshader", "--ignore-gpu-blocklist",
+         "--disable-background-networking", "--disable-component-update", "--disable-sync", "--no-first-run"],
+});
+try {
+  const page = await browser.newPage({ viewport: { width: 1280, height: 800 } });
+  const errors = [];
+  page.on("pageerror", (error) => errors.push(String(error)));
+  await page.goto(url);
+  await page.waitForFunction(() => window.viewer && (window.viewer.settledAt !== null || window.viewer.error),
+                             null, { timeout: 120000, polling: 250 });
+  const first = await page.evaluate(() => ({ frames: window.viewer.frames, at: performance.now() }));
+  await page.waitForTimeout(Number(seconds) * 1000);
+  const state = await page.evaluate(() => ({ ...window.viewer, at: performance.now() }));
+  await page.screenshot({ path: out });
+  console.log(JSON.stringify({
+    tilesLoaded: state.tilesLoaded, tilesVisible: state.tilesVisible, triangles: state.triangles,
+    loadSeconds: state.settledAt / 1000, fps: ((state.frames - first.frames) * 1000) / (state.at - first.at),
+    error: state.error ?? (errors.length ? errors.join("; ") : null),
+  }));
+} finally {
+  await browser.close();
+}
