@@ -110,7 +110,8 @@ class TilesetWriter(TiledWriter):
         frame = ecef_frame(self._meta["crs"], reference) if self._meta.get("crs") else None
         if frame is not None:
             root["transform"] = frame
-        tileset = {"asset": {"version": "1.1", "generator": f"grammarc {self._meta.get('grammarc', '')}".strip()},
+        made_by = f"grammarc {self._meta.get('grammarc', '')}".strip()
+        tileset = {"asset": {"version": "1.1", "extras": {"generator": made_by}},
                    "geometricError": 2 * _error(max(depth, 1), size),
                    "root": root,
                    "extras": {"grammarc": self._meta, "crs": self._meta.get("crs"),
@@ -245,8 +246,12 @@ def _masses(cells: np.ndarray, low: np.ndarray, high: np.ndarray, rgb: np.ndarra
 
 
 def _bounds(low: np.ndarray, high: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """The (low, high) of boxes' corners ``low`` and ``high`` (n, 3) or (3,), y up."""
-    return np.asarray(low, np.float64).reshape(-1, 3).min(axis=0), np.asarray(high, np.float64).reshape(-1, 3).max(axis=0)
+    """The (low, high) of boxes' corners ``low`` and ``high`` (n, 3) or (3,), y up, at least ``2 * _THIN``
+    thick (a tile of one flat facade still has a volume, which its parent's box then holds too)."""
+    low = np.asarray(low, np.float64).reshape(-1, 3).min(axis=0)
+    high = np.asarray(high, np.float64).reshape(-1, 3).max(axis=0)
+    pad = np.maximum(_THIN - 0.5 * (high - low), 0.0)
+    return low - pad, high + pad
 
 
 def _tree(nodes: dict[tuple[int, int, int], dict], depth: int, size: float) -> dict:
@@ -273,7 +278,7 @@ def _tree(nodes: dict[tuple[int, int, int], dict], depth: int, size: float) -> d
                 tile["children"] = [tiles.pop(child) for child in children]
             tiles[key] = tile
     if not tiles:  # an empty city: a root without content
-        return {"boundingVolume": {"box": _box(np.zeros(3), np.zeros(3))}, "geometricError": 0.0,
+        return {"boundingVolume": {"box": _box(*_bounds(np.zeros(3), np.zeros(3)))}, "geometricError": 0.0,
                 "refine": "REPLACE"}
     (root,) = tiles.values()
     root["refine"] = "REPLACE"
@@ -282,8 +287,7 @@ def _tree(nodes: dict[tuple[int, int, int], dict], depth: int, size: float) -> d
 
 def _box(low: np.ndarray, high: np.ndarray) -> list[float]:
     """3D Tiles' ``box`` (centre, then half axes x, y, z) of a y-up box, in the z-up frame (x, -z, y)."""
-    centre = 0.5 * (low + high)
-    half = np.maximum(0.5 * (high - low), _THIN)
+    centre, half = 0.5 * (low + high), 0.5 * (high - low)
     return [float(centre[0]), float(-centre[2]), float(centre[1]),
             float(half[0]), 0.0, 0.0, 0.0, float(half[2]), 0.0, 0.0, 0.0, float(half[1])]
 
