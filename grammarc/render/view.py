@@ -21,7 +21,7 @@ from urllib.parse import urlsplit
 
 from grammarc.errors import UsageError
 
-__all__ = ["PAGE", "page_missing", "serve", "tileset_folder"]
+__all__ = ["PAGE", "address", "page_missing", "page_server", "serve", "tileset_folder"]
 
 #: The page's folder, in the package.
 PAGE = Path(__file__).with_name("viewer")
@@ -82,17 +82,26 @@ class _Handler(SimpleHTTPRequestHandler):
         pass
 
 
+def page_server(tileset: Path, port: int = 0) -> ThreadingHTTPServer:
+    """A server of the page and ``tileset`` on 127.0.0.1 (``port`` 0: a free one), not yet serving; its page
+    is at ``address(server)``."""
+    return ThreadingHTTPServer(("127.0.0.1", port), partial(_Handler, tiles=Path(tileset).resolve()))
+
+
+def address(server: ThreadingHTTPServer) -> str:
+    """The page's address on ``server``."""
+    return f"http://127.0.0.1:{server.server_port}/"
+
+
 def serve(tileset: Path, *, port: int = 0, open_browser: bool = True,
           ready: Callable[[str], None] = print) -> None:
-    """Serve the page and ``tileset`` on 127.0.0.1 (``port`` 0: a free one) until interrupted; ``ready`` is
-    told the page's address once it is served, and a browser opens it unless ``open_browser`` is false."""
+    """Serve the page and ``tileset`` until interrupted; ``ready`` is told the page's address once it is
+    served, and a browser opens it unless ``open_browser`` is false."""
     problem = page_missing()
     if problem is not None:
         raise UsageError(problem)
-    server = ThreadingHTTPServer(("127.0.0.1", port), partial(_Handler, tiles=Path(tileset).resolve()))
-    url = f"http://127.0.0.1:{server.server_port}/"
-    with server:
-        ready(url)
+    with page_server(tileset, port) as server:
+        ready(address(server))
         if open_browser:
-            webbrowser.open(url)
+            webbrowser.open(address(server))
         server.serve_forever()

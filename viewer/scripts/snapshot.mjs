@@ -1,11 +1,14 @@
 // Loads the page of `grammarc view` in headless Chromium and reports what it shows:
-//   node snapshot.mjs URL OUT.png [SECONDS]
+//   node snapshot.mjs URL OUT.png [SECONDS] [WIDTHxHEIGHT]
 // waits until the page's tiles have settled (or 120 s), counts frames for SECONDS (default 3), takes a
-// screenshot, and prints one JSON line: tilesLoaded, tilesVisible, loadSeconds (from navigation to the
-// last tile loaded), fps, error. The browser is CHROMIUM, else /usr/bin/chromium (Debian's package).
+// screenshot (default 1280x800), clicks from the middle outwards until a click shows a feature, and prints
+// one JSON line: tilesLoaded, tilesVisible, triangles, loadSeconds (from navigation to the last tile
+// loaded), fps, picked (the panel's text, or null), error. The browser is CHROMIUM, else /usr/bin/chromium
+// (Debian's package).
 import { chromium } from "playwright-core";
 
-const [url, out, seconds = "3"] = process.argv.slice(2);
+const [url, out, seconds = "3", size = "1280x800"] = process.argv.slice(2);
+const [width, height] = size.split("x").map(Number);
 const browser = await chromium.launch({
   executablePath: process.env.CHROMIUM ?? "/usr/bin/chromium",
   // WebGL on the CPU (SwiftShader): CI machines have no GPU
@@ -13,7 +16,7 @@ const browser = await chromium.launch({
          "--disable-background-networking", "--disable-component-update", "--disable-sync", "--no-first-run"],
 });
 try {
-  const page = await browser.newPage({ viewport: { width: 1280, height: 800 } });
+  const page = await browser.newPage({ viewport: { width, height } });
   const errors = [];
   page.on("pageerror", (error) => errors.push(String(error)));
   await page.goto(url);
@@ -23,9 +26,17 @@ try {
   await page.waitForTimeout(Number(seconds) * 1000);
   const state = await page.evaluate(() => ({ ...window.viewer, at: performance.now() }));
   await page.screenshot({ path: out });
+  let picked = null;
+  for (let ring = 0; ring < 6 && picked === null; ring += 1) {
+    for (let k = 0; k < Math.max(1, 8 * ring) && picked === null; k += 1) {
+      const angle = (2 * Math.PI * k) / Math.max(1, 8 * ring);
+      await page.mouse.click(width / 2 + ring * 40 * Math.cos(angle), height / 2 + ring * 40 * Math.sin(angle));
+      picked = await page.evaluate(() => (document.getElementById("info").hidden ? null : document.getElementById("info").innerText));
+    }
+  }
   console.log(JSON.stringify({
     tilesLoaded: state.tilesLoaded, tilesVisible: state.tilesVisible, triangles: state.triangles,
-    loadSeconds: state.settledAt / 1000, fps: ((state.frames - first.frames) * 1000) / (state.at - first.at),
+    loadSeconds: state.settledAt / 1000, fps: ((state.frames - first.frames) * 1000) / (state.at - first.at), picked,
     error: state.error ?? (errors.length ? errors.join("; ") : null),
   }));
 } finally {

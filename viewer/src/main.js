@@ -86,14 +86,19 @@ const down = new THREE.Vector2();
 canvas.addEventListener("pointerdown", (event) => down.set(event.clientX, event.clientY));
 canvas.addEventListener("pointerup", (event) => {
   if (down.distanceTo(new THREE.Vector2(event.clientX, event.clientY)) > 4) return;
+  showPicked(pickAt(event.clientX, event.clientY));
+});
+
+// the features of the nearest surface at a point of the page, or null
+function pickAt(x, y) {
   const rect = canvas.getBoundingClientRect();
-  const pointer = new THREE.Vector2(((event.clientX - rect.left) / rect.width) * 2 - 1,
-                                    -((event.clientY - rect.top) / rect.height) * 2 + 1);
+  const pointer = new THREE.Vector2(((x - rect.left) / rect.width) * 2 - 1, -((y - rect.top) / rect.height) * 2 + 1);
   const raycaster = new THREE.Raycaster();
   raycaster.setFromCamera(pointer, camera);
   const hit = raycaster.intersectObject(tiles.group, true)[0];
-  showPicked(hit ? pickedFeatures(hit) : null);
-});
+  return hit ? pickedFeatures(hit) : null;
+}
+viewer.pickAt = pickAt;
 
 function showPicked(picked) {
   info.replaceChildren();
