@@ -1,10 +1,10 @@
 // Loads the page of `grammarc view` in headless Chromium and reports what it shows:
 //   node snapshot.mjs URL OUT.png [SECONDS] [WIDTHxHEIGHT]
-// waits until the page's tiles have settled (or 120 s), counts frames for SECONDS (default 3), takes a
-// screenshot (default 1280x800), clicks from the middle outwards until a click shows a feature, and prints
-// one JSON line: tilesLoaded, tilesVisible, triangles, loadSeconds (from navigation to the last tile
-// loaded), fps, picked (the panel's text, or null), error. The browser is CHROMIUM, else /usr/bin/chromium
-// (Debian's package).
+// waits until the page's tiles have settled (or 120 s), counts frames for SECONDS (default 3), clicks from
+// the middle outwards until a click shows a feature, takes a screenshot (default 1280x800, the feature's
+// panel in it) and prints one JSON line: tilesLoaded, tilesVisible, triangles, loadSeconds (from navigation
+// to the last tile loaded), fps, picked (the panel's text, or null), error. The browser is CHROMIUM, else
+// /usr/bin/chromium (Debian's package).
 import { chromium } from "playwright-core";
 
 const [url, out, seconds = "3", size = "1280x800"] = process.argv.slice(2);
@@ -25,7 +25,6 @@ try {
   const first = await page.evaluate(() => ({ frames: window.viewer.frames, at: performance.now() }));
   await page.waitForTimeout(Number(seconds) * 1000);
   const state = await page.evaluate(() => ({ ...window.viewer, at: performance.now() }));
-  await page.screenshot({ path: out });
   let picked = null;
   for (let ring = 0; ring < 6 && picked === null; ring += 1) {
     for (let k = 0; k < Math.max(1, 8 * ring) && picked === null; k += 1) {
@@ -34,6 +33,7 @@ try {
       picked = await page.evaluate(() => (document.getElementById("info").hidden ? null : document.getElementById("info").innerText));
     }
   }
+  await page.screenshot({ path: out });
   console.log(JSON.stringify({
     tilesLoaded: state.tilesLoaded, tilesVisible: state.tilesVisible, triangles: state.triangles,
     loadSeconds: state.settledAt / 1000, fps: ((state.frames - first.frames) * 1000) / (state.at - first.at), picked,

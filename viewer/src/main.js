@@ -36,7 +36,17 @@ tiles.registerPlugin(new GLTFExtensionsPlugin({ metadata: true, plugins: [(parse
 tiles.registerPlugin(new ReorientationPlugin({ up: "+z", recenter: true }));
 tiles.setCamera(camera);
 scene.add(tiles.group);
-tiles.addEventListener("load-model", () => { viewer.tilesLoaded += 1; });
+tiles.addEventListener("load-model", ({ scene: model }) => {
+  viewer.tilesLoaded += 1;
+  // Lambert shading: the tiles' materials are flat colours (and colour maps), which a physically based
+  // material draws no better at several times the cost per pixel
+  model.traverse((object) => {
+    if (!object.isMesh || !object.material.isMeshStandardMaterial) return;
+    const { color, map, vertexColors, transparent, opacity, side, flatShading } = object.material;
+    object.material.dispose();
+    object.material = new THREE.MeshLambertMaterial({ color, map, vertexColors, transparent, opacity, side, flatShading });
+  });
+});
 tiles.addEventListener("dispose-model", () => { viewer.tilesLoaded -= 1; });
 tiles.addEventListener("load-error", (event) => { viewer.error = String(event.error); });
 tiles.addEventListener("load-root-tileset", () => {
