@@ -218,17 +218,31 @@ def _parser() -> argparse.ArgumentParser:
 
 
 def _view(args) -> int:
-    from grammarc.render.view import page_missing, serve, tileset_folder
+    import tempfile
+
+    from grammarc.render.view import page_missing, serve
 
     problem = page_missing()  # said before an .npz is written as a tileset
     if problem is not None:
         raise UsageError(problem)
-    if not args.city.exists():
-        raise UsageError(f"`{args.city}` not found")
-    with tileset_folder(args.city, args.lod) as folder:
+
+    def show(folder: Path) -> int:
         serve(folder, port=args.port, open_browser=not args.no_browser,
               ready=lambda url: print(f"grammarc view: {url} (Ctrl-C stops)", flush=True))
-    return 0
+        return 0
+
+    if args.city.is_dir():
+        if not (args.city / "tileset.json").is_file():
+            raise UsageError(f"`{args.city}` has no tileset.json: give a folder written with --emit CITY.3dtiles")
+        return show(args.city)
+    from grammarc.io.npz import load_record
+    from grammarc.io.tiles3d import write_record
+
+    record = load_record(args.city)  # a UsageError where it is not a record
+    with tempfile.TemporaryDirectory(prefix="grammarc-view-") as folder:
+        tileset = Path(folder) / f"{args.city.stem}.3dtiles"
+        write_record(record, tileset, args.lod)
+        return show(tileset)
 
 
 def _server(args) -> int:

@@ -50,7 +50,7 @@ from grammarc.io.instancing import Tile, TiledWriter
 from grammarc.io.tile_content import LotTable, TileContent
 from grammarc.model.lots import Lots
 
-__all__ = ["LEAF_SIZE", "WRITERS", "TilesetWriter", "ecef_frame"]
+__all__ = ["LEAF_SIZE", "WRITERS", "TilesetWriter", "ecef_frame", "write_record"]
 
 #: Default leaf edge (metres) of a tileset.
 LEAF_SIZE = LIMITS.leaf_size
@@ -313,3 +313,15 @@ def ecef_frame(crs: str, reference: np.ndarray) -> list[float]:
     matrix = np.eye(4)
     matrix[:3, 0], matrix[:3, 1], matrix[:3, 2], matrix[:3, 3] = *axes, ecef(0, 0, 0)
     return [float(v) for v in matrix.T.reshape(-1)]
+
+
+def write_record(record: dict, path: str | os.PathLike, lod: str | None = None) -> dict:
+    """Write a record (``io.npz.read_instances``) as a tileset at ``path``; the writer's counts. The lots
+    file is not at hand: a lot's features are its number, as ``lot<number>``."""
+    from grammarc.io.npz import record_chunks
+
+    with TilesetWriter(path, assets=record["assets"], symbols=record["symbols"], meta=record["meta"],
+                       lod=lod) as writer:
+        for chunk in record_chunks(record):
+            writer.write(chunk)
+        return writer.close()

@@ -1,5 +1,5 @@
-"""``grammarc view``: a city in a browser. A 3D Tiles folder (or an .npz record, written as one first) is
-served on localhost together with the page that shows it.
+"""``grammarc view``: a city in a browser. A 3D Tiles folder is served on localhost together with the page
+that shows it (the command writes an .npz record as one first, ``io.tiles3d.write_record``).
 
 The page (``render/viewer/``: ``index.html`` and ``viewer.js``) is three.js with 3d-tiles-renderer, bundled
 into one file from the repository's ``viewer/`` (``npm ci && npm run build`` there) so that it works
@@ -9,10 +9,8 @@ offline; the server serves the page at ``/`` and the tileset at ``/tiles/``, fro
 
 from __future__ import annotations
 
-import contextlib
-import tempfile
 import webbrowser
-from collections.abc import Callable, Iterator
+from collections.abc import Callable
 from functools import partial
 from http.server import SimpleHTTPRequestHandler, ThreadingHTTPServer
 from pathlib import Path
@@ -21,7 +19,7 @@ from urllib.parse import urlsplit
 
 from grammarc.errors import UsageError
 
-__all__ = ["PAGE", "address", "page_missing", "page_server", "serve", "tileset_folder"]
+__all__ = ["PAGE", "address", "page_missing", "page_server", "serve"]
 
 #: The page's folder, in the package.
 PAGE = Path(__file__).with_name("viewer")
@@ -35,29 +33,6 @@ def page_missing() -> str | None:
         return None
     return ("the viewer's page is not built: in grammarc's source folder run `npm ci --prefix viewer && "
             "npm run build --prefix viewer` (Node.js 18 or later), which writes grammarc/render/viewer/viewer.js")
-
-
-@contextlib.contextmanager
-def tileset_folder(path: Path, lod: str | None = None) -> Iterator[Path]:
-    """The tileset to show: ``path`` itself (a .3dtiles folder), or an .npz record written as 3D Tiles into
-    a temporary folder for as long as the block lasts."""
-    path = Path(path)
-    if path.is_dir():
-        if not (path / "tileset.json").is_file():
-            raise UsageError(f"`{path}` has no tileset.json: give a folder written with --emit CITY.3dtiles")
-        yield path
-        return
-    from grammarc.io.npz import load_record, record_chunks
-    from grammarc.io.tiles3d import TilesetWriter
-
-    record = load_record(path)
-    with tempfile.TemporaryDirectory(prefix="grammarc-view-") as folder:
-        out = Path(folder) / f"{path.stem}.3dtiles"
-        with TilesetWriter(out, assets=record["assets"], symbols=record["symbols"], meta=record["meta"],
-                           lod=lod) as writer:
-            for chunk in record_chunks(record):
-                writer.write(chunk)
-        yield out
 
 
 class _Handler(SimpleHTTPRequestHandler):

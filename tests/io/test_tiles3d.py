@@ -22,7 +22,7 @@ from grammarc.io import OutputOptions, written_paths
 from grammarc.io.gltf import _read_part
 from grammarc.io.instancing import compose
 from grammarc.io.npz import read_instances
-from grammarc.io.tiles3d import TilesetWriter
+from grammarc.io.tiles3d import TilesetWriter, write_record
 
 VIEWER = Path(__file__).resolve().parents[2] / "viewer"
 PROPERTIES = [{"height": 9.5, "roof-type": "hip"}, {"height": 12.0}, {"height": 7.25, "roof-type": "flat"}]
@@ -203,3 +203,16 @@ def test_coarse_boxes_span_their_lots(tmp_path):
         local_low, local_high = low - reference, high - reference
         assert (box_low <= np.c_[local_low[:, 0], -local_high[:, 2], local_low[:, 1]] + 1e-3).all()
         assert (box_high >= np.c_[local_high[:, 0], -local_low[:, 2], local_high[:, 1]] - 1e-3).all()
+
+
+def test_a_record_written_again_as_a_tileset_has_the_same_instances_and_lot_numbers(tmp_path):
+    record, _, _ = built(tmp_path)
+    counts = write_record(read_instances(tmp_path / "city.npz"), tmp_path / "again.3dtiles")
+    tileset = check_tileset(tmp_path / "again.3dtiles")
+    assert counts["instances"] == len(record["asset"])
+    xform, lot, _ = leaf_instances(tmp_path / "again.3dtiles", np.array(tileset["extras"]["reference"]))
+    assert sorted(lot.tolist()) == sorted(record["lot"].tolist())
+    np.testing.assert_allclose(np.sort(xform[:, :, 3], axis=0), np.sort(record["xform"][:, :, 3], axis=0), atol=2e-4)
+    tree, blob = _read_part(next((tmp_path / "again.3dtiles").glob("tiles/tile_*.glb")))
+    lots = property_tables(tree, blob)[0]
+    assert lots["id"] == [f"lot{n}" for n in lots["number"]]  # no lots file: a lot is its number

@@ -1,6 +1,6 @@
-"""``grammarc view``: the page and a tileset served on localhost (and nothing outside them), a record shown
-through a tileset written for the while, a clear message where the page is not built, and the page in
-headless Chromium showing the example city (where CI has installed Chromium and the viewer's packages)."""
+"""``grammarc view``: the page and a tileset served on localhost (and nothing outside them), a clear message
+where the page is not built or the folder is no tileset, and the page in headless Chromium showing the
+example city (where CI has installed Chromium and the viewer's packages)."""
 
 from __future__ import annotations
 
@@ -18,22 +18,14 @@ from PIL import Image
 
 from grammarc.build import build
 from grammarc.cli import main
-from grammarc.io.npz import read_instances
 from grammarc.render import view
-from grammarc.render.view import address, page_missing, page_server, tileset_folder
+from grammarc.render.view import address, page_missing, page_server
 
 ROOT = Path(__file__).resolve().parents[2]
 VIEWER = ROOT / "viewer"
 CHROMIUM = Path("/usr/bin/chromium")
 #: The page's background (index.html's scene): a screenshot of a city is mostly something else.
 BACKGROUND = (223, 230, 238)
-GRAMMAR = """
-Lot --> extrude(9) comp(f){ side : Facade | top : Roof }
-Facade --> split(y){ 3 : Floor }*
-Floor --> split(x){ ~2 : Window }*
-Window --> i("builtin:cube")
-Roof --> i("builtin:cube")
-"""
 
 
 @pytest.fixture
@@ -65,17 +57,6 @@ def test_the_page_and_the_tileset_are_served_and_nothing_beside_them(served):
     assert (status, kind) == (200, "application/json") and json.loads(body)["asset"]["version"] == "1.1"
     assert fetch(served + "tiles/../../secret.txt")[0] == 404
     assert fetch(served + "tiles/%2e%2e/secret.txt")[0] == 404
-
-
-def test_a_record_is_shown_through_a_tileset_written_for_the_while(tmp_path):
-    (tmp_path / "g.cga").write_text(GRAMMAR)
-    build(tmp_path / "g.cga", tmp_path / "city.npz")
-    record = read_instances(tmp_path / "city.npz")
-    with tileset_folder(tmp_path / "city.npz") as folder:
-        tileset = json.loads((folder / "tileset.json").read_text())
-        assert tileset["asset"]["version"] == "1.1" and list(folder.glob("tiles/tile_*.glb"))
-        assert tileset["extras"]["symbols"] == [str(s) for s in record["symbols"]]
-    assert not folder.exists()
 
 
 def test_a_folder_without_a_tileset_is_refused(tmp_path, capsys, monkeypatch):
