@@ -133,9 +133,9 @@ class TileContent(GlbPart):
         return super().add_tile(tile, max_bytes)
 
     def _describe_instances(self, node: dict, tile: Tile, members: np.ndarray) -> None:
-        rows = tile.instances[members]
         attributes = node["extensions"][INSTANCING]["attributes"]
-        for k, ids in enumerate(self._feature_ids(rows["lot"], rows["symbol"])):
+        rows = tile.instances
+        for k, ids in enumerate(self._feature_ids(rows["lot"][members], rows["symbol"][members])):
             attributes[f"_FEATURE_ID_{k}"] = self._accessor(ids, "SCALAR")
         node["extensions"][INSTANCE_FEATURES] = {"featureIds": self._feature_sets()}
 
