@@ -56,7 +56,8 @@ tiles.addEventListener("load-root-tileset", () => {
   tiles.group.updateMatrixWorld(true);
   sphere.applyMatrix4(tiles.group.matrixWorld);
   controls.target.copy(sphere.center);
-  camera.position.copy(sphere.center).add(new THREE.Vector3(0.45, 0.55, 0.7).multiplyScalar(sphere.radius * 1.3));
+  const distance = sphere.radius / Math.sin(THREE.MathUtils.degToRad(camera.fov / 2));
+  camera.position.copy(sphere.center).add(new THREE.Vector3(0.45, 0.55, 0.7).normalize().multiplyScalar(distance));
   camera.far = sphere.radius * 20;
   camera.updateProjectionMatrix();
   controls.update();
