@@ -16,7 +16,7 @@ from conftest import in_world
 from tiles3d_checks import box_bounds, check_content, check_tileset, property_tables, read_accessor, tiles
 from writers_city import GRAMMAR
 
-from grammarc.build import build
+from grammarc.build import BuildOptions, build
 from grammarc.errors import UsageError
 from grammarc.io import OutputOptions, written_paths
 from grammarc.io.gltf import _read_part
@@ -216,3 +216,15 @@ def test_a_record_written_again_as_a_tileset_has_the_same_instances_and_lot_numb
     tree, blob = _read_part(next((tmp_path / "again.3dtiles").glob("tiles/tile_*.glb")))
     lots = property_tables(tree, blob)[0]
     assert lots["id"] == [f"lot{n}" for n in lots["number"]]  # no lots file: a lot is its number
+
+
+def test_the_tileset_does_not_depend_on_the_chunking(tmp_path):
+    _, folder, _ = built(tmp_path, tile_size=50.0)
+    again = tmp_path / "chunked.3dtiles"
+    build(tmp_path / "g.cga", again, lots_path=tmp_path / "lots.geojson", options=BuildOptions(chunk_size=1),
+          output_options=OutputOptions(tile_size=50.0))
+
+    def files(root: Path) -> dict:
+        return {p.relative_to(root): p.read_bytes() for p in sorted(root.rglob("*")) if p.is_file()}
+
+    assert files(again) == files(folder)
