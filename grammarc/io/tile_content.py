@@ -4,9 +4,9 @@ A leaf tile is what ``io.gltf`` writes of one tile of the city (an asset per mes
 colour) group carrying its instances in ``EXT_mesh_gpu_instancing``, the mesh table's polygons as one mesh)
 plus its features, so that a viewer can say what was clicked:
 
-* ``EXT_structural_metadata`` on the root: a schema of two classes, ``lot`` (its id, its number in the
-  input and the lots file's attributes of the build, one property each) and ``symbol`` (the shape's
-  symbol name), and two property tables: the tile's lots (one row per lot with rows in the tile, in the
+* ``EXT_structural_metadata`` on the root: a schema of the classes ``lot`` (its id, its number in the
+  input and the lots file's attributes of the build, one property each), ``symbol`` (the shape's
+  symbol name) and ``mass`` (below), and two property tables: the tile's lots (one row per lot with rows in the tile, in the
   order of their numbers) and the record's symbols;
 * ``EXT_instance_features`` on each instancing node: the feature IDs of its instances, ``_FEATURE_ID_0``
   (the row of the lot table) and ``_FEATURE_ID_1`` (the symbol), extra attributes of its
@@ -18,7 +18,8 @@ extension's specification advises. Property values follow the 3D Metadata binary
 a buffer view aligned to 8 bytes, strings as UTF-8 bytes with a UINT32 offset per row and one past the end.
 
 A coarse tile (``add_boxes``) is one node instancing a unit cube with a translation, a scale and a colour
-(``_COLOR_0``, linear RGB) per box; boxes of single lots carry the lot feature ID and table too.
+(``_COLOR_0``, linear RGB) per box; a box of one lot has that lot's feature (a table of its lots), a mass of
+merged lots its own (a ``mass`` table: how many lots, how high).
 """
 
 from __future__ import annotations
@@ -37,8 +38,6 @@ __all__ = ["LotTable", "TileContent", "linear_rgb"]
 INSTANCE_FEATURES = "EXT_instance_features"
 MESH_FEATURES = "EXT_mesh_features"
 METADATA = "EXT_structural_metadata"
-#: The feature ID sets of every tile, in order: (label, property table).
-FEATURE_SETS = (("lot", 0), ("symbol", 1))
 #: The unit cube of box tiles: corners and triangles (outward, counter-clockwise).
 _CUBE_VERTICES = np.array([[x, y, z] for x in (0, 1) for y in (0, 1) for z in (0, 1)], np.float32)
 _CUBE_FACES = np.array([[0, 1, 3], [0, 3, 2], [4, 6, 7], [4, 7, 5], [0, 4, 5], [0, 5, 1],
@@ -82,7 +81,12 @@ class LotTable:
         return {"id": "grammarc", "classes": {
             "lot": {"name": "Lot", "description": "a lot (initial shape) of the build", "properties": properties},
             "symbol": {"name": "Symbol", "description": "the rule symbol a shape had when it became a leaf",
-                       "properties": {"name": {"type": "STRING"}}}}}
+                       "properties": {"name": {"type": "STRING"}}},
+            "mass": {"name": "Mass", "description": "lots merged into one box for the far view",
+                     "properties": {"lots": {"type": "SCALAR", "componentType": "INT32",
+                                             "description": "the lots merged"},
+                                    "height": {"type": "SCALAR", "componentType": "FLOAT64",
+                                               "description": "their mean height weighted by footprint (m)"}}}}}
 
     def rows(self, numbers: np.ndarray) -> dict[str, np.ndarray]:
         """The property columns of lots ``numbers`` (k,): ``id`` (str), ``number`` (int32), attributes."""
@@ -114,7 +118,9 @@ def _identifier(name: str, taken: set[str]) -> str:
 class TileContent(GlbPart):
     """One tile's GLB (``io.gltf``'s part) with the features of its instances and polygons.
 
-    ``add_tile`` (a leaf) or ``add_boxes`` (a coarse tile) once, then ``finish``.
+    ``add_tile`` (a leaf) or ``add_boxes`` (a coarse tile) once, then ``finish``. Feature ID set ``k`` of a
+    node or primitive is its ``_FEATURE_ID_k`` attribute and reads property table ``k``: a leaf's are the
+    lots and the symbols, a coarse tile's its lots or its masses.
     """
 
     def __init__(self, binary: Path, library, meta: dict, colormap, lots: LotTable, symbols: list[str]):
@@ -122,37 +128,39 @@ class TileContent(GlbPart):
         self.lots = lots
         self.symbols = symbols
         self._lot_row = np.zeros(0, np.int64)  # a lot number -> its row of this tile's lot table
-        self._lot_numbers = np.zeros(0, np.int64)
+        self._tables: list[tuple[str, dict[str, np.ndarray]]] = []  # (class, columns) of each property table
 
     # --------------------------------------------------------------------------------- leaf tiles
 
     def add_tile(self, tile: Tile, max_bytes: int) -> bool:
         """The tile's nodes (``io.gltf``) with feature IDs, and its two property tables."""
         numbers = np.unique(np.concatenate([tile.instances["lot"], tile.triangles["lot"]]).astype(np.int64))
-        self._index_lots(numbers)
+        self._tables = [("lot", self._lot_columns(numbers)), ("symbol", {"name": np.array(self.symbols, object)})]
         return super().add_tile(tile, max_bytes)
 
     def _describe_instances(self, node: dict, tile: Tile, members: np.ndarray) -> None:
         attributes = node["extensions"][INSTANCING]["attributes"]
         rows = tile.instances
-        for k, ids in enumerate(self._feature_ids(rows["lot"][members], rows["symbol"][members])):
-            attributes[f"_FEATURE_ID_{k}"] = self._accessor(ids, "SCALAR")
+        for k, ids in enumerate((self._lot_row[rows["lot"][members]], rows["symbol"][members])):
+            attributes[f"_FEATURE_ID_{k}"] = self._accessor(ids.astype(np.float32), "SCALAR")
         node["extensions"][INSTANCE_FEATURES] = {"featureIds": self._feature_sets()}
 
     def _describe_polygons(self, primitives: list[dict], tile: Tile) -> None:
         triangles = tile.triangles
         attributes = primitives[0]["attributes"]  # the primitives share their attributes
-        for k, ids in enumerate(self._feature_ids(triangles["lot"], triangles["symbol"])):
-            attributes[f"_FEATURE_ID_{k}"] = self._accessor(np.repeat(ids, 3), "SCALAR", ARRAY_BUFFER)
+        for k, ids in enumerate((self._lot_row[triangles["lot"]], triangles["symbol"])):
+            attributes[f"_FEATURE_ID_{k}"] = self._accessor(np.repeat(ids, 3).astype(np.float32), "SCALAR",
+                                                            ARRAY_BUFFER)
         for primitive in primitives:
             primitive["extensions"] = {MESH_FEATURES: {"featureIds": self._feature_sets()}}
 
     # -------------------------------------------------------------------------------- coarse tiles
 
-    def add_boxes(self, low: np.ndarray, size: np.ndarray, rgb: np.ndarray, lots: np.ndarray | None) -> None:
+    def add_boxes(self, low: np.ndarray, size: np.ndarray, rgb: np.ndarray, lots: np.ndarray | None = None,
+                  merged: np.ndarray | None = None) -> None:
         """One node instancing a unit cube: box ``i`` from ``low[i]`` (n, 3) float32, relative to the tile's
-        node, of ``size[i]`` (n, 3), colour ``rgb[i]`` (n, 3) uint8; ``lots`` (n,): each box's lot number,
-        or None for boxes of several lots (no features)."""
+        node, of ``size[i]`` (n, 3), colour ``rgb[i]`` (n, 3) uint8; its feature is its lot (``lots`` (n,):
+        lot numbers) or its mass (``merged`` (n,): the number of lots merged into each box)."""
         position = self._accessor(_CUBE_VERTICES, "VEC3", ARRAY_BUFFER, bounds=True)
         indices = self._accessor(_CUBE_FACES.reshape(-1), "SCALAR", ELEMENT_ARRAY_BUFFER)
         self.json["meshes"].append({"name": "box", "primitives": [
@@ -161,12 +169,16 @@ class TileContent(GlbPart):
         attributes = {"TRANSLATION": self._accessor(np.asarray(low, np.float32), "VEC3"),
                       "SCALE": self._accessor(np.asarray(size, np.float32), "VEC3"),
                       "_COLOR_0": self._accessor(linear_rgb(rgb), "VEC3")}
-        node = {"name": "boxes", "mesh": 0, "extensions": {INSTANCING: {"attributes": attributes}}}
         if lots is not None:
-            self._index_lots(np.unique(lots))
-            attributes["_FEATURE_ID_0"] = self._accessor(self._lot_row[lots].astype(np.float32), "SCALAR")
-            node["extensions"][INSTANCE_FEATURES] = {"featureIds": self._feature_sets()[:1]}
-        self.json["nodes"].append(node)
+            self._tables = [("lot", self._lot_columns(np.unique(lots)))]
+            ids = self._lot_row[lots]
+        else:
+            self._tables = [("mass", {"lots": np.asarray(merged, np.int32),
+                                      "height": np.asarray(size, np.float64)[:, 1]})]
+            ids = np.arange(len(low))
+        attributes["_FEATURE_ID_0"] = self._accessor(ids.astype(np.float32), "SCALAR")
+        self.json["nodes"].append({"name": "boxes", "mesh": 0, "extensions": {
+            INSTANCING: {"attributes": attributes}, INSTANCE_FEATURES: {"featureIds": self._feature_sets()}}})
         self.json["scenes"][0]["nodes"].append(len(self.json["nodes"]) - 1)
 
     # ------------------------------------------------------------------------------------ features
@@ -174,30 +186,27 @@ class TileContent(GlbPart):
     def finish(self, out: Path) -> None:
         """The property tables and the extensions' names, then the GLB (``io.gltf``)."""
         used = {INSTANCING}
-        if len(self._lot_numbers):
+        if self._tables:
             self.json.setdefault("extensions", {})[METADATA] = {
                 "schema": self.lots.schema(),
-                "propertyTables": [self._table("lot", self.lots.rows(self._lot_numbers)),
-                                   self._table("symbol", {"name": np.array(self.symbols, object)})]}
+                "propertyTables": [self._table(name, columns) for name, columns in self._tables]}
             used |= {METADATA, INSTANCE_FEATURES}
             if any(MESH_FEATURES in p.get("extensions", {}) for m in self.json["meshes"] for p in m["primitives"]):
                 used.add(MESH_FEATURES)
         self.json["extensionsUsed"] = sorted(used)
         super().finish(out)
 
-    def _index_lots(self, numbers: np.ndarray) -> None:
-        self._lot_numbers = np.asarray(numbers, np.int64)
-        self._lot_row = np.full(int(self._lot_numbers.max()) + 1 if len(self._lot_numbers) else 0, -1, np.int64)
-        self._lot_row[self._lot_numbers] = np.arange(len(self._lot_numbers))
-
-    def _feature_ids(self, lot: np.ndarray, symbol: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """(n,) float32 feature IDs of rows of lots ``lot`` and symbols ``symbol``: their table rows."""
-        return self._lot_row[lot].astype(np.float32), np.asarray(symbol).astype(np.float32)
+    def _lot_columns(self, numbers: np.ndarray) -> dict[str, np.ndarray]:
+        """The lot table of lots ``numbers`` (ascending), and each lot's row of it in ``_lot_row``."""
+        numbers = np.asarray(numbers, np.int64)
+        self._lot_row = np.full(int(numbers.max()) + 1 if len(numbers) else 0, -1, np.int64)
+        self._lot_row[numbers] = np.arange(len(numbers))
+        return self.lots.rows(numbers)
 
     def _feature_sets(self) -> list[dict]:
-        counts = (len(self._lot_numbers), len(self.symbols))
-        return [{"featureCount": count, "attribute": k, "propertyTable": table, "label": label}
-                for k, ((label, table), count) in enumerate(zip(FEATURE_SETS, counts))]
+        """Feature ID set ``k``: attribute ``_FEATURE_ID_k``, property table ``k``."""
+        return [{"featureCount": len(next(iter(columns.values()))), "attribute": k, "propertyTable": k,
+                 "label": name} for k, (name, columns) in enumerate(self._tables)]
 
     def _table(self, name: str, columns: dict[str, np.ndarray]) -> dict:
         """A property table of class ``name``: each column's values (and string offsets) in buffer views."""

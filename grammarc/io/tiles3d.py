@@ -14,7 +14,8 @@ The layout::
   covers the city's footprint. A node of level 1 holds a box per lot (the bounding box of the lot's
   instances and polygons, in their mean colour), a node of level ``k >= 2`` merged masses: the lots whose
   box centres fall in one cell of ``2^k * tile_size / 32`` metres become one box spanning their boxes,
-  as high as their mean height weighted by footprint (so a tower does not raise a block). A node's
+  as high as their mean height weighted by footprint (so a tower does not raise a block); a click on a
+  mass tells how many lots it merges (its feature, ``io.tile_content``). A node's
   geometric error is that cell edge (``2^k * tile_size / 32``; a box of a lot at level 1), a leaf's 0,
   so a viewer refines the masses into boxes and the boxes into the buildings as the camera comes
   nearer; children replace their parent (``REPLACE``).
@@ -152,12 +153,11 @@ class TilesetWriter(TiledWriter):
         offset = np.clip(0.5 * (low + high)[:, [0, 2]] - corner, 0.0, np.nextafter(extent, 0.0))
         if level == 1:
             node_of = np.floor(offset / edge).astype(np.int64)
-            features = lots
+            merged = None
         else:
             cells = np.floor(offset / (edge / _CELLS)).astype(np.int64)
-            low, high, rgb, cells = _masses(cells, low, high, rgb)
+            low, high, rgb, merged, cells = _masses(cells, low, high, rgb)
             node_of = cells // _CELLS
-            features = None
         packed = (node_of[:, 0] << 32) | node_of[:, 1]
         order = np.argsort(packed, kind="stable")
         starts = np.flatnonzero(np.r_[True, packed[order][1:] != packed[order][:-1]])
@@ -165,8 +165,10 @@ class TilesetWriter(TiledWriter):
             rows = order[begin:end]
             key = (level, int(node_of[rows[0], 0]), int(node_of[rows[0], 1]))
             content = self._content()
-            content.add_boxes(low[rows], high[rows] - low[rows], rgb[rows],
-                              None if features is None else features[rows])
+            if merged is None:
+                content.add_boxes(low[rows], high[rows] - low[rows], rgb[rows], lots=lots[rows])
+            else:
+                content.add_boxes(low[rows], high[rows] - low[rows], rgb[rows], merged=merged[rows])
             uri = f"tiles/L{level}_{key[1]}_{key[2]}.glb"
             content.finish(staged / uri)
             nodes[key] = {"uri": uri, "box": _bounds(low[rows].min(axis=0), high[rows].max(axis=0))}
@@ -229,7 +231,8 @@ class _LotBoxes:
 def _masses(cells: np.ndarray, low: np.ndarray, high: np.ndarray, rgb: np.ndarray):
     """Boxes merged by cell (``cells`` (n, 2) int64): each cell's box spans its boxes' footprints and rises
     from their lowest bottom by their heights' mean weighted by footprint area, in their colours' mean so
-    weighted; returns low, high, rgb (uint8) and the cells, one row per cell in cell order."""
+    weighted; returns low, high, rgb (uint8), the number of boxes merged and the cells, one row per cell in
+    cell order."""
     packed = (cells[:, 0] << 32) | cells[:, 1]
     unique, first, group = np.unique(packed, return_index=True, return_inverse=True)
     group = group.reshape(-1)
@@ -242,7 +245,7 @@ def _masses(cells: np.ndarray, low: np.ndarray, high: np.ndarray, rgb: np.ndarra
     height = np.bincount(group, area * (high[:, 1] - low[:, 1])) / weight
     out_high[:, 1] = out_low[:, 1] + height
     colour = np.stack([np.bincount(group, area * rgb[:, c]) for c in range(3)], axis=1) / weight[:, None]
-    return out_low, out_high, np.rint(colour).astype(np.uint8), cells[first]
+    return out_low, out_high, np.rint(colour).astype(np.uint8), np.bincount(group), cells[first]
 
 
 def _bounds(low: np.ndarray, high: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

@@ -120,7 +120,7 @@ def test_coarser_levels_stand_for_the_lots_with_errors_that_grow_towards_the_roo
     errors = sorted(by_level)
     assert errors[0] == 0 and all(t["content"]["uri"].startswith("tiles/tile_") for t in by_level[0])
     assert errors[1:] == [8.0 * 2 ** k / 32 for k in range(1, len(errors))]
-    # level 1: a box per lot, with the lot's features; above: merged masses, without
+    # level 1: a box per lot, with the lot's features; above: merged masses, with their own
     boxes = 0
     for tile in (t for t in by_level[errors[1]] if "content" in t):  # a node may hold no lot's centre
         tree, _ = check_content(folder / tile["content"]["uri"])
@@ -128,8 +128,10 @@ def test_coarser_levels_stand_for_the_lots_with_errors_that_grow_towards_the_roo
         assert "EXT_instance_features" in node["extensions"]
         boxes += tree["accessors"][node["extensions"]["EXT_mesh_gpu_instancing"]["attributes"]["SCALE"]]["count"]
     assert boxes == len(np.unique(record["lot"]))
-    top, _ = _read_part(folder / tileset["root"]["content"]["uri"])
-    assert "EXT_instance_features" not in top["nodes"][0]["extensions"]
+    top, blob = check_content(folder / tileset["root"]["content"]["uri"])
+    (masses,) = property_tables(top, blob)
+    assert top["extensions"]["EXT_structural_metadata"]["propertyTables"][0]["class"] == "mass"
+    assert sum(masses["lots"]) == len(np.unique(record["lot"]))
     assert tileset["geometricError"] > tileset["root"]["geometricError"]
 
 
