@@ -208,8 +208,9 @@ class GlbPart:
         self.instances += len(rows)
         return True
 
-    def finish(self, out: Path) -> None:
-        """Write the GLB: header, JSON chunk, binary chunk (copied from the temporary file)."""
+    def finish(self, out: Path, sync: bool = True) -> None:
+        """Write the GLB: header, JSON chunk, binary chunk (copied from the temporary file); fsynced unless
+        ``sync`` is false (a writer of many files syncs them together, ``io.tiles3d``)."""
         self.json["buffers"][0]["byteLength"] = self.size
         for key in ("meshes", "materials", "accessors", "bufferViews"):
             if not self.json[key]:
@@ -225,7 +226,8 @@ class GlbPart:
             self.binary.seek(0)
             shutil.copyfileobj(self.binary, glb, 16 << 20)
             glb.flush()
-            os.fsync(glb.fileno())
+            if sync:
+                os.fsync(glb.fileno())
         self.binary.close()
 
     def _describe_instances(self, node: dict, tile: Tile, members: np.ndarray) -> None:

@@ -183,7 +183,7 @@ class TileContent(GlbPart):
 
     # ------------------------------------------------------------------------------------ features
 
-    def finish(self, out: Path) -> None:
+    def finish(self, out: Path, sync: bool = True) -> None:
         """The property tables and the extensions' names, then the GLB (``io.gltf``)."""
         used = {INSTANCING}
         if self._tables:
@@ -194,7 +194,7 @@ class TileContent(GlbPart):
             if any(MESH_FEATURES in p.get("extensions", {}) for m in self.json["meshes"] for p in m["primitives"]):
                 used.add(MESH_FEATURES)
         self.json["extensionsUsed"] = sorted(used)
-        super().finish(out)
+        super().finish(out, sync)
 
     def _lot_columns(self, numbers: np.ndarray) -> dict[str, np.ndarray]:
         """The lot table of lots ``numbers`` (ascending), and each lot's row of it in ``_lot_row``."""

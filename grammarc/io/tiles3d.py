@@ -38,6 +38,7 @@ from __future__ import annotations
 import json
 import os
 from collections.abc import Sequence
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import replace
 from pathlib import Path
 from typing import ClassVar
@@ -119,8 +120,7 @@ class TilesetWriter(TiledWriter):
                               "reference": reference.tolist(), "symbols": self._symbols}}
         with open(staged / "tileset.json", "w", encoding="utf-8") as out:
             json.dump(tileset, out, separators=(",", ":"))
-            out.flush()
-            os.fsync(out.fileno())
+        _sync(staged.rglob("*.*"))
         if self.path.exists() or self.path.is_symlink():
             os.replace(self.path, self._tmp / "previous")  # removed with the temporary folder
         os.replace(staged, self.path)
@@ -136,7 +136,7 @@ class TilesetWriter(TiledWriter):
         if not content.add_tile(tile, MAX_BYTES):
             raise UsageError(f"{self.path}: tile {tile.name} passes {MAX_BYTES:,} bytes; give a smaller --tile-size")
         uri = f"tiles/{tile.name}.glb"
-        content.finish(staged / uri)
+        content.finish(staged / uri, sync=False)
         low, high, lots, rgb = _tile_boxes(tile)
         boxes.add(lots, low + tile.origin, high + tile.origin, rgb)
         return {"uri": uri, "box": _bounds(low + tile.origin, high + tile.origin)}
@@ -170,12 +170,23 @@ class TilesetWriter(TiledWriter):
             else:
                 content.add_boxes(low[rows], high[rows] - low[rows], rgb[rows], merged=merged[rows])
             uri = f"tiles/L{level}_{key[1]}_{key[2]}.glb"
-            content.finish(staged / uri)
+            content.finish(staged / uri, sync=False)
             nodes[key] = {"uri": uri, "box": _bounds(low[rows].min(axis=0), high[rows].max(axis=0))}
 
 
 #: The extension this module writes (``grammarc.io.writers``): a folder.
 WRITERS = {".3dtiles": TilesetWriter}
+
+
+def _sync(paths) -> None:
+    """fsync the files ``paths`` before the folder is renamed into place, many at once: the file system
+    commits them together (one at a time, a tileset of 600 tiles spent 2.4 s here)."""
+    def sync(path: Path) -> None:
+        with open(path, "rb") as file:
+            os.fsync(file.fileno())
+
+    with ThreadPoolExecutor(max_workers=16) as pool:
+        list(pool.map(sync, paths))
 
 
 def _error(level: int, size: float) -> float:
