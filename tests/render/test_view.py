@@ -59,6 +59,23 @@ def test_the_page_and_the_tileset_are_served_and_nothing_beside_them(served):
     assert fetch(served + "tiles/%2e%2e/secret.txt")[0] == 404
 
 
+def test_a_record_is_served_through_a_tileset_written_for_the_while(tmp_path, monkeypatch):
+    (tmp_path / "g.cga").write_text("Lot --> extrude(9) Mass\nMass --> i(\"builtin:cube\")\n")
+    build(tmp_path / "g.cga", tmp_path / "city.npz")
+    served = []
+
+    def serve(folder, **options):
+        tileset = json.loads((folder / "tileset.json").read_text())
+        served.append((folder, tileset["extras"]["symbols"], options["open_browser"]))
+
+    monkeypatch.setattr(view, "_BUNDLE", Path(__file__))  # as if the page were built
+    monkeypatch.setattr(view, "serve", serve)
+    assert main(["view", str(tmp_path / "city.npz"), "--no-browser"]) == 0
+    ((folder, symbols, open_browser),) = served
+    assert folder.name == "city.3dtiles" and symbols == ["Lot", "Mass"] and not open_browser
+    assert not folder.exists()  # the temporary tileset is gone with the server
+
+
 def test_a_folder_without_a_tileset_is_refused(tmp_path, capsys, monkeypatch):
     monkeypatch.setattr(view, "_BUNDLE", Path(__file__))  # as if the page were built
     assert main(["view", str(tmp_path), "--no-browser"]) == 2
