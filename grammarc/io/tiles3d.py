@@ -6,7 +6,7 @@ The layout::
     city.3dtiles/tiles/tile_3_m2.glb      a leaf: the city's instances and polygons in one square tile
     city.3dtiles/tiles/L2_0_1.glb         a coarse tile: boxes standing for the lots, or masses of lots
 
-* **Leaves** are the squares of ``io.instancing`` (``--tile-size``, 125 m by default here: a browser loads
+* **Leaves** are the squares of ``io.instancing`` (``--tile-size``, 250 m by default here: a browser loads
   a leaf at a time), each a GLB as ``io.gltf`` writes a tile (the assets as shared meshes, instanced with
   ``EXT_mesh_gpu_instancing``, the mesh table's polygons as one mesh) with the features of its instances
   and polygons (``io.tile_content``: the lot id, number and attributes, and the symbol, for a click).
