@@ -5,9 +5,9 @@ colour) group carrying its instances in ``EXT_mesh_gpu_instancing``, the mesh ta
 plus its features, so that a viewer can say what was clicked:
 
 * ``EXT_structural_metadata`` on the root: a schema of the classes ``lot`` (its id, its number in the
-  input and the lots file's attributes of the build, one property each), ``symbol`` (the shape's
-  symbol name) and ``mass`` (below), and two property tables: the tile's lots (one row per lot with rows in the tile, in the
-  order of their numbers) and the record's symbols;
+  input and the lots file's attributes of the build, one property each), ``symbol`` (the shape's symbol
+  name) and ``mass`` (below), and two property tables: the tile's lots (one row per lot with rows in the
+  tile, in the order of their numbers) and the record's symbols;
 * ``EXT_instance_features`` on each instancing node: the feature IDs of its instances, ``_FEATURE_ID_0``
   (the row of the lot table) and ``_FEATURE_ID_1`` (the symbol), extra attributes of its
   ``EXT_mesh_gpu_instancing``;

@@ -120,7 +120,7 @@ class TilesetWriter(TiledWriter):
                               "reference": reference.tolist(), "symbols": self._symbols}}
         with open(staged / "tileset.json", "w", encoding="utf-8") as out:
             json.dump(tileset, out, separators=(",", ":"))
-        _sync(staged.rglob("*.*"))
+        _sync(path for path in staged.rglob("*") if path.is_file())
         if self.path.exists() or self.path.is_symlink():
             os.replace(self.path, self._tmp / "previous")  # removed with the temporary folder
         os.replace(staged, self.path)
@@ -179,8 +179,8 @@ WRITERS = {".3dtiles": TilesetWriter}
 
 
 def _sync(paths) -> None:
-    """fsync the files ``paths`` before the folder is renamed into place, many at once: the file system
-    commits them together (one at a time, a tileset of 600 tiles spent 2.4 s here)."""
+    """fsync the files ``paths`` before the folder is renamed into place, many at once, so that the file
+    system commits them together rather than one journal commit per tile."""
     def sync(path: Path) -> None:
         with open(path, "rb") as file:
             os.fsync(file.fileno())
