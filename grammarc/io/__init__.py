@@ -59,8 +59,8 @@ class OutputOptions:
     the level of detail of assets (``model.assets.load_asset``), the tile edge of the instanced formats
     (``io.instancing``), the folders assets are loaded from (the build gives the grammar's, a rule
     package's while it is extracted, and ``--assets``), the world point baked meshes are relative to
-    (``io.bake.BakedWriter``), the build's lots (``io.cityjson``: Buildings' ids and attributes). None: the
-    writer's default."""
+    (``io.bake.BakedWriter``), the build's lots (``io.cityjson``: Buildings' ids and attributes;
+    ``io.tiles3d``: the features' ids and attributes). None: the writer's default."""
 
     bake: bool = False
     lod: str | None = None
