@@ -179,7 +179,7 @@ def _parser() -> argparse.ArgumentParser:
     lots.set_defaults(run=_lots)
 
     info = sub.add_parser("info", help="what a city holds: counts, lots, bbox, polygons")
-    info.add_argument("record", type=Path, help="an output of build: .npz, .usda/.usdc/.usd or .glb")
+    info.add_argument("record", type=Path, help="an output of build: .npz, .usda/.usdc/.usd, .glb or .3dtiles")
     info.add_argument("--assets", type=Path, action="append", metavar="DIR",
                       help="folders for file assets (default: those the record names)")
     info.add_argument("--lod", metavar="NAME", help="count polygons at this level of detail")

@@ -47,12 +47,12 @@ import numpy as np
 
 from grammarc.constants import LIMITS
 from grammarc.errors import UsageError
-from grammarc.io.gltf import MAX_BYTES
-from grammarc.io.instancing import Tile, TiledWriter
-from grammarc.io.tile_content import LotTable, TileContent
+from grammarc.io.gltf import INSTANCING, MAX_BYTES
+from grammarc.io.instancing import Tile, TiledWriter, compose
+from grammarc.io.tile_content import METADATA, LotTable, TileContent
 from grammarc.model.lots import Lots
 
-__all__ = ["LEAF_SIZE", "WRITERS", "TilesetWriter", "ecef_frame", "write_record"]
+__all__ = ["LEAF_SIZE", "WRITERS", "TilesetWriter", "ecef_frame", "read_tileset", "write_record"]
 
 #: Default leaf edge (metres) of a tileset.
 LEAF_SIZE = LIMITS.leaf_size
@@ -339,3 +339,66 @@ def write_record(record: dict, path: str | os.PathLike, lod: str | None = None) 
         for chunk in record_chunks(record):
             writer.write(chunk)
         return writer.close()
+
+
+def read_tileset(path: str | os.PathLike) -> dict:
+    """The instances of a tileset written by ``TilesetWriter``, as a record dict (``io.npz.read_instances``'s
+    keys that a tileset keeps: assets, asset, xform (float64, world), lot, symbol, symbols, the mesh table as
+    triangles with their lots and symbols, meta), read from its leaves; grouped by leaf and (asset, colour),
+    not in the record's order."""
+    from grammarc.io.gltf import _accessor, _read_part
+
+    folder = Path(path)
+    tileset = json.loads((folder / "tileset.json").read_text(encoding="utf-8"))
+    reference = np.array(tileset["extras"]["reference"], np.float64)
+    names: dict[str, int] = {}
+    columns: dict[str, list] = {"asset": [], "xform": [], "lot": [], "symbol": [], "vertices": [],
+                                "mesh_lot": [], "mesh_symbol": []}
+    leaves = [tile["content"]["uri"] for tile in _walk(tileset["root"])
+              if tile["geometricError"] == 0 and "content" in tile]
+    for uri in leaves:
+        tree, blob = _read_part(folder / uri)
+        numbers = _lot_numbers(tree, blob)
+        for root in tree["scenes"][0]["nodes"]:
+            corner = np.array(tree["nodes"][root]["translation"], np.float64) + reference
+            for child in tree["nodes"][root]["children"]:
+                node = tree["nodes"][child]
+                instancing = node.get("extensions", {}).get(INSTANCING)
+                if instancing is None:  # the leaf's polygons: a lot and a symbol per vertex
+                    attributes = tree["meshes"][node["mesh"]]["primitives"][0]["attributes"]
+                    columns["vertices"].append(_accessor(tree, blob, attributes["POSITION"]) + corner)
+                    columns["mesh_lot"].append(numbers[_accessor(tree, blob, attributes["_FEATURE_ID_0"])[::3]
+                                                       .astype(np.int64)])
+                    columns["mesh_symbol"].append(_accessor(tree, blob, attributes["_FEATURE_ID_1"])[::3])
+                    continue
+                attributes = instancing["attributes"]
+                t, r, s = (_accessor(tree, blob, attributes[k]) for k in ("TRANSLATION", "ROTATION", "SCALE"))
+                columns["xform"].append(compose(t.astype(np.float64) + corner, r, s))
+                mesh = tree["meshes"][node["mesh"]]["name"]
+                columns["asset"].append(np.full(len(t), names.setdefault(mesh, len(names)), np.int32))
+                columns["lot"].append(numbers[_accessor(tree, blob, attributes["_FEATURE_ID_0"]).astype(np.int64)])
+                columns["symbol"].append(_accessor(tree, blob, attributes["_FEATURE_ID_1"]))
+    record = {key: np.concatenate(values) if values else np.zeros(0) for key, values in columns.items()}
+    vertices = record.pop("vertices").reshape(-1, 3).astype(np.float64)
+    record.update(
+        assets=np.array(list(names)), xform=record["xform"].reshape(-1, 3, 4),
+        asset=record["asset"].astype(np.int32), lot=record["lot"].astype(np.int32),
+        symbol=record["symbol"].astype(np.int32), symbols=np.array(tileset["extras"]["symbols"]),
+        meta=tileset["extras"]["grammarc"], mesh_vertices=vertices,
+        mesh_ring_offsets=np.arange(0, len(vertices) + 1, 3), mesh_face_offsets=np.arange(len(vertices) // 3 + 1),
+        mesh_lot=record["mesh_lot"].astype(np.int32), mesh_symbol=record["mesh_symbol"].astype(np.int32))
+    return record
+
+
+def _walk(tile: dict):
+    """``tile`` and every tile under it."""
+    yield tile
+    for child in tile.get("children", []):
+        yield from _walk(child)
+
+
+def _lot_numbers(tree: dict, blob: bytes) -> np.ndarray:
+    """The lot numbers of a leaf's lot table (property table 0), by row."""
+    table = tree["extensions"][METADATA]["propertyTables"][0]
+    view = tree["bufferViews"][table["properties"]["number"]["values"]]
+    return np.frombuffer(blob, np.int32, view["byteLength"] // 4, view.get("byteOffset", 0)).astype(np.int64)

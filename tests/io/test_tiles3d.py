@@ -22,7 +22,7 @@ from grammarc.io import OutputOptions, written_paths
 from grammarc.io.gltf import _read_part
 from grammarc.io.instancing import compose
 from grammarc.io.npz import read_instances
-from grammarc.io.tiles3d import TilesetWriter, write_record
+from grammarc.io.tiles3d import TilesetWriter, read_tileset, write_record
 
 VIEWER = Path(__file__).resolve().parents[2] / "viewer"
 PROPERTIES = [{"height": 9.5, "roof-type": "hip"}, {"height": 12.0}, {"height": 7.25, "roof-type": "flat"}]
@@ -230,3 +230,25 @@ def test_the_tileset_does_not_depend_on_the_chunking(tmp_path):
         return {p.relative_to(root): p.read_bytes() for p in sorted(root.rglob("*")) if p.is_file()}
 
     assert files(again) == files(folder)
+
+
+def test_read_back_a_tileset_is_the_record_by_leaf(tmp_path):
+    record, folder, _ = built(tmp_path)
+    back = read_tileset(folder)
+    assert [str(s) for s in back["symbols"]] == [str(s) for s in record["symbols"]]
+    names = sorted(str(n) for n in record["assets"])
+
+    def order(r: dict) -> np.ndarray:
+        """Rows by asset name, lot, symbol and place: the same order whatever the file's grouping."""
+        asset = np.searchsorted(names, [str(r["assets"][a]) for a in r["asset"]])
+        return np.lexsort((*np.round(r["xform"][:, :, 3].T, 2), r["symbol"], r["lot"], asset))
+
+    got, want = order(back), order(record)
+    np.testing.assert_array_equal(back["lot"][got], record["lot"][want])
+    np.testing.assert_array_equal(back["symbol"][got], record["symbol"][want])
+    np.testing.assert_allclose(back["xform"][got], record["xform"][want], atol=2e-4)
+    # the mesh table as triangles, each with its face's lot and symbol
+    faces = len(back["mesh_face_offsets"]) - 1
+    assert faces >= len(record["mesh_face_offsets"]) - 1 and len(back["mesh_lot"]) == faces
+    assert set(back["mesh_lot"].tolist()) == set(record["mesh_lot"].tolist())
+    assert set(back["mesh_symbol"].tolist()) == set(record["mesh_symbol"].tolist())
