@@ -6,7 +6,7 @@ streams its chunks: the facade tiles (quads, every third a cube) of 12 x 15 m bu
 colours. Each format is written in a child process,
 so its peak RSS is its own::
 
-    python -m pytest benchmarks/bench_writers.py                   # npz, usdc, glb at 10^6 instances
+    python -m pytest benchmarks/bench_writers.py                   # npz, usdc, glb, 3dtiles at 10^6 instances
     /usr/bin/time -f "%e s %M KB" python benchmarks/bench_writers.py --format usdc --rows 10000000
 
 The second form is how the 10^7-instance figure of the closing note was made (streaming: the memory is
@@ -85,7 +85,7 @@ def run_child(fmt: str, rows: int, directory: Path) -> dict:
     return json.loads(proc.stdout)
 
 
-@pytest.mark.parametrize("fmt", ["npz", "usdc", "glb"])
+@pytest.mark.parametrize("fmt", ["npz", "usdc", "glb", "3dtiles"])
 def test_writer_speed(benchmark, tmp_path, fmt):
     if fmt == "usdc":
         pytest.importorskip("pxr")
@@ -104,7 +104,7 @@ def test_writer_speed(benchmark, tmp_path, fmt):
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    parser.add_argument("--format", choices=("npz", "usdc", "usda", "glb"), default="usdc")
+    parser.add_argument("--format", choices=("npz", "usdc", "usda", "glb", "3dtiles"), default="usdc")
     parser.add_argument("--rows", type=int, default=1_000_000)
     parser.add_argument("--dir", type=Path)
     args = parser.parse_args()

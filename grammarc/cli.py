@@ -92,7 +92,8 @@ def _parser() -> argparse.ArgumentParser:
                        help="the grammar: a .cga file (paper notation or CityEngine CGA) or a .rpk package")
     build.add_argument("--emit", required=True, metavar="OUT",
                        help="output file: .npz (instance record), .usda/.usdc/.usd (instanced USD, extra "
-                            "`usd`), .glb (glTF with GPU instancing), or .obj/.ply/.stl (baked mesh)")
+                            "`usd`), .glb (glTF with GPU instancing), .3dtiles (a folder of 3D Tiles 1.1, for "
+                            "`grammarc view`), or .obj/.ply/.stl (baked mesh)")
     build.add_argument("--lots", type=Path, metavar="PATH",
                        help="footprints: GeoJSON, a GeoJSON sequence, GeoParquet, a GIS file (.gpkg, .shp, "
                             ".fgb, ...) or OBJ (default: the lots beside the grammar, or one 30 x 20 m lot)")
@@ -132,7 +133,8 @@ def _parser() -> argparse.ArgumentParser:
                        help="world point subtracted from a baked mesh's coordinates (default: world coordinates, "
                             "or the middle of the city in float32 formats far from the origin; the file says which)")
     build.add_argument("--tile-size", type=float, metavar="M",
-                       help=f"edge of the tiles of .usd*/.glb outputs in metres (default {LIMITS.tile_size:g})")
+                       help=f"edge of the tiles of .usd*/.glb outputs in metres (default {LIMITS.tile_size:g}; "
+                            f"the leaves of .3dtiles: {LIMITS.leaf_size:g})")
     build.add_argument("--select", metavar="IDS",
                        help="derive only these lots (comma-separated ids), e.g. to bake a few")
     build.add_argument("--reports", type=Path, metavar="PATH",
@@ -177,7 +179,7 @@ def _parser() -> argparse.ArgumentParser:
     lots.set_defaults(run=_lots)
 
     info = sub.add_parser("info", help="what a city holds: counts, lots, bbox, polygons")
-    info.add_argument("record", type=Path, help="an output of build: .npz, .usda/.usdc/.usd or .glb")
+    info.add_argument("record", type=Path, help="an output of build: .npz, .usda/.usdc/.usd, .glb or .3dtiles")
     info.add_argument("--assets", type=Path, action="append", metavar="DIR",
                       help="folders for file assets (default: those the record names)")
     info.add_argument("--lod", metavar="NAME", help="count polygons at this level of detail")
@@ -196,6 +198,15 @@ def _parser() -> argparse.ArgumentParser:
                         help="a folder for file assets, instead of the grammar's folder (repeatable)")
     render.set_defaults(run=_render)
 
+    view = sub.add_parser("view", help="show a city in a browser: a .3dtiles folder or an .npz record, served on "
+                                       "this machine")
+    view.add_argument("city", type=Path, help="a folder written with --emit CITY.3dtiles, or an instance record "
+                                              "(.npz), written as 3D Tiles into a temporary folder first")
+    view.add_argument("--port", type=int, default=0, metavar="N", help="the port on 127.0.0.1 (default: a free one)")
+    view.add_argument("--no-browser", action="store_true", help="print the page's address, open no browser")
+    view.add_argument("--lod", metavar="NAME", help="with an .npz: the assets' level of detail (as build's)")
+    view.set_defaults(run=_view)
+
     serve = sub.add_parser("server", help="a resident grammarc that starts each command warm: start it, "
                                           "stop (every server of this user), status")
     serve.add_argument("action", choices=("start", "stop", "status"))
@@ -204,6 +215,34 @@ def _parser() -> argparse.ArgumentParser:
     serve.add_argument("--foreground", action="store_true", help="serve from this process, logging to stderr")
     serve.set_defaults(run=_server)
     return parser
+
+
+def _view(args) -> int:
+    import tempfile
+
+    from grammarc.render.view import page_missing, serve
+
+    problem = page_missing()  # said before an .npz is written as a tileset
+    if problem is not None:
+        raise UsageError(problem)
+
+    def show(folder: Path) -> int:
+        serve(folder, port=args.port, open_browser=not args.no_browser,
+              ready=lambda url: print(f"grammarc view: {url} (Ctrl-C stops)", flush=True))
+        return 0
+
+    if args.city.is_dir():
+        if not (args.city / "tileset.json").is_file():
+            raise UsageError(f"`{args.city}` has no tileset.json: give a folder written with --emit CITY.3dtiles")
+        return show(args.city)
+    from grammarc.io.npz import load_record
+    from grammarc.io.tiles3d import write_record
+
+    record = load_record(args.city)  # a UsageError where it is not a record
+    with tempfile.TemporaryDirectory(prefix="grammarc-view-") as folder:
+        tileset = Path(folder) / f"{args.city.stem}.3dtiles"
+        write_record(record, tileset, args.lod)
+        return show(tileset)
 
 
 def _server(args) -> int:

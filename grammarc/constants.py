@@ -48,6 +48,9 @@ class Limits:
     #: Edge (metres) of the tiles of the instanced outputs (``--tile-size``): float32 positions relative
     #: to a 500 m tile's corner are exact to about 30 micrometres (``io.instancing``).
     tile_size: float = 500.0
+    #: Edge (metres) of the leaves of a 3D Tiles output (``io.tiles3d``): a browser loads a leaf at a time,
+    #: and a 250 m square of a dense town is about 10^4 instances, under a megabyte.
+    leaf_size: float = 250.0
 
 
 TOL = Tol()

@@ -7,6 +7,8 @@ their exporters: each writer module has ``WRITERS``, the extensions it writes ->
 * ``.npz``: the instance record (``io/npz.py``);
 * ``.usda``, ``.usdc``, ``.usd``: instanced USD, one PointInstancer per tile (``io/usd.py``);
 * ``.glb``: glTF with GPU instancing (``io/gltf.py``), or baked with ``--bake``;
+* ``.3dtiles``: a folder of 3D Tiles 1.1, instanced GLB tiles under a quadtree of coarser ones
+  (``io/tiles3d.py``), which ``grammarc view`` shows in a browser;
 * ``.obj``, ``.ply``, ``.stl``: the record baked into one mesh (``io/bake.py``), as a .glb with ``--bake``;
 * ``.json`` (``city.city.json``): CityJSON 2.0, a Building per lot (``io/cityjson.py``).
 
@@ -33,7 +35,8 @@ if TYPE_CHECKING:
     from grammarc.model.lots import Lots
 
 #: The modules that declare ``WRITERS``, in the order ``writer_for``'s messages list their extensions.
-WRITER_MODULES = ("grammarc.io.npz", "grammarc.io.usd", "grammarc.io.gltf", "grammarc.io.bake", "grammarc.io.cityjson")
+WRITER_MODULES = ("grammarc.io.npz", "grammarc.io.usd", "grammarc.io.gltf", "grammarc.io.tiles3d", "grammarc.io.bake",
+                  "grammarc.io.cityjson")
 
 
 class WriterBlock:
@@ -56,8 +59,8 @@ class OutputOptions:
     the level of detail of assets (``model.assets.load_asset``), the tile edge of the instanced formats
     (``io.instancing``), the folders assets are loaded from (the build gives the grammar's, a rule
     package's while it is extracted, and ``--assets``), the world point baked meshes are relative to
-    (``io.bake.BakedWriter``), the build's lots (``io.cityjson``: Buildings' ids and attributes). None: the
-    writer's default."""
+    (``io.bake.BakedWriter``), the build's lots (``io.cityjson``: Buildings' ids and attributes;
+    ``io.tiles3d``: the features' ids and attributes). None: the writer's default."""
 
     bake: bool = False
     lod: str | None = None
@@ -93,9 +96,13 @@ def writer_for(path: str | Path, options: OutputOptions = OutputOptions()):
 def written_paths(path: str | Path, options: OutputOptions = OutputOptions()) -> tuple[list[Path], list[Path]]:
     """The files and the folders that writing ``path`` makes: the output, and what its writer class puts
     beside it (its ``beside(path)``: ``(files, folders)``, the longest names they may have), for
-    ``io.output_paths.check_writable`` to check before a build derives anything."""
+    ``io.output_paths.check_writable`` to check before a build derives anything. A writer class whose
+    ``folder`` is true writes the output as a folder."""
     path = Path(path)
-    beside = getattr(_writer_class(path, options), "beside", None)
+    writer = _writer_class(path, options)
+    if getattr(writer, "folder", False):
+        return [], [path]
+    beside = getattr(writer, "beside", None)
     files, folders = beside(path) if beside is not None else ([], [])
     return [path, *files], list(folders)
 

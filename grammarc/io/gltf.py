@@ -45,16 +45,17 @@ from grammarc.io.instancing import TILE_SIZE, Tile, TiledWriter, compose, decomp
 from grammarc.ir.asset_names import locate
 
 __all__ = [
-    "MAX_BYTES", "MAX_GROUPS", "WRITERS", "GltfWriter", "baked_glb", "index_path", "part_paths", "read_glb", "written_parts",
+    "ARRAY_BUFFER", "ELEMENT_ARRAY_BUFFER", "INSTANCING", "MAX_BYTES", "MAX_GROUPS", "WRITERS", "GlbPart", "GltfWriter",
+    "baked_glb", "index_path", "part_paths", "read_glb", "written_parts",
 ]
 
 #: GLB's 32-bit length fields, less room for the JSON chunk.
 MAX_BYTES = (1 << 32) - (64 << 20)
 #: (asset, colour) groups of a tile beyond which it groups by asset only (module docstring).
 MAX_GROUPS = 256
-_EXTENSION = "EXT_mesh_gpu_instancing"
+INSTANCING = "EXT_mesh_gpu_instancing"
 _FLOAT, _UINT, _UBYTE = 5126, 5125, 5121
-_ARRAY_BUFFER, _ELEMENT_ARRAY_BUFFER = 34962, 34963
+ARRAY_BUFFER, ELEMENT_ARRAY_BUFFER = 34962, 34963
 _WHITE = (255, 255, 255, 255)
 #: The image formats glTF's core takes for textures, by file ending.
 _IMAGE_TYPES = {".png": "image/png", ".jpg": "image/jpeg", ".jpeg": "image/jpeg"}
@@ -115,10 +116,10 @@ class GltfWriter(TiledWriter):
 
     def _finish(self) -> dict:
         """The parts (``parts`` in the counts), the index when there are several."""
-        parts = [_Part(self._tmp / "part0.bin", self._library, self._meta, self._colormap)]
+        parts = [GlbPart(self._tmp / "part0.bin", self._library, self._meta, self._colormap)]
         for tile in self._spool.tiles():
             if not parts[-1].add_tile(tile, self.max_bytes):
-                parts.append(_Part(self._tmp / f"part{len(parts)}.bin", self._library, self._meta, self._colormap))
+                parts.append(GlbPart(self._tmp / f"part{len(parts)}.bin", self._library, self._meta, self._colormap))
                 if not parts[-1].add_tile(tile, self.max_bytes):
                     raise UsageError(f"{self.path}: tile {tile.name} alone passes {self.max_bytes:,} bytes; "
                                      "give a smaller --tile-size")
@@ -146,8 +147,9 @@ class GltfWriter(TiledWriter):
 WRITERS = {".glb": GltfWriter}
 
 
-class _Part:
-    """One GLB file being built: its JSON lists and its binary chunk in a temporary file."""
+class GlbPart:
+    """One GLB file being built: its JSON lists and its binary chunk in a temporary file (``io.tile_content``
+    makes a 3D Tiles tile's content of one)."""
 
     def __init__(self, binary: Path, library, meta: dict, colormap=lambda material: None):
         self.library = library
@@ -160,7 +162,7 @@ class _Part:
             "asset": {"version": "2.0", "generator": f"grammarc {meta.get('grammarc', '')}".strip(),
                       # world = a node's translation (double) + its positions; the world's coordinate system
                       "extras": {"grammarc": meta, "origin": [0.0, 0.0, 0.0], "crs": meta.get("crs")}},
-            "extensionsUsed": [_EXTENSION],
+            "extensionsUsed": [INSTANCING],
             "scene": 0, "scenes": [{"nodes": []}],
             "nodes": [], "meshes": [], "materials": [], "accessors": [], "bufferViews": [],
             "buffers": [{"byteLength": 0}],
@@ -185,15 +187,17 @@ class _Part:
         if len(rows):
             positions, orientations, scales = decompose(rows["xform"])
             for asset, color, material, members in groups:
-                nodes.append({
+                node = {
                     "name": self.library.names[asset],
                     "mesh": self._mesh(asset, color, self.colormap(material)),
-                    "extensions": {_EXTENSION: {"attributes": {
+                    "extensions": {INSTANCING: {"attributes": {
                         "TRANSLATION": self._accessor(positions[members], "VEC3"),
                         "ROTATION": self._accessor(orientations[members], "VEC4"),
                         "SCALE": self._accessor(scales[members], "VEC3"),
                     }}},
-                })
+                }
+                self._describe_instances(node, tile, members)
+                nodes.append(node)
         if len(tile.triangles):
             nodes.append({"name": "mesh", "mesh": self._polygons(tile)})
         self.json["nodes"].extend(nodes)
@@ -204,8 +208,9 @@ class _Part:
         self.instances += len(rows)
         return True
 
-    def finish(self, out: Path) -> None:
-        """Write the GLB: header, JSON chunk, binary chunk (copied from the temporary file)."""
+    def finish(self, out: Path, sync: bool = True) -> None:
+        """Write the GLB: header, JSON chunk, binary chunk (copied from the temporary file); fsynced unless
+        ``sync`` is false (a writer of many files syncs them together, ``io.tiles3d``)."""
         self.json["buffers"][0]["byteLength"] = self.size
         for key in ("meshes", "materials", "accessors", "bufferViews"):
             if not self.json[key]:
@@ -221,8 +226,16 @@ class _Part:
             self.binary.seek(0)
             shutil.copyfileobj(self.binary, glb, 16 << 20)
             glb.flush()
-            os.fsync(glb.fileno())
+            if sync:
+                os.fsync(glb.fileno())
         self.binary.close()
+
+    def _describe_instances(self, node: dict, tile: Tile, members: np.ndarray) -> None:
+        """Add what a subclass says of a group's instances (``tile.instances[members]``) to its node: here
+        nothing (``io.tiles3d`` adds their features)."""
+
+    def _describe_polygons(self, primitives: list[dict], tile: Tile) -> None:
+        """Add what a subclass says of a tile's polygons to their primitives: here nothing."""
 
     # ------------------------------------------------------------------------------------------- parts
 
@@ -290,8 +303,8 @@ class _Part:
             if asset not in self._assets:
                 shape = self.library[asset]
                 self._assets[asset] = (
-                    self._accessor(shape.vertices.astype(np.float32), "VEC3", _ARRAY_BUFFER, bounds=True),
-                    self._accessor(shape.faces.astype(np.uint32).reshape(-1), "SCALAR", _ELEMENT_ARRAY_BUFFER),
+                    self._accessor(shape.vertices.astype(np.float32), "VEC3", ARRAY_BUFFER, bounds=True),
+                    self._accessor(shape.faces.astype(np.uint32).reshape(-1), "SCALAR", ELEMENT_ARRAY_BUFFER),
                 )
             position, indices = self._assets[asset]
             self.json["meshes"].append({"name": self.library.names[asset], "primitives": [
@@ -305,11 +318,11 @@ class _Part:
         triangles = tile.triangles
         points = np.ascontiguousarray(triangles["vertices"].reshape(-1, 3))
         colors = np.repeat(triangles["color"], 3, axis=0)
-        attributes = {"POSITION": self._accessor(points, "VEC3", _ARRAY_BUFFER, bounds=True),
-                      "COLOR_0": self._accessor(colors, "VEC4", _ARRAY_BUFFER, normalized=True)}
+        attributes = {"POSITION": self._accessor(points, "VEC3", ARRAY_BUFFER, bounds=True),
+                      "COLOR_0": self._accessor(colors, "VEC4", ARRAY_BUFFER, normalized=True)}
         uv = tile.texture_coordinates()
         if uv is not None:
-            attributes["TEXCOORD_0"] = self._accessor(_gltf_uv(uv), "VEC2", _ARRAY_BUFFER)
+            attributes["TEXCOORD_0"] = self._accessor(_gltf_uv(uv), "VEC2", ARRAY_BUFFER)
         translucent = bool((colors[:, 3] < 255).any())
         primitives = [{"attributes": attributes, "material": self._material(_WHITE, translucent=translucent)}]
         if tile.triangle_material is not None:
@@ -320,7 +333,8 @@ class _Part:
                 vertices = (np.flatnonzero(used == colormap)[:, None] * 3 + np.arange(3)).reshape(-1)
                 primitives.append({"attributes": attributes, "material": self._material(
                     _WHITE, translucent=translucent, colormap=colormap),
-                    "indices": self._accessor(vertices.astype(np.uint32), "SCALAR", _ELEMENT_ARRAY_BUFFER)})
+                    "indices": self._accessor(vertices.astype(np.uint32), "SCALAR", ELEMENT_ARRAY_BUFFER)})
+        self._describe_polygons(primitives, tile)
         self.json["meshes"].append({"name": f"{tile.name}_polygons", "primitives": primitives})
         return len(self.json["meshes"]) - 1
 
@@ -348,16 +362,16 @@ def baked_glb(vertices: np.ndarray, faces: np.ndarray, looks: np.ndarray | None,
         World point of the vertices' zero: the node's translation (and ``extras.origin``).
     """
     with tempfile.TemporaryDirectory() as folder:
-        part = _Part(Path(folder) / "part.bin", None, meta)
+        part = GlbPart(Path(folder) / "part.bin", None, meta)
         del part.json["extensionsUsed"]
         if looks is None:
             looks = np.full(len(faces), 0xFFFFFFFF, np.int64)
         primitives = []
         if len(faces):
-            attributes = {"POSITION": part._accessor(np.asarray(vertices, np.float32), "VEC3", _ARRAY_BUFFER,
+            attributes = {"POSITION": part._accessor(np.asarray(vertices, np.float32), "VEC3", ARRAY_BUFFER,
                                                      bounds=True)}
             if uv is not None:
-                attributes["TEXCOORD_0"] = part._accessor(_gltf_uv(uv), "VEC2", _ARRAY_BUFFER)
+                attributes["TEXCOORD_0"] = part._accessor(_gltf_uv(uv), "VEC2", ARRAY_BUFFER)
             distinct, inverse = np.unique(looks, return_inverse=True)
             order = np.argsort(inverse.reshape(-1), kind="stable")
             bounds = np.searchsorted(inverse.reshape(-1)[order], np.arange(len(distinct) + 1))
@@ -369,7 +383,7 @@ def baked_glb(vertices: np.ndarray, faces: np.ndarray, looks: np.ndarray | None,
                 primitives.append({
                     "attributes": attributes,
                     "indices": part._accessor(triangles.astype(np.uint32).reshape(-1), "SCALAR",
-                                              _ELEMENT_ARRAY_BUFFER),
+                                              ELEMENT_ARRAY_BUFFER),
                     "material": part._material(rgba, colormap=found[1] if found else None)})
             part.json["meshes"].append({"name": "city", "primitives": primitives})
             node = {"name": "city", "mesh": 0}
@@ -430,7 +444,7 @@ def read_glb(path: str | os.PathLike) -> dict:
             for child in nodes[root].get("children", []):
                 node = nodes[child]
                 mesh = tree["meshes"][node["mesh"]]
-                instancing = node.get("extensions", {}).get(_EXTENSION)
+                instancing = node.get("extensions", {}).get(INSTANCING)
                 if instancing is None:  # the tile's polygons
                     points = _accessor(tree, blob, mesh["primitives"][0]["attributes"]["POSITION"])
                     triangles.append(points.astype(np.float64) + corner)

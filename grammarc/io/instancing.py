@@ -46,10 +46,9 @@ TILE_SIZE = LIMITS.tile_size
 #: One instance row in a tile's spool, its transform relative to the tile's corner.
 INSTANCE = np.dtype([("row", "<i8"), ("asset", "<i4"), ("lot", "<i4"), ("symbol", "<i4"), ("color", "u1", (4,)),
                      ("xform", "<f4", (3, 4))])
-#: One triangle of the mesh table in a tile's spool: vertices relative to the tile's corner, the face's colour
-#: and symbol, and its
-#: vertices' texture coordinates of set 0 (NaN: none).
-TRIANGLE = np.dtype([("vertices", "<f4", (3, 3)), ("color", "u1", (4,)), ("symbol", "<i4"),
+#: One triangle of the mesh table in a tile's spool: vertices relative to the tile's corner, the face's colour,
+#: symbol and lot, and its vertices' texture coordinates of set 0 (NaN: none).
+TRIANGLE = np.dtype([("vertices", "<f4", (3, 3)), ("color", "u1", (4,)), ("symbol", "<i4"), ("lot", "<i4"),
                      ("uv", "<f4", (3, 2))])
 #: A column shorter than this (in world units) is a flat axis.
 _FLAT = 1e-9
@@ -231,6 +230,7 @@ class TileSpool:
             triangles["vertices"] = vertices[faces] - self._corners(keys)[:, None]
             triangles["color"] = mesh.colors()[face]
             triangles["symbol"] = np.asarray(mesh.symbol)[face]
+            triangles["lot"] = np.asarray(mesh.lot)[face]
             triangles["uv"] = mesh.texture()[faces]
             self._append("triangles", keys, triangles)
             if mesh_material is not None:

@@ -45,6 +45,7 @@ import threading
 import weakref
 import zipfile
 from collections.abc import Sequence
+from dataclasses import replace
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -55,12 +56,12 @@ from zlib_ng.zlib_ng import crc32, crc32_combine
 
 from grammarc.atomic import private_folder
 from grammarc.errors import UsageError
-from grammarc.model.records import LotOrigins, MaterialTable, TerminalChunk
+from grammarc.model.records import LotOrigins, MaterialTable, MeshChunk, TerminalChunk, record_mesh
 
 if TYPE_CHECKING:
     from typing_extensions import Self
 
-__all__ = ["WRITERS", "InstanceWriter", "load_record", "read_instances"]
+__all__ = ["WRITERS", "InstanceWriter", "load_record", "read_instances", "record_chunks"]
 
 _FORMAT = "grammarc.instances/2"
 #: Formats this version reads: /1 has no ``lot_origin`` (its transforms and vertices are in world coordinates).
@@ -338,6 +339,26 @@ def read_instances(path: str | os.PathLike) -> dict[str, np.ndarray | dict]:
 
 #: The extension this module writes (``grammarc.io.writers``).
 WRITERS = {".npz": InstanceWriter}
+
+
+def record_chunks(record: dict, rows: int = 1 << 20):
+    """A record (``read_instances``) as TerminalChunks of at most ``rows`` instances, in its order, to write
+    it in another format (``grammarc view`` of an .npz); the mesh table comes with the first chunk."""
+    origins = LotOrigins.from_table(record.get("lot_origin"))
+    textured = "material" in record
+    mesh = replace(record_mesh(record) or MeshChunk.empty(), color=record.get("mesh_color"),
+                   material=record.get("mesh_material"), materials=record.get("materials") if textured else None,
+                   uv=record.get("mesh_uv"))
+    total = len(record["asset"])
+    for start in range(0, max(total, 1), rows):
+        part = slice(start, start + rows)
+        yield TerminalChunk(
+            asset=record["asset"][part], xform=record["xform"][part], lot=record["lot"][part],
+            symbol=record["symbol"][part], mesh=mesh if start == 0 else MeshChunk.empty(),
+            color=record["color"][part] if "color" in record else None,
+            material=record["material"][part] if textured else None,
+            materials=record["materials"] if textured else None,
+            uv=record["uv"][part] if "uv" in record else None, origins=origins)
 
 
 def load_record(path: str | os.PathLike) -> dict[str, np.ndarray | dict]:

@@ -1,8 +1,9 @@
 """``grammarc info OUT``: what a city's output holds, without opening another program.
 
-OUT is an instance record (``.npz``), or instanced USD or glTF as ``build`` writes them (read back by
-``io.usd.read_usd`` and ``io.gltf.read_glb``): glTF keeps no lots or symbols, so those lines are left out
-for it; the bytes are those of every file of the output (USD's tile layers, glTF's parts).
+OUT is an instance record (``.npz``), or instanced USD, glTF or 3D Tiles as ``build`` writes them (read back
+by ``io.usd.read_usd``, ``io.gltf.read_glb`` and ``io.tiles3d.read_tileset``, its leaves): glTF keeps no
+lots or symbols, so those lines are left out for it; the bytes are those of every file of the output (USD's
+tile layers, glTF's parts, a tileset's tiles, the coarse ones too).
 
 Counts per asset and per symbol, terminals per lot (min, median, max), the bounding box, and what the city
 weighs once instanced assets are expanded: polygons and triangles as ``bake`` would make them (each asset
@@ -33,7 +34,8 @@ from grammarc.model.records import world_columns
 __all__ = ["READS", "format_summary", "summarize", "what_file"]
 
 #: What ``summarize`` reads, for the message about a file it cannot.
-READS = ".npz instance records, .usda/.usdc/.usd and .glb outputs of build, a cluster build's .manifest.json"
+READS = (".npz instance records, .usda/.usdc/.usd, .glb and .3dtiles outputs of build, a cluster build's "
+         ".manifest.json")
 #: A file's first bytes -> what it is, for a file ``summarize`` cannot read.
 _MAGIC = {b"PK\x03\x04": "a zip archive that is not an instance record", b"\x93NUMPY": "a single numpy array (.npy)",
           b"glTF": "a glTF file that is not an output of build", b"#usda": "a USD layer that is not an output of build",
@@ -175,6 +177,10 @@ def _read(path: Path) -> tuple[dict, list[Path]]:
 
         index = index_path(path)
         return read_glb(path), written_parts(path) + ([index] if index.exists() else [])
+    if suffix == ".3dtiles":
+        from grammarc.io.tiles3d import read_tileset
+
+        return read_tileset(path), [f for f in path.rglob("*") if f.is_file()]
     return read_instances(path), [path]
 
 

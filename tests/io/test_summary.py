@@ -38,10 +38,10 @@ def test_info_command(tmp_path, capsys):
     assert "missing.npz: No such file or directory" in capsys.readouterr().err
 
 
-@pytest.mark.parametrize("output", ["city.usdc", "city.glb"])
+@pytest.mark.parametrize("output", ["city.usdc", "city.glb", "city.3dtiles"])
 def test_info_of_instanced_outputs_counts_what_the_record_has(tmp_path, output):
-    """USD and glTF read back (``read_usd``, ``read_glb``): the same instances per asset, the same box;
-    USD keeps lots and symbols too."""
+    """USD, glTF and 3D Tiles read back (``read_usd``, ``read_glb``, ``read_tileset``): the same instances per
+    asset, the same box; USD and 3D Tiles keep lots and symbols too."""
     if output.endswith(".usdc"):
         pytest.importorskip("pxr")
     city(tmp_path, output, tile_size=100.0)
@@ -50,7 +50,7 @@ def test_info_of_instanced_outputs_counts_what_the_record_has(tmp_path, output):
     np.testing.assert_allclose(other["bbox"]["min"], npz["bbox"]["min"], atol=2e-3)
     np.testing.assert_allclose(other["bbox"]["max"], npz["bbox"]["max"], atol=2e-3)
     assert other["polygons"]["baked_triangles"] == npz["polygons"]["baked_triangles"]
-    if output.endswith(".usdc"):
+    if not output.endswith(".glb"):
         assert other["symbols"] == npz["symbols"] and other["per_lot"] == npz["per_lot"]
     else:
         assert other["symbols"] == {} and "symbols" not in format_summary(other)

@@ -45,7 +45,7 @@ def test_options_left_unset_are_not_passed():
     assert made("city.usdc", OutputOptions(lod="low")) == (UsdWriter, {"lod": "low"})
 
 
-SUPPORTED = "(supported: .npz, .usda, .usdc, .usd, .glb, .obj, .ply, .stl, .json)"
+SUPPORTED = "(supported: .npz, .usda, .usdc, .usd, .glb, .3dtiles, .obj, .ply, .stl, .json)"
 
 
 @pytest.mark.parametrize(("path", "bake", "message"), [
