@@ -148,6 +148,34 @@ def _parser() -> argparse.ArgumentParser:
     build.add_argument("--quiet", "-q", action="store_true", help="no progress bar and no summary")
     build.set_defaults(run=_build)
 
+    search = sub.add_parser("search", help="search a grammar's designs for those that meet its goal: "
+                                            "breadth-first, depth-first or A*")
+    search.add_argument("grammar", type=Path, help="the grammar (paper notation) with sets of consequents: "
+                                                    "choose(...) and `?` alternatives, and a `goal:`")
+    search.add_argument("--lots", type=Path, metavar="PATH",
+                        help="the lots to search from, each on its own (default: as for build)")
+    search.add_argument("--strategy", choices=("bfs", "dfs", "astar"), default="bfs",
+                        help="breadth-first (all solutions, fewest choices first), depth-first (in the written "
+                             "order of the consequents) or A* (cheapest first, by `cost:` and `heuristic:`)")
+    search.add_argument("--solutions", type=_positive, metavar="K", help="stop a lot's search at K solutions "
+                        "(default: all)")
+    search.add_argument("--max-states", type=_positive, default=1_000_000, metavar="N",
+                        help="derive at most N states per lot (default 1,000,000): memory follows it")
+    search.add_argument("--batch", type=_positive, default=4096, metavar="N",
+                        help="states derived together (default 4096)")
+    search.add_argument("--emit", type=Path, metavar="OUT",
+                        help="the solutions' designs as a record (.npz...), its lot column the solution number")
+    search.add_argument("--tree", type=Path, metavar="JSON", help="the derivation graph of the states derived")
+    search.add_argument("--seed", type=int, default=0, help="random seed of the draws that are not choices")
+    search.add_argument("--attr", action="append", default=[], metavar="NAME=VALUE",
+                        help="override an attribute for every lot (repeatable)")
+    search.add_argument("--max-depth", type=_positive, default=LIMITS.max_depth, metavar="N",
+                        help=f"rule applications along one path of a state (default {LIMITS.max_depth})")
+    search.add_argument("--max-shapes", type=_positive, default=LIMITS.max_shapes, metavar="N",
+                        help=f"shapes made in one state (default {LIMITS.max_shapes:,})")
+    search.add_argument("--quiet", "-q", action="store_true", help="no summary")
+    search.set_defaults(run=_search)
+
     conform = sub.add_parser("conform", help="compare grammarc with Esri's PRT on the conformance kit")
     conform.add_argument("rpk", type=Path, nargs="?", help="a rule package of the kit (.rpk)")
     conform.add_argument("footprint", nargs="?", help="a kit footprint name (rect_30x20) or a lots file")
@@ -592,6 +620,45 @@ def _build(args) -> int:
     if result.bad:
         print(f"grammarc: {len(result.bad):,} of {result.lots:,} lots skipped", file=sys.stderr)
     return 1 if result.bad and args.strict else 0
+
+
+def _search(args) -> int:
+    from grammarc.backend.attributes import check_overrides, parse_override
+    from grammarc.backend.plan import make_plan
+    from grammarc.build import BuildOptions, compile_source, load_lots, record_meta
+    from grammarc.io import written_paths
+    from grammarc.io.output_paths import check_writable
+    from grammarc.search import Deriving, SearchOptions, run_search, write_solutions
+
+    options = BuildOptions(seed=args.seed, attrs=dict(parse_override(a) for a in args.attr),
+                           limits=replace(LIMITS, max_depth=args.max_depth, max_shapes=args.max_shapes))
+    grammar = compile_source(args.grammar, None, options)
+    if grammar.module.dialect != "cga2006":
+        raise UsageError(f"{args.grammar}: search takes grammars in the paper notation (choose, `?`, goal:)")
+    check_overrides(grammar.module, options.attrs)
+    outputs = [*(written_paths(args.emit)[0] if args.emit else []), *([args.tree] if args.tree else [])]
+    check_writable(outputs, [])
+    lots = load_lots(args.grammar, args.lots)
+    plan = make_plan(grammar)
+    deriving = Deriving(plan, lots, seed=args.seed, limits=options.limits, overrides=tuple(options.attrs.items()))
+    search = SearchOptions(args.strategy, args.solutions, args.max_states, args.batch)
+    result = run_search(deriving, search, record_tree=args.tree is not None)
+    meta = record_meta(args.grammar, grammar, plan, options, lots.source, (), lots.crs)
+    if args.emit:
+        write_solutions(args.emit, deriving, result, search, meta)
+    if args.tree:
+        result.tree.write(args.tree, grammar.module, lots.ids, {**meta, "search": result.summary(deriving, search)})
+    found = sum(r.found for r in result.lots)
+    for lot in result.lots:  # said even with --quiet: the search did not end on its own
+        if lot.limited:
+            print(f"grammarc: lot {lots.ids[lot.lot]}: stopped at --max-states {args.max_states:,} "
+                  f"({lot.states:,} states derived, {lot.found:,} solutions)", file=sys.stderr)
+    if not args.quiet:
+        _warn(grammar)
+        rate = result.states / result.seconds if result.seconds > 0 else 0.0
+        print(f"{args.strategy}: {found:,} solutions from {result.states:,} states of {len(lots):,} lots in "
+              f"{result.seconds:.2f} s ({rate:,.0f} states/s)", file=sys.stderr)
+    return 0
 
 
 if __name__ == "__main__":
