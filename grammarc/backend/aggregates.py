@@ -1,9 +1,10 @@
 """The values of a whole design that a search reads: aggregates over its shapes, goal, prune, heuristic.
 
-A search state is a lot derived with fixed choices (``backend.choices``). Its aggregates (``count("room")``,
-``min(Scope.sx of "room")``, ``area("room")``) are over every shape its derivation gave the symbol, taken as
-the successor is made (``collect``: one evaluation per batch, summed per lot with ``bincount``), so that a
-partial state's aggregates are those of the shapes made so far. ``judge`` evaluates the search statements
+A search state is a lot derived with fixed choices (``backend.choices``). Its design is its leaves: the
+shapes that end under a symbol no rule of which applies to them. Its aggregates (``count("room")``,
+``min(Scope.sx of "room")``, ``area("room")``) are over the leaves of one symbol, taken as they are emitted
+(``collect``: one evaluation per batch, summed per lot with ``bincount``), so that a partial state's
+aggregates are those of the leaves made so far. ``judge`` evaluates the search statements
 once the derivation stops, on the lots' own shapes: ``Scope`` there is the lot's.
 """
 
@@ -18,7 +19,7 @@ from grammarc.ir import nodes as ir
 
 
 def collect(choices: Choices, env: Env, symbol: str) -> None:
-    """Add the shapes ``env.shapes``, just given ``symbol``, to the aggregates over it, per lot."""
+    """Add the leaves ``env.shapes`` of ``symbol`` to the aggregates over it, per lot."""
     shapes = env.shapes
     live = ~choices.stopped[shapes.lot]
     lot = shapes.lot[live]

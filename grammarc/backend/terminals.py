@@ -21,6 +21,7 @@ from dataclasses import replace
 
 import numpy as np
 
+from grammarc.backend.aggregates import collect
 from grammarc.backend.context import Context
 from grammarc.backend.kernels.scope import xforms
 from grammarc.backend.materials import material_ids, rgba
@@ -215,6 +216,8 @@ def emit_leaves(ctx: Context, shapes: Shapes, symbol: int) -> None:
     if not len(shapes):
         return
     chunk = ctx.chunk
+    if chunk.choices is not None and chunk.choices.aggregates:  # a search state's design (``aggregates``)
+        collect(chunk.choices, ctx.env(shapes), ctx.plan.symbols[symbol].name)
     assets = shapes.geom < -1
     if assets.any():
         for code in np.unique(shapes.geom[assets]):

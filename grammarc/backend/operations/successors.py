@@ -11,7 +11,6 @@ from __future__ import annotations
 import numpy as np
 
 from grammarc.backend import terminals
-from grammarc.backend.aggregates import collect
 from grammarc.backend.context import Context
 from grammarc.backend.evaluate import evaluate_array
 from grammarc.backend.occlusion import add_occluders, occluder_label
@@ -35,8 +34,6 @@ def successor(ctx: Context, cursor: Shapes, op: ir.Symbol) -> None:
                     successor_keys(plan.sequential_random, cursor.key, op.site), cursor.depth + 1, params,
                     cursor.dynamic)
     ctx.count(shapes, op.span)
-    if ctx.chunk.choices is not None and ctx.chunk.choices.aggregates:
-        collect(ctx.chunk.choices, ctx.env(shapes), sym.name)
     if sym.terminal or op.leaf:
         if plan.occluders:
             add_occluders(ctx.chunk, shapes, occluder_label(plan, sym.id))  # a leaf solid occludes
