@@ -173,6 +173,9 @@ def _parser() -> argparse.ArgumentParser:
                         help=f"rule applications along one path of a state (default {LIMITS.max_depth})")
     search.add_argument("--max-shapes", type=_positive, default=LIMITS.max_shapes, metavar="N",
                         help=f"shapes made in one state (default {LIMITS.max_shapes:,})")
+    search.add_argument("--workers", type=_positive, default=_cores(), metavar="N",
+                        help=f"states derived at once in N forked processes (default: the {_cores()} cores this "
+                             "process may use); the solutions do not depend on it")
     search.add_argument("--quiet", "-q", action="store_true", help="no summary")
     search.set_defaults(run=_search)
 
@@ -642,7 +645,7 @@ def _search(args) -> int:
     plan = make_plan(grammar)
     deriving = Deriving(plan, lots, seed=args.seed, limits=options.limits, overrides=tuple(options.attrs.items()))
     search = SearchOptions(args.strategy, args.solutions, args.max_states, args.batch)
-    result = run_search(deriving, search, record_tree=args.tree is not None)
+    result = run_search(deriving, search, record_tree=args.tree is not None, workers=args.workers)
     meta = record_meta(args.grammar, grammar, plan, options, lots.source, (), lots.crs)
     if args.emit:
         write_solutions(args.emit, deriving, result, search, meta)

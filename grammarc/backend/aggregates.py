@@ -15,6 +15,7 @@ import numpy as np
 from grammarc.backend.choices import Choices
 from grammarc.backend.env import Env
 from grammarc.backend.evaluate import evaluate_array
+from grammarc.backend.kernels.order import fold_groups
 from grammarc.ir import nodes as ir
 
 
@@ -23,7 +24,6 @@ def collect(choices: Choices, env: Env, symbol: str) -> None:
     shapes = env.shapes
     live = ~choices.stopped[shapes.lot]
     lot = shapes.lot[live]
-    n_lots = len(choices.length)
     for i, aggregate in enumerate(choices.aggregates):
         if aggregate.symbol != symbol or not len(lot):
             continue
@@ -36,10 +36,7 @@ def collect(choices: Choices, env: Env, symbol: str) -> None:
         else:
             values = evaluate_array(aggregate.value, env, dtype=bool if aggregate.func == "count" else np.float64)
             values = values[live].astype(np.float64)
-        choices.total[i] += np.bincount(lot, weights=values, minlength=n_lots)
-        choices.counted[i] += np.bincount(lot, minlength=n_lots)
-        np.minimum.at(choices.low[i], lot, values)
-        np.maximum.at(choices.high[i], lot, values)
+        fold_groups(lot, values, choices.total[i], choices.counted[i], choices.low[i], choices.high[i])
 
 
 def judge(module: ir.Module, choices: Choices, env: Env) -> None:

@@ -18,9 +18,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from grammarc.backend.kernels.order import rank_in_group
 from grammarc.backend.streams import draw
 from grammarc.ir import nodes as ir
-from grammarc.ragged import rank_within
 
 
 @dataclass(eq=False)
@@ -37,6 +37,8 @@ class Choices:
     path: np.ndarray
     length: np.ndarray
     aggregates: tuple[ir.Aggregate, ...] = ()
+    #: Whether the states' leaves are written as records (a solution's), or only read (a search's).
+    records: bool = False
     taken: np.ndarray = field(init=False)
     options: np.ndarray = field(init=False)
     site: np.ndarray = field(init=False)
@@ -70,7 +72,7 @@ class Choices:
         """The option (n,) int64 that shapes of ``lot`` (n,) take at a choice of ``count`` options at
         ``site``; a lot whose path ends before this choice stops here (its shapes take option 0, and are
         dropped)."""
-        position = self.taken[lot] + rank_within(lot)
+        position = self.taken[lot] + rank_in_group(lot, len(self.taken))
         fixed = position < self.length[lot]
         picked = np.zeros(len(lot), dtype=np.int64)
         picked[fixed] = self.path[lot[fixed], position[fixed]]

@@ -53,7 +53,7 @@ def initial_chunk(lots: Lots, seed: int, foreign: Occluders | None = None,
     """The chunk state and initial shapes (one per lot) of ``lots``, their random keys from ``seed`` (and
     the lots' ``seed`` properties where they draw from a ``sequential`` stream, ``backend.streams``);
     ``foreign`` the occluders of every lot from a first pass (``derive_chunk``)."""
-    origin, axes, size, local = lot_scopes(lots)
+    origin, axes, size, local = _scopes(lots)
     is_rect, coords, ring_offsets, poly_offsets = footprint_polygons(lots, size, local)
     frames = Frames(capacity=max(256, 4 * len(lots)))
     polygons = PolygonStore()
@@ -69,6 +69,18 @@ def initial_chunk(lots: Lots, seed: int, foreign: Occluders | None = None,
                     np.zeros(n, dtype=np.int32))  # a sequential stream's draws advance the copy
     chunk.lot_shapes = (shapes.size, shapes.frame, shapes.geom)
     return chunk, shapes
+
+
+def _scopes(lots: Lots):
+    """``lot_scopes`` of ``lots``, measured once per lot where a lot comes more than once (a search's
+    states are their lot, many times over)."""
+    first, inverse = np.unique(lots.index, return_index=True, return_inverse=True)[1:]
+    if len(first) == len(lots):
+        return lot_scopes(lots)
+    once = lots.take(first)
+    origin, axes, size, local = lot_scopes(once)
+    vertices, _ = ragged_take(once.ring_offsets[once.lot_offsets], inverse)
+    return origin[inverse], axes[inverse], size[inverse], local[vertices]
 
 
 def derive_chunk(plan: Plan, lots: Lots, *, seed: int, limits: Limits, overrides: dict,

@@ -216,8 +216,11 @@ def emit_leaves(ctx: Context, shapes: Shapes, symbol: int) -> None:
     if not len(shapes):
         return
     chunk = ctx.chunk
-    if chunk.choices is not None and chunk.choices.aggregates:  # a search state's design (``aggregates``)
-        collect(chunk.choices, ctx.env(shapes), ctx.plan.symbols[symbol].name)
+    if chunk.choices is not None:  # a search state's design (``aggregates``), written for its solutions only
+        if chunk.choices.aggregates:
+            collect(chunk.choices, ctx.env(shapes), ctx.plan.symbols[symbol].name)
+        if not chunk.choices.records:
+            return
     assets = shapes.geom < -1
     if assets.any():
         for code in np.unique(shapes.geom[assets]):

@@ -9,6 +9,7 @@ solution came from, its cost, and how the search went.
 from __future__ import annotations
 
 import time
+from concurrent.futures import Future
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -16,6 +17,7 @@ from grammarc.io import writer_for
 from grammarc.search.states import Deriving, States
 from grammarc.search.strategies import LotSearch, SearchOptions, search_lot
 from grammarc.search.tree import Tree
+from grammarc.workers import worker_pool
 
 
 @dataclass
@@ -46,12 +48,41 @@ class SearchResult:
                 "limited": [str(ids[r.lot]) for r in self.lots if r.limited], "solutions": listed}
 
 
-def run_search(deriving: Deriving, options: SearchOptions, *, record_tree: bool = False) -> SearchResult:
-    """Search every lot of ``deriving.lots`` in turn."""
+def run_search(deriving: Deriving, options: SearchOptions, *, record_tree: bool = False,
+               workers: int = 1) -> SearchResult:
+    """Search every lot of ``deriving.lots`` in turn, deriving states in ``workers`` processes (forked
+    once, with the plan); the result does not depend on ``workers``."""
     started = time.perf_counter()
     tree = Tree(record_tree)
-    found = [search_lot(deriving, options, tree, lot) for lot in range(len(deriving.lots))]
+    with worker_pool(_outcomes(deriving), workers) as submit:
+        def outcome(states: States) -> Future:
+            received: Future = Future()
+            submit(states).add_done_callback(lambda done: _first(done, received))
+            return received
+
+        found = [search_lot(outcome, workers, options, tree, lot) for lot in range(len(deriving.lots))]
     return SearchResult(found, time.perf_counter() - started, tree)
+
+
+def _outcomes(deriving: Deriving):
+    """The work of ``worker_pool`` (results as its build's are shaped: ``[(n, (arrays, per lot))]``):
+    the outcome of a batch of states."""
+    def work(states: States):
+        outcome, _ = deriving.derive(states)
+        return [(len(states), (outcome, None))], []
+
+    return work
+
+
+def _first(done: Future, received: Future) -> None:
+    """``received`` gets the outcome of the pool's ``done``, or its error."""
+    if not received.set_running_or_notify_cancel():
+        return
+    try:
+        results, _ = done.result()
+        received.set_result(results[0][1][0])
+    except BaseException as error:  # noqa: BLE001 - handed to the strategy by received.result()
+        received.set_exception(error)
 
 
 def write_solutions(path: Path, deriving: Deriving, result: SearchResult, options: SearchOptions,

@@ -148,7 +148,7 @@ class Deriving:
         failed = np.zeros(n, dtype=bool)
         reasons: dict[int, str] = {}
         while True:
-            choices = Choices(states.path[keep], states.length[keep], self.aggregates)
+            choices = Choices(states.path[keep], states.length[keep], self.aggregates, records)
             try:
                 made, _ = derive_chunk(self.plan, self.lots.take(states.lot[keep]), seed=self.seed,
                                        limits=self.limits, overrides=dict(self.overrides),

@@ -28,7 +28,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from grammarc.search.states import Deriving, Outcome, States
+from grammarc.search.states import Outcome, States
 from grammarc.search.tree import Tree
 
 STRATEGIES = ("bfs", "dfs", "astar")
@@ -61,10 +61,15 @@ class LotSearch:
 
 
 class _Run:
-    """What a strategy asks of its lot's search: derive within the budget, give solutions."""
+    """What a strategy asks of its lot's search: derive within the budget, give solutions.
 
-    def __init__(self, deriving: Deriving, options: SearchOptions, tree: Tree, lot: int) -> None:
-        self.deriving = deriving
+    ``submit(states) -> Future`` derives states (``Deriving.derive``, maybe in a worker process) and
+    ``workers`` says how many at once: a batch is cut into that many pieces, all submitted before the
+    first is waited for."""
+
+    def __init__(self, submit, workers: int, options: SearchOptions, tree: Tree, lot: int) -> None:
+        self.submit = submit
+        self.workers = workers
         self.options = options
         self.tree = tree
         self.result = LotSearch(lot)
@@ -86,21 +91,29 @@ class _Run:
             self.result.solutions.append(taken)
 
     def derive(self, states: States):
-        """``(derived states, outcome)`` of each batch of ``states``, as far as the budget goes."""
+        """``(derived states, outcome)`` of each piece of ``states`` in order, as far as the budget goes.
+        The pieces are at most a batch, and as many as the workers where a batch is not more; how the
+        states are cut changes nothing of their outcomes."""
         if len(states) > self.budget:
             self.result.limited = True
             states = states.take(slice(0, max(self.budget, 0)))
-        for start in range(0, len(states), self.options.batch):
-            part = states.take(slice(start, start + self.options.batch))
-            outcome, _ = self.deriving.derive(part)
-            ids = self.tree.add(part, outcome)
-            self.result.states += len(part)
-            yield part.with_outcome(ids, outcome), outcome
+        size = max(min(self.options.batch, -(-len(states) // self.workers)), 1)
+        pieces = [states.take(slice(start, start + size)) for start in range(0, len(states), size)]
+        futures = [self.submit(piece) for piece in pieces]
+        try:
+            for piece, future in zip(pieces, futures):
+                outcome = future.result()
+                ids = self.tree.add(piece, outcome)
+                self.result.states += len(piece)
+                yield piece.with_outcome(ids, outcome), outcome
+        finally:  # a strategy that stops early gives up the pieces it no longer needs
+            for future in futures:
+                future.cancel()
 
 
-def search_lot(deriving: Deriving, options: SearchOptions, tree: Tree, lot: int) -> LotSearch:
-    """Search lot ``lot`` (a row of ``deriving.lots``) from its initial state with ``options.strategy``."""
-    run = _Run(deriving, options, tree, lot)
+def search_lot(submit, workers: int, options: SearchOptions, tree: Tree, lot: int) -> LotSearch:
+    """Search lot ``lot`` from its initial state with ``options.strategy``; ``submit`` derives states."""
+    run = _Run(submit, workers, options, tree, lot)
     _STRATEGY[options.strategy](run, States.initial(lot))
     return run.result
 
