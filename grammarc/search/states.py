@@ -102,6 +102,17 @@ class Outcome:
     failed: np.ndarray
     reasons: dict[int, str]
 
+    @staticmethod
+    def concat(parts: list[Outcome]) -> Outcome:
+        """The outcomes of consecutive pieces of states, as one."""
+        if len(parts) == 1:
+            return parts[0]
+        starts = np.cumsum([0, *(len(p.options) for p in parts)])
+        columns = {f.name: None if getattr(parts[0], f.name) is None else
+                   np.concatenate([getattr(p, f.name) for p in parts]) for f in fields(Outcome)[:-1]}
+        reasons = {int(start) + row: why for start, p in zip(starts, parts) for row, why in p.reasons.items()}
+        return Outcome(**columns, reasons=reasons)
+
     @property
     def complete(self) -> np.ndarray:
         return (self.options == 0) & ~self.failed

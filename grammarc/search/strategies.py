@@ -151,7 +151,9 @@ def _dfs(run: _Run, stack: States) -> None:
         k = min(run.options.batch, run.budget, len(stack))
         below, top, waiting = stack.take(slice(0, len(stack) - k)), stack.take(slice(len(stack) - k, None)), found[-k:]
         todo = np.flatnonzero(~waiting)
-        (derived, outcome), = run.derive(top.take(todo))
+        pieces = [*run.derive(top.take(todo))]
+        derived = States.concat([piece for piece, _ in pieces])
+        outcome = Outcome.concat([piece for _, piece in pieces])
         # each entry of the top, bottom to top, becomes: itself if found, else its consequents (the first
         # option uppermost), nothing if it has none
         found_rows = np.concatenate([np.flatnonzero(waiting), todo[outcome.solution]])

@@ -291,3 +291,26 @@ def test_array_types_follow_their_elements_and_indices():
 ])
 def test_array_type_errors(text, expected):
     assert cityengine_errors(text) == expected
+
+
+@pytest.mark.parametrize("text, expected", [
+    ('a ~> S(count("b"), 1, 1) b', (1, 8, ('`count` of "b" is a value of a whole design: only `goal:`, '
+                                          '`heuristic:` and `prune:` read it'))),
+    ("a ~> b\ngoal: choose(1, 2) > 1", (2, 7, "`choose` makes the consequents of a rule, not of a search statement")),
+    ('a ~> S(choose(1, "x"), 1, 1) b', (1, 8, "the options of `choose` give a num and a str")),
+    ('a ~> b\ngoal: sum(count("b") of "b") > 1', (2, 7, "an aggregate inside `sum`: it reads one shape's values")),
+    ('a ~> b\ncost: count("b")', (2, 7, ('`count` of "b" is a value of a whole design: only `goal:`, '
+                                        '`heuristic:` and `prune:` read it'))),
+    ("a ~> b\nheuristic: true", (2, 12, "the heuristic must be a num, got a bool")),
+    ("a ~> b\ngoal: 1", (2, 7, "the goal must be a bool, got a num")),
+    ('a ~> b\ngoal: min(Scope.sx > 1 of "b") > 1', (2, 20, "the value `min` aggregates must be a num, got a bool")),
+])
+def test_search_statement_errors(text, expected):
+    assert expected in errors(text)
+
+
+def test_search_statements_read_attributes_and_aggregates():
+    module, diags = typed('attr rooms = 2\na ~> b\ngoal: count("b") == rooms && mean(Scope.sx of "b") > 1\n'
+                          "cost: Scope.sx\nprune: count(Scope.sx > 3 of \"b\") > 0\nheuristic: 0")
+    assert not diags.has_errors
+    assert [o.kind for o in module.objectives] == ["goal", "cost", "prune", "heuristic"]
