@@ -533,6 +533,21 @@ class Comp:
 
 
 @dataclass(frozen=True, slots=True)
+class Cut:
+    """``Cut(e1, t1, e2, t2){ A | B }`` (GRAMATICA's ice-ray grammar): the shape's polygon in its scope's
+    x-z plane divided by the line from the point at fraction ``t1`` of its edge ``e1`` to the point at
+    ``t2`` of edge ``e2`` (edges in ring order from its first vertex, modulo their number;
+    ``geometry.cuts``). ``A`` takes the piece from the first point on along the ring to the second, ``B``
+    the other; each piece's scope is its bounding box in the parent's."""
+
+    edges: tuple[Expr, Expr] = child(Type.NUM, "an edge number")
+    at: tuple[Expr, Expr] = child(Type.NUM, "a fraction of an edge")
+    parts: tuple[Body, ...] = child(holds=Holds.BODIES)
+    span: Span = NO_SPAN
+    site: int = 0
+
+
+@dataclass(frozen=True, slots=True)
 class Extrude:
     """CityEngine ``extrude(h)`` and ``extrude(direction, h)``: a flat shape becomes a solid along its
     normal (its flat scope axis; ``face.normal``, ``vertex.normal``) or the world's up axis (``world.up``,
@@ -1143,7 +1158,7 @@ Op = (Symbol | Empty | Translate | Scale | Rotate | Push | Pop | Insert | Split 
       | Trim | SplitArea | ReduceGeometry | MirrorScope | SetOpacity | SetupProjection | ProjectUV | TransformUV
       | TileUV | NormalizeUV | SetbackToArea | Taper | ResetGeometry | AlignScopeToBBox
       | Footprint | Rectify | CopyUV | InsertAlongUV | ResetMaterial | SetMaterial
-      | SetPivot)
+      | SetPivot | Cut)
 Body = tuple[Op, ...]
 
 

@@ -9,7 +9,7 @@ construct" at its span.
 
 from __future__ import annotations
 
-from lark import v_args
+from lark import Token, v_args
 
 from grammarc.diagnostics import Span, suggest
 from grammarc.frontend.cga2006.nodes import ContinuationStatement, PriorityStatement, Relative, RuleStatement
@@ -150,6 +150,9 @@ class Lowering(OperationLowering, LoweringBase):
             return self.occlusion(f"{head}.{field}", args or (), span)
         if (str(head), str(field)) == ("Shape", "visible"):
             return self.visible(tuple(self.expr(a) for a in args or ()), span)
+        if str(head) == "geometry" and f"{head}.{field}" in FUNCTIONS:  # CityEngine's queries of the geometry
+            return self.function(meta, Token("NAME", f"{head}.{field}", head.start_pos, head.line, head.column,
+                                             field.end_line, field.end_column, head.end_pos), args)
         self.diags.error("unknown-function", f"unknown function `{head}.{field}`", span)
         return ir.placeholder(span)
 
