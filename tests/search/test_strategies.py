@@ -11,6 +11,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from grammarc.backend.plan import make_plan
@@ -171,3 +172,14 @@ def test_unbounded_recursion_is_stopped_by_max_states(tmp_path):
     for strategy in ("bfs", "dfs", "astar"):
         result = run_search(deriving, SearchOptions(strategy=strategy, max_states=100, batch=16))
         assert result.lots[0].states == 100 and result.lots[0].limited and not result.lots[0].found
+
+
+def test_ice_ray_lattices_are_found_depth_first():
+    deriving = Deriving(make_plan(compile_grammar(EXAMPLES / "iceray.cga")), read_lots(EXAMPLES / "figure1.geojson"))
+    result = run_search(deriving, SearchOptions(strategy="dfs", solutions=2))
+    found = result.summary(deriving, SearchOptions())["solutions"]
+    assert len(found) == 2 and found[0]["path"] < found[1]["path"]
+    _, records = deriving.derive(result.solutions, records=True)
+    corners = np.diff(records.mesh.ring_offsets)
+    assert set(corners.tolist()) <= {3, 4, 5}
+    assert np.bincount(records.mesh.lot).min() >= 4  # a lattice of cells of 2.5 to 6 m2 on 24 m2
