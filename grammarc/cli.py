@@ -216,7 +216,8 @@ def _parser() -> argparse.ArgumentParser:
     info.set_defaults(run=_info)
 
     render = sub.add_parser("render", help="draw an instance record as a shaded picture (PNG)")
-    render.add_argument("record", type=Path, help="an instance record (.npz) written by `grammarc build`")
+    render.add_argument("record", type=Path, help="an instance record (.npz) written by `grammarc build` or "
+                                                   "`grammarc search`, or the tree (.json) of `grammarc search --tree`")
     render.add_argument("-o", "--output", required=True, type=Path, metavar="PNG", help="the picture, .png")
     render.add_argument("--view", choices=("oblique", "top"), default="oblique",
                         help="oblique: perspective from above at an angle (default); top: orthographic")
@@ -453,6 +454,8 @@ def _render(args) -> int:
 
     size = parse_size(args.size)
     check_writable([png_path(args.output)])  # before the record is read, which may be large
+    if args.record.suffix.lower() == ".json":
+        return _render_tree(args)
     record = load_record(args.record)
     with record_asset_roots(record.get("meta"), args.assets or None) as roots:
         result = render(record, args.output, size=size, view=args.view, color=args.color, asset_roots=roots)
@@ -460,6 +463,32 @@ def _render(args) -> int:
         print(f"grammarc: {problem}; drawn as boxes (--assets DIR gives a folder)", file=sys.stderr)
     print(f"{args.output}: {result['instances']:,} instances, {result['mesh_faces']:,} mesh faces",
           file=sys.stderr)
+    return 0
+
+
+def _render_tree(args) -> int:
+    """``grammarc render tree.json``: the derivation graph of ``grammarc search --tree``, a thumbnail per
+    state, its states derived again from the grammar and lots its meta names."""
+    import json
+
+    from grammarc.backend.plan import make_plan
+    from grammarc.build import BuildOptions, compile_source, load_lots
+    from grammarc.search import Deriving
+    from grammarc.search.tree_picture import draw_tree
+
+    try:
+        tree = json.loads(args.record.read_text(encoding="utf-8"))
+        meta, nodes = tree, tree["states"]
+        grammar_path = Path(meta["grammar"])
+    except (OSError, ValueError, KeyError, TypeError) as error:
+        raise UsageError(f"{args.record}: not a tree of `grammarc search --tree` ({error})") from error
+    options = BuildOptions(seed=meta.get("seed", 0), attrs=meta.get("attrs", {}))
+    grammar = compile_source(grammar_path, None, options)
+    lots_source = meta.get("lots_source")
+    lots = load_lots(grammar_path, Path(lots_source) if lots_source and Path(lots_source).is_file() else None)
+    deriving = Deriving(make_plan(grammar), lots, seed=options.seed, overrides=tuple(options.attrs.items()))
+    drawn = draw_tree(deriving, nodes, args.output)
+    print(f"{args.output}: {drawn['states']:,} states in {drawn['rows']:,} rows", file=sys.stderr)
     return 0
 
 

@@ -216,10 +216,15 @@ def emit_leaves(ctx: Context, shapes: Shapes, symbol: int) -> None:
     if not len(shapes):
         return
     chunk = ctx.chunk
-    if chunk.choices is not None:  # a search state's design (``aggregates``), written for its solutions only
+    if chunk.choices is not None:  # a search state's design (``aggregates``), written where asked for
         if chunk.choices.aggregates:
             collect(chunk.choices, ctx.env(shapes), ctx.plan.symbols[symbol].name)
         if not chunk.choices.records:
+            return
+        # a stopped state's design is the leaves it made before its stop, not those of the option its
+        # stopping body goes on with
+        shapes = shapes.take(~chunk.choices.stopped[shapes.lot])
+        if not len(shapes):
             return
     assets = shapes.geom < -1
     if assets.any():
