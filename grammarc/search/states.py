@@ -161,9 +161,9 @@ class Deriving:
         while True:
             choices = Choices(states.path[keep], states.length[keep], self.aggregates, records)
             try:
-                made, _ = derive_chunk(self.plan, self.lots.take(states.lot[keep]), seed=self.seed,
-                                       limits=self.limits, overrides=dict(self.overrides),
-                                       chunk_budget=self.chunk_budget, choices=choices, records=records)
+                made, _ = derive_chunk(self.plan, self.lots, seed=self.seed, limits=self.limits,
+                                       overrides=dict(self.overrides), chunk_budget=self.chunk_budget,
+                                       choices=choices, records=records, rows=states.lot[keep])
                 break
             except LotFailure as failure:
                 if records:
