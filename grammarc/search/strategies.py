@@ -180,7 +180,10 @@ def _astar(run: _Run, start: States) -> None:
         run.give(open_states.take(best[:leading]))
         rest = best[leading:]
         expand = rest[~open_states.goal[rest]]
-        if run.wanted <= 0 or (not len(expand) and not leading):
+        if run.wanted <= 0:
+            return
+        if len(expand) and run.budget <= 0:  # solutions still open behind these are not the best
+            run.result.limited = True
             return
         kids = open_states.take(expand).consequents(open_options[expand])
         keep = np.ones(len(open_states), dtype=bool)
@@ -189,8 +192,6 @@ def _astar(run: _Run, start: States) -> None:
         made_states, made_options = _opened([*run.derive(kids)])
         open_states = States.concat([open_states.take(keep), made_states])
         open_options = np.concatenate([open_options[keep], made_options])
-        if run.result.limited:
-            return
 
 
 def _leading(flags: np.ndarray) -> int:
