@@ -39,6 +39,8 @@ class Choices:
     aggregates: tuple[ir.Aggregate, ...] = ()
     #: Whether the states' leaves are written as records (a solution's), or only read (a search's).
     records: bool = False
+    #: The number of the first state in the records' ``lot`` column (the states are numbered from it).
+    first: int = 0
     taken: np.ndarray = field(init=False)
     options: np.ndarray = field(init=False)
     site: np.ndarray = field(init=False)

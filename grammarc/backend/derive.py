@@ -129,7 +129,7 @@ def derive_chunk(plan: Plan, lots: Lots, *, seed: int, limits: Limits, overrides
     if choices is not None:
         judge(plan.grammar.module, choices, Env(shapes, chunk, plan))
         # a search's states share their lot's number (and so its random keys): its records number the states
-        chunk.lot_index = np.arange(len(lots))
+        chunk.lot_index = np.arange(len(lots)) + choices.first
     reports = aggregate_chunk(chunk.outputs.reports, chunk.lot_index, list(plan.strings.ids))
     return collect(chunk, plan) if records else None, reports
 

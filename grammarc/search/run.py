@@ -93,7 +93,10 @@ def write_solutions(path: Path, deriving: Deriving, result: SearchResult, option
     solutions = result.solutions
     with writer_class(path, assets=grammar.assets, symbols=deriving.plan.symbol_names,
                       meta={**meta, "search": result.summary(deriving, options)}) as writer:
-        if solutions is not None:
-            _, records = deriving.derive(solutions, records=True)
-            writer.write(records)
+        # the solutions derived again a batch at a time, numbered in the order found
+        for start in range(0, 0 if solutions is None else len(solutions), options.batch):
+            _, chunks = deriving.derive(solutions.take(slice(start, start + options.batch)), records=True,
+                                        first=start)
+            for records in chunks:
+                writer.write(records)
         return writer.close()

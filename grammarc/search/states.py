@@ -17,7 +17,7 @@ from grammarc.backend.choices import Choices
 from grammarc.backend.derive import derive_chunk
 from grammarc.backend.plan import Plan
 from grammarc.constants import LIMITS, Limits
-from grammarc.errors import LotFailure
+from grammarc.errors import ChunkTooLarge, LotFailure
 from grammarc.ir import nodes as ir
 from grammarc.ir.traverse import iter_exprs
 from grammarc.model.lots import Lots
@@ -141,7 +141,8 @@ class Deriving:
     seed: int = 0
     limits: Limits = LIMITS
     overrides: tuple[tuple[str, object], ...] = ()
-    chunk_budget: int = 50_000_000
+    #: Shapes a chunk of states may make before it is halved (``ChunkTooLarge``), as a build's chunk.
+    chunk_budget: int = 20_000_000
 
     @property
     def aggregates(self) -> tuple[ir.Aggregate, ...]:
@@ -149,17 +150,27 @@ class Deriving:
         return tuple(dict.fromkeys(e for o in module.objectives for e in iter_exprs(o.expr)
                                    if isinstance(e, ir.Aggregate)))
 
-    def derive(self, states: States, records: bool = False) -> tuple[Outcome, TerminalChunk | None]:
-        """Derive ``states`` as one chunk: their outcome, and with ``records`` their records (the
-        record's ``lot`` numbers the states). A state whose derivation fails is ``failed``; the others
-        are derived again without it. Records are asked of states derived before (solutions), which
-        derive again as they did: a failure there is raised."""
+    def derive(self, states: States, records: bool = False, first: int = 0) -> tuple[Outcome, list[TerminalChunk]]:
+        """Derive ``states`` as one chunk (halves of it, where it makes more shapes than ``chunk_budget``):
+        their outcome, and with ``records`` their records (chunks in order, whose ``lot`` numbers the
+        states from ``first``). A state whose derivation fails is ``failed``; the others are derived again
+        without it. Records are asked of states derived before (solutions), which derive again as they
+        did: a failure there is raised."""
+        try:
+            return self._derive(states, records, first)
+        except ChunkTooLarge:
+            half = len(states) // 2
+            (a, made_a), (b, made_b) = (self.derive(states.take(slice(0, half)), records, first),
+                                        self.derive(states.take(slice(half, None)), records, first + half))
+            return Outcome.concat([a, b]), made_a + made_b
+
+    def _derive(self, states: States, records: bool, first: int) -> tuple[Outcome, list[TerminalChunk]]:
         n = len(states)
         keep = np.arange(n)
         failed = np.zeros(n, dtype=bool)
         reasons: dict[int, str] = {}
         while True:
-            choices = Choices(states.path[keep], states.length[keep], self.aggregates, records)
+            choices = Choices(states.path[keep], states.length[keep], self.aggregates, records, first)
             try:
                 made, _ = derive_chunk(self.plan, self.lots, seed=self.seed, limits=self.limits,
                                        overrides=dict(self.overrides), chunk_budget=self.chunk_budget,
@@ -176,7 +187,7 @@ class Deriving:
             _spread(choices.options, keep, n, 0), _spread(choices.site, keep, n, -1), _spread(choices.cost, keep, n, 0.0),
             *(None if v is None else _spread(v, keep, n, v.dtype.type(0)) for v in
               (choices.goal, choices.prune, choices.heuristic)), failed, reasons)
-        return outcome, made
+        return outcome, [made] if made is not None else []
 
 
 def _spread(values: np.ndarray, rows: np.ndarray, n: int, fill) -> np.ndarray:

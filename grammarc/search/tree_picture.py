@@ -85,21 +85,28 @@ def _states(nodes: list[dict], row_of: dict[str, int]) -> States:
 
 def _thumbnails(deriving: Deriving, states: States, size: int, folder: Path):
     """A picture (PIL image) of each state's leaves on its lot's footprint, in order."""
-    _, records = deriving.derive(states, records=True)
+    _, chunks = deriving.derive(states, records=True)
     grammar = deriving.plan.grammar
     quad = grammar.assets.index(LEAF_QUAD)
     symbols = [*deriving.plan.symbol_names, "(lot)"]
     footprints = _footprints(deriving, states)
+    for records in chunks:
+        yield from _chunk_thumbnails(records, grammar.assets, quad, symbols, footprints, size, folder)
+
+
+def _chunk_thumbnails(records, assets, quad: int, symbols: list[str], footprints: np.ndarray, size: int,
+                      folder: Path):
+    """The thumbnails of the states of one chunk of records (its lots), in order."""
     record = {"xform": records.xform, "lot": records.lot, "lot_origin": records.origins.table(), "mesh": records.mesh}
     xform, vertices = world_columns(record)
     mesh = records.mesh
-    for k in range(len(states)):
+    for k in records.origins.lot.tolist():
         rows = np.flatnonzero(records.lot == k)
         faces = np.flatnonzero(mesh.lot == k)
         rings, face_offsets = ragged_take(mesh.face_offsets, faces)
         points, ring_offsets = ragged_take(mesh.ring_offsets, rings)
         state = {
-            "assets": list(grammar.assets), "symbols": symbols,
+            "assets": list(assets), "symbols": symbols,
             "asset": np.concatenate([[quad], records.asset[rows]]).astype(np.int32),
             "xform": np.concatenate([footprints[k:k + 1], xform[rows]]),
             "symbol": np.concatenate([[len(symbols) - 1], records.symbol[rows]]).astype(np.int32),

@@ -179,7 +179,7 @@ def test_ice_ray_lattices_are_found_depth_first():
     result = run_search(deriving, SearchOptions(strategy="dfs", solutions=2))
     found = result.summary(deriving, SearchOptions())["solutions"]
     assert len(found) == 2 and found[0]["path"] < found[1]["path"]
-    _, records = deriving.derive(result.solutions, records=True)
+    _, (records,) = deriving.derive(result.solutions, records=True)
     corners = np.diff(records.mesh.ring_offsets)
     assert set(corners.tolist()) <= {3, 4, 5}
     assert np.bincount(records.mesh.lot).min() >= 4  # a lattice of cells of 2.5 to 6 m2 on 24 m2
