@@ -51,3 +51,4 @@ def test_question_mark_consequents_build_equally_likely(write):
     r = paper(write, "lot ~> a ?\n    ~> b ?\n    ~> c ?\n", LOTS, seed=1)
     counts = Counter(names(r))
     assert set(counts) == {"a", "b", "c"} and min(counts.values()) > 70
+

@@ -35,6 +35,12 @@ def infer_types(module: ir.Module, diags: Diagnostics) -> ir.Module:
     attrs = []
     for attr in module.attrs:
         t = type_of(attr.default, attr_types, (), diags)
+        for expr in iter_exprs(attr.default):
+            if isinstance(expr, (ir.Choose, ir.Aggregate)):
+                diags.error("choose" if isinstance(expr, ir.Choose) else "aggregate",
+                            f"`{'choose' if isinstance(expr, ir.Choose) else expr.func}` in the default of "
+                            f"`{attr.name}`: a lot's attribute is neither a design's choice nor its value; "
+                            "write it in a rule", expr.span)
         attr_types[attr.name] = t
         attrs.append(replace(attr, type=t))
 
