@@ -161,8 +161,8 @@ def _parser() -> argparse.ArgumentParser:
                         "(default: all)")
     search.add_argument("--max-states", type=_positive, default=1_000_000, metavar="N",
                         help="derive at most N states per lot (default 1,000,000): memory follows it")
-    search.add_argument("--batch", type=_positive, default=4096, metavar="N",
-                        help="the states DFS and A* take at once, and the most derived together (default 4096); "
+    search.add_argument("--batch", type=_positive, default=16384, metavar="N",
+                        help="the states DFS and A* take at once, and the most derived together (default 16384); "
                              "the solutions' order does not depend on it")
     search.add_argument("--emit", type=Path, metavar="OUT",
                         help="the solutions' designs as a record (.npz...), its lot column the solution number")

@@ -42,7 +42,7 @@ class SearchOptions:
     #: States to derive per lot at most.
     max_states: int = 1_000_000
     #: States derived together (a frontier's batch).
-    batch: int = 4096
+    batch: int = 16384
 
 
 @dataclass
