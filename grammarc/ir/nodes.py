@@ -537,7 +537,7 @@ class Cut:
     """``Cut(e1, t1, e2, t2){ A | B }`` (GRAMATICA's ice-ray grammar): the shape's polygon in its scope's
     x-z plane divided by the line from the point at fraction ``t1`` of its edge ``e1`` to the point at
     ``t2`` of edge ``e2`` (edges in ring order from its first vertex, modulo their number;
-    ``geometry.cuts``). ``A`` takes the piece from the first point on along the ring to the second, ``B``
+    ``geometry.edge_cuts``). ``A`` takes the piece from the first point on along the ring to the second, ``B``
     the other; each piece's scope is its bounding box in the parent's."""
 
     edges: tuple[Expr, Expr] = child(Type.NUM, "an edge number")

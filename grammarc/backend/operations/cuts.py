@@ -3,7 +3,7 @@
 Stiny's ice-ray grammar divides a lattice's cells (triangles, quadrilaterals, pentagons) by segments
 from edge to edge; GRAMATICA's example derives it. A shape's polygon is its footprint in the scope's
 x-z plane: its rectangle (a lot, a split part) or its polygon of the store (a piece of an earlier cut);
-``geometry.cuts`` divides them all at once, and each piece becomes a child whose scope is the piece's
+``geometry.edge_cuts`` divides them all at once, and each piece becomes a child whose scope is the piece's
 bounding box in its parent's frame (as a polygon split across its plane gives its pieces), its polygon
 normalized to it in the store. Reads: the scope, ``geom``, ``lot``, ``key``, ``depth``, ``params`` and
 ``dynamic`` (the pieces inherit them), and what the edge numbers and fractions read. Writes: no column
@@ -21,7 +21,7 @@ from grammarc.backend.operations.table import Parts, operation
 from grammarc.backend.shapes import Shapes
 from grammarc.backend.streams import piece_keys
 from grammarc.geometry.components import rect_rings
-from grammarc.geometry.cuts import cut_rings
+from grammarc.geometry.edge_cuts import cut_rings
 from grammarc.ir import nodes as ir
 from grammarc.ragged import segment_of, segment_reduce
 

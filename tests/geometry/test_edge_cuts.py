@@ -1,11 +1,11 @@
-"""geometry/cuts.py: rings divided by a segment between two of their edges."""
+"""geometry/edge_cuts.py: rings divided by a segment between two of their edges."""
 
 from __future__ import annotations
 
 import numpy as np
 import pytest
 
-from grammarc.geometry.cuts import cut_rings
+from grammarc.geometry.edge_cuts import cut_rings
 
 SQUARE = np.array([[0, 0], [4, 0], [4, 4], [0, 4]], float)
 
