@@ -58,12 +58,17 @@ def concave_lots(path: Path, n: int, seed: int = 7) -> Path:
 
 
 def run_build(args: list[str], env: dict | None = None) -> dict:
-    """Run ``grammarc build`` in a child process; returns its stderr and its own peak RSS (KiB).
+    """Run ``grammarc build`` in a child process; returns its stderr and its own peak RSS (KiB)."""
+    return run_command("build", args, env)
+
+
+def run_command(command: str, args: list[str], env: dict | None = None) -> dict:
+    """Run ``grammarc COMMAND`` in a child process; returns its stderr and its own peak RSS (KiB).
 
     ``os.wait4`` gives the child's own resource usage (RUSAGE_CHILDREN would be the maximum over every
     child the benchmark session ever waited for).
     """
-    proc = subprocess.Popen([sys.executable, "-m", "grammarc.cli", "build", *args],
+    proc = subprocess.Popen([sys.executable, "-m", "grammarc.cli", command, *args],
                             stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True,
                             env={**os.environ, **(env or {})})
     stderr = proc.stderr.read()

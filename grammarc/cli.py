@@ -150,6 +150,38 @@ def _parser() -> argparse.ArgumentParser:
     build.add_argument("--quiet", "-q", action="store_true", help="no progress bar and no summary")
     build.set_defaults(run=_build)
 
+    search = sub.add_parser("search", help="search a grammar's designs for those that meet its goal: "
+                                            "breadth-first, depth-first or A*")
+    search.add_argument("grammar", type=Path, help="the grammar (paper notation) with sets of consequents: "
+                                                    "choose(...) and `?` alternatives, and a `goal:`")
+    search.add_argument("--lots", type=Path, metavar="PATH",
+                        help="the lots to search from, each on its own (default: as for build)")
+    search.add_argument("--strategy", choices=("bfs", "dfs", "astar"), default="bfs",
+                        help="breadth-first (all solutions, fewest choices first), depth-first (in the written "
+                             "order of the consequents) or A* (cheapest first, by `cost:` and `heuristic:`)")
+    search.add_argument("--solutions", type=_positive, metavar="K", help="stop a lot's search at K solutions "
+                        "(default: all)")
+    search.add_argument("--max-states", type=_positive, default=1_000_000, metavar="N",
+                        help="derive at most N states per lot (default 1,000,000): memory follows it")
+    search.add_argument("--batch", type=_positive, default=16384, metavar="N",
+                        help="the states DFS and A* take at once, and the most derived together (default 16384); "
+                             "the solutions' order does not depend on it")
+    search.add_argument("--emit", type=Path, metavar="OUT",
+                        help="the solutions' designs as a record (.npz...), its lot column the solution number")
+    search.add_argument("--tree", type=Path, metavar="JSON", help="the derivation graph of the states derived")
+    search.add_argument("--seed", type=int, default=0, help="random seed of the draws that are not choices")
+    search.add_argument("--attr", action="append", default=[], metavar="NAME=VALUE",
+                        help="override an attribute for every lot (repeatable)")
+    search.add_argument("--max-depth", type=_positive, default=LIMITS.max_depth, metavar="N",
+                        help=f"rule applications along one path of a state (default {LIMITS.max_depth})")
+    search.add_argument("--max-shapes", type=_positive, default=LIMITS.max_shapes, metavar="N",
+                        help=f"shapes made in one state (default {LIMITS.max_shapes:,})")
+    search.add_argument("--workers", type=_positive, default=_cores(), metavar="N",
+                        help=f"states derived at once in N forked processes (default: the {_cores()} cores this "
+                             "process may use); the solutions do not depend on it")
+    search.add_argument("--quiet", "-q", action="store_true", help="no summary")
+    search.set_defaults(run=_search)
+
     conform = sub.add_parser("conform", help="compare grammarc with Esri's PRT on the conformance kit")
     conform.add_argument("rpk", type=Path, nargs="?", help="a rule package of the kit (.rpk)")
     conform.add_argument("footprint", nargs="?", help="a kit footprint name (rect_30x20) or a lots file")
@@ -187,7 +219,8 @@ def _parser() -> argparse.ArgumentParser:
     info.set_defaults(run=_info)
 
     render = sub.add_parser("render", help="draw an instance record as a shaded picture (PNG)")
-    render.add_argument("record", type=Path, help="an instance record (.npz) written by `grammarc build`")
+    render.add_argument("record", type=Path, help="an instance record (.npz) written by `grammarc build` or "
+                                                   "`grammarc search`, or the tree (.json) of `grammarc search --tree`")
     render.add_argument("-o", "--output", required=True, type=Path, metavar="PNG", help="the picture, .png")
     render.add_argument("--view", choices=("oblique", "top"), default="oblique",
                         help="oblique: perspective from above at an angle (default); top: orthographic")
@@ -461,6 +494,8 @@ def _render(args) -> int:
 
     size = parse_size(args.size)
     check_writable([png_path(args.output)])  # before the record is read, which may be large
+    if args.record.suffix.lower() == ".json":
+        return _render_tree(args)
     record = load_record(args.record)
     with record_asset_roots(record.get("meta"), args.assets or None) as roots:
         result = render(record, args.output, size=size, view=args.view, color=args.color, asset_roots=roots)
@@ -468,6 +503,32 @@ def _render(args) -> int:
         print(f"grammarc: {problem}; drawn as boxes (--assets DIR gives a folder)", file=sys.stderr)
     print(f"{args.output}: {result['instances']:,} instances, {result['mesh_faces']:,} mesh faces",
           file=sys.stderr)
+    return 0
+
+
+def _render_tree(args) -> int:
+    """``grammarc render tree.json``: the derivation graph of ``grammarc search --tree``, a thumbnail per
+    state, its states derived again from the grammar and lots its meta names."""
+    import json
+
+    from grammarc.backend.plan import make_plan
+    from grammarc.build import BuildOptions, compile_source, load_lots
+    from grammarc.search import Deriving
+    from grammarc.search.tree_picture import draw_tree
+
+    try:
+        tree = json.loads(args.record.read_text(encoding="utf-8"))
+        meta, nodes = tree, tree["states"]
+        grammar_path = Path(meta["grammar"])
+    except (OSError, ValueError, KeyError, TypeError) as error:
+        raise UsageError(f"{args.record}: not a tree of `grammarc search --tree` ({error})") from error
+    options = BuildOptions(seed=meta.get("seed", 0), attrs=meta.get("attrs", {}))
+    grammar = compile_source(grammar_path, None, options)
+    lots_source = meta.get("lots_source")
+    lots = load_lots(grammar_path, Path(lots_source) if lots_source and Path(lots_source).is_file() else None)
+    deriving = Deriving(make_plan(grammar), lots, seed=options.seed, overrides=tuple(options.attrs.items()))
+    drawn = draw_tree(deriving, nodes, args.output)
+    print(f"{args.output}: {drawn['states']:,} states in {drawn['rows']:,} rows", file=sys.stderr)
     return 0
 
 
@@ -631,6 +692,45 @@ def _build(args) -> int:
     if result.bad:
         print(f"grammarc: {len(result.bad):,} of {result.lots:,} lots skipped", file=sys.stderr)
     return 1 if result.bad and args.strict else 0
+
+
+def _search(args) -> int:
+    from grammarc.backend.attributes import check_overrides, parse_override
+    from grammarc.backend.plan import make_plan
+    from grammarc.build import BuildOptions, compile_source, load_lots, record_meta
+    from grammarc.io import written_paths
+    from grammarc.io.output_paths import check_writable
+    from grammarc.search import Deriving, SearchOptions, run_search, write_solutions
+
+    options = BuildOptions(seed=args.seed, attrs=dict(parse_override(a) for a in args.attr),
+                           limits=replace(LIMITS, max_depth=args.max_depth, max_shapes=args.max_shapes))
+    grammar = compile_source(args.grammar, None, options)
+    if grammar.module.dialect != "cga2006":
+        raise UsageError(f"{args.grammar}: search takes grammars in the paper notation (choose, `?`, goal:)")
+    check_overrides(grammar.module, options.attrs)
+    outputs = [*(written_paths(args.emit)[0] if args.emit else []), *([args.tree] if args.tree else [])]
+    check_writable(outputs, [])
+    lots = load_lots(args.grammar, args.lots)
+    plan = make_plan(grammar)
+    deriving = Deriving(plan, lots, seed=args.seed, limits=options.limits, overrides=tuple(options.attrs.items()))
+    search = SearchOptions(args.strategy, args.solutions, args.max_states, args.batch)
+    result = run_search(deriving, search, record_tree=args.tree is not None, workers=args.workers)
+    meta = record_meta(args.grammar, grammar, plan, options, lots.source, (), lots.crs)
+    if args.emit:
+        write_solutions(args.emit, deriving, result, search, meta)
+    if args.tree:
+        result.tree.write(args.tree, grammar.module, lots.ids, {**meta, "search": result.summary(deriving, search)})
+    found = sum(r.found for r in result.lots)
+    for lot in result.lots:  # said even with --quiet: the search did not end on its own
+        if lot.limited:
+            print(f"grammarc: lot {lots.ids[lot.lot]}: stopped at --max-states {args.max_states:,} "
+                  f"({lot.states:,} states derived, {lot.found:,} solutions)", file=sys.stderr)
+    if not args.quiet:
+        _warn(grammar)
+        rate = result.states / result.seconds if result.seconds > 0 else 0.0
+        print(f"{args.strategy}: {found:,} solutions from {result.states:,} states of {len(lots):,} lots in "
+              f"{result.seconds:.2f} s ({rate:,.0f} states/s)", file=sys.stderr)
+    return 0
 
 
 if __name__ == "__main__":

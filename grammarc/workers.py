@@ -123,7 +123,9 @@ def _receive(done: Future, received: Future, lots) -> None:
 
 
 def _span(lots) -> str:
-    """``#first-#last`` of a chunk of lots, by their numbers in the input."""
+    """``#first-#last`` of a chunk of lots, by their numbers in the input (of a search's states, how many)."""
+    if not hasattr(lots, "index"):
+        return f"({len(lots)} search states)"
     return f"#{lots.index[0]}-#{lots.index[-1]}" if len(lots) else "(none)"
 
 

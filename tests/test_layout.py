@@ -23,7 +23,7 @@ FLOORS = (
     ("compiler", "backend"),
     ("io", "render"),
     ("workers", "server"),
-    ("build",),
+    ("build", "search"),
     ("cluster", "conform"),
     ("cli",),
     ("client",),

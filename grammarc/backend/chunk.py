@@ -9,6 +9,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from grammarc.backend.choices import Choices
 from grammarc.backend.occlusion import Occluders, OccluderStore
 from grammarc.backend.snaps import SnapStore
 from grammarc.constants import STRICT
@@ -122,6 +123,8 @@ class Chunk:
     snaps: SnapStore = field(default_factory=SnapStore)
     #: Texture maps the shapes' texture columns name (``backend.texture_space``).
     texture_maps: TextureMaps = field(default_factory=TextureMaps)
+    #: A search's fixed choices, one state per lot (``backend.choices``); None in a build.
+    choices: Choices | None = None
     #: Shapes created so far per lot, for the ``max_shapes`` limit, and in all.
     shape_count: np.ndarray = field(init=False)
     shape_total: int = field(init=False, default=0)

@@ -13,7 +13,9 @@ from dataclasses import replace
 
 import numpy as np
 
+from grammarc.backend.aggregates import judge
 from grammarc.backend.attributes import attribute_columns
+from grammarc.backend.choices import Choices
 from grammarc.backend.chunk import Chunk, Frames
 from grammarc.backend.context import Context
 from grammarc.backend.evaluate import Env
@@ -47,11 +49,12 @@ from grammarc.ragged import ragged_take
 
 
 def initial_chunk(lots: Lots, seed: int, foreign: Occluders | None = None,
-                  sequential: bool = False) -> tuple[Chunk, Shapes]:
+                  sequential: bool = False, scopes: tuple | None = None) -> tuple[Chunk, Shapes]:
     """The chunk state and initial shapes (one per lot) of ``lots``, their random keys from ``seed`` (and
     the lots' ``seed`` properties where they draw from a ``sequential`` stream, ``backend.streams``);
-    ``foreign`` the occluders of every lot from a first pass (``derive_chunk``)."""
-    origin, axes, size, local = lot_scopes(lots)
+    ``foreign`` the occluders of every lot from a first pass (``derive_chunk``); ``scopes`` the lots'
+    ``lot_scopes`` where they are known (``repeated_scopes``)."""
+    origin, axes, size, local = lot_scopes(lots) if scopes is None else scopes
     is_rect, coords, ring_offsets, poly_offsets = footprint_polygons(lots, size, local)
     frames = Frames(capacity=max(256, 4 * len(lots)))
     polygons = PolygonStore()
@@ -69,20 +72,38 @@ def initial_chunk(lots: Lots, seed: int, foreign: Occluders | None = None,
     return chunk, shapes
 
 
+def repeated_scopes(lots: Lots, rows: np.ndarray) -> tuple:
+    """``lot_scopes`` of ``lots.take(rows)``, each lot measured once however often ``rows`` takes it."""
+    distinct, inverse = np.unique(rows, return_inverse=True)
+    once = lots.take(distinct)
+    origin, axes, size, local = lot_scopes(once)
+    vertices, _ = ragged_take(once.ring_offsets[once.lot_offsets], inverse)
+    return origin[inverse], axes[inverse], size[inverse], local[vertices]
+
+
 def derive_chunk(plan: Plan, lots: Lots, *, seed: int, limits: Limits, overrides: dict,
                  chunk_budget: int, foreign: Occluders | None = None,
-                 occluders_only: bool = False) -> tuple[TerminalChunk, dict] | Occluders:
+                 occluders_only: bool = False, choices: Choices | None = None,
+                 records: bool = True, rows: np.ndarray | None = None) -> tuple[TerminalChunk | None, dict] | Occluders:
     """Derive ``lots``: their records and their reports per lot (``reports.aggregate_chunk``).
 
     ``foreign`` are the occluders of every lot from a first pass, for ``inter`` queries; with
     ``occluders_only`` this is that first pass: the derivation stops where the first query would run
-    and returns the occluders made up to there.
+    and returns the occluders made up to there. ``choices``: the lots are a search's states, whose
+    choices they fix and whose outcomes (stop, cost, goal...) they receive (``backend.choices``);
+    without ``records`` none are collected (None). ``rows``: the chunk's lots are ``lots``' rows
+    ``rows``, a lot as often as it comes there (a search's states are their lot, many times over).
 
     Raises ``LotFailure`` naming lots to skip (a limit reached among them), or ``ChunkTooLarge``.
     """
-    chunk, shapes = initial_chunk(lots, seed, foreign, plan.sequential_random)
+    scopes = None
+    if rows is not None:
+        scopes = repeated_scopes(lots, rows)
+        lots = lots.take(rows)
+    chunk, shapes = initial_chunk(lots, seed, foreign, plan.sequential_random, scopes)
     attribute_columns(plan.grammar.module, Env(shapes, chunk, plan), lots.attrs, overrides, plan.strings)
     shapes = replace(shapes, dynamic=tuple(initial_dynamic(plan, name, chunk, shapes) for name in plan.dynamic))
+    chunk.choices = choices
     ctx = Context(plan, chunk, limits, chunk_budget)
     pending = ctx.pending
     pending[plan.start].append(shapes)
@@ -105,8 +126,12 @@ def derive_chunk(plan: Plan, lots: Lots, *, seed: int, limits: Limits, overrides
                     apply_pending(ctx, plan.symbols[sym_id], batches)
     if occluders_only:
         return chunk.occluders.table()
+    if choices is not None:
+        judge(plan.grammar.module, choices, Env(shapes, chunk, plan))
+        # a search's states share their lot's number (and so its random keys): its records number the states
+        chunk.lot_index = np.arange(len(lots)) + choices.first
     reports = aggregate_chunk(chunk.outputs.reports, chunk.lot_index, list(plan.strings.ids))
-    return collect(chunk, plan), reports
+    return collect(chunk, plan) if records else None, reports
 
 
 def initial_dynamic(plan: Plan, name: str, chunk: Chunk, shapes: Shapes) -> np.ndarray:

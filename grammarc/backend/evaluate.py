@@ -12,6 +12,7 @@ import numpy as np
 
 from grammarc.backend import arrays, euler, materials, occlusion
 from grammarc.backend.arrays import Arrays
+from grammarc.backend.choices import consequent
 from grammarc.backend.env import Env
 from grammarc.backend.functions import FUNCTIONS
 from grammarc.backend.functions.strings import as_string, concatenate, is_string, string_ranks
@@ -80,6 +81,11 @@ def evaluate(expr: ir.Expr, env: Env):
         return _call(expr, env)
     if isinstance(expr, (ir.ArrayLit, ir.Range, ir.Index)):
         return _ARRAY_EXPRESSIONS[type(expr)](expr, env)
+    if isinstance(expr, ir.Choose):
+        return _choose(expr, env)
+    if isinstance(expr, ir.Aggregate):  # of a search state, read by the search statements (``aggregates``)
+        choices = env.chunk.choices
+        return choices.value(choices.aggregates.index(expr))[env.shapes.lot]
     raise TypeError(f"cannot evaluate {expr!r}")
 
 
@@ -212,6 +218,15 @@ def _scope_angles(env: Env, axes: np.ndarray, frames: np.ndarray | None) -> np.n
     if frames is None:
         return euler.angles(np.einsum("nij,nkj->nik", scope_axes, axes))  # rows: new axes in the lot's frame
     return relative_angles(scope_axes, axes, env.shapes.frame == frames)
+
+
+def _choose(expr: ir.Choose, env: Env) -> np.ndarray:
+    """``choose(a, b, ...)``: each shape's option (``backend.choices``)."""
+    shapes = env.shapes
+    options = [np.broadcast_to(np.asarray(evaluate(o, env)), (len(shapes),)) for o in expr.options]
+    picked = consequent(env.chunk.choices, env.plan.sequential_random, shapes.lot, shapes.key, expr.site,
+                        len(options))
+    return np.stack(options)[picked, np.arange(len(shapes))]
 
 
 def _call(expr: ir.Call, env: Env):

@@ -16,6 +16,7 @@ from dataclasses import replace
 import numpy as np
 
 from grammarc.backend import terminals
+from grammarc.backend.choices import consequent
 from grammarc.backend.context import Context
 from grammarc.backend.evaluate import evaluate_array
 from grammarc.backend.fusion.run import FusedBatch
@@ -79,7 +80,12 @@ def apply(ctx: Context, sym: SymbolPlan, shapes: Shapes) -> None:
 
 
 def apply_all(ctx: Context, sym: SymbolPlan, shapes: Shapes) -> None:
-    """``apply`` on all of ``shapes`` at once."""
+    """``apply`` on all of ``shapes`` at once; in a search, but for the states stopped at a choice."""
+    choices = ctx.chunk.choices
+    if choices is not None:
+        shapes = shapes.take(~choices.stopped[shapes.lot])
+        if not len(shapes):
+            return
     ctx.check_depth(shapes, sym.rules[0].span)
     remaining = shapes
     for rule in sym.rules:
@@ -98,8 +104,18 @@ def apply_all(ctx: Context, sym: SymbolPlan, shapes: Shapes) -> None:
 def apply_rule(ctx: Context, rule: ir.Rule, shapes: Shapes) -> None:
     """Run ``rule`` on ``shapes``: its body, or each shape's stochastic alternative."""
     alts = rule.alternatives
+    if ctx.chunk.choices is not None:
+        _charge(ctx, rule, shapes)
     if len(alts) == 1:
         run(ctx, alts[0].body, shapes, leaf_at_end=True)
+        return
+    if alts[0].choice:  # a set of consequents: the state's, or one drawn, all equally likely
+        choice = consequent(ctx.chunk.choices, ctx.plan.sequential_random, shapes.lot, shapes.key, rule.site,
+                            len(alts))
+        for i, alt in enumerate(alts):
+            picked = shapes.take(choice == i)
+            if len(picked):
+                run(ctx, alt.body, picked, leaf_at_end=True)
         return
     env = ctx.env(shapes)
     probs = np.stack([evaluate_array(a.prob, env) for a in alts], axis=1)
@@ -113,6 +129,16 @@ def apply_rule(ctx: Context, rule: ir.Rule, shapes: Shapes) -> None:
         picked = shapes.take(choice == i)
         if len(picked):
             run(ctx, alt.body, picked, leaf_at_end=True)
+
+
+def _charge(ctx: Context, rule: ir.Rule, shapes: Shapes) -> None:
+    """A search state pays the grammar's ``cost:`` (1 where it states none) for each rule application."""
+    expr = ctx.plan.grammar.module.objective("cost")
+    cost = np.ones(len(shapes)) if expr is None else evaluate_array(expr, ctx.env(shapes))
+    bad = ~(cost >= 0)
+    if bad.any():
+        ctx.fail(shapes, bad, f"a negative cost ({cost[bad][0]:g})", rule.span)
+    ctx.chunk.choices.charge(shapes.lot, cost)
 
 
 def run(ctx: Context, body: ir.Body, cursor: Shapes, leaf_at_end: bool = False) -> None:

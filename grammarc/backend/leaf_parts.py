@@ -81,8 +81,9 @@ class LeafPart:
 
 def leaf_inserts(plan) -> dict[int, LeafInsert]:
     """The symbols of ``plan`` whose rule only places an asset (see the module docstring), by id."""
+    # a search's aggregates count the shapes a symbol is given (``backend.aggregates``): none is skipped
     if plan.leaf_bodies or plan.queries or plan.occluders or plan.color_slot is not None or plan.material_slots \
-            or plan.uv_slots:
+            or plan.uv_slots or plan.grammar.module.objectives:
         return {}
     found = {}
     for sym in plan.symbols:

@@ -21,6 +21,7 @@ from dataclasses import replace
 
 import numpy as np
 
+from grammarc.backend.aggregates import collect
 from grammarc.backend.context import Context
 from grammarc.backend.kernels.scope import xforms
 from grammarc.backend.materials import material_ids, rgba
@@ -215,6 +216,16 @@ def emit_leaves(ctx: Context, shapes: Shapes, symbol: int) -> None:
     if not len(shapes):
         return
     chunk = ctx.chunk
+    if chunk.choices is not None:  # a search state's design (``aggregates``), written where asked for
+        if chunk.choices.aggregates:
+            collect(chunk.choices, ctx.env(shapes), ctx.plan.symbols[symbol].name)
+        if not chunk.choices.records:
+            return
+        # a stopped state's design is the leaves it made before its stop, not those of the option its
+        # stopping body goes on with
+        shapes = shapes.take(~chunk.choices.stopped[shapes.lot])
+        if not len(shapes):
+            return
     assets = shapes.geom < -1
     if assets.any():
         for code in np.unique(shapes.geom[assets]):

@@ -336,8 +336,38 @@ class Index:
     span: Span = NO_SPAN
 
 
+@dataclass(frozen=True, slots=True)
+class Choose:
+    """``choose(a, b, c)``: a set of consequents, one per value (GRAMATICA's operators). A search fixes
+    which value each state takes; a build draws one from the shape's stream at ``site``, all equally
+    likely, so that a search grammar also builds."""
+
+    #: of one type, whichever it is (``passes.types.type_of``)
+    options: tuple[Expr, ...] = child(None, "an option of `choose`")
+    span: Span = NO_SPAN
+    site: int = 0
+
+
+#: The aggregates over a design's shapes of one symbol, and what each reads of a shape: ``count`` the
+#: shapes (or those where a bool holds), ``area`` and ``volume`` their scopes', the others a number.
+AGGREGATES = ("count", "sum", "min", "max", "mean", "area", "volume")
+
+
+@dataclass(frozen=True, slots=True)
+class Aggregate:
+    """``count("room")``, ``sum(Scope.sx of "room")``, ``area("room")``...: a value of a whole design (a
+    search state), over the shapes its derivation gave ``symbol``; only the search statements
+    (``Objective``) read them."""
+
+    func: str
+    symbol: str
+    value: Expr | None = child(lambda e: Type.BOOL if e.func == "count" else Type.NUM,
+                               lambda e: f"the value `{e.func}` aggregates", default=None)
+    span: Span = NO_SPAN
+
+
 Expr = (Num | Str | Bool | Name | Param | AttrRef | ScopeRef | Unary | Binary | Call | Select | ContextRef
-        | Occlusion | ArrayLit | Range | Index)
+        | Occlusion | ArrayLit | Range | Index | Choose | Aggregate)
 
 #: CityEngine shape attributes that ``set`` changes for a shape and its successors (not declared attrs).
 SHAPE_ATTRIBUTES: dict[str, Type] = {"trim.vertical": Type.BOOL, "trim.horizontal": Type.BOOL,
@@ -497,6 +527,21 @@ class Comp:
 
     kind: str
     index: Expr | None = child(Type.NUM, "a component index")
+    parts: tuple[Body, ...] = child(holds=Holds.BODIES)
+    span: Span = NO_SPAN
+    site: int = 0
+
+
+@dataclass(frozen=True, slots=True)
+class Cut:
+    """``Cut(e1, t1, e2, t2){ A | B }`` (GRAMATICA's ice-ray grammar): the shape's polygon in its scope's
+    x-z plane divided by the line from the point at fraction ``t1`` of its edge ``e1`` to the point at
+    ``t2`` of edge ``e2`` (edges in ring order from its first vertex, modulo their number;
+    ``geometry.edge_cuts``). ``A`` takes the piece from the first point on along the ring to the second, ``B``
+    the other; each piece's scope is its bounding box in the parent's."""
+
+    edges: tuple[Expr, Expr] = child(Type.NUM, "an edge number")
+    at: tuple[Expr, Expr] = child(Type.NUM, "a fraction of an edge")
     parts: tuple[Body, ...] = child(holds=Holds.BODIES)
     span: Span = NO_SPAN
     site: int = 0
@@ -1113,7 +1158,7 @@ Op = (Symbol | Empty | Translate | Scale | Rotate | Push | Pop | Insert | Split 
       | Trim | SplitArea | ReduceGeometry | MirrorScope | SetOpacity | SetupProjection | ProjectUV | TransformUV
       | TileUV | NormalizeUV | SetbackToArea | Taper | ResetGeometry | AlignScopeToBBox
       | Footprint | Rectify | CopyUV | InsertAlongUV | ResetMaterial | SetMaterial
-      | SetPivot)
+      | SetPivot | Cut)
 Body = tuple[Op, ...]
 
 
@@ -1125,6 +1170,8 @@ class Alternative:
     body: Body = child(holds=Holds.BODY)
     prob: Expr | None = child(Type.NUM, "a probability")
     span: Span = NO_SPAN
+    #: One of a set of consequents (``~> B ?``): a search takes each; a build takes one, all equally likely.
+    choice: bool = False
 
 
 @dataclass(frozen=True, slots=True)
@@ -1154,6 +1201,22 @@ class AttrDecl:
     type: Type = Type.UNKNOWN
     const: bool = False
     annotations: tuple[tuple[str, tuple[str, ...]], ...] = ()
+
+
+#: The search statements: what each is, and the type of its expression.
+OBJECTIVES = {"goal": Type.BOOL, "prune": Type.BOOL, "cost": Type.NUM, "heuristic": Type.NUM}
+
+
+@dataclass(frozen=True, slots=True)
+class Objective:
+    """``goal: expr``, ``prune: expr`` (of a design), ``heuristic: expr`` (of a design, for A*) and
+    ``cost: expr`` (of the shape a rule is applied to, added per application): what a search
+    (``grammarc search``) looks for. A design's expressions read its aggregates (``Aggregate``), the lot's
+    attributes and, as ``Scope``, the lot's own shape."""
+
+    kind: str
+    expr: Expr = child(lambda o: OBJECTIVES[o.kind], lambda o: f"the {o.kind}")
+    span: Span = NO_SPAN
 
 
 @dataclass(frozen=True)
@@ -1204,3 +1267,9 @@ class Module:
     assets: tuple[str, ...] = ()
     #: ``I()`` name as written -> asset id, as pairs: the module is frozen (``model.Grammar`` has the dict).
     asset_ids: tuple[tuple[str, int], ...] = ()
+    #: The search statements (goal, cost, heuristic, prune), at most one of each.
+    objectives: tuple[Objective, ...] = child(holds=Holds.NODES, default=())
+
+    def objective(self, kind: str) -> Expr | None:
+        """The expression of the search statement ``kind``, None where the grammar has none."""
+        return next((o.expr for o in self.objectives if o.kind == kind), None)

@@ -52,6 +52,8 @@ _EXPR_FORMATS = {
     ir.Range: lambda e: f"[{print_expr(e.base)}:{print_expr(e.step)}:{print_expr(e.limit)}]",
     ir.Index: lambda e: f"{print_expr(e.array)}[{print_expr(e.index)}"
                         f"{'' if e.column is None else ', ' + print_expr(e.column)}]",
+    ir.Choose: lambda e: f"choose({_list(e.options)})",
+    ir.Aggregate: lambda e: f'{e.func}({"" if e.value is None else print_expr(e.value) + " of "}"{e.symbol}")',
 }
 
 
@@ -279,7 +281,7 @@ def print_rule(rule: ir.Rule) -> str:
         head += f" : {print_expr(rule.guard)}"
     alts = []
     for alt in rule.alternatives:
-        prob = f" : {print_expr(alt.prob)}" if alt.prob is not None else ""
+        prob = " ?" if alt.choice else f" : {print_expr(alt.prob)}" if alt.prob is not None else ""
         alts.append(f"~> {_body(alt.body)}{prob}")
     return f"{head} " + " ".join(alts)
 
@@ -292,4 +294,5 @@ def print_module(module: ir.Module) -> str:
             priority = rule.priority
             lines.append(f"PRIORITY {priority}:")
         lines.append(print_rule(rule))
+    lines += [f"{o.kind}: {print_expr(o.expr)}" for o in module.objectives]
     return "\n".join(lines)

@@ -29,6 +29,7 @@ from grammarc.errors import AssetError, UsageError
 from grammarc.geometry.triangulation import triangulate_polygons
 from grammarc.model.assets import asset_library, builtin_mesh
 from grammarc.model.records import record_mesh, world_columns
+from grammarc.ragged import segment_of
 from grammarc.render.camera import VIEWS, Camera, fit_camera
 from grammarc.render.raster import draw_instances, draw_triangles
 
@@ -205,6 +206,8 @@ def _columns(record: Mapping) -> dict:
         raise UsageError(f"not an instance record: asset index out of range [0, {len(out['assets'])})")
     # drawn around the middle of the city, where float32 keeps its detail wherever the city lies
     xform, vertices = world_columns(record)
+    if isinstance(record.get("meta"), Mapping) and "search" in record["meta"]:
+        xform, vertices = _side_by_side(record, xform, vertices)
     middle = np.round(_middle(xform, vertices))
     xform[:, :, 3] -= middle
     out["xform"] = np.ascontiguousarray(xform, np.float32)
@@ -214,20 +217,55 @@ def _columns(record: Mapping) -> dict:
     return out
 
 
+def _side_by_side(record: Mapping, xform: np.ndarray, vertices: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """A search's solutions (``grammarc search``: the record's lots are solutions, which lie on their
+    lots, one over the other) laid out on a grid in the order found, rows of ``ceil(sqrt(n))`` from
+    west to east, then north to south, a fifth of a solution apart."""
+    lot = np.asarray(record.get("lot", np.zeros(0, np.int32)), np.int64)
+    mesh = record_mesh(record)
+    vertex_lot = np.zeros(0, np.int64)
+    if mesh is not None and len(vertices):
+        vertex_lot = np.asarray(mesh.lot, np.int64)[segment_of(mesh.face_offsets)[segment_of(mesh.ring_offsets)]]
+    n = int(max(lot.max(initial=-1), vertex_lot.max(initial=-1))) + 1
+    if n < 2:
+        return xform, vertices
+    # each solution's own box, its lower corner moved to its cell's (solutions of several lots alike)
+    low, high = np.full((n, 3), np.inf), np.full((n, 3), -np.inf)
+    corner_low, corner_high = _boxes(xform)
+    for rows, low_rows, high_rows in ((lot, corner_low, corner_high), (vertex_lot, vertices, vertices)):
+        np.minimum.at(low, rows, low_rows)
+        np.maximum.at(high, rows, high_rows)
+    low, high = np.where(np.isfinite(low), low, 0.0), np.where(np.isfinite(high), high, 0.0)
+    cell = (high - low).max(axis=0) * 1.2
+    columns = int(np.ceil(np.sqrt(n)))
+    shift = -low
+    shift[:, 0] += (np.arange(n) % columns) * cell[0]
+    shift[:, 2] += (np.arange(n) // columns) * cell[2]
+    xform = xform.copy()
+    xform[:, :, 3] += shift[lot]
+    return xform, vertices + shift[vertex_lot]
+
+
 def _middle(xform: np.ndarray, vertices: np.ndarray) -> np.ndarray:
     """(3,) float64: the middle of the instances' origins and the mesh vertices (0 for an empty record)."""
     points = np.concatenate([xform[:, :, 3], vertices])
     return (points.min(axis=0) + points.max(axis=0)) / 2 if len(points) else np.zeros(3)
 
 
-def _bounds(xform: np.ndarray, vertices: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """The world bounding box (low, high) float64 of every instance's box and every mesh vertex."""
+def _boxes(xform: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Each instance's world box (low, high), (N, 3) each."""
     # An instance's box spans origin + sum over its axes of [min(0, axis), max(0, axis)], per coordinate;
     # column by column, as (N, 3) sums: a (N, 3, 3) temporary would cost more than the sums.
     low, high = xform[:, :, 3].copy(), xform[:, :, 3].copy()
     for j in range(3):
         low += np.minimum(xform[:, :, j], 0)
         high += np.maximum(xform[:, :, j], 0)
+    return low, high
+
+
+def _bounds(xform: np.ndarray, vertices: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The world bounding box (low, high) float64 of every instance's box and every mesh vertex."""
+    low, high = _boxes(xform)
     low, high = np.concatenate([low, vertices]), np.concatenate([high, vertices])
     if not len(low):
         return np.zeros(3), np.zeros(3)

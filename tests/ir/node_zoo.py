@@ -25,11 +25,12 @@ DATACLASSES = tuple(c for c in vars(ir).values() if isinstance(c, type) and data
 EXPRESSIONS = tuple(c for c in DATACLASSES if c in get_args(ir.Expr))
 OPERATIONS = tuple(c for c in DATACLASSES if c in get_args(ir.Op))
 #: The nodes that are neither: the parts of operations and the top level.
-STRUCTURE = (ir.Size, ir.Alternative, ir.Rule, ir.AttrDecl, ir.Module)
+STRUCTURE = (ir.Size, ir.Alternative, ir.Rule, ir.AttrDecl, ir.Objective, ir.Module)
 NODE_CLASSES = EXPRESSIONS + OPERATIONS + STRUCTURE
 #: Plain fields whose value decides what a node means to the type checker: a valid value each.
 PLAIN = {(ir.Unary, "op"): "-", (ir.Binary, "op"): "+", (ir.Call, "func"): "max",
-         (ir.ContextRef, "name"): "split.index", (ir.Occlusion, "kind"): "inside"}
+         (ir.ContextRef, "name"): "split.index", (ir.Occlusion, "kind"): "inside",
+         (ir.Aggregate, "func"): "sum", (ir.Objective, "kind"): "goal"}
 
 
 MARK = "§"

@@ -16,7 +16,7 @@ from node_zoo import DATACLASSES, EXPRESSIONS, NODE_CLASSES, OPERATIONS, STRUCTU
 from grammarc.ir import nodes as ir
 
 #: Classes of IR whose fields hold IR.
-_IR = {*get_args(ir.Expr), *get_args(ir.Op), ir.Size, ir.Alternative, ir.Rule, ir.AttrDecl}
+_IR = {*get_args(ir.Expr), *get_args(ir.Op), ir.Size, ir.Alternative, ir.Rule, ir.AttrDecl, ir.Objective}
 
 
 def _holds(hint) -> ir.Holds | None:
@@ -34,7 +34,7 @@ def _holds(hint) -> ir.Holds | None:
             return ir.Holds.BODIES
         if args[-1] is Ellipsis and get_args(args[0])[-1:] == (ir.Body,):
             return ir.Holds.BRANCHES
-        if args[-1] is Ellipsis and args[0] in (ir.Alternative, ir.Rule, ir.AttrDecl):
+        if args[-1] is Ellipsis and args[0] in (ir.Alternative, ir.Rule, ir.AttrDecl, ir.Objective):
             return ir.Holds.NODES
         return ir.Holds.EXPRS if ir.Holds.EXPRS in inner else None
     return ir.Holds.EXPRS if hint is ir.Size else None

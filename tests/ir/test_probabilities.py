@@ -81,3 +81,14 @@ def test_every_probability_set_returns_the_same_module():
                         stop_after="fold")
     assert check_probabilities(module, diags) is module
     assert not diags
+
+
+def test_consequents_written_with_a_question_mark_are_equally_likely():
+    module, diags = checked("a ~> b ?\n  ~> c ?\n  ~> d ?")
+    assert not diags.has_errors
+    assert print_rule(module.rules[0]) == "a ~> b ? ~> c ? ~> d ?"
+    assert [alt.prob.value for alt in module.rules[0].alternatives] == [pytest.approx(1 / 3)] * 3
+
+
+def test_consequents_and_probabilities_do_not_mix():
+    assert errors("a ~> b ?\n  ~> c : 0.5") == [(2, 3, "rule `a` mixes `?` consequents with probabilities")]

@@ -187,15 +187,18 @@ def _wanted(node) -> dict[int, tuple[ir.Type | None, str]]:
 
 
 def _type_errors(node) -> list[tuple[Span, str]]:
-    """The type errors of ``node`` in a module: an expression as an attribute's default, an operation in
-    a rule's body, an alternative or a rule as itself."""
+    """The type errors of ``node`` in a module: an expression as an attribute's default (an aggregate as a
+    heuristic), an operation in a rule's body, an alternative or a rule as itself."""
     if type(node) in EXPRESSIONS:
         attrs, rules = (ir.AttrDecl("x", node),), ()
     else:
         alt = node if isinstance(node, ir.Alternative) else ir.Alternative((node,), ir.Num(1.0))
         attrs, rules = (), (node if isinstance(node, ir.Rule) else ir.Rule("a", (), None, (alt,), 0),)
+    objectives = ()
+    if type(node) is ir.Aggregate:  # a design's value: only the search statements read it
+        attrs, objectives = (), (ir.Objective("heuristic", node),)
     diags = Diagnostics()
-    infer_types(ir.Module("g.cga", attrs, rules, rules[0].symbol if rules else None), diags)
+    infer_types(ir.Module("g.cga", attrs, rules, rules[0].symbol if rules else None, objectives=objectives), diags)
     return [(d.span, d.message) for d in diags if d.is_error]
 
 
@@ -291,3 +294,28 @@ def test_array_types_follow_their_elements_and_indices():
 ])
 def test_array_type_errors(text, expected):
     assert cityengine_errors(text) == expected
+
+
+@pytest.mark.parametrize("text, expected", [
+    ('a ~> S(count("b"), 1, 1) b', (1, 8, ('`count` of "b" is a value of a whole design: only `goal:`, '
+                                          '`heuristic:` and `prune:` read it'))),
+    ("a ~> b\ngoal: choose(1, 2) > 1", (2, 7, "`choose` makes the consequents of a rule, not of a search statement")),
+    ('a ~> S(choose(1, "x"), 1, 1) b', (1, 8, "the options of `choose` give a num and a str")),
+    ('a ~> b\ngoal: sum(count("b") of "b") > 1', (2, 7, "an aggregate inside `sum`: it reads one shape's values")),
+    ('a ~> b\ncost: count("b")', (2, 7, ('`count` of "b" is a value of a whole design: only `goal:`, '
+                                        '`heuristic:` and `prune:` read it'))),
+    ("a ~> b\nheuristic: true", (2, 12, "the heuristic must be a num, got a bool")),
+    ("attr d = choose(2, 3)\na ~> b", (1, 10, ("`choose` in the default of `d`: a lot's attribute is neither a "
+                                           "design's choice nor its value; write it in a rule"))),
+    ("a ~> b\ngoal: 1", (2, 7, "the goal must be a bool, got a num")),
+    ('a ~> b\ngoal: min(Scope.sx > 1 of "b") > 1', (2, 20, "the value `min` aggregates must be a num, got a bool")),
+])
+def test_search_statement_errors(text, expected):
+    assert expected in errors(text)
+
+
+def test_search_statements_read_attributes_and_aggregates():
+    module, diags = typed('attr rooms = 2\na ~> b\ngoal: count("b") == rooms && mean(Scope.sx of "b") > 1\n'
+                          "cost: Scope.sx\nprune: count(Scope.sx > 3 of \"b\") > 0\nheuristic: 0")
+    assert not diags.has_errors
+    assert [o.kind for o in module.objectives] == ["goal", "cost", "prune", "heuristic"]

@@ -179,3 +179,14 @@ def test_parse_size():
     for bad in ("320", "x200", "320x-2", "axb", "0x10"):
         with pytest.raises(UsageError):
             parse_size(bad)
+
+
+def test_a_search_records_solutions_are_drawn_side_by_side(tmp_path):
+    from grammarc.render.picture import _side_by_side
+
+    # three solutions of one 4 x 6 lot, one over the other: laid out on a grid of two columns
+    xform = np.stack([box_xform((0, 0, 0), (4, 0, 6))] * 3).astype(np.float64)
+    record = {"lot": np.array([0, 1, 2]), "meta": {"search": {}}}
+    moved, _ = _side_by_side(record, xform, np.zeros((0, 3)))
+    np.testing.assert_allclose(moved[:, :, 3], [[0, 0, 0], [4.8, 0, 0], [0, 0, 7.2]])
+    np.testing.assert_array_equal(moved[:, :, :3], xform[:, :, :3])

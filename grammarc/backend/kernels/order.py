@@ -46,3 +46,28 @@ def tally(counts, lot, weights):
         counts[lot[i]] += w
         added += w
     return added
+
+
+@njit(cache=True, nogil=True)
+def rank_in_group(group, k):
+    """Each row's number among the rows of its group before it, for groups in [0, k): one pass with a
+    counter per group. group [5, 3, 5, 5], k 6 -> [0, 0, 1, 2]."""
+    seen = np.zeros(k, np.int64)
+    rank = np.empty(len(group), np.int64)
+    for i in range(len(group)):
+        rank[i] = seen[group[i]]
+        seen[group[i]] += 1
+    return rank
+
+
+@njit(cache=True, nogil=True)
+def fold_groups(group, values, total, counted, low, high):
+    """Add ``values`` (n,) to their groups' (k,) sum ``total``, count ``counted``, least ``low`` and
+    greatest ``high``, in place: the aggregates of a group in one pass."""
+    for i in range(len(group)):
+        g = group[i]
+        v = values[i]
+        total[g] += v
+        counted[g] += 1.0
+        low[g] = min(low[g], v)
+        high[g] = max(high[g], v)

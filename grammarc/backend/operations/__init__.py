@@ -10,6 +10,7 @@ columns:
 - ``scope``: ``T S R``, ``extrude``, the scope alignments, ``mirror``, ``center``;
 - ``splits``: ``Subdiv``/``Repeat``, CityEngine's ``split``, ``Snap``;
 - ``component_splits``: ``Comp``, ``comp(f|e|v)``;
+- ``cuts``: ``Cut``, a footprint divided by a line between two of its edges (the ice-ray grammar);
 - ``faces``: ``offset``, ``setback``, ``setbackToArea``, ``innerRectangle``, ``convexify``, roofs, ``taper``,
   ``cleanupGeometry``;
 - ``inserts``: ``I``, ``i``, ``label``;
@@ -31,6 +32,7 @@ from grammarc.backend.operations import (  # noqa: F401 - each registers its ope
     along_uv,
     component_splits,
     control,
+    cuts,
     faces,
     inserts,
     primitives,

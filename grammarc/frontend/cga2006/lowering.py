@@ -9,7 +9,7 @@ construct" at its span.
 
 from __future__ import annotations
 
-from lark import v_args
+from lark import Token, v_args
 
 from grammarc.diagnostics import Span, suggest
 from grammarc.frontend.cga2006.nodes import ContinuationStatement, PriorityStatement, Relative, RuleStatement
@@ -76,6 +76,19 @@ class Lowering(OperationLowering, LoweringBase):
     def alternative(self, meta, arrow, body, prob):
         return ir.Alternative(body, self.expr(prob) if prob is not None else None, self.span(meta))
 
+    def choice_alternative(self, meta, arrow, body):
+        """``~> successor ?``: one of a set of consequents."""
+        return ir.Alternative(body, None, self.span(meta), choice=True)
+
+    def objective(self, meta, name, expr):
+        """``goal: expr`` and the other search statements; any other ``name: expr`` lacks its successor."""
+        if str(name) not in ir.OBJECTIVES:
+            self.diags.error("syntax", f"`{name}: ...` is neither a rule (it has no `~>` successor) nor a "
+                             f"search statement ({', '.join(f'`{k}:`' for k in ir.OBJECTIVES)})",
+                             self.token_span(name))
+            return None  # nothing to assemble
+        return ir.Objective(str(name), self.expr(expr), self.token_span(name))
+
     # -------------------------------------------------------------------------------------- successors
     def successor(self, meta, *items):
         # `[` and `]` pair up within one successor (a split part is a successor of its own)
@@ -137,6 +150,9 @@ class Lowering(OperationLowering, LoweringBase):
             return self.occlusion(f"{head}.{field}", args or (), span)
         if (str(head), str(field)) == ("Shape", "visible"):
             return self.visible(tuple(self.expr(a) for a in args or ()), span)
+        if str(head) == "geometry" and f"{head}.{field}" in FUNCTIONS:  # CityEngine's queries of the geometry
+            return self.function(meta, Token("NAME", f"{head}.{field}", head.start_pos, head.line, head.column,
+                                             field.end_line, field.end_column, head.end_pos), args)
         self.diags.error("unknown-function", f"unknown function `{head}.{field}`", span)
         return ir.placeholder(span)
 
@@ -163,10 +179,26 @@ class Lowering(OperationLowering, LoweringBase):
         return ir.Occlusion("occ", "all", label, span, parents=which != "noparent", active=which == "active",
                             distance=distance)
 
+    def aggregate(self, meta, name, value, symbol):
+        """``sum(Scope.sx of "room")``: an aggregate of a design."""
+        span = self.token_span(name)
+        if str(name) not in ir.AGGREGATES or str(name) in ("area", "volume"):
+            self.diags.error("unknown-function", f"`{name}(... of \"symbol\")` is not an aggregate: "
+                             "count, sum, min, max and mean take a value of each shape", span)
+            return ir.placeholder(span)
+        return ir.Aggregate(str(name), str(symbol)[1:-1], self.expr(value), span)
+
     def function(self, meta, name, args):
         span = self.token_span(name)
         args = tuple(self.expr(a) for a in (args or ()))
         func = str(name)
+        if func == "choose":
+            if len(args) < 1:
+                self.diags.error("arity", "`choose` takes one value or more", span)
+                return ir.placeholder(span)
+            return ir.Choose(args, span, self.site())
+        if func in ("count", "area", "volume") and len(args) == 1 and isinstance(args[0], ir.Str):
+            return ir.Aggregate(func, args[0].value, None, span)
         signature = FUNCTIONS.get(func)
         if signature is None:
             self.diags.error("unknown-function",

@@ -44,4 +44,4 @@ class PriorityStatement:
     span: Span
 
 
-Statement = RuleStatement | ContinuationStatement | PriorityStatement | ir.AttrDecl
+Statement = RuleStatement | ContinuationStatement | PriorityStatement | ir.AttrDecl | ir.Objective

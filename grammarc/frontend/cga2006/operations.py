@@ -1,5 +1,5 @@
 """The operations of the paper notation lowered to IR operations: scope rules (``T``, ``S``, ``R``), inserts
-(``I``), splits (``Subdiv``, ``Repeat``, ``Comp``), roofs and snap planes. ``OperationLowering`` is the
+(``I``), splits (``Subdiv``, ``Repeat``, ``Comp``, ``Cut``), roofs and snap planes. ``OperationLowering`` is the
 mixin of ``lowering.Lowering`` with a handler per operation that needs one; ``OPERATIONS`` and
 ``PART_OPERATIONS`` (calls with a body ``{ A | B }``) map names to handlers, or to ``direct`` where the
 arguments are the IR node's fields.
@@ -171,6 +171,18 @@ class OperationLowering:
         index = self.expr(args[1]) if len(args) == 2 else None
         return ir.Comp(kind, index, parts, span, self.site())
 
+    def op_cut(self, op, args, parts, span):
+        """``Cut(e1, t1, e2, t2){ A | B }``: a polygon divided by a line between two of its edges."""
+        parts = self.expect_parts(op, parts, span)
+        if not self.arity(op, args, (4,), span):
+            return ir.Empty(span)
+        if len(parts) != 2:
+            self.diags.error("arity", f"`{op}` makes two pieces: its body has two parts `{{ A | B }}`, "
+                             f"got {len(parts)}", span)
+            return ir.Empty(span)
+        e1, t1, e2, t2 = (self.expr(a) for a in args)
+        return ir.Cut((e1, e2), (t1, t2), parts, span, self.site())
+
     def op_roof(self, op, args, parts, span):
         """``Roof(type, angle){ part }`` (paper section 3.1): a roof over the scope's footprint, its
         part applied to the roof. Lowered to the roof, then the part's operations; the part is optional."""
@@ -214,4 +226,5 @@ PART_OPERATIONS = {
     "Repeat": OperationLowering.op_repeat,
     "Comp": OperationLowering.op_comp,
     "Roof": OperationLowering.op_roof,
+    "Cut": OperationLowering.op_cut,
 }

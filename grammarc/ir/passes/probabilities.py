@@ -1,7 +1,7 @@
 """Stochastic rules: every alternative of a rule with several has a probability, and they sum to 1.
 
 Assumes: constants folded, so that ``1/3`` is a number here. Guarantees: a rule with one alternative and no
-probability gets probability 1; constant probabilities are non-negative and sum to 1 within
+probability gets probability 1, the ``?`` consequents of a rule (``ir.Alternative.choice``) each 1/n; constant probabilities are non-negative and sum to 1 within
 ``TOL.probability``. Probabilities that depend on attributes are checked per shape when derived.
 """
 
@@ -18,6 +18,16 @@ def check_probabilities(module: ir.Module, diags: Diagnostics) -> ir.Module:
     rules = []
     for rule in module.rules:
         alts = rule.alternatives
+        chosen = [a for a in alts if a.choice]
+        if chosen and len(chosen) != len(alts):
+            diags.error("probability", f"rule `{rule.symbol}` mixes `?` consequents with probabilities",
+                        next(a for a in alts if not a.choice).span,
+                        hint="a rule's alternatives are either all `?` or all `: probability`")
+            # reported once: the `?` ones stand in with an error's placeholder for their probability
+            alts = tuple(replace(a, choice=False, prob=ir.placeholder(a.span) if a.prob is None else a.prob)
+                         for a in alts)
+        elif chosen:  # a build takes one of the consequents, all equally likely
+            alts = tuple(replace(a, prob=ir.Num(1.0 / len(alts), a.span)) for a in alts)
         if len(alts) == 1 and alts[0].prob is None:
             alts = (replace(alts[0], prob=ir.Num(1.0, alts[0].span)),)
         missing = [a for a in alts if a.prob is None]

@@ -15,7 +15,7 @@ from itertools import count
 from grammarc.diagnostics import Diagnostics, suggest
 from grammarc.ir import nodes as ir
 from grammarc.ir.functions import FUNCTIONS
-from grammarc.ir.traverse import iter_exprs, iter_ops, rewrite_expr, rewrite_rule
+from grammarc.ir.traverse import iter_exprs, iter_ops, rewrite_expr, rewrite_node, rewrite_rule
 
 
 def resolve_names(module: ir.Module, diags: Diagnostics) -> ir.Module:
@@ -43,9 +43,13 @@ def resolve_names(module: ir.Module, diags: Diagnostics) -> ir.Module:
                               rule.span)
         rules.append(rewrite_rule(rule, _resolver(params, all_attrs, diags, f"rule `{rule.symbol}`", sites)))
         _check_set_targets(rule, module, diags)
-    if all(a is b for a, b in zip(attrs, module.attrs)) and all(a is b for a, b in zip(rules, module.rules)):
+    # a search statement reads the design's aggregates and the lot's attributes, no rule's parameters
+    objectives = tuple(rewrite_node(o, _resolver({}, all_attrs, diags, f"`{o.kind}:`", sites))
+                       for o in module.objectives)
+    if all(a is b for a, b in zip(attrs, module.attrs)) and all(a is b for a, b in zip(rules, module.rules)) \
+            and all(a is b for a, b in zip(objectives, module.objectives)):
         return module
-    return replace(module, attrs=tuple(attrs), rules=tuple(rules))
+    return replace(module, attrs=tuple(attrs), rules=tuple(rules), objectives=objectives)
 
 
 def _check_cycles(attrs: list[ir.AttrDecl], diags: Diagnostics) -> None:

@@ -21,7 +21,7 @@ from dataclasses import replace
 from grammarc.diagnostics import Diagnostics
 from grammarc.ir import nodes as ir
 from grammarc.ir.functions import ARRAY_FUNCTIONS, FUNCTIONS
-from grammarc.ir.traverse import all_exprs, expr_fields, field_exprs, iter_nodes, iter_ops
+from grammarc.ir.traverse import all_exprs, expr_fields, field_exprs, iter_exprs, iter_nodes, iter_ops
 
 T = ir.Type
 
@@ -35,6 +35,12 @@ def infer_types(module: ir.Module, diags: Diagnostics) -> ir.Module:
     attrs = []
     for attr in module.attrs:
         t = type_of(attr.default, attr_types, (), diags)
+        for expr in iter_exprs(attr.default):
+            if isinstance(expr, (ir.Choose, ir.Aggregate)):
+                diags.error("choose" if isinstance(expr, ir.Choose) else "aggregate",
+                            f"`{'choose' if isinstance(expr, ir.Choose) else expr.func}` in the default of "
+                            f"`{attr.name}`: a lot's attribute is neither a design's choice nor its value; "
+                            "write it in a rule", expr.span)
         attr_types[attr.name] = t
         attrs.append(replace(attr, type=t))
 
@@ -51,7 +57,25 @@ def infer_types(module: ir.Module, diags: Diagnostics) -> ir.Module:
                     got = type_of(expr, attr_types, params, diags)
                 if got.is_array and (want is None or want.is_array) and type(node) not in TAKE_ARRAYS:
                     diags.error("unsupported", f"unsupported: an array as {what}", expr.span)
+        _check_search_exprs(all_exprs(rule), design=False, diags=diags)
+    for objective in module.objectives:
+        _expect(objective.expr, ir.OBJECTIVES[objective.kind], f"the {objective.kind}", attr_types, (), diags)
+        _check_search_exprs(iter_exprs(objective.expr), design=objective.kind != "cost", diags=diags)
     return replace(module, attrs=tuple(attrs), param_types=tuple(sorted(param_types.items())))
+
+
+def _check_search_exprs(exprs, *, design: bool, diags: Diagnostics) -> None:
+    """Aggregates are values of a whole design: only ``goal:``, ``heuristic:`` and ``prune:`` read them, and
+    not inside one another; ``choose`` makes consequents of a rule, never of a search statement."""
+    for expr in exprs:
+        if isinstance(expr, ir.Aggregate) and not design:
+            diags.error("aggregate", f"`{expr.func}` of \"{expr.symbol}\" is a value of a whole design: only "
+                        "`goal:`, `heuristic:` and `prune:` read it", expr.span)
+        elif isinstance(expr, ir.Aggregate) and expr.value is not None and any(
+                isinstance(e, ir.Aggregate) for e in iter_exprs(expr.value)):
+            diags.error("aggregate", f"an aggregate inside `{expr.func}`: it reads one shape's values", expr.span)
+        elif isinstance(expr, ir.Choose) and design:
+            diags.error("choose", "`choose` makes the consequents of a rule, not of a search statement", expr.span)
 
 
 def _wanted(node, attr_types, param_types) -> Iterator[tuple[ir.Expr, ir.Type | None, str]]:
@@ -225,6 +249,16 @@ _LEAVES = {
 }
 
 
+def _same(expr, got: list[ir.Type], diags: Diagnostics, what: str) -> ir.Type:
+    """The one type of values that must have one (``choose``'s options)."""
+    known = [t for t in got if t is not T.UNKNOWN]
+    if any(t is not known[0] for t in known):
+        diags.error("type", f"{what} give a {known[0].value} and a "
+                    f"{next(t for t in known if t is not known[0]).value}", expr.span)
+        return T.UNKNOWN
+    return known[0] if known else T.UNKNOWN
+
+
 def _select(expr: ir.Select, got: list[ir.Type], diags: Diagnostics) -> ir.Type:
     _, then, other = got
     if T.UNKNOWN not in (then, other) and then is not other:
@@ -370,6 +404,8 @@ def _call(expr: ir.Call, got: list[ir.Type], diags: Diagnostics) -> ir.Type:
 
 #: The types of expressions with children, from the children's types.
 _RESULTS = {
+    ir.Choose: lambda e, got, diags: _same(e, got, diags, "the options of `choose`"),
+    ir.Aggregate: lambda e, got, diags: T.NUM,
     ir.Occlusion: lambda e, got, diags: T.STR if e.kind == "occ" else T.NUM if e.kind in ir.CONTEXT_KINDS \
     else T.BOOL,  # inside, overlaps, touches, visible; minimumDistance, contextCount
     ir.Select: _select,
