@@ -19,8 +19,8 @@ from grammarc.backend import terminals
 from grammarc.backend.choices import consequent
 from grammarc.backend.context import Context
 from grammarc.backend.evaluate import evaluate_array
-from grammarc.backend.fusion.run import FusedBatch
-from grammarc.backend.fusion.run import derive as derive_fused
+from grammarc.backend.fusion.fused import FusedBatch
+from grammarc.backend.fusion.fused import derive as derive_fused
 from grammarc.backend.occlusion import add_occluders
 from grammarc.backend.operations import OPERATIONS, Parts
 from grammarc.backend.operations.scope import center

@@ -5,10 +5,10 @@ records, with no shape columns between their operations ("compile, don't interpr
 inserts: the whitelist) and which of their successors can be derived with them; ``codegen`` writes a
 region's kernel, run in two passes (count the records each site makes; write them at offsets from a
 cumulative sum), and the order its records are due in; ``compiled`` keeps the generated modules in the
-user's cache folder, so that numba's cache keeps their machine code; ``run`` derives a root's pending batch
+user's cache folder, so that numba's cache keeps their machine code; ``fused`` derives a root's pending batch
 with them.
 ``backend.plan`` finds the regions (this module: nothing here imports the derivation, which imports the
-plan); ``backend.execute`` hands a region root's shapes to ``run.derive`` and falls back to the interpreter
+plan); ``backend.execute`` hands a region root's shapes to ``fused.derive`` and falls back to the interpreter
 where it declines; the interpreter derives everything else.
 
 The records are the interpreter's, bit for bit and in the same order. Bits: the kernels do the
@@ -19,7 +19,7 @@ records of one emission site (an ``I`` reached through given parts of given spli
 order of the batch, which is the order of the root's shapes and, within one, of the children of each split
 (a split's part holds its children in their parents' order). The kernel writes site by site in that order;
 the records of a site in an inlined symbol's rules are emitted when the schedule reaches that symbol
-(``run.FusedBatch``), where the interpreter would have emitted them. ``GRAMMARC_FUSION=off`` derives with
+(``fused.FusedBatch``), where the interpreter would have emitted them. ``GRAMMARC_FUSION=off`` derives with
 the interpreter alone. A kernel is compiled once (numba's cache keeps it), when enough shapes have come to
 pay for its compilation; a compiled one then serves every batch.
 """

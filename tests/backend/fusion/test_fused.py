@@ -11,8 +11,8 @@ import pytest
 from conftest import make_lots
 
 from grammarc.backend import execute
+from grammarc.backend.fusion.fused import derive as derive_fused
 from grammarc.backend.fusion.regions import SWITCH
-from grammarc.backend.fusion.run import derive as derive_fused
 from grammarc.backend.plan import make_plan
 from grammarc.build import BuildOptions, derive
 from grammarc.compiler import compile_grammar
