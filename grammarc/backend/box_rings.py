@@ -10,9 +10,10 @@ one ``Shapes.dynamic`` column (``slots.RING_START``) that the plan adds only whe
 scopes and numbers edges or cuts faces (``plan.renumbers_boxes``). Elsewhere every box starts at corner 0,
 as it did before.
 
-Every consumer of a box's ring takes it from ``box_rings`` (``outlines.polygons_of``, ``setback``'s faces,
-component splits), and every operation that makes a box from a polygon or a piece notes where the
-polygon's ring started (``corners_of``): ``backend.reframing``, the pieces of splits, setbacks and offsets,
+Every consumer of a box's ring takes it from ``geometry.components.rect_rings`` with the box's corner
+(``outlines.polygons_of``, ``setback``'s faces, component splits, ``alignScopeToGeometry``'s edges), and
+every operation that makes a box from a polygon or a piece notes where the polygon's ring started
+(``geometry.components.rect_corners``): ``backend.reframing``, the pieces of splits, setbacks and offsets,
 the caps of component splits. A split cuts a box whose ring starts elsewhere than corner 0 as its polygon
 (``as_polygons``), so that its pieces start where PRT's do.
 """
@@ -26,7 +27,7 @@ import numpy as np
 
 from grammarc.backend.shapes import Shapes
 from grammarc.constants import TOL
-from grammarc.geometry.components import RECT_RINGS, rect_plane
+from grammarc.geometry.components import rect_corners, rect_plane, rect_rings
 
 if TYPE_CHECKING:
     from grammarc.backend.chunk import Chunk
@@ -50,27 +51,11 @@ def with_corners(plan: Plan, shapes: Shapes, corner: np.ndarray | int) -> Shapes
     return replace(shapes, dynamic=tuple(dynamic))
 
 
-def box_rings(plane: np.ndarray, corner: np.ndarray | None = None) -> np.ndarray:
-    """The rings of boxes in planes ``plane`` (n,) starting at ``corner`` (n,) (None: corner 0), one
-    after another: (4 n, 2) normalized coordinates."""
-    if corner is None:
-        return RECT_RINGS[plane].reshape(-1, 2)
-    turn = (np.arange(4)[None, :] + np.asarray(corner, dtype=np.int64)[:, None]) % 4
-    return RECT_RINGS[np.asarray(plane, dtype=np.int64)[:, None], turn].reshape(-1, 2)
-
-
-def corners_of(first: np.ndarray, plane: np.ndarray) -> np.ndarray:
-    """The corners (n,) int64 of the implicit rings of planes ``plane`` (n,) nearest each ring's first
-    vertex ``first`` (n, 2) (normalized coordinates): where a rectangle's ring starts, as its box's."""
-    rings = RECT_RINGS[np.asarray(plane, dtype=np.int64)]  # (n, 4, 2)
-    return np.argmin(((rings - np.asarray(first)[:, None, :]) ** 2).sum(axis=2), axis=1)
-
-
 def piece_corners(pieces) -> np.ndarray:
     """The corners (k,) that pieces (``geometry.clip.Clipped``) kept as boxes start their rings at (0 for
     the others): where each rectangle's ring starts, as cutting or moving it in left it."""
     first = pieces.coords[pieces.ring_offsets[pieces.poly_offsets[:-1]]]
-    return np.where(pieces.is_rect, corners_of(first, pieces.plane), 0)
+    return np.where(pieces.is_rect, rect_corners(first, pieces.plane), 0)
 
 
 def as_polygons(plan: Plan, chunk: Chunk, shapes: Shapes, axis: int) -> Shapes:
@@ -85,7 +70,7 @@ def as_polygons(plan: Plan, chunk: Chunk, shapes: Shapes, axis: int) -> Shapes:
         return shapes
     plane = plane[rows]
     geom = shapes.geom.copy()
-    geom[rows] = chunk.polygons.add(box_rings(plane, corner[rows]),
+    geom[rows] = chunk.polygons.add(rect_rings(plane, corner[rows]),
                                     np.arange(0, 4 * len(rows) + 1, 4, dtype=np.int64),
                                     np.arange(len(rows) + 1, dtype=np.int64), plane)
     return replace(shapes, geom=geom)

@@ -14,7 +14,7 @@ from dataclasses import replace
 import numpy as np
 
 from grammarc.backend import mesh_shapes
-from grammarc.backend.box_rings import box_rings, piece_corners, with_corners
+from grammarc.backend.box_rings import piece_corners, with_corners
 from grammarc.backend.chunk import Chunk
 from grammarc.backend.context import Context
 from grammarc.backend.kernels import scope as scope_kernels
@@ -24,6 +24,7 @@ from grammarc.backend.shapes import Shapes
 from grammarc.backend.streams import piece_keys
 from grammarc.constants import TOL
 from grammarc.geometry.clip import clip_to_slabs
+from grammarc.geometry.components import rect_rings
 from grammarc.geometry.meshes import MESH_BASE, is_mesh, is_polygon
 from grammarc.geometry.polygons import PLANE_U, PLANE_V
 from grammarc.ragged import ragged_take, segment_of
@@ -124,7 +125,8 @@ def fill_slabs(chunk: Chunk, shapes: Shapes, axis: int, parent, pos, length, geo
         rects = np.flatnonzero(geom[polygons] < 0)
         ids = geom[polygons].astype(np.int64)
         if len(rects):
-            ids[rects] = store.add(box_rings(plane[rects], corner[polygons[rects]]), np.arange(0, 4 * len(rects) + 1, 4, dtype=np.int64),
+            ids[rects] = store.add(rect_rings(plane[rects], corner[polygons[rects]]),
+                                   np.arange(0, 4 * len(rects) + 1, 4, dtype=np.int64),
                                    np.arange(len(rects) + 1, dtype=np.int64), plane[rects])
         coords, ring_offsets, poly_offsets = store.gather(ids)
         vertex_piece = segment_of(poly_offsets)[segment_of(ring_offsets)]

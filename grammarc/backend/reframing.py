@@ -11,10 +11,11 @@ from __future__ import annotations
 import numpy as np
 
 from grammarc.backend import mesh_shapes
-from grammarc.backend.box_rings import corners, corners_of, with_corners
+from grammarc.backend.box_rings import corners, with_corners
 from grammarc.backend.context import Context
 from grammarc.backend.outlines import polygons_of
 from grammarc.backend.shapes import Shapes
+from grammarc.geometry.components import rect_corners
 from grammarc.geometry.meshes import is_mesh
 from grammarc.geometry.reframe import reframe
 from grammarc.ragged import ragged_take
@@ -63,7 +64,7 @@ def reframed(ctx: Context, shapes: Shapes, new_axes: np.ndarray, span) -> Shapes
     result = shapes.with_scope(origin, size, chunk.frames.add(np.ascontiguousarray(new_axes)), geom)
     if ctx.plan.ring_slot is not None:  # a rectangle kept as its box keeps its ring's first vertex
         result = with_corners(ctx.plan, result, np.where(
-            is_rect, corners_of(new_coords[ring_offsets[shape_offsets[:-1]]], plane), 0))
+            is_rect, rect_corners(new_coords[ring_offsets[shape_offsets[:-1]]], plane), 0))
     if ok.all():
         return result
     # Turned out of their polygon's plane (a prism onto a side face, a face tilted): their faces as meshes.

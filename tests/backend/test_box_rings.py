@@ -6,12 +6,8 @@ the tier's remainder, its roof at 20 m."""
 
 from __future__ import annotations
 
-import numpy as np
 import pytest
 from operations.derivations import assets, mesh_faces, rect, run, totals
-
-from grammarc.backend.box_rings import box_rings, corners_of
-from grammarc.geometry.components import RECT_RINGS
 
 #: massing's orientation and tier rules, on one footprint rule (``{footprint}``) and its per-edge distances.
 MASSING = """
@@ -38,14 +34,6 @@ def test_a_turned_rectangle_keeps_its_edge_numbers(write, footprint, distances, 
     text = MASSING.format(orientation=orientation, footprint=footprint, distances=distances)
     assert totals(run(write, text, [rect(30, 10)])).get("r_sum", 0.0) == pytest.approx(remainder)
 
-
-def test_a_box_ring_starts_at_its_corner():
-    """The corner a box's ring starts at is read off its first vertex, and its ring turned to start there."""
-    for plane in range(3):
-        for corner in range(4):
-            ring = box_rings(np.array([plane]), np.array([corner]))
-            assert corners_of(ring[:1], np.array([plane])).tolist() == [corner]
-            np.testing.assert_array_equal(ring, np.roll(RECT_RINGS[plane], -corner, axis=0))
 
 
 def test_a_turned_rectangle_is_still_a_quad_record(write):

@@ -16,7 +16,7 @@ from dataclasses import replace
 import numpy as np
 
 from grammarc.backend import mesh_shapes
-from grammarc.backend.box_rings import box_rings, corners, corners_of, with_corners
+from grammarc.backend.box_rings import corners, with_corners
 from grammarc.backend.children import with_context
 from grammarc.backend.context import Context
 from grammarc.backend.evaluate import evaluate_array
@@ -206,10 +206,10 @@ def _box_corners(poly: np.ndarray, plane: np.ndarray, geom: np.ndarray, parent: 
     for code, flip_where in ((comp_kernels.TOP_POLY, True), (comp_kernels.BOTTOM_POLY, False)):
         rows = np.flatnonzero((poly == code) & (geom[parent] == -1))
         if len(rows):
-            first = box_rings(plane[parent[rows]], corner[parent[rows]])[::4].copy()
+            first = comp_kernels.rect_rings(plane[parent[rows]], corner[parent[rows]])[::4].copy()
             flip = (plane[parent[rows]] == 1) == flip_where
             first[flip, 1] = 1.0 - first[flip, 1]
-            out[rows] = corners_of(first, np.full(len(rows), 2))
+            out[rows] = comp_kernels.rect_corners(first, np.full(len(rows), 2))
     return out
 
 

@@ -21,7 +21,7 @@ import numpy as np
 import shapely
 
 from grammarc.backend import mesh_shapes
-from grammarc.backend.box_rings import box_rings, corners, piece_corners, with_corners
+from grammarc.backend.box_rings import corners, piece_corners, with_corners
 from grammarc.backend.children import with_context
 from grammarc.backend.context import Context
 from grammarc.backend.evaluate import evaluate_array
@@ -562,7 +562,7 @@ def face_polygons(ctx: Context, cursor: Shapes, what: str, span) -> tuple[np.nda
     if len(rects):
         plane = comp_kernels.rect_plane(cursor.size[rects], TOL.zero)
         corner = corners(ctx.plan, cursor)
-        geom[rects] = store.add(box_rings(plane, None if corner is None else corner[rects]),
+        geom[rects] = store.add(comp_kernels.rect_rings(plane, None if corner is None else corner[rects]),
                                 np.arange(0, 4 * len(rects) + 1, 4, dtype=np.int64),
                                 np.arange(len(rects) + 1, dtype=np.int64), plane)
     return scope_polygons(store, geom, cursor.size), store.plane[geom]
