@@ -432,7 +432,7 @@ def align_to_geometry(ctx: Context, cursor: Shapes, op: ir.AlignToGeometry) -> S
     n = len(cursor)
     env = ctx.env(cursor)
     axes = chunk.frames[cursor.frame]
-    faces = shape_faces(cursor.size, cursor.geom, chunk.polygons, chunk.meshes)
+    faces = shape_faces(cursor.size, cursor.geom, chunk.polygons, chunk.meshes, corners(ctx.plan, cursor))
     # world-oriented offsets from each scope's origin: a shape's own shift does not change its choices
     verts = np.einsum("vi,vij->vj", faces.verts, axes[faces.vertex_shape()])
     vector = face_shapes(verts, faces.ring_offsets, faces.face_offsets)[0]
