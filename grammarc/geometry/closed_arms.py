@@ -17,6 +17,7 @@ import shapely
 from numba import njit
 
 from grammarc.geometry.clip import open_rings, polygons_from_rings
+from grammarc.ragged import offsets_from_counts
 
 #: How far (scope units, metres) a vertex may lie off its run, or an edge off its moved line.
 TOLERANCE = 1e-6
@@ -25,12 +26,13 @@ TOLERANCE = 1e-6
 @njit(cache=True, nogil=True)
 def _edge_of(ax, ay, bx, by, g, parent_coords, parent_rings, parent_offsets, distance, tolerance):
     """The edge of polygon g's outer ring that the inset edge a -> b was moved in from (parallel, in its
-    direction, ``distance`` inside it), the one whose span it overlaps most; -1 for none."""
+    direction, ``distance`` inside it), the one whose span it overlaps most; -1 for none (an edge of no
+    length, or one whose span it does not overlap)."""
     q0, q1 = parent_rings[parent_offsets[g]], parent_rings[parent_offsets[g] + 1]
     n = q1 - q0
     dx, dy = bx - ax, by - ay
     length = np.hypot(dx, dy)
-    best, overlap = -1, -np.inf
+    best, overlap = -1, tolerance
     if length <= tolerance:
         return best
     for e in range(n):
@@ -77,10 +79,12 @@ def _bisector_point(ax, ay, ux, uy, g, side_a, side_b, parent_coords, parent_rin
 def place_closed_arm_vertices(coords, ring_offsets, ring_poly, parent_coords, parent_rings, parent_offsets,
                               distance, tolerance):
     """The inset rings' coords (V, 2) (counter-clockwise outer rings, ``ring_poly`` (R,) their polygons, -1
-    for holes) with each vertex between the moved parts of two edges on one line, an arm closed between
-    them, moved along that line onto the bisector of the arm's side lines (see the module); ``distance``
-    (G,) each polygon's inset distance, the parents' outer rings counter-clockwise."""
+    for holes) with the vertices between the moved parts of two edges on one line, an arm closed between
+    them, made one vertex on the bisector of the arm's side lines (see the module), and which vertices
+    stay (V,) bool (GEOS leaves a vertex where each moved side crossed the line, and repeats some);
+    ``distance`` (G,) each polygon's inset distance, the parents' outer rings counter-clockwise."""
     out = coords.copy()
+    keep = np.ones(len(coords), np.bool_)
     for r in range(len(ring_offsets) - 1):
         g = ring_poly[r]
         if g < 0:
@@ -88,43 +92,42 @@ def place_closed_arm_vertices(coords, ring_offsets, ring_poly, parent_coords, pa
         r0, r1 = ring_offsets[r], ring_offsets[r + 1]
         m = r1 - r0
         n = parent_rings[parent_offsets[g] + 1] - parent_rings[parent_offsets[g]]
+        source = np.empty(m, np.int64)  # the parent edge each inset edge was moved in from, -1 for none
+        for k in range(m):
+            a, b = r0 + k, r0 + (k + 1) % m
+            source[k] = _edge_of(coords[a, 0], coords[a, 1], coords[b, 0], coords[b, 1], g, parent_coords,
+                                 parent_rings, parent_offsets, distance[g], tolerance)
         for j in range(m):
-            v = r0 + j
-            if _same(coords, v, r0 + (j - 1) % m, tolerance):
-                continue  # the first of a run of coincident vertices (GEOS leaves some) stands for the run
-            last = j  # the run's last vertex, and the vertices before and after it
-            while last - j < m - 1 and _same(coords, v, r0 + (last + 1) % m, tolerance):
+            before = source[(j - 1) % m]
+            if before < 0 or source[j] == before:
+                continue
+            # the run from vertex j over edges from no parent edge to the first from another one
+            last = j
+            while source[last % m] < 0 and last - j < m - 1:
                 last += 1
+            after = source[last % m]
+            if after < 0 or after == before or (after - before) % n < 3:
+                continue  # no arm between the two (an arm has two sides and an end)
             p, w = r0 + (j - 1) % m, r0 + (last + 1) % m
             ax, ay = coords[p, 0], coords[p, 1]
-            bx, by = coords[w, 0], coords[w, 1]
-            dx, dy = bx - ax, by - ay
+            dx, dy = coords[w, 0] - ax, coords[w, 1] - ay
             length = np.hypot(dx, dy)
             if length <= tolerance:
                 continue
             ux, uy = dx / length, dy / length
-            off = ux * (coords[v, 1] - ay) - uy * (coords[v, 0] - ax)
-            along = (coords[v, 0] - ax) * ux + (coords[v, 1] - ay) * uy
-            if abs(off) > tolerance or along <= tolerance or along >= length - tolerance:
-                continue  # not a vertex on a straight run
-            before = _edge_of(ax, ay, coords[v, 0], coords[v, 1], g, parent_coords, parent_rings, parent_offsets,
-                              distance[g], tolerance)
-            after = _edge_of(coords[v, 0], coords[v, 1], bx, by, g, parent_coords, parent_rings, parent_offsets,
-                             distance[g], tolerance)
-            if before < 0 or after < 0 or (after - before) % n < 3:
-                continue  # one edge, or no arm between the two (an arm has two sides and an end)
+            straight = True
+            for k in range(j, last + 1):
+                v = r0 + k % m
+                straight &= abs(ux * (coords[v, 1] - ay) - uy * (coords[v, 0] - ax)) <= tolerance
+            if not straight:
+                continue
             s = _bisector_point(ax, ay, ux, uy, g, (before + 1) % n, (after - 1) % n, parent_coords,
                                 parent_rings, parent_offsets)
             if tolerance < s < length - tolerance:
-                for k in range(j, last + 1):
-                    out[r0 + k % m, 0], out[r0 + k % m, 1] = ax + s * ux, ay + s * uy
-    return out
-
-
-@njit(cache=True, nogil=True)
-def _same(coords, a, b, tolerance):
-    """Whether vertices a and b coincide."""
-    return abs(coords[a, 0] - coords[b, 0]) <= tolerance and abs(coords[a, 1] - coords[b, 1]) <= tolerance
+                out[r0 + j, 0], out[r0 + j, 1] = ax + s * ux, ay + s * uy
+                for k in range(j + 1, last + 1):
+                    keep[r0 + k % m] = False
+    return out, keep
 
 
 def closed_arm_insets(insets: np.ndarray, polygons: np.ndarray, distance: np.ndarray) -> np.ndarray:
@@ -144,11 +147,12 @@ def closed_arm_insets(insets: np.ndarray, polygons: np.ndarray, distance: np.nda
     part_offsets = np.asarray(part_offsets, dtype=np.int64)
     ring_poly = np.full(len(ring_offsets) - 1, -1, dtype=np.int64)
     ring_poly[part_offsets[:-1]] = part_row  # outer rings only: a hole's vertices stay
-    moved = place_closed_arm_vertices(coords, ring_offsets, ring_poly, parent_coords, parent_rings,
-                                      np.asarray(parent_offsets, dtype=np.int64), distance[rows], TOLERANCE)
-    if np.array_equal(moved, coords):
+    moved, keep = place_closed_arm_vertices(coords, ring_offsets, ring_poly, parent_coords, parent_rings,
+                                            np.asarray(parent_offsets, dtype=np.int64), distance[rows], TOLERANCE)
+    if keep.all() and np.array_equal(moved, coords):
         return insets
-    rebuilt = polygons_from_rings(moved, ring_offsets, part_offsets)
+    counts = np.add.reduceat(keep.astype(np.int64), ring_offsets[:-1]) if len(keep) else np.zeros(0, np.int64)
+    rebuilt = polygons_from_rings(moved[keep], offsets_from_counts(counts), part_offsets)
     out = insets.copy()
     out[rows] = shapely.multipolygons(rebuilt, indices=part_row) if len(parts) != len(rows) or (
         shapely.get_type_id(insets[rows]) != shapely.GeometryType.POLYGON).any() else rebuilt
