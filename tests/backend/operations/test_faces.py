@@ -449,3 +449,34 @@ def test_an_offset_or_setback_beyond_any_coordinate_fails_its_lot(write, select)
             lot_attrs={"d": np.array([-1.0, 1e308, -1e308])})
     reasons = [(b.index, b.reason.split(" in rule")[0]) for b in r["bad"]]
     assert reasons == [(1, f"`{what}` by 1e+308, beyond any coordinate")]
+
+
+#: massing's footprint split and first tier after an offset (the kit's massing rule package, reduced).
+MASSING_SPLIT_TIER = """
+Lot --> offset(-{offset}) comp(f){{ inside : Space }}
+Space --> rotateScope(0, {orientation}, 0) alignScopeToAxes(y) split(z){{ '{coverage} : Footprint | ~1 : NIL }}
+Footprint --> extrude(12.2) comp(f){{ top : Top }}
+Top --> setback(comp(fe){{ all : float(listItem("4;0;4;4;0", comp.index)) }}) {{ all : T | remainder : R }}
+T --> report("t", geometry.area)
+R --> report("r", geometry.area)
+"""
+
+
+@pytest.mark.parametrize("lot, offset, orientation, coverage, terrace, remainder", [
+    ([np.array([[0, 0], [30, 0], [30, 20], [16, 20], [16, 30], [10, 30], [10, 20], [0, 20]], float)],
+     4, 0, 1, 176, 88),
+    ([np.array([[0, 0], [30, 0], [30, 20], [16, 20], [16, 30], [10, 30], [10, 20], [0, 20]], float)],
+     4, 90, 0.5, 88, 44),
+    ([np.array([[14.406894270, -5.510212092], [20.305712965, 6.879814355], [-7.461061809, 20.099412460],
+                [-13.359880504, 7.709386014], [-3.390871145, 2.963199310], [-15.980567771, -23.480514629],
+                [-8.151811715, -27.207739327], [4.437884911, -0.764025388]])], 4.916, 90, 0.204, 11.476, 5.129),
+])
+def test_an_inset_whose_arm_closed_splits_its_run_on_the_arm_centre_line(write, lot, offset, orientation,
+                                                                          coverage, terrace, remainder):
+    """A T's stem that the offset closes leaves a vertex on the bar's inset edge, where the stem's centre
+    line crosses it, and the tier's per-edge setback moves that edge's two parts by edges 2 and 3's
+    distances: PRT's terraces and remainders (the harness's T.18003 last; was: the vertex where a moved
+    side of the stem crosses the edge, 176 / 88 m² became 144 / 120)."""
+    text = MASSING_SPLIT_TIER.format(offset=offset, orientation=orientation, coverage=coverage)
+    t = totals(run(write, text, [lot]))
+    assert (t["t_sum"], t.get("r_sum", 0.0)) == (pytest.approx(terrace, abs=2e-3), pytest.approx(remainder, abs=2e-3))
