@@ -15,9 +15,9 @@ from grammarc.geometry.meshes import is_mesh, is_polygon
 
 def polygons_of(chunk: Chunk, shapes: Shapes, corner: np.ndarray | None = None):
     """Each shape's polygon as batch-local ragged arrays (implicit rectangles for scope shapes, starting at
-    their ``corner`` (n,) as ``box_rings.corners`` gives it, None for corner 0): coords (V, 2) float64 in the plane's
-    units, ring_offsets (R+1,) and shape_offsets (n+1,) int64, and each shape's plane (n,) (the scope axis
-    its polygon is flat across)."""
+    their ``corner`` (n,) as ``box_rings.corners`` gives it, None for corner 0): coords (V, 2) float64 in
+    the plane's units, ring_offsets (R+1,) and shape_offsets (n+1,) int64, and each shape's plane (n,) (the
+    scope axis its polygon is flat across)."""
     polygons = chunk.polygons
     n = len(shapes)
     plane = comp_kernels.rect_plane(shapes.size, TOL.zero)

@@ -147,8 +147,9 @@ def closed_arm_insets(insets: np.ndarray, polygons: np.ndarray, distance: np.nda
     part_offsets = np.asarray(part_offsets, dtype=np.int64)
     ring_poly = np.full(len(ring_offsets) - 1, -1, dtype=np.int64)
     ring_poly[part_offsets[:-1]] = part_row  # outer rings only: a hole's vertices stay
+    parent_offsets = np.asarray(parent_offsets, dtype=np.int64)
     moved, keep = place_closed_arm_vertices(coords, ring_offsets, ring_poly, parent_coords, parent_rings,
-                                            np.asarray(parent_offsets, dtype=np.int64), distance[rows], TOLERANCE)
+                                            parent_offsets, distance[rows], TOLERANCE)
     if keep.all() and np.array_equal(moved, coords):
         return insets
     counts = np.add.reduceat(keep.astype(np.int64), ring_offsets[:-1]) if len(keep) else np.zeros(0, np.int64)

@@ -61,7 +61,8 @@ def shape_faces(size: np.ndarray, geom: np.ndarray, store: PolygonStore, meshes:
         coords, ring_offsets, poly_offsets = store.gather(geom[poly])
         plane = np.concatenate([store.plane[geom[poly]], rect_plane(size[box], TOL.zero)]).astype(np.int8)
         # the scope boxes' implicit rectangles after the polygons, one ring each
-        coords = np.concatenate([coords, rect_rings(plane[len(poly):], None if corner is None else corner[box])])
+        box_corner = None if corner is None else corner[box]
+        coords = np.concatenate([coords, rect_rings(plane[len(poly):], box_corner)])
         ring_offsets = np.concatenate([ring_offsets, ring_offsets[-1] + 4 * np.arange(1, len(box) + 1)])
         poly_offsets = np.concatenate([poly_offsets, poly_offsets[-1] + np.arange(1, len(box) + 1)])
         rows = np.concatenate([poly, box])

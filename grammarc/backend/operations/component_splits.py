@@ -134,7 +134,8 @@ def components(ctx: Context, kind: int, cursor: Shapes, site: int, span, wanted=
     mesh = is_mesh(cursor.geom)
     pieces = []
     if not mesh.all():
-        pieces.append(_solid_components(chunk, kind, cursor, np.flatnonzero(~mesh), corners(ctx.plan, cursor)))
+        pieces.append(_solid_components(chunk, kind, cursor, np.flatnonzero(~mesh),
+                                        corners(ctx.plan, cursor)))
     if mesh.any():
         which = np.flatnonzero(mesh)
         parent, index, origin, axes, size, geom, roof, border = mesh_shapes.mesh_components(
@@ -189,7 +190,8 @@ def _solid_components(chunk, kind: int, cursor: Shapes, which: np.ndarray, corne
     normal = axes[:, 2].copy()
     normal[same] = np.eye(3)[plane[parent[same]]]
     border = ((shapes.size <= TOL.zero).sum(axis=1) >= 1)[parent]
-    return (which[parent], index, origin, axes, size, geom, normal, np.full(len(parent), -1, dtype=np.int32), border,
+    no_roof = np.full(len(parent), -1, dtype=np.int32)
+    return (which[parent], index, origin, axes, size, geom, normal, no_roof, border,
             _box_corners(poly, plane, shapes.geom, parent, corner))
 
 

@@ -180,9 +180,9 @@ def _ridge_roofs(ctx: Context, cursor: Shapes, op: ir.Roof, ridge: np.ndarray, v
     if not len(others):
         return roofed, failed
     rest = cursor.take(others)
-    gables, failed[others] = mesh_shapes.build_roofs(ctx.chunk, rest, op.kind, polygons_of(ctx.chunk, rest, corners(ctx.plan, rest)),
-                                                     value[others], op.by_height, overhang[others],
-                                                     np.zeros(len(others)), None)
+    outlines = polygons_of(ctx.chunk, rest, corners(ctx.plan, rest))
+    gables, failed[others] = mesh_shapes.build_roofs(ctx.chunk, rest, op.kind, outlines, value[others],
+                                                     op.by_height, overhang[others], np.zeros(len(others)), None)
     return Shapes.merge([roofed, gables], [rows, others]), failed
 
 
@@ -512,8 +512,9 @@ def cleanup_geometry(ctx: Context, cursor: Shapes, op: ir.CleanupGeometry) -> Sh
     polygon = np.flatnonzero(is_polygon(geom) | ((geom == -1) & flat))
     if len(polygon):
         shapes = cursor.take(polygon)
-        geom[polygon] = mesh_shapes.clean_polygons(ctx.chunk, shapes, polygons_of(ctx.chunk, shapes, corners(ctx.plan, shapes)),
-                                                   tolerance[polygon], op.component)
+        outlines = polygons_of(ctx.chunk, shapes, corners(ctx.plan, shapes))
+        geom[polygon] = mesh_shapes.clean_polygons(ctx.chunk, shapes, outlines, tolerance[polygon],
+                                                   op.component)
     mesh = np.flatnonzero(is_mesh(cursor.geom))
     if len(mesh):
         geom[mesh] = mesh_shapes.clean_meshes(ctx.chunk, cursor.take(mesh), tolerance[mesh], op.component)
