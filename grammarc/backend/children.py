@@ -14,6 +14,7 @@ from dataclasses import replace
 import numpy as np
 
 from grammarc.backend import mesh_shapes
+from grammarc.backend.box_rings import piece_corners, with_corners
 from grammarc.backend.chunk import Chunk
 from grammarc.backend.context import Context
 from grammarc.backend.kernels import scope as scope_kernels
@@ -34,7 +35,8 @@ def children(ctx: Context, shapes: Shapes, axis: int, parent, index, pos, length
     """Children of a split along ``axis``: the parent's scope moved by ``pos`` and cut to ``length``.
 
     ``order`` (default: as given) picks and orders the children; ``geometry`` (from ``clip``) gives
-    the clipped pieces their own boxes and polygons.
+    the clipped pieces their own boxes and polygons, and the corners the rings of pieces kept as boxes
+    start at (``box_rings``).
     """
     frames = ctx.chunk.frames
     if order is None:
@@ -44,7 +46,7 @@ def children(ctx: Context, shapes: Shapes, axis: int, parent, index, pos, length
         frames.data, axis, order, parent, pos, length, site, index,
     )
     if geometry is not None:
-        is_piece, piece_geom, low, extent = (g[order] for g in geometry)
+        is_piece, piece_geom, low, extent, piece_corner = (g[order] for g in geometry)
         rows = np.flatnonzero(is_piece)
         axes = frames[frame[rows]]
         origin[rows] = shapes.origin[parents[rows]] + np.einsum("ni,nij->nj", low[rows], axes)
@@ -54,6 +56,10 @@ def children(ctx: Context, shapes: Shapes, axis: int, parent, index, pos, length
         key = piece_keys(True, shapes.key[parents], index[order], site)
     made = Shapes(origin, size, frame, geom, lot, key, depth, tuple(p[parents] for p in shapes.params),
                   tuple(d[parents] for d in shapes.dynamic))
+    if geometry is not None and len(rows) and ctx.plan.ring_slot is not None:
+        corner = made.dynamic[ctx.plan.ring_slot].copy()
+        corner[rows] = piece_corner[rows]
+        made = with_corners(ctx.plan, made, corner)
     return with_context(ctx.plan, made, "split", index[order], parents, len(shapes))
 
 
@@ -101,7 +107,7 @@ def fill_slabs(chunk: Chunk, shapes: Shapes, axis: int, parent, pos, length, geo
     """The geometry of ``clip_pieces`` with each piece's box its slab of the parent's scope: a piece that
     does not fill its slab gets its polygon or mesh again, normalized to the slab (a rectangle piece
     becomes a polygon)."""
-    is_piece, geom, low, extent = (g.copy() for g in geometry)
+    is_piece, geom, low, extent, corner = (g.copy() for g in geometry)
     slab_low = np.zeros((len(parent), 3))
     slab_low[:, axis] = pos
     slab_extent = shapes.size[parent].copy()
@@ -119,7 +125,8 @@ def fill_slabs(chunk: Chunk, shapes: Shapes, axis: int, parent, pos, length, geo
         rects = np.flatnonzero(geom[polygons] < 0)
         ids = geom[polygons].astype(np.int64)
         if len(rects):
-            ids[rects] = store.add(rect_rings(plane[rects]), np.arange(0, 4 * len(rects) + 1, 4, dtype=np.int64),
+            ids[rects] = store.add(rect_rings(plane[rects], corner[polygons[rects]]),
+                                   np.arange(0, 4 * len(rects) + 1, 4, dtype=np.int64),
                                    np.arange(len(rects) + 1, dtype=np.int64), plane[rects])
         coords, ring_offsets, poly_offsets = store.gather(ids)
         vertex_piece = segment_of(poly_offsets)[segment_of(ring_offsets)]
@@ -133,7 +140,7 @@ def fill_slabs(chunk: Chunk, shapes: Shapes, axis: int, parent, pos, length, geo
         coords = _renormalized(coords, low[of], extent[of], slab_low[of], slab_extent[of])
         geom[meshes] = (MESH_BASE + chunk.meshes.add(coords, ring_offsets, face_offsets, mesh_offsets)).astype(np.int32)
     low[moved], extent[moved] = slab_low[moved], slab_extent[moved]
-    return is_piece, geom, low, extent
+    return is_piece, geom, low, extent, corner
 
 
 def _renormalized(coords, low, extent, slab_low, slab_extent) -> np.ndarray:
@@ -181,10 +188,11 @@ def clip_pieces(chunk: Chunk, shapes: Shapes, axis: int, parent, step, pos, leng
     pos[is_piece] = clipped.low[piece[is_piece], axis]
     length[is_piece] = clipped.extent[piece[is_piece], axis]
     if len(clipped.source):
-        geometry = (is_piece, new_geom[piece], clipped.low[piece], clipped.extent[piece])
+        geometry = (is_piece, new_geom[piece], clipped.low[piece], clipped.extent[piece],
+                    piece_corners(clipped)[piece])
     else:  # every slab missed its polygon (the parents' holes): only the other children are left
         geometry = (is_piece, np.full(len(rows), -1, dtype=np.int32), np.zeros((len(rows), 3)),
-                    np.zeros((len(rows), 3)))
+                    np.zeros((len(rows), 3)), np.zeros(len(rows), dtype=np.int64))
     if meshes is not None:  # the mesh children keep their cut meshes
         from_mesh = ~is_piece & meshes[0][rows]
         for mine, theirs in zip(geometry, meshes):
@@ -205,9 +213,10 @@ def _clip_meshes(chunk: Chunk, shapes: Shapes, axis: int, parent, step, pos, len
     piece_geom = np.full(n, -1, dtype=np.int32)
     piece_low = np.zeros((n, 3))
     piece_extent = np.zeros((n, 3))
+    piece_corner = np.zeros(n, dtype=np.int64)
     is_piece[mesh_rows] = True
     piece_geom[mesh_rows], piece_low[mesh_rows], piece_extent[mesh_rows] = geom, low, extent
     pos, length = pos.copy(), length.copy()
     pos[mesh_rows], length[mesh_rows] = low[:, axis], extent[:, axis]
-    geometry = tuple(a[kept] for a in (is_piece, piece_geom, piece_low, piece_extent))
+    geometry = tuple(a[kept] for a in (is_piece, piece_geom, piece_low, piece_extent, piece_corner))
     return parent[kept], step[kept], pos[kept], length[kept], index[kept], geometry

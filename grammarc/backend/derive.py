@@ -33,6 +33,7 @@ from grammarc.backend.slots import (
     HORIZONTAL_SLOTS,
     HORIZONTAL_SWITCH,
     PIVOT_SLOTS,
+    RING_START,
     TRIM_SLOTS,
     TRIM_SWITCH,
     WHITE_RGB,
@@ -153,6 +154,8 @@ def initial_dynamic(plan: Plan, name: str, chunk: Chunk, shapes: Shapes) -> np.n
         return np.zeros(n)
     if name in PIVOT_SLOTS:
         return initial_pivot(name, chunk, shapes)
+    if name == RING_START:
+        return np.zeros(n)
     if plan.uv_slots:
         texture = initial_column(plan, name, chunk, shapes)
         if texture is not None:

@@ -13,24 +13,25 @@ from grammarc.geometry import components as comp_kernels
 from grammarc.geometry.meshes import is_mesh, is_polygon
 
 
-def polygons_of(chunk: Chunk, shapes: Shapes):
-    """Each shape's polygon as batch-local ragged arrays (implicit rectangles for scope shapes): coords
-    (V, 2) float64 in the plane's units, ring_offsets (R+1,) and shape_offsets (n+1,) int64, and each
-    shape's plane (n,) (the scope axis its polygon is flat across)."""
+def polygons_of(chunk: Chunk, shapes: Shapes, corner: np.ndarray | None = None):
+    """Each shape's polygon as batch-local ragged arrays (implicit rectangles for scope shapes, starting at
+    their ``corner`` (n,) as ``box_rings.corners`` gives it, None for corner 0): coords (V, 2) float64 in
+    the plane's units, ring_offsets (R+1,) and shape_offsets (n+1,) int64, and each shape's plane (n,) (the
+    scope axis its polygon is flat across)."""
     polygons = chunk.polygons
     n = len(shapes)
     plane = comp_kernels.rect_plane(shapes.size, TOL.zero)
     is_poly = is_polygon(shapes.geom)
     plane[is_poly] = polygons.plane[shapes.geom[is_poly]]
     if not is_poly.any():
-        coords = comp_kernels.rect_rings(plane)
+        coords = comp_kernels.rect_rings(plane, corner)
         return (coords, np.arange(0, 4 * n + 1, 4, dtype=np.int64), np.arange(n + 1, dtype=np.int64),
                 plane)
     # Mixed batch: give scope shapes a stored rectangle so one gather serves all.
     geom = shapes.geom.copy()
     rects = np.flatnonzero(~is_poly)
     if len(rects):
-        rect_coords = comp_kernels.rect_rings(plane[rects])
+        rect_coords = comp_kernels.rect_rings(plane[rects], None if corner is None else corner[rects])
         geom[rects] = polygons.add(rect_coords, np.arange(0, 4 * len(rects) + 1, 4, dtype=np.int64),
                                    np.arange(len(rects) + 1, dtype=np.int64), plane[rects])
     coords, ring_offsets, shape_offsets = polygons.gather(geom)

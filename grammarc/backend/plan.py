@@ -17,6 +17,7 @@ from grammarc.backend.slots import (
     HORIZONTAL_SLOTS,
     HORIZONTAL_SWITCH,
     PIVOT_SLOTS,
+    RING_START,
     TRIM_SLOTS,
     TRIM_SWITCH,
     uv_slots,
@@ -107,6 +108,9 @@ class Plan:
     #: Index into ``Shapes.dynamic`` of the first of the pivot's columns (``backend.pivot``), None where the
     #: grammar needs no pivot of its own.
     pivot_slot: int | None = None
+    #: Index into ``Shapes.dynamic`` of the corner each box's ring starts at (``backend.box_rings``), None
+    #: where the grammar turns no scope around a rectangle whose edges it numbers.
+    ring_slot: int | None = None
     #: ``load_asset(name, asset_roots) -> AssetMesh``: how trimmed inserts get their asset's triangles
     #: (the model's loader, or a test's stand-in).
     load_asset: Callable = load_asset
@@ -156,9 +160,10 @@ def make_plan(grammar: Grammar, *, load_asset: Callable = load_asset) -> Plan:
     ancestors = list(ANCESTORS) if occlusion or any(isinstance(op, ir.Label) for op in ops) else []
     uv_sets = texture_sets(module, ops)
     pivot = list(PIVOT_SLOTS) if uses_pivot(module, ops, all_exprs(module)) else []
+    ring = [RING_START] if renumbers_boxes(module, ops) else []
     dynamic = {name: i for i, name in enumerate(dict.fromkeys(
         [op.name for op in ops if isinstance(op, ir.SetAttr)] + sorted(set(context)) + colour + trims
-        + ancestors + [name for s in uv_sets for name in uv_slots(s)] + pivot))}
+        + ancestors + [name for s in uv_sets for name in uv_slots(s)] + pivot + ring))}
     not_applied = tuple(sorted({op.name for op in ops if isinstance(op, ir.NotApplied)}))
     strings.intern("")
     for answer in ("none", "part", "full"):  # of Shape.occ
@@ -184,7 +189,8 @@ def make_plan(grammar: Grammar, *, load_asset: Callable = load_asset) -> Plan:
         trim_switch=dynamic.get(TRIM_SWITCH) if trim_slot is not None else None,
         horizontal_slot=dynamic.get(HORIZONTAL_SLOTS[0]), horizontal_switch=dynamic.get(HORIZONTAL_SWITCH),
         occluders=ANCESTORS[0] in dynamic, load_asset=load_asset,
-        uv_slots={s: dynamic[uv_slots(s)[0]] for s in uv_sets}, pivot_slot=dynamic.get(PIVOT_SLOTS[0]))
+        uv_slots={s: dynamic[uv_slots(s)[0]] for s in uv_sets}, pivot_slot=dynamic.get(PIVOT_SLOTS[0]),
+        ring_slot=dynamic.get(RING_START))
     plan = replace(plan, leaf_inserts=leaf_inserts(plan))
     return replace(plan, fused=fused_regions(plan))
 
@@ -224,6 +230,22 @@ def uses_pivot(module: ir.Module, ops, exprs) -> bool:
                 isinstance(a, ir.Str) and a.value == "pivot" for a in expr.args[1:3]):
             return True
     return False
+
+
+#: Operations that turn a scope around its geometry, restarting a box's implicit ring at the new scope.
+REFRAMING_OPS = (ir.AlignScope, ir.AlignToGeometry, ir.AlignScopeToBBox)
+#: Operations whose results depend on where a face's ring starts: its edges' and side faces' numbers
+#: (``comp``, ``setback`` and ``shapeL/U/O`` by edge), and where pieces cut or moved in from it start.
+RING_OPS = (ir.Comp, ir.CompFaces, ir.Setback, ir.SetbackToArea, ir.Offset)
+
+
+def renumbers_boxes(module: ir.Module, ops) -> bool:
+    """Whether shapes of ``module`` need the corner their box's ring starts at (``backend.box_rings``):
+    a CityEngine grammar that turns scopes (``rotateScope``, ``alignScopeToAxes``...) and numbers edges or
+    cuts faces. PRT keeps a polygon's vertex order whatever its scope; elsewhere a rectangle turned with
+    its scope starts its ring where the new scope does, as before."""
+    return module.dialect == "cityengine" and any(isinstance(op, REFRAMING_OPS) for op in ops) and any(
+        isinstance(op, RING_OPS) for op in ops)
 
 
 TEXTURE_OPS = (ir.SetupProjection, ir.ProjectUV, ir.TransformUV, ir.TileUV, ir.NormalizeUV, ir.CopyUV,

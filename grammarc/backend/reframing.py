@@ -11,9 +11,11 @@ from __future__ import annotations
 import numpy as np
 
 from grammarc.backend import mesh_shapes
+from grammarc.backend.box_rings import corners, with_corners
 from grammarc.backend.context import Context
 from grammarc.backend.outlines import polygons_of
 from grammarc.backend.shapes import Shapes
+from grammarc.geometry.components import rect_corners
 from grammarc.geometry.meshes import is_mesh
 from grammarc.geometry.reframe import reframe
 from grammarc.ragged import ragged_take
@@ -49,7 +51,7 @@ def reframed(ctx: Context, shapes: Shapes, new_axes: np.ndarray, span) -> Shapes
     bad = shapes.geom < -1
     if bad.any():
         ctx.fail(shapes, bad, "aligning the scope of an inserted asset is not supported yet", span)
-    coords, ring_offsets, shape_offsets, plane = polygons_of(chunk, shapes)
+    coords, ring_offsets, shape_offsets, plane = polygons_of(chunk, shapes, corners(ctx.plan, shapes))
     ok, plane, origin, size, is_rect, new_coords = reframe(
         shapes.origin, shapes.size, chunk.frames[shapes.frame], coords, ring_offsets, shape_offsets,
         plane, new_axes)
@@ -60,6 +62,9 @@ def reframed(ctx: Context, shapes: Shapes, new_axes: np.ndarray, span) -> Shapes
         vertices, packed_rings = ragged_take(ring_offsets, rings)
         geom[poly] = chunk.polygons.add(new_coords[vertices], packed_rings, packed_shapes, plane[poly])
     result = shapes.with_scope(origin, size, chunk.frames.add(np.ascontiguousarray(new_axes)), geom)
+    if ctx.plan.ring_slot is not None:  # a rectangle kept as its box keeps its ring's first vertex
+        result = with_corners(ctx.plan, result, np.where(
+            is_rect, rect_corners(new_coords[ring_offsets[shape_offsets[:-1]]], plane), 0))
     if ok.all():
         return result
     # Turned out of their polygon's plane (a prism onto a side face, a face tilted): their faces as meshes.

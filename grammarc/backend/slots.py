@@ -40,3 +40,7 @@ def uv_slots(uv_set: int) -> tuple[str, str]:
 #: A shape's pivot (``backend.pivot``): its origin in world coordinates (three float64 columns) and its axes,
 #: an id (int32) into the chunk's ``Frames``.
 PIVOT_SLOTS = ("pivot.px", "pivot.py", "pivot.pz", "pivot.frame")
+
+#: The corner a scope box's ring starts at (``backend.box_rings``): an index into its implicit rectangle's
+#: corners, 0 where the ring starts as that rectangle does. Kept as float64, as the context columns are.
+RING_START = "ring.start"

@@ -57,7 +57,7 @@ def scope_polygons(store: PolygonStore, geom: np.ndarray, size: np.ndarray) -> n
     coords, ring_offsets, poly_offsets = store.gather(geom)
     vertex_poly = segment_of(poly_offsets)[segment_of(ring_offsets)]
     scale = np.stack([size[rows, _A[plane]], size[rows, _B[plane]]], axis=1)
-    return _polygons(coords * scale[vertex_poly], ring_offsets, poly_offsets)
+    return polygons_from_rings(coords * scale[vertex_poly], ring_offsets, poly_offsets)
 
 
 def clip_to_slabs(store: PolygonStore, geom: np.ndarray, size: np.ndarray, axis: int, pos: np.ndarray,
@@ -101,7 +101,7 @@ def oriented_rings(parts: np.ndarray, part_plane: np.ndarray):
     if not len(parts):
         return parts, np.zeros((0, 2)), np.zeros(1, np.int64), np.zeros(1, np.int64)
     _, flat, (closed_rings, part_offsets) = shapely.to_ragged_array(parts)
-    flat, ring_offsets = _open_rings(np.asarray(flat)[:, :2], np.asarray(closed_rings, dtype=np.int64))
+    flat, ring_offsets = open_rings(np.asarray(flat)[:, :2], np.asarray(closed_rings, dtype=np.int64))
     return parts, flat, ring_offsets, np.asarray(part_offsets, dtype=np.int64)
 
 
@@ -130,7 +130,7 @@ def fit_pieces(geometries: np.ndarray, plane: np.ndarray, size: np.ndarray,
     bounds = shapely.bounds(parts).reshape(-1, 4)
     if parents is not None and len(parts):
         _, parent_flat, (parent_closed, parent_offsets) = shapely.to_ragged_array(parents)
-        parent_flat, parent_rings = _open_rings(np.asarray(parent_flat)[:, :2],
+        parent_flat, parent_rings = open_rings(np.asarray(parent_flat)[:, :2],
                                                 np.asarray(parent_closed, dtype=np.int64))
         cut = cut_sides is not None
         side = cut_sides if cut else np.ones(len(geometries), dtype=np.bool_)
@@ -348,7 +348,7 @@ def _places(px, py, qx, qy, g, parent_coords, parent_rings, parent_offsets, mate
     return near, key, vertex_key, scale, edge, away
 
 
-def _polygons(coords: np.ndarray, ring_offsets: np.ndarray, poly_offsets: np.ndarray) -> np.ndarray:
+def polygons_from_rings(coords: np.ndarray, ring_offsets: np.ndarray, poly_offsets: np.ndarray) -> np.ndarray:
     """Shapely polygons from open ragged rings (shapely wants each ring closed)."""
     counts = np.diff(ring_offsets)
     closed_counts = counts + 1
@@ -359,7 +359,7 @@ def _polygons(coords: np.ndarray, ring_offsets: np.ndarray, poly_offsets: np.nda
                                      (closed_offsets, poly_offsets))
 
 
-def _open_rings(coords: np.ndarray, closed_offsets: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def open_rings(coords: np.ndarray, closed_offsets: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Drop each ring's closing vertex (the repeat of its first)."""
     counts = np.diff(closed_offsets) - 1
     keep = np.ones(len(coords), dtype=bool)

@@ -236,9 +236,20 @@ RECT_RINGS = np.array([
 ])
 
 
-def rect_rings(plane: np.ndarray) -> np.ndarray:
-    """The implicit rectangles of shapes in planes ``plane`` (n,), one after another: (4 n, 2)."""
-    return RECT_RINGS[plane].reshape(-1, 2)
+def rect_rings(plane: np.ndarray, corner: np.ndarray | None = None) -> np.ndarray:
+    """The implicit rectangles of shapes in planes ``plane`` (n,), one after another: (4 n, 2); each ring
+    starting at its ``corner`` (n,) (an index into its ``RECT_RINGS``; None: all at corner 0)."""
+    if corner is None:
+        return RECT_RINGS[plane].reshape(-1, 2)
+    turn = (np.arange(4)[None, :] + np.asarray(corner, dtype=np.int64)[:, None]) % 4
+    return RECT_RINGS[np.asarray(plane, dtype=np.int64)[:, None], turn].reshape(-1, 2)
+
+
+def rect_corners(first: np.ndarray, plane: np.ndarray) -> np.ndarray:
+    """The corners (n,) int64 of the implicit rectangles of planes ``plane`` (n,) nearest the points
+    ``first`` (n, 2) (normalized coordinates): where a rectangle's ring whose first vertex that is starts."""
+    rings = RECT_RINGS[np.asarray(plane, dtype=np.int64)]  # (n, 4, 2)
+    return np.argmin(((rings - np.asarray(first)[:, None, :]) ** 2).sum(axis=2), axis=1)
 
 
 def rect_plane(size: np.ndarray, tol: float) -> np.ndarray:

@@ -47,9 +47,11 @@ class Faces:
         return self.face_shape()[segment_of(self.face_offsets)][segment_of(self.ring_offsets)]
 
 
-def shape_faces(size: np.ndarray, geom: np.ndarray, store: PolygonStore, meshes: MeshStore) -> Faces:
+def shape_faces(size: np.ndarray, geom: np.ndarray, store: PolygonStore, meshes: MeshStore,
+                corner: np.ndarray | None = None) -> Faces:
     """The faces of shapes with scope sizes (n, 3) and geometry codes (n,): boxes, faces and prisms of the
-    polygon store, meshes of the mesh store; an inserted asset is its box, as ``geometry.area`` has it."""
+    polygon store, meshes of the mesh store; an inserted asset is its box, as ``geometry.area`` has it. A
+    box's ring starts at its ``corner`` (n,) (``rect_rings``; None: corner 0)."""
     n = len(geom)
     poly = np.flatnonzero(is_polygon(geom))
     mesh = np.flatnonzero(is_mesh(geom))
@@ -59,7 +61,8 @@ def shape_faces(size: np.ndarray, geom: np.ndarray, store: PolygonStore, meshes:
         coords, ring_offsets, poly_offsets = store.gather(geom[poly])
         plane = np.concatenate([store.plane[geom[poly]], rect_plane(size[box], TOL.zero)]).astype(np.int8)
         # the scope boxes' implicit rectangles after the polygons, one ring each
-        coords = np.concatenate([coords, rect_rings(plane[len(poly):])])
+        box_corner = None if corner is None else corner[box]
+        coords = np.concatenate([coords, rect_rings(plane[len(poly):], box_corner)])
         ring_offsets = np.concatenate([ring_offsets, ring_offsets[-1] + 4 * np.arange(1, len(box) + 1)])
         poly_offsets = np.concatenate([poly_offsets, poly_offsets[-1] + np.arange(1, len(box) + 1)])
         rows = np.concatenate([poly, box])

@@ -5,7 +5,15 @@ from __future__ import annotations
 from operations.derivations import VERSION
 
 from grammarc.backend.plan import make_plan
-from grammarc.backend.slots import ANCESTORS, COLOR_SLOT, PIVOT_SLOTS, TRIM_SLOTS, TRIM_SWITCH, uv_slots
+from grammarc.backend.slots import (
+    ANCESTORS,
+    COLOR_SLOT,
+    PIVOT_SLOTS,
+    RING_START,
+    TRIM_SLOTS,
+    TRIM_SWITCH,
+    uv_slots,
+)
 from grammarc.compiler import compile_grammar
 
 
@@ -48,3 +56,17 @@ def test_pivot_columns_only_where_the_grammar_uses_the_pivot(write):
                  "Lot --> set(scope.ry, 30) X\n", "Lot --> translate(rel, pivot, 1, 0, 0) X\n"):
         plan = plan_of(write, text)
         assert [plan.dynamic[name] - plan.pivot_slot for name in PIVOT_SLOTS] == [0, 1, 2, 3], text
+
+
+
+def test_the_box_ring_column_only_where_the_grammar_turns_scopes_and_numbers_edges(write):
+    """A box's ring corner (``backend.box_rings``) rides with the shapes of a grammar that turns scopes and
+    numbers edges or cuts faces; a grammar that does only one of the two pays nothing."""
+    for text in ("Lot --> rotateScope(0, 90, 0) X\n", "Lot --> setback(2){ front : A | remainder : B }\n",
+                 "Lot --> alignScopeToAxes(y) extrude(3) X\n"):
+        assert plan_of(write, text).ring_slot is None, text
+    for text in ("Lot --> rotateScope(0, 90, 0) setback(2){ front : A | remainder : B }\n",
+                 "Lot --> alignScopeToAxes(y) extrude(3) comp(f){ side : A }\n",
+                 "Lot --> alignScopeToGeometry(yUp, 0, 0) offset(-1) comp(f){ inside : A }\n"):
+        plan = plan_of(write, text)
+        assert plan.ring_slot == plan.dynamic[RING_START], text

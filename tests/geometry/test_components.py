@@ -19,7 +19,9 @@ from grammarc.geometry.components import (
     SAME_POLY,
     TOP_POLY,
     components,
+    rect_corners,
     rect_plane,
+    rect_rings,
     reverse_rings,
 )
 from grammarc.geometry.footprint import footprint_polygons, lot_scopes
@@ -384,3 +386,12 @@ def test_reverse_rings(n):
     want = [np.roll(coords[s:e][::-1], 1, axis=0) for s, e in itertools.pairwise(offsets)]
     np.testing.assert_array_equal(out, np.concatenate(want) if n else coords)
     np.testing.assert_array_equal(reverse_rings(out, offsets), coords)
+
+
+def test_a_rectangle_ring_starts_at_its_corner():
+    """A box's ring turned to start at a corner, and the corner read back off its first vertex."""
+    for plane in range(3):
+        for corner in range(4):
+            ring = rect_rings(np.array([plane]), np.array([corner]))
+            assert rect_corners(ring[:1], np.array([plane])).tolist() == [corner]
+            np.testing.assert_array_equal(ring, np.roll(RECT_RINGS[plane], -corner, axis=0))

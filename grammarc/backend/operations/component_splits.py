@@ -16,6 +16,7 @@ from dataclasses import replace
 import numpy as np
 
 from grammarc.backend import mesh_shapes
+from grammarc.backend.box_rings import corners, with_corners
 from grammarc.backend.children import with_context
 from grammarc.backend.context import Context
 from grammarc.backend.evaluate import evaluate_array
@@ -133,23 +134,25 @@ def components(ctx: Context, kind: int, cursor: Shapes, site: int, span, wanted=
     mesh = is_mesh(cursor.geom)
     pieces = []
     if not mesh.all():
-        pieces.append(_solid_components(chunk, kind, cursor, np.flatnonzero(~mesh)))
+        pieces.append(_solid_components(chunk, kind, cursor, np.flatnonzero(~mesh),
+                                        corners(ctx.plan, cursor)))
     if mesh.any():
         which = np.flatnonzero(mesh)
         parent, index, origin, axes, size, geom, roof, border = mesh_shapes.mesh_components(
             chunk, cursor.take(which), kind, borders)
-        pieces.append((which[parent], index, origin, axes, size, geom, axes[:, 2], roof, border))
-    parent, index, origin, axes, size, geom, normal, roof, border = (
+        pieces.append((which[parent], index, origin, axes, size, geom, axes[:, 2], roof, border,
+                       np.zeros(len(parent), dtype=np.int64)))
+    parent, index, origin, axes, size, geom, normal, roof, border, corner = (
         pieces[0] if len(pieces) == 1 else
         (np.concatenate(columns) for columns in zip(*pieces)))
     if len(pieces) > 1:
         order = np.argsort(parent, kind="stable")
-        parent, index, origin, axes, size, geom, normal, roof, border = (
-            a[order] for a in (parent, index, origin, axes, size, geom, normal, roof, border))
+        parent, index, origin, axes, size, geom, normal, roof, border, corner = (
+            a[order] for a in (parent, index, origin, axes, size, geom, normal, roof, border, corner))
     if wanted is not None:
         keep = index == np.round(wanted[parent])
-        parent, index, origin, axes, size, geom, normal, roof, border = (
-            a[keep] for a in (parent, index, origin, axes, size, geom, normal, roof, border))
+        parent, index, origin, axes, size, geom, normal, roof, border, corner = (
+            a[keep] for a in (parent, index, origin, axes, size, geom, normal, roof, border, corner))
     child = cursor.take(parent)
     gram = np.einsum("nij,nkj->nik", axes, axes)
     bad = ~(np.abs(gram - np.eye(3)) < 1e-6).all(axis=(1, 2))
@@ -161,16 +164,19 @@ def components(ctx: Context, kind: int, cursor: Shapes, site: int, span, wanted=
     shapes = Shapes(world_origin, size, frame, geom.astype(np.int32), child.lot,
                     piece_keys(ctx.plan.sequential_random, child.key, index, site), child.depth, child.params,
                     child.dynamic)
+    shapes = with_corners(ctx.plan, shapes, corner)
     return (with_context(ctx.plan, shapes, "comp", index, parent, len(cursor)), normal, index, parent, roof,
             border)
 
 
-def _solid_components(chunk, kind: int, cursor: Shapes, which: np.ndarray):
-    """Components of the boxes, polygons and prisms ``which`` of ``cursor``: parent (into cursor),
-    index, origin, axes, size (in the parents' frames), geom, normal, roof (-1: no roof edges), border
-    (the components of flat shapes)."""
+def _solid_components(chunk, kind: int, cursor: Shapes, which: np.ndarray, corner: np.ndarray | None):
+    """Components of the boxes, polygons and prisms ``which`` of ``cursor`` (whose box rings start at
+    ``corner`` (n,), None for corner 0): parent (into cursor), index, origin, axes, size (in the parents'
+    frames), geom, normal, roof (-1: no roof edges), border (the components of flat shapes), and the
+    corner each box component's ring starts at."""
     shapes = cursor.take(which)
-    coords, ring_offsets, shape_offsets, plane = polygons_of(chunk, shapes)
+    corner = None if corner is None else corner[which]
+    coords, ring_offsets, shape_offsets, plane = polygons_of(chunk, shapes, corner)
     parent, index, origin, axes, size, poly = comp_kernels.components(
         kind, coords, ring_offsets, shape_offsets, plane, shapes.size, TOL.zero)
     geom = np.full(len(parent), -1, dtype=np.int32)
@@ -184,7 +190,29 @@ def _solid_components(chunk, kind: int, cursor: Shapes, which: np.ndarray):
     normal = axes[:, 2].copy()
     normal[same] = np.eye(3)[plane[parent[same]]]
     border = ((shapes.size <= TOL.zero).sum(axis=1) >= 1)[parent]
-    return which[parent], index, origin, axes, size, geom, normal, np.full(len(parent), -1, dtype=np.int32), border
+    no_roof = np.full(len(parent), -1, dtype=np.int32)
+    return (which[parent], index, origin, axes, size, geom, normal, no_roof, border,
+            _box_corners(poly, plane, shapes.geom, parent, corner))
+
+
+def _box_corners(poly: np.ndarray, plane: np.ndarray, geom: np.ndarray, parent: np.ndarray,
+                 corner: np.ndarray | None) -> np.ndarray:
+    """The corners (m,) that components' box rings start at: a flat box's face is the box itself; a box's
+    top and bottom start at its ring's first vertex, as a prism's (``_cap_polygons``); side faces and
+    edges at corner 0."""
+    out = np.zeros(len(poly), dtype=np.int64)
+    if corner is None:
+        return out
+    same = poly == comp_kernels.SAME_POLY
+    out[same] = corner[parent[same]]
+    for code, flip_where in ((comp_kernels.TOP_POLY, True), (comp_kernels.BOTTOM_POLY, False)):
+        rows = np.flatnonzero((poly == code) & (geom[parent] == -1))
+        if len(rows):
+            first = comp_kernels.rect_rings(plane[parent[rows]], corner[parent[rows]])[::4].copy()
+            flip = (plane[parent[rows]] == 1) == flip_where
+            first[flip, 1] = 1.0 - first[flip, 1]
+            out[rows] = comp_kernels.rect_corners(first, np.full(len(rows), 2))
+    return out
 
 
 def _cap_polygons(chunk, geom: np.ndarray, which: str) -> np.ndarray:

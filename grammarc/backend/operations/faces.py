@@ -21,6 +21,7 @@ import numpy as np
 import shapely
 
 from grammarc.backend import mesh_shapes
+from grammarc.backend.box_rings import corners, piece_corners, with_corners
 from grammarc.backend.children import with_context
 from grammarc.backend.context import Context
 from grammarc.backend.evaluate import evaluate_array
@@ -34,6 +35,7 @@ from grammarc.backend.streams import piece_keys, remade_keys
 from grammarc.constants import TOL
 from grammarc.geometry import components as comp_kernels
 from grammarc.geometry.clip import fit_pieces, scope_polygons
+from grammarc.geometry.closed_arms import closed_arm_insets
 from grammarc.geometry.convexify import convex_parts
 from grammarc.geometry.inner_rectangle import largest_rectangles
 from grammarc.geometry.meshes import MESH_BASE, is_mesh, is_polygon
@@ -72,7 +74,7 @@ def roof(ctx: Context, cursor: Shapes, op: ir.Roof) -> Shapes:
     if ctx.plan.leaf_bodies and op.kind != "envelope":
         checks.append((flat_axis(ctx.chunk, cursor) < 0, "of a solid (CityEngine roofs faces)"))
     cap = edges = even = None
-    polygons = polygons_of(ctx.chunk, cursor)
+    polygons = polygons_of(ctx.chunk, cursor, corners(ctx.plan, cursor))
     if op.cap is not None:
         cap = np.broadcast_to(np.asarray(evaluate_array(op.cap, env), float), (n,))
         sides = [(overhang, value), *((evaluate_array(h, env), evaluate_array(a, env)) for h, a in op.sides)]
@@ -178,13 +180,13 @@ def _ridge_roofs(ctx: Context, cursor: Shapes, op: ir.Roof, ridge: np.ndarray, v
     if not len(others):
         return roofed, failed
     rest = cursor.take(others)
-    gables, failed[others] = mesh_shapes.build_roofs(ctx.chunk, rest, op.kind, polygons_of(ctx.chunk, rest),
-                                                     value[others], op.by_height, overhang[others],
-                                                     np.zeros(len(others)), None)
+    outlines = polygons_of(ctx.chunk, rest, corners(ctx.plan, rest))
+    gables, failed[others] = mesh_shapes.build_roofs(ctx.chunk, rest, op.kind, outlines, value[others],
+                                                     op.by_height, overhang[others], np.zeros(len(others)), None)
     return Shapes.merge([roofed, gables], [rows, others]), failed
 
 
-@operation(ir.Taper, writes=("origin", "size", "frame", "geom"))
+@operation(ir.Taper, writes=("origin", "size", "frame", "geom", "dynamic"))
 def taper(ctx: Context, cursor: Shapes, op: ir.Taper) -> Shapes:
     """``taper(height)``: each face becomes a pyramid, a triangle from each edge of its outline to the apex
     ``height`` along the face's normal over the face's centre of gravity (holes stay in the bottom face, as
@@ -201,7 +203,7 @@ def taper(ctx: Context, cursor: Shapes, op: ir.Taper) -> Shapes:
     polygons, plane = face_polygons(ctx, cursor, "taper", op.span)
     rows = np.flatnonzero(np.abs(height) > TOL.zero)
     sub, face = cursor.take(rows), plane[rows]
-    coords, ring_offsets, shape_offsets, _ = polygons_of(ctx.chunk, sub)
+    coords, ring_offsets, shape_offsets, _ = polygons_of(ctx.chunk, sub, corners(ctx.plan, sub))
     # behind the face: the pyramid of the face mirrored in u, turned a half turn about v (so its faces
     # still face out)
     behind = height[rows] < 0
@@ -510,8 +512,9 @@ def cleanup_geometry(ctx: Context, cursor: Shapes, op: ir.CleanupGeometry) -> Sh
     polygon = np.flatnonzero(is_polygon(geom) | ((geom == -1) & flat))
     if len(polygon):
         shapes = cursor.take(polygon)
-        geom[polygon] = mesh_shapes.clean_polygons(ctx.chunk, shapes, polygons_of(ctx.chunk, shapes),
-                                                   tolerance[polygon], op.component)
+        outlines = polygons_of(ctx.chunk, shapes, corners(ctx.plan, shapes))
+        geom[polygon] = mesh_shapes.clean_polygons(ctx.chunk, shapes, outlines, tolerance[polygon],
+                                                   op.component)
     mesh = np.flatnonzero(is_mesh(cursor.geom))
     if len(mesh):
         geom[mesh] = mesh_shapes.clean_meshes(ctx.chunk, cursor.take(mesh), tolerance[mesh], op.component)
@@ -560,7 +563,8 @@ def face_polygons(ctx: Context, cursor: Shapes, what: str, span) -> tuple[np.nda
     rects = np.flatnonzero(geom < 0)
     if len(rects):
         plane = comp_kernels.rect_plane(cursor.size[rects], TOL.zero)
-        geom[rects] = store.add(comp_kernels.rect_rings(plane),
+        corner = corners(ctx.plan, cursor)
+        geom[rects] = store.add(comp_kernels.rect_rings(plane, None if corner is None else corner[rects]),
                                 np.arange(0, 4 * len(rects) + 1, 4, dtype=np.int64),
                                 np.arange(len(rects) + 1, dtype=np.int64), plane)
     return scope_polygons(store, geom, cursor.size), store.plane[geom]
@@ -588,8 +592,10 @@ def _distances(ctx: Context, distance: ir.Expr, cursor: Shapes, span) -> np.ndar
 
 def _inset_and_border(polygons: np.ndarray, distance: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """``offset``'s two regions of each face (k,) (shapely): its outline moved by ``distance`` (k,) (in
-    when negative) with sharp corners kept, and the ring between that and the face."""
+    when negative) with sharp corners kept, an arm it closes leaving its vertex where PRT does
+    (``geometry.closed_arms``), and the ring between that and the face."""
     inset = shapely.buffer(polygons, distance, join_style="mitre", mitre_limit=1e6)
+    inset = closed_arm_insets(inset, polygons, -distance)
     return inset, shapely.difference(polygons, inset)
 
 
@@ -635,8 +641,9 @@ def _piece_shapes(ctx: Context, cursor: Shapes, pieces, site: int, remade: bool 
     sequential = ctx.plan.sequential_random
     key = remade_keys(sequential, child.key) if remade else piece_keys(sequential, child.key,
                                                                          rank_within(pieces.source), site)
-    return Shapes(origin, pieces.extent, child.frame, geom, child.lot, key, child.depth, child.params,
-                  child.dynamic)
+    shapes = Shapes(origin, pieces.extent, child.frame, geom, child.lot, key, child.depth, child.params,
+                    child.dynamic)
+    return with_corners(ctx.plan, shapes, piece_corners(pieces))
 
 
 def _regions(ctx: Context, op: ir.Setback | ir.SetbackToArea | ir.InnerRectangle, cursor: Shapes, regions: list, plane,

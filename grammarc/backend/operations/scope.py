@@ -18,6 +18,7 @@ import numpy as np
 import shapely
 
 from grammarc.backend import mesh_shapes
+from grammarc.backend.box_rings import corners
 from grammarc.backend.context import Context
 from grammarc.backend.euler import orientation, rotation
 from grammarc.backend.evaluate import evaluate, evaluate_array
@@ -41,6 +42,9 @@ from grammarc.ir import nodes as ir
 from grammarc.ragged import ragged_take, segment_of, segment_reduce
 
 _SCOPE = ("origin", "size", "frame", "geom")
+#: The columns of operations that fit scopes to their geometry again (``backend.reframing``): the scope, and
+#: the corner a box's ring starts at (``backend.box_rings``), one of the dynamic columns.
+_REFRAMED = (*_SCOPE, "dynamic")
 
 
 @operation(ir.Translate, writes=("origin",), meshes=True)
@@ -203,7 +207,7 @@ def center(ctx: Context, cursor: Shapes, op: ir.Center, base) -> Shapes:
     return cursor.with_scope(origin, cursor.size, cursor.frame, cursor.geom)
 
 
-@operation(ir.Extrude, writes=_SCOPE, meshes=True)
+@operation(ir.Extrude, writes=_REFRAMED, meshes=True)
 def extrude(ctx: Context, cursor: Shapes, op: ir.Extrude) -> Shapes:
     """A face becomes a solid along its normal; a negative height extrudes behind the face. As in
     CityEngine, the solid's scope keeps x and has y along the extrusion: a face whose normal is
@@ -354,7 +358,7 @@ def _extruded_upwards(ctx: Context, cursor: Shapes, height: np.ndarray, straight
     every vertex by ``height`` (``straight``) or to one level (flatTop)."""
     chunk = ctx.chunk
     axes = chunk.frames[cursor.frame]
-    coords, ring_offsets, shape_offsets, plane = polygons_of(chunk, cursor)
+    coords, ring_offsets, shape_offsets, plane = polygons_of(chunk, cursor, corners(ctx.plan, cursor))
     vertex_shape = segment_of(shape_offsets)[segment_of(ring_offsets)]
     rows = np.arange(len(cursor))
     scaled = coords * np.stack([cursor.size[rows, PLANE_U[plane]], cursor.size[rows, PLANE_V[plane]]], 1)[
@@ -381,7 +385,7 @@ def _extruded_upwards(ctx: Context, cursor: Shapes, height: np.ndarray, straight
     return cursor.with_scope(origin, size, chunk.frames.add(np.ascontiguousarray(new_axes)), geom)
 
 
-@operation(ir.AlignScope, writes=_SCOPE, meshes=True)
+@operation(ir.AlignScope, writes=_REFRAMED, meshes=True)
 def align_scope(ctx: Context, cursor: Shapes, op: ir.AlignScope) -> Shapes:
     """New scope axes around unchanged geometry (``backend.reframing``)."""
     axes = ctx.chunk.frames[cursor.frame]
@@ -420,7 +424,7 @@ def _world_axis(axes: np.ndarray, k: int) -> np.ndarray:
     return new_axes
 
 
-@operation(ir.AlignToGeometry, writes=_SCOPE, meshes=True)
+@operation(ir.AlignToGeometry, writes=_REFRAMED, meshes=True)
 def align_to_geometry(ctx: Context, cursor: Shapes, op: ir.AlignToGeometry) -> Shapes:
     """``alignScopeToGeometry``: every shape's faces in world space, a face and an edge picked per shape
     (``geometry.align``), the scope turned to them around the unchanged geometry."""
@@ -428,7 +432,7 @@ def align_to_geometry(ctx: Context, cursor: Shapes, op: ir.AlignToGeometry) -> S
     n = len(cursor)
     env = ctx.env(cursor)
     axes = chunk.frames[cursor.frame]
-    faces = shape_faces(cursor.size, cursor.geom, chunk.polygons, chunk.meshes)
+    faces = shape_faces(cursor.size, cursor.geom, chunk.polygons, chunk.meshes, corners(ctx.plan, cursor))
     # world-oriented offsets from each scope's origin: a shape's own shift does not change its choices
     verts = np.einsum("vi,vij->vj", faces.verts, axes[faces.vertex_shape()])
     vector = face_shapes(verts, faces.ring_offsets, faces.face_offsets)[0]
@@ -457,7 +461,7 @@ def align_to_geometry(ctx: Context, cursor: Shapes, op: ir.AlignToGeometry) -> S
                         [rows, others])
 
 
-@operation(ir.AlignScopeToBBox, writes=_SCOPE, meshes=True)
+@operation(ir.AlignScopeToBBox, writes=_REFRAMED, meshes=True)
 def align_scope_to_bbox(ctx: Context, cursor: Shapes, op: ir.AlignScopeToBBox) -> Shapes:
     """``alignScopeToGeometryBBox``: each scope turned about its third axis so that the first of ``op.axes``
     runs along the longer side of the smallest rectangle around the geometry's vertices seen along that
@@ -529,7 +533,7 @@ def _mirrored_assets(geom: np.ndarray, bits: np.ndarray) -> np.ndarray:
     return geom
 
 
-@operation(ir.MirrorScope, writes=_SCOPE, meshes=True)
+@operation(ir.MirrorScope, writes=_REFRAMED, meshes=True)
 def mirror_scope(ctx: Context, cursor: Shapes, op: ir.MirrorScope) -> Shapes:
     """``mirrorScope``: the flagged axes reversed around the unchanged geometry (``backend.reframing``:
     the box fitted again starts at their far ends). Two reversed axes are a half turn; one or three would

@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from grammarc.backend.box_rings import as_polygons
 from grammarc.backend.children import by_part, children, clip, grouped_children
 from grammarc.backend.context import Context
 from grammarc.backend.evaluate import evaluate, evaluate_array
@@ -133,7 +134,9 @@ def _group_layout(ctx: Context, cursor: Shapes, op: ir.GroupSplit, values: np.nd
 def _group_children(ctx: Context, cursor: Shapes, op: ir.GroupSplit, axis: int, parent, part, pos, length, index,
                     axes: np.ndarray | None = None) -> Parts:
     """The children of a split's parts along ``axis``, their geometry cut to their slabs, by part; with the
-    parents' ``axes`` (a split in texture space, its shapes turned) they take those axes again."""
+    parents' ``axes`` (a split in texture space, its shapes turned) they take those axes again. A box whose
+    ring starts elsewhere than corner 0 is cut as its polygon (``box_rings.as_polygons``)."""
+    cursor = as_polygons(ctx.plan, ctx.chunk, cursor, axis)
     parent, part, pos, length, index, geometry = clip(ctx.chunk, cursor, axis, parent, part, pos, length,
                                                       index, op.adjust)
     order, offsets = group_by(part, len(op.parts))
@@ -188,6 +191,7 @@ def _fan_out(ctx: Context, cursor: Shapes, op: ir.Split | ir.Repeat, cut) -> Par
     cell = np.zeros(len(cursor), dtype=np.int64)
     for level, axis in enumerate(op.axes):
         parent, step, pos, length = cut(shapes, level, axis)
+        shapes = as_polygons(ctx.plan, ctx.chunk, shapes, axis)
         parent, step, pos, length, _, geometry = clip(ctx.chunk, shapes, axis, parent, step, pos, length,
                                                       np.zeros(len(parent), dtype=np.int64))
         cell = cell[parent] + step

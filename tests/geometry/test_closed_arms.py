@@ -1,0 +1,41 @@
+"""geometry/closed_arms.py: an offset that closes an arm leaves one vertex on the run its neighbours make,
+on the bisector of the arm's side lines, as PRT's insets have it (measured through PyPRT on massing)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+import shapely
+
+from grammarc.geometry.closed_arms import closed_arm_insets
+
+#: A T: a 30 x 20 m bar, a 6 m wide stem on it from x = 10 to 16.
+T_LOT = shapely.Polygon([[0, 0], [30, 0], [30, 20], [16, 20], [16, 30], [10, 30], [10, 20], [0, 20]])
+
+
+def _inset(polygon, distance):
+    inset = shapely.buffer(np.array([polygon]), -distance, join_style="mitre", mitre_limit=1e6)
+    return closed_arm_insets(inset, np.array([polygon]), np.array([distance]))[0]
+
+
+def test_a_closed_stem_leaves_one_vertex_on_its_centre_line():
+    """Offset by 4 m the 6 m stem closes: PRT's inset is the 22 x 12 m bar with one more vertex, at the
+    stem's centre line (13, 16); GEOS leaves two, where each moved side crosses the run (12 and 14)."""
+    ring = shapely.get_coordinates(shapely.orient_polygons(_inset(T_LOT, 4.0)).exterior)[:-1]
+    assert sorted(map(tuple, ring.tolist())) == [(4, 4), (4, 16), (13, 16), (26, 4), (26, 16)]
+
+
+def test_a_closed_slanted_stem_leaves_its_vertex_on_the_bisector_of_its_sides():
+    """A stem narrowing from 6 m to 4 m: its sides' bisector is the line x = 13 still, by symmetry."""
+    narrowing = shapely.Polygon([[0, 0], [30, 0], [30, 20], [16, 20], [15, 30], [11, 30], [10, 20], [0, 20]])
+    ring = shapely.get_coordinates(_inset(narrowing, 4.0).exterior)[:-1]
+    on_run = ring[(np.abs(ring[:, 1] - 16) < 1e-9) & (ring[:, 0] > 4) & (ring[:, 0] < 26)]
+    assert on_run[:, 0].tolist() == pytest.approx([13.0])
+
+
+def test_an_inset_without_a_closed_arm_is_left_alone():
+    """A rectangle's inset, and an inset whose arm stays open, keep GEOS's vertices."""
+    for polygon, distance in ((shapely.box(0, 0, 30, 20), 4.0), (T_LOT, 2.0)):
+        inset = shapely.buffer(np.array([polygon]), -distance, join_style="mitre", mitre_limit=1e6)
+        assert shapely.equals_exact(closed_arm_insets(inset, np.array([polygon]), np.array([distance]))[0],
+                                    inset[0])
