@@ -107,7 +107,8 @@ class Context:
     def check_fan_out(self, shapes: Shapes, counts: np.ndarray, span) -> None:
         """Refuse a fan-out of ``counts`` (n,) children per shape (int64, or float64 where a count may be
         beyond int64) that would take a lot over --max-shapes, before allocating them."""
-        if self.chunk.shape_total + counts.sum() <= self.limits.max_shapes:  # no lot can be over (NaN: check)
+        # summed as floats: two counts of ``MAX_COUNT`` overflow int64 to a negative sum, which passed
+        if self.chunk.shape_total + counts.sum(dtype=np.float64) <= self.limits.max_shapes:  # NaN: check
             return
         per_lot = np.bincount(shapes.lot, weights=counts, minlength=len(self.chunk.shape_count))
         self.check_shape_limit(per_lot + self.chunk.shape_count, span)

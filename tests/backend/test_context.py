@@ -74,3 +74,12 @@ def test_the_shape_limit_fails_each_lot_over_it_with_its_own_count(write):
         f"more than 10 shapes ({n}) in rule `Lot` at g.cga:2:1: a runaway grammar? Raise the limit with "
         "--max-shapes N." for n in ("11", "beyond counting")]
 
+
+
+def test_counts_beyond_counting_of_several_shapes_fail_their_lots(write):
+    """A repeat of a 1e-306 m element makes ``MAX_COUNT`` children on each shape: two of them overflowed
+    int64 to a negative sum, which passed the limit and failed the allocation (the build fuzz)."""
+    text = "attr h = 12\nattr w = 1e308\nlot ~> Repeat(\"X\", (h / w) * 12){ r4 }\n"
+    r = paper(write, text, [rect(1, 1)] * 2)
+    assert [b.index for b in r["bad"]] == [0, 1]
+    assert all("(beyond counting)" in b.reason for b in r["bad"])
