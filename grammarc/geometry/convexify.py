@@ -1,13 +1,14 @@
 """Convex parts of polygons with holes (CityEngine's ``convexify``), all polygons of a batch at once.
 
+Holes are opened first (``_opened``): from each of a hole's reflex corners a cut runs along the line of
+one of its edges and stops at the boundary, as PRT's do; the faces they enclose are cut as follows.
 Each round cuts every piece that still has a reflex vertex along a line through its first one (one that
-is nearly straight only when it has no other): the line
-of one of the two edges that meet there, the one that runs a shorter way into the piece from the
-vertex (on one side the vertex becomes straight, on the other its angle drops below 180 degrees). A
-nearly straight corner too: the cut shaves a sliver off along the edge, and the rest of the piece stays
-whole (PRT's candler roofs keep a roof access on pieces with corners of a few degrees, candler.yverdon.10,
-concave.11029). A cut never makes a reflex vertex, so the reflex vertices of a lineage strictly
-decrease. A hole's corners are reflex too, so holes are cut open.
+is nearly straight only when it has no other): the line of one of the two edges that meet there, the
+one that runs a shorter way into the piece from the vertex (on one side the vertex becomes straight, on
+the other its angle drops below 180 degrees). A nearly straight corner too: the cut shaves a sliver off
+along the edge, and the rest of the piece stays whole (PRT's candler roofs keep a roof access on pieces
+with corners of a few degrees, candler.yverdon.10, concave.11029). A cut never makes a reflex vertex, so
+the reflex vertices of a lineage strictly decrease.
 Rectilinear footprints come out as rectangles (an L in two, a U in three) whose corners where a cut
 ends on an edge stay: PRT's pieces keep them, and ``geometry.isRectangular`` tells such a piece from a
 rectangle (candler's roofs). Each piece starts where its boundary leaves the last cut: at the corner
@@ -28,7 +29,7 @@ import numpy as np
 import shapely
 
 from grammarc.constants import TOL
-from grammarc.ragged import segment_of
+from grammarc.ragged import rank_within, segment_of
 
 #: Cutting rounds at most (each removes at least one reflex vertex from every piece it cuts).
 MAX_ROUNDS = 256
@@ -63,7 +64,7 @@ def _mirrored(polygons: np.ndarray) -> np.ndarray:
 def _convex_parts(polygons: np.ndarray, max_length: np.ndarray | None) -> tuple[np.ndarray, np.ndarray]:
     """``convex_parts`` of polygons in a right-handed pair of axes."""
     pieces = shapely.orient_polygons(polygons, exterior_cw=False)
-    source = np.arange(len(pieces))
+    pieces, source = _opened(pieces)
     across = np.zeros(len(pieces), dtype=bool)  # cut across the boundary this time
     done_pieces, done_source = [], []
     for _ in range(MAX_ROUNDS):
@@ -107,6 +108,79 @@ def _convex_parts(polygons: np.ndarray, max_length: np.ndarray | None) -> tuple[
     pieces, source = np.concatenate(done_pieces), np.concatenate(done_source)
     order = np.argsort(source, kind="stable")
     return pieces[order], source[order]
+
+
+def _opened(pieces: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Polygons (m,) with their holes opened: (pieces (k,), source (k,)). From each reflex corner of a hole
+    a cut runs along the line of one of its edges (the one whose run into the polygon is shorter) and stops
+    where it comes to the boundary; the polygon falls into the faces these cuts and its rings enclose.
+    PRT's roof accesses on candler's courtyards lie on such faces (courtyard.32354: two faces over 200
+    m^2, where cuts along whole lines left four under it)."""
+    holed = np.flatnonzero(shapely.get_num_interior_rings(pieces) > 0)
+    if not len(holed):
+        return pieces, np.arange(len(pieces))
+    _, coords, (ring_offsets, part_offsets) = shapely.to_ragged_array(pieces[holed])
+    coords = np.asarray(coords)[:, :2]
+    ring_offsets = np.asarray(ring_offsets, dtype=np.int64)
+    part_offsets = np.asarray(part_offsets, dtype=np.int64)
+    ring = segment_of(ring_offsets)
+    start, end = ring_offsets[:-1][ring], ring_offsets[1:][ring] - 1
+    at = np.arange(len(coords))
+    inner = np.ones(len(ring_offsets) - 1, dtype=bool)
+    inner[part_offsets[:-1]] = False
+    owner = segment_of(part_offsets)[ring]
+    prev = np.where(at > start, at - 1, end - 1)
+    d_in = coords - coords[prev]
+    d_out = coords[np.minimum(at + 1, len(coords) - 1)] - coords
+    cross = d_in[:, 0] * d_out[:, 1] - d_in[:, 1] * d_out[:, 0]
+    scale = np.hypot(d_in[:, 0], d_in[:, 1]) * np.hypot(d_out[:, 0], d_out[:, 1])
+    corner = np.flatnonzero((at < end) & inner[ring] & (cross < -1e-9 * np.maximum(scale, TOL.zero)))
+    a = d_in[corner] / np.hypot(*d_in[corner].T)[:, None]
+    b = d_out[corner] / np.hypot(*d_out[corner].T)[:, None]
+    polygons = pieces[holed]
+    run_in, run_out = np.split(_runs(polygons, np.r_[owner[corner], owner[corner]],
+                                     np.r_[coords[corner], coords[corner]], np.r_[a, -b]), 2)
+    shorter = run_in <= run_out * (1.0 + 1e-9)
+    # a hair past the boundary (the runs end just inside it), so that noding ends the cut on it
+    over = 1e-7 * _reach(polygons)[owner[corner]]
+    far = coords[corner] + np.where(shorter[:, None], a * (run_in + over)[:, None], -b * (run_out + over)[:, None])
+    rays = shapely.linestrings(np.stack([coords[corner], far], axis=1))
+    # each polygon's rings and its cuts, noded together, then the faces they enclose
+    rings = shapely.get_rings(polygons)
+    ring_owner = np.repeat(np.arange(len(polygons)), shapely.get_num_interior_rings(polygons) + 1)
+    lines = np.concatenate([rings, rays])
+    line_owner = np.concatenate([ring_owner, owner[corner]])
+    order = np.argsort(line_owner, kind="stable")
+    lines, line_owner = lines[order], line_owner[order]
+    width = np.bincount(line_owner, minlength=len(polygons))
+    table = np.full((len(polygons), width.max()), None, dtype=object)
+    table[line_owner, rank_within(line_owner)] = lines
+    faces, index = shapely.get_parts(shapely.polygonize(shapely.union_all(table, axis=1)[:, None], axis=1),
+                                     return_index=True)
+    inside = shapely.contains_properly(polygons[index], shapely.point_on_surface(faces))
+    faces, index = shapely.orient_polygons(faces[inside], exterior_cw=False), index[inside]
+    # a face starts at the first hole corner its cuts leave, in the hole's order
+    first = np.full((len(faces), 2), np.nan)
+    ray_start = coords[corner]
+    # each face against the cuts of its own polygon (corners are in their polygon's order)
+    per_owner = np.bincount(owner[corner], minlength=len(polygons))
+    first_corner = np.r_[0, np.cumsum(per_owner)[:-1]]
+    n = per_owner[index]
+    pair_face = np.repeat(np.arange(len(faces)), n)
+    pair_corner = first_corner[index][pair_face] + np.arange(n.sum()) - np.repeat(np.cumsum(n) - n, n)
+    on = shapely.dwithin(faces[pair_face], shapely.points(ray_start[pair_corner]),
+                         1e-9 * (1.0 + np.abs(ray_start[pair_corner]).max(axis=1)))
+    pairs_face, pairs_corner = pair_face[on], pair_corner[on]
+    taken = np.r_[True, pairs_face[1:] != pairs_face[:-1]] if len(pairs_face) else np.zeros(0, bool)
+    first[pairs_face[taken]] = ray_start[pairs_corner[taken]]
+    fallback = shapely.get_coordinates(shapely.get_point(shapely.get_exterior_ring(faces), 0))
+    faces = _starting_at(faces, np.where(np.isnan(first), fallback, first))
+    whole = np.ones(len(pieces), dtype=bool)
+    whole[holed] = False
+    kept = np.flatnonzero(whole)
+    source = np.concatenate([kept, holed[index]])
+    order = np.argsort(source, kind="stable")
+    return np.concatenate([pieces[kept], faces])[order], source[order]
 
 
 def _cut_vertices(pieces: np.ndarray, limit: np.ndarray | None, across: np.ndarray):

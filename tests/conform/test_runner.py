@@ -16,8 +16,8 @@ FOOTPRINTS = ["rect_30x20", "rect_12x8", "L_30x20", "U_40x30", "courtyard_40x40"
               "triangle", "octagon"]
 #: The records grammarc meets at the kit's tolerances: (rpk, footprints, attributes). The others need PRT's
 #: own random numbers (extrusion_rule with its default random height, reporting with its random draws).
-#: candler's courtyard variant passes by a hair (0.9995 % of area): convexify parts the roof's ring
-#: differently from PRT (two roof accesses here, three there).
+#: candler's courtyard: convexify's faces of the holed roof are not all PRT's (PRT builds three roof
+#: accesses on it, grammarc's pinwheel of cuts from the hole's corners four), within the kit's tolerance.
 
 
 CANDLER_VARIANT = {"BuildingHeight": 40, "FloorHeight": 3.2, "TileWidth": 3}

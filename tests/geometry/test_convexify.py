@@ -22,7 +22,7 @@ def is_convex(pieces):
 
 
 @pytest.mark.parametrize("polygon, areas", [
-    (L_SHAPE, [200, 200]), (U_SHAPE, [300, 300, 200]), (COURTYARD, [400, 300, 300, 200]),
+    (L_SHAPE, [200, 200]), (U_SHAPE, [300, 300, 200]), (COURTYARD, [300, 300, 300, 300]),
     (shapely.box(0, 0, 5, 3), [15]),
 ])
 def test_rectilinear_footprints_become_rectangles(polygon, areas):
@@ -164,3 +164,15 @@ def test_a_nearly_straight_corner_waits_for_the_real_one():
     pieces, _ = convex_parts(np.array([roof]), None, np.array([True]))
     assert shapely.area(pieces).max() < 170
     assert np.isclose(shapely.area(pieces).sum(), roof.area)
+
+
+def test_a_hole_is_opened_by_cuts_that_stop_at_the_boundary():
+    """candler.courtyard.32354's roof (a rectangle with a turned square hole that nearly touches two of its
+    sides): from each of the hole's corners a cut runs on along one of its edges to the outer ring and
+    stops there. PRT builds roof accesses on two faces over 200 m^2, which a cut along the whole line
+    (through the hole and out the other side) split into four under it."""
+    roof = shapely.Polygon([(0.0, 41.67), (22.77, 41.67), (22.77, 0.0), (0.0, 0.0)],
+                           [[(21.91, 27.27), (11.64, 33.17), (0.86, 14.4), (11.13, 8.5)]])
+    pieces, _ = convex_parts(np.array([roof]), None, np.array([True]))
+    assert sorted(shapely.area(pieces).round(0)) == [109, 109, 237, 237]
+    assert is_convex(pieces).all()
