@@ -124,26 +124,17 @@ def _opened(pieces: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     ring_offsets = np.asarray(ring_offsets, dtype=np.int64)
     part_offsets = np.asarray(part_offsets, dtype=np.int64)
     ring = segment_of(ring_offsets)
-    start, end = ring_offsets[:-1][ring], ring_offsets[1:][ring] - 1
-    at = np.arange(len(coords))
     inner = np.ones(len(ring_offsets) - 1, dtype=bool)
     inner[part_offsets[:-1]] = False
     owner = segment_of(part_offsets)[ring]
-    prev = np.where(at > start, at - 1, end - 1)
-    d_in = coords - coords[prev]
-    d_out = coords[np.minimum(at + 1, len(coords) - 1)] - coords
-    cross = d_in[:, 0] * d_out[:, 1] - d_in[:, 1] * d_out[:, 0]
-    scale = np.hypot(d_in[:, 0], d_in[:, 1]) * np.hypot(d_out[:, 0], d_out[:, 1])
-    corner = np.flatnonzero((at < end) & inner[ring] & (cross < -1e-9 * np.maximum(scale, TOL.zero)))
+    d_in, d_out, _, reflex = _corners(coords, ring_offsets)
+    corner = np.flatnonzero(reflex & inner[ring])
     a = d_in[corner] / np.hypot(*d_in[corner].T)[:, None]
     b = d_out[corner] / np.hypot(*d_out[corner].T)[:, None]
     polygons = pieces[holed]
-    run_in, run_out = np.split(_runs(polygons, np.r_[owner[corner], owner[corner]],
-                                     np.r_[coords[corner], coords[corner]], np.r_[a, -b]), 2)
-    shorter = run_in <= run_out * (1.0 + 1e-9)
+    _, direction, run = _edge_cuts(polygons, owner[corner], coords[corner], a, b)
     # a hair past the boundary (the runs end just inside it), so that noding ends the cut on it
-    over = 1e-7 * _reach(polygons)[owner[corner]]
-    far = coords[corner] + np.where(shorter[:, None], a * (run_in + over)[:, None], -b * (run_out + over)[:, None])
+    far = coords[corner] + direction * (run + 1e-7 * _reach(polygons)[owner[corner]])[:, None]
     rays = shapely.linestrings(np.stack([coords[corner], far], axis=1))
     # each polygon's rings and its cuts, noded together, then the faces they enclose
     rings = shapely.get_rings(polygons)
@@ -173,8 +164,7 @@ def _opened(pieces: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     pairs_face, pairs_corner = pair_face[on], pair_corner[on]
     taken = np.r_[True, pairs_face[1:] != pairs_face[:-1]] if len(pairs_face) else np.zeros(0, bool)
     first[pairs_face[taken]] = ray_start[pairs_corner[taken]]
-    fallback = shapely.get_coordinates(shapely.get_point(shapely.get_exterior_ring(faces), 0))
-    faces = _starting_at(faces, np.where(np.isnan(first), fallback, first))
+    faces = _starting_at(faces, np.where(np.isnan(first), _first_vertices(faces), first))
     whole = np.ones(len(pieces), dtype=bool)
     whole[holed] = False
     kept = np.flatnonzero(whole)
@@ -198,18 +188,7 @@ def _cut_vertices(pieces: np.ndarray, limit: np.ndarray | None, across: np.ndarr
     coords = np.asarray(coords)[:, :2]
     ring_offsets = np.asarray(ring_offsets, dtype=np.int64)
     ring = segment_of(ring_offsets)
-    # closed rings: vertex j of a ring (its last point repeats its first) has neighbours j - 1 and j + 1,
-    # the previous of its first being the one before its closing point
-    start, end = ring_offsets[:-1][ring], ring_offsets[1:][ring] - 1
-    at = np.arange(len(coords))
-    real = at < end
-    prev = np.where(at > start, at - 1, end - 1)
-    nxt = at + 1
-    d_in = coords[at] - coords[prev]
-    d_out = coords[np.minimum(nxt, len(coords) - 1)] - coords[at]
-    cross = d_in[:, 0] * d_out[:, 1] - d_in[:, 1] * d_out[:, 0]
-    scale = np.hypot(d_in[:, 0], d_in[:, 1]) * np.hypot(d_out[:, 0], d_out[:, 1])
-    reflex = real & (cross < -1e-9 * np.maximum(scale, TOL.zero))
+    d_in, d_out, cross, reflex = _corners(coords, ring_offsets)
     piece = segment_of(np.asarray(part_offsets, dtype=np.int64))[ring]
     candidates = np.flatnonzero(reflex)
     # a corner that is nearly straight (under a degree) waits until the piece has no other: an L's
@@ -234,15 +213,12 @@ def _cut_vertices(pieces: np.ndarray, limit: np.ndarray | None, across: np.ndarr
     point = coords[candidates]
     left, right = point.copy(), point.copy()
     if along.any():
-        owner = piece[candidates[along]]
-        run_in, run_out = np.split(_runs(pieces, np.r_[owner, owner], np.r_[point[along], point[along]],
-                                         np.r_[a[along], -b[along]]), 2)
-        shorter = run_in <= run_out * (1.0 + 1e-9)
-        edge[np.flatnonzero(along)[shorter]] = a[along][shorter]
+        shorter, into, run = _edge_cuts(pieces, piece[candidates[along]], point[along], a[along], b[along])
+        rows = np.flatnonzero(along)
+        edge[rows[shorter]] = a[along][shorter]
         # the far end: on the right of the outgoing edge's line (the incoming edge's side), on the left of
         # the incoming edge's line
-        far = point[along] + np.where(shorter[:, None], a[along] * run_in[:, None], -b[along] * run_out[:, None])
-        rows = np.flatnonzero(along)
+        far = point[along] + into * run[:, None]
         left[rows[shorter]] = far[shorter]
         right[rows[~shorter]] = far[~shorter]
     direction = np.where(along[:, None], edge, normal)
@@ -259,6 +235,32 @@ def _cut_vertices(pieces: np.ndarray, limit: np.ndarray | None, across: np.ndarr
     starts[piece[candidates[first]], 0] = left[first]
     starts[piece[candidates[first]], 1] = right[first]
     return vertex, chosen, starts
+
+
+def _corners(coords: np.ndarray, ring_offsets: np.ndarray):
+    """Each vertex's incoming and outgoing edge (n, 2) each, their cross product (n,), and whether it is a
+    reflex corner (n,) bool (turning right, the boundary running counter-clockwise; never a ring's closing
+    point). Closed rings: vertex j of a ring (its last point repeats its first) has neighbours j - 1 and
+    j + 1, the previous of its first being the one before its closing point."""
+    ring = segment_of(ring_offsets)
+    start, end = ring_offsets[:-1][ring], ring_offsets[1:][ring] - 1
+    at = np.arange(len(coords))
+    prev = np.where(at > start, at - 1, end - 1)
+    d_in = coords - coords[prev]
+    d_out = coords[np.minimum(at + 1, len(coords) - 1)] - coords
+    cross = d_in[:, 0] * d_out[:, 1] - d_in[:, 1] * d_out[:, 0]
+    scale = np.hypot(d_in[:, 0], d_in[:, 1]) * np.hypot(d_out[:, 0], d_out[:, 1])
+    return d_in, d_out, cross, (at < end) & (cross < -1e-9 * np.maximum(scale, TOL.zero))
+
+
+def _edge_cuts(pieces: np.ndarray, owner: np.ndarray, point: np.ndarray, a: np.ndarray, b: np.ndarray):
+    """Of the two edges meeting at each corner ``point`` (k, 2) of ``pieces[owner]``, incoming ``a`` and
+    outgoing ``b`` (unit, (k, 2) each), the one whose line runs the shorter way into the piece from the
+    corner (the incoming one on a tie): whether it is the incoming one (k,), the cut's direction (k, 2)
+    and its length to the boundary (k,)."""
+    run_in, run_out = np.split(_runs(pieces, np.r_[owner, owner], np.r_[point, point], np.r_[a, -b]), 2)
+    shorter = run_in <= run_out * (1.0 + 1e-9)
+    return shorter, np.where(shorter[:, None], a, -b), np.where(shorter, run_in, run_out)
 
 
 def _runs(pieces: np.ndarray, owner: np.ndarray, point: np.ndarray, direction: np.ndarray) -> np.ndarray:
