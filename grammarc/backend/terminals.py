@@ -68,13 +68,12 @@ def emit_instances(ctx: Context, shapes: Shapes, asset: int, symbol: int, mirror
         xform = z_up(xform)
     if ctx.plan.trim_slot is not None:
         planes = trim_planes(ctx.plan, shapes)
-        world = xform.astype(np.float64)  # the trim planes are in world coordinates
-        world[:, :, 3] += base
-        cut = boxes_crossing(planes, world, TOL.zero)
+        placed = xform.astype(np.float64)  # relative to the lot's origin, as the trim planes are
+        cut = boxes_crossing(planes, placed, TOL.zero)
         mesh = ctx.asset_mesh(asset) if cut.any() else None
         if mesh is not None:
             crossing = shapes.take(cut)
-            trimmed, owner = _trimmed(ctx.plan, crossing, world[cut], base[cut], planes[cut], mesh, symbol)
+            trimmed, owner = _trimmed(ctx.plan, crossing, placed[cut], planes[cut], mesh, symbol)
             append_mesh(ctx, _with_uv(ctx, crossing, owner, trimmed) if textured else trimmed, crossing, owner)
             shapes, xform = shapes.take(~cut), xform[~cut]
     _append(ctx, shapes, xform, asset, symbol, textured)
@@ -105,13 +104,12 @@ def trim_planes(plan, shapes: Shapes) -> np.ndarray:
     return np.concatenate([planes, shallow], axis=1)
 
 
-def _trimmed(plan, shapes: Shapes, world: np.ndarray, base: np.ndarray, planes: np.ndarray, mesh,
+def _trimmed(plan, shapes: Shapes, placed: np.ndarray, planes: np.ndarray, mesh,
              symbol: int) -> tuple[MeshChunk, np.ndarray]:
-    """The asset's triangles placed by ``world`` (n, 3, 4) float64 and cut by the shapes' trim ``planes``,
-    as mesh faces relative to their lot origins ``base`` (n, 3), and the row of ``shapes`` each face comes
-    from."""
-    vertices, ring_offsets, owner = trim_triangles(mesh.vertices, mesh.faces, world, planes, TOL.zero)
-    vertices -= base[owner][segment_of(ring_offsets)]
+    """The asset's triangles placed by ``placed`` (n, 3, 4) float64 and cut by the shapes' trim
+    ``planes``, both relative to their lots' origins, as mesh faces, and the row of ``shapes`` each face
+    comes from."""
+    vertices, ring_offsets, owner = trim_triangles(mesh.vertices, mesh.faces, placed, planes, TOL.zero)
     return MeshChunk(
         vertices=vertices.astype(np.float32), ring_offsets=ring_offsets,
         face_offsets=np.arange(len(owner) + 1, dtype=np.int64), lot=shapes.lot[owner].astype(np.int32),

@@ -35,8 +35,9 @@ def side_face_planes(axes: np.ndarray, origin: np.ndarray, size: np.ndarray, par
     edge, keeping n . X + d >= 0; NaN where a face has no such neighbour or its edges are not steep.
 
     axes (m, 3, 3) world rows (x along the face's bottom edge, y up its side), origin (m, 3) the start of
-    the bottom edge, size (m, 3), parent (m,): faces of one parent meet where one's end is the next's
-    start; up (m, 3) the split shape's scope y axis in world coordinates."""
+    the bottom edge (from its lot's origin, as the planes are then), size (m, 3), parent (m,): faces of
+    one parent meet where one's end is the next's start; up (m, 3) the split shape's scope y axis in
+    world coordinates."""
     m = len(parent)
     out = np.full((m, 8), np.nan)
     if not m:
@@ -45,9 +46,8 @@ def side_face_planes(axes: np.ndarray, origin: np.ndarray, size: np.ndarray, par
     steep = (np.abs(np.einsum("ij,ij->i", y, up)) >= np.sin(np.radians(VERTICAL_DEGREES))) & (size[:, 0] > 0) & (size[:, 1] > 0)
     start = origin
     end = origin + size[:, 0:1] * x
-    scale = _corner_scale(parent, origin)
-    keys = np.concatenate([np.column_stack([parent, np.round(start / scale)]),
-                           np.column_stack([parent, np.round(end / scale)])]).astype(np.int64)
+    (first, last), _ = _corner_cells(parent, start, end)
+    keys = np.concatenate([np.column_stack([parent, first]), np.column_stack([parent, last])])
     inverse, _ = row_groups(keys)  # the same corner of the same parent: one id
     at_start, at_end = inverse[:m], inverse[m:]
     ending = np.full(int(inverse.max()) + 1, -1)
@@ -76,7 +76,7 @@ def shallow_edge_planes(verts: np.ndarray, ring_offsets: np.ndarray, face_offset
     the x-z plane of the split shape's scope (its ``up`` (m, 3)), in the order of its outline, keeping
     n . X + d >= 0; NaN after the last.
 
-    verts (V, 3) world coordinates of the m faces (outline first: ``face_offsets`` (m+1,) into
+    verts (V, 3) the corners of the m faces (from their lots' origins, as the planes are then) (outline first: ``face_offsets`` (m+1,) into
     ``ring_offsets``). The plane holds the shared edge and bisects the angle between the
     faces: its normal is the direction into this face across the edge minus the one into the neighbour,
     so a wall's ledge meets the roof's or the next slope's in a mitre, as at the vertical corners."""
@@ -98,8 +98,7 @@ def shallow_edge_planes(verts: np.ndarray, ring_offsets: np.ndarray, face_offset
     edge = q - p
     length = np.linalg.norm(edge, axis=1)
     direction = edge / np.maximum(length, 1e-300)[:, None]
-    scale = _corner_scale(parent[face], p)
-    ends = [np.round(x / scale).astype(np.int64) for x in (p, q)]
+    ends, scale = _corner_cells(parent[face], p, q)
     keys = np.concatenate([np.column_stack([parent[face], ends[0], ends[1]]),
                            np.column_stack([parent[face], ends[1], ends[0]])])
     group, _ = row_groups(keys)
@@ -127,13 +126,20 @@ def shallow_edge_planes(verts: np.ndarray, ring_offsets: np.ndarray, face_offset
     return out
 
 
-def _corner_scale(parent: np.ndarray, points: np.ndarray) -> np.ndarray:
-    """(k, 1) the grid that corners ``points`` (k, 3) of parents ``parent`` (k,) are matched on: 1e-7 of
-    their parent's largest coordinate (1 at least). Per parent, so that a lot far from the origin
-    (national-grid coordinates) coarsens no other lot's matching in its chunk."""
-    magnitude = np.ones(int(parent.max()) + 1)
-    np.maximum.at(magnitude, parent, np.abs(points).max(axis=1))
-    return (magnitude * 1e-7)[parent][:, None]
+def _corner_cells(parent: np.ndarray, *points: np.ndarray) -> tuple[list[np.ndarray], np.ndarray]:
+    """The grid cells (k, 3) int64 that corners ``points`` (each (k, 3)) of parents ``parent`` (k,) are
+    matched on, and the grid's spacing (k, 1): 1e-7 of the parent's extent (1 at least), from the
+    parent's lowest corner. Per parent and from its own corner, so that a lot far from the origin
+    (national-grid coordinates) is matched as it would be at the origin and coarsens no other lot's
+    matching in its chunk (a grid of its coordinates' magnitude, 0.8 m at 7.8e6, made the corners of
+    complexpatterns' 0.6 m deep top floors one corner)."""
+    n = int(parent.max()) + 1
+    low, high = np.full((n, 3), np.inf), np.full((n, 3), -np.inf)
+    for p in points:
+        np.minimum.at(low, parent, p)
+        np.maximum.at(high, parent, p)
+    scale = (np.maximum((high - low).max(axis=1), 1.0) * 1e-7)[parent][:, None]
+    return [np.round((p - low[parent]) / scale).astype(np.int64) for p in points], scale
 
 
 def plane_coordinates(normal: np.ndarray) -> np.ndarray:
@@ -173,7 +179,7 @@ def boxes_crossing(planes, xform, eps):
 @njit(cache=True, nogil=True)
 def trim_triangles(verts, tris, xform, planes, eps):
     """Triangles of an asset (verts (v, 3) in its unit box, tris (t, 3)) placed by xform (k, 3, 4) and
-    cut by each placement's planes (k, 4 P; NaN: none): the kept polygons in world coordinates.
+    cut by each placement's planes (k, 4 P; NaN: none): the kept polygons in the placements' coordinates.
     Returns vertices (V, 3), ring_offsets (F+1,) and each polygon's placement (F,)."""
     k_count, t_count = len(xform), len(tris)
     n_planes = planes.shape[1] // 4

@@ -103,3 +103,18 @@ def test_shallow_edge_planes_of_a_box_bisect_its_horizontal_edges():
         normal, offset = plane[4 * k:4 * k + 3], plane[4 * k + 3]
         assert np.abs(normal) @ np.ones(3) == pytest.approx(np.sqrt(2))
         assert normal @ mine + offset > 0 > normal @ theirs + offset
+
+
+def test_corners_far_from_the_origin_are_matched_as_at_the_origin():
+    """The side faces of a 0.64 x 11 m box (complexpatterns' top floor on a lot of Uummannaq) 7,842 km
+    north in UTM get the planes they get at the origin, moved with them. Corners matched on a grid of
+    the coordinates' magnitude (0.78 m there) made the box's two corners 0.64 m apart one, and the faces
+    at its ends lost their neighbours."""
+    axes, origin, size = box_sides(width=0.64, depth=11.1)
+    far = np.array([457596.4, 0.0, -7842088.517217704])
+    here = side_face_planes(axes, origin, size, np.zeros(4, dtype=np.int64), UP)
+    there = side_face_planes(axes, origin + far, size, np.zeros(4, dtype=np.int64), UP)
+    assert not np.isnan(there).any()
+    np.testing.assert_allclose(there[:, [0, 1, 2, 4, 5, 6]], here[:, [0, 1, 2, 4, 5, 6]], atol=1e-12)
+    moved = here[:, [3, 7]] - np.stack([here[:, 0:3] @ far, here[:, 4:7] @ far], axis=1)
+    np.testing.assert_allclose(there[:, [3, 7]], moved, atol=1e-6)

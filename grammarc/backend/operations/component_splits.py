@@ -75,17 +75,19 @@ def comp_faces(ctx: Context, cursor: Shapes, op: ir.CompFaces) -> Parts:
     slot = ctx.plan.trim_slot
     if op.kind == "f" and slot is not None:
         # the faces' trim planes where they meet their neighbours (``geometry.trim``)
+        # relative to the lot's origin, so that a lot far from the origin is trimmed as it is there
         up = chunk.frames[cursor.frame[parent]][:, 1]
-        planes = side_face_planes(chunk.frames[shapes.frame], shapes.origin, shapes.size, parent, up)
+        origin = shapes.origin - chunk.lot_origin[shapes.lot]
+        planes = side_face_planes(chunk.frames[shapes.frame], origin, shapes.size, parent, up)
         dynamic = list(shapes.dynamic)
         dynamic[slot:slot + 8] = list(planes.T)
         shallow = ctx.plan.horizontal_slot
         if shallow is not None:
-            # each component is one face (none for a degenerate one): its outline in world coordinates
+            # each component is one face (none for a degenerate one): its outline from the lot's origin
             faces = shape_faces(shapes.size, shapes.geom, chunk.polygons, chunk.meshes)
             owner, at = faces.face_shape(), faces.vertex_shape()
-            world = shapes.origin[at] + np.einsum("vi,vij->vj", faces.verts, chunk.frames[shapes.frame[at]])
-            found = shallow_edge_planes(world, faces.ring_offsets, faces.face_offsets, parent[owner], up[owner])
+            verts = origin[at] + np.einsum("vi,vij->vj", faces.verts, chunk.frames[shapes.frame[at]])
+            found = shallow_edge_planes(verts, faces.ring_offsets, faces.face_offsets, parent[owner], up[owner])
             planes = np.full((len(shapes), found.shape[1]), np.nan)
             planes[owner] = found
             dynamic[shallow:shallow + planes.shape[1]] = list(planes.T)

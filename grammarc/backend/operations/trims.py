@@ -51,7 +51,8 @@ def trim(ctx: Context, cursor: Shapes, op: ir.Trim) -> Shapes:
         normal = np.where(present[:, None], plane[:, :3], (1.0, 0.0, 0.0))
         # the plane in scope units: its normal along the scope's axes, its offset from the scope's origin
         frame = plane_coordinates(np.einsum("nij,nj->ni", axes, normal))
-        offset = np.where(present, np.einsum("nj,nj->n", normal, shapes.origin) + plane[:, 3], 0.0)
+        origin = shapes.origin - chunk.lot_origin[shapes.lot]  # the planes are relative to the lot's origin
+        offset = np.where(present, np.einsum("nj,nj->n", normal, origin) + plane[:, 3], 0.0)
         vertex_shape = segment_of(mesh_offsets)[segment_of(face_offsets)][segment_of(ring_offsets)]
         local = np.einsum("nij,nj->ni", frame[vertex_shape], verts)
         local[:, 0] += offset[vertex_shape]
