@@ -158,9 +158,9 @@ def append_records(ctx: Context, xform: np.ndarray, lot: np.ndarray, asset: int,
     if uv is not None:
         out.uv.append(uv)
     out.xform.append(xform)
-    out.asset.append(np.full(len(lot), asset, dtype=np.int32))
-    out.lot.append(lot.astype(np.int32))
-    out.symbol.append(np.full(len(lot), symbol, dtype=np.int32))
+    out.asset.append(asset)
+    out.lot.append(lot.astype(np.int32, copy=False))
+    out.symbol.append(symbol)
     if ctx.plan.color_slot is not None:
         out.color.append(rgba(color))
     if material is not None:
