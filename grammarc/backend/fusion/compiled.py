@@ -63,6 +63,26 @@ def kernel(text: str, columns: int):
     return module.derive
 
 
+def import_compiled() -> int:
+    """Import the module of every kernel that a build compiled into the cache folder (its mark beside it),
+    as a warm server does before it serves (``server.load_cached_kernels`` then loads their machine
+    code): a command forked from it finds them ready, without reading, importing or loading them
+    itself. Returns how many."""
+    folder = user_cache.cache_folder("fusion")
+    if folder is None:
+        return 0
+    imported = 0
+    for mark in sorted(folder.glob("region_*.compiled")):
+        text = user_cache.load(mark.with_suffix(".py"), lambda f: f.read().decode())
+        if text is None or text in _KERNELS or not user_cache.load(mark, lambda f: True) \
+                or mark.stem != f"region_{digest(text)}":
+            continue
+        module, _ = load(text)
+        _KERNELS[text] = module.derive
+        imported += 1
+    return imported
+
+
 #: Shapes this process derived without the kernel of a source text, because it was not compiled yet.
 _WAITED: dict[str, int] = {}
 
@@ -106,7 +126,7 @@ def load(text: str):
         if user_cache.load(path, lambda f: f.read().decode()) != text:  # a folder that cannot be written
             path = _private_folder() / path.name
             path.write_text(text)
-    name = f"grammarc_fused_{key}"
+    name = f"grammarc_fused_{key}"  # ``server.FUSED_MODULES``
     spec = importlib.util.spec_from_file_location(name, path)
     module = importlib.util.module_from_spec(spec)
     sys.modules[name] = module  # numba's cache finds the functions' globals by the module's name

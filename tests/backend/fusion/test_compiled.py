@@ -81,3 +81,17 @@ with ProcessPoolExecutor(1, mp_context=multiprocessing.get_context("fork")) as p
     assert run.returncode == 0, run.stderr
     worker, own = run.stdout.split()
     assert worker != own and list(temp.iterdir()) == []
+
+
+def test_the_modules_of_compiled_kernels_are_imported_for_a_warm_server(own_cache, monkeypatch):
+    monkeypatch.setattr(compiled, "_KERNELS", {})
+    marked, unmarked = TEXT.replace("stand-in", "marked stand-in"), TEXT.replace("stand-in", "unmarked stand-in")
+    for text in (marked, unmarked):
+        compiled.load(text)
+    (own_cache / f"region_{compiled.digest(marked)}.compiled").touch(mode=0o600)
+    stale = own_cache / f"region_{compiled.digest('another text')}"  # a mark whose module holds another text
+    stale.with_suffix(".py").write_text(TEXT)
+    stale.with_suffix(".compiled").touch(mode=0o600)
+    assert compiled.import_compiled() == 1
+    assert list(compiled._KERNELS) == [marked] and compiled._KERNELS[marked](1) == 2
+    assert compiled.import_compiled() == 0  # imported once
