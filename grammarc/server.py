@@ -280,6 +280,11 @@ def _child(connection: socket.socket, run: Callable[[list[str]], int]) -> None:
 
             traceback.print_exc()
     finally:
+        # The command is over: a client that hangs up once it has its status makes ``_watch`` send a
+        # SIGTERM, which must not raise here, past ``_exit``, into the server's own code (which would say
+        # "error: 15" on the client's streams)
+        for signum in (signal.SIGINT, *_FORWARDED):
+            signal.signal(signum, signal.SIG_IGN)
         with contextlib.suppress(BaseException):
             sys.stdout.flush()
             sys.stderr.flush()
