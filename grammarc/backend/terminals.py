@@ -151,9 +151,12 @@ def append_records(ctx: Context, xform: np.ndarray, lot: np.ndarray, asset: int,
     """Add instance records: transforms, lots, and colours (packed floats) and texture channels (string ids
     (n, k)) where the grammar sets them (``backend.materials``), and texture maps (``TerminalChunk.uv``)
     where it has texture coordinates."""
-    if not np.isfinite(xform).all():
+    # the sum is finite where every value is: one pass and no temporary for the usual case; a sum that
+    # overflowed, or a value that is not finite, is looked at value by value
+    if not np.isfinite(xform.sum()):
         bad = ~np.isfinite(xform).all(axis=(1, 2))
-        _fail_non_finite(ctx, lot[bad], xform[bad], "an instance")
+        if bad.any():
+            _fail_non_finite(ctx, lot[bad], xform[bad], "an instance")
     out = ctx.chunk.outputs
     if uv is not None:
         out.uv.append(uv)
