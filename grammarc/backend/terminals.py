@@ -152,8 +152,11 @@ def append_records(ctx: Context, xform: np.ndarray, lot: np.ndarray, asset: int,
     (n, k)) where the grammar sets them (``backend.materials``), and texture maps (``TerminalChunk.uv``)
     where it has texture coordinates."""
     # the sum is finite where every value is: one pass and no temporary for the usual case; a sum that
-    # overflowed, or a value that is not finite, is looked at value by value
-    if not np.isfinite(xform.sum()):
+    # overflowed (which is no failure: not warned about), or a value that is not finite, is looked at
+    # value by value
+    with np.errstate(over="ignore", invalid="ignore"):
+        total = xform.sum()
+    if not np.isfinite(total):
         bad = ~np.isfinite(xform).all(axis=(1, 2))
         if bad.any():
             _fail_non_finite(ctx, lot[bad], xform[bad], "an instance")
