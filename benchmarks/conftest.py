@@ -57,18 +57,20 @@ def concave_lots(path: Path, n: int, seed: int = 7) -> Path:
     return path
 
 
-def run_build(args: list[str], env: dict | None = None) -> dict:
+def run_build(args: list[str], env: dict | None = None, entry: str = "grammarc.cli") -> dict:
     """Run ``grammarc build`` in a child process; returns its stderr and its own peak RSS (KiB)."""
-    return run_command("build", args, env)
+    return run_command("build", args, env, entry)
 
 
-def run_command(command: str, args: list[str], env: dict | None = None) -> dict:
+def run_command(command: str, args: list[str], env: dict | None = None, entry: str = "grammarc.cli") -> dict:
     """Run ``grammarc COMMAND`` in a child process; returns its stderr and its own peak RSS (KiB).
 
-    ``os.wait4`` gives the child's own resource usage (RUSAGE_CHILDREN would be the maximum over every
-    child the benchmark session ever waited for).
+    ``entry`` is the module run: ``grammarc.cli`` runs the command in the child itself, ``grammarc.client``
+    as the ``grammarc`` command does (in a fork of a warm server where one is up: the RSS is then the
+    client's). ``os.wait4`` gives the child's own resource usage (RUSAGE_CHILDREN would be the maximum
+    over every child the benchmark session ever waited for).
     """
-    proc = subprocess.Popen([sys.executable, "-m", "grammarc.cli", command, *args],
+    proc = subprocess.Popen([sys.executable, "-m", entry, command, *args],
                             stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True,
                             env={**os.environ, **(env or {})})
     stderr = proc.stderr.read()

@@ -355,12 +355,14 @@ def _detached(serve, ready) -> int:
 
 def _warm() -> None:
     """What a server loads before serving: every module of grammarc (those of extras not installed
-    excepted), the dialects' parsers, and the machine code of every kernel numba has cached."""
+    excepted), the dialects' parsers, the fused regions' kernels that builds compiled, and the machine
+    code of every kernel numba has cached."""
     import importlib
     import pkgutil
 
     import grammarc
     from grammarc import server
+    from grammarc.backend.fusion import compiled
     from grammarc.frontend.parse import DIALECTS
     from grammarc.frontend.parsers import parser_for
 
@@ -371,6 +373,7 @@ def _warm() -> None:
             continue
     for dialect in DIALECTS.values():
         parser_for(dialect.grammar)
+    compiled.import_compiled()
     server.load_cached_kernels()
 
 

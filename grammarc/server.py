@@ -51,6 +51,8 @@ _LENGTH = struct.Struct("!I")
 #: Server to client: the command's exit status.
 _STATUS = struct.Struct("!i")
 _FORWARDED = (signal.SIGINT, signal.SIGTERM, getattr(signal, "SIGHUP", signal.SIGTERM))
+#: The prefix of the names of fused regions' generated modules (``backend.fusion.compiled.load``).
+FUSED_MODULES = "grammarc_fused_"
 #: Whether this system can run a server: it forks, and passes descriptors over Unix sockets (not Windows).
 AVAILABLE = hasattr(os, "fork") and hasattr(socket, "send_fds") and hasattr(signal, "pthread_sigmask")
 
@@ -169,8 +171,9 @@ def servers() -> dict[Path, int]:
 
 
 def load_cached_kernels() -> int:
-    """Load the machine code of every kernel of grammarc's imported modules that numba's cache holds for
-    this version of its source; returns how many were loaded. Kernels not cached yet are left to be
+    """Load the machine code of every kernel of grammarc's imported modules (its own, and the generated
+    modules of fused regions, ``backend.fusion.compiled``) that numba's cache holds for this version of
+    its source; returns how many were loaded. Kernels not cached yet are left to be
     compiled on their first call, as without a server.
 
     numba offers no public way to list a function's cached signatures: its cache index is read through
@@ -181,7 +184,7 @@ def load_cached_kernels() -> int:
 
     loaded = 0
     for name, module in list(sys.modules.items()):
-        if not name.startswith("grammarc.") or module is None:
+        if not name.startswith(("grammarc.", FUSED_MODULES)) or module is None:
             continue
         for kernel in list(vars(module).values()):
             if not isinstance(kernel, Dispatcher) or kernel.__module__ != name:
@@ -277,6 +280,11 @@ def _child(connection: socket.socket, run: Callable[[list[str]], int]) -> None:
 
             traceback.print_exc()
     finally:
+        # The command is over: a client that hangs up once it has its status makes ``_watch`` send a
+        # SIGTERM, which must not raise here, past ``_exit``, into the server's own code (which would say
+        # "error: 15" on the client's streams)
+        for signum in (signal.SIGINT, *_FORWARDED):
+            signal.signal(signum, signal.SIG_IGN)
         with contextlib.suppress(BaseException):
             sys.stdout.flush()
             sys.stderr.flush()

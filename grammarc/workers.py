@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import contextlib
 import dataclasses
+import functools
 import itertools
 import multiprocessing
 import os
@@ -49,17 +50,13 @@ _ALIGN = 64
 def worker_pool(work: Callable, workers: int):
     """``submit(lots) -> Future`` of ``work(lots)``, which returns ``(results, failed)`` with results
     ``[(n_lots, (records, per_lot))]``: in this process when ``workers`` is 1 or processes cannot be forked
-    (Windows), else in ``workers`` forked processes."""
-    if workers == 1 or "fork" not in multiprocessing.get_all_start_methods():
-        def at_once(lots) -> Future:
-            future: Future = Future()
-            try:
-                future.set_result(work(lots))
-            except BaseException as error:  # noqa: BLE001 - handed to the caller by future.result()
-                future.set_exception(error)
-            return future
+    (Windows), else in ``workers`` forked processes, but for the first task.
 
-        yield at_once
+    The first task runs in this process, before the workers are forked: the kernels it loads (numba's
+    machine code from its cache, fused regions' modules) are then the workers' from the start, where
+    each worker would load them again, in every build, at a cost of a few hundredths of a second each."""
+    if workers == 1 or "fork" not in multiprocessing.get_all_start_methods():
+        yield functools.partial(_at_once, work)
         return
     memory = "/dev/shm" if os.path.isdir("/dev/shm") and os.access("/dev/shm", os.W_OK) else None
     shared = Path(memory if memory is not None else tempfile.gettempdir())
@@ -67,9 +64,14 @@ def worker_pool(work: Callable, workers: int):
     folder = Path(tempfile.mkdtemp(prefix=f"grammarc-records-{os.getpid()}-", dir=shared))
     _SHARED.update(work=work, folder=folder)
     try:
+        forked = False
         with ProcessPoolExecutor(workers, mp_context=multiprocessing.get_context("fork"),
                                  initializer=_die_with_parent) as pool:
             def submit(lots) -> Future:
+                nonlocal forked
+                if not forked:  # the pool forks its workers at its first task: this one runs here
+                    forked = True
+                    return _at_once(work, lots)
                 shipped = pool.submit(_run, lots)
                 received: Future = Future()
                 shipped.add_done_callback(lambda done: _receive(done, received, lots))
@@ -79,6 +81,16 @@ def worker_pool(work: Callable, workers: int):
     finally:
         _SHARED.clear()
         shutil.rmtree(folder, ignore_errors=True)
+
+
+def _at_once(work: Callable, lots) -> Future:
+    """The future of ``work(lots)``, run in this process."""
+    future: Future = Future()
+    try:
+        future.set_result(work(lots))
+    except BaseException as error:  # noqa: BLE001 - handed to the caller by future.result()
+        future.set_exception(error)
+    return future
 
 
 def _die_with_parent() -> None:
@@ -135,7 +147,7 @@ def _ship(records, path: Path) -> tuple:
     layout = _layout(records, arrays, [0])
     with open(path, "wb") as out:
         for array in arrays:
-            out.write(np.ascontiguousarray(array).tobytes())
+            out.write(np.ascontiguousarray(array).reshape(-1).view(np.uint8))  # its bytes, not a copy
             out.write(b"\0" * (-array.nbytes % _ALIGN))
     return str(path), layout
 

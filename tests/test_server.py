@@ -167,3 +167,19 @@ def test_the_kernels_numba_cached_are_loaded_without_a_call():
     loaded, overloads = subprocess.run([sys.executable, "-c", script], check=True, capture_output=True,
                                        text=True).stdout.split()
     assert int(loaded) >= 1 and int(overloads) >= 1
+
+
+def test_a_fused_kernel_a_build_compiled_is_loaded_without_a_call(tmp_path):
+    text = '"""A stand-in for a generated module."""\nfrom numba import njit\n\n\n' \
+           '@njit(cache=True)\ndef derive(x):\n    return x + 1\n'
+    env = {**os.environ, "XDG_CACHE_HOME": str(tmp_path)}
+    build = ("from grammarc.backend.fusion import compiled\n"
+             f"module, path = compiled.load({text!r})\nmodule.derive(1)\n"
+             "path.with_suffix('.compiled').touch(mode=0o600)\n")
+    subprocess.run([sys.executable, "-c", build], env=env, check=True)
+    warm = ("from grammarc import server\nfrom grammarc.backend.fusion import compiled\n"
+            "print(compiled.import_compiled(), server.load_cached_kernels(), "
+            f"len(compiled._KERNELS[{text!r}].overloads))\n")
+    imported, loaded, overloads = subprocess.run([sys.executable, "-c", warm], env=env, check=True,
+                                                 capture_output=True, text=True).stdout.split()
+    assert (imported, overloads) == ("1", "1") and int(loaded) >= 1

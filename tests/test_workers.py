@@ -1,5 +1,7 @@
 """Worker processes: records shipped through memory files come back equal; bad lots come back named."""
 
+import os
+
 import numpy as np
 import pytest
 
@@ -56,8 +58,14 @@ def test_a_worker_killed_by_sigkill_fails_the_build_with_one_line():
     from grammarc.workers import worker_pool
 
     lots = lots_from_polygons([[np.array([[0, 0], [10, 0], [10, 10], [0, 10]], float)]] * 3)
-    with (worker_pool(lambda lots: os.kill(os.getpid(), signal.SIGKILL), 2) as submit,
+    parent = os.getpid()
+
+    def work(lots):
+        return ([], []) if os.getpid() == parent else os.kill(os.getpid(), signal.SIGKILL)
+
+    with (worker_pool(work, 2) as submit,
           pytest.raises(DerivationError, match=r"worker process was killed while deriving lots #0-#2")):
+        assert submit(lots).result() == ([], [])  # the first task, here
         submit(lots).result(timeout=60)
 
 
@@ -69,9 +77,29 @@ def test_a_chunk_given_up_by_a_stopped_build_is_dropped_without_a_traceback(capl
     from grammarc.workers import worker_pool
 
     with worker_pool(lambda lots: (time.sleep(0.5), ([], []))[1], 2) as submit:
+        assert submit([]).done()  # the first task ran here
         in_flight = submit([])
         assert in_flight.cancel()
     assert in_flight.cancelled() and not [r for r in caplog.records if r.levelname == "ERROR"]
+
+
+LOADED: list[int] = []  # what a task loaded (a kernel's machine code), in the process that ran it
+
+
+def _load_and_say(lots):
+    LOADED.append(os.getpid())
+    return [], (os.getpid(), list(LOADED))
+
+
+def test_the_first_task_runs_here_and_the_workers_inherit_what_it_loaded():
+    from grammarc.workers import worker_pool
+
+    LOADED.clear()
+    with worker_pool(_load_and_say, 2) as submit:
+        _, (here, loaded) = submit([]).result()
+        assert here == os.getpid() and loaded == [here]
+        for _, (worker, loaded) in (f.result(timeout=60) for f in [submit([]), submit([])]):
+            assert worker != here and loaded[0] == here  # forked after the first task: they have its load
 
 
 @pytest.mark.parametrize(("lots", "chunk_size", "forked"), [(3, 16384, False), (3, 2, True), (65, 16384, True)])

@@ -69,7 +69,11 @@ class TextureMaps(Table):
 
 @dataclass
 class Outputs:
-    """Terminal rows and leaf meshes of a chunk, as lists of arrays concatenated at the end."""
+    """Terminal rows and leaf meshes of a chunk, as lists of arrays concatenated at the end.
+
+    Rows come in pieces of one asset and one symbol (``terminals.append_records``): ``asset`` and
+    ``symbol`` hold a piece's ids, not a column, which ``derive.collect`` writes once, in sorted order.
+    """
 
     asset: list = field(default_factory=list)
     xform: list = field(default_factory=list)

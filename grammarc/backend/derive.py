@@ -20,7 +20,7 @@ from grammarc.backend.chunk import Chunk, Frames
 from grammarc.backend.context import Context
 from grammarc.backend.evaluate import Env
 from grammarc.backend.execute import apply_pending
-from grammarc.backend.kernels.order import group_by, scatter_rows
+from grammarc.backend.kernels.order import place, put, scatter_rows, tally
 from grammarc.backend.materials import MAP_FIELDS, collect_materials
 from grammarc.backend.occlusion import Occluders
 from grammarc.backend.pivot import initial_column as initial_pivot
@@ -47,6 +47,8 @@ from grammarc.geometry.streets import lot_streets
 from grammarc.model.lots import Lots
 from grammarc.model.records import LotOrigins, MeshChunk, TerminalChunk
 from grammarc.ragged import ragged_take
+
+_NO_WEIGHTS = np.zeros(0, np.int64)  # ``tally``: each row counts 1
 
 
 def initial_chunk(lots: Lots, seed: int, foreign: Occluders | None = None,
@@ -167,17 +169,25 @@ def collect(chunk: Chunk, plan: Plan) -> TerminalChunk:
     """The chunk's records, sorted stably by lot, with lots numbered as in the input, relative to their lots'
     scope origins (``LotOrigins``).
 
-    Rows are scattered straight from the pieces the operations emitted into their sorted places, so each
-    column is copied once. Texture channels become the chunk's table of materials (``backend.materials``).
+    Rows are scattered straight from the pieces the operations emitted into their sorted places (a counting
+    sort: one pass over the rows' lots to count, one to place them), so each column is copied once; a
+    piece's asset and symbol, one id each, are written there. Texture channels become the chunk's table of
+    materials (``backend.materials``).
     """
     out = chunk.outputs
-    n_lots = len(chunk.lot_index)
     lot = np.concatenate(out.lot) if out.lot else np.zeros(0, dtype=np.int32)
-    order, _ = group_by(lot.astype(np.int64), n_lots)
-    dest = np.empty_like(order)
-    dest[order] = np.arange(len(order))
+    counts = np.zeros(len(chunk.lot_index), np.int64)
+    tally(counts, lot, _NO_WEIGHTS)
+    fill = np.zeros(len(counts), np.int64)
+    np.cumsum(counts[:-1], out=fill[1:])
+    dest = place(lot, fill)  # a stable counting sort: each row's place among the chunk's sorted rows
+    bounds = np.cumsum([0, *map(len, out.lot)])
     columns = {}
-    names = [("asset", (), np.int32), ("xform", (3, 4), np.float32), ("symbol", (), np.int32)]
+    for name, ids in (("asset", out.asset), ("symbol", out.symbol)):  # one id for each piece of rows
+        columns[name] = np.empty(len(lot), np.int32)
+        for k, value in enumerate(ids):
+            put(value, dest[bounds[k]:bounds[k + 1]], columns[name])
+    names = [("xform", (3, 4), np.float32)]
     if out.color:
         names.append(("color", (4,), np.uint8))
     if plan.material_slots:
@@ -207,7 +217,7 @@ def collect(chunk: Chunk, plan: Plan) -> TerminalChunk:
         material, mesh_material = both[:len(lot)], both[len(lot):]
     mesh = MeshChunk(mesh.vertices, mesh.ring_offsets, mesh.face_offsets, index[mesh.lot], mesh.symbol,
                      mesh.color, mesh_material, materials, mesh.uv)
-    return TerminalChunk(asset=columns["asset"], xform=columns["xform"], lot=index[lot[order]],
+    return TerminalChunk(asset=columns["asset"], xform=columns["xform"], lot=np.repeat(index, counts),
                          symbol=columns["symbol"], mesh=mesh, color=columns.get("color"), material=material,
                          materials=materials, uv=columns.get("uv"),
                          origins=LotOrigins.of_lots(index, chunk.lot_origin))

@@ -149,16 +149,22 @@ def append_records(ctx: Context, xform: np.ndarray, lot: np.ndarray, asset: int,
     """Add instance records: transforms, lots, and colours (packed floats) and texture channels (string ids
     (n, k)) where the grammar sets them (``backend.materials``), and texture maps (``TerminalChunk.uv``)
     where it has texture coordinates."""
-    if not np.isfinite(xform).all():
+    # the sum is finite where every value is: one pass and no temporary for the usual case; a sum that
+    # overflowed (which is no failure: not warned about), or a value that is not finite, is looked at
+    # value by value
+    with np.errstate(over="ignore", invalid="ignore"):
+        total = xform.sum()
+    if not np.isfinite(total):
         bad = ~np.isfinite(xform).all(axis=(1, 2))
-        _fail_non_finite(ctx, lot[bad], xform[bad], "an instance")
+        if bad.any():
+            _fail_non_finite(ctx, lot[bad], xform[bad], "an instance")
     out = ctx.chunk.outputs
     if uv is not None:
         out.uv.append(uv)
     out.xform.append(xform)
-    out.asset.append(np.full(len(lot), asset, dtype=np.int32))
-    out.lot.append(lot.astype(np.int32))
-    out.symbol.append(np.full(len(lot), symbol, dtype=np.int32))
+    out.asset.append(asset)
+    out.lot.append(lot.astype(np.int32, copy=False))
+    out.symbol.append(symbol)
     if ctx.plan.color_slot is not None:
         out.color.append(rgba(color))
     if material is not None:

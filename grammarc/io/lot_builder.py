@@ -157,6 +157,18 @@ class LotBuilder:
                 self._add_one(*entry)
             return
         xyz = _with_z(positions[:, :3])
+        if all(rings and STREET_WIDTH not in props for _, _, rings, props in queued):
+            # lots with rings and no street edges (most files): added as one block, as ``_add`` adds each
+            self.polygons += len(queued)
+            self.rings.append(xyz)
+            self.sizes.extend(np.diff(offsets).tolist())
+            self.vertices += len(xyz)
+            for index, lot_id, rings, props in queued:
+                self.ring_counts.append(len(rings))
+                self.index.append(index)
+                self.ids.append(lot_id)
+                self.props.append(props)
+            return
         k = 0
         for index, lot_id, rings, props in queued:
             self._add(index, lot_id, [xyz[offsets[j]:offsets[j + 1]] for j in range(k, k + len(rings))], props)

@@ -90,7 +90,8 @@ class Lots:
         lots : Lots
           The selected lots with rebased offsets and sliced attrs; ``bad`` and ``source`` are kept as is.
         """
-        lot = np.atleast_1d(np.arange(len(self))[sel])
+        # a slice (a chunk of a build) costs its own length, not that of all the lots
+        lot = np.arange(*sel.indices(len(self))) if isinstance(sel, slice) else np.atleast_1d(np.arange(len(self))[sel])
         ring, lot_offsets = ragged_take(self.lot_offsets, lot)
         vertex, ring_offsets = ragged_take(self.ring_offsets, ring)
         return Lots(

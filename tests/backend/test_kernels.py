@@ -7,7 +7,7 @@ import math
 import numpy as np
 import pytest
 
-from grammarc.backend.kernels.order import group_by, scatter_rows, tally
+from grammarc.backend.kernels.order import group_by, place, put, scatter_rows, tally
 from grammarc.backend.kernels.scope import place_children, xforms
 from grammarc.backend.kernels.split import repeat, repeat_counts, subdiv
 from grammarc.backend.random import child_keys
@@ -182,6 +182,31 @@ def test_scatter_rows(n):
     want[dest] = src
     scatter_rows(src, dest, out)
     assert np.array_equal(out, want)
+
+
+@pytest.mark.parametrize("n", SIZES)
+@pytest.mark.parametrize("k", [1, 3, 8])
+def test_place_in_pieces_is_a_stable_counting_sort(n, k):
+    group = np.random.default_rng(n + k).integers(0, k, n).astype(np.int32)
+    counts = np.bincount(group, minlength=k)
+    fill = np.concatenate([[0], np.cumsum(counts)[:-1]]).astype(np.int64)
+    cut = n // 3
+    dest = np.concatenate([place(group[:cut], fill), place(group[cut:], fill)])  # fill carries over
+    order = np.argsort(group, kind="stable")
+    assert dest.tolist() == np.argsort(order).tolist()
+    assert fill.tolist() == np.cumsum(counts).tolist()
+
+
+def test_place_docstring_example():
+    fill = np.array([0, 2], np.int64)
+    assert place(np.array([1, 0, 1]), fill).tolist() == [2, 0, 3]
+    assert fill.tolist() == [1, 4]
+
+
+def test_put():
+    out = np.zeros(5, np.int32)
+    put(7, np.array([4, 1], np.int64), out)
+    assert out.tolist() == [0, 7, 0, 0, 7]
 
 
 # -------------------------------------------------------------------------------------------------- scope

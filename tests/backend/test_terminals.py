@@ -106,6 +106,16 @@ def test_a_record_with_a_coordinate_that_is_not_finite_fails_its_lot_with_the_ru
     assert "(not finite as float32) in rule `lot` at " in bad.reason
 
 
+def test_records_whose_sum_overflows_float32_are_finite_and_kept(write):
+    """Finite transforms whose float32 sum is not (two heights of 3e38) are checked value by value and kept:
+    the sum only spares that check where it is finite."""
+    text = 'attr height = 9\nlot ~> S(1r, height, 1r) Repeat("X", 2){ I("cube") }\n'
+    r = paper(write, text, [rect(4, 4)] * 2, lot_attrs={"height": np.array([3e38, 3e38])})
+    assert not r["bad"] and r["lot"].tolist() == [0, 0, 1, 1]
+    with np.errstate(over="ignore"):
+        assert np.isinf(r["xform"].astype(np.float32).sum()) and np.isfinite(r["xform"]).all()
+
+
 def test_a_mesh_vertex_that_is_not_finite_fails_its_lot_with_the_rule(write):
     r = run(write, "attr h = 3\nLot --> roofHip(byHeight, h) Roof.\n", [rect(10, 10)] * 2,
             lot_attrs={"h": np.array([3.0, 1e39])})

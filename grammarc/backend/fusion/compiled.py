@@ -5,7 +5,7 @@ The file is named by a digest of its text (the text is a function of the region'
 the region's key): an unchanged grammar finds its kernels compiled; a changed one writes a new file. A file
 is imported only if it is the user's own, writable by nobody else, and holds exactly the text expected
 (``frontend.user_cache``); where the cache folder cannot be used, the module goes to a private temporary
-folder of this process, and is compiled again in the next.
+folder of this process, removed when it exits, and is compiled again in the next.
 """
 
 from __future__ import annotations
@@ -13,10 +13,12 @@ from __future__ import annotations
 import hashlib
 import importlib.util
 import os
+import shutil
 import sys
 import tempfile
 from contextlib import contextmanager
 from functools import cache
+from multiprocessing.util import Finalize
 from pathlib import Path
 
 import numpy as np
@@ -26,6 +28,7 @@ try:
 except ImportError:  # Windows: no forked workers to wait for
     fcntl = None
 
+from grammarc.atomic import remove_stale
 from grammarc.frontend import user_cache
 
 
@@ -58,6 +61,26 @@ def kernel(text: str, columns: int):
     user_cache.store(path.with_suffix(".compiled"), lambda f: None)
     _KERNELS[text] = module.derive
     return module.derive
+
+
+def import_compiled() -> int:
+    """Import the module of every kernel that a build compiled into the cache folder (its mark beside it),
+    as a warm server does before it serves (``server.load_cached_kernels`` then loads their machine
+    code): a command forked from it finds them ready, without reading, importing or loading them
+    itself. Returns how many."""
+    folder = user_cache.cache_folder("fusion")
+    if folder is None:
+        return 0
+    imported = 0
+    for mark in sorted(folder.glob("region_*.compiled")):
+        text = user_cache.load(mark.with_suffix(".py"), lambda f: f.read().decode())
+        if text is None or text in _KERNELS or not user_cache.load(mark, lambda f: True) \
+                or mark.stem != f"region_{digest(text)}":
+            continue
+        module, _ = load(text)
+        _KERNELS[text] = module.derive
+        imported += 1
+    return imported
 
 
 #: Shapes this process derived without the kernel of a source text, because it was not compiled yet.
@@ -103,7 +126,7 @@ def load(text: str):
         if user_cache.load(path, lambda f: f.read().decode()) != text:  # a folder that cannot be written
             path = _private_folder() / path.name
             path.write_text(text)
-    name = f"grammarc_fused_{key}"
+    name = f"grammarc_fused_{key}"  # ``server.FUSED_MODULES``
     spec = importlib.util.spec_from_file_location(name, path)
     module = importlib.util.module_from_spec(spec)
     sys.modules[name] = module  # numba's cache finds the functions' globals by the module's name
@@ -111,6 +134,23 @@ def load(text: str):
     return module, path
 
 
+#: The prefix of the private folders of modules that the cache folder could not take.
+_PRIVATE_PREFIX = "grammarc-fusion-"
+
+
 @cache
 def _private_folder() -> Path:
-    return Path(tempfile.mkdtemp(prefix="grammarc-fusion-"))
+    """This process's folder of modules that the cache folder could not take, removed when the process
+    exits: at the interpreter's exit, or a forked worker's (``multiprocessing``'s finalizers run in both;
+    a fork that inherits the folder leaves it to its maker). Those of processes that were killed are
+    removed by the next process that makes one (``atomic.remove_stale``)."""
+    temp = Path(tempfile.gettempdir())
+    remove_stale(temp, _PRIVATE_PREFIX)
+    folder = Path(tempfile.mkdtemp(prefix=f"{_PRIVATE_PREFIX}{os.getpid()}-", dir=temp))
+    Finalize(None, _remove, args=(folder, os.getpid()), exitpriority=0)
+    return folder
+
+
+def _remove(folder: Path, maker: int) -> None:
+    if os.getpid() == maker:
+        shutil.rmtree(folder, ignore_errors=True)

@@ -37,6 +37,26 @@ def scatter_rows(src, dest, out):
 
 
 @njit(cache=True, nogil=True)
+def place(group, fill):
+    """Each row's place in a stable counting sort by group, advancing ``fill`` (k,) int64, the next free
+    place of each group: for rows that come in several pieces, ``fill`` carries over from piece to piece.
+    group [1, 0, 1], fill [0, 2] -> [2, 0, 3], fill [1, 4]."""
+    dest = np.empty(len(group), np.int64)
+    for i in range(len(group)):
+        g = group[i]
+        dest[i] = fill[g]
+        fill[g] += 1
+    return dest
+
+
+@njit(cache=True, nogil=True)
+def put(value, dest, out):
+    """out[dest[i]] = value for every i: a constant column (a piece's asset or symbol) in sorted places."""
+    for i in range(len(dest)):
+        out[dest[i]] = value
+
+
+@njit(cache=True, nogil=True)
 def tally(counts, lot, weights):
     """``counts[lot[i]] += weights[i]`` (1 each where ``weights`` is empty) for counts (L,) int64, lot (n,)
     integers, weights (n,) or (0,) int64; returns the sum added. O(n), whatever L is."""

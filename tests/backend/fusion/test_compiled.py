@@ -3,6 +3,10 @@ compiled once enough shapes came."""
 
 from __future__ import annotations
 
+import os
+import subprocess
+import sys
+
 import pytest
 
 from grammarc.backend.fusion import compiled
@@ -46,3 +50,48 @@ def test_a_kernel_is_ready_once_enough_shapes_came_or_once_compiled(own_cache):
     _, path = compiled.load(other)
     path.with_suffix(".compiled").touch(mode=0o600)
     assert compiled.ready(other, 1, 10_000)
+
+
+def test_a_module_the_cache_cannot_take_goes_to_a_private_folder_removed_at_exit(tmp_path):
+    """A cache folder that others may write is not used: the module is imported from a folder of the
+    process's own in the temp folder, which is gone once the process (or a forked worker) ends, as are
+    those of processes that were killed."""
+    shared, temp = tmp_path / "shared", tmp_path / "temp"
+    (shared / "grammarc").mkdir(parents=True)
+    (shared / "grammarc").chmod(0o777)
+    temp.mkdir()
+    dead = subprocess.run([sys.executable, "-c", "import os; print(os.getpid())"], capture_output=True,
+                          text=True, check=True).stdout.strip()
+    (temp / f"grammarc-fusion-{dead}-stale").mkdir()
+    script = f"""
+import multiprocessing
+from concurrent.futures import ProcessPoolExecutor
+from grammarc.backend.fusion import compiled
+def in_worker(_):
+    module, path = compiled.load({TEXT!r}.replace("stand-in", "worker's stand-in"))
+    return str(path.parent)
+module, path = compiled.load({TEXT!r})
+assert module.derive(1) == 2 and str(path.parent.parent) == {str(temp)!r}, path
+compiled._private_folder.cache_clear()  # as a worker forked before the folder was made
+with ProcessPoolExecutor(1, mp_context=multiprocessing.get_context("fork")) as pool:  # as workers.py
+    print(pool.submit(in_worker, 0).result(), path.parent)
+"""
+    env = {**os.environ, "XDG_CACHE_HOME": str(shared), "TMPDIR": str(temp)}
+    run = subprocess.run([sys.executable, "-c", script], check=False, env=env, capture_output=True, text=True)
+    assert run.returncode == 0, run.stderr
+    worker, own = run.stdout.split()
+    assert worker != own and list(temp.iterdir()) == []
+
+
+def test_the_modules_of_compiled_kernels_are_imported_for_a_warm_server(own_cache, monkeypatch):
+    monkeypatch.setattr(compiled, "_KERNELS", {})
+    marked, unmarked = TEXT.replace("stand-in", "marked stand-in"), TEXT.replace("stand-in", "unmarked stand-in")
+    for text in (marked, unmarked):
+        compiled.load(text)
+    (own_cache / f"region_{compiled.digest(marked)}.compiled").touch(mode=0o600)
+    stale = own_cache / f"region_{compiled.digest('another text')}"  # a mark whose module holds another text
+    stale.with_suffix(".py").write_text(TEXT)
+    stale.with_suffix(".compiled").touch(mode=0o600)
+    assert compiled.import_compiled() == 1
+    assert list(compiled._KERNELS) == [marked] and compiled._KERNELS[marked](1) == 2
+    assert compiled.import_compiled() == 0  # imported once
