@@ -53,3 +53,17 @@ def test_facing_lines_that_meet_apart_are_a_split_event_the_sweep_does_not_follo
     ring = [(0, 0), (21, 0), (21, 10), (18, 10), (18, 1.6), (3.2, 1.6), (3.2, 10), (0, 10)]
     _, _, trusted, _ = sweep(ring, [4, 4, 3, 3, 0, 0, 4, 3])
     assert not trusted
+
+
+def test_the_step_beside_a_vanished_edge_goes_with_it():
+    """massing.far.33391's first tier: edge 3 (2.8 m, moved 4 m) turns by 13 degrees into the kept edge 4, a
+    step; it vanishes, and PRT's remainder then runs along edge 2's moved line up to edge 4 (measured through
+    PyPRT: 300.245 m^2, its corner at (30.247, 9.223)), where keeping the step left a notch (303.48 m^2)."""
+    ring = [(0.0, 3.524), (0.0, 0.0), (24.4042, 0.0), (31.3414, 5.0686), (30.8369, 7.8597), (27.8887, 14.6713),
+            (19.6308, 18.3044)]
+    strips, collapsed, trusted, left = sweep(ring, [4, 0, 4, 4, 0, 0, 0])
+    assert trusted and not collapsed
+    covered = shapely.union_all([s for s in strips if s is not None])
+    remainder = shapely.Polygon(ring).difference(covered)
+    assert remainder.area == pytest.approx(300.245, abs=0.02)
+    assert min(np.hypot(*(np.asarray(remainder.exterior.coords) - (30.247, 9.223)).T)) < 2e-3
