@@ -6,9 +6,9 @@ neighbouring edges meet: a strip stops at an unmoved neighbour's line, and two m
 corner, as in CityEngine; where the boundary turns by less than 15 degrees between edges moved by
 different distances (one of them 0, or not), each strip ends at its own distance's mitre point instead
 and the remainder steps across at the vertex. A quad that folds over itself (a distance longer than the edge allows) is cut to the
-triangle of its edge and its end lines, as a straight skeleton's face ends; on a face without holes
-the folded edge then vanishes and its neighbours' moved lines meet, the face's edges swept as a
-wavefront (``geometry.wavefront``). The strips of each owner (a
+triangle of its edge and its end lines, as a straight skeleton's face ends; the folded edge
+then vanishes and its neighbours' moved lines meet, the edges of the face's outline swept as a
+wavefront (``geometry.wavefront``; a hole stays, the strips are clipped to it). The strips of each owner (a
 selector of the operation) are united and clipped to the polygon; an edge belongs to the first owner that
 claims it, and the remainder is what no strip covers. All of it runs on whole batches: numpy over the
 ragged edges, GEOS over arrays of quads.
@@ -103,10 +103,9 @@ def setback_regions(polygons: np.ndarray, edges: Edges, distance: np.ndarray, ow
     if folded.any():
         strips[folded] = _folded_strips(quads[folded])
     group = owner[idx] * m + edges.poly[idx]
-    # a face without holes whose strips fold: its strips swept by its edges as a wavefront
+    # a face whose strips fold: its strips swept by its outline's edges as a wavefront (holes do not move)
     swept = np.zeros(m, dtype=bool)
     swept[edges.poly[idx[folded]]] = True
-    swept[edges.poly[edges.hole]] = False
     if swept.any():
         strips, group = _swept(polygons, edges, d, corner, ends, owner, swept, strips, group, idx)
     united = union_by_group(strips, group, n_owners * m).reshape(n_owners, m)
@@ -121,18 +120,19 @@ def setback_regions(polygons: np.ndarray, edges: Edges, distance: np.ndarray, ow
 def _swept(polygons: np.ndarray, edges: Edges, d, corner, ends, owner, swept, strips, group, idx):
     """The strips (k,) of the moved edges ``idx`` (k,) and their groups (owner * m + polygon), those of the
     polygons ``swept`` (m,) bool replaced by the regions their edges sweep as a wavefront
-    (``geometry.wavefront``); a polygon of which nothing is left goes whole to the owner of its
-    furthest-moved edge (what no strip reaches of it is no remainder either). A wavefront that ends
-    outside its polygon missed a split event (an arm that closed parts it): that polygon keeps its
-    strips."""
+    (``geometry.wavefront``: their outer rings; holes stay); a polygon of which nothing is left goes whole
+    to the owner of its furthest-moved edge (what no strip reaches of it is no remainder either). A
+    wavefront that ends outside its outline missed a split event (an arm that closed parts it): that
+    polygon keeps its strips."""
     m = len(polygons)
     faces = np.flatnonzero(swept)
-    rows = np.flatnonzero(swept[edges.poly])  # (their outer rings, one after the other)
+    rows = np.flatnonzero(swept[edges.poly] & ~edges.hole)  # (their outer rings, one after the other)
     ring_offsets = offsets_from_counts(np.bincount(edges.poly[rows], minlength=m)[faces])
     coords, offsets, collapsed, followed, left, left_ring = swept_strips(
         edges.start[rows], edges.end[rows], edges.inward[rows], d[rows], corner[rows], ends[rows], ring_offsets)
     scale = max(float(np.abs(edges.start[rows]).max(initial=1.0)), 1.0)
-    outside = shapely.distance(shapely.points(left), polygons[faces[left_ring]]) > 1e-9 * scale
+    outlines = shapely.polygons(shapely.get_exterior_ring(polygons[faces]))
+    outside = shapely.distance(shapely.points(left), outlines[left_ring]) > 1e-9 * scale
     trusted = np.zeros(m, dtype=bool)
     trusted[faces[followed]] = True
     trusted[faces[left_ring[outside]]] = False

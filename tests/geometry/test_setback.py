@@ -93,6 +93,21 @@ def test_an_edge_whose_strip_folds_vanishes_and_its_neighbours_meet(ring, d, rem
         assert shapely.area(rest[0]) > 0
 
 
+def test_a_holed_face_whose_strips_fold_sweeps_its_outline_and_its_strips_stop_at_the_hole():
+    """The 9 x 5 m L above with a hole in its front's strip: its outline is swept as the L's is (the hole does
+    not move) and the strips are clipped to the face (PRT on massing.concave.33183, a shapeU whose shape has a
+    hole: the tier's remainder 3.464 m^2 where the folded quads left 11.94)."""
+    ring = [(0, 0), (9, 0), (9, 3), (5.4, 3), (5.4, 5), (0, 5)]
+    hole = [(6, 1), (7, 1), (7, 2), (6, 2)]
+    face = np.array([shapely.Polygon(ring, [hole])])
+    edges = polygon_edges(face)
+    d = np.where(edges.hole, 0.0, np.array([4, 4, 0, 0, 0, 0, 0, 0, 0, 0], float))
+    owner = np.where(edges.hole, 1, 0)
+    (strips,), rest = setback_regions(face, edges, d, owner, 1)
+    assert shapely.area(rest[0]) == pytest.approx(5.4 * 1, rel=1e-9)
+    assert shapely.area(strips[0]) == pytest.approx(face[0].area - 5.4, rel=1e-9)
+
+
 def test_collinear_edges_with_different_distances_step_instead_of_slanting():
     """A top edge in two collinear pieces set back 4 and 3 (as a second setback meets the edges a first
     one left, massing's U): the remainder steps at the shared vertex, 10 x 6 + 10 x 7."""

@@ -61,7 +61,7 @@ def test_the_step_beside_a_vanished_edge_goes_with_it():
     PyPRT: 300.245 m^2, its corner at (30.247, 9.223)), where keeping the step left a notch (303.48 m^2)."""
     ring = [(0.0, 3.524), (0.0, 0.0), (24.4042, 0.0), (31.3414, 5.0686), (30.8369, 7.8597), (27.8887, 14.6713),
             (19.6308, 18.3044)]
-    strips, collapsed, trusted, left = sweep(ring, [4, 0, 4, 4, 0, 0, 0])
+    strips, collapsed, trusted, _ = sweep(ring, [4, 0, 4, 4, 0, 0, 0])
     assert trusted and not collapsed
     covered = shapely.union_all([s for s in strips if s is not None])
     remainder = shapely.Polygon(ring).difference(covered)
