@@ -151,7 +151,7 @@ def _swept(polygons: np.ndarray, edges: Edges, d, corner, ends, owner, swept, st
         furthest = sub[order][np.r_[True, np.diff(edges.poly[sub][order]) != 0]]
         made = np.concatenate([made, polygons[gone]])
         made_group = np.concatenate([made_group, owner[furthest] * m + gone])
-    kept = ~swept[edges.poly[idx]]
+    kept = ~swept[edges.poly[idx]] | edges.hole[idx]  # (a moved hole edge keeps its strip)
     return np.concatenate([strips[kept], made]), np.concatenate([group[kept], made_group])
 
 
