@@ -15,9 +15,10 @@ Where ``geometry.setback`` steps between two edges (a turn of less than 15 degre
 distances) or cuts a mitre too long, the two strips end apart; the segment between their ends is a line
 of its own here (through the vertex, along the step, moving so that its ends stay on the two strips'
 lines), so the steps stay PRT's. An edge event (an edge's segment shrinks to nothing) removes the edge;
-its neighbours then meet. Neighbours whose lines are parallel meet only where they coincide (two facing
-edges passing each other): the slower one goes too and the faster sweeps on, as PRT's front strip runs on
-past the kept end of an L's arm; a kept edge between parallel neighbours does not vanish (PRT's strip
+its neighbours then meet, and a step beside it goes with it. Neighbours whose lines are parallel meet only
+where they coincide (two facing edges passing each other): a kept one goes too and the moving one sweeps
+on, as PRT's front strip runs on past the kept end of an L's arm (two moving ones annihilate only where
+they overlap, which is not followed either); a kept edge between parallel neighbours does not vanish (PRT's strip
 ends at its line: massing.H.15118). Split events (an arm that closes parts the wavefront) are not
 followed: where two parallel lines apart become neighbours, or the wavefront ends outside its face, the
 caller keeps the folded quads' strips. A ring that falls below three lines has nothing left.
@@ -165,10 +166,13 @@ def _ring_strips(start, end, inward, d, corner, ends, out, out_n, left):
                 used = _push(pool, link, used, s_head, s_tail, q, jx, jy)
                 break
             # parallel neighbours meet where they coincide: the slower goes (both where equally fast);
-            # apart, the ring parts there (a split event): the strips are not to be trusted
+            # apart, the ring parts there (a split event), and two moving lines that meet face to face
+            # annihilate only where they overlap, the rest of the longer sweeping on (PRT's bar of a T, its
+            # top moved 3 m and its bottom 4 m: massing.T.34179): the strips are not to be trusted
             same = nx[p] * nx[q] + ny[p] * ny[q] > 0.0
             at_p, at_q = c[p] + w[p] * now, c[q] + w[q] * now
-            if abs(at_p - at_q if same else at_p + at_q) > _EPS * (1.0 + abs(at_p)):
+            if abs(at_p - at_q if same else at_p + at_q) > _EPS * (1.0 + abs(at_p)) or (
+                    not same and w[p] > _EPS and w[q] > _EPS):
                 trusted = False
                 break
             gone_p, gone_q = w[p] <= w[q] + _EPS, w[q] <= w[p] + _EPS

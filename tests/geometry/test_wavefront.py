@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 import shapely
 
-from grammarc.geometry.setback import _mitres, polygon_edges
+from grammarc.geometry.setback import _mitres, polygon_edges, setback_regions
 from grammarc.geometry.wavefront import swept_strips
 
 
@@ -67,3 +67,18 @@ def test_the_step_beside_a_vanished_edge_goes_with_it():
     remainder = shapely.Polygon(ring).difference(covered)
     assert remainder.area == pytest.approx(300.245, abs=0.02)
     assert min(np.hypot(*(np.asarray(remainder.exterior.coords) - (30.247, 9.223)).T)) < 2e-3
+
+
+def test_moving_lines_that_meet_face_to_face_are_not_followed():
+    """massing.T.34179's second tier: the bar's left end (moved 4 m) vanishes as its bottom (4 m) and top (3 m)
+    meet; the top runs on over the right half, which the sweep does not follow: the face keeps its folded
+    quads' strips (PRT's remainder: 25.999 m^2, the bar's right half 3 m below its top)."""
+    ring = [(0.0, 30.19), (0.0, 25.214), (18.238, 25.214), (18.238, 0.0), (20.155, 0.0), (20.155, 25.214),
+            (38.393, 25.214), (38.393, 30.19)]
+    _, _, trusted, _ = sweep(ring, [4, 4, 3, 3, 0, 0, 4, 3])
+    assert not trusted
+    face = np.array([shapely.Polygon(ring)])
+    edges = polygon_edges(face)
+    d = np.array([4, 4, 3, 3, 0, 0, 4, 3], float)
+    _, rest = setback_regions(face, edges, d, np.zeros(8, np.int64), 1)
+    assert shapely.area(rest[0]) == pytest.approx((38.393 - 4 - 21.238) * (30.19 - 3 - 25.214), rel=1e-9)
