@@ -17,8 +17,8 @@ of its own here (through the vertex, along the step, moving so that its ends sta
 lines), so the steps stay PRT's. An edge event (an edge's segment shrinks to nothing) removes the edge;
 its neighbours then meet, and a step beside it goes with it. Neighbours whose lines are parallel meet only
 where they coincide (two facing edges passing each other): a kept one goes too and the moving one sweeps
-on, as PRT's front strip runs on past the kept end of an L's arm (two moving ones annihilate only where
-they overlap, which is not followed either); a kept edge between parallel neighbours does not vanish (PRT's strip
+on, as PRT's front strip runs on past the kept end of an L's arm (of two moving ones, the shorter goes and
+the rest of the longer sweeps on); a kept edge between parallel neighbours does not vanish (PRT's strip
 ends at its line: massing.H.15118). Split events (an arm that closes parts the wavefront) are not
 followed: where two parallel lines apart become neighbours, or the wavefront ends outside its face, the
 caller keeps the folded quads' strips. A ring that falls below three lines has nothing left.
@@ -158,6 +158,7 @@ def _ring_strips(start, end, inward, d, corner, ends, out, out_n, left):
                 used = _push(pool, link, used, s_head, s_tail, q, pool[k, 0], pool[k, 1])
                 p = prv[p]
         nxt[p], prv[q] = q, p
+        hx, hy = x, y  # where p's segment and q's meet
         while count >= 3:
             det = nx[p] * ny[q] - ny[p] * nx[q]
             if abs(det) > _EPS:
@@ -165,17 +166,25 @@ def _ring_strips(start, end, inward, d, corner, ends, out, out_n, left):
                 used = _push(pool, link, used, e_head, e_tail, p, jx, jy)
                 used = _push(pool, link, used, s_head, s_tail, q, jx, jy)
                 break
-            # parallel neighbours meet where they coincide: the slower goes (both where equally fast);
-            # apart, the ring parts there (a split event), and two moving lines that meet face to face
-            # annihilate only where they overlap, the rest of the longer sweeping on (PRT's bar of a T, its
-            # top moved 3 m and its bottom 4 m: massing.T.34179): the strips are not to be trusted
+            # parallel neighbours meet where they coincide; apart, the ring parts there (a split event): the
+            # strips are not to be trusted. Lines with the same normal: the slower goes (both where equally
+            # fast); facing lines annihilate where their segments overlap: the shorter goes (both where
+            # equally long) and the rest of the longer sweeps on, as PRT's front strip runs on past the kept
+            # end of an L's arm, and a T's bar top (moved 3 m) on past where its bottom (4 m) met it
+            # (massing.T.34179)
             same = nx[p] * nx[q] + ny[p] * ny[q] > 0.0
             at_p, at_q = c[p] + w[p] * now, c[q] + w[q] * now
-            if abs(at_p - at_q if same else at_p + at_q) > _EPS * (1.0 + abs(at_p)) or (
-                    not same and w[p] > _EPS and w[q] > _EPS):
+            if abs(at_p - at_q if same else at_p + at_q) > _EPS * (1.0 + abs(at_p)):
                 trusted = False
                 break
-            gone_p, gone_q = w[p] <= w[q] + _EPS, w[q] <= w[p] + _EPS
+            if same:
+                gone_p, gone_q = w[p] <= w[q] + _EPS, w[q] <= w[p] + _EPS
+            else:
+                ax, ay, oka = _meet(nx, ny, c, w, prv[p], p, now)
+                bx, by, okb = _meet(nx, ny, c, w, q, nxt[q], now)
+                long_p = np.hypot(hx - ax, hy - ay) if oka else np.inf
+                long_q = np.hypot(bx - hx, by - hy) if okb else np.inf
+                gone_p, gone_q = long_p <= long_q + _EPS, long_q <= long_p + _EPS
             for r in (p, q):
                 if (r == p and gone_p) or (r == q and gone_q):
                     a, b = prv[r], nxt[r]
@@ -189,8 +198,10 @@ def _ring_strips(start, end, inward, d, corner, ends, out, out_n, left):
             if gone_p and gone_q:
                 p, q = prv[p], nxt[q]
             elif gone_p:
+                hx, hy = final[p, 0, 0], final[p, 0, 1]
                 p = prv[p]
             else:
+                hx, hy = final[q, 1, 0], final[q, 1, 1]
                 q = nxt[q]
         if not trusted:
             break
