@@ -121,9 +121,9 @@ def _swept(polygons: np.ndarray, edges: Edges, d, corner, ends, owner, swept, st
     """The strips (k,) of the moved edges ``idx`` (k,) and their groups (owner * m + polygon), those of the
     polygons ``swept`` (m,) bool replaced by the regions their edges sweep as a wavefront
     (``geometry.wavefront``: their outer rings; holes stay); a polygon of which nothing is left goes whole
-    to the owner of its furthest-moved edge (what no strip reaches of it is no remainder either). A
-    wavefront that ends outside its outline missed a split event (an arm that closed parts it): that
-    polygon keeps its strips."""
+    to the owner of its furthest-moved edge (what no strip reaches of it is no remainder either), as does
+    one whose wavefront turned inside out. A wavefront that ends outside its outline or crossing itself
+    missed a split event (an arm that closed parts it): that polygon keeps its strips."""
     m = len(polygons)
     faces = np.flatnonzero(swept)
     rows = np.flatnonzero(swept[edges.poly] & ~edges.hole)  # (their outer rings, one after the other)
@@ -131,11 +131,26 @@ def _swept(polygons: np.ndarray, edges: Edges, d, corner, ends, owner, swept, st
     coords, offsets, collapsed, followed, left, left_ring = swept_strips(
         edges.start[rows], edges.end[rows], edges.inward[rows], d[rows], corner[rows], ends[rows], ring_offsets)
     scale = max(float(np.abs(edges.start[rows]).max(initial=1.0)), 1.0)
-    outlines = shapely.polygons(shapely.get_exterior_ring(polygons[faces]))
-    outside = shapely.distance(shapely.points(left), outlines[left_ring]) > 1e-9 * scale
+    outlines = shapely.get_exterior_ring(polygons[faces])
+    outside = shapely.distance(shapely.points(left), shapely.polygons(outlines)[left_ring]) > 1e-9 * scale
+    # a wavefront that ends wound against its outline (or flat), simple or passed out of its face, turned
+    # inside out past an event it did not see, the face closing between two edge events: nothing is left of
+    # it (PRT's terraces cover massing's concave.33925, convex.33448 and acute.33595 whole); one that ends
+    # outside its face otherwise, or crosses itself inside it, missed a split event
+    n = len(faces)
+    out, crossed = np.zeros(n, dtype=bool), np.zeros(n, dtype=bool)
+    out[left_ring[outside]] = True
+    front = shapely.linearrings(left, indices=left_ring)
+    ends_as = np.unique(left_ring)
+    crossed[ends_as] = ~shapely.is_simple(front)
+    winding = _winding(left, left_ring, n)
+    turned = np.zeros(n, dtype=bool)
+    turned[ends_as] = (winding[ends_as] > 0) != shapely.is_ccw(outlines[ends_as])
+    turned |= np.abs(winding) <= 1e-12 * scale * scale
+    turned &= (~crossed | out) & (np.diff(ring_offsets) > 0) & np.isin(np.arange(n), ends_as)
     trusted = np.zeros(m, dtype=bool)
-    trusted[faces[followed]] = True
-    trusted[faces[left_ring[outside]]] = False
+    trusted[faces] = turned | (followed & ~out & ~crossed)
+    collapsed = collapsed | turned
     swept = swept & trusted
     has = (np.diff(offsets) > 0) & swept[edges.poly[rows]]
     counts = np.diff(offsets)
@@ -153,6 +168,17 @@ def _swept(polygons: np.ndarray, edges: Edges, d, corner, ends, owner, swept, st
         made_group = np.concatenate([made_group, owner[furthest] * m + gone])
     kept = ~swept[edges.poly[idx]] | edges.hole[idx]  # (a moved hole edge keeps its strip)
     return np.concatenate([strips[kept], made]), np.concatenate([group[kept], made_group])
+
+
+def _winding(points: np.ndarray, ring: np.ndarray, n: int) -> np.ndarray:
+    """Twice the signed area (n,) of each ring through ``points`` (k, 2) (``ring`` (k,) ascending): its
+    winding, positive counter-clockwise (not GEOS's ``is_ccw``, which looks at one vertex of a ring that
+    may cross itself)."""
+    first, last = np.ones(len(ring), dtype=bool), np.ones(len(ring), dtype=bool)
+    first[1:] = last[:-1] = ring[1:] != ring[:-1]
+    following = np.roll(points, -1, axis=0)
+    following[last] = points[first]
+    return np.bincount(ring, points[:, 0] * following[:, 1] - following[:, 0] * points[:, 1], minlength=n)
 
 
 def _folded_strips(quads: np.ndarray) -> np.ndarray:

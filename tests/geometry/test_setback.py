@@ -108,6 +108,23 @@ def test_a_holed_face_whose_strips_fold_sweeps_its_outline_and_its_strips_stop_a
     assert shapely.area(strips[0]) == pytest.approx(face[0].area - 5.4, rel=1e-9)
 
 
+@pytest.mark.parametrize("ring, d", [
+    # massing.concave.33925's first tier (4;0;4;4;0): the notch's side moved 4 m sweeps the block beside it
+    # past the short kept edge's line; the wavefront ends wound the wrong way, outside the face
+    ([(6.581, 5.0485), (6.581, 0.3199), (2.6349, 2.241), (0.0, 0.0), (16.2799, 0.0), (13.5498, 3.5265),
+      (7.0198, 4.5729)], [4, 0, 4, 4, 0, 0, 0]),
+    # massing.acute.33595's second tier (4;4;0;0): a 0.7 m wide sliver whose long side moves 4 m
+    ([(0.0, 9.5729), (2.4448, 0.0), (2.4448, 2.9147), (0.7444, 9.5729)], [4, 4, 0, 0]),
+])
+def test_a_wavefront_turned_inside_out_leaves_nothing(ring, d):
+    """A face whose wavefront ends turned inside out closed between two of its events: nothing is left of
+    it, as of PRT's tiers (the folded quads left 2.39 and 0.53 m^2 that PRT does not build on)."""
+    face = np.array([shapely.Polygon(ring)])
+    (strips,), rest = setback_regions(face, polygon_edges(face), np.array(d, float), np.zeros(len(d), np.int64), 1)
+    assert shapely.area(rest[0]) == 0
+    assert shapely.area(strips[0]) == pytest.approx(face[0].area)
+
+
 def test_collinear_edges_with_different_distances_step_instead_of_slanting():
     """A top edge in two collinear pieces set back 4 and 3 (as a second setback meets the edges a first
     one left, massing's U): the remainder steps at the shared vertex, 10 x 6 + 10 x 7."""
