@@ -141,8 +141,8 @@ def _swept(polygons: np.ndarray, edges: Edges, d, corner, ends, owner, swept, st
     n = len(faces)
     out, crossed, has_front = np.zeros(n, dtype=bool), np.zeros(n, dtype=bool), np.zeros(n, dtype=bool)
     out[left_ring[outside]] = True
-    front = shapely.linearrings(left, indices=left_ring)
-    ends_as = np.unique(left_ring)
+    ends_as, dense = np.unique(left_ring, return_inverse=True)
+    front = shapely.linearrings(left, indices=dense)
     has_front[ends_as] = True
     crossed[ends_as] = ~shapely.is_simple(front)
     winding = _winding(left, left_ring, n)

@@ -11,6 +11,7 @@ from hypothesis import strategies as st
 from grammarc.geometry.setback import distances_to_area, polygon_edges, setback_regions
 
 L_SHAPE = shapely.Polygon([(0, 0), (30, 0), (30, 10), (10, 10), (10, 20), (0, 20)])
+L_SHAPE_9x5 = [(0, 0), (9, 0), (9, 3), (5.4, 3), (5.4, 5), (0, 5)]
 COURTYARD = shapely.Polygon([(0, 0), (40, 0), (40, 40), (0, 40)], [[(10, 10), (10, 30), (30, 30), (30, 10)]])
 
 
@@ -124,6 +125,19 @@ def test_a_wavefront_turned_inside_out_keeps_its_strips(ring, d, sliver):
     (strips,), rest = setback_regions(face, polygon_edges(face), np.array(d, float), np.zeros(len(d), np.int64), 1)
     assert shapely.area(rest[0]) == pytest.approx(sliver, rel=0.05, abs=1e-12)
     assert shapely.area(strips[0]) + shapely.area(rest[0]) == pytest.approx(face[0].area)
+
+
+def test_faces_swept_together_are_swept_as_alone():
+    """A batch of swept faces, the first closing whole (its wavefront gone) and the next not: each face's
+    strips and remainder are those it has alone."""
+    faces = [shapely.Polygon([(0, 0), (4, 0), (0, 3)]), shapely.Polygon(L_SHAPE_9x5)]
+    d = [[2, 2, 2], [4, 4, 0, 0, 0, 0]]
+    alone = [setback([f], dk)[1][0] for f, dk in zip(faces, d)]
+    edges = polygon_edges(np.array(faces))
+    _, rest = setback_regions(np.array(faces), edges, np.concatenate(d).astype(float),
+                              np.zeros(9, np.int64), 1)
+    assert [shapely.area(r) for r in rest] == pytest.approx([shapely.area(a) for a in alone])
+    assert shapely.area(rest[1]) == pytest.approx(5.4)
 
 
 def test_collinear_edges_with_different_distances_step_instead_of_slanting():
