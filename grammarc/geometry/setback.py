@@ -103,9 +103,16 @@ def setback_regions(polygons: np.ndarray, edges: Edges, distance: np.ndarray, ow
     if folded.any():
         strips[folded] = _folded_strips(quads[folded])
     group = owner[idx] * m + edges.poly[idx]
-    # a face whose strips fold: its strips swept by its outline's edges as a wavefront (holes do not move)
+    # a face whose strips fold, or where a moved edge's line passes a kept neighbour's far end (the kept
+    # edge's segment turns over: PRT's tiers on massing's near_degenerate.34258 and 34006 run on past a
+    # short kept edge): its strips swept by its outline's edges as a wavefront (holes do not move)
     swept = np.zeros(m, dtype=bool)
     swept[edges.poly[idx[folded]]] = True
+    tangent = edges.end - edges.start
+    span = np.einsum("ij,ij->i", tangent + end_corner - corner, tangent)
+    turned_over = ~moved & ~edges.hole & (moved[edges.prev] | moved[edges.next]) & (
+        span < -TOL.zero * np.einsum("ij,ij->i", tangent, tangent))
+    swept[edges.poly[turned_over]] = True
     if swept.any():
         strips, group = _swept(polygons, edges, d, corner, ends, owner, swept, strips, group, idx)
     united = union_by_group(strips, group, n_owners * m).reshape(n_owners, m)

@@ -140,6 +140,19 @@ def test_faces_swept_together_are_swept_as_alone():
     assert shapely.area(rest[1]) == pytest.approx(5.4)
 
 
+def test_a_moved_line_that_passes_a_kept_edge_s_far_end_sweeps_on():
+    """massing.near_degenerate.34258's first tier (4;0;4;4;0, an arm 3.3 m wide): the arm's side moved 4 m
+    passes the far end of the 2 m kept edge at the arm's end (nearly collinear with the next one), whose
+    segment turns over: the face is swept, the kept edge vanishes and nothing is left, as of PRT's tier
+    (the quads left a 1.7e-4 m^2 sliver between the two kept edges, extruded to a 39 m tower)."""
+    ring = [(0.0, 10.0285), (0.0, 0.0), (3.8306, 0.0), (3.8314, 6.7034), (14.6193, 6.7022), (14.6194, 8.7073),
+            (14.6197, 10.0269), (3.2052, 10.028)]
+    face = np.array([shapely.Polygon(ring)])
+    d = np.array([4, 0, 4, 4, 0, 0, 0, 0], float)
+    _, rest = setback_regions(face, polygon_edges(face), d, np.zeros(8, np.int64), 1)
+    assert shapely.area(rest[0]) == 0
+
+
 def test_collinear_edges_with_different_distances_step_instead_of_slanting():
     """A top edge in two collinear pieces set back 4 and 3 (as a second setback meets the edges a first
     one left, massing's U): the remainder steps at the shared vertex, 10 x 6 + 10 x 7."""
