@@ -16,12 +16,14 @@ distances) or cuts a mitre too long, the two strips end apart; the segment betwe
 of its own here (through the vertex, along the step, moving so that its ends stay on the two strips'
 lines), so the steps stay PRT's. An edge event (an edge's segment shrinks to nothing) removes the edge;
 its neighbours then meet, and a step beside it goes with it. Neighbours whose lines are parallel meet only
-where they coincide (two facing edges passing each other): a kept one goes too and the moving one sweeps
-on, as PRT's front strip runs on past the kept end of an L's arm (of two moving ones, the shorter goes and
-the rest of the longer sweeps on); a kept edge between parallel neighbours does not vanish (PRT's strip
-ends at its line: massing.H.15118). Split events (an arm that closes parts the wavefront) are not
-followed: where two parallel lines apart become neighbours, or the wavefront ends outside its face, the
-caller keeps the folded quads' strips. A ring that falls below three lines has nothing left.
+where they coincide: facing ones (two edges passing each other) annihilate where their segments overlap,
+the shorter going and the rest of the longer sweeping on, as PRT's front strip runs on past the kept end
+of an L's arm and a T's bar top past where its bottom met it; of two with the same normal the slower
+goes; a kept edge between parallel neighbours does not vanish (PRT's strip ends at its line:
+massing.H.15118). Split events (an arm that closes parts the wavefront) are not followed: where two
+parallel lines apart become neighbours, or the wavefront ends outside its face or crossing itself (but
+for one turned inside out, ``geometry.setback``), the caller keeps the folded quads' strips. A ring that
+falls below three lines has nothing left.
 """
 
 from __future__ import annotations
