@@ -215,6 +215,8 @@ def ring_starts(coords, ring_offsets, part_offsets, part_source, part_with_start
                     keys[j] = key  # on the boundary: a kept vertex, a cut's crossing
                 else:
                     keys[j] = vertex_key
+            if not cut and not part_inset[p]:
+                _after_steps(keys, moved_from, r0, r1)
     last_end = _last_edge_ends(coords, ring_offsets, part_offsets, part_source, part_inset, moved_from,
                                parent_coords, parent_rings, parent_offsets)
     for p in range(len(part_offsets) - 1):
@@ -246,6 +248,23 @@ def ring_starts(coords, ring_offsets, part_offsets, part_source, part_with_start
                 k = r0 + (best + j) % n
                 out[r0 + j, 0], out[r0 + j, 1] = coords[k, 0], coords[k, 1]
     return out
+
+
+@njit(cache=True, nogil=True)
+def _after_steps(keys, moved_from, r0, r1):
+    """A setback's remainder whose edge moved in from parent edge i ends in a step (an edge along no
+    parent edge, to the next parent edge's kept vertex or moved copy) counts that edge and the step after
+    the next parent edge: PRT starts its tier there (massing's convex.33000, moved edge 0 stepping to kept
+    edge 1 at 11 degrees: PRT's remainder starts at vertex 1; far.33307, edges set back 4 and 3 m
+    stepping at 5 degrees). ``keys`` (V,) turned in place for the ring ``r0:r1``."""
+    n = r1 - r0
+    for j in range(r0, r1):
+        k = r0 + (j - r0 + 1) % n
+        m = r0 + (j - r0 + 2) % n
+        i = moved_from[j]
+        if np.isfinite(i) and keys[j] == i and not np.isfinite(moved_from[k]) and (
+                moved_from[m] == i + 1 or keys[m] == i + 1):
+            keys[j] = keys[k] = i + 1.5
 
 
 @njit(cache=True, nogil=True)

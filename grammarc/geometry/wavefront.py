@@ -15,12 +15,15 @@ Where ``geometry.setback`` steps between two edges (a turn of less than 15 degre
 distances) or cuts a mitre too long, the two strips end apart; the segment between their ends is a line
 of its own here (through the vertex, along the step, moving so that its ends stay on the two strips'
 lines), so the steps stay PRT's. An edge event (an edge's segment shrinks to nothing) removes the edge;
-its neighbours then meet. Neighbours whose lines are parallel meet only where they coincide (two facing
-edges passing each other): the slower one goes too and the faster sweeps on, as PRT's front strip runs on
-past the kept end of an L's arm; a kept edge between parallel neighbours does not vanish (PRT's strip
-ends at its line: massing.H.15118). Split events (an arm that closes parts the wavefront) are not
-followed: where two parallel lines apart become neighbours, or the wavefront ends outside its face, the
-caller keeps the folded quads' strips. A ring that falls below three lines has nothing left.
+its neighbours then meet, and a step beside it goes with it. Neighbours whose lines are parallel meet only
+where they coincide: facing ones (two edges passing each other) annihilate where their segments overlap,
+the shorter going and the rest of the longer sweeping on, as PRT's front strip runs on past the kept end
+of an L's arm and a T's bar top past where its bottom met it; of two with the same normal the slower
+goes; a kept edge between parallel neighbours does not vanish (PRT's strip ends at its line:
+massing.H.15118). Split events (an arm that closes parts the wavefront) are not followed: where two
+parallel lines apart become neighbours, or the wavefront ends outside its face or crossing itself (but
+for one turned inside out, ``geometry.setback``), the caller keeps the folded quads' strips. A ring that
+falls below three lines has nothing left.
 """
 
 from __future__ import annotations
@@ -76,7 +79,7 @@ def _ring_strips(start, end, inward, d, corner, ends, out, out_n, left):
     ux, uy = np.empty(m_cap), np.empty(m_cap)
     real = np.full(m_cap, -1, np.int64)
     # each line's start path (where its strip starts, from its start vertex on) and end path, as linked
-    # lists in one pool: two points per line, and at most four per event
+    # lists in one pool: two points per line, and at most six per event
     pool = np.empty((10 * m_cap + 8, 2))
     link = np.empty(10 * m_cap + 8, np.int64)
     s_head, s_tail = np.full(m_cap, -1, np.int64), np.full(m_cap, -1, np.int64)
@@ -136,9 +139,28 @@ def _ring_strips(start, end, inward, d, corner, ends, out, out_n, left):
         final[best, 0, 0], final[best, 0, 1], final[best, 1, 0], final[best, 1, 1] = x, y, x, y
         alive[best] = False
         count -= 1
-        nxt[p], prv[q] = q, p
         used = _push(pool, link, used, e_head, e_tail, p, x, y)
         used = _push(pool, link, used, s_head, s_tail, q, x, y)
+        if real[best] >= 0:
+            # the steps at a vanished edge's ends go with it: its neighbours meet as they would have without
+            # it, their strips reaching across its step's vertex (PRT's on massing.far.33391, where a short
+            # edge moved 4 m between a moved and a kept edge turned by 13 degrees)
+            if real[q] < 0 and count > 3:
+                k = s_head[q]
+                alive[q] = False
+                count -= 1
+                final[q, 0, 0], final[q, 0, 1], final[q, 1, 0], final[q, 1, 1] = x, y, x, y
+                used = _push(pool, link, used, e_head, e_tail, p, pool[k, 0], pool[k, 1])
+                q = nxt[q]
+            if real[p] < 0 and count > 3:
+                k = s_head[p]
+                alive[p] = False
+                count -= 1
+                final[p, 0, 0], final[p, 0, 1], final[p, 1, 0], final[p, 1, 1] = x, y, x, y
+                used = _push(pool, link, used, s_head, s_tail, q, pool[k, 0], pool[k, 1])
+                p = prv[p]
+        nxt[p], prv[q] = q, p
+        hx, hy = x, y  # where p's segment and q's meet
         while count >= 3:
             det = nx[p] * ny[q] - ny[p] * nx[q]
             if abs(det) > _EPS:
@@ -146,14 +168,25 @@ def _ring_strips(start, end, inward, d, corner, ends, out, out_n, left):
                 used = _push(pool, link, used, e_head, e_tail, p, jx, jy)
                 used = _push(pool, link, used, s_head, s_tail, q, jx, jy)
                 break
-            # parallel neighbours meet where they coincide: the slower goes (both where equally fast);
-            # apart, the ring parts there (a split event): the strips are not to be trusted
+            # parallel neighbours meet where they coincide; apart, the ring parts there (a split event): the
+            # strips are not to be trusted. Lines with the same normal: the slower goes (both where equally
+            # fast); facing lines annihilate where their segments overlap: the shorter goes (both where
+            # equally long) and the rest of the longer sweeps on, as PRT's front strip runs on past the kept
+            # end of an L's arm, and a T's bar top (moved 3 m) on past where its bottom (4 m) met it
+            # (massing.T.34179)
             same = nx[p] * nx[q] + ny[p] * ny[q] > 0.0
             at_p, at_q = c[p] + w[p] * now, c[q] + w[q] * now
             if abs(at_p - at_q if same else at_p + at_q) > _EPS * (1.0 + abs(at_p)):
                 trusted = False
                 break
-            gone_p, gone_q = w[p] <= w[q] + _EPS, w[q] <= w[p] + _EPS
+            if same:
+                gone_p, gone_q = w[p] <= w[q] + _EPS, w[q] <= w[p] + _EPS
+            else:
+                ax, ay, oka = _meet(nx, ny, c, w, prv[p], p, now)
+                bx, by, okb = _meet(nx, ny, c, w, q, nxt[q], now)
+                long_p = np.hypot(hx - ax, hy - ay) if oka else np.inf
+                long_q = np.hypot(bx - hx, by - hy) if okb else np.inf
+                gone_p, gone_q = long_p <= long_q + _EPS, long_q <= long_p + _EPS
             for r in (p, q):
                 if (r == p and gone_p) or (r == q and gone_q):
                     a, b = prv[r], nxt[r]
@@ -167,8 +200,10 @@ def _ring_strips(start, end, inward, d, corner, ends, out, out_n, left):
             if gone_p and gone_q:
                 p, q = prv[p], nxt[q]
             elif gone_p:
+                hx, hy = final[p, 0, 0], final[p, 0, 1]
                 p = prv[p]
             else:
+                hx, hy = final[q, 1, 0], final[q, 1, 1]
                 q = nxt[q]
         if not trusted:
             break

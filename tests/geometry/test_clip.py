@@ -261,3 +261,23 @@ def test_strips_start_at_the_first_edge_they_set_back():
 
     assert first_vertex(None) == (10, 10)
     assert first_vertex(np.array([False, False, True, True])) == (-10, -10)
+
+
+def test_a_remainder_whose_first_edge_steps_starts_after_the_step():
+    """massing.convex.33000's first tier (4;0;4;4;0): moved edge 0 steps to the kept edge 1 it turns 11
+    degrees from; PRT's remainder starts at vertex 1, the kept edge's, not at moved edge 0 (its second tier's
+    setback 3;3;4;4;0 then leaves the 18.3 m^2 that PRT extrudes to the third tier; one vertex sooner,
+    nothing)."""
+    import shapely
+
+    from grammarc.geometry.clip import fit_pieces
+
+    # the tier's top in its plane (x, z), where it winds clockwise: the traced (u, v) with v = -z
+    tier = shapely.Polygon([(25.156, -6.763), (13.55, -6.763), (2.785, -4.689), (0.0, 0.0), (12.216, 0.0),
+                            (27.76, -1.874)])
+    remainder = shapely.from_wkt("POLYGON ((27.2866 -2.7633, 27.7603 -1.8742, 12.2159 0, 11.9756 -4, 7.0281 -4, "
+                                 "8.0387 -5.7015, 13.5501 -6.7633, 13.9319 -2.7633, 27.2866 -2.7633))")
+    fitted = fit_pieces(np.array([remainder]), np.ones(1, np.int8), np.array([[27.76, 0.0, 6.763]]),
+                        np.array([tier]))
+    first = fitted.coords[0] * fitted.extent[0, [0, 2]] + fitted.low[0, [0, 2]]
+    np.testing.assert_allclose(first, (13.5501, -6.7633), atol=1e-9)

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 import shapely
 
-from grammarc.geometry.setback import _mitres, polygon_edges
+from grammarc.geometry.setback import _mitres, polygon_edges, setback_regions
 from grammarc.geometry.wavefront import swept_strips
 
 
@@ -47,9 +47,41 @@ def test_a_face_swept_whole_leaves_nothing():
     assert [s.area for s in strips] == pytest.approx([2, 2.5, 1.5])
 
 
-def test_facing_lines_that_meet_apart_are_a_split_event_the_sweep_does_not_follow():
-    """A U whose left arm closes (its sides moved 4 m, 3.2 m apart): its bottom's line and the kept edge
-    above it are parallel but apart when they become neighbours, where the wavefront parts."""
-    ring = [(0, 0), (21, 0), (21, 10), (18, 10), (18, 1.6), (3.2, 1.6), (3.2, 10), (0, 10)]
-    _, _, trusted, _ = sweep(ring, [4, 4, 3, 3, 0, 0, 4, 3])
+def test_lines_that_become_neighbours_apart_are_a_split_event_the_sweep_does_not_follow():
+    """An outline (``random_polygon(1395)`` of the setback tests) whose edges 1-3 run nearly collinear; moved
+    by 3;8;0;4;8;4;0;3 its wavefront parts where two parallel lines apart become neighbours."""
+    ring = [(-2.741298957897467, -1.8729945287653271), (-2.7677734989337943, -1.971798861019968),
+            (-2.7345322386164876, -2.09585693343178), (-2.286436292788719, -16.853930360413194),
+            (-6.468099005249695, -11.517845132766984), (-6.8529512539598585, -6.28356906748052),
+            (-16.24326538759794, -10.687517687190201), (-3.1990815156498873, 13.204108185076974)]
+    _, _, trusted, _ = sweep(ring, [3, 8, 0, 4, 8, 4, 0, 3])
     assert not trusted
+
+
+def test_the_step_beside_a_vanished_edge_goes_with_it():
+    """massing.far.33391's first tier: edge 3 (2.8 m, moved 4 m) turns by 13 degrees into the kept edge 4, a
+    step; it vanishes, and PRT's remainder then runs along edge 2's moved line up to edge 4 (measured through
+    PyPRT: 300.245 m^2, its corner at (30.247, 9.223)), where keeping the step left a notch (303.48 m^2)."""
+    ring = [(0.0, 3.524), (0.0, 0.0), (24.4042, 0.0), (31.3414, 5.0686), (30.8369, 7.8597), (27.8887, 14.6713),
+            (19.6308, 18.3044)]
+    strips, collapsed, trusted, _ = sweep(ring, [4, 0, 4, 4, 0, 0, 0])
+    assert trusted and not collapsed
+    covered = shapely.union_all([s for s in strips if s is not None])
+    remainder = shapely.Polygon(ring).difference(covered)
+    assert remainder.area == pytest.approx(300.245, abs=0.02)
+    assert min(np.hypot(*(np.asarray(remainder.exterior.coords) - (30.247, 9.223)).T)) < 2e-3
+
+
+def test_moving_lines_that_meet_face_to_face_annihilate_where_they_overlap():
+    """massing.T.34179's second tier: the bar's left end (moved 4 m) vanishes as its bottom (4 m) and top (3 m)
+    meet; the bottom's segment, the shorter, goes and the top runs on over the bar's right half (PRT's
+    remainder: 25.999 m^2, that half 3 m below the top, from the stem's side moved 3 m to the end moved 4 m;
+    the top went, as the slower, before)."""
+    ring = [(0.0, 30.19), (0.0, 25.214), (18.238, 25.214), (18.238, 0.0), (20.155, 0.0), (20.155, 25.214),
+            (38.393, 25.214), (38.393, 30.19)]
+    d = [4, 4, 3, 3, 0, 0, 4, 3]
+    _, collapsed, trusted, _ = sweep(ring, d)
+    assert trusted and not collapsed
+    face = np.array([shapely.Polygon(ring)])
+    _, rest = setback_regions(face, polygon_edges(face), np.array(d, float), np.zeros(8, np.int64), 1)
+    assert shapely.area(rest[0]) == pytest.approx((38.393 - 4 - 21.238) * (30.19 - 3 - 25.214), rel=1e-9)
