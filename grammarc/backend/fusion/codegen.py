@@ -24,18 +24,21 @@ from dataclasses import dataclass, field
 from itertools import count
 from typing import NamedTuple
 
-from grammarc.backend.fusion.regions import SIZES, applied_rules
+from grammarc.backend.fusion.regions import SIZES, applied_rules, leaf_successor
 from grammarc.backend.kernels.split import MAX_COUNT
 from grammarc.constants import TOL
+from grammarc.ir.asset_names import LEAF_CUBE, LEAF_QUAD
 from grammarc.ir import nodes as ir
 
 
 @dataclass(frozen=True)
 class Emit:
-    """Records of ``asset`` made at emission ``site``: the instances of an ``I``."""
+    """Records of ``asset`` made at emission ``site`` by ``symbol``: the instances of an ``I`` (the symbol
+    whose rule it is in), or a leaf's cubes or quads (the leaf's symbol)."""
 
     site: int
     asset: int
+    symbol: int
 
 
 @dataclass
@@ -162,7 +165,10 @@ class _Writer:
             elif isinstance(op, ir.Repeat):
                 self.repeat(op, block, scope, level, depth)
             elif isinstance(op, ir.Insert):
-                self.emit(block, self.plan.grammar.asset_ids[op.asset], scope, level)
+                self.emit(block, self.plan.grammar.asset_ids[op.asset], block.symbol, scope, level)
+            elif isinstance(op, ir.Symbol) and leaf_successor(self.plan, op):
+                self.made(level)
+                self.leaf(block, self.plan.symbol_ids[op.name], scope, level)
             elif isinstance(op, ir.Symbol):
                 self.made(level)
                 args = []
@@ -274,21 +280,48 @@ class _Writer:
         self.put(level, "pass")
         self.body(part, block, scope._replace(origin=tuple(moved), size=cut), level, depth)
 
-    def emit(self, block: Block, asset: int, scope: Scope, level: int) -> None:
-        """An emission site: counted, or a record of the scope (``kernels.scope.xforms``) at the site's next
-        row."""
+    def emit(self, block: Block, asset: int, symbol: int, scope: Scope, level: int) -> None:
+        """An emission site of ``asset`` and its record of the scope."""
+        self.record(self.site(block, asset, symbol), scope, level)
+
+    def site(self, block: Block, asset: int, symbol: int) -> int:
+        """A new emission site, due in ``block``'s order where it is met."""
         site = self.sites
         self.sites += 1
-        block.events.append(Emit(site, asset))
+        block.events.append(Emit(site, asset, symbol))
+        return site
+
+    def record(self, site: int, scope: Scope, level: int, axes: tuple = (0, 1, 2), flat: bool = False) -> None:
+        """Counted, or a record of the scope (``kernels.scope.xforms``) at ``site``'s next row: column j is
+        scope axis ``axes[j]`` times its size, the last times zero where ``flat`` (a quad's normal,
+        ``terminals.emit_leaves``)."""
         self.put(level, "if writing:")
         row = self.fresh("w")
         self.put(level + 1, f"{row} = sites[{site}]")
         for r in range(3):
-            for j in range(3):
-                self.put(level + 1, f"xform[{row}, {r}, {j}] = frames[f, {j}, {r}] * {scope.size[j]}")
+            for j, axis in enumerate(axes):
+                size = "0.0" if flat and j == 2 else scope.size[axis]
+                self.put(level + 1, f"xform[{row}, {r}, {j}] = frames[f, {axis}, {r}] * {size}")
             self.put(level + 1, f"xform[{row}, {r}, 3] = {scope.origin[r]} - base[l, {r}]")
         self.put(level + 1, f"record_lot[{row}] = l")
         self.put(level, f"sites[{site}] += 1")
+
+    def leaf(self, block: Block, symbol: int, scope: Scope, level: int) -> None:
+        """A leaf of ``symbol`` as ``terminals.emit_leaves`` makes it, which emits a batch's cubes, then its
+        quads (two sites): a cube where no axis is flat (``TOL.zero`` or less); a quad where one is, its
+        columns the two others in turn and the flat one (the first flat axis where two are); nothing
+        where more are, which has no surface."""
+        assets = self.plan.grammar.module.assets
+        cube, quad = self.site(block, assets.index(LEAF_CUBE), symbol), self.site(block, assets.index(LEAF_QUAD), symbol)
+        flat = [f"{size} <= {TOL.zero!r}" for size in scope.size]
+        count = self.fresh("z")
+        self.put(level, f"{count} = ({flat[0]}) + ({flat[1]}) + ({flat[2]})")
+        self.put(level, f"if {count} == 0:")
+        self.record(cube, scope, level + 1)
+        self.put(level, f"elif {count} == 1:")
+        for k, test in enumerate((f"if {flat[0]}:", f"elif {flat[1]}:", "else:")):
+            self.put(level + 1, test)
+            self.record(quad, scope, level + 2, ((k + 1) % 3, (k + 2) % 3, k), flat=True)
 
     def made(self, level: int) -> None:
         """One more shape of the parent (a split child, a successor), as ``Context.count`` counts them."""

@@ -44,8 +44,8 @@ class FusedBatch:
             if type(event) is Emit:
                 a, b = starts[event.site], starts[event.site + 1]
                 if b > a:
-                    terminals.append_records(ctx, records.xform[a:b], records.lot[a:b], event.asset,
-                                             self.block.symbol, None)
+                    terminals.append_records(ctx, records.xform[a:b], records.lot[a:b], event.asset, event.symbol,
+                                             None)
             elif starts[event.last] > starts[event.first]:
                 ctx.pending[event.symbol].append(FusedBatch(records, event))
 

@@ -3,8 +3,10 @@
 A region is a symbol (its *root*) with the symbols its rules lead to, all derived by one generated kernel
 (``codegen``) from the root's pending shapes: no intermediate shape columns, the terminals written straight
 into the records. It covers what needs no context: the scope operations ``S`` and ``T``, single-axis
-``Subdiv`` and ``Repeat`` (no snapping), ``I``, ``ε``, ``[ ]``, successor symbols (with arguments), guards
-and sizes made of numbers, attributes, parameters (numbers), ``scope.sx|sy|sz`` and arithmetic. Anything
+``Subdiv`` and ``Repeat`` (no snapping), ``I``, ``ε``, ``[ ]``, successor symbols (with arguments), leaves
+(a successor without rules, or ``X.``, without arguments: its box or rectangle is a record at once, as
+``terminals.emit_leaves`` makes it), guards and sizes made of numbers, attributes, parameters (numbers),
+``scope.sx|sy|sz`` and arithmetic. Anything
 else - another operation, a stochastic rule, a function call - keeps the symbol for the interpreter (``backend.execute``), which remains the
 reference: both give the same records, bit for bit (``tests/backend/fusion``).
 
@@ -14,8 +16,9 @@ pending shapes then come from this one place), or when its rule only places an a
 shapes' records are the same however its batches are concatenated). A region whose successors cannot all
 be inlined is no region. The whole grammar is left to the interpreter where records carry more than an
 asset and a transform (colours, texture channels or coordinates, trims), where shapes carry per-shape
-state (``set``, ``split.index``, a pivot), where an insert occludes, and in CityEngine's dialect (a body's
-end is a leaf, and shapes draw from PRT's sequential stream, which successors move on in place).
+state (``set``, ``split.index``, a pivot), where an insert occludes, in a search that sums a design's leaves
+(``backend.aggregates``), and in CityEngine's dialect (a body's end is a leaf, and shapes draw from PRT's
+sequential stream, which successors move on in place).
 ``GRAMMARC_FUSION=off`` turns fusion off; ``GRAMMARC_FUSION=always`` compiles a kernel for any batch, however
 small (``COMPILE_AT``).
 """
@@ -56,9 +59,10 @@ def compile_at() -> int | None:
 
 def grammar_allows(plan) -> bool:
     """Whether ``plan``'s grammar may be fused at all (see the module docstring)."""
+    # a search's aggregates count the shapes and leaves each symbol is given (``backend.aggregates``)
     return not (plan.leaf_bodies or plan.sequential_random or plan.queries or plan.occluders or plan.dynamic
                 or plan.color_slot is not None or plan.material_slots or plan.uv_slots
-                or plan.trim_slot is not None or plan.pivot_slot is not None)
+                or plan.trim_slot is not None or plan.pivot_slot is not None or plan.grammar.module.objectives)
 
 
 class Fusible:
@@ -88,11 +92,12 @@ class Fusible:
         return False
 
     def inlined(self, name: str) -> bool:
-        """Whether the successor symbol ``name`` is derived inside its region (module docstring)."""
+        """Whether the successor symbol ``name``, which has rules, is derived inside its region (module
+        docstring)."""
         plan = self.plan
         sym_id = plan.symbol_ids[name]
         alone = self.uses[name] == 1 and sym_id != plan.start
-        return bool(plan.symbols[sym_id].rules) and (alone or sym_id in plan.leaf_inserts) and self.symbol(sym_id)
+        return (alone or sym_id in plan.leaf_inserts) and self.symbol(sym_id)
 
     def _rules(self, sym) -> bool:
         if not sym.rules or any(t is not ir.Type.NUM for t in sym.param_types) or sym.id in self.plan.snapping:
@@ -119,7 +124,9 @@ class Fusible:
             return (len(op.axes) == 1 and not op.snap and all(self.expr(e) for e in op.sizes)
                     and all(self.body(part) for part in op.parts))
         if isinstance(op, ir.Symbol):
-            return not op.leaf and self.inlined(op.name) and all(self.expr(arg) for arg in op.args)
+            if leaf_successor(self.plan, op):  # its leaves are records at once, wherever it is named
+                return not op.args
+            return self.inlined(op.name) and all(self.expr(arg) for arg in op.args)
         return isinstance(op, (ir.Insert, ir.Empty, ir.Push, ir.Pop))
 
     def expr(self, expr: ir.Expr) -> bool:
@@ -134,6 +141,11 @@ class Fusible:
         if isinstance(expr, ir.Binary):
             return expr.op in ARITHMETIC | COMPARE | LOGIC and self.expr(expr.left) and self.expr(expr.right)
         return False
+
+
+def leaf_successor(plan, op: ir.Symbol) -> bool:
+    """Whether successor ``op`` makes leaves (``operations.successors``): a symbol without rules, or ``X.``."""
+    return op.leaf or plan.symbols[plan.symbol_ids[op.name]].terminal
 
 
 def applied_rules(sym) -> tuple[ir.Rule, ...]:

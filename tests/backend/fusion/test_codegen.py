@@ -24,7 +24,7 @@ def test_sites_are_numbered_in_the_interpreter_order_of_emission():
     names = [plan.symbols[b.symbol].name for b in tile.events]
     # Subdiv("X"){ wall | Subdiv("Y"){ wall | window | wall } | wall }: parts in order, nested parts in place
     assert names == ["wall", "wall", "window", "wall", "wall"]
-    assert [b.events for b in tile.events] == [[Emit(k, b.events[0].asset)] for k, b in enumerate(tile.events)]
+    assert [b.events for b in tile.events] == [[Emit(k, b.events[0].asset, b.symbol)] for k, b in enumerate(tile.events)]
     assert (source.block.first, source.block.last, source.sites) == (0, 5, 5)
     assert isinstance(tile, Block) and (tile.first, tile.last) == (0, 5)
     assert source.attrs == ("floor_h", "tile_w") and source.depth == 3

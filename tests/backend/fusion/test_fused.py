@@ -59,6 +59,14 @@ part ~> Repeat("Y", 3){ I("quad") }
 """
 
 
+#: Leaves, cubes and quads (``terminals.emit_leaves``) of one batch: ``row``, named twice, is its own region,
+#: whose batch holds the lot's flat scopes and boxes; every flat axis of a quad, two flat axes (no record),
+#: and leaves reached through an inlined symbol.
+LEAVES = """
+lot ~> Subdiv("Z", 1r, 1r){ row | S(1r, 2, 1r) row }
+row ~> Repeat("X", 2){ wall | S(0, 1r, 1r) wall | S(1r, 1r, 0) wall | S(1r, 1r, 0.5) T(0, 1, 0) roof | S(0, 0, 1r) wall | bay }
+bay ~> Subdiv("Y", 1r, 1r){ wall | S(1r, 1r, 0.2) roof }
+"""
 
 @pytest.fixture(autouse=True)
 def fused_always(monkeypatch):
@@ -94,6 +102,14 @@ def test_fused_and_interpreted_symbols_meet_in_the_interpreter_order(write, monk
     assert {plan.symbols[k].name for k in plan.fused} == {"bay"}
     fused, interpreted = both(write, monkeypatch, MIXED, make_lots("square", "rect_12x8", "concave_L", "courtyard"))
     assert len(fused["asset"]) > 200 and fused["kernels"]
+    assert_same(fused, interpreted)
+
+
+def test_leaves_are_the_cubes_and_quads_of_the_interpreter_in_its_order(write, monkeypatch):
+    plan = make_plan(compile_grammar(write("g.cga", LEAVES)))
+    assert {plan.symbols[k].name for k in plan.fused} == {"row", "bay"}
+    fused, interpreted = both(write, monkeypatch, LEAVES, make_lots("square", "rect_12x8", "sliver"))
+    assert fused["kernels"] and {0, 1} <= set(fused["asset"].tolist())
     assert_same(fused, interpreted)
 
 

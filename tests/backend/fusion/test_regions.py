@@ -54,6 +54,20 @@ x ~> S(1r, 1r, 0.2) I("cube")
 """) == {"lot"}
 
 
+def test_leaves_are_emitted_inside_a_region_wherever_their_symbol_is_named(write):
+    # ``socle`` and ``plaster`` have no rules: their boxes are records where ``band`` and ``wall`` name them
+    assert fused(write, """
+lot ~> Subdiv("X", 1r, 1r){ band | wall }
+band ~> Subdiv("Y", 0.8, 1r){ socle | plaster }
+wall ~> Repeat("X", 2){ plaster | I("cube") }
+""") == {"lot", "band", "wall"}
+    # a leaf with arguments is left to the interpreter
+    assert fused(write, """
+lot ~> Subdiv("X", 1r, 1r){ band(1) | band(2) }
+band(k) ~> Subdiv("Y", k, 1r){ socle(k) | plaster }
+""") == set()
+
+
 def test_functions_random_choices_and_recursion_are_not_fused_parameters_are(write):
     assert fused(write, """
 lot ~> Subdiv("X", 1r, rand(1, 2)){ a(2) | b }
