@@ -2,19 +2,23 @@
 
 A region (``regions``) becomes one function over its root's batch, a loop over the parent shapes with the
 rules of the root and of the symbols it inlines written out as nested code: a split is a loop over its
-children (or one block per ``Subdiv`` part), a guard an ``if``, a successor the code of its symbol's rules,
-an ``I`` an *emission site*. The scope travels in local variables (origin and size per axis; the frame stays
-the parent's: no operation of a region turns it). The runner calls it twice (one function to compile, not
-two). Counting, ``sites[k]`` adds up the records site k makes; ``made`` the shapes each parent
-makes (as the interpreter counts them for --max-shapes), and ``bad`` flags parents the interpreter would
-fail (a negative size, a repeat beyond the limit). Writing, ``sites[k]`` is site k's next row, where its
-record goes. Records of one site thus come in the parents' order and, within a parent, in the order of
-its children: the order the interpreter gives them (``backend.fusion``).
+children (or one block per ``Subdiv`` part), a guard an ``if``, a successor the code of its symbol's rules
+where the region inlines it and else a *hand-off site* (its shapes written out), an ``I`` or a leaf an
+*emission site*. The scope travels in local variables (origin and size per axis; the frame stays the
+parent's: no operation of a region turns it), the random key as an expression evaluated only where a shape
+is handed off. The runner calls it twice (one function to compile, not two). Counting, ``sites[k]`` adds
+up the records site k makes and ``handoffs[k]`` the shapes hand-off site k makes; ``made`` the shapes each
+parent makes (as the interpreter counts them for --max-shapes), and ``bad`` flags parents the interpreter
+would fail (a negative size, a repeat beyond the limit). Writing, ``sites[k]`` is site k's next row, where
+its record goes, and ``handoffs[k]`` likewise. Records (and shapes) of one site thus come in the parents'
+order and, within a parent, in the order of its children: the order the interpreter gives them
+(``backend.fusion``).
 
 The arithmetic is the interpreter's, operation by operation, in the same order (``kernels.split`` lays
 the parts, ``kernels.scope`` places children and writes transforms, ``operations.scope`` moves and sizes):
-every record has the same bits. The region's ``Block`` tree tells the runner when each site's records are
-due: a site of the root at once, a site of an inlined symbol when that symbol's turn comes.
+every record and shape has the same bits. The region's ``Block`` tree tells the runner when each site's
+records and shapes are due: a site of the root at once, a site of an inlined symbol when that symbol's turn
+comes.
 """
 
 from __future__ import annotations
@@ -24,11 +28,11 @@ from dataclasses import dataclass, field
 from itertools import count
 from typing import NamedTuple
 
-from grammarc.backend.fusion.regions import SIZES, applied_rules, leaf_successor
+from grammarc.backend.fusion.regions import SIZES, Fusible, applied_rules, leaf_successor
 from grammarc.backend.kernels.split import MAX_COUNT
 from grammarc.constants import TOL
-from grammarc.ir.asset_names import LEAF_CUBE, LEAF_QUAD
 from grammarc.ir import nodes as ir
+from grammarc.ir.asset_names import LEAF_CUBE, LEAF_QUAD
 
 
 @dataclass(frozen=True)
@@ -41,36 +45,54 @@ class Emit:
     symbol: int
 
 
+@dataclass(frozen=True)
+class Handoff:
+    """Shapes of ``symbol`` made at hand-off ``site``: successors the region does not derive, which wait for
+    their symbol's turn as the interpreter's would (``regions.Fusible.inlined``)."""
+
+    site: int
+    symbol: int
+
+
 @dataclass
 class Block:
-    """What one symbol of a region emits when its rules run, in the interpreter's order: records (``Emit``)
-    and the blocks of the symbols it hands shapes to. Its sites and those of its blocks are the range
-    ``first`` to ``last`` (sites are numbered in this order)."""
+    """What one symbol of a region emits when its rules run, in the interpreter's order: records (``Emit``),
+    shapes handed on (``Handoff``) and the blocks of the symbols it derives. Its sites and those of its
+    blocks are the range ``first`` to ``last``, its hand-off sites ``first_handoff`` to ``last_handoff``
+    (sites are numbered in this order)."""
 
     symbol: int
     events: list = field(default_factory=list)
     first: int = 0
     last: int = 0
+    first_handoff: int = 0
+    last_handoff: int = 0
 
 
 class Scope(NamedTuple):
     """Where the generated code holds a shape: the names of its origin's and size's variables (per axis)
-    and of its parameters' values."""
+    and of its parameters' values; the expression of its random key (``backend.random``: a split child's
+    mixes its parent's with the split's site and its index, a successor's with its site and 0), computed
+    only where a shape is handed off."""
 
     origin: tuple[str, str, str]
     size: tuple[str, str, str]
     params: tuple[str, ...]
+    key: str
 
 
 @dataclass(frozen=True)
 class Source:
     """A region's generated module: its text, the root's ``Block``, the attributes its functions take (in
-    order), its number of sites and how many symbols deep it reaches below its root."""
+    order), its numbers of sites and of hand-off sites, the most parameters a shape handed off has, and how
+    many symbols deep it reaches below its root."""
 
     text: str
     block: Block
     attrs: tuple[str, ...]
     sites: int
+    handoffs: int
+    params: int
     depth: int
 
 
@@ -78,27 +100,32 @@ HEADER = '''"""Generated by grammarc.backend.fusion.codegen from a region of a g
 import numpy as np
 from numba import njit
 
+from grammarc.backend.random import mix1
+
 '''
 
 
-def generate(plan, root: int) -> Source:
-    """The source of the region rooted at symbol ``root`` (which ``regions.Fusible`` accepted)."""
-    writer = _Writer(plan)
+def generate(fusible: Fusible, root: int) -> Source:
+    """The source of the region rooted at symbol ``root`` (which ``fusible`` accepted)."""
+    writer = _Writer(fusible)
     writer.function(root)
     return Source(HEADER + "\n".join(writer.lines) + "\n", writer.block, tuple(writer.attrs), writer.sites,
-                  writer.depth)
+                  writer.handoffs, writer.params, writer.depth)
 
 
 class _Writer:
     """The walk over the region's IR that writes the kernel's lines, numbering sites and attributes as it
     meets them."""
 
-    def __init__(self, plan) -> None:
-        self.plan = plan
+    def __init__(self, fusible: Fusible) -> None:
+        self.fusible = fusible
+        self.plan = fusible.plan
         self.lines: list[str] = []
         self.attrs: list[str] = []
         self.names = count()
         self.sites = 0
+        self.handoffs = 0
+        self.params = 0
         self.depth = 0
         self.block: Block | None = None
 
@@ -115,12 +142,12 @@ class _Writer:
         ]
         self.lines += ["    " + line for line in body]
         root_params = tuple(f"q{k}[i]" for k in range(len(self.plan.symbols[root].param_types)))
-        self.block = self.symbol(root, Scope(("o0", "o1", "o2"), ("s0", "s1", "s2"), root_params), 2, 0)
+        self.block = self.symbol(root, Scope(("o0", "o1", "o2"), ("s0", "s1", "s2"), root_params, "key[i]"), 2, 0)
         self.lines += ["        made[i] = n", "        if n > limit:", "            bad[i] = True"]
         columns = "".join(f"q{k}, " for k in range(len(root_params))) + "".join(
             f"a{k}, " for k in range(len(self.attrs)))
-        self.lines[1] = (f"def derive(origin, size, frame, lot, frames, {columns}base, limit, writing, sites, made, "
-                         "bad, xform, record_lot):")
+        self.lines[1] = (f"def derive(origin, size, frame, lot, key, depth, frames, {columns}base, limit, writing, "
+                         "sites, made, bad, xform, record_lot, handoffs, handed):")
 
     def put(self, level: int, line: str) -> None:
         self.lines.append("    " * level + line)
@@ -132,7 +159,7 @@ class _Writer:
     def symbol(self, sym_id: int, scope: Scope, level: int, depth: int) -> Block:
         """The code of symbol ``sym_id``'s rules on ``scope``."""
         self.depth = max(self.depth, depth)
-        block = Block(sym_id, first=self.sites)
+        block = Block(sym_id, first=self.sites, first_handoff=self.handoffs)
         rules = applied_rules(self.plan.symbols[sym_id])
         for k, rule in enumerate(rules):
             if rule.guard is None:
@@ -144,7 +171,7 @@ class _Writer:
                 inner = level + 1
             self.put(inner, "pass")
             self.body(rule.alternatives[0].body, block, scope, inner, depth)
-        block.last = self.sites
+        block.last, block.last_handoff = self.sites, self.handoffs
         return block
 
     def body(self, body: ir.Body, block: Block, scope: Scope, level: int, depth: int) -> None:
@@ -176,7 +203,11 @@ class _Writer:
                     args.append(self.fresh("p"))
                     self.put(level, f"{args[-1]} = {self.expr(arg, scope)}")
                 target = self.plan.symbol_ids[op.name]
-                block.events.append(self.symbol(target, scope._replace(params=tuple(args)), level, depth + 1))
+                successor = scope._replace(params=tuple(args), key=f"mix1(mix1({scope.key}, {op.site}), 0)")
+                if self.fusible.inlined(op.name):
+                    block.events.append(self.symbol(target, successor, level, depth + 1))
+                else:
+                    self.handoff(block, target, successor, level, depth + 1)
             # ``ε``: nothing
 
     # ------------------------------------------------------------------------------------------ operations
@@ -227,7 +258,7 @@ class _Writer:
         self.put(level, f"{free} = {extent} - {absolute}")
         self.put(level, f"{free} = max({free}, 0.0)")
         self.put(level, f"{at} = 0.0")
-        for name, s, part in zip(values, op.sizes, op.parts):
+        for k, (name, s, part) in enumerate(zip(values, op.sizes, op.parts)):
             step, end, length = (self.fresh(stem) for stem in ("sz", "en", "ln"))
             if s.kind is ir.SizeKind.RELATIVE:
                 self.put(level, f"{step} = {name} * {free} / {relative} if {relative} > 0.0 else 0.0")
@@ -237,7 +268,7 @@ class _Writer:
             self.put(level, f"{end} = min({end}, {extent})")
             self.put(level, f"if {end} - {at} > {TOL.zero!r}:")
             self.put(level + 1, f"{length} = {end} - {at}")
-            self.child(part, block, scope, axis, at, length, level + 1, depth)
+            self.child(part, block, scope, axis, at, length, level + 1, depth, op.site, str(k))
             self.put(level, f"{at} = {at} + {step}")
 
     def repeat(self, op: ir.Repeat, block: Block, scope: Scope, level: int, depth: int) -> None:
@@ -265,12 +296,13 @@ class _Writer:
             if parts > 1:
                 self.put(level + 1, f"{'if' if k == 0 else 'elif'} {j} % {parts} == {k}:")
                 inner = level + 2
-            self.child(part, block, scope, axis, pos, step, inner, depth)
+            self.child(part, block, scope, axis, pos, step, inner, depth, op.site, j)
 
     def child(self, part: ir.Body, block: Block, scope: Scope, axis: int, pos: str, length: str, level: int,
-              depth: int) -> None:
+              depth: int, site: int, index: str) -> None:
         """A split child (``kernels.scope.place_children``: the origin moved by ``pos`` along the split
-        axis, the size cut to ``length``) and its part's body."""
+        axis, the size cut to ``length``, the key mixed with the split's ``site`` and the child's ``index``)
+        and its part's body."""
         moved = []
         for j in range(3):
             moved.append(self.fresh("o"))
@@ -278,7 +310,8 @@ class _Writer:
         cut = tuple(length if k == axis else scope.size[k] for k in range(3))
         self.made(level)
         self.put(level, "pass")
-        self.body(part, block, scope._replace(origin=tuple(moved), size=cut), level, depth)
+        key = f"mix1(mix1({scope.key}, {site}), {index})"
+        self.body(part, block, scope._replace(origin=tuple(moved), size=cut, key=key), level, depth)
 
     def emit(self, block: Block, asset: int, symbol: int, scope: Scope, level: int) -> None:
         """An emission site of ``asset`` and its record of the scope."""
@@ -322,6 +355,28 @@ class _Writer:
         for k, test in enumerate((f"if {flat[0]}:", f"elif {flat[1]}:", "else:")):
             self.put(level + 1, test)
             self.record(quad, scope, level + 2, ((k + 1) % 3, (k + 2) % 3, k), flat=True)
+
+    def handoff(self, block: Block, symbol: int, scope: Scope, level: int, depth: int) -> None:
+        """A hand-off site: counted, or the shape written at the site's next row of ``handed`` (origin,
+        size, frame, lot, key, depth, parameters), as ``operations.successors`` makes it."""
+        site = self.handoffs
+        self.handoffs += 1
+        self.params = max(self.params, len(scope.params))
+        block.events.append(Handoff(site, symbol))
+        origin, size, frame, lot, key, depth_, params = (f"handed[{k}]" for k in range(7))
+        self.put(level, "if writing:")
+        row = self.fresh("h")
+        self.put(level + 1, f"{row} = handoffs[{site}]")
+        for j in range(3):
+            self.put(level + 1, f"{origin}[{row}, {j}] = {scope.origin[j]}")
+            self.put(level + 1, f"{size}[{row}, {j}] = {scope.size[j]}")
+        self.put(level + 1, f"{frame}[{row}] = f")
+        self.put(level + 1, f"{lot}[{row}] = l")
+        self.put(level + 1, f"{key}[{row}] = {scope.key}")
+        self.put(level + 1, f"{depth_}[{row}] = depth[i] + {depth}")
+        for k, value in enumerate(scope.params):
+            self.put(level + 1, f"{params}[{k}, {row}] = {value}")
+        self.put(level, f"handoffs[{site}] += 1")
 
     def made(self, level: int) -> None:
         """One more shape of the parent (a split child, a successor), as ``Context.count`` counts them."""

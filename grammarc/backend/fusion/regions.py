@@ -13,8 +13,10 @@ reference: both give the same records, bit for bit (``tests/backend/fusion``).
 A successor symbol is derived inside the region (*inlined*) only where the interpreter's record order can be
 kept (``backend.fusion`` explains the order): when the symbol is named once in the whole grammar (its
 pending shapes then come from this one place), or when its rule only places an asset (``leaf_parts``: its
-shapes' records are the same however its batches are concatenated). A region whose successors cannot all
-be inlined is no region. The whole grammar is left to the interpreter where records carry more than an
+shapes' records are the same however its batches are concatenated). Any other successor is *handed off*:
+the kernel writes its shapes (scope, key, depth, parameters of numbers), which join the symbol's pending
+batches where the interpreter's would, and its rules run at its turn, by the interpreter or by the kernel
+of its own region. The whole grammar is left to the interpreter where records carry more than an
 asset and a transform (colours, texture channels or coordinates, trims), where shapes carry per-shape
 state (``set``, ``split.index``, a pivot), where an insert occludes, in a search that sums a design's leaves
 (``backend.aggregates``), and in CityEngine's dialect (a body's end is a leaf, and shapes draw from PRT's
@@ -87,7 +89,8 @@ class Fusible:
             for op in iter_ops(rule):
                 if isinstance(op, (ir.Split, ir.Repeat)):
                     return True
-                if isinstance(op, ir.Symbol) and self.worth_a_kernel(self.plan.symbol_ids[op.name]):
+                if (isinstance(op, ir.Symbol) and not leaf_successor(self.plan, op) and self.inlined(op.name)
+                        and self.worth_a_kernel(self.plan.symbol_ids[op.name])):
                     return True
         return False
 
@@ -126,7 +129,10 @@ class Fusible:
         if isinstance(op, ir.Symbol):
             if leaf_successor(self.plan, op):  # its leaves are records at once, wherever it is named
                 return not op.args
-            return self.inlined(op.name) and all(self.expr(arg) for arg in op.args)
+            target = self.plan.symbols[self.plan.symbol_ids[op.name]]
+            # derived here, or handed off: its shapes wait for its turn, their parameters numbers
+            return all(self.expr(arg) for arg in op.args) and (
+                self.inlined(op.name) or all(t is ir.Type.NUM for t in target.param_types))
         return isinstance(op, (ir.Insert, ir.Empty, ir.Push, ir.Pop))
 
     def expr(self, expr: ir.Expr) -> bool:

@@ -6,6 +6,7 @@ from pathlib import Path
 
 from grammarc.backend.fusion.codegen import Block, Emit, generate
 from grammarc.backend.fusion.compiled import digest, load
+from grammarc.backend.fusion.regions import Fusible
 from grammarc.backend.plan import make_plan
 from grammarc.compiler import compile_grammar
 
@@ -18,7 +19,7 @@ def facade_plan():
 
 def test_sites_are_numbered_in_the_interpreter_order_of_emission():
     plan = facade_plan()
-    source = generate(plan, plan.symbol_ids["facade"])
+    source = generate(Fusible(plan), plan.symbol_ids["facade"])
     floor, = source.block.events
     tile, = floor.events
     names = [plan.symbols[b.symbol].name for b in tile.events]
@@ -32,9 +33,9 @@ def test_sites_are_numbered_in_the_interpreter_order_of_emission():
 
 def test_the_source_is_a_function_of_the_region():
     plan, again = facade_plan(), facade_plan()
-    texts = {generate(p, p.symbol_ids["tile"]).text for p in (plan, again)}
+    texts = {generate(Fusible(p), p.symbol_ids["tile"]).text for p in (plan, again)}
     assert len(texts) == 1
     text = texts.pop()
-    assert digest(text) != digest(generate(plan, plan.symbol_ids["floor"]).text)
+    assert digest(text) != digest(generate(Fusible(plan), plan.symbol_ids["floor"]).text)
     module, path = load(text)
     assert path.read_text() == text and callable(module.derive)

@@ -68,6 +68,17 @@ row ~> Repeat("X", 2){ wall | S(0, 1r, 1r) wall | S(1r, 1r, 0) wall | S(1r, 1r, 
 bay ~> Subdiv("Y", 1r, 1r){ wall | S(1r, 1r, 0.2) roof }
 """
 
+#: Hand-offs: ``cell``, named from several places, takes its parameter from ``lot``'s kernel and is its own
+#: region; ``pick`` is the interpreter's (a stochastic rule, ``rand``), whose draws need the keys the kernels
+#: hand on, and whose pending list mixes shapes of both kernels.
+HANDOFF = """
+attr w = 2
+lot ~> Subdiv("Z", 1r, 1r){ Repeat("X", w){ cell(1.5) | cell(0.5) } | [ T(0, 1, 0) cell(2) ] S(1r, 3, 1r) Subdiv("X", 1r, 2){ pick | cell(1) } }
+cell(h) ~> S(1r, h, 1r) Repeat("X", 1){ pick | [ S(1r, 1r, 0.3) pick ] I("cube") }
+pick ~> I("cube") : 0.5
+     ~> S(1r, rand(1, 2), 1r) I("quad") : 0.5
+"""
+
 @pytest.fixture(autouse=True)
 def fused_always(monkeypatch):
     """Kernels for every batch, however small (``regions.COMPILE_AT``)."""
@@ -107,9 +118,25 @@ def test_fused_and_interpreted_symbols_meet_in_the_interpreter_order(write, monk
 
 def test_leaves_are_the_cubes_and_quads_of_the_interpreter_in_its_order(write, monkeypatch):
     plan = make_plan(compile_grammar(write("g.cga", LEAVES)))
-    assert {plan.symbols[k].name for k in plan.fused} == {"row", "bay"}
+    assert {plan.symbols[k].name for k in plan.fused} == {"lot", "row", "bay"}
     fused, interpreted = both(write, monkeypatch, LEAVES, make_lots("square", "rect_12x8", "sliver"))
     assert fused["kernels"] and {0, 1} <= set(fused["asset"].tolist())
+    assert_same(fused, interpreted)
+
+
+def test_shapes_handed_off_are_the_interpreters_with_their_keys_and_parameters(write, monkeypatch):
+    plan = make_plan(compile_grammar(write("g.cga", HANDOFF)))
+    assert {plan.symbols[k].name for k in plan.fused} == {"lot", "cell"}
+    fused, interpreted = both(write, monkeypatch, HANDOFF, make_lots("square", "rect_12x8"))
+    assert fused["kernels"] == 2 and len(fused["asset"]) > 50
+    assert_same(fused, interpreted)
+
+
+def test_shapes_handed_off_are_as_deep_as_the_interpreters(write, monkeypatch):
+    # ``pick`` reaches the depth first, from ``cell``: the failure names it
+    fused, interpreted = both(write, monkeypatch, HANDOFF, make_lots("square", "rect_12x8"),
+                              limits=replace(LIMITS, max_depth=2))
+    assert fused["bad"] and "`pick`" in fused["bad"][0].reason
     assert_same(fused, interpreted)
 
 
