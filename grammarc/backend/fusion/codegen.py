@@ -73,7 +73,7 @@ class Scope(NamedTuple):
     """Where the generated code holds a shape: the names of its origin's and size's variables (per axis)
     and of its parameters' values; the expression of its random key (``backend.random``: a split child's
     mixes its parent's with the split's site and its index, a successor's with its site and 0), computed
-    only where a shape is handed off."""
+    only where a shape draws or is handed off."""
 
     origin: tuple[str, str, str]
     size: tuple[str, str, str]
@@ -170,9 +170,41 @@ class _Writer:
                 self.put(level, f"{'el' if k else ''}if {self.expr(rule.guard, scope)}:")
                 inner = level + 1
             self.put(inner, "pass")
-            self.body(rule.alternatives[0].body, block, scope, inner, depth)
+            self.alternatives(rule, block, scope, inner, depth)
         block.last, block.last_handoff = self.sites, self.handoffs
         return block
+
+    def alternatives(self, rule: ir.Rule, block: Block, scope: Scope, level: int, depth: int) -> None:
+        """``execute.apply_rule``: the body, or the alternative the shape's draw at the rule's site picks
+        from the running sum of the probabilities (which fail the lot unless they sum to 1 and none is
+        negative); the alternatives' sites in their order, as the interpreter runs them one after the
+        other."""
+        alternatives = rule.alternatives
+        if len(alternatives) == 1:
+            self.body(alternatives[0].body, block, scope, level, depth)
+            return
+        probs = [self.fresh("pr") for _ in alternatives]
+        for name, alternative in zip(probs, alternatives):
+            self.put(level, f"{name} = {self.expr(alternative.prob, scope)}")
+        self.check(level, f"not (abs(({' + '.join(probs)}) - 1.0) > {TOL.probability!r} or "
+                          f"{' or '.join(f'{name} < 0.0' for name in probs)})")
+        drawn, running, pick = self.fresh("u"), self.fresh("cu"), self.fresh("pk")
+        self.put(level, f"{drawn} = {self.draw(scope, rule.site)}")
+        self.put(level, f"{running} = 0.0")
+        self.put(level, f"{pick} = 0")
+        for name in probs:
+            self.put(level, f"{running} += {name}")
+            self.put(level, f"if {drawn} >= {running}:")
+            self.put(level + 1, f"{pick} += 1")
+        for k, alternative in enumerate(alternatives):
+            last = k == len(alternatives) - 1
+            self.put(level, "else:" if last else f"{'el' if k else ''}if {pick} == {k}:")
+            self.put(level + 1, "pass")
+            self.body(alternative.body, block, scope, level + 1, depth)
+
+    def draw(self, scope: Scope, site: int) -> str:
+        """``random.uniform``: the shape's draw at ``site``."""
+        return f"(mix1({scope.key}, {site}) >> np.uint64(11)) * (1.0 / 9007199254740992.0)"
 
     def body(self, body: ir.Body, block: Block, scope: Scope, level: int, depth: int) -> None:
         """``execute.run``: the operations in order on one scope; ``[`` keeps it, ``]`` takes it back; an
@@ -390,8 +422,8 @@ class _Writer:
     # ------------------------------------------------------------------------------------------ expressions
     def expr(self, expr: ir.Expr, scope: Scope) -> str:
         """``expr`` as numba source: numbers as float64 literals, attributes read by lot, parameters and
-        ``scope.s*`` from the scope's variables, operators as ``backend.evaluate`` applies them (float64,
-        IEEE division)."""
+        ``scope.s*`` from the scope's variables, operators and functions as ``backend.evaluate`` applies
+        them (float64, IEEE division, NaN-propagating ``min`` and ``max``, ``rand``'s scaled draw)."""
         if isinstance(expr, ir.Bool):
             return repr(bool(expr.value))
         if isinstance(expr, ir.Num):
@@ -407,5 +439,14 @@ class _Writer:
             return scope.size[SIZES[expr.field]]
         if isinstance(expr, ir.Unary):
             return f"({'not ' if expr.op == '!' else '-'}{self.expr(expr.operand, scope)})"
+        if isinstance(expr, ir.Call):  # ``functions.math``
+            args = [self.expr(arg, scope) for arg in expr.args]
+            if expr.func != "rand":
+                return f"np.{'minimum' if expr.func == 'min' else 'maximum'}({args[0]}, {args[1]})"
+            drawn = self.draw(scope, expr.site)
+            if not args:
+                return f"({drawn})"
+            low, high = ("0.0", args[0]) if len(args) == 1 else args
+            return f"({low} + ({high} - {low}) * {drawn})"
         operator = {"&&": "and", "||": "or"}.get(expr.op, expr.op)
         return f"({self.expr(expr.left, scope)} {operator} {self.expr(expr.right, scope)})"

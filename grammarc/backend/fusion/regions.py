@@ -6,9 +6,10 @@ into the records. It covers what needs no context: the scope operations ``S`` an
 ``Subdiv`` and ``Repeat`` (no snapping), ``I``, ``ε``, ``[ ]``, successor symbols (with arguments), leaves
 (a successor without rules, or ``X.``, without arguments: its box or rectangle is a record at once, as
 ``terminals.emit_leaves`` makes it), guards and sizes made of numbers, attributes, parameters (numbers),
-``scope.sx|sy|sz`` and arithmetic. Anything
-else - another operation, a stochastic rule, a function call - keeps the symbol for the interpreter (``backend.execute``), which remains the
-reference: both give the same records, bit for bit (``tests/backend/fusion``).
+``scope.sx|sy|sz``, arithmetic, ``min``, ``max`` and ``rand``, and stochastic rules (their draws and
+``rand``'s from the shape's counter-based stream, ``backend.random``, whose keys the kernel carries). Anything
+else - another operation, another function - keeps the symbol for the interpreter (``backend.execute``),
+which remains the reference: both give the same records, bit for bit (``tests/backend/fusion``).
 
 A successor symbol is derived inside the region (*inlined*) only where the interpreter's record order can be
 kept (``backend.fusion`` explains the order): when the symbol is named once in the whole grammar (its
@@ -42,6 +43,8 @@ COMPARE = frozenset({"<", "<=", ">", ">=", "==", "!="})
 LOGIC = frozenset({"&&", "||"})
 #: The scope fields a fused expression may read: the scope's size.
 SIZES = {"sx": 0, "sy": 1, "sz": 2}
+#: The functions a fused expression may call: ``rand`` draws from the shape's counter-based stream.
+FUNCTIONS = frozenset({"min", "max", "rand"})
 
 
 #: A kernel that is not compiled yet is compiled once a process has met this many shapes of its root:
@@ -106,9 +109,13 @@ class Fusible:
         if not sym.rules or any(t is not ir.Type.NUM for t in sym.param_types) or sym.id in self.plan.snapping:
             return False
         for rule in applied_rules(sym):
-            if len(rule.alternatives) != 1 or (rule.guard is not None and not self.expr(rule.guard)):
+            if rule.guard is not None and not self.expr(rule.guard):
                 return False
-            if not self.body(rule.alternatives[0].body):
+            alternatives = rule.alternatives
+            # a search's consequents are chosen by its states (``backend.choices``)
+            if alternatives[0].choice or (len(alternatives) > 1 and not all(self.expr(a.prob) for a in alternatives)):
+                return False
+            if not all(self.body(a.body) for a in alternatives):
                 return False
         return applied_rules(sym)[-1].guard is None  # shapes no rule applies to would be leaves
 
@@ -146,6 +153,8 @@ class Fusible:
             return expr.op in ("-", "!") and self.expr(expr.operand)
         if isinstance(expr, ir.Binary):
             return expr.op in ARITHMETIC | COMPARE | LOGIC and self.expr(expr.left) and self.expr(expr.right)
+        if isinstance(expr, ir.Call):
+            return expr.func in FUNCTIONS and all(self.expr(arg) for arg in expr.args)
         return False
 
 

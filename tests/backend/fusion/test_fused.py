@@ -17,6 +17,7 @@ from grammarc.backend.plan import make_plan
 from grammarc.build import BuildOptions, derive
 from grammarc.compiler import compile_grammar
 from grammarc.constants import LIMITS
+from grammarc.io.lots import lots_from_polygons
 
 #: ``side`` turns its scope (no kernel does) and hands shapes to ``pane``, a leaf insert that the fused
 #: ``bay`` inlines too: pane's pending list mixes both; ``bay``'s guards pick rules per shape.
@@ -79,6 +80,18 @@ pick ~> I("cube") : 0.5
      ~> S(1r, rand(1, 2), 1r) I("quad") : 0.5
 """
 
+#: Draws: stochastic rules and ``rand`` in the root, in an inlined symbol (``cell``) and in one handed off
+#: (``pick``), and ``min`` and ``max``; ``lot``'s probabilities do not sum to 1 on lots wider than 11 m.
+RANDOM = """
+lot ~> Subdiv("Z", 1r, min(Scope.sz * 0.5, 4)){ Repeat("X", 1.5){ cell } | S(1r, max(rand(1, 3), 2), 1r) Repeat("X", 2){ pick } } : 0.9
+    ~> Repeat("X", rand(1, 2)){ pick } : 0.1 + max(Scope.sx - 11, 0)
+cell ~> S(1r, rand(2), 1r) Subdiv("Y", 1r, rand(0.5, 1)){ pick | I("cube") } : 0.3
+     ~> [ T(0, rand(), 0) I("quad") ] pick : 0.5
+     ~> ε : 0.2
+pick ~> Repeat("X", 0.7){ I("cube") } : 0.5
+     ~> S(1r, rand(1, 2), 1r) I("quad") : 0.5
+"""
+
 @pytest.fixture(autouse=True)
 def fused_always(monkeypatch):
     """Kernels for every batch, however small (``regions.COMPILE_AT``)."""
@@ -137,6 +150,18 @@ def test_shapes_handed_off_are_as_deep_as_the_interpreters(write, monkeypatch):
     fused, interpreted = both(write, monkeypatch, HANDOFF, make_lots("square", "rect_12x8"),
                               limits=replace(LIMITS, max_depth=2))
     assert fused["bad"] and "`pick`" in fused["bad"][0].reason
+    assert_same(fused, interpreted)
+
+
+@pytest.mark.parametrize("widest", [11, 12])
+def test_draws_are_the_interpreters(write, monkeypatch, widest):
+    plan = make_plan(compile_grammar(write("g.cga", RANDOM)))
+    assert {plan.symbols[k].name for k in plan.fused} == {"lot", "cell", "pick"}
+    widths = np.linspace(5, widest, 16)
+    lots = lots_from_polygons([[np.array([[0, 0], [w, 0], [w, 9], [0, 9]])] for w in widths],
+                              ids=[f"w{w:g}" for w in widths])
+    fused, interpreted = both(write, monkeypatch, RANDOM, lots)
+    assert fused["kernels"] and bool(fused["bad"]) == (widest > 11) and len(fused["asset"]) > 200
     assert_same(fused, interpreted)
 
 

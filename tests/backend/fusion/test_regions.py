@@ -70,13 +70,24 @@ band(k) ~> Subdiv("Y", k, 1r){ socle(k) | plaster }
 """) == {"lot"}
 
 
-def test_functions_and_random_choices_are_not_fused_parameters_are_recursion_is_handed_off(write):
+def test_random_choices_min_max_rand_and_parameters_are_fused_other_functions_not(write):
     assert fused(write, """
 lot ~> Subdiv("X", 1r, rand(1, 2)){ a(2) | b }
-a(k) ~> S(k, 1r, 1r) Repeat("Y", k){ [ T(0, 0, k) I("quad") ] I("cube") }
-b ~> I("cube") : 0.5
+a(k) ~> S(k, 1r, min(Scope.sz, 3)) Repeat("Y", k){ [ T(0, 0, k) I("quad") ] I("cube") }
+b ~> Repeat("Y", 1){ I("cube") } : 0.5
   ~> I("quad") : 0.5
-""") == {"a"}
+""") == {"lot", "a", "b"}
+    # ``c`` is the interpreter's (``sin``), ``lot`` hands its shapes on; a search's consequents are chosen by
+    # its states
+    assert fused(write, """
+lot ~> Subdiv("X", 1r, 1r){ c | d }
+c ~> Repeat("Y", sin(Scope.sx) + 2){ I("cube") }
+d ~> Repeat("Y", 1){ I("cube") } ?
+  ~> I("quad") ?
+""") == {"lot"}
+
+
+def test_recursion_is_handed_off(write):
     assert fused(write, """
 lot ~> Subdiv("X", 1r, 1r){ lot | I("cube") }
 """) == {"lot"}
