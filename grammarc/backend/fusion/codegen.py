@@ -102,6 +102,29 @@ from numba import njit
 
 from grammarc.backend.random import mix1
 
+
+@njit(cache=True, nogil=True, error_model='numpy')
+def put_record(xform, record_lot, row, frames, f, l, base, a0, a1, a2, z0, z1, z2, o0, o1, o2):
+    """The record at ``row`` (``kernels.scope.xforms``): column j frame axis ``aj`` times ``zj``, column 3
+    the origin less the lot's."""
+    for r in range(3):
+        xform[row, r, 0] = frames[f, a0, r] * z0
+        xform[row, r, 1] = frames[f, a1, r] * z1
+        xform[row, r, 2] = frames[f, a2, r] * z2
+    xform[row, 0, 3] = o0 - base[l, 0]
+    xform[row, 1, 3] = o1 - base[l, 1]
+    xform[row, 2, 3] = o2 - base[l, 2]
+    record_lot[row] = l
+
+
+@njit(cache=True, nogil=True, error_model='numpy')
+def put_shape(handed, row, o0, o1, o2, s0, s1, s2, f, l, key, depth):
+    """The shape handed off at ``row`` of ``handed`` (``compiled.handed_columns``), but its parameters."""
+    origin, size, frame, lot, keys, depths = handed[0], handed[1], handed[2], handed[3], handed[4], handed[5]
+    origin[row, 0], origin[row, 1], origin[row, 2] = o0, o1, o2
+    size[row, 0], size[row, 1], size[row, 2] = s0, s1, s2
+    frame[row], lot[row], keys[row], depths[row] = f, l, key, depth
+
 '''
 
 
@@ -356,58 +379,50 @@ class _Writer:
         block.events.append(Emit(site, asset, symbol))
         return site
 
-    def record(self, site: int, scope: Scope, level: int, axes: tuple = (0, 1, 2), flat: bool = False) -> None:
-        """Counted, or a record of the scope (``kernels.scope.xforms``) at ``site``'s next row: column j is
-        scope axis ``axes[j]`` times its size, the last times zero where ``flat`` (a quad's normal,
-        ``terminals.emit_leaves``)."""
+    def record(self, site: int, scope: Scope, level: int) -> None:
+        """Counted, or a record of the scope at ``site``'s next row (``put_record``)."""
         self.put(level, "if writing:")
-        row = self.fresh("w")
-        self.put(level + 1, f"{row} = sites[{site}]")
-        for r in range(3):
-            for j, axis in enumerate(axes):
-                size = "0.0" if flat and j == 2 else scope.size[axis]
-                self.put(level + 1, f"xform[{row}, {r}, {j}] = frames[f, {axis}, {r}] * {size}")
-            self.put(level + 1, f"xform[{row}, {r}, 3] = {scope.origin[r]} - base[l, {r}]")
-        self.put(level + 1, f"record_lot[{row}] = l")
+        self.put(level + 1, f"put_record(xform, record_lot, sites[{site}], frames, f, l, base, 0, 1, 2, "
+                            f"{', '.join(scope.size)}, {', '.join(scope.origin)})")
         self.put(level, f"sites[{site}] += 1")
 
     def leaf(self, block: Block, symbol: int, scope: Scope, level: int) -> None:
         """A leaf of ``symbol`` as ``terminals.emit_leaves`` makes it, which emits a batch's cubes, then its
         quads (two sites): a cube where no axis is flat (``TOL.zero`` or less); a quad where one is, its
-        columns the two others in turn and the flat one (the first flat axis where two are); nothing
-        where more are, which has no surface."""
+        columns the two others in turn and the flat one times zero (the first flat axis where two are);
+        nothing where more are, which has no surface."""
         assets = self.plan.grammar.module.assets
         cube, quad = self.site(block, assets.index(LEAF_CUBE), symbol), self.site(block, assets.index(LEAF_QUAD), symbol)
         flat = [f"{size} <= {TOL.zero!r}" for size in scope.size]
-        count = self.fresh("z")
+        count, a, b, k, za, zb = (self.fresh(stem) for stem in ("z", "qa", "qb", "qk", "za", "zb"))
         self.put(level, f"{count} = ({flat[0]}) + ({flat[1]}) + ({flat[2]})")
         self.put(level, f"if {count} == 0:")
         self.record(cube, scope, level + 1)
         self.put(level, f"elif {count} == 1:")
-        for k, test in enumerate((f"if {flat[0]}:", f"elif {flat[1]}:", "else:")):
+        for axis, test in enumerate((f"if {flat[0]}:", f"elif {flat[1]}:", "else:")):
+            first, second = (axis + 1) % 3, (axis + 2) % 3
             self.put(level + 1, test)
-            self.record(quad, scope, level + 2, ((k + 1) % 3, (k + 2) % 3, k), flat=True)
+            self.put(level + 2, f"{a}, {b}, {k}, {za}, {zb} = {first}, {second}, {axis}, {scope.size[first]}, "
+                                f"{scope.size[second]}")
+        self.put(level + 1, "if writing:")
+        self.put(level + 2, f"put_record(xform, record_lot, sites[{quad}], frames, f, l, base, {a}, {b}, {k}, "
+                            f"{za}, {zb}, 0.0, {', '.join(scope.origin)})")
+        self.put(level + 1, f"sites[{quad}] += 1")
 
     def handoff(self, block: Block, symbol: int, scope: Scope, level: int, depth: int) -> None:
-        """A hand-off site: counted, or the shape written at the site's next row of ``handed`` (origin,
-        size, frame, lot, key, depth, parameters), as ``operations.successors`` makes it."""
+        """A hand-off site: counted, or the shape written at the site's next row of ``handed``
+        (``put_shape``), as ``operations.successors`` makes it."""
         site = self.handoffs
         self.handoffs += 1
         self.params = max(self.params, len(scope.params))
         block.events.append(Handoff(site, symbol))
-        origin, size, frame, lot, key, depth_, params = (f"handed[{k}]" for k in range(7))
         self.put(level, "if writing:")
         row = self.fresh("h")
         self.put(level + 1, f"{row} = handoffs[{site}]")
-        for j in range(3):
-            self.put(level + 1, f"{origin}[{row}, {j}] = {scope.origin[j]}")
-            self.put(level + 1, f"{size}[{row}, {j}] = {scope.size[j]}")
-        self.put(level + 1, f"{frame}[{row}] = f")
-        self.put(level + 1, f"{lot}[{row}] = l")
-        self.put(level + 1, f"{key}[{row}] = {scope.key}")
-        self.put(level + 1, f"{depth_}[{row}] = depth[i] + {depth}")
+        self.put(level + 1, f"put_shape(handed, {row}, {', '.join(scope.origin)}, {', '.join(scope.size)}, f, l, "
+                            f"{scope.key}, depth[i] + {depth})")
         for k, value in enumerate(scope.params):
-            self.put(level + 1, f"{params}[{k}, {row}] = {value}")
+            self.put(level + 1, f"handed[6][{k}, {row}] = {value}")
         self.put(level, f"handoffs[{site}] += 1")
 
     def made(self, level: int) -> None:
