@@ -103,7 +103,9 @@ class Fusible:
         plan = self.plan
         sym_id = plan.symbol_ids[name]
         alone = self.uses[name] == 1 and sym_id != plan.start
-        return (alone or sym_id in plan.leaf_inserts) and self.symbol(sym_id)
+        # a symbol on a cycle of the rule graph is handed off, or its code would hold itself
+        return ((alone or sym_id in plan.leaf_inserts) and name not in plan.grammar.graph.recursive
+                and self.symbol(sym_id))
 
     def _rules(self, sym) -> bool:
         if not sym.rules or any(t is not ir.Type.NUM for t in sym.param_types) or sym.id in self.plan.snapping:

@@ -92,6 +92,14 @@ pick ~> Repeat("X", 0.7){ I("cube") } : 0.5
      ~> S(1r, rand(1, 2), 1r) I("quad") : 0.5
 """
 
+#: Recursion: ``shrink`` names itself (once) and is handed off to itself, round after round.
+RECURSIVE = """
+lot ~> Subdiv("X", 1r, 1r){ half | I("cube") }
+half ~> Repeat("Z", 3){ shrink }
+shrink : Scope.sx > 1 ~> Subdiv("X", 1r, 1r){ S(1r, 2, 1r) shrink | I("quad") }
+shrink ~> I("cube")
+"""
+
 @pytest.fixture(autouse=True)
 def fused_always(monkeypatch):
     """Kernels for every batch, however small (``regions.COMPILE_AT``)."""
@@ -162,6 +170,14 @@ def test_draws_are_the_interpreters(write, monkeypatch, widest):
                               ids=[f"w{w:g}" for w in widths])
     fused, interpreted = both(write, monkeypatch, RANDOM, lots)
     assert fused["kernels"] and bool(fused["bad"]) == (widest > 11) and len(fused["asset"]) > 200
+    assert_same(fused, interpreted)
+
+
+def test_recursion_is_derived_round_after_round(write, monkeypatch):
+    plan = make_plan(compile_grammar(write("g.cga", RECURSIVE)))
+    assert {plan.symbols[k].name for k in plan.fused} == {"lot", "half", "shrink"}
+    fused, interpreted = both(write, monkeypatch, RECURSIVE, make_lots("square", "rect_12x8"))
+    assert fused["kernels"] > 3 and len(fused["asset"]) >= 30
     assert_same(fused, interpreted)
 
 

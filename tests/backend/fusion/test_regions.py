@@ -91,6 +91,12 @@ def test_recursion_is_handed_off(write):
     assert fused(write, """
 lot ~> Subdiv("X", 1r, 1r){ lot | I("cube") }
 """) == {"lot"}
+    # named once, by itself: handed off to itself, never inlined into itself
+    assert fused(write, """
+lot ~> Subdiv("X", 1r, 1r){ a | I("cube") }
+a ~> Repeat("X", 1){ b }
+b ~> S(1r, 0.5r, 1r) b
+""") == {"lot", "a"}
 
 
 def test_the_switch_turns_fusion_off(write, monkeypatch):
