@@ -2,7 +2,8 @@
 records, with no shape columns between their operations ("compile, don't interpret").
 
 ``regions`` finds the symbols whose rules need no context (scope operations, splits, repeats, guards,
-inserts: the whitelist) and which of their successors can be derived with them; ``codegen`` writes a
+inserts, leaves: the whitelist) and which of their successors can be derived with them (the others' shapes
+are handed off: written out, to wait for their symbol's turn); ``codegen`` writes a
 region's kernel, run in two passes (count the records each site makes; write them at offsets from a
 cumulative sum), and the order its records are due in; ``compiled`` keeps the generated modules in the
 user's cache folder, so that numba's cache keeps their machine code; ``fused`` derives a root's pending batch
@@ -19,7 +20,8 @@ records of one emission site (an ``I`` reached through given parts of given spli
 order of the batch, which is the order of the root's shapes and, within one, of the children of each split
 (a split's part holds its children in their parents' order). The kernel writes site by site in that order;
 the records of a site in an inlined symbol's rules are emitted when the schedule reaches that symbol
-(``fused.FusedBatch``), where the interpreter would have emitted them. ``GRAMMARC_FUSION=off`` derives with
+(``fused.FusedBatch``), where the interpreter would have emitted them; shapes handed off join their symbol's
+pending batches at that moment too, where the interpreter's would. ``GRAMMARC_FUSION=off`` derives with
 the interpreter alone. A kernel is compiled once (numba's cache keeps it), when enough shapes have come to
 pay for its compilation; a compiled one then serves every batch.
 """
@@ -51,5 +53,5 @@ def fused_regions(plan) -> dict[int, Region]:
     if threshold is None or not grammar_allows(plan):
         return {}
     fusible = Fusible(plan)
-    return {sym.id: Region(sym.id, generate(plan, sym.id), threshold) for sym in plan.symbols
+    return {sym.id: Region(sym.id, generate(fusible, sym.id), threshold) for sym in plan.symbols
             if fusible.symbol(sym.id) and fusible.worth_a_kernel(sym.id)}

@@ -2,19 +2,23 @@
 
 A region (``regions``) becomes one function over its root's batch, a loop over the parent shapes with the
 rules of the root and of the symbols it inlines written out as nested code: a split is a loop over its
-children (or one block per ``Subdiv`` part), a guard an ``if``, a successor the code of its symbol's rules,
-an ``I`` an *emission site*. The scope travels in local variables (origin and size per axis; the frame stays
-the parent's: no operation of a region turns it). The runner calls it twice (one function to compile, not
-two). Counting, ``sites[k]`` adds up the records site k makes; ``made`` the shapes each parent
-makes (as the interpreter counts them for --max-shapes), and ``bad`` flags parents the interpreter would
-fail (a negative size, a repeat beyond the limit). Writing, ``sites[k]`` is site k's next row, where its
-record goes. Records of one site thus come in the parents' order and, within a parent, in the order of
-its children: the order the interpreter gives them (``backend.fusion``).
+children (or one block per ``Subdiv`` part), a guard an ``if``, a successor the code of its symbol's rules
+where the region inlines it and else a *hand-off site* (its shapes written out), an ``I`` or a leaf an
+*emission site*. The scope travels in local variables (origin and size per axis; the frame stays the
+parent's: no operation of a region turns it), the random key as an expression evaluated only where a shape
+is handed off. The runner calls it twice (one function to compile, not two). Counting, ``sites[k]`` adds
+up the records site k makes and ``handoffs[k]`` the shapes hand-off site k makes; ``made`` the shapes each
+parent makes (as the interpreter counts them for --max-shapes), and ``bad`` flags parents the interpreter
+would fail (a negative size, a repeat beyond the limit). Writing, ``sites[k]`` is site k's next row, where
+its record goes, and ``handoffs[k]`` likewise. Records (and shapes) of one site thus come in the parents'
+order and, within a parent, in the order of its children: the order the interpreter gives them
+(``backend.fusion``).
 
 The arithmetic is the interpreter's, operation by operation, in the same order (``kernels.split`` lays
 the parts, ``kernels.scope`` places children and writes transforms, ``operations.scope`` moves and sizes):
-every record has the same bits. The region's ``Block`` tree tells the runner when each site's records are
-due: a site of the root at once, a site of an inlined symbol when that symbol's turn comes.
+every record and shape has the same bits. The region's ``Block`` tree tells the runner when each site's
+records and shapes are due: a site of the root at once, a site of an inlined symbol when that symbol's turn
+comes.
 """
 
 from __future__ import annotations
@@ -24,50 +28,71 @@ from dataclasses import dataclass, field
 from itertools import count
 from typing import NamedTuple
 
-from grammarc.backend.fusion.regions import SIZES, applied_rules
+from grammarc.backend.fusion.regions import SIZES, Fusible, applied_rules, leaf_successor
 from grammarc.backend.kernels.split import MAX_COUNT
 from grammarc.constants import TOL
 from grammarc.ir import nodes as ir
+from grammarc.ir.asset_names import LEAF_CUBE, LEAF_QUAD
 
 
 @dataclass(frozen=True)
 class Emit:
-    """Records of ``asset`` made at emission ``site``: the instances of an ``I``."""
+    """Records of ``asset`` made at emission ``site`` by ``symbol``: the instances of an ``I`` (the symbol
+    whose rule it is in), or a leaf's cubes or quads (the leaf's symbol)."""
 
     site: int
     asset: int
+    symbol: int
+
+
+@dataclass(frozen=True)
+class Handoff:
+    """Shapes of ``symbol`` made at hand-off ``site``: successors the region does not derive, which wait for
+    their symbol's turn as the interpreter's would (``regions.Fusible.inlined``)."""
+
+    site: int
+    symbol: int
 
 
 @dataclass
 class Block:
-    """What one symbol of a region emits when its rules run, in the interpreter's order: records (``Emit``)
-    and the blocks of the symbols it hands shapes to. Its sites and those of its blocks are the range
-    ``first`` to ``last`` (sites are numbered in this order)."""
+    """What one symbol of a region emits when its rules run, in the interpreter's order: records (``Emit``),
+    shapes handed on (``Handoff``) and the blocks of the symbols it derives. Its sites and those of its
+    blocks are the range ``first`` to ``last``, its hand-off sites ``first_handoff`` to ``last_handoff``
+    (sites are numbered in this order)."""
 
     symbol: int
     events: list = field(default_factory=list)
     first: int = 0
     last: int = 0
+    first_handoff: int = 0
+    last_handoff: int = 0
 
 
 class Scope(NamedTuple):
     """Where the generated code holds a shape: the names of its origin's and size's variables (per axis)
-    and of its parameters' values."""
+    and of its parameters' values; the expression of its random key (``backend.random``: a split child's
+    mixes its parent's with the split's site and its index, a successor's with its site and 0), computed
+    only where a shape draws or is handed off."""
 
     origin: tuple[str, str, str]
     size: tuple[str, str, str]
     params: tuple[str, ...]
+    key: str
 
 
 @dataclass(frozen=True)
 class Source:
     """A region's generated module: its text, the root's ``Block``, the attributes its functions take (in
-    order), its number of sites and how many symbols deep it reaches below its root."""
+    order), its numbers of sites and of hand-off sites, the most parameters a shape handed off has, and how
+    many symbols deep it reaches below its root."""
 
     text: str
     block: Block
     attrs: tuple[str, ...]
     sites: int
+    handoffs: int
+    params: int
     depth: int
 
 
@@ -75,27 +100,55 @@ HEADER = '''"""Generated by grammarc.backend.fusion.codegen from a region of a g
 import numpy as np
 from numba import njit
 
+from grammarc.backend.random import mix1
+
+
+@njit(cache=True, nogil=True, error_model='numpy')
+def put_record(xform, record_lot, row, frames, f, l, base, a0, a1, a2, z0, z1, z2, o0, o1, o2):
+    """The record at ``row`` (``kernels.scope.xforms``): column j frame axis ``aj`` times ``zj``, column 3
+    the origin less the lot's."""
+    for r in range(3):
+        xform[row, r, 0] = frames[f, a0, r] * z0
+        xform[row, r, 1] = frames[f, a1, r] * z1
+        xform[row, r, 2] = frames[f, a2, r] * z2
+    xform[row, 0, 3] = o0 - base[l, 0]
+    xform[row, 1, 3] = o1 - base[l, 1]
+    xform[row, 2, 3] = o2 - base[l, 2]
+    record_lot[row] = l
+
+
+@njit(cache=True, nogil=True, error_model='numpy')
+def put_shape(handed, row, o0, o1, o2, s0, s1, s2, f, l, key, depth):
+    """The shape handed off at ``row`` of ``handed`` (``compiled.handed_columns``), but its parameters."""
+    origin, size, frame, lot, keys, depths = handed[0], handed[1], handed[2], handed[3], handed[4], handed[5]
+    origin[row, 0], origin[row, 1], origin[row, 2] = o0, o1, o2
+    size[row, 0], size[row, 1], size[row, 2] = s0, s1, s2
+    frame[row], lot[row], keys[row], depths[row] = f, l, key, depth
+
 '''
 
 
-def generate(plan, root: int) -> Source:
-    """The source of the region rooted at symbol ``root`` (which ``regions.Fusible`` accepted)."""
-    writer = _Writer(plan)
+def generate(fusible: Fusible, root: int) -> Source:
+    """The source of the region rooted at symbol ``root`` (which ``fusible`` accepted)."""
+    writer = _Writer(fusible)
     writer.function(root)
     return Source(HEADER + "\n".join(writer.lines) + "\n", writer.block, tuple(writer.attrs), writer.sites,
-                  writer.depth)
+                  writer.handoffs, writer.params, writer.depth)
 
 
 class _Writer:
     """The walk over the region's IR that writes the kernel's lines, numbering sites and attributes as it
     meets them."""
 
-    def __init__(self, plan) -> None:
-        self.plan = plan
+    def __init__(self, fusible: Fusible) -> None:
+        self.fusible = fusible
+        self.plan = fusible.plan
         self.lines: list[str] = []
         self.attrs: list[str] = []
         self.names = count()
         self.sites = 0
+        self.handoffs = 0
+        self.params = 0
         self.depth = 0
         self.block: Block | None = None
 
@@ -112,12 +165,12 @@ class _Writer:
         ]
         self.lines += ["    " + line for line in body]
         root_params = tuple(f"q{k}[i]" for k in range(len(self.plan.symbols[root].param_types)))
-        self.block = self.symbol(root, Scope(("o0", "o1", "o2"), ("s0", "s1", "s2"), root_params), 2, 0)
+        self.block = self.symbol(root, Scope(("o0", "o1", "o2"), ("s0", "s1", "s2"), root_params, "key[i]"), 2, 0)
         self.lines += ["        made[i] = n", "        if n > limit:", "            bad[i] = True"]
         columns = "".join(f"q{k}, " for k in range(len(root_params))) + "".join(
             f"a{k}, " for k in range(len(self.attrs)))
-        self.lines[1] = (f"def derive(origin, size, frame, lot, frames, {columns}base, limit, writing, sites, made, "
-                         "bad, xform, record_lot):")
+        self.lines[1] = (f"def derive(origin, size, frame, lot, key, depth, frames, {columns}base, limit, writing, "
+                         "sites, made, bad, xform, record_lot, handoffs, handed):")
 
     def put(self, level: int, line: str) -> None:
         self.lines.append("    " * level + line)
@@ -129,7 +182,7 @@ class _Writer:
     def symbol(self, sym_id: int, scope: Scope, level: int, depth: int) -> Block:
         """The code of symbol ``sym_id``'s rules on ``scope``."""
         self.depth = max(self.depth, depth)
-        block = Block(sym_id, first=self.sites)
+        block = Block(sym_id, first=self.sites, first_handoff=self.handoffs)
         rules = applied_rules(self.plan.symbols[sym_id])
         for k, rule in enumerate(rules):
             if rule.guard is None:
@@ -140,9 +193,41 @@ class _Writer:
                 self.put(level, f"{'el' if k else ''}if {self.expr(rule.guard, scope)}:")
                 inner = level + 1
             self.put(inner, "pass")
-            self.body(rule.alternatives[0].body, block, scope, inner, depth)
-        block.last = self.sites
+            self.alternatives(rule, block, scope, inner, depth)
+        block.last, block.last_handoff = self.sites, self.handoffs
         return block
+
+    def alternatives(self, rule: ir.Rule, block: Block, scope: Scope, level: int, depth: int) -> None:
+        """``execute.apply_rule``: the body, or the alternative the shape's draw at the rule's site picks
+        from the running sum of the probabilities (which fail the lot unless they sum to 1 and none is
+        negative); the alternatives' sites in their order, as the interpreter runs them one after the
+        other."""
+        alternatives = rule.alternatives
+        if len(alternatives) == 1:
+            self.body(alternatives[0].body, block, scope, level, depth)
+            return
+        probs = [self.fresh("pr") for _ in alternatives]
+        for name, alternative in zip(probs, alternatives):
+            self.put(level, f"{name} = {self.expr(alternative.prob, scope)}")
+        self.check(level, f"not (abs(({' + '.join(probs)}) - 1.0) > {TOL.probability!r} or "
+                          f"{' or '.join(f'{name} < 0.0' for name in probs)})")
+        drawn, running, pick = self.fresh("u"), self.fresh("cu"), self.fresh("pk")
+        self.put(level, f"{drawn} = {self.draw(scope, rule.site)}")
+        self.put(level, f"{running} = 0.0")
+        self.put(level, f"{pick} = 0")
+        for name in probs:
+            self.put(level, f"{running} += {name}")
+            self.put(level, f"if {drawn} >= {running}:")
+            self.put(level + 1, f"{pick} += 1")
+        for k, alternative in enumerate(alternatives):
+            last = k == len(alternatives) - 1
+            self.put(level, "else:" if last else f"{'el' if k else ''}if {pick} == {k}:")
+            self.put(level + 1, "pass")
+            self.body(alternative.body, block, scope, level + 1, depth)
+
+    def draw(self, scope: Scope, site: int) -> str:
+        """``random.uniform``: the shape's draw at ``site``."""
+        return f"(mix1({scope.key}, {site}) >> np.uint64(11)) * (1.0 / 9007199254740992.0)"
 
     def body(self, body: ir.Body, block: Block, scope: Scope, level: int, depth: int) -> None:
         """``execute.run``: the operations in order on one scope; ``[`` keeps it, ``]`` takes it back; an
@@ -162,7 +247,10 @@ class _Writer:
             elif isinstance(op, ir.Repeat):
                 self.repeat(op, block, scope, level, depth)
             elif isinstance(op, ir.Insert):
-                self.emit(block, self.plan.grammar.asset_ids[op.asset], scope, level)
+                self.emit(block, self.plan.grammar.asset_ids[op.asset], block.symbol, scope, level)
+            elif isinstance(op, ir.Symbol) and leaf_successor(self.plan, op):
+                self.made(level)
+                self.leaf(block, self.plan.symbol_ids[op.name], scope, level)
             elif isinstance(op, ir.Symbol):
                 self.made(level)
                 args = []
@@ -170,7 +258,11 @@ class _Writer:
                     args.append(self.fresh("p"))
                     self.put(level, f"{args[-1]} = {self.expr(arg, scope)}")
                 target = self.plan.symbol_ids[op.name]
-                block.events.append(self.symbol(target, scope._replace(params=tuple(args)), level, depth + 1))
+                successor = scope._replace(params=tuple(args), key=f"mix1(mix1({scope.key}, {op.site}), 0)")
+                if self.fusible.inlined(op.name):
+                    block.events.append(self.symbol(target, successor, level, depth + 1))
+                else:
+                    self.handoff(block, target, successor, level, depth + 1)
             # ``ε``: nothing
 
     # ------------------------------------------------------------------------------------------ operations
@@ -221,7 +313,7 @@ class _Writer:
         self.put(level, f"{free} = {extent} - {absolute}")
         self.put(level, f"{free} = max({free}, 0.0)")
         self.put(level, f"{at} = 0.0")
-        for name, s, part in zip(values, op.sizes, op.parts):
+        for k, (name, s, part) in enumerate(zip(values, op.sizes, op.parts)):
             step, end, length = (self.fresh(stem) for stem in ("sz", "en", "ln"))
             if s.kind is ir.SizeKind.RELATIVE:
                 self.put(level, f"{step} = {name} * {free} / {relative} if {relative} > 0.0 else 0.0")
@@ -231,7 +323,7 @@ class _Writer:
             self.put(level, f"{end} = min({end}, {extent})")
             self.put(level, f"if {end} - {at} > {TOL.zero!r}:")
             self.put(level + 1, f"{length} = {end} - {at}")
-            self.child(part, block, scope, axis, at, length, level + 1, depth)
+            self.child(part, block, scope, axis, at, length, level + 1, depth, op.site, str(k))
             self.put(level, f"{at} = {at} + {step}")
 
     def repeat(self, op: ir.Repeat, block: Block, scope: Scope, level: int, depth: int) -> None:
@@ -259,12 +351,13 @@ class _Writer:
             if parts > 1:
                 self.put(level + 1, f"{'if' if k == 0 else 'elif'} {j} % {parts} == {k}:")
                 inner = level + 2
-            self.child(part, block, scope, axis, pos, step, inner, depth)
+            self.child(part, block, scope, axis, pos, step, inner, depth, op.site, j)
 
     def child(self, part: ir.Body, block: Block, scope: Scope, axis: int, pos: str, length: str, level: int,
-              depth: int) -> None:
+              depth: int, site: int, index: str) -> None:
         """A split child (``kernels.scope.place_children``: the origin moved by ``pos`` along the split
-        axis, the size cut to ``length``) and its part's body."""
+        axis, the size cut to ``length``, the key mixed with the split's ``site`` and the child's ``index``)
+        and its part's body."""
         moved = []
         for j in range(3):
             moved.append(self.fresh("o"))
@@ -272,23 +365,65 @@ class _Writer:
         cut = tuple(length if k == axis else scope.size[k] for k in range(3))
         self.made(level)
         self.put(level, "pass")
-        self.body(part, block, scope._replace(origin=tuple(moved), size=cut), level, depth)
+        key = f"mix1(mix1({scope.key}, {site}), {index})"
+        self.body(part, block, scope._replace(origin=tuple(moved), size=cut, key=key), level, depth)
 
-    def emit(self, block: Block, asset: int, scope: Scope, level: int) -> None:
-        """An emission site: counted, or a record of the scope (``kernels.scope.xforms``) at the site's next
-        row."""
+    def emit(self, block: Block, asset: int, symbol: int, scope: Scope, level: int) -> None:
+        """An emission site of ``asset`` and its record of the scope."""
+        self.record(self.site(block, asset, symbol), scope, level)
+
+    def site(self, block: Block, asset: int, symbol: int) -> int:
+        """A new emission site, due in ``block``'s order where it is met."""
         site = self.sites
         self.sites += 1
-        block.events.append(Emit(site, asset))
+        block.events.append(Emit(site, asset, symbol))
+        return site
+
+    def record(self, site: int, scope: Scope, level: int) -> None:
+        """Counted, or a record of the scope at ``site``'s next row (``put_record``)."""
         self.put(level, "if writing:")
-        row = self.fresh("w")
-        self.put(level + 1, f"{row} = sites[{site}]")
-        for r in range(3):
-            for j in range(3):
-                self.put(level + 1, f"xform[{row}, {r}, {j}] = frames[f, {j}, {r}] * {scope.size[j]}")
-            self.put(level + 1, f"xform[{row}, {r}, 3] = {scope.origin[r]} - base[l, {r}]")
-        self.put(level + 1, f"record_lot[{row}] = l")
+        self.put(level + 1, f"put_record(xform, record_lot, sites[{site}], frames, f, l, base, 0, 1, 2, "
+                            f"{', '.join(scope.size)}, {', '.join(scope.origin)})")
         self.put(level, f"sites[{site}] += 1")
+
+    def leaf(self, block: Block, symbol: int, scope: Scope, level: int) -> None:
+        """A leaf of ``symbol`` as ``terminals.emit_leaves`` makes it, which emits a batch's cubes, then its
+        quads (two sites): a cube where no axis is flat (``TOL.zero`` or less); a quad where one is, its
+        columns the two others in turn and the flat one times zero (the first flat axis where two are);
+        nothing where more are, which has no surface."""
+        assets = self.plan.grammar.module.assets
+        cube, quad = self.site(block, assets.index(LEAF_CUBE), symbol), self.site(block, assets.index(LEAF_QUAD), symbol)
+        flat = [f"{size} <= {TOL.zero!r}" for size in scope.size]
+        count, a, b, k, za, zb = (self.fresh(stem) for stem in ("z", "qa", "qb", "qk", "za", "zb"))
+        self.put(level, f"{count} = ({flat[0]}) + ({flat[1]}) + ({flat[2]})")
+        self.put(level, f"if {count} == 0:")
+        self.record(cube, scope, level + 1)
+        self.put(level, f"elif {count} == 1:")
+        for axis, test in enumerate((f"if {flat[0]}:", f"elif {flat[1]}:", "else:")):
+            first, second = (axis + 1) % 3, (axis + 2) % 3
+            self.put(level + 1, test)
+            self.put(level + 2, f"{a}, {b}, {k}, {za}, {zb} = {first}, {second}, {axis}, {scope.size[first]}, "
+                                f"{scope.size[second]}")
+        self.put(level + 1, "if writing:")
+        self.put(level + 2, f"put_record(xform, record_lot, sites[{quad}], frames, f, l, base, {a}, {b}, {k}, "
+                            f"{za}, {zb}, 0.0, {', '.join(scope.origin)})")
+        self.put(level + 1, f"sites[{quad}] += 1")
+
+    def handoff(self, block: Block, symbol: int, scope: Scope, level: int, depth: int) -> None:
+        """A hand-off site: counted, or the shape written at the site's next row of ``handed``
+        (``put_shape``), as ``operations.successors`` makes it."""
+        site = self.handoffs
+        self.handoffs += 1
+        self.params = max(self.params, len(scope.params))
+        block.events.append(Handoff(site, symbol))
+        self.put(level, "if writing:")
+        row = self.fresh("h")
+        self.put(level + 1, f"{row} = handoffs[{site}]")
+        self.put(level + 1, f"put_shape(handed, {row}, {', '.join(scope.origin)}, {', '.join(scope.size)}, f, l, "
+                            f"{scope.key}, depth[i] + {depth})")
+        for k, value in enumerate(scope.params):
+            self.put(level + 1, f"handed[6][{k}, {row}] = {value}")
+        self.put(level, f"handoffs[{site}] += 1")
 
     def made(self, level: int) -> None:
         """One more shape of the parent (a split child, a successor), as ``Context.count`` counts them."""
@@ -302,8 +437,8 @@ class _Writer:
     # ------------------------------------------------------------------------------------------ expressions
     def expr(self, expr: ir.Expr, scope: Scope) -> str:
         """``expr`` as numba source: numbers as float64 literals, attributes read by lot, parameters and
-        ``scope.s*`` from the scope's variables, operators as ``backend.evaluate`` applies them (float64,
-        IEEE division)."""
+        ``scope.s*`` from the scope's variables, operators and functions as ``backend.evaluate`` applies
+        them (float64, IEEE division, NaN-propagating ``min`` and ``max``, ``rand``'s scaled draw)."""
         if isinstance(expr, ir.Bool):
             return repr(bool(expr.value))
         if isinstance(expr, ir.Num):
@@ -319,5 +454,14 @@ class _Writer:
             return scope.size[SIZES[expr.field]]
         if isinstance(expr, ir.Unary):
             return f"({'not ' if expr.op == '!' else '-'}{self.expr(expr.operand, scope)})"
+        if isinstance(expr, ir.Call):  # ``functions.math``
+            args = [self.expr(arg, scope) for arg in expr.args]
+            if expr.func != "rand":
+                return f"np.{'minimum' if expr.func == 'min' else 'maximum'}({args[0]}, {args[1]})"
+            drawn = self.draw(scope, expr.site)
+            if not args:
+                return f"({drawn})"
+            low, high = ("0.0", args[0]) if len(args) == 1 else args
+            return f"({low} + ({high} - {low}) * {drawn})"
         operator = {"&&": "and", "||": "or"}.get(expr.op, expr.op)
         return f"({self.expr(expr.left, scope)} {operator} {self.expr(expr.right, scope)})"

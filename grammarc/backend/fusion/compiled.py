@@ -53,9 +53,10 @@ def kernel(text: str, columns: int):
     if text in _KERNELS:
         return _KERNELS[text]
     module, path = load(text)
-    rows = [np.zeros((0, 3)), np.zeros((0, 3)), np.zeros(0, np.int32), np.zeros(0, np.int32), np.zeros((1, 3, 3)),
-            *(np.zeros(0) for _ in range(columns)), np.zeros((0, 3)), 0.0, False, np.zeros(0, np.int64),
-            np.zeros(0), np.zeros(0, np.bool_), np.zeros((0, 3, 4), np.float32), np.zeros(0, np.int32)]
+    rows = [np.zeros((0, 3)), np.zeros((0, 3)), np.zeros(0, np.int32), np.zeros(0, np.int32), np.zeros(0, np.uint64),
+            np.zeros(0, np.int32), np.zeros((1, 3, 3)), *(np.zeros(0) for _ in range(columns)), np.zeros((0, 3)), 0.0,
+            False, np.zeros(0, np.int64), np.zeros(0), np.zeros(0, np.bool_), np.zeros((0, 3, 4), np.float32),
+            np.zeros(0, np.int32), np.zeros(0, np.int64), handed_columns(0, 0)]
     with _locked(path.with_suffix(".lock")):
         module.derive(*rows)
     user_cache.store(path.with_suffix(".compiled"), lambda f: None)
@@ -98,6 +99,13 @@ def ready(text: str, shapes: int, compile_at: int) -> bool:
         return True
     _WAITED[text] = _WAITED.get(text, 0) + shapes
     return _WAITED[text] >= compile_at
+
+
+def handed_columns(rows: int, params: int) -> tuple:
+    """The columns of ``rows`` shapes a kernel hands off (``codegen._Writer.handoff``): origin, size, frame,
+    lot, key, depth, and ``params`` parameters (params, rows)."""
+    return (np.empty((rows, 3)), np.empty((rows, 3)), np.empty(rows, np.int32), np.empty(rows, np.int32),
+            np.empty(rows, np.uint64), np.empty(rows, np.int32), np.empty((params, rows)))
 
 
 @contextmanager

@@ -15,19 +15,30 @@ from dataclasses import dataclass
 import numpy as np
 
 from grammarc.backend import terminals
-from grammarc.backend.fusion.codegen import Block, Emit
-from grammarc.backend.fusion.compiled import kernel, ready
+from grammarc.backend.fusion.codegen import Block, Emit, Handoff
+from grammarc.backend.fusion.compiled import handed_columns, kernel, ready
 from grammarc.backend.shapes import Shapes
 from grammarc.ragged import offsets_from_counts
 
 
 @dataclass(frozen=True, eq=False)
 class FusedRecords:
-    """The records a region's kernel wrote, by site: site k's are rows ``starts[k]`` to ``starts[k + 1]``."""
+    """The records a region's kernel wrote, by site: site k's are rows ``starts[k]`` to ``starts[k + 1]``; and
+    the shapes it handed off (``handed``: origin, size, frame, lot, key, depth, parameters (p, h)), hand-off
+    site k's rows ``handoff_starts[k]`` to ``handoff_starts[k + 1]``."""
 
     xform: np.ndarray  # (m, 3, 4) float32
     lot: np.ndarray  # (m,) int32
     starts: np.ndarray  # (sites + 1,) int64
+    handed: tuple
+    handoff_starts: np.ndarray  # (handoff sites + 1,) int64
+
+    def shapes(self, handoff: Handoff, params: int) -> Shapes:
+        """The shapes of ``handoff``, which take ``params`` parameters."""
+        a, b = self.handoff_starts[handoff.site], self.handoff_starts[handoff.site + 1]
+        origin, size, frame, lot, key, depth, values = self.handed
+        return Shapes(origin[a:b], size[a:b], frame[a:b], np.full(b - a, -1, np.int32), lot[a:b], key[a:b],
+                      depth[a:b], tuple(values[k, a:b] for k in range(params)))
 
 
 @dataclass(frozen=True, eq=False)
@@ -39,14 +50,19 @@ class FusedBatch:
 
     def emit(self, ctx) -> None:
         """Append this block's records and queue its symbols' blocks, in the interpreter's order."""
-        records, starts = self.records, self.records.starts
+        records, starts, handoff_starts = self.records, self.records.starts, self.records.handoff_starts
         for event in self.block.events:
             if type(event) is Emit:
                 a, b = starts[event.site], starts[event.site + 1]
                 if b > a:
-                    terminals.append_records(ctx, records.xform[a:b], records.lot[a:b], event.asset,
-                                             self.block.symbol, None)
-            elif starts[event.last] > starts[event.first]:
+                    terminals.append_records(ctx, records.xform[a:b], records.lot[a:b], event.asset, event.symbol,
+                                             None)
+            elif type(event) is Handoff:
+                if handoff_starts[event.site + 1] > handoff_starts[event.site]:
+                    params = len(ctx.plan.symbols[event.symbol].param_types)
+                    ctx.pending[event.symbol].append(records.shapes(event, params))
+            elif (starts[event.last] > starts[event.first]
+                  or handoff_starts[event.last_handoff] > handoff_starts[event.first_handoff]):
                 ctx.pending[event.symbol].append(FusedBatch(records, event))
 
 
@@ -62,21 +78,26 @@ def derive(ctx, region, shapes: Shapes) -> bool:
     attrs = [*shapes.params, *(chunk.attrs.get(name) for name in region.source.attrs)]
     if not all(isinstance(a, np.ndarray) and a.dtype == np.float64 for a in attrs):
         return False
-    derive_batch = kernel(region.source.text, len(attrs))
+    source = region.source
+    derive_batch = kernel(source.text, len(attrs))
     n = len(shapes)
-    sites, made, bad = np.zeros(region.source.sites, np.int64), np.empty(n), np.zeros(n, np.bool_)
+    sites, made, bad = np.zeros(source.sites, np.int64), np.empty(n), np.zeros(n, np.bool_)
+    handoffs = np.zeros(source.handoffs, np.int64)
     # contiguous, as the kernel was compiled for (``compiled.kernel``): a copy only where one is not
-    columns = (*map(np.ascontiguousarray, (shapes.origin, shapes.size, shapes.frame, shapes.lot, chunk.frames.data,
-                                           *attrs, chunk.lot_origin)), float(limits.max_shapes))
-    derive_batch(*columns, False, sites, made, bad, np.empty((0, 3, 4), np.float32), np.empty(0, np.int32))
+    columns = (*map(np.ascontiguousarray, (shapes.origin, shapes.size, shapes.frame, shapes.lot, shapes.key,
+                                           shapes.depth, chunk.frames.data, *attrs, chunk.lot_origin)),
+               float(limits.max_shapes))
+    derive_batch(*columns, False, sites, made, bad, np.empty((0, 3, 4), np.float32), np.empty(0, np.int32),
+                 handoffs, handed_columns(0, source.params))
     if bad.any() or not _within_limit(ctx, shapes.lot, made):
         return False
     ctx.count_lots(shapes.lot, ctx.plan.symbols[region.root].rules[0].span, made.astype(np.int64))
-    starts = offsets_from_counts(sites)
+    starts, handoff_starts = offsets_from_counts(sites), offsets_from_counts(handoffs)
     total = int(starts[-1])
     xform, lot = np.empty((total, 3, 4), np.float32), np.empty(total, np.int32)
-    derive_batch(*columns, True, starts[:-1].copy(), made, bad, xform, lot)
-    FusedBatch(FusedRecords(xform, lot, starts), region.source.block).emit(ctx)
+    handed = handed_columns(int(handoff_starts[-1]), source.params)
+    derive_batch(*columns, True, starts[:-1].copy(), made, bad, xform, lot, handoff_starts[:-1].copy(), handed)
+    FusedBatch(FusedRecords(xform, lot, starts, handed, handoff_starts), source.block).emit(ctx)
     return True
 
 

@@ -3,19 +3,25 @@
 A region is a symbol (its *root*) with the symbols its rules lead to, all derived by one generated kernel
 (``codegen``) from the root's pending shapes: no intermediate shape columns, the terminals written straight
 into the records. It covers what needs no context: the scope operations ``S`` and ``T``, single-axis
-``Subdiv`` and ``Repeat`` (no snapping), ``I``, ``ε``, ``[ ]``, successor symbols (with arguments), guards
-and sizes made of numbers, attributes, parameters (numbers), ``scope.sx|sy|sz`` and arithmetic. Anything
-else - another operation, a stochastic rule, a function call - keeps the symbol for the interpreter (``backend.execute``), which remains the
-reference: both give the same records, bit for bit (``tests/backend/fusion``).
+``Subdiv`` and ``Repeat`` (no snapping), ``I``, ``ε``, ``[ ]``, successor symbols (with arguments), leaves
+(a successor without rules, or ``X.``, without arguments: its box or rectangle is a record at once, as
+``terminals.emit_leaves`` makes it), guards and sizes made of numbers, attributes, parameters (numbers),
+``scope.sx|sy|sz``, arithmetic, ``min``, ``max`` and ``rand``, and stochastic rules (their draws and
+``rand``'s from the shape's counter-based stream, ``backend.random``, whose keys the kernel carries). Anything
+else - another operation, another function - keeps the symbol for the interpreter (``backend.execute``),
+which remains the reference: both give the same records, bit for bit (``tests/backend/fusion``).
 
 A successor symbol is derived inside the region (*inlined*) only where the interpreter's record order can be
 kept (``backend.fusion`` explains the order): when the symbol is named once in the whole grammar (its
 pending shapes then come from this one place), or when its rule only places an asset (``leaf_parts``: its
-shapes' records are the same however its batches are concatenated). A region whose successors cannot all
-be inlined is no region. The whole grammar is left to the interpreter where records carry more than an
+shapes' records are the same however its batches are concatenated). Any other successor is *handed off*:
+the kernel writes its shapes (scope, key, depth, parameters of numbers), which join the symbol's pending
+batches where the interpreter's would, and its rules run at its turn, by the interpreter or by the kernel
+of its own region. The whole grammar is left to the interpreter where records carry more than an
 asset and a transform (colours, texture channels or coordinates, trims), where shapes carry per-shape
-state (``set``, ``split.index``, a pivot), where an insert occludes, and in CityEngine's dialect (a body's
-end is a leaf, and shapes draw from PRT's sequential stream, which successors move on in place).
+state (``set``, ``split.index``, a pivot), where an insert occludes, in a search that sums a design's leaves
+(``backend.aggregates``), and in CityEngine's dialect (a body's end is a leaf, and shapes draw from PRT's
+sequential stream, which successors move on in place).
 ``GRAMMARC_FUSION=off`` turns fusion off; ``GRAMMARC_FUSION=always`` compiles a kernel for any batch, however
 small (``COMPILE_AT``).
 """
@@ -37,6 +43,8 @@ COMPARE = frozenset({"<", "<=", ">", ">=", "==", "!="})
 LOGIC = frozenset({"&&", "||"})
 #: The scope fields a fused expression may read: the scope's size.
 SIZES = {"sx": 0, "sy": 1, "sz": 2}
+#: The functions a fused expression may call: ``rand`` draws from the shape's counter-based stream.
+FUNCTIONS = frozenset({"min", "max", "rand"})
 
 
 #: A kernel that is not compiled yet is compiled once a process has met this many shapes of its root:
@@ -56,9 +64,10 @@ def compile_at() -> int | None:
 
 def grammar_allows(plan) -> bool:
     """Whether ``plan``'s grammar may be fused at all (see the module docstring)."""
+    # a search's aggregates count the shapes and leaves each symbol is given (``backend.aggregates``)
     return not (plan.leaf_bodies or plan.sequential_random or plan.queries or plan.occluders or plan.dynamic
                 or plan.color_slot is not None or plan.material_slots or plan.uv_slots
-                or plan.trim_slot is not None or plan.pivot_slot is not None)
+                or plan.trim_slot is not None or plan.pivot_slot is not None or plan.grammar.module.objectives)
 
 
 class Fusible:
@@ -83,24 +92,32 @@ class Fusible:
             for op in iter_ops(rule):
                 if isinstance(op, (ir.Split, ir.Repeat)):
                     return True
-                if isinstance(op, ir.Symbol) and self.worth_a_kernel(self.plan.symbol_ids[op.name]):
+                if (isinstance(op, ir.Symbol) and not leaf_successor(self.plan, op) and self.inlined(op.name)
+                        and self.worth_a_kernel(self.plan.symbol_ids[op.name])):
                     return True
         return False
 
     def inlined(self, name: str) -> bool:
-        """Whether the successor symbol ``name`` is derived inside its region (module docstring)."""
+        """Whether the successor symbol ``name``, which has rules, is derived inside its region (module
+        docstring)."""
         plan = self.plan
         sym_id = plan.symbol_ids[name]
         alone = self.uses[name] == 1 and sym_id != plan.start
-        return bool(plan.symbols[sym_id].rules) and (alone or sym_id in plan.leaf_inserts) and self.symbol(sym_id)
+        # a symbol on a cycle of the rule graph is handed off, or its code would hold itself
+        return ((alone or sym_id in plan.leaf_inserts) and name not in plan.grammar.graph.recursive
+                and self.symbol(sym_id))
 
     def _rules(self, sym) -> bool:
         if not sym.rules or any(t is not ir.Type.NUM for t in sym.param_types) or sym.id in self.plan.snapping:
             return False
         for rule in applied_rules(sym):
-            if len(rule.alternatives) != 1 or (rule.guard is not None and not self.expr(rule.guard)):
+            if rule.guard is not None and not self.expr(rule.guard):
                 return False
-            if not self.body(rule.alternatives[0].body):
+            alternatives = rule.alternatives
+            # a search's consequents are chosen by its states (``backend.choices``)
+            if alternatives[0].choice or (len(alternatives) > 1 and not all(self.expr(a.prob) for a in alternatives)):
+                return False
+            if not all(self.body(a.body) for a in alternatives):
                 return False
         return applied_rules(sym)[-1].guard is None  # shapes no rule applies to would be leaves
 
@@ -119,7 +136,12 @@ class Fusible:
             return (len(op.axes) == 1 and not op.snap and all(self.expr(e) for e in op.sizes)
                     and all(self.body(part) for part in op.parts))
         if isinstance(op, ir.Symbol):
-            return not op.leaf and self.inlined(op.name) and all(self.expr(arg) for arg in op.args)
+            if leaf_successor(self.plan, op):  # its leaves are records at once, wherever it is named
+                return not op.args
+            target = self.plan.symbols[self.plan.symbol_ids[op.name]]
+            # derived here, or handed off: its shapes wait for its turn, their parameters numbers
+            return all(self.expr(arg) for arg in op.args) and (
+                self.inlined(op.name) or all(t is ir.Type.NUM for t in target.param_types))
         return isinstance(op, (ir.Insert, ir.Empty, ir.Push, ir.Pop))
 
     def expr(self, expr: ir.Expr) -> bool:
@@ -133,7 +155,14 @@ class Fusible:
             return expr.op in ("-", "!") and self.expr(expr.operand)
         if isinstance(expr, ir.Binary):
             return expr.op in ARITHMETIC | COMPARE | LOGIC and self.expr(expr.left) and self.expr(expr.right)
+        if isinstance(expr, ir.Call):
+            return expr.func in FUNCTIONS and all(self.expr(arg) for arg in expr.args)
         return False
+
+
+def leaf_successor(plan, op: ir.Symbol) -> bool:
+    """Whether successor ``op`` makes leaves (``operations.successors``): a symbol without rules, or ``X.``."""
+    return op.leaf or plan.symbols[plan.symbol_ids[op.name]].terminal
 
 
 def applied_rules(sym) -> tuple[ir.Rule, ...]:

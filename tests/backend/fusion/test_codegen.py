@@ -6,6 +6,7 @@ from pathlib import Path
 
 from grammarc.backend.fusion.codegen import Block, Emit, generate
 from grammarc.backend.fusion.compiled import digest, load
+from grammarc.backend.fusion.regions import Fusible
 from grammarc.backend.plan import make_plan
 from grammarc.compiler import compile_grammar
 
@@ -18,13 +19,13 @@ def facade_plan():
 
 def test_sites_are_numbered_in_the_interpreter_order_of_emission():
     plan = facade_plan()
-    source = generate(plan, plan.symbol_ids["facade"])
+    source = generate(Fusible(plan), plan.symbol_ids["facade"])
     floor, = source.block.events
     tile, = floor.events
     names = [plan.symbols[b.symbol].name for b in tile.events]
     # Subdiv("X"){ wall | Subdiv("Y"){ wall | window | wall } | wall }: parts in order, nested parts in place
     assert names == ["wall", "wall", "window", "wall", "wall"]
-    assert [b.events for b in tile.events] == [[Emit(k, b.events[0].asset)] for k, b in enumerate(tile.events)]
+    assert [b.events for b in tile.events] == [[Emit(k, b.events[0].asset, b.symbol)] for k, b in enumerate(tile.events)]
     assert (source.block.first, source.block.last, source.sites) == (0, 5, 5)
     assert isinstance(tile, Block) and (tile.first, tile.last) == (0, 5)
     assert source.attrs == ("floor_h", "tile_w") and source.depth == 3
@@ -32,9 +33,9 @@ def test_sites_are_numbered_in_the_interpreter_order_of_emission():
 
 def test_the_source_is_a_function_of_the_region():
     plan, again = facade_plan(), facade_plan()
-    texts = {generate(p, p.symbol_ids["tile"]).text for p in (plan, again)}
+    texts = {generate(Fusible(p), p.symbol_ids["tile"]).text for p in (plan, again)}
     assert len(texts) == 1
     text = texts.pop()
-    assert digest(text) != digest(generate(plan, plan.symbol_ids["floor"]).text)
+    assert digest(text) != digest(generate(Fusible(plan), plan.symbol_ids["floor"]).text)
     module, path = load(text)
     assert path.read_text() == text and callable(module.derive)

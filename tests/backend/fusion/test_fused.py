@@ -17,6 +17,7 @@ from grammarc.backend.plan import make_plan
 from grammarc.build import BuildOptions, derive
 from grammarc.compiler import compile_grammar
 from grammarc.constants import LIMITS
+from grammarc.io.lots import lots_from_polygons
 
 #: ``side`` turns its scope (no kernel does) and hands shapes to ``pane``, a leaf insert that the fused
 #: ``bay`` inlines too: pane's pending list mixes both; ``bay``'s guards pick rules per shape.
@@ -59,6 +60,45 @@ part ~> Repeat("Y", 3){ I("quad") }
 """
 
 
+#: Leaves, cubes and quads (``terminals.emit_leaves``) of one batch: ``row``, named twice, is its own region,
+#: whose batch holds the lot's flat scopes and boxes; every flat axis of a quad, two flat axes (no record),
+#: and leaves reached through an inlined symbol.
+LEAVES = """
+lot ~> Subdiv("Z", 1r, 1r){ row | S(1r, 2, 1r) row }
+row ~> Repeat("X", 2){ wall | S(0, 1r, 1r) wall | S(1r, 1r, 0) wall | S(1r, 1r, 0.5) T(0, 1, 0) roof | S(0, 0, 1r) wall | bay }
+bay ~> Subdiv("Y", 1r, 1r){ wall | S(1r, 1r, 0.2) roof }
+"""
+
+#: Hand-offs: ``cell``, named from several places, takes its parameter from ``lot``'s kernel and is its own
+#: region; ``pick`` is the interpreter's (a stochastic rule, ``rand``), whose draws need the keys the kernels
+#: hand on, and whose pending list mixes shapes of both kernels.
+HANDOFF = """
+attr w = 2
+lot ~> Subdiv("Z", 1r, 1r){ Repeat("X", w){ cell(1.5) | cell(0.5) } | [ T(0, 1, 0) cell(2) ] S(1r, 3, 1r) Subdiv("X", 1r, 2){ pick | cell(1) } }
+cell(h) ~> S(1r, h, 1r) Repeat("X", 1){ pick | [ S(1r, 1r, 0.3) pick ] I("cube") }
+pick ~> I("cube") : 0.5
+     ~> S(1r, rand(1, 2), 1r) I("quad") : 0.5
+"""
+
+#: Draws: stochastic rules and ``rand`` in the root, in an inlined symbol (``cell``) and in one handed off
+#: (``pick``), and ``min`` and ``max``; ``lot``'s probabilities do not sum to 1 on lots wider than 11 m.
+RANDOM = """
+lot ~> Subdiv("Z", 1r, min(Scope.sz * 0.5, 4)){ Repeat("X", 1.5){ cell } | S(1r, max(rand(1, 3), 2), 1r) Repeat("X", 2){ pick } } : 0.9
+    ~> Repeat("X", rand(1, 2)){ pick } : 0.1 + max(Scope.sx - 11, 0)
+cell ~> S(1r, rand(2), 1r) Subdiv("Y", 1r, rand(0.5, 1)){ pick | I("cube") } : 0.3
+     ~> [ T(0, rand(), 0) I("quad") ] pick : 0.5
+     ~> ε : 0.2
+pick ~> Repeat("X", 0.7){ I("cube") } : 0.5
+     ~> S(1r, rand(1, 2), 1r) I("quad") : 0.5
+"""
+
+#: Recursion: ``shrink`` names itself (once) and is handed off to itself, round after round.
+RECURSIVE = """
+lot ~> Subdiv("X", 1r, 1r){ half | I("cube") }
+half ~> Repeat("Z", 3){ shrink }
+shrink : Scope.sx > 1 ~> Subdiv("X", 1r, 1r){ S(1r, 2, 1r) shrink | I("quad") }
+shrink ~> I("cube")
+"""
 
 @pytest.fixture(autouse=True)
 def fused_always(monkeypatch):
@@ -94,6 +134,50 @@ def test_fused_and_interpreted_symbols_meet_in_the_interpreter_order(write, monk
     assert {plan.symbols[k].name for k in plan.fused} == {"bay"}
     fused, interpreted = both(write, monkeypatch, MIXED, make_lots("square", "rect_12x8", "concave_L", "courtyard"))
     assert len(fused["asset"]) > 200 and fused["kernels"]
+    assert_same(fused, interpreted)
+
+
+def test_leaves_are_the_cubes_and_quads_of_the_interpreter_in_its_order(write, monkeypatch):
+    plan = make_plan(compile_grammar(write("g.cga", LEAVES)))
+    assert {plan.symbols[k].name for k in plan.fused} == {"lot", "row", "bay"}
+    fused, interpreted = both(write, monkeypatch, LEAVES, make_lots("square", "rect_12x8", "sliver"))
+    assert fused["kernels"] and {0, 1} <= set(fused["asset"].tolist())
+    assert_same(fused, interpreted)
+
+
+def test_shapes_handed_off_are_the_interpreters_with_their_keys_and_parameters(write, monkeypatch):
+    plan = make_plan(compile_grammar(write("g.cga", HANDOFF)))
+    assert {plan.symbols[k].name for k in plan.fused} == {"lot", "cell"}
+    fused, interpreted = both(write, monkeypatch, HANDOFF, make_lots("square", "rect_12x8"))
+    assert fused["kernels"] == 2 and len(fused["asset"]) > 50
+    assert_same(fused, interpreted)
+
+
+def test_shapes_handed_off_are_as_deep_as_the_interpreters(write, monkeypatch):
+    # ``pick`` reaches the depth first, from ``cell``: the failure names it
+    fused, interpreted = both(write, monkeypatch, HANDOFF, make_lots("square", "rect_12x8"),
+                              limits=replace(LIMITS, max_depth=2))
+    assert fused["bad"] and "`pick`" in fused["bad"][0].reason
+    assert_same(fused, interpreted)
+
+
+@pytest.mark.parametrize("widest", [11, 12])
+def test_draws_are_the_interpreters(write, monkeypatch, widest):
+    plan = make_plan(compile_grammar(write("g.cga", RANDOM)))
+    assert {plan.symbols[k].name for k in plan.fused} == {"lot", "cell", "pick"}
+    widths = np.linspace(5, widest, 16)
+    lots = lots_from_polygons([[np.array([[0, 0], [w, 0], [w, 9], [0, 9]])] for w in widths],
+                              ids=[f"w{w:g}" for w in widths])
+    fused, interpreted = both(write, monkeypatch, RANDOM, lots)
+    assert fused["kernels"] and bool(fused["bad"]) == (widest > 11) and len(fused["asset"]) > 200
+    assert_same(fused, interpreted)
+
+
+def test_recursion_is_derived_round_after_round(write, monkeypatch):
+    plan = make_plan(compile_grammar(write("g.cga", RECURSIVE)))
+    assert {plan.symbols[k].name for k in plan.fused} == {"lot", "half", "shrink"}
+    fused, interpreted = both(write, monkeypatch, RECURSIVE, make_lots("square", "rect_12x8"))
+    assert fused["kernels"] > 3 and len(fused["asset"]) >= 30
     assert_same(fused, interpreted)
 
 

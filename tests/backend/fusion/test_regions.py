@@ -28,23 +28,25 @@ def test_the_facade_benchmark_is_fused_below_its_component_split():
     assert {plan.symbols[k].name for k in plan.fused} == {"facade", "floor", "tile"}
 
 
-def test_an_operation_off_the_whitelist_keeps_its_symbol_and_those_leading_to_it(write):
+def test_an_operation_off_the_whitelist_keeps_its_symbol_whose_shapes_are_handed_off(write):
+    # ``b`` is the interpreter's: ``lot``'s kernel hands its shapes on to it
     assert fused(write, """
 lot ~> Subdiv("X", 1r, 1r){ a | b }
 a ~> Repeat("Y", 2){ c }
 b ~> R(0, 30, 0) I("cube")
 c ~> I("quad")
-""") == {"a"}
+""") == {"lot", "a"}
 
 
 def test_a_symbol_named_twice_is_inlined_only_if_it_only_places_an_asset(write):
-    # ``x`` is named by ``a`` and ``b`` and splits: ``a`` and ``b`` would not keep its order
+    # ``x`` is named by ``a`` and ``b`` and splits: inlined, ``a`` and ``b`` would not keep its order; its
+    # shapes are handed off to its own region
     assert fused(write, """
 lot ~> Subdiv("X", 1r, 1r){ a | b }
 a ~> T(1, 0, 0) x
 b ~> S(1r, 2, 1r) x
 x ~> Subdiv("Y", 1r, 1r){ I("cube") | I("quad") }
-""") == {"x"}
+""") == {"lot", "x"}
     # a leaf insert is the same however its batches come
     assert fused(write, """
 lot ~> Subdiv("X", 1r, 1r){ a | b }
@@ -54,16 +56,47 @@ x ~> S(1r, 1r, 0.2) I("cube")
 """) == {"lot"}
 
 
-def test_functions_random_choices_and_recursion_are_not_fused_parameters_are(write):
+def test_leaves_are_emitted_inside_a_region_wherever_their_symbol_is_named(write):
+    # ``socle`` and ``plaster`` have no rules: their boxes are records where ``band`` and ``wall`` name them
+    assert fused(write, """
+lot ~> Subdiv("X", 1r, 1r){ band | wall }
+band ~> Subdiv("Y", 0.8, 1r){ socle | plaster }
+wall ~> Repeat("X", 2){ plaster | I("cube") }
+""") == {"lot", "band", "wall"}
+    # a leaf with arguments is left to the interpreter, and with it ``band``
+    assert fused(write, """
+lot ~> Subdiv("X", 1r, 1r){ band(1) | band(2) }
+band(k) ~> Subdiv("Y", k, 1r){ socle(k) | plaster }
+""") == {"lot"}
+
+
+def test_random_choices_min_max_rand_and_parameters_are_fused_other_functions_not(write):
     assert fused(write, """
 lot ~> Subdiv("X", 1r, rand(1, 2)){ a(2) | b }
-a(k) ~> S(k, 1r, 1r) Repeat("Y", k){ [ T(0, 0, k) I("quad") ] I("cube") }
-b ~> I("cube") : 0.5
+a(k) ~> S(k, 1r, min(Scope.sz, 3)) Repeat("Y", k){ [ T(0, 0, k) I("quad") ] I("cube") }
+b ~> Repeat("Y", 1){ I("cube") } : 0.5
   ~> I("quad") : 0.5
-""") == {"a"}
+""") == {"lot", "a", "b"}
+    # ``c`` is the interpreter's (``sin``), ``lot`` hands its shapes on; a search's consequents are chosen by
+    # its states
+    assert fused(write, """
+lot ~> Subdiv("X", 1r, 1r){ c | d }
+c ~> Repeat("Y", sin(Scope.sx) + 2){ I("cube") }
+d ~> Repeat("Y", 1){ I("cube") } ?
+  ~> I("quad") ?
+""") == {"lot"}
+
+
+def test_recursion_is_handed_off(write):
     assert fused(write, """
 lot ~> Subdiv("X", 1r, 1r){ lot | I("cube") }
-""") == set()
+""") == {"lot"}
+    # named once, by itself: handed off to itself, never inlined into itself
+    assert fused(write, """
+lot ~> Subdiv("X", 1r, 1r){ a | I("cube") }
+a ~> Repeat("X", 1){ b }
+b ~> S(1r, 0.5r, 1r) b
+""") == {"lot", "a"}
 
 
 def test_the_switch_turns_fusion_off(write, monkeypatch):
