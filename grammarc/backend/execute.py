@@ -65,8 +65,12 @@ def apply(ctx: Context, sym: SymbolPlan, shapes: Shapes) -> None:
     the other, as the paper derives: its first shape's snaps are there when its second one splits
     (the front volume's floors set the levels of the wings'). All lots still go together: the k-th
     shape of every lot in one batch. A symbol that roots a fused region is derived by its kernels
-    (``backend.fusion``) unless they decline the batch.
+    (``backend.fusion``) unless they decline the batch. In a search, the shapes of the states stopped at
+    a choice go no further, by either way.
     """
+    shapes = _going_on(ctx, shapes)
+    if not len(shapes):
+        return
     region = ctx.plan.fused.get(sym.id)
     if region is not None and derive_fused(ctx, region, shapes):
         return
@@ -80,12 +84,11 @@ def apply(ctx: Context, sym: SymbolPlan, shapes: Shapes) -> None:
 
 
 def apply_all(ctx: Context, sym: SymbolPlan, shapes: Shapes) -> None:
-    """``apply`` on all of ``shapes`` at once; in a search, but for the states stopped at a choice."""
-    choices = ctx.chunk.choices
-    if choices is not None:
-        shapes = shapes.take(~choices.stopped[shapes.lot])
-        if not len(shapes):
-            return
+    """``apply`` on all of ``shapes`` at once (a snapping symbol's k-th shapes: a choice met by the
+    ones before may have stopped their state)."""
+    shapes = _going_on(ctx, shapes)
+    if not len(shapes):
+        return
     ctx.check_depth(shapes, sym.rules[0].span)
     remaining = shapes
     for rule in sym.rules:
@@ -99,6 +102,12 @@ def apply_all(ctx: Context, sym: SymbolPlan, shapes: Shapes) -> None:
         apply_rule(ctx, rule, remaining)
         return
     terminals.emit_leaves(ctx, remaining, sym.id)
+
+
+def _going_on(ctx: Context, shapes: Shapes) -> Shapes:
+    """``shapes`` but, in a search, those of the states stopped at a choice."""
+    choices = ctx.chunk.choices
+    return shapes if choices is None else shapes.take(~choices.stopped[shapes.lot])
 
 
 def apply_rule(ctx: Context, rule: ir.Rule, shapes: Shapes) -> None:
