@@ -244,6 +244,41 @@ def test_cut_pieces_start_as_prt_starts_them():
         (10, 10), (0, 10)]
 
 
+def test_a_cut_through_a_hole_starts_the_side_of_vertex_0_at_the_cut_into_the_hole():
+    """A cut that runs through a hole: PRT starts the piece that holds vertices 0 and 1 with the cut edge
+    that runs into the hole, where the outline leaves the piece, not at vertex 0 (measured through PyPRT
+    on a 40 x 20 m lot whose hole the footprint split of massing crosses, at each orientation); the
+    other piece starts with its cut edge as without a hole."""
+    import shapely
+
+    lot = shapely.Polygon([(0, 0), (30, 0), (30, -30), (0, -30)],  # clockwise in (x, z)
+                          [[(10, -12), (16, -12), (16, -18), (10, -18)]])
+    upper, lower = shapely.box(-1, -15, 31, 1), shapely.box(-1, -31, 31, -15)
+    assert _first_vertices(lot, [lot.intersection(upper), lot.intersection(lower)], [True, False]) == [
+        (30, -15), (0, -15)]
+    whole = shapely.Polygon(lot.exterior)  # without the hole vertex 0 starts its piece
+    assert _first_vertices(whole, [whole.intersection(upper)], [True]) == [(0, 0)]
+
+
+def test_an_inset_side_comes_from_the_edge_moved_by_the_offset():
+    """A hole's side parallel to the outline's left edge, nearer the inset's left side than that edge:
+    the side was moved in from the left edge (by the offset's 3 m), not from the hole's side (1 m off),
+    so the inset starts at vertex 0's mitre, where its last edge's run ends (PRT on massing's holes.33921,
+    whose footprint split ran along the inset's first edge)."""
+    import shapely
+
+    from grammarc.geometry.clip import fit_pieces
+
+    lot = shapely.Polygon([(0, 0), (30, 0), (30, -40), (0, -40)],  # clockwise in (x, z)
+                          [[(1, -10), (1, -30), (2, -30), (2, -10)]])
+    inset = shapely.buffer(lot, -3, join_style="mitre", mitre_limit=1e6)
+    vertices = len(shapely.get_coordinates(lot)) - 2
+    pieces = fit_pieces(np.array([inset]), np.array([1]), np.array([[30.0, 0.0, 40.0]]), np.array([lot]),
+                        insets=np.array([True]), moves=np.full(vertices, 3.0))
+    np.testing.assert_allclose(pieces.coords[:2] * pieces.extent[0, [0, 2]] + pieces.low[0, [0, 2]],
+                               [[3, -3], [27, -3]])
+
+
 def test_strips_start_at_the_first_edge_they_set_back():
     """PRT's shapeL and shapeU: the strips' region starts at the first parent edge it sets back, though it
     holds vertex 0 (an L along the left and top edges, 2 and 3, of the square)."""
