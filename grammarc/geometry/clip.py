@@ -198,6 +198,7 @@ def ring_starts(coords, ring_offsets, part_offsets, part_source, part_with_start
     keys = np.empty(len(coords))
     marked = np.zeros(len(coords), np.bool_)
     moved_from = np.full(len(coords), np.inf)
+    ties = np.zeros(len(coords))
     for p in range(len(part_offsets) - 1):
         g = part_source[p]
         for r in range(part_offsets[p], part_offsets[p + 1]):
@@ -205,7 +206,7 @@ def ring_starts(coords, ring_offsets, part_offsets, part_source, part_with_start
             n = r1 - r0
             for j in range(r0, r1):
                 k = r0 + (j - r0 + 1) % n
-                near, key, vertex_key, scale, edge, away = _places(
+                near, key, vertex_key, scale, edge, away, along = _places(
                     coords[j, 0], coords[j, 1], coords[k, 0], coords[k, 1], g, parent_coords,
                     parent_rings, parent_offsets, material, moves)
                 if cut:
@@ -216,6 +217,9 @@ def ring_starts(coords, ring_offsets, part_offsets, part_source, part_with_start
                     marked[j] = start_edges[parent_rings[parent_offsets[g]] + int(edge)]
                 if np.isfinite(edge) and away > tolerance:
                     keys[j] = edge  # its outgoing edge was moved in from that edge (an offset, a setback)
+                    # of two moved in from one edge (a hole across the strip parted it), the one that starts
+                    # nearer the edge's start first
+                    ties[j] = along
                 elif near <= tolerance * tolerance:
                     keys[j] = key  # on the boundary: a kept vertex, a cut's crossing
                 else:
@@ -228,7 +232,7 @@ def ring_starts(coords, ring_offsets, part_offsets, part_source, part_with_start
         for r in range(part_offsets[p], part_offsets[p + 1]):
             r0, r1 = ring_offsets[r], ring_offsets[r + 1]
             n = r1 - r0
-            best = int(np.argmin(keys[r0:r1]))
+            best = _first(keys[r0:r1], ties[r0:r1])
             if r == part_offsets[p] and part_inset[p]:
                 # where the first outer edge left, counting from the last, ends: vertex 0's mitre when the
                 # last edge and edge 0 are left; the end of the last edge's run nearest vertex 0 of all
@@ -243,7 +247,7 @@ def ring_starts(coords, ring_offsets, part_offsets, part_source, part_with_start
                 if np.isfinite(rank).any():
                     best = int(np.argmin(rank))
             if r == part_offsets[p] and marked[r0:r1].any():
-                best = int(np.argmin(np.where(marked[r0:r1], keys[r0:r1], np.inf)))
+                best = _first(np.where(marked[r0:r1], keys[r0:r1], np.inf), ties[r0:r1])
             if r == part_offsets[p] and not part_with_start[p]:
                 # the last place on the parent's outer ring (a piece may run along its holes too)
                 best = int(np.argmax(np.where(keys[r0:r1] < outer, keys[r0:r1], -1.0)))
@@ -258,6 +262,16 @@ def ring_starts(coords, ring_offsets, part_offsets, part_source, part_with_start
                 k = r0 + (best + j) % n
                 out[r0 + j, 0], out[r0 + j, 1] = coords[k, 0], coords[k, 1]
     return out
+
+
+@njit(cache=True, nogil=True)
+def _first(keys, ties):
+    """The index of the least key, of equal ones that of the least tie."""
+    best = 0
+    for j in range(1, len(keys)):
+        if keys[j] < keys[best] or (keys[j] == keys[best] and ties[j] < ties[best]):
+            best = j
+    return best
 
 
 @njit(cache=True, nogil=True)
@@ -320,10 +334,11 @@ def _places(px, py, qx, qy, g, parent_coords, parent_rings, parent_offsets, mate
     ``moves`` (one per parent vertex, empty for none known: the nearest edge), so that of an offset's
     sides the one moved in from the outline by the offset is not taken for a hole's, whose grown end
     stops short of it (massing's holes.33921); of collinear ones the one whose span is nearest the
-    edge's: an H's inner sides; inf when there is none) with the distance between their lines."""
+    edge's: an H's inner sides; inf when there is none) with the distance between their lines, and how far
+    along that edge p lies (a fraction in [0, 1])."""
     near, key = np.inf, np.inf
     near_vertex, vertex_key = np.inf, np.inf
-    away, edge, gap, best = np.inf, np.inf, np.inf, np.inf
+    away, edge, gap, best, along = np.inf, np.inf, np.inf, np.inf, 0.0
     dx, dy = qx - px, qy - py
     length = np.sqrt(dx * dx + dy * dy)
     scale = 0.0
@@ -360,8 +375,9 @@ def _places(px, py, qx, qy, g, parent_coords, parent_rings, parent_offsets, mate
                 same = abs(miss - best) <= 1e-9 * max(u, 1.0)
                 if (miss < best and not same) or (same and apart < gap):
                     away, edge, gap, best = distance, base + i, apart, miss
+                    along = min(max(low / u, 0.0), 1.0)
         base += m
-    return near, key, vertex_key, scale, edge, away
+    return near, key, vertex_key, scale, edge, away, along
 
 
 def polygons_from_rings(coords: np.ndarray, ring_offsets: np.ndarray, poly_offsets: np.ndarray) -> np.ndarray:

@@ -279,6 +279,25 @@ def test_an_inset_side_comes_from_the_edge_moved_by_the_offset():
                                [[3, -3], [27, -3]])
 
 
+def test_a_remainder_that_a_hole_notches_starts_at_the_first_run_of_its_edge():
+    """A hole that the setback's strip reaches parts the edge moved in from the parent's edge 0 in two
+    runs: the remainder starts at the run nearer edge 0's start, as PRT's second tiers on massing's holed
+    footprints (courtyard.33584, holes.33347), whichever of the runs GEOS lists first."""
+    import shapely
+
+    from grammarc.geometry.clip import fit_pieces
+
+    lot = shapely.Polygon([(0, 0), (0, 20), (20, 20), (20, 0)],  # clockwise in (x, z): edge 0 the left side
+                          [[(2, 8), (6, 8), (6, 12), (2, 12)]])
+    remainder = shapely.box(4, 4, 20, 16).difference(shapely.box(2, 8, 6, 12))
+    for turned in range(8):  # GEOS's start anywhere on the ring
+        ring = np.asarray(remainder.exterior.coords)[:-1]
+        piece = shapely.Polygon(np.roll(ring, turned, axis=0))
+        pieces = fit_pieces(np.array([piece]), np.array([1]), np.array([[20.0, 0.0, 20.0]]), np.array([lot]))
+        np.testing.assert_allclose(pieces.coords[:2] * pieces.extent[0, [0, 2]] + pieces.low[0, [0, 2]],
+                                   [[4, 4], [4, 8]])
+
+
 def test_strips_start_at_the_first_edge_they_set_back():
     """PRT's shapeL and shapeU: the strips' region starts at the first parent edge it sets back, though it
     holds vertex 0 (an L along the left and top edges, 2 and 3, of the square)."""
