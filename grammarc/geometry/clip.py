@@ -185,7 +185,8 @@ def ring_starts(coords, ring_offsets, part_offsets, part_source, part_with_start
     start where their first outer edge left ends (``_last_edge_ends``). PRT (measured through PyPRT on some 700
     pieces of convex and concave lots cut by ``split``) starts the outline of a piece on a side of the cut that holds the
     parent's vertex 0 or 1 (``part_with_start``) at its first place: vertex 0 itself, or the crossing
-    where the boundary enters it. A piece on another side starts with its cut edge: at its last place
+    where the boundary enters it; where the cut runs through a hole, with its first cut edge into the hole
+    (measured through PyPRT on a lot whose hole massing's footprint split crosses). A piece on another side starts with its cut edge: at its last place
     on the parent's outer ring, the crossing where that ring leaves it. Holes start at their first
     place. Where ``start_edges`` (per parent vertex, empty for none) marks edges, an outer ring that runs
     along some of them starts at the first place among its vertices that do. ``moves`` (per parent
