@@ -332,7 +332,7 @@ def _places(px, py, qx, qy, g, parent_coords, parent_rings, parent_offsets, mate
     little; in the same direction; on the polygon's side of it (``material`` (R,), ``_material_sides``),
     as an offset or a setback moves edges in, so that a hole's edge beside an inset edge is not taken for
     its source: massing's holes.11067; where ``moves`` gives the distance each parent edge moved by (one
-    per parent vertex, empty for none known: the nearest edge), only an edge at that distance (or
+    per parent vertex; empty, or NaN, for none known: the nearest edge), only an edge at that distance (or
     along it), so that of an offset's sides the one moved in from the outline by the offset is not taken
     for a hole's, whose grown end stops short of it (massing's holes.33921); of collinear ones the one
     whose span is nearest the edge's: an H's inner sides; inf when there is none) with the distance
@@ -370,8 +370,9 @@ def _places(px, py, qx, qy, g, parent_coords, parent_rings, parent_offsets, mate
                 distance = abs(left)
                 # off the distance the parent edge moved by (0 where none is known: the nearest); an edge
                 # at another distance than its own (and than 0: along it) was not moved in from it
-                miss = abs(distance - (moves[q0 + i] if len(moves) else 0.0))
-                if len(moves) and miss > 1e-6 * max(u, 1.0) and distance > 1e-6 * max(u, 1.0):
+                known = len(moves) > 0 and np.isfinite(moves[q0 + i])
+                miss = abs(distance - (moves[q0 + i] if known else 0.0))
+                if known and miss > 1e-6 * max(u, 1.0) and distance > 1e-6 * max(u, 1.0):
                     continue
                 # how far the edge's span along the line lies from the parent edge's [0, u]
                 low, high = ((px - ax) * bx + (py - ay) * by) / u, ((qx - ax) * bx + (qy - ay) * by) / u

@@ -261,7 +261,7 @@ def _offset_selected(ctx: Context, cursor: Shapes, op: ir.Offset):
         inset, border, plane, polygons, faces, owner, moves = _offset_polygons(ctx, op.distance, cursor, op.span)
         pieces = fit_pieces(np.concatenate([inset, border]), np.tile(plane, 2), np.tile(faces.size, (2, 1)),
                             np.tile(polygons, 2), insets=np.arange(2 * len(inset)) < len(inset),
-                            moves=np.tile(moves, 2))
+                            moves=np.concatenate([moves, np.full(len(moves), np.nan)]))
         # each shape's inside pieces, then its border's
         pieces = replace(pieces, source=owner[pieces.source % len(faces)])
         pieces = pieces.take(np.argsort(pieces.source, kind="stable"))
@@ -609,7 +609,7 @@ def _offset_pieces(ctx: Context, distance: ir.Expr, cursor: Shapes, span):
     inset, border, plane, polygons, faces, owner, moves = _offset_polygons(ctx, distance, cursor, span)
     return tuple(replace(p, source=owner[p.source]) for p in (
         fit_pieces(inset, plane, faces.size, polygons, insets=np.ones(len(inset), dtype=bool), moves=moves),
-        fit_pieces(border, plane, faces.size, polygons, moves=moves)))
+        fit_pieces(border, plane, faces.size, polygons)))
 
 
 def _faces_in_plane(cursor: Shapes, chunk) -> tuple[Shapes, np.ndarray]:
