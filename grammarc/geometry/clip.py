@@ -174,7 +174,8 @@ def ring_starts(coords, ring_offsets, part_offsets, part_source, part_with_start
     ``_places``) gets i; one inside with neither gets the place of the nearest parent vertex.
 
     CityEngine keeps a polygon's vertex order through offsets, setbacks and cuts: a setback's remainder
-    starts at the edge moved in from the first parent edge that is left; an inset (an offset's,
+    starts at the edge moved in from the first parent edge that is left, or at that edge's end vertex
+    where the remainder keeps it (its strip steps back to it, or ends at a reflex corner there); an inset (an offset's,
     ``part_inset``) where the first outer parent edge that is left ends, counting from the last: at
     vertex 0's mitre where the last edge and edge 0 are left. Where the offset took the last edge (and
     vertex 0 with it) the inset starts at the end of edge 0 (PRT on massing's H and L lots whose arms an
@@ -200,6 +201,8 @@ def ring_starts(coords, ring_offsets, part_offsets, part_source, part_with_start
     marked = np.zeros(len(coords), np.bool_)
     moved_from = np.full(len(coords), np.inf)
     ties = np.zeros(len(coords))
+    moved_in = np.zeros(len(coords), np.bool_)
+    at_vertex = np.zeros(len(coords), np.bool_)
     for p in range(len(part_offsets) - 1):
         g = part_source[p]
         for r in range(part_offsets[p], part_offsets[p + 1]):
@@ -216,7 +219,9 @@ def ring_starts(coords, ring_offsets, part_offsets, part_source, part_with_start
                 tolerance = 1e-6 * max(scale, 1.0) ** 0.5
                 if np.isfinite(edge) and away <= tolerance and len(start_edges):
                     marked[j] = start_edges[parent_rings[parent_offsets[g]] + int(edge)]
+                at_vertex[j] = near <= tolerance * tolerance and key == np.floor(key)
                 if np.isfinite(edge) and away > tolerance:
+                    moved_in[j] = True
                     keys[j] = edge  # its outgoing edge was moved in from that edge (an offset, a setback)
                     # of two moved in from one edge (a hole across the strip parted it), the one that starts
                     # nearer the edge's start first
@@ -234,6 +239,14 @@ def ring_starts(coords, ring_offsets, part_offsets, part_source, part_with_start
             r0, r1 = ring_offsets[r], ring_offsets[r + 1]
             n = r1 - r0
             best = _first(keys[r0:r1], ties[r0:r1])
+            if r == part_offsets[p] and not cut and not part_inset[p] and moved_in[r0 + best]:
+                # a moved edge whose strip stops short of the vertex it ends at (a step, a reflex corner):
+                # the remainder starts at that vertex, which it keeps
+                end = (keys[r0 + best] + 1.0) % outer
+                for j in range(n):
+                    if at_vertex[r0 + j] and keys[r0 + j] == end:
+                        best = j
+                        break
             if r == part_offsets[p] and part_inset[p]:
                 # where the first outer edge left, counting from the last, ends: vertex 0's mitre when the
                 # last edge and edge 0 are left; the end of the last edge's run nearest vertex 0 of all

@@ -298,6 +298,26 @@ def test_a_remainder_that_a_hole_notches_starts_at_the_first_run_of_its_edge():
                                    [[4, 4], [4, 8]])
 
 
+def test_a_remainder_starts_at_the_vertex_its_first_moved_edge_steps_back_to():
+    """Edge 0 set back 4 m, edge 1 beside it kept and turned by under 15 degrees: the strip steps back to
+    vertex 1, which the remainder keeps, and PRT starts the remainder there, not at edge 0's moved copy
+    (measured through PyPRT on this lot under massing's tiers; its concave.33911, T.33381 at a reflex
+    vertex 1); where edge 0's strip runs out to edge 1 (a turn of 27 degrees), at edge 0's moved copy."""
+    import shapely
+
+    from grammarc.geometry.clip import fit_pieces
+
+    def first_vertex(lot, remainder):
+        pieces = fit_pieces(np.array([remainder]), np.array([1]), np.array([[40.0, 0.0, 20.0]]), np.array([lot]))
+        return tuple(np.round(pieces.coords[0] * pieces.extent[0, [0, 2]] + pieces.low[0, [0, 2]], 3))
+
+    stepped = shapely.Polygon([(0, 0), (20, 0), (40, -3.5), (40, -20), (0, -20)])  # clockwise in (x, z)
+    assert first_vertex(stepped, shapely.Polygon([(0, -4), (19.653, -4), (20, 0), (36, -2.8), (36, -16),
+                                                  (0, -16)])) == (20, 0)
+    met = shapely.Polygon([(0, 0), (20, 0), (40, -10), (40, -20), (0, -20)])
+    assert first_vertex(met, shapely.Polygon([(28, -4), (36, -8), (36, -16), (0, -16), (0, -4)])) == (0, -4)
+
+
 def test_strips_start_at_the_first_edge_they_set_back():
     """PRT's shapeL and shapeU: the strips' region starts at the first parent edge it sets back, though it
     holds vertex 0 (an L along the left and top edges, 2 and 3, of the square)."""
