@@ -107,7 +107,8 @@ def oriented_rings(parts: np.ndarray, part_plane: np.ndarray):
 
 def fit_pieces(geometries: np.ndarray, plane: np.ndarray, size: np.ndarray,
                parents: np.ndarray | None = None, cut_sides: np.ndarray | None = None,
-               start_edges: np.ndarray | None = None, insets: np.ndarray | None = None) -> Clipped:
+               start_edges: np.ndarray | None = None, insets: np.ndarray | None = None,
+               moves: np.ndarray | None = None) -> Clipped:
     """Polygons (or multipolygons) in scope units, one per source row, as pieces with fitted boxes.
 
     ``parents`` (one polygon per source row, the polygons the pieces were cut or moved in from): each
@@ -119,7 +120,9 @@ def fit_pieces(geometries: np.ndarray, plane: np.ndarray, size: np.ndarray,
     parent edges (from that vertex) where pieces moved in start when they run along one (a setback's
     strips start at the first edge they set back). ``insets`` (one bool per source row, None for none):
     the rows whose pieces are an offset's insets, which start otherwise than a setback's remainder where
-    the offset took edges (``ring_starts``)."""
+    the offset took edges (``ring_starts``). ``moves`` (one float per vertex of the parents' open
+    rings, as ``start_edges``; None where not known): how far each parent edge was moved in, so that a
+    piece's edge is told to come from the edge at that distance (``ring_starts``)."""
     parts, source = shapely.get_parts(geometries, return_index=True)
     keep = (shapely.get_type_id(parts) == shapely.GeometryType.POLYGON) & (
         shapely.area(parts) > TOL.area_floor)
@@ -136,8 +139,9 @@ def fit_pieces(geometries: np.ndarray, plane: np.ndarray, size: np.ndarray,
         side = cut_sides if cut else np.ones(len(geometries), dtype=np.bool_)
         allowed = np.zeros(0, dtype=np.bool_) if start_edges is None else start_edges
         inset = np.zeros(len(geometries), dtype=np.bool_) if insets is None else insets
+        moved = np.zeros(0) if moves is None else np.asarray(moves, dtype=np.float64)
         flat = ring_starts(flat, ring_offsets, part_offsets, source, side[source], cut, inset[source],
-                           allowed, parent_flat, parent_rings, np.asarray(parent_offsets, dtype=np.int64))
+                           allowed, moved, parent_flat, parent_rings, np.asarray(parent_offsets, dtype=np.int64))
     vertex_part = segment_of(part_offsets)[segment_of(ring_offsets)]
     low2 = bounds[:, :2]
     extent2 = bounds[:, 2:] - bounds[:, :2]
@@ -160,7 +164,7 @@ def fit_pieces(geometries: np.ndarray, plane: np.ndarray, size: np.ndarray,
 
 @njit(cache=True, nogil=True)
 def ring_starts(coords, ring_offsets, part_offsets, part_source, part_with_start, cut, part_inset,
-                start_edges, parent_coords, parent_rings, parent_offsets):
+                start_edges, moves, parent_coords, parent_rings, parent_offsets):
     """Each ring of each piece turned to start where CityEngine's clipping and offsets start it.
 
     Every piece vertex gets its place along the parent's boundary: i for the parent's vertex i (ring
@@ -170,7 +174,8 @@ def ring_starts(coords, ring_offsets, part_offsets, part_source, part_with_start
     ``_places``) gets i; one inside with neither gets the place of the nearest parent vertex.
 
     CityEngine keeps a polygon's vertex order through offsets, setbacks and cuts: a setback's remainder
-    starts at the edge moved in from the first parent edge that is left; an inset (an offset's,
+    starts at the edge moved in from the first parent edge that is left, or at that edge's end vertex
+    where the remainder keeps it (its strip steps back to it, or ends at a reflex corner there); an inset (an offset's,
     ``part_inset``) where the first outer parent edge that is left ends, counting from the last: at
     vertex 0's mitre where the last edge and edge 0 are left. Where the offset took the last edge (and
     vertex 0 with it) the inset starts at the end of edge 0 (PRT on massing's H and L lots whose arms an
@@ -181,11 +186,13 @@ def ring_starts(coords, ring_offsets, part_offsets, part_source, part_with_start
     start where their first outer edge left ends (``_last_edge_ends``). PRT (measured through PyPRT on some 700
     pieces of convex and concave lots cut by ``split``) starts the outline of a piece on a side of the cut that holds the
     parent's vertex 0 or 1 (``part_with_start``) at its first place: vertex 0 itself, or the crossing
-    where the boundary enters it. A piece on another side starts with its cut edge: at its last place
+    where the boundary enters it; where the cut runs through a hole, with its first cut edge into the hole
+    (measured through PyPRT on a lot whose hole massing's footprint split crosses). A piece on another side starts with its cut edge: at its last place
     on the parent's outer ring, the crossing where that ring leaves it. Holes start at their first
     place. Where ``start_edges`` (per parent vertex, empty for none) marks edges, an outer ring that runs
-    along some of them starts at the first place among its vertices that do. Returns the coords (V, 2)
-    with every ring turned.
+    along some of them starts at the first place among its vertices that do. ``moves`` (per parent
+    vertex, empty for none known): how far each parent edge was moved in (``_places``). Returns the
+    coords (V, 2) with every ring turned.
     """
     out = np.empty_like(coords)
     material = _material_sides(parent_coords, parent_rings, parent_offsets)
@@ -193,6 +200,9 @@ def ring_starts(coords, ring_offsets, part_offsets, part_source, part_with_start
     keys = np.empty(len(coords))
     marked = np.zeros(len(coords), np.bool_)
     moved_from = np.full(len(coords), np.inf)
+    ties = np.zeros(len(coords))
+    moved_in = np.zeros(len(coords), np.bool_)
+    at_vertex = np.zeros(len(coords), np.bool_)
     for p in range(len(part_offsets) - 1):
         g = part_source[p]
         for r in range(part_offsets[p], part_offsets[p + 1]):
@@ -200,17 +210,22 @@ def ring_starts(coords, ring_offsets, part_offsets, part_source, part_with_start
             n = r1 - r0
             for j in range(r0, r1):
                 k = r0 + (j - r0 + 1) % n
-                near, key, vertex_key, scale, edge, away = _places(
+                near, key, vertex_key, scale, edge, away, along = _places(
                     coords[j, 0], coords[j, 1], coords[k, 0], coords[k, 1], g, parent_coords,
-                    parent_rings, parent_offsets, material)
+                    parent_rings, parent_offsets, material, moves)
                 if cut:
                     edge = np.inf  # a cut's crossings keep their places: their chords run along no edge
                 moved_from[j] = edge
                 tolerance = 1e-6 * max(scale, 1.0) ** 0.5
                 if np.isfinite(edge) and away <= tolerance and len(start_edges):
                     marked[j] = start_edges[parent_rings[parent_offsets[g]] + int(edge)]
+                at_vertex[j] = near <= tolerance * tolerance and key == np.floor(key)
                 if np.isfinite(edge) and away > tolerance:
+                    moved_in[j] = True
                     keys[j] = edge  # its outgoing edge was moved in from that edge (an offset, a setback)
+                    # of two moved in from one edge (a hole across the strip parted it), the one that starts
+                    # nearer the edge's start first
+                    ties[j] = along
                 elif near <= tolerance * tolerance:
                     keys[j] = key  # on the boundary: a kept vertex, a cut's crossing
                 else:
@@ -225,7 +240,15 @@ def ring_starts(coords, ring_offsets, part_offsets, part_source, part_with_start
         for r in range(part_offsets[p], part_offsets[p + 1]):
             r0, r1 = ring_offsets[r], ring_offsets[r + 1]
             n = r1 - r0
-            best = int(np.argmin(keys[r0:r1]))
+            best = _first(keys[r0:r1], ties[r0:r1])
+            if r == part_offsets[p] and not cut and not part_inset[p] and moved_in[r0 + best]:
+                # a moved edge whose strip stops short of the vertex it ends at (a step, a reflex corner):
+                # the remainder starts at that vertex, which it keeps
+                end = (keys[r0 + best] + 1.0) % outer
+                for j in range(n):
+                    if at_vertex[r0 + j] and keys[r0 + j] == end:
+                        best = j
+                        break
             if r == part_offsets[p] and part_inset[p]:
                 # where the first outer edge left, counting from the last, ends: vertex 0's mitre when the
                 # last edge and edge 0 are left; the end of the last edge's run nearest vertex 0 of all
@@ -240,10 +263,17 @@ def ring_starts(coords, ring_offsets, part_offsets, part_source, part_with_start
                 if np.isfinite(rank).any():
                     best = int(np.argmin(rank))
             if r == part_offsets[p] and marked[r0:r1].any():
-                best = int(np.argmin(np.where(marked[r0:r1], keys[r0:r1], np.inf)))
+                best = _first(np.where(marked[r0:r1], keys[r0:r1], np.inf), ties[r0:r1])
             if r == part_offsets[p] and not part_with_start[p]:
                 # the last place on the parent's outer ring (a piece may run along its holes too)
                 best = int(np.argmax(np.where(keys[r0:r1] < outer, keys[r0:r1], -1.0)))
+            elif r == part_offsets[p] and cut:
+                # a cut through a hole: the piece starts with the first cut edge that runs into the hole
+                for j in range(n):
+                    k = r0 + (best + j) % n
+                    if keys[k] < outer and keys[r0 + (k - r0 + 1) % n] >= outer:
+                        best = k - r0
+                        break
             for j in range(n):
                 k = r0 + (best + j) % n
                 out[r0 + j, 0], out[r0 + j, 1] = coords[k, 0], coords[k, 1]
@@ -265,6 +295,16 @@ def _after_steps(keys, moved_from, r0, r1):
         if np.isfinite(i) and keys[j] == i and not np.isfinite(moved_from[k]) and (
                 moved_from[m] == i + 1 or keys[m] == i + 1):
             keys[j] = keys[k] = i + 1.5
+
+
+@njit(cache=True, nogil=True)
+def _first(keys, ties):
+    """The index of the least key, of equal ones that of the least tie."""
+    best = 0
+    for j in range(1, len(keys)):
+        if keys[j] < keys[best] or (keys[j] == keys[best] and ties[j] < ties[best]):
+            best = j
+    return best
 
 
 @njit(cache=True, nogil=True)
@@ -315,7 +355,7 @@ def _material_sides(parent_coords, parent_rings, parent_offsets):
 
 
 @njit(cache=True, nogil=True)
-def _places(px, py, qx, qy, g, parent_coords, parent_rings, parent_offsets, material):
+def _places(px, py, qx, qy, g, parent_coords, parent_rings, parent_offsets, material, moves):
     """Where the point p and the edge (p, q) of a piece lie on polygon g: the squared distance to the
     nearest point of its boundary and that point's place (i + f a fraction f along the edge from vertex
     i to vertex i + 1, ring after ring), the place of the nearest vertex, the largest squared edge length
@@ -323,12 +363,15 @@ def _places(px, py, qx, qy, g, parent_coords, parent_rings, parent_offsets, mate
     (parallel to it to a millionth, as GEOS's mitres between near-collinear edges turn an inset's edges a
     little; in the same direction; on the polygon's side of it (``material`` (R,), ``_material_sides``),
     as an offset or a setback moves edges in, so that a hole's edge beside an inset edge is not taken for
-    its source: massing's holes.11067; the nearest such, and of collinear ones the one whose span is
-    nearest the edge's: an H's inner sides; inf when there is none) with the distance between their
-    lines."""
+    its source: massing's holes.11067; where ``moves`` gives the distance each parent edge moved by (one
+    per parent vertex; empty, or NaN, for none known: the nearest edge), only an edge at that distance (or
+    along it), so that of an offset's sides the one moved in from the outline by the offset is not taken
+    for a hole's, whose grown end stops short of it (massing's holes.33921); of collinear ones the one
+    whose span is nearest the edge's: an H's inner sides; inf when there is none) with the distance
+    between their lines, and how far along that edge p lies (a fraction in [0, 1])."""
     near, key = np.inf, np.inf
     near_vertex, vertex_key = np.inf, np.inf
-    away, edge, gap = np.inf, np.inf, np.inf
+    away, edge, gap, best, along = np.inf, np.inf, np.inf, np.inf, 0.0
     dx, dy = qx - px, qy - py
     length = np.sqrt(dx * dx + dy * dy)
     scale = 0.0
@@ -357,14 +400,21 @@ def _places(px, py, qx, qy, g, parent_coords, parent_rings, parent_offsets, mate
                 if material[q] * left < -1e-9 * max(u, 1.0):
                     continue  # outside the polygon's side of it: not moved in from it
                 distance = abs(left)
+                # off the distance the parent edge moved by (0 where none is known: the nearest); an edge
+                # at another distance than its own (and than 0: along it) was not moved in from it
+                known = len(moves) > 0 and np.isfinite(moves[q0 + i])
+                miss = abs(distance - (moves[q0 + i] if known else 0.0))
+                if known and miss > 1e-6 * max(u, 1.0) and distance > 1e-6 * max(u, 1.0):
+                    continue
                 # how far the edge's span along the line lies from the parent edge's [0, u]
                 low, high = ((px - ax) * bx + (py - ay) * by) / u, ((qx - ax) * bx + (qy - ay) * by) / u
                 apart = max(0.0, low - u, -high)
-                same = abs(distance - away) <= 1e-9 * max(u, 1.0)
-                if (distance < away and not same) or (same and apart < gap):
-                    away, edge, gap = distance, base + i, apart
+                same = abs(miss - best) <= 1e-9 * max(u, 1.0)
+                if (miss < best and not same) or (same and apart < gap):
+                    away, edge, gap, best = distance, base + i, apart, miss
+                    along = min(max(low / u, 0.0), 1.0)
         base += m
-    return near, key, vertex_key, scale, edge, away
+    return near, key, vertex_key, scale, edge, away, along
 
 
 def polygons_from_rings(coords: np.ndarray, ring_offsets: np.ndarray, poly_offsets: np.ndarray) -> np.ndarray:

@@ -98,6 +98,13 @@ def _ring_strips(start, end, inward, d, corner, ends, out, out_n, left):
             used = _push(pool, link, used, s_head, s_tail, m, start[k, 0], start[k, 1])
             used = _push(pool, link, used, e_head, e_tail, m, start[k, 0], start[k, 1])
             m += 1
+        if (m > 0 and gap <= _EPS and real[m - 1] >= 0 and abs(w[m - 1] - d[k]) <= _EPS
+                and abs(nx[m - 1] - inward[k, 0]) <= _EPS and abs(ny[m - 1] - inward[k, 1]) <= _EPS
+                and abs(nx[m - 1] * start[k, 0] + ny[m - 1] * start[k, 1] - c[m - 1]) <= _EPS * (1.0 + abs(c[m - 1]))):
+            # edge k runs on along edge k-1's line and moves as far: one line, whose strip covers both (a
+            # vertex on a straight run, as an inset leaves where a hole's channel closed, is no corner)
+            pool[e_tail[m - 1], 0], pool[e_tail[m - 1], 1] = end[k, 0], end[k, 1]
+            continue
         ex, ey = end[k, 0] - start[k, 0], end[k, 1] - start[k, 1]
         length = np.sqrt(ex * ex + ey * ey)
         ux[m], uy[m] = ex / length, ey / length

@@ -244,6 +244,80 @@ def test_cut_pieces_start_as_prt_starts_them():
         (10, 10), (0, 10)]
 
 
+def test_a_cut_through_a_hole_starts_the_side_of_vertex_0_at_the_cut_into_the_hole():
+    """A cut that runs through a hole: PRT starts the piece that holds vertices 0 and 1 with the cut edge
+    that runs into the hole, where the outline leaves the piece, not at vertex 0 (measured through PyPRT
+    on a 40 x 20 m lot whose hole the footprint split of massing crosses, at each orientation); the
+    other piece starts with its cut edge as without a hole."""
+    import shapely
+
+    lot = shapely.Polygon([(0, 0), (30, 0), (30, -30), (0, -30)],  # clockwise in (x, z)
+                          [[(10, -12), (16, -12), (16, -18), (10, -18)]])
+    upper, lower = shapely.box(-1, -15, 31, 1), shapely.box(-1, -31, 31, -15)
+    assert _first_vertices(lot, [lot.intersection(upper), lot.intersection(lower)], [True, False]) == [
+        (30, -15), (0, -15)]
+    whole = shapely.Polygon(lot.exterior)  # without the hole vertex 0 starts its piece
+    assert _first_vertices(whole, [whole.intersection(upper)], [True]) == [(0, 0)]
+
+
+def test_an_inset_side_comes_from_the_edge_moved_by_the_offset():
+    """A hole's side parallel to the outline's left edge, nearer the inset's left side than that edge:
+    the side was moved in from the left edge (by the offset's 3 m), not from the hole's side (1 m off),
+    so the inset starts at vertex 0's mitre, where its last edge's run ends (PRT on massing's holes.33921,
+    whose footprint split ran along the inset's first edge)."""
+    import shapely
+
+    from grammarc.geometry.clip import fit_pieces
+
+    lot = shapely.Polygon([(0, 0), (30, 0), (30, -40), (0, -40)],  # clockwise in (x, z)
+                          [[(1, -10), (1, -30), (2, -30), (2, -10)]])
+    inset = shapely.buffer(lot, -3, join_style="mitre", mitre_limit=1e6)
+    vertices = len(shapely.get_coordinates(lot)) - 2
+    pieces = fit_pieces(np.array([inset]), np.array([1]), np.array([[30.0, 0.0, 40.0]]), np.array([lot]),
+                        insets=np.array([True]), moves=np.full(vertices, 3.0))
+    np.testing.assert_allclose(pieces.coords[:2] * pieces.extent[0, [0, 2]] + pieces.low[0, [0, 2]],
+                               [[3, -3], [27, -3]])
+
+
+def test_a_remainder_that_a_hole_notches_starts_at_the_first_run_of_its_edge():
+    """A hole that the setback's strip reaches parts the edge moved in from the parent's edge 0 in two
+    runs: the remainder starts at the run nearer edge 0's start, as PRT's second tiers on massing's holed
+    footprints (courtyard.33584, holes.33347), whichever of the runs GEOS lists first."""
+    import shapely
+
+    from grammarc.geometry.clip import fit_pieces
+
+    lot = shapely.Polygon([(0, 0), (0, 20), (20, 20), (20, 0)],  # clockwise in (x, z): edge 0 the left side
+                          [[(2, 8), (6, 8), (6, 12), (2, 12)]])
+    remainder = shapely.box(4, 4, 20, 16).difference(shapely.box(2, 8, 6, 12))
+    for turned in range(8):  # GEOS's start anywhere on the ring
+        ring = np.asarray(remainder.exterior.coords)[:-1]
+        piece = shapely.Polygon(np.roll(ring, turned, axis=0))
+        pieces = fit_pieces(np.array([piece]), np.array([1]), np.array([[20.0, 0.0, 20.0]]), np.array([lot]))
+        np.testing.assert_allclose(pieces.coords[:2] * pieces.extent[0, [0, 2]] + pieces.low[0, [0, 2]],
+                                   [[4, 4], [4, 8]])
+
+
+def test_a_remainder_starts_at_the_vertex_its_first_moved_edge_steps_back_to():
+    """Edge 0 set back 4 m, edge 1 beside it kept and turned by under 15 degrees: the strip steps back to
+    vertex 1, which the remainder keeps, and PRT starts the remainder there, not at edge 0's moved copy
+    (measured through PyPRT on this lot under massing's tiers; its concave.33911, T.33381 at a reflex
+    vertex 1); where edge 0's strip runs out to edge 1 (a turn of 27 degrees), at edge 0's moved copy."""
+    import shapely
+
+    from grammarc.geometry.clip import fit_pieces
+
+    def first_vertex(lot, remainder):
+        pieces = fit_pieces(np.array([remainder]), np.array([1]), np.array([[40.0, 0.0, 20.0]]), np.array([lot]))
+        return tuple(np.round(pieces.coords[0] * pieces.extent[0, [0, 2]] + pieces.low[0, [0, 2]], 3))
+
+    stepped = shapely.Polygon([(0, 0), (20, 0), (40, -3.5), (40, -20), (0, -20)])  # clockwise in (x, z)
+    assert first_vertex(stepped, shapely.Polygon([(0, -4), (19.653, -4), (20, 0), (36, -2.8), (36, -16),
+                                                  (0, -16)])) == (20, 0)
+    met = shapely.Polygon([(0, 0), (20, 0), (40, -10), (40, -20), (0, -20)])
+    assert first_vertex(met, shapely.Polygon([(28, -4), (36, -8), (36, -16), (0, -16), (0, -4)])) == (0, -4)
+
+
 def test_strips_start_at_the_first_edge_they_set_back():
     """PRT's shapeL and shapeU: the strips' region starts at the first parent edge it sets back, though it
     holds vertex 0 (an L along the left and top edges, 2 and 3, of the square)."""

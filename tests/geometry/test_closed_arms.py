@@ -39,3 +39,16 @@ def test_an_inset_without_a_closed_arm_is_left_alone():
         inset = shapely.buffer(np.array([polygon]), -distance, join_style="mitre", mitre_limit=1e6)
         assert shapely.equals_exact(closed_arm_insets(inset, np.array([polygon]), np.array([distance]))[0],
                                     inset[0])
+
+
+def test_channels_between_grown_holes_leave_one_vertex_each_on_their_centre_lines():
+    """Three bars whose ends lie on one line, 3 m apart, grown by a 4 m offset: the channels between them
+    close, and the inset's side along the grown ends keeps one vertex per channel, on its centre line
+    (y = 9.5 and 16.5), as PRT's wavefront does (massing's holes.33739), where GEOS leaves each grown
+    bar's corners (y = 7, 12, 14 and 19)."""
+    lot = shapely.Polygon([(0, 0), (40, 0), (40, 30), (0, 30)],
+                          [[(5, 4), (5, 8), (30, 8), (30, 4)], [(5, 11), (5, 15), (30, 15), (30, 11)],
+                           [(5, 18), (5, 21), (30, 21), (30, 18)]])
+    ring = shapely.get_coordinates(_inset(lot, 4.0).exterior)[:-1]
+    assert sorted(ring[ring[:, 0] == 34][:, 1].tolist()) == [4, 9.5, 16.5, 25]
+    assert len(ring) == 8

@@ -38,6 +38,18 @@ def test_a_short_end_vanishes_and_the_front_runs_on_past_the_kept_edge_parallel_
     assert shapely.Polygon(ring).difference(covered).area == pytest.approx(5.4)
 
 
+def test_edges_on_one_line_that_move_alike_sweep_as_one_line():
+    """A 1 x 20 m face whose right side is three edges on one line (an inset's side past holes' closed
+    channels, massing's holes.33739): sides moved 0.7 m, the top 15 m. The three sweep as one line, and
+    the strips cover the face, as the strips of a side of one edge do."""
+    one_edge = ([(0, 0), (0, 20), (1, 20), (1, 0)], [0.7, 15, 0.7, 0])
+    three_edges = ([(0, 0), (0, 20), (1, 20), (1, 13), (1, 6), (1, 0)], [0.7, 15, 0.7, 0.7, 0.7, 0])
+    for ring, d in (one_edge, three_edges):
+        strips, _, trusted, _ = sweep(ring, d)
+        covered = shapely.union_all([s for s in strips if s is not None])
+        assert trusted and shapely.Polygon(ring).difference(covered).area == pytest.approx(0, abs=1e-9)
+
+
 def test_a_face_swept_whole_leaves_nothing():
     """A 3-4-5 triangle (inradius 1) whose edges move 2 m: its edges vanish at t = 1/2, nothing is left,
     and the strips are the skeleton's three faces."""

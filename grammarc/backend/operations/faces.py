@@ -258,9 +258,10 @@ def _offset_selected(ctx: Context, cursor: Shapes, op: ir.Offset):
     """The pieces ``offset`` keeps of flat shapes: their insets, borders or both, each shape's inside
     pieces before its border's."""
     if op.select == "all":
-        inset, border, plane, polygons, faces, owner = _offset_polygons(ctx, op.distance, cursor, op.span)
+        inset, border, plane, polygons, faces, owner, moves = _offset_polygons(ctx, op.distance, cursor, op.span)
         pieces = fit_pieces(np.concatenate([inset, border]), np.tile(plane, 2), np.tile(faces.size, (2, 1)),
-                            np.tile(polygons, 2), insets=np.arange(2 * len(inset)) < len(inset))
+                            np.tile(polygons, 2), insets=np.arange(2 * len(inset)) < len(inset),
+                            moves=np.concatenate([moves, np.full(len(moves), np.nan)]))
         # each shape's inside pieces, then its border's
         pieces = replace(pieces, source=owner[pieces.source % len(faces)])
         pieces = pieces.take(np.argsort(pieces.source, kind="stable"))
@@ -572,12 +573,15 @@ def face_polygons(ctx: Context, cursor: Shapes, what: str, span) -> tuple[np.nda
 
 def _offset_polygons(ctx: Context, distance: ir.Expr, cursor: Shapes, span):
     """Each flat shape's faces (``_faces_in_plane``) offset by ``distance``: the insets and the borders
-    (k,) (shapely, in the scopes' units), the faces' planes (k,) and polygons (k,), the faces as shapes and
-    each face's row in ``cursor``."""
+    (k,) (shapely, in the scopes' units), the faces' planes (k,) and polygons (k,), the faces as shapes,
+    each face's row in ``cursor`` and how far each face's edges moved (one per vertex of its rings, as
+    ``fit_pieces`` takes them)."""
     d = _distances(ctx, distance, cursor, span)
     faces, owner = _faces_in_plane(cursor, ctx.chunk)
     polygons, plane = face_polygons(ctx, faces, "offset", span)
-    return *_inset_and_border(polygons, d[owner]), plane, polygons, faces, owner
+    vertices = shapely.get_num_coordinates(polygons) - shapely.get_num_interior_rings(polygons) - 1
+    moves = np.repeat(np.abs(d[owner]), np.maximum(vertices, 0))
+    return *_inset_and_border(polygons, d[owner]), plane, polygons, faces, owner, moves
 
 
 def _distances(ctx: Context, distance: ir.Expr, cursor: Shapes, span) -> np.ndarray:
@@ -602,9 +606,9 @@ def _inset_and_border(polygons: np.ndarray, distance: np.ndarray) -> tuple[np.nd
 def _offset_pieces(ctx: Context, distance: ir.Expr, cursor: Shapes, span):
     """The inside and border pieces of each flat shape's faces offset by ``distance``, each piece's
     ``source`` its shape's row."""
-    inset, border, plane, polygons, faces, owner = _offset_polygons(ctx, distance, cursor, span)
+    inset, border, plane, polygons, faces, owner, moves = _offset_polygons(ctx, distance, cursor, span)
     return tuple(replace(p, source=owner[p.source]) for p in (
-        fit_pieces(inset, plane, faces.size, polygons, insets=np.ones(len(inset), dtype=bool)),
+        fit_pieces(inset, plane, faces.size, polygons, insets=np.ones(len(inset), dtype=bool), moves=moves),
         fit_pieces(border, plane, faces.size, polygons)))
 
 
