@@ -9,9 +9,10 @@ A chunk's records (6 * 10^5 rows, ~40 MB) do not come back through the pool's pi
 pushing them through a pipe cost more than deriving them on a grammar as cheap as the facade benchmark.
 A worker writes a task's record arrays into one file of a private folder on a memory filesystem
 (``/dev/shm`` where there is one), and the parent takes the arrays as views of the file mapped into
-memory: the records are copied once on their way, by the writer. The files are slots that are used
-again: the parent gives each task a slot that no array refers to any more, so a worker writes over pages
-the memory filesystem already holds and the parent's mapping of them is already there. A new file for
+memory: the records are copied into the file by the worker and out of it by the writer. The files are
+slots that are used again: the parent gives each task a slot that no array refers to any more, so a
+worker writes over pages the memory filesystem already holds (and cuts the file to the task's size, so a
+large chunk's pages go with the next task) and the parent's mapping of them is already there. A new file for
 each task had the kernel allocate, zero and map its pages and free them again, chunk after chunk, for
 every record byte: that cost more system time than a second worker saves on a grammar as cheap as the
 facade benchmark (README, "Figures"). The folder goes when the pool does, so a failed build leaves
