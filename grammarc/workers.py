@@ -208,7 +208,8 @@ class _Slots:
         self._made = itertools.count()
         self._free: list[Path] = []
         self._mapped: dict[Path, mmap.mmap] = {}
-        self._lock = threading.Lock()
+        # reentrant: the garbage collector may run a finalizer (``_give_back``) while this thread holds it
+        self._lock = threading.RLock()
 
     def take(self) -> Path:
         with self._lock:
