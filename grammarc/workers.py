@@ -84,7 +84,11 @@ def worker_pool(work: Callable, workers: int):
                     forked = True
                     return _at_once(work, lots)
                 slot = slots.take()
-                shipped = pool.submit(_run, lots, slot)
+                try:
+                    shipped = pool.submit(_run, lots, slot)
+                except BrokenProcessPool as broken:  # a worker was killed before this task went in
+                    shipped = Future()
+                    shipped.set_exception(broken)
                 received: Future = Future()
                 shipped.add_done_callback(lambda done: _receive(done, received, lots, slots, slot))
                 return received
