@@ -7,11 +7,16 @@ each task sends only its lots.
 
 A chunk's records (6 * 10^5 rows, ~40 MB) do not come back through the pool's pipe: pickling them and
 pushing them through a pipe cost more than deriving them on a grammar as cheap as the facade benchmark.
-A worker writes each record's arrays into one file in a private folder on a memory filesystem
-(``/dev/shm`` where there is one), and the parent maps the file into memory, takes the arrays as views
-of the mapping and deletes it: the records are copied once on their way, by the writer. The folder goes
-when the pool does, so a failed build leaves nothing behind. What two workers gain, and what the pipe and
-a read buffer cost, is measured in the README ("Figures").
+A worker writes a task's record arrays into one file of a private folder on a memory filesystem
+(``/dev/shm`` where there is one), and the parent takes the arrays as views of the file mapped into
+memory: the records are copied into the file by the worker and out of it by the writer. The files are
+slots that are used again: the parent gives each task a slot that no array refers to any more, so a
+worker writes over pages the memory filesystem already holds (and cuts the file to the task's size, so a
+large chunk's pages go with the next task) and the parent's mapping of them is already there. A new file for
+each task had the kernel allocate, zero and map its pages and free them again, chunk after chunk, for
+every record byte: that cost more system time than a second worker saves on a grammar as cheap as the
+facade benchmark (README, "Figures"). The folder goes when the pool does, so a failed build leaves
+nothing behind.
 """
 
 from __future__ import annotations
@@ -20,12 +25,15 @@ import contextlib
 import dataclasses
 import functools
 import itertools
+import mmap
 import multiprocessing
 import os
 import shutil
 import signal
 import sys
 import tempfile
+import threading
+import weakref
 from collections.abc import Callable
 from concurrent.futures import Future, ProcessPoolExecutor
 from concurrent.futures.process import BrokenProcessPool
@@ -38,12 +46,14 @@ from grammarc.errors import DerivationError
 
 __all__ = ["worker_pool"]
 
-#: What the workers run, set in the parent before they are forked: ``work``, the shipping folder.
+#: What the workers run, set in the parent before they are forked.
 _SHARED: dict = {}
-#: Numbers a worker's files (with its pid, unique in the folder).
-_TASKS = itertools.count()
 #: Arrays start at multiples of this in a shipped file, so their views are aligned.
 _ALIGN = 64
+#: Shipped arrays smaller than this are copied out of their file: consumers keep small tables past a
+#: chunk (the npz writer keeps each chunk's lot origins to its close), and a view would keep the file's
+#: slot from being used again.
+_COPIED = 1 << 20
 
 
 @contextlib.contextmanager
@@ -62,19 +72,25 @@ def worker_pool(work: Callable, workers: int):
     shared = Path(memory if memory is not None else tempfile.gettempdir())
     remove_stale(shared, "grammarc-records-")  # what builds that were killed left
     folder = Path(tempfile.mkdtemp(prefix=f"grammarc-records-{os.getpid()}-", dir=shared))
-    _SHARED.update(work=work, folder=folder)
+    _SHARED.update(work=work)
+    slots = _Slots(folder)
     try:
         forked = False
         with ProcessPoolExecutor(workers, mp_context=multiprocessing.get_context("fork"),
-                                 initializer=_die_with_parent) as pool:
+                                 initializer=_start_worker) as pool:
             def submit(lots) -> Future:
                 nonlocal forked
                 if not forked:  # the pool forks its workers at its first task: this one runs here
                     forked = True
                     return _at_once(work, lots)
-                shipped = pool.submit(_run, lots)
+                slot = slots.take()
+                try:
+                    shipped = pool.submit(_run, lots, slot)
+                except BrokenProcessPool as broken:  # a worker was killed before this task went in
+                    shipped = Future()
+                    shipped.set_exception(broken)
                 received: Future = Future()
-                shipped.add_done_callback(lambda done: _receive(done, received, lots))
+                shipped.add_done_callback(lambda done: _receive(done, received, lots, slots, slot))
                 return received
 
             yield submit
@@ -93,36 +109,44 @@ def _at_once(work: Callable, lots) -> Future:
     return future
 
 
-def _die_with_parent() -> None:
+def _start_worker() -> None:
     """In a new worker: the kernel kills it when the parent dies however it dies (Linux's
     ``PR_SET_PDEATHSIG``; a SIGKILL of the parent runs no code of ours), and SIGTERM and SIGHUP end it
-    as by default rather than unwind it as they do the parent (``errors.Stopped``)."""
+    as by default rather than unwind it as they do the parent (``errors.Stopped``).
+
+    Its C heap keeps the memory it frees (glibc's ``mallopt``): each chunk's columns (up to ~30 MB each)
+    would otherwise be mapped fresh and unmapped again, and the kernel would fault in and zero every page
+    of them, chunk after chunk; kept, the next chunk's columns take the same pages. A worker lives for one
+    build, and its memory is bounded by its largest chunk as before."""
     signal.signal(signal.SIGTERM, signal.SIG_DFL)
     signal.signal(signal.SIGHUP, signal.SIG_DFL)
     if sys.platform.startswith("linux"):
         import ctypes
 
-        ctypes.CDLL(None, use_errno=True).prctl(1, signal.SIGKILL)  # 1: PR_SET_PDEATHSIG
+        libc = ctypes.CDLL(None, use_errno=True)
+        libc.prctl(1, signal.SIGKILL)  # 1: PR_SET_PDEATHSIG
         if os.getppid() == 1:  # the parent died before the call: go now
             os._exit(1)
+        if hasattr(libc, "mallopt"):  # glibc (musl has none)
+            libc.mallopt(-3, 32 << 20)  # M_MMAP_THRESHOLD: glibc's largest; blocks above it are still mapped
+            libc.mallopt(-1, 1 << 30)  # M_TRIM_THRESHOLD (an int): keep up to 1 GiB free at the heap's top
 
 
-def _run(lots):
-    """In a worker: the work, its records written to memory files."""
+def _run(lots, slot: Path):
+    """In a worker: the work, its records written to the memory file ``slot``."""
     results, failed = _SHARED["work"](lots)
-    shipped = []
-    for k, (n_lots, (records, per_lot)) in enumerate(results):
-        path = _SHARED["folder"] / f"{os.getpid()}-{next(_TASKS)}-{k}.bin"
-        shipped.append((n_lots, (_ship(records, path), per_lot)))
-    return shipped, failed
+    layouts, size = _ship([records for _, (records, _) in results], slot)
+    return [(n_lots, per_lot) for n_lots, (_, per_lot) in results], layouts, size, failed
 
 
-def _receive(done: Future, received: Future, lots) -> None:
+def _receive(done: Future, received: Future, lots, slots: _Slots, slot: Path) -> None:
     if not received.set_running_or_notify_cancel():  # the build stopped (Ctrl-C) and gave this chunk up
         return
     try:
-        shipped, failed = done.result()
-        received.set_result(([(n, (_unship(layout), per_lot)) for n, (layout, per_lot) in shipped], failed))
+        counts, layouts, size, failed = done.result()
+        data = slots.open(slot, size)
+        received.set_result(([(n_lots, (_rebuild(layout, data), per_lot))
+                              for (n_lots, per_lot), layout in zip(counts, layouts, strict=True)], failed))
     except BrokenProcessPool:
         # A worker was killed (most often by the kernel's out-of-memory killer: SIGKILL runs no code of
         # ours). Deriving its lots again would most likely kill again, so the build stops as after any
@@ -141,15 +165,25 @@ def _span(lots) -> str:
     return f"#{lots.index[0]}-#{lots.index[-1]}" if len(lots) else "(none)"
 
 
-def _ship(records, path: Path) -> tuple:
-    """Write the arrays of a (nested) dataclass of arrays into ``path``; the layout to rebuild it."""
+def _ship(values: list, path: Path) -> tuple[list[tuple], int]:
+    """Write the arrays of (nested) dataclasses of arrays into ``path``, over what it held, and cut it to
+    their size; their layouts (to rebuild them) and that size."""
     arrays: list[np.ndarray] = []
-    layout = _layout(records, arrays, [0])
-    with open(path, "wb") as out:
+    at = [0]
+    layouts = [_layout(value, arrays, at) for value in values]
+    fd = os.open(path, os.O_WRONLY | os.O_CREAT, 0o600)
+    try:
+        os.ftruncate(fd, at[0])
+        offset = 0
         for array in arrays:
-            out.write(np.ascontiguousarray(array).reshape(-1).view(np.uint8))  # its bytes, not a copy
-            out.write(b"\0" * (-array.nbytes % _ALIGN))
-    return str(path), layout
+            view = memoryview(np.ascontiguousarray(array).reshape(-1).view(np.uint8))  # its bytes, not a copy
+            done = 0
+            while done < len(view):
+                done += os.pwrite(fd, view[done:], offset + done)
+            offset += array.nbytes + (-array.nbytes % _ALIGN)
+    finally:
+        os.close(fd)
+    return layouts, at[0]
 
 
 def _layout(value, arrays: list, at: list[int]) -> tuple:
@@ -165,13 +199,43 @@ def _layout(value, arrays: list, at: list[int]) -> tuple:
     return "value", value
 
 
-def _unship(shipped: tuple):
-    """The records a worker wrote, as views of the file mapped into memory (private, copy-on-write: no
-    copy is made, and none is written back); the file deleted, its pages freed with the last view."""
-    path, layout = shipped
-    data = np.memmap(path, dtype=np.uint8, mode="c") if os.path.getsize(path) else np.zeros(0, np.uint8)
-    os.unlink(path)
-    return _rebuild(layout, data)
+class _Slots:
+    """The memory files of a pool's tasks, each used again once no array refers to its last contents.
+
+    The parent maps each file once, for reading only (an array written to in place would be an error,
+    not a change that the next task's records would find), and maps it again only when it grew. Slots are
+    taken when tasks are submitted and given back, from whatever thread drops the last view of a task's
+    records (the writer's), by a finalizer; a slot of a task that failed is not used again."""
+
+    def __init__(self, folder: Path):
+        self._folder = folder
+        self._made = itertools.count()
+        self._free: list[Path] = []
+        self._mapped: dict[Path, mmap.mmap] = {}
+        # reentrant: the garbage collector may run a finalizer (``_give_back``) while this thread holds it
+        self._lock = threading.RLock()
+
+    def take(self) -> Path:
+        with self._lock:
+            return self._free.pop() if self._free else self._folder / f"{next(self._made)}.bin"
+
+    def open(self, path: Path, size: int) -> np.ndarray:
+        """The first ``size`` bytes of ``path``, which is free again when they and their views are gone."""
+        if not size:
+            self._give_back(path)
+            return np.zeros(0, np.uint8)
+        with self._lock:
+            mapped = self._mapped.get(path)
+            if mapped is None or len(mapped) < size:
+                with open(path, "rb") as file:
+                    mapped = self._mapped[path] = mmap.mmap(file.fileno(), size, access=mmap.ACCESS_READ)
+        data = np.frombuffer(mapped, np.uint8, size)  # views of it keep it, not the mapping, as their base
+        weakref.finalize(data, self._give_back, path)
+        return data
+
+    def _give_back(self, path: Path) -> None:
+        with self._lock:
+            self._free.append(path)
 
 
 def _rebuild(layout: tuple, data: np.ndarray):
@@ -181,5 +245,6 @@ def _rebuild(layout: tuple, data: np.ndarray):
     if kind == "array":
         dtype, shape, offset = np.dtype(layout[1]), layout[2], layout[3]
         size = int(np.prod(shape, dtype=np.int64)) * dtype.itemsize
-        return data[offset:offset + size].view(dtype).reshape(shape)
+        array = data[offset:offset + size].view(dtype).reshape(shape)
+        return array.copy() if size < _COPIED else array
     return layout[1]

@@ -9,22 +9,53 @@ from grammarc.build import BuildOptions, derive
 from grammarc.compiler import compile_grammar
 from grammarc.io.lots import lots_from_polygons
 from grammarc.model.records import MeshChunk, TerminalChunk
-from grammarc.workers import _ship, _unship
+from grammarc.workers import _rebuild, _ship, _Slots
 
 
-def test_a_shipped_chunk_comes_back_equal(tmp_path):
+def _chunk(rows: int, seed: int) -> TerminalChunk:
     mesh = MeshChunk(vertices=np.arange(12, dtype=np.float32).reshape(4, 3), ring_offsets=np.array([0, 4]),
                      face_offsets=np.array([0, 1]), lot=np.array([1], np.int32), symbol=np.array([0], np.int32))
-    chunk = TerminalChunk(asset=np.array([0, 1, 1], np.int32), xform=np.random.default_rng(0).normal(
-        size=(3, 3, 4)).astype(np.float32), lot=np.array([0, 0, 1], np.int32), symbol=np.zeros(3, np.int32),
-        mesh=mesh)
-    back = _unship(_ship(chunk, tmp_path / "c.bin"))
-    assert not (tmp_path / "c.bin").exists() and back.color is None and back.mesh.color is None
+    rng = np.random.default_rng(seed)
+    return TerminalChunk(asset=rng.integers(0, 5, rows, dtype=np.int32),
+                         xform=rng.normal(size=(rows, 3, 4)).astype(np.float32),
+                         lot=np.sort(rng.integers(0, 3, rows)).astype(np.int32), symbol=np.zeros(rows, np.int32),
+                         mesh=mesh)
+
+
+def _assert_equal(back: TerminalChunk, chunk: TerminalChunk) -> None:
+    assert back.color is None and back.mesh.color is None
     for name in ("asset", "xform", "lot", "symbol"):
         np.testing.assert_array_equal(getattr(back, name), getattr(chunk, name))
         assert getattr(back, name).dtype == getattr(chunk, name).dtype
     for name in ("vertices", "ring_offsets", "face_offsets", "lot", "symbol"):
-        np.testing.assert_array_equal(getattr(back.mesh, name), getattr(mesh, name))
+        np.testing.assert_array_equal(getattr(back.mesh, name), getattr(chunk.mesh, name))
+
+
+def test_shipped_chunks_come_back_equal_and_their_slot_is_used_again_once_they_are_dropped(tmp_path):
+    slots = _Slots(tmp_path)
+    first, second = _chunk(30_000, 0), _chunk(10, 1)  # xform: 1.4 MB, shipped; 480 bytes, copied
+    slot = slots.take()
+    layouts, size = _ship([first, second], slot)
+    data = slots.open(slot, size)
+    back = [_rebuild(layout, data) for layout in layouts]
+    _assert_equal(back[0], first)
+    _assert_equal(back[1], second)
+    del data
+    assert slots.take() != slot  # views of its records are alive: not free
+    kept, small = back[0].xform, back[1].xform
+    del back
+    assert slots.take() != slot  # one view is enough to keep it
+    assert small.flags.owndata  # small arrays are copies, which do not keep it
+    del kept
+    assert slots.take() == slot
+    for rows in (25_000, 40_000):  # written over: a smaller and a larger task (the parent maps it again)
+        chunk = _chunk(rows, rows)
+        layouts, size = _ship([chunk], slot)
+        back = _rebuild(layouts[0], slots.open(slot, size))
+        _assert_equal(back, chunk)
+        assert not back.xform.flags.writeable and os.path.getsize(slot) == size
+        del back
+        assert slots.take() == slot
 
 
 def test_lots_failed_in_a_worker_come_back_as_bad_lots(write):
