@@ -267,6 +267,11 @@ def _extruded_along_normal(ctx: Context, cursor: Shapes, height, axis: np.ndarra
     if not mesh.any():
         return extruded
     rows, others = np.flatnonzero(mesh), np.flatnonzero(~mesh)
+    # GEOS joins the faces' outlines, and loops on coordinates near float's limit (s(0, 1, -1e308))
+    huge = ~(np.abs(np.column_stack([cursor.size[rows], height[rows]])) <= TOL.coordinate).all(axis=1)
+    if huge.any():
+        ctx.fail_lots(cursor.lot[rows[huge]], "`extrude` of a face whose size or height is beyond any geometry "
+                      f"(over {TOL.coordinate:g} m)", span)
     return Shapes.merge([extruded.take(others), _extruded_faces(ctx, cursor.take(rows), height[rows])],
                         [others, rows])
 

@@ -693,3 +693,12 @@ def test_extrude_of_convex_parts_has_no_lamina_faces(write):
     assert sum(face_area(f) for f in got) == pytest.approx(2 * 400 + 100 * 3)
     t = totals(r)
     assert (t["w_n"], t["w_sum"]) == (6, pytest.approx(100 * 3))
+
+
+def test_extruding_a_face_beyond_any_geometry_fails_its_lot(write):
+    """The build fuzz's `s(0, 1, -1e308) extrude(-1e308)`: GEOS, joining the face's outline, never
+    returned (nor let a signal stop the build); the lot fails with the operation named, the other builds."""
+    text = "attr h = 5\nLot --> s(0, 1, h) extrude(h) X.\n"
+    out = run(write, text, [rect(10, 8), rect(6, 4)], lot_attrs={"h": np.array([-1e308, 3.0])})
+    assert [b.index for b in out["bad"]] == [0]
+    assert "beyond any geometry" in out["bad"][0].reason
