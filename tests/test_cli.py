@@ -362,11 +362,11 @@ def test_a_worker_killed_by_sigkill_fails_the_build_cleanly(tmp_path):
 
 @contextlib.contextmanager
 def _a_build_under_way(tmp_path):
-    """A two-worker build of 12,000 lots in a subprocess, caught in its derivation: the process.
-    After the caller has stopped it, nothing may be left: no output, no temporary folder, no shared
-    memory, no process."""
+    """A two-worker build of 24,000 lots in a subprocess, caught in its derivation once its workers
+    run (the parent derives the first chunk before it starts them): the process. After the caller has
+    stopped it, nothing may be left: no output, no temporary folder, no shared memory, no process."""
     lots = [[[[x * 25, y * 25], [x * 25 + 20, y * 25], [x * 25 + 20, y * 25 + 15], [x * 25, y * 25 + 15]]]
-            for x in range(120) for y in range(100)]
+            for x in range(120) for y in range(200)]
     geojson(tmp_path / "lots.geojson", lots)
     out = tmp_path / "out" / "city.npz"
     out.parent.mkdir()
@@ -377,8 +377,11 @@ def _a_build_under_way(tmp_path):
     deadline = time.monotonic() + 120
     while not list(out.parent.glob(".city.npz.tmp*")) and build.poll() is None and time.monotonic() < deadline:
         time.sleep(0.05)
+    children = Path(f"/proc/{build.pid}/task/{build.pid}/children")
+    while build.poll() is None and not children.read_text().split() and time.monotonic() < deadline:
+        time.sleep(0.02)
     assert build.poll() is None, "the build ended before it could be stopped"
-    time.sleep(0.5)  # into the derivation
+    time.sleep(0.1)  # into the workers' derivation
     yield build
     assert list(out.parent.iterdir()) == []
     assert list(Path("/dev/shm").glob(f"grammarc-records-{build.pid}-*")) == []  # named by their process

@@ -54,6 +54,15 @@ def _length(nx, ny, c, w, ux, uy, prv, nxt, e, t):
 
 
 @njit(cache=True, nogil=True)
+def _retire(alive, final, pool, s_head, e, x, y):
+    """Line e (a step) goes with the edge that vanished at (x, y); returns where its segment started."""
+    alive[e] = False
+    final[e, 0, 0], final[e, 0, 1], final[e, 1, 0], final[e, 1, 1] = x, y, x, y
+    k = s_head[e]
+    return pool[k, 0], pool[k, 1]
+
+
+@njit(cache=True, nogil=True)
 def _push(pool, link, used, head, tail, e, x, y):
     """Append (x, y) to line e's path (a linked list in ``pool``); returns the pool's new size."""
     pool[used, 0], pool[used, 1] = x, y
@@ -153,18 +162,14 @@ def _ring_strips(start, end, inward, d, corner, ends, out, out_n, left):
             # it, their strips reaching across its step's vertex (PRT's on massing.far.33391, where a short
             # edge moved 4 m between a moved and a kept edge turned by 13 degrees)
             if real[q] < 0 and count > 3:
-                k = s_head[q]
-                alive[q] = False
+                sx, sy = _retire(alive, final, pool, s_head, q, x, y)
                 count -= 1
-                final[q, 0, 0], final[q, 0, 1], final[q, 1, 0], final[q, 1, 1] = x, y, x, y
-                used = _push(pool, link, used, e_head, e_tail, p, pool[k, 0], pool[k, 1])
+                used = _push(pool, link, used, e_head, e_tail, p, sx, sy)
                 q = nxt[q]
             if real[p] < 0 and count > 3:
-                k = s_head[p]
-                alive[p] = False
+                sx, sy = _retire(alive, final, pool, s_head, p, x, y)
                 count -= 1
-                final[p, 0, 0], final[p, 0, 1], final[p, 1, 0], final[p, 1, 1] = x, y, x, y
-                used = _push(pool, link, used, s_head, s_tail, q, pool[k, 0], pool[k, 1])
+                used = _push(pool, link, used, s_head, s_tail, q, sx, sy)
                 p = prv[p]
         nxt[p], prv[q] = q, p
         hx, hy = x, y  # where p's segment and q's meet
