@@ -51,8 +51,6 @@ _LENGTH = struct.Struct("!I")
 #: Server to client: the command's exit status.
 _STATUS = struct.Struct("!i")
 _FORWARDED = (signal.SIGINT, signal.SIGTERM, getattr(signal, "SIGHUP", signal.SIGTERM))
-#: The prefix of the names of fused regions' generated modules (``backend.fusion.compiled.load``).
-FUSED_MODULES = "grammarc_fused_"
 #: Whether this system can run a server: it forks, and passes descriptors over Unix sockets (not Windows).
 AVAILABLE = hasattr(os, "fork") and hasattr(socket, "send_fds") and hasattr(signal, "pthread_sigmask")
 
@@ -182,9 +180,11 @@ def load_cached_kernels() -> int:
     """
     from numba.core.dispatcher import Dispatcher
 
+    from grammarc.backend.fusion.compiled import MODULE_PREFIX
+
     loaded = 0
     for name, module in list(sys.modules.items()):
-        if not name.startswith(("grammarc.", FUSED_MODULES)) or module is None:
+        if not name.startswith(("grammarc.", MODULE_PREFIX)) or module is None:
             continue
         for kernel in list(vars(module).values()):
             if not isinstance(kernel, Dispatcher) or kernel.__module__ != name:
@@ -283,7 +283,7 @@ def _child(connection: socket.socket, run: Callable[[list[str]], int]) -> None:
         # The command is over: a client that hangs up once it has its status makes ``_watch`` send a
         # SIGTERM, which must not raise here, past ``_exit``, into the server's own code (which would say
         # "error: 15" on the client's streams)
-        for signum in (signal.SIGINT, *_FORWARDED):
+        for signum in _FORWARDED:
             signal.signal(signum, signal.SIG_IGN)
         with contextlib.suppress(BaseException):
             sys.stdout.flush()

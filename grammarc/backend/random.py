@@ -32,20 +32,31 @@ def _mix(key, value):
     return out
 
 
+@njit(cache=True, nogil=True, inline="always")
+def child_key1(key, site, index):
+    """The key of child ``index`` made at ``site`` of a shape of ``key`` (fused kernels call it too)."""
+    return mix1(mix1(key, site), index)
+
+
+@njit(cache=True, nogil=True, inline="always")
+def uniform1(key, site):
+    """The draw in [0, 1) of a shape of ``key`` at ``site``: its mixed key's top 53 bits times 2**-53."""
+    return (mix1(key, site) >> np.uint64(11)) * (1.0 / 9007199254740992.0)
+
+
 @njit(cache=True, nogil=True)
 def _child_keys(key, site, index):
     out = np.empty(len(key), np.uint64)
     for i in range(len(key)):
-        out[i] = mix1(mix1(key[i], site), index[i])
+        out[i] = child_key1(key[i], site, index[i])
     return out
 
 
 @njit(cache=True, nogil=True)
 def _uniform(key, site):
     out = np.empty(len(key))
-    scale = 1.0 / 9007199254740992.0  # 2**-53
     for i in range(len(key)):
-        out[i] = (mix1(key[i], site) >> np.uint64(11)) * scale
+        out[i] = uniform1(key[i], site)
     return out
 
 

@@ -37,6 +37,8 @@ def digest(text: str) -> str:
     return hashlib.sha256(text.encode()).hexdigest()[:24]
 
 
+#: The prefix of the generated modules' names (``server.load_cached_kernels`` looks for it).
+MODULE_PREFIX = "grammarc_fused_"
 #: The kernels compiled or loaded in this process, by source text.
 _KERNELS: dict[str, object] = {}
 
@@ -134,7 +136,7 @@ def load(text: str):
         if user_cache.load(path, lambda f: f.read().decode()) != text:  # a folder that cannot be written
             path = _private_folder() / path.name
             path.write_text(text)
-    name = f"grammarc_fused_{key}"  # ``server.FUSED_MODULES``
+    name = f"{MODULE_PREFIX}{key}"
     spec = importlib.util.spec_from_file_location(name, path)
     module = importlib.util.module_from_spec(spec)
     sys.modules[name] = module  # numba's cache finds the functions' globals by the module's name
