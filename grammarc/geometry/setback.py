@@ -22,6 +22,7 @@ import numpy as np
 import shapely
 
 from grammarc.constants import TOL
+from grammarc.geometry.meshes import ring_vector_areas
 from grammarc.geometry.wavefront import swept_strips
 from grammarc.ragged import offsets_from_counts, rank_within
 
@@ -152,7 +153,10 @@ def _swept(polygons: np.ndarray, edges: Edges, d, corner, ends, owner, swept, st
     front = shapely.linearrings(left, indices=dense)
     has_front[ends_as] = True
     crossed[ends_as] = ~shapely.is_simple(front)
-    winding = _winding(left, left_ring, n)
+    # twice the signed area of each front: its winding, positive counter-clockwise (not GEOS's ``is_ccw``,
+    # which looks at one vertex of a ring that may cross itself)
+    fronts = offsets_from_counts(np.bincount(left_ring, minlength=n))
+    winding = 2 * ring_vector_areas(np.column_stack([left, np.zeros(len(left))]), fronts)[:, 2]
     turned = np.zeros(n, dtype=bool)
     turned[ends_as] = (winding[ends_as] > 0) != shapely.is_ccw(outlines[ends_as])
     turned |= np.abs(winding) <= 1e-12 * scale * scale
@@ -176,17 +180,6 @@ def _swept(polygons: np.ndarray, edges: Edges, d, corner, ends, owner, swept, st
         made_group = np.concatenate([made_group, owner[furthest] * m + gone])
     kept = ~swept[edges.poly[idx]] | edges.hole[idx]  # (a moved hole edge keeps its strip)
     return np.concatenate([strips[kept], made]), np.concatenate([group[kept], made_group])
-
-
-def _winding(points: np.ndarray, ring: np.ndarray, n: int) -> np.ndarray:
-    """Twice the signed area (n,) of each ring through ``points`` (k, 2) (``ring`` (k,) ascending): its
-    winding, positive counter-clockwise (not GEOS's ``is_ccw``, which looks at one vertex of a ring that
-    may cross itself)."""
-    first, last = np.ones(len(ring), dtype=bool), np.ones(len(ring), dtype=bool)
-    first[1:] = last[:-1] = ring[1:] != ring[:-1]
-    following = np.roll(points, -1, axis=0)
-    following[last] = points[first]
-    return np.bincount(ring, points[:, 0] * following[:, 1] - following[:, 0] * points[:, 1], minlength=n)
 
 
 def _folded_strips(quads: np.ndarray) -> np.ndarray:

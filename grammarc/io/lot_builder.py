@@ -120,13 +120,17 @@ class LotBuilder:
         properties are not kept here: the caller passes them to ``finish`` as columns."""
         self._convert()
         self.polygons += len(ids)
-        self.rings.append(vertices if self.world else _with_z(vertices))
-        self.sizes.extend(np.asarray(sizes, dtype=np.int64).tolist())
         self.street.append((self.vertices, street))
-        self.vertices += len(vertices)
+        self._add_rings(vertices if self.world else _with_z(vertices), sizes)
         self.ring_counts.extend(np.asarray(ring_counts).tolist())
         self.index.extend(np.asarray(index).tolist())
         self.ids.extend(ids)
+
+    def _add_rings(self, vertices: np.ndarray, sizes) -> None:
+        """The rings of lots added as one block: all their vertices (V, 3), and vertices per ring."""
+        self.rings.append(vertices)
+        self.sizes.extend(np.asarray(sizes, dtype=np.int64).tolist())
+        self.vertices += len(vertices)
 
     def add_positions(self, index: int, lot_id: str, rings, props: dict) -> None:
         """Add a lot given as lists of map positions (GeoJSON): x, y and an optional elevation; further
@@ -160,9 +164,7 @@ class LotBuilder:
         if all(rings and STREET_WIDTH not in props for _, _, rings, props in queued):
             # lots with rings and no street edges (most files): added as one block, as ``_add`` adds each
             self.polygons += len(queued)
-            self.rings.append(xyz)
-            self.sizes.extend(np.diff(offsets).tolist())
-            self.vertices += len(xyz)
+            self._add_rings(xyz, np.diff(offsets))
             for index, lot_id, rings, props in queued:
                 self.ring_counts.append(len(rings))
                 self.index.append(index)
