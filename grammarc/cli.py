@@ -27,7 +27,7 @@ from pathlib import Path
 from grammarc import __version__
 from grammarc.constants import LIMITS, PARTITION_SIZE
 from grammarc.diagnostics import render_all
-from grammarc.errors import GrammarcError, GrammarError, UsageError, raise_stopped, stopped
+from grammarc.errors import GrammarcError, GrammarError, UsageError, interruption, raise_stopped, stopped
 
 _START_HELP = ("the start rule (default: @StartRule, else the first rule); a call `Lot(10, \"a\", true)` "
               "gives the arguments of a start rule with parameters")
@@ -60,6 +60,11 @@ def main(argv: list[str] | None = None) -> int:
         print(f"grammarc: error: {error}", file=sys.stderr)
         return error.exit_code
     except KeyboardInterrupt as stop:  # Ctrl-C, or SIGTERM / SIGHUP (``Stopped``)
+        return stopped(stop)
+    except SystemError as error:  # a signal that came while numba's code called back into Python
+        stop = interruption(error)
+        if stop is None:
+            raise
         return stopped(stop)
     except BrokenPipeError:
         # the reader of our output went away (`grammarc info city.npz | head`): not an error of ours

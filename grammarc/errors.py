@@ -80,6 +80,19 @@ def raise_stopped(signum, frame) -> None:
     raise Stopped(signum)
 
 
+def interruption(error: BaseException) -> KeyboardInterrupt | None:
+    """The Ctrl-C or ``Stopped`` behind ``error``, if any. A signal's handler that raises while numba's
+    compiled code calls back into Python (``_numba_unpickle``) comes out as a ``SystemError`` whose cause is
+    the interruption: the command was stopped all the same."""
+    seen = set()
+    while error is not None and id(error) not in seen:
+        if isinstance(error, KeyboardInterrupt):
+            return error
+        seen.add(id(error))
+        error = error.__cause__ or error.__context__
+    return None
+
+
 def stopped(stop: KeyboardInterrupt) -> int:
     """Say that a command was stopped (Ctrl-C or ``Stopped``); its exit status (128 + the signal)."""
     signum = stop.signum if isinstance(stop, Stopped) else signal.SIGINT

@@ -16,6 +16,7 @@ import numpy as np
 import pytest
 
 from grammarc.cli import main
+from grammarc.errors import Stopped
 from grammarc.io.npz import read_instances
 
 GOOD = 'attr height = 9\nlot ~> S(1r, height, 1r) Comp("sidefaces"){ wall }\n'
@@ -345,6 +346,22 @@ def test_sigterm_and_sighup_stop_a_build_as_ctrl_c_does(tmp_path, signum):
         _, err = build.communicate(timeout=120)
     assert build.returncode == 128 + signum
     assert err.endswith(f"grammarc: {signal.Signals(signum).name}: stopped; nothing was written\n")
+
+
+def test_a_signal_raised_inside_numbas_callback_still_stops_the_build(write, tmp_path, capsys, monkeypatch):
+    """A handler that raises while compiled code calls back into Python surfaces as a SystemError caused by
+    the signal (a served build caught it so): it is said and exits as the signal, not as a traceback."""
+    def derive_chunk(*args, **kwargs):
+        try:
+            raise Stopped(signal.SIGTERM)
+        except Stopped as stop:
+            raise SystemError("CPUDispatcher(group_by) returned a result with an exception set") from stop
+
+    monkeypatch.setattr("grammarc.build.derive_chunk", derive_chunk)
+    grammar = write("g.cga", "Lot --> extrude(3)\n")
+    assert main(["build", str(grammar), "--emit", str(tmp_path / "out.npz"), "--quiet"]) == 128 + signal.SIGTERM
+    assert capsys.readouterr().err == "grammarc: SIGTERM: stopped; nothing was written\n"
+    assert not (tmp_path / "out.npz").exists()
 
 
 def test_a_worker_killed_by_sigkill_fails_the_build_cleanly(tmp_path):
