@@ -122,6 +122,10 @@ class Plan:
     def symbol_names(self) -> tuple[str, ...]:
         return tuple(s.name for s in self.symbols)
 
+    def makes_leaves(self, successor: ir.Symbol) -> bool:
+        """Whether ``successor``'s shapes are leaves (records) at once: a symbol without rules, or ``X.``."""
+        return successor.leaf or self.symbols[self.symbol_ids[successor.name]].terminal
+
 
 def make_plan(grammar: Grammar, *, load_asset: Callable = load_asset) -> Plan:
     """The plan of ``grammar``; ``load_asset(name, asset_roots) -> AssetMesh`` loads the assets whose

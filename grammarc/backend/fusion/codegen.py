@@ -28,7 +28,7 @@ from dataclasses import dataclass, field
 from itertools import count
 from typing import NamedTuple
 
-from grammarc.backend.fusion.regions import SIZES, Fusible, applied_rules, leaf_successor
+from grammarc.backend.fusion.regions import SIZES, Fusible, applied_rules
 from grammarc.backend.kernels.split import MAX_COUNT
 from grammarc.constants import TOL
 from grammarc.ir import nodes as ir
@@ -248,7 +248,7 @@ class _Writer:
                 self.repeat(op, block, scope, level, depth)
             elif isinstance(op, ir.Insert):
                 self.emit(block, self.plan.grammar.asset_ids[op.asset], block.symbol, scope, level)
-            elif isinstance(op, ir.Symbol) and leaf_successor(self.plan, op):
+            elif isinstance(op, ir.Symbol) and self.plan.makes_leaves(op):
                 self.made(level)
                 self.leaf(block, self.plan.symbol_ids[op.name], scope, level)
             elif isinstance(op, ir.Symbol):

@@ -92,7 +92,7 @@ class Fusible:
             for op in iter_ops(rule):
                 if isinstance(op, (ir.Split, ir.Repeat)):
                     return True
-                if (isinstance(op, ir.Symbol) and not leaf_successor(self.plan, op) and self.inlined(op.name)
+                if (isinstance(op, ir.Symbol) and not self.plan.makes_leaves(op) and self.inlined(op.name)
                         and self.worth_a_kernel(self.plan.symbol_ids[op.name])):
                     return True
         return False
@@ -136,7 +136,7 @@ class Fusible:
             return (len(op.axes) == 1 and not op.snap and all(self.expr(e) for e in op.sizes)
                     and all(self.body(part) for part in op.parts))
         if isinstance(op, ir.Symbol):
-            if leaf_successor(self.plan, op):  # its leaves are records at once, wherever it is named
+            if self.plan.makes_leaves(op):  # its leaves are records at once, wherever it is named
                 return not op.args
             target = self.plan.symbols[self.plan.symbol_ids[op.name]]
             # derived here, or handed off: its shapes wait for its turn, their parameters numbers
@@ -158,11 +158,6 @@ class Fusible:
         if isinstance(expr, ir.Call):
             return expr.func in FUNCTIONS and all(self.expr(arg) for arg in expr.args)
         return False
-
-
-def leaf_successor(plan, op: ir.Symbol) -> bool:
-    """Whether successor ``op`` makes leaves (``operations.successors``): a symbol without rules, or ``X.``."""
-    return op.leaf or plan.symbols[plan.symbol_ids[op.name]].terminal
 
 
 def applied_rules(sym) -> tuple[ir.Rule, ...]:

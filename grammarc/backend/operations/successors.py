@@ -34,7 +34,7 @@ def successor(ctx: Context, cursor: Shapes, op: ir.Symbol) -> None:
                     successor_keys(plan.sequential_random, cursor.key, op.site), cursor.depth + 1, params,
                     cursor.dynamic)
     ctx.count(shapes, op.span)
-    if sym.terminal or op.leaf:
+    if plan.makes_leaves(op):
         if plan.occluders:
             add_occluders(ctx.chunk, shapes, occluder_label(plan, sym.id))  # a leaf solid occludes
         terminals.emit_leaves(ctx, shapes, sym.id)
