@@ -19,7 +19,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from grammarc.ragged import rank_within, row_groups
+from grammarc.ragged import group_bounds, rank_within, row_groups
 
 #: A shared edge steeper than this (degrees from the horizontal) makes a vertical trim plane, a shallower
 #: one a horizontal plane.
@@ -133,11 +133,7 @@ def _corner_cells(parent: np.ndarray, *points: np.ndarray) -> tuple[list[np.ndar
     (national-grid coordinates) is matched as it would be at the origin and coarsens no other lot's
     matching in its chunk (a grid of its coordinates' magnitude, 0.8 m at 7.8e6, made the corners of
     complexpatterns' 0.6 m deep top floors one corner)."""
-    n = int(parent.max()) + 1
-    low, high = np.full((n, 3), np.inf), np.full((n, 3), -np.inf)
-    for p in points:
-        np.minimum.at(low, parent, p)
-        np.maximum.at(high, parent, p)
+    low, high = group_bounds(np.tile(parent, len(points)), int(parent.max()) + 1, np.concatenate(points))
     scale = (np.maximum((high - low).max(axis=1), 1.0) * 1e-7)[parent][:, None]
     return [np.round((p - low[parent]) / scale).astype(np.int64) for p in points], scale
 

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from grammarc.backend.kernels.order import group_by, place, put, scatter_rows, tally
-from grammarc.backend.kernels.scope import place_children, xforms
+from grammarc.backend.kernels.scope import component_frames, place_children, xforms
 from grammarc.backend.kernels.split import repeat, repeat_counts, subdiv
 from grammarc.backend.random import child_keys
 
@@ -261,6 +261,27 @@ def test_xforms(n):
             want[i, :, j] = frames[frame[i], j] * size[i, j]  # column j = scope axis j * size j
         want[i, :, 3] = origin[i] - base[i]  # relative to the lot's origin, rounded once
     assert np.array_equal(out, want.astype(np.float32))
+
+
+@pytest.mark.parametrize("n", SIZES)
+def test_component_frames_give_einsums_bits_signed_zeros_included(n):
+    rng = np.random.default_rng(n)
+    frames = random_frames(rng, 6)
+    frames[5] = np.eye(3) * np.array([1.0, -1.0, -1.0])[:, None]  # a turn whose zeros are signed
+    frame = rng.integers(0, 6, n).astype(np.int32)
+    origin = rng.normal(size=(n, 3)) * 100
+    local_origin = np.where(rng.random((n, 3)) < 0.3, -0.0, rng.normal(size=(n, 3)))
+    local_axes = random_frames(rng, n)
+    local_axes[::3] = np.eye(3) * np.array([-1.0, -1.0, 1.0])[:, None]
+    local_axes[1::7] *= 1e155  # its axes' squares overflow: not orthonormal
+    world_origin, world_axes, bad = component_frames(frames, frame, origin, local_origin, local_axes, 1e-6)
+    want_origin = origin + np.einsum("ni,nij->nj", local_origin, frames[frame])
+    want_axes = np.einsum("nij,njk->nik", local_axes, frames[frame])
+    gram = np.einsum("nij,nkj->nik", local_axes, local_axes)
+    assert np.array_equal(world_origin.view(np.int64), want_origin.view(np.int64))
+    assert np.array_equal(world_axes.view(np.int64), want_axes.view(np.int64))
+    assert np.array_equal(bad, ~(np.abs(gram - np.eye(3)) < 1e-6).all(axis=(1, 2)))
+    assert bad[1::7].all()
 
 
 def test_xforms_maps_unit_box_corners_to_scope_corners():

@@ -99,3 +99,36 @@ def leaf_xforms(origin, base, size, frame, frames, axis, rows, parent, pos, leng
                 out[c, r, j] = frames[f, j, r] * s[j]
             out[c, r, 3] = o[r] - base[p, r]
     return out
+
+
+@njit(cache=True, nogil=True)
+def component_frames(frames, frame, origin, local_origin, local_axes, tol):
+    """World scopes of components: ``origin + local_origin @ frames[frame]`` (m, 3) and
+    ``local_axes @ frames[frame]`` (m, 3, 3), summed from 0.0 in axis order as ``np.einsum`` sums them
+    (the same bits), and whether each component's local axes are not orthonormal within ``tol`` (m,)
+    bool (a scope of sizes no float can square). ``frame`` (m,) int32 the parents' frame ids, ``origin``
+    (m, 3) their origins, ``local_origin`` and ``local_axes`` in the parents' frames."""
+    m = len(frame)
+    out_origin = np.empty((m, 3))
+    out_axes = np.empty((m, 3, 3))
+    bad = np.zeros(m, np.bool_)
+    for c in range(m):
+        f = frame[c]
+        for j in range(3):
+            moved = 0.0
+            for i in range(3):
+                moved += local_origin[c, i] * frames[f, i, j]
+            out_origin[c, j] = origin[c, j] + moved
+            for r in range(3):
+                turned = 0.0
+                for i in range(3):
+                    turned += local_axes[c, r, i] * frames[f, i, j]
+                out_axes[c, r, j] = turned
+        for r in range(3):
+            for k in range(3):
+                dot = 0.0
+                for j in range(3):
+                    dot += local_axes[c, r, j] * local_axes[c, k, j]
+                if not abs(dot - (1.0 if r == k else 0.0)) < tol:
+                    bad[c] = True
+    return out_origin, out_axes, bad
