@@ -47,14 +47,8 @@ def side_face_planes(axes: np.ndarray, origin: np.ndarray, size: np.ndarray, par
     start = origin
     end = origin + size[:, 0:1] * x
     (first, last), _ = _corner_cells(parent, start, end)
-    keys = np.concatenate([np.column_stack([parent, first]), np.column_stack([parent, last])])
-    inverse, _ = row_groups(keys)  # the same corner of the same parent: one id
-    at_start, at_end = inverse[:m], inverse[m:]
-    ending = np.full(int(inverse.max()) + 1, -1)
-    ending[at_end] = np.arange(m)
-    starting = np.full(int(inverse.max()) + 1, -1)
-    starting[at_start] = np.arange(m)
-    before, after = ending[at_start], starting[at_end]  # the neighbour sharing each face's start / end
+    # the neighbour sharing each face's start / end
+    before, after = _neighbours(np.argsort(parent, kind="stable"), parent, first, last)
     for which, neighbour, corner, sign in ((0, before, start, 1.0), (1, after, end, -1.0)):
         ok = steep & (neighbour >= 0)
         ok[ok] &= steep[neighbour[ok]]
@@ -136,6 +130,33 @@ def _corner_cells(parent: np.ndarray, *points: np.ndarray) -> tuple[list[np.ndar
     low, high = group_bounds(np.tile(parent, len(points)), int(parent.max()) + 1, np.concatenate(points))
     scale = (np.maximum((high - low).max(axis=1), 1.0) * 1e-7)[parent][:, None]
     return [np.round((p - low[parent]) / scale).astype(np.int64) for p in points], scale
+
+
+@njit(cache=True, nogil=True)
+def _neighbours(order, parent, first, last):
+    """Each face's neighbour at its start, the face of its parent whose end is in the same grid cell as its
+    start, and at its end, the one whose start is in its end's cell (-1: none; the last face, where
+    several are). ``order`` (m,) lists the faces parent by parent (a stable sort: faces in their order);
+    ``first`` and ``last`` (m, 3) int64 are the cells of their starts and ends (``_corner_cells``). A
+    parent's faces are few (a box's six, a footprint's walls): each is matched against all of them."""
+    m = len(order)
+    before = np.full(m, -1, np.int64)
+    after = np.full(m, -1, np.int64)
+    group = 0
+    while group < m:
+        stop = group
+        while stop < m and parent[order[stop]] == parent[order[group]]:
+            stop += 1
+        for a in range(group, stop):
+            i = order[a]
+            for b in range(group, stop):
+                j = order[b]
+                if last[j, 0] == first[i, 0] and last[j, 1] == first[i, 1] and last[j, 2] == first[i, 2]:
+                    before[i] = j
+                if first[j, 0] == last[i, 0] and first[j, 1] == last[i, 1] and first[j, 2] == last[i, 2]:
+                    after[i] = j
+        group = stop
+    return before, after
 
 
 def plane_coordinates(normal: np.ndarray) -> np.ndarray:
