@@ -38,28 +38,54 @@ def side_face_planes(axes: np.ndarray, origin: np.ndarray, size: np.ndarray, par
     the bottom edge (from its lot's origin, as the planes are then), size (m, 3), parent (m,): faces of
     one parent meet where one's end is the next's start; up (m, 3) the split shape's scope y axis in
     world coordinates."""
-    m = len(parent)
-    out = np.full((m, 8), np.nan)
-    if not m:
-        return out
-    x, y = axes[:, 0], axes[:, 1]
-    steep = (np.abs(np.einsum("ij,ij->i", y, up)) >= np.sin(np.radians(VERTICAL_DEGREES))) & (size[:, 0] > 0) & (size[:, 1] > 0)
-    start = origin
-    end = origin + size[:, 0:1] * x
-    (first, last), _ = _corner_cells(parent, start, end)
+    if not len(parent):
+        return np.full((0, 8), np.nan)
+    end = origin + size[:, 0:1] * axes[:, 0]
+    (first, last), _ = _corner_cells(parent, origin, end)
     # the neighbour sharing each face's start / end
     before, after = _neighbours(np.argsort(parent, kind="stable"), parent, first, last)
-    for which, neighbour, corner, sign in ((0, before, start, 1.0), (1, after, end, -1.0)):
-        ok = steep & (neighbour >= 0)
-        ok[ok] &= steep[neighbour[ok]]
-        rows = np.flatnonzero(ok)
-        bisector = x[rows] + x[neighbour[rows]]
-        length = np.linalg.norm(bisector, axis=1)
-        good = length > 1e-9
-        rows, bisector = rows[good], bisector[good] / length[good, None]
-        normal = sign * bisector
-        out[rows, 4 * which: 4 * which + 3] = normal
-        out[rows, 4 * which + 3] = -np.einsum("ij,ij->i", normal, corner[rows])
+    return _bisector_planes(axes, origin, end, size, up, before, after, np.sin(np.radians(VERTICAL_DEGREES)))
+
+
+@njit(cache=True, nogil=True)
+def _bisector_planes(axes, start, end, size, up, before, after, steepest):
+    """``side_face_planes``' planes, once each face's neighbours ``before`` and ``after`` (m,) are known:
+    where a face and its neighbour are both steep (their y axes at least ``steepest``, the sine, along
+    ``up``; not flat), the plane through the shared corner (``start`` or ``end`` (m, 3)) whose normal
+    bisects their x axes. The sums run in numpy's order (``einsum``'s from 0.0, ``norm``'s in axis
+    order), so the planes have the bits they had when numpy computed them."""
+    m = len(axes)
+    out = np.full((m, 8), np.nan)
+    steep = np.empty(m, np.bool_)
+    for i in range(m):
+        dot = 0.0
+        for j in range(3):
+            dot += axes[i, 1, j] * up[i, j]
+        steep[i] = abs(dot) >= steepest and size[i, 0] > 0 and size[i, 1] > 0
+    for i in range(m):
+        if not steep[i]:
+            continue
+        for which in range(2):
+            k = before[i] if which == 0 else after[i]
+            if k < 0 or not steep[k]:
+                continue
+            b0 = axes[i, 0, 0] + axes[k, 0, 0]
+            b1 = axes[i, 0, 1] + axes[k, 0, 1]
+            b2 = axes[i, 0, 2] + axes[k, 0, 2]
+            length = np.sqrt((b0 * b0 + b1 * b1) + b2 * b2)
+            if not length > 1e-9:
+                continue
+            sign = 1.0 if which == 0 else -1.0
+            n0, n1, n2 = sign * (b0 / length), sign * (b1 / length), sign * (b2 / length)
+            corner = start if which == 0 else end
+            d = 0.0
+            d += n0 * corner[i, 0]
+            d += n1 * corner[i, 1]
+            d += n2 * corner[i, 2]
+            out[i, 4 * which] = n0
+            out[i, 4 * which + 1] = n1
+            out[i, 4 * which + 2] = n2
+            out[i, 4 * which + 3] = -d
     return out
 
 
