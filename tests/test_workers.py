@@ -145,3 +145,27 @@ def test_only_builds_of_more_than_one_chunk_fork_workers(monkeypatch, write, lot
     square = [[np.array([[0, 0], [10, 0], [10, 10], [0, 10]], float)]]
     derive(grammar, lots_from_polygons(square * lots), BuildOptions(workers=2, chunk_size=chunk_size))
     assert asked == [2 if forked else 1]
+
+
+def test_the_last_chunks_are_shared_out_among_the_workers():
+    from grammarc.build import LAST_CHUNKS, _chunk_size
+
+    assert _chunk_size(107, 1000, 2) == 107  # far from the end: the size the records per lot give
+    assert _chunk_size(107, 131, 2) == 66  # near it: a share of what is left for each worker
+    assert _chunk_size(107, 10, 2) == LAST_CHUNKS  # never a chunk of a lot or two
+    assert _chunk_size(2, 10, 2) == 2  # nor more than the size asked for (--chunk-size)
+    assert _chunk_size(107, 131, 1) == 107  # one process: nothing to share
+
+
+def test_chunks_of_a_build_with_workers_start_small_and_end_shared(monkeypatch, write):
+    from grammarc import build
+
+    asked = []
+    real = build._chunk_size
+    monkeypatch.setattr(build, "_chunk_size", lambda size, left, workers: (
+        asked.append(min(real(size, left, workers), left)), asked[-1])[1])
+    grammar = compile_grammar(write("g.cga", "Lot --> extrude(3)\n"))
+    square = [[np.array([[0, 0], [10, 0], [10, 10], [0, 10]], float)]]
+    derive(grammar, lots_from_polygons(square * 100), BuildOptions(workers=2))
+    # 16 here, two more of 16 queued before the first records come back; then at most half of what is left
+    assert asked == [16, 16, 16, 26, 13, 8, 5]
