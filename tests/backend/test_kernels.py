@@ -253,14 +253,17 @@ def test_xforms(n):
     size[rng.random((n, 3)) < 0.2] = 0.0
     base = rng.uniform(-1e7, 1e7, (n, 3)).round()  # lots' origins, far from the world's
     origin = base + rng.normal(size=(n, 3)) * 100
-    out = xforms(frames, frame, size, origin, base)
+    flat = np.where(rng.random(n) < 0.5, -1, rng.integers(0, 3, n))
+    out = xforms(frames, frame, size, origin, base, flat)
     assert out.dtype == np.float32 and out.shape == (n, 3, 4)
     want = np.empty((n, 3, 4))
     for i in range(n):
+        k = flat[i]
         for j in range(3):
-            want[i, :, j] = frames[frame[i], j] * size[i, j]  # column j = scope axis j * size j
+            axis = j if k < 0 else (k + 1 + j) % 3  # a face: its two extents, then its normal times 0
+            want[i, :, j] = frames[frame[i], axis] * (size[i, axis] if k < 0 or j < 2 else 0.0)
         want[i, :, 3] = origin[i] - base[i]  # relative to the lot's origin, rounded once
-    assert np.array_equal(out, want.astype(np.float32))
+    assert np.array_equal(out.view(np.int32), want.astype(np.float32).view(np.int32))  # zeros' signs too
 
 
 @pytest.mark.parametrize("n", SIZES)
@@ -289,7 +292,7 @@ def test_xforms_maps_unit_box_corners_to_scope_corners():
     frames = random_frames(rng, 1)
     size = np.array([[2.0, 3.0, 4.0]])
     origin = np.array([[1.0, -2.0, 5.0]])
-    x = xforms(frames, np.zeros(1, np.int32), size, origin, np.zeros((1, 3)))[0].astype(np.float64)
+    x = xforms(frames, np.zeros(1, np.int32), size, origin, np.zeros((1, 3)), np.full(1, -1))[0].astype(np.float64)
     for corner in np.ndindex(2, 2, 2):
         c = np.array(corner, float)
         world = x[:, :3] @ c + x[:, 3]

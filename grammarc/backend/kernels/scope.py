@@ -51,16 +51,22 @@ def place_children(origin, size, key, frame, geom, lot, depth, frames, axis, ord
 
 
 @njit(cache=True, nogil=True)
-def xforms(frames, frame, size, origin, base):
+def xforms(frames, frame, size, origin, base, flat):
     """Record transforms (n, 3, 4) float32: column j = scope axis j * size j, column 3 = origin - base
-    (``base`` (n, 3): each row's lot origin, ``model.records.LotOrigins``)."""
+    (``base`` (n, 3): each row's lot origin, ``model.records.LotOrigins``). A flat scope, ``flat`` (n,) its
+    flat axis k (-1: a box), is a face (``builtin:quad``): its columns are axes k + 1 and k + 2 (mod 3) with
+    their sizes, then axis k times 0, as ``shapes.face_axes`` orders them: the quad's normal is axis k."""
     n = len(frame)
     out = np.empty((n, 3, 4), np.float32)
     for i in range(n):
         f = frame[i]
+        k = flat[i]
+        for j in range(3):
+            a = j if k < 0 else (k + 1 + j) % 3
+            s = size[i, a] if k < 0 or j < 2 else 0.0
+            for r in range(3):
+                out[i, r, j] = frames[f, a, r] * s
         for r in range(3):
-            for j in range(3):
-                out[i, r, j] = frames[f, j, r] * size[i, j]
             out[i, r, 3] = origin[i, r] - base[i, r]
     return out
 
