@@ -30,6 +30,8 @@ def turned(ctx: Context, shapes: Shapes, turn: np.ndarray, matrices: np.ndarray,
     rows, others = np.flatnonzero(turn), np.flatnonzero(~turn)
     sub = shapes.take(rows)
     new_axes = np.einsum("nij,njk->nik", matrices[axis[rows]], ctx.chunk.frames[sub.frame])
+    if not len(others):  # all turn (a comp(f)'s faces, extruded): nothing to merge them with
+        return reframed(ctx, sub, new_axes, span)
     return Shapes.merge([shapes.take(others), reframed(ctx, sub, new_axes, span)], [others, rows])
 
 
