@@ -47,24 +47,44 @@ def _axes_of(plane):
 
 @njit(cache=True, nogil=True)
 def _cross(a, b):
-    return np.array([a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]])
+    out = np.empty(3)
+    _cross_into(a, b, out)
+    return out
+
+
+@njit(cache=True, nogil=True)
+def _cross_into(a, b, out):
+    """a cross b, written into ``out`` (3,): the kernel's loops over edges allocate nothing."""
+    out[0] = a[1] * b[2] - a[2] * b[1]
+    out[1] = a[2] * b[0] - a[0] * b[2]
+    out[2] = a[0] * b[1] - a[1] * b[0]
 
 
 @njit(cache=True, nogil=True)
 def _edge(coords, j, r0, count, a, b, size_row):
     """Ring edge from vertex j to its successor in local coordinates: start p (3,), unit direction and
     length (the direction is zero for a zero-length edge)."""
-    k = r0 + (j - r0 + 1) % count
     p = np.zeros(3)
     d = np.zeros(3)
+    length = _edge_into(coords, j, r0, count, a, b, size_row, p, d)
+    return p, d, length
+
+
+@njit(cache=True, nogil=True)
+def _edge_into(coords, j, r0, count, a, b, size_row, p, d):
+    """``_edge`` written into ``p`` and ``d`` (3,); returns the length."""
+    k = r0 + (j - r0 + 1) % count
+    p[:] = 0.0
+    d[:] = 0.0
     p[a] = coords[j, 0] * size_row[a]
     p[b] = coords[j, 1] * size_row[b]
     d[a] = coords[k, 0] * size_row[a] - p[a]
     d[b] = coords[k, 1] * size_row[b] - p[b]
     length = np.sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2])
     if length > 0.0:
-        d = d / length
-    return p, d, length
+        for c in range(3):
+            d[c] = d[c] / length
+    return length
 
 
 @njit(cache=True, nogil=True)
@@ -99,17 +119,18 @@ def _put(out, m, i, o, x, y, z, s, code):
 
 
 @njit(cache=True, nogil=True)
-def _sizes(sx, sy):
-    s = np.zeros(3)
+def _sized(s, sx, sy):
+    """The size (sx, sy, 0) written into ``s`` (3,)."""
     s[0] = sx
     s[1] = sy
+    s[2] = 0.0
     return s
 
 
 @njit(cache=True, nogil=True)
 def _cap_size(size_row, a, b):
     """Size of a top or bottom face: the polygon's two in-plane extents."""
-    return _sizes(size_row[a], size_row[b])
+    return _sized(np.empty(3), size_row[a], size_row[b])
 
 
 @njit(cache=True, nogil=True)
@@ -158,6 +179,8 @@ def components(kind, coords, ring_offsets, shape_offsets, plane, size, tol):
     csize = np.zeros((total, 3))
     poly = np.zeros(total, np.int8)
     out = (parent, origin, axes, csize, poly)
+    # one edge's start, direction, outward normal, size and lifted start, used again edge after edge
+    p, d, outward, s, lifted = np.zeros(3), np.zeros(3), np.zeros(3), np.zeros(3), np.zeros(3)
     m = 0
     for i in range(n):
         a, b, nrm = _axes_of(plane[i])
@@ -183,39 +206,42 @@ def components(kind, coords, ring_offsets, shape_offsets, plane, size, tol):
             r0 = ring_offsets[ring]
             count = ring_offsets[ring + 1] - r0
             for j in range(r0, r0 + count):
-                p, d, length = _edge(coords, j, r0, count, a, b, size[i])
+                length = _edge_into(coords, j, r0, count, a, b, size[i], p, d)
                 if length <= tol:
                     continue
-                outward = _cross(d, nvec)
+                _cross_into(d, nvec, outward)
                 if volume and (kind == 0 or kind == 1):
-                    m = _put(out, m, i, p, d, nvec, outward, _sizes(length, h), RECT)
+                    m = _put(out, m, i, p, d, nvec, outward, _sized(s, length, h), RECT)
                 if kind == 4 or (kind == 7 and volume):
-                    m = _put(out, m, i, p, d, nvec, outward, _sizes(length, 0.0), RECT)
+                    m = _put(out, m, i, p, d, nvec, outward, _sized(s, length, 0.0), RECT)
                 if kind == 8:
-                    m = _put(out, m, i, p, d, nvec, outward, _sizes(0.0, 0.0), RECT)
+                    m = _put(out, m, i, p, d, nvec, outward, _sized(s, 0.0, 0.0), RECT)
         if volume and (kind == 4 or kind == 6 or kind == 8):
             # the top ring: ring edges (or vertices) lifted by the extrusion height
             for ring in range(shape_offsets[i], shape_offsets[i + 1]):
                 r0 = ring_offsets[ring]
                 count = ring_offsets[ring + 1] - r0
                 for j in range(r0, r0 + count):
-                    p, d, length = _edge(coords, j, r0, count, a, b, size[i])
+                    length = _edge_into(coords, j, r0, count, a, b, size[i], p, d)
                     if length <= tol:
                         continue
                     edge_length = length if kind != 8 else 0.0
-                    m = _put(out, m, i, p + nvec * h, d, nvec, _cross(d, nvec), _sizes(edge_length, 0.0),
-                             RECT)
+                    for c in range(3):
+                        lifted[c] = p[c] + nvec[c] * h
+                    _cross_into(d, nvec, outward)
+                    m = _put(out, m, i, lifted, d, nvec, outward, _sized(s, edge_length, 0.0), RECT)
         if volume and (kind == 4 or kind == 5):
             # side edges: x up the extrusion, z between the normals of the two side faces that meet there
             for ring in range(shape_offsets[i], shape_offsets[i + 1]):
                 r0 = ring_offsets[ring]
                 count = ring_offsets[ring + 1] - r0
                 for j in range(r0, r0 + count):
-                    p, d, length = _edge(coords, j, r0, count, a, b, size[i])
+                    length = _edge_into(coords, j, r0, count, a, b, size[i], p, d)
                     if length <= tol:
                         continue
                     z = _side_edge_normal(coords, j, r0, count, a, b, size[i], d, nvec, tol)
-                    m = _put(out, m, i, p, nvec, _cross(z, nvec), z, _sizes(h, 0.0), RECT)
+                    _cross_into(z, nvec, outward)
+                    m = _put(out, m, i, p, nvec, outward, z, _sized(s, h, 0.0), RECT)
         if volume and (kind == 0 or kind == 2):
             # top: z = n, x = a, y = z cross x
             y = _cross(nvec, avec)
