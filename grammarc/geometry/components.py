@@ -274,8 +274,28 @@ def rect_rings(plane: np.ndarray, corner: np.ndarray | None = None) -> np.ndarra
 def rect_corners(first: np.ndarray, plane: np.ndarray) -> np.ndarray:
     """The corners (n,) int64 of the implicit rectangles of planes ``plane`` (n,) nearest the points
     ``first`` (n, 2) (normalized coordinates): where a rectangle's ring whose first vertex that is starts."""
-    rings = RECT_RINGS[np.asarray(plane, dtype=np.int64)]  # (n, 4, 2)
-    return np.argmin(((rings - np.asarray(first)[:, None, :]) ** 2).sum(axis=2), axis=1)
+    return _nearest_corners(RECT_RINGS, np.asarray(plane, dtype=np.int64),
+                            np.ascontiguousarray(first, dtype=np.float64))
+
+
+@njit(cache=True, nogil=True)
+def _nearest_corners(rings, plane, first):
+    """``rect_corners`` in one pass: the first corner at the least squared distance (a NaN one first, as
+    ``np.argmin`` takes it)."""
+    out = np.zeros(len(plane), np.int64)
+    for i in range(len(plane)):
+        best = np.inf
+        for c in range(4):
+            dx = rings[plane[i], c, 0] - first[i, 0]
+            dy = rings[plane[i], c, 1] - first[i, 1]
+            d = dx * dx + dy * dy
+            if np.isnan(d):
+                out[i] = c
+                break
+            if d < best or c == 0:
+                best = d
+                out[i] = c
+    return out
 
 
 def rect_plane(size: np.ndarray, tol: float) -> np.ndarray:

@@ -395,3 +395,12 @@ def test_a_rectangle_ring_starts_at_its_corner():
             ring = rect_rings(np.array([plane]), np.array([corner]))
             assert rect_corners(ring[:1], np.array([plane])).tolist() == [corner]
             np.testing.assert_array_equal(ring, np.roll(RECT_RINGS[plane], -corner, axis=0))
+
+
+def test_rect_corners_are_the_nearest_as_argmin_takes_them():
+    rng = np.random.default_rng(4)
+    plane = rng.integers(0, 3, 5000)
+    first = rng.choice([0.0, 1.0, 0.5, -0.0, 1 - 1e-16, np.nan, np.inf], (5000, 2))  # ties, NaN, inf
+    first[:2500] = rng.random((2500, 2))
+    nearest = np.argmin(((RECT_RINGS[plane] - first[:, None, :]) ** 2).sum(axis=2), axis=1)
+    np.testing.assert_array_equal(rect_corners(first, plane), nearest)
