@@ -128,12 +128,6 @@ def _sized(s, sx, sy):
 
 
 @njit(cache=True, nogil=True)
-def _cap_size(size_row, a, b):
-    """Size of a top or bottom face: the polygon's two in-plane extents."""
-    return _sized(np.empty(3), size_row[a], size_row[b])
-
-
-@njit(cache=True, nogil=True)
 def _count(kind, n_edges, volume):
     if volume:
         if kind == 0:
@@ -179,19 +173,23 @@ def components(kind, coords, ring_offsets, shape_offsets, plane, size, tol):
     csize = np.zeros((total, 3))
     poly = np.zeros(total, np.int8)
     out = (parent, origin, axes, csize, poly)
-    # one edge's start, direction, outward normal, size and lifted start, used again edge after edge
+    # one edge's start, direction, outward normal, size and lifted start, and one shape's axes (its
+    # normal, then negated, and its in-plane axes), a cap's y and origin: used again, nothing allocated
     p, d, outward, s, lifted = np.zeros(3), np.zeros(3), np.zeros(3), np.zeros(3), np.zeros(3)
+    nvec, negn, avec, bvec, y, o = np.zeros(3), np.zeros(3), np.zeros(3), np.zeros(3), np.zeros(3), np.zeros(3)
     m = 0
     for i in range(n):
         a, b, nrm = _axes_of(plane[i])
         h = size[i, nrm]
         volume = h > tol
-        nvec = np.zeros(3)
+        nvec[:] = 0.0
         nvec[nrm] = 1.0
-        avec = np.zeros(3)
+        avec[:] = 0.0
         avec[a] = 1.0
-        bvec = np.zeros(3)
+        bvec[:] = 0.0
         bvec[b] = 1.0
+        for c in range(3):
+            negn[c] = -nvec[c]
         first = m
         if kind == 0 and not volume:
             # a flat shape's only face is itself
@@ -199,9 +197,10 @@ def components(kind, coords, ring_offsets, shape_offsets, plane, size, tol):
             m = _put(out, m, i, np.zeros(3), e[0], e[1], e[2], size[i], SAME_POLY)
         if volume and (kind == 0 or kind == 3):
             # bottom: z = -n, x = a, y = z cross x; origin keeps the polygon in the positive quadrant
-            y = _cross(-nvec, avec)
-            o = bvec * size[i, b] if y[b] < 0 else np.zeros(3)
-            m = _put(out, m, i, o, avec, y, -nvec, _cap_size(size[i], a, b), BOTTOM_POLY)
+            _cross_into(negn, avec, y)
+            for c in range(3):
+                o[c] = bvec[c] * size[i, b] if y[b] < 0 else 0.0
+            m = _put(out, m, i, o, avec, y, negn, _sized(s, size[i, a], size[i, b]), BOTTOM_POLY)
         for ring in range(shape_offsets[i], shape_offsets[i + 1]):
             r0 = ring_offsets[ring]
             count = ring_offsets[ring + 1] - r0
@@ -244,9 +243,10 @@ def components(kind, coords, ring_offsets, shape_offsets, plane, size, tol):
                     m = _put(out, m, i, p, nvec, outward, z, _sized(s, h, 0.0), RECT)
         if volume and (kind == 0 or kind == 2):
             # top: z = n, x = a, y = z cross x
-            y = _cross(nvec, avec)
-            o = nvec * h + (bvec * size[i, b] if y[b] < 0 else np.zeros(3))
-            m = _put(out, m, i, o, avec, y, nvec, _cap_size(size[i], a, b), TOP_POLY)
+            _cross_into(nvec, avec, y)
+            for c in range(3):
+                o[c] = nvec[c] * h + (bvec[c] * size[i, b] if y[b] < 0 else 0.0)
+            m = _put(out, m, i, o, avec, y, nvec, _sized(s, size[i, a], size[i, b]), TOP_POLY)
         for c in range(first, m):
             index[c] = c - first
     return parent[:m], index[:m], origin[:m], axes[:m], csize[:m], poly[:m]
