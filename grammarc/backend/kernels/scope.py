@@ -110,10 +110,10 @@ def leaf_xforms(origin, base, size, frame, frames, axis, rows, parent, pos, leng
 @njit(cache=True, nogil=True)
 def component_frames(frames, frame, origin, local_origin, local_axes, tol):
     """World scopes of components: ``origin + local_origin @ frames[frame]`` (m, 3) and
-    ``local_axes @ frames[frame]`` (m, 3, 3), summed from 0.0 in axis order as ``np.einsum`` sums them
-    (the same bits), and whether each component's local axes are not orthonormal within ``tol`` (m,)
-    bool (a scope of sizes no float can square). ``frame`` (m,) int32 the parents' frame ids, ``origin``
-    (m, 3) their origins, ``local_origin`` and ``local_axes`` in the parents' frames."""
+    ``local_axes @ frames[frame]`` (m, 3, 3) (``_times_frame``: einsum's bits), and whether each
+    component's local axes are not orthonormal within ``tol`` (m,) bool (a scope of sizes no float can
+    square). ``frame`` (m,) int32 the parents' frame ids, ``origin`` (m, 3) their origins,
+    ``local_origin`` and ``local_axes`` in the parents' frames."""
     m = len(frame)
     out_origin = np.empty((m, 3))
     out_axes = np.empty((m, 3, 3))
@@ -125,11 +125,7 @@ def component_frames(frames, frame, origin, local_origin, local_axes, tol):
             for i in range(3):
                 moved += local_origin[c, i] * frames[f, i, j]
             out_origin[c, j] = origin[c, j] + moved
-            for r in range(3):
-                turned = 0.0
-                for i in range(3):
-                    turned += local_axes[c, r, i] * frames[f, i, j]
-                out_axes[c, r, j] = turned
+        _times_frame(local_axes, c, frames, f, out_axes)
         for r in range(3):
             for k in range(3):
                 dot = 0.0
@@ -138,3 +134,25 @@ def component_frames(frames, frame, origin, local_origin, local_axes, tol):
                 if not abs(dot - (1.0 if r == k else 0.0)) < tol:
                     bad[c] = True
     return out_origin, out_axes, bad
+
+
+@njit(cache=True, nogil=True)
+def turned_frames(local_axes, frames, frame):
+    """``local_axes @ frames[frame]`` (m, 3, 3): axes given in their shapes' frames (``frame`` (m,) int32
+    ids into the table ``frames``), in the world (``_times_frame``: einsum's bits)."""
+    out = np.empty((len(frame), 3, 3))
+    for c in range(len(frame)):
+        _times_frame(local_axes, c, frames, frame[c], out)
+    return out
+
+
+@njit(cache=True, nogil=True)
+def _times_frame(local_axes, c, frames, f, out):
+    """Row c of ``out`` = ``local_axes[c] @ frames[f]``, each sum from 0.0 in axis order, as
+    ``np.einsum("nij,njk->nik")`` sums (the same bits, signed zeros too)."""
+    for r in range(3):
+        for j in range(3):
+            turned = 0.0
+            for i in range(3):
+                turned += local_axes[c, r, i] * frames[f, i, j]
+            out[c, r, j] = turned
