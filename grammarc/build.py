@@ -59,9 +59,6 @@ ONE_CHUNK = 64
 #: (``workers.worker_pool``): while it derives, the other cores wait, so it holds few lots (enough to load
 #: the kernels and to count the records a lot makes).
 FIRST_CHUNK = 16
-#: The fewest lots a chunk holds while the last ones are shared out (``_chunk_size``): a chunk costs a
-#: fixed ~0.04 s of Python besides its lots (candler: ~0.01 s a lot).
-LAST_CHUNKS = 8
 
 
 @dataclass(frozen=True)
@@ -284,8 +281,9 @@ def derive_all(plan, lots: Lots, options: BuildOptions, writer, failed: list[Bad
     waits in the pool's queue, so a worker that finishes starts on it while the parent writes the chunk it
     returned, rather than wait. Results are written in chunk order, and a chunk's size is decided from the chunks finished before it in that
     order, so the chunking does not depend on timing (and the records never depend on the chunking). The
-    first chunk is small (``FIRST_CHUNK``: the other cores wait for it), and the last ones shrink, each a share
-    of the lots left (``_chunk_size``), so that no worker derives a long last chunk while the others wait.
+    first chunk is small (``FIRST_CHUNK``: the other cores wait for it), and the lots left once they are no
+    more than a chunk for each worker are shared equally among the workers (``_last_share``), so that no
+    worker derives a long last chunk while the others wait.
     """
     if plan.inter and foreign is None:
         foreign = occluders(plan, lots if context is None else context, options)
@@ -318,6 +316,7 @@ def _derive_chunks(plan, lots: Lots, options: BuildOptions, writer, failed: list
     first = 0
     rows = 0
     written = 0
+    last = None  # the lots of each of the last chunks, once they are shared out
     # lots that make one chunk are derived in this process: forked workers would only wait for it
     workers = options.workers if len(lots) > min(options.chunk_size, ONE_CHUNK) else 1
     size = min(options.chunk_size, FIRST_CHUNK if workers > 1 else ONE_CHUNK)
@@ -326,7 +325,8 @@ def _derive_chunks(plan, lots: Lots, options: BuildOptions, writer, failed: list
         try:
             while first < len(lots) or window:
                 while first < len(lots) and len(window) <= workers:
-                    part = lots.take(slice(first, first + _chunk_size(size, len(lots) - first, workers)))
+                    last = last or _last_share(size, len(lots) - first, workers)
+                    part = lots.take(slice(first, first + (last or size)))
                     window.append((len(part), submit(part)))
                     first += len(part)
                 n_lots, future = window.popleft()
@@ -349,11 +349,12 @@ def _derive_chunks(plan, lots: Lots, options: BuildOptions, writer, failed: list
     return derived
 
 
-def _chunk_size(size: int, left: int, workers: int) -> int:
-    """The lots of the next chunk: ``size``, or, as the build ends, a share of the ``left`` lots for each
-    of the ``workers`` (at least ``LAST_CHUNKS``), so that they finish together rather than one deriving a
-    long last chunk alone (guided self-scheduling)."""
-    return size if workers == 1 else min(size, max(LAST_CHUNKS, -(-left // workers)))
+def _last_share(size: int, left: int, workers: int) -> int | None:
+    """The lots of each of the last chunks where the ``left`` lots are no more than a chunk of ``size`` for
+    each of the ``workers``: an equal share for each (None before then, and with one worker). Shared once,
+    not halved again and again: a chunk costs a fixed time besides its lots (much of it on a grammar of
+    many rules, examples/pompeii), and one more for each worker is what evens their ends."""
+    return -(-left // workers) if workers > 1 and left <= workers * size else None
 
 
 def _derive(plan, lots: Lots, options: BuildOptions, foreign=None) -> tuple[list, list[BadLot]]:

@@ -148,24 +148,30 @@ def test_only_builds_of_more_than_one_chunk_fork_workers(monkeypatch, write, lot
 
 
 def test_the_last_chunks_are_shared_out_among_the_workers():
-    from grammarc.build import LAST_CHUNKS, _chunk_size
+    from grammarc.build import _last_share
 
-    assert _chunk_size(107, 1000, 2) == 107  # far from the end: the size the records per lot give
-    assert _chunk_size(107, 131, 2) == 66  # near it: a share of what is left for each worker
-    assert _chunk_size(107, 10, 2) == LAST_CHUNKS  # never a chunk of a lot or two
-    assert _chunk_size(2, 10, 2) == 2  # nor more than the size asked for (--chunk-size)
-    assert _chunk_size(107, 131, 1) == 107  # one process: nothing to share
+    assert _last_share(107, 1000, 2) is None  # far from the end: chunks of the size records per lot give
+    assert _last_share(107, 131, 2) == 66  # near it: an equal share for each worker
+    assert _last_share(2, 3, 2) == 2  # never more than the size asked for (--chunk-size)
+    assert _last_share(107, 131, 1) is None  # one process: nothing to share
 
 
 def test_chunks_of_a_build_with_workers_start_small_and_end_shared(monkeypatch, write):
+    import contextlib
+
     from grammarc import build
 
-    asked = []
-    real = build._chunk_size
-    monkeypatch.setattr(build, "_chunk_size", lambda size, left, workers: (
-        asked.append(min(real(size, left, workers), left)), asked[-1])[1])
+    sizes = []
+    real = build.worker_pool
+
+    @contextlib.contextmanager
+    def pool(work, workers):
+        with real(work, workers) as submit:
+            yield lambda lots: (sizes.append(len(lots)), submit(lots))[1]
+
+    monkeypatch.setattr(build, "worker_pool", pool)
     grammar = compile_grammar(write("g.cga", "Lot --> extrude(3)\n"))
     square = [[np.array([[0, 0], [10, 0], [10, 10], [0, 10]], float)]]
     derive(grammar, lots_from_polygons(square * 100), BuildOptions(workers=2))
-    # 16 here, two more of 16 queued before the first records come back; then at most half of what is left
-    assert asked == [16, 16, 16, 26, 13, 8, 5]
+    # 16 here, two more of 16 queued before the first records come back; then the 52 left, one half each
+    assert sizes == [16, 16, 16, 26, 26]
