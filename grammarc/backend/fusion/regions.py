@@ -21,7 +21,9 @@ of its own region. The whole grammar is left to the interpreter where records ca
 asset and a transform (colours, texture channels or coordinates, trims), where shapes carry per-shape
 state (``set``, ``split.index``, a pivot), where an insert occludes, in a search that sums a design's leaves
 (``backend.aggregates``), and in CityEngine's dialect (a body's end is a leaf, and shapes draw from PRT's
-sequential stream, which successors move on in place).
+sequential stream, which successors move on in place). ``grammar_refusals`` says which of these keep a
+grammar out, ``Fusible.refusal`` the first construct that keeps a symbol out and where it is: what
+``grammarc check --fusion`` prints.
 ``GRAMMARC_FUSION=off`` turns fusion off; ``GRAMMARC_FUSION=always`` compiles a kernel for any batch, however
 small (``COMPILE_AT``).
 """
