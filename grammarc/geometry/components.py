@@ -267,8 +267,19 @@ def rect_rings(plane: np.ndarray, corner: np.ndarray | None = None) -> np.ndarra
     starting at its ``corner`` (n,) (an index into its ``RECT_RINGS``; None: all at corner 0)."""
     if corner is None:
         return RECT_RINGS[plane].reshape(-1, 2)
-    turn = (np.arange(4)[None, :] + np.asarray(corner, dtype=np.int64)[:, None]) % 4
-    return RECT_RINGS[np.asarray(plane, dtype=np.int64)[:, None], turn].reshape(-1, 2)
+    return _turned_rings(RECT_RINGS, np.asarray(plane, dtype=np.int64), np.asarray(corner, dtype=np.int64))
+
+
+@njit(cache=True, nogil=True)
+def _turned_rings(rings, plane, corner):
+    """``rect_rings`` with corners: ring i is ``rings[plane[i]]`` from its corner ``corner[i]`` (mod 4)."""
+    out = np.empty((4 * len(plane), 2))
+    for i in range(len(plane)):
+        for k in range(4):
+            c = (k + corner[i]) % 4
+            out[4 * i + k, 0] = rings[plane[i], c, 0]
+            out[4 * i + k, 1] = rings[plane[i], c, 1]
+    return out
 
 
 def rect_corners(first: np.ndarray, plane: np.ndarray) -> np.ndarray:
