@@ -154,8 +154,21 @@ def _corner_cells(parent: np.ndarray, *points: np.ndarray) -> tuple[list[np.ndar
     matching in its chunk (a grid of its coordinates' magnitude, 0.8 m at 7.8e6, made the corners of
     complexpatterns' 0.6 m deep top floors one corner)."""
     low, high = group_bounds(np.tile(parent, len(points)), int(parent.max()) + 1, np.concatenate(points))
-    scale = (np.maximum((high - low).max(axis=1), 1.0) * 1e-7)[parent][:, None]
-    return [np.round((p - low[parent]) / scale).astype(np.int64) for p in points], scale
+    scale = np.maximum((high - low).max(axis=1), 1.0) * 1e-7
+    return [_cells(parent, low, scale, np.ascontiguousarray(p, dtype=np.float64)) for p in points], scale[parent][:, None]
+
+
+@njit(cache=True, nogil=True)
+def _cells(parent, low, scale, points):
+    """``round((points - low[parent]) / scale[parent])`` as int64 in one pass, as numpy rounds (half to
+    even) and casts (a value beyond int64, or not finite, is int64's least, as numpy's cast gives it here)."""
+    out = np.empty(points.shape, np.int64)
+    for k in range(len(parent)):
+        g = parent[k]
+        for j in range(points.shape[1]):
+            cell = np.rint((points[k, j] - low[g, j]) / scale[g])
+            out[k, j] = np.int64(cell) if abs(cell) < 9.2e18 else np.iinfo(np.int64).min
+    return out
 
 
 @njit(cache=True, nogil=True)
