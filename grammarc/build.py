@@ -52,6 +52,13 @@ CHUNK_BUDGET = 20_000_000
 #: many rules (examples/pompeii) wants large chunks; one of a few rules (the facade benchmark) is as fast
 #: with small ones (README, "Figures").
 ROWS_PER_CHUNK = 600_000
+#: A build of at most this many lots is one chunk, derived in this process: forked workers would only wait
+#: for it.
+ONE_CHUNK = 64
+#: Lots of the first chunk of a build with workers, derived in this process before they are forked
+#: (``workers.worker_pool``): while it derives, the other cores wait, so it holds few lots (enough to load
+#: the kernels and to count the records a lot makes).
+FIRST_CHUNK = 16
 
 
 @dataclass(frozen=True)
@@ -273,7 +280,10 @@ def derive_all(plan, lots: Lots, options: BuildOptions, writer, failed: list[Bad
     ``options.workers`` chunks are derived at once, each in a worker process (``workers.py``), and one more
     waits in the pool's queue, so a worker that finishes starts on it while the parent writes the chunk it
     returned, rather than wait. Results are written in chunk order, and a chunk's size is decided from the chunks finished before it in that
-    order, so the chunking does not depend on timing (and the records never depend on the chunking).
+    order, so the chunking does not depend on timing (and the records never depend on the chunking). The
+    first chunk is small (``FIRST_CHUNK``: the other cores wait for it), and the lots left once they are no
+    more than a chunk for each worker are shared equally among the workers (``_last_share``), so that no
+    worker derives a long last chunk while the others wait.
     """
     if plan.inter and foreign is None:
         foreign = occluders(plan, lots if context is None else context, options)
@@ -304,17 +314,19 @@ def _derive_chunks(plan, lots: Lots, options: BuildOptions, writer, failed: list
     """``derive_all`` once the occluders are known."""
     derived = 0
     first = 0
-    size = min(options.chunk_size, 64)
     rows = 0
     written = 0
+    last = None  # the lots of each of the last chunks, once they are shared out
     # lots that make one chunk are derived in this process: forked workers would only wait for it
-    workers = options.workers if len(lots) > size else 1
+    workers = options.workers if len(lots) > min(options.chunk_size, ONE_CHUNK) else 1
+    size = min(options.chunk_size, FIRST_CHUNK if workers > 1 else ONE_CHUNK)
     with worker_pool(functools.partial(_derive, plan, options=options, foreign=foreign), workers) as submit:
         window: deque = deque()
         try:
             while first < len(lots) or window:
                 while first < len(lots) and len(window) <= workers:
-                    part = lots.take(slice(first, first + size))
+                    last = last or _last_share(size, len(lots) - first, workers)
+                    part = lots.take(slice(first, first + (last or size)))
                     window.append((len(part), submit(part)))
                     first += len(part)
                 n_lots, future = window.popleft()
@@ -335,6 +347,14 @@ def _derive_chunks(plan, lots: Lots, options: BuildOptions, writer, failed: list
                 future.cancel()
             raise
     return derived
+
+
+def _last_share(size: int, left: int, workers: int) -> int | None:
+    """The lots of each of the last chunks where the ``left`` lots are no more than a chunk of ``size`` for
+    each of the ``workers``: an equal share for each (None before then, and with one worker). Shared once,
+    not halved again and again: a chunk costs a fixed time besides its lots (much of it on a grammar of
+    many rules, examples/pompeii), and one more for each worker is what evens their ends."""
+    return -(-left // workers) if workers > 1 and left <= workers * size else None
 
 
 def _derive(plan, lots: Lots, options: BuildOptions, foreign=None) -> tuple[list, list[BadLot]]:

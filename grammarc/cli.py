@@ -201,6 +201,9 @@ def _parser() -> argparse.ArgumentParser:
     check.add_argument("--start", metavar="RULE", help=_START_HELP)
     check.add_argument("--warnings-as-errors", action="store_true", help=_WARNINGS_HELP)
     check.add_argument("--dump-ir", action="store_true", help="print the IR after the passes")
+    check.add_argument("--fusion", action="store_true",
+                       help="say which symbols the fused kernels derive, and why each other one is left to the "
+                            "interpreter")
     _workspace_option(check)
     _package_size_option(check)
     check.add_argument("--dialect", choices=("cga2006", "cityengine"),
@@ -482,7 +485,29 @@ def _check(args) -> int:
     print(f"  recursive: {_listed(sorted(graph.recursive))}")
     print(f"  attrs:     {_listed([a.name for a in grammar.module.attrs])}")
     print(f"  assets:    {_listed(grammar.assets)}")
+    if args.fusion:
+        _fusion_summary(grammar)
     return 0
+
+
+def _fusion_summary(grammar) -> None:
+    """``check --fusion``: what keeps the grammar, and then each symbol, from the fused kernels
+    (``backend.fusion.regions``), and the most frequent reasons among the symbols."""
+    from collections import Counter
+
+    from grammarc.backend.fusion.regions import grammar_refusals, symbol_refusals
+    from grammarc.backend.plan import make_plan
+
+    plan = make_plan(grammar)
+    whole = grammar_refusals(plan)
+    refused = symbol_refusals(plan)
+    fused = [sym.name for sym in plan.symbols if sym.rules and sym.name not in refused]
+    print(f"  fusion:    {'the whole grammar is interpreted: ' + '; '.join(whole) if whole else 'allowed'}")
+    print(f"  fusible:   {_listed(fused)}" + (" (were the grammar's reasons gone)" if whole and fused else ""))
+    for name, why in refused.items():
+        print(f"    {name}: {why}")
+    tally = Counter(f"{why.what}{f' `{why.name}`' if why.name else ''}" for why in refused.values())
+    print("  most frequent: " + (", ".join(f"{what} ({n})" for what, n in tally.most_common(5)) or "-"))
 
 
 def _listed(names, most: int = 40) -> str:

@@ -248,6 +248,17 @@ def test_check_summary_of_a_grammar_of_many_rules_stays_short(write, capsys):
     assert line.endswith("W39 and 5 more") and "W40" not in line
 
 
+def test_check_says_why_symbols_are_not_fused(write, capsys):
+    grammar = write("g.cga", 'version "2022.0"\n@StartRule\nLot --> extrude(3) comp(f){ top: Roof | all: W. }\n'
+                             "Roof --> color(1, 0, 0) R.\n")
+    assert main(["check", "--fusion", str(grammar)]) == 0
+    out = capsys.readouterr().out
+    assert "fusion:    the whole grammar is interpreted: CityEngine's dialect" in out
+    assert "    Lot: an operation no kernel takes: `extrude(3)` at " in out
+    assert "    Roof: an operation no kernel takes: `color(1, 0, 0)` at " in out
+    assert "most frequent: an operation no kernel takes `extrude` (1), an operation no kernel takes `color` (1)" in out
+
+
 def test_check_dump_ir(write, capsys):
     assert main(["check", "--dump-ir", str(write("g.cga", "attr h = 2 * 3\nlot ~> S(1r, h, 1r) x\n"))]) == 0
     assert "lot ~> S(1r, @h, 1r) x" in capsys.readouterr().out

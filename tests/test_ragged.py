@@ -7,6 +7,7 @@ import pytest
 
 from grammarc.ragged import (
     fan_out,
+    group_bounds,
     next_in_segment,
     offsets_from_counts,
     ragged_take,
@@ -129,3 +130,23 @@ def test_row_groups_number_equal_rows_as_unique_does():
 def test_next_in_segment_wraps_each_ring():
     assert next_in_segment(np.array([0, 3, 5, 6])).tolist() == [1, 2, 0, 4, 3, 5]
     assert next_in_segment(np.array([0])).tolist() == []
+
+
+@pytest.mark.parametrize("n", [0, 1, 7, 200])
+def test_group_bounds_are_what_minimum_at_and_maximum_at_give(n):
+    rng = np.random.default_rng(n)
+    groups = 9
+    group = rng.integers(0, groups, n)
+    values = rng.normal(size=(n, 3))
+    values[rng.random((n, 3)) < 0.05] = np.nan  # a NaN wins, as in np.minimum
+    low, high = group_bounds(group, groups, values)
+    want_low, want_high = np.full((groups, 3), np.inf), np.full((groups, 3), -np.inf)
+    np.minimum.at(want_low, group, values)
+    np.maximum.at(want_high, group, values)
+    np.testing.assert_array_equal(low, want_low)
+    np.testing.assert_array_equal(high, want_high)
+
+
+def test_group_bounds_docstring_example():
+    low, high = group_bounds(np.array([1, 0, 1]), 2, np.array([[2.0], [5.0], [-1.0]]))
+    assert low.tolist() == [[5.0], [-1.0]] and high.tolist() == [[5.0], [2.0]]

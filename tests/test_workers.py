@@ -145,3 +145,33 @@ def test_only_builds_of_more_than_one_chunk_fork_workers(monkeypatch, write, lot
     square = [[np.array([[0, 0], [10, 0], [10, 10], [0, 10]], float)]]
     derive(grammar, lots_from_polygons(square * lots), BuildOptions(workers=2, chunk_size=chunk_size))
     assert asked == [2 if forked else 1]
+
+
+def test_the_last_chunks_are_shared_out_among_the_workers():
+    from grammarc.build import _last_share
+
+    assert _last_share(107, 1000, 2) is None  # far from the end: chunks of the size records per lot give
+    assert _last_share(107, 131, 2) == 66  # near it: an equal share for each worker
+    assert _last_share(2, 3, 2) == 2  # never more than the size asked for (--chunk-size)
+    assert _last_share(107, 131, 1) is None  # one process: nothing to share
+
+
+def test_chunks_of_a_build_with_workers_start_small_and_end_shared(monkeypatch, write):
+    import contextlib
+
+    from grammarc import build
+
+    sizes = []
+    real = build.worker_pool
+
+    @contextlib.contextmanager
+    def pool(work, workers):
+        with real(work, workers) as submit:
+            yield lambda lots: (sizes.append(len(lots)), submit(lots))[1]
+
+    monkeypatch.setattr(build, "worker_pool", pool)
+    grammar = compile_grammar(write("g.cga", "Lot --> extrude(3)\n"))
+    square = [[np.array([[0, 0], [10, 0], [10, 10], [0, 10]], float)]]
+    derive(grammar, lots_from_polygons(square * 100), BuildOptions(workers=2))
+    # 16 here, two more of 16 queued before the first records come back; then the 52 left, one half each
+    assert sizes == [16, 16, 16, 26, 26]

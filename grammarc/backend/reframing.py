@@ -13,6 +13,7 @@ import numpy as np
 from grammarc.backend import mesh_shapes
 from grammarc.backend.box_rings import corners, with_corners
 from grammarc.backend.context import Context
+from grammarc.backend.kernels.scope import turned_frames
 from grammarc.backend.outlines import polygons_of
 from grammarc.backend.shapes import Shapes
 from grammarc.geometry.components import rect_corners
@@ -29,7 +30,9 @@ def turned(ctx: Context, shapes: Shapes, turn: np.ndarray, matrices: np.ndarray,
         return shapes
     rows, others = np.flatnonzero(turn), np.flatnonzero(~turn)
     sub = shapes.take(rows)
-    new_axes = np.einsum("nij,njk->nik", matrices[axis[rows]], ctx.chunk.frames[sub.frame])
+    new_axes = turned_frames(matrices[axis[rows]], ctx.chunk.frames.data, sub.frame)
+    if not len(others):  # all turn (a comp(f)'s faces, extruded): nothing to merge them with
+        return reframed(ctx, sub, new_axes, span)
     return Shapes.merge([shapes.take(others), reframed(ctx, sub, new_axes, span)], [others, rows])
 
 

@@ -1,6 +1,6 @@
 """Terminal records: instances mapping an asset's unit box onto a scope, and leaf geometry.
 
-``instance_xform`` builds the (n, 3, 4) record transform (README, "The record"): column j is scope axis j times
+``kernels.scope.xforms`` builds the (n, 3, 4) record transform (README, "The record"): column j is scope axis j times
 scope size j, column 3 the scope origin relative to its lot's origin (``model.records.LotOrigins``: records
 and mesh vertices are float32 relative to it, the derivation is float64 in world). ``emit_leaves`` turns shapes whose symbol has no rule (or to which
 no rule applied) into output, as CityEngine emits leaf geometry:
@@ -26,7 +26,7 @@ from grammarc.backend.context import Context
 from grammarc.backend.kernels.scope import xforms
 from grammarc.backend.materials import material_ids, rgba
 from grammarc.backend.mesh_shapes import mesh_leaves
-from grammarc.backend.shapes import Z_UP, Shapes, asset_of, face_axes
+from grammarc.backend.shapes import Z_UP, Shapes, asset_of
 from grammarc.backend.slots import HORIZONTAL_SLOTS
 from grammarc.backend.texture_space import texture_maps
 from grammarc.constants import TOL
@@ -40,14 +40,6 @@ from grammarc.ragged import next_in_segment, offsets_from_counts, segment_of
 CUBE, QUAD = 0, 1  # asset ids of the leaf built-ins (see ir.passes.assets)
 
 
-def instance_xform(axes: np.ndarray, size: np.ndarray, origin: np.ndarray) -> np.ndarray:
-    """(n, 3, 4) float32 transforms from axes (n, 3, 3) (rows), size (n, 3) and origin (n, 3)."""
-    xform = np.empty((len(size), 3, 4), dtype=np.float32)
-    xform[:, :, :3] = (axes * size[:, :, None]).transpose(0, 2, 1)
-    xform[:, :, 3] = origin
-    return xform
-
-
 def emit_instances(ctx: Context, shapes: Shapes, asset: int, symbol: int, mirrored: int = 0,
                    textured: bool = False) -> None:
     """Instances of ``asset`` on the scopes of ``shapes``; ``mirrored`` bits (1 x, 2 y, 4 z) flip the
@@ -59,7 +51,7 @@ def emit_instances(ctx: Context, shapes: Shapes, asset: int, symbol: int, mirror
         return
     chunk = ctx.chunk
     base = chunk.lot_origin[shapes.lot]
-    xform = xforms(chunk.frames.data, shapes.frame, shapes.size, shapes.origin, base)
+    xform = xforms(chunk.frames.data, shapes.frame, shapes.size, shapes.origin, base, np.full(len(shapes), -1))
     for axis in range(3):
         if mirrored >> axis & 1:
             xform[:, :, 3] += xform[:, :, axis]
@@ -242,11 +234,9 @@ def emit_leaves(ctx: Context, shapes: Shapes, symbol: int) -> None:
     is_quad = box & (zeros == 1)
     quads = shapes.take(is_quad)
     if len(quads):
-        permuted_axes, permuted_size = face_axes(chunk.frames[quads.frame], quads.size,
-                                                 np.argmax(flat[is_quad], axis=1))
-        permuted_size[:, 2] = 0.0
-        _append(ctx, quads, instance_xform(permuted_axes, permuted_size, quads.origin - chunk.lot_origin[quads.lot]),
-                QUAD, symbol)
+        xform = xforms(chunk.frames.data, quads.frame, quads.size, quads.origin, chunk.lot_origin[quads.lot],
+                       np.argmax(flat[is_quad], axis=1))
+        _append(ctx, quads, xform, QUAD, symbol)
     polygons = shapes.take(is_polygon(shapes.geom))
     if len(polygons):
         faces, owner = polygon_meshes(ctx, polygons, symbol)

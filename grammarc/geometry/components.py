@@ -47,24 +47,44 @@ def _axes_of(plane):
 
 @njit(cache=True, nogil=True)
 def _cross(a, b):
-    return np.array([a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]])
+    out = np.empty(3)
+    _cross_into(a, b, out)
+    return out
+
+
+@njit(cache=True, nogil=True)
+def _cross_into(a, b, out):
+    """a cross b, written into ``out`` (3,): the kernel's loops over edges allocate nothing."""
+    out[0] = a[1] * b[2] - a[2] * b[1]
+    out[1] = a[2] * b[0] - a[0] * b[2]
+    out[2] = a[0] * b[1] - a[1] * b[0]
 
 
 @njit(cache=True, nogil=True)
 def _edge(coords, j, r0, count, a, b, size_row):
     """Ring edge from vertex j to its successor in local coordinates: start p (3,), unit direction and
     length (the direction is zero for a zero-length edge)."""
-    k = r0 + (j - r0 + 1) % count
     p = np.zeros(3)
     d = np.zeros(3)
+    length = _edge_into(coords, j, r0, count, a, b, size_row, p, d)
+    return p, d, length
+
+
+@njit(cache=True, nogil=True)
+def _edge_into(coords, j, r0, count, a, b, size_row, p, d):
+    """``_edge`` written into ``p`` and ``d`` (3,); returns the length."""
+    k = r0 + (j - r0 + 1) % count
+    p[:] = 0.0
+    d[:] = 0.0
     p[a] = coords[j, 0] * size_row[a]
     p[b] = coords[j, 1] * size_row[b]
     d[a] = coords[k, 0] * size_row[a] - p[a]
     d[b] = coords[k, 1] * size_row[b] - p[b]
     length = np.sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2])
     if length > 0.0:
-        d = d / length
-    return p, d, length
+        for c in range(3):
+            d[c] = d[c] / length
+    return length
 
 
 @njit(cache=True, nogil=True)
@@ -99,17 +119,12 @@ def _put(out, m, i, o, x, y, z, s, code):
 
 
 @njit(cache=True, nogil=True)
-def _sizes(sx, sy):
-    s = np.zeros(3)
+def _sized(s, sx, sy):
+    """The size (sx, sy, 0) written into ``s`` (3,)."""
     s[0] = sx
     s[1] = sy
+    s[2] = 0.0
     return s
-
-
-@njit(cache=True, nogil=True)
-def _cap_size(size_row, a, b):
-    """Size of a top or bottom face: the polygon's two in-plane extents."""
-    return _sizes(size_row[a], size_row[b])
 
 
 @njit(cache=True, nogil=True)
@@ -158,17 +173,23 @@ def components(kind, coords, ring_offsets, shape_offsets, plane, size, tol):
     csize = np.zeros((total, 3))
     poly = np.zeros(total, np.int8)
     out = (parent, origin, axes, csize, poly)
+    # one edge's start, direction, outward normal, size and lifted start, and one shape's axes (its
+    # normal, then negated, and its in-plane axes), a cap's y and origin: used again, nothing allocated
+    p, d, outward, s, lifted = np.zeros(3), np.zeros(3), np.zeros(3), np.zeros(3), np.zeros(3)
+    nvec, negn, avec, bvec, y, o = np.zeros(3), np.zeros(3), np.zeros(3), np.zeros(3), np.zeros(3), np.zeros(3)
     m = 0
     for i in range(n):
         a, b, nrm = _axes_of(plane[i])
         h = size[i, nrm]
         volume = h > tol
-        nvec = np.zeros(3)
+        nvec[:] = 0.0
         nvec[nrm] = 1.0
-        avec = np.zeros(3)
+        avec[:] = 0.0
         avec[a] = 1.0
-        bvec = np.zeros(3)
+        bvec[:] = 0.0
         bvec[b] = 1.0
+        for c in range(3):
+            negn[c] = -nvec[c]
         first = m
         if kind == 0 and not volume:
             # a flat shape's only face is itself
@@ -176,51 +197,56 @@ def components(kind, coords, ring_offsets, shape_offsets, plane, size, tol):
             m = _put(out, m, i, np.zeros(3), e[0], e[1], e[2], size[i], SAME_POLY)
         if volume and (kind == 0 or kind == 3):
             # bottom: z = -n, x = a, y = z cross x; origin keeps the polygon in the positive quadrant
-            y = _cross(-nvec, avec)
-            o = bvec * size[i, b] if y[b] < 0 else np.zeros(3)
-            m = _put(out, m, i, o, avec, y, -nvec, _cap_size(size[i], a, b), BOTTOM_POLY)
+            _cross_into(negn, avec, y)
+            for c in range(3):
+                o[c] = bvec[c] * size[i, b] if y[b] < 0 else 0.0
+            m = _put(out, m, i, o, avec, y, negn, _sized(s, size[i, a], size[i, b]), BOTTOM_POLY)
         for ring in range(shape_offsets[i], shape_offsets[i + 1]):
             r0 = ring_offsets[ring]
             count = ring_offsets[ring + 1] - r0
             for j in range(r0, r0 + count):
-                p, d, length = _edge(coords, j, r0, count, a, b, size[i])
+                length = _edge_into(coords, j, r0, count, a, b, size[i], p, d)
                 if length <= tol:
                     continue
-                outward = _cross(d, nvec)
+                _cross_into(d, nvec, outward)
                 if volume and (kind == 0 or kind == 1):
-                    m = _put(out, m, i, p, d, nvec, outward, _sizes(length, h), RECT)
+                    m = _put(out, m, i, p, d, nvec, outward, _sized(s, length, h), RECT)
                 if kind == 4 or (kind == 7 and volume):
-                    m = _put(out, m, i, p, d, nvec, outward, _sizes(length, 0.0), RECT)
+                    m = _put(out, m, i, p, d, nvec, outward, _sized(s, length, 0.0), RECT)
                 if kind == 8:
-                    m = _put(out, m, i, p, d, nvec, outward, _sizes(0.0, 0.0), RECT)
+                    m = _put(out, m, i, p, d, nvec, outward, _sized(s, 0.0, 0.0), RECT)
         if volume and (kind == 4 or kind == 6 or kind == 8):
             # the top ring: ring edges (or vertices) lifted by the extrusion height
             for ring in range(shape_offsets[i], shape_offsets[i + 1]):
                 r0 = ring_offsets[ring]
                 count = ring_offsets[ring + 1] - r0
                 for j in range(r0, r0 + count):
-                    p, d, length = _edge(coords, j, r0, count, a, b, size[i])
+                    length = _edge_into(coords, j, r0, count, a, b, size[i], p, d)
                     if length <= tol:
                         continue
                     edge_length = length if kind != 8 else 0.0
-                    m = _put(out, m, i, p + nvec * h, d, nvec, _cross(d, nvec), _sizes(edge_length, 0.0),
-                             RECT)
+                    for c in range(3):
+                        lifted[c] = p[c] + nvec[c] * h
+                    _cross_into(d, nvec, outward)
+                    m = _put(out, m, i, lifted, d, nvec, outward, _sized(s, edge_length, 0.0), RECT)
         if volume and (kind == 4 or kind == 5):
             # side edges: x up the extrusion, z between the normals of the two side faces that meet there
             for ring in range(shape_offsets[i], shape_offsets[i + 1]):
                 r0 = ring_offsets[ring]
                 count = ring_offsets[ring + 1] - r0
                 for j in range(r0, r0 + count):
-                    p, d, length = _edge(coords, j, r0, count, a, b, size[i])
+                    length = _edge_into(coords, j, r0, count, a, b, size[i], p, d)
                     if length <= tol:
                         continue
                     z = _side_edge_normal(coords, j, r0, count, a, b, size[i], d, nvec, tol)
-                    m = _put(out, m, i, p, nvec, _cross(z, nvec), z, _sizes(h, 0.0), RECT)
+                    _cross_into(z, nvec, outward)
+                    m = _put(out, m, i, p, nvec, outward, z, _sized(s, h, 0.0), RECT)
         if volume and (kind == 0 or kind == 2):
             # top: z = n, x = a, y = z cross x
-            y = _cross(nvec, avec)
-            o = nvec * h + (bvec * size[i, b] if y[b] < 0 else np.zeros(3))
-            m = _put(out, m, i, o, avec, y, nvec, _cap_size(size[i], a, b), TOP_POLY)
+            _cross_into(nvec, avec, y)
+            for c in range(3):
+                o[c] = nvec[c] * h + (bvec[c] * size[i, b] if y[b] < 0 else 0.0)
+            m = _put(out, m, i, o, avec, y, nvec, _sized(s, size[i, a], size[i, b]), TOP_POLY)
         for c in range(first, m):
             index[c] = c - first
     return parent[:m], index[:m], origin[:m], axes[:m], csize[:m], poly[:m]
@@ -241,15 +267,46 @@ def rect_rings(plane: np.ndarray, corner: np.ndarray | None = None) -> np.ndarra
     starting at its ``corner`` (n,) (an index into its ``RECT_RINGS``; None: all at corner 0)."""
     if corner is None:
         return RECT_RINGS[plane].reshape(-1, 2)
-    turn = (np.arange(4)[None, :] + np.asarray(corner, dtype=np.int64)[:, None]) % 4
-    return RECT_RINGS[np.asarray(plane, dtype=np.int64)[:, None], turn].reshape(-1, 2)
+    return _turned_rings(RECT_RINGS, np.asarray(plane, dtype=np.int64), np.asarray(corner, dtype=np.int64))
+
+
+@njit(cache=True, nogil=True)
+def _turned_rings(rings, plane, corner):
+    """``rect_rings`` with corners: ring i is ``rings[plane[i]]`` from its corner ``corner[i]`` (mod 4)."""
+    out = np.empty((4 * len(plane), 2))
+    for i in range(len(plane)):
+        for k in range(4):
+            c = (k + corner[i]) % 4
+            out[4 * i + k, 0] = rings[plane[i], c, 0]
+            out[4 * i + k, 1] = rings[plane[i], c, 1]
+    return out
 
 
 def rect_corners(first: np.ndarray, plane: np.ndarray) -> np.ndarray:
     """The corners (n,) int64 of the implicit rectangles of planes ``plane`` (n,) nearest the points
     ``first`` (n, 2) (normalized coordinates): where a rectangle's ring whose first vertex that is starts."""
-    rings = RECT_RINGS[np.asarray(plane, dtype=np.int64)]  # (n, 4, 2)
-    return np.argmin(((rings - np.asarray(first)[:, None, :]) ** 2).sum(axis=2), axis=1)
+    return _nearest_corners(RECT_RINGS, np.asarray(plane, dtype=np.int64),
+                            np.ascontiguousarray(first, dtype=np.float64))
+
+
+@njit(cache=True, nogil=True)
+def _nearest_corners(rings, plane, first):
+    """``rect_corners`` in one pass: the first corner at the least squared distance (a NaN one first, as
+    ``np.argmin`` takes it)."""
+    out = np.zeros(len(plane), np.int64)
+    for i in range(len(plane)):
+        best = np.inf
+        for c in range(4):
+            dx = rings[plane[i], c, 0] - first[i, 0]
+            dy = rings[plane[i], c, 1] - first[i, 1]
+            d = dx * dx + dy * dy
+            if np.isnan(d):
+                out[i] = c
+                break
+            if d < best or c == 0:
+                best = d
+                out[i] = c
+    return out
 
 
 def rect_plane(size: np.ndarray, tol: float) -> np.ndarray:

@@ -19,7 +19,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from grammarc.ragged import rank_within, row_groups
+from grammarc.ragged import group_bounds, rank_within, row_groups
 
 #: A shared edge steeper than this (degrees from the horizontal) makes a vertical trim plane, a shallower
 #: one a horizontal plane.
@@ -38,34 +38,54 @@ def side_face_planes(axes: np.ndarray, origin: np.ndarray, size: np.ndarray, par
     the bottom edge (from its lot's origin, as the planes are then), size (m, 3), parent (m,): faces of
     one parent meet where one's end is the next's start; up (m, 3) the split shape's scope y axis in
     world coordinates."""
-    m = len(parent)
+    if not len(parent):
+        return np.full((0, 8), np.nan)
+    end = origin + size[:, 0:1] * axes[:, 0]
+    (first, last), _ = _corner_cells(parent, origin, end)
+    # the neighbour sharing each face's start / end
+    before, after = _neighbours(np.argsort(parent, kind="stable"), parent, first, last)
+    return _bisector_planes(axes, origin, end, size, up, before, after, np.sin(np.radians(VERTICAL_DEGREES)))
+
+
+@njit(cache=True, nogil=True)
+def _bisector_planes(axes, start, end, size, up, before, after, steepest):
+    """``side_face_planes``' planes, once each face's neighbours ``before`` and ``after`` (m,) are known:
+    where a face and its neighbour are both steep (their y axes at least ``steepest``, the sine, along
+    ``up``; not flat), the plane through the shared corner (``start`` or ``end`` (m, 3)) whose normal
+    bisects their x axes. The sums run in numpy's order (``einsum``'s from 0.0, ``norm``'s in axis
+    order), so the planes have the bits they had when numpy computed them."""
+    m = len(axes)
     out = np.full((m, 8), np.nan)
-    if not m:
-        return out
-    x, y = axes[:, 0], axes[:, 1]
-    steep = (np.abs(np.einsum("ij,ij->i", y, up)) >= np.sin(np.radians(VERTICAL_DEGREES))) & (size[:, 0] > 0) & (size[:, 1] > 0)
-    start = origin
-    end = origin + size[:, 0:1] * x
-    (first, last), _ = _corner_cells(parent, start, end)
-    keys = np.concatenate([np.column_stack([parent, first]), np.column_stack([parent, last])])
-    inverse, _ = row_groups(keys)  # the same corner of the same parent: one id
-    at_start, at_end = inverse[:m], inverse[m:]
-    ending = np.full(int(inverse.max()) + 1, -1)
-    ending[at_end] = np.arange(m)
-    starting = np.full(int(inverse.max()) + 1, -1)
-    starting[at_start] = np.arange(m)
-    before, after = ending[at_start], starting[at_end]  # the neighbour sharing each face's start / end
-    for which, neighbour, corner, sign in ((0, before, start, 1.0), (1, after, end, -1.0)):
-        ok = steep & (neighbour >= 0)
-        ok[ok] &= steep[neighbour[ok]]
-        rows = np.flatnonzero(ok)
-        bisector = x[rows] + x[neighbour[rows]]
-        length = np.linalg.norm(bisector, axis=1)
-        good = length > 1e-9
-        rows, bisector = rows[good], bisector[good] / length[good, None]
-        normal = sign * bisector
-        out[rows, 4 * which: 4 * which + 3] = normal
-        out[rows, 4 * which + 3] = -np.einsum("ij,ij->i", normal, corner[rows])
+    steep = np.empty(m, np.bool_)
+    for i in range(m):
+        dot = 0.0
+        for j in range(3):
+            dot += axes[i, 1, j] * up[i, j]
+        steep[i] = abs(dot) >= steepest and size[i, 0] > 0 and size[i, 1] > 0
+    for i in range(m):
+        if not steep[i]:
+            continue
+        for which in range(2):
+            k = before[i] if which == 0 else after[i]
+            if k < 0 or not steep[k]:
+                continue
+            b0 = axes[i, 0, 0] + axes[k, 0, 0]
+            b1 = axes[i, 0, 1] + axes[k, 0, 1]
+            b2 = axes[i, 0, 2] + axes[k, 0, 2]
+            length = np.sqrt((b0 * b0 + b1 * b1) + b2 * b2)
+            if not length > 1e-9:
+                continue
+            sign = 1.0 if which == 0 else -1.0
+            n0, n1, n2 = sign * (b0 / length), sign * (b1 / length), sign * (b2 / length)
+            corner = start if which == 0 else end
+            d = 0.0
+            d += n0 * corner[i, 0]
+            d += n1 * corner[i, 1]
+            d += n2 * corner[i, 2]
+            out[i, 4 * which] = n0
+            out[i, 4 * which + 1] = n1
+            out[i, 4 * which + 2] = n2
+            out[i, 4 * which + 3] = -d
     return out
 
 
@@ -133,13 +153,49 @@ def _corner_cells(parent: np.ndarray, *points: np.ndarray) -> tuple[list[np.ndar
     (national-grid coordinates) is matched as it would be at the origin and coarsens no other lot's
     matching in its chunk (a grid of its coordinates' magnitude, 0.8 m at 7.8e6, made the corners of
     complexpatterns' 0.6 m deep top floors one corner)."""
-    n = int(parent.max()) + 1
-    low, high = np.full((n, 3), np.inf), np.full((n, 3), -np.inf)
-    for p in points:
-        np.minimum.at(low, parent, p)
-        np.maximum.at(high, parent, p)
-    scale = (np.maximum((high - low).max(axis=1), 1.0) * 1e-7)[parent][:, None]
-    return [np.round((p - low[parent]) / scale).astype(np.int64) for p in points], scale
+    low, high = group_bounds(np.tile(parent, len(points)), int(parent.max()) + 1, np.concatenate(points))
+    scale = np.maximum((high - low).max(axis=1), 1.0) * 1e-7
+    return [_cells(parent, low, scale, np.ascontiguousarray(p, dtype=np.float64)) for p in points], scale[parent][:, None]
+
+
+@njit(cache=True, nogil=True)
+def _cells(parent, low, scale, points):
+    """``round((points - low[parent]) / scale[parent])`` as int64 in one pass, as numpy rounds (half to
+    even) and casts (a value beyond int64, or not finite, is int64's least, as numpy's cast gives it here)."""
+    out = np.empty(points.shape, np.int64)
+    for k in range(len(parent)):
+        g = parent[k]
+        for j in range(points.shape[1]):
+            cell = np.rint((points[k, j] - low[g, j]) / scale[g])
+            out[k, j] = np.int64(cell) if abs(cell) < 9.2e18 else np.iinfo(np.int64).min
+    return out
+
+
+@njit(cache=True, nogil=True)
+def _neighbours(order, parent, first, last):
+    """Each face's neighbour at its start, the face of its parent whose end is in the same grid cell as its
+    start, and at its end, the one whose start is in its end's cell (-1: none; the last face, where
+    several are). ``order`` (m,) lists the faces parent by parent (a stable sort: faces in their order);
+    ``first`` and ``last`` (m, 3) int64 are the cells of their starts and ends (``_corner_cells``). A
+    parent's faces are few (a box's six, a footprint's walls): each is matched against all of them."""
+    m = len(order)
+    before = np.full(m, -1, np.int64)
+    after = np.full(m, -1, np.int64)
+    group = 0
+    while group < m:
+        stop = group
+        while stop < m and parent[order[stop]] == parent[order[group]]:
+            stop += 1
+        for a in range(group, stop):
+            i = order[a]
+            for b in range(group, stop):
+                j = order[b]
+                if last[j, 0] == first[i, 0] and last[j, 1] == first[i, 1] and last[j, 2] == first[i, 2]:
+                    before[i] = j
+                if first[j, 0] == last[i, 0] and first[j, 1] == last[i, 1] and first[j, 2] == last[i, 2]:
+                    after[i] = j
+        group = stop
+    return before, after
 
 
 def plane_coordinates(normal: np.ndarray) -> np.ndarray:

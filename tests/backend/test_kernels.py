@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from grammarc.backend.kernels.order import group_by, place, put, scatter_rows, tally
-from grammarc.backend.kernels.scope import place_children, xforms
+from grammarc.backend.kernels.scope import component_frames, place_children, turned_frames, xforms
 from grammarc.backend.kernels.split import repeat, repeat_counts, subdiv
 from grammarc.backend.random import child_keys
 
@@ -253,14 +253,49 @@ def test_xforms(n):
     size[rng.random((n, 3)) < 0.2] = 0.0
     base = rng.uniform(-1e7, 1e7, (n, 3)).round()  # lots' origins, far from the world's
     origin = base + rng.normal(size=(n, 3)) * 100
-    out = xforms(frames, frame, size, origin, base)
+    flat = np.where(rng.random(n) < 0.5, -1, rng.integers(0, 3, n))
+    out = xforms(frames, frame, size, origin, base, flat)
     assert out.dtype == np.float32 and out.shape == (n, 3, 4)
     want = np.empty((n, 3, 4))
     for i in range(n):
+        k = flat[i]
         for j in range(3):
-            want[i, :, j] = frames[frame[i], j] * size[i, j]  # column j = scope axis j * size j
+            axis = j if k < 0 else (k + 1 + j) % 3  # a face: its two extents, then its normal times 0
+            want[i, :, j] = frames[frame[i], axis] * (size[i, axis] if k < 0 or j < 2 else 0.0)
         want[i, :, 3] = origin[i] - base[i]  # relative to the lot's origin, rounded once
-    assert np.array_equal(out, want.astype(np.float32))
+    assert np.array_equal(out.view(np.int32), want.astype(np.float32).view(np.int32))  # zeros' signs too
+
+
+@pytest.mark.parametrize("n", SIZES)
+def test_component_frames_give_einsums_bits_signed_zeros_included(n):
+    rng = np.random.default_rng(n)
+    frames = random_frames(rng, 6)
+    frames[5] = np.eye(3) * np.array([1.0, -1.0, -1.0])[:, None]  # a turn whose zeros are signed
+    frame = rng.integers(0, 6, n).astype(np.int32)
+    origin = rng.normal(size=(n, 3)) * 100
+    local_origin = np.where(rng.random((n, 3)) < 0.3, -0.0, rng.normal(size=(n, 3)))
+    local_axes = random_frames(rng, n)
+    local_axes[::3] = np.eye(3) * np.array([-1.0, -1.0, 1.0])[:, None]
+    local_axes[1::7] *= 1e155  # its axes' squares overflow: not orthonormal
+    world_origin, world_axes, bad = component_frames(frames, frame, origin, local_origin, local_axes, 1e-6)
+    want_origin = origin + np.einsum("ni,nij->nj", local_origin, frames[frame])
+    want_axes = np.einsum("nij,njk->nik", local_axes, frames[frame])
+    gram = np.einsum("nij,nkj->nik", local_axes, local_axes)
+    assert np.array_equal(world_origin.view(np.int64), want_origin.view(np.int64))
+    assert np.array_equal(world_axes.view(np.int64), want_axes.view(np.int64))
+    assert np.array_equal(bad, ~(np.abs(gram - np.eye(3)) < 1e-6).all(axis=(1, 2)))
+    assert bad[1::7].all()
+
+
+@pytest.mark.parametrize("n", SIZES)
+def test_turned_frames_give_einsums_bits(n):
+    rng = np.random.default_rng(n)
+    frames = random_frames(rng, 4)
+    frames[3] = np.eye(3) * np.array([1.0, -1.0, -1.0])[:, None]  # signed zeros
+    frame = rng.integers(0, 4, n).astype(np.int32)
+    local = np.where(rng.random((n, 3, 3)) < 0.3, -0.0, random_frames(rng, n))
+    want = np.einsum("nij,njk->nik", local, frames[frame])
+    assert np.array_equal(turned_frames(local, frames, frame).view(np.int64), want.view(np.int64))
 
 
 def test_xforms_maps_unit_box_corners_to_scope_corners():
@@ -268,7 +303,7 @@ def test_xforms_maps_unit_box_corners_to_scope_corners():
     frames = random_frames(rng, 1)
     size = np.array([[2.0, 3.0, 4.0]])
     origin = np.array([[1.0, -2.0, 5.0]])
-    x = xforms(frames, np.zeros(1, np.int32), size, origin, np.zeros((1, 3)))[0].astype(np.float64)
+    x = xforms(frames, np.zeros(1, np.int32), size, origin, np.zeros((1, 3)), np.full(1, -1))[0].astype(np.float64)
     for corner in np.ndindex(2, 2, 2):
         c = np.array(corner, float)
         world = x[:, :3] @ c + x[:, 3]

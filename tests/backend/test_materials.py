@@ -72,3 +72,19 @@ def test_a_grammar_without_textures_records_no_materials(write):
     assert plan.material_slots == ()
     chunk, _ = derive_chunk(plan, lots_from_polygons([rect(4, 4)]), **OPTIONS)
     assert chunk.materials is None and chunk.material is None and chunk.mesh.material is None
+
+
+@pytest.mark.parametrize("names", [7, 100_000])  # keys as ids in base 7; rows, past 2^62
+def test_the_table_of_materials_is_that_of_every_row_though_only_runs_are_sorted(names):
+    class Plan:  # what collect_materials reads of a plan
+        strings = type("Strings", (), {"ids": {f"s{k}": k for k in range(names)}})()
+        material_slots = ((0, 10), (1, 11), (2, 12), (3, 13))
+
+    rng = np.random.default_rng(5)
+    runs = rng.integers(0, names, (300, 4)).astype(np.int32)
+    ids = np.repeat(runs, rng.integers(1, 6, len(runs)), axis=0)  # runs of one to five equal rows
+    table, material = materials.collect_materials(Plan, ids)
+    assert len(table) == len(np.unique(ids, axis=0))  # each distinct row once
+    assert table[material, :4].tolist() == [[f"s{i}" for i in row] for row in ids]  # each row its own
+    empty_table, empty = materials.collect_materials(Plan, ids[:0])
+    assert empty_table.shape[0] == 0 and empty.shape == (0,)

@@ -395,3 +395,20 @@ def test_a_rectangle_ring_starts_at_its_corner():
             ring = rect_rings(np.array([plane]), np.array([corner]))
             assert rect_corners(ring[:1], np.array([plane])).tolist() == [corner]
             np.testing.assert_array_equal(ring, np.roll(RECT_RINGS[plane], -corner, axis=0))
+
+
+def test_rect_corners_are_the_nearest_as_argmin_takes_them():
+    rng = np.random.default_rng(4)
+    plane = rng.integers(0, 3, 5000)
+    first = rng.choice([0.0, 1.0, 0.5, -0.0, 1 - 1e-16, np.nan, np.inf], (5000, 2))  # ties, NaN, inf
+    first[:2500] = rng.random((2500, 2))
+    nearest = np.argmin(((RECT_RINGS[plane] - first[:, None, :]) ** 2).sum(axis=2), axis=1)
+    np.testing.assert_array_equal(rect_corners(first, plane), nearest)
+
+
+def test_rect_rings_start_at_their_corners_taken_mod_4():
+    rng = np.random.default_rng(6)
+    plane, corner = rng.integers(0, 3, 500), rng.integers(-9, 9, 500).astype(float)  # as the float columns hold it
+    rings = rect_rings(plane, corner).reshape(-1, 4, 2)
+    for ring, p, c in zip(rings, plane, corner.astype(int)):
+        np.testing.assert_array_equal(ring, np.roll(RECT_RINGS[p], -(c % 4), axis=0))

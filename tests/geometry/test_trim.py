@@ -118,3 +118,37 @@ def test_corners_far_from_the_origin_are_matched_as_at_the_origin():
     np.testing.assert_allclose(there[:, [0, 1, 2, 4, 5, 6]], here[:, [0, 1, 2, 4, 5, 6]], atol=1e-12)
     moved = here[:, [3, 7]] - np.stack([here[:, 0:3] @ far, here[:, 4:7] @ far], axis=1)
     np.testing.assert_allclose(there[:, [3, 7]], moved, atol=1e-6)
+
+
+def test_faces_of_boxes_in_any_order_find_their_neighbours_in_their_own_parent():
+    """Two boxes' side faces interleaved and shuffled (and a third box at the same place, another parent):
+    each face gets the planes it gets with its box alone."""
+    axes, origin, size = box_sides()
+    alone = side_face_planes(axes, origin, size, np.zeros(4, dtype=np.int64), UP)
+    rng = np.random.default_rng(2)
+    parent = np.repeat([0, 1, 2], 4)
+    order = rng.permutation(12)
+    planes = side_face_planes(np.tile(axes, (3, 1, 1))[order], np.tile(origin, (3, 1))[order],
+                              np.tile(size, (3, 1))[order], parent[order], np.tile(UP, (3, 1)))
+    np.testing.assert_array_equal(planes, np.tile(alone, (3, 1))[order])
+
+
+def test_corner_cells_round_and_cast_as_numpy():
+    from grammarc.geometry.trim import _corner_cells
+
+    rng = np.random.default_rng(8)
+    parent = rng.integers(0, 5, 400)
+    start = np.round(rng.normal(size=(400, 3)) * 1e7) / 2  # halves of the grid: rounded to even
+    end = rng.normal(size=(400, 3)) * 1e3
+    end[::37] = np.nan  # a cell of no number: int64's least, as numpy's cast gives it
+    (first, last), scale = _corner_cells(parent, start, end)
+    lows = np.full((5, 3), np.inf)
+    highs = np.full((5, 3), -np.inf)
+    for p in (start, end):
+        np.minimum.at(lows, parent, p)
+        np.maximum.at(highs, parent, p)
+    want_scale = (np.maximum((highs - lows).max(axis=1), 1.0) * 1e-7)[parent][:, None]
+    np.testing.assert_array_equal(scale, want_scale)
+    with np.errstate(invalid="ignore"):
+        for got, p in ((first, start), (last, end)):
+            np.testing.assert_array_equal(got, np.round((p - lows[parent]) / want_scale).astype(np.int64))

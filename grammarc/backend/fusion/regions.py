@@ -21,7 +21,9 @@ of its own region. The whole grammar is left to the interpreter where records ca
 asset and a transform (colours, texture channels or coordinates, trims), where shapes carry per-shape
 state (``set``, ``split.index``, a pivot), where an insert occludes, in a search that sums a design's leaves
 (``backend.aggregates``), and in CityEngine's dialect (a body's end is a leaf, and shapes draw from PRT's
-sequential stream, which successors move on in place).
+sequential stream, which successors move on in place). ``grammar_refusals`` says which of these keep a
+grammar out, ``Fusible.refusal`` the first construct that keeps a symbol out and where it is: what
+``grammarc check --fusion`` prints.
 ``GRAMMARC_FUSION=off`` turns fusion off; ``GRAMMARC_FUSION=always`` compiles a kernel for any batch, however
 small (``COMPILE_AT``).
 """
@@ -30,8 +32,21 @@ from __future__ import annotations
 
 import os
 from collections import Counter
+from dataclasses import dataclass
 
+from grammarc.backend.materials import MAP_FIELDS
+from grammarc.backend.slots import (
+    ANCESTORS,
+    COLOR_SLOT,
+    HORIZONTAL_SLOTS,
+    PIVOT_SLOTS,
+    RING_START,
+    TRIM_SLOTS,
+    uv_slots,
+)
+from grammarc.diagnostics import Span
 from grammarc.ir import nodes as ir
+from grammarc.ir.printer import print_expr, print_op
 from grammarc.ir.traverse import iter_ops
 
 #: The environment switch: ``off`` derives everything with the interpreter.
@@ -64,26 +79,53 @@ def compile_at() -> int | None:
 
 def grammar_allows(plan) -> bool:
     """Whether ``plan``'s grammar may be fused at all (see the module docstring)."""
-    # a search's aggregates count the shapes and leaves each symbol is given (``backend.aggregates``)
-    return not (plan.leaf_bodies or plan.sequential_random or plan.queries or plan.occluders or plan.dynamic
-                or plan.color_slot is not None or plan.material_slots or plan.uv_slots
-                or plan.trim_slot is not None or plan.pivot_slot is not None or plan.grammar.module.objectives)
+    return not grammar_refusals(plan)
+
+
+def grammar_refusals(plan) -> list[str]:
+    """Why ``plan``'s grammar may not be fused at all, one phrase each (none: it may be; the module
+    docstring says why each keeps it out)."""
+    slots = {COLOR_SLOT, *MAP_FIELDS, *TRIM_SLOTS, *HORIZONTAL_SLOTS, *ANCESTORS, *PIVOT_SLOTS, RING_START,
+             *(name for s in plan.uv_slots for name in uv_slots(s))}
+    state = [name for name in plan.dynamic if name not in slots]
+    found = (
+        (plan.leaf_bodies or plan.sequential_random,
+         "CityEngine's dialect (a body's end is a leaf; PRT's sequential random stream)"),
+        (state, f"per-shape state ({', '.join(state)}: `set`, `split.index`, `comp.sel`...)"),
+        (plan.color_slot is not None, "colours (`color`, `set(material.color...)`)"),
+        (plan.material_slots, "texture channels (`texture`, `set(material.*map)`)"),
+        (plan.uv_slots, "texture coordinates (`setupProjection`, `projectUV`...)"),
+        (plan.trim_slot is not None, "trim planes (a `comp(f)` before inserts)"),
+        (plan.pivot_slot is not None, "a pivot (`setPivot`, `scope.t`, `r`...)"),
+        (plan.ring_slot is not None, "box rings' first corners (`rotateScope`, `alignScopeToAxes`)"),
+        (plan.queries or plan.occluders, "occlusion (queries, occluding inserts, labels)"),
+        # a search's aggregates count the shapes and leaves each symbol is given (``backend.aggregates``)
+        (plan.grammar.module.objectives, "a search's objectives"),
+    )
+    return [reason for present, reason in found if present]
 
 
 class Fusible:
-    """The answers of one plan: which symbols' rules may be fused, which may be inlined (memoized)."""
+    """The answers of one plan: which symbols' rules may be fused and why not, which may be inlined
+    (memoized)."""
 
     def __init__(self, plan) -> None:
         self.plan = plan
         self.uses = Counter(op.name for op in iter_ops(plan.grammar.module) if isinstance(op, ir.Symbol))
-        self._fusible: dict[int, bool] = {}
+        self._refusals: dict[int, Refusal | None] = {}
 
     def symbol(self, sym_id: int) -> bool:
         """Whether every rule of symbol ``sym_id`` and every symbol it leads to can be fused."""
-        if sym_id not in self._fusible:
-            self._fusible[sym_id] = False  # a symbol that leads back to itself is not fused
-            self._fusible[sym_id] = self._rules(self.plan.symbols[sym_id])
-        return self._fusible[sym_id]
+        return self.refusal(sym_id) is None
+
+    def refusal(self, sym_id: int) -> Refusal | None:
+        """Why symbol ``sym_id``'s rules, or those of a symbol they lead to, cannot be fused: the first
+        construct no kernel takes, with where it is (None: they can)."""
+        if sym_id not in self._refusals:
+            sym = self.plan.symbols[sym_id]
+            self._refusals[sym_id] = Refusal(f"`{sym.name}` leads back to itself")  # not fused
+            self._refusals[sym_id] = self._rules(sym)
+        return self._refusals[sym_id]
 
     def worth_a_kernel(self, sym_id: int) -> bool:
         """Whether the region of fusible symbol ``sym_id`` splits or repeats: a kernel's compilation pays off
@@ -107,57 +149,110 @@ class Fusible:
         return ((alone or sym_id in plan.leaf_inserts) and name not in plan.grammar.graph.recursive
                 and self.symbol(sym_id))
 
-    def _rules(self, sym) -> bool:
-        if not sym.rules or any(t is not ir.Type.NUM for t in sym.param_types) or sym.id in self.plan.snapping:
-            return False
+    def _rules(self, sym) -> Refusal | None:
+        if not sym.rules:
+            return Refusal(f"`{sym.name}` has no rules")
+        if any(t is not ir.Type.NUM for t in sym.param_types):
+            return Refusal(f"`{sym.name}` has a parameter that is not a number")
+        if sym.id in self.plan.snapping:
+            return Refusal(f"`{sym.name}` snaps")
         for rule in applied_rules(sym):
-            if rule.guard is not None and not self.expr(rule.guard):
-                return False
+            if rule.guard is not None and (why := self.expr(rule.guard)):
+                return why
             alternatives = rule.alternatives
             # a search's consequents are chosen by its states (``backend.choices``)
-            if alternatives[0].choice or (len(alternatives) > 1 and not all(self.expr(a.prob) for a in alternatives)):
-                return False
-            if not all(self.body(a.body) for a in alternatives):
-                return False
-        return applied_rules(sym)[-1].guard is None  # shapes no rule applies to would be leaves
+            if alternatives[0].choice:
+                return Refusal("a search's choice", "", rule.span)
+            if len(alternatives) > 1 and (why := _first(self.expr(a.prob) for a in alternatives)):
+                return why
+            if why := _first(self.body(a.body) for a in alternatives):
+                return why
+        if applied_rules(sym)[-1].guard is not None:
+            return Refusal(f"`{sym.name}`'s shapes that no rule applies to would be leaves")
+        return None
 
-    def body(self, body: ir.Body) -> bool:
-        return all(self.op(op) for op in body)
+    def body(self, body: ir.Body) -> Refusal | None:
+        return _first(self.op(op) for op in body)
 
-    def op(self, op: ir.Op) -> bool:
+    def op(self, op: ir.Op) -> Refusal | None:
         if isinstance(op, ir.Scale):
-            return not op.mirrors and all(self.expr(s.value) for s in op.sizes)
+            return _refused(op, "CityEngine's `s` (a negative size mirrors)") if op.mirrors else _first(self.expr(s.value) for s in op.sizes)
         if isinstance(op, ir.Translate):
-            return all(self.expr(e) for e in op.vector)
-        if isinstance(op, ir.Split):
-            return (len(op.axes) == 1 and not op.snap and all(self.expr(s.value) for s in op.sizes)
-                    and all(self.body(part) for part in op.parts))
-        if isinstance(op, ir.Repeat):
-            return (len(op.axes) == 1 and not op.snap and all(self.expr(e) for e in op.sizes)
-                    and all(self.body(part) for part in op.parts))
+            return _first(self.expr(e) for e in op.vector)
+        if isinstance(op, (ir.Split, ir.Repeat)):
+            if len(op.axes) != 1 or op.snap:
+                return _refused(op, "a split of several axes or one that snaps")
+            sizes = (s.value for s in op.sizes) if isinstance(op, ir.Split) else op.sizes
+            return _first(self.expr(e) for e in sizes) or _first(self.body(part) for part in op.parts)
         if isinstance(op, ir.Symbol):
             if self.plan.makes_leaves(op):  # its leaves are records at once, wherever it is named
-                return not op.args
+                return _refused(op, "a leaf with arguments") if op.args else None
             target = self.plan.symbols[self.plan.symbol_ids[op.name]]
             # derived here, or handed off: its shapes wait for its turn, their parameters numbers
-            return all(self.expr(arg) for arg in op.args) and (
-                self.inlined(op.name) or all(t is ir.Type.NUM for t in target.param_types))
-        return isinstance(op, (ir.Insert, ir.Empty, ir.Push, ir.Pop))
+            if why := _first(self.expr(arg) for arg in op.args):
+                return why
+            if self.inlined(op.name) or all(t is ir.Type.NUM for t in target.param_types):
+                return None
+            return _refused(op, "a successor handed off with a parameter that is not a number")
+        if isinstance(op, (ir.Insert, ir.Empty, ir.Push, ir.Pop)):
+            return None
+        return _refused(op, "an operation no kernel takes")
 
-    def expr(self, expr: ir.Expr) -> bool:
+    def expr(self, expr: ir.Expr) -> Refusal | None:
         if isinstance(expr, (ir.Num, ir.Bool, ir.Param)):  # parameters: numbers (``_rules``)
-            return True
+            return None
         if isinstance(expr, ir.AttrRef):
-            return True  # a column of numbers, which the runner checks (``run.attribute_columns``)
+            return None  # a column of numbers, which the runner checks (``run.attribute_columns``)
         if isinstance(expr, ir.ScopeRef):
-            return expr.field in SIZES
+            return None if expr.field in SIZES else _refused(expr, "a scope field other than a size")
         if isinstance(expr, ir.Unary):
-            return expr.op in ("-", "!") and self.expr(expr.operand)
+            return self.expr(expr.operand) if expr.op in ("-", "!") else _refused(expr, "an operator")
         if isinstance(expr, ir.Binary):
-            return expr.op in ARITHMETIC | COMPARE | LOGIC and self.expr(expr.left) and self.expr(expr.right)
+            if expr.op not in ARITHMETIC | COMPARE | LOGIC:
+                return _refused(expr, "an operator")
+            return self.expr(expr.left) or self.expr(expr.right)
         if isinstance(expr, ir.Call):
-            return expr.func in FUNCTIONS and all(self.expr(arg) for arg in expr.args)
-        return False
+            if expr.func not in FUNCTIONS:
+                return _refused(expr, "a function no kernel takes")
+            return _first(self.expr(arg) for arg in expr.args)
+        return _refused(expr, "an expression no kernel takes")
+
+
+def _first(reasons) -> Refusal | None:
+    """The first of ``reasons`` (an iterable of refusals or None), or None."""
+    return next((why for why in reasons if why), None)
+
+
+@dataclass(frozen=True)
+class Refusal:
+    """Why a symbol is not fused: ``what`` keeps it out (``an operation no kernel takes``), the construct
+    (its text, as ``grammarc check --dump-ir`` prints it, cut short of its bodies; its name: the text's first word) and where it is, or only ``what`` for a reason of the symbol itself."""
+
+    what: str
+    text: str = ""
+    span: Span | None = None
+
+    @property
+    def name(self) -> str:
+        return self.text.replace("(", " ").split()[0] if self.text else ""
+
+    def __str__(self) -> str:
+        return self.what + (f": `{self.text}`" if self.text else "") + (f" at {self.span}" if self.span else "")
+
+
+def _refused(node, what: str) -> Refusal:
+    if isinstance(node, (ir.Case, ir.Stochastic)):  # printed as its bodies: named by its first branch
+        text = f"{'case' if isinstance(node, ir.Case) else '%'} {print_expr(node.branches[0][0])}"
+    else:
+        text = (print_op(node) if isinstance(node, ir.Op) else print_expr(node)).split("{")[0].strip()
+    return Refusal(what, text if len(text) <= 60 else text[:57] + "...", node.span)
+
+
+def symbol_refusals(plan) -> dict[str, Refusal]:
+    """Why each symbol with rules is not fused, by name: its first refusal (what ``grammarc check
+    --fusion`` lists, with ``grammar_refusals``; symbols fused are left out)."""
+    fusible = Fusible(plan)
+    return {sym.name: why for sym in plan.symbols if sym.rules and (why := fusible.refusal(sym.id))}
 
 
 def applied_rules(sym) -> tuple[ir.Rule, ...]:

@@ -51,16 +51,22 @@ def place_children(origin, size, key, frame, geom, lot, depth, frames, axis, ord
 
 
 @njit(cache=True, nogil=True)
-def xforms(frames, frame, size, origin, base):
+def xforms(frames, frame, size, origin, base, flat):
     """Record transforms (n, 3, 4) float32: column j = scope axis j * size j, column 3 = origin - base
-    (``base`` (n, 3): each row's lot origin, ``model.records.LotOrigins``)."""
+    (``base`` (n, 3): each row's lot origin, ``model.records.LotOrigins``). A flat scope, ``flat`` (n,) its
+    flat axis k (-1: a box), is a face (``builtin:quad``): its columns are axes k + 1 and k + 2 (mod 3) with
+    their sizes, then axis k times 0, as ``shapes.face_axes`` orders them: the quad's normal is axis k."""
     n = len(frame)
     out = np.empty((n, 3, 4), np.float32)
     for i in range(n):
         f = frame[i]
+        k = flat[i]
+        for j in range(3):
+            a = j if k < 0 else (k + 1 + j) % 3
+            s = size[i, a] if k < 0 or j < 2 else 0.0
+            for r in range(3):
+                out[i, r, j] = frames[f, a, r] * s
         for r in range(3):
-            for j in range(3):
-                out[i, r, j] = frames[f, j, r] * size[i, j]
             out[i, r, 3] = origin[i, r] - base[i, r]
     return out
 
@@ -99,3 +105,54 @@ def leaf_xforms(origin, base, size, frame, frames, axis, rows, parent, pos, leng
                 out[c, r, j] = frames[f, j, r] * s[j]
             out[c, r, 3] = o[r] - base[p, r]
     return out
+
+
+@njit(cache=True, nogil=True)
+def component_frames(frames, frame, origin, local_origin, local_axes, tol):
+    """World scopes of components: ``origin + local_origin @ frames[frame]`` (m, 3) and
+    ``local_axes @ frames[frame]`` (m, 3, 3) (``_times_frame``: einsum's bits), and whether each
+    component's local axes are not orthonormal within ``tol`` (m,) bool (a scope of sizes no float can
+    square). ``frame`` (m,) int32 the parents' frame ids, ``origin`` (m, 3) their origins,
+    ``local_origin`` and ``local_axes`` in the parents' frames."""
+    m = len(frame)
+    out_origin = np.empty((m, 3))
+    out_axes = np.empty((m, 3, 3))
+    bad = np.zeros(m, np.bool_)
+    for c in range(m):
+        f = frame[c]
+        for j in range(3):
+            moved = 0.0
+            for i in range(3):
+                moved += local_origin[c, i] * frames[f, i, j]
+            out_origin[c, j] = origin[c, j] + moved
+        _times_frame(local_axes, c, frames, f, out_axes)
+        for r in range(3):
+            for k in range(3):
+                dot = 0.0
+                for j in range(3):
+                    dot += local_axes[c, r, j] * local_axes[c, k, j]
+                if not abs(dot - (1.0 if r == k else 0.0)) < tol:
+                    bad[c] = True
+    return out_origin, out_axes, bad
+
+
+@njit(cache=True, nogil=True)
+def turned_frames(local_axes, frames, frame):
+    """``local_axes @ frames[frame]`` (m, 3, 3): axes given in their shapes' frames (``frame`` (m,) int32
+    ids into the table ``frames``), in the world (``_times_frame``: einsum's bits)."""
+    out = np.empty((len(frame), 3, 3))
+    for c in range(len(frame)):
+        _times_frame(local_axes, c, frames, frame[c], out)
+    return out
+
+
+@njit(cache=True, nogil=True)
+def _times_frame(local_axes, c, frames, f, out):
+    """Row c of ``out`` = ``local_axes[c] @ frames[f]``, each sum from 0.0 in axis order, as
+    ``np.einsum("nij,njk->nik")`` sums (the same bits, signed zeros too)."""
+    for r in range(3):
+        for j in range(3):
+            turned = 0.0
+            for i in range(3):
+                turned += local_axes[c, r, i] * frames[f, i, j]
+            out[c, r, j] = turned

@@ -164,13 +164,17 @@ def group_counts(extent, values, kind, group, n_groups, tol):
     gap = np.zeros((n, slots))
     scale = np.ones(n)
     total = np.zeros(n)
+    # each shape's sums by group, in arrays used again shape after shape
+    nominal = np.zeros(slots)
+    group_fixed = np.zeros(slots)
+    group_float = np.zeros(slots)
     for i in range(n):
         row = 0 if shared else i
         fixed = 0.0
         floating = 0.0
-        nominal = np.zeros(slots)
-        group_fixed = np.zeros(slots)
-        group_float = np.zeros(slots)
+        nominal[:] = 0.0
+        group_fixed[:] = 0.0
+        group_float[:] = 0.0
         for j in range(count):
             size = values[row, j] * extent[i] if kind[j] == 1 else values[row, j]
             g = group[j]

@@ -21,6 +21,7 @@ from grammarc.backend.children import with_context
 from grammarc.backend.context import Context
 from grammarc.backend.evaluate import evaluate_array
 from grammarc.backend.kernels.order import group_by
+from grammarc.backend.kernels.scope import component_frames
 from grammarc.backend.occlusion import take_apart
 from grammarc.backend.operations.faces import offset_faces
 from grammarc.backend.operations.table import Parts, operation
@@ -156,13 +157,11 @@ def components(ctx: Context, kind: int, cursor: Shapes, site: int, span, wanted=
         parent, index, origin, axes, size, geom, normal, roof, border, corner = (
             a[keep] for a in (parent, index, origin, axes, size, geom, normal, roof, border, corner))
     child = cursor.take(parent)
-    gram = np.einsum("nij,nkj->nik", axes, axes)
-    bad = ~(np.abs(gram - np.eye(3)) < 1e-6).all(axis=(1, 2))
+    world_origin, world_axes, bad = component_frames(chunk.frames.data, child.frame, child.origin, origin, axes,
+                                                     1e-6)
     if bad.any():  # a scope of sizes no float can square (s(0, 0, 1e290)) has no component frames
         ctx.fail_lots(child.lot[bad], "a component of a scope whose size is beyond any geometry", span)
-    parent_axes = chunk.frames[child.frame]
-    world_origin = child.origin + np.einsum("ni,nij->nj", origin, parent_axes)
-    frame = chunk.frames.add(np.einsum("nij,njk->nik", axes, parent_axes))
+    frame = chunk.frames.add(world_axes)
     shapes = Shapes(world_origin, size, frame, geom.astype(np.int32), child.lot,
                     piece_keys(ctx.plan.sequential_random, child.key, index, site), child.depth, child.params,
                     child.dynamic)

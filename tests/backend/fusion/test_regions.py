@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from grammarc.backend.fusion.regions import SWITCH
+from grammarc.backend.fusion.regions import SWITCH, grammar_refusals, symbol_refusals
 from grammarc.backend.plan import make_plan
 from grammarc.compiler import compile_grammar
 
@@ -111,3 +111,25 @@ Lot --> split(x){ 2: A | ~1: B }*
 A --> s('1, '1, 2) i("builtin:cube")
 B --> color(1, 0, 0)
 """) == set()
+
+
+def test_what_keeps_a_grammar_and_each_symbol_out_is_said_with_where(write):
+    plan = make_plan(compile_grammar(write("g.cga", """
+version "2023.0"
+Lot --> split(x){ 2: A | ~1: B }*
+A --> s('1, '1, 2) i("builtin:cube")
+B --> case scope.sx > 1: color(1, 0, 0)
+      else: NIL
+""")))
+    whole = grammar_refusals(plan)
+    assert whole[0].startswith("CityEngine's dialect") and any(w.startswith("colours") for w in whole)
+    refused = symbol_refusals(plan)
+    assert str(refused["Lot"]).startswith("an operation no kernel takes: `split(x)` at ")
+    assert refused["Lot"].name == "split" and str(refused["Lot"]).endswith("g.cga:3:9")
+    assert refused["A"].what == "CityEngine's `s` (a negative size mirrors)" and refused["A"].name == "S"
+    assert refused["B"].name == "case" and refused["B"].text == "case (Scope.sx > 1)"
+    # a fused grammar: nothing keeps it out, and its fused symbols have no refusal
+    facade = make_plan(compile_grammar(ROOT / "benchmarks" / "facade.cga"))
+    assert grammar_refusals(facade) == []
+    assert set(symbol_refusals(facade)) == {"mass"}  # its component split
+    assert str(symbol_refusals(facade)["mass"]).startswith("an operation no kernel takes: `Comp(")
