@@ -182,7 +182,8 @@ def clip_pieces(chunk: Chunk, shapes: Shapes, axis: int, parent, step, pos, leng
     if len(shaped):
         rings, poly_offsets = ragged_take(clipped.poly_offsets, shaped)
         vertices, ring_offsets = ragged_take(clipped.ring_offsets, rings)
-        new_geom[shaped] = store.add(clipped.coords[vertices], ring_offsets, poly_offsets, clipped.plane[shaped])
+        new_geom[shaped] = store.add(clipped.coords[vertices], ring_offsets, poly_offsets, clipped.plane[shaped],
+                                     clipped.turn[vertices])
     is_piece = piece >= 0
     pos, length = pos[rows].copy(), length[rows].copy()
     pos[is_piece] = clipped.low[piece[is_piece], axis]
