@@ -90,10 +90,12 @@ def clip_to_slabs(store: PolygonStore, geom: np.ndarray, size: np.ndarray, axis:
         at = np.where(along_a, point[:, 0], point[:, 1])
         with_start |= (at >= pos - slack) & (at <= pos + length + slack)
     clipped = fit_pieces(pieces, plane, size, polygons, cut_sides=with_start)
-    # the slab's sides that cut the polygon (NaN: the polygon's own extent ends there)
+    # the slab's sides that cut a solid (NaN: the polygon's own extent ends there, or it is flat: a cut
+    # face has no faces of its own, and a solid extruded from its pieces has side faces like any other)
     far = np.where(along_a, sa, sb)
-    lo = np.where(pos > slack, pos, np.nan)
-    hi = np.where(pos + length < far - slack, pos + length, np.nan)
+    solid = size[rows, plane] > TOL.zero
+    lo = np.where(solid & (pos > slack), pos, np.nan)
+    hi = np.where(solid & (pos + length < far - slack), pos + length, np.nan)
     turn = cap_turns(clipped, polygons, along_a, lo, hi, slack)
     # a rectangle with turned faces keeps its polygon: a box's faces are never turned
     turned = np.zeros(len(clipped.source), dtype=bool)
@@ -115,11 +117,14 @@ def cap_turns(clipped: Clipped, parents: np.ndarray, along_a: np.ndarray, lo: np
     x up, where it is the edge after it (measured through PyPRT on complexpatterns' top floors, whose
     front is that face, on courtyard lots a split crosses through the courtyard: the x of each part of the
     face runs down or up as this says, in nine parts of five lots). Pieces without an edge of a hole in
-    their outline (the cut misses the holes, or they have none) keep ``ALONG``.
+    their outline (the cut misses the holes, or they have none) keep ``ALONG``, and so do the pieces of a
+    flat polygon: its cut makes no faces, and a solid extruded from a piece has side faces like any
+    other's (massing on the kit's courtyard lot, whose inset it splits through the courtyard: its facades'
+    floors, split along y, are 114 faces with the faces turned, 118 without, 122 in PRT).
 
     ``parents`` (m,): the polygons cut, in scope units; ``along_a`` (m,): whether the cut's axis is their
-    plane's first; ``lo``, ``hi`` (m,): the slab's cutting sides on that axis (NaN where it does not cut);
-    ``slack`` (m,): lengths within it count as nought."""
+    plane's first; ``lo``, ``hi`` (m,): the slab's cutting sides on that axis (NaN where it does not cut,
+    or the polygon is flat); ``slack`` (m,): lengths within it count as nought."""
     parent_flat, parent_rings, parent_offsets = _open_polygons(parents)
     vertex_piece = segment_of(clipped.poly_offsets)[segment_of(clipped.ring_offsets)]
     piece = np.arange(len(clipped.source))

@@ -209,6 +209,16 @@ def test_faces_a_split_cuts_through_a_courtyard_start_on_the_first_side_face(wri
         got.append((round(corners[0].min(), 6), round(corners[0].max(), 6), round(corners[2, 0], 5), turn))
     assert sorted(got, key=lambda g: (-g[2], g[0])) == want
 
+def test_a_solid_extruded_from_a_face_cut_through_its_hole_has_no_turned_faces(write):
+    """massing on the kit's courtyard lot splits its (flat) inset through the courtyard and extrudes a piece:
+    the cut of a face makes no faces of its own, and the solid's side faces have x along their edges (its
+    facades' floors, split along y, are 118 faces so, 114 with the cut edges' faces turned; PRT's 122)."""
+    r = run(write, "Lot --> split(z){ ~1 : Back | 5.8 : Front }\n"
+                   "Back --> extrude(5) comp(f){ front : Face }\n", [NOTCHED_COURTYARD])
+    x = r["xform"][rows(r, "Face")][:, :, 0]
+    assert len(x) == 5 and (np.abs(x[:, 1]) < 1e-9).all() and (x[:, 0] > 0).all()
+
+
 def test_index_selectors_given_by_expressions_take_the_component_they_evaluate_to(write):
     """``comp(f){ n + 1 : A | k : B }`` with a constant and an attribute (public files index the faces of
     their assets so), evaluated per shape: the lot's attribute picks another face on each lot."""
