@@ -64,11 +64,13 @@ def scope_polygons(store: PolygonStore, geom: np.ndarray, size: np.ndarray) -> n
 
 
 def clip_to_slabs(store: PolygonStore, geom: np.ndarray, size: np.ndarray, axis: int, pos: np.ndarray,
-                  length: np.ndarray) -> Clipped:
+                  length: np.ndarray, turn_cuts: bool = False) -> Clipped:
     """Clip the polygons ``geom`` (m,) of the children's parents to the children's slabs.
 
     size (m, 3): the parents' scope sizes; the slab of child i runs from pos[i] to pos[i] + length[i]
-    along scope axis ``axis``, which must lie in each polygon's plane.
+    along scope axis ``axis``, which must lie in each polygon's plane. With ``turn_cuts`` (CityEngine's
+    ``split``), the faces of a solid's cut through a hole turn as PRT's do (``cap_turns``); the paper's
+    ``Subdiv`` and ``Repeat`` keep every side face's x along its edge.
     """
     plane = store.plane[geom]
     a, b = _A[plane], _B[plane]
@@ -93,7 +95,7 @@ def clip_to_slabs(store: PolygonStore, geom: np.ndarray, size: np.ndarray, axis:
     # the slab's sides that cut a solid (NaN: the polygon's own extent ends there, or it is flat: a cut
     # face has no faces of its own, and a solid extruded from its pieces has side faces like any other)
     far = np.where(along_a, sa, sb)
-    solid = size[rows, plane] > TOL.zero
+    solid = (size[rows, plane] > TOL.zero) & turn_cuts
     lo = np.where(solid & (pos > slack), pos, np.nan)
     hi = np.where(solid & (pos + length < far - slack), pos + length, np.nan)
     turn = cap_turns(clipped, polygons, along_a, lo, hi, slack)

@@ -368,12 +368,14 @@ def test_cut_edges_of_a_piece_the_cut_takes_through_a_hole_turn_their_faces():
     hole = np.array([[1 / 3, 0.25], [2 / 3, 0.25], [2 / 3, 0.75], [1 / 3, 0.75]])
     store = store_of([outer, hole])
     size = np.array([[30.0, 5.0, 20.0]] * 2)  # a prism 5 m high
-    through = clip_to_slabs(store, np.zeros(2, np.int32), size, 2, np.array([0.0, 10.0]),
-                            np.array([10.0, 10.0]))
+    halves = np.array([0.0, 10.0]), np.array([10.0, 10.0])
+    through = clip_to_slabs(store, np.zeros(2, np.int32), size, 2, *halves, turn_cuts=True)
     assert sorted(through.turn[through.turn != ALONG].tolist()) == sorted([UP, DOWN, UP, DOWN])
     assert not through.is_rect.any()
-    missed = clip_to_slabs(store, np.zeros(2, np.int32), size, 2, np.array([0.0, 2.0]), np.array([2.0, 18.0]))
+    missed = clip_to_slabs(store, np.zeros(2, np.int32), size, 2, np.array([0.0, 2.0]), np.array([2.0, 18.0]),
+                           turn_cuts=True)
     assert (missed.turn == ALONG).all()
-    flat = clip_to_slabs(store, np.zeros(2, np.int32), size * [1, 0, 1], 2, np.array([0.0, 10.0]),
-                         np.array([10.0, 10.0]))  # a face: its cut makes no faces
-    assert (flat.turn == ALONG).all()
+    # a face's cut makes no faces; the paper's Subdiv (no ``turn_cuts``) keeps x along every edge
+    flat = clip_to_slabs(store, np.zeros(2, np.int32), size * [1, 0, 1], 2, *halves, turn_cuts=True)
+    paper = clip_to_slabs(store, np.zeros(2, np.int32), size, 2, *halves)
+    assert (flat.turn == ALONG).all() and (paper.turn == ALONG).all()

@@ -141,7 +141,7 @@ def _group_children(ctx: Context, cursor: Shapes, op: ir.GroupSplit, axis: int, 
     ring starts elsewhere than corner 0 is cut as its polygon (``box_rings.as_polygons``)."""
     cursor = as_polygons(ctx.plan, ctx.chunk, cursor, axis)
     parent, part, pos, length, index, geometry = clip(ctx.chunk, cursor, axis, parent, part, pos, length,
-                                                      index, op.adjust)
+                                                      index, op.adjust, turn_cuts=True)
     order, offsets = group_by(part, len(op.parts))
     made = children(ctx, cursor, axis, parent, index, pos, length, op.site, order, geometry)
     if axes is not None:  # the children take their parent's axes again
