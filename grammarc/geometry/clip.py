@@ -92,10 +92,12 @@ def clip_to_slabs(store: PolygonStore, geom: np.ndarray, size: np.ndarray, axis:
         at = np.where(along_a, point[:, 0], point[:, 1])
         with_start |= (at >= pos - slack) & (at <= pos + length + slack)
     clipped = fit_pieces(pieces, plane, size, polygons, cut_sides=with_start)
+    if not turn_cuts:
+        return clipped
     # the slab's sides that cut a solid (NaN: the polygon's own extent ends there, or it is flat: a cut
     # face has no faces of its own, and a solid extruded from its pieces has side faces like any other)
     far = np.where(along_a, sa, sb)
-    solid = (size[rows, plane] > TOL.zero) & turn_cuts
+    solid = size[rows, plane] > TOL.zero
     lo = np.where(solid & (pos > slack), pos, np.nan)
     hi = np.where(solid & (pos + length < far - slack), pos + length, np.nan)
     turn = cap_turns(clipped, polygons, along_a, lo, hi, slack)
@@ -147,6 +149,8 @@ def _cap_turns(coords, ring_offsets, part_offsets, part_source, along_a, lo, hi,
     no_moves = np.zeros(0)
     for p in range(len(part_offsets) - 1):
         g = part_source[p]
+        if (np.isnan(lo[g]) and np.isnan(hi[g])) or parent_offsets[g + 1] - parent_offsets[g] < 2:
+            continue  # no cut of a solid, or no hole for it to run through
         outer = parent_rings[parent_offsets[g] + 1] - parent_rings[parent_offsets[g]]
         r0, r1 = ring_offsets[part_offsets[p]], ring_offsets[part_offsets[p] + 1]
         n = r1 - r0
