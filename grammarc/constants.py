@@ -16,7 +16,9 @@ class Tol:
     #: Footprints come in metres; 1e-9 m is far below any modelled feature and above float64 noise
     #: of coordinates up to ~1e6 m.
     zero: float = 1e-9
-    #: Lot rings: edges shorter than this collapse (near-duplicate points in GIS data), PRT's limit.
+    #: PRT's length limit: lot ring edges shorter than this collapse (near-duplicate points in GIS data),
+    #: and CityEngine's ``split`` makes no part this long or shorter (PRT drops a 0.799 mm part and keeps
+    #: a 0.805 mm one, on a 0.79 m window and on a 30 m facade alike).
     merge: float = 8e-4
     #: Lots with a smaller area (m^2) are reported as bad lots: they cannot carry a building.
     area_floor: float = 1e-6

@@ -90,14 +90,15 @@ def with_context(plan: Plan, shapes: Shapes, kind: str, index, parents, n_parent
     return replace(shapes, dynamic=tuple(dynamic))
 
 
-def clip(chunk: Chunk, shapes: Shapes, axis: int, parent, step, pos, length, index, adjust: bool = True):
+def clip(chunk: Chunk, shapes: Shapes, axis: int, parent, step, pos, length, index, adjust: bool = True,
+         turn_cuts: bool = False):
     """``clip_pieces``; with ``adjust`` false (CityEngine's ``split(axis, noAdjust)``) the pieces keep
     their slabs as their scopes (``fill_slabs``), so the children's scopes fill the parent's without gaps."""
     if adjust:
-        return clip_pieces(chunk, shapes, axis, parent, step, pos, length, index)
+        return clip_pieces(chunk, shapes, axis, parent, step, pos, length, index, turn_cuts)
     # the children's row numbers go through in place of their numbers: their slabs are taken by them
     parent, step, _, _, source, geometry = clip_pieces(chunk, shapes, axis, parent, step, pos, length,
-                                                       np.arange(len(parent)))
+                                                       np.arange(len(parent)), turn_cuts)
     if geometry is not None:
         geometry = fill_slabs(chunk, shapes, axis, parent, pos[source], length[source], geometry)
     return parent, step, pos[source], length[source], index[source], geometry
@@ -150,7 +151,7 @@ def _renormalized(coords, low, extent, slab_low, slab_extent) -> np.ndarray:
     return np.divide(scope - slab_low, slab_extent, out=np.zeros_like(scope), where=slab_extent > TOL.zero)
 
 
-def clip_pieces(chunk: Chunk, shapes: Shapes, axis: int, parent, step, pos, length, index):
+def clip_pieces(chunk: Chunk, shapes: Shapes, axis: int, parent, step, pos, length, index, turn_cuts: bool = False):
     """Children of polygons split across their plane become the pieces of the polygon in their slabs
     (``geometry.clip``): empty ones go, a slab that cuts the polygon apart gives one child a piece.
     Children of meshes (roofs, envelopes) become the mesh cut to their slab and closed
@@ -170,7 +171,8 @@ def clip_pieces(chunk: Chunk, shapes: Shapes, axis: int, parent, step, pos, leng
     poly = poly[store.plane[geom[poly]] != axis]
     if not len(poly):
         return parent, step, pos, length, index, meshes
-    clipped = clip_to_slabs(store, geom[poly], shapes.size[parent[poly]], axis, pos[poly], length[poly])
+    clipped = clip_to_slabs(store, geom[poly], shapes.size[parent[poly]], axis, pos[poly], length[poly],
+                            turn_cuts)
     whole = np.ones(len(parent), dtype=bool)
     whole[poly] = False
     rows = np.concatenate([np.flatnonzero(whole), poly[clipped.source]])
@@ -182,7 +184,8 @@ def clip_pieces(chunk: Chunk, shapes: Shapes, axis: int, parent, step, pos, leng
     if len(shaped):
         rings, poly_offsets = ragged_take(clipped.poly_offsets, shaped)
         vertices, ring_offsets = ragged_take(clipped.ring_offsets, rings)
-        new_geom[shaped] = store.add(clipped.coords[vertices], ring_offsets, poly_offsets, clipped.plane[shaped])
+        new_geom[shaped] = store.add(clipped.coords[vertices], ring_offsets, poly_offsets, clipped.plane[shaped],
+                                     clipped.turn[vertices])
     is_piece = piece >= 0
     pos, length = pos[rows].copy(), length[rows].copy()
     pos[is_piece] = clipped.low[piece[is_piece], axis]

@@ -11,6 +11,7 @@ from grammarc.backend.shapes import Shapes
 from grammarc.constants import TOL
 from grammarc.geometry import components as comp_kernels
 from grammarc.geometry.meshes import is_mesh, is_polygon
+from grammarc.ragged import segment_of
 
 
 def polygons_of(chunk: Chunk, shapes: Shapes, corner: np.ndarray | None = None):
@@ -36,6 +37,16 @@ def polygons_of(chunk: Chunk, shapes: Shapes, corner: np.ndarray | None = None):
                                    np.arange(len(rects) + 1, dtype=np.int64), plane[rects])
     coords, ring_offsets, shape_offsets = polygons.gather(geom)
     return coords, ring_offsets, shape_offsets, plane
+
+
+def side_turns(chunk: Chunk, shapes: Shapes, ring_offsets: np.ndarray, shape_offsets: np.ndarray) -> np.ndarray:
+    """Where the side faces over the edges of ``polygons_of``'s outlines start their rings (V,) int8
+    (``geometry.polygons``' ``turn``): the stored polygons' turns, ``ALONG`` on implicit rectangles."""
+    turn = np.zeros(ring_offsets[-1], dtype=np.int8)
+    poly = is_polygon(shapes.geom)
+    if poly.any():
+        turn[poly[segment_of(shape_offsets)[segment_of(ring_offsets)]]] = chunk.polygons.turns(shapes.geom[poly])
+    return turn
 
 
 def flat_axis(chunk: Chunk, shapes: Shapes) -> np.ndarray:

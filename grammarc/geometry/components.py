@@ -8,7 +8,9 @@ not extruded. So one kernel serves boxes, prisms and faces.
 Component scopes follow the paper (section 2, "Component split") and CityEngine:
 
 - side face of ring edge p -> q: x along the edge, y along the extrusion axis, z = x cross y pointing
-  out of the solid, origin at p on the base, size (|q - p|, height, 0);
+  out of the solid, origin at p on the base, size (|q - p|, height, 0); but where the polygon's ``turn``
+  says the face's ring starts elsewhere (``UP``, ``DOWN``: the faces a split cut through a hole,
+  ``geometry.clip.cap_turns``), x runs along its first edge, up or down the extrusion axis;
 - top face: z along the extrusion axis, x along the polygon's first axis; bottom face: z against it;
 - ring edge: x along the edge, y the polygon's normal, z outward in the polygon's plane, size (|q-p|, 0, 0);
 - side edge at a ring vertex: x along the extrusion axis, z the mean of the outward normals of the two
@@ -33,6 +35,11 @@ KIND_CODES = {
 
 #: ``poly`` codes of the kernel output: what geometry a component has.
 RECT, BOTTOM_POLY, TOP_POLY, SAME_POLY = 0, 1, 2, 3
+
+#: ``turn``: where a side face's ring starts, and so which way its scope's x runs (a polygon's per-vertex ``turn``,
+#: ``geometry.polygons``): at its bottom's start (x along the edge, the rule), at its bottom's end (x up
+#: the extrusion axis, y back along the edge), at its top's start (x down, y along the edge).
+ALONG, UP, DOWN = 0, 1, 2
 
 
 @njit(cache=True, nogil=True)
@@ -147,11 +154,12 @@ def _count(kind, n_edges, volume):
 
 
 @njit(cache=True, nogil=True)
-def components(kind, coords, ring_offsets, shape_offsets, plane, size, tol):
+def components(kind, coords, ring_offsets, shape_offsets, plane, size, tol, turn):
     """Component scopes of n shapes, in each shape's local frame.
 
     kind : int, a value of KIND_CODES.
-    coords : (V, 2) float64 normalized polygon vertices; ring_offsets : (R+1,) int64 into coords;
+    coords : (V, 2) float64 normalized polygon vertices; turn : (V,) int8 where the side face over the
+    edge from each vertex starts its ring (``ALONG``, ``UP``, ``DOWN``); ring_offsets : (R+1,) int64 into coords;
     shape_offsets : (n+1,) int64 into rings (one polygon per shape); plane : (n,) int8 normal axis;
     size : (n, 3) float64 scope sizes; tol : lengths at or below it are zero.
 
@@ -210,7 +218,12 @@ def components(kind, coords, ring_offsets, shape_offsets, plane, size, tol):
                     continue
                 _cross_into(d, nvec, outward)
                 if volume and (kind == 0 or kind == 1):
-                    m = _put(out, m, i, p, d, nvec, outward, _sized(s, length, h), RECT)
+                    if turn[j] == UP:
+                        m = _put(out, m, i, p + d * length, nvec, -d, outward, _sized(s, h, length), RECT)
+                    elif turn[j] == DOWN:
+                        m = _put(out, m, i, p + nvec * h, -nvec, d, outward, _sized(s, h, length), RECT)
+                    else:
+                        m = _put(out, m, i, p, d, nvec, outward, _sized(s, length, h), RECT)
                 if kind == 4 or (kind == 7 and volume):
                     m = _put(out, m, i, p, d, nvec, outward, _sized(s, length, 0.0), RECT)
                 if kind == 8:

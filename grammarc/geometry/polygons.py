@@ -10,7 +10,10 @@ around the +normal axis, holes clockwise.
 Layout (Arrow-style offsets, each starting at 0):
 
 - ``coords`` (V, 2) float64, ``ring_offsets`` (R+1,) int64 into coords,
-- ``poly_offsets`` (G+1,) int64 into rings (exterior ring first), ``plane`` (G,) int8.
+- ``poly_offsets`` (G+1,) int64 into rings (exterior ring first), ``plane`` (G,) int8,
+- ``turn`` (V,) int8: where the ring of a prism's side face over the edge from each vertex starts, and so
+  which way its scope's x runs (``geometry.components.ALONG``, ``UP``, ``DOWN``): ``ALONG`` (0) but on
+  the faces a split cuts through a hole (``geometry.clip.cap_turns``).
 """
 
 from __future__ import annotations
@@ -19,6 +22,7 @@ import numpy as np
 from numba import njit
 
 from grammarc.constants import STRICT
+from grammarc.ragged import ragged_take
 
 #: Scope axes spanned by (u, v) for each normal axis.
 PLANE_AXES = {0: (1, 2), 1: (0, 2), 2: (0, 1)}
@@ -47,13 +51,15 @@ class PolygonStore:
         self.ring_offsets = np.zeros(1, dtype=np.int64)
         self.poly_offsets = np.zeros(1, dtype=np.int64)
         self.plane = np.empty(0, dtype=np.int8)
+        self.turn = np.empty(0, dtype=np.int8)
 
     def __len__(self) -> int:
         return len(self.plane)
 
     def add(self, coords: np.ndarray, ring_offsets: np.ndarray, poly_offsets: np.ndarray,
-            plane: np.ndarray) -> np.ndarray:
-        """Append polygons given as ragged arrays (offsets from 0); returns their ids (k,) int32."""
+            plane: np.ndarray, turn: np.ndarray | None = None) -> np.ndarray:
+        """Append polygons given as ragged arrays (offsets from 0), with their side faces' ``turn`` (V,)
+        (None: all 0); returns their ids (k,) int32."""
         if STRICT:
             assert ring_offsets[0] == 0 and poly_offsets[0] == 0, "offsets must start at 0"
             assert (np.diff(ring_offsets) >= 3).all(), "a ring has fewer than 3 vertices"
@@ -65,12 +71,20 @@ class PolygonStore:
             [self.poly_offsets, poly_offsets[1:] + (len(self.ring_offsets) - len(ring_offsets))]
         )
         self.coords = np.concatenate([self.coords, coords])
+        self.turn = np.concatenate([self.turn, np.zeros(len(coords), np.int8) if turn is None
+                                    else np.asarray(turn, dtype=np.int8)])
         self.plane = np.concatenate([self.plane, np.asarray(plane, dtype=np.int8)])
         return np.arange(first, len(self.plane), dtype=np.int32)
 
     def gather(self, ids: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Polygons ``ids`` as new ragged arrays: (coords, ring_offsets, poly_offsets)."""
         return _gather(self.coords, self.ring_offsets, self.poly_offsets, np.asarray(ids, np.int64))
+
+    def turns(self, ids: np.ndarray) -> np.ndarray:
+        """The ``turn`` of polygons ``ids``' vertices (V',) int8, in ``gather``'s order."""
+        rings, _ = ragged_take(self.poly_offsets, np.asarray(ids, np.int64))
+        vertices, _ = ragged_take(self.ring_offsets, rings)
+        return self.turn[vertices]
 
 
 @njit(cache=True, nogil=True)

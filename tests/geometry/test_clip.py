@@ -355,3 +355,27 @@ def test_a_remainder_whose_first_edge_steps_starts_after_the_step():
                         np.array([tier]))
     first = fitted.coords[0] * fitted.extent[0, [0, 2]] + fitted.low[0, [0, 2]]
     np.testing.assert_allclose(first, (13.5501, -6.7633), atol=1e-9)
+
+
+def test_cut_edges_of_a_piece_the_cut_takes_through_a_hole_turn_their_faces():
+    """A courtyard prism (plane 1, 30 x 20) cut at v = 0.5 through its hole: each piece's two cut edges
+    turn their side faces (``cap_turns``: DOWN after the outer edge 3, UP before the outer edge 1, as the
+    hole's edges come after the outline's); the piece the cut does not take through the hole keeps ALONG
+    everywhere, and so do edges that are not cut."""
+    from grammarc.geometry.components import ALONG, DOWN, UP
+
+    outer = np.array([[0, 0], [0, 1], [1, 1], [1, 0]], float)  # clockwise in (u, v), as plane 1 wants
+    hole = np.array([[1 / 3, 0.25], [2 / 3, 0.25], [2 / 3, 0.75], [1 / 3, 0.75]])
+    store = store_of([outer, hole])
+    size = np.array([[30.0, 5.0, 20.0]] * 2)  # a prism 5 m high
+    halves = np.array([0.0, 10.0]), np.array([10.0, 10.0])
+    through = clip_to_slabs(store, np.zeros(2, np.int32), size, 2, *halves, turn_cuts=True)
+    assert sorted(through.turn[through.turn != ALONG].tolist()) == sorted([UP, DOWN, UP, DOWN])
+    assert not through.is_rect.any()
+    missed = clip_to_slabs(store, np.zeros(2, np.int32), size, 2, np.array([0.0, 2.0]), np.array([2.0, 18.0]),
+                           turn_cuts=True)
+    assert (missed.turn == ALONG).all()
+    # a face's cut makes no faces; the paper's Subdiv (no ``turn_cuts``) keeps x along every edge
+    flat = clip_to_slabs(store, np.zeros(2, np.int32), size * [1, 0, 1], 2, *halves, turn_cuts=True)
+    paper = clip_to_slabs(store, np.zeros(2, np.int32), size, 2, *halves)
+    assert (flat.turn == ALONG).all() and (paper.turn == ALONG).all()

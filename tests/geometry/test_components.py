@@ -40,7 +40,8 @@ def run(kind, shapes):
     shape_offsets = np.concatenate([[0], np.cumsum([len(s[0]) for s in shapes])]).astype(np.int64)
     plane = np.array([s[1] for s in shapes], np.int8)
     size = np.array([s[2] for s in shapes], float).reshape(-1, 3)
-    return components(KIND_CODES[kind], coords, ring_offsets, shape_offsets, plane, size, TOL)
+    return components(KIND_CODES[kind], coords, ring_offsets, shape_offsets, plane, size, TOL,
+                      np.zeros(len(coords), np.int8))
 
 
 def box(size, plane=1):

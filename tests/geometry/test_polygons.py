@@ -101,3 +101,12 @@ def test_plane_to_scope_puts_uv_on_each_planes_axes_and_height_on_its_normal():
     plane = np.array([0, 1, 2])
     assert np.array_equal(plane_to_scope(uv, plane), [[0, 1, 2], [3, 0, 4], [5, 6, 0]])
     assert np.array_equal(plane_to_scope(uv, plane, np.array([7.0, 8.0, 9.0])), [[7, 1, 2], [3, 8, 4], [5, 6, 9]])
+
+
+def test_turns_come_back_in_gathers_order_and_are_0_where_none_were_given():
+    store = PolygonStore()
+    square = np.array([[0, 0], [1, 0], [1, 1], [0, 1]], float)
+    store.add(square, np.array([0, 4]), np.array([0, 1]), np.array([1], np.int8))
+    store.add(np.concatenate([square, square * 0.5]), np.array([0, 4, 8]), np.array([0, 1, 2]),
+              np.array([1, 1], np.int8), np.array([0, 1, 0, 2, 0, 0, 1, 1], np.int8))
+    assert store.turns(np.array([2, 0, 1])).tolist() == [0, 0, 1, 1, 0, 0, 0, 0, 0, 1, 0, 2]

@@ -25,7 +25,7 @@ from grammarc.backend.kernels.scope import component_frames
 from grammarc.backend.occlusion import take_apart
 from grammarc.backend.operations.faces import offset_faces
 from grammarc.backend.operations.table import Parts, operation
-from grammarc.backend.outlines import flat_axis, polygons_of
+from grammarc.backend.outlines import flat_axis, polygons_of, side_turns
 from grammarc.backend.reframing import turned
 from grammarc.backend.selectors import classify_edges, classify_faces, index_masks, selector_frames
 from grammarc.backend.shapes import Shapes
@@ -179,7 +179,8 @@ def _solid_components(chunk, kind: int, cursor: Shapes, which: np.ndarray, corne
     corner = None if corner is None else corner[which]
     coords, ring_offsets, shape_offsets, plane = polygons_of(chunk, shapes, corner)
     parent, index, origin, axes, size, poly = comp_kernels.components(
-        kind, coords, ring_offsets, shape_offsets, plane, shapes.size, TOL.zero)
+        kind, coords, ring_offsets, shape_offsets, plane, shapes.size, TOL.zero,
+        side_turns(chunk, shapes, ring_offsets, shape_offsets))
     geom = np.full(len(parent), -1, dtype=np.int32)
     same = poly == comp_kernels.SAME_POLY
     geom[same] = shapes.geom[parent[same]]

@@ -97,7 +97,8 @@ def group_split(ctx: Context, cursor: Shapes, op: ir.GroupSplit) -> Parts:
         values = np.where(_kinds(op) == _SIZE_KIND[ir.SizeKind.RELATIVE], values, values * metres[:, None])
         axis = 0
     extent = np.ascontiguousarray(cursor.size[:, axis])
-    parent, part, pos, length, index = _group_layout(ctx, cursor, op, values, extent)
+    # parts of PRT's length limit or shorter are not made (complexpatterns' red window frames of 0.4 mm)
+    parent, part, pos, length, index = _group_layout(ctx, cursor, op, values, extent, TOL.merge)
     return _group_children(ctx, cursor, op, axis, parent, part, pos, length, index, axes)
 
 
@@ -110,17 +111,19 @@ def split_area(ctx: Context, cursor: Shapes, op: ir.SplitArea) -> Parts:
     rings, offsets = (faces.verts, faces.ring_offsets, faces.face_offsets), faces.shape_offsets
     total = total_areas(*rings, offsets)
     values = _split_sizes(ctx, cursor, op, "splitArea")
-    parent, part, start, area, index = _group_layout(ctx, cursor, op, values, total)
+    parent, part, start, area, index = _group_layout(ctx, cursor, op, values, total, TOL.zero)
     extent = cursor.size[parent, op.axis]
     ends = [area_positions(*rings, offsets, op.axis, parent, a, extent, total[parent])
             for a in (start, start + area)]
     return _group_children(ctx, cursor, op, op.axis, parent, part, ends[0], ends[1] - ends[0], index)
 
 
-def _group_layout(ctx: Context, cursor: Shapes, op: ir.GroupSplit, values: np.ndarray, extent: np.ndarray):
+def _group_layout(ctx: Context, cursor: Shapes, op: ir.GroupSplit, values: np.ndarray, extent: np.ndarray,
+                  shortest: float):
     """The parts of CityEngine's split of sizes ``values`` (n, P) or (1, P) over ``extent`` (n,) of
     ``cursor``'s shapes: parent, part, position, length and index of each (``kernels.split.group_split``),
-    counted first: a lot they would take over --max-shapes fails before they are made."""
+    counted first: a lot they would take over --max-shapes fails before they are made. Parts of length
+    ``shortest`` or less are not made."""
     kind = _kinds(op)
     groups = np.array(op.groups, dtype=np.int64)
     if op.repeat:
@@ -128,7 +131,7 @@ def _group_layout(ctx: Context, cursor: Shapes, op: ir.GroupSplit, values: np.nd
     n_groups = int(groups.max()) + 1 if len(groups) else 0
     plan = split_kernels.group_counts(extent, values, kind, groups, n_groups, TOL.zero)
     ctx.check_fan_out(cursor, plan[-1], op.span)
-    return split_kernels.group_split(extent, values, kind, groups, *plan, TOL.zero)
+    return split_kernels.group_split(extent, values, kind, groups, *plan, shortest)
 
 
 def _group_children(ctx: Context, cursor: Shapes, op: ir.GroupSplit, axis: int, parent, part, pos, length, index,
@@ -138,7 +141,7 @@ def _group_children(ctx: Context, cursor: Shapes, op: ir.GroupSplit, axis: int, 
     ring starts elsewhere than corner 0 is cut as its polygon (``box_rings.as_polygons``)."""
     cursor = as_polygons(ctx.plan, ctx.chunk, cursor, axis)
     parent, part, pos, length, index, geometry = clip(ctx.chunk, cursor, axis, parent, part, pos, length,
-                                                      index, op.adjust)
+                                                      index, op.adjust, turn_cuts=True)
     order, offsets = group_by(part, len(op.parts))
     made = children(ctx, cursor, axis, parent, index, pos, length, op.site, order, geometry)
     if axes is not None:  # the children take their parent's axes again

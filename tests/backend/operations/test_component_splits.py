@@ -176,6 +176,49 @@ def test_comp_faces_of_a_courtyard_prism(write):
 
 
 
+NOTCHED_COURTYARD = [np.array([[0, 0], [28, 0], [28, 12], [34, 12], [34, 0], [40, 0], [40, 20], [0, 20]], float),
+                     np.array([[10, 3], [10, 12], [20, 12], [20, 3]], float)]
+DEEP_COURTYARD = [np.array([[0, 0], [30, 0], [30, 20], [0, 20]], float),
+                  np.array([[10, 8], [10, 16], [20, 16], [20, 8]], float)]
+
+
+@pytest.mark.parametrize("lot, want", [
+    # the cut's three parts: x down (from the top of the part's start) after an outer edge or the first
+    # hole's, up (from the bottom of its end) before one: the first of the two in the solid's face order;
+    # the hole's and the notch's walls that face the same way keep x along them
+    (NOTCHED_COURTYARD, [(0, 10, -5.8, "down"), (20, 28, -5.8, "up"), (34, 40, -5.8, "down"),
+                         (10, 20, -12, "along"), (28, 34, -12, "along")]),
+    # the cut misses the hole: x along it
+    (DEEP_COURTYARD, [(0, 30, -5.8, "along"), (10, 20, -16, "along")]),
+])
+def test_faces_a_split_cuts_through_a_courtyard_start_on_the_first_side_face(write, lot, want):
+    """complexpatterns' top floor on courtyard lots (PRT through PyPRT, complexpatterns.rpk with the
+    attributes of conformance case courtyard.42990 on these two lots): ``split(z)`` cuts the building through
+    its courtyard, and the front of the part behind the cut, the cut's face in three parts, is laid out with
+    its x up or down the wall (the tiles' frames say so), where grammarc laid every part's x along the cut.
+    A cut that misses the courtyard keeps x along it."""
+    r = run(write, "Lot --> extrude(5) split(z){ ~1 : Back | 5.8 : Front }\n"
+                   "Back --> comp(f){ front : Face }\n", [lot])
+    got = []
+    for xform in r["xform"][rows(r, "Face")]:
+        corners = xform[:, 3:4] + xform[:, :2] @ np.array([[0, 1, 0, 1], [0, 0, 1, 1]])
+        np.testing.assert_allclose([corners[1].min(), corners[1].max()], [0, 5], atol=1e-6)
+        np.testing.assert_allclose(quad_normals({"xform": xform[None]})[0], [0, 0, 1], atol=1e-6)
+        x = np.round(xform[:, 0], 6)
+        turn = "up" if x[1] > 0 else "down" if x[1] < 0 else "along" if x[0] > 0 else "back"
+        got.append((round(corners[0].min(), 6), round(corners[0].max(), 6), round(corners[2, 0], 5), turn))
+    assert sorted(got, key=lambda g: (-g[2], g[0])) == want
+
+def test_a_solid_extruded_from_a_face_cut_through_its_hole_has_no_turned_faces(write):
+    """massing on the kit's courtyard lot splits its (flat) inset through the courtyard and extrudes a piece:
+    the cut of a face makes no faces of its own, and the solid's side faces have x along their edges (its
+    facades' floors, split along y, are 118 faces so, 114 with the cut edges' faces turned; PRT's 122)."""
+    r = run(write, "Lot --> split(z){ ~1 : Back | 5.8 : Front }\n"
+                   "Back --> extrude(5) comp(f){ front : Face }\n", [NOTCHED_COURTYARD])
+    x = r["xform"][rows(r, "Face")][:, :, 0]
+    assert len(x) == 5 and (np.abs(x[:, 1]) < 1e-9).all() and (x[:, 0] > 0).all()
+
+
 def test_index_selectors_given_by_expressions_take_the_component_they_evaluate_to(write):
     """``comp(f){ n + 1 : A | k : B }`` with a constant and an attribute (public files index the faces of
     their assets so), evaluated per shape: the lot's attribute picks another face on each lot."""

@@ -289,3 +289,16 @@ def test_a_recursive_subdiv_into_a_lots_hole_leaves_the_pieces_that_are_not_in_i
     r = paper(write, 'lot ~> Subdiv("X", 3r, 1r, 1r){ r1 | lot | r1 }\nr1 ~> Subdiv("X", 1r){ I("cube") }\n',
               [[square], [square, hole]])
     assert not r["bad"] and set(np.unique(r["lot"]).tolist()) == {0, 1}
+
+
+@pytest.mark.parametrize("width, made", [(2.0007, ["A", "C"]), (2.0009, ["A", "B", "C"])])
+def test_a_split_makes_no_part_of_prts_length_limit_or_shorter(write, width, made):
+    """complexpatterns' red windows, ``split(x){ frameW : RedFrame | ~1 : ... | frameW : RedFrame }``, a
+    little wider than two frames (PRT through PyPRT on the H lot of conformance case H.42188, frameW made to
+    leave the middle 0.2 to 0.85 mm): PRT makes no middle part of 0.799 mm or less and makes one of
+    0.805 mm, as on a 30 m facade (borderwallW leaving 0.5 mm and 5 mm); grammarc made every part longer
+    than 1e-9 m, 0.4 mm red frames 1.6 m deep among them."""
+    r = run(write, "Lot --> extrude(3) split(x){ 1 : A | ~1 : B | 1 : C }\n", [rect(width, 4)])
+    assert names(r) == made
+    starts = {"A": 0, "B": 1, "C": width - 1}  # C keeps its place: B's room is left empty
+    np.testing.assert_allclose(r["xform"][:, 0, 3], [starts[n] for n in made], atol=1e-9)
