@@ -2,10 +2,11 @@
 
 Holes are opened first (``_opened``): from each of a hole's reflex corners a cut runs along the line of
 one of its edges and stops at the boundary, as PRT's do; the faces they enclose are cut as follows.
-Each round cuts every piece that still has a reflex vertex along a line through its first one (one that
-is nearly straight only when it has no other): the line of one of the two edges that meet there, the
-one that runs a shorter way into the piece from the vertex (on one side the vertex becomes straight, on
-the other its angle drops below 180 degrees). A nearly straight corner too: the cut shaves a sliver off
+Each round cuts every piece that still has a reflex vertex along a line through one of them: the line
+of one of the two edges that meet there, the one that runs a shorter way into the piece from the vertex
+(on one side the vertex becomes straight, on the other its angle drops below 180 degrees). The vertex
+whose cut is the shortest goes first (of cuts within 1 % of it, the first in the ring), one that is
+nearly straight only when the piece has no other. A nearly straight corner too: the cut shaves a sliver off
 along the edge, and the rest of the piece stays whole (PRT's candler roofs keep a roof access on pieces
 with corners of a few degrees, candler.yverdon.10, concave.11029). A cut never makes a reflex vertex, so
 the reflex vertices of a lineage strictly decrease.
@@ -35,6 +36,8 @@ from grammarc.ragged import rank_within, segment_of
 MAX_ROUNDS = 256
 #: A reflex corner that turns less than this (radians: one degree) is cut after the piece's others.
 NEARLY_STRAIGHT = np.radians(1.0)
+#: Cuts whose lengths differ by less than this fraction are tied: the first in the ring goes first.
+TIED = 0.01
 
 
 def convex_parts(polygons: np.ndarray, max_length: np.ndarray | None = None,
@@ -174,7 +177,7 @@ def _opened(pieces: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 
 
 def _cut_vertices(pieces: np.ndarray, limit: np.ndarray | None, across: np.ndarray):
-    """Per piece, its first reflex vertex that may be cut (k, 2), the cut's direction (k, 2): along the
+    """Per piece, the reflex vertex that is cut first (k, 2: its shortest cut, ``TIED``), the cut's direction (k, 2): along the
     line of one of the edges that meet there, or across the boundary (pieces flagged ``across``), and
     where the parts on its left and on its right start (k, 2) each; NaN where there is
     none (the piece is convex, or every cut is too long).
@@ -195,9 +198,6 @@ def _cut_vertices(pieces: np.ndarray, limit: np.ndarray | None, across: np.ndarr
     # corner is cut across its bar, not after a cut at a bump in the bar took the whole bar off
     # (candler.near_degenerate.31488: PRT's parts of the bar are too small for a roof access)
     turn = np.arctan2(cross, d_in[:, 0] * d_out[:, 0] + d_in[:, 1] * d_out[:, 1])
-    candidates = candidates[np.lexsort((candidates, turn[candidates] > -NEARLY_STRAIGHT, piece[candidates]))]
-    if limit is None and len(candidates):  # only each piece's first reflex vertex is cut
-        candidates = candidates[np.r_[True, piece[candidates][1:] != piece[candidates][:-1]]]
     a = d_in[candidates] / np.hypot(d_in[candidates, 0], d_in[candidates, 1])[:, None]
     b = d_out[candidates] / np.hypot(d_out[candidates, 0], d_out[candidates, 1])[:, None]
     # a clear corner is cut along the line of one of its edges, the one whose run into the piece from the
@@ -222,13 +222,29 @@ def _cut_vertices(pieces: np.ndarray, limit: np.ndarray | None, across: np.ndarr
         left[rows[shorter]] = far[shorter]
         right[rows[~shorter]] = far[~shorter]
     direction = np.where(along[:, None], edge, normal)
+    # the shortest cut goes first, the first in the ring of cuts within TIED of it (a piece cut across the
+    # boundary: its first corner): PRT's candler roofs take a small bump off before the long cut at a
+    # corner earlier in the ring (candler.tartu.17: the ventilation stands on the bump's outer strip;
+    # candler.seoul.42: a jog between two bars leaves no rectangle), and cut an H's bar ends, 2.949 and
+    # 2.955 m long, in ring order (candler.H.31062)
+    length = np.zeros(len(candidates))
+    if along.any():
+        length[along] = run
+    straight = turn[candidates] > -NEARLY_STRAIGHT
+    group = 2 * piece[candidates] + straight
+    shortest = np.full(2 * len(pieces), np.inf)
+    np.minimum.at(shortest, group, length)
+    longer = length > shortest[group] * (1.0 + TIED)
+    order = np.lexsort((candidates, longer, straight, piece[candidates]))
+    candidates, direction, left, right = candidates[order], direction[order], left[order], right[order]
+    point = point[order]
     if limit is not None and len(candidates):
         chord = _chords(pieces[piece[candidates]], point, direction)
         keep = chord < limit[piece[candidates]]
         candidates, direction, left, right = candidates[keep], direction[keep], left[keep], right[keep]
     vertex, chosen = np.full((len(pieces), 2), np.nan), np.full((len(pieces), 2), np.nan)
     starts = np.full((len(pieces), 2, 2), np.nan)
-    # the first candidate of each piece (candidates are in vertex order)
+    # the first candidate of each piece (candidates in the order they go)
     first = np.r_[True, piece[candidates][1:] != piece[candidates][:-1]] if len(candidates) else np.zeros(0, bool)
     vertex[piece[candidates[first]]] = coords[candidates[first]]
     chosen[piece[candidates[first]]] = direction[first]
