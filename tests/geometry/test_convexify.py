@@ -87,6 +87,20 @@ def test_the_shortest_cut_goes_first():
     assert sorted(zip(shapely.area(pieces).round(9), (corners(p) for p in pieces))) == [
         (0.2, 4), (3.705, 5), (77.05, 5)]
 
+
+def test_a_cut_that_passes_a_corner_by_a_millimetre_ends_there():
+    """A block with a bump whose sides stand 1 mm off the line of the block's side (candler.tartu.12's
+    outline, squared): PRT's candler, from four ring starts of the footprint, lays its ventilation on the
+    bump, a rectangle, and none on the block. The cut along the block's side at the bump's foot ends at the
+    bump's other corner, 1 mm beside its line, instead of running on along the side and leaving a
+    sliver rectangle (1.3 to 1.5 m off PRT's bounding box)."""
+    footprint = shapely.Polygon([(0, 0), (10, 0), (9.999, 4), (12.5, 4), (12.5, 7.5), (9.999, 7.5), (10, 12), (0, 12)])
+    roof = shapely.buffer(footprint, -0.8, join_style="mitre")
+    pieces, _ = convex_parts(np.array([roof]))
+    assert is_convex(pieces).all() and shapely.area(pieces).sum() == pytest.approx(roof.area)
+    rectangles = [p for p in pieces if corners(p) == 4]
+    assert len(rectangles) == 1 and rectangles[0].area == pytest.approx(2.501 * 1.9, abs=1e-3)
+
 # candler.H.31062's footprint: an H turned by 5 degrees, its bars 27 m by 4.5 m; its roof is inset by 0.8 m
 H_LOT = shapely.Polygon([(13.13, 4.42), (12.73, 8.96), (-14.09, 6.63), (-13.7, 2.09), (-3.7, 2.96), (-3.14, -3.56),
                          (-13.13, -4.42), (-12.73, -8.96), (14.09, -6.63), (13.7, -2.09), (3.7, -2.96),
