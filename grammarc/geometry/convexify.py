@@ -2,18 +2,22 @@
 
 Holes are opened first (``_opened``): from each of a hole's reflex corners a cut runs along the line of
 one of its edges and stops at the boundary, as PRT's do; the faces they enclose are cut as follows.
-Each round cuts every piece that still has a reflex vertex along a line through its first one (one that
-is nearly straight only when it has no other): the line of one of the two edges that meet there, the
-one that runs a shorter way into the piece from the vertex (on one side the vertex becomes straight, on
-the other its angle drops below 180 degrees). A nearly straight corner too: the cut shaves a sliver off
+Each round cuts every piece that still has a reflex vertex along a line through one of them: the line
+of one of the two edges that meet there, the one that runs a shorter way into the piece from the vertex
+(on one side the vertex becomes straight, on the other its angle drops below 180 degrees). The vertex
+whose cut is the shortest goes first (of cuts within 1 % of it, the first in the ring), one that is
+nearly straight only when the piece has no other. A nearly straight corner too: the cut shaves a sliver off
 along the edge, and the rest of the piece stays whole (PRT's candler roofs keep a roof access on pieces
 with corners of a few degrees, candler.yverdon.10, concave.11029). A cut never makes a reflex vertex, so
 the reflex vertices of a lineage strictly decrease.
 Rectilinear footprints come out as rectangles (an L in two, a U in three) whose corners where a cut
 ends on an edge stay: PRT's pieces keep them, and ``geometry.isRectangular`` tells such a piece from a
 rectangle (candler's roofs). Each piece starts where its boundary leaves the last cut: at the corner
-cut, or where the cut ends on the boundary (``_cut_vertices``). The cut is the whole line through the
-piece: a concave piece may be cut in more places than the reflex vertex needs.
+cut, or where the cut ends on the boundary (``_cut_vertices``). A clear corner's cut runs from the corner
+to where it first comes to the boundary, as PRT's cuts of holes do, and ends at a corner of the piece that
+it passes within 5 mm of (``SNAP``: a bump whose side stands a millimetre off the line of the block's
+side is cut off whole); a nearly straight corner's cut and a cut across the boundary run along the whole
+line through the piece.
 
 A cut that only shaves off a sliver (below the area floor) is tried again across the boundary; if that
 fails too, the piece stays concave (about one piece in 10^4 on random star-shaped footprints).
@@ -35,6 +39,10 @@ from grammarc.ragged import rank_within, segment_of
 MAX_ROUNDS = 256
 #: A reflex corner that turns less than this (radians: one degree) is cut after the piece's others.
 NEARLY_STRAIGHT = np.radians(1.0)
+#: Cuts whose lengths differ by less than this fraction are tied: the first in the ring goes first.
+TIED = 0.01
+#: A clear corner's cut that passes a corner of its piece closer than this (metres) ends there.
+SNAP = 0.005
 
 
 def convex_parts(polygons: np.ndarray, max_length: np.ndarray | None = None,
@@ -72,18 +80,16 @@ def _convex_parts(polygons: np.ndarray, max_length: np.ndarray | None) -> tuple[
             break
         pieces = _without_spikes(pieces)
         limit = None if max_length is None else max_length[source]
-        vertex, direction, starts = _cut_vertices(pieces, limit, across)
+        vertex, direction, starts, end = _cut_vertices(pieces, limit, across)
         finished = np.isnan(vertex[:, 0])
         done_pieces.append(pieces[finished])
         done_source.append(source[finished])
-        pieces, source, vertex, direction, starts, across = (
+        pieces, source, vertex, direction, starts, end, across = (
             pieces[~finished], source[~finished], vertex[~finished], direction[~finished], starts[~finished],
-            across[~finished])
+            end[~finished], across[~finished])
         if not len(pieces):
             break
-        left, right = _half_planes(vertex, direction, _reach(pieces))
-        cut = np.concatenate([shapely.intersection(pieces, left), shapely.intersection(pieces, right)])
-        parts, index = shapely.get_parts(cut, return_index=True)
+        parts, index = _cut(pieces, vertex, direction, end)
         keep = (shapely.get_type_id(parts) == shapely.GeometryType.POLYGON) & (shapely.area(parts) > TOL.area_floor)
         parent = np.concatenate([np.arange(len(pieces))] * 2)[index[keep]]
         parts = parts.copy()
@@ -133,23 +139,7 @@ def _opened(pieces: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     b = d_out[corner] / np.hypot(*d_out[corner].T)[:, None]
     polygons = pieces[holed]
     _, direction, run = _edge_cuts(polygons, owner[corner], coords[corner], a, b)
-    # a hair past the boundary (the runs end just inside it), so that noding ends the cut on it
-    far = coords[corner] + direction * (run + 1e-7 * _reach(polygons)[owner[corner]])[:, None]
-    rays = shapely.linestrings(np.stack([coords[corner], far], axis=1))
-    # each polygon's rings and its cuts, noded together, then the faces they enclose
-    rings = shapely.get_rings(polygons)
-    ring_owner = np.repeat(np.arange(len(polygons)), shapely.get_num_interior_rings(polygons) + 1)
-    lines = np.concatenate([rings, rays])
-    line_owner = np.concatenate([ring_owner, owner[corner]])
-    order = np.argsort(line_owner, kind="stable")
-    lines, line_owner = lines[order], line_owner[order]
-    width = np.bincount(line_owner, minlength=len(polygons))
-    table = np.full((len(polygons), width.max()), None, dtype=object)
-    table[line_owner, rank_within(line_owner)] = lines
-    faces, index = shapely.get_parts(shapely.polygonize(shapely.union_all(table, axis=1)[:, None], axis=1),
-                                     return_index=True)
-    inside = shapely.contains_properly(polygons[index], shapely.point_on_surface(faces))
-    faces, index = shapely.orient_polygons(faces[inside], exterior_cw=False), index[inside]
+    faces, index = _cut_faces(polygons, owner[corner], coords[corner], coords[corner] + direction * run[:, None])
     # a face starts at the first hole corner its cuts leave, in the hole's order
     first = np.full((len(faces), 2), np.nan)
     ray_start = coords[corner]
@@ -173,8 +163,37 @@ def _opened(pieces: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return np.concatenate([pieces[kept], faces])[order], source[order]
 
 
+def _cut_faces(polygons: np.ndarray, owner: np.ndarray, start: np.ndarray, end: np.ndarray):
+    """The faces (k,) that ``polygons`` (m,) fall into when each is cut along its segments from ``start`` to
+    ``end`` (n, 2) (segment i cuts ``polygons[owner[i]]``), and the polygon each face is of (k,): each
+    polygon's rings and its cuts, noded together, then the faces they enclose. A cut is carried a hair past
+    its end (a run ends just inside the boundary), so that noding ends it on the boundary, unless it ends at
+    a corner (where the hair would add a vertex to an edge running on from there)."""
+    if not len(polygons):
+        return np.empty(0, dtype=object), np.zeros(0, dtype=np.int64)
+    direction = end - start
+    direction /= np.maximum(np.hypot(direction[:, 0], direction[:, 1]), 1e-300)[:, None]
+    reach = _reach(polygons)[owner]
+    at_corner = shapely.distance(shapely.points(end), shapely.extract_unique_points(polygons[owner])) <= 1e-9 * reach
+    far = end + direction * np.where(at_corner, 0.0, 1e-7 * reach)[:, None]
+    rays = shapely.linestrings(np.stack([start, far], axis=1))
+    rings = shapely.get_rings(polygons)
+    ring_owner = np.repeat(np.arange(len(polygons)), shapely.get_num_interior_rings(polygons) + 1)
+    lines = np.concatenate([rings, rays])
+    line_owner = np.concatenate([ring_owner, owner])
+    order = np.argsort(line_owner, kind="stable")
+    lines, line_owner = lines[order], line_owner[order]
+    width = np.bincount(line_owner, minlength=len(polygons))
+    table = np.full((len(polygons), width.max()), None, dtype=object)
+    table[line_owner, rank_within(line_owner)] = lines
+    faces, index = shapely.get_parts(shapely.polygonize(shapely.union_all(table, axis=1)[:, None], axis=1),
+                                     return_index=True)
+    inside = shapely.contains_properly(polygons[index], shapely.point_on_surface(faces))
+    return shapely.orient_polygons(faces[inside], exterior_cw=False), index[inside]
+
+
 def _cut_vertices(pieces: np.ndarray, limit: np.ndarray | None, across: np.ndarray):
-    """Per piece, its first reflex vertex that may be cut (k, 2), the cut's direction (k, 2): along the
+    """Per piece, the reflex vertex that is cut first (k, 2: its shortest cut, ``TIED``), the cut's direction (k, 2): along the
     line of one of the edges that meet there, or across the boundary (pieces flagged ``across``), and
     where the parts on its left and on its right start (k, 2) each; NaN where there is
     none (the piece is convex, or every cut is too long).
@@ -195,9 +214,6 @@ def _cut_vertices(pieces: np.ndarray, limit: np.ndarray | None, across: np.ndarr
     # corner is cut across its bar, not after a cut at a bump in the bar took the whole bar off
     # (candler.near_degenerate.31488: PRT's parts of the bar are too small for a roof access)
     turn = np.arctan2(cross, d_in[:, 0] * d_out[:, 0] + d_in[:, 1] * d_out[:, 1])
-    candidates = candidates[np.lexsort((candidates, turn[candidates] > -NEARLY_STRAIGHT, piece[candidates]))]
-    if limit is None and len(candidates):  # only each piece's first reflex vertex is cut
-        candidates = candidates[np.r_[True, piece[candidates][1:] != piece[candidates][:-1]]]
     a = d_in[candidates] / np.hypot(d_in[candidates, 0], d_in[candidates, 1])[:, None]
     b = d_out[candidates] / np.hypot(d_out[candidates, 0], d_out[candidates, 1])[:, None]
     # a clear corner is cut along the line of one of its edges, the one whose run into the piece from the
@@ -212,29 +228,104 @@ def _cut_vertices(pieces: np.ndarray, limit: np.ndarray | None, across: np.ndarr
     edge = b.copy()
     point = coords[candidates]
     left, right = point.copy(), point.copy()
+    end = np.full((len(candidates), 2), np.nan)
     if along.any():
         shorter, into, run = _edge_cuts(pieces, piece[candidates[along]], point[along], a[along], b[along])
         rows = np.flatnonzero(along)
-        edge[rows[shorter]] = a[along][shorter]
+        # a clear corner's cut ends at a corner of the piece that it passes within SNAP of, and stops
+        # where it comes to the boundary (``_cut``); a nearly straight one's runs along the whole line
+        # through the piece, shaving a sliver off along the edge
+        clear = turn[candidates[rows]] <= -NEARLY_STRAIGHT
+        far = point[along] + into * run[:, None]
+        into[clear], run[clear], far[clear] = _snapped(coords, piece, piece[candidates[rows[clear]]],
+                                                       point[rows[clear]], into[clear], run[clear])
+        edge[rows] = np.where(shorter[:, None], into, -into)
+        end[rows[clear]] = far[clear]
         # the far end: on the right of the outgoing edge's line (the incoming edge's side), on the left of
         # the incoming edge's line
-        far = point[along] + into * run[:, None]
         left[rows[shorter]] = far[shorter]
         right[rows[~shorter]] = far[~shorter]
     direction = np.where(along[:, None], edge, normal)
+    # the shortest cut goes first, the first in the ring of cuts within TIED of it (a piece cut across the
+    # boundary: its first corner): PRT's candler roofs take a small bump off before the long cut at a
+    # corner earlier in the ring (candler.tartu.17: the ventilation stands on the bump's outer strip;
+    # candler.seoul.42: a jog between two bars leaves no rectangle), and cut an H's bar ends, 2.949 and
+    # 2.955 m long, in ring order (candler.H.31062)
+    length = np.zeros(len(candidates))
+    if along.any():
+        length[along] = run
+    straight = turn[candidates] > -NEARLY_STRAIGHT
+    group = 2 * piece[candidates] + straight
+    shortest = np.full(2 * len(pieces), np.inf)
+    np.minimum.at(shortest, group, length)
+    longer = length > shortest[group] * (1.0 + TIED)
+    order = np.lexsort((candidates, longer, straight, piece[candidates]))
+    candidates, direction, left, right, end = (candidates[order], direction[order], left[order], right[order],
+                                               end[order])
+    point = point[order]
     if limit is not None and len(candidates):
         chord = _chords(pieces[piece[candidates]], point, direction)
         keep = chord < limit[piece[candidates]]
-        candidates, direction, left, right = candidates[keep], direction[keep], left[keep], right[keep]
+        candidates, direction, left, right, end = (candidates[keep], direction[keep], left[keep], right[keep],
+                                                   end[keep])
     vertex, chosen = np.full((len(pieces), 2), np.nan), np.full((len(pieces), 2), np.nan)
-    starts = np.full((len(pieces), 2, 2), np.nan)
-    # the first candidate of each piece (candidates are in vertex order)
+    starts, ends = np.full((len(pieces), 2, 2), np.nan), np.full((len(pieces), 2), np.nan)
+    # the first candidate of each piece (candidates in the order they go)
     first = np.r_[True, piece[candidates][1:] != piece[candidates][:-1]] if len(candidates) else np.zeros(0, bool)
     vertex[piece[candidates[first]]] = coords[candidates[first]]
     chosen[piece[candidates[first]]] = direction[first]
     starts[piece[candidates[first]], 0] = left[first]
     starts[piece[candidates[first]], 1] = right[first]
-    return vertex, chosen, starts
+    ends[piece[candidates[first]]] = end[first]
+    return vertex, chosen, starts, ends
+
+
+def _cut(pieces: np.ndarray, vertex: np.ndarray, direction: np.ndarray, end: np.ndarray):
+    """Each piece cut through its ``vertex`` (k, 2) along ``direction`` (k, 2): the parts (j,) and where each
+    comes from (j,): i for piece i's parts on the cut's left, k + i for those on its right. A clear corner's
+    cut runs from the vertex to ``end``, where it comes to the boundary, and cuts the piece in two (PRT's
+    cuts stop there, as they do on holes); a nearly straight corner's and a cut across the boundary (``end``
+    NaN) run along the whole line through the piece."""
+    k = len(pieces)
+    segment = np.flatnonzero(~np.isnan(end[:, 0]))
+    line = np.flatnonzero(np.isnan(end[:, 0]))
+    faces, owner = _cut_faces(pieces[segment], np.arange(len(segment)), vertex[segment], end[segment])
+    # a face is on the cut's left where it holds a point a hair left of the cut's middle
+    normal = np.stack([-direction[:, 1], direction[:, 0]], axis=1)
+    beside = (vertex + end) / 2 + normal * (1e-7 * _reach(pieces))[:, None]
+    on_left = shapely.contains(faces, shapely.points(beside[segment][owner]))
+    left, right = _half_planes(vertex[line], direction[line], _reach(pieces[line]))
+    halves, half = shapely.get_parts(np.concatenate([shapely.intersection(pieces[line], left),
+                                                     shapely.intersection(pieces[line], right)]), return_index=True)
+    index = np.concatenate([segment[owner] + np.where(on_left, 0, k), np.concatenate([line, line + k])[half]])
+    order = np.argsort(index, kind="stable")
+    return np.concatenate([faces, halves])[order], index[order]
+
+
+def _snapped(coords: np.ndarray, vertex_piece: np.ndarray, owner: np.ndarray, point: np.ndarray,
+             into: np.ndarray, run: np.ndarray):
+    """Cuts from ``point`` (k, 2) along ``into`` (k, 2) for ``run`` (k,) into ``pieces[owner]`` (whose
+    vertices are ``coords``, of pieces ``vertex_piece``), ended at the first vertex of the piece that lies
+    within SNAP of them: (direction, run, end) (k, 2), (k,), (k, 2). A cut along an edge's line that passes
+    a millimetre beside a corner of the piece ends there (candler.tartu.12: the line of the roof's side
+    beside a bump, 1.2 mm off the bump's other corner, cuts the bump off, a rectangle, where it ran on
+    along the side and left slivers)."""
+    first_vertex = np.searchsorted(vertex_piece, owner, side="left")
+    n = np.searchsorted(vertex_piece, owner, side="right") - first_vertex
+    pair = np.repeat(np.arange(len(owner)), n)
+    v = first_vertex[pair] + np.arange(n.sum()) - np.repeat(np.cumsum(n) - n, n)
+    rel = coords[v] - point[pair]
+    along = rel[:, 0] * into[pair, 0] + rel[:, 1] * into[pair, 1]
+    off = np.abs(into[pair, 0] * rel[:, 1] - into[pair, 1] * rel[:, 0])
+    near = (along > SNAP) & (along < run[pair] + SNAP) & (off <= SNAP)
+    nearest = np.full(len(owner), np.inf)
+    np.minimum.at(nearest, pair[near], along[near])
+    end = point + into * run[:, None]
+    hit = near & (along == nearest[pair])
+    end[pair[hit]] = coords[v[hit]]
+    direction = end - point
+    length = np.hypot(direction[:, 0], direction[:, 1])
+    return direction / np.maximum(length, 1e-300)[:, None], length, end
 
 
 def _corners(coords: np.ndarray, ring_offsets: np.ndarray):

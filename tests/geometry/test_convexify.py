@@ -68,6 +68,39 @@ def test_pieces_start_where_their_boundary_leaves_the_cut():
     assert all(p.exterior.is_ccw for p in pieces)
 
 
+
+# a roof whose main block has a strip along one side and a small bump at the strip's end (candler.tartu.17's,
+# squared): the corner where the strip leaves the block comes first in the ring, its cut (5.7 m, across the
+# strip's foot) is longer than the one at the bump's foot (1 m)
+BUMPED_ROOF = shapely.Polygon([(0, 11.5), (6.7, 11.5), (6.7, 5.7), (7.55, 5.7), (7.55, 4.7), (7.35, 4.7), (7.35, 0),
+                               (0, 0)])
+
+
+def test_the_shortest_cut_goes_first():
+    """PRT's candler on this roof's footprint (inset by 0.8 m), from each of its eight ring starts, lays its
+    one ventilation on the bump's 0.2 m outer strip: the bump's foot is cut first, across the bump (1 m),
+    and the rest then along the block's side, so that the strip (with the bump's inner part) and the block
+    keep a cut's end as a fifth corner. Cut at the ring's first corner, the strip came out a rectangle and
+    the ventilation stood on it (2.3 to 2.9 m off PRT's bounding box)."""
+    pieces, _ = convex_parts(np.array([BUMPED_ROOF]), None, np.array([True]))
+    assert is_convex(pieces).all()
+    assert sorted(zip(shapely.area(pieces).round(9), (corners(p) for p in pieces))) == [
+        (0.2, 4), (3.705, 5), (77.05, 5)]
+
+
+def test_a_cut_that_passes_a_corner_by_a_millimetre_ends_there():
+    """A block with a bump whose sides stand 1 mm off the line of the block's side (candler.tartu.12's
+    outline, squared): PRT's candler, from four ring starts of the footprint, lays its ventilation on the
+    bump, a rectangle, and none on the block. The cut along the block's side at the bump's foot ends at the
+    bump's other corner, 1 mm beside its line, instead of running on along the side and leaving a
+    sliver rectangle (1.3 to 1.5 m off PRT's bounding box)."""
+    footprint = shapely.Polygon([(0, 0), (10, 0), (9.999, 4), (12.5, 4), (12.5, 7.5), (9.999, 7.5), (10, 12), (0, 12)])
+    roof = shapely.buffer(footprint, -0.8, join_style="mitre")
+    pieces, _ = convex_parts(np.array([roof]))
+    assert is_convex(pieces).all() and shapely.area(pieces).sum() == pytest.approx(roof.area)
+    rectangles = [p for p in pieces if corners(p) == 4]
+    assert len(rectangles) == 1 and rectangles[0].area == pytest.approx(2.501 * 1.9, abs=1e-3)
+
 # candler.H.31062's footprint: an H turned by 5 degrees, its bars 27 m by 4.5 m; its roof is inset by 0.8 m
 H_LOT = shapely.Polygon([(13.13, 4.42), (12.73, 8.96), (-14.09, 6.63), (-13.7, 2.09), (-3.7, 2.96), (-3.14, -3.56),
                          (-13.13, -4.42), (-12.73, -8.96), (14.09, -6.63), (13.7, -2.09), (3.7, -2.96),
