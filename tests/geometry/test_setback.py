@@ -94,6 +94,25 @@ def test_an_edge_whose_strip_folds_vanishes_and_its_neighbours_meet(ring, d, rem
         assert shapely.area(rest[0]) > 0
 
 
+@pytest.mark.parametrize("ring, d, remainder", [
+    # a 2 m step (moved 4 m) between the kept edge before it and the moved edge after it, parallel to it:
+    # the step does not move and the moved edge's strip ends at its line (PRT's first tier on this lot under
+    # massing's 4;0;4;4;0: terrace 100 m^2 of 240; the swept wavefront ran the moved edge's front on past
+    # the kept edge, 132 m^2, as on the real lot massing.tartu.0)
+    ([(0, 8), (0, 3), (20, 3), (20, 1), (40, 1), (40, 8)], [4, 0, 4, 4, 0, 0], 16 * 5 + 20 * 3),
+    # massing.hiroshima.111's shapeL arm (4;4;0;0;0;0): the 2.4 m end folds between the kept left side and
+    # the moved right side; the right side's strip stops at the kept 0.6 m step's line and the upper arm is
+    # left, as PRT leaves it (4.713 m^2; the wavefront, started by the step's turning over, took it all)
+    ([(0.0, 0.0), (2.4291, 0.0), (2.4331, 7.5647), (1.8122, 7.5647), (1.8125, 10.1675), (0.0013, 10.1674)],
+     [4, 4, 0, 0, 0, 0], (1.8125 - 0.0013) * (10.1675 - 7.5647)),
+])
+def test_an_edge_whose_strip_folds_beside_a_kept_and_a_moved_parallel_edge_does_not_move(ring, d, remainder):
+    face = np.array([shapely.Polygon(ring)])
+    (strips,), rest = setback_regions(face, polygon_edges(face), np.array(d, float), np.zeros(len(d), np.int64), 1)
+    assert shapely.area(rest[0]) == pytest.approx(remainder, rel=1e-4)
+    assert shapely.area(strips[0]) + shapely.area(rest[0]) == pytest.approx(face[0].area)
+
+
 def test_a_holed_face_whose_strips_fold_sweeps_its_outline_and_its_strips_stop_at_the_hole():
     """The 9 x 5 m L above with a hole in its front's strip: its outline is swept as the L's is (the hole does
     not move) and the strips are clipped to the face (PRT on massing.concave.33183, a shapeU whose shape has a
