@@ -188,30 +188,31 @@ def _swept(polygons: np.ndarray, edges: Edges, d, corner, ends, owner, swept, st
 
 
 def _unfolded(edges: Edges, d: np.ndarray) -> np.ndarray:
-    """The distances (E,) with those of the edges whose quads fold between two parallel neighbours (turned
-    by under ``_STEP_TURN`` from each other, facing or not), one moved and one kept, set to 0, until none
-    does: such an edge (a short end moved further than its length) does not move in PRT, and its
-    neighbours' strips end at its line
-    (measured through PyPRT on massing's tiers over real lots: tartu.0, a 2 m edge moved 4 m between a kept
-    edge and a moved one parallel to it, where PRT's front stops at the short edge's line and the swept
-    wavefront ran on past the kept edge, 62.6 m^2; seoul.31, hiroshima.111; the random lots' narrow arms,
-    massing.H.15118 and an L's 3 m end moved 4 m, as the wavefront had them). Between neighbours that are
-    not parallel, or both moved (a channel's end that closes: massing.holes.33921's second tier, where
-    PRT leaves nothing), a folded quad is swept (``_swept``)."""
+    """The distances (E,) with that of the shortest edge of each face whose quad folds between two parallel
+    neighbours (turned by under ``_STEP_TURN`` from each other, facing or not), one moved and one kept, set
+    to 0: such an edge (a short end moved further than its length) does not move in PRT, and its
+    neighbours' strips end at its line (measured through PyPRT on massing's tiers over real lots: tartu.0, a
+    2 m edge moved 4 m between a kept edge and a moved one parallel to it, where PRT's front stops at the
+    short edge's line and the swept wavefront ran on past the kept edge, 62.6 m^2; seoul.31,
+    hiroshima.111, whose second tier, a 1.8 x 2.6 m face with sides moved 3 and 4 m, keeps the 1.8 m side
+    and the other's strip covers the face; the random lots' narrow arms, massing.H.15118 and an L's 3 m end
+    moved 4 m, as the wavefront had them). Another folded quad is swept (``_swept``): between neighbours that
+    are not parallel, or both moved (a channel's end that closes: massing.holes.33921's second tier, where
+    PRT leaves nothing), or past the one edge that stays (bergen.44's 0.5 m wide shapeU, all terrace)."""
     tangent = edges.end - edges.start
+    length = np.hypot(tangent[:, 0], tangent[:, 1])
+    moved = d > TOL.zero
+    corner, ends, mitred = _mitres(edges, d)
+    end_corner = np.where(mitred[edges.next][:, None], ends[edges.next], edges.inward * d[:, None])
     parallel = np.abs(_cosines(tangent[edges.prev], tangent[edges.next])) > np.cos(np.radians(_STEP_TURN))
-    for _ in range(len(d)):
-        corner, ends, mitred = _mitres(edges, d)
-        end_corner = np.where(mitred[edges.next][:, None], ends[edges.next], edges.inward * d[:, None])
-        moved = d > TOL.zero
-        idx = np.flatnonzero(moved & parallel & (moved[edges.prev] != moved[edges.next]))
-        quads = np.stack([edges.start[idx], edges.end[idx], edges.end[idx] + end_corner[idx],
-                          edges.start[idx] + corner[idx]], axis=1)
-        folded = idx[~shapely.is_valid(shapely.polygons(quads))] if len(idx) else idx
-        if not len(folded):
-            return d
-        d = d.copy()
-        d[folded] = 0.0
+    idx = np.flatnonzero(moved & parallel & (moved[edges.prev] != moved[edges.next]))
+    quads = np.stack([edges.start[idx], edges.end[idx], edges.end[idx] + end_corner[idx],
+                      edges.start[idx] + corner[idx]], axis=1)
+    folded = idx[~shapely.is_valid(shapely.polygons(quads))] if len(idx) else idx
+    order = np.lexsort((length[folded], edges.poly[folded]))
+    first = folded[order][np.r_[True, np.diff(edges.poly[folded][order]) != 0]] if len(folded) else folded
+    d = d.copy()
+    d[first] = 0.0
     return d
 
 
