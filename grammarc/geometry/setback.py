@@ -32,6 +32,9 @@ from grammarc.ragged import offsets_from_counts, rank_within
 _MITRE_LIMIT = 10.0
 #: The turn (degrees) of the boundary below which edges moved by different distances step (``_mitres``).
 _STEP_TURN = 15.0
+#: The turn (degrees) past a kept edge under which a moved line that passes its far end sweeps on
+#: (``setback_regions``): measured between 20 (sweeps on) and 90 (stops).
+_RUN_ON_TURN = 45.0
 #: The grid (scope units, metres) that setback regions are snapped to, collapsing zero-width spikes.
 _SNAP = 1e-9
 #: The most steps ``distances_to_area`` takes for one polygon.
@@ -112,12 +115,13 @@ def setback_regions(polygons: np.ndarray, edges: Edges, distance: np.ndarray, ow
     swept[edges.poly[idx[folded]]] = True
     tangent = edges.end - edges.start
     span = np.einsum("ij,ij->i", tangent + end_corner - corner, tangent)
-    # (beside a kept edge nearly collinear with it: a kept edge the boundary turns at stops the moved line,
-    # as PRT's tier on the real lot massing.hiroshima.111, whose shapeL arm it keeps: 4.71 m^2)
+    # (where the boundary runs on past it turned by less than ``_RUN_ON_TURN``: 1 degree on 34258, 20 on
+    # concave.46141; past a corner, the moved line stops at the kept edge's line, as PRT's tier on the real
+    # lot massing.hiroshima.111, whose shapeL arm it keeps: 4.71 m^2)
     other = np.where(moved[edges.prev], edges.next, edges.prev)
     turned_over = ~moved & ~edges.hole & (moved[edges.prev] | moved[edges.next]) & (
-        span < -TOL.zero * np.einsum("ij,ij->i", tangent, tangent)) & ~moved[other] & (
-        _cosines(tangent, tangent[other]) > np.cos(np.radians(_STEP_TURN)))
+        span < -TOL.zero * np.einsum("ij,ij->i", tangent, tangent)) & (
+        moved[other] | (_cosines(tangent, tangent[other]) > np.cos(np.radians(_RUN_ON_TURN))))
     swept[edges.poly[turned_over]] = True
     if swept.any():
         strips, group = _swept(polygons, edges, d, corner, ends, owner, swept, strips, group, idx)
@@ -190,30 +194,42 @@ def _swept(polygons: np.ndarray, edges: Edges, d, corner, ends, owner, swept, st
 def _unfolded(edges: Edges, d: np.ndarray) -> np.ndarray:
     """The distances (E,) with that of the shortest edge of each face whose quad folds between two parallel
     neighbours (turned by under ``_STEP_TURN`` from each other, facing or not), one moved and one kept, set
-    to 0: such an edge (a short end moved further than its length) does not move in PRT, and its
-    neighbours' strips end at its line (measured through PyPRT on massing's tiers over real lots: tartu.0, a
-    2 m edge moved 4 m between a kept edge and a moved one parallel to it, where PRT's front stops at the
-    short edge's line and the swept wavefront ran on past the kept edge, 62.6 m^2; seoul.31,
-    hiroshima.111, whose second tier, a 1.8 x 2.6 m face with sides moved 3 and 4 m, keeps the 1.8 m side
-    and the other's strip covers the face; the random lots' narrow arms, massing.H.15118 and an L's 3 m end
-    moved 4 m, as the wavefront had them). Another folded quad is swept (``_swept``): between neighbours that
-    are not parallel, or both moved (a channel's end that closes: massing.holes.33921's second tier, where
-    PRT leaves nothing), or past the one edge that stays (bergen.44's 0.5 m wide shapeU, all terrace)."""
+    to 0 where then no strip of the face folds: such an edge (a short end moved further than its length)
+    does not move in PRT, and its neighbours' strips end at its line (measured through PyPRT on massing's
+    tiers over real lots: tartu.0, a 2 m edge moved 4 m between a kept edge and a moved one parallel to
+    it, where PRT's front stops at the short edge's line and the swept wavefront ran on past the kept edge,
+    62.6 m^2; seoul.31; hiroshima.111, whose second tier, a 1.8 x 2.6 m face with sides moved 3 and 4 m,
+    keeps the 1.8 m side and the other's strip covers the face; the random lots' narrow arms,
+    massing.H.15118 and an L's 3 m end moved 4 m, as the wavefront had them). A face whose strips would
+    still fold is swept as it is (``_swept``), the edge moving (massing.L.46072's 0.07 m wide shapeU frame,
+    bergen.44's 0.5 m wide one: PRT's terraces), and so is one whose folded edges lie between neighbours
+    that are not parallel, or both moved (a channel's end that closes: holes.33921's second tier)."""
     tangent = edges.end - edges.start
     length = np.hypot(tangent[:, 0], tangent[:, 1])
     moved = d > TOL.zero
-    corner, ends, mitred = _mitres(edges, d)
-    end_corner = np.where(mitred[edges.next][:, None], ends[edges.next], edges.inward * d[:, None])
     parallel = np.abs(_cosines(tangent[edges.prev], tangent[edges.next])) > np.cos(np.radians(_STEP_TURN))
-    idx = np.flatnonzero(moved & parallel & (moved[edges.prev] != moved[edges.next]))
-    quads = np.stack([edges.start[idx], edges.end[idx], edges.end[idx] + end_corner[idx],
-                      edges.start[idx] + corner[idx]], axis=1)
-    folded = idx[~shapely.is_valid(shapely.polygons(quads))] if len(idx) else idx
+    folded = _folds(edges, d)
+    folded = folded[(parallel & (moved[edges.prev] != moved[edges.next]))[folded]]
     order = np.lexsort((length[folded], edges.poly[folded]))
     first = folded[order][np.r_[True, np.diff(edges.poly[folded][order]) != 0]] if len(folded) else folded
-    d = d.copy()
-    d[first] = 0.0
-    return d
+    unfolded = d.copy()
+    unfolded[first] = 0.0
+    # a face where strips still fold is swept as it was (massing.L.46072: its end stays moved)
+    still = np.zeros(len(d), dtype=bool)
+    still[_folds(edges, unfolded)] = True
+    swept = np.zeros(int(edges.poly.max(initial=-1)) + 1, dtype=bool)
+    swept[edges.poly[still]] = True
+    return np.where(swept[edges.poly], d, unfolded)
+
+
+def _folds(edges: Edges, d: np.ndarray) -> np.ndarray:
+    """The moved edges (indices) whose quads fold over themselves (a distance longer than the edge allows)."""
+    corner, ends, mitred = _mitres(edges, d)
+    end_corner = np.where(mitred[edges.next][:, None], ends[edges.next], edges.inward * d[:, None])
+    idx = np.flatnonzero(d > TOL.zero)
+    quads = np.stack([edges.start[idx], edges.end[idx], edges.end[idx] + end_corner[idx],
+                      edges.start[idx] + corner[idx]], axis=1)
+    return idx[~shapely.is_valid(shapely.polygons(quads))] if len(idx) else idx
 
 
 def _cosines(a: np.ndarray, b: np.ndarray) -> np.ndarray:
