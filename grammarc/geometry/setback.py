@@ -32,6 +32,10 @@ from grammarc.ragged import offsets_from_counts, rank_within
 _MITRE_LIMIT = 10.0
 #: The turn (degrees) of the boundary below which edges moved by different distances step (``_mitres``).
 _STEP_TURN = 15.0
+#: The angle (degrees) under which the neighbours of a folded edge are parallel (``_unfolded``): the real
+#: lots' were 0.01-0.7 degrees apart; an edge between neighbours 11 degrees apart moves in PRT (a
+#: concave lot of the replay's, whose tier it sweeps).
+_PARALLEL = 2.0
 #: The turn (degrees) past a kept edge under which a moved line that passes its far end sweeps on
 #: (``setback_regions``): measured between 20 (sweeps on) and 90 (stops).
 _RUN_ON_TURN = 45.0
@@ -193,7 +197,7 @@ def _swept(polygons: np.ndarray, edges: Edges, d, corner, ends, owner, swept, st
 
 def _unfolded(edges: Edges, d: np.ndarray) -> np.ndarray:
     """The distances (E,) with that of the shortest edge of each face whose quad folds between two parallel
-    neighbours (turned by under ``_STEP_TURN`` from each other, facing or not), one moved and one kept, set
+    neighbours (turned by under ``_PARALLEL`` from each other, facing or not), one moved and one kept, set
     to 0 where then no strip of the face folds: such an edge (a short end moved further than its length)
     does not move in PRT, and its neighbours' strips end at its line (measured through PyPRT on massing's
     tiers over real lots: tartu.0, a 2 m edge moved 4 m between a kept edge and a moved one parallel to
@@ -207,7 +211,7 @@ def _unfolded(edges: Edges, d: np.ndarray) -> np.ndarray:
     tangent = edges.end - edges.start
     length = np.hypot(tangent[:, 0], tangent[:, 1])
     moved = d > TOL.zero
-    parallel = np.abs(_cosines(tangent[edges.prev], tangent[edges.next])) > np.cos(np.radians(_STEP_TURN))
+    parallel = np.abs(_cosines(tangent[edges.prev], tangent[edges.next])) > np.cos(np.radians(_PARALLEL))
     folded = _folds(edges, d)
     folded = folded[(parallel & (moved[edges.prev] != moved[edges.next]))[folded]]
     order = np.lexsort((length[folded], edges.poly[folded]))

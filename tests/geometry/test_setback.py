@@ -133,6 +133,11 @@ def test_an_edge_whose_strip_folds_beside_a_kept_and_a_moved_parallel_edge_does_
     ([(0.0, 2.9709), (7.1492, 2.9709), (9.6707, 0.0), (10.0664, 0.782), (17.6153, 8.8373), (14.3539, 12.6801),
       (17.817, 27.5399), (4.7465, 19.2314), (2.7897, 18.1895), (3.5211, 18.0795)], [4, 4, 0, 0, 0, 0, 0, 0, 0, 0],
      47.921),
+    # a concave lot of the replay's (4;0;4;4;0), swept where edge 0's moved line passes the kept 0.26 m edge
+    # 9: edge 3 folds between a moved and a kept edge 11 degrees apart, not parallel, and moves (PRT's
+    # terrace 29.862 m^2; 29.785 where it stayed)
+    ([(0.6573, 0.0), (8.5734, 0.0), (9.2553, 2.9407), (9.1815, 3.9155), (5.3402, 2.6055), (4.3043, 6.401),
+      (2.438, 5.6842), (1.1034, 2.6418), (0.0, 1.6567), (0.5763, 0.2446)], [4, 0, 4, 4, 0, 0, 0, 0, 0, 0], 29.862),
 ])
 def test_a_face_whose_strips_still_fold_or_run_past_a_kept_edge_is_swept(ring, d, terrace):
     face = np.array([shapely.Polygon(ring)])
