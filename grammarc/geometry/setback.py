@@ -98,15 +98,8 @@ def setback_regions(polygons: np.ndarray, edges: Edges, distance: np.ndarray, ow
     m = len(polygons)
     # a distance that is not a number (``float("")`` of a missing list item) moves nothing
     d = _unfolded(edges, np.where((owner < n_owners) & np.isfinite(distance), np.maximum(distance, 0.0), 0.0))
-    corner, ends, mitred = _mitres(edges, d)
-    # a strip ends at its next edge's mitre (its own, where the two step); where the two do not meet in
-    # one (a straight vertex, as between the collinear edges a setback leaves, or a spike), at its own
-    # moved end
-    end_corner = np.where(mitred[edges.next][:, None], ends[edges.next], edges.inward * d[:, None])
+    corner, ends, end_corner, idx, quads = _quads(edges, d)
     moved = d > TOL.zero
-    idx = np.flatnonzero(moved)
-    quads = np.stack([edges.start[idx], edges.end[idx], edges.end[idx] + end_corner[idx],
-                      edges.start[idx] + corner[idx]], axis=1)
     strips = shapely.polygons(quads) if len(idx) else np.empty(0, dtype=object)
     folded = ~shapely.is_valid(strips)
     if folded.any():
@@ -219,20 +212,29 @@ def _unfolded(edges: Edges, d: np.ndarray) -> np.ndarray:
     unfolded = d.copy()
     unfolded[first] = 0.0
     # a face where strips still fold is swept as it was (massing.L.46072: its end stays moved)
-    still = np.zeros(len(d), dtype=bool)
-    still[_folds(edges, unfolded)] = True
-    swept = np.zeros(int(edges.poly.max(initial=-1)) + 1, dtype=bool)
-    swept[edges.poly[still]] = True
-    return np.where(swept[edges.poly], d, unfolded)
+    folding = np.zeros(int(edges.poly.max(initial=-1)) + 1, dtype=bool)
+    folding[edges.poly[_folds(edges, unfolded)]] = True
+    return np.where(folding[edges.poly], d, unfolded)
 
 
-def _folds(edges: Edges, d: np.ndarray) -> np.ndarray:
-    """The moved edges (indices) whose quads fold over themselves (a distance longer than the edge allows)."""
+def _quads(edges: Edges, d: np.ndarray):
+    """The quads of the edges moved by ``d`` (E,): (E, 2) where each edge's strip starts and where its
+    previous edge's ends (``_mitres``), and (E, 2) where its own strip ends, relative to its vertices; the
+    moved edges (k,) and their quads (k, 4, 2): start, end, moved end, moved start."""
     corner, ends, mitred = _mitres(edges, d)
+    # a strip ends at its next edge's mitre (its own, where the two step); where the two do not meet in
+    # one (a straight vertex, as between the collinear edges a setback leaves, or a spike), at its own
+    # moved end
     end_corner = np.where(mitred[edges.next][:, None], ends[edges.next], edges.inward * d[:, None])
     idx = np.flatnonzero(d > TOL.zero)
     quads = np.stack([edges.start[idx], edges.end[idx], edges.end[idx] + end_corner[idx],
                       edges.start[idx] + corner[idx]], axis=1)
+    return corner, ends, end_corner, idx, quads
+
+
+def _folds(edges: Edges, d: np.ndarray) -> np.ndarray:
+    """The moved edges (indices) whose quads fold over themselves (a distance longer than the edge allows)."""
+    _, _, _, idx, quads = _quads(edges, d)
     return idx[~shapely.is_valid(shapely.polygons(quads))] if len(idx) else idx
 
 
