@@ -194,8 +194,8 @@ def _unfolded(edges: Edges, d: np.ndarray) -> np.ndarray:
     to 0 where then no strip of the face folds: such an edge (a short end moved further than its length)
     does not move in PRT, and its neighbours' strips end at its line (measured through PyPRT on massing's
     tiers over real lots: tartu.0, a 2 m edge moved 4 m between a kept edge and a moved one parallel to
-    it, where PRT's front stops at the short edge's line and the swept wavefront ran on past the kept edge,
-    62.6 m^2; seoul.31; hiroshima.111, whose second tier, a 1.8 x 2.6 m face with sides moved 3 and 4 m,
+    it, where PRT's front runs on past the kept edge's line and ends at the short edge's line, and the swept
+    wavefront left 62.6 m^2 of that terrace out; seoul.31; hiroshima.111, whose second tier, a 1.8 x 2.6 m face with sides moved 3 and 4 m,
     keeps the 1.8 m side and the other's strip covers the face; the random lots' narrow arms,
     massing.H.15118 and an L's 3 m end moved 4 m, as the wavefront had them). A face whose strips would
     still fold is swept as it is (``_swept``), the edge moving (massing.L.46072's 0.07 m wide shapeU frame,

@@ -97,8 +97,8 @@ def test_an_edge_whose_strip_folds_vanishes_and_its_neighbours_meet(ring, d, rem
 @pytest.mark.parametrize("ring, d, remainder", [
     # a 2 m step (moved 4 m) between the kept edge before it and the moved edge after it, parallel to it:
     # the step does not move and the moved edge's strip ends at its line (PRT's first tier on this lot under
-    # massing's 4;0;4;4;0: terrace 100 m^2 of 240; the swept wavefront ran the moved edge's front on past
-    # the kept edge, 132 m^2, as on the real lot massing.tartu.0)
+    # massing's 4;0;4;4;0: terrace 100 m^2 of 240, where the swept wavefront made 132; on the real lot
+    # massing.tartu.0 it left 62.6 m^2 of PRT's terrace out)
     ([(0, 8), (0, 3), (20, 3), (20, 1), (40, 1), (40, 8)], [4, 0, 4, 4, 0, 0], 16 * 5 + 20 * 3),
     # massing.hiroshima.111's shapeL arm (4;4;0;0;0;0): the 2.4 m end folds between the kept left side and
     # the moved right side; the right side's strip stops at the kept 0.6 m step's line and the upper arm is
