@@ -286,6 +286,8 @@ def ring_starts(coords, ring_offsets, part_offsets, part_source, part_with_start
     ties = np.zeros(len(coords))
     moved_in = np.zeros(len(coords), np.bool_)
     at_vertex = np.zeros(len(coords), np.bool_)
+    corner = np.full(len(coords), -1, np.int64)  # the parent vertex each lies at, -1 for none
+    runs_along = np.full(len(coords), -1, np.int64)  # the parent edge its outgoing edge runs along, -1 for none
     for p in range(len(part_offsets) - 1):
         g = part_source[p]
         for r in range(part_offsets[p], part_offsets[p + 1]):
@@ -303,6 +305,10 @@ def ring_starts(coords, ring_offsets, part_offsets, part_source, part_with_start
                 if np.isfinite(edge) and away <= tolerance and len(start_edges):
                     marked[j] = start_edges[parent_rings[parent_offsets[g]] + int(edge)]
                 at_vertex[j] = near <= tolerance * tolerance and key == np.floor(key)
+                if at_vertex[j]:
+                    corner[j] = int(key)
+                if np.isfinite(edge) and away <= tolerance:
+                    runs_along[j] = int(edge)
                 if np.isfinite(edge) and away > tolerance:
                     moved_in[j] = True
                     keys[j] = edge  # its outgoing edge was moved in from that edge (an offset, a setback)
@@ -332,6 +338,8 @@ def ring_starts(coords, ring_offsets, part_offsets, part_source, part_with_start
                     if at_vertex[r0 + j] and keys[r0 + j] == end:
                         best = j
                         break
+            if r == part_offsets[p] and not cut and not part_inset[p]:
+                best = _at_vertex_0(best, corner[r0:r1], runs_along[r0:r1], outer)
             if r == part_offsets[p] and part_inset[p]:
                 # where the first outer edge left, counting from the last, ends: vertex 0's mitre when the
                 # last edge and edge 0 are left; the end of the last edge's run nearest vertex 0 of all
@@ -361,6 +369,28 @@ def ring_starts(coords, ring_offsets, part_offsets, part_source, part_with_start
                 k = r0 + (best + j) % n
                 out[r0 + j, 0], out[r0 + j, 1] = coords[k, 0], coords[k, 1]
     return out
+
+
+@njit(cache=True, nogil=True)
+def _at_vertex_0(best, corner, along, outer):
+    """The vertex (an index into one ring of a setback's remainder) where PRT starts a remainder that keeps
+    the parent's vertex 0, ``best`` otherwise. ``corner`` (n,): the parent vertex each vertex of the ring
+    lies at (-1 for none); ``along`` (n,): the parent edge its outgoing edge runs along (-1 for none).
+
+    Where the kept last edge runs on past vertex 0 (a reflex vertex 0, edge 0's strip starting beside the
+    last edge's line), the remainder starts at vertex 0 (measured through PyPRT on massing's second tiers
+    over real lots: three of three); where edge 0's strip steps back to vertex 0 from the kept last edge
+    (turned by under 15 degrees, ``geometry.setback``), at the run along the last edge that ends at vertex
+    0, not at the step (sixteen of sixteen)."""
+    n = len(corner)
+    for j in range(n):
+        if corner[j] == 0 and along[j] == outer - 1:
+            return j
+    # (the run before the step lies along the last edge, or along edge 0's line where the two are one line)
+    previous = (best - 1) % n
+    if corner[best] == 0 and along[best] < 0 and (along[previous] == outer - 1 or along[previous] == 0):
+        return previous
+    return best
 
 
 @njit(cache=True, nogil=True)

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import numpy as np
+import pytest
 import shapely
 from conftest import make_lots
 from hypothesis import given, settings
@@ -379,3 +380,29 @@ def test_cut_edges_of_a_piece_the_cut_takes_through_a_hole_turn_their_faces():
     flat = clip_to_slabs(store, np.zeros(2, np.int32), size * [1, 0, 1], 2, *halves, turn_cuts=True)
     paper = clip_to_slabs(store, np.zeros(2, np.int32), size, 2, *halves)
     assert (flat.turn == ALONG).all() and (paper.turn == ALONG).all()
+
+
+@pytest.mark.parametrize("lot, remainder, first", [
+    # the last edge (kept) and edge 0 (set back 4 m) on one line: edge 0's strip steps back to vertex 0 and
+    # PRT starts the remainder at the run along the last edge that ends there (was: at the step)
+    ([(10, 0), (20, 0), (20, -20), (0, -20), (0, 0)],
+     [(4, 0), (10, 0), (10, -4), (20, -4), (20, -16), (4, -16)], (4, 0)),
+    # a reflex vertex 0: the kept last edge runs on past it beside edge 0's strip, and PRT starts the
+    # remainder at vertex 0 (was: at edge 0's moved copy)
+    ([(10, -5), (20, -5), (20, -30), (0, -30), (0, 0), (10, 0)],
+     [(4, 0), (10, 0), (10, -5), (10, -9), (20, -9), (20, -26), (4, -26)], (10, -5)),
+])
+def test_a_remainder_that_keeps_vertex_0_starts_where_prt_starts_it(lot, remainder, first):
+    """massing's tiers (4;0;4;4;0) on these lots, PRT's second tier's edge 0 measured through PyPRT (a
+    setback of edge 0 alone); the same on 19 of 19 real lots of Seoul, Bergen, Tartu and Yaroslavl."""
+    import shapely
+
+    from grammarc.geometry.clip import fit_pieces
+
+    lot = shapely.Polygon(lot)  # clockwise in (x, z)
+    ring = np.array(remainder, float)
+    for turned in range(len(ring)):  # GEOS's start anywhere on the ring
+        pieces = fit_pieces(np.array([shapely.Polygon(np.roll(ring, turned, axis=0))]), np.array([1]),
+                            np.array([[20.0, 0.0, 30.0]]), np.array([lot]))
+        start = pieces.coords[0] * pieces.extent[0, [0, 2]] + pieces.low[0, [0, 2]]
+        np.testing.assert_allclose(start, first, atol=1e-9)

@@ -94,6 +94,58 @@ def test_an_edge_whose_strip_folds_vanishes_and_its_neighbours_meet(ring, d, rem
         assert shapely.area(rest[0]) > 0
 
 
+@pytest.mark.parametrize("ring, d, remainder", [
+    # a 2 m step (moved 4 m) between the kept edge before it and the moved edge after it, parallel to it:
+    # the step does not move and the moved edge's strip ends at its line (PRT's first tier on this lot under
+    # massing's 4;0;4;4;0: terrace 100 m^2 of 240, where the swept wavefront made 132; on the real lot
+    # massing.tartu.0 it left 62.6 m^2 of PRT's terrace out)
+    ([(0, 8), (0, 3), (20, 3), (20, 1), (40, 1), (40, 8)], [4, 0, 4, 4, 0, 0], 16 * 5 + 20 * 3),
+    # massing.hiroshima.111's shapeL arm (4;4;0;0;0;0): the 2.4 m end folds between the kept left side and
+    # the moved right side; the right side's strip stops at the kept 0.6 m step's line and the upper arm is
+    # left, as PRT leaves it (4.713 m^2; the wavefront, started by the step's turning over, took it all)
+    ([(0.0, 0.0), (2.4291, 0.0), (2.4331, 7.5647), (1.8122, 7.5647), (1.8125, 10.1675), (0.0013, 10.1674)],
+     [4, 4, 0, 0, 0, 0], (1.8125 - 0.0013) * (10.1675 - 7.5647)),
+    # its second tier (3;4;0;0), that arm's 1.8 x 2.6 m top: both sides fold; the shorter stays and the other's
+    # strip covers the face, PRT's terrace (nothing left where both stayed)
+    ([(0.0, 0.0), (1.8112, 0.0), (1.8115, 2.6028), (0.0003, 2.6027)], [3, 4, 0, 0], 0.0),
+    # massing.bergen.44's 0.5 m wide shapeU (4;4;3;3;0;0;4;3): with the left side kept the bottom's strip
+    # would fold past it; the face is swept as it is: all terrace, as PRT's (0.36 m^2 were left where it stayed)
+    ([(3.0128, 0.0), (3.0128, 0.467), (2.2295, 0.4748), (2.2295, 0.1399), (0.784, 0.1594), (0.7856, 0.4893),
+      (0.0023, 0.4972), (0.0, 0.0407)], [4, 4, 3, 3, 0, 0, 4, 3], 0.0),
+])
+def test_an_edge_whose_strip_folds_beside_a_kept_and_a_moved_parallel_edge_does_not_move(ring, d, remainder):
+    face = np.array([shapely.Polygon(ring)])
+    (strips,), rest = setback_regions(face, polygon_edges(face), np.array(d, float), np.zeros(len(d), np.int64), 1)
+    assert shapely.area(rest[0]) == pytest.approx(remainder, rel=1e-4, abs=1e-9)
+    assert shapely.area(strips[0]) + shapely.area(rest[0]) == pytest.approx(face[0].area)
+
+
+@pytest.mark.parametrize("ring, d, terrace", [
+    # massing.L.46072's shapeU frame, 0.07 m wide (4;4;3;3;0;0;4;3): its 3.4 m end folds between the kept and
+    # the moved side, and other strips fold too; with the end kept they still would, and the frame is swept
+    # as before, the end moving: PRT's terrace 2.723 m^2 (2.437 where the end stayed)
+    ([(20.7025, 0.0), (24.1359, 0.0), (24.1359, 14.1167), (24.0635, 14.1167), (24.0635, 0.0424), (20.7749, 0.0424),
+      (20.7749, 12.6471), (0.0724, 12.6471), (0.0724, 14.1167), (0.0, 14.1167), (0.0, 12.6047), (20.7025, 12.6047)],
+     [4, 4, 3, 3, 0, 0, 4, 3, 0, 0, 0, 0], 2.723),
+    # massing.concave.46141's first tier (4;4;0;0;0;0): edge 1's moved line passes the far end of the kept
+    # 0.9 m edge 2, past which the boundary turns by 20 degrees: swept on, PRT's terrace 47.921 m^2 (46.357
+    # where the strip stopped at edge 2's line)
+    ([(0.0, 2.9709), (7.1492, 2.9709), (9.6707, 0.0), (10.0664, 0.782), (17.6153, 8.8373), (14.3539, 12.6801),
+      (17.817, 27.5399), (4.7465, 19.2314), (2.7897, 18.1895), (3.5211, 18.0795)], [4, 4, 0, 0, 0, 0, 0, 0, 0, 0],
+     47.921),
+    # a concave lot of the replay's (4;0;4;4;0), swept where edge 0's moved line passes the kept 0.26 m edge
+    # 9: edge 3 folds between a moved and a kept edge 11 degrees apart, not parallel, and moves (PRT's
+    # terrace 29.862 m^2; 29.785 where it stayed)
+    ([(0.6573, 0.0), (8.5734, 0.0), (9.2553, 2.9407), (9.1815, 3.9155), (5.3402, 2.6055), (4.3043, 6.401),
+      (2.438, 5.6842), (1.1034, 2.6418), (0.0, 1.6567), (0.5763, 0.2446)], [4, 0, 4, 4, 0, 0, 0, 0, 0, 0], 29.862),
+])
+def test_a_face_whose_strips_still_fold_or_run_past_a_kept_edge_is_swept(ring, d, terrace):
+    face = np.array([shapely.Polygon(ring)])
+    (strips,), rest = setback_regions(face, polygon_edges(face), np.array(d, float), np.zeros(len(d), np.int64), 1)
+    assert shapely.area(strips[0]) == pytest.approx(terrace, abs=0.01)
+    assert shapely.area(strips[0]) + shapely.area(rest[0]) == pytest.approx(face[0].area)
+
+
 def test_a_holed_face_whose_strips_fold_sweeps_its_outline_and_its_strips_stop_at_the_hole():
     """The 9 x 5 m L above with a hole in its front's strip: its outline is swept as the L's is (the hole does
     not move) and the strips are clipped to the face (PRT on massing.concave.33183, a shapeU whose shape has a
