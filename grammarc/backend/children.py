@@ -154,7 +154,8 @@ def _renormalized(coords, low, extent, slab_low, slab_extent) -> np.ndarray:
 
 def clip_pieces(chunk: Chunk, shapes: Shapes, axis: int, parent, step, pos, length, index, turn_cuts: bool = False):
     """Children of polygons split across their plane become the pieces of the polygon in their slabs
-    (``geometry.clip``): empty ones go, a slab that cuts the polygon apart gives one child a piece.
+    (``geometry.clip``): empty ones go, a slab that cuts a polygon apart gives one child a piece, one that
+    cuts a prism apart one child all its pieces (``_join_prism_pieces``).
     Children of meshes (roofs, envelopes) become the mesh cut to their slab and closed
     (``mesh_shapes.clip_meshes``).
 
