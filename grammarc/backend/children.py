@@ -27,6 +27,7 @@ from grammarc.geometry.clip import clip_to_slabs
 from grammarc.geometry.components import rect_rings
 from grammarc.geometry.meshes import MESH_BASE, is_mesh, is_polygon
 from grammarc.geometry.polygons import PLANE_U, PLANE_V
+from grammarc.geometry.queries import shape_faces
 from grammarc.ragged import ragged_take, segment_of
 
 
@@ -153,7 +154,8 @@ def _renormalized(coords, low, extent, slab_low, slab_extent) -> np.ndarray:
 
 def clip_pieces(chunk: Chunk, shapes: Shapes, axis: int, parent, step, pos, length, index, turn_cuts: bool = False):
     """Children of polygons split across their plane become the pieces of the polygon in their slabs
-    (``geometry.clip``): empty ones go, a slab that cuts the polygon apart gives one child a piece.
+    (``geometry.clip``): empty ones go, a slab that cuts a polygon apart gives one child a piece, one that
+    cuts a prism apart one child all its pieces (``_join_prism_pieces``).
     Children of meshes (roofs, envelopes) become the mesh cut to their slab and closed
     (``mesh_shapes.clip_meshes``).
 
@@ -200,7 +202,43 @@ def clip_pieces(chunk: Chunk, shapes: Shapes, axis: int, parent, step, pos, leng
         from_mesh = ~is_piece & meshes[0][rows]
         for mine, theirs in zip(geometry, meshes):
             mine[from_mesh] = theirs[rows][from_mesh]
-    return parent[rows], step[rows], pos, length, index[rows], geometry
+    keep = _join_prism_pieces(chunk, shapes, axis, parent[rows], rows, pos, length, geometry)
+    return (parent[rows][keep], step[rows][keep], pos[keep], length[keep], index[rows][keep],
+            tuple(g[keep] for g in geometry))
+
+
+def _join_prism_pieces(chunk: Chunk, shapes: Shapes, axis: int, parent, child, pos, length, geometry) -> np.ndarray:
+    """A slab that cuts a prism (an extruded concave footprint) apart leaves its child all the pieces, one
+    mesh in the box around them, as PRT does (a balcony's ``s()`` then scales the pieces together:
+    complexpatterns' railings on a U's two arms stand where PRT's do). The first piece of each child
+    takes the mesh, in place (``pos``, ``length`` and ``geometry``, rows (k,) of children ``child`` (k,)
+    of parents ``parent`` (k,)); returns which rows stay."""
+    is_piece, geom, low, extent, corner = geometry
+    keep = np.ones(len(child), dtype=bool)
+    store = chunk.polygons
+    parent_geom = shapes.geom[parent]
+    prism = is_piece & is_polygon(parent_geom)
+    at = np.flatnonzero(prism)
+    flat_axis = store.plane[parent_geom[at]]
+    prism[at] = (flat_axis != axis) & (shapes.size[parent[at], flat_axis] > TOL.zero)
+    # rows of a child follow each other: the later pieces of a prism's child join its first
+    later = np.zeros(len(child), dtype=bool)
+    later[1:] = prism[1:] & prism[:-1] & (child[1:] == child[:-1])
+    if not later.any():
+        return keep
+    joined = later.copy()
+    joined[:-1] |= later[1:]
+    rows = np.flatnonzero(joined)
+    faces = shape_faces(extent[rows], geom[rows], store, chunk.meshes, corner[rows])
+    verts = faces.verts + low[rows][faces.vertex_shape()]  # in the parent's scope
+    first = rows[~later[rows]]
+    mesh_offsets = faces.shape_offsets[np.append(np.flatnonzero(~later[rows]), len(rows))]
+    new_geom, new_low, new_extent = mesh_shapes.store_fitted(chunk, verts, faces.ring_offsets, faces.face_offsets,
+                                                             mesh_offsets)
+    geom[first], low[first], extent[first], corner[first] = new_geom, new_low, new_extent, 0
+    pos[first], length[first] = new_low[:, axis], new_extent[:, axis]
+    keep[later] = False
+    return keep
 
 
 def _clip_meshes(chunk: Chunk, shapes: Shapes, axis: int, parent, step, pos, length, index):

@@ -302,3 +302,19 @@ def test_a_split_makes_no_part_of_prts_length_limit_or_shorter(write, width, mad
     assert names(r) == made
     starts = {"A": 0, "B": 1, "C": width - 1}  # C keeps its place: B's room is left empty
     np.testing.assert_allclose(r["xform"][:, 0, 3], [starts[n] for n in made], atol=1e-9)
+
+
+def test_a_slab_that_cuts_a_prism_apart_keeps_its_pieces_in_one_shape(write):
+    """PRT (complexpatterns' balconies on a U whose arms the last slab cuts): the pieces of an extruded
+    footprint in one slab are one shape in the box around them, so s() scales them together and the
+    railings of the inner sides stand at 0.877 + x * 18.246 / 20 (x 6 and 14: 6.351 and 13.649), not each
+    arm on its own (5.123 and 14.877)."""
+    u = [np.array([[0, 0], [6, 0], [6, 10], [14, 10], [14, 0], [20, 0], [20, 15], [0, 15]], float)]
+    r = run(write, "Lot --> extrude(10) split(z){ ~1 : NIL | 4 : Arms }\nArms --> primitiveCube()\n", [u])
+    np.testing.assert_allclose(r["xform"][:, 0, 0], [20.0])  # one shape across both arms
+    r = run(write, "Lot --> extrude(10) split(z){ ~1 : NIL | 4 : Arms }\n"
+                   "Arms --> s(scope.sx - 1.754, '1, '1) center(x) comp(f){ bottom : Bottom }\n", [u])
+    bottoms = [ring for face in mesh_faces(r) for ring in face]
+    assert len(bottoms) == 2
+    xs = sorted(round(float(x), 3) for ring in bottoms for x in np.unique(ring[:, 0].round(3)))
+    assert xs == [0.877, 6.351, 13.649, 19.123]
