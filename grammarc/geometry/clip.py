@@ -386,9 +386,12 @@ def _at_vertex_0(best, corner, along, outer):
     for j in range(n):
         if corner[j] == 0 and along[j] == outer - 1:
             return j
-    # (the run before the step lies along the last edge, or along edge 0's line where the two are one line)
+    # (the run before the step lies along the last edge, or along edge 0's line where the two are one line,
+    # and starts where a strip ends on it: one from the last edge's kept start is not where PRT starts,
+    # massing.near_degenerate.43572's 1 m last edge)
     previous = (best - 1) % n
-    if corner[best] == 0 and along[best] < 0 and (along[previous] == outer - 1 or along[previous] == 0):
+    if corner[best] == 0 and along[best] < 0 and corner[previous] < 0 and (
+            along[previous] == outer - 1 or along[previous] == 0):
         return previous
     return best
 

@@ -200,13 +200,21 @@ def _unfolded(edges: Edges, d: np.ndarray) -> np.ndarray:
     massing.H.15118 and an L's 3 m end moved 4 m, as the wavefront had them). A face whose strips would
     still fold is swept as it is (``_swept``), the edge moving (massing.L.46072's 0.07 m wide shapeU frame,
     bergen.44's 0.5 m wide one: PRT's terraces), and so is one whose folded edges lie between neighbours
-    that are not parallel, or both moved (a channel's end that closes: holes.33921's second tier)."""
+    that are not parallel, or both moved (a channel's end that closes: holes.33921's second tier), or whose
+    moved neighbour steps from the edge beyond it (nearly collinear, moved by another distance: a part of a
+    kept edge's line that moves, as near_degenerate.44048's 0.67 m step, where PRT's terrace runs on along
+    the bar as the wavefront's; a moved line that runs on, as hiroshima.136's, is a side)."""
     tangent = edges.end - edges.start
     length = np.hypot(tangent[:, 0], tangent[:, 1])
     moved = d > TOL.zero
     parallel = np.abs(_cosines(tangent[edges.prev], tangent[edges.next])) > np.cos(np.radians(_PARALLEL))
+    # the moved neighbour (``side``) and the edge beyond it step as in ``_mitres``
+    side = np.where(moved[edges.prev], edges.prev, edges.next)
+    beyond = np.where(moved[edges.prev], edges.prev[side], edges.next[side])
+    steps = (_cosines(tangent[side], tangent[beyond]) > np.cos(np.radians(_STEP_TURN))) & (
+        np.abs(d[side] - d[beyond]) > TOL.zero)
     folded = _folds(edges, d)
-    folded = folded[(parallel & (moved[edges.prev] != moved[edges.next]))[folded]]
+    folded = folded[(parallel & (moved[edges.prev] != moved[edges.next]) & ~steps)[folded]]
     order = np.lexsort((length[folded], edges.poly[folded]))
     first = folded[order][np.r_[True, np.diff(edges.poly[folded][order]) != 0]] if len(folded) else folded
     unfolded = d.copy()

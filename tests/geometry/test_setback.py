@@ -138,6 +138,11 @@ def test_an_edge_whose_strip_folds_beside_a_kept_and_a_moved_parallel_edge_does_
     # terrace 29.862 m^2; 29.785 where it stayed)
     ([(0.6573, 0.0), (8.5734, 0.0), (9.2553, 2.9407), (9.1815, 3.9155), (5.3402, 2.6055), (4.3043, 6.401),
       (2.438, 5.6842), (1.1034, 2.6418), (0.0, 1.6567), (0.5763, 0.2446)], [4, 0, 4, 4, 0, 0, 0, 0, 0, 0], 29.862),
+    # massing.near_degenerate.44048's second tier (4;4;0;0;...): edge 1 folds between the kept edge 2 and the
+    # moved edge 0, a 0.67 m step of the kept bottom's line: the face is swept, the wavefront running on
+    # along the bar, as PRT's terrace (8.245 m^2; 2.13 where edge 1 stayed)
+    ([(10.6076, 0.0014), (11.2778, 0.0014), (12.4133, 1.7215), (10.6075, 1.7215), (2.782, 1.7203), (8.6323, 11.1495),
+      (7.5022, 12.0281), (5.8456, 10.7931), (0.0, 1.3713), (0.7805, 0.0)], [4, 4, 0, 0, 0, 0, 0, 0, 0, 0], 8.245),
 ])
 def test_a_face_whose_strips_still_fold_or_run_past_a_kept_edge_is_swept(ring, d, terrace):
     face = np.array([shapely.Polygon(ring)])
