@@ -213,10 +213,15 @@ def _unfolded(edges: Edges, d: np.ndarray) -> np.ndarray:
     beyond = np.where(moved[edges.prev], edges.prev[side], edges.next[side])
     steps = (_cosines(tangent[side], tangent[beyond]) > np.cos(np.radians(_STEP_TURN))) & (
         np.abs(d[side] - d[beyond]) > TOL.zero)
+    between = parallel & (moved[edges.prev] != moved[edges.next]) & ~steps
+    if not (between & moved).any():  # no edge to keep (most faces): the quads need no test of their own
+        return d
     folded = _folds(edges, d)
-    folded = folded[(parallel & (moved[edges.prev] != moved[edges.next]) & ~steps)[folded]]
+    folded = folded[between[folded]]
+    if not len(folded):
+        return d
     order = np.lexsort((length[folded], edges.poly[folded]))
-    first = folded[order][np.r_[True, np.diff(edges.poly[folded][order]) != 0]] if len(folded) else folded
+    first = folded[order][np.r_[True, np.diff(edges.poly[folded][order]) != 0]]
     unfolded = d.copy()
     unfolded[first] = 0.0
     # a face where strips still fold is swept as it was (massing.L.46072: its end stays moved)
