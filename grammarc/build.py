@@ -30,7 +30,7 @@ from grammarc.backend.occlusion import Occluders
 from grammarc.backend.plan import make_plan
 from grammarc.compiler import compile_grammar
 from grammarc.constants import LIMITS, Limits
-from grammarc.errors import ChunkTooLarge, LotFailure, UsageError
+from grammarc.errors import ChunkTooLarge, LotFailure, UsageError, check_stopped
 from grammarc.io import OutputOptions, writer_for, written_paths
 from grammarc.io.lot_format import LotsOptions
 from grammarc.io.lots import default_lot, read_lots
@@ -191,6 +191,7 @@ def _build(source: Path, display: str | None, grammar_path: Path, output, lots_p
             raise _NothingBuilt  # a failed build: the writer aborts, an older output stays as it was
         # the reports are written before the output is put in place and renamed after it: a build whose
         # reports cannot be written leaves no new output
+        check_stopped()  # a stop whose raise was lost leaves no output either
         with (staged_reports(reports, reports_file, dict(zip(every.index.tolist(), every.ids.tolist())))
               if reports else contextlib.nullcontext()):
             counts = writer.close()

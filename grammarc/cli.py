@@ -27,7 +27,16 @@ from pathlib import Path
 from grammarc import __version__
 from grammarc.constants import LIMITS, PARTITION_SIZE
 from grammarc.diagnostics import render_all
-from grammarc.errors import GrammarcError, GrammarError, UsageError, interruption, raise_stopped, stopped
+from grammarc.errors import (
+    GrammarcError,
+    GrammarError,
+    UsageError,
+    clear_stopped,
+    hide_lost_stops,
+    interruption,
+    raise_stopped,
+    stopped,
+)
 
 _START_HELP = ("the start rule (default: @StartRule, else the first rule); a call `Lot(10, \"a\", true)` "
               "gives the arguments of a start rule with parameters")
@@ -41,16 +50,23 @@ def main(argv: list[str] | None = None) -> int:
     # (README, "Figures"). ``build.derive_all`` turns it on while chunks are derived.
     collecting = gc.isenabled()
     gc.disable()
-    handlers = {s: signal.signal(s, raise_stopped) for s in (signal.SIGTERM, signal.SIGHUP)} \
+    handlers = {s: signal.signal(s, raise_stopped) for s in (signal.SIGINT, signal.SIGTERM, signal.SIGHUP)} \
         if threading.current_thread() is threading.main_thread() else {}
+    unraisable, sys.unraisablehook = sys.unraisablehook, hide_lost_stops
     try:
-        with warnings.catch_warnings():
-            # grammarc says what concerns the user itself; the libraries' warnings (numpy's "invalid value
-            # in divide" of a value grammarc handles) are not the user's to read, unless asked for with
-            # Python's -W or PYTHONWARNINGS. The workers are forked with this filter.
-            if not sys.warnoptions:
-                warnings.simplefilter("ignore")
-            return args.run(args)
+        try:
+            with warnings.catch_warnings():
+                # grammarc says what concerns the user itself; the libraries' warnings (numpy's "invalid
+                # value in divide" of a value grammarc handles) are not the user's to read, unless asked
+                # for with Python's -W or PYTHONWARNINGS. The workers are forked with this filter.
+                if not sys.warnoptions:
+                    warnings.simplefilter("ignore")
+                return args.run(args)
+        except BaseException as error:  # whatever failed after a signal: the command was stopped
+            stop = interruption(error)
+            if stop is None or stop is error:
+                raise
+            raise stop from error
     except GrammarError as error:
         print(str(error), file=sys.stderr)
         n = sum(d.is_error for d in error.diagnostics)
@@ -60,11 +76,6 @@ def main(argv: list[str] | None = None) -> int:
         print(f"grammarc: error: {error}", file=sys.stderr)
         return error.exit_code
     except KeyboardInterrupt as stop:  # Ctrl-C, or SIGTERM / SIGHUP (``Stopped``)
-        return stopped(stop)
-    except SystemError as error:  # a signal that came while numba's code called back into Python
-        stop = interruption(error)
-        if stop is None:
-            raise
         return stopped(stop)
     except BrokenPipeError:
         # the reader of our output went away (`grammarc info city.npz | head`): not an error of ours
@@ -76,6 +87,8 @@ def main(argv: list[str] | None = None) -> int:
     finally:
         for signum, handler in handlers.items():
             signal.signal(signum, handler)
+        clear_stopped()
+        sys.unraisablehook = unraisable
         if collecting:
             gc.enable()
 

@@ -75,22 +75,51 @@ class Stopped(KeyboardInterrupt):
         self.signum = signum
 
 
+#: The signal of a stop raised while the command runs: kept until the command ends, because the raise
+#: itself can be lost. Python runs a handler wherever the program is, and when that is C code calling back
+#: into Python, the callback's caller may swallow the exception (llvmlite's ctypes callbacks while numba
+#: compiles: "Exception ignored on calling ctypes callback function") or turn it into another
+#: (numba's ``_numba_unpickle``: a ``SystemError``).
+_pending: list[int] = []
+
+
 def raise_stopped(signum, frame) -> None:
-    """The handler of SIGTERM and SIGHUP while a command runs."""
+    """The handler of SIGINT, SIGTERM and SIGHUP while a command runs."""
+    _pending.append(signum)
     raise Stopped(signum)
 
 
+def check_stopped() -> None:
+    """Raise the stop whose raise was lost, if any: called where a command goes on for long (each round
+    of a derivation) and before an output is put in place."""
+    if _pending:
+        raise Stopped(_pending[0])
+
+
+def hide_lost_stops(unraisable) -> None:
+    """``sys.unraisablehook`` while a command runs: a stop that a callback's caller swallowed is kept and
+    said when the command stops; the traceback Python would print for it is not the user's to read."""
+    if not isinstance(unraisable.exc_value, KeyboardInterrupt):
+        sys.__unraisablehook__(unraisable)
+
+
+def clear_stopped() -> None:
+    """The command is over: a later command in this process (tests, a served command's fork) starts
+    without its stop."""
+    _pending.clear()
+
+
 def interruption(error: BaseException) -> KeyboardInterrupt | None:
-    """The Ctrl-C or ``Stopped`` behind ``error``, if any. A signal's handler that raises while numba's
-    compiled code calls back into Python (``_numba_unpickle``) comes out as a ``SystemError`` whose cause is
-    the interruption: the command was stopped all the same."""
+    """The Ctrl-C or ``Stopped`` behind ``error``, if any: in its chain of causes (numba's ``SystemError``),
+    or a stop whose raise was lost (see ``_pending``). Whatever failed after a stop, the command was
+    stopped."""
     seen = set()
     while error is not None and id(error) not in seen:
         if isinstance(error, KeyboardInterrupt):
             return error
         seen.add(id(error))
         error = error.__cause__ or error.__context__
-    return None
+    return Stopped(_pending[0]) if _pending else None
 
 
 def stopped(stop: KeyboardInterrupt) -> int:

@@ -41,7 +41,7 @@ import time
 from collections.abc import Callable
 from pathlib import Path
 
-from grammarc.errors import raise_stopped, stopped
+from grammarc.errors import interruption, raise_stopped, stopped
 from grammarc.frontend.user_cache import code_stamp
 
 #: Environment variables that change what the imported code does (read at import time).
@@ -268,17 +268,18 @@ def _child(connection: socket.socket, run: Callable[[list[str]], int]) -> None:
     status = 1
     try:
         signal.signal(signal.SIGCHLD, signal.SIG_DFL)
-        signal.signal(signal.SIGINT, signal.default_int_handler)
-        for signum in (signal.SIGTERM, signal.SIGHUP):  # as the command will, from before it begins
+        for signum in _FORWARDED:  # as the command will, from before it begins
             signal.signal(signum, raise_stopped)
         status = _run_request(connection, run)
-    except KeyboardInterrupt as stop:  # a signal forwarded before the command began
-        status = stopped(stop)
-    except BaseException:  # noqa: BLE001 - whatever happened, the client hears a status
-        with contextlib.suppress(BaseException):
-            import traceback
+    except BaseException as error:  # noqa: BLE001 - whatever happened, the client hears a status
+        stop = interruption(error)  # a signal forwarded before the command began
+        if stop is not None:
+            status = stopped(stop)
+        else:
+            with contextlib.suppress(BaseException):
+                import traceback
 
-            traceback.print_exc()
+                traceback.print_exc()
     finally:
         # The command is over: a client that hangs up once it has its status makes ``_watch`` send a
         # SIGTERM, which must not raise here, past ``_exit``, into the server's own code (which would say

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import contextlib
+import ctypes
 import json
 import os
 import re
@@ -16,7 +17,7 @@ import numpy as np
 import pytest
 
 from grammarc.cli import main
-from grammarc.errors import Stopped
+from grammarc.errors import Stopped, raise_stopped
 from grammarc.io.npz import read_instances
 
 GOOD = 'attr height = 9\nlot ~> S(1r, height, 1r) Comp("sidefaces"){ wall }\n'
@@ -370,6 +371,26 @@ def test_a_signal_raised_inside_numbas_callback_still_stops_the_build(write, tmp
 
     monkeypatch.setattr("grammarc.build.derive_chunk", derive_chunk)
     grammar = write("g.cga", "Lot --> extrude(3)\n")
+    assert main(["build", str(grammar), "--emit", str(tmp_path / "out.npz"), "--quiet"]) == 128 + signal.SIGTERM
+    assert capsys.readouterr().err == "grammarc: SIGTERM: stopped; nothing was written\n"
+    assert not (tmp_path / "out.npz").exists()
+
+
+def test_a_signal_whose_raise_a_c_callback_swallows_still_stops_the_build(write, tmp_path, capsys,
+                                                                           monkeypatch):
+    """llvmlite's ctypes callbacks (while numba compiles) drop what a handler raises in them: the stop is
+    kept, and the derivation's next round stops the build, which writes nothing and prints no traceback."""
+    from grammarc import build
+
+    swallowing = ctypes.CFUNCTYPE(None)(lambda: raise_stopped(signal.SIGTERM, None))
+    derive_chunk = build.derive_chunk
+
+    def derive_chunk_after_a_signal(*args, **kwargs):
+        swallowing()  # "Exception ignored on calling ctypes callback function"
+        return derive_chunk(*args, **kwargs)
+
+    monkeypatch.setattr("grammarc.build.derive_chunk", derive_chunk_after_a_signal)
+    grammar = write("g.cga", "Lot --> extrude(3) A\nA --> split(y) { 1 : B }*\n")
     assert main(["build", str(grammar), "--emit", str(tmp_path / "out.npz"), "--quiet"]) == 128 + signal.SIGTERM
     assert capsys.readouterr().err == "grammarc: SIGTERM: stopped; nothing was written\n"
     assert not (tmp_path / "out.npz").exists()

@@ -99,7 +99,7 @@ def test_a_signal_to_the_client_stops_its_served_command(served, tmp_path, signu
     _wait_for(lambda: _children(served.pid))  # it connected: the signal is held, then forwarded
     client.send_signal(signum)
     _, err = client.communicate(timeout=60)
-    assert client.returncode == status and said in err and not (tmp_path / "x.npz").exists()
+    assert client.returncode == status and said in err and not (tmp_path / "x.npz").exists(), err
     _wait_for(lambda: not _children(served.pid))
 
 

@@ -41,6 +41,7 @@ from grammarc.backend.slots import (
 from grammarc.backend.streams import lot_keys
 from grammarc.backend.texture_space import initial_column
 from grammarc.constants import Limits
+from grammarc.errors import check_stopped
 from grammarc.geometry.footprint import footprint_polygons, lot_scopes
 from grammarc.geometry.polygons import PolygonStore
 from grammarc.geometry.streets import lot_streets
@@ -117,6 +118,7 @@ def derive_chunk(plan: Plan, lots: Lots, *, seed: int, limits: Limits, overrides
         order = [s.id for s in plan.symbols if s.rules and s.priority <= stage]
         others = [s for s in order if s not in plan.queries]
         while any(pending.get(s) for s in order):
+            check_stopped()
             if occluders_only and not any(pending.get(s) for s in others):
                 return chunk.occluders.table()
             for sym_id in order:
