@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import os
 import signal
 import sys
 
@@ -75,23 +76,36 @@ class Stopped(KeyboardInterrupt):
         self.signum = signum
 
 
-#: The signal of a stop raised while the command runs: kept until the command ends, because the raise
-#: itself can be lost. Python runs a handler wherever the program is, and when that is C code calling back
-#: into Python, the callback's caller may swallow the exception (llvmlite's ctypes callbacks while numba
-#: compiles: "Exception ignored on calling ctypes callback function") or turn it into another
-#: (numba's ``_numba_unpickle``: a ``SystemError``).
+#: The signals that stopped the command: kept until the command ends, because the stop is not always
+#: raised where the signal comes (``raise_stopped``), and a raise can be lost.
 _pending: list[int] = []
 
 
 def raise_stopped(signum, frame) -> None:
-    """The handler of SIGINT, SIGTERM and SIGHUP while a command runs."""
+    """The handler of SIGINT, SIGTERM and SIGHUP while a command runs: the stop is raised where the program
+    is, unless that is numba's or llvmlite's Python code. There, raising is unsafe: llvmlite's ctypes
+    callbacks, while numba compiles, swallow the exception ("Exception ignored on calling ctypes callback
+    function") and the compile leaves objects that are freed twice later (glibc aborts the process); numba's
+    callbacks from compiled code turn it into a ``SystemError``. The stop is then held, and raised by
+    ``check_stopped`` where the command next looks."""
     _pending.append(signum)
-    raise Stopped(signum)
+    if not _in_numba(frame):
+        raise Stopped(signum)
+
+
+def _in_numba(frame) -> bool:
+    roots = tuple(os.path.dirname(module.__file__) + os.sep
+                  for module in (sys.modules.get("numba"), sys.modules.get("llvmlite")) if module is not None)
+    while frame is not None:
+        if frame.f_code.co_filename.startswith(roots):
+            return True
+        frame = frame.f_back
+    return False
 
 
 def check_stopped() -> None:
-    """Raise the stop whose raise was lost, if any: called where a command goes on for long (each round
-    of a derivation) and before an output is put in place."""
+    """Raise the stop that was held or whose raise was lost, if any: called where a command goes on for
+    long (each round of a derivation) and before an output is put in place."""
     if _pending:
         raise Stopped(_pending[0])
 
