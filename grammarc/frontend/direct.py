@@ -1,9 +1,9 @@
 """``direct``: the lowering of an operation whose arguments are its IR node's fields, which the dialects'
 tables of operations name (``cga2006/operations.py``, ``cityengine/operations.py``).
 
-Apart from ``lowering``, which imports lark: CityEngine's table is needed wherever a file is assembled
-(``cityengine.assembly`` checks its calls against it), also from statements the lowered cache kept, which
-need no lark.
+A module of its own, not ``lowering``'s, which imports lark: CityEngine's table of operations is built
+wherever a file is assembled (``cityengine.assembly`` checks the file's calls against it), also one whose
+statements the lowered cache kept, which needs no lark.
 """
 
 from __future__ import annotations

@@ -1,7 +1,7 @@
 """The numbers of random-stream sites of a grammar's files, given out in source order.
 
-Apart from ``lowering``, which imports lark: a file taken from the lowered cache (``lowered_cache``) goes on
-numbering the sites of the files after it without lowering, or importing lark.
+A module of its own, not ``lowering``'s, which imports lark: a file whose statements the lowered cache
+kept (``lowered_cache``) goes on numbering the sites of the files after it without being lowered.
 """
 
 from __future__ import annotations
