@@ -1,6 +1,7 @@
 """What the lowerings of both dialects share: spans, random-stream sites, the expression operators of
-``grammars/expressions.lark``, scope brackets and argument lists, arity checks, and ``direct``, the lowering
-of an operation whose arguments are its IR node's fields.
+``grammars/expressions.lark``, scope brackets and argument lists, arity checks (``direct``, the lowering of
+an operation whose arguments are its IR node's fields, is in ``direct.py``, and the sites' numbering in
+``sites.py``: the statements of a file the lowered cache keeps need those, not lark).
 
 A dialect's ``Lowering`` subclasses ``LoweringBase`` and defines ``expr`` (how an argument that must be a
 plain expression is checked), its statements, and its operations in two tables: ``OPERATIONS`` for calls
@@ -10,25 +11,10 @@ without parts, name -> handler(lowering, op, args, span); ``PART_OPERATIONS`` fo
 
 from __future__ import annotations
 
-import dataclasses
-import typing
-
 from lark import Token, Transformer, v_args
 
 from grammarc.diagnostics import Diagnostics, Span
 from grammarc.ir import nodes as ir
-
-
-class Sites:
-    """The numbers of random-stream sites, given out in source order across a grammar's files
-    (``next(sites)``); ``next_site`` is the number the next one gets."""
-
-    def __init__(self, next_site: int = 1):
-        self.next_site = next_site
-
-    def __next__(self) -> int:
-        self.next_site += 1
-        return self.next_site - 1
 
 
 @v_args(inline=True, meta=True)
@@ -110,41 +96,3 @@ class LoweringBase(Transformer):
 
     def name(self, meta, tok):
         return ir.Name(str(tok), self.token_span(tok))
-
-
-def direct(node: type):
-    """The lowering of an operation whose arguments are ``node``'s fields in order, each a plain
-    expression: a line ``"report": direct(ir.Report)`` in a dialect's ``OPERATIONS``.
-
-    The fields before ``span`` say how many arguments the operation takes: an ``Expr`` field one, a
-    ``tuple[Expr, Expr, Expr]`` field three (``ir.Translate``). A call with another count is an ``arity``
-    error and lowers to ``ir.Empty``. A ``site`` field gets the next random-stream site, drawn after the
-    arguments' own as everywhere in lowering. A node with any other field before ``span`` needs a handler
-    of its own: ``TypeError`` here.
-    """
-    names = [f.name for f in dataclasses.fields(node)]
-    hints = typing.get_type_hints(node)
-    widths = []  # per field before span: None for one expression, n for a tuple of n
-    for name in names[:names.index("span")]:
-        hint = hints[name]
-        if hint == ir.Expr:
-            widths.append(None)
-        elif typing.get_origin(hint) is tuple and all(a == ir.Expr for a in typing.get_args(hint)):
-            widths.append(len(typing.get_args(hint)))
-        else:
-            raise TypeError(f"`{node.__name__}.{name}` is not an expression: lower {node.__name__} "
-                            "with a handler of its own")
-    count = sum(1 if w is None else w for w in widths)
-    random = "site" in names
-
-    def lower(lowering: LoweringBase, op: str, args: tuple, span: Span):
-        if not lowering.arity(op, args, (count,), span):
-            return ir.Empty(span)
-        values = iter([lowering.expr(a) for a in args])
-        fields = [next(values) if w is None else tuple(next(values) for _ in range(w)) for w in widths]
-        if random:
-            return node(*fields, span, site=lowering.site())
-        return node(*fields, span)
-
-    lower.__qualname__ = lower.__name__ = f"direct({node.__name__})"
-    return lower

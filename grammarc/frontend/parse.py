@@ -6,7 +6,8 @@ import their expressions from ``grammars/expressions.lark``; their parsers come 
 text is cut into statements (``statements.py``, each dialect its way); each is parsed on its own, with
 leading newlines so that lark's line numbers are the file's, checked for a nesting that the recursive
 passes after it could not take, lowered to IR by the dialect's ``Lowering``, and the statements are
-assembled into a module by its ``assemble``.
+assembled into a module by its ``assemble``. A file's statements that the user's cache folder keeps
+(``lowered_cache``) are not parsed again: lark and the lowerings are imported only where a statement is.
 """
 
 from __future__ import annotations
@@ -14,36 +15,39 @@ from __future__ import annotations
 import re
 from collections.abc import Callable
 from dataclasses import dataclass
+from importlib import import_module
 from pathlib import Path
-
-from lark import Tree
-from lark.exceptions import UnexpectedCharacters, UnexpectedEOF, UnexpectedInput, UnexpectedToken
+from typing import TYPE_CHECKING
 
 from grammarc.diagnostics import Diagnostics, Span
 from grammarc.frontend import cga2006, cityengine, lowered_cache
 from grammarc.frontend.cityengine.nodes import Import
 from grammarc.frontend.imports import Roots, find_roots, load_import
-from grammarc.frontend.lowering import LoweringBase, Sites
-from grammarc.frontend.parsers import parser_for
+from grammarc.frontend.sites import Sites
 from grammarc.frontend.statements import Statement, split_cityengine, split_paper
 from grammarc.ir import nodes as ir
+
+if TYPE_CHECKING:
+    from lark import Tree
+    from lark.exceptions import UnexpectedInput
 
 
 @dataclass(frozen=True, slots=True)
 class Dialect:
     """How a dialect is read: its lark grammar (a file of the package), how its text is cut into statements,
-    the Transformer that lowers one statement, and the function that assembles the lowered statements of a
-    file into a module."""
+    the module whose ``Lowering`` (a lark Transformer) lowers one statement, and the function that
+    assembles the lowered statements of a file into a module."""
 
     grammar: str
     split: Callable[[str], list[Statement]]
-    lowering: type[LoweringBase]
+    lowering: str
     assemble: Callable[..., ir.Module]
 
 
 DIALECTS = {
-    "cga2006": Dialect("grammars/cga2006.lark", split_paper, cga2006.Lowering, cga2006.assemble),
-    "cityengine": Dialect("grammars/cityengine.lark", split_cityengine, cityengine.Lowering,
+    "cga2006": Dialect("grammars/cga2006.lark", split_paper, "grammarc.frontend.cga2006.lowering",
+                       cga2006.assemble),
+    "cityengine": Dialect("grammars/cityengine.lark", split_cityengine, "grammarc.frontend.cityengine.lowering",
                           cityengine.assemble),
 }
 #: Text that only CityEngine CGA has: its version line, annotations, lower-case operations, const.
@@ -117,7 +121,11 @@ def parse_source(text: str, file: str, diags: Diagnostics, dialect: str | None =
 
 def _lower(spec: Dialect, text: str, file: str, diags: Diagnostics, sites: Sites) -> list:
     """Each statement of ``text`` parsed and lowered on its own (an error in one leaves the others)."""
-    parser = parser_for(spec.grammar)
+    from lark.exceptions import UnexpectedInput
+
+    from grammarc.frontend.parsers import parser_for
+
+    parser, lowering = parser_for(spec.grammar), import_module(spec.lowering).Lowering
     lowered = []
     for statement in spec.split(text):
         try:
@@ -131,7 +139,7 @@ def _lower(spec: Dialect, text: str, file: str, diags: Diagnostics, sites: Sites
                         "levels of brackets and operators", Span(file, statement.line, column,
                                                                  statement.line, column + 1))
             continue
-        lowered.append(spec.lowering(file, diags, sites).transform(tree))
+        lowered.append(lowering(file, diags, sites).transform(tree))
     return lowered
 
 
@@ -145,6 +153,8 @@ MAX_NESTING = 150
 def _too_deep(tree: Tree) -> bool:
     """Whether ``tree`` is deeper than ``MAX_NESTING``, found without recursion (the tree may be deeper
     than Python's recursion limit)."""
+    from lark import Tree
+
     stack = [(tree, 1)]
     while stack:
         node, depth = stack.pop()
@@ -171,6 +181,8 @@ def _import(statement, file: str, path: Path | None, diags: Diagnostics, sources
 
 
 def _syntax_error(error: UnexpectedInput, file: str, text: str, first_line: int, diags: Diagnostics):
+    from lark.exceptions import UnexpectedCharacters, UnexpectedEOF, UnexpectedToken
+
     if isinstance(error, UnexpectedCharacters):
         span = Span(file, error.line, error.column, error.line, error.column + 1)
         char = error.char if hasattr(error, "char") else "?"

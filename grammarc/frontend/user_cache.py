@@ -1,11 +1,12 @@
 """Files kept between runs in the user's own cache folder, and loaded only if nobody else could have
 written them.
 
-What is kept (an LALR parser's tables, a file's lowered statements) is a pickle, and loading a pickle
-runs what it says: so files live in ``$XDG_CACHE_HOME/grammarc`` (by default ``~/.cache/grammarc``), a
-folder created ``0700``, never in the shared temp folder; a file is loaded only if that folder and the
-file belong to the user and nobody else can write them, and it is written atomically (a temporary file
-renamed over it), so that a reader never sees half a file. A cache that cannot be used is no error: the
+What is kept (an LALR parser's tables, a file's lowered statements) is a pickle, or a fused region's
+code object (``backend.fusion.compiled``), and loading either runs what it says: so files live in
+``$XDG_CACHE_HOME/grammarc`` (by default ``~/.cache/grammarc``), a folder created ``0700``, never in the
+shared temp folder; a file is loaded only if that folder and the file belong to the user and nobody else
+can write them, and it is written atomically (a temporary file renamed over it), so that a reader never
+sees half a file. A cache that cannot be used is no error: the
 caller computes what it would have held.
 """
 

@@ -7,7 +7,7 @@ import pytest
 
 from grammarc.diagnostics import Diagnostics
 from grammarc.frontend import lowered_cache, parse
-from grammarc.frontend.lowering import Sites
+from grammarc.frontend.sites import Sites
 from grammarc.ir.printer import print_module
 
 TEXT = 'version "2023.0"\n@Odd\nattr height = rand(3, 9)\nLot --> extrude(height) split(y){ 3 : Floor }*\n'

@@ -7,6 +7,9 @@ parameters, ``@name`` attributes, binaries parenthesized, every alternative with
 
 from __future__ import annotations
 
+import os
+import subprocess
+import sys
 from pathlib import Path
 
 import pytest
@@ -344,3 +347,24 @@ def test_the_issues_deep_nestings_are_errors_at_their_line(kind, n):
     parse_source("\n" + _nested(kind, n), FILE, diags)
     line = 2 if kind == "subdiv" else 3  # after the version line
     assert [(d.code, d.span.line, d.span.col) for d in diags] == [("nesting", line, 1)]
+
+
+@pytest.mark.parametrize("dialect, text", [("cityengine", 'version "2022.0"\nLot --> extrude(3) A.\n'),
+                                           ("cga2006", "lot ~> S(1, 2, 3) I(\"box\")\n")])
+def test_a_file_the_lowered_cache_keeps_is_read_without_lark(tmp_path, dialect, text):
+    """lark and the dialects' lowerings are imported only where a statement is parsed: a fresh process
+    reading a file whose statements the user's cache folder keeps imports neither, and reads the same."""
+    script = f"""
+import sys
+from grammarc.diagnostics import Diagnostics
+from grammarc.frontend.parse import parse_source
+from grammarc.ir.printer import print_rule
+module = parse_source({text!r}, "g.cga", Diagnostics(), {dialect!r})
+print([print_rule(rule) for rule in module.rules], sorted(m for m in sys.modules if m.startswith("lark")
+      or m.endswith(".lowering")) != [])
+"""
+    env = {**os.environ, "XDG_CACHE_HOME": str(tmp_path), "PYTHONPATH": str(Path(__file__).resolve().parents[2])}
+    runs = [subprocess.run([sys.executable, "-c", script], env=env, capture_output=True, text=True, check=True)
+            for _ in range(2)]
+    lowered, kept = (run.stdout.strip() for run in runs)
+    assert lowered.startswith("['") and lowered.endswith("True") and kept == lowered.removesuffix("True") + "False"

@@ -4,18 +4,22 @@
 The file is named by a digest of its text (the text is a function of the region's IR, so the digest is
 the region's key): an unchanged grammar finds its kernels compiled; a changed one writes a new file. A file
 is imported only if it is the user's own, writable by nobody else, and holds exactly the text expected
-(``frontend.user_cache``); where the cache folder cannot be used, the module goes to a private temporary
-folder of this process, removed when it exits, and is compiled again in the next.
+(``frontend.user_cache``); its code object is kept beside it (``code``), so that a run does not compile
+it from its text again where Python writes no bytecode. Where the cache folder cannot be used, the module
+goes to a private temporary folder of this process, removed when it exits, and is compiled again in the
+next.
 """
 
 from __future__ import annotations
 
 import hashlib
 import importlib.util
+import marshal
 import os
 import shutil
 import sys
 import tempfile
+import types
 from contextlib import contextmanager
 from functools import cache
 from multiprocessing.util import Finalize
@@ -140,8 +144,41 @@ def load(text: str):
     spec = importlib.util.spec_from_file_location(name, path)
     module = importlib.util.module_from_spec(spec)
     sys.modules[name] = module  # numba's cache finds the functions' globals by the module's name
-    spec.loader.exec_module(module)
+    exec(code(text, path), module.__dict__)  # noqa: S102 - the module's own code, run as its loader would
     return module, path
+
+
+def code(text: str, path: Path) -> types.CodeType:
+    """The code object of ``text``, the source of the module at ``path``, from the file beside it that
+    keeps it (``region_<key>.<Python's cache tag>.code``) or compiled and kept there.
+
+    Python keeps its own compiled modules in ``__pycache__`` only where it may write bytecode, which
+    containers and CI runs often forbid (``PYTHONDONTWRITEBYTECODE``): then each run would compile every
+    region's module again (``examples/pompeii`` has 84). The kept file starts
+    with Python's magic number and the text's full digest, and its code must name ``path`` as its file
+    (numba's cache finds a kernel's machine code by its function's file and line): a file of another
+    Python, of another text, from a moved cache folder, or a damaged one, is compiled again and replaced.
+    """
+    tag = sys.implementation.cache_tag
+    if tag is None:  # this Python keeps no compiled modules
+        return compile(text, str(path), "exec", dont_inherit=True)
+    kept = path.with_name(f"{path.stem}.{tag}.code")
+    header = importlib.util.MAGIC_NUMBER + hashlib.sha256(text.encode()).digest()
+
+    def read(file):
+        if file.read(len(header)) != header:
+            raise ValueError("another Python's or another text's code")
+        found = marshal.load(file)
+        if not isinstance(found, types.CodeType) or found.co_filename != str(path):
+            raise ValueError("not the code of this file")
+        return found
+
+    found = user_cache.load(kept, read)
+    if found is not None:
+        return found
+    made = compile(text, str(path), "exec", dont_inherit=True)  # as Python's import compiles a module
+    user_cache.store(kept, lambda file: file.write(header + marshal.dumps(made)))
+    return made
 
 
 #: The prefix of the private folders of modules that the cache folder could not take.

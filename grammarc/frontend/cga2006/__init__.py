@@ -5,6 +5,5 @@ module).
 """
 
 from grammarc.frontend.cga2006.assembly import assemble
-from grammarc.frontend.cga2006.lowering import Lowering
 
-__all__ = ["Lowering", "assemble"]
+__all__ = ["assemble"]

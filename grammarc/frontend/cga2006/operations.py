@@ -9,7 +9,7 @@ from __future__ import annotations
 
 from grammarc.diagnostics import suggest
 from grammarc.frontend.cga2006.nodes import Relative
-from grammarc.frontend.lowering import direct
+from grammarc.frontend.direct import direct
 from grammarc.ir import nodes as ir
 
 #: Split axes of Subdiv and Repeat (paper section 2, "Basic split rule").

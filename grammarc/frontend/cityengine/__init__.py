@@ -5,6 +5,5 @@ parse tree of ``grammars/cityengine.lark`` to IR), ``operations`` (the operation
 """
 
 from grammarc.frontend.cityengine.assembly import assemble
-from grammarc.frontend.cityengine.lowering import Lowering
 
-__all__ = ["Lowering", "assemble"]
+__all__ = ["assemble"]

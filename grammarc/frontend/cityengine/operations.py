@@ -17,7 +17,7 @@ from functools import cache
 
 from grammarc.diagnostics import Diagnostics, Typos, suggest, typo_of
 from grammarc.frontend.cityengine.nodes import EdgeDistances, Group, Part, PendingOffset, Sized
-from grammarc.frontend.lowering import direct
+from grammarc.frontend.direct import direct
 from grammarc.ir import nodes as ir
 from grammarc.ir.traverse import rewrite_ops
 
