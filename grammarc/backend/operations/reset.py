@@ -31,5 +31,5 @@ def reset_geometry(ctx: Context, cursor: Shapes, op: ir.ResetGeometry) -> Shapes
         if first is not None:
             dynamic[first:first + count] = [np.full(len(cursor), np.nan)] * count
     reset = replace(cursor, origin=ctx.chunk.lot_origin[lot], size=size[lot], frame=frame[lot], geom=geom[lot],
-                   dynamic=tuple(dynamic))
+                    dynamic=tuple(dynamic))
     return marked_inserted(ctx.plan, reset, False)
