@@ -34,6 +34,7 @@ from grammarc.backend.slots import (
     HORIZONTAL_SWITCH,
     PIVOT_SLOTS,
     RING_START,
+    TRIM_INSERTED,
     TRIM_SLOTS,
     TRIM_SWITCH,
     WHITE_RGB,
@@ -154,6 +155,8 @@ def initial_dynamic(plan: Plan, name: str, chunk: Chunk, shapes: Shapes) -> np.n
         return np.full(n, np.nan)
     if name == TRIM_SWITCH:
         return np.ones(n)
+    if name == TRIM_INSERTED:  # a lot's geometry is its own
+        return np.zeros(n)
     if name == HORIZONTAL_SWITCH:
         return np.zeros(n)
     if name in PIVOT_SLOTS:

@@ -18,6 +18,7 @@ from grammarc.backend.slots import (
     HORIZONTAL_SWITCH,
     PIVOT_SLOTS,
     RING_START,
+    TRIM_INSERTED,
     TRIM_SLOTS,
     TRIM_SWITCH,
     uv_slots,
@@ -96,6 +97,8 @@ class Plan:
     material_slots: tuple[tuple[int, int], ...] = ()
     trim_slot: int | None = None
     trim_switch: int | None = None
+    #: whether each shape's geometry was inserted (``slots.TRIM_INSERTED``), where shapes have trim planes.
+    inserted_slot: int | None = None
     #: the first of the horizontal trim planes and ``trim.horizontal``, when the grammar turns them on.
     horizontal_slot: int | None = None
     horizontal_switch: int | None = None
@@ -150,10 +153,11 @@ def make_plan(grammar: Grammar, *, load_asset: Callable = load_asset) -> Plan:
     colour = [COLOR_SLOT] if any(isinstance(op, (ir.SetColor, ir.SetOpacity, ir.SetMaterial)) for op in ops) else []
     # setMaterial's names are known per shape only: every texture channel gets its column
     colour += list(MAP_FIELDS) if any(isinstance(op, ir.SetMaterial) for op in ops) else []
-    # CityEngine trims inserted geometry at the planes a comp(f) leaves between neighbouring faces
-    trims = list(TRIM_SLOTS) if module.dialect == "cityengine" and any(
+    # CityEngine trims inserted geometry (assets, primitives) at the planes a comp(f) leaves between
+    # neighbouring faces, and a shape's own where it says `trim()`
+    trims = [*TRIM_SLOTS, TRIM_INSERTED] if module.dialect == "cityengine" and any(
         isinstance(op, ir.CompFaces) and op.kind == "f" for op in ops) and any(
-        isinstance(op, (ir.UseAsset, ir.Trim)) for op in ops) else []
+        isinstance(op, (ir.UseAsset, ir.Primitive, ir.Trim)) for op in ops) else []
     # horizontal planes only where the grammar may turn them on (CityEngine's default is off)
     trims += list(HORIZONTAL_SLOTS) if trims and any(
         isinstance(op, ir.SetAttr) and op.name == HORIZONTAL_SWITCH
@@ -191,6 +195,7 @@ def make_plan(grammar: Grammar, *, load_asset: Callable = load_asset) -> Plan:
         color_slot=dynamic.get(COLOR_SLOT), trim_slot=trim_slot,
         material_slots=tuple((k, dynamic[name]) for k, name in enumerate(MAP_FIELDS) if name in dynamic),
         trim_switch=dynamic.get(TRIM_SWITCH) if trim_slot is not None else None,
+        inserted_slot=dynamic.get(TRIM_INSERTED),
         horizontal_slot=dynamic.get(HORIZONTAL_SLOTS[0]), horizontal_switch=dynamic.get(HORIZONTAL_SWITCH),
         occluders=ANCESTORS[0] in dynamic, load_asset=load_asset,
         uv_slots={s: dynamic[uv_slots(s)[0]] for s in uv_sets}, pivot_slot=dynamic.get(PIVOT_SLOTS[0]),

@@ -19,6 +19,11 @@ WHITE_RGB = float(0xFFFFFF)
 TRIM_SLOTS = tuple(f"trim.{k}" for k in range(8))
 #: ``set(trim.vertical, false)`` turns the planes off for a shape and its successors (1: on, 0: off).
 TRIM_SWITCH = "trim.vertical"
+#: Whether a shape's geometry was inserted (1: ``i()`` or a ``primitive*()`` made it, or cut it out of what
+#: they made; 0: the lot's, or what ``extrude`` made). CityEngine trims geometry as it is inserted, and a
+#: shape's own only at ``trim()``, so a leaf box is cut at its trim planes only where it is inserted: an
+#: extruded window frame stands whole across a plane where an inserted cube beside it is cut.
+TRIM_INSERTED = "trim.inserted"
 #: A shape's horizontal trim planes (``geometry.trim.shallow_edge_planes``), made where the grammar turns
 #: them on with ``set(trim.horizontal, ...)`` (0: off, CityEngine's default; 1: on).
 HORIZONTAL_SLOTS = tuple(f"trim.h{k}" for k in range(4 * HORIZONTAL_PLANES))

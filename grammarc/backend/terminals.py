@@ -41,12 +41,13 @@ CUBE, QUAD = 0, 1  # asset ids of the leaf built-ins (see ir.passes.assets)
 
 
 def emit_instances(ctx: Context, shapes: Shapes, asset: int, symbol: int, mirrored: int = 0,
-                   textured: bool = False) -> None:
+                   textured: bool = False, inserted: np.ndarray | None = None) -> None:
     """Instances of ``asset`` on the scopes of ``shapes``; ``mirrored`` bits (1 x, 2 y, 4 z) flip the
     asset along those scope axes (the column is negated and the origin moved to the far side); ``Z_UP``
     turns the asset in its box before that. Where the grammar trims inserts, those crossing their trim planes become the asset's
-    triangles cut by them. ``textured``: they carry the shapes' texture coordinates (a leaf box); an inserted
-    asset has its own, which grammarc does not keep, and carries none."""
+    triangles cut by them; ``inserted`` (n,) bool, when given, says which shapes' geometry was inserted, the
+    others are not cut (a leaf box a shape extruded). ``textured``: they carry the shapes' texture
+    coordinates (a leaf box); an inserted asset has its own, which grammarc does not keep, and carries none."""
     if not len(shapes):
         return
     chunk = ctx.chunk
@@ -62,6 +63,8 @@ def emit_instances(ctx: Context, shapes: Shapes, asset: int, symbol: int, mirror
         planes = trim_planes(ctx.plan, shapes)
         placed = xform.astype(np.float64)  # relative to the lot's origin, as the trim planes are
         cut = boxes_crossing(planes, placed, TOL.zero)
+        if inserted is not None:
+            cut &= inserted
         mesh = ctx.asset_mesh(asset) if cut.any() else None
         if mesh is not None:
             crossing = shapes.take(cut)
@@ -94,6 +97,17 @@ def trim_planes(plan, shapes: Shapes) -> np.ndarray:
     shallow = np.stack(shapes.dynamic[slot:slot + len(HORIZONTAL_SLOTS)], axis=1)
     shallow[shapes.dynamic[plan.horizontal_switch] == 0] = np.nan
     return np.concatenate([planes, shallow], axis=1)
+
+
+def marked_inserted(plan, shapes: Shapes, inserted: bool) -> Shapes:
+    """``shapes`` with their geometry marked as inserted, which leaves cut at their trim planes, or as
+    their own (``slots.TRIM_INSERTED``), where the grammar has trim planes."""
+    slot = plan.inserted_slot
+    if slot is None:
+        return shapes
+    dynamic = list(shapes.dynamic)
+    dynamic[slot] = np.full(len(shapes), float(inserted))
+    return replace(shapes, dynamic=tuple(dynamic))
 
 
 def _trimmed(plan, shapes: Shapes, placed: np.ndarray, planes: np.ndarray, mesh,
@@ -230,7 +244,10 @@ def emit_leaves(ctx: Context, shapes: Shapes, symbol: int) -> None:
     box = shapes.geom == -1
     flat = shapes.size <= TOL.zero
     zeros = flat.sum(axis=1)
-    emit_instances(ctx, shapes.take(box & (zeros == 0)), CUBE, symbol, textured=True)
+    boxes = shapes.take(box & (zeros == 0))
+    slot = ctx.plan.inserted_slot
+    emit_instances(ctx, boxes, CUBE, symbol, textured=True,
+                   inserted=boxes.dynamic[slot] == 1 if slot is not None else None)
     is_quad = box & (zeros == 1)
     quads = shapes.take(is_quad)
     if len(quads):

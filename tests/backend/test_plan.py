@@ -10,6 +10,7 @@ from grammarc.backend.slots import (
     COLOR_SLOT,
     PIVOT_SLOTS,
     RING_START,
+    TRIM_INSERTED,
     TRIM_SLOTS,
     TRIM_SWITCH,
     uv_slots,
@@ -28,6 +29,10 @@ def test_columns_of_colours_trims_and_occluders_only_where_the_grammar_needs_the
     assert colour.color_slot == colour.dynamic[COLOR_SLOT]
     trims = plan_of(write, 'Lot --> extrude(3) comp(f){ side : i("builtin:cube") X }\n')
     assert trims.trim_slot == trims.dynamic[TRIM_SLOTS[0]] and trims.trim_switch is None
+    assert trims.inserted_slot == trims.dynamic[TRIM_INSERTED] and plain.inserted_slot is None
+    # a primitive is inserted geometry too: a grammar whose inserts are all primitives has trim planes
+    primitives = plan_of(write, "Lot --> extrude(3) comp(f){ side : primitiveCube(1, 1, 1) X }\n")
+    assert primitives.trim_slot is not None and primitives.inserted_slot is not None
     switch = plan_of(write, 'Lot --> set(trim.vertical, false) extrude(3) comp(f){ side : i("builtin:cube") X }\n')
     assert switch.trim_switch == switch.dynamic[TRIM_SWITCH]
     labelled = plan_of(write, 'Lot --> label("mass") X\n')

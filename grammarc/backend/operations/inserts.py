@@ -2,8 +2,8 @@
 ``i(name)`` (the shape's geometry becomes the asset) and ``label(name)`` (the shape's solid an occluder).
 
 Reads: the scope (``origin``, ``size``, ``frame``), ``geom``, ``lot``, ``dynamic`` (colour, trim planes,
-occluding ancestors). Writes: ``i`` the ``geom``, and the scope's ``origin`` and ``size`` in the insert modes
-that keep the asset's size; ``label`` the ``dynamic`` ancestors.
+occluding ancestors). Writes: ``i`` the ``geom``, its mark as inserted (``dynamic``), and the scope's
+``origin`` and ``size`` in the insert modes that keep the asset's size; ``label`` the ``dynamic`` ancestors.
 """
 
 from __future__ import annotations
@@ -27,15 +27,15 @@ def insert(ctx: Context, cursor: Shapes, op: ir.Insert) -> None:
     terminals.emit_instances(ctx, cursor, ctx.plan.grammar.asset_ids[op.asset], ctx.symbol)
 
 
-@operation(ir.UseAsset, writes=("origin", "size", "geom"), meshes=True)
+@operation(ir.UseAsset, writes=("origin", "size", "geom", "dynamic"), meshes=True)
 def use_asset(ctx: Context, cursor: Shapes, op: ir.UseAsset) -> Shapes:
-    """The geometry becomes the asset placed by the insert mode (``placed``); a computed up axis or
-    mode is read per shape."""
+    """The geometry becomes the asset placed by the insert mode (``placed``), inserted geometry, which its
+    leaves' trim planes cut; a computed up axis or mode is read per shape."""
     asset = asset_ids(ctx, cursor, op, "i")
     up = op.up == "zUp" if op.up_by is None else _chosen(ctx, cursor, op.up_by, ir.UP_AXES, "up axis", op) == 1
     mode = ir.INSERT_MODES.index(op.mode) if op.mode_by is None else \
         _chosen(ctx, cursor, op.mode_by, ir.INSERT_MODES, "insert mode", op)
-    return placed(ctx, cursor, asset, up, mode, op.span)
+    return terminals.marked_inserted(ctx.plan, placed(ctx, cursor, asset, up, mode, op.span), True)
 
 
 def asset_ids(ctx: Context, cursor: Shapes, op: ir.UseAsset | ir.InsertAlongUV, verb: str) -> np.ndarray:

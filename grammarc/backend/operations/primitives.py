@@ -13,8 +13,11 @@ of its scope's flat axis (``rect_plane``: y for a volume, whose y size becomes 0
 plane's two axes in order, centred in that plane. CityEngine also gives a zero scope size of a 3D
 primitive a size from its other two; grammarc keeps it flat, as ``i()`` does.
 
+A primitive is inserted geometry, as an asset is: a leaf cube is cut at its trim planes, where a box
+``extrude`` made is not (``slots.TRIM_INSERTED``).
+
 Reads: the scope (``origin``, ``size``, ``frame``) and what the sizes read. Writes: ``origin``, ``size``,
-``geom``.
+``geom`` and the mark as inserted (``dynamic``).
 """
 
 from __future__ import annotations
@@ -26,6 +29,7 @@ from grammarc.backend.evaluate import evaluate
 from grammarc.backend.operations.inserts import scope_at
 from grammarc.backend.operations.table import operation
 from grammarc.backend.shapes import Shapes, asset_geom
+from grammarc.backend.terminals import marked_inserted
 from grammarc.constants import TOL
 from grammarc.geometry.components import rect_plane
 from grammarc.geometry.polygons import PLANE_U, PLANE_V
@@ -36,7 +40,7 @@ from grammarc.ir.asset_names import primitive_asset, segment_counts
 FLAT = ("quad", "disk")
 
 
-@operation(ir.Primitive, writes=("origin", "size", "geom"), meshes=True)
+@operation(ir.Primitive, writes=("origin", "size", "geom", "dynamic"), meshes=True)
 def primitive(ctx: Context, cursor: Shapes, op: ir.Primitive) -> Shapes:
     n = len(cursor)
     plane = rect_plane(cursor.size, TOL.zero) if op.kind in FLAT else np.ones(n, dtype=np.int8)
@@ -56,7 +60,7 @@ def primitive(ctx: Context, cursor: Shapes, op: ir.Primitive) -> Shapes:
     geom = np.full(n, -1, dtype=np.int32)
     if op.segments:
         geom = _segmented(ctx, cursor, op, plane)
-    return scope_at(ctx, cursor, (cursor.size - size) * 0.5 * centred, size, geom)
+    return marked_inserted(ctx.plan, scope_at(ctx, cursor, (cursor.size - size) * 0.5 * centred, size, geom), True)
 
 
 def _segmented(ctx: Context, cursor: Shapes, op: ir.Primitive, plane: np.ndarray) -> np.ndarray:

@@ -29,6 +29,7 @@ from grammarc.backend.outlines import flat_axis, polygons_of
 from grammarc.backend.pivot import corner_axes, pivot_frames, pivot_system, relative_angles, with_pivot
 from grammarc.backend.reframing import reframed, turned
 from grammarc.backend.shapes import Shapes, asset_geom, asset_of
+from grammarc.backend.terminals import marked_inserted
 from grammarc.constants import TOL
 from grammarc.geometry import components as comp_kernels
 from grammarc.geometry.align import EDGE_MODES, FACE_MODES, aligned_axes, bbox_turns, pick_edges
@@ -209,6 +210,12 @@ def center(ctx: Context, cursor: Shapes, op: ir.Center, base) -> Shapes:
 
 @operation(ir.Extrude, writes=_REFRAMED, meshes=True)
 def extrude(ctx: Context, cursor: Shapes, op: ir.Extrude) -> Shapes:
+    """The solids of ``_extruded``: the shape's own geometry, which its trim planes do not cut even where
+    it extrudes an inserted face (CityEngine trims geometry as it is inserted)."""
+    return marked_inserted(ctx.plan, _extruded(ctx, cursor, op), False)
+
+
+def _extruded(ctx: Context, cursor: Shapes, op: ir.Extrude) -> Shapes:
     """A face becomes a solid along its normal; a negative height extrudes behind the face. As in
     CityEngine, the solid's scope keeps x and has y along the extrusion: a face whose normal is
     another scope axis (a comp(f) face's z) is first re-expressed in such a scope.
@@ -236,7 +243,7 @@ def extrude(ctx: Context, cursor: Shapes, op: ir.Extrude) -> Shapes:
         elif roofs.any():
             rows, others = np.flatnonzero(roofs), np.flatnonzero(~roofs)
             solids = _extruded_roofs(ctx, cursor.take(rows), height[rows])
-            rest = extrude(ctx, cursor.take(others), op) if len(others) else solids.take([])
+            rest = _extruded(ctx, cursor.take(others), op) if len(others) else solids.take([])
             return Shapes.merge([rest, solids], [others, rows])
     bad = (axis < 0) | ~np.isfinite(height)
     if bad.any():
