@@ -17,7 +17,8 @@ cut, or where the cut ends on the boundary (``_cut_vertices``). A clear corner's
 to where it first comes to the boundary, as PRT's cuts of holes do, and ends at a corner of the piece that
 it passes within 5 mm of (``SNAP``: a bump whose side stands a millimetre off the line of the block's
 side is cut off whole); a nearly straight corner's cut and a cut across the boundary run along the whole
-line through the piece.
+line through the piece. The pieces come out as one mesh's faces, as PRT's do: a cut that ends on an
+earlier cut gives the piece beyond that a corner there too (``_conforming``).
 
 A cut that only shaves off a sliver (below the area floor) is tried again across the boundary; if that
 fails too, the piece stays concave (about one piece in 10^4 on random star-shaped footprints).
@@ -31,9 +32,10 @@ from __future__ import annotations
 
 import numpy as np
 import shapely
+from numba import njit
 
 from grammarc.constants import TOL
-from grammarc.ragged import rank_within, segment_of
+from grammarc.ragged import offsets_from_counts, rank_within, segment_of
 
 #: Cutting rounds at most (each removes at least one reflex vertex from every piece it cuts).
 MAX_ROUNDS = 256
@@ -113,7 +115,78 @@ def _convex_parts(polygons: np.ndarray, max_length: np.ndarray | None) -> tuple[
         done_source.append(source)
     pieces, source = np.concatenate(done_pieces), np.concatenate(done_source)
     order = np.argsort(source, kind="stable")
-    return pieces[order], source[order]
+    return _conforming(pieces[order], source[order]), source[order]
+
+
+def _conforming(pieces: np.ndarray, source: np.ndarray) -> np.ndarray:
+    """Pieces (k,) (each source's together) with every corner of another piece of their source that lies
+    inside one of their edges inserted there. PRT cuts the polygon as one mesh: a cut that ends on an
+    edge that two pieces share (an earlier cut) splits the edge in both, and the piece on the edge's far
+    side gets a fifth corner too (PRT's candler roofs: of a strip along a block's side and a strip across
+    its end that meet at a corner, only the one whose cut goes last comes out a rectangle and carries a
+    ventilation, candler.seoul.35). A cut's end is a corner of the pieces beside the cut; a vertex where a
+    piece's boundary runs on within a degree (``NEARLY_STRAIGHT``) is none: the overlay leaves such
+    vertices where a cut runs a hair off an edge's line."""
+    if len(pieces) < 2:
+        return pieces
+    _, coords, (ring_offsets, part_offsets) = shapely.to_ragged_array(pieces)
+    coords = np.asarray(coords)[:, :2]
+    ring_offsets = np.asarray(ring_offsets, dtype=np.int64)
+    part_offsets = np.asarray(part_offsets, dtype=np.int64)
+    group = np.r_[0, np.flatnonzero(source[1:] != source[:-1]) + 1, len(source)]
+    d_in, d_out, cross, _ = _corners(coords, ring_offsets)
+    corner = np.abs(cross) > np.sin(NEARLY_STRAIGHT) * np.hypot(*d_in.T) * np.hypot(*d_out.T)
+    corner[ring_offsets[1:] - 1] = False  # a ring's closing point repeats its first
+    counts, new_coords = _edges_split(coords, ring_offsets, part_offsets, group, corner, 1e-9 * _reach(pieces))
+    return shapely.from_ragged_array(shapely.GeometryType.POLYGON, new_coords,
+                                     (offsets_from_counts(counts), part_offsets))
+
+
+@njit(cache=True, nogil=True)
+def _edges_split(coords, ring_offsets, part_offsets, group, corner, tolerance):
+    """``_conforming`` on ragged closed rings: each ring's new vertex count (closing point included) and
+    the new coordinates. A ``corner`` of another piece of the same group (pieces ``group[g]:group[g + 1]``)
+    lies inside an edge where it is within the piece's ``tolerance`` of it and farther than that from
+    the edge's ends; it goes in as it is, in order along the edge, several at one point once."""
+    counts = np.empty(len(ring_offsets) - 1, np.int64)
+    out = np.empty((len(coords), 2))
+    at = 0
+    for g in range(len(group) - 1):
+        v_first, v_last = ring_offsets[part_offsets[group[g]]], ring_offsets[part_offsets[group[g + 1]]]
+        along, vertex = np.empty(v_last - v_first), np.empty(v_last - v_first, np.int64)
+        for p in range(group[g], group[g + 1]):
+            tol = tolerance[p]
+            own_first, own_last = ring_offsets[part_offsets[p]], ring_offsets[part_offsets[p + 1]]
+            for r in range(part_offsets[p], part_offsets[p + 1]):
+                first = at
+                for j in range(ring_offsets[r], ring_offsets[r + 1] - 1):
+                    dx, dy = coords[j + 1, 0] - coords[j, 0], coords[j + 1, 1] - coords[j, 1]
+                    length = np.sqrt(dx * dx + dy * dy)
+                    n = 0
+                    for v in range(v_first, v_last):
+                        if not corner[v] or own_first <= v < own_last or length <= 2 * tol:
+                            continue
+                        rx, ry = coords[v, 0] - coords[j, 0], coords[v, 1] - coords[j, 1]
+                        t = (rx * dx + ry * dy) / length
+                        if tol < t < length - tol and abs(dx * ry - dy * rx) <= tol * length:
+                            along[n], vertex[n] = t, v
+                            n += 1
+                    if at + n + 2 > len(out):
+                        grown = np.empty((2 * len(out) + n + 2, 2))
+                        grown[:at] = out[:at]
+                        out = grown
+                    out[at] = coords[j]
+                    at += 1
+                    last = 0.0
+                    for k in np.argsort(along[:n]):
+                        if along[k] - last > tol:
+                            out[at] = coords[vertex[k]]
+                            at += 1
+                            last = along[k]
+                out[at] = out[first]
+                at += 1
+                counts[r] = at - first
+    return counts, out[:at].copy()
 
 
 def _opened(pieces: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

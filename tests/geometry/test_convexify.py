@@ -147,6 +147,25 @@ def test_the_arms_of_a_z_start_along_their_long_side(mirrored):
         assert np.hypot(*(xy[1] - xy[0])) == pytest.approx(13.48, abs=0.02)
 
 
+# a 12 m by 8 m block with a strip 0.4 m wide along its side (its foot 4 m from the block's corner) and one 0.5 m
+# wide across its end, the two meeting at the corner (candler.seoul.35's roof, squared); the strip across the
+# end runs 3 m along the block (its cut, 3.4 m, goes before the side strip's, 4.5 m), or 6 m (6.4 m: after it)
+def strips(end_strip):
+    return shapely.Polygon([(0, 0), (12, 0), (12, 8), (end_strip, 8), (end_strip, 8.5), (-0.4, 8.5), (-0.4, 4), (0, 4)])
+
+
+@pytest.mark.parametrize("end_strip, rectangle", [(3, shapely.box(-0.4, 4, 0, 8)), (6, shapely.box(0, 8, 6, 8.5))])
+def test_a_cut_that_ends_on_an_earlier_cut_gives_the_piece_beyond_it_a_corner_there(end_strip, rectangle):
+    """PRT's candler on these roofs' footprints (inset by 0.8 m) lays one ventilation, on the strip whose cut
+    goes last (on the side strip, x -0.4..0, when the end strip's is shorter; on the end strip, y 8..8.5,
+    when it is longer): the cut that goes last ends on the first one, and the strip beyond that, whose
+    edge it splits, keeps the cut's end as a fifth corner."""
+    pieces, _ = convex_parts(np.array([strips(end_strip)]), None, np.array([True]))
+    assert sorted(corners(p) for p in pieces) == [4, 5, 6]
+    (four,) = [p for p in pieces if corners(p) == 4]
+    assert four.equals(rectangle)
+
+
 def test_split_lines_longer_than_max_length_are_not_cut():
     # the split lines at the L's and the U's inner corners cross their 10 m deep foot
     _, source = convex_parts(np.array([L_SHAPE, U_SHAPE, L_SHAPE, U_SHAPE]), np.array([5.0, 8.0, 12.0, 12.0]))
