@@ -16,12 +16,13 @@ rectangle (candler's roofs). Each piece starts where its boundary leaves the las
 cut, or where the cut ends on the boundary (``_cut_vertices``). A clear corner's cut runs from the corner
 to where it first comes to the boundary, as PRT's cuts of holes do, and ends at a corner of the piece that
 it passes within 5 mm of (``SNAP``: a bump whose side stands a millimetre off the line of the block's
-side is cut off whole); a nearly straight corner's cut and a cut across the boundary run along the whole
-line through the piece. The pieces come out as one mesh's faces, as PRT's do: a cut that ends on an
+side is cut off whole); a nearly straight corner's cut runs along the whole line through the piece. The pieces come out as one mesh's faces, as PRT's do: a cut that ends on an
 earlier cut gives the piece beyond that a corner there too (``_conforming``).
 
-A cut that only shaves off a sliver (below the area floor) is tried again across the boundary; if that
-fails too, the piece stays concave (about one piece in 10^4 on random star-shaped footprints).
+A corner whose cut only shaves off a sliver (below the area floor) is passed over: the piece's next corner
+is cut instead, and a piece whose corners are all passed over stays as it is. PRT cuts no such corner
+otherwise: a roof whose side bends back by 0.001 to 1.7 degrees 16 cm before its end gets no ventilation
+from PRT's candler, where a cut across the boundary there made two rectangles (candler.seoul.12).
 
 ``max_length`` (CityEngine's ``convexify(maxLength)``): a reflex vertex is only cut where the cut's
 chord through the piece, from boundary to boundary through the vertex, is shorter; a piece whose reflex
@@ -75,20 +76,20 @@ def _convex_parts(polygons: np.ndarray, max_length: np.ndarray | None) -> tuple[
     """``convex_parts`` of polygons in a right-handed pair of axes."""
     pieces = shapely.orient_polygons(polygons, exterior_cw=False)
     pieces, source = _opened(pieces)
-    across = np.zeros(len(pieces), dtype=bool)  # cut across the boundary this time
+    passed = np.zeros(len(pieces), dtype=np.int64)  # corners passed over: their cuts only shaved slivers off
     done_pieces, done_source = [], []
     for _ in range(MAX_ROUNDS):
         if not len(pieces):
             break
         pieces = _without_spikes(pieces)
         limit = None if max_length is None else max_length[source]
-        vertex, direction, starts, end = _cut_vertices(pieces, limit, across)
+        vertex, direction, starts, end = _cut_vertices(pieces, limit, passed)
         finished = np.isnan(vertex[:, 0])
         done_pieces.append(pieces[finished])
         done_source.append(source[finished])
-        pieces, source, vertex, direction, starts, end, across = (
+        pieces, source, vertex, direction, starts, end, passed = (
             pieces[~finished], source[~finished], vertex[~finished], direction[~finished], starts[~finished],
-            end[~finished], across[~finished])
+            end[~finished], passed[~finished])
         if not len(pieces):
             break
         parts, index = _cut(pieces, vertex, direction, end)
@@ -97,18 +98,15 @@ def _convex_parts(polygons: np.ndarray, max_length: np.ndarray | None) -> tuple[
         parts = parts.copy()
         parts[keep] = _keeping_vertex(parts[keep], vertex[parent], _reach(pieces)[parent])
         side = (index[keep] >= len(pieces)).astype(np.int64)  # 0: on the cut's left, 1: on its right
-        # a cut that only shaves off a sliver (an edge's line running close to another edge) is tried
-        # again across the boundary; if that fails too, the piece stays as it is
+        # a cut that only shaves off a sliver (an edge's line running close to another edge) passes its
+        # corner over: the piece goes again, to be cut at its next corner
         stuck = np.bincount(parent, minlength=len(pieces)) < 2
-        given_up = stuck & across
-        done_pieces.append(pieces[given_up])
-        done_source.append(source[given_up])
-        retry = np.flatnonzero(stuck & ~across)
+        retry = np.flatnonzero(stuck)
         parts, parent, side = parts[keep][~stuck[parent]], parent[~stuck[parent]], side[~stuck[parent]]
         parts = _starting_at(parts, _kept_start(parts, _first_vertices(pieces)[parent], starts[parent, side]))
         order = np.argsort(np.concatenate([parent, retry]), kind="stable")
         pieces = shapely.orient_polygons(np.concatenate([parts, pieces[retry]])[order], exterior_cw=False)
-        across = np.concatenate([np.zeros(len(parts), dtype=bool), np.ones(len(retry), dtype=bool)])[order]
+        passed = np.concatenate([np.zeros(len(parts), dtype=np.int64), passed[retry] + 1])[order]
         source = source[np.concatenate([parent, retry])[order]]
     else:
         done_pieces.append(pieces)
@@ -265,17 +263,18 @@ def _cut_faces(polygons: np.ndarray, owner: np.ndarray, start: np.ndarray, end: 
     return shapely.orient_polygons(faces[inside], exterior_cw=False), index[inside]
 
 
-def _cut_vertices(pieces: np.ndarray, limit: np.ndarray | None, across: np.ndarray):
-    """Per piece, the reflex vertex that is cut first (k, 2: its shortest cut, ``TIED``), the cut's direction (k, 2): along the
-    line of one of the edges that meet there, or across the boundary (pieces flagged ``across``), and
-    where the parts on its left and on its right start (k, 2) each; NaN where there is
-    none (the piece is convex, or every cut is too long).
+def _cut_vertices(pieces: np.ndarray, limit: np.ndarray | None, passed: np.ndarray):
+    """Per piece, the reflex vertex that is cut first (k, 2: its shortest cut, ``TIED``; after the piece's
+    first ``passed`` (k,) corners in that order), the cut's direction (k, 2): along the line of one of
+    the edges that meet there, and where the parts on its left and on its right start (k, 2) each; NaN
+    where there is none (the piece is convex, every cut is too long, or every corner is passed over).
 
     The ring of the piece cut off along an edge's line runs from the vertex on along the boundary to the
     cut's far end and back along the cut; the other part's ring runs from that far end on to the vertex:
     the one part starts at the vertex, the other where the cut ends on the boundary (PRT's pieces: the
-    scope of a Z's arm lies along its long side, from the cut's end, not along the cut). A part cut
-    across the boundary starts at the vertex."""
+    scope of a Z's arm lies along its long side, from the cut's end, not along the cut)."""
+    vertex, chosen = np.full((len(pieces), 2), np.nan), np.full((len(pieces), 2), np.nan)
+    starts, ends = np.full((len(pieces), 2, 2), np.nan), np.full((len(pieces), 2), np.nan)
     _, coords, (ring_offsets, part_offsets) = shapely.to_ragged_array(pieces)
     coords = np.asarray(coords)[:, :2]
     ring_offsets = np.asarray(ring_offsets, dtype=np.int64)
@@ -283,73 +282,61 @@ def _cut_vertices(pieces: np.ndarray, limit: np.ndarray | None, across: np.ndarr
     d_in, d_out, cross, reflex = _corners(coords, ring_offsets)
     piece = segment_of(np.asarray(part_offsets, dtype=np.int64))[ring]
     candidates = np.flatnonzero(reflex)
+    if not len(candidates):
+        return vertex, chosen, starts, ends
     # a corner that is nearly straight (under a degree) waits until the piece has no other: an L's
     # corner is cut across its bar, not after a cut at a bump in the bar took the whole bar off
     # (candler.near_degenerate.31488: PRT's parts of the bar are too small for a roof access)
     turn = np.arctan2(cross, d_in[:, 0] * d_out[:, 0] + d_in[:, 1] * d_out[:, 1])
     a = d_in[candidates] / np.hypot(d_in[candidates, 0], d_in[candidates, 1])[:, None]
     b = d_out[candidates] / np.hypot(d_out[candidates, 0], d_out[candidates, 1])[:, None]
-    # a clear corner is cut along the line of one of its edges, the one whose run into the piece from the
+    # a corner is cut along the line of one of its edges, the one whose run into the piece from the
     # corner is shorter (PRT's candler roofs: an H's bar, a Z's middle and a U's arms come out as
     # rectangles, the rest keeping the cut's ends); the incoming edge's on a tie (the kit's L into its
-    # two 10 m arms, the boundary running forward about the roof's normal). A piece whose cut only shaved
-    # off a sliver below the area floor is cut across the boundary, which no edge's line runs close to.
-    tangent = a + b
-    normal = np.stack([-tangent[:, 1], tangent[:, 0]], axis=1)
-    normal /= np.maximum(np.hypot(normal[:, 0], normal[:, 1]), 1e-300)[:, None]
-    along = ~across[piece[candidates]]
-    edge = b.copy()
+    # two 10 m arms, the boundary running forward about the roof's normal)
     point = coords[candidates]
-    left, right = point.copy(), point.copy()
-    end = np.full((len(candidates), 2), np.nan)
-    if along.any():
-        shorter, into, run = _edge_cuts(pieces, piece[candidates[along]], point[along], a[along], b[along])
-        rows = np.flatnonzero(along)
-        # a clear corner's cut ends at a corner of the piece that it passes within SNAP of, and stops
-        # where it comes to the boundary (``_cut``); a nearly straight one's runs along the whole line
-        # through the piece, shaving a sliver off along the edge
-        clear = turn[candidates[rows]] <= -NEARLY_STRAIGHT
-        far = point[along] + into * run[:, None]
-        into[clear], run[clear], far[clear] = _snapped(coords, piece, piece[candidates[rows[clear]]],
-                                                       point[rows[clear]], into[clear], run[clear])
-        edge[rows] = np.where(shorter[:, None], into, -into)
-        end[rows[clear]] = far[clear]
-        # the far end: on the right of the outgoing edge's line (the incoming edge's side), on the left of
-        # the incoming edge's line
-        left[rows[shorter]] = far[shorter]
-        right[rows[~shorter]] = far[~shorter]
-    direction = np.where(along[:, None], edge, normal)
-    # the shortest cut goes first, the first in the ring of cuts within TIED of it (a piece cut across the
-    # boundary: its first corner): PRT's candler roofs take a small bump off before the long cut at a
-    # corner earlier in the ring (candler.tartu.17: the ventilation stands on the bump's outer strip;
-    # candler.seoul.42: a jog between two bars leaves no rectangle), and cut an H's bar ends, 2.949 and
-    # 2.955 m long, in ring order (candler.H.31062)
-    length = np.zeros(len(candidates))
-    if along.any():
-        length[along] = run
-    straight = turn[candidates] > -NEARLY_STRAIGHT
+    shorter, into, run = _edge_cuts(pieces, piece[candidates], point, a, b)
+    # a clear corner's cut ends at a corner of the piece that it passes within SNAP of, and stops where it
+    # comes to the boundary (``_cut``); a nearly straight one's runs along the whole line through the
+    # piece, shaving a sliver off along the edge
+    clear = turn[candidates] <= -NEARLY_STRAIGHT
+    far = point + into * run[:, None]
+    first, last = ring_offsets[:-1][ring[candidates]], ring_offsets[1:][ring[candidates]] - 1
+    neighbours = np.stack([coords[np.where(candidates > first, candidates - 1, last - 1)], coords[candidates + 1]],
+                          axis=1)
+    into[clear], run[clear], far[clear] = _snapped(coords, piece, piece[candidates[clear]], point[clear],
+                                                   into[clear], run[clear], neighbours[clear])
+    direction = np.where(shorter[:, None], into, -into)
+    end = np.where(clear[:, None], far, np.nan)
+    # the far end: on the right of the outgoing edge's line (the incoming edge's side), on the left of the
+    # incoming edge's line
+    left = np.where(shorter[:, None], far, point)
+    right = np.where(shorter[:, None], point, far)
+    # the shortest cut goes first, the first in the ring of cuts within TIED of it: PRT's candler roofs
+    # take a small bump off before the long cut at a corner earlier in the ring (candler.tartu.17: the
+    # ventilation stands on the bump's outer strip; candler.seoul.42: a jog between two bars leaves no
+    # rectangle), and cut an H's bar ends, 2.949 and 2.955 m long, in ring order (candler.H.31062)
+    straight = ~clear
     group = 2 * piece[candidates] + straight
     shortest = np.full(2 * len(pieces), np.inf)
-    np.minimum.at(shortest, group, length)
-    longer = length > shortest[group] * (1.0 + TIED)
+    np.minimum.at(shortest, group, run)
+    longer = run > shortest[group] * (1.0 + TIED)
     order = np.lexsort((candidates, longer, straight, piece[candidates]))
-    candidates, direction, left, right, end = (candidates[order], direction[order], left[order], right[order],
-                                               end[order])
-    point = point[order]
-    if limit is not None and len(candidates):
+    candidates, direction, left, right, end, point = (candidates[order], direction[order], left[order],
+                                                      right[order], end[order], point[order])
+    if limit is not None:
         chord = _chords(pieces[piece[candidates]], point, direction)
         keep = chord < limit[piece[candidates]]
         candidates, direction, left, right, end = (candidates[keep], direction[keep], left[keep], right[keep],
                                                    end[keep])
-    vertex, chosen = np.full((len(pieces), 2), np.nan), np.full((len(pieces), 2), np.nan)
-    starts, ends = np.full((len(pieces), 2, 2), np.nan), np.full((len(pieces), 2), np.nan)
-    # the first candidate of each piece (candidates in the order they go)
-    first = np.r_[True, piece[candidates][1:] != piece[candidates][:-1]] if len(candidates) else np.zeros(0, bool)
-    vertex[piece[candidates[first]]] = coords[candidates[first]]
-    chosen[piece[candidates[first]]] = direction[first]
-    starts[piece[candidates[first]], 0] = left[first]
-    starts[piece[candidates[first]], 1] = right[first]
-    ends[piece[candidates[first]]] = end[first]
+    # each piece's candidate after the ones passed over (candidates in the order they go)
+    at = piece[candidates]
+    first = rank_within(at) == passed[at]
+    vertex[at[first]] = coords[candidates[first]]
+    chosen[at[first]] = direction[first]
+    starts[at[first], 0] = left[first]
+    starts[at[first], 1] = right[first]
+    ends[at[first]] = end[first]
     return vertex, chosen, starts, ends
 
 
@@ -357,8 +344,8 @@ def _cut(pieces: np.ndarray, vertex: np.ndarray, direction: np.ndarray, end: np.
     """Each piece cut through its ``vertex`` (k, 2) along ``direction`` (k, 2): the parts (j,) and where each
     comes from (j,): i for piece i's parts on the cut's left, k + i for those on its right. A clear corner's
     cut runs from the vertex to ``end``, where it comes to the boundary, and cuts the piece in two (PRT's
-    cuts stop there, as they do on holes); a nearly straight corner's and a cut across the boundary (``end``
-    NaN) run along the whole line through the piece."""
+    cuts stop there, as they do on holes); a nearly straight corner's cut (``end`` NaN) runs along the
+    whole line through the piece."""
     k = len(pieces)
     segment = np.flatnonzero(~np.isnan(end[:, 0]))
     line = np.flatnonzero(np.isnan(end[:, 0]))
@@ -376,13 +363,15 @@ def _cut(pieces: np.ndarray, vertex: np.ndarray, direction: np.ndarray, end: np.
 
 
 def _snapped(coords: np.ndarray, vertex_piece: np.ndarray, owner: np.ndarray, point: np.ndarray,
-             into: np.ndarray, run: np.ndarray):
+             into: np.ndarray, run: np.ndarray, neighbours: np.ndarray):
     """Cuts from ``point`` (k, 2) along ``into`` (k, 2) for ``run`` (k,) into ``pieces[owner]`` (whose
     vertices are ``coords``, of pieces ``vertex_piece``), ended at the first vertex of the piece that lies
     within SNAP of them: (direction, run, end) (k, 2), (k,), (k, 2). A cut along an edge's line that passes
     a millimetre beside a corner of the piece ends there (candler.tartu.12: the line of the roof's side
     beside a bump, 1.2 mm off the bump's other corner, cuts the bump off, a rectangle, where it ran on
-    along the side and left slivers)."""
+    along the side and left slivers); but never at one of the cut corner's own ``neighbours`` (k, 2, 2):
+    ended there, it would run along their edge and cut nothing off (a corner 16 cm before the end of a
+    side that bends back by 1.5 degrees; PRT's candler lays no ventilation on either side of it)."""
     first_vertex = np.searchsorted(vertex_piece, owner, side="left")
     n = np.searchsorted(vertex_piece, owner, side="right") - first_vertex
     pair = np.repeat(np.arange(len(owner)), n)
@@ -390,7 +379,8 @@ def _snapped(coords: np.ndarray, vertex_piece: np.ndarray, owner: np.ndarray, po
     rel = coords[v] - point[pair]
     along = rel[:, 0] * into[pair, 0] + rel[:, 1] * into[pair, 1]
     off = np.abs(into[pair, 0] * rel[:, 1] - into[pair, 1] * rel[:, 0])
-    near = (along > SNAP) & (along < run[pair] + SNAP) & (off <= SNAP)
+    own = (coords[v] == neighbours[pair, 0]).all(axis=1) | (coords[v] == neighbours[pair, 1]).all(axis=1)
+    near = (along > SNAP) & (along < run[pair] + SNAP) & (off <= SNAP) & ~own
     nearest = np.full(len(owner), np.inf)
     np.minimum.at(nearest, pair[near], along[near])
     end = point + into * run[:, None]
