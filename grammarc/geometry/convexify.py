@@ -5,8 +5,8 @@ one of its edges and stops at the boundary, as PRT's do; the faces they enclose 
 Each round cuts every piece that still has a reflex vertex along a line through one of them: the line
 of one of the two edges that meet there, the one that runs a shorter way into the piece from the vertex
 (on one side the vertex becomes straight, on the other its angle drops below 180 degrees). The vertex
-whose cut is the shortest goes first (of cuts within 1 % of it, the first in the ring), one that is
-nearly straight only when the piece has no other. A nearly straight corner too: the cut shaves a sliver off
+whose cut is the shortest goes first (of cuts as long as it but for rounding, the first in the ring),
+one that is nearly straight only when the piece has no other. A nearly straight corner too: the cut shaves a sliver off
 along the edge, and the rest of the piece stays whole (PRT's candler roofs keep a roof access on pieces
 with corners of a few degrees, candler.yverdon.10, concave.11029). A cut never makes a reflex vertex, so
 the reflex vertices of a lineage strictly decrease.
@@ -15,9 +15,10 @@ ends on an edge stay: PRT's pieces keep them, and ``geometry.isRectangular`` tel
 rectangle (candler's roofs). Each piece starts where its boundary leaves the last cut: at the corner
 cut, or where the cut ends on the boundary (``_cut_vertices``). A clear corner's cut runs from the corner
 to where it first comes to the boundary, as PRT's cuts of holes do, and ends at a corner of the piece that
-it passes within 5 mm of (``SNAP``: a bump whose side stands a millimetre off the line of the block's
-side is cut off whole); a nearly straight corner's cut runs along the whole line through the piece. The pieces come out as one mesh's faces, as PRT's do: a cut that ends on an
-earlier cut gives the piece beyond that a corner there too (``_conforming``).
+it passes within 0.8 mm of (``SNAP``: a bump whose side stands half a millimetre off the line of the
+block's side is cut off whole); a nearly straight corner's cut runs along the whole line through the
+piece. The pieces come out as one mesh's faces, as PRT's do: a cut that ends on an earlier cut gives
+the piece beyond that a corner there too (``_conforming``).
 
 A corner whose cut only shaves off a sliver (below the area floor) is passed over: the piece's next corner
 is cut instead, and a piece whose corners are all passed over stays as it is. PRT cuts no such corner
@@ -42,10 +43,13 @@ from grammarc.ragged import offsets_from_counts, rank_within, segment_of
 MAX_ROUNDS = 256
 #: A reflex corner that turns less than this (radians: one degree) is cut after the piece's others.
 NEARLY_STRAIGHT = np.radians(1.0)
-#: Cuts whose lengths differ by less than this fraction are tied: the first in the ring goes first.
-TIED = 0.01
-#: A clear corner's cut that passes a corner of its piece closer than this (metres) ends there.
-SNAP = 0.005
+#: Cuts whose lengths differ by less than this fraction are tied (rounding): the first in the ring goes first.
+TIED = 1e-9
+#: A clear corner's cut that passes a corner of its piece this close (metres) ends there. PRT's candler on a
+#: block whose side steps sideways by e at a bump on it: from 0.3 to 0.7 mm the bump's feet are cut along
+#: one line, from 0.9 mm on (0.8 mm at twice the size) each foot is cut on its own (ventilations on other
+#: pieces), the same at half and twice the size.
+SNAP = 0.0008
 
 
 def convex_parts(polygons: np.ndarray, max_length: np.ndarray | None = None,
@@ -264,7 +268,7 @@ def _cut_faces(polygons: np.ndarray, owner: np.ndarray, start: np.ndarray, end: 
 
 
 def _cut_vertices(pieces: np.ndarray, limit: np.ndarray | None, passed: np.ndarray):
-    """Per piece, the reflex vertex that is cut first (k, 2: its shortest cut, ``TIED``; after the piece's
+    """Per piece, the reflex vertex that is cut first (k, 2: the shortest cut, ``TIED``; after the piece's
     first ``passed`` (k,) corners in that order), the cut's direction (k, 2): along the line of one of
     the edges that meet there, and where the parts on its left and on its right start (k, 2) each; NaN
     where there is none (the piece is convex, every cut is too long, or every corner is passed over).
@@ -312,16 +316,18 @@ def _cut_vertices(pieces: np.ndarray, limit: np.ndarray | None, passed: np.ndarr
     # incoming edge's line
     left = np.where(shorter[:, None], far, point)
     right = np.where(shorter[:, None], point, far)
-    # the shortest cut goes first, the first in the ring of cuts within TIED of it: PRT's candler roofs
-    # take a small bump off before the long cut at a corner earlier in the ring (candler.tartu.17: the
-    # ventilation stands on the bump's outer strip; candler.seoul.42: a jog between two bars leaves no
-    # rectangle), and cut an H's bar ends, 2.949 and 2.955 m long, in ring order (candler.H.31062)
+    # the shortest cut goes first, the first in the ring of cuts as long but for rounding (TIED): PRT's
+    # candler roofs take a small bump off before the long cut at a corner earlier in the ring
+    # (candler.tartu.17: the ventilation stands on the bump's outer strip; candler.seoul.42: a jog between
+    # two bars leaves no rectangle), and cut a block across at a corner 11 m from its far side before a
+    # cut 3.5 mm longer across it, whatever the ring's start (a ventilation on the block)
     straight = ~clear
     group = 2 * piece[candidates] + straight
     shortest = np.full(2 * len(pieces), np.inf)
     np.minimum.at(shortest, group, run)
-    longer = run > shortest[group] * (1.0 + TIED)
-    order = np.lexsort((candidates, longer, straight, piece[candidates]))
+    # then the others by length (a piece's corners passed over give way to the next)
+    key = np.where(run > shortest[group] * (1.0 + TIED), run, 0.0)
+    order = np.lexsort((candidates, key, straight, piece[candidates]))
     candidates, direction, left, right, end, point = (candidates[order], direction[order], left[order],
                                                       right[order], end[order], point[order])
     if limit is not None:
@@ -367,9 +373,9 @@ def _snapped(coords: np.ndarray, vertex_piece: np.ndarray, owner: np.ndarray, po
     """Cuts from ``point`` (k, 2) along ``into`` (k, 2) for ``run`` (k,) into ``pieces[owner]`` (whose
     vertices are ``coords``, of pieces ``vertex_piece``), ended at the first vertex of the piece that lies
     within SNAP of them: (direction, run, end) (k, 2), (k,), (k, 2). A cut along an edge's line that passes
-    a millimetre beside a corner of the piece ends there (candler.tartu.12: the line of the roof's side
-    beside a bump, 1.2 mm off the bump's other corner, cuts the bump off, a rectangle, where it ran on
-    along the side and left slivers); but never at one of the cut corner's own ``neighbours`` (k, 2, 2):
+    half a millimetre beside a corner of the piece ends there (candler.tartu.12: the line of the roof's
+    side beside a bump, 0.5 mm off the bump's other corner, cuts the bump off, a rectangle, where it ran
+    on along the side and left slivers); but never at one of the cut corner's own ``neighbours`` (k, 2, 2):
     ended there, it would run along their edge and cut nothing off (a corner 16 cm before the end of a
     side that bends back by 1.5 degrees; PRT's candler lays no ventilation on either side of it)."""
     first_vertex = np.searchsorted(vertex_piece, owner, side="left")

@@ -88,11 +88,11 @@ def test_the_shortest_cut_goes_first():
         (0.2, 4), (3.705, 5), (77.05, 5)]
 
 
-def test_a_cut_that_passes_a_corner_by_a_millimetre_ends_there():
+def test_a_cut_that_passes_a_corner_by_half_a_millimetre_ends_there():
     """A block with a bump whose sides stand 1 mm off the line of the block's side (candler.tartu.12's
     outline, squared): PRT's candler, from four ring starts of the footprint, lays its ventilation on the
     bump, a rectangle, and none on the block. The cut along the block's side at the bump's foot ends at the
-    bump's other corner, 1 mm beside its line, instead of running on along the side and leaving a
+    bump's other corner, half a millimetre beside its line, instead of running on along the side and leaving a
     sliver rectangle (1.3 to 1.5 m off PRT's bounding box)."""
     footprint = shapely.Polygon([(0, 0), (10, 0), (9.999, 4), (12.5, 4), (12.5, 7.5), (9.999, 7.5), (10, 12), (0, 12)])
     roof = shapely.buffer(footprint, -0.8, join_style="mitre")
@@ -179,6 +179,46 @@ def test_a_side_that_bends_back_just_before_its_end_leaves_no_rectangle(degrees)
     pieces, _ = convex_parts(np.array([roof]), None, np.array([True]))
     assert 4 not in [corners(p) for p in pieces]
     assert shapely.area(pieces).sum() == pytest.approx(roof.area)
+
+
+def stepped_block(side):
+    """An 11 m wide block whose left side steps sideways by ``side`` at a bump 0.85 m deep, 3.39 m high (its
+    top 1.02 m below a step of 1.4 m out on the right side): candler.tartu.3's roof, squared."""
+    return shapely.Polygon([(0, 0), (11, 0), (11, 18.14), (12.4, 18.14), (12.4, 30), (side, 30), (side, 17.12),
+                            (-0.85, 17.12), (-0.85, 13.73), (0, 13.73)])
+
+
+def rectangles(pieces):
+    return sorted(tuple(np.round(shapely.bounds(p), 4)) for p in pieces if corners(p) == 4)
+
+
+BUMP = (-0.85, 13.73, 0.0, 17.12)
+
+
+@pytest.mark.parametrize("side, expected", [
+    (0.0007, [(-0.85, 13.73, 0.0007, 17.12)]),  # cut along one slanting line
+    (0.0015, [BUMP, (0.0015, 17.12, 11.0, 18.14)]),
+    (0.0035, [BUMP, (0.0035, 17.12, 11.0, 18.14)]),
+])
+def test_a_cut_passing_a_corner_by_a_millimetre_runs_on(side, expected):
+    """PRT's candler on these roofs' footprints: a side that steps 0.7 mm sideways at the bump (0.3 to 0.7
+    mm measured) gets one ventilation, on the bump; one that steps 0.9 mm or more, a second on the strip
+    between the bump's top and the step on the right side. The cut along the side's line at the bump's
+    top passes its other foot and runs on to the block's bottom; the cut along the bump's top, shorter,
+    goes instead (it ended at the other foot, 1.5 and 3.5 mm beside its line, and took the bump off)."""
+    pieces, _ = convex_parts(np.array([stepped_block(side)]), None, np.array([True]))
+    assert [r for r in rectangles(pieces) if r[0] < 0 or r[1] > 17] == expected
+
+
+@pytest.mark.parametrize("start", range(10))
+def test_of_two_cuts_across_a_block_the_shorter_by_millimetres_goes_first(start):
+    """The side steps 3.5 mm out at the bump: PRT's candler, from each of the footprint's ten ring starts,
+    lays a ventilation on the block below the bump (11 m by 13.73 m). The cut across it at the bump's foot
+    (11 m) goes before the one across at the step on the right (11.0035 m), whose end at the side would
+    have sent the foot's cut up along the side; cuts within 1 % of each other went in ring order."""
+    ring = np.asarray(stepped_block(-0.0035).exterior.coords)[:-1]
+    pieces, _ = convex_parts(np.array([shapely.Polygon(np.roll(ring, -start, axis=0))]), None, np.array([True]))
+    assert (0.0, 0.0, 11.0, 13.73) in rectangles(pieces)
 
 
 def test_split_lines_longer_than_max_length_are_not_cut():
