@@ -5,19 +5,19 @@ one of its edges and stops at the boundary, as PRT's do; the faces they enclose 
 Each round cuts every piece that still has a reflex vertex along a line through one of them: the line
 of one of the two edges that meet there, the one that runs a shorter way into the piece from the vertex
 (on one side the vertex becomes straight, on the other its angle drops below 180 degrees). The vertex
-whose cut is the shortest goes first (of cuts as long as it but for rounding, the first in the ring),
-one that is nearly straight only when the piece has no other. A nearly straight corner too: the cut shaves a sliver off
-along the edge, and the rest of the piece stays whole (PRT's candler roofs keep a roof access on pieces
-with corners of a few degrees, candler.yverdon.10, concave.11029). A cut never makes a reflex vertex, so
-the reflex vertices of a lineage strictly decrease.
+whose cut is the shortest goes first (of cuts as long as it but for rounding, the first in the ring).
+A reflex corner that turns by less than a degree (``NEARLY_STRAIGHT``) is not cut at all: PRT's candler
+lays a ventilation on a strip across a block's end whose side bends in by 0.007 to 0.99 degrees, and
+none from 1.02 degrees on (the bend's cut ends on the strip's edge and gives it a fifth corner); its
+roof accesses stand on roofs dented by under a degree as on whole ones (candler.yverdon.10,
+concave.11029). A cut never makes a reflex vertex, so the reflex vertices of a lineage strictly decrease.
 Rectilinear footprints come out as rectangles (an L in two, a U in three) whose corners where a cut
 ends on an edge stay: PRT's pieces keep them, and ``geometry.isRectangular`` tells such a piece from a
 rectangle (candler's roofs). Each piece starts where its boundary leaves the last cut: at the corner
 cut, or where the cut ends on the boundary (``_cut_vertices``). A clear corner's cut runs from the corner
 to where it first comes to the boundary, as PRT's cuts of holes do, and ends at a corner of the piece that
 it passes within 0.8 mm of (``SNAP``: a bump whose side stands half a millimetre off the line of the
-block's side is cut off whole); a nearly straight corner's cut runs along the whole line through the
-piece. The pieces come out as one mesh's faces, as PRT's do: a cut that ends on an earlier cut gives
+block's side is cut off whole). The pieces come out as one mesh's faces, as PRT's do: a cut that ends on an earlier cut gives
 the piece beyond that a corner there too (``_conforming``).
 
 A corner whose cut only shaves off a sliver (below the area floor) is passed over: the piece's next corner
@@ -41,7 +41,7 @@ from grammarc.ragged import offsets_from_counts, rank_within, segment_of
 
 #: Cutting rounds at most (each removes at least one reflex vertex from every piece it cuts).
 MAX_ROUNDS = 256
-#: A reflex corner that turns less than this (radians: one degree) is cut after the piece's others.
+#: A reflex corner that turns less than this (radians: one degree) is left as it is.
 NEARLY_STRAIGHT = np.radians(1.0)
 #: Cuts whose lengths differ by less than this fraction are tied (rounding): the first in the ring goes first.
 TIED = 1e-9
@@ -285,13 +285,13 @@ def _cut_vertices(pieces: np.ndarray, limit: np.ndarray | None, passed: np.ndarr
     ring = segment_of(ring_offsets)
     d_in, d_out, cross, reflex = _corners(coords, ring_offsets)
     piece = segment_of(np.asarray(part_offsets, dtype=np.int64))[ring]
-    candidates = np.flatnonzero(reflex)
+    # a corner that is nearly straight (under a degree) is none: a bump of 1 cm in an L's bar does not
+    # take the bar off whole before the L's corner is cut across it (candler.near_degenerate.31488: PRT's
+    # parts of the bar are too small for a roof access)
+    turn = np.arctan2(cross, d_in[:, 0] * d_out[:, 0] + d_in[:, 1] * d_out[:, 1])
+    candidates = np.flatnonzero(reflex & (turn <= -NEARLY_STRAIGHT))
     if not len(candidates):
         return vertex, chosen, starts, ends
-    # a corner that is nearly straight (under a degree) waits until the piece has no other: an L's
-    # corner is cut across its bar, not after a cut at a bump in the bar took the whole bar off
-    # (candler.near_degenerate.31488: PRT's parts of the bar are too small for a roof access)
-    turn = np.arctan2(cross, d_in[:, 0] * d_out[:, 0] + d_in[:, 1] * d_out[:, 1])
     a = d_in[candidates] / np.hypot(d_in[candidates, 0], d_in[candidates, 1])[:, None]
     b = d_out[candidates] / np.hypot(d_out[candidates, 0], d_out[candidates, 1])[:, None]
     # a corner is cut along the line of one of its edges, the one whose run into the piece from the
@@ -300,34 +300,27 @@ def _cut_vertices(pieces: np.ndarray, limit: np.ndarray | None, passed: np.ndarr
     # two 10 m arms, the boundary running forward about the roof's normal)
     point = coords[candidates]
     shorter, into, run = _edge_cuts(pieces, piece[candidates], point, a, b)
-    # a clear corner's cut ends at a corner of the piece that it passes within SNAP of, and stops where it
-    # comes to the boundary (``_cut``); a nearly straight one's runs along the whole line through the
-    # piece, shaving a sliver off along the edge
-    clear = turn[candidates] <= -NEARLY_STRAIGHT
-    far = point + into * run[:, None]
+    # the cut ends at a corner of the piece that it passes within SNAP of, and stops where it comes to the
+    # boundary (``_cut``)
     first, last = ring_offsets[:-1][ring[candidates]], ring_offsets[1:][ring[candidates]] - 1
     neighbours = np.stack([coords[np.where(candidates > first, candidates - 1, last - 1)], coords[candidates + 1]],
                           axis=1)
-    into[clear], run[clear], far[clear] = _snapped(coords, piece, piece[candidates[clear]], point[clear],
-                                                   into[clear], run[clear], neighbours[clear])
+    into, run, end = _snapped(coords, piece, piece[candidates], point, into, run, neighbours)
     direction = np.where(shorter[:, None], into, -into)
-    end = np.where(clear[:, None], far, np.nan)
     # the far end: on the right of the outgoing edge's line (the incoming edge's side), on the left of the
     # incoming edge's line
-    left = np.where(shorter[:, None], far, point)
-    right = np.where(shorter[:, None], point, far)
+    left = np.where(shorter[:, None], end, point)
+    right = np.where(shorter[:, None], point, end)
     # the shortest cut goes first, the first in the ring of cuts as long but for rounding (TIED): PRT's
     # candler roofs take a small bump off before the long cut at a corner earlier in the ring
     # (candler.tartu.17: the ventilation stands on the bump's outer strip; candler.seoul.42: a jog between
     # two bars leaves no rectangle), and cut a block across at a corner 11 m from its far side before a
     # cut 3.5 mm longer across it, whatever the ring's start (a ventilation on the block)
-    straight = ~clear
-    group = 2 * piece[candidates] + straight
-    shortest = np.full(2 * len(pieces), np.inf)
-    np.minimum.at(shortest, group, run)
+    shortest = np.full(len(pieces), np.inf)
+    np.minimum.at(shortest, piece[candidates], run)
     # then the others by length (a piece's corners passed over give way to the next)
-    key = np.where(run > shortest[group] * (1.0 + TIED), run, 0.0)
-    order = np.lexsort((candidates, key, straight, piece[candidates]))
+    key = np.where(run > shortest[piece[candidates]] * (1.0 + TIED), run, 0.0)
+    order = np.lexsort((candidates, key, piece[candidates]))
     candidates, direction, left, right, end, point = (candidates[order], direction[order], left[order],
                                                       right[order], end[order], point[order])
     if limit is not None:
@@ -347,25 +340,17 @@ def _cut_vertices(pieces: np.ndarray, limit: np.ndarray | None, passed: np.ndarr
 
 
 def _cut(pieces: np.ndarray, vertex: np.ndarray, direction: np.ndarray, end: np.ndarray):
-    """Each piece cut through its ``vertex`` (k, 2) along ``direction`` (k, 2): the parts (j,) and where each
-    comes from (j,): i for piece i's parts on the cut's left, k + i for those on its right. A clear corner's
-    cut runs from the vertex to ``end``, where it comes to the boundary, and cuts the piece in two (PRT's
-    cuts stop there, as they do on holes); a nearly straight corner's cut (``end`` NaN) runs along the
-    whole line through the piece."""
-    k = len(pieces)
-    segment = np.flatnonzero(~np.isnan(end[:, 0]))
-    line = np.flatnonzero(np.isnan(end[:, 0]))
-    faces, owner = _cut_faces(pieces[segment], np.arange(len(segment)), vertex[segment], end[segment])
+    """Each piece cut through its ``vertex`` (k, 2) along ``direction`` (k, 2) to ``end`` (k, 2), where the cut
+    comes to the boundary (PRT's cuts stop there, as they do on holes): the parts (j,) and where each comes
+    from (j,): i for piece i's parts on the cut's left, k + i for those on its right."""
+    faces, owner = _cut_faces(pieces, np.arange(len(pieces)), vertex, end)
     # a face is on the cut's left where it holds a point a hair left of the cut's middle
     normal = np.stack([-direction[:, 1], direction[:, 0]], axis=1)
     beside = (vertex + end) / 2 + normal * (1e-7 * _reach(pieces))[:, None]
-    on_left = shapely.contains(faces, shapely.points(beside[segment][owner]))
-    left, right = _half_planes(vertex[line], direction[line], _reach(pieces[line]))
-    halves, half = shapely.get_parts(np.concatenate([shapely.intersection(pieces[line], left),
-                                                     shapely.intersection(pieces[line], right)]), return_index=True)
-    index = np.concatenate([segment[owner] + np.where(on_left, 0, k), np.concatenate([line, line + k])[half]])
+    on_left = shapely.contains(faces, shapely.points(beside[owner]))
+    index = owner + np.where(on_left, 0, len(pieces))
     order = np.argsort(index, kind="stable")
-    return np.concatenate([faces, halves])[order], index[order]
+    return faces[order], index[order]
 
 
 def _snapped(coords: np.ndarray, vertex_piece: np.ndarray, owner: np.ndarray, point: np.ndarray,
@@ -562,14 +547,3 @@ def _reach(pieces: np.ndarray) -> np.ndarray:
     """A length past which a line through a point of the piece has left it: twice its box's diagonal."""
     bounds = shapely.bounds(pieces).reshape(-1, 4)
     return 2.0 * np.hypot(bounds[:, 2] - bounds[:, 0], bounds[:, 3] - bounds[:, 1]) + 1.0
-
-
-def _half_planes(vertex: np.ndarray, direction: np.ndarray, reach: np.ndarray):
-    """Squares of side 2 * reach on the left and the right of each line through ``vertex``."""
-    normal = np.stack([-direction[:, 1], direction[:, 0]], axis=1)
-    along = direction * reach[:, None]
-    across = normal * (2 * reach)[:, None]
-    a, b = vertex - along, vertex + along
-    left = shapely.polygons(np.stack([a, b, b + across, a + across], axis=1))
-    right = shapely.polygons(np.stack([a, a - across, b - across, b], axis=1))
-    return left, right
