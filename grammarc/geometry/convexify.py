@@ -14,16 +14,17 @@ concave.11029). A cut never makes a reflex vertex, so the reflex vertices of a l
 Rectilinear footprints come out as rectangles (an L in two, a U in three) whose corners where a cut
 ends on an edge stay: PRT's pieces keep them, and ``geometry.isRectangular`` tells such a piece from a
 rectangle (candler's roofs). Each piece starts where its boundary leaves the last cut: at the corner
-cut, or where the cut ends on the boundary (``_cut_vertices``). A clear corner's cut runs from the corner
-to where it first comes to the boundary, as PRT's cuts of holes do, and ends at a corner of the piece that
-it passes within 0.8 mm of (``SNAP``: a bump whose side stands half a millimetre off the line of the
-block's side is cut off whole). The pieces come out as one mesh's faces, as PRT's do: a cut that ends on an earlier cut gives
-the piece beyond that a corner there too (``_conforming``).
+cut, or where the cut ends on the boundary (``_cut_vertices``). A cut runs from the corner to where it
+first comes to the boundary, as PRT's cuts of holes do, and ends at a corner of the piece that it passes
+within 0.8 mm of (``SNAP``: a bump whose side stands half a millimetre off the line of the block's side
+is cut off whole), never at the corner's own neighbour. The pieces come out as one mesh's faces, as
+PRT's do: a cut that ends on an earlier cut gives the piece beyond that a corner there too
+(``_conforming``).
 
-A corner whose cut only shaves off a sliver (below the area floor) is passed over: the piece's next corner
-is cut instead, and a piece whose corners are all passed over stays as it is. PRT cuts no such corner
-otherwise: a roof whose side bends back by 0.001 to 1.7 degrees 16 cm before its end gets no ventilation
-from PRT's candler, where a cut across the boundary there made two rectangles (candler.seoul.12).
+A corner whose cut would only shave off a sliver (below the area floor) is passed over: the piece's next
+corner is cut instead, and a piece whose corners are all passed over stays as it is (such a corner was
+cut across the boundary, which PRT does not: candler.seoul.12's roof, whose side bends back by a
+thousandth of a degree 16 cm before its end, got two rectangles and ventilations PRT does not lay).
 
 ``max_length`` (CityEngine's ``convexify(maxLength)``): a reflex vertex is only cut where the cut's
 chord through the piece, from boundary to boundary through the vertex, is shorter; a piece whose reflex
@@ -45,7 +46,7 @@ MAX_ROUNDS = 256
 NEARLY_STRAIGHT = np.radians(1.0)
 #: Cuts whose lengths differ by less than this fraction are tied (rounding): the first in the ring goes first.
 TIED = 1e-9
-#: A clear corner's cut that passes a corner of its piece this close (metres) ends there. PRT's candler on a
+#: A corner's cut that passes a corner of its piece this close (metres) ends there. PRT's candler on a
 #: block whose side steps sideways by e at a bump on it: from 0.3 to 0.7 mm the bump's feet are cut along
 #: one line, from 0.9 mm on (0.8 mm at twice the size) each foot is cut on its own (ventilations on other
 #: pieces), the same at half and twice the size.

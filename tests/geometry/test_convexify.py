@@ -177,10 +177,9 @@ def test_a_cut_that_ends_on_an_earlier_cut_gives_the_piece_beyond_it_a_corner_th
 def test_a_side_that_bends_back_just_before_its_end_leaves_no_rectangle(degrees):
     """A 10 m by 6 m roof whose side bends back by a few thousandths of a degree or by 1.5 degrees 15.8 cm
     before its end (candler.seoul.12's roof, squared): PRT's candler lays no ventilation on it, from 0.0003
-    to 5 degrees. The corner's cut along the side's line shaves off a sliver below the area floor (the
-    corner is passed over), or, 1.5 degrees, runs 4 mm beside the side's end, its own neighbour, and on to
-    the boundary; cut across the boundary, or ended at that neighbour and then cut across, it made two
-    rectangles."""
+    to 5 degrees. The corner is not cut (under a degree), or its cut, 1.5 degrees, runs 4 mm beside the
+    side's end, its own neighbour, on to the boundary; cut across the boundary, or ended at that neighbour
+    and then cut across, it made two rectangles."""
     bend = 0.158 * np.tan(np.radians(degrees))
     roof = shapely.Polygon([(0, 0), (9.842, 0), (10, -bend), (10, 6), (0, 6)])
     pieces, _ = convex_parts(np.array([roof]), None, np.array([True]))
