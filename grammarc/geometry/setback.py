@@ -30,8 +30,11 @@ from grammarc.ragged import offsets_from_counts, rank_within
 #: A mitre longer than this many setback distances (a near-reversal of the boundary) is cut to the
 #: edge's rectangle.
 _MITRE_LIMIT = 10.0
-#: The turn (degrees) of the boundary below which edges moved by different distances step (``_mitres``).
+#: The turn (degrees) of the boundary below which edges moved by different distances step (``_mitres``)
+#: at a convex vertex, and at a reflex one: measured through PyPRT, 14.99 steps and 15.01 meets at a convex
+#: vertex; 44.5 and 45 step and 45.5 meets at a reflex one, whatever the distances (2, 4 and 8 m).
 _STEP_TURN = 15.0
+_REFLEX_STEP_TURN = 45.0
 #: The angle (degrees) under which the neighbours of a folded edge are parallel (``_unfolded``): the real
 #: lots' were 0.01-0.7 degrees apart; an edge between neighbours 11 degrees apart moves in PRT (a
 #: concave lot of the replay's, whose tier it sweeps).
@@ -211,7 +214,8 @@ def _unfolded(edges: Edges, d: np.ndarray) -> np.ndarray:
     # the moved neighbour (``side``) and the edge beyond it step as in ``_mitres``
     side = np.where(moved[edges.prev], edges.prev, edges.next)
     beyond = np.where(moved[edges.prev], edges.prev[side], edges.next[side])
-    steps = (_cosines(tangent[side], tangent[beyond]) > np.cos(np.radians(_STEP_TURN))) & (
+    leaving, arriving = np.where(moved[edges.prev], side, beyond), np.where(moved[edges.prev], beyond, side)
+    steps = _stepping(tangent[leaving], edges.inward[arriving], _cosines(tangent[side], tangent[beyond])) & (
         np.abs(d[side] - d[beyond]) > TOL.zero)
     between = parallel & (moved[edges.prev] != moved[edges.next]) & ~steps
     if not (between & moved).any():  # no edge to keep (most faces): the quads need no test of their own
@@ -398,11 +402,13 @@ def _mitres(edges: Edges, d: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.nda
     near it); and (E,) whether they do.
 
     Where the two distances differ (one edge stays, or both move by different distances) and the
-    boundary turns there by less than ``_STEP_TURN``, PRT steps instead of running the moved lines out to
-    where they meet, far off: each strip ends at the mitre point of its own distance on both edges, and
-    the remainder steps across between them (measured through PyPRT on massing's tiers: a kept edge then
-    a moved one, turned by 14.99 degrees steps, by 15.01 meets; edges set back 4 and 3 m turned by 7
-    degrees step by 1 m on convex.11084)."""
+    boundary turns there by less than ``_STEP_TURN`` (at a convex vertex; ``_REFLEX_STEP_TURN`` at a reflex
+    one, ``_stepping``), PRT steps instead of running the moved lines out to where they meet: each strip
+    ends at the mitre point of its own distance on both edges, and the remainder steps across between them
+    (measured through PyPRT on massing's tiers: a kept edge then a moved one, turned by 14.99 degrees
+    steps, by 15.01 meets; edges set back 4 and 3 m turned by 7 degrees step by 1 m on convex.11084; at a
+    reflex vertex, a kept edge then one moved 2, 4 or 8 m, or edges moved 4 and 3 or 4 and 1 m, turned by
+    5 to 45 degrees step, by 45.5 to 89 meet: massing.concave.43421's first tier, 30 degrees)."""
     a, b = edges.inward[edges.prev], edges.inward
     da, db = d[edges.prev], d
     det = a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0]
@@ -412,13 +418,23 @@ def _mitres(edges: Edges, d: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.nda
     reach = np.hypot(corner[:, 0], corner[:, 1])
     far = np.maximum(da, db)
     cosine = np.einsum("ij,ij->i", a, b)
-    step = (np.abs(da - db) > TOL.zero) & (cosine > np.cos(np.radians(_STEP_TURN)))
+    step = (np.abs(da - db) > TOL.zero) & _stepping(edges.end - edges.start, a, cosine)
     too_far = ~step & ((np.abs(det) <= 1e-9) | (reach > _MITRE_LIMIT * np.maximum(far, TOL.zero)))
     corner = np.where(too_far[:, None], straight, corner)
     ends = corner.copy()
     bisector = (a[step] + b[step]) / (1.0 + cosine[step])[:, None]
     corner[step], ends[step] = bisector * db[step, None], bisector * da[step, None]
     return corner, ends, ~too_far
+
+
+def _stepping(tangent: np.ndarray, previous_inward: np.ndarray, cosine: np.ndarray) -> np.ndarray:
+    """(k,) whether the boundary turns by little enough at the vertices where edges (their ``tangent`` (k, 2))
+    leave their previous edges (``previous_inward`` (k, 2) normals; ``cosine`` (k,) of the turn) that
+    edges moved by different distances step there: under ``_STEP_TURN`` where the edge turns into the
+    polygon (a convex vertex), up to ``_REFLEX_STEP_TURN`` where it turns away (a reflex one)."""
+    reflex = np.einsum("ij,ij->i", tangent, previous_inward) < 0
+    return np.where(reflex, cosine >= np.cos(np.radians(_REFLEX_STEP_TURN)) - 1e-12,
+                    cosine > np.cos(np.radians(_STEP_TURN)))
 
 
 def union_by_group(geometries: np.ndarray, group: np.ndarray, n_groups: int) -> np.ndarray:
