@@ -320,7 +320,8 @@ def ring_starts(coords, ring_offsets, part_offsets, part_source, part_with_start
                 else:
                     keys[j] = vertex_key
             if not cut and not part_inset[p]:
-                _after_steps(keys, moved_from, r0, r1)
+                outer = parent_rings[parent_offsets[g] + 1] - parent_rings[parent_offsets[g]]
+                _after_steps(keys, moved_from, r0, r1, outer)
     last_end = _last_edge_ends(coords, ring_offsets, part_offsets, part_source, part_inset, moved_from,
                                parent_coords, parent_rings, parent_offsets)
     for p in range(len(part_offsets) - 1):
@@ -397,19 +398,22 @@ def _at_vertex_0(best, corner, along, outer):
 
 
 @njit(cache=True, nogil=True)
-def _after_steps(keys, moved_from, r0, r1):
+def _after_steps(keys, moved_from, r0, r1, outer):
     """A setback's remainder whose edge moved in from parent edge i ends in a step (an edge along no
     parent edge, to the next parent edge's kept vertex or moved copy) counts that edge and the step after
     the next parent edge: PRT starts its tier there (massing's convex.33000, moved edge 0 stepping to kept
     edge 1 at 11 degrees: PRT's remainder starts at vertex 1; far.33307, edges set back 4 and 3 m
-    stepping at 5 degrees). ``keys`` (V,) turned in place for the ring ``r0:r1``."""
+    stepping at 5 degrees). The last edge of the ``outer`` ring steps to edge 0: its run and its step
+    count last, and the remainder starts at edge 0 (measured through PyPRT: a last edge moved 4 m
+    stepping to a kept edge 0 at 12 degrees). ``keys`` (V,) turned in place for the ring ``r0:r1``."""
     n = r1 - r0
     for j in range(r0, r1):
         k = r0 + (j - r0 + 1) % n
         m = r0 + (j - r0 + 2) % n
         i = moved_from[j]
+        following = 0.0 if i == outer - 1 else i + 1
         if np.isfinite(i) and keys[j] == i and not np.isfinite(moved_from[k]) and (
-                moved_from[m] == i + 1 or keys[m] == i + 1):
+                moved_from[m] == following or keys[m] == following):
             keys[j] = keys[k] = i + 1.5
 
 
