@@ -319,6 +319,40 @@ def test_edges_moved_by_different_distances_step_where_they_turn_little():
         assert np.min(np.linalg.norm(corners - ([30, 0] + distance * bisector), axis=1)) < 1e-6
 
 
+@pytest.mark.parametrize("turn, corner", [(10.0, -0.350), (30.0, -1.072), (44.5, -1.636), (45.0, -1.657),
+                                          (45.5, 3.931), (60.0, 2.309), (89.0, 0.070)])
+def test_a_moved_edge_steps_at_a_reflex_vertex_up_to_45_degrees(turn, corner):
+    """PRT's massing (measured through PyPRT, its corners below): edge 0 set back 4 m after a kept last
+    edge that it turns from by up to 45 degrees the other way (a reflex vertex 0): the strip ends on the
+    vertex's bisector, and the remainder steps from there back to vertex 0; turned by more, the moved line
+    runs on to the kept edge's line (at a convex vertex the step stops at 15 degrees: test above). Before,
+    a reflex vertex stepped under 15 degrees too (massing.concave.43421's first tier, 30 degrees: 16 m^2)."""
+    a = np.radians(turn)
+    last = (-12 * np.cos(a), -12 * np.sin(a))
+    polygon = shapely.Polygon([(0, 0), (30, 0), (30, 20), (-20, 20), (-20, min(last[1], -1.0)), last])
+    edges = polygon_edges(np.array([polygon]))
+    d = np.where(np.arange(len(edges.poly)) == 0, 4.0, 0.0)
+    _, remainder = setback_regions(np.array([polygon]), edges, d, np.zeros(len(d), dtype=np.int64), 1)
+    moved = [x for x, y in remainder[0].exterior.coords if abs(y - 4) < 1e-9]
+    assert min(moved) == pytest.approx(corner, abs=1e-3)
+
+
+def test_edges_moved_by_different_distances_step_at_a_reflex_vertex():
+    """PRT's massing (measured through PyPRT): the last edge set back 3 m and edge 0 4 m, turned by 30
+    degrees at a reflex vertex 0: each strip ends at its own distance's point of the bisector, (-0.804, 3)
+    and (-1.072, 4), and the remainder steps between them (before, the moved lines met at (-10.392, -2))."""
+    a = np.radians(30.0)
+    last = (-12 * np.cos(a), -12 * np.sin(a))
+    polygon = shapely.Polygon([(0, 0), (30, 0), (30, 20), (-20, 20), (-20, last[1]), last])
+    edges = polygon_edges(np.array([polygon]))
+    d = np.zeros(len(edges.poly))
+    d[0], d[-1] = 4.0, 3.0
+    _, remainder = setback_regions(np.array([polygon]), edges, d, np.zeros(len(d), dtype=np.int64), 1)
+    corners = np.asarray(remainder[0].exterior.coords)
+    for point in ((-0.804, 3.0), (-1.072, 4.0)):
+        assert np.min(np.linalg.norm(corners - point, axis=1)) < 1e-3
+
+
 def test_strips_that_cover_the_face_leave_no_seam_vertices():
     """PRT's shapeO whose widths cover the whole face is the face itself: where two strips meet on an
     edge no vertex is left, so the face's edges keep their numbers (as its tiers' setbacks count them)."""
