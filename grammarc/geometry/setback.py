@@ -101,12 +101,11 @@ def setback_regions(polygons: np.ndarray, edges: Edges, distance: np.ndarray, ow
     m = len(polygons)
     # a distance that is not a number (``float("")`` of a missing list item) moves nothing
     d = _unfolded(edges, np.where((owner < n_owners) & np.isfinite(distance), np.maximum(distance, 0.0), 0.0))
-    corner, ends, end_corner, idx, quads = _quads(edges, d)
+    # whether a face folds or is swept is decided on the strips that step at convex vertices alone, as
+    # PRT's are swept (``_reflex_strips``)
+    corner, _, end_corner, idx, quads = _quads(edges, d, reflex_steps=False)
     moved = d > TOL.zero
-    strips = shapely.polygons(quads) if len(idx) else np.empty(0, dtype=object)
-    folded = ~shapely.is_valid(strips)
-    if folded.any():
-        strips[folded] = _folded_strips(quads[folded])
+    strips, folded = _strips(quads)
     group = owner[idx] * m + edges.poly[idx]
     # a face whose strips fold, or where a moved edge's line passes a kept neighbour's far end (the kept
     # edge's segment turns over: PRT's tiers on massing's near_degenerate.34258 and 34006 run on past a
@@ -123,8 +122,9 @@ def setback_regions(polygons: np.ndarray, edges: Edges, distance: np.ndarray, ow
         span < -TOL.zero * np.einsum("ij,ij->i", tangent, tangent)) & (
         moved[other] | (_cosines(tangent, tangent[other]) > np.cos(np.radians(_RUN_ON_TURN))))
     swept[edges.poly[turned_over]] = True
+    strips = _reflex_strips(edges, d, swept, strips, idx, quads)
     if swept.any():
-        strips, group = _swept(polygons, edges, d, corner, ends, owner, swept, strips, group, idx)
+        strips, group = _swept(polygons, edges, d, owner, swept, strips, group, idx)
     united = union_by_group(strips, group, n_owners * m).reshape(n_owners, m)
     regions, covered = [], np.full(m, shapely.Polygon(), dtype=object)
     for k in range(n_owners):
@@ -134,7 +134,32 @@ def setback_regions(polygons: np.ndarray, edges: Edges, distance: np.ndarray, ow
     return regions, _without_spikes(shapely.difference(polygons, covered))
 
 
-def _swept(polygons: np.ndarray, edges: Edges, d, corner, ends, owner, swept, strips, group, idx):
+def _strips(quads: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The strips (k,) of quads (k, 4, 2): each quad, or where it folds over itself (k,) its triangle
+    (``_folded_strips``)."""
+    strips = shapely.polygons(quads) if len(quads) else np.empty(0, dtype=object)
+    folded = ~shapely.is_valid(strips)
+    if folded.any():
+        strips[folded] = _folded_strips(quads[folded])
+    return strips, folded
+
+
+def _reflex_strips(edges: Edges, d: np.ndarray, swept: np.ndarray, strips: np.ndarray, idx: np.ndarray,
+                   quads: np.ndarray) -> np.ndarray:
+    """The strips (k,) of the moved edges ``idx`` (k,) with those of the faces not ``swept`` (m,) made
+    again where they step at a reflex vertex (``_stepping``; ``quads`` (k, 4, 2) step at convex ones
+    alone). A swept face keeps them: its wavefront steps at convex vertices alone (massing.concave.50953's
+    first tier, whose edge set back 4 m beside one set back 3 m at a 25-degree reflex vertex folds and
+    sweeps on past a kept edge, as PRT's; stepped there, it folded no more and its strip stopped)."""
+    _, _, _, _, stepped = _quads(edges, d)
+    changed = np.flatnonzero(~swept[edges.poly[idx]] & np.any(stepped != quads, axis=(1, 2)))
+    if len(changed):
+        strips = strips.copy()
+        strips[changed] = _strips(stepped[changed])[0]
+    return strips
+
+
+def _swept(polygons: np.ndarray, edges: Edges, d, owner, swept, strips, group, idx):
     """The strips (k,) of the moved edges ``idx`` (k,) and their groups (owner * m + polygon), those of the
     polygons ``swept`` (m,) bool replaced by the regions their edges sweep as a wavefront
     (``geometry.wavefront``: their outer rings; holes stay); a polygon of which nothing is left goes whole
@@ -145,8 +170,12 @@ def _swept(polygons: np.ndarray, edges: Edges, d, corner, ends, owner, swept, st
     faces = np.flatnonzero(swept)
     rows = np.flatnonzero(swept[edges.poly] & ~edges.hole)  # (their outer rings, one after the other)
     ring_offsets = offsets_from_counts(np.bincount(edges.poly[rows], minlength=m)[faces])
+    # (a reflex vertex steps as a convex one does in a swept face: stepping up to 45 degrees there broke the
+    # fronts of massing.concave.50953's first tier, which the mitres followed as PRT's)
+    corner, ends, _ = _mitres(edges, d, reflex_steps=False)
     coords, offsets, collapsed, followed, left, left_ring = swept_strips(
-        edges.start[rows], edges.end[rows], edges.inward[rows], d[rows], corner[rows], ends[rows], ring_offsets)
+        edges.start[rows], edges.end[rows], edges.inward[rows], d[rows], corner[rows], ends[rows], ring_offsets,
+        np.cos(np.radians(_STEP_TURN)))
     scale = max(float(np.abs(edges.start[rows]).max(initial=1.0)), 1.0)
     outlines = shapely.get_exterior_ring(polygons[faces])
     outside = shapely.distance(shapely.points(left), shapely.polygons(outlines)[left_ring]) > 1e-9 * scale
@@ -214,8 +243,7 @@ def _unfolded(edges: Edges, d: np.ndarray) -> np.ndarray:
     # the moved neighbour (``side``) and the edge beyond it step as in ``_mitres``
     side = np.where(moved[edges.prev], edges.prev, edges.next)
     beyond = np.where(moved[edges.prev], edges.prev[side], edges.next[side])
-    leaving, arriving = np.where(moved[edges.prev], side, beyond), np.where(moved[edges.prev], beyond, side)
-    steps = _stepping(tangent[leaving], edges.inward[arriving], _cosines(tangent[side], tangent[beyond])) & (
+    steps = (_cosines(tangent[side], tangent[beyond]) > np.cos(np.radians(_STEP_TURN))) & (
         np.abs(d[side] - d[beyond]) > TOL.zero)
     between = parallel & (moved[edges.prev] != moved[edges.next]) & ~steps
     if not (between & moved).any():  # no edge to keep (most faces): the quads need no test of their own
@@ -234,11 +262,12 @@ def _unfolded(edges: Edges, d: np.ndarray) -> np.ndarray:
     return np.where(folding[edges.poly], d, unfolded)
 
 
-def _quads(edges: Edges, d: np.ndarray):
+def _quads(edges: Edges, d: np.ndarray, reflex_steps: bool = True):
     """The quads of the edges moved by ``d`` (E,): (E, 2) where each edge's strip starts and where its
-    previous edge's ends (``_mitres``), and (E, 2) where its own strip ends, relative to its vertices; the
-    moved edges (k,) and their quads (k, 4, 2): start, end, moved end, moved start."""
-    corner, ends, mitred = _mitres(edges, d)
+    previous edge's ends (``_mitres``, stepping at reflex vertices too or not), and (E, 2) where its own
+    strip ends, relative to its vertices; the moved edges (k,) and their quads (k, 4, 2): start, end, moved
+    end, moved start."""
+    corner, ends, mitred = _mitres(edges, d, reflex_steps)
     # a strip ends at its next edge's mitre (its own, where the two step); where the two do not meet in
     # one (a straight vertex, as between the collinear edges a setback leaves, or a spike), at its own
     # moved end
@@ -251,7 +280,7 @@ def _quads(edges: Edges, d: np.ndarray):
 
 def _folds(edges: Edges, d: np.ndarray) -> np.ndarray:
     """The moved edges (indices) whose quads fold over themselves (a distance longer than the edge allows)."""
-    _, _, _, idx, quads = _quads(edges, d)
+    _, _, _, idx, quads = _quads(edges, d, reflex_steps=False)
     return idx[~shapely.is_valid(shapely.polygons(quads))] if len(idx) else idx
 
 
@@ -396,7 +425,7 @@ def _without_spikes(geometries: np.ndarray) -> np.ndarray:
     return shapely.set_precision(geometries, _SNAP)
 
 
-def _mitres(edges: Edges, d: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def _mitres(edges: Edges, d: np.ndarray, reflex_steps: bool = True) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """(E, 2) twice: where the strip of each edge starts and where its previous edge's strip ends, relative
     to the vertex they share: where their moved lines meet (the edge's own move where they do not meet
     near it); and (E,) whether they do.
@@ -418,7 +447,8 @@ def _mitres(edges: Edges, d: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.nda
     reach = np.hypot(corner[:, 0], corner[:, 1])
     far = np.maximum(da, db)
     cosine = np.einsum("ij,ij->i", a, b)
-    step = (np.abs(da - db) > TOL.zero) & _stepping(edges.end - edges.start, a, cosine)
+    step = (np.abs(da - db) > TOL.zero) & (_stepping(edges.end - edges.start, a, cosine) if reflex_steps else
+                                            cosine > np.cos(np.radians(_STEP_TURN)))
     too_far = ~step & ((np.abs(det) <= 1e-9) | (reach > _MITRE_LIMIT * np.maximum(far, TOL.zero)))
     corner = np.where(too_far[:, None], straight, corner)
     ends = corner.copy()

@@ -353,6 +353,25 @@ def test_edges_moved_by_different_distances_step_at_a_reflex_vertex():
         assert np.min(np.linalg.norm(corners - point, axis=1)) < 1e-3
 
 
+@pytest.mark.parametrize("turn, corner", [(-35.0, (0.7375, 4.0)), (-40.0, (0.869, 4.0)), (-25.0, (9.2425, 4.0))])
+def test_a_moved_line_past_a_kept_edge_steps_to_the_next_edge_it_turns_little_from(turn, corner):
+    """Edge 0 set back 4 m runs past the far end (1, 1) of the kept edge 1 (45 degrees up from it); the
+    kept edge 2 turns from edge 1 by ``turn``, from edge 0 by 45 + turn. PRT's tiers (measured through PyPRT,
+    its corners below): turned from edge 0 by under 15 degrees, edge 0's line steps where it passes (1, 1),
+    along the bisector of the two edges' normals, so the remainder keeps (1, 1) and its moved line ends at
+    (0.7375, 4) (10 degrees) or (0.869, 4) (5); by 20 degrees, it runs on to edge 2's line at (9.2425, 4).
+    Before, the swept front met edge 2's line however little the two turned."""
+    a = np.radians(45 + turn)
+    far = (1 + 10 * np.cos(a), 1 + 10 * np.sin(a))
+    polygon = shapely.Polygon([(-20, 0), (0, 0), (1, 1), far, (far[0], 25), (-20, 25)])
+    edges = polygon_edges(np.array([polygon]))
+    d = np.where(np.arange(len(edges.poly)) == 0, 4.0, 0.0)
+    _, remainder = setback_regions(np.array([polygon]), edges, d, np.zeros(len(d), dtype=np.int64), 1)
+    corners = np.asarray(remainder[0].exterior.coords)
+    assert np.min(np.linalg.norm(corners - corner, axis=1)) < 1e-3
+    assert (np.min(np.linalg.norm(corners - (1, 1), axis=1)) < 1e-9) == (turn < -30)
+
+
 def test_strips_that_cover_the_face_leave_no_seam_vertices():
     """PRT's shapeO whose widths cover the whole face is the face itself: where two strips meet on an
     edge no vertex is left, so the face's edges keep their numbers (as its tiers' setbacks count them)."""
