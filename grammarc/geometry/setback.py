@@ -122,9 +122,10 @@ def setback_regions(polygons: np.ndarray, edges: Edges, distance: np.ndarray, ow
         span < -TOL.zero * np.einsum("ij,ij->i", tangent, tangent)) & (
         moved[other] | (_cosines(tangent, tangent[other]) > np.cos(np.radians(_RUN_ON_TURN))))
     swept[edges.poly[turned_over]] = True
-    strips = _reflex_strips(edges, d, swept, strips, idx, quads)
+    corner, ends, _, _, stepped = _quads(edges, d)
+    strips = _reflex_strips(edges, swept, strips, idx, quads, stepped)
     if swept.any():
-        strips, group = _swept(polygons, edges, d, owner, swept, strips, group, idx)
+        strips, group = _swept(polygons, edges, d, corner, ends, owner, swept, strips, group, idx)
     united = union_by_group(strips, group, n_owners * m).reshape(n_owners, m)
     regions, covered = [], np.full(m, shapely.Polygon(), dtype=object)
     for k in range(n_owners):
@@ -144,14 +145,14 @@ def _strips(quads: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return strips, folded
 
 
-def _reflex_strips(edges: Edges, d: np.ndarray, swept: np.ndarray, strips: np.ndarray, idx: np.ndarray,
-                   quads: np.ndarray) -> np.ndarray:
-    """The strips (k,) of the moved edges ``idx`` (k,) with those of the faces not ``swept`` (m,) made
-    again where they step at a reflex vertex (``_stepping``; ``quads`` (k, 4, 2) step at convex ones
-    alone). A swept face keeps them: its wavefront steps at convex vertices alone (massing.concave.50953's
-    first tier, whose edge set back 4 m beside one set back 3 m at a 25-degree reflex vertex folds and
-    sweeps on past a kept edge, as PRT's; stepped there, it folded no more and its strip stopped)."""
-    _, _, _, _, stepped = _quads(edges, d)
+def _reflex_strips(edges: Edges, swept: np.ndarray, strips: np.ndarray, idx: np.ndarray, quads: np.ndarray,
+                   stepped: np.ndarray) -> np.ndarray:
+    """The strips (k,) of the moved edges ``idx`` (k,), those of the faces not ``swept`` (m,) made again of
+    the quads ``stepped`` (k, 4, 2) that step at reflex vertices too (``_stepping``) where they differ from
+    ``quads`` (k, 4, 2), which step at convex ones alone. Whether a face folds, and is swept, is decided on
+    the latter (massing.concave.50953's first tier, whose edge set back 4 m beside one set back 3 m at a
+    25-degree reflex vertex folds there and sweeps on past a kept edge, as PRT's does; stepped, it
+    folded no more and its strip stopped short); its wavefront then steps at the reflex vertex too."""
     changed = np.flatnonzero(~swept[edges.poly[idx]] & np.any(stepped != quads, axis=(1, 2)))
     if len(changed):
         strips = strips.copy()
@@ -159,7 +160,7 @@ def _reflex_strips(edges: Edges, d: np.ndarray, swept: np.ndarray, strips: np.nd
     return strips
 
 
-def _swept(polygons: np.ndarray, edges: Edges, d, owner, swept, strips, group, idx):
+def _swept(polygons: np.ndarray, edges: Edges, d, corner, ends, owner, swept, strips, group, idx):
     """The strips (k,) of the moved edges ``idx`` (k,) and their groups (owner * m + polygon), those of the
     polygons ``swept`` (m,) bool replaced by the regions their edges sweep as a wavefront
     (``geometry.wavefront``: their outer rings; holes stay); a polygon of which nothing is left goes whole
@@ -170,9 +171,6 @@ def _swept(polygons: np.ndarray, edges: Edges, d, owner, swept, strips, group, i
     faces = np.flatnonzero(swept)
     rows = np.flatnonzero(swept[edges.poly] & ~edges.hole)  # (their outer rings, one after the other)
     ring_offsets = offsets_from_counts(np.bincount(edges.poly[rows], minlength=m)[faces])
-    # (a reflex vertex steps as a convex one does in a swept face: stepping up to 45 degrees there broke the
-    # fronts of massing.concave.50953's first tier, which the mitres followed as PRT's)
-    corner, ends, _ = _mitres(edges, d, reflex_steps=False)
     coords, offsets, collapsed, followed, left, left_ring = swept_strips(
         edges.start[rows], edges.end[rows], edges.inward[rows], d[rows], corner[rows], ends[rows], ring_offsets,
         np.cos(np.radians(_STEP_TURN)))

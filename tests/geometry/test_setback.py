@@ -253,8 +253,11 @@ def test_strips_and_remainder_partition_the_polygon(seed, d):
     polygon = random_polygon(seed)
     (strips,), remainder = setback([polygon], d, owner=lambda e: (np.arange(len(e.poly)) % 2))
     assert shapely.area(strips[0]) + shapely.area(remainder[0]) == pytest.approx(polygon.area, rel=1e-6)
-    # on a fine grid: GEOS's floating overlay misjudges vertices that agree to the last digit or so
-    overlap = shapely.intersection(strips[0], remainder[0], grid_size=1e-9)
+    # on a fine grid: GEOS's floating overlay misjudges vertices that agree to the last digit or so (of
+    # the polygons: a region may hold the lines its spikes collapse to, which its pieces leave)
+    parts = shapely.get_parts(strips[0])
+    polygonal = shapely.union_all(parts[shapely.get_type_id(parts) == shapely.GeometryType.POLYGON])
+    overlap = shapely.intersection(polygonal, remainder[0], grid_size=1e-9)
     assert shapely.area(overlap) <= 1e-6 * polygon.area
 
 
