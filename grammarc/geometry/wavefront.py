@@ -15,7 +15,9 @@ Where ``geometry.setback`` steps between two edges (a turn of less than 15 degre
 distances) or cuts a mitre too long, the two strips end apart; the segment between their ends is a line
 of its own here (through the vertex, along the step, moving so that its ends stay on the two strips'
 lines), so the steps stay PRT's. An edge event (an edge's segment shrinks to nothing) removes the edge;
-its neighbours then meet, and a step beside it goes with it. Neighbours whose lines are parallel meet only
+its neighbours then meet, and a step beside it goes with it; neighbours moved by different distances
+that turn by less than 15 degrees step from where they met instead, as at a vertex of the outline (PRT's
+moved line past a kept edge's far end, where the next kept edge turns little from it). Neighbours whose lines are parallel meet only
 where they coincide: facing ones (two edges passing each other) annihilate where their segments overlap,
 the shorter going and the rest of the longer sweeping on, as PRT's front strip runs on past the kept end
 of an L's arm and a T's bar top past where its bottom met it; of two with the same normal the slower
@@ -83,12 +85,12 @@ def _ring_strips(start, end, inward, d, corner, ends, out, out_n, left, step_cos
     how many vertices it ended with, and whether it met no split event (two parallel lines apart
     becoming neighbours)."""
     n = len(d)
-    m_cap = 4 * n + 4  # the edges, a step at each vertex, and one at each event
+    m_cap = 6 * n + 4  # the edges, a step at each vertex, and one at each of at most 2 m events
     nx, ny, c, w = np.empty(m_cap), np.empty(m_cap), np.empty(m_cap), np.empty(m_cap)
     ux, uy = np.empty(m_cap), np.empty(m_cap)
     real = np.full(m_cap, -1, np.int64)
     # each line's start path (where its strip starts, from its start vertex on) and end path, as linked
-    # lists in one pool: two points per line, and at most six per event
+    # lists in one pool: two points per line, and at most eight per event
     pool = np.empty((10 * m_cap + 8, 2))
     link = np.empty(10 * m_cap + 8, np.int64)
     s_head, s_tail = np.full(m_cap, -1, np.int64), np.full(m_cap, -1, np.int64)
@@ -305,8 +307,8 @@ def swept_strips(start, end, inward, d, corner, ends, ring_offsets, step_cos):
     inward unit normals; d (E,): how far each moves in; corner (E, 2): where edge k's strip starts,
     relative to its start vertex, and ends (E, 2) where edge k-1's strip ends, relative to the same
     vertex (``geometry.setback._mitres``); step_cos: the cosine of the turn under which neighbours moved
-    by different distances that meet after an event step there. Returns the strips as ragged rings: coords (V, 2) and
-    offsets (E+1,) (an edge that does not move has none); (R,) bool whether nothing is left of the
+    by different distances that meet after an event step there. Returns the strips as ragged rings:
+    coords (V, 2) and offsets (E+1,) (an edge that does not move has none); (R,) bool whether nothing is left of the
     ring's face; (R,) bool whether its wavefront met no split event it cannot follow; and the
     wavefront's vertices at the end (W, 2) with their ring (W,) (where they lie outside the face, a split
     event was missed: the strips are not to be trusted either).
