@@ -320,7 +320,8 @@ def ring_starts(coords, ring_offsets, part_offsets, part_source, part_with_start
                 else:
                     keys[j] = vertex_key
             if not cut and not part_inset[p]:
-                _after_steps(keys, moved_from, r0, r1)
+                outer = parent_rings[parent_offsets[g] + 1] - parent_rings[parent_offsets[g]]
+                _after_steps(keys, moved_from, moved_in, r0, r1, outer)
     last_end = _last_edge_ends(coords, ring_offsets, part_offsets, part_source, part_inset, moved_from,
                                parent_coords, parent_rings, parent_offsets)
     for p in range(len(part_offsets) - 1):
@@ -397,19 +398,26 @@ def _at_vertex_0(best, corner, along, outer):
 
 
 @njit(cache=True, nogil=True)
-def _after_steps(keys, moved_from, r0, r1):
+def _after_steps(keys, moved_from, moved_in, r0, r1, outer):
     """A setback's remainder whose edge moved in from parent edge i ends in a step (an edge along no
     parent edge, to the next parent edge's kept vertex or moved copy) counts that edge and the step after
     the next parent edge: PRT starts its tier there (massing's convex.33000, moved edge 0 stepping to kept
     edge 1 at 11 degrees: PRT's remainder starts at vertex 1; far.33307, edges set back 4 and 3 m
-    stepping at 5 degrees). ``keys`` (V,) turned in place for the ring ``r0:r1``."""
+    stepping at 5 degrees). A moved last edge of the ``outer`` ring (``moved_in``) that steps to edge 0
+    counts, with its step, after the last: the remainder starts at edge 0 (measured through PyPRT: a last
+    edge moved 4 m stepping to a kept edge 0 at 12 degrees); a kept last edge's run before a moved edge 0's
+    step stays where it is (``_at_vertex_0``: near_degenerate.43572). ``keys`` (V,) turned in place for
+    the ring ``r0:r1``."""
     n = r1 - r0
     for j in range(r0, r1):
         k = r0 + (j - r0 + 1) % n
         m = r0 + (j - r0 + 2) % n
         i = moved_from[j]
+        following = i + 1
+        if i == outer - 1:
+            following = 0.0 if moved_in[j] else np.inf
         if np.isfinite(i) and keys[j] == i and not np.isfinite(moved_from[k]) and (
-                moved_from[m] == i + 1 or keys[m] == i + 1):
+                moved_from[m] == following or keys[m] == following):
             keys[j] = keys[k] = i + 1.5
 
 

@@ -30,8 +30,11 @@ from grammarc.ragged import offsets_from_counts, rank_within
 #: A mitre longer than this many setback distances (a near-reversal of the boundary) is cut to the
 #: edge's rectangle.
 _MITRE_LIMIT = 10.0
-#: The turn (degrees) of the boundary below which edges moved by different distances step (``_mitres``).
+#: The turn (degrees) of the boundary below which edges moved by different distances step (``_mitres``)
+#: at a convex vertex, and at a reflex one: measured through PyPRT, 14.99 steps and 15.01 meets at a convex
+#: vertex; 44.5 and 45 step and 45.5 meets at a reflex one, whatever the distances (2, 4 and 8 m).
 _STEP_TURN = 15.0
+_REFLEX_STEP_TURN = 45.0
 #: The angle (degrees) under which the neighbours of a folded edge are parallel (``_unfolded``): the real
 #: lots' were 0.01-0.7 degrees apart; an edge between neighbours 11 degrees apart moves in PRT (a
 #: concave lot of the replay's, whose tier it sweeps).
@@ -98,12 +101,11 @@ def setback_regions(polygons: np.ndarray, edges: Edges, distance: np.ndarray, ow
     m = len(polygons)
     # a distance that is not a number (``float("")`` of a missing list item) moves nothing
     d = _unfolded(edges, np.where((owner < n_owners) & np.isfinite(distance), np.maximum(distance, 0.0), 0.0))
-    corner, ends, end_corner, idx, quads = _quads(edges, d)
+    # whether a face folds or is swept is decided on the strips that step at convex vertices alone, as
+    # PRT's are swept (``_reflex_strips``)
+    corner, _, end_corner, idx, quads = _quads(edges, d, reflex_steps=False)
     moved = d > TOL.zero
-    strips = shapely.polygons(quads) if len(idx) else np.empty(0, dtype=object)
-    folded = ~shapely.is_valid(strips)
-    if folded.any():
-        strips[folded] = _folded_strips(quads[folded])
+    strips, folded = _strips(quads)
     group = owner[idx] * m + edges.poly[idx]
     # a face whose strips fold, or where a moved edge's line passes a kept neighbour's far end (the kept
     # edge's segment turns over: PRT's tiers on massing's near_degenerate.34258 and 34006 run on past a
@@ -120,8 +122,18 @@ def setback_regions(polygons: np.ndarray, edges: Edges, distance: np.ndarray, ow
         span < -TOL.zero * np.einsum("ij,ij->i", tangent, tangent)) & (
         moved[other] | (_cosines(tangent, tangent[other]) > np.cos(np.radians(_RUN_ON_TURN))))
     swept[edges.poly[turned_over]] = True
+    stepped_corner, stepped_ends, _, _, stepped = _quads(edges, d)
+    strips = _reflex_strips(edges, swept, strips, idx, quads, stepped)
     if swept.any():
-        strips, group = _swept(polygons, edges, d, corner, ends, owner, swept, strips, group, idx)
+        # a swept face's wavefront steps at reflex vertices too, but for those of an edge whose strip folds
+        # (it vanishes there: massing.concave.50953's and a replay lot's first tiers, whose folded edge set
+        # back 4 m turns by 25 and 40 degrees at a reflex vertex; PRT's fronts run on past it as the mitres')
+        folding = np.zeros(len(d), dtype=bool)
+        folding[idx[folded]] = True
+        keep = (folding | folding[edges.prev])[:, None]
+        _, convex_ends, _ = _mitres(edges, d, reflex_steps=False)
+        strips, group = _swept(polygons, edges, d, np.where(keep, corner, stepped_corner),
+                               np.where(keep, convex_ends, stepped_ends), owner, swept, strips, group, idx)
     united = union_by_group(strips, group, n_owners * m).reshape(n_owners, m)
     regions, covered = [], np.full(m, shapely.Polygon(), dtype=object)
     for k in range(n_owners):
@@ -129,6 +141,31 @@ def setback_regions(polygons: np.ndarray, edges: Edges, distance: np.ndarray, ow
         regions.append(_without_seams(_without_spikes(region), polygons))
         covered = shapely.union(covered, region)
     return regions, _without_spikes(shapely.difference(polygons, covered))
+
+
+def _strips(quads: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The strips (k,) of quads (k, 4, 2): each quad, or where it folds over itself (k,) its triangle
+    (``_folded_strips``)."""
+    strips = shapely.polygons(quads) if len(quads) else np.empty(0, dtype=object)
+    folded = ~shapely.is_valid(strips)
+    if folded.any():
+        strips[folded] = _folded_strips(quads[folded])
+    return strips, folded
+
+
+def _reflex_strips(edges: Edges, swept: np.ndarray, strips: np.ndarray, idx: np.ndarray, quads: np.ndarray,
+                   stepped: np.ndarray) -> np.ndarray:
+    """The strips (k,) of the moved edges ``idx`` (k,), those of the faces not ``swept`` (m,) made again of
+    the quads ``stepped`` (k, 4, 2) that step at reflex vertices too (``_stepping``) where they differ from
+    ``quads`` (k, 4, 2), which step at convex ones alone. Whether a face folds, and is swept, is decided on
+    the latter (massing.concave.50953's first tier, whose edge set back 4 m beside one set back 3 m at a
+    25-degree reflex vertex folds there and sweeps on past a kept edge, as PRT's does; stepped, it
+    folded no more and its strip stopped short); its wavefront then steps at the reflex vertex too."""
+    changed = np.flatnonzero(~swept[edges.poly[idx]] & np.any(stepped != quads, axis=(1, 2)))
+    if len(changed):
+        strips = strips.copy()
+        strips[changed] = _strips(stepped[changed])[0]
+    return strips
 
 
 def _swept(polygons: np.ndarray, edges: Edges, d, corner, ends, owner, swept, strips, group, idx):
@@ -143,7 +180,8 @@ def _swept(polygons: np.ndarray, edges: Edges, d, corner, ends, owner, swept, st
     rows = np.flatnonzero(swept[edges.poly] & ~edges.hole)  # (their outer rings, one after the other)
     ring_offsets = offsets_from_counts(np.bincount(edges.poly[rows], minlength=m)[faces])
     coords, offsets, collapsed, followed, left, left_ring = swept_strips(
-        edges.start[rows], edges.end[rows], edges.inward[rows], d[rows], corner[rows], ends[rows], ring_offsets)
+        edges.start[rows], edges.end[rows], edges.inward[rows], d[rows], corner[rows], ends[rows], ring_offsets,
+        np.cos(np.radians(_STEP_TURN)))
     scale = max(float(np.abs(edges.start[rows]).max(initial=1.0)), 1.0)
     outlines = shapely.get_exterior_ring(polygons[faces])
     outside = shapely.distance(shapely.points(left), shapely.polygons(outlines)[left_ring]) > 1e-9 * scale
@@ -230,11 +268,12 @@ def _unfolded(edges: Edges, d: np.ndarray) -> np.ndarray:
     return np.where(folding[edges.poly], d, unfolded)
 
 
-def _quads(edges: Edges, d: np.ndarray):
+def _quads(edges: Edges, d: np.ndarray, reflex_steps: bool = True):
     """The quads of the edges moved by ``d`` (E,): (E, 2) where each edge's strip starts and where its
-    previous edge's ends (``_mitres``), and (E, 2) where its own strip ends, relative to its vertices; the
-    moved edges (k,) and their quads (k, 4, 2): start, end, moved end, moved start."""
-    corner, ends, mitred = _mitres(edges, d)
+    previous edge's ends (``_mitres``, stepping at reflex vertices too or not), and (E, 2) where its own
+    strip ends, relative to its vertices; the moved edges (k,) and their quads (k, 4, 2): start, end, moved
+    end, moved start."""
+    corner, ends, mitred = _mitres(edges, d, reflex_steps)
     # a strip ends at its next edge's mitre (its own, where the two step); where the two do not meet in
     # one (a straight vertex, as between the collinear edges a setback leaves, or a spike), at its own
     # moved end
@@ -247,7 +286,7 @@ def _quads(edges: Edges, d: np.ndarray):
 
 def _folds(edges: Edges, d: np.ndarray) -> np.ndarray:
     """The moved edges (indices) whose quads fold over themselves (a distance longer than the edge allows)."""
-    _, _, _, idx, quads = _quads(edges, d)
+    _, _, _, idx, quads = _quads(edges, d, reflex_steps=False)
     return idx[~shapely.is_valid(shapely.polygons(quads))] if len(idx) else idx
 
 
@@ -392,17 +431,19 @@ def _without_spikes(geometries: np.ndarray) -> np.ndarray:
     return shapely.set_precision(geometries, _SNAP)
 
 
-def _mitres(edges: Edges, d: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def _mitres(edges: Edges, d: np.ndarray, reflex_steps: bool = True) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """(E, 2) twice: where the strip of each edge starts and where its previous edge's strip ends, relative
     to the vertex they share: where their moved lines meet (the edge's own move where they do not meet
     near it); and (E,) whether they do.
 
     Where the two distances differ (one edge stays, or both move by different distances) and the
-    boundary turns there by less than ``_STEP_TURN``, PRT steps instead of running the moved lines out to
-    where they meet, far off: each strip ends at the mitre point of its own distance on both edges, and
-    the remainder steps across between them (measured through PyPRT on massing's tiers: a kept edge then
-    a moved one, turned by 14.99 degrees steps, by 15.01 meets; edges set back 4 and 3 m turned by 7
-    degrees step by 1 m on convex.11084)."""
+    boundary turns there by less than ``_STEP_TURN`` (at a convex vertex; ``_REFLEX_STEP_TURN`` at a reflex
+    one, ``_stepping``), PRT steps instead of running the moved lines out to where they meet: each strip
+    ends at the mitre point of its own distance on both edges, and the remainder steps across between them
+    (measured through PyPRT on massing's tiers: a kept edge then a moved one, turned by 14.99 degrees
+    steps, by 15.01 meets; edges set back 4 and 3 m turned by 7 degrees step by 1 m on convex.11084; at a
+    reflex vertex, a kept edge then one moved 2, 4 or 8 m, or edges moved 4 and 3 or 4 and 1 m, turned by
+    5 to 45 degrees step, by 45.5 to 89 meet: massing.concave.43421's first tier, 30 degrees)."""
     a, b = edges.inward[edges.prev], edges.inward
     da, db = d[edges.prev], d
     det = a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0]
@@ -412,13 +453,24 @@ def _mitres(edges: Edges, d: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.nda
     reach = np.hypot(corner[:, 0], corner[:, 1])
     far = np.maximum(da, db)
     cosine = np.einsum("ij,ij->i", a, b)
-    step = (np.abs(da - db) > TOL.zero) & (cosine > np.cos(np.radians(_STEP_TURN)))
+    step = (np.abs(da - db) > TOL.zero) & (_stepping(edges.end - edges.start, a, cosine) if reflex_steps else
+                                            cosine > np.cos(np.radians(_STEP_TURN)))
     too_far = ~step & ((np.abs(det) <= 1e-9) | (reach > _MITRE_LIMIT * np.maximum(far, TOL.zero)))
     corner = np.where(too_far[:, None], straight, corner)
     ends = corner.copy()
     bisector = (a[step] + b[step]) / (1.0 + cosine[step])[:, None]
     corner[step], ends[step] = bisector * db[step, None], bisector * da[step, None]
     return corner, ends, ~too_far
+
+
+def _stepping(tangent: np.ndarray, previous_inward: np.ndarray, cosine: np.ndarray) -> np.ndarray:
+    """(k,) whether the boundary turns by little enough at the vertices where edges (their ``tangent`` (k, 2))
+    leave their previous edges (``previous_inward`` (k, 2) normals; ``cosine`` (k,) of the turn) that
+    edges moved by different distances step there: under ``_STEP_TURN`` where the edge turns into the
+    polygon (a convex vertex), up to ``_REFLEX_STEP_TURN`` where it turns away (a reflex one)."""
+    reflex = np.einsum("ij,ij->i", tangent, previous_inward) < 0
+    return np.where(reflex, cosine >= np.cos(np.radians(_REFLEX_STEP_TURN)) - 1e-12,
+                    cosine > np.cos(np.radians(_STEP_TURN)))
 
 
 def union_by_group(geometries: np.ndarray, group: np.ndarray, n_groups: int) -> np.ndarray:

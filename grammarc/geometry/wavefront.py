@@ -15,7 +15,9 @@ Where ``geometry.setback`` steps between two edges (a turn of less than 15 degre
 distances) or cuts a mitre too long, the two strips end apart; the segment between their ends is a line
 of its own here (through the vertex, along the step, moving so that its ends stay on the two strips'
 lines), so the steps stay PRT's. An edge event (an edge's segment shrinks to nothing) removes the edge;
-its neighbours then meet, and a step beside it goes with it. Neighbours whose lines are parallel meet only
+its neighbours then meet, and a step beside it goes with it; neighbours moved by different distances
+that turn by less than 15 degrees step from where they met instead, as at a vertex of the outline (PRT's
+moved line past a kept edge's far end, where the next kept edge turns little from it). Neighbours whose lines are parallel meet only
 where they coincide: facing ones (two edges passing each other) annihilate where their segments overlap,
 the shorter going and the rest of the longer sweeping on, as PRT's front strip runs on past the kept end
 of an L's arm and a T's bar top past where its bottom met it; of two with the same normal the slower
@@ -76,19 +78,19 @@ def _push(pool, link, used, head, tail, e, x, y):
 
 
 @njit(cache=True, nogil=True)
-def _ring_strips(start, end, inward, d, corner, ends, out, out_n, left):
+def _ring_strips(start, end, inward, d, corner, ends, out, out_n, left, step_cos):
     """The swept strip of each edge of one ring (n edges), written one after another to ``out`` with its
     vertex count in ``out_n`` (n,) (0 for an edge that does not move), and the wavefront's vertices at
     the end to ``left`` (2 n, 2); returns whether the wavefront fell below three lines (nothing is left),
     how many vertices it ended with, and whether it met no split event (two parallel lines apart
     becoming neighbours)."""
     n = len(d)
-    m_cap = 2 * n
+    m_cap = 6 * n + 4  # the edges, a step at each vertex, and one at each of at most 2 m events
     nx, ny, c, w = np.empty(m_cap), np.empty(m_cap), np.empty(m_cap), np.empty(m_cap)
     ux, uy = np.empty(m_cap), np.empty(m_cap)
     real = np.full(m_cap, -1, np.int64)
     # each line's start path (where its strip starts, from its start vertex on) and end path, as linked
-    # lists in one pool: two points per line, and at most six per event
+    # lists in one pool: two points per line, and at most eight per event
     pool = np.empty((10 * m_cap + 8, 2))
     link = np.empty(10 * m_cap + 8, np.int64)
     s_head, s_tail = np.full(m_cap, -1, np.int64), np.full(m_cap, -1, np.int64)
@@ -124,12 +126,13 @@ def _ring_strips(start, end, inward, d, corner, ends, out, out_n, left):
         used = _push(pool, link, used, s_head, s_tail, m, start[k, 0], start[k, 1])
         used = _push(pool, link, used, e_head, e_tail, m, end[k, 0], end[k, 1])
         m += 1
-    prv, nxt = np.empty(m, np.int64), np.empty(m, np.int64)
+    prv, nxt = np.empty(m_cap, np.int64), np.empty(m_cap, np.int64)
     for i in range(m):
         prv[i], nxt[i] = (i - 1) % m, (i + 1) % m
-    alive = np.ones(m, np.bool_)
+    alive = np.zeros(m_cap, np.bool_)
+    alive[:m] = True
     count = m
-    final = np.empty((m, 2, 2))
+    final = np.empty((m_cap, 2, 2))
     now = 0.0
     collapsed = False
     trusted = True
@@ -179,6 +182,27 @@ def _ring_strips(start, end, inward, d, corner, ends, out, out_n, left):
                 jx, jy, _ = _meet(nx, ny, c, w, p, q, now)
                 used = _push(pool, link, used, e_head, e_tail, p, jx, jy)
                 used = _push(pool, link, used, s_head, s_tail, q, jx, jy)
+                if (real[p] >= 0 and real[q] >= 0 and abs(w[p] - w[q]) > _EPS
+                        and nx[p] * nx[q] + ny[p] * ny[q] > step_cos):
+                    # neighbours moved by different distances that turn little step from where they met, as
+                    # at a vertex of the outline (``geometry.setback._mitres``): a line through the point
+                    # along their normals' bisector, which their moved lines cross at their own distances
+                    # (PRT's tiers: a moved edge that runs past a kept edge's far end, where the next kept
+                    # edge turns from it by 15 degrees or less, steps there)
+                    bx, by = nx[p] + nx[q], ny[p] + ny[q]
+                    size = np.sqrt(bx * bx + by * by)
+                    sign = 1.0 if w[q] > w[p] else -1.0
+                    ux[m], uy[m] = sign * bx / size, sign * by / size
+                    nx[m], ny[m] = -uy[m], ux[m]
+                    c[m] = nx[m] * jx + ny[m] * jy
+                    w[m] = 0.0  # (it stays where it is)
+                    real[m] = -1
+                    alive[m] = True
+                    used = _push(pool, link, used, s_head, s_tail, m, jx, jy)
+                    used = _push(pool, link, used, e_head, e_tail, m, jx, jy)
+                    nxt[p], prv[m], nxt[m], prv[q] = m, p, q, m
+                    m += 1
+                    count += 1
                 break
             # parallel neighbours meet where they coincide; apart, the ring parts there (a split event): the
             # strips are not to be trusted. Lines with the same normal: the slower goes (both where equally
@@ -231,10 +255,16 @@ def _ring_strips(start, end, inward, d, corner, ends, out, out_n, left):
             final[e, 1, 0], final[e, 1, 1] = (fx, fy) if okf else (pool[e_tail[e], 0], pool[e_tail[e], 1])
     n_left = 0
     if not collapsed:
-        for e in range(m):
-            if alive[e]:
-                left[n_left], left[n_left + 1] = final[e, 0], final[e, 1]
-                n_left += 2
+        first = 0
+        while first < m and not alive[first]:
+            first += 1
+        e = first
+        while first < m:  # (in the ring's order: a step made at an event comes after the lines before it)
+            left[n_left], left[n_left + 1] = final[e, 0], final[e, 1]
+            n_left += 2
+            e = nxt[e]
+            if e == first:
+                break
     j = 0
     back = np.empty(used, np.int64)
     for e in range(m):
@@ -270,14 +300,15 @@ def _ring_strips(start, end, inward, d, corner, ends, out, out_n, left):
 
 
 @njit(cache=True, nogil=True)
-def swept_strips(start, end, inward, d, corner, ends, ring_offsets):
+def swept_strips(start, end, inward, d, corner, ends, ring_offsets, step_cos):
     """The strips of the edges of rings (outer rings of faces), each the region its edge sweeps.
 
     start, end, inward (E, 2) float64: the edges, ring after ring (``ring_offsets`` (R+1,)), and their
     inward unit normals; d (E,): how far each moves in; corner (E, 2): where edge k's strip starts,
     relative to its start vertex, and ends (E, 2) where edge k-1's strip ends, relative to the same
-    vertex (``geometry.setback._mitres``). Returns the strips as ragged rings: coords (V, 2) and
-    offsets (E+1,) (an edge that does not move has none); (R,) bool whether nothing is left of the
+    vertex (``geometry.setback._mitres``); step_cos: the cosine of the turn under which neighbours moved
+    by different distances that meet after an event step there. Returns the strips as ragged rings:
+    coords (V, 2) and offsets (E+1,) (an edge that does not move has none); (R,) bool whether nothing is left of the
     ring's face; (R,) bool whether its wavefront met no split event it cannot follow; and the
     wavefront's vertices at the end (W, 2) with their ring (W,) (where they lie outside the face, a split
     event was missed: the strips are not to be trusted either).
@@ -295,7 +326,8 @@ def swept_strips(start, end, inward, d, corner, ends, ring_offsets):
     for r in range(n_rings):
         a, b = ring_offsets[r], ring_offsets[r + 1]
         collapsed[r], k, trusted[r] = _ring_strips(start[a:b], end[a:b], inward[a:b], d[a:b], corner[a:b],
-                                                   ends[a:b], coords[used:], counts[a:b], left[n_left:])
+                                                   ends[a:b], coords[used:], counts[a:b], left[n_left:],
+                                                   step_cos)
         left_ring[n_left:n_left + k] = r
         n_left += k
         used += counts[a:b].sum()

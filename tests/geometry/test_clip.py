@@ -358,6 +358,37 @@ def test_a_remainder_whose_first_edge_steps_starts_after_the_step():
     np.testing.assert_allclose(first, (13.5501, -6.7633), atol=1e-9)
 
 
+def test_a_remainder_whose_last_edge_steps_to_edge_0_starts_at_edge_0():
+    """The last edge set back 4 m, turning by 12 degrees into the kept edge 0: its strip steps back to
+    vertex 0, and PRT starts the remainder at vertex 0, along edge 0 (measured through PyPRT under massing's
+    tiers), not at the step from the last edge's moved copy (which comes first in the ring)."""
+    import shapely
+
+    from grammarc.geometry.clip import fit_pieces
+    from grammarc.geometry.setback import polygon_edges, setback_regions
+
+    ring = np.array([[4.279, -5.065], [9.389, 3.478], [10.586, 5.661], [6.247, 18.281], [-13.91, -11.706],
+                     [-3.311, -13.327]])  # counter-clockwise in (x, y)
+    lot = shapely.Polygon(ring)
+    edges = polygon_edges(np.array([lot]))
+    d = np.where(np.arange(len(edges.poly)) == len(edges.poly) - 1, 4.0, 0.0)
+    _, remainder = setback_regions(np.array([lot]), edges, d, np.zeros(len(d), dtype=np.int64), 1)
+    low = ring.min(axis=0)
+    size = ring.max(axis=0) - low
+
+    def to_plane(coords):  # (x, z) with z = -y: the lot winds clockwise there, as a face's top does
+        coords = np.asarray(coords) - low
+        return np.c_[coords[:, 0], -coords[:, 1]]
+
+    kept = np.asarray(remainder[0].exterior.coords)[:-1]
+    for turned in range(len(kept)):  # GEOS's start anywhere on the ring
+        piece = shapely.Polygon(to_plane(np.roll(kept, turned, axis=0)))
+        fitted = fit_pieces(np.array([piece]), np.ones(1, np.int8), np.array([[size[0], 0.0, size[1]]]),
+                            np.array([shapely.Polygon(to_plane(ring))]))
+        first = fitted.coords[:2] * fitted.extent[0, [0, 2]] + fitted.low[0, [0, 2]]
+        np.testing.assert_allclose(first, to_plane(ring[:2]), atol=1e-9)
+
+
 def test_cut_edges_of_a_piece_the_cut_takes_through_a_hole_turn_their_faces():
     """A courtyard prism (plane 1, 30 x 20) cut at v = 0.5 through its hole: each piece's two cut edges
     turn their side faces (``cap_turns``: DOWN after the outer edge 3, UP before the outer edge 1, as the
