@@ -585,13 +585,14 @@ def _offset_polygons(ctx: Context, distance: ir.Expr, cursor: Shapes, span):
 
 
 def _distances(ctx: Context, distance: ir.Expr, cursor: Shapes, span) -> np.ndarray:
-    """``offset``'s distance (n,) float64 per shape; a lot whose outline it moves out beyond ``FAR`` fails.
-    Moved in that far, nothing is left of an outline: that is no error."""
+    """``offset``'s distance (n,) float64 per shape; a lot whose outline it moves out beyond ``FAR`` fails,
+    as does one whose distance is not a number. Moved in that far (by -inf too), nothing is left of an
+    outline: that is no error, and the distance is ``-FAR`` (GEOS takes no infinite distance)."""
     d = np.broadcast_to(np.asarray(evaluate_array(distance, ctx.env(cursor)), float), (len(cursor),))
-    far = d > FAR
-    if far.any():
-        ctx.fail(cursor, far, f"`offset` by {d[far][0]:g}, beyond any coordinate", span)
-    return d
+    for bad, said in ((np.isnan(d), "a distance that is not a number"), (d > FAR, None)):
+        if bad.any():
+            ctx.fail(cursor, bad, f"`offset` by {said or f'{d[bad][0]:g}, beyond any coordinate'}", span)
+    return np.maximum(d, -FAR)
 
 
 def _inset_and_border(polygons: np.ndarray, distance: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

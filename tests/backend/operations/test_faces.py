@@ -440,15 +440,23 @@ def test_a_roof_of_90_degrees_or_more_fails_its_lot_by_name(write, op, angle):
 @pytest.mark.parametrize("select", ["", "comp(f){ inside : I. | border : B. }", "Roof.", "setback", "shapeL"])
 def test_an_offset_or_setback_beyond_any_coordinate_fails_its_lot(write, select):
     """An outline moved out by more than float32 holds (GEOS raised on 1e308) fails its lot; moved in that
-    far, nothing is left of it, which is no error."""
+    far, or by -inf (GEOS raised on it), nothing is left of it, which is no error."""
     body = {"Roof.": "extrude(3) comp(f){ top : roofHip(30) offset(d) Roof. }",
             "setback": "setback(d){ front : A. | remainder : B. }",
             "shapeL": "shapeL(d, 2){ shape : A. | remainder : B. }"}.get(select, f"offset(d) {select or 'A.'}")
     what = "setback" if select in ("setback", "shapeL") else "offset"
-    r = run(write, f"attr d = -1\nLot --> {body}\n", [rect(10, 10)] * 3,
-            lot_attrs={"d": np.array([-1.0, 1e308, -1e308])})
+    r = run(write, f"attr d = -1\nLot --> {body}\n", [rect(10, 10)] * 4,
+            lot_attrs={"d": np.array([-1.0, 1e308, -1e308, -np.inf])})
     reasons = [(b.index, b.reason.split(" in rule")[0]) for b in r["bad"]]
     assert reasons == [(1, f"`{what}` by 1e+308, beyond any coordinate")]
+
+
+def test_an_offset_by_a_distance_that_is_not_a_number_fails_its_lot(write):
+    """0/0 (GEOS raised on it): the lot is named, the others derived."""
+    r = run(write, "attr d = 1\nLot --> offset(-d / d) A.\n", [rect(10, 10)] * 2,
+            lot_attrs={"d": np.array([1.0, 0.0])})
+    assert [(b.index, b.reason.split(" in rule")[0]) for b in r["bad"]] == [
+        (1, "`offset` by a distance that is not a number")]
 
 
 #: massing's footprint (``{footprint}``) and first tier (``{distances}`` per edge) after an offset (the kit's
