@@ -38,6 +38,7 @@ from grammarc.geometry.clip import fit_pieces, scope_polygons
 from grammarc.geometry.closed_arms import closed_arm_insets
 from grammarc.geometry.convexify import convex_parts
 from grammarc.geometry.inner_rectangle import largest_rectangles
+from grammarc.geometry.insets import mitred_insets
 from grammarc.geometry.meshes import MESH_BASE, is_mesh, is_polygon
 from grammarc.geometry.polygons import PLANE_U, PLANE_V, plane_to_scope
 from grammarc.geometry.projection import projected_outlines
@@ -597,10 +598,10 @@ def _distances(ctx: Context, distance: ir.Expr, cursor: Shapes, span) -> np.ndar
 
 def _inset_and_border(polygons: np.ndarray, distance: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """``offset``'s two regions of each face (k,) (shapely): its outline moved by ``distance`` (k,) (in
-    when negative) with sharp corners kept, an arm it closes leaving its vertex where PRT does
-    (``geometry.closed_arms``), and the ring between that and the face."""
-    inset = shapely.buffer(polygons, distance, join_style="mitre", mitre_limit=1e6)
-    inset = closed_arm_insets(inset, polygons, -distance)
+    when negative) with sharp corners kept, a nearly collapsing one kept as PRT keeps it
+    (``geometry.insets``), an arm it closes leaving its vertex where PRT does (``geometry.closed_arms``),
+    and the ring between that and the face."""
+    inset = closed_arm_insets(mitred_insets(polygons, distance), polygons, -distance)
     return inset, shapely.difference(polygons, inset)
 
 

@@ -269,6 +269,17 @@ def test_offset_that_leaves_nothing_keeps_the_shape_as_it_was(write):
     assert roofs[0]["a_sum"] == pytest.approx(2.4 ** 2 * (1 + np.sqrt(2)))
 
 
+def test_offset_that_nearly_collapses_keeps_its_sliver(write):
+    """candler's roof on fuzz lot candler.tiny.44289 (its largest inscribed circle 0.8217 m in radius):
+    ``offset(-0.8, inside)`` leaves a triangle of 3.36 dm2, which PRT keeps (its roof pipes stand on it) and
+    GEOS's buffer alone finds empty; a deeper inset leaves nothing and keeps the face as it was."""
+    roof = [np.array([(0.31, 0.143), (0, 1.739), (0.712, 1.89), (3.777, 0.367), (2.814, 0), (0.751, 0)], float)]
+    text = 'Lot --> offset(-{d}, inside) report("a", geometry.area) X.\n'
+    sliver = shapely.Polygon([(0.98553707, 0.86075826), (0.99733849, 0.8), (1.10781159, 0.8)]).area
+    assert totals(run(write, text.format(d=0.8), [roof]))["a_sum"] == pytest.approx(sliver, rel=1e-5)
+    assert totals(run(write, text.format(d=0.83), [roof]))["a_sum"] == pytest.approx(shapely.Polygon(roof[0]).area)
+
+
 def _pyramid_offsets(d):
     """A 45-degree pyramid roof over a 10 m square offset by -d, face by face in its own plane: the
     bottom's inset and each triangle's (a similar triangle, scaled by (r - d) / r for its inradius r)."""
