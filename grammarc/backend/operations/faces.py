@@ -279,6 +279,9 @@ def _roof_offsets(ctx: Context, roofs: Shapes, op: ir.Offset) -> tuple[Shapes, n
     scope fitted to them. Returns the shapes and the mask (n,) of the roofs with any piece left."""
     d = _distances(ctx, op.distance, roofs, op.span)
     parent, _, origin, axes, size, geom, _, _ = mesh_shapes.mesh_components(ctx.chunk, roofs, mesh_shapes.FACES)
+    bad = ~np.isfinite(size).all(axis=1) | ~np.isfinite(origin).all(axis=1)
+    if bad.any():  # a scope scaled beyond any coordinate: GEOS takes no ring of such faces
+        ctx.fail_lots(roofs.lot[parent[bad]], "`offset` of a geometry whose coordinates are not finite", op.span)
     polygons = scope_polygons(ctx.chunk.polygons, geom, size)
     inset, border = _inset_and_border(polygons, d[parent])
     chosen = {"inside": [inset], "border": [border]}
