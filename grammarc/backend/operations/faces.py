@@ -593,9 +593,12 @@ def _distances(ctx: Context, distance: ir.Expr, cursor: Shapes, span) -> np.ndar
     as does one whose distance is not a number. Moved in that far (by -inf too), nothing is left of an
     outline: that is no error, and the distance is ``-FAR`` (GEOS takes no infinite distance)."""
     d = np.broadcast_to(np.asarray(evaluate_array(distance, ctx.env(cursor)), float), (len(cursor),))
-    for bad, said in ((np.isnan(d), "a distance that is not a number"), (d > FAR, None)):
-        if bad.any():
-            ctx.fail(cursor, bad, f"`offset` by {said or f'{d[bad][0]:g}, beyond any coordinate'}", span)
+    nan = np.isnan(d)
+    if nan.any():
+        ctx.fail(cursor, nan, "`offset` by a distance that is not a number", span)
+    far = d > FAR
+    if far.any():
+        ctx.fail(cursor, far, f"`offset` by {d[far][0]:g}, beyond any coordinate", span)
     return np.maximum(d, -FAR)
 
 
