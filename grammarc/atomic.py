@@ -12,7 +12,7 @@ import shutil
 import tempfile
 from pathlib import Path
 
-__all__ = ["NAME_MAX", "private_folder", "remove_stale", "replacing"]
+__all__ = ["NAME_MAX", "private_folder", "remove_stale", "replace_folder", "replacing"]
 
 #: The longest file name, in bytes, of the file systems grammarc writes to (Linux, macOS and Windows alike).
 NAME_MAX = 255
@@ -70,3 +70,13 @@ def replacing(path: Path):
         os.replace(tmp, path)
     finally:
         shutil.rmtree(folder, ignore_errors=True)
+
+
+def replace_folder(new: Path, path: Path, aside: Path) -> None:
+    """Move the complete folder ``new`` onto ``path`` (the same filesystem). A folder already at ``path`` is
+    first moved to ``aside`` (a name in a private folder) and removed after, so ``path`` is the old folder,
+    then for an instant nothing, then the new one; never a mix of the two."""
+    if path.is_dir():
+        os.replace(path, aside)
+    os.replace(new, path)
+    shutil.rmtree(aside, ignore_errors=True)

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import pytest
 
-from grammarc.atomic import replacing
+from grammarc.atomic import replace_folder, replacing
 
 
 def test_the_new_contents_replace_the_file_with_nothing_left_beside_it(tmp_path):
@@ -51,3 +51,16 @@ def test_an_output_of_the_longest_legal_name_has_a_legal_temporary_folder(tmp_pa
     with replacing(path) as tmp:
         tmp.write_text("new")
     assert path.read_text() == "new" and [p.name for p in tmp_path.iterdir()] == [path.name]
+
+
+def test_a_folder_replaces_the_old_one_whole(tmp_path):
+    target, new, aside = tmp_path / "city.obj.textures", tmp_path / "staged", tmp_path / "aside"
+    for folder, name in ((target, "old.png"), (new, "new.png")):
+        (folder / "sub").mkdir(parents=True)
+        (folder / "sub" / name).write_text(name)
+    replace_folder(new, target, aside)
+    assert [p.name for p in target.rglob("*.png")] == ["new.png"]
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["city.obj.textures"]
+    (tmp_path / "again").mkdir()
+    replace_folder(tmp_path / "again", tmp_path / "fresh", aside)  # nothing there before
+    assert (tmp_path / "fresh").is_dir() and not (tmp_path / "again").exists()

@@ -21,7 +21,7 @@ so ``bake`` also counts the polygons before triangulation, in the mesh's ``metad
 Colours and textures. Every triangle keeps how its instance or face looks: its RGBA colour and its material
 (texture paths, ``model.records.MaterialTable``). The OBJ gets a material library beside it (``city.mtl``:
 a material per look, ``Kd`` and ``d`` from the colour, ``map_Kd`` and the other maps from the textures,
-resolved in the asset roots) and its triangles in a group ``g lot_N`` per lot, a ``usemtl`` run per look;
+resolved in the asset roots; a rule package's textures copied into ``city.obj.textures``, ``io.textures``) and its triangles in a group ``g lot_N`` per lot, a ``usemtl`` run per look;
 the PLY gets vertex colours; the GLB a primitive and material per look, its colour map embedded.
 
 Memory: the baked mesh holds ~60 bytes a triangle (float64 vertices, int64 faces), so ``bake`` counts the
@@ -34,18 +34,19 @@ import os
 import shutil
 from collections.abc import Mapping, Sequence
 from dataclasses import replace
-from pathlib import Path
+from pathlib import Path, PurePosixPath
 from typing import ClassVar
 
 import numpy as np
 
-from grammarc.atomic import private_folder
+from grammarc.atomic import private_folder, replace_folder
 from grammarc.constants import LIMITS
 from grammarc.errors import UsageError
 from grammarc.geometry.triangulation import triangulate_polygons
 from grammarc.io import WriterBlock
 from grammarc.io.gltf import baked_glb
 from grammarc.io.obj import obj_bytes, with_lines
+from grammarc.io.textures import PackagedTextures
 from grammarc.ir.asset_names import locate
 from grammarc.ir.nodes import MATERIAL_MAPS
 from grammarc.model.assets import AssetLibrary, AssetMesh, asset_library
@@ -280,7 +281,7 @@ class BakedWriter(WriterBlock):
     their headers, one buffer), so their chunks are kept until ``close()``, which bakes and exports them
     (PLY and STL with trimesh, GLB with ``io.gltf.baked_glb``). Either way the writer counts the
     triangles chunks will make as they come and refuses a chunk that would pass ``max_triangles``; the
-    file is renamed onto ``path`` only when complete (an OBJ's ``.mtl`` just before it), so ``abort()``
+    file is renamed onto ``path`` only when complete (an OBJ's texture folder and ``.mtl`` just before it), so ``abort()``
     (or an exception inside ``with``) leaves nothing there.
 
     Parameters
@@ -446,8 +447,15 @@ class BakedWriter(WriterBlock):
         return ("\n".join(lines) + "\n").encode()
 
     def _texture_path(self, name: str) -> str:
+        """A texture's path as the material library names it: relative to the OBJ where the asset roots
+        hold it, in the OBJ's texture folder where it is a rule package's (``io.textures``), else as given."""
         found = locate(name, self._library.roots)
-        return os.path.relpath(found[1], self.path.parent.resolve()) if found else name
+        if found is None:
+            return name
+        copied = self._textures.copy(found[1])
+        if copied is not None:
+            return (PurePosixPath(self._textures_path.name) / copied).as_posix()
+        return os.path.relpath(found[1], self.path.parent.resolve())
 
     def _count(self, mesh, table: MeshChunk) -> None:
         made = self._made
@@ -495,6 +503,7 @@ class BakedWriter(WriterBlock):
                 staged = os.path.join(self._tmpdir, self._mtl_path.name)
                 with open(staged, "wb") as mtl:
                     mtl.write(self._mtl())
+                self._place_textures()
                 os.replace(staged, self._mtl_path)
             os.replace(os.path.join(self._tmpdir, self.path.name), self.path)
         except BaseException:
@@ -519,17 +528,34 @@ class BakedWriter(WriterBlock):
         """The output's file, in a private directory next to it (same filesystem, for the rename), with
         the umask's permissions as the npz writer's output has (mkstemp would give 0600)."""
         self._tmpdir = private_folder(self.path)
+        self._textures = PackagedTextures(self._meta, self._library.roots, Path(self._tmpdir) / "textures")
         self._file = open(os.path.join(self._tmpdir, self.path.name), "xb")  # noqa: SIM115 - closed by close/abort
+
+    def _place_textures(self) -> None:
+        """The OBJ's texture folder into place, before its material library: the copies of a rule package's
+        textures, or no folder (an older build's removed) when the OBJ names none."""
+        if self._textures.copied:
+            replace_folder(self._textures.into, self._textures_path, Path(self._tmpdir) / "replaced")
+        elif self._textures_path.is_dir():
+            shutil.rmtree(self._textures_path)
 
     @property
     def _mtl_path(self) -> Path:
         """The OBJ's material library, beside it: ``city.obj`` -> ``city.mtl``."""
         return self.beside(self.path)[0][0]
 
+    @property
+    def _textures_path(self) -> Path:
+        """The OBJ's texture folder, beside it: ``city.obj`` -> ``city.obj.textures``."""
+        return self.beside(self.path)[1][0]
+
     @staticmethod
     def beside(path: Path) -> tuple[list[Path], list[Path]]:
-        """The files written beside ``path`` (``io.written_paths``): an OBJ's material library."""
-        return ([path.with_suffix(".mtl")] if path.suffix.lower() == ".obj" else []), []
+        """The files and folders written beside ``path`` (``io.written_paths``): an OBJ's material library
+        and its texture folder (``io.textures``)."""
+        if path.suffix.lower() != ".obj":
+            return [], []
+        return [path.with_suffix(".mtl")], [path.with_name(f"{path.name}.textures")]
 
     def _export(self, mesh, looks: np.ndarray | None) -> bytes:
         """The bytes of a PLY (with vertex colours where the record has colours) or STL (binary), or a GLB

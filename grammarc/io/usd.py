@@ -16,7 +16,8 @@ The layout, for ``city.usdc``::
   (and ``displayOpacity``) of vertex interpolation, which prototypes inherit, and ``grammarc:lot`` and
   ``grammarc:symbol``. Its ``prototypes`` are children of the instancer referencing the prototype
   layer, one for each asset the tile uses (for each asset and material where the record has textures:
-  those with a colour map are bound to a ``UsdPreviewSurface`` reading it through a ``UsdUVTexture``).
+  those with a colour map are bound to a ``UsdPreviewSurface`` reading it through a ``UsdUVTexture``; a
+  rule package's colour maps are copied into the tile folder's ``textures``, ``io.textures``).
 * **Prototypes**: the asset meshes as ``model.assets`` loads them (OBJ by its own reader, other formats
   through trimesh, built-ins generated), fitted to the unit box as CityEngine fits an inserted asset to its
   scope; ``subdivisionScheme`` is ``none`` (they are polygon models, not subdivision cages).
@@ -51,6 +52,7 @@ import numpy as np
 from grammarc.atomic import replacing
 from grammarc.errors import UsageError
 from grammarc.io.instancing import TILE_SIZE, Tile, TiledWriter, compose, decompose
+from grammarc.io.textures import PackagedTextures
 
 # usd-core's modules (the `usd` extra), imported by _require_pxr when USD is first written or read: the writer
 # registry imports this module for every output, which must not load usd-core.
@@ -80,12 +82,13 @@ def _tiles_base(path: Path) -> Path:
 
 
 def _digest_folder(path: Path, staged: Path) -> Path:
-    """The tile folder of root ``path`` named by the SHA-256 of the layers in ``staged`` (names and
-    bytes, in name order)."""
+    """The tile folder of root ``path`` named by the SHA-256 of the files in ``staged`` (the layers and any
+    copied textures: paths and bytes, in path order)."""
     digest = hashlib.sha256()
-    for layer in sorted(staged.iterdir()):
-        with open(layer, "rb") as file:
-            digest.update(layer.name.encode() + b"\0" + hashlib.file_digest(file, "sha256").digest())
+    for staged_file in sorted(p for p in staged.rglob("*") if p.is_file()):
+        with open(staged_file, "rb") as file:
+            name = staged_file.relative_to(staged).as_posix()
+            digest.update(name.encode() + b"\0" + hashlib.file_digest(file, "sha256").digest())
     return path.with_name(f"{_tiles_base(path).name}-{digest.hexdigest()[:_DIGEST]}")
 
 
@@ -140,6 +143,7 @@ class UsdWriter(TiledWriter):
         """The prototype, tile and root layers, moved into place."""
         staged = self._tmp / "tiles"
         staged.mkdir()
+        self._textures = PackagedTextures(self._meta, self._library.roots, staged / "textures")
         prototypes = self._write_prototypes(staged / f"prototypes{self._ext}")
         tiles = [self._write_tile(staged, tile, prototypes) for tile in self._spool.tiles()]  # (name, origin)
         folder = _digest_folder(self.path, staged)
@@ -243,14 +247,21 @@ class UsdWriter(TiledWriter):
             reader.CreateInput("varname", Sdf.ValueTypeNames.Token).Set("st")
             texture = UsdShade.Shader.Define(stage, f"{path}/Colormap")
             texture.CreateIdAttr("UsdUVTexture")
-            texture.CreateInput("file", Sdf.ValueTypeNames.Asset).Set(
-                Sdf.AssetPath(os.path.relpath(colormap, _tiles_base(self.path).resolve())))
+            texture.CreateInput("file", Sdf.ValueTypeNames.Asset).Set(Sdf.AssetPath(self._texture_path(colormap)))
             texture.CreateInput("st", Sdf.ValueTypeNames.Float2).ConnectToSource(
                 reader.ConnectableAPI(), "result")
             surface.CreateInput("diffuseColor", Sdf.ValueTypeNames.Color3f).ConnectToSource(
                 texture.ConnectableAPI(), "rgb")
             material.CreateSurfaceOutput().ConnectToSource(surface.ConnectableAPI(), "surface")
         UsdShade.MaterialBindingAPI.Apply(prim).Bind(material)
+
+    def _texture_path(self, colormap: Path) -> str:
+        """A colour map's path as a tile layer names it: a rule package's copied into the tile folder's
+        ``textures`` (``io.textures``), any other relative to the tile folder, beside which it lies."""
+        copied = self._textures.copy(colormap)
+        if copied is not None:
+            return f"./{self._textures.into.name}/{copied}"
+        return os.path.relpath(colormap, _tiles_base(self.path).resolve())
 
     def _write_root(self, path: Path, tiles: list[tuple[str, np.ndarray]], folder: str) -> None:
         stage = _new_stage(path, UsdGeom.Xform, "/City")
