@@ -10,7 +10,9 @@ A rule package is a 7-zip archive as CityEngine exports it::
 
 ``open_rpk`` extracts the archive to a temporary directory that lives as long as the returned
 ``RulePackage`` (use it as a context manager, or call ``close()``), so rule files and assets are plain
-paths the compiler and the baker read as they read any other.
+paths the compiler and the baker read as they read any other. The directory's name holds the process id
+(``grammarc-rpk-<pid>-<package>-<random>``): one a process left behind as it died (a SIGKILL, a power cut)
+goes when a package is next opened in the same temporary folder.
 
 An archive is untrusted input: a few kilobytes may decompress to gigabytes (a "zip bomb"). Extraction
 counts the bytes as they are decompressed, not as the archive's headers claim, and stops at the first of
@@ -40,6 +42,7 @@ from collections.abc import Iterator, Mapping
 from pathlib import Path, PurePosixPath
 from typing import TYPE_CHECKING
 
+from grammarc.atomic import remove_stale
 from grammarc.errors import UsageError
 from grammarc.frontend.source import read_grammar_text
 from grammarc.model.assets import record_roots
@@ -55,6 +58,9 @@ MAX_PACKAGE_SIZE = 2 << 30
 MAX_RATIO = 1000
 #: The bytes py7zr decompresses at a time (``_small_blocks``).
 _BLOCK = 4 << 20
+
+#: The names of extraction folders begin so, then the process id (module docstring).
+_EXTRACTED = "grammarc-rpk-"
 
 _INSTALL_HINT = "pip install 'grammarc[rpk]' (or pip install py7zr)"
 
@@ -173,7 +179,9 @@ def open_rpk(path: str | os.PathLike, *, tmpdir: str | os.PathLike | None = None
     path = Path(path)
     if not path.is_file():
         raise UsageError(f"rule package `{path}` does not exist")
-    root = Path(tempfile.mkdtemp(prefix=f"grammarc-rpk-{path.stem}-", dir=tmpdir))
+    folder = Path(tmpdir) if tmpdir is not None else Path(tempfile.gettempdir())
+    remove_stale(folder, _EXTRACTED)
+    root = Path(tempfile.mkdtemp(prefix=f"{_EXTRACTED}{os.getpid()}-{path.stem}-", dir=folder))
     try:
         # an open file, not its path: py7zr then extracts in this thread (with a path, it extracts an
         # archive's blocks in threads that each open the file and leave it open)

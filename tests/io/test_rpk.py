@@ -2,6 +2,7 @@
 
 import gc
 import json
+import os
 import sys
 from pathlib import Path
 
@@ -245,3 +246,18 @@ def test_extracting_a_package_leaves_no_file_open():
             pass
         gc.collect()
     assert [w for w in caught if issubclass(w.category, ResourceWarning)] == []
+
+
+@needs_kit
+def test_an_extraction_whose_process_died_goes_at_the_next_open(tmp_path):
+    import subprocess
+
+    dead = subprocess.run([sys.executable, "-c", "import os; print(os.getpid())"], capture_output=True,
+                          text=True, check=True).stdout.strip()
+    left = tmp_path / f"grammarc-rpk-{dead}-candler-abcd1234"  # a SIGKILLed build's
+    running = tmp_path / f"grammarc-rpk-{os.getpid()}-candler-efgh5678"
+    for folder in (left, running):
+        (folder / "rules").mkdir(parents=True)
+    with open_rpk(KIT / "rpk" / "extrude_color.rpk", tmpdir=tmp_path) as rpk:
+        assert rpk.root.name.startswith(f"grammarc-rpk-{os.getpid()}-extrude_color-")
+        assert not left.exists() and running.is_dir()
