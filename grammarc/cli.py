@@ -18,7 +18,6 @@ import math
 import os
 import signal
 import sys
-import threading
 import warnings
 from collections import Counter
 from dataclasses import replace
@@ -31,10 +30,8 @@ from grammarc.errors import (
     GrammarcError,
     GrammarError,
     UsageError,
-    clear_stopped,
-    hide_lost_stops,
     interruption,
-    raise_stopped,
+    signals_stop,
     stopped,
 )
 
@@ -50,47 +47,41 @@ def main(argv: list[str] | None = None) -> int:
     # (README, "Figures"). ``build.derive_all`` turns it on while chunks are derived.
     collecting = gc.isenabled()
     gc.disable()
-    handlers = {s: signal.signal(s, raise_stopped) for s in (signal.SIGINT, signal.SIGTERM, signal.SIGHUP)} \
-        if threading.current_thread() is threading.main_thread() else {}
-    unraisable, sys.unraisablehook = sys.unraisablehook, hide_lost_stops
-    try:
+    with signals_stop():
         try:
-            with warnings.catch_warnings():
-                # grammarc says what concerns the user itself; the libraries' warnings (numpy's "invalid
-                # value in divide" of a value grammarc handles) are not the user's to read, unless asked
-                # for with Python's -W or PYTHONWARNINGS. The workers are forked with this filter.
-                if not sys.warnoptions:
-                    warnings.simplefilter("ignore")
-                return args.run(args)
-        except BaseException as error:  # whatever failed after a signal: the command was stopped
-            stop = interruption(error)
-            if stop is None or stop is error:
-                raise
-            raise stop from error
-    except GrammarError as error:
-        print(str(error), file=sys.stderr)
-        n = sum(d.is_error for d in error.diagnostics)
-        print(f"{n} error{'s' if n != 1 else ''}; nothing was written", file=sys.stderr)
-        return error.exit_code
-    except GrammarcError as error:
-        print(f"grammarc: error: {error}", file=sys.stderr)
-        return error.exit_code
-    except KeyboardInterrupt as stop:  # Ctrl-C, or SIGTERM / SIGHUP (``Stopped``)
-        return stopped(stop)
-    except BrokenPipeError:
-        # the reader of our output went away (`grammarc info city.npz | head`): not an error of ours
-        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
-        return 0
-    except OSError as error:  # the disk filled, a folder's permissions changed: said as a failure, no traceback
-        print(f"grammarc: error: {_os_error(error)}; nothing was written", file=sys.stderr)
-        return 1
-    finally:
-        for signum, handler in handlers.items():
-            signal.signal(signum, handler)
-        clear_stopped()
-        sys.unraisablehook = unraisable
-        if collecting:
-            gc.enable()
+            try:
+                with warnings.catch_warnings():
+                    # grammarc says what concerns the user itself; the libraries' warnings (numpy's "invalid
+                    # value in divide" of a value grammarc handles) are not the user's to read, unless asked
+                    # for with Python's -W or PYTHONWARNINGS. The workers are forked with this filter.
+                    if not sys.warnoptions:
+                        warnings.simplefilter("ignore")
+                    return args.run(args)
+            except BaseException as error:  # whatever failed after a signal: the command was stopped
+                stop = interruption(error)
+                if stop is None or stop is error:
+                    raise
+                raise stop from error
+        except GrammarError as error:
+            print(str(error), file=sys.stderr)
+            n = sum(d.is_error for d in error.diagnostics)
+            print(f"{n} error{'s' if n != 1 else ''}; nothing was written", file=sys.stderr)
+            return error.exit_code
+        except GrammarcError as error:
+            print(f"grammarc: error: {error}", file=sys.stderr)
+            return error.exit_code
+        except KeyboardInterrupt as stop:  # Ctrl-C, or SIGTERM / SIGHUP (``Stopped``)
+            return stopped(stop)
+        except BrokenPipeError:
+            # the reader of our output went away (`grammarc info city.npz | head`): not an error of ours
+            os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+            return 0
+        except OSError as error:  # the disk filled, a folder's permissions changed: said as a failure, no traceback
+            print(f"grammarc: error: {_os_error(error)}; nothing was written", file=sys.stderr)
+            return 1
+        finally:
+            if collecting:
+                gc.enable()
 
 
 def _os_error(error: OSError) -> str:

@@ -2,9 +2,11 @@
 
 from __future__ import annotations
 
+import contextlib
 import os
 import signal
 import sys
+import threading
 
 
 class GrammarcError(Exception):
@@ -103,6 +105,23 @@ def _in_numba(frame) -> bool:
     return False
 
 
+@contextlib.contextmanager
+def signals_stop():
+    """While the block runs, SIGINT, SIGTERM and SIGHUP stop the command (``raise_stopped``; in the main
+    thread only, where Python runs handlers) and a stop a callback's caller swallowed is not printed
+    (``hide_lost_stops``); after it, the handlers and hook are the ones before and no stop is held."""
+    handlers = {s: signal.signal(s, raise_stopped) for s in (signal.SIGINT, signal.SIGTERM, signal.SIGHUP)} \
+        if threading.current_thread() is threading.main_thread() else {}
+    unraisable, sys.unraisablehook = sys.unraisablehook, hide_lost_stops
+    try:
+        yield
+    finally:
+        for signum, handler in handlers.items():
+            signal.signal(signum, handler)
+        clear_stopped()
+        sys.unraisablehook = unraisable
+
+
 def check_stopped() -> None:
     """Raise the stop that was held or whose raise was lost, if any: called where a command goes on for
     long (each round of a derivation) and before an output is put in place."""
@@ -136,9 +155,10 @@ def interruption(error: BaseException) -> KeyboardInterrupt | None:
     return Stopped(_pending[0]) if _pending else None
 
 
-def stopped(stop: KeyboardInterrupt) -> int:
-    """Say that a command was stopped (Ctrl-C or ``Stopped``); its exit status (128 + the signal)."""
+def stopped(stop: KeyboardInterrupt, command: str = "grammarc", kept: str = "nothing was written") -> int:
+    """Say that ``command`` was stopped (Ctrl-C or ``Stopped``) and what it ``kept``; its exit status (128 +
+    the signal)."""
     signum = stop.signum if isinstance(stop, Stopped) else signal.SIGINT
     said = "interrupted" if signum == signal.SIGINT else f"{signal.Signals(signum).name}: stopped"
-    print(f"grammarc: {said}; nothing was written", file=sys.stderr)
+    print(f"{command}: {said}; {kept}", file=sys.stderr)
     return 128 + signum

@@ -18,7 +18,7 @@ from pathlib import Path
 
 from grammarc.conform.footprints import CLASSES
 from grammarc.conform.fuzz import PACKAGES, distributions, fuzz, read_results, rerun_case, table
-from grammarc.errors import UsageError
+from grammarc.errors import UsageError, signals_stop, stopped
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -36,20 +36,28 @@ def main(argv: list[str] | None = None) -> int:
                         help="take the lots of this GeoJSON file (metres) instead of generated footprints")
     args = parser.parse_args(argv)
     try:
-        if args.table:
-            results = read_results(args.table)
-            print("\n\n".join(filter(None, [table(results), distributions(results)])))
-            return 0
-        if args.case:
-            result = rerun_case(args.case)
-            print(json.dumps(result, indent=1, default=float))
-            return 1 if result["failed"] else 0
-        results = fuzz(args.fuzz, args.out, packages=[p for p in args.packages.split(",") if p],
-                       kinds=[k for k in args.classes.split(",") if k], seed=args.seed, batch=args.batch,
-                       footprints=args.footprints, progress=lambda line: print(line, file=sys.stderr, flush=True))
+        with signals_stop():
+            return _run(args)
     except UsageError as error:
         print(f"grammarc conform: {error}", file=sys.stderr)
         return 2
+    except KeyboardInterrupt as stop:  # Ctrl-C, SIGTERM, SIGHUP: PRT's process and the temporary files go
+        return stopped(stop, "grammarc conform", f"the finished batches' results are in {args.out}"
+                       if args.fuzz else "nothing was written")
+
+
+def _run(args) -> int:
+    if args.table:
+        results = read_results(args.table)
+        print("\n\n".join(filter(None, [table(results), distributions(results)])))
+        return 0
+    if args.case:
+        result = rerun_case(args.case)
+        print(json.dumps(result, indent=1, default=float))
+        return 1 if result["failed"] else 0
+    results = fuzz(args.fuzz, args.out, packages=[p for p in args.packages.split(",") if p],
+                   kinds=[k for k in args.classes.split(",") if k], seed=args.seed, batch=args.batch,
+                   footprints=args.footprints, progress=lambda line: print(line, file=sys.stderr, flush=True))
     print("\n\n".join(filter(None, [table(results), distributions(results)])))
     return 1 if any(r["failed"] for r in results) else 0
 

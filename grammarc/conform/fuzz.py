@@ -20,6 +20,7 @@ tabulates it per package and footprint class.
 from __future__ import annotations
 
 import contextlib
+import functools
 import json
 import math
 import subprocess
@@ -40,6 +41,7 @@ from grammarc.conform.cases import Case, cases_from_file, make_case, write_lots
 from grammarc.conform.footprints import CLASSES
 from grammarc.conform.kit import kit_dir, prt_python
 from grammarc.conform.measure import compare, compare_reports, measure, surface_distance
+from grammarc.conform.processes import Processes
 from grammarc.errors import UsageError
 
 __all__ = ["PACKAGES", "distributions", "fuzz", "judge_batch", "lot_record", "read_results", "rerun_case", "same_lot_records", "table"]
@@ -89,32 +91,34 @@ def open_packages(names: Iterable[str], kit: Path) -> Iterator[dict[str, Package
 # ------------------------------------------------------------------------------------------ PRT's side
 
 
-def run_prt(python: Path, kit: Path, rpk: Path, lots: Path, folder: Path, timeout: float = 900) -> dict:
+def run_prt(python: Path, kit: Path, rpk: Path, lots: Path, folder: Path, timeout: float = 900,
+            processes: Processes | None = None) -> dict:
     """PRT's records of the lots of ``lots``: {case name: record}, each with ``triangles`` an (n, 3, 3)
     array. A batch whose PRT process dies is run again in halves, so that one lot that crashes PRT costs
-    only itself (its record then says so)."""
+    only itself (its record then says so). PRT runs through ``processes`` (``conform.processes``), which
+    the caller can stop."""
     with open(lots, encoding="utf-8") as file:
         features = json.load(file)["features"]
-    return _prt_records(python, kit, rpk, features, folder, timeout)
+    return _prt_records(python, kit, rpk, features, folder, timeout, processes or Processes())
 
 
-def _prt_records(python, kit, rpk, features, folder, timeout) -> dict:
+def _prt_records(python, kit, rpk, features, folder, timeout, processes: Processes) -> dict:
     path = folder / f"prt-{features[0]['properties']['name']}-{len(features)}"
     with open(path.with_suffix(".geojson"), "w", encoding="utf-8") as file:
         json.dump({"type": "FeatureCollection", "features": features}, file)
     command = [str(python), str(Path(__file__).with_name("prt_batch.py")), str(kit), str(rpk),
                str(path.with_suffix(".geojson")), str(path)]
     try:
-        run = subprocess.run(command, check=False, capture_output=True, text=True, timeout=timeout)
-        failure = run.returncode != 0 and (run.stderr.strip().splitlines() or [f"exit {run.returncode}"])[-1]
+        status, stderr = processes.run(command, timeout)
+        failure = status != 0 and (stderr.strip().splitlines() or [f"exit {status}"])[-1]
     except subprocess.TimeoutExpired:
         failure = f"PRT took more than {timeout:g} s"
     if failure:
         if len(features) == 1:
             return {features[0]["properties"]["name"]: {"error": f"PRT failed: {failure}"}}
         half = len(features) // 2
-        return {**_prt_records(python, kit, rpk, features[:half], folder, timeout),
-                **_prt_records(python, kit, rpk, features[half:], folder, timeout)}
+        return {**_prt_records(python, kit, rpk, features[:half], folder, timeout, processes),
+                **_prt_records(python, kit, rpk, features[half:], folder, timeout, processes)}
     with open(str(path) + ".json", encoding="utf-8") as file:
         records = json.load(file)["lots"]
     corners = array("d")
@@ -339,23 +343,28 @@ def fuzz(n: int, out: Path, *, packages: Iterable[str] = PACKAGES, kinds: Iterab
                 write_lots(lots, cases, SPACING)
                 jobs.append((package, cases, lots))
         # PRT runs one batch ahead, in its own process, while grammarc derives and judges the one before.
-        pending = [prt_pool.submit(run_prt, python, kit, p.rpk, lots, Path(tmp)) for p, _, lots in jobs[:1]]
+        processes = Processes()
+        prt_batch = functools.partial(run_prt, python, kit, folder=Path(tmp), processes=processes)
+        pending = [prt_pool.submit(prt_batch, p.rpk, lots) for p, _, lots in jobs[:1]]
         begun = time.perf_counter()
-        for i, (package, cases, lots) in enumerate(jobs):
-            if i + 1 < len(jobs):
-                following = jobs[i + 1]
-                pending.append(prt_pool.submit(run_prt, python, kit, following[0].rpk, following[2], Path(tmp)))
-            prt = pending[i].result()
-            for case, result in zip(cases, judge_batch(package, cases, lots, prt)):
-                if result["failed"]:
-                    result["case_file"] = str(save_case(out / "cases", case, result,
-                                                        prt.get(case.name, {})))
-                log.write(json.dumps(result, default=float) + "\n")
-                results.append(result)
-            log.flush()
-            matched = sum(not r["failed"] for r in results)
-            progress(f"{package.name}: {len(results)} cases, {matched} match "
-                     f"({time.perf_counter() - begun:.0f} s)")
+        try:
+            for i, (package, cases, lots) in enumerate(jobs):
+                if i + 1 < len(jobs):
+                    pending.append(prt_pool.submit(prt_batch, jobs[i + 1][0].rpk, jobs[i + 1][2]))
+                prt = pending[i].result()
+                for case, result in zip(cases, judge_batch(package, cases, lots, prt)):
+                    if result["failed"]:
+                        result["case_file"] = str(save_case(out / "cases", case, result,
+                                                            prt.get(case.name, {})))
+                    log.write(json.dumps(result, default=float) + "\n")
+                    results.append(result)
+                log.flush()
+                matched = sum(not r["failed"] for r in results)
+                progress(f"{package.name}: {len(results)} cases, {matched} match "
+                         f"({time.perf_counter() - begun:.0f} s)")
+        except BaseException:  # a stop, or a failure: PRT's process goes with the harness
+            processes.stop()
+            raise
     return results
 
 
