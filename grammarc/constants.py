@@ -31,6 +31,10 @@ class Tol:
     #: Lot coordinates (metres, or degrees before reprojection) beyond this in magnitude are no place on
     #: Earth (its circumference is 4e7 m): such a lot is bad, before squares of its lengths overflow.
     coordinate: float = 1e8
+    #: A scope size or position beyond this (float32's largest number) makes no record, and GEOS's
+    #: arithmetic overflows on it (``extrude(1e308)`` then ``offset``): the operation that makes such a
+    #: scope fails its lot, as ``offset`` and ``setback`` fail a lot they would move an outline that far.
+    far: float = 3.4028234663852886e38
 
 
 @dataclass(frozen=True)

@@ -20,7 +20,7 @@ from grammarc.backend.kernels.order import tally
 from grammarc.backend.kernels.split import MAX_COUNT
 from grammarc.backend.plan import Plan
 from grammarc.backend.shapes import Shapes
-from grammarc.constants import Limits
+from grammarc.constants import TOL, Limits
 from grammarc.errors import AssetError, ChunkTooLarge, LotFailure
 from grammarc.geometry.meshes import is_mesh
 from grammarc.ir import nodes as ir
@@ -85,6 +85,18 @@ class Context:
             name = print_op(op).split("(")[0]
             self.fail(shapes, mesh, f"`{name}` of a roof is not supported yet (split the roof into faces "
                       "with comp(f) first)", op.span)
+
+    def refuse_far(self, op: ir.Op, made) -> None:
+        """Fail the lots of the shapes ``op`` made (``Shapes``, or ``Parts``' shapes) whose scope it sized or
+        placed beyond any coordinate (``Tol.far``; NaN is left to the operations that read it)."""
+        shapes = getattr(made, "shapes", made)
+        if not len(shapes):
+            return
+        size, origin = np.abs(shapes.size), np.abs(shapes.origin)
+        if size.max() > TOL.far or origin.max() > TOL.far:  # the usual case in two reductions
+            far = (size > TOL.far).any(axis=1) | (origin > TOL.far).any(axis=1)
+            value = max(size[far][0].max(), origin[far][0].max())
+            self.fail(shapes, far, f"a scope sized or placed beyond any coordinate ({value:g})", op.span)
 
     # ------------------------------------------------------------------------------------------ the limits
     def count(self, shapes: Shapes, span) -> None:

@@ -183,6 +183,8 @@ def run(ctx: Context, body: ir.Body, cursor: Shapes, leaf_at_end: bool = False) 
                 ctx.refuse_meshes(op, cursor)
             # an operation changes the cursor (returns it), makes shapes for its parts, or neither
             made = entry.function(ctx, cursor, op)
+            if made is not None:
+                ctx.refuse_far(op, made)
             if type(made) is Parts:
                 run_parts(ctx, _pivoted(ctx, op, made))
             elif made is not None:

@@ -98,3 +98,17 @@ def test_push_pop_and_rotation(write):
     np.testing.assert_allclose(x[1, :, 0], [0, 0, -3], atol=1e-6)
     np.testing.assert_allclose(x[0, :, 3], x[1, :, 3])
 
+
+
+def test_an_operation_that_sizes_or_places_a_scope_beyond_any_coordinate_fails_its_lot(write):
+    """As the build fuzz test found it: ``extrude(1e308)`` then ``offset`` of its side faces stopped the build
+    where GEOS's arithmetic overflowed. A scope past float32's largest number makes no record: the
+    operation that makes it fails its lot, named, and the other lots are derived."""
+    text = ("attr h = 1\nattr x = 0\nLot --> extrude(h) t(x, 0, 0) comp(f){ side : Side }\n"
+            "Side --> offset(-0.1, inside) A.\n")
+    r = run(write, text, [rect(10, 10)] * 3, lot_attrs={"h": np.array([1.0, 1e308, 1.0]),
+                                                        "x": np.array([0.0, 0.0, -1e39])})
+    assert [(b.index, b.reason.split(" in rule")[0]) for b in r["bad"]] == [
+        (1, "a scope sized or placed beyond any coordinate (1e+308)"),
+        (2, "a scope sized or placed beyond any coordinate (1e+39)")]
+    assert np.unique(r["lot"]).tolist() == [0]

@@ -51,10 +51,10 @@ from grammarc.geometry.setback import distances_to_area, polygon_edges, setback_
 from grammarc.ir import nodes as ir
 from grammarc.ragged import next_in_segment, ragged_take, rank_within, segment_of
 
-#: A distance that moves an outline out beyond this (float32's largest number) makes no record, and beyond
-#: float64's GEOS raises: ``offset`` and ``setback`` fail the lots of such distances (a NaN one stays what
-#: it was: no setback, as PRT takes massing's; ``setbackToArea``'s maximums may be inf: none).
-FAR = float(np.finfo(np.float32).max)
+#: A distance that moves an outline out beyond this (``Tol.far``) makes no record, and beyond float64's
+#: GEOS raises: ``offset`` and ``setback`` fail the lots of such distances (a NaN one stays what it was: no
+#: setback, as PRT takes massing's; ``setbackToArea``'s maximums may be inf: none).
+FAR = TOL.far
 
 @operation(ir.Roof, writes=("origin", "size", "geom"))
 def roof(ctx: Context, cursor: Shapes, op: ir.Roof) -> Shapes:

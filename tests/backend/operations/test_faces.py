@@ -464,11 +464,11 @@ def test_an_offset_or_setback_beyond_any_coordinate_fails_its_lot(write, select)
 
 def test_an_offset_of_a_geometry_scaled_beyond_any_coordinate_fails_its_lot(write):
     """As the build fuzz test found it: a lot scaled by -1e308 has faces GEOS takes no ring of (it raised
-    and stopped the build)."""
+    and stopped the build); the scale fails it (``Context.refuse_far``), before the offset."""
     r = run(write, "attr z = 0\nLot --> s(1, 1, z) A\nA --> offset(-0.1, inside) B.\n",
             [rect(10, 10)] * 2, lot_attrs={"z": np.array([0.0, -1e308])})
     assert [(b.index, b.reason.split(" in rule")[0]) for b in r["bad"]] == [
-        (1, "`offset` of a geometry whose coordinates are not finite")]
+        (1, "a scope sized or placed beyond any coordinate (1e+308)")]
 
 
 def test_an_offset_by_a_distance_that_is_not_a_number_fails_its_lot(write):
