@@ -55,6 +55,13 @@ class MeshStore:
         self.coords = np.concatenate([self.coords, coords])
         return np.arange(first, len(self), dtype=np.int64)
 
+    def vertex_counts(self, ids: np.ndarray) -> np.ndarray:
+        """The vertices (k,) int64 of meshes ``ids``, every ring's counted."""
+        rings = self.face_offsets[self.mesh_offsets]
+        vertices = self.ring_offsets[rings]
+        ids = np.asarray(ids, np.int64)
+        return vertices[ids + 1] - vertices[ids]
+
     def gather(self, ids: np.ndarray):
         """Meshes ``ids`` as new ragged arrays: (coords, ring_offsets, face_offsets, mesh_offsets)."""
         faces, mesh_offsets = ragged_take(self.mesh_offsets, np.asarray(ids, np.int64))

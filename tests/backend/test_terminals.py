@@ -146,14 +146,15 @@ def test_inserted_geometry_carries_no_texture_coordinates(write):
 
 @pytest.mark.parametrize("height", [1e308, np.inf, 1e39])
 def test_a_record_with_a_coordinate_that_is_not_finite_fails_its_lot_with_the_rule(write, height):
-    """The last guard before records are made: an instance whose transform is not finite as float32 (a
-    height of 1e308 or inf) fails its lot, named with the rule; the others are written."""
+    """An instance whose transform would not be finite as float32 (a height of 1e308 or inf) fails its lot,
+    named with the rule, where the scale makes the scope (``Context.refuse_far``; the records' own guard
+    stands behind it); the others are written."""
     text = 'attr height = 9\nlot ~> S(1r, height, 1r) Repeat("X", 2){ I("cube") }\n'
     r = paper(write, text, [rect(4, 4)] * 2, lot_attrs={"height": np.array([9.0, height])})
     assert np.isfinite(r["xform"]).all() and r["lot"].tolist() == [0, 0]
     [bad] = r["bad"]
-    assert bad.index == 1 and bad.reason.startswith("an instance with a coordinate of ")
-    assert "(not finite as float32) in rule `lot` at " in bad.reason
+    assert bad.index == 1 and bad.reason.startswith(f"a scope sized or placed beyond any coordinate ({height:g})")
+    assert " in rule `lot` at " in bad.reason
 
 
 def test_records_whose_sum_overflows_float32_are_finite_and_kept(write):
@@ -171,5 +172,5 @@ def test_a_mesh_vertex_that_is_not_finite_fails_its_lot_with_the_rule(write):
             lot_attrs={"h": np.array([3.0, 1e39])})
     assert np.isfinite(r["mesh"].vertices).all() and np.unique(r["mesh"].lot).tolist() == [0]
     [bad] = r["bad"]
-    assert bad.index == 1 and bad.reason.startswith("a mesh vertex with a coordinate of ")
-    assert "(not finite as float32) in rule `Lot` at " in bad.reason
+    assert bad.index == 1 and bad.reason.startswith("a scope sized or placed beyond any coordinate (")
+    assert " in rule `Lot` at " in bad.reason

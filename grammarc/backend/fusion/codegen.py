@@ -276,7 +276,7 @@ class _Writer:
             self.put(level, f"{name} = ({value}) * {scope.size[axis]}" if s.kind is ir.SizeKind.RELATIVE
                      else f"{name} = {value}")
             new.append(name)
-        self.check(level, " and ".join(f"{name} >= 0.0" for name in new))
+        self.check(level, " and ".join(f"{name} >= 0.0 and {name} <= {TOL.far!r}" for name in new))
         return tuple(new)
 
     def translate(self, op: ir.Translate, scope: Scope, level: int) -> tuple:
@@ -294,6 +294,7 @@ class _Writer:
                 self.put(level, f"{delta} += {local[i]} * frames[f, {i}, {j}]")
             new.append(self.fresh("o"))
             self.put(level, f"{new[-1]} = {scope.origin[j]} + {delta}")
+        self.within_coordinates(level, new)
         return tuple(new)
 
     def split(self, op: ir.Split, block: Block, scope: Scope, level: int, depth: int) -> None:
@@ -362,6 +363,7 @@ class _Writer:
         for j in range(3):
             moved.append(self.fresh("o"))
             self.put(level, f"{moved[-1]} = {scope.origin[j]} + {pos} * frames[f, {axis}, {j}]")
+        self.within_coordinates(level, moved)
         cut = tuple(length if k == axis else scope.size[k] for k in range(3))
         self.made(level)
         self.put(level, "pass")
@@ -433,6 +435,11 @@ class _Writer:
         """Flag the parent where ``holds`` does not: the interpreter fails its lot (and derives the batch)."""
         self.put(level, f"if not ({holds}):")
         self.put(level + 1, "bad[i] = True")
+
+    def within_coordinates(self, level: int, origin: list[str]) -> None:
+        """Flag the parent where an origin moves beyond any coordinate: the interpreter fails its lot there
+        (``Context.refuse_far``; a scale's sizes are checked with its other conditions)."""
+        self.check(level, " and ".join(f"abs({o}) <= {TOL.far!r}" for o in origin))
 
     # ------------------------------------------------------------------------------------------ expressions
     def expr(self, expr: ir.Expr, scope: Scope) -> str:

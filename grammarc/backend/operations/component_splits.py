@@ -159,7 +159,8 @@ def components(ctx: Context, kind: int, cursor: Shapes, site: int, span, wanted=
     child = cursor.take(parent)
     world_origin, world_axes, bad = component_frames(chunk.frames.data, child.frame, child.origin, origin, axes,
                                                      1e-6)
-    if bad.any():  # a scope of sizes no float can square (s(0, 0, 1e290)) has no component frames
+    if bad.any():  # a scope of sizes no float can square has no component frames (``refuse_far`` fails such a
+        # scope where it is made: this guards the kernel's output)
         ctx.fail_lots(child.lot[bad], "a component of a scope whose size is beyond any geometry", span)
     frame = chunk.frames.add(world_axes)
     shapes = Shapes(world_origin, size, frame, geom.astype(np.int32), child.lot,

@@ -211,7 +211,16 @@ def center(ctx: Context, cursor: Shapes, op: ir.Center, base) -> Shapes:
 @operation(ir.Extrude, writes=_REFRAMED, meshes=True)
 def extrude(ctx: Context, cursor: Shapes, op: ir.Extrude) -> Shapes:
     """The solids of ``_extruded``: the shape's own geometry, which its trim planes do not cut even where
-    it extrudes an inserted face (CityEngine trims geometry as it is inserted)."""
+    it extrudes an inserted face (CityEngine trims geometry as it is inserted).
+
+    A mesh's solids have up to six vertices for each of its own (each face's bottom and top, a quad per
+    edge), so a geometry extruded again and again grows sixfold each time: those vertices count as shapes
+    toward --max-shapes, refused before they are made, and such a lot fails as a shape explosion does."""
+    mesh = np.flatnonzero(is_mesh(cursor.geom))
+    if len(mesh):
+        made = 6 * ctx.chunk.meshes.vertex_counts(cursor.geom[mesh] - MESH_BASE)
+        ctx.check_fan_out(cursor.take(mesh), made.astype(np.float64), op.span)
+        ctx.count_lots(cursor.lot[mesh], op.span, per_row=made)
     return marked_inserted(ctx.plan, _extruded(ctx, cursor, op), False)
 
 

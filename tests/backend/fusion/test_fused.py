@@ -209,3 +209,13 @@ def test_shapes_count_as_the_interpreter_counts_them(write, monkeypatch, max_sha
                              limits=replace(LIMITS, max_shapes=max_shapes))
     assert_same(fused, interpreted)
     assert bool(fused["bad"]) == (max_shapes == 40)
+
+
+@pytest.mark.parametrize("far", ["S(1r, 1e39, 1r)", "T(0, -1e39, 0)"])
+def test_a_scope_beyond_any_coordinate_is_left_to_the_interpreter_which_fails_its_lot(write, monkeypatch, far):
+    """A scale or move past float32's largest number: the kernel hands the batch back, and the lot fails
+    where the interpreter fails it (``Context.refuse_far``), the records the interpreter's."""
+    text = NEGATIVE.replace("Subdiv(\"X\", Scope.sx - 9, 1r){ part | part }", f"{far} part")
+    fused, interpreted = both(write, monkeypatch, text, make_lots("square", "rect_12x8"))
+    assert fused["bad"] and all("beyond any coordinate" in b.reason for b in fused["bad"])
+    assert_same(fused, interpreted)

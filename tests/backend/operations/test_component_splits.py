@@ -294,9 +294,10 @@ def test_border_and_inside_of_shapes_no_offset_made(write, body, want):
 
 def test_components_of_a_scope_beyond_any_geometry_fail_its_lot(write):
     """``s(1, 1, -1e290)``: its faces' axes cannot be normalized (squares overflow); the lot fails by name
-    instead of carrying frames of NaN, and the other lot builds."""
+    (where the scale makes the scope: ``Context.refuse_far``) instead of carrying frames of NaN, and the
+    other lot builds."""
     r = run(write, 'attr d = 3\nLot --> s(1, 1, d) comp(f){ top : i("builtin:cube") | side : X }\n',
             [rect(12, 8), rect(12, 8)], lot_attrs={"d": [-1e290, np.nan]})
     (bad,) = r["bad"]
-    assert bad.index == 0 and bad.reason.startswith("a component of a scope whose size is beyond any geometry")
+    assert bad.index == 0 and bad.reason.startswith("a scope sized or placed beyond any coordinate (1e+290)")
     assert np.isfinite(r["xform"]).all() and set(r["lot"].tolist()) == {1}

@@ -22,6 +22,8 @@ from derivations import (
     totals,
 )
 
+from grammarc.constants import Limits
+
 
 def test_extrude_leaves_one_cube_of_the_height(write):
     """CityEngine: a rule that makes no successor leaves its shape; the mass is the lot's box."""
@@ -697,8 +699,23 @@ def test_extrude_of_convex_parts_has_no_lamina_faces(write):
 
 def test_extruding_a_face_beyond_any_geometry_fails_its_lot(write):
     """The build fuzz's `s(0, 1, -1e308) extrude(-1e308)`: GEOS, joining the face's outline, never
-    returned (nor let a signal stop the build); the lot fails with the operation named, the other builds."""
+    returned (nor let a signal stop the build); the lot fails with the operation named (the scale, past any
+    coordinate; the extrude, past 1e8 m), the other builds."""
     text = "attr h = 5\nLot --> s(0, 1, h) extrude(h) X.\n"
-    out = run(write, text, [rect(10, 8), rect(6, 4)], lot_attrs={"h": np.array([-1e308, 3.0])})
-    assert [b.index for b in out["bad"]] == [0]
-    assert "beyond any geometry" in out["bad"][0].reason
+    out = run(write, text, [rect(10, 8), rect(6, 4), rect(6, 4)], lot_attrs={"h": np.array([-1e308, 3.0, -1e9])})
+    assert [b.index for b in out["bad"]] == [0, 2]
+    assert out["bad"][0].reason.startswith("a scope sized or placed beyond any coordinate (1e+308)")
+    assert "`extrude` of a face whose size or height is beyond any geometry" in out["bad"][1].reason
+
+
+def test_a_geometry_extruded_again_and_again_fails_its_lot_before_it_fills_the_memory(write):
+    """As the build fuzz test found it: a mirrored box (a mesh) extruded, mirrored and extruded again grows
+    sixfold a round (15 million vertices in eight; the test process ran out of its 2 GB). The vertices of
+    a mesh's solids count toward --max-shapes before they are made: the lot fails, named, and the others
+    derive."""
+    text = "attr n = 0\nLot --> case n > 0 : s(-1, 2, 1) extrude(1) Lot\n    else : X.\n"
+    r = run(write, text, [rect(5, 5)] * 2, lot_attrs={"n": np.array([1.0, 0.0])},
+            limits=Limits(max_shapes=50_000))
+    [bad] = r["bad"]
+    assert bad.index == 0 and bad.reason.startswith("more than 50,000 shapes (")
+    assert np.unique(r["lot"]).tolist() == [1]
