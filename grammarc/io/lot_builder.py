@@ -39,7 +39,7 @@ from grammarc.geometry.short_edges import collapse_short_edges
 from grammarc.io.crs import georeference
 from grammarc.io.lot_format import NO_OPTIONS, LotsOptions
 from grammarc.model.lots import BadLot, Lots
-from grammarc.ragged import offsets_from_counts, segment_reduce
+from grammarc.ragged import next_in_segment, offsets_from_counts, segment_reduce
 
 __all__ = [
     "STREET_WIDTH", "LotBuilder", "id_text", "parse_features", "property_column", "property_columns", "street_flags",
@@ -451,8 +451,11 @@ def _validate(lots: Lots, normals: np.ndarray, world: bool, min_area: float | No
     reasons[wall & (reasons == "")] = "not a footprint: face normal is not vertical"
 
     candidates = np.flatnonzero(reasons == "")
-    polygons = _map_polygons(lots.take(candidates))
-    why = shapely.is_valid_reason(polygons)
+    checked = lots.take(candidates)
+    polygons = _map_polygons(checked)
+    convex = _plainly_convex(checked)
+    why = np.full(len(candidates), "Valid Geometry", dtype=object)
+    why[~convex] = shapely.is_valid_reason(polygons[~convex])
     valid = why == "Valid Geometry"
     area = shapely.area(polygons)
     # a symmetric bowtie has zero area too; only a polygon whose convex hull is flat is "zero area"
@@ -467,6 +470,28 @@ def _validate(lots: Lots, normals: np.ndarray, world: bool, min_area: float | No
         sliver = np.flatnonzero((area < min_area) & (reasons[candidates] == ""))
         reasons[candidates[sliver]] = [f"area {a:.3g} m2 under --min-area {min_area:g}" for a in area[sliver]]
     return reasons
+
+
+def _plainly_convex(lots: Lots) -> np.ndarray:
+    """(L,) bool: the lots without holes that turn left at every vertex, and plainly so (by more than a
+    billionth of their edges' lengths), once around. Such a polygon is convex, so simple: GEOS would find
+    it valid, and is asked only about the others (a city's lots are mostly such; its check of every lot
+    was a fifth of the time it took to read a GeoParquet file)."""
+    xy = np.column_stack([lots.vertices[:, 0], -lots.vertices[:, 2]])
+    following = next_in_segment(lots.ring_offsets)
+    edge = xy[following] - xy
+    before = np.empty_like(edge)
+    before[following] = edge  # the edge that ends at each vertex
+    cross = before[:, 0] * edge[:, 1] - before[:, 1] * edge[:, 0]
+    dot = (before * edge).sum(axis=1)
+    left = cross > 1e-9 * np.hypot(*before.T) * np.hypot(*edge.T)
+    ring = lots.ring_offsets
+    turning = segment_reduce(np.add, np.arctan2(cross, dot), ring, 0.0)
+    every = segment_reduce(np.add, (~left).astype(np.int64), ring, 0) == 0
+    one_ring = np.diff(lots.lot_offsets) == 1
+    convex = np.zeros(len(lots), dtype=bool)
+    convex[one_ring] = (every & (turning < 3 * np.pi))[lots.lot_offsets[:-1][one_ring]]
+    return convex
 
 
 def _map_polygons(lots: Lots) -> np.ndarray:
