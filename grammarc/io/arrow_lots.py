@@ -1,8 +1,10 @@
 """Lots of an Arrow table of WKB footprints: what a GeoParquet file (``io.geoparquet``) and a GIS file read
 through GDAL (``io.gis``) both are once read.
 
-The footprints are decoded with shapely (GEOS, vectorized) and their rings taken as ragged arrays
-(``shapely.to_ragged_array``), so no Python object is made per lot but its id. The lots are the same as a
+The footprints are decoded into ragged arrays by a kernel straight from the column's buffers (``io.wkb``)
+where every row is a plain polygon or multipolygon, else by shapely (GEOS, vectorized, then
+``shapely.to_ragged_array``), which says what each odd row is; no Python object is made per lot but its
+id. The lots are the same as a
 GeoJSON's (``io.lot_builder.parse_features``): a Polygon is a lot, a MultiPolygon a lot per polygon (ids
 ``"<id>:<k>"``), any other geometry a bad lot; the id is the ``id`` column, else ``name``, else the row
 number; the other columns are properties (numbers as float64 with nan for nulls, the rest as text), and a

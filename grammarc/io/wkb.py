@@ -36,7 +36,8 @@ class Polygons:
     ``shapely.to_ragged_array`` of their polygons.
 
     kinds : (N,) int64
-      Each row's geometry type, as shapely numbers them: 3 a polygon, 6 a multipolygon.
+      Each row's geometry type, as shapely numbers them: 3 a polygon, 6 a multipolygon (other types, and
+      -1 for none, in a column read through shapely).
     parts : (N,) int64
       Polygons per row: 1 for a polygon, 0 for a row that is none (read through shapely: another type, a
       null, an empty or unreadable geometry).
