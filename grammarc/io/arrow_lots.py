@@ -105,8 +105,7 @@ def lots_from_table(table, column: str, path, first_row: int = 0, first_index: i
             feature, index, lot_ids = feature[keep], index[keep], lot_ids[keep]
     attrs = {name: values[feature] for name, values in columns.items()}
     if len(feature):
-        builder.add_block(index, lot_ids.tolist(), coords[:, :3], np.diff(ring_offsets), np.diff(part_offsets),
-                          street)
+        builder.add_block(index, lot_ids, coords[:, :3], np.diff(ring_offsets), np.diff(part_offsets), street)
     return builder, attrs
 
 

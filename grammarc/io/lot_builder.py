@@ -66,10 +66,10 @@ class LotBuilder:
         self.declared: str | None = None
         self.implied: str | None = None
         self.rings: list[np.ndarray] = []  # rings, or a block of rings (``add_block``)
-        self.sizes: list[int] = []  # vertices per ring
-        self.ring_counts: list[int] = []  # rings per lot
-        self.index: list[int] = []
-        self.ids: list[str] = []
+        self.sizes = _Column(np.int64)  # vertices per ring
+        self.ring_counts = _Column(np.int64)  # rings per lot
+        self.index = _Column(np.int64)
+        self.ids = _Column(object)
         self.props: list[dict] = []
         self.vertices = 0  # positions added so far
         #: (first position, flags) of the lots or blocks that have street edges: a flag per position, its
@@ -123,14 +123,14 @@ class LotBuilder:
         self.polygons += len(ids)
         self.street.append((self.vertices, street))
         self._add_rings(vertices if self.world else _with_z(vertices), sizes)
-        self.ring_counts.extend(np.asarray(ring_counts).tolist())
-        self.index.extend(np.asarray(index).tolist())
-        self.ids.extend(ids)
+        self.ring_counts.add_block(ring_counts)
+        self.index.add_block(index)
+        self.ids.add_block(ids)
 
     def _add_rings(self, vertices: np.ndarray, sizes) -> None:
         """The rings of lots added as one block: all their vertices (V, 3), and vertices per ring."""
         self.rings.append(vertices)
-        self.sizes.extend(np.asarray(sizes, dtype=np.int64).tolist())
+        self.sizes.add_block(sizes)
         self.vertices += len(vertices)
 
     def add_positions(self, index: int, lot_id: str, rings, props: dict) -> None:
@@ -190,11 +190,10 @@ class LotBuilder:
         """Bring every lot to metres (``io.crs.georeference``, as the user's ``options`` ask), then clean,
         orient and validate them all at once; ``attrs`` are columns over all added lots."""
         self._convert()
-        counts = np.array(self.sizes, dtype=np.int64)
+        counts, ring_counts = self.sizes.array(), self.ring_counts.array()
         vertices = np.concatenate([np.zeros((0, 3)), *self.rings])
         xy = np.column_stack([vertices[:, 0], np.subtract(0.0, vertices[:, 2])]) if self.world else vertices[:, :2]
-        lot_counts = np.add.reduceat(counts, offsets_from_counts(np.array(self.ring_counts, np.int64))[:-1]) \
-            if len(counts) else counts
+        lot_counts = np.add.reduceat(counts, offsets_from_counts(ring_counts)[:-1]) if len(counts) else counts
         beyond = _beyond_the_earth(vertices, lot_counts)
         if beyond.any():  # points at 0 that _validate rejects with their reason; the CRS is judged without them
             on_earth = ~np.repeat(beyond, lot_counts)
@@ -217,15 +216,15 @@ class LotBuilder:
             given[start:start + len(flags)] = flags
         street = np.zeros(len(vertices), dtype=bool)
         np.logical_or.at(street, owner, given)
-        lot_offsets = offsets_from_counts(np.array(self.ring_counts, dtype=np.int64))
+        lot_offsets = offsets_from_counts(ring_counts)
         normals = _newell(vertices, ring_offsets)
         exterior = np.zeros(len(normals), dtype=bool)
         exterior[lot_offsets[:-1]] = True
         vertex_order, edge_order = _orient(ring_offsets, exterior, normals[:, 1])
         vertices, street = vertices[vertex_order], street[edge_order]
         lots = Lots(
-            ids=np.array(self.ids, dtype=object),
-            index=np.array(self.index, dtype=np.int64),
+            ids=self.ids.array(),
+            index=self.index.array(),
             vertices=vertices,
             ring_offsets=ring_offsets,
             lot_offsets=lot_offsets,
@@ -248,6 +247,39 @@ class LotBuilder:
         if self.polygons == 0:
             raise LotsError(f"no polygon in lots file {path}")
         return self.finish(attrs, str(path), options)
+
+
+class _Column:
+    """A column of the builder, grown a value at a time (GeoJSON's lots) or a block at a time (a columnar
+    file's): values wait in a list, blocks stay arrays, so a block of 10^5 lots is not made into Python
+    objects and back."""
+
+    def __init__(self, dtype):
+        self.dtype = dtype
+        self._blocks: list[np.ndarray] = []
+        self._values: list = []
+
+    def append(self, value) -> None:
+        self._values.append(value)
+
+    def extend(self, values) -> None:
+        self._values.extend(values)
+
+    def add_block(self, values) -> None:
+        self._flush()
+        self._blocks.append(np.asarray(values, dtype=self.dtype))
+
+    def array(self) -> np.ndarray:
+        """Every value so far, in order."""
+        self._flush()
+        return self._blocks[0] if len(self._blocks) == 1 else np.concatenate([np.zeros(0, self.dtype), *self._blocks])
+
+    def _flush(self) -> None:
+        if self._values:
+            block = np.empty(len(self._values), dtype=self.dtype)  # objects stay objects, whatever they are
+            block[:] = self._values
+            self._blocks.append(block)
+            self._values = []
 
 
 def street_flags(widths, ring: np.ndarray) -> np.ndarray | str:
