@@ -15,6 +15,7 @@ from __future__ import annotations
 import contextlib
 import functools
 import gc
+import threading
 import time
 from collections import deque
 from collections.abc import Sequence
@@ -117,6 +118,35 @@ def load_lots(grammar_path: Path, lots_path: Path | None, options: LotsOptions |
     return read_lots(path, options) if path is not None else default_lot()
 
 
+class _Reading:
+    """``load_lots`` in a thread of its own, started before the grammar is compiled: a large lots file takes
+    as long to read as the start-up takes, and most of the reading (Arrow's, the WKB kernel, numpy's and
+    GEOS's work over whole columns, numba's first kernel) runs outside the interpreter's lock, so the two
+    overlap on a machine of two cores. The lots, or the reading's error, are had from ``result()`` where
+    they were read before, so a grammar's errors still come first; a build that fails before leaves the
+    thread to end with the process (a daemon)."""
+
+    def __init__(self, grammar_path: Path, lots_path: Path | None, options: LotsOptions | None):
+        self._lots: Lots | None = None
+        self._error: BaseException | None = None
+        self._thread = threading.Thread(target=self._read, args=(grammar_path, lots_path, options),
+                                        name="grammarc lots", daemon=True)
+        self._thread.start()
+
+    def _read(self, grammar_path: Path, lots_path: Path | None, options: LotsOptions | None) -> None:
+        try:
+            self._lots = load_lots(grammar_path, lots_path, options)
+        except BaseException as error:  # noqa: BLE001 - raised in the build's thread by result()
+            self._error = error
+
+    def result(self) -> Lots:
+        """The lots, once read (the wait ends on a signal: Ctrl-C stops the build here as anywhere)."""
+        self._thread.join()
+        if self._error is not None:
+            raise self._error
+        return self._lots
+
+
 def build(grammar_path, output, *, lots_path=None, options: BuildOptions = BuildOptions(),
           progress=None, output_options: OutputOptions | None = None,
           select: Sequence[str] | None = None, reports_to: Path | None = None) -> BuildResult:
@@ -128,8 +158,9 @@ def build(grammar_path, output, *, lots_path=None, options: BuildOptions = Build
     values of ``report()`` go, ``.json`` or ``.csv`` (default ``reports_path(output)``).
     """
     started = time.perf_counter()
+    reading = _Reading(Path(grammar_path), Path(lots_path) if lots_path else None, options.lots)
     with grammar_source(Path(grammar_path), options) as (source, display, resolved):
-        return _build(source, display, Path(grammar_path), output, lots_path, resolved, progress, started,
+        return _build(source, display, Path(grammar_path), output, reading, resolved, progress, started,
                       recorded_roots=options.asset_roots, output_options=output_options or OutputOptions(),
                       select=select,
                       reports_to=reports_to)
@@ -161,7 +192,7 @@ def compile_source(source: Path, display: str | None, options: BuildOptions, *, 
                            warnings_as_errors=options.warnings_as_errors, derive=derive)
 
 
-def _build(source: Path, display: str | None, grammar_path: Path, output, lots_path,
+def _build(source: Path, display: str | None, grammar_path: Path, output, reading: _Reading,
            options: BuildOptions, progress, started: float, recorded_roots: tuple[Path, ...],
            output_options: OutputOptions, select: Sequence[str] | None,
            reports_to: Path | None) -> BuildResult:
@@ -174,7 +205,7 @@ def _build(source: Path, display: str | None, grammar_path: Path, output, lots_p
     reporting = reports_to is not None or any(isinstance(op, ir.Report) for op in iter_ops(grammar.module))
     check_writable([*files, *([reports_file] if reporting else [])], folders)
     Path(output).parent.mkdir(parents=True, exist_ok=True)
-    every = load_lots(grammar_path, Path(lots_path) if lots_path else None, options.lots)
+    every = reading.result()
     lots = every if select is None else every.select(select)
     if display is None:  # a rule file on disk: its CityEngine project's folders too, for a later render
         recorded_roots = (*recorded_roots, *(r for r in grammar.asset_roots[1:] if r not in recorded_roots))
@@ -197,10 +228,18 @@ def _build(source: Path, display: str | None, grammar_path: Path, output, lots_p
             counts = writer.close()
         written = True
     bad = tuple(sorted((*lots.bad, *failed), key=lambda b: b.index))
-    ids, times = np.unique(every.ids.astype(str), return_counts=True)
     return BuildResult(Path(output), len(lots) + len(lots.bad), derived, bad, counts,
                        time.perf_counter() - started, grammar, lots.crs_note, every.source,
-                       tuple(ids[times > 1].tolist()), written=written)
+                       _duplicates(every.ids), written=written)
+
+
+def _duplicates(ids: np.ndarray) -> tuple[str, ...]:
+    """The ids that more than one lot has, in order; sorted out only where there are any (a set of the
+    ids tells, in a tenth of the time sorting them takes)."""
+    if len(set(ids.tolist())) == len(ids):
+        return ()
+    unique, times = np.unique(ids.astype(str), return_counts=True)
+    return tuple(unique[times > 1].tolist())
 
 
 class _NothingBuilt(Exception):

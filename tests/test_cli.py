@@ -220,6 +220,17 @@ def test_unreadable_lots_exit_1(write, tmp_path, capsys, content, message):
     assert not out.exists()
 
 
+def test_the_grammars_errors_and_the_options_come_before_those_of_the_lots_read_meanwhile(write, tmp_path, capsys):
+    """The lots are read in a thread while the grammar compiles (``build._Reading``); their error is said
+    only where it was before, once the grammar and the options are found good."""
+    missing = str(tmp_path / "missing.geojson")
+    out = str(tmp_path / "out.npz")
+    assert main(["build", str(write("g.cga", GOOD)), "--lots", missing, "--emit", out, "--attr", "nope=1"]) == 2
+    assert "declares no attribute `nope`" in (err := capsys.readouterr().err) and "not found" not in err
+    assert main(["build", str(write("bad.cga", "lot ~> S(1, 2\n")), "--lots", missing, "--emit", out]) == 2
+    assert "not found" not in capsys.readouterr().err
+
+
 @pytest.mark.parametrize("args, message", [
     (["--emit", "out.fbx"], "output format `.fbx` is not supported"),
     (["--emit", "out.npz", "--attr", "nope=1"], "declares no attribute `nope`"),

@@ -97,8 +97,11 @@ def area_and_volume(store: MeshStore, ids: np.ndarray, size: np.ndarray):
 def ring_vector_areas(verts: np.ndarray, ring_offsets: np.ndarray) -> np.ndarray:
     """Vector area (R, 3) of each ring of points (V, 3) in space (Newell): its length is the ring's
     area, its direction the normal the ring winds counter-clockwise around."""
-    cross = np.cross(verts, verts[next_in_segment(ring_offsets)])
-    return np.stack([segment_reduce(np.add, cross[:, j], ring_offsets, 0.0) for j in range(3)], 1) / 2
+    a, b = verts, verts[next_in_segment(ring_offsets)]
+    # np.cross's products and differences, without its copies (a tenth of a second for a city's lots)
+    cross = (a[:, 1] * b[:, 2] - a[:, 2] * b[:, 1], a[:, 2] * b[:, 0] - a[:, 0] * b[:, 2],
+             a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0])
+    return np.stack([segment_reduce(np.add, cross[j], ring_offsets, 0.0) for j in range(3)], 1) / 2
 
 
 @njit(cache=True, nogil=True)

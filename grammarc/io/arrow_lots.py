@@ -1,8 +1,10 @@
 """Lots of an Arrow table of WKB footprints: what a GeoParquet file (``io.geoparquet``) and a GIS file read
 through GDAL (``io.gis``) both are once read.
 
-The footprints are decoded with shapely (GEOS, vectorized) and their rings taken as ragged arrays
-(``shapely.to_ragged_array``), so no Python object is made per lot but its id. The lots are the same as a
+The footprints are decoded into ragged arrays by a kernel straight from the column's buffers (``io.wkb``)
+where every row is a plain polygon or multipolygon, else by shapely (GEOS, vectorized, then
+``shapely.to_ragged_array``), which says what each odd row is; no Python object is made per lot but its
+id. The lots are the same as a
 GeoJSON's (``io.lot_builder.parse_features``): a Polygon is a lot, a MultiPolygon a lot per polygon (ids
 ``"<id>:<k>"``), any other geometry a bad lot; the id is the ``id`` column, else ``name``, else the row
 number; the other columns are properties (numbers as float64 with nan for nulls, the rest as text), and a
@@ -18,6 +20,8 @@ import shapely
 
 from grammarc.errors import LotsError, UsageError
 from grammarc.io.lot_builder import STREET_WIDTH, LotBuilder, id_text, property_column, street_flags
+from grammarc.io.wkb import Polygons, decode_polygons
+from grammarc.ragged import ragged_take
 
 __all__ = ["import_pyarrow", "lots_from_table", "table_lot_numbers"]
 
@@ -61,57 +65,73 @@ def lots_from_table(table, column: str, path, first_row: int = 0, first_index: i
       The property columns over the builder's lots.
     """
     pa, _ = import_pyarrow()
-    geometry, unreadable = _geometry(table, column)
-    n = len(geometry)
+    rows, unreadable = _polygons(table, column)
     names = [c for c in table.column_names if c != column]
-    ids = _ids(table, names, n, first_row, id_field)
-    kind, good, parts, feature, per_feature = _parts(geometry)
+    ids = _ids(table, names, len(rows.kinds), first_row, id_field)
+    good = rows.parts > 0
+    per_feature = np.where(good, rows.parts, 1)  # a bad feature takes one number, as in GeoJSON
     first = np.cumsum(per_feature) - per_feature + first_index
-    k = np.arange(len(parts)) - np.searchsorted(feature, feature)  # part number within its feature
+    feature = np.repeat(np.arange(len(rows.parts)), rows.parts)
+    k = np.arange(len(feature)) - np.searchsorted(feature, feature)  # part number within its feature
     index = first[feature] + k
-    multi = kind[feature] == _MULTIPOLYGON
-    lot_ids = [f"{ids[f]}:{j}" if m else ids[f] for f, j, m in zip(feature.tolist(), k.tolist(), multi.tolist())]
+    lot_ids = ids[feature]
+    multi = np.flatnonzero(rows.kinds[feature] == _MULTIPOLYGON)
+    lot_ids[multi] = lot_ids[multi] + ":" + k[multi].astype(str).astype(object)
 
     builder = LotBuilder(world=False)
     for f in np.flatnonzero(~good):
-        what = "empty polygon" if kind[f] in (_POLYGON, _MULTIPOLYGON) else f"not a polygon ({_type_name(kind[f])})"
+        what = "empty polygon" if rows.kinds[f] in (_POLYGON, _MULTIPOLYGON) else \
+            f"not a polygon ({_type_name(rows.kinds[f])})"
         builder.reject(int(first[f]), ids[f], unreadable.get(int(f), what))
     columns = {name: _column(table.column(name), pa) for name in names if name not in ("id", STREET_WIDTH)}
-    widths = [_text_list(w) for w in table.column(STREET_WIDTH).to_pylist()] if STREET_WIDTH in names else None
-    if widths is not None:  # only files with street widths pay a loop over their lots
-        exterior = shapely.get_num_coordinates(shapely.get_exterior_ring(parts))
-        keep = np.ones(len(parts), dtype=bool)
-        for lot in range(len(parts)):
+    coords, ring_offsets, part_offsets = rows.coords, rows.ring_offsets, rows.part_offsets
+    street = np.zeros(len(coords), dtype=bool)
+    if STREET_WIDTH in names:  # only files with street widths pay a loop over their lots
+        widths = [_text_list(w) for w in table.column(STREET_WIDTH).to_pylist()]
+        keep = np.ones(len(feature), dtype=bool)
+        for lot, (start, stop) in enumerate(zip(ring_offsets[part_offsets[:-1]].tolist(),
+                                                _exterior_ends(ring_offsets, part_offsets).tolist())):
             value = widths[feature[lot]]
-            problem = street_flags(value, np.zeros((exterior[lot], 2))) if value is not None else None
-            if isinstance(problem, str):
+            flags = street_flags(value, np.zeros((stop - start, 2))) if value is not None else None
+            if isinstance(flags, str):
                 keep[lot] = False
-                builder.reject(int(index[lot]), lot_ids[lot], problem)
-        parts, feature, index = parts[keep], feature[keep], index[keep]
-        lot_ids = [i for i, kept in zip(lot_ids, keep) if kept]
+                builder.reject(int(index[lot]), lot_ids[lot], flags)
+            elif flags is not None:
+                street[start:stop] = flags
+        if not keep.all():
+            rings, part_offsets = ragged_take(part_offsets, np.flatnonzero(keep))
+            points, ring_offsets = ragged_take(ring_offsets, rings)
+            coords, street = coords[points], street[points]
+            feature, index, lot_ids = feature[keep], index[keep], lot_ids[keep]
     attrs = {name: values[feature] for name, values in columns.items()}
-    if len(parts):
-        _, coords, (ring_offsets, lot_offsets) = shapely.to_ragged_array(parts)
-        street = np.zeros(len(coords), dtype=bool)
-        if widths is not None:
-            for lot, start in enumerate(ring_offsets[lot_offsets[:-1]].tolist()):
-                value = widths[feature[lot]]
-                if value is not None:
-                    street[start:start + len(value)] = np.asarray(value, dtype=np.float64) > 0
-        builder.add_block(index, lot_ids, coords[:, :3], np.diff(ring_offsets), np.diff(lot_offsets), street)
+    if len(feature):
+        builder.add_block(index, lot_ids, coords[:, :3], np.diff(ring_offsets), np.diff(part_offsets), street)
     return builder, attrs
+
+
+def _exterior_ends(ring_offsets: np.ndarray, part_offsets: np.ndarray) -> np.ndarray:
+    """Where each polygon's exterior ring ends in the positions (where it starts: a polygon without rings,
+    an empty part of a multipolygon)."""
+    starts = ring_offsets[part_offsets[:-1]]
+    has = np.diff(part_offsets) > 0
+    return np.where(has, ring_offsets[np.minimum(part_offsets[:-1] + 1, len(ring_offsets) - 1)], starts)
 
 
 def table_lot_numbers(table, column: str, path) -> int:
     """The lot numbers the rows of a table take: a polygon one, a multipolygon one per part, anything else
     one (a bad lot)."""
-    return int(_parts(_geometry(table, column)[0])[4].sum())
+    return int(np.maximum(_polygons(table, column)[0].parts, 1).sum())
 
 
-def _geometry(table, column: str) -> tuple[np.ndarray, dict[int, str]]:
-    """The rows' geometries (None where null or unreadable), and why each unreadable row's WKB is (by row
-    of the table): such a row is a bad lot, as a GeoJSON feature whose geometry is not one."""
+def _polygons(table, column: str) -> tuple[Polygons, dict[int, str]]:
+    """The rows' polygons (``io.wkb``; a bad row, not a polygon or multipolygon or an empty one, has no
+    parts), and why each unreadable row's WKB is (by row of the table): such a row is a bad lot, as a
+    GeoJSON feature whose geometry is not one. Decoded in one pass where every row is a plain polygon or
+    multipolygon, else through shapely (GEOS), which says what each odd row is."""
     values = table.column(column)
+    decoded = decode_polygons(values)
+    if decoded is not None:
+        return decoded, {}
     present = ~values.is_null().to_numpy(zero_copy_only=False)
     if hasattr(values.type, "storage_type"):  # an extension type (geoarrow.wkb): its WKB bytes
         values = [chunk.storage for chunk in values.chunks]
@@ -119,8 +139,18 @@ def _geometry(table, column: str) -> tuple[np.ndarray, dict[int, str]]:
     else:
         values = values.to_numpy(zero_copy_only=False)
     geometry = shapely.from_wkb(values, on_invalid="ignore")
-    return geometry, {int(row): f"bad WKB in column {column!r}: {_wkb_error(values[row])}"
-                      for row in np.flatnonzero(present & shapely.is_missing(geometry))}
+    unreadable = {int(row): f"bad WKB in column {column!r}: {_wkb_error(values[row])}"
+                  for row in np.flatnonzero(present & shapely.is_missing(geometry))}
+    kinds = shapely.get_type_id(geometry).astype(np.int64)
+    good = np.isin(kinds, (_POLYGON, _MULTIPOLYGON)) & ~shapely.is_empty(geometry)
+    parts, feature = shapely.get_parts(geometry[good], return_index=True)
+    counts = np.zeros(len(geometry), dtype=np.int64)
+    counts[good] = np.bincount(feature, minlength=int(good.sum()))
+    if len(parts):
+        _, coords, (ring_offsets, part_offsets) = shapely.to_ragged_array(parts)
+    else:
+        coords, ring_offsets, part_offsets = np.zeros((0, 2)), np.zeros(1, np.int64), np.zeros(1, np.int64)
+    return Polygons(kinds, counts, coords, ring_offsets, part_offsets), unreadable
 
 
 def _wkb_error(value) -> str:
@@ -130,18 +160,6 @@ def _wkb_error(value) -> str:
     except (shapely.errors.GEOSException, TypeError, ValueError) as error:
         return str(error)
     return "unreadable"
-
-
-def _parts(geometry: np.ndarray):
-    """Each feature's kind and goodness, the polygons of the good ones with their feature, and the lot
-    numbers each feature takes (lots are numbered in file order: a feature's parts, then the next's)."""
-    kind = shapely.get_type_id(geometry)
-    good = np.isin(kind, (_POLYGON, _MULTIPOLYGON)) & ~shapely.is_empty(geometry)
-    parts, feature = shapely.get_parts(geometry[good], return_index=True)
-    feature = np.flatnonzero(good)[feature]
-    per_feature = np.where(good, 0, 1)  # a bad feature takes one number, as in GeoJSON
-    np.add.at(per_feature, feature, 1)
-    return kind, good, parts, feature, per_feature
 
 
 def _text_list(value):
@@ -165,16 +183,32 @@ def _column(values, pa) -> np.ndarray:
     return property_column(values.to_pylist())
 
 
-def _ids(table, names: list[str], n: int, first_row: int, id_field: str | None) -> list[str]:
-    """The rows' ids: column ``id_field`` where given (``--id-field``), else ``id``, else ``name``; a row
-    without one is its number."""
+def _ids(table, names: list[str], n: int, first_row: int, id_field: str | None) -> np.ndarray:
+    """(N,) object: the rows' ids, column ``id_field`` where given (``--id-field``), else ``id``, else
+    ``name``; a row without one is its number."""
     if id_field is not None and id_field not in names:
         raise LotsError(f"--id-field {id_field}: the lots have no such field (they have {', '.join(names) or 'none'})")
+    rows = np.arange(first_row, first_row + n)
     for name in (id_field,) if id_field is not None else ("id", "name"):
         if name in names:
-            values = table.column(name).to_pylist()
-            return [id_text(v) if v is not None else str(i) for i, v in enumerate(values, first_row)]
-    return [str(i) for i in range(first_row, first_row + n)]
+            return _id_texts(table.column(name), rows)
+    return rows.astype(str).astype(object)
+
+
+def _id_texts(values, rows: np.ndarray) -> np.ndarray:
+    """(N,) object: an id column as text (``lot_builder.id_text``), a null its row's number. Text and whole
+    numbers are converted as a column (their text is Arrow's, the same as Python's); other types (floats
+    among them: ``3.0`` is ``"3"``) value by value."""
+    pa, _ = import_pyarrow()
+    kind = values.type
+    if pa.types.is_string(kind) or pa.types.is_large_string(kind) or pa.types.is_integer(kind):
+        texts = values.cast(pa.string()).to_numpy(zero_copy_only=False).astype(object)
+    else:
+        texts = np.array([id_text(v) if v is not None else None for v in values.to_pylist()] + [None],
+                         dtype=object)[:-1]  # [None]: one object per row, whatever the values are
+    missing = values.is_null().to_numpy(zero_copy_only=False)
+    texts[missing] = rows[missing].astype(str)
+    return texts
 
 
 def _type_name(type_id: int) -> str:

@@ -26,16 +26,19 @@ def same(a, b, numbers=True):
         assert a.attrs[name].astype(str).tolist() == b.attrs[name].astype(str).tolist()
 
 
-def test_a_parquet_file_gives_the_lots_of_its_geojson(tmp_path):
-    """Written from the features directly (a GIS tool's GeoParquet): the same lots, the same bad lots."""
+@pytest.mark.parametrize("line", [True, False])
+def test_a_parquet_file_gives_the_lots_of_its_geojson(tmp_path, line):
+    """Written from the features directly (a GIS tool's GeoParquet): the same lots, the same bad lots; read
+    through shapely where a row is a line, else by the WKB kernel (``io.wkb``)."""
+    features = [f for f in FEATURES if line or f["id"] != "line"]
     path = tmp_path / "lots.geojson"
-    path.write_text(json.dumps({"type": "FeatureCollection", "features": FEATURES}))
-    geometry = [shapely.from_geojson(json.dumps(f["geometry"])) for f in FEATURES]
+    path.write_text(json.dumps({"type": "FeatureCollection", "features": features}))
+    geometry = [shapely.from_geojson(json.dumps(f["geometry"])) for f in features]
     table = pa.table({
-        "id": [f["id"] for f in FEATURES],
-        "kind": [f["properties"]["kind"] for f in FEATURES],
-        "h": pa.array([f["properties"]["h"] for f in FEATURES], type=pa.float64()),
-        "streetWidth": [f["properties"].get("streetWidth") for f in FEATURES],
+        "id": [f["id"] for f in features],
+        "kind": [f["properties"]["kind"] for f in features],
+        "h": pa.array([f["properties"]["h"] for f in features], type=pa.float64()),
+        "streetWidth": [f["properties"].get("streetWidth") for f in features],
         "geometry": shapely.to_wkb(geometry),
     }).replace_schema_metadata({"geo": json.dumps({"primary_column": "geometry",
                                                    "columns": {"geometry": {"encoding": "WKB"}}})})
@@ -43,7 +46,7 @@ def test_a_parquet_file_gives_the_lots_of_its_geojson(tmp_path):
     geojson, parquet = read_lots(path), read_lots(tmp_path / "lots.parquet")
     same(geojson, parquet)
     assert parquet.ids.tolist() == ["a", "m:0", "m:1"] and parquet.street.sum() == 1
-    assert parquet.bad == geojson.bad and [b.id for b in parquet.bad] == ["line", "bad-width"]
+    assert parquet.bad == geojson.bad and [b.id for b in parquet.bad] == ["line", "bad-width"][0 if line else 1:]
 
 
 def test_lots_command_converts_and_the_conversion_reads_back(tmp_path, capsys):
@@ -94,3 +97,13 @@ def test_parquet_partitions_follow_row_groups_near_their_size(tmp_path):
                                                                         (10, 13)]
     assert [(p.start, p.stop) for p in partition_lots(parquet, 6)] == [(0, 6), (6, 12), (12, 13)]
 
+
+
+@pytest.mark.parametrize("ids", [[7, None, -3], ["a", None, "c"], [True, None, False]])
+def test_ids_of_every_column_type_are_their_text_and_a_null_is_the_row_number(tmp_path, ids):
+    """Text and whole numbers are converted as columns, other types value by value: the same text."""
+    squares = shapely.to_wkb([shapely.box(20 * k, 0, 20 * k + 10, 10) for k in range(3)])
+    geo = {"primary_column": "geometry", "columns": {"geometry": {"encoding": "WKB", "crs": None}}}
+    table = pa.table({"id": ids, "geometry": squares}).replace_schema_metadata({"geo": json.dumps(geo)})
+    pq.write_table(table, tmp_path / "ids.parquet")
+    assert read_lots(tmp_path / "ids.parquet").ids.tolist() == [str(i) if i is not None else "1" for i in ids]

@@ -274,6 +274,39 @@ def test_star_polygons_keep_first_vertex_and_area(n, seed, clockwise, offset):
     assert map_area(out - out[0]) == pytest.approx(area, rel=1e-9)
 
 
+@settings(max_examples=80, deadline=None)
+@given(seed=st.integers(0, 2**32 - 1), offset=st.sampled_from([0.0, 5e5]))
+def test_lots_that_skip_geos_validity_are_those_it_finds_valid(seed, offset):
+    """Rings of 3-7 vertices on a coarse grid (convex, concave, bow-ties, collinear runs, slivers, rings
+    that wind twice), some with a hole: the same lots and bad lots as when GEOS checks every lot, and
+    every lot it is not asked about is one it finds valid."""
+    import shapely
+
+    from grammarc.io import lot_builder
+
+    rng = np.random.default_rng(seed)
+    polygons = []
+    for _ in range(40):
+        n = rng.integers(3, 8)
+        ring = offset + rng.integers(0, 4, (n, 2)) * rng.choice([1.0, 1e-4])
+        if rng.random() < 0.3:  # a convex polygon, maybe wound twice (a pentagram's order)
+            angles = np.sort(rng.uniform(0, 2 * np.pi, n))
+            ring = offset + np.column_stack([np.cos(angles), np.sin(angles)]) * rng.uniform(1e-3, 50)
+            if n == 5 and rng.random() < 0.5:
+                ring = ring[[0, 2, 4, 1, 3]]
+        polygons.append([ring] if rng.random() < 0.8 else [ring, offset + np.array([[1, 1], [1.5, 1], [1, 1.5]])])
+    fast = lots_from_polygons(polygons)
+    convex = lot_builder._plainly_convex(fast)
+    assert shapely.is_valid(lot_builder._map_polygons(fast)[convex]).all()
+    original = lot_builder._plainly_convex
+    try:
+        lot_builder._plainly_convex = lambda lots: np.zeros(len(lots), dtype=bool)
+        slow = lots_from_polygons(polygons)
+    finally:
+        lot_builder._plainly_convex = original
+    assert fast.bad == slow.bad
+    np.testing.assert_array_equal(fast.vertices, slow.vertices)
+
 
 @pytest.mark.parametrize(("values", "want"), [
     ([1, 2.5, None], [1.0, 2.5, np.nan]),
