@@ -344,12 +344,16 @@ def ring_starts(coords, ring_offsets, part_offsets, part_source, part_with_start
             if r == part_offsets[p] and part_inset[p]:
                 # where the first outer edge left, counting from the last, ends: vertex 0's mitre when the
                 # last edge and edge 0 are left; the end of the last edge's run nearest vertex 0 of all
-                # the inset's pieces (``_last_edge_ends``) counts as the last one's end
+                # the inset's pieces (``_last_edge_ends``) counts as the last one's end. Of an edge that a
+                # grown hole parts in runs, the end of its last run counts: the edge's own end (PRT on a lot
+                # whose last edge a hole takes and another parts edge 0: the inset starts at edge 0's end,
+                # its mitre with edge 1, not where the first run ends at the hole; massing's holes.43599)
                 rank = np.full(n, np.inf)
                 for j in range(n):
                     incoming = moved_from[r0 + (j - 1) % n]
                     if incoming < outer and moved_from[r0 + j] != incoming:  # (the end of a run along it)
-                        rank[j] = incoming + 1
+                        # (how far along the edge its last segment starts, in [0, 1], orders its runs)
+                        rank[j] = incoming + 1 - 0.5 * ties[r0 + (j - 1) % n]
                         if incoming == outer - 1 and last_end[g] == r0 + j:
                             rank[j] = 0
                 if np.isfinite(rank).any():

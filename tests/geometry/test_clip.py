@@ -149,6 +149,26 @@ def test_an_inset_whose_hole_cuts_the_last_edge_off_starts_at_its_end():
                                [[3, -13], [13, -13]])
 
 
+def test_an_inset_without_the_last_edge_starts_at_the_end_of_edge_0s_last_run():
+    """A hole grown by the offset takes the last edge (and vertex 0), another parts edge 0 in two runs: the
+    inset starts where edge 0 itself ends, at its last run's mitre with edge 1, not where its first run
+    ends at the hole (measured through PyPRT on massing: a 60 x 40 m lot, holes 10 x 34 m beside its last
+    edge and 10 x 7 m beside edge 0, offset 5 m, its first tier setting back edge 0 by 8 m: PRT's moved
+    the inset of edge 1; massing's holes.43599, whose split footprint's edges follow that start)."""
+    import shapely
+
+    from grammarc.geometry.clip import fit_pieces
+
+    # clockwise in (x, z), as the lots' footprints are; edge 0 along z = 0, the last edge along x = 0
+    lot = shapely.Polygon([(0, 0), (60, 0), (60, -40), (0, -40)],
+                          [[(2, -3), (2, -37), (12, -37), (12, -3)], [(30, -2), (30, -9), (40, -9), (40, -2)]])
+    inset = shapely.buffer(lot, -5, join_style="mitre")  # edge 0's runs: x 17 to 25 and 45 to 55
+    pieces = fit_pieces(np.array([inset]), np.array([1]), np.array([[60.0, 0.0, 40.0]]), np.array([lot]),
+                        insets=np.array([True]))
+    np.testing.assert_allclose(pieces.coords[:2] * pieces.extent[0, [0, 2]] + pieces.low[0, [0, 2]],
+                               [[55, -5], [55, -35]])
+
+
 def test_inset_pieces_of_a_hole_across_the_lot_start_at_their_first_edges_end():
     """A hole grown across the inset parts it in two; a run along the last edge ends at the hole in both,
     but only the one nearest vertex 0 (its mitre, in the lower piece) counts from the last: the upper
