@@ -179,7 +179,7 @@ def _swept(polygons: np.ndarray, edges: Edges, d, corner, ends, owner, swept, st
     faces = np.flatnonzero(swept)
     rows = np.flatnonzero(swept[edges.poly] & ~edges.hole)  # (their outer rings, one after the other)
     ring_offsets = offsets_from_counts(np.bincount(edges.poly[rows], minlength=m)[faces])
-    coords, offsets, collapsed, followed, left, left_ring = swept_strips(
+    coords, offsets, collapsed, followed, left, left_ring, left_kept = swept_strips(
         edges.start[rows], edges.end[rows], edges.inward[rows], d[rows], corner[rows], ends[rows], ring_offsets,
         np.cos(np.radians(_STEP_TURN)))
     scale = max(float(np.abs(edges.start[rows]).max(initial=1.0)), 1.0)
@@ -205,8 +205,14 @@ def _swept(polygons: np.ndarray, edges: Edges, d, corner, ends, owner, swept, st
     turned[ends_as] = (winding[ends_as] > 0) != shapely.is_ccw(outlines[ends_as])
     turned |= np.abs(winding) <= 1e-12 * scale * scale
     turned &= (~crossed | out) & has_front
+    # a front that crosses itself inside its face only where a moved line passed kept ones (a reflex corner
+    # of kept edges, where the moved line parts the face: a split event) is followed, its strips clipped
+    # to the face making the pieces, as PRT's tier on massing's concave.43897 (an edge set back 4 m past
+    # a reflex corner of kept edges, 2.8 m beyond it: PRT keeps the two pieces beyond the moved line)
+    passed = crossed & ~out
+    passed[passed] = ~_moved_lines_cross(left, left_ring, left_kept, passed)[passed]
     trusted = np.zeros(m, dtype=bool)
-    trusted[faces] = turned | (followed & ~out & ~crossed)
+    trusted[faces] = turned | (followed & ~out & (~crossed | passed))
     swept = swept & trusted
     has = (np.diff(offsets) > 0) & swept[edges.poly[rows]]
     counts = np.diff(offsets)
@@ -224,6 +230,22 @@ def _swept(polygons: np.ndarray, edges: Edges, d, corner, ends, owner, swept, st
         made_group = np.concatenate([made_group, owner[furthest] * m + gone])
     kept = ~swept[edges.poly[idx]] | edges.hole[idx]  # (a moved hole edge keeps its strip)
     return np.concatenate([strips[kept], made]), np.concatenate([group[kept], made_group])
+
+
+def _moved_lines_cross(left: np.ndarray, ring: np.ndarray, kept: np.ndarray, fronts: np.ndarray) -> np.ndarray:
+    """(n,) whether segments of two moved lines of the same front cross, for the ``fronts`` (n,) bool asked
+    about; ``left`` (W, 2): the fronts' lines' segments, two ends per line, ``ring`` (W,) the front of each,
+    ``kept`` (W,) whether its line stays where it is (``geometry.wavefront.swept_strips``)."""
+    first = np.arange(0, len(left), 2)
+    moved = first[~kept[first] & fronts[ring[first]]]
+    crossing = np.zeros(len(fronts), dtype=bool)
+    if len(moved) < 2:
+        return crossing
+    segments = shapely.linestrings(np.stack([left[moved], left[moved + 1]], axis=1))
+    a, b = shapely.STRtree(segments).query(segments, predicate="crosses")
+    same = ring[moved[a]] == ring[moved[b]]
+    crossing[ring[moved[a[same]]]] = True
+    return crossing
 
 
 def _unfolded(edges: Edges, d: np.ndarray) -> np.ndarray:

@@ -395,3 +395,21 @@ def test_seams_go_from_regions_that_also_hold_lines():
     region = shapely.GeometryCollection([seamed, shapely.LineString([(10, 4), (12, 6)])])
     out = _without_seams(np.array([region]), np.array([polygon]))
     assert len(shapely.get_coordinates(out[0])) == 5
+
+
+
+def test_a_swept_front_past_a_reflex_corner_of_kept_edges_parts_the_remainder():
+    """A face swept as a wavefront (a 0.57 m edge set back 4 m folds) whose moved bottom line passes a
+    reflex corner of kept edges 1 m above the bottom: the front crosses the kept edges there (a split
+    event), and the strips, clipped to the face, leave the remainder in two pieces beyond the moved line,
+    as PRT's (measured through PyPRT: massing's first tier on this lot, edges 0 and 1 set back 4 m: the
+    tier above is these two pieces, 251.187 m^2; the folded quads' strips, kept before, left 266.855 m^2;
+    massing.concave.43897)."""
+    face = shapely.Polygon([(0, 0), (20, 0), (19.6, 0.4), (22, 5), (18, 1), (14, 20), (0, 20)])
+    (strips,), (remainder,) = setback([face], [4, 4, 0, 0, 0, 0, 0])
+    # the moved line y = 4 meets edge 2 at x = 21.478 and crosses edges 3 and 4 at x = 21 and 17.368
+    expected = shapely.MultiPolygon([shapely.Polygon([(21, 4), (19.6 + 2.4 * 3.6 / 4.6, 4), (22, 5)]),
+                                     shapely.Polygon([(0, 4), (18 - 4 * 3 / 19, 4), (14, 20), (0, 20)])])
+    assert shapely.symmetric_difference(remainder, expected).area < 1e-9
+    assert abs(shapely.area(remainder) - 251.187) < 1e-3
+    assert abs(shapely.area(strips[0]) + shapely.area(remainder) - face.area) < 1e-6
