@@ -443,15 +443,15 @@ def test_cut_edges_of_a_piece_the_cut_takes_through_a_hole_turn_their_faces():
     ([(10, -5), (20, -5), (20, -30), (0, -30), (0, 0), (10, 0)],
      [(4, 0), (10, 0), (10, -5), (10, -9), (20, -9), (20, -26), (4, -26)], (10, -5)),
     # the first lot's edge 0 stepping back from a last edge kept whole, from a kept corner: PRT starts the
-    # remainder at vertex 0 (massing.near_degenerate.43572's second tier, its 1 m last edge 0.02 degrees
-    # off edge 0's line; was: at the last edge's start, 1.4 % of the area off)
+    # remainder at the run along the last edge too (this lot's second tier setting back its edge 0 by 2 m:
+    # PRT's moved the run from (6, 0), 204 m^2 left, where the step's would leave 206.667;
+    # massing.near_degenerate.43838's second tier, a 6.3 m last edge on edge 0's line)
     ([(10, 0), (20, 0), (20, -20), (0, -20), (0, -4), (6, 0)],
-     [(6, 0), (10, 0), (10, -4), (20, -4), (20, -20), (0, -20), (0, -4)], (10, 0)),
+     [(6, 0), (10, 0), (10, -4), (20, -4), (20, -20), (0, -20), (0, -4)], (6, 0)),
 ])
 def test_a_remainder_that_keeps_vertex_0_starts_where_prt_starts_it(lot, remainder, first):
     """massing's tiers (4;0;4;4;0) on these lots, PRT's second tier's edge 0 measured through PyPRT (a
-    setback of edge 0 alone); the same on 19 of 19 real lots of Seoul, Bergen, Tartu and Yaroslavl; the
-    third reduced from a random lot's."""
+    setback of edge 0 alone); the same on 19 of 19 real lots of Seoul, Bergen, Tartu and Yaroslavl."""
     import shapely
 
     from grammarc.geometry.clip import fit_pieces
