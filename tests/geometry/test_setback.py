@@ -413,3 +413,19 @@ def test_a_swept_front_past_a_reflex_corner_of_kept_edges_parts_the_remainder():
     assert shapely.symmetric_difference(remainder, expected).area < 1e-9
     assert abs(shapely.area(remainder) - 251.187) < 1e-3
     assert abs(shapely.area(strips[0]) + shapely.area(remainder) - face.area) < 1e-6
+
+
+def test_a_step_beside_a_vanished_edge_stays_where_the_edge_beyond_runs_on_along_its_line():
+    """Edge 2, set back 4 m, folds (edge 1 beside it, at 53 degrees, is set back 4 m too) and vanishes; the
+    kept edge 3 beyond it runs on along its line, the two stepping at vertex 3 along their normal. The step
+    stays: edge 1's moved line meets it, 0.44 m from vertex 3, as PRT's (measured through PyPRT: massing's
+    first tier on this lot, edges 1 and 2 set back 4 m, 124.485 m^2 left; the step going with the edge, the
+    moved line met edge 3's line behind the vertex and left 127.456 m^2; massing.near_degenerate.43838's
+    second tier)."""
+    face = shapely.Polygon([(0, 10.048), (4, 10.048), (4, 0), (8.263, 3.193), (15.042, 8.274), (15.018, 8.329),
+                            (8.966, 16.562), (5.499, 21.275), (0, 16.373)])
+    _, (remainder,) = setback([face], [0, 4, 4, 0, 0, 0, 0, 0, 0])
+    assert abs(shapely.area(remainder) - 124.485) < 2e-3
+    corner = (8, 3.193 + 0.263 * 0.8 / 0.6)  # edge 1's moved line x = 8 on the step, the normal (-0.6, 0.8)
+    assert shapely.distance(shapely.Point(corner), remainder.exterior) < 1e-3
+    assert shapely.Point(8.263, 3.193).distance(remainder.exterior) < 1e-9  # vertex 3 kept
