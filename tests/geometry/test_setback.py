@@ -429,3 +429,19 @@ def test_a_step_beside_a_vanished_edge_stays_where_the_edge_beyond_runs_on_along
     corner = (8, 3.193 + 0.263 * 0.8 / 0.6)  # edge 1's moved line x = 8 on the step, the normal (-0.6, 0.8)
     assert shapely.distance(shapely.Point(corner), remainder.exterior) < 1e-3
     assert shapely.Point(8.263, 3.193).distance(remainder.exterior) < 1e-9  # vertex 3 kept
+
+
+def test_swept_strips_that_pass_an_event_point_twice_are_all_united():
+    """massing's far.43727: a shapeU (front 9.55 m, sides 9.83 m) whose kept back edge vanishes; the left
+    side's swept path passes the event point twice, and make_valid kept a part of 7.9e-31 m^2 there, beside
+    which GEOS's union dropped the whole 102.7 m^2 strip of the right side: a remainder of 128 m^2 where
+    PRT's shape covers all but the wavefront's 25.4 m^2 (PRT's model of the lot: 7006.03 m^2 of surface;
+    grammarc's, 6625.33 before, 7006.07 now)."""
+    face = shapely.Polygon([(11.130205291622756, 27.13265531797522), (25.729926220049986, 27.13265531797522),
+                            (27.938243971109266, 11.971738820353957), (25.814481463561258, 8.484919132278453),
+                            (21.050961559434274, 1.6795391770203134), (7.274977851225474, 0),
+                            (0, 12.034543888649004)])
+    front, side = 9.550694671927277, 9.83426187783046
+    (strips,), (remainder,) = setback([face], [front, side, side, side, 0, side, side])
+    assert abs(shapely.area(strips[0]) + shapely.area(remainder) - face.area) < 1e-6
+    assert abs(shapely.area(remainder) - 25.388) < 1e-3
