@@ -68,13 +68,14 @@ def _retire(alive, final, pool, s_head, e, x, y):
 def _past_step(nx, ny, c, w, ux, uy, pool, s_head, step, a, b, t, sign):
     """Whether lines a and b, the neighbours a step (a line, ``step``) lies between once an edge beside it
     vanished, meet at time t on the far line's side of the step's vertex (where the step's path starts):
-    past it along b (``sign`` 1, b the line beyond the step) or before it along a (``sign`` -1); lines
-    that do not meet count as meeting there."""
+    past it along b (``sign`` 1, b the line beyond the step) or before it along a (``sign`` -1). Lines
+    that do not meet, and a far line that moves, count as meeting there (only steps to kept edges were
+    measured staying: those between moved edges go with the edge, as before)."""
+    far = b if sign > 0 else a
     x, y, ok = _meet(nx, ny, c, w, a, b, t)
-    if not ok:
+    if not ok or w[far] > _EPS:
         return True
     k = s_head[step]
-    far = b if sign > 0 else a
     return sign * ((x - pool[k, 0]) * ux[far] + (y - pool[k, 1]) * uy[far]) >= -_EPS
 
 
@@ -179,9 +180,10 @@ def _ring_strips(start, end, inward, d, corner, ends, out, out_n, left, left_kep
             # the steps at a vanished edge's ends go with it: its neighbours meet as they would have without
             # it, their strips reaching across its step's vertex (PRT's on massing.far.33391, where a short
             # edge moved 4 m between a moved and a kept edge turned by 13 degrees), where they meet on the
-            # far side's line past the step's vertex; where they would meet behind it (the line beyond
-            # the step runs on along the vanished edge's line), the step stays and the neighbour meets it
-            # (PRT's tier on a lot whose edge set back 4 m vanishes beside a kept edge on its line:
+            # far side's line past the step's vertex; where they would meet behind it (the kept edge beyond
+            # the step runs on along the vanished edge's line, or turns from it by up to 8 degrees either
+            # way), the step stays and the neighbour meets it (PRT's tiers on a lot whose edge set back 4 m
+            # vanishes beside such a kept edge, after it and, mirrored, before it:
             # massing.near_degenerate.43838's second tier)
             if real[q] < 0 and count > 3 and _past_step(nx, ny, c, w, ux, uy, pool, s_head, q, p, nxt[q], now, 1.0):
                 sx, sy = _retire(alive, final, pool, s_head, q, x, y)

@@ -420,8 +420,8 @@ def test_a_step_beside_a_vanished_edge_stays_where_the_edge_beyond_runs_on_along
     kept edge 3 beyond it runs on along its line, the two stepping at vertex 3 along their normal. The step
     stays: edge 1's moved line meets it, 0.44 m from vertex 3, as PRT's (measured through PyPRT: massing's
     first tier on this lot, edges 1 and 2 set back 4 m, 124.485 m^2 left; the step going with the edge, the
-    moved line met edge 3's line behind the vertex and left 127.456 m^2; massing.near_degenerate.43838's
-    second tier)."""
+    moved line met edge 3's line behind the vertex and left 127.456 m^2; PRT's the same with edge 3 turned
+    by 4 or 8 degrees either way; massing.near_degenerate.43838's second tier)."""
     face = shapely.Polygon([(0, 10.048), (4, 10.048), (4, 0), (8.263, 3.193), (15.042, 8.274), (15.018, 8.329),
                             (8.966, 16.562), (5.499, 21.275), (0, 16.373)])
     _, (remainder,) = setback([face], [0, 4, 4, 0, 0, 0, 0, 0, 0])
@@ -429,6 +429,11 @@ def test_a_step_beside_a_vanished_edge_stays_where_the_edge_beyond_runs_on_along
     corner = (8, 3.193 + 0.263 * 0.8 / 0.6)  # edge 1's moved line x = 8 on the step, the normal (-0.6, 0.8)
     assert shapely.distance(shapely.Point(corner), remainder.exterior) < 1e-3
     assert shapely.Point(8.263, 3.193).distance(remainder.exterior) < 1e-9  # vertex 3 kept
+    # mirrored, the step comes before the vanished edge: PRT's tier 124.484 m^2 (measured the same way)
+    mirrored = shapely.Polygon([(10.048, 0), (16.373, 0), (21.275, 5.499), (16.562, 8.966), (8.329, 15.018),
+                                (8.274, 15.042), (3.193, 8.263), (0, 4), (10.048, 4)])
+    _, (remainder,) = setback([mirrored], [0, 0, 0, 0, 0, 0, 4, 4, 0])
+    assert abs(shapely.area(remainder) - 124.484) < 2e-3
 
 
 def test_swept_strips_that_pass_an_event_point_twice_are_all_united():
