@@ -179,7 +179,7 @@ def _swept(polygons: np.ndarray, edges: Edges, d, corner, ends, owner, swept, st
     faces = np.flatnonzero(swept)
     rows = np.flatnonzero(swept[edges.poly] & ~edges.hole)  # (their outer rings, one after the other)
     ring_offsets = offsets_from_counts(np.bincount(edges.poly[rows], minlength=m)[faces])
-    coords, offsets, collapsed, followed, left, left_ring, left_kept = swept_strips(
+    coords, offsets, collapsed, followed, overtook, left, left_ring, left_kept = swept_strips(
         edges.start[rows], edges.end[rows], edges.inward[rows], d[rows], corner[rows], ends[rows], ring_offsets,
         np.cos(np.radians(_STEP_TURN)))
     scale = max(float(np.abs(edges.start[rows]).max(initial=1.0)), 1.0)
@@ -208,8 +208,10 @@ def _swept(polygons: np.ndarray, edges: Edges, d, corner, ends, owner, swept, st
     # a front that crosses itself inside its face only where a moved line passed kept ones (a reflex corner
     # of kept edges, where the moved line parts the face: a split event) is followed, its strips clipped
     # to the face making the pieces, as PRT's tier on massing's concave.43897 (an edge set back 4 m past
-    # a reflex corner of kept edges, 2.8 m beyond it: PRT keeps the two pieces beyond the moved line)
-    passed = crossed & ~out
+    # a reflex corner of kept edges, 2.8 m beyond it: PRT keeps the two pieces beyond the moved line);
+    # not one where a moved line overtook a kept edge with its normal and swept on past it (the wall of
+    # massing's H.43552, a 0.77 m stem that PRT's second tier keeps)
+    passed = crossed & ~out & ~overtook
     passed[passed] = ~_moved_lines_cross(left, left_ring, left_kept, passed)[passed]
     trusted = np.zeros(m, dtype=bool)
     trusted[faces] = turned | (followed & ~out & (~crossed | passed))

@@ -98,8 +98,9 @@ def _ring_strips(start, end, inward, d, corner, ends, out, out_n, left, left_kep
     vertex count in ``out_n`` (n,) (0 for an edge that does not move), and the wavefront's vertices at
     the end to ``left`` (2 n, 2), two per line (its segment's ends), and to ``left_kept`` whether that line
     stays where it is (a kept edge, a step made at an event); returns whether the wavefront fell below three lines (nothing is left),
-    how many vertices it ended with, and whether it met no split event (two parallel lines apart
-    becoming neighbours)."""
+    how many vertices it ended with, whether it met no split event (two parallel lines apart
+    becoming neighbours), and whether a moved line overtook a kept one (a kept edge went where a moved
+    line with its normal reached it)."""
     n = len(d)
     m_cap = 6 * n + 4  # the edges, a step at each vertex, and one at each of at most 2 m events
     nx, ny, c, w = np.empty(m_cap), np.empty(m_cap), np.empty(m_cap), np.empty(m_cap)
@@ -152,6 +153,7 @@ def _ring_strips(start, end, inward, d, corner, ends, out, out_n, left, left_kep
     now = 0.0
     collapsed = False
     trusted = True
+    overtook = False
     for _ in range(2 * m):
         best, best_t = -1, np.inf
         for e in range(m):
@@ -239,6 +241,7 @@ def _ring_strips(start, end, inward, d, corner, ends, out, out_n, left, left_kep
                 break
             if same:
                 gone_p, gone_q = w[p] <= w[q] + _EPS, w[q] <= w[p] + _EPS
+                overtook |= (w[p] <= _EPS) != (w[q] <= _EPS)
             else:
                 ax, ay, oka = _meet(nx, ny, c, w, prv[p], p, now)
                 bx, by, okb = _meet(nx, ny, c, w, q, nxt[q], now)
@@ -319,7 +322,7 @@ def _ring_strips(start, end, inward, d, corner, ends, out, out_n, left, left_kep
             out[j] = pool[back[b]]
             j += 1
         out_n[k] = j - first
-    return collapsed, n_left, trusted
+    return collapsed, n_left, trusted, overtook
 
 
 @njit(cache=True, nogil=True)
@@ -332,7 +335,8 @@ def swept_strips(start, end, inward, d, corner, ends, ring_offsets, step_cos):
     vertex (``geometry.setback._mitres``); step_cos: the cosine of the turn under which neighbours moved
     by different distances that meet after an event step there. Returns the strips as ragged rings:
     coords (V, 2) and offsets (E+1,) (an edge that does not move has none); (R,) bool whether nothing is left of the
-    ring's face; (R,) bool whether its wavefront met no split event it cannot follow; and the
+    ring's face; (R,) bool whether its wavefront met no split event it cannot follow; (R,) bool whether a
+    moved line overtook a kept one (``_ring_strips``); and the
     wavefront's vertices at the end (W, 2), two per line, with their ring (W,) and whether their line
     stays where it is (W,) (where they lie outside the face, or moved lines cross, a split event was
     missed: the strips are not to be trusted either).
@@ -343,6 +347,7 @@ def swept_strips(start, end, inward, d, corner, ends, ring_offsets, step_cos):
     counts = np.zeros(n_edges, np.int64)
     collapsed = np.zeros(n_rings, np.bool_)
     trusted = np.zeros(n_rings, np.bool_)
+    overtook = np.zeros(n_rings, np.bool_)
     left = np.empty((4 * n_edges, 2))
     left_ring = np.empty(4 * n_edges, np.int64)
     left_kept = np.empty(4 * n_edges, np.bool_)
@@ -350,7 +355,7 @@ def swept_strips(start, end, inward, d, corner, ends, ring_offsets, step_cos):
     used = 0
     for r in range(n_rings):
         a, b = ring_offsets[r], ring_offsets[r + 1]
-        collapsed[r], k, trusted[r] = _ring_strips(start[a:b], end[a:b], inward[a:b], d[a:b], corner[a:b],
+        collapsed[r], k, trusted[r], overtook[r] = _ring_strips(start[a:b], end[a:b], inward[a:b], d[a:b], corner[a:b],
                                                    ends[a:b], coords[used:], counts[a:b], left[n_left:],
                                                    left_kept[n_left:], step_cos)
         left_ring[n_left:n_left + k] = r
@@ -359,4 +364,5 @@ def swept_strips(start, end, inward, d, corner, ends, ring_offsets, step_cos):
     offsets = np.zeros(n_edges + 1, np.int64)
     for k in range(n_edges):
         offsets[k + 1] = offsets[k] + counts[k]
-    return coords[:used], offsets, collapsed, trusted, left[:n_left], left_ring[:n_left], left_kept[:n_left]
+    return (coords[:used], offsets, collapsed, trusted, overtook, left[:n_left], left_ring[:n_left],
+            left_kept[:n_left])

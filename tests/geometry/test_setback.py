@@ -450,3 +450,16 @@ def test_swept_strips_that_pass_an_event_point_twice_are_all_united():
     (strips,), (remainder,) = setback([face], [front, side, side, side, 0, side, side])
     assert abs(shapely.area(strips[0]) + shapely.area(remainder) - face.area) < 1e-6
     assert abs(shapely.area(remainder) - 25.388) < 1e-3
+
+
+def test_a_moved_line_that_overtakes_a_kept_wall_keeps_the_folded_strips():
+    """massing's H.43552, its second tier: the bottom of an H whose 0.77 m stem runs up to its top bar; edge
+    0, set back 3 m, reaches the stem's left wall (kept, with its normal) and the wavefront let the wall go
+    and swept the stem, its front crossing only kept edges; PRT's second tier keeps the stem (its third
+    tier's section 120.685 m^2: the top bar and the stem), so such a front is not followed."""
+    x0, x1, x2, x3, x4 = 3.000000000000001, 5.1939952520000015, 5.959649959000002, 8.153645211000004, 11.153645211000004
+    y1, y2, y3, y4 = 6.557037155999998, 9.557037156000002, 27.95971428200001, 37.51675143800001
+    face = shapely.Polygon([(x0, y2), (x0, 0), (x3, 0), (x3, y1), (x2, y1), (x2, y2), (x2, y3), (x4, y3), (x4, y4),
+                            (0, y4), (0, y3), (x1, y3), (x1, y2)])
+    _, (remainder,) = setback([face], [3, 3, 3, 3] + [0] * 9)
+    assert abs(shapely.area(remainder) - 120.685) < 2e-3
