@@ -344,12 +344,16 @@ def ring_starts(coords, ring_offsets, part_offsets, part_source, part_with_start
             if r == part_offsets[p] and part_inset[p]:
                 # where the first outer edge left, counting from the last, ends: vertex 0's mitre when the
                 # last edge and edge 0 are left; the end of the last edge's run nearest vertex 0 of all
-                # the inset's pieces (``_last_edge_ends``) counts as the last one's end
+                # the inset's pieces (``_last_edge_ends``) counts as the last one's end. Of an edge that a
+                # grown hole parts in runs, the end of its last run counts: the edge's own end (PRT on a lot
+                # whose last edge a hole takes and another parts edge 0: the inset starts at edge 0's end,
+                # its mitre with edge 1, not where the first run ends at the hole; massing's holes.43599)
                 rank = np.full(n, np.inf)
                 for j in range(n):
                     incoming = moved_from[r0 + (j - 1) % n]
                     if incoming < outer and moved_from[r0 + j] != incoming:  # (the end of a run along it)
-                        rank[j] = incoming + 1
+                        # (how far along the edge its last segment starts, in [0, 1], orders its runs)
+                        rank[j] = incoming + 1 - 0.5 * ties[r0 + (j - 1) % n]
                         if incoming == outer - 1 and last_end[g] == r0 + j:
                             rank[j] = 0
                 if np.isfinite(rank).any():
@@ -387,11 +391,11 @@ def _at_vertex_0(best, corner, along, outer):
     for j in range(n):
         if corner[j] == 0 and along[j] == outer - 1:
             return j
-    # (the run before the step lies along the last edge, or along edge 0's line where the two are one line,
-    # and starts where a strip ends on it: one from the last edge's kept start is not where PRT starts,
-    # massing.near_degenerate.43572's 1 m last edge)
+    # (the run before the step lies along the last edge, or along edge 0's line where the two are one line;
+    # also where it is kept whole from a kept corner: PRT's second tiers on a lot whose 4 m last edge runs
+    # from a kept corner on edge 0's line, and on massing.near_degenerate.43838's 6.3 m one)
     previous = (best - 1) % n
-    if corner[best] == 0 and along[best] < 0 and corner[previous] < 0 and (
+    if corner[best] == 0 and along[best] < 0 and (
             along[previous] == outer - 1 or along[previous] == 0):
         return previous
     return best
@@ -406,7 +410,7 @@ def _after_steps(keys, moved_from, moved_in, r0, r1, outer):
     stepping at 5 degrees). A moved last edge of the ``outer`` ring (``moved_in``) that steps to edge 0
     counts, with its step, after the last: the remainder starts at edge 0 (measured through PyPRT: a last
     edge moved 4 m stepping to a kept edge 0 at 12 degrees); a kept last edge's run before a moved edge 0's
-    step stays where it is (``_at_vertex_0``: near_degenerate.43572). ``keys`` (V,) turned in place for
+    step stays where it is (``_at_vertex_0``: near_degenerate.43838). ``keys`` (V,) turned in place for
     the ring ``r0:r1``."""
     n = r1 - r0
     for j in range(r0, r1):

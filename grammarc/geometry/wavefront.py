@@ -65,6 +65,21 @@ def _retire(alive, final, pool, s_head, e, x, y):
 
 
 @njit(cache=True, nogil=True)
+def _past_step(nx, ny, c, w, ux, uy, pool, s_head, step, a, b, t, sign):
+    """Whether lines a and b, the neighbours a step (a line, ``step``) lies between once an edge beside it
+    vanished, meet at time t on the far line's side of the step's vertex (where the step's path starts):
+    past it along b (``sign`` 1, b the line beyond the step) or before it along a (``sign`` -1). Lines
+    that do not meet, and a far line that moves, count as meeting there (only steps to kept edges were
+    measured staying: those between moved edges go with the edge, as before)."""
+    far = b if sign > 0 else a
+    x, y, ok = _meet(nx, ny, c, w, a, b, t)
+    if not ok or w[far] > _EPS:
+        return True
+    k = s_head[step]
+    return sign * ((x - pool[k, 0]) * ux[far] + (y - pool[k, 1]) * uy[far]) >= -_EPS
+
+
+@njit(cache=True, nogil=True)
 def _push(pool, link, used, head, tail, e, x, y):
     """Append (x, y) to line e's path (a linked list in ``pool``); returns the pool's new size."""
     pool[used, 0], pool[used, 1] = x, y
@@ -78,12 +93,14 @@ def _push(pool, link, used, head, tail, e, x, y):
 
 
 @njit(cache=True, nogil=True)
-def _ring_strips(start, end, inward, d, corner, ends, out, out_n, left, step_cos):
+def _ring_strips(start, end, inward, d, corner, ends, out, out_n, left, left_kept, step_cos):
     """The swept strip of each edge of one ring (n edges), written one after another to ``out`` with its
     vertex count in ``out_n`` (n,) (0 for an edge that does not move), and the wavefront's vertices at
-    the end to ``left`` (2 n, 2); returns whether the wavefront fell below three lines (nothing is left),
-    how many vertices it ended with, and whether it met no split event (two parallel lines apart
-    becoming neighbours)."""
+    the end to ``left`` (2 n, 2), two per line (its segment's ends), and to ``left_kept`` whether that line
+    stays where it is (a kept edge, a step made at an event); returns whether the wavefront fell below three lines (nothing is left),
+    how many vertices it ended with, whether it met no split event (two parallel lines apart
+    becoming neighbours), and whether a moved line overtook a kept one (a kept edge went where a moved
+    line with its normal reached it)."""
     n = len(d)
     m_cap = 6 * n + 4  # the edges, a step at each vertex, and one at each of at most 2 m events
     nx, ny, c, w = np.empty(m_cap), np.empty(m_cap), np.empty(m_cap), np.empty(m_cap)
@@ -136,6 +153,7 @@ def _ring_strips(start, end, inward, d, corner, ends, out, out_n, left, step_cos
     now = 0.0
     collapsed = False
     trusted = True
+    overtook = False
     for _ in range(2 * m):
         best, best_t = -1, np.inf
         for e in range(m):
@@ -163,13 +181,19 @@ def _ring_strips(start, end, inward, d, corner, ends, out, out_n, left, step_cos
         if real[best] >= 0:
             # the steps at a vanished edge's ends go with it: its neighbours meet as they would have without
             # it, their strips reaching across its step's vertex (PRT's on massing.far.33391, where a short
-            # edge moved 4 m between a moved and a kept edge turned by 13 degrees)
-            if real[q] < 0 and count > 3:
+            # edge moved 4 m between a moved and a kept edge turned by 13 degrees), where they meet on the
+            # far side's line past the step's vertex; where they would meet behind it (the kept edge beyond
+            # the step runs on along the vanished edge's line, or turns from it by up to 8 degrees either
+            # way), the step stays and the neighbour meets it (PRT's tiers on a lot whose edge set back 4 m
+            # vanishes beside such a kept edge, after it and, mirrored, before it:
+            # massing.near_degenerate.43838's second tier)
+            if real[q] < 0 and count > 3 and _past_step(nx, ny, c, w, ux, uy, pool, s_head, q, p, nxt[q], now, 1.0):
                 sx, sy = _retire(alive, final, pool, s_head, q, x, y)
                 count -= 1
                 used = _push(pool, link, used, e_head, e_tail, p, sx, sy)
                 q = nxt[q]
-            if real[p] < 0 and count > 3:
+            if real[p] < 0 and count > 3 and _past_step(nx, ny, c, w, ux, uy, pool, s_head, p, prv[p], q, now,
+                                                        -1.0):
                 sx, sy = _retire(alive, final, pool, s_head, p, x, y)
                 count -= 1
                 used = _push(pool, link, used, s_head, s_tail, q, sx, sy)
@@ -217,6 +241,7 @@ def _ring_strips(start, end, inward, d, corner, ends, out, out_n, left, step_cos
                 break
             if same:
                 gone_p, gone_q = w[p] <= w[q] + _EPS, w[q] <= w[p] + _EPS
+                overtook |= (w[p] <= _EPS) != (w[q] <= _EPS)
             else:
                 ax, ay, oka = _meet(nx, ny, c, w, prv[p], p, now)
                 bx, by, okb = _meet(nx, ny, c, w, q, nxt[q], now)
@@ -261,6 +286,7 @@ def _ring_strips(start, end, inward, d, corner, ends, out, out_n, left, step_cos
         e = first
         while first < m:  # (in the ring's order: a step made at an event comes after the lines before it)
             left[n_left], left[n_left + 1] = final[e, 0], final[e, 1]
+            left_kept[n_left] = left_kept[n_left + 1] = w[e] <= _EPS
             n_left += 2
             e = nxt[e]
             if e == first:
@@ -296,7 +322,7 @@ def _ring_strips(start, end, inward, d, corner, ends, out, out_n, left, step_cos
             out[j] = pool[back[b]]
             j += 1
         out_n[k] = j - first
-    return collapsed, n_left, trusted
+    return collapsed, n_left, trusted, overtook
 
 
 @njit(cache=True, nogil=True)
@@ -309,9 +335,11 @@ def swept_strips(start, end, inward, d, corner, ends, ring_offsets, step_cos):
     vertex (``geometry.setback._mitres``); step_cos: the cosine of the turn under which neighbours moved
     by different distances that meet after an event step there. Returns the strips as ragged rings:
     coords (V, 2) and offsets (E+1,) (an edge that does not move has none); (R,) bool whether nothing is left of the
-    ring's face; (R,) bool whether its wavefront met no split event it cannot follow; and the
-    wavefront's vertices at the end (W, 2) with their ring (W,) (where they lie outside the face, a split
-    event was missed: the strips are not to be trusted either).
+    ring's face; (R,) bool whether its wavefront met no split event it cannot follow; (R,) bool whether a
+    moved line overtook a kept one (``_ring_strips``); and the
+    wavefront's vertices at the end (W, 2), two per line, with their ring (W,) and whether their line
+    stays where it is (W,) (where they lie outside the face, or moved lines cross, a split event was
+    missed: the strips are not to be trusted either).
     """
     n_edges = len(d)
     n_rings = len(ring_offsets) - 1
@@ -319,19 +347,22 @@ def swept_strips(start, end, inward, d, corner, ends, ring_offsets, step_cos):
     counts = np.zeros(n_edges, np.int64)
     collapsed = np.zeros(n_rings, np.bool_)
     trusted = np.zeros(n_rings, np.bool_)
+    overtook = np.zeros(n_rings, np.bool_)
     left = np.empty((4 * n_edges, 2))
     left_ring = np.empty(4 * n_edges, np.int64)
+    left_kept = np.empty(4 * n_edges, np.bool_)
     n_left = 0
     used = 0
     for r in range(n_rings):
         a, b = ring_offsets[r], ring_offsets[r + 1]
-        collapsed[r], k, trusted[r] = _ring_strips(start[a:b], end[a:b], inward[a:b], d[a:b], corner[a:b],
+        collapsed[r], k, trusted[r], overtook[r] = _ring_strips(start[a:b], end[a:b], inward[a:b], d[a:b], corner[a:b],
                                                    ends[a:b], coords[used:], counts[a:b], left[n_left:],
-                                                   step_cos)
+                                                   left_kept[n_left:], step_cos)
         left_ring[n_left:n_left + k] = r
         n_left += k
         used += counts[a:b].sum()
     offsets = np.zeros(n_edges + 1, np.int64)
     for k in range(n_edges):
         offsets[k + 1] = offsets[k] + counts[k]
-    return coords[:used], offsets, collapsed, trusted, left[:n_left], left_ring[:n_left]
+    return (coords[:used], offsets, collapsed, trusted, overtook, left[:n_left], left_ring[:n_left],
+            left_kept[:n_left])

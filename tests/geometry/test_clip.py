@@ -149,6 +149,26 @@ def test_an_inset_whose_hole_cuts_the_last_edge_off_starts_at_its_end():
                                [[3, -13], [13, -13]])
 
 
+def test_an_inset_without_the_last_edge_starts_at_the_end_of_edge_0s_last_run():
+    """A hole grown by the offset takes the last edge (and vertex 0), another parts edge 0 in two runs: the
+    inset starts where edge 0 itself ends, at its last run's mitre with edge 1, not where its first run
+    ends at the hole (measured through PyPRT on massing: a 60 x 40 m lot, holes 10 x 34 m beside its last
+    edge and 10 x 7 m beside edge 0, offset 5 m, its first tier setting back edge 0 by 8 m: PRT's moved
+    the inset of edge 1; massing's holes.43599, whose split footprint's edges follow that start)."""
+    import shapely
+
+    from grammarc.geometry.clip import fit_pieces
+
+    # clockwise in (x, z), as the lots' footprints are; edge 0 along z = 0, the last edge along x = 0
+    lot = shapely.Polygon([(0, 0), (60, 0), (60, -40), (0, -40)],
+                          [[(2, -3), (2, -37), (12, -37), (12, -3)], [(30, -2), (30, -9), (40, -9), (40, -2)]])
+    inset = shapely.buffer(lot, -5, join_style="mitre")  # edge 0's runs: x 17 to 25 and 45 to 55
+    pieces = fit_pieces(np.array([inset]), np.array([1]), np.array([[60.0, 0.0, 40.0]]), np.array([lot]),
+                        insets=np.array([True]))
+    np.testing.assert_allclose(pieces.coords[:2] * pieces.extent[0, [0, 2]] + pieces.low[0, [0, 2]],
+                               [[55, -5], [55, -35]])
+
+
 def test_inset_pieces_of_a_hole_across_the_lot_start_at_their_first_edges_end():
     """A hole grown across the inset parts it in two; a run along the last edge ends at the hole in both,
     but only the one nearest vertex 0 (its mitre, in the lower piece) counts from the last: the upper
@@ -423,15 +443,15 @@ def test_cut_edges_of_a_piece_the_cut_takes_through_a_hole_turn_their_faces():
     ([(10, -5), (20, -5), (20, -30), (0, -30), (0, 0), (10, 0)],
      [(4, 0), (10, 0), (10, -5), (10, -9), (20, -9), (20, -26), (4, -26)], (10, -5)),
     # the first lot's edge 0 stepping back from a last edge kept whole, from a kept corner: PRT starts the
-    # remainder at vertex 0 (massing.near_degenerate.43572's second tier, its 1 m last edge 0.02 degrees
-    # off edge 0's line; was: at the last edge's start, 1.4 % of the area off)
+    # remainder at the run along the last edge too (this lot's second tier setting back its edge 0 by 2 m:
+    # PRT's moved the run from (6, 0), 204 m^2 left, where the step's would leave 206.667;
+    # massing.near_degenerate.43838's second tier, a 6.3 m last edge on edge 0's line)
     ([(10, 0), (20, 0), (20, -20), (0, -20), (0, -4), (6, 0)],
-     [(6, 0), (10, 0), (10, -4), (20, -4), (20, -20), (0, -20), (0, -4)], (10, 0)),
+     [(6, 0), (10, 0), (10, -4), (20, -4), (20, -20), (0, -20), (0, -4)], (6, 0)),
 ])
 def test_a_remainder_that_keeps_vertex_0_starts_where_prt_starts_it(lot, remainder, first):
     """massing's tiers (4;0;4;4;0) on these lots, PRT's second tier's edge 0 measured through PyPRT (a
-    setback of edge 0 alone); the same on 19 of 19 real lots of Seoul, Bergen, Tartu and Yaroslavl; the
-    third reduced from a random lot's."""
+    setback of edge 0 alone); the same on 19 of 19 real lots of Seoul, Bergen, Tartu and Yaroslavl."""
     import shapely
 
     from grammarc.geometry.clip import fit_pieces

@@ -395,3 +395,71 @@ def test_seams_go_from_regions_that_also_hold_lines():
     region = shapely.GeometryCollection([seamed, shapely.LineString([(10, 4), (12, 6)])])
     out = _without_seams(np.array([region]), np.array([polygon]))
     assert len(shapely.get_coordinates(out[0])) == 5
+
+
+
+def test_a_swept_front_past_a_reflex_corner_of_kept_edges_parts_the_remainder():
+    """A face swept as a wavefront (a 0.57 m edge set back 4 m folds) whose moved bottom line passes a
+    reflex corner of kept edges 1 m above the bottom: the front crosses the kept edges there (a split
+    event), and the strips, clipped to the face, leave the remainder in two pieces beyond the moved line,
+    as PRT's (measured through PyPRT: massing's first tier on this lot, edges 0 and 1 set back 4 m: the
+    tier above is these two pieces, 251.187 m^2; the folded quads' strips, kept before, left 266.855 m^2;
+    massing.concave.43897)."""
+    face = shapely.Polygon([(0, 0), (20, 0), (19.6, 0.4), (22, 5), (18, 1), (14, 20), (0, 20)])
+    (strips,), (remainder,) = setback([face], [4, 4, 0, 0, 0, 0, 0])
+    # the moved line y = 4 meets edge 2 at x = 21.478 and crosses edges 3 and 4 at x = 21 and 17.368
+    expected = shapely.MultiPolygon([shapely.Polygon([(21, 4), (19.6 + 2.4 * 3.6 / 4.6, 4), (22, 5)]),
+                                     shapely.Polygon([(0, 4), (18 - 4 * 3 / 19, 4), (14, 20), (0, 20)])])
+    assert shapely.symmetric_difference(remainder, expected).area < 1e-9
+    assert abs(shapely.area(remainder) - 251.187) < 1e-3
+    assert abs(shapely.area(strips[0]) + shapely.area(remainder) - face.area) < 1e-6
+
+
+def test_a_step_beside_a_vanished_edge_stays_where_the_edge_beyond_runs_on_along_its_line():
+    """Edge 2, set back 4 m, folds (edge 1 beside it, at 53 degrees, is set back 4 m too) and vanishes; the
+    kept edge 3 beyond it runs on along its line, the two stepping at vertex 3 along their normal. The step
+    stays: edge 1's moved line meets it, 0.44 m from vertex 3, as PRT's (measured through PyPRT: massing's
+    first tier on this lot, edges 1 and 2 set back 4 m, 124.485 m^2 left; the step going with the edge, the
+    moved line met edge 3's line behind the vertex and left 127.456 m^2; PRT's the same with edge 3 turned
+    by 4 or 8 degrees either way; massing.near_degenerate.43838's second tier)."""
+    face = shapely.Polygon([(0, 10.048), (4, 10.048), (4, 0), (8.263, 3.193), (15.042, 8.274), (15.018, 8.329),
+                            (8.966, 16.562), (5.499, 21.275), (0, 16.373)])
+    _, (remainder,) = setback([face], [0, 4, 4, 0, 0, 0, 0, 0, 0])
+    assert abs(shapely.area(remainder) - 124.485) < 2e-3
+    corner = (8, 3.193 + 0.263 * 0.8 / 0.6)  # edge 1's moved line x = 8 on the step, the normal (-0.6, 0.8)
+    assert shapely.distance(shapely.Point(corner), remainder.exterior) < 1e-3
+    assert shapely.Point(8.263, 3.193).distance(remainder.exterior) < 1e-9  # vertex 3 kept
+    # mirrored, the step comes before the vanished edge: PRT's tier 124.484 m^2 (measured the same way)
+    mirrored = shapely.Polygon([(10.048, 0), (16.373, 0), (21.275, 5.499), (16.562, 8.966), (8.329, 15.018),
+                                (8.274, 15.042), (3.193, 8.263), (0, 4), (10.048, 4)])
+    _, (remainder,) = setback([mirrored], [0, 0, 0, 0, 0, 0, 4, 4, 0])
+    assert abs(shapely.area(remainder) - 124.484) < 2e-3
+
+
+def test_swept_strips_that_pass_an_event_point_twice_are_all_united():
+    """massing's far.43727: a shapeU (front 9.55 m, sides 9.83 m) whose kept back edge vanishes; the left
+    side's swept path passes the event point twice, and make_valid kept a part of 7.9e-31 m^2 there, beside
+    which GEOS's union dropped the whole 102.7 m^2 strip of the right side: a remainder of 128 m^2 where
+    PRT's shape covers all but the wavefront's 25.4 m^2 (PRT's model of the lot: 7006.03 m^2 of surface;
+    grammarc's, 6625.33 before, 7006.07 now)."""
+    face = shapely.Polygon([(11.130205291622756, 27.13265531797522), (25.729926220049986, 27.13265531797522),
+                            (27.938243971109266, 11.971738820353957), (25.814481463561258, 8.484919132278453),
+                            (21.050961559434274, 1.6795391770203134), (7.274977851225474, 0),
+                            (0, 12.034543888649004)])
+    front, side = 9.550694671927277, 9.83426187783046
+    (strips,), (remainder,) = setback([face], [front, side, side, side, 0, side, side])
+    assert abs(shapely.area(strips[0]) + shapely.area(remainder) - face.area) < 1e-6
+    assert abs(shapely.area(remainder) - 25.388) < 1e-3
+
+
+def test_a_moved_line_that_overtakes_a_kept_wall_keeps_the_folded_strips():
+    """massing's H.43552, its second tier: the bottom of an H whose 0.77 m stem runs up to its top bar; edge
+    0, set back 3 m, reaches the stem's left wall (kept, with its normal) and the wavefront let the wall go
+    and swept the stem, its front crossing only kept edges; PRT's second tier keeps the stem (its third
+    tier's section 120.685 m^2: the top bar and the stem), so such a front is not followed."""
+    x0, x1, x2, x3, x4 = 3.000000000000001, 5.1939952520000015, 5.959649959000002, 8.153645211000004, 11.153645211000004
+    y1, y2, y3, y4 = 6.557037155999998, 9.557037156000002, 27.95971428200001, 37.51675143800001
+    face = shapely.Polygon([(x0, y2), (x0, 0), (x3, 0), (x3, y1), (x2, y1), (x2, y2), (x2, y3), (x4, y3), (x4, y4),
+                            (0, y4), (0, y3), (x1, y3), (x1, y2)])
+    _, (remainder,) = setback([face], [3, 3, 3, 3] + [0] * 9)
+    assert abs(shapely.area(remainder) - 120.685) < 2e-3
