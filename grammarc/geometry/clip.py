@@ -430,17 +430,18 @@ def _runs_into_kept_vertices(keys, corner, along, moved_in, r0, r1, outer):
     """A setback's remainder that reaches a kept vertex i along edge i's own line, from a point before it
     (where the strip of a moved edge i - 1 that covers an arm ends on that line), counts that run just
     before vertex i: PRT starts its tier there where vertex i is the first it keeps (measured through
-    PyPRT: a 10 x 10 m block with a 1 m arm whose side, edge 1, is set back 3 m, the arm's strip ending on
-    the kept edge 2's line, square or turned 12.5 degrees; massing's holes.43991 and 50445, whose first tiers
-    lose such an arm). Before vertex 0 the run counts after the last edge, and the remainder starts at
-    vertex 0 (measured likewise, the arm's side being the last edge). ``corner``, ``along`` (V,): the
-    parent vertex each vertex lies at and the parent edge its outgoing edge runs along (-1 for none);
+    PyPRT: a 10 x 10 m block with a 1 m arm whose side, edge 1 or 2, is set back 3 m, the arm's strip ending
+    on the next, kept, edge's line, square or turned 12.5 degrees; massing's holes.43991 and 50445, whose
+    first tiers lose such an arm past edge 3). Not so after edge 0 nor the last edge: where the arm's side
+    is edge 0 the remainder starts at vertex 1 (measured likewise; massing's U.43550, a shapeO frame whose
+    0.27 m arm edge 0's strip takes), where it is the last edge, at vertex 0. ``corner``, ``along`` (V,):
+    the parent vertex each vertex lies at and the parent edge its outgoing edge runs along (-1 for none);
     ``keys`` (V,) turned in place for the ring ``r0:r1`` of a parent with ``outer`` outer edges."""
     n = r1 - r0
     for j in range(r0, r1):
         i = along[j]
-        if corner[j] < 0 and not moved_in[j] and 0 <= i < outer and corner[r0 + (j - r0 + 1) % n] == i:
-            keys[j] = (i - 0.5) % outer
+        if corner[j] < 0 and not moved_in[j] and 2 <= i < outer and corner[r0 + (j - r0 + 1) % n] == i:
+            keys[j] = i - 0.5
 
 
 @njit(cache=True, nogil=True)

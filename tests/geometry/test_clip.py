@@ -406,15 +406,19 @@ def test_a_remainder_whose_edge_0_steps_from_a_last_edge_kept_whole_starts_at_th
     # a 10 x 10 m block with a 1 m arm whose side, edge 1, is set back 3 m: the strip takes the arm and ends
     # on the kept edge 2's line, and PRT starts the remainder where that line leaves the boundary, 1 m before
     # vertex 2, the first vertex it keeps (measured through PyPRT: massing's second tier's edge 0, set back
-    # alone, is that 1 m run; so with edge 2 turned 12.5 degrees; holes.43991, 50445)
+    # alone, is that 1 m run; so with edge 2 turned 12.5 degrees, and with the arm's side edge 2 after a
+    # tip of two edges; holes.43991, 50445)
     ([(-20, 10), (-20, 9), (0, 9), (0, 0), (10, 0), (10, 10)], [0, 3, 0, 0, 0, 0], (0, 10)),
     ([(-20, 10), (-20, 9), (0, 9), (2, 0), (10, 0), (10, 10)], [0, 3, 0, 0, 0, 0], (round(-2 / 9, 9), 10)),
-    # the arm's side the last edge, the kept vertex 0 after it: PRT starts the remainder at vertex 0 (measured)
+    ([(-20, 11), (-20, 10), (-20, 9), (0, 9), (0, 0), (10, 0), (10, 10)], [0, 0, 3, 0, 0, 0, 0], (0, round(31 / 3, 9))),
+    # the arm's side edge 0 or the last edge: PRT starts the remainder at vertex 1 or 0 (measured; U.43550)
+    ([(-20, 9), (0, 9), (0, 0), (10, 0), (10, 10), (-20, 10)], [3, 0, 0, 0, 0, 0], (0, 9)),
     ([(0, 9), (0, 0), (10, 0), (10, 10), (-20, 10), (-20, 9)], [0, 0, 0, 0, 0, 3], (0, 9)),
 ])
 def test_a_remainder_that_reaches_its_first_kept_vertex_along_its_edge_starts_at_that_run(ring, distances, first):
     """The strip of a moved edge that covers an arm ends on the next, kept, edge's line; the remainder
-    reaches that edge's vertex along the line, from the boundary: PRT counts the run before the vertex."""
+    reaches that edge's vertex along the line, from the boundary: PRT counts the run before the vertex,
+    but for the vertex after edge 0 or the last edge."""
     assert set(_remainder_starts(ring, distances)) == {first}
 
 
