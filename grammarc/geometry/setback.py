@@ -119,13 +119,17 @@ def setback_regions(polygons: np.ndarray, edges: Edges, distance: np.ndarray, ow
     tangent = edges.end - edges.start
     span = np.einsum("ij,ij->i", tangent + end_corner - corner, tangent)
     # (where the boundary runs on past it turned by less than ``_RUN_ON_TURN``: 1 degree on 34258, 20 on
-    # concave.46141, or turns away from the face, at a reflex vertex: PRT's tier on a block whose kept 1.1 m
-    # foot of a bump the bump's side set back 2 or 4 m passes, measured through PyPRT, and on
-    # massing.concave.50953; past a convex corner, the moved line stops at the kept edge's line, as PRT's
-    # tier on the real lot massing.hiroshima.111, whose shapeL arm it keeps: 4.71 m^2)
+    # concave.46141, or turns away from the face, at a reflex vertex, and runs on back the way the moved line
+    # goes: PRT's tier on a block whose kept 1.1 m foot of a bump the bump's side set back 2 or 4 m passes,
+    # measured through PyPRT, and on massing.concave.50953, not on far.51343, whose boundary runs away; past
+    # a convex corner, the moved line stops at the kept edge's line, as PRT's tier on the real lot
+    # massing.hiroshima.111, whose shapeL arm it keeps: 4.71 m^2)
     other = np.where(moved[edges.prev], edges.next, edges.prev)
-    reflex_end = np.where(moved[edges.prev], np.einsum("ij,ij->i", tangent[edges.next], edges.inward),
-                          np.einsum("ij,ij->i", tangent, edges.inward[edges.prev])) < 0
+    mover = np.where(moved[edges.prev], edges.prev, edges.next)
+    beyond = np.where(moved[edges.prev][:, None], tangent[edges.next], -tangent[edges.prev])  # (from that end)
+    reflex_end = (np.where(moved[edges.prev], np.einsum("ij,ij->i", tangent[edges.next], edges.inward),
+                           np.einsum("ij,ij->i", tangent, edges.inward[edges.prev])) < 0) & (
+        np.einsum("ij,ij->i", beyond, edges.inward[mover]) > 0)
     turned_over = ~moved & ~edges.hole & (moved[edges.prev] | moved[edges.next]) & (
         span < -TOL.zero * np.einsum("ij,ij->i", tangent, tangent)) & (
         moved[other] | reflex_end | (_cosines(tangent, tangent[other]) > np.cos(np.radians(_RUN_ON_TURN))))

@@ -416,10 +416,15 @@ def _tip(length, turn):
     # (the wavefront with the mitre kept, 0.600 m^2)
     (_tip(2, 25), [3], 2.063), (_tip(2, 25), [3, 1], 8.246),
     # a bump's side (edge 2) set back 4 or 2 m passes the far end of the bump's kept foot (edge 1), a reflex
-    # corner: the face is swept on into the block, as PRT's terrace (where the strip stopped at the foot's
-    # line, 73.600 and 36.851 m^2)
+    # corner past which the boundary runs back along the moved line's way: the face is swept on along the
+    # block's side, as PRT's terrace (where the strip stopped at the foot's line, 73.600 and 36.851 m^2)
     ([(19.76, 4.28), (20.28, 14.12), (21.36, 14.1), (12.0, 30.0), (5.0, 30.0), (5.0, 4.28)], [0, 0, 4], 83.672),
     ([(19.76, 4.28), (20.28, 14.12), (21.36, 14.1), (12.0, 30.0), (5.0, 30.0), (5.0, 4.28)], [0, 0, 2], 38.089),
+    # massing.far.51343's first tier (4;4;0;0;...): edge 1's moved line passes the far end of the kept 2.8 m
+    # edge 2, a reflex corner, but the boundary beyond runs away from the moved line: the strip stops at edge
+    # 2's line (PRT's terrace 78.016 m^2; swept on, 75.599)
+    ([(0, 0), (17.0335, 0), (14.9575, 7.1404), (12.2008, 7.1404), (12.3109, 8.2645), (4.4839, 10.6257),
+      (0.7815, 7.9778)], [4, 4], 78.107),
 ])
 def test_strips_fold_as_prt_steps_them_and_sweep_past_a_kept_edge_s_reflex_end(ring, d, terrace):
     face = np.array([shapely.Polygon(ring)])
