@@ -123,16 +123,18 @@ def setback_regions(polygons: np.ndarray, edges: Edges, distance: np.ndarray, ow
     # goes: PRT's tier on a block whose kept 1.1 m foot of a bump the bump's side set back 2 or 4 m passes,
     # measured through PyPRT, and on massing.concave.50953, not on far.51343, whose boundary runs away; past
     # a convex corner, the moved line stops at the kept edge's line, as PRT's tier on the real lot
-    # massing.hiroshima.111, whose shapeL arm it keeps: 4.71 m^2)
+    # massing.hiroshima.111, whose shapeL arm it keeps: 4.71 m^2; nor does a kept edge between two moved
+    # ones start it, whose moved lines cross its line the other way round: massing.concave.50323's first
+    # tier, PRT's terrace the union of the strips)
     other = np.where(moved[edges.prev], edges.next, edges.prev)
     mover = np.where(moved[edges.prev], edges.prev, edges.next)
     beyond = np.where(moved[edges.prev][:, None], tangent[edges.next], -tangent[edges.prev])  # (from that end)
     reflex_end = (np.where(moved[edges.prev], np.einsum("ij,ij->i", tangent[edges.next], edges.inward),
                            np.einsum("ij,ij->i", tangent, edges.inward[edges.prev])) < 0) & (
         np.einsum("ij,ij->i", beyond, edges.inward[mover]) > 0)
-    turned_over = ~moved & ~edges.hole & (moved[edges.prev] | moved[edges.next]) & (
+    turned_over = ~moved & ~edges.hole & (moved[edges.prev] != moved[edges.next]) & (
         span < -TOL.zero * np.einsum("ij,ij->i", tangent, tangent)) & (
-        moved[other] | reflex_end | (_cosines(tangent, tangent[other]) > np.cos(np.radians(_RUN_ON_TURN))))
+        reflex_end | (_cosines(tangent, tangent[other]) > np.cos(np.radians(_RUN_ON_TURN))))
     swept[edges.poly[turned_over]] = True
     strips = _reflex_strips(edges, swept, strips, idx, quads, stepped, stepped_strips)
     if swept.any():

@@ -398,6 +398,11 @@ def test_seams_go_from_regions_that_also_hold_lines():
     assert len(shapely.get_coordinates(out[0])) == 5
 
 
+CONCAVE_50323 = [(12.785058, 9.557631), (12.785058, 11.271266), (8.331864, 15.807824), (6.356168, 15.367785),
+                 (3.749396, 15.591084), (4.952566, 8.467218), (0, 8.895165), (0.839205, 3.781472),
+                 (6.469083, 0.317521), (9.801663, 0), (10.418725, 4.375636), (14.439722, 5.512751)]
+
+
 def _tip(length, turn):
     """A block whose edge 0, ``length`` m long, runs from an acute corner (40 degrees, its kept last edge the
     block's side) to a reflex vertex where edge 1 turns ``turn`` degrees away from the face."""
@@ -425,6 +430,11 @@ def _tip(length, turn):
     # 2's line (PRT's terrace 78.016 m^2; swept on, 75.599)
     ([(0, 0), (17.0335, 0), (14.9575, 7.1404), (12.2008, 7.1404), (12.3109, 8.2645), (4.4839, 10.6257),
       (0.7815, 7.9778)], [4, 4], 78.107),
+    # massing.concave.50323's first tier (a shapeO footprint, 3;0;3;3 and 3;0;3): the kept 6.4 m edge 1
+    # between edges 0 and 2, set back 3 m, turns over (their moved lines cross its line the other way round),
+    # but the face is not swept: PRT's terrace is the strips' union (measured through PyPRT; swept, 17.973
+    # and 1.831 m^2)
+    (CONCAVE_50323, [3, 0, 3, 3], 26.904), (CONCAVE_50323, [3, 0, 3], 19.527),
 ])
 def test_strips_fold_as_prt_steps_them_and_sweep_past_a_kept_edge_s_reflex_end(ring, d, terrace):
     face = np.array([shapely.Polygon(ring)])
