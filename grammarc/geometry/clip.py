@@ -322,6 +322,7 @@ def ring_starts(coords, ring_offsets, part_offsets, part_source, part_with_start
             if not cut and not part_inset[p]:
                 outer = parent_rings[parent_offsets[g] + 1] - parent_rings[parent_offsets[g]]
                 _after_steps(keys, moved_from, moved_in, r0, r1, outer)
+                _runs_into_kept_vertices(keys, corner, runs_along, moved_in, r0, r1, outer)
     last_end = _last_edge_ends(coords, ring_offsets, part_offsets, part_source, part_inset, moved_from,
                                parent_coords, parent_rings, parent_offsets)
     for p in range(len(part_offsets) - 1):
@@ -385,18 +386,23 @@ def _at_vertex_0(best, corner, along, outer):
     Where the kept last edge runs on past vertex 0 (a reflex vertex 0, edge 0's strip starting beside the
     last edge's line), the remainder starts at vertex 0 (measured through PyPRT on massing's second tiers
     over real lots: three of three); where edge 0's strip steps back to vertex 0 from the kept last edge
-    (turned by under 15 degrees, ``geometry.setback``), at the run along the last edge that ends at vertex
-    0, not at the step (sixteen of sixteen)."""
+    (turned by under 15 degrees, or under 45 at a reflex vertex 0, ``geometry.setback``), at the run along
+    the last edge that ends at vertex 0, not at the step (sixteen of sixteen), also where that run is the
+    last edge kept whole, from its kept start (measured through PyPRT: a 5 m last edge turned 10 or 14
+    degrees from edge 0 at a convex vertex 0, 10 to 44 degrees at a reflex one, six of six; massing's
+    concave.43155, 20.7 degrees reflex, and near_degenerate.50908, on edge 0's line)."""
     n = len(corner)
     for j in range(n):
         if corner[j] == 0 and along[j] == outer - 1:
             return j
     # (the run before the step lies along the last edge, or along edge 0's line where the two are one line;
-    # also where it is kept whole from a kept corner: PRT's second tiers on a lot whose 4 m last edge runs
-    # from a kept corner on edge 0's line, and on massing.near_degenerate.43838's 6.3 m one)
-    previous = (best - 1) % n
-    if corner[best] == 0 and along[best] < 0 and (
-            along[previous] == outer - 1 or along[previous] == 0):
+    # it starts where a strip ends on it or at the last edge's kept start alike: PRT's second tiers on a lot
+    # whose 4 m last edge runs from a kept corner on edge 0's line, and on massing.near_degenerate.43838's
+    # 6.3 m one); the step's end, where edge 0's moved copy starts, ties with vertex 0 (both count as edge
+    # 0's) and may come first in GEOS's ring
+    step = best if corner[best] == 0 or corner[(best - 1) % n] != 0 else (best - 1) % n
+    previous = (step - 1) % n
+    if corner[step] == 0 and along[step] < 0 and (along[previous] == outer - 1 or along[previous] == 0):
         return previous
     return best
 
@@ -423,6 +429,25 @@ def _after_steps(keys, moved_from, moved_in, r0, r1, outer):
         if np.isfinite(i) and keys[j] == i and not np.isfinite(moved_from[k]) and (
                 moved_from[m] == following or keys[m] == following):
             keys[j] = keys[k] = i + 1.5
+
+
+@njit(cache=True, nogil=True)
+def _runs_into_kept_vertices(keys, corner, along, moved_in, r0, r1, outer):
+    """A setback's remainder that reaches a kept vertex i along edge i's own line, from a point before it
+    (where the strip of a moved edge i - 1 that covers an arm ends on that line), counts that run just
+    before vertex i: PRT starts its tier there where vertex i is the first it keeps (measured through
+    PyPRT: a 10 x 10 m block with a 1 m arm whose side, edge 1 or 2, is set back 3 m, the arm's strip ending
+    on the next, kept, edge's line, square or turned 12.5 degrees; massing's holes.43991 and 50445, whose
+    first tiers lose such an arm past edge 3). Not so after edge 0 nor the last edge: where the arm's side
+    is edge 0 the remainder starts at vertex 1 (measured likewise; massing's U.43550, a shapeO frame whose
+    0.27 m arm edge 0's strip takes), where it is the last edge, at vertex 0. ``corner``, ``along`` (V,):
+    the parent vertex each vertex lies at and the parent edge its outgoing edge runs along (-1 for none);
+    ``keys`` (V,) turned in place for the ring ``r0:r1`` of a parent with ``outer`` outer edges."""
+    n = r1 - r0
+    for j in range(r0, r1):
+        i = along[j]
+        if corner[j] < 0 and not moved_in[j] and 2 <= i < outer and corner[r0 + (j - r0 + 1) % n] == i:
+            keys[j] = i - 0.5
 
 
 @njit(cache=True, nogil=True)

@@ -101,35 +101,51 @@ def setback_regions(polygons: np.ndarray, edges: Edges, distance: np.ndarray, ow
     m = len(polygons)
     # a distance that is not a number (``float("")`` of a missing list item) moves nothing
     d = _unfolded(edges, np.where((owner < n_owners) & np.isfinite(distance), np.maximum(distance, 0.0), 0.0))
-    # whether a face folds or is swept is decided on the strips that step at convex vertices alone, as
-    # PRT's are swept (``_reflex_strips``)
+    # the strips mitred at reflex vertices (``quads``) and stepped there too (``stepped``), as PRT's are
     corner, _, end_corner, idx, quads = _quads(edges, d, reflex_steps=False)
+    stepped_corner, stepped_ends, _, _, stepped = _quads(edges, d)
     moved = d > TOL.zero
     strips, folded = _strips(quads)
+    stepped_strips, stepped_folded = _strips(stepped)
     group = owner[idx] * m + edges.poly[idx]
-    # a face whose strips fold, or where a moved edge's line passes a kept neighbour's far end (the kept
-    # edge's segment turns over: PRT's tiers on massing's near_degenerate.34258 and 34006 run on past a
-    # short kept edge): its strips swept by its outline's edges as a wavefront (holes do not move)
+    # a face whose stepped strips fold, or where a moved edge's line passes a kept neighbour's far end (the
+    # kept edge's segment turns over: PRT's tiers on massing's near_degenerate.34258 and 34006 run on past a
+    # short kept edge): its strips swept by its outline's edges as a wavefront (holes do not move). (A strip
+    # that folds mitred but not stepped does not fold: PRT's terrace on lots whose edge, 2 to 4 m long and
+    # set back 3 or 4 m, runs from an acute corner's kept edge to a reflex vertex of 25 or 40 degrees is the
+    # stepped quad, measured through PyPRT; massing.concave.44289's and 50043's first tiers.)
     swept = np.zeros(m, dtype=bool)
-    swept[edges.poly[idx[folded]]] = True
+    swept[edges.poly[idx[stepped_folded]]] = True
     tangent = edges.end - edges.start
     span = np.einsum("ij,ij->i", tangent + end_corner - corner, tangent)
     # (where the boundary runs on past it turned by less than ``_RUN_ON_TURN``: 1 degree on 34258, 20 on
-    # concave.46141; past a corner, the moved line stops at the kept edge's line, as PRT's tier on the real
-    # lot massing.hiroshima.111, whose shapeL arm it keeps: 4.71 m^2)
+    # concave.46141, or turns away from the face, at a reflex vertex, and runs on back the way the moved line
+    # goes: PRT's tier on a block whose kept 1.1 m foot of a bump the bump's side set back 2 or 4 m passes,
+    # measured through PyPRT, and on massing.concave.50953, not on far.51343, whose boundary runs away; past
+    # a convex corner, the moved line stops at the kept edge's line, as PRT's tier on the real lot
+    # massing.hiroshima.111, whose shapeL arm it keeps: 4.71 m^2; nor does a kept edge between two moved
+    # ones start it, whose moved lines cross its line the other way round: massing.concave.50323's first
+    # tier, PRT's terrace the union of the strips)
     other = np.where(moved[edges.prev], edges.next, edges.prev)
-    turned_over = ~moved & ~edges.hole & (moved[edges.prev] | moved[edges.next]) & (
+    mover = np.where(moved[edges.prev], edges.prev, edges.next)
+    beyond = np.where(moved[edges.prev][:, None], tangent[edges.next], -tangent[edges.prev])  # (from that end)
+    reflex_end = (np.where(moved[edges.prev], np.einsum("ij,ij->i", tangent[edges.next], edges.inward),
+                           np.einsum("ij,ij->i", tangent, edges.inward[edges.prev])) < 0) & (
+        np.einsum("ij,ij->i", beyond, edges.inward[mover]) > 0)
+    turned_over = ~moved & ~edges.hole & (moved[edges.prev] != moved[edges.next]) & (
         span < -TOL.zero * np.einsum("ij,ij->i", tangent, tangent)) & (
-        moved[other] | (_cosines(tangent, tangent[other]) > np.cos(np.radians(_RUN_ON_TURN))))
+        reflex_end | (_cosines(tangent, tangent[other]) > np.cos(np.radians(_RUN_ON_TURN))))
     swept[edges.poly[turned_over]] = True
-    stepped_corner, stepped_ends, _, _, stepped = _quads(edges, d)
-    strips = _reflex_strips(edges, swept, strips, idx, quads, stepped)
+    strips = _reflex_strips(edges, swept, strips, idx, quads, stepped, stepped_strips)
     if swept.any():
         # a swept face's wavefront steps at reflex vertices too, but for those of an edge whose strip folds
-        # (it vanishes there: massing.concave.50953's and a replay lot's first tiers, whose folded edge set
-        # back 4 m turns by 25 and 40 degrees at a reflex vertex; PRT's fronts run on past it as the mitres')
+        # mitred and not stepped (it vanishes there: massing.concave.50953's and a replay lot's first tiers,
+        # whose folded edge set back 4 m turns by 25 and 40 degrees at a reflex vertex; PRT's fronts run on
+        # past it as the mitres'); one whose stepped strip folds too vanishes on the stepped lines (PRT's
+        # terrace on a 2 m edge set back 3 m from an acute corner's kept edge to a 25-degree reflex vertex:
+        # the triangle of its stepped lines, measured through PyPRT)
         folding = np.zeros(len(d), dtype=bool)
-        folding[idx[folded]] = True
+        folding[idx[folded & ~stepped_folded]] = True
         keep = (folding | folding[edges.prev])[:, None]
         _, convex_ends, _ = _mitres(edges, d, reflex_steps=False)
         strips, group = _swept(polygons, edges, d, np.where(keep, corner, stepped_corner),
@@ -154,18 +170,12 @@ def _strips(quads: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 
 
 def _reflex_strips(edges: Edges, swept: np.ndarray, strips: np.ndarray, idx: np.ndarray, quads: np.ndarray,
-                   stepped: np.ndarray) -> np.ndarray:
-    """The strips (k,) of the moved edges ``idx`` (k,), those of the faces not ``swept`` (m,) made again of
-    the quads ``stepped`` (k, 4, 2) that step at reflex vertices too (``_stepping``) where they differ from
-    ``quads`` (k, 4, 2), which step at convex ones alone. Whether a face folds, and is swept, is decided on
-    the latter (massing.concave.50953's first tier, whose edge set back 4 m beside one set back 3 m at a
-    25-degree reflex vertex folds there and sweeps on past a kept edge, as PRT's does; stepped, it
-    folded no more and its strip stopped short); its wavefront then steps at the reflex vertex too."""
-    changed = np.flatnonzero(~swept[edges.poly[idx]] & np.any(stepped != quads, axis=(1, 2)))
-    if len(changed):
-        strips = strips.copy()
-        strips[changed] = _strips(stepped[changed])[0]
-    return strips
+                   stepped: np.ndarray, stepped_strips: np.ndarray) -> np.ndarray:
+    """The strips (k,) of the moved edges ``idx`` (k,), those of the faces not ``swept`` (m,) the
+    ``stepped_strips`` (k,) of the quads ``stepped`` (k, 4, 2) that step at reflex vertices too
+    (``_stepping``) where they differ from ``quads`` (k, 4, 2), which step at convex ones alone."""
+    changed = ~swept[edges.poly[idx]] & np.any(stepped != quads, axis=(1, 2))
+    return np.where(changed, stepped_strips, strips)
 
 
 def _swept(polygons: np.ndarray, edges: Edges, d, corner, ends, owner, swept, strips, group, idx):

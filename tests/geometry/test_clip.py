@@ -378,35 +378,68 @@ def test_a_remainder_whose_first_edge_steps_starts_after_the_step():
     np.testing.assert_allclose(first, (13.5501, -6.7633), atol=1e-9)
 
 
+def _remainder_starts(ring, distances):
+    """The first vertex, in (x, y), of the remainder of the lot ``ring`` (counter-clockwise in (x, y)) set back
+    by ``distances`` per edge (``geometry.setback``), as ``fit_pieces`` starts it in the lot's plane (x, z)
+    with z = -y, where the lot winds clockwise as a face's top does: one per start GEOS may give the ring."""
+    from grammarc.geometry.clip import fit_pieces
+    from grammarc.geometry.setback import polygon_edges, setback_regions
+
+    ring = np.asarray(ring, float)
+    lot = shapely.Polygon(ring)
+    edges = polygon_edges(np.array([lot]))
+    _, remainder = setback_regions(np.array([lot]), edges, np.asarray(distances, float),
+                                   np.zeros(len(edges.poly), dtype=np.int64), 1)
+    low, size = ring.min(axis=0), np.ptp(ring, axis=0)
+    kept = np.asarray(remainder[0].exterior.coords)[:-1]
+    firsts = []
+    for turned in range(len(kept)):  # GEOS's start anywhere on the ring
+        piece = shapely.Polygon((np.roll(kept, turned, axis=0) - low) * (1, -1))
+        fitted = fit_pieces(np.array([piece]), np.ones(1, np.int8), np.array([[size[0], 0.0, size[1]]]),
+                            np.array([shapely.Polygon((ring - low) * (1, -1))]))
+        firsts.append(tuple(np.round((fitted.coords[0] * fitted.extent[0, [0, 2]] + fitted.low[0, [0, 2]])
+                                     * (1, -1) + low, 9)))
+    return firsts
+
+
 def test_a_remainder_whose_last_edge_steps_to_edge_0_starts_at_edge_0():
     """The last edge set back 4 m, turning by 12 degrees into the kept edge 0: its strip steps back to
     vertex 0, and PRT starts the remainder at vertex 0, along edge 0 (measured through PyPRT under massing's
     tiers), not at the step from the last edge's moved copy (which comes first in the ring)."""
-    import shapely
+    ring = [(4.279, -5.065), (9.389, 3.478), (10.586, 5.661), (6.247, 18.281), (-13.91, -11.706), (-3.311, -13.327)]
+    assert set(_remainder_starts(ring, [0, 0, 0, 0, 0, 4])) == {ring[0]}
 
-    from grammarc.geometry.clip import fit_pieces
-    from grammarc.geometry.setback import polygon_edges, setback_regions
 
-    ring = np.array([[4.279, -5.065], [9.389, 3.478], [10.586, 5.661], [6.247, 18.281], [-13.91, -11.706],
-                     [-3.311, -13.327]])  # counter-clockwise in (x, y)
-    lot = shapely.Polygon(ring)
-    edges = polygon_edges(np.array([lot]))
-    d = np.where(np.arange(len(edges.poly)) == len(edges.poly) - 1, 4.0, 0.0)
-    _, remainder = setback_regions(np.array([lot]), edges, d, np.zeros(len(d), dtype=np.int64), 1)
-    low = ring.min(axis=0)
-    size = ring.max(axis=0) - low
+@pytest.mark.parametrize("turn", [-10, -14, 10, 20, 30, 44])
+def test_a_remainder_whose_edge_0_steps_from_a_last_edge_kept_whole_starts_at_the_last_edge(turn):
+    """Edge 0 set back 3 m steps back to vertex 0 from the kept last edge, 5 m long, from a kept corner,
+    turned ``turn`` degrees from edge 0 (a convex vertex 0 below 0, a reflex one above): PRT starts the
+    remainder at the last edge's start (measured through PyPRT: massing's second tier's edge 0, set back
+    alone, is the last edge's run at each of these turns; concave.43155's 20.7 degrees, reflex), not at
+    vertex 0."""
+    corner = (-5 * np.cos(np.radians(turn)), -5 * np.sin(np.radians(turn)))
+    ring = [(0, 0), (20, 0), (20, 15), (-10, 15), corner]
+    assert set(_remainder_starts(ring, [3, 0, 0, 0, 0])) == {tuple(np.round(corner, 9))}
 
-    def to_plane(coords):  # (x, z) with z = -y: the lot winds clockwise there, as a face's top does
-        coords = np.asarray(coords) - low
-        return np.c_[coords[:, 0], -coords[:, 1]]
 
-    kept = np.asarray(remainder[0].exterior.coords)[:-1]
-    for turned in range(len(kept)):  # GEOS's start anywhere on the ring
-        piece = shapely.Polygon(to_plane(np.roll(kept, turned, axis=0)))
-        fitted = fit_pieces(np.array([piece]), np.ones(1, np.int8), np.array([[size[0], 0.0, size[1]]]),
-                            np.array([shapely.Polygon(to_plane(ring))]))
-        first = fitted.coords[:2] * fitted.extent[0, [0, 2]] + fitted.low[0, [0, 2]]
-        np.testing.assert_allclose(first, to_plane(ring[:2]), atol=1e-9)
+@pytest.mark.parametrize("ring, distances, first", [
+    # a 10 x 10 m block with a 1 m arm whose side, edge 1, is set back 3 m: the strip takes the arm and ends
+    # on the kept edge 2's line, and PRT starts the remainder where that line leaves the boundary, 1 m before
+    # vertex 2, the first vertex it keeps (measured through PyPRT: massing's second tier's edge 0, set back
+    # alone, is that 1 m run; so with edge 2 turned 12.5 degrees, and with the arm's side edge 2 after a
+    # tip of two edges; holes.43991, 50445)
+    ([(-20, 10), (-20, 9), (0, 9), (0, 0), (10, 0), (10, 10)], [0, 3, 0, 0, 0, 0], (0, 10)),
+    ([(-20, 10), (-20, 9), (0, 9), (2, 0), (10, 0), (10, 10)], [0, 3, 0, 0, 0, 0], (round(-2 / 9, 9), 10)),
+    ([(-20, 11), (-20, 10), (-20, 9), (0, 9), (0, 0), (10, 0), (10, 10)], [0, 0, 3, 0, 0, 0, 0], (0, round(31 / 3, 9))),
+    # the arm's side edge 0 or the last edge: PRT starts the remainder at vertex 1 or 0 (measured; U.43550)
+    ([(-20, 9), (0, 9), (0, 0), (10, 0), (10, 10), (-20, 10)], [3, 0, 0, 0, 0, 0], (0, 9)),
+    ([(0, 9), (0, 0), (10, 0), (10, 10), (-20, 10), (-20, 9)], [0, 0, 0, 0, 0, 3], (0, 9)),
+])
+def test_a_remainder_that_reaches_its_first_kept_vertex_along_its_edge_starts_at_that_run(ring, distances, first):
+    """The strip of a moved edge that covers an arm ends on the next, kept, edge's line; the remainder
+    reaches that edge's vertex along the line, from the boundary: PRT counts the run before the vertex,
+    but for the vertex after edge 0 or the last edge."""
+    assert set(_remainder_starts(ring, distances)) == {first}
 
 
 def test_cut_edges_of_a_piece_the_cut_takes_through_a_hole_turn_their_faces():

@@ -101,10 +101,11 @@ def test_an_edge_whose_strip_folds_vanishes_and_its_neighbours_meet(ring, d, rem
     # massing.tartu.0 it left 62.6 m^2 of PRT's terrace out)
     ([(0, 8), (0, 3), (20, 3), (20, 1), (40, 1), (40, 8)], [4, 0, 4, 4, 0, 0], 16 * 5 + 20 * 3),
     # massing.hiroshima.111's shapeL arm (4;4;0;0;0;0): the 2.4 m end folds between the kept left side and
-    # the moved right side; the right side's strip stops at the kept 0.6 m step's line and the upper arm is
-    # left, as PRT leaves it (4.713 m^2; the wavefront, started by the step's turning over, took it all)
+    # the moved right side; the right side's moved line passes the kept 0.6 m step, whose far end is a
+    # reflex corner, and the upper arm is left, as PRT leaves it (4.7138 m^2 on this ring, measured through
+    # PyPRT; 4.7142 where the strip stopped at the step's line; the wavefront with the end moved took it all)
     ([(0.0, 0.0), (2.4291, 0.0), (2.4331, 7.5647), (1.8122, 7.5647), (1.8125, 10.1675), (0.0013, 10.1674)],
-     [4, 4, 0, 0, 0, 0], (1.8125 - 0.0013) * (10.1675 - 7.5647)),
+     [4, 4, 0, 0, 0, 0], 4.7138),
     # its second tier (3;4;0;0), that arm's 1.8 x 2.6 m top: both sides fold; the shorter stays and the other's
     # strip covers the face, PRT's terrace (nothing left where both stayed)
     ([(0.0, 0.0), (1.8112, 0.0), (1.8115, 2.6028), (0.0003, 2.6027)], [3, 4, 0, 0], 0.0),
@@ -463,3 +464,49 @@ def test_a_moved_line_that_overtakes_a_kept_wall_keeps_the_folded_strips():
                             (0, y4), (0, y3), (x1, y3), (x1, y2)])
     _, (remainder,) = setback([face], [3, 3, 3, 3] + [0] * 9)
     assert abs(shapely.area(remainder) - 120.685) < 2e-3
+
+CONCAVE_50323 = [(12.785058, 9.557631), (12.785058, 11.271266), (8.331864, 15.807824), (6.356168, 15.367785),
+                 (3.749396, 15.591084), (4.952566, 8.467218), (0, 8.895165), (0.839205, 3.781472),
+                 (6.469083, 0.317521), (9.801663, 0), (10.418725, 4.375636), (14.439722, 5.512751)]
+
+
+def _tip(length, turn):
+    """A block whose edge 0, ``length`` m long, runs from an acute corner (40 degrees, its kept last edge the
+    block's side) to a reflex vertex where edge 1 turns ``turn`` degrees away from the face."""
+    a = np.radians(turn)
+    turned = (-length - 5 * np.cos(a), 5 * np.sin(a))
+    return [(0, 0), (-length, 0), turned, (turned[0] - 6, turned[1]), (turned[0] - 6, -12), (-7.66, -12),
+            (-7.66, -6.43)]
+
+
+@pytest.mark.parametrize("ring, d, terrace", [
+    # edge 0 set back 3 or 4 m (and edge 1 by 3 or 1): mitred at the reflex vertex its quad folds, stepped
+    # it does not, and PRT's terrace is the stepped quad (measured through PyPRT under massing's first tier;
+    # the folded quads' triangles gave 2.398, 33.182 and 3.357 m^2)
+    (_tip(4, 25), [3], 7.637), (_tip(4, 25), [4, 3], 33.610), (_tip(4, 40), [3], 8.277), (_tip(3, 25), [3], 4.637),
+    # edge 0 2 m long: the stepped quad folds too, and PRT's terrace is the triangle of the stepped lines
+    # (the wavefront with the mitre kept, 0.600 m^2)
+    (_tip(2, 25), [3], 2.063), (_tip(2, 25), [3, 1], 8.246),
+    # a bump's side (edge 2) set back 4 or 2 m passes the far end of the bump's kept foot (edge 1), a reflex
+    # corner past which the boundary runs back along the moved line's way: the face is swept on along the
+    # block's side, as PRT's terrace (where the strip stopped at the foot's line, 73.600 and 36.851 m^2)
+    ([(19.76, 4.28), (20.28, 14.12), (21.36, 14.1), (12.0, 30.0), (5.0, 30.0), (5.0, 4.28)], [0, 0, 4], 83.672),
+    ([(19.76, 4.28), (20.28, 14.12), (21.36, 14.1), (12.0, 30.0), (5.0, 30.0), (5.0, 4.28)], [0, 0, 2], 38.089),
+    # massing.far.51343's first tier (4;4;0;0;...): edge 1's moved line passes the far end of the kept 2.8 m
+    # edge 2, a reflex corner, but the boundary beyond runs away from the moved line: the strip stops at edge
+    # 2's line (PRT's terrace 78.016 m^2; swept on, 75.599)
+    ([(0, 0), (17.0335, 0), (14.9575, 7.1404), (12.2008, 7.1404), (12.3109, 8.2645), (4.4839, 10.6257),
+      (0.7815, 7.9778)], [4, 4], 78.107),
+    # massing.concave.50323's first tier (a shapeO footprint, 3;0;3;3 and 3;0;3): the kept 6.4 m edge 1
+    # between edges 0 and 2, set back 3 m, turns over (their moved lines cross its line the other way round),
+    # but the face is not swept: PRT's terrace is the strips' union (measured through PyPRT; swept, 17.973
+    # and 1.831 m^2)
+    (CONCAVE_50323, [3, 0, 3, 3], 26.904), (CONCAVE_50323, [3, 0, 3], 19.527),
+])
+def test_strips_fold_as_prt_steps_them_and_sweep_past_a_kept_edge_s_reflex_end(ring, d, terrace):
+    face = np.array([shapely.Polygon(ring)])
+    distance = np.zeros(len(ring))
+    distance[:len(d)] = d
+    (strips,), rest = setback_regions(face, polygon_edges(face), distance, np.zeros(len(ring), np.int64), 1)
+    assert shapely.area(strips[0]) == pytest.approx(terrace, abs=2e-3)
+    assert shapely.area(strips[0]) + shapely.area(rest[0]) == pytest.approx(face[0].area)
