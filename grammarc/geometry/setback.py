@@ -121,16 +121,20 @@ def setback_regions(polygons: np.ndarray, edges: Edges, distance: np.ndarray, ow
     turned_over = ~moved & ~edges.hole & (moved[edges.prev] | moved[edges.next]) & (
         span < -TOL.zero * np.einsum("ij,ij->i", tangent, tangent)) & (
         moved[other] | (_cosines(tangent, tangent[other]) > np.cos(np.radians(_RUN_ON_TURN))))
-    swept[edges.poly[turned_over]] = True
+    passed = np.zeros(m, dtype=bool)
+    passed[edges.poly[turned_over]] = True
+    swept |= passed
     stepped_corner, stepped_ends, _, _, stepped = _quads(edges, d)
     strips = _reflex_strips(edges, swept, strips, idx, quads, stepped)
     if swept.any():
         # a swept face's wavefront steps at reflex vertices too, but for those of an edge whose strip folds
-        # (it vanishes there: massing.concave.50953's and a replay lot's first tiers, whose folded edge set
-        # back 4 m turns by 25 and 40 degrees at a reflex vertex; PRT's fronts run on past it as the mitres')
+        # in a face that a moved line passes a kept edge of (it vanishes there: a replay lot's first tier,
+        # whose folded edge set back 4 m turns by 40 degrees at a reflex vertex; PRT's front runs on past it
+        # as the mitres'). A face swept only because a strip folds steps there (massing.convex.43938's
+        # second tier, 15 degrees; concave.50953's first, 25: PRT's fronts step as the edge's lone strip)
         folding = np.zeros(len(d), dtype=bool)
         folding[idx[folded]] = True
-        keep = (folding | folding[edges.prev])[:, None]
+        keep = ((folding | folding[edges.prev]) & passed[edges.poly])[:, None]
         _, convex_ends, _ = _mitres(edges, d, reflex_steps=False)
         strips, group = _swept(polygons, edges, d, np.where(keep, corner, stepped_corner),
                                np.where(keep, convex_ends, stepped_ends), owner, swept, strips, group, idx)

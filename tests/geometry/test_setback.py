@@ -356,6 +356,26 @@ def test_edges_moved_by_different_distances_step_at_a_reflex_vertex():
         assert np.min(np.linalg.norm(corners - point, axis=1)) < 1e-3
 
 
+@pytest.mark.parametrize("turn, length, kept, corner", [(15.4, 6.0, 0.0, 6.541), (20.0, 2.0, 0.0, 2.705),
+                                                        (40.0, 0.3, 0.0, 1.756), (15.4, 6.0, 1.0, 6.541)])
+def test_an_edge_whose_mitred_strip_folds_still_steps_at_a_reflex_vertex(turn, length, kept, corner):
+    """An inner corner: edge 0 (up, 8.86 m) and edge 1 (right, ``length``) set back 4 m, edge 2 turning right
+    from edge 1 by ``turn`` (a reflex vertex) kept or set back ``kept``. Mitred there, edge 1's strip folds
+    (the face is swept); PRT's (measured through PyPRT on massing's second tier: terraces of 76.52, 60.85,
+    55.55 and 86.45 m^2) steps at the reflex vertex all the same: edge 1's moved line ends at (``corner``,
+    4). Before, the wavefront kept the mitre there and the moved line ran back along edge 2's line
+    (massing.convex.43938's second tier: 26.9 m^2 of terrace missing)."""
+    a = np.radians(turn)
+    far = (length + 10 * np.cos(a), -10 * np.sin(a))
+    polygon = shapely.Polygon([(0, -8.86), (0, 0), (length, 0), far, (far[0], 15), (-10, 15), (-10, -8.86)])
+    edges = polygon_edges(np.array([polygon]))
+    d = np.zeros(len(edges.poly))
+    d[:3] = 4.0, 4.0, kept
+    _, remainder = setback_regions(np.array([polygon]), edges, d, np.zeros(len(d), dtype=np.int64), 1)
+    moved = [x for x, y in remainder[0].exterior.coords if abs(y - 4) < 1e-9]
+    assert max(moved) == pytest.approx(corner, abs=1e-3)
+
+
 @pytest.mark.parametrize("turn, corner", [(-35.0, (0.7375, 4.0)), (-40.0, (0.869, 4.0)), (-25.0, (9.2425, 4.0))])
 def test_a_moved_line_past_a_kept_edge_steps_to_the_next_edge_it_turns_little_from(turn, corner):
     """Edge 0 set back 4 m runs past the far end (1, 1) of the kept edge 1 (45 degrees up from it); the
