@@ -382,18 +382,18 @@ def _at_vertex_0(best, corner, along, outer):
     last edge's line), the remainder starts at vertex 0 (measured through PyPRT on massing's second tiers
     over real lots: three of three); where edge 0's strip steps back to vertex 0 from the kept last edge
     (turned by under 15 degrees, ``geometry.setback``), at the run along the last edge that ends at vertex
-    0, not at the step (sixteen of sixteen)."""
+    0, not at the step (sixteen of sixteen), also where that run is the last edge kept whole from a kept
+    corner (measured through PyPRT on a 20 x 20 m lot whose 4 m last edge lies on edge 0's line, or turns
+    from it by 10 degrees or by 0.02: massing.convex.50756's second tier, whose 3 m last edge turns by 10)."""
     n = len(corner)
     for j in range(n):
         if corner[j] == 0 and along[j] == outer - 1:
             return j
-    # (the run before the step lies along the last edge, or along edge 0's line where the two are one line,
-    # and starts where a strip ends on it: one from the last edge's kept start is not where PRT starts,
-    # massing.near_degenerate.43572's 1 m last edge)
-    previous = (best - 1) % n
-    if corner[best] == 0 and along[best] < 0 and corner[previous] < 0 and (
-            along[previous] == outer - 1 or along[previous] == 0):
-        return previous
+    # (the run before the step lies along the last edge, or along edge 0's line where the two are one line)
+    for j in range(n):
+        previous = (j - 1) % n
+        if corner[j] == 0 and along[j] < 0 and (along[previous] == outer - 1 or along[previous] == 0):
+            return previous
     return best
 
 
@@ -406,7 +406,7 @@ def _after_steps(keys, moved_from, moved_in, r0, r1, outer):
     stepping at 5 degrees). A moved last edge of the ``outer`` ring (``moved_in``) that steps to edge 0
     counts, with its step, after the last: the remainder starts at edge 0 (measured through PyPRT: a last
     edge moved 4 m stepping to a kept edge 0 at 12 degrees); a kept last edge's run before a moved edge 0's
-    step stays where it is (``_at_vertex_0``: near_degenerate.43572). ``keys`` (V,) turned in place for
+    step stays where it is (``_at_vertex_0``). ``keys`` (V,) turned in place for
     the ring ``r0:r1``."""
     n = r1 - r0
     for j in range(r0, r1):

@@ -423,10 +423,12 @@ def test_cut_edges_of_a_piece_the_cut_takes_through_a_hole_turn_their_faces():
     ([(10, -5), (20, -5), (20, -30), (0, -30), (0, 0), (10, 0)],
      [(4, 0), (10, 0), (10, -5), (10, -9), (20, -9), (20, -26), (4, -26)], (10, -5)),
     # the first lot's edge 0 stepping back from a last edge kept whole, from a kept corner: PRT starts the
-    # remainder at vertex 0 (massing.near_degenerate.43572's second tier, its 1 m last edge 0.02 degrees
-    # off edge 0's line; was: at the last edge's start, 1.4 % of the area off)
+    # remainder at the last edge's start all the same (measured through PyPRT on this lot, and with the last
+    # edge turned from edge 0 by 10 degrees: massing.convex.50756's second tier; was: at vertex 0)
     ([(10, 0), (20, 0), (20, -20), (0, -20), (0, -4), (6, 0)],
-     [(6, 0), (10, 0), (10, -4), (20, -4), (20, -20), (0, -20), (0, -4)], (10, 0)),
+     [(6, 0), (10, 0), (10, -4), (20, -4), (20, -20), (0, -20), (0, -4)], (6, 0)),
+    ([(10, 0), (20, 0), (20, -20), (0, -20), (0, -4), (6, 0.7053)],
+     [(6, 0.7053), (10, 0), (9.65, -4), (20, -4), (20, -20), (0, -20), (0, -4)], (6, 0.7053)),
 ])
 def test_a_remainder_that_keeps_vertex_0_starts_where_prt_starts_it(lot, remainder, first):
     """massing's tiers (4;0;4;4;0) on these lots, PRT's second tier's edge 0 measured through PyPRT (a
