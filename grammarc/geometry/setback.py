@@ -40,7 +40,8 @@ _REFLEX_STEP_TURN = 45.0
 #: concave lot of the replay's, whose tier it sweeps).
 _PARALLEL = 2.0
 #: The turn (degrees) past a kept edge under which a moved line that passes its far end sweeps on
-#: (``setback_regions``): measured between 20 (sweeps on) and 90 (stops).
+#: (``setback_regions``): measured between 20 (sweeps on) and 90 (stops); a larger one sweeps on too
+#: unless the edge beyond runs parallel to the moved edge (within ``_PARALLEL``).
 _RUN_ON_TURN = 45.0
 #: The grid (scope units, metres) that setback regions are snapped to, collapsing zero-width spikes.
 _SNAP = 1e-9
@@ -115,12 +116,16 @@ def setback_regions(polygons: np.ndarray, edges: Edges, distance: np.ndarray, ow
     tangent = edges.end - edges.start
     span = np.einsum("ij,ij->i", tangent + end_corner - corner, tangent)
     # (where the boundary runs on past it turned by less than ``_RUN_ON_TURN``: 1 degree on 34258, 20 on
-    # concave.46141; past a corner, the moved line stops at the kept edge's line, as PRT's tier on the real
-    # lot massing.hiroshima.111, whose shapeL arm it keeps: 4.71 m^2)
+    # concave.46141; past a corner too, but for one whose edge beyond runs parallel to the moved edge, where
+    # the moved line stops at the kept edge's line, as PRT's tier on the real lot massing.hiroshima.111,
+    # whose shapeL arm it keeps: 4.71 m^2; a 1.3 m kept jog whose edge beyond turns 5 to 40 degrees from the
+    # moved edge, 50 to 85 past the jog, is swept in PRT: concave.43589's first tier)
     other = np.where(moved[edges.prev], edges.next, edges.prev)
     turned_over = ~moved & ~edges.hole & (moved[edges.prev] | moved[edges.next]) & (
         span < -TOL.zero * np.einsum("ij,ij->i", tangent, tangent)) & (
-        moved[other] | (_cosines(tangent, tangent[other]) > np.cos(np.radians(_RUN_ON_TURN))))
+        moved[other] | (_cosines(tangent, tangent[other]) > np.cos(np.radians(_RUN_ON_TURN))) | (
+            np.abs(_cosines(tangent[other], tangent[np.where(moved[edges.prev], edges.prev, edges.next)]))
+            < np.cos(np.radians(_PARALLEL))))
     passed = np.zeros(m, dtype=bool)
     passed[edges.poly[turned_over]] = True
     swept |= passed

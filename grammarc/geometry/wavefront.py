@@ -163,13 +163,16 @@ def _ring_strips(start, end, inward, d, corner, ends, out, out_n, left, step_cos
         if real[best] >= 0:
             # the steps at a vanished edge's ends go with it: its neighbours meet as they would have without
             # it, their strips reaching across its step's vertex (PRT's on massing.far.33391, where a short
-            # edge moved 4 m between a moved and a kept edge turned by 13 degrees)
-            if real[q] < 0 and count > 3:
+            # edge moved 4 m between a moved and a kept edge turned by 13 degrees); not where its other
+            # neighbour stays too, which would meet the edge beyond the step out of the face (PRT's first
+            # tier on massing.concave.43589 keeps the step its moved edge left past a kept edge's far end,
+            # that edge's front then running out on the kept edge beyond)
+            if real[q] < 0 and count > 3 and w[p] > _EPS:
                 sx, sy = _retire(alive, final, pool, s_head, q, x, y)
                 count -= 1
                 used = _push(pool, link, used, e_head, e_tail, p, sx, sy)
                 q = nxt[q]
-            if real[p] < 0 and count > 3:
+            if real[p] < 0 and count > 3 and w[q] > _EPS:
                 sx, sy = _retire(alive, final, pool, s_head, p, x, y)
                 count -= 1
                 used = _push(pool, link, used, s_head, s_tail, q, sx, sy)
