@@ -399,6 +399,11 @@ def _at_vertex_0(best, corner, along, outer):
     return best
 
 
+#: The cosine under which a lost edge faces the moved line that swept it (``_before_a_sweep``): 2 degrees,
+#: as the parallel neighbours of ``geometry.setback``.
+_FACING = float(np.cos(np.radians(2.0)))
+
+
 @njit(cache=True, nogil=True)
 def _before_a_sweep(best, keys, moved_in, moved_from, along, outer, ring):
     """The vertex (an index into one ring of a setback's remainder) where PRT starts a remainder that has
@@ -413,9 +418,9 @@ def _before_a_sweep(best, keys, moved_in, moved_from, along, outer, ring):
     run (or moved line), along the last edge left (measured through PyPRT on an L whose 3 m arm's long
     side, set back 4 m, covers the arm, its vertex 0 at the arm's end, the arm's inner side cut in one or
     two edges or vertex 0 between them, the inner side kept or set back 3 m: massing.L.50366's second
-    tier, holes.44173's). A moved line that passed a kept edge's far end is no
-    sweep (a chamfer between two moved edges, or beside a kept one: PRT starts at the moved line). Where edge
-    0 is lost otherwise and the kept last edge's run is left, the remainder starts where that run ends."""
+    tier, holes.44173's). A moved line that passed a kept edge's far end is no sweep (a chamfer between two
+    moved edges, or beside a kept one: PRT starts at the moved line). Where edge 0 is lost otherwise and the
+    kept last edge's run is left, the remainder starts where that run ends."""
     n = len(keys)
     if keys.min() < 1.0 or (moved_from == 0.0).any():  # (edge 0, or vertex 0, is left)
         return best
@@ -436,7 +441,7 @@ def _before_a_sweep(best, keys, moved_in, moved_from, along, outer, ring):
     while i != int(k):
         ex, ey = ring[(i + 1) % outer, 0] - ring[i, 0], ring[(i + 1) % outer, 1] - ring[i, 1]
         length = np.sqrt(ex * ex + ey * ey)
-        if length > 0.0 and size > 0.0 and (ex * kx + ey * ky) / (length * size) < -np.cos(np.radians(2.0)):
+        if length > 0.0 and size > 0.0 and (ex * kx + ey * ky) / (length * size) < -_FACING:
             return previous
         i = (i + 1) % outer
     return best
