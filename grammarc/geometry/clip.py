@@ -342,6 +342,8 @@ def ring_starts(coords, ring_offsets, part_offsets, part_source, part_with_start
                         break
             if r == part_offsets[p] and not cut and not part_inset[p]:
                 best = _at_vertex_0(best, corner[r0:r1], runs_along[r0:r1], outer)
+                best = _before_a_sweep(best, keys[r0:r1], moved_in[r0:r1], moved_from[r0:r1], runs_along[r0:r1],
+                                       outer, parent_coords[parent_rings[parent_offsets[g]]:])
             if r == part_offsets[p] and part_inset[p]:
                 # where the first outer edge left, counting from the last, ends: vertex 0's mitre when the
                 # last edge and edge 0 are left; the end of the last edge's run nearest vertex 0 of all
@@ -389,8 +391,10 @@ def _at_vertex_0(best, corner, along, outer):
     (turned by under 15 degrees, or under 45 at a reflex vertex 0, ``geometry.setback``), at the run along
     the last edge that ends at vertex 0, not at the step (sixteen of sixteen), also where that run is the
     last edge kept whole, from its kept start (measured through PyPRT: a 5 m last edge turned 10 or 14
-    degrees from edge 0 at a convex vertex 0, 10 to 44 degrees at a reflex one, six of six; massing's
-    concave.43155, 20.7 degrees reflex, and near_degenerate.50908, on edge 0's line)."""
+    degrees from edge 0 at a convex vertex 0, 10 to 44 degrees at a reflex one, six of six; a 20 x 20 m lot
+    whose 4 m last edge lies on edge 0's line, or turns from it by 10 degrees or by 0.02; massing's
+    concave.43155, 20.7 degrees reflex, near_degenerate.50908, on edge 0's line, and convex.50756's second
+    tier, whose 3 m last edge turns by 10)."""
     n = len(corner)
     for j in range(n):
         if corner[j] == 0 and along[j] == outer - 1:
@@ -404,6 +408,54 @@ def _at_vertex_0(best, corner, along, outer):
     previous = (step - 1) % n
     if corner[step] == 0 and along[step] < 0 and (along[previous] == outer - 1 or along[previous] == 0):
         return previous
+    return best
+
+
+#: The cosine under which a lost edge faces the moved line that swept it (``_before_a_sweep``): 2 degrees,
+#: as the parallel neighbours of ``geometry.setback``.
+_FACING = float(np.cos(np.radians(2.0)))
+
+
+@njit(cache=True, nogil=True)
+def _before_a_sweep(best, keys, moved_in, moved_from, along, outer, ring):
+    """The vertex (an index into one ring of a setback's remainder) where PRT starts a remainder that has
+    lost edge 0 to a moved line sweeping over it, ``best`` otherwise. ``keys`` (n,), ``moved_in`` (n,),
+    ``moved_from`` (n,) and ``along`` (n,) as ``ring_starts`` finds them (the parent edge a vertex's outgoing
+    edge runs along or was moved in from, inf for none; the one it runs along, -1 for none); ``ring`` (the
+    parent's outer ring first, ``outer`` vertices).
+
+    Where the first edge left is a moved line (``best``, edge k) that swept over a kept edge facing it
+    (parallel, within 2 degrees) among the edges lost from the run before it around to edge k (an arm
+    narrower than the setback: its side and end go under edge k's strip), PRT starts the remainder at that
+    run (or moved line), along the last edge left (measured through PyPRT on an L whose 3 m arm's long
+    side, set back 4 m, covers the arm, its vertex 0 at the arm's end, the arm's inner side cut in one or
+    two edges or vertex 0 between them, the inner side kept or set back 3 m: massing.L.50366's second
+    tier, holes.44173's). A moved line that passed a kept edge's far end is no sweep (a chamfer between two
+    moved edges, or beside a kept one: PRT starts at the moved line). Where edge 0 is lost otherwise and the
+    kept last edge's run is left, the remainder starts where that run ends."""
+    n = len(keys)
+    if keys.min() < 1.0 or (moved_from == 0.0).any():  # (edge 0, or vertex 0, is left)
+        return best
+    k = keys[best]
+    previous = (best - 1) % n
+    p = moved_from[previous]  # (a kept run, or a moved line)
+    if not moved_in[best] or k >= outer or not p > k or p >= outer:
+        # edge 0 lost otherwise: the remainder starts where the kept last edge's run ends (PRT's on that
+        # L numbered from the arm's far corner, the arm's end and side lost under the long side's line,
+        # where a strip's side runs on from the last edge's run: massing.holes.50515's second tier)
+        for j in range(n):
+            if along[j] == outer - 1 and not moved_in[j]:
+                return (j + 1) % n
+        return best
+    kx, ky = ring[(int(k) + 1) % outer, 0] - ring[int(k), 0], ring[(int(k) + 1) % outer, 1] - ring[int(k), 1]
+    size = np.sqrt(kx * kx + ky * ky)
+    i = (int(p) + 1) % outer
+    while i != int(k):
+        ex, ey = ring[(i + 1) % outer, 0] - ring[i, 0], ring[(i + 1) % outer, 1] - ring[i, 1]
+        length = np.sqrt(ex * ex + ey * ey)
+        if length > 0.0 and size > 0.0 and (ex * kx + ey * ky) / (length * size) < -_FACING:
+            return previous
+        i = (i + 1) % outer
     return best
 
 

@@ -40,7 +40,8 @@ _REFLEX_STEP_TURN = 45.0
 #: concave lot of the replay's, whose tier it sweeps).
 _PARALLEL = 2.0
 #: The turn (degrees) past a kept edge under which a moved line that passes its far end sweeps on
-#: (``setback_regions``): measured between 20 (sweeps on) and 90 (stops).
+#: (``setback_regions``): measured between 20 (sweeps on) and 90 (stops); a larger one sweeps on too
+#: unless the edge beyond runs parallel to the moved edge (within ``_PARALLEL``).
 _RUN_ON_TURN = 45.0
 #: The grid (scope units, metres) that setback regions are snapped to, collapsing zero-width spikes.
 _SNAP = 1e-9
@@ -122,31 +123,42 @@ def setback_regions(polygons: np.ndarray, edges: Edges, distance: np.ndarray, ow
     # concave.46141, or turns away from the face, at a reflex vertex, and runs on back the way the moved line
     # goes: PRT's tier on a block whose kept 1.1 m foot of a bump the bump's side set back 2 or 4 m passes,
     # measured through PyPRT, and on massing.concave.50953, not on far.51343, whose boundary runs away; past
-    # a convex corner, the moved line stops at the kept edge's line, as PRT's tier on the real lot
-    # massing.hiroshima.111, whose shapeL arm it keeps: 4.71 m^2; nor does a kept edge between two moved
-    # ones start it, whose moved lines cross its line the other way round: massing.concave.50323's first
-    # tier, PRT's terrace the union of the strips)
+    # a convex corner too, but for one whose edge beyond runs parallel to the moved edge, where the moved
+    # line stops at the kept edge's line, as PRT's tier on the real lot massing.hiroshima.111, whose shapeL
+    # arm it keeps: 4.71 m^2; a 1.3 m kept jog whose edge beyond turns 5 to 40 degrees from the moved edge,
+    # 50 to 85 past the jog, is swept in PRT: concave.43589's first tier; nor does a kept edge between two
+    # moved ones start it, whose moved lines cross its line the other way round: massing.concave.50323's
+    # first tier, PRT's terrace the union of the strips)
     other = np.where(moved[edges.prev], edges.next, edges.prev)
     mover = np.where(moved[edges.prev], edges.prev, edges.next)
     beyond = np.where(moved[edges.prev][:, None], tangent[edges.next], -tangent[edges.prev])  # (from that end)
-    reflex_end = (np.where(moved[edges.prev], np.einsum("ij,ij->i", tangent[edges.next], edges.inward),
-                           np.einsum("ij,ij->i", tangent, edges.inward[edges.prev])) < 0) & (
-        np.einsum("ij,ij->i", beyond, edges.inward[mover]) > 0)
+    far_reflex = np.where(moved[edges.prev], np.einsum("ij,ij->i", tangent[edges.next], edges.inward),
+                          np.einsum("ij,ij->i", tangent, edges.inward[edges.prev])) < 0
+    reflex_end = far_reflex & (np.einsum("ij,ij->i", beyond, edges.inward[mover]) > 0)
+    # (the edge beyond turned from the moved edge by more than ``_PARALLEL`` and at most ``_RUN_ON_TURN``: the
+    # jog's 5 to 40 degrees sweep; a 6 m kept edge whose edge beyond turns 65 degrees from the moved one does
+    # not, PRT's terrace being the stepped quad there, 33.610 m^2, measured through PyPRT)
+    turn = np.abs(_cosines(tangent[other], tangent[mover]))
+    across = (turn < np.cos(np.radians(_PARALLEL))) & (turn >= np.cos(np.radians(_RUN_ON_TURN)))
     turned_over = ~moved & ~edges.hole & (moved[edges.prev] != moved[edges.next]) & (
         span < -TOL.zero * np.einsum("ij,ij->i", tangent, tangent)) & (
-        reflex_end | (_cosines(tangent, tangent[other]) > np.cos(np.radians(_RUN_ON_TURN))))
-    swept[edges.poly[turned_over]] = True
+        reflex_end | (~far_reflex & across) | (_cosines(tangent, tangent[other]) > np.cos(np.radians(_RUN_ON_TURN))))
+    passed = np.zeros(m, dtype=bool)
+    passed[edges.poly[turned_over]] = True
+    swept |= passed
     strips = _reflex_strips(edges, swept, strips, idx, quads, stepped, stepped_strips)
     if swept.any():
         # a swept face's wavefront steps at reflex vertices too, but for those of an edge whose strip folds
-        # mitred and not stepped (it vanishes there: massing.concave.50953's and a replay lot's first tiers,
-        # whose folded edge set back 4 m turns by 25 and 40 degrees at a reflex vertex; PRT's fronts run on
-        # past it as the mitres'); one whose stepped strip folds too vanishes on the stepped lines (PRT's
+        # mitred and not stepped in a face that a moved line passes a kept edge of (it vanishes there: a
+        # replay lot's first tier, whose folded edge set back 4 m turns by 40 degrees at a reflex vertex;
+        # PRT's front runs on past it as the mitres'); a face swept only because a strip folds steps there
+        # (massing.convex.43938's second tier, 15 degrees; concave.50953's first, 25: PRT's fronts step as
+        # the edge's lone strip); one whose stepped strip folds too vanishes on the stepped lines (PRT's
         # terrace on a 2 m edge set back 3 m from an acute corner's kept edge to a 25-degree reflex vertex:
         # the triangle of its stepped lines, measured through PyPRT)
         folding = np.zeros(len(d), dtype=bool)
         folding[idx[folded & ~stepped_folded]] = True
-        keep = (folding | folding[edges.prev])[:, None]
+        keep = ((folding | folding[edges.prev]) & passed[edges.poly])[:, None]
         _, convex_ends, _ = _mitres(edges, d, reflex_steps=False)
         strips, group = _swept(polygons, edges, d, np.where(keep, corner, stepped_corner),
                                np.where(keep, convex_ends, stepped_ends), owner, swept, strips, group, idx)

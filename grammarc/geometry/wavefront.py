@@ -186,14 +186,18 @@ def _ring_strips(start, end, inward, d, corner, ends, out, out_n, left, left_kep
             # the step runs on along the vanished edge's line, or turns from it by up to 8 degrees either
             # way), the step stays and the neighbour meets it (PRT's tiers on a lot whose edge set back 4 m
             # vanishes beside such a kept edge, after it and, mirrored, before it:
-            # massing.near_degenerate.43838's second tier)
-            if real[q] < 0 and count > 3 and _past_step(nx, ny, c, w, ux, uy, pool, s_head, q, p, nxt[q], now, 1.0):
+            # massing.near_degenerate.43838's second tier); nor where its other neighbour stays too, which
+            # would meet the edge beyond the step out of the face (PRT's first tier on massing.concave.43589
+            # keeps the step its moved edge left past a kept edge's far end, that edge's front then running
+            # out on the kept edge beyond)
+            if real[q] < 0 and count > 3 and w[p] > _EPS and _past_step(nx, ny, c, w, ux, uy, pool, s_head, q, p,
+                                                                         nxt[q], now, 1.0):
                 sx, sy = _retire(alive, final, pool, s_head, q, x, y)
                 count -= 1
                 used = _push(pool, link, used, e_head, e_tail, p, sx, sy)
                 q = nxt[q]
-            if real[p] < 0 and count > 3 and _past_step(nx, ny, c, w, ux, uy, pool, s_head, p, prv[p], q, now,
-                                                        -1.0):
+            if real[p] < 0 and count > 3 and w[q] > _EPS and _past_step(nx, ny, c, w, ux, uy, pool, s_head, p,
+                                                                         prv[p], q, now, -1.0):
                 sx, sy = _retire(alive, final, pool, s_head, p, x, y)
                 count -= 1
                 used = _push(pool, link, used, s_head, s_tail, q, sx, sy)

@@ -477,10 +477,13 @@ def test_cut_edges_of_a_piece_the_cut_takes_through_a_hole_turn_their_faces():
      [(4, 0), (10, 0), (10, -5), (10, -9), (20, -9), (20, -26), (4, -26)], (10, -5)),
     # the first lot's edge 0 stepping back from a last edge kept whole, from a kept corner: PRT starts the
     # remainder at the run along the last edge too (this lot's second tier setting back its edge 0 by 2 m:
-    # PRT's moved the run from (6, 0), 204 m^2 left, where the step's would leave 206.667;
+    # PRT's moved the run from (6, 0), 204 m^2 left, where the step's would leave 206.667; and with the last
+    # edge turned from edge 0 by 10 degrees: massing.convex.50756's second tier;
     # massing.near_degenerate.43838's second tier, a 6.3 m last edge on edge 0's line)
     ([(10, 0), (20, 0), (20, -20), (0, -20), (0, -4), (6, 0)],
      [(6, 0), (10, 0), (10, -4), (20, -4), (20, -20), (0, -20), (0, -4)], (6, 0)),
+    ([(10, 0), (20, 0), (20, -20), (0, -20), (0, -4), (6, 0.7053)],
+     [(6, 0.7053), (10, 0), (9.65, -4), (20, -4), (20, -20), (0, -20), (0, -4)], (6, 0.7053)),
 ])
 def test_a_remainder_that_keeps_vertex_0_starts_where_prt_starts_it(lot, remainder, first):
     """massing's tiers (4;0;4;4;0) on these lots, PRT's second tier's edge 0 measured through PyPRT (a
@@ -496,3 +499,42 @@ def test_a_remainder_that_keeps_vertex_0_starts_where_prt_starts_it(lot, remaind
                             np.array([[20.0, 0.0, 30.0]]), np.array([lot]))
         start = pieces.coords[0] * pieces.extent[0, [0, 2]] + pieces.low[0, [0, 2]]
         np.testing.assert_allclose(start, first, atol=1e-9)
+
+
+def _flip(points):
+    """(x, y) of a map (counter-clockwise) as (x, z) of PRT's ground plane (clockwise)."""
+    return [(x, -y) for x, y in points]
+
+
+ARM_L = [(10, 0), (10, 3), (-10, 3), (-10, -10), (-5, -10), (-5, 0)]  # vertex 0 at the 3 m arm's end
+
+
+@pytest.mark.parametrize("lot, remainder, first", [
+    # the arm's long side set back 4 m covers the 3 m arm: its end (edge 0) and inner side (the last edge)
+    # are lost, and PRT starts at the run of the edge before them (was: at the long side's moved line)
+    (ARM_L, [(-5, -1), (-10, -1), (-10, -10), (-5, -10)], (-5, -10)),
+    # the same L numbered from the arm's inner corner: its inner side is edge 0, the run before it the last
+    (ARM_L[5:] + ARM_L[:5], [(-5, -1), (-10, -1), (-10, -10), (-5, -10)], (-5, -10)),
+    # the body's side beside the arm set back 3 m too: PRT starts at its moved line
+    (ARM_L, [(-8, -1), (-10, -1), (-10, -10), (-8, -10)], (-8, -10)),
+    # the arm's short side set back 4 m under the kept long side (both lost with the arm's end, edge 0): PRT
+    # starts where the last edge's run ends, with the side of the strip along the body's kept side
+    ([(-7, 3), (-7, 0), (2, 0), (2, -6), (12, -6), (12, 3)], [(2, 3), (2, 0), (2, -6), (12, -6), (12, 3)], (2, 3)),
+    # a kept chamfer (edge 0) that the moved line of edge 1 passes: no sweep, PRT starts at that moved line
+    ([(0, 1), (1, 0), (20, 0), (20, 10), (0, 10)], [(0, 4), (20, 4), (20, 10), (0, 10)], (0, 4)),
+])
+def test_a_remainder_that_lost_edge_0_starts_where_prt_starts_it(lot, remainder, first):
+    """massing's first tier set back as the comments say on these lots (map coordinates), PRT's second tier's
+    edge 0 measured through PyPRT (a setback of it alone), on every turn of the first two lots' rings (an
+    edge 0 left starts the remainder: twelve of twelve); massing.L.50366's and holes.50515's second tiers."""
+    import shapely
+
+    from grammarc.geometry.clip import fit_pieces
+
+    lot = shapely.Polygon(_flip(lot))
+    ring = np.array(_flip(remainder), float)
+    for turned in range(len(ring)):  # GEOS's start anywhere on the ring
+        pieces = fit_pieces(np.array([shapely.Polygon(np.roll(ring, turned, axis=0))]), np.array([1]),
+                            np.array([[30.0, 0.0, 30.0]]), np.array([lot]))
+        start = pieces.coords[0] * pieces.extent[0, [0, 2]] + pieces.low[0, [0, 2]]
+        np.testing.assert_allclose(start, _flip([first])[0], atol=1e-9)

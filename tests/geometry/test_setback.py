@@ -357,6 +357,61 @@ def test_edges_moved_by_different_distances_step_at_a_reflex_vertex():
         assert np.min(np.linalg.norm(corners - point, axis=1)) < 1e-3
 
 
+@pytest.mark.parametrize("turn, corner, terrace", [(5.0, 9.882, 39.8408), (10.0, 9.764, 39.6811),
+                                                   (20.0, 17.418, 50.0142), (40.0, 13.218, 44.3438)])
+def test_a_moved_line_past_a_kept_jog_sweeps_on_whatever_the_jog_turns(turn, corner, terrace):
+    """Edge 0 (10 m) set back 4 m past the far end of a kept 1.3 m jog up (edge 1), the kept edge 2 beyond it
+    turning from edge 0 by ``turn``: PRT's tier (measured through PyPRT: terraces and corners below) runs
+    edge 0's line on past the jog, stepping at its far end under 15 degrees and meeting edge 2's line from
+    20 on, though the boundary turns by 50 to 85 degrees past the jog. Before, a turn of 45 degrees or more
+    past the kept edge stopped the strip at the jog's line (massing.concave.43589's first tier)."""
+    a = np.radians(turn)
+    far = (10 + 10 * np.cos(a), 1.3 + 10 * np.sin(a))
+    polygon = shapely.Polygon([(0, 0), (10, 0), (10, 1.3), far, (far[0], 16), (0, 16)])
+    edges = polygon_edges(np.array([polygon]))
+    d = np.where(np.arange(len(edges.poly)) == 0, 4.0, 0.0)
+    (strips,), remainder = setback_regions(np.array([polygon]), edges, d, np.zeros(len(d), dtype=np.int64), 1)
+    assert shapely.area(strips[0]) == pytest.approx(terrace, abs=1e-3)
+    moved = [x for x, y in remainder[0].exterior.coords if abs(y - 4) < 1e-9]
+    assert max(moved) == pytest.approx(corner, abs=1e-3)
+
+
+def test_a_step_left_past_a_kept_edge_stays_when_its_moved_edge_vanishes():
+    """massing.concave.43589's first tier with its edge 1 alone set back 4 m: the moved line passes the far
+    end of the kept 1.27 m edge 2 and steps there to the kept edge 3 (turned 5 degrees from it); its front
+    then runs out on the kept edge 0 and the kept last edge. PRT's terrace (measured through PyPRT): 8.1252
+    m^2, the step from (2.809, 1.614) to (3.695, 3.410). Before, the step went with the moved edge and the
+    kept edges beyond met out of the face (the folded quads' 7.95 m^2 instead)."""
+    polygon = shapely.Polygon([(0.0, 3.8225), (0.0, 1.7295), (2.3534, 0.4332), (2.8095, 1.6141), (6.4932, 0.0),
+                               (6.9653, 3.0441)])
+    edges = polygon_edges(np.array([polygon]))
+    d = np.where(np.arange(len(edges.poly)) == 1, 4.0, 0.0)
+    (strips,), remainder = setback_regions(np.array([polygon]), edges, d, np.zeros(len(d), dtype=np.int64), 1)
+    assert shapely.area(strips[0]) == pytest.approx(8.1252, abs=1e-3)
+    corners = np.asarray(remainder[0].exterior.coords)
+    assert np.min(np.linalg.norm(corners - (3.695, 3.410), axis=1)) < 2e-3
+
+
+@pytest.mark.parametrize("turn, length, kept, corner", [(15.4, 6.0, 0.0, 6.541), (20.0, 2.0, 0.0, 2.705),
+                                                        (40.0, 0.3, 0.0, 1.756), (15.4, 6.0, 1.0, 6.541)])
+def test_an_edge_whose_mitred_strip_folds_still_steps_at_a_reflex_vertex(turn, length, kept, corner):
+    """An inner corner: edge 0 (up, 8.86 m) and edge 1 (right, ``length``) set back 4 m, edge 2 turning right
+    from edge 1 by ``turn`` (a reflex vertex) kept or set back ``kept``. Mitred there, edge 1's strip folds
+    (the face is swept); PRT's (measured through PyPRT on massing's second tier: terraces of 76.52, 60.85,
+    55.55 and 86.45 m^2) steps at the reflex vertex all the same: edge 1's moved line ends at (``corner``,
+    4). Before, the wavefront kept the mitre there and the moved line ran back along edge 2's line
+    (massing.convex.43938's second tier: 26.9 m^2 of terrace missing)."""
+    a = np.radians(turn)
+    far = (length + 10 * np.cos(a), -10 * np.sin(a))
+    polygon = shapely.Polygon([(0, -8.86), (0, 0), (length, 0), far, (far[0], 15), (-10, 15), (-10, -8.86)])
+    edges = polygon_edges(np.array([polygon]))
+    d = np.zeros(len(edges.poly))
+    d[:3] = 4.0, 4.0, kept
+    _, remainder = setback_regions(np.array([polygon]), edges, d, np.zeros(len(d), dtype=np.int64), 1)
+    moved = [x for x, y in remainder[0].exterior.coords if abs(y - 4) < 1e-9]
+    assert max(moved) == pytest.approx(corner, abs=1e-3)
+
+
 @pytest.mark.parametrize("turn, corner", [(-35.0, (0.7375, 4.0)), (-40.0, (0.869, 4.0)), (-25.0, (9.2425, 4.0))])
 def test_a_moved_line_past_a_kept_edge_steps_to_the_next_edge_it_turns_little_from(turn, corner):
     """Edge 0 set back 4 m runs past the far end (1, 1) of the kept edge 1 (45 degrees up from it); the
