@@ -106,6 +106,15 @@ def _bytes(chunks, large: list[bool]) -> tuple[np.ndarray, np.ndarray]:
 
 
 @njit(cache=True, nogil=True)
+def _count(data, at, end, little):
+    """The count (an unsigned 32-bit integer) at byte ``at`` and the byte after it; a count of 0 where the
+    value would run past ``end``."""
+    if at + 4 > end:
+        return np.int64(0), at
+    return _u32(data, at, little), at + 4
+
+
+@njit(cache=True, nogil=True)
 def _u32(data, at, little):
     """The unsigned 32-bit integer at byte ``at``."""
     if little:
@@ -149,10 +158,7 @@ def _scan(data, offsets, kinds, parts, rings, points, coords, native_little, fil
             return row, p, r, v
         n_parts = 1
         if kind == _MULTIPOLYGON:
-            if at + 4 > end:
-                return row, p, r, v
-            n_parts = _u32(data, at, little)
-            at += 4
+            n_parts, at = _count(data, at, end, little)
             if n_parts == 0:
                 return row, p, r, v
         kinds[row] = kind
@@ -162,20 +168,14 @@ def _scan(data, offsets, kinds, parts, rings, points, coords, native_little, fil
                 at, little, part_kind, part_dims = _header(data, at, end)
                 if part_kind != _POLYGON or part_dims != dims:
                     return row, p, r, v
-            if at + 4 > end:
-                return row, p, r, v
-            n_rings = _u32(data, at, little)
-            at += 4
+            n_rings, at = _count(data, at, end, little)
             if n_rings == 0:
                 return row, p, r, v
             if fill:
                 rings[p] = n_rings
             p += 1
             for _ in range(n_rings):
-                if at + 4 > end:
-                    return row, p, r, v
-                n = _u32(data, at, little)
-                at += 4
+                n, at = _count(data, at, end, little)
                 if n < 4 or at + n * dims * 8 > end:
                     return row, p, r, v
                 if fill:
