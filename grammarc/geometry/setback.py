@@ -40,8 +40,9 @@ _REFLEX_STEP_TURN = 45.0
 #: concave lot of the replay's, whose tier it sweeps).
 _PARALLEL = 2.0
 #: The turn (degrees) past a kept edge under which a moved line that passes its far end sweeps on
-#: (``setback_regions``): measured between 20 (sweeps on) and 90 (stops); a larger one sweeps on too
-#: unless the edge beyond runs parallel to the moved edge (within ``_PARALLEL``).
+#: (``setback_regions``): measured between 20 (sweeps on) and 90 (stops). Past a convex far end the moved
+#: line sweeps on also where the edge beyond turns from the moved edge by more than ``_PARALLEL`` and at
+#: most this (a jog's 5 to 40 degrees sweep on; 65 degrees stops).
 _RUN_ON_TURN = 45.0
 #: The grid (scope units, metres) that setback regions are snapped to, collapsing zero-width spikes.
 _SNAP = 1e-9

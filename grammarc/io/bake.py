@@ -21,8 +21,9 @@ so ``bake`` also counts the polygons before triangulation, in the mesh's ``metad
 Colours and textures. Every triangle keeps how its instance or face looks: its RGBA colour and its material
 (texture paths, ``model.records.MaterialTable``). The OBJ gets a material library beside it (``city.mtl``:
 a material per look, ``Kd`` and ``d`` from the colour, ``map_Kd`` and the other maps from the textures,
-resolved in the asset roots; a rule package's textures copied into ``city.obj.textures``, ``io.textures``) and its triangles in a group ``g lot_N`` per lot, a ``usemtl`` run per look;
-the PLY gets vertex colours; the GLB a primitive and material per look, its colour map embedded.
+resolved in the asset roots; a rule package's textures copied into ``city.obj.textures``, ``io.textures``)
+and its triangles in a group ``g lot_N`` per lot, a ``usemtl`` run per look; the PLY gets vertex colours;
+the GLB a primitive and material per look, its colour map embedded.
 
 Memory: the baked mesh holds ~60 bytes a triangle (float64 vertices, int64 faces), so ``bake`` counts the
 triangles before it allocates anything and refuses a record beyond ``max_triangles``.
@@ -281,8 +282,8 @@ class BakedWriter(WriterBlock):
     their headers, one buffer), so their chunks are kept until ``close()``, which bakes and exports them
     (PLY and STL with trimesh, GLB with ``io.gltf.baked_glb``). Either way the writer counts the
     triangles chunks will make as they come and refuses a chunk that would pass ``max_triangles``; the
-    file is renamed onto ``path`` only when complete (an OBJ's texture folder and ``.mtl`` just before it), so ``abort()``
-    (or an exception inside ``with``) leaves nothing there.
+    file is renamed onto ``path`` only when complete (an OBJ's texture folder and ``.mtl`` just before it),
+    so ``abort()`` (or an exception inside ``with``) leaves nothing there.
 
     Parameters
     ----------

@@ -51,10 +51,6 @@ from grammarc.geometry.setback import distances_to_area, polygon_edges, setback_
 from grammarc.ir import nodes as ir
 from grammarc.ragged import next_in_segment, ragged_take, rank_within, segment_of
 
-#: A distance that moves an outline out beyond this (``Tol.far``) makes no record, and beyond float64's
-#: GEOS raises: ``offset`` and ``setback`` fail the lots of such distances (a NaN one stays what it was: no
-#: setback, as PRT takes massing's; ``setbackToArea``'s maximums may be inf: none).
-FAR = TOL.far
 
 @operation(ir.Roof, writes=("origin", "size", "geom"))
 def roof(ctx: Context, cursor: Shapes, op: ir.Roof) -> Shapes:
@@ -399,7 +395,10 @@ def setback(ctx: Context, cursor: Shapes, op: ir.Setback) -> Parts:
     """``setback`` and ``shapeL/U/O``: the face's edge strips and its remainder to their parts."""
     face = _SetbackFaces(ctx, cursor, op, "setback", (*op.selectors, *(s for s, _ in op.distances)))
     distance = face.distances(ctx, cursor, op.distances, op.per_edge, 0.0)
-    far = distance > FAR
+    # an outline moved out beyond any coordinate (``Tol.far``) makes no record, and beyond float64's GEOS
+    # raises; a NaN distance stays what it was: no setback, as PRT takes massing's (``setbackToArea``'s
+    # maximums may be inf: it checks none)
+    far = distance > TOL.far
     if far.any():
         ctx.fail_lots(cursor.lot[face.edges.poly[far]], f"`setback` by {distance[far][0]:g}, beyond any coordinate",
                       op.span)
@@ -589,17 +588,18 @@ def _offset_polygons(ctx: Context, distance: ir.Expr, cursor: Shapes, span):
 
 
 def _distances(ctx: Context, distance: ir.Expr, cursor: Shapes, span) -> np.ndarray:
-    """``offset``'s distance (n,) float64 per shape; a lot whose outline it moves out beyond ``FAR`` fails,
-    as does one whose distance is not a number. Moved in that far (by -inf too), nothing is left of an
-    outline: that is no error, and the distance is ``-FAR`` (GEOS takes no infinite distance)."""
+    """``offset``'s distance (n,) float64 per shape; a lot whose outline it moves out beyond any coordinate
+    (``Tol.far``: no record holds it, and beyond float64's GEOS raises) fails, as does one whose distance is
+    not a number. Moved in that far (by -inf too), nothing is left of an outline: that is no error, and the
+    distance is ``-Tol.far`` (GEOS takes no infinite distance)."""
     d = np.broadcast_to(np.asarray(evaluate_array(distance, ctx.env(cursor)), float), (len(cursor),))
     nan = np.isnan(d)
     if nan.any():
         ctx.fail(cursor, nan, "`offset` by a distance that is not a number", span)
-    far = d > FAR
+    far = d > TOL.far
     if far.any():
         ctx.fail(cursor, far, f"`offset` by {d[far][0]:g}, beyond any coordinate", span)
-    return np.maximum(d, -FAR)
+    return np.maximum(d, -TOL.far)
 
 
 def _inset_and_border(polygons: np.ndarray, distance: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
