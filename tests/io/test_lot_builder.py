@@ -275,11 +275,12 @@ def test_star_polygons_keep_first_vertex_and_area(n, seed, clockwise, offset):
 
 
 @settings(max_examples=80, deadline=None)
-@given(seed=st.integers(0, 2**32 - 1), offset=st.sampled_from([0.0, 5e5]))
+@given(seed=st.integers(0, 2**32 - 1), offset=st.sampled_from([200.0, 5e5]))
 def test_lots_that_skip_geos_validity_are_those_it_finds_valid(seed, offset):
     """Rings of 3-7 vertices on a coarse grid (convex, concave, bow-ties, collinear runs, slivers, rings
     that wind twice), some with a hole: the same lots and bad lots as when GEOS checks every lot, and
-    every lot it is not asked about is one it finds valid."""
+    every lot it is not asked about is one it finds valid. (The offsets keep x beyond 180: tiny lots
+    near the origin would look like degrees, which the reader refuses without a coordinate system.)"""
     import shapely
 
     from grammarc.io import lot_builder
