@@ -11,8 +11,10 @@ columns:
 - ``splits``: ``Subdiv``/``Repeat``, CityEngine's ``split``, ``Snap``;
 - ``component_splits``: ``Comp``, ``comp(f|e|v)``;
 - ``cuts``: ``Cut``, a footprint divided by a line between two of its edges (the ice-ray grammar);
-- ``faces``: ``offset``, ``setback``, ``setbackToArea``, ``innerRectangle``, ``convexify``, roofs, ``taper``,
-  ``cleanupGeometry``;
+- ``faces``: ``convexify``, ``cleanupGeometry``, ``deleteHoles``, and what the face operations share;
+- ``offsets``: ``offset``, ``footprint``, ``rectify``;
+- ``setbacks``: ``setback``, ``setbackToArea``, ``shapeL/U/O``, ``innerRectangle``;
+- ``roofs``: the roofs, ``envelope``, ``taper``;
 - ``inserts``: ``I``, ``i``, ``label``;
 - ``along_uv``: ``insertAlongUV``, an asset laid along texture coordinates as the shape's mesh;
 - ``primitives``: CityEngine's ``primitiveCube/Quad/Disk/Cylinder/Sphere/Cone``;
@@ -35,10 +37,13 @@ from grammarc.backend.operations import (  # noqa: F401 - each registers its ope
     cuts,
     faces,
     inserts,
+    offsets,
     primitives,
     reset,
+    roofs,
     scatter,
     scope,
+    setbacks,
     simplify,
     splits,
     successors,

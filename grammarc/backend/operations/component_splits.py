@@ -23,7 +23,7 @@ from grammarc.backend.evaluate import evaluate_array
 from grammarc.backend.kernels.order import group_by
 from grammarc.backend.kernels.scope import component_frames
 from grammarc.backend.occlusion import take_apart
-from grammarc.backend.operations.faces import offset_faces
+from grammarc.backend.operations.offsets import offset_faces
 from grammarc.backend.operations.table import Parts, operation
 from grammarc.backend.outlines import flat_axis, polygons_of, side_turns
 from grammarc.backend.reframing import turned
