@@ -19,8 +19,9 @@ import time
 from grammarc.diagnostics import Diagnostic
 from grammarc.frontend.user_cache import cache_folder, code_stamp, load, store
 
-#: Lowered files kept; the least recently used go first.
-MAX_FILES = 256
+#: Lowered files kept; the least recently used go first. A rule package can hold many (candler's is 76
+#: files), and 256 let a few packages and a test run push out each other's; a file is a few kilobytes.
+MAX_FILES = 1024
 
 
 def lookup(dialect: str, file: str, text: str, first_site: int) -> tuple[list, list[Diagnostic], int] | None:
