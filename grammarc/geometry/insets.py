@@ -13,10 +13,11 @@ GEOS's mitred buffer also cuts the whole mitre of every reflex corner out of the
 is a wavefront's (a straight skeleton's): a reflex corner whose edge the wavefront closes before it has
 moved the distance is gone from then on, and the neighbours' lines meet instead. A narrow arm's reflex
 root then leaves GEOS's inset a notch past the other moved edge's line that PRT's has not (massing's
-concave.57869, a 3 cm notch that made the inset's edges, and so its per-edge setbacks, one too many;
-concave.57617: 0.1 m^2). Where the inset of the skeleton's faces (each face kept beyond the distance from
-its edge's line) covers more than GEOS's, the two are united; a face whose skeleton cannot be completed
-keeps GEOS's inset.
+concave.57869, a 3 cm notch that made the inset's edges, and so its per-edge setbacks, three too many;
+concave.57617: 0.1 m^2). Where a face's wavefront ends a reflex corner before the distance and the inset
+of its skeleton's faces (each face kept beyond the distance from its edge's line) covers more than GEOS's,
+the two are united; a face whose skeleton cannot be completed
+keeps GEOS's inset, as does one of more than ``SKELETON_VERTICES`` vertices.
 """
 
 from __future__ import annotations
@@ -39,6 +40,10 @@ COLLINEAR = 1e-9
 #: The area (scope units squared) beyond GEOS's inset that the skeleton's must cover to be taken.
 NOTCH = 1e-6
 
+#: The most vertices of a face whose skeleton is taken: the skeleton's tables of split candidates grow as
+#: the square of a face's vertices (6 n x n per table); a larger face keeps GEOS's inset.
+SKELETON_VERTICES = 512
+
 
 def mitred_insets(polygons: np.ndarray, distance: np.ndarray) -> np.ndarray:
     """Each polygon (k,) (shapely) moved out by ``distance`` (k,) (in when negative) with sharp corners: its
@@ -59,7 +64,8 @@ def _notches_filled(polygons: np.ndarray, distance: np.ndarray, inset: np.ndarra
     ``-distance`` (k,) where those cover more (``NOTCH``): the notches of reflex corners the wavefront
     closed before the distance filled."""
     rows = np.flatnonzero((distance < 0) & ~shapely.is_empty(inset))
-    rows = rows[shapely.area(shapely.convex_hull(polygons[rows])) > shapely.area(polygons[rows]) * (1 + 1e-12)]
+    rows = rows[(shapely.area(shapely.convex_hull(polygons[rows])) > shapely.area(polygons[rows]) * (1 + 1e-12))
+                & (shapely.get_num_coordinates(polygons[rows]) <= SKELETON_VERTICES)]
     if not len(rows):
         return inset
     # (the skeleton takes no collinear or repeated vertices)

@@ -3,7 +3,7 @@
 import numpy as np
 import shapely
 
-from grammarc.geometry.insets import mitred_insets
+from grammarc.geometry.insets import SKELETON_VERTICES, mitred_insets
 
 #: Candler's roof on fuzz lot candler.tiny.44289 (seed 44000), in its scope: 1.64 m across at its widest
 #: inscribed circle (radius 0.8217), so ``offset(-0.8)`` leaves a sliver. GEOS (3.14) finds that buffer empty
@@ -90,3 +90,11 @@ def test_the_inset_of_a_spiked_lot_is_prts_wavefront():
     assert abs(shapely.buffer(SPIKED_LOT, -2.0, join_style="mitre", mitre_limit=1e6).area - 408.260) < 1e-3
     assert abs(inset.area - 413.532) < 0.02  # (PRT's corners to the millimetre)
     assert np.allclose(_corners(inset), sorted(PRT_SPIKED_INSET), atol=1e-3)
+
+
+def test_a_face_of_many_vertices_keeps_geos_inset():
+    # the spiked lot with a point every 5 cm along its edges: past SKELETON_VERTICES, no skeleton is taken
+    dense = shapely.segmentize(SPIKED_LOT, 0.05)
+    assert shapely.get_num_coordinates(dense) > SKELETON_VERTICES
+    (inset,) = mitred_insets(np.array([dense]), np.array([-2.0]))
+    assert abs(inset.area - 408.260) < 1e-3
