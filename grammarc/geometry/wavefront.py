@@ -23,9 +23,9 @@ the shorter going and the rest of the longer sweeping on, as PRT's front strip r
 of an L's arm and a T's bar top past where its bottom met it; of two with the same normal the slower
 goes; a kept edge between parallel neighbours does not vanish (PRT's strip ends at its line:
 massing.H.15118). Split events (an arm that closes parts the wavefront) are not followed: where two
-parallel lines apart become neighbours, or the wavefront ends outside its face or crossing itself (but
-for one turned inside out, ``geometry.setback``), the caller keeps the folded quads' strips. A ring that
-falls below three lines has nothing left.
+parallel lines apart become neighbours, or the wavefront ends outside its face (but for one turned inside
+out; one that ends crossing itself inside its face has its strips clipped to the face, ``geometry.setback``),
+the caller keeps the folded quads' strips. A ring that falls below three lines has nothing left.
 """
 
 from __future__ import annotations
