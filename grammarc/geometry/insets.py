@@ -108,7 +108,8 @@ def _skeleton_faces(coords, ring_offsets, poly_offsets, depth):
     counter-clockwise, holes clockwise, as ``shapely.to_ragged_array`` lists them) where the wavefront
     ends a reflex corner before it moves ``depth`` (m,) in (elsewhere GEOS's mitres are the wavefront's,
     and a polygon whose skeleton is not completed keeps them): the faces' vertices (V, 2) and offsets
-    (F+1,), one face per edge, and each face's edge's start and end (F, 2) and polygon (F,)."""
+    (F+1,), one face per edge that reaches past the distance, and each face's edge's start and end (F, 2)
+    and polygon (F,)."""
     m = len(poly_offsets) - 1
     n_edges = 0
     for r in range(len(ring_offsets) - 1):
@@ -144,6 +145,11 @@ def _skeleton_faces(coords, ring_offsets, poly_offsets, depth):
             continue
         for r in range(r1 - r0):
             for e in range(local[r], local[r + 1]):
+                top = 0.0
+                for j in range(foff[e], foff[e + 1]):
+                    top = max(top, node_t[fnodes[j]])
+                if top <= depth[g]:
+                    continue  # (the face ends before the distance: nothing of it is left)
                 start[f] = xy[e]
                 end[f] = xy[local[r] + (e - local[r] + 1) % (local[r + 1] - local[r])]
                 polygon[f] = g
