@@ -202,7 +202,7 @@ def _swept(polygons: np.ndarray, edges: Edges, d, corner, ends, owner, swept, st
     faces = np.flatnonzero(swept)
     rows = np.flatnonzero(swept[edges.poly] & ~edges.hole)  # (their outer rings, one after the other)
     ring_offsets = offsets_from_counts(np.bincount(edges.poly[rows], minlength=m)[faces])
-    coords, offsets, collapsed, followed, overtook, left, left_ring, left_kept = swept_strips(
+    coords, offsets, collapsed, followed, overtook, left, left_ring = swept_strips(
         edges.start[rows], edges.end[rows], edges.inward[rows], d[rows], corner[rows], ends[rows], ring_offsets,
         np.cos(np.radians(_STEP_TURN)))
     scale = max(float(np.abs(edges.start[rows]).max(initial=1.0)), 1.0)
@@ -228,14 +228,16 @@ def _swept(polygons: np.ndarray, edges: Edges, d, corner, ends, owner, swept, st
     turned[ends_as] = (winding[ends_as] > 0) != shapely.is_ccw(outlines[ends_as])
     turned |= np.abs(winding) <= 1e-12 * scale * scale
     turned &= (~crossed | out) & has_front
-    # a front that crosses itself inside its face only where a moved line passed kept ones (a reflex corner
-    # of kept edges, where the moved line parts the face: a split event) is followed, its strips clipped
-    # to the face making the pieces, as PRT's tier on massing's concave.43897 (an edge set back 4 m past
-    # a reflex corner of kept edges, 2.8 m beyond it: PRT keeps the two pieces beyond the moved line);
-    # not one where a moved line overtook a kept edge with its normal and swept on past it (the wall of
-    # massing's H.43552, a 0.77 m stem that PRT's second tier keeps)
+    # a front that crosses itself inside its face is followed, its strips clipped to the face making the
+    # pieces: where a moved line passed kept ones (a reflex corner of kept edges, where the moved line parts
+    # the face: a split event), as PRT's tier on massing's concave.43897 (an edge set back 4 m past a
+    # reflex corner of kept edges, 2.8 m beyond it: PRT keeps the two pieces beyond the moved line), and
+    # where moved lines cross each other, as on a face narrower than its distances (PRT's terrace on
+    # massing's concave.44289, a 0.5 m wide shapeO ring whose outer edges are set back 3 m: 13.731 m^2,
+    # measured through PyPRT; concave.30589 and 57225's tiers); not one where a moved line overtook a kept
+    # edge with its normal and swept on past it (the wall of massing's H.43552, a 0.77 m stem that PRT's
+    # second tier keeps)
     passed = crossed & ~out & ~overtook
-    passed[passed] = ~_moved_lines_cross(left, left_ring, left_kept, passed)[passed]
     trusted = np.zeros(m, dtype=bool)
     trusted[faces] = turned | (followed & ~out & (~crossed | passed))
     swept = swept & trusted
@@ -274,22 +276,6 @@ def _without_flat_parts(geometries: np.ndarray) -> np.ndarray:
     out[rows[touched]] = union_by_group(parts[keep], np.searchsorted(rows[touched], row[keep]),
                                         int(touched.sum()))
     return out
-
-
-def _moved_lines_cross(left: np.ndarray, ring: np.ndarray, kept: np.ndarray, fronts: np.ndarray) -> np.ndarray:
-    """(n,) whether segments of two moved lines of the same front cross, for the ``fronts`` (n,) bool asked
-    about; ``left`` (W, 2): the fronts' lines' segments, two ends per line, ``ring`` (W,) the front of each,
-    ``kept`` (W,) whether its line stays where it is (``geometry.wavefront.swept_strips``)."""
-    first = np.arange(0, len(left), 2)
-    moved = first[~kept[first] & fronts[ring[first]]]
-    crossing = np.zeros(len(fronts), dtype=bool)
-    if len(moved) < 2:
-        return crossing
-    segments = shapely.linestrings(np.stack([left[moved], left[moved + 1]], axis=1))
-    a, b = shapely.STRtree(segments).query(segments, predicate="crosses")
-    same = ring[moved[a]] == ring[moved[b]]
-    crossing[ring[moved[a[same]]]] = True
-    return crossing
 
 
 def _unfolded(edges: Edges, d: np.ndarray) -> np.ndarray:

@@ -23,9 +23,9 @@ the shorter going and the rest of the longer sweeping on, as PRT's front strip r
 of an L's arm and a T's bar top past where its bottom met it; of two with the same normal the slower
 goes; a kept edge between parallel neighbours does not vanish (PRT's strip ends at its line:
 massing.H.15118). Split events (an arm that closes parts the wavefront) are not followed: where two
-parallel lines apart become neighbours, or the wavefront ends outside its face or crossing itself (but
-for one turned inside out, ``geometry.setback``), the caller keeps the folded quads' strips. A ring that
-falls below three lines has nothing left.
+parallel lines apart become neighbours, or the wavefront ends outside its face (but for one turned inside
+out; one that ends crossing itself inside its face has its strips clipped to the face, ``geometry.setback``),
+the caller keeps the folded quads' strips. A ring that falls below three lines has nothing left.
 """
 
 from __future__ import annotations
@@ -93,11 +93,10 @@ def _push(pool, link, used, head, tail, e, x, y):
 
 
 @njit(cache=True, nogil=True)
-def _ring_strips(start, end, inward, d, corner, ends, out, out_n, left, left_kept, step_cos):
+def _ring_strips(start, end, inward, d, corner, ends, out, out_n, left, step_cos):
     """The swept strip of each edge of one ring (n edges), written one after another to ``out`` with its
     vertex count in ``out_n`` (n,) (0 for an edge that does not move), and the wavefront's vertices at
-    the end to ``left`` (2 n, 2), two per line (its segment's ends), and to ``left_kept`` whether that line
-    stays where it is (a kept edge, a step made at an event); returns whether the wavefront fell below three lines (nothing is left),
+    the end to ``left`` (2 n, 2), two per line (its segment's ends); returns whether the wavefront fell below three lines (nothing is left),
     how many vertices it ended with, whether it met no split event (two parallel lines apart
     becoming neighbours), and whether a moved line overtook a kept one (a kept edge went where a moved
     line with its normal reached it)."""
@@ -290,7 +289,6 @@ def _ring_strips(start, end, inward, d, corner, ends, out, out_n, left, left_kep
         e = first
         while first < m:  # (in the ring's order: a step made at an event comes after the lines before it)
             left[n_left], left[n_left + 1] = final[e, 0], final[e, 1]
-            left_kept[n_left] = left_kept[n_left + 1] = w[e] <= _EPS
             n_left += 2
             e = nxt[e]
             if e == first:
@@ -341,9 +339,8 @@ def swept_strips(start, end, inward, d, corner, ends, ring_offsets, step_cos):
     coords (V, 2) and offsets (E+1,) (an edge that does not move has none); (R,) bool whether nothing is left of the
     ring's face; (R,) bool whether its wavefront met no split event it cannot follow; (R,) bool whether a
     moved line overtook a kept one (``_ring_strips``); and the
-    wavefront's vertices at the end (W, 2), two per line, with their ring (W,) and whether their line
-    stays where it is (W,) (where they lie outside the face, or moved lines cross, a split event was
-    missed: the strips are not to be trusted either).
+    wavefront's vertices at the end (W, 2), two per line, with their ring (W,) (where they lie outside
+    the face, a split event was missed: the strips are not to be trusted either).
     """
     n_edges = len(d)
     n_rings = len(ring_offsets) - 1
@@ -354,19 +351,17 @@ def swept_strips(start, end, inward, d, corner, ends, ring_offsets, step_cos):
     overtook = np.zeros(n_rings, np.bool_)
     left = np.empty((4 * n_edges, 2))
     left_ring = np.empty(4 * n_edges, np.int64)
-    left_kept = np.empty(4 * n_edges, np.bool_)
     n_left = 0
     used = 0
     for r in range(n_rings):
         a, b = ring_offsets[r], ring_offsets[r + 1]
         collapsed[r], k, trusted[r], overtook[r] = _ring_strips(start[a:b], end[a:b], inward[a:b], d[a:b], corner[a:b],
                                                    ends[a:b], coords[used:], counts[a:b], left[n_left:],
-                                                   left_kept[n_left:], step_cos)
+                                                   step_cos)
         left_ring[n_left:n_left + k] = r
         n_left += k
         used += counts[a:b].sum()
     offsets = np.zeros(n_edges + 1, np.int64)
     for k in range(n_edges):
         offsets[k + 1] = offsets[k] + counts[k]
-    return (coords[:used], offsets, collapsed, trusted, overtook, left[:n_left], left_ring[:n_left],
-            left_kept[:n_left])
+    return coords[:used], offsets, collapsed, trusted, overtook, left[:n_left], left_ring[:n_left]

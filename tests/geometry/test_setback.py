@@ -565,3 +565,20 @@ def test_strips_fold_as_prt_steps_them_and_sweep_past_a_kept_edge_s_reflex_end(r
     (strips,), rest = setback_regions(face, polygon_edges(face), distance, np.zeros(len(ring), np.int64), 1)
     assert shapely.area(strips[0]) == pytest.approx(terrace, abs=2e-3)
     assert shapely.area(strips[0]) + shapely.area(rest[0]) == pytest.approx(face[0].area)
+
+
+def test_a_face_narrower_than_its_distances_is_swept_where_moved_lines_cross():
+    """Massing's first tier on fuzz lot concave.44289 (seed 43000): a shapeO ring 0.5 m wide whose outer
+    edges 0, 2 and 3 are set back 3 m (the rest of the list is empty: kept). The swept front crosses itself
+    where the moved lines cross each other; it is followed, and the terrace runs on past the kept 0.5 m
+    edge 4 to the moved line of edge 3, as PRT's: 13.731 m^2 of the face's 15.249, measured through PyPRT
+    (the face's strips alone, which stop at edge 4's line, left 11.835)."""
+    ring = shapely.from_wkt(
+        "POLYGON ((1.676022 7.208959, 1.676022 0, 11.125903 6.065079, 7.212657 6.742835, 3.988461 8.954833, "
+        "3.774838 8.486598, 0 7.660906, 1.676022 7.208959), (2.310199 7.566608, 2.152276 7.609192, "
+        "4.284369 8.075557, 4.304266 8.11917, 7.01577 6.25891, 9.746123 5.786026, 2.310199 1.013535, "
+        "2.310199 7.566608))")
+    distance = [3, 0, 3, 3, 0, np.nan, np.nan] + [np.nan] * 7
+    (strips,), (remainder,) = setback([ring], distance)
+    assert abs(shapely.area(strips[0]) - 13.731) < 5e-3
+    assert abs(shapely.area(strips[0]) + shapely.area(remainder) - ring.area) < 1e-6

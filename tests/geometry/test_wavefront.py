@@ -18,7 +18,7 @@ def sweep(ring, d):
     edges = polygon_edges(np.array([shapely.Polygon(ring)]))
     d = np.asarray(d, float)
     corner, ends, _ = _mitres(edges, d)
-    coords, offsets, collapsed, trusted, _, left, _, _ = swept_strips(
+    coords, offsets, collapsed, trusted, _, left, _ = swept_strips(
         edges.start, edges.end, edges.inward, d, corner, ends, np.array([0, len(d)]),
         np.cos(np.radians(_STEP_TURN)))
     strips = [shapely.make_valid(shapely.Polygon(coords[a:b])) if b > a else None
