@@ -18,7 +18,7 @@ import gc
 import threading
 import time
 from collections import deque
-from collections.abc import Sequence
+from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 
@@ -27,6 +27,7 @@ import numpy as np
 from grammarc import __version__
 from grammarc.backend.attributes import check_overrides
 from grammarc.backend.derive import derive_chunk
+from grammarc.backend.fusion.fused import preload
 from grammarc.backend.occlusion import Occluders
 from grammarc.backend.plan import make_plan
 from grammarc.compiler import compile_grammar
@@ -118,6 +119,9 @@ def load_lots(grammar_path: Path, lots_path: Path | None, options: LotsOptions |
     return read_lots(path, options) if path is not None else default_lot()
 
 
+_DONE = object()  # the end of ``_Reading.result``'s steps
+
+
 class _Reading:
     """``load_lots`` in a thread of its own, started before the grammar is compiled: a large lots file takes
     as long to read as the start-up takes, and most of the reading (Arrow's, the WKB kernel, numpy's and
@@ -139,8 +143,12 @@ class _Reading:
         except BaseException as error:  # noqa: BLE001 - raised in the build's thread by result()
             self._error = error
 
-    def result(self) -> Lots:
-        """The lots, once read (the wait ends on a signal: Ctrl-C stops the build here as anywhere)."""
+    def result(self, meanwhile: Iterable = ()) -> Lots:
+        """The lots, once read (the wait ends on a signal: Ctrl-C stops the build here as anywhere); the
+        steps of ``meanwhile`` are taken while they are being read, none once they are."""
+        steps = iter(meanwhile)
+        while self._thread.is_alive() and next(steps, _DONE) is not _DONE:
+            pass
         self._thread.join()
         if self._error is not None:
             raise self._error
@@ -205,7 +213,7 @@ def _build(source: Path, display: str | None, grammar_path: Path, output, readin
     reporting = reports_to is not None or any(isinstance(op, ir.Report) for op in iter_ops(grammar.module))
     check_writable([*files, *([reports_file] if reporting else [])], folders)
     Path(output).parent.mkdir(parents=True, exist_ok=True)
-    every = reading.result()
+    every = reading.result(meanwhile=preload(plan))
     lots = every if select is None else every.select(select)
     if display is None:  # a rule file on disk: its CityEngine project's folders too, for a later render
         recorded_roots = (*recorded_roots, *(r for r in grammar.asset_roots[1:] if r not in recorded_roots))
