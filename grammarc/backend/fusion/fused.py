@@ -113,7 +113,7 @@ def _within_limit(ctx, lot: np.ndarray, made: np.ndarray) -> bool:
 
 def preload(plan) -> Iterator[None]:
     """Load the machine code of ``plan``'s kernels that an earlier build compiled, one a step (none is
-    compiled here), for a build to run while it waits for its lots (``build._Reading``): the kernels are
+    compiled here), for a build to run while it waits for its lots (``io.lots_reading``): the kernels are
     then loaded when its workers are forked, which would otherwise each load them as their shapes come,
     at a few hundredths of a second each (``examples/pompeii`` has 84)."""
     for region in plan.fused.values():
