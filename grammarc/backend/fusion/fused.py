@@ -114,8 +114,8 @@ def _within_limit(ctx, lot: np.ndarray, made: np.ndarray) -> bool:
 def preload(plan) -> Iterator[None]:
     """Load the machine code of ``plan``'s kernels that an earlier build compiled, one a step (none is
     compiled here), for a build to run while it waits for its lots (``io.lots_reading``): the kernels are
-    then loaded when its workers are forked, which would otherwise each load them as their shapes come,
-    at a few hundredths of a second each (``examples/pompeii`` has 84)."""
+    then loaded when its workers are forked, which would otherwise each load them again as their shapes
+    come."""
     for region in plan.fused.values():
         if compiled_before(region.source.text):
             kernel(region.source.text, len(plan.symbols[region.root].param_types) + len(region.source.attrs))
