@@ -15,7 +15,6 @@ from __future__ import annotations
 import contextlib
 import functools
 import gc
-import threading
 import time
 from collections import deque
 from collections.abc import Sequence
@@ -27,6 +26,7 @@ import numpy as np
 from grammarc import __version__
 from grammarc.backend.attributes import check_overrides
 from grammarc.backend.derive import derive_chunk
+from grammarc.backend.fusion.fused import preload
 from grammarc.backend.occlusion import Occluders
 from grammarc.backend.plan import make_plan
 from grammarc.compiler import compile_grammar
@@ -34,7 +34,7 @@ from grammarc.constants import LIMITS, Limits
 from grammarc.errors import ChunkTooLarge, LotFailure, UsageError, check_stopped
 from grammarc.io import OutputOptions, writer_for, written_paths
 from grammarc.io.lot_format import LotsOptions
-from grammarc.io.lots import default_lot, read_lots
+from grammarc.io.lots_reading import LotsReading
 from grammarc.io.output_paths import check_writable
 from grammarc.io.reports import staged_reports
 from grammarc.io.rpk import MAX_PACKAGE_SIZE
@@ -104,61 +104,22 @@ class BuildResult:
     written: bool = True
 
 
-def find_lots(grammar_path: Path) -> Path | None:
-    """The example's own lots: ``<grammar stem>.geojson`` or ``lots.geojson`` beside the grammar."""
-    for name in (grammar_path.with_suffix(".geojson").name, "lots.geojson"):
-        candidate = grammar_path.parent / name
-        if candidate.is_file():
-            return candidate
-    return None
-
-
-def load_lots(grammar_path: Path, lots_path: Path | None, options: LotsOptions | None = None) -> Lots:
-    path = lots_path or find_lots(grammar_path)
-    return read_lots(path, options) if path is not None else default_lot()
-
-
-class _Reading:
-    """``load_lots`` in a thread of its own, started before the grammar is compiled: a large lots file takes
-    as long to read as the start-up takes, and most of the reading (Arrow's, the WKB kernel, numpy's and
-    GEOS's work over whole columns, numba's first kernel) runs outside the interpreter's lock, so the two
-    overlap on a machine of two cores. The lots, or the reading's error, are had from ``result()`` where
-    they were read before, so a grammar's errors still come first; a build that fails before leaves the
-    thread to end with the process (a daemon)."""
-
-    def __init__(self, grammar_path: Path, lots_path: Path | None, options: LotsOptions | None):
-        self._lots: Lots | None = None
-        self._error: BaseException | None = None
-        self._thread = threading.Thread(target=self._read, args=(grammar_path, lots_path, options),
-                                        name="grammarc lots", daemon=True)
-        self._thread.start()
-
-    def _read(self, grammar_path: Path, lots_path: Path | None, options: LotsOptions | None) -> None:
-        try:
-            self._lots = load_lots(grammar_path, lots_path, options)
-        except BaseException as error:  # noqa: BLE001 - raised in the build's thread by result()
-            self._error = error
-
-    def result(self) -> Lots:
-        """The lots, once read (the wait ends on a signal: Ctrl-C stops the build here as anywhere)."""
-        self._thread.join()
-        if self._error is not None:
-            raise self._error
-        return self._lots
-
-
 def build(grammar_path, output, *, lots_path=None, options: BuildOptions = BuildOptions(),
           progress=None, output_options: OutputOptions | None = None,
-          select: Sequence[str] | None = None, reports_to: Path | None = None) -> BuildResult:
+          select: Sequence[str] | None = None, reports_to: Path | None = None,
+          reading: LotsReading | None = None) -> BuildResult:
     """Derive the lots with the grammar and write the records to ``output`` (atomically).
 
     ``progress(done, total)`` is called with the number of lots finished after each chunk.
     ``select``: derive only the lots of these ids (``--select``); occlusion queries still see every
     lot's occluders, so a selected lot looks as it does in the whole city. ``reports_to``: where the
-    values of ``report()`` go, ``.json`` or ``.csv`` (default ``reports_path(output)``).
+    values of ``report()`` go, ``.json`` or ``.csv`` (default ``reports_path(output)``). ``reading``: these
+    lots (of ``lots_path`` and ``options.lots``) already being read (``io.lots_reading``: the command starts
+    reading them before it imports this module); by default the build starts reading them.
     """
     started = time.perf_counter()
-    reading = _Reading(Path(grammar_path), Path(lots_path) if lots_path else None, options.lots)
+    if reading is None:
+        reading = LotsReading(Path(grammar_path), Path(lots_path) if lots_path else None, options.lots)
     with grammar_source(Path(grammar_path), options) as (source, display, resolved):
         return _build(source, display, Path(grammar_path), output, reading, resolved, progress, started,
                       recorded_roots=options.asset_roots, output_options=output_options or OutputOptions(),
@@ -192,7 +153,7 @@ def compile_source(source: Path, display: str | None, options: BuildOptions, *, 
                            warnings_as_errors=options.warnings_as_errors, derive=derive)
 
 
-def _build(source: Path, display: str | None, grammar_path: Path, output, reading: _Reading,
+def _build(source: Path, display: str | None, grammar_path: Path, output, reading: LotsReading,
            options: BuildOptions, progress, started: float, recorded_roots: tuple[Path, ...],
            output_options: OutputOptions, select: Sequence[str] | None,
            reports_to: Path | None) -> BuildResult:
@@ -205,7 +166,7 @@ def _build(source: Path, display: str | None, grammar_path: Path, output, readin
     reporting = reports_to is not None or any(isinstance(op, ir.Report) for op in iter_ops(grammar.module))
     check_writable([*files, *([reports_file] if reporting else [])], folders)
     Path(output).parent.mkdir(parents=True, exist_ok=True)
-    every = reading.result()
+    every = reading.result(meanwhile=preload(plan))
     lots = every if select is None else every.select(select)
     if display is None:  # a rule file on disk: its CityEngine project's folders too, for a later render
         recorded_roots = (*recorded_roots, *(r for r in grammar.asset_roots[1:] if r not in recorded_roots))

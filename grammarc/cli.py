@@ -549,7 +549,8 @@ def _render_tree(args) -> int:
     import json
 
     from grammarc.backend.plan import make_plan
-    from grammarc.build import BuildOptions, compile_source, load_lots
+    from grammarc.build import BuildOptions, compile_source
+    from grammarc.io.lots_reading import load_lots
     from grammarc.search import Deriving
     from grammarc.search.tree_picture import draw_tree
 
@@ -669,6 +670,12 @@ def _conform(args) -> int:
 
 
 def _build(args) -> int:
+    from grammarc.io.lots_reading import LotsReading
+
+    lots_options = _lots_options(args)
+    # the lots are read while the derivation is imported and the grammar compiled (``io.lots_reading``)
+    reading = None if args.dask else LotsReading(args.grammar, args.lots, lots_options)
+
     from grammarc.backend.attributes import parse_override
     from grammarc.build import BuildOptions, build
     from grammarc.io import OutputOptions
@@ -684,7 +691,7 @@ def _build(args) -> int:
         workers=args.workers,
         workspace=args.workspace,
         warnings_as_errors=args.warnings_as_errors,
-        lots=_lots_options(args),
+        lots=lots_options,
         max_package_size=args.max_package_size,
     )
     bar = _ProgressBar() if not args.quiet else None
@@ -696,7 +703,7 @@ def _build(args) -> int:
                            output_options=OutputOptions(bake=args.bake, lod=args.lod, tile_size=args.tile_size,
                                                         max_triangles=args.max_triangles, bake_origin=args.bake_origin),
                            select=None if args.select is None else [i for i in args.select.split(",") if i],
-                           reports_to=args.reports)
+                           reports_to=args.reports, reading=reading)
     finally:
         if bar is not None:
             bar.close()
@@ -734,8 +741,9 @@ def _build(args) -> int:
 def _search(args) -> int:
     from grammarc.backend.attributes import check_overrides, parse_override
     from grammarc.backend.plan import make_plan
-    from grammarc.build import BuildOptions, compile_source, load_lots, record_meta
+    from grammarc.build import BuildOptions, compile_source, record_meta
     from grammarc.io import written_paths
+    from grammarc.io.lots_reading import load_lots
     from grammarc.io.output_paths import check_writable
     from grammarc.search import Deriving, SearchOptions, run_search, write_solutions
 

@@ -47,7 +47,6 @@ from grammarc.build import (
     check_overrides,
     compile_source,
     derive_all,
-    find_lots,
     grammar_source,
     occluders,
     record_meta,
@@ -56,6 +55,7 @@ from grammarc.constants import PARTITION_SIZE
 from grammarc.errors import UsageError
 from grammarc.io import OutputOptions, writer_for
 from grammarc.io.lots import Partition, count_lots, file_stamp, partition_lots, read_partition
+from grammarc.io.lots_reading import find_lots
 from grammarc.io.reports import write_reports
 from grammarc.io.shards import (
     complete_shard,

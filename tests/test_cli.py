@@ -221,7 +221,7 @@ def test_unreadable_lots_exit_1(write, tmp_path, capsys, content, message):
 
 
 def test_the_grammars_errors_and_the_options_come_before_those_of_the_lots_read_meanwhile(write, tmp_path, capsys):
-    """The lots are read in a thread while the grammar compiles (``build._Reading``); their error is said
+    """The lots are read in a thread while the grammar compiles (``io.lots_reading``); their error is said
     only where it was before, once the grammar and the options are found good."""
     missing = str(tmp_path / "missing.geojson")
     out = str(tmp_path / "out.npz")

@@ -13,11 +13,14 @@ import itertools
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from grammarc.errors import LotsError
-from grammarc.model.lots import Lots
+
+if TYPE_CHECKING:  # for annotations only: this module is imported before the lots are read (``io.lots_reading``)
+    from grammarc.model.lots import Lots
 
 __all__ = ["NO_OPTIONS", "LotsFormat", "LotsOptions", "Partition", "partitions_at", "read_text"]
 

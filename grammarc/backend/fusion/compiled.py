@@ -98,13 +98,17 @@ def ready(text: str, shapes: int, compile_at: int) -> bool:
     """Whether to derive ``shapes`` more shapes with the kernel of ``text``: it is compiled (in this process,
     or by an earlier one into the cache folder: its mark is there, whence numba loads its machine code), or
     this process has now met ``compile_at`` shapes for it, enough to pay for compiling it."""
-    if text in _KERNELS:
-        return True
-    folder = user_cache.cache_folder("fusion")
-    if folder is not None and user_cache.load(folder / f"region_{digest(text)}.compiled", lambda f: True):
+    if text in _KERNELS or compiled_before(text):
         return True
     _WAITED[text] = _WAITED.get(text, 0) + shapes
     return _WAITED[text] >= compile_at
+
+
+def compiled_before(text: str) -> bool:
+    """Whether a process compiled the kernel of ``text`` into the cache folder (its mark is there, whence
+    numba loads its machine code instead of compiling it)."""
+    folder = user_cache.cache_folder("fusion")
+    return folder is not None and bool(user_cache.load(folder / f"region_{digest(text)}.compiled", lambda f: True))
 
 
 def handed_columns(rows: int, params: int) -> tuple:

@@ -10,13 +10,14 @@ schedule reaches it, where the interpreter would have run its rules on the shape
 
 from __future__ import annotations
 
+from collections.abc import Iterator
 from dataclasses import dataclass
 
 import numpy as np
 
 from grammarc.backend import terminals
 from grammarc.backend.fusion.codegen import Block, Emit, Handoff
-from grammarc.backend.fusion.compiled import handed_columns, kernel, ready
+from grammarc.backend.fusion.compiled import compiled_before, handed_columns, kernel, ready
 from grammarc.backend.shapes import Shapes
 from grammarc.ragged import offsets_from_counts
 
@@ -108,3 +109,14 @@ def _within_limit(ctx, lot: np.ndarray, made: np.ndarray) -> bool:
         return True
     return bool((np.bincount(lot, weights=made, minlength=len(chunk.shape_count)) + chunk.shape_count
                  <= limit).all())
+
+
+def preload(plan) -> Iterator[None]:
+    """Load the machine code of ``plan``'s kernels that an earlier build compiled, one a step (none is
+    compiled here), for a build to run while it waits for its lots (``io.lots_reading``): the kernels are
+    then loaded when its workers are forked, which would otherwise each load them again as their shapes
+    come."""
+    for region in plan.fused.values():
+        if compiled_before(region.source.text):
+            kernel(region.source.text, len(plan.symbols[region.root].param_types) + len(region.source.attrs))
+            yield

@@ -11,7 +11,9 @@ import pytest
 from conftest import make_lots
 
 from grammarc.backend import execute
+from grammarc.backend.fusion import compiled
 from grammarc.backend.fusion.fused import derive as derive_fused
+from grammarc.backend.fusion.fused import preload
 from grammarc.backend.fusion.regions import SWITCH
 from grammarc.backend.plan import make_plan
 from grammarc.build import BuildOptions, derive
@@ -219,3 +221,15 @@ def test_a_scope_beyond_any_coordinate_is_left_to_the_interpreter_which_fails_it
     fused, interpreted = both(write, monkeypatch, text, make_lots("square", "rect_12x8"))
     assert fused["bad"] and all("beyond any coordinate" in b.reason for b in fused["bad"])
     assert_same(fused, interpreted)
+
+
+def test_preload_loads_the_kernels_an_earlier_build_compiled_and_compiles_none(write, monkeypatch, tmp_path):
+    monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path))  # a cache folder where nothing is compiled yet
+    monkeypatch.setattr(compiled, "_KERNELS", {})
+    path = write("g.cga", 'lot ~> Repeat("X", 2){ I("cube") }\n')
+    plan = make_plan(compile_grammar(path))
+    [region] = plan.fused.values()
+    assert list(preload(plan)) == [] and region.source.text not in compiled._KERNELS
+    derive(compile_grammar(path), make_lots("square"), BuildOptions())  # compiles the kernel
+    monkeypatch.setattr(compiled, "_KERNELS", {})  # as in the next build's process
+    assert len(list(preload(plan))) == 1 and region.source.text in compiled._KERNELS
