@@ -414,6 +414,9 @@ def _at_vertex_0(best, corner, along, outer):
 #: The cosine under which a lost edge faces the moved line that swept it (``_before_a_sweep``): 2 degrees,
 #: as the parallel neighbours of ``geometry.setback``.
 _FACING = float(np.cos(np.radians(2.0)))
+#: How much of the moved edge's length (``_before_a_sweep``) a facing edge must lie beside to be swept by its
+#: strip: any of it but rounding.
+_BESIDE = 1e-9
 
 
 @njit(cache=True, nogil=True)
@@ -425,14 +428,17 @@ def _before_a_sweep(best, keys, moved_in, moved_from, along, outer, ring):
     parent's outer ring first, ``outer`` vertices).
 
     Where the first edge left is a moved line (``best``, edge k) that swept over a kept edge facing it
-    (parallel, within 2 degrees) among the edges lost from the run before it around to edge k (an arm
-    narrower than the setback: its side and end go under edge k's strip), PRT starts the remainder at that
-    run (or moved line), along the last edge left (measured through PyPRT on an L whose 3 m arm's long
-    side, set back 4 m, covers the arm, its vertex 0 at the arm's end, the arm's inner side cut in one or
-    two edges or vertex 0 between them, the inner side kept or set back 3 m: massing.L.50366's second
-    tier, holes.44173's). A moved line that passed a kept edge's far end is no sweep (a chamfer between two
-    moved edges, or beside a kept one: PRT starts at the moved line). Where edge 0 is lost otherwise and the
-    kept last edge's run is left, the remainder starts where that run ends."""
+    (parallel, within 2 degrees, and beside some of edge k) among the edges lost from the run before it
+    around to edge k (an arm narrower than the setback: its side and end go under edge k's strip), PRT
+    starts the remainder at that run (or moved line), along the last edge left (measured through PyPRT on
+    an L whose 3 m arm's long side, set back 4 m, covers the arm, its vertex 0 at the arm's end, the arm's
+    inner side cut in one or two edges or vertex 0 between them, the inner side kept or set back 3 m:
+    massing.L.50366's second tier, holes.44173's). A facing edge beside none of edge k (lost under another
+    strip) is no sweep: PRT starts at the moved line (a 0.6 m jog set back 4 m whose facing 0.6 m edge lies
+    4 m past its end, measured through PyPRT; massing.seoul.47's second tier). Nor is a moved line that
+    passed a kept edge's far end (a chamfer between two moved edges, or beside a kept one: PRT starts at
+    the moved line). Where edge 0 is lost otherwise and the kept last edge's run is left, the remainder
+    starts where that run ends."""
     n = len(keys)
     if keys.min() < 1.0 or (moved_from == 0.0).any():  # (edge 0, or vertex 0, is left)
         return best
@@ -449,11 +455,17 @@ def _before_a_sweep(best, keys, moved_in, moved_from, along, outer, ring):
         return best
     kx, ky = ring[(int(k) + 1) % outer, 0] - ring[int(k), 0], ring[(int(k) + 1) % outer, 1] - ring[int(k), 1]
     size = np.sqrt(kx * kx + ky * ky)
+    if size == 0.0:
+        return best
     i = (int(p) + 1) % outer
     while i != int(k):
         ex, ey = ring[(i + 1) % outer, 0] - ring[i, 0], ring[(i + 1) % outer, 1] - ring[i, 1]
         length = np.sqrt(ex * ex + ey * ey)
-        if length > 0.0 and size > 0.0 and (ex * kx + ey * ky) / (length * size) < -_FACING:
+        # (how far along edge k each end of the edge lies: the strip sweeps it only where the two overlap)
+        t0 = ((ring[i, 0] - ring[int(k), 0]) * kx + (ring[i, 1] - ring[int(k), 1]) * ky) / size
+        t1 = t0 + (ex * kx + ey * ky) / size
+        beside = min(t0, t1) < size - _BESIDE * size and max(t0, t1) > _BESIDE * size
+        if length > 0.0 and (ex * kx + ey * ky) / (length * size) < -_FACING and beside:
             return previous
         i = (i + 1) % outer
     return best

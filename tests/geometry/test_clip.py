@@ -522,6 +522,12 @@ ARM_L = [(10, 0), (10, 3), (-10, 3), (-10, -10), (-5, -10), (-5, 0)]  # vertex 0
     ([(-7, 3), (-7, 0), (2, 0), (2, -6), (12, -6), (12, 3)], [(2, 3), (2, 0), (2, -6), (12, -6), (12, 3)], (2, 3)),
     # a kept chamfer (edge 0) that the moved line of edge 1 passes: no sweep, PRT starts at that moved line
     ([(0, 1), (1, 0), (20, 0), (20, 10), (0, 10)], [(0, 4), (20, 4), (20, 10), (0, 10)], (0, 4)),
+    # a 0.6 m jog (edge 1) set back 4 m, with edge 0: the kept 0.6 m edge facing it that edge 0's strip takes
+    # lies 4 m beyond the jog's end, beside none of it, so it is no sweep: PRT starts at the jog's moved line
+    # (its second tier's edge 0 set back 1 m alone: PRT's terrace the 4.1 m^2 strip along x = 10, measured
+    # through PyPRT; was the 4.0 m^2 one along the kept y = 4.1; massing.seoul.47's second tier)
+    ([(0, 0.6), (6, 0.6), (6, 0), (14, 0), (14, 4.1), (9, 4.1), (9, 4.7), (4, 4.7), (4, 12), (0, 12)],
+     [(10, 0), (14, 0), (14, 4.1), (10, 4.1)], (10, 4.1)),
 ])
 def test_a_remainder_that_lost_edge_0_starts_where_prt_starts_it(lot, remainder, first):
     """massing's first tier set back as the comments say on these lots (map coordinates), PRT's second tier's
