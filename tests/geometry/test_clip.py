@@ -544,3 +544,34 @@ def test_a_remainder_that_lost_edge_0_starts_where_prt_starts_it(lot, remainder,
                             np.array([[30.0, 0.0, 30.0]]), np.array([lot]))
         start = pieces.coords[0] * pieces.extent[0, [0, 2]] + pieces.low[0, [0, 2]]
         np.testing.assert_allclose(start, _flip([first])[0], atol=1e-9)
+
+
+JOG_BLOCK = [(20, 5.4), (10, 5.4), (10, 6), (6, 6), (6, 6.6), (4, 6.6), (4, 6), (0, 6), (0, 0), (20, 0)]
+
+
+@pytest.mark.parametrize("moves, remainder, first", [
+    # edges 0 and 2 set back 4 m past the kept 0.6 m jog (edge 1), carried along its line: PRT starts at edge
+    # 2's moved line (was: at edge 0's, which edge 2's moved line was taken for, the nearer parallel)
+    ([4, 0, 4, 4], [(20, 1.4), (10, 1.4), (10, 2), (2, 2), (2, 6), (0, 6), (0, 0), (20, 0)], (10, 2)),
+    # edge 3 kept: the remainder runs on through its kept vertex, which is no start
+    ([4, 0, 4, 0], [(20, 1.4), (10, 1.4), (10, 2), (6, 2), (6, 6), (6, 6.6), (4, 6.6), (4, 6), (0, 6), (0, 0),
+                    (20, 0)], (10, 2)),
+    # edge 0 set back 3 m: the jog vanishes and the step left runs against its line: at edge 0's moved line
+    ([3, 0, 4, 4], [(20, 2.4), (10, 2.4), (10, 2), (2, 2), (2, 6), (0, 6), (0, 0), (20, 0)], (20, 2.4)),
+])
+def test_a_remainder_past_a_carried_jog_starts_where_prt_starts_it(moves, remainder, first):
+    """massing's first tier set back as ``moves`` says on a 20 x 6 m block with a kept jog after edge 0, PRT's
+    second tier's edge 0 measured through PyPRT (a setback of it alone by 1 m; the jog 0.5 to 0.8 m high:
+    five of five; massing.tartu.8's second tier), on every turn of the remainder's ring."""
+    import shapely
+
+    from grammarc.geometry.clip import fit_pieces
+
+    lot = shapely.Polygon(_flip(JOG_BLOCK))
+    distances = np.array(moves + [0] * (len(JOG_BLOCK) - len(moves)), float)
+    ring = np.array(_flip(remainder), float)
+    for turned in range(len(ring)):  # GEOS's start anywhere on the ring
+        pieces = fit_pieces(np.array([shapely.Polygon(np.roll(ring, turned, axis=0))]), np.array([1]),
+                            np.array([[30.0, 0.0, 30.0]]), np.array([lot]), moves=distances)
+        start = pieces.coords[0] * pieces.extent[0, [0, 2]] + pieces.low[0, [0, 2]]
+        np.testing.assert_allclose(start, _flip([first])[0], atol=1e-9)
