@@ -322,8 +322,6 @@ def ring_starts(coords, ring_offsets, part_offsets, part_source, part_with_start
             if not cut and not part_inset[p]:
                 outer = parent_rings[parent_offsets[g] + 1] - parent_rings[parent_offsets[g]]
                 _after_steps(keys, moved_from, moved_in, r0, r1, outer)
-                _after_carried_edges(keys, coords, moved_from, moved_in, runs_along, r0, r1, outer,
-                                     parent_coords[parent_rings[parent_offsets[g]]:])
                 _runs_into_kept_vertices(keys, corner, runs_along, moved_in, r0, r1, outer)
     last_end = _last_edge_ends(coords, ring_offsets, part_offsets, part_source, part_inset, moved_from,
                                parent_coords, parent_rings, parent_offsets)
@@ -336,16 +334,14 @@ def ring_starts(coords, ring_offsets, part_offsets, part_source, part_with_start
             best = _first(keys[r0:r1], ties[r0:r1])
             if r == part_offsets[p] and not cut and not part_inset[p] and moved_in[r0 + best]:
                 # a moved edge whose strip stops short of the vertex it ends at (a step, a reflex corner):
-                # the remainder starts at that vertex, which it keeps; not where the remainder runs on
-                # through it along the next edge's line (a kept edge carried along its line past it: PRT's
-                # tier starts at the moved edge, measured through PyPRT on the block of
-                # ``_after_carried_edges`` with its edge 3 kept)
+                # the remainder starts at that vertex, which it keeps
                 end = (keys[r0 + best] + 1.0) % outer
                 for j in range(n):
-                    through = runs_along[r0 + j] >= 0 and runs_along[r0 + (j - 1) % n] == runs_along[r0 + j]
-                    if at_vertex[r0 + j] and keys[r0 + j] == end and not through:
+                    if at_vertex[r0 + j] and keys[r0 + j] == end:
                         best = j
                         break
+                best = _past_a_carried_edge(best, coords[r0:r1], moved_from[r0:r1], moved_in[r0:r1],
+                                            runs_along[r0:r1], outer, parent_coords[parent_rings[parent_offsets[g]]:])
             if r == part_offsets[p] and not cut and not part_inset[p]:
                 best = _at_vertex_0(best, corner[r0:r1], runs_along[r0:r1], outer)
                 best = _before_a_sweep(best, keys[r0:r1], moved_in[r0:r1], moved_from[r0:r1], runs_along[r0:r1],
@@ -502,37 +498,35 @@ def _after_steps(keys, moved_from, moved_in, r0, r1, outer):
 
 
 @njit(cache=True, nogil=True)
-def _after_carried_edges(keys, coords, moved_from, moved_in, along, r0, r1, outer, ring):
-    """A setback's remainder whose edge moved in from parent edge i runs on along the line of the kept edge
-    i + 1 beside none of it, to the edge moved in from edge i + 2 (a kept jog at a reflex vertex between
-    two moved edges, carried along its own line as both its ends slide: the jog's far end moved no less
-    than its near one), counts that edge and the run after edge i + 2: PRT starts its tier at edge i + 2's
-    moved line (measured through PyPRT: an 18 x 6 m block whose 0.5 to 0.8 m jog after edge 0 is kept,
-    edges 0 and 2 set back 4 m, or 4 and 3 m: PRT's second tier's edge 0 is edge 2's moved line, five of
-    five; massing.tartu.8's second tier, whose 0.64 m jog its first tier carries). Where the jog's far end
-    moved less, the jog vanishes and the step left runs against its line: PRT starts at edge i's moved line
-    (edges 0 and 2 set back 3 and 4 m, measured likewise). ``coords`` (V, 2), ``moved_from``, ``moved_in``,
-    ``along`` (V,) as ``ring_starts`` finds them; ``ring`` the parent's outer ring first, ``outer``
-    vertices; ``keys`` (V,) turned in place for the ring ``r0:r1``."""
-    n = r1 - r0
-    for j in range(r0, r1):
-        k = r0 + (j - r0 + 1) % n
-        m = r0 + (j - r0 + 2) % n
-        i = moved_from[j]
-        if not (moved_in[j] and keys[j] == i and i + 2 < outer and along[k] == i + 1 and moved_in[m]
-                and moved_from[m] == i + 2):
-            continue
-        e = int(i) + 1
-        ax, ay = ring[e, 0], ring[e, 1]
-        bx, by = ring[e + 1, 0] - ax, ring[e + 1, 1] - ay
-        length2 = bx * bx + by * by
-        if length2 == 0.0:
-            continue
-        # (where the run's ends lie along edge i + 1, in its lengths: beside none of it outside [0, 1])
-        t0 = ((coords[k, 0] - ax) * bx + (coords[k, 1] - ay) * by) / length2
-        t1 = ((coords[m, 0] - ax) * bx + (coords[m, 1] - ay) * by) / length2
-        if max(t0, t1) < -_BESIDE or min(t0, t1) > 1.0 + _BESIDE:
-            keys[j] = keys[k] = i + 2.5
+def _past_a_carried_edge(best, coords, moved_from, moved_in, along, outer, ring):
+    """The vertex (an index into one ring of a setback's remainder) where PRT starts a remainder whose first
+    edge (``best``), moved in from parent edge i, runs on along the line of the kept edge i + 1 beside none
+    of it to the edge moved in from edge i + 2 (a kept jog at a reflex vertex between two moved edges,
+    carried along its own line as both its ends slide: its far end moved no less than its near one): that
+    edge, ``best`` otherwise (measured through PyPRT: a 20 x 6 m block whose 0.5 to 0.8 m jog after edge 0
+    is kept, edges 0 and 2 set back 4 m, or 4 and 3 m, edge 3 set back 4 m or kept: PRT's second tier's
+    edge 0 is edge 2's moved line, seven of seven; massing.tartu.8's second tier, whose 0.64 m jog its
+    first tier carries). Where the jog's far end moved less, the jog vanishes and the step left runs against
+    its line: PRT starts at edge i's moved line (edges 0 and 2 set back 3 and 4 m, measured likewise).
+    ``coords`` (n, 2) the ring, ``moved_from``, ``moved_in``, ``along`` (n,) as ``ring_starts`` finds them;
+    ``ring`` the parent's outer ring first, ``outer`` vertices."""
+    n = len(moved_from)
+    k, m = (best + 1) % n, (best + 2) % n
+    i = moved_from[best]
+    if not (moved_in[best] and i + 2 < outer and along[k] == i + 1 and moved_in[m] and moved_from[m] == i + 2):
+        return best
+    e = int(i) + 1
+    ax, ay = ring[e, 0], ring[e, 1]
+    bx, by = ring[e + 1, 0] - ax, ring[e + 1, 1] - ay
+    length2 = bx * bx + by * by
+    if length2 == 0.0:
+        return best
+    # (where the run's ends lie along edge i + 1, in its lengths: beside none of it outside [0, 1])
+    t0 = ((coords[k, 0] - ax) * bx + (coords[k, 1] - ay) * by) / length2
+    t1 = ((coords[m, 0] - ax) * bx + (coords[m, 1] - ay) * by) / length2
+    if max(t0, t1) < -_BESIDE or min(t0, t1) > 1.0 + _BESIDE:
+        return m
+    return best
 
 
 @njit(cache=True, nogil=True)
