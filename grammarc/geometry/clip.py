@@ -340,8 +340,12 @@ def ring_starts(coords, ring_offsets, part_offsets, part_source, part_with_start
                     if at_vertex[r0 + j] and keys[r0 + j] == end:
                         best = j
                         break
+                # (a swept last edge first: PRT's start on the lot of both, massing.seoul.37's first tier)
+                ring = parent_coords[parent_rings[parent_offsets[g]]:]
+                best = _past_a_swept_last_edge(best, corner[r0:r1], moved_from[r0:r1], moved_in[r0:r1],
+                                               runs_along[r0:r1], outer, ring)
                 best = _past_a_carried_edge(best, coords[r0:r1], moved_from[r0:r1], moved_in[r0:r1],
-                                            runs_along[r0:r1], outer, parent_coords[parent_rings[parent_offsets[g]]:])
+                                            runs_along[r0:r1], outer, ring)
             if r == part_offsets[p] and not cut and not part_inset[p]:
                 best = _at_vertex_0(best, corner[r0:r1], runs_along[r0:r1], outer)
                 best = _before_a_sweep(best, keys[r0:r1], moved_in[r0:r1], moved_from[r0:r1], runs_along[r0:r1],
@@ -470,6 +474,37 @@ def _before_a_sweep(best, keys, moved_in, moved_from, along, outer, ring):
         if length > 0.0 and (ex * kx + ey * ky) / (length * size) < -_FACING and beside:
             return previous
         i = (i + 1) % outer
+    return best
+
+
+#: The sine of the largest turn off square (degrees) between the kept last edge and edge 0 at which a
+#: remainder that edge 0's moved line swept the last edge from starts before it (``_past_a_swept_last_edge``):
+#: measured between 20 (starts before) and 30 (at edge 0's moved line).
+_SWEPT_SQUARE = float(np.sin(np.radians(25.0)))
+
+
+@njit(cache=True, nogil=True)
+def _past_a_swept_last_edge(best, corner, moved_from, moved_in, along, outer, ring):
+    """The vertex (an index into one ring of a setback's remainder) where PRT starts a remainder whose first
+    edge (``best``) is edge 0's moved line that ran past the far end of the kept last edge (edge 0 the end of
+    an arm, or the bottom of a notch, shorter than its setback: the remainder steps from the last edge's
+    start, which it keeps, out to that line): the run along the edge before the last that ends there, where
+    the last edge turns from edge 0 by a right angle, give or take ``_SWEPT_SQUARE`` (measured through
+    PyPRT: a 1.4 m wide arm, 1.7 to 3.5 m long, whose end, edge 0, is set back 4 m, its top the last edge,
+    turned 0, 10 or 20 degrees off square: PRT's second tier's edge 0 is that run; 30 and 45: edge 0's moved
+    line; massing.H.51126's and seoul.37's second tiers); ``best`` otherwise. ``corner``, ``moved_from``,
+    ``moved_in``, ``along`` (n,) as ``ring_starts`` finds them; ``ring`` the parent's outer ring first,
+    ``outer`` vertices."""
+    n = len(corner)
+    step, run = (best - 1) % n, (best - 2) % n
+    if not (moved_in[best] and moved_from[best] == 0.0 and outer >= 3 and corner[step] == outer - 1
+            and not np.isfinite(moved_from[step]) and along[run] == outer - 2):
+        return best
+    lx, ly = ring[0, 0] - ring[outer - 1, 0], ring[0, 1] - ring[outer - 1, 1]
+    ex, ey = ring[1, 0] - ring[0, 0], ring[1, 1] - ring[0, 1]
+    sizes = np.sqrt((lx * lx + ly * ly) * (ex * ex + ey * ey))
+    if sizes > 0.0 and abs(lx * ex + ly * ey) <= _SWEPT_SQUARE * sizes:
+        return run
     return best
 
 

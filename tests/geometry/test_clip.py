@@ -575,3 +575,35 @@ def test_a_remainder_past_a_carried_jog_starts_where_prt_starts_it(moves, remain
                             np.array([[30.0, 0.0, 30.0]]), np.array([lot]), moves=distances)
         start = pieces.coords[0] * pieces.extent[0, [0, 2]] + pieces.low[0, [0, 2]]
         np.testing.assert_allclose(start, _flip([first])[0], atol=1e-9)
+
+
+def _arm(turn):
+    """A 12 x 11 m block with a 1.4 m wide arm whose end is edge 0 and whose top, the last edge, turns
+    ``turn`` degrees off square (its inner end raised)."""
+    top = 8.2 + 3.5 * np.tan(np.radians(turn))
+    return [(0, 8.2), (0, 6.8), (1.7, 6.8), (1.7, 3), (12, 3), (12, 14), (5, 14), (5, 13), (3.5, 13), (3.5, top)]
+
+
+@pytest.mark.parametrize("turn, remainder, first", [
+    # the arm's end set back 4 m past the top's far end: PRT starts at the run along the edge before the last
+    (0, [(4, 8.2), (4, 7), (12, 7), (12, 14), (5, 14), (5, 13), (3.5, 13), (3.5, 8.2)], (3.5, 13)),
+    # the top turned 30 degrees: at edge 0's moved line
+    (30, [(3.5, 13), (5, 13), (5, 14), (12, 14), (12, 7), (4, 7), (4, 10.5094), (3.5, 10.2207)], (4, 10.5094)),
+])
+def test_a_remainder_past_a_swept_last_edge_starts_where_prt_starts_it(turn, remainder, first):
+    """massing's first tier ("4;0;4;4;0") on ``_arm``, PRT's second tier's edge 0 measured through PyPRT (a
+    setback of it alone by 1 m: the run before the last edge at 0, 10 and 20 degrees, edge 0's moved line
+    at 30 and 45; massing.seoul.37's second tier), on every turn of the remainder's ring."""
+    import shapely
+
+    from grammarc.geometry.clip import fit_pieces
+
+    lot = _arm(turn)
+    distances = np.array([4, 0, 4, 4] + [0] * (len(lot) - 4), float)
+    ring = np.array(_flip(remainder), float)
+    for turned in range(len(ring)):  # GEOS's start anywhere on the ring
+        pieces = fit_pieces(np.array([shapely.Polygon(np.roll(ring, turned, axis=0))]), np.array([1]),
+                            np.array([[30.0, 0.0, 30.0]]), np.array([shapely.Polygon(_flip(lot))]),
+                            moves=distances)
+        start = pieces.coords[0] * pieces.extent[0, [0, 2]] + pieces.low[0, [0, 2]]
+        np.testing.assert_allclose(start, _flip([first])[0], atol=1e-4)

@@ -546,3 +546,17 @@ def test_tier_setback_past_a_kept_jog_starts_where_prt_starts_it(write, first, t
             'R --> setback(comp(fe){ all : float(listItem("1", comp.index)) }) { all : T | remainder : S }\n'
             'T --> report("t", geometry.area)\n')
     assert totals(run(write, text, [block]))["t_sum"] == pytest.approx(terrace)
+
+
+def test_tier_setback_past_a_swept_arm_starts_where_prt_starts_it(write):
+    """massing's two tiers on a 12 x 11 m block whose 1.4 m wide arm's end (edge 0) its first tier sets back
+    4 m, past the arm's 3.5 m top (the last edge), the second tier setting back its edge 0 alone by 1 m: PRT's
+    terrace is the strip along the edge before the last, 4.8 m^2, measured through PyPRT (was 1.2, along
+    edge 0's moved line; massing.seoul.37's second tier)."""
+    block = [np.array([[0, 8.2], [0, 6.8], [1.7, 6.8], [1.7, 3], [12, 3], [12, 14], [5, 14], [5, 13], [3.5, 13],
+                       [3.5, 8.2]], float)]
+    text = ('Lot --> setback(comp(fe){ all : float(listItem("4;0;4;4;0;0;0;0;0;0", comp.index)) })'
+            '{ all : A | remainder : R }\n'
+            'R --> setback(comp(fe){ all : float(listItem("1", comp.index)) }) { all : T | remainder : S }\n'
+            'T --> report("t", geometry.area)\n')
+    assert totals(run(write, text, [block]))["t_sum"] == pytest.approx(4.8)
