@@ -340,6 +340,12 @@ def ring_starts(coords, ring_offsets, part_offsets, part_source, part_with_start
                     if at_vertex[r0 + j] and keys[r0 + j] == end:
                         best = j
                         break
+                # (a swept last edge first: PRT's start on the lot of both, massing.seoul.37's first tier)
+                ring = parent_coords[parent_rings[parent_offsets[g]]:]
+                best = _past_a_swept_last_edge(best, corner[r0:r1], moved_from[r0:r1], moved_in[r0:r1],
+                                               runs_along[r0:r1], outer, ring)
+                best = _past_a_carried_edge(best, coords[r0:r1], moved_from[r0:r1], moved_in[r0:r1],
+                                            runs_along[r0:r1], outer, ring)
             if r == part_offsets[p] and not cut and not part_inset[p]:
                 best = _at_vertex_0(best, corner[r0:r1], runs_along[r0:r1], outer)
                 best = _before_a_sweep(best, keys[r0:r1], moved_in[r0:r1], moved_from[r0:r1], runs_along[r0:r1],
@@ -414,6 +420,9 @@ def _at_vertex_0(best, corner, along, outer):
 #: The cosine under which a lost edge faces the moved line that swept it (``_before_a_sweep``): 2 degrees,
 #: as the parallel neighbours of ``geometry.setback``.
 _FACING = float(np.cos(np.radians(2.0)))
+#: How much of the moved edge's length (``_before_a_sweep``) a facing edge must lie beside to be swept by its
+#: strip: any of it but rounding.
+_BESIDE = 1e-9
 
 
 @njit(cache=True, nogil=True)
@@ -425,14 +434,17 @@ def _before_a_sweep(best, keys, moved_in, moved_from, along, outer, ring):
     parent's outer ring first, ``outer`` vertices).
 
     Where the first edge left is a moved line (``best``, edge k) that swept over a kept edge facing it
-    (parallel, within 2 degrees) among the edges lost from the run before it around to edge k (an arm
-    narrower than the setback: its side and end go under edge k's strip), PRT starts the remainder at that
-    run (or moved line), along the last edge left (measured through PyPRT on an L whose 3 m arm's long
-    side, set back 4 m, covers the arm, its vertex 0 at the arm's end, the arm's inner side cut in one or
-    two edges or vertex 0 between them, the inner side kept or set back 3 m: massing.L.50366's second
-    tier, holes.44173's). A moved line that passed a kept edge's far end is no sweep (a chamfer between two
-    moved edges, or beside a kept one: PRT starts at the moved line). Where edge 0 is lost otherwise and the
-    kept last edge's run is left, the remainder starts where that run ends."""
+    (parallel, within 2 degrees, and beside some of edge k) among the edges lost from the run before it
+    around to edge k (an arm narrower than the setback: its side and end go under edge k's strip), PRT
+    starts the remainder at that run (or moved line), along the last edge left (measured through PyPRT on
+    an L whose 3 m arm's long side, set back 4 m, covers the arm, its vertex 0 at the arm's end, the arm's
+    inner side cut in one or two edges or vertex 0 between them, the inner side kept or set back 3 m:
+    massing.L.50366's second tier, holes.44173's). A facing edge beside none of edge k (lost under another
+    strip) is no sweep: PRT starts at the moved line (a 0.6 m jog set back 4 m whose facing 0.6 m edge lies
+    4 m past its end, measured through PyPRT; massing.seoul.47's second tier). Nor is a moved line that
+    passed a kept edge's far end (a chamfer between two moved edges, or beside a kept one: PRT starts at
+    the moved line). Where edge 0 is lost otherwise and the kept last edge's run is left, the remainder
+    starts where that run ends."""
     n = len(keys)
     if keys.min() < 1.0 or (moved_from == 0.0).any():  # (edge 0, or vertex 0, is left)
         return best
@@ -449,13 +461,50 @@ def _before_a_sweep(best, keys, moved_in, moved_from, along, outer, ring):
         return best
     kx, ky = ring[(int(k) + 1) % outer, 0] - ring[int(k), 0], ring[(int(k) + 1) % outer, 1] - ring[int(k), 1]
     size = np.sqrt(kx * kx + ky * ky)
+    if size == 0.0:
+        return best
     i = (int(p) + 1) % outer
     while i != int(k):
         ex, ey = ring[(i + 1) % outer, 0] - ring[i, 0], ring[(i + 1) % outer, 1] - ring[i, 1]
         length = np.sqrt(ex * ex + ey * ey)
-        if length > 0.0 and size > 0.0 and (ex * kx + ey * ky) / (length * size) < -_FACING:
+        # (how far along edge k each end of the edge lies: the strip sweeps it only where the two overlap)
+        t0 = ((ring[i, 0] - ring[int(k), 0]) * kx + (ring[i, 1] - ring[int(k), 1]) * ky) / size
+        t1 = t0 + (ex * kx + ey * ky) / size
+        beside = min(t0, t1) < size - _BESIDE * size and max(t0, t1) > _BESIDE * size
+        if length > 0.0 and (ex * kx + ey * ky) / (length * size) < -_FACING and beside:
             return previous
         i = (i + 1) % outer
+    return best
+
+
+#: The sine of the largest turn off square (degrees) between the kept last edge and edge 0 at which a
+#: remainder that edge 0's moved line swept the last edge from starts before it (``_past_a_swept_last_edge``):
+#: measured between 20 (starts before) and 30 (at edge 0's moved line).
+_SWEPT_SQUARE = float(np.sin(np.radians(25.0)))
+
+
+@njit(cache=True, nogil=True)
+def _past_a_swept_last_edge(best, corner, moved_from, moved_in, along, outer, ring):
+    """The vertex (an index into one ring of a setback's remainder) where PRT starts a remainder whose first
+    edge (``best``) is edge 0's moved line that ran past the far end of the kept last edge (edge 0 the end of
+    an arm, or the bottom of a notch, shorter than its setback: the remainder steps from the last edge's
+    start, which it keeps, out to that line): the run along the edge before the last that ends there, where
+    the last edge turns from edge 0 by a right angle, give or take ``_SWEPT_SQUARE`` (measured through
+    PyPRT: a 1.4 m wide arm, 1.7 to 3.5 m long, whose end, edge 0, is set back 4 m, its top the last edge,
+    turned 0, 10 or 20 degrees off square: PRT's second tier's edge 0 is that run; 30 and 45: edge 0's moved
+    line; massing.H.51126's and seoul.37's second tiers); ``best`` otherwise. ``corner``, ``moved_from``,
+    ``moved_in``, ``along`` (n,) as ``ring_starts`` finds them; ``ring`` the parent's outer ring first,
+    ``outer`` vertices."""
+    n = len(corner)
+    step, run = (best - 1) % n, (best - 2) % n
+    if not (moved_in[best] and moved_from[best] == 0.0 and outer >= 3 and corner[step] == outer - 1
+            and not np.isfinite(moved_from[step]) and along[run] == outer - 2):
+        return best
+    lx, ly = ring[0, 0] - ring[outer - 1, 0], ring[0, 1] - ring[outer - 1, 1]
+    ex, ey = ring[1, 0] - ring[0, 0], ring[1, 1] - ring[0, 1]
+    sizes = np.sqrt((lx * lx + ly * ly) * (ex * ex + ey * ey))
+    if sizes > 0.0 and abs(lx * ex + ly * ey) <= _SWEPT_SQUARE * sizes:
+        return run
     return best
 
 
@@ -481,6 +530,38 @@ def _after_steps(keys, moved_from, moved_in, r0, r1, outer):
         if np.isfinite(i) and keys[j] == i and not np.isfinite(moved_from[k]) and (
                 moved_from[m] == following or keys[m] == following):
             keys[j] = keys[k] = i + 1.5
+
+
+@njit(cache=True, nogil=True)
+def _past_a_carried_edge(best, coords, moved_from, moved_in, along, outer, ring):
+    """The vertex (an index into one ring of a setback's remainder) where PRT starts a remainder whose first
+    edge (``best``), moved in from parent edge i, runs on along the line of the kept edge i + 1 beside none
+    of it to the edge moved in from edge i + 2 (a kept jog at a reflex vertex between two moved edges,
+    carried along its own line as both its ends slide: its far end moved no less than its near one): that
+    edge, ``best`` otherwise (measured through PyPRT: a 20 x 6 m block whose 0.5 to 0.8 m jog after edge 0
+    is kept, edges 0 and 2 set back 4 m, or 4 and 3 m, edge 3 set back 4 m or kept: PRT's second tier's
+    edge 0 is edge 2's moved line, seven of seven; massing.tartu.8's second tier, whose 0.64 m jog its
+    first tier carries). Where the jog's far end moved less, the jog vanishes and the step left runs against
+    its line: PRT starts at edge i's moved line (edges 0 and 2 set back 3 and 4 m, measured likewise).
+    ``coords`` (n, 2) the ring, ``moved_from``, ``moved_in``, ``along`` (n,) as ``ring_starts`` finds them;
+    ``ring`` the parent's outer ring first, ``outer`` vertices."""
+    n = len(moved_from)
+    k, m = (best + 1) % n, (best + 2) % n
+    i = moved_from[best]
+    if not (moved_in[best] and i + 2 < outer and along[k] == i + 1 and moved_in[m] and moved_from[m] == i + 2):
+        return best
+    e = int(i) + 1
+    ax, ay = ring[e, 0], ring[e, 1]
+    bx, by = ring[e + 1, 0] - ax, ring[e + 1, 1] - ay
+    length2 = bx * bx + by * by
+    if length2 == 0.0:
+        return best
+    # (where the run's ends lie along edge i + 1, in its lengths: beside none of it outside [0, 1])
+    t0 = ((coords[k, 0] - ax) * bx + (coords[k, 1] - ay) * by) / length2
+    t1 = ((coords[m, 0] - ax) * bx + (coords[m, 1] - ay) * by) / length2
+    if max(t0, t1) < -_BESIDE or min(t0, t1) > 1.0 + _BESIDE:
+        return m
+    return best
 
 
 @njit(cache=True, nogil=True)

@@ -522,6 +522,12 @@ ARM_L = [(10, 0), (10, 3), (-10, 3), (-10, -10), (-5, -10), (-5, 0)]  # vertex 0
     ([(-7, 3), (-7, 0), (2, 0), (2, -6), (12, -6), (12, 3)], [(2, 3), (2, 0), (2, -6), (12, -6), (12, 3)], (2, 3)),
     # a kept chamfer (edge 0) that the moved line of edge 1 passes: no sweep, PRT starts at that moved line
     ([(0, 1), (1, 0), (20, 0), (20, 10), (0, 10)], [(0, 4), (20, 4), (20, 10), (0, 10)], (0, 4)),
+    # a 0.6 m jog (edge 1) set back 4 m, with edge 0: the kept 0.6 m edge facing it that edge 0's strip takes
+    # lies 4 m beyond the jog's end, beside none of it, so it is no sweep: PRT starts at the jog's moved line
+    # (its second tier's edge 0 set back 1 m alone: PRT's terrace the 4.1 m^2 strip along x = 10, measured
+    # through PyPRT; was the 4.0 m^2 one along the kept y = 4.1; massing.seoul.47's second tier)
+    ([(0, 0.6), (6, 0.6), (6, 0), (14, 0), (14, 4.1), (9, 4.1), (9, 4.7), (4, 4.7), (4, 12), (0, 12)],
+     [(10, 0), (14, 0), (14, 4.1), (10, 4.1)], (10, 4.1)),
 ])
 def test_a_remainder_that_lost_edge_0_starts_where_prt_starts_it(lot, remainder, first):
     """massing's first tier set back as the comments say on these lots (map coordinates), PRT's second tier's
@@ -538,3 +544,66 @@ def test_a_remainder_that_lost_edge_0_starts_where_prt_starts_it(lot, remainder,
                             np.array([[30.0, 0.0, 30.0]]), np.array([lot]))
         start = pieces.coords[0] * pieces.extent[0, [0, 2]] + pieces.low[0, [0, 2]]
         np.testing.assert_allclose(start, _flip([first])[0], atol=1e-9)
+
+
+JOG_BLOCK = [(20, 5.4), (10, 5.4), (10, 6), (6, 6), (6, 6.6), (4, 6.6), (4, 6), (0, 6), (0, 0), (20, 0)]
+
+
+@pytest.mark.parametrize("moves, remainder, first", [
+    # edges 0 and 2 set back 4 m past the kept 0.6 m jog (edge 1), carried along its line: PRT starts at edge
+    # 2's moved line (was: at edge 0's, which edge 2's moved line was taken for, the nearer parallel)
+    ([4, 0, 4, 4], [(20, 1.4), (10, 1.4), (10, 2), (2, 2), (2, 6), (0, 6), (0, 0), (20, 0)], (10, 2)),
+    # edge 3 kept: the remainder runs on through its kept vertex, which is no start
+    ([4, 0, 4, 0], [(20, 1.4), (10, 1.4), (10, 2), (6, 2), (6, 6), (6, 6.6), (4, 6.6), (4, 6), (0, 6), (0, 0),
+                    (20, 0)], (10, 2)),
+    # edge 0 set back 3 m: the jog vanishes and the step left runs against its line: at edge 0's moved line
+    ([3, 0, 4, 4], [(20, 2.4), (10, 2.4), (10, 2), (2, 2), (2, 6), (0, 6), (0, 0), (20, 0)], (20, 2.4)),
+])
+def test_a_remainder_past_a_carried_jog_starts_where_prt_starts_it(moves, remainder, first):
+    """massing's first tier set back as ``moves`` says on a 20 x 6 m block with a kept jog after edge 0, PRT's
+    second tier's edge 0 measured through PyPRT (a setback of it alone by 1 m; the jog 0.5 to 0.8 m high:
+    five of five; massing.tartu.8's second tier), on every turn of the remainder's ring."""
+    import shapely
+
+    from grammarc.geometry.clip import fit_pieces
+
+    lot = shapely.Polygon(_flip(JOG_BLOCK))
+    distances = np.array(moves + [0] * (len(JOG_BLOCK) - len(moves)), float)
+    ring = np.array(_flip(remainder), float)
+    for turned in range(len(ring)):  # GEOS's start anywhere on the ring
+        pieces = fit_pieces(np.array([shapely.Polygon(np.roll(ring, turned, axis=0))]), np.array([1]),
+                            np.array([[30.0, 0.0, 30.0]]), np.array([lot]), moves=distances)
+        start = pieces.coords[0] * pieces.extent[0, [0, 2]] + pieces.low[0, [0, 2]]
+        np.testing.assert_allclose(start, _flip([first])[0], atol=1e-9)
+
+
+def _arm(turn):
+    """A 12 x 11 m block with a 1.4 m wide arm whose end is edge 0 and whose top, the last edge, turns
+    ``turn`` degrees off square (its inner end raised)."""
+    top = 8.2 + 3.5 * np.tan(np.radians(turn))
+    return [(0, 8.2), (0, 6.8), (1.7, 6.8), (1.7, 3), (12, 3), (12, 14), (5, 14), (5, 13), (3.5, 13), (3.5, top)]
+
+
+@pytest.mark.parametrize("turn, remainder, first", [
+    # the arm's end set back 4 m past the top's far end: PRT starts at the run along the edge before the last
+    (0, [(4, 8.2), (4, 7), (12, 7), (12, 14), (5, 14), (5, 13), (3.5, 13), (3.5, 8.2)], (3.5, 13)),
+    # the top turned 30 degrees: at edge 0's moved line
+    (30, [(3.5, 13), (5, 13), (5, 14), (12, 14), (12, 7), (4, 7), (4, 10.5094), (3.5, 10.2207)], (4, 10.5094)),
+])
+def test_a_remainder_past_a_swept_last_edge_starts_where_prt_starts_it(turn, remainder, first):
+    """massing's first tier ("4;0;4;4;0") on ``_arm``, PRT's second tier's edge 0 measured through PyPRT (a
+    setback of it alone by 1 m: the run before the last edge at 0, 10 and 20 degrees, edge 0's moved line
+    at 30 and 45; massing.seoul.37's second tier), on every turn of the remainder's ring."""
+    import shapely
+
+    from grammarc.geometry.clip import fit_pieces
+
+    lot = _arm(turn)
+    distances = np.array([4, 0, 4, 4] + [0] * (len(lot) - 4), float)
+    ring = np.array(_flip(remainder), float)
+    for turned in range(len(ring)):  # GEOS's start anywhere on the ring
+        pieces = fit_pieces(np.array([shapely.Polygon(np.roll(ring, turned, axis=0))]), np.array([1]),
+                            np.array([[30.0, 0.0, 30.0]]), np.array([shapely.Polygon(_flip(lot))]),
+                            moves=distances)
+        start = pieces.coords[0] * pieces.extent[0, [0, 2]] + pieces.low[0, [0, 2]]
+        np.testing.assert_allclose(start, _flip([first])[0], atol=1e-4)

@@ -582,3 +582,21 @@ def test_a_face_narrower_than_its_distances_is_swept_where_moved_lines_cross():
     (strips,), (remainder,) = setback([ring], distance)
     assert abs(shapely.area(strips[0]) - 13.731) < 5e-3
     assert abs(shapely.area(strips[0]) + shapely.area(remainder) - ring.area) < 1e-6
+
+
+def test_strips_whose_seams_leave_a_ring_of_no_area_keep_it():
+    """A tier of massing's on a real lot (seoul.47's 0.4 m wide arm, numbered from another vertex): the
+    strips' union has a part of no area along one line, which the seams' removal would leave two vertices,
+    no ring (it raised); the regions still tile the face."""
+    face = shapely.Polygon([
+        (0.0, 4.111938639000002), (0.018859747999998795, 0.0), (0.42424044799999916, 0.00032186299999996057),
+        (0.419474681999999, 1.963732990000001), (1.261663418, 1.9609742119999998),
+        (1.2687395269999997, 4.6611051250000015), (2.431065181, 4.659195919000001),
+        (2.433002774000001, 8.771150601000002), (1.2795154980000008, 8.773045289000002),
+        (1.2724393870000008, 6.072913292000001), (0.40949365300000035, 6.075740063000001),
+        (0.41425956800000047, 4.112267552000001)])
+    polygons = np.array([face])
+    distance = np.array([0, 0, 0, 0, 0, 3, 4, 0, 0, 4, 4, 0], float)
+    edges = polygon_edges(polygons)
+    (region,), remainder = setback_regions(polygons, edges, distance, np.zeros(len(distance), dtype=np.int64), 1)
+    assert shapely.area(region[0]) + shapely.area(remainder[0]) == pytest.approx(face.area)

@@ -107,8 +107,14 @@ class _SetbackFaces:
         for k, owner in enumerate(self.owners):
             starts[owner] = np.zeros(vertices, dtype=bool)
             starts[owner][self.edges.vertex[moved & (self.owner == k)]] = True
+        # the remainder's edges come from the parent edges moved by their distances (of two parallel edges,
+        # not the nearer one: a jog's far side's moved line beside the near side's, PRT's tier on
+        # massing.tartu.8); an edge of no length keeps none known
+        moves = np.full(vertices, np.nan)
+        moves[self.edges.vertex] = np.where(moved & (self.owner < len(self.owners)), distance, 0.0)
         return _regions(ctx, op, cursor, [by_owner[s] if s != "remainder" else remainder for s in op.selectors],
-                        self.plane, self.polygons, [starts.get(s) for s in op.selectors])
+                        self.plane, self.polygons, [starts.get(s) for s in op.selectors],
+                        [moves if s == "remainder" else None for s in op.selectors])
 
 
 @operation(ir.InnerRectangle, consumes=True)
@@ -124,13 +130,15 @@ def inner_rectangle(ctx: Context, cursor: Shapes, op: ir.InnerRectangle) -> Part
 
 
 def _regions(ctx: Context, op: ir.Setback | ir.SetbackToArea | ir.InnerRectangle, cursor: Shapes, regions: list, plane,
-             polygons, start_edges: list | None = None) -> Parts:
+             polygons, start_edges: list | None = None, moves: list | None = None) -> Parts:
     """Part k of ``op`` on the pieces of ``regions[k]`` (n,) (polygons in the shapes' scope units, cut
     from ``polygons``), each parent's pieces together, numbered in stream ``op.site`` part by part;
-    ``start_edges[k]``: the parent edges its pieces start at (``fit_pieces``), or None."""
+    ``start_edges[k]``: the parent edges its pieces start at, ``moves[k]`` how far each parent edge moved
+    (``fit_pieces``), or None."""
     starts = start_edges or [None] * len(regions)
-    pieces = [fit_pieces(region, plane, cursor.size, polygons, start_edges=edges)
-              for region, edges in zip(regions, starts)]
+    distances = moves or [None] * len(regions)
+    pieces = [fit_pieces(region, plane, cursor.size, polygons, start_edges=edges, moves=moved)
+              for region, edges, moved in zip(regions, starts, distances)]
     shapes, kind = pieces_by_parent(ctx, cursor, pieces, [(op.site << 20) + k for k in range(len(pieces))])
     ctx.count(shapes, op.span)
     order, offsets = group_by(kind, len(op.parts))

@@ -220,3 +220,35 @@ def test_shape_u_that_covers_its_face_numbers_its_edges_as_the_face(write):
     assert _massing_tier(write, lot, offset=3.805, orientation=270, footprint=footprint,
                          distances="4;4;3;3;0;0;4;3") == (pytest.approx(118.166, rel=1e-4),
                                                           pytest.approx(56.551 + 2.348, rel=1e-4))
+
+
+@pytest.mark.parametrize("first, terrace", [
+    ("4;0;4;4", 8.0),  # the jog carried along its line: PRT's tier starts at edge 2's moved line, 8 m long
+    ("4;0;4;0", 4.0),  # edge 3 kept too: at edge 2's moved line, not at edge 3's kept vertex it runs through
+    ("3;0;4;4", 10.0),  # the jog's far end moved further: it vanishes, the tier starts at edge 0's moved line
+])
+def test_tier_setback_past_a_kept_jog_starts_where_prt_starts_it(write, first, terrace):
+    """massing's two tiers on a 20 x 6 m block whose 0.6 m jog after edge 0 is kept, its second tier setting
+    back its edge 0 alone by 1 m: PRT's terrace measured through PyPRT (massing.tartu.8's second tier; the
+    first was 10 m^2 where PRT's is 8)."""
+    block = [np.array([[20, 5.4], [10, 5.4], [10, 6], [6, 6], [6, 6.6], [4, 6.6], [4, 6], [0, 6], [0, 0], [20, 0]],
+                      float)]
+    text = (f'Lot --> setback(comp(fe){{ all : float(listItem("{first};0;0;0;0;0;0", comp.index)) }})'
+            '{ all : A | remainder : R }\n'
+            'R --> setback(comp(fe){ all : float(listItem("1", comp.index)) }) { all : T | remainder : S }\n'
+            'T --> report("t", geometry.area)\n')
+    assert totals(run(write, text, [block]))["t_sum"] == pytest.approx(terrace)
+
+
+def test_tier_setback_past_a_swept_arm_starts_where_prt_starts_it(write):
+    """massing's two tiers on a 12 x 11 m block whose 1.4 m wide arm's end (edge 0) its first tier sets back
+    4 m, past the arm's 3.5 m top (the last edge), the second tier setting back its edge 0 alone by 1 m: PRT's
+    terrace is the strip along the edge before the last, 4.8 m^2, measured through PyPRT (was 1.2, along
+    edge 0's moved line; massing.seoul.37's second tier)."""
+    block = [np.array([[0, 8.2], [0, 6.8], [1.7, 6.8], [1.7, 3], [12, 3], [12, 14], [5, 14], [5, 13], [3.5, 13],
+                       [3.5, 8.2]], float)]
+    text = ('Lot --> setback(comp(fe){ all : float(listItem("4;0;4;4;0;0;0;0;0;0", comp.index)) })'
+            '{ all : A | remainder : R }\n'
+            'R --> setback(comp(fe){ all : float(listItem("1", comp.index)) }) { all : T | remainder : S }\n'
+            'T --> report("t", geometry.area)\n')
+    assert totals(run(write, text, [block]))["t_sum"] == pytest.approx(4.8)
