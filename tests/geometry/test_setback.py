@@ -441,6 +441,23 @@ def test_strips_that_cover_the_face_leave_no_seam_vertices():
     assert len(shapely.get_coordinates(strips[0])) == 6  # the five vertices, the first repeated
 
 
+def test_a_face_s_vertices_a_rounding_off_its_strip_s_line_stay():
+    """massing's shapeO on the harness's holes.43809, the lot moved 2 km away: the face's top edge is a run
+    of collinear vertices (where closed arms left them), 1e-14 m above and below the one strip along it,
+    as rounding the lot's coordinates left them. GEOS's overlay in floating point cut off the one just
+    above the strip's line (its record was not the lot's at its own place: 316 faces for 346); snapped
+    to the regions' nanometre grid, every vertex stays, and the tier numbers the edges as the face's."""
+    top = [(0, 5.340254278740662), (6.1345660309827466, 5.340254278740643), (14.852090963408658, 5.3402542787405975),
+           (24.487436067997116, 5.340254278740604), (29.2722126149976, 5.3402542787405824)]
+    polygon = shapely.Polygon([(0, 7.105427357601002e-14), *top, (29.2722126149976, 0)])
+    edges = polygon_edges(np.array([polygon]))
+    d = np.array([12.96759019, 2.36573265, 2.36573265, 2.36573265, 2.36573265, 12.96759019, 2.36573265])
+    (region,), _ = setback_regions(np.array([polygon]), edges, d, np.zeros(len(d), dtype=np.int64), 1)
+    corners = shapely.get_coordinates(region[0])
+    on_top = np.unique(corners[np.abs(corners[:, 1] - top[0][1]) < 1e-6, 0])
+    assert on_top == pytest.approx(sorted({x for x, _ in top}), abs=1e-8)
+
+
 def test_seams_go_from_regions_that_also_hold_lines():
     """A region that snapping left with a line beside its polygon (a strip's zero-wide spike) loses its
     seams as well."""
