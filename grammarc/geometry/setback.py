@@ -163,17 +163,33 @@ def setback_regions(polygons: np.ndarray, edges: Edges, distance: np.ndarray, ow
         _, convex_ends, _ = _mitres(edges, d, reflex_steps=False)
         strips, group = _swept(polygons, edges, d, np.where(keep, corner, stepped_corner),
                                np.where(keep, convex_ends, stepped_ends), owner, swept, strips, group, idx)
-    united = union_by_group(strips, group, n_owners * m).reshape(n_owners, m)
+    united = _polygonal(union_by_group(strips, group, n_owners * m)).reshape(n_owners, m)
     regions, covered = [], np.full(m, shapely.Polygon(), dtype=object)
     # overlaid on the regions' grid (snap rounding): in floating point GEOS cuts off a face's vertex that
     # rounding left 1e-14 m outside the strip along its edge (a lot moved 2 km away, massing's holes.43809:
     # its tier numbered the face's edges otherwise, 316 faces for 346)
     for k in range(n_owners):
-        region = shapely.difference(shapely.intersection(polygons, united[k], grid_size=_SNAP), covered,
-                                    grid_size=_SNAP)
+        inside = _polygonal(shapely.intersection(polygons, united[k], grid_size=_SNAP))
+        region = _polygonal(shapely.difference(inside, covered, grid_size=_SNAP))
         regions.append(_without_seams(_without_spikes(region), polygons))
         covered = shapely.union(covered, region, grid_size=_SNAP)
     return regions, _without_spikes(shapely.difference(polygons, covered, grid_size=_SNAP))
+
+
+def _polygonal(geometries: np.ndarray) -> np.ndarray:
+    """Geometries (k,) without the lines and points an overlay leaves where areas touch: GEOS's snap rounding
+    takes no input of mixed dimension (it raised on a strip region that touched its face along a line)."""
+    parts, row = shapely.get_parts(geometries, return_index=True)
+    areal = shapely.get_type_id(parts) == shapely.GeometryType.POLYGON
+    if areal.all():
+        return geometries
+    out = geometries.copy()
+    touched = np.unique(row[~areal])
+    out[touched] = shapely.Polygon()
+    mine = areal & np.isin(row, touched)
+    kept = np.unique(row[mine])
+    out[kept] = shapely.multipolygons(parts[mine], indices=np.searchsorted(kept, row[mine]))
+    return out
 
 
 def _strips(quads: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

@@ -458,6 +458,20 @@ def test_a_face_s_vertices_a_rounding_off_its_strip_s_line_stay():
     assert on_top == pytest.approx(sorted({x for x, _ in top}), abs=1e-8)
 
 
+def test_a_strip_region_that_touches_its_face_along_a_line_overlays_on_the_grid():
+    """massing's far.57181: a tier on a 5.4 m^2 piece of a shapeL whose two moved edges cover it; their
+    region touches the face along a line besides, and GEOS's snap rounding takes no input of mixed
+    dimension: the lines go, and the strips are the face."""
+    polygon = shapely.from_wkt("POLYGON ((0 2.3443283890000006, 0 0.7780751060000005, 1.514718494 0, "
+                               "2.810555406 1.5070280880000004, 2.717534762 1.5548105950000004, "
+                               "2.717534762 2.6429381760000004, 0 2.3443283890000006))")
+    edges = polygon_edges(np.array([polygon]))
+    (strips,), remainder = setback_regions(np.array([polygon]), edges, np.array([4.0, 4, 0, 0, 0, 0]),
+                                           np.zeros(6, dtype=np.int64), 1)
+    assert shapely.area(strips[0]) == pytest.approx(polygon.area, rel=1e-9)
+    assert shapely.area(remainder[0]) == pytest.approx(0.0, abs=1e-12)
+
+
 def test_seams_go_from_regions_that_also_hold_lines():
     """A region that snapping left with a line beside its polygon (a strip's zero-wide spike) loses its
     seams as well."""
