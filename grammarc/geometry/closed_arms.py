@@ -10,8 +10,9 @@ T.19073, T.19129, 0.5 to 1.6 m from GEOS's vertex). The vertex's place decides w
 meet, so which part of it a per-edge setback moves by which edge's distance.
 
 A run is taken whole: the parent edges whose moved copies lie on it, in their order along it, give its
-vertices (one per arm closed between two of them), whatever GEOS left there. GEOS's vertices on such a run
-depend on the rounding of the coordinates (a lot moved 2 km away had others), the run's do not.
+vertices (one per arm closed between two of them), whatever GEOS left there, none included (an H's leg
+whose bar closed: massing's H.57370 59 km away). GEOS's vertices on such a run depend on the rounding of
+the coordinates (a lot moved 2 km away had others), the run's do not.
 """
 
 from __future__ import annotations
@@ -154,8 +155,9 @@ def place_closed_arm_vertices(coords, ring_offsets, ring_poly, parent_coords, pa
     """The inset rings' coords (V', 2) and their counts (R,), the straight runs of the outer rings (their
     polygons ``ring_poly`` (R,), -1 for holes, which stay) along moved parent edges given the vertices a
     wavefront leaves there (``_run_vertices``) in place of GEOS's (V, 2) (which leaves one where each
-    moved side of a closed arm crossed the run, where grown holes' corners cross it, and repeats some:
-    vertices that depend on rounding, and on where the lot lies); and whether any ring changed.
+    moved side of a closed arm crossed the run, where grown holes' corners cross it, repeats some, or
+    leaves none: vertices that depend on rounding, and on where the lot lies); and whether any ring
+    changed.
     ``distance`` (G,) each polygon's inset distance, the parents' outer rings counter-clockwise, their
     holes clockwise. The parent edges along a run may lie on holes (or a hole and the outline): a channel
     between them closed as an arm does (PRT's inset of massing's holes.33739, whose holes' ends lie on one
@@ -170,7 +172,7 @@ def place_closed_arm_vertices(coords, ring_offsets, ring_poly, parent_coords, pa
         if g >= 0 and m >= 4:
             for k in range(m):
                 straight[k] = _straight(coords, r0, m, k, tolerance)
-        if not straight.any() or straight.all():
+        if g < 0 or m < 4 or straight.all():
             for k in range(m):
                 out = _push(out, n, coords[r0 + k, 0], coords[r0 + k, 1])
                 n += 1
@@ -185,6 +187,19 @@ def place_closed_arm_vertices(coords, ring_offsets, ring_poly, parent_coords, pa
                 out = _push(out, n, coords[r0 + k, 0], coords[r0 + k, 1])
                 n += 1
                 t += 1
+                w = (k0 + t) % m
+                if not straight[w]:  # a run of one edge, where GEOS left no vertex of a closed arm
+                    ax, ay = coords[r0 + k, 0], coords[r0 + k, 1]
+                    length = np.hypot(coords[r0 + w, 0] - ax, coords[r0 + w, 1] - ay)
+                    if length > tolerance:
+                        ux, uy = (coords[r0 + w, 0] - ax) / length, (coords[r0 + w, 1] - ay) / length
+                        kept = _run_vertices(ax, ay, ux, uy, length, g, parent_coords, parent_rings,
+                                             parent_offsets, distance[g], tolerance)
+                        if kept is not None and len(kept):
+                            changed = True
+                            for s in kept:
+                                out = _push(out, n, ax + s * ux, ay + s * uy)
+                                n += 1
                 continue
             t_end = t
             while straight[(k0 + t_end) % m]:
