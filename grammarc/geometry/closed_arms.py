@@ -8,6 +8,11 @@ there and the merged vertex moves straight on) puts it where the bisector of the
 crosses the run: on a straight stem's centre line (measured through PyPRT on massing's T lots: T.18003,
 T.19073, T.19129, 0.5 to 1.6 m from GEOS's vertex). The vertex's place decides where the run's two edges
 meet, so which part of it a per-edge setback moves by which edge's distance.
+
+A run is taken whole: the parent edges whose moved copies lie on it, in their order along it, give its
+vertices (one per arm closed between two of them), whatever GEOS left there, none included (an H's leg
+whose bar closed: massing's H.57370 59 km away). GEOS's vertices on such a run depend on the rounding of
+the coordinates (a lot moved 2 km away had others), the run's do not.
 """
 
 from __future__ import annotations
@@ -40,39 +45,6 @@ def _along(edge, step, g, parent_rings, parent_offsets):
 
 
 @njit(cache=True, nogil=True)
-def _edge_of(ax, ay, bx, by, g, parent_coords, parent_rings, parent_offsets, distance, tolerance):
-    """The edge of polygon g (its index among the parents' vertices: the outer ring's or a hole's) that the
-    inset edge a -> b was moved in from (parallel, in its direction, ``distance`` inside it), the one whose
-    span it overlaps most; -1 for none (an edge of no length, or one whose span it does not overlap)."""
-    dx, dy = bx - ax, by - ay
-    length = np.hypot(dx, dy)
-    best, overlap = -1, tolerance
-    if length <= tolerance:
-        return best
-    for q in range(parent_offsets[g], parent_offsets[g + 1]):
-        q0, q1 = parent_rings[q], parent_rings[q + 1]
-        n = q1 - q0
-        for e in range(n):
-            px, py = parent_coords[q0 + e, 0], parent_coords[q0 + e, 1]
-            qx, qy = parent_coords[q0 + (e + 1) % n, 0], parent_coords[q0 + (e + 1) % n, 1]
-            ex, ey = qx - px, qy - py
-            span = np.hypot(ex, ey)
-            if span <= tolerance:
-                continue
-            ux, uy = ex / span, ey / span
-            if (dx * ux + dy * uy) < length * (1.0 - 1e-9):  # not parallel, or against it
-                continue
-            inside = ux * (ay - py) - uy * (ax - px)  # to the left of the edge: the polygon's side
-            if abs(inside - distance) > tolerance:
-                continue
-            s0, s1 = (ax - px) * ux + (ay - py) * uy, (bx - px) * ux + (by - py) * uy
-            shared = min(s1, span) - max(s0, 0.0)
-            if shared > overlap:
-                best, overlap = q0 + e, shared
-    return best
-
-
-@njit(cache=True, nogil=True)
 def _bisector_point(ax, ay, ux, uy, side_a, side_b, g, parent_coords, parent_rings, parent_offsets):
     """The parameter s of the point a + s u equidistant from the lines of the parents' edges ``side_a``
     and ``side_b`` of polygon g (distances to their left), NaN where no such point is."""
@@ -92,70 +64,170 @@ def _bisector_point(ax, ay, ux, uy, side_a, side_b, g, parent_coords, parent_rin
 
 
 @njit(cache=True, nogil=True)
+def _unit(parent_coords, a, b):
+    """The unit direction from parent vertex a to b, and the length between them."""
+    ex, ey = parent_coords[b, 0] - parent_coords[a, 0], parent_coords[b, 1] - parent_coords[a, 1]
+    span = np.hypot(ex, ey)
+    if span <= 0.0:
+        return 0.0, 0.0, 0.0
+    return ex / span, ey / span, span
+
+
+@njit(cache=True, nogil=True)
+def _run_vertices(ax, ay, ux, uy, length, g, parent_coords, parent_rings, parent_offsets, distance, tolerance):
+    """Where (parameters s along a + s u, ascending, 0 < s < length) the straight run from a moved in by
+    ``distance`` keeps vertices: between each two parent edges of polygon g that it runs along (those
+    whose moved, mitred copies lie on it), taken in their order along it, the point where the arm between
+    them closed (on the bisector of its side lines), or the moved vertex they share. None where no parent
+    edge lies on the run's line (the run is not a moved edge's)."""
+    first, last = parent_rings[parent_offsets[g]], parent_rings[parent_offsets[g + 1]]
+    edges = np.empty(last - first, np.int64)
+    starts = np.empty(last - first)
+    k = 0
+    for q in range(parent_offsets[g], parent_offsets[g + 1]):
+        q0, n = parent_rings[q], parent_rings[q + 1] - parent_rings[q]
+        for e in range(n):
+            here, after, before = q0 + e, q0 + (e + 1) % n, q0 + (e - 1) % n
+            tx, ty, span = _unit(parent_coords, here, after)
+            if span <= tolerance or tx * ux + ty * uy < 1.0 - 1e-9:  # not parallel, or against the run
+                continue
+            px, py = parent_coords[here, 0], parent_coords[here, 1]
+            if abs(tx * (ay - py) - ty * (ax - px) - distance) > tolerance:  # the run is not its moved line
+                continue
+            s0 = (px - ax) * ux + (py - ay) * uy
+            # the moved copy's ends, where its neighbours' moved lines meet it (reflex corners reach further)
+            reach = np.empty(2)
+            for end, (a, b) in enumerate(((before, here), (after, (e + 2) % n + q0))):
+                nx, ny, nspan = _unit(parent_coords, a, b)
+                cosine = nx * tx + ny * ty
+                sine = ny * ux - nx * uy if end == 0 else nx * uy - ny * ux  # the neighbour's normal along u
+                reach[end] = distance * sine / (1.0 + cosine) if nspan > 0.0 and 1.0 + cosine > 1e-9 else 0.0
+            if min(s0 + span + reach[1], length) - max(s0 - reach[0], 0.0) <= tolerance:
+                continue
+            edges[k], starts[k] = here, s0
+            k += 1
+    if k == 0:
+        return None
+    order = np.argsort(starts[:k], kind="mergesort")
+    out = np.empty(max(k - 1, 0))
+    n_out = 0
+    for i in range(k - 1):
+        a, b = edges[order[i]], edges[order[i + 1]]
+        if _along(a, 1, g, parent_rings, parent_offsets) == b:  # one ring's edges on one line: their vertex
+            s = (parent_coords[b, 0] - ax) * ux + (parent_coords[b, 1] - ay) * uy
+        else:
+            s = _bisector_point(ax, ay, ux, uy, _along(a, 1, g, parent_rings, parent_offsets),
+                                _along(b, -1, g, parent_rings, parent_offsets), g, parent_coords, parent_rings,
+                                parent_offsets)
+        if tolerance < s < length - tolerance and (n_out == 0 or s > out[n_out - 1] + tolerance):
+            out[n_out] = s
+            n_out += 1
+    return out[:n_out]
+
+
+@njit(cache=True, nogil=True)
+def _straight(coords, r0, m, k, tolerance):
+    """Whether vertex k of the ring at r0 (m vertices) lies on the segment between its neighbours."""
+    p, v, w = r0 + (k - 1) % m, r0 + k, r0 + (k + 1) % m
+    cx, cy = coords[w, 0] - coords[p, 0], coords[w, 1] - coords[p, 1]
+    chord = np.hypot(cx, cy)
+    if chord <= tolerance:
+        return False
+    vx, vy = coords[v, 0] - coords[p, 0], coords[v, 1] - coords[p, 1]
+    along = (vx * cx + vy * cy) / chord
+    return abs(cx * vy - cy * vx) / chord <= tolerance and -tolerance <= along <= chord + tolerance
+
+
+@njit(cache=True, nogil=True)
+def _push(out, n, x, y):
+    """``out`` with (x, y) at row n, grown where full."""
+    if n == len(out):
+        grown = np.empty((2 * len(out) + 8, 2))
+        grown[:n] = out[:n]
+        out = grown
+    out[n, 0], out[n, 1] = x, y
+    return out
+
+
+@njit(cache=True, nogil=True)
 def place_closed_arm_vertices(coords, ring_offsets, ring_poly, parent_coords, parent_rings, parent_offsets,
                               distance, tolerance):
-    """The inset rings' coords (V, 2) (counter-clockwise outer rings, ``ring_poly`` (R,) their polygons, -1
-    for holes) with the vertices between the moved parts of two edges on one line, an arm closed between
-    them, made one vertex on the bisector of the arm's side lines (see the module), and which vertices
-    stay (V,) bool (GEOS leaves a vertex where each moved side crossed the line, and repeats some);
+    """The inset rings' coords (V', 2) and their counts (R,), the straight runs of the outer rings (their
+    polygons ``ring_poly`` (R,), -1 for holes, which stay) along moved parent edges given the vertices a
+    wavefront leaves there (``_run_vertices``) in place of GEOS's (V, 2) (which leaves one where each
+    moved side of a closed arm crossed the run, where grown holes' corners cross it, repeats some, or
+    leaves none: vertices that depend on rounding, and on where the lot lies); and whether any ring
+    changed.
     ``distance`` (G,) each polygon's inset distance, the parents' outer rings counter-clockwise, their
-    holes clockwise. The two edges may lie on two holes (or a hole and the outline): the arm is then the
-    channel between them, its sides the edges that follow the first and precede the second along their
-    rings (PRT's inset of massing's holes.33739, whose holes' ends lie on one line)."""
-    out = coords.copy()
-    keep = np.ones(len(coords), np.bool_)
+    holes clockwise. The parent edges along a run may lie on holes (or a hole and the outline): a channel
+    between them closed as an arm does (PRT's inset of massing's holes.33739, whose holes' ends lie on one
+    line)."""
+    out = np.empty((len(coords) + 8, 2))
+    counts = np.zeros(len(ring_offsets) - 1, np.int64)
+    n = 0
+    changed = False
     for r in range(len(ring_offsets) - 1):
-        g = ring_poly[r]
-        if g < 0:
+        r0, m, g = ring_offsets[r], ring_offsets[r + 1] - ring_offsets[r], ring_poly[r]
+        straight = np.zeros(m, np.bool_)
+        if g >= 0 and m >= 4:
+            for k in range(m):
+                straight[k] = _straight(coords, r0, m, k, tolerance)
+        if g < 0 or m < 4 or straight.all():
+            for k in range(m):
+                out = _push(out, n, coords[r0 + k, 0], coords[r0 + k, 1])
+                n += 1
+            counts[r] = m
             continue
-        r0, r1 = ring_offsets[r], ring_offsets[r + 1]
-        m = r1 - r0
-        source = np.empty(m, np.int64)  # the parent edge each inset edge was moved in from, -1 for none
-        for k in range(m):
-            a, b = r0 + k, r0 + (k + 1) % m
-            source[k] = _edge_of(coords[a, 0], coords[a, 1], coords[b, 0], coords[b, 1], g, parent_coords,
-                                 parent_rings, parent_offsets, distance[g], tolerance)
-        for j in range(m):
-            before = source[(j - 1) % m]
-            if before < 0:
+        k0 = np.flatnonzero(~straight)[0]
+        begun = n
+        t = 0
+        while t < m:
+            k = (k0 + t) % m
+            if not straight[k]:
+                out = _push(out, n, coords[r0 + k, 0], coords[r0 + k, 1])
+                n += 1
+                t += 1
+                w = (k0 + t) % m
+                if not straight[w]:  # a run of one edge, where GEOS left no vertex of a closed arm
+                    ax, ay = coords[r0 + k, 0], coords[r0 + k, 1]
+                    length = np.hypot(coords[r0 + w, 0] - ax, coords[r0 + w, 1] - ay)
+                    if length > tolerance:
+                        ux, uy = (coords[r0 + w, 0] - ax) / length, (coords[r0 + w, 1] - ay) / length
+                        kept = _run_vertices(ax, ay, ux, uy, length, g, parent_coords, parent_rings,
+                                             parent_offsets, distance[g], tolerance)
+                        if kept is not None and len(kept):
+                            changed = True
+                            for s in kept:
+                                out = _push(out, n, ax + s * ux, ay + s * uy)
+                                n += 1
                 continue
-            # the run from vertex j over edges from no parent edge to the first from any one
-            last = j
-            while source[last % m] < 0 and last - j < m - 1:
-                last += 1
-            after = source[last % m]
-            if after < 0:
-                continue
-            q0, n = _ring_at(before, g, parent_rings, parent_offsets)
-            if after != before and q0 <= after < q0 + n and (after - before) % n < 3:
-                continue  # no arm between the two (an arm has two sides and an end)
-            p, w = r0 + (j - 1) % m, r0 + (last + 1) % m
+            t_end = t
+            while straight[(k0 + t_end) % m]:
+                t_end += 1
+            p, w = r0 + (k0 + t - 1) % m, r0 + (k0 + t_end) % m
             ax, ay = coords[p, 0], coords[p, 1]
             dx, dy = coords[w, 0] - ax, coords[w, 1] - ay
             length = np.hypot(dx, dy)
-            if length <= tolerance:
-                continue
             ux, uy = dx / length, dy / length
-            straight = True
-            for k in range(j, last + 1):
-                v = r0 + k % m
-                straight &= abs(ux * (coords[v, 1] - ay) - uy * (coords[v, 0] - ax)) <= tolerance
-            if not straight:
-                continue
-            if after == before:
-                # one moved edge that GEOS broke where grown holes' corners crossed it: one edge, as a
-                # wavefront's front is
-                for k in range(j, last + 1):
-                    keep[r0 + k % m] = False
-                continue
-            s = _bisector_point(ax, ay, ux, uy, _along(before, 1, g, parent_rings, parent_offsets),
-                                _along(after, -1, g, parent_rings, parent_offsets), g, parent_coords,
-                                parent_rings, parent_offsets)
-            if tolerance < s < length - tolerance:
-                out[r0 + j, 0], out[r0 + j, 1] = ax + s * ux, ay + s * uy
-                for k in range(j + 1, last + 1):
-                    keep[r0 + k % m] = False
-    return out, keep
+            on_line = True
+            for i in range(t, t_end):
+                v = r0 + (k0 + i) % m
+                on_line &= abs(ux * (coords[v, 1] - ay) - uy * (coords[v, 0] - ax)) <= tolerance
+            kept = _run_vertices(ax, ay, ux, uy, length, g, parent_coords, parent_rings, parent_offsets,
+                                 distance[g], tolerance) if on_line else None
+            if kept is None:
+                for i in range(t, t_end):
+                    v = r0 + (k0 + i) % m
+                    out = _push(out, n, coords[v, 0], coords[v, 1])
+                    n += 1
+            else:
+                changed = True
+                for s in kept:
+                    out = _push(out, n, ax + s * ux, ay + s * uy)
+                    n += 1
+            t = t_end
+        counts[r] = n - begun
+    return out[:n], counts, changed
 
 
 def closed_arm_insets(insets: np.ndarray, polygons: np.ndarray, distance: np.ndarray) -> np.ndarray:
@@ -176,12 +248,11 @@ def closed_arm_insets(insets: np.ndarray, polygons: np.ndarray, distance: np.nda
     ring_poly = np.full(len(ring_offsets) - 1, -1, dtype=np.int64)
     ring_poly[part_offsets[:-1]] = part_row  # outer rings only: a hole's vertices stay
     parent_offsets = np.asarray(parent_offsets, dtype=np.int64)
-    moved, keep = place_closed_arm_vertices(coords, ring_offsets, ring_poly, parent_coords, parent_rings,
-                                            parent_offsets, distance[rows], TOLERANCE)
-    if keep.all() and np.array_equal(moved, coords):
+    placed, counts, changed = place_closed_arm_vertices(coords, ring_offsets, ring_poly, parent_coords,
+                                                        parent_rings, parent_offsets, distance[rows], TOLERANCE)
+    if not changed:
         return insets
-    counts = np.add.reduceat(keep.astype(np.int64), ring_offsets[:-1]) if len(keep) else np.zeros(0, np.int64)
-    rebuilt = polygons_from_rings(moved[keep], offsets_from_counts(counts), part_offsets)
+    rebuilt = polygons_from_rings(placed, offsets_from_counts(counts), part_offsets)
     out = insets.copy()
     out[rows] = shapely.multipolygons(rebuilt, indices=part_row) if len(parts) != len(rows) or (
         shapely.get_type_id(insets[rows]) != shapely.GeometryType.POLYGON).any() else rebuilt

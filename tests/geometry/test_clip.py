@@ -607,3 +607,52 @@ def test_a_remainder_past_a_swept_last_edge_starts_where_prt_starts_it(turn, rem
                             moves=distances)
         start = pieces.coords[0] * pieces.extent[0, [0, 2]] + pieces.low[0, [0, 2]]
         np.testing.assert_allclose(start, _flip([first])[0], atol=1e-4)
+
+
+def _pieces_starts(ring, distances):
+    """``_remainder_starts`` for a remainder in pieces: per piece (in the order GEOS lists them), the set of
+    its first vertices in (x, y) over every start GEOS may give its ring, the other pieces as they are."""
+    from grammarc.geometry.clip import fit_pieces
+    from grammarc.geometry.setback import polygon_edges, setback_regions
+
+    ring = np.asarray(ring, float)
+    lot = shapely.Polygon(ring)
+    edges = polygon_edges(np.array([lot]))
+    _, remainder = setback_regions(np.array([lot]), edges, np.asarray(distances, float),
+                                   np.zeros(len(edges.poly), dtype=np.int64), 1)
+    low, size = ring.min(axis=0), np.ptp(ring, axis=0)
+    pieces = [np.asarray(p.exterior.coords)[:-1] for p in shapely.get_parts(remainder[0])]
+    starts = []
+    for k, kept in enumerate(pieces):
+        firsts = set()
+        for turned in range(len(kept)):
+            rings = [np.roll(kept, turned, axis=0) if i == k else p for i, p in enumerate(pieces)]
+            multi = shapely.MultiPolygon([shapely.Polygon((r - low) * (1, -1)) for r in rings])
+            fitted = fit_pieces(np.array([multi]), np.ones(1, np.int8), np.array([[size[0], 0.0, size[1]]]),
+                                np.array([shapely.Polygon((ring - low) * (1, -1))]))
+            first = fitted.coords[fitted.ring_offsets[fitted.poly_offsets[k]]]
+            firsts.add(tuple(np.round((first * fitted.extent[k, [0, 2]] + fitted.low[k, [0, 2]]) * (1, -1) + low, 3)))
+        starts.append(firsts)
+    return starts
+
+
+def test_a_moved_line_past_its_edge_s_end_is_not_the_edge_s_copy():
+    """massing.courtyard.57080's second tier: edge 0 set back 4 m from an acute vertex 0 beside the kept last
+    edge; its moved line meets the last edge's line past edge 0's end, and the remainder's edge along it lies
+    wholly beyond edge 0's span. PRT numbers that remainder from the next edge moved in (edge 1's copy, at
+    (16.133, 18.243)), not from that edge nor from the end of the last edge's run (its third tier then 21.02
+    m^2, grammarc's was 25.59 in two pieces)."""
+    ring = [(0, 19.125), (11.117, 15.628), (6.2, 0), (23.437, 0), (23.437, 19.125)]
+    assert _pieces_starts(ring, [4, 4, 3, 3, 0]) == [{(16.133, 18.243)}]
+
+
+def test_a_sweep_that_parts_the_remainder_starts_each_piece_at_its_first_edge_left():
+    """massing.holes.58313's second tier: edge 1's strip (4 m) sweeps over the 2.1 m bar between a U's two
+    notches, across edge 7 facing it, and parts the remainder; a piece beyond keeps edges 8 to 10. PRT starts
+    the first piece at edge 1's copy (not at the run before the sweep, as where an arm goes under a strip
+    whole), and the second at edge 8's run: the part of edge 1's moved line over it lies past edge 1's end
+    (PRT's third tier a 6.24 x 12.16 m rectangle, 75.94 m^2; grammarc's was 95.10)."""
+    ring = [(38.55, 38.92), (38.55, 20.163), (8.32, 20.163), (8.32, 38.92), (0, 38.92), (0, 0), (13.244, 0),
+            (13.244, 18.043), (38.55, 18.043), (38.55, 0), (40.301, 0), (40.301, 38.92)]
+    starts = _pieces_starts(ring, [4, 4, 3, 3, 0, 0, 4, 3, 0, 0, 0, 0])
+    assert sorted(starts, key=lambda s: min(s)) == [{(9.244, 16.163)}, {(38.55, 16.163)}]

@@ -52,3 +52,40 @@ def test_channels_between_grown_holes_leave_one_vertex_each_on_their_centre_line
     ring = shapely.get_coordinates(_inset(lot, 4.0).exterior)[:-1]
     assert sorted(ring[ring[:, 0] == 34][:, 1].tolist()) == [4, 9.5, 16.5, 25]
     assert len(ring) == 8
+
+
+def test_channels_closed_along_a_run_leave_their_vertices_whatever_the_rounding():
+    """massing's holes.43669: four holes whose ends lie on one line, offset 7.232 m: the narrow piece between
+    them and the outline keeps one vertex per closed channel, on its centre line (y = 9.301, 18.3655 and
+    27.9025), as PRT's wavefront does (its building 5346.85 m², grammarc's now 5346.85). GEOS's vertices on
+    that run change with a rounding of the coordinates (the lot moved 2 km away: 6564.5 m² at home,
+    5334.8 away); the run's vertices do not."""
+    holes = [(2.359, 6.806, 30.174), (11.796, 15.498, 40.401), (21.233, 25.135, 38.131), (30.670, 34.404, 38.706)]
+    rng = np.random.default_rng(0)
+    for noise in (0.0, 1e-13, 1e-13, 1e-13):
+        def jiggled(points, noise=noise):
+            return [(x + noise * rng.standard_normal(), y + noise * rng.standard_normal()) for x, y in points]
+        lot = shapely.Polygon(jiggled([(0, 0), (60.058, 0), (60.058, 37.748), (0, 37.748)]),
+                              [jiggled([(15.0145, low), (15.0145, high), (right, high), (right, low)])
+                               for low, high, right in holes])
+        (piece,) = [p for p in shapely.get_parts(_inset(lot, 7.232)) if p.bounds[2] < 10]
+        ring = shapely.get_coordinates(piece.exterior)[:-1]
+        run = np.sort(ring[np.abs(ring[:, 0] - 7.7825) < 1e-6][:, 1])
+        assert run == pytest.approx([7.232, 9.301, 18.3655, 27.9025, 30.516], abs=1e-9)
+
+
+def test_a_closed_bar_leaves_its_vertex_on_a_run_where_geos_leaves_none():
+    """massing's H.57370: an H's 4.7 m bar closes under a 7.721 m offset, and each leg's inner side keeps
+    one vertex on the bar's centre line (y = 12.95), as PRT's wavefront does (its building 2247.03 m²,
+    grammarc's 2247.02). Moved 59 km away, GEOS leaves no vertex on that run at all (grammarc's building
+    was 1561.99 m² there); the run's vertex is placed all the same."""
+    outline = [(0, 0), (17.5, 0), (17.5, 10.6), (27.15, 10.6), (27.15, 0), (44.65, 0), (44.65, 25.9),
+               (27.15, 25.9), (27.15, 15.3), (17.5, 15.3), (17.5, 25.9), (0, 25.9)]
+    rng = np.random.default_rng(1)
+    for noise in (0.0, 1e-12, 1e-12, 1e-12, 1e-12):
+        lot = shapely.Polygon([(x + noise * rng.standard_normal(), y + noise * rng.standard_normal())
+                               for x, y in outline])
+        ring = np.concatenate([shapely.get_coordinates(p.exterior)[:-1]
+                               for p in shapely.get_parts(_inset(lot, 7.721))])
+        inner = ring[np.isclose(ring[:, 0], 17.5 - 7.721) | np.isclose(ring[:, 0], 27.15 + 7.721)]
+        assert np.sort(inner[:, 1]) == pytest.approx([7.721] * 2 + [12.95] * 2 + [25.9 - 7.721] * 2, abs=1e-9)

@@ -441,6 +441,57 @@ def test_strips_that_cover_the_face_leave_no_seam_vertices():
     assert len(shapely.get_coordinates(strips[0])) == 6  # the five vertices, the first repeated
 
 
+def test_a_face_s_vertices_a_rounding_off_its_strip_s_line_stay():
+    """massing's shapeO on the harness's holes.43809, the lot moved 2 km away: the face's top edge is a run
+    of collinear vertices (where closed arms left them), 1e-14 m above and below the one strip along it,
+    as rounding the lot's coordinates left them. GEOS's overlay in floating point cut off the one just
+    above the strip's line (its record was not the lot's at its own place: 316 faces for 346); snapped
+    to the regions' nanometre grid, every vertex stays, and the tier numbers the edges as the face's."""
+    top = [(0, 5.340254278740662), (6.1345660309827466, 5.340254278740643), (14.852090963408658, 5.3402542787405975),
+           (24.487436067997116, 5.340254278740604), (29.2722126149976, 5.3402542787405824)]
+    polygon = shapely.Polygon([(0, 7.105427357601002e-14), *top, (29.2722126149976, 0)])
+    edges = polygon_edges(np.array([polygon]))
+    d = np.array([12.96759019, 2.36573265, 2.36573265, 2.36573265, 2.36573265, 12.96759019, 2.36573265])
+    (region,), _ = setback_regions(np.array([polygon]), edges, d, np.zeros(len(d), dtype=np.int64), 1)
+    corners = shapely.get_coordinates(region[0])
+    on_top = np.unique(corners[np.abs(corners[:, 1] - top[0][1]) < 1e-6, 0])
+    assert on_top == pytest.approx(sorted({x for x, _ in top}), abs=1e-8)
+
+
+def test_a_strip_region_that_touches_its_face_along_a_line_overlays_on_the_grid():
+    """massing's far.57181: a tier on a 5.4 m^2 piece of a shapeL whose two moved edges cover it; their
+    region touches the face along a line besides, and GEOS's snap rounding takes no input of mixed
+    dimension: the lines go, and the strips are the face."""
+    polygon = shapely.from_wkt("POLYGON ((0 2.3443283890000006, 0 0.7780751060000005, 1.514718494 0, "
+                               "2.810555406 1.5070280880000004, 2.717534762 1.5548105950000004, "
+                               "2.717534762 2.6429381760000004, 0 2.3443283890000006))")
+    edges = polygon_edges(np.array([polygon]))
+    (strips,), remainder = setback_regions(np.array([polygon]), edges, np.array([4.0, 4, 0, 0, 0, 0]),
+                                           np.zeros(6, dtype=np.int64), 1)
+    assert shapely.area(strips[0]) == pytest.approx(polygon.area, rel=1e-9)
+    assert shapely.area(remainder[0]) == pytest.approx(0.0, abs=1e-12)
+
+
+def test_snapping_leaves_no_nanometre_step_nor_sliver():
+    """Two strips' lines that should be one but for rounding (a lot far from the origin) snap to neighbouring
+    grid lines: the step of a nanometre between them goes (massing's holes.62285 90 km away: 130 faces for
+    126), and so does a sliver a nanometre wide where two folded strips should meet on one line, a hole in
+    the strips and a piece of the remainder (holes.62033 56 km away: 192 faces for 191)."""
+    from grammarc.geometry.setback import _without_spikes
+
+    stepped = shapely.Polygon([(0, 0), (52, 0), (52, 3.691705197), (45, 3.691705197), (45, 3.691705196),
+                               (2.7, 3.691705196), (2.7, 0.5), (0, 0.5)])
+    holed = shapely.Polygon([(0, 0), (27, 0), (27, 9), (0, 9)],
+                            [[(5.4, 8.1253), (0.6, 8.1253), (0.6, 8.125300001)], [(10, 1), (12, 1), (12, 3), (10, 3)]])
+    sliver = shapely.MultiPolygon([shapely.box(21, 0, 27, 5.7), shapely.Polygon([(0.6, 8.1253), (5.4, 8.1253),
+                                                                                 (0.6, 8.125300001)])])
+    out = _without_spikes(np.array([stepped, holed, sliver]))
+    assert len(np.asarray(shapely.get_exterior_ring(shapely.get_geometry(out[0], 0)).coords)) == 8
+    assert shapely.get_num_interior_rings(shapely.get_geometry(out[1], 0)) == 1
+    assert shapely.area(out[1]) == pytest.approx(27 * 9 - 4)
+    assert shapely.get_num_geometries(out[2]) == 1 and shapely.area(out[2]) == pytest.approx(6 * 5.7)
+
+
 def test_seams_go_from_regions_that_also_hold_lines():
     """A region that snapping left with a line beside its polygon (a strip's zero-wide spike) loses its
     seams as well."""

@@ -38,6 +38,3 @@ def test_delete_holes_of_a_solid_with_holes_fails_its_lot(write):
     (bad,) = records["bad"]
     assert bad.index == 0 and bad.reason.startswith("`deleteHoles` of a solid with holes is not supported yet")
     assert set(records["lot"]) == {1}
-
-
-#: Two 10 x 10 squares joined by a bridge 2 wide: an inset of 1.5 leaves two disjoint squares of 7 x 7.

@@ -101,6 +101,7 @@ def test_offset_on_its_own_keeps_the_inside_and_the_border_as_the_faces_of_one_s
     assert not r["bad"] and totals(r)["s_sum"] == pytest.approx(3 * 40)
 
 
+#: Two 10 x 10 squares joined by a bridge 2 wide: an inset of 1.5 leaves two disjoint squares of 7 x 7.
 DUMBBELL = [np.array([[0, 0], [10, 0], [10, 4], [14, 4], [14, 0], [24, 0], [24, 10], [14, 10], [14, 6],
                       [10, 6], [10, 10], [0, 10]], float)]
 
@@ -249,7 +250,3 @@ def test_an_offset_by_a_distance_that_is_not_a_number_fails_its_lot(write):
             lot_attrs={"d": np.array([1.0, 0.0])})
     assert [(b.index, b.reason.split(" in rule")[0]) for b in r["bad"]] == [
         (1, "`offset` by a distance that is not a number")]
-
-
-#: massing's footprint (``{footprint}``) and first tier (``{distances}`` per edge) after an offset (the kit's
-#: massing rule package, reduced).
