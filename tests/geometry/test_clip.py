@@ -378,11 +378,9 @@ def test_a_remainder_whose_first_edge_steps_starts_after_the_step():
     np.testing.assert_allclose(first, (13.5501, -6.7633), atol=1e-9)
 
 
-def _remainder_starts(ring, distances):
-    """The first vertex, in (x, y), of the remainder of the lot ``ring`` (counter-clockwise in (x, y)) set back
-    by ``distances`` per edge (``geometry.setback``), as ``fit_pieces`` starts it in the lot's plane (x, z)
-    with z = -y, where the lot winds clockwise as a face's top does: one per start GEOS may give the ring."""
-    from grammarc.geometry.clip import fit_pieces
+def _setback_remainder(ring, distances):
+    """The lot ``ring`` (k, 2) set back by ``distances`` per edge (``geometry.setback``): the ring as an array,
+    its remainder (shapely), the ring's lowest corner and its extent."""
     from grammarc.geometry.setback import polygon_edges, setback_regions
 
     ring = np.asarray(ring, float)
@@ -390,8 +388,17 @@ def _remainder_starts(ring, distances):
     edges = polygon_edges(np.array([lot]))
     _, remainder = setback_regions(np.array([lot]), edges, np.asarray(distances, float),
                                    np.zeros(len(edges.poly), dtype=np.int64), 1)
-    low, size = ring.min(axis=0), np.ptp(ring, axis=0)
-    kept = np.asarray(remainder[0].exterior.coords)[:-1]
+    return ring, remainder[0], ring.min(axis=0), np.ptp(ring, axis=0)
+
+
+def _remainder_starts(ring, distances):
+    """The first vertex, in (x, y), of the remainder of the lot ``ring`` (counter-clockwise in (x, y)) set back
+    by ``distances`` per edge (``geometry.setback``), as ``fit_pieces`` starts it in the lot's plane (x, z)
+    with z = -y, where the lot winds clockwise as a face's top does: one per start GEOS may give the ring."""
+    from grammarc.geometry.clip import fit_pieces
+
+    ring, remainder, low, size = _setback_remainder(ring, distances)
+    kept = np.asarray(remainder.exterior.coords)[:-1]
     firsts = []
     for turned in range(len(kept)):  # GEOS's start anywhere on the ring
         piece = shapely.Polygon((np.roll(kept, turned, axis=0) - low) * (1, -1))
@@ -613,15 +620,9 @@ def _pieces_starts(ring, distances):
     """``_remainder_starts`` for a remainder in pieces: per piece (in the order GEOS lists them), the set of
     its first vertices in (x, y) over every start GEOS may give its ring, the other pieces as they are."""
     from grammarc.geometry.clip import fit_pieces
-    from grammarc.geometry.setback import polygon_edges, setback_regions
 
-    ring = np.asarray(ring, float)
-    lot = shapely.Polygon(ring)
-    edges = polygon_edges(np.array([lot]))
-    _, remainder = setback_regions(np.array([lot]), edges, np.asarray(distances, float),
-                                   np.zeros(len(edges.poly), dtype=np.int64), 1)
-    low, size = ring.min(axis=0), np.ptp(ring, axis=0)
-    pieces = [np.asarray(p.exterior.coords)[:-1] for p in shapely.get_parts(remainder[0])]
+    ring, remainder, low, size = _setback_remainder(ring, distances)
+    pieces = [np.asarray(p.exterior.coords)[:-1] for p in shapely.get_parts(remainder)]
     starts = []
     for k, kept in enumerate(pieces):
         firsts = set()
