@@ -35,6 +35,11 @@ class Tol:
     #: arithmetic overflows on it (``extrude(1e308)`` then ``offset``): the operation that makes such a
     #: scope fails its lot, as ``offset`` and ``setback`` fail a lot they would move an outline that far.
     far: float = 3.4028234663852886e38
+    #: Two edges turned by less than this (degrees) from each other are parallel: the neighbours of an edge
+    #: a setback folds (``geometry.setback``), and an edge facing the moved line that swept it
+    #: (``geometry.clip``). Real lots' were 0.01-0.7 degrees apart; an edge between neighbours 11 degrees
+    #: apart moves in PRT (a concave lot of the replay's, whose tier it sweeps).
+    parallel: float = 2.0
 
 
 @dataclass(frozen=True)

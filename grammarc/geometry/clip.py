@@ -424,9 +424,9 @@ def _at_vertex_0(best, corner, along, outer):
     return best
 
 
-#: The cosine under which a lost edge faces the moved line that swept it (``_before_a_sweep``): 2 degrees,
-#: as the parallel neighbours of ``geometry.setback``.
-_FACING = float(np.cos(np.radians(2.0)))
+#: The cosine under which a lost edge faces the moved line that swept it (``_before_a_sweep``): parallel
+#: (``Tol.parallel``).
+_FACING = float(np.cos(np.radians(TOL.parallel)))
 #: How much of the moved edge's length (``_before_a_sweep``) a facing edge must lie beside to be swept by its
 #: strip: any of it but rounding.
 _BESIDE = 1e-9

@@ -35,13 +35,9 @@ _MITRE_LIMIT = 10.0
 #: vertex; 44.5 and 45 step and 45.5 meets at a reflex one, whatever the distances (2, 4 and 8 m).
 _STEP_TURN = 15.0
 _REFLEX_STEP_TURN = 45.0
-#: The angle (degrees) under which the neighbours of a folded edge are parallel (``_unfolded``): the real
-#: lots' were 0.01-0.7 degrees apart; an edge between neighbours 11 degrees apart moves in PRT (a
-#: concave lot of the replay's, whose tier it sweeps).
-_PARALLEL = 2.0
 #: The turn (degrees) past a kept edge under which a moved line that passes its far end sweeps on
 #: (``setback_regions``): measured between 20 (sweeps on) and 90 (stops). Past a convex far end the moved
-#: line sweeps on also where the edge beyond turns from the moved edge by more than ``_PARALLEL`` and at
+#: line sweeps on also where the edge beyond turns from the moved edge by more than ``Tol.parallel`` and at
 #: most this (a jog's 5 to 40 degrees sweep on; 65 degrees stops).
 _RUN_ON_TURN = 45.0
 #: The grid (scope units, metres) that setback regions are snapped to, collapsing zero-width spikes.
@@ -136,11 +132,11 @@ def setback_regions(polygons: np.ndarray, edges: Edges, distance: np.ndarray, ow
     far_reflex = np.where(moved[edges.prev], np.einsum("ij,ij->i", tangent[edges.next], edges.inward),
                           np.einsum("ij,ij->i", tangent, edges.inward[edges.prev])) < 0
     reflex_end = far_reflex & (np.einsum("ij,ij->i", beyond, edges.inward[mover]) > 0)
-    # (the edge beyond turned from the moved edge by more than ``_PARALLEL`` and at most ``_RUN_ON_TURN``: the
+    # (the edge beyond turned from the moved edge by more than ``Tol.parallel`` and at most ``_RUN_ON_TURN``: the
     # jog's 5 to 40 degrees sweep; a 6 m kept edge whose edge beyond turns 65 degrees from the moved one does
     # not, PRT's terrace being the stepped quad there, 33.610 m^2, measured through PyPRT)
     turn = np.abs(_cosines(tangent[other], tangent[mover]))
-    across = (turn < np.cos(np.radians(_PARALLEL))) & (turn >= np.cos(np.radians(_RUN_ON_TURN)))
+    across = (turn < np.cos(np.radians(TOL.parallel))) & (turn >= np.cos(np.radians(_RUN_ON_TURN)))
     turned_over = ~moved & ~edges.hole & (moved[edges.prev] != moved[edges.next]) & (
         span < -TOL.zero * np.einsum("ij,ij->i", tangent, tangent)) & (
         reflex_end | (~far_reflex & across) | (_cosines(tangent, tangent[other]) > np.cos(np.radians(_RUN_ON_TURN))))
@@ -301,7 +297,7 @@ def _without_flat_parts(geometries: np.ndarray) -> np.ndarray:
 
 def _unfolded(edges: Edges, d: np.ndarray) -> np.ndarray:
     """The distances (E,) with that of the shortest edge of each face whose quad folds between two parallel
-    neighbours (turned by under ``_PARALLEL`` from each other, facing or not), one moved and one kept, set
+    neighbours (turned by under ``Tol.parallel`` from each other, facing or not), one moved and one kept, set
     to 0 where then no strip of the face folds: such an edge (a short end moved further than its length)
     does not move in PRT, and its neighbours' strips end at its line (measured through PyPRT on massing's
     tiers over real lots: tartu.0, a 2 m edge moved 4 m between a kept edge and a moved one parallel to
@@ -318,7 +314,7 @@ def _unfolded(edges: Edges, d: np.ndarray) -> np.ndarray:
     tangent = edges.end - edges.start
     length = np.hypot(tangent[:, 0], tangent[:, 1])
     moved = d > TOL.zero
-    parallel = np.abs(_cosines(tangent[edges.prev], tangent[edges.next])) > np.cos(np.radians(_PARALLEL))
+    parallel = np.abs(_cosines(tangent[edges.prev], tangent[edges.next])) > np.cos(np.radians(TOL.parallel))
     # the moved neighbour (``side``) and the edge beyond it step as in ``_mitres``
     side = np.where(moved[edges.prev], edges.prev, edges.next)
     beyond = np.where(moved[edges.prev], edges.prev[side], edges.next[side])
