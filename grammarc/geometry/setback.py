@@ -132,9 +132,10 @@ def setback_regions(polygons: np.ndarray, edges: Edges, distance: np.ndarray, ow
     far_reflex = np.where(moved[edges.prev], np.einsum("ij,ij->i", tangent[edges.next], edges.inward),
                           np.einsum("ij,ij->i", tangent, edges.inward[edges.prev])) < 0
     reflex_end = far_reflex & (np.einsum("ij,ij->i", beyond, edges.inward[mover]) > 0)
-    # (the edge beyond turned from the moved edge by more than ``Tol.parallel`` and at most ``_RUN_ON_TURN``: the
-    # jog's 5 to 40 degrees sweep; a 6 m kept edge whose edge beyond turns 65 degrees from the moved one does
-    # not, PRT's terrace being the stepped quad there, 33.610 m^2, measured through PyPRT)
+    # (the edge beyond turned from the moved edge by more than ``Tol.parallel`` and at most
+    # ``_RUN_ON_TURN``: the jog's 5 to 40 degrees sweep; a 6 m kept edge whose edge beyond turns 65 degrees
+    # from the moved one does not, PRT's terrace being the stepped quad there, 33.610 m^2, measured through
+    # PyPRT)
     turn = np.abs(_cosines(tangent[other], tangent[mover]))
     across = (turn < np.cos(np.radians(TOL.parallel))) & (turn >= np.cos(np.radians(_RUN_ON_TURN)))
     turned_over = ~moved & ~edges.hole & (moved[edges.prev] != moved[edges.next]) & (
