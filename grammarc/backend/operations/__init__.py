@@ -14,7 +14,7 @@ columns:
 - ``faces``: ``convexify``, ``cleanupGeometry``, ``deleteHoles``, and what the face operations share;
 - ``offsets``: ``offset``, ``footprint``, ``rectify``;
 - ``setbacks``: ``setback``, ``setbackToArea``, ``shapeL/U/O``, ``innerRectangle``;
-- ``roofs``: the roofs, ``envelope``, ``taper``;
+- ``roofing``: the roofs, ``envelope``, ``taper``;
 - ``inserts``: ``I``, ``i``, ``label``;
 - ``along_uv``: ``insertAlongUV``, an asset laid along texture coordinates as the shape's mesh;
 - ``primitives``: CityEngine's ``primitiveCube/Quad/Disk/Cylinder/Sphere/Cone``;
@@ -40,7 +40,7 @@ from grammarc.backend.operations import (  # noqa: F401 - each registers its ope
     offsets,
     primitives,
     reset,
-    roofs,
+    roofing,
     scatter,
     scope,
     setbacks,

@@ -1,5 +1,5 @@
 """Operations on the faces of a shape that keep it one shape: ``convexify``, ``cleanupGeometry`` and
-``deleteHoles``; and what the face operations share (``offsets``, ``setbacks``, ``roofs``): the batch's
+``deleteHoles``; and what the face operations share (``offsets``, ``setbacks``, ``roofing``): the batch's
 faces as shapely polygons in their scopes' units (``face_polygons``), pieces back as shapes
 (``piece_shapes``, ``pieces_by_parent``), in-plane points as world points (``world_points``).
 

@@ -55,7 +55,7 @@ class OperationLowering:
     def op_envelope(self, op, args, span):
         """``envelope(normal|world.up, maxHeight, baseHeight, angle, ...)``: one (baseHeight, angle) pair
         all round, or the pairs for front and back, front, back and sides, or front, back, right and left
-        (``operations.roofs.envelope_edges``)."""
+        (``operations.roofing.envelope_edges``)."""
         if len(args) not in (4, 6, 8, 10):
             return self.unsupported(f"envelope with {len(args)} arguments", span,
                                     "envelope(direction, maxHeight, baseHeight, angle, ...) with 1 to 4 sides")

@@ -1,4 +1,4 @@
-"""backend/operations/roofs.py in derivations: taper, and the roofs' refusals (the roofs' geometry:
+"""backend/operations/roofing.py in derivations: taper, and the roofs' refusals (the roofs' geometry:
 test_mesh_shapes.py)."""
 
 from __future__ import annotations
