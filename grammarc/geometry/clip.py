@@ -288,7 +288,6 @@ def ring_starts(coords, ring_offsets, part_offsets, part_source, part_with_start
     at_vertex = np.zeros(len(coords), np.bool_)
     corner = np.full(len(coords), -1, np.int64)  # the parent vertex each lies at, -1 for none
     runs_along = np.full(len(coords), -1, np.int64)  # the parent edge its outgoing edge runs along, -1 for none
-    beyond = np.zeros(len(coords), np.bool_)  # its outgoing edge lies on a moved line past that edge's span
     for p in range(len(part_offsets) - 1):
         g = part_source[p]
         for r in range(part_offsets[p], part_offsets[p + 1]):
@@ -296,9 +295,9 @@ def ring_starts(coords, ring_offsets, part_offsets, part_source, part_with_start
             n = r1 - r0
             for j in range(r0, r1):
                 k = r0 + (j - r0 + 1) % n
-                near, key, vertex_key, scale, edge, away, along, beyond[j] = _places(
+                near, key, vertex_key, scale, edge, away, along = _places(
                     coords[j, 0], coords[j, 1], coords[k, 0], coords[k, 1], g, parent_coords,
-                    parent_rings, parent_offsets, material, moves, not cut and not part_inset[p])
+                    parent_rings, parent_offsets, material, moves)
                 if cut:
                     edge = np.inf  # a cut's crossings keep their places: their chords run along no edge
                 moved_from[j] = edge
@@ -324,11 +323,6 @@ def ring_starts(coords, ring_offsets, part_offsets, part_source, part_with_start
                 outer = parent_rings[parent_offsets[g] + 1] - parent_rings[parent_offsets[g]]
                 _after_steps(keys, moved_from, moved_in, r0, r1, outer)
                 _runs_into_kept_vertices(keys, corner, runs_along, moved_in, r0, r1, outer)
-    left = np.zeros(len(parent_coords), np.bool_)  # the parent edges some piece keeps (runs along, or moved in)
-    for p in range(len(part_offsets) - 1):
-        for j in range(ring_offsets[part_offsets[p]], ring_offsets[part_offsets[p + 1]]):
-            if np.isfinite(moved_from[j]):
-                left[parent_rings[parent_offsets[part_source[p]]] + int(moved_from[j])] = True
     last_end = _last_edge_ends(coords, ring_offsets, part_offsets, part_source, part_inset, moved_from,
                                parent_coords, parent_rings, parent_offsets)
     for p in range(len(part_offsets) - 1):
@@ -354,9 +348,8 @@ def ring_starts(coords, ring_offsets, part_offsets, part_source, part_with_start
                                             runs_along[r0:r1], outer, ring)
             if r == part_offsets[p] and not cut and not part_inset[p]:
                 best = _at_vertex_0(best, corner[r0:r1], runs_along[r0:r1], outer)
-                first = parent_rings[parent_offsets[g]]
                 best = _before_a_sweep(best, keys[r0:r1], moved_in[r0:r1], moved_from[r0:r1], runs_along[r0:r1],
-                                       beyond[r0:r1], left[first:], outer, parent_coords[first:])
+                                       outer, parent_coords[parent_rings[parent_offsets[g]]:])
             if r == part_offsets[p] and part_inset[p]:
                 # where the first outer edge left, counting from the last, ends: vertex 0's mitre when the
                 # last edge and edge 0 are left; the end of the last edge's run nearest vertex 0 of all
@@ -433,14 +426,12 @@ _BESIDE = 1e-9
 
 
 @njit(cache=True, nogil=True)
-def _before_a_sweep(best, keys, moved_in, moved_from, along, beyond, left, outer, ring):
+def _before_a_sweep(best, keys, moved_in, moved_from, along, outer, ring):
     """The vertex (an index into one ring of a setback's remainder) where PRT starts a remainder that has
     lost edge 0 to a moved line sweeping over it, ``best`` otherwise. ``keys`` (n,), ``moved_in`` (n,),
     ``moved_from`` (n,) and ``along`` (n,) as ``ring_starts`` finds them (the parent edge a vertex's outgoing
-    edge runs along or was moved in from, inf for none; the one it runs along, -1 for none); ``beyond`` (n,)
-    whether it lies on a moved line past its edge's span (``_places``); ``left`` (the parent's outer edges
-    first): whether any piece of the remainder keeps each parent edge; ``ring`` (the parent's outer ring
-    first, ``outer`` vertices).
+    edge runs along or was moved in from, inf for none; the one it runs along, -1 for none); ``ring`` (the
+    parent's outer ring first, ``outer`` vertices).
 
     Where the first edge left is a moved line (``best``, edge k) that swept over a kept edge facing it
     (parallel, within 2 degrees, and beside some of edge k) among the edges lost from the run before it
@@ -452,11 +443,8 @@ def _before_a_sweep(best, keys, moved_in, moved_from, along, beyond, left, outer
     strip) is no sweep: PRT starts at the moved line (a 0.6 m jog set back 4 m whose facing 0.6 m edge lies
     4 m past its end, measured through PyPRT; massing.seoul.47's second tier). Nor is a moved line that
     passed a kept edge's far end (a chamfer between two moved edges, or beside a kept one: PRT starts at
-    the moved line), nor one across a bar that another piece of the remainder keeps edges beyond (the sweep
-    parted the remainder: PRT starts each piece at its first edge left, massing.holes.58313's second tier).
-    Where edge 0 is lost otherwise and the kept last edge's run is left, the remainder starts where that run
-    ends, but where a moved line runs on there past its own edge's end (a strip beside an acute vertex 0:
-    PRT starts at the first edge left, massing.courtyard.57080's second tier)."""
+    the moved line). Where edge 0 is lost otherwise and the kept last edge's run is left, the remainder
+    starts where that run ends."""
     n = len(keys)
     if keys.min() < 1.0 or (moved_from == 0.0).any():  # (edge 0, or vertex 0, is left)
         return best
@@ -469,17 +457,12 @@ def _before_a_sweep(best, keys, moved_in, moved_from, along, beyond, left, outer
         # where a strip's side runs on from the last edge's run: massing.holes.50515's second tier)
         for j in range(n):
             if along[j] == outer - 1 and not moved_in[j]:
-                return best if beyond[(j + 1) % n] else (j + 1) % n
+                return (j + 1) % n
         return best
     kx, ky = ring[(int(k) + 1) % outer, 0] - ring[int(k), 0], ring[(int(k) + 1) % outer, 1] - ring[int(k), 1]
     size = np.sqrt(kx * kx + ky * ky)
     if size == 0.0:
         return best
-    i = (int(p) + 1) % outer
-    while i != int(k):
-        if left[i]:
-            return best
-        i = (i + 1) % outer
     i = (int(p) + 1) % outer
     while i != int(k):
         ex, ey = ring[(i + 1) % outer, 0] - ring[i, 0], ring[(i + 1) % outer, 1] - ring[i, 1]
@@ -658,7 +641,7 @@ def _material_sides(parent_coords, parent_rings, parent_offsets):
 
 
 @njit(cache=True, nogil=True)
-def _places(px, py, qx, qy, g, parent_coords, parent_rings, parent_offsets, material, moves, beside=False):
+def _places(px, py, qx, qy, g, parent_coords, parent_rings, parent_offsets, material, moves):
     """Where the point p and the edge (p, q) of a piece lie on polygon g: the squared distance to the
     nearest point of its boundary and that point's place (i + f a fraction f along the edge from vertex
     i to vertex i + 1, ring after ring), the place of the nearest vertex, the largest squared edge length
@@ -671,16 +654,10 @@ def _places(px, py, qx, qy, g, parent_coords, parent_rings, parent_offsets, mate
     along it), so that of an offset's sides the one moved in from the outline by the offset is not taken
     for a hole's, whose grown end stops short of it (massing's holes.33921); of collinear ones the one
     whose span is nearest the edge's: an H's inner sides; inf when there is none) with the distance
-    between their lines, and how far along that edge p lies (a fraction in [0, 1]). With ``beside`` (a
-    setback's pieces), an edge moved in that lies wholly beyond a parent edge's span, along its line, is
-    no copy of it: where a strip's end runs on along a moved line past the edge's end (an acute corner's
-    kept neighbour, a neighbour's strip mitred beyond it), PRT numbers the remainder as though that part
-    of the line were not the edge's (massing's courtyard.57080 and holes.58313: their second tiers start
-    at the next edge moved in, or at the first kept run)."""
+    between their lines, and how far along that edge p lies (a fraction in [0, 1])."""
     near, key = np.inf, np.inf
     near_vertex, vertex_key = np.inf, np.inf
     away, edge, gap, best, along = np.inf, np.inf, np.inf, np.inf, 0.0
-    beyond = False
     dx, dy = qx - px, qy - py
     length = np.sqrt(dx * dx + dy * dy)
     scale = 0.0
@@ -717,16 +694,13 @@ def _places(px, py, qx, qy, g, parent_coords, parent_rings, parent_offsets, mate
                     continue
                 # how far the edge's span along the line lies from the parent edge's [0, u]
                 low, high = ((px - ax) * bx + (py - ay) * by) / u, ((qx - ax) * bx + (qy - ay) * by) / u
-                if beside and distance > 1e-6 * max(u, 1.0) and min(high, u) - max(low, 0.0) <= 1e-6 * max(u, 1.0):
-                    beyond = True
-                    continue
                 apart = max(0.0, low - u, -high)
                 same = abs(miss - best) <= 1e-9 * max(u, 1.0)
                 if (miss < best and not same) or (same and apart < gap):
                     away, edge, gap, best = distance, base + i, apart, miss
                     along = min(max(low / u, 0.0), 1.0)
         base += m
-    return near, key, vertex_key, scale, edge, away, along, beyond
+    return near, key, vertex_key, scale, edge, away, along
 
 
 def _open_polygons(polygons: np.ndarray):
