@@ -238,6 +238,12 @@ def _inset_and_border(polygons: np.ndarray, distance: np.ndarray) -> tuple[np.nd
     when negative) with sharp corners kept, a nearly collapsing one kept as PRT keeps it
     (``geometry.insets``), an arm it closes leaving its vertex where PRT does (``geometry.closed_arms``),
     and the ring between that and the face."""
+    # a face that crosses itself (a shed roof's side under a concave outline's reflex corner is a bow tie)
+    # is taken as its valid parts: GEOS's overlay refuses it
+    invalid = ~shapely.is_valid(polygons)
+    if invalid.any():
+        polygons = polygons.copy()
+        polygons[invalid] = shapely.make_valid(polygons[invalid], method="structure", keep_collapsed=False)
     inset = closed_arm_insets(mitred_insets(polygons, distance), polygons, -distance)
     return inset, shapely.difference(polygons, inset)
 

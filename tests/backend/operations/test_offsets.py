@@ -250,3 +250,14 @@ def test_an_offset_by_a_distance_that_is_not_a_number_fails_its_lot(write):
             lot_attrs={"d": np.array([1.0, 0.0])})
     assert [(b.index, b.reason.split(" in rule")[0]) for b in r["bad"]] == [
         (1, "`offset` by a distance that is not a number")]
+
+
+@pytest.mark.parametrize("text", ["Lot --> roofShed(1) offset(0, inside) X.\n",
+                                  "Lot --> roofShed(1) comp(f){ all : F }\nF --> offset(-0.1, inside) X.\n"])
+def test_offset_of_a_face_that_crosses_itself_takes_its_valid_parts(write, text):
+    """A shed roof over a concave outline has a side face that crosses itself under the reflex corner (a bow
+    tie 2.5 cm high), which GEOS's overlay refused ("side location conflict": the build stopped with a
+    traceback, found by the build fuzz); its valid parts are offset, and every face makes its pieces."""
+    concave = [np.array([[0.0, -2.0], [1.0, -1.0], [3.0, 0.0], [0.0, 0.0]])]
+    r = run(write, text, [concave])
+    assert not r["bad"] and len(mesh_faces(r)) >= 4
