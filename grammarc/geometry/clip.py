@@ -328,6 +328,7 @@ def ring_starts(coords, ring_offsets, part_offsets, part_source, part_with_start
     for p in range(len(part_offsets) - 1):
         g = part_source[p]
         outer = parent_rings[parent_offsets[g] + 1] - parent_rings[parent_offsets[g]]
+        ring = parent_coords[parent_rings[parent_offsets[g]]:]  # (the parent's outer ring first)
         for r in range(part_offsets[p], part_offsets[p + 1]):
             r0, r1 = ring_offsets[r], ring_offsets[r + 1]
             n = r1 - r0
@@ -341,7 +342,6 @@ def ring_starts(coords, ring_offsets, part_offsets, part_source, part_with_start
                         best = j
                         break
                 # (a swept last edge first: PRT's start on the lot of both, massing.seoul.37's first tier)
-                ring = parent_coords[parent_rings[parent_offsets[g]]:]
                 best = _past_a_swept_last_edge(best, corner[r0:r1], moved_from[r0:r1], moved_in[r0:r1],
                                                runs_along[r0:r1], outer, ring)
                 best = _past_a_carried_edge(best, coords[r0:r1], moved_from[r0:r1], moved_in[r0:r1],
@@ -349,7 +349,7 @@ def ring_starts(coords, ring_offsets, part_offsets, part_source, part_with_start
             if r == part_offsets[p] and not cut and not part_inset[p]:
                 best = _at_vertex_0(best, corner[r0:r1], runs_along[r0:r1], outer)
                 best = _before_a_sweep(best, keys[r0:r1], moved_in[r0:r1], moved_from[r0:r1], runs_along[r0:r1],
-                                       outer, parent_coords[parent_rings[parent_offsets[g]]:])
+                                       outer, ring)
             if r == part_offsets[p] and part_inset[p]:
                 # where the first outer edge left, counting from the last, ends: vertex 0's mitre when the
                 # last edge and edge 0 are left; the end of the last edge's run nearest vertex 0 of all

@@ -22,7 +22,7 @@ import shapely
 from numba import njit
 
 from grammarc.geometry.clip import open_rings, polygons_from_rings
-from grammarc.ragged import offsets_from_counts
+from grammarc.ragged import grow, offsets_from_counts
 
 #: How far (scope units, metres) a vertex may lie off its run, or an edge off its moved line.
 TOLERANCE = 1e-6
@@ -140,11 +140,8 @@ def _straight(coords, r0, m, k, tolerance):
 
 @njit(cache=True, nogil=True)
 def _push(out, n, x, y):
-    """``out`` with (x, y) at row n, grown where full."""
-    if n == len(out):
-        grown = np.empty((2 * len(out) + 8, 2))
-        grown[:n] = out[:n]
-        out = grown
+    """``out`` with (x, y) at row n, grown where full (``ragged.grow``)."""
+    out = grow(out, n + 1)
     out[n, 0], out[n, 1] = x, y
     return out
 

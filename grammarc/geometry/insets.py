@@ -28,6 +28,7 @@ from numba import njit
 
 from grammarc.geometry.setback import union_by_group
 from grammarc.geometry.skeleton import skeleton_faces
+from grammarc.ragged import grow
 
 #: How many pieces an outline is at least cut into where its inset comes out empty: GEOS checks rings of
 #: fewer than 9 coordinates only.
@@ -154,10 +155,7 @@ def _skeleton_faces(coords, ring_offsets, poly_offsets, depth):
                 end[f] = xy[local[r] + (e - local[r] + 1) % (local[r + 1] - local[r])]
                 polygon[f] = g
                 used, count = face_offsets[f], foff[e + 1] - foff[e]
-                while used + count > len(face_xy):
-                    grown = np.empty((2 * len(face_xy), 2))
-                    grown[:used] = face_xy[:used]
-                    face_xy = grown
+                face_xy = grow(face_xy, used + count)
                 for j in range(count):
                     face_xy[used + j] = node_xy[fnodes[foff[e] + j]]
                 face_offsets[f + 1] = used + count

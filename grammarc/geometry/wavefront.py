@@ -96,10 +96,10 @@ def _push(pool, link, used, head, tail, e, x, y):
 def _ring_strips(start, end, inward, d, corner, ends, out, out_n, left, step_cos):
     """The swept strip of each edge of one ring (n edges), written one after another to ``out`` with its
     vertex count in ``out_n`` (n,) (0 for an edge that does not move), and the wavefront's vertices at
-    the end to ``left`` (2 n, 2), two per line (its segment's ends); returns whether the wavefront fell below three lines (nothing is left),
-    how many vertices it ended with, whether it met no split event (two parallel lines apart
-    becoming neighbours), and whether a moved line overtook a kept one (a kept edge went where a moved
-    line with its normal reached it)."""
+    the end to ``left`` (2 n, 2), two per line (its segment's ends); returns whether the wavefront fell
+    below three lines (nothing is left), how many vertices it ended with, whether it met no split event
+    (two parallel lines apart becoming neighbours), and whether a moved line overtook a kept one (a kept
+    edge went where a moved line with its normal reached it)."""
     n = len(d)
     m_cap = 6 * n + 4  # the edges, a step at each vertex, and one at each of at most 2 m events
     nx, ny, c, w = np.empty(m_cap), np.empty(m_cap), np.empty(m_cap), np.empty(m_cap)

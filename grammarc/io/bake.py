@@ -35,7 +35,7 @@ import os
 import shutil
 from collections.abc import Mapping, Sequence
 from dataclasses import replace
-from pathlib import Path, PurePosixPath
+from pathlib import Path
 from typing import ClassVar
 
 import numpy as np
@@ -453,10 +453,7 @@ class BakedWriter(WriterBlock):
         found = locate(name, self._library.roots)
         if found is None:
             return name
-        copied = self._textures.copy(found[1])
-        if copied is not None:
-            return (PurePosixPath(self._textures_path.name) / copied).as_posix()
-        return os.path.relpath(found[1], self.path.parent.resolve())
+        return self._textures.named(found[1], self._textures_path.name, self.path.parent.resolve())
 
     def _count(self, mesh, table: MeshChunk) -> None:
         made = self._made

@@ -72,3 +72,10 @@ class PackagedTextures:
             shutil.copyfile(file, target)
             self._copied.add(relative)
         return relative
+
+    def named(self, file: Path, folder: str, base: Path) -> str:
+        """How an output at ``base`` names texture ``file`` (a resolved path): its copy, under ``folder``
+        (the output's name for ``into``), where the file lies in the rule package; else its path relative to
+        ``base``, where the grammar's folders hold it."""
+        copied = self.copy(file)
+        return f"{folder}/{copied}" if copied is not None else os.path.relpath(file, base)

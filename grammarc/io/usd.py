@@ -258,10 +258,7 @@ class UsdWriter(TiledWriter):
     def _texture_path(self, colormap: Path) -> str:
         """A colour map's path as a tile layer names it: a rule package's copied into the tile folder's
         ``textures`` (``io.textures``), any other relative to the tile folder, beside which it lies."""
-        copied = self._textures.copy(colormap)
-        if copied is not None:
-            return f"./{self._textures.into.name}/{copied}"
-        return os.path.relpath(colormap, _tiles_base(self.path).resolve())
+        return self._textures.named(colormap, f"./{self._textures.into.name}", _tiles_base(self.path).resolve())
 
     def _write_root(self, path: Path, tiles: list[tuple[str, np.ndarray]], folder: str) -> None:
         stage = _new_stage(path, UsdGeom.Xform, "/City")
