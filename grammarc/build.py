@@ -5,9 +5,14 @@ is bounded by a chunk (docs/architecture.md, invariant 3). A chunk that cannot b
 
 - lots that fail (a negative size, an unsupported geometry, more shapes than --max-shapes, a recursion
   deeper than --max-depth) are reported by id and skipped, and the chunk is derived again without them;
-- a chunk that makes more shapes than its memory budget is split in halves, derived one after the other.
+- a chunk that makes more shapes than its memory budget is split in halves, derived one after the other;
+- a chunk on which grammarc itself fails (an exception that is not one of its errors: a fault of grammarc's
+  that some lot's geometry meets) is split in halves until the lots it fails on are found; each is reported
+  as a bad lot that names the fault, and the others are derived. A city of a million lots is not lost to
+  one lot, and the fault is said with the lot to reproduce it. With ``GRAMMARC_STRICT`` set (the tests
+  set it) the fault is raised instead, with its traceback.
 
-Neither changes the output of the other lots, because a lot's records do not depend on its chunk.
+None changes the output of the other lots, because a lot's records do not depend on its chunk.
 """
 
 from __future__ import annotations
@@ -16,6 +21,7 @@ import contextlib
 import functools
 import gc
 import time
+import traceback
 from collections import deque
 from collections.abc import Sequence
 from dataclasses import dataclass, field, replace
@@ -30,8 +36,8 @@ from grammarc.backend.fusion.fused import preload
 from grammarc.backend.occlusion import Occluders
 from grammarc.backend.plan import make_plan
 from grammarc.compiler import compile_grammar
-from grammarc.constants import LIMITS, Limits
-from grammarc.errors import ChunkTooLarge, LotFailure, UsageError, check_stopped
+from grammarc.constants import LIMITS, STRICT, Limits
+from grammarc.errors import ChunkTooLarge, GrammarcError, LotFailure, UsageError, check_stopped
 from grammarc.io import OutputOptions, writer_for, written_paths
 from grammarc.io.lot_format import LotsOptions
 from grammarc.io.lots_reading import LotsReading
@@ -371,8 +377,8 @@ def _derive(plan, lots: Lots, options: BuildOptions, foreign=None) -> tuple[list
 
 
 def _attempts(lots: Lots, derive_part, failed: list[BadLot] | None):
-    """``(part, derive_part(part))`` over ``lots``: lots that fail are left out (and listed in ``failed``),
-    a chunk too large for memory is halved."""
+    """``(part, derive_part(part))`` over ``lots``: lots that fail, or that grammarc fails on, are left out
+    (and listed in ``failed``), a chunk too large for memory is halved."""
     queue = [lots]
     while queue:
         part = queue.pop(0)
@@ -389,10 +395,32 @@ def _attempts(lots: Lots, derive_part, failed: list[BadLot] | None):
             queue.insert(0, part.take(~skip))
             continue
         except ChunkTooLarge:
-            half = len(part) // 2
-            queue[:0] = [part.take(slice(0, half)), part.take(slice(half, None))]
+            queue[:0] = _halves(part)
+            continue
+        except (GrammarcError, MemoryError):
+            raise
+        except Exception as fault:
+            if STRICT:
+                raise
+            if len(part) > 1:
+                queue[:0] = _halves(part)
+            elif failed is not None:
+                failed.append(BadLot(int(part.index[0]), str(part.ids[0]), _fault(fault)))
             continue
         yield part, result
+
+
+def _halves(part: Lots) -> list[Lots]:
+    half = len(part) // 2
+    return [part.take(slice(0, half)), part.take(slice(half, None))]
+
+
+def _fault(fault: Exception) -> str:
+    """What a bad lot says of a fault of grammarc's it met: the exception and where it was raised."""
+    frames = traceback.extract_tb(fault.__traceback__)
+    where = f" at {Path(frames[-1].filename).name}:{frames[-1].lineno}" if frames else ""
+    return (f"grammarc failed on this lot ({type(fault).__name__}{where}: {fault}); this is a fault of "
+            "grammarc's, not of the lot: please report it with the lot")
 
 
 def occluders(plan, lots: Lots, options: BuildOptions) -> Occluders:

@@ -175,6 +175,42 @@ def test_a_runaway_lot_is_skipped_by_name_and_the_others_built(write, tmp_path, 
     assert sorted(p.name for p in tmp_path.iterdir()) == ["city.geojson", "g.cga", "out.npz"]
 
 
+def test_a_lot_grammarc_fails_on_is_named_with_the_fault_and_the_others_written(write, tmp_path, capsys,
+                                                                              monkeypatch):
+    """A fault of grammarc's that one lot's geometry meets (an exception that is none of its errors) does not
+    lose the city: the chunk is halved until the lot is found, which is skipped and named with the fault and
+    where it was raised; the other lots' records are those they have without it. The tests' strict mode
+    raises the fault instead."""
+    import grammarc.build
+
+    derive_chunk = grammarc.build.derive_chunk
+
+    def faulty(plan, lots, **kwargs):
+        if "lot2" in lots.ids.tolist():
+            raise ValueError("too many values to unpack (expected 2)")
+        return derive_chunk(plan, lots, **kwargs)
+
+    grammar = write("g.cga", GOOD)
+    lots = geojson(tmp_path / "city.geojson", [SQUARE] * 4)
+    expected = tmp_path / "expected.npz"
+    assert main(["build", str(grammar), "--lots", str(lots), "--emit", str(expected), "--quiet"]) == 0
+    monkeypatch.setattr(grammarc.build, "derive_chunk", faulty)
+    out = tmp_path / "out.npz"
+    with pytest.raises(ValueError):
+        main(["build", str(grammar), "--lots", str(lots), "--emit", str(out), "--quiet"])
+    monkeypatch.setattr(grammarc.build, "STRICT", False)
+    assert main(["build", str(grammar), "--lots", str(lots), "--emit", str(out)]) == 0
+    err = capsys.readouterr().err
+    assert re.search(r"grammarc: lot lot2 \(#2\) skipped: grammarc failed on this lot \(ValueError at "
+                     r"test_cli\.py:\d+: too many values to unpack \(expected 2\)\); this is a fault of "
+                     r"grammarc's, not of the lot: please report it with the lot\n", err)
+    assert err.endswith("grammarc: 1 of 4 lots skipped\n")
+    got, want = read_instances(out), read_instances(expected)
+    keep = want["lot"] != 2
+    assert got["lot"].tolist() == want["lot"][keep].tolist()
+    assert np.array_equal(got["xform"], want["xform"][keep])
+
+
 def test_bad_lots_of_the_derivation_are_named_and_the_good_ones_written(write, tmp_path, capsys):
     """One lot of a facade's tile 1e-9 m wide (3e10 tiles), one of a height of 1e308 (no float32 holds it:
     the extrude fails it), one of ``height: true`` (a boolean for a number): each is named on stderr with

@@ -89,3 +89,21 @@ def test_a_closed_bar_leaves_its_vertex_on_a_run_where_geos_leaves_none():
                                for p in shapely.get_parts(_inset(lot, 7.721))])
         inner = ring[np.isclose(ring[:, 0], 17.5 - 7.721) | np.isclose(ring[:, 0], 27.15 + 7.721)]
         assert np.sort(inner[:, 1]) == pytest.approx([7.721] * 2 + [12.95] * 2 + [25.9 - 7.721] * 2, abs=1e-9)
+
+
+def test_a_face_offset_as_its_valid_parts_takes_the_rings_of_all_its_parts():
+    """A face whose ring runs back over its own edge (a facade face of candler on a real lot of Sibiu's old
+    town) is offset as its valid parts, a multipolygon (``offsets._inset_and_border``); beside a polygon in
+    one batch, the closed arm of the polygon is still placed, and the parts' inset kept (the batch's
+    rings were read as one polygon's each, and the build stopped with a traceback)."""
+    face = shapely.Polygon([(14.9, 0.43), (15.12, 6.49), (17.98, 6.49), (17.6, 0.96), (31.89, 0), (37.81, 0),
+                            (38.26, 6.49), (57.62, 6.49), (56.33, 0), (18.79, 0), (11.84, 0.53), (14.9, 0.43)])
+    parts = shapely.make_valid(face, method="structure", keep_collapsed=False)
+    assert shapely.get_type_id(parts) == shapely.GeometryType.MULTIPOLYGON
+    polygons, distance = np.array([T_LOT, parts]), np.array([4.0, 1.85])
+    inset = shapely.buffer(polygons, -distance, join_style="mitre", mitre_limit=1e6)
+    out = closed_arm_insets(inset, polygons, distance)
+    ring = shapely.get_coordinates(shapely.orient_polygons(out[0]).exterior)[:-1]
+    assert sorted(map(tuple, ring.tolist())) == [(4, 4), (4, 16), (13, 16), (26, 4), (26, 16)]
+    assert shapely.equals(out[1], inset[1])
+    assert shapely.get_num_coordinates(out[1]) == shapely.get_num_coordinates(inset[1])
