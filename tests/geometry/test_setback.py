@@ -664,13 +664,14 @@ def _stepped_block(top_x: float, y: float, mirrored: bool = False) -> np.ndarray
     return np.array([shapely.Polygon(ring)])
 
 
-def _strip_faces(face: np.ndarray, d: list, mirrored: bool = False) -> tuple[list, float]:
+def _strip_faces(face: np.ndarray, d: list, mirrored: bool = False) -> list:
+    """The areas of the strip faces of ``face`` set back by ``d`` per edge, largest first."""
     edges = polygon_edges(face)
     # (the mirrored ring runs backwards: its edge k is the block's edge 4 - k)
     distance = np.array([d[(4 - k) % 6] for k in range(6)] if mirrored else d, float)
     (strips,), rest = setback_regions(face, edges, distance, np.zeros(len(edges.poly), np.int64), 1)
     assert shapely.area(strips[0]) + shapely.area(rest[0]) == pytest.approx(shapely.area(face[0]))
-    return sorted(shapely.area(shapely.get_parts(strips[0])), reverse=True), shapely.area(rest[0])
+    return sorted(shapely.area(shapely.get_parts(strips[0])), reverse=True)
 
 
 @pytest.mark.parametrize("mirrored", [False, True])
@@ -685,8 +686,24 @@ def test_a_strip_past_a_kept_edge_s_reflex_end_stops_at_the_bisector_ray(top_x, 
     """Edge 5's strip runs along the kept edge 4's line past its reflex end (10, 12), where edge 3 moves:
     it stops at the ray from there along the bisector of edges 3 and 5, and the two strips, which touched
     along the line, are two faces, as PRT's; the same with the strip's end side past the reflex end."""
-    areas, _ = _strip_faces(_stepped_block(top_x, y, mirrored), d, mirrored)
+    areas = _strip_faces(_stepped_block(top_x, y, mirrored), d, mirrored)
     np.testing.assert_allclose(areas, faces, atol=1e-3)
+
+
+@pytest.mark.parametrize(("x0", "faces"), [
+    (7.94, [181.513, 54.375]),  # edge 5 turned 14.98 degrees from edge 3, into the face: cut
+    (8.0, [235.885]),  # 15.26 degrees: no cut (PRT's 235.884 m^2)
+    (9.0, [232.76]),  # 20.8 degrees (PRT's 232.759)
+    (2.0, [206.771, 54.375]),  # turned away from the face by 15.3 degrees: cut (PRT's 206.769)
+    (-3.0, [235.126, 54.375]),  # by 36 degrees (PRT's 235.124)
+])
+def test_a_strip_stops_at_the_ray_where_the_two_edges_turn_little_into_the_face_or_away(x0, faces):
+    """The block with edge 5 (from (5, 11) to (x0, 0)) turned from edge 3: its strip stops at the ray where
+    the two edges, met at one vertex, would turn from each other by under 15 degrees into the face (as two
+    edges step there) or turn away from it, as PRT's faces (measured through PyPRT)."""
+    face = np.array([shapely.Polygon([(x0, 0), (30, 0), (30, 20), (10, 20), (10, 12), (5, 11)])])
+    areas = _strip_faces(face, [6, 0, 0, 7.5, 0, 7.5])
+    np.testing.assert_allclose(areas, faces, atol=2e-3)
 
 
 @pytest.mark.parametrize(("y", "face"), [(11.99, 254.925), (12.0, 255.0), (13.0, 262.5)])
@@ -694,5 +711,5 @@ def test_a_ray_within_a_quarter_degree_of_the_kept_line_or_beyond_it_cuts_nothin
     """The ray 0.11 degrees from the kept edge's line (PRT's one face of 254.937 m^2: it takes the sliver
     between the ray and the next strip's moved corner, 0.0125 m^2, which the strips leave), on it (a
     square step) or on its other side (the kept edge turned 101 degrees: PRT's 262.5 m^2)."""
-    areas, _ = _strip_faces(_stepped_block(10, y), [6, 0, 0, 7.5, 0, 7.5])
+    areas = _strip_faces(_stepped_block(10, y), [6, 0, 0, 7.5, 0, 7.5])
     np.testing.assert_allclose(areas, [face], atol=1e-3)
