@@ -506,3 +506,31 @@ def test_a_remainder_past_a_swept_last_edge_starts_where_prt_starts_it(turn, rem
                             moves=distances)
         start = pieces.coords[0] * pieces.extent[0, [0, 2]] + pieces.low[0, [0, 2]]
         np.testing.assert_allclose(start, _flip([first])[0], atol=1e-4)
+
+
+@pytest.mark.parametrize("ring, distances, first", [
+    # edge 0 set back 4 m past the 3 m kept step (edge 1) after it, to the reflex vertex 2: PRT starts there
+    ([(0, 0), (8, 0), (8, 3), (14, 3), (14, 20), (0, 20)], [4, 0, 0, 0, 0, 0], (8, 3)),
+    ([(0, 0), (8, 0), (7, 3), (14, 3), (14, 20), (0, 20)], [4, 0, 0, 0, 0, 0], (7, 3)),
+    ([(0, 0), (8, 0), (9, 3), (14, 3), (14, 20), (0, 20)], [4, 0, 0, 0, 0, 0], (9, 3)),
+    # edge 1 set back as far: its strip folds, and it stays (``geometry.setback``); the same start
+    ([(0, 0), (8, 0), (8, 3), (14, 3), (14, 20), (0, 20)], [4, 4, 0, 0, 0, 0], (8, 3)),
+    # set back 2 m, short of the step: at edge 0's moved line
+    ([(0, 0), (8, 0), (8, 3), (14, 3), (14, 20), (0, 20)], [2, 0, 0, 0, 0, 0], (0, 2)),
+])
+def test_a_remainder_whose_first_edge_ends_past_a_kept_step_starts_at_the_step_s_reflex_end(ring, distances,
+                                                                                          first):
+    """massing's first tier set back as ``distances`` say on a 14 x 20 m block with a kept step after edge 0,
+    PRT's second tier's edges read off its roof (measured through PyPRT, distinct distances per edge), on
+    every turn of the remainder's ring (its edges told from the parent edges moved by their distances, as
+    ``backend.operations.setbacks`` tells them: edge 0's moved line lies nearer the step's top)."""
+    from grammarc.geometry.clip import fit_pieces
+
+    _, remainder, _, _ = _setback_remainder(ring, distances)
+    kept = np.array(_flip(np.asarray(remainder.exterior.coords)[:-1]), float)
+    lot = shapely.Polygon(_flip(ring))
+    for turned in range(len(kept)):  # GEOS's start anywhere on the ring
+        pieces = fit_pieces(np.array([shapely.Polygon(np.roll(kept, turned, axis=0))]), np.array([1]),
+                            np.array([[30.0, 0.0, 30.0]]), np.array([lot]), moves=np.asarray(distances, float))
+        start = pieces.coords[0] * pieces.extent[0, [0, 2]] + pieces.low[0, [0, 2]]
+        np.testing.assert_allclose(start, _flip([first])[0], atol=1e-9)

@@ -651,3 +651,65 @@ def test_strips_whose_seams_leave_a_ring_of_no_area_keep_it():
     edges = polygon_edges(polygons)
     (region,), remainder = setback_regions(polygons, edges, distance, np.zeros(len(distance), dtype=np.int64), 1)
     assert shapely.area(region[0]) + shapely.area(remainder[0]) == pytest.approx(face.area)
+
+
+#: A block whose west side steps in at a kept 5 m edge: edge 3 runs down to the reflex vertex (10, 12),
+#: edge 4 (kept) turns west from it to (5, y), edge 5 runs down from there; mirrored, the same block with
+#: its strip's end side past the kept edge's reflex end. PRT's areas are its tiers' (``setback`` per edge on
+#: massing's first tier), measured through PyPRT.
+def _stepped_block(top_x: float, y: float, mirrored: bool = False) -> np.ndarray:
+    ring = [(5, 0), (30, 0), (30, 20), (top_x, 20), (10, 12), (5, y)]
+    if mirrored:
+        ring = [(-x, y) for x, y in ring][::-1]
+    return np.array([shapely.Polygon(ring)])
+
+
+def _strip_faces(face: np.ndarray, d: list, mirrored: bool = False) -> list:
+    """The areas of the strip faces of ``face`` set back by ``d`` per edge, largest first."""
+    edges = polygon_edges(face)
+    # (the mirrored ring runs backwards: its edge k is the block's edge 4 - k)
+    distance = np.array([d[(4 - k) % 6] for k in range(6)] if mirrored else d, float)
+    (strips,), rest = setback_regions(face, edges, distance, np.zeros(len(edges.poly), np.int64), 1)
+    assert shapely.area(strips[0]) + shapely.area(rest[0]) == pytest.approx(shapely.area(face[0]))
+    return sorted(shapely.area(shapely.get_parts(strips[0])), reverse=True)
+
+
+@pytest.mark.parametrize("mirrored", [False, True])
+@pytest.mark.parametrize(("top_x", "y", "d", "faces"), [
+    (10, 11, [6, 0, 0, 7.5, 0, 7.5], [192.5, 54.375]),  # the kept edge turned 79 degrees: a 0.625 m^2 cut
+    (10, 11, [6, 0, 0, 5, 0, 7.5], [192.5, 37.5]),
+    (12, 11, [0, 0, 0, 7.5, 0, 7.5], [87.115, 55.555]),  # edge 3 turned 14 degrees: the ray turns 7
+    (12, 11, [0, 0, 0, 5, 0, 7.5], [87.115, 38.435]),
+    (10, 11.97, [6, 0, 0, 7.5, 0, 7.5], [194.925, 59.831]),  # the ray 0.34 degrees from the line
+])
+def test_a_strip_past_a_kept_edge_s_reflex_end_stops_at_the_bisector_ray(top_x, y, d, faces, mirrored):
+    """Edge 5's strip runs along the kept edge 4's line past its reflex end (10, 12), where edge 3 moves:
+    it stops at the ray from there along the bisector of edges 3 and 5, and the two strips, which touched
+    along the line, are two faces, as PRT's; the same with the strip's end side past the reflex end."""
+    areas = _strip_faces(_stepped_block(top_x, y, mirrored), d, mirrored)
+    np.testing.assert_allclose(areas, faces, atol=1e-3)
+
+
+@pytest.mark.parametrize(("x0", "faces"), [
+    (7.94, [181.513, 54.375]),  # edge 5 turned 14.98 degrees from edge 3, into the face: cut
+    (8.0, [235.885]),  # 15.26 degrees: no cut (PRT's 235.884 m^2)
+    (9.0, [232.76]),  # 20.8 degrees (PRT's 232.759)
+    (2.0, [206.771, 54.375]),  # turned away from the face by 15.3 degrees: cut (PRT's 206.769)
+    (-3.0, [235.126, 54.375]),  # by 36 degrees (PRT's 235.124)
+])
+def test_a_strip_stops_at_the_ray_where_the_two_edges_turn_little_into_the_face_or_away(x0, faces):
+    """The block with edge 5 (from (5, 11) to (x0, 0)) turned from edge 3: its strip stops at the ray where
+    the two edges, met at one vertex, would turn from each other by under 15 degrees into the face (as two
+    edges step there) or turn away from it, as PRT's faces (measured through PyPRT)."""
+    face = np.array([shapely.Polygon([(x0, 0), (30, 0), (30, 20), (10, 20), (10, 12), (5, 11)])])
+    areas = _strip_faces(face, [6, 0, 0, 7.5, 0, 7.5])
+    np.testing.assert_allclose(areas, faces, atol=2e-3)
+
+
+@pytest.mark.parametrize(("y", "face"), [(11.99, 254.925), (12.0, 255.0), (13.0, 262.5)])
+def test_a_ray_within_a_quarter_degree_of_the_kept_line_or_beyond_it_cuts_nothing(y, face):
+    """The ray 0.11 degrees from the kept edge's line (PRT's one face of 254.937 m^2: it takes the sliver
+    between the ray and the next strip's moved corner, 0.0125 m^2, which the strips leave), on it (a
+    square step) or on its other side (the kept edge turned 101 degrees: PRT's 262.5 m^2)."""
+    areas = _strip_faces(_stepped_block(10, y), [6, 0, 0, 7.5, 0, 7.5])
+    np.testing.assert_allclose(areas, [face], atol=1e-3)
