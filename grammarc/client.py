@@ -12,15 +12,16 @@ from __future__ import annotations
 import os
 import sys
 
-from grammarc import server
-
 
 def main(argv: list[str] | None = None) -> int:
     argv = sys.argv[1:] if argv is None else argv
-    if server.AVAILABLE and os.environ.get("GRAMMARC_SERVER") != "off" and argv[:1] != ["server"]:
-        status = server.request(argv)
-        if status is not None:
-            return status
+    if os.environ.get("GRAMMARC_SERVER") != "off" and argv[:1] != ["server"]:
+        from grammarc import server  # not imported by a command that runs here in any case
+
+        if server.AVAILABLE:
+            status = server.request(argv)
+            if status is not None:
+                return status
     from grammarc.cli import main as run
 
     return run(argv)

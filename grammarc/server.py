@@ -19,7 +19,7 @@ at start-up (``GRAMMARC_*``, ``NUMBA_*``, ``PYTHON*``, the locale's); a client t
 digest finds no server and runs the command itself. The socket lives in a folder only its user can enter
 (``$XDG_RUNTIME_DIR/grammarc`` or ``/tmp/grammarc-<uid>``), and the server checks the caller's user id.
 
-This module is imported by the client on every command: it imports nothing heavy.
+This module is imported by the client on every command that a server may run: it imports nothing heavy.
 """
 
 from __future__ import annotations

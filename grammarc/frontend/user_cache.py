@@ -89,8 +89,21 @@ def code_stamp() -> str:
     """A digest of the code that made a cached file: grammarc's version and the name, size and time of
     each of its source files and grammars, and the Python (pickles are read by the same one)."""
     digest = hashlib.sha256(f"{grammarc.__version__}\0{sys.executable}\0{sys.version}\0".encode())
-    package = Path(grammarc.__file__).parent
-    for path in sorted([*package.rglob("*.py"), *package.rglob("*.lark")]):
-        info = path.stat()
-        digest.update(f"{path.relative_to(package)}\0{info.st_mtime_ns}\0{info.st_size}\0".encode())
+    for parts, info in sorted(_sources(os.path.dirname(grammarc.__file__), ())):
+        digest.update(f"{'/'.join(parts)}\0{info.st_mtime_ns}\0{info.st_size}\0".encode())
     return digest.hexdigest()
+
+
+def _sources(folder: str, parts: tuple[str, ...]) -> list[tuple[tuple[str, ...], os.stat_result]]:
+    """``(path parts, stat)`` of the ``.py`` and ``.lark`` files under ``folder``, found with ``os.scandir``
+    past the ``__pycache__`` folders (full of numba's cache files, which ``Path.rglob`` listed on every
+    command's start)."""
+    found = []
+    with os.scandir(folder) as entries:
+        for entry in entries:
+            if entry.is_dir(follow_symlinks=False):
+                if entry.name != "__pycache__":
+                    found += _sources(entry.path, (*parts, entry.name))
+            elif entry.name.endswith((".py", ".lark")):
+                found.append(((*parts, entry.name), entry.stat()))
+    return found
