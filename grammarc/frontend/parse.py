@@ -20,8 +20,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from grammarc.diagnostics import Diagnostics, Span
-from grammarc.frontend import cga2006, cityengine, lowered_cache
-from grammarc.frontend.cityengine.nodes import Import
+from grammarc.frontend import lowered_cache
 from grammarc.frontend.imports import Roots, find_roots, load_import
 from grammarc.frontend.sites import Sites
 from grammarc.frontend.statements import Statement, split_cityengine, split_paper
@@ -35,20 +34,24 @@ if TYPE_CHECKING:
 @dataclass(frozen=True, slots=True)
 class Dialect:
     """How a dialect is read: its lark grammar (a file of the package), how its text is cut into statements,
-    the module whose ``Lowering`` (a lark Transformer) lowers one statement, and the function that
-    assembles the lowered statements of a file into a module."""
+    the module whose ``Lowering`` (a lark Transformer) lowers one statement, and the package whose
+    ``assemble`` assembles the lowered statements of a file into a module (imported where a file of the
+    dialect is: a build of the other's does without it)."""
 
     grammar: str
     split: Callable[[str], list[Statement]]
     lowering: str
-    assemble: Callable[..., ir.Module]
+    package: str
+
+    def assemble(self, *args, **kwargs) -> ir.Module:
+        return import_module(self.package).assemble(*args, **kwargs)
 
 
 DIALECTS = {
     "cga2006": Dialect("grammars/cga2006.lark", split_paper, "grammarc.frontend.cga2006.lowering",
-                       cga2006.assemble),
+                       "grammarc.frontend.cga2006"),
     "cityengine": Dialect("grammars/cityengine.lark", split_cityengine, "grammarc.frontend.cityengine.lowering",
-                          cityengine.assemble),
+                          "grammarc.frontend.cityengine"),
 }
 #: Text that only CityEngine CGA has: its version line, annotations, lower-case operations, const.
 _CITYENGINE_MARKS = re.compile(r'^[ \t]*(version\s+"|@StartRule|const\s)|\b(extrude|split|comp)\s*\(',
@@ -109,6 +112,8 @@ def parse_source(text: str, file: str, diags: Diagnostics, dialect: str | None =
             lowered_cache.keep(name, file, text, first_site, lowered, diags[said:], sites.next_site)
     if spec is not DIALECTS["cityengine"]:  # the paper notation imports no files
         return spec.assemble(file, lowered, diags)
+    from grammarc.frontend.cityengine.nodes import Import
+
     imports = []
     for st in lowered:
         declaration = getattr(st, "declaration", st)
