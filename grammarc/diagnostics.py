@@ -10,7 +10,6 @@ a list, so that all of them are reported at once. ``render`` prints the CGA-styl
 
 from __future__ import annotations
 
-import difflib
 from dataclasses import dataclass
 from enum import Enum
 
@@ -124,6 +123,8 @@ def _render(diag: Diagnostic, lines: _Lines) -> str:
 
 def suggest(name: str, candidates) -> str:
     """`` (did you mean `x`?)`` for the closest candidate, or an empty string."""
+    import difflib  # here: a compile that finds no unknown name does without it
+
     close = difflib.get_close_matches(name, list(candidates), n=1, cutoff=0.6)
     return f" (did you mean `{close[0]}`?)" if close else ""
 
