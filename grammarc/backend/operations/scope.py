@@ -67,6 +67,10 @@ def scale(ctx: Context, cursor: Shapes, op: ir.Scale) -> Shapes:
         size[:, axis] = value * cursor.size[:, axis] if s.kind is ir.SizeKind.RELATIVE else value
     flips = size < 0
     if op.mirrors and flips.any():
+        nan = np.isnan(size).any(axis=1)
+        if nan.any():
+            row = size[np.flatnonzero(nan)[0]]
+            ctx.fail(cursor, nan, f"`s` gives a NaN size ({', '.join(f'{v:g}' for v in row)})", op.span)
         return _inside_out(ctx, cursor.with_scope(cursor.origin, np.abs(size), cursor.frame, cursor.geom), flips)
     ctx.fail_negative(cursor, size, "`S` gives a negative or NaN size", op.span)
     return cursor.with_scope(cursor.origin, size, cursor.frame, cursor.geom)

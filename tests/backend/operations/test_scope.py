@@ -470,6 +470,15 @@ def test_negative_size_lot_is_reported_and_skipped(write):
 
 
 
+def test_a_nan_size_beside_a_negative_one_fails_the_lot(write):
+    """CityEngine's ``s`` mirrors along an axis given a negative size; a NaN size on another axis (``h / w``
+    of two zero attributes) fails the lot by name, as the paper's ``S`` does, and is not mirrored (GEOS
+    refused the mirrored face's NaN ring and the build stopped: the build fuzz, seed 94)."""
+    text = "attr h = 0\nattr w = 0\nLot --> s(1, -1, h / w) X.\n"
+    r = run(write, text, [rect(10, 5), rect(10, 5)], lot_attrs={"w": np.array([0.0, 1.0])})
+    assert [(b.index, b.reason.split(" in rule")[0]) for b in r["bad"]] == [(0, "`s` gives a NaN size (1, -1, nan)")]
+
+
 def test_negative_size_mirrors_the_shape_and_inverts_its_normals(write):
     """CityEngine's ``s`` mirrors along an axis given a negative size (the reference: "the normals are
     inverted"). complexpatterns' ``Balcony`` on a tiny lot, a parallelogram: its box narrower than its two
