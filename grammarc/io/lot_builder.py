@@ -214,7 +214,8 @@ class LotBuilder:
         for start, flags in self.street:
             given[start:start + len(flags)] = flags
         street = np.zeros(len(vertices), dtype=bool)
-        np.logical_or.at(street, owner, given)
+        if given.any():  # most files mark no street edge
+            np.logical_or.at(street, owner, given)
         lot_offsets = offsets_from_counts(ring_counts)
         normals = _newell(vertices, ring_offsets)
         exterior = np.zeros(len(normals), dtype=bool)
@@ -428,13 +429,6 @@ def property_columns(props: list[dict]) -> dict[str, np.ndarray]:
 # ------------------------------------------------------------------------------------- ragged kernels
 
 
-def _ring_positions(ring_offsets: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Per vertex: its ring, its ring's start and its ring's vertex count, each (V,) int64."""
-    counts = np.diff(ring_offsets)
-    ring = np.repeat(np.arange(len(counts)), counts)
-    return ring, ring_offsets[:-1][ring], counts[ring]
-
-
 @njit(cache=True, nogil=True)
 def _newell(vertices, ring_offsets):
     """(R, 3) float64 Newell normals, twice the vector area; ``normal[:, 1]`` = 2 x the map signed area.
@@ -457,18 +451,23 @@ def _newell(vertices, ring_offsets):
     return normals
 
 
-def _orient(ring_offsets, exterior, normal_y) -> tuple[np.ndarray, np.ndarray]:
+@njit(cache=True, nogil=True)
+def _orient(ring_offsets, exterior, normal_y):
     """Reverse exterior rings with a -Y normal and holes with a +Y one, keeping each ring's first vertex:
     where each vertex and each edge (from its vertex to the next) comes from, (V,) int64 each.
 
     A reversed ring of n vertices takes position p from position (n - p) % n: v0, v_{n-1}, ..., v1; its
     edge p is the old edge (n - p - 1) % n run backwards.
     """
-    ring, start, count = _ring_positions(ring_offsets)
-    flip = np.where(exterior, normal_y < 0, normal_y > 0)[ring]
-    position = np.arange(len(ring)) - start
-    return (start + np.where(flip, (count - position) % count, position),
-            start + np.where(flip, (count - position - 1) % count, position))
+    vertex_order = np.empty(ring_offsets[-1], dtype=np.int64)
+    edge_order = np.empty(ring_offsets[-1], dtype=np.int64)
+    for r in range(len(ring_offsets) - 1):
+        start, n = ring_offsets[r], ring_offsets[r + 1] - ring_offsets[r]
+        flip = normal_y[r] < 0 if exterior[r] else normal_y[r] > 0
+        for p in range(n):
+            vertex_order[start + p] = start + ((n - p) % n if flip else p)
+            edge_order[start + p] = start + ((n - p - 1) % n if flip else p)
+    return vertex_order, edge_order
 
 
 def _beyond_the_earth(vertices: np.ndarray, lot_counts: np.ndarray) -> np.ndarray:
