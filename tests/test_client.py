@@ -42,3 +42,21 @@ def test_where_no_server_can_run_commands_run_here_and_server_says_why(asked, mo
     assert client.main(["check", str(write("g.cga", "Lot --> extrude(3)\n"))]) == 0 and asked == []
     assert client.main(["server", "start"]) == 2
     assert "grammarc server needs a system that forks" in capsys.readouterr().err
+
+
+def test_run_as_the_program_the_process_ends_with_the_status_its_exit_functions_run_and_its_output(write):
+    """``main()`` without arguments (the console script) ends the process itself (``client._end``): with the
+    command's status, after the exit functions, its output flushed; a failing command's status too."""
+    import os
+    import subprocess
+    import sys
+
+    good, bad = write("g.cga", "Lot --> extrude(3)\n"), write("b.cga", "Lot --> extrude(\n")
+    program = ("import atexit, sys; from grammarc.client import main; atexit.register(print, 'exit functions ran')"
+               "; sys.argv[1:] = ['check', sys.argv[1]]; print('before', end=''); main(); print('not reached')")
+    env = {**os.environ, "GRAMMARC_SERVER": "off"}
+    ran = [subprocess.run([sys.executable, "-c", program, str(path)], env=env, capture_output=True, text=True,
+                          check=False) for path in (good, bad)]
+    assert [r.returncode for r in ran] == [0, 2]
+    assert all(r.stdout.startswith("before") and r.stdout.endswith("exit functions ran\n") for r in ran)
+    assert all("not reached" not in r.stdout for r in ran) and "b.cga:1" in ran[1].stderr

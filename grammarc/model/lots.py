@@ -90,7 +90,8 @@ class Lots:
         lots : Lots
           The selected lots with rebased offsets and sliced attrs; ``bad`` and ``source`` are kept as is.
         """
-        # a slice (a chunk of a build) costs its own length, not that of all the lots
+        if isinstance(sel, slice) and sel.indices(len(self))[2] == 1:
+            return self._span(*sel.indices(len(self))[:2])
         lot = np.arange(*sel.indices(len(self))) if isinstance(sel, slice) else np.atleast_1d(np.arange(len(self))[sel])
         ring, lot_offsets = ragged_take(self.lot_offsets, lot)
         vertex, ring_offsets = ragged_take(self.ring_offsets, ring)
@@ -102,6 +103,26 @@ class Lots:
             lot_offsets=lot_offsets,
             street=self.street[vertex],
             attrs={name: column[lot] for name, column in self.attrs.items()},
+            bad=self.bad,
+            source=self.source,
+            crs=self.crs,
+            crs_note=self.crs_note,
+        )
+
+    def _span(self, first: int, stop: int) -> Lots:
+        """``take`` of the lots ``first:stop`` (a chunk of a build): views of these arrays, read-only, but
+        for the offsets (rebased); a gather of every column cost a build's parent ~0.2 s of CPU over
+        pompeii x100's 35 chunks, beside its workers."""
+        stop = max(stop, first)
+        rings, vertices = self.lot_offsets[[first, stop]], self.ring_offsets[self.lot_offsets[[first, stop]]]
+        return Lots(
+            ids=_read_only(self.ids[first:stop]),
+            index=_read_only(self.index[first:stop]),
+            vertices=_read_only(self.vertices[vertices[0]:vertices[1]]),
+            ring_offsets=self.ring_offsets[rings[0]:rings[1] + 1] - vertices[0],
+            lot_offsets=self.lot_offsets[first:stop + 1] - rings[0],
+            street=_read_only(self.street[vertices[0]:vertices[1]]),
+            attrs={name: _read_only(column[first:stop]) for name, column in self.attrs.items()},
             bad=self.bad,
             source=self.source,
             crs=self.crs,
@@ -124,3 +145,9 @@ class Lots:
                              + (f" (and {len(unknown) - 10} more)" if len(unknown) > 10 else ""))
         keep = np.isin(ids, sorted(wanted))
         return replace(self.take(keep), bad=tuple(b for b in self.bad if b.id in wanted))
+
+
+def _read_only(view: np.ndarray) -> np.ndarray:
+    """``view`` marked read-only: a write into a chunk's lots would be a write into every lot's."""
+    view.flags.writeable = False
+    return view

@@ -309,6 +309,36 @@ def test_lots_that_skip_geos_validity_are_those_it_finds_valid(seed, offset):
     np.testing.assert_array_equal(fast.vertices, slow.vertices)
 
 
+@pytest.mark.parametrize("min_area", [None, 0.5, 2.0])
+def test_lots_near_the_least_area_are_judged_by_geos_as_before(min_area):
+    """Convex lots skip GEOS only where their area is plainly more than the least a lot may have (the
+    area floor, ``--min-area``): squares just over and under either are the bad lots, with the reasons
+    and areas, of the check that asks GEOS about every lot."""
+    from grammarc.io import lot_builder
+    from grammarc.io.lot_format import LotsOptions
+
+    sides = [np.sqrt(a) for a in (1e-6 * 0.9999, 1e-6 * 1.0001, 1e-6 * 1.01, 0.5 * 0.9999, 0.5 * 1.0001,
+                                  2.0 * 0.99999, 2.0 * 1.00001, 2.0 * 1.002, 100.0)]
+
+    def read():
+        builder = lot_builder.LotBuilder(world=False)
+        for k, side in enumerate(sides):
+            square = 5e5 + np.array([[0, 0], [side, 0], [side, side], [0, side]])
+            builder.add_positions(k, f"s{k}", [square], {})
+        return builder.finish({}, "<memory>", LotsOptions(min_area=min_area))
+
+    fast = read()
+    original = lot_builder._plainly_convex
+    try:
+        lot_builder._plainly_convex = lambda lots: np.zeros(len(lots), dtype=bool)
+        slow = read()
+    finally:
+        lot_builder._plainly_convex = original
+    assert fast.bad == slow.bad and fast.ids.tolist() == slow.ids.tolist()
+    least = {None: 0, 0.5: 4, 2.0: 6}[min_area]
+    assert [b.index for b in fast.bad] == list(range(max(least, 1)))
+
+
 @pytest.mark.parametrize(("values", "want"), [
     ([1, 2.5, None], [1.0, 2.5, np.nan]),
     ([2**53 + 1, -3], [float(2**53 + 1), -3.0]),

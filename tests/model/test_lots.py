@@ -38,6 +38,23 @@ def test_take_rebases_offsets_and_slices_attrs():
     assert tail.bad is lots.bad and tail.source == lots.source
 
 
+@pytest.mark.parametrize("span", [slice(1, 3), slice(0, 4), slice(2, 2), slice(3, 9), slice(1, None)])
+def test_a_run_of_lots_is_taken_as_read_only_views_the_same_as_by_their_positions(span):
+    """A chunk of a build (a slice) takes views of the lots' arrays, not a gather of them: the same lots
+    as taken by their positions, and a write into them raises rather than change every lot's."""
+    holed = [np.array([[0, 0], [40, 0], [40, 40], [0, 40]]), np.array([[10, 10], [10, 30], [30, 30], [30, 10]])]
+    lots = lots_from_polygons([[np.array(SQUARE) + 100], holed, [np.array(SQUARE)], holed],
+                              attrs={"k": [0, 1, 2, 3], "name": list("wxyz")}, ids=list("abcd"))
+    run, gathered = lots.take(span), lots.take(np.arange(len(lots))[span])
+    for name in ("ids", "index", "vertices", "ring_offsets", "lot_offsets", "street"):
+        np.testing.assert_array_equal(getattr(run, name), getattr(gathered, name))
+    assert run.attrs.keys() == gathered.attrs.keys()
+    assert all(run.attrs[k].tolist() == gathered.attrs[k].tolist() for k in run.attrs)
+    assert len(run) == 0 or np.shares_memory(run.vertices, lots.vertices)
+    with pytest.raises(ValueError, match="read-only"):
+        run.vertices[:1] = 0.0
+
+
 def test_select_keeps_input_order_and_the_bad_lots_asked_for():
     flat = np.array([[0, 0], [5, 0], [10, 0]])
     lots = lots_from_polygons([[np.array(SQUARE) + 100 * i] for i in range(3)] + [[flat]], ids=list("abcz"))
