@@ -37,7 +37,7 @@ from grammarc.backend.occlusion import Occluders
 from grammarc.backend.plan import make_plan
 from grammarc.compiler import compile_grammar
 from grammarc.constants import LIMITS, STRICT, Limits
-from grammarc.errors import ChunkTooLarge, GrammarcError, LotFailure, UsageError, check_stopped
+from grammarc.errors import ChunkTooLarge, GrammarcError, LotFailure, UsageError, check_stopped, stops_held
 from grammarc.io import OutputOptions, writer_for, written_paths
 from grammarc.io.lot_format import LotsOptions
 from grammarc.io.lots_reading import LotsReading
@@ -182,8 +182,10 @@ def _build(source: Path, display: str | None, grammar_path: Path, output, readin
     reports = Reports()
     counts: dict = {}
     written = False
-    with contextlib.suppress(_NothingBuilt), \
-            writer_class(output, assets=grammar.assets, symbols=plan.symbol_names, meta=meta) as writer:
+    with contextlib.suppress(_NothingBuilt), contextlib.ExitStack() as stack:
+        with stops_held():  # a stop between the writer's temporaries and their removal set up would leave them
+            writer = stack.enter_context(writer_class(output, assets=grammar.assets, symbols=plan.symbol_names,
+                                                      meta=meta))
         derived = derive_all(plan, lots, options, writer, failed, reports, progress, every)
         if not derived and (lots.bad or failed):
             raise _NothingBuilt  # a failed build: the writer aborts, an older output stays as it was

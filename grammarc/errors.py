@@ -81,17 +81,19 @@ class Stopped(KeyboardInterrupt):
 #: The signals that stopped the command: kept until the command ends, because the stop is not always
 #: raised where the signal comes (``raise_stopped``), and a raise can be lost.
 _pending: list[int] = []
+#: Blocks of ``stops_held`` running: a stop is held until they end.
+_held = 0
 
 
 def raise_stopped(signum, frame) -> None:
     """The handler of SIGINT, SIGTERM and SIGHUP while a command runs: the stop is raised where the program
-    is, unless that is numba's or llvmlite's Python code. There, raising is unsafe: llvmlite's ctypes
-    callbacks, while numba compiles, swallow the exception ("Exception ignored on calling ctypes callback
-    function") and the compile leaves objects that are freed twice later (glibc aborts the process); numba's
-    callbacks from compiled code turn it into a ``SystemError``. The stop is then held, and raised by
-    ``check_stopped`` where the command next looks."""
+    is, unless that is inside ``stops_held``, or numba's or llvmlite's Python code. There, raising is unsafe:
+    llvmlite's ctypes callbacks, while numba compiles, swallow the exception ("Exception ignored on calling
+    ctypes callback function") and the compile leaves objects that are freed twice later (glibc aborts the
+    process); numba's callbacks from compiled code turn it into a ``SystemError``. The stop is then held,
+    and raised where the block ends or by ``check_stopped`` where the command next looks."""
     _pending.append(signum)
-    if not _in_numba(frame):
+    if not _held and not _in_numba(frame):
         raise Stopped(signum)
 
 
@@ -120,6 +122,22 @@ def signals_stop():
             signal.signal(signum, handler)
         clear_stopped()
         sys.unraisablehook = unraisable
+
+
+@contextlib.contextmanager
+def stops_held():
+    """While the block runs, a stop is held (``raise_stopped``) and raised when it ends: for what must be
+    made whole or not at all, such as an output's temporary folder and the removal of it that an abort
+    runs. Held, not blocked: a signal sent to the process goes to any thread that does not block it, and
+    Python runs the handler in the main thread wherever it is."""
+    global _held
+    _held += 1
+    try:
+        yield
+    finally:
+        _held -= 1
+    if not _held:
+        check_stopped()
 
 
 def check_stopped() -> None:

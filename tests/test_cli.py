@@ -407,6 +407,26 @@ def test_sigterm_and_sighup_stop_a_build_as_ctrl_c_does(tmp_path, signum):
     assert err.endswith(f"grammarc: {signal.Signals(signum).name}: stopped; nothing was written\n")
 
 
+def test_a_stop_while_the_writer_makes_its_temporary_folder_leaves_none(write, tmp_path, capsys, monkeypatch):
+    """SIGTERM just after the output's temporary folder is made, before the writer exists to remove it (a
+    served build stopped by its client's death left the folder so, once in a loaded test run): the signal
+    waits until the writer is set up, then the build stops and its abort removes the folder."""
+    import grammarc.io.npz
+
+    made = grammarc.io.npz.private_folder
+
+    def made_then_stopped(path):
+        folder = made(path)
+        os.kill(os.getpid(), signal.SIGTERM)
+        return folder
+
+    monkeypatch.setattr(grammarc.io.npz, "private_folder", made_then_stopped)
+    grammar = write("g.cga", "Lot --> extrude(3)\n")
+    assert main(["build", str(grammar), "--emit", str(tmp_path / "out.npz"), "--quiet"]) == 128 + signal.SIGTERM
+    assert capsys.readouterr().err == "grammarc: SIGTERM: stopped; nothing was written\n"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["g.cga"]
+
+
 def test_a_signal_raised_inside_numbas_callback_still_stops_the_build(write, tmp_path, capsys, monkeypatch):
     """A handler that raises while compiled code calls back into Python surfaces as a SystemError caused by
     the signal (a served build caught it so): it is said and exits as the signal, not as a traceback."""
