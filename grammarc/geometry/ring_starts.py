@@ -260,9 +260,9 @@ def _at_edge_1_s_step(best, keys, corner, moved_from, moved_in, along, edge_1_mo
     A piece that holds nothing of edge 0 (nor vertex 0) nor edge 1's moved copy, where edge 1's strip
     ends in a step back to the kept vertex 2 that runs across the face and parts the remainder, starts
     where that step (along no parent edge) enters it, before vertex 2, as it comes after edge 1 in the
-    remainder's order (measured through PyPRT: massing.hannam.48's second
-    tier, its first tier's remainder parted by edge 1's step at a 39 degree reflex vertex 2, and that face
-    as a designed lot; started at vertex 2, the terrace was off by 4.5 m^2)."""
+    remainder's order (measured through PyPRT: massing.hannam.48's second tier, its first tier's remainder
+    parted by edge 1's step at a 39 degree reflex vertex 2, and that face as a designed lot; started at
+    vertex 2, the terrace was off by 4.5 m^2)."""
     n = len(keys)
     if not edge_1_moved or keys.min() < 1.0 or (moved_from == 0.0).any() or (moved_from == 1.0).any():
         return best

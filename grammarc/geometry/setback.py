@@ -346,7 +346,7 @@ def _unfolded(edges: Edges, d: np.ndarray) -> np.ndarray:
     # a face where strips still fold is swept as it was (massing.L.46072: its end stays moved)
     folding = np.zeros(int(edges.poly.max(initial=-1)) + 1, dtype=bool)
     folding[edges.poly[_folds(edges, unfolded)]] = True
-    folding[edges.poly[first[apart[first]]]] = False
+    folding[edges.poly[first[apart[first]]]] = False  # (a jog between distances stays even so: utrecht.8)
     return np.where(folding[edges.poly], d, unfolded)
 
 
