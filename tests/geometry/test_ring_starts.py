@@ -534,3 +534,27 @@ def test_a_remainder_whose_first_edge_ends_past_a_kept_step_starts_at_the_step_s
                             np.array([[30.0, 0.0, 30.0]]), np.array([lot]), moves=np.asarray(distances, float))
         start = pieces.coords[0] * pieces.extent[0, [0, 2]] + pieces.low[0, [0, 2]]
         np.testing.assert_allclose(start, _flip([first])[0], atol=1e-9)
+
+
+def test_a_piece_that_edge_1_s_step_parts_off_starts_on_the_step():
+    """Massing's first tier on massing.hannam.48's face (edges 0 and 1 set back 4 m): edge 1's strip ends
+    in a step back to the kept vertex 2 (a 39 degree reflex vertex) that runs across the face to edge 6 and
+    parts the remainder. The piece beyond it, without edge 0's or edge 1's moved copy, starts where the step
+    enters it, not at vertex 2, as PRT's (measured through PyPRT: its second tier, whose terrace is off by
+    4.5 m^2 when numbered from vertex 2)."""
+    from grammarc.geometry.clip import fit_pieces
+
+    ring = np.array([(6.725, 0), (7.125, 0), (6.877, 8.812), (10.428, 13.475), (15.356, 13.763),
+                     (17.549, 16.933), (12.023, 21.12), (0, 5.061)])
+    distances = [4, 4, 0, 0, 0, 0, np.nan, np.nan]
+    _, remainder, low, size = _setback_remainder(ring, distances)
+    piece = max(remainder.geoms, key=lambda part: part.area)
+    kept = np.asarray(piece.exterior.coords)[:-1]
+    step = kept[np.argmin(np.abs(kept[:, 0] - 3.599) + np.abs(kept[:, 1] - 9.867))]
+    moves = np.nan_to_num(np.asarray(distances, float))
+    for turned in range(len(kept)):  # GEOS's start anywhere on the ring
+        fitted = fit_pieces(np.array([shapely.Polygon((np.roll(kept, turned, axis=0) - low) * (1, -1))]),
+                            np.ones(1, np.int8), np.array([[size[0], 0.0, size[1]]]),
+                            np.array([shapely.Polygon((ring - low) * (1, -1))]), moves=moves)
+        first = (fitted.coords[0] * fitted.extent[0, [0, 2]] + fitted.low[0, [0, 2]]) * (1, -1) + low
+        np.testing.assert_allclose(first, step, atol=1e-6)

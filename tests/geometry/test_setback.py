@@ -635,6 +635,27 @@ def test_a_face_narrower_than_its_distances_is_swept_where_moved_lines_cross():
     assert abs(shapely.area(strips[0]) + shapely.area(remainder) - ring.area) < 1e-6
 
 
+@pytest.mark.parametrize("ring, d, terrace", [
+    # massing.utrecht.8's first tier (shapeR's 4;0;4;4;0) on a designed lot: edge 2, the 3.03 m end of an
+    # arm between the kept edge 1 and edge 3, and edge 3, a 3.43 m jog between edge 2 and the kept edge 4,
+    # both fold; the jog stays (PRT's terrace, measured through PyPRT: 14.700 m^2; keeping the end: 12.985)
+    ([(0.65, 8), (0, 8), (0, 0), (3.025, 0), (3.025, 3.433), (4.925, 3.433), (4.925, 9.7), (4.475, 9.7),
+      (4.475, 8.4), (0.65, 8.4)], [4, 0, 4, 4, 0] + [np.nan] * 5, 14.7),
+    # the jog before the end: edge 2 (3.5 m) between the kept edge 1 and edge 3, the 3 m end (PRT: 52.0)
+    ([(-10, -10), (0, -10), (0, 0), (3.5, 0), (3.5, 3), (-10, 3)], [4, 0, 4, 4, 0, np.nan], 52.0),
+    # massing.utrecht.8's second tier (shapeR's 3;3;4;4;0): the 0.57 m jog, edge 2, between edges set back 3
+    # and 4 m stays, though edge 1's strip then folds (PRT: 17.264 m^2 on the real lot; moved: 16.713)
+    ([(0.002, 4.532), (0.019, 0.567), (2.378, 0.567), (2.379, 0), (4.257, 0.008), (4.266, 6.244),
+      (3.819, 6.245), (3.812, 4.989), (0, 4.982)], [3, 3, 4, 4, 0] + [np.nan] * 4, 17.264),
+])
+def test_a_jog_whose_strip_folds_beside_an_arm_s_end_stays(ring, d, terrace):
+    """Of the folded edges between parallel neighbours, the jog (its neighbours run the same way) keeps its
+    line, whichever is shorter, and one between neighbours set back by different distances too."""
+    (strips,), (remainder,) = setback([shapely.Polygon(ring)], d)
+    assert abs(shapely.area(strips[0]) - terrace) < 3e-3
+    assert abs(shapely.area(strips[0]) + shapely.area(remainder) - shapely.Polygon(ring).area) < 1e-6
+
+
 def test_strips_whose_seams_leave_a_ring_of_no_area_keep_it():
     """A tier of massing's on a real lot (seoul.47's 0.4 m wide arm, numbered from another vertex): the
     strips' union has a part of no area along one line, which the seams' removal would leave two vertices,
