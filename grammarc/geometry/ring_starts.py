@@ -330,6 +330,15 @@ def _after_steps(keys, moved_from, moved_in, r0, r1, outer):
 
 
 @njit(cache=True, nogil=True)
+def _edge_after(ring, i):
+    """Parent edge i + 1 of ``ring``: its start, its vector and its length squared."""
+    e = int(i) + 1
+    ax, ay = ring[e, 0], ring[e, 1]
+    bx, by = ring[e + 1, 0] - ax, ring[e + 1, 1] - ay
+    return ax, ay, bx, by, bx * bx + by * by
+
+
+@njit(cache=True, nogil=True)
 def _past_a_carried_edge(best, coords, moved_from, moved_in, along, outer, ring):
     """The vertex (an index into one ring of a setback's remainder) where PRT starts a remainder whose first
     edge (``best``), moved in from parent edge i, runs on along the line of the kept edge i + 1 beside none
@@ -347,10 +356,7 @@ def _past_a_carried_edge(best, coords, moved_from, moved_in, along, outer, ring)
     i = moved_from[best]
     if not (moved_in[best] and i + 2 < outer and along[k] == i + 1 and moved_in[m] and moved_from[m] == i + 2):
         return best
-    e = int(i) + 1
-    ax, ay = ring[e, 0], ring[e, 1]
-    bx, by = ring[e + 1, 0] - ax, ring[e + 1, 1] - ay
-    length2 = bx * bx + by * by
+    ax, ay, bx, by, length2 = _edge_after(ring, i)
     if length2 == 0.0:
         return best
     # (where the run's ends lie along edge i + 1, in its lengths: beside none of it outside [0, 1])
@@ -377,10 +383,7 @@ def _past_a_kept_edge_s_reflex_end(best, coords, corner, moved_from, moved_in, o
     i = moved_from[best]
     if not (moved_in[best] and i + 2 < outer and corner[m] == i + 2):
         return best
-    e = int(i) + 1
-    ax, ay = ring[e, 0], ring[e, 1]
-    bx, by = ring[e + 1, 0] - ax, ring[e + 1, 1] - ay
-    length2 = bx * bx + by * by
+    ax, ay, bx, by, length2 = _edge_after(ring, i)
     if length2 == 0.0:
         return best
     # (where the first edge ends along edge i + 1, in its lengths, and whether the run from there back to
