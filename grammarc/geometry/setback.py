@@ -564,9 +564,9 @@ def _without_seams(regions: np.ndarray, polygons: np.ndarray) -> np.ndarray:
     counts = np.add.reduceat(keep.astype(np.int64), ring_offsets[:-1])
     # a ring of no area, all its vertices on one line, keeps them (it would lose all but two, no ring; a
     # tier's strips on a 0.4 m wide arm of massing.seoul.47's, numbered from another vertex)
-    flat = np.repeat(counts < 4, np.diff(ring_offsets))
-    keep |= flat
-    counts = np.add.reduceat(keep.astype(np.int64), ring_offsets[:-1])
+    flat = counts < 4
+    keep |= np.repeat(flat, np.diff(ring_offsets))
+    counts = np.where(flat, np.diff(ring_offsets), counts)
     rebuilt = shapely.from_ragged_array(kind, coords[keep], (offsets_from_counts(counts),
                                                              np.asarray(poly_offsets)))
     out = regions.copy()

@@ -4,9 +4,9 @@ and validates them all at once; GeoJSON features to lots; property columns; stre
 The format modules (``io.geojson``, ``io.geojson_sequence``, ``io.obj_lots``, ``io.arrow_lots``) parse
 their files into a ``LotBuilder``, a lot or a block of lots at a time; ``LotBuilder.finish`` then runs
 over all lots at once: numpy and kernels over the ragged arrays, and shapely's vectorized predicates on
-the array of polygons of the lots that may be bad (not plainly convex, or near the least area). Python loops only where parsing needs them (over JSON features) and over the bad lots'
-messages. A bad lot is listed with its number, its id and a reason (``grammarc.model.lots.BadLot``), and
-the other lots load.
+the array of polygons of the lots that may be bad (not plainly convex, or near the least area). Python
+loops only where parsing needs them (over JSON features) and over the bad lots' messages. A bad lot is
+listed with its number, its id and a reason (``grammarc.model.lots.BadLot``), and the other lots load.
 
 Conventions, those of CityEngine and Esri PRT:
 
