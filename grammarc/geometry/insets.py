@@ -26,7 +26,7 @@ import numpy as np
 import shapely
 from numba import njit
 
-from grammarc.geometry.setback import union_by_group
+from grammarc.geometry.overlay import union_by_group
 from grammarc.geometry.skeleton import skeleton_faces
 from grammarc.ragged import grow
 

@@ -11,7 +11,7 @@ import numpy as np
 import shapely
 
 from grammarc.constants import TOL
-from grammarc.geometry.setback import union_by_group
+from grammarc.geometry.overlay import union_by_group
 from grammarc.ragged import offsets_from_counts, segment_of
 
 #: The grid (metres) the projected outlines are snapped to.

@@ -170,7 +170,7 @@ def _at_vertex_0(best, corner, along, outer):
     Where the kept last edge runs on past vertex 0 (a reflex vertex 0, edge 0's strip starting beside the
     last edge's line), the remainder starts at vertex 0 (measured through PyPRT on massing's second tiers
     over real lots: three of three); where edge 0's strip steps back to vertex 0 from the kept last edge
-    (turned by under 15 degrees, or under 45 at a reflex vertex 0, ``geometry.setback``), at the run along
+    (turned by under 15 degrees, or under 45 at a reflex vertex 0, ``geometry.setback_strips``), at the run along
     the last edge that ends at vertex 0, not at the step (sixteen of sixteen), also where that run is the
     last edge kept whole, from its kept start (measured through PyPRT: a 5 m last edge turned 10 or 14
     degrees from edge 0 at a convex vertex 0, 10 to 44 degrees at a reflex one, six of six; a 20 x 20 m lot

@@ -2,7 +2,7 @@
 time order.
 
 ``setback`` moves each edge of a face in by its own distance. Where no strip folds, each strip is the quad
-between the edge and its moved copy, ended at the neighbours' mitre points (``geometry.setback``). Where
+between the edge and its moved copy, ended at the neighbours' mitre points (``geometry.setback_strips``). Where
 one does (a short edge moved further than its neighbours' lines allow, a strip of massing's tiers whose
 end lines cross before its moved line), PRT lets that edge vanish where its end lines cross and its
 neighbours' moved lines meet from there on, as in a weighted straight skeleton whose edges move at their
@@ -11,7 +11,7 @@ a notch (measured through PyPRT on massing's harness lot convex.15000, four real
 whose 3 m end moves 4 m: PRT's remainder is the 5.4 x 1 m rectangle past the moved front).
 
 The wavefront is a ring of lines ``n . x = c + w t`` (n the inward normal, w the distance, t from 0 to 1).
-Where ``geometry.setback`` steps between two edges (a turn of less than 15 degrees between different
+Where ``geometry.setback_strips`` steps between two edges (a turn of less than 15 degrees between different
 distances) or cuts a mitre too long, the two strips end apart; the segment between their ends is a line
 of its own here (through the vertex, along the step, moving so that its ends stay on the two strips'
 lines), so the steps stay PRT's. An edge event (an edge's segment shrinks to nothing) removes the edge;
@@ -212,7 +212,7 @@ def _ring_strips(start, end, inward, d, corner, ends, out, out_n, left, step_cos
                 if (real[p] >= 0 and real[q] >= 0 and abs(w[p] - w[q]) > _EPS
                         and nx[p] * nx[q] + ny[p] * ny[q] > step_cos):
                     # neighbours moved by different distances that turn little step from where they met, as
-                    # at a vertex of the outline (``geometry.setback._mitres``): a line through the point
+                    # at a vertex of the outline (``geometry.setback_strips.mitres``): a line through the point
                     # along their normals' bisector, which their moved lines cross at their own distances
                     # (PRT's tiers: a moved edge that runs past a kept edge's far end, where the next kept
                     # edge turns from it by 15 degrees or less, steps there)
@@ -334,7 +334,7 @@ def swept_strips(start, end, inward, d, corner, ends, ring_offsets, step_cos):
     start, end, inward (E, 2) float64: the edges, ring after ring (``ring_offsets`` (R+1,)), and their
     inward unit normals; d (E,): how far each moves in; corner (E, 2): where edge k's strip starts,
     relative to its start vertex, and ends (E, 2) where edge k-1's strip ends, relative to the same
-    vertex (``geometry.setback._mitres``); step_cos: the cosine of the turn under which neighbours moved
+    vertex (``geometry.setback_strips.mitres``); step_cos: the cosine of the turn under which neighbours moved
     by different distances that meet after an event step there. Returns the strips as ragged rings:
     coords (V, 2) and offsets (E+1,) (an edge that does not move has none); (R,) bool whether nothing is left of the
     ring's face; (R,) bool whether its wavefront met no split event it cannot follow; (R,) bool whether a

@@ -297,7 +297,8 @@ def test_a_remainder_whose_first_edge_steps_starts_after_the_step():
 def _setback_remainder(ring, distances):
     """The lot ``ring`` (k, 2) set back by ``distances`` per edge (``geometry.setback``): the ring as an array,
     its remainder (shapely), the ring's lowest corner and its extent."""
-    from grammarc.geometry.setback import polygon_edges, setback_regions
+    from grammarc.geometry.polygon_edges import polygon_edges
+    from grammarc.geometry.setback import setback_regions
 
     ring = np.asarray(ring, float)
     lot = shapely.Polygon(ring)

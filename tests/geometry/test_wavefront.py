@@ -8,7 +8,9 @@ import numpy as np
 import pytest
 import shapely
 
-from grammarc.geometry.setback import _STEP_TURN, _mitres, polygon_edges, setback_regions
+from grammarc.geometry.polygon_edges import polygon_edges
+from grammarc.geometry.setback import setback_regions
+from grammarc.geometry.setback_strips import STEP_TURN, mitres
 from grammarc.geometry.wavefront import swept_strips
 
 
@@ -17,10 +19,10 @@ def sweep(ring, d):
     the sweep followed the wavefront to the end, and its vertices at the end, of one outline."""
     edges = polygon_edges(np.array([shapely.Polygon(ring)]))
     d = np.asarray(d, float)
-    corner, ends, _ = _mitres(edges, d)
+    corner, ends, _ = mitres(edges, d)
     coords, offsets, collapsed, trusted, _, left, _ = swept_strips(
         edges.start, edges.end, edges.inward, d, corner, ends, np.array([0, len(d)]),
-        np.cos(np.radians(_STEP_TURN)))
+        np.cos(np.radians(STEP_TURN)))
     strips = [shapely.make_valid(shapely.Polygon(coords[a:b])) if b > a else None
               for a, b in pairwise(offsets)]
     return strips, collapsed[0], trusted[0], left

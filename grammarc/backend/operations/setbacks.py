@@ -23,8 +23,9 @@ from grammarc.backend.shapes import Shapes
 from grammarc.constants import TOL
 from grammarc.geometry.clip import fit_pieces
 from grammarc.geometry.inner_rectangle import largest_rectangles
+from grammarc.geometry.polygon_edges import polygon_edges
 from grammarc.geometry.polygons import plane_to_scope
-from grammarc.geometry.setback import distances_to_area, polygon_edges, setback_regions
+from grammarc.geometry.setback import distances_to_area, setback_regions
 from grammarc.ir import nodes as ir
 from grammarc.ragged import rank_within
 
@@ -64,7 +65,7 @@ def setback_to_area(ctx: Context, cursor: Shapes, op: ir.SetbackToArea) -> Parts
 
 class _SetbackFaces:
     """What ``setback`` and ``setbackToArea`` find of a batch of faces: their polygons and planes, their
-    edges (``geometry.setback.Edges``) with their normals and the frames of the selectors ``names``, and
+    edges (``geometry.polygon_edges.Edges``) with their normals and the frames of the selectors ``names``, and
     the part (``owners``) each edge's strip goes to (``owner``, len(owners) for none)."""
 
     def __init__(self, ctx: Context, cursor: Shapes, op: ir.Setback | ir.SetbackToArea, what: str,
