@@ -8,9 +8,11 @@ A rule package is a 7-zip archive as CityEngine exports it::
     .resolvemap.xml                 workspace path -> path in the package
     .ws/ESRI.lib/rules/x.cga        files of other projects of the workspace (in some packages)
 
-``open_rpk`` extracts the archive to a temporary directory that lives as long as the returned
-``RulePackage`` (use it as a context manager, or call ``close()``), so rule files and assets are plain
-paths the compiler and the baker read as they read any other. The directory's name holds the process id
+``open_rpk`` extracts the archive once into the user's cache folder, where it is kept for the next builds
+of the same package (``io.kept_packages``), so rule files and assets are plain paths the compiler and the
+baker read as they read any other. Asked to (``tmpdir``), or without a usable cache folder, it extracts to a
+temporary directory instead, which lives as long as the returned ``RulePackage`` (use it as a context
+manager, or call ``close()``). That directory's name holds the process id
 (``grammarc-rpk-<pid>-<package>-<random>``): one a process left behind as it died (a SIGKILL, a power cut)
 goes when a package is next opened in the same temporary folder.
 
@@ -27,7 +29,7 @@ order; a package is one project. Workspace paths (``/Project/assets/x.obj``, ``i
 "/ESRI.lib/rules/y.cga"``) are looked up in its ``.ws`` folder, else in the package itself (an export
 keeps a project's files at the package's root): ``RulePackage.workspace``, and ``frontend.imports``.
 
-py7zr is an optional dependency (the ``rpk`` extra), imported when a package is opened.
+py7zr is an optional dependency (the ``rpk`` extra), imported when a package is extracted.
 """
 
 from __future__ import annotations
@@ -45,6 +47,7 @@ from typing import TYPE_CHECKING
 from grammarc.atomic import remove_stale
 from grammarc.errors import UsageError
 from grammarc.frontend.source import read_grammar_text
+from grammarc.io import kept_packages
 from grammarc.model.assets import record_roots
 
 if TYPE_CHECKING:
@@ -73,14 +76,15 @@ _START_RULE = re.compile(r"@StartRule\b\s*(?:@\w+\s*(?:\([^)]*\))?\s*)*([A-Za-z_
 
 
 class RulePackage:
-    """An extracted rule package; its files exist until ``close()`` (or the end of a ``with`` block).
+    """An extracted rule package; its files exist until ``close()`` (or the end of a ``with`` block) at least:
+    a temporary extraction's are removed then, a kept one's stay in the cache.
 
     Attributes
     ----------
     path : Path
         The ``.rpk`` file.
     root : Path
-        The temporary directory holding the extracted package.
+        The directory holding the extracted package: a kept one in the user's cache, or a temporary one.
     rules : dict of str to Path
         Every CGA source, by its POSIX path in the package (``"rules/Candler Building.cga"``), sorted.
     compiled : list of str
@@ -102,11 +106,13 @@ class RulePackage:
     ('Footprint', 'Candler Building.cga')
     """
 
-    def __init__(self, path: Path, root: Path):
+    def __init__(self, path: Path, root: Path, temporary: bool = True):
         self.path = path
         self.root = root
-        # Removes the extracted files on close(), or when the package is dropped unclosed.
-        self._cleanup = weakref.finalize(self, shutil.rmtree, str(root), ignore_errors=True)
+        self._closed = False
+        # A temporary extraction's files go on close(), or when the package is dropped unclosed.
+        self._cleanup = weakref.finalize(self, shutil.rmtree, str(root), ignore_errors=True) if temporary \
+            else None
         files = sorted(p for p in root.rglob("*") if p.is_file())
         relative = {p.relative_to(root).as_posix(): p for p in files}
         self.rules = {name: p for name, p in relative.items() if name.lower().endswith(".cga")}
@@ -128,12 +134,15 @@ class RulePackage:
 
     @property
     def closed(self) -> bool:
-        """True once the extracted files are removed."""
-        return not self._cleanup.alive
+        """True once closed."""
+        return self._closed
 
     def close(self) -> None:
-        """Remove the extracted files; the paths of this package are invalid afterwards. Idempotent."""
-        self._cleanup()
+        """Remove the extracted files of a temporary extraction; the paths of this package are not to be used
+        afterwards. Idempotent."""
+        self._closed = True
+        if self._cleanup is not None:
+            self._cleanup()
 
     def __enter__(self) -> Self:
         return self
@@ -156,14 +165,16 @@ def open_rpk(path: str | os.PathLike, *, tmpdir: str | os.PathLike | None = None
     path : str or os.PathLike
         The ``.rpk`` file (a 7-zip archive).
     tmpdir : str or os.PathLike, optional
-        Where to create the extraction directory; the system's temporary folder by default.
+        Where to create a temporary extraction directory, removed on ``close()``. By default the package
+        is extracted once into the user's cache folder and kept there (``io.kept_packages``), or, where
+        there is no usable cache folder, into the system's temporary folder.
     max_size : int
         The most bytes the package may extract to (module docstring: this and ``MAX_RATIO``).
 
     Returns
     -------
     RulePackage
-        Its files live until ``close()``; use it as a context manager.
+        Its files live until ``close()`` at least; use it as a context manager.
 
     Raises
     ------
@@ -172,16 +183,33 @@ def open_rpk(path: str | os.PathLike, *, tmpdir: str | os.PathLike | None = None
         member's path is absolute, leaves the package or is a link, or the package extracts to more than
         its limits.
     """
+    path = Path(path)
+    if not path.is_file():
+        raise UsageError(f"rule package `{path}` does not exist")
+    limit = min(max_size, MAX_RATIO * path.stat().st_size)
+    if tmpdir is None and (entry := kept_packages.entry_of(path)) is not None:
+        root = kept_packages.kept(entry, limit) or kept_packages.keep(
+            entry, lambda folder: _extract(path, folder, limit), limit)
+        if root is not None:
+            return RulePackage(path, root, temporary=False)
+    folder = Path(tmpdir) if tmpdir is not None else Path(tempfile.gettempdir())
+    remove_stale(folder, _EXTRACTED)
+    root = Path(tempfile.mkdtemp(prefix=f"{_EXTRACTED}{os.getpid()}-{path.stem}-", dir=folder))
+    try:
+        _extract(path, root, limit)
+    except BaseException:
+        shutil.rmtree(root, ignore_errors=True)
+        raise
+    return RulePackage(path, root)
+
+
+def _extract(path: Path, root: Path, limit: int) -> None:
+    """Extract the archive ``path`` into the folder ``root`` (made if missing), at most ``limit`` bytes."""
     try:
         import py7zr
     except ImportError as error:
         raise UsageError(f"reading rule packages (.rpk) needs py7zr: {_INSTALL_HINT}") from error
-    path = Path(path)
-    if not path.is_file():
-        raise UsageError(f"rule package `{path}` does not exist")
-    folder = Path(tmpdir) if tmpdir is not None else Path(tempfile.gettempdir())
-    remove_stale(folder, _EXTRACTED)
-    root = Path(tempfile.mkdtemp(prefix=f"{_EXTRACTED}{os.getpid()}-{path.stem}-", dir=folder))
+    root.mkdir(exist_ok=True)
     try:
         # an open file, not its path: py7zr then extracts in this thread (with a path, it extracts an
         # archive's blocks in threads that each open the file and leave it open)
@@ -190,19 +218,14 @@ def open_rpk(path: str | os.PathLike, *, tmpdir: str | os.PathLike | None = None
                 _check_member(path, info)
                 folder = root / info.filename if info.is_directory else (root / info.filename).parent
                 folder.mkdir(parents=True, exist_ok=True)
-            extracted = _Extracted(root, _Budget(path, min(max_size, MAX_RATIO * path.stat().st_size)))
+            extracted = _Extracted(root, _Budget(path, limit))
             try:
                 with _small_blocks(py7zr):
                     archive.extractall(factory=extracted)
             finally:
                 extracted.close()
-        return RulePackage(path, root)
     except (py7zr.exceptions.ArchiveError, EOFError) as error:
-        shutil.rmtree(root, ignore_errors=True)
         raise UsageError(f"cannot read rule package `{path}`: {error}") from error
-    except BaseException:
-        shutil.rmtree(root, ignore_errors=True)
-        raise
 
 
 def start_rule_of(cga: str | os.PathLike) -> str | None:
@@ -335,8 +358,8 @@ def _main_rule_file(rules: dict[str, Path], compiled: list[str]) -> Path | None:
 @contextlib.contextmanager
 def record_asset_roots(meta: Mapping | None, asset_roots=None) -> Iterator[list[Path] | None]:
     """The folders a record's assets load from, for ``render`` and ``info`` after the build: a record built
-    from a rule package names the ``.rpk`` as its grammar (the folder it was extracted to was temporary),
-    so while the block runs the package is extracted again and its ``asset_roots`` come first, then
+    from a rule package names the ``.rpk`` as its grammar (not the folder it was extracted to), so while
+    the block runs the package is opened again (``open_rpk``) and its ``asset_roots`` come first, then
     ``asset_roots`` or the record's own (``model.assets.record_roots``). Any other record, or a package no
     longer where the record says: ``asset_roots`` as given (None: the record's own)."""
     grammar = meta.get("grammar") if isinstance(meta, Mapping) else None

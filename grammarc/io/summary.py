@@ -62,7 +62,7 @@ def summarize(path: str | os.PathLike, asset_roots=None, lod: str | None = None)
         tallies = []
         for part in shard_outputs(path) if is_manifest(path) else [path]:
             record, files = _read(part)
-            if not tallies:  # a rule package's assets: extracted again while the summary is made
+            if not tallies:  # a rule package's assets: opened again while the summary is made
                 asset_roots = package.enter_context(record_asset_roots(record["meta"], asset_roots))
             tallies.append(_tally(record, files, asset_roots, lod))
         return _summary(path, tallies, asset_roots, lod)

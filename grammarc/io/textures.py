@@ -1,8 +1,9 @@
 """Texture files that an output names by path: an OBJ's material library, USD's ``UsdUVTexture`` shaders.
 
 An output names a texture by its path relative to the output, where the grammar's folders hold it. A rule
-package's folders are different: the build extracts the package to a temporary folder and removes it when
-the build ends (``io.rpk``), so a path into it would name nothing once the command returns. A texture found
+package's folders are different: the build extracts the package into the user's cache, which removes it
+once unused (``io.kept_packages``), or into a temporary folder removed when the build ends (``io.rpk``), so
+a path into it would name nothing for long. A texture found
 there is copied into the output's own files instead (the OBJ's ``city.obj.textures`` folder, the USD tile
 folder's ``textures``), at its path inside the package, as PRT's OBJ encoder writes a package's textures
 beside its OBJ. The other formats embed their textures (GLB, 3D Tiles) or name none (npz, PLY, STL).

@@ -1,4 +1,5 @@
-"""Rule packages: the kit's eight .rpk files opened, their start rules, assets, and the temporary files."""
+"""Rule packages: the kit's eight .rpk files opened, their start rules, assets, the packages kept in the
+cache, and the temporary files."""
 
 import gc
 import json
@@ -16,6 +17,14 @@ py7zr = pytest.importorskip("py7zr")
 
 KIT = Path(__file__).resolve().parents[2].parent / "shared" / "prt"
 needs_kit = pytest.mark.skipif(not (KIT / "rpk").is_dir(), reason="PRT kit (../shared/prt) absent")
+
+
+@pytest.fixture(autouse=True)
+def own_cache(tmp_path_factory, monkeypatch):
+    """A cache folder of the test's own, where packages are kept (``io.kept_packages``)."""
+    cache = tmp_path_factory.mktemp("cache")
+    monkeypatch.setenv("XDG_CACHE_HOME", str(cache))
+    return cache / "grammarc" / "rpk"
 
 #: Start rules as read from the CGA sources; PRT names them "Default$" + the rule (reference.json).
 START_RULES = {
@@ -156,7 +165,7 @@ def test_a_package_is_its_own_workspace():
         assert roots.project == rpk.root.resolve() and rpk.root.parent.resolve() not in roots.folders
 
 
-def test_a_record_of_a_package_loads_the_package_assets_again(tmp_path, capsys):
+def test_a_record_of_a_package_loads_the_package_assets_again(own_cache, tmp_path, capsys):
     """The record names the .rpk, not the folder it was extracted to: ``info`` and ``render`` extract it
     again and load the package's own assets (they said "not loaded" and drew boxes)."""
     from grammarc.build import build
@@ -176,7 +185,7 @@ def test_a_record_of_a_package_loads_the_package_assets_again(tmp_path, capsys):
     meta = load_record(tmp_path / "posts.npz")["meta"]
     with record_asset_roots(meta) as roots:
         assert (roots[0] / "props" / "post.obj").is_file() and roots[-1] == tmp_path
-    assert not roots[0].exists()  # extracted for the block only
+    assert roots[0].parent.parent.parent == own_cache  # the package kept by the build
     with record_asset_roots({"grammar": str(tmp_path / "x.cga")}, [tmp_path]) as roots:
         assert roots == [tmp_path]  # not a package: the roots as given
     info = summarize(tmp_path / "posts.npz")
@@ -261,3 +270,45 @@ def test_an_extraction_whose_process_died_goes_at_the_next_open(tmp_path):
     with open_rpk(KIT / "rpk" / "extrude_color.rpk", tmpdir=tmp_path) as rpk:
         assert rpk.root.name.startswith(f"grammarc-rpk-{os.getpid()}-extrude_color-")
         assert not left.exists() and running.is_dir()
+
+
+def test_a_package_is_extracted_once_and_kept_in_the_cache(own_cache, tmp_path, monkeypatch):
+    import grammarc.io.rpk as rpk_module
+
+    package = make_rpk(tmp_path / "p.rpk", {"rules/a.cga": "@StartRule\nLot --> X\n", "assets/a.obj": "v 0 0 0\n"})
+    with open_rpk(package) as first:
+        root = first.root
+        assert root.is_relative_to(own_cache) and first.start_rule == "Lot"
+    assert first.closed and (root / "assets" / "a.obj").is_file()  # kept, not removed
+
+    def no_extraction(*args):
+        raise AssertionError("extracted again")
+
+    monkeypatch.setattr(rpk_module, "_extract", no_extraction)
+    with open_rpk(package) as again:
+        assert again.root == root and list(again.rules) == ["rules/a.cga"]
+
+
+def test_a_kept_package_whose_files_changed_is_extracted_again(tmp_path):
+    package = make_rpk(tmp_path / "p.rpk", {"rules/a.cga": "@StartRule\nLot --> X\n"})
+    with open_rpk(package) as rpk:
+        rule = rpk.main_rule_file
+    rule.write_text("@StartRule\nLot --> Y\n")
+    with open_rpk(package) as rpk:
+        assert rpk.main_rule_file.read_text() == "@StartRule\nLot --> X\n"
+    (rule.parent / "extra.cga").write_text("Z --> X\n")
+    with open_rpk(package) as rpk:
+        assert list(rpk.rules) == ["rules/a.cga"]
+
+
+def test_without_a_cache_folder_a_package_is_extracted_for_the_block_only(tmp_path, monkeypatch):
+    import tempfile
+
+    (tmp_path / "not-a-folder").write_text("")
+    monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path / "not-a-folder"))
+    monkeypatch.setattr(tempfile, "tempdir", str(tmp_path / "tmp"))
+    (tmp_path / "tmp").mkdir()
+    package = make_rpk(tmp_path / "p.rpk", {"rules/a.cga": "@StartRule\nLot --> X\n"})
+    with open_rpk(package) as rpk:
+        assert rpk.root.parent == tmp_path / "tmp"
+    assert list((tmp_path / "tmp").iterdir()) == []
