@@ -10,6 +10,7 @@ import pytest
 from grammarc.backend.kernels.order import group_by, place, put, scatter_rows, tally
 from grammarc.backend.kernels.scope import component_frames, place_children, turned_frames, xforms
 from grammarc.backend.kernels.split import repeat, repeat_counts, subdiv
+from grammarc.backend.kernels.texture import instance_maps
 from grammarc.backend.random import child_keys
 
 SIZES = [0, 1, 2, 50]
@@ -319,3 +320,31 @@ def test_tally_adds_what_bincount_counts(n, weighted):
     want = counts + np.bincount(lot, weights=weights if weighted else None, minlength=7).astype(np.int64)
     added = tally(counts, lot, weights if weighted else np.zeros(0, np.int64))
     assert np.array_equal(counts, want) and added == (weights.sum() if weighted else n)
+
+
+# ---------------------------------------------------------------------------------- texture.instance_maps
+
+
+@pytest.mark.parametrize("n", SIZES)
+def test_instance_maps_give_numpys_bits(n):
+    """The maps of records are numpy's composition, bit for bit: the shapes' maps made relative to their
+    lots' origins (``einsum``), composed with the records' transforms (``matmul``), for some of the rows in
+    any order; map 0 is NaN, some entries and origins are (signed) zeros."""
+    rng = np.random.default_rng(n)
+    table = rng.normal(size=(9, 2, 4)) * rng.choice([1e-3, 1.0, 1e4], size=(9, 2, 4))
+    table[rng.random((9, 2, 4)) < 0.3] = -0.0
+    table[0] = np.nan
+    lot_origin = rng.uniform(-1e6, 1e6, (4, 3))
+    lot_origin[rng.random((4, 3)) < 0.3] = 0.0
+    map_id = rng.integers(0, 9, n).astype(np.int32)
+    lot = rng.integers(0, 4, n).astype(np.int32)
+    rows = rng.permutation(n)[: n - n // 3]
+    xform = (rng.normal(size=(len(rows), 3, 4)) * 50).astype(np.float32)
+    xform[rng.random(xform.shape) < 0.2] = 0.0
+    maps = table[map_id[rows]]
+    maps[:, :, 3] += np.einsum("nij,nj->ni", maps[:, :, :3], lot_origin[lot[rows]])
+    want = maps[:, :, :3] @ xform
+    want[:, :, 3] += maps[:, :, 3]
+    got = instance_maps(table, map_id, rows, lot_origin, lot, xform)
+    assert got.dtype == np.float32 and got.shape == (len(rows), 2, 4)
+    assert np.array_equal(got.view(np.int32), want.astype(np.float32).view(np.int32))
