@@ -23,7 +23,7 @@ import numpy as np
 
 from grammarc.backend.aggregates import collect
 from grammarc.backend.context import Context
-from grammarc.backend.kernels.scope import xforms
+from grammarc.backend.kernels.scope import leaf_kinds, xforms
 from grammarc.backend.kernels.texture import instance_maps
 from grammarc.backend.materials import material_ids, rgba
 from grammarc.backend.mesh_shapes import mesh_leaves
@@ -56,9 +56,8 @@ def emit_instances(ctx: Context, shapes: Shapes, asset: int, symbol: int, mirror
     if not len(rows):
         return
     chunk = ctx.chunk
-    base = chunk.lot_origin[shapes.lot[rows]]
-    xform = xforms(chunk.frames.data, shapes.frame[rows], shapes.size[rows], shapes.origin[rows], base,
-                   np.full(len(rows), -1))
+    xform = xforms(chunk.frames.data, shapes.frame, shapes.size, shapes.origin, shapes.lot, chunk.lot_origin, rows,
+                   np.full(len(rows), -1, np.int8))
     for axis in range(3):
         if mirrored >> axis & 1:
             xform[:, :, 3] += xform[:, :, axis]
@@ -253,17 +252,15 @@ def emit_leaves(ctx: Context, shapes: Shapes, symbol: int) -> None:
             asset, mirrored = asset_of(np.array([code]))
             emit_instances(ctx, shapes, int(asset[0]), symbol, int(mirrored[0]),
                            rows=np.flatnonzero(shapes.geom == code))
-    box = shapes.geom == -1
-    flat = shapes.size <= TOL.zero
-    zeros = flat.sum(axis=1)
-    boxes = np.flatnonzero(box & (zeros == 0))
+    kind = leaf_kinds(shapes.geom, shapes.size, TOL.zero)
+    boxes = np.flatnonzero(kind == -1)
     slot = ctx.plan.inserted_slot
     emit_instances(ctx, shapes, CUBE, symbol, textured=True,
                    inserted=shapes.dynamic[slot][boxes] == 1 if slot is not None else None, rows=boxes)
-    quads = np.flatnonzero(box & (zeros == 1))
+    quads = np.flatnonzero((kind >= 0) & (kind < 3))
     if len(quads):
-        xform = xforms(chunk.frames.data, shapes.frame[quads], shapes.size[quads], shapes.origin[quads],
-                       chunk.lot_origin[shapes.lot[quads]], np.argmax(flat[quads], axis=1))
+        xform = xforms(chunk.frames.data, shapes.frame, shapes.size, shapes.origin, shapes.lot, chunk.lot_origin,
+                       quads, kind[quads])
         _append(ctx, shapes, quads, xform, QUAD, symbol)
     polygons = shapes.take(is_polygon(shapes.geom))
     if len(polygons):
