@@ -77,8 +77,13 @@ def collect_materials(plan, ids: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """
     names = list(plan.strings.ids)
     # rows come in long runs of one material (a chunk's ~5 * 10^5 rows of candler in ~2,000 runs): the
-    # first row of each run is sorted, not every row
-    first = np.flatnonzero(np.r_[True, (ids[1:] != ids[:-1]).any(axis=1)]) if len(ids) else np.zeros(0, np.int64)
+    # first row of each run is sorted, not every row. Rows are compared column by column: numpy's
+    # ``any(axis=1)`` over a row of a few columns costs several times as much
+    changed = np.zeros(len(ids), dtype=bool)
+    changed[:1] = True
+    for column in range(ids.shape[1]):
+        changed[1:] |= ids[1:, column] != ids[:-1, column]
+    first = np.flatnonzero(changed)
     heads = ids[first]
     # one int64 key per row (the ids in base len(names)) sorts far faster than rows (np.unique(axis=0))
     radix = np.int64(len(names)) ** np.arange(ids.shape[1], dtype=np.int64)
