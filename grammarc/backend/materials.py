@@ -31,8 +31,13 @@ COLOR_FIELDS = frozenset(ir.MATERIAL_FIELDS) - frozenset(MAP_FIELDS)
 def rgba(packed: np.ndarray) -> np.ndarray:
     """(n, 4) uint8 RGBA colours from packed colours (n,) stored as floats (module docstring)."""
     value = packed.astype(np.int64)
-    return np.stack([value >> 16 & 255, value >> 8 & 255, value & 255, 255 - (value >> 24 & 255)],
-                    axis=1).astype(np.uint8)
+    out = np.empty((len(value), 4), np.uint8)
+    # a uint8 column keeps the low byte of what it is given: the channel, without masks and a stack
+    out[:, 0] = value >> 16
+    out[:, 1] = value >> 8
+    out[:, 2] = value
+    out[:, 3] = 255 - (value >> 24 & 255)
+    return out
 
 
 def with_transparency_of(rgb: np.ndarray, packed: np.ndarray) -> np.ndarray:
