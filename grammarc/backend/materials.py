@@ -67,7 +67,7 @@ def material_ids(plan, shapes, rows=slice(None)) -> np.ndarray | None:
     of ``shapes`` rows ``rows``; None when it carries none."""
     if not plan.material_slots:
         return None
-    return np.stack([shapes.dynamic[slot][rows] for _, slot in plan.material_slots], axis=1).astype(np.int32)
+    return np.stack([shapes.dynamic[slot][rows] for _, slot in plan.material_slots], axis=1).astype(np.int32, copy=False)
 
 
 def collect_materials(plan, ids: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
