@@ -39,7 +39,9 @@ class Table:
         return ids
 
     def __getitem__(self, ids: np.ndarray) -> np.ndarray:
-        return self.data[ids]
+        """The rows ``ids``, each copied as one block by ``np.take`` (``data[ids]`` copies them element by
+        element, several times slower on rows this short)."""
+        return np.take(self.data, ids, axis=0)
 
 
 class Frames(Table):

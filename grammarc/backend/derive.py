@@ -229,8 +229,9 @@ def collect(chunk: Chunk, plan: Plan) -> TerminalChunk:
 
 
 def _sort_mesh(mesh: MeshChunk, order: np.ndarray) -> MeshChunk:
+    """The faces ``order`` of ``mesh``, their rows gathered by ``np.take`` (whole rows, see ``Shapes.take``)."""
     rings, face_offsets = ragged_take(mesh.face_offsets, order)
     vertices, ring_offsets = ragged_take(mesh.ring_offsets, rings)
-    return MeshChunk(mesh.vertices[vertices], ring_offsets, face_offsets, mesh.lot[order],
-                     mesh.symbol[order], mesh.color[order] if mesh.color is not None else None,
-                     uv=mesh.uv[vertices] if mesh.uv is not None else None)
+    return MeshChunk(np.take(mesh.vertices, vertices, axis=0), ring_offsets, face_offsets, mesh.lot[order],
+                     mesh.symbol[order], np.take(mesh.color, order, axis=0) if mesh.color is not None else None,
+                     uv=np.take(mesh.uv, vertices, axis=0) if mesh.uv is not None else None)

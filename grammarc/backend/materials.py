@@ -31,8 +31,13 @@ COLOR_FIELDS = frozenset(ir.MATERIAL_FIELDS) - frozenset(MAP_FIELDS)
 def rgba(packed: np.ndarray) -> np.ndarray:
     """(n, 4) uint8 RGBA colours from packed colours (n,) stored as floats (module docstring)."""
     value = packed.astype(np.int64)
-    return np.stack([value >> 16 & 255, value >> 8 & 255, value & 255, 255 - (value >> 24 & 255)],
-                    axis=1).astype(np.uint8)
+    out = np.empty((len(value), 4), np.uint8)
+    # a uint8 column keeps the low byte of what it is given: the channel, without masks and a stack
+    out[:, 0] = value >> 16
+    out[:, 1] = value >> 8
+    out[:, 2] = value
+    out[:, 3] = 255 - (value >> 24 & 255)
+    return out
 
 
 def with_transparency_of(rgb: np.ndarray, packed: np.ndarray) -> np.ndarray:
@@ -62,7 +67,7 @@ def material_ids(plan, shapes, rows=slice(None)) -> np.ndarray | None:
     of ``shapes`` rows ``rows``; None when it carries none."""
     if not plan.material_slots:
         return None
-    return np.stack([shapes.dynamic[slot][rows] for _, slot in plan.material_slots], axis=1).astype(np.int32)
+    return np.stack([shapes.dynamic[slot][rows] for _, slot in plan.material_slots], axis=1).astype(np.int32, copy=False)
 
 
 def collect_materials(plan, ids: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -77,8 +82,13 @@ def collect_materials(plan, ids: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """
     names = list(plan.strings.ids)
     # rows come in long runs of one material (a chunk's ~5 * 10^5 rows of candler in ~2,000 runs): the
-    # first row of each run is sorted, not every row
-    first = np.flatnonzero(np.r_[True, (ids[1:] != ids[:-1]).any(axis=1)]) if len(ids) else np.zeros(0, np.int64)
+    # first row of each run is sorted, not every row. Rows are compared column by column: numpy's
+    # ``any(axis=1)`` over a row of a few columns costs several times as much
+    changed = np.zeros(len(ids), dtype=bool)
+    changed[:1] = True
+    for column in range(ids.shape[1]):
+        changed[1:] |= ids[1:, column] != ids[:-1, column]
+    first = np.flatnonzero(changed)
     heads = ids[first]
     # one int64 key per row (the ids in base len(names)) sorts far faster than rows (np.unique(axis=0))
     radix = np.int64(len(names)) ** np.arange(ids.shape[1], dtype=np.int64)

@@ -72,16 +72,20 @@ class Shapes:
         would pass over it once per column, ten times for a batch's ten columns. A mask that
         keeps every shape gives the batch itself: columns are never changed in place (``with_scope`` and
         the operations make new ones), so nothing need be copied, and guards and leaf kinds often keep all.
+        Row numbers gather with ``np.take``, which copies each row of ``origin`` and ``size`` as one block,
+        where indexing (``origin[index]``) copies it element by element through numpy's general indexing,
+        several times slower on rows this short.
         """
-        if isinstance(index, np.ndarray) and index.dtype == bool:
-            if index.all():
-                return self
-            index = np.flatnonzero(index)
-        return Shapes(
-            self.origin[index], self.size[index], self.frame[index], self.geom[index], self.lot[index],
-            self.key[index], self.depth[index], tuple(p[index] for p in self.params),
-            tuple(d[index] for d in self.dynamic),
-        )
+        if not isinstance(index, slice):
+            index = np.asarray(index)
+            if index.dtype == bool:
+                if index.all():
+                    return self
+                index = np.flatnonzero(index)
+            elif not len(index):  # ``take([])``: no rows (the empty list is float64 as an array)
+                index = index.astype(np.int64)
+        return Shapes(*(_rows(getattr(self, f), index) for f in _ARRAYS),
+                      tuple(_rows(p, index) for p in self.params), tuple(_rows(d, index) for d in self.dynamic))
 
     def with_scope(self, origin, size, frame, geom) -> Shapes:
         return replace(self, origin=origin, size=size, frame=frame, geom=geom)
@@ -105,5 +109,11 @@ class Shapes:
         )
 
 
-#: The names of a batch's columns, in order.
+#: The names of a batch's columns, in order: the arrays, then the tuples of them (``params``, ``dynamic``).
 COLUMNS = tuple(f.name for f in fields(Shapes))
+_ARRAYS = COLUMNS[:COLUMNS.index("params")]
+
+
+def _rows(column: np.ndarray, index: np.ndarray | slice) -> np.ndarray:
+    """A column's rows ``index``: a view of a slice, else a copy by ``np.take``."""
+    return column[index] if isinstance(index, slice) else np.take(column, index, axis=0)

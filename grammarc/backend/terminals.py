@@ -23,12 +23,13 @@ import numpy as np
 
 from grammarc.backend.aggregates import collect
 from grammarc.backend.context import Context
-from grammarc.backend.kernels.scope import xforms
+from grammarc.backend.kernels.scope import leaf_kinds, xforms
+from grammarc.backend.kernels.texture import instance_maps
 from grammarc.backend.materials import material_ids, rgba
 from grammarc.backend.mesh_shapes import mesh_leaves
 from grammarc.backend.shapes import Z_UP, Shapes, asset_of
 from grammarc.backend.slots import HORIZONTAL_SLOTS
-from grammarc.backend.texture_space import texture_maps
+from grammarc.backend.texture_space import COORDINATES, texture_maps
 from grammarc.constants import TOL
 from grammarc.geometry.components import reverse_rings
 from grammarc.geometry.meshes import is_mesh, is_polygon
@@ -41,18 +42,22 @@ CUBE, QUAD = 0, 1  # asset ids of the leaf built-ins (see ir.passes.assets)
 
 
 def emit_instances(ctx: Context, shapes: Shapes, asset: int, symbol: int, mirrored: int = 0,
-                   textured: bool = False, inserted: np.ndarray | None = None) -> None:
-    """Instances of ``asset`` on the scopes of ``shapes``; ``mirrored`` bits (1 x, 2 y, 4 z) flip the
+                   textured: bool = False, inserted: np.ndarray | None = None,
+                   rows: np.ndarray | None = None) -> None:
+    """Instances of ``asset`` on the scopes of ``shapes`` (their ``rows`` (m,) int64, default all: a leaf
+    batch places its boxes without copying its other columns); ``mirrored`` bits (1 x, 2 y, 4 z) flip the
     asset along those scope axes (the column is negated and the origin moved to the far side); ``Z_UP``
     turns the asset in its box before that. Where the grammar trims inserts, those crossing their trim planes become the asset's
-    triangles cut by them; ``inserted`` (n,) bool, when given, says which shapes' geometry was inserted, the
+    triangles cut by them; ``inserted`` (m,) bool, when given, says which shapes' geometry was inserted, the
     others are not cut (a leaf box a shape extruded). ``textured``: they carry the shapes' texture
     coordinates (a leaf box); an inserted asset has its own, which grammarc does not keep, and carries none."""
-    if not len(shapes):
+    if rows is None:
+        rows = np.arange(len(shapes))
+    if not len(rows):
         return
     chunk = ctx.chunk
-    base = chunk.lot_origin[shapes.lot]
-    xform = xforms(chunk.frames.data, shapes.frame, shapes.size, shapes.origin, base, np.full(len(shapes), -1))
+    xform = xforms(chunk.frames.data, shapes.frame, shapes.size, shapes.origin, shapes.lot, chunk.lot_origin, rows,
+                   np.full(len(rows), -1, np.int8))
     for axis in range(3):
         if mirrored >> axis & 1:
             xform[:, :, 3] += xform[:, :, axis]
@@ -60,18 +65,18 @@ def emit_instances(ctx: Context, shapes: Shapes, asset: int, symbol: int, mirror
     if mirrored & Z_UP:  # the asset turns in its own box, before the mirror in the scope's
         xform = z_up(xform)
     if ctx.plan.trim_slot is not None:
-        planes = trim_planes(ctx.plan, shapes)
+        planes = trim_planes(ctx.plan, shapes, rows)
         placed = xform.astype(np.float64)  # relative to the lot's origin, as the trim planes are
         cut = boxes_crossing(planes, placed, TOL.zero)
         if inserted is not None:
             cut &= inserted
         mesh = ctx.asset_mesh(asset) if cut.any() else None
         if mesh is not None:
-            crossing = shapes.take(cut)
+            crossing = shapes.take(rows[cut])
             trimmed, owner = _trimmed(ctx.plan, crossing, placed[cut], planes[cut], mesh, symbol)
             append_mesh(ctx, _with_uv(ctx, crossing, owner, trimmed) if textured else trimmed, crossing, owner)
-            shapes, xform = shapes.take(~cut), xform[~cut]
-    _append(ctx, shapes, xform, asset, symbol, textured)
+            rows, xform = rows[~cut], xform[~cut]
+    _append(ctx, shapes, rows, xform, asset, symbol, textured)
 
 
 def z_up(xform: np.ndarray) -> np.ndarray:
@@ -83,19 +88,19 @@ def z_up(xform: np.ndarray) -> np.ndarray:
     return turned
 
 
-def trim_planes(plan, shapes: Shapes) -> np.ndarray:
-    """The shapes' trim planes (n, 4 P): the two vertical ones, NaN where there are none or
-    ``set(trim.vertical, false)``; then, where the grammar turns them on, the horizontal ones, NaN where
-    ``trim.horizontal`` is false."""
+def trim_planes(plan, shapes: Shapes, rows=slice(None)) -> np.ndarray:
+    """The trim planes (m, 4 P) of ``shapes`` rows ``rows``: the two vertical ones, NaN where there are
+    none or ``set(trim.vertical, false)``; then, where the grammar turns them on, the horizontal ones, NaN
+    where ``trim.horizontal`` is false."""
     slot = plan.trim_slot
-    planes = np.stack(shapes.dynamic[slot:slot + 8], axis=1)
+    planes = np.stack([d[rows] for d in shapes.dynamic[slot:slot + 8]], axis=1)
     if plan.trim_switch is not None:
-        planes[shapes.dynamic[plan.trim_switch] == 0] = np.nan
+        planes[shapes.dynamic[plan.trim_switch][rows] == 0] = np.nan
     if plan.horizontal_slot is None:
         return planes
     slot = plan.horizontal_slot
-    shallow = np.stack(shapes.dynamic[slot:slot + len(HORIZONTAL_SLOTS)], axis=1)
-    shallow[shapes.dynamic[plan.horizontal_switch] == 0] = np.nan
+    shallow = np.stack([d[rows] for d in shapes.dynamic[slot:slot + len(HORIZONTAL_SLOTS)]], axis=1)
+    shallow[shapes.dynamic[plan.horizontal_switch][rows] == 0] = np.nan
     return np.concatenate([planes, shallow], axis=1)
 
 
@@ -142,11 +147,13 @@ def append_mesh(ctx: Context, mesh: MeshChunk, shapes: Shapes, rows=slice(None))
         out.mesh_material.append(material_ids(ctx.plan, shapes, rows))
 
 
-def _append(ctx: Context, shapes: Shapes, xform: np.ndarray, asset: int, symbol: int, textured: bool = True) -> None:
+def _append(ctx: Context, shapes: Shapes, rows: np.ndarray, xform: np.ndarray, asset: int, symbol: int,
+            textured: bool = True) -> None:
+    """Add the instance records placed by ``xform`` (m, 3, 4) of ``shapes`` rows ``rows`` (m,)."""
     color_slot = ctx.plan.color_slot
-    append_records(ctx, xform, shapes.lot, asset, symbol,
-                   shapes.dynamic[color_slot] if color_slot is not None else None, material_ids(ctx.plan, shapes),
-                   _instance_uv(ctx, shapes, xform, textured))
+    append_records(ctx, xform, shapes.lot[rows], asset, symbol,
+                   shapes.dynamic[color_slot][rows] if color_slot is not None else None,
+                   material_ids(ctx.plan, shapes, rows), _instance_uv(ctx, shapes, rows, xform, textured))
 
 
 def append_records(ctx: Context, xform: np.ndarray, lot: np.ndarray, asset: int, symbol: int,
@@ -188,18 +195,19 @@ def _fail_non_finite(ctx: Context, lots: np.ndarray, rows: np.ndarray, what: str
                   sym.rules[0].span if sym.rules else None)
 
 
-def _instance_uv(ctx: Context, shapes: Shapes, xform: np.ndarray, textured: bool) -> np.ndarray | None:
-    """(n, 2, 4) float32: the texture coordinates of set 0 of instances placed by ``xform`` as maps of
-    their unit box's points, where the grammar has texture coordinates (NaN where a shape has none, or
-    all of them unless ``textured``)."""
-    if 0 not in ctx.plan.uv_slots:
+def _instance_uv(ctx: Context, shapes: Shapes, rows: np.ndarray, xform: np.ndarray,
+                 textured: bool) -> np.ndarray | None:
+    """(m, 2, 4) float32: the texture coordinates of set 0 of instances of ``shapes`` rows ``rows`` placed
+    by ``xform`` as maps of their unit box's points, where the grammar has texture coordinates (NaN where
+    a shape has none, or all of them unless ``textured``)."""
+    start = ctx.plan.uv_slots.get(0)
+    if start is None:
         return None
     if not textured:
-        return np.full((len(shapes), 2, 4), np.nan, np.float32)
-    maps = _record_maps(ctx, shapes)
-    placed = maps[:, :, :3] @ xform
-    placed[:, :, 3] += maps[:, :, 3]
-    return placed.astype(np.float32)
+        return np.full((len(rows), 2, 4), np.nan, np.float32)
+    chunk = ctx.chunk
+    return instance_maps(chunk.texture_maps.data, shapes.dynamic[start + COORDINATES], rows, chunk.lot_origin,
+                         shapes.lot, xform)
 
 
 def _with_uv(ctx: Context, shapes: Shapes, owner: np.ndarray, mesh: MeshChunk) -> MeshChunk:
@@ -236,24 +244,24 @@ def emit_leaves(ctx: Context, shapes: Shapes, symbol: int) -> None:
         shapes = shapes.take(~chunk.choices.stopped[shapes.lot])
         if not len(shapes):
             return
+    # instances are placed from the batch's rows, not from batches of them: a leaf batch has some twenty
+    # columns, of which records read a few
     assets = shapes.geom < -1
     if assets.any():
         for code in np.unique(shapes.geom[assets]):
             asset, mirrored = asset_of(np.array([code]))
-            emit_instances(ctx, shapes.take(shapes.geom == code), int(asset[0]), symbol, int(mirrored[0]))
-    box = shapes.geom == -1
-    flat = shapes.size <= TOL.zero
-    zeros = flat.sum(axis=1)
-    boxes = shapes.take(box & (zeros == 0))
+            emit_instances(ctx, shapes, int(asset[0]), symbol, int(mirrored[0]),
+                           rows=np.flatnonzero(shapes.geom == code))
+    kind = leaf_kinds(shapes.geom, shapes.size, TOL.zero)
+    boxes = np.flatnonzero(kind == -1)
     slot = ctx.plan.inserted_slot
-    emit_instances(ctx, boxes, CUBE, symbol, textured=True,
-                   inserted=boxes.dynamic[slot] == 1 if slot is not None else None)
-    is_quad = box & (zeros == 1)
-    quads = shapes.take(is_quad)
+    emit_instances(ctx, shapes, CUBE, symbol, textured=True,
+                   inserted=shapes.dynamic[slot][boxes] == 1 if slot is not None else None, rows=boxes)
+    quads = np.flatnonzero((kind >= 0) & (kind < 3))
     if len(quads):
-        xform = xforms(chunk.frames.data, quads.frame, quads.size, quads.origin, chunk.lot_origin[quads.lot],
-                       np.argmax(flat[is_quad], axis=1))
-        _append(ctx, quads, xform, QUAD, symbol)
+        xform = xforms(chunk.frames.data, shapes.frame, shapes.size, shapes.origin, shapes.lot, chunk.lot_origin,
+                       quads, kind[quads])
+        _append(ctx, shapes, quads, xform, QUAD, symbol)
     polygons = shapes.take(is_polygon(shapes.geom))
     if len(polygons):
         faces, owner = polygon_meshes(ctx, polygons, symbol)

@@ -8,8 +8,9 @@ import numpy as np
 import pytest
 
 from grammarc.backend.kernels.order import group_by, place, put, scatter_rows, tally
-from grammarc.backend.kernels.scope import component_frames, place_children, turned_frames, xforms
+from grammarc.backend.kernels.scope import component_frames, leaf_kinds, place_children, turned_frames, xforms
 from grammarc.backend.kernels.split import repeat, repeat_counts, subdiv
+from grammarc.backend.kernels.texture import instance_maps
 from grammarc.backend.random import child_keys
 
 SIZES = [0, 1, 2, 50]
@@ -251,19 +252,35 @@ def test_xforms(n):
     frame = rng.integers(0, 5, n).astype(np.int32)
     size = rng.uniform(0, 10, (n, 3))
     size[rng.random((n, 3)) < 0.2] = 0.0
-    base = rng.uniform(-1e7, 1e7, (n, 3)).round()  # lots' origins, far from the world's
-    origin = base + rng.normal(size=(n, 3)) * 100
-    flat = np.where(rng.random(n) < 0.5, -1, rng.integers(0, 3, n))
-    out = xforms(frames, frame, size, origin, base, flat)
-    assert out.dtype == np.float32 and out.shape == (n, 3, 4)
-    want = np.empty((n, 3, 4))
-    for i in range(n):
-        k = flat[i]
+    lot_origin = rng.uniform(-1e7, 1e7, (4, 3)).round()  # lots' origins, far from the world's
+    lot = rng.integers(0, 4, n).astype(np.int32)
+    origin = lot_origin[lot] + rng.normal(size=(n, 3)) * 100
+    rows = rng.permutation(n)[: n - n // 3]  # some of the batch's rows, in any order
+    flat = np.where(rng.random(len(rows)) < 0.5, -1, rng.integers(0, 3, len(rows))).astype(np.int8)
+    out = xforms(frames, frame, size, origin, lot, lot_origin, rows, flat)
+    assert out.dtype == np.float32 and out.shape == (len(rows), 3, 4)
+    want = np.empty((len(rows), 3, 4))
+    for c, i in enumerate(rows):
+        k = flat[c]
         for j in range(3):
             axis = j if k < 0 else (k + 1 + j) % 3  # a face: its two extents, then its normal times 0
-            want[i, :, j] = frames[frame[i], axis] * (size[i, axis] if k < 0 or j < 2 else 0.0)
-        want[i, :, 3] = origin[i] - base[i]  # relative to the lot's origin, rounded once
+            want[c, :, j] = frames[frame[i], axis] * (size[i, axis] if k < 0 or j < 2 else 0.0)
+        want[c, :, 3] = origin[i] - lot_origin[lot[i]]  # relative to the lot's origin, rounded once
     assert np.array_equal(out.view(np.int32), want.astype(np.float32).view(np.int32))  # zeros' signs too
+
+
+@pytest.mark.parametrize("n", SIZES)
+def test_leaf_kinds(n):
+    rng = np.random.default_rng(n)
+    geom = np.where(rng.random(n) < 0.8, -1, rng.integers(-5, 5, n)).astype(np.int32)
+    size = rng.uniform(0, 10, (n, 3))
+    size[rng.random((n, 3)) < 0.3] = rng.choice([0.0, 1e-12, np.nan])
+    got = leaf_kinds(geom, size, 1e-9)
+    flat = size <= 1e-9
+    zeros = flat.sum(axis=1)
+    want = np.where(zeros == 0, -1, np.where(zeros == 1, np.argmax(flat, axis=1), 3))
+    want[geom != -1] = -2
+    assert got.dtype == np.int8 and np.array_equal(got, want)
 
 
 @pytest.mark.parametrize("n", SIZES)
@@ -303,7 +320,9 @@ def test_xforms_maps_unit_box_corners_to_scope_corners():
     frames = random_frames(rng, 1)
     size = np.array([[2.0, 3.0, 4.0]])
     origin = np.array([[1.0, -2.0, 5.0]])
-    x = xforms(frames, np.zeros(1, np.int32), size, origin, np.zeros((1, 3)), np.full(1, -1))[0].astype(np.float64)
+    one = np.zeros(1, np.int32)
+    x = xforms(frames, one, size, origin, one, np.zeros((1, 3)), np.zeros(1, np.int64), np.full(1, -1, np.int8))[0]
+    x = x.astype(np.float64)
     for corner in np.ndindex(2, 2, 2):
         c = np.array(corner, float)
         world = x[:, :3] @ c + x[:, 3]
@@ -319,3 +338,31 @@ def test_tally_adds_what_bincount_counts(n, weighted):
     want = counts + np.bincount(lot, weights=weights if weighted else None, minlength=7).astype(np.int64)
     added = tally(counts, lot, weights if weighted else np.zeros(0, np.int64))
     assert np.array_equal(counts, want) and added == (weights.sum() if weighted else n)
+
+
+# ---------------------------------------------------------------------------------- texture.instance_maps
+
+
+@pytest.mark.parametrize("n", SIZES)
+def test_instance_maps_give_numpys_bits(n):
+    """The maps of records are numpy's composition, bit for bit: the shapes' maps made relative to their
+    lots' origins (``einsum``), composed with the records' transforms (``matmul``), for some of the rows in
+    any order; map 0 is NaN, some entries and origins are (signed) zeros."""
+    rng = np.random.default_rng(n)
+    table = rng.normal(size=(9, 2, 4)) * rng.choice([1e-3, 1.0, 1e4], size=(9, 2, 4))
+    table[rng.random((9, 2, 4)) < 0.3] = -0.0
+    table[0] = np.nan
+    lot_origin = rng.uniform(-1e6, 1e6, (4, 3))
+    lot_origin[rng.random((4, 3)) < 0.3] = 0.0
+    map_id = rng.integers(0, 9, n).astype(np.int32)
+    lot = rng.integers(0, 4, n).astype(np.int32)
+    rows = rng.permutation(n)[: n - n // 3]
+    xform = (rng.normal(size=(len(rows), 3, 4)) * 50).astype(np.float32)
+    xform[rng.random(xform.shape) < 0.2] = 0.0
+    maps = table[map_id[rows]]
+    maps[:, :, 3] += np.einsum("nij,nj->ni", maps[:, :, :3], lot_origin[lot[rows]])
+    want = maps[:, :, :3] @ xform
+    want[:, :, 3] += maps[:, :, 3]
+    got = instance_maps(table, map_id, rows, lot_origin, lot, xform)
+    assert got.dtype == np.float32 and got.shape == (len(rows), 2, 4)
+    assert np.array_equal(got.view(np.int32), want.astype(np.float32).view(np.int32))

@@ -30,6 +30,16 @@ def test_packed_colours_keep_their_opacity_apart():
     assert materials.channel("material.color.r", None) == 1.0  # no colour set: white and opaque
 
 
+def test_rgba_takes_each_channel_from_its_byte_of_the_packed_colour():
+    rng = np.random.default_rng(3)
+    packed = np.r_[0.0, 0xFFFFFF, 0xFF000000, 0xFFFFFFFF, rng.integers(0, 2**32, 50)].astype(np.float64)
+    value = packed.astype(np.int64)
+    want = [[v >> 16 & 255, v >> 8 & 255, v & 255, 255 - (v >> 24 & 255)] for v in value.tolist()]
+    got = materials.rgba(packed)
+    assert got.dtype == np.uint8 and got.tolist() == want
+    assert materials.rgba(packed[:0]).shape == (0, 4)
+
+
 def test_colour_components_and_opacity_are_read_and_set(write):
     r = run(write, 'Lot --> report("r0", material.color.r) report("o0", material.opacity) color(1, 0.5, 0)\n'
                    '    set(material.opacity, 0.25) set(material.color.b, material.color.g / 2)\n'

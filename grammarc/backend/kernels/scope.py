@@ -51,23 +51,45 @@ def place_children(origin, size, key, frame, geom, lot, depth, frames, axis, ord
 
 
 @njit(cache=True, nogil=True)
-def xforms(frames, frame, size, origin, base, flat):
-    """Record transforms (n, 3, 4) float32: column j = scope axis j * size j, column 3 = origin - base
-    (``base`` (n, 3): each row's lot origin, ``model.records.LotOrigins``). A flat scope, ``flat`` (n,) its
-    flat axis k (-1: a box), is a face (``builtin:quad``): its columns are axes k + 1 and k + 2 (mod 3) with
-    their sizes, then axis k times 0, as ``shapes.face_axes`` orders them: the quad's normal is axis k."""
-    n = len(frame)
-    out = np.empty((n, 3, 4), np.float32)
-    for i in range(n):
+def xforms(frames, frame, size, origin, lot, lot_origin, rows, flat):
+    """Record transforms (m, 3, 4) float32 of shapes ``rows`` (m,) of a batch (``frame``, ``size``,
+    ``origin``, ``lot`` (n, ...)): column j = scope axis j * size j, column 3 = origin - the origin of the
+    shape's lot (``lot_origin`` (L, 3), ``model.records.LotOrigins``). A flat scope, ``flat`` (m,) its
+    flat axis k (-1: a box), is a face (``builtin:quad``): its columns are axes k + 1 and k + 2 (mod 3)
+    with their sizes, then axis k times 0, as ``shapes.face_axes`` orders them: the quad's normal is axis
+    k. Rows are read where they are: a leaf batch's columns are not gathered for its records."""
+    m = len(rows)
+    out = np.empty((m, 3, 4), np.float32)
+    for c in range(m):
+        i = rows[c]
         f = frame[i]
-        k = flat[i]
+        k = flat[c]
         for j in range(3):
             a = j if k < 0 else (k + 1 + j) % 3
             s = size[i, a] if k < 0 or j < 2 else 0.0
             for r in range(3):
-                out[i, r, j] = frames[f, a, r] * s
+                out[c, r, j] = frames[f, a, r] * s
+        base = lot_origin[lot[i]]
         for r in range(3):
-            out[i, r, 3] = origin[i, r] - base[i, r]
+            out[c, r, 3] = origin[i, r] - base[r]
+    return out
+
+
+@njit(cache=True, nogil=True)
+def leaf_kinds(geom, size, tol):
+    """What each leaf shape is, (n,) int8: a scope box's flat axis k (0-2, its one axis of size ``tol``
+    or less: a face), -1 for a box of none, 3 for an edge or a vertex (two or more: no surface); -2
+    for a shape whose geometry is not its scope (a polygon, a mesh, an asset)."""
+    out = np.empty(len(geom), np.int8)
+    for i in range(len(geom)):
+        if geom[i] != -1:
+            out[i] = -2
+            continue
+        kind = -1
+        for a in range(3):
+            if size[i, a] <= tol:
+                kind = a if kind == -1 else 3
+        out[i] = kind
     return out
 
 

@@ -394,7 +394,7 @@ def _repetitions(share, nominal, fixed, floating, loose, laid, tol):
     return r + 1 if above < below + 1e-9 else r
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, inline="always")
 def _part_size(value, kind, extent, scale):
     if kind == 1:
         return value * extent
@@ -403,9 +403,10 @@ def _part_size(value, kind, extent, scale):
     return value
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, inline="always")
 def _place(parent, part, pos, length, index, m, i, j, at, size, extent, tol, child):
-    """Lay one part at ``at``; cut at the extent, drop if empty. Returns (m, next position, child)."""
+    """Lay one part at ``at``; cut at the extent, drop if empty. Returns (m, next position, child).
+    Inlined, as ``_part_size``, into ``group_split``'s loop over the parts: no call per part."""
     end = min(at + size, extent)
     if end - at > tol:
         parent[m] = i

@@ -37,6 +37,8 @@ def branch(ctx: Context, cursor: Shapes, op: ir.Case | ir.Stochastic) -> Parts:
         taken = (u[:, None] >= cumulative).sum(axis=1)
     bodies = [body for _, body in op.branches] + [op.default]
     order, offsets = group_by(taken, len(bodies))
+    if np.count_nonzero(np.diff(offsets)) == 1:  # one branch for every shape: they stay in their order
+        return Parts(tuple(bodies), cursor, offsets)
     return Parts(tuple(bodies), cursor.take(order), offsets)
 
 
