@@ -73,13 +73,14 @@ def comp_faces(ctx: Context, cursor: Shapes, op: ir.CompFaces) -> Parts:
     shapes = take_apart(ctx, cursor, shapes, parent)
     if op.kind == "f":
         shapes = _face_scopes(ctx, shapes, cursor, parent, op.span)
+    axes = chunk.frames[shapes.frame]
     slot = ctx.plan.trim_slot
     if op.kind == "f" and slot is not None:
         # the faces' trim planes where they meet their neighbours (``geometry.trim``)
         # relative to the lot's origin, so that a lot far from the origin is trimmed as it is there
-        up = chunk.frames[cursor.frame[parent]][:, 1]
+        up = chunk.frames[cursor.frame][:, 1][parent]
         origin = shapes.origin - chunk.lot_origin[shapes.lot]
-        planes = side_face_planes(chunk.frames[shapes.frame], origin, shapes.size, parent, up)
+        planes = side_face_planes(axes, origin, shapes.size, parent, up)
         dynamic = list(shapes.dynamic)
         dynamic[slot:slot + 8] = list(planes.T)
         shallow = ctx.plan.horizontal_slot
@@ -100,27 +101,28 @@ def comp_faces(ctx: Context, cursor: Shapes, op: ir.CompFaces) -> Parts:
     if borders:
         picked.update({"border": border, "inside": ~border})
     if op.kind == "f":
-        axes = chunk.frames[shapes.frame]
         base = (shapes.origin, shapes.origin + axes[:, 0] * shapes.size[:, :1])  # each face's bottom edge
         which = classify_faces(normal, op.selectors, selector_frames(chunk, normal, cursor, parent, op.selectors,
                                                                       base), picked)
     else:
-        direction = chunk.frames[shapes.frame][:, 0] if op.kind == "e" else None
+        direction = axes[:, 0] if op.kind == "e" else None
         which = classify_edges(direction, op.selectors, len(shapes), picked, roof)
-    keep = which < len(op.selectors)
-    shapes, which, parent = shapes.take(keep), which[keep], parent[keep]
+    # the selected components grouped by body part, taken in one gather: numbered in face order first
+    kept = np.flatnonzero(which < len(op.selectors))
+    which, parent = which[kept], parent[kept]
+    order, offsets = group_by(which, len(op.parts))
+    shapes = shapes.take(kept[order])
     if ctx.plan.sequential_random:  # PRT makes shapes of the selected faces only, numbered in face order
-        shapes = replace(shapes, key=piece_keys(True, cursor.key[parent], rank_within(parent), op.site))
+        number = rank_within(parent)[order]
+        shapes = replace(shapes, key=piece_keys(True, cursor.key[parent[order]], number, op.site))
     if {"comp.index", "comp.total", "comp.sel"} & set(ctx.plan.dynamic):
         # CityEngine numbers the components of each selector: the front face is 0 of 1
         group = parent * (len(op.selectors) + 1) + which
-        rank = rank_within(group)
+        rank, n_groups = rank_within(group)[order], int(group.max(initial=0)) + 1
         ids = np.array([ctx.plan.strings.ids[s] for s in comp_selectors(op)], dtype=np.int32)
-        shapes = with_context(ctx.plan, shapes, "comp", rank, group, int(group.max(initial=0)) + 1,
-                              selector=ids[which])
+        shapes = with_context(ctx.plan, shapes, "comp", rank, group[order], n_groups, selector=ids[which[order]])
     ctx.count(shapes, op.span)
-    order, offsets = group_by(which, len(op.parts))
-    return Parts(op.parts, shapes.take(order), offsets)
+    return Parts(op.parts, shapes, offsets)
 
 
 def components(ctx: Context, kind: int, cursor: Shapes, site: int, span, wanted=None, borders: bool = False):
@@ -137,8 +139,7 @@ def components(ctx: Context, kind: int, cursor: Shapes, site: int, span, wanted=
     mesh = is_mesh(cursor.geom)
     pieces = []
     if not mesh.all():
-        pieces.append(_solid_components(chunk, kind, cursor, np.flatnonzero(~mesh),
-                                        corners(ctx.plan, cursor)))
+        pieces.append(_solid_components(chunk, kind, cursor, ~mesh, corners(ctx.plan, cursor)))
     if mesh.any():
         which = np.flatnonzero(mesh)
         parent, index, origin, axes, size, geom, roof, border = mesh_shapes.mesh_components(
@@ -171,13 +172,13 @@ def components(ctx: Context, kind: int, cursor: Shapes, site: int, span, wanted=
             border)
 
 
-def _solid_components(chunk, kind: int, cursor: Shapes, which: np.ndarray, corner: np.ndarray | None):
-    """Components of the boxes, polygons and prisms ``which`` of ``cursor`` (whose box rings start at
-    ``corner`` (n,), None for corner 0): parent (into cursor), index, origin, axes, size (in the parents'
+def _solid_components(chunk, kind: int, cursor: Shapes, solid: np.ndarray, corner: np.ndarray | None):
+    """Components of the boxes, polygons and prisms ``solid`` (n,) bool of ``cursor`` (whose box rings start
+    at ``corner`` (n,), None for corner 0): parent (into cursor), index, origin, axes, size (in the parents'
     frames), geom, normal, roof (-1: no roof edges), border (the components of flat shapes), and the
     corner each box component's ring starts at."""
-    shapes = cursor.take(which)
-    corner = None if corner is None else corner[which]
+    shapes, which = cursor.take(solid), np.flatnonzero(solid)  # all of them taken as they are
+    corner = None if corner is None else corner[solid]
     coords, ring_offsets, shape_offsets, plane = polygons_of(chunk, shapes, corner)
     parent, index, origin, axes, size, poly = comp_kernels.components(
         kind, coords, ring_offsets, shape_offsets, plane, shapes.size, TOL.zero,
