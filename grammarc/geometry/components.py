@@ -81,8 +81,9 @@ def _edge(coords, j, r0, count, a, b, size_row):
 def _edge_into(coords, j, r0, count, a, b, size_row, p, d):
     """``_edge`` written into ``p`` and ``d`` (3,); returns the length."""
     k = r0 + (j - r0 + 1) % count
-    p[:] = 0.0
-    d[:] = 0.0
+    for c in range(3):
+        p[c] = 0.0
+        d[c] = 0.0
     p[a] = coords[j, 0] * size_row[a]
     p[b] = coords[j, 1] * size_row[b]
     d[a] = coords[k, 0] * size_row[a] - p[a]
@@ -116,11 +117,12 @@ def _put(out, m, i, o, x, y, z, s, code):
     """Write component m: parent i, origin o, axes x, y, z (rows), size s (3,), geometry code."""
     parent, origin, axes, csize, poly = out
     parent[m] = i
-    origin[m] = o
-    axes[m, 0] = x
-    axes[m, 1] = y
-    axes[m, 2] = z
-    csize[m] = s
+    for c in range(3):  # element by element: a row assigned whole costs a broadcast each time
+        origin[m, c] = o[c]
+        axes[m, 0, c] = x[c]
+        axes[m, 1, c] = y[c]
+        axes[m, 2, c] = z[c]
+        csize[m, c] = s[c]
     poly[m] = code
     return m + 1
 
@@ -176,10 +178,10 @@ def components(kind, coords, ring_offsets, shape_offsets, plane, size, tol, turn
         total += _count(kind, n_edges, volume)
     parent = np.empty(total, np.int64)
     index = np.empty(total, np.int64)
-    origin = np.zeros((total, 3))
-    axes = np.zeros((total, 3, 3))
-    csize = np.zeros((total, 3))
-    poly = np.zeros(total, np.int8)
+    origin = np.empty((total, 3))  # every component's row is written whole (``_put``)
+    axes = np.empty((total, 3, 3))
+    csize = np.empty((total, 3))
+    poly = np.empty(total, np.int8)
     out = (parent, origin, axes, csize, poly)
     # one edge's start, direction, outward normal, size and lifted start, and one shape's axes (its
     # normal, then negated, and its in-plane axes), a cap's y and origin: used again, nothing allocated

@@ -19,7 +19,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from grammarc.ragged import group_bounds, rank_within, row_groups
+from grammarc.ragged import rank_within, row_groups
 
 #: A shared edge steeper than this (degrees from the horizontal) makes a vertical trim plane, a shallower
 #: one a horizontal plane.
@@ -40,11 +40,21 @@ def side_face_planes(axes: np.ndarray, origin: np.ndarray, size: np.ndarray, par
     world coordinates."""
     if not len(parent):
         return np.full((0, 8), np.nan)
-    end = origin + size[:, 0:1] * axes[:, 0]
+    end = _face_ends(origin, size, axes)
     (first, last), _ = _corner_cells(parent, origin, end)
     # the neighbour sharing each face's start / end
-    before, after = _neighbours(np.argsort(parent, kind="stable"), parent, first, last)
+    before, after = _neighbours(np.asarray(parent, dtype=np.int64), first, last)
     return _bisector_planes(axes, origin, end, size, up, before, after, np.sin(np.radians(VERTICAL_DEGREES)))
+
+
+@njit(cache=True, nogil=True)
+def _face_ends(origin, size, axes):
+    """The end of each face's bottom edge (m, 3): ``origin + size[:, 0:1] * axes[:, 0]`` in one pass."""
+    end = np.empty((len(origin), 3))
+    for i in range(len(origin)):
+        for j in range(3):
+            end[i, j] = origin[i, j] + size[i, 0] * axes[i, 0, j]
+    return end
 
 
 @njit(cache=True, nogil=True)
@@ -146,55 +156,88 @@ def shallow_edge_planes(verts: np.ndarray, ring_offsets: np.ndarray, face_offset
     return out
 
 
-def _corner_cells(parent: np.ndarray, *points: np.ndarray) -> tuple[list[np.ndarray], np.ndarray]:
-    """The grid cells (k, 3) int64 that corners ``points`` (each (k, 3)) of parents ``parent`` (k,) are
-    matched on, and the grid's spacing (k, 1): 1e-7 of the parent's extent (1 at least), from the
+def _corner_cells(parent: np.ndarray, start: np.ndarray, end: np.ndarray) -> tuple[list[np.ndarray], np.ndarray]:
+    """The grid cells (k, 3) int64 that corners ``start`` and ``end`` (each (k, 3)) of parents ``parent`` (k,)
+    are matched on, and the grid's spacing (k, 1): 1e-7 of the parent's extent (1 at least), from the
     parent's lowest corner. Per parent and from its own corner, so that a lot far from the origin
     (national-grid coordinates) is matched as it would be at the origin and coarsens no other lot's
     matching in its chunk (a grid of its coordinates' magnitude, 0.8 m at 7.8e6, made the corners of
     complexpatterns' 0.6 m deep top floors one corner)."""
-    low, high = group_bounds(np.tile(parent, len(points)), int(parent.max()) + 1, np.concatenate(points))
-    scale = np.maximum((high - low).max(axis=1), 1.0) * 1e-7
-    return [_cells(parent, low, scale, np.ascontiguousarray(p, dtype=np.float64)) for p in points], scale[parent][:, None]
+    parent = np.ascontiguousarray(parent, dtype=np.int64)
+    first, last, scale = _cells(parent, int(parent.max()) + 1, np.ascontiguousarray(start, dtype=np.float64),
+                                np.ascontiguousarray(end, dtype=np.float64))
+    return [first, last], scale[parent][:, None]
 
 
 @njit(cache=True, nogil=True)
-def _cells(parent, low, scale, points):
-    """``round((points - low[parent]) / scale[parent])`` as int64 in one pass, as numpy rounds (half to
-    even) and casts (a value beyond int64, or not finite, is int64's least, as numpy's cast gives it here)."""
-    out = np.empty(points.shape, np.int64)
-    for k in range(len(parent)):
-        g = parent[k]
-        for j in range(points.shape[1]):
-            cell = np.rint((points[k, j] - low[g, j]) / scale[g])
-            out[k, j] = np.int64(cell) if abs(cell) < 9.2e18 else np.iinfo(np.int64).min
-    return out
+def _cells(parent, n, start, end):
+    """``_corner_cells`` in two passes: each parent's lowest and highest corner (a NaN wins, as with
+    ``np.minimum``), its spacing, then ``round((points - low[parent]) / scale[parent])`` as int64, as numpy
+    rounds (half to even) and casts (a value beyond int64, or not finite, is int64's least, as numpy's cast
+    gives it here). The spacing (n,) is numpy's: the largest extent (a NaN wins), at least 1, times 1e-7."""
+    low = np.full((n, 3), np.inf)
+    high = np.full((n, 3), -np.inf)
+    for points in (start, end):
+        for k in range(len(parent)):
+            g = parent[k]
+            for j in range(3):
+                v = points[k, j]
+                if v < low[g, j] or np.isnan(v):
+                    low[g, j] = v
+                if v > high[g, j] or np.isnan(v):
+                    high[g, j] = v
+    scale = np.empty(n)
+    for g in range(n):
+        extent = high[g, 0] - low[g, 0]
+        for j in range(1, 3):
+            d = high[g, j] - low[g, j]
+            if not np.isnan(extent) and (d > extent or np.isnan(d)):
+                extent = d
+        scale[g] = (extent if extent > 1.0 or np.isnan(extent) else 1.0) * 1e-7
+    first = np.empty(start.shape, np.int64)
+    last = np.empty(end.shape, np.int64)
+    for points, out in ((start, first), (end, last)):
+        for k in range(len(parent)):
+            g = parent[k]
+            for j in range(3):
+                cell = np.rint((points[k, j] - low[g, j]) / scale[g])
+                out[k, j] = np.int64(cell) if abs(cell) < 9.2e18 else np.iinfo(np.int64).min
+    return first, last, scale
 
 
 @njit(cache=True, nogil=True)
-def _neighbours(order, parent, first, last):
+def _neighbours(parent, first, last):
     """Each face's neighbour at its start, the face of its parent whose end is in the same grid cell as its
     start, and at its end, the one whose start is in its end's cell (-1: none; the last face, where
-    several are). ``order`` (m,) lists the faces parent by parent (a stable sort: faces in their order);
-    ``first`` and ``last`` (m, 3) int64 are the cells of their starts and ends (``_corner_cells``). A
-    parent's faces are few (a box's six, a footprint's walls): each is matched against all of them."""
-    m = len(order)
+    several are). ``parent`` (m,) int64 in any order (the faces are listed parent by parent with a
+    counting sort, faces in their order); ``first`` and ``last`` (m, 3) int64 are the cells of their starts
+    and ends (``_corner_cells``). A parent's faces are few (a box's six, a footprint's walls): each is
+    matched against all of them."""
+    m = len(parent)
+    n = 0
+    for i in range(m):
+        n = max(n, parent[i] + 1)
+    offsets = np.zeros(n + 1, np.int64)
+    for i in range(m):
+        offsets[parent[i] + 1] += 1
+    for g in range(n):
+        offsets[g + 1] += offsets[g]
+    fill = offsets[:-1].copy()
+    order = np.empty(m, np.int64)
+    for i in range(m):
+        order[fill[parent[i]]] = i
+        fill[parent[i]] += 1
     before = np.full(m, -1, np.int64)
     after = np.full(m, -1, np.int64)
-    group = 0
-    while group < m:
-        stop = group
-        while stop < m and parent[order[stop]] == parent[order[group]]:
-            stop += 1
-        for a in range(group, stop):
+    for g in range(n):
+        for a in range(offsets[g], offsets[g + 1]):
             i = order[a]
-            for b in range(group, stop):
+            for b in range(offsets[g], offsets[g + 1]):
                 j = order[b]
                 if last[j, 0] == first[i, 0] and last[j, 1] == first[i, 1] and last[j, 2] == first[i, 2]:
                     before[i] = j
                 if first[j, 0] == last[i, 0] and first[j, 1] == last[i, 1] and first[j, 2] == last[i, 2]:
                     after[i] = j
-        group = stop
     return before, after
 
 
