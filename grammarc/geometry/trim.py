@@ -40,7 +40,7 @@ def side_face_planes(axes: np.ndarray, origin: np.ndarray, size: np.ndarray, par
     world coordinates."""
     if not len(parent):
         return np.full((0, 8), np.nan)
-    end = _face_ends(origin, size, axes)
+    end = bottom_ends(origin, size, axes)
     (first, last), _ = _corner_cells(parent, origin, end)
     # the neighbour sharing each face's start / end
     before, after = _neighbours(np.asarray(parent, dtype=np.int64), first, last)
@@ -48,8 +48,9 @@ def side_face_planes(axes: np.ndarray, origin: np.ndarray, size: np.ndarray, par
 
 
 @njit(cache=True, nogil=True)
-def _face_ends(origin, size, axes):
-    """The end of each face's bottom edge (m, 3): ``origin + size[:, 0:1] * axes[:, 0]`` in one pass."""
+def bottom_ends(origin, size, axes):
+    """The end of each face's bottom edge (m, 3), the edge from its ``origin`` (m, 3) along its x, ``axes``
+    (m, 3, 3) rows: ``origin + size[:, 0:1] * axes[:, 0]`` in one pass."""
     end = np.empty((len(origin), 3))
     for i in range(len(origin)):
         for j in range(3):

@@ -11,6 +11,7 @@ cursor.
 
 from __future__ import annotations
 
+import functools
 from dataclasses import replace
 
 import numpy as np
@@ -35,7 +36,7 @@ from grammarc.geometry import components as comp_kernels
 from grammarc.geometry.meshes import is_mesh, is_polygon
 from grammarc.geometry.queries import shape_faces
 from grammarc.geometry.reframe import NORMAL_OUT
-from grammarc.geometry.trim import shallow_edge_planes, side_face_planes
+from grammarc.geometry.trim import bottom_ends, shallow_edge_planes, side_face_planes
 from grammarc.ir import nodes as ir
 from grammarc.ir.printer import comp_selectors
 from grammarc.ragged import rank_within
@@ -78,7 +79,7 @@ def comp_faces(ctx: Context, cursor: Shapes, op: ir.CompFaces) -> Parts:
     if op.kind == "f" and slot is not None:
         # the faces' trim planes where they meet their neighbours (``geometry.trim``)
         # relative to the lot's origin, so that a lot far from the origin is trimmed as it is there
-        up = chunk.frames[cursor.frame][:, 1][parent]
+        up = chunk.frames.data[cursor.frame, 1][parent]
         origin = shapes.origin - chunk.lot_origin[shapes.lot]
         planes = side_face_planes(axes, origin, shapes.size, parent, up)
         dynamic = list(shapes.dynamic)
@@ -101,7 +102,7 @@ def comp_faces(ctx: Context, cursor: Shapes, op: ir.CompFaces) -> Parts:
     if borders:
         picked.update({"border": border, "inside": ~border})
     if op.kind == "f":
-        base = (shapes.origin, shapes.origin + axes[:, 0] * shapes.size[:, :1])  # each face's bottom edge
+        base = (shapes.origin, bottom_ends(shapes.origin, shapes.size, axes))  # each face's bottom edge
         which = classify_faces(normal, op.selectors, selector_frames(chunk, normal, cursor, parent, op.selectors,
                                                                       base), picked)
     else:
@@ -209,14 +210,27 @@ def _box_corners(poly: np.ndarray, plane: np.ndarray, geom: np.ndarray, parent: 
         return out
     same = poly == comp_kernels.SAME_POLY
     out[same] = corner[parent[same]]
-    for code, flip_where in ((comp_kernels.TOP_POLY, True), (comp_kernels.BOTTOM_POLY, False)):
-        rows = np.flatnonzero((poly == code) & (geom[parent] == -1))
-        if len(rows):
-            first = comp_kernels.rect_rings(plane[parent[rows]], corner[parent[rows]])[::4].copy()
-            flip = (plane[parent[rows]] == 1) == flip_where
-            first[flip, 1] = 1.0 - first[flip, 1]
-            out[rows] = comp_kernels.rect_corners(first, np.full(len(rows), 2))
+    for cap, code in enumerate((comp_kernels.TOP_POLY, comp_kernels.BOTTOM_POLY)):
+        rows = np.flatnonzero(poly == code)
+        rows = rows[geom[parent[rows]] == -1]
+        out[rows] = _cap_corners()[cap, plane[parent[rows]], corner[parent[rows]] % 4]
     return out
+
+
+@functools.cache
+def _cap_corners() -> np.ndarray:
+    """The corner (2, 3, 4) int64 a box's top (0) and bottom (1) face's ring starts at, by the box's plane
+    and its ring's corner: the box ring's first vertex, seen in the cap's plane (y flipped where the cap
+    runs against the box's second axis, as ``_cap_polygons`` flips a prism's)."""
+    plane, corner = np.repeat(np.arange(3), 4), np.tile(np.arange(4), 3)
+    first = comp_kernels.rect_rings(plane, corner)[::4]
+    table = np.empty((2, 3, 4), dtype=np.int64)
+    for cap, flip_where in enumerate((True, False)):
+        seen = first.copy()
+        flip = (plane == 1) == flip_where
+        seen[flip, 1] = 1.0 - seen[flip, 1]
+        table[cap] = comp_kernels.rect_corners(seen, np.full(len(plane), 2)).reshape(3, 4)
+    return table
 
 
 def _cap_polygons(chunk, geom: np.ndarray, which: str) -> np.ndarray:
@@ -243,5 +257,6 @@ def _face_scopes(ctx: Context, shapes: Shapes, cursor: Shapes, parent: np.ndarra
     along the face's normal (x kept, y = z cross x)."""
     axis = flat_axis(ctx.chunk, cursor)[parent]
     turn = (axis >= 0) & (axis != 2) & (shapes.geom > -2) & ~is_mesh(shapes.geom)
-    turn &= (shapes.size <= TOL.zero).sum(axis=1) == 1
+    rows = np.flatnonzero(turn)  # only these are asked whether they are flat (the faces of solids are not)
+    turn[rows] = (shapes.size[rows] <= TOL.zero).sum(axis=1) == 1
     return turned(ctx, shapes, turn, NORMAL_OUT, axis, span)
