@@ -19,7 +19,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from grammarc.ragged import rank_within, row_groups
+from grammarc.ragged import group_bounds, rank_within, row_groups
 
 #: A shared edge steeper than this (degrees from the horizontal) makes a vertical trim plane, a shallower
 #: one a horizontal plane.
@@ -165,30 +165,20 @@ def _corner_cells(parent: np.ndarray, start: np.ndarray, end: np.ndarray) -> tup
     matching in its chunk (a grid of its coordinates' magnitude, 0.8 m at 7.8e6, made the corners of
     complexpatterns' 0.6 m deep top floors one corner)."""
     parent = np.ascontiguousarray(parent, dtype=np.int64)
-    first, last, scale = _cells(parent, int(parent.max()) + 1, np.ascontiguousarray(start, dtype=np.float64),
-                                np.ascontiguousarray(end, dtype=np.float64))
+    start, end = np.ascontiguousarray(start, dtype=np.float64), np.ascontiguousarray(end, dtype=np.float64)
+    low, high = group_bounds(parent, int(parent.max()) + 1, start, end)
+    first, last, scale = _cells(parent, low, high, start, end)
     return [first, last], scale[parent][:, None]
 
 
 @njit(cache=True, nogil=True)
-def _cells(parent, n, start, end):
-    """``_corner_cells`` in two passes: each parent's lowest and highest corner (a NaN wins, as with
-    ``np.minimum``), its spacing, then ``round((points - low[parent]) / scale[parent])`` as int64, as numpy
-    rounds (half to even) and casts (a value beyond int64, or not finite, is int64's least, as numpy's cast
-    gives it here). The spacing (n,) is numpy's: the largest extent (a NaN wins), at least 1, times 1e-7."""
-    low = np.full((n, 3), np.inf)
-    high = np.full((n, 3), -np.inf)
-    for points in (start, end):
-        for k in range(len(parent)):
-            g = parent[k]
-            for j in range(3):
-                v = points[k, j]
-                if v < low[g, j] or np.isnan(v):
-                    low[g, j] = v
-                if v > high[g, j] or np.isnan(v):
-                    high[g, j] = v
-    scale = np.empty(n)
-    for g in range(n):
+def _cells(parent, low, high, start, end):
+    """``_corner_cells`` from each parent's lowest and highest corner (n, 3): its spacing (n,), numpy's
+    (the largest extent, a NaN winning, at least 1, times 1e-7), and ``round((points - low[parent]) /
+    scale[parent])`` as int64, as numpy rounds (half to even) and casts (a value beyond int64, or not
+    finite, is int64's least, as numpy's cast gives it here), for the starts and the ends."""
+    scale = np.empty(len(low))
+    for g in range(len(low)):
         extent = high[g, 0] - low[g, 0]
         for j in range(1, 3):
             d = high[g, j] - low[g, j]
