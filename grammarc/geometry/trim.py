@@ -280,35 +280,42 @@ def trim_triangles(verts, tris, xform, planes, eps):
     n_f = 0
     poly = np.empty((3 + 2 * n_planes, 3))
     clipped = np.empty((3 + 2 * n_planes, 3))
+    # element by element throughout: a row assigned whole, or made by array arithmetic, allocates each time
     for k in range(k_count):
         for t in range(t_count):
             count = 3
             for c in range(3):
-                v = verts[tris[t, c]]
+                v = tris[t, c]
                 for r in range(3):
-                    poly[c, r] = xform[k, r, 0] * v[0] + xform[k, r, 1] * v[1] + xform[k, r, 2] * v[2] + xform[k, r, 3]
+                    poly[c, r] = (xform[k, r, 0] * verts[v, 0] + xform[k, r, 1] * verts[v, 1]
+                                  + xform[k, r, 2] * verts[v, 2] + xform[k, r, 3])
             for p in range(n_planes):
                 nx, ny, nz, d = planes[k, 4 * p], planes[k, 4 * p + 1], planes[k, 4 * p + 2], planes[k, 4 * p + 3]
                 if np.isnan(nx) or count < 3:
                     continue
                 kept = 0
                 for j in range(count):
-                    s_ = poly[(j - 1) % count]
-                    e_ = poly[j]
-                    ds = nx * s_[0] + ny * s_[1] + nz * s_[2] + d
-                    de = nx * e_[0] + ny * e_[1] + nz * e_[2] + d
+                    s_ = (j - 1) % count
+                    ds = nx * poly[s_, 0] + ny * poly[s_, 1] + nz * poly[s_, 2] + d
+                    de = nx * poly[j, 0] + ny * poly[j, 1] + nz * poly[j, 2] + d
                     if (de >= -eps) != (ds >= -eps):
                         f = ds / (ds - de)
-                        clipped[kept] = s_ + f * (e_ - s_)
+                        for r in range(3):
+                            clipped[kept, r] = poly[s_, r] + f * (poly[j, r] - poly[s_, r])
                         kept += 1
                     if de >= -eps:
-                        clipped[kept] = e_
+                        for r in range(3):
+                            clipped[kept, r] = poly[j, r]
                         kept += 1
                 count = kept
-                poly[:count] = clipped[:count]
+                for c in range(count):
+                    for r in range(3):
+                        poly[c, r] = clipped[c, r]
             if count < 3:
                 continue
-            out[n_v:n_v + count] = poly[:count]
+            for c in range(count):
+                for r in range(3):
+                    out[n_v + c, r] = poly[c, r]
             n_v += count
             owner[n_f] = k
             n_f += 1
