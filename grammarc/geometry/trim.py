@@ -43,7 +43,7 @@ def side_face_planes(axes: np.ndarray, origin: np.ndarray, size: np.ndarray, par
     end = bottom_ends(origin, size, axes)
     (first, last), _ = _corner_cells(parent, origin, end)
     # the neighbour sharing each face's start / end
-    before, after = _neighbours(np.asarray(parent, dtype=np.int64), first, last)
+    before, after = _neighbours(np.argsort(parent, kind="stable"), parent, first, last)
     return _bisector_planes(axes, origin, end, size, up, before, after, np.sin(np.radians(VERTICAL_DEGREES)))
 
 
@@ -197,38 +197,29 @@ def _cells(parent, low, high, start, end):
 
 
 @njit(cache=True, nogil=True)
-def _neighbours(parent, first, last):
+def _neighbours(order, parent, first, last):
     """Each face's neighbour at its start, the face of its parent whose end is in the same grid cell as its
     start, and at its end, the one whose start is in its end's cell (-1: none; the last face, where
-    several are). ``parent`` (m,) int64 in any order (the faces are listed parent by parent with a
-    counting sort, faces in their order); ``first`` and ``last`` (m, 3) int64 are the cells of their starts
-    and ends (``_corner_cells``). A parent's faces are few (a box's six, a footprint's walls): each is
-    matched against all of them."""
-    m = len(parent)
-    n = 0
-    for i in range(m):
-        n = max(n, parent[i] + 1)
-    offsets = np.zeros(n + 1, np.int64)
-    for i in range(m):
-        offsets[parent[i] + 1] += 1
-    for g in range(n):
-        offsets[g + 1] += offsets[g]
-    fill = offsets[:-1].copy()
-    order = np.empty(m, np.int64)
-    for i in range(m):
-        order[fill[parent[i]]] = i
-        fill[parent[i]] += 1
+    several are). ``order`` (m,) lists the faces parent by parent (a stable sort: faces in their order);
+    ``first`` and ``last`` (m, 3) int64 are the cells of their starts and ends (``_corner_cells``). A
+    parent's faces are few (a box's six, a footprint's walls): each is matched against all of them."""
+    m = len(order)
     before = np.full(m, -1, np.int64)
     after = np.full(m, -1, np.int64)
-    for g in range(n):
-        for a in range(offsets[g], offsets[g + 1]):
+    group = 0
+    while group < m:
+        stop = group
+        while stop < m and parent[order[stop]] == parent[order[group]]:
+            stop += 1
+        for a in range(group, stop):
             i = order[a]
-            for b in range(offsets[g], offsets[g + 1]):
+            for b in range(group, stop):
                 j = order[b]
                 if last[j, 0] == first[i, 0] and last[j, 1] == first[i, 1] and last[j, 2] == first[i, 2]:
                     before[i] = j
                 if first[j, 0] == last[i, 0] and first[j, 1] == last[i, 1] and first[j, 2] == last[i, 2]:
                     after[i] = j
+        group = stop
     return before, after
 
 
