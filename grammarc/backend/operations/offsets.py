@@ -68,18 +68,10 @@ def offset(ctx: Context, cursor: Shapes, op: ir.Offset) -> Shapes:
 def _offset_selected(ctx: Context, cursor: Shapes, op: ir.Offset):
     """The pieces ``offset`` keeps of flat shapes: their insets, borders or both, each shape's inside
     pieces before its border's."""
-    if op.select == "all":
-        inset, border, plane, polygons, faces, owner, moves = _offset_polygons(ctx, op.distance, cursor, op.span)
-        pieces = fit_pieces(np.concatenate([inset, border]), np.tile(plane, 2), np.tile(faces.size, (2, 1)),
-                            np.tile(polygons, 2), insets=np.arange(2 * len(inset)) < len(inset),
-                            moves=np.concatenate([moves, np.full(len(moves), np.nan)]))
-        # each shape's inside pieces, then its border's
-        pieces = replace(pieces, source=owner[pieces.source % len(faces)])
-        pieces = pieces.take(np.argsort(pieces.source, kind="stable"))
-    else:
-        inside, border = _offset_pieces(ctx, op.distance, cursor, op.span)
-        pieces = inside if op.select == "inside" else border
-    return pieces
+    pieces, border = _fitted_pieces(ctx, op.distance, cursor, op.span)
+    if op.select == "all":  # each shape's inside pieces, then its border's
+        return pieces.take(np.argsort(pieces.source, kind="stable"))
+    return pieces.take(border if op.select == "border" else ~border)
 
 
 def _roof_offsets(ctx: Context, roofs: Shapes, op: ir.Offset) -> tuple[Shapes, np.ndarray]:
@@ -251,10 +243,19 @@ def _inset_and_border(polygons: np.ndarray, distance: np.ndarray) -> tuple[np.nd
 def _offset_pieces(ctx: Context, distance: ir.Expr, cursor: Shapes, span):
     """The inside and border pieces of each flat shape's faces offset by ``distance``, each piece's
     ``source`` its shape's row."""
+    pieces, border = _fitted_pieces(ctx, distance, cursor, span)
+    return pieces.take(~border), pieces.take(border)
+
+
+def _fitted_pieces(ctx: Context, distance: ir.Expr, cursor: Shapes, span):
+    """The pieces of each flat shape's faces offset by ``distance``, fitted in one pass: all the insides'
+    pieces, then all the borders' (whose edges moved by no distance known), each piece's ``source`` its
+    shape's row; and which pieces are of a border (k,) bool."""
     inset, border, plane, polygons, faces, owner, moves = _offset_polygons(ctx, distance, cursor, span)
-    return tuple(replace(p, source=owner[p.source]) for p in (
-        fit_pieces(inset, plane, faces.size, polygons, insets=np.ones(len(inset), dtype=bool), moves=moves),
-        fit_pieces(border, plane, faces.size, polygons)))
+    pieces = fit_pieces(np.concatenate([inset, border]), np.tile(plane, 2), np.tile(faces.size, (2, 1)),
+                        np.tile(polygons, 2), insets=np.arange(2 * len(inset)) < len(inset),
+                        moves=np.concatenate([moves, np.full(len(moves), np.nan)]))
+    return replace(pieces, source=owner[pieces.source % len(faces)]), pieces.source >= len(faces)
 
 
 def _faces_in_plane(cursor: Shapes, chunk) -> tuple[Shapes, np.ndarray]:
