@@ -282,7 +282,7 @@ def _extruded_along_normal(ctx: Context, cursor: Shapes, height, axis: np.ndarra
     cursor = turned(ctx, cursor, axis != 1, NORMAL_UP, axis, span)
     size = cursor.size.copy()
     size[:, 1] = np.abs(height)
-    up = ctx.chunk.frames[cursor.frame][:, 1]
+    up = ctx.chunk.frames.data[cursor.frame, 1]
     origin = cursor.origin + np.minimum(height, 0.0)[:, None] * up
     extruded = cursor.with_scope(origin, size, cursor.frame, cursor.geom)
     mesh = is_mesh(cursor.geom)
