@@ -137,7 +137,7 @@ def component_frames(frames, frame, origin, local_origin, local_axes, tol):
     for c in range(m):
         _times_frame(local_axes, c, frames, frame[c], out_axes)
         for r in range(3):
-            for k in range(3):
+            for k in range(r, 3):  # axis k . axis r is axis r . axis k
                 dot = 0.0
                 for j in range(3):
                     dot += local_axes[c, r, j] * local_axes[c, k, j]
