@@ -49,8 +49,8 @@ def comp(ctx: Context, cursor: Shapes, op: ir.Comp) -> Parts:
     index_of = None
     if op.index is not None:
         index_of = evaluate_array(op.index, ctx.env(cursor))
-    shapes, _, index, parent, _, _ = components(ctx, comp_kernels.KIND_CODES[op.kind], cursor, op.site, op.span,
-                                                index_of)
+    shapes, _, index, parent, _, _, _ = components(ctx, comp_kernels.KIND_CODES[op.kind], cursor, op.site,
+                                                   op.span, index_of)
     shapes = take_apart(ctx, cursor, shapes, parent)
     ctx.count(shapes, op.span)
     order, offsets = group_by(index % len(op.parts), len(op.parts))
@@ -69,12 +69,14 @@ def comp_faces(ctx: Context, cursor: Shapes, op: ir.CompFaces) -> Parts:
     chunk = ctx.chunk
     kind = {"f": "faces", "e": "edges", "v": "vertices"}[op.kind]
     borders = bool({"border", "inside"} & set(op.selectors))
-    shapes, normal, _, parent, roof, border = components(ctx, comp_kernels.KIND_CODES[kind], cursor, op.site,
-                                                         op.span, borders=borders)
+    shapes, normal, _, parent, roof, border, axes = components(ctx, comp_kernels.KIND_CODES[kind], cursor,
+                                                               op.site, op.span, borders=borders)
     shapes = take_apart(ctx, cursor, shapes, parent)
     if op.kind == "f":
+        framed = shapes.frame
         shapes = _face_scopes(ctx, shapes, cursor, parent, op.span)
-    axes = chunk.frames[shapes.frame]
+        if shapes.frame is not framed:  # faces turned: their new axes
+            axes = chunk.frames[shapes.frame]
     slot = ctx.plan.trim_slot
     if op.kind == "f" and slot is not None:
         # the faces' trim planes where they meet their neighbours (``geometry.trim``)
@@ -134,8 +136,8 @@ def components(ctx: Context, kind: int, cursor: Shapes, site: int, span, wanted=
     ``offset`` made: a border edge meets one face, a border face or vertex touches a border edge. A flat
     shape is one face, all of it border; a solid (a box, a prism) and a roof or other mesh that is
     closed have no border, all of them inside (found only with ``borders``; else no component is on a
-    border). ``wanted`` (n,) keeps, per shape, only that index. Roofs (meshes) have faces and edges
-    (``comp_faces`` and ``comp`` check)."""
+    border); and their scopes' axes (m, 3, 3), the rows of their frames. ``wanted`` (n,) keeps, per
+    shape, only that index. Roofs (meshes) have faces and edges (``comp_faces`` and ``comp`` check)."""
     chunk = ctx.chunk
     mesh = is_mesh(cursor.geom)
     pieces = []
@@ -170,7 +172,7 @@ def components(ctx: Context, kind: int, cursor: Shapes, site: int, span, wanted=
                     child.dynamic)
     shapes = with_corners(ctx.plan, shapes, corner)
     return (with_context(ctx.plan, shapes, "comp", index, parent, len(cursor)), normal, index, parent, roof,
-            border)
+            border, world_axes)
 
 
 def _solid_components(chunk, kind: int, cursor: Shapes, solid: np.ndarray, corner: np.ndarray | None):
