@@ -100,29 +100,31 @@ def row_groups(keys: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return groups, order[new]
 
 
-def group_bounds(group: np.ndarray, n: int, values: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def group_bounds(group: np.ndarray, n: int, *values: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Each group's lowest and highest values (n, d): what ``np.minimum.at`` and ``np.maximum.at`` into
     ``inf`` / ``-inf`` give (a NaN wins, a group without items keeps the infinities), in one pass of a
-    kernel (``ufunc.at`` is slow on rows). ``group`` (k,) in [0, n), in any order; ``values`` (k, d).
+    kernel (``ufunc.at`` is slow on rows). ``group`` (k,) in [0, n), in any order; ``values`` one or more
+    (k, d) arrays whose rows are all of those groups (a segment's starts and ends: no concatenation).
 
     group [1, 0, 1], values [[2], [5], [-1]] -> low [[5], [-1]], high [[5], [2]]."""
     return _group_bounds(np.ascontiguousarray(group, dtype=np.int64), n,
-                         np.ascontiguousarray(values, dtype=np.float64))
+                         tuple(np.ascontiguousarray(v, dtype=np.float64) for v in values))
 
 
 @njit(cache=True, nogil=True)
 def _group_bounds(group, n, values):
-    low = np.full((n, values.shape[1]), np.inf)
-    high = np.full((n, values.shape[1]), -np.inf)
-    for k in range(len(group)):
-        g = group[k]
-        for j in range(values.shape[1]):
-            v = values[k, j]
-            # as np.minimum / np.maximum: a NaN, once met, stays
-            if v < low[g, j] or np.isnan(v):
-                low[g, j] = v
-            if v > high[g, j] or np.isnan(v):
-                high[g, j] = v
+    low = np.full((n, values[0].shape[1]), np.inf)
+    high = np.full((n, values[0].shape[1]), -np.inf)
+    for rows in values:
+        for k in range(len(group)):
+            g = group[k]
+            for j in range(rows.shape[1]):
+                v = rows[k, j]
+                # as np.minimum / np.maximum: a NaN, once met, stays
+                if v < low[g, j] or np.isnan(v):
+                    low[g, j] = v
+                if v > high[g, j] or np.isnan(v):
+                    high[g, j] = v
     return low, high
 
 

@@ -147,6 +147,15 @@ def test_group_bounds_are_what_minimum_at_and_maximum_at_give(n):
     np.testing.assert_array_equal(high, want_high)
 
 
+def test_group_bounds_of_several_arrays_are_those_of_their_rows_together():
+    rng = np.random.default_rng(3)
+    group = rng.integers(0, 4, 50)
+    start, end = rng.normal(size=(50, 2)), rng.normal(size=(50, 2))
+    end[7, 1] = np.nan
+    together = group_bounds(np.tile(group, 2), 4, np.concatenate([start, end]))
+    np.testing.assert_array_equal(group_bounds(group, 4, start, end), together)
+
+
 def test_group_bounds_docstring_example():
     low, high = group_bounds(np.array([1, 0, 1]), 2, np.array([[2.0], [5.0], [-1.0]]))
     assert low.tolist() == [[5.0], [-1.0]] and high.tolist() == [[5.0], [2.0]]

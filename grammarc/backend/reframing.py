@@ -28,11 +28,12 @@ def turned(ctx: Context, shapes: Shapes, turn: np.ndarray, matrices: np.ndarray,
     frames: ``NORMAL_UP``, ``NORMAL_OUT``) around their unchanged geometry."""
     if not turn.any():
         return shapes
-    rows, others = np.flatnonzero(turn), np.flatnonzero(~turn)
-    sub = shapes.take(rows)
+    rows = np.flatnonzero(turn)
+    sub = shapes.take(turn)  # the batch itself where all turn (a comp(f)'s faces, extruded)
     new_axes = turned_frames(matrices[axis[rows]], ctx.chunk.frames.data, sub.frame)
-    if not len(others):  # all turn (a comp(f)'s faces, extruded): nothing to merge them with
+    if len(rows) == len(shapes):  # nothing to merge them with
         return reframed(ctx, sub, new_axes, span)
+    others = np.flatnonzero(~turn)
     return Shapes.merge([shapes.take(others), reframed(ctx, sub, new_axes, span)], [others, rows])
 
 

@@ -237,7 +237,7 @@ def closed_arm_insets(insets: np.ndarray, polygons: np.ndarray, distance: np.nda
     parts = shapely.orient_polygons(parts, exterior_cw=False)
     parents = shapely.orient_polygons(polygons[rows], exterior_cw=False)
     _, flat, (closed_rings, part_offsets) = shapely.to_ragged_array(parts)
-    # a face offset as its valid parts is a multipolygon (``offsets._inset_and_border``): its rings are
+    # a face offset as its valid parts is a multipolygon (``offsets._offset_regions``): its rings are
     # those of all its parts
     _, parent_flat, (parent_closed, *parent_parts) = shapely.to_ragged_array(parents)
     parent_offsets = parent_parts[0] if len(parent_parts) == 1 else parent_parts[0][parent_parts[1]]

@@ -53,13 +53,6 @@ def _axes_of(plane):
 
 
 @njit(cache=True, nogil=True)
-def _cross(a, b):
-    out = np.empty(3)
-    _cross_into(a, b, out)
-    return out
-
-
-@njit(cache=True, nogil=True)
 def _cross_into(a, b, out):
     """a cross b, written into ``out`` (3,): the kernel's loops over edges allocate nothing."""
     out[0] = a[1] * b[2] - a[2] * b[1]
@@ -68,21 +61,13 @@ def _cross_into(a, b, out):
 
 
 @njit(cache=True, nogil=True)
-def _edge(coords, j, r0, count, a, b, size_row):
-    """Ring edge from vertex j to its successor in local coordinates: start p (3,), unit direction and
-    length (the direction is zero for a zero-length edge)."""
-    p = np.zeros(3)
-    d = np.zeros(3)
-    length = _edge_into(coords, j, r0, count, a, b, size_row, p, d)
-    return p, d, length
-
-
-@njit(cache=True, nogil=True)
 def _edge_into(coords, j, r0, count, a, b, size_row, p, d):
-    """``_edge`` written into ``p`` and ``d`` (3,); returns the length."""
+    """Ring edge from vertex j to its successor in local coordinates, written into ``p`` (its start) and
+    ``d`` (3,) (its unit direction, zero for a zero-length edge); returns its length."""
     k = r0 + (j - r0 + 1) % count
-    p[:] = 0.0
-    d[:] = 0.0
+    for c in range(3):
+        p[c] = 0.0
+        d[c] = 0.0
     p[a] = coords[j, 0] * size_row[a]
     p[b] = coords[j, 1] * size_row[b]
     d[a] = coords[k, 0] * size_row[a] - p[a]
@@ -95,20 +80,27 @@ def _edge_into(coords, j, r0, count, a, b, size_row, p, d):
 
 
 @njit(cache=True, nogil=True)
-def _side_edge_normal(coords, j, r0, count, a, b, size_row, d, nvec, tol):
-    """The z axis of the side edge at ring vertex j, whose outgoing edge has direction ``d``: the mean of
-    the outward normals of the side faces before and after it, as CityEngine points an edge's z along the
-    mean of its faces' normals (PRT: a prism's corner edges look along the corner's bisector); the normal
-    after it where the two cancel (a spike) or no edge before it has a length."""
-    after = _cross(d, nvec)
+def _side_edge_normal(coords, j, r0, count, a, b, size_row, d, nvec, tol, scratch, z):
+    """The z axis of the side edge at ring vertex j, whose outgoing edge has direction ``d``, written into
+    ``z`` (3,): the mean of the outward normals of the side faces before and after it, as CityEngine points
+    an edge's z along the mean of its faces' normals (PRT: a prism's corner edges look along the corner's
+    bisector); the normal after it where the two cancel (a spike) or no edge before it has a length.
+    ``scratch`` (4, 3) holds the normal after, the edge before (start, direction) and its normal."""
+    after, p, before, mean = scratch[0], scratch[1], scratch[2], scratch[3]
+    _cross_into(d, nvec, after)
     for back in range(1, count):
         q = r0 + (j - r0 - back) % count
-        _, before, length = _edge(coords, q, r0, count, a, b, size_row)
+        length = _edge_into(coords, q, r0, count, a, b, size_row, p, before)
         if length > tol:
-            mean = _cross(before, nvec) + after
+            _cross_into(before, nvec, mean)
+            for c in range(3):
+                mean[c] = mean[c] + after[c]
             norm = np.sqrt(mean[0] * mean[0] + mean[1] * mean[1] + mean[2] * mean[2])
-            return mean / norm if norm > tol else after
-    return after
+            for c in range(3):
+                z[c] = mean[c] / norm if norm > tol else after[c]
+            return
+    for c in range(3):
+        z[c] = after[c]
 
 
 @njit(cache=True, nogil=True)
@@ -116,11 +108,12 @@ def _put(out, m, i, o, x, y, z, s, code):
     """Write component m: parent i, origin o, axes x, y, z (rows), size s (3,), geometry code."""
     parent, origin, axes, csize, poly = out
     parent[m] = i
-    origin[m] = o
-    axes[m, 0] = x
-    axes[m, 1] = y
-    axes[m, 2] = z
-    csize[m] = s
+    for c in range(3):  # element by element: a row assigned whole costs a broadcast each time
+        origin[m, c] = o[c]
+        axes[m, 0, c] = x[c]
+        axes[m, 1, c] = y[c]
+        axes[m, 2, c] = z[c]
+        csize[m, c] = s[c]
     poly[m] = code
     return m + 1
 
@@ -176,15 +169,16 @@ def components(kind, coords, ring_offsets, shape_offsets, plane, size, tol, turn
         total += _count(kind, n_edges, volume)
     parent = np.empty(total, np.int64)
     index = np.empty(total, np.int64)
-    origin = np.zeros((total, 3))
-    axes = np.zeros((total, 3, 3))
-    csize = np.zeros((total, 3))
-    poly = np.zeros(total, np.int8)
+    origin = np.empty((total, 3))  # every component's row is written whole (``_put``)
+    axes = np.empty((total, 3, 3))
+    csize = np.empty((total, 3))
+    poly = np.empty(total, np.int8)
     out = (parent, origin, axes, csize, poly)
     # one edge's start, direction, outward normal, size and lifted start, and one shape's axes (its
     # normal, then negated, and its in-plane axes), a cap's y and origin: used again, nothing allocated
     p, d, outward, s, lifted = np.zeros(3), np.zeros(3), np.zeros(3), np.zeros(3), np.zeros(3)
     nvec, negn, avec, bvec, y, o = np.zeros(3), np.zeros(3), np.zeros(3), np.zeros(3), np.zeros(3), np.zeros(3)
+    z, scratch = np.zeros(3), np.zeros((4, 3))  # a side edge's z, and what finding it needs
     m = 0
     for i in range(n):
         a, b, nrm = _axes_of(plane[i])
@@ -251,7 +245,7 @@ def components(kind, coords, ring_offsets, shape_offsets, plane, size, tol, turn
                     length = _edge_into(coords, j, r0, count, a, b, size[i], p, d)
                     if length <= tol:
                         continue
-                    z = _side_edge_normal(coords, j, r0, count, a, b, size[i], d, nvec, tol)
+                    _side_edge_normal(coords, j, r0, count, a, b, size[i], d, nvec, tol, scratch, z)
                     _cross_into(z, nvec, outward)
                     m = _put(out, m, i, p, nvec, outward, z, _sized(s, h, 0.0), RECT)
         if volume and (kind == 0 or kind == 2):

@@ -11,10 +11,11 @@ polygon issue.
 from __future__ import annotations
 
 import numpy as np
+from numba import njit
 
 from grammarc.constants import TOL
 from grammarc.geometry.polygons import PLANE_U, PLANE_V
-from grammarc.ragged import next_in_segment, segment_of, segment_reduce
+from grammarc.ragged import ragged_take, segment_reduce
 
 #: Per normal axis n: new scope axes, as rows in the old frame, that put y along axis n and keep x where
 #: they can (CityEngine's extrude and roofs: "x kept, y along the normal, z = x cross y").
@@ -48,32 +49,88 @@ def reframe(origin, size, axes, coords, ring_offsets, shape_offsets, plane, new_
     new_plane = np.argmax(alignment, axis=1)
     ok = alignment[rows, new_plane] > 1 - 1e-9
     height = size[rows, plane]
-    vertex_shape = segment_of(shape_offsets)[segment_of(ring_offsets)]
-    s = vertex_shape
     # each shape's in-plane axes, scaled by its size, in the new axes: a vertex is u, v along them
     along_u = np.einsum("nj,nij->ni", axes[rows, a] * size[rows, a, None], new_axes)
     along_v = np.einsum("nj,nij->ni", axes[rows, b] * size[rows, b, None], new_axes)
-    local = coords[:, 0, None] * along_u[s] + coords[:, 1, None] * along_v[s]  # from the old origin
+    ring_offsets = np.asarray(ring_offsets, dtype=np.int64)
+    shape_offsets = np.asarray(shape_offsets, dtype=np.int64)
+    local, low, high, tied = _local(np.ascontiguousarray(coords, dtype=np.float64), ring_offsets, shape_offsets,
+                                    along_u, along_v)  # from the old origin
     vertex_offsets = ring_offsets[shape_offsets]
-    low = segment_reduce(np.minimum, local, vertex_offsets, 0.0)
-    high = segment_reduce(np.maximum, local, vertex_offsets, 0.0)
+    tied = np.flatnonzero(tied)
+    if len(tied):  # which of -0.0 and 0.0, or which NaN, numpy's bounds keep: as numpy finds them
+        items, packed = ragged_take(vertex_offsets, tied)
+        low[tied] = segment_reduce(np.minimum, local[items], packed, 0.0)
+        high[tied] = segment_reduce(np.maximum, local[items], packed, 0.0)
     plane = new_plane
-    a, b = PLANE_U[plane], PLANE_V[plane]
     new_size = high - low
     new_size[rows, plane] = height
     shift = low.copy()
     shift[rows, plane] = 0.0
     new_origin = origin + np.einsum("ni,nij->nj", shift, new_axes)
-    u = local[np.arange(len(s)), a[s]] - low[s, a[s]]
-    v = local[np.arange(len(s)), b[s]] - low[s, b[s]]
+    a, b = PLANE_U[plane], PLANE_V[plane]
     extent_a = np.where(new_size[rows, a] > TOL.zero, new_size[rows, a], 1.0)
     extent_b = np.where(new_size[rows, b] > TOL.zero, new_size[rows, b], 1.0)
-    new_coords = np.stack([u / extent_a[s], v / extent_b[s]], axis=1)
+    new_coords, cross = _normalized(local, ring_offsets, shape_offsets, low[rows, a], low[rows, b], a, b,
+                                    extent_a, extent_b)
     # a rectangle lined up with the new axes: one ring of 4 vertices filling its box
-    nxt = next_in_segment(ring_offsets)
-    cross = new_coords[:, 0] * new_coords[nxt, 1] - new_coords[nxt, 0] * new_coords[:, 1]
     area = np.abs(segment_reduce(np.add, cross, vertex_offsets, 0.0)) / 2
     one_ring = np.diff(shape_offsets) == 1
     four = np.diff(vertex_offsets) == 4
     is_rect = one_ring & four & (np.abs(area - 1.0) <= TOL.rect)
     return ok, new_plane.astype(np.int8), new_origin, new_size, is_rect, new_coords
+
+
+@njit(cache=True, nogil=True)
+def _local(coords, ring_offsets, shape_offsets, along_u, along_v):
+    """Each vertex (V, 3) in its shape's new axes from its old origin, ``u along_u + v along_v`` of its
+    shape (n, 3), and each shape's lowest and highest (n, 3) (0 for a shape without vertices), in one
+    pass instead of a gather of each shape's row per vertex and two ``reduceat``.
+
+    Where a shape's values on an axis hold both -0.0 and 0.0, or a NaN, the bound's bits depend on the
+    order numpy's reduction compares them in: such shapes are ``tied`` (n,) bool, for numpy to bound."""
+    n = len(shape_offsets) - 1
+    local = np.empty((len(coords), 3))
+    low = np.zeros((n, 3))
+    high = np.zeros((n, 3))
+    tied = np.zeros(n, np.bool_)
+    for i in range(n):
+        start, stop = ring_offsets[shape_offsets[i]], ring_offsets[shape_offsets[i + 1]]
+        for k in range(3):
+            positive_zero = negative_zero = False
+            for v in range(start, stop):
+                x = coords[v, 0] * along_u[i, k] + coords[v, 1] * along_v[i, k]
+                local[v, k] = x
+                if v == start or x < low[i, k]:
+                    low[i, k] = x
+                if v == start or x > high[i, k]:
+                    high[i, k] = x
+                if x == 0.0:
+                    if np.signbit(x):
+                        negative_zero = True
+                    else:
+                        positive_zero = True
+                elif np.isnan(x):
+                    tied[i] = True
+            if positive_zero and negative_zero:
+                tied[i] = True
+    return local, low, high, tied
+
+
+@njit(cache=True, nogil=True)
+def _normalized(local, ring_offsets, shape_offsets, low_a, low_b, a, b, extent_a, extent_b):
+    """The new normalized coordinates (V, 2) of the vertices ``local`` (V, 3): their shape's new in-plane
+    axes ``a`` and ``b`` (n,) from its lowest corner (``low_a``, ``low_b`` (n,)) over its extents (n,);
+    and each vertex's term of its shape's doubled signed area (V,), x_k y_k+1 - x_k+1 y_k along its ring."""
+    coords = np.empty((len(local), 2))
+    cross = np.empty(len(local))
+    for i in range(len(shape_offsets) - 1):
+        for v in range(ring_offsets[shape_offsets[i]], ring_offsets[shape_offsets[i + 1]]):
+            coords[v, 0] = (local[v, a[i]] - low_a[i]) / extent_a[i]
+            coords[v, 1] = (local[v, b[i]] - low_b[i]) / extent_b[i]
+        for ring in range(shape_offsets[i], shape_offsets[i + 1]):
+            first, last = ring_offsets[ring], ring_offsets[ring + 1]
+            for v in range(first, last):
+                w = v + 1 if v + 1 < last else first
+                cross[v] = coords[v, 0] * coords[w, 1] - coords[w, 0] * coords[v, 1]
+    return coords, cross

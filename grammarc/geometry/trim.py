@@ -40,11 +40,22 @@ def side_face_planes(axes: np.ndarray, origin: np.ndarray, size: np.ndarray, par
     world coordinates."""
     if not len(parent):
         return np.full((0, 8), np.nan)
-    end = origin + size[:, 0:1] * axes[:, 0]
+    end = bottom_ends(origin, size, axes)
     (first, last), _ = _corner_cells(parent, origin, end)
     # the neighbour sharing each face's start / end
     before, after = _neighbours(np.argsort(parent, kind="stable"), parent, first, last)
     return _bisector_planes(axes, origin, end, size, up, before, after, np.sin(np.radians(VERTICAL_DEGREES)))
+
+
+@njit(cache=True, nogil=True)
+def bottom_ends(origin, size, axes):
+    """The end of each face's bottom edge (m, 3), the edge from its ``origin`` (m, 3) along its x, ``axes``
+    (m, 3, 3) rows: ``origin + size[:, 0:1] * axes[:, 0]`` in one pass."""
+    end = np.empty((len(origin), 3))
+    for i in range(len(origin)):
+        for j in range(3):
+            end[i, j] = origin[i, j] + size[i, 0] * axes[i, 0, j]
+    return end
 
 
 @njit(cache=True, nogil=True)
@@ -146,29 +157,43 @@ def shallow_edge_planes(verts: np.ndarray, ring_offsets: np.ndarray, face_offset
     return out
 
 
-def _corner_cells(parent: np.ndarray, *points: np.ndarray) -> tuple[list[np.ndarray], np.ndarray]:
-    """The grid cells (k, 3) int64 that corners ``points`` (each (k, 3)) of parents ``parent`` (k,) are
-    matched on, and the grid's spacing (k, 1): 1e-7 of the parent's extent (1 at least), from the
+def _corner_cells(parent: np.ndarray, start: np.ndarray, end: np.ndarray) -> tuple[list[np.ndarray], np.ndarray]:
+    """The grid cells (k, 3) int64 that corners ``start`` and ``end`` (each (k, 3)) of parents ``parent`` (k,)
+    are matched on, and the grid's spacing (k, 1): 1e-7 of the parent's extent (1 at least), from the
     parent's lowest corner. Per parent and from its own corner, so that a lot far from the origin
     (national-grid coordinates) is matched as it would be at the origin and coarsens no other lot's
     matching in its chunk (a grid of its coordinates' magnitude, 0.8 m at 7.8e6, made the corners of
     complexpatterns' 0.6 m deep top floors one corner)."""
-    low, high = group_bounds(np.tile(parent, len(points)), int(parent.max()) + 1, np.concatenate(points))
-    scale = np.maximum((high - low).max(axis=1), 1.0) * 1e-7
-    return [_cells(parent, low, scale, np.ascontiguousarray(p, dtype=np.float64)) for p in points], scale[parent][:, None]
+    parent = np.ascontiguousarray(parent, dtype=np.int64)
+    start, end = np.ascontiguousarray(start, dtype=np.float64), np.ascontiguousarray(end, dtype=np.float64)
+    low, high = group_bounds(parent, int(parent.max()) + 1, start, end)
+    first, last, scale = _cells(parent, low, high, start, end)
+    return [first, last], scale[parent][:, None]
 
 
 @njit(cache=True, nogil=True)
-def _cells(parent, low, scale, points):
-    """``round((points - low[parent]) / scale[parent])`` as int64 in one pass, as numpy rounds (half to
-    even) and casts (a value beyond int64, or not finite, is int64's least, as numpy's cast gives it here)."""
-    out = np.empty(points.shape, np.int64)
-    for k in range(len(parent)):
-        g = parent[k]
-        for j in range(points.shape[1]):
-            cell = np.rint((points[k, j] - low[g, j]) / scale[g])
-            out[k, j] = np.int64(cell) if abs(cell) < 9.2e18 else np.iinfo(np.int64).min
-    return out
+def _cells(parent, low, high, start, end):
+    """``_corner_cells`` from each parent's lowest and highest corner (n, 3): its spacing (n,), numpy's
+    (the largest extent, a NaN winning, at least 1, times 1e-7), and ``round((points - low[parent]) /
+    scale[parent])`` as int64, as numpy rounds (half to even) and casts (a value beyond int64, or not
+    finite, is int64's least, as numpy's cast gives it here), for the starts and the ends."""
+    scale = np.empty(len(low))
+    for g in range(len(low)):
+        extent = high[g, 0] - low[g, 0]
+        for j in range(1, 3):
+            d = high[g, j] - low[g, j]
+            if not np.isnan(extent) and (d > extent or np.isnan(d)):
+                extent = d
+        scale[g] = (extent if extent > 1.0 or np.isnan(extent) else 1.0) * 1e-7
+    first = np.empty(start.shape, np.int64)
+    last = np.empty(end.shape, np.int64)
+    for points, out in ((start, first), (end, last)):
+        for k in range(len(parent)):
+            g = parent[k]
+            for j in range(3):
+                cell = np.rint((points[k, j] - low[g, j]) / scale[g])
+                out[k, j] = np.int64(cell) if abs(cell) < 9.2e18 else np.iinfo(np.int64).min
+    return first, last, scale
 
 
 @njit(cache=True, nogil=True)

@@ -8,7 +8,14 @@ import numpy as np
 import pytest
 
 from grammarc.backend.kernels.order import group_by, place, put, scatter_rows, tally
-from grammarc.backend.kernels.scope import component_frames, leaf_kinds, place_children, turned_frames, xforms
+from grammarc.backend.kernels.scope import (
+    component_frames,
+    leaf_kinds,
+    place_children,
+    translated,
+    turned_frames,
+    xforms,
+)
 from grammarc.backend.kernels.split import repeat, repeat_counts, subdiv
 from grammarc.backend.kernels.texture import instance_maps
 from grammarc.backend.random import child_keys
@@ -302,6 +309,18 @@ def test_component_frames_give_einsums_bits_signed_zeros_included(n):
     assert np.array_equal(world_axes.view(np.int64), want_axes.view(np.int64))
     assert np.array_equal(bad, ~(np.abs(gram - np.eye(3)) < 1e-6).all(axis=(1, 2)))
     assert bad[1::7].all()
+
+
+@pytest.mark.parametrize("n", SIZES)
+def test_translated_gives_einsums_bits_signed_zeros_included(n):
+    rng = np.random.default_rng(n)
+    frames = random_frames(rng, 4)
+    frames[3] = np.eye(3) * np.array([1.0, -1.0, -1.0])[:, None]  # signed zeros
+    frame = rng.integers(0, 4, n).astype(np.int32)
+    origin = np.where(rng.random((n, 3)) < 0.3, -0.0, rng.normal(size=(n, 3)) * 100)
+    local = np.where(rng.random((n, 3)) < 0.3, -0.0, rng.normal(size=(n, 3)))
+    want = origin + np.einsum("ni,nij->nj", local, frames[frame])
+    assert np.array_equal(translated(origin, local, frames, frame).view(np.int64), want.view(np.int64))
 
 
 @pytest.mark.parametrize("n", SIZES)

@@ -130,6 +130,22 @@ def leaf_xforms(origin, base, size, frame, frames, axis, rows, parent, pos, leng
 
 
 @njit(cache=True, nogil=True)
+def translated(origin, local, frames, frame):
+    """Origins (n, 3) moved by ``local`` (n, 3) along their scopes' axes (``frame`` (n,) int32 ids into the
+    table ``frames``): ``origin + np.einsum("ni,nij->nj", local, frames[frame])``, each sum from 0.0 in axis
+    order as einsum's (the same bits), without gathering a frame per shape."""
+    out = np.empty((len(frame), 3))
+    for c in range(len(frame)):
+        f = frame[c]
+        for j in range(3):
+            delta = 0.0
+            for i in range(3):
+                delta += local[c, i] * frames[f, i, j]
+            out[c, j] = origin[c, j] + delta
+    return out
+
+
+@njit(cache=True, nogil=True)
 def component_frames(frames, frame, origin, local_origin, local_axes, tol):
     """World scopes of components: ``origin + local_origin @ frames[frame]`` (m, 3) and
     ``local_axes @ frames[frame]`` (m, 3, 3) (``_times_frame``: einsum's bits), and whether each
@@ -137,19 +153,13 @@ def component_frames(frames, frame, origin, local_origin, local_axes, tol):
     square). ``frame`` (m,) int32 the parents' frame ids, ``origin`` (m, 3) their origins,
     ``local_origin`` and ``local_axes`` in the parents' frames."""
     m = len(frame)
-    out_origin = np.empty((m, 3))
+    out_origin = translated(origin, local_origin, frames, frame)
     out_axes = np.empty((m, 3, 3))
     bad = np.zeros(m, np.bool_)
     for c in range(m):
-        f = frame[c]
-        for j in range(3):
-            moved = 0.0
-            for i in range(3):
-                moved += local_origin[c, i] * frames[f, i, j]
-            out_origin[c, j] = origin[c, j] + moved
-        _times_frame(local_axes, c, frames, f, out_axes)
+        _times_frame(local_axes, c, frames, frame[c], out_axes)
         for r in range(3):
-            for k in range(3):
+            for k in range(r, 3):  # axis k . axis r is axis r . axis k
                 dot = 0.0
                 for j in range(3):
                     dot += local_axes[c, r, j] * local_axes[c, k, j]

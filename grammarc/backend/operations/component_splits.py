@@ -11,6 +11,7 @@ cursor.
 
 from __future__ import annotations
 
+import functools
 from dataclasses import replace
 
 import numpy as np
@@ -35,7 +36,7 @@ from grammarc.geometry import components as comp_kernels
 from grammarc.geometry.meshes import is_mesh, is_polygon
 from grammarc.geometry.queries import shape_faces
 from grammarc.geometry.reframe import NORMAL_OUT
-from grammarc.geometry.trim import shallow_edge_planes, side_face_planes
+from grammarc.geometry.trim import bottom_ends, shallow_edge_planes, side_face_planes
 from grammarc.ir import nodes as ir
 from grammarc.ir.printer import comp_selectors
 from grammarc.ragged import rank_within
@@ -48,8 +49,8 @@ def comp(ctx: Context, cursor: Shapes, op: ir.Comp) -> Parts:
     index_of = None
     if op.index is not None:
         index_of = evaluate_array(op.index, ctx.env(cursor))
-    shapes, _, index, parent, _, _ = components(ctx, comp_kernels.KIND_CODES[op.kind], cursor, op.site, op.span,
-                                                index_of)
+    shapes, _, index, parent, _, _, _ = components(ctx, comp_kernels.KIND_CODES[op.kind], cursor, op.site,
+                                                   op.span, index_of)
     shapes = take_apart(ctx, cursor, shapes, parent)
     ctx.count(shapes, op.span)
     order, offsets = group_by(index % len(op.parts), len(op.parts))
@@ -68,18 +69,21 @@ def comp_faces(ctx: Context, cursor: Shapes, op: ir.CompFaces) -> Parts:
     chunk = ctx.chunk
     kind = {"f": "faces", "e": "edges", "v": "vertices"}[op.kind]
     borders = bool({"border", "inside"} & set(op.selectors))
-    shapes, normal, _, parent, roof, border = components(ctx, comp_kernels.KIND_CODES[kind], cursor, op.site,
-                                                         op.span, borders=borders)
+    shapes, normal, _, parent, roof, border, axes = components(ctx, comp_kernels.KIND_CODES[kind], cursor,
+                                                               op.site, op.span, borders=borders)
     shapes = take_apart(ctx, cursor, shapes, parent)
     if op.kind == "f":
+        framed = shapes.frame
         shapes = _face_scopes(ctx, shapes, cursor, parent, op.span)
+        if shapes.frame is not framed:  # faces turned: their new axes
+            axes = chunk.frames[shapes.frame]
     slot = ctx.plan.trim_slot
     if op.kind == "f" and slot is not None:
         # the faces' trim planes where they meet their neighbours (``geometry.trim``)
         # relative to the lot's origin, so that a lot far from the origin is trimmed as it is there
-        up = chunk.frames[cursor.frame[parent]][:, 1]
+        up = chunk.frames.data[cursor.frame, 1][parent]
         origin = shapes.origin - chunk.lot_origin[shapes.lot]
-        planes = side_face_planes(chunk.frames[shapes.frame], origin, shapes.size, parent, up)
+        planes = side_face_planes(axes, origin, shapes.size, parent, up)
         dynamic = list(shapes.dynamic)
         dynamic[slot:slot + 8] = list(planes.T)
         shallow = ctx.plan.horizontal_slot
@@ -100,27 +104,28 @@ def comp_faces(ctx: Context, cursor: Shapes, op: ir.CompFaces) -> Parts:
     if borders:
         picked.update({"border": border, "inside": ~border})
     if op.kind == "f":
-        axes = chunk.frames[shapes.frame]
-        base = (shapes.origin, shapes.origin + axes[:, 0] * shapes.size[:, :1])  # each face's bottom edge
+        base = (shapes.origin, bottom_ends(shapes.origin, shapes.size, axes))  # each face's bottom edge
         which = classify_faces(normal, op.selectors, selector_frames(chunk, normal, cursor, parent, op.selectors,
                                                                       base), picked)
     else:
-        direction = chunk.frames[shapes.frame][:, 0] if op.kind == "e" else None
+        direction = axes[:, 0] if op.kind == "e" else None
         which = classify_edges(direction, op.selectors, len(shapes), picked, roof)
-    keep = which < len(op.selectors)
-    shapes, which, parent = shapes.take(keep), which[keep], parent[keep]
+    # the selected components grouped by body part, taken in one gather: numbered in face order first
+    kept = np.flatnonzero(which < len(op.selectors))
+    which, parent = which[kept], parent[kept]
+    order, offsets = group_by(which, len(op.parts))
+    shapes = shapes.take(kept[order])
     if ctx.plan.sequential_random:  # PRT makes shapes of the selected faces only, numbered in face order
-        shapes = replace(shapes, key=piece_keys(True, cursor.key[parent], rank_within(parent), op.site))
+        number = rank_within(parent)[order]
+        shapes = replace(shapes, key=piece_keys(True, cursor.key[parent[order]], number, op.site))
     if {"comp.index", "comp.total", "comp.sel"} & set(ctx.plan.dynamic):
         # CityEngine numbers the components of each selector: the front face is 0 of 1
         group = parent * (len(op.selectors) + 1) + which
-        rank = rank_within(group)
+        rank, n_groups = rank_within(group)[order], int(group.max(initial=0)) + 1
         ids = np.array([ctx.plan.strings.ids[s] for s in comp_selectors(op)], dtype=np.int32)
-        shapes = with_context(ctx.plan, shapes, "comp", rank, group, int(group.max(initial=0)) + 1,
-                              selector=ids[which])
+        shapes = with_context(ctx.plan, shapes, "comp", rank, group[order], n_groups, selector=ids[which[order]])
     ctx.count(shapes, op.span)
-    order, offsets = group_by(which, len(op.parts))
-    return Parts(op.parts, shapes.take(order), offsets)
+    return Parts(op.parts, shapes, offsets)
 
 
 def components(ctx: Context, kind: int, cursor: Shapes, site: int, span, wanted=None, borders: bool = False):
@@ -131,14 +136,13 @@ def components(ctx: Context, kind: int, cursor: Shapes, site: int, span, wanted=
     ``offset`` made: a border edge meets one face, a border face or vertex touches a border edge. A flat
     shape is one face, all of it border; a solid (a box, a prism) and a roof or other mesh that is
     closed have no border, all of them inside (found only with ``borders``; else no component is on a
-    border). ``wanted`` (n,) keeps, per shape, only that index. Roofs (meshes) have faces and edges
-    (``comp_faces`` and ``comp`` check)."""
+    border); and their scopes' axes (m, 3, 3), the rows of their frames. ``wanted`` (n,) keeps, per
+    shape, only that index. Roofs (meshes) have faces and edges (``comp_faces`` and ``comp`` check)."""
     chunk = ctx.chunk
     mesh = is_mesh(cursor.geom)
     pieces = []
     if not mesh.all():
-        pieces.append(_solid_components(chunk, kind, cursor, np.flatnonzero(~mesh),
-                                        corners(ctx.plan, cursor)))
+        pieces.append(_solid_components(chunk, kind, cursor, ~mesh, corners(ctx.plan, cursor)))
     if mesh.any():
         which = np.flatnonzero(mesh)
         parent, index, origin, axes, size, geom, roof, border = mesh_shapes.mesh_components(
@@ -168,16 +172,16 @@ def components(ctx: Context, kind: int, cursor: Shapes, site: int, span, wanted=
                     child.dynamic)
     shapes = with_corners(ctx.plan, shapes, corner)
     return (with_context(ctx.plan, shapes, "comp", index, parent, len(cursor)), normal, index, parent, roof,
-            border)
+            border, world_axes)
 
 
-def _solid_components(chunk, kind: int, cursor: Shapes, which: np.ndarray, corner: np.ndarray | None):
-    """Components of the boxes, polygons and prisms ``which`` of ``cursor`` (whose box rings start at
-    ``corner`` (n,), None for corner 0): parent (into cursor), index, origin, axes, size (in the parents'
+def _solid_components(chunk, kind: int, cursor: Shapes, solid: np.ndarray, corner: np.ndarray | None):
+    """Components of the boxes, polygons and prisms ``solid`` (n,) bool of ``cursor`` (whose box rings start
+    at ``corner`` (n,), None for corner 0): parent (into cursor), index, origin, axes, size (in the parents'
     frames), geom, normal, roof (-1: no roof edges), border (the components of flat shapes), and the
     corner each box component's ring starts at."""
-    shapes = cursor.take(which)
-    corner = None if corner is None else corner[which]
+    shapes, which = cursor.take(solid), np.flatnonzero(solid)  # all of them taken as they are
+    corner = None if corner is None else corner[solid]
     coords, ring_offsets, shape_offsets, plane = polygons_of(chunk, shapes, corner)
     parent, index, origin, axes, size, poly = comp_kernels.components(
         kind, coords, ring_offsets, shape_offsets, plane, shapes.size, TOL.zero,
@@ -208,14 +212,27 @@ def _box_corners(poly: np.ndarray, plane: np.ndarray, geom: np.ndarray, parent: 
         return out
     same = poly == comp_kernels.SAME_POLY
     out[same] = corner[parent[same]]
-    for code, flip_where in ((comp_kernels.TOP_POLY, True), (comp_kernels.BOTTOM_POLY, False)):
-        rows = np.flatnonzero((poly == code) & (geom[parent] == -1))
-        if len(rows):
-            first = comp_kernels.rect_rings(plane[parent[rows]], corner[parent[rows]])[::4].copy()
-            flip = (plane[parent[rows]] == 1) == flip_where
-            first[flip, 1] = 1.0 - first[flip, 1]
-            out[rows] = comp_kernels.rect_corners(first, np.full(len(rows), 2))
+    for cap, code in enumerate((comp_kernels.TOP_POLY, comp_kernels.BOTTOM_POLY)):
+        rows = np.flatnonzero(poly == code)
+        rows = rows[geom[parent[rows]] == -1]
+        out[rows] = _cap_corners()[cap, plane[parent[rows]], corner[parent[rows]] % 4]
     return out
+
+
+@functools.cache
+def _cap_corners() -> np.ndarray:
+    """The corner (2, 3, 4) int64 a box's top (0) and bottom (1) face's ring starts at, by the box's plane
+    and its ring's corner: the box ring's first vertex, seen in the cap's plane (y flipped where the cap
+    runs against the box's second axis, as ``_cap_polygons`` flips a prism's)."""
+    plane, corner = np.repeat(np.arange(3), 4), np.tile(np.arange(4), 3)
+    first = comp_kernels.rect_rings(plane, corner)[::4]
+    table = np.empty((2, 3, 4), dtype=np.int64)
+    for cap, flip_where in enumerate((True, False)):
+        seen = first.copy()
+        flip = (plane == 1) == flip_where
+        seen[flip, 1] = 1.0 - seen[flip, 1]
+        table[cap] = comp_kernels.rect_corners(seen, np.full(len(plane), 2)).reshape(3, 4)
+    return table
 
 
 def _cap_polygons(chunk, geom: np.ndarray, which: str) -> np.ndarray:
@@ -242,5 +259,6 @@ def _face_scopes(ctx: Context, shapes: Shapes, cursor: Shapes, parent: np.ndarra
     along the face's normal (x kept, y = z cross x)."""
     axis = flat_axis(ctx.chunk, cursor)[parent]
     turn = (axis >= 0) & (axis != 2) & (shapes.geom > -2) & ~is_mesh(shapes.geom)
-    turn &= (shapes.size <= TOL.zero).sum(axis=1) == 1
+    rows = np.flatnonzero(turn)  # only these are asked whether they are flat (the faces of solids are not)
+    turn[rows] = (shapes.size[rows] <= TOL.zero).sum(axis=1) == 1
     return turned(ctx, shapes, turn, NORMAL_OUT, axis, span)

@@ -68,17 +68,9 @@ def offset(ctx: Context, cursor: Shapes, op: ir.Offset) -> Shapes:
 def _offset_selected(ctx: Context, cursor: Shapes, op: ir.Offset):
     """The pieces ``offset`` keeps of flat shapes: their insets, borders or both, each shape's inside
     pieces before its border's."""
-    if op.select == "all":
-        inset, border, plane, polygons, faces, owner, moves = _offset_polygons(ctx, op.distance, cursor, op.span)
-        pieces = fit_pieces(np.concatenate([inset, border]), np.tile(plane, 2), np.tile(faces.size, (2, 1)),
-                            np.tile(polygons, 2), insets=np.arange(2 * len(inset)) < len(inset),
-                            moves=np.concatenate([moves, np.full(len(moves), np.nan)]))
-        # each shape's inside pieces, then its border's
-        pieces = replace(pieces, source=owner[pieces.source % len(faces)])
-        pieces = pieces.take(np.argsort(pieces.source, kind="stable"))
-    else:
-        inside, border = _offset_pieces(ctx, op.distance, cursor, op.span)
-        pieces = inside if op.select == "inside" else border
+    pieces, _ = _fitted_pieces(ctx, op.distance, cursor, op.span, op.select)
+    if op.select == "all":  # each shape's inside pieces, then its border's
+        return pieces.take(np.argsort(pieces.source, kind="stable"))
     return pieces
 
 
@@ -93,10 +85,8 @@ def _roof_offsets(ctx: Context, roofs: Shapes, op: ir.Offset) -> tuple[Shapes, n
     if bad.any():  # a scope scaled beyond any coordinate: GEOS takes no ring of such faces
         ctx.fail_lots(roofs.lot[parent[bad]], "`offset` of a geometry whose coordinates are not finite", op.span)
     polygons = scope_polygons(ctx.chunk.polygons, geom, size)
-    inset, border = _inset_and_border(polygons, d[parent])
-    chosen = {"inside": [inset], "border": [border]}
-    chosen["all"] = chosen["inside"] + chosen["border"]
-    parts, which = shapely.get_parts(np.concatenate(chosen[op.select]), return_index=True)
+    parts, which = shapely.get_parts(np.concatenate(_offset_regions(polygons, d[parent], op.select)),
+                                     return_index=True)
     face = which % len(polygons)
     keep = shapely.area(parts) > TOL.zero
     parts, face = parts[keep], face[keep]
@@ -205,17 +195,17 @@ def _along_first_edges(ctx: Context, shapes: Shapes, pieces: list, span) -> Shap
 
 
 
-def _offset_polygons(ctx: Context, distance: ir.Expr, cursor: Shapes, span):
-    """Each flat shape's faces (``_faces_in_plane``) offset by ``distance``: the insets and the borders
-    (k,) (shapely, in the scopes' units), the faces' planes (k,) and polygons (k,), the faces as shapes,
-    each face's row in ``cursor`` and how far each face's edges moved (one per vertex of its rings, as
-    ``fit_pieces`` takes them)."""
+def _offset_polygons(ctx: Context, distance: ir.Expr, cursor: Shapes, span, select: str):
+    """Each flat shape's faces (``_faces_in_plane``) offset by ``distance``: the regions ``select`` keeps
+    (``_offset_regions``: (k,) each, shapely, in the scopes' units), the faces' planes (k,) and polygons
+    (k,), the faces as shapes, each face's row in ``cursor`` and how far each face's edges moved (one per
+    vertex of its rings, as ``fit_pieces`` takes them)."""
     d = _distances(ctx, distance, cursor, span)
     faces, owner = _faces_in_plane(cursor, ctx.chunk)
     polygons, plane = face_polygons(ctx, faces, "offset", span)
     vertices = shapely.get_num_coordinates(polygons) - shapely.get_num_interior_rings(polygons) - 1
     moves = np.repeat(np.abs(d[owner]), np.maximum(vertices, 0))
-    return *_inset_and_border(polygons, d[owner]), plane, polygons, faces, owner, moves
+    return _offset_regions(polygons, d[owner], select), plane, polygons, faces, owner, moves
 
 
 def _distances(ctx: Context, distance: ir.Expr, cursor: Shapes, span) -> np.ndarray:
@@ -233,11 +223,12 @@ def _distances(ctx: Context, distance: ir.Expr, cursor: Shapes, span) -> np.ndar
     return np.maximum(d, -TOL.far)
 
 
-def _inset_and_border(polygons: np.ndarray, distance: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """``offset``'s two regions of each face (k,) (shapely): its outline moved by ``distance`` (k,) (in
-    when negative) with sharp corners kept, a nearly collapsing one kept as PRT keeps it
-    (``geometry.insets``), an arm it closes leaving its vertex where PRT does (``geometry.closed_arms``),
-    and the ring between that and the face."""
+def _offset_regions(polygons: np.ndarray, distance: np.ndarray, select: str) -> list[np.ndarray]:
+    """``offset``'s regions of each face (k,) (shapely) that ``select`` keeps: ``inside``, its outline moved
+    by ``distance`` (k,) (in when negative) with sharp corners kept, a nearly collapsing one kept as PRT
+    keeps it (``geometry.insets``), an arm it closes leaving its vertex where PRT does
+    (``geometry.closed_arms``); ``border``, the ring between that and the face; ``all``, both, in that
+    order."""
     # a face that crosses itself (a shed roof's side under a concave outline's reflex corner is a bow tie)
     # is taken as its valid parts: GEOS's overlay refuses it
     invalid = ~shapely.is_valid(polygons)
@@ -245,16 +236,28 @@ def _inset_and_border(polygons: np.ndarray, distance: np.ndarray) -> tuple[np.nd
         polygons = polygons.copy()
         polygons[invalid] = shapely.make_valid(polygons[invalid], method="structure", keep_collapsed=False)
     inset = closed_arm_insets(mitred_insets(polygons, distance), polygons, -distance)
-    return inset, shapely.difference(polygons, inset)
+    border = [] if select == "inside" else [shapely.difference(polygons, inset)]
+    return border if select == "border" else [inset, *border]
 
 
 def _offset_pieces(ctx: Context, distance: ir.Expr, cursor: Shapes, span):
     """The inside and border pieces of each flat shape's faces offset by ``distance``, each piece's
     ``source`` its shape's row."""
-    inset, border, plane, polygons, faces, owner, moves = _offset_polygons(ctx, distance, cursor, span)
-    return tuple(replace(p, source=owner[p.source]) for p in (
-        fit_pieces(inset, plane, faces.size, polygons, insets=np.ones(len(inset), dtype=bool), moves=moves),
-        fit_pieces(border, plane, faces.size, polygons)))
+    pieces, border = _fitted_pieces(ctx, distance, cursor, span, "all")
+    return pieces.take(~border), pieces.take(border)
+
+
+def _fitted_pieces(ctx: Context, distance: ir.Expr, cursor: Shapes, span, select: str):
+    """The pieces of each flat shape's faces offset by ``distance`` that ``select`` keeps, fitted in one
+    pass: all the insides' pieces, then all the borders' (whose edges moved by no distance known), each
+    piece's ``source`` its shape's row; and which pieces are of a border (k,) bool."""
+    regions, plane, polygons, faces, owner, moves = _offset_polygons(ctx, distance, cursor, span, select)
+    of_border = {"inside": [False], "border": [True], "all": [False, True]}[select]
+    border = np.repeat(of_border, len(faces))
+    pieces = fit_pieces(np.concatenate(regions), np.tile(plane, len(regions)),
+                        np.tile(faces.size, (len(regions), 1)), np.tile(polygons, len(regions)), insets=~border,
+                        moves=np.concatenate([np.full(len(moves), np.nan) if b else moves for b in of_border]))
+    return replace(pieces, source=owner[pieces.source % len(faces)]), border[pieces.source]
 
 
 def _faces_in_plane(cursor: Shapes, chunk) -> tuple[Shapes, np.ndarray]:

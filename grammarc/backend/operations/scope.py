@@ -23,6 +23,7 @@ from grammarc.backend.context import Context
 from grammarc.backend.euler import orientation, rotation
 from grammarc.backend.evaluate import evaluate, evaluate_array
 from grammarc.backend.functions.coordinates import system
+from grammarc.backend.kernels.scope import translated
 from grammarc.backend.mesh_shapes import store_fitted
 from grammarc.backend.operations.table import operation
 from grammarc.backend.outlines import flat_axis, polygons_of
@@ -51,9 +52,10 @@ _REFRAMED = (*_SCOPE, "dynamic")
 @operation(ir.Translate, writes=("origin",), meshes=True)
 def translate(ctx: Context, cursor: Shapes, op: ir.Translate) -> Shapes:
     env = ctx.env(cursor)
-    local = np.stack([evaluate_array(e, env) for e in op.vector], axis=1)
-    delta = np.einsum("ni,nij->nj", local, ctx.chunk.frames[cursor.frame])
-    return cursor.with_scope(cursor.origin + delta, cursor.size, cursor.frame, cursor.geom)
+    local = np.stack([np.broadcast_to(np.asarray(evaluate_array(e, env), dtype=np.float64), (len(cursor),))
+                      for e in op.vector], axis=1)
+    origin = translated(cursor.origin, local, ctx.chunk.frames.data, cursor.frame)
+    return cursor.with_scope(origin, cursor.size, cursor.frame, cursor.geom)
 
 
 @operation(ir.Scale, writes=("origin", "size", "geom"), meshes=True)
@@ -280,7 +282,7 @@ def _extruded_along_normal(ctx: Context, cursor: Shapes, height, axis: np.ndarra
     cursor = turned(ctx, cursor, axis != 1, NORMAL_UP, axis, span)
     size = cursor.size.copy()
     size[:, 1] = np.abs(height)
-    up = ctx.chunk.frames[cursor.frame][:, 1]
+    up = ctx.chunk.frames.data[cursor.frame, 1]
     origin = cursor.origin + np.minimum(height, 0.0)[:, None] * up
     extruded = cursor.with_scope(origin, size, cursor.frame, cursor.geom)
     mesh = is_mesh(cursor.geom)
