@@ -311,12 +311,17 @@ def test_component_frames_give_einsums_bits_signed_zeros_included(n):
     assert bad[1::7].all()
 
 
+def frames_and_ids(rng, n):
+    """Four frames, the last a turn whose axes hold signed zeros, and n frame ids among them."""
+    frames = random_frames(rng, 4)
+    frames[3] = np.eye(3) * np.array([1.0, -1.0, -1.0])[:, None]
+    return frames, rng.integers(0, 4, n).astype(np.int32)
+
+
 @pytest.mark.parametrize("n", SIZES)
 def test_translated_gives_einsums_bits_signed_zeros_included(n):
     rng = np.random.default_rng(n)
-    frames = random_frames(rng, 4)
-    frames[3] = np.eye(3) * np.array([1.0, -1.0, -1.0])[:, None]  # signed zeros
-    frame = rng.integers(0, 4, n).astype(np.int32)
+    frames, frame = frames_and_ids(rng, n)
     origin = np.where(rng.random((n, 3)) < 0.3, -0.0, rng.normal(size=(n, 3)) * 100)
     local = np.where(rng.random((n, 3)) < 0.3, -0.0, rng.normal(size=(n, 3)))
     want = origin + np.einsum("ni,nij->nj", local, frames[frame])
@@ -326,9 +331,7 @@ def test_translated_gives_einsums_bits_signed_zeros_included(n):
 @pytest.mark.parametrize("n", SIZES)
 def test_turned_frames_give_einsums_bits(n):
     rng = np.random.default_rng(n)
-    frames = random_frames(rng, 4)
-    frames[3] = np.eye(3) * np.array([1.0, -1.0, -1.0])[:, None]  # signed zeros
-    frame = rng.integers(0, 4, n).astype(np.int32)
+    frames, frame = frames_and_ids(rng, n)
     local = np.where(rng.random((n, 3, 3)) < 0.3, -0.0, random_frames(rng, n))
     want = np.einsum("nij,njk->nik", local, frames[frame])
     assert np.array_equal(turned_frames(local, frames, frame).view(np.int64), want.view(np.int64))
