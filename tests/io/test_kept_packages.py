@@ -78,3 +78,23 @@ def test_entries_unused_for_long_and_extractions_of_dead_processes_go_at_the_nex
     kept_packages.keep(entry.parent / "fedcba9876543210fedcba9876543210", extract("Lot --> Z\n"), 1000)
     assert sorted(p.name for p in entry.parent.iterdir()) == sorted([recent.name, "fedcba9876543210fedcba9876543210"])
     assert json.loads((recent / "files.json").read_text())["bytes"] == len("Lot --> Y\n")
+
+
+def test_two_processes_extracting_one_package_at_once_both_build_and_one_entry_stays(tmp_path):
+    """Real processes, started together on an empty cache: each extracts, one entry is renamed into place and
+    the other process takes it."""
+    py7zr = pytest.importorskip("py7zr")
+    archive = tmp_path / "p.rpk"
+    with py7zr.SevenZipFile(archive, "w") as package:
+        package.writestr(b"@StartRule\nLot --> X\n" * 2000, "rules/a.cga")
+        package.writestr(b"v 0 0 0\n" * 20000, "assets/a.obj")
+    env = {**os.environ, "XDG_CACHE_HOME": str(tmp_path / "cache")}
+    script = ("import sys\nfrom grammarc.io.rpk import open_rpk\n"
+              "with open_rpk(sys.argv[1]) as rpk:\n    print(rpk.root, rpk.start_rule)\n")
+    runs = [subprocess.Popen([sys.executable, "-c", script, str(archive)], env=env, stdout=subprocess.PIPE,
+                             text=True) for _ in range(2)]
+    said = [run.communicate(timeout=120)[0].split() for run in runs]
+    assert [run.returncode for run in runs] == [0, 0]
+    assert said[0] == said[1] and said[0][1] == "Lot"
+    cache = tmp_path / "cache" / "grammarc" / "rpk"
+    assert [p.name for p in cache.iterdir()] == [os.path.basename(os.path.dirname(said[0][0]))]
