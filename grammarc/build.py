@@ -135,8 +135,9 @@ def build(grammar_path, output, *, lots_path=None, options: BuildOptions = Build
 
 @contextlib.contextmanager
 def grammar_source(path: Path, options: BuildOptions):
-    """The rule file to compile and the options to use: a ``.rpk`` package is extracted for the
-    duration of the build, its main rule file compiled, its assets and start rule used."""
+    """The rule file to compile and the options to use: a ``.rpk`` package is opened (extracted, or found
+    in the cache of extracted packages) for the duration of the build, its main rule file compiled, its
+    assets and start rule used."""
     if path.suffix.lower() != ".rpk":
         yield path, None, options
         return
@@ -229,8 +230,8 @@ def record_meta(grammar_path: Path, grammar: Grammar, plan, options: BuildOption
         "lots_source": lots_source,
         "crs": crs,
         "dialect": grammar.module.dialect,
-        # the user's asset folders (baking); a package's own are left out: extracted to a fresh temporary
-        # folder for this build only, their names would make each run's record differ
+        # the user's asset folders (baking); a package's own are left out: extracted to the user's cache, or
+        # to a fresh temporary folder, their names would make the record differ by where it was built
         "asset_roots": [str(r) for r in recorded_roots],
         # operations accepted without effect on the record (material, texture, print)
         "not_applied": list(plan.not_applied),
