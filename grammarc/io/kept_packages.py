@@ -34,6 +34,8 @@ UNUSED_DAYS = 30
 _MAKING = "grammarc-rpk-"
 _PACKAGE = "package"
 _MANIFEST = "files.json"
+#: The bytes of an archive read at a time to take its digest.
+_BLOCK = 1 << 20
 
 
 def entry_of(archive: Path) -> Path | None:
@@ -42,8 +44,11 @@ def entry_of(archive: Path) -> Path | None:
     folder = cache_folder("rpk")
     if folder is None:
         return None
-    digest = hashlib.sha256(archive.read_bytes()).hexdigest()
-    return folder / digest[:32]
+    digest = hashlib.sha256()
+    with open(archive, "rb") as file:  # in blocks: a package of textures may hold gigabytes
+        for block in iter(lambda: file.read(_BLOCK), b""):
+            digest.update(block)
+    return folder / digest.hexdigest()[:32]
 
 
 def kept(entry: Path, limit: int) -> Path | None:
