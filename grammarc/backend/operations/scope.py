@@ -52,8 +52,7 @@ _REFRAMED = (*_SCOPE, "dynamic")
 @operation(ir.Translate, writes=("origin",), meshes=True)
 def translate(ctx: Context, cursor: Shapes, op: ir.Translate) -> Shapes:
     env = ctx.env(cursor)
-    local = np.stack([np.broadcast_to(np.asarray(evaluate_array(e, env), dtype=np.float64), (len(cursor),))
-                      for e in op.vector], axis=1)
+    local = np.stack([evaluate_array(e, env) for e in op.vector], axis=1)  # (n, 3) float64, one row a shape
     origin = translated(cursor.origin, local, ctx.chunk.frames.data, cursor.frame)
     return cursor.with_scope(origin, cursor.size, cursor.frame, cursor.geom)
 
