@@ -50,7 +50,7 @@ from grammarc.model.grammar import Grammar
 from grammarc.model.lots import BadLot, Lots
 from grammarc.model.records import LotOrigins, MeshChunk
 from grammarc.model.reports import Reports
-from grammarc.workers import worker_pool
+from grammarc.workers import first_tasks, worker_pool
 
 #: Shapes plus records one chunk may make before it is split: ~100 bytes each, so about 2 GB.
 CHUNK_BUDGET = 20_000_000
@@ -334,7 +334,10 @@ def _derive_chunks(plan, lots: Lots, options: BuildOptions, writer, failed: list
         window: deque = deque()
         try:
             while first < len(lots) or window:
-                while first < len(lots) and len(window) <= workers:
+                # before the first chunk's records are known, its size and the next are FIRST_CHUNK: the
+                # first chunk alone, or one for each worker (``workers.first_tasks``); then a chunk for each
+                # worker and one more, waiting, sized by the records a lot makes
+                while first < len(lots) and len(window) < (workers + 1 if written else first_tasks(workers)):
                     last = last or _last_share(size, len(lots) - first, workers)
                     part = lots.take(slice(first, first + (last or size)))
                     window.append((len(part), submit(part)))

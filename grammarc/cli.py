@@ -368,12 +368,12 @@ def _detached(serve, ready) -> int:
 def _warm() -> None:
     """What a server loads before serving: every module of grammarc (those of extras not installed
     excepted), the dialects' parsers, the fused regions' kernels that builds compiled, and the machine
-    code of every kernel numba has cached."""
+    code of every kernel numba has cached; then its builds' workers need load none (``workers.warm``)."""
     import importlib
     import pkgutil
 
     import grammarc
-    from grammarc import server
+    from grammarc import server, workers
     from grammarc.backend.fusion import compiled
     from grammarc.frontend.parse import DIALECTS
     from grammarc.frontend.parsers import parser_for
@@ -387,6 +387,7 @@ def _warm() -> None:
         parser_for(dialect.grammar)
     compiled.import_compiled()
     server.load_cached_kernels()
+    workers.warm()
 
 
 def _cores() -> int:

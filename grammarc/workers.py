@@ -50,22 +50,44 @@ __all__ = ["worker_pool"]
 _SHARED: dict = {}
 #: Arrays start at multiples of this in a shipped file, so their views are aligned.
 _ALIGN = 64
+#: Whether this process is warm (``warm``).
+_warm = False
 #: Shipped arrays smaller than this are copied out of their file: consumers keep small tables past a
 #: chunk (the npz writer keeps each chunk's lot origins to its close), and a view would keep the file's
 #: slot from being used again.
 _COPIED = 1 << 20
 
 
+def warm() -> None:
+    """Mark this process warm: it has loaded every kernel numba's cache holds (a server does, before it
+    forks a child for each command), so workers forked from it have them whatever they derive first."""
+    global _warm
+    _warm = True
+
+
+def forks() -> bool:
+    """Whether this system forks workers (not Windows)."""
+    return "fork" in multiprocessing.get_all_start_methods()
+
+
+def first_tasks(workers: int) -> int:
+    """How many tasks a pool of ``workers`` is given before the first one's result is known: one, run in
+    this process, unless it is warm (``worker_pool``); else one for each worker."""
+    return workers if _warm and workers > 1 and forks() else 1
+
+
 @contextlib.contextmanager
 def worker_pool(work: Callable, workers: int):
     """``submit(lots) -> Future`` of ``work(lots)``, which returns ``(results, failed)`` with results
     ``[(n_lots, (records, per_lot))]``: in this process when ``workers`` is 1 or processes cannot be forked
-    (Windows), else in ``workers`` forked processes, but for the first task.
+    (Windows), else in ``workers`` forked processes, but for the first task unless this process is warm.
 
     The first task runs in this process, before the workers are forked: the kernels it loads (numba's
     machine code from its cache, fused regions' modules) are then the workers' from the start, where
-    each worker would load them again, in every build, at a cost of a few hundredths of a second each."""
-    if workers == 1 or "fork" not in multiprocessing.get_all_start_methods():
+    each worker would load them again, in every build, at a cost of a few hundredths of a second each.
+    While it runs, the other cores wait. A warm process (``warm``) has them all loaded already: its
+    workers are forked at the first task, and each is given one of the first tasks (``first_tasks``)."""
+    if workers == 1 or not forks():
         yield functools.partial(_at_once, work)
         return
     memory = "/dev/shm" if os.path.isdir("/dev/shm") and os.access("/dev/shm", os.W_OK) else None
@@ -75,13 +97,13 @@ def worker_pool(work: Callable, workers: int):
     _SHARED.update(work=work)
     slots = _Slots(folder)
     try:
-        forked = False
+        here = not _warm  # the first task runs here; the pool forks its workers at the next
         with ProcessPoolExecutor(workers, mp_context=multiprocessing.get_context("fork"),
                                  initializer=_start_worker) as pool:
             def submit(lots) -> Future:
-                nonlocal forked
-                if not forked:  # the pool forks its workers at its first task: this one runs here
-                    forked = True
+                nonlocal here
+                if here:
+                    here = False
                     return _at_once(work, lots)
                 slot = slots.take()
                 try:

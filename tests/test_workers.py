@@ -133,6 +133,19 @@ def test_the_first_task_runs_here_and_the_workers_inherit_what_it_loaded():
             assert worker != here and loaded[0] == here  # forked after the first task: they have its load
 
 
+def test_a_warm_process_gives_its_first_task_to_a_worker(monkeypatch):
+    """A warm process (a server's child) has every kernel loaded: no task runs here for its workers to
+    inherit what it loaded."""
+    from grammarc import workers
+
+    monkeypatch.setattr(workers, "_warm", True)
+    assert workers.first_tasks(2) == 2 and workers.first_tasks(1) == 1
+    LOADED.clear()
+    with workers.worker_pool(_load_and_say, 2) as submit:
+        _, (worker, loaded) = submit([]).result(timeout=60)
+        assert worker != os.getpid() and loaded == [worker]
+
+
 @pytest.mark.parametrize(("lots", "chunk_size", "forked"), [(3, 16384, False), (3, 2, True), (65, 16384, True)])
 def test_only_builds_of_more_than_one_chunk_fork_workers(monkeypatch, write, lots, chunk_size, forked):
     """Forking workers for one chunk only makes it wait for them (the first chunk holds up to 64 lots)."""
@@ -156,11 +169,16 @@ def test_the_last_chunks_are_shared_out_among_the_workers():
     assert _last_share(107, 131, 1) is None  # one process: nothing to share
 
 
-def test_chunks_of_a_build_with_workers_start_small_and_end_shared(monkeypatch, write):
+@pytest.mark.parametrize(("warm", "expected"), [(False, [16, 42, 42]), (True, [16, 16, 34, 34])])
+def test_chunks_of_a_build_with_workers_start_small_and_end_shared(monkeypatch, write, warm, expected):
+    """The first chunk (here) or the first for each worker (a warm process) are small, and the next are
+    sized by the records a lot made in them: here the lots left are no more than a chunk for each worker,
+    and are shared out."""
     import contextlib
 
-    from grammarc import build
+    from grammarc import build, workers
 
+    monkeypatch.setattr(workers, "_warm", warm)
     sizes = []
     real = build.worker_pool
 
@@ -173,5 +191,4 @@ def test_chunks_of_a_build_with_workers_start_small_and_end_shared(monkeypatch, 
     grammar = compile_grammar(write("g.cga", "Lot --> extrude(3)\n"))
     square = [[np.array([[0, 0], [10, 0], [10, 10], [0, 10]], float)]]
     derive(grammar, lots_from_polygons(square * 100), BuildOptions(workers=2))
-    # 16 here, two more of 16 queued before the first records come back; then the 52 left, one half each
-    assert sizes == [16, 16, 16, 26, 26]
+    assert sizes == expected
