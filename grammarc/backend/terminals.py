@@ -24,12 +24,12 @@ import numpy as np
 from grammarc.backend.aggregates import collect
 from grammarc.backend.context import Context
 from grammarc.backend.kernels.scope import leaf_kinds, xforms
-from grammarc.backend.kernels.texture import instance_maps
+from grammarc.backend.kernels.texture import instance_maps, vertex_maps
 from grammarc.backend.materials import material_ids, rgba
 from grammarc.backend.mesh_shapes import mesh_leaves
 from grammarc.backend.shapes import Z_UP, Shapes, asset_of
 from grammarc.backend.slots import HORIZONTAL_SLOTS
-from grammarc.backend.texture_space import COORDINATES, texture_maps
+from grammarc.backend.texture_space import COORDINATES
 from grammarc.constants import TOL
 from grammarc.geometry.components import reverse_rings
 from grammarc.geometry.meshes import is_mesh, is_polygon
@@ -213,20 +213,13 @@ def _instance_uv(ctx: Context, shapes: Shapes, rows: np.ndarray, xform: np.ndarr
 def _with_uv(ctx: Context, shapes: Shapes, owner: np.ndarray, mesh: MeshChunk) -> MeshChunk:
     """``mesh`` with the texture coordinates of set 0 of its vertices (``MeshChunk.uv``), its faces those
     of ``shapes`` rows ``owner``, where the grammar has texture coordinates."""
-    if 0 not in ctx.plan.uv_slots:
+    start = ctx.plan.uv_slots.get(0)
+    if start is None:
         return mesh
-    maps = _record_maps(ctx, shapes)[owner][segment_of(mesh.face_offsets)]
-    maps = maps[segment_of(mesh.ring_offsets)]
-    uv = np.einsum("vij,vj->vi", maps[:, :, :3], mesh.vertices.astype(np.float64)) + maps[:, :, 3]
-    return replace(mesh, uv=uv.astype(np.float32))
-
-
-def _record_maps(ctx: Context, shapes: Shapes) -> np.ndarray:
-    """(n, 2, 4): the shapes' texture maps of set 0 (``texture_space.texture_maps``, of world points) as
-    maps of points relative to their lots' origins, the frame of their records."""
-    maps = texture_maps(ctx.plan, ctx.chunk, shapes, 0).copy()
-    maps[:, :, 3] += np.einsum("nij,nj->ni", maps[:, :, :3], ctx.chunk.lot_origin[shapes.lot])
-    return maps
+    chunk = ctx.chunk
+    vertex_shape = owner[segment_of(mesh.face_offsets)][segment_of(mesh.ring_offsets)]
+    return replace(mesh, uv=vertex_maps(chunk.texture_maps.data, shapes.dynamic[start + COORDINATES],
+                                        chunk.lot_origin, shapes.lot, vertex_shape, mesh.vertices))
 
 
 def emit_leaves(ctx: Context, shapes: Shapes, symbol: int) -> None:

@@ -17,7 +17,7 @@ from grammarc.backend.kernels.scope import (
     xforms,
 )
 from grammarc.backend.kernels.split import repeat, repeat_counts, subdiv
-from grammarc.backend.kernels.texture import instance_maps
+from grammarc.backend.kernels.texture import instance_maps, vertex_maps
 from grammarc.backend.random import child_keys
 
 SIZES = [0, 1, 2, 50]
@@ -365,26 +365,53 @@ def test_tally_adds_what_bincount_counts(n, weighted):
 # ---------------------------------------------------------------------------------- texture.instance_maps
 
 
+def map_table(rng, n):
+    """Texture maps (a table of 9, map 0 NaN, some entries signed zeros), the ids of ``n`` shapes' maps, lot
+    origins (some coordinates zero) and the shapes' lots."""
+    table = rng.normal(size=(9, 2, 4)) * rng.choice([1e-3, 1.0, 1e4], size=(9, 2, 4))
+    table[rng.random((9, 2, 4)) < 0.3] = -0.0
+    table[0] = np.nan
+    lot_origin = rng.uniform(-1e6, 1e6, (4, 3))
+    lot_origin[rng.random((4, 3)) < 0.3] = 0.0
+    return table, rng.integers(0, 9, n).astype(np.int32), lot_origin, rng.integers(0, 4, n).astype(np.int32)
+
+
+def maps_from_lots(table, map_id, lot_origin, lot, rows):
+    """numpy's maps of shapes ``rows`` moved to their lots' origins."""
+    maps = table[map_id[rows]]
+    maps[:, :, 3] += np.einsum("nij,nj->ni", maps[:, :, :3], lot_origin[lot[rows]])
+    return maps
+
+
 @pytest.mark.parametrize("n", SIZES)
 def test_instance_maps_give_numpys_bits(n):
     """The maps of records are numpy's composition, bit for bit: the shapes' maps made relative to their
     lots' origins (``einsum``), composed with the records' transforms (``matmul``), for some of the rows in
     any order; map 0 is NaN, some entries and origins are (signed) zeros."""
     rng = np.random.default_rng(n)
-    table = rng.normal(size=(9, 2, 4)) * rng.choice([1e-3, 1.0, 1e4], size=(9, 2, 4))
-    table[rng.random((9, 2, 4)) < 0.3] = -0.0
-    table[0] = np.nan
-    lot_origin = rng.uniform(-1e6, 1e6, (4, 3))
-    lot_origin[rng.random((4, 3)) < 0.3] = 0.0
-    map_id = rng.integers(0, 9, n).astype(np.int32)
-    lot = rng.integers(0, 4, n).astype(np.int32)
+    table, map_id, lot_origin, lot = map_table(rng, n)
     rows = rng.permutation(n)[: n - n // 3]
     xform = (rng.normal(size=(len(rows), 3, 4)) * 50).astype(np.float32)
     xform[rng.random(xform.shape) < 0.2] = 0.0
-    maps = table[map_id[rows]]
-    maps[:, :, 3] += np.einsum("nij,nj->ni", maps[:, :, :3], lot_origin[lot[rows]])
+    maps = maps_from_lots(table, map_id, lot_origin, lot, rows)
     want = maps[:, :, :3] @ xform
     want[:, :, 3] += maps[:, :, 3]
     got = instance_maps(table, map_id, rows, lot_origin, lot, xform)
     assert got.dtype == np.float32 and got.shape == (len(rows), 2, 4)
+    assert np.array_equal(got.view(np.int32), want.astype(np.float32).view(np.int32))
+
+
+@pytest.mark.parametrize("n", SIZES)
+def test_vertex_maps_give_numpys_bits(n):
+    """Mesh vertices' texture coordinates are numpy's, bit for bit: their shapes' maps made relative to
+    their lots' origins, applied to the points (``einsum``), the offset added last."""
+    rng = np.random.default_rng(n)
+    table, map_id, lot_origin, lot = map_table(rng, n)
+    vertex_shape = rng.integers(0, n, 3 * n) if n else np.zeros(0, np.int64)
+    vertices = (rng.normal(size=(len(vertex_shape), 3)) * 30).astype(np.float32)
+    vertices[rng.random(vertices.shape) < 0.2] = -0.0
+    maps = maps_from_lots(table, map_id, lot_origin, lot, vertex_shape)
+    want = np.einsum("vij,vj->vi", maps[:, :, :3], vertices.astype(np.float64)) + maps[:, :, 3]
+    got = vertex_maps(table, map_id, lot_origin, lot, vertex_shape, vertices)
+    assert got.dtype == np.float32 and got.shape == (len(vertex_shape), 2)
     assert np.array_equal(got.view(np.int32), want.astype(np.float32).view(np.int32))

@@ -46,7 +46,7 @@ def instance_maps(maps, map_id, rows, lot_origin, lot, xform):
         o = lot_origin[lot[i]]
         for r in range(2):
             a = maps[m, r]
-            offset = a[3] + ((a[0] * o[0] + a[2] * o[2]) + a[1] * o[1])
+            offset = _lot_offset(a, o)
             for k in range(4):
                 placed = 0.0
                 for j in range(3):
@@ -55,3 +55,28 @@ def instance_maps(maps, map_id, rows, lot_origin, lot, xform):
                     placed += offset
                 out[c, r, k] = placed
     return out
+
+
+@njit(cache=True, nogil=True)
+def vertex_maps(maps, map_id, lot_origin, lot, vertex_shape, vertices):
+    """(V, 2) float32: texture coordinates of mesh vertices ``vertices`` (V, 3) float32, relative to their
+    lots' origins, each of shape ``vertex_shape`` (V,) of a batch whose maps are ``maps[map_id]`` and lots
+    ``lot`` (n,) at ``lot_origin`` (L, 3): the shape's map moved to its lot's origin (as ``instance_maps``
+    moves it) applied to the point, its sum taken as ``np.einsum("vij,vj->vi")`` takes it and the offset
+    added last."""
+    out = np.empty((len(vertex_shape), 2), np.float32)
+    for v in range(len(vertex_shape)):
+        i = vertex_shape[v]
+        o = lot_origin[lot[i]]
+        x, y, z = np.float64(vertices[v, 0]), np.float64(vertices[v, 1]), np.float64(vertices[v, 2])
+        for r in range(2):
+            a = maps[map_id[i], r]
+            out[v, r] = ((a[0] * x + a[2] * z) + a[1] * y) + _lot_offset(a, o)
+    return out
+
+
+@njit(cache=True, nogil=True, inline="always")
+def _lot_offset(a, o):
+    """The offset of map row ``a`` (4,) for points relative to the lot origin ``o`` (3,): ``a[3] + a[:3] @ o``,
+    summed as ``np.einsum("nij,nj->ni")`` sums (axes 0 and 2, then 1)."""
+    return a[3] + ((a[0] * o[0] + a[2] * o[2]) + a[1] * o[1])
