@@ -87,8 +87,11 @@ def store(path: Path, write: Callable[[BinaryIO], None]) -> None:
 @cache
 def code_stamp() -> str:
     """A digest of the code that made a cached file: grammarc's version and the name, size and time of
-    each of its source files and grammars, and the Python (pickles are read by the same one)."""
-    digest = hashlib.sha256(f"{grammarc.__version__}\0{sys.executable}\0{sys.version}\0".encode())
+    each of its source files and grammars, and the Python (pickles are read by the same one): its
+    environment and its program, whichever of its names started it (``python``, ``python3``, the
+    ``grammarc`` script's), so that ``python -m grammarc`` finds the server ``grammarc server start`` left."""
+    python = f"{sys.prefix}\0{os.path.realpath(sys.executable)}\0{sys.version}"
+    digest = hashlib.sha256(f"{grammarc.__version__}\0{python}\0".encode())
     for parts, info in sorted(_sources(os.path.dirname(grammarc.__file__), ())):
         digest.update(f"{'/'.join(parts)}\0{info.st_mtime_ns}\0{info.st_size}\0".encode())
     return digest.hexdigest()
