@@ -13,8 +13,8 @@ tests/test_layout.py checks), from the ground up:
 - ``grammarc.compiler``: text to the checked grammar; ``grammarc.backend``: the derivation, the IR's
   operations over columns of shapes.
 - ``grammarc.io``: lots in, records out (a table of formats each way); ``grammarc.render``: pictures.
-- ``grammarc.workers``, ``grammarc.build``, ``grammarc.cluster``, ``grammarc.conform``, ``grammarc.cli``:
-  the ``grammarc`` command.
+- ``grammarc.workers``, ``grammarc.build``, ``grammarc.cluster``, ``grammarc.conform``,
+  ``grammarc.commands``, ``grammarc.cli``: the ``grammarc`` command.
 """
 
 __version__ = "0.1.0"

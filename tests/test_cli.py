@@ -279,39 +279,6 @@ def test_usage_errors_exit_2(write, tmp_path, capsys, args, message):
     assert message in capsys.readouterr().err
 
 
-def test_check_prints_a_summary(write, capsys):
-    grammar = write("g.cga", "lot ~> S(1r, 3, 1r) grow(2)\ngrow(n) : n > 0 ~> grow(n - 1) leaf\n"
-                             "grow(n) ~> ε\n")
-    assert main(["check", str(grammar)]) == 0
-    out = capsys.readouterr().out
-    assert "rules:     3 (2 symbols with rules)" in out
-    assert "terminals: leaf" in out and "recursive: grow" in out
-
-
-def test_check_summary_of_a_grammar_of_many_rules_stays_short(write, capsys):
-    leaves = " ".join(f"W{i}." for i in range(45))
-    grammar = write("g.cga", f'version "2022.0"\n@StartRule\nLot --> {leaves}\n')
-    assert main(["check", str(grammar)]) == 0
-    line = next(s for s in capsys.readouterr().out.splitlines() if "terminals:" in s)
-    assert line.endswith("W39 and 5 more") and "W40" not in line
-
-
-def test_check_says_why_symbols_are_not_fused(write, capsys):
-    grammar = write("g.cga", 'version "2022.0"\n@StartRule\nLot --> extrude(3) comp(f){ top: Roof | all: W. }\n'
-                             "Roof --> color(1, 0, 0) R.\n")
-    assert main(["check", "--fusion", str(grammar)]) == 0
-    out = capsys.readouterr().out
-    assert "fusion:    the whole grammar is interpreted: CityEngine's dialect" in out
-    assert "    Lot: an operation no kernel takes: `extrude(3)` at " in out
-    assert "    Roof: an operation no kernel takes: `color(1, 0, 0)` at " in out
-    assert "most frequent: an operation no kernel takes `extrude` (1), an operation no kernel takes `color` (1)" in out
-
-
-def test_check_dump_ir(write, capsys):
-    assert main(["check", "--dump-ir", str(write("g.cga", "attr h = 2 * 3\nlot ~> S(1r, h, 1r) x\n"))]) == 0
-    assert "lot ~> S(1r, @h, 1r) x" in capsys.readouterr().out
-
-
 def test_workspace_option_of_check_and_build(write, capsys, tmp_path):
     from pathlib import Path
 
@@ -324,11 +291,6 @@ def test_workspace_option_of_check_and_build(write, capsys, tmp_path):
     out = tmp_path / "o.npz"
     assert main(["build", "--workspace", str(workspace), str(grammar), "--emit", str(out), "--quiet"]) == 0
     assert "Houses/assets/window.obj" in list(read_instances(out)["assets"])
-
-
-def test_check_reports_errors_exit_2(write, capsys):
-    assert main(["check", str(write("g.cga", "lot ~> T(1, 2)\n"))]) == 2
-    assert "`T` takes 3 arguments, got 2" in capsys.readouterr().err
 
 
 CITYENGINE_START = 'version "2022.0"\n@StartRule\nLot(h, floors) --> extrude(h) split(y){ ~floors : Floor }*\n'
@@ -370,11 +332,6 @@ def test_a_cityengine_file_of_constants_only_checks_with_a_warning_and_does_not_
     assert main(["build", str(grammar), "--emit", str(out)]) == 2
     assert "error: the grammar has no rules" in capsys.readouterr().err
     assert not out.exists()
-
-
-def test_check_says_which_rule_starts_without_start_rule(write, capsys):
-    assert main(["check", str(write("g.cga", 'version "2022.0"\nLot --> extrude(3) Mass\nMass --> X\n'))]) == 0
-    assert "warning: no @StartRule: starting with `Lot`, the first rule" in capsys.readouterr().err
 
 
 @pytest.mark.parametrize("command", ["check", "build"])
@@ -579,33 +536,6 @@ def test_a_build_whose_reports_cannot_be_written_leaves_no_new_output(write, tmp
     assert main(["build", str(grammar), "--emit", str(out), "--quiet", "--workers", "1", "--seed", "2"]) == 1
     assert "No space left on device" in capsys.readouterr().err
     assert (out.read_bytes(), (tmp_path / "out.reports.json").read_text()) == before
-
-
-@pytest.mark.parametrize("name, content, seems", [
-    ("x.obj", b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n", "a baked mesh"),
-    ("x.npz", np.lib.format.magic(1, 0) + b"{'descr': '<f8'}", "a single numpy array"),
-    ("notes.txt", b"hello\n", "a text file"),
-])
-def test_info_on_a_file_that_is_not_a_record_says_what_it_reads_and_what_the_file_seems(tmp_path, capsys, name,
-                                                                                       content, seems):
-    (tmp_path / name).write_bytes(content)
-    assert main(["info", str(tmp_path / name)]) == 2
-    err = capsys.readouterr().err.strip()
-    assert len(err.splitlines()) == 1 and ".npz instance records" in err and f"): {seems}" in err
-    assert "pickled" not in err
-
-
-def test_info_on_a_missing_file_says_so(tmp_path, capsys):
-    assert main(["info", str(tmp_path / "city.npz")]) == 2
-    assert capsys.readouterr().err.strip().endswith("city.npz: No such file or directory")
-
-
-def test_lots_to_a_path_that_cannot_be_written_is_refused_before_reading(tmp_path, capsys):
-    lots = geojson(tmp_path / "lots.geojson", [SQUARE])
-    (tmp_path / "out.parquet").mkdir()
-    assert main(["lots", str(lots), "--to", str(tmp_path / "out.parquet")]) == 2
-    err = capsys.readouterr()
-    assert err.out == "" and err.err.strip().endswith("out.parquet`: it is a folder")
 
 
 def test_the_libraries_warnings_do_not_reach_the_user(write, tmp_path):

@@ -25,6 +25,7 @@ FLOORS = (
     ("workers", "server"),
     ("build", "search"),
     ("cluster", "conform"),
+    ("commands",),
     ("cli",),
     ("client",),
 )
