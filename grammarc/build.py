@@ -329,7 +329,10 @@ def _derive_chunks(plan, lots: Lots, options: BuildOptions, writer, failed: list
     last = None  # the lots of each of the last chunks, once they are shared out
     # lots that make one chunk are derived in this process: forked workers would only wait for it
     workers = options.workers if len(lots) > min(options.chunk_size, ONE_CHUNK) else 1
-    size = min(options.chunk_size, FIRST_CHUNK if workers > 1 else ONE_CHUNK)
+    # the first chunks are sized before a lot's records are known: one of FIRST_CHUNK lots here while the
+    # other cores wait, or in a warm process one of up to ONE_CHUNK lots for each worker at once (a build
+    # of up to a chunk for each worker is then shared among them at once, ``_last_share``)
+    size = min(options.chunk_size, FIRST_CHUNK if first_tasks(workers) < workers else ONE_CHUNK)
     with worker_pool(functools.partial(_derive, plan, options=options, foreign=foreign), workers) as submit:
         window: deque = deque()
         try:

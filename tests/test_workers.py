@@ -169,11 +169,13 @@ def test_the_last_chunks_are_shared_out_among_the_workers():
     assert _last_share(107, 131, 1) is None  # one process: nothing to share
 
 
-@pytest.mark.parametrize(("warm", "expected"), [(False, [16, 42, 42]), (True, [16, 16, 34, 34])])
-def test_chunks_of_a_build_with_workers_start_small_and_end_shared(monkeypatch, write, warm, expected):
-    """The first chunk (here) or the first for each worker (a warm process) are small, and the next are
-    sized by the records a lot made in them: here the lots left are no more than a chunk for each worker,
-    and are shared out."""
+@pytest.mark.parametrize(("warm", "lots", "expected"), [(False, 100, [16, 42, 42]), (True, 100, [50, 50]),
+                                                        (True, 300, [64, 64, 86, 86])])
+def test_chunks_of_a_build_with_workers_start_small_and_end_shared(monkeypatch, write, warm, lots, expected):
+    """The first chunk (here, while the other core waits) is small, and the next are sized by the records a
+    lot made in it: here the lots left are no more than a chunk for each worker, and are shared out. In a
+    warm process each worker is given a first chunk of up to 64 lots at once: 100 lots are shared out at
+    once."""
     import contextlib
 
     from grammarc import build, workers
@@ -190,5 +192,5 @@ def test_chunks_of_a_build_with_workers_start_small_and_end_shared(monkeypatch, 
     monkeypatch.setattr(build, "worker_pool", pool)
     grammar = compile_grammar(write("g.cga", "Lot --> extrude(3)\n"))
     square = [[np.array([[0, 0], [10, 0], [10, 10], [0, 10]], float)]]
-    derive(grammar, lots_from_polygons(square * 100), BuildOptions(workers=2))
+    derive(grammar, lots_from_polygons(square * lots), BuildOptions(workers=2))
     assert sizes == expected

@@ -55,8 +55,8 @@ def children(ctx: Context, shapes: Shapes, axis: int, parent, index, pos, length
         geom[rows] = piece_geom[rows]
     if ctx.plan.sequential_random:  # PRT's stream: the child's state from its parent's and its number
         key = piece_keys(True, shapes.key[parents], index[order], site)
-    made = Shapes(origin, size, frame, geom, lot, key, depth, tuple(np.take(p, parents) for p in shapes.params),
-                  tuple(np.take(d, parents) for d in shapes.dynamic))
+    made = Shapes(origin, size, frame, geom, lot, key, depth, tuple(p.take(parents) for p in shapes.params),
+                  tuple(d.take(parents) for d in shapes.dynamic))
     if geometry is not None and len(rows) and ctx.plan.ring_slot is not None:
         corner = made.dynamic[ctx.plan.ring_slot].copy()
         corner[rows] = piece_corner[rows]
