@@ -20,34 +20,34 @@ in (whether its shapes may read the planes they carry), to a fixed point over th
 states in which each symbol's shapes may arrive are followed from the start symbol, whose shapes are the
 lots' (not inserted), and each ``comp(f)`` met is judged in the state it is met in.
 
-Where unsure, planes are read: every body's end is taken as a leaf (one that hands on no successor is; which
-operations hand their shape on is the operation table's to say, above the plan), a symbol whose rules all
-have guards as a leaf on arrival, a site the start symbol does not reach, or whose number another site
-shares and reads, keeps its planes, and a grammar that names a plane's column in an expression or a ``set``
-reads them everywhere.
+A body's end is a leaf where no operation of it hands its shape on (``execute.run``: ``HANDS_ON`` names
+them, as the operation table declares them, which the plan is below), and so is a shape that no rule of its
+symbol applies to (every rule has a guard). Where unsure, planes are read: a site the start symbol does
+not reach, or whose number another site shares and reads, keeps its planes. No expression reads the planes' columns, nor ``set`` writes them: they
+are named as no attribute can be (``slots``), and ``set`` takes attributes and ``trim.vertical`` and
+``trim.horizontal``, the switches, which the readers look at.
 """
 
 from __future__ import annotations
 
 from collections import defaultdict
 
-from grammarc.backend.slots import HORIZONTAL_SLOTS, TRIM_INSERTED, TRIM_SLOTS
 from grammarc.ir import nodes as ir
-from grammarc.ir.traverse import all_exprs, iter_ops, sub_bodies
+from grammarc.ir.traverse import sub_bodies
 
 #: Operations that read the shape's trim planes where they run: the paper's instance, and ``trim()``.
 READERS = (ir.Insert, ir.Trim)
+#: Operations that hand their shape on (to successors, parts, an instance or nothing): a body that holds one
+#: leaves no leaf at its end. The operations registered with ``consumes`` (``operations.table``).
+HANDS_ON = frozenset((ir.Symbol, ir.Empty, ir.Insert, ir.Split, ir.Repeat, ir.GroupSplit, ir.SplitArea, ir.Comp,
+                      ir.CompFaces, ir.Cut, ir.Setback, ir.SetbackToArea, ir.InnerRectangle, ir.Case, ir.Stochastic))
 #: Operations after which the shape's geometry is inserted (True) or its own (False).
 MARKS = {ir.UseAsset: True, ir.Primitive: True, ir.Extrude: False, ir.ResetGeometry: False}
-#: The per-shape columns the planes and the mark of inserted geometry are kept in (``backend.slots``).
-COLUMNS = frozenset((*TRIM_SLOTS, *HORIZONTAL_SLOTS, TRIM_INSERTED))
 
 
 def unread_plane_sites(module: ir.Module, start: str) -> frozenset[int]:
     """The sites of ``module``'s ``comp(f)`` splits (without ``offset``) whose faces' trim planes no
     derivation from ``start`` reads: they need not be found."""
-    if _names_columns(module):
-        return frozenset()
     return _Derivation(module).unread(start)
 
 
@@ -55,14 +55,6 @@ def makes_planes(op: ir.Op) -> bool:
     """Whether ``op`` gives its components trim planes: a ``comp(f)``, but the one of an ``offset``'s faces
     (``operations.offsets.offset_faces``), whose components keep their shape's."""
     return isinstance(op, ir.CompFaces) and op.kind == "f" and op.offset is None
-
-
-def _names_columns(module: ir.Module) -> bool:
-    """Whether an expression or a ``set`` of ``module`` names a column of the planes (or the mark): then
-    every shape's planes are read, whatever its rules do."""
-    names = {e.name for e in all_exprs(module) if isinstance(e, (ir.AttrRef, ir.ContextRef))}
-    names |= {op.name for op in iter_ops(module) if isinstance(op, ir.SetAttr)}
-    return bool(names & COLUMNS)
 
 
 class _Derivation:
@@ -111,7 +103,7 @@ class _Derivation:
 
     def _body(self, body: ir.Body, carried: bool, inserted: bool, met: bool) -> bool:
         """Whether shapes running ``body`` may read the planes they arrive with (``carried``: they still
-        have them), their geometry ``inserted`` or not; its end taken as a leaf."""
+        have them), their geometry ``inserted`` or not."""
         read = False
         stack = []
         for op in body:
@@ -135,7 +127,8 @@ class _Derivation:
             else:
                 for part in sub_bodies(op):
                     read |= self._body(part, carried, inserted, met)
-        return read | (carried and inserted)
+        leaf = not any(type(op) in HANDS_ON for op in body)
+        return read | (leaf and carried and inserted)
 
     def _successor(self, op: ir.Symbol, inserted: bool, met: bool) -> bool:
         """Whether a successor's shapes may read the planes they are handed with: as leaves at once (a
