@@ -5,27 +5,28 @@ a grammar that inserts anything gets them for every face of every ``comp(f)`` (`
 are read in three places only: the leaf of a shape whose geometry was inserted (an ``i()`` asset, a
 ``primitive*``, or a box cut out of one: ``terminals.emit_leaves`` cuts it as it is placed), the paper's
 ``I()`` (cut as it is placed) and ``trim()``. Many faces never get there: candler's window reveals are an
-``extrude`` then a ``comp(f)`` whose faces end as textured walls of their own geometry, a fifth of its
-shapes, and finding their planes is a kernel over every face of the split (its faces' neighbours).
+``extrude`` then a ``comp(f)`` whose faces end as textured walls of their own geometry, and finding their
+planes is a kernel over every face of the split (a face's planes need its neighbours).
 
-So this follows the grammar as ``execute.run`` follows a body, with what can be known of a shape without its
-numbers: whether its geometry may be inserted (``i()`` and ``primitive*`` make it so; ``extrude`` and
-``resetGeometry`` make it the shape's own: ``slots.TRIM_INSERTED``) and whether it still carries the planes
-in question (``resetGeometry`` clears them); ``[`` keeps both and ``]`` gives them back. A site's planes are
-read where a shape it makes, or one made from it (parts of splits and of ``comp(e|v)``, case and stochastic
-branches, successors handed on through any number of rules, recursion included), reaches a reader before
-another ``comp(f)`` gives it planes of its own (a nested site that reads none is no reader of these: what
-reaches its parts reads nothing either). Each symbol's rules are summed up once per state its shapes may be
-in (whether its shapes may read the planes they carry), to a fixed point over the rule graph; then the
-states in which each symbol's shapes may arrive are followed from the start symbol, whose shapes are the
-lots' (not inserted), and each ``comp(f)`` met is judged in the state it is met in.
+So this follows the grammar as ``execute.run`` follows a body, with what can be known of a shape without
+its numbers: whether its geometry may be inserted (``i()`` and ``primitive*`` make it so; ``extrude`` and
+``resetGeometry`` make it the shape's own: ``slots.TRIM_INSERTED``) and whether it still carries the
+planes in question (``resetGeometry`` clears them); ``[`` keeps both and ``]`` gives them back. A site's
+planes are read where a shape it makes, or one made from it (parts of splits and of ``comp(e|v)``, case and
+stochastic branches, successors handed on through any number of rules, recursion included), reaches a
+reader before another ``comp(f)`` gives it planes of its own (a nested site whose planes nothing reads is
+no reader of these either: what reaches its parts reads nothing). Each symbol's rules are summed up once
+per state its shapes may arrive in (whether they may read the planes they carry), to the least fixed point
+over the rule graph; then the states in which each symbol's shapes do arrive are followed from the start
+symbol, whose shapes are the lots' (not inserted), and each ``comp(f)`` met is judged in the states it is
+met in.
 
-A body's end is a leaf where no operation of it hands its shape on (``execute.run``: ``HANDS_ON`` names
-them, as the operation table declares them, which the plan is below), and so is a shape that no rule of its
-symbol applies to (every rule has a guard). Where unsure, planes are read: a site the start symbol does
-not reach, or whose number another site shares and reads, keeps its planes. No expression reads the planes' columns, nor ``set`` writes them: they
-are named as no attribute can be (``slots``), and ``set`` takes attributes and ``trim.vertical`` and
-``trim.horizontal``, the switches, which the readers look at.
+A body's end is a leaf where no operation of it hands its shape on (``execute.run``; ``HANDS_ON`` names
+them as the operation table declares them, which is above the plan), and so is a shape that no rule of its
+symbol applies to (every rule has a guard). Where unsure, planes are read: a site the start symbol does not
+reach, or whose number another site shares and reads, keeps its planes. No expression reads the planes'
+columns, nor does ``set`` write them: they are named as no attribute can be (``slots``), and ``set`` takes
+attributes and the switches ``trim.vertical`` and ``trim.horizontal``, which the readers look at.
 """
 
 from __future__ import annotations
