@@ -23,6 +23,7 @@ from grammarc.backend.slots import (
     TRIM_SWITCH,
     uv_slots,
 )
+from grammarc.backend.trim_reads import unread_plane_sites
 from grammarc.ir import nodes as ir
 from grammarc.ir.printer import comp_selectors
 from grammarc.ir.traverse import all_exprs, iter_ops
@@ -96,6 +97,9 @@ class Plan:
     #: ``Shapes.dynamic``) each (``backend.materials``).
     material_slots: tuple[tuple[int, int], ...] = ()
     trim_slot: int | None = None
+    #: The sites of the ``comp(f)`` splits whose faces' trim planes nothing reads (``backend.trim_reads``): their
+    #: faces keep the planes their shape had, unread.
+    unread_planes: frozenset[int] = frozenset()
     trim_switch: int | None = None
     #: whether each shape's geometry was inserted (``slots.TRIM_INSERTED``), where shapes have trim planes.
     inserted_slot: int | None = None
@@ -193,6 +197,7 @@ def make_plan(grammar: Grammar, *, load_asset: Callable = load_asset) -> Plan:
         snapping=frozenset(s.id for s in symbols if any(getattr(op, "snap", False) for rule in s.rules
                                                         for op in iter_ops(rule))),
         color_slot=dynamic.get(COLOR_SLOT), trim_slot=trim_slot,
+        unread_planes=unread_plane_sites(module, grammar.graph.start) if trim_slot is not None else frozenset(),
         material_slots=tuple((k, dynamic[name]) for k, name in enumerate(MAP_FIELDS) if name in dynamic),
         trim_switch=dynamic.get(TRIM_SWITCH) if trim_slot is not None else None,
         inserted_slot=dynamic.get(TRIM_INSERTED),

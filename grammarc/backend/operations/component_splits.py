@@ -78,8 +78,9 @@ def comp_faces(ctx: Context, cursor: Shapes, op: ir.CompFaces) -> Parts:
         if shapes.frame is not framed:  # faces turned: their new axes
             axes = chunk.frames[shapes.frame]
     slot = ctx.plan.trim_slot
-    if op.kind == "f" and slot is not None:
-        # the faces' trim planes where they meet their neighbours (``geometry.trim``)
+    if op.kind == "f" and slot is not None and op.site not in ctx.plan.unread_planes:
+        # the faces' trim planes where they meet their neighbours (``geometry.trim``), where something reads
+        # them (``backend.trim_reads``; elsewhere the faces keep their shape's, which nothing reads either)
         # relative to the lot's origin, so that a lot far from the origin is trimmed as it is there
         up = chunk.frames.data[cursor.frame, 1][parent]
         origin = shapes.origin - chunk.lot_origin[shapes.lot]
