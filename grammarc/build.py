@@ -337,9 +337,9 @@ def _derive_chunks(plan, lots: Lots, options: BuildOptions, writer, failed: list
         window: deque = deque()
         try:
             while first < len(lots) or window:
-                # before the first chunk's records are known, its size and the next are FIRST_CHUNK: the
-                # first chunk alone, or one for each worker (``workers.first_tasks``); then a chunk for each
-                # worker and one more, waiting, sized by the records a lot makes
+                # before the first chunk's records are known: the first chunk alone, or one for each worker
+                # (``workers.first_tasks``); then a chunk for each worker and one more, waiting, sized by
+                # the records a lot makes
                 while first < len(lots) and len(window) < (workers + 1 if written else first_tasks(workers)):
                     last = last or _last_share(size, len(lots) - first, workers)
                     part = lots.take(slice(first, first + (last or size)))

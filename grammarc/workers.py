@@ -97,7 +97,7 @@ def worker_pool(work: Callable, workers: int):
     _SHARED.update(work=work)
     slots = _Slots(folder)
     try:
-        here = not _warm  # the first task runs here; the pool forks its workers at the next
+        here = not _warm  # the first task runs here, but in a warm process; the pool forks its workers at the next
         with ProcessPoolExecutor(workers, mp_context=multiprocessing.get_context("fork"),
                                  initializer=_start_worker) as pool:
             def submit(lots) -> Future:
