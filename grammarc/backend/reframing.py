@@ -13,7 +13,6 @@ import numpy as np
 from grammarc.backend import mesh_shapes
 from grammarc.backend.box_rings import corners, with_corners
 from grammarc.backend.context import Context
-from grammarc.backend.kernels.scope import turned_frames
 from grammarc.backend.outlines import polygons_of
 from grammarc.backend.shapes import Shapes
 from grammarc.geometry.components import rect_corners
@@ -30,26 +29,25 @@ def turned(ctx: Context, shapes: Shapes, turn: np.ndarray, matrices: np.ndarray,
         return shapes
     rows = np.flatnonzero(turn)
     sub = shapes.take(turn)  # the batch itself where all turn (a comp(f)'s faces, extruded)
-    new_axes = turned_frames(matrices[axis[rows]], ctx.chunk.frames.data, sub.frame)
+    frame = ctx.chunk.frames.turned(matrices, sub.frame, axis[rows])  # one row per frame and axis
     if len(rows) == len(shapes):  # nothing to merge them with
-        return reframed(ctx, sub, new_axes, span)
+        return reframed(ctx, sub, frame, span)
     others = np.flatnonzero(~turn)
-    return Shapes.merge([shapes.take(others), reframed(ctx, sub, new_axes, span)], [others, rows])
+    return Shapes.merge([shapes.take(others), reframed(ctx, sub, frame, span)], [others, rows])
 
 
-def reframed(ctx: Context, shapes: Shapes, new_axes: np.ndarray, span) -> Shapes:
-    """The same geometry in scopes with ``new_axes`` (n, 3, 3), fitted to it; fails the lots of inserted
-    assets."""
+def reframed(ctx: Context, shapes: Shapes, frame: np.ndarray, span) -> Shapes:
+    """The same geometry in the scopes of the frames ``frame`` (n,) (ids in the chunk's table, which shapes
+    turned alike share), fitted to it; fails the lots of inserted assets."""
     chunk = ctx.chunk
     mesh = is_mesh(shapes.geom)
     if mesh.any():
-        new_axes = np.asarray(new_axes)
         if mesh.all():
-            return mesh_shapes.reframe_meshes(chunk, shapes, new_axes)
+            return mesh_shapes.reframe_meshes(chunk, shapes, frame)
         rows = np.flatnonzero(mesh)
         others = np.flatnonzero(~mesh)
-        return Shapes.merge([mesh_shapes.reframe_meshes(chunk, shapes.take(rows), new_axes[rows]),
-                             reframed(ctx, shapes.take(others), new_axes[others], span)],
+        return Shapes.merge([mesh_shapes.reframe_meshes(chunk, shapes.take(rows), frame[rows]),
+                             reframed(ctx, shapes.take(others), frame[others], span)],
                             [rows, others])
     n = len(shapes)
     bad = shapes.geom < -1
@@ -58,14 +56,14 @@ def reframed(ctx: Context, shapes: Shapes, new_axes: np.ndarray, span) -> Shapes
     coords, ring_offsets, shape_offsets, plane = polygons_of(chunk, shapes, corners(ctx.plan, shapes))
     ok, plane, origin, size, is_rect, new_coords = reframe(
         shapes.origin, shapes.size, chunk.frames[shapes.frame], coords, ring_offsets, shape_offsets,
-        plane, new_axes)
+        plane, chunk.frames[frame])
     geom = np.full(n, -1, dtype=np.int32)
     poly = np.flatnonzero(~is_rect & ok)
     if len(poly):
         rings, packed_shapes = ragged_take(shape_offsets, poly)
         vertices, packed_rings = ragged_take(ring_offsets, rings)
         geom[poly] = chunk.polygons.add(new_coords[vertices], packed_rings, packed_shapes, plane[poly])
-    result = shapes.with_scope(origin, size, chunk.frames.add(np.ascontiguousarray(new_axes)), geom)
+    result = shapes.with_scope(origin, size, frame, geom)
     if ctx.plan.ring_slot is not None:  # a rectangle kept as its box keeps its ring's first vertex
         result = with_corners(ctx.plan, result, np.where(
             is_rect, rect_corners(new_coords[ring_offsets[shape_offsets[:-1]]], plane), 0))
@@ -73,5 +71,5 @@ def reframed(ctx: Context, shapes: Shapes, new_axes: np.ndarray, span) -> Shapes
         return result
     # Turned out of their polygon's plane (a prism onto a side face, a face tilted): their faces as meshes.
     rows, others = np.flatnonzero(~ok), np.flatnonzero(ok)
-    turned = mesh_shapes.reframe_meshes(chunk, shapes.take(rows), new_axes[rows])
+    turned = mesh_shapes.reframe_meshes(chunk, shapes.take(rows), frame[rows])
     return Shapes.merge([result.take(others), turned], [others, rows])
