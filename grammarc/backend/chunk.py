@@ -61,16 +61,20 @@ class Frames(Table):
             assert np.allclose(np.linalg.det(axes), 1.0, atol=1e-9), "a scope frame is left-handed"
         return super().add(axes)
 
-    def turned(self, local_axes: np.ndarray, frame: np.ndarray, local: np.ndarray | None = None) -> np.ndarray:
-        """Ids (m,) int32 of the frames ``local_axes[local] @ self[frame]``: turn c gives the axes
-        ``local_axes[local[c]]`` (``local`` None: ``local_axes[c]``), rows in the frame ``frame[c]``. Turns of
-        the same frame id by the same axes (a window's front faces, each window's box in its facade's frame)
-        share one new row: each is computed and stored once (``kernels.scope.distinct_turns``)."""
+    def turned(self, local_axes: np.ndarray, frame: np.ndarray,
+               local: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
+        """The frames ``local_axes[local] @ self[frame]``, their ids (m,) int32 and axes (m, 3, 3): turn c
+        gives the axes ``local_axes[local[c]]`` (``local`` None: ``local_axes[c]``), rows in the frame
+        ``frame[c]``. Turns of the same frame id by the same axes (the same face of every window's box in
+        a facade's frame) share one new row, computed and stored once (``kernels.turns``)."""
         local_axes = np.ascontiguousarray(local_axes, dtype=np.float64)
         local = None if local is None else np.asarray(local, dtype=np.int64)
         first, which = distinct_turns(frame, local_axes, local)
-        ids = self.add(turned_frames(local_axes[first if local is None else local[first]], self.data, frame[first]))
-        return ids if len(first) == len(which) else ids[which]
+        if len(first) == len(frame):  # every turn its own (``first`` is every turn, in order)
+            axes = turned_frames(local_axes if local is None else local_axes[local], self.data, frame)
+            return self.add(axes), axes
+        axes = turned_frames(local_axes[first if local is None else local[first]], self.data, frame[first])
+        return self.add(axes)[which], np.take(axes, which, axis=0)
 
 
 class TextureMaps(Table):

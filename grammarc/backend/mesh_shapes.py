@@ -234,15 +234,15 @@ def cut_to_slabs(verts, ring_offsets, face_offsets, mesh_offsets, child_mesh, ax
     return cut
 
 
-def reframe_meshes(chunk: Chunk, shapes: Shapes, frame: np.ndarray) -> Shapes:
-    """Shapes in the scopes of the frames ``frame`` (n,) around unchanged geometry (``alignScopeToAxes``,
-    ``rotateScope``, ``alignScopeToGeometry``): any turn, their faces (``geometry.queries.shape_faces``: a
-    polygon or a prism its faces, a mesh its own) stored as a mesh fitted to the new scope. A scope box
-    turned by quarter turns (each new axis an old one or its opposite) stays a box."""
+def reframe_meshes(chunk: Chunk, shapes: Shapes, new_axes: np.ndarray, frame: np.ndarray) -> Shapes:
+    """Shapes in scopes with ``new_axes`` (n, 3, 3), the rows of the frames ``frame`` (n,), around unchanged
+    geometry (``alignScopeToAxes``, ``rotateScope``, ``alignScopeToGeometry``): any turn, their faces
+    (``geometry.queries.shape_faces``: a polygon or a prism its faces, a mesh its own) stored as a mesh
+    fitted to the new scope. A scope box turned by quarter turns (each new axis an old one or its opposite)
+    stays a box."""
     faces = shape_faces(shapes.size, shapes.geom, chunk.polygons, chunk.meshes)
     vertex_shape = faces.vertex_shape()
     old_axes = chunk.frames[shapes.frame]
-    new_axes = chunk.frames[frame]
     # world offsets from the old origin, then coordinates along the new axes
     world = np.einsum("vi,vij->vj", faces.verts, old_axes[vertex_shape])
     local = np.einsum("vj,vij->vi", world, new_axes[vertex_shape])

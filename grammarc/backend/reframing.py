@@ -29,25 +29,29 @@ def turned(ctx: Context, shapes: Shapes, turn: np.ndarray, matrices: np.ndarray,
         return shapes
     rows = np.flatnonzero(turn)
     sub = shapes.take(turn)  # the batch itself where all turn (a comp(f)'s faces, extruded)
-    frame = ctx.chunk.frames.turned(matrices, sub.frame, axis[rows])  # one row per frame and axis
+    frame, new_axes = ctx.chunk.frames.turned(matrices, sub.frame, axis[rows])  # a row per frame and axis
     if len(rows) == len(shapes):  # nothing to merge them with
-        return reframed(ctx, sub, frame, span)
+        return reframed(ctx, sub, new_axes, span, frame)
     others = np.flatnonzero(~turn)
-    return Shapes.merge([shapes.take(others), reframed(ctx, sub, frame, span)], [others, rows])
+    return Shapes.merge([shapes.take(others), reframed(ctx, sub, new_axes, span, frame)], [others, rows])
 
 
-def reframed(ctx: Context, shapes: Shapes, frame: np.ndarray, span) -> Shapes:
-    """The same geometry in the scopes of the frames ``frame`` (n,) (ids in the chunk's table, which shapes
-    turned alike share), fitted to it; fails the lots of inserted assets."""
+def reframed(ctx: Context, shapes: Shapes, new_axes: np.ndarray, span, frame: np.ndarray | None = None) -> Shapes:
+    """The same geometry in scopes with ``new_axes`` (n, 3, 3), fitted to it; fails the lots of inserted
+    assets. ``frame`` (n,): the ids of ``new_axes`` where the caller has them in the chunk's table (shapes
+    turned alike share a row: ``turned``); else each shape gets a row of its own."""
     chunk = ctx.chunk
+    if frame is None:
+        frame = chunk.frames.add(np.ascontiguousarray(new_axes))
     mesh = is_mesh(shapes.geom)
     if mesh.any():
+        new_axes = np.asarray(new_axes)
         if mesh.all():
-            return mesh_shapes.reframe_meshes(chunk, shapes, frame)
+            return mesh_shapes.reframe_meshes(chunk, shapes, new_axes, frame)
         rows = np.flatnonzero(mesh)
         others = np.flatnonzero(~mesh)
-        return Shapes.merge([mesh_shapes.reframe_meshes(chunk, shapes.take(rows), frame[rows]),
-                             reframed(ctx, shapes.take(others), frame[others], span)],
+        return Shapes.merge([mesh_shapes.reframe_meshes(chunk, shapes.take(rows), new_axes[rows], frame[rows]),
+                             reframed(ctx, shapes.take(others), new_axes[others], span, frame[others])],
                             [rows, others])
     n = len(shapes)
     bad = shapes.geom < -1
@@ -56,7 +60,7 @@ def reframed(ctx: Context, shapes: Shapes, frame: np.ndarray, span) -> Shapes:
     coords, ring_offsets, shape_offsets, plane = polygons_of(chunk, shapes, corners(ctx.plan, shapes))
     ok, plane, origin, size, is_rect, new_coords = reframe(
         shapes.origin, shapes.size, chunk.frames[shapes.frame], coords, ring_offsets, shape_offsets,
-        plane, chunk.frames[frame])
+        plane, new_axes)
     geom = np.full(n, -1, dtype=np.int32)
     poly = np.flatnonzero(~is_rect & ok)
     if len(poly):
@@ -71,5 +75,5 @@ def reframed(ctx: Context, shapes: Shapes, frame: np.ndarray, span) -> Shapes:
         return result
     # Turned out of their polygon's plane (a prism onto a side face, a face tilted): their faces as meshes.
     rows, others = np.flatnonzero(~ok), np.flatnonzero(ok)
-    turned = mesh_shapes.reframe_meshes(chunk, shapes.take(rows), frame[rows])
+    turned = mesh_shapes.reframe_meshes(chunk, shapes.take(rows), new_axes[rows], frame[rows])
     return Shapes.merge([result.take(others), turned], [others, rows])

@@ -165,13 +165,13 @@ def components(ctx: Context, kind: int, cursor: Shapes, site: int, span, wanted=
     if bad.any():  # a scope of sizes no float can square has no component frames (``refuse_far`` fails such a
         # scope where it is made: this guards the kernel's output)
         ctx.fail_lots(child.lot[bad], "a component of a scope whose size is beyond any geometry", span)
-    frame = chunk.frames.turned(axes, child.frame)  # the same face of many boxes in one frame: one row
+    frame, world_axes = chunk.frames.turned(axes, child.frame)  # the same face of many boxes in a frame: one row
     shapes = Shapes(world_origin, size, frame, geom.astype(np.int32), child.lot,
                     piece_keys(ctx.plan.sequential_random, child.key, index, site), child.depth, child.params,
                     child.dynamic)
     shapes = with_corners(ctx.plan, shapes, corner)
     return (with_context(ctx.plan, shapes, "comp", index, parent, len(cursor)), normal, index, parent, roof,
-            border, chunk.frames[frame])
+            border, world_axes)
 
 
 def _solid_components(chunk, kind: int, cursor: Shapes, solid: np.ndarray, corner: np.ndarray | None):

@@ -191,8 +191,7 @@ def _along_first_edges(ctx: Context, shapes: Shapes, pieces: list, span) -> Shap
     new_axes = axes.copy()
     new_axes[k, u] = cos * axes[k, u] + sin * axes[k, v]
     new_axes[k, v] = cos * axes[k, v] - sin * axes[k, u]
-    return Shapes.merge([shapes.take(others), reframed(ctx, shapes.take(rows), ctx.chunk.frames.add(new_axes), span)],
-                        [others, rows])
+    return Shapes.merge([shapes.take(others), reframed(ctx, shapes.take(rows), new_axes, span)], [others, rows])
 
 
 

@@ -417,7 +417,8 @@ def align_scope(ctx: Context, cursor: Shapes, op: ir.AlignScope) -> Shapes:
     frames = ctx.chunk.frames
     n = len(cursor)
     if op.mode == "world":  # one frame for all
-        return reframed(ctx, cursor, np.repeat(frames.add(np.eye(3)[None]), n), op.span)
+        return reframed(ctx, cursor, np.broadcast_to(np.eye(3), (n, 3, 3)), op.span,
+                        np.repeat(frames.add(np.eye(3)[None]), n))
     axes = frames[cursor.frame]
     if op.mode == "rotate":  # rotateScope: in xyz order as r, about the pivot's axes where it is kept
         env = ctx.env(cursor)
@@ -426,7 +427,7 @@ def align_scope(ctx: Context, cursor: Shapes, op: ir.AlignScope) -> Shapes:
             np.einsum("nij,njk->nik", orientation(*angles), axes)
     else:
         new_axes = _world_axis(axes, "xyz".index(op.mode))
-    return reframed(ctx, cursor, frames.add(new_axes), op.span)
+    return reframed(ctx, cursor, new_axes, op.span)
 
 
 #: Per world axis k of ``alignScopeToAxes(k)``: the scope axis projected onto the plane across it (the
@@ -480,12 +481,12 @@ def align_to_geometry(ctx: Context, cursor: Shapes, op: ir.AlignToGeometry) -> S
     edge[found] = verts[end[found]] - verts[start[found]]
     new_axes, ok = aligned_axes(edge, normal, axes, op.up)
     if ok.all():
-        return reframed(ctx, cursor, chunk.frames.add(new_axes), op.span)
+        return reframed(ctx, cursor, new_axes, op.span)
     # no face with an area, or no edge with a length (a line, a point, a degenerate face): the scope stays,
     # as CityEngine leaves it rather than stopping the model
     rows, others = np.flatnonzero(ok), np.flatnonzero(~ok)
-    return Shapes.merge([reframed(ctx, cursor.take(rows), chunk.frames.add(new_axes[rows]), op.span),
-                         cursor.take(others)], [rows, others])
+    return Shapes.merge([reframed(ctx, cursor.take(rows), new_axes[rows], op.span), cursor.take(others)],
+                        [rows, others])
 
 
 @operation(ir.AlignScopeToBBox, writes=_REFRAMED, meshes=True)
@@ -503,8 +504,8 @@ def align_scope_to_bbox(ctx: Context, cursor: Shapes, op: ir.AlignScopeToBBox) -
     new_axes[:, a] = turn[:, :1] * axes[:, a] + turn[:, 1:] * axes[:, b]
     new_axes[:, b] = turn[:, :1] * axes[:, b] - turn[:, 1:] * axes[:, a]
     rows, others = np.flatnonzero(ok), np.flatnonzero(~ok)
-    return Shapes.merge([reframed(ctx, cursor.take(rows), ctx.chunk.frames.add(new_axes[rows]), op.span),
-                         cursor.take(others)], [rows, others])
+    return Shapes.merge([reframed(ctx, cursor.take(rows), new_axes[rows], op.span), cursor.take(others)],
+                        [rows, others])
 
 
 @operation(ir.Mirror, writes=("geom",), meshes=True)
@@ -575,7 +576,7 @@ def mirror_scope(ctx: Context, cursor: Shapes, op: ir.MirrorScope) -> Shapes:
     if not flips.any():
         return cursor
     new_axes = ctx.chunk.frames[cursor.frame] * np.where(flips, -1.0, 1.0)[:, :, None]
-    return reframed(ctx, cursor, ctx.chunk.frames.add(new_axes), op.span)
+    return reframed(ctx, cursor, new_axes, op.span)
 
 
 @operation(ir.SetPivot, writes=(*_SCOPE, "dynamic"), meshes=True)
@@ -596,9 +597,9 @@ def set_pivot(ctx: Context, cursor: Shapes, op: ir.SetPivot) -> Shapes:
     origin = cursor.origin + np.einsum("ni,nij->nj", ends * cursor.size, axes)
     # a new axis is an old one, reversed or not: its size is that one's
     size = np.abs(np.einsum("nij,nj->ni", turn, cursor.size))
-    moved = cursor.with_scope(origin, size, frames.add(new_axes), cursor.geom)
+    moved = cursor.with_scope(origin, size, frames.add(np.ascontiguousarray(new_axes)), cursor.geom)
     if not box.all():
         rows, others = np.flatnonzero(~box), np.flatnonzero(box)
-        moved = Shapes.merge([moved.take(others), reframed(ctx, cursor.take(rows), moved.frame[rows], op.span)],
-                             [others, rows])
+        moved = Shapes.merge([moved.take(others), reframed(ctx, cursor.take(rows), new_axes[rows], op.span,
+                                                           moved.frame[rows])], [others, rows])
     return with_pivot(ctx.plan.pivot_slot, moved, moved.origin, moved.frame)

@@ -137,15 +137,16 @@ def _group_layout(ctx: Context, cursor: Shapes, op: ir.GroupSplit, values: np.nd
 def _group_children(ctx: Context, cursor: Shapes, op: ir.GroupSplit, axis: int, parent, part, pos, length, index,
                     frame: np.ndarray | None = None) -> Parts:
     """The children of a split's parts along ``axis``, their geometry cut to their slabs, by part; with the
-    parents' ``frame`` ids (a split in texture space, its shapes turned) they take those frames again. A box whose
-    ring starts elsewhere than corner 0 is cut as its polygon (``box_rings.as_polygons``)."""
+    parents' ``frame`` ids (a split in texture space, its shapes turned) they take those frames again. A box
+    whose ring starts elsewhere than corner 0 is cut as its polygon (``box_rings.as_polygons``)."""
     cursor = as_polygons(ctx.plan, ctx.chunk, cursor, axis)
     parent, part, pos, length, index, geometry = clip(ctx.chunk, cursor, axis, parent, part, pos, length,
                                                       index, op.adjust, turn_cuts=True)
     order, offsets = group_by(part, len(op.parts))
     made = children(ctx, cursor, axis, parent, index, pos, length, op.site, order, geometry)
     if frame is not None:  # the children take their parent's frame again
-        made = reframed(ctx, made, frame[parent[order]], op.span)
+        frame = frame[parent[order]]
+        made = reframed(ctx, made, ctx.chunk.frames[frame], op.span, frame)
     ctx.count(made, op.span)
     return Parts(op.parts, made, offsets)
 

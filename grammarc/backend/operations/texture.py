@@ -159,8 +159,7 @@ def texture_axis(ctx: Context, cursor: Shapes, op: ir.GroupSplit) -> tuple[Shape
         ctx.fail(cursor, bad, f"`split({name}, ...)` of a shape whose texture set {op.uv_set} has no {name} "
                  "across its surface (projectUV first)", op.span)
     direction = along / length[:, None]
-    turned = reframed(ctx, cursor, chunk.frames.add(np.stack([direction, np.cross(normal, direction), normal], axis=1)),
-                      op.span)
+    turned = reframed(ctx, cursor, np.stack([direction, np.cross(normal, direction), normal], axis=1), op.span)
     return turned, np.ones(len(cursor)) if op.unit_space else 1.0 / length, cursor.frame
 
 
