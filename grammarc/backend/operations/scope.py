@@ -139,7 +139,7 @@ def rotate(ctx: Context, cursor: Shapes, op: ir.Rotate) -> Shapes:
         turn = orientation if op.fixed else rotation
         n = len(cursor)
         matrices = turn(*(np.broadcast_to(np.asarray(a, np.float64), (n,)) for a in angles))
-        frame = frames.add(np.einsum("nij,njk->nik", matrices, frames[cursor.frame]))
+        frame = frames.turned(matrices, cursor.frame)[0]  # shapes of one frame turned alike share a row
     origin = cursor.origin
     if op.center:
         half = cursor.size / 2
