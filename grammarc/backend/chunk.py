@@ -10,6 +10,8 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from grammarc.backend.choices import Choices
+from grammarc.backend.kernels.scope import turned_frames
+from grammarc.backend.kernels.turns import distinct_turns
 from grammarc.backend.occlusion import Occluders, OccluderStore
 from grammarc.backend.snaps import SnapStore
 from grammarc.constants import STRICT
@@ -58,6 +60,21 @@ class Frames(Table):
             assert np.allclose(gram, np.eye(3), atol=1e-9), "a scope frame is not orthonormal"
             assert np.allclose(np.linalg.det(axes), 1.0, atol=1e-9), "a scope frame is left-handed"
         return super().add(axes)
+
+    def turned(self, local_axes: np.ndarray, frame: np.ndarray,
+               local: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
+        """The frames ``local_axes[local] @ self[frame]``, their ids (m,) int32 and axes (m, 3, 3): turn c
+        gives the axes ``local_axes[local[c]]`` (``local`` None: ``local_axes[c]``), rows in the frame
+        ``frame[c]``. Turns of the same frame id by the same axes (the same face of every window's box in
+        a facade's frame) share one new row, computed and stored once (``kernels.turns``)."""
+        local_axes = np.ascontiguousarray(local_axes, dtype=np.float64)
+        local = None if local is None else np.asarray(local, dtype=np.int64)
+        first, which = distinct_turns(frame, local_axes, local)
+        if len(first) == len(frame):  # every turn its own (``first`` is every turn, in order)
+            axes = turned_frames(local_axes if local is None else local_axes[local], self.data, frame)
+            return self.add(axes), axes
+        axes = turned_frames(local_axes[first if local is None else local[first]], self.data, frame[first])
+        return self.add(axes)[which], np.take(axes, which, axis=0)
 
 
 class TextureMaps(Table):

@@ -234,11 +234,12 @@ def cut_to_slabs(verts, ring_offsets, face_offsets, mesh_offsets, child_mesh, ax
     return cut
 
 
-def reframe_meshes(chunk: Chunk, shapes: Shapes, new_axes: np.ndarray) -> Shapes:
-    """Shapes in scopes with ``new_axes`` (n, 3, 3) around unchanged geometry (``alignScopeToAxes``,
-    ``rotateScope``, ``alignScopeToGeometry``): any turn, their faces (``geometry.queries.shape_faces``: a
-    polygon or a prism its faces, a mesh its own) stored as a mesh fitted to the new scope. A scope box
-    turned by quarter turns (each new axis an old one or its opposite) stays a box."""
+def reframe_meshes(chunk: Chunk, shapes: Shapes, new_axes: np.ndarray, frame: np.ndarray) -> Shapes:
+    """Shapes in scopes with ``new_axes`` (n, 3, 3), the rows of the frames ``frame`` (n,), around unchanged
+    geometry (``alignScopeToAxes``, ``rotateScope``, ``alignScopeToGeometry``): any turn, their faces
+    (``geometry.queries.shape_faces``: a polygon or a prism its faces, a mesh its own) stored as a mesh
+    fitted to the new scope. A scope box turned by quarter turns (each new axis an old one or its opposite)
+    stays a box."""
     faces = shape_faces(shapes.size, shapes.geom, chunk.polygons, chunk.meshes)
     vertex_shape = faces.vertex_shape()
     old_axes = chunk.frames[shapes.frame]
@@ -250,7 +251,7 @@ def reframe_meshes(chunk: Chunk, shapes: Shapes, new_axes: np.ndarray) -> Shapes
     box = (shapes.geom == -1) & (np.abs(turns.max(axis=2) - 1) < 1e-9).all(axis=1)
     geom[box] = -1
     origin = shapes.origin + np.einsum("ni,nij->nj", low, new_axes)
-    return shapes.with_scope(origin, size, chunk.frames.add(np.ascontiguousarray(new_axes)), geom)
+    return shapes.with_scope(origin, size, frame, geom)
 
 
 def clean_meshes(chunk: Chunk, shapes: Shapes, tolerance: np.ndarray, component: str) -> np.ndarray:

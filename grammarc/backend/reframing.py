@@ -13,7 +13,6 @@ import numpy as np
 from grammarc.backend import mesh_shapes
 from grammarc.backend.box_rings import corners, with_corners
 from grammarc.backend.context import Context
-from grammarc.backend.kernels.scope import turned_frames
 from grammarc.backend.outlines import polygons_of
 from grammarc.backend.shapes import Shapes
 from grammarc.geometry.components import rect_corners
@@ -30,26 +29,29 @@ def turned(ctx: Context, shapes: Shapes, turn: np.ndarray, matrices: np.ndarray,
         return shapes
     rows = np.flatnonzero(turn)
     sub = shapes.take(turn)  # the batch itself where all turn (a comp(f)'s faces, extruded)
-    new_axes = turned_frames(matrices[axis[rows]], ctx.chunk.frames.data, sub.frame)
+    frame, new_axes = ctx.chunk.frames.turned(matrices, sub.frame, axis[rows])  # a row per frame and axis
     if len(rows) == len(shapes):  # nothing to merge them with
-        return reframed(ctx, sub, new_axes, span)
+        return reframed(ctx, sub, new_axes, span, frame)
     others = np.flatnonzero(~turn)
-    return Shapes.merge([shapes.take(others), reframed(ctx, sub, new_axes, span)], [others, rows])
+    return Shapes.merge([shapes.take(others), reframed(ctx, sub, new_axes, span, frame)], [others, rows])
 
 
-def reframed(ctx: Context, shapes: Shapes, new_axes: np.ndarray, span) -> Shapes:
+def reframed(ctx: Context, shapes: Shapes, new_axes: np.ndarray, span, frame: np.ndarray | None = None) -> Shapes:
     """The same geometry in scopes with ``new_axes`` (n, 3, 3), fitted to it; fails the lots of inserted
-    assets."""
+    assets. ``frame`` (n,): the ids of ``new_axes`` where the caller has them in the chunk's table (shapes
+    turned alike share a row: ``turned``); else each shape gets a row of its own."""
     chunk = ctx.chunk
+    if frame is None:
+        frame = chunk.frames.add(np.ascontiguousarray(new_axes))
     mesh = is_mesh(shapes.geom)
     if mesh.any():
         new_axes = np.asarray(new_axes)
         if mesh.all():
-            return mesh_shapes.reframe_meshes(chunk, shapes, new_axes)
+            return mesh_shapes.reframe_meshes(chunk, shapes, new_axes, frame)
         rows = np.flatnonzero(mesh)
         others = np.flatnonzero(~mesh)
-        return Shapes.merge([mesh_shapes.reframe_meshes(chunk, shapes.take(rows), new_axes[rows]),
-                             reframed(ctx, shapes.take(others), new_axes[others], span)],
+        return Shapes.merge([mesh_shapes.reframe_meshes(chunk, shapes.take(rows), new_axes[rows], frame[rows]),
+                             reframed(ctx, shapes.take(others), new_axes[others], span, frame[others])],
                             [rows, others])
     n = len(shapes)
     bad = shapes.geom < -1
@@ -65,7 +67,7 @@ def reframed(ctx: Context, shapes: Shapes, new_axes: np.ndarray, span) -> Shapes
         rings, packed_shapes = ragged_take(shape_offsets, poly)
         vertices, packed_rings = ragged_take(ring_offsets, rings)
         geom[poly] = chunk.polygons.add(new_coords[vertices], packed_rings, packed_shapes, plane[poly])
-    result = shapes.with_scope(origin, size, chunk.frames.add(np.ascontiguousarray(new_axes)), geom)
+    result = shapes.with_scope(origin, size, frame, geom)
     if ctx.plan.ring_slot is not None:  # a rectangle kept as its box keeps its ring's first vertex
         result = with_corners(ctx.plan, result, np.where(
             is_rect, rect_corners(new_coords[ring_offsets[shape_offsets[:-1]]], plane), 0))
@@ -73,5 +75,5 @@ def reframed(ctx: Context, shapes: Shapes, new_axes: np.ndarray, span) -> Shapes
         return result
     # Turned out of their polygon's plane (a prism onto a side face, a face tilted): their faces as meshes.
     rows, others = np.flatnonzero(~ok), np.flatnonzero(ok)
-    turned = mesh_shapes.reframe_meshes(chunk, shapes.take(rows), new_axes[rows])
+    turned = mesh_shapes.reframe_meshes(chunk, shapes.take(rows), new_axes[rows], frame[rows])
     return Shapes.merge([result.take(others), turned], [others, rows])

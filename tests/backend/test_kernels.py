@@ -9,7 +9,7 @@ import pytest
 
 from grammarc.backend.kernels.order import group_by, place, put, scatter_rows, tally
 from grammarc.backend.kernels.scope import (
-    component_frames,
+    component_origins,
     leaf_kinds,
     place_children,
     translated,
@@ -18,6 +18,7 @@ from grammarc.backend.kernels.scope import (
 )
 from grammarc.backend.kernels.split import repeat, repeat_counts, subdiv
 from grammarc.backend.kernels.texture import instance_maps, vertex_maps
+from grammarc.backend.kernels.turns import _MOSTLY_NEW, distinct_turns
 from grammarc.backend.random import child_keys
 
 SIZES = [0, 1, 2, 50]
@@ -291,7 +292,7 @@ def test_leaf_kinds(n):
 
 
 @pytest.mark.parametrize("n", SIZES)
-def test_component_frames_give_einsums_bits_signed_zeros_included(n):
+def test_component_origins_give_einsums_bits_signed_zeros_included(n):
     rng = np.random.default_rng(n)
     frames = random_frames(rng, 6)
     frames[5] = np.eye(3) * np.array([1.0, -1.0, -1.0])[:, None]  # a turn whose zeros are signed
@@ -301,12 +302,10 @@ def test_component_frames_give_einsums_bits_signed_zeros_included(n):
     local_axes = random_frames(rng, n)
     local_axes[::3] = np.eye(3) * np.array([-1.0, -1.0, 1.0])[:, None]
     local_axes[1::7] *= 1e155  # its axes' squares overflow: not orthonormal
-    world_origin, world_axes, bad = component_frames(frames, frame, origin, local_origin, local_axes, 1e-6)
+    world_origin, bad = component_origins(frames, frame, origin, local_origin, local_axes, 1e-6)
     want_origin = origin + np.einsum("ni,nij->nj", local_origin, frames[frame])
-    want_axes = np.einsum("nij,njk->nik", local_axes, frames[frame])
     gram = np.einsum("nij,nkj->nik", local_axes, local_axes)
     assert np.array_equal(world_origin.view(np.int64), want_origin.view(np.int64))
-    assert np.array_equal(world_axes.view(np.int64), want_axes.view(np.int64))
     assert np.array_equal(bad, ~(np.abs(gram - np.eye(3)) < 1e-6).all(axis=(1, 2)))
     assert bad[1::7].all()
 
@@ -415,3 +414,79 @@ def test_vertex_maps_give_numpys_bits(n):
     got = vertex_maps(table, map_id, lot_origin, lot, vertex_shape, vertices)
     assert got.dtype == np.float32 and got.shape == (len(vertex_shape), 2)
     assert np.array_equal(got.view(np.int32), want.astype(np.float32).view(np.int32))
+
+
+# -------------------------------------------------------------------------------------------- turns.distinct
+
+
+def distinct_reference(frame, local_axes, local):
+    """The distinct (frame id, bits of local axes) keys in the order they first come, by a dict."""
+    seen, first, which = {}, [], []
+    for c in range(len(frame)):
+        key = (int(frame[c]), local_axes[c if local is None else local[c]].tobytes())
+        if key not in seen:
+            seen[key] = len(first)
+            first.append(c)
+        which.append(seen[key])
+    return np.array(first, dtype=np.int64), np.array(which, dtype=np.int32)
+
+
+def turns_with_repeats(rng, m, n_frames, n_local):
+    """m turns of n_frames frame ids by n_local local axes, among them signed zeros and a NaN: -0.0 and
+    0.0 are different bits, so different turns; the same NaN's bits are the same turn."""
+    local_axes = np.where(rng.random((n_local, 3, 3)) < 0.3, 0.0, rng.normal(size=(n_local, 3, 3)))
+    local_axes[1 % n_local] = np.eye(3)
+    local_axes[2 % n_local] = np.eye(3) * np.array([1.0, -1.0, -1.0])[:, None]  # signed zeros
+    local_axes[3 % n_local] = np.where(np.eye(3) == 0, -0.0, 1.0)  # the identity with -0.0 for its zeros
+    local_axes[4 % n_local, 0, 0] = np.nan
+    frame = rng.integers(0, n_frames, m).astype(np.int32)
+    return frame, np.ascontiguousarray(local_axes), rng.integers(0, n_local, m).astype(np.int64)
+
+
+@pytest.mark.parametrize("m, n_frames, n_local", [(0, 1, 5), (1, 1, 5), (50, 3, 5), (5000, 40, 9),
+                                                  (20000, 300, 12)])
+def test_distinct_turns_find_each_key_once_in_order(m, n_frames, n_local):
+    rng = np.random.default_rng(m)
+    frame, local_axes, local = turns_with_repeats(rng, m, n_frames, n_local)
+    local[1::2] = local[:-1:2]  # runs of the same turn, which skip the table
+    frame[1::2] = frame[:-1:2]
+    want_first, want_which = distinct_reference(frame, local_axes, local)
+    first, which = distinct_turns(frame, local_axes, local)
+    assert first.dtype == np.int64 and which.dtype == np.int32
+    assert np.array_equal(first, want_first) and np.array_equal(which, want_which)
+    # the same with every turn's local axes given (local None)
+    per_turn = np.ascontiguousarray(local_axes[local])
+    first, which = distinct_turns(frame, per_turn, None)
+    assert np.array_equal(first, want_first) and np.array_equal(which, want_which)
+
+
+def test_distinct_turns_tell_signed_zeros_and_frames_apart():
+    local_axes = np.stack([np.eye(3), np.where(np.eye(3) == 0, -0.0, 1.0), np.eye(3)])
+    frame = np.array([0, 0, 0, 1, 1], dtype=np.int32)
+    first, which = distinct_turns(frame, local_axes, np.array([0, 1, 2, 0, 2]))
+    assert first.tolist() == [0, 1, 3] and which.tolist() == [0, 1, 0, 2, 2]
+
+
+def test_distinct_turns_grow_their_table_past_the_mostly_new_mark():
+    """More distinct turns than ``_MOSTLY_NEW`` where most turns repeat one: the table grows, all are
+    found."""
+    rng = np.random.default_rng(7)
+    n = 3 * _MOSTLY_NEW
+    frame = np.repeat(np.arange(n, dtype=np.int32), 6)
+    local_axes = random_frames(rng, 2)
+    local = np.tile(np.array([0, 1, 0, 1, 1, 0]), n)
+    first, which = distinct_turns(frame, local_axes, local)
+    assert len(first) == 2 * n
+    assert np.array_equal(which, distinct_reference(frame, local_axes, local)[1])
+
+
+def test_distinct_turns_give_up_where_they_are_mostly_new():
+    """Turns each new: once more than ``_MOSTLY_NEW`` are found every turn is its own, even those that
+    repeat after that."""
+    m = 4 * _MOSTLY_NEW
+    frame = np.arange(m, dtype=np.int32)
+    frame[-10:] = 0
+    local_axes = np.ascontiguousarray(np.broadcast_to(np.eye(3), (1, 3, 3)))
+    first, which = distinct_turns(frame, local_axes, np.zeros(m, dtype=np.int64))
+    assert np.array_equal(first, np.arange(m)) and np.array_equal(which, np.arange(m))
+    assert which.dtype == np.int32

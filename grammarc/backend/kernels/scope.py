@@ -146,18 +146,15 @@ def translated(origin, local, frames, frame):
 
 
 @njit(cache=True, nogil=True)
-def component_frames(frames, frame, origin, local_origin, local_axes, tol):
-    """World scopes of components: ``origin + local_origin @ frames[frame]`` (m, 3) and
-    ``local_axes @ frames[frame]`` (m, 3, 3) (``_times_frame``: einsum's bits), and whether each
-    component's local axes are not orthonormal within ``tol`` (m,) bool (a scope of sizes no float can
-    square). ``frame`` (m,) int32 the parents' frame ids, ``origin`` (m, 3) their origins,
-    ``local_origin`` and ``local_axes`` in the parents' frames."""
+def component_origins(frames, frame, origin, local_origin, local_axes, tol):
+    """World origins of components, ``origin + local_origin @ frames[frame]`` (m, 3) (``translated``:
+    einsum's bits), and whether each component's local axes are not orthonormal within ``tol`` (m,) bool
+    (a scope of sizes no float can square). ``frame`` (m,) int32 the parents' frame ids, ``origin`` (m, 3)
+    their origins, ``local_origin`` and ``local_axes`` in the parents' frames."""
     m = len(frame)
     out_origin = translated(origin, local_origin, frames, frame)
-    out_axes = np.empty((m, 3, 3))
     bad = np.zeros(m, np.bool_)
     for c in range(m):
-        _times_frame(local_axes, c, frames, frame[c], out_axes)
         for r in range(3):
             for k in range(r, 3):  # axis k . axis r is axis r . axis k
                 dot = 0.0
@@ -165,7 +162,7 @@ def component_frames(frames, frame, origin, local_origin, local_axes, tol):
                     dot += local_axes[c, r, j] * local_axes[c, k, j]
                 if not abs(dot - (1.0 if r == k else 0.0)) < tol:
                     bad[c] = True
-    return out_origin, out_axes, bad
+    return out_origin, bad
 
 
 @njit(cache=True, nogil=True)

@@ -22,7 +22,7 @@ from grammarc.backend.children import with_context
 from grammarc.backend.context import Context
 from grammarc.backend.evaluate import evaluate_array
 from grammarc.backend.kernels.order import group_by
-from grammarc.backend.kernels.scope import component_frames
+from grammarc.backend.kernels.scope import component_origins
 from grammarc.backend.occlusion import take_apart
 from grammarc.backend.operations.offsets import offset_faces
 from grammarc.backend.operations.table import Parts, operation
@@ -162,12 +162,11 @@ def components(ctx: Context, kind: int, cursor: Shapes, site: int, span, wanted=
         parent, index, origin, axes, size, geom, normal, roof, border, corner = (
             a[keep] for a in (parent, index, origin, axes, size, geom, normal, roof, border, corner))
     child = cursor.take(parent)
-    world_origin, world_axes, bad = component_frames(chunk.frames.data, child.frame, child.origin, origin, axes,
-                                                     1e-6)
+    world_origin, bad = component_origins(chunk.frames.data, child.frame, child.origin, origin, axes, 1e-6)
     if bad.any():  # a scope of sizes no float can square has no component frames (``refuse_far`` fails such a
         # scope where it is made: this guards the kernel's output)
         ctx.fail_lots(child.lot[bad], "a component of a scope whose size is beyond any geometry", span)
-    frame = chunk.frames.add(world_axes)
+    frame, world_axes = chunk.frames.turned(axes, child.frame)  # the same face of many boxes in a frame: one row
     shapes = Shapes(world_origin, size, frame, geom.astype(np.int32), child.lot,
                     piece_keys(ctx.plan.sequential_random, child.key, index, site), child.depth, child.params,
                     child.dynamic)

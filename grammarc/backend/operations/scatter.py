@@ -95,7 +95,8 @@ def scatter(ctx: Context, cursor: Shapes, op: ir.Scatter) -> Parts:
     frame = cursor.frame[parent].copy()
     turned = np.flatnonzero((kind == _SURFACE) & ~(np.abs(normal[:, 1] - 1.0) <= TOL.zero))
     if len(turned):
-        frame[turned] = frames.add(np.einsum("nij,njk->nik", _surface_axes(normal[turned]), axes[turned]))
+        # points on one face share its turned frame
+        frame[turned] = frames.turned(_surface_axes(normal[turned]), frame[turned])[0]
     made = Shapes(origin, np.zeros((len(parent), 3)), frame.astype(np.int32),
                   np.full(len(parent), -1, dtype=np.int32), cursor.lot[parent], key, cursor.depth[parent],
                   tuple(p[parent] for p in cursor.params), tuple(d[parent] for d in cursor.dynamic))

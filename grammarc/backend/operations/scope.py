@@ -139,7 +139,7 @@ def rotate(ctx: Context, cursor: Shapes, op: ir.Rotate) -> Shapes:
         turn = orientation if op.fixed else rotation
         n = len(cursor)
         matrices = turn(*(np.broadcast_to(np.asarray(a, np.float64), (n,)) for a in angles))
-        frame = frames.add(np.einsum("nij,njk->nik", matrices, frames[cursor.frame]))
+        frame = frames.turned(matrices, cursor.frame)[0]  # shapes of one frame turned alike share a row
     origin = cursor.origin
     if op.center:
         half = cursor.size / 2
@@ -414,11 +414,13 @@ def _extruded_upwards(ctx: Context, cursor: Shapes, height: np.ndarray, straight
 @operation(ir.AlignScope, writes=_REFRAMED, meshes=True)
 def align_scope(ctx: Context, cursor: Shapes, op: ir.AlignScope) -> Shapes:
     """New scope axes around unchanged geometry (``backend.reframing``)."""
-    axes = ctx.chunk.frames[cursor.frame]
+    frames = ctx.chunk.frames
     n = len(cursor)
-    if op.mode == "world":
-        new_axes = np.broadcast_to(np.eye(3), (n, 3, 3))
-    elif op.mode == "rotate":  # rotateScope: in xyz order as r, about the pivot's axes where it is kept
+    if op.mode == "world":  # one frame for all
+        return reframed(ctx, cursor, np.broadcast_to(np.eye(3), (n, 3, 3)), op.span,
+                        np.repeat(frames.add(np.eye(3)[None]), n))
+    axes = frames[cursor.frame]
+    if op.mode == "rotate":  # rotateScope: in xyz order as r, about the pivot's axes where it is kept
         env = ctx.env(cursor)
         angles = [np.broadcast_to(evaluate_array(e, env), (n,)) for e in op.angles]
         new_axes = _about_pivot(ctx, cursor, angles) if ctx.plan.pivot_slot is not None else \
@@ -598,6 +600,6 @@ def set_pivot(ctx: Context, cursor: Shapes, op: ir.SetPivot) -> Shapes:
     moved = cursor.with_scope(origin, size, frames.add(np.ascontiguousarray(new_axes)), cursor.geom)
     if not box.all():
         rows, others = np.flatnonzero(~box), np.flatnonzero(box)
-        moved = Shapes.merge([moved.take(others), reframed(ctx, cursor.take(rows), new_axes[rows], op.span)],
-                             [others, rows])
+        moved = Shapes.merge([moved.take(others), reframed(ctx, cursor.take(rows), new_axes[rows], op.span,
+                                                           moved.frame[rows])], [others, rows])
     return with_pivot(ctx.plan.pivot_slot, moved, moved.origin, moved.frame)

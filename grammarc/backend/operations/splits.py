@@ -91,15 +91,15 @@ def repeat(ctx: Context, cursor: Shapes, op: ir.Repeat) -> Parts | None:
 @operation(ir.GroupSplit, meshes=True, consumes=True)
 def group_split(ctx: Context, cursor: Shapes, op: ir.GroupSplit) -> Parts:
     values = _split_sizes(ctx, cursor, op, "split")
-    axis, axes = op.axis, None
+    axis, frame = op.axis, None
     if op.uv_set >= 0:  # texture space: a split along x turned the way u (v) grows, sizes in metres
-        cursor, metres, axes = texture_axis(ctx, cursor, op)
+        cursor, metres, frame = texture_axis(ctx, cursor, op)
         values = np.where(_kinds(op) == _SIZE_KIND[ir.SizeKind.RELATIVE], values, values * metres[:, None])
         axis = 0
     extent = np.ascontiguousarray(cursor.size[:, axis])
     # parts of PRT's length limit or shorter are not made (complexpatterns' red window frames of 0.4 mm)
     parent, part, pos, length, index = _group_layout(ctx, cursor, op, values, extent, TOL.merge)
-    return _group_children(ctx, cursor, op, axis, parent, part, pos, length, index, axes)
+    return _group_children(ctx, cursor, op, axis, parent, part, pos, length, index, frame)
 
 
 @operation(ir.SplitArea, consumes=True)
@@ -135,17 +135,18 @@ def _group_layout(ctx: Context, cursor: Shapes, op: ir.GroupSplit, values: np.nd
 
 
 def _group_children(ctx: Context, cursor: Shapes, op: ir.GroupSplit, axis: int, parent, part, pos, length, index,
-                    axes: np.ndarray | None = None) -> Parts:
+                    frame: np.ndarray | None = None) -> Parts:
     """The children of a split's parts along ``axis``, their geometry cut to their slabs, by part; with the
-    parents' ``axes`` (a split in texture space, its shapes turned) they take those axes again. A box whose
-    ring starts elsewhere than corner 0 is cut as its polygon (``box_rings.as_polygons``)."""
+    parents' ``frame`` ids (a split in texture space, its shapes turned) they take those frames again. A box
+    whose ring starts elsewhere than corner 0 is cut as its polygon (``box_rings.as_polygons``)."""
     cursor = as_polygons(ctx.plan, ctx.chunk, cursor, axis)
     parent, part, pos, length, index, geometry = clip(ctx.chunk, cursor, axis, parent, part, pos, length,
                                                       index, op.adjust, turn_cuts=True)
     order, offsets = group_by(part, len(op.parts))
     made = children(ctx, cursor, axis, parent, index, pos, length, op.site, order, geometry)
-    if axes is not None:  # the children take their parent's axes again
-        made = reframed(ctx, made, axes[parent[order]], op.span)
+    if frame is not None:  # the children take their parent's frame again
+        frame = frame[parent[order]]
+        made = reframed(ctx, made, ctx.chunk.frames[frame], op.span, frame)
     ctx.count(made, op.span)
     return Parts(op.parts, made, offsets)
 

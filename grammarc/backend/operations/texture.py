@@ -135,7 +135,8 @@ def normalize_uv(ctx: Context, cursor: Shapes, op: ir.NormalizeUV) -> Shapes:
 def texture_axis(ctx: Context, cursor: Shapes, op: ir.GroupSplit) -> tuple[Shapes, np.ndarray, np.ndarray]:
     """A split in texture space as a split along x: the shapes turned about their surface's normal so that
     their x runs the way u (v) grows on it, the scope fitted to the geometry (so the split starts where
-    the geometry's u does), the metres per size unit, and the axes (n, 3, 3) the children return to.
+    the geometry's u does), the metres per size unit, and the frames (n,) the children return to (the
+    shapes' own).
 
     The surface's normal is a polygon's or prism's plane axis, a flat scope's flat axis, else the scope
     axis across which u changes least. A shape on which u does not change fails its lot.
@@ -159,7 +160,7 @@ def texture_axis(ctx: Context, cursor: Shapes, op: ir.GroupSplit) -> tuple[Shape
                  "across its surface (projectUV first)", op.span)
     direction = along / length[:, None]
     turned = reframed(ctx, cursor, np.stack([direction, np.cross(normal, direction), normal], axis=1), op.span)
-    return turned, np.ones(len(cursor)) if op.unit_space else 1.0 / length, axes
+    return turned, np.ones(len(cursor)) if op.unit_space else 1.0 / length, cursor.frame
 
 
 #: The constant term of a map's row: what moving u or v by a number changes.

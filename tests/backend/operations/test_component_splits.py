@@ -20,6 +20,8 @@ from derivations import (
     totals,
 )
 
+from grammarc.backend.chunk import Frames
+
 
 def test_comp_front_side_top_on_a_box(write):
     r = run(write, "Lot --> extrude(10) Mass\nMass --> comp(f){ front : A | side : B | top : C }\n",
@@ -301,3 +303,21 @@ def test_components_of_a_scope_beyond_any_geometry_fail_its_lot(write):
     (bad,) = r["bad"]
     assert bad.index == 0 and bad.reason.startswith("a scope sized or placed beyond any coordinate (1e+290)")
     assert np.isfinite(r["xform"]).all() and set(r["lot"].tolist()) == {1}
+
+
+def test_the_same_face_of_boxes_in_one_frame_shares_a_frame_row(write, monkeypatch):
+    """Twelve boxes split from one mass keep its frame: each of their six faces is one new frame row,
+    shared by the twelve (``chunk.Frames.turned``), not a row per face."""
+    added = []
+    add = Frames.add
+
+    def counted(self, axes):
+        added.append(len(axes))
+        return add(self, axes)
+
+    monkeypatch.setattr(Frames, "add", counted)
+    r = run(write, "Lot --> extrude(10) Mass\nMass --> split(x){ ~1 : Box }*\nBox --> comp(f){ all : F. }\n",
+            [rect(12, 8)])
+    assert Counter(names(r)) == {"F": 12 * 6}
+    assert sum(added) == 1 + 6  # the lot's frame, then one per face
+    assert len(np.unique(np.round(quad_normals(r), 6), axis=0)) == 6
