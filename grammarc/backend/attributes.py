@@ -137,10 +137,10 @@ def _from_lots(attr: ir.AttrDecl, values: np.ndarray, column: np.ndarray, string
     parsed = np.full(len(values), np.nan)
     parsed[given] = _per_distinct(values[given], lambda text: _number(text, attr.type))
     bad = given & np.isnan(parsed)
-    if bad.any():
-        first = np.flatnonzero(bad)[0]
-        raise LotFailure(f"attribute `{attr.name}` is \"{values[first]}\", not a {attr.type.value}",
-                         np.flatnonzero(bad))
+    if bad.any():  # each lot's reason quotes its own value
+        lots = np.flatnonzero(bad)
+        reasons = [f"attribute `{attr.name}` is \"{values[lot]}\", not a {attr.type.value}" for lot in lots]
+        raise LotFailure(reasons[0], lots, reasons)
     column[given] = parsed[given] if attr.type is T.NUM else parsed[given] != 0
     return column
 
@@ -158,10 +158,9 @@ def _arrays_from_lots(attr: ir.AttrDecl, values: np.ndarray, column: Arrays, str
     texts = [str(v) if values.dtype == object else json.dumps(float(v)) for v in distinct]
     parsed = [_parse_array(text, attr.type, strings) for text in texts]
     failed = np.array([p is None for p in parsed])[inverse]
-    if failed.any():
-        first = texts[inverse[np.flatnonzero(failed)[0]]]
-        raise LotFailure(f"attribute `{attr.name}` is {first}, not a {attr.type.value}",
-                         np.flatnonzero(given)[failed])
+    if failed.any():  # each lot's reason quotes its own value
+        reasons = [f"attribute `{attr.name}` is {texts[k]}, not a {attr.type.value}" for k in inverse[failed]]
+        raise LotFailure(reasons[0], np.flatnonzero(given)[failed], reasons)
     dtype = column.values.dtype
     table = Arrays(np.concatenate([column.values, *(np.asarray(p[0], dtype=dtype) for p in parsed)]),
                    np.concatenate([column.offsets, column.offsets[-1] + np.cumsum([len(p[0]) for p in parsed],

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import weakref
 from collections import defaultdict
+from collections.abc import Callable
 
 import numpy as np
 
@@ -64,19 +65,38 @@ class Context:
     def fail_lots(self, lots: np.ndarray, message: str, span) -> None:
         """Report ``lots`` (chunk-local numbers, repeats allowed) as failed in the rule being applied, at
         ``span`` (None: a symbol without rules, whose leaves are being emitted): raises ``LotFailure``."""
+        raise LotFailure(f"{message}{self._where(span)}", np.unique(lots))
+
+    def fail_each(self, shapes: Shapes, bad: np.ndarray, describe: Callable[[int], str], span) -> None:
+        """Report the lots of shapes ``bad`` (n,) bool as failed, each lot with the message ``describe(i)`` of
+        its own first failing shape i (``fail_quoting``)."""
+        rows = np.flatnonzero(bad)
+        self.fail_quoting(shapes.lot[rows], lambda k: describe(int(rows[k])), span)
+
+    def fail_quoting(self, lots: np.ndarray, quote: Callable[[int], str], span) -> None:
+        """Report the lots of rows whose lots are ``lots`` (one a row, repeats allowed) as failed, each with
+        the message ``quote(row)`` of its own first row: a lot's reason quotes its own value, whatever
+        other lots share its chunk (the records and reasons do not depend on the chunking)."""
+        failed, first = np.unique(lots, return_index=True)
+        reasons = [f"{quote(int(row))}{self._where(span)}" for row in first]
+        raise LotFailure(reasons[0], failed, reasons)
+
+    def _where(self, span) -> str:
+        """`` in rule `X` at file:line:col`` of the rule being applied."""
         rule = self.plan.symbols[self.symbol].name
-        where = f" at {span}" if span is not None else ""
-        raise LotFailure(f"{message} in rule `{rule}`{where}", np.unique(lots))
+        return f" in rule `{rule}`" + (f" at {span}" if span is not None else "")
 
     def fail_negative(self, shapes: Shapes, values: np.ndarray, message: str, span) -> None:
-        """Fail the shapes whose sizes (n, k), or (1, k) for all, are negative or NaN, quoting the first."""
+        """Fail the shapes whose sizes (n, k), or (1, k) for all, are negative or NaN, each lot quoting its
+        first."""
         fine = values >= 0  # False for NaN too
         if fine.all():
             return
-        bad = np.broadcast_to(~fine.all(axis=1), (len(shapes),))
-        if bad.any():
-            row = values[np.flatnonzero(bad)[0]]
-            self.fail(shapes, bad, f"{message} ({', '.join(f'{v:g}' for v in np.atleast_1d(row))})", span)
+        bad = np.flatnonzero(np.broadcast_to(~fine.all(axis=1), (len(shapes),)))
+        if len(bad):
+            sizes = np.broadcast_to(values, (len(shapes), values.shape[1]))[bad]
+            self.fail_quoting(shapes.lot[bad], lambda row: f"{message} ({', '.join(f'{v:g}' for v in sizes[row])})",
+                              span)
 
     def refuse_meshes(self, op: ir.Op, shapes: Shapes) -> None:
         """Fail the roofs (meshes) among ``shapes``: ``op`` does not take them (``Operation.meshes``)."""
@@ -96,8 +116,8 @@ class Context:
         if any(bound > TOL.far for column in (shapes.size, shapes.origin) for bound in (column.max(), -column.min())):
             size, origin = np.abs(shapes.size), np.abs(shapes.origin)
             far = (size > TOL.far).any(axis=1) | (origin > TOL.far).any(axis=1)
-            value = max(size[far][0].max(), origin[far][0].max())
-            self.fail(shapes, far, f"a scope sized or placed beyond any coordinate ({value:g})", op.span)
+            self.fail_each(shapes, far, lambda i: "a scope sized or placed beyond any coordinate "
+                           f"({max(size[i].max(), origin[i].max()):g})", op.span)
 
     # ------------------------------------------------------------------------------------------ the limits
     def count(self, shapes: Shapes, span) -> None:

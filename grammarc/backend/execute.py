@@ -146,7 +146,7 @@ def _charge(ctx: Context, rule: ir.Rule, shapes: Shapes) -> None:
     cost = np.ones(len(shapes)) if expr is None else evaluate_array(expr, ctx.env(shapes))
     bad = ~(cost >= 0)
     if bad.any():
-        ctx.fail(shapes, bad, f"a negative cost ({cost[bad][0]:g})", rule.span)
+        ctx.fail_each(shapes, bad, lambda i: f"a negative cost ({cost[i]:g})", rule.span)
     ctx.chunk.choices.charge(shapes.lot, cost)
 
 

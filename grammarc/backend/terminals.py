@@ -187,12 +187,11 @@ def append_records(ctx: Context, xform: np.ndarray, lot: np.ndarray, asset: int,
 def _fail_non_finite(ctx: Context, lots: np.ndarray, rows: np.ndarray, what: str) -> None:
     """Fail ``lots``, whose record ``rows`` (float32) have a coordinate that is not finite: beyond 3.4e38
     (a size or a move far beyond any city) or made of inf and NaN (attributes such as ``height=inf``).
-    The last guard before records are written, wherever the value came from; the message quotes the
+    The last guard before records are written, wherever the value came from; each lot's message quotes its
     first such value."""
-    value = rows[~np.isfinite(rows)].flat[0]
     sym = ctx.plan.symbols[ctx.symbol]
-    ctx.fail_lots(lots, f"{what} with a coordinate of {value} (not finite as float32)",
-                  sym.rules[0].span if sym.rules else None)
+    ctx.fail_quoting(lots, lambda row: f"{what} with a coordinate of {rows[row][~np.isfinite(rows[row])].flat[0]} "
+                     "(not finite as float32)", sym.rules[0].span if sym.rules else None)
 
 
 def _instance_uv(ctx: Context, shapes: Shapes, rows: np.ndarray, xform: np.ndarray,

@@ -153,6 +153,20 @@ def test_bad_lots_from_input_are_listed(write):
     assert [b.index for b in r["bad"]] == [1]
 
 
+@pytest.mark.parametrize("rule", [
+    'lot ~> S(1r, 3, Scope.sx - 10) I("cube")\n',  # a negative size (``fail_negative``)
+    'lot ~> T(0, 0, 1e40 * (10 - Scope.sx)) I("cube")\n',  # beyond any coordinate (``refuse_far``)
+])
+def test_a_bad_lots_reason_quotes_its_own_value_whatever_the_chunking(write, rule):
+    """Lots that fail alike, each by its own value: each lot's reason quotes its own, however the lots are
+    chunked (it quoted the first of its chunk's, which made the reasons depend on the chunking)."""
+    polygons = [rect(w, 4) for w in (3, 12, 5, 7, 11)]
+    reasons = {chunk_size: [b.reason for b in paper(write, rule, polygons, chunk_size=chunk_size)["bad"]]
+               for chunk_size in (1, 2, 16)}
+    assert reasons[1] == reasons[2] == reasons[16]
+    assert len(reasons[1]) >= 3 and len(set(reasons[1])) == len(reasons[1])
+
+
 def test_zoo_lots_all_derive(write):
     lots = make_lots("square", "rect_12x8", "concave_L", "courtyard", "sliver")
     grammar = compile_grammar(write("g.cga", SECTION_4))

@@ -49,11 +49,15 @@ def asset_ids(ctx: Context, cursor: Shapes, op: ir.UseAsset | ir.InsertAlongUV, 
     asset = np.array([plan.asset_of_string.get(int(s), -1) for s in distinct], dtype=np.int32)[inverse.reshape(-1)]
     bad = asset < 0
     if bad.any():
-        name = list(plan.strings.ids)[int(names[np.flatnonzero(bad)[0]])]
-        # the assets a computed name may take are found when compiling (``passes.assets``)
-        why = ("a file search that found nothing" if not name else "not an asset of the grammar: a computed "
-               "name is a string constant of an asset file, or a file a search may find")
-        ctx.fail(cursor, bad, f"`{verb}` of `{name}`, {why}", op.span)
+        texts = list(plan.strings.ids)
+
+        def refused(i: int) -> str:
+            name = texts[int(names[i])]
+            # the assets a computed name may take are found when compiling (``passes.assets``)
+            why = ("a file search that found nothing" if not name else "not an asset of the grammar: a computed "
+                   "name is a string constant of an asset file, or a file a search may find")
+            return f"`{verb}` of `{name}`, {why}"
+        ctx.fail_each(cursor, bad, refused, op.span)
     return asset
 
 
@@ -67,8 +71,9 @@ def _chosen(ctx: Context, cursor: Shapes, expr: ir.Expr, allowed: tuple[str, ...
     index = np.array([allowed.index(t) if t in allowed else -1 for t in texts], dtype=np.int64)[inverse.reshape(-1)]
     bad = index < 0
     if bad.any():
-        text = texts[inverse.reshape(-1)[np.flatnonzero(bad)[0]]]
-        ctx.fail(cursor, bad, f"`i` with {what} `{text}`, not one of {', '.join(allowed)}", op.span)
+        inverse = inverse.reshape(-1)
+        ctx.fail_each(cursor, bad, lambda i: f"`i` with {what} `{texts[inverse[i]]}`, not one of {', '.join(allowed)}",
+                      op.span)
     return np.maximum(index, 0)
 
 
@@ -114,12 +119,13 @@ def _bounds(ctx: Context, cursor: Shapes, asset: np.ndarray, up, mode, span) -> 
     need = np.broadcast_to(mode != 0, asset.shape)
     ids, inverse = np.unique(np.where(need, asset, -1), return_inverse=True)
     table = np.zeros((len(ids), 2, 3))
+    modes = np.broadcast_to(mode, asset.shape)
     for k, a in enumerate(ids.tolist()):
         mesh = None if a < 0 else ctx.asset_mesh(a)
         if a >= 0 and mesh is None:
-            failing = need & (asset == a)
-            name = ir.INSERT_MODES[int(np.broadcast_to(mode, asset.shape)[np.flatnonzero(failing)[0]])]
-            ctx.fail(cursor, failing, f"`i(..., {name})` needs the asset's size: {ctx.asset_problem(a)}", span)
+            problem = ctx.asset_problem(a)
+            ctx.fail_each(cursor, need & (asset == a), lambda i, problem=problem: "`i(..., "
+                          f"{ir.INSERT_MODES[int(modes[i])]})` needs the asset's size: {problem}", span)
         if mesh is not None:
             table[k] = mesh.bounds
     rows = inverse.reshape(-1)

@@ -219,7 +219,7 @@ def _distances(ctx: Context, distance: ir.Expr, cursor: Shapes, span) -> np.ndar
         ctx.fail(cursor, nan, "`offset` by a distance that is not a number", span)
     far = d > TOL.far
     if far.any():
-        ctx.fail(cursor, far, f"`offset` by {d[far][0]:g}, beyond any coordinate", span)
+        ctx.fail_each(cursor, far, lambda i: f"`offset` by {d[i]:g}, beyond any coordinate", span)
     return np.maximum(d, -TOL.far)
 
 

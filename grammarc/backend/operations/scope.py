@@ -70,8 +70,8 @@ def scale(ctx: Context, cursor: Shapes, op: ir.Scale) -> Shapes:
     if op.mirrors and flips.any():
         nan = np.isnan(size).any(axis=1)
         if nan.any():
-            row = size[np.flatnonzero(nan)[0]]
-            ctx.fail(cursor, nan, f"`s` gives a NaN size ({', '.join(f'{v:g}' for v in row)})", op.span)
+            ctx.fail_each(cursor, nan, lambda i: f"`s` gives a NaN size ({', '.join(f'{v:g}' for v in size[i])})",
+                          op.span)
         return _inside_out(ctx, cursor.with_scope(cursor.origin, np.abs(size), cursor.frame, cursor.geom), flips)
     ctx.fail_negative(cursor, size, "`S` gives a negative or NaN size", op.span)
     return cursor.with_scope(cursor.origin, size, cursor.frame, cursor.geom)

@@ -38,10 +38,10 @@ def setback(ctx: Context, cursor: Shapes, op: ir.Setback) -> Parts:
     # an outline moved out beyond any coordinate (``Tol.far``) makes no record, and beyond float64's GEOS
     # raises; a NaN distance stays what it was: no setback, as PRT takes massing's (``setbackToArea``'s
     # maximums may be inf: it checks none)
-    far = distance > TOL.far
-    if far.any():
-        ctx.fail_lots(cursor.lot[face.edges.poly[far]], f"`setback` by {distance[far][0]:g}, beyond any coordinate",
-                      op.span)
+    far = np.flatnonzero(distance > TOL.far)
+    if len(far):
+        ctx.fail_quoting(cursor.lot[face.edges.poly[far]],
+                         lambda k: f"`setback` by {distance[far[k]]:g}, beyond any coordinate", op.span)
     return face.parts(ctx, cursor, op, distance)
 
 

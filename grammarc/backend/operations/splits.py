@@ -63,7 +63,7 @@ def repeat(ctx: Context, cursor: Shapes, op: ir.Repeat) -> Parts | None:
         size = sizes[level]
         bad = ~(size > 0)
         if bad.any():
-            ctx.fail(shapes, bad, f"`Repeat` needs a positive size, got {size[bad][0]:g}", op.span)
+            ctx.fail_each(shapes, bad, lambda i: f"`Repeat` needs a positive size, got {size[i]:g}", op.span)
         extent = np.ascontiguousarray(shapes.size[:, axis])
         counts = split_kernels.repeat_counts(extent, size, TOL.zero)
         if op.snap:  # each snap plane adds one element at most

@@ -49,8 +49,7 @@ def set_color(ctx: Context, cursor: Shapes, op: ir.SetColor) -> Shapes:
         packed = np.array([_hex_color(names[int(i)]) for i in distinct])[inverse.reshape(-1)]
         bad = np.isnan(packed)
         if bad.any():
-            text = names[int(ids[np.flatnonzero(bad)[0]])]
-            ctx.fail(cursor, bad, f'color("{text}") is not a colour "#rrggbb"', op.span)
+            ctx.fail_each(cursor, bad, lambda i: f'color("{names[int(ids[i])]}") is not a colour "#rrggbb"', op.span)
     index = ctx.plan.color_slot
     packed = with_transparency_of(packed.astype(np.float64), cursor.dynamic[index])
     dynamic = cursor.dynamic[:index] + (packed,) + cursor.dynamic[index + 1:]
