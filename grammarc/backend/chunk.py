@@ -86,6 +86,15 @@ class TextureMaps(Table):
         super().__init__(np.full((capacity, 2, 4), np.nan), 1)
 
 
+class TrimPlanes(Table):
+    """Table of shapes' trim planes (P, width) (``slots.TRIM_PLANES``): (nx, ny, nz, d) per plane, the two
+    vertical ones first; row 0 is NaN, no planes. A ``comp(f)`` adds a row per face it gives planes, and
+    whatever that face becomes shares it, as shapes share frames."""
+
+    def __init__(self, width: int, capacity: int = 256) -> None:
+        super().__init__(np.full((capacity, width), np.nan), 1)
+
+
 @dataclass
 class Outputs:
     """Terminal rows and leaf meshes of a chunk, as lists of arrays concatenated at the end.
@@ -146,6 +155,9 @@ class Chunk:
     snaps: SnapStore = field(default_factory=SnapStore)
     #: Texture maps the shapes' texture columns name (``backend.texture_space``).
     texture_maps: TextureMaps = field(default_factory=TextureMaps)
+    #: Trim planes the shapes' ``slots.TRIM_PLANES`` name (``Plan.trim_width`` wide: ``derive.derive_chunk``
+    #: sets it up where the grammar has them).
+    trim_planes: TrimPlanes | None = None
     #: A search's fixed choices, one state per lot (``backend.choices``); None in a build.
     choices: Choices | None = None
     #: Shapes created so far per lot, for the ``max_shapes`` limit, and in all.

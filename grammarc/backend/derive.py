@@ -16,7 +16,7 @@ import numpy as np
 from grammarc.backend.aggregates import judge
 from grammarc.backend.attributes import attribute_columns
 from grammarc.backend.choices import Choices
-from grammarc.backend.chunk import Chunk, Frames
+from grammarc.backend.chunk import Chunk, Frames, TrimPlanes
 from grammarc.backend.context import Context
 from grammarc.backend.evaluate import Env
 from grammarc.backend.execute import apply_pending
@@ -30,12 +30,11 @@ from grammarc.backend.shapes import Shapes
 from grammarc.backend.slots import (
     ANCESTORS,
     COLOR_SLOT,
-    HORIZONTAL_SLOTS,
     HORIZONTAL_SWITCH,
     PIVOT_SLOTS,
     RING_START,
     TRIM_INSERTED,
-    TRIM_SLOTS,
+    TRIM_PLANES,
     TRIM_SWITCH,
     WHITE_RGB,
 )
@@ -106,6 +105,8 @@ def derive_chunk(plan: Plan, lots: Lots, *, seed: int, limits: Limits, overrides
         scopes = repeated_scopes(lots, rows)
         lots = lots.take(rows)
     chunk, shapes = initial_chunk(lots, seed, foreign, plan.sequential_random, scopes)
+    if plan.trim_slot is not None:
+        chunk.trim_planes = TrimPlanes(plan.trim_width)
     attribute_columns(plan.grammar.module, Env(shapes, chunk, plan), lots.attrs, overrides, plan.strings)
     shapes = replace(shapes, dynamic=tuple(initial_dynamic(plan, name, chunk, shapes) for name in plan.dynamic))
     chunk.choices = choices
@@ -151,7 +152,9 @@ def initial_dynamic(plan: Plan, name: str, chunk: Chunk, shapes: Shapes) -> np.n
         return np.ones(n)
     if name in ("split.index", "comp.index"):
         return np.zeros(n)
-    if name in TRIM_SLOTS or name in HORIZONTAL_SLOTS or name in ANCESTORS:
+    if name == TRIM_PLANES:  # none
+        return np.zeros(n, dtype=np.int32)
+    if name in ANCESTORS:
         return np.full(n, np.nan)
     if name == TRIM_SWITCH:
         return np.ones(n)

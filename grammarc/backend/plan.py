@@ -14,16 +14,16 @@ from grammarc.backend.materials import COLOR_FIELDS, MAP_FIELDS
 from grammarc.backend.slots import (
     ANCESTORS,
     COLOR_SLOT,
-    HORIZONTAL_SLOTS,
     HORIZONTAL_SWITCH,
     PIVOT_SLOTS,
     RING_START,
     TRIM_INSERTED,
-    TRIM_SLOTS,
+    TRIM_PLANES,
     TRIM_SWITCH,
     uv_slots,
 )
 from grammarc.backend.trim_reads import unread_plane_sites
+from grammarc.geometry.trim import HORIZONTAL_PLANES, VERTICAL_PLANES
 from grammarc.ir import nodes as ir
 from grammarc.ir.printer import comp_selectors
 from grammarc.ir.traverse import all_exprs, iter_ops
@@ -90,8 +90,9 @@ class Plan:
     #: Symbols whose pending shapes fused kernels derive, by id: their ``backend.fusion.Region``.
     fused: dict = field(default_factory=dict)
     #: Indices into ``Shapes.dynamic`` of the columns the derivation adds (``backend.slots``), None where
-    #: the grammar needs none: the colour (else no colours are recorded and the rows are white), the first
-    #: of the trim planes (when inserted geometry is trimmed) and ``trim.vertical`` (when the grammar sets it).
+    #: the grammar needs none: the colour (else no colours are recorded and the rows are white), the id of
+    #: the trim planes (``slots.TRIM_PLANES``, when inserted geometry is trimmed) and ``trim.vertical`` (when
+    #: the grammar sets it).
     color_slot: int | None = None
     #: The texture channels the grammar sets or reads: (index into ``ir.MATERIAL_MAPS``, index into
     #: ``Shapes.dynamic``) each (``backend.materials``).
@@ -103,8 +104,9 @@ class Plan:
     trim_switch: int | None = None
     #: whether each shape's geometry was inserted (``slots.TRIM_INSERTED``), where shapes have trim planes.
     inserted_slot: int | None = None
-    #: the first of the horizontal trim planes and ``trim.horizontal``, when the grammar turns them on.
-    horizontal_slot: int | None = None
+    #: whether the trim planes' rows hold horizontal planes too, and ``trim.horizontal``: where the grammar
+    #: turns them on.
+    horizontal_planes: bool = False
     horizontal_switch: int | None = None
     #: Whether shapes carry their occluding ancestors (``backend.occlusion``): the grammar asks occlusion
     #: queries or labels shapes.
@@ -124,6 +126,11 @@ class Plan:
     #: CityEngine semantics: shapes draw from PRT's sequential stream, not from counter-based keys
     #: (``backend.streams``).
     sequential_random: bool = False
+
+    @property
+    def trim_width(self) -> int:
+        """The width of a row of the chunk's ``TrimPlanes``: the vertical planes, then any horizontal ones."""
+        return 4 * (VERTICAL_PLANES + (HORIZONTAL_PLANES if self.horizontal_planes else 0))
 
     @property
     def symbol_names(self) -> tuple[str, ...]:
@@ -159,13 +166,13 @@ def make_plan(grammar: Grammar, *, load_asset: Callable = load_asset) -> Plan:
     colour += list(MAP_FIELDS) if any(isinstance(op, ir.SetMaterial) for op in ops) else []
     # CityEngine trims inserted geometry (assets, primitives) at the planes a comp(f) leaves between
     # neighbouring faces, and a shape's own where it says `trim()`
-    trims = [*TRIM_SLOTS, TRIM_INSERTED] if module.dialect == "cityengine" and any(
+    trims = [TRIM_PLANES, TRIM_INSERTED] if module.dialect == "cityengine" and any(
         isinstance(op, ir.CompFaces) and op.kind == "f" for op in ops) and any(
         isinstance(op, (ir.UseAsset, ir.Primitive, ir.Trim)) for op in ops) else []
     # horizontal planes only where the grammar may turn them on (CityEngine's default is off)
-    trims += list(HORIZONTAL_SLOTS) if trims and any(
+    horizontal = bool(trims) and any(
         isinstance(op, ir.SetAttr) and op.name == HORIZONTAL_SWITCH
-        and not (isinstance(op.value, ir.Bool) and not op.value.value) for op in ops) else []
+        and not (isinstance(op.value, ir.Bool) and not op.value.value) for op in ops)
     occlusion = {symbol.id: [e for rule in symbol.rules for e in all_exprs(rule) if isinstance(e, ir.Occlusion)]
                  for symbol in symbols}
     occlusion = {k: v for k, v in occlusion.items() if v}
@@ -187,7 +194,7 @@ def make_plan(grammar: Grammar, *, load_asset: Callable = load_asset) -> Plan:
         if isinstance(op, ir.CompFaces):
             for text in comp_selectors(op):
                 strings.intern(text)
-    trim_slot = dynamic.get(TRIM_SLOTS[0])
+    trim_slot = dynamic.get(TRIM_PLANES)
     plan = Plan(
         grammar=grammar, symbols=tuple(symbols), symbol_ids=ids, start=ids[grammar.graph.start], strings=strings,
         stages=stages, dynamic=dynamic, leaf_bodies=module.dialect == "cityengine", not_applied=not_applied,
@@ -201,7 +208,7 @@ def make_plan(grammar: Grammar, *, load_asset: Callable = load_asset) -> Plan:
         material_slots=tuple((k, dynamic[name]) for k, name in enumerate(MAP_FIELDS) if name in dynamic),
         trim_switch=dynamic.get(TRIM_SWITCH) if trim_slot is not None else None,
         inserted_slot=dynamic.get(TRIM_INSERTED),
-        horizontal_slot=dynamic.get(HORIZONTAL_SLOTS[0]), horizontal_switch=dynamic.get(HORIZONTAL_SWITCH),
+        horizontal_planes=horizontal, horizontal_switch=dynamic.get(HORIZONTAL_SWITCH),
         occluders=ANCESTORS[0] in dynamic, load_asset=load_asset,
         uv_slots={s: dynamic[uv_slots(s)[0]] for s in uv_sets}, pivot_slot=dynamic.get(PIVOT_SLOTS[0]),
         ring_slot=dynamic.get(RING_START))

@@ -8,15 +8,16 @@ grammar needs them (``plan``, ``leaf_parts``, ``occlusion``), so that none of th
 
 from __future__ import annotations
 
-from grammarc.geometry.trim import HORIZONTAL_PLANES
-
 #: The shape's colour set by ``color()``: 0xRRGGBB as a float, white to begin with.
 COLOR_SLOT = "#color"
 WHITE_RGB = float(0xFFFFFF)
 
-#: A shape's two vertical trim planes, (nx, ny, nz, d) each in world coordinates: inserted geometry keeps
-#: the side where n . X + d >= 0 (NaN: no plane).
-TRIM_SLOTS = tuple(f"trim.{k}" for k in range(8))
+#: A shape's trim planes: an id (int32) into the chunk's ``TrimPlanes`` (0: none), whose row holds its two
+#: vertical planes, (nx, ny, nz, d) each in world coordinates relative to its lot's origin (inserted geometry
+#: keeps the side where n . X + d >= 0; NaN: no plane), then, where the grammar turns them on, its horizontal
+#: ones. A ``comp(f)`` sets both kinds at once and everything else keeps or drops them together, so one id
+#: names them: children share their parent's row instead of copying eight columns or more.
+TRIM_PLANES = "trim.planes"
 #: ``set(trim.vertical, false)`` turns the planes off for a shape and its successors (1: on, 0: off).
 TRIM_SWITCH = "trim.vertical"
 #: Whether a shape's geometry was inserted (1: ``i()`` or a ``primitive*()`` made it, or cut it out of what
@@ -24,9 +25,9 @@ TRIM_SWITCH = "trim.vertical"
 #: shape's own only at ``trim()``, so a leaf box is cut at its trim planes only where it is inserted: an
 #: extruded window frame stands whole across a plane where an inserted cube beside it is cut.
 TRIM_INSERTED = "trim.inserted"
-#: A shape's horizontal trim planes (``geometry.trim.shallow_edge_planes``), made where the grammar turns
-#: them on with ``set(trim.horizontal, ...)`` (0: off, CityEngine's default; 1: on).
-HORIZONTAL_SLOTS = tuple(f"trim.h{k}" for k in range(4 * HORIZONTAL_PLANES))
+#: Whether a shape's horizontal trim planes (``geometry.trim.shallow_edge_planes``, in its ``TRIM_PLANES``
+#: row where the grammar may turn them on) cut: ``set(trim.horizontal, ...)`` (0: off, CityEngine's
+#: default; 1: on).
 HORIZONTAL_SWITCH = "trim.horizontal"
 
 #: The ids of a shape's nearest occluding ancestors (NaN: none), nearest first (``backend.occlusion``).

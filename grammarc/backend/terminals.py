@@ -28,13 +28,12 @@ from grammarc.backend.kernels.texture import instance_maps, vertex_maps
 from grammarc.backend.materials import material_ids, rgba
 from grammarc.backend.mesh_shapes import mesh_leaves
 from grammarc.backend.shapes import Z_UP, Shapes, asset_of
-from grammarc.backend.slots import HORIZONTAL_SLOTS
 from grammarc.backend.texture_space import COORDINATES
 from grammarc.constants import TOL
 from grammarc.geometry.components import reverse_rings
 from grammarc.geometry.meshes import is_mesh, is_polygon
 from grammarc.geometry.polygons import PLANE_U, PLANE_V
-from grammarc.geometry.trim import boxes_crossing, trim_triangles
+from grammarc.geometry.trim import VERTICAL_PLANES, boxes_crossing, trim_triangles
 from grammarc.model.records import MeshChunk
 from grammarc.ragged import next_in_segment, offsets_from_counts, segment_of
 
@@ -65,7 +64,7 @@ def emit_instances(ctx: Context, shapes: Shapes, asset: int, symbol: int, mirror
     if mirrored & Z_UP:  # the asset turns in its own box, before the mirror in the scope's
         xform = z_up(xform)
     if ctx.plan.trim_slot is not None:
-        planes = trim_planes(ctx.plan, shapes, rows)
+        planes = trim_planes(ctx.plan, ctx.chunk, shapes, rows)
         placed = xform.astype(np.float64)  # relative to the lot's origin, as the trim planes are
         cut = boxes_crossing(planes, placed, TOL.zero)
         if inserted is not None:
@@ -88,20 +87,17 @@ def z_up(xform: np.ndarray) -> np.ndarray:
     return turned
 
 
-def trim_planes(plan, shapes: Shapes, rows=slice(None)) -> np.ndarray:
-    """The trim planes (m, 4 P) of ``shapes`` rows ``rows``: the two vertical ones, NaN where there are
-    none or ``set(trim.vertical, false)``; then, where the grammar turns them on, the horizontal ones, NaN
-    where ``trim.horizontal`` is false."""
-    slot = plan.trim_slot
-    planes = np.stack([d[rows] for d in shapes.dynamic[slot:slot + 8]], axis=1)
+def trim_planes(plan, chunk, shapes: Shapes, rows=slice(None)) -> np.ndarray:
+    """The trim planes (m, ``plan.trim_width``) of ``shapes`` rows ``rows``, gathered from the ``chunk``'s
+    table by id: the two vertical ones, NaN where there are none or ``set(trim.vertical, false)``; then,
+    where the grammar turns them on, the horizontal ones, NaN where ``trim.horizontal`` is false."""
+    planes = chunk.trim_planes[shapes.dynamic[plan.trim_slot][rows]]
+    vertical = 4 * VERTICAL_PLANES
     if plan.trim_switch is not None:
-        planes[shapes.dynamic[plan.trim_switch][rows] == 0] = np.nan
-    if plan.horizontal_slot is None:
-        return planes
-    slot = plan.horizontal_slot
-    shallow = np.stack([d[rows] for d in shapes.dynamic[slot:slot + len(HORIZONTAL_SLOTS)]], axis=1)
-    shallow[shapes.dynamic[plan.horizontal_switch][rows] == 0] = np.nan
-    return np.concatenate([planes, shallow], axis=1)
+        planes[shapes.dynamic[plan.trim_switch][rows] == 0, :vertical] = np.nan
+    if plan.horizontal_planes:
+        planes[shapes.dynamic[plan.horizontal_switch][rows] == 0, vertical:] = np.nan
+    return planes
 
 
 def marked_inserted(plan, shapes: Shapes, inserted: bool) -> Shapes:

@@ -25,7 +25,7 @@ A body's end is a leaf where no operation of it hands its shape on (``execute.ru
 them as the operation table declares them, which is above the plan), and so is a shape that no rule of its
 symbol applies to (every rule has a guard). Where unsure, planes are read: a site the start symbol does not
 reach, or whose number another site shares and reads, keeps its planes. No expression reads the planes'
-columns, nor does ``set`` write them: they are named as no attribute can be (``slots``), and ``set`` takes
+id, nor does ``set`` write it: it is named as no attribute can be (``slots.TRIM_PLANES``), and ``set`` takes
 attributes and the switches ``trim.vertical`` and ``trim.horizontal``, which the readers look at.
 """
 

@@ -24,6 +24,8 @@ from grammarc.ragged import group_bounds, rank_within, row_groups
 #: A shared edge steeper than this (degrees from the horizontal) makes a vertical trim plane, a shallower
 #: one a horizontal plane.
 VERTICAL_DEGREES = 40.0
+#: Vertical trim planes a side face has: at its start edge and at its end edge (``side_face_planes``).
+VERTICAL_PLANES = 2
 #: Horizontal trim planes a face keeps (a box's top face has four shallow edges, a hip roof's face its
 #: eave, its hips and its ridge).
 HORIZONTAL_PLANES = 4

@@ -1,11 +1,11 @@
-"""The chunk's frame table: turned frames shared by the shapes turned alike."""
+"""The chunk's tables: turned frames shared by the shapes turned alike, trim planes by id."""
 
 from __future__ import annotations
 
 import numpy as np
 import pytest
 
-from grammarc.backend.chunk import Frames
+from grammarc.backend.chunk import Frames, TrimPlanes
 from grammarc.backend.kernels.turns import _MOSTLY_NEW
 
 
@@ -60,3 +60,14 @@ def test_turned_frames_of_nothing_add_no_row():
     frames = Frames()
     ids, axes = frames.turned(np.eye(3)[None], np.zeros(0, dtype=np.int32), np.zeros(0, dtype=np.int64))
     assert len(ids) == 0 and ids.dtype == np.int32 and axes.shape == (0, 3, 3) and frames.count == 0
+
+
+def test_trim_planes_row_0_is_none_and_stays_so_as_the_table_grows():
+    """Shapes without planes hold id 0, a NaN row; added rows are numbered from 1 and kept as the table
+    grows past its capacity."""
+    table = TrimPlanes(24, capacity=2)
+    rows = np.arange(3 * 24, dtype=float).reshape(3, 24)
+    assert table.add(rows).tolist() == [1, 2, 3]
+    got = table[np.array([0, 3, 1], dtype=np.int32)]
+    assert got.shape == (3, 24) and np.isnan(got[0]).all()
+    np.testing.assert_array_equal(got[1:], rows[[2, 0]])

@@ -11,7 +11,7 @@ from grammarc.backend.slots import (
     PIVOT_SLOTS,
     RING_START,
     TRIM_INSERTED,
-    TRIM_SLOTS,
+    TRIM_PLANES,
     TRIM_SWITCH,
     uv_slots,
 )
@@ -28,13 +28,19 @@ def test_columns_of_colours_trims_and_occluders_only_where_the_grammar_needs_the
     colour = plan_of(write, "Lot --> color(1, 0, 0) X\n")
     assert colour.color_slot == colour.dynamic[COLOR_SLOT]
     trims = plan_of(write, 'Lot --> extrude(3) comp(f){ side : i("builtin:cube") X }\n')
-    assert trims.trim_slot == trims.dynamic[TRIM_SLOTS[0]] and trims.trim_switch is None
+    assert trims.trim_slot == trims.dynamic[TRIM_PLANES] and trims.trim_switch is None
     assert trims.inserted_slot == trims.dynamic[TRIM_INSERTED] and plain.inserted_slot is None
     # a primitive is inserted geometry too: a grammar whose inserts are all primitives has trim planes
     primitives = plan_of(write, "Lot --> extrude(3) comp(f){ side : primitiveCube(1, 1, 1) X }\n")
     assert primitives.trim_slot is not None and primitives.inserted_slot is not None
     switch = plan_of(write, 'Lot --> set(trim.vertical, false) extrude(3) comp(f){ side : i("builtin:cube") X }\n')
     assert switch.trim_switch == switch.dynamic[TRIM_SWITCH]
+    # one id column for all the planes, whose rows are wider where the grammar may turn horizontal ones on
+    assert (trims.horizontal_planes, trims.trim_width) == (False, 8)
+    assert not any(name.startswith("trim.") for name in trims.dynamic if name not in (TRIM_PLANES, TRIM_INSERTED))
+    shallow = 'Lot --> set(trim.horizontal, {}) extrude(3) comp(f){{ side : i("builtin:cube") X }}\n'
+    on, off = plan_of(write, shallow.format("true")), plan_of(write, shallow.format("false"))
+    assert (on.horizontal_planes, on.trim_width, off.horizontal_planes, off.trim_width) == (True, 24, False, 8)
     labelled = plan_of(write, 'Lot --> label("mass") X\n')
     assert labelled.occluders and ANCESTORS[0] in labelled.dynamic
 

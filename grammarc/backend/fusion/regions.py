@@ -38,11 +38,10 @@ from grammarc.backend.materials import MAP_FIELDS
 from grammarc.backend.slots import (
     ANCESTORS,
     COLOR_SLOT,
-    HORIZONTAL_SLOTS,
     PIVOT_SLOTS,
     RING_START,
     TRIM_INSERTED,
-    TRIM_SLOTS,
+    TRIM_PLANES,
     uv_slots,
 )
 from grammarc.diagnostics import Span
@@ -86,7 +85,7 @@ def grammar_allows(plan) -> bool:
 def grammar_refusals(plan) -> list[str]:
     """Why ``plan``'s grammar may not be fused at all, one phrase each (none: it may be; the module
     docstring says why each keeps it out)."""
-    slots = {COLOR_SLOT, *MAP_FIELDS, *TRIM_SLOTS, TRIM_INSERTED, *HORIZONTAL_SLOTS, *ANCESTORS, *PIVOT_SLOTS, RING_START,
+    slots = {COLOR_SLOT, *MAP_FIELDS, TRIM_PLANES, TRIM_INSERTED, *ANCESTORS, *PIVOT_SLOTS, RING_START,
              *(name for s in plan.uv_slots for name in uv_slots(s))}
     state = [name for name in plan.dynamic if name not in slots]
     found = (

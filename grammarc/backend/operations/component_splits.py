@@ -85,18 +85,21 @@ def comp_faces(ctx: Context, cursor: Shapes, op: ir.CompFaces) -> Parts:
         up = chunk.frames.data[cursor.frame, 1][parent]
         origin = shapes.origin - chunk.lot_origin[shapes.lot]
         planes = side_face_planes(axes, origin, shapes.size, parent, up)
-        dynamic = list(shapes.dynamic)
-        dynamic[slot:slot + 8] = list(planes.T)
-        shallow = ctx.plan.horizontal_slot
-        if shallow is not None:
+        if ctx.plan.horizontal_planes:
             # each component is one face (none for a degenerate one): its outline from the lot's origin
             faces = shape_faces(shapes.size, shapes.geom, chunk.polygons, chunk.meshes)
             owner, at = faces.face_shape(), faces.vertex_shape()
             verts = origin[at] + np.einsum("vi,vij->vj", faces.verts, chunk.frames[shapes.frame[at]])
             found = shallow_edge_planes(verts, faces.ring_offsets, faces.face_offsets, parent[owner], up[owner])
-            planes = np.full((len(shapes), found.shape[1]), np.nan)
-            planes[owner] = found
-            dynamic[shallow:shallow + planes.shape[1]] = list(planes.T)
+            shallow = np.full((len(shapes), found.shape[1]), np.nan)
+            shallow[owner] = found
+            planes = np.concatenate([planes, shallow], axis=1)
+        # a row of the chunk's table for each face with a plane; the others none (row 0)
+        ids = np.zeros(len(shapes), dtype=np.int32)
+        some = ~np.isnan(planes).all(axis=1)
+        ids[some] = chunk.trim_planes.add(planes[some])
+        dynamic = list(shapes.dynamic)
+        dynamic[slot] = ids
         shapes = replace(shapes, dynamic=tuple(dynamic))
     env = ctx.env(cursor) if op.picks else None
     picks = [np.broadcast_to(np.asarray(evaluate_array(e, env), dtype=np.float64), (len(cursor),))

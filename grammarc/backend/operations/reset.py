@@ -4,7 +4,7 @@ The reference's example sets a lot back again and again by growing distances, ea
 itself; what a rule ``set`` (colour, material, attributes), its texture space and its place in the
 derivation (``comp.index``...) stay, the trim planes a ``comp(f)`` gave it go. The initial shapes are the
 chunk's (``Chunk.lot_shapes``), gathered by each shape's lot. Reads: ``lot``. Writes: the scope,
-``geom``, the trim planes and the mark of inserted geometry (``dynamic``).
+``geom``, the trim planes' id and the mark of inserted geometry (``dynamic``).
 """
 
 from __future__ import annotations
@@ -16,7 +16,6 @@ import numpy as np
 from grammarc.backend.context import Context
 from grammarc.backend.operations.table import operation
 from grammarc.backend.shapes import Shapes
-from grammarc.backend.slots import HORIZONTAL_SLOTS, TRIM_SLOTS
 from grammarc.backend.terminals import marked_inserted
 from grammarc.ir import nodes as ir
 
@@ -27,9 +26,8 @@ def reset_geometry(ctx: Context, cursor: Shapes, op: ir.ResetGeometry) -> Shapes
     size, frame, geom = ctx.chunk.lot_shapes
     lot = cursor.lot
     dynamic = list(cursor.dynamic)
-    for first, count in ((ctx.plan.trim_slot, len(TRIM_SLOTS)), (ctx.plan.horizontal_slot, len(HORIZONTAL_SLOTS))):
-        if first is not None:
-            dynamic[first:first + count] = [np.full(len(cursor), np.nan)] * count
+    if ctx.plan.trim_slot is not None:  # the chunk's ``TrimPlanes`` row 0: none
+        dynamic[ctx.plan.trim_slot] = np.zeros(len(cursor), dtype=np.int32)
     reset = replace(cursor, origin=ctx.chunk.lot_origin[lot], size=size[lot], frame=frame[lot], geom=geom[lot],
                     dynamic=tuple(dynamic))
     return marked_inserted(ctx.plan, reset, False)

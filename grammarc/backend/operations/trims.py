@@ -8,7 +8,7 @@ own (``geometry.trim.plane_coordinates``): the shape's faces go into that frame,
 front of the plane and closed as a split closes a cut roof (``mesh_shapes.cut_to_slabs``), and come
 back. A trimmed shape's geometry becomes a mesh in its unchanged scope (CityEngine keeps the scope, as an
 insert does); a shape no plane cuts keeps its geometry, and an inserted asset is left to be trimmed
-where it is placed. Reads: the scope, ``geom`` and the trim planes (``dynamic``). Writes: ``geom``.
+where it is placed. Reads: the scope, ``geom`` and the trim planes' id (``dynamic``). Writes: ``geom``.
 """
 
 from __future__ import annotations
@@ -34,7 +34,7 @@ def trim(ctx: Context, cursor: Shapes, op: ir.Trim) -> Shapes:
     if plan.trim_slot is None or not len(cursor):  # no comp(f) in the grammar: no shape has planes
         return cursor
     chunk = ctx.chunk
-    planes = trim_planes(plan, cursor)
+    planes = trim_planes(plan, chunk, cursor)
     planes[cursor.geom < -1] = np.nan  # an asset is trimmed where it is placed
     rows = np.flatnonzero(~np.isnan(planes[:, 0::4]).all(axis=1))
     if not len(rows):

@@ -20,7 +20,7 @@ from derivations import (
     totals,
 )
 
-from grammarc.backend.chunk import Frames
+from grammarc.backend.chunk import Frames, TrimPlanes
 
 
 def test_comp_front_side_top_on_a_box(write):
@@ -321,3 +321,28 @@ def test_the_same_face_of_boxes_in_one_frame_shares_a_frame_row(write, monkeypat
     assert Counter(names(r)) == {"F": 12 * 6}
     assert sum(added) == 1 + 6  # the lot's frame, then one per face
     assert len(np.unique(np.round(quad_normals(r), 6), axis=0)) == 6
+
+
+def test_comp_f_gives_each_face_with_planes_a_row_that_its_pieces_share(write, monkeypatch):
+    """A box's four side faces get a row of trim planes each in the chunk's table (``chunk.TrimPlanes``), its
+    top, whose edges are not steep, none (row 0); the pieces split from a side face hold that face's id, and
+    the cubes inserted on them are cut by its row."""
+    added, gathered = [], []
+    add, gather = TrimPlanes.add, TrimPlanes.__getitem__
+
+    def counted(self, rows):
+        added.append(rows.copy())
+        return add(self, rows)
+
+    def seen(self, ids):
+        gathered.append(np.array(ids))
+        return gather(self, ids)
+
+    monkeypatch.setattr(TrimPlanes, "add", counted)
+    monkeypatch.setattr(TrimPlanes, "__getitem__", seen)
+    cube = "s('1, '1, 1) i(\"builtin:cube\")"
+    r = run(write, f"Lot --> extrude(10) comp(f){{ side : split(y){{ ~5 : {cube} X }}* | top : {cube} T }}\n",
+            [rect(12, 8)])
+    assert Counter(names(r)) == {"X": 8, "T": 1}
+    assert [rows.shape for rows in added] == [(4, 8)] and not np.isnan(added[0][:, [0, 4]]).any()
+    assert sorted(np.concatenate(gathered).tolist()) == [0, 1, 1, 2, 2, 3, 3, 4, 4]
