@@ -92,11 +92,10 @@ class Context:
         fine = values >= 0  # False for NaN too
         if fine.all():
             return
-        bad = np.flatnonzero(np.broadcast_to(~fine.all(axis=1), (len(shapes),)))
-        if len(bad):
-            sizes = np.broadcast_to(values, (len(shapes), values.shape[1]))[bad]
-            self.fail_quoting(shapes.lot[bad], lambda row: f"{message} ({', '.join(f'{v:g}' for v in sizes[row])})",
-                              span)
+        bad = np.broadcast_to(~fine.all(axis=1), (len(shapes),))
+        if bad.any():
+            sizes = np.broadcast_to(values, (len(shapes), values.shape[1]))
+            self.fail_each(shapes, bad, lambda i: f"{message} ({', '.join(f'{v:g}' for v in sizes[i])})", span)
 
     def refuse_meshes(self, op: ir.Op, shapes: Shapes) -> None:
         """Fail the roofs (meshes) among ``shapes``: ``op`` does not take them (``Operation.meshes``)."""
