@@ -41,6 +41,7 @@ import time
 from collections.abc import Callable
 from pathlib import Path
 
+from grammarc import releases
 from grammarc.errors import interruption, raise_stopped, stopped
 from grammarc.frontend.user_cache import code_stamp
 
@@ -266,6 +267,7 @@ def serve(run: Callable[[list[str]], int], warm: Callable[[], None], *, idle_tim
 def _child(connection: socket.socket, run: Callable[[list[str]], int]) -> None:
     """In a forked child: take over the client's place and streams, run its command, report the status."""
     status = 1
+    releases.hold()  # until the client has its status (``releases``)
     try:
         signal.signal(signal.SIGCHLD, signal.SIG_DFL)
         for signum in _FORWARDED:  # as the command will, from before it begins
@@ -291,7 +293,22 @@ def _child(connection: socket.socket, run: Callable[[list[str]], int]) -> None:
             sys.stderr.flush()
         with contextlib.suppress(OSError):
             connection.sendall(_STATUS.pack(status))
+        _let_go(connection)
+        releases.release_all()
         os._exit(status & 0xFF)
+
+
+def _let_go(connection: socket.socket) -> None:
+    """End the connection (which wakes ``_watch``: its SIGTERM is ignored by now) and let go of the client's
+    streams (``/dev/null`` in their place): a client whose output goes into a pipe is done when every
+    writer of the pipe is gone, not when it has its status."""
+    with contextlib.suppress(OSError):  # the client may be gone already
+        connection.shutdown(socket.SHUT_RDWR)
+    with contextlib.suppress(OSError):
+        null = os.open(os.devnull, os.O_RDWR)
+        for fd in (0, 1, 2):
+            os.dup2(null, fd)
+        os.close(null)
 
 
 def _run_request(connection: socket.socket, run: Callable[[list[str]], int]) -> int:

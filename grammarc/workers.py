@@ -41,6 +41,7 @@ from pathlib import Path
 
 import numpy as np
 
+from grammarc import releases
 from grammarc.atomic import remove_stale
 from grammarc.errors import DerivationError
 
@@ -96,29 +97,42 @@ def worker_pool(work: Callable, workers: int):
     folder = Path(tempfile.mkdtemp(prefix=f"grammarc-records-{os.getpid()}-", dir=shared))
     _SHARED.update(work=work)
     slots = _Slots(folder)
+    pool = None
     try:
         here = not _warm  # the first task runs here, but in a warm process; the pool forks its workers at the next
-        with ProcessPoolExecutor(workers, mp_context=multiprocessing.get_context("fork"),
-                                 initializer=_start_worker) as pool:
-            def submit(lots) -> Future:
-                nonlocal here
-                if here:
-                    here = False
-                    return _at_once(work, lots)
-                slot = slots.take()
-                try:
-                    shipped = pool.submit(_run, lots, slot)
-                except BrokenProcessPool as broken:  # a worker was killed before this task went in
-                    shipped = Future()
-                    shipped.set_exception(broken)
-                received: Future = Future()
-                shipped.add_done_callback(lambda done: _receive(done, received, lots, slots, slot))
-                return received
+        pool = ProcessPoolExecutor(workers, mp_context=multiprocessing.get_context("fork"),
+                                   initializer=_start_worker)
 
-            yield submit
+        def submit(lots) -> Future:
+            nonlocal here
+            if here:
+                here = False
+                return _at_once(work, lots)
+            slot = slots.take()
+            try:
+                shipped = pool.submit(_run, lots, slot)
+            except BrokenProcessPool as broken:  # a worker was killed before this task went in
+                shipped = Future()
+                shipped.set_exception(broken)
+            received: Future = Future()
+            shipped.add_done_callback(lambda done: _receive(done, received, lots, slots, slot))
+            return received
+
+        yield submit
     finally:
         _SHARED.clear()
-        shutil.rmtree(folder, ignore_errors=True)
+        # the workers' exit and the unmapping of the memory files (the slots, kept to then) are left for
+        # after a served build's reply; the folder goes once no worker can write into it
+        releases.later(functools.partial(_close_pool, pool, slots, folder))
+
+
+def _close_pool(pool: ProcessPoolExecutor | None, slots: _Slots, folder: Path) -> None:
+    """Wait for the workers to exit, then remove the folder of memory files (and, with ``slots``, the
+    mappings of its files that no record array refers to any more)."""
+    if pool is not None:
+        pool.shutdown(wait=True)
+    shutil.rmtree(folder, ignore_errors=True)
+    slots.close()
 
 
 def _at_once(work: Callable, lots) -> Future:
@@ -258,6 +272,11 @@ class _Slots:
     def _give_back(self, path: Path) -> None:
         with self._lock:
             self._free.append(path)
+
+    def close(self) -> None:
+        """Let go of the mappings: each is unmapped once the last array viewing it is gone."""
+        with self._lock:
+            self._mapped.clear()
 
 
 def _rebuild(layout: tuple, data: np.ndarray):

@@ -15,7 +15,7 @@ PACKAGE = Path(__file__).resolve().parents[1] / "grammarc"
 
 #: From the ground up; the packages (or top-level modules) of one floor do not import each other.
 FLOORS = (
-    ("grammarc", "constants", "diagnostics", "ragged", "atomic"),
+    ("grammarc", "constants", "diagnostics", "ragged", "atomic", "releases"),
     ("errors",),
     ("ir",),
     ("model",),

@@ -65,9 +65,15 @@ def _children(pid: int) -> list[int]:
 
 def test_a_served_build_writes_the_bytes_its_own_process_writes(served, tmp_path):
     grammar = ROOT / "examples" / "city" / "city.cga"
+    (tmp_path / "served.npz").write_bytes(b"an older output")
     assert server.request(["build", str(grammar), "--emit", str(tmp_path / "served.npz"), "--quiet"]) == 0
     assert main(["build", str(grammar), "--emit", str(tmp_path / "own.npz"), "--quiet"]) == 0
     assert (tmp_path / "served.npz").read_bytes() == (tmp_path / "own.npz").read_bytes()
+    # what the build left to release after its reply (its workers, the older output) goes, and its child
+    deadline = time.monotonic() + 60
+    while _children(served.pid) and time.monotonic() < deadline:
+        time.sleep(0.05)
+    assert not _children(served.pid)
 
 
 def test_a_served_command_runs_in_the_clients_folder(served, tmp_path):

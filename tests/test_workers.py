@@ -1,5 +1,6 @@
 """Worker processes: records shipped through memory files come back equal; bad lots come back named."""
 
+import multiprocessing
 import os
 
 import numpy as np
@@ -194,3 +195,30 @@ def test_chunks_of_a_build_with_workers_start_small_and_end_shared(monkeypatch, 
     square = [[np.array([[0, 0], [10, 0], [10, 10], [0, 10]], float)]]
     derive(grammar, lots_from_polygons(square * lots), BuildOptions(workers=2))
     assert sizes == expected
+
+
+def test_where_releases_are_held_the_workers_and_their_memory_files_stay_until_release_all():
+    """A served build replies before its workers exit and its shared memory goes (``releases``)."""
+    from grammarc import releases, workers
+
+    releases.hold()
+    try:
+        with workers.worker_pool(_load_and_say, 2) as submit:
+            for future in [submit([]), submit([])]:
+                future.result(timeout=60)
+            children = set(multiprocessing.active_children())
+            folders = set(_record_folders())
+        assert children and all(child.is_alive() for child in children)
+        assert folders and all(folder.is_dir() for folder in folders)
+    finally:
+        releases.release_all()
+    assert not any(child.is_alive() for child in children)
+    assert not any(folder.exists() for folder in folders)
+
+
+def _record_folders():
+    import tempfile
+    from pathlib import Path
+
+    shared = Path("/dev/shm") if Path("/dev/shm").is_dir() else Path(tempfile.gettempdir())
+    return shared.glob(f"grammarc-records-{os.getpid()}-*")

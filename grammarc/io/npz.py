@@ -54,6 +54,7 @@ import numpy as np
 # zlib's CRC-32 with SIMD (every record byte passes it), and its crc32_combine
 from zlib_ng.zlib_ng import crc32, crc32_combine
 
+from grammarc import releases
 from grammarc.atomic import private_folder
 from grammarc.errors import UsageError
 from grammarc.model.records import LotOrigins, MaterialTable, MeshChunk, TerminalChunk, record_mesh
@@ -258,7 +259,7 @@ class InstanceWriter:
         }
         try:
             tmp = self._sink.finish(self._members(counts))
-            os.replace(tmp, self.path)
+            releases.replace(tmp, self.path)
         except BaseException:
             self.abort()
             raise
