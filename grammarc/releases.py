@@ -5,7 +5,9 @@ build's size: freeing the blocks of the output a new one replaced, the exit of t
 unmapping of the shared memory their records came through. A command in its own process does them where
 they come (``later`` runs them at once): its process ends right after, and ending would do the same work.
 A served command's child (``server``) ``hold``\\s them instead, sends its client the exit status, lets go
-of the client's streams and only then runs them (``release_all``), so the client's command ends first.
+of the client's streams and only then runs them (``release_all``), so the client's command ends first. A
+command that starts such work again (a search, the conformance runs derive again and again) ``flush``\\es
+what it holds first: only the last work's releases wait for the reply, not a pile of idle workers.
 """
 
 from __future__ import annotations
@@ -16,7 +18,7 @@ import os
 import stat
 from collections.abc import Callable
 
-__all__ = ["hold", "holding", "later", "release_all", "replace"]
+__all__ = ["flush", "hold", "holding", "later", "release_all", "replace"]
 
 _held: list[Callable[[], object]] | None = None
 
@@ -39,12 +41,25 @@ def later(release: Callable[[], object]) -> None:
         _held.append(release)
 
 
+def flush() -> None:
+    """Run the kept releases now, in the order they were given, and go on holding the next ones."""
+    if _held:
+        held = _held[:]
+        _held.clear()
+        _run(held)
+
+
 def release_all() -> None:
-    """Run the kept releases in the order they were given. The command is over: a release that fails
-    (a worker that will not exit cleanly) has nobody left to tell, and must not stop the others."""
+    """Run the kept releases in the order they were given, and hold no more."""
     global _held
     held, _held = _held or [], None
-    for release in held:
+    _run(held)
+
+
+def _run(releases: list[Callable[[], object]]) -> None:
+    """Each of ``releases``: one that fails (a worker that will not exit cleanly) has nobody left to tell,
+    and must not stop the others."""
+    for release in releases:
         with contextlib.suppress(Exception):
             release()
 

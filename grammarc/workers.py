@@ -91,6 +91,7 @@ def worker_pool(work: Callable, workers: int):
     if workers == 1 or not forks():
         yield functools.partial(_at_once, work)
         return
+    releases.flush()  # the workers of a pool before, kept for after a served command's reply, go first
     memory = "/dev/shm" if os.path.isdir("/dev/shm") and os.access("/dev/shm", os.W_OK) else None
     shared = Path(memory if memory is not None else tempfile.gettempdir())
     remove_stale(shared, "grammarc-records-")  # what builds that were killed left

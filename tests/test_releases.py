@@ -31,6 +31,16 @@ def test_held_releases_run_in_order_at_release_all_and_a_failing_one_stops_none(
     assert done == [1, 2] and not releases.holding()
 
 
+def test_a_flush_runs_what_is_held_and_goes_on_holding(held):
+    done = []
+    releases.later(lambda: done.append(1))
+    releases.flush()
+    releases.later(lambda: done.append(2))
+    assert done == [1] and releases.holding()
+    releases.release_all()
+    assert done == [1, 2]
+
+
 def _deleted_but_open(inode: int) -> bool:
     """Whether this process holds a descriptor of the file ``inode`` that has no name any more."""
     for fd in os.listdir("/proc/self/fd"):

@@ -210,6 +210,12 @@ def test_where_releases_are_held_the_workers_and_their_memory_files_stay_until_r
             folders = set(_record_folders())
         assert children and all(child.is_alive() for child in children)
         assert folders and all(folder.is_dir() for folder in folders)
+        with workers.worker_pool(_load_and_say, 2) as submit:  # a command that derives again (a search)
+            assert not any(child.is_alive() for child in children)  # lets go of the pool before first
+            assert not any(folder.exists() for folder in folders)
+            submit([]).result(timeout=60)
+            children = set(multiprocessing.active_children())
+            folders = set(_record_folders())
     finally:
         releases.release_all()
     assert not any(child.is_alive() for child in children)
