@@ -30,6 +30,7 @@ def hold() -> None:
 
 
 def holding() -> bool:
+    """Whether this process keeps its releases (``hold``) until ``release_all``."""
     return _held is not None
 
 
@@ -57,8 +58,8 @@ def release_all() -> None:
 
 
 def _run(releases: list[Callable[[], object]]) -> None:
-    """Each of ``releases``: one that fails (a worker that will not exit cleanly) has nobody left to tell,
-    and must not stop the others."""
+    """Each of ``releases``: one that fails (a worker that will not exit cleanly) stops neither the others
+    nor the command, as it changes nothing the command made."""
     for release in releases:
         with contextlib.suppress(Exception):
             release()
@@ -70,7 +71,7 @@ def replace(new: str | os.PathLike, path: str | os.PathLike) -> None:
     The filesystem frees a file's blocks when its last name and its last descriptor are gone: a
     descriptor held over the rename moves that work to where it is closed. Taken only where releases are
     held (Windows, which cannot rename over an open file, has no server)."""
-    old = _opened(path) if _held is not None else None
+    old = _opened(path) if holding() else None
     os.replace(new, path)
     if old is not None:
         later(functools.partial(os.close, old))

@@ -11,9 +11,9 @@ import os
 os.environ.setdefault("GRAMMARC_STRICT", "1")
 # The tests' grammars make fused kernels and extracted packages of their own: they go to a cache of the tests
 # (kept between runs, as the user's is), not into the user's, all of whose kernels a warm server loads.
-os.environ["XDG_CACHE_HOME"] = os.path.join(
-    os.environ.get("XDG_CACHE_HOME") if os.path.isabs(os.environ.get("XDG_CACHE_HOME", "")) else
-    os.path.join(os.path.expanduser("~"), ".cache"), "grammarc-tests")
+from grammarc.frontend.user_cache import cache_home
+
+os.environ["XDG_CACHE_HOME"] = os.path.join(cache_home(), "grammarc-tests")
 
 import importlib.util
 from dataclasses import replace

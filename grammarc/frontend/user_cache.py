@@ -27,14 +27,17 @@ import grammarc
 T = TypeVar("T")
 
 
-def cache_folder(*parts: str) -> Path | None:
-    """``$XDG_CACHE_HOME/grammarc[/parts...]`` or ``~/.cache/grammarc[/parts...]``, created ``0700``;
-    ``None`` if it cannot be made, is not a folder of the user's own (a link, another owner), or others
-    may write into it or into the folders between."""
+def cache_home() -> str:
+    """The user's cache folder: ``$XDG_CACHE_HOME``, or ``~/.cache`` where it is unset or relative (the XDG
+    rule: a relative path is ignored)."""
     base = os.environ.get("XDG_CACHE_HOME", "")
-    if not os.path.isabs(base):  # the XDG rule: a relative path is ignored
-        base = os.path.join(os.path.expanduser("~"), ".cache")
-    folder = Path(base) / "grammarc"
+    return base if os.path.isabs(base) else os.path.join(os.path.expanduser("~"), ".cache")
+
+
+def cache_folder(*parts: str) -> Path | None:
+    """``cache_home()/grammarc[/parts...]``, created ``0700``; ``None`` if it cannot be made, is not a folder
+    of the user's own (a link, another owner), or others may write into it or into the folders between."""
+    folder = Path(cache_home()) / "grammarc"
     for name in (None, *parts):
         folder = folder / name if name else folder
         try:
