@@ -102,3 +102,22 @@ def write(tmp_path):
         return path
 
     return _write
+
+
+@pytest.fixture
+def georeferenced_lots(tmp_path) -> Path:
+    """One 30 x 20 m lot in UTM 33N, as GeoParquet (``tmp_path/lots.parquet``): lots as a GIS user has them,
+    read through Arrow and PROJ. Skipped without the ``parquet`` and ``gis`` extras."""
+    import json
+
+    from grammarc.cli import main
+
+    pytest.importorskip("pyarrow")
+    pytest.importorskip("pyproj")
+    ring = [[500000, 6000000], [500030, 6000000], [500030, 6000020], [500000, 6000020], [500000, 6000000]]
+    (tmp_path / "lots.geojson").write_text(json.dumps({
+        "type": "FeatureCollection", "crs": {"type": "name", "properties": {"name": "EPSG:32633"}},
+        "features": [{"type": "Feature", "properties": {"id": "a"},
+                      "geometry": {"type": "Polygon", "coordinates": [ring]}}]}))
+    assert main(["lots", str(tmp_path / "lots.geojson"), "--to", str(tmp_path / "lots.parquet")]) == 0
+    return tmp_path / "lots.parquet"

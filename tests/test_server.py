@@ -76,6 +76,20 @@ def test_a_served_build_writes_the_bytes_its_own_process_writes(served, tmp_path
     assert not _children(served.pid)
 
 
+@pytest.mark.parametrize("emit", ["g.usda", "g.obj"])
+def test_a_served_build_through_the_libraries_its_server_imported_writes_the_same_bytes(served, georeferenced_lots,
+                                                                                    emit):
+    """The server imported Arrow, PROJ, USD and trimesh before it forked the command (``serving.LIBRARIES``)."""
+    if emit.endswith(".usda"):
+        pytest.importorskip("pxr")
+    folder = georeferenced_lots.parent
+    (folder / "g.cga").write_text("Lot --> extrude(3) split(y) { 1 : X | ~1 : Y. }*\n")
+    build = ["build", str(folder / "g.cga"), "--lots", str(georeferenced_lots), "--quiet", "--emit"]
+    assert server.request([*build, str(folder / "served" / emit)]) == 0
+    assert main([*build, str(folder / "own" / emit)]) == 0
+    assert (folder / "served" / emit).read_bytes() == (folder / "own" / emit).read_bytes()
+
+
 def test_a_served_command_runs_in_the_clients_folder(served, tmp_path):
     (tmp_path / "g.cga").write_text("Lot --> extrude(3)\n")
     client = _client("build", "g.cga", "--emit", "out/g.npz", cwd=tmp_path, env=os.environ.copy())

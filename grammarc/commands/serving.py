@@ -3,6 +3,7 @@ warm (``server``); what it loads before it serves (``warm``)."""
 
 from __future__ import annotations
 
+import contextlib
 import os
 import signal
 import sys
@@ -88,10 +89,22 @@ def _detached(serve, ready) -> int:
     os._exit(0)
 
 
+#: The libraries grammarc's readers and writers import where a command first needs one, imported by a server
+#: before it serves, where installed: a served command is a fork, which would otherwise import its own, 35 ms
+#: (PROJ) to 0.3 s (trimesh) on every command that needs it. Lots with a coordinate system (``io.crs``),
+#: GeoParquet files (``io.arrow_lots``; reading a file goes through Arrow's datasets), GIS files
+#: (``io.gis``), rule packages not kept yet (``io.rpk``), baked meshes and glTF assets (``io.bake``,
+#: ``model.assets``), USD (``io.usd``). None starts a thread that a fork would lose but the allocator's,
+#: which forks take care of.
+LIBRARIES = ("pyproj", "pyarrow.parquet", "pyarrow.dataset", "pyogrio.raw", "py7zr", "trimesh",
+             "pxr.Gf", "pxr.Sdf", "pxr.Tf", "pxr.Usd", "pxr.UsdGeom", "pxr.UsdShade", "pxr.Vt")
+
+
 def warm() -> None:
     """What a server loads before serving: every module of grammarc (those of extras not installed
-    excepted), the dialects' parsers, the fused regions' kernels that builds compiled, and the machine
-    code of every kernel numba has cached; then its builds' workers need load none (``workers.warm``)."""
+    excepted) and the libraries its readers and writers import when first needed (``LIBRARIES``), the
+    dialects' parsers, the fused regions' kernels that builds compiled, and the machine code of every kernel
+    numba has cached; then its builds' workers need load none (``workers.warm``)."""
     import importlib
     import pkgutil
 
@@ -106,6 +119,9 @@ def warm() -> None:
             importlib.import_module(module.name)
         except ImportError:  # an optional extra's module (USD, Dask, ...) whose library is missing
             continue
+    for name in LIBRARIES:
+        with contextlib.suppress(ImportError):  # an extra not installed
+            importlib.import_module(name)
     for dialect in DIALECTS.values():
         parser_for(dialect.grammar)
     compiled.import_compiled()

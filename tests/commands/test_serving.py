@@ -1,0 +1,38 @@
+"""What a server loads before serving (``commands/serving.py``, ``warm``): a served command is a fork of it, so
+whatever it would import on its way is what every command of its kind pays again."""
+
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[2]
+#: After ``warm``, builds of GeoParquet lots with a coordinate system to USD, a baked mesh, glTF, 3D Tiles and
+#: npz: the modules of the libraries in ``LIBRARIES`` they import (printed as JSON).
+BUILDS = """
+import json, sys
+from grammarc.cli import main
+from grammarc.commands.serving import LIBRARIES, warm
+tops = {name.split(".")[0] for name in LIBRARIES}
+warm()
+before = set(sys.modules)
+for emit in ("o.usda", "o.obj", "o.glb", "o.3dtiles", "o.npz"):
+    assert main(["build", "g.cga", "--lots", "lots.parquet", "--emit", emit, "--quiet"]) == 0
+print(json.dumps(sorted(m for m in set(sys.modules) - before if m.split(".")[0] in tops)))
+"""
+
+
+def test_a_warm_server_has_imported_the_libraries_its_commands_read_and_write_with(georeferenced_lots):
+    pytest.importorskip("pxr")
+    folder = georeferenced_lots.parent
+    (folder / "g.cga").write_text("Lot --> extrude(3) X.\n")
+    env = {**os.environ, "GRAMMARC_SERVER": "off", "PYTHONPATH": str(ROOT)}
+    done = subprocess.run([sys.executable, "-c", BUILDS], cwd=folder, env=env, capture_output=True, text=True,
+                          timeout=600, check=False)
+    assert done.returncode == 0, done.stderr
+    assert json.loads(done.stdout) == []
