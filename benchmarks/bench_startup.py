@@ -3,7 +3,9 @@ timed in turn in one run (own, served, own, served, ...), so that a noisy machin
 
 The served build is the ``grammarc`` command as a user runs it once a server is up: Python starts, the
 client hands the command to the server and waits for its status. The grammars: candler.rpk of the PRT
-kit (skipped without the kit), and the example city's grammar, each on one 30 x 20 m lot.
+kit (skipped without the kit), and the example city's grammar, each on one 30 x 20 m lot; and the city's
+grammar on a lot as a GIS user has it (GeoParquet in UTM, read through Arrow and PROJ) to npz, USD and a
+baked OBJ, whose libraries a served build finds imported by its server.
 """
 
 from __future__ import annotations
@@ -36,7 +38,26 @@ def test_one_lot_build(benchmark, served_env, tmp_path, grammar):
     if not path.exists():
         pytest.skip("needs the PRT kit (../shared/prt)")
     lots = grid_lots(tmp_path / "one.geojson", 1, 30.0, 20.0)
-    args = [str(path), "--lots", str(lots), "--emit", str(tmp_path / "one.npz"), "--quiet"]
+    _own_and_served(benchmark, served_env, [str(path), "--lots", str(lots), "--emit", str(tmp_path / "one.npz")])
+
+
+@pytest.mark.parametrize("emit", ["npz", "usda", "obj"])
+def test_one_lot_build_of_gis_lots(benchmark, served_env, tmp_path, emit):
+    pytest.importorskip("pyarrow")
+    pytest.importorskip("pyproj")
+    if emit == "usda":
+        pytest.importorskip("pxr")
+    lots = grid_lots(tmp_path / "one.geojson", 1, 30.0, 20.0, crs="EPSG:32633", at=(500000.0, 6000000.0))
+    subprocess.run([sys.executable, "-m", "grammarc.client", "lots", str(lots), "--to", str(tmp_path / "one.parquet")],
+                   env={**served_env, "GRAMMARC_SERVER": "off"}, check=True, capture_output=True)
+    _own_and_served(benchmark, served_env, [str(ROOT / "examples/city/city.cga"), "--lots",
+                                            str(tmp_path / "one.parquet"), "--emit", str(tmp_path / f"one.{emit}")])
+
+
+def _own_and_served(benchmark, served_env: dict, args: list[str]) -> None:
+    """Time the build of ``args`` served, each run after one in its own process (whose times go in the extra
+    info)."""
+    args = [*args, "--quiet"]
     own_env = {**served_env, "GRAMMARC_SERVER": "off"}
     _timed(args, own_env)  # the numba cache filled, the files in the page cache
     own: list[float] = []

@@ -20,16 +20,19 @@ import shapely
 HERE = Path(__file__).parent
 
 
-def grid_lots(path: Path, n: int, width: float = 20.0, depth: float = 15.0) -> Path:
-    """n rectangular lots on a grid, as GeoJSON (deterministic)."""
+def grid_lots(path: Path, n: int, width: float = 20.0, depth: float = 15.0, crs: str | None = None,
+              at: tuple[float, float] = (0.0, 0.0)) -> Path:
+    """n rectangular lots on a grid from ``at``, as GeoJSON (deterministic), in the coordinate system ``crs``
+    (a ``crs`` member, as GDAL writes it) or none."""
     side = int(n ** 0.5 + 0.999)
     features = []
     for i in range(n):
-        x, y = (i % side) * (width + 10), (i // side) * (depth + 10)
+        x, y = at[0] + (i % side) * (width + 10), at[1] + (i // side) * (depth + 10)
         ring = [[x, y], [x + width, y], [x + width, y + depth], [x, y + depth], [x, y]]
         features.append({"type": "Feature", "id": f"lot{i}", "properties": {},
                          "geometry": {"type": "Polygon", "coordinates": [ring]}})
-    path.write_text(json.dumps({"type": "FeatureCollection", "features": features}))
+    named = {"crs": {"type": "name", "properties": {"name": crs}}} if crs else {}
+    path.write_text(json.dumps({"type": "FeatureCollection", **named, "features": features}))
     return path
 
 
