@@ -96,7 +96,7 @@ def _os_error(error: OSError) -> str:
 @functools.cache
 def _parser() -> argparse.ArgumentParser:
     """The command line's parser, made once a process: a warm server made it to read its own command, and
-    every command it forks parses with it (making it takes a fork 4-5 ms; parsing leaves it unchanged)."""
+    every command it forks parses with it rather than make its own (parsing leaves it unchanged)."""
     parser = argparse.ArgumentParser(prog="grammarc", description=" ".join(__doc__.split("\n\n")[0].split()))
     parser.add_argument("--version", action="version", version=f"grammarc {__version__}")
     sub = parser.add_subparsers(required=True, metavar="COMMAND")

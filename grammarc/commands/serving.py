@@ -90,8 +90,8 @@ def _detached(serve, ready) -> int:
 
 
 #: The libraries grammarc's readers and writers import where a command first needs one, imported by a server
-#: before it serves, where installed: a served command is a fork, which would otherwise import its own, 35 ms
-#: (PROJ) to 0.3 s (trimesh) on every command that needs it. Lots with a coordinate system (``io.crs``),
+#: before it serves, where installed: a served command is a fork, which would otherwise import its own on
+#: every command that needs it (README, "Start-up"). Lots with a coordinate system (``io.crs``),
 #: GeoParquet files (``io.arrow_lots``; reading a file goes through Arrow's datasets), GIS files
 #: (``io.gis``), rule packages not kept yet (``io.rpk``), baked meshes and glTF assets (``io.bake``,
 #: ``model.assets``), USD (``io.usd``). None starts a thread that a fork would lose but the allocator's,
