@@ -15,7 +15,8 @@ it would in the client's own process).
 
 A server serves only commands that would run the same code in the same way: its socket's name is a
 digest of grammarc's version and source files, the Python it runs on, and the environment variables read
-at start-up (``GRAMMARC_*``, ``NUMBA_*``, ``PYTHON*``, the locale's); a client that computes another
+at start-up (``GRAMMARC_*``, ``NUMBA_*``, ``PYTHON*``, the locale's, those of the libraries it imports:
+``_KEYED_ENV``); a client that computes another
 digest finds no server and runs the command itself. The socket lives in a folder only its user can enter
 (``$XDG_RUNTIME_DIR/grammarc`` or ``/tmp/grammarc-<uid>``), and the server checks the caller's user id.
 
@@ -45,8 +46,12 @@ from grammarc import releases
 from grammarc.errors import interruption, raise_stopped, stopped
 from grammarc.frontend.user_cache import code_stamp
 
-#: Environment variables that change what the imported code does (read at import time).
-_KEYED_ENV = ("GRAMMARC_", "NUMBA_", "PYTHON", "LANG", "LC_")
+#: Environment variables that change what the imported code does (read at import time): grammarc's, numba's,
+#: Python's, the locale's, and those of the libraries a server imports before it serves
+#: (``commands.serving.LIBRARIES``): PROJ's data and network (pyproj), USD's plugins and debugging (``PXR_``,
+#: ``TF_``), Arrow's memory pool and threads.
+_KEYED_ENV = ("GRAMMARC_", "NUMBA_", "PYTHON", "LANG", "LC_", "PROJ_", "PYPROJ_", "CURL_CA_BUNDLE", "SSL_CERT_FILE",
+              "PXR_", "TF_", "ARROW_")
 #: Client to server: a request's length, then the request (JSON); then one byte per forwarded signal.
 _LENGTH = struct.Struct("!I")
 #: Server to client: the command's exit status.

@@ -142,8 +142,10 @@ def _wait_for(condition, timeout: float = 60.0) -> None:
         time.sleep(0.05)
 
 
-def test_a_server_of_other_settings_is_not_used(served, monkeypatch):
-    monkeypatch.setenv("GRAMMARC_STRICT", "0" if os.environ.get("GRAMMARC_STRICT") == "1" else "1")
+@pytest.mark.parametrize("name", ["GRAMMARC_STRICT", "PROJ_DATA", "PXR_PLUGINPATH_NAME"])
+def test_a_server_of_other_settings_is_not_used(served, monkeypatch, name):
+    """Settings read when grammarc, or a library its server imported, is imported (``server._KEYED_ENV``)."""
+    monkeypatch.setenv(name, "0" if os.environ.get(name) == "1" else "1")
     assert server.request(["--version"]) is None
 
 

@@ -92,11 +92,13 @@ def _detached(serve, ready) -> int:
 #: The libraries grammarc's readers and writers import where a command first needs one, imported by a server
 #: before it serves, where installed: a served command is a fork, which would otherwise import its own on
 #: every command that needs it (README, "Start-up"). Lots with a coordinate system (``io.crs``),
-#: GeoParquet files (``io.arrow_lots``; reading a file goes through Arrow's datasets), GIS files
-#: (``io.gis``), rule packages not kept yet (``io.rpk``), baked meshes and glTF assets (``io.bake``,
-#: ``model.assets``), USD (``io.usd``). None starts a thread that a fork would lose but the allocator's,
-#: which forks take care of.
-LIBRARIES = ("pyproj", "pyarrow.parquet", "pyarrow.dataset", "pyogrio.raw", "py7zr", "trimesh",
+#: GeoParquet files (``io.arrow_lots``; reading a file goes through Arrow's datasets),
+#: rule packages not kept yet (``io.rpk``), baked meshes and glTF assets (``io.bake``, ``model.assets``), USD
+#: (``io.usd``). None starts a thread that a fork would lose but the allocator's, which forks take care of,
+#: and none changes the environment; the settings they read from it when imported are part of the server's
+#: key (``server.key``). GIS files' pyogrio is left out: its import sets GDAL's and PROJ's certificate
+#: bundles in the environment, which a served command, given its client's environment, would not have.
+LIBRARIES = ("pyproj", "pyarrow.parquet", "pyarrow.dataset", "py7zr", "trimesh",
              "pxr.Gf", "pxr.Sdf", "pxr.Tf", "pxr.Usd", "pxr.UsdGeom", "pxr.UsdShade", "pxr.Vt")
 
 
