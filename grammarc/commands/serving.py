@@ -122,7 +122,9 @@ def warm() -> None:
         except ImportError:  # an optional extra's module (USD, Dask, ...) whose library is missing
             continue
     for name in LIBRARIES:
-        with contextlib.suppress(ImportError):  # an extra not installed
+        # an extra not installed, or one that cannot start here (pyproj without its data): the command that
+        # needs it imports it again, and says what failed as it would in its own process
+        with contextlib.suppress(Exception):
             importlib.import_module(name)
     for dialect in DIALECTS.values():
         parser_for(dialect.grammar)

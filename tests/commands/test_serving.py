@@ -42,3 +42,18 @@ def test_a_warm_server_has_imported_the_libraries_its_commands_read_and_write_wi
                           timeout=600, check=False)
     assert done.returncode == 0, done.stderr
     assert json.loads(done.stdout) == {"changed": [], "imported": []}
+
+
+def test_a_library_that_fails_to_import_leaves_the_server_warm_without_it(tmp_path):
+    """pyproj without its data raises an error of its own when imported: the server starts, and the command
+    that needs the library meets the error itself."""
+    (tmp_path / "broken_library.py").write_text("raise RuntimeError('no data here')\n")
+    warming = ("from grammarc.commands import serving\n"
+               "serving.LIBRARIES = ('broken_library',)\n"
+               "serving.warm()\n"
+               "print('warm')\n")
+    env = {**os.environ, "GRAMMARC_SERVER": "off", "PYTHONPATH": os.pathsep.join((str(ROOT), str(tmp_path)))}
+    done = subprocess.run([sys.executable, "-c", warming], env=env, capture_output=True, text=True, timeout=600,
+                          check=False)
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.split() == ["warm"]
