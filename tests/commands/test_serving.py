@@ -37,11 +37,7 @@ def test_a_warm_server_has_imported_the_libraries_its_commands_read_and_write_wi
     pytest.importorskip("pxr")
     folder = georeferenced_lots.parent
     (folder / "g.cga").write_text("Lot --> extrude(3) X.\n")
-    env = {**os.environ, "GRAMMARC_SERVER": "off", "PYTHONPATH": str(ROOT)}
-    done = subprocess.run([sys.executable, "-c", BUILDS], cwd=folder, env=env, capture_output=True, text=True,
-                          timeout=600, check=False)
-    assert done.returncode == 0, done.stderr
-    assert json.loads(done.stdout) == {"changed": [], "imported": []}
+    assert json.loads(_fresh_python(BUILDS, folder)) == {"changed": [], "imported": []}
 
 
 def test_a_library_that_fails_to_import_leaves_the_server_warm_without_it(tmp_path):
@@ -52,8 +48,14 @@ def test_a_library_that_fails_to_import_leaves_the_server_warm_without_it(tmp_pa
                "serving.LIBRARIES = ('broken_library',)\n"
                "serving.warm()\n"
                "print('warm')\n")
-    env = {**os.environ, "GRAMMARC_SERVER": "off", "PYTHONPATH": os.pathsep.join((str(ROOT), str(tmp_path)))}
-    done = subprocess.run([sys.executable, "-c", warming], env=env, capture_output=True, text=True, timeout=600,
-                          check=False)
+    assert _fresh_python(warming, tmp_path).split() == ["warm"]
+
+
+def _fresh_python(code: str, folder: Path) -> str:
+    """What ``code`` prints, run by a Python of its own in ``folder`` (whose modules it may import), as a
+    server warms up: in a process that has imported nothing of grammarc's yet."""
+    env = {**os.environ, "GRAMMARC_SERVER": "off", "PYTHONPATH": os.pathsep.join((str(ROOT), str(folder)))}
+    done = subprocess.run([sys.executable, "-c", code], cwd=folder, env=env, capture_output=True, text=True,
+                          timeout=600, check=False)
     assert done.returncode == 0, done.stderr
-    assert done.stdout.split() == ["warm"]
+    return done.stdout
