@@ -3,7 +3,8 @@
 Issue 23's target: 10 M terminals/s for the whole ``grammarc build`` command at 2 x 10^4 and 10^5 lots on
 the 2-core machine. "first" runs with an empty numba cache (JIT compile included), "warm" with a filled
 one, in the command's own process; "served" is the ``grammarc`` command with a warm server up
-(``grammarc server start``), which pays no start-up.
+(``grammarc server start``), which pays no start-up. ``facade_ce.cga`` is the grammar in CityEngine's
+dialect, timed with its fused kernels and with the interpreter alone.
 """
 
 from __future__ import annotations
@@ -50,3 +51,22 @@ def test_facade_build(benchmark, request, lots_dir, tmp_path, n_lots, cache):
     benchmark.extra_info.update(terminals=terminals, terminals_per_s=round(terminals / seconds))
     if cache != "served":  # a served build's is the client's
         benchmark.extra_info.update(peak_rss_mib=round(result["peak_rss_kib"] / 1024, 1))
+
+
+@pytest.mark.parametrize("fusion", ["fused", "interpreted"])
+def test_cityengine_facade_build(benchmark, lots_dir, tmp_path, fusion):
+    """The facade grammar in CityEngine's dialect (``facade_ce.cga``) on 2 x 10^4 lots, warm, in the command's
+    own process, with its fused kernels and with the interpreter alone (``GRAMMARC_FUSION=off``)."""
+    lots = lots_dir / "lots_20000.geojson"
+    if not lots.exists():
+        grid_lots(lots, 20_000)
+    out = tmp_path / "out.npz"
+    args = [str(HERE / "facade_ce.cga"), "--lots", str(lots), "--emit", str(out), "--quiet"]
+    env = {"GRAMMARC_FUSION": "off"} if fusion == "interpreted" else {}
+    run_build(args, env)  # fill the numba cache outside the timed region
+    result = {}
+    benchmark.pedantic(lambda: result.update(run_build(args, env)), rounds=3, iterations=1)
+    terminals = len(read_instances(out)["asset"])
+    seconds = benchmark.stats.stats.min
+    benchmark.extra_info.update(terminals=terminals, terminals_per_s=round(terminals / seconds),
+                                peak_rss_mib=round(result["peak_rss_kib"] / 1024, 1))

@@ -131,15 +131,31 @@ def _advanced(state, k):
     return out
 
 
+@njit(cache=True, nogil=True, inline="always")
+def next_state(x):
+    """The state after one draw from state ``x`` (uint64): where the draw lands."""
+    return (np.uint64(MULTIPLIER) * x + np.uint64(INCREMENT)) % np.uint64(MODULUS)
+
+
+@njit(cache=True, nogil=True, inline="always")
+def child_state(x):
+    """The state of a shape made by the rule from a parent in state ``x`` (uint64), before its own draw."""
+    return (np.uint64(MULTIPLIER) * x + np.uint64(CHILD_INCREMENT)) % np.uint64(MODULUS)
+
+
+@njit(cache=True, nogil=True, inline="always")
+def value(x):
+    """The value of a draw that landed on state ``x``, as ``uniform`` gives it (float32 division)."""
+    return np.float32(x) / np.float32(MODULUS - 1)
+
+
 @njit(cache=True, nogil=True)
 def piece_states(state, index):
     """``pieces`` on uint64 states (m,) and int64 numbers (m,): the pieces' states (m,) uint64."""
     mul, add = _jumps(index.max() if len(index) else 0)
     out = np.empty_like(state)
     for i in range(len(state)):
-        x = (mul[index[i]] * state[i] + add[index[i]]) % np.uint64(MODULUS)
-        x = (np.uint64(MULTIPLIER) * x + np.uint64(CHILD_INCREMENT)) % np.uint64(MODULUS)
-        out[i] = (np.uint64(MULTIPLIER) * x + np.uint64(INCREMENT)) % np.uint64(MODULUS)
+        out[i] = next_state(child_state((mul[index[i]] * state[i] + add[index[i]]) % np.uint64(MODULUS)))
     return out
 
 
@@ -149,9 +165,8 @@ def draw_in_place(state):
     float64, as ``draw`` gives them."""
     out = np.empty(len(state))
     for i in range(len(state)):
-        x = (np.uint64(MULTIPLIER) * state[i] + np.uint64(INCREMENT)) % np.uint64(MODULUS)
-        state[i] = x
-        out[i] = np.float32(x) / np.float32(MODULUS - 1)
+        state[i] = next_state(state[i])
+        out[i] = value(state[i])
     return out
 
 
@@ -161,7 +176,6 @@ def child_in_place(state):
     on in place."""
     made = np.empty_like(state)
     for i in range(len(state)):
-        x = state[i]
-        made[i] = (np.uint64(MULTIPLIER) * x + np.uint64(CHILD_INCREMENT)) % np.uint64(MODULUS)
-        state[i] = (np.uint64(MULTIPLIER) * x + np.uint64(INCREMENT)) % np.uint64(MODULUS)
+        made[i] = child_state(state[i])
+        state[i] = next_state(state[i])
     return made

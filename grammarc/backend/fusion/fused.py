@@ -38,7 +38,7 @@ class FusedRecords:
         """The shapes of ``handoff``, which take ``params`` parameters."""
         a, b = self.handoff_starts[handoff.site], self.handoff_starts[handoff.site + 1]
         origin, size, frame, lot, key, depth, values = self.handed
-        return Shapes(origin[a:b], size[a:b], frame[a:b], np.full(b - a, -1, np.int32), lot[a:b], key[a:b],
+        return Shapes(origin[a:b], size[a:b], frame[a:b], np.full(b - a, handoff.geom, np.int32), lot[a:b], key[a:b],
                       depth[a:b], tuple(values[k, a:b] for k in range(params)))
 
 

@@ -6,8 +6,13 @@ into the records. It covers what needs no context: the scope operations ``S`` an
 ``Subdiv`` and ``Repeat`` (no snapping), ``I``, ``ε``, ``[ ]``, successor symbols (with arguments), leaves
 (a successor without rules, or ``X.``, without arguments: its box or rectangle is a record at once, as
 ``terminals.emit_leaves`` makes it), guards and sizes made of numbers, attributes, parameters (numbers),
-``scope.sx|sy|sz``, arithmetic, ``min``, ``max`` and ``rand``, and stochastic rules (their draws and
-``rand``'s from the shape's counter-based stream, ``backend.random``, whose keys the kernel carries). Anything
+``scope.sx|sy|sz``, arithmetic, ``min``, ``max``, ``rand`` and ``p``, and stochastic rules (their draws and
+``rand``'s from the shape's counter-based stream, ``backend.random``, whose keys the kernel carries).
+In CityEngine's dialect it covers ``s`` and ``t``, ``split`` of the scope (its repeat groups and floating
+sizes, laid by the interpreter's kernels), ``i`` of an asset named in the rule (fitted to the scope),
+``case``, stochastic ``%`` choices, ``NIL``, ``[ ]``, successors and leaves; a body that hands its shape to
+nothing ends in a leaf. Shapes there carry their state in PRT's sequential stream, which the kernel moves on
+as the interpreter does, where shapes are made and where they draw (``rand``, ``p``, ``%``). Anything
 else - another operation, another function - keeps the symbol for the interpreter (``backend.execute``),
 which remains the reference: both give the same records, bit for bit (``tests/backend/fusion``).
 
@@ -19,9 +24,8 @@ the kernel writes its shapes (scope, key, depth, parameters of numbers), which j
 batches where the interpreter's would, and its rules run at its turn, by the interpreter or by the kernel
 of its own region. The whole grammar is left to the interpreter where records carry more than an
 asset and a transform (colours, texture channels or coordinates, trims), where shapes carry per-shape
-state (``set``, ``split.index``, a pivot), where an insert occludes, in a search that sums a design's leaves
-(``backend.aggregates``), and in CityEngine's dialect (a body's end is a leaf, and shapes draw from PRT's
-sequential stream, which successors move on in place). ``grammar_refusals`` says which of these keep a
+state (``set``, ``split.index``, a pivot, box rings), where an insert occludes, and in a search that sums a
+design's leaves (``backend.aggregates``). ``grammar_refusals`` says which of these keep a
 grammar out, ``Fusible.refusal`` the first construct that keeps a symbol out and where it is: what
 ``grammarc check --fusion`` prints.
 ``GRAMMARC_FUSION=off`` turns fusion off; ``GRAMMARC_FUSION=always`` compiles a kernel for any batch, however
@@ -44,6 +48,7 @@ from grammarc.backend.slots import (
     TRIM_PLANES,
     uv_slots,
 )
+from grammarc.backend.streams import draws
 from grammarc.diagnostics import Span
 from grammarc.ir import nodes as ir
 from grammarc.ir.printer import print_expr, print_op
@@ -58,8 +63,8 @@ COMPARE = frozenset({"<", "<=", ">", ">=", "==", "!="})
 LOGIC = frozenset({"&&", "||"})
 #: The scope fields a fused expression may read: the scope's size.
 SIZES = {"sx": 0, "sy": 1, "sz": 2}
-#: The functions a fused expression may call: ``rand`` draws from the shape's counter-based stream.
-FUNCTIONS = frozenset({"min", "max", "rand"})
+#: The functions a fused expression may call: ``rand`` and ``p`` draw from the shape's stream.
+FUNCTIONS = frozenset({"min", "max", "rand", "p"})
 
 
 #: A kernel that is not compiled yet is compiled once a process has met this many shapes of its root:
@@ -89,8 +94,6 @@ def grammar_refusals(plan) -> list[str]:
              *(name for s in plan.uv_slots for name in uv_slots(s))}
     state = [name for name in plan.dynamic if name not in slots]
     found = (
-        (plan.leaf_bodies or plan.sequential_random,
-         "CityEngine's dialect (a body's end is a leaf; PRT's sequential random stream)"),
         (state, f"per-shape state ({', '.join(state)}: `set`, `split.index`, `comp.sel`...)"),
         (plan.color_slot is not None, "colours (`color`, `set(material.color...)`)"),
         (plan.material_slots, "texture channels (`texture`, `set(material.*map)`)"),
@@ -132,7 +135,7 @@ class Fusible:
         where shapes fan out (one of scope operations and inserts alone the interpreter runs as fast)."""
         for rule in applied_rules(self.plan.symbols[sym_id]):
             for op in iter_ops(rule):
-                if isinstance(op, (ir.Split, ir.Repeat)):
+                if isinstance(op, (ir.Split, ir.Repeat)) or type(op) is ir.GroupSplit:
                     return True
                 if (isinstance(op, ir.Symbol) and not self.plan.makes_leaves(op) and self.inlined(op.name)
                         and self.worth_a_kernel(self.plan.symbol_ids[op.name])):
@@ -159,6 +162,8 @@ class Fusible:
         for rule in applied_rules(sym):
             if rule.guard is not None and (why := self.expr(rule.guard)):
                 return why
+            if rule.guard is not None and self.plan.sequential_random and draws(rule.guard):
+                return Refusal("a guard that draws from PRT's stream", "", rule.span)
             alternatives = rule.alternatives
             # a search's consequents are chosen by its states (``backend.choices``)
             if alternatives[0].choice:
@@ -175,8 +180,8 @@ class Fusible:
         return _first(self.op(op) for op in body)
 
     def op(self, op: ir.Op) -> Refusal | None:
-        if isinstance(op, ir.Scale):
-            return _refused(op, "CityEngine's `s` (a negative size mirrors)") if op.mirrors else _first(self.expr(s.value) for s in op.sizes)
+        if isinstance(op, ir.Scale):  # CityEngine's `s` of a negative size mirrors: the interpreter derives it
+            return _first(self.expr(s.value) for s in op.sizes)
         if isinstance(op, ir.Translate):
             return _first(self.expr(e) for e in op.vector)
         if isinstance(op, (ir.Split, ir.Repeat)):
@@ -184,6 +189,16 @@ class Fusible:
                 return _refused(op, "a split of several axes or one that snaps")
             sizes = (s.value for s in op.sizes) if isinstance(op, ir.Split) else op.sizes
             return _first(self.expr(e) for e in sizes) or _first(self.body(part) for part in op.parts)
+        if type(op) is ir.GroupSplit:  # not its subclass ``splitArea``, whose layout needs the geometry
+            if op.uv_set >= 0:
+                return _refused(op, "a split in texture space")
+            return _first(self.expr(s.value) for s in op.sizes) or _first(self.body(part) for part in op.parts)
+        if isinstance(op, ir.UseAsset):
+            if op.name is not None or op.up_by is not None or op.mode_by is not None:
+                return _refused(op, "an `i` of a computed asset, up axis or mode")
+            if op.up != ir.UP_AXES[0] or op.mode != ir.INSERT_MODES[0]:
+                return _refused(op, "an `i` that turns the asset or keeps its size")
+            return None
         if isinstance(op, ir.Symbol):
             if self.plan.makes_leaves(op):  # its leaves are records at once, wherever it is named
                 return _refused(op, "a leaf with arguments") if op.args else None
@@ -194,6 +209,9 @@ class Fusible:
             if self.inlined(op.name) or all(t is ir.Type.NUM for t in target.param_types):
                 return None
             return _refused(op, "a successor handed off with a parameter that is not a number")
+        if isinstance(op, (ir.Case, ir.Stochastic)):  # conditions, or percentages
+            return (_first(self.expr(value) for value, _ in op.branches)
+                    or _first(self.body(body) for body in (*(body for _, body in op.branches), op.default)))
         if isinstance(op, (ir.Insert, ir.Empty, ir.Push, ir.Pop)):
             return None
         return _refused(op, "an operation no kernel takes")

@@ -157,8 +157,6 @@ def group_counts(extent, values, kind, group, n_groups, tol):
     allocates them (an upper bound: parts of length <= tol are dropped).
     """
     n = len(extent)
-    count = values.shape[1]
-    shared = values.shape[0] == 1
     slots = max(n_groups, 1)
     reps = np.zeros((n, slots), np.int64)
     gap = np.zeros((n, slots))
@@ -169,75 +167,91 @@ def group_counts(extent, values, kind, group, n_groups, tol):
     group_fixed = np.zeros(slots)
     group_float = np.zeros(slots)
     for i in range(n):
-        row = 0 if shared else i
-        fixed = 0.0
-        floating = 0.0
-        nominal[:] = 0.0
-        group_fixed[:] = 0.0
-        group_float[:] = 0.0
+        plan_row(i, extent[i], values, 0 if values.shape[0] == 1 else i, kind, group, n_groups, tol, reps, gap,
+                 scale, total, nominal, group_fixed, group_float)
+    return reps, gap, scale, total
+
+
+@njit(cache=True, nogil=True)
+def plan_row(i, extent, values, row, kind, group, n_groups, tol, reps, gap, scale, total, nominal, group_fixed,
+             group_float):
+    """``group_counts`` of one shape: its row ``i`` of ``reps``, ``gap``, ``scale`` and ``total`` laid out
+    for an ``extent`` and the sizes of row ``row`` of ``values``; ``nominal``, ``group_fixed`` and
+    ``group_float`` (max(n_groups, 1),) are room for its sums. A fused kernel calls it on its own arrays
+    of one row, made once (``fusion.codegen``)."""
+    count = values.shape[1]
+    for g in range(len(nominal)):  # a loop, not slices: a slice's view costs as much as this row's layout
+        reps[i, g] = 0
+        gap[i, g] = 0.0
+        nominal[g] = 0.0
+        group_fixed[g] = 0.0
+        group_float[g] = 0.0
+    scale[i] = 1.0
+    total[i] = 0.0
+    fixed = 0.0
+    floating = 0.0
+    for j in range(count):
+        size = values[row, j] * extent if kind[j] == 1 else values[row, j]
+        g = group[j]
+        if g < 0:
+            if kind[j] == 2:
+                floating += size
+            else:
+                fixed += size
+        else:
+            nominal[g] += size
+            if kind[j] == 2:
+                group_float[g] += size
+            else:
+                group_fixed[g] += size
+    avail = extent - fixed - floating
+    loose = floating
+    if _in_turns(nominal, group_float, n_groups, tol):
+        parts = 0
         for j in range(count):
-            size = values[row, j] * extent[i] if kind[j] == 1 else values[row, j]
-            g = group[j]
-            if g < 0:
-                if kind[j] == 2:
-                    floating += size
-                else:
-                    fixed += size
-            else:
-                nominal[g] += size
-                if kind[j] == 2:
-                    group_float[g] += size
-                else:
-                    group_fixed[g] += size
-        avail = extent[i] - fixed - floating
-        loose = floating
-        if _in_turns(nominal, group_float, n_groups, tol):
-            parts = 0
-            for j in range(count):
-                size = values[row, j] * extent[i] if kind[j] == 1 else values[row, j]
-                parts += size > tol
-            _turns(max(avail, 0.0), loose, nominal, group_fixed, group_float, n_groups, parts, tol, reps, i)
-            for g in range(n_groups):
-                fixed += reps[i, g] * group_fixed[g]
-                floating += reps[i, g] * group_float[g]
-            if floating > 0.0:
-                scale[i] = max(extent[i] - fixed, 0.0) / floating
-            for j in range(count):
-                g = group[j]
-                total[i] += 1.0 if g < 0 else float(reps[i, g])
-            continue
-        # the groups in order, each sharing what the earlier ones left with the later ones
-        left = max(avail, 0.0)
-        later = 0.0
+            size = values[row, j] * extent if kind[j] == 1 else values[row, j]
+            parts += size > tol
+        _turns(max(avail, 0.0), loose, nominal, group_fixed, group_float, n_groups, parts, tol, reps, i)
         for g in range(n_groups):
-            later += nominal[g]
-        for g in range(n_groups):
-            if nominal[g] <= tol:
-                # a repetition too small to lay repeats nothing, but counts as the parts it would make:
-                # its lot fails if they are more than --max-shapes (one of no size makes none)
-                if nominal[g] > 0.0 and left > tol:
-                    total[i] += left / nominal[g]
-                continue
-            share = left * nominal[g] / later
-            if share == np.inf:  # left * nominal overflowed (a size near float64's largest)
-                share = left * (nominal[g] / later)
-            later -= nominal[g]
-            if group_float[g] > 0.0:
-                r = _repetitions(share, nominal[g], group_fixed[g], group_float[g], loose, floating, tol)
-                left = max(left - r * nominal[g], 0.0)
-            else:
-                r = _count(np.floor(share / nominal[g] + 1e-9))
-                gap[i, g] = share - r * nominal[g]
-                left -= share
-            reps[i, g] = r
-            fixed += r * group_fixed[g] + gap[i, g]
-            floating += r * group_float[g]
+            fixed += reps[i, g] * group_fixed[g]
+            floating += reps[i, g] * group_float[g]
         if floating > 0.0:
-            scale[i] = max(extent[i] - fixed, 0.0) / floating
+            scale[i] = max(extent - fixed, 0.0) / floating
         for j in range(count):
             g = group[j]
             total[i] += 1.0 if g < 0 else float(reps[i, g])
-    return reps, gap, scale, total
+        return
+    # the groups in order, each sharing what the earlier ones left with the later ones
+    left = max(avail, 0.0)
+    later = 0.0
+    for g in range(n_groups):
+        later += nominal[g]
+    for g in range(n_groups):
+        if nominal[g] <= tol:
+            # a repetition too small to lay repeats nothing, but counts as the parts it would make:
+            # its lot fails if they are more than --max-shapes (one of no size makes none)
+            if nominal[g] > 0.0 and left > tol:
+                total[i] += left / nominal[g]
+            continue
+        share = left * nominal[g] / later
+        if share == np.inf:  # left * nominal overflowed (a size near float64's largest)
+            share = left * (nominal[g] / later)
+        later -= nominal[g]
+        if group_float[g] > 0.0:
+            r = _repetitions(share, nominal[g], group_fixed[g], group_float[g], loose, floating, tol)
+            left = max(left - r * nominal[g], 0.0)
+        else:
+            r = _count(np.floor(share / nominal[g] + 1e-9))
+            gap[i, g] = share - r * nominal[g]
+            left -= share
+        reps[i, g] = r
+        fixed += r * group_fixed[g] + gap[i, g]
+        floating += r * group_float[g]
+    if floating > 0.0:
+        scale[i] = max(extent - fixed, 0.0) / floating
+    for j in range(count):
+        g = group[j]
+        total[i] += 1.0 if g < 0 else float(reps[i, g])
 
 
 @njit(cache=True, nogil=True)
@@ -250,8 +264,6 @@ def group_split(extent, values, kind, group, reps, gap, scale, count, tol):
     child's number within its parent.
     """
     n = len(extent)
-    parts = values.shape[1]
-    shared = values.shape[0] == 1
     total = 0
     for i in range(n):
         total += int(count[i])
@@ -262,29 +274,45 @@ def group_split(extent, values, kind, group, reps, gap, scale, count, tol):
     index = np.empty(total, np.int64)
     m = 0
     for i in range(n):
-        row = 0 if shared else i
-        at = 0.0
-        child = 0
-        j = 0
-        while j < parts:
-            g = group[j]
-            if g < 0:
-                size = _part_size(values[row, j], kind[j], extent[i], scale[i])
-                m, at, child = _place(parent, part, pos, length, index, m, i, j, at, size, extent[i], tol,
-                                      child)
-                j += 1
-                continue
-            end = j
-            while end < parts and group[end] == g:
-                end += 1
-            for _ in range(reps[i, g]):
-                for k in range(j, end):
-                    size = _part_size(values[row, k], kind[k], extent[i], scale[i])
-                    m, at, child = _place(parent, part, pos, length, index, m, i, k, at, size, extent[i],
-                                          tol, child)
-            at += gap[i, g]
-            j = end
+        m = lay_row(i, extent[i], values, 0 if values.shape[0] == 1 else i, kind, group, reps, gap, scale, tol,
+                    parent, part, pos, length, index, m)
     return parent[:m], part[:m], pos[:m], length[:m], index[:m]
+
+
+@njit(cache=True, nogil=True)
+def lay_row(i, extent, values, row, kind, group, reps, gap, scale, tol, parent, part, pos, length, index, m):
+    """``group_split`` of one shape: the parts of row ``i`` of the plan (``plan_row``) on an ``extent``,
+    sizes from row ``row`` of ``values``, written from ``m`` on into ``parent``...``index`` (which have
+    room for the plan's ``total``); returns where the next shape's parts go."""
+    parts = values.shape[1]
+    at = 0.0
+    child = 0
+    j = 0
+    while j < parts:
+        # a part outside the groups once, a group's parts as often as it repeats, then the room left at its end
+        g = group[j]
+        end = j + 1
+        while g >= 0 and end < parts and group[end] == g:
+            end += 1
+        for _ in range(1 if g < 0 else reps[i, g]):
+            for k in range(j, end):
+                # written out here, not called: a call per part (even one numba inlines) costs it several times
+                value = values[row, k]
+                size = value * extent if kind[k] == 1 else (value * scale[i] if kind[k] == 2 else value)
+                stop = min(at + size, extent)  # cut at the extent; dropped if empty
+                if stop - at > tol:
+                    parent[m] = i
+                    part[m] = k
+                    pos[m] = at
+                    length[m] = stop - at
+                    index[m] = child
+                    m += 1
+                    child += 1
+                at += size
+        if g >= 0:
+            at += gap[i, g]
+        j = end
+    return m
 
 
 @njit(cache=True, nogil=True)
@@ -392,31 +420,6 @@ def _repetitions(share, nominal, fixed, floating, loose, laid, tol):
     below = abs((room - r * fixed) / (loose + r * floating) - 1.0)
     above = abs((room - (r + 1) * fixed) / (loose + (r + 1) * floating) - 1.0)
     return r + 1 if above < below + 1e-9 else r
-
-
-@njit(cache=True, nogil=True, inline="always")
-def _part_size(value, kind, extent, scale):
-    if kind == 1:
-        return value * extent
-    if kind == 2:
-        return value * scale
-    return value
-
-
-@njit(cache=True, nogil=True, inline="always")
-def _place(parent, part, pos, length, index, m, i, j, at, size, extent, tol, child):
-    """Lay one part at ``at``; cut at the extent, drop if empty. Returns (m, next position, child).
-    Inlined, as ``_part_size``, into ``group_split``'s loop over the parts: no call per part."""
-    end = min(at + size, extent)
-    if end - at > tol:
-        parent[m] = i
-        part[m] = j
-        pos[m] = at
-        length[m] = end - at
-        index[m] = child
-        m += 1
-        child += 1
-    return m, at + size, child
 
 
 @njit(cache=True, nogil=True)

@@ -1,6 +1,6 @@
 """Fused kernels and the interpreter give the same records: every build of ``tools/replay.py`` whose grammar
-has fused regions (examples, benchmark grammars, the tests' grammars; rule packages are CityEngine's dialect,
-which is not fused) is derived both ways and its digest compared (records, reports, bad lots)."""
+has fused regions (examples, benchmark grammars, the tests' grammars, rule packages) is derived both ways and
+its digest compared (records, reports, bad lots)."""
 
 from __future__ import annotations
 
@@ -14,7 +14,7 @@ import pytest
 
 from grammarc.backend.fusion.regions import SWITCH
 from grammarc.backend.plan import make_plan
-from grammarc.compiler import compile_grammar
+from grammarc.build import compile_source, grammar_source
 
 ROOT = Path(__file__).resolve().parents[3]
 
@@ -32,13 +32,17 @@ LOTS = Path(tempfile.mkdtemp(prefix="grammarc-fusion-lots-"))
 atexit.register(shutil.rmtree, LOTS, True)
 
 
+def _plan(grammar: Path, options):
+    """The plan of ``grammar`` (a rule file, or a package's main one) as a build makes it."""
+    with grammar_source(grammar, options) as (source, display, resolved):
+        return make_plan(compile_source(source, display, resolved))
+
+
 def _fused_cases():
     fused = {}
     for name, grammar, lots, options in REPLAY.cases(LOTS):
-        if grammar.suffix != ".cga":
-            continue
         if grammar not in fused:
-            fused[grammar] = bool(make_plan(compile_grammar(grammar)).fused)
+            fused[grammar] = bool(_plan(grammar, options).fused)
         if fused[grammar]:
             yield pytest.param(grammar, lots, options, id=name)
 
@@ -53,5 +57,5 @@ def fused_always(monkeypatch):
 def test_fused_and_interpreted_records_are_the_same(grammar, lots, options, tmp_path, monkeypatch):
     fused = REPLAY.digest(grammar, lots, options, tmp_path)
     monkeypatch.setenv(SWITCH, "off")
-    assert not make_plan(compile_grammar(grammar)).fused
+    assert not _plan(grammar, options).fused
     assert REPLAY.digest(grammar, lots, options, tmp_path) == fused

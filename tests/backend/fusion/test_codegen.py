@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
+from grammarc.backend.fusion import codegen
 from grammarc.backend.fusion.codegen import Block, Emit, generate
 from grammarc.backend.fusion.compiled import digest, load
 from grammarc.backend.fusion.regions import Fusible
@@ -39,3 +40,17 @@ def test_the_source_is_a_function_of_the_region():
     assert digest(text) != digest(generate(Fusible(plan), plan.symbol_ids["floor"]).text)
     module, path = load(text)
     assert path.read_text() == text and callable(module.derive)
+
+
+def test_a_change_to_the_functions_kernels_call_changes_their_text(monkeypatch):
+    """numba's cache of a kernel holds the machine code of what it calls, and does not see that change."""
+    plan = facade_plan()
+    before = generate(Fusible(plan), plan.symbol_ids["tile"]).text
+    assert codegen.called_code() in before
+    monkeypatch.setattr(codegen, "CALLED", codegen.CALLED[:-1])
+    codegen.called_code.cache_clear()
+    try:
+        assert generate(Fusible(plan), plan.symbol_ids["tile"]).text != before
+    finally:
+        monkeypatch.undo()
+        codegen.called_code.cache_clear()

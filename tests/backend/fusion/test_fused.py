@@ -102,6 +102,61 @@ shrink : Scope.sx > 1 ~> Subdiv("X", 1r, 1r){ S(1r, 2, 1r) shrink | I("quad") }
 shrink ~> I("cube")
 """
 
+#: CityEngine's dialect: splits with floating, relative and absolute sizes and repeat groups (two that take
+#: their repetitions in turns in ``Facade``; ``Bay``'s first size goes negative, taken as 0), a body's end a
+#: leaf (``Pier``'s, ``Yard.``, the asset ``Win`` inserts), ``case``, brackets and ``NIL``, which move PRT's
+#: stream on;
+#: ``Chimney`` (stochastic) and ``Glass`` (``rand``) are the interpreter's, whose draws need the states the
+#: kernel hands on, ``Glass`` its shapes' geometry (the door) too; ``Pier``, named from several places, is
+#: handed off.
+CITYENGINE = """
+version "2023.0"
+attr w = 5
+attr gap = 0.5
+
+@StartRule
+Lot --> split(x) { ~w : Strip }*
+Strip --> split(z) { 1 : Yard. | { ~6 : House | gap : NIL }* | '0.1 : s('1, 0.2, '1) }
+House --> s('1, 4, '0.8) [ t(0, 4, 0) s('0.5, 1, '0.5) Chimney ] NIL Front
+Front --> split(x) { 1 : Pier | { ~3 : Bay }* | 0.6 : Pier | { ~2 : Bay }* | 1 : Pier }
+Bay --> split(y) { scope.sy - 3.5 : Pier | ~1.5 : Win | 0.3 : i("builtin:cube") Sill. }
+Win --> case scope.sx > 1.4 : [ t(0, 0, -0.2) s('1, '1, 0.2) ] i("door.obj") Glass
+        case scope.sy > 2 : split(x) { ~1 : Pier | 0.1 : NIL }*
+        else : s('1, '1, 0.5)
+Pier --> s('1, '1, '1)
+Chimney --> 50% : s('1, rand(1, 2), '1)
+            else : t(0, 1, 0)
+Glass --> s('1, rand(0.5, 1), '1)
+"""
+
+
+#: Draws from PRT's stream inside the kernels, in the interpreter's order: in split sizes and scale
+#: arguments (``rand``, several on one line), in ``case`` conditions (``p``: a later condition draws only
+#: where the earlier ones did not hold), stochastic choices, and a successor's argument; ``Mark`` is
+#: handed off and draws in the interpreter, after the kernel's draws moved its parent's state on.
+CITYENGINE_DRAWS = """
+version "2023.0"
+attr depth = 0.4
+
+@StartRule
+Lot --> split(x) { ~rand(3, 5) : Strip | rand() * 0.5 : NIL }*
+Strip --> split(z) { { ~rand(4, 6) + rand(0, 1) : Unit }* | 1 : Mark }
+Unit --> case p(0.3) : s('1, rand(2, 5), '1) Mark
+         case p(0.5) : split(x) { ~1 : Cell(rand(1, 2)) }*
+         else : 40% : [ t(0, rand(), 0) Mark ] s('1, rand(1, 2) * depth + 1, '1)
+                25% : NIL
+                else : split(y) { ~rand(1, 2) : Mark }*
+Cell(h) --> s('1, h, '1) split(y) { ~1 : Mark | rand(0, 0.5) : 20% : Mark else : s('1, '1, 0) }
+Mark --> s('1, '1, rand(0.1, 0.3)) i("builtin:cube")
+"""
+
+
+def cityengine_lots():
+    widths = np.linspace(4, 31, 10)
+    return lots_from_polygons([[np.array([[0, 0], [w, 0], [w, 7 + w / 3], [0, 7 + w / 3]])] for w in widths],
+                              ids=[f"w{w:g}" for w in widths])
+
+
 @pytest.fixture(autouse=True)
 def fused_always(monkeypatch):
     """Kernels for every batch, however small (``regions.COMPILE_AT``)."""
@@ -233,3 +288,41 @@ def test_preload_loads_the_kernels_an_earlier_build_compiled_and_compiles_none(w
     derive(compile_grammar(path), make_lots("square"), BuildOptions())  # compiles the kernel
     monkeypatch.setattr(compiled, "_KERNELS", {})  # as in the next build's process
     assert len(list(preload(plan))) == 1 and region.source.text in compiled._KERNELS
+
+
+def test_cityengine_dialect_splits_leaves_and_prt_stream_are_the_interpreters(write, monkeypatch):
+    plan = make_plan(compile_grammar(write("g.cga", CITYENGINE)))
+    assert {plan.symbols[k].name for k in plan.fused} == {"Lot", "Strip", "House", "Front", "Bay", "Win"}
+    fused, interpreted = both(write, monkeypatch, CITYENGINE, cityengine_lots())
+    assert fused["kernels"] >= 2 and len(fused["asset"]) > 300
+    names = [plan.grammar.module.assets[a] for a in np.unique(fused["asset"])]
+    assert "door.obj" in names and "builtin:cube" in names and "builtin:quad" in names
+    assert_same(fused, interpreted)
+
+
+@pytest.mark.parametrize(("group", "failing"), [
+    ("{ ~3 : Bay | min(scope.sx - 5, 0) / min(scope.sx - 5, 0) : Pier }*", 5),
+    ("{ tiny : Pier }* | { ~3 : Bay }*", 10),
+])
+def test_a_cityengine_split_the_interpreter_fails_is_left_to_it(write, monkeypatch, group, failing):
+    """A NaN size (0 / 0 on strips 5 m wide or more), or parts beyond --max-shapes (repetitions of 1e-200 m):
+    the kernel declines its batch, and the interpreter fails those lots."""
+    text = CITYENGINE.replace("attr gap", "attr tiny = 1e-200\nattr gap").replace("{ ~3 : Bay }*", group)
+    fused, interpreted = both(write, monkeypatch, text, cityengine_lots())
+    assert len(fused["bad"]) == failing
+    assert_same(fused, interpreted)
+
+
+def test_cityengine_shapes_of_their_own_geometry_are_left_to_the_interpreter(write, monkeypatch):
+    fused, interpreted = both(write, monkeypatch, CITYENGINE, make_lots("concave_L", "square"))
+    assert fused["kernels"] == 1  # the square's lot; the L's shapes are polygons
+    assert_same(fused, interpreted)
+
+
+@pytest.mark.parametrize("seed", [0, 3])
+def test_cityengine_draws_are_the_interpreters(write, monkeypatch, seed):
+    plan = make_plan(compile_grammar(write("g.cga", CITYENGINE_DRAWS)))
+    assert {plan.symbols[k].name for k in plan.fused} == {"Lot", "Strip", "Unit", "Cell"}
+    fused, interpreted = both(write, monkeypatch, CITYENGINE_DRAWS, cityengine_lots(), seed=seed)
+    assert fused["kernels"] and len(fused["asset"]) > 300
+    assert_same(fused, interpreted)
