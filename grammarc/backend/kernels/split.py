@@ -145,7 +145,7 @@ def group_counts(extent, values, kind, group, n_groups, tol):
     25 m, 1 and 1 on 20 m, 1 then 0 on 15 m). Otherwise the groups take it in order, each a share of what
     the earlier ones left in proportion to its repetition's size among the groups still to come. A
     group with floating parts repeats as often as brings the floating parts nearest their written sizes
-    (``_repetitions``) and uses that many repetitions' room (``{ ~w: A | d: B }* | ~w: A`` on an extent
+    (``repetitions``) and uses that many repetitions' room (``{ ~w: A | d: B }* | ~w: A`` on an extent
     of w is one A). A group of fixed sizes repeats floor(share / repetition) times, the rest of its share
     left empty at its end. Then every floating size, in groups or not, is scaled by one factor so that
     the parts fill the extent.
@@ -238,7 +238,7 @@ def plan_row(i, extent, values, row, kind, group, n_groups, tol, reps, gap, scal
             share = left * (nominal[g] / later)
         later -= nominal[g]
         if group_float[g] > 0.0:
-            r = _repetitions(share, nominal[g], group_fixed[g], group_float[g], loose, floating, tol)
+            r = repetitions(share, nominal[g], group_fixed[g], group_float[g], loose, floating, tol)
             left = max(left - r * nominal[g], 0.0)
         else:
             r = _count(np.floor(share / nominal[g] + 1e-9))
@@ -395,7 +395,7 @@ def _unevenness(room, loose, nominal, fixed, floating, n_groups, parts, reps, i)
 
 
 @njit(cache=True, nogil=True)
-def _repetitions(share, nominal, fixed, floating, loose, laid, tol):
+def repetitions(share, nominal, fixed, floating, loose, laid, tol):
     """How often a group with floating parts repeats in ``share``: the count that brings the floating
     parts nearest their written sizes, as the reference has a floating repeat come "closest" to them.
     With r repetitions every floating part, in the group (``floating`` of its ``nominal`` size, ``fixed``

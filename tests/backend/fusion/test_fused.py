@@ -300,14 +300,15 @@ def test_cityengine_dialect_splits_leaves_and_prt_stream_are_the_interpreters(wr
     assert_same(fused, interpreted)
 
 
-@pytest.mark.parametrize(("group", "failing"), [
-    ("{ ~3 : Bay | min(scope.sx - 5, 0) / min(scope.sx - 5, 0) : Pier }*", 5),
-    ("{ tiny : Pier }* | { ~3 : Bay }*", 10),
+@pytest.mark.parametrize(("split", "made", "failing"), [
+    ("{ ~3 : Bay }*", "{ ~3 : Bay | min(scope.sx - 5, 0) / min(scope.sx - 5, 0) : Pier }*", 5),
+    ("{ ~3 : Bay }*", "{ tiny : Pier }* | { ~3 : Bay }*", 10),
+    ("{ ~w : Strip }*", "{ ~w * tiny : Strip }*", 10),
 ])
-def test_a_cityengine_split_the_interpreter_fails_is_left_to_it(write, monkeypatch, group, failing):
-    """A NaN size (0 / 0 on strips 5 m wide or more), or parts beyond --max-shapes (repetitions of 1e-200 m):
-    the kernel declines its batch, and the interpreter fails those lots."""
-    text = CITYENGINE.replace("attr gap", "attr tiny = 1e-200\nattr gap").replace("{ ~3 : Bay }*", group)
+def test_a_cityengine_split_the_interpreter_fails_is_left_to_it(write, monkeypatch, split, made, failing):
+    """A NaN size (0 / 0 on strips 5 m wide or more), or parts beyond --max-shapes (repetitions of 1e-200 m,
+    fixed or floating): the kernel declines its batch, and the interpreter fails those lots."""
+    text = CITYENGINE.replace("attr gap", "attr tiny = 1e-200\nattr gap").replace(split, made)
     fused, interpreted = both(write, monkeypatch, text, cityengine_lots())
     assert len(fused["bad"]) == failing
     assert_same(fused, interpreted)
