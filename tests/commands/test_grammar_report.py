@@ -28,7 +28,7 @@ def test_check_says_why_symbols_are_not_fused(write, capsys):
                              "Roof --> color(1, 0, 0) R.\n")
     assert main(["check", "--fusion", str(grammar)]) == 0
     out = capsys.readouterr().out
-    assert "fusion:    the whole grammar is interpreted: CityEngine's dialect" in out
+    assert "fusion:    the whole grammar is interpreted: colours" in out
     assert "    Lot: an operation no kernel takes: `extrude(3)` at " in out
     assert "    Roof: an operation no kernel takes: `color(1, 0, 0)` at " in out
     assert "most frequent: an operation no kernel takes `extrude` (1), an operation no kernel takes `color` (1)" in out

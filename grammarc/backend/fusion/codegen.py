@@ -40,8 +40,8 @@ from typing import NamedTuple
 
 import numpy as np
 
-from grammarc.backend.fusion.regions import SIZES, Fusible, applied_rules
-from grammarc.backend.kernels.split import MAX_COUNT
+from grammarc.backend.fusion.regions import ENDING, SIZES, Fusible, applied_rules
+from grammarc.backend.kernels.split import MAX_COUNT, group_arrays
 from grammarc.backend.shapes import asset_geom
 from grammarc.constants import TOL
 from grammarc.ir import nodes as ir
@@ -185,8 +185,6 @@ class _Writer:
         self.prologue: list[str] = []  # the kernel's arrays made once, before its loop over the parents
         self.attrs: list[str] = []
         self.sequential = self.plan.sequential_random
-        from grammarc.backend.operations import OPERATIONS  # which imports the plan, which imports this
-        self.consuming = tuple(node for node, entry in OPERATIONS.items() if entry.consumes)
         self.names = count()
         self.sites = 0
         self.handoffs = 0
@@ -261,19 +259,26 @@ class _Writer:
             self.put(level, f"{name} = {self.expr(alternative.prob, scope)}")
         self.check(level, f"not (abs(({' + '.join(probs)}) - 1.0) > {TOL.probability!r} or "
                           f"{' or '.join(f'{name} < 0.0' for name in probs)})")
-        drawn, running, pick = self.fresh("u"), self.fresh("cu"), self.fresh("pk")
+        drawn = self.fresh("u")
         self.put(level, f"{drawn} = {self.draw(scope, rule.site)}")
-        self.put(level, f"{running} = 0.0")
-        self.put(level, f"{pick} = 0")
-        for name in probs:
-            self.put(level, f"{running} += {name}")
-            self.put(level, f"if {drawn} >= {running}:")
-            self.put(level + 1, f"{pick} += 1")
+        pick = self.picked(level, drawn, probs)
         for k, alternative in enumerate(alternatives):
             last = k == len(alternatives) - 1
             self.put(level, "else:" if last else f"{'el' if k else ''}if {pick} == {k}:")
             self.put(level + 1, "pass")
             self.body(alternative.body, block, scope, level + 1, depth)
+
+    def picked(self, level: int, drawn: str, shares: list[str], per: str = "") -> str:
+        """The variable of the branch the draw ``drawn`` picks: how many of the running sums of ``shares``
+        (each divided as ``per`` says) it reaches, as ``execute.apply_rule`` and ``control.branch`` count."""
+        running, pick = self.fresh("cu"), self.fresh("pk")
+        self.put(level, f"{running} = 0.0")
+        self.put(level, f"{pick} = 0")
+        for name in shares:
+            self.put(level, f"{running} += {name}")
+            self.put(level, f"if {drawn} >= {running}{per}:")
+            self.put(level + 1, f"{pick} += 1")
+        return pick
 
     def draw(self, scope: Scope, site: int) -> str:
         """``streams.draw``: the shape's draw at ``site`` (``random.uniform``); in PRT's stream, the next
@@ -321,7 +326,7 @@ class _Writer:
                 self.stochastic(op, block, scope, level, depth)
             elif isinstance(op, ir.Empty) and self.sequential:  # ``NIL`` moves the stream on (``streams.skip``)
                 scope = scope._replace(key=self.moved(scope, level))
-        if self.plan.leaf_bodies and not any(isinstance(op, self.consuming) for op in body):
+        if self.plan.leaf_bodies and not any(isinstance(op, ENDING) for op in body):
             self.leaf(block, block.symbol, scope, level)
 
     def successor(self, op: ir.Symbol, block: Block, scope: Scope, level: int, depth: int) -> Scope:
@@ -367,13 +372,7 @@ class _Writer:
         percent = [self.fresh("pc") for _ in op.branches]
         for name, (value, _) in zip(percent, op.branches):
             self.put(level, f"{name} = {self.expr(value, scope)}")
-        drawn, running, taken = self.draw(scope, op.site), self.fresh("cu"), self.fresh("tk")
-        self.put(level, f"{running} = 0.0")
-        self.put(level, f"{taken} = 0")
-        for name in percent:
-            self.put(level, f"{running} += {name}")
-            self.put(level, f"if {drawn} >= {running} / 100.0:")
-            self.put(level + 1, f"{taken} += 1")
+        taken = self.picked(level, self.draw(scope, op.site), percent, " / 100.0")
         for k, body in enumerate([*(body for _, body in op.branches), op.default]):
             self.put(level, f"{'el' if k else ''}if {taken} == {k}:")
             self.put(level + 1, "pass")
@@ -485,8 +484,6 @@ class _Writer:
         (``kernels.split.plan_row`` and ``lay_row``, on arrays of one row made once per batch, the
         children's grown as a parent needs), negative sizes taken as 0 and a NaN one refused, parts of
         ``TOL.merge`` or less not made; then the children in order, each in its part's body."""
-        from grammarc.backend.operations.splits import group_arrays  # the operations import the plan
-
         kind, groups, n_groups = group_arrays(op)
         if not n_groups:
             self.ungrouped_split(op, kind.tolist(), block, scope, level, depth)

@@ -67,6 +67,11 @@ SIZES = {"sx": 0, "sy": 1, "sz": 2}
 FUNCTIONS = frozenset({"min", "max", "rand", "p"})
 
 
+#: The fused operations after which a body's shape is not the body's to emit as a leaf (CityEngine's
+#: dialect): it was replaced by successors, split into parts, handed to branches, placed or deleted (the
+#: operations' ``consumes``, ``operations.table``, which imports the plan and so cannot be read here).
+ENDING = (ir.Split, ir.Repeat, ir.GroupSplit, ir.Insert, ir.Symbol, ir.Case, ir.Stochastic, ir.Empty)
+
 #: A kernel that is not compiled yet is compiled once a process has met this many shapes of its root:
 #: compiling one costs seconds, which a build of a few lots would not win back (a compiled one serves
 #: every batch).

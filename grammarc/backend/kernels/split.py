@@ -10,6 +10,8 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
+from grammarc.ir import nodes as ir
+
 
 @njit(cache=True, nogil=True)
 def subdiv(extent, values, relative, tol):
@@ -457,3 +459,18 @@ def snap_subdiv(parent, pos, length, offsets, snaps):
                 pos[k + 1] = target[k]
                 length[k + 1] = right - target[k]
         c = end
+
+
+#: ``group_counts``' codes of a CityEngine split's size kinds.
+SIZE_KINDS = {ir.SizeKind.ABSOLUTE: 0, ir.SizeKind.RELATIVE: 1, ir.SizeKind.FLOATING: 2}
+
+
+def group_arrays(op: ir.GroupSplit) -> tuple[np.ndarray, np.ndarray, int]:
+    """What ``group_counts`` (and ``plan_row``) take of ``op``: the kind of each part's size (P,) int64
+    (``SIZE_KINDS``), its repeat group (P,) int64 (-1 outside any; all one group where the whole split
+    repeats) and the number of groups."""
+    groups = np.array(op.groups, dtype=np.int64)
+    if op.repeat:
+        groups = np.zeros_like(groups)
+    return (np.array([SIZE_KINDS[s.kind] for s in op.sizes], dtype=np.int64), groups,
+            int(groups.max()) + 1 if len(groups) else 0)

@@ -94,7 +94,8 @@ def group_split(ctx: Context, cursor: Shapes, op: ir.GroupSplit) -> Parts:
     axis, frame = op.axis, None
     if op.uv_set >= 0:  # texture space: a split along x turned the way u (v) grows, sizes in metres
         cursor, metres, frame = texture_axis(ctx, cursor, op)
-        values = np.where(group_arrays(op)[0] == _SIZE_KIND[ir.SizeKind.RELATIVE], values, values * metres[:, None])
+        relative = split_kernels.group_arrays(op)[0] == split_kernels.SIZE_KINDS[ir.SizeKind.RELATIVE]
+        values = np.where(relative, values, values * metres[:, None])
         axis = 0
     extent = np.ascontiguousarray(cursor.size[:, axis])
     # parts of PRT's length limit or shorter are not made (complexpatterns' red window frames of 0.4 mm)
@@ -124,7 +125,7 @@ def _group_layout(ctx: Context, cursor: Shapes, op: ir.GroupSplit, values: np.nd
     ``cursor``'s shapes: parent, part, position, length and index of each (``kernels.split.group_split``),
     counted first: a lot they would take over --max-shapes fails before they are made. Parts of length
     ``shortest`` or less are not made."""
-    kind, groups, n_groups = group_arrays(op)
+    kind, groups, n_groups = split_kernels.group_arrays(op)
     plan = split_kernels.group_counts(extent, values, kind, groups, n_groups, TOL.zero)
     ctx.check_fan_out(cursor, plan[-1], op.span)
     return split_kernels.group_split(extent, values, kind, groups, *plan, shortest)
@@ -261,18 +262,3 @@ def _size_matrix(values: list, n: int) -> np.ndarray:
     if all(np.ndim(v) == 0 for v in values):
         return np.array([values], dtype=np.float64)
     return np.stack([np.broadcast_to(np.asarray(v, np.float64), (n,)) for v in values], axis=1)
-
-
-#: GroupSplit size kinds for the kernel.
-_SIZE_KIND = {ir.SizeKind.ABSOLUTE: 0, ir.SizeKind.RELATIVE: 1, ir.SizeKind.FLOATING: 2}
-
-
-def group_arrays(op: ir.GroupSplit) -> tuple[np.ndarray, np.ndarray, int]:
-    """What ``kernels.split.group_counts`` takes of ``op``: the kind of each part's size (P,) int64
-    (``_SIZE_KIND``), its repeat group (P,) int64 (-1 outside any; all one group where the whole split
-    repeats) and the number of groups."""
-    groups = np.array(op.groups, dtype=np.int64)
-    if op.repeat:
-        groups = np.zeros_like(groups)
-    return (np.array([_SIZE_KIND[s.kind] for s in op.sizes], dtype=np.int64), groups,
-            int(groups.max()) + 1 if len(groups) else 0)

@@ -4,9 +4,11 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from grammarc.backend.fusion.regions import SWITCH, grammar_refusals, symbol_refusals
+from grammarc.backend.fusion.regions import ENDING, SWITCH, grammar_refusals, symbol_refusals
+from grammarc.backend.operations import OPERATIONS
 from grammarc.backend.plan import make_plan
 from grammarc.compiler import compile_grammar
+from grammarc.ir import nodes as ir
 
 ROOT = Path(__file__).resolve().parents[3]
 
@@ -161,3 +163,9 @@ B --> case scope.sx > 1: color(1, 0, 0)
     assert grammar_refusals(facade) == []
     assert set(symbol_refusals(facade)) == {"mass"}  # its component split
     assert str(symbol_refusals(facade)["mass"]).startswith("an operation no kernel takes: `Comp(")
+
+
+def test_the_fused_operations_that_end_a_body_are_those_the_interpreter_ends_it_with():
+    """``ENDING``: no leaf at a CityEngine body's end after them, as ``execute.run`` decides with the table."""
+    fused = (*ENDING, ir.Scale, ir.Translate, ir.UseAsset)  # and `[ ]`, which the runner keeps
+    assert [t for t in fused if OPERATIONS[t].consumes] == list(ENDING)
