@@ -38,8 +38,6 @@ from itertools import count
 from pathlib import Path
 from typing import NamedTuple
 
-import numpy as np
-
 from grammarc.backend.fusion.regions import ENDING, SIZES, Fusible, applied_rules
 from grammarc.backend.kernels.split import MAX_COUNT, group_arrays
 from grammarc.backend.shapes import asset_geom
@@ -491,7 +489,7 @@ class _Writer:
         if op.repeat and all(k == 2 for k in kind.tolist()):
             self.floating_repeat(op, block, scope, level, depth)
             return
-        slots, parts = max(n_groups, 1), len(op.sizes)
+        slots, parts = n_groups, len(op.sizes)  # the splits without groups are written out above
         tables = self.fresh("kind"), self.fresh("group")
         for name, table in zip(tables, (kind, groups)):
             self.constants.append(f"{name} = np.array({table.tolist()!r}, dtype=np.int64)")
@@ -502,12 +500,10 @@ class _Writer:
                           f"{gap} = np.zeros((1, {slots}))", f"{scale} = np.ones(1)", f"{total} = np.zeros(1)",
                           *(f"{sums}{k} = np.zeros({slots})" for k in range(3)), f"{room} = 0",
                           *(f"{name} = np.empty(0{dtype})" for name, dtype in zip(made, self._CHILD_TYPES))]
-        for j, s in enumerate(op.sizes):
-            value = self.fresh("v")
-            self.put(level, f"{value} = {self.expr(s.value, scope)}")
-            self.put(level, f"{values}[0, {j}] = 0.0 if {value} < 0.0 else {value}")
-        self.check(level, " and ".join(f"{values}[0, {j}] >= 0.0" for j in range(parts)))
+        sizes = self.sizes(op, scope, level)
         self.put(level, "else:")
+        for j, size in enumerate(sizes):
+            self.put(level + 1, f"{values}[0, {j}] = {size}")
         extent = scope.size[op.axis]
         self.put(level + 1, f"plan_row(0, {extent}, {values}, 0, {tables[0]}, {tables[1]}, {n_groups}, {TOL.zero!r}, "
                             f"{reps}, {gap}, {scale}, {total}, {sums}0, {sums}1, {sums}2)")
@@ -557,7 +553,7 @@ class _Writer:
         """``group_split`` of a split repeated as a whole whose sizes all float (``{ ~a: A | ~b: B }*``),
         ``plan_row`` and ``lay_row`` written out for its one group (their arithmetic in their order, the
         sums of no fixed part as the 0.0 they are there): as many repetitions as bring the floating sizes
-        nearest their written ones (``_repetitions``), the sizes scaled to fill the extent."""
+        nearest their written ones (``repetitions``), the sizes scaled to fill the extent."""
         extent, values = scope.size[op.axis], self.sizes(op, scope, level)
         self.put(level, "else:")
         level += 1
@@ -697,7 +693,7 @@ class _Writer:
         site = self.handoffs
         self.handoffs += 1
         self.params = max(self.params, len(scope.params))
-        block.events.append(Handoff(site, symbol, int(asset_geom(np.array([scope.asset]))[0]) if scope.asset >= 0 else -1))
+        block.events.append(Handoff(site, symbol, int(asset_geom(scope.asset)) if scope.asset >= 0 else -1))
         self.put(level, "if writing:")
         row = self.fresh("h")
         self.put(level + 1, f"{row} = handoffs[{site}]")
