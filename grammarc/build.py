@@ -263,6 +263,10 @@ def derive(grammar: Grammar, lots: Lots, options: BuildOptions = BuildOptions())
     if any(c.uv is not None for c in chunks):  # texture coordinates of set 0 (``TerminalChunk.uv``)
         columns["uv"] = np.concatenate([c.uv if c.uv is not None else np.full((len(c.asset), 2, 4), np.nan, np.float32)
                                         for c in chunks])
+    if chunks and chunks[0].color is not None:  # where the grammar sets colours, every chunk has them
+        columns["color"] = np.concatenate([c.color for c in chunks])
+    if chunks and chunks[0].material is not None:  # each instance's texture paths, not its chunk's row of them
+        columns["material"] = np.concatenate([c.materials[c.material] for c in chunks])
     columns.update(
         assets=np.array(grammar.assets), symbols=np.array(plan.symbol_names), mesh=mesh,
         lot_origin=LotOrigins.concat([c.origins for c in chunks]).table(),

@@ -63,6 +63,15 @@ def emit_instances(ctx: Context, shapes: Shapes, asset: int, symbol: int, mirror
             xform[:, :, axis] *= -1
     if mirrored & Z_UP:  # the asset turns in its own box, before the mirror in the scope's
         xform = z_up(xform)
+    place_instances(ctx, shapes, rows, xform, asset, symbol, textured, inserted)
+
+
+def place_instances(ctx: Context, shapes: Shapes, rows: np.ndarray, xform: np.ndarray, asset: int, symbol: int,
+                    textured: bool = False, inserted: np.ndarray | None = None) -> None:
+    """The instances of ``asset`` placed by ``xform`` (m, 3, 4) on ``shapes`` rows ``rows`` (m,), as
+    ``emit_instances`` places them: cut at their trim planes where they cross them, ``textured`` and
+    ``inserted`` as there (a fused kernel's records, their transforms written by the kernel, come here
+    with the rows of the shapes they come from)."""
     if ctx.plan.trim_slot is not None:
         planes = trim_planes(ctx.plan, ctx.chunk, shapes, rows)
         placed = xform.astype(np.float64)  # relative to the lot's origin, as the trim planes are
@@ -75,7 +84,7 @@ def emit_instances(ctx: Context, shapes: Shapes, asset: int, symbol: int, mirror
             trimmed, owner = _trimmed(ctx.plan, crossing, placed[cut], planes[cut], mesh, symbol)
             append_mesh(ctx, _with_uv(ctx, crossing, owner, trimmed) if textured else trimmed, crossing, owner)
             rows, xform = rows[~cut], xform[~cut]
-    _append(ctx, shapes, rows, xform, asset, symbol, textured)
+    append_instances(ctx, shapes, rows, xform, asset, symbol, textured)
 
 
 def z_up(xform: np.ndarray) -> np.ndarray:
@@ -143,8 +152,8 @@ def append_mesh(ctx: Context, mesh: MeshChunk, shapes: Shapes, rows=slice(None))
         out.mesh_material.append(material_ids(ctx.plan, shapes, rows))
 
 
-def _append(ctx: Context, shapes: Shapes, rows: np.ndarray, xform: np.ndarray, asset: int, symbol: int,
-            textured: bool = True) -> None:
+def append_instances(ctx: Context, shapes: Shapes, rows: np.ndarray, xform: np.ndarray, asset: int, symbol: int,
+                     textured: bool = True) -> None:
     """Add the instance records placed by ``xform`` (m, 3, 4) of ``shapes`` rows ``rows`` (m,)."""
     color_slot = ctx.plan.color_slot
     append_records(ctx, xform, shapes.lot[rows], asset, symbol,
@@ -249,7 +258,7 @@ def emit_leaves(ctx: Context, shapes: Shapes, symbol: int) -> None:
     if len(quads):
         xform = xforms(chunk.frames.data, shapes.frame, shapes.size, shapes.origin, shapes.lot, chunk.lot_origin,
                        quads, kind[quads])
-        _append(ctx, shapes, quads, xform, QUAD, symbol)
+        append_instances(ctx, shapes, quads, xform, QUAD, symbol)
     polygons = shapes.take(is_polygon(shapes.geom))
     if len(polygons):
         faces, owner = polygon_meshes(ctx, polygons, symbol)

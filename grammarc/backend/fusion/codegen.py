@@ -48,23 +48,29 @@ from grammarc.ir.asset_names import LEAF_CUBE, LEAF_QUAD
 
 @dataclass(frozen=True)
 class Emit:
-    """Records of ``asset`` made at emission ``site`` by ``symbol``: the instances of an ``I`` (the symbol
-    whose rule it is in), or a leaf's cubes or quads (the leaf's symbol)."""
+    """Records of ``asset`` made at emission ``site`` by ``symbol``: the instances of an ``I`` or of the
+    asset an ``i`` made a leaf's geometry (the symbol whose rule it is in), or a leaf's cubes or quads (the
+    leaf's symbol: ``leaf``, as ``terminals.emit_leaves`` emits them, textured; a cube cut at its trim
+    planes where its geometry was ``inserted`` by an ``i`` in the region, else where its root's was)."""
 
     site: int
     asset: int
     symbol: int
+    leaf: bool = False
+    inserted: bool = False
 
 
 @dataclass(frozen=True)
 class Handoff:
     """Shapes of ``symbol`` made at hand-off ``site``: successors the region does not derive, which wait for
     their symbol's turn as the interpreter's would (``regions.Fusible.inlined``). Their geometry is
-    ``geom`` (``Shapes.geom``: -1 their scope, or the asset an ``i`` made it)."""
+    ``geom`` (``Shapes.geom``: -1 their scope, or the asset an ``i`` made it), ``inserted`` where an ``i``
+    in the region made it (``slots.TRIM_INSERTED``), else as their root's."""
 
     site: int
     symbol: int
     geom: int = -1
+    inserted: bool = False
 
 
 @dataclass
@@ -88,20 +94,24 @@ class Scope(NamedTuple):
     mixes its parent's with the split's site and its index, a successor's with its site and 0), computed
     only where a shape draws or is handed off; in CityEngine's dialect the variable of its state in PRT's
     stream (``backend.prt_random``), which the operations that make shapes move on. And its geometry,
-    known where the code is written: -1 its scope, or the id of the asset an ``i`` made it."""
+    known where the code is written: -1 its scope, or the id of the asset an ``i`` made it; and whether an
+    ``i`` inserted it (``builtin:cube`` leaves the scope's box as its geometry, but inserted)."""
 
     origin: tuple[str, str, str]
     size: tuple[str, str, str]
     params: tuple[str, ...]
     key: str
     asset: int = -1
+    inserted: bool = False
 
 
 @dataclass(frozen=True)
 class Source:
     """A region's generated module: its text, the root's ``Block``, the attributes its functions take (in
-    order), its numbers of sites and of hand-off sites, the most parameters a shape handed off has, and how
-    many symbols deep it reaches below its root."""
+    order), its numbers of sites and of hand-off sites, the most parameters a shape handed off has, how
+    many symbols deep it reaches below its root, and whether it writes the root row each record and shape
+    handed off comes from (``carries``: where the grammar's shapes carry per-shape columns, ``Plan.dynamic``,
+    which pass unchanged from a root to everything the region makes of it: ``regions``)."""
 
     text: str
     block: Block
@@ -110,6 +120,7 @@ class Source:
     handoffs: int
     params: int
     depth: int
+    carries: bool
 
 
 #: The modules whose compiled functions a kernel calls (``HEADER``'s imports).
@@ -167,7 +178,8 @@ def generate(fusible: Fusible, root: int) -> Source:
     writer = _Writer(fusible)
     writer.function(root)
     text = HEADER.format(called=called_code()) + "".join(f"{line}\n" for line in [*writer.constants, *writer.lines])
-    return Source(text, writer.block, tuple(writer.attrs), writer.sites, writer.handoffs, writer.params, writer.depth)
+    return Source(text, writer.block, tuple(writer.attrs), writer.sites, writer.handoffs, writer.params, writer.depth,
+                  writer.carries)
 
 
 class _Writer:
@@ -183,6 +195,7 @@ class _Writer:
         self.prologue: list[str] = []  # the kernel's arrays made once, before its loop over the parents
         self.attrs: list[str] = []
         self.sequential = self.plan.sequential_random
+        self.carries = bool(self.plan.dynamic)
         self.names = count()
         self.sites = 0
         self.handoffs = 0
@@ -211,7 +224,7 @@ class _Writer:
         columns = "".join(f"q{k}, " for k in range(len(root_params))) + "".join(
             f"a{k}, " for k in range(len(self.attrs)))
         self.lines[1] = (f"def derive(origin, size, frame, lot, key, depth, frames, {columns}base, limit, writing, "
-                         "sites, made, bad, xform, record_lot, handoffs, handed):")
+                         "sites, made, bad, xform, record_lot, record_row, handoffs, handed):")
         self.lines[2:2] = ["    " + line for line in self.prologue]
 
     def put(self, level: int, line: str) -> None:
@@ -315,7 +328,7 @@ class _Writer:
             elif isinstance(op, ir.Insert):
                 self.emit(block, self.plan.grammar.asset_ids[op.asset], block.symbol, scope, level)
             elif isinstance(op, ir.UseAsset):  # ``inserts.placed``: ``builtin:cube`` is the scope's box
-                scope = scope._replace(asset=self.plan.grammar.asset_ids[op.asset] or -1)
+                scope = scope._replace(asset=self.plan.grammar.asset_ids[op.asset] or -1, inserted=True)
             elif isinstance(op, ir.Symbol):
                 scope = self.successor(op, block, scope, level, depth)
             elif isinstance(op, ir.Case):
@@ -646,11 +659,11 @@ class _Writer:
         """An emission site of ``asset`` and its record of the scope."""
         self.record(self.site(block, asset, symbol), scope, level)
 
-    def site(self, block: Block, asset: int, symbol: int) -> int:
+    def site(self, block: Block, asset: int, symbol: int, leaf: bool = False, inserted: bool = False) -> int:
         """A new emission site, due in ``block``'s order where it is met."""
         site = self.sites
         self.sites += 1
-        block.events.append(Emit(site, asset, symbol))
+        block.events.append(Emit(site, asset, symbol, leaf, inserted))
         return site
 
     def record(self, site: int, scope: Scope, level: int) -> None:
@@ -658,7 +671,14 @@ class _Writer:
         self.put(level, "if writing:")
         self.put(level + 1, f"put_record(xform, record_lot, sites[{site}], frames, f, l, base, 0, 1, 2, "
                             f"{', '.join(scope.size)}, {', '.join(scope.origin)})")
+        self.rooted(level + 1, f"record_row[sites[{site}]]")
         self.put(level, f"sites[{site}] += 1")
+
+    def rooted(self, level: int, target: str) -> None:
+        """Where the region ``carries`` per-shape columns: the row of the root that a record or a shape
+        handed off comes from, into ``target``."""
+        if self.carries:
+            self.put(level, f"{target} = i")
 
     def leaf(self, block: Block, symbol: int, scope: Scope, level: int) -> None:
         """A leaf of ``symbol`` as ``terminals.emit_leaves`` makes it, which emits a batch's cubes, then its
@@ -670,7 +690,8 @@ class _Writer:
             self.emit(block, scope.asset, symbol, scope, level)
             return
         assets = self.plan.grammar.module.assets
-        cube, quad = self.site(block, assets.index(LEAF_CUBE), symbol), self.site(block, assets.index(LEAF_QUAD), symbol)
+        cube = self.site(block, assets.index(LEAF_CUBE), symbol, True, scope.inserted)
+        quad = self.site(block, assets.index(LEAF_QUAD), symbol, True)
         flat = [f"{size} <= {TOL.zero!r}" for size in scope.size]
         count, a, b, k, za, zb = (self.fresh(stem) for stem in ("z", "qa", "qb", "qk", "za", "zb"))
         self.put(level, f"{count} = ({flat[0]}) + ({flat[1]}) + ({flat[2]})")
@@ -685,6 +706,7 @@ class _Writer:
         self.put(level + 1, "if writing:")
         self.put(level + 2, f"put_record(xform, record_lot, sites[{quad}], frames, f, l, base, {a}, {b}, {k}, "
                             f"{za}, {zb}, 0.0, {', '.join(scope.origin)})")
+        self.rooted(level + 2, f"record_row[sites[{quad}]]")
         self.put(level + 1, f"sites[{quad}] += 1")
 
     def handoff(self, block: Block, symbol: int, scope: Scope, level: int, depth: int) -> None:
@@ -693,7 +715,8 @@ class _Writer:
         site = self.handoffs
         self.handoffs += 1
         self.params = max(self.params, len(scope.params))
-        block.events.append(Handoff(site, symbol, int(asset_geom(scope.asset)) if scope.asset >= 0 else -1))
+        block.events.append(Handoff(site, symbol, int(asset_geom(scope.asset)) if scope.asset >= 0 else -1,
+                                    scope.inserted))
         self.put(level, "if writing:")
         row = self.fresh("h")
         self.put(level + 1, f"{row} = handoffs[{site}]")
@@ -701,6 +724,7 @@ class _Writer:
                             f"{scope.key}, depth[i] + {depth})")
         for k, value in enumerate(scope.params):
             self.put(level + 1, f"handed[6][{k}, {row}] = {value}")
+        self.rooted(level + 1, f"handed[7][{row}]")
         self.put(level, f"handoffs[{site}] += 1")
 
     def made(self, level: int) -> None:
@@ -719,19 +743,19 @@ class _Writer:
 
     # ------------------------------------------------------------------------------------------ expressions
     def expr(self, expr: ir.Expr, scope: Scope) -> str:
-        """``expr`` as numba source: numbers as float64 literals, attributes read by lot, parameters and
-        ``scope.s*`` from the scope's variables, operators and functions as ``backend.evaluate`` applies
-        them (float64, IEEE division, NaN-propagating ``min`` and ``max``, ``rand``'s scaled draw, ``p``'s
-        draw below its probability)."""
+        """``expr`` as numba source: numbers as float64 literals, attributes read by lot (those the shapes
+        carry by root), parameters and ``scope.s*`` from the scope's variables, operators and functions as
+        ``backend.evaluate`` applies them (float64, IEEE division, NaN-propagating ``min`` and ``max``,
+        ``rand``'s scaled draw, ``p``'s draw below its probability)."""
         if isinstance(expr, ir.Bool):
             return repr(bool(expr.value))
         if isinstance(expr, ir.Num):
             value = float(expr.value)
             return repr(value) if math.isfinite(value) else f"np.float64({str(value)!r})"
-        if isinstance(expr, ir.AttrRef):
+        if isinstance(expr, ir.AttrRef):  # a per-shape column is the root's: no fused operation writes one
             if expr.name not in self.attrs:
                 self.attrs.append(expr.name)
-            return f"a{self.attrs.index(expr.name)}[l]"
+            return f"a{self.attrs.index(expr.name)}[{'i' if expr.name in self.plan.dynamic else 'l'}]"
         if isinstance(expr, ir.Param):
             return scope.params[expr.index]
         if isinstance(expr, ir.ScopeRef):

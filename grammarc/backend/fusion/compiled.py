@@ -62,7 +62,7 @@ def kernel(text: str, columns: int):
     rows = [np.zeros((0, 3)), np.zeros((0, 3)), np.zeros(0, np.int32), np.zeros(0, np.int32), np.zeros(0, np.uint64),
             np.zeros(0, np.int32), np.zeros((1, 3, 3)), *(np.zeros(0) for _ in range(columns)), np.zeros((0, 3)), 0.0,
             False, np.zeros(0, np.int64), np.zeros(0), np.zeros(0, np.bool_), np.zeros((0, 3, 4), np.float32),
-            np.zeros(0, np.int32), np.zeros(0, np.int64), handed_columns(0, 0)]
+            np.zeros(0, np.int32), np.zeros(0, np.int64), np.zeros(0, np.int64), handed_columns(0, 0)]
     with _locked(path.with_suffix(".lock")):
         module.derive(*rows)
     user_cache.store(path.with_suffix(".compiled"), lambda f: None)
@@ -111,11 +111,13 @@ def compiled_before(text: str) -> bool:
     return folder is not None and bool(user_cache.load(folder / f"region_{digest(text)}.compiled", lambda f: True))
 
 
-def handed_columns(rows: int, params: int) -> tuple:
+def handed_columns(rows: int, params: int, carries: bool = False) -> tuple:
     """The columns of ``rows`` shapes a kernel hands off (``codegen._Writer.handoff``): origin, size, frame,
-    lot, key, depth, and ``params`` parameters (params, rows)."""
+    lot, key, depth, ``params`` parameters (params, rows), and the rows of the roots they come from where
+    the kernel ``carries`` per-shape columns (else none)."""
     return (np.empty((rows, 3)), np.empty((rows, 3)), np.empty(rows, np.int32), np.empty(rows, np.int32),
-            np.empty(rows, np.uint64), np.empty(rows, np.int32), np.empty((params, rows)))
+            np.empty(rows, np.uint64), np.empty(rows, np.int32), np.empty((params, rows)),
+            np.empty(rows if carries else 0, np.int64))
 
 
 @contextmanager

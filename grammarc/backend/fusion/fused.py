@@ -6,6 +6,12 @@ the whole batch back, and the interpreter derives it, failing what it fails), co
 --max-shapes as the interpreter does, allocates the records once and runs the kernel again, writing. The
 root's own records are emitted at once; those of each inlined symbol wait in that symbol's pending list as a ``FusedBatch`` until the
 schedule reaches it, where the interpreter would have run its rules on the shapes handed to it.
+
+Where the grammar's shapes carry per-shape columns (colours, texture channels and coordinates, trim planes,
+attributes rules ``set``...: ``Plan.dynamic``), no operation of a region writes them (``regions``), so a
+record or a shape handed off has its root's: the kernel writes the root's row beside each, and its records
+are placed as the interpreter places them from those rows (``terminals.place_instances``: cut at trim
+planes, coloured, textured).
 """
 
 from __future__ import annotations
@@ -25,21 +31,46 @@ from grammarc.ragged import offsets_from_counts
 @dataclass(frozen=True, eq=False)
 class FusedRecords:
     """The records a region's kernel wrote, by site: site k's are rows ``starts[k]`` to ``starts[k + 1]``; and
-    the shapes it handed off (``handed``: origin, size, frame, lot, key, depth, parameters (p, h)), hand-off
-    site k's rows ``handoff_starts[k]`` to ``handoff_starts[k + 1]``."""
+    the shapes it handed off (``handed``: origin, size, frame, lot, key, depth, parameters (p, h), root
+    rows), hand-off site k's rows ``handoff_starts[k]`` to ``handoff_starts[k + 1]``. Where the kernel
+    carries per-shape columns, ``root`` is its batch and ``row`` the root row of each record (else None)."""
 
     xform: np.ndarray  # (m, 3, 4) float32
     lot: np.ndarray  # (m,) int32
     starts: np.ndarray  # (sites + 1,) int64
     handed: tuple
     handoff_starts: np.ndarray  # (handoff sites + 1,) int64
+    root: Shapes | None = None
+    row: np.ndarray | None = None  # (m,) int64
 
-    def shapes(self, handoff: Handoff, params: int) -> Shapes:
-        """The shapes of ``handoff``, which take ``params`` parameters."""
+    def shapes(self, plan, handoff: Handoff) -> Shapes:
+        """The shapes of ``handoff``, with their roots' per-shape columns (their geometry inserted where an
+        ``i`` made it)."""
         a, b = self.handoff_starts[handoff.site], self.handoff_starts[handoff.site + 1]
-        origin, size, frame, lot, key, depth, values = self.handed
-        return Shapes(origin[a:b], size[a:b], frame[a:b], np.full(b - a, handoff.geom, np.int32), lot[a:b], key[a:b],
-                      depth[a:b], tuple(values[k, a:b] for k in range(params)))
+        origin, size, frame, lot, key, depth, values, row = self.handed
+        params = len(plan.symbols[handoff.symbol].param_types)
+        dynamic = () if self.root is None else tuple(d[row[a:b]] for d in self.root.dynamic)
+        made = Shapes(origin[a:b], size[a:b], frame[a:b], np.full(b - a, handoff.geom, np.int32), lot[a:b],
+                      key[a:b], depth[a:b], tuple(values[k, a:b] for k in range(params)), dynamic)
+        return terminals.marked_inserted(plan, made, True) if handoff.inserted else made
+
+    def emit(self, ctx, event: Emit, a: int, b: int) -> None:
+        """Append the records ``a`` to ``b`` of emission site ``event``: placed from their roots' rows, as
+        ``terminals.emit_instances`` and ``emit_leaves`` place them, where the kernel carries per-shape
+        columns."""
+        xform = self.xform[a:b]
+        if self.root is None:
+            terminals.append_records(ctx, xform, self.lot[a:b], event.asset, event.symbol, None)
+            return
+        rows = self.row[a:b]
+        if event.leaf and event.asset == terminals.QUAD:  # a leaf quad is never cut
+            terminals.append_instances(ctx, self.root, rows, xform, event.asset, event.symbol)
+            return
+        slot = ctx.plan.inserted_slot
+        inserted = None
+        if event.leaf and not event.inserted and slot is not None:  # a leaf box: cut where its root was inserted
+            inserted = self.root.dynamic[slot][rows] == 1
+        terminals.place_instances(ctx, self.root, rows, xform, event.asset, event.symbol, event.leaf, inserted)
 
 
 @dataclass(frozen=True, eq=False)
@@ -56,12 +87,10 @@ class FusedBatch:
             if type(event) is Emit:
                 a, b = starts[event.site], starts[event.site + 1]
                 if b > a:
-                    terminals.append_records(ctx, records.xform[a:b], records.lot[a:b], event.asset, event.symbol,
-                                             None)
+                    records.emit(ctx, event, a, b)
             elif type(event) is Handoff:
                 if handoff_starts[event.site + 1] > handoff_starts[event.site]:
-                    params = len(ctx.plan.symbols[event.symbol].param_types)
-                    ctx.pending[event.symbol].append(records.shapes(event, params))
+                    ctx.pending[event.symbol].append(records.shapes(ctx.plan, event))
             elif (starts[event.last] > starts[event.first]
                   or handoff_starts[event.last_handoff] > handoff_starts[event.first_handoff]):
                 ctx.pending[event.symbol].append(FusedBatch(records, event))
@@ -76,7 +105,7 @@ def derive(ctx, region, shapes: Shapes) -> bool:
         return False  # a few shapes do not pay for compiling a kernel; the interpreter derives them
     if (shapes.geom != -1).any() or int(shapes.depth.max()) + region.source.depth >= limits.max_depth:
         return False
-    attrs = [*shapes.params, *(chunk.attrs.get(name) for name in region.source.attrs)]
+    attrs = [*shapes.params, *(_attribute(ctx, shapes, name) for name in region.source.attrs)]
     if not all(isinstance(a, np.ndarray) and a.dtype == np.float64 for a in attrs):
         return False
     source = region.source
@@ -89,17 +118,28 @@ def derive(ctx, region, shapes: Shapes) -> bool:
                                            shapes.depth, chunk.frames.data, *attrs, chunk.lot_origin)),
                float(limits.max_shapes))
     derive_batch(*columns, False, sites, made, bad, np.empty((0, 3, 4), np.float32), np.empty(0, np.int32),
-                 handoffs, handed_columns(0, source.params))
+                 np.empty(0, np.int64), handoffs, handed_columns(0, source.params))
     if bad.any() or not _within_limit(ctx, shapes.lot, made):
         return False
     ctx.count_lots(shapes.lot, ctx.plan.symbols[region.root].rules[0].span, made.astype(np.int64))
     starts, handoff_starts = offsets_from_counts(sites), offsets_from_counts(handoffs)
     total = int(starts[-1])
     xform, lot = np.empty((total, 3, 4), np.float32), np.empty(total, np.int32)
-    handed = handed_columns(int(handoff_starts[-1]), source.params)
-    derive_batch(*columns, True, starts[:-1].copy(), made, bad, xform, lot, handoff_starts[:-1].copy(), handed)
-    FusedBatch(FusedRecords(xform, lot, starts, handed, handoff_starts), source.block).emit(ctx)
+    row = np.empty(total if source.carries else 0, np.int64)
+    handed = handed_columns(int(handoff_starts[-1]), source.params, source.carries)
+    derive_batch(*columns, True, starts[:-1].copy(), made, bad, xform, lot, row, handoff_starts[:-1].copy(), handed)
+    records = FusedRecords(xform, lot, starts, handed, handoff_starts, *((shapes, row) if source.carries else ()))
+    FusedBatch(records, source.block).emit(ctx)
     return True
+
+
+def _attribute(ctx, shapes: Shapes, name: str):
+    """The column of attribute ``name`` a kernel reads (``codegen._Writer.expr``): the shapes' own where
+    they carry it (``Plan.dynamic``), by row, else the chunk's, by lot (as ``evaluate`` reads them); a
+    boolean one as numbers (true 1.0), which the kernel's conditions and arithmetic take as numpy does."""
+    slot = ctx.plan.dynamic.get(name)
+    column = shapes.dynamic[slot] if slot is not None else ctx.chunk.attrs.get(name)
+    return column.astype(np.float64) if isinstance(column, np.ndarray) and column.dtype == np.bool_ else column
 
 
 def _within_limit(ctx, lot: np.ndarray, made: np.ndarray) -> bool:

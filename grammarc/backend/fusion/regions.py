@@ -22,12 +22,19 @@ pending shapes then come from this one place), or when its rule only places an a
 shapes' records are the same however its batches are concatenated). Any other successor is *handed off*:
 the kernel writes its shapes (scope, key, depth, parameters of numbers), which join the symbol's pending
 batches where the interpreter's would, and its rules run at its turn, by the interpreter or by the kernel
-of its own region. The whole grammar is left to the interpreter where records carry more than an
-asset and a transform (colours, texture channels or coordinates, trims), where shapes carry per-shape
-state (``set``, ``split.index``, a pivot, box rings), where an insert occludes, and in a search that sums a
-design's leaves (``backend.aggregates``). ``grammar_refusals`` says which of these keep a
-grammar out, ``Fusible.refusal`` the first construct that keeps a symbol out and where it is: what
-``grammarc check --fusion`` prints.
+of its own region.
+
+Shapes may carry per-shape columns (``Plan.dynamic``: colours, texture channels and coordinates, trim
+planes, a pivot, box rings, attributes rules ``set``): no operation a kernel takes writes one (an ``i``
+marks its geometry inserted, which the kernel knows where it writes its code), so everything a region
+makes of a root has the root's, and the kernel writes the root's row beside its records and shapes
+(``fused``); an attribute a shape carries is read from its root's row. The texture maps and trim planes are
+in world coordinates, which a split or a move keeps. A split where the grammar reads ``split.index`` or
+``split.total`` writes them, which no kernel does: its symbol is left to the interpreter. The whole grammar
+is left to the interpreter where an insert occludes and in a search that sums a design's leaves
+(``backend.aggregates``). ``grammar_refusals`` says which of these keep a grammar out,
+``Fusible.refusal`` the first construct that keeps a symbol out and where it is: what ``grammarc check
+--fusion`` prints.
 ``GRAMMARC_FUSION=off`` turns fusion off; ``GRAMMARC_FUSION=always`` compiles a kernel for any batch, however
 small (``COMPILE_AT``).
 """
@@ -38,16 +45,6 @@ import os
 from collections import Counter
 from dataclasses import dataclass
 
-from grammarc.backend.materials import MAP_FIELDS
-from grammarc.backend.slots import (
-    ANCESTORS,
-    COLOR_SLOT,
-    PIVOT_SLOTS,
-    RING_START,
-    TRIM_INSERTED,
-    TRIM_PLANES,
-    uv_slots,
-)
 from grammarc.backend.streams import draws
 from grammarc.diagnostics import Span
 from grammarc.ir import nodes as ir
@@ -65,6 +62,8 @@ LOGIC = frozenset({"&&", "||"})
 SIZES = {"sx": 0, "sy": 1, "sz": 2}
 #: The functions a fused expression may call: ``rand`` and ``p`` draw from the shape's stream.
 FUNCTIONS = frozenset({"min", "max", "rand", "p"})
+#: The per-shape columns a split writes to its children (``children.with_context``).
+SPLIT_CONTEXT = frozenset({"split.index", "split.total"})
 
 
 #: The fused operations after which a body's shape is not the body's to emit as a leaf (CityEngine's
@@ -95,17 +94,7 @@ def grammar_allows(plan) -> bool:
 def grammar_refusals(plan) -> list[str]:
     """Why ``plan``'s grammar may not be fused at all, one phrase each (none: it may be; the module
     docstring says why each keeps it out)."""
-    slots = {COLOR_SLOT, *MAP_FIELDS, TRIM_PLANES, TRIM_INSERTED, *ANCESTORS, *PIVOT_SLOTS, RING_START,
-             *(name for s in plan.uv_slots for name in uv_slots(s))}
-    state = [name for name in plan.dynamic if name not in slots]
     found = (
-        (state, f"per-shape state ({', '.join(state)}: `set`, `split.index`, `comp.sel`...)"),
-        (plan.color_slot is not None, "colours (`color`, `set(material.color...)`)"),
-        (plan.material_slots, "texture channels (`texture`, `set(material.*map)`)"),
-        (plan.uv_slots, "texture coordinates (`setupProjection`, `projectUV`...)"),
-        (plan.trim_slot is not None, "trim planes (a `comp(f)` before inserts)"),
-        (plan.pivot_slot is not None, "a pivot (`setPivot`, `scope.t`, `r`...)"),
-        (plan.ring_slot is not None, "box rings' first corners (`rotateScope`, `alignScopeToAxes`)"),
         (plan.queries or plan.occluders, "occlusion (queries, occluding inserts, labels)"),
         # a search's aggregates count the shapes and leaves each symbol is given (``backend.aggregates``)
         (plan.grammar.module.objectives, "a search's objectives"),
@@ -189,6 +178,8 @@ class Fusible:
             return _first(self.expr(s.value) for s in op.sizes)
         if isinstance(op, ir.Translate):
             return _first(self.expr(e) for e in op.vector)
+        if isinstance(op, (ir.Split, ir.Repeat, ir.GroupSplit)) and SPLIT_CONTEXT & self.plan.dynamic.keys():
+            return _refused(op, "a split whose `split.index` or `split.total` a rule reads")
         if isinstance(op, (ir.Split, ir.Repeat)):
             if len(op.axes) != 1 or op.snap:
                 return _refused(op, "a split of several axes or one that snaps")

@@ -4,7 +4,7 @@ the shape limit."""
 
 from __future__ import annotations
 
-from dataclasses import replace
+from dataclasses import fields, replace
 
 import numpy as np
 import pytest
@@ -20,6 +20,7 @@ from grammarc.build import BuildOptions, derive
 from grammarc.compiler import compile_grammar
 from grammarc.constants import LIMITS
 from grammarc.io.lots import lots_from_polygons
+from grammarc.model.records import MeshChunk
 
 #: ``side`` turns its scope (no kernel does) and hands shapes to ``pane``, a leaf insert that the fused
 #: ``bay`` inlines too: pane's pending list mixes both; ``bay``'s guards pick rules per shape.
@@ -151,6 +152,33 @@ Mark --> s('1, '1, rand(0.1, 0.3)) i("builtin:cube")
 """
 
 
+#: Shapes that carry per-shape columns through the kernels, made by the interpreter before them: a colour
+#: (the front), a texture channel and coordinates (the sides), an attribute ``set`` per face and read in
+#: ``case``s, and trim planes (``comp(f)`` before inserts). ``Edge``'s cube, which an ``i`` inserted, stands
+#: over the facade's end and is cut at its trim plane; ``Ledge``'s box, as long, is the extrusion's and is not.
+#: ``Sill`` and ``Pier``, named twice, are handed off, inserted after an ``i`` and not after the other;
+#: ``Sill`` colours its box, cut where it stands over the facade's other end.
+CARRIED = """
+version "2023.0"
+attr street = false
+attr floor_h = 3
+
+@StartRule
+Lot --> extrude(10) comp(f) { front : set(street, true) color("#ff8000") Facade | side : Side | top : Roof. }
+Side --> setupProjection(0, scope.xy, 4, 3) projectUV(0) set(material.colormap, "brick.jpg") Facade
+Facade --> split(y) { ~floor_h : Floor }*
+Floor --> case street : split(x) { 0.6 : Edge | { ~2 : Tile | 0.5 : i("builtin:cube") Pier }* | 0.6 : s('1.8, '1, 0.4) i("builtin:cube") Sill }
+          else : split(x) { 0.4 : s('3, '1, 0.4) t('-1, 0, 0) Ledge. | { ~3 : Tile }* }
+Tile --> split(x) { 0.2 : Pier | ~1 : s('1, '1, 0.3) Win | 0.2 : Sill }
+Edge --> s('1.8, '1, 0.4) t('-0.4, 0, 0) i("builtin:cube")
+Win --> case street : t(0, 0, -0.2) Pane
+        else : s('1, '0.5, '1) Pane
+Pane --> s('1, '1, 0) Glass.
+Pier --> t(0, 0, -0.1)
+Sill --> color("#00ff00")
+"""
+
+
 def cityengine_lots():
     widths = np.linspace(4, 31, 10)
     return lots_from_polygons([[np.array([[0, 0], [w, 0], [w, 7 + w / 3], [0, 7 + w / 3]])] for w in widths],
@@ -181,8 +209,15 @@ def both(write, monkeypatch, text: str, lots, **options) -> tuple[dict, dict]:
 
 
 def assert_same(fused: dict, interpreted: dict) -> None:
-    for column in ("asset", "xform", "lot", "symbol"):
-        np.testing.assert_array_equal(fused[column], interpreted[column], err_msg=column)
+    for column in ("asset", "xform", "lot", "symbol", "color", "material", "uv"):
+        assert (column in fused) == (column in interpreted), column
+        if column in fused:
+            np.testing.assert_array_equal(fused[column], interpreted[column], err_msg=column)
+    for column in fields(MeshChunk):  # the leaves that are faces: polygons, inserts cut at trim planes
+        ours, theirs = getattr(fused["mesh"], column.name), getattr(interpreted["mesh"], column.name)
+        assert (ours is None) == (theirs is None), column.name
+        if ours is not None:
+            np.testing.assert_array_equal(ours, theirs, err_msg=column.name)
     assert [(b.id, b.reason) for b in fused["bad"]] == [(b.id, b.reason) for b in interpreted["bad"]]
 
 
@@ -326,4 +361,14 @@ def test_cityengine_draws_are_the_interpreters(write, monkeypatch, seed):
     assert {plan.symbols[k].name for k in plan.fused} == {"Lot", "Strip", "Unit", "Cell"}
     fused, interpreted = both(write, monkeypatch, CITYENGINE_DRAWS, cityengine_lots(), seed=seed)
     assert fused["kernels"] and len(fused["asset"]) > 300
+    assert_same(fused, interpreted)
+
+
+def test_cityengine_shapes_carry_their_columns_through_the_kernels(write, monkeypatch):
+    plan = make_plan(compile_grammar(write("g.cga", CARRIED)))
+    assert {plan.symbols[k].name for k in plan.fused} == {"Facade", "Floor", "Tile"}
+    fused, interpreted = both(write, monkeypatch, CARRIED, cityengine_lots())
+    assert fused["kernels"] >= 2 and len(fused["asset"]) > 1000
+    assert {"color", "material", "uv"} <= fused.keys() and len(fused["mesh"].lot)  # cut: faces
+    assert len(np.unique(fused["color"], axis=0)) == 3  # white, orange, green
     assert_same(fused, interpreted)

@@ -142,7 +142,7 @@ D --> setupProjection(0, scope.xy, 1, 1) split(u, unitSpace, 0){ ~1: C }*
     assert refused["B"].name == "splitArea"
     assert refused["C"].what == "an `i` that turns the asset or keeps its size"
     assert refused["D"].name == "setupProjection"
-    assert any(w.startswith("texture coordinates") for w in grammar_refusals(plan))
+    assert grammar_refusals(plan) == []  # texture coordinates pass through the kernels
 
 
 def test_what_keeps_a_grammar_and_each_symbol_out_is_said_with_where(write):
@@ -152,12 +152,13 @@ Lot --> split(x){ 2: A | ~1: B }*
 A --> s('1, '1, 2) i("builtin:cube")
 B --> case scope.sx > 1: color(1, 0, 0)
       else: NIL
+C --> case inside(): NIL else: A
 """)))
-    assert [w.split(" (")[0] for w in grammar_refusals(plan)] == ["colours"]
+    assert [w.split(" (")[0] for w in grammar_refusals(plan)] == ["occlusion"]
     refused = symbol_refusals(plan)
     assert str(refused["B"]).startswith("an operation no kernel takes: `color(1, 0, 0)` at ")
     assert refused["B"].name == "color" and str(refused["B"]).endswith("g.cga:5:26")
-    assert set(refused) == {"B"}  # ``Lot`` hands its shapes to ``B``; ``A``'s ``s`` and ``i`` are fused
+    assert set(refused) == {"B", "C"}  # ``Lot`` hands its shapes to ``B``; ``A``'s ``s`` and ``i`` are fused
     # a fused grammar: nothing keeps it out, and its fused symbols have no refusal
     facade = make_plan(compile_grammar(ROOT / "benchmarks" / "facade.cga"))
     assert grammar_refusals(facade) == []
@@ -165,7 +166,39 @@ B --> case scope.sx > 1: color(1, 0, 0)
     assert str(symbol_refusals(facade)["mass"]).startswith("an operation no kernel takes: `Comp(")
 
 
+def test_shapes_that_carry_columns_are_fused_but_a_split_whose_index_is_read(write):
+    """Colours, textures and attributes ``set`` pass through the kernels; ``split.index``, which a split writes
+    and no kernel does, keeps every symbol that splits out."""
+    plan = make_plan(compile_grammar(write("g.cga", """
+version "2023.0"
+attr lit = false
+Lot --> color(1, 0, 0) set(lit, true) setupProjection(0, scope.xy, 1, 1) projectUV(0) A
+A --> split(x){ ~1: case lit: B else: C. }*
+B --> split(y){ ~1: s('1, '1, 0.2) i("builtin:cube") }*
+""")))
+    assert grammar_refusals(plan) == [] and {plan.symbols[k].name for k in plan.fused} == {"A", "B"}
+    plan = make_plan(compile_grammar(write("h.cga", """
+version "2023.0"
+Lot --> split(x){ ~1: A }*
+A --> s('1, '1, split.index) B
+B --> split(y){ ~1: C. }*
+""")))
+    refused = symbol_refusals(plan)
+    assert set(refused) == {"Lot", "A", "B"} and not plan.fused
+    assert str(refused["B"]).startswith("a split whose `split.index` or `split.total` a rule reads: `split(y)")
+    assert refused["A"].what == "an expression no kernel takes"  # reading it
+
+
 def test_the_fused_operations_that_end_a_body_are_those_the_interpreter_ends_it_with():
     """``ENDING``: no leaf at a CityEngine body's end after them, as ``execute.run`` decides with the table."""
     fused = (*ENDING, ir.Scale, ir.Translate, ir.UseAsset)  # and `[ ]`, which the runner keeps
     assert [t for t in fused if OPERATIONS[t].consumes] == list(ENDING)
+
+
+def test_of_the_fused_operations_only_i_writes_a_per_shape_column():
+    """A root's per-shape columns are those of everything its region makes (``regions``): of the operations
+    a kernel takes, only ``i`` writes one (its geometry inserted, which the kernel knows where it writes its
+    code); a split's parts are the parent's columns and ``split.index`` (``children.with_context``), whose
+    reading keeps splits out."""
+    fused = (*ENDING, ir.Scale, ir.Translate, ir.UseAsset)
+    assert [t for t in fused if "dynamic" in OPERATIONS[t].writes] == [ir.UseAsset]
