@@ -4,7 +4,7 @@ records, with no shape columns between their operations ("compile, don't interpr
 ``regions`` finds the symbols whose rules need no context (scope operations, splits, repeats, guards,
 inserts, leaves: the whitelist) and which of their successors can be derived with them (the others' shapes
 are handed off: written out, to wait for their symbol's turn); ``codegen`` writes a
-region's kernel, run in two passes (count the records each site makes; write them at offsets from a
+region's kernel (``group_splits`` its CityEngine splits), run in two passes (count the records each site makes; write them at offsets from a
 cumulative sum), and the order its records are due in; ``compiled`` keeps the generated modules in the
 user's cache folder, so that numba's cache keeps their machine code; ``fused`` derives a root's pending batch
 with them.

@@ -21,7 +21,7 @@ records and shapes are due: a site of the root at once, a site of an inlined sym
 comes.
 
 CityEngine's dialect: a ``split`` is laid by the interpreter's own kernels (``kernels.split.plan_row`` and
-``lay_row``), called on the one parent; a shape's state in PRT's stream is a variable that
+``lay_row``), called on the one parent, or their arithmetic written out (``group_splits``); a shape's state in PRT's stream is a variable that
 successors, ``[`` and ``NIL`` move on with ``prt_random``'s steps, and a split's pieces start where their
 parent's stream stands after the pieces before them; a body that hands its shape to nothing ends in a leaf
 of its rule's symbol, an instance of the asset where an ``i`` made it one.
@@ -33,76 +33,18 @@ import functools
 import hashlib
 import importlib.util
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from itertools import count
 from pathlib import Path
-from typing import NamedTuple
 
+from grammarc.backend.fusion.group_splits import SplitWriter
 from grammarc.backend.fusion.regions import ENDING, SIZES, Fusible, applied_rules
-from grammarc.backend.kernels.split import MAX_COUNT, group_arrays
+from grammarc.backend.fusion.sites import Block, Emit, Handoff, Scope
+from grammarc.backend.kernels.split import MAX_COUNT
 from grammarc.backend.shapes import asset_geom
 from grammarc.constants import TOL
 from grammarc.ir import nodes as ir
 from grammarc.ir.asset_names import LEAF_CUBE, LEAF_QUAD
-
-
-@dataclass(frozen=True)
-class Emit:
-    """Records of ``asset`` made at emission ``site`` by ``symbol``: the instances of an ``I`` or of the
-    asset an ``i`` made a leaf's geometry (the symbol whose rule it is in), or a leaf's cubes or quads (the
-    leaf's symbol: ``leaf``, as ``terminals.emit_leaves`` emits them, textured; a cube cut at its trim
-    planes where its geometry was ``inserted`` by an ``i`` in the region, else where its root's was)."""
-
-    site: int
-    asset: int
-    symbol: int
-    leaf: bool = False
-    inserted: bool = False
-
-
-@dataclass(frozen=True)
-class Handoff:
-    """Shapes of ``symbol`` made at hand-off ``site``: successors the region does not derive, which wait for
-    their symbol's turn as the interpreter's would (``regions.Fusible.inlined``). Their geometry is
-    ``geom`` (``Shapes.geom``: -1 their scope, or the asset an ``i`` made it), ``inserted`` where an ``i``
-    in the region made it (``slots.TRIM_INSERTED``), else as their root's."""
-
-    site: int
-    symbol: int
-    geom: int = -1
-    inserted: bool = False
-
-
-@dataclass
-class Block:
-    """What one symbol of a region emits when its rules run, in the interpreter's order: records (``Emit``),
-    shapes handed on (``Handoff``) and the blocks of the symbols it derives. Its sites and those of its
-    blocks are the range ``first`` to ``last``, its hand-off sites ``first_handoff`` to ``last_handoff``
-    (sites are numbered in this order)."""
-
-    symbol: int
-    events: list = field(default_factory=list)
-    first: int = 0
-    last: int = 0
-    first_handoff: int = 0
-    last_handoff: int = 0
-
-
-class Scope(NamedTuple):
-    """Where the generated code holds a shape: the names of its origin's and size's variables (per axis)
-    and of its parameters' values; the expression of its random key (``backend.random``: a split child's
-    mixes its parent's with the split's site and its index, a successor's with its site and 0), computed
-    only where a shape draws or is handed off; in CityEngine's dialect the variable of its state in PRT's
-    stream (``backend.prt_random``), which the operations that make shapes move on. And its geometry,
-    known where the code is written: -1 its scope, or the id of the asset an ``i`` made it; and whether an
-    ``i`` inserted it (``builtin:cube`` leaves the scope's box as its geometry, but inserted)."""
-
-    origin: tuple[str, str, str]
-    size: tuple[str, str, str]
-    params: tuple[str, ...]
-    key: str
-    asset: int = -1
-    inserted: bool = False
 
 
 @dataclass(frozen=True)
@@ -182,7 +124,7 @@ def generate(fusible: Fusible, root: int) -> Source:
                   writer.carries)
 
 
-class _Writer:
+class _Writer(SplitWriter):
     """The walk over the region's IR that writes the kernel's lines, numbering sites and attributes as it
     meets them."""
 
@@ -489,157 +431,6 @@ class _Writer:
                 self.put(level + 1, f"{'if' if k == 0 else 'elif'} {j} % {parts} == {k}:")
                 inner = level + 2
             self.child(part, block, scope, axis, pos, step, inner, depth, f"child_key1({scope.key}, {op.site}, {j})")
-
-    def group_split(self, op: ir.GroupSplit, block: Block, scope: Scope, level: int, depth: int) -> None:
-        """``splits.group_split`` for one parent: CityEngine's layout by the interpreter's own kernels
-        (``kernels.split.plan_row`` and ``lay_row``, on arrays of one row made once per batch, the
-        children's grown as a parent needs), negative sizes taken as 0 and a NaN one refused, parts of
-        ``TOL.merge`` or less not made; then the children in order, each in its part's body."""
-        kind, groups, n_groups = group_arrays(op)
-        if not n_groups:
-            self.ungrouped_split(op, kind.tolist(), block, scope, level, depth)
-            return
-        if op.repeat and all(k == 2 for k in kind.tolist()):
-            self.floating_repeat(op, block, scope, level, depth)
-            return
-        slots, parts = n_groups, len(op.sizes)  # the splits without groups are written out above
-        tables = self.fresh("kind"), self.fresh("group")
-        for name, table in zip(tables, (kind, groups)):
-            self.constants.append(f"{name} = np.array({table.tolist()!r}, dtype=np.int64)")
-        values, reps, gap, scale, total, sums, room = (self.fresh(stem) for stem in ("gv", "gr", "gg", "gs", "gt",
-                                                                                       "gn", "cap"))
-        made = [self.fresh(stem) for stem in ("cp", "cj", "cpos", "cln", "cix")]
-        self.prologue += [f"{values} = np.empty((1, {parts}))", f"{reps} = np.zeros((1, {slots}), np.int64)",
-                          f"{gap} = np.zeros((1, {slots}))", f"{scale} = np.ones(1)", f"{total} = np.zeros(1)",
-                          *(f"{sums}{k} = np.zeros({slots})" for k in range(3)), f"{room} = 0",
-                          *(f"{name} = np.empty(0{dtype})" for name, dtype in zip(made, self._CHILD_TYPES))]
-        sizes = self.sizes(op, scope, level)
-        self.put(level, "else:")
-        for j, size in enumerate(sizes):
-            self.put(level + 1, f"{values}[0, {j}] = {size}")
-        extent = scope.size[op.axis]
-        self.put(level + 1, f"plan_row(0, {extent}, {values}, 0, {tables[0]}, {tables[1]}, {n_groups}, {TOL.zero!r}, "
-                            f"{reps}, {gap}, {scale}, {total}, {sums}0, {sums}1, {sums}2)")
-        self.put(level + 1, f"if not ({total}[0] <= limit):")  # beyond --max-shapes: the interpreter fails it
-        self.put(level + 2, "bad[i] = True")
-        self.put(level + 1, "else:")
-        inner = level + 2
-        self.put(inner, f"if int({total}[0]) > {room}:")
-        self.put(inner + 1, f"{room} = int({total}[0])")
-        for name, dtype in zip(made, self._CHILD_TYPES):
-            self.put(inner + 1, f"{name} = np.empty({room}{dtype})")
-        laid, c = self.fresh("m"), self.fresh("c")
-        self.put(inner, f"{laid} = lay_row(0, {extent}, {values}, 0, {tables[0]}, {tables[1]}, {reps}, {gap}, "
-                        f"{scale}, {TOL.merge!r}, {', '.join(made)}, 0)")
-        stream = self.fresh("ks")
-        self.put(inner, f"{stream} = {scope.key}")
-        self.put(inner, f"for {c} in range({laid}):")
-        self.put(inner + 1, "if n > limit:")
-        self.put(inner + 2, "break")
-        key = self.piece(stream, inner + 1)
-        for k, part in enumerate(op.parts):
-            self.put(inner + 1, f"{'if' if k == 0 else 'elif'} {made[1]}[{c}] == {k}:")
-            self.child(part, block, scope, op.axis, f"{made[2]}[{c}]", f"{made[3]}[{c}]", inner + 2, depth, key)
-
-    def ungrouped_split(self, op: ir.GroupSplit, kind: list[int], block: Block, scope: Scope, level: int,
-                        depth: int) -> None:
-        """``group_split`` of a split without repeat groups, ``plan_row`` and ``lay_row`` written out (their
-        arithmetic in their order, no call and no array per parent): the fixed (and relative) sizes and
-        the floating ones summed apart, the floating ones scaled to fill what the others leave, the parts
-        laid end to end, each in place."""
-        extent, values = scope.size[op.axis], self.sizes(op, scope, level)
-        self.put(level, f"elif not ({float(len(values))!r} <= limit):")  # beyond --max-shapes
-        self.put(level + 1, "bad[i] = True")
-        self.put(level, "else:")
-        level += 1
-        fixed, floating, scale, at, stream = (self.fresh(stem) for stem in ("fx", "fl", "sc", "at", "ks"))
-        self.put(level, f"{fixed} = 0.0")
-        self.put(level, f"{floating} = 0.0")
-        for value, k in zip(values, kind):
-            self.put(level, f"{floating if k == 2 else fixed} += {f'{value} * {extent}' if k == 1 else value}")
-        self.put(level, f"{scale} = max({extent} - {fixed}, 0.0) / {floating} if {floating} > 0.0 else 1.0")
-        self.put(level, f"{at} = 0.0")
-        self.put(level, f"{stream} = {scope.key}")
-        self.lay(op, values, kind, scale, at, stream, block, scope, level, depth)
-
-    def floating_repeat(self, op: ir.GroupSplit, block: Block, scope: Scope, level: int, depth: int) -> None:
-        """``group_split`` of a split repeated as a whole whose sizes all float (``{ ~a: A | ~b: B }*``),
-        ``plan_row`` and ``lay_row`` written out for its one group (their arithmetic in their order, the
-        sums of no fixed part as the 0.0 they are there): as many repetitions as bring the floating sizes
-        nearest their written ones (``repetitions``), the sizes scaled to fill the extent."""
-        extent, values = scope.size[op.axis], self.sizes(op, scope, level)
-        self.put(level, "else:")
-        level += 1
-        nominal, left, reps, scale, total, share, laid = (self.fresh(stem) for stem in ("nm", "lf", "rp", "sc", "tt",
-                                                                                         "sh", "fl"))
-        self.put(level, f"{nominal} = 0.0")
-        for value in values:
-            self.put(level, f"{nominal} += {value}")
-        self.put(level, f"{left} = max({extent} - 0.0 - 0.0, 0.0)")
-        self.put(level, f"{reps} = 0")
-        self.put(level, f"{scale} = 1.0")
-        self.put(level, f"{total} = 0.0")
-        self.put(level, f"if {nominal} <= {TOL.zero!r}:")  # a repetition too small to lay counts what it would make
-        self.put(level + 1, f"if {nominal} > 0.0 and {left} > {TOL.zero!r}:")
-        self.put(level + 2, f"{total} += {left} / {nominal}")
-        self.put(level, "else:")
-        self.put(level + 1, f"{share} = {left} * {nominal} / {nominal}")
-        self.put(level + 1, f"if {share} == np.inf:")
-        self.put(level + 2, f"{share} = {left} * ({nominal} / {nominal})")
-        self.put(level + 1, f"{reps} = repetitions({share}, {nominal}, 0.0, {nominal}, 0.0, 0.0, {TOL.zero!r})")
-        self.put(level + 1, f"{laid} = 0.0 + {reps} * {nominal}")
-        self.put(level + 1, f"if {laid} > 0.0:")
-        self.put(level + 2, f"{scale} = max({extent} - (0.0 + ({reps} * 0.0 + 0.0)), 0.0) / {laid}")
-        for _ in values:
-            self.put(level, f"{total} += float({reps})")
-        self.put(level, f"if not ({total} <= limit):")  # beyond --max-shapes: the interpreter fails it
-        self.put(level + 1, "bad[i] = True")
-        self.put(level, "else:")
-        level += 1
-        at, stream = self.fresh("at"), self.fresh("ks")
-        self.put(level, f"{at} = 0.0")
-        self.put(level, f"{stream} = {scope.key}")
-        self.put(level, f"for _ in range({reps}):")
-        self.put(level + 1, "if n > limit:")
-        self.put(level + 2, "break")
-        self.lay(op, values, [2] * len(values), scale, at, stream, block, scope, level + 1, depth)
-
-    def sizes(self, op: ir.GroupSplit, scope: Scope, level: int) -> list[str]:
-        """The variables of a split's sizes, a negative one taken as 0; the parent flagged where one is NaN
-        (an ``if`` the caller's ``else`` follows)."""
-        values = []
-        for s in op.sizes:
-            values.append(self.fresh("v"))
-            self.put(level, f"{values[-1]} = {self.expr(s.value, scope)}")
-            self.put(level, f"{values[-1]} = 0.0 if {values[-1]} < 0.0 else {values[-1]}")
-        self.check(level, " and ".join(f"{value} >= 0.0" for value in values))
-        return values
-
-    def lay(self, op: ir.GroupSplit, values: list[str], kind: list[int], scale: str, at: str, stream: str,
-            block: Block, scope: Scope, level: int, depth: int) -> None:
-        """``lay_row``'s parts, each in place: its size (relative, floating times ``scale``, or absolute), cut at
-        the extent, made if longer than ``TOL.merge``, its piece of PRT's stream, its body; then the next."""
-        extent = scope.size[op.axis]
-        for value, k, part in zip(values, kind, op.parts):
-            size, stop, length = (self.fresh(stem) for stem in ("sz", "st", "ln"))
-            self.put(level, f"{size} = {f'{value} * {extent}' if k == 1 else f'{value} * {scale}' if k == 2 else value}")
-            self.put(level, f"{stop} = min({at} + {size}, {extent})")
-            self.put(level, f"if {stop} - {at} > {TOL.merge!r}:")
-            self.put(level + 1, f"{length} = {stop} - {at}")
-            self.child(part, block, scope, op.axis, at, length, level + 1, depth, self.piece(stream, level + 1))
-            self.put(level, f"{at} += {size}")
-
-    def piece(self, stream: str, level: int) -> str:
-        """The state of a split's next piece (``prt_random.pieces``: where its parent's stream, ``stream``,
-        stands after the pieces before it, then one draw), and the stream moved on: CityEngine's ``split``
-        draws from PRT's stream, as its dialect does."""
-        key = self.fresh("k")
-        self.put(level, f"{key} = next_state(child_state({stream}))")
-        self.put(level, f"{stream} = next_state({stream})")
-        return key
-
-    #: The dtypes of ``lay_row``'s columns of children: parent, part, position, length, index.
-    _CHILD_TYPES = (", np.int64", ", np.int64", "", "", ", np.int64")
 
     def child(self, part: ir.Body, block: Block, scope: Scope, axis: int, pos: str, length: str, level: int,
               depth: int, key: str) -> None:

@@ -22,8 +22,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from grammarc.backend import terminals
-from grammarc.backend.fusion.codegen import Block, Emit, Handoff
 from grammarc.backend.fusion.compiled import compiled_before, handed_columns, kernel, ready
+from grammarc.backend.fusion.sites import Block, Emit, Handoff
 from grammarc.backend.shapes import Shapes
 from grammarc.ragged import offsets_from_counts
 

@@ -5,9 +5,10 @@ from __future__ import annotations
 from pathlib import Path
 
 from grammarc.backend.fusion import codegen
-from grammarc.backend.fusion.codegen import Block, Emit, generate
+from grammarc.backend.fusion.codegen import generate
 from grammarc.backend.fusion.compiled import digest, load
 from grammarc.backend.fusion.regions import Fusible
+from grammarc.backend.fusion.sites import Block, Emit
 from grammarc.backend.plan import make_plan
 from grammarc.compiler import compile_grammar
 
