@@ -263,8 +263,8 @@ def derive(grammar: Grammar, lots: Lots, options: BuildOptions = BuildOptions())
     if any(c.uv is not None for c in chunks):  # texture coordinates of set 0 (``TerminalChunk.uv``)
         columns["uv"] = np.concatenate([c.uv if c.uv is not None else np.full((len(c.asset), 2, 4), np.nan, np.float32)
                                         for c in chunks])
-    if chunks and chunks[0].color is not None:  # where the grammar sets colours, every chunk has them
-        columns["color"] = np.concatenate([c.color for c in chunks])
+    if any(c.color is not None for c in chunks):  # RGBA, white where a chunk set none (``TerminalChunk.colors``)
+        columns["color"] = np.concatenate([c.colors() for c in chunks])
     if chunks and chunks[0].material is not None:  # each instance's texture paths, not its chunk's row of them
         columns["material"] = np.concatenate([c.materials[c.material] for c in chunks])
     columns.update(
