@@ -3,9 +3,10 @@
 Its layout (repeat groups, floating sizes, PRT's rounding of repetitions) is the interpreter's own code,
 not a copy: ``kernels.split.plan_row`` and ``lay_row``, which the interpreter's batch kernels call row by
 row, called here for one parent on arrays made once per batch. A kernel lays each split twice (its count
-pass and its write pass), where the interpreter lays it once per batch, so the two commonest forms are
-written out with the same arithmetic in the same order, no call and no array: a split without repeat
-groups, and a split repeated as a whole whose sizes all float. A split's pieces take their states in
+pass and its write pass), where the interpreter lays it once per batch, so the commonest forms are written
+out with the same arithmetic in the same order, no call and no array: a split without repeat groups, and
+a split with one (a window row ``{ ~w: Window | d: Wall }* | ~w: Window``; a split repeated as a whole is
+one group). A split's pieces take their states in
 PRT's stream where their parent's stands after the pieces before them.
 
 ``SplitWriter`` is a part of ``codegen._Writer``, whose ``put``, ``fresh``, ``check``, ``expr`` and ``child``
@@ -15,7 +16,7 @@ it writes with.
 from __future__ import annotations
 
 from grammarc.backend.fusion.sites import Block, Scope
-from grammarc.backend.kernels.split import group_arrays
+from grammarc.backend.kernels.split import MAX_COUNT, group_arrays
 from grammarc.constants import TOL
 from grammarc.ir import nodes as ir
 
@@ -35,10 +36,10 @@ class SplitWriter:
         if not n_groups:
             self.ungrouped_split(op, kind.tolist(), block, scope, level, depth)
             return
-        if op.repeat and all(k == 2 for k in kind.tolist()):
-            self.floating_repeat(op, block, scope, level, depth)
+        if n_groups == 1:  # its parts are one run: a group is written between braces
+            self.one_group(op, kind.tolist(), groups.tolist(), block, scope, level, depth)
             return
-        slots, parts = n_groups, len(op.sizes)  # the splits without groups are written out above
+        slots, parts = n_groups, len(op.sizes)  # the splits of fewer groups are written out above
         tables = self.fresh("kind"), self.fresh("group")
         for name, table in zip(tables, (kind, groups)):
             self.constants.append(f"{name} = np.array({table.tolist()!r}, dtype=np.int64)")
@@ -96,23 +97,36 @@ class SplitWriter:
         self.put(level, f"{scale} = max({extent} - {fixed}, 0.0) / {floating} if {floating} > 0.0 else 1.0")
         self.put(level, f"{at} = 0.0")
         self.put(level, f"{stream} = {scope.key}")
-        self.lay(op, values, kind, scale, at, stream, block, scope, level, depth)
+        self.lay(op, values, kind, range(len(values)), scale, at, stream, block, scope, level, depth)
 
-    def floating_repeat(self, op: ir.GroupSplit, block: Block, scope: Scope, level: int, depth: int) -> None:
-        """``group_split`` of a split repeated as a whole whose sizes all float (``{ ~a: A | ~b: B }*``),
-        ``plan_row`` and ``lay_row`` written out for its one group (their arithmetic in their order, the
-        sums of no fixed part as the 0.0 they are there): as many repetitions as bring the floating sizes
-        nearest their written ones (``repetitions``), the sizes scaled to fill the extent."""
+    def one_group(self, op: ir.GroupSplit, kind: list[int], groups: list[int], block: Block, scope: Scope,
+                  level: int, depth: int) -> None:
+        """``group_split`` of a split with one repeat group (``{ ~a: A | b: B }* | ~c: C``, or a split repeated
+        as a whole), ``plan_row`` and ``lay_row`` written out for it (their arithmetic in their order, one
+        group's): the sizes outside the group and the group's own summed apart, fixed and floating; the
+        group repeated as often as brings its floating parts nearest their written sizes (``repetitions``,
+        PRT's rounding), or, all its sizes fixed, as often as it fits, what is left a gap after it; the
+        floating sizes scaled to fill the extent."""
         extent, values = scope.size[op.axis], self.sizes(op, scope, level)
         self.put(level, "else:")
         level += 1
-        nominal, left, reps, scale, total, share, laid = (self.fresh(stem) for stem in ("nm", "lf", "rp", "sc", "tt",
-                                                                                         "sh", "fl"))
-        self.put(level, f"{nominal} = 0.0")
-        for value in values:
-            self.put(level, f"{nominal} += {value}")
-        self.put(level, f"{left} = max({extent} - 0.0 - 0.0, 0.0)")
+        fixed, floating, nominal, group_fixed, group_float, left, reps, gap, scale, total, share, times = (
+            self.fresh(stem) for stem in ("fx", "fl", "nm", "gx", "gf", "lf", "rp", "gp", "sc", "tt", "sh", "x"))
+        for name in (fixed, floating, nominal, group_fixed, group_float):
+            self.put(level, f"{name} = 0.0")
+        for value, k, g in zip(values, kind, groups):
+            size = value
+            if k == 1:  # relative: of the extent
+                size = self.fresh("sz")
+                self.put(level, f"{size} = {value} * {extent}")
+            if g < 0:
+                self.put(level, f"{floating if k == 2 else fixed} += {size}")
+            else:
+                self.put(level, f"{nominal} += {size}")
+                self.put(level, f"{group_float if k == 2 else group_fixed} += {size}")
+        self.put(level, f"{left} = max({extent} - {fixed} - {floating}, 0.0)")
         self.put(level, f"{reps} = 0")
+        self.put(level, f"{gap} = 0.0")
         self.put(level, f"{scale} = 1.0")
         self.put(level, f"{total} = 0.0")
         self.put(level, f"if {nominal} <= {TOL.zero!r}:")  # a repetition too small to lay counts what it would make
@@ -122,12 +136,19 @@ class SplitWriter:
         self.put(level + 1, f"{share} = {left} * {nominal} / {nominal}")
         self.put(level + 1, f"if {share} == np.inf:")
         self.put(level + 2, f"{share} = {left} * ({nominal} / {nominal})")
-        self.put(level + 1, f"{reps} = repetitions({share}, {nominal}, 0.0, {nominal}, 0.0, 0.0, {TOL.zero!r})")
-        self.put(level + 1, f"{laid} = 0.0 + {reps} * {nominal}")
-        self.put(level + 1, f"if {laid} > 0.0:")
-        self.put(level + 2, f"{scale} = max({extent} - (0.0 + ({reps} * 0.0 + 0.0)), 0.0) / {laid}")
-        for _ in values:
-            self.put(level, f"{total} += float({reps})")
+        self.put(level + 1, f"if {group_float} > 0.0:")  # the floating ones outside are both loose and laid
+        self.put(level + 2, f"{reps} = repetitions({share}, {nominal}, {group_fixed}, {group_float}, {floating}, "
+                            f"{floating}, {TOL.zero!r})")
+        self.put(level + 1, "else:")
+        self.put(level + 2, f"{times} = np.floor({share} / {nominal} + 1e-9)")
+        self.put(level + 2, f"{reps} = int({times}) if {times} < {MAX_COUNT} else {MAX_COUNT}")
+        self.put(level + 2, f"{gap} = {share} - {reps} * {nominal}")
+        self.put(level + 1, f"{fixed} += {reps} * {group_fixed} + {gap}")
+        self.put(level + 1, f"{floating} += {reps} * {group_float}")
+        self.put(level, f"if {floating} > 0.0:")
+        self.put(level + 1, f"{scale} = max({extent} - {fixed}, 0.0) / {floating}")
+        for g in groups:
+            self.put(level, f"{total} += {'1.0' if g < 0 else f'float({reps})'}")
         self.put(level, f"if not ({total} <= limit):")  # beyond --max-shapes: the interpreter fails it
         self.put(level + 1, "bad[i] = True")
         self.put(level, "else:")
@@ -135,10 +156,14 @@ class SplitWriter:
         at, stream = self.fresh("at"), self.fresh("ks")
         self.put(level, f"{at} = 0.0")
         self.put(level, f"{stream} = {scope.key}")
+        inside = [j for j, g in enumerate(groups) if g >= 0]
+        self.lay(op, values, kind, range(inside[0]), scale, at, stream, block, scope, level, depth)
         self.put(level, f"for _ in range({reps}):")
         self.put(level + 1, "if n > limit:")
         self.put(level + 2, "break")
-        self.lay(op, values, [2] * len(values), scale, at, stream, block, scope, level + 1, depth)
+        self.lay(op, values, kind, inside, scale, at, stream, block, scope, level + 1, depth)
+        self.put(level, f"{at} += {gap}")
+        self.lay(op, values, kind, range(inside[-1] + 1, len(values)), scale, at, stream, block, scope, level, depth)
 
     def sizes(self, op: ir.GroupSplit, scope: Scope, level: int) -> list[str]:
         """The variables of a split's sizes, a negative one taken as 0; the parent flagged where one is NaN
@@ -151,14 +176,16 @@ class SplitWriter:
         self.check(level, " and ".join(f"{value} >= 0.0" for value in values))
         return values
 
-    def lay(self, op: ir.GroupSplit, values: list[str], kind: list[int], scale: str, at: str, stream: str,
+    def lay(self, op: ir.GroupSplit, values: list[str], kind: list[int], parts, scale: str, at: str, stream: str,
             block: Block, scope: Scope, level: int, depth: int) -> None:
-        """``lay_row``'s parts, each in place: its size (relative, floating times ``scale``, or absolute), cut at
-        the extent, made if longer than ``TOL.merge``, its piece of PRT's stream, its body; then the next."""
+        """``lay_row``'s parts ``parts`` (their numbers), each in place: its size (relative, floating times
+        ``scale``, or absolute), cut at the extent, made if longer than ``TOL.merge``, its piece of PRT's
+        stream, its body; then the next."""
         extent = scope.size[op.axis]
-        for value, k, part in zip(values, kind, op.parts):
+        for k in parts:
+            value, part = values[k], op.parts[k]
             size, stop, length = (self.fresh(stem) for stem in ("sz", "st", "ln"))
-            self.put(level, f"{size} = {f'{value} * {extent}' if k == 1 else f'{value} * {scale}' if k == 2 else value}")
+            self.put(level, f"{size} = {f'{value} * {extent}' if kind[k] == 1 else f'{value} * {scale}' if kind[k] == 2 else value}")
             self.put(level, f"{stop} = min({at} + {size}, {extent})")
             self.put(level, f"if {stop} - {at} > {TOL.merge!r}:")
             self.put(level + 1, f"{length} = {stop} - {at}")

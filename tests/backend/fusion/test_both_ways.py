@@ -11,6 +11,7 @@ import tempfile
 from pathlib import Path
 
 import pytest
+from test_fused import fused_always  # noqa: F401 - an autouse fixture: kernels for every batch
 
 from grammarc.backend.fusion.regions import SWITCH
 from grammarc.backend.plan import make_plan
@@ -46,12 +47,6 @@ def _fused_cases():
         if fused[grammar]:
             yield pytest.param(grammar, lots, options, id=name)
 
-
-
-@pytest.fixture(autouse=True)
-def fused_always(monkeypatch):
-    """Kernels for every batch, however small (``regions.COMPILE_AT``)."""
-    monkeypatch.setenv(SWITCH, "always")
 
 @pytest.mark.parametrize(("grammar", "lots", "options"), list(_fused_cases()))
 def test_fused_and_interpreted_records_are_the_same(grammar, lots, options, tmp_path, monkeypatch):

@@ -3,21 +3,24 @@ as the interpreter lays it."""
 
 from __future__ import annotations
 
-from test_fused import assert_same, both, cityengine_lots
+from test_fused import assert_same, both, cityengine_lots, fused_always  # noqa: F401 - an autouse fixture
 
 from grammarc.backend.plan import make_plan
 from grammarc.compiler import compile_grammar
 
-#: ``F`` (the lot's shape, split from its polygon) inlines ``A``, ``A2`` and ``B`` (each named once): a split
-#: without repeat groups, two repeated as a whole whose sizes all float, and one with repeat groups among
-#: fixed parts.
+#: ``F`` (the lot's shape, split from its polygon) inlines the others (each named once): a split without
+#: repeat groups (``F``'s own); splits with one group: repeated as a whole (``A``, ``A2``), among floating
+#: parts as window rows are written (``H``), of fixed sizes only, what they leave a gap (``G``); and a split
+#: of two groups (``B``), which the interpreter's row functions lay.
 FORMS = """
 version "2023.0"
 Lot --> split(x){ ~100: F }*
-F --> s('1, 8, '1) split(x){ 1: A | ~2: B | '0.2: A2 }
+F --> s('1, 8, '1) split(x){ 1: A | ~2: B | '0.2: A2 | 1.5: G | ~3: H }
 A --> split(y){ ~1.5: C. | ~0.5: D. }*
 A2 --> split(y){ ~1: C. }*
-B --> split(y){ 0.5: C. | { ~1: D. | 0.2: C. }* | 0.5: D. }
+B --> split(y){ 0.5: C. | { ~1: D. | 0.2: C. }* | 0.5: D. | { ~2: C. }* }
+G --> split(y){ { 0.7: C. | 0.2: D. }* | ~1: C. | '0.1: D. }
+H --> split(y){ 0.3: C. | { ~1.2: D. | 0.25: C. }* | ~1.2: D. | 0.3: C. }
 """
 
 
@@ -26,7 +29,7 @@ def test_each_form_is_written_as_it_should_be(write):
     root = plan.symbol_ids["F"]
     text = plan.fused[root].source.text.split("def derive(")[-1]
     assert text.count("plan_row(") == text.count("lay_row(") == 1  # ``B``, whose groups are laid by calls
-    assert text.count("repetitions(") == 2  # ``A`` and ``A2``, written out around PRT's rounding
+    assert text.count("repetitions(") == 4  # the splits of one group, written out around PRT's rounding
 
 
 def test_each_form_lays_the_interpreters_parts(write, monkeypatch):
