@@ -21,10 +21,10 @@ records and shapes are due: a site of the root at once, a site of an inlined sym
 comes.
 
 CityEngine's dialect: a ``split`` is laid by the interpreter's own kernels (``kernels.split.plan_row`` and
-``lay_row``), called on the one parent, or their arithmetic written out (``group_splits``); a shape's state in PRT's stream is a variable that
-successors, ``[`` and ``NIL`` move on with ``prt_random``'s steps, and a split's pieces start where their
-parent's stream stands after the pieces before them; a body that hands its shape to nothing ends in a leaf
-of its rule's symbol, an instance of the asset where an ``i`` made it one.
+``lay_row``), called on the one parent, or their arithmetic written out (``group_splits``); a shape's state
+in PRT's stream is a variable that successors, ``[`` and ``NIL`` move on with ``prt_random``'s steps, and a
+split's pieces start where their parent's stream stands after the pieces before them; a body that hands its
+shape to nothing ends in a leaf of its rule's symbol, an instance of the asset where an ``i`` made it one.
 """
 
 from __future__ import annotations
