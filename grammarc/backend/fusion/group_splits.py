@@ -6,8 +6,8 @@ row, called here for one parent on arrays made once per batch. A kernel lays eac
 pass and its write pass), where the interpreter lays it once per batch, so the commonest forms are written
 out with the same arithmetic in the same order, no call and no array: a split without repeat groups, and
 a split with one (a window row ``{ ~w: Window | d: Wall }* | ~w: Window``; a split repeated as a whole is
-one group). A split's pieces take their states in
-PRT's stream where their parent's stands after the pieces before them.
+one group). A split's pieces take their states in PRT's stream where their parent's stands after the pieces
+before them.
 
 ``SplitWriter`` is a part of ``codegen._Writer``, whose ``put``, ``fresh``, ``check``, ``expr`` and ``child``
 it writes with.
@@ -33,11 +33,8 @@ class SplitWriter:
         children's grown as a parent needs), negative sizes taken as 0 and a NaN one refused, parts of
         ``TOL.merge`` or less not made; then the children in order, each in its part's body."""
         kind, groups, n_groups = group_arrays(op)
-        if not n_groups:
-            self.ungrouped_split(op, kind.tolist(), block, scope, level, depth)
-            return
-        if n_groups == 1:  # its parts are one run: a group is written between braces
-            self.one_group(op, kind.tolist(), groups.tolist(), block, scope, level, depth)
+        if n_groups <= 1:  # a group's parts are one run: it is written between braces
+            self.written_out(op, kind.tolist(), groups.tolist(), block, scope, level, depth)
             return
         slots, parts = n_groups, len(op.sizes)  # the splits of fewer groups are written out above
         tables = self.fresh("kind"), self.fresh("group")
@@ -78,41 +75,23 @@ class SplitWriter:
             self.put(inner + 1, f"{'if' if k == 0 else 'elif'} {made[1]}[{c}] == {k}:")
             self.child(part, block, scope, op.axis, f"{made[2]}[{c}]", f"{made[3]}[{c}]", inner + 2, depth, key)
 
-    def ungrouped_split(self, op: ir.GroupSplit, kind: list[int], block: Block, scope: Scope, level: int,
-                        depth: int) -> None:
-        """``group_split`` of a split without repeat groups, ``plan_row`` and ``lay_row`` written out (their
-        arithmetic in their order, no call and no array per parent): the fixed (and relative) sizes and
-        the floating ones summed apart, the floating ones scaled to fill what the others leave, the parts
-        laid end to end, each in place."""
-        extent, values = scope.size[op.axis], self.sizes(op, scope, level)
-        self.put(level, f"elif not ({float(len(values))!r} <= limit):")  # beyond --max-shapes
-        self.put(level + 1, "bad[i] = True")
-        self.put(level, "else:")
-        level += 1
-        fixed, floating, scale, at, stream = (self.fresh(stem) for stem in ("fx", "fl", "sc", "at", "ks"))
-        self.put(level, f"{fixed} = 0.0")
-        self.put(level, f"{floating} = 0.0")
-        for value, k in zip(values, kind):
-            self.put(level, f"{floating if k == 2 else fixed} += {f'{value} * {extent}' if k == 1 else value}")
-        self.put(level, f"{scale} = max({extent} - {fixed}, 0.0) / {floating} if {floating} > 0.0 else 1.0")
-        self.put(level, f"{at} = 0.0")
-        self.put(level, f"{stream} = {scope.key}")
-        self.lay(op, values, kind, range(len(values)), scale, at, stream, block, scope, level, depth)
-
-    def one_group(self, op: ir.GroupSplit, kind: list[int], groups: list[int], block: Block, scope: Scope,
-                  level: int, depth: int) -> None:
-        """``group_split`` of a split with one repeat group (``{ ~a: A | b: B }* | ~c: C``, or a split repeated
-        as a whole), ``plan_row`` and ``lay_row`` written out for it (their arithmetic in their order, one
-        group's): the sizes outside the group and the group's own summed apart, fixed and floating; the
-        group repeated as often as brings its floating parts nearest their written sizes (``repetitions``,
-        PRT's rounding), or, all its sizes fixed, as often as it fits, what is left a gap after it; the
-        floating sizes scaled to fill the extent."""
+    def written_out(self, op: ir.GroupSplit, kind: list[int], groups: list[int], block: Block, scope: Scope,
+                    level: int, depth: int) -> None:
+        """``group_split`` of a split of no repeat group or one (``{ ~a: A | b: B }* | ~c: C``, or a split
+        repeated as a whole), ``plan_row`` and ``lay_row`` written out (their arithmetic in their order, no
+        call and no array per parent): the sizes outside the group and the group's own summed apart, fixed
+        and floating; the group repeated (``repeated``); the floating sizes scaled to fill the extent; the
+        parts laid end to end, each in place, the group's as often as it repeats."""
         extent, values = scope.size[op.axis], self.sizes(op, scope, level)
         self.put(level, "else:")
         level += 1
-        fixed, floating, nominal, group_fixed, group_float, left, reps, gap, scale, total, share, times = (
-            self.fresh(stem) for stem in ("fx", "fl", "nm", "gx", "gf", "lf", "rp", "gp", "sc", "tt", "sh", "x"))
-        for name in (fixed, floating, nominal, group_fixed, group_float):
+        inside = [j for j, g in enumerate(groups) if g >= 0]
+        fixed, floating, scale, total = (self.fresh(stem) for stem in ("fx", "fl", "sc", "tt"))
+        sums = [fixed, floating]
+        if inside:
+            nominal, group_fixed, group_float = (self.fresh(stem) for stem in ("nm", "gx", "gf"))
+            sums += [nominal, group_fixed, group_float]
+        for name in sums:
             self.put(level, f"{name} = 0.0")
         for value, k, g in zip(values, kind, groups):
             size = value
@@ -124,12 +103,45 @@ class SplitWriter:
             else:
                 self.put(level, f"{nominal} += {size}")
                 self.put(level, f"{group_float if k == 2 else group_fixed} += {size}")
+        self.put(level, f"{scale} = 1.0")
+        self.put(level, f"{total} = 0.0")
+        if inside:
+            reps, gap = self.repeated(extent, fixed, floating, nominal, group_fixed, group_float, total, level)
+        self.put(level, f"if {floating} > 0.0:")
+        self.put(level + 1, f"{scale} = max({extent} - {fixed}, 0.0) / {floating}")
+        for g in groups:
+            self.put(level, f"{total} += {'1.0' if g < 0 else f'float({reps})'}")
+        self.put(level, f"if not ({total} <= limit):")  # beyond --max-shapes: the interpreter fails it
+        self.put(level + 1, "bad[i] = True")
+        self.put(level, "else:")
+        level += 1
+        at, stream = self.fresh("at"), self.fresh("ks")
+        self.put(level, f"{at} = 0.0")
+        self.put(level, f"{stream} = {scope.key}")
+        if not inside:
+            self.lay(op, values, kind, range(len(values)), scale, at, stream, block, scope, level, depth)
+            return
+        self.lay(op, values, kind, range(inside[0]), scale, at, stream, block, scope, level, depth)
+        self.put(level, f"for _ in range({reps}):")
+        self.put(level + 1, "if n > limit:")
+        self.put(level + 2, "break")
+        self.lay(op, values, kind, inside, scale, at, stream, block, scope, level + 1, depth)
+        self.put(level, f"{at} += {gap}")
+        self.lay(op, values, kind, range(inside[-1] + 1, len(values)), scale, at, stream, block, scope, level, depth)
+
+    def repeated(self, extent: str, fixed: str, floating: str, nominal: str, group_fixed: str, group_float: str,
+                 total: str, level: int) -> tuple[str, str]:
+        """``plan_row``'s repetitions of a split's one group, of ``nominal`` size (``group_fixed`` of it fixed,
+        ``group_float`` floating) in what the sizes outside it leave (``fixed`` and ``floating``, which take
+        its repetitions' share): as many as bring its floating parts nearest their written sizes
+        (``repetitions``, PRT's rounding), or, all its sizes fixed, as many as fit, what is left a gap after
+        them; one too small to lay counts into ``total`` what it would make. The variables of the count and
+        the gap."""
+        left, reps, gap, share, times = (self.fresh(stem) for stem in ("lf", "rp", "gp", "sh", "x"))
         self.put(level, f"{left} = max({extent} - {fixed} - {floating}, 0.0)")
         self.put(level, f"{reps} = 0")
         self.put(level, f"{gap} = 0.0")
-        self.put(level, f"{scale} = 1.0")
-        self.put(level, f"{total} = 0.0")
-        self.put(level, f"if {nominal} <= {TOL.zero!r}:")  # a repetition too small to lay counts what it would make
+        self.put(level, f"if {nominal} <= {TOL.zero!r}:")
         self.put(level + 1, f"if {nominal} > 0.0 and {left} > {TOL.zero!r}:")
         self.put(level + 2, f"{total} += {left} / {nominal}")
         self.put(level, "else:")
@@ -145,25 +157,7 @@ class SplitWriter:
         self.put(level + 2, f"{gap} = {share} - {reps} * {nominal}")
         self.put(level + 1, f"{fixed} += {reps} * {group_fixed} + {gap}")
         self.put(level + 1, f"{floating} += {reps} * {group_float}")
-        self.put(level, f"if {floating} > 0.0:")
-        self.put(level + 1, f"{scale} = max({extent} - {fixed}, 0.0) / {floating}")
-        for g in groups:
-            self.put(level, f"{total} += {'1.0' if g < 0 else f'float({reps})'}")
-        self.put(level, f"if not ({total} <= limit):")  # beyond --max-shapes: the interpreter fails it
-        self.put(level + 1, "bad[i] = True")
-        self.put(level, "else:")
-        level += 1
-        at, stream = self.fresh("at"), self.fresh("ks")
-        self.put(level, f"{at} = 0.0")
-        self.put(level, f"{stream} = {scope.key}")
-        inside = [j for j, g in enumerate(groups) if g >= 0]
-        self.lay(op, values, kind, range(inside[0]), scale, at, stream, block, scope, level, depth)
-        self.put(level, f"for _ in range({reps}):")
-        self.put(level + 1, "if n > limit:")
-        self.put(level + 2, "break")
-        self.lay(op, values, kind, inside, scale, at, stream, block, scope, level + 1, depth)
-        self.put(level, f"{at} += {gap}")
-        self.lay(op, values, kind, range(inside[-1] + 1, len(values)), scale, at, stream, block, scope, level, depth)
+        return reps, gap
 
     def sizes(self, op: ir.GroupSplit, scope: Scope, level: int) -> list[str]:
         """The variables of a split's sizes, a negative one taken as 0; the parent flagged where one is NaN
