@@ -20,8 +20,8 @@ import numpy as np
 
 from grammarc.ir import nodes as ir
 
-#: The transparency's place in the packed colour.
-_ALPHA_UNIT = float(1 << 24)
+#: The transparency's place in the packed colour (a fused kernel packs colours too: ``fusion.codegen``).
+ALPHA_UNIT = float(1 << 24)
 #: The texture channel columns' names, in the record's order.
 MAP_FIELDS = tuple(f"material.{m}" for m in ir.MATERIAL_MAPS)
 #: The material attributes read from the colour column.
@@ -40,15 +40,26 @@ def rgba(packed: np.ndarray) -> np.ndarray:
     return out
 
 
+def hex_color(text: str) -> float:
+    """0xRRGGBB of "#rrggbb" (or "#rgb"), NaN when the text is no such colour."""
+    digits = text.strip().lstrip("#")
+    if len(digits) == 3:
+        digits = "".join(c * 2 for c in digits)
+    try:
+        return float(int(digits, 16)) if len(digits) == 6 else float("nan")
+    except ValueError:
+        return float("nan")
+
+
 def with_transparency_of(rgb: np.ndarray, packed: np.ndarray) -> np.ndarray:
     """New colours 0xRRGGBB (n,) keeping the transparency of the shapes' packed colours (n,)."""
-    return rgb + np.floor(packed / _ALPHA_UNIT) * _ALPHA_UNIT
+    return rgb + np.floor(packed / ALPHA_UNIT) * ALPHA_UNIT
 
 
 def with_opacity(packed: np.ndarray, opacity: np.ndarray) -> np.ndarray:
     """The packed colours (n,) with a new opacity (n,) in [0, 1] (clipped)."""
     transparency = 255 - np.round(np.clip(opacity, 0.0, 1.0) * 255)
-    return packed % _ALPHA_UNIT + transparency * _ALPHA_UNIT
+    return packed % ALPHA_UNIT + transparency * ALPHA_UNIT
 
 
 def channel(name: str, packed: np.ndarray | None):

@@ -6,7 +6,9 @@ children (or one block per ``Subdiv`` part), a guard an ``if``, a successor the 
 where the region inlines it and else a *hand-off site* (its shapes written out), an ``I`` or a leaf an
 *emission site*. The scope travels in local variables (origin and size per axis; the frame stays the
 parent's: no operation of a region turns it), the random key as an expression evaluated only where a shape
-is handed off. The runner calls it twice (one function to compile, not two). Counting, ``sites[k]`` adds
+is handed off, and so do the per-shape columns the region writes (``set``, ``color``: ``Scope.written``),
+whose values the kernel writes beside each record and shape handed off below them (``record_written``,
+``handed[8]``). The runner calls it twice (one function to compile, not two). Counting, ``sites[k]`` adds
 up the records site k makes and ``handoffs[k]`` the shapes hand-off site k makes; ``made`` the shapes each
 parent makes (as the interpreter counts them for --max-shapes), and ``bad`` flags parents the interpreter
 would fail (a negative size, a repeat beyond the limit). Writing, ``sites[k]`` is site k's next row, where
@@ -41,7 +43,9 @@ from grammarc.backend.fusion.group_splits import SplitWriter
 from grammarc.backend.fusion.regions import ENDING, SIZES, Fusible, applied_rules
 from grammarc.backend.fusion.sites import Block, Emit, Handoff, Scope
 from grammarc.backend.kernels.split import MAX_COUNT
+from grammarc.backend.materials import ALPHA_UNIT, hex_color
 from grammarc.backend.shapes import asset_geom
+from grammarc.backend.slots import COLOR_SLOT
 from grammarc.constants import TOL
 from grammarc.ir import nodes as ir
 from grammarc.ir.asset_names import LEAF_CUBE, LEAF_QUAD
@@ -53,7 +57,9 @@ class Source:
     order), its numbers of sites and of hand-off sites, the most parameters a shape handed off has, how
     many symbols deep it reaches below its root, and whether it writes the root row each record and shape
     handed off comes from (``carries``: where the grammar's shapes carry per-shape columns, ``Plan.dynamic``,
-    which pass unchanged from a root to everything the region makes of it: ``regions``)."""
+    which pass from a root to everything the region makes of it: ``regions``); the slots of the columns
+    the region writes (``written``: the rows of the kernel's ``record_written`` and of the shapes'
+    ``handed[8]``), and whether it reads colours from the table of the interned strings (``hexes``)."""
 
     text: str
     block: Block
@@ -63,6 +69,8 @@ class Source:
     params: int
     depth: int
     carries: bool
+    written: tuple[int, ...] = ()
+    hexes: bool = False
 
 
 #: The modules whose compiled functions a kernel calls (``HEADER``'s imports).
@@ -121,7 +129,7 @@ def generate(fusible: Fusible, root: int) -> Source:
     writer.function(root)
     text = HEADER.format(called=called_code()) + "".join(f"{line}\n" for line in [*writer.constants, *writer.lines])
     return Source(text, writer.block, tuple(writer.attrs), writer.sites, writer.handoffs, writer.params, writer.depth,
-                  writer.carries)
+                  writer.carries, tuple(writer.written), writer.hexes)
 
 
 class _Writer(SplitWriter):
@@ -138,6 +146,8 @@ class _Writer(SplitWriter):
         self.attrs: list[str] = []
         self.sequential = self.plan.sequential_random
         self.carries = bool(self.plan.dynamic)
+        self.written: list[int] = []  # the slots of the columns the region writes, in the order met
+        self.hexes = False
         self.names = count()
         self.sites = 0
         self.handoffs = 0
@@ -165,8 +175,8 @@ class _Writer(SplitWriter):
         self.lines += ["        made[i] = n", "        if n > limit:", "            bad[i] = True"]
         columns = "".join(f"q{k}, " for k in range(len(root_params))) + "".join(
             f"a{k}, " for k in range(len(self.attrs)))
-        self.lines[1] = (f"def derive(origin, size, frame, lot, key, depth, frames, {columns}base, limit, writing, "
-                         "sites, made, bad, xform, record_lot, record_row, handoffs, handed):")
+        self.lines[1] = (f"def derive(origin, size, frame, lot, key, depth, frames, {columns}base, hexes, limit, "
+                         "writing, sites, made, bad, xform, record_lot, record_row, record_written, handoffs, handed):")
         self.lines[2:2] = ["    " + line for line in self.prologue]
 
     def put(self, level: int, line: str) -> None:
@@ -279,6 +289,10 @@ class _Writer(SplitWriter):
                 self.stochastic(op, block, scope, level, depth)
             elif isinstance(op, ir.Empty) and self.sequential:  # ``NIL`` moves the stream on (``streams.skip``)
                 scope = scope._replace(key=self.moved(scope, level))
+            elif isinstance(op, ir.SetAttr):
+                scope = self.write(scope, self.plan.dynamic[op.name], self.expr(op.value, scope), level)
+            elif isinstance(op, ir.SetColor):
+                scope = self.write(scope, self.plan.color_slot, self.color(op, scope, level), level)
         if self.plan.leaf_bodies and not any(isinstance(op, ENDING) for op in body):
             self.leaf(block, block.symbol, scope, level)
 
@@ -375,6 +389,37 @@ class _Writer(SplitWriter):
         self.within_coordinates(level, new)
         return tuple(new)
 
+    def write(self, scope: Scope, slot: int, value: str, level: int) -> Scope:
+        """``scope`` with the per-shape column ``slot`` set to ``value``, held in a variable of its own."""
+        name = self.fresh("w")
+        self.put(level, f"{name} = np.float64({value})")
+        if slot not in self.written:
+            self.written.append(slot)
+        return scope._replace(written=tuple(sorted({**dict(scope.written), slot: name}.items())))
+
+    def color(self, op: ir.SetColor, scope: Scope, level: int) -> str:
+        """``operations.values.set_color``: 0xRRGGBB from components in [0, 1] (rounded to even, clipped) or
+        from "#rrggbb" (a constant's, or looked up in ``hexes`` by the id of an attribute's: a text that is
+        no colour fails the lot), with the transparency of the shape's colour before
+        (``materials.with_transparency_of``)."""
+        if len(op.values) == 3:
+            parts = []
+            for value in op.values:  # ``np.clip``'s bounds as numpy compares them (a NaN kept, -0.0 made 0.0)
+                channel, parts = self.fresh("cc"), [*parts, self.fresh("cc")]
+                self.put(level, f"{channel} = np.rint(np.float64({self.expr(value, scope)}) * 255.0)")
+                self.put(level, f"{channel} = {channel} if np.isnan({channel}) or {channel} > 0.0 else 0.0")
+                self.put(level, f"{parts[-1]} = {channel} if np.isnan({channel}) or {channel} < 255.0 else 255.0")
+            rgb = f"{parts[0]} * 65536.0 + {parts[1]} * 256.0 + {parts[2]}"
+        elif isinstance(op.values[0], ir.Str):
+            rgb = repr(hex_color(op.values[0].value))  # a colour (``regions`` refuses a text that is none)
+        else:
+            self.hexes = True
+            rgb = self.fresh("hx")
+            self.put(level, f"{rgb} = hexes[int({self.expr(op.values[0], scope)})]")
+            self.check(level, f"not np.isnan({rgb})")
+        before = self.attribute(COLOR_SLOT, scope)
+        return f"({rgb}) + np.floor({before} / {ALPHA_UNIT!r}) * {ALPHA_UNIT!r}"
+
     def split(self, op: ir.Split, block: Block, scope: Scope, level: int, depth: int) -> None:
         """``kernels.split.subdiv`` for one parent: relative sizes share what the absolute ones leave, parts
         laid end to end, cut at the scope's end, those of length ``TOL.zero`` or less dropped."""
@@ -448,13 +493,14 @@ class _Writer(SplitWriter):
 
     def emit(self, block: Block, asset: int, symbol: int, scope: Scope, level: int) -> None:
         """An emission site of ``asset`` and its record of the scope."""
-        self.record(self.site(block, asset, symbol), scope, level)
+        self.record(self.site(block, asset, symbol, scope), scope, level)
 
-    def site(self, block: Block, asset: int, symbol: int, leaf: bool = False, inserted: bool = False) -> int:
-        """A new emission site, due in ``block``'s order where it is met."""
+    def site(self, block: Block, asset: int, symbol: int, scope: Scope, leaf: bool = False,
+             inserted: bool = False) -> int:
+        """A new emission site of records of ``scope``, due in ``block``'s order where it is met."""
         site = self.sites
         self.sites += 1
-        block.events.append(Emit(site, asset, symbol, leaf, inserted))
+        block.events.append(Emit(site, asset, symbol, leaf, inserted, tuple(slot for slot, _ in scope.written)))
         return site
 
     def record(self, site: int, scope: Scope, level: int) -> None:
@@ -462,14 +508,17 @@ class _Writer(SplitWriter):
         self.put(level, "if writing:")
         self.put(level + 1, f"put_record(xform, record_lot, sites[{site}], frames, f, l, base, 0, 1, 2, "
                             f"{', '.join(scope.size)}, {', '.join(scope.origin)})")
-        self.rooted(level + 1, f"record_row[sites[{site}]]")
+        self.rooted(level + 1, scope, "record_row", "record_written", f"sites[{site}]")
         self.put(level, f"sites[{site}] += 1")
 
-    def rooted(self, level: int, target: str) -> None:
+    def rooted(self, level: int, scope: Scope, rows: str, written: str, row: str) -> None:
         """Where the region ``carries`` per-shape columns: the row of the root that a record or a shape
-        handed off comes from, into ``target``."""
+        handed off comes from, into ``rows[row]``, and the values of the columns the region wrote, into
+        their rows of ``written``."""
         if self.carries:
-            self.put(level, f"{target} = i")
+            self.put(level, f"{rows}[{row}] = i")
+        for slot, value in scope.written:
+            self.put(level, f"{written}[{self.written.index(slot)}, {row}] = {value}")
 
     def leaf(self, block: Block, symbol: int, scope: Scope, level: int) -> None:
         """A leaf of ``symbol`` as ``terminals.emit_leaves`` makes it, which emits a batch's cubes, then its
@@ -481,8 +530,8 @@ class _Writer(SplitWriter):
             self.emit(block, scope.asset, symbol, scope, level)
             return
         assets = self.plan.grammar.module.assets
-        cube = self.site(block, assets.index(LEAF_CUBE), symbol, True, scope.inserted)
-        quad = self.site(block, assets.index(LEAF_QUAD), symbol, True)
+        cube = self.site(block, assets.index(LEAF_CUBE), symbol, scope, True, scope.inserted)
+        quad = self.site(block, assets.index(LEAF_QUAD), symbol, scope, True)
         flat = [f"{size} <= {TOL.zero!r}" for size in scope.size]
         count, a, b, k, za, zb = (self.fresh(stem) for stem in ("z", "qa", "qb", "qk", "za", "zb"))
         self.put(level, f"{count} = ({flat[0]}) + ({flat[1]}) + ({flat[2]})")
@@ -497,7 +546,7 @@ class _Writer(SplitWriter):
         self.put(level + 1, "if writing:")
         self.put(level + 2, f"put_record(xform, record_lot, sites[{quad}], frames, f, l, base, {a}, {b}, {k}, "
                             f"{za}, {zb}, 0.0, {', '.join(scope.origin)})")
-        self.rooted(level + 2, f"record_row[sites[{quad}]]")
+        self.rooted(level + 2, scope, "record_row", "record_written", f"sites[{quad}]")
         self.put(level + 1, f"sites[{quad}] += 1")
 
     def handoff(self, block: Block, symbol: int, scope: Scope, level: int, depth: int) -> None:
@@ -507,7 +556,7 @@ class _Writer(SplitWriter):
         self.handoffs += 1
         self.params = max(self.params, len(scope.params))
         block.events.append(Handoff(site, symbol, int(asset_geom(scope.asset)) if scope.asset >= 0 else -1,
-                                    scope.inserted))
+                                    scope.inserted, tuple(slot for slot, _ in scope.written)))
         self.put(level, "if writing:")
         row = self.fresh("h")
         self.put(level + 1, f"{row} = handoffs[{site}]")
@@ -515,7 +564,7 @@ class _Writer(SplitWriter):
                             f"{scope.key}, depth[i] + {depth})")
         for k, value in enumerate(scope.params):
             self.put(level + 1, f"handed[6][{k}, {row}] = {value}")
-        self.rooted(level + 1, f"handed[7][{row}]")
+        self.rooted(level + 1, scope, "handed[7]", "handed[8]", row)
         self.put(level, f"handoffs[{site}] += 1")
 
     def made(self, level: int) -> None:
@@ -533,6 +582,17 @@ class _Writer(SplitWriter):
         self.check(level, " and ".join(f"abs({o}) <= {TOL.far!r}" for o in origin))
 
     # ------------------------------------------------------------------------------------------ expressions
+    def attribute(self, name: str, scope: Scope) -> str:
+        """The value of attribute ``name``: the variable the region set it in, else its column (the kernel's
+        arguments ``a0``, ``a1``...), read by root row where the shapes carry it, else by lot."""
+        slot = self.plan.dynamic.get(name)
+        written = dict(scope.written)
+        if slot in written:
+            return written[slot]
+        if name not in self.attrs:
+            self.attrs.append(name)
+        return f"a{self.attrs.index(name)}[{'i' if slot is not None else 'l'}]"
+
     def expr(self, expr: ir.Expr, scope: Scope) -> str:
         """``expr`` as numba source: numbers as float64 literals, attributes read by lot (those the shapes
         carry by root), parameters and ``scope.s*`` from the scope's variables, operators and functions as
@@ -540,13 +600,13 @@ class _Writer(SplitWriter):
         ``rand``'s scaled draw, ``p``'s draw below its probability)."""
         if isinstance(expr, ir.Bool):
             return repr(bool(expr.value))
+        if isinstance(expr, ir.Str):  # compared with another string (``regions``): its interned id
+            return repr(float(self.plan.strings.ids[expr.value]))
         if isinstance(expr, ir.Num):
             value = float(expr.value)
             return repr(value) if math.isfinite(value) else f"np.float64({str(value)!r})"
-        if isinstance(expr, ir.AttrRef):  # a per-shape column is the root's: no fused operation writes one
-            if expr.name not in self.attrs:
-                self.attrs.append(expr.name)
-            return f"a{self.attrs.index(expr.name)}[{'i' if expr.name in self.plan.dynamic else 'l'}]"
+        if isinstance(expr, ir.AttrRef):
+            return self.attribute(expr.name, scope)
         if isinstance(expr, ir.Param):
             return scope.params[expr.index]
         if isinstance(expr, ir.ScopeRef):

@@ -60,9 +60,10 @@ def kernel(text: str, columns: int):
         return _KERNELS[text]
     module, path = load(text)
     rows = [np.zeros((0, 3)), np.zeros((0, 3)), np.zeros(0, np.int32), np.zeros(0, np.int32), np.zeros(0, np.uint64),
-            np.zeros(0, np.int32), np.zeros((1, 3, 3)), *(np.zeros(0) for _ in range(columns)), np.zeros((0, 3)), 0.0,
-            False, np.zeros(0, np.int64), np.zeros(0), np.zeros(0, np.bool_), np.zeros((0, 3, 4), np.float32),
-            np.zeros(0, np.int32), np.zeros(0, np.int64), np.zeros(0, np.int64), handed_columns(0, 0)]
+            np.zeros(0, np.int32), np.zeros((1, 3, 3)), *(np.zeros(0) for _ in range(columns)), np.zeros((0, 3)),
+            np.zeros(0), 0.0, False, np.zeros(0, np.int64), np.zeros(0), np.zeros(0, np.bool_),
+            np.zeros((0, 3, 4), np.float32), np.zeros(0, np.int32), np.zeros(0, np.int64), np.zeros((0, 0)),
+            np.zeros(0, np.int64), handed_columns(0, 0)]
     with _locked(path.with_suffix(".lock")):
         module.derive(*rows)
     user_cache.store(path.with_suffix(".compiled"), lambda f: None)
@@ -111,13 +112,14 @@ def compiled_before(text: str) -> bool:
     return folder is not None and bool(user_cache.load(folder / f"region_{digest(text)}.compiled", lambda f: True))
 
 
-def handed_columns(rows: int, params: int, carries: bool = False) -> tuple:
+def handed_columns(rows: int, params: int, carries: bool = False, written: int = 0) -> tuple:
     """The columns of ``rows`` shapes a kernel hands off (``codegen._Writer.handoff``): origin, size, frame,
-    lot, key, depth, ``params`` parameters (params, rows), and the rows of the roots they come from where
-    the kernel ``carries`` per-shape columns (else none)."""
+    lot, key, depth, ``params`` parameters (params, rows), the rows of the roots they come from where
+    the kernel ``carries`` per-shape columns (else none), and the values of the ``written`` columns the
+    region writes (written, rows)."""
     return (np.empty((rows, 3)), np.empty((rows, 3)), np.empty(rows, np.int32), np.empty(rows, np.int32),
             np.empty(rows, np.uint64), np.empty(rows, np.int32), np.empty((params, rows)),
-            np.empty(rows if carries else 0, np.int64))
+            np.empty(rows if carries else 0, np.int64), np.empty((written, rows)))
 
 
 @contextmanager

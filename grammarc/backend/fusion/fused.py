@@ -8,22 +8,24 @@ root's own records are emitted at once; those of each inlined symbol wait in tha
 schedule reaches it, where the interpreter would have run its rules on the shapes handed to it.
 
 Where the grammar's shapes carry per-shape columns (colours, texture channels and coordinates, trim planes,
-attributes rules ``set``...: ``Plan.dynamic``), no operation of a region writes them (``regions``), so a
-record or a shape handed off has its root's: the kernel writes the root's row beside each, and its records
-are placed as the interpreter places them from those rows (``terminals.place_instances``: cut at trim
-planes, coloured, textured).
+attributes rules ``set``...: ``Plan.dynamic``), a record or a shape handed off has its root's, but for those
+the region wrote on its way (``set``, ``color``: ``regions``): the kernel writes the root's row beside each,
+and the values it wrote; its records are placed as the interpreter places them from those columns
+(``terminals.place_instances``: cut at trim planes, coloured, textured).
 """
 
 from __future__ import annotations
 
+import weakref
 from collections.abc import Iterator
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
 from grammarc.backend import terminals
 from grammarc.backend.fusion.compiled import compiled_before, handed_columns, kernel, ready
 from grammarc.backend.fusion.sites import Block, Emit, Handoff
+from grammarc.backend.materials import hex_color
 from grammarc.backend.shapes import Shapes
 from grammarc.ragged import offsets_from_counts
 
@@ -32,8 +34,9 @@ from grammarc.ragged import offsets_from_counts
 class FusedRecords:
     """The records a region's kernel wrote, by site: site k's are rows ``starts[k]`` to ``starts[k + 1]``; and
     the shapes it handed off (``handed``: origin, size, frame, lot, key, depth, parameters (p, h), root
-    rows), hand-off site k's rows ``handoff_starts[k]`` to ``handoff_starts[k + 1]``. Where the kernel
-    carries per-shape columns, ``root`` is its batch and ``row`` the root row of each record (else None)."""
+    rows, written columns (w, h)), hand-off site k's rows ``handoff_starts[k]`` to ``handoff_starts[k + 1]``.
+    Where the kernel carries per-shape columns, ``root`` is its batch, ``row`` the root row of each record
+    (else None), and ``written`` (w, m) the values of the columns ``slots`` that the region wrote."""
 
     xform: np.ndarray  # (m, 3, 4) float32
     lot: np.ndarray  # (m,) int32
@@ -42,17 +45,27 @@ class FusedRecords:
     handoff_starts: np.ndarray  # (handoff sites + 1,) int64
     root: Shapes | None = None
     row: np.ndarray | None = None  # (m,) int64
+    written: np.ndarray | None = None  # (w, m) float64
+    slots: tuple[int, ...] = ()
 
     def shapes(self, plan, handoff: Handoff) -> Shapes:
-        """The shapes of ``handoff``, with their roots' per-shape columns (their geometry inserted where an
-        ``i`` made it)."""
+        """The shapes of ``handoff``, with their roots' per-shape columns but those the region wrote (their
+        geometry inserted where an ``i`` made it)."""
         a, b = self.handoff_starts[handoff.site], self.handoff_starts[handoff.site + 1]
-        origin, size, frame, lot, key, depth, values, row = self.handed
+        origin, size, frame, lot, key, depth, values, row, written = self.handed
         params = len(plan.symbols[handoff.symbol].param_types)
-        dynamic = () if self.root is None else tuple(d[row[a:b]] for d in self.root.dynamic)
+        dynamic = () if self.root is None else self._columns(row[a:b], handoff.written, written[:, a:b])
         made = Shapes(origin[a:b], size[a:b], frame[a:b], np.full(b - a, handoff.geom, np.int32), lot[a:b],
                       key[a:b], depth[a:b], tuple(values[k, a:b] for k in range(params)), dynamic)
         return terminals.marked_inserted(plan, made, True) if handoff.inserted else made
+
+    def _columns(self, rows: np.ndarray, slots: tuple[int, ...], written: np.ndarray) -> tuple:
+        """The per-shape columns of shapes made of the roots ``rows``: their roots', but the ``slots`` the
+        region wrote, whose values are the rows of ``written`` (w, m), in the roots' columns' types."""
+        columns = [column if k in slots else column[rows] for k, column in enumerate(self.root.dynamic)]
+        for slot in slots:
+            columns[slot] = written[self.slots.index(slot)].astype(columns[slot].dtype)
+        return tuple(columns)
 
     def emit(self, ctx, event: Emit, a: int, b: int) -> None:
         """Append the records ``a`` to ``b`` of emission site ``event``: placed from their roots' rows, as
@@ -62,15 +75,18 @@ class FusedRecords:
         if self.root is None:
             terminals.append_records(ctx, xform, self.lot[a:b], event.asset, event.symbol, None)
             return
-        rows = self.row[a:b]
+        shapes, rows = self.root, self.row[a:b]
+        if event.written:  # the records' own columns, the roots' but those the region wrote
+            shapes = replace(shapes.take(rows), dynamic=self._columns(rows, event.written, self.written[:, a:b]))
+            rows = np.arange(b - a)
         if event.leaf and event.asset == terminals.QUAD:  # a leaf quad is never cut
-            terminals.append_instances(ctx, self.root, rows, xform, event.asset, event.symbol)
+            terminals.append_instances(ctx, shapes, rows, xform, event.asset, event.symbol)
             return
         slot = ctx.plan.inserted_slot
         inserted = None
         if event.leaf and not event.inserted and slot is not None:  # a leaf box: cut where its root was inserted
-            inserted = self.root.dynamic[slot][rows] == 1
-        terminals.place_instances(ctx, self.root, rows, xform, event.asset, event.symbol, event.leaf, inserted)
+            inserted = shapes.dynamic[slot][rows] == 1
+        terminals.place_instances(ctx, shapes, rows, xform, event.asset, event.symbol, event.leaf, inserted)
 
 
 @dataclass(frozen=True, eq=False)
@@ -114,11 +130,12 @@ def derive(ctx, region, shapes: Shapes) -> bool:
     sites, made, bad = np.zeros(source.sites, np.int64), np.empty(n), np.zeros(n, np.bool_)
     handoffs = np.zeros(source.handoffs, np.int64)
     # contiguous, as the kernel was compiled for (``compiled.kernel``): a copy only where one is not
+    hexes = _hexes(ctx.plan.strings) if source.hexes else np.empty(0)
     columns = (*map(np.ascontiguousarray, (shapes.origin, shapes.size, shapes.frame, shapes.lot, shapes.key,
                                            shapes.depth, chunk.frames.data, *attrs, chunk.lot_origin)),
-               float(limits.max_shapes))
+               hexes, float(limits.max_shapes))
     derive_batch(*columns, False, sites, made, bad, np.empty((0, 3, 4), np.float32), np.empty(0, np.int32),
-                 np.empty(0, np.int64), handoffs, handed_columns(0, source.params))
+                 np.empty(0, np.int64), np.empty((0, 0)), handoffs, handed_columns(0, source.params))
     if bad.any() or not _within_limit(ctx, shapes.lot, made):
         return False
     ctx.count_lots(shapes.lot, ctx.plan.symbols[region.root].rules[0].span, made.astype(np.int64))
@@ -126,20 +143,41 @@ def derive(ctx, region, shapes: Shapes) -> bool:
     total = int(starts[-1])
     xform, lot = np.empty((total, 3, 4), np.float32), np.empty(total, np.int32)
     row = np.empty(total if source.carries else 0, np.int64)
-    handed = handed_columns(int(handoff_starts[-1]), source.params, source.carries)
-    derive_batch(*columns, True, starts[:-1].copy(), made, bad, xform, lot, row, handoff_starts[:-1].copy(), handed)
-    records = FusedRecords(xform, lot, starts, handed, handoff_starts, *((shapes, row) if source.carries else ()))
+    written = np.empty((len(source.written), total))
+    handed = handed_columns(int(handoff_starts[-1]), source.params, source.carries, len(source.written))
+    derive_batch(*columns, True, starts[:-1].copy(), made, bad, xform, lot, row, written, handoff_starts[:-1].copy(),
+                 handed)
+    records = FusedRecords(xform, lot, starts, handed, handoff_starts,
+                           *((shapes, row, written, source.written) if source.carries else ()))
     FusedBatch(records, source.block).emit(ctx)
     return True
 
 
 def _attribute(ctx, shapes: Shapes, name: str):
-    """The column of attribute ``name`` a kernel reads (``codegen._Writer.expr``): the shapes' own where
+    """The column of attribute ``name`` a kernel reads (``codegen._Writer.attribute``): the shapes' own where
     they carry it (``Plan.dynamic``), by row, else the chunk's, by lot (as ``evaluate`` reads them); a
-    boolean one as numbers (true 1.0), which the kernel's conditions and arithmetic take as numpy does."""
+    boolean one as numbers (true 1.0), which the kernel's conditions and arithmetic take as numpy does, and a
+    string one as its interned ids in numbers (a kernel reads one only as the value of ``set`` or
+    ``color``: ``regions``)."""
     slot = ctx.plan.dynamic.get(name)
     column = shapes.dynamic[slot] if slot is not None else ctx.chunk.attrs.get(name)
-    return column.astype(np.float64) if isinstance(column, np.ndarray) and column.dtype == np.bool_ else column
+    if isinstance(column, np.ndarray) and column.dtype in (np.bool_, np.int32):
+        return column.astype(np.float64)
+    return column
+
+
+#: The colours (0xRRGGBB, NaN for a text that is none) of each table of interned strings, by its ids so far.
+_HEXES: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
+
+
+def _hexes(strings) -> np.ndarray:
+    """The colour of each interned string of ``strings`` (``plan.Strings``) as ``color`` reads it
+    (``materials.hex_color``), for a kernel to look up by id: each text read once, as it is interned."""
+    table = _HEXES.get(strings, np.empty(0))
+    if len(table) < len(strings.ids):
+        texts = list(strings.ids)[len(table):]
+        table = _HEXES[strings] = np.concatenate([table, [hex_color(text) for text in texts]])
+    return table
 
 
 def _within_limit(ctx, lot: np.ndarray, made: np.ndarray) -> bool:

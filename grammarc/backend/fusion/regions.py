@@ -10,8 +10,8 @@ into the records. It covers what needs no context: the scope operations ``S`` an
 ``rand``'s from the shape's counter-based stream, ``backend.random``, whose keys the kernel carries).
 In CityEngine's dialect it covers ``s`` and ``t``, ``split`` of the scope (its repeat groups and floating
 sizes, laid by the interpreter's kernels), ``i`` of an asset named in the rule (fitted to the scope),
-``case``, stochastic ``%`` choices, ``NIL``, ``[ ]``, successors and leaves; a body that hands its shape to
-nothing ends in a leaf. Shapes there carry their state in PRT's sequential stream, which the kernel moves on
+``case``, stochastic ``%`` choices, ``NIL``, ``[ ]``, ``set`` and ``color`` (below), successors and leaves; a
+body that hands its shape to nothing ends in a leaf. Shapes there carry their state in PRT's sequential stream, which the kernel moves on
 as the interpreter does, where shapes are made and where they draw (``rand``, ``p``, ``%``). Anything
 else - another operation, another function - keeps the symbol for the interpreter (``backend.execute``),
 which remains the reference: both give the same records, bit for bit (``tests/backend/fusion``).
@@ -25,12 +25,20 @@ batches where the interpreter's would, and its rules run at its turn, by the int
 of its own region.
 
 Shapes may carry per-shape columns (``Plan.dynamic``: colours, texture channels and coordinates, trim
-planes, a pivot, box rings, attributes rules ``set``): no operation a kernel takes writes one (an ``i``
-marks its geometry inserted, which the kernel knows where it writes its code), so everything a region
-makes of a root has the root's, and the kernel writes the root's row beside its records and shapes
-(``fused``); an attribute a shape carries is read from its root's row. The texture maps and trim planes are
-in world coordinates, which a split or a move keeps. A split where the grammar reads ``split.index`` or
-``split.total`` writes them, which no kernel does: its symbol is left to the interpreter. The whole grammar
+planes, a pivot, box rings, attributes rules ``set``). A region writes some of them: ``set`` of a value a
+kernel computes (numbers and booleans as its expressions, a string as a constant or another attribute's,
+which is an interned id), ``color`` (three components, or ``"#rrggbb"`` as a constant or an attribute's,
+looked up in a table of the interned strings), each a variable of the code from there on, which the
+expressions after it read and which the records and shapes handed off below it carry (``codegen``); an
+``i`` marks its geometry inserted, which the kernel knows where it writes its code. Everything else a
+region makes of a root has the root's columns, so the kernel writes the root's row beside its records and
+shapes (``fused``); an attribute a shape carries is read from its root's row where the region has not set
+it. The texture maps and trim planes are in world coordinates, which a split or a move keeps. A string
+(a constant, or an attribute's) is read only as the value of ``set`` or ``color``, or compared with ``==``
+or ``!=`` to another one: the kernels' arithmetic is of numbers. A split
+where the grammar reads ``split.index`` or ``split.total`` writes them, which no kernel does: its symbol is
+left to the interpreter. Operations CityEngine has that change nothing in the record (``reverseNormals``,
+``print``, the other material settings: ``ir.NotApplied``) are nothing in a kernel either. The whole grammar
 is left to the interpreter where an insert occludes and in a search that sums a design's leaves
 (``backend.aggregates``). ``grammar_refusals`` says which of these keep a grammar out,
 ``Fusible.refusal`` the first construct that keeps a symbol out and where it is: what ``grammarc check
@@ -41,10 +49,12 @@ small (``COMPILE_AT``).
 
 from __future__ import annotations
 
+import math
 import os
 from collections import Counter
 from dataclasses import dataclass
 
+from grammarc.backend.materials import hex_color
 from grammarc.backend.streams import draws
 from grammarc.diagnostics import Span
 from grammarc.ir import nodes as ir
@@ -109,6 +119,8 @@ class Fusible:
     def __init__(self, plan) -> None:
         self.plan = plan
         self.uses = Counter(op.name for op in iter_ops(plan.grammar.module) if isinstance(op, ir.Symbol))
+        #: The types of the attributes, declared and CityEngine's own (``ir.SHAPE_ATTRIBUTES``).
+        self.types = {attr.name: attr.type for attr in plan.grammar.module.attrs} | ir.SHAPE_ATTRIBUTES
         self._refusals: dict[int, Refusal | None] = {}
 
     def symbol(self, sym_id: int) -> bool:
@@ -208,15 +220,32 @@ class Fusible:
         if isinstance(op, (ir.Case, ir.Stochastic)):  # conditions, or percentages
             return (_first(self.expr(value) for value, _ in op.branches)
                     or _first(self.body(body) for body in (*(body for _, body in op.branches), op.default)))
-        if isinstance(op, (ir.Insert, ir.Empty, ir.Push, ir.Pop)):
+        if isinstance(op, ir.SetAttr):
+            if self.types.get(op.name) is ir.Type.STR:
+                return None if self.string(op.value) else _refused(op.value, "a string other than a constant or "
+                                                                              "an attribute")
+            return self.expr(op.value)
+        if isinstance(op, ir.SetColor):
+            if len(op.values) == 3:
+                return _first(self.expr(value) for value in op.values)
+            value = op.values[0]
+            if isinstance(value, ir.Str) and math.isnan(hex_color(value.value)):
+                return _refused(value, "a colour that is not \"#rrggbb\"")
+            return None if self.string(value) else _refused(value, "a colour other than a constant or an attribute")
+        if isinstance(op, (ir.Insert, ir.Empty, ir.Push, ir.Pop, ir.NotApplied)):
             return None
         return _refused(op, "an operation no kernel takes")
+
+    def string(self, expr: ir.Expr) -> bool:
+        """Whether ``expr`` is a string a kernel takes as a value: a constant, or a string attribute (both
+        interned ids)."""
+        return isinstance(expr, ir.Str) or (isinstance(expr, ir.AttrRef) and self.types.get(expr.name) is ir.Type.STR)
 
     def expr(self, expr: ir.Expr) -> Refusal | None:
         if isinstance(expr, (ir.Num, ir.Bool, ir.Param)):  # parameters: numbers (``_rules``)
             return None
-        if isinstance(expr, ir.AttrRef):
-            return None  # a column of numbers, which the runner checks (``run.attribute_columns``)
+        if isinstance(expr, ir.AttrRef):  # a column of numbers (or booleans), which the runner checks
+            return _refused(expr, "a string attribute") if self.types.get(expr.name) is ir.Type.STR else None
         if isinstance(expr, ir.ScopeRef):
             return None if expr.field in SIZES else _refused(expr, "a scope field other than a size")
         if isinstance(expr, ir.Unary):
@@ -224,6 +253,8 @@ class Fusible:
         if isinstance(expr, ir.Binary):
             if expr.op not in ARITHMETIC | COMPARE | LOGIC:
                 return _refused(expr, "an operator")
+            if expr.op in ("==", "!=") and self.string(expr.left) and self.string(expr.right):
+                return None  # the same text is the same interned id
             return self.expr(expr.left) or self.expr(expr.right)
         if isinstance(expr, ir.Call):
             if expr.func not in FUNCTIONS:

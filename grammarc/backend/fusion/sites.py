@@ -13,13 +13,16 @@ class Emit:
     """Records of ``asset`` made at emission ``site`` by ``symbol``: the instances of an ``I`` or of the
     asset an ``i`` made a leaf's geometry (the symbol whose rule it is in), or a leaf's cubes or quads (the
     leaf's symbol: ``leaf``, as ``terminals.emit_leaves`` emits them, textured; a cube cut at its trim
-    planes where its geometry was ``inserted`` by an ``i`` in the region, else where its root's was)."""
+    planes where its geometry was ``inserted`` by an ``i`` in the region, else where its root's was). The
+    per-shape columns (``Plan.dynamic`` slots) ``written`` are the region's (``Scope.written``), the others
+    their root's."""
 
     site: int
     asset: int
     symbol: int
     leaf: bool = False
     inserted: bool = False
+    written: tuple[int, ...] = ()
 
 
 @dataclass(frozen=True)
@@ -27,12 +30,14 @@ class Handoff:
     """Shapes of ``symbol`` made at hand-off ``site``: successors the region does not derive, which wait for
     their symbol's turn as the interpreter's would (``regions.Fusible.inlined``). Their geometry is
     ``geom`` (``Shapes.geom``: -1 their scope, or the asset an ``i`` made it), ``inserted`` where an ``i``
-    in the region made it (``slots.TRIM_INSERTED``), else as their root's."""
+    in the region made it (``slots.TRIM_INSERTED``), else as their root's; their columns ``written`` as
+    ``Emit``'s."""
 
     site: int
     symbol: int
     geom: int = -1
     inserted: bool = False
+    written: tuple[int, ...] = ()
 
 
 @dataclass
@@ -56,8 +61,10 @@ class Scope(NamedTuple):
     mixes its parent's with the split's site and its index, a successor's with its site and 0), computed
     only where a shape draws or is handed off; in CityEngine's dialect the variable of its state in PRT's
     stream (``backend.prt_random``), which the operations that make shapes move on. And its geometry,
-    known where the code is written: -1 its scope, or the id of the asset an ``i`` made it; and whether an
-    ``i`` inserted it (``builtin:cube`` leaves the scope's box as its geometry, but inserted)."""
+    known where the code is written: -1 its scope, or the id of the asset an ``i`` made it; whether an
+    ``i`` inserted it (``builtin:cube`` leaves the scope's box as its geometry, but inserted); and the
+    per-shape columns the region wrote (``set``, ``color``), in the order of their slots: (slot, the
+    variable of its value as a float64, a string's interned id) pairs."""
 
     origin: tuple[str, str, str]
     size: tuple[str, str, str]
@@ -65,3 +72,4 @@ class Scope(NamedTuple):
     key: str
     asset: int = -1
     inserted: bool = False
+    written: tuple[tuple[int, str], ...] = ()

@@ -16,7 +16,7 @@ import numpy as np
 
 from grammarc.backend.context import Context
 from grammarc.backend.evaluate import evaluate, evaluate_array
-from grammarc.backend.materials import with_opacity, with_transparency_of
+from grammarc.backend.materials import hex_color, with_opacity, with_transparency_of
 from grammarc.backend.operations.table import operation
 from grammarc.backend.shapes import Shapes
 from grammarc.backend.slots import WHITE_RGB
@@ -46,7 +46,7 @@ def set_color(ctx: Context, cursor: Shapes, op: ir.SetColor) -> Shapes:
         ids = np.broadcast_to(evaluate_array(op.values[0], env, dtype=np.int32), (n,))
         names = list(ctx.plan.strings.ids)
         distinct, inverse = np.unique(ids, return_inverse=True)
-        packed = np.array([_hex_color(names[int(i)]) for i in distinct])[inverse.reshape(-1)]
+        packed = np.array([hex_color(names[int(i)]) for i in distinct])[inverse.reshape(-1)]
         bad = np.isnan(packed)
         if bad.any():
             ctx.fail_each(cursor, bad, lambda i: f'color("{names[int(ids[i])]}") is not a colour "#rrggbb"', op.span)
@@ -153,14 +153,3 @@ def report_rows(lot: np.ndarray, key, value, n: int) -> tuple:
         kind = "num"
     values = np.broadcast_to(np.asarray(value, dtype=np.float64), (n,))
     return lot, key, values, kind
-
-
-def _hex_color(text: str) -> float:
-    """0xRRGGBB of "#rrggbb" (or "#rgb"), NaN when the text is no such colour."""
-    digits = text.strip().lstrip("#")
-    if len(digits) == 3:
-        digits = "".join(c * 2 for c in digits)
-    try:
-        return float(int(digits, 16)) if len(digits) == 6 else float("nan")
-    except ValueError:
-        return float("nan")

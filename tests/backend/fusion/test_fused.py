@@ -179,6 +179,33 @@ Sill --> color("#00ff00")
 """
 
 
+#: Columns a region writes: ``set`` of a number read back (``level``), of a boolean (``street``, which ``Band``,
+#: handed off, reads), of a string constant and a string attribute (texture channels); ``color`` of three
+#: components (clipped), of a constant and of a string attribute; a string attribute compared with a
+#: constant; ``reverseNormals``, which changes nothing.
+#: ``Pier``, ``Corner`` and ``Glass``, named once, are inlined; ``Floor`` and ``Band``, named more often, are
+#: handed off with the columns written before.
+WRITTEN = """
+version "2023.0"
+attr street = false
+attr floor_h = 3
+attr wall = "#c0b090"
+attr tex = "wall.jpg"
+attr level = 0
+
+@StartRule
+Lot --> extrude(10) comp(f) { front : set(street, true) Facade | side : Facade | top : Roof. }
+Facade --> split(y) { floor_h : Floor | ~1 : set(level, level + 3) Floor }
+Floor --> split(x) { { ~2 : Tile | 0.5 : color(wall) Pier }* | 0.6 : set(material.colormap, tex) color(wall) Corner }
+Tile --> case level > 2 && tex != "none.jpg" : color(0.2, 0.4 + level / 10, 1.2) reverseNormals split(y) { ~1 : texture("glass.jpg") Glass | 0.3 : Band }
+         else : set(street, false) color("#abc") split(x) { 0.2 : Band | ~1 : s('1, '1, 0.3) i("builtin:cube") Win. | 0.2 : Band }
+Band --> case street : color("#ff0000") else : NIL
+Pier --> t(0, 0, -0.1) Band
+Corner --> s('1, '1, 0.2)
+Glass --> set(material.dirtmap, "dirt.jpg")
+"""
+
+
 def cityengine_lots():
     widths = np.linspace(4, 31, 10)
     return lots_from_polygons([[np.array([[0, 0], [w, 0], [w, 7 + w / 3], [0, 7 + w / 3]])] for w in widths],
@@ -371,4 +398,28 @@ def test_cityengine_shapes_carry_their_columns_through_the_kernels(write, monkey
     assert fused["kernels"] >= 2 and len(fused["asset"]) > 1000
     assert {"color", "material", "uv"} <= fused.keys() and len(fused["mesh"].lot)  # cut: faces
     assert len(np.unique(fused["color"], axis=0)) == 3  # white, orange, green
+    assert_same(fused, interpreted)
+
+
+def test_cityengine_regions_write_the_columns_they_set(write, monkeypatch):
+    plan = make_plan(compile_grammar(write("g.cga", WRITTEN)))
+    assert {plan.symbols[k].name for k in plan.fused} == {"Facade", "Floor", "Tile"}
+    written = {plan.symbols[k].name: region.source.written for k, region in plan.fused.items()}
+    assert {name: {k for k, slot in plan.dynamic.items() if slot in slots} for name, slots in written.items()} == {
+        "Facade": {"level"},  # its floors handed off with their levels
+        "Floor": {"street", "#color", "material.colormap", "material.dirtmap"},
+        "Tile": {"street", "#color", "material.colormap", "material.dirtmap"}}
+    fused, interpreted = both(write, monkeypatch, WRITTEN, cityengine_lots())
+    assert fused["kernels"] >= 2 and len(fused["asset"]) > 500
+    colors = {tuple(c) for c in fused["color"].tolist()}
+    assert {(192, 176, 144, 255), (170, 187, 204, 255), (255, 0, 0, 255)} <= colors  # wall, "#abc", Band's
+    assert (51, 178, 255, 255) in colors  # 0.2, the upper floor's 0.7 (178.5, rounded to even), 1.2 clipped
+    assert_same(fused, interpreted)
+
+
+def test_a_colour_that_is_none_fails_its_lot_as_the_interpreter_fails_it(write, monkeypatch):
+    fused, interpreted = both(write, monkeypatch, WRITTEN, cityengine_lots(), attrs={"wall": "brick"})
+    # the facades' kernel derives; the floors', which colour their corners, hands its batch to the interpreter
+    assert fused["kernels"] == 1 and len(fused["bad"]) == len(cityengine_lots())
+    assert "is not a colour" in fused["bad"][0].reason
     assert_same(fused, interpreted)

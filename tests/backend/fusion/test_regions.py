@@ -150,14 +150,14 @@ def test_what_keeps_a_grammar_and_each_symbol_out_is_said_with_where(write):
 version "2023.0"
 Lot --> split(x){ 2: A | ~1: B }*
 A --> s('1, '1, 2) i("builtin:cube")
-B --> case scope.sx > 1: color(1, 0, 0)
+B --> case scope.sx > 1: center(x)
       else: NIL
 C --> case inside(): NIL else: A
 """)))
     assert [w.split(" (")[0] for w in grammar_refusals(plan)] == ["occlusion"]
     refused = symbol_refusals(plan)
-    assert str(refused["B"]).startswith("an operation no kernel takes: `color(1, 0, 0)` at ")
-    assert refused["B"].name == "color" and str(refused["B"]).endswith("g.cga:5:26")
+    assert str(refused["B"]).startswith("an operation no kernel takes: `center(x)` at ")
+    assert refused["B"].name == "center" and str(refused["B"]).endswith("g.cga:5:26")
     assert set(refused) == {"B", "C"}  # ``Lot`` hands its shapes to ``B``; ``A``'s ``s`` and ``i`` are fused
     # a fused grammar: nothing keeps it out, and its fused symbols have no refusal
     facade = make_plan(compile_grammar(ROOT / "benchmarks" / "facade.cga"))
@@ -195,10 +195,30 @@ def test_the_fused_operations_that_end_a_body_are_those_the_interpreter_ends_it_
     assert [t for t in fused if OPERATIONS[t].consumes] == list(ENDING)
 
 
-def test_of_the_fused_operations_only_i_writes_a_per_shape_column():
-    """A root's per-shape columns are those of everything its region makes (``regions``): of the operations
-    a kernel takes, only ``i`` writes one (its geometry inserted, which the kernel knows where it writes its
-    code); a split's parts are the parent's columns and ``split.index`` (``children.with_context``), whose
-    reading keeps splits out."""
-    fused = (*ENDING, ir.Scale, ir.Translate, ir.UseAsset)
-    assert [t for t in fused if "dynamic" in OPERATIONS[t].writes] == [ir.UseAsset]
+def test_the_fused_operations_that_write_a_per_shape_column_are_i_set_and_color():
+    """A root's per-shape columns are those of everything its region makes (``regions``) but those it writes:
+    of the operations a kernel takes, ``i`` (its geometry inserted, which the kernel knows where it writes
+    its code), ``set`` and ``color`` (whose values the kernel writes beside its records and shapes); a
+    split's parts are the parent's columns and ``split.index`` (``children.with_context``), whose reading
+    keeps splits out."""
+    fused = (*ENDING, ir.Scale, ir.Translate, ir.UseAsset, ir.SetAttr, ir.SetColor, ir.NotApplied)
+    assert [t for t in fused if "dynamic" in OPERATIONS[t].writes] == [ir.UseAsset, ir.SetAttr, ir.SetColor]
+
+
+def test_strings_are_fused_as_the_values_of_set_and_color_and_in_equalities_only(write):
+    plan = make_plan(compile_grammar(write("g.cga", """
+version "2023.0"
+attr tex = "a.jpg"
+attr hue = "#ffffff"
+Lot --> split(x){ ~1: A | ~1: C | ~1: D | ~1: E | ~1: F }*
+A --> texture(tex) color(hue) set(material.dirtmap, "d.jpg") reverseNormals split(y){ ~1: B. }*
+C --> split(y){ ~1: set(material.colormap, tex + ".png") B. }*
+D --> split(y){ ~1: color("teal") B. }*
+E --> split(y){ ~1: case tex == hue || "b.jpg" != tex: B. else: NIL }*
+F --> split(y){ ~1: case tex < hue: B. else: NIL }*
+""")))
+    refused = symbol_refusals(plan)
+    assert {plan.symbols[k].name for k in plan.fused} == {"Lot", "A", "E"}
+    assert refused["C"].what == "a string other than a constant or an attribute"
+    assert refused["D"].what == 'a colour that is not "#rrggbb"' and refused["D"].text == '"teal"'
+    assert refused["F"].what == "a string attribute"
