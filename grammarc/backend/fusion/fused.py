@@ -77,7 +77,8 @@ class FusedRecords:
             return
         shapes, rows = self.root, self.row[a:b]
         if event.written:  # the records' own columns, the roots' but those the region wrote
-            shapes = replace(shapes.take(rows), dynamic=self._columns(rows, event.written, self.written[:, a:b]))
+            shapes = replace(replace(shapes, dynamic=()).take(rows),
+                             dynamic=self._columns(rows, event.written, self.written[:, a:b]))
             rows = np.arange(b - a)
         if event.leaf and event.asset == terminals.QUAD:  # a leaf quad is never cut
             terminals.append_instances(ctx, shapes, rows, xform, event.asset, event.symbol)
