@@ -405,10 +405,11 @@ class _Writer(SplitWriter):
         if len(op.values) == 3:
             parts = []
             for value in op.values:  # ``np.clip``'s bounds as numpy compares them (a NaN kept, -0.0 made 0.0)
-                channel, parts = self.fresh("cc"), [*parts, self.fresh("cc")]
+                channel, part = self.fresh("cc"), self.fresh("cc")
                 self.put(level, f"{channel} = np.rint(np.float64({self.expr(value, scope)}) * 255.0)")
                 self.put(level, f"{channel} = {channel} if np.isnan({channel}) or {channel} > 0.0 else 0.0")
-                self.put(level, f"{parts[-1]} = {channel} if np.isnan({channel}) or {channel} < 255.0 else 255.0")
+                self.put(level, f"{part} = {channel} if np.isnan({channel}) or {channel} < 255.0 else 255.0")
+                parts.append(part)
             rgb = f"{parts[0]} * 65536.0 + {parts[1]} * 256.0 + {parts[2]}"
         elif isinstance(op.values[0], ir.Str):
             rgb = repr(hex_color(op.values[0].value))  # a colour (``regions`` refuses a text that is none)
