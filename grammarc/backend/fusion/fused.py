@@ -159,7 +159,7 @@ def _attribute(ctx, shapes: Shapes, name: str):
     they carry it (``Plan.dynamic``), by row, else the chunk's, by lot (as ``evaluate`` reads them); a
     boolean one as numbers (true 1.0), which the kernel's conditions and arithmetic take as numpy does, and a
     string one as its interned ids in numbers (a kernel reads one only as the value of ``set`` or
-    ``color``: ``regions``)."""
+    ``color`` or in an equality with another string: ``regions``)."""
     slot = ctx.plan.dynamic.get(name)
     column = shapes.dynamic[slot] if slot is not None else ctx.chunk.attrs.get(name)
     if isinstance(column, np.ndarray) and column.dtype in (np.bool_, np.int32):

@@ -10,9 +10,10 @@ into the records. It covers what needs no context: the scope operations ``S`` an
 ``rand``'s from the shape's counter-based stream, ``backend.random``, whose keys the kernel carries).
 In CityEngine's dialect it covers ``s`` and ``t``, ``split`` of the scope (its repeat groups and floating
 sizes, laid by the interpreter's kernels), ``i`` of an asset named in the rule (fitted to the scope),
-``case``, stochastic ``%`` choices, ``NIL``, ``[ ]``, ``set`` and ``color`` (below), successors and leaves; a
-body that hands its shape to nothing ends in a leaf. Shapes there carry their state in PRT's sequential stream, which the kernel moves on
-as the interpreter does, where shapes are made and where they draw (``rand``, ``p``, ``%``). Anything
+``case``, stochastic ``%`` choices, ``NIL``, ``[ ]``, ``set`` and ``color`` (below), successors and leaves;
+a body that hands its shape to nothing ends in a leaf. Shapes there carry their state in PRT's sequential
+stream, which the kernel moves on as the interpreter does, where shapes are made and where they draw
+(``rand``, ``p``, ``%``). Anything
 else - another operation, another function - keeps the symbol for the interpreter (``backend.execute``),
 which remains the reference: both give the same records, bit for bit (``tests/backend/fusion``).
 
@@ -35,11 +36,11 @@ region makes of a root has the root's columns, so the kernel writes the root's r
 shapes (``fused``); an attribute a shape carries is read from its root's row where the region has not set
 it. The texture maps and trim planes are in world coordinates, which a split or a move keeps. A string
 (a constant, or an attribute's) is read only as the value of ``set`` or ``color``, or compared with ``==``
-or ``!=`` to another one: the kernels' arithmetic is of numbers. A split
-where the grammar reads ``split.index`` or ``split.total`` writes them, which no kernel does: its symbol is
-left to the interpreter. Operations CityEngine has that change nothing in the record (``reverseNormals``,
-``print``, the other material settings: ``ir.NotApplied``) are nothing in a kernel either. The whole grammar
-is left to the interpreter where an insert occludes and in a search that sums a design's leaves
+or ``!=`` to another one: the kernels' arithmetic is of numbers. A split where the grammar reads
+``split.index`` or ``split.total`` writes them, which no kernel does: its symbol is left to the
+interpreter. Operations CityEngine has that change nothing in the record (``reverseNormals``, ``print``,
+the other material settings: ``ir.NotApplied``) are nothing in a kernel either. The whole grammar is left
+to the interpreter where an insert occludes and in a search that sums a design's leaves
 (``backend.aggregates``). ``grammar_refusals`` says which of these keep a grammar out,
 ``Fusible.refusal`` the first construct that keeps a symbol out and where it is: what ``grammarc check
 --fusion`` prints.
