@@ -16,6 +16,8 @@ row; the paths are kept as the grammar wrote them and resolved by the writers th
 
 from __future__ import annotations
 
+import weakref
+
 import numpy as np
 
 from grammarc.ir import nodes as ir
@@ -49,6 +51,21 @@ def hex_color(text: str) -> float:
         return float(int(digits, 16)) if len(digits) == 6 else float("nan")
     except ValueError:
         return float("nan")
+
+
+#: The colours of each table of interned strings (``hex_colors``), by id, as far as its strings had come.
+_HEX_COLORS: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
+
+
+def hex_colors(strings) -> np.ndarray:
+    """The colour (``hex_color``: NaN for a text that is none) of each string interned in ``strings``
+    (``plan.Strings``), by id: ``color`` of a string maps over interned ids, in the interpreter and in the
+    fused kernels alike. Each text is read once, as strings are interned."""
+    table = _HEX_COLORS.get(strings, np.empty(0))
+    if len(table) < len(strings.ids):
+        texts = list(strings.ids)[len(table):]
+        table = _HEX_COLORS[strings] = np.concatenate([table, [hex_color(text) for text in texts]])
+    return table
 
 
 def with_transparency_of(rgb: np.ndarray, packed: np.ndarray) -> np.ndarray:

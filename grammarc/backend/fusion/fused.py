@@ -16,7 +16,6 @@ and the values it wrote; its records are placed as the interpreter places them f
 
 from __future__ import annotations
 
-import weakref
 from collections.abc import Iterator
 from dataclasses import dataclass, replace
 
@@ -25,7 +24,7 @@ import numpy as np
 from grammarc.backend import terminals
 from grammarc.backend.fusion.compiled import compiled_before, handed_columns, kernel, ready
 from grammarc.backend.fusion.sites import Block, Emit, Handoff
-from grammarc.backend.materials import hex_color
+from grammarc.backend.materials import hex_colors
 from grammarc.backend.shapes import Shapes
 from grammarc.ragged import offsets_from_counts
 
@@ -131,7 +130,7 @@ def derive(ctx, region, shapes: Shapes) -> bool:
     sites, made, bad = np.zeros(source.sites, np.int64), np.empty(n), np.zeros(n, np.bool_)
     handoffs = np.zeros(source.handoffs, np.int64)
     # contiguous, as the kernel was compiled for (``compiled.kernel``): a copy only where one is not
-    hexes = _hexes(ctx.plan.strings) if source.hexes else np.empty(0)
+    hexes = hex_colors(ctx.plan.strings) if source.hexes else np.empty(0)
     columns = (*map(np.ascontiguousarray, (shapes.origin, shapes.size, shapes.frame, shapes.lot, shapes.key,
                                            shapes.depth, chunk.frames.data, *attrs, chunk.lot_origin)),
                hexes, float(limits.max_shapes))
@@ -165,20 +164,6 @@ def _attribute(ctx, shapes: Shapes, name: str):
     if isinstance(column, np.ndarray) and column.dtype in (np.bool_, np.int32):
         return column.astype(np.float64)
     return column
-
-
-#: The colours (0xRRGGBB, NaN for a text that is none) of each table of interned strings, by its ids so far.
-_HEXES: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
-
-
-def _hexes(strings) -> np.ndarray:
-    """The colour of each interned string of ``strings`` (``plan.Strings``) as ``color`` reads it
-    (``materials.hex_color``), for a kernel to look up by id: each text read once, as it is interned."""
-    table = _HEXES.get(strings, np.empty(0))
-    if len(table) < len(strings.ids):
-        texts = list(strings.ids)[len(table):]
-        table = _HEXES[strings] = np.concatenate([table, [hex_color(text) for text in texts]])
-    return table
 
 
 def _within_limit(ctx, lot: np.ndarray, made: np.ndarray) -> bool:

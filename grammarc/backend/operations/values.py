@@ -16,7 +16,7 @@ import numpy as np
 
 from grammarc.backend.context import Context
 from grammarc.backend.evaluate import evaluate, evaluate_array
-from grammarc.backend.materials import hex_color, with_opacity, with_transparency_of
+from grammarc.backend.materials import hex_colors, with_opacity, with_transparency_of
 from grammarc.backend.operations.table import operation
 from grammarc.backend.shapes import Shapes
 from grammarc.backend.slots import WHITE_RGB
@@ -44,11 +44,10 @@ def set_color(ctx: Context, cursor: Shapes, op: ir.SetColor) -> Shapes:
         packed = parts[0] * 65536 + parts[1] * 256 + parts[2]
     else:
         ids = np.broadcast_to(evaluate_array(op.values[0], env, dtype=np.int32), (n,))
-        names = list(ctx.plan.strings.ids)
-        distinct, inverse = np.unique(ids, return_inverse=True)
-        packed = np.array([hex_color(names[int(i)]) for i in distinct])[inverse.reshape(-1)]
+        packed = hex_colors(ctx.plan.strings)[ids]
         bad = np.isnan(packed)
         if bad.any():
+            names = list(ctx.plan.strings.ids)
             ctx.fail_each(cursor, bad, lambda i: f'color("{names[int(ids[i])]}") is not a colour "#rrggbb"', op.span)
     index = ctx.plan.color_slot
     packed = with_transparency_of(packed.astype(np.float64), cursor.dynamic[index])
