@@ -9,6 +9,7 @@ import pytest
 
 from grammarc.backend.kernels.order import group_by, place, put, scatter_rows, tally
 from grammarc.backend.kernels.scope import (
+    centred,
     component_origins,
     leaf_kinds,
     place_children,
@@ -325,6 +326,36 @@ def test_translated_gives_einsums_bits_signed_zeros_included(n):
     local = np.where(rng.random((n, 3)) < 0.3, -0.0, rng.normal(size=(n, 3)))
     want = origin + np.einsum("ni,nij->nj", local, frames[frame])
     assert np.array_equal(translated(origin, local, frames, frame).view(np.int64), want.view(np.int64))
+
+
+def centred_reference(origin, size, frame, base_origin, base_size, base_frame, frames, axes):
+    """``center`` as it was first written, in numpy (``einsum``)."""
+    base_center = base_origin + np.einsum("ni,nij->nj", base_size / 2, frames[base_frame])
+    offset = base_center - (origin + np.einsum("ni,nij->nj", size / 2, frames[frame]))
+    out = origin.copy()
+    for k in axes:
+        axis = frames[frame][:, k]
+        out += np.einsum("nj,nj->n", offset, axis)[:, None] * axis
+    return out
+
+
+@pytest.mark.parametrize("n", [*SIZES, 20_000])
+@pytest.mark.parametrize("axes", [(0,), (1,), (2,), (0, 2), (1, 2), (0, 1, 2)])
+def test_centred_gives_numpys_bits_signed_zeros_included(n, axes):
+    """The scopes centred on their bases, whose frames are mostly their own (a push keeps the frame)."""
+    rng = np.random.default_rng(n)
+    frames, frame = frames_and_ids(rng, n)
+    base_frame = np.where(rng.random(n) < 0.7, frame, rng.integers(0, 4, n)).astype(np.int32)
+
+    def values(scale):
+        return np.where(rng.random((n, 3)) < 0.3, -0.0, rng.normal(size=(n, 3)) * scale)
+
+    origin, base_origin, size, base_size = values(100), values(1e3), np.abs(values(10)), np.abs(values(10))
+    size[::5] = 0.0
+    axes = np.array(axes, np.int64)
+    got = centred(origin, size, frame, base_origin, base_size, base_frame, frames, axes)
+    want = centred_reference(origin, size, frame, base_origin, base_size, base_frame, frames, axes)
+    assert np.array_equal(got.view(np.int64), want.view(np.int64))
 
 
 @pytest.mark.parametrize("n", SIZES)

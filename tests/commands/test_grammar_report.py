@@ -25,13 +25,13 @@ def test_check_summary_of_a_grammar_of_many_rules_stays_short(write, capsys):
 
 def test_check_says_why_symbols_are_not_fused(write, capsys):
     grammar = write("g.cga", 'version "2022.0"\n@StartRule\nLot --> extrude(3) comp(f){ top: Roof | all: W. }\n'
-                             "Roof --> center(x) R.\nW --> case touches(): NIL else: X.\n")
+                             "Roof --> rotateScope(0, 90, 0) R.\nW --> case touches(): NIL else: X.\n")
     assert main(["check", "--fusion", str(grammar)]) == 0
     out = capsys.readouterr().out
     assert "fusion:    the whole grammar is interpreted: occlusion" in out
     assert "    Lot: an operation no kernel takes: `extrude(3)` at " in out
-    assert "    Roof: an operation no kernel takes: `center(x)` at " in out
-    assert "most frequent: an operation no kernel takes `extrude` (1), an operation no kernel takes `center` (1)" in out
+    assert "    Roof: an operation no kernel takes: `rotateScope(0, 90, 0)` at " in out
+    assert "most frequent: an operation no kernel takes `extrude` (1), an operation no kernel takes `rotateScope` (1)" in out
 
 
 def test_check_dump_ir(write, capsys):

@@ -258,15 +258,19 @@ class _Writer(SplitWriter):
         operation that makes shapes or records leaves it as it was (but for its state in PRT's stream). In
         CityEngine's dialect a body that hands its shape to nothing ends in a leaf of its rule's symbol."""
         stack = []
+        base = scope  # what ``center`` centres on: the body's first scope, or the last push's
         for op in body:
             if isinstance(op, ir.Push):
                 if self.sequential:  # ``streams.bracket``: the copy a child, the shape waiting moved on
-                    stack.append(scope._replace(key=self.moved(scope, level)))
+                    stack.append((scope._replace(key=self.moved(scope, level)), base))
                     scope = scope._replace(key=self.made_state(scope, level))
                 else:
-                    stack.append(scope)
+                    stack.append((scope, base))
+                base = scope
             elif isinstance(op, ir.Pop):
-                scope = stack.pop() if stack else scope
+                scope, base = stack.pop() if stack else (scope, base)
+            elif isinstance(op, ir.Center):
+                scope = scope._replace(origin=self.center(op, scope, base, level))
             elif isinstance(op, ir.Scale):
                 scope = scope._replace(size=self.scale(op, scope, level))
             elif isinstance(op, ir.Translate):
@@ -388,6 +392,30 @@ class _Writer(SplitWriter):
             self.put(level, f"{new[-1]} = {scope.origin[j]} + {delta}")
         self.within_coordinates(level, new)
         return tuple(new)
+
+    def center(self, op: ir.Center, scope: Scope, base: Scope, level: int) -> tuple:
+        """``kernels.scope.centred`` on one scope, whose base has its frame (no operation of a region turns
+        it): the offset of the centres, projected on each axis in turn (einsum's sums, to the bit)."""
+        offset = []
+        for j in range(3):
+            to_base, to_middle = self.fresh("cb"), self.fresh("cm")
+            self.put(level, f"{to_base} = 0.0")
+            self.put(level, f"{to_middle} = 0.0")
+            for i in range(3):
+                self.put(level, f"{to_base} += {base.size[i]} / 2 * frames[f, {i}, {j}]")
+                self.put(level, f"{to_middle} += {scope.size[i]} / 2 * frames[f, {i}, {j}]")
+            offset.append(self.fresh("of"))
+            self.put(level, f"{offset[-1]} = ({base.origin[j]} + {to_base}) - ({scope.origin[j]} + {to_middle})")
+        origin = scope.origin
+        for k in op.axes:
+            along = self.fresh("al")
+            self.put(level, f"{along} = ((0.0 + {offset[0]} * frames[f, {k}, 0]) + {offset[2]} * frames[f, {k}, 2]) "
+                            f"+ (0.0 + {offset[1]} * frames[f, {k}, 1])")
+            moved = tuple(self.fresh("o") for _ in range(3))
+            for j in range(3):
+                self.put(level, f"{moved[j]} = {origin[j]} + {along} * frames[f, {k}, {j}]")
+            origin = moved
+        return origin
 
     def write(self, scope: Scope, slot: int, value: str, level: int) -> Scope:
         """``scope`` with the per-shape column ``slot`` set to ``value``, held in a variable of its own."""

@@ -8,7 +8,7 @@ into the records. It covers what needs no context: the scope operations ``S`` an
 ``terminals.emit_leaves`` makes it), guards and sizes made of numbers, attributes, parameters (numbers),
 ``scope.sx|sy|sz``, arithmetic, ``min``, ``max``, ``rand`` and ``p``, and stochastic rules (their draws and
 ``rand``'s from the shape's counter-based stream, ``backend.random``, whose keys the kernel carries).
-In CityEngine's dialect it covers ``s`` and ``t``, ``split`` of the scope (its repeat groups and floating
+In CityEngine's dialect it covers ``s``, ``t`` and ``center``, ``split`` of the scope (its repeat groups and floating
 sizes, laid by the interpreter's kernels), ``i`` of an asset named in the rule (fitted to the scope),
 ``case``, stochastic ``%`` choices, ``NIL``, ``[ ]``, ``set`` and ``color`` (below), successors and leaves;
 a body that hands its shape to nothing ends in a leaf. Shapes there carry their state in PRT's sequential
@@ -233,7 +233,7 @@ class Fusible:
             if isinstance(value, ir.Str) and math.isnan(hex_color(value.value)):
                 return _refused(value, "a colour that is not \"#rrggbb\"")
             return None if self.string(value) else _refused(value, "a colour other than a constant or an attribute")
-        if isinstance(op, (ir.Insert, ir.Empty, ir.Push, ir.Pop, ir.NotApplied)):
+        if isinstance(op, (ir.Insert, ir.Empty, ir.Push, ir.Pop, ir.NotApplied, ir.Center)):
             return None
         return _refused(op, "an operation no kernel takes")
 

@@ -146,6 +146,33 @@ def translated(origin, local, frames, frame):
 
 
 @njit(cache=True, nogil=True)
+def centred(origin, size, frame, base_origin, base_size, base_frame, frames, axes):
+    """Origins (n, 3) of scopes ``origin``, ``size`` (n, 3) in frames ``frame`` (n,) moved along their axes
+    ``axes`` (k,) int64 so that their centres meet those of ``base_origin``, ``base_size`` in ``base_frame``
+    (CityEngine's ``center``): the offset of the centres projected on each axis in turn. The arithmetic is
+    numpy's (einsum) as the operation was first written, to the bit: the centres as ``translated`` sums,
+    each projection as einsum's two lanes sum a product of three (x and z, then y) - the fused kernels
+    write the same sums (``fusion.codegen``)."""
+    out = origin.copy()
+    offset = np.empty(3)
+    for c in range(len(frame)):
+        f, g = frame[c], base_frame[c]
+        for j in range(3):
+            to_base = 0.0
+            to_middle = 0.0
+            for i in range(3):
+                to_base += base_size[c, i] / 2 * frames[g, i, j]
+                to_middle += size[c, i] / 2 * frames[f, i, j]
+            offset[j] = (base_origin[c, j] + to_base) - (origin[c, j] + to_middle)
+        for k in axes:
+            along = ((0.0 + offset[0] * frames[f, k, 0]) + offset[2] * frames[f, k, 2]) + (
+                0.0 + offset[1] * frames[f, k, 1])
+            for j in range(3):
+                out[c, j] += along * frames[f, k, j]
+    return out
+
+
+@njit(cache=True, nogil=True)
 def component_origins(frames, frame, origin, local_origin, local_axes, tol):
     """World origins of components, ``origin + local_origin @ frames[frame]`` (m, 3) (``translated``:
     einsum's bits), and whether each component's local axes are not orthonormal within ``tol`` (m,) bool

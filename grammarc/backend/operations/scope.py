@@ -23,7 +23,7 @@ from grammarc.backend.context import Context
 from grammarc.backend.euler import orientation, rotation
 from grammarc.backend.evaluate import evaluate, evaluate_array
 from grammarc.backend.functions.coordinates import system
-from grammarc.backend.kernels.scope import translated
+from grammarc.backend.kernels.scope import centred, translated
 from grammarc.backend.mesh_shapes import store_fitted
 from grammarc.backend.operations.table import operation
 from grammarc.backend.outlines import flat_axis, polygons_of
@@ -199,17 +199,10 @@ def transform(ctx: Context, cursor: Shapes, op: ir.Transform) -> Shapes:
 
 def center(ctx: Context, cursor: Shapes, op: ir.Center, base) -> Shapes:
     """Centre the scope on ``base`` (origin, size, frame: the body's first scope or the last push) along
-    ``op.axes``."""
+    ``op.axes`` (``kernels.scope.centred``)."""
     base_origin, base_size, base_frame = base
-    frames = ctx.chunk.frames
-    base_axes = frames[base_frame]
-    axes = frames[cursor.frame]
-    base_center = base_origin + np.einsum("ni,nij->nj", base_size / 2, base_axes)
-    middle = cursor.origin + np.einsum("ni,nij->nj", cursor.size / 2, axes)
-    offset = base_center - middle
-    origin = cursor.origin.copy()
-    for k in op.axes:
-        origin += np.einsum("nj,nj->n", offset, axes[:, k])[:, None] * axes[:, k]
+    origin = centred(cursor.origin, cursor.size, cursor.frame, base_origin, base_size, base_frame,
+                     ctx.chunk.frames.data, np.asarray(op.axes, dtype=np.int64))
     return cursor.with_scope(origin, cursor.size, cursor.frame, cursor.geom)
 
 

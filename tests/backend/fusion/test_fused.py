@@ -4,6 +4,7 @@ the shape limit."""
 
 from __future__ import annotations
 
+import os
 from dataclasses import fields, replace
 
 import numpy as np
@@ -205,6 +206,24 @@ Corner --> s('1, '1, 0.2)
 Glass --> set(material.dirtmap, "dirt.jpg")
 """
 
+
+#: ``center`` on the body's first scope (a rule's, a split part's, a case branch's, an inlined symbol's),
+#: on the last push's, and again on the first after a ``]``; on one axis, two and three.
+CENTERED = """
+version "2023.0"
+attr sill = 0.2
+
+@StartRule
+Lot --> extrude(8) comp(f) { front : r(10, 5, 20) Facade | side : Facade }
+Facade --> split(y) { ~3 : Floor }*
+Floor --> split(x) { ~2.5 : s('1, '1, 0.5) center(z) Tile }*
+Tile --> s('0.6, '0.5, 0.3) center(xy) Window
+         [ t(0, 0.2, 0) s('1, sill, 0.4) center(x) i("builtin:cube") Sill. ]
+         [ s(1, 1, 1) [ s('0.5, '0.5, '1) center(xyz) Mark ] t(0.1, 0, 0.3) center(z) Mark ]
+Window --> case scope.sx > 1.4 : split(x) { ~1 : s('0.8, '1, 0.1) center(x) Pane. }*
+           else : t(0.3, 0, 0) s('0.5, '1, '1) center(y) Pane.
+Mark --> color("#808080")
+"""
 
 def cityengine_lots():
     widths = np.linspace(4, 31, 10)
@@ -416,6 +435,26 @@ def test_cityengine_regions_write_the_columns_they_set(write, monkeypatch):
     assert (51, 178, 255, 255) in colors  # 0.2, the upper floor's 0.7 (178.5, rounded to even), 1.2 clipped
     assert_same(fused, interpreted)
 
+
+def test_cityengine_regions_centre_scopes_as_the_interpreter_does(write, monkeypatch):
+    """The records, and the origins of the shapes handed to ``Mark`` to the bit (a record's float32 hides
+    the last bits of a sum's order): the front facades are turned, so that no axis has a zero."""
+    plan = make_plan(compile_grammar(write("g.cga", CENTERED)))
+    assert {plan.symbols[k].name for k in plan.fused} == {"Facade", "Floor", "Tile", "Window"}
+    origins = {"always": [], "off": []}
+    apply = execute.apply
+
+    def watched(ctx, sym, shapes):
+        if sym.name == "Mark":
+            origins[os.environ[SWITCH]].append(shapes.origin.copy())
+        apply(ctx, sym, shapes)
+
+    monkeypatch.setattr(execute, "apply", watched)
+    fused, interpreted = both(write, monkeypatch, CENTERED, cityengine_lots())
+    assert fused["kernels"] and len(fused["asset"]) > 500  # the facades' kernel, its symbols all inlined
+    assert_same(fused, interpreted)
+    handed, derived = (np.concatenate(origins[mode]) for mode in ("always", "off"))
+    assert len(handed) > 500 and np.array_equal(handed.view(np.int64), derived.view(np.int64))
 
 def test_a_colour_that_is_none_fails_its_lot_as_the_interpreter_fails_it(write, monkeypatch):
     fused, interpreted = both(write, monkeypatch, WRITTEN, cityengine_lots(), attrs={"wall": "brick"})

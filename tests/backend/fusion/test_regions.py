@@ -110,7 +110,7 @@ def test_cityengine_splits_scope_operations_inserts_and_brackets_are_fused(write
     assert fused(write, """
 version "2023.0"
 Lot --> split(x){ 2: A | { ~1: B | '0.1: NIL }* }*
-A --> s('1, '1, 2) t(0, 0, -1) i("builtin:cube")
+A --> s('1, '1, 2) t(0, 0, -1) center(xz) i("builtin:cube")
 B --> [ t(0, 1, 0) C. ] split(y){ 1: A | ~2: i("door.obj") }
 """) == {"Lot", "B"}
 
@@ -150,14 +150,14 @@ def test_what_keeps_a_grammar_and_each_symbol_out_is_said_with_where(write):
 version "2023.0"
 Lot --> split(x){ 2: A | ~1: B }*
 A --> s('1, '1, 2) i("builtin:cube")
-B --> case scope.sx > 1: center(x)
+B --> case scope.sx > 1: rotateScope(0, 90, 0)
       else: NIL
 C --> case inside(): NIL else: A
 """)))
     assert [w.split(" (")[0] for w in grammar_refusals(plan)] == ["occlusion"]
     refused = symbol_refusals(plan)
-    assert str(refused["B"]).startswith("an operation no kernel takes: `center(x)` at ")
-    assert refused["B"].name == "center" and str(refused["B"]).endswith("g.cga:5:26")
+    assert str(refused["B"]).startswith("an operation no kernel takes: `rotateScope(0, 90, 0)` at ")
+    assert refused["B"].name == "rotateScope" and str(refused["B"]).endswith("g.cga:5:26")
     assert set(refused) == {"B", "C"}  # ``Lot`` hands its shapes to ``B``; ``A``'s ``s`` and ``i`` are fused
     # a fused grammar: nothing keeps it out, and its fused symbols have no refusal
     facade = make_plan(compile_grammar(ROOT / "benchmarks" / "facade.cga"))
@@ -191,7 +191,7 @@ B --> split(y){ ~1: C. }*
 
 def test_the_fused_operations_that_end_a_body_are_those_the_interpreter_ends_it_with():
     """``ENDING``: no leaf at a CityEngine body's end after them, as ``execute.run`` decides with the table."""
-    fused = (*ENDING, ir.Scale, ir.Translate, ir.UseAsset)  # and `[ ]`, which the runner keeps
+    fused = (*ENDING, ir.Scale, ir.Translate, ir.UseAsset)  # and `[ ]` and `center`, which the runner keeps
     assert [t for t in fused if OPERATIONS[t].consumes] == list(ENDING)
 
 
@@ -201,7 +201,7 @@ def test_the_fused_operations_that_write_a_per_shape_column_are_i_set_and_color(
     its code), ``set`` and ``color`` (whose values the kernel writes beside its records and shapes); a
     split's parts are the parent's columns and ``split.index`` (``children.with_context``), whose reading
     keeps splits out."""
-    fused = (*ENDING, ir.Scale, ir.Translate, ir.UseAsset, ir.SetAttr, ir.SetColor, ir.NotApplied)
+    fused = (*ENDING, ir.Scale, ir.Translate, ir.UseAsset, ir.SetAttr, ir.SetColor, ir.NotApplied)  # and `center`
     assert [t for t in fused if "dynamic" in OPERATIONS[t].writes] == [ir.UseAsset, ir.SetAttr, ir.SetColor]
 
 
