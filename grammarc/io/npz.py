@@ -8,14 +8,19 @@ A city's terminals (10^7-10^8 rows, gigabytes) arrive chunk by chunk from the de
   the file, its local header and ``.npy`` header are written up front with a placeholder shape and sizes of fixed
   width, each chunk's bytes are appended behind them, and ``close()`` patches the headers in place. Its CRC is
   kept running over the data and combined with the CRC of the final ``.npy`` header (zlib's ``crc32_combine``).
-* The other columns (12 bytes a row, and the mesh table) are appended to spool files, their CRCs kept running,
-  and ``close()`` copies each spool behind the others in the kernel (``os.copy_file_range``) and unlinks it.
+* The other columns (12 bytes a row, more with colours, materials and texture coordinates, and the mesh table)
+  are written in place too where the filesystem can take a range out of a file (Linux's ``fallocate`` with
+  ``FALLOC_FL_COLLAPSE_RANGE``: ext4, XFS): each into its own region of a sparse temporary, far apart, and
+  ``close()`` collapses the holes between them, so no byte is copied and the data went to disk as it came.
+  Elsewhere they are appended to spool files, and ``close()`` copies each spool into place in the kernel
+  (``os.copy_file_range``) and unlinks it. Either way each of these members' data starts at a multiple of
+  ``_ALIGN`` bytes, its local header padded up to there: the file's bytes do not depend on the way.
 * ``write()`` validates the chunk and hands its columns to one background thread that does the file I/O
   (through a queue two chunks deep, so the derivation overlaps the writes and memory stays bounded). The
   arrays are not copied: the caller must not modify them after ``write()``.
-* Where it can (Linux), the thread starts the writeback of the streamed data as it goes and drops the pages
-  already written back (``posix_fadvise(DONTNEED)``), so the final fsync has little left to write and the
-  output does not fill the page cache.
+* Where it can (Linux), the thread starts the writeback of the data written in place as it goes and drops the
+  pages already written back (``posix_fadvise(DONTNEED)``), so the final fsync has little left to write and
+  the output does not fill the page cache.
 
 Zip readers find members through the central directory, which lists them in the order of the record's table
 (``_KEYS``), whatever their order in the file. Members are stored (no compression) with zip64 local headers,
@@ -35,12 +40,14 @@ a file already at the output path untouched.
 from __future__ import annotations
 
 import contextlib
+import ctypes
 import errno
 import json
 import os
 import queue
 import shutil
 import struct
+import sys
 import threading
 import weakref
 import zipfile
@@ -70,6 +77,18 @@ _READS = ("grammarc.instances/1", _FORMAT)
 _FADVISE = hasattr(os, "posix_fadvise")  # Linux: DONTNEED starts the writeback of a range, drops clean pages
 _QUEUE_DEPTH = 2  # chunks waiting for the background thread: bounds the memory of write()
 _BLOCK = 16 << 20  # bytes per copy call from a spool into the npz (and the buffer of the fallback copy)
+#: The data of each member the thread writes (but the streamed one, first in the file) starts at a multiple of
+#: this many bytes: its local header is padded up to there with an extra field, as Android's zipalign pads
+#: (its id, which readers skip as they skip any they do not know). The layout, and so the bytes, are the same
+#: whether the member was written in place or spooled and copied.
+_ALIGN = 4096
+_PAD_ID = 0xD935
+#: Written in place, column k (in file order, after the streamed one) starts at (k + 1) * _REGION of the
+#: sparse temporary; it may grow to _REGION - _SLACK bytes, the slack left for the members held in memory
+#: that follow it in the file. 15 regions of 2^39 bytes: 7.5 TiB, within ext4's largest file (16 TiB).
+_REGION = 1 << 39
+_SLACK = 1 << 32
+_COLLAPSE_RANGE = 0x08  # Linux's FALLOC_FL_COLLAPSE_RANGE
 _ZIP_DATE = (1980, 1, 1, 0, 0, 0)  # the earliest date zip can store; fixed so that runs are byte-identical
 
 # Columns written by the background thread: npz key -> (dtype, shape of one row). Offsets are written without
@@ -484,17 +503,23 @@ class _Sink:
         self._thread: threading.Thread | None = None
         try:
             self._fds[""] = _create(self.path)
-            for key in _SPOOLED:
-                if key != _STREAMED:
-                    self._fds[key] = _create(os.path.join(tmpdir, key))
+            # where each column's data goes in the output, or None: into spool files
+            self._regions = _regions(self._fds[""])
+            if self._regions is None:
+                for key in _SPOOLED:
+                    if key != _STREAMED:
+                        self._fds[key] = _create(os.path.join(tmpdir, key))
             # The streamed member's headers, for 0 rows: as wide as the final ones, which finish() writes over.
             dtype, row_shape = _SPOOLED[_STREAMED]
             header = _npy_header(_descr(dtype), (0, *row_shape))
             head = _local_header(f"{_STREAMED}.npy".encode(), 0, 0) + header
             _write_all(self._fds[""], head)
             self._head_size = len(head)
-            # For _FADVISE: the output before _dropped is on disk, before _written on its way there.
-            self._dropped = self._written = 0
+            # For _FADVISE: where each column written in place starts, and how far its data is on disk
+            # (dropped from memory) and on its way there (written back)
+            self._starts = {_STREAMED: self._head_size, **(self._regions or {})}
+            self._dropped = dict(self._starts)
+            self._written = dict(self._starts)
             self._thread = threading.Thread(target=self._run, name=f"InstanceWriter {name}", daemon=True)
             self._thread.start()
         except BaseException:
@@ -514,12 +539,14 @@ class _Sink:
 
         ``members`` maps every key, in central directory order, to the ``.npy`` descr and shape of its array
         and the bytes of the member before those written by the thread (all of them for an array held in
-        memory). Each spool is copied into the output in the kernel and unlinked.
+        memory). Written in place, the holes before each column's data are collapsed out of the file; else
+        each spool is copied into the output in the kernel and unlinked.
         """
         self._join()
         self._raise_error()
         out = self._fds[""]
         position = self._head_size + self._size[_STREAMED]  # where the file ends: after the streamed data
+        removed = 0  # the bytes collapsed out of the file so far
         entries = []  # (name, crc, size, offset of the local header) of each member, in central order
         for key, (descr, shape, body) in members.items():
             header = _npy_header(descr, shape)
@@ -529,25 +556,37 @@ class _Sink:
             size = len(header) + len(body) + written
             crc = crc32_combine(crc32(body, crc32(header)), self._crc.get(key, 0), written)
             name = f"{key}.npy".encode()
-            local = _local_header(name, crc, size)
             if key == _STREAMED:
-                head = local + header
+                head = _local_header(name, crc, size) + header
                 if len(head) != self._head_size:
                     raise RuntimeError(f"{key}: the final headers do not fit the space left for them")
                 entries.append((name, crc, size, 0))
                 continue
             entries.append((name, crc, size, position))
-            _write_all(out, local + header + body)
+            local = _local_header(name, crc, size)
+            if key in _SPOOLED:  # its data at the next multiple of _ALIGN that leaves room for its headers
+                local = _local_header(name, crc, size, -(position + len(local) + len(header) + len(body) + 4)
+                                      % _ALIGN + 4)
+            start = position + len(local) + len(header) + len(body)  # where the thread's bytes of the member go
+            if self._regions is not None and key in self._regions:
+                gap = self._regions[key] - removed - start
+                if gap < 0:
+                    raise OSError(errno.EFBIG, f"the record's columns before {key} pass the room left for them")
+                if gap:
+                    _collapse(out, -(-position // _ALIGN) * _ALIGN, gap)
+                    removed += gap
+            _write_all(out, local + header + body, position)
             if key in self._fds:
-                _copy_file(self._fds[key], out, written)
+                _copy_file(self._fds[key], out, written, start)
                 # Unlinked at once: its pages are freed, and if not written back yet, never will be.
                 os.close(self._fds.pop(key))
                 os.unlink(os.path.join(self.tmpdir, key))
-            position += len(local) + size
+            position = start + written
         directory = b"".join(_central_header(*entry) for entry in entries)
-        _write_all(out, directory + _end_records(len(entries), position, len(directory)))
-        os.lseek(out, 0, os.SEEK_SET)
-        _write_all(out, head)
+        end = directory + _end_records(len(entries), position, len(directory))
+        _write_all(out, end, position)
+        os.ftruncate(out, position + len(end))  # the regions of the columns a record has not: holes
+        _write_all(out, head, 0)
         os.fsync(out)
         os.close(self._fds.pop(""))
         return self.path
@@ -590,18 +629,27 @@ class _Sink:
             data = column.reshape(-1).view(np.uint8)  # the bytes of the contiguous column, not a copy
             if len(data):
                 self._crc[key] = crc32(data, self._crc[key])
-                _write_all(self._fds["" if key == _STREAMED else key], data)
+                if key in self._starts:
+                    if self._regions is not None and self._size[key] + len(data) > _REGION - _SLACK:
+                        raise OSError(errno.EFBIG, f"the record's {key} column passes {(_REGION - _SLACK) >> 30} GiB")
+                    _write_all(self._fds[""], data, self._starts[key] + self._size[key])
+                else:
+                    _write_all(self._fds[key], data)
                 self._size[key] += len(data)
-        end = self._head_size + self._size[_STREAMED]
-        if _FADVISE and end > self._written:
-            # Start writing the new streamed data to disk now, while the caller derives, rather than in the
-            # final fsync, and drop the pages of the previous chunk, written back by now: the output need not
-            # stay in memory, and new pages cost more system time than reused ones.
-            try:
-                os.posix_fadvise(self._fds[""], self._dropped, end - self._dropped, os.POSIX_FADV_DONTNEED)
-            except OSError:
-                pass  # advice only: this filesystem does not take it
-            self._dropped, self._written = self._written, end
+        if not _FADVISE:
+            return
+        for key, start in self._starts.items():
+            end = start + self._size[key]
+            if end > self._written[key]:
+                # Start writing the new data to disk now, while the caller derives, rather than in the final
+                # fsync, and drop the pages of the previous chunk, written back by now: the output need not
+                # stay in memory, and new pages cost more system time than reused ones.
+                try:
+                    os.posix_fadvise(self._fds[""], self._dropped[key], end - self._dropped[key],
+                                     os.POSIX_FADV_DONTNEED)
+                except OSError:
+                    pass  # advice only: this filesystem does not take it
+                self._dropped[key], self._written[key] = self._written[key], end
 
     def _join(self) -> None:
         """Tell the thread to end once the queue is empty, and wait for it."""
@@ -624,11 +672,19 @@ def _create(path: str) -> int:
     return os.open(path, os.O_RDWR | os.O_CREAT | os.O_EXCL | getattr(os, "O_BINARY", 0), 0o666)
 
 
-def _write_all(fd: int, data) -> None:
-    """Write the bytes of the buffer ``data`` at the position of ``fd`` (os.write may write fewer)."""
+def _write_all(fd: int, data, offset: int | None = None) -> None:
+    """Write the bytes of the buffer ``data`` at ``offset`` of ``fd`` (None: at its position), all of them
+    (os.write may write fewer)."""
     view = memoryview(data).cast("B")
+    if offset is not None and not hasattr(os, "pwrite"):  # Windows
+        os.lseek(fd, offset, os.SEEK_SET)
+        offset = None
     while view:
-        view = view[os.write(fd, view) :]
+        if offset is None:
+            view = view[os.write(fd, view) :]
+        else:
+            n = os.pwrite(fd, view, offset)
+            view, offset = view[n:], offset + n
 
 
 # Errors of os.copy_file_range that mean "not between these files": copy through a buffer instead.
@@ -636,8 +692,8 @@ _NO_COPY_RANGE = {errno.EXDEV, errno.ENOSYS, errno.EINVAL, errno.EPERM, errno.ET
 _NO_COPY_RANGE.add(getattr(errno, "ENOTSUP", errno.EOPNOTSUPP))
 
 
-def _copy_file(source: int, target: int, size: int) -> None:
-    """Append the first ``size`` bytes of file ``source`` at the position of ``target``.
+def _copy_file(source: int, target: int, size: int, at: int) -> None:
+    """Copy the first ``size`` bytes of file ``source`` to offset ``at`` of ``target``.
 
     In the kernel with ``os.copy_file_range`` (Linux): the bytes do not pass through Python. Elsewhere, or where
     the filesystem refuses, through a buffer of ``_BLOCK`` bytes.
@@ -646,7 +702,7 @@ def _copy_file(source: int, target: int, size: int) -> None:
     copy_range = getattr(os, "copy_file_range", None)
     while copy_range is not None and done < size:
         try:
-            n = copy_range(source, target, min(size - done, _BLOCK), done)
+            n = copy_range(source, target, min(size - done, _BLOCK), done, at + done)
         except OSError as error:
             if error.errno not in _NO_COPY_RANGE:
                 raise
@@ -660,8 +716,50 @@ def _copy_file(source: int, target: int, size: int) -> None:
         data = os.read(source, min(size - done, _BLOCK))
         if not data:
             raise OSError(errno.EIO, f"spool file ended after {done} of {size} bytes")
-        _write_all(target, data)
+        _write_all(target, data, at + done)
         done += len(data)
+
+
+def _fallocate():
+    """libc's ``fallocate`` (Linux), or None."""
+    if not sys.platform.startswith("linux"):
+        return None
+    try:
+        function = ctypes.CDLL(None, use_errno=True).fallocate
+    except (OSError, AttributeError):
+        return None
+    function.argtypes = [ctypes.c_int, ctypes.c_int, ctypes.c_int64, ctypes.c_int64]
+    function.restype = ctypes.c_int
+    return function
+
+
+_FALLOCATE = _fallocate()
+
+
+def _regions(fd: int) -> dict[str, int] | None:
+    """The offset of each spooled column's region in the new, empty file ``fd``, which this makes as large as
+    they need (holes), or None where its filesystem cannot collapse a range out of a file (tried on its first
+    blocks) or hold a file that large."""
+    if _FALLOCATE is None:
+        return None
+    keys = [key for key in _KEYS if key in _SPOOLED and key != _STREAMED]
+    try:
+        os.ftruncate(fd, 2 * _ALIGN)
+        collapses = _FALLOCATE(fd, _COLLAPSE_RANGE, 0, _ALIGN) == 0
+        os.ftruncate(fd, 0)
+        if collapses:
+            os.ftruncate(fd, (len(keys) + 1) * _REGION)
+    except OSError:
+        os.ftruncate(fd, 0)
+        return None
+    return {key: (k + 1) * _REGION for k, key in enumerate(keys)} if collapses else None
+
+
+def _collapse(fd: int, offset: int, length: int) -> None:
+    """Take ``length`` bytes at ``offset`` out of file ``fd``, what follows moved down (no data copied)."""
+    if _FALLOCATE(fd, _COLLAPSE_RANGE, offset, length) != 0:
+        error = ctypes.get_errno()
+        raise OSError(error, f"cannot collapse the record's temporary file: {os.strerror(error)}")
 
 
 def _descr(dtype) -> str:
@@ -696,9 +794,12 @@ _ZIP64_LIMIT = (1 << 31) - 1  # as zipfile: beyond this, a size or offset goes i
 _FULL32 = 0xFFFFFFFF  # a 32-bit size or offset whose value is in the zip64 extra field
 
 
-def _local_header(name: bytes, crc: int, size: int) -> bytes:
-    """The local header of a stored member of ``size`` bytes; always zip64, so its width does not depend on size."""
+def _local_header(name: bytes, crc: int, size: int, pad: int = 0) -> bytes:
+    """The local header of a stored member of ``size`` bytes; always zip64, so its width does not depend on size.
+    ``pad`` (0, or 4 or more) bytes more, an extra field of zeros (``_PAD_ID``) after the zip64 one."""
     extra = struct.pack("<HHQQ", 1, 16, size, size)
+    if pad:
+        extra += struct.pack("<HH", _PAD_ID, pad - 4) + bytes(pad - 4)
     fixed = struct.pack(
         "<4s2B4HL2L2H", b"PK\x03\x04", _ZIP_VERSION, 0, 0, 0, _DOS_TIME, _DOS_DATE,
         crc, _FULL32, _FULL32, len(name), len(extra),

@@ -494,6 +494,17 @@ def test_zip_records(tmp_path, chunks):
         assert crc == info.CRC and size32 == 0xFFFFFFFF
         sizes = struct.unpack("<HHQQ", data[offset + 30 + name_size : offset + 30 + name_size + 20])
         assert sizes == (1, 16, info.file_size, info.file_size)
+        # The columns the thread writes but the first start at a multiple of _ALIGN: the local header padded
+        # up to there with zipalign's extra field; the others have none.
+        key = info.filename.removesuffix(".npy")
+        if key in npz._SPOOLED and key != npz._STREAMED:
+            pad_id, pad = struct.unpack("<HH", data[offset + 30 + name_size + 20 : offset + 30 + name_size + 24])
+            assert pad_id == npz._PAD_ID and extra_size == 24 + pad
+            dtype, row_shape = npz._SPOOLED[key]
+            start = offset + 30 + name_size + extra_size + len(npz._npy_header(dtype, (0, *row_shape)))
+            assert (start + (8 if key in npz._OFFSETS else 0)) % npz._ALIGN == 0
+        else:
+            assert extra_size == 20
 
 
 def test_zip64_records_load(tmp_path, chunks, monkeypatch):
@@ -514,7 +525,11 @@ def test_zip64_records_load(tmp_path, chunks, monkeypatch):
         np.testing.assert_array_equal(got[key], expected[key])
 
 
-def test_bytes_do_not_depend_on_how_spools_are_copied(tmp_path, chunks, monkeypatch):
+def test_bytes_do_not_depend_on_how_columns_are_written(tmp_path, chunks, monkeypatch):
+    """In place where the filesystem collapses a range (here, or else spooled too), spooled and copied in
+    the kernel, or through a buffer where it refuses or has no such call."""
+    write(tmp_path / "in_place.npz", chunks)
+    monkeypatch.setattr(npz, "_FALLOCATE", None)
     write(tmp_path / "kernel.npz", chunks)
 
     def refused(*args, **kwargs):
@@ -525,8 +540,57 @@ def test_bytes_do_not_depend_on_how_spools_are_copied(tmp_path, chunks, monkeypa
     write(tmp_path / "refused.npz", chunks)
     monkeypatch.delattr(os, "copy_file_range", raising=False)
     write(tmp_path / "absent.npz", chunks)
-    data = {name: (tmp_path / name).read_bytes() for name in ("kernel.npz", "refused.npz", "absent.npz")}
-    assert len(set(data.values())) == 1
+    names = ("in_place.npz", "kernel.npz", "refused.npz", "absent.npz")
+    assert len({(tmp_path / name).read_bytes() for name in names}) == 1
+
+
+def collapses(folder) -> bool:
+    """Whether the filesystem of ``folder`` takes ranges out of files (``npz._regions``)."""
+    fd = os.open(folder / "probe", os.O_RDWR | os.O_CREAT)
+    try:
+        return npz._regions(fd) is not None
+    finally:
+        os.close(fd)
+        os.unlink(folder / "probe")
+
+
+def test_columns_are_written_in_place_where_the_filesystem_collapses_ranges(tmp_path, chunks):
+    if not collapses(tmp_path):
+        pytest.skip("this filesystem cannot collapse a range out of a file: the columns are spooled")
+    out = InstanceWriter(tmp_path / "city.npz", assets=ASSETS, symbols=SYMBOLS, meta={})
+    for chunk in chunks:
+        out.write(chunk)
+    out._sink._join()
+    (folder,) = tmp_path.glob(".city.npz.tmp*")
+    assert os.listdir(folder) == ["city.npz"]  # no spool files: every column in the output
+    sparse = os.stat(folder / "city.npz")
+    assert sparse.st_size > npz._REGION and sparse.st_blocks * 512 < 1 << 24  # holes between the columns
+    out.close()
+    assert os.stat(tmp_path / "city.npz").st_size < 1 << 24 and read_instances(tmp_path / "city.npz")
+
+
+@pytest.mark.parametrize("collapsing", [True, False])
+def test_a_column_past_its_region_fails_the_writer(tmp_path, chunks, monkeypatch, collapsing):
+    """Written in place, a column may grow to its region less the slack (spooled, it has no such bound)."""
+    if collapsing and not collapses(tmp_path):
+        pytest.skip("this filesystem cannot collapse a range out of a file: the columns are spooled")
+    if not collapsing:
+        monkeypatch.setattr(npz, "_FALLOCATE", None)
+    monkeypatch.setattr(npz, "_REGION", 16 * npz._ALIGN)
+    monkeypatch.setattr(npz, "_SLACK", 8 * npz._ALIGN)
+    path = tmp_path / "city.npz"
+    path.write_bytes(b"the previous city")
+    rows = 32 * npz._ALIGN // 48  # xform: twice the room
+    out = InstanceWriter(path, assets=ASSETS, symbols=SYMBOLS, meta={})
+    if collapsing:
+        with pytest.raises(OSError, match="the record's xform column passes"):
+            out.write(random_chunk(np.random.default_rng(1), rows, 0))
+            out.close()
+        assert path.read_bytes() == b"the previous city" and os.listdir(tmp_path) == ["city.npz"]
+    else:
+        out.write(random_chunk(np.random.default_rng(1), rows, 0))
+        out.close()
+        assert len(read_instances(path)["xform"]) == rows
 
 
 def failing_writes(monkeypatch, after=0):
@@ -534,11 +598,11 @@ def failing_writes(monkeypatch, after=0):
     write_all = npz._write_all
     calls = []
 
-    def full_disk(fd, data):
+    def full_disk(fd, data, offset=None):
         calls.append(len(memoryview(data)))
         if len(calls) > after:
             raise OSError(errno.ENOSPC, "No space left on device")
-        write_all(fd, data)
+        write_all(fd, data, offset)
 
     monkeypatch.setattr(npz, "_write_all", full_disk)
     return calls
@@ -588,9 +652,9 @@ def test_error_while_finishing_removes_temporaries(tmp_path, chunks, monkeypatch
 def test_abort_stops_the_thread_with_chunks_queued(tmp_path, chunks, monkeypatch):
     write_all = npz._write_all
 
-    def slow(fd, data):
+    def slow(fd, data, offset=None):
         time.sleep(0.02)
-        write_all(fd, data)
+        write_all(fd, data, offset)
 
     out = InstanceWriter(tmp_path / "city.npz", assets=ASSETS, symbols=SYMBOLS, meta={})
     monkeypatch.setattr(npz, "_write_all", slow)
