@@ -26,6 +26,7 @@ from grammarc.backend.fusion.compiled import compiled_before, handed_columns, ke
 from grammarc.backend.fusion.sites import Block, Emit, Handoff
 from grammarc.backend.materials import hex_colors
 from grammarc.backend.shapes import Shapes
+from grammarc.ir import nodes as ir
 from grammarc.ragged import offsets_from_counts
 
 
@@ -52,10 +53,12 @@ class FusedRecords:
         geometry inserted where an ``i`` made it)."""
         a, b = self.handoff_starts[handoff.site], self.handoff_starts[handoff.site + 1]
         origin, size, frame, lot, key, depth, values, row, written = self.handed
-        params = len(plan.symbols[handoff.symbol].param_types)
+        types = plan.symbols[handoff.symbol].param_types
         dynamic = () if self.root is None else self._columns(row[a:b], handoff.written, written[:, a:b])
+        params = tuple(values[k, a:b].astype(np.int32) if t is ir.Type.STR else values[k, a:b]
+                       for k, t in enumerate(types))  # a string as the interpreter holds it: its interned id
         made = Shapes(origin[a:b], size[a:b], frame[a:b], np.full(b - a, handoff.geom, np.int32), lot[a:b],
-                      key[a:b], depth[a:b], tuple(values[k, a:b] for k in range(params)), dynamic)
+                      key[a:b], depth[a:b], params, dynamic)
         return terminals.marked_inserted(plan, made, True) if handoff.inserted else made
 
     def _columns(self, rows: np.ndarray, slots: tuple[int, ...], written: np.ndarray) -> tuple:
@@ -121,7 +124,7 @@ def derive(ctx, region, shapes: Shapes) -> bool:
         return False  # a few shapes do not pay for compiling a kernel; the interpreter derives them
     if (shapes.geom != -1).any() or int(shapes.depth.max()) + region.source.depth >= limits.max_depth:
         return False
-    attrs = [*shapes.params, *(_attribute(ctx, shapes, name) for name in region.source.attrs)]
+    attrs = [*map(_numbers, shapes.params), *(_attribute(ctx, shapes, name) for name in region.source.attrs)]
     if not all(isinstance(a, np.ndarray) and a.dtype == np.float64 for a in attrs):
         return False
     source = region.source
@@ -155,12 +158,15 @@ def derive(ctx, region, shapes: Shapes) -> bool:
 
 def _attribute(ctx, shapes: Shapes, name: str):
     """The column of attribute ``name`` a kernel reads (``codegen._Writer.attribute``): the shapes' own where
-    they carry it (``Plan.dynamic``), by row, else the chunk's, by lot (as ``evaluate`` reads them); a
-    boolean one as numbers (true 1.0), which the kernel's conditions and arithmetic take as numpy does, and a
-    string one as its interned ids in numbers (a kernel reads one only as the value of ``set`` or
-    ``color`` or in an equality with another string: ``regions``)."""
+    they carry it (``Plan.dynamic``), by row, else the chunk's, by lot (as ``evaluate`` reads them), in
+    numbers (``_numbers``)."""
     slot = ctx.plan.dynamic.get(name)
-    column = shapes.dynamic[slot] if slot is not None else ctx.chunk.attrs.get(name)
+    return _numbers(shapes.dynamic[slot] if slot is not None else ctx.chunk.attrs.get(name))
+
+
+def _numbers(column):
+    """A column as a kernel reads it: booleans as numbers (true 1.0), which its conditions and arithmetic take
+    as numpy does, and strings as their interned ids in numbers (``regions`` says where it reads them)."""
     if isinstance(column, np.ndarray) and column.dtype in (np.bool_, np.int32):
         return column.astype(np.float64)
     return column

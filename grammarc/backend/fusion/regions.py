@@ -5,23 +5,23 @@ A region is a symbol (its *root*) with the symbols its rules lead to, all derive
 into the records. It covers what needs no context: the scope operations ``S`` and ``T``, single-axis
 ``Subdiv`` and ``Repeat`` (no snapping), ``I``, ``ε``, ``[ ]``, successor symbols (with arguments), leaves
 (a successor without rules, or ``X.``, without arguments: its box or rectangle is a record at once, as
-``terminals.emit_leaves`` makes it), guards and sizes made of numbers, attributes, parameters (numbers),
-``scope.sx|sy|sz``, arithmetic, ``min``, ``max``, ``rand`` and ``p``, and stochastic rules (their draws and
-``rand``'s from the shape's counter-based stream, ``backend.random``, whose keys the kernel carries).
-In CityEngine's dialect it covers ``s``, ``t`` and ``center``, ``split`` of the scope (its repeat groups and floating
-sizes, laid by the interpreter's kernels), ``i`` of an asset named in the rule (fitted to the scope),
-``case``, stochastic ``%`` choices, ``NIL``, ``[ ]``, ``set`` and ``color`` (below), successors and leaves;
-a body that hands its shape to nothing ends in a leaf. Shapes there carry their state in PRT's sequential
-stream, which the kernel moves on as the interpreter does, where shapes are made and where they draw
-(``rand``, ``p``, ``%``). Anything
-else - another operation, another function - keeps the symbol for the interpreter (``backend.execute``),
+``terminals.emit_leaves`` makes it), guards and sizes made of numbers, attributes, parameters (numbers,
+booleans), ``scope.sx|sy|sz``, arithmetic, ``min``, ``max``, ``rand`` and ``p``, and stochastic rules (their
+draws and ``rand``'s from the shape's counter-based stream, ``backend.random``, whose keys the kernel
+carries). In CityEngine's dialect it covers ``s``, ``t`` and ``center``, ``split`` of the scope (its repeat
+groups and floating sizes, laid by the interpreter's kernels), ``i`` of an asset named in the rule (fitted
+to the scope), ``case``, stochastic ``%`` choices, ``NIL``, ``[ ]``, ``set`` and ``color`` (below),
+successors and leaves; a body that hands its shape to nothing ends in a leaf. Shapes there carry their state
+in PRT's sequential stream, which the kernel moves on as the interpreter does, where shapes are made and
+where they draw (``rand``, ``p``, ``%``). Anything else - another operation, another function - keeps the
+symbol for the interpreter (``backend.execute``),
 which remains the reference: both give the same records, bit for bit (``tests/backend/fusion``).
 
 A successor symbol is derived inside the region (*inlined*) only where the interpreter's record order can be
 kept (``backend.fusion`` explains the order): when the symbol is named once in the whole grammar (its
 pending shapes then come from this one place), or when its rule only places an asset (``leaf_parts``: its
 shapes' records are the same however its batches are concatenated). Any other successor is *handed off*:
-the kernel writes its shapes (scope, key, depth, parameters of numbers), which join the symbol's pending
+the kernel writes its shapes (scope, key, depth, parameters), which join the symbol's pending
 batches where the interpreter's would, and its rules run at its turn, by the interpreter or by the kernel
 of its own region.
 
@@ -35,8 +35,9 @@ expressions after it read and which the records and shapes handed off below it c
 region makes of a root has the root's columns, so the kernel writes the root's row beside its records and
 shapes (``fused``); an attribute a shape carries is read from its root's row where the region has not set
 it. The texture maps and trim planes are in world coordinates, which a split or a move keeps. A string
-(a constant, or an attribute's) is read only as the value of ``set`` or ``color``, or compared with ``==``
-or ``!=`` to another one: the kernels' arithmetic is of numbers. A split where the grammar reads
+(a constant, an attribute's or a parameter's, all interned ids) is read only as the value of ``set`` or
+``color`` or of a successor's string parameter, or compared with ``==`` or ``!=`` to another one: the
+kernels' arithmetic is of numbers. A split where the grammar reads
 ``split.index`` or ``split.total`` writes them, which no kernel does: its symbol is left to the
 interpreter. Operations CityEngine has that change nothing in the record (``reverseNormals``, ``print``,
 the other material settings: ``ir.NotApplied``) are nothing in a kernel either. The whole grammar is left
@@ -73,6 +74,9 @@ LOGIC = frozenset({"&&", "||"})
 SIZES = {"sx": 0, "sy": 1, "sz": 2}
 #: The functions a fused expression may call: ``rand`` and ``p`` draw from the shape's stream.
 FUNCTIONS = frozenset({"min", "max", "rand", "p"})
+#: The types of the parameters a kernel takes: numbers and booleans (as the interpreter holds them, float64),
+#: strings as their interned ids.
+PARAMETERS = frozenset({ir.Type.NUM, ir.Type.BOOL, ir.Type.STR})
 #: The per-shape columns a split writes to its children (``children.with_context``).
 SPLIT_CONTEXT = frozenset({"split.index", "split.total"})
 
@@ -123,6 +127,7 @@ class Fusible:
         #: The types of the attributes, declared and CityEngine's own (``ir.SHAPE_ATTRIBUTES``).
         self.types = {attr.name: attr.type for attr in plan.grammar.module.attrs} | ir.SHAPE_ATTRIBUTES
         self._refusals: dict[int, Refusal | None] = {}
+        self.params: tuple[ir.Type, ...] = ()  # the types of the parameters of the symbol whose rules are read
 
     def symbol(self, sym_id: int) -> bool:
         """Whether every rule of symbol ``sym_id`` and every symbol it leads to can be fused."""
@@ -160,10 +165,17 @@ class Fusible:
                 and self.symbol(sym_id))
 
     def _rules(self, sym) -> Refusal | None:
+        outer, self.params = self.params, sym.param_types
+        try:
+            return self._read_rules(sym)
+        finally:
+            self.params = outer
+
+    def _read_rules(self, sym) -> Refusal | None:
         if not sym.rules:
             return Refusal(f"`{sym.name}` has no rules")
-        if any(t is not ir.Type.NUM for t in sym.param_types):
-            return Refusal(f"`{sym.name}` has a parameter that is not a number")
+        if any(t not in PARAMETERS for t in sym.param_types):
+            return Refusal(f"`{sym.name}` has a parameter that is not a number, a boolean or a string")
         if sym.id in self.plan.snapping:
             return Refusal(f"`{sym.name}` snaps")
         for rule in applied_rules(sym):
@@ -212,19 +224,22 @@ class Fusible:
             if self.plan.makes_leaves(op):  # its leaves are records at once, wherever it is named
                 return _refused(op, "a leaf with arguments") if op.args else None
             target = self.plan.symbols[self.plan.symbol_ids[op.name]]
-            # derived here, or handed off: its shapes wait for its turn, their parameters numbers
-            if why := _first(self.expr(arg) for arg in op.args):
-                return why
-            if self.inlined(op.name) or all(t is ir.Type.NUM for t in target.param_types):
-                return None
-            return _refused(op, "a successor handed off with a parameter that is not a number")
+            # derived here, or handed off: its shapes wait for its turn with their parameters
+            if any(t not in PARAMETERS for t in target.param_types):
+                return _refused(op, "a successor with a parameter that is not a number, a boolean or a string")
+            for arg, t in zip(op.args, target.param_types):
+                if t is ir.Type.STR and not self.string(arg):
+                    return _refused(arg, "a string other than a constant, an attribute or a parameter")
+                if t is not ir.Type.STR and (why := self.expr(arg)):
+                    return why
+            return None
         if isinstance(op, (ir.Case, ir.Stochastic)):  # conditions, or percentages
             return (_first(self.expr(value) for value, _ in op.branches)
                     or _first(self.body(body) for body in (*(body for _, body in op.branches), op.default)))
         if isinstance(op, ir.SetAttr):
             if self.types.get(op.name) is ir.Type.STR:
-                return None if self.string(op.value) else _refused(op.value, "a string other than a constant or "
-                                                                              "an attribute")
+                return None if self.string(op.value) else _refused(op.value, "a string other than a constant, an "
+                                                                              "attribute or a parameter")
             return self.expr(op.value)
         if isinstance(op, ir.SetColor):
             if len(op.values) == 3:
@@ -232,19 +247,23 @@ class Fusible:
             value = op.values[0]
             if isinstance(value, ir.Str) and math.isnan(hex_color(value.value)):
                 return _refused(value, "a colour that is not \"#rrggbb\"")
-            return None if self.string(value) else _refused(value, "a colour other than a constant or an attribute")
+            return None if self.string(value) else _refused(value, "a colour other than a constant, an attribute or "
+                                                                   "a parameter")
         if isinstance(op, (ir.Insert, ir.Empty, ir.Push, ir.Pop, ir.NotApplied, ir.Center)):
             return None
         return _refused(op, "an operation no kernel takes")
 
     def string(self, expr: ir.Expr) -> bool:
-        """Whether ``expr`` is a string a kernel takes as a value: a constant, or a string attribute (both
-        interned ids)."""
-        return isinstance(expr, ir.Str) or (isinstance(expr, ir.AttrRef) and self.types.get(expr.name) is ir.Type.STR)
+        """Whether ``expr`` is a string a kernel takes as a value: a constant, a string attribute or a string
+        parameter (all interned ids)."""
+        return (isinstance(expr, ir.Str) or (isinstance(expr, ir.AttrRef) and self.types.get(expr.name) is ir.Type.STR)
+                or (isinstance(expr, ir.Param) and self.params[expr.index] is ir.Type.STR))
 
     def expr(self, expr: ir.Expr) -> Refusal | None:
-        if isinstance(expr, (ir.Num, ir.Bool, ir.Param)):  # parameters: numbers (``_rules``)
+        if isinstance(expr, (ir.Num, ir.Bool)):
             return None
+        if isinstance(expr, ir.Param):  # a number or a boolean (``_rules``), or a string
+            return _refused(expr, "a string parameter") if self.params[expr.index] is ir.Type.STR else None
         if isinstance(expr, ir.AttrRef):  # a column of numbers (or booleans), which the runner checks
             return _refused(expr, "a string attribute") if self.types.get(expr.name) is ir.Type.STR else None
         if isinstance(expr, ir.ScopeRef):

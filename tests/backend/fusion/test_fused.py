@@ -225,6 +225,25 @@ Window --> case scope.sx > 1.4 : split(x) { ~1 : s('0.8, '1, 0.1) center(x) Pane
 Mark --> color("#808080")
 """
 
+#: Parameters of strings and booleans: a string attribute's, constants and parameters passed on, compared, set
+#: and coloured with; the facades' come from the interpreter (their kernel takes the ids), the bands' are
+#: handed back to it.
+PARAMETERS = """
+version "2023.0"
+attr tex = "wall.jpg"
+attr hue = "#c0b090"
+
+@StartRule
+Lot --> extrude(8) comp(f) { front : Facade("brick.jpg", true) | side : Facade(tex, false) }
+Facade(image, front) --> split(y) { ~3 : Floor(image, front) }*
+Floor(image, front) --> split(x) { ~2.5 : Tile(image, front, "#abcdef") | 0.5 : Pier(image) }*
+Tile(image, front, tint) --> case image == "brick.jpg" && front : texture(image) color(tint) split(y) { ~1 : Glass | 0.3 : Band(image) }
+                             else : color(hue) split(x) { 0.2 : Band(tex) | ~1 : set(material.dirtmap, image) Win. | 0.2 : Band("band.jpg") }
+Band(name) --> case name != "band.jpg" : texture(name) else : color("#ff0000")
+Pier(name) --> set(material.colormap, name) t(0, 0, -0.1) Band(name)
+Glass --> set(material.dirtmap, "dirt.jpg")
+"""
+
 def cityengine_lots():
     widths = np.linspace(4, 31, 10)
     return lots_from_polygons([[np.array([[0, 0], [w, 0], [w, 7 + w / 3], [0, 7 + w / 3]])] for w in widths],
@@ -455,6 +474,16 @@ def test_cityengine_regions_centre_scopes_as_the_interpreter_does(write, monkeyp
     assert_same(fused, interpreted)
     handed, derived = (np.concatenate(origins[mode]) for mode in ("always", "off"))
     assert len(handed) > 500 and np.array_equal(handed.view(np.int64), derived.view(np.int64))
+
+def test_cityengine_regions_take_and_hand_off_parameters_of_strings_and_booleans(write, monkeypatch):
+    plan = make_plan(compile_grammar(write("g.cga", PARAMETERS)))
+    assert {plan.symbols[k].name for k in plan.fused} == {"Facade", "Floor", "Tile"}
+    fused, interpreted = both(write, monkeypatch, PARAMETERS, cityengine_lots())
+    assert fused["kernels"] and len(fused["asset"]) > 500
+    # the tiles' and bands' textures, the strings handed to them, and the windows' dirt maps
+    assert {"brick.jpg", "wall.jpg", "dirt.jpg"} <= set(np.unique(fused["material"]).tolist())
+    assert (255, 0, 0, 255) in {tuple(c) for c in fused["color"].tolist()}  # the bands of "band.jpg"
+    assert_same(fused, interpreted)
 
 def test_a_colour_that_is_none_fails_its_lot_as_the_interpreter_fails_it(write, monkeypatch):
     fused, interpreted = both(write, monkeypatch, WRITTEN, cityengine_lots(), attrs={"wall": "brick"})

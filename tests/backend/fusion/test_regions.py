@@ -210,15 +210,21 @@ def test_strings_are_fused_as_the_values_of_set_and_color_and_in_equalities_only
 version "2023.0"
 attr tex = "a.jpg"
 attr hue = "#ffffff"
-Lot --> split(x){ ~1: A | ~1: C | ~1: D | ~1: E | ~1: F }*
+Lot --> split(x){ ~1: A | ~1: C | ~1: D | ~1: E | ~1: F | ~1: G("g.jpg", tex) | ~1: H(hue + "0") | ~1: I("i") }*
 A --> texture(tex) color(hue) set(material.dirtmap, "d.jpg") reverseNormals split(y){ ~1: B. }*
 C --> split(y){ ~1: set(material.colormap, tex + ".png") B. }*
 D --> split(y){ ~1: color("teal") B. }*
 E --> split(y){ ~1: case tex == hue || "b.jpg" != tex: B. else: NIL }*
 F --> split(y){ ~1: case tex < hue: B. else: NIL }*
+G(image, other) --> split(y){ ~1: case image != other: texture(image) color(hue) J(image, true) else: NIL }*
+H(name) --> split(y){ ~1: B. }*
+I(name) --> split(y){ ~1: case name < "j": B. else: NIL }*
+J(name, on) --> set(material.colormap, name) B.
 """)))
     refused = symbol_refusals(plan)
-    assert {plan.symbols[k].name for k in plan.fused} == {"Lot", "A", "E"}
-    assert refused["C"].what == "a string other than a constant or an attribute"
+    assert {plan.symbols[k].name for k in plan.fused} == {"A", "E", "G", "H"}
+    assert refused["C"].what == "a string other than a constant, an attribute or a parameter"
     assert refused["D"].what == 'a colour that is not "#rrggbb"' and refused["D"].text == '"teal"'
     assert refused["F"].what == "a string attribute"
+    assert refused["I"].what == "a string parameter"  # compared as no kernel compares strings
+    assert refused["Lot"].text == '(@hue + "0")'  # H's argument
