@@ -123,10 +123,22 @@ def put_shape(handed, row, o0, o1, o2, s0, s1, s2, f, l, key, depth):
 '''
 
 
+#: The most lines a region's function may have. numba's compile time grows faster than a function's length
+#: (examples/pompeii inlined whole below its lots, 4,500 lines, would cost a first build minutes more: the
+#: README's "Fused kernels"), so past this the successor whose inlined code is the largest is handed off
+#: instead, again until the function fits: its shapes wait for their turn, and it roots a region of its own.
+MAX_LINES = 1200
+
+
 def generate(fusible: Fusible, root: int) -> Source:
     """The source of the region rooted at symbol ``root`` (which ``fusible`` accepted)."""
-    writer = _Writer(fusible)
-    writer.function(root)
+    handed: frozenset[int] = frozenset()
+    while True:
+        writer = _Writer(fusible, handed)
+        writer.function(root)
+        if len(writer.lines) <= MAX_LINES or not writer.inlined:
+            break
+        handed |= {max(writer.inlined, key=writer.inlined.__getitem__)}
     text = HEADER.format(called=called_code()) + "".join(f"{line}\n" for line in [*writer.constants, *writer.lines])
     return Source(text, writer.block, tuple(writer.attrs), writer.sites, writer.handoffs, writer.params, writer.depth,
                   writer.carries, tuple(writer.written), writer.hexes)
@@ -136,9 +148,11 @@ class _Writer(SplitWriter):
     """The walk over the region's IR that writes the kernel's lines, numbering sites and attributes as it
     meets them."""
 
-    def __init__(self, fusible: Fusible) -> None:
+    def __init__(self, fusible: Fusible, handed: frozenset[int] = frozenset()) -> None:
         self.fusible = fusible
         self.plan = fusible.plan
+        self.handed = handed  # symbols handed off though they could be inlined (``MAX_LINES``)
+        self.inlined: dict[int, int] = {}  # the lines of the code of each symbol inlined, in the order met
         self.lines: list[str] = []
         self.hoisted: list[str] = []  # statements that the next line's expressions need first (``draw``)
         self.constants: list[str] = []  # the module's arrays of constants, before the kernel
@@ -317,8 +331,10 @@ class _Writer(SplitWriter):
             self.leaf(block, target, scope, level)
             return scope
         made = scope._replace(params=tuple(args), key=key)
-        if self.fusible.inlined(op.name):
+        if self.fusible.inlined(op.name) and target not in self.handed:
+            before = len(self.lines)
             block.events.append(self.symbol(target, made, level, depth + 1))
+            self.inlined[target] = self.inlined.get(target, 0) + len(self.lines) - before
         else:
             self.handoff(block, target, made, level, depth + 1)
         return scope
@@ -450,13 +466,41 @@ class _Writer(SplitWriter):
         return f"({rgb}) + np.floor({before} / {ALPHA_UNIT!r}) * {ALPHA_UNIT!r}"
 
     def split(self, op: ir.Split, block: Block, scope: Scope, level: int, depth: int) -> None:
-        """``kernels.split.subdiv`` for one parent: relative sizes share what the absolute ones leave, parts
-        laid end to end, cut at the scope's end, those of length ``TOL.zero`` or less dropped."""
-        axis, extent = op.axes[0], scope.size[op.axes[0]]
+        """``kernels.split.subdiv`` for one parent (``split_axis``), along each of the split's axes in turn
+        (``operations.splits._fan_out``): the sizes evaluated once, on the parent, and laid again along
+        each axis, whose extent no cut along another changes; a cell numbered by its part along each axis
+        (the first axis fastest), its body the cell's number modulo the bodies (``regions`` takes a split
+        whose bodies have a cell each), its scope cut axis after axis and its key mixed level after level.
+        The cells are written in the order of their numbers, that of their bodies, in which the
+        interpreter runs them."""
         values = [self.fresh("v") for _ in op.sizes]
         for name, s in zip(values, op.sizes):
             self.put(level, f"{name} = {self.expr(s.value, scope)}")
         self.check(level, " and ".join(f"{name} >= 0.0" for name in values))
+        if len(op.axes) == 1:
+            self.split_axis(op, values, block, scope, level, depth)
+            return
+        laid = [self.split_axis(op, values, block, scope, level, depth, axis) for axis in op.axes]
+        n = len(op.sizes)
+        for cell in range(n ** len(op.axes)):
+            parts = [cell // n ** k % n for k in range(len(op.axes))]
+            self.put(level, f"if {' and '.join(laid[k][part][0] for k, part in enumerate(parts))}:")
+            placed, number = scope, 0
+            for k, (axis, part) in enumerate(zip(op.axes, parts)):
+                number += part * n ** k
+                _, at, length = laid[k][part]
+                placed = self.placed(placed, axis, at, length, level + 1,
+                                     f"child_key1({placed.key}, {op.site}, {number})")
+            self.child(op.parts[cell % len(op.parts)], block, placed, level + 1, depth)
+
+    def split_axis(self, op: ir.Split, values: list[str], block: Block, scope: Scope, level: int, depth: int,
+                   axis: int | None = None) -> list[tuple[str, str, str]]:
+        """The parts of ``split`` along one axis of ``scope``: relative sizes share what the absolute ones
+        leave, parts laid end to end, cut at the scope's end, those of length ``TOL.zero`` or less dropped.
+        Along ``axis``, the variables of each part's being made, start and length; else (a split of one
+        axis) each part's child and body in its place."""
+        along = op.axes[0] if axis is None else axis
+        extent = scope.size[along]
         absolute, relative, free, at = (self.fresh(stem) for stem in ("ab", "rl", "fr", "at"))
         self.put(level, f"{absolute} = 0.0")
         self.put(level, f"{relative} = 0.0")
@@ -466,7 +510,8 @@ class _Writer(SplitWriter):
         self.put(level, f"{free} = {extent} - {absolute}")
         self.put(level, f"{free} = max({free}, 0.0)")
         self.put(level, f"{at} = 0.0")
-        for k, (name, s, part) in enumerate(zip(values, op.sizes, op.parts)):
+        laid = []
+        for part, (name, s) in enumerate(zip(values, op.sizes)):
             step, end, length = (self.fresh(stem) for stem in ("sz", "en", "ln"))
             if s.kind is ir.SizeKind.RELATIVE:
                 self.put(level, f"{step} = {name} * {free} / {relative} if {relative} > 0.0 else 0.0")
@@ -474,51 +519,84 @@ class _Writer(SplitWriter):
                 self.put(level, f"{step} = {name}")
             self.put(level, f"{end} = {at} + {step}")
             self.put(level, f"{end} = min({end}, {extent})")
-            self.put(level, f"if {end} - {at} > {TOL.zero!r}:")
-            self.put(level + 1, f"{length} = {end} - {at}")
-            self.child(part, block, scope, axis, at, length, level + 1, depth, f"child_key1({scope.key}, {op.site}, {k})")
+            if axis is None:
+                self.put(level, f"if {end} - {at} > {TOL.zero!r}:")
+                self.put(level + 1, f"{length} = {end} - {at}")
+                placed = self.placed(scope, along, at, length, level + 1, f"child_key1({scope.key}, {op.site}, {part})")
+                self.child(op.parts[part], block, placed, level + 1, depth)
+            else:
+                made, start = self.fresh("mk"), self.fresh("ps")
+                self.put(level, f"{made} = {end} - {at} > {TOL.zero!r}")
+                self.put(level, f"{start} = {at}")
+                self.put(level, f"{length} = {end} - {at}")
+                laid.append((made, start, length))
             self.put(level, f"{at} = {at} + {step}")
+        return laid
 
     def repeat(self, op: ir.Repeat, block: Block, scope: Scope, level: int, depth: int) -> None:
-        """``kernels.split.repeat_counts`` and ``repeat`` for one parent: ceil(extent / size) equal
-        elements (at least one on a scope longer than ``TOL.zero``), element j in part j mod parts."""
-        axis, extent = op.axes[0], scope.size[op.axes[0]]
-        value, times, ceiling, step, j, pos = (self.fresh(s) for s in ("rv", "c", "x", "st", "j", "ps"))
-        self.put(level, f"{value} = {self.expr(op.sizes[0], scope)}")
-        self.check(level, f"{value} > 0.0")
+        """``kernels.split.repeat_counts`` and ``repeat`` for one parent along each of the split's axes in
+        turn: ceil(extent / size) equal elements (at least one on a scope longer than ``TOL.zero``), the
+        sizes evaluated once, on the parent; a cell numbered by its element along each axis (the first axis
+        fastest: an element's number times the elements of the axes before), its body the cell's number
+        modulo the bodies."""
+        values = [self.fresh("rv") for _ in op.sizes]
+        for name, size in zip(values, op.sizes):
+            self.put(level, f"{name} = {self.expr(size, scope)}")
+        self.check(level, " and ".join(f"{name} > 0.0" for name in values))
+        self.repeat_axis(op, values, block, scope, level, depth, 0, "0", "1")
+
+    def repeat_axis(self, op: ir.Repeat, values: list[str], block: Block, scope: Scope, level: int, depth: int,
+                    k: int, cell: str, stride: str) -> None:
+        """The elements of ``repeat`` along its ``k``-th axis, in the cell ``cell`` of the axes before it,
+        whose elements make ``stride`` cells. An axis after the first that makes no element is left to the
+        interpreter, which counted the cells before it toward --max-shapes."""
+        axis, extent, value = op.axes[k], scope.size[op.axes[k]], values[k]
+        times, ceiling, step, j, pos = (self.fresh(s) for s in ("c", "x", "st", "j", "ps"))
         self.put(level, f"{times} = 0")
         self.put(level, f"if {value} > 0.0 and {extent} > {TOL.zero!r}:")
         self.put(level + 1, f"{ceiling} = np.ceil({extent} / {value} - 1e-9)")
         self.put(level + 1, f"{times} = max(int({ceiling}) if {ceiling} < {MAX_COUNT} else {MAX_COUNT}, 1)")
-        self.put(level, f"if {times} > limit:")  # beyond --max-shapes: the interpreter fails the lot
-        self.put(level + 1, "bad[i] = True")
+        self.put(level, f"if {times} > limit{' or ' + times + ' == 0' if k else ''}:")  # the interpreter fails
+        self.put(level + 1, "bad[i] = True")  # the lot beyond --max-shapes
         self.put(level + 1, f"{times} = 0")
         self.put(level, f"{step} = {extent} / {times} if {times} > 0 else 0.0")
         self.put(level, f"for {j} in range({times}):")
         self.put(level + 1, "if n > limit:")
         self.put(level + 2, "break")
         self.put(level + 1, f"{pos} = {j} * {step}")
+        here = j
+        if k:
+            here = self.fresh("cl")
+            self.put(level + 1, f"{here} = {cell} + {j} * {stride}")
+        key = f"child_key1({scope.key}, {op.site}, {here})"
+        if k < len(op.axes) - 1:
+            placed = self.placed(scope, axis, pos, step, level + 1, key)
+            self.repeat_axis(op, values, block, placed, level + 1, depth, k + 1, here, f"{stride} * {times}")
+            return
         parts = len(op.parts)
-        for k, part in enumerate(op.parts):
+        for part, body in enumerate(op.parts):
             inner = level + 1
             if parts > 1:
-                self.put(level + 1, f"{'if' if k == 0 else 'elif'} {j} % {parts} == {k}:")
+                self.put(level + 1, f"{'if' if part == 0 else 'elif'} {here} % {parts} == {part}:")
                 inner = level + 2
-            self.child(part, block, scope, axis, pos, step, inner, depth, f"child_key1({scope.key}, {op.site}, {j})")
+            self.child(body, block, self.placed(scope, axis, pos, step, inner, key), inner, depth)
 
-    def child(self, part: ir.Body, block: Block, scope: Scope, axis: int, pos: str, length: str, level: int,
-              depth: int, key: str) -> None:
-        """A split child (``kernels.scope.place_children``: the origin moved by ``pos`` along the split
-        axis, the size cut to ``length``) with random key ``key``, and its part's body."""
+    def placed(self, scope: Scope, axis: int, pos: str, length: str, level: int, key: str) -> Scope:
+        """A split child's scope (``kernels.scope.place_children``: the origin moved by ``pos`` along the
+        split axis, the size cut to ``length``) with random key ``key``."""
         moved = []
         for j in range(3):
             moved.append(self.fresh("o"))
             self.put(level, f"{moved[-1]} = {scope.origin[j]} + {pos} * frames[f, {axis}, {j}]")
         self.within_coordinates(level, moved)
         cut = tuple(length if k == axis else scope.size[k] for k in range(3))
+        return scope._replace(origin=tuple(moved), size=cut, key=key)
+
+    def child(self, part: ir.Body, block: Block, scope: Scope, level: int, depth: int) -> None:
+        """A split's cell, one more shape of the parent, and its part's body."""
         self.made(level)
         self.put(level, "pass")
-        self.body(part, block, scope._replace(origin=tuple(moved), size=cut, key=key), level, depth)
+        self.body(part, block, scope, level, depth)
 
     def emit(self, block: Block, asset: int, symbol: int, scope: Scope, level: int) -> None:
         """An emission site of ``asset`` and its record of the scope."""

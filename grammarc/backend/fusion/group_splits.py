@@ -73,7 +73,8 @@ class SplitWriter:
         key = self.piece(stream, inner + 1)
         for k, part in enumerate(op.parts):
             self.put(inner + 1, f"{'if' if k == 0 else 'elif'} {made[1]}[{c}] == {k}:")
-            self.child(part, block, scope, op.axis, f"{made[2]}[{c}]", f"{made[3]}[{c}]", inner + 2, depth, key)
+            self.child(part, block, self.placed(scope, op.axis, f"{made[2]}[{c}]", f"{made[3]}[{c}]", inner + 2, key),
+                       inner + 2, depth)
 
     def written_out(self, op: ir.GroupSplit, kind: list[int], groups: list[int], block: Block, scope: Scope,
                     level: int, depth: int) -> None:
@@ -183,7 +184,8 @@ class SplitWriter:
             self.put(level, f"{stop} = min({at} + {size}, {extent})")
             self.put(level, f"if {stop} - {at} > {TOL.merge!r}:")
             self.put(level + 1, f"{length} = {stop} - {at}")
-            self.child(part, block, scope, op.axis, at, length, level + 1, depth, self.piece(stream, level + 1))
+            self.child(part, block, self.placed(scope, op.axis, at, length, level + 1, self.piece(stream, level + 1)),
+                       level + 1, depth)
             self.put(level, f"{at} += {size}")
 
     def piece(self, stream: str, level: int) -> str:

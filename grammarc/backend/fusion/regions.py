@@ -2,8 +2,8 @@
 
 A region is a symbol (its *root*) with the symbols its rules lead to, all derived by one generated kernel
 (``codegen``) from the root's pending shapes: no intermediate shape columns, the terminals written straight
-into the records. It covers what needs no context: the scope operations ``S`` and ``T``, single-axis
-``Subdiv`` and ``Repeat`` (no snapping), ``I``, ``ε``, ``[ ]``, successor symbols (with arguments), leaves
+into the records. It covers what needs no context: the scope operations ``S`` and ``T``, ``Subdiv`` and
+``Repeat`` along one axis or several (no snapping), ``I``, ``ε``, ``[ ]``, successor symbols (with arguments), leaves
 (a successor without rules, or ``X.``, without arguments: its box or rectangle is a record at once, as
 ``terminals.emit_leaves`` makes it), guards and sizes made of numbers, attributes, parameters (numbers,
 booleans), ``scope.sx|sy|sz``, arithmetic, ``min``, ``max``, ``rand`` and ``p``, and stochastic rules (their
@@ -205,9 +205,7 @@ class Fusible:
             return _first(self.expr(e) for e in op.vector)
         if isinstance(op, (ir.Split, ir.Repeat, ir.GroupSplit)) and SPLIT_CONTEXT & self.plan.dynamic.keys():
             return _refused(op, "a split whose `split.index` or `split.total` a rule reads")
-        if isinstance(op, (ir.Split, ir.Repeat)):
-            if len(op.axes) != 1 or op.snap:
-                return _refused(op, "a split of several axes or one that snaps")
+        if isinstance(op, (ir.Split, ir.Repeat)):  # one that snaps keeps its symbol out (``_read_rules``)
             sizes = (s.value for s in op.sizes) if isinstance(op, ir.Split) else op.sizes
             return _first(self.expr(e) for e in sizes) or _first(self.body(part) for part in op.parts)
         if type(op) is ir.GroupSplit:  # not its subclass ``splitArea``, whose layout needs the geometry

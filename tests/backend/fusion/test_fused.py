@@ -12,7 +12,7 @@ import pytest
 from conftest import make_lots
 
 from grammarc.backend import execute
-from grammarc.backend.fusion import compiled
+from grammarc.backend.fusion import codegen, compiled
 from grammarc.backend.fusion.fused import derive as derive_fused
 from grammarc.backend.fusion.fused import preload
 from grammarc.backend.fusion.regions import SWITCH
@@ -93,6 +93,22 @@ cell ~> S(1r, rand(2), 1r) Subdiv("Y", 1r, rand(0.5, 1)){ pick | I("cube") } : 0
      ~> [ T(0, rand(), 0) I("quad") ] pick : 0.5
      ~> ε : 0.2
 pick ~> Repeat("X", 0.7){ I("cube") } : 0.5
+     ~> S(1r, rand(1, 2), 1r) I("quad") : 0.5
+"""
+
+#: Splits along several axes: a cell numbered by its part (``Subdiv``) or element (``Repeat``) along each axis,
+#: the first fastest, its body the number modulo the bodies; a repeat of one body and of two, the keys handed
+#: to ``post`` (a region of its own) and drawn from in ``bed`` and ``pick``; ``flat``'s first batch holds a
+#: scope of no height, whose y makes no element: the interpreter derives that batch.
+AXES = """
+attr w = 2.5
+lot ~> S(1r, 4, 1r) Subdiv("X", 1r, 1r, 1r){ yard | S(1r, 0, 1r) flat | flat }
+yard ~> Subdiv("XZ", 0.45, 1r, 0.45){ post | ε | post | ε | court | ε | post | ε | post }
+court ~> Repeat("XZ", w, 3){ bed | pick }
+bed ~> S(1r, rand(0.2, 0.6), 1r) I("cube")
+post ~> Repeat("XY", 0.2, 1.5){ I("quad") }
+flat ~> Repeat("XYZ", 2, 1, 3){ I("cube") | I("quad") }
+pick ~> I("cube") : 0.5
      ~> S(1r, rand(1, 2), 1r) I("quad") : 0.5
 """
 
@@ -338,6 +354,13 @@ def test_recursion_is_derived_round_after_round(write, monkeypatch):
     assert_same(fused, interpreted)
 
 
+def test_splits_along_several_axes_are_the_interpreters(write, monkeypatch):
+    plan = make_plan(compile_grammar(write("g.cga", AXES)))
+    assert {plan.symbols[k].name for k in plan.fused} == {"lot", "yard", "court", "post", "flat"}
+    fused, interpreted = both(write, monkeypatch, AXES, cityengine_lots())
+    assert fused["kernels"] == 2 and len(fused["asset"]) > 1000  # ``lot``'s and ``post``'s; ``flat``'s declined
+    assert_same(fused, interpreted)
+
 def test_parameters_and_brackets(write, monkeypatch):
     plan = make_plan(compile_grammar(write("g.cga", PASSED_ON)))
     assert {plan.symbols[k].name for k in plan.fused} == {"facade", "storey", "bay"}
@@ -483,6 +506,24 @@ def test_cityengine_regions_take_and_hand_off_parameters_of_strings_and_booleans
     # the tiles' and bands' textures, the strings handed to them, and the windows' dirt maps
     assert {"brick.jpg", "wall.jpg", "dirt.jpg"} <= set(np.unique(fused["material"]).tolist())
     assert (255, 0, 0, 255) in {tuple(c) for c in fused["color"].tolist()}  # the bands of "band.jpg"
+    assert_same(fused, interpreted)
+
+def test_a_region_past_its_most_lines_hands_off_the_symbols_it_would_inline(write, monkeypatch):
+    """``codegen.MAX_LINES``: the facades' region, which inlines floors, tiles and windows, hands off the
+    largest of them (its floors) until its function fits; the records stay the interpreter's."""
+
+    def facade(plan):
+        (region,) = (r for k, r in plan.fused.items() if plan.symbols[k].name == "Facade")
+        return region.source
+
+    whole = facade(make_plan(compile_grammar(write("g.cga", CENTERED))))
+    lines = whole.text.count("\n") - whole.text[:whole.text.index("def derive(")].count("\n")
+    monkeypatch.setattr(codegen, "MAX_LINES", lines // 2)
+    cut = facade(make_plan(compile_grammar(write("g.cga", CENTERED))))
+    assert cut.text.count("\n") - cut.text[:cut.text.index("def derive(")].count("\n") <= lines // 2
+    assert (whole.sites, cut.sites, cut.handoffs) == (6, 0, 1)  # its floors handed off, with all below them
+    fused, interpreted = both(write, monkeypatch, CENTERED, cityengine_lots())
+    assert fused["kernels"] >= 2  # the facades', and the floors' of their own
     assert_same(fused, interpreted)
 
 def test_a_colour_that_is_none_fails_its_lot_as_the_interpreter_fails_it(write, monkeypatch):

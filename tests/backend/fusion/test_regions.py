@@ -72,6 +72,16 @@ band(k) ~> Subdiv("Y", k, 1r){ socle(k) | plaster }
 """) == {"lot"}
 
 
+def test_splits_along_several_axes_are_fused_but_those_that_snap(write):
+    plan = make_plan(compile_grammar(write("g.cga", """
+lot ~> Subdiv("X", 1r, 1r, 1r){ a | b | d }
+a ~> Subdiv("XZ", 1, 1r){ I("cube") | ε | ε | I("quad") }
+b ~> Repeat("XYZ", 1, 2, 3){ I("cube") | I("quad") }
+d ~> Repeat("XS", 1){ I("cube") }
+""")))
+    assert {plan.symbols[k].name for k in plan.fused} == {"lot", "a", "b"}  # ``lot`` hands ``d`` its shapes
+    assert symbol_refusals(plan)["d"].what == "`d` snaps"
+
 def test_random_choices_min_max_rand_and_parameters_are_fused_other_functions_not(write):
     assert fused(write, """
 lot ~> Subdiv("X", 1r, rand(1, 2)){ a(2) | b }
