@@ -631,7 +631,8 @@ class _Sink:
                 self._crc[key] = crc32(data, self._crc[key])
                 if key in self._starts:
                     if self._regions is not None and self._size[key] + len(data) > _REGION - _SLACK:
-                        raise OSError(errno.EFBIG, f"the record's {key} column passes {(_REGION - _SLACK) >> 30} GiB")
+                        room = (_REGION - _SLACK) >> 30
+                        raise OSError(errno.EFBIG, f"the record's {key} column passes {room} GiB")
                     _write_all(self._fds[""], data, self._starts[key] + self._size[key])
                 else:
                     _write_all(self._fds[key], data)

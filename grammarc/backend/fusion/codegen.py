@@ -469,10 +469,9 @@ class _Writer(SplitWriter):
         """``kernels.split.subdiv`` for one parent (``split_axis``), along each of the split's axes in turn
         (``operations.splits._fan_out``): the sizes evaluated once, on the parent, and laid again along
         each axis, whose extent no cut along another changes; a cell numbered by its part along each axis
-        (the first axis fastest), its body the cell's number modulo the bodies (``regions`` takes a split
-        whose bodies have a cell each), its scope cut axis after axis and its key mixed level after level.
-        The cells are written in the order of their numbers, that of their bodies, in which the
-        interpreter runs them."""
+        (the first axis fastest), its body the cell's (the paper's ``Subdiv`` has one for each cell), its
+        scope cut axis after axis and its key mixed level after level. The cells are written in the order
+        of their numbers, that of their bodies, in which the interpreter runs them."""
         values = [self.fresh("v") for _ in op.sizes]
         for name, s in zip(values, op.sizes):
             self.put(level, f"{name} = {self.expr(s.value, scope)}")

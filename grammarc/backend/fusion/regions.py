@@ -3,9 +3,9 @@
 A region is a symbol (its *root*) with the symbols its rules lead to, all derived by one generated kernel
 (``codegen``) from the root's pending shapes: no intermediate shape columns, the terminals written straight
 into the records. It covers what needs no context: the scope operations ``S`` and ``T``, ``Subdiv`` and
-``Repeat`` along one axis or several (no snapping), ``I``, ``ε``, ``[ ]``, successor symbols (with arguments), leaves
-(a successor without rules, or ``X.``, without arguments: its box or rectangle is a record at once, as
-``terminals.emit_leaves`` makes it), guards and sizes made of numbers, attributes, parameters (numbers,
+``Repeat`` along one axis or several (no snapping), ``I``, ``ε``, ``[ ]``, successor symbols (with
+arguments), leaves (a successor without rules, or ``X.``, without arguments: its box or rectangle is a
+record at once, as ``terminals.emit_leaves`` makes it), guards and sizes made of numbers, attributes, parameters (numbers,
 booleans), ``scope.sx|sy|sz``, arithmetic, ``min``, ``max``, ``rand`` and ``p``, and stochastic rules (their
 draws and ``rand``'s from the shape's counter-based stream, ``backend.random``, whose keys the kernel
 carries). In CityEngine's dialect it covers ``s``, ``t`` and ``center``, ``split`` of the scope (its repeat
