@@ -225,20 +225,12 @@ class Fusible:
             # derived here, or handed off: its shapes wait for its turn with their parameters
             if any(t not in PARAMETERS for t in target.param_types):
                 return _refused(op, "a successor with a parameter that is not a number, a boolean or a string")
-            for arg, t in zip(op.args, target.param_types):
-                if t is ir.Type.STR and not self.string(arg):
-                    return _refused(arg, "a string other than a constant, an attribute or a parameter")
-                if t is not ir.Type.STR and (why := self.expr(arg)):
-                    return why
-            return None
+            return _first(self.value(arg, t) for arg, t in zip(op.args, target.param_types))
         if isinstance(op, (ir.Case, ir.Stochastic)):  # conditions, or percentages
             return (_first(self.expr(value) for value, _ in op.branches)
                     or _first(self.body(body) for body in (*(body for _, body in op.branches), op.default)))
         if isinstance(op, ir.SetAttr):
-            if self.types.get(op.name) is ir.Type.STR:
-                return None if self.string(op.value) else _refused(op.value, "a string other than a constant, an "
-                                                                              "attribute or a parameter")
-            return self.expr(op.value)
+            return self.value(op.value, self.types.get(op.name))
         if isinstance(op, ir.SetColor):
             if len(op.values) == 3:
                 return _first(self.expr(value) for value in op.values)
@@ -250,6 +242,14 @@ class Fusible:
         if isinstance(op, (ir.Insert, ir.Empty, ir.Push, ir.Pop, ir.NotApplied, ir.Center)):
             return None
         return _refused(op, "an operation no kernel takes")
+
+    def value(self, expr: ir.Expr, kind: ir.Type | None) -> Refusal | None:
+        """Why ``expr`` is no value of type ``kind`` a kernel takes (an attribute ``set``, a successor's
+        argument): a string as ``string`` says, anything else as ``expr`` does."""
+        if kind is ir.Type.STR:
+            return None if self.string(expr) else _refused(expr, "a string other than a constant, an attribute or "
+                                                                 "a parameter")
+        return self.expr(expr)
 
     def string(self, expr: ir.Expr) -> bool:
         """Whether ``expr`` is a string a kernel takes as a value: a constant, a string attribute or a string
