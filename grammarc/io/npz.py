@@ -503,9 +503,9 @@ class _Sink:
         self._thread: threading.Thread | None = None
         try:
             self._fds[""] = _create(self.path)
-            # where each column's data goes in the output, or None: into spool files
+            # where each column's data goes in the output; none: into spool files
             self._regions = _regions(self._fds[""])
-            if self._regions is None:
+            if not self._regions:
                 for key in _SPOOLED:
                     if key != _STREAMED:
                         self._fds[key] = _create(os.path.join(tmpdir, key))
@@ -517,7 +517,7 @@ class _Sink:
             self._head_size = len(head)
             # For _FADVISE: where each column written in place starts, and how far its data is on disk
             # (dropped from memory) and on its way there (written back)
-            self._starts = {_STREAMED: self._head_size, **(self._regions or {})}
+            self._starts = {_STREAMED: self._head_size, **self._regions}
             self._dropped = dict(self._starts)
             self._written = dict(self._starts)
             self._thread = threading.Thread(target=self._run, name=f"InstanceWriter {name}", daemon=True)
@@ -568,7 +568,7 @@ class _Sink:
                 local = _local_header(name, crc, size, -(position + len(local) + len(header) + len(body) + 4)
                                       % _ALIGN + 4)
             start = position + len(local) + len(header) + len(body)  # where the thread's bytes of the member go
-            if self._regions is not None and key in self._regions:
+            if key in self._regions:
                 gap = self._regions[key] - removed - start
                 if gap < 0:
                     raise OSError(errno.EFBIG, f"the record's columns before {key} pass the room left for them")
@@ -630,7 +630,7 @@ class _Sink:
             if len(data):
                 self._crc[key] = crc32(data, self._crc[key])
                 if key in self._starts:
-                    if self._regions is not None and self._size[key] + len(data) > _REGION - _SLACK:
+                    if self._regions and self._size[key] + len(data) > _REGION - _SLACK:
                         room = (_REGION - _SLACK) >> 30
                         raise OSError(errno.EFBIG, f"the record's {key} column passes {room} GiB")
                     _write_all(self._fds[""], data, self._starts[key] + self._size[key])
@@ -737,12 +737,12 @@ def _fallocate():
 _FALLOCATE = _fallocate()
 
 
-def _regions(fd: int) -> dict[str, int] | None:
+def _regions(fd: int) -> dict[str, int]:
     """The offset of each spooled column's region in the new, empty file ``fd``, which this makes as large as
-    they need (holes), or None where its filesystem cannot collapse a range out of a file (tried on its first
+    they need (holes); none where its filesystem cannot collapse a range out of a file (tried on its first
     blocks) or hold a file that large."""
     if _FALLOCATE is None:
-        return None
+        return {}
     keys = [key for key in _KEYS if key in _SPOOLED and key != _STREAMED]
     try:
         os.ftruncate(fd, 2 * _ALIGN)
@@ -752,8 +752,8 @@ def _regions(fd: int) -> dict[str, int] | None:
             os.ftruncate(fd, (len(keys) + 1) * _REGION)
     except OSError:
         os.ftruncate(fd, 0)
-        return None
-    return {key: (k + 1) * _REGION for k, key in enumerate(keys)} if collapses else None
+        return {}
+    return {key: (k + 1) * _REGION for k, key in enumerate(keys)} if collapses else {}
 
 
 def _collapse(fd: int, offset: int, length: int) -> None:

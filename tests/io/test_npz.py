@@ -548,7 +548,7 @@ def collapses(folder) -> bool:
     """Whether the filesystem of ``folder`` takes ranges out of files (``npz._regions``)."""
     fd = os.open(folder / "probe", os.O_RDWR | os.O_CREAT)
     try:
-        return npz._regions(fd) is not None
+        return bool(npz._regions(fd))
     finally:
         os.close(fd)
         os.unlink(folder / "probe")
